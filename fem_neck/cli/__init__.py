@@ -1,0 +1,82 @@
+"""Command-line plumbing shared by the ``python -m fem_neck`` sub-commands.
+
+Each sub-command lives in its own module of this package and exposes ``register(subparsers)``, which adds its
+parser and sets ``run``: a function of the parsed arguments returning a JSON-ready dict. :func:`main` prints that
+dict (``--json``: one object on stdout, nothing else), turns a ``ValueError`` into one line on stderr with exit code
+2, and never shows a traceback for bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import re
+import sys
+
+COMMAND_MODULES = ("neck",)  # each module imports its heavy dependencies (gmsh, scikit-fem) inside run()
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An argparse parser whose usage errors are one line on stderr and exit code 2.
+
+    Negative numbers in scientific notation (``--ri -1e-3``) are read as values, not as options, so that the
+    command can reject them with a message about the value.
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$", re.I)
+
+    def error(self, message):
+        sys.stderr.write(f"{self.prog}: error: {message}\n")
+        raise SystemExit(2)
+
+
+def add_output_options(parser: argparse.ArgumentParser) -> None:
+    """The options every sub-command shares: ``--json`` and ``--out DIR``."""
+    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout, nothing else")
+    parser.add_argument("--out", metavar="DIR", default=None, help="write result files into DIR")
+
+
+def _format(value) -> str:
+    if isinstance(value, float):
+        return f"{value:.10g}"
+    if isinstance(value, (list, tuple)) and len(value) > 8:
+        return f"[{len(value)} items]"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_format(v) for v in value) + "]"
+    return str(value)
+
+
+def print_result(result: dict, as_json: bool) -> None:
+    """``--json``: one JSON object; otherwise one ``key: value`` line per entry."""
+    if as_json:
+        json.dump(result, sys.stdout)
+        sys.stdout.write("\n")
+    else:
+        width = max((len(k) for k in result), default=0)
+        for key, value in result.items():
+            print(f"{key:<{width}}  {_format(value)}")
+
+
+def build_parser(prog: str, description: str, modules, package: str) -> argparse.ArgumentParser:
+    parser = OneLineParser(prog=prog, description=description)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=OneLineParser)
+    sub.required = True
+    for name in modules:
+        importlib.import_module(f"{package}.{name}").register(sub)
+    return parser
+
+
+def main(argv=None, *, prog="python -m fem_neck", description=None, modules=COMMAND_MODULES,
+         package="fem_neck.cli") -> int:
+    parser = build_parser(prog, description or __doc__.splitlines()[0], modules, package)
+    args = parser.parse_args(argv)
+    try:
+        result = args.run(args)
+    except ValueError as exc:
+        sys.stderr.write(f"{prog} {args.command}: error: {exc}\n")
+        return 2
+    print_result(result, args.json)
+    return 0

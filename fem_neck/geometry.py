@@ -1,0 +1,212 @@
+"""Neck geometry of two sintered spheres (Rojek, Kasztelan & Tharmaraj 2022, Section 4).
+
+Two spheres of radii ``r_i`` and ``r_j`` overlap by ``h = r_i + r_j - d`` (eq. 21). Three models of the neck:
+
+* ``"coble"`` -- Coble's neck ``a = sqrt(2 r* h)`` with the effective radius ``r* = 2 r_i r_j / (r_i + r_j)``
+  (eqs. 10-12). It does not conserve volume and over-estimates the neck.
+* ``"newton"`` -- the volume-conserving cylindrical neck: a cylinder of radius ``a`` and height ``h_n`` whose
+  volume equals the two spherical caps it replaces (eqs. 22-29). Solved by Newton's method on ``Z(a)`` (eqs. 27,
+  31, 32) from Coble's start (eq. 33). For equal radii it reproduces the closed form of eqs. (18)-(20).
+* ``"first"`` -- the first Newton iterate from Coble's start (eq. 34), a cheap approximation.
+
+Numerics. With ``h_c(a) = r - sqrt(r^2 - a^2)`` (eqs. 28-29) the identity ``d/dh_c [h_c^2 (3r - h_c)] = 3 a^2``
+reduces the derivative of eq. (31) to ``Z'(a) = 6 a h_n``, and dividing eq. (27) by ``3 a^2`` gives
+
+    G(a) = Z / (3 a^2) = phi(h_ci; r_i) + phi(h_cj; r_j) - h,   phi(h_c; r) = h_c (3r - 2h_c) / (3 (2r - h_c)),
+
+which is strictly increasing in ``a`` on ``[0, min(r_i, r_j)]``: the root is unique, and the Newton step of eq. (32),
+``a - Z/Z' = a - a G / (2 h_n)``, is evaluated from ``G`` without the cancellation of eq. (27) for small necks.
+``Z`` is convex where ``h_n > 0``, so Newton started to the right of the root decreases monotonically onto it.
+Coble's start lies to the right in the cases of the paper; where it does not (or lies beyond the smaller radius)
+the iteration starts from the bracket's right end ``a = min(r_i, r_j)`` instead, so it never diverges.
+
+The model's range: a solution exists for ``0 < h <= max_overlap(r_i, r_j)``, where ``a`` reaches the smaller radius
+(``2r/3`` for equal spheres, Section 4.2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+METHODS = ("newton", "first", "coble")
+_MAX_ITERATIONS = 60
+
+
+@dataclass(frozen=True)
+class NeckGeometry:
+    """The full geometry of a sintered pair; every field is an array of the broadcast input shape (or a float).
+
+    a: neck radius; h_ci, h_cj: heights of the caps cut from sphere i and j (eqs. 28-29); h_n: neck (cylinder)
+    length (eq. 24); d: centre distance (eq. 21); z_i, z_j: distance from each centre to its cap's base plane, so the
+    neck spans ``z_i <= z <= z_i + h_n`` measured from centre i and ``z_i + h_n + z_j = d``; volume_residual:
+    ``|V_cyl - V_cap,i - V_cap,j| / V_cyl`` (eq. 22); iterations: Newton iterations taken (0 for Coble).
+    """
+
+    r_i: np.ndarray
+    r_j: np.ndarray
+    h: np.ndarray
+    a: np.ndarray
+    h_ci: np.ndarray
+    h_cj: np.ndarray
+    h_n: np.ndarray
+    d: np.ndarray
+    z_i: np.ndarray
+    z_j: np.ndarray
+    volume_residual: np.ndarray
+    iterations: int
+    method: str
+
+    def as_dict(self) -> dict:
+        """Plain-Python dict (floats or lists), ready for JSON."""
+        out = {}
+        for key, value in self.__dict__.items():
+            if isinstance(value, np.ndarray):
+                value = value.item() if value.ndim == 0 else value.tolist()
+            out[key] = value
+        return out
+
+
+def check_positive(name: str, value, upper=None, upper_name: str | None = None) -> np.ndarray:
+    """Return ``value`` as a float array, raising ``ValueError`` unless every entry is finite and ``> 0``.
+
+    With ``upper`` also require ``value <= upper`` (``upper_name`` says what that bound is).
+    """
+    arr = np.asarray(value, dtype=float)
+    bad = ~np.isfinite(arr) | (arr <= 0.0)
+    if upper is not None:
+        bad |= arr > np.asarray(upper, dtype=float)
+    if np.any(bad):
+        idx = np.flatnonzero(bad)[0]
+        shown = arr.flat[idx]
+        where = "" if arr.ndim == 0 else f"[{idx}]"
+        if upper is None:
+            valid = "must be finite and > 0"
+        else:
+            bound = np.broadcast_to(upper, arr.shape).flat[idx]
+            valid = f"valid range 0 < {name} <= {bound:.9g}" + (f" ({upper_name})" if upper_name else "")
+        raise ValueError(f"{name}{where} = {shown:.9g}: {valid}")
+    return arr
+
+
+def cap_height(r, a):
+    """Height of the spherical cap of radius ``r`` with base radius ``a`` (Rojek 2022, eqs. 28-29).
+
+    Written as ``a^2 / (r + sqrt(r^2 - a^2))`` so that small caps keep full relative precision.
+    """
+    return a * a / (r + np.sqrt(np.maximum((r - a) * (r + a), 0.0)))
+
+
+def _phi(h_c, r):
+    """Cap height minus the share of the neck length it fills; ``sum(phi) = h`` at the volume-conserving root."""
+    return h_c * (3.0 * r - 2.0 * h_c) / (3.0 * (2.0 * r - h_c))
+
+
+def max_overlap(r_i, r_j):
+    """Largest overlap ``h`` for which the cylindrical neck exists: ``a`` reaches ``min(r_i, r_j)``.
+
+    Equal spheres: ``2r/3`` (from eq. 18 with ``h_c = r``). Unequal: the smaller sphere's cap is a hemisphere.
+    """
+    r_i = np.asarray(r_i, dtype=float)
+    r_j = np.asarray(r_j, dtype=float)
+    r_min = np.minimum(r_i, r_j)
+    r_max = np.maximum(r_i, r_j)
+    return r_min / 3.0 + _phi(cap_height(r_max, r_min), r_max)
+
+
+def coble_radius(r_i, r_j, h):
+    """Coble's neck radius ``sqrt(2 r* h)``, ``r* = 2 r_i r_j / (r_i + r_j)`` (Rojek 2022, eqs. 11-12)."""
+    return np.sqrt(4.0 * r_i * r_j / (r_i + r_j) * h)
+
+
+def equal_neck_radius(r, h):
+    """Closed-form volume-conserving neck of two equal spheres (Rojek 2022, eqs. 18-20).
+
+    The small root of eq. (18) is written as ``2c / (b + sqrt(b^2 - 16c))`` with the discriminant factorised,
+    ``9(2r+h)^2 - 96rh = (2r - 3h)(18r - 3h)``, so it is accurate for small and for limiting overlaps alike.
+    """
+    r = np.asarray(r, dtype=float)
+    h = np.asarray(h, dtype=float)
+    disc = np.maximum((2.0 * r - 3.0 * h) * (18.0 * r - 3.0 * h), 0.0)
+    h_c = 12.0 * r * h / (3.0 * (2.0 * r + h) + np.sqrt(disc))
+    return np.sqrt(h_c * (2.0 * r - h_c))
+
+
+def _newton_step(a, r_i, r_j, h):
+    """One step of eq. (32) for ``Z``: ``a - Z/Z' = a - a G(a) / (2 h_n(a))``; returns (new a, G)."""
+    h_ci = cap_height(r_i, a)
+    h_cj = cap_height(r_j, a)
+    g = _phi(h_ci, r_i) + _phi(h_cj, r_j) - h
+    h_n = h_ci + h_cj - h
+    return a - a * g / (2.0 * h_n), g
+
+
+def _validated(r_i, r_j, h):
+    r_i = check_positive("r_i", r_i)
+    r_j = check_positive("r_j", r_j)
+    h = np.asarray(h, dtype=float)
+    if h.ndim == 0 and r_i.ndim == 0 and r_j.ndim == 0:
+        h_max = max_overlap(r_i, r_j)
+        h = check_positive("h", h, upper=h_max, upper_name="the neck reaches the smaller radius")
+    else:
+        r_i, r_j, h = np.broadcast_arrays(r_i, r_j, h)
+        h = check_positive("h", h, upper=max_overlap(r_i, r_j), upper_name="the neck reaches the smaller radius")
+    return r_i, r_j, h
+
+
+def _solve(r_i, r_j, h, method):
+    """Neck radius and Newton iteration count for validated, broadcast inputs."""
+    a0 = coble_radius(r_i, r_j, h)
+    if method == "coble":
+        return a0, 0
+    r_min = np.minimum(r_i, r_j)
+    a = np.minimum(a0, r_min)
+    if method == "first":
+        # Eq. (34) taken literally: one Newton step from Coble's radius.
+        return _newton_step(a, r_i, r_j, h)[0], 1
+    # Bracketing fallback: start where G >= 0 (right of the unique root) so the convex Newton descent is monotone.
+    g0 = _phi(cap_height(r_i, a), r_i) + _phi(cap_height(r_j, a), r_j) - h
+    a = np.where(g0 < 0.0, r_min, a)
+    iterations = 0
+    for iterations in range(1, _MAX_ITERATIONS + 1):
+        a_new, g = _newton_step(a, r_i, r_j, h)
+        # Monotone from the right: a step that would leave the bracket can only be round-off at the root.
+        a_new = np.clip(a_new, 0.0, a)
+        a_new = np.where(g <= 0.0, a, a_new)
+        step = np.abs(a - a_new)
+        a = a_new
+        if np.all(step <= 4.0 * np.finfo(float).eps * a):
+            break
+    return a, iterations
+
+
+def neck_radius(r_i, r_j, h, method: str = "newton"):
+    """Neck radius ``a`` of two spheres of radii ``r_i``, ``r_j`` overlapping by ``h`` (all in metres).
+
+    Vectorised over arrays (broadcast together); a scalar call returns a float. ``method`` is ``"newton"``
+    (volume-conserving, Rojek 2022 eqs. 27-33, default), ``"first"`` (eq. 34) or ``"coble"`` (eqs. 11-12).
+    Raises ``ValueError`` for non-positive or non-finite input, or ``h`` beyond :func:`max_overlap`.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
+    r_i, r_j, h = _validated(r_i, r_j, h)
+    a, _ = _solve(r_i, r_j, h, method)
+    return float(a) if np.ndim(a) == 0 else a
+
+
+def neck_geometry(r_i, r_j, h, method: str = "newton") -> NeckGeometry:
+    """All of the neck geometry (Rojek 2022, eqs. 21-29); see :class:`NeckGeometry`."""
+    if method not in METHODS:
+        raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
+    r_i, r_j, h = _validated(r_i, r_j, h)
+    a, iterations = _solve(r_i, r_j, h, method)
+    h_ci = cap_height(r_i, a)
+    h_cj = cap_height(r_j, a)
+    h_n = h_ci + h_cj - h
+    # |V_cyl - V_caps| / V_cyl = |Z| / (3 a^2 h_n) = |G| / h_n  (eq. 27 divided by 3 a^2)
+    residual = np.abs(_phi(h_ci, r_i) + _phi(h_cj, r_j) - h) / np.abs(h_n)
+    return NeckGeometry(
+        r_i=r_i, r_j=r_j, h=h, a=a, h_ci=h_ci, h_cj=h_cj, h_n=h_n, d=r_i + r_j - h,
+        z_i=np.sqrt((r_i - a) * (r_i + a)), z_j=np.sqrt((r_j - a) * (r_j + a)), volume_residual=residual, iterations=iterations, method=method,
+    )
