@@ -4,6 +4,13 @@
 scikit-fem only when used.
 """
 
-from fem_neck.geometry import NeckGeometry, coble_radius, max_overlap, neck_geometry, neck_radius
+from fem_neck.geometry import (
+    NeckGeometry,
+    coble_radius,
+    max_overlap,
+    neck_geometry,
+    neck_radius,
+    overlap_for_neck,
+)
 
-__all__ = ["NeckGeometry", "coble_radius", "max_overlap", "neck_geometry", "neck_radius"]
+__all__ = ["NeckGeometry", "coble_radius", "max_overlap", "neck_geometry", "neck_radius", "overlap_for_neck"]

@@ -115,6 +115,19 @@ def max_overlap(r_i, r_j):
     return r_min / 3.0 + _phi(cap_height(r_max, r_min), r_max)
 
 
+def overlap_for_neck(r_i, r_j, a):
+    """Inverse of the volume-conserving neck: the overlap ``h`` at which the neck radius is ``a``.
+
+    From ``G(a) = 0``: ``h = phi(h_ci) + phi(h_cj)``; for equal spheres ``h = 2 h_c (3r - 2h_c) / (3 (2r - h_c))``,
+    which is eq. (18) solved for ``h``. Valid for ``0 < a <= min(r_i, r_j)``.
+    """
+    r_i = check_positive("r_i", r_i)
+    r_j = check_positive("r_j", r_j)
+    a = check_positive("a", a, upper=np.minimum(r_i, r_j), upper_name="the smaller radius")
+    h = _phi(cap_height(r_i, a), r_i) + _phi(cap_height(r_j, a), r_j)
+    return float(h) if np.ndim(h) == 0 else h
+
+
 def coble_radius(r_i, r_j, h):
     """Coble's neck radius ``sqrt(2 r* h)``, ``r* = 2 r_i r_j / (r_i + r_j)`` (Rojek 2022, eqs. 11-12)."""
     return np.sqrt(4.0 * r_i * r_j / (r_i + r_j) * h)
