@@ -32,6 +32,7 @@ import numpy as np
 
 METHODS = ("newton", "first", "coble")
 _MAX_ITERATIONS = 60
+_LIMIT_SLACK = 1e-12  # relative round-off tolerated beyond the model's largest overlap
 
 
 @dataclass(frozen=True)
@@ -85,7 +86,7 @@ def check_positive(name: str, value, upper=None, upper_name: str | None = None) 
             valid = "must be finite and > 0"
         else:
             bound = np.broadcast_to(upper, arr.shape).flat[idx]
-            valid = f"valid range 0 < {name} <= {bound:.9g}" + (f" ({upper_name})" if upper_name else "")
+            valid = f"valid range 0 < {name} <= {bound:.12g}" + (f" ({upper_name})" if upper_name else "")
         raise ValueError(f"{name}{where} = {shown:.9g}: {valid}")
     return arr
 
@@ -159,12 +160,12 @@ def _validated(r_i, r_j, h):
     r_i = check_positive("r_i", r_i)
     r_j = check_positive("r_j", r_j)
     h = np.asarray(h, dtype=float)
-    if h.ndim == 0 and r_i.ndim == 0 and r_j.ndim == 0:
-        h_max = max_overlap(r_i, r_j)
-        h = check_positive("h", h, upper=h_max, upper_name="the neck reaches the smaller radius")
-    else:
+    if not (h.ndim == 0 and r_i.ndim == 0 and r_j.ndim == 0):
         r_i, r_j, h = np.broadcast_arrays(r_i, r_j, h)
-        h = check_positive("h", h, upper=max_overlap(r_i, r_j), upper_name="the neck reaches the smaller radius")
+    h_max = max_overlap(r_i, r_j)
+    # an overlap at the limit computed in another way may exceed h_max by round-off: that is the limit itself
+    h = np.where(h > h_max, np.where(h <= h_max * (1.0 + _LIMIT_SLACK), h_max, h), h)
+    h = check_positive("h", h, upper=h_max, upper_name="the neck reaches the smaller radius")
     return r_i, r_j, h
 
 
