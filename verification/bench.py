@@ -97,15 +97,16 @@ class Report:
         return path
 
     def section(self, heading: str, text: str) -> None:
-        self.sections.append(f"## {heading}\n\n{text.strip()}\n")
+        self.sections.append(f"### {heading}\n\n{text.strip()}\n")
         self.flush()
 
     @property
     def markdown(self) -> str:
-        return f"# {self.title}\n\n" + "\n".join(self.sections)
+        """The sections (level-3 headings; ``verification.report`` puts the title above them)."""
+        return "\n".join(self.sections)
 
     def flush(self) -> None:
-        (self.out_dir / f"{self.name}.md").write_text(self.markdown)
+        (self.out_dir / f"{self.name}.md").write_text(f"# {self.title}\n\n{self.markdown}")
         (self.out_dir / f"{self.name}.json").write_text(json.dumps(self.summary, indent=1, default=_jsonable))
 
     def result(self) -> dict:

@@ -1,0 +1,275 @@
+"""Numerical stability stress tests (issue 6, section 3): ``python -m verification stability``.
+
+Each stress case runs one scenario at the edge of the models' range and records ``name``, ``outcome`` (what
+happened, one line) and ``passed``. A case passes when the code either answers correctly (to its stated accuracy,
+or against a closed form) or refuses with a clear ``ValueError``/one-line CLI error -- never a silent NaN, a blow-up,
+a hang or a traceback. An unexpected exception is a failed case, recorded with its type and message.
+
+Groups: neck geometry (a/r from 1e-4 to the model's limit, radius ratios to 100, bad input); explicit time steps at
+0.5x/0.99x/1.01x/2x the stable limit; extreme networks (conductance contrast 1e8, isolated particles, disconnected
+clusters with and without fixed temperatures, 10^6 bonds with duplicates); FE degenerate geometries; and CLI abuse
+of ``python -m dem`` / ``python -m fem_neck`` in subprocesses (exit 2 with one line, no NaN, no hang).
+The property-based (hypothesis) tests over random scenes live in ``tests/test_stability_properties.py``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import pathlib
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from fem_neck.geometry import max_overlap, neck_geometry, neck_radius, overlap_for_neck
+from verification.bench import Report, md_table
+
+
+@dataclass
+class StressCase:
+    name: str
+    outcome: str
+    passed: bool
+    seconds: float = 0.0
+
+
+def run_case(name: str, fn) -> StressCase:
+    """Run ``fn() -> (passed, outcome)``; an exception escaping ``fn`` is a failure naming the exception."""
+    t0 = time.perf_counter()
+    try:
+        passed, outcome = fn()
+    except Exception as exc:  # the point of a stress test: record, don't crash the suite
+        passed, outcome = False, f"unexpected {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+    return StressCase(name, outcome, bool(passed), time.perf_counter() - t0)
+
+
+def expect_value_error(fn, *needles) -> tuple[bool, str]:
+    """Pass when ``fn()`` raises ``ValueError`` whose message contains every needle (case-insensitive)."""
+    try:
+        value = fn()
+    except ValueError as exc:
+        msg = str(exc)
+        ok = all(n.lower() in msg.lower() for n in needles) and "\n" not in msg.strip()
+        return ok, f"ValueError: {msg}" + ("" if ok else f" (expected mention of {needles})")
+    return False, f"accepted, returned {value!r:.80}"
+
+
+# --------------------------------------------------------------------------------------------------------------
+# Neck geometry
+# --------------------------------------------------------------------------------------------------------------
+def geometry_cases() -> list[StressCase]:
+    cases = []
+
+    def roundtrip(ratio):
+        def fn():
+            r_i = 1e-3
+            r_j = ratio * r_i
+            a = r_i * np.concatenate([np.logspace(-4, 0, 81)[:-1], [1.0 - 1e-12, 1.0]])
+            h = overlap_for_neck(r_i, r_j, a)
+            geo = neck_geometry(r_i, r_j, h)
+            err = np.abs(geo.a - a) / a
+            ok = (np.all(np.isfinite(geo.a)) and err.max() < 1e-9 and geo.volume_residual.max() < 1e-12
+                  and np.all(geo.a <= min(r_i, r_j)))
+            return ok, (f"a/r_i 1e-4..1 ({a.size} necks): max rel error of a {err.max():.1e}, "
+                        f"max volume residual {geo.volume_residual.max():.1e}, iterations {geo.iterations}")
+        return fn
+
+    for ratio in (1.0, 10.0, 100.0):
+        cases.append(run_case(f"neck a/r 1e-4 to limit, r_j/r_i = {ratio:g}", roundtrip(ratio)))
+
+    def beyond_limit():
+        h_max = max_overlap(1e-3, 3e-3)
+        return expect_value_error(lambda: neck_radius(1e-3, 3e-3, h_max * (1 + 1e-9)), "h")
+
+    cases.append(run_case("neck h just beyond the model's range", beyond_limit))
+    for label, args, needle in [
+        ("neck NaN radius", (float("nan"), 1e-3, 1e-5), "r_i"),
+        ("neck negative radius", (1e-3, -1e-3, 1e-5), "r_j"),
+        ("neck zero overlap", (1e-3, 1e-3, 0.0), "h"),
+        ("neck infinite overlap", (1e-3, 1e-3, float("inf")), "h"),
+        ("neck one bad bond among 10^5", (np.full(100_000, 1e-3), np.full(100_000, 1e-3),
+                                          np.r_[np.full(99_999, 1e-5), -1.0]), "h[99999]"),
+    ]:
+        cases.append(run_case(label, lambda args=args, needle=needle: expect_value_error(
+            lambda: neck_radius(*args), needle)))
+    return cases
+
+
+# --------------------------------------------------------------------------------------------------------------
+# CLI abuse
+# --------------------------------------------------------------------------------------------------------------
+def cli_case(name: str, argv: list[str], expect: str = "error", timeout: float = 120.0, cwd=None) -> StressCase:
+    """Run ``python -m <argv>``; ``expect`` is ``"error"`` (exit 2, one line on stderr), ``"ok"`` (exit 0, finite
+    JSON when ``--json``) or ``"either"``. Never: a traceback, NaN/Infinity in the output, a hang (``timeout``)."""
+
+    def fn():
+        try:
+            proc = subprocess.run([sys.executable, "-m", *argv], capture_output=True, text=True, timeout=timeout,
+                                  cwd=cwd)
+        except subprocess.TimeoutExpired:
+            return False, f"hang: no exit within {timeout:g} s"
+        err_lines = [ln for ln in proc.stderr.splitlines() if ln.strip() and not _is_progress(ln)]
+        if "Traceback" in proc.stderr:
+            return False, f"exit {proc.returncode} with a traceback: {err_lines[-1] if err_lines else ''}"[:300]
+        has_nan = any(tok in proc.stdout for tok in ("NaN", "nan,", "Infinity", " inf"))
+        if proc.returncode == 2:
+            one = len(err_lines) == 1
+            ok = expect in ("error", "either") and one
+            msg = err_lines[0] if err_lines else "(empty stderr)"
+            return ok, f"exit 2: {msg}"[:300] + ("" if one else f" (+{len(err_lines) - 1} more stderr lines)")
+        if proc.returncode == 0:
+            if has_nan:
+                return False, "exit 0 but NaN/Infinity in the output"
+            if "--json" in argv:
+                try:
+                    json.loads(proc.stdout)
+                except json.JSONDecodeError:
+                    return False, "exit 0 but stdout is not one JSON object"
+            return expect in ("ok", "either"), f"exit 0: {proc.stdout.strip()[:200]}"
+        return False, f"exit {proc.returncode}: {(err_lines[-1] if err_lines else proc.stdout.strip())[:250]}"
+
+    return run_case(name, fn)
+
+
+def _is_progress(line: str) -> bool:
+    return "it/s]" in line or "s/it]" in line or "%|" in line
+
+
+def fem_neck_cli_cases() -> list[StressCase]:
+    m = ["fem_neck"]
+    specs = [
+        ("neck: NaN radius", ["neck", "--ri", "nan", "--rj", "1e-3", "--h", "1e-5", "--json"], "error"),
+        ("neck: negative radius", ["neck", "--ri", "-1e-3", "--rj", "1e-3", "--h", "1e-5", "--json"], "error"),
+        ("neck: text radius", ["neck", "--ri", "abc", "--rj", "1e-3", "--h", "1e-5"], "error"),
+        ("neck: overlap beyond range", ["neck", "--ri", "1e-3", "--rj", "1e-3", "--h", "1e-3", "--json"], "error"),
+        ("neck: missing option", ["neck", "--ri", "1e-3"], "error"),
+        ("neck: unknown method", ["neck", "--ri", "1", "--rj", "1", "--h", "0.1", "--method", "x"], "error"),
+        ("neck: radius ratio 1e6", ["neck", "--ri", "1e-9", "--rj", "1e-3", "--h", "1e-10", "--json"], "either"),
+        ("neck: huge radii", ["neck", "--ri", "1e300", "--rj", "1e300", "--h", "1e299", "--json"], "either"),
+        ("semisphere: NaN", ["semisphere", "--h-over-r", "nan", "--json"], "error"),
+        ("semisphere: negative", ["semisphere", "--h-over-r", "-0.1", "--json"], "error"),
+        ("semisphere: beyond 2/3", ["semisphere", "--h-over-r", "0.7", "--json"], "error"),
+        ("semisphere: rtol 0", ["semisphere", "--h-over-r", "0.1", "--rtol", "0", "--json"], "error"),
+        ("semisphere: rtol negative", ["semisphere", "--h-over-r", "0.1", "--rtol", "-1", "--json"], "error"),
+        ("semisphere: rtol 1e-14", ["semisphere", "--h-over-r", "0.1", "--rtol", "1e-14", "--json"], "either"),
+        ("semisphere: rtol 10", ["semisphere", "--h-over-r", "0.1", "--rtol", "10", "--json"], "either"),
+        ("semisphere: h/r 1e-9", ["semisphere", "--h-over-r", "1e-9", "--json"], "either"),
+        ("pair: rj negative", ["pair", "--ri", "1e-3", "--rj", "-3e-3", "--h", "6e-5", "--kappa", "394",
+                               "--json"], "error"),
+        ("pair: kappa 0", ["pair", "--ri", "1e-3", "--rj", "3e-3", "--h", "6e-5", "--kappa", "0", "--json"],
+         "error"),
+        ("pair: h beyond range", ["pair", "--ri", "1e-3", "--rj", "3e-3", "--h", "1e-3", "--kappa", "394",
+                                  "--json"], "error"),
+        ("chain: lengths disagree", ["chain", "--radii", "1e-3,1e-3,1e-3", "--overlaps", "1e-4", "--kappa", "394",
+                                     "--json"], "error"),
+        ("chain: empty radii", ["chain", "--radii", "", "--overlaps", "", "--kappa", "394", "--json"], "error"),
+        ("chain: garbage list", ["chain", "--radii", "1e-3,x", "--overlaps", "1e-4", "--kappa", "394"], "error"),
+        ("fit: zero points", ["fit", "--points", "0", "--json"], "error"),
+        ("fit: negative points", ["fit", "--points", "-5", "--json"], "error"),
+        ("unknown command", ["frobnicate"], "error"),
+    ]
+    return [cli_case(f"fem_neck CLI {name}", m + argv, expect) for name, argv, expect in specs]
+
+
+SCENE_OK = """
+[material]
+conductivity = 394.0
+density = 8960.0
+specific_heat = 385.0
+[particles]
+position = [[0.0, 0.0, 0.0], [0.0, 0.0, 3.94e-3]]
+radius = [1.0e-3, 3.0e-3]
+temperature = [100.0, 0.0]
+[conductance]
+law = "rojek"
+[solver]
+mode = "transient"
+integrator = "{integrator}"
+dt = {dt}
+t_end = {t_end}
+"""
+
+
+def dem_cli_cases(scene_dir: pathlib.Path) -> list[StressCase]:
+    """Bad scenes for ``python -m dem run``; each is written to ``scene_dir`` first."""
+    scene_dir.mkdir(parents=True, exist_ok=True)
+    base = SCENE_OK.format(integrator="implicit", dt="1.0e-3", t_end="0.01")
+    bad = {
+        "malformed TOML": base.replace("radius = [", "radius = [[", 1),
+        "unknown key": base.replace("[conductance]", "[conductance]\nfoo = 1"),
+        "unknown section": base + "\n[bogus]\nx = 1\n",
+        "missing conductivity": base.replace("conductivity = 394.0\n", ""),
+        "negative radius": base.replace("radius = [1.0e-3", "radius = [-1.0e-3"),
+        "NaN radius": base.replace("radius = [1.0e-3", "radius = [nan"),
+        "NaN temperature": base.replace("temperature = [100.0", "temperature = [nan"),
+        "inf temperature": base.replace("temperature = [100.0", "temperature = [inf"),
+        "lengths disagree": base.replace("radius = [1.0e-3, 3.0e-3]", "radius = [1.0e-3]"),
+        "empty particle list": base.replace("position = [[0.0, 0.0, 0.0], [0.0, 0.0, 3.94e-3]]", "position = []")
+        .replace("radius = [1.0e-3, 3.0e-3]", "radius = []").replace("temperature = [100.0, 0.0]", "temperature = []"),
+        "position not 3D": base.replace("[0.0, 0.0, 3.94e-3]]", "[0.0, 3.94e-3]]"),
+        "overlap beyond neck range": base.replace("3.94e-3]]", "2.1e-3]]"),
+        "coincident particles": base.replace("3.94e-3]]", "0.0]]"),
+        "negative dt": base.replace("dt = 1.0e-3", "dt = -1.0e-3"),
+        "zero dt": base.replace("dt = 1.0e-3", "dt = 0.0"),
+        "dt as text": base.replace("dt = 1.0e-3", 'dt = "fast"'),
+        "negative t_end": base.replace("t_end = 0.01", "t_end = -1.0"),
+        "unknown integrator": base.replace('integrator = "implicit"', 'integrator = "rk4"'),
+        "unknown law": base.replace('law = "rojek"', 'law = "magic"'),
+        "unknown mode": base.replace('mode = "transient"', 'mode = "quasi"'),
+        "negative density": base.replace("density = 8960.0", "density = -8960.0"),
+        "explicit dt 1e3x the limit": SCENE_OK.format(integrator="explicit", dt="1.0", t_end="10.0"),
+        "steady without fixed temperature": base.replace('mode = "transient"', 'mode = "steady"'),
+    }
+    long_run = {
+        # would take ~1e12 steps: must be refused or capped, never a hang
+        "explicit t_end 1e9 s": SCENE_OK.format(integrator="explicit", dt="1.0e-6", t_end="1.0e9"),
+    }
+    cases = []
+    for name, text in {**bad, **long_run}.items():
+        path = scene_dir / (name.replace(" ", "_").replace("/", "_") + ".toml")
+        path.write_text(text)
+        expect = "error" if name in bad else "either"
+        cases.append(cli_case(f"dem CLI {name}", ["dem", "run", str(path), "--json", "--out",
+                                                  str(scene_dir / "out")], expect, timeout=60.0))
+    cases.append(cli_case("dem CLI missing scene file", ["dem", "run", str(scene_dir / "nope.toml"), "--json"]))
+    cases.append(cli_case("dem CLI scene is a directory", ["dem", "run", str(scene_dir), "--json"]))
+    cases.append(cli_case("dem CLI no arguments", ["dem"]))
+    cases.append(cli_case("dem CLI good scene runs", ["dem", "run", str(_write(scene_dir / "good.toml", base)),
+                                                      "--json", "--out", str(scene_dir / "out")], "ok"))
+    return cases
+
+
+def _write(path: pathlib.Path, text: str) -> pathlib.Path:
+    path.write_text(text)
+    return path
+
+
+# --------------------------------------------------------------------------------------------------------------
+def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
+    """Run every stress case; write ``stress_cases.csv``, ``stability.md``/``stability.json``; return the section."""
+    report = Report(out_dir, "Numerical stability stress tests", "stability")
+    all_cases: list[StressCase] = []
+    groups = [
+        ("Neck geometry", geometry_cases),
+        ("CLI abuse: python -m fem_neck", fem_neck_cli_cases),
+        ("CLI abuse: python -m dem run", lambda: dem_cli_cases(pathlib.Path(out_dir) / "scenes")),
+    ]
+    for heading, make in groups:
+        cases = make()
+        all_cases += cases
+        rows = [{"case": c.name, "passed": "yes" if c.passed else "**NO**", "outcome": c.outcome.replace("|", "/"),
+                 "seconds": c.seconds} for c in cases]
+        report.csv("stress_cases", [asdict(c) for c in all_cases])
+        report.summary["stress_cases"] = [{"name": c.name, "outcome": c.outcome, "passed": c.passed}
+                                          for c in all_cases]
+        report.section(f"{heading}: {sum(c.passed for c in cases)}/{len(cases)} passed",
+                       md_table(rows, ["case", "passed", "outcome", "seconds"], fmt="{:.2f}"))
+    failed = [c.name for c in all_cases if not c.passed]
+    report.summary["stress_passed"] = len(all_cases) - len(failed)
+    report.summary["stress_failed"] = len(failed)
+    report.sections.insert(0, f"{len(all_cases) - len(failed)} of {len(all_cases)} stress cases passed."
+                              + (f" Failed: {', '.join(failed)}." if failed else "") + "\n")
+    return report.result()
