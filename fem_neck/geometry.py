@@ -32,6 +32,7 @@ import numpy as np
 
 METHODS = ("newton", "first", "coble")
 _MAX_ITERATIONS = 60
+_STEP_TOL = 1e-8  # relative Newton step after which the iterate is at round-off (quadratic convergence)
 _LIMIT_SLACK = 1e-12  # relative round-off tolerated beyond the model's largest overlap
 
 
@@ -72,14 +73,15 @@ class NeckGeometry:
 def check_positive(name: str, value, upper=None, upper_name: str | None = None) -> np.ndarray:
     """Return ``value`` as a float array, raising ``ValueError`` unless every entry is finite and ``> 0``.
 
-    With ``upper`` also require ``value <= upper`` (``upper_name`` says what that bound is).
+    With ``upper`` also require ``value <= upper`` (``upper_name`` says what that bound is). The message names the
+    parameter, the first offending entry and the valid range.
     """
     arr = np.asarray(value, dtype=float)
-    bad = ~np.isfinite(arr) | (arr <= 0.0)
+    ok = (arr > 0.0) & (arr < np.inf)  # False for NaN as well
     if upper is not None:
-        bad |= arr > np.asarray(upper, dtype=float)
-    if np.any(bad):
-        idx = np.flatnonzero(bad)[0]
+        ok &= arr <= upper
+    if not np.all(ok):
+        idx = np.flatnonzero(~ok)[0]
         shown = arr.flat[idx]
         where = "" if arr.ndim == 0 else f"[{idx}]"
         if upper is None:
@@ -147,13 +149,14 @@ def equal_neck_radius(r, h):
     return np.sqrt(h_c * (2.0 * r - h_c))
 
 
-def _newton_step(a, r_i, r_j, h):
-    """One step of eq. (32) for ``Z``: ``a - Z/Z' = a - a G(a) / (2 h_n(a))``; returns (new a, G)."""
-    h_ci = cap_height(r_i, a)
-    h_cj = cap_height(r_j, a)
-    g = _phi(h_ci, r_i) + _phi(h_cj, r_j) - h
+def _z_and_slope(a, r_i, r_j, h):
+    """``Z(a)`` of eq. (27) and ``Z'(a) = 6 a h_n`` (eq. 31), with the cap heights in cancellation-free form."""
+    a2 = a * a
+    h_ci = a2 / (r_i + np.sqrt((r_i - a) * (r_i + a)))
+    h_cj = a2 / (r_j + np.sqrt((r_j - a) * (r_j + a)))
     h_n = h_ci + h_cj - h
-    return a - a * g / (2.0 * h_n), g
+    z = 3.0 * a2 * h_n - h_ci * h_ci * (3.0 * r_i - h_ci) - h_cj * h_cj * (3.0 * r_j - h_cj)
+    return z, 6.0 * a * h_n
 
 
 def _validated(r_i, r_j, h):
@@ -163,36 +166,37 @@ def _validated(r_i, r_j, h):
     if not (h.ndim == 0 and r_i.ndim == 0 and r_j.ndim == 0):
         r_i, r_j, h = np.broadcast_arrays(r_i, r_j, h)
     h_max = max_overlap(r_i, r_j)
-    # an overlap at the limit computed in another way may exceed h_max by round-off: that is the limit itself
-    h = np.where(h > h_max, np.where(h <= h_max * (1.0 + _LIMIT_SLACK), h_max, h), h)
-    h = check_positive("h", h, upper=h_max, upper_name="the neck reaches the smaller radius")
-    return r_i, r_j, h
+    # An overlap at the limit computed in another way may exceed h_max by round-off: that is the limit itself.
+    h = check_positive("h", h, upper=h_max * (1.0 + _LIMIT_SLACK), upper_name="the neck reaches the smaller radius")
+    return r_i, r_j, np.minimum(h, h_max)
 
 
 def _solve(r_i, r_j, h, method):
-    """Neck radius and Newton iteration count for validated, broadcast inputs."""
-    a0 = coble_radius(r_i, r_j, h)
+    """Neck radius and Newton iteration count for validated, broadcast inputs (Rojek 2022, eqs. 32-34)."""
+    a = coble_radius(r_i, r_j, h)
     if method == "coble":
-        return a0, 0
+        return a, 0
     r_min = np.minimum(r_i, r_j)
-    a = np.minimum(a0, r_min)
-    if method == "first":
-        # Eq. (34) taken literally: one Newton step from Coble's radius.
-        return _newton_step(a, r_i, r_j, h)[0], 1
-    # Bracketing fallback: start where G >= 0 (right of the unique root) so the convex Newton descent is monotone.
-    g0 = _phi(cap_height(r_i, a), r_i) + _phi(cap_height(r_j, a), r_j) - h
-    a = np.where(g0 < 0.0, r_min, a)
-    iterations = 0
+    # Coble's radius may lie beyond the smaller sphere, where eqs. (28)-(29) have no answer: start at r_min there.
+    a = np.minimum(a, r_min)
     for iterations in range(1, _MAX_ITERATIONS + 1):
-        a_new, g = _newton_step(a, r_i, r_j, h)
-        # Monotone from the right: a step that would leave the bracket can only be round-off at the root.
-        a_new = np.clip(a_new, 0.0, a)
-        a_new = np.where(g <= 0.0, a, a_new)
-        step = np.abs(a - a_new)
-        a = a_new
-        if np.all(step <= 4.0 * np.finfo(float).eps * a):
-            break
-    return a, iterations
+        z, slope = _z_and_slope(a, r_i, r_j, h)
+        if iterations == 1:
+            if method == "first":  # eq. (34)
+                return a - z / slope, 1
+            # Bracketing fallback: Newton descends monotonically onto the root only from its right (Z >= 0);
+            # a start on the left is replaced by the bracket's right end, r_min, where Z >= 0 within the range.
+            left = z < 0.0
+            if np.any(left):
+                a = np.where(left, r_min, a)
+                z, slope = _z_and_slope(a, r_i, r_j, h)
+        step = np.divide(z, slope, out=np.zeros_like(z), where=slope > 0.0)
+        a = np.minimum(a - step, r_min)  # at the range's end round-off may step past the smaller radius
+        # Quadratic convergence: after a relative step s the error is ~ s^2 (measured: 3.4e-8 -> 4e-15), so a
+        # step below 1e-8 leaves the root at round-off and one more iteration would change nothing.
+        if np.all(np.abs(step) <= _STEP_TOL * a):
+            return a, iterations
+    raise RuntimeError(f"neck radius: Newton did not converge in {_MAX_ITERATIONS} iterations")  # pragma: no cover
 
 
 def neck_radius(r_i, r_j, h, method: str = "newton"):
