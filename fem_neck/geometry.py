@@ -10,15 +10,16 @@ Two spheres of radii ``r_i`` and ``r_j`` overlap by ``h = r_i + r_j - d`` (eq. 2
 * ``"first"`` -- the first Newton iterate from Coble's start (eq. 34), a cheap approximation.
 
 Numerics. With ``h_c(a) = r - sqrt(r^2 - a^2)`` (eqs. 28-29) the identity ``d/dh_c [h_c^2 (3r - h_c)] = 3 a^2``
-reduces the derivative of eq. (31) to ``Z'(a) = 6 a h_n``, and dividing eq. (27) by ``3 a^2`` gives
+reduces the derivative of eq. (31) to ``Z'(a) = 6 a h_n``. Dividing eq. (27) by ``3 a^2`` gives
 
     G(a) = Z / (3 a^2) = phi(h_ci; r_i) + phi(h_cj; r_j) - h,   phi(h_c; r) = h_c (3r - 2h_c) / (3 (2r - h_c)),
 
-which is strictly increasing in ``a`` on ``[0, min(r_i, r_j)]``: the root is unique, and the Newton step of eq. (32),
-``a - Z/Z' = a - a G / (2 h_n)``, is evaluated from ``G`` without the cancellation of eq. (27) for small necks.
-``Z`` is convex where ``h_n > 0``, so Newton started to the right of the root decreases monotonically onto it.
-Coble's start lies to the right in the cases of the paper; where it does not (or lies beyond the smaller radius)
-the iteration starts from the bracket's right end ``a = min(r_i, r_j)`` instead, so it never diverges.
+strictly increasing in ``a`` on ``[0, min(r_i, r_j)]``: the root is unique, and ``h = phi_i + phi_j`` inverts the
+model (:func:`overlap_for_neck`, :func:`max_overlap`). ``Z`` is convex where ``h_n > 0``, so Newton started to the
+right of the root decreases monotonically onto it. Coble's start lies to the right in every case tested (radius
+ratios up to 100, see the tests); where it does not, or lies beyond the smaller radius, the iteration starts from
+the bracket's right end ``a = min(r_i, r_j)`` instead, so it never diverges. Cap heights are computed as
+``a^2 / (r + sqrt(r^2 - a^2))`` so that small necks keep full relative precision.
 
 The model's range: a solution exists for ``0 < h <= max_overlap(r_i, r_j)``, where ``a`` reaches the smaller radius
 (``2r/3`` for equal spheres, Section 4.2).
