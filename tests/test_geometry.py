@@ -175,3 +175,17 @@ def test_symmetric_in_the_two_radii_and_scale_free(pair, scale):
 def test_overlap_for_neck_inverts_neck_radius(pair):
     r_i, r_j, h = pair
     assert overlap_for_neck(r_i, r_j, neck_radius(r_i, r_j, h)) == pytest.approx(h, rel=1e-12)
+
+
+def test_bracketing_fallback_converges_from_a_start_left_of_the_root(monkeypatch):
+    """Were Coble's start ever left of the root (Z < 0), Newton restarts from the smaller radius, never diverges."""
+    import fem_neck.geometry as geometry
+
+    r_i = np.full(5, 1.0)
+    r_j = np.array([1.0, 2.0, 3.0, 10.0, 100.0])
+    h = 0.5 * max_overlap(r_i, r_j)
+    expected = neck_radius(r_i, r_j, h)
+    monkeypatch.setattr(geometry, "coble_radius", lambda r_i, r_j, h: 1e-3 * np.sqrt(h))
+    g = neck_geometry(r_i, r_j, h)
+    assert np.allclose(g.a, expected, rtol=1e-13, atol=0)
+    assert np.all(g.volume_residual < 1e-12)
