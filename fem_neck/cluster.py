@@ -1,0 +1,516 @@
+"""3D finite-element conduction through small clusters of sintered spheres (gmsh OCC + scikit-fem tetrahedra).
+
+Geometry (Rojek, Kasztelan & Tharmaraj 2022, Sections 4.3, Fig. 8). Each bonded pair ``(i, j)`` with overlap
+``h = r_i + r_j - |c_j - c_i|`` gets the volume-conserving cylindrical neck of :func:`fem_neck.neck_geometry`: radius
+``a``, spanning ``c_i + z_i e .. c_i + (z_i + h_n) e`` along the unit vector ``e`` from ``c_i`` to ``c_j``. The solid is
+
+    union of the full spheres  U  union of the neck cylinders.
+
+This *is* the truncated-sphere geometry of the paper: the cap of sphere ``i`` beyond its base plane ``z_i`` lies
+inside the neck cylinder (the sphere's cross-section there is narrower than ``a``) or, where it pokes past the
+cylinder's far end (unequal radii), inside the truncated sphere ``j``. So no cap has to be cut explicitly, and for
+necks that do not touch one another the volume is exactly ``sum 4/3 pi r^3`` (volume conservation, eq. 22). Each
+cylinder is extended by ``delta = z/4`` into both spheres so that its side meets each sphere transversally at the
+neck circle instead of along a shared edge, which keeps the OCC boolean robust without changing the union.
+
+Boundary conditions that the pipe network represents exactly (chosen here, see :class:`Terminal`):
+
+* ``"plane"`` -- a particle with exactly one bond is cut by the plane through its centre normal to that bond and
+  the cut disk is held at a fixed temperature. That half-particle is precisely the body whose conductance defines
+  the pipe's half-conductance ``K_i`` (Rojek 2022, Fig. 12, eqs. 36, 43) and the end of the FE pair/chain solves,
+  so a DEM particle held at ``T`` with that bond's law is an exact model of this boundary; any difference is the
+  law's error, not the boundary's.
+* ``"core"`` -- a concentric ball of radius ``rho r`` (default ``rho = 0.25``) is removed and its surface held at
+  ``T``: the particle's "centre temperature". Usable for particles with several bonds; it is *not* exactly the pipe
+  model's boundary (the half-conductance is defined from the equatorial disk), which the comparison quantifies.
+
+Everything else is insulated. The effective conductance is ``K = Q / (T_hot - T_cold)`` with ``Q`` from the reaction
+at the hot Dirichlet dofs. The per-particle mean temperature is the volume average over the particle's own share of
+the solid: its truncated sphere plus the part of each neck cylinder next to it whose volume equals its cap's, so
+that each particle owns exactly ``4/3 pi r^3`` (the DEM's mass, ``m = rho 4/3 pi r^3``) less what a terminal cut
+removes. Elements are assigned by their centroids.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fem_neck.geometry import check_positive, max_overlap, neck_geometry
+
+BC_KINDS = ("plane", "core")
+_EXTEND = 0.25  # neck cylinders reach delta = _EXTEND * z into each sphere (hidden inside it)
+
+
+@dataclass(frozen=True)
+class Terminal:
+    """A particle held at temperature ``T``: ``kind`` is ``"plane"`` (one-bond particle cut at its centre plane)
+    or ``"core"`` (ball of radius ``rho * r`` at the centre removed, its surface held at ``T``)."""
+
+    particle: int
+    T: float
+    kind: str = "plane"
+    rho: float = 0.25
+
+
+@dataclass(frozen=True)
+class Cluster:
+    """Spheres ``centres`` (n, 3) and ``radii`` (n,) in metres joined by ``bonds`` (m, 2) of particle indices."""
+
+    centres: np.ndarray
+    radii: np.ndarray
+    bonds: np.ndarray
+
+    def __post_init__(self):
+        centres = np.asarray(self.centres, dtype=float).reshape(-1, 3)
+        radii = check_positive("radii", np.asarray(self.radii, dtype=float).reshape(-1))
+        bonds = np.asarray(self.bonds, dtype=int).reshape(-1, 2)
+        if len(radii) != len(centres):
+            raise ValueError(f"radii has {len(radii)} entries: must match the {len(centres)} centres")
+        if bonds.size and (bonds.min() < 0 or bonds.max() >= len(radii) or np.any(bonds[:, 0] == bonds[:, 1])):
+            raise ValueError(f"bonds = {bonds.tolist()}: indices must be distinct and in 0..{len(radii) - 1}")
+        object.__setattr__(self, "centres", centres)
+        object.__setattr__(self, "radii", radii)
+        object.__setattr__(self, "bonds", bonds)
+
+    @property
+    def n(self) -> int:
+        return len(self.radii)
+
+    def overlaps(self) -> np.ndarray:
+        """Overlap ``h = r_i + r_j - d`` of every bond (Rojek 2022, eq. 21/44)."""
+        i, j = self.bonds.T
+        return self.radii[i] + self.radii[j] - np.linalg.norm(self.centres[j] - self.centres[i], axis=1)
+
+    def necks(self, method: str = "newton"):
+        """:class:`fem_neck.NeckGeometry` of every bond (raises ``ValueError`` outside the neck model's range)."""
+        i, j = self.bonds.T
+        return neck_geometry(self.radii[i], self.radii[j], self.overlaps(), method=method)
+
+    def directions(self) -> np.ndarray:
+        """Unit vectors ``e`` from ``c_i`` to ``c_j`` of every bond."""
+        i, j = self.bonds.T
+        v = self.centres[j] - self.centres[i]
+        return v / np.linalg.norm(v, axis=1)[:, None]
+
+    def degree(self) -> np.ndarray:
+        """Coordination number (bonds per particle)."""
+        return np.bincount(self.bonds.ravel(), minlength=self.n)
+
+    def validate(self, method: str = "newton") -> None:
+        """Raise ``ValueError`` unless the cluster is a valid union of non-interfering necks.
+
+        Bonded pairs must overlap within the neck model's range; unbonded spheres must not touch; the two neck
+        circles on one sphere must not touch (angular radius ``arcsin(a/r)`` each).
+        """
+        h = self.overlaps()
+        i, j = self.bonds.T
+        for b in range(len(h)):
+            if not 0.0 < h[b] <= max_overlap(self.radii[i[b]], self.radii[j[b]]):
+                raise ValueError(
+                    f"bond {b} ({i[b]}, {j[b]}): overlap h = {h[b]:.6g} outside the neck model's range "
+                    f"0 < h <= {max_overlap(self.radii[i[b]], self.radii[j[b]]):.6g}")
+        bonded = {tuple(sorted(p)) for p in self.bonds.tolist()}
+        dist = np.linalg.norm(self.centres[:, None] - self.centres[None], axis=2)
+        gap = dist - self.radii[:, None] - self.radii[None]
+        for p, q in zip(*np.nonzero(np.triu(gap <= 0.0, 1))):
+            if (int(p), int(q)) not in bonded:
+                raise ValueError(f"particles {p} and {q} overlap (gap = {gap[p, q]:.3g}) but are not bonded")
+        if len(bonded) != len(self.bonds):
+            raise ValueError("bonds contain a duplicate pair")
+        a = self.necks(method).a
+        e = self.directions()
+        for k in range(self.n):
+            ends = [(b, 1.0) for b in np.flatnonzero(i == k)] + [(b, -1.0) for b in np.flatnonzero(j == k)]
+            for x in range(len(ends)):
+                for y in range(x + 1, len(ends)):
+                    (b1, s1), (b2, s2) = ends[x], ends[y]
+                    angle = np.arccos(np.clip(s1 * s2 * e[b1] @ e[b2], -1.0, 1.0))
+                    need = np.arcsin(min(a[b1] / self.radii[k], 1.0)) + np.arcsin(min(a[b2] / self.radii[k], 1.0))
+                    if angle <= need:
+                        raise ValueError(
+                            f"particle {k}: necks of bonds {b1} and {b2} touch (angle {np.degrees(angle):.1f} deg "
+                            f"<= {np.degrees(need):.1f} deg); the cylindrical-neck model needs separate necks")
+
+
+@dataclass
+class ClusterMesh:
+    """A tetrahedral mesh of a cluster with boundaries ``"hot"`` and ``"cold"``.
+
+    ``particle`` gives the owning particle of every element; ``volume_exact`` is the solid's exact volume and
+    ``volume_cad`` the OCC volume of the built solid (they agree to the CAD kernel's tolerance).
+    """
+
+    cluster: Cluster
+    terminals: tuple
+    mesh: object
+    particle: np.ndarray
+    volume_exact: float
+    volume_cad: float
+    neck_a: np.ndarray = field(repr=False)
+
+
+def _surface_of(cx, tags, centre, area, kind, tol):
+    """The tag of the surface of type ``kind`` centred at ``centre`` with area ``area`` (found by position)."""
+    import gmsh
+
+    for tag in tags:
+        if gmsh.model.getType(2, tag) != kind:
+            continue
+        com = np.array(gmsh.model.occ.getCenterOfMass(2, tag))
+        if np.linalg.norm(com - centre) < tol and abs(gmsh.model.occ.getMass(2, tag) - area) < 1e-3 * area:
+            return tag
+    raise RuntimeError(f"{cx}: boundary surface of type {kind} at {centre.tolist()} not found after the boolean")
+
+
+def _check_terminals(cluster: Cluster, terminals) -> tuple:
+    terminals = tuple(terminals)
+    deg = cluster.degree()
+    seen = set()
+    for t in terminals:
+        if t.kind not in BC_KINDS:
+            raise ValueError(f"terminal kind = {t.kind!r}: must be one of {', '.join(BC_KINDS)}")
+        if not 0 <= t.particle < cluster.n or t.particle in seen:
+            raise ValueError(f"terminal particle = {t.particle}: must be a distinct index in 0..{cluster.n - 1}")
+        seen.add(t.particle)
+        if t.kind == "plane" and deg[t.particle] != 1:
+            raise ValueError(f"terminal particle {t.particle} has {deg[t.particle]} bonds: a 'plane' terminal "
+                             "needs exactly one (use kind='core')")
+        if t.kind == "core" and not 0.0 < t.rho < 0.5:
+            raise ValueError(f"terminal rho = {t.rho}: valid range 0 < rho < 0.5")
+    if len({t.T for t in terminals}) < 2:
+        raise ValueError("terminals: need at least two different temperatures")
+    return terminals
+
+
+def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size_far: float = 0.35,
+                       curvature: int = 20, method: str = "newton", curved: bool = True) -> ClusterMesh:
+    """Mesh the cluster with first-order tetrahedra, graded toward every neck circle.
+
+    ``size_neck`` is the element size at the neck circles as a fraction of the neck radius ``a``; it grows
+    linearly to ``size_far`` times the smaller radius of the bond at a distance ``2 a`` (gmsh Distance + Threshold
+    fields). ``curvature`` is gmsh's elements per 2 pi of surface curvature. ``curved`` returns the quadratic
+    :func:`curved_mesh` (exact boundary edge midpoints; use with ``order=2``). Deterministic (one thread, fixed
+    algorithm). Terminals: a sequence of :class:`Terminal`; only the hottest and coldest boundaries are named
+    (``"hot"``, ``"cold"``), intermediate temperatures are not supported.
+    """
+    from skfem import MeshTet
+
+    from fem_neck.shapes import gmsh_session
+
+    cluster.validate(method)
+    terminals = _check_terminals(cluster, terminals)
+    check_positive("size_neck", size_neck)
+    check_positive("size_far", size_far)
+    # Build in units of the largest radius (OCC's tolerances are absolute), scale the mesh back at the end.
+    unit = float(cluster.radii.max())
+    real = cluster
+    cluster = Cluster(cluster.centres / unit, cluster.radii / unit, cluster.bonds)
+    geo = cluster.necks(method)
+    e = cluster.directions()
+    c, r = cluster.centres, cluster.radii
+    bi, bj = cluster.bonds.T
+    scale = float(r.max())
+    tol = 1e-6 * scale
+    by_particle = {t.particle: t for t in terminals}
+    volume_exact = float(np.sum(4.0 / 3.0 * np.pi * r**3))
+    for t in terminals:
+        volume_exact -= (2.0 / 3.0 * np.pi * r[t.particle] ** 3 if t.kind == "plane"
+                         else 4.0 / 3.0 * np.pi * (t.rho * r[t.particle]) ** 3)
+
+    with gmsh_session() as gmsh:
+        occ = gmsh.model.occ
+        solids = []
+        for k in range(cluster.n):
+            t = by_particle.get(k)
+            if t is not None and t.kind == "plane":
+                # the half sphere z >= 0 about its own centre, turned so that +z points along the bond: its
+                # flat face is the terminal disk, and no sphere pole lies in the cut plane
+                s = occ.addSphere(*c[k], r[k], angle1=0.0)
+                b = int(np.flatnonzero((bi == k) | (bj == k))[0])
+                ek = e[b] if bi[b] == k else -e[b]
+                axis = np.cross([0.0, 0.0, 1.0], ek)
+                angle = float(np.arctan2(np.linalg.norm(axis), ek[2]))
+                if np.linalg.norm(axis) < 1e-12:
+                    axis = np.array([1.0, 0.0, 0.0])
+                if angle > 0.0:
+                    occ.rotate([(3, s)], *c[k], *axis, angle)
+            else:
+                s = occ.addSphere(*c[k], r[k])
+            solids.append((3, s))
+        for b in range(len(bi)):
+            start = c[bi[b]] + (geo.z_i[b] - _EXTEND * geo.z_i[b]) * e[b]
+            length = geo.h_n[b] + _EXTEND * (geo.z_i[b] + geo.z_j[b])
+            solids.append((3, occ.addCylinder(*start, *(length * e[b]), geo.a[b])))
+        out, _ = occ.fuse(solids[:1], solids[1:])
+        if len(out) != 1:
+            raise RuntimeError(f"cluster solid has {len(out)} volumes after the union: the cluster must be connected")
+        volume = out
+        cores = [t for t in terminals if t.kind == "core"]
+        if cores:
+            balls = [(3, occ.addSphere(*c[t.particle], t.rho * r[t.particle])) for t in cores]
+            volume = occ.cut(volume, balls)[0]
+        occ.synchronize()
+        vol_tag = volume[0][1]
+        volume_cad = occ.getMass(3, vol_tag)
+        surfaces = [tag for _, tag in gmsh.model.getBoundary(volume, oriented=False)]
+        named = {"hot": [], "cold": []}
+        t_hot = max(t.T for t in terminals)
+        t_cold = min(t.T for t in terminals)
+        for t in terminals:
+            k = t.particle
+            if t.kind == "plane":
+                tag = _surface_of(f"particle {k}", surfaces, c[k], np.pi * r[k] ** 2, "Plane", tol)
+            else:
+                tag = _surface_of(f"particle {k}", surfaces, c[k], 4 * np.pi * (t.rho * r[k]) ** 2, "Sphere", tol)
+            if t.T == t_hot:
+                named["hot"].append(tag)
+            elif t.T == t_cold:
+                named["cold"].append(tag)
+            else:
+                raise ValueError(f"terminal T = {t.T}: only two temperature levels are supported")
+        # Grading toward each neck circle: the curves whose centre of mass is a neck-circle centre.
+        curves = [tag for _, tag in gmsh.model.getBoundary(
+            [(2, s) for s in surfaces], combined=False, oriented=False)]
+        curves = sorted(set(abs(x) for x in curves))
+        samples = {}
+        for tag in curves:
+            lo, hi = gmsh.model.getParametrizationBounds(1, tag)
+            samples[tag] = np.reshape(gmsh.model.getValue(1, tag, np.linspace(lo[0], hi[0], 5)), (-1, 3))
+        thresholds = []
+        for b in range(len(bi)):
+            # The neck circles (possibly split into arcs at the sphere's seam): every sample point at axial
+            # position z_i or z_i + h_n and distance a from the bond axis.
+            found = []
+            for tag, xyz in samples.items():
+                rel = xyz - c[bi[b]]
+                axial = rel @ e[b]
+                radial = np.linalg.norm(rel - axial[:, None] * e[b], axis=1)
+                on_radius = np.all(np.abs(radial - geo.a[b]) < 10 * tol)
+                for z in (geo.z_i[b], geo.z_i[b] + geo.h_n[b]):
+                    if on_radius and np.all(np.abs(axial - z) < 10 * tol):
+                        found.append(tag)
+            if len(found) < 2:
+                raise RuntimeError(f"bond {b}: found {len(found)} neck-circle curves after the union, expected >= 2")
+            dist = gmsh.model.mesh.field.add("Distance")
+            gmsh.model.mesh.field.setNumbers(dist, "CurvesList", found)
+            gmsh.model.mesh.field.setNumber(dist, "Sampling", 200)
+            thr = gmsh.model.mesh.field.add("Threshold")
+            gmsh.model.mesh.field.setNumber(thr, "InField", dist)
+            gmsh.model.mesh.field.setNumber(thr, "SizeMin", size_neck * geo.a[b])
+            gmsh.model.mesh.field.setNumber(thr, "SizeMax", size_far * min(r[bi[b]], r[bj[b]]))
+            gmsh.model.mesh.field.setNumber(thr, "DistMin", 0.0)
+            gmsh.model.mesh.field.setNumber(thr, "DistMax", 2.0 * geo.a[b])
+            thresholds.append(thr)
+        fmin = gmsh.model.mesh.field.add("Min")
+        gmsh.model.mesh.field.setNumbers(fmin, "FieldsList", thresholds)
+        gmsh.model.mesh.field.setAsBackgroundMesh(fmin)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", curvature)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", size_far * float(r.max()))
+        gmsh.option.setNumber("Mesh.Algorithm", 6)
+        gmsh.option.setNumber("Mesh.Algorithm3D", 1)
+        gmsh.option.setNumber("Mesh.Optimize", 1)
+        gmsh.model.mesh.generate(3)
+        node_tags, coords, _ = gmsh.model.mesh.getNodes()
+        points = np.asarray(coords).reshape(-1, 3)
+        index = np.full(int(node_tags.max()) + 1, -1, dtype=np.int64)
+        index[node_tags.astype(np.int64)] = np.arange(len(node_tags))
+        _, _, elem_nodes = gmsh.model.mesh.getElements(3, vol_tag)
+        tets = index[np.asarray(elem_nodes[0], dtype=np.int64)].reshape(-1, 4)
+        facets = {}
+        for name, tags in named.items():
+            tris = []
+            for tag in tags:
+                _, _, fn = gmsh.model.mesh.getElements(2, tag)
+                tris.append(index[np.asarray(fn[0], dtype=np.int64)].reshape(-1, 3))
+            facets[name] = np.vstack(tris)
+
+    used = np.unique(tets)
+    remap = np.full(len(points), -1, dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    points = points[used]
+    tets = remap[tets]
+    mesh = MeshTet(points.T.copy(), tets.T.copy())
+    lookup = {tuple(f): n for n, f in enumerate(np.sort(mesh.facets.T, axis=1).tolist())}
+    boundaries = {name: np.array([lookup[tuple(f)] for f in np.sort(remap[tri], axis=1).tolist()], dtype=np.int64)
+                  for name, tri in facets.items()}
+    particle = assign_particles(cluster, geo, points[tets].mean(axis=1))
+    if curved:
+        mesh = curved_mesh(mesh, cluster, geo, terminals)
+    mesh = type(mesh)(mesh.doflocs * unit, mesh.t).with_boundaries(boundaries)
+    return ClusterMesh(cluster=real, terminals=terminals, mesh=mesh, particle=particle,
+                       volume_exact=volume_exact * unit**3, volume_cad=volume_cad * unit**3,
+                       neck_a=np.asarray(geo.a) * unit)
+
+
+def _on_sphere(x, centre, radius, tol):
+    return np.abs(np.linalg.norm(x - centre, axis=-1) - radius) < tol
+
+
+def curved_mesh(mesh, cluster: Cluster, geo, terminals, tol: float | None = None):
+    """Quadratic (isoparametric) version of a first-order cluster mesh: ``skfem.MeshTet2`` whose boundary edge
+    midpoints are moved onto the exact surfaces -- the spheres, the neck cylinders, the core balls and the neck
+    circles where sphere and cylinder meet. Straight-sided tetrahedra inscribe the spheres (volume and ``K`` too
+    small); with P2 on this mesh the geometric error falls from O(h^2) to O(h^3) or better.
+    """
+    from skfem import MeshTet2
+
+    c, r = cluster.centres, cluster.radii
+    bi, bj = cluster.bonds.T
+    e = cluster.directions()
+    tol = 1e-7 * float(r.max()) if tol is None else tol
+    p = mesh.p.T
+    nv = len(p)
+    edges = np.sort(mesh.edges.T, axis=1)
+    keys = edges[:, 0] * nv + edges[:, 1]
+    order = np.argsort(keys)
+    facets = mesh.facets[:, mesh.boundary_facets()].T
+    x = p[facets]                                  # (nf, 3 vertices, 3)
+    xc = x.mean(axis=1)
+    normal = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    fedges = np.sort(np.stack([facets[:, [0, 1]], facets[:, [1, 2]], facets[:, [0, 2]]], axis=1), axis=2)
+    m2 = MeshTet2.from_mesh(mesh)
+    doflocs = m2.doflocs.copy()
+
+    def move(on_surface, project):
+        ed = fedges[on_surface].reshape(-1, 2)
+        ed = np.unique(ed[:, 0] * nv + ed[:, 1])
+        idx = order[np.searchsorted(keys, ed, sorter=order)]
+        mid = 0.5 * (p[edges[idx, 0]] + p[edges[idx, 1]])
+        doflocs[:, nv + idx] = project(mid).T
+
+    def sphere(centre, radius):
+        on = np.all(_on_sphere(x, centre, radius, tol), axis=1)
+        radial = xc - centre
+        on &= np.abs(np.sum(normal * radial, axis=1)) > 0.5 * np.linalg.norm(radial, axis=1)
+        move(on, lambda m: centre + radius * (m - centre) / np.linalg.norm(m - centre, axis=1)[:, None])
+
+    def cylinder(origin, axis, radius, z0, z1, circle=False):
+        def split(y):
+            axial = (y - origin) @ axis
+            rad = (y - origin) - axial[..., None] * axis
+            return axial, rad
+
+        axial, rad = split(x)
+        dist = np.linalg.norm(rad, axis=-1)
+        on = np.all(np.abs(dist - radius) < tol, axis=1) & np.all((axial > z0 - tol) & (axial < z1 + tol), axis=1)
+        if circle:  # edges along the neck circle at z0 (z1 == z0): both ends on it, any facet type
+            ed = np.sort(np.stack([facets[:, [0, 1]], facets[:, [1, 2]], facets[:, [0, 2]]], axis=1), axis=2)
+            a0, r0 = split(p[ed[..., 0]])
+            a1, r1 = split(p[ed[..., 1]])
+            ok = ((np.abs(np.linalg.norm(r0, axis=-1) - radius) < tol) & (np.abs(a0 - z0) < tol)
+                  & (np.abs(np.linalg.norm(r1, axis=-1) - radius) < tol) & (np.abs(a1 - z0) < tol))
+            sel = np.unique(ed[ok][:, 0] * nv + ed[ok][:, 1])
+            idx = order[np.searchsorted(keys, sel, sorter=order)]
+            mid = 0.5 * (p[edges[idx, 0]] + p[edges[idx, 1]])
+            ma, mr = split(mid)
+            doflocs[:, nv + idx] = (origin + z0 * axis + radius * mr / np.linalg.norm(mr, axis=1)[:, None]).T
+            return
+        on &= np.abs(normal @ axis) < 0.5
+        move(on, lambda m: origin + (split(m)[0])[:, None] * axis
+             + radius * split(m)[1] / np.linalg.norm(split(m)[1], axis=1)[:, None])
+
+    for k in range(cluster.n):
+        sphere(c[k], r[k])
+    for t in terminals:
+        if t.kind == "core":
+            sphere(c[t.particle], t.rho * r[t.particle])
+    for b in range(len(bi)):
+        cylinder(c[bi[b]], e[b], geo.a[b], geo.z_i[b], geo.z_i[b] + geo.h_n[b])
+    for b in range(len(bi)):
+        z0, z1 = geo.z_i[b], geo.z_i[b] + geo.h_n[b]
+        cylinder(c[bi[b]], e[b], geo.a[b], z0, z0, circle=True)
+        cylinder(c[bi[b]], e[b], geo.a[b], z1, z1, circle=True)
+    return MeshTet2(doflocs, m2.t)
+
+
+def assign_particles(cluster: Cluster, geo, x: np.ndarray) -> np.ndarray:
+    """Owning particle of each point ``x`` (N, 3) of the solid.
+
+    In a neck cylinder of bond ``(i, j)``, the part of length ``V_cap,i / (pi a^2)`` next to ``i`` belongs to ``i``,
+    the rest to ``j``; elsewhere the point belongs to the sphere that contains it on the near side of all of that
+    sphere's cap planes (its truncated sphere). Each particle thus owns the volume ``4/3 pi r^3``.
+    """
+    c, r = cluster.centres, cluster.radii
+    bi, bj = cluster.bonds.T
+    e = cluster.directions()
+    owner = np.full(len(x), -1, dtype=np.int64)
+    beyond = np.zeros((len(x), cluster.n), dtype=bool)
+    for b in range(len(bi)):
+        rel = x - c[bi[b]]
+        axial = rel @ e[b]
+        radial = np.linalg.norm(rel - axial[:, None] * e[b], axis=1)
+        z0, z1 = geo.z_i[b], geo.z_i[b] + geo.h_n[b]
+        cap_i = np.pi * geo.h_ci[b] ** 2 * (3.0 * r[bi[b]] - geo.h_ci[b]) / 3.0
+        split = z0 + cap_i / (np.pi * geo.a[b] ** 2)
+        inside = (radial <= geo.a[b] * (1 + 1e-9)) & (axial >= z0) & (axial <= z1)
+        owner[inside & (axial <= split)] = bi[b]
+        owner[inside & (axial > split)] = bj[b]
+        beyond[:, bi[b]] |= axial > z0
+        beyond[:, bj[b]] |= axial < z1
+    dist = np.linalg.norm(x[:, None, :] - c[None], axis=2) / r[None]
+    dist[beyond] = np.inf
+    rest = owner < 0
+    owner[rest] = np.argmin(dist[rest], axis=1)
+    return owner
+
+
+@dataclass
+class ClusterSolution:
+    """Steady 3D conduction result: ``K`` (W/K) = ``Q / (T_hot - T_cold)``; ``particle_T`` the per-particle mean
+    temperatures; ``particle_volume`` the mesh volume each particle owns; ``dofs``; ``u`` and ``basis`` the field."""
+
+    K: float
+    Q: float
+    particle_T: np.ndarray
+    particle_volume: np.ndarray
+    dofs: int
+    u: np.ndarray = field(repr=False)
+    basis: object = field(repr=False)
+
+
+def particle_means(basis, u: np.ndarray, particle: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Volume-averaged ``u`` per particle and each particle's volume (elementwise quadrature, then summed)."""
+    from skfem import Functional
+
+    ones = Functional(lambda w: 1.0 + 0.0 * w.x[0]).elemental(basis)
+    vals = Functional(lambda w: w["u"]).elemental(basis, u=basis.interpolate(u))
+    vol = np.bincount(particle, weights=ones, minlength=n)
+    return np.bincount(particle, weights=vals, minlength=n) / vol, vol
+
+
+def solve_cluster(cmesh: ClusterMesh, kappa: float = 1.0, order: int = 2, rtol: float = 1e-10) -> ClusterSolution:
+    """Steady conduction ``div(kappa grad T) = 0`` on the cluster, ``T`` fixed on the terminals, insulated elsewhere.
+
+    P1 or P2 tetrahedra; the linear system is solved by conjugate gradients with a smoothed-aggregation AMG
+    preconditioner (pyamg) to relative residual ``rtol``. ``Q`` is the reaction at the hot dofs (design notes).
+    """
+    import pyamg
+    from skfem import Basis, ElementTetP1, ElementTetP2, condense
+    from skfem.models.poisson import laplace
+
+    check_positive("kappa", kappa)
+    if order not in (1, 2):
+        raise ValueError(f"order = {order}: must be 1 or 2")
+    elem = ElementTetP1() if order == 1 else ElementTetP2()
+    basis = Basis(cmesh.mesh, elem)
+    A = (kappa * laplace.assemble(basis)).tocsr()
+    t_hot = max(t.T for t in cmesh.terminals)
+    t_cold = min(t.T for t in cmesh.terminals)
+    hot = basis.get_dofs(cmesh.mesh.boundaries["hot"]).all()
+    cold = basis.get_dofs(cmesh.mesh.boundaries["cold"]).all()
+    u = np.zeros(basis.N)
+    u[hot] = t_hot
+    u[cold] = t_cold
+    D = np.concatenate([hot, cold])
+    Ai, bi, _, I = condense(A, np.zeros(basis.N), x=u, D=D)
+    ml = pyamg.smoothed_aggregation_solver(Ai.tocsr(), symmetry="symmetric")
+    u[I] = ml.solve(bi, x0=np.full(len(I), 0.5 * (t_hot + t_cold)), tol=rtol, accel="cg", maxiter=500)
+    Q = float((A @ u)[hot].sum())
+    means, vols = particle_means(basis, u, cmesh.particle, cmesh.cluster.n)
+    return ClusterSolution(K=Q / (t_hot - t_cold), Q=Q, particle_T=means, particle_volume=vols, dofs=basis.N,
+                           u=u, basis=basis)

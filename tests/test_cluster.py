@@ -1,0 +1,89 @@
+"""3D cluster FE (fem_neck.cluster): geometry, volume conservation, conductance against independent references."""
+
+import numpy as np
+import pytest
+
+from fem_neck import neck_geometry, overlap_for_neck
+from fem_neck.cluster import Cluster, Terminal, assign_particles, build_cluster_mesh, solve_cluster
+
+COARSE = {"size_neck": 0.2, "size_far": 0.35, "curvature": 16}
+
+
+def _pair(r_i, r_j, h):
+    return Cluster(centres=[[0, 0, 0], [0.0, 0.0, r_i + r_j - h]], radii=[r_i, r_j], bonds=[[0, 1]])
+
+
+def test_two_sphere_cluster_matches_semisphere_reference():
+    # /work/shared/reference/README.md, semisphere row h/r = 0.08: K/K_cyl = 0.412739950539 (independent hp-FE).
+    # The equal pair cut at both equators is two semispheres in series: K_pair = K_half / 2, K_half = kappa pi r f.
+    r, kappa = 1.0e-3, 394.0
+    cm = build_cluster_mesh(_pair(r, r, 0.08 * r), [Terminal(0, 1.0), Terminal(1, 0.0)], **COARSE)
+    sol = solve_cluster(cm, kappa=kappa, order=2)
+    ref = 0.412739950539 * kappa * np.pi * r / 2
+    assert abs(sol.K / ref - 1) < 1e-2  # P2 on curved tets, coarse graded mesh: ~5e-3 measured
+    # symmetry: the two halves' mean temperatures mirror each other
+    assert sol.particle_T[0] + sol.particle_T[1] == pytest.approx(1.0, abs=2e-3)
+
+
+def test_unequal_pair_agrees_with_axisymmetric_chain_solve():
+    # The unequal pair of Rojek 2022, Sec. 6 solved independently by the axisymmetric FE (fem_neck.conduction).
+    conduction = pytest.importorskip("fem_neck.conduction")
+    r_i, r_j, h, kappa = 1e-3, 3e-3, 0.06e-3, 394.0
+    cm = build_cluster_mesh(_pair(r_i, r_j, h), [Terminal(0, 1.0), Terminal(1, 0.0)], **COARSE)
+    K3 = solve_cluster(cm, kappa=kappa).K
+    K2 = conduction.chain_conductance([r_i, r_j], [h], kappa=kappa).K
+    assert abs(K3 / K2 - 1) < 1.5e-2
+
+
+def test_volume_is_conserved_and_terminals_cut_exactly():
+    # three unequal spheres, bent; one plane terminal (half sphere removed) and one core terminal (ball removed)
+    r = np.array([1.0, 1.5, 0.8])
+    a = [0.4, 0.35]
+    c1 = np.array([r[0] + r[1] - overlap_for_neck(r[0], r[1], a[0]), 0, 0])
+    c2 = c1 + (r[1] + r[2] - overlap_for_neck(r[1], r[2], a[1])) * np.array([0.0, 1.0, 0.0])
+    cl = Cluster([[0, 0, 0], c1, c2], r, [[0, 1], [1, 2]])
+    cm = build_cluster_mesh(cl, [Terminal(0, 1.0, "plane"), Terminal(2, 0.0, "core", rho=0.3)], **COARSE)
+    exact = 4 / 3 * np.pi * np.sum(r**3) - 2 / 3 * np.pi * r[0] ** 3 - 4 / 3 * np.pi * (0.3 * r[2]) ** 3
+    assert cm.volume_exact == pytest.approx(exact, rel=1e-12)
+    assert cm.volume_cad == pytest.approx(exact, rel=1e-6)  # OCC union of spheres + necks: volume conserved
+    sol = solve_cluster(cm, order=2)
+    assert sol.particle_volume.sum() == pytest.approx(exact, rel=1e-3)  # curved P2 geometry
+    # each particle owns its 4/3 pi r^3 (less its cut), up to the centroid assignment of straddling elements
+    own = 4 / 3 * np.pi * r**3 - np.array([2 / 3 * np.pi * r[0] ** 3, 0, 4 / 3 * np.pi * (0.3 * r[2]) ** 3])
+    assert np.allclose(sol.particle_volume, own, rtol=2e-2)
+    # maximum principle and monotone order along the chain
+    assert 1.0 > sol.particle_T[0] > sol.particle_T[1] > sol.particle_T[2] > 0.0
+
+
+def test_assign_particles_splits_the_neck_by_cap_volume():
+    geo = neck_geometry(1.0, 3.0, 0.06)
+    cl = _pair(1.0, 3.0, 0.06)
+    z = np.linspace(float(geo.z_i), float(geo.z_i + geo.h_n), 2001)[1:-1]
+    owner = assign_particles(cl, cl.necks(), np.column_stack([0 * z, 0 * z, z]))
+    cap_i = np.pi * geo.h_ci**2 * (3 * 1.0 - geo.h_ci) / 3
+    split = geo.z_i + cap_i / (np.pi * geo.a**2)
+    assert np.all(owner[z < split - 1e-9] == 0) and np.all(owner[z > split + 1e-9] == 1)
+    # far from the neck: the sphere that contains the point
+    assert assign_particles(cl, cl.necks(), np.array([[0, 0, -0.5], [0, 0, 3.9]])).tolist() == [0, 1]
+
+
+def test_invalid_clusters_are_refused():
+    r, d = 1.0, 2.0 - overlap_for_neck(1.0, 1.0, 0.6)
+    # three spheres at 60 degrees with a/r = 0.6: the necks on one sphere would intersect
+    tri = Cluster(d / np.sqrt(3) * np.array([[1, 0, 0], [-0.5, np.sqrt(3) / 2, 0], [-0.5, -np.sqrt(3) / 2, 0]]),
+                  [r] * 3, [[0, 1], [1, 2], [2, 0]])
+    with pytest.raises(ValueError, match="necks of bonds"):
+        tri.validate()
+    with pytest.raises(ValueError, match="overlap"):  # overlapping but unbonded
+        Cluster([[0, 0, 0], [0, 0, 1.9]], [1, 1], np.zeros((0, 2))).validate()
+    with pytest.raises(ValueError, match="needs exactly one"):  # plane terminal on a two-bond particle
+        build_cluster_mesh(Cluster([[0, 0, 0], [0, 0, d], [0, 0, 2 * d]], [1, 1, 1], [[0, 1], [1, 2]]),
+                           [Terminal(1, 1.0), Terminal(0, 0.0)])
+
+
+def test_mesh_is_deterministic():
+    cl = _pair(1.0, 1.0, 0.1)
+    terms = [Terminal(0, 1.0), Terminal(1, 0.0)]
+    m1 = build_cluster_mesh(cl, terms, **COARSE).mesh
+    m2 = build_cluster_mesh(cl, terms, **COARSE).mesh
+    assert np.array_equal(m1.t, m2.t) and np.array_equal(m1.doflocs, m2.doflocs)

@@ -1,0 +1,479 @@
+"""3D clusters: the pipe-network DEM against full 3D finite-element conduction (issue 5, item 2).
+
+Clusters (radii ~1 mm, copper kappa = 394 W/(m K); relative errors do not depend on either):
+
+* ``triangle`` -- three equal spheres bonded in a ring, plus two *leads*;
+* ``tetrahedron`` -- four equal spheres, all six bonds, plus two leads;
+* ``bent chain`` -- five spheres of radii 1.0, 1.6, 0.8, 1.3, 1.0 mm along a non-planar zigzag (bond angles 135, 90,
+  120 degrees, with torsion);
+* ``random`` -- 10-20 spheres of radii 0.6-1.4 mm grown by seeded random attachment, a third of them placed in the
+  pocket of two bonded neighbours so that rings and coordination numbers up to 4-5 occur.
+
+Boundary conditions. Heat enters and leaves through two one-bond particles cut by the plane through their centre
+normal to their bond (``fem_neck.cluster.Terminal(kind="plane")``), held at 1 K and 0 K. Such a half particle is
+exactly the body that defines the pipe's half-conductance (Rojek 2022, Fig. 12 and eq. 36), so the DEM -- that
+particle held at its temperature, with that bond's law -- represents the boundary exactly: any difference is the
+surrogate's own error (the law and the lumped particle temperature), not a boundary artefact. The triangle and the
+tetrahedron have no one-bond particle, so each gets two leads: equal spheres bonded to two of its particles,
+pointing away from the centroid. For the compact clusters a second variant holds two particles' *centre balls*
+(radius r/4) instead -- a "centre temperature", which the pipe network does not represent exactly; its rows show how
+much that choice alone costs.
+
+Measured: the effective conductance ``K = Q/(T_hot - T_cold)`` and each free particle's mean temperature (volume
+average over the particle's own share, ``4/3 pi r^3``), FE against the DEM steady network for each conductance law.
+The FE error bar is the change between two mesh levels (full run). The error map puts the per-particle temperature
+error against the particle's coordination number and its mean neck size a/r.
+"""
+
+from __future__ import annotations
+
+import pathlib
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from fem_neck.cluster import Cluster, Terminal, build_cluster_mesh, solve_cluster
+from fem_neck.geometry import overlap_for_neck
+
+KAPPA = 394.0
+R0 = 1.0e-3
+MESH_QUICK = {"size_neck": 0.3, "size_far": 0.5, "curvature": 12}
+MESH_LEVELS = ({"size_neck": 0.2, "size_far": 0.35, "curvature": 16},
+               {"size_neck": 0.12, "size_far": 0.25, "curvature": 24})
+
+
+@dataclass(frozen=True)
+class Case:
+    """One cluster with its boundary: ``name``, ``family``, the :class:`Cluster` and its two terminals."""
+
+    name: str
+    family: str
+    cluster: Cluster
+    terminals: tuple
+
+
+def _place(c_host, r_host, r_new, a, direction):
+    """Centre of a sphere of radius ``r_new`` bonded to the host with neck radius ``a`` along ``direction``."""
+    d = r_host + r_new - overlap_for_neck(r_host, r_new, a)
+    return c_host + d * direction / np.linalg.norm(direction)
+
+
+def with_leads(centres, radii, bonds, hosts, a_over_r):
+    """Add a lead sphere (equal to its host) to each of ``hosts``, along centroid -> host; return the cluster and
+    the indices of the two leads."""
+    centres = [np.asarray(c, dtype=float) for c in centres]
+    radii = list(radii)
+    bonds = [tuple(b) for b in bonds]
+    centroid = np.mean(centres, axis=0)
+    leads = []
+    for host in hosts:
+        r = radii[host]
+        centres.append(_place(centres[host], r, r, a_over_r * r, centres[host] - centroid))
+        radii.append(r)
+        bonds.append((host, len(radii) - 1))
+        leads.append(len(radii) - 1)
+    return Cluster(np.array(centres), np.array(radii), np.array(bonds)), leads
+
+
+def triangle(a_over_r: float, leads: bool = True) -> Case:
+    """Three equal spheres in a ring (bond angle 60 degrees; necks must stay below a/r = 0.5)."""
+    r = R0
+    d = 2 * r - overlap_for_neck(r, r, a_over_r * r)
+    centres = d / np.sqrt(3.0) * np.array([[np.cos(t), np.sin(t), 0.0] for t in np.radians([90, 210, 330])])
+    bonds = [(0, 1), (1, 2), (2, 0)]
+    return _compact("triangle", centres, [r] * 3, bonds, a_over_r, leads)
+
+
+def tetrahedron(a_over_r: float, leads: bool = True) -> Case:
+    """Four equal spheres, all six bonds (bond angle 60 degrees)."""
+    r = R0
+    d = 2 * r - overlap_for_neck(r, r, a_over_r * r)
+    verts = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]], dtype=float)
+    centres = verts * d / np.linalg.norm(verts[0] - verts[1])
+    bonds = [(p, q) for p in range(4) for q in range(p + 1, 4)]
+    return _compact("tetrahedron", centres, [r] * 4, bonds, a_over_r, leads)
+
+
+def _compact(family, centres, radii, bonds, a_over_r, leads):
+    if leads:
+        cluster, (hot, cold) = with_leads(centres, radii, bonds, (0, 1), a_over_r)
+        terminals = (Terminal(hot, 1.0), Terminal(cold, 0.0))
+        name = f"{family} a/r={a_over_r:g} (leads)"
+    else:
+        cluster = Cluster(np.asarray(centres), np.asarray(radii), np.asarray(bonds))
+        terminals = (Terminal(0, 1.0, "core"), Terminal(1, 0.0, "core"))
+        name = f"{family} a/r={a_over_r:g} (centre balls)"
+    return Case(name, family + ("" if leads else " (centre balls)"), cluster, terminals)
+
+
+def bent_chain(a_over_r: float) -> Case:
+    """Five spheres of mixed radii along a non-planar zigzag; ``a_over_r`` is relative to each bond's smaller radius."""
+    radii = R0 * np.array([1.0, 1.6, 0.8, 1.3, 1.0])
+    dirs = np.array([[0, 0, 1], [np.sin(np.radians(45)), 0, np.cos(np.radians(45))], [1, 0, 0],
+                     [np.cos(np.radians(60)), np.sin(np.radians(60)), 0]], dtype=float)
+    centres = [np.zeros(3)]
+    for k, u in enumerate(dirs):
+        a = a_over_r * min(radii[k], radii[k + 1])
+        centres.append(_place(centres[-1], radii[k], radii[k + 1], a, u))
+    cluster = Cluster(np.array(centres), radii, np.array([(k, k + 1) for k in range(4)]))
+    return Case(f"bent chain a/r={a_over_r:g}", "bent chain", cluster, (Terminal(0, 1.0), Terminal(4, 0.0)))
+
+
+def random_cluster(n: int, seed: int, a_range=(0.15, 0.55), r_range=(0.6, 1.4), max_tries: int = 2000) -> Case:
+    """``n`` spheres grown by seeded random attachment (mixed radii and necks, some rings); terminals: the two
+    one-bond particles farthest apart (the cluster is regrown until there are two)."""
+    rng = np.random.default_rng(seed)
+    for _ in range(50):
+        radii = [R0 * rng.uniform(*r_range)]
+        centres = [np.zeros(3)]
+        bonds = []
+        tries = 0
+        while len(radii) < n and tries < max_tries:
+            tries += 1
+            r_new = R0 * rng.uniform(*r_range)
+            host = int(rng.integers(len(radii)))
+            a = rng.uniform(*a_range) * min(r_new, radii[host])
+            new_bonds = [(host, len(radii))]
+            partners = [q for p, q in bonds if p == host] + [p for p, q in bonds if q == host]
+            if partners and rng.uniform() < 0.35:
+                # a pocket: bond to the host and to one of its neighbours (a ring of three)
+                other = int(rng.choice(partners))
+                a2 = rng.uniform(*a_range) * min(r_new, radii[other])
+                c = _pocket(centres[host], radii[host], centres[other], radii[other], r_new, a, a2, rng)
+                if c is None:
+                    continue
+                new_bonds.append((other, len(radii)))
+            else:
+                c = _place(centres[host], radii[host], r_new, a, rng.normal(size=3))
+            trial = Cluster(np.array(centres + [c]), np.array(radii + [r_new]), np.array(bonds + new_bonds))
+            try:
+                trial.validate()
+                gaps = (np.linalg.norm(trial.centres[:-1] - c, axis=1) - trial.radii[:-1] - r_new)
+                bonded = {p for b in new_bonds for p in b}
+                if any(gaps[q] < 0.1 * R0 for q in range(len(gaps)) if q not in bonded):
+                    continue
+                if _crowded(trial, min_angle_margin=np.radians(8)):
+                    continue
+            except ValueError:
+                continue
+            centres.append(c)
+            radii.append(r_new)
+            bonds += new_bonds
+        cluster = Cluster(np.array(centres), np.array(radii), np.array(bonds))
+        leaves = np.flatnonzero(cluster.degree() == 1)
+        if len(radii) == n and len(leaves) >= 2:
+            dist = np.linalg.norm(cluster.centres[leaves][:, None] - cluster.centres[leaves][None], axis=2)
+            p, q = np.unravel_index(np.argmax(dist), dist.shape)
+            return Case(f"random n={n} seed={seed}", "random", cluster,
+                        (Terminal(int(leaves[p]), 1.0), Terminal(int(leaves[q]), 0.0)))
+    raise RuntimeError(f"random cluster n={n} seed={seed}: could not grow a valid cluster")
+
+
+def _pocket(c1, r1, c2, r2, r_new, a1, a2, rng):
+    """A centre at distance d1 from c1 and d2 from c2 (both bonds' neck radii a1, a2), random on that circle."""
+    d1 = r1 + r_new - overlap_for_neck(r1, r_new, a1)
+    d2 = r2 + r_new - overlap_for_neck(r2, r_new, a2)
+    axis = c2 - c1
+    L = np.linalg.norm(axis)
+    axis /= L
+    x = (d1**2 - d2**2 + L**2) / (2 * L)
+    rho2 = d1**2 - x**2
+    if rho2 <= 0:
+        return None
+    perp = np.cross(axis, rng.normal(size=3))
+    perp /= np.linalg.norm(perp)
+    return c1 + x * axis + np.sqrt(rho2) * perp
+
+
+def _crowded(cluster: Cluster, min_angle_margin: float) -> bool:
+    """True if two necks on one sphere come closer than ``min_angle_margin`` (keeps the mesh reasonable)."""
+    a = cluster.necks().a
+    e = cluster.directions()
+    bi, bj = cluster.bonds.T
+    for k in range(cluster.n):
+        ends = [(b, 1.0) for b in np.flatnonzero(bi == k)] + [(b, -1.0) for b in np.flatnonzero(bj == k)]
+        for x in range(len(ends)):
+            for y in range(x + 1, len(ends)):
+                (b1, s1), (b2, s2) = ends[x], ends[y]
+                angle = np.arccos(np.clip(s1 * s2 * e[b1] @ e[b2], -1, 1))
+                need = np.arcsin(min(a[b1] / cluster.radii[k], 1)) + np.arcsin(min(a[b2] / cluster.radii[k], 1))
+                if angle < need + min_angle_margin:
+                    return True
+    return False
+
+
+def all_cases(quick: bool) -> list[Case]:
+    """The clusters of the study (quick: one neck size per family and a 10-particle random cluster)."""
+    if quick:
+        return [triangle(0.3), tetrahedron(0.3), bent_chain(0.4), random_cluster(10, seed=1)]
+    out = []
+    for x in (0.15, 0.3, 0.45):
+        out += [triangle(x), tetrahedron(x)]
+    out += [triangle(0.3, leads=False), tetrahedron(0.3, leads=False)]
+    out += [bent_chain(x) for x in (0.15, 0.3, 0.45, 0.6)]
+    out += [random_cluster(12, seed=1), random_cluster(16, seed=2)]
+    return out
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The DEM side
+# ---------------------------------------------------------------------------------------------------------------
+
+LAWS = ("rojek", "argento-bouvard", "fit", "zohdi")
+
+
+def available_laws() -> tuple:
+    """The laws of :data:`LAWS` that can be evaluated here (``fit`` needs the shipped fit file)."""
+    from fem_neck import law as laws
+
+    try:
+        laws.ConductanceLaw.default()
+    except ValueError:
+        return tuple(x for x in LAWS if x != "fit")
+    return LAWS
+
+
+def dem_conductances(cluster: Cluster, law: str) -> np.ndarray:
+    """Pipe conductance of every bond of ``cluster`` under ``law``."""
+    from fem_neck import law as laws
+
+    i, j = cluster.bonds.T
+    r_i, r_j = cluster.radii[i], cluster.radii[j]
+    a = cluster.necks().a
+    if law == "zohdi":  # kappa A_c / |x_i - x_j| with the lens (intersection circle) contact area (Zohdi 2014)
+        d = np.linalg.norm(cluster.centres[j] - cluster.centres[i], axis=1)
+        x = (d**2 + r_i**2 - r_j**2) / (2 * d)
+        return KAPPA * np.pi * (r_i**2 - x**2) / d
+    chosen = {"rojek": laws.ROJEK, "argento-bouvard": laws.ARGENTO_BOUVARD, "fit": None}[law]
+    return np.asarray(laws.pair_conductance(KAPPA, r_i, r_j, a, chosen))
+
+
+def dem_steady(cluster: Cluster, terminals, K: np.ndarray) -> tuple[float, np.ndarray]:
+    """Steady pipe network (Rojek 2022, eqs. 2-4 with dT/dt = 0): effective conductance and particle temperatures."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spl
+
+    n = cluster.n
+    i, j = cluster.bonds.T
+    L = sp.coo_matrix((np.concatenate([K, K, -K, -K]), (np.concatenate([i, j, i, j]), np.concatenate([i, j, j, i]))),
+                      shape=(n, n)).tocsr()
+    T = np.zeros(n)
+    fixed = np.array([t.particle for t in terminals])
+    T[fixed] = [t.T for t in terminals]
+    free = np.setdiff1d(np.arange(n), fixed)
+    T[free] = spl.spsolve(L[free][:, free].tocsc(), -L[free][:, fixed] @ T[fixed])
+    t_hot = max(t.T for t in terminals)
+    t_cold = min(t.T for t in terminals)
+    hot = [t.particle for t in terminals if t.T == t_hot]
+    Q = float((L @ T)[hot].sum())
+    return Q / (t_hot - t_cold), T
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The comparison
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def fe_solve(case: Case, quick: bool) -> dict:
+    """FE of one case: ``K`` and particle means on the finest level, and the change from the level before."""
+    levels = (MESH_QUICK,) if quick else MESH_LEVELS
+    out = {}
+    t0 = time.perf_counter()
+    for opts in levels:
+        cmesh = build_cluster_mesh(case.cluster, case.terminals, **opts)
+        sol = solve_cluster(cmesh, kappa=KAPPA, order=2)
+        if out:
+            out["mesh_change"] = abs(sol.K - out["K"]) / sol.K
+            out["T_change"] = float(np.max(np.abs(sol.particle_T - out["T"])))
+        out.update(K=sol.K, T=sol.particle_T, dofs=sol.dofs, cmesh=cmesh, sol=sol)
+    out.setdefault("mesh_change", float("nan"))
+    out.setdefault("T_change", float("nan"))
+    out["seconds"] = time.perf_counter() - t0
+    return out
+
+
+def particle_neck_ratio(cluster: Cluster) -> np.ndarray:
+    """Mean a/r_k over each particle's bonds."""
+    a = cluster.necks().a
+    i, j = cluster.bonds.T
+    total = np.bincount(i, a / cluster.radii[i], cluster.n) + np.bincount(j, a / cluster.radii[j], cluster.n)
+    return total / np.maximum(cluster.degree(), 1)
+
+
+def compare(case: Case, fe: dict) -> tuple[dict, list]:
+    """Per-case and per-particle FE vs DEM errors for every law."""
+    cl = case.cluster
+    fixed = {t.particle for t in case.terminals}
+    free = np.array([k for k in range(cl.n) if k not in fixed])
+    dT = max(t.T for t in case.terminals) - min(t.T for t in case.terminals)
+    i, j = cl.bonds.T
+    a = cl.necks().a
+    row = {"case": case.name, "family": case.family, "n": cl.n, "bonds": len(i),
+           "a_over_r_mean": float(np.mean(a / np.minimum(cl.radii[i], cl.radii[j]))),
+           "z_max": int(cl.degree().max()), "K_fe": fe["K"], "fe_mesh_change": fe["mesh_change"],
+           "fe_T_change": fe["T_change"], "dofs": fe["dofs"], "fe_seconds": fe["seconds"], "laws": {}}
+    particles = []
+    z = cl.degree()
+    ratio = particle_neck_ratio(cl)
+    for law in available_laws():
+        K_dem, T_dem = dem_steady(cl, case.terminals, dem_conductances(cl, law))
+        err = (T_dem[free] - fe["T"][free]) / dT
+        row["laws"][law] = {"K_dem": K_dem, "K_rel_err": K_dem / fe["K"] - 1.0,
+                            "T_max_err": float(np.max(np.abs(err))), "T_rms_err": float(np.sqrt(np.mean(err**2)))}
+        particles += [{"case": case.name, "family": case.family, "law": law, "particle": int(k), "z": int(z[k]),
+                       "a_over_r": float(ratio[k]), "T_fe": float(fe["T"][k]), "T_dem": float(T_dem[k]),
+                       "err": float(e)} for k, e in zip(free, err)]
+    return row, particles
+
+
+def _table(rows) -> str:
+    LAWS = available_laws()
+    head = ("| cluster | n | bonds | z max | mean a/r | K_FE (W/K) | FE mesh change | "
+            + " | ".join(f"K {law} rel. err" for law in LAWS) + " | "
+            + " | ".join(f"max abs dT {law}" for law in LAWS) + " |")
+    lines = [head, "|" + "---|" * (7 + 2 * len(LAWS))]
+    for r in rows:
+        lines.append(f"| {r['case']} | {r['n']} | {r['bonds']} | {r['z_max']} | {r['a_over_r_mean']:.3f} | "
+                     f"{r['K_fe']:.5g} | {r['fe_mesh_change']:.1e} | "
+                     + " | ".join(f"{r['laws'][law]['K_rel_err']:+.2%}" for law in LAWS) + " | "
+                     + " | ".join(f"{r['laws'][law]['T_max_err']:.3f}" for law in LAWS) + " |")
+    return "\n".join(lines)
+
+
+Z_BINS = ((1, 1), (2, 2), (3, 3), (4, 4), (5, 99))
+A_BINS = ((0.0, 0.25), (0.25, 0.4), (0.4, 1.0))
+
+
+def error_map(particles, law: str) -> str:
+    """Markdown table: RMS particle-temperature error (units of the imposed difference) by coordination number and
+    mean neck size, for one law (centre-ball variants excluded: their boundary is not exact)."""
+    sel = [p for p in particles if p["law"] == law and "centre balls" not in p["family"]]
+    lines = ["| coordination z | " + " | ".join(f"a/r in [{lo:g}, {hi:g})" for lo, hi in A_BINS) + " |",
+             "|---|" + "---|" * len(A_BINS)]
+    for zlo, zhi in Z_BINS:
+        cells = []
+        for lo, hi in A_BINS:
+            errs = [p["err"] for p in sel if zlo <= p["z"] <= zhi and lo <= p["a_over_r"] < hi]
+            cells.append(f"{np.sqrt(np.mean(np.square(errs))):.4f} (n={len(errs)})" if errs else "-")
+        label = str(zlo) if zlo == zhi else f">= {zlo}"
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def _figures(rows, particles, out_dir: pathlib.Path) -> list:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    LAWS = available_laws()
+    figs = []
+    markers = {"triangle": "^", "tetrahedron": "s", "bent chain": "o", "random": "*"}
+    fig, axes = plt.subplots(1, len(LAWS), figsize=(4 * len(LAWS), 3.6), sharey=False)
+    for ax, law in zip(axes, LAWS):
+        for fam, mk in markers.items():
+            sel = [r for r in rows if r["family"] == fam]
+            if sel:
+                ax.plot([r["a_over_r_mean"] for r in sel], [100 * r["laws"][law]["K_rel_err"] for r in sel],
+                        mk, label=fam, ms=8)
+        sel = [r for r in rows if "centre balls" in r["family"]]
+        if sel:
+            ax.plot([r["a_over_r_mean"] for r in sel], [100 * r["laws"][law]["K_rel_err"] for r in sel],
+                    "x", color="k", label="centre-ball boundary")
+        ax.axhline(0, color="grey", lw=0.8)
+        ax.set_title(f"law: {law}")
+        ax.set_xlabel("mean neck size a/r")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("K_DEM / K_FE - 1  (%)")
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    path = out_dir / "clusters_K_error.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    figs.append(path)
+
+    fig, axes = plt.subplots(1, len(LAWS), figsize=(4 * len(LAWS), 3.6), sharey=True)
+    for ax, law in zip(axes, LAWS):
+        sel = [p for p in particles if p["law"] == law and "centre balls" not in p["family"]]
+        if sel:
+            jitter = np.random.default_rng(0).uniform(-0.15, 0.15, len(sel))
+            sc = ax.scatter(np.array([p["z"] for p in sel]) + jitter, [100 * p["err"] for p in sel],
+                            c=[p["a_over_r"] for p in sel], cmap="viridis", vmin=0.1, vmax=0.6, s=18)
+        ax.axhline(0, color="grey", lw=0.8)
+        ax.set_title(f"law: {law}")
+        ax.set_xlabel("coordination number z")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("(T_DEM - T_FE) / dT  (%)")
+    if particles:
+        fig.colorbar(sc, ax=axes, label="particle mean a/r", shrink=0.8)
+    path = out_dir / "clusters_T_error_map.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    figs.append(path)
+    return figs
+
+
+def render_cluster(fe: dict, path: pathlib.Path, title: str) -> pathlib.Path:
+    """Off-screen pyvista render of the FE temperature on the cluster surface (PNG)."""
+    import pyvista
+
+    pyvista.OFF_SCREEN = True
+    mesh = fe["cmesh"].mesh
+    nv = mesh.p.shape[1]
+    cells = np.hstack([np.full((mesh.t.shape[1], 1), 4), mesh.t.T]).ravel()
+    grid = pyvista.UnstructuredGrid(cells, np.full(mesh.t.shape[1], pyvista.CellType.TETRA, dtype=np.uint8),
+                                    mesh.p.T * 1e3)
+    grid.point_data["T (K)"] = fe["sol"].u[:nv]
+    plotter = pyvista.Plotter(off_screen=True, window_size=(900, 700))
+    plotter.add_mesh(grid.extract_surface(), scalars="T (K)", cmap="coolwarm", show_edges=False,
+                     scalar_bar_args={"title": "T (K)"})
+    plotter.add_text(title, font_size=10)
+    plotter.view_isometric()
+    plotter.screenshot(str(path))
+    plotter.close()
+    return path
+
+
+def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
+    """Run the cluster study into ``out_dir``; returns the section contract of :mod:`verification.report`."""
+    import json
+
+    from tqdm import tqdm
+
+    from verification.report import jsonable
+
+    LAWS = available_laws()
+    out_dir = pathlib.Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    rows, particles, summary = [], [], {}
+    last_random = None
+    for case in tqdm(all_cases(quick), desc="3D clusters", unit="cluster", leave=False):
+        fe = fe_solve(case, quick)
+        row, parts = compare(case, fe)
+        rows.append(row)
+        particles += parts
+        summary[f"cluster {case.name}"] = {
+            "K_fe": row["K_fe"], **{f"K_rel_err_{law}": row["laws"][law]["K_rel_err"] for law in LAWS},
+            **{f"T_max_err_{law}": row["laws"][law]["T_max_err"] for law in LAWS}}
+        if case.family == "random":
+            last_random = (case, fe)
+    (out_dir / "clusters.json").write_text(json.dumps(jsonable({"cases": rows, "particles": particles}), indent=1))
+    figures = _figures(rows, particles, out_dir)
+    if last_random is not None:
+        case, fe = last_random
+        figures.append(render_cluster(fe, out_dir / "cluster_random_T.png", f"{case.name}: FE temperature"))
+    worst = {law: max(abs(r["laws"][law]["K_rel_err"]) for r in rows if "centre balls" not in r["family"])
+             for law in LAWS}
+    summary.update({f"clusters worst K rel err {law}": worst[law] for law in LAWS})
+    md = [__doc__.split("\n\n", 1)[1].strip(), "",
+          "Relative errors are DEM minus FE over FE; temperature errors are in units of the imposed difference "
+          f"(1 K). FE: P2 on curved tetrahedra, {'one mesh level (quick)' if quick else 'two mesh levels; the change between them is the FE error bar'}.",
+          "", _table(rows), "",
+          "### Error map: RMS particle-temperature error by coordination number and neck size", ""]
+    for law in [x for x in ("fit", "rojek") if x in LAWS]:
+        md += [f"Law `{law}`:", "", error_map(particles, law), ""]
+    md += [f"![K error]({figures[0].name})", "", f"![T error map]({figures[1].name})", ""]
+    if last_random is not None:
+        md += [f"![random cluster]({figures[2].name})", ""]
+    return {"title": "DEM vs FE: 3D clusters", "markdown": "\n".join(md), "summary": summary, "figures": figures}
