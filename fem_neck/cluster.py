@@ -512,5 +512,29 @@ def solve_cluster(cmesh: ClusterMesh, kappa: float = 1.0, order: int = 2, rtol: 
     u[I] = ml.solve(bi, x0=np.full(len(I), 0.5 * (t_hot + t_cold)), tol=rtol, accel="cg", maxiter=500)
     Q = float((A @ u)[hot].sum())
     means, vols = particle_means(basis, u, cmesh.particle, cmesh.cluster.n)
-    return ClusterSolution(K=Q / (t_hot - t_cold), Q=Q, particle_T=means, particle_volume=vols, dofs=basis.N,
+    return ClusterSolution(K=Q / (t_hot - t_cold), Q=Q, particle_T=means, particle_volume=vols, dofs=int(basis.N),
                            u=u, basis=basis)
+
+
+def write_vtu(cmesh: ClusterMesh, sol: ClusterSolution, path) -> None:
+    """Write the temperature (vertex values) and the owning particle per element to a VTU file for ParaView."""
+    import meshio
+
+    mesh = cmesh.mesh
+    nv = mesh.p.shape[1]
+    meshio.Mesh(mesh.p.T, [("tetra", mesh.t.T)], point_data={"T": sol.u[:nv]},
+                cell_data={"particle": [cmesh.particle]}).write(str(path))
+
+
+def load_cluster_json(data: dict) -> tuple[Cluster, list]:
+    """``{"centres": [[x, y, z], ...], "radii": [...], "bonds": [[i, j], ...], "terminals": [{"particle": k,
+    "T": ..., "kind": "plane"|"core", "rho": 0.25}, ...]}`` (metres, kelvin) -> (Cluster, terminals)."""
+    try:
+        cluster = Cluster(np.asarray(data["centres"], dtype=float), np.asarray(data["radii"], dtype=float),
+                          np.asarray(data["bonds"], dtype=int))
+        terminals = [Terminal(int(t["particle"]), float(t["T"]), t.get("kind", "plane"), float(t.get("rho", 0.25)))
+                     for t in data["terminals"]]
+    except (KeyError, TypeError) as exc:
+        raise ValueError(f"cluster file: missing or malformed entry ({exc}); need centres, radii, bonds, "
+                         "terminals") from exc
+    return cluster, terminals

@@ -87,3 +87,21 @@ def test_mesh_is_deterministic():
     m1 = build_cluster_mesh(cl, terms, **COARSE).mesh
     m2 = build_cluster_mesh(cl, terms, **COARSE).mesh
     assert np.array_equal(m1.t, m2.t) and np.array_equal(m1.doflocs, m2.doflocs)
+
+
+def test_cli_cluster(tmp_path, capsys):
+    import json
+
+    from fem_neck.cli import main
+
+    f = tmp_path / "pair.json"
+    f.write_text(json.dumps({"centres": [[0, 0, 0], [0, 0, 1.92e-3]], "radii": [1e-3, 1e-3], "bonds": [[0, 1]],
+                             "terminals": [{"particle": 0, "T": 1.0}, {"particle": 1, "T": 0.0}]}))
+    args = ["cluster", str(f), "--json", "--levels", "1", "--size-neck", "0.3", "--size-far", "0.5"]
+    assert main(args, modules=("cluster",)) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["K"] == pytest.approx(0.412739950539 * 394.0 * np.pi * 1e-3 / 2, rel=3e-2)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"centres": [[0, 0, 0]], "radii": [-1.0], "bonds": [], "terminals": []}))
+    assert main(["cluster", str(bad), "--json"], modules=("cluster",)) == 2
+    assert capsys.readouterr().err.count("\n") == 1
