@@ -188,7 +188,8 @@ def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size
                        curvature: int = 20, method: str = "newton", curved: bool = True) -> ClusterMesh:
     """Mesh the cluster with first-order tetrahedra, graded toward every neck circle.
 
-    ``size_neck`` is the element size at the neck circles as a fraction of the neck radius ``a``; it grows
+    ``size_neck`` is the element size at the neck circles as a fraction of the neck radius ``a`` (and at most half
+    the neck length, which is ~a^2/(2r) for small necks); it grows
     linearly to ``size_far`` times the smaller radius of the bond at a distance ``2 a`` (gmsh Distance + Threshold
     fields). ``curvature`` is gmsh's elements per 2 pi of surface curvature. ``curved`` returns the quadratic
     :func:`curved_mesh` (exact boundary edge midpoints; use with ``order=2``). Deterministic (one thread, fixed
@@ -298,7 +299,7 @@ def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size
             gmsh.model.mesh.field.setNumber(dist, "Sampling", 200)
             thr = gmsh.model.mesh.field.add("Threshold")
             gmsh.model.mesh.field.setNumber(thr, "InField", dist)
-            gmsh.model.mesh.field.setNumber(thr, "SizeMin", size_neck * geo.a[b])
+            gmsh.model.mesh.field.setNumber(thr, "SizeMin", min(size_neck * geo.a[b], 0.5 * geo.h_n[b]))
             gmsh.model.mesh.field.setNumber(thr, "SizeMax", size_far * min(r[bi[b]], r[bj[b]]))
             gmsh.model.mesh.field.setNumber(thr, "DistMin", 0.0)
             gmsh.model.mesh.field.setNumber(thr, "DistMax", 2.0 * geo.a[b])
