@@ -185,11 +185,12 @@ def _check_terminals(cluster: Cluster, terminals) -> tuple:
 
 
 def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size_far: float = 0.35,
-                       curvature: int = 20, method: str = "newton", curved: bool = True) -> ClusterMesh:
+                       curvature: int = 20, method: str = "newton", curved: bool = True,
+                       neck_cells: float = 2.0) -> ClusterMesh:
     """Mesh the cluster with first-order tetrahedra, graded toward every neck circle.
 
-    ``size_neck`` is the element size at the neck circles as a fraction of the neck radius ``a`` (and at most half
-    the neck length, which is ~a^2/(2r) for small necks); it grows
+    ``size_neck`` is the element size at the neck circles as a fraction of the neck radius ``a`` (and at most the
+    neck length over ``neck_cells``; the length is ~a^2/(2r) for small necks); it grows
     linearly to ``size_far`` times the smaller radius of the bond at a distance ``2 a`` (gmsh Distance + Threshold
     fields). ``curvature`` is gmsh's elements per 2 pi of surface curvature. ``curved`` returns the quadratic
     :func:`curved_mesh` (exact boundary edge midpoints; use with ``order=2``). Deterministic (one thread, fixed
@@ -204,6 +205,7 @@ def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size
     terminals = _check_terminals(cluster, terminals)
     check_positive("size_neck", size_neck)
     check_positive("size_far", size_far)
+    check_positive("neck_cells", neck_cells)
     # Build in units of the largest radius (OCC's tolerances are absolute), scale the mesh back at the end.
     unit = float(cluster.radii.max())
     real = cluster
@@ -299,7 +301,7 @@ def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size
             gmsh.model.mesh.field.setNumber(dist, "Sampling", 200)
             thr = gmsh.model.mesh.field.add("Threshold")
             gmsh.model.mesh.field.setNumber(thr, "InField", dist)
-            gmsh.model.mesh.field.setNumber(thr, "SizeMin", min(size_neck * geo.a[b], 0.5 * geo.h_n[b]))
+            gmsh.model.mesh.field.setNumber(thr, "SizeMin", min(size_neck * geo.a[b], geo.h_n[b] / neck_cells))
             gmsh.model.mesh.field.setNumber(thr, "SizeMax", size_far * min(r[bi[b]], r[bj[b]]))
             gmsh.model.mesh.field.setNumber(thr, "DistMin", 0.0)
             gmsh.model.mesh.field.setNumber(thr, "DistMax", 2.0 * geo.a[b])

@@ -31,8 +31,8 @@ def test_unequal_pair_agrees_with_axisymmetric_chain_solve():
     r_i, r_j, h, kappa = 1e-3, 3e-3, 0.06e-3, 394.0
     cm = build_cluster_mesh(_pair(r_i, r_j, h), [Terminal(0, 1.0), Terminal(1, 0.0)], **COARSE)
     K3 = solve_cluster(cm, kappa=kappa).K
-    K2 = conduction.chain_conductance([r_i, r_j], [h], kappa=kappa).K
-    assert abs(K3 / K2 - 1) < 1.5e-2
+    K2 = conduction.pair_conductance(r_i, r_j, h, kappa=kappa).K
+    assert abs(K3 / K2 - 1) < 5e-3  # measured 2.2e-3 (3D converges from above)
 
 
 def test_volume_is_conserved_and_terminals_cut_exactly():

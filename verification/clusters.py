@@ -38,7 +38,7 @@ from fem_neck.geometry import overlap_for_neck
 
 KAPPA = 394.0
 R0 = 1.0e-3
-MESH_QUICK = {"size_neck": 0.3, "size_far": 0.5, "curvature": 12}
+MESH_QUICK = {"size_neck": 0.3, "size_far": 0.5, "curvature": 12, "neck_cells": 0.5}
 MESH_LEVELS = ({"size_neck": 0.2, "size_far": 0.35, "curvature": 16},
                {"size_neck": 0.12, "size_far": 0.25, "curvature": 24})
 
