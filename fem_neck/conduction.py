@@ -1,0 +1,222 @@
+"""Steady axisymmetric heat conduction through sintered necks (scikit-fem), and the conductances of Rojek 2022.
+
+Physics. In the meridian half-plane (``x`` radial, ``y`` axial) the steady conduction equation of a body of
+revolution is ``div(kappa x grad T) = 0``; its weak form is the Laplacian weighted by the radial coordinate ``x``
+(``w.x[0]``), and every heat flow is ``2 pi`` times the meridian integral. The temperature is fixed on the two end
+disks (``T = 1`` on ``top``, ``0`` on ``bottom``), every other surface is insulated, so with ``Delta T = 1``
+
+    K = Q / Delta T = 2 pi kappa sum_{i in top} (A u)_i          (the reaction at the Dirichlet dofs)
+      = 2 pi kappa u^T A u                                       (the energy; identical to round-off),
+
+which converges at twice the rate of the boundary flux ``-kappa dT/dn`` (the tests cross-check both).
+Lengths are normalised by the largest radius before meshing, and ``K`` scales back linearly with length.
+
+Accuracy: see :mod:`fem_neck.accuracy`. Elements are Lagrange P1-P4 on the isoparametric (quadratic) version of the
+graded mesh, so the curved sphere surface is followed; ``curved=False`` keeps straight sides (studies only).
+
+Public API (all plain functions of numbers, safe to call from a process pool; gmsh is opened and closed per mesh):
+
+* :func:`semisphere_conductance` -- the semisphere with a neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Section 5);
+* :func:`pair_conductance` -- two spheres ``r_i``, ``r_j`` with overlap ``h`` (Section 6);
+* :func:`chain_conductance` -- a collinear chain;
+* :func:`solve_profile` -- one solve on a given mesh and order (for convergence studies).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fem_neck import accuracy, shapes
+from fem_neck.geometry import check_positive
+
+
+@dataclass
+class Solution:
+    """One FE solve on one mesh (length-normalised body, ``kappa = 1``): the conductance ``K = K_reaction +
+    geometry_correction``, the basis and the temperature ``u`` (``T = 0`` on ``bottom``, ``1`` on ``top``)."""
+
+    K: float
+    K_reaction: float
+    geometry_correction: float
+    dofs: int
+    order: int
+    basis: object = field(repr=False)
+    u: np.ndarray = field(repr=False)
+    matrix: object = field(repr=False)
+
+
+@dataclass
+class Result:
+    """A conductance solved to a tolerance.
+
+    K: conductance in W/K for the given ``kappa`` and lengths. K_over_Kcyl: ``K / (kappa pi r)`` with ``r`` the
+    sphere radius (semisphere) or the smallest radius (pair, chain) -- the normalisation of Rojek 2022, eqs. 38-39.
+    error_estimate: relative error estimate of ``K`` (see :mod:`fem_neck.accuracy`); converged: whether it met
+    the tolerance. dofs: unknowns of the reported solve; seconds: wall time of meshing and all solves; h_min:
+    shortest mesh edge (in the input length unit); grading: final size-per-corner-distance factor; order: element
+    order of the reported solve; rounds: meshes tried. necks: neck radius per bond (input length unit).
+    solution, profile, length_scale, kappa: what :mod:`fem_neck.render` needs (dropped when pickled, so results
+    travel cheaply between processes).
+    """
+
+    K: float
+    K_over_Kcyl: float
+    error_estimate: float
+    converged: bool
+    dofs: int
+    seconds: float
+    h_min: float
+    grading: float
+    order: int
+    rounds: int
+    necks: list
+    kappa: float
+    length_scale: float
+    solution: Solution | None = field(default=None, repr=False)
+    profile: shapes.ProfileMesh | None = field(default=None, repr=False)
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state["solution"] = None
+        state["profile"] = None
+        return state
+
+
+_ELEMENTS = {1: "ElementTriP1", 2: "ElementTriP2", 3: "ElementTriP3", 4: "ElementTriP4"}
+
+
+def _axisymmetric_laplace():
+    import skfem
+    from skfem.helpers import dot, grad
+
+    @skfem.BilinearForm
+    def laplace(u, v, w):
+        return w.x[0] * dot(grad(u), grad(v))
+
+    return laplace
+
+
+def solve_profile(profile: shapes.ProfileMesh, order: int = 2, curved: bool = True) -> Solution:
+    """Solve ``div(x grad T) = 0`` with ``T = 0`` on ``bottom``, ``1`` on ``top``; ``K = 2 pi (reaction)``, kappa = 1.
+
+    ``curved`` uses the isoparametric quadratic mesh (:func:`fem_neck.shapes.curved_mesh`); P1 is always affine.
+    """
+    import skfem
+
+    if order not in _ELEMENTS:
+        raise ValueError(f"order = {order!r}: must be one of {', '.join(map(str, _ELEMENTS))}")
+    mesh = shapes.curved_mesh(profile) if curved and order > 1 else profile.mesh
+    basis = skfem.Basis(mesh, getattr(skfem, _ELEMENTS[order])())
+    matrix = _axisymmetric_laplace().assemble(basis)
+    top = basis.get_dofs("top").all()
+    fixed = np.concatenate([top, basis.get_dofs("bottom").all()])
+    u = np.zeros(basis.N)
+    u[top] = 1.0
+    u = skfem.solve(*skfem.condense(matrix, x=u, D=fixed))
+    K = 2.0 * math.pi * float(np.sum((matrix @ u)[top]))
+    correction = geometry_correction(profile, basis, u)
+    return Solution(K=K + correction, K_reaction=K, geometry_correction=correction, dofs=int(basis.N), order=order,
+                    basis=basis, u=u, matrix=matrix)
+
+
+_REFERENCE_EDGES = np.array([[[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 1.0]], [[0.0, 0.0], [0.0, 1.0]]])
+
+
+def geometry_correction(profile: shapes.ProfileMesh, basis, u, points: int = 8) -> float:
+    """First-order (Hadamard) correction of ``K`` for the gap between the meshed and the true spherical surfaces.
+
+    Moving an insulated boundary outwards by ``delta`` changes the conductance by
+    ``dK = int_Gamma kappa |grad T|^2 delta dS`` (the shape derivative of the Dirichlet energy). ``delta`` is the
+    distance from each boundary edge of the mesh (straight, or quadratic isoparametric) to its circle, evaluated at
+    Gauss points along the edge (taken in the reference triangle, so no point inversion is needed); ``kappa = 1``,
+    ``Delta T = 1``, ``dS = 2 pi x ds``. It removes the ``O(h^4)`` geometric error of quadratic boundaries to
+    second order (measured: P4 from -3e-6 to 1e-8 on the reference semisphere).
+    """
+    import skfem
+
+    mesh = basis.mesh
+    s, weights = np.polynomial.legendre.leggauss(points)
+    s, weights = 0.5 * (s + 1.0), 0.5 * weights
+    total = 0.0
+    for name, (z_centre, radius) in profile.arcs.items():
+        facets = profile.mesh.boundaries[name]
+        elements = mesh.f2t[0, facets]
+        for k, (va, vb) in enumerate(_REFERENCE_EDGES):
+            on_edge = mesh.t2f[k, elements] == facets
+            if not np.any(on_edge):
+                continue
+            sel = elements[on_edge]
+            tangent = vb - va
+            ref = va[:, None] + tangent[:, None] * s[None, :]
+            edge_basis = skfem.CellBasis(mesh, basis.elem, elements=sel, quadrature=(ref, weights))
+            grad_u = edge_basis.interpolate(u).grad
+            x = edge_basis.mapping.F(ref, tind=sel)
+            jac = edge_basis.mapping.DF(ref, tind=sel)
+            ds = np.hypot(jac[0, 0] * tangent[0] + jac[0, 1] * tangent[1], jac[1, 0] * tangent[0] + jac[1, 1] * tangent[1])
+            gap = radius - np.hypot(x[0], x[1] - z_centre)
+            total += float(np.sum((grad_u[0] ** 2 + grad_u[1] ** 2) * gap * x[0] * ds * weights))
+    return 2.0 * math.pi * total
+
+
+def _to_tolerance(build, kappa: float, length_scale: float, r_ref: float, rtol, order, necks) -> Result:
+    """Mesh with ``build(grading)`` and solve orders ``p-1`` and ``p`` until the estimate meets ``rtol``."""
+    rtol = accuracy.check_rtol(rtol)
+    order = accuracy.check_order(order, rtol)
+    start = time.perf_counter()
+
+    def solve_pair(grading, p):
+        profile = build(grading)
+        high = solve_profile(profile, p)
+        low = solve_profile(profile, p - 1)
+        return high.K, low.K, (profile, high)
+
+    K, estimate, grading, (profile, high), rounds, converged = accuracy.solve_to_tolerance(solve_pair, rtol, order)
+    K_si = K * kappa * length_scale
+    return Result(
+        K=K_si, K_over_Kcyl=K_si / (kappa * math.pi * r_ref), error_estimate=estimate, converged=converged,
+        dofs=high.dofs, seconds=time.perf_counter() - start, h_min=profile.h_min * length_scale,
+        grading=grading, order=order, rounds=rounds, necks=[float(a) for a in necks], kappa=kappa,
+        length_scale=length_scale, solution=high, profile=profile,
+    )
+
+
+def semisphere_conductance(a_over_r: float, rtol: float = 1e-4, order: int | None = None) -> Result:
+    """Conductance of the semisphere with a cylindrical neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Sec. 5, Fig. 12).
+
+    ``a_over_r`` in (0, 1): neck radius over sphere radius (from an overlap: ``fem_neck.geometry.equal_neck_radius``;
+    the inverse is ``overlap_for_neck``). The half-neck height is ``h_n/2`` of the volume-conserving neck (eqs.
+    19-20). ``K_over_Kcyl = K / pi`` (eqs. 38-39). ``rtol``: relative tolerance of ``K`` (default 1e-4);
+    ``order``: element order of the reported solve (2, 3 or 4; default: the fastest for ``rtol``).
+    """
+    a_over_r = float(a_over_r)
+    shapes.semisphere_profile(a_over_r)  # validates before any meshing
+    return _to_tolerance(lambda g: shapes.semisphere_mesh(a_over_r, grading=g), 1.0, 1.0, 1.0, rtol, order,
+                         [a_over_r])
+
+
+def chain_conductance(radii, overlaps, kappa: float, rtol: float = 1e-4, order: int | None = None) -> Result:
+    """Conductance (W/K) between the outer equatorial planes of a collinear chain of sintered spheres.
+
+    ``radii``: N sphere radii (m); ``overlaps``: N-1 overlaps ``h = r_k + r_(k+1) - d`` (m), each neck from the
+    volume-conserving model (Rojek 2022, eqs. 21-33); ``kappa`` in W/(m K). ``K_over_Kcyl`` uses the smallest radius.
+    """
+    kappa = float(check_positive("kappa", kappa))
+    radii = np.atleast_1d(check_positive("radii", radii)).astype(float)
+    overlaps = np.atleast_1d(np.asarray(overlaps, dtype=float))
+    scale = float(np.max(radii))
+    _, _, _, necks = shapes.chain_profile(radii, overlaps)  # validates before any meshing
+    return _to_tolerance(lambda g: shapes.chain_mesh(radii / scale, overlaps / scale, grading=g), kappa, scale,
+                         float(np.min(radii)), rtol, order, [n[0] for n in necks])
+
+
+def pair_conductance(r_i: float, r_j: float, h: float, kappa: float, rtol: float = 1e-4,
+                     order: int | None = None) -> Result:
+    """Conductance (W/K) of two sintered spheres between their outer equatorial planes (Rojek 2022, Sec. 6).
+
+    The chain of two: :func:`chain_conductance` ``([r_i, r_j], [h], kappa)``.
+    """
+    return chain_conductance([r_i, r_j], [h], kappa, rtol=rtol, order=order)
