@@ -23,10 +23,15 @@ Measured: the effective conductance ``K = Q/(T_hot - T_cold)`` and each free par
 average over the particle's own share, ``4/3 pi r^3``), FE against the DEM steady network for each conductance law.
 The FE error bar is the change between two mesh levels (full run). The error map puts the per-particle temperature
 error against the particle's coordination number and its mean neck size a/r.
+
+The pseudo-law ``fe-pair`` gives every pipe the axisymmetric FE conductance of its own pair
+(``fem_neck.conduction.pair_conductance``, between equatorial disks): no law error is left, so its error is that of
+the pipe-network idea itself -- several necks sharing one particle, one temperature per particle.
 """
 
 from __future__ import annotations
 
+import functools
 import pathlib
 import time
 from dataclasses import dataclass
@@ -223,6 +228,9 @@ def all_cases(quick: bool) -> list[Case]:
 LAWS = ("rojek", "argento-bouvard", "fit", "zohdi")
 
 
+NETWORK_ONLY = "fe-pair"  # every pipe gets the FE conductance of its own pair: no law error, only the network's
+
+
 def available_laws() -> tuple:
     """The laws of :data:`LAWS` that can be evaluated here (``fit`` needs the shipped fit file)."""
     from fem_neck import law as laws
@@ -234,6 +242,19 @@ def available_laws() -> tuple:
     return LAWS
 
 
+def compared_laws() -> tuple:
+    """What the clusters are compared with: the network-only pseudo-law, then the available DEM laws."""
+    return (NETWORK_ONLY,) + available_laws()
+
+
+@functools.lru_cache(maxsize=None)
+def fe_pair_conductance(r_i: float, r_j: float, h: float) -> float:
+    """Steady axisymmetric FE conductance of one sintered pair between its equatorial disks (W/K), cached."""
+    from fem_neck import conduction
+
+    return float(conduction.pair_conductance(r_i, r_j, h, kappa=KAPPA).K)
+
+
 def dem_conductances(cluster: Cluster, law: str) -> np.ndarray:
     """Pipe conductance of every bond of ``cluster`` under ``law``."""
     from fem_neck import law as laws
@@ -241,6 +262,9 @@ def dem_conductances(cluster: Cluster, law: str) -> np.ndarray:
     i, j = cluster.bonds.T
     r_i, r_j = cluster.radii[i], cluster.radii[j]
     a = cluster.necks().a
+    if law == NETWORK_ONLY:
+        return np.array([fe_pair_conductance(float(x), float(y), float(z))
+                         for x, y, z in zip(r_i, r_j, cluster.overlaps())])
     if law == "zohdi":  # kappa A_c / |x_i - x_j| with the lens (intersection circle) contact area (Zohdi 2014)
         d = np.linalg.norm(cluster.centres[j] - cluster.centres[i], axis=1)
         x = (d**2 + r_i**2 - r_j**2) / (2 * d)
@@ -316,7 +340,7 @@ def compare(case: Case, fe: dict) -> tuple[dict, list]:
     particles = []
     z = cl.degree()
     ratio = particle_neck_ratio(cl)
-    for law in available_laws():
+    for law in compared_laws():
         K_dem, T_dem = dem_steady(cl, case.terminals, dem_conductances(cl, law))
         err = (T_dem[free] - fe["T"][free]) / dT
         row["laws"][law] = {"K_dem": K_dem, "K_rel_err": K_dem / fe["K"] - 1.0,
@@ -328,16 +352,16 @@ def compare(case: Case, fe: dict) -> tuple[dict, list]:
 
 
 def _table(rows) -> str:
-    LAWS = available_laws()
+    names = compared_laws()
     head = ("| cluster | n | bonds | z max | mean a/r | K_FE (W/K) | FE mesh change | "
-            + " | ".join(f"K {law} rel. err" for law in LAWS) + " | "
-            + " | ".join(f"max abs dT {law}" for law in LAWS) + " |")
-    lines = [head, "|" + "---|" * (7 + 2 * len(LAWS))]
+            + " | ".join(f"K {law} rel. err" for law in names) + " | "
+            + " | ".join(f"max abs dT {law}" for law in names) + " |")
+    lines = [head, "|" + "---|" * (7 + 2 * len(names))]
     for r in rows:
         lines.append(f"| {r['case']} | {r['n']} | {r['bonds']} | {r['z_max']} | {r['a_over_r_mean']:.3f} | "
                      f"{r['K_fe']:.5g} | {r['fe_mesh_change']:.1e} | "
-                     + " | ".join(f"{r['laws'][law]['K_rel_err']:+.2%}" for law in LAWS) + " | "
-                     + " | ".join(f"{r['laws'][law]['T_max_err']:.3f}" for law in LAWS) + " |")
+                     + " | ".join(f"{r['laws'][law]['K_rel_err']:+.2%}" for law in names) + " | "
+                     + " | ".join(f"{r['laws'][law]['T_max_err']:.3f}" for law in names) + " |")
     return "\n".join(lines)
 
 
@@ -367,11 +391,11 @@ def _figures(rows, particles, out_dir: pathlib.Path) -> list:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    LAWS = available_laws()
+    names = compared_laws()
     figs = []
     markers = {"triangle": "^", "tetrahedron": "s", "bent chain": "o", "random": "*"}
-    fig, axes = plt.subplots(1, len(LAWS), figsize=(4 * len(LAWS), 3.6), sharey=False)
-    for ax, law in zip(axes, LAWS):
+    fig, axes = plt.subplots(1, len(names), figsize=(4 * len(names), 3.6), sharey=False)
+    for ax, law in zip(axes, names):
         for fam, mk in markers.items():
             sel = [r for r in rows if r["family"] == fam]
             if sel:
@@ -393,8 +417,8 @@ def _figures(rows, particles, out_dir: pathlib.Path) -> list:
     plt.close(fig)
     figs.append(path)
 
-    fig, axes = plt.subplots(1, len(LAWS), figsize=(4 * len(LAWS), 3.6), sharey=True)
-    for ax, law in zip(axes, LAWS):
+    fig, axes = plt.subplots(1, len(names), figsize=(4 * len(names), 3.6), sharey=True)
+    for ax, law in zip(axes, names):
         sel = [p for p in particles if p["law"] == law and "centre balls" not in p["family"]]
         if sel:
             jitter = np.random.default_rng(0).uniform(-0.15, 0.15, len(sel))
@@ -443,7 +467,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
 
     from verification.report import jsonable
 
-    LAWS = available_laws()
+    names = compared_laws()
     out_dir = pathlib.Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     rows, particles, summary = [], [], {}
@@ -454,8 +478,8 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
         rows.append(row)
         particles += parts
         summary[f"cluster {case.name}"] = {
-            "K_fe": row["K_fe"], **{f"K_rel_err_{law}": row["laws"][law]["K_rel_err"] for law in LAWS},
-            **{f"T_max_err_{law}": row["laws"][law]["T_max_err"] for law in LAWS}}
+            "K_fe": row["K_fe"], **{f"K_rel_err_{law}": row["laws"][law]["K_rel_err"] for law in names},
+            **{f"T_max_err_{law}": row["laws"][law]["T_max_err"] for law in names}}
         if case.family == "random":
             last_random = (case, fe)
     (out_dir / "clusters.json").write_text(json.dumps(jsonable({"cases": rows, "particles": particles}), indent=1))
@@ -464,14 +488,14 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
         case, fe = last_random
         figures.append(render_cluster(fe, out_dir / "cluster_random_T.png", f"{case.name}: FE temperature"))
     worst = {law: max(abs(r["laws"][law]["K_rel_err"]) for r in rows if "centre balls" not in r["family"])
-             for law in LAWS}
-    summary.update({f"clusters worst K rel err {law}": worst[law] for law in LAWS})
+             for law in names}
+    summary.update({f"clusters worst K rel err {law}": worst[law] for law in names})
     md = [__doc__.split("\n\n", 1)[1].strip(), "",
           "Relative errors are DEM minus FE over FE; temperature errors are in units of the imposed difference "
           f"(1 K). FE: P2 on curved tetrahedra, {'one mesh level (quick)' if quick else 'two mesh levels; the change between them is the FE error bar'}.",
           "", _table(rows), "",
           "### Error map: RMS particle-temperature error by coordination number and neck size", ""]
-    for law in [x for x in ("fit", "rojek") if x in LAWS]:
+    for law in [x for x in (NETWORK_ONLY, "fit", "rojek") if x in names]:
         md += [f"Law `{law}`:", "", error_map(particles, law), ""]
     md += [f"![K error]({figures[0].name})", "", f"![T error map]({figures[1].name})", ""]
     if last_random is not None:
