@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fem_neck import accuracy, shapes
-from fem_neck.geometry import check_positive
+from fem_neck.geometry import check_positive, neck_geometry
 
 
 @dataclass
@@ -219,4 +219,5 @@ def pair_conductance(r_i: float, r_j: float, h: float, kappa: float, rtol: float
 
     The chain of two: :func:`chain_conductance` ``([r_i, r_j], [h], kappa)``.
     """
+    neck_geometry(check_positive("r_i", r_i), check_positive("r_j", r_j), h)  # names the bad argument
     return chain_conductance([r_i, r_j], [h], kappa, rtol=rtol, order=order)

@@ -33,8 +33,27 @@ import numpy as np
 from fem_neck.geometry import cap_height, check_positive, neck_geometry
 
 # Defaults of the size field (lengths relative to the corner or neck scale, see module docstring).
-DEFAULT_GRADING = 0.25
-H_MIN_FRACTION = 1e-6  # innermost element size relative to the neck radius
+DEFAULT_GRADING = 0.3
+
+
+@dataclass(frozen=True)
+class SizeField:
+    """Element-size law: ``min(h_max, h_min + grading * d)`` with ``d`` the distance to the nearest re-entrant
+    corner and ``h_min = h_min_fraction * a``; ``uniform`` replaces it by one constant size (for convergence studies
+    only: it leaves the corner singularity unresolved). Inside a neck thinner than ``grading * a`` the size is at most
+    the neck height over ``neck_cells_per_height``.
+    """
+
+    grading: float = DEFAULT_GRADING
+    h_min_fraction: float = 1e-6
+    neck_cells_per_height: float = 1.0
+    uniform: float | None = None
+
+    def __post_init__(self):
+        if not (np.isfinite(self.grading) and 0.0 < self.grading <= 1.0):
+            raise ValueError(f"grading = {self.grading!r}: valid range 0 < grading <= 1")
+        if self.uniform is not None and not (np.isfinite(self.uniform) and self.uniform > 0.0):
+            raise ValueError(f"uniform = {self.uniform!r}: must be finite and > 0")
 
 
 @contextlib.contextmanager
@@ -179,18 +198,17 @@ def _is_corner(point, corners) -> bool:
     return bool(np.any(np.all(np.isclose(corners, point, rtol=0.0, atol=1e-12 * max(1.0, abs(point[1]))), axis=1)))
 
 
-def _build_mesh(start, segments, corners, necks, grading, h_min_fraction, neck_cells_per_height):
-    """Mesh the profile in gmsh and return (skfem MeshTri1 with boundaries, volume)."""
+def _build_mesh(start, segments, corners, necks, sizes: SizeField):
+    """Mesh the profile in gmsh and return (skfem MeshTri1 with boundaries, volume, z_top)."""
     import skfem
 
-    if not (np.isfinite(grading) and 0.0 < grading <= 1.0):
-        raise ValueError(f"grading = {grading!r}: valid range 0 < grading <= 1")
+    grading = sizes.grading
     points = [start] + [seg[1] for seg in segments]
     z_top = points[-1][1]
     volume = sum(_segment_volume(points[i], points[i + 1], segments[i]) for i in range(len(segments)))
     scale = max(p[0] for p in points)
     a_min = float(np.min(corners[:, 0]))
-    h_min = h_min_fraction * a_min
+    h_min = sizes.h_min_fraction * a_min if sizes.uniform is None else sizes.uniform
     h_max = 0.5 * scale
     try:
         with gmsh_session() as gmsh:
@@ -225,10 +243,11 @@ def _build_mesh(start, segments, corners, necks, grading, h_min_fraction, neck_c
             dist = field.add("Distance")
             field.setNumbers(dist, "PointsList", corner_tags)
             graded = field.add("MathEval")
-            field.setString(graded, "F", f"min({h_max:.17g}, {h_min:.17g} + {float(grading):.17g}*F{dist})")
+            law = f"min({h_max:.17g}, {h_min:.17g} + {float(grading):.17g}*F{dist})"
+            field.setString(graded, "F", law if sizes.uniform is None else f"{sizes.uniform:.17g} + 0*F{dist}")
             fields = [graded]
             for a, z0, z1 in necks:
-                cell = (z1 - z0) / neck_cells_per_height
+                cell = (z1 - z0) / sizes.neck_cells_per_height
                 if cell < grading * a:
                     box = field.add("Box")
                     for key, val in (("VIn", cell), ("VOut", 1e22), ("XMin", -a), ("XMax", a * (1 + 1e-9)),
@@ -294,9 +313,8 @@ def _in_order(curves, segments):
     return [curves[name] for name in seen]
 
 
-def _finish(start, segments, corners, necks, grading, h_min_fraction, neck_cells_per_height) -> ProfileMesh:
-    mesh, volume, z_top = _build_mesh(start, segments, corners, necks, grading, h_min_fraction,
-                                      neck_cells_per_height)
+def _finish(start, segments, corners, necks, sizes) -> ProfileMesh:
+    mesh, volume, z_top = _build_mesh(start, segments, corners, necks, sizes)
     arcs = {seg[-1]: (seg[2], seg[3]) for seg in segments if seg[0] == "arc"}
     edges = mesh.p[:, mesh.facets]
     h_min = float(np.min(np.hypot(*(edges[:, 1] - edges[:, 0]))))
@@ -323,17 +341,16 @@ def curved_mesh(profile: ProfileMesh):
 
 
 def semisphere_mesh(a_over_r: float, r: float = 1.0, grading: float = DEFAULT_GRADING,
-                    h_min_fraction: float = H_MIN_FRACTION, neck_cells_per_height: float = 2.0) -> ProfileMesh:
+                    sizes: SizeField | None = None) -> ProfileMesh:
     """Graded mesh of the semisphere with a neck (Rojek 2022, Fig. 12); see :func:`semisphere_profile`.
 
     ``bottom`` is the equatorial disk (``z = 0``), ``top`` the neck's end disk (``z = z_i + h_n/2``).
     """
     start, segments, corners, necks = semisphere_profile(a_over_r, r)
-    return _finish(start, segments, corners, necks, grading, h_min_fraction, neck_cells_per_height)
+    return _finish(start, segments, corners, necks, sizes or SizeField(grading=grading))
 
 
-def chain_mesh(radii, overlaps, grading: float = DEFAULT_GRADING, h_min_fraction: float = H_MIN_FRACTION,
-               neck_cells_per_height: float = 2.0) -> ProfileMesh:
+def chain_mesh(radii, overlaps, grading: float = DEFAULT_GRADING, sizes: SizeField | None = None) -> ProfileMesh:
     """Graded mesh of a collinear chain (``bottom``: equator of the first sphere, ``top``: of the last)."""
     start, segments, corners, necks = chain_profile(radii, overlaps)
-    return _finish(start, segments, corners, necks, grading, h_min_fraction, neck_cells_per_height)
+    return _finish(start, segments, corners, necks, sizes or SizeField(grading=grading))
