@@ -99,6 +99,69 @@ def geometry_cases() -> list[StressCase]:
 
 
 # --------------------------------------------------------------------------------------------------------------
+# FE degenerate geometries
+# --------------------------------------------------------------------------------------------------------------
+def _fe_outcome(res, rtol) -> tuple[bool, str]:
+    ok = bool(res.converged and np.isfinite(res.K) and res.error_estimate <= rtol)
+    return ok, (f"K/K_cyl = {res.K_over_Kcyl:.8g}, estimate {res.error_estimate:.1e} (rtol {rtol:g}), "
+                f"converged {res.converged}, {res.dofs} dofs, {res.seconds:.2f} s")
+
+
+def _solve_or_refuse(fn, check=None, rtol: float = 1e-4) -> tuple[bool, str]:
+    """Pass when ``fn()`` returns a converged result (and ``check(res)`` holds) or raises a ValueError that
+    explains itself; a bare gmsh error or any other exception fails."""
+    try:
+        res = fn()
+    except ValueError as exc:
+        return True, f"refused: {exc}"
+    except RuntimeError as exc:
+        msg = str(exc)
+        explained = "gmsh" in msg and not msg.rstrip().endswith(("Could not create line", "Could not create arc"))
+        return explained, f"{type(exc).__name__}: {msg}" + ("" if explained else " (not explained: why, what range)")
+    ok, text = _fe_outcome(res, rtol)
+    if check is not None and ok:
+        ok, extra = check(res)
+        text += f"; {extra}"
+    return ok, text
+
+
+def fe_cases(quick: bool) -> list[StressCase]:
+    from fem_neck import conduction
+
+    cases = []
+    small = (1e-4, 3e-4) if quick else (1e-4, 3e-4, 1e-3)
+    for a in small:
+        def near_constriction(res, a=a):
+            ratio = res.K_over_Kcyl / (4 * a / math.pi)  # K -> 4 kappa a (isothermal disk on a half-space)
+            return abs(ratio - 1) < 0.01, f"K / (4 kappa a) = {ratio:.5f}"
+        cases.append(run_case(f"FE semisphere tiny neck a/r = {a:g}", lambda a=a, c=near_constriction:
+                              _solve_or_refuse(lambda: conduction.semisphere_conductance(a, rtol=1e-4), c)))
+    for a in (0.999, 0.999999):
+        def towards_cylinder(res):  # a = r: the body is a cylinder of height 2r/3, K/K_cyl = 1.5 exactly
+            return 1.3646 < res.K_over_Kcyl <= 1.5 * (1 + 1e-4), "between K(a/r=0.97) and the a = r limit 1.5"
+        cases.append(run_case(f"FE semisphere a -> r, a/r = {a}", lambda a=a, c=towards_cylinder:
+                              _solve_or_refuse(lambda: conduction.semisphere_conductance(a, rtol=1e-4), c)))
+    cases.append(run_case("FE semisphere a/r = 1 exactly", lambda: _solve_or_refuse(
+        lambda: conduction.semisphere_conductance(1.0, rtol=1e-4),
+        lambda res: (abs(res.K_over_Kcyl - 1.5) < 1e-4, "closed form 1.5"))))
+    r_i, r_j = 1e-3, 3e-3
+    h_max = float(max_overlap(r_i, r_j))
+    for frac in (1 - 1e-6, 1.0):
+        def near_ri(res):
+            a = res.necks[0]
+            return a / r_i > 0.99, f"a/r_i = {a / r_i:.6f}"
+        cases.append(run_case(f"FE unequal pair a ~ r_i (h = {frac:.7g} h_max, r_j/r_i = 3)",
+                              lambda frac=frac, c=near_ri: _solve_or_refuse(
+                                  lambda: conduction.pair_conductance(r_i, r_j, frac * h_max, 394.0, rtol=1e-4), c)))
+    cases.append(run_case("FE pair h/r -> 0 (h = 1e-12 r)", lambda: _solve_or_refuse(
+        lambda: conduction.pair_conductance(1e-3, 1e-3, 1e-15, 394.0, rtol=1e-4))))
+    cases.append(run_case("FE pair radius ratio 100", lambda: _solve_or_refuse(
+        lambda: conduction.pair_conductance(1e-5, 1e-3, 0.5 * float(max_overlap(1e-5, 1e-3)), 394.0, rtol=1e-3),
+        rtol=1e-3)))
+    return cases
+
+
+# --------------------------------------------------------------------------------------------------------------
 # CLI abuse
 # --------------------------------------------------------------------------------------------------------------
 def cli_case(name: str, argv: list[str], expect: str = "error", timeout: float = 120.0, cwd=None) -> StressCase:
@@ -254,6 +317,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
     all_cases: list[StressCase] = []
     groups = [
         ("Neck geometry", geometry_cases),
+        ("FE degenerate geometries", lambda: fe_cases(quick)),
         ("CLI abuse: python -m fem_neck", fem_neck_cli_cases),
         ("CLI abuse: python -m dem run", lambda: dem_cli_cases(pathlib.Path(out_dir) / "scenes")),
     ]
