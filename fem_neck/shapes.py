@@ -239,7 +239,9 @@ def _build_mesh(start, segments, corners, necks, sizes: SizeField):
             # Distance + MathEval + Box combined by a Min field (a MathEval that references another MathEval
             # deadlocks gmsh 4.15, and numbers are formatted explicitly: numpy reprs are not gmsh syntax).
             field = gmsh.model.mesh.field
-            corner_tags = [p_tags[i + 1] for i, seg in enumerate(segments) if _is_corner(seg[1], corners)]
+            corner_tags = [tag for tag, pt in zip(p_tags, points) if _is_corner(pt, corners)]
+            if len(corner_tags) != len(corners):
+                raise ValueError("corners: every corner must be an end point of the profile's segments")
             dist = field.add("Distance")
             field.setNumbers(dist, "PointsList", corner_tags)
             graded = field.add("MathEval")
@@ -300,7 +302,8 @@ def _build_mesh(start, segments, corners, necks, sizes: SizeField):
         pos = np.searchsorted(facet_key, key, sorter=order)
         boundaries[name] = np.sort(order[pos]).astype(np.int32)
     boundaries["insulated"] = np.sort(np.concatenate(
-        [v for k, v in boundaries.items() if k.startswith(("sphere", "neck"))])).astype(np.int32)
+        [np.empty(0, np.int32)] + [v for k, v in boundaries.items() if k.startswith(("sphere", "neck"))]
+    )).astype(np.int32)
     mesh = mesh.with_boundaries(boundaries)
     return mesh, volume, z_top
 
@@ -313,7 +316,14 @@ def _in_order(curves, segments):
     return [curves[name] for name in seen]
 
 
-def _finish(start, segments, corners, necks, sizes) -> ProfileMesh:
+def profile_mesh(start, segments, corners, necks=(), sizes: SizeField | None = None) -> ProfileMesh:
+    """Mesh any axisymmetric profile: the ``bottom`` line from the axis to ``start``, then ``segments`` (each
+    ``("line", end, name)`` or ``("arc", end, z_centre, radius, name)``, counter-clockwise, ending at the top rim),
+    then the ``top`` line back to the axis and the ``axis``. ``corners`` ((m, 2), each a segment end point) are
+    where the size is graded; ``necks`` are ``(a, z_low, z_high)`` cylinders kept isotropic when thin.
+    """
+    sizes = sizes or SizeField()
+    corners = np.atleast_2d(np.asarray(corners, dtype=float))
     mesh, volume, z_top = _build_mesh(start, segments, corners, necks, sizes)
     arcs = {seg[-1]: (seg[2], seg[3]) for seg in segments if seg[0] == "arc"}
     edges = mesh.p[:, mesh.facets]
@@ -347,10 +357,10 @@ def semisphere_mesh(a_over_r: float, r: float = 1.0, grading: float = DEFAULT_GR
     ``bottom`` is the equatorial disk (``z = 0``), ``top`` the neck's end disk (``z = z_i + h_n/2``).
     """
     start, segments, corners, necks = semisphere_profile(a_over_r, r)
-    return _finish(start, segments, corners, necks, sizes or SizeField(grading=grading))
+    return profile_mesh(start, segments, corners, necks, sizes or SizeField(grading=grading))
 
 
 def chain_mesh(radii, overlaps, grading: float = DEFAULT_GRADING, sizes: SizeField | None = None) -> ProfileMesh:
     """Graded mesh of a collinear chain (``bottom``: equator of the first sphere, ``top``: of the last)."""
     start, segments, corners, necks = chain_profile(radii, overlaps)
-    return _finish(start, segments, corners, necks, sizes or SizeField(grading=grading))
+    return profile_mesh(start, segments, corners, necks, sizes or SizeField(grading=grading))
