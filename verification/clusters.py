@@ -255,42 +255,41 @@ def fe_pair_conductance(r_i: float, r_j: float, h: float) -> float:
     return float(conduction.pair_conductance(r_i, r_j, h, kappa=KAPPA).K)
 
 
-def dem_conductances(cluster: Cluster, law: str) -> np.ndarray:
-    """Pipe conductance of every bond of ``cluster`` under ``law``."""
-    from fem_neck import law as laws
+def dem_steady(cluster: Cluster, terminals, law: str) -> tuple[float, np.ndarray]:
+    """The DEM's steady pipe network of the same cluster (Rojek 2022, eqs. 2-4 with dT/dt = 0): the effective
+    conductance (W/K) and every particle's temperature.
 
-    i, j = cluster.bonds.T
-    r_i, r_j = cluster.radii[i], cluster.radii[j]
-    a = cluster.necks().a
+    The DEM finds the bonds itself from the overlaps (:func:`dem.bonds.find_bonds`); they must be the cluster's.
+    The terminals are its fixed particles. ``law`` is a DEM conductance law, or :data:`NETWORK_ONLY`.
+    """
+    from dem.bonds import find_bonds
+    from dem.laws.conductance import ConductanceSpec, bond_conductances
+    from dem.particles import Material, Particles
+    from dem.thermal import Network, boundary_heat_flow, steady
+
+    T0 = np.zeros(cluster.n)
+    fixed = np.zeros(cluster.n, dtype=bool)
+    for t in terminals:
+        T0[t.particle] = t.T
+        fixed[t.particle] = True
+    copper = Material(KAPPA, 8960.0, 385.0, "copper")
+    particles = Particles.from_arrays(cluster.centres, cluster.radii, T0, materials=(copper,), fixed=fixed)
+    spec = ConductanceSpec(law="rojek" if law == NETWORK_ONLY else law)
+    bonds = find_bonds(particles, contact=spec.contact)
+    found = {(int(i), int(j)) for i, j in zip(bonds.i, bonds.j)}
+    if found != {tuple(sorted(map(int, b))) for b in cluster.bonds}:
+        raise RuntimeError(f"the DEM found bonds {sorted(found)}, the cluster has {cluster.bonds.tolist()}")
     if law == NETWORK_ONLY:
-        return np.array([fe_pair_conductance(float(x), float(y), float(z))
-                         for x, y, z in zip(r_i, r_j, cluster.overlaps())])
-    if law == "zohdi":  # kappa A_c / |x_i - x_j| with the lens (intersection circle) contact area (Zohdi 2014)
-        d = np.linalg.norm(cluster.centres[j] - cluster.centres[i], axis=1)
-        x = (d**2 + r_i**2 - r_j**2) / (2 * d)
-        return KAPPA * np.pi * (r_i**2 - x**2) / d
-    chosen = {"rojek": laws.ROJEK, "argento-bouvard": laws.ARGENTO_BOUVARD, "fit": None}[law]
-    return np.asarray(laws.pair_conductance(KAPPA, r_i, r_j, a, chosen))
-
-
-def dem_steady(cluster: Cluster, terminals, K: np.ndarray) -> tuple[float, np.ndarray]:
-    """Steady pipe network (Rojek 2022, eqs. 2-4 with dT/dt = 0): effective conductance and particle temperatures."""
-    import scipy.sparse as sp
-    import scipy.sparse.linalg as spl
-
-    n = cluster.n
-    i, j = cluster.bonds.T
-    L = sp.coo_matrix((np.concatenate([K, K, -K, -K]), (np.concatenate([i, j, i, j]), np.concatenate([i, j, j, i]))),
-                      shape=(n, n)).tocsr()
-    T = np.zeros(n)
-    fixed = np.array([t.particle for t in terminals])
-    T[fixed] = [t.T for t in terminals]
-    free = np.setdiff1d(np.arange(n), fixed)
-    T[free] = spl.spsolve(L[free][:, free].tocsc(), -L[free][:, fixed] @ T[fixed])
+        K = np.array([fe_pair_conductance(float(cluster.radii[i]), float(cluster.radii[j]), float(h))
+                      for i, j, h in zip(bonds.i, bonds.j, bonds.h)])
+    else:
+        K = bond_conductances(spec, particles, bonds)[0]
+    net = Network(particles, bonds, K, np.zeros(0), np.zeros(0))
+    T = steady(net).T
+    into = boundary_heat_flow(net, T)["particles"]
     t_hot = max(t.T for t in terminals)
     t_cold = min(t.T for t in terminals)
-    hot = [t.particle for t in terminals if t.T == t_hot]
-    Q = float((L @ T)[hot].sum())
+    Q = -sum(into[t.particle] for t in terminals if t.T == t_hot)
     return Q / (t_hot - t_cold), T
 
 
@@ -341,7 +340,7 @@ def compare(case: Case, fe: dict) -> tuple[dict, list]:
     z = cl.degree()
     ratio = particle_neck_ratio(cl)
     for law in compared_laws():
-        K_dem, T_dem = dem_steady(cl, case.terminals, dem_conductances(cl, law))
+        K_dem, T_dem = dem_steady(cl, case.terminals, law)
         err = (T_dem[free] - fe["T"][free]) / dT
         row["laws"][law] = {"K_dem": K_dem, "K_rel_err": K_dem / fe["K"] - 1.0,
                             "T_max_err": float(np.max(np.abs(err))), "T_rms_err": float(np.sqrt(np.mean(err**2)))}
