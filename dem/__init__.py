@@ -1,0 +1,17 @@
+"""Pipe-network thermal DEM of sintered particles (Rojek, Kasztelan & Tharmaraj 2022, Section 2), TOML scenes.
+
+Python use::
+
+    from dem import make_scene, load_scene, run
+    result = run(make_scene(positions, radii, temperatures, fixed=mask, law="rojek", mode="steady"))
+    result.T, result.summary["boundary_heat_flow"], result.thermal.bonds, result.thermal.K_pairs
+
+``dem`` needs no gmsh or FE code: it imports only :mod:`fem_neck.geometry` and :mod:`fem_neck.law`.
+"""
+
+from dem.particles import COPPER, Material, Particles
+from dem.scene import Scene, SolverSpec, load_scene, make_scene, parse_scene
+from dem.simulation import RunResult, run
+
+__all__ = ["COPPER", "Material", "Particles", "RunResult", "Scene", "SolverSpec", "load_scene", "make_scene",
+           "parse_scene", "run"]

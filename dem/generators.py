@@ -1,0 +1,153 @@
+"""Particle arrangements for scenes: a chain, a cubic lattice block and a random sintered packing.
+
+Every generator returns a :class:`Layout`: positions, radii, the indices of the bottom and top layers and the
+specimen's cross-section, so that a scene can hold the two ends at different temperatures (hot and cold plates,
+or fixed end particles) and read off an effective conductivity ``k_eff = Q L / (A dT)``.
+
+Overlaps are relative to the smaller radius of a pair: ``h = overlap * min(r_i, r_j)``.
+
+The random sintered packing is a jittered face-centred cubic lattice with random radii: the sites of an FCC lattice
+block of m x m cells and complete (001) layers (N is rounded up to fill the top layer), each moved by a uniform random jitter, radii drawn from a distribution of the given
+mean and relative spread, then all radii scaled by one factor (bisection) so that the mean relative overlap of the
+bonded pairs hits the target. Everything is vectorised and costs O(N log N) (one k-d tree): 10^6 particles take
+seconds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+from scipy.spatial import cKDTree
+
+DISTRIBUTIONS = ("constant", "uniform", "lognormal")
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Generated geometry: ``position`` (N,3), ``radius`` (N,), ``bottom``/``top`` layer indices, the z of the
+    lowest/highest particle surfaces, the cross-section ``area`` (m^2) normal to z."""
+
+    position: np.ndarray
+    radius: np.ndarray
+    bottom: np.ndarray
+    top: np.ndarray
+    z_low: float
+    z_high: float
+    area: float
+
+
+def _positive(name, value):
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value) or value <= 0:
+        raise ValueError(f"[generator] {name} = {value!r}: must be a finite number > 0")
+    return float(value)
+
+
+def _overlap(value, count, name="overlap"):
+    arr = np.broadcast_to(np.asarray(value, dtype=float), (count,)) if np.ndim(value) == 0 else np.asarray(
+        value, dtype=float)
+    if arr.shape != (count,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ValueError(f"[generator] {name} = {value!r}: must be a number > 0 or a list of {count} such numbers "
+                         f"(relative to the smaller radius of each pair)")
+    return arr
+
+
+def chain(n: int, radius, overlap) -> Layout:
+    """``n`` collinear particles along z; ``radius`` scalar or per particle, ``overlap`` scalar or per bond."""
+    if not isinstance(n, int) or n < 1:
+        raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
+    r = np.broadcast_to(np.asarray(radius, dtype=float), (n,)).copy() if np.ndim(radius) == 0 else np.asarray(
+        radius, dtype=float)
+    if r.shape != (n,) or not np.all(np.isfinite(r)) or np.any(r <= 0):
+        raise ValueError(f"[generator] radius = {radius!r}: must be a number > 0 or a list of {n} such numbers")
+    h = _overlap(overlap, n - 1) * np.minimum(r[:-1], r[1:])
+    z = np.concatenate([[0.0], np.cumsum(r[:-1] + r[1:] - h)])
+    pos = np.column_stack([np.zeros(n), np.zeros(n), z])
+    return Layout(pos, r, np.array([0]), np.array([n - 1]), float(z[0] - r[0]), float(z[-1] + r[-1]),
+                  float(np.pi * r.max() ** 2))
+
+
+def lattice(shape, radius, overlap) -> Layout:
+    """A simple cubic block of ``shape = [nx, ny, nz]`` equal spheres, spacing ``2r - h``."""
+    if (not isinstance(shape, (list, tuple)) or len(shape) != 3
+            or not all(isinstance(k, int) and k >= 1 for k in shape)):
+        raise ValueError(f"[generator] shape = {shape!r}: must be three integers >= 1")
+    r = _positive("radius", radius)
+    s = 2.0 * r - float(_overlap(overlap, 1)[0]) * r
+    nx, ny, nz = shape
+    ix, iy, iz = np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij")
+    pos = s * np.column_stack([ix.ravel(), iy.ravel(), iz.ravel()]).astype(float)
+    k = iz.ravel()
+    return Layout(pos, np.full(len(pos), r), np.flatnonzero(k == 0), np.flatnonzero(k == nz - 1), -r,
+                  (nz - 1) * s + r, nx * ny * s * s)
+
+
+def _shape_radii(rng, n, distribution, spread):
+    if distribution not in DISTRIBUTIONS:
+        raise ValueError(f"[generator] distribution = {distribution!r}: must be one of {', '.join(DISTRIBUTIONS)}")
+    if not (np.isfinite(spread) and 0 <= spread < 1):
+        raise ValueError(f"[generator] radius_spread = {spread!r}: must be in [0, 1) (relative)")
+    if distribution == "constant" or spread == 0:
+        return np.ones(n)
+    if distribution == "uniform":
+        return rng.uniform(1.0 - spread, 1.0 + spread, n)
+    sigma = np.sqrt(np.log1p(spread**2))  # lognormal with mean 1 and relative standard deviation ``spread``
+    return rng.lognormal(-0.5 * sigma**2, sigma, n)
+
+
+def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float = 0.1,
+                   distribution: str = "uniform", jitter: float = 0.02) -> Layout:
+    """Random sintered packing (module docstring); ``radius`` is the mean radius, ``overlap`` the target mean of
+    ``h / min(r_i, r_j)`` over bonded pairs, ``jitter`` the half-width of the position noise over the neighbour
+    distance."""
+    if not isinstance(n, int) or n < 1:
+        raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
+    r_mean = _positive("radius", radius)
+    target = float(_overlap(overlap, 1)[0])
+    if target >= 2.0 / 3.0:
+        raise ValueError(f"[generator] overlap = {overlap!r}: the mean relative overlap must be < 2/3 (the neck "
+                         f"model's range)")
+    if not (np.isfinite(jitter) and 0 <= jitter < 0.25):
+        raise ValueError(f"[generator] jitter = {jitter!r}: must be in [0, 0.25) (fraction of the neighbour "
+                         f"distance)")
+    rng = np.random.default_rng(seed)
+    m = max(1, int(round((n / 4.0) ** (1.0 / 3.0))))
+    layers = int(np.ceil(n / (2.0 * m * m)))  # FCC: 2 m^2 sites per (001) layer; complete layers only
+    cell = np.sqrt(2.0)  # FCC cell edge for a neighbour distance of 1
+    basis = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]])
+    g, gz = np.arange(m), np.arange((layers + 1) // 2)
+    cz, cy, cx = np.meshgrid(gz, g, g, indexing="ij")
+    corners = np.column_stack([cx.ravel(), cy.ravel(), cz.ravel()]).astype(float)
+    sites = (corners[:, None, :] + basis[None, :, :]).reshape(-1, 3) * cell
+    sites = sites[np.round(sites[:, 2] / (0.5 * cell)) < layers]
+    sites = sites[np.lexsort((sites[:, 0], sites[:, 1], sites[:, 2]))]
+    n = len(sites)
+    pos = sites + rng.uniform(-jitter, jitter, sites.shape)
+    shape = _shape_radii(rng, n, distribution, radius_spread)
+    # candidate neighbours: every pair that could overlap for radii up to the 2/3-overlap scale
+    cutoff = (1.0 + 2.0 * np.sqrt(3.0) * jitter) * 1.05
+    pairs = cKDTree(pos).query_pairs(cutoff, output_type="ndarray")
+    i, j = pairs[:, 0], pairs[:, 1]
+    d = np.linalg.norm(pos[i] - pos[j], axis=1)
+    ssum, smin = shape[i] + shape[j], np.minimum(shape[i], shape[j])
+
+    def mean_overlap(sigma):
+        h = sigma * ssum - d
+        bonded = h > 0
+        return float(np.mean(h[bonded] / (sigma * smin[bonded]))) if np.any(bonded) else 0.0
+
+    if len(d) == 0:
+        sigma = 0.5
+    else:
+        lo, hi = 0.5 * d.min() / ssum.max(), cutoff / ssum.min()
+        if mean_overlap(hi) < target:
+            raise ValueError(f"[generator] overlap = {overlap!r}: not reachable with this jitter and spread")
+        sigma = brentq(lambda s: mean_overlap(s) - target, lo, hi, xtol=1e-14, rtol=1e-12)
+    scale = r_mean / (sigma * shape.mean())  # metres per neighbour distance
+    r = sigma * shape * scale
+    pos = pos * scale
+    layer = np.round(sites[:, 2] / (0.5 * cell)).astype(np.int64)
+    bottom, top = np.flatnonzero(layer == layer.min()), np.flatnonzero(layer == layer.max())
+    side = m * cell * scale
+    return Layout(pos, r, bottom, top, float(np.min(pos[:, 2] - r)), float(np.max(pos[:, 2] + r)), side * side)

@@ -1,0 +1,95 @@
+"""Run outputs, written as the run goes: a CSV time series, VTU/PVD snapshots for ParaView, ``summary.json``.
+
+* ``timeseries.csv`` -- step, t, mean/min/max temperature, and the heat flow into the particles (W) through
+  each boundary: fixed particles, walls, convection, radiation, internal sources.
+* ``particles.pvd`` + ``particles_NNNNN.vtu`` -- particles as points (vertex cells) with radius, temperature,
+  fixed and material.
+* ``bonds.pvd`` + ``bonds_NNNNN.vtu`` -- bonds as lines with conductance, heat flow and neck radius; a wall bond
+  joins the particle to its foot point on the wall.
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+
+import meshio
+import numpy as np
+
+CSV_FLOWS = ("fixed", "walls", "convection", "radiation", "internal")
+
+
+def write_pvd(path: pathlib.Path, entries: list[tuple[float, str]]) -> None:
+    """A ParaView collection of ``(time, file)`` entries."""
+    rows = "\n".join(f'    <DataSet timestep="{t:.17g}" group="" part="0" file="{f}"/>' for t, f in entries)
+    path.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
+                    f"  <Collection>\n{rows}\n  </Collection>\n</VTKFile>\n")
+
+
+class RunWriter:
+    """Observer for the integrators: CSV row every ``every`` steps, snapshots every ``vtu_every`` steps."""
+
+    def __init__(self, out_dir, scene, model):
+        self.out = pathlib.Path(out_dir)
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.scene, self.model = scene, model
+        self.csv = (self.out / "timeseries.csv").open("w")
+        self.csv.write("step,t,T_mean,T_min,T_max," + ",".join(f"Q_{k}" for k in CSV_FLOWS) + "\n")
+        self.snapshots: list[tuple[float, int]] = []
+        self.last = None
+
+    def __call__(self, step, t, T_free, flows):
+        net = self.model.network
+        T = net.full(T_free)
+        self.last = (step, t, T, flows)
+        if step % self.scene.output.every == 0:
+            self._row(step, t, T, flows)
+        every = self.scene.output.vtu_every
+        if self.scene.output.vtu and (step == 0 or (every and step % every == 0)):
+            self._snapshot(step, t, T)
+
+    def _row(self, step, t, T, flows):
+        q = ",".join(f"{flows.get(k, 0.0):.12g}" for k in CSV_FLOWS)
+        self.csv.write(f"{step},{t:.12g},{T.mean():.12g},{T.min():.12g},{T.max():.12g},{q}\n")
+        self.csv.flush()
+
+    def _snapshot(self, step, t, T):
+        if self.snapshots and self.snapshots[-1][1] == step:
+            return
+        p, b = self.scene.particles, self.model.bonds
+        meshio.write(self.out / f"particles_{step:05d}.vtu", meshio.Mesh(
+            p.position, [("vertex", np.arange(p.n).reshape(-1, 1))],
+            point_data={"radius": p.radius, "temperature": T, "fixed": p.fixed.astype(np.int8),
+                        "material": p.material.astype(np.int32)}))
+        self.model.T = T
+        q_pairs, q_walls = self.model.bond_heat_flow()
+        walls = self.scene.walls
+        foot = np.array([walls[w].point for w in b.wall_index]).reshape(-1, 3)
+        normal = np.array([walls[w].normal for w in b.wall_index]).reshape(-1, 3)
+        x = p.position[b.wall_particle]
+        foot = x - np.sum((x - foot) * normal, axis=1, keepdims=True) * normal
+        points = np.vstack([p.position, foot])
+        lines = np.vstack([np.column_stack([b.i, b.j]),
+                           np.column_stack([b.wall_particle, p.n + np.arange(b.n_walls)])]).astype(np.int64)
+        meshio.write(self.out / f"bonds_{step:05d}.vtu", meshio.Mesh(
+            points, [("line", lines.reshape(-1, 2))],
+            cell_data={"conductance": [np.concatenate([self.model.K_pairs, self.model.K_walls])],
+                       "heat_flow": [np.concatenate([q_pairs, q_walls])],
+                       "neck_radius": [np.concatenate([b.a, b.wall_a])]}))
+        self.snapshots.append((t, step))
+        for kind in ("particles", "bonds"):
+            write_pvd(self.out / f"{kind}.pvd", [(tt, f"{kind}_{s:05d}.vtu") for tt, s in self.snapshots])
+
+    def finish(self, summary: dict):
+        if self.last is not None:
+            step, t, T, flows = self.last
+            if step % self.scene.output.every:
+                self._row(step, t, T, flows)
+            if self.scene.output.vtu:
+                self._snapshot(step, t, T)
+        self.csv.close()
+        write_summary(self.out / "summary.json", summary)
+
+
+def write_summary(path, summary: dict) -> None:
+    pathlib.Path(path).write_text(json.dumps(summary, indent=2) + "\n")

@@ -1,0 +1,111 @@
+"""Conductance of the thermal pipes: each bond's two halves (and an optional contact interface) in series.
+
+Rojek 2022, Section 3: ``R_ij = R_i + R_j + R_c`` (eq. 5), i.e. ``K_ij = K_i K_j K_c / (K_i K_j + K_j K_c +
+K_i K_c)`` (eq. 8), or eq. (9) without the interface. Every law is a *half* conductance ``K_i`` of one particle's
+side of the contact, evaluated with that particle's own conductivity, radius and contact; putting the halves in
+series makes the mixed-material rule the harmonic combination of the two halves.
+
+Laws (``ConductanceSpec.law``):
+
+* ``"rojek"`` -- ``K_i = c kappa_i pi a`` with c = 1.064 (eqs. 40, 43); equal materials give ``K_ij = K_i / 2``
+  (eq. 45). ``slope`` overrides c.
+* ``"argento-bouvard"`` -- the same with c = 1/0.899 = 1.112 (eqs. 41-42).
+* ``"fit"`` -- the full-range FE law ``K_i = kappa_i pi r_i f(a/r_i)`` read from a fit.json written by
+  ``python -m fem_neck fit`` (``fit_file``; default: the fit shipped in ``fem_neck/data/fit.json``), each half at
+  its own ``a/r_i``.
+* ``"zohdi"`` -- ``K_ij = kappa A_c / |x_i - x_j|`` with the lens contact area ``A_c = pi a^2`` (Zohdi 2014,
+  eqs. 11-12, 33), written as halves ``K_i = kappa_i pi a^2 / L_i`` (``L_i + L_j = |x_i - x_j|``, eq. 9), which
+  is eq. (33) exactly for one material. (Zohdi's footnote 4 averages two conductivities arithmetically; the halves
+  in series are the harmonic combination this project uses for every law.)
+
+A wall bond is one half (the particle's side; the wall is isothermal) in series with ``K_c``.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from fem_neck import law as fem_law
+
+from dem.bonds import OUT_OF_RANGE, Bonds
+from dem.particles import Particles
+
+LAWS = ("rojek", "argento-bouvard", "fit", "zohdi")
+NECK_MODELS = ("newton", "first", "coble")
+LINEAR_SLOPES = {"rojek": fem_law.ROJEK.slope, "argento-bouvard": fem_law.ARGENTO_BOUVARD.slope}
+
+
+@dataclass(frozen=True)
+class ConductanceSpec:
+    """Which law, and its options: ``slope`` (linear laws), ``fit_file`` (fit), ``neck`` model for the neck laws,
+    ``contact_conductance`` K_c in W/K (eq. 8; None = no interface resistance), ``out_of_range`` bond policy."""
+
+    law: str = "rojek"
+    slope: float | None = None
+    fit_file: str | None = None
+    neck: str = "newton"
+    contact_conductance: float | None = None
+    out_of_range: str = "error"
+
+    def __post_init__(self):
+        if self.law not in LAWS:
+            raise ValueError(f"conductance.law = {self.law!r}: must be one of {', '.join(LAWS)}")
+        if self.neck not in NECK_MODELS:
+            raise ValueError(f"conductance.neck = {self.neck!r}: must be one of {', '.join(NECK_MODELS)}")
+        if self.out_of_range not in OUT_OF_RANGE:
+            raise ValueError(f"conductance.out_of_range = {self.out_of_range!r}: must be one of "
+                             f"{', '.join(OUT_OF_RANGE)}")
+        if self.slope is not None and (self.law not in LINEAR_SLOPES or not np.isfinite(self.slope)
+                                       or self.slope <= 0):
+            raise ValueError(f"conductance.slope = {self.slope!r}: must be > 0 and only with law rojek or "
+                             f"argento-bouvard")
+        if self.fit_file is not None and self.law != "fit":
+            raise ValueError(f"conductance.fit_file = {self.fit_file!r}: only with law = \"fit\"")
+        kc = self.contact_conductance
+        if kc is not None and (not np.isfinite(kc) or kc <= 0):
+            raise ValueError(f"conductance.contact_conductance = {kc!r}: must be finite and > 0 (W/K)")
+        if self.law == "fit":
+            fit_law(self.fit_file)  # a missing or malformed fit file is reported when the scene is read
+
+    @property
+    def contact(self) -> str:
+        """The contact geometry the law needs (:mod:`dem.bonds`)."""
+        return "lens" if self.law == "zohdi" else self.neck
+
+
+@functools.lru_cache(maxsize=8)
+def fit_law(path: str | None):
+    """The full-range law of a fit.json (:class:`fem_neck.law.ConductanceLaw`), read once per path."""
+    return fem_law.ConductanceLaw.default() if path is None else fem_law.ConductanceLaw.from_json(path)
+
+
+def half_conductance(spec: ConductanceSpec, kappa, r, a, length):
+    """One particle's half of a contact in W/K (module docstring); ``length`` is the centre-to-contact distance."""
+    kappa, r, a, length = (np.asarray(x, dtype=float) for x in (kappa, r, a, length))
+    if spec.law in LINEAR_SLOPES:
+        return (spec.slope or LINEAR_SLOPES[spec.law]) * kappa * np.pi * a          # eqs. (43), (42)
+    if spec.law == "fit":
+        return kappa * np.pi * r * np.asarray(fit_law(spec.fit_file).k_over_kcyl(np.minimum(a / r, 1.0)))
+    with np.errstate(divide="ignore"):
+        return kappa * np.pi * a * a / length                                         # Zohdi 2014, eq. (33)
+
+
+def series(*halves):
+    """Conductances in series, ``1 / sum(1/K)`` (Rojek 2022, eqs. 5-9); an infinite half adds no resistance."""
+    with np.errstate(divide="ignore"):
+        resistance = sum(1.0 / np.asarray(k, dtype=float) for k in halves if k is not None)
+    return 1.0 / resistance
+
+
+def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds) -> tuple[np.ndarray, np.ndarray]:
+    """``(K_pairs, K_walls)`` in W/K for every pair bond and wall bond."""
+    kappa, r = particles.conductivity, particles.radius
+    kc = spec.contact_conductance
+    k_i = half_conductance(spec, kappa[bonds.i], r[bonds.i], bonds.a, bonds.l_i)
+    k_j = half_conductance(spec, kappa[bonds.j], r[bonds.j], bonds.a, bonds.l_j)
+    p = bonds.wall_particle
+    k_w = half_conductance(spec, kappa[p], r[p], bonds.wall_a, bonds.wall_l)
+    return series(k_i, k_j, kc), series(k_w, kc)

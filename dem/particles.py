@@ -1,0 +1,137 @@
+"""Particle state as arrays (structure of arrays): the lumped capacities of the pipe network.
+
+Rojek, Kasztelan & Tharmaraj 2022, Section 2: every particle is a lumped capacity ``C_i = m_i c`` (eq. 1) at its
+centre with one temperature ``T_i``. The mass is ``m_i = rho (4/3) pi r_i^3``: the volume-conserving neck
+(Section 4.2) moves material from the caps into the neck, so the sphere volume stays exact.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def finite_array(name: str, value, shape_tail=(), dtype=float) -> np.ndarray:
+    """``value`` as an array of rank ``1 + len(shape_tail)`` with the given trailing shape and finite entries."""
+    try:
+        arr = np.asarray(value, dtype=dtype)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name}: must be a list of numbers{' of length ' + str(shape_tail[0]) if shape_tail else ''}"
+                         f" ({exc})") from None
+    if arr.ndim != 1 + len(shape_tail) or tuple(arr.shape[1:]) != tuple(shape_tail):
+        want = "a list of numbers" if not shape_tail else f"a list of {shape_tail[0]}-vectors"
+        raise ValueError(f"{name}: must be {want}, got shape {arr.shape}")
+    if arr.dtype.kind == "f" and not np.all(np.isfinite(arr)):
+        bad = np.argwhere(~np.isfinite(arr))[0]
+        raise ValueError(f"{name}[{bad[0]}] = {arr[tuple(bad)]}: must be finite")
+    return arr
+
+
+def check_positive_entries(name: str, arr: np.ndarray, allow_zero: bool = False) -> np.ndarray:
+    """Raise ``ValueError`` naming the first entry that is not ``> 0`` (or ``>= 0``)."""
+    bad = arr < 0.0 if allow_zero else arr <= 0.0
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"{name}[{k}] = {arr.flat[k]:.9g}: must be {'>= 0' if allow_zero else '> 0'}")
+    return arr
+
+
+@dataclass(frozen=True)
+class Material:
+    """Thermal properties of one material (SI units): conductivity kappa W/(m K), density kg/m^3, c J/(kg K)."""
+
+    conductivity: float
+    density: float
+    specific_heat: float
+    name: str = "material"
+
+    def __post_init__(self):
+        for key in ("conductivity", "density", "specific_heat"):
+            value = getattr(self, key)
+            if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value) or value <= 0:
+                raise ValueError(f"material {self.name!r}: {key} = {value!r}: must be a finite number > 0")
+
+
+COPPER = Material(394.0, 8960.0, 385.0, "copper")
+
+
+@dataclass(frozen=True)
+class Particles:
+    """N spheres: ``position`` (N, 3) m, ``radius`` (N,) m, ``temperature`` (N,), ``material`` (N,) index into
+    ``materials``, ``fixed`` (N,) bool (held at the initial temperature), ``heat`` (N,) internal heat W (eq. 3).
+
+    Build with :meth:`from_arrays`, which validates every array and names the first bad entry.
+    """
+
+    position: np.ndarray
+    radius: np.ndarray
+    temperature: np.ndarray
+    material: np.ndarray
+    fixed: np.ndarray
+    heat: np.ndarray
+    materials: tuple = field(default=(COPPER,))
+
+    @classmethod
+    def from_arrays(cls, position, radius, temperature, materials=(COPPER,), material=None, fixed=None,
+                    heat=None, prefix: str = "particles") -> "Particles":
+        """Validated particle state; ``material`` defaults to 0, ``fixed`` to False, ``heat`` to 0 W."""
+        if isinstance(materials, Material):
+            materials = (materials,)
+        materials = tuple(materials)
+        if not materials:
+            raise ValueError("materials: at least one material is required")
+        pos = finite_array(f"{prefix}.position", position, (3,))
+        n = len(pos)
+        if n == 0:
+            raise ValueError(f"{prefix}.position: at least one particle is required")
+        rad = check_positive_entries(f"{prefix}.radius", finite_array(f"{prefix}.radius", radius))
+        temp = finite_array(f"{prefix}.temperature", temperature)
+        mat = np.zeros(n, dtype=np.int64) if material is None else finite_array(f"{prefix}.material", material,
+                                                                                dtype=np.int64)
+        fix = np.zeros(n, dtype=bool) if fixed is None else _bool_array(f"{prefix}.fixed", fixed)
+        q = np.zeros(n) if heat is None else finite_array(f"{prefix}.heat", heat)
+        for key, arr in (("radius", rad), ("temperature", temp), ("material", mat), ("fixed", fix), ("heat", q)):
+            if len(arr) != n:
+                raise ValueError(f"{prefix}.{key} has {len(arr)} entries but {prefix}.position has {n}")
+        if np.any((mat < 0) | (mat >= len(materials))):
+            k = int(np.flatnonzero((mat < 0) | (mat >= len(materials)))[0])
+            raise ValueError(f"{prefix}.material[{k}] = {mat[k]}: must index one of {len(materials)} material(s)")
+        return cls(pos, rad, temp, mat, fix, q, materials)
+
+    @property
+    def n(self) -> int:
+        return len(self.radius)
+
+    def _property(self, key: str) -> np.ndarray:
+        return np.array([getattr(m, key) for m in self.materials])[self.material]
+
+    @property
+    def conductivity(self) -> np.ndarray:
+        return self._property("conductivity")
+
+    @property
+    def volume(self) -> np.ndarray:
+        return 4.0 / 3.0 * np.pi * self.radius**3
+
+    @property
+    def mass(self) -> np.ndarray:
+        """``m_i = rho (4/3) pi r_i^3``."""
+        return self._property("density") * self.volume
+
+    @property
+    def capacity(self) -> np.ndarray:
+        """``C_i = m_i c`` (Rojek 2022, eq. 1), J/K."""
+        return self.mass * self._property("specific_heat")
+
+    def permuted(self, order: np.ndarray) -> "Particles":
+        """The same particles in the order ``order`` (used to test independence from ordering)."""
+        return Particles(self.position[order], self.radius[order], self.temperature[order], self.material[order],
+                         self.fixed[order], self.heat[order], self.materials)
+
+
+def _bool_array(name: str, value) -> np.ndarray:
+    arr = np.asarray(value)
+    if arr.ndim != 1 or (arr.size and arr.dtype != bool):
+        raise ValueError(f"{name}: must be a list of true/false")
+    return arr.astype(bool)

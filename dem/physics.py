@@ -1,0 +1,97 @@
+"""The submodels a scene can ask for, and where new ones plug in.
+
+A scene names its physics (``[scene] physics = ["thermal"]``); only those are built. Each entry of
+:data:`REGISTRY` is a class constructed from the :class:`~dem.scene.Scene` that builds its own state, and whose
+``run(observer, progress)`` returns a summary dict. The thermal model of a static packing builds its bonds once,
+never moves a particle and allocates no mechanical state.
+
+Next to plug in (see :data:`PLANNED`): the mechanical sintering contact of Luding et al. 2005 (positions,
+velocities, the hysteretic normal law; bonds rebuilt as particles move, then the thermal network re-assembled) and
+the electrical current flow with Joule heating of Zohdi 2014 (eqs. 38-44; a second network Laplacian on the same
+bonds, feeding ``Particles.heat``), staggered with the thermal model as in Zohdi's Algorithm 1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dem.bonds import find_bonds
+from dem.laws.conductance import bond_conductances
+from dem.thermal import Network, boundary_heat_flow, integrate, steady
+
+PLANNED = {
+    "mechanical": "the Luding 2005 sintering contact (hysteretic normal law, temperature-dependent stiffness)",
+    "electrical": "the Zohdi 2014 current flow and Joule heating (eqs. 38-44)",
+}
+
+
+class ThermalModel:
+    """The pipe network of Rojek 2022 (eqs. 1-9) on bonds found once from the scene's geometry."""
+
+    name = "thermal"
+
+    def __init__(self, scene):
+        self.scene = scene
+        p = scene.particles
+        spec = scene.conductance
+        self.bonds = find_bonds(p, scene.walls, spec.contact, spec.out_of_range)
+        self.K_pairs, self.K_walls = bond_conductances(spec, p, self.bonds)
+        wall_T = np.array([w.temperature for w in scene.walls], dtype=float)
+        self.network = Network(p, self.bonds, self.K_pairs, self.K_walls, wall_T, scene.sources)
+
+    def run(self, observer=None, progress=None) -> dict:
+        s = self.scene.solver
+        out = {"law": self.scene.conductance.law, "contact": self.bonds.contact,
+               "bonds_clipped": self.bonds.clipped, "bonds_dropped": self.bonds.dropped,
+               "wall_bonds": self.bonds.n_walls}
+        if s.mode == "steady":
+            res = steady(self.network, s.floating, s.linear)
+            self.T = res.T
+            if observer is not None:
+                observer(0, 0.0, res.T[self.network.free], res.flows)
+            out.update(t=0.0, steps=0, energy_error=res.energy_error, heat_flow=res.flows, linear_solver=res.solver,
+                       newton_iterations=res.iterations, floating_groups=res.floating)
+            if len(self.network.fixed) or len(self.scene.walls):
+                out["boundary_heat_flow"] = self._boundary(res.T)
+        else:
+            res = integrate(self.network, s.integrator, s.dt, s.t_end, s.rtol, s.linear, s.max_steps, observer,
+                            progress)
+            self.T = res.T
+            out.update(t=res.t, steps=res.steps, energy_error=res.energy_error, heat_in=res.heat_in,
+                       integrator=s.integrator, dt=s.dt, dt_min=res.dt_min, dt_max=res.dt_max,
+                       rejected_steps=res.rejected, stable_limit=res.stable_limit, linear_solver=res.solver,
+                       factorizations=res.factorizations)
+        return out
+
+    def _boundary(self, T: np.ndarray) -> dict:
+        flows = boundary_heat_flow(self.network, T)
+        out = {"walls": {w.name: float(q) for w, q in zip(self.scene.walls, flows["walls"])},
+               "fixed_total": float(sum(flows["particles"].values()))}
+        if len(flows["particles"]) <= 1000:
+            out["particles"] = {str(k): v for k, v in flows["particles"].items()}
+        return out
+
+    def bond_heat_flow(self) -> tuple[np.ndarray, np.ndarray]:
+        """Heat flow (W) along each pair bond from i to j, and from each wall-bonded particle into its wall."""
+        b, T = self.bonds, self.T
+        wall_T = self.network.wall_temperature[b.wall_index]
+        return self.K_pairs * (T[b.i] - T[b.j]), self.K_walls * (T[b.wall_particle] - wall_T)
+
+
+REGISTRY = {"thermal": ThermalModel}
+
+
+def build(scene) -> list:
+    """The submodels the scene names, in order; unknown or planned names raise ValueError."""
+    models = []
+    for name in scene.physics:
+        if name in REGISTRY:
+            models.append(REGISTRY[name](scene))
+        elif name in PLANNED:
+            raise ValueError(f"[scene] physics = {name!r}: not implemented yet ({PLANNED[name]}); available: "
+                             f"{', '.join(REGISTRY)}")
+        else:
+            raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(REGISTRY)})")
+    if not models:
+        raise ValueError("[scene] physics: names no submodel (available: thermal)")
+    return models

@@ -1,0 +1,374 @@
+"""Scenes: everything one DEM run needs, read from TOML (``tomllib``) or built from arrays in Python.
+
+:func:`load_scene` reads a file path or a built-in name (``dem/scenes/*.toml``); :func:`parse_scene` validates a
+TOML document (a dict) into a :class:`Scene`; :func:`make_scene` builds one from explicit arrays. The schema is
+documented in ``dem/SCHEMA.md``. Every problem raises ``ValueError`` naming the table and key (and, for malformed
+TOML, the line).
+"""
+
+from __future__ import annotations
+
+import math
+import pathlib
+import tomllib
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from dem import generators
+from dem.laws.conductance import ConductanceSpec
+from dem.particles import COPPER, Material, Particles
+from dem.sources import Convection, Radiation, Sources, Wall
+from dem.thermal import INTEGRATORS
+from dem.linsolve import BACKENDS
+
+SCENE_DIR = pathlib.Path(__file__).with_name("scenes")
+MODES = ("transient", "steady")
+BOUNDARIES = ("plates", "fixed", "none")
+
+ALLOWED = {
+    "scene": {"name", "description", "physics"},
+    "material": {"name", "conductivity", "density", "specific_heat"},
+    "particles": {"position", "radius", "temperature", "fixed", "material", "heat"},
+    "generator": {"kind", "n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter",
+                  "temperature", "boundary", "hot", "cold", "heat"},
+    "walls": {"name", "point", "normal", "temperature"},
+    "conductance": {"law", "slope", "fit_file", "neck", "contact_conductance", "out_of_range"},
+    "convection": {"h", "T_inf", "area_fraction"},
+    "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
+    "solver": {"mode", "integrator", "dt", "t_end", "rtol", "linear", "floating", "max_steps"},
+    "output": {"every", "vtu_every", "vtu"},
+}
+GENERATOR_KEYS = {
+    "chain": {"n", "radius", "overlap"},
+    "lattice": {"shape", "radius", "overlap"},
+    "random": {"n", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter"},
+}
+
+
+@dataclass(frozen=True)
+class SolverSpec:
+    """``mode`` steady|transient; transient: ``integrator``, ``dt`` (s or "auto"), ``t_end``, ``rtol`` (auto dt);
+    ``linear`` backend (:mod:`dem.linsolve`); ``floating`` steady policy; ``max_steps`` guard."""
+
+    mode: str = "steady"
+    integrator: str = "crank-nicolson"
+    dt: object = "auto"
+    t_end: float | None = None
+    rtol: float = 1e-3
+    linear: str = "auto"
+    floating: str = "error"
+    max_steps: int = 1_000_000
+
+    def __post_init__(self):
+        if self.mode not in MODES:
+            raise ValueError(f"[solver] mode = {self.mode!r}: must be one of {', '.join(MODES)}")
+        if self.integrator not in INTEGRATORS:
+            raise ValueError(f"[solver] integrator = {self.integrator!r}: must be one of {', '.join(INTEGRATORS)}")
+        if self.linear not in ("auto", *BACKENDS):
+            raise ValueError(f"[solver] linear = {self.linear!r}: must be one of auto, {', '.join(BACKENDS)}")
+        if self.floating not in ("error", "mean"):
+            raise ValueError(f"[solver] floating = {self.floating!r}: must be error or mean")
+        if isinstance(self.dt, str):
+            if self.dt != "auto":
+                raise ValueError(f"[solver] dt = {self.dt!r}: must be a number > 0 (s) or \"auto\"")
+        elif not _is_number(self.dt) or not math.isfinite(self.dt) or self.dt <= 0:
+            raise ValueError(f"[solver] dt = {self.dt!r}: must be a number > 0 (s) or \"auto\"")
+        if self.mode == "transient":
+            if self.t_end is None:
+                raise ValueError("[solver] t_end: required in transient mode (s)")
+            if not _is_number(self.t_end) or not math.isfinite(self.t_end) or self.t_end <= 0:
+                raise ValueError(f"[solver] t_end = {self.t_end!r}: must be a finite number > 0 (s)")
+        if not _is_number(self.rtol) or not (0 < self.rtol < 1):
+            raise ValueError(f"[solver] rtol = {self.rtol!r}: must be in (0, 1)")
+        if not isinstance(self.max_steps, int) or isinstance(self.max_steps, bool) or self.max_steps < 1:
+            raise ValueError(f"[solver] max_steps = {self.max_steps!r}: must be an integer >= 1")
+
+
+@dataclass(frozen=True)
+class OutputSpec:
+    """CSV row every ``every`` steps; VTU snapshot every ``vtu_every`` steps (0: first and last only)."""
+
+    every: int = 1
+    vtu_every: int = 0
+    vtu: bool = True
+
+    def __post_init__(self):
+        for key in ("every", "vtu_every"):
+            v = getattr(self, key)
+            if not isinstance(v, int) or isinstance(v, bool) or v < (1 if key == "every" else 0):
+                raise ValueError(f"[output] {key} = {v!r}: must be an integer >= {1 if key == 'every' else 0}")
+        if not isinstance(self.vtu, bool):
+            raise ValueError(f"[output] vtu = {self.vtu!r}: must be true or false")
+
+
+@dataclass(frozen=True)
+class Specimen:
+    """For generated scenes with hot/cold ends: length L (m) and cross-section A (m^2) for ``k_eff = Q L/(A dT)``,
+    and where the heat enters: the wall named ``hot`` or the fixed particles ``hot_particles``."""
+
+    length: float
+    area: float
+    hot: float
+    cold: float
+    hot_particles: tuple = ()
+
+
+@dataclass(frozen=True)
+class Scene:
+    """One DEM run: particles (+ walls), conductance law, ambient sources, solver, outputs, the physics to run."""
+
+    particles: Particles
+    walls: tuple = ()
+    conductance: ConductanceSpec = field(default_factory=ConductanceSpec)
+    sources: Sources = field(default_factory=Sources)
+    solver: SolverSpec = field(default_factory=SolverSpec)
+    output: OutputSpec = field(default_factory=OutputSpec)
+    physics: tuple = ("thermal",)
+    name: str = "scene"
+    description: str = ""
+    specimen: Specimen | None = None
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def make_scene(position, radius, temperature, *, materials=(COPPER,), material=None, fixed=None, heat=None,
+               walls=(), law="rojek", conductance: ConductanceSpec | None = None, sources: Sources | None = None,
+               solver: SolverSpec | None = None, output: OutputSpec | None = None, name="scene",
+               **solver_options) -> Scene:
+    """A :class:`Scene` from explicit arrays, e.g. for a chain or cluster to compare with FE::
+
+        make_scene(x, r, T, fixed=mask, law="fit", mode="steady")
+        make_scene(x, r, T, mode="transient", integrator="implicit", dt=1e-3, t_end=0.1)
+
+    Keyword ``solver_options`` are :class:`SolverSpec` fields (``mode``, ``integrator``, ``dt``, ...).
+    """
+    particles = Particles.from_arrays(position, radius, temperature, materials, material, fixed, heat)
+    return Scene(particles, tuple(walls), conductance or ConductanceSpec(law=law), sources or Sources(),
+                 solver or SolverSpec(**solver_options), output or OutputSpec(), name=name)
+
+
+# --------------------------------------------------------------------------------------------------- TOML
+def _check_keys(table: dict, section: str, allowed: set):
+    if not isinstance(table, dict):
+        raise ValueError(f"[{section}]: must be a table")
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise ValueError(f"[{section}] {unknown[0]}: unknown key (allowed: {', '.join(sorted(allowed))})")
+
+
+def _number(table, section, key, default=None, required=False):
+    if key not in table:
+        if required:
+            raise ValueError(f"[{section}] {key}: required")
+        return default
+    v = table[key]
+    if not _is_number(v) or not math.isfinite(v):
+        raise ValueError(f"[{section}] {key} = {v!r}: must be a finite number")
+    return float(v)
+
+
+def _materials(doc) -> tuple:
+    if "material" in doc and "materials" in doc:
+        raise ValueError("[material] and [[materials]]: give one or the other")
+    tables = doc.get("materials", [doc["material"]] if "material" in doc else None)
+    if tables is None:
+        raise ValueError("[material]: required (conductivity, density, specific_heat)")
+    if not isinstance(tables, list) or not tables:
+        raise ValueError("[[materials]]: must be a non-empty array of tables")
+    out = []
+    for k, t in enumerate(tables):
+        section = "material" if "material" in doc else f"materials[{k}]"
+        _check_keys(t, section, ALLOWED["material"])
+        props = {key: _number(t, section, key, required=True) for key in ("conductivity", "density",
+                                                                          "specific_heat")}
+        for key, v in props.items():
+            if v <= 0:
+                raise ValueError(f"[{section}] {key} = {v!r}: must be > 0")
+        out.append(Material(**props, name=str(t.get("name", f"material{k}"))))
+    return tuple(out)
+
+
+def _material_index(value, materials, n):
+    if value is None:
+        return None
+    names = [m.name for m in materials]
+    if isinstance(value, (str, int)) and not isinstance(value, bool):
+        value = [value] * n
+    if not isinstance(value, list):
+        raise ValueError("[particles] material: must be a material name/index or a list of them")
+    out = []
+    for k, v in enumerate(value):
+        if isinstance(v, str):
+            if v not in names:
+                raise ValueError(f"[particles] material[{k}] = {v!r}: unknown (materials: {', '.join(names)})")
+            out.append(names.index(v))
+        elif isinstance(v, int) and not isinstance(v, bool):
+            out.append(v)
+        else:
+            raise ValueError(f"[particles] material[{k}] = {v!r}: must be a material name or index")
+    return out
+
+
+def _explicit_particles(t: dict, materials):
+    _check_keys(t, "particles", ALLOWED["particles"])
+    for key in ("position", "radius", "temperature"):
+        if key not in t:
+            raise ValueError(f"[particles] {key}: required")
+    n = len(t["position"]) if isinstance(t["position"], list) else 0
+    return Particles.from_arrays(t["position"], t["radius"], t["temperature"], materials,
+                                 _material_index(t.get("material"), materials, n), t.get("fixed"), t.get("heat"),
+                                 prefix="[particles]"), (), None
+
+
+def _generated_particles(t: dict, materials):
+    _check_keys(t, "generator", ALLOWED["generator"])
+    kind = t.get("kind")
+    if kind not in GENERATOR_KEYS:
+        raise ValueError(f"[generator] kind = {kind!r}: must be one of {', '.join(GENERATOR_KEYS)}")
+    geometry_keys = {"n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter"}
+    extra = sorted((set(t) & geometry_keys) - GENERATOR_KEYS[kind])
+    if extra:
+        raise ValueError(f"[generator] {extra[0]}: not a parameter of kind = {kind!r} "
+                         f"(its parameters: {', '.join(sorted(GENERATOR_KEYS[kind]))})")
+    args = {k: t[k] for k in GENERATOR_KEYS[kind] if k in t}
+    missing = sorted({"radius", "overlap", "shape" if kind == "lattice" else "n"} - set(args))
+    if missing:
+        raise ValueError(f"[generator] {missing[0]}: required for kind = {kind!r}")
+    try:
+        layout = {"chain": generators.chain, "lattice": generators.lattice,
+                  "random": generators.random_packing}[kind](**args)
+    except TypeError as exc:
+        raise ValueError(f"[generator]: bad parameter types for kind = {kind!r} ({exc})") from None
+    n = len(layout.radius)
+    T0 = _number(t, "generator", "temperature", 0.0)
+    boundary = t.get("boundary", "none")
+    if boundary not in BOUNDARIES:
+        raise ValueError(f"[generator] boundary = {boundary!r}: must be one of {', '.join(BOUNDARIES)}")
+    hot = _number(t, "generator", "hot", required=boundary != "none")
+    cold = _number(t, "generator", "cold", required=boundary != "none")
+    heat = _number(t, "generator", "heat", 0.0)
+    temperature = np.full(n, T0)
+    fixed = np.zeros(n, dtype=bool)
+    walls, specimen = (), None
+    mean_overlap = float(np.mean(np.atleast_1d(t["overlap"])))
+    if boundary == "fixed":
+        fixed[layout.bottom] = fixed[layout.top] = True
+        temperature[layout.bottom], temperature[layout.top] = hot, cold
+        length = float(np.mean(layout.position[layout.top, 2]) - np.mean(layout.position[layout.bottom, 2]))
+        specimen = Specimen(length, layout.area, hot, cold, tuple(int(k) for k in layout.bottom))
+    elif boundary == "plates":
+        # plane walls touching the end layers with overlap delta = overlap * r / 2: the mirror pair's neck equals
+        # that of a pair with the generator's relative overlap
+        r_b, r_t = layout.radius[layout.bottom], layout.radius[layout.top]
+        z_b = float(np.mean(layout.position[layout.bottom, 2] - r_b * (1.0 - 0.5 * mean_overlap)))
+        z_t = float(np.mean(layout.position[layout.top, 2] + r_t * (1.0 - 0.5 * mean_overlap)))
+        walls = (Wall("hot", [0.0, 0.0, z_b], [0.0, 0.0, 1.0], hot), Wall("cold", [0.0, 0.0, z_t], [0.0, 0.0, -1.0],
+                                                                          cold))
+        specimen = Specimen(z_t - z_b, layout.area, hot, cold)
+    particles = Particles.from_arrays(layout.position, layout.radius, temperature, materials, None, fixed,
+                                      np.full(n, heat), prefix="[generator]")
+    return particles, walls, specimen
+
+
+def _walls(doc) -> tuple:
+    tables = doc.get("walls", [])
+    if not isinstance(tables, list):
+        raise ValueError("[[walls]]: must be an array of tables")
+    out = []
+    for k, w in enumerate(tables):
+        _check_keys(w, f"walls[{k}]", ALLOWED["walls"])
+        for key in ("point", "normal", "temperature"):
+            if key not in w:
+                raise ValueError(f"[[walls]] {k}: {key}: required")
+        out.append(Wall(str(w.get("name", f"wall{k}")), w["point"], w["normal"],
+                        _number(w, f"walls[{k}]", "temperature", required=True)))
+    names = [w.name for w in out]
+    if len(set(names)) != len(names):
+        raise ValueError(f"[[walls]] name: names must be unique, got {names}")
+    return tuple(out)
+
+
+def _spec(cls, table, section, numeric=(), integer=()):
+    _check_keys(table, section, ALLOWED[section])
+    kwargs = {}
+    for key, v in table.items():
+        if key in numeric and not isinstance(v, str):
+            v = _number(table, section, key)
+        if key in integer and (not isinstance(v, int) or isinstance(v, bool)):
+            raise ValueError(f"[{section}] {key} = {v!r}: must be an integer")
+        kwargs[key] = v
+    try:
+        return cls(**kwargs)
+    except ValueError as exc:
+        msg = str(exc)
+        if msg.startswith(f"{section}."):
+            msg = f"[{section}] {msg[len(section) + 1:]}"
+        raise ValueError(msg if msg.startswith("[") else f"[{section}] {msg}") from None
+
+
+def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None) -> Scene:
+    """Validate a parsed TOML document into a :class:`Scene` (schema: ``dem/SCHEMA.md``)."""
+    top = set(ALLOWED) | {"materials"}
+    unknown = sorted(set(doc) - top)
+    if unknown:
+        raise ValueError(f"[{unknown[0]}]: unknown table (allowed: {', '.join(sorted(top))})")
+    meta = doc.get("scene", {})
+    _check_keys(meta, "scene", ALLOWED["scene"])
+    physics = meta.get("physics", ["thermal"])
+    if isinstance(physics, str):
+        physics = [physics]
+    materials = _materials(doc)
+    if ("particles" in doc) == ("generator" in doc):
+        raise ValueError("[particles] or [generator]: give exactly one of them")
+    if "particles" in doc:
+        particles, walls, specimen = _explicit_particles(doc["particles"], materials)
+    else:
+        particles, walls, specimen = _generated_particles(doc["generator"], materials)
+    walls = walls + _walls(doc)
+    cond = dict(doc.get("conductance", {}))
+    if "fit_file" in cond and base_dir is not None and isinstance(cond["fit_file"], str):
+        cond["fit_file"] = str((base_dir / cond["fit_file"]).resolve())
+    conductance = _spec(ConductanceSpec, cond, "conductance", numeric=("slope", "contact_conductance"))
+    conv = _spec(Convection, doc["convection"], "convection", numeric=("h", "T_inf")) if "convection" in doc else None
+    rad = (_spec(Radiation, doc["radiation"], "radiation", numeric=("emissivity", "T_inf"))
+           if "radiation" in doc else None)
+    solver = _spec(SolverSpec, doc.get("solver", {}), "solver", numeric=("dt", "t_end", "rtol"),
+                   integer=("max_steps",))
+    output = _spec(OutputSpec, doc.get("output", {}), "output", integer=("every", "vtu_every"))
+    return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
+                 str(meta.get("name", source)), str(meta.get("description", "")), specimen)
+
+
+def builtin_scenes() -> dict:
+    """``{name: description}`` of the scenes shipped in ``dem/scenes``."""
+    out = {}
+    for path in sorted(SCENE_DIR.glob("*.toml")):
+        with path.open("rb") as fh:
+            out[path.stem] = tomllib.load(fh).get("scene", {}).get("description", "")
+    return out
+
+
+def load_scene(name_or_path) -> Scene:
+    """Read a scene from a TOML file path or a built-in name (``python -m dem scenes`` lists them)."""
+    path = pathlib.Path(name_or_path)
+    if not path.exists() and (SCENE_DIR / f"{name_or_path}.toml").exists():
+        path = SCENE_DIR / f"{name_or_path}.toml"
+    if not path.exists():
+        raise ValueError(f"scene = {str(name_or_path)!r}: no such file or built-in scene "
+                         f"(built-ins: {', '.join(builtin_scenes())})")
+    if not path.is_file():
+        raise ValueError(f"scene = {str(name_or_path)!r}: not a file")
+    try:
+        with path.open("rb") as fh:
+            doc = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{path.name}: malformed TOML: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path.name}: cannot be read ({exc})") from None
+    try:
+        return parse_scene(doc, path.stem, path.parent)
+    except ValueError as exc:
+        raise ValueError(f"{path.name}: {exc}") from None

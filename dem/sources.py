@@ -1,0 +1,143 @@
+"""Heat sources and boundaries of the particle heat balance (Rojek 2022, eq. 3).
+
+``Q_i = sum_j Q_ij^cond + Q_i^int + Q_i^conv + Q_i^rad``. Besides the pipes (``dem.thermal``) a particle exchanges
+heat with
+
+* its internal source ``Q_i^int`` (W, ``Particles.heat``),
+* an ambient by convection ``Q_i^conv = h A_i (T_inf - T_i)`` (:class:`Convection`),
+* an ambient by radiation ``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)`` in absolute temperature (:class:`Radiation`),
+* isothermal plane walls it touches (:class:`Wall`; the contact conductance comes from the conductance law).
+
+Particles held at a fixed temperature are a mask of :class:`dem.particles.Particles`. Every term is linear in
+``T_i`` except radiation, which the solvers use linearised about the current temperature
+(:func:`linear_sink_terms`); a scene without radiation never evaluates ``T^4``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+STEFAN_BOLTZMANN = 5.670374419e-8  # W/(m^2 K^4), CODATA 2018 (exact)
+KELVIN_OFFSET = {"K": 0.0, "C": 273.15}
+
+
+def _unit_vector(name: str, value) -> np.ndarray:
+    v = np.asarray(value, dtype=float)
+    if v.shape != (3,) or not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0.0:
+        raise ValueError(f"{name} = {value!r}: must be a finite non-zero 3-vector")
+    return v / np.linalg.norm(v)
+
+
+@dataclass(frozen=True)
+class Wall:
+    """An isothermal plane through ``point`` with unit ``normal`` pointing into the packing, at ``temperature``.
+
+    A particle touches the wall when its centre lies closer than its radius to the plane; the overlap is
+    ``delta = r - distance``.
+    """
+
+    name: str
+    point: np.ndarray
+    normal: np.ndarray
+    temperature: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "point", np.asarray(self.point, dtype=float))
+        if self.point.shape != (3,) or not np.all(np.isfinite(self.point)):
+            raise ValueError(f"wall {self.name!r}: point = {self.point.tolist()}: must be a finite 3-vector")
+        object.__setattr__(self, "normal", _unit_vector(f"wall {self.name!r}: normal", self.normal))
+        if not np.isfinite(self.temperature):
+            raise ValueError(f"wall {self.name!r}: temperature = {self.temperature!r}: must be finite")
+
+    def distance(self, position: np.ndarray) -> np.ndarray:
+        """Signed distance of each point from the plane (positive on the packing's side)."""
+        return (position - self.point) @ self.normal
+
+
+def _area(name: str, fraction, radius: np.ndarray) -> np.ndarray:
+    frac = np.broadcast_to(np.asarray(fraction, dtype=float), radius.shape)
+    if not np.all(np.isfinite(frac)) or np.any((frac < 0) | (frac > 1)):
+        raise ValueError(f"{name}.area_fraction = {fraction!r}: must be in [0, 1] (scalar or one per particle)")
+    return frac * 4.0 * np.pi * radius**2
+
+
+@dataclass(frozen=True)
+class Convection:
+    """``Q_i^conv = h A_i (T_inf - T_i)`` with ``A_i = area_fraction * 4 pi r_i^2`` (the exposed surface)."""
+
+    h: float
+    T_inf: float
+    area_fraction: object = 1.0
+
+    def __post_init__(self):
+        if not (np.isfinite(self.h) and self.h >= 0):
+            raise ValueError(f"convection.h = {self.h!r}: must be finite and >= 0 (W/(m^2 K))")
+        if not np.isfinite(self.T_inf):
+            raise ValueError(f"convection.T_inf = {self.T_inf!r}: must be finite")
+
+    def coefficient(self, radius: np.ndarray) -> np.ndarray:
+        """``h A_i`` in W/K."""
+        return self.h * _area("convection", self.area_fraction, radius)
+
+
+@dataclass(frozen=True)
+class Radiation:
+    """``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)``; temperatures in ``unit`` ("K" or "C"), T^4 in kelvin."""
+
+    emissivity: float
+    T_inf: float
+    area_fraction: object = 1.0
+    unit: str = "K"
+
+    def __post_init__(self):
+        if not (np.isfinite(self.emissivity) and 0 <= self.emissivity <= 1):
+            raise ValueError(f"radiation.emissivity = {self.emissivity!r}: must be in [0, 1]")
+        if self.unit not in KELVIN_OFFSET:
+            raise ValueError(f"radiation.unit = {self.unit!r}: must be one of {', '.join(KELVIN_OFFSET)}")
+        if not (np.isfinite(self.T_inf) and self.T_inf + KELVIN_OFFSET[self.unit] >= 0):
+            raise ValueError(f"radiation.T_inf = {self.T_inf!r}: must be finite and >= absolute zero")
+
+    def kelvin(self, T):
+        return np.asarray(T, dtype=float) + KELVIN_OFFSET[self.unit]
+
+    def coefficient(self, radius: np.ndarray) -> np.ndarray:
+        """``eps sigma A_i`` in W/K^4."""
+        return self.emissivity * STEFAN_BOLTZMANN * _area("radiation", self.area_fraction, radius)
+
+    def outflow(self, radius: np.ndarray, T: np.ndarray) -> np.ndarray:
+        """Exact radiated power per particle ``eps sigma A_i (T_i^4 - T_inf^4)`` (W)."""
+        return self.coefficient(radius) * (self.kelvin(T) ** 4 - self.kelvin(self.T_inf) ** 4)
+
+
+@dataclass(frozen=True)
+class Sources:
+    """The ambient exchanges of a scene; ``None`` means the term is absent (and never evaluated)."""
+
+    convection: Convection | None = None
+    radiation: Radiation | None = None
+
+    @property
+    def names(self) -> list[str]:
+        return [k for k in ("convection", "radiation") if getattr(self, k) is not None]
+
+
+def linear_sink_terms(sources: Sources, radius: np.ndarray, T_lin: np.ndarray | None) -> dict:
+    """Ambient exchange as ``Q_i = b_i - g_i T_i`` (W): ``{name: (g, b)}`` for each term the scene has.
+
+    Convection is linear: ``g = h A``, ``b = h A T_inf``. Radiation is linearised about ``T_lin`` (a Newton step
+    of ``T^4``): ``T^4 ~ 4 T0^3 T - 3 T0^4`` in kelvin, so ``g = 4 eps sigma A T0^3 >= 0`` keeps the system
+    matrix symmetric positive definite and the implicit integrators unconditionally stable.
+    """
+    terms = {}
+    if sources.convection is not None:
+        g = sources.convection.coefficient(radius)
+        terms["convection"] = (g, g * sources.convection.T_inf)
+    if sources.radiation is not None:
+        rad = sources.radiation
+        coef = rad.coefficient(radius)
+        t0 = np.maximum(rad.kelvin(T_lin), 0.0)
+        g = 4.0 * coef * t0**3
+        terms["radiation"] = (g, coef * (rad.kelvin(rad.T_inf) ** 4 + 3.0 * t0**4) - g * rad.kelvin(0.0))
+    return terms

@@ -1,0 +1,409 @@
+"""The thermal pipe network: steady solve and time integration of ``C_i dT_i/dt = Q_i`` (Rojek 2022, eqs. 2-4).
+
+With the pipes ``Q_ij = K_ij (T_j - T_i)`` (eq. 4), the heat balance of the free (not fixed) particles is linear
+apart from radiation::
+
+    C dT/dt = r - A T,    A = L_FF + diag(K_wall + g),    r = -L_FD T_D + K_wall T_wall + Q_int + b,
+
+with ``L`` the weighted graph Laplacian of the bonds (symmetric positive semidefinite, rows summing to zero),
+``F``/``D`` the free/fixed particles, ``(g, b)`` the ambient exchange ``Q = b - g T`` (convection; radiation
+linearised about the current temperature, :func:`dem.sources.linear_sink_terms`). ``A`` is built once as a CSR
+matrix; it is SPD when every connected group of free particles reaches a fixed particle, a wall or the ambient.
+
+* :func:`steady` -- ``A T = r`` (Newton on the radiation term); singular systems are detected and explained.
+* :func:`integrate` -- the theta method ``(C/dt + theta A) T+ = (C/dt - (1-theta) A) T + r`` with theta = 0
+  (explicit forward Euler), 1 (implicit backward Euler), 1/2 (Crank-Nicolson); the matrix is factorised once per
+  step size and reused. Explicit steps are stable only for ``dt <= 2/lambda_max(C^-1 A)``: a larger ``dt`` is
+  refused with a message giving the limit. ``dt = "auto"`` keeps the largest temperature change per step near
+  ``rtol`` times the temperature range (halving or doubling the step, factorisations cached per step size), and
+  for explicit never above 0.9 of the stable limit.
+
+Energy bookkeeping: the heat flowing into the free particles through each boundary (fixed particles, walls,
+convection, radiation, internal sources) is integrated with the same theta weighting as the step, so the change
+of ``sum C_i T_i`` must match it to round-off; the relative mismatch is ``energy_error``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spl
+from scipy.sparse.csgraph import connected_components
+
+from dem.bonds import Bonds
+from dem.linsolve import make_solver
+from dem.particles import Particles
+from dem.sources import Sources, linear_sink_terms
+
+INTEGRATORS = {"explicit": 0.0, "implicit": 1.0, "crank-nicolson": 0.5}
+FLOW_NAMES = ("fixed", "walls", "convection", "radiation", "internal")
+AUTO_SAFETY = 0.9  # explicit dt = "auto" stays below this fraction of the stable limit
+
+
+def laplacian(n: int, i: np.ndarray, j: np.ndarray, K: np.ndarray) -> sp.csr_matrix:
+    """Weighted graph Laplacian ``L_ii = sum_j K_ij``, ``L_ij = -K_ij`` (symmetric, rows sum to zero)."""
+    diag = np.bincount(i, K, n) + np.bincount(j, K, n)
+    rows = np.concatenate([i, j, np.arange(n)])
+    cols = np.concatenate([j, i, np.arange(n)])
+    vals = np.concatenate([-K, -K, diag])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+
+@dataclass
+class Network:
+    """The linear(ised) heat balance of the free particles (module docstring), assembled once."""
+
+    particles: Particles
+    bonds: Bonds
+    K_pairs: np.ndarray
+    K_walls: np.ndarray
+    wall_temperature: np.ndarray
+    sources: Sources = field(default_factory=Sources)
+
+    def __post_init__(self):
+        p = self.particles
+        n = p.n
+        self.free = np.flatnonzero(~p.fixed)
+        self.fixed = np.flatnonzero(p.fixed)
+        self.L = laplacian(n, self.bonds.i, self.bonds.j, self.K_pairs)
+        if len(self.fixed):
+            rows = self.L[self.free]
+            self.L_FF = rows[:, self.free].tocsr()
+            L_FD = rows[:, self.fixed].tocsr()
+        else:
+            self.L_FF, L_FD = self.L, sp.csr_matrix((n, 0))
+        self.T_D = p.temperature[self.fixed]
+        wp = self.bonds.wall_particle
+        kw_diag = np.bincount(wp, self.K_walls, n)
+        kw_rhs = np.bincount(wp, self.K_walls * self.wall_temperature[self.bonds.wall_index], n)
+        self.wall_diag = kw_diag[self.free]
+        self.wall_rhs = kw_rhs[self.free]
+        self.fixed_rhs = -(L_FD @ self.T_D)
+        self.fixed_diag = -np.asarray(L_FD.sum(axis=1)).ravel()
+        self.heat = p.heat[self.free]
+        self.C = p.capacity[self.free]
+        self.radius = p.radius[self.free]
+        self.base_diag = self.L_FF.diagonal()
+        self.r_const = self.fixed_rhs + self.wall_rhs + self.heat
+
+    @property
+    def n_free(self) -> int:
+        return len(self.free)
+
+    def sinks(self, T_F: np.ndarray) -> dict:
+        return linear_sink_terms(self.sources, self.radius, T_F)
+
+    def matrix(self, sinks: dict, shift=None) -> sp.csr_matrix:
+        """``shift + theta``-free system matrix ``A`` (plus ``diag(shift)`` when given)."""
+        extra = self.wall_diag + sum((g for g, _ in sinks.values()), np.zeros(self.n_free))
+        if shift is not None:
+            extra = extra + shift
+        return (self.L_FF + sp.diags(extra)).tocsr()
+
+    def rhs(self, sinks: dict) -> np.ndarray:
+        return self.r_const + sum((b for _, b in sinks.values()), np.zeros(self.n_free))
+
+    def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
+        """Heat flow into the free particles (W) through each boundary at temperatures ``T_F``."""
+        out = {"fixed": float(self.fixed_rhs.sum() - self.fixed_diag @ T_F),
+               "walls": float(self.wall_rhs.sum() - self.wall_diag @ T_F),
+               "internal": float(self.heat.sum())}
+        for name, (g, b) in sinks.items():
+            out[name] = float(b.sum() - g @ T_F)
+        return out
+
+    def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
+        """Sum of the absolute heat flows into or out of each free particle through its boundaries (W): the scale
+        of the energy balance (hot and cold ends do not cancel in it)."""
+        total = np.abs(self.fixed_rhs - self.fixed_diag * T_F) + np.abs(self.wall_rhs - self.wall_diag * T_F)
+        total = total + np.abs(self.heat)
+        for g, b in sinks.values():
+            total = total + np.abs(b - g * T_F)
+        return float(total.sum())
+
+    def full(self, T_F: np.ndarray) -> np.ndarray:
+        T = self.particles.temperature.copy()
+        T[self.free] = T_F
+        return T
+
+    def temperature_bounds(self) -> tuple[float, float]:
+        """Lowest and highest temperature the scene prescribes (initial, fixed, walls, ambient)."""
+        temps = [self.particles.temperature, self.wall_temperature]
+        temps += [[s.T_inf] for s in (self.sources.convection, self.sources.radiation) if s is not None]
+        allt = np.concatenate([np.ravel(t) for t in temps])
+        return float(allt.min()), float(allt.max())
+
+    def temperature_range(self) -> float:
+        lo, hi = self.temperature_bounds()
+        return hi - lo
+
+
+def boundary_heat_flow(net: Network, T: np.ndarray) -> dict:
+    """W into each fixed particle (from its bonds and walls) and into each wall, at full temperatures ``T``."""
+    p, b = net.particles, net.bonds
+    into_fixed = -(net.L @ T)
+    to_wall = net.K_walls * (T[b.wall_particle] - net.wall_temperature[b.wall_index])
+    into_fixed -= np.bincount(b.wall_particle, to_wall, p.n)
+    n_walls = len(net.wall_temperature)
+    walls = np.bincount(b.wall_index, to_wall, n_walls) if n_walls else np.zeros(0)
+    return {"particles": {int(k): float(into_fixed[k]) for k in net.fixed}, "walls": walls}
+
+
+# -------------------------------------------------------------------------------------------------- steady
+@dataclass
+class SteadyResult:
+    T: np.ndarray
+    flows: dict
+    energy_error: float
+    iterations: int
+    solver: str
+    floating: int = 0
+
+
+def _components(net: Network):
+    """Connected components of the free particles and whether each is anchored (reaches a fixed temperature)."""
+    n_comp, label = connected_components(net.L_FF, directed=False)
+    anchor = net.fixed_diag + net.wall_diag
+    sinks = net.sinks(net.particles.temperature[net.free])
+    for g, _ in sinks.values():
+        anchor = anchor + g
+    anchored = np.zeros(n_comp, dtype=bool)
+    anchored[label[anchor > 0]] = True
+    return n_comp, label, anchored
+
+
+def steady(net: Network, floating: str = "error", linear: str = "auto", max_newton: int = 50,
+           rtol: float = 1e-10) -> SteadyResult:
+    """Steady temperatures ``A T = r`` (Rojek 2022, eq. 2 with dT/dt = 0).
+
+    A connected group of free particles with no fixed particle, wall or ambient exchange makes ``A`` singular.
+    ``floating = "error"`` explains and refuses; ``"mean"`` keeps such a group at the capacity-weighted mean of its
+    initial temperatures (the long-time limit of the transient), provided its internal sources sum to zero.
+    """
+    T_F = net.particles.temperature[net.free].astype(float)
+    n_comp, label, anchored = _components(net)
+    n_float = int((~anchored).sum())
+    if n_float:
+        lost = np.flatnonzero(~anchored[label])
+        if floating == "error":
+            first = net.free[lost[:8]].tolist()
+            raise ValueError(f"steady problem is singular: {n_float} of {n_comp} connected group(s) of free particles "
+                             f"({len(lost)} particles, e.g. {first}) touch no fixed particle, wall, convection or "
+                             f"radiation, so their temperature is undetermined; fix a particle's temperature, add a "
+                             f"wall or an ambient, set solver.floating = \"mean\", or use mode = \"transient\"")
+        if floating != "mean":
+            raise ValueError(f"solver.floating = {floating!r}: must be error or mean")
+        comp = label[lost]
+        net_heat = np.bincount(comp, net.heat[lost], n_comp)
+        scale = np.bincount(comp, np.abs(net.heat[lost]), n_comp)
+        if np.any(np.abs(net_heat) > 1e-12 * np.maximum(scale, 1e-300)):
+            raise ValueError("steady problem has no solution: a floating group of particles (no fixed temperature, "
+                             "wall or ambient) has a net internal heat source, so it heats up forever")
+        energy = np.bincount(comp, net.C[lost] * T_F[lost], n_comp)
+        cap = np.bincount(comp, net.C[lost], n_comp)
+        T_F[lost] = energy[comp] / cap[comp]
+    solve_idx = np.flatnonzero(anchored[label])
+    T_sub = T_F[solve_idx]
+    restrict = None if len(solve_idx) == net.n_free else solve_idx
+    iterations, backend = 0, "none"
+    for iterations in range(1, max_newton + 1):
+        T_F[solve_idx] = T_sub
+        sinks = net.sinks(T_F)
+        A, r = net.matrix(sinks), net.rhs(sinks)
+        if restrict is not None:
+            A, r = A[restrict][:, restrict], r[restrict]
+        if len(r) == 0:
+            break
+        solver = make_solver(A, linear, net.base_diag if restrict is None else net.base_diag[restrict], rtol)
+        backend = solver.name
+        T_new = solver.solve(r, T_sub)
+        change = np.max(np.abs(T_new - T_sub)) if net.sources.radiation is not None else 0.0
+        T_sub = T_new
+        if change <= 1e-12 * max(net.temperature_range(), np.max(np.abs(T_sub)), 1e-300):
+            break
+    else:
+        raise ValueError(f"steady radiation (Newton) did not converge in {max_newton} iterations")
+    T_F[solve_idx] = T_sub
+    # radiation: report the exact T^4 flow at the solution
+    sinks = net.sinks(T_F)
+    flows = net.flows(T_F, sinks)
+    total = net.flow_magnitude(T_F, sinks)
+    err = abs(sum(flows.values())) / total if total > 0 else 0.0
+    return SteadyResult(net.full(T_F), flows, err, iterations, backend, n_float)
+
+
+# ------------------------------------------------------------------------------------------------ transient
+def stable_limit(net: Network, sinks: dict | None = None) -> float:
+    """Largest stable explicit step ``2 / lambda_max(C^-1 A)`` (``inf`` without any coupling).
+
+    ``lambda_max`` from Lanczos on the symmetric ``C^-1/2 A C^-1/2`` (dense for small systems); where Lanczos
+    fails the Gershgorin bound ``lambda_max <= max_i 2 A_ii / C_i`` gives a safe (smaller) limit.
+    """
+    sinks = net.sinks(net.particles.temperature[net.free]) if sinks is None else sinks
+    A = net.matrix(sinks)
+    if net.n_free == 0 or A.nnz == 0 or not np.any(A.diagonal() > 0):
+        return math.inf
+    s = 1.0 / np.sqrt(net.C)
+    S = sp.diags(s) @ A @ sp.diags(s)
+    if net.n_free <= 400:
+        lam = float(np.linalg.eigvalsh(S.toarray())[-1])
+    else:
+        try:
+            lam = float(spl.eigsh(S, k=1, which="LA", tol=1e-8, return_eigenvectors=False,
+                                  maxiter=5000)[0]) * (1 + 1e-7)
+        except spl.ArpackNoConvergence:
+            lam = float(np.max(2.0 * A.diagonal() / net.C))
+    return 2.0 / lam if lam > 0 else math.inf
+
+
+@dataclass
+class TransientResult:
+    T: np.ndarray
+    t: float
+    steps: int
+    rejected: int
+    energy_error: float
+    heat_in: dict
+    stable_limit: float | None
+    dt_min: float
+    dt_max: float
+    solver: str
+    factorizations: int
+
+
+class _Stepper:
+    """One theta-method step of a given size; the system solver is built once per step size."""
+
+    def __init__(self, net: Network, theta: float, linear: str, rtol_linear: float):
+        self.net, self.theta, self.linear, self.rtol_linear = net, theta, linear, rtol_linear
+        self.linear_sinks = net.sources.radiation is None
+        self._cache: dict = {}
+        self.factorizations = 0
+        self.backend = "none"
+        self.A0 = net.matrix(net.sinks(net.particles.temperature[net.free])) if self.linear_sinks else None
+
+    def _solver(self, dt: float, A: sp.csr_matrix, reuse: bool):
+        key = dt if reuse else None
+        if key is not None and key in self._cache:
+            return self._cache[key]
+        M = A * self.theta
+        M = (M + sp.diags(self.net.C / dt)).tocsr()
+        solver = make_solver(M, self.linear, self.net.base_diag * self.theta, self.rtol_linear)
+        self.factorizations += 1
+        self.backend = solver.name
+        if key is not None:
+            if len(self._cache) >= 8:
+                self._cache.pop(next(iter(self._cache)))
+            self._cache[key] = solver
+        return solver
+
+    def step(self, T: np.ndarray, dt: float):
+        """``(T_new, T_theta, sinks)`` for one step of size ``dt`` from ``T``."""
+        net = self.net
+        sinks = net.sinks(T)
+        A = self.A0 if self.linear_sinks else net.matrix(sinks)
+        r = net.rhs(sinks)
+        if self.theta == 0.0:
+            T_new = T + dt / net.C * (r - A @ T)
+        else:
+            rhs = net.C / dt * T + r - (1.0 - self.theta) * (A @ T)
+            T_new = self._solver(dt, A, self.linear_sinks).solve(rhs, T)
+        return T_new, self.theta * T_new + (1.0 - self.theta) * T, sinks
+
+
+def check_step_count(t_end: float, dt: float, max_steps: int, what: str):
+    steps = t_end / dt
+    if steps > max_steps:
+        raise ValueError(f"{what}: t_end / dt = {steps:.3g} steps exceeds solver.max_steps = {max_steps}; "
+                         f"raise max_steps, shorten t_end or use a larger dt (implicit or crank-nicolson)")
+
+
+def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end: float = 1.0, rtol: float = 1e-3,
+              linear: str = "auto", max_steps: int = 1_000_000, observer=None, progress=None,
+              rtol_linear: float = 1e-12) -> TransientResult:
+    """Integrate from the particles' initial temperatures to ``t_end`` (module docstring).
+
+    ``observer(step, t, T_F, flows)`` is called after every accepted step (and at t = 0 with step 0);
+    ``progress(t)`` reports the simulated time.
+    """
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"solver.integrator = {integrator!r}: must be one of {', '.join(INTEGRATORS)}")
+    if not (np.isfinite(t_end) and t_end > 0):
+        raise ValueError(f"solver.t_end = {t_end!r}: must be finite and > 0 (s)")
+    theta = INTEGRATORS[integrator]
+    stepper = _Stepper(net, theta, linear, rtol_linear)
+    T = net.particles.temperature[net.free].astype(float)
+    limit = None
+    if theta < 0.5:
+        # radiation: the stiffest linearisation within the prescribed temperatures (maximum principle)
+        t_hot = np.full(net.n_free, net.temperature_bounds()[1])
+        limit = stable_limit(net, net.sinks(t_hot if net.sources.radiation else T))
+    auto = isinstance(dt, str)
+    if auto:
+        if dt != "auto":
+            raise ValueError(f"solver.dt = {dt!r}: must be a number (s) or \"auto\"")
+        if not (np.isfinite(rtol) and rtol > 0):
+            raise ValueError(f"solver.rtol = {rtol!r}: must be finite and > 0")
+        scale = net.temperature_range() or max(float(np.max(np.abs(T), initial=0.0)), 1.0)
+        tol = rtol * scale
+        sinks0 = net.sinks(T)
+        rate = np.max(np.abs((net.rhs(sinks0) - net.matrix(sinks0) @ T) / net.C), initial=0.0)
+        dt_cap = AUTO_SAFETY * limit if limit is not None else math.inf
+        dt_now = min(t_end, tol / rate if rate > 0 else t_end, dt_cap)
+        if limit is not None and math.isfinite(limit):
+            check_step_count(t_end, dt_cap, max_steps, "explicit dt = \"auto\" at 0.9 x the stable limit "
+                                                       f"{limit:.6g} s")
+    else:
+        dt = float(dt)
+        if not (np.isfinite(dt) and dt > 0):
+            raise ValueError(f"solver.dt = {dt!r}: must be finite and > 0 (s) or \"auto\"")
+        if limit is not None and dt > limit:
+            raise ValueError(f"solver.dt = {dt:.6g} s exceeds the explicit stability limit {limit:.6g} s "
+                             f"(2/lambda_max of C^-1 A); use dt <= {limit:.6g}, dt = \"auto\", or an implicit "
+                             f"integrator")
+        check_step_count(t_end, dt, max_steps, f"solver.dt = {dt:.6g} s")
+        dt_now = dt
+    energy0 = float(net.C @ T)
+    heat_in = {k: 0.0 for k in ("fixed", "walls", "internal", *net.sources.names)}
+    abs_in = 0.0
+    t, steps, rejected = 0.0, 0, 0
+    dt_min, dt_max = math.inf, 0.0
+    if observer is not None:
+        observer(0, 0.0, T, net.flows(T, net.sinks(T)))
+    while t < t_end:
+        remaining = t_end - t
+        h = remaining if dt_now > remaining * (1 + 1e-9) else dt_now
+        T_new, T_theta, sinks = stepper.step(T, h)
+        if auto:
+            change = np.max(np.abs(T_new - T), initial=0.0)
+            if change > tol and h > 1e-12 * t_end:
+                dt_now = h / 2.0
+                rejected += 1
+                continue
+        flows = net.flows(T_theta, sinks)
+        for k, v in flows.items():
+            heat_in[k] += h * v
+        abs_in += h * net.flow_magnitude(T_theta, sinks)
+        T, steps = T_new, steps + 1
+        t = t_end if h >= remaining * (1 - 1e-9) else t + h
+        dt_min, dt_max = min(dt_min, h), max(dt_max, h)
+        if not np.all(np.isfinite(T)):
+            raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {steps})")
+        if observer is not None:
+            observer(steps, t, T, flows)
+        if progress is not None:
+            progress(t)
+        if auto and change < 0.5 * tol and h == dt_now:
+            dt_now = min(2.0 * h, dt_cap)
+        if steps > max_steps:
+            raise ValueError(f"more than solver.max_steps = {max_steps} steps before t_end = {t_end:g} s")
+    energy = float(net.C @ T)
+    scale_e = float(net.C.sum()) * net.temperature_range() + abs_in
+    err = abs(energy - energy0 - sum(heat_in.values())) / scale_e if scale_e > 0 else 0.0
+    heat_in = {k: float(v) for k, v in heat_in.items()}
+    return TransientResult(net.full(T), t, steps, rejected, err, heat_in, limit, dt_min, dt_max, stepper.backend,
+                           stepper.factorizations)
