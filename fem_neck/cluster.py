@@ -98,11 +98,12 @@ class Cluster:
         """Coordination number (bonds per particle)."""
         return np.bincount(self.bonds.ravel(), minlength=self.n)
 
-    def validate(self, method: str = "newton") -> None:
+    def validate(self, method: str = "newton", gap: float = 0.0, angle_margin: float = 0.0) -> None:
         """Raise ``ValueError`` unless the cluster is a valid union of non-interfering necks.
 
-        Bonded pairs must overlap within the neck model's range; unbonded spheres must not touch; the two neck
-        circles on one sphere must not touch (angular radius ``arcsin(a/r)`` each).
+        Bonded pairs must overlap within the neck model's range; unbonded spheres must stay more than ``gap``
+        (m) apart; two neck circles on one sphere (angular radius ``arcsin(a/r)`` each) must stay more than
+        ``angle_margin`` (radians) apart.
         """
         h = self.overlaps()
         i, j = self.bonds.T
@@ -113,10 +114,11 @@ class Cluster:
                     f"0 < h <= {max_overlap(self.radii[i[b]], self.radii[j[b]]):.6g}")
         bonded = {tuple(sorted(p)) for p in self.bonds.tolist()}
         dist = np.linalg.norm(self.centres[:, None] - self.centres[None], axis=2)
-        gap = dist - self.radii[:, None] - self.radii[None]
-        for p, q in zip(*np.nonzero(np.triu(gap <= 0.0, 1))):
+        space = dist - self.radii[:, None] - self.radii[None]
+        for p, q in zip(*np.nonzero(np.triu(space <= gap, 1))):
             if (int(p), int(q)) not in bonded:
-                raise ValueError(f"particles {p} and {q} overlap (gap = {gap[p, q]:.3g}) but are not bonded")
+                raise ValueError(f"particles {p} and {q} are not bonded but {space[p, q]:.3g} m apart "
+                                 f"(must be > {gap:.3g} m)")
         if len(bonded) != len(self.bonds):
             raise ValueError("bonds contain a duplicate pair")
         a = self.necks(method).a
@@ -128,7 +130,7 @@ class Cluster:
                     (b1, s1), (b2, s2) = ends[x], ends[y]
                     angle = np.arccos(np.clip(s1 * s2 * e[b1] @ e[b2], -1.0, 1.0))
                     need = np.arcsin(min(a[b1] / self.radii[k], 1.0)) + np.arcsin(min(a[b2] / self.radii[k], 1.0))
-                    if angle <= need:
+                    if angle <= need + angle_margin:
                         raise ValueError(
                             f"particle {k}: necks of bonds {b1} and {b2} touch (angle {np.degrees(angle):.1f} deg "
                             f"<= {np.degrees(need):.1f} deg); the cylindrical-neck model needs separate necks")

@@ -74,7 +74,7 @@ def test_invalid_clusters_are_refused():
                   [r] * 3, [[0, 1], [1, 2], [2, 0]])
     with pytest.raises(ValueError, match="necks of bonds"):
         tri.validate()
-    with pytest.raises(ValueError, match="overlap"):  # overlapping but unbonded
+    with pytest.raises(ValueError, match="not bonded"):  # overlapping but unbonded
         Cluster([[0, 0, 0], [0, 0, 1.9]], [1, 1], np.zeros((0, 2))).validate()
     with pytest.raises(ValueError, match="needs exactly one"):  # plane terminal on a two-bond particle
         build_cluster_mesh(Cluster([[0, 0, 0], [0, 0, d], [0, 0, 2 * d]], [1, 1, 1], [[0, 1], [1, 2]]),
@@ -105,3 +105,18 @@ def test_cli_cluster(tmp_path, capsys):
     bad.write_text(json.dumps({"centres": [[0, 0, 0]], "radii": [-1.0], "bonds": [], "terminals": []}))
     assert main(["cluster", str(bad), "--json"], modules=("cluster",)) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_dem_network_of_a_pair_equals_the_fe_pair():
+    # verification.clusters against the DEM: for one bonded pair cut at both equators the pipe network with the
+    # FE pair conductance is exact, so DEM (network-only) and the 3D FE must agree to the 3D mesh accuracy.
+    pytest.importorskip("dem.thermal")
+    pytest.importorskip("fem_neck.conduction")
+    from verification.clusters import NETWORK_ONLY, dem_steady
+
+    cl = _pair(1e-3, 2e-3, 0.1e-3)
+    terms = [Terminal(0, 1.0), Terminal(1, 0.0)]
+    K_dem, T_dem = dem_steady(cl, terms, NETWORK_ONLY)
+    K_fe = solve_cluster(build_cluster_mesh(cl, terms, **COARSE), kappa=394.0).K
+    assert abs(K_dem / K_fe - 1) < 5e-3
+    assert T_dem.tolist() == [1.0, 0.0]

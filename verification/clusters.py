@@ -152,14 +152,8 @@ def random_cluster(n: int, seed: int, a_range=(0.15, 0.55), r_range=(0.6, 1.4), 
             else:
                 c = _place(centres[host], radii[host], r_new, a, rng.normal(size=3))
             trial = Cluster(np.array(centres + [c]), np.array(radii + [r_new]), np.array(bonds + new_bonds))
-            try:
-                trial.validate()
-                gaps = (np.linalg.norm(trial.centres[:-1] - c, axis=1) - trial.radii[:-1] - r_new)
-                bonded = {p for b in new_bonds for p in b}
-                if any(gaps[q] < 0.1 * R0 for q in range(len(gaps)) if q not in bonded):
-                    continue
-                if _crowded(trial, min_angle_margin=np.radians(8)):
-                    continue
+            try:  # keep unbonded spheres and neighbouring necks apart, so the meshes stay reasonable
+                trial.validate(gap=0.1 * R0, angle_margin=np.radians(8))
             except ValueError:
                 continue
             centres.append(c)
@@ -191,23 +185,6 @@ def _pocket(c1, r1, c2, r2, r_new, a1, a2, rng):
     return c1 + x * axis + np.sqrt(rho2) * perp
 
 
-def _crowded(cluster: Cluster, min_angle_margin: float) -> bool:
-    """True if two necks on one sphere come closer than ``min_angle_margin`` (keeps the mesh reasonable)."""
-    a = cluster.necks().a
-    e = cluster.directions()
-    bi, bj = cluster.bonds.T
-    for k in range(cluster.n):
-        ends = [(b, 1.0) for b in np.flatnonzero(bi == k)] + [(b, -1.0) for b in np.flatnonzero(bj == k)]
-        for x in range(len(ends)):
-            for y in range(x + 1, len(ends)):
-                (b1, s1), (b2, s2) = ends[x], ends[y]
-                angle = np.arccos(np.clip(s1 * s2 * e[b1] @ e[b2], -1, 1))
-                need = np.arcsin(min(a[b1] / cluster.radii[k], 1)) + np.arcsin(min(a[b2] / cluster.radii[k], 1))
-                if angle < need + min_angle_margin:
-                    return True
-    return False
-
-
 def all_cases(quick: bool) -> list[Case]:
     """The clusters of the study (quick: one neck size per family and a 10-particle random cluster)."""
     if quick:
@@ -217,7 +194,7 @@ def all_cases(quick: bool) -> list[Case]:
         out += [triangle(x), tetrahedron(x)]
     out += [triangle(0.3, leads=False), tetrahedron(0.3, leads=False)]
     out += [bent_chain(x) for x in (0.15, 0.3, 0.45, 0.6)]
-    out += [random_cluster(12, seed=1), random_cluster(16, seed=2)]
+    out += [random_cluster(n, seed=seed) for n, seed in ((12, 1), (14, 3), (16, 2), (20, 4))]
     return out
 
 
