@@ -11,8 +11,8 @@ The heat equation ``rho c dT/dt = div(kappa grad T)``, insulated everywhere, in 
 integrand weighted by the radial coordinate ``x``, design notes): mass ``M = 2 pi rho c int u v x``, stiffness
 ``A = 2 pi kappa int grad u . grad v x``. Time stepping is implicit: backward Euler for the first steps (it damps
 the stiff modes of the discontinuous start; Rannacher's start-up) then Crank-Nicolson, with the step doubling in
-blocks up to a cap (:func:`time_grid`), each distinct step's matrix factorised once. Both conserve ``1^T M T`` exactly (``A 1 = 0``), i.e. the energy
-``sum_i C_i Tbar_i``.
+blocks up to a cap (:func:`time_grid`), each distinct step's matrix factorised once. Both conserve ``1^T M T``
+exactly (``A 1 = 0``), i.e. the energy ``sum_i C_i Tbar_i``.
 
 The lumped model (Rojek 2022, eqs. 2-4): ``C_i dT_i/dt = K (T_j - T_i)``, so the particle-temperature difference
 decays as ``exp(-lambda t)`` with ``lambda = K (1/C_i + 1/C_j)``, ``C = rho c 4/3 pi r^3``. The FE difference of the

@@ -468,7 +468,8 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
     summary.update({f"clusters worst K rel err {law}": worst[law] for law in names})
     md = [__doc__.split("\n\n", 1)[1].strip(), "",
           "Relative errors are DEM minus FE over FE; temperature errors are in units of the imposed difference "
-          f"(1 K). FE: P2 on curved tetrahedra, {'one mesh level (quick)' if quick else 'two mesh levels; the change between them is the FE error bar'}.",
+          "(1 K). FE: P2 on curved tetrahedra, "
+          + ("one mesh level (quick)." if quick else "two mesh levels; the change between them is the FE error bar."),
           "", _table(rows), "",
           "### Error map: RMS particle-temperature error by coordination number and neck size", ""]
     for law in [x for x in (NETWORK_ONLY, "fit", "rojek") if x in names]:
