@@ -69,10 +69,11 @@ def write_png(result, path, title: str = "", delta_t: float = 1.0) -> pathlib.Pa
     for col, (name, log) in enumerate((("temperature [K]", False), ("|q| [W/m^2]", True))):
         plotter.subplot(0, col)
         plotter.add_mesh(grid.copy(), scalars=name, cmap="turbo", log_scale=log, show_edges=False,
-                         scalar_bar_args={"title": name, "vertical": True, "fmt": "%.3g",
-                                                           "position_x": 0.86, "position_y": 0.1})
+                         scalar_bar_args={"title": name, "vertical": False, "fmt": "%.3g",
+                                          "position_x": 0.2, "position_y": 0.04, "width": 0.6, "height": 0.08})
         plotter.add_text(f"{title}  {name.split(' ')[0]}", font_size=10)
         plotter.view_xy()
+        plotter.camera.zoom(0.9)
     path = pathlib.Path(path)
     plotter.screenshot(str(path))
     plotter.close()

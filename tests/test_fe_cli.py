@@ -19,6 +19,12 @@ def test_semisphere_json(capsys, tmp_path):
     assert {"h_over_r", "a_over_r", "K_over_Kcyl", "dofs", "error_estimate", "seconds"} <= out.keys()
     assert out["K_over_Kcyl"] == pytest.approx(0.412739950539, rel=3e-4)  # reference README, h/r = 0.08
     assert {p.name for p in tmp_path.iterdir()} >= {"semisphere.vtu", "semisphere.png", "semisphere.json"}
+    import meshio
+
+    vtu = meshio.read(tmp_path / "semisphere.vtu")
+    temperature = vtu.point_data["temperature"]
+    assert temperature.min() == pytest.approx(0.0, abs=1e-6) and temperature.max() == pytest.approx(10.0, rel=1e-6)
+    assert (vtu.point_data["heat_flux"] >= 0).all()
 
 
 def test_semisphere_by_neck_radius(capsys):
