@@ -560,3 +560,293 @@ def targets_table(summary: dict) -> str:
 
 def _ratio(a, b):
     return None if a is None or b is None else a / b
+
+
+# --------------------------------------------------------------------------------------------------------------
+# 3. DEM: transient accuracy, steady scaling, the 10^5 x 1000 implicit run; 4b. OpenPNM on the same network
+# --------------------------------------------------------------------------------------------------------------
+PACKING = {"radius": 50e-6, "overlap": 0.15}  # copper, mean radius 50 um, mean relative overlap 0.15 (rojek law)
+
+
+def packing_network(n: int, seed: int = 0, connected_only: bool = False, t_hot: float = 1.0):
+    """A random sintered packing of ~n copper particles (``dem.generators.random_packing``) between a hot bottom
+    layer (fixed at ``t_hot``) and a cold top layer (fixed at 0), free particles starting at 0, rojek law.
+
+    ``connected_only`` keeps only the particles connected to a fixed layer (what a pore-network code can solve).
+    Returns ``(network, timings)`` with the seconds of the packing, the bonds and the network assembly.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from dem.bonds import find_bonds
+    from dem.generators import random_packing
+    from dem.laws.conductance import ConductanceSpec, bond_conductances
+    from dem.particles import Particles
+    from dem.thermal import Network
+
+    times = {}
+    t0 = time.perf_counter()
+    lay = random_packing(n, PACKING["radius"], PACKING["overlap"], seed=seed)
+    times["packing_seconds"] = time.perf_counter() - t0
+    n = len(lay.radius)
+    fixed = np.zeros(n, dtype=bool)
+    fixed[lay.bottom] = True
+    fixed[lay.top] = True
+    temp = np.zeros(n)
+    temp[lay.bottom] = t_hot
+    pos, rad = lay.position, lay.radius
+    if connected_only:
+        particles = Particles.from_arrays(pos, rad, temp, fixed=fixed)
+        bonds = find_bonds(particles)
+        _, label = connected_components(coo_matrix((np.ones(bonds.n_pairs), (bonds.i, bonds.j)), shape=(n, n)),
+                                        directed=False)
+        keep = np.isin(label, np.unique(label[fixed]))
+        pos, rad, temp, fixed = pos[keep], rad[keep], temp[keep], fixed[keep]
+    t0 = time.perf_counter()
+    particles = Particles.from_arrays(pos, rad, temp, fixed=fixed)
+    bonds = find_bonds(particles)
+    times["bonds_seconds"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    k_pairs, k_walls = bond_conductances(ConductanceSpec("rojek"), particles, bonds)
+    net = Network(particles, bonds, k_pairs, k_walls, np.zeros(0))
+    times["network_seconds"] = time.perf_counter() - t0
+    return net, times
+
+
+def _peak_rss_mib() -> float:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # kB on Linux
+
+
+def steady_worker(n: int) -> None:
+    """Subprocess body: one steady solve of a packing of ~n particles; prints one JSON line."""
+    from dem.thermal import steady
+
+    base = _peak_rss_mib()
+    net, times = packing_network(n)
+    t0 = time.perf_counter()
+    res = steady(net, floating="mean")
+    times["solve_seconds"] = time.perf_counter() - t0
+    times["steady_seconds"] = times["bonds_seconds"] + times["network_seconds"] + times["solve_seconds"]
+    print(json.dumps({"particles": net.particles.n, "bonds": int(net.bonds.n_pairs), "solver": res.solver,
+                      "floating_groups": res.floating, "peak_rss_mib": _peak_rss_mib(),
+                      "baseline_rss_mib": base, **times}))
+
+
+def openpnm_worker(n: int) -> None:
+    """Subprocess body: ours and OpenPNM on the same connected network of ~n particles; prints one JSON line."""
+    from dem.thermal import Network, steady
+    from verification.peers import openpnm_steady
+
+    net, _ = packing_network(n, connected_only=True)
+    p, b = net.particles, net.bonds
+    t0 = time.perf_counter()  # ours: assembly of the network matrix from the bonds + steady solve
+    net = Network(p, b, net.K_pairs, net.K_walls, net.wall_temperature)
+    res = steady(net)
+    ours = time.perf_counter() - t0
+    T_pnm, times = openpnm_steady(p.position, b.i, b.j, net.K_pairs, p.fixed, p.temperature)
+    print(json.dumps({"particles": p.n, "bonds": int(b.n_pairs), "ours_seconds": ours, "ours_solver": res.solver,
+                      "openpnm_setup_seconds": times["setup_seconds"],
+                      "openpnm_solve_seconds": times["solve_seconds"],
+                      "openpnm_seconds": times["setup_seconds"] + times["solve_seconds"],
+                      "max_abs_difference": float(np.max(np.abs(T_pnm - res.T)))}))
+
+
+def run_worker(func: str, n: int, timeout: float) -> dict:
+    """Run ``func(n)`` of this module in a fresh interpreter (own peak memory); its JSON line, or an error."""
+    import subprocess
+
+    code = f"from verification.bench import {func}; {func}({int(n)})"
+    try:
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return {"particles": n, "error": f"timeout after {timeout:g} s"}
+    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("{")]
+    if proc.returncode != 0 or not lines:
+        tail = (proc.stderr.strip().splitlines() or ["no output"])[-1]
+        return {"particles": n, "error": f"exit {proc.returncode}: {tail[:200]}"}
+    return json.loads(lines[-1])
+
+
+def growth_exponent(n, t) -> float | None:
+    """Least-squares slope of log t against log n."""
+    n, t = np.asarray(n, float), np.asarray(t, float)
+    ok = (n > 0) & (t > 0)
+    return float(np.polyfit(np.log(n[ok]), np.log(t[ok]), 1)[0]) if ok.sum() >= 2 else None
+
+
+def bench_dem_accuracy(report: Report, quick: bool) -> None:
+    import matplotlib.pyplot as plt
+
+    from dem.thermal import integrate, stable_limit
+
+    net, _ = packing_network(500 if quick else 2000, seed=1)
+    limit = stable_limit(net)
+    t_end = 200 * limit
+    t_ref, ref = best_time(lambda: integrate(net, "crank-nicolson", dt=limit / 16, t_end=t_end), 1)
+    check = integrate(net, "crank-nicolson", dt=limit / 8, t_end=t_end)
+    ref_error = float(np.max(np.abs(check.T - ref.T)) / 3.0)  # CN is 2nd order: error(dt/16) ~ diff / 3
+    rows = []
+    factors = {"explicit": (0.9, 0.45, 0.225, 0.1125),
+               "implicit": (0.5, 2, 8, 32), "crank-nicolson": (0.5, 2, 8, 32)}
+    for integrator, facs in factors.items():
+        for f in facs:
+            t, res = best_time(lambda: integrate(net, integrator, dt=f * limit, t_end=t_end), 1)
+            rows.append({"integrator": integrator, "dt": f"{f:g} x limit", "steps": res.steps,
+                         "error": float(np.max(np.abs(res.T - ref.T))), "energy_error": res.energy_error,
+                         "seconds": t})
+        for rtol in (1e-2, 1e-3, 1e-4):
+            t, res = best_time(lambda: integrate(net, integrator, dt="auto", rtol=rtol, t_end=t_end), 1)
+            rows.append({"integrator": integrator, "dt": f"auto, rtol {rtol:g}", "steps": res.steps,
+                         "error": float(np.max(np.abs(res.T - ref.T))), "energy_error": res.energy_error,
+                         "seconds": t})
+    report.csv("dem_transient_accuracy", rows)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for integrator, marker in zip(factors, "os^"):
+        sel = [r for r in rows if r["integrator"] == integrator]
+        ax.loglog([r["seconds"] for r in sel], [max(r["error"], 1e-16) for r in sel], marker, label=integrator)
+    ax.set_xlabel("wall time [s]")
+    ax.set_ylabel("max |T - T_ref| (hot plate 1, cold 0)")
+    ax.set_title(f"DEM transient, {net.particles.n} particles, t_end = 200 x explicit limit")
+    ax.legend(fontsize=8)
+    report.figure(fig, "dem_transient_accuracy")
+    report.section(
+        "DEM transient: error against time",
+        f"Random sintered packing ({net.particles.n} copper particles, mean radius {PACKING['radius']:g} m, mean "
+        f"relative overlap {PACKING['overlap']}, rojek law), bottom layer fixed at 1, top at 0, free particles "
+        f"starting at 0; explicit stable limit {limit:.4g} s (dem.thermal.stable_limit); t_end = 200 x limit. "
+        f"Reference: Crank-Nicolson at dt = limit/16 ({t_ref:.2f} s; its own error ~{ref_error:.1e} from the "
+        "dt/8 run). Error: max over particles of |T - T_ref|.\n\n"
+        + md_table(rows, ["integrator", "dt", "steps", "error", "energy_error", "seconds"]),
+    )
+
+
+def bench_dem_scaling(report: Report, quick: bool) -> None:
+    import matplotlib.pyplot as plt
+
+    sizes = (1_000, 10_000) if quick else (1_000, 10_000, 100_000, 1_000_000)
+    rows = []
+    for n in sizes:
+        rows.append(run_worker("steady_worker", n, timeout=900))
+        report.csv("dem_steady_scaling", rows)
+    good = [r for r in rows if "error" not in r]
+    report.summary["dem_steady_seconds"] = {str(r["particles"]): r["steady_seconds"] for r in good}
+    report.summary["dem_steady_peak_rss_mib"] = {str(r["particles"]): r["peak_rss_mib"] for r in good}
+    big = [r for r in good if r["particles"] >= 10_000] or good
+    exp_t = growth_exponent([r["particles"] for r in big], [r["steady_seconds"] for r in big])
+    exp_m = growth_exponent([r["particles"] for r in big],
+                            [max(r["peak_rss_mib"] - r["baseline_rss_mib"], 1e-3) for r in big])
+    report.summary["dem_steady_time_exponent"] = exp_t
+    report.summary["dem_steady_memory_exponent"] = exp_m
+    if good:
+        fig, ax = plt.subplots(figsize=(5.5, 4))
+        ns = [r["particles"] for r in good]
+        for key in ("bonds_seconds", "solve_seconds", "steady_seconds"):
+            ax.loglog(ns, [r[key] for r in good], "o-", label=key.replace("_seconds", ""))
+        ax2 = ax.twinx()
+        ax2.loglog(ns, [r["peak_rss_mib"] for r in good], "k--", label="peak RSS [MiB]")
+        ax2.set_ylabel("peak RSS [MiB]")
+        ax.set_xlabel("particles")
+        ax.set_ylabel("wall time [s]")
+        ax.legend(fontsize=8, loc="upper left")
+        report.figure(fig, "dem_steady_scaling")
+    big_n = max((r["particles"] for r in good), default=0)
+    big_t = next((r["steady_seconds"] for r in good if r["particles"] == big_n), None)
+    report.section(
+        "DEM steady solve: cost against N",
+        "Each N in a fresh subprocess: random sintered packing with hot/cold fixed layers; `steady_seconds` = bonds "
+        "(k-d tree + neck radii) + conductances and network assembly + `dem.thermal.steady` (floating = \"mean\" "
+        "for the few particles the packing leaves unbonded); the packing generation is listed apart. Peak memory "
+        "is the process's maximum RSS (getrusage), baseline after imports alongside.\n\n"
+        + md_table(rows, ["particles", "bonds", "packing_seconds", "bonds_seconds", "network_seconds",
+                          "solve_seconds", "steady_seconds", "solver", "peak_rss_mib", "baseline_rss_mib", "error"])
+        + ("\n\nGrowth exponent: too few points." if exp_t is None or exp_m is None else
+           f"\n\nGrowth exponents over N >= 10^4: time ~ N^{exp_t:.2f}, memory above baseline ~ N^{exp_m:.2f}.")
+        + (f"\n\nTarget: 10^6 particles in <= {TARGETS['dem_steady_1e6_seconds']:g} s: "
+           f"{verdict(big_t, TARGETS['dem_steady_1e6_seconds'])} ({big_t:.1f} s)" if big_n >= 10**6 else ""),
+    )
+
+
+def bench_openpnm(report: Report, quick: bool) -> None:
+    from verification import peers
+
+    if not peers.available()["openpnm"]:
+        report.summary["openpnm_seconds"] = None
+        report.section("Peer: OpenPNM", "OpenPNM is not installed (optional extra: `pip install .[peers]`); skipped.")
+        return
+    sizes = (1_000, 10_000) if quick else (10_000, 100_000, 1_000_000)
+    rows = []
+    for n in sizes:
+        rows.append(run_worker("openpnm_worker", n, timeout=600))
+        report.csv("openpnm_same_network", rows)
+        if "error" in rows[-1]:
+            break
+    good = [r for r in rows if "error" not in r]
+    for r in good:
+        r["ratio_ours_over_openpnm"] = r["ours_seconds"] / r["openpnm_seconds"]
+    head = max(good, key=lambda r: r["particles"]) if good else None
+    report.summary["openpnm_seconds"] = None if head is None else head["openpnm_seconds"]
+    report.summary["dem_steady_same_network_seconds"] = None if head is None else head["ours_seconds"]
+    report.summary["openpnm_particles"] = None if head is None else head["particles"]
+    report.section(
+        "Peer: OpenPNM on the same network",
+        f"OpenPNM {_version('openpnm')} `FourierConduction` (its default solver) on exactly our network: the "
+        "particles connected to the fixed layers, our bonds as throats, our bond conductances as "
+        "`throat.thermal_conductance`, the hot/cold layers as value boundary conditions; each N in a fresh "
+        "subprocess. Ours = network assembly + `dem.thermal.steady`; OpenPNM = network/phase/algorithm set-up + "
+        "`run()`. The two solutions agree to `max_abs_difference` (temperatures in [0, 1]).\n\n"
+        + md_table(rows, ["particles", "bonds", "ours_seconds", "ours_solver", "openpnm_setup_seconds",
+                          "openpnm_solve_seconds", "openpnm_seconds", "ratio_ours_over_openpnm",
+                          "max_abs_difference", "error"])
+        + ("" if head is None else f"\n\nHeadline (N = {head['particles']}): ours {head['ours_seconds']:.3g} s, "
+           f"OpenPNM {head['openpnm_seconds']:.3g} s, ratio {head['ratio_ours_over_openpnm']:.2f}."),
+    )
+
+
+def transient_worker(n: int) -> None:
+    """Subprocess body: implicit Euler, ~n particles x 1000 steps at dt = 10 x the cheap explicit bound."""
+    from dem.thermal import integrate
+
+    net, times = packing_network(n)
+    cap, diag = net.particles.capacity, np.asarray(net.L.diagonal())
+    bound = 2.0 * float(np.min(cap[diag > 0] / diag[diag > 0]))  # 2 min C_i / sum_j K_ij
+    dt = 10.0 * bound
+    t0 = time.perf_counter()
+    res = integrate(net, "implicit", dt=dt, t_end=1000 * dt)
+    seconds = time.perf_counter() - t0
+    print(json.dumps({"particles": net.particles.n, "bonds": int(net.bonds.n_pairs), "steps": res.steps, "dt": dt,
+                      "cheap_explicit_bound": bound, "solver": res.solver, "energy_error": res.energy_error,
+                      "integrate_seconds": seconds, "setup_seconds": times["bonds_seconds"] + times["network_seconds"],
+                      "peak_rss_mib": _peak_rss_mib()}))
+
+
+def bench_dem_transient_big(report: Report, quick: bool) -> None:
+    n = 10_000 if quick else 100_000
+    row = run_worker("transient_worker", n, timeout=1800)
+    report.csv("dem_transient_big", [row])
+    seconds = row.get("integrate_seconds")
+    if not quick:
+        report.summary["dem_transient_1e5x1000_seconds"] = seconds
+    report.summary["dem_transient_big"] = row
+    report.section(
+        "DEM transient: implicit, 10^5 particles x 1000 steps" + (" (quick: 10^4)" if quick else ""),
+        "Random sintered packing with hot/cold fixed layers; backward Euler (`dem.thermal.integrate`, linear "
+        "backend auto) at dt = 10 x the cheap explicit bound 2 min C_i / sum_j K_ij, 1000 steps, in a fresh "
+        "subprocess; `integrate_seconds` excludes building the bonds (`setup_seconds`).\n\n"
+        + md_table([row], ["particles", "bonds", "steps", "dt", "solver", "integrate_seconds", "setup_seconds",
+                           "energy_error", "peak_rss_mib", "error"])
+        + (f"\n\nTarget <= {TARGETS['dem_transient_1e5x1000_seconds']:g} s: "
+           f"{verdict(seconds, TARGETS['dem_transient_1e5x1000_seconds'])}" if not quick else ""),
+    )
+
+
+def bench_dem(report: Report, quick: bool) -> None:
+    try:
+        import dem.generators  # noqa: F401
+        import dem.thermal  # noqa: F401
+    except ImportError as exc:
+        report.section("DEM", f"not available: {exc}")
+        return
+    for step in (bench_dem_accuracy, bench_dem_scaling, bench_openpnm, bench_dem_transient_big):
+        step(report, quick)
