@@ -36,6 +36,9 @@ from fem_neck.geometry import cap_height, check_positive, neck_geometry
 
 # Defaults of the size field (lengths relative to the corner or neck scale, see module docstring).
 DEFAULT_GRADING = 0.3
+# Smallest neck radius over sphere radius that is meshed: the half neck is a^2/(4r) high, ~2.5e-9 r at the limit
+# (meshing takes ~10 s there, ~2 s at 3e-4, 0.3 s at 1e-3). Below it K is the constriction limit 4 kappa a to O(a/r).
+MIN_NECK_RATIO = 1e-4
 
 
 @dataclass(frozen=True)
@@ -137,8 +140,9 @@ def semisphere_profile(a_over_r: float, r: float = 1.0):
     """
     r = float(check_positive("r", r))
     a = float(check_positive("a_over_r", a_over_r, upper=1.0, upper_name="the neck reaches the sphere radius")) * r
-    if a >= r * (1.0 - 1e-9):
-        raise ValueError(f"a_over_r = {a / r:.9g}: valid range 0 < a_over_r < 1 (the sphere surface vanishes at 1)")
+    if not MIN_NECK_RATIO * r <= a < r * (1.0 - 1e-9):
+        raise ValueError(f"a_over_r = {a / r:.9g}: valid range {MIN_NECK_RATIO:g} <= a_over_r < 1 (a thinner neck "
+                         "cannot be meshed; at 1 the sphere surface vanishes)")
     h_c = float(cap_height(r, a))
     z_i = math.sqrt((r - a) * (r + a))
     half_neck = h_c * (3.0 * r - h_c) / (3.0 * (2.0 * r - h_c))
@@ -171,6 +175,9 @@ def chain_profile(radii, overlaps):
         zc = centres[k]
         if k < len(geos):
             a = float(geos[k].a)
+            if a < MIN_NECK_RATIO * min(r, radii[k + 1]):
+                raise ValueError(f"overlaps[{k}] = {overlaps[k]:.9g}: neck radius {a:.6g} is below {MIN_NECK_RATIO:g} "
+                                 "of the smaller radius, too thin to mesh (K is the constriction limit there)")
             z_hi, x_hi = zc + float(geos[k].z_i), a
         else:
             z_hi, x_hi = zc, r
@@ -212,20 +219,23 @@ def _build_mesh(start, segments, corners, necks, sizes: SizeField):
     a_min = float(np.min(corners[:, 0]))
     h_min = sizes.h_min_fraction * a_min if sizes.uniform is None else sizes.uniform
     h_max = 0.5 * scale
+    # gmsh works in units of the smallest neck radius: OpenCASCADE cannot make edges shorter than ~1e-7 units, and
+    # the half neck of a/r = 1e-4 is 2.5e-9 r high but 2.5e-5 a.
+    unit = a_min
     try:
         with gmsh_session() as gmsh:
             gmsh.model.add("profile")
             occ = gmsh.model.occ
             axis_bottom = occ.addPoint(0.0, 0.0, 0.0)
-            p_tags = [occ.addPoint(x, z, 0.0) for x, z in points]
-            axis_top = occ.addPoint(0.0, z_top, 0.0)
+            p_tags = [occ.addPoint(x / unit, z / unit, 0.0) for x, z in points]
+            axis_top = occ.addPoint(0.0, z_top / unit, 0.0)
             centre_tags = {}
             curves = {"bottom": [occ.addLine(axis_bottom, p_tags[0])]}
             for i, seg in enumerate(segments):
                 if seg[0] == "arc":
                     zc = seg[2]
                     if zc not in centre_tags:
-                        centre_tags[zc] = axis_bottom if zc == 0.0 else occ.addPoint(0.0, zc, 0.0)
+                        centre_tags[zc] = axis_bottom if zc == 0.0 else occ.addPoint(0.0, zc / unit, 0.0)
                     tag = occ.addCircleArc(p_tags[i], centre_tags[zc], p_tags[i + 1])
                 else:
                     tag = occ.addLine(p_tags[i], p_tags[i + 1])
@@ -247,8 +257,8 @@ def _build_mesh(start, segments, corners, necks, sizes: SizeField):
             dist = field.add("Distance")
             field.setNumbers(dist, "PointsList", corner_tags)
             graded = field.add("MathEval")
-            law = f"min({h_max:.17g}, {h_min:.17g} + {float(grading):.17g}*F{dist})"
-            field.setString(graded, "F", law if sizes.uniform is None else f"{sizes.uniform:.17g} + 0*F{dist}")
+            law = f"min({h_max / unit:.17g}, {h_min / unit:.17g} + {float(grading):.17g}*F{dist})"
+            field.setString(graded, "F", law if sizes.uniform is None else f"{h_min / unit:.17g} + 0*F{dist}")
             fields = [graded]
             for a, z0, z1 in necks:
                 cell = (z1 - z0) / sizes.neck_cells_per_height
@@ -256,14 +266,14 @@ def _build_mesh(start, segments, corners, necks, sizes: SizeField):
                     box = field.add("Box")
                     for key, val in (("VIn", cell), ("VOut", 1e22), ("XMin", -a), ("XMax", a * (1 + 1e-9)),
                                      ("YMin", z0 - 1e-9 * a), ("YMax", z1 + 1e-9 * a)):
-                        field.setNumber(box, key, float(val))
+                        field.setNumber(box, key, float(val) / (1.0 if key == "VOut" else unit))
                     fields.append(box)
             size = field.add("Min")
             field.setNumbers(size, "FieldsList", fields)
             field.setAsBackgroundMesh(size)
             for opt, val in (("Mesh.MeshSizeExtendFromBoundary", 0), ("Mesh.MeshSizeFromPoints", 0),
                              ("Mesh.MeshSizeFromCurvature", 0), ("Mesh.Algorithm", 6),
-                             ("Mesh.MeshSizeMin", h_min), ("Mesh.MeshSizeMax", h_max)):
+                             ("Mesh.MeshSizeMin", h_min / unit), ("Mesh.MeshSizeMax", h_max / unit)):
                 gmsh.option.setNumber(opt, val)
             gmsh.model.mesh.generate(2)
 
@@ -277,7 +287,7 @@ def _build_mesh(start, segments, corners, necks, sizes: SizeField):
         raise RuntimeError(f"gmsh failed to mesh the profile: {exc}") from exc
 
     # gmsh node tags -> contiguous indices over the nodes used by triangles
-    xy = coords.reshape(-1, 3)[:, :2]
+    xy = coords.reshape(-1, 3)[:, :2] * unit
     tag_to_row = np.full(int(node_tags.max()) + 1, -1, dtype=np.int64)
     tag_to_row[node_tags.astype(np.int64)] = np.arange(node_tags.size)
     tri = tag_to_row[tri_nodes.astype(np.int64)].reshape(-1, 3)
