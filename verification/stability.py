@@ -162,6 +162,202 @@ def fe_cases(quick: bool) -> list[StressCase]:
 
 
 # --------------------------------------------------------------------------------------------------------------
+# DEM: explicit step limit and extreme networks
+# --------------------------------------------------------------------------------------------------------------
+def _network(particles, K=None, pairs=None):
+    from dem.bonds import find_bonds
+    from dem.laws.conductance import ConductanceSpec, bond_conductances
+    from dem.thermal import Network
+
+    bonds = find_bonds(particles, pairs=pairs)
+    k_pairs, k_walls = bond_conductances(ConductanceSpec("rojek"), particles, bonds)
+    return Network(particles, bonds, k_pairs if K is None else K(k_pairs), k_walls, np.zeros(0))
+
+
+def _lattice(shape, spacing=1e-4, seed=0, temperature=None, fixed=None, keep=None):
+    """Particles on a cubic lattice, radii 0.52-0.6 spacing (every neighbour bonded, in the neck model's range)."""
+    from dem.particles import Particles
+
+    rng = np.random.default_rng(seed)
+    grid = np.stack(np.meshgrid(*[np.arange(k) for k in shape], indexing="ij"), -1).reshape(-1, 3) * spacing
+    if keep is not None:
+        grid = grid[keep(grid / spacing)]
+    n = len(grid)
+    radius = spacing * rng.uniform(0.52, 0.6, n)
+    temp = rng.uniform(0.0, 100.0, n) if temperature is None else temperature(grid / spacing)
+    fix = None if fixed is None else fixed(grid / spacing)
+    return Particles.from_arrays(grid, radius, temp, fixed=fix)
+
+
+def dem_cases(quick: bool) -> list[StressCase]:
+    from dem.thermal import integrate, stable_limit, steady
+
+    cases = []
+    net = _network(_lattice((8, 8, 6), seed=1))
+    limit = stable_limit(net)
+    C = net.particles.capacity
+
+    for factor in (0.5, 0.99, 1.01, 2.0):
+        def explicit(factor=factor):
+            norms = []
+
+            def observer(step, t, T, flows):
+                dev = T - (C @ T) / C.sum()
+                norms.append(float(np.sqrt(C @ dev**2)))
+
+            try:
+                res = integrate(net, "explicit", dt=factor * limit, t_end=300 * limit, observer=observer)
+            except ValueError as exc:
+                ok = factor > 1 and "limit" in str(exc)
+                return ok, f"refused: {str(exc)[:160]}"
+            growth = max(np.diff(norms).max() / norms[0], 0.0)
+            ok = factor <= 1 and np.all(np.isfinite(res.T)) and growth <= 1e-12
+            return ok, (f"ran {res.steps} steps: C-norm of the deviation {norms[0]:.3g} -> {norms[-1]:.3g}, "
+                        f"largest growth per step {growth:.1e}, T in [{res.T.min():.3g}, {res.T.max():.3g}]"
+                        + ("" if factor <= 1 else " -- ran above the limit: silent blow-up risk"))
+        cases.append(run_case(f"DEM explicit dt = {factor} x stable limit ({limit:.3g} s)", explicit))
+
+    def explicit_auto():
+        res = integrate(net, "explicit", dt="auto", t_end=300 * limit)
+        T0 = net.particles.temperature
+        ok = bool(np.all(np.isfinite(res.T)) and res.dt_max <= limit and res.T.min() >= T0.min() - 1e-9
+                  and res.T.max() <= T0.max() + 1e-9)
+        return ok, f"{res.steps} steps, dt_max = {res.dt_max / limit:.3f} x limit, T in [{res.T.min():.4g}, " \
+                   f"{res.T.max():.4g}] (initial [{T0.min():.4g}, {T0.max():.4g}])"
+    cases.append(run_case("DEM explicit dt = auto stays below the limit", explicit_auto))
+
+    def contrast(n_shape, label):
+        def fn():
+            import scipy.sparse.linalg as spl
+
+            particles = _lattice(n_shape, seed=2, temperature=lambda g: np.where(g[:, 2] == 0, 100.0, 0.0),
+                                 fixed=lambda g: (g[:, 2] == 0) | (g[:, 2] == g[:, 2].max()))
+            rng = np.random.default_rng(3)
+            net2 = _network(particles, K=lambda k: k * 10.0 ** (8.0 * rng.random(len(k))))
+            res = steady(net2)
+            A = net2.matrix({})
+            x_ref = spl.spsolve(A.tocsc(), net2.rhs({}))
+            err = float(np.max(np.abs(res.T[net2.free] - x_ref)))
+            inside = res.T.min() >= -1e-9 and res.T.max() <= 100 + 1e-9
+            ok = err <= 1e-6 * 100 and inside
+            return ok, (f"{particles.n} particles, K spread {net2.K_pairs.max() / net2.K_pairs.min():.2g}, "
+                        f"solver {res.solver}: max |T - T_spsolve| = {err:.2e} K, T in [{res.T.min():.4g}, "
+                        f"{res.T.max():.4g}]")
+        return run_case(f"DEM steady, conductance contrast 1e8 ({label})", fn)
+
+    cases.append(contrast((10, 10, 10), "direct backend"))
+    cases.append(contrast((40, 40, 20) if quick else (60, 60, 30), "iterative backend"))
+
+    def two_materials():  # chain of 4, kappa contrast 1e8: series conductance to round-off
+        from dem.particles import Material, Particles
+
+        mats = (Material(394.0, 8960.0, 385.0, "copper"), Material(394e-8, 8960.0, 385.0, "insulator"))
+        pos = np.array([[0, 0, 0], [0, 0, 1.9e-4], [0, 0, 3.8e-4], [0, 0, 5.7e-4]])
+        particles = Particles.from_arrays(pos, np.full(4, 1e-4), [100.0, 0, 0, 0.0], materials=mats,
+                                          material=[0, 1, 0, 0], fixed=[True, False, False, True])
+        net2 = _network(particles)
+        res = steady(net2)
+        K = 1.0 / np.sum(1.0 / net2.K_pairs)
+        q = res.flows["fixed"] if False else K * 100.0
+        drop = 100.0 - np.cumsum(q / net2.K_pairs)[:-1]
+        err = float(np.max(np.abs(res.T[1:3] - drop)) / 100.0)
+        return err < 1e-9, f"K contrast {net2.K_pairs.max() / net2.K_pairs.min():.2g}: max relative error of the " \
+                           f"free temperatures against the series solution {err:.1e}"
+    cases.append(run_case("DEM steady chain, conductivity contrast 1e8 vs series closed form", two_materials))
+
+    def isolated():
+        from dem.particles import Particles
+
+        block = _lattice((3, 3, 3), seed=4)
+        lone_pos = np.array([[1e-2, 0, 0], [2e-2, 0, 0], [3e-2, 0, 0]])
+        particles = Particles.from_arrays(np.vstack([block.position, lone_pos]), np.r_[block.radius, [5e-5] * 3],
+                                          np.r_[block.temperature, [500.0, -20.0, 7.0]])
+        net2 = _network(particles)
+        T0 = particles.temperature
+        out = []
+        for integ in ("explicit", "implicit", "crank-nicolson"):
+            res = integrate(net2, integ, dt="auto", t_end=1e-2)
+            kept = np.allclose(res.T[-3:], T0[-3:], rtol=4 * np.finfo(float).eps, atol=0.0)
+            out.append((integ, bool(kept), res.energy_error))
+        ok = all(kept and e < 1e-10 for _, kept, e in out)
+        return ok, "3 particles without bonds: " + "; ".join(
+            f"{k}: temperature unchanged (to round-off) {kept}, energy error {e:.0e}" for k, kept, e in out)
+    cases.append(run_case("DEM particles with no bonds (transient)", isolated))
+
+    def clusters(with_fixed):
+        def fn():
+            keep = lambda g: g[:, 0] != 3  # noqa: E731  two blocks of 3 x 3 x 3, no bond between them
+            if with_fixed:
+                fixed = lambda g: (g[:, 2] == 0) | (g[:, 2] == 2)  # noqa: E731
+            else:
+                fixed = lambda g: ((g[:, 2] == 0) | (g[:, 2] == 2)) & (g[:, 0] < 3)  # noqa: E731
+            temperature = lambda g: np.where(g[:, 2] == 0, 10.0, 0.0) + np.where(g[:, 0] > 3, 50.0, 0.0)  # noqa
+            particles = _lattice((7, 3, 3), keep=keep, seed=5, temperature=temperature, fixed=fixed)
+            net2 = _network(particles)
+            try:
+                res = steady(net2)
+            except ValueError as exc:
+                msg = str(exc)
+                ok = (not with_fixed) and "singular" in msg and "connected group" in msg
+                return ok, f"refused: {msg[:170]}"
+            right = particles.position[:, 0] > 3.5e-4
+            ok = with_fixed and res.T[right].min() >= 50 - 1e-9 and res.T[~right].max() <= 10 + 1e-9
+            return ok, f"solved: left block T in [{res.T[~right].min():.3g}, {res.T[~right].max():.3g}], right " \
+                       f"block in [{res.T[right].min():.3g}, {res.T[right].max():.3g}]"
+        return fn
+    cases.append(run_case("DEM disconnected clusters, each with fixed temperatures (steady)", clusters(True)))
+    cases.append(run_case("DEM disconnected clusters, one without fixed temperature (steady)", clusters(False)))
+
+    def steady_energy_error():
+        particles = _lattice((4, 4, 6), seed=6, temperature=lambda g: np.where(g[:, 2] == 0, 1.0, 0.0),
+                             fixed=lambda g: (g[:, 2] == 0) | (g[:, 2] == 5))
+        res = steady(_network(particles))
+        return res.energy_error < 1e-8, (f"hot/cold fixed layers: energy_error = {res.energy_error:.3g}, flows "
+                                         f"{ {k: float(f'{v:.3g}') for k, v in res.flows.items()} }")
+    cases.append(run_case("DEM steady energy_error with hot and cold fixed layers", steady_energy_error))
+
+    def duplicates():
+        shape = (30, 30, 30) if quick else (64, 64, 64)
+        particles = _lattice(shape, seed=7, temperature=lambda g: np.where(g[:, 2] == 0, 1.0, 0.0),
+                             fixed=lambda g: (g[:, 2] == 0) | (g[:, 2] == g[:, 2].max()))
+        base = _network(particles)
+        i, j = base.bonds.i, base.bonds.j
+        rng = np.random.default_rng(8)
+        extra = rng.integers(0, len(i), len(i) // 2)
+        ii = np.concatenate([i, j, i[extra]])  # every bond, every bond reversed, half again
+        jj = np.concatenate([j, i, j[extra]])
+        t0 = time.perf_counter()
+        dup = _network(particles, pairs=(ii, jj))
+        secs = time.perf_counter() - t0
+        same = dup.bonds.n_pairs == base.bonds.n_pairs
+        dT = float(np.max(np.abs(steady(dup).T - steady(base).T)))
+        return same and dT < 1e-9, (f"{len(ii):,} listed bonds ({len(i):,} unique) -> {dup.bonds.n_pairs:,} bonds in "
+                                    f"{secs:.1f} s; steady T differs by {dT:.1e}")
+    cases.append(run_case(f"DEM {'2e5' if quick else '1e6+'} bonds with duplicates and reversed pairs",
+                          duplicates))
+
+    def ratio_100():
+        from dem.particles import Particles
+
+        r_i, r_j = 1e-5, 1e-3
+        h = 0.3 * float(max_overlap(r_i, r_j))
+        particles = Particles.from_arrays([[0, 0, 0], [0, 0, r_i + r_j - h]], [r_i, r_j], [100.0, 0.0])
+        net2 = _network(particles)
+        Cp = particles.capacity
+        rate = net2.K_pairs[0] * (1 / Cp[0] + 1 / Cp[1])
+        t_end = 3.0 / rate
+        out = []
+        for integ in ("explicit", "implicit", "crank-nicolson"):
+            res = integrate(net2, integ, dt="auto", t_end=t_end)
+            diff = (res.T[0] - res.T[1]) / 100.0
+            out.append((integ, abs(diff - np.exp(-rate * t_end)), res.energy_error, res.steps))
+        ok = all(e < 2e-2 and ee < 1e-10 for _, e, ee, _ in out)
+        return ok, "; ".join(f"{k}: |dT/dT0 - exp| = {e:.1e}, energy {ee:.0e}, {s} steps" for k, e, ee, s in out)
+    cases.append(run_case("DEM pair, radius ratio 100, dt = auto, decay vs closed form", ratio_100))
+    return cases
+
+
+# --------------------------------------------------------------------------------------------------------------
 # CLI abuse
 # --------------------------------------------------------------------------------------------------------------
 def cli_case(name: str, argv: list[str], expect: str = "error", timeout: float = 120.0, cwd=None) -> StressCase:
@@ -318,6 +514,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
     groups = [
         ("Neck geometry", geometry_cases),
         ("FE degenerate geometries", lambda: fe_cases(quick)),
+        ("DEM time steps and extreme networks", lambda: dem_cases(quick)),
         ("CLI abuse: python -m fem_neck", fem_neck_cli_cases),
         ("CLI abuse: python -m dem run", lambda: dem_cli_cases(pathlib.Path(out_dir) / "scenes")),
     ]
