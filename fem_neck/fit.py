@@ -1,0 +1,306 @@
+"""The conductance fit: an FE sweep of the semisphere with a neck over a/r, Rojek's linear fit and the full-range law.
+
+* :func:`sweep_points` -- the a/r of the sweep: ``n // 8`` points log-spaced on [0.001, 0.02) for the small-neck
+  end, the rest uniform in a/r on (0, 0.97] (``0.97 k / m``, k = 1..m), the sampling of Rojek 2022, Fig. 16.
+* :func:`sweep` -- solves every point to the tolerance in a process pool (gmsh is one global, thread-unsafe state
+  per process), appending each result to ``fit.csv`` as it arrives so an interrupted run resumes where it stopped.
+* :func:`linear_slope` -- ``K/K_cyl = c a/r`` by least squares through the origin on the uniform points with
+  ``a/r <= 0.7`` (Rojek 2022, eq. 40); :func:`slope_sensitivity` shows how c moves with the sampling.
+* :func:`fit_law` -- the parameters of :class:`fem_neck.law.ConductanceLaw`, least squares on relative residuals.
+* :func:`run_fit` -- all of it, writing ``fit.json`` (read by the DEM), ``fit.csv`` and ``fit.png`` (the Fig. 16
+  analogue) into one folder.
+
+The FE solver is named by ``"module:function"`` (default :data:`SOLVER`, ``semisphere_conductance(a_over_r,
+rtol)`` returning an object with ``K_over_Kcyl``, ``error_estimate`` and ``dofs``), so worker processes import it.
+"""
+
+from __future__ import annotations
+
+import csv
+import importlib
+import json
+import multiprocessing
+import os
+import pathlib
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from fem_neck.law import ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, neck_resistance
+
+SOLVER = "fem_neck.conduction:semisphere_conductance"
+X_MAX = 0.97  # the sweep's largest a/r
+X_SMALL = (0.001, 0.02)  # the log-spaced small-neck block
+LINEAR_RANGE = 0.7  # Rojek 2022, Section 5: "up to nearly a/r = 0.7 ... linear"
+PAPER_H_OVER_R = (0.02, 0.08, 0.2, 0.4)  # the four cases of Rojek 2022, Figs. 13-14
+CSV_FIELDS = ("a_over_r", "K_over_Kcyl", "error_estimate", "dofs", "seconds", "rtol", "uniform")
+
+
+@dataclass(frozen=True)
+class FitPoint:
+    """One FE solve of the semisphere with a neck: K/K_cyl at a/r to the tolerance ``rtol``."""
+
+    a_over_r: float
+    K_over_Kcyl: float
+    error_estimate: float
+    dofs: int
+    seconds: float
+    rtol: float
+    uniform: bool  # part of the uniform-in-a/r sampling used by the linear fit
+
+
+def sweep_points(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The sweep's a/r (sorted) and a mask of the uniform ones; ``n >= 4`` points in total.
+
+    ``n // 8`` points log-spaced on [0.001, 0.02) (the constriction end, where the linear law fails) and
+    ``m = n - n // 8`` uniform points ``0.97 k / m``, k = 1..m.
+    """
+    if not isinstance(n, (int, np.integer)) or n < 4:
+        raise ValueError(f"points = {n!r}: must be an integer >= 4")
+    n_log = n // 8
+    m = n - n_log
+    small = np.geomspace(*X_SMALL, n_log, endpoint=False) if n_log else np.empty(0)
+    uniform = X_MAX * np.arange(1, m + 1) / m
+    x = np.concatenate([small, uniform])
+    mask = np.concatenate([np.zeros(n_log, bool), np.ones(m, bool)])
+    order = np.argsort(x, kind="stable")
+    return x[order], mask[order]
+
+
+def _key(x: float) -> str:
+    return f"{x:.12g}"
+
+
+def _solve_point(solver: str, a_over_r: float, rtol: float) -> dict:
+    """Worker: import the solver by name and solve one point (runs in a child process)."""
+    module, func = solver.split(":")
+    t0 = time.perf_counter()
+    res = getattr(importlib.import_module(module), func)(a_over_r, rtol=rtol)
+    return {"a_over_r": a_over_r, "K_over_Kcyl": float(res.K_over_Kcyl),
+            "error_estimate": float(res.error_estimate), "dofs": int(res.dofs),
+            "seconds": time.perf_counter() - t0, "rtol": rtol}
+
+
+def read_points(path) -> dict:
+    """Points already in a ``fit.csv`` (for resuming), keyed by a/r."""
+    path = pathlib.Path(path)
+    if not path.exists():
+        return {}
+    out = {}
+    with path.open(newline="") as fh:
+        for row in csv.DictReader(fh):
+            try:
+                p = FitPoint(float(row["a_over_r"]), float(row["K_over_Kcyl"]), float(row["error_estimate"]),
+                             int(row["dofs"]), float(row["seconds"]), float(row["rtol"]),
+                             row["uniform"] in ("1", "True", "true"))
+            except (KeyError, ValueError, TypeError):
+                continue  # a half-written last line of an interrupted run
+            out[_key(p.a_over_r)] = p
+    return out
+
+
+def _append(path: pathlib.Path, point: FitPoint) -> None:
+    new = not path.exists() or path.stat().st_size == 0
+    with path.open("a", newline="") as fh:
+        w = csv.writer(fh)
+        if new:
+            w.writerow(CSV_FIELDS)
+        w.writerow([repr(v) if isinstance(v, float) else int(v) for v in asdict(point).values()])
+
+
+def _pool_context():
+    # fork starts workers warm (the solver module is imported in the parent first); spawn where fork is absent.
+    return multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
+
+
+def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int | None = None,
+          solver: str = SOLVER, progress: bool = True) -> list[FitPoint]:
+    """Solve the semisphere at every a/r to ``rtol`` on ``workers`` processes (default: all cores).
+
+    With ``csv_path`` each point is appended to that CSV as soon as it is solved, and points already there with a
+    tolerance at least as tight are reused (resume). Returns the points sorted by a/r.
+    """
+    from tqdm import tqdm
+
+    if not (isinstance(rtol, float) and 0.0 < rtol < 0.1):
+        raise ValueError(f"rtol = {rtol!r}: must be a float in (0, 0.1)")
+    x = np.asarray(a_over_r, dtype=float)
+    uniform = np.asarray(uniform, dtype=bool)
+    csv_path = pathlib.Path(csv_path) if csv_path is not None else None
+    done = {k: p for k, p in (read_points(csv_path) if csv_path else {}).items() if p.rtol <= rtol}
+    points = {_key(xi): done[_key(xi)] for xi in x if _key(xi) in done}
+    todo = [(float(xi), bool(ui)) for xi, ui in zip(x, uniform) if _key(xi) not in points]
+    if csv_path is not None:  # rewrite the CSV with the reused points only, then append as results arrive
+        csv_path.parent.mkdir(parents=True, exist_ok=True)
+        csv_path.unlink(missing_ok=True)
+        for p in points.values():
+            _append(csv_path, p)
+    workers = workers or os.cpu_count() or 1
+    bar = tqdm(total=len(x), initial=len(points), desc="fit sweep", unit="pt", file=sys.stderr,
+               disable=not progress)
+    if todo:
+        importlib.import_module(solver.split(":")[0])  # fail early in the parent, and let fork start warm
+        with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=_pool_context()) as pool:
+            futures = {pool.submit(_solve_point, solver, xi, rtol): ui for xi, ui in todo}
+            for fut in as_completed(futures):
+                p = FitPoint(**fut.result(), uniform=futures[fut])
+                points[_key(p.a_over_r)] = p
+                if csv_path is not None:
+                    _append(csv_path, p)
+                bar.update()
+    bar.close()
+    return sorted(points.values(), key=lambda p: p.a_over_r)
+
+
+def linear_slope(a_over_r, k_over_kcyl, x_max: float = LINEAR_RANGE) -> float:
+    """Least-squares slope through the origin, ``c = sum(x f) / sum(x^2)`` over ``a/r <= x_max`` (eq. 40)."""
+    x = np.asarray(a_over_r, dtype=float)
+    f = np.asarray(k_over_kcyl, dtype=float)
+    m = x <= x_max
+    if not np.any(m):
+        raise ValueError(f"x_max = {x_max!r}: no points with a/r <= x_max")
+    return float(x[m] @ f[m] / (x[m] @ x[m]))
+
+
+def _law_basis(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``P(x) = p0 + F @ (A, B, C, E)`` (the form of :class:`fem_neck.law.ConductanceLaw`)."""
+    one_minus_s = x * x / (1.0 + np.sqrt(1.0 - x * x))
+    p0 = 1.0 - one_minus_s
+    F = np.stack([-x * np.log(x), x - one_minus_s, x**2 - one_minus_s, x**3 - one_minus_s], axis=1)
+    return p0, F
+
+
+def fit_law(a_over_r, k_over_kcyl) -> ConductanceLaw:
+    """Fit the full-range law to FE points (0 < a/r < 1) by least squares on the relative residual.
+
+    ``1/f - lambda = pi/(4x) P`` is linear in the parameters; Gauss-Newton on the exact relative residual
+    ``f_law/f_FE - 1`` from that linear start converges in a few steps.
+    """
+    x = np.asarray(a_over_r, dtype=float)
+    f = np.asarray(k_over_kcyl, dtype=float)
+    if x.size < len(PARAMETERS) + 1:
+        raise ValueError(f"points = {x.size}: the law needs at least {len(PARAMETERS) + 1} FE points")
+    p0, F = _law_basis(x)
+    p_data = (1.0 / f - np.asarray(neck_resistance(x))) * 4.0 * x / np.pi
+    weight = f * np.pi / (4.0 * x)  # d(rel. residual)/dP to first order
+    params, *_ = np.linalg.lstsq(F * weight[:, None], (p_data - p0) * weight, rcond=None)
+    for _ in range(8):
+        p = p0 + F @ params
+        f_law = x / (x * neck_resistance(x) + 0.25 * np.pi * p)
+        r = f_law / f - 1.0
+        jac = -(f_law**2 / f * np.pi / (4.0 * x))[:, None] * F
+        step, *_ = np.linalg.lstsq(jac, -r, rcond=None)
+        params = params + step
+        if np.max(np.abs(step)) < 1e-13:
+            break
+    law = ConductanceLaw(*map(float, params), fit_range=(float(x.min()), float(x.max())))
+    resid = np.asarray(law.k_over_kcyl(x)) / f - 1.0
+    return ConductanceLaw(*map(float, params), fit_range=law.fit_range, max_rel_residual=float(np.abs(resid).max()))
+
+
+def slope_sensitivity(law: ConductanceLaw) -> dict:
+    """The least-squares slope c of eq. (40) under other samplings, evaluated on the (FE-fitted) law.
+
+    Keys: continuous uniform a/r on (0, 0.6], (0, 0.7], (0, 0.8]; uniform in h/r for a/r <= 0.7; the paper's four
+    h/r of Figs. 13-14 (their a/r reach 0.83).
+    """
+    from fem_neck.geometry import neck_radius, overlap_for_neck
+
+    def cont(x):
+        return linear_slope(x, law.k_over_kcyl(x), x_max=1.0)
+
+    dense = lambda hi: np.linspace(hi / 4000, hi, 4000)  # noqa: E731 - midpoint-free uniform grid
+    h_max = overlap_for_neck(1.0, 1.0, LINEAR_RANGE)
+    x_h = np.asarray(neck_radius(1.0, 1.0, np.linspace(h_max / 4000, h_max, 4000)))
+    x_paper = np.asarray(neck_radius(1.0, 1.0, np.array(PAPER_H_OVER_R)))
+    return {
+        "uniform_a_over_r_to_0.6": cont(dense(0.6)),
+        "uniform_a_over_r_to_0.7": cont(dense(0.7)),
+        "uniform_a_over_r_to_0.8": cont(dense(0.8)),
+        "uniform_h_over_r_to_a_over_r_0.7": cont(x_h),
+        "paper_four_cases": cont(x_paper),
+    }
+
+
+def plot(points: list[FitPoint], slope: float, law: ConductanceLaw, path) -> None:
+    """The Fig. 16 analogue: FE points, the linear fits and the law; below, relative deviations from FE."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    x = np.array([p.a_over_r for p in points])
+    f = np.array([p.K_over_Kcyl for p in points])
+    xs = np.linspace(0.0, 1.0, 401)
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(6.4, 7.2), height_ratios=(3, 2), constrained_layout=True)
+    ax.plot(x, f, "o", ms=4, mfc="none", color="k", label="FE (this work)")
+    ax.plot(xs, law.k_over_kcyl(xs), "-", color="C0", label="full-range law")
+    ax.plot(xs, slope * xs, "--", color="C1", label=f"linear fit, c = {slope:.4f} (a/r <= {LINEAR_RANGE})")
+    ax.plot(xs, ROJEK.slope * xs, ":", color="C2", label=f"Rojek 2022 eq. 40, c = {ROJEK.slope}")
+    ax.plot(xs, ARGENTO_BOUVARD.slope * xs, "-.", color="C3",
+            label=f"Argento-Bouvard eq. 42, c = {ARGENTO_BOUVARD.slope:.3f}")
+    ax.plot(xs[:120], 4 / np.pi * xs[:120], lw=0.8, color="grey", label="constriction limit (4/pi) a/r")
+    ax.set(xlabel="a/r", ylabel="K / K_cyl", xlim=(0, 1), ylim=(0, 1.6))
+    ax.legend(fontsize=8)
+    axr.axhspan(-0.5, 0.5, color="C0", alpha=0.10, label="+-0.5 % target")
+    axr.plot(x, 100 * (np.asarray(law.k_over_kcyl(x)) / f - 1.0), "o-", ms=3, lw=0.8, color="C0",
+             label="full-range law")
+    axr.set(xscale="log", xlabel="a/r", ylabel="law / FE - 1 [%]", ylim=(-0.6, 0.6))
+    axl = axr.twinx()  # the linear laws miss by up to ~20 %: their own scale
+    axl.plot(x, 100 * (slope * x / f - 1.0), "--", lw=0.8, color="C1", label="our linear fit (right axis)")
+    axl.plot(x, 100 * (ROJEK.slope * x / f - 1.0), ":", lw=0.8, color="C2", label="Rojek eq. 40 (right axis)")
+    axl.set_ylabel("linear law / FE - 1 [%]")
+    handles = axr.get_legend_handles_labels()
+    more = axl.get_legend_handles_labels()
+    axr.legend(handles[0] + more[0], handles[1] + more[1], fontsize=8, loc="lower right")
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def run_fit(n_points: int = 44, rtol: float = 1e-4, out=None, *, workers: int | None = None,
+            solver: str = SOLVER, progress: bool = True, plot_png: bool = True) -> dict:
+    """Sweep, fit and (with ``out``) write fit.json, fit.csv and fit.png; returns the content of fit.json."""
+    t0 = time.perf_counter()
+    x, uniform = sweep_points(n_points)
+    out = pathlib.Path(out) if out is not None else None
+    csv_path = out / "fit.csv" if out is not None else None
+    points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, progress=progress)
+    xa = np.array([p.a_over_r for p in points])
+    fa = np.array([p.K_over_Kcyl for p in points])
+    um = np.array([p.uniform for p in points])
+    slope = linear_slope(xa[um], fa[um])
+    law = fit_law(xa, fa)
+    result = {
+        "slope": slope,
+        "sampling": f"least squares through the origin on the {int(np.sum(um & (xa <= LINEAR_RANGE)))} FE points "
+                    f"uniform in a/r (0.97 k/m) with a/r <= {LINEAR_RANGE}, as Rojek 2022 Fig. 16 / eq. (40)",
+        "slope_sensitivity": slope_sensitivity(law),
+        "points": [[p.a_over_r, p.K_over_Kcyl] for p in points],
+        "error_estimates": [p.error_estimate for p in points],
+        "unconverged": [p.a_over_r for p in points if not p.error_estimate <= p.rtol],
+        "rtol": rtol,
+        "law": {**law.to_dict(), "table": law.table(200)},
+        "paper": {"rojek_eq40": ROJEK.slope, "argento_bouvard_eq42": ARGENTO_BOUVARD.slope},
+        "solver": solver,
+        "cpu_seconds": float(sum(p.seconds for p in points)),
+        "seconds": time.perf_counter() - t0,
+    }
+    if out is not None:
+        (out / "fit.json").write_text(json.dumps(result, indent=1) + "\n")
+        resid = np.asarray(law.k_over_kcyl(xa)) / fa - 1.0
+        with (out / "fit.csv").open("w", newline="") as fh:  # final: sorted, with the law's residual
+            w = csv.writer(fh)
+            w.writerow(CSV_FIELDS + ("law", "law_rel_residual"))
+            for p, r in zip(points, resid):
+                w.writerow([repr(v) if isinstance(v, float) else int(v) for v in asdict(p).values()]
+                           + [repr(float(p.K_over_Kcyl * (1 + r))), repr(float(r))])
+        if plot_png:
+            plot(points, slope, law, out / "fit.png")
+    return result
+
+
+__all__ = ["FitPoint", "SOLVER", "fit_law", "linear_slope", "plot", "read_points", "run_fit", "slope_sensitivity",
+           "sweep", "sweep_points"]
