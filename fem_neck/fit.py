@@ -260,7 +260,7 @@ def plot(points: list[FitPoint], slope: float, law: ConductanceLaw, path) -> Non
     plt.close(fig)
 
 
-def run_fit(n_points: int = 44, rtol: float = 1e-4, out=None, *, workers: int | None = None,
+def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | None = None,
             solver: str = SOLVER, progress: bool = True, plot_png: bool = True) -> dict:
     """Sweep, fit and (with ``out``) write fit.json, fit.csv and fit.png; returns the content of fit.json."""
     t0 = time.perf_counter()

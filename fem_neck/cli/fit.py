@@ -1,0 +1,33 @@
+"""``python -m fem_neck fit``: FE sweep of the semisphere over a/r, Rojek's linear fit (eq. 40) and the full-range law.
+
+Writes fit.json (the file the DEM's ``fit`` law reads), fit.csv (written point by point: rerunning with the same
+--out resumes an interrupted sweep) and fit.png (the Fig. 16 analogue) into --out (default: results/fit).
+"""
+
+from __future__ import annotations
+
+from fem_neck.cli import add_output_options
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "fit", help="sweep a/r, fit K/K_cyl = c a/r and the full-range law (Fig. 16 analogue)",
+        description=__doc__.splitlines()[0] + " " + " ".join(__doc__.split("\n\n")[1].split()))
+    p.add_argument("--points", type=int, default=40, metavar="N",
+                   help="number of FE points (>= 4; default 40: 5 log-spaced on [0.001, 0.02), 35 uniform on "
+                        "(0, 0.97])")
+    p.add_argument("--rtol", type=float, default=1e-4, help="relative tolerance of each FE point (default 1e-4)")
+    p.add_argument("--workers", type=int, default=None, metavar="W", help="processes (default: all cores)")
+    add_output_options(p)
+    p.set_defaults(run=run, out="results/fit")
+
+
+def run(args) -> dict:
+    from fem_neck.fit import run_fit
+
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"workers = {args.workers!r}: must be >= 1")
+    result = run_fit(args.points, args.rtol, args.out, workers=args.workers)
+    return {"slope": result["slope"], "sampling": result["sampling"], "points": result["points"],
+            "law": result["law"], "slope_sensitivity": result["slope_sensitivity"],
+            "unconverged": result["unconverged"], "seconds": result["seconds"], "out": str(args.out)}
