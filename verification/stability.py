@@ -482,7 +482,37 @@ def dem_cli_cases(scene_dir: pathlib.Path) -> list[StressCase]:
         "explicit dt 1e3x the limit": SCENE_OK.format(integrator="explicit", dt="1.0", t_end="10.0"),
         "steady without fixed temperature": base.replace('mode = "transient"', 'mode = "steady"'),
     }
+    gen = base.split("[particles]")[0] + """[generator]
+kind = "random"
+n = {n}
+radius = 5.0e-5
+overlap = {overlap}
+seed = 1
+boundary = "plates"
+hot = 1.0
+cold = 0.0
+[conductance]
+law = "rojek"
+[solver]
+mode = "steady"
+floating = "mean"
+"""
+    bad.update({
+        "generator n = 0": gen.format(n=0, overlap=0.1),
+        "generator n = 1e12": gen.format(n="1000000000000", overlap=0.1),
+        "generator n = 2.5": gen.format(n=2.5, overlap=0.1),
+        "generator overlap 0.7 (beyond 2/3)": gen.format(n=100, overlap=0.7),
+        "generator overlap negative": gen.format(n=100, overlap=-0.1),
+        "radiation negative emissivity": base + "\n[radiation]\nemissivity = -0.5\nT_inf = 20.0\n",
+        "convection NaN h": base + "\n[convection]\nh = nan\nT_inf = 20.0\n",
+        "duplicate key": base.replace("t_end = 0.01", "t_end = 0.01\nt_end = 0.02"),
+        "binary garbage": "\x00\x01\x02 = [[[",
+    })
     long_run = {
+        "generator single particle, steady": gen.format(n=1, overlap=0.1),
+        "radiation, explicit auto": SCENE_OK.format(integrator="explicit", dt='"auto"', t_end="1.0")
+        + "\n[radiation]\nemissivity = 1.0\nT_inf = 20.0\n".replace("[particles]", "[particles]"),
+        "implicit auto, t_end 1e6 s": SCENE_OK.format(integrator="implicit", dt='"auto"', t_end="1.0e6"),
         # would take ~1e12 steps: must be refused or capped, never a hang
         "explicit t_end 1e9 s": SCENE_OK.format(integrator="explicit", dt="1.0e-6", t_end="1.0e9"),
     }
