@@ -116,6 +116,25 @@ def _pool_context():
     return multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
 
 
+def in_processes(jobs, workers: int | None = None, *, desc: str = "", progress: bool = True, done: int = 0):
+    """Run ``func(*args)`` for every ``(func, args)`` of ``jobs`` in a process pool; yield results as they finish.
+
+    Processes, not threads: gmsh is one global, thread-unsafe state per process. ``workers`` defaults to all cores;
+    a tqdm bar on stderr counts ``done`` jobs finished earlier plus these.
+    """
+    from tqdm import tqdm
+
+    workers = workers or os.cpu_count() or 1
+    with tqdm(total=done + len(jobs), initial=done, desc=desc, unit="solve", file=sys.stderr,
+              disable=not progress) as bar:
+        if not jobs:
+            return
+        with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=_pool_context()) as pool:
+            for fut in as_completed([pool.submit(func, *args) for func, args in jobs]):
+                bar.update()
+                yield fut.result()
+
+
 def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int | None = None,
           solver: str = SOLVER, progress: bool = True) -> list[FitPoint]:
     """Solve the semisphere at every a/r to ``rtol`` on ``workers`` processes (default: all cores).
@@ -123,8 +142,6 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
     With ``csv_path`` each point is appended to that CSV as soon as it is solved, and points already there with a
     tolerance at least as tight are reused (resume). Returns the points sorted by a/r.
     """
-    from tqdm import tqdm
-
     if not (isinstance(rtol, float) and 0.0 < rtol < 0.1):
         raise ValueError(f"rtol = {rtol!r}: must be a float in (0, 0.1)")
     x = np.asarray(a_over_r, dtype=float)
@@ -138,20 +155,15 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
         csv_path.unlink(missing_ok=True)
         for p in points.values():
             _append(csv_path, p)
-    workers = workers or os.cpu_count() or 1
-    bar = tqdm(total=len(x), initial=len(points), desc="fit sweep", unit="pt", file=sys.stderr,
-               disable=not progress)
     if todo:
         importlib.import_module(solver.split(":")[0])  # fail early in the parent, and let fork start warm
-        with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=_pool_context()) as pool:
-            futures = {pool.submit(_solve_point, solver, xi, rtol): ui for xi, ui in todo}
-            for fut in as_completed(futures):
-                p = FitPoint(**fut.result(), uniform=futures[fut])
-                points[_key(p.a_over_r)] = p
-                if csv_path is not None:
-                    _append(csv_path, p)
-                bar.update()
-    bar.close()
+    jobs = [(_solve_point, (solver, xi, rtol)) for xi, _ in todo]
+    uniform_of = {_key(xi): ui for xi, ui in todo}
+    for res in in_processes(jobs, workers, desc="fit sweep", progress=progress, done=len(points)):
+        p = FitPoint(**res, uniform=uniform_of[_key(res["a_over_r"])])
+        points[_key(p.a_over_r)] = p
+        if csv_path is not None:
+            _append(csv_path, p)
     return sorted(points.values(), key=lambda p: p.a_over_r)
 
 
@@ -302,5 +314,5 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
     return result
 
 
-__all__ = ["FitPoint", "SOLVER", "fit_law", "linear_slope", "plot", "read_points", "run_fit", "slope_sensitivity",
+__all__ = ["FitPoint", "SOLVER", "fit_law", "in_processes", "linear_slope", "plot", "read_points", "run_fit", "slope_sensitivity",
            "sweep", "sweep_points"]

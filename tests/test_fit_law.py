@@ -77,8 +77,13 @@ def test_paper_pair_with_the_linear_law():
 def test_pair_is_the_series_of_halves(default):
     a, ri, rj = 0.3e-3, 1e-3, 4e-3
     ki, kj = law.half_conductance(2.0, ri, a, default), law.half_conductance(2.0, rj, a, default)
-    assert law.pair_conductance(2.0, ri, rj, a, default) == pytest.approx(1 / (1 / ki + 1 / kj), rel=1e-14)
-    assert law.pair_conductance(2.0, ri, ri, a, default) == pytest.approx(ki / 2, rel=1e-14)
+    series = 1 / (1 / ki + 1 / kj)
+    assert law.pair_conductance(2.0, ri, rj, a, default, unequal=False) == pytest.approx(series, rel=1e-14)
+    corrected = series / (1 + law.UNEQUAL_C * 0.3 * np.log(4.0))
+    assert law.pair_conductance(2.0, ri, rj, a, default) == pytest.approx(corrected, rel=1e-14)
+    assert law.pair_conductance(2.0, rj, ri, a, default) == pytest.approx(corrected, rel=1e-14)  # symmetric
+    assert law.pair_conductance(2.0, ri, ri, a, default) == pytest.approx(ki / 2, rel=1e-14)  # equal: no correction
+    assert law.pair_conductance(2.0, ri, rj, a, law.ROJEK) == pytest.approx(1.064 * 2.0 * np.pi * a / 2, rel=1e-14)
     k = law.pair_conductance(1.0, np.array([1.0, 1.0]), np.array([1.0, 2.0]), np.array([0.0, 0.5]), default)
     assert k[0] == 0.0 and k[1] > 0
 
@@ -138,3 +143,18 @@ def test_cli_rejects_bad_input(capsys):
     assert main(["fit", "--points", "3"]) == 2
     assert main(["fit", "--rtol", "0.5"]) == 2
     assert "error" in capsys.readouterr().err
+
+
+def test_unequal_pairs_against_fe(tmp_path):
+    from fem_neck.unequal import study
+
+    res = study([1, 3], [0.5], 1e-4, tmp_path, workers=2, progress=False, paper_rtol=1e-5)
+    assert {p.name for p in tmp_path.iterdir()} >= {"unequal.json", "unequal.csv", "unequal.png"}
+    dev = res["max_abs_dev_per_ratio"]
+    assert dev["1"]["halves"] < 5e-4  # equal pair = two semispheres: the law's own accuracy
+    assert 1e-3 < dev["3"]["halves"] < 5e-3  # the series of halves over-estimates an unequal pair (upper bound) ...
+    assert dev["3"]["corrected"] < 1e-3  # ... and the fitted correction removes most of it
+    assert res["a_only_spread"]["0.5"] > 0.01  # eq. 43's "K depends on a only" is off by percents
+    paper = res["paper_case"]  # Rojek 2022 Sec. 6: r_i = 1 mm, r_j = 3 mm, h = 0.06 mm, kappa = 394
+    assert paper["a"] == pytest.approx(0.419186e-3, rel=2e-6)
+    assert paper["K_law"] == pytest.approx(paper["K_fe"], rel=2e-3)

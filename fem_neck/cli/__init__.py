@@ -14,7 +14,7 @@ import json
 import re
 import sys
 
-COMMAND_MODULES = ("neck", "solve", "converge", "fit")  # each module imports its heavy dependencies (gmsh, scikit-fem) inside run()
+COMMAND_MODULES = ("neck", "solve", "converge", "fit", "unequal")  # each module imports its heavy dependencies (gmsh, scikit-fem) inside run()
 
 
 class OneLineParser(argparse.ArgumentParser):

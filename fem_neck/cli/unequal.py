@@ -1,0 +1,32 @@
+"""``python -m fem_neck unequal``: FE of unequal sintered pairs against eq. 43 (K from a only) and the law per half.
+
+Writes unequal.json, unequal.csv and unequal.png into --out (default: results/unequal).
+"""
+
+from __future__ import annotations
+
+from fem_neck.cli import add_output_options
+
+
+def register(subparsers) -> None:
+    from fem_neck.unequal import NECKS, RATIOS
+
+    p = subparsers.add_parser("unequal", help="unequal radii: FE pairs vs eq. 43 and the full-range law per half",
+                              description=" ".join(__doc__.split()))
+    p.add_argument("--ratios", default=",".join(f"{q:g}" for q in RATIOS), metavar="Q1,Q2,...",
+                   help="radius ratios r_j/r_i in [1, 100] (default %(default)s)")
+    p.add_argument("--necks", default=",".join(f"{x:g}" for x in NECKS), metavar="X1,X2,...",
+                   help="neck radii a/r_i in [0.001, 0.99] (default %(default)s)")
+    p.add_argument("--rtol", type=float, default=1e-4, help="relative tolerance of each FE solve (default 1e-4)")
+    p.add_argument("--workers", type=int, default=None, metavar="W", help="processes (default: all cores)")
+    add_output_options(p)
+    p.set_defaults(run=run, out="results/unequal")
+
+
+def run(args) -> dict:
+    from fem_neck.unequal import study
+
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"workers = {args.workers!r}: must be >= 1")
+    result = study(args.ratios.split(","), args.necks.split(","), args.rtol, args.out, workers=args.workers)
+    return {k: v for k, v in result.items() if k != "cases"} | {"out": str(args.out)}
