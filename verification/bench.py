@@ -341,7 +341,7 @@ def _fe_config(a_over_r: float, order: int, mesh: str, size: float) -> tuple[flo
     from fem_neck import conduction, shapes
 
     if mesh == "uniform":
-        profile = shapes.semisphere_mesh(a_over_r, grading=1e-12, h_min_fraction=size / a_over_r)
+        profile = shapes.semisphere_mesh(a_over_r, sizes=shapes.SizeField(uniform=size))
     else:
         profile = shapes.semisphere_mesh(a_over_r, grading=size)
     sol = conduction.solve_profile(profile, order, curved=order > 1)

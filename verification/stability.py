@@ -129,6 +129,8 @@ def fe_cases(quick: bool) -> list[StressCase]:
     from fem_neck import conduction
 
     cases = []
+    cases.append(run_case("FE semisphere neck below the supported range, a/r = 5e-5", lambda: expect_value_error(
+        lambda: conduction.semisphere_conductance(5e-5, rtol=1e-4), "a_over_r")))
     small = (1e-4, 3e-4) if quick else (1e-4, 3e-4, 1e-3)
     for a in small:
         def near_constriction(res, a=a):
