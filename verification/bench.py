@@ -614,9 +614,17 @@ def packing_network(n: int, seed: int = 0, connected_only: bool = False, t_hot: 
 
 
 def _peak_rss_mib() -> float:
+    """Peak resident memory of this process in MiB: ``VmHWM`` (reset by exec, unlike ``ru_maxrss``, which a
+    forked child inherits from its parent)."""
+    try:
+        for line in pathlib.Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return float(line.split()[1]) / 1024.0
+    except OSError:
+        pass
     import resource
 
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # kB on Linux
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
 def steady_worker(n: int) -> None:
@@ -625,9 +633,10 @@ def steady_worker(n: int) -> None:
 
     base = _peak_rss_mib()
     net, times = packing_network(n)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     res = steady(net, floating="mean")
     times["solve_seconds"] = time.perf_counter() - t0
+    times["solve_cpu_seconds"] = time.process_time() - c0
     times["steady_seconds"] = times["bonds_seconds"] + times["network_seconds"] + times["solve_seconds"]
     print(json.dumps({"particles": net.particles.n, "bonds": int(net.bonds.n_pairs), "solver": res.solver,
                       "floating_groups": res.floating, "peak_rss_mib": _peak_rss_mib(),
@@ -761,7 +770,7 @@ def bench_dem_scaling(report: Report, quick: bool) -> None:
         "for the few particles the packing leaves unbonded); the packing generation is listed apart. Peak memory "
         "is the process's maximum RSS (getrusage), baseline after imports alongside.\n\n"
         + md_table(rows, ["particles", "bonds", "packing_seconds", "bonds_seconds", "network_seconds",
-                          "solve_seconds", "steady_seconds", "solver", "peak_rss_mib", "baseline_rss_mib", "error"])
+                          "solve_seconds", "solve_cpu_seconds", "steady_seconds", "solver", "peak_rss_mib", "baseline_rss_mib", "error"])
         + ("\n\nGrowth exponent: too few points." if exp_t is None or exp_m is None else
            f"\n\nGrowth exponents (least squares over N = {', '.join(str(r['particles']) for r in big)}): time ~ N^{exp_t:.2f}, memory above baseline ~ N^{exp_m:.2f}.")
         + (f"\n\nTarget: 10^6 particles in <= {TARGETS['dem_steady_1e6_seconds']:g} s: "
@@ -813,18 +822,18 @@ def transient_worker(n: int) -> None:
     cap, diag = net.particles.capacity, np.asarray(net.L.diagonal())
     bound = 2.0 * float(np.min(cap[diag > 0] / diag[diag > 0]))  # 2 min C_i / sum_j K_ij
     dt = 10.0 * bound
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     res = integrate(net, "implicit", dt=dt, t_end=1000 * dt)
-    seconds = time.perf_counter() - t0
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     print(json.dumps({"particles": net.particles.n, "bonds": int(net.bonds.n_pairs), "steps": res.steps, "dt": dt,
                       "cheap_explicit_bound": bound, "solver": res.solver, "energy_error": res.energy_error,
-                      "integrate_seconds": seconds, "setup_seconds": times["bonds_seconds"] + times["network_seconds"],
+                      "integrate_seconds": seconds, "integrate_cpu_seconds": cpu, "setup_seconds": times["bonds_seconds"] + times["network_seconds"],
                       "peak_rss_mib": _peak_rss_mib()}))
 
 
 def bench_dem_transient_big(report: Report, quick: bool) -> None:
     n = 10_000 if quick else 100_000
-    row = run_worker("transient_worker", n, timeout=1800)
+    row = run_worker("transient_worker", n, timeout=1200)
     report.csv("dem_transient_big", [row])
     seconds = row.get("integrate_seconds")
     if not quick:
@@ -835,7 +844,8 @@ def bench_dem_transient_big(report: Report, quick: bool) -> None:
         "Random sintered packing with hot/cold fixed layers; backward Euler (`dem.thermal.integrate`, linear "
         "backend auto) at dt = 10 x the cheap explicit bound 2 min C_i / sum_j K_ij, 1000 steps, in a fresh "
         "subprocess; `integrate_seconds` excludes building the bonds (`setup_seconds`).\n\n"
-        + md_table([row], ["particles", "bonds", "steps", "dt", "solver", "integrate_seconds", "setup_seconds",
+        + md_table([row], ["particles", "bonds", "steps", "dt", "solver", "integrate_seconds",
+                           "integrate_cpu_seconds", "setup_seconds",
                            "energy_error", "peak_rss_mib", "error"])
         + (f"\n\nTarget <= {TARGETS['dem_transient_1e5x1000_seconds']:g} s: "
            f"{verdict(seconds, TARGETS['dem_transient_1e5x1000_seconds'])}" if not quick else ""),
