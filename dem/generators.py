@@ -22,6 +22,12 @@ from scipy.optimize import brentq
 from scipy.spatial import cKDTree
 
 DISTRIBUTIONS = ("constant", "uniform", "lognormal")
+MAX_PARTICLES = 20_000_000  # about 10 GiB of bonds and solver state; larger packings need a distributed backend
+
+
+def _check_count(n: int, name: str):
+    if n > MAX_PARTICLES:
+        raise ValueError(f"[generator] {name}: {n} particles exceeds the limit of {MAX_PARTICLES} for one machine")
 
 
 @dataclass(frozen=True)
@@ -57,6 +63,7 @@ def chain(n: int, radius, overlap) -> Layout:
     """``n`` collinear particles along z; ``radius`` scalar or per particle, ``overlap`` scalar or per bond."""
     if not isinstance(n, int) or n < 1:
         raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
+    _check_count(n, "n")
     r = np.broadcast_to(np.asarray(radius, dtype=float), (n,)).copy() if np.ndim(radius) == 0 else np.asarray(
         radius, dtype=float)
     if r.shape != (n,) or not np.all(np.isfinite(r)) or np.any(r <= 0):
@@ -73,6 +80,7 @@ def lattice(shape, radius, overlap) -> Layout:
     if (not isinstance(shape, (list, tuple)) or len(shape) != 3
             or not all(isinstance(k, int) and k >= 1 for k in shape)):
         raise ValueError(f"[generator] shape = {shape!r}: must be three integers >= 1")
+    _check_count(int(np.prod(shape)), "shape")
     r = _positive("radius", radius)
     s = 2.0 * r - float(_overlap(overlap, 1)[0]) * r
     nx, ny, nz = shape
@@ -103,6 +111,7 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
     distance."""
     if not isinstance(n, int) or n < 1:
         raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
+    _check_count(n, "n")
     r_mean = _positive("radius", radius)
     target = float(_overlap(overlap, 1)[0])
     if target >= 2.0 / 3.0:

@@ -76,28 +76,36 @@ class Particles:
     def from_arrays(cls, position, radius, temperature, materials=(COPPER,), material=None, fixed=None,
                     heat=None, prefix: str = "particles") -> "Particles":
         """Validated particle state; ``material`` defaults to 0, ``fixed`` to False, ``heat`` to 0 W."""
+        sep = " " if prefix.startswith("[") else "."
         if isinstance(materials, Material):
             materials = (materials,)
         materials = tuple(materials)
         if not materials:
             raise ValueError("materials: at least one material is required")
-        pos = finite_array(f"{prefix}.position", position, (3,))
+        pos = finite_array(f"{prefix}{sep}position", position, (3,))
         n = len(pos)
         if n == 0:
-            raise ValueError(f"{prefix}.position: at least one particle is required")
-        rad = check_positive_entries(f"{prefix}.radius", finite_array(f"{prefix}.radius", radius))
-        temp = finite_array(f"{prefix}.temperature", temperature)
-        mat = np.zeros(n, dtype=np.int64) if material is None else finite_array(f"{prefix}.material", material,
+            raise ValueError(f"{prefix}{sep}position: at least one particle is required")
+        rad = check_positive_entries(f"{prefix}{sep}radius", finite_array(f"{prefix}{sep}radius", radius))
+        temp = finite_array(f"{prefix}{sep}temperature", temperature)
+        mat = np.zeros(n, dtype=np.int64) if material is None else finite_array(f"{prefix}{sep}material", material,
                                                                                 dtype=np.int64)
-        fix = np.zeros(n, dtype=bool) if fixed is None else _bool_array(f"{prefix}.fixed", fixed)
-        q = np.zeros(n) if heat is None else finite_array(f"{prefix}.heat", heat)
+        fix = np.zeros(n, dtype=bool) if fixed is None else _bool_array(f"{prefix}{sep}fixed", fixed)
+        q = np.zeros(n) if heat is None else finite_array(f"{prefix}{sep}heat", heat)
         for key, arr in (("radius", rad), ("temperature", temp), ("material", mat), ("fixed", fix), ("heat", q)):
             if len(arr) != n:
-                raise ValueError(f"{prefix}.{key} has {len(arr)} entries but {prefix}.position has {n}")
+                raise ValueError(f"{prefix}{sep}{key} has {len(arr)} entries but {prefix}{sep}position has {n}")
         if np.any((mat < 0) | (mat >= len(materials))):
             k = int(np.flatnonzero((mat < 0) | (mat >= len(materials)))[0])
-            raise ValueError(f"{prefix}.material[{k}] = {mat[k]}: must index one of {len(materials)} material(s)")
-        return cls(pos, rad, temp, mat, fix, q, materials)
+            raise ValueError(f"{prefix}{sep}material[{k}] = {mat[k]}: must index one of {len(materials)} material(s)")
+        out = cls(pos, rad, temp, mat, fix, q, materials)
+        cap = out.capacity
+        bad = ~np.isfinite(cap) | (cap <= 0)
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"{prefix}{sep}radius[{k}] = {rad[k]:.6g}: gives a heat capacity of {cap[k]:.6g} J/K, "
+                             f"which is not a finite positive number")
+        return out
 
     @property
     def n(self) -> int:
@@ -112,7 +120,8 @@ class Particles:
 
     @property
     def volume(self) -> np.ndarray:
-        return 4.0 / 3.0 * np.pi * self.radius**3
+        with np.errstate(over="ignore", under="ignore"):
+            return 4.0 / 3.0 * np.pi * self.radius**3
 
     @property
     def mass(self) -> np.ndarray:

@@ -226,7 +226,7 @@ def _explicit_particles(t: dict, materials):
 def _generated_particles(t: dict, materials):
     _check_keys(t, "generator", ALLOWED["generator"])
     kind = t.get("kind")
-    if kind not in GENERATOR_KEYS:
+    if not isinstance(kind, str) or kind not in GENERATOR_KEYS:
         raise ValueError(f"[generator] kind = {kind!r}: must be one of {', '.join(GENERATOR_KEYS)}")
     geometry_keys = {"n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter"}
     extra = sorted((set(t) & geometry_keys) - GENERATOR_KEYS[kind])
@@ -240,8 +240,9 @@ def _generated_particles(t: dict, materials):
     try:
         layout = {"chain": generators.chain, "lattice": generators.lattice,
                   "random": generators.random_packing}[kind](**args)
-    except TypeError as exc:
-        raise ValueError(f"[generator]: bad parameter types for kind = {kind!r} ({exc})") from None
+    except (TypeError, ValueError) as exc:
+        msg = str(exc)
+        raise ValueError(msg if msg.startswith("[") else f"[generator] kind = {kind!r}: bad parameter ({msg})") from None
     n = len(layout.radius)
     T0 = _number(t, "generator", "temperature", 0.0)
     boundary = t.get("boundary", "none")
@@ -320,6 +321,8 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     physics = meta.get("physics", ["thermal"])
     if isinstance(physics, str):
         physics = [physics]
+    if not isinstance(physics, list) or not all(isinstance(x, str) for x in physics):
+        raise ValueError(f"[scene] physics = {physics!r}: must be a list of names (available: thermal)")
     materials = _materials(doc)
     if ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
@@ -329,7 +332,9 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         particles, walls, specimen = _generated_particles(doc["generator"], materials)
     walls = walls + _walls(doc)
     cond = dict(doc.get("conductance", {}))
-    if "fit_file" in cond and base_dir is not None and isinstance(cond["fit_file"], str):
+    if "fit_file" in cond and not isinstance(cond["fit_file"], str):
+        raise ValueError(f"[conductance] fit_file = {cond['fit_file']!r}: must be a path (string)")
+    if "fit_file" in cond and base_dir is not None:
         cond["fit_file"] = str((base_dir / cond["fit_file"]).resolve())
     conductance = _spec(ConductanceSpec, cond, "conductance", numeric=("slope", "contact_conductance"))
     conv = _spec(Convection, doc["convection"], "convection", numeric=("h", "T_inf")) if "convection" in doc else None

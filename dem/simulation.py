@@ -30,10 +30,14 @@ class RunResult:
 
 
 def _progress_bar(scene: Scene, enabled: bool):
-    if not enabled or scene.solver.mode != "transient":
+    """A tqdm bar on stderr that appears only after 2 s: simulated time (transient) or the build/solve stages."""
+    if not enabled:
         return None, None
     from tqdm import tqdm
 
+    if scene.solver.mode != "transient":
+        bar = tqdm(total=2, desc=f"dem {scene.name}: bonds, solve", file=sys.stderr, delay=2.0)
+        return bar, (lambda stage: bar.update(1))
     bar = tqdm(total=scene.solver.t_end, unit="s", desc=f"dem {scene.name}", file=sys.stderr, delay=2.0,
                bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s simulated [{elapsed}<{remaining}]")
     return bar, (lambda t: bar.update(t - bar.n))
@@ -54,12 +58,16 @@ def effective_conductivity(scene: Scene, boundary: dict) -> float | None:
 def run(scene: Scene, out=None, progress: bool = False) -> RunResult:
     """Run ``scene``; with ``out`` write summary.json, timeseries.csv and VTU/PVD snapshots into that folder."""
     start = time.perf_counter()
-    models = physics.build(scene)
-    thermal = next(m for m in models if m.name == "thermal")
-    writer = RunWriter(out, scene, thermal) if out is not None else None
     bar, report = _progress_bar(scene, progress)
     try:
-        details = thermal.run(writer, report)
+        models = physics.build(scene)
+        thermal = next(m for m in models if m.name == "thermal")
+        writer = RunWriter(out, scene, thermal) if out is not None else None
+        if scene.solver.mode != "transient" and report is not None:
+            report("bonds")
+        details = thermal.run(writer, report if scene.solver.mode == "transient" else None)
+        if scene.solver.mode != "transient" and report is not None:
+            report("solve")
     finally:
         if bar is not None:
             bar.close()

@@ -57,7 +57,10 @@ class Wall:
 
 
 def _area(name: str, fraction, radius: np.ndarray) -> np.ndarray:
-    frac = np.broadcast_to(np.asarray(fraction, dtype=float), radius.shape)
+    try:
+        frac = np.broadcast_to(np.asarray(fraction, dtype=float), radius.shape)
+    except (TypeError, ValueError):
+        frac = np.full(radius.shape, np.nan)
     if not np.all(np.isfinite(frac)) or np.any((frac < 0) | (frac > 1)):
         raise ValueError(f"{name}.area_fraction = {fraction!r}: must be in [0, 1] (scalar or one per particle)")
     return frac * 4.0 * np.pi * radius**2
@@ -94,7 +97,7 @@ class Radiation:
     def __post_init__(self):
         if not (np.isfinite(self.emissivity) and 0 <= self.emissivity <= 1):
             raise ValueError(f"radiation.emissivity = {self.emissivity!r}: must be in [0, 1]")
-        if self.unit not in KELVIN_OFFSET:
+        if not isinstance(self.unit, str) or self.unit not in KELVIN_OFFSET:
             raise ValueError(f"radiation.unit = {self.unit!r}: must be one of {', '.join(KELVIN_OFFSET)}")
         if not (np.isfinite(self.T_inf) and self.T_inf + KELVIN_OFFSET[self.unit] >= 0):
             raise ValueError(f"radiation.T_inf = {self.T_inf!r}: must be finite and >= absolute zero")

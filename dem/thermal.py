@@ -306,6 +306,8 @@ class _Stepper:
         """``(T_new, T_theta, sinks)`` for one step of size ``dt`` from ``T``."""
         net = self.net
         sinks = net.sinks(T)
+        if net.n_free == 0:  # every particle fixed: nothing evolves
+            return T, T, sinks
         A = self.A0 if self.linear_sinks else net.matrix(sinks)
         r = net.rhs(sinks)
         if self.theta == 0.0:
