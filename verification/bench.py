@@ -404,7 +404,7 @@ def bench_fe(report: Report, quick: bool) -> None:
                                  [r for r in sel if r["error_estimate"] is not None and r["rtol"] == tol])):
                 row = fastest(cand, tol) if label.startswith("any") else (cand[0] if cand else None)
                 fastest_rows.append({"tolerance": tol, "h_over_r": h_over_r, "kind": label,
-                                     **({"path": "not reached"} if row is None else
+                                     **({"path": "not reached" if cand else "not run"} if row is None else
                                         {k: row.get(k) for k in ("path", "size", "rtol", "dofs", "rel_error",
                                                              "seconds")})})
         # one fixed setting meeting tol at all three h/r (what a default must do without knowing the answer)
@@ -659,6 +659,7 @@ def openpnm_worker(n: int) -> None:
                       "openpnm_setup_seconds": times["setup_seconds"],
                       "openpnm_solve_seconds": times["solve_seconds"],
                       "openpnm_seconds": times["setup_seconds"] + times["solve_seconds"],
+                      "openpnm_solver": times["solver"],
                       "max_abs_difference": float(np.max(np.abs(T_pnm - res.T)))}))
 
 
@@ -807,7 +808,7 @@ def bench_openpnm(report: Report, quick: bool) -> None:
         "subprocess. Ours = network assembly + `dem.thermal.steady`; OpenPNM = network/phase/algorithm set-up + "
         "`run()`. The two solutions agree to `max_abs_difference` (temperatures in [0, 1]).\n\n"
         + md_table(rows, ["particles", "bonds", "ours_seconds", "ours_solver", "openpnm_setup_seconds",
-                          "openpnm_solve_seconds", "openpnm_seconds", "ratio_ours_over_openpnm",
+                          "openpnm_solve_seconds", "openpnm_seconds", "openpnm_solver", "ratio_ours_over_openpnm",
                           "max_abs_difference", "error"])
         + ("" if head is None else f"\n\nHeadline (N = {head['particles']}): ours {head['ours_seconds']:.3g} s, "
            f"OpenPNM {head['openpnm_seconds']:.3g} s, ratio {head['ratio_ours_over_openpnm']:.2f}."),

@@ -63,8 +63,8 @@ def openpnm_steady(coords, i, j, conductance, fixed, t_fixed) -> tuple[np.ndarra
     """Steady Fourier conduction in OpenPNM on the network (coords, bonds i-j, throat conductances [W/K]).
 
     ``fixed`` is a boolean mask of pores held at ``t_fixed`` (array over all pores; only fixed entries are read).
-    Returns the pore temperatures and ``{"setup_seconds", "solve_seconds"}`` (building the network/phase/algorithm,
-    and ``run()`` with OpenPNM's default solver).
+    Returns the pore temperatures and ``{"setup_seconds", "solve_seconds", "solver"}`` (building the
+    network/phase/algorithm, and ``run()`` with OpenPNM's default solver, whose name is ``solver``).
     """
     import logging
 
@@ -85,4 +85,4 @@ def openpnm_steady(coords, i, j, conductance, fixed, t_fixed) -> tuple[np.ndarra
     t2 = time.perf_counter()
     temperature = np.array(alg["pore.temperature"])
     ws.clear()
-    return temperature, {"setup_seconds": t1 - t0, "solve_seconds": t2 - t1}
+    return temperature, {"setup_seconds": t1 - t0, "solve_seconds": t2 - t1, "solver": ws.settings.default_solver}
