@@ -131,3 +131,24 @@ def test_large_network_iterative_matches_direct():
     ref = steady(net, floating="mean", linear="direct").T
     for backend in ("amg", "cg"):
         assert np.max(np.abs(steady(net, floating="mean", linear=backend, rtol=1e-12).T - ref)) < 1e-9
+
+
+def test_zohdi_wall_contact_is_lens_area_over_distance():
+    r, L = 1e-3, 0.9e-3
+    walls = [Wall("hot", [0, 0, -L], [0, 0, 1], 1.0), Wall("cold", [0, 0, L], [0, 0, -1], 0.0)]
+    res = run(make_scene([[0, 0, 0]], [r], [0.0], walls=walls, law="zohdi", mode="steady"))
+    k_half = 394.0 * np.pi * (r * r - L * L) / L  # Zohdi 2014, eq. (33) with the wall's lens circle
+    assert res.summary["boundary_heat_flow"]["walls"]["cold"] == pytest.approx(k_half / 2, rel=1e-12)
+    assert res.T[0] == pytest.approx(0.5, rel=1e-12)
+
+
+def test_explicit_pairs_deduplicated():
+    from dem.bonds import find_bonds
+    from dem.particles import Particles
+
+    x, r, h = chain_arrays([1e-3, 1e-3, 1e-3], [0.1, 0.1])
+    p = Particles.from_arrays(x, r, [0, 0, 0])
+    b = find_bonds(p, pairs=([0, 1, 1, 2, 0], [1, 0, 2, 1, 1]))
+    assert b.n_pairs == 2 and b.i.tolist() == [0, 1] and b.j.tolist() == [1, 2]
+    with pytest.raises(ValueError, match="do not overlap"):
+        find_bonds(p, pairs=([0], [2]))
