@@ -19,7 +19,7 @@ def chain_arrays(radii, rel_overlap):
     return np.column_stack([np.zeros_like(z), np.zeros_like(z), z]), r, h
 
 
-@pytest.mark.parametrize("law", ["rojek", "argento-bouvard", "zohdi"])
+@pytest.mark.parametrize("law", ["rojek", "argento-bouvard", "zohdi", "fit"])
 def test_chain_is_series_conductance(law):
     radii = [1e-3, 3e-3, 2e-3, 1e-3, 5e-3, 1.5e-3]
     x, r, h = chain_arrays(radii, [0.06, 0.2, 0.1, 0.3, 0.02])
@@ -33,8 +33,8 @@ def test_chain_is_series_conductance(law):
         l_i = 0.5 * (d - (r[1:] ** 2 - r[:-1] ** 2) / d)
         K = 394.0 * np.pi * (r[:-1] ** 2 - l_i**2) / d
     else:
-        lin = fem_law.ROJEK if law == "rojek" else fem_law.ARGENTO_BOUVARD
-        K = fem_law.pair_conductance(394.0, r[:-1], r[1:], neck_radius(r[:-1], r[1:], h), lin)
+        chosen = {"rojek": fem_law.ROJEK, "argento-bouvard": fem_law.ARGENTO_BOUVARD, "fit": None}[law]
+        K = fem_law.pair_conductance(394.0, r[:-1], r[1:], neck_radius(r[:-1], r[1:], h), chosen)
     Q = 10.0 / np.sum(1.0 / K)
     flows = res.summary["boundary_heat_flow"]["particles"]
     assert -flows["0"] == pytest.approx(Q, rel=1e-12)
