@@ -33,7 +33,7 @@ ALLOWED = {
     "generator": {"kind", "n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter",
                   "temperature", "boundary", "hot", "cold", "heat"},
     "walls": {"name", "point", "normal", "temperature"},
-    "conductance": {"law", "slope", "fit_file", "neck", "contact_conductance", "out_of_range"},
+    "conductance": {"law", "slope", "fit_file", "neck", "contact_conductance", "out_of_range", "unequal"},
     "convection": {"h", "T_inf", "area_fraction"},
     "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
     "solver": {"mode", "integrator", "dt", "t_end", "rtol", "linear", "floating", "max_steps"},

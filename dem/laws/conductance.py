@@ -12,7 +12,8 @@ Laws (``ConductanceSpec.law``):
 * ``"argento-bouvard"`` -- the same with c = 1/0.899 = 1.112 (eqs. 41-42).
 * ``"fit"`` -- the full-range FE law ``K_i = kappa_i pi r_i f(a/r_i)`` read from a fit.json written by
   ``python -m fem_neck fit`` (``fit_file``; default: the fit shipped in ``fem_neck/data/fit.json``), each half at
-  its own ``a/r_i``.
+  its own ``a/r_i``; for unequal radii the series is multiplied by the FE correction
+  :func:`fem_neck.law.unequal_factor` (``unequal = true``, default), as :func:`fem_neck.law.pair_conductance` does.
 * ``"zohdi"`` -- ``K_ij = kappa A_c / |x_i - x_j|`` with the lens contact area ``A_c = pi a^2`` (Zohdi 2014,
   eqs. 11-12, 33), written as halves ``K_i = kappa_i pi a^2 / L_i`` (``L_i + L_j = |x_i - x_j|``, eq. 9), which
   is eq. (33) exactly for one material. (Zohdi's footnote 4 averages two conductivities arithmetically; the halves
@@ -49,6 +50,7 @@ class ConductanceSpec:
     neck: str = "newton"
     contact_conductance: float | None = None
     out_of_range: str = "error"
+    unequal: bool = True
 
     def __post_init__(self):
         if self.law not in LAWS:
@@ -62,6 +64,8 @@ class ConductanceSpec:
                                        or self.slope <= 0):
             raise ValueError(f"conductance.slope = {self.slope!r}: must be > 0 and only with law rojek or "
                              f"argento-bouvard")
+        if not isinstance(self.unequal, bool):
+            raise ValueError(f"conductance.unequal = {self.unequal!r}: must be true or false")
         if self.fit_file is not None and self.law != "fit":
             raise ValueError(f"conductance.fit_file = {self.fit_file!r}: only with law = \"fit\"")
         kc = self.contact_conductance
@@ -108,4 +112,7 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds)
     k_j = half_conductance(spec, kappa[bonds.j], r[bonds.j], bonds.a, bonds.l_j)
     p = bonds.wall_particle
     k_w = half_conductance(spec, kappa[p], r[p], bonds.wall_a, bonds.wall_l)
-    return series(k_i, k_j, kc), series(k_w, kc)
+    k_pair = series(k_i, k_j)
+    if spec.law == "fit" and spec.unequal and bonds.n_pairs:
+        k_pair = k_pair * fem_law.unequal_factor(r[bonds.i], r[bonds.j], bonds.a)
+    return series(k_pair, kc), series(k_w, kc)
