@@ -6,7 +6,8 @@
   per process), appending each result to ``fit.csv`` as it arrives so an interrupted run resumes where it stopped.
 * :func:`linear_slope` -- ``K/K_cyl = c a/r`` by least squares through the origin on the uniform points with
   ``a/r <= 0.7`` (Rojek 2022, eq. 40); :func:`slope_sensitivity` shows how c moves with the sampling.
-* :func:`fit_law` -- the parameters of :class:`fem_neck.law.ConductanceLaw`, least squares on relative residuals.
+* :func:`fit_law` -- B, C, E of :class:`fem_neck.law.ConductanceLaw` (A = 5/(4 pi) is derived), least squares on
+  relative residuals.
 * :func:`run_fit` -- all of it, writing ``fit.json`` (read by the DEM), ``fit.csv`` and ``fit.png`` (the Fig. 16
   analogue) into one folder.
 
@@ -29,7 +30,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from fem_neck.law import ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, neck_resistance
+from fem_neck.law import A_LOG, ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, neck_resistance
 
 SOLVER = "fem_neck.conduction:semisphere_conductance"
 X_MAX = 0.97  # the sweep's largest a/r
@@ -185,17 +186,18 @@ def _law_basis(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return p0, F
 
 
-def fit_law(a_over_r, k_over_kcyl) -> ConductanceLaw:
-    """Fit the full-range law to FE points (0 < a/r < 1) by least squares on the relative residual.
+def fit_law(a_over_r, k_over_kcyl, A: float = A_LOG) -> ConductanceLaw:
+    """Fit B, C, E of the full-range law (A fixed, default the derived 5/(4 pi)) to FE points, 0 < a/r < 1.
 
-    ``1/f - lambda = pi/(4x) P`` is linear in the parameters; Gauss-Newton on the exact relative residual
-    ``f_law/f_FE - 1`` from that linear start converges in a few steps.
+    Least squares on the relative residual: ``1/f - lambda = pi/(4x) P`` is linear in the parameters; Gauss-Newton
+    on the exact relative residual ``f_law/f_FE - 1`` from that linear start converges in a few steps.
     """
     x = np.asarray(a_over_r, dtype=float)
     f = np.asarray(k_over_kcyl, dtype=float)
-    if x.size < len(PARAMETERS) + 1:
-        raise ValueError(f"points = {x.size}: the law needs at least {len(PARAMETERS) + 1} FE points")
+    if x.size < len(PARAMETERS):
+        raise ValueError(f"points = {x.size}: the law needs at least {len(PARAMETERS)} FE points")
     p0, F = _law_basis(x)
+    p0, F = p0 + A * F[:, 0], F[:, 1:]
     p_data = (1.0 / f - np.asarray(neck_resistance(x))) * 4.0 * x / np.pi
     weight = f * np.pi / (4.0 * x)  # d(rel. residual)/dP to first order
     params, *_ = np.linalg.lstsq(F * weight[:, None], (p_data - p0) * weight, rcond=None)
@@ -208,9 +210,10 @@ def fit_law(a_over_r, k_over_kcyl) -> ConductanceLaw:
         params = params + step
         if np.max(np.abs(step)) < 1e-13:
             break
-    law = ConductanceLaw(*map(float, params), fit_range=(float(x.min()), float(x.max())))
+    fit_range = (round(float(x.min()), 12), round(float(x.max()), 12))
+    law = ConductanceLaw(A, *map(float, params), fit_range=fit_range)
     resid = np.asarray(law.k_over_kcyl(x)) / f - 1.0
-    return ConductanceLaw(*map(float, params), fit_range=law.fit_range, max_rel_residual=float(np.abs(resid).max()))
+    return ConductanceLaw(A, *map(float, params), fit_range=fit_range, max_rel_residual=float(np.abs(resid).max()))
 
 
 def slope_sensitivity(law: ConductanceLaw) -> dict:
@@ -314,5 +317,5 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
     return result
 
 
-__all__ = ["FitPoint", "SOLVER", "fit_law", "in_processes", "linear_slope", "plot", "read_points", "run_fit", "slope_sensitivity",
-           "sweep", "sweep_points"]
+__all__ = ["FitPoint", "SOLVER", "fit_law", "in_processes", "linear_slope", "plot", "read_points", "run_fit",
+           "slope_sensitivity", "sweep", "sweep_points"]
