@@ -285,7 +285,7 @@ class _Stepper:
         self.factorizations = 0
         self.backend = "none"
         self.A0 = net.matrix(net.sinks(net.particles.temperature[net.free])) if self.linear_sinks else None
-        self.previous = None  # (T, dt) of the last step: linear extrapolation warm-starts iterative solvers
+        self.history: list = []  # (T, dt) of the last two steps: extrapolation warm-starts iterative solvers
 
     def _solver(self, dt: float, A: sp.csr_matrix, reuse: bool):
         key = dt if reuse else None
@@ -302,6 +302,15 @@ class _Stepper:
             self._cache[key] = solver
         return solver
 
+    def _guess(self, T: np.ndarray, dt: float) -> np.ndarray:
+        """Start of the iterative solve: quadratic extrapolation at a constant step, else linear, else ``T``."""
+        h = self.history
+        if len(h) == 2 and h[0][1] == dt and h[1][1] == dt:
+            return 3.0 * (T - h[0][0]) + h[1][0]
+        if h:
+            return T + (T - h[0][0]) * (dt / h[0][1])
+        return T
+
     def step(self, T: np.ndarray, dt: float):
         """``(T_new, T_theta, sinks)`` for one step of size ``dt`` from ``T``."""
         net = self.net
@@ -316,9 +325,8 @@ class _Stepper:
             rhs = net.C / dt * T + r
             if self.theta < 1.0:
                 rhs -= (1.0 - self.theta) * (A @ T)
-            guess = T if self.previous is None else T + (T - self.previous[0]) * (dt / self.previous[1])
-            T_new = self._solver(dt, A, self.linear_sinks).solve(rhs, guess)
-        self.previous = (T, dt)
+            T_new = self._solver(dt, A, self.linear_sinks).solve(rhs, self._guess(T, dt))
+        self.history = [(T, dt)] + self.history[:1]
         return T_new, self.theta * T_new + (1.0 - self.theta) * T, sinks
 
 
