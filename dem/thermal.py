@@ -97,11 +97,9 @@ class Network:
     def sinks(self, T_F: np.ndarray) -> dict:
         return linear_sink_terms(self.sources, self.radius, T_F)
 
-    def matrix(self, sinks: dict, shift=None) -> sp.csr_matrix:
-        """``shift + theta``-free system matrix ``A`` (plus ``diag(shift)`` when given)."""
+    def matrix(self, sinks: dict) -> sp.csr_matrix:
+        """The system matrix ``A = L_FF + diag(K_wall + g)``, CSR."""
         extra = self.wall_diag + sum((g for g, _ in sinks.values()), np.zeros(self.n_free))
-        if shift is not None:
-            extra = extra + shift
         return (self.L_FF + sp.diags(extra)).tocsr()
 
     def rhs(self, sinks: dict) -> np.ndarray:

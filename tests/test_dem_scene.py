@@ -63,19 +63,23 @@ BAD = {
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
-def test_bad_input_exits_2_with_one_line(tmp_path, case):
+def test_bad_input_exits_2_with_one_line(tmp_path, capsys, case):
+    """In-process (``dem.cli.main``, what ``python -m dem`` calls); the subprocess path is tested below."""
+    from dem.cli import main
+
     edit, word = BAD[case]
     path = tmp_path / "bad.toml"
     path.write_text(edit(EXAMPLE))
-    proc = dem_cli("run", str(path), "--json")
-    assert proc.returncode == 2
-    assert proc.stdout == ""
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and word in lines[0], proc.stderr
+    assert main(["run", str(path), "--json"]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and word in lines[0], err
 
 
 def test_missing_file_and_no_args():
-    assert dem_cli("run", "no/such/scene.toml").returncode == 2
+    proc = dem_cli("run", "no/such/scene.toml")
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
     assert dem_cli().returncode == 2
 
 
@@ -114,3 +118,42 @@ def test_random_packing_hits_target_overlap_and_is_seeded():
     h = a.radius[i] + a.radius[j] - np.linalg.norm(a.position[i] - a.position[j], axis=1)
     assert np.mean(h / np.minimum(a.radius[i], a.radius[j])) == pytest.approx(0.1, rel=1e-9)
     assert a.radius.mean() == pytest.approx(1e-4, rel=1e-12)
+
+
+def test_several_materials_walls_and_sources_from_toml(tmp_path):
+    text = """
+[scene]
+name = "two materials"
+[[materials]]
+name = "copper"
+conductivity = 394.0
+density = 8960.0
+specific_heat = 385.0
+[[materials]]
+name = "steel"
+conductivity = 16.0
+density = 7900.0
+specific_heat = 500.0
+[particles]
+position = [[0.0, 0.0, 0.0], [0.0, 0.0, 1.9e-3]]
+radius = [1.0e-3, 1.0e-3]
+temperature = [0.0, 0.0]
+material = ["copper", "steel"]
+heat = [0.01, 0.0]
+[[walls]]
+name = "sink"
+point = [0.0, 0.0, 2.88e-3]
+normal = [0.0, 0.0, -1.0]
+temperature = 0.0
+[convection]
+h = 10.0
+T_inf = 0.0
+[solver]
+mode = "steady"
+"""
+    path = tmp_path / "two.toml"
+    path.write_text(text)
+    s = run(load_scene(path)).summary
+    # all heat generated leaves through the wall and the ambient
+    assert s["boundary_heat_flow"]["walls"]["sink"] + (-s["heat_flow"]["convection"]) == pytest.approx(0.01, rel=1e-10)
+    assert s["T"][0] > s["T"][1] > 0

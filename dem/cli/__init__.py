@@ -1,2 +1,17 @@
-"""Sub-commands of ``python -m dem``; each module exposes ``register(subparsers)`` (the plumbing of
-:mod:`fem_neck.cli`: one JSON object with ``--json``, one line on stderr and exit 2 for bad input)."""
+"""``python -m dem``: run a pipe-network thermal DEM scene, or list the built-in scenes.
+
+    python -m dem run SCENE [--out DIR] [--json]     SCENE: a TOML file or a built-in name
+    python -m dem scenes [--json]
+
+Each sub-command is a module of this package exposing ``register(subparsers)``; the plumbing is that of
+:mod:`fem_neck.cli` (one JSON object with ``--json``; bad input: one line on stderr, exit code 2).
+"""
+
+from fem_neck.cli import main as _main
+
+COMMANDS = ("run", "scenes")
+
+
+def main(argv=None) -> int:
+    return _main(argv, prog="python -m dem", description=__doc__.splitlines()[0], modules=COMMANDS,
+                 package="dem.cli")
