@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pathlib
 import sys
 
@@ -49,7 +50,7 @@ def build_parser(command: str | None = None) -> tuple[argparse.ArgumentParser, l
         p.add_argument("--quick", action="store_true", help="reduced run (all --quick: under 3 minutes on 2 cores)")
         p.add_argument("--out", metavar="DIR", default=DEFAULT_OUT, help=f"output folder (default: {DEFAULT_OUT})")
         p.add_argument("--json", action="store_true", help="print summary.json as one JSON object on stdout")
-        p.add_argument("--no-progress", action="store_true", help="no progress bars on stderr")
+        p.add_argument("--no-progress", action="store_true", help="no progress bars on stderr (none of the sections' either)")
         if name == command and name in PLUGINS and section_available(name):
             module = importlib.import_module(f"verification.{name}")
             if hasattr(module, "add_arguments"):
@@ -73,6 +74,8 @@ def main(argv=None) -> int:
         sys.stderr.write(f"{PROG} {args.command}: error: --out {args.out}: exists and is not a directory\n")
         return 2
     options = {k: getattr(args, k) for k in extra}
+    if args.no_progress:
+        os.environ["TQDM_DISABLE"] = "1"  # also silences the sections' own bars (and those of worker processes)
     report = run_sections(sections, out, args.command, quick=args.quick, options=options,
                           progress=not args.no_progress)
     if args.json:
