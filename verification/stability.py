@@ -513,6 +513,8 @@ floating = "mean"
         "convection NaN h": base + "\n[convection]\nh = nan\nT_inf = 20.0\n",
         "duplicate key": base.replace("t_end = 0.01", "t_end = 0.01\nt_end = 0.02"),
         "binary garbage": "\x00\x01\x02 = [[[",
+        "radiation with a temperature below absolute zero": base.replace("temperature = [100.0", "temperature = [-400.0")
+        + '\n[radiation]\nemissivity = 0.5\nT_inf = 20.0\nunit = "C"\n',
     })
     long_run = {
         "generator single particle, steady": gen.format(n=1, overlap=0.1),
@@ -532,6 +534,9 @@ floating = "mean"
     cases.append(cli_case("dem CLI missing scene file", ["dem", "run", str(scene_dir / "nope.toml"), "--json"]))
     cases.append(cli_case("dem CLI scene is a directory", ["dem", "run", str(scene_dir), "--json"]))
     cases.append(cli_case("dem CLI no arguments", ["dem"]))
+    cases.append(cli_case("dem CLI --out is an existing file", ["dem", "run", str(_write(scene_dir / "good.toml", base)),
+                                                               "--json", "--out", str(_write(scene_dir / "afile",
+                                                                                             ""))]))
     cases.append(cli_case("dem CLI good scene runs", ["dem", "run", str(_write(scene_dir / "good.toml", base)),
                                                       "--json", "--out", str(scene_dir / "out")], "ok"))
     return cases
