@@ -19,6 +19,7 @@ import math
 import pathlib
 import subprocess
 import sys
+import tempfile
 import time
 from dataclasses import asdict, dataclass
 
@@ -436,6 +437,10 @@ def fem_neck_cli_cases() -> list[StressCase]:
         ("fit: negative points", ["fit", "--points", "-5", "--json"], "error"),
         ("unknown command", ["frobnicate"], "error"),
     ]
+    afile = pathlib.Path(tempfile.gettempdir()) / "stability-out-is-a-file"
+    afile.write_text("")
+    specs.append(("semisphere: --out is an existing file", ["semisphere", "--h-over-r", "0.2", "--out", str(afile),
+                                                           "--json"], "error"))
     return [cli_case(f"fem_neck CLI {name}", m + argv, expect) for name, argv, expect in specs]
 
 
