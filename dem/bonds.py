@@ -98,10 +98,15 @@ def candidate_pairs(position: np.ndarray, radius: np.ndarray) -> tuple[np.ndarra
             found_j.append(pj)
     i = np.concatenate(found_i).astype(np.int64)
     j = np.concatenate(found_j).astype(np.int64)
-    d = np.linalg.norm(position[i] - position[j], axis=1)
-    keep = d < radius[i] + radius[j]
-    i, j = i[keep], j[keep]
-    return np.minimum(i, j), np.maximum(i, j)
+    diff = position[i] - position[j]
+    keep = np.einsum("ij,ij->i", diff, diff) < (radius[i] + radius[j]) ** 2
+    return sorted_pairs(i[keep], j[keep], n)
+
+
+def sorted_pairs(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs as ``i < j``, sorted by ``(i, j)`` (one int64 key), without duplicates."""
+    key = np.unique(np.minimum(i, j) * n + np.maximum(i, j))
+    return key // n, key % n
 
 
 def unique_pairs(i, j, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -114,9 +119,7 @@ def unique_pairs(i, j, n: int) -> tuple[np.ndarray, np.ndarray]:
     if np.any(bad):
         k = int(np.flatnonzero(bad)[0])
         raise ValueError(f"bonds[{k}] = ({i[k]}, {j[k]}): must join two different particles among 0..{n - 1}")
-    lo, hi = np.minimum(i, j), np.maximum(i, j)
-    key = np.unique(lo * n + hi)
-    return key // n, key % n
+    return sorted_pairs(i, j, n)
 
 
 def _lens_planes(r_i, r_j, d):
@@ -236,7 +239,6 @@ def find_bonds(particles: Particles, walls=(), contact: str = "newton", out_of_r
             k = int(np.flatnonzero(apart)[0])
             raise ValueError(f"bonds: particles {i[k]} and {j[k]} do not overlap (d = {d[k]:.6g} m >= "
                              f"r_i + r_j = {particles.radius[i[k]] + particles.radius[j[k]]:.6g} m)")
-    order = np.lexsort((j, i))
-    i, j, h, d, a, l_i, l_j, c1, d1 = _pair_contacts(particles, i[order], j[order], contact, out_of_range)
+    i, j, h, d, a, l_i, l_j, c1, d1 = _pair_contacts(particles, i, j, contact, out_of_range)
     wp, wi, wh, wa, wl, c2, d2 = _wall_contacts(particles, tuple(walls), contact, out_of_range)
     return Bonds(i, j, h, d, a, l_i, l_j, wp, wi, wh, wa, wl, contact, c1 + c2, d1 + d2)
