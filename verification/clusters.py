@@ -44,8 +44,8 @@ from fem_neck.geometry import overlap_for_neck
 KAPPA = 394.0
 R0 = 1.0e-3
 MESH_QUICK = {"size_neck": 0.3, "size_far": 0.5, "curvature": 12, "neck_cells": 0.5}
-MESH_LEVELS = ({"size_neck": 0.2, "size_far": 0.35, "curvature": 16},
-               {"size_neck": 0.12, "size_far": 0.25, "curvature": 24})
+MESH_LEVELS = ({"size_neck": 0.3, "size_far": 0.5, "curvature": 12, "neck_cells": 1.0},
+               {"size_neck": 0.2, "size_far": 0.35, "curvature": 16, "neck_cells": 2.0})
 
 
 @dataclass(frozen=True)
@@ -301,8 +301,8 @@ def particle_neck_ratio(cluster: Cluster) -> np.ndarray:
     return total / np.maximum(cluster.degree(), 1)
 
 
-def compare(case: Case, fe: dict) -> tuple[dict, list]:
-    """Per-case and per-particle FE vs DEM errors for every law."""
+def compare(case: Case, fe: dict, names: tuple) -> tuple[dict, list]:
+    """Per-case and per-particle FE vs DEM errors for every law in ``names``."""
     cl = case.cluster
     fixed = {t.particle for t in case.terminals}
     free = np.array([k for k in range(cl.n) if k not in fixed])
@@ -316,7 +316,7 @@ def compare(case: Case, fe: dict) -> tuple[dict, list]:
     particles = []
     z = cl.degree()
     ratio = particle_neck_ratio(cl)
-    for law in compared_laws():
+    for law in names:
         K_dem, T_dem = dem_steady(cl, case.terminals, law)
         err = (T_dem[free] - fe["T"][free]) / dT
         row["laws"][law] = {"K_dem": K_dem, "K_rel_err": K_dem / fe["K"] - 1.0,
@@ -327,8 +327,7 @@ def compare(case: Case, fe: dict) -> tuple[dict, list]:
     return row, particles
 
 
-def _table(rows) -> str:
-    names = compared_laws()
+def _table(rows, names) -> str:
     head = ("| cluster | n | bonds | z max | mean a/r | K_FE (W/K) | FE mesh change | "
             + " | ".join(f"K {law} rel. err" for law in names) + " | "
             + " | ".join(f"max abs dT {law}" for law in names) + " |")
@@ -361,13 +360,12 @@ def error_map(particles, law: str) -> str:
     return "\n".join(lines)
 
 
-def _figures(rows, particles, out_dir: pathlib.Path) -> list:
+def _figures(rows, particles, out_dir: pathlib.Path, names) -> list:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = compared_laws()
     figs = []
     markers = {"triangle": "^", "tetrahedron": "s", "bent chain": "o", "random": "*"}
     fig, axes = plt.subplots(1, len(names), figsize=(4 * len(names), 3.6), sharey=False)
@@ -450,7 +448,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
     last_random = None
     for case in tqdm(all_cases(quick), desc="3D clusters", unit="cluster", leave=False):
         fe = fe_solve(case, quick)
-        row, parts = compare(case, fe)
+        row, parts = compare(case, fe, names)
         rows.append(row)
         particles += parts
         summary[f"cluster {case.name}"] = {
@@ -459,7 +457,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
         if case.family == "random":
             last_random = (case, fe)
     (out_dir / "clusters.json").write_text(json.dumps(jsonable({"cases": rows, "particles": particles}), indent=1))
-    figures = _figures(rows, particles, out_dir)
+    figures = _figures(rows, particles, out_dir, names)
     if last_random is not None:
         case, fe = last_random
         figures.append(render_cluster(fe, out_dir / "cluster_random_T.png", f"{case.name}: FE temperature"))
@@ -470,7 +468,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
           "Relative errors are DEM minus FE over FE; temperature errors are in units of the imposed difference "
           "(1 K). FE: P2 on curved tetrahedra, "
           + ("one mesh level (quick)." if quick else "two mesh levels; the change between them is the FE error bar."),
-          "", _table(rows), "",
+          "", _table(rows, names), "",
           "### Error map: RMS particle-temperature error by coordination number and neck size", ""]
     for law in [x for x in (NETWORK_ONLY, "fit", "rojek") if x in names]:
         md += [f"Law `{law}`:", "", error_map(particles, law), ""]
