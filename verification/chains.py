@@ -19,6 +19,7 @@ chains.
 
 from __future__ import annotations
 
+import json
 import pathlib
 from dataclasses import dataclass
 
@@ -172,5 +173,5 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
         "sintered necks; the linear laws (eqs. 40, 42) miss the small-neck limit 4κa and the bend above "
         "a/r ≈ 0.7, which the `fit` law (the FE's full-range law, each half at its own a/r_i) captures.",
     ])
-    (out_dir / "chains.json").write_text(__import__("json").dumps(rows, indent=1) + "\n")
+    (out_dir / "chains.json").write_text(json.dumps(rows, indent=1) + "\n")
     return {"title": TITLE, "markdown": md, "summary": summary, "figures": [fig_path]}

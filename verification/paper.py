@@ -361,7 +361,7 @@ def fit_fig16(out_dir: pathlib.Path, quick: bool) -> Part:
     from fem_neck.fit import run_fit
 
     n_points, rtol = (16, 1e-3) if quick else (40, 1e-4)
-    fit = run_fit(n_points, rtol, out_dir / "fit", workers=2, progress=False)
+    fit = run_fit(n_points, rtol, out_dir / "fit", progress=False)
     slope = fit["slope"]
     summary = {
         "paper.fig16.slope": compare(slope, cases.SLOPE_ROJEK, points=n_points, rtol=rtol),
