@@ -22,7 +22,7 @@ from scipy.optimize import brentq
 from scipy.spatial import cKDTree
 
 DISTRIBUTIONS = ("constant", "uniform", "lognormal")
-MAX_PARTICLES = 20_000_000  # about 10 GiB of bonds and solver state; larger packings need a distributed backend
+MAX_PARTICLES = 5_000_000  # ~1.7 GiB peak per 10^6 particles (steady, AMG): larger packings need a distributed backend
 
 
 def _check_count(n: int, name: str):

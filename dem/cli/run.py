@@ -14,5 +14,9 @@ def run(args) -> dict:
     from dem.scene import load_scene
     from dem.simulation import run as run_scene
 
-    scene = load_scene(args.scene)
-    return run_scene(scene, args.out, progress=True).summary
+    try:
+        scene = load_scene(args.scene)
+        return run_scene(scene, args.out, progress=True).summary
+    except MemoryError:
+        raise ValueError(f"scene = {args.scene!r}: out of memory (about 1.7 GiB per 10^6 particles for a steady "
+                         f"solve); use a smaller scene") from None
