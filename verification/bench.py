@@ -81,6 +81,7 @@ class Report:
         self.out_dir.mkdir(parents=True, exist_ok=True)
 
     def csv(self, stem: str, rows: list[dict]) -> pathlib.Path:
+        self.out_dir.mkdir(parents=True, exist_ok=True)
         path = self.out_dir / f"{stem}.csv"
         if rows:
             columns = list(dict.fromkeys(k for row in rows for k in row))
@@ -93,6 +94,7 @@ class Report:
     def figure(self, fig, stem: str) -> pathlib.Path:
         import matplotlib.pyplot as plt
 
+        self.out_dir.mkdir(parents=True, exist_ok=True)
         path = self.out_dir / f"{stem}.png"
         fig.savefig(path, dpi=110, bbox_inches="tight")
         plt.close(fig)
@@ -109,6 +111,7 @@ class Report:
         return "\n".join(self.sections)
 
     def flush(self) -> None:
+        self.out_dir.mkdir(parents=True, exist_ok=True)
         (self.out_dir / f"{self.name}.md").write_text(f"# {self.title}\n\n{self.markdown}")
         (self.out_dir / f"{self.name}.json").write_text(json.dumps(self.summary, indent=1, default=_jsonable))
 
