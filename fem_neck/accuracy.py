@@ -20,7 +20,7 @@ import numpy as np
 # P1 ~2, P2 3-4, P3 4.5-6), and the grading that meets the reference tolerance in one round.
 RATE = {2: 2.0, 3: 3.0, 4: 4.5}
 REFERENCE_GRADING = {2: (0.05, 1e-4), 3: (0.3, 1e-4), 4: (0.3, 1e-6)}
-MAX_ROUNDS = 8
+MAX_ROUNDS = 6
 ORDERS = (2, 3, 4)
 COARSEST_GRADING = 0.45
 FINEST_GRADING = 0.02
@@ -67,15 +67,26 @@ def next_grading(grading: float, rtol: float, estimate: float, order: int) -> fl
 
 def solve_to_tolerance(solve_pair, rtol: float, order: int):
     """Call ``solve_pair(grading, order) -> (K_p, K_(p-1), payload)`` with finer gradings until the estimate meets
-    ``rtol``. Returns ``(K_p, estimate, grading, payload, rounds, converged)``.
+    ``rtol``. Returns ``(K_p, estimate, grading, payload, rounds, converged)``; when refining stops paying (the
+    finest grading, an estimate that no longer halves, or a mesh too fine for double precision -- tiny necks at
+    rtol < 1e-6) the best round so far is returned with ``converged = False`` and its honest estimate.
     """
     grading = initial_grading(rtol, order)
+    best = None
     for rounds in range(1, MAX_ROUNDS + 1):
-        k_high, k_low, payload = solve_pair(grading, order)
+        try:
+            k_high, k_low, payload = solve_pair(grading, order)
+        except RuntimeError:
+            if best is None:
+                raise
+            break
         estimate = relative_difference(k_high, k_low)
+        if best is not None and estimate > 0.5 * best[1]:
+            break
+        best = (k_high, estimate, grading, payload, rounds)
         if estimate <= rtol:
-            return k_high, estimate, grading, payload, rounds, True
+            return (*best, True)
         if grading <= FINEST_GRADING * (1 + 1e-12):
             break
         grading = next_grading(grading, rtol, estimate, order)
-    return k_high, estimate, grading, payload, rounds, False
+    return (*best, False)

@@ -110,7 +110,10 @@ def solve_profile(profile: shapes.ProfileMesh, order: int = 2, curved: bool = Tr
     if order not in _ELEMENTS:
         raise ValueError(f"order = {order!r}: must be one of {', '.join(map(str, _ELEMENTS))}")
     mesh = shapes.curved_mesh(profile) if curved and order > 1 else profile.mesh
-    basis = skfem.Basis(mesh, getattr(skfem, _ELEMENTS[order])())
+    try:
+        basis = skfem.Basis(mesh, getattr(skfem, _ELEMENTS[order])())
+    except Exception as exc:  # skfem raises a bare Exception for degenerate (round-off flat) elements
+        raise RuntimeError(f"FE basis failed on a mesh with h_min = {profile.h_min:.3g}: {exc}") from exc
     matrix = _axisymmetric_laplace().assemble(basis)
     top = basis.get_dofs("top").all()
     fixed = np.concatenate([top, basis.get_dofs("bottom").all()])

@@ -50,7 +50,7 @@ def test_estimate_is_honest_for_each_order(order, rtol):
     assert abs(res.K_over_Kcyl - k_ref) / k_ref <= 3.0 * res.error_estimate
 
 
-@pytest.mark.parametrize("a_over_r", [0.03, 0.3, 0.95])
+@pytest.mark.parametrize("a_over_r", [0.001, 0.03, 0.3, 0.95])
 def test_estimate_is_honest_against_fine_solve(a_over_r):
     fine = conduction.semisphere_conductance(a_over_r, rtol=1e-7)
     res = conduction.semisphere_conductance(a_over_r)
@@ -173,3 +173,14 @@ def test_result_pickles_without_the_field():
 def test_bad_input_raises_value_error(call):
     with pytest.raises(ValueError):
         call()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("rtol", [1e-3, 1e-4, 1e-5])
+def test_estimate_is_honest_over_the_range(rtol):
+    """Sweep a/r over 1e-3 .. 0.97 at several tolerances against solves to 1e-7."""
+    for a_over_r in (1e-3, 0.01, 0.05, 0.1, 0.2, 0.4, 0.6, 0.8, 0.9, 0.97):
+        fine = conduction.semisphere_conductance(a_over_r, rtol=1e-7)
+        res = conduction.semisphere_conductance(a_over_r, rtol=rtol)
+        assert res.converged and res.error_estimate <= rtol
+        assert abs(res.K - fine.K) / fine.K <= 3.0 * res.error_estimate + fine.error_estimate
