@@ -391,7 +391,7 @@ def _figures(rows, particles, out_dir: pathlib.Path, names) -> list:
     plt.close(fig)
     figs.append(path)
 
-    fig, axes = plt.subplots(1, len(names), figsize=(4 * len(names), 3.6), sharey=True, layout="constrained")
+    fig, axes = plt.subplots(1, len(names), figsize=(4 * len(names), 3.6), layout="constrained")
     for ax, law in zip(axes, names):
         sel = [p for p in particles if p["law"] == law and "centre balls" not in p["family"]]
         if sel:
