@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import os
 import re
 import sys
 
@@ -50,7 +51,18 @@ def _format(value) -> str:
 
 
 def print_result(result: dict, as_json: bool) -> None:
-    """``--json``: one JSON object; otherwise one ``key: value`` line per entry."""
+    """``--json``: one JSON object; otherwise one ``key: value`` line per entry.
+
+    A reader that closes the pipe early (``| head``) ends the output quietly, as for any Unix filter.
+    """
+    try:
+        _write_result(result, as_json)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        sys.stdout = open(os.devnull, "w")  # nothing more can reach the reader; keep interpreter exit quiet
+
+
+def _write_result(result: dict, as_json: bool) -> None:
     if as_json:
         json.dump(result, sys.stdout)
         sys.stdout.write("\n")
