@@ -117,8 +117,8 @@ def _segment_volume(p, q, seg) -> float:
     return math.pi * (rad**2 * (z1 - z0) - (z1**3 - z0**3) / 3.0)
 
 
-def _sphere_segments(k, r, zc, z_lo, z_hi, x_lo, x_hi):
-    """Arc(s) of sphere k from height ``z_lo`` (radius ``x_lo``) to ``z_hi``; split at the equator if crossed."""
+def _sphere_segments(k, r, zc, z_lo, z_hi, x_hi):
+    """Arc(s) of sphere k from height ``z_lo`` to ``z_hi`` (radius ``x_hi`` there); split at the equator if crossed."""
     name = f"sphere{k}"
     segs = []
     if z_lo < zc < z_hi:
@@ -170,7 +170,7 @@ def chain_profile(radii, overlaps):
             else _bad_overlap(k, overlaps[k]) for k in range(overlaps.size)]
     centres = np.concatenate(([0.0], np.cumsum([float(g.d) for g in geos])))
     segments, corners, necks = [], [], []
-    z_lo, x_lo = 0.0, radii[0]
+    z_lo = 0.0
     for k, r in enumerate(radii):
         zc = centres[k]
         if k < len(geos):
@@ -182,7 +182,7 @@ def chain_profile(radii, overlaps):
         else:
             z_hi, x_hi = zc, r
         _check_arc(k, r, z_lo, z_hi)
-        segments += _sphere_segments(k, r, zc, z_lo, z_hi, x_lo, x_hi)
+        segments += _sphere_segments(k, r, zc, z_lo, z_hi, x_hi)
         if k < len(geos):
             z_top_neck = centres[k + 1] - float(geos[k].z_j)
             if not z_top_neck > z_hi:
@@ -190,7 +190,7 @@ def chain_profile(radii, overlaps):
             segments.append(("line", (a, z_top_neck), f"neck{k}"))
             corners += [(a, z_hi), (a, z_top_neck)]
             necks.append((a, z_hi, z_top_neck))
-            z_lo, x_lo = z_top_neck, a
+            z_lo = z_top_neck
     return (radii[0], 0.0), segments, np.array(corners), necks
 
 
