@@ -2,7 +2,7 @@
 
 :func:`load_scene` reads a file path or a built-in name (``dem/scenes/*.toml``); :func:`parse_scene` validates a
 TOML document (a dict) into a :class:`Scene`; :func:`make_scene` builds one from explicit arrays. The schema is
-documented in ``dem/SCHEMA.md``. Every problem raises ``ValueError`` naming the table and key (and, for malformed
+documented in the README (section "Scene schema"). Every problem raises ``ValueError`` naming the table and key (and, for malformed
 TOML, the line).
 """
 
@@ -311,7 +311,7 @@ def _spec(cls, table, section, numeric=(), integer=()):
 
 
 def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None) -> Scene:
-    """Validate a parsed TOML document into a :class:`Scene` (schema: ``dem/SCHEMA.md``)."""
+    """Validate a parsed TOML document into a :class:`Scene` (schema: README, "Scene schema")."""
     top = set(ALLOWED) | {"materials"}
     unknown = sorted(set(doc) - top)
     if unknown:
