@@ -424,7 +424,8 @@ def render_cluster(fe: dict, path: pathlib.Path, title: str) -> pathlib.Path:
                                     mesh.p.T * 1e3)
     grid.point_data["T (K)"] = fe["sol"].u[:nv]
     plotter = pyvista.Plotter(off_screen=True, window_size=(900, 700))
-    plotter.add_mesh(grid.extract_surface(), scalars="T (K)", cmap="coolwarm", show_edges=False,
+    plotter.add_mesh(grid.extract_surface(algorithm="dataset_surface"), scalars="T (K)", cmap="coolwarm",
+                     show_edges=False,
                      scalar_bar_args={"title": "T (K)"})
     plotter.add_text(title, font_size=10)
     plotter.view_isometric()
