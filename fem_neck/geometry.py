@@ -161,38 +161,48 @@ def _z_and_slope(a, r_i, r_j, h):
 
 
 def _validated(r_i, r_j, h):
+    """Checked, broadcast input in units of the smaller radius, and that radius (the length scale).
+
+    The model is scale-free; working in units of ``min(r_i, r_j)`` keeps squares of lengths representable for
+    any radius a float can hold.
+    """
     r_i = check_positive("r_i", r_i)
     r_j = check_positive("r_j", r_j)
     h = np.asarray(h, dtype=float)
     if not (h.ndim == 0 and r_i.ndim == 0 and r_j.ndim == 0):
         r_i, r_j, h = np.broadcast_arrays(r_i, r_j, h)
-    h_max = max_overlap(r_i, r_j)
+    scale = np.minimum(r_i, r_j)
+    r_i, r_j, h_s = r_i / scale, r_j / scale, h / scale  # x / x is exactly 1: the smaller radius is exactly 1
+    r_max = np.maximum(r_i, r_j)
+    h_max = 1.0 / 3.0 + _phi(cap_height(r_max, 1.0), r_max)  # max_overlap in these units (smaller radius 1)
     # An overlap at the limit computed in another way may exceed h_max by round-off: that is the limit itself.
-    h = check_positive("h", h, upper=h_max * (1.0 + _LIMIT_SLACK), upper_name="the neck reaches the smaller radius")
-    return r_i, r_j, np.minimum(h, h_max)
+    h_limit = h_max * (1.0 + _LIMIT_SLACK)
+    if not np.all((h_s > 0.0) & (h_s <= h_limit)):  # False for NaN too
+        check_positive("h", h, upper=h_limit * scale, upper_name="the neck reaches the smaller radius")
+    return r_i, r_j, np.minimum(h_s, h_max), scale
 
 
 def _solve(r_i, r_j, h, method):
-    """Neck radius and Newton iteration count for validated, broadcast inputs (Rojek 2022, eqs. 32-34)."""
+    """Neck radius and Newton iteration count (Rojek 2022, eqs. 32-34) for the output of :func:`_validated`."""
     a = coble_radius(r_i, r_j, h)
     if method == "coble":
         return a, 0
-    r_min = np.minimum(r_i, r_j)
-    # Coble's radius may lie beyond the smaller sphere, where eqs. (28)-(29) have no answer: start at r_min there.
-    a = np.minimum(a, r_min)
+    # Lengths are in units of the smaller radius (see _validated), so the bracket's right end is a = 1. Coble's
+    # radius may lie beyond it, where eqs. (28)-(29) have no answer: start at 1 there.
+    a = np.minimum(a, 1.0)
     for iterations in range(1, _MAX_ITERATIONS + 1):
         z, slope = _z_and_slope(a, r_i, r_j, h)
         if iterations == 1:
             if method == "first":  # eq. (34)
                 return a - z / slope, 1
             # Bracketing fallback: Newton descends monotonically onto the root only from its right (Z >= 0);
-            # a start on the left is replaced by the bracket's right end, r_min, where Z >= 0 within the range.
+            # a start on the left is replaced by the bracket's right end, where Z >= 0 within the range.
             left = z < 0.0
             if np.any(left):
-                a = np.where(left, r_min, a)
+                a = np.where(left, 1.0, a)
                 z, slope = _z_and_slope(a, r_i, r_j, h)
         step = np.divide(z, slope, out=np.zeros_like(z), where=slope > 0.0)
-        a = np.minimum(a - step, r_min)  # at the range's end round-off may step past the smaller radius
+        a = np.minimum(a - step, 1.0)  # at the range's end round-off may step past the smaller radius
         # Quadratic convergence: after a relative step s the error is ~ s^2 (measured: 3.4e-8 -> 4e-15), so a
         # step below 1e-8 leaves the root at round-off and one more iteration would change nothing.
         if np.all(np.abs(step) <= _STEP_TOL * a):
@@ -209,8 +219,8 @@ def neck_radius(r_i, r_j, h, method: str = "newton"):
     """
     if method not in METHODS:
         raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
-    r_i, r_j, h = _validated(r_i, r_j, h)
-    a, _ = _solve(r_i, r_j, h, method)
+    r_i, r_j, h, scale = _validated(r_i, r_j, h)
+    a = _solve(r_i, r_j, h, method)[0] * scale
     return float(a) if np.ndim(a) == 0 else a
 
 
@@ -218,14 +228,17 @@ def neck_geometry(r_i, r_j, h, method: str = "newton") -> NeckGeometry:
     """All of the neck geometry (Rojek 2022, eqs. 21-29); see :class:`NeckGeometry`."""
     if method not in METHODS:
         raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
-    r_i, r_j, h = _validated(r_i, r_j, h)
+    r_i, r_j, h, scale = _validated(r_i, r_j, h)
     a, iterations = _solve(r_i, r_j, h, method)
     h_ci = cap_height(r_i, a)
     h_cj = cap_height(r_j, a)
     h_n = h_ci + h_cj - h
     # |V_cyl - V_caps| / V_cyl = |Z| / (3 a^2 h_n) = |G| / h_n  (eq. 27 divided by 3 a^2)
     residual = np.abs(_phi(h_ci, r_i) + _phi(h_cj, r_j) - h) / np.abs(h_n)
+    z_i = np.sqrt((r_i - a) * (r_i + a))
+    z_j = np.sqrt((r_j - a) * (r_j + a))
     return NeckGeometry(
-        r_i=r_i, r_j=r_j, h=h, a=a, h_ci=h_ci, h_cj=h_cj, h_n=h_n, d=r_i + r_j - h,
-        z_i=np.sqrt((r_i - a) * (r_i + a)), z_j=np.sqrt((r_j - a) * (r_j + a)), volume_residual=residual, iterations=iterations, method=method,
+        r_i=r_i * scale, r_j=r_j * scale, h=h * scale, a=a * scale, h_ci=h_ci * scale, h_cj=h_cj * scale,
+        h_n=h_n * scale, d=(r_i + r_j - h) * scale, z_i=z_i * scale, z_j=z_j * scale, volume_residual=residual,
+        iterations=iterations, method=method,
     )

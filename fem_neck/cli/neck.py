@@ -1,7 +1,7 @@
 """``python -m fem_neck neck``: the neck of two sintered spheres (Rojek 2022, Section 4)."""
 
 from fem_neck.cli import add_output_options
-from fem_neck.geometry import METHODS, coble_radius, neck_geometry
+from fem_neck.geometry import METHODS, neck_geometry, neck_radius
 
 
 def register(subparsers) -> None:
@@ -22,7 +22,7 @@ def register(subparsers) -> None:
 
 def run(args) -> dict:
     geo = neck_geometry(args.ri, args.rj, args.h, method=args.method)
-    a_coble = float(coble_radius(geo.r_i, geo.r_j, geo.h))
+    a_coble = neck_radius(args.ri, args.rj, args.h, method="coble")
     result = {
         "method": args.method,
         "r_i": args.ri,
