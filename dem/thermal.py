@@ -116,12 +116,18 @@ class Network:
 
     def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
         """Sum of the absolute heat flows into or out of each free particle through its boundaries (W): the scale
-        of the energy balance (hot and cold ends do not cancel in it)."""
-        total = np.abs(self.fixed_rhs - self.fixed_diag * T_F) + np.abs(self.wall_rhs - self.wall_diag * T_F)
-        total = total + np.abs(self.heat)
-        for g, b in sinks.values():
-            total = total + np.abs(b - g * T_F)
-        return float(total.sum())
+        of the energy balance (hot and cold ends do not cancel in it).
+
+        Each flow is a difference of terms ``K T``. Where (almost) no heat flows, the flows are the round-off of
+        those terms and a balance relative to them means nothing, so the scale is never taken below
+        ``sqrt(eps) sum |K T|``: temperature differences below ~1e-8 of the temperatures count as no flow.
+        """
+        pairs = [(self.fixed_diag, self.fixed_rhs), (self.wall_diag, self.wall_rhs), *sinks.values()]  # (g, b)
+        net = gross = float(np.abs(self.heat).sum())
+        for g, b in pairs:
+            net += float(np.abs(b - g * T_F).sum())
+            gross += float(np.abs(b).sum() + np.abs(g * T_F).sum())
+        return float(max(net, np.sqrt(np.finfo(float).eps) * gross))
 
     def full(self, T_F: np.ndarray) -> np.ndarray:
         T = self.particles.temperature.copy()

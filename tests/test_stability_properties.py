@@ -96,11 +96,9 @@ def test_steady_within_fixed_range_or_explained(scene, n_fixed):
     assert res.T.min() >= fixed_T.min() - 1e-8 * span
     assert res.T.max() <= fixed_T.max() + 1e-8 * span
     flow_scale = float(net.K_pairs.sum()) * span
-    assert abs(sum(res.flows.values())) <= 1e-10 * flow_scale  # energy balance (see the xfail test below)
+    assert abs(sum(res.flows.values())) <= 1e-10 * flow_scale  # energy balance
 
 
-@pytest.mark.xfail(reason="dem.thermal.steady: energy_error is |sum of flows| / sum |flows|, which is 1.0 when every "
-                          "flow is round-off (one fixed temperature, no heat flowing)", strict=False)
 def test_steady_energy_error_without_heat_flow():
     net = make_network(seed=0, shape=(1, 1, 4), vacancy=0.0, n_fixed=1)
     assert steady(net).energy_error < 1e-8
