@@ -1,7 +1,6 @@
 """Fast stress cases from ``verification.stability`` (the full suite: ``python -m verification stability``).
 
-Known defects found by the suite are kept here as ``xfail`` with the reason, so that they stay visible and turn into
-passes (XPASS) once fixed.
+Known defects found by the suite were kept here as ``xfail`` until fixed; none is open.
 """
 
 import pathlib
@@ -30,9 +29,6 @@ def test_cli_bad_input_is_one_line_exit_2(argv):
     assert case.passed, case.outcome
 
 
-@pytest.mark.xfail(reason="fem_neck.geometry.max_overlap/cap_height square the radii: radii ~1e300 overflow, "
-                          "RuntimeWarnings reach stderr and the message says 'valid range 0 < h <= nan'",
-                   strict=False)
 def test_neck_cli_huge_radii():
     case = cli_case("huge radii", ["fem_neck", "neck", "--ri", "1e300", "--rj", "1e300", "--h", "1e299", "--json"],
                     "either")
@@ -55,8 +51,6 @@ def test_dem_generator_huge_n_refused(tmp_path: pathlib.Path):
     assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr[-300:]
 
 
-@pytest.mark.xfail(reason="fem_neck.cli.main catches only ValueError: --out naming an existing file raises "
-                          "FileExistsError (traceback, exit 1) in python -m fem_neck and python -m dem", strict=False)
 @pytest.mark.parametrize("argv", [["fem_neck", "semisphere", "--h-over-r", "0.2"], ["dem", "run", "pair"]])
 def test_out_is_an_existing_file(tmp_path: pathlib.Path, argv):
     afile = tmp_path / "afile"

@@ -3,7 +3,7 @@
 Each sub-command lives in its own module of this package and exposes ``register(subparsers)``, which adds its
 parser and sets ``run``: a function of the parsed arguments returning a JSON-ready dict. :func:`main` prints that
 dict (``--json``: one object on stdout, nothing else), turns a ``ValueError`` into one line on stderr with exit code
-2, and never shows a traceback for bad input.
+2, and never shows a traceback for bad input (an ``OSError``, e.g. ``--out`` naming a file, is treated the same).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import os
 import re
 import sys
 
-COMMAND_MODULES = ("neck", "solve", "converge", "fit", "unequal")  # each module imports its heavy dependencies (gmsh, scikit-fem) inside run()
+COMMAND_MODULES = ("neck", "solve", "converge", "fit", "unequal", "cluster")  # each module imports its heavy dependencies (gmsh, scikit-fem) inside run()
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -89,7 +89,7 @@ def main(argv=None, *, prog="python -m fem_neck", description=None, modules=COMM
     args = parser.parse_args(argv)
     try:
         result = args.run(args)
-    except ValueError as exc:
+    except (ValueError, OSError) as exc:  # bad input, or an output path that cannot be written
         sys.stderr.write(f"{prog} {args.command}: error: {exc}\n")
         return 2
     print_result(result, args.json)
