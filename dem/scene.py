@@ -340,11 +340,26 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     conv = _spec(Convection, doc["convection"], "convection", numeric=("h", "T_inf")) if "convection" in doc else None
     rad = (_spec(Radiation, doc["radiation"], "radiation", numeric=("emissivity", "T_inf"))
            if "radiation" in doc else None)
+    if rad is not None:
+        _check_above_absolute_zero(rad, particles.temperature, walls)
     solver = _spec(SolverSpec, doc.get("solver", {}), "solver", numeric=("dt", "t_end", "rtol"),
                    integer=("max_steps",))
     output = _spec(OutputSpec, doc.get("output", {}), "output", integer=("every", "vtu_every"))
     return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
                  str(meta.get("name", source)), str(meta.get("description", "")), specimen)
+
+
+def _check_above_absolute_zero(rad: Radiation, temperature: np.ndarray, walls) -> None:
+    """Radiation works in absolute temperature: every prescribed temperature must be at or above 0 K."""
+    named = [("particles.temperature", np.asarray(temperature, dtype=float))]
+    named += [(f"walls.{w.name}.temperature", np.asarray([w.temperature], dtype=float)) for w in walls]
+    for name, values in named:
+        below = np.flatnonzero(rad.kelvin(values) < 0.0)
+        if below.size:
+            k = int(below[0])
+            where = f"[{k}]" if name == "particles.temperature" else ""
+            raise ValueError(f"{name}{where} = {values[k]:g} {rad.unit}: below absolute zero "
+                             f"(radiation.unit = {rad.unit!r}); valid range >= {-rad.kelvin(0.0):g} {rad.unit}")
 
 
 def builtin_scenes() -> dict:

@@ -59,6 +59,8 @@ BAD = {
     "steady no fixed": (lambda t: t.replace('mode = "transient"', 'mode = "steady"'), "singular"),
     "coincident": (lambda t: t.replace("3.94e-3]]", "0.0]]"), "beyond"),
     "too many steps": (lambda t: t.replace("t_end = 0.1", "t_end = 1.0e9"), "max_steps"),
+    "below absolute zero": (lambda t: t.replace("temperature = [100.0", "temperature = [-400.0")
+                            + '\n[radiation]\nemissivity = 0.5\nT_inf = 20.0\nunit = "C"\n', "absolute zero"),
 }
 
 

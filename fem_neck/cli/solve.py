@@ -23,9 +23,12 @@ def model_bond_conductance(kappa: float, a):
 
 def _floats(name: str, text: str) -> list:
     try:
-        return [float(v) for v in text.split(",") if v.strip()]
+        values = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
         raise ValueError(f"{name} = {text!r}: must be comma-separated numbers") from None
+    if not values:
+        raise ValueError(f"{name} = {text!r}: must list at least one number")
+    return values
 
 
 def _add_accuracy(p) -> None:
