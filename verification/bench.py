@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fem_neck.geometry import coble_radius, max_overlap, neck_radius
+from verification.report import md_table as report_table
 
 # shared/reference/README.md, "Semisphere with a cylindrical neck": independent hp-FE (curved elements, p <= 14),
 # energy upper bound and dual lower bound agree to ~1e-12. Keys h/r -> (a/r, K/K_cyl).
@@ -127,21 +128,11 @@ def _jsonable(value):
 
 
 def md_table(rows: list[dict], columns: list[str] | None = None, fmt: str = "{:.4g}") -> str:
-    """A markdown table of ``rows`` (floats formatted with ``fmt``)."""
+    """A markdown table of dict ``rows`` (columns: given, or every key in order of appearance)."""
     if not rows:
         return "(no rows)"
     columns = columns or list(dict.fromkeys(k for row in rows for k in row))
-
-    def cell(v):
-        if v is None:
-            return "–"
-        if isinstance(v, (float, np.floating)):
-            return fmt.format(v)
-        return str(v)
-
-    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    lines += ["| " + " | ".join(cell(row.get(c)) for c in columns) + " |" for row in rows]
-    return "\n".join(lines)
+    return report_table(columns, [[row.get(c) for c in columns] for row in rows], fmt)
 
 
 def verdict(value, target) -> str:

@@ -108,14 +108,9 @@ def run(args) -> dict:
     from tqdm import tqdm
 
     from fem_neck import conduction
-    from fem_neck.geometry import check_positive, equal_neck_radius, overlap_for_neck
+    from fem_neck.cli.solve import semisphere_case
 
-    if args.h_over_r is not None:
-        h = float(check_positive("h_over_r", args.h_over_r, upper=2.0 / 3.0, upper_name="the neck reaches r"))
-        a = float(equal_neck_radius(1.0, h))
-    else:
-        a = float(check_positive("a_over_r", args.a_over_r, upper=1.0, upper_name="the neck reaches r"))
-        h = float(overlap_for_neck(1.0, 1.0, a))
+    h, a = semisphere_case(args)
     try:
         reference = conduction.semisphere_conductance(a, rtol=1e-7)
         with tqdm(total=sum(len(GRADINGS if s[2] else UNIFORM_SIZES) for s in SERIES), desc="converge",

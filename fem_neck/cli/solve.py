@@ -104,16 +104,21 @@ def _accuracy_fields(result) -> dict:
             "order": result.order, "grading": result.grading, "h_min": result.h_min, "seconds": result.seconds}
 
 
-def run_semisphere(args) -> dict:
-    from fem_neck import conduction
+def semisphere_case(args) -> tuple[float, float]:
+    """``(h/r, a/r)`` of the semisphere from ``--h-over-r`` or ``--a-over-r`` (eqs. 19-20 and their inverse)."""
     from fem_neck.geometry import check_positive, equal_neck_radius, overlap_for_neck
 
     if args.h_over_r is not None:
         h = float(check_positive("h_over_r", args.h_over_r, upper=2.0 / 3.0, upper_name="the neck reaches r"))
-        a = float(equal_neck_radius(1.0, h))
-    else:
-        a = float(check_positive("a_over_r", args.a_over_r, upper=1.0, upper_name="the neck reaches r"))
-        h = float(overlap_for_neck(1.0, 1.0, a))
+        return h, float(equal_neck_radius(1.0, h))
+    a = float(check_positive("a_over_r", args.a_over_r, upper=1.0, upper_name="the neck reaches r"))
+    return float(overlap_for_neck(1.0, 1.0, a)), a
+
+
+def run_semisphere(args) -> dict:
+    from fem_neck import conduction
+
+    h, a = semisphere_case(args)
     result = _mesh_errors_as_value_errors(
         lambda: conduction.semisphere_conductance(a, rtol=args.rtol, order=args.order))
     summary = {"h_over_r": h, "a_over_r": a, "K_over_Kcyl": result.K_over_Kcyl, **_accuracy_fields(result)}
