@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fem_neck.geometry import coble_radius, max_overlap, neck_radius
+from verification.report import jsonable
 from verification.report import md_table as report_table
 
 # shared/reference/README.md, "Semisphere with a cylindrical neck": independent hp-FE (curved elements, p <= 14),
@@ -114,17 +115,11 @@ class Report:
     def flush(self) -> None:
         self.out_dir.mkdir(parents=True, exist_ok=True)
         (self.out_dir / f"{self.name}.md").write_text(f"# {self.title}\n\n{self.markdown}")
-        (self.out_dir / f"{self.name}.json").write_text(json.dumps(self.summary, indent=1, default=_jsonable))
+        (self.out_dir / f"{self.name}.json").write_text(json.dumps(jsonable(self.summary), indent=1))
 
     def result(self) -> dict:
         self.flush()
         return {"title": self.title, "markdown": self.markdown, "summary": self.summary, "figures": self.figures}
-
-
-def _jsonable(value):
-    if isinstance(value, np.generic):
-        return value.item()
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
 
 
 def md_table(rows: list[dict], columns: list[str] | None = None, fmt: str = "{:.4g}") -> str:
