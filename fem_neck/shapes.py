@@ -166,8 +166,7 @@ def chain_profile(radii, overlaps):
         raise ValueError(f"radii: need at least 2 spheres, got {radii.size}")
     if overlaps.shape != (radii.size - 1,):
         raise ValueError(f"overlaps: need {radii.size - 1} values (one per bond), got {overlaps.size}")
-    geos = [neck_geometry(radii[k], radii[k + 1], overlaps[k]) if np.isfinite(overlaps[k]) and overlaps[k] > 0
-            else _bad_overlap(k, overlaps[k]) for k in range(overlaps.size)]
+    geos = [_bond_geometry(radii, overlaps, k) for k in range(overlaps.size)]
     centres = np.concatenate(([0.0], np.cumsum([float(g.d) for g in geos])))
     segments, corners, necks = [], [], []
     z_lo = 0.0
@@ -194,8 +193,14 @@ def chain_profile(radii, overlaps):
     return (radii[0], 0.0), segments, np.array(corners), necks
 
 
-def _bad_overlap(k, value):
-    raise ValueError(f"overlaps[{k}] = {value:.9g}: must be finite and > 0")
+def _bond_geometry(radii, overlaps, k):
+    """The neck of bond ``k``; a bad overlap is reported as ``overlaps[k]`` with the bond's valid range."""
+    try:
+        return neck_geometry(radii[k], radii[k + 1], overlaps[k])
+    except ValueError as exc:
+        reason = str(exc).split(": ", 1)[-1]
+        raise ValueError(f"overlaps[{k}] = {overlaps[k]:.9g} (radii {radii[k]:.6g}, {radii[k + 1]:.6g}): "
+                         f"{reason.replace('0 < h', '0 < overlap')}") from None
 
 
 # ---------------------------------------------------------------------------------------------------------------
