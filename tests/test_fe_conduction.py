@@ -184,3 +184,15 @@ def test_estimate_is_honest_over_the_range(rtol):
         res = conduction.semisphere_conductance(a_over_r, rtol=rtol)
         assert res.converged and res.error_estimate <= rtol
         assert abs(res.K - fine.K) / fine.K <= 3.0 * res.error_estimate + fine.error_estimate
+
+
+@pytest.mark.parametrize("overlaps, match", [
+    ([1e-4, 3e-4], r"overlaps\[1\] = 0\.0003 \(radii 0\.003, 0\.0005\): valid range 0 < overlap <= 0\.000"),
+    ([-1e-4, 1e-4], r"overlaps\[0\] = -0\.0001"),
+    ([1e-4, float("nan")], r"overlaps\[1\] = nan"),
+])
+def test_chain_names_the_bad_bond(overlaps, match):
+    from fem_neck.conduction import chain_conductance
+
+    with pytest.raises(ValueError, match=match):
+        chain_conductance([1e-3, 3e-3, 0.5e-3], overlaps, kappa=394.0)
