@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fem_neck.geometry import coble_radius, max_overlap, neck_radius
-from verification.report import jsonable
+from verification.report import jsonable, save_figure
 from verification.report import md_table as report_table
 
 # shared/reference/README.md, "Semisphere with a cylindrical neck": independent hp-FE (curved elements, p <= 14),
@@ -94,12 +94,8 @@ class Report:
         return path
 
     def figure(self, fig, stem: str) -> pathlib.Path:
-        import matplotlib.pyplot as plt
-
         self.out_dir.mkdir(parents=True, exist_ok=True)
-        path = self.out_dir / f"{stem}.png"
-        fig.savefig(path, dpi=110, bbox_inches="tight")
-        plt.close(fig)
+        path = save_figure(fig, self.out_dir / f"{stem}.png", bbox_inches="tight")
         self.figures.append(str(path))
         return path
 

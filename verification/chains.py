@@ -28,7 +28,7 @@ from matplotlib.figure import Figure
 
 from dem import COPPER
 from fem_neck.geometry import overlap_for_neck
-from verification.report import md_table
+from verification.report import md_table, save_figure
 
 TITLE = "DEM against FE: collinear chains"
 LAWS = ("rojek", "argento-bouvard", "fit", "zohdi")
@@ -123,9 +123,7 @@ def _figure(rows, out_dir: pathlib.Path) -> pathlib.Path:
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    path = out_dir / "chains_dem_vs_fe.png"
-    fig.savefig(path, dpi=120)
-    return path
+    return save_figure(fig, out_dir / "chains_dem_vs_fe.png", dpi=120)
 
 
 def run(out_dir: pathlib.Path, quick: bool = False) -> dict:

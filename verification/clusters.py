@@ -40,6 +40,7 @@ import numpy as np
 
 from fem_neck.cluster import Cluster, Terminal, build_cluster_mesh, solve_cluster
 from fem_neck.geometry import overlap_for_neck
+from verification.report import save_figure
 
 KAPPA = 394.0
 R0 = 1.0e-3
@@ -386,10 +387,7 @@ def _figures(rows, particles, out_dir: pathlib.Path, names) -> list:
     axes[0].set_ylabel("K_DEM / K_FE - 1  (%)")
     axes[0].legend(fontsize=7)
     fig.tight_layout()
-    path = out_dir / "clusters_K_error.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    figs.append(path)
+    figs.append(save_figure(fig, out_dir / "clusters_K_error.png"))
 
     fig, axes = plt.subplots(1, len(names), figsize=(4 * len(names), 3.6), layout="constrained")
     for ax, law in zip(axes, names):
@@ -405,10 +403,7 @@ def _figures(rows, particles, out_dir: pathlib.Path, names) -> list:
     axes[0].set_ylabel("(T_DEM - T_FE) / dT  (%)")
     if particles:
         fig.colorbar(sc, ax=axes, label="particle mean a/r", shrink=0.8)
-    path = out_dir / "clusters_T_error_map.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    figs.append(path)
+    figs.append(save_figure(fig, out_dir / "clusters_T_error_map.png"))
     return figs
 
 

@@ -38,7 +38,7 @@ from fem_neck.geometry import (
     overlap_for_neck,
 )
 from verification import cases
-from verification.report import md_table
+from verification.report import md_table, save_figure
 
 TITLE = "Paper reproduction: Rojek, Kasztelan & Tharmaraj 2022"
 DPI = 120
@@ -61,11 +61,6 @@ def compare(ours: float, ref: cases.Reference, **extra) -> dict:
 
 def _pct(x: float) -> str:
     return f"{100.0 * x:+.3g} %"
-
-
-def _save(fig: Figure, path: pathlib.Path) -> pathlib.Path:
-    fig.savefig(path, dpi=DPI)
-    return path
 
 
 # --- Figs. 6 and 7: equal spheres ---------------------------------------------------------------------------------------
@@ -93,7 +88,7 @@ def neck_equal(out_dir: pathlib.Path) -> Part:
     ax2.set(xlabel="a / r (volume-conserving)", ylabel="Coble error [%]",
             title="Fig. 7: per cent error of Coble's neck radius")
     ax2.grid(alpha=0.3)
-    fig_path = _save(fig, out_dir / "fig06_07_equal_necks.png")
+    fig_path = save_figure(fig, out_dir / "fig06_07_equal_necks.png", dpi=DPI)
 
     rows = []
     for hr in (0.005, 0.02, 0.08, 0.2, 0.4, 0.6, 2.0 / 3.0):
@@ -172,7 +167,7 @@ def neck_sec43(out_dir: pathlib.Path) -> Part:
     ax2.set(xlabel="a [mm]", ylabel="Z [mm³]", title="Fig. 9b: zoom, Newton from Coble's radius")
     ax2.legend(fontsize=8)
     ax2.grid(alpha=0.3)
-    fig_path = _save(fig, out_dir / "fig09_newton.png")
+    fig_path = save_figure(fig, out_dir / "fig09_newton.png", dpi=DPI)
 
     md = "\n".join([
         "### Sec. 4.3 and Fig. 9 — neck of the unequal pair r_i = 1 mm, r_j = 3 mm, h = 0.2 mm",
@@ -207,7 +202,7 @@ def neck_unequal(out_dir: pathlib.Path) -> Part:
     for ax in (ax1, ax2):
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
-    fig_path = _save(fig, out_dir / "fig10_11_unequal_necks.png")
+    fig_path = save_figure(fig, out_dir / "fig10_11_unequal_necks.png", dpi=DPI)
 
     levels = (0.2, 0.4, 0.6, 0.8)
     rows, coble_err, first_err = [], [], []
@@ -317,7 +312,7 @@ def convergence_fig15(out_dir: pathlib.Path, quick: bool) -> Part:
            title=f"Fig. 15 analogue: default solver, h/r = {hr:g}, a/r = {a:.6f}")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
-    figures = [_save(fig, out_dir / "fig15_tolerance_ladder.png")]
+    figures = [save_figure(fig, out_dir / "fig15_tolerance_ladder.png", dpi=DPI)]
     md = [
         f"### Fig. 15 — convergence at h/r = {hr:g} (a/r = {a:.6f})",
         "",

@@ -218,6 +218,16 @@ def run_sections(names, out_dir: pathlib.Path, command: str, quick: bool = False
     return report
 
 
+def save_figure(fig, path: pathlib.Path, dpi: int = 110, **savefig_options) -> pathlib.Path:
+    """Write ``fig`` as a PNG at ``path`` and release it (pyplot figures are closed; a bare ``Figure`` needs
+    nothing); returns ``path``."""
+    import matplotlib.pyplot as plt
+
+    fig.savefig(path, dpi=dpi, **savefig_options)
+    plt.close(fig)
+    return path
+
+
 def md_table(header, rows, fmt: str = "{:.6g}") -> str:
     """A markdown table; floats are written with ``fmt``, ``None`` as an em dash, anything else with ``str``."""
 

@@ -29,6 +29,7 @@ import numpy as np
 
 from fem_neck.geometry import overlap_for_neck
 from fem_neck.transient import first_decay_rate, lumped_pair, pair_mesh, solve_transient, time_grid
+from verification.report import save_figure
 
 KAPPA, RHO, CP = 394.0, 8960.0, 385.0
 T_FRACTIONS = (0.001, 0.01, 0.1, 1.0, 3.0)
@@ -152,10 +153,7 @@ def _figures(results, out_dir: pathlib.Path) -> list:
     for ax in (ax1, ax2):
         ax.grid(alpha=0.3)
     fig.tight_layout()
-    path = out_dir / "transient_pair_curves.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    figs.append(path)
+    figs.append(save_figure(fig, out_dir / "transient_pair_curves.png"))
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
     for ax, fam in zip(axes, ("unequal", "equal")):
@@ -176,10 +174,7 @@ def _figures(results, out_dir: pathlib.Path) -> list:
         fig.colorbar(mesh, ax=ax, label="% of initial difference")
     axes[0].set_ylabel("a / r (smaller sphere)")
     fig.tight_layout()
-    path = out_dir / "transient_error_map.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    figs.append(path)
+    figs.append(save_figure(fig, out_dir / "transient_error_map.png"))
 
     fig, ax = plt.subplots(figsize=(6, 4))
     names = list(results[0][1]["metrics"])
@@ -197,10 +192,7 @@ def _figures(results, out_dir: pathlib.Path) -> list:
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    path = out_dir / "transient_rate_error.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    figs.append(path)
+    figs.append(save_figure(fig, out_dir / "transient_rate_error.png"))
     return figs
 
 
