@@ -40,6 +40,22 @@ def add_output_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", metavar="DIR", default=None, help="write result files into DIR")
 
 
+def _worker_count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"workers = {text!r}: must be an integer >= 1") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"workers = {value!r}: must be >= 1")
+    return value
+
+
+def add_workers_option(parser: argparse.ArgumentParser) -> None:
+    """``--workers W``: processes of a parallel sweep (default: all cores), checked to be >= 1."""
+    parser.add_argument("--workers", type=_worker_count, default=None, metavar="W",
+                        help="processes (default: all cores)")
+
+
 def _format(value) -> str:
     if isinstance(value, float):
         return f"{value:.10g}"

@@ -6,7 +6,7 @@ Writes fit.json (the file the DEM's ``fit`` law reads), fit.csv (written point b
 
 from __future__ import annotations
 
-from fem_neck.cli import add_output_options
+from fem_neck.cli import add_output_options, add_workers_option
 
 
 def register(subparsers) -> None:
@@ -17,7 +17,7 @@ def register(subparsers) -> None:
                    help="number of FE points (>= 4; default 40: 5 log-spaced on [0.001, 0.02), 35 uniform on "
                         "(0, 0.97])")
     p.add_argument("--rtol", type=float, default=1e-4, help="relative tolerance of each FE point (default 1e-4)")
-    p.add_argument("--workers", type=int, default=None, metavar="W", help="processes (default: all cores)")
+    add_workers_option(p)
     add_output_options(p)
     p.set_defaults(run=run, out="results/fit")
 
@@ -25,8 +25,6 @@ def register(subparsers) -> None:
 def run(args) -> dict:
     from fem_neck.fit import run_fit
 
-    if args.workers is not None and args.workers < 1:
-        raise ValueError(f"workers = {args.workers!r}: must be >= 1")
     result = run_fit(args.points, args.rtol, args.out, workers=args.workers)
     return {"slope": result["slope"], "sampling": result["sampling"], "points": result["points"],
             "law": result["law"], "slope_sensitivity": result["slope_sensitivity"],

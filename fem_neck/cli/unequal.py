@@ -5,7 +5,7 @@ Writes unequal.json, unequal.csv and unequal.png into --out (default: results/un
 
 from __future__ import annotations
 
-from fem_neck.cli import add_output_options
+from fem_neck.cli import add_output_options, add_workers_option
 
 
 def register(subparsers) -> None:
@@ -18,7 +18,7 @@ def register(subparsers) -> None:
     p.add_argument("--necks", default=",".join(f"{x:g}" for x in NECKS), metavar="X1,X2,...",
                    help="neck radii a/r_i in [0.001, 0.99] (default %(default)s)")
     p.add_argument("--rtol", type=float, default=1e-4, help="relative tolerance of each FE solve (default 1e-4)")
-    p.add_argument("--workers", type=int, default=None, metavar="W", help="processes (default: all cores)")
+    add_workers_option(p)
     add_output_options(p)
     p.set_defaults(run=run, out="results/unequal")
 
@@ -26,7 +26,5 @@ def register(subparsers) -> None:
 def run(args) -> dict:
     from fem_neck.unequal import study
 
-    if args.workers is not None and args.workers < 1:
-        raise ValueError(f"workers = {args.workers!r}: must be >= 1")
     result = study(args.ratios.split(","), args.necks.split(","), args.rtol, args.out, workers=args.workers)
     return {k: v for k, v in result.items() if k != "cases"} | {"out": str(args.out)}
