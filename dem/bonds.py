@@ -35,7 +35,6 @@ from scipy.spatial import cKDTree
 from fem_neck.geometry import max_overlap, neck_radius
 
 from dem.particles import Particles
-from dem.sources import Wall
 
 CONTACT_MODELS = ("newton", "first", "coble", "lens")
 OUT_OF_RANGE = ("error", "clip", "drop")

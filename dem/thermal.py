@@ -26,7 +26,6 @@ of ``sum C_i T_i`` must match it to round-off; the relative mismatch is ``energy
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, field
 
 import numpy as np

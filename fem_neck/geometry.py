@@ -61,15 +61,6 @@ class NeckGeometry:
     iterations: int
     method: str
 
-    def as_dict(self) -> dict:
-        """Plain-Python dict (floats or lists), ready for JSON."""
-        out = {}
-        for key, value in self.__dict__.items():
-            if isinstance(value, np.ndarray):
-                value = value.item() if value.ndim == 0 else value.tolist()
-            out[key] = value
-        return out
-
 
 def check_positive(name: str, value, upper=None, upper_name: str | None = None) -> np.ndarray:
     """Return ``value`` as a float array, raising ``ValueError`` unless every entry is finite and ``> 0``.

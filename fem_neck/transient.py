@@ -57,7 +57,6 @@ def pair_mesh(r_i: float, r_j: float, h: float, grading: float = 0.3, size_max: 
     The size grows linearly with the distance ``s`` to the two neck corners, ``min(size_max r_min, size_min m +
     grading s)`` with ``m = min(a, h_n)``; single-threaded gmsh (deterministic).
     """
-    import gmsh
     from skfem import MeshTri1
 
     from fem_neck.shapes import gmsh_session
