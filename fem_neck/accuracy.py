@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from fem_neck.hpmesh import SIGMA
+
 # Conservative exponent of the order p-1 error in the grading factor (observed on the reference semispheres:
 # P1 ~2, P2 3-4, P3 4.5-6), and the grading that meets the reference tolerance in one round.
 RATE = {2: 2.0, 3: 3.0, 4: 4.5}
@@ -90,3 +92,34 @@ def solve_to_tolerance(solve_pair, rtol: float, order: int):
             break
         grading = next_grading(grading, rtol, estimate, order)
     return (*best, False)
+
+
+# The hp path (fem_neck.hpmesh + fem_neck.spectral): one geometric mesh, the order raised until two consecutive
+# orders agree. Measured on a/r = 1e-4 .. 0.995: the order-p error falls ~10-20x per order, so the difference of
+# orders p - 1 and p bounds the order-p error with that margin. The corner refinement is chosen a priori so that
+# its own error (which raising p does not remove) stays 100x below rtol: each level divides it by
+# SIGMA^(-2 lambda) >= 13 (lambda >= 2/3 the corner exponent); 2 levels already give <= 1e-7 (measured).
+HP_MAX_ORDER = 11
+
+
+def hp_start_order(rtol: float) -> int:
+    """First reported order: the one whose difference to ``p - 1`` typically meets ``rtol`` (about 1.2 decades per
+    order at a/r = 0.39: p = 4 for 1e-4, 6 for 1e-6)."""
+    return int(np.clip(np.ceil((np.log10(1.0 / rtol) + 0.3) / 1.2), 2, HP_MAX_ORDER))
+
+
+def check_hp_order(order, rtol: float) -> int:
+    if order is None:
+        return hp_start_order(rtol)
+    if not (isinstance(order, (int, np.integer)) and 2 <= order <= HP_MAX_ORDER):
+        raise ValueError(f"order = {order!r}: valid range 2 <= order <= {HP_MAX_ORDER} for method 'hp' (the first "
+                         "order tried; the estimate compares it with one order lower)")
+    return int(order)
+
+
+def hp_corner_levels(a_over_r: float, rtol: float, sigma: float = SIGMA) -> int:
+    """Geometric refinement levels toward the corner: the corner cell's error ``~ 1e-7 * sigma^(2 lambda (L - 2))``
+    (measured at L = 2) pushed 100x below ``rtol``."""
+    lam = np.pi / (np.pi + np.arccos(a_over_r))
+    decades = max(0.0, np.log10(1e-7 / (0.01 * rtol)))
+    return int(2 + np.ceil(decades / (-2.0 * lam * np.log10(sigma))))

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fem_neck import accuracy, shapes
+from fem_neck import accuracy, hpmesh, shapes, spectral
 from fem_neck.geometry import check_positive, neck_geometry
 
 
@@ -77,7 +77,7 @@ class Result:
     kappa: float
     length_scale: float
     solution: Solution | None = field(default=None, repr=False)
-    profile: shapes.ProfileMesh | None = field(default=None, repr=False)
+    profile: object = field(default=None, repr=False)
 
     def __getstate__(self):
         state = dict(self.__dict__)
@@ -193,18 +193,58 @@ def _to_tolerance(build, kappa: float, length_scale: float, r_ref: float, rtol, 
     )
 
 
-def semisphere_conductance(a_over_r: float, rtol: float = 1e-4, order: int | None = None) -> Result:
+METHODS = ("hp", "gmsh")
+
+
+def semisphere_conductance(a_over_r: float, rtol: float = 1e-4, order: int | None = None,
+                           method: str = "hp") -> Result:
     """Conductance of the semisphere with a cylindrical neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Sec. 5, Fig. 12).
 
-    ``a_over_r`` in (0, 1): neck radius over sphere radius (from an overlap: ``fem_neck.geometry.equal_neck_radius``;
-    the inverse is ``overlap_for_neck``). The half-neck height is ``h_n/2`` of the volume-conserving neck (eqs.
-    19-20). ``K_over_Kcyl = K / pi`` (eqs. 38-39). ``rtol``: relative tolerance of ``K`` (default 1e-4);
-    ``order``: element order of the reported solve (2, 3 or 4; default: the fastest for ``rtol``).
+    ``a_over_r`` in [1e-4, 1): neck radius over sphere radius (from an overlap: ``fem_neck.geometry.
+    equal_neck_radius``; the inverse is ``overlap_for_neck``). The half-neck height is ``h_n/2`` of the
+    volume-conserving neck (eqs. 19-20). ``K_over_Kcyl = K / pi`` (eqs. 38-39). ``rtol``: relative tolerance of
+    ``K`` (default 1e-4).
+
+    ``method``: ``"hp"`` (default) -- curved spectral elements on a geometric quadrilateral mesh with the exact
+    sphere (:mod:`fem_neck.hpmesh`, :mod:`fem_neck.spectral`): the order is raised on one mesh until two
+    consecutive orders agree to ``rtol``; ``order`` is then the first order tried (2 to 11, default from ``rtol``).
+    ``"gmsh"`` -- the triangle path shared with pairs and chains (graded gmsh mesh, P2-P4, regraded until orders
+    ``p - 1`` and ``p`` agree; ``order`` 2, 3 or 4); an independent discretisation for cross-checks.
     """
     a_over_r = float(a_over_r)
     shapes.semisphere_profile(a_over_r)  # validates before any meshing
-    return _to_tolerance(lambda g: shapes.semisphere_mesh(a_over_r, grading=g), 1.0, 1.0, 1.0, rtol, order,
-                         [a_over_r])
+    if method == "gmsh":
+        return _to_tolerance(lambda g: shapes.semisphere_mesh(a_over_r, grading=g), 1.0, 1.0, 1.0, rtol, order,
+                             [a_over_r])
+    if method != "hp":
+        raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
+    return _semisphere_hp(a_over_r, accuracy.check_rtol(rtol), order)
+
+
+def _semisphere_hp(a: float, rtol: float, order: int | None) -> Result:
+    """Raise the order on one geometric mesh until ``|K_p - K_(p-1)| / K_p <= rtol`` (see
+    :func:`fem_neck.accuracy.hp_start_order` and :func:`fem_neck.accuracy.hp_corner_levels`)."""
+    start = time.perf_counter()
+    p = accuracy.check_hp_order(order, rtol)
+    mesh, shape = hpmesh.semisphere_quad_mesh(a, accuracy.hp_corner_levels(a, rtol))
+    z = mesh.points[:, 1]
+    fixed = {0.0: z == -shape.z_i, 1.0: z == shape.t}  # T = 0 on the equator, 1 on the neck's end disk
+    low = spectral.conductance(mesh, p - 1, fixed)
+    rounds = 1
+    while True:
+        high = spectral.conductance(mesh, p, fixed)
+        estimate = accuracy.relative_difference(high.K_over_kappa, low.K_over_kappa)
+        if estimate <= rtol or p == accuracy.HP_MAX_ORDER:
+            break
+        low, p, rounds = high, p + 1, rounds + 1
+    K = high.K_over_kappa
+    edges = mesh.points[mesh.quads] - mesh.points[np.roll(mesh.quads, -1, axis=1)]
+    return Result(
+        K=K, K_over_Kcyl=K / math.pi, error_estimate=estimate, converged=estimate <= rtol, dofs=high.dofs,
+        seconds=time.perf_counter() - start, h_min=float(np.min(np.hypot(edges[..., 0], edges[..., 1]))),
+        grading=hpmesh.SIGMA, order=p, rounds=rounds, necks=[a], kappa=1.0, length_scale=1.0, solution=high,
+        profile=mesh,
+    )
 
 
 def chain_conductance(radii, overlaps, kappa: float, rtol: float = 1e-4, order: int | None = None) -> Result:

@@ -18,9 +18,15 @@ def sampled_fields(result, delta_t: float = 1.0, refine: int = 2):
     """Refined linear sampling of the solution: ``(points (n, 2), triangles (m, 3), T (n,), q (n,))``."""
     import skfem
 
+    from fem_neck import spectral
+
     sol = result.solution
     if sol is None:
         raise ValueError("result has no field (it was pickled, which drops the solution); solve in this process")
+    if isinstance(sol, spectral.Solution):  # the hp path: sample the polynomials directly
+        points, triangles, temperature, gradient = spectral.sample(result.profile, sol, points_per_edge=2 * refine + 4)
+        scale = result.length_scale
+        return points * scale, triangles, delta_t * temperature, result.kappa * delta_t * gradient / scale
     basis = sol.basis
     dg = basis.with_element(skfem.ElementDG(skfem.ElementTriP1()))
     grad = basis.interpolate(sol.u).grad

@@ -1,0 +1,331 @@
+"""Curved tensor-product spectral elements: axisymmetric conduction on a quadrilateral mesh (the hp-FEM path).
+
+An element of order ``p`` is the image of the unit square under a transfinite (Gordon-Hall) map of its four edges,
+so an edge on the sphere follows the circle exactly -- no geometric error, no correction. The shape functions are
+the tensor-product Lagrange polynomials on the Gauss-Lobatto-Legendre nodes (``(p + 1)^2`` per element, continuous
+across edges); the stiffness is integrated with ``p + 2`` Gauss points per direction. On a mesh graded
+geometrically toward the re-entrant corner the conductance converges exponentially in ``p`` (Babuska-Guo), which
+is what makes this path fast: a few hundred to a few thousand unknowns for 1e-6 (see :mod:`fem_neck.hpmesh`).
+
+Physics as in :mod:`fem_neck.conduction`: in the meridian half-plane (``x`` radial, ``z`` axial) the weak form is
+``int x grad T . grad v`` (the radial weight of axisymmetry), ``T`` is fixed on two straight boundaries, every
+other boundary is insulated, and the conductance is ``K = 2 pi kappa u^T A u`` for a unit temperature difference
+(the energy, equal to the reaction heat flow).
+
+Meshes are plain arrays (:class:`QuadMesh`); coordinates may be given relative to a point of interest (the corner)
+so that tiny elements near it keep full precision: only ``x`` (the weight) must be absolute.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+MAX_ORDER = 12
+
+
+@dataclass(frozen=True)
+class QuadMesh:
+    """Quadrilaterals with straight or circular edges.
+
+    points: ``(V, 2)`` vertex coordinates ``(x, z)`` (``x`` the radial coordinate).
+    quads: ``(E, 4)`` vertex indices, counter-clockwise.
+    arc_angles: ``(E, 4, 2)`` for edge ``k`` (from vertex ``k`` to ``k + 1``): the angle offsets ``(delta_start,
+    delta_end)`` of its ends along a circle, or NaN for a straight edge. The circle is ``arc_point(delta)``.
+    arc_point: function ``delta (array) -> (points (..., 2), d points / d delta (..., 2))``, cancellation-free
+    in the coordinates of ``points``.
+    origin: ``(0, z0)``: absolute coordinates are ``points + origin`` (only the axial coordinate may be shifted:
+    the radial one is the weight of the axisymmetric forms).
+    """
+
+    points: np.ndarray
+    quads: np.ndarray
+    arc_angles: np.ndarray
+    arc_point: object
+    origin: tuple = (0.0, 0.0)
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.quads.shape[0])
+
+
+@functools.lru_cache(maxsize=None)
+def reference(order: int):
+    """GLL nodes on [0, 1], Gauss points/weights on [0, 1], and the 1D Lagrange values and derivatives at the Gauss
+    points: ``(nodes, gauss, weights, values (q, p+1), derivatives (q, p+1))``, ``q = p + 2``."""
+    from numpy.polynomial import legendre
+
+    coefficients = np.zeros(order + 1)
+    coefficients[-1] = 1.0
+    interior = legendre.legroots(legendre.legder(coefficients)) if order > 1 else np.array([])
+    nodes = 0.5 * (np.concatenate(([-1.0], np.sort(interior), [1.0])) + 1.0)
+    g, w = np.polynomial.legendre.leggauss(order + 2)
+    gauss, weights = 0.5 * (g + 1.0), 0.5 * w
+    values, derivatives = lagrange(nodes, gauss)
+    return nodes, gauss, weights, values, derivatives
+
+
+def lagrange(nodes: np.ndarray, x: np.ndarray):
+    """Values and derivatives ``(len(x), len(nodes))`` of the Lagrange polynomials on ``nodes`` at ``x``."""
+    diff = x[:, None] - nodes[None, :]
+    n = nodes.size
+    values = np.empty((x.size, n))
+    derivatives = np.empty((x.size, n))
+    for j in range(n):
+        others = np.delete(np.arange(n), j)
+        denom = np.prod(nodes[j] - nodes[others])
+        terms = diff[:, others]
+        values[:, j] = np.prod(terms, axis=1) / denom
+        total = np.zeros(x.size)
+        for m in range(others.size):
+            total += np.prod(np.delete(terms, m, axis=1), axis=1)
+        derivatives[:, j] = total / denom
+    return values, derivatives
+
+
+def _edge_offsets(mesh: QuadMesh, k: int, s: np.ndarray):
+    """Offset of edge ``k`` of every element from its chord, and its derivative in the edge parameter ``s`` (from
+    vertex ``k`` to ``k + 1``): ``(E, m, 2)`` each, zero on straight edges; ``None`` when no such edge is curved."""
+    angles = mesh.arc_angles[:, k]
+    curved = np.flatnonzero(~np.isnan(angles[:, 0]))
+    if curved.size == 0:
+        return None
+    start = mesh.points[mesh.quads[curved, k]]
+    end = mesh.points[mesh.quads[curved, (k + 1) % 4]]
+    d0, d1 = angles[curved, 0], angles[curved, 1]
+    point, tangent = mesh.arc_point(d0[:, None] + s[None, :] * (d1 - d0)[:, None])
+    chord = end - start
+    offset = np.zeros((mesh.quads.shape[0], s.size, 2))
+    slope = np.zeros_like(offset)
+    offset[curved] = point - start[:, None, :] - s[None, :, None] * chord[:, None, :]
+    slope[curved] = tangent * (d1 - d0)[:, None, None] - chord[:, None, :]
+    return offset, slope
+
+
+def geometry(mesh: QuadMesh, xi: np.ndarray, eta: np.ndarray):
+    """Transfinite map at reference points ``(xi, eta)`` (1D arrays, same length m): ``X (E, m, 2)``, ``dX/dxi`` and
+    ``dX/deta``. Bilinear interpolation of the vertices plus, per curved edge, its offset from the chord blended
+    linearly toward the opposite edge (Gordon-Hall)."""
+    P = mesh.points[mesh.quads]                          # (E, 4, 2)
+    xi_, eta_ = xi[None, :, None], eta[None, :, None]
+    p0, p1, p2, p3 = (P[:, k, None, :] for k in range(4))
+    X = (1 - xi_) * (1 - eta_) * p0 + xi_ * (1 - eta_) * p1 + xi_ * eta_ * p2 + (1 - xi_) * eta_ * p3
+    X_xi = (1 - eta_) * (p1 - p0) + eta_ * (p2 - p3)
+    X_eta = (1 - xi_) * (p3 - p0) + xi_ * (p2 - p1)
+    # edge k and its parameter: 0 bottom (s = xi), 1 right (s = eta), 2 top (s = 1 - xi), 3 left (s = 1 - eta)
+    for k, s in enumerate((xi, eta, 1 - xi, 1 - eta)):
+        found = _edge_offsets(mesh, k, s)
+        if found is None:
+            continue
+        off, dos = found
+        if k == 0:
+            X += (1 - eta_) * off
+            X_xi += (1 - eta_) * dos
+            X_eta -= off
+        elif k == 1:
+            X += xi_ * off
+            X_xi += off
+            X_eta += xi_ * dos
+        elif k == 2:
+            X += eta_ * off
+            X_xi -= eta_ * dos
+            X_eta += off
+        else:
+            X += (1 - xi_) * off
+            X_xi -= off
+            X_eta -= (1 - xi_) * dos
+    return X, X_xi, X_eta
+
+
+def numbering(mesh: QuadMesh, order: int):
+    """Global dof of every local node ``(E, (p + 1)^2)`` (local node ``a + (p + 1) b``, ``a`` along xi), the dof
+    count, the skeleton dof count and the vertex pair of every global edge ``(NE, 2)``. Vertices come first, then
+    ``p - 1`` nodes per edge (ordered from its lower to its higher vertex index) -- together the skeleton -- then
+    ``(p - 1)^2`` interior nodes per element."""
+    p = order
+    quads = mesh.quads
+    n_vertices = mesh.points.shape[0]
+    first, second = quads, np.roll(quads, -1, axis=1)
+    lo, hi = np.minimum(first, second), np.maximum(first, second)
+    keys, edge_of = np.unique(lo * n_vertices + hi, return_inverse=True)
+    edge_of = edge_of.reshape(quads.shape)
+    edge_vertices = np.column_stack([keys // n_vertices, keys % n_vertices])
+    forward = first < second
+    n_elements = quads.shape[0]
+    skeleton = n_vertices + keys.size * (p - 1)
+    l2g = np.empty((n_elements, (p + 1) ** 2), dtype=np.int64)
+    for k, node in enumerate(_element(p).corner_nodes):
+        l2g[:, node] = quads[:, k]
+    positions = np.arange(p - 1)
+    for k, nodes in enumerate(_element(p).edge_nodes):
+        pos = np.where(forward[:, k, None], positions[None, :], p - 2 - positions[None, :])
+        l2g[:, nodes] = n_vertices + edge_of[:, k, None] * (p - 1) + pos
+    l2g[:, _element(p).interior] = skeleton + np.arange(n_elements * (p - 1) ** 2).reshape(n_elements, -1)
+    return l2g, int(skeleton + n_elements * (p - 1) ** 2), int(skeleton), edge_vertices
+
+
+@dataclass(frozen=True)
+class _Element:
+    """Order-``p`` reference data: quadrature (points ``xi``, ``eta``, weights ``w``), reference gradients
+    ``(Q, n)`` of the shape functions, and the local node sets (corners, edges in edge direction, skeleton =
+    corners + edges, interior)."""
+
+    xi: np.ndarray
+    eta: np.ndarray
+    w: np.ndarray
+    g_xi: np.ndarray
+    g_eta: np.ndarray
+    corner_nodes: tuple
+    edge_nodes: tuple
+    skeleton: np.ndarray
+    interior: np.ndarray
+
+
+@functools.lru_cache(maxsize=None)
+def _element(p: int) -> _Element:
+    _, gauss, weights, B, D = reference(p)
+    q = gauss.size
+    idx = lambda a, b: a + (p + 1) * b  # noqa: E731
+    edges = (
+        [idx(a, 0) for a in range(1, p)],
+        [idx(p, b) for b in range(1, p)],
+        [idx(a, p) for a in range(p - 1, 0, -1)],
+        [idx(0, b) for b in range(p - 1, 0, -1)],
+    )
+    corners = (idx(0, 0), idx(p, 0), idx(p, p), idx(0, p))
+    interior = np.array([idx(a, b) for b in range(1, p) for a in range(1, p)], dtype=np.int64)
+    skeleton = np.setdiff1d(np.arange((p + 1) ** 2), interior)
+    return _Element(
+        xi=np.tile(gauss, q), eta=np.repeat(gauss, q), w=np.tile(weights, q) * np.repeat(weights, q),
+        # d/dxi = D[i, a] B[j, b] and d/deta = B[i, a] D[j, b] at quadrature point i + q j, node a + (p + 1) b
+        g_xi=np.einsum("ia,jb->jiba", D, B).reshape(q * q, -1), g_eta=np.einsum("ia,jb->jiba", B, D).reshape(q * q, -1),
+        corner_nodes=corners, edge_nodes=tuple(np.array(e, dtype=np.int64) for e in edges), skeleton=skeleton,
+        interior=interior,
+    )
+
+
+def stiffness(mesh: QuadMesh, order: int):
+    """Element matrices ``(E, n, n)`` of ``int x grad u . grad v`` (``x`` = first coordinate, the radius) and the
+    smallest ``det J`` at a quadrature point."""
+    el = _element(order)
+    X, X_xi, X_eta = geometry(mesh, el.xi, el.eta)
+    det = X_xi[..., 0] * X_eta[..., 1] - X_xi[..., 1] * X_eta[..., 0]          # (E, Q)
+    scale = el.w[None, :] * X[..., 0] / det
+    c_xx = scale * np.einsum("eqk,eqk->eq", X_eta, X_eta)
+    c_xe = -scale * np.einsum("eqk,eqk->eq", X_xi, X_eta)
+    c_ee = scale * np.einsum("eqk,eqk->eq", X_xi, X_xi)
+    flux_xi = c_xx[..., None] * el.g_xi + c_xe[..., None] * el.g_eta          # (E, Q, n)
+    flux_eta = c_xe[..., None] * el.g_xi + c_ee[..., None] * el.g_eta
+    return np.matmul(el.g_xi.T, flux_xi) + np.matmul(el.g_eta.T, flux_eta), float(det.min())
+
+
+@dataclass
+class Solution:
+    """One solve: ``K_over_kappa = K / kappa`` for a unit temperature difference, the dof count (all nodes) and the
+    skeleton dofs actually solved for (interiors are condensed), the order, the temperature at every local node
+    ``u_local (E, (p + 1)^2)`` and the smallest Jacobian determinant."""
+
+    K_over_kappa: float
+    dofs: int
+    skeleton_dofs: int
+    order: int
+    u_local: np.ndarray
+    jacobian_min: float
+
+
+def conductance(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
+    """Solve ``div(x grad T) = 0`` with ``T`` held at ``value`` on every edge whose two vertices are in
+    ``fixed_vertices[value]`` (a boolean mask over the vertices; two values), insulated elsewhere; return ``K / kappa
+    = 2 pi u^T A u / (Delta T)^2``. Element interiors are condensed (Schur complement, batched) so only the skeleton
+    is factorised; the energy of the condensed system equals that of the full one."""
+    if not (isinstance(order, (int, np.integer)) and 1 <= order <= MAX_ORDER):
+        raise ValueError(f"order = {order!r}: valid range 1 <= order <= {MAX_ORDER}")
+    p = int(order)
+    el = _element(p)
+    matrices, jac_min = stiffness(mesh, p)
+    if not jac_min > 0.0:
+        raise RuntimeError(f"degenerate element (det J = {jac_min:.3g} <= 0): the mesh is invalid for this shape")
+    l2g, n, n_skel, edge_vertices = numbering(mesh, p)
+    sk, inn = el.skeleton, el.interior
+    S = matrices[:, sk[:, None], sk[None, :]]
+    if inn.size:
+        K_ib = matrices[:, inn[:, None], sk[None, :]]
+        elimination = np.linalg.solve(matrices[:, inn[:, None], inn[None, :]], K_ib)   # K_ii^-1 K_ib
+        S = S - np.matmul(np.transpose(K_ib, (0, 2, 1)), elimination)
+    # fixed skeleton dofs: vertices in a mask, and the nodes of edges with both ends in the same mask
+    u = np.zeros(n_skel)
+    is_fixed = np.zeros(n_skel, dtype=bool)
+    values = sorted(fixed_vertices)
+    n_vertices = mesh.points.shape[0]
+    for value in values:
+        mask = np.asarray(fixed_vertices[value], dtype=bool)
+        edges = np.flatnonzero(mask[edge_vertices[:, 0]] & mask[edge_vertices[:, 1]])
+        dofs = np.concatenate([np.flatnonzero(mask), (n_vertices + edges[:, None] * (p - 1)
+                                                      + np.arange(p - 1)[None, :]).ravel()])
+        u[dofs] = value
+        is_fixed[dofs] = True
+    free = ~is_fixed
+    index = np.cumsum(free) - 1
+    g = l2g[:, sk]
+    rows = np.broadcast_to(g[:, :, None], S.shape)
+    cols = np.broadcast_to(g[:, None, :], S.shape)
+    free_rows = free[rows]
+    ff = free_rows & free[cols]
+    fd = free_rows & ~free[cols]
+    n_free = int(free.sum())
+    rhs = -np.bincount(index[rows[fd]], S[fd] * u[cols[fd]], minlength=n_free)
+    # sparse LU, not dense Cholesky: multi-threaded BLAS on these small dense matrices was 5-50x slower on a busy
+    # 2-core machine (measured), SuperLU is single-threaded and steady
+    A = sp.csc_matrix((S[ff], (index[rows[ff]], index[cols[ff]])), shape=(n_free, n_free))
+    u[free] = splu(A, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True}).solve(rhs)
+    u_skel = u[g]                                                               # (E, skeleton nodes)
+    energy = float(np.einsum("ei,eij,ej->", u_skel, S, u_skel))
+    u_local = np.empty((mesh.quads.shape[0], (p + 1) ** 2))
+    u_local[:, sk] = u_skel
+    if inn.size:
+        u_local[:, inn] = -np.einsum("eij,ej->ei", elimination, u_skel)
+    delta = values[-1] - values[0]
+    return Solution(K_over_kappa=2.0 * math.pi * energy / delta**2, dofs=n, skeleton_dofs=n_skel, order=p,
+                    u_local=u_local, jacobian_min=jac_min)
+
+
+def measure(mesh: QuadMesh, order: int = 4) -> tuple[float, float]:
+    """``(2 pi int x dA, min det J)``: the volume of revolution of the mesh (a check against the exact body) and its
+    smallest Jacobian determinant at the order's quadrature points (> 0 for a valid mesh)."""
+    el = _element(order)
+    X, X_xi, X_eta = geometry(mesh, el.xi, el.eta)
+    det = X_xi[..., 0] * X_eta[..., 1] - X_xi[..., 1] * X_eta[..., 0]
+    return 2.0 * math.pi * float(np.sum(el.w[None, :] * X[..., 0] * det)), float(det.min())
+
+
+def sample(mesh: QuadMesh, solution: Solution, points_per_edge: int = 6):
+    """The solution on a uniform ``points_per_edge``-grid in every element, for pictures and VTU files:
+    ``(points (n, 2), triangles (m, 3), T (n,), |grad T| (n,))`` in absolute coordinates (points per element, not
+    shared)."""
+    p = solution.order
+    nodes = reference(p)[0]
+    s = np.linspace(0.0, 1.0, points_per_edge)
+    values, derivatives = lagrange(nodes, s)
+    xi, eta = np.tile(s, s.size), np.repeat(s, s.size)
+    X, X_xi, X_eta = geometry(mesh, xi, eta)
+    shape = np.einsum("ia,jb->jiba", values, values).reshape(s.size**2, -1)
+    d_xi = np.einsum("ia,jb->jiba", derivatives, values).reshape(s.size**2, -1)
+    d_eta = np.einsum("ia,jb->jiba", values, derivatives).reshape(s.size**2, -1)
+    u = solution.u_local
+    T = u @ shape.T
+    t_xi, t_eta = u @ d_xi.T, u @ d_eta.T
+    det = X_xi[..., 0] * X_eta[..., 1] - X_xi[..., 1] * X_eta[..., 0]
+    # grad T = J^-T (dT/dxi, dT/deta), J = [X_xi X_eta]
+    gx = (X_eta[..., 1] * t_xi - X_xi[..., 1] * t_eta) / det
+    gz = (-X_eta[..., 0] * t_xi + X_xi[..., 0] * t_eta) / det
+    m = s.size
+    local = np.array([[i + m * j, i + 1 + m * j, i + 1 + m * (j + 1)] for j in range(m - 1) for i in range(m - 1)]
+                     + [[i + m * j, i + 1 + m * (j + 1), i + m * (j + 1)] for j in range(m - 1) for i in range(m - 1)])
+    offsets = (np.arange(mesh.quads.shape[0]) * m * m)[:, None, None]
+    triangles = (local[None, :, :] + offsets).reshape(-1, 3)
+    return X.reshape(-1, 2) + np.asarray(mesh.origin), triangles, T.ravel(), np.hypot(gx, gz).ravel()

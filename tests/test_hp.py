@@ -1,0 +1,110 @@
+"""The hp path (fem_neck.hpmesh + fem_neck.spectral) against exact volumes, closed forms, the 12-digit reference
+semispheres and the independent gmsh/scikit-fem triangle path."""
+
+import math
+
+import numpy as np
+import pytest
+
+from fem_neck import conduction, hpmesh, spectral
+from fem_neck.geometry import equal_neck_radius
+
+# (h/r, K/K_cyl) -- /work/shared/reference/README.md, semisphere table (independent hp-FE, 12 digits)
+REFERENCE = [(0.02, 0.216136324118), (0.08, 0.412739950539), (0.2, 0.655577629373), (0.4, 0.992974073489)]
+SWEEP = np.concatenate([np.geomspace(1e-4, 0.1, 13), np.linspace(0.12, 0.98, 44), [0.59999, 0.60001, 0.995, 0.999]])
+
+
+@pytest.mark.parametrize("a", SWEEP)
+def test_mesh_is_valid_and_exact_in_volume(a):
+    """Every element has a positive Jacobian and the mesh's volume of revolution is the body's (exact arcs)."""
+    for levels in (0, 6):
+        mesh, shape = hpmesh.semisphere_quad_mesh(a, levels)
+        volume, det_min = spectral.measure(mesh, order=6)
+        assert det_min > 0.0
+        assert volume == pytest.approx(shape.volume(), rel=1e-13)
+
+
+def _cylinder(radius, height, nx=3, nz=2):
+    """A rectangle [0, R] x [0, H] as a structured quad mesh with shuffled vertex numbers and rotated quads."""
+    x, z = np.linspace(0.0, radius, nx + 1), np.linspace(0.0, height, nz + 1)
+    points = np.array([(xi, zj) for zj in z for xi in x])
+    perm = np.random.default_rng(1).permutation(len(points))
+    new = np.empty_like(perm)
+    new[perm] = np.arange(len(perm))
+    quads = np.array([[new[i + j * (nx + 1)], new[i + 1 + j * (nx + 1)], new[i + 1 + (j + 1) * (nx + 1)],
+                       new[i + (j + 1) * (nx + 1)]] for j in range(nz) for i in range(nx)])
+    quads = np.array([np.roll(q, k % 4) for k, q in enumerate(quads)])
+    mesh = spectral.QuadMesh(points=points[perm], quads=quads, arc_angles=np.full(quads.shape + (2,), np.nan),
+                             arc_point=None)
+    return mesh, points[perm]
+
+
+@pytest.mark.parametrize("order", [1, 2, 5])
+def test_cylinder_conductance_is_exact(order):
+    """A cylinder between its end disks: K = kappa pi R^2 / H exactly (T linear is in every space)."""
+    mesh, pts = _cylinder(0.7, 1.9)
+    sol = spectral.conductance(mesh, order, {0.0: pts[:, 1] == 0.0, 1.0: pts[:, 1] == 1.9})
+    assert sol.K_over_kappa == pytest.approx(math.pi * 0.7**2 / 1.9, rel=1e-12)
+    assert np.all(np.abs(sol.u_local) <= 1.0 + 1e-12)
+
+
+@pytest.mark.parametrize("h_over_r, k_ref", REFERENCE)
+def test_reference_semispheres_to_1e_minus_8(h_over_r, k_ref):
+    a = float(equal_neck_radius(1.0, h_over_r))
+    res = conduction.semisphere_conductance(a, rtol=1e-8)
+    assert res.converged and res.error_estimate <= 1e-8
+    assert abs(res.K_over_Kcyl - k_ref) / k_ref <= 1e-8
+
+
+@pytest.mark.parametrize("rtol", [1e-3, 1e-4, 1e-6])
+def test_estimate_covers_the_error_over_the_range(rtol):
+    """Across a/r = 1e-4 .. 0.99 the reported K is within its estimate of a solve 1000x tighter."""
+    for a in (1e-4, 0.003, 0.05, 0.2, 0.39, 0.61, 0.75, 0.9, 0.99):
+        fine = conduction.semisphere_conductance(a, rtol=rtol * 1e-3)
+        res = conduction.semisphere_conductance(a, rtol=rtol)
+        assert res.converged and res.error_estimate <= rtol
+        assert abs(res.K - fine.K) / fine.K <= res.error_estimate + fine.error_estimate
+
+
+@pytest.mark.parametrize("a", [1e-3, 0.03, 0.3, 0.61, 0.95])
+def test_hp_agrees_with_the_gmsh_path(a):
+    """Two independent discretisations (exact-geometry quads vs graded curved triangles) agree to 1e-6."""
+    hp = conduction.semisphere_conductance(a, rtol=1e-8)
+    tri = conduction.semisphere_conductance(a, rtol=1e-6, method="gmsh")
+    assert tri.converged
+    assert abs(hp.K - tri.K) / hp.K <= 1e-8 + tri.error_estimate
+
+
+def test_constriction_limit():
+    """Small necks: K -> 4 kappa a (isothermal disk on a half-space), approached from below at O(a ln(1/a))."""
+    ratios = [conduction.semisphere_conductance(a, rtol=1e-6).K / (4.0 * a) for a in (1e-4, 1e-3)]
+    assert 1.0 - 1e-3 < ratios[0] < 1.0
+    assert ratios[1] < ratios[0]
+
+
+def test_exponential_convergence_in_the_order():
+    """On one geometric mesh the error falls by >= 5x per order from p = 3 to 8 (a/r = 0.39; measured 18x to 7x)."""
+    mesh, shape = hpmesh.semisphere_quad_mesh(0.394592534534, 8)
+    z = mesh.points[:, 1]
+    fixed = {0.0: z == -shape.z_i, 1.0: z == shape.t}
+    k_ref = REFERENCE[1][1] * math.pi
+    errors = [abs(spectral.conductance(mesh, p, fixed).K_over_kappa - k_ref) / k_ref for p in range(3, 9)]
+    assert all(later * 5.0 <= earlier for earlier, later in zip(errors, errors[1:]))
+
+
+def test_field_is_bounded_by_the_boundary_values():
+    """Maximum principle: the temperature stays within [0, 1] up to the polynomial's overshoot."""
+    res = conduction.semisphere_conductance(0.05, rtol=1e-6)
+    u = res.solution.u_local
+    assert u.min() >= -1e-3 and u.max() <= 1.0 + 1e-3
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda: conduction.semisphere_conductance(0.5, order=1), "order = 1"),
+    (lambda: conduction.semisphere_conductance(0.5, order=12), "order = 12"),
+    (lambda: conduction.semisphere_conductance(5e-5), "a_over_r"),
+    (lambda: conduction.semisphere_conductance(0.5, rtol=0.0), "rtol"),
+])
+def test_bad_input(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
