@@ -121,7 +121,8 @@ def in_processes(jobs, workers: int | None = None, *, desc: str = "", progress: 
     """Run ``func(*args)`` for every ``(func, args)`` of ``jobs`` in a process pool; yield results as they finish.
 
     Processes, not threads: gmsh is one global, thread-unsafe state per process. ``workers`` defaults to all cores;
-    a tqdm bar on stderr counts ``done`` jobs finished earlier plus these.
+    one worker (or one job) runs in this process. A tqdm bar on stderr counts ``done`` jobs finished earlier plus
+    these.
     """
     from tqdm import tqdm
 
@@ -129,6 +130,12 @@ def in_processes(jobs, workers: int | None = None, *, desc: str = "", progress: 
     with tqdm(total=done + len(jobs), initial=done, desc=desc, unit="solve", file=sys.stderr,
               disable=not progress) as bar:
         if not jobs:
+            return
+        if workers == 1 or len(jobs) == 1:  # no pool to start: fast solves (the hp path) finish before it would
+            for func, args in jobs:
+                result = func(*args)
+                bar.update()
+                yield result
             return
         with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=_pool_context()) as pool:
             for fut in as_completed([pool.submit(func, *args) for func, args in jobs]):
