@@ -1,0 +1,159 @@
+"""The error-controlled step of ``dt = "auto"`` (dem.thermal.integrate).
+
+The insulated pair and chain have exact solutions ``T(t) = expm(-t C^-1 L) T0`` (by eigenvectors); the global error of every
+integrator must track ``rtol`` (relative to the temperature range), Crank-Nicolson must take few steps, rejected
+steps must be redone without trace in the energy bookkeeping, and the step sizes of the implicit integrators must
+stay on the dyadic grid ``t_end / 2^k`` so that their factorisations are reused.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import dem.thermal
+from dem.bonds import find_bonds
+from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.particles import Particles
+from dem.thermal import Network, integrate, stable_limit
+
+INTEGRATORS = ("explicit", "implicit", "crank-nicolson")
+
+
+def chain_network(n: int, hot: float = 100.0, fixed_ends: bool = False, radii=None):
+    """``n`` copper spheres in a row (overlap 6 % of the radius), the first at ``hot``, the others at 0."""
+    r = np.full(n, 1e-3) if radii is None else np.asarray(radii, float)
+    z = np.concatenate([[0.0], np.cumsum(r[:-1] + r[1:] - 0.06 * np.minimum(r[:-1], r[1:]))])
+    x = np.column_stack([np.zeros(n), np.zeros(n), z])
+    T0 = np.zeros(n)
+    T0[0] = hot
+    fixed = np.zeros(n, dtype=bool)
+    if fixed_ends:
+        fixed[[0, -1]] = True
+    p = Particles.from_arrays(x, r, T0, fixed=fixed)
+    spec = ConductanceSpec(law="rojek")
+    b = find_bonds(p, (), spec.contact)
+    k_pairs, k_walls = bond_conductances(spec, p, b)
+    return Network(p, b, k_pairs, k_walls, np.zeros(0))
+
+
+def run_against_exact(net: Network, integrator: str, rtol: float, t_end: float):
+    """(max error over the accepted steps relative to the temperature range, result, observed (step, t))."""
+    s = net.particles.capacity**-0.5
+    lam, V = np.linalg.eigh(s[:, None] * net.L.toarray() * s[None, :])  # C^-1/2 L C^-1/2 = V diag(lam) V^T
+    modes = V.T @ (net.particles.temperature / s)
+    worst, seen = [0.0], []
+
+    def observe(step, t, T, flows):
+        seen.append((step, t))
+        worst[0] = max(worst[0], float(np.max(np.abs(T - s * (V @ (np.exp(-lam * t) * modes))))))
+
+    res = integrate(net, integrator, "auto", t_end, rtol=rtol, observer=observe)
+    return worst[0] / net.temperature_range(), res, seen
+
+
+def decay_time(net: Network) -> float:
+    """1 / (slowest nonzero decay rate) of the insulated network."""
+    s = net.particles.capacity**-0.5
+    lam = np.linalg.eigvalsh(s[:, None] * net.L.toarray() * s[None, :])
+    return 1.0 / lam[lam > 1e-9 * lam.max()].min()
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+@pytest.mark.parametrize("rtol", [1e-2, 1e-3])
+def test_global_error_tracks_rtol_on_a_pair(integrator, rtol):
+    net = chain_network(2, radii=[1e-3, 3e-3])
+    err, res, _ = run_against_exact(net, integrator, rtol, 3.0 * decay_time(net))
+    assert err <= 3.0 * rtol
+    assert err >= 0.01 * rtol  # not wastefully accurate either (the old controller was 1e-3 x rtol for CN)
+    assert res.energy_error < 1e-12
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_global_error_tracks_rtol_on_a_chain(integrator):
+    net = chain_network(6, radii=[1e-3, 2e-3, 1e-3, 1.5e-3, 1e-3, 3e-3])
+    err, res, _ = run_against_exact(net, integrator, 1e-3, 2.0 * decay_time(net))
+    assert err <= 3e-3
+    assert res.energy_error < 1e-12
+
+
+def test_crank_nicolson_takes_few_steps():
+    """At rtol 1e-3 the old change-per-step controller took 1313 steps on this pair (error 1e-6); the error
+    controller needs a few dozen for an error of about rtol."""
+    net = chain_network(2, radii=[1e-3, 3e-3])
+    err, res, _ = run_against_exact(net, "crank-nicolson", 1e-3, 0.2)
+    assert res.steps <= 60
+    assert err <= 3e-3
+
+
+def test_implicit_steps_on_the_dyadic_grid_and_factorisations_reused():
+    net = chain_network(6)
+    t_end = 2.0 * decay_time(net)
+    for integrator in ("implicit", "crank-nicolson"):
+        times = []
+        res = integrate(net, integrator, "auto", t_end, rtol=1e-3,
+                        observer=lambda step, t, T, flows: times.append(t))
+        assert times[-1] == t_end and res.t == t_end  # ends exactly on t_end
+        steps = np.diff(times)
+        levels = np.log2(t_end / steps)
+        assert np.allclose(levels, np.round(levels), atol=1e-9)
+        assert res.dt_min < res.dt_max  # the step really varies
+        # one factorisation per step size used (step doubling also needs dt/2)
+        assert res.factorizations <= len(set(np.round(levels).astype(int))) + 1
+
+
+def test_rejected_steps_are_redone(monkeypatch):
+    """A controller that always asks for 4x the step overshoots, so steps are rejected and redone; the rejected
+    attempts leave no trace (observer, energy), and the answer still meets the tolerance. (On linear decays the
+    real controller seldom rejects: the error of a step falls smoothly as the modes decay.)"""
+    factor = dem.thermal._controller_factor
+    monkeypatch.setattr(dem.thermal, "_controller_factor", lambda err, tol, q: max(4.0, factor(err, tol, q)))
+    net = chain_network(6)
+    for integrator in INTEGRATORS:
+        err, res, seen = run_against_exact(net, integrator, 1e-3, 2.0 * decay_time(net))
+        assert res.rejected > 0
+        assert [s for s, _ in seen] == list(range(res.steps + 1))
+        assert np.all(np.diff([t for _, t in seen]) > 0)
+        assert err <= 3e-3
+        assert res.energy_error < 1e-12
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_energy_balance_with_variable_steps(integrator):
+    """Heated from a fixed hot end, cooled at a fixed cold end: the change of sum C T of the free particles equals
+    the heat booked through the fixed particles over the variable steps."""
+    net = chain_network(8, fixed_ends=True, radii=np.linspace(1e-3, 2e-3, 8))
+    res = integrate(net, integrator, "auto", 0.5 * decay_time(net), rtol=1e-3)
+    assert res.dt_max > 4 * res.dt_min
+    C, free = net.particles.capacity, net.free
+    gained = C[free] @ (res.T[free] - net.particles.temperature[free])
+    assert gained == pytest.approx(res.heat_in["fixed"], rel=1e-11)
+    assert gained > 0
+    assert res.energy_error < 1e-12
+
+
+def test_explicit_auto_stays_below_the_stable_limit():
+    net = chain_network(6)
+    limit = stable_limit(net)
+    res = integrate(net, "explicit", "auto", 2000 * limit, rtol=1e-1)
+    assert res.dt_max <= dem.thermal.AUTO_SAFETY * limit * (1 + 1e-12)
+    assert res.steps >= 2000 / dem.thermal.AUTO_SAFETY - 1
+
+
+def test_runs_beyond_max_steps_are_refused():
+    net = chain_network(6)
+    limit = stable_limit(net)
+    with pytest.raises(ValueError, match="exceeds solver.max_steps"):  # explicit: refused up front
+        integrate(net, "explicit", "auto", 1e4 * limit, max_steps=1000)
+    for integrator in ("implicit", "crank-nicolson"):  # too tight a tolerance: stopped, not hanging
+        with pytest.raises(ValueError, match="max_steps = 20 steps"):
+            integrate(net, integrator, "auto", decay_time(net), rtol=1e-7, max_steps=20)
+
+
+def test_step_tolerance_is_the_documented_rule():
+    for q in (1, 2):
+        for rtol in (1e-2, 1e-3, 1e-4):
+            tau = dem.thermal.step_tolerance(rtol, q)
+            assert tau == pytest.approx(min(rtol, dem.thermal.AUTO_LOCAL[q] * rtol ** ((q + 1) / q)))
+            assert tau <= rtol
+    assert math.isclose(dem.thermal.step_tolerance(1.0, 1), 1.0)
