@@ -218,17 +218,20 @@ def semisphere_conductance(a_over_r: float, rtol: float = 1e-4, order: int | Non
                              [a_over_r])
     if method != "hp":
         raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
-    return _semisphere_hp(a_over_r, accuracy.check_rtol(rtol), order)
-
-
-def _semisphere_hp(a: float, rtol: float, order: int | None) -> Result:
-    """Raise the order on one geometric mesh until ``|K_p - K_(p-1)| / K_p <= rtol`` (see
-    :func:`fem_neck.accuracy.hp_start_order` and :func:`fem_neck.accuracy.hp_corner_levels`)."""
+    rtol = accuracy.check_rtol(rtol)
+    order = accuracy.check_hp_order(order, rtol)
     start = time.perf_counter()
-    p = accuracy.check_hp_order(order, rtol)
-    mesh, shape = hpmesh.semisphere_quad_mesh(a, accuracy.hp_corner_levels(a, rtol))
+    mesh, shape = hpmesh.semisphere_quad_mesh(a_over_r, accuracy.hp_corner_levels(a_over_r, rtol))
     z = mesh.points[:, 1]
     fixed = {0.0: z == -shape.z_i, 1.0: z == shape.t}  # T = 0 on the equator, 1 on the neck's end disk
+    return _hp_to_tolerance(mesh, fixed, rtol, order, start, 1.0, 1.0, 1.0, [a_over_r])
+
+
+def _hp_to_tolerance(mesh, fixed: dict, rtol: float, p: int, start: float, kappa: float, length_scale: float,
+                     r_ref: float, necks: list) -> Result:
+    """Raise the order on one hp mesh (lengths in units of ``length_scale``) until ``|K_p - K_(p-1)| / K_p <=
+    rtol`` (:func:`fem_neck.accuracy.hp_start_order`; the corner levels were chosen by
+    :func:`fem_neck.accuracy.hp_corner_levels`)."""
     low = spectral.conductance(mesh, p - 1, fixed)
     rounds = 1
     while True:
@@ -237,12 +240,13 @@ def _semisphere_hp(a: float, rtol: float, order: int | None) -> Result:
         if estimate <= rtol or p == accuracy.HP_MAX_ORDER:
             break
         low, p, rounds = high, p + 1, rounds + 1
-    K = high.K_over_kappa
+    K = high.K_over_kappa * kappa * length_scale
     edges = mesh.points[mesh.quads] - mesh.points[np.roll(mesh.quads, -1, axis=1)]
     return Result(
-        K=K, K_over_Kcyl=K / math.pi, error_estimate=estimate, converged=estimate <= rtol, dofs=high.dofs,
-        seconds=time.perf_counter() - start, h_min=float(np.min(np.hypot(edges[..., 0], edges[..., 1]))),
-        grading=hpmesh.SIGMA, order=p, rounds=rounds, necks=[a], kappa=1.0, length_scale=1.0, solution=high,
+        K=K, K_over_Kcyl=K / (kappa * math.pi * r_ref), error_estimate=estimate, converged=estimate <= rtol,
+        dofs=high.dofs, seconds=time.perf_counter() - start,
+        h_min=float(np.min(np.hypot(edges[..., 0], edges[..., 1]))) * length_scale, grading=hpmesh.SIGMA, order=p,
+        rounds=rounds, necks=[float(a) for a in necks], kappa=kappa, length_scale=length_scale, solution=high,
         profile=mesh,
     )
 
@@ -263,10 +267,28 @@ def chain_conductance(radii, overlaps, kappa: float, rtol: float = 1e-4, order: 
 
 
 def pair_conductance(r_i: float, r_j: float, h: float, kappa: float, rtol: float = 1e-4,
-                     order: int | None = None) -> Result:
+                     order: int | None = None, method: str = "auto") -> Result:
     """Conductance (W/K) of two sintered spheres between their outer equatorial planes (Rojek 2022, Sec. 6).
 
-    The chain of two: :func:`chain_conductance` ``([r_i, r_j], [h], kappa)``.
+    ``method``: ``"hp"`` -- the two halves of :func:`fem_neck.hpmesh.pair_quad_mesh` (necks up to 0.6 of the
+    smaller radius), order raised until two orders agree; ``"gmsh"`` -- the chain of two,
+    :func:`chain_conductance` ``([r_i, r_j], [h], kappa)``; ``"auto"`` (default) -- hp where it applies, else gmsh.
+    ``K_over_Kcyl`` uses the smaller radius.
     """
-    neck_geometry(check_positive("r_i", r_i), check_positive("r_j", r_j), h)  # names the bad argument
-    return chain_conductance([r_i, r_j], [h], kappa, rtol=rtol, order=order)
+    geo = neck_geometry(check_positive("r_i", r_i), check_positive("r_j", r_j), h)  # names the bad argument
+    kappa = float(check_positive("kappa", kappa))
+    if method not in ("auto", *METHODS):
+        raise ValueError(f"method = {method!r}: must be one of auto, {', '.join(METHODS)}")
+    r_min = min(float(r_i), float(r_j))
+    hp_applies = float(geo.a) <= hpmesh.SMALL_NECK_MAX * r_min and float(geo.a) >= shapes.MIN_NECK_RATIO * r_min
+    if method == "gmsh" or (method == "auto" and not hp_applies):
+        return chain_conductance([r_i, r_j], [h], kappa, rtol=rtol, order=order)
+    rtol = accuracy.check_rtol(rtol)
+    order = accuracy.check_hp_order(order, rtol)
+    if float(geo.a) < shapes.MIN_NECK_RATIO * r_min:
+        raise ValueError(f"h = {h!r}: neck radius {float(geo.a):.6g} is below {shapes.MIN_NECK_RATIO:g} of the "
+                         "smaller radius (K is the constriction limit there)")
+    start = time.perf_counter()
+    levels = accuracy.hp_corner_levels(float(geo.a) / r_min, rtol)
+    mesh, scale, bottom, top, a = hpmesh.pair_quad_mesh(float(r_i), float(r_j), float(h), levels)
+    return _hp_to_tolerance(mesh, {0.0: bottom, 1.0: top}, rtol, order, start, kappa, scale, r_min, [a])

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fem_neck.geometry import cap_height
+from fem_neck.geometry import cap_height, neck_geometry
 from fem_neck.spectral import QuadMesh
 
 SIGMA = 0.17            # geometric factor of the corner refinement (hp optimum ~0.15-0.2)
@@ -126,8 +126,8 @@ class _Builder:
         ends = np.stack([delta[quads], delta[np.roll(quads, -1, axis=1)]], axis=-1)
         straight = np.isnan(ends).any(axis=-1)
         ends[straight] = np.nan
-        return QuadMesh(points=points, quads=quads, arc_angles=ends, arc_point=self.shape.sphere_point,
-                        origin=(0.0, self.shape.z_i))
+        return QuadMesh(points=points, quads=quads, arc_angles=ends, arc_circle=np.where(straight, -1, 0),
+                        circles=(self.shape.sphere_point,), origin=(0.0, self.shape.z_i))
 
 
 def _radii(start: float, end: float, ratio: float = RING_RATIO) -> np.ndarray:
@@ -170,13 +170,29 @@ def semisphere_quad_mesh(a: float, levels: int, sigma: float = SIGMA) -> tuple[Q
     """The geometric quadrilateral mesh of the semisphere with neck radius ``a`` (``1e-4 <= a < 1``, sphere radius
     1) refined ``levels`` times toward the corner; see the module docstring."""
     shape = SemisphereShape.from_neck(a)
+    return half_body(shape, corner_radius(shape), levels, sigma), shape
+
+
+def corner_radius(shape: SemisphereShape) -> float:
+    """Radius ``R`` of the corner cells: the neck height ``t`` for small necks, at most half of ``z_i`` otherwise."""
+    return shape.t if shape.a <= SMALL_NECK_MAX else min(shape.t, 0.5 * shape.z_i)
+
+
+def half_body(shape: SemisphereShape, R: float, levels: int, sigma: float = SIGMA) -> QuadMesh:
+    """One sphere from its equator to the plane ``t`` above its cap base (the neck's end disk), corner cells of
+    radius ``R <= t``. The neck cylinder is a tensor grid whose columns end at ``x = a - rho`` for the ring radii
+    ``rho`` from ``R`` to ``a`` -- so two halves with the same ``a``, ``t`` and ``R`` share their end disk's nodes
+    (:func:`pair_quad_mesh`)."""
     b = _Builder(shape)
     corner = b.sphere(0.0)
-    if a <= SMALL_NECK_MAX:
-        _small_neck(b, shape, corner, levels, sigma)
+    down, mid, on_sphere = _corner_cells(b, shape, corner, R, levels, sigma)
+    radii = _radii(R, shape.a)
+    _neck_block(b, shape, R, radii)
+    if shape.a <= SMALL_NECK_MAX:
+        _small_neck_body(b, shape, radii)
     else:
-        _large_neck(b, shape, corner, levels, sigma)
-    return b.mesh(), shape
+        _large_neck_body(b, shape, R, radii, down, mid, on_sphere)
+    return b.mesh()
 
 
 def _corner_cells(b: _Builder, shape: SemisphereShape, corner: int, R: float, levels: int, sigma: float):
@@ -193,13 +209,24 @@ def _corner_cells(b: _Builder, shape: SemisphereShape, corner: int, R: float, le
     return down, mid, on_sphere
 
 
-def _small_neck(b: _Builder, shape: SemisphereShape, corner: int, levels: int, sigma: float) -> None:
-    a, t, z_i = shape.a, shape.t, shape.z_i
-    _corner_cells(b, shape, corner, t, levels, sigma)
-    radii = _radii(t, a)
+def _neck_block(b: _Builder, shape: SemisphereShape, R: float, radii) -> None:
+    """The neck cylinder ``[0, a] x [0, t]`` (above the cap base) as a tensor grid, without the corner cell."""
+    a, t = shape.a, shape.t
+    xs = [a - rho for rho in radii[::-1]] + [a]
+    zs = [0.0] + (_graded_breaks(R, t, 3.0 * R) if R < t else [t])
+    for i in range(len(xs) - 1):
+        for j in range(len(zs) - 1):
+            if i == len(xs) - 2 and j == 0:
+                continue  # the corner cell
+            b.quad(b.vertex(xs[i], zs[j]), b.vertex(xs[i + 1], zs[j]), b.vertex(xs[i + 1], zs[j + 1]),
+                   b.vertex(xs[i], zs[j + 1]))
+
+
+def _small_neck_body(b: _Builder, shape: SemisphereShape, radii) -> None:
+    """Below the cap base of a small neck: square rings and wedge rings around the corner out to ``a``, rings
+    around the axis point ``P`` out to ``0.6 z_i``, then spokes to the equator."""
+    a, z_i = shape.a, shape.z_i
     for rho, nxt in zip(radii[:-1], radii[1:]):
-        # neck strip above the interface, the square ring below it, the wedge ring against the sphere
-        b.quad(b.vertex(a - nxt, 0.0), b.vertex(a - rho, 0.0), b.vertex(a - rho, t), b.vertex(a - nxt, t))
         b.quad(b.vertex(a - rho, 0.0), b.vertex(a - nxt, 0.0), b.vertex(a - nxt, -nxt), b.vertex(a - rho, -rho))
         b.quad(b.vertex(a - rho, -rho), b.vertex(a - nxt, -nxt), b.vertex(a, -nxt), b.vertex(a, -rho))
         d0, d1 = _chord_delta(rho), _chord_delta(nxt)
@@ -220,7 +247,6 @@ def _small_neck(b: _Builder, shape: SemisphereShape, corner: int, levels: int, s
         for k in range(3):
             b.quad(layer[k], nxt[k], nxt[k + 1], layer[k + 1])
         layer = nxt
-    # spokes to the equator
     origin = b.vertex(0.0, -z_i)
     f1 = b.vertex(0.5 * b.points[layer[1]][0] + 1.0 / 6.0, -z_i)
     f2 = b.vertex(0.5 * b.points[layer[2]][0] + 1.0 / 3.0, -z_i)
@@ -229,21 +255,19 @@ def _small_neck(b: _Builder, shape: SemisphereShape, corner: int, levels: int, s
     _far_wedge(b, shape, f2, layer[3], layer[2])
 
 
-def _large_neck(b: _Builder, shape: SemisphereShape, corner: int, levels: int, sigma: float) -> None:
-    a, t, z_i = shape.a, shape.t, shape.z_i
-    R = min(t, 0.5 * z_i)
-    down, mid, on_sphere = _corner_cells(b, shape, corner, R, levels, sigma)
-    xs = _graded_breaks(a - R, 0.0, 3.0 * R)[::-1] + [a]
-    zs = [-z_i, -R, 0.0] + _graded_breaks(R, t, 3.0 * R)
-    if R == t:
-        zs = zs[:-1]
+def _large_neck_body(b: _Builder, shape: SemisphereShape, R: float, radii, down: int, mid: int,
+                     on_sphere: int) -> None:
+    """Below the cap base of a large neck: the cylinder ``x <= a`` as two rows of the neck's columns, then the
+    wedge between ``x = a`` and the sphere down to the equator."""
+    a, z_i = shape.a, shape.z_i
+    xs = [a - rho for rho in radii[::-1]] + [a]
+    zs = [-z_i, -R, 0.0]
     for i in range(len(xs) - 1):
         for j in range(len(zs) - 1):
-            if i == len(xs) - 2 and zs[j] in (-R, 0.0):
-                continue  # the corner cells
+            if i == len(xs) - 2 and j == 1:
+                continue  # the corner cell
             b.quad(b.vertex(xs[i], zs[j]), b.vertex(xs[i + 1], zs[j]), b.vertex(xs[i + 1], zs[j + 1]),
                    b.vertex(xs[i], zs[j + 1]))
-    # the rest of the wedge between x = a and the sphere, down to the equator
     foot = b.vertex(a, -z_i)
     f = b.vertex(0.5 * (a + 1.0), -z_i)
     b.quad(down, foot, f, mid)
@@ -267,3 +291,68 @@ def _far_wedge(b: _Builder, shape: SemisphereShape, foot: int, on_sphere: int, i
     b.quad(foot, half, centre, inner)
     b.quad(half, equator, middle, centre)
     b.quad(centre, middle, on_sphere, inner)
+
+
+def pair_quad_mesh(r_i: float, r_j: float, h: float, levels: int, sigma: float = SIGMA):
+    """The hp mesh of two sintered spheres (Rojek 2022, Sec. 6): sphere ``i`` below, ``j`` above, each built by
+    :func:`half_body` in its own radius and glued at the neck's mid-plane (both halves have the same neck radius,
+    half-neck height and corner radius, hence the same nodes there). Lengths in units of ``s = min(r_i, r_j)``, ``z``
+    from the mid-plane. Small necks only (``a <= 0.6 min(r)``, the layout whose end disk depends on ``a`` and ``t``
+    alone). Returns ``(mesh, s, bottom vertex mask, top vertex mask, a)``."""
+    geo = neck_geometry(r_i, r_j, h)
+    a, t = float(geo.a), 0.5 * float(geo.h_n)
+    s = min(r_i, r_j)
+    if a > SMALL_NECK_MAX * s:
+        raise ValueError(f"h = {h!r}: the hp pair mesh covers necks a <= {SMALL_NECK_MAX} min(r_i, r_j) (here a = "
+                         f"{a:.6g}, a/r_min = {a / s:.4g}); use method 'gmsh'")
+    halves = []
+    for r, z_cap, mirror in ((r_i, float(geo.z_i), False), (r_j, float(geo.z_j), True)):
+        shape = SemisphereShape(a=a / r, z_i=z_cap / r, t=t / r, phi_c=math.atan2(z_cap, a))
+        halves.append((half_body(shape, shape.t, levels, sigma), shape, r / s, mirror))
+    points, quads, angles, circles, index = [], [], [], [], []
+    masks, offset, interface = [], 0, None
+    for number, (mesh, shape, k, mirror) in enumerate(halves):
+        sign = -1.0 if mirror else 1.0
+        p = np.column_stack([mesh.points[:, 0] * k, sign * (mesh.points[:, 1] - shape.t) * k])
+        ids = np.arange(len(p)) + offset
+        on_disk = np.flatnonzero(mesh.points[:, 1] == shape.t)
+        on_disk = on_disk[np.argsort(p[on_disk, 0])]
+        if interface is None:
+            interface = (ids[on_disk], p[on_disk, 0])
+        else:
+            lower_ids, lower_x = interface
+            if lower_x.size != on_disk.size or not np.allclose(p[on_disk, 0], lower_x, rtol=0, atol=1e-12 * a / s):
+                raise RuntimeError("hp pair mesh: the two halves do not share the neck's mid-plane nodes")
+            ids[on_disk] = lower_ids
+            keep = np.ones(len(p), dtype=bool)
+            keep[on_disk] = False
+            ids[keep] = offset + np.arange(int(keep.sum()))
+            p = p[keep]
+        q, ang = ids[mesh.quads], mesh.arc_angles
+        if mirror:  # reversed vertex order keeps the quads counter-clockwise; edge m was edge (2 - m) mod 4
+            q, ang = q[:, ::-1], ang[:, [2, 1, 0, 3], ::-1]
+        points.append(p)
+        quads.append(q)
+        angles.append(ang)
+        index.append(np.where(np.isnan(ang[..., 0]), -1, number))
+        circles.append(_scaled_circle(shape.sphere_point, k, shape.t, sign))
+        masks.append((ids, mesh.points[:, 1] == -shape.z_i))
+        offset += len(p)
+    n = offset
+    fixed = []
+    for ids, mask in masks:
+        full = np.zeros(n, dtype=bool)
+        full[ids[mask]] = True
+        fixed.append(full)
+    mesh = QuadMesh(points=np.vstack(points), quads=np.vstack(quads), arc_angles=np.concatenate(angles),
+                    arc_circle=np.concatenate(index), circles=tuple(circles))
+    return mesh, s, fixed[0], fixed[1], a
+
+
+def _scaled_circle(circle, k: float, t: float, sign: float):
+    """``circle`` in pair coordinates: ``x k``, ``sign (z - t) k``."""
+    def point(delta):
+        p, d = circle(delta)
+        return (np.stack([p[..., 0] * k, sign * (p[..., 1] - t) * k], axis=-1),
+                np.stack([d[..., 0] * k, sign * d[..., 1] * k], axis=-1))
+    return point

@@ -36,8 +36,9 @@ class QuadMesh:
     points: ``(V, 2)`` vertex coordinates ``(x, z)`` (``x`` the radial coordinate).
     quads: ``(E, 4)`` vertex indices, counter-clockwise.
     arc_angles: ``(E, 4, 2)`` for edge ``k`` (from vertex ``k`` to ``k + 1``): the angle offsets ``(delta_start,
-    delta_end)`` of its ends along a circle, or NaN for a straight edge. The circle is ``arc_point(delta)``.
-    arc_point: function ``delta (array) -> (points (..., 2), d points / d delta (..., 2))``, cancellation-free
+    delta_end)`` of its ends along a circle, or NaN for a straight edge.
+    arc_circle: ``(E, 4)`` index into ``circles`` of a curved edge's circle (-1 for straight edges).
+    circles: functions ``delta (array) -> (points (..., 2), d points / d delta (..., 2))``, cancellation-free
     in the coordinates of ``points``.
     origin: ``(0, z0)``: absolute coordinates are ``points + origin`` (only the axial coordinate may be shifted:
     the radial one is the weight of the axisymmetric forms).
@@ -46,7 +47,8 @@ class QuadMesh:
     points: np.ndarray
     quads: np.ndarray
     arc_angles: np.ndarray
-    arc_point: object
+    arc_circle: np.ndarray
+    circles: tuple
     origin: tuple = (0.0, 0.0)
 
     @property
@@ -98,7 +100,13 @@ def _edge_offsets(mesh: QuadMesh, k: int, s: np.ndarray):
     start = mesh.points[mesh.quads[curved, k]]
     end = mesh.points[mesh.quads[curved, (k + 1) % 4]]
     d0, d1 = angles[curved, 0], angles[curved, 1]
-    point, tangent = mesh.arc_point(d0[:, None] + s[None, :] * (d1 - d0)[:, None])
+    delta = d0[:, None] + s[None, :] * (d1 - d0)[:, None]
+    point = np.empty(delta.shape + (2,))
+    tangent = np.empty_like(point)
+    which = mesh.arc_circle[curved, k]
+    for c in np.unique(which):
+        on = which == c
+        point[on], tangent[on] = mesh.circles[c](delta[on])
     chord = end - start
     offset = np.zeros((mesh.quads.shape[0], s.size, 2))
     slope = np.zeros_like(offset)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from fem_neck import conduction, hpmesh, spectral
-from fem_neck.geometry import equal_neck_radius
+from fem_neck.geometry import equal_neck_radius, neck_geometry, overlap_for_neck
 
 # (h/r, K/K_cyl) -- /work/shared/reference/README.md, semisphere table (independent hp-FE, 12 digits)
 REFERENCE = [(0.02, 0.216136324118), (0.08, 0.412739950539), (0.2, 0.655577629373), (0.4, 0.992974073489)]
@@ -35,7 +35,7 @@ def _cylinder(radius, height, nx=3, nz=2):
                        new[i + (j + 1) * (nx + 1)]] for j in range(nz) for i in range(nx)])
     quads = np.array([np.roll(q, k % 4) for k, q in enumerate(quads)])
     mesh = spectral.QuadMesh(points=points[perm], quads=quads, arc_angles=np.full(quads.shape + (2,), np.nan),
-                             arc_point=None)
+                             arc_circle=np.full(quads.shape, -1), circles=())
     return mesh, points[perm]
 
 
@@ -108,3 +108,51 @@ def test_field_is_bounded_by_the_boundary_values():
 def test_bad_input(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+# ---- pairs: two halves glued at the neck's mid-plane ---------------------------------------------------------
+
+def test_equal_pair_is_half_the_semisphere():
+    """Two equal halves in series: K_pair = K_semisphere / 2 exactly (kappa = r = 1)."""
+    a = 0.394592534534
+    h = float(overlap_for_neck(1.0, 1.0, a))
+    pair = conduction.pair_conductance(1.0, 1.0, h, 1.0, rtol=1e-8)
+    assert pair.K == pytest.approx(0.5 * math.pi * REFERENCE[1][1], rel=1e-8)
+
+
+@pytest.mark.parametrize("ratio, a_over_r", [(1.0, 0.001), (3.0, 0.42), (10.0, 0.02), (100.0, 0.3)])
+def test_pair_mesh_is_valid_and_exact_in_volume(ratio, a_over_r):
+    r_i, r_j = 1.0, ratio
+    h = float(overlap_for_neck(r_i, r_j, a_over_r))
+    mesh, s, bottom, top, a = hpmesh.pair_quad_mesh(r_i, r_j, h, 5)
+    geo = neck_geometry(r_i, r_j, h)
+    exact = sum(math.pi * (float(z) * r**2 - float(z) ** 3 / 3.0) for r, z in ((r_i, geo.z_i), (r_j, geo.z_j)))
+    exact += math.pi * a**2 * float(geo.h_n)
+    volume, det_min = spectral.measure(mesh, order=6)
+    assert det_min > 0.0
+    assert volume * s**3 == pytest.approx(exact, rel=1e-12)
+    assert bottom.sum() > 2 and top.sum() > 2 and not np.any(bottom & top)
+
+
+def test_paper_pair_matches_the_converged_gmsh_value():
+    """Rojek 2022 Sec. 6 (copper, r = 1 and 3 mm, h = 0.06 mm): the gmsh path's ladder converges to 0.279167696."""
+    res = conduction.pair_conductance(1e-3, 3e-3, 0.06e-3, 394.0, rtol=1e-8)
+    assert res.error_estimate <= 1e-8
+    assert res.K == pytest.approx(0.279167696, rel=3e-9)
+
+
+@pytest.mark.parametrize("ratio, a_over_r", [(2.0, 0.42), (10.0, 0.02), (10.0, 0.6)])
+def test_hp_pair_agrees_with_the_gmsh_pair(ratio, a_over_r):
+    r_i, r_j = 1e-3, ratio * 1e-3
+    h = float(overlap_for_neck(r_i, r_j, a_over_r * r_i))
+    hp = conduction.pair_conductance(r_i, r_j, h, 394.0, rtol=1e-8, method="hp")
+    tri = conduction.pair_conductance(r_i, r_j, h, 394.0, rtol=1e-5, method="gmsh")
+    assert abs(hp.K - tri.K) / hp.K <= hp.error_estimate + tri.error_estimate
+
+
+def test_pair_auto_falls_back_to_gmsh_for_large_necks():
+    h = float(overlap_for_neck(1.0, 1.0, 0.8))
+    auto = conduction.pair_conductance(1.0, 1.0, h, 1.0, rtol=1e-3)
+    assert auto.order <= 4 and auto.grading != hpmesh.SIGMA  # the triangle path
+    with pytest.raises(ValueError, match="hp pair mesh covers necks a <= 0.6"):
+        conduction.pair_conductance(1.0, 1.0, h, 1.0, method="hp")

@@ -31,12 +31,14 @@ def _floats(name: str, text: str) -> list:
     return values
 
 
-def _add_accuracy(p, semisphere: bool = False) -> None:
+def _add_accuracy(p, methods: tuple = ()) -> None:
     p.add_argument("--rtol", type=float, default=1e-4, help="relative tolerance of K (default 1e-4)")
-    if semisphere:
-        p.add_argument("--method", choices=("hp", "gmsh"), default="hp",
+    if methods:
+        p.add_argument("--method", choices=methods, default=methods[0],
                        help="hp: spectral elements on a geometric mesh with the exact sphere, order raised until two "
-                       "orders agree (default, milliseconds); gmsh: the graded triangle mesh of pairs and chains")
+                       "orders agree (milliseconds; pairs: necks up to 0.6 r_min); gmsh: the graded triangle mesh "
+                       "of chains" + ("; auto: hp where it applies, else gmsh" if "auto" in methods else "")
+                       + f" (default {methods[0]})")
         p.add_argument("--order", type=int, default=None,
                        help="first order tried (hp: 2-11) or order of the reported solve (gmsh: 2-4); default: "
                        "from --rtol")
@@ -54,7 +56,7 @@ def register(subparsers) -> None:
     size = p.add_mutually_exclusive_group(required=True)
     size.add_argument("--h-over-r", type=float, metavar="X", help="overlap of the two spheres over r, 0 < X < 2/3")
     size.add_argument("--a-over-r", type=float, metavar="X", help="neck radius over r, 0 < X < 1")
-    _add_accuracy(p, semisphere=True)
+    _add_accuracy(p, ("hp", "gmsh"))
     p.set_defaults(run=run_semisphere)
 
     p = subparsers.add_parser(
@@ -65,7 +67,7 @@ def register(subparsers) -> None:
     p.add_argument("--rj", type=float, required=True, metavar="R_J", help="radius of particle j [m]")
     p.add_argument("--h", type=float, required=True, metavar="H", help="overlap r_i + r_j - d [m]")
     p.add_argument("--kappa", type=float, required=True, help="thermal conductivity [W/(m K)]")
-    _add_accuracy(p)
+    _add_accuracy(p, ("auto", "hp", "gmsh"))
     p.set_defaults(run=run_pair)
 
     p = subparsers.add_parser(
@@ -146,7 +148,8 @@ def run_pair(args) -> dict:
     from fem_neck import conduction
 
     result = _mesh_errors_as_value_errors(
-        lambda: conduction.pair_conductance(args.ri, args.rj, args.h, args.kappa, rtol=args.rtol, order=args.order))
+        lambda: conduction.pair_conductance(args.ri, args.rj, args.h, args.kappa, rtol=args.rtol, order=args.order,
+                                            method=args.method))
     summary = {"a": result.necks[0], **_compare(result, args.kappa, result.necks), **_accuracy_fields(result)}
     out = _output_dir(args)
     if out is not None:
