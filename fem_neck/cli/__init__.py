@@ -4,6 +4,8 @@ Each sub-command lives in its own module of this package and exposes ``register(
 parser and sets ``run``: a function of the parsed arguments returning a JSON-ready dict. :func:`main` prints that
 dict (``--json``: one object on stdout, nothing else), turns a ``ValueError`` into one line on stderr with exit code
 2, and never shows a traceback for bad input (an ``OSError``, e.g. ``--out`` naming a file, is treated the same).
+Warnings raised while a command runs (e.g. numpy overflow in an extreme input) are collected: after an error only
+the one error line is printed; after success each distinct warning is one ``warning:`` line on stderr.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import json
 import os
 import re
 import sys
+import warnings
 
 COMMAND_MODULES = ("neck", "solve", "converge", "fit", "unequal", "cluster")  # each module imports its heavy dependencies (gmsh, scikit-fem) inside run()
 
@@ -103,10 +106,17 @@ def main(argv=None, *, prog="python -m fem_neck", description=None, modules=COMM
          package="fem_neck.cli") -> int:
     parser = build_parser(prog, description or __doc__.splitlines()[0], modules, package)
     args = parser.parse_args(argv)
-    try:
-        result = args.run(args)
-    except (ValueError, OSError) as exc:  # bad input, or an output path that cannot be written
-        sys.stderr.write(f"{prog} {args.command}: error: {exc}\n")
-        return 2
+    with warnings.catch_warnings(record=True) as caught:
+        try:
+            result = args.run(args)
+        except (ValueError, OSError) as exc:  # bad input, or an output path that cannot be written
+            sys.stderr.write(f"{prog} {args.command}: error: {_one_line(exc)}\n")
+            return 2
+    for text in dict.fromkeys(f"{w.category.__name__}: {_one_line(w.message)}" for w in caught):
+        sys.stderr.write(f"{prog} {args.command}: warning: {text}\n")
     print_result(result, args.json)
     return 0
+
+
+def _one_line(message) -> str:
+    return " ".join(str(message).split())

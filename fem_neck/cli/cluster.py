@@ -1,6 +1,23 @@
 """``python -m fem_neck cluster``: steady 3D FE conduction through a small cluster of sintered spheres."""
 
+import math
+
 from fem_neck.cli import add_output_options
+
+# What one 3D solve can afford: the mesh sizes' range, the particle count, and a run-time budget. Measured on 2 cores
+# for two spheres: defaults ~1.5 s, size_far 0.1 ~9 s, 0.06 ~39 s, size_neck 0.04 ~14 s; estimate_seconds fits that.
+SIZE_NECK = (0.02, 1.0)
+SIZE_FAR = (0.05, 1.0)
+MAX_PARTICLES = 40
+MAX_SECONDS = 300.0
+
+
+def estimate_seconds(n: int, size_neck: float, size_far: float, levels: int) -> float:
+    """Rough run time (s) of a cluster solve on 2 cores: per particle ~0.75 s x ((0.25/size_far)^2.2 +
+    (0.12/size_neck)^2); the coarser level of ``--levels 2`` adds about 40 %."""
+    per_level = 0.75 * n * ((0.25 / size_far) ** 2.2 + (0.12 / size_neck) ** 2)
+    return per_level * (1.4 if levels == 2 else 1.0)
+TERMINAL_KEYS = {"particle", "T", "kind", "rho"}
 
 
 def register(subparsers) -> None:
@@ -15,10 +32,12 @@ def register(subparsers) -> None:
         "centre ball of radius rho*r. Output: K = Q/(T_hot - T_cold) in W/K and each particle's mean temperature; "
         "with --levels 2 also the change from a coarser mesh (an error bar).",
     )
-    p.add_argument("file", help="cluster JSON file")
+    p.add_argument("file", help=f"cluster JSON file (at most {MAX_PARTICLES} particles)")
     p.add_argument("--kappa", type=float, default=394.0, help="thermal conductivity [W/(m K)] (default 394)")
-    p.add_argument("--size-neck", type=float, default=0.12, help="element size at the neck circles / a")
-    p.add_argument("--size-far", type=float, default=0.25, help="element size away from the necks / r")
+    p.add_argument("--size-neck", type=float, default=0.12,
+                   help=f"element size at the neck circles / a, in [{SIZE_NECK[0]:g}, {SIZE_NECK[1]:g}]")
+    p.add_argument("--size-far", type=float, default=0.25,
+                   help=f"element size away from the necks / r, in [{SIZE_FAR[0]:g}, {SIZE_FAR[1]:g}]")
     p.add_argument("--levels", type=int, choices=(1, 2), default=2, help="mesh levels (2: error bar)")
     add_output_options(p)
     p.set_defaults(run=run)
@@ -33,8 +52,20 @@ def run(args) -> dict:
 
     try:
         data = json.loads(pathlib.Path(args.file).read_text())
-    except (OSError, json.JSONDecodeError) as exc:
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ValueError(f"file = {args.file!r}: cannot be read as JSON ({exc})") from exc
+    for name, (low, high) in (("size_neck", SIZE_NECK), ("size_far", SIZE_FAR)):
+        value = getattr(args, name)
+        if not low <= value <= high:  # False for NaN
+            raise ValueError(f"{name} = {value!r}: valid range {low:g} <= {name} <= {high:g}")
+    if not (0.0 < args.kappa < math.inf):
+        raise ValueError(f"kappa = {args.kappa!r}: must be finite and > 0")
+    data = checked_cluster_data(data)
+    seconds = estimate_seconds(len(data["radii"]), args.size_neck, args.size_far, args.levels)
+    if seconds > MAX_SECONDS:
+        raise ValueError(f"size_neck = {args.size_neck:g}, size_far = {args.size_far:g} with {len(data['radii'])} "
+                         f"particles and --levels {args.levels}: an estimated {seconds:.0f} s exceeds the budget of "
+                         f"{MAX_SECONDS:.0f} s for one run; use coarser sizes, --levels 1 or fewer particles")
     cluster, terminals = load_cluster_json(data)
     t0 = time.perf_counter()
     sizes = [(args.size_neck, args.size_far)]
@@ -44,9 +75,10 @@ def run(args) -> dict:
     for size_neck, size_far in sizes:
         cmesh = build_cluster_mesh(cluster, terminals, size_neck=size_neck, size_far=size_far,
                                    curvature=max(12, int(round(4.0 / size_far))))
-        results.append((cmesh, solve_cluster(cmesh, kappa=args.kappa, order=2)))
+        # K is linear in kappa: solve with kappa = 1 and scale, so any kappa a float holds keeps full precision
+        results.append((cmesh, solve_cluster(cmesh, kappa=1.0, order=2)))
     cmesh, sol = results[-1]
-    out = {"K": sol.K, "Q": sol.Q, "particle_T": sol.particle_T.tolist(), "necks": cmesh.neck_a.tolist(),
+    out = {"K": args.kappa * sol.K, "Q": args.kappa * sol.Q, "particle_T": sol.particle_T.tolist(), "necks": cmesh.neck_a.tolist(),
            "dofs": int(sol.dofs), "error_estimate": (abs(sol.K - results[0][1].K) / sol.K if len(results) > 1
                                                 else None),
            "volume_exact": float(cmesh.volume_exact), "seconds": time.perf_counter() - t0}
@@ -56,3 +88,68 @@ def run(args) -> dict:
         (path / "cluster.json").write_text(json.dumps(out, indent=2) + "\n")
         write_vtu(cmesh, sol, path / "cluster.vtu")
     return out
+
+
+def _numbers(name: str, value, shape_tail: tuple = ()) -> list:
+    """``value`` as a (nested) list of finite JSON numbers of rank ``1 + len(shape_tail)``, else ValueError."""
+    if not isinstance(value, list):
+        raise ValueError(f"cluster file: {name} = {value!r:.60}: must be a list")
+    for k, item in enumerate(value):
+        if shape_tail:
+            if not isinstance(item, list) or len(item) != shape_tail[0]:
+                raise ValueError(f"cluster file: {name}[{k}] = {item!r:.60}: must be a list of {shape_tail[0]} numbers")
+            _numbers(f"{name}[{k}]", item, shape_tail[1:])
+        elif not isinstance(item, (int, float)) or isinstance(item, bool) or not math.isfinite(item):
+            raise ValueError(f"cluster file: {name}[{k}] = {item!r}: must be a finite number")
+    return value
+
+
+def _index(name: str, value, n: int) -> int:
+    if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value < n:
+        raise ValueError(f"cluster file: {name} = {value!r}: must be an integer particle index in 0..{n - 1}")
+    return value
+
+
+def checked_cluster_data(data) -> dict:
+    """The cluster JSON with every entry's type, shape and range checked, naming the first bad entry."""
+    if not isinstance(data, dict):
+        raise ValueError(f"cluster file: must be a JSON object with centres, radii, bonds, terminals; got "
+                         f"{type(data).__name__}")
+    keys = {"centres", "radii", "bonds", "terminals"}
+    for key in sorted(keys - set(data)):
+        raise ValueError(f"cluster file: {key}: required (keys: {', '.join(sorted(keys))})")
+    for key in sorted(set(data) - keys):
+        raise ValueError(f"cluster file: {key}: unknown key (keys: {', '.join(sorted(keys))})")
+    centres = _numbers("centres", data["centres"], (3,))
+    radii = _numbers("radii", data["radii"])
+    n = len(radii)
+    if len(centres) != n:
+        raise ValueError(f"cluster file: radii has {n} entries but centres has {len(centres)}")
+    if not 1 <= n <= MAX_PARTICLES:
+        raise ValueError(f"cluster file: {n} particles: valid range 1 to {MAX_PARTICLES} for one 3D FE solve (use the "
+                         f"DEM, python -m dem, for larger packings)")
+    if not isinstance(data["bonds"], list):
+        raise ValueError(f"cluster file: bonds = {data['bonds']!r:.60}: must be a list of [i, j] pairs")
+    for k, bond in enumerate(data["bonds"]):
+        if not isinstance(bond, list) or len(bond) != 2:
+            raise ValueError(f"cluster file: bonds[{k}] = {bond!r:.60}: must be a pair [i, j] of particle indices")
+        for m in (0, 1):
+            _index(f"bonds[{k}][{m}]", bond[m], n)
+    if not isinstance(data["terminals"], list):
+        raise ValueError(f"cluster file: terminals = {data['terminals']!r:.60}: must be a list of objects")
+    for k, t in enumerate(data["terminals"]):
+        if not isinstance(t, dict):
+            raise ValueError(f"cluster file: terminals[{k}] = {t!r:.60}: must be an object {{\"particle\": k, "
+                             f"\"T\": ..., \"kind\": \"plane\"|\"core\", \"rho\": 0.25}}")
+        for key in sorted(set(t) - TERMINAL_KEYS):
+            raise ValueError(f"cluster file: terminals[{k}].{key}: unknown key (keys: {', '.join(sorted(TERMINAL_KEYS))})")
+        for key in ("particle", "T"):
+            if key not in t:
+                raise ValueError(f"cluster file: terminals[{k}].{key}: required")
+        _index(f"terminals[{k}].particle", t["particle"], n)
+        _numbers(f"terminals[{k}].T", [t["T"]])
+        if "rho" in t:
+            _numbers(f"terminals[{k}].rho", [t["rho"]])
+        if not isinstance(t.get("kind", "plane"), str):
+            raise ValueError(f"cluster file: terminals[{k}].kind = {t['kind']!r}: must be \"plane\" or \"core\"")
+    return data

@@ -14,6 +14,7 @@ import numpy as np
 from fem_neck.cli import add_output_options
 
 PAPER_SLOPE = 1.064  # Rojek 2022, eq. (40)
+MAX_CHAIN = 50  # spheres in one chain solve (40 take ~28 s and 1.4 GB on 2 cores)
 
 
 def model_bond_conductance(kappa: float, a):
@@ -74,7 +75,7 @@ def register(subparsers) -> None:
         "chain", help="conductance of a collinear chain of sintered spheres (FE vs the pipe model)",
         description="Chain of spheres on one axis, end particles cut at their outer equatorial planes, T fixed "
         "there. The model: eq. (43) halves in series over all bonds.")
-    p.add_argument("--radii", required=True, metavar="R1,R2,...", help="sphere radii [m]")
+    p.add_argument("--radii", required=True, metavar="R1,R2,...", help=f"sphere radii [m] (2 to {MAX_CHAIN} spheres)")
     p.add_argument("--overlaps", required=True, metavar="H1,...", help="overlap of each bond [m] (one fewer)")
     p.add_argument("--kappa", type=float, required=True, help="thermal conductivity [W/(m K)]")
     _add_accuracy(p)
@@ -162,6 +163,10 @@ def run_chain(args) -> dict:
     from fem_neck import conduction
 
     radii = _floats("radii", args.radii)
+    if len(radii) > MAX_CHAIN:
+        raise ValueError(f"radii: {len(radii)} spheres exceeds the limit of {MAX_CHAIN} for one FE solve (about "
+                         f"0.7 s and 35 MB per sphere at 40, growing faster than linearly); the bonds are in series, so "
+                         f"solve shorter pieces")
     overlaps = _floats("overlaps", args.overlaps)
     result = _mesh_errors_as_value_errors(
         lambda: conduction.chain_conductance(radii, overlaps, args.kappa, rtol=args.rtol, order=args.order))

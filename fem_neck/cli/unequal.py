@@ -23,8 +23,16 @@ def register(subparsers) -> None:
     p.set_defaults(run=run, out="results/unequal")
 
 
+MAX_PAIRS = 200  # FE pair solves in one study (~1 s each of one core)
+
+
 def run(args) -> dict:
     from fem_neck.unequal import study
+
+    pairs = len(args.ratios.split(",")) * len(args.necks.split(","))
+    if pairs > MAX_PAIRS:
+        raise ValueError(f"ratios x necks = {pairs} pair solves exceeds the limit of {MAX_PAIRS} for one study (each "
+                         f"is an FE solve of ~1 s); run fewer ratios or necks at a time")
 
     result = study(args.ratios.split(","), args.necks.split(","), args.rtol, args.out, workers=args.workers)
     return {k: v for k, v in result.items() if k != "cases"} | {"out": str(args.out)}
