@@ -246,7 +246,23 @@ class Solution:
     jacobian_min: float
 
 
+@functools.lru_cache(maxsize=None)
+def _blas():
+    """The BLAS thread-pool controller (threadpoolctl), made once: limiting a pool then costs ~20 us."""
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
+
+
 def conductance(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
+    """:func:`solve` with BLAS on one thread: the dense work here is many small products, for which a second BLAS
+    thread only adds synchronisation -- on a busy 2-core machine it made the element matrices 3-6x slower and a
+    dense 300 x 300 Cholesky 5-50x slower (measured); parallel sweeps use processes instead."""
+    with _blas().limit(limits=1, user_api="blas"):
+        return solve(mesh, order, fixed_vertices)
+
+
+def solve(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
     """Solve ``div(x grad T) = 0`` with ``T`` held at ``value`` on every edge whose two vertices are in
     ``fixed_vertices[value]`` (a boolean mask over the vertices; two values), insulated elsewhere; return ``K / kappa
     = 2 pi u^T A u / (Delta T)^2``. Element interiors are condensed (Schur complement, batched) so only the skeleton
