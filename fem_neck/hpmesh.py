@@ -298,7 +298,8 @@ def pair_quad_mesh(r_i: float, r_j: float, h: float, levels: int, sigma: float =
     :func:`half_body` in its own radius and glued at the neck's mid-plane (both halves have the same neck radius,
     half-neck height and corner radius, hence the same nodes there). Lengths in units of ``s = min(r_i, r_j)``, ``z``
     from the mid-plane. Small necks only (``a <= 0.6 min(r)``, the layout whose end disk depends on ``a`` and ``t``
-    alone). Returns ``(mesh, s, bottom vertex mask, top vertex mask, a)``."""
+    alone); ``mesh.origin`` puts absolute ``z`` at sphere ``i``'s centre, as on the gmsh path. Returns ``(mesh, s,
+    bottom vertex mask, top vertex mask, a)``."""
     geo = neck_geometry(r_i, r_j, h)
     a, t = float(geo.a), 0.5 * float(geo.h_n)
     s = min(r_i, r_j)
@@ -345,7 +346,7 @@ def pair_quad_mesh(r_i: float, r_j: float, h: float, levels: int, sigma: float =
         full[ids[mask]] = True
         fixed.append(full)
     mesh = QuadMesh(points=np.vstack(points), quads=np.vstack(quads), arc_angles=np.concatenate(angles),
-                    arc_circle=np.concatenate(index), circles=tuple(circles))
+                    arc_circle=np.concatenate(index), circles=tuple(circles), origin=(0.0, (float(geo.z_i) + t) / s))
     return mesh, s, fixed[0], fixed[1], a
 
 
