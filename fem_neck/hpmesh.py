@@ -119,6 +119,16 @@ class _Builder:
             ray1, opposite, ray2 = r1, o, r2
         self.quad(corner, ray1, opposite, ray2)
 
+    def grid(self, xs, zs, skip_row: int) -> None:
+        """The tensor grid of cells ``[xs[i], xs[i+1]] x [zs[j], zs[j+1]]``, without the last column's row
+        ``skip_row`` (a corner cell, built by :meth:`corner_cell`)."""
+        for i in range(len(xs) - 1):
+            for j in range(len(zs) - 1):
+                if i == len(xs) - 2 and j == skip_row:
+                    continue
+                self.quad(self.vertex(xs[i], zs[j]), self.vertex(xs[i + 1], zs[j]),
+                          self.vertex(xs[i + 1], zs[j + 1]), self.vertex(xs[i], zs[j + 1]))
+
     def mesh(self) -> QuadMesh:
         points = np.array(self.points)
         quads = np.array(self.quads, dtype=np.int64)
@@ -212,14 +222,8 @@ def _corner_cells(b: _Builder, shape: SemisphereShape, corner: int, R: float, le
 def _neck_block(b: _Builder, shape: SemisphereShape, R: float, radii) -> None:
     """The neck cylinder ``[0, a] x [0, t]`` (above the cap base) as a tensor grid, without the corner cell."""
     a, t = shape.a, shape.t
-    xs = [a - rho for rho in radii[::-1]] + [a]
-    zs = [0.0] + (_graded_breaks(R, t, 3.0 * R) if R < t else [t])
-    for i in range(len(xs) - 1):
-        for j in range(len(zs) - 1):
-            if i == len(xs) - 2 and j == 0:
-                continue  # the corner cell
-            b.quad(b.vertex(xs[i], zs[j]), b.vertex(xs[i + 1], zs[j]), b.vertex(xs[i + 1], zs[j + 1]),
-                   b.vertex(xs[i], zs[j + 1]))
+    b.grid([a - rho for rho in radii[::-1]] + [a], [0.0] + (_graded_breaks(R, t, 3.0 * R) if R < t else [t]),
+           skip_row=0)
 
 
 def _small_neck_body(b: _Builder, shape: SemisphereShape, radii) -> None:
@@ -260,14 +264,7 @@ def _large_neck_body(b: _Builder, shape: SemisphereShape, R: float, radii, down:
     """Below the cap base of a large neck: the cylinder ``x <= a`` as two rows of the neck's columns, then the
     wedge between ``x = a`` and the sphere down to the equator."""
     a, z_i = shape.a, shape.z_i
-    xs = [a - rho for rho in radii[::-1]] + [a]
-    zs = [-z_i, -R, 0.0]
-    for i in range(len(xs) - 1):
-        for j in range(len(zs) - 1):
-            if i == len(xs) - 2 and j == 1:
-                continue  # the corner cell
-            b.quad(b.vertex(xs[i], zs[j]), b.vertex(xs[i + 1], zs[j]), b.vertex(xs[i + 1], zs[j + 1]),
-                   b.vertex(xs[i], zs[j + 1]))
+    b.grid([a - rho for rho in radii[::-1]] + [a], [-z_i, -R, 0.0], skip_row=1)
     foot = b.vertex(a, -z_i)
     f = b.vertex(0.5 * (a + 1.0), -z_i)
     b.quad(down, foot, f, mid)
