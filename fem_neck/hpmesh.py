@@ -15,11 +15,15 @@ converges exponentially when the elements shrink geometrically toward ``C`` whil
   sphere radius is covered by elements of its own size;
 * a few **far cells** that reach the equator.
 
-Two layouts share the corner cells: *small neck* (``a <= 0.6``: ``R = t``, neck strips over the rings, rings to the
-axis, then rings around ``P``) and *large neck* (``a > 0.6``: ``R = min(t, z_i / 2)`` and a tensor grid of the
-cylinder ``x <= a``). Coordinates are ``(x, z - z_i)``: relative to the corner's height, so elements of size 1e-15
-next to ``C`` keep full precision even at ``a = 1e-4`` (where ``t = 2.5e-9``); points on the sphere are given by
-their angle offset ``delta`` from ``C`` and evaluated without cancellation.
+The neck above the cap base is a tensor grid whose columns end at ``x = a - rho`` for the ring radii ``rho``. Two
+layouts of the body below share the corner cells: *small neck* (``a <= 0.6``, ``R = t``: square and wedge rings to
+the axis, then rings around ``P`` and spokes to the equator) and *large neck* (``a > 0.6``, ``R = min(t, z_i / 2)``:
+two rows of the neck's columns, then the wedge down to the equator). A pair (:func:`pair_quad_mesh`) is two such
+half bodies, each in its own sphere radius, glued at the neck's mid-plane.
+
+Coordinates are ``(x, z - z_i)``: relative to the corner's height, so elements of size 1e-15 next to ``C`` keep full
+precision even at ``a = 1e-4`` (where ``t = 2.5e-9``); points on the sphere are given by their angle offset
+``delta`` from ``C`` and evaluated without cancellation.
 """
 
 from __future__ import annotations
