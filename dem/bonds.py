@@ -165,12 +165,19 @@ def _pair_contacts(p: Particles, i, j, contact, policy):
     elif count:
         clipped = count
     if contact == "lens":
-        if clipped:  # the smaller sphere's centre on the radical plane: a is its radius
-            small = np.where(r_i <= r_j, l_i, l_j)
-            fix = small < 0
-            l_i = np.where(fix & (r_i <= r_j), 0.0, l_i)
-            l_j = np.where(fix & (r_j < r_i), 0.0, l_j)
-        a = np.sqrt(np.maximum(r_i**2 - np.maximum(l_i, 0.0) ** 2, 0.0))
+        small_i = r_i <= r_j
+        if clipped:  # the smaller sphere's centre on the radical plane: a is its radius, the larger's pipe is d
+            coincident = np.flatnonzero(bad & (d == 0.0))
+            if coincident.size:
+                k = int(coincident[0])
+                raise ValueError(f"particles {i[k]} and {j[k]} coincide (d = 0): the lens law's conductance "
+                                 f"kappa pi a^2 / d is infinite; remove the duplicate particle or set "
+                                 f"conductance.out_of_range = \"drop\"")
+            l_i = np.where(bad, np.where(small_i, 0.0, d), l_i)
+            l_j = np.where(bad, np.where(small_i, d, 0.0), l_j)
+        # a from the smaller sphere (the same circle for a valid lens; the clipped one is that sphere's equator)
+        r_small, l_small = np.where(small_i, r_i, r_j), np.where(small_i, l_i, l_j)
+        a = np.sqrt(np.maximum(r_small**2 - np.maximum(l_small, 0.0) ** 2, 0.0))
     else:
         h_model = np.minimum(h, max_overlap(r_i, r_j)) if clipped else h
         a = np.asarray(neck_radius(r_i, r_j, h_model, method=contact)) if len(h) else np.zeros(0)
@@ -210,8 +217,12 @@ def _wall_contacts(p: Particles, walls, contact, policy):
         dropped = count
     elif count:
         clipped = count
-        delta = np.minimum(delta, r / 3.0) if contact != "lens" else delta
-        dist = np.maximum(dist, 0.0)
+        if contact == "lens":  # centre on or behind the plane: the pipe has no length, the conductance no bound
+            k = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"particle {k_p[k]} has its centre on or behind wall {walls[k_w[k]].name!r} (distance "
+                             f"{dist[k]:.6g} m): the lens law's conductance kappa pi a^2 / L is infinite at L = 0; "
+                             f"move the wall or set conductance.out_of_range = \"drop\"")
+        delta = np.minimum(delta, r / 3.0)
     if contact == "lens":
         a = np.sqrt(np.maximum(r**2 - dist**2, 0.0))
     else:

@@ -21,6 +21,8 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.spatial import cKDTree
 
+from fem_neck.geometry import max_overlap
+
 DISTRIBUTIONS = ("constant", "uniform", "lognormal")
 MAX_PARTICLES = 5_000_000  # ~1.7 GiB peak per 10^6 particles (steady, AMG): larger packings need a distributed backend
 
@@ -50,9 +52,16 @@ def _positive(name, value):
     return float(value)
 
 
+def _floats(name, value) -> np.ndarray:
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"[generator] {name} = {value!r}: must be a number or a list of numbers") from None
+
+
 def _overlap(value, count, name="overlap"):
-    arr = np.broadcast_to(np.asarray(value, dtype=float), (count,)) if np.ndim(value) == 0 else np.asarray(
-        value, dtype=float)
+    arr = _floats(name, value)
+    arr = np.broadcast_to(arr, (count,)) if arr.ndim == 0 else arr
     if arr.shape != (count,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
         raise ValueError(f"[generator] {name} = {value!r}: must be a number > 0 or a list of {count} such numbers "
                          f"(relative to the smaller radius of each pair)")
@@ -61,14 +70,22 @@ def _overlap(value, count, name="overlap"):
 
 def chain(n: int, radius, overlap) -> Layout:
     """``n`` collinear particles along z; ``radius`` scalar or per particle, ``overlap`` scalar or per bond."""
-    if not isinstance(n, int) or n < 1:
+    if not isinstance(n, int) or isinstance(n, bool) or n < 1:
         raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
     _check_count(n, "n")
-    r = np.broadcast_to(np.asarray(radius, dtype=float), (n,)).copy() if np.ndim(radius) == 0 else np.asarray(
-        radius, dtype=float)
+    r = _floats("radius", radius)
+    r = np.broadcast_to(r, (n,)).copy() if r.ndim == 0 else r
     if r.shape != (n,) or not np.all(np.isfinite(r)) or np.any(r <= 0):
         raise ValueError(f"[generator] radius = {radius!r}: must be a number > 0 or a list of {n} such numbers")
-    h = _overlap(overlap, n - 1) * np.minimum(r[:-1], r[1:])
+    rel = _overlap(overlap, n - 1)
+    h = rel * np.minimum(r[:-1], r[1:])
+    h_max = max_overlap(r[:-1], r[1:])
+    beyond = np.flatnonzero(h > h_max * (1.0 + 1e-12))
+    if beyond.size:
+        k = int(beyond[0])
+        raise ValueError(f"[generator] overlap[{k}] = {rel[k]:.9g}: valid range 0 < overlap <= "
+                         f"{h_max[k] / min(r[k], r[k + 1]):.9g} for radii {r[k]:.6g} and {r[k + 1]:.6g} m (relative to "
+                         f"the smaller radius; there the neck reaches it)")
     z = np.concatenate([[0.0], np.cumsum(r[:-1] + r[1:] - h)])
     pos = np.column_stack([np.zeros(n), np.zeros(n), z])
     return Layout(pos, r, np.array([0]), np.array([n - 1]), float(z[0] - r[0]), float(z[-1] + r[-1]),
@@ -78,11 +95,15 @@ def chain(n: int, radius, overlap) -> Layout:
 def lattice(shape, radius, overlap) -> Layout:
     """A simple cubic block of ``shape = [nx, ny, nz]`` equal spheres, spacing ``2r - h``."""
     if (not isinstance(shape, (list, tuple)) or len(shape) != 3
-            or not all(isinstance(k, int) and k >= 1 for k in shape)):
+            or not all(isinstance(k, int) and not isinstance(k, bool) and k >= 1 for k in shape)):
         raise ValueError(f"[generator] shape = {shape!r}: must be three integers >= 1")
-    _check_count(int(np.prod(shape)), "shape")
+    _check_count(shape[0] * shape[1] * shape[2], "shape")  # Python integers: no overflow
     r = _positive("radius", radius)
-    s = 2.0 * r - float(_overlap(overlap, 1)[0]) * r
+    rel = float(_overlap(overlap, 1)[0])
+    if rel > 2.0 / 3.0:
+        raise ValueError(f"[generator] overlap = {overlap!r}: valid range 0 < overlap <= 2/3 (relative to the radius; "
+                         f"at 2/3 the neck reaches the radius)")
+    s = 2.0 * r - rel * r
     nx, ny, nz = shape
     ix, iy, iz = np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij")
     pos = s * np.column_stack([ix.ravel(), iy.ravel(), iz.ravel()]).astype(float)
@@ -109,9 +130,14 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
     """Random sintered packing (module docstring); ``radius`` is the mean radius, ``overlap`` the target mean of
     ``h / min(r_i, r_j)`` over bonded pairs, ``jitter`` the half-width of the position noise over the neighbour
     distance."""
-    if not isinstance(n, int) or n < 1:
+    if not isinstance(n, int) or isinstance(n, bool) or n < 1:
         raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
     _check_count(n, "n")
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise ValueError(f"[generator] seed = {seed!r}: must be an integer >= 0")
+    for name, value in (("radius_spread", radius_spread), ("jitter", jitter)):
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            raise ValueError(f"[generator] {name} = {value!r}: must be a number")
     r_mean = _positive("radius", radius)
     target = float(_overlap(overlap, 1)[0])
     if target >= 2.0 / 3.0:

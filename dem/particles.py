@@ -12,6 +12,26 @@ from dataclasses import dataclass, field
 import numpy as np
 
 
+# Magnitudes the network stays representable for (C_i T_i, K_ij dT and their sums finite in double precision); each
+# range is far wider than any sintered powder, and a value outside is refused with the range in the message.
+RADIUS_RANGE = (1e-12, 1e6)            # m
+POSITION_MAX = 1e12                    # m, |x|, |y|, |z|
+TEMPERATURE_MAX = 1e12                 # |T| in the scene's unit (K or C)
+PROPERTY_RANGE = (1e-10, 1e10)         # conductivity W/(m K), density kg/m^3, specific heat J/(kg K)
+
+
+def check_range(name: str, arr: np.ndarray, low: float | None, high: float, what: str = "") -> np.ndarray:
+    """Raise ``ValueError`` naming the first entry outside ``[low, high]`` (``|value| <= high`` when ``low`` is
+    None) and the valid range."""
+    bad = (np.abs(arr) > high) if low is None else ((arr < low) | (arr > high))
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        where = f"[{k}]" if np.ndim(arr) else ""
+        valid = f"|value| <= {high:g}" if low is None else f"{low:g} <= value <= {high:g}"
+        raise ValueError(f"{name}{where} = {np.ravel(arr)[k]:.9g}: outside the valid range {valid}{what}")
+    return arr
+
+
 def finite_array(name: str, value, shape_tail=(), dtype=float) -> np.ndarray:
     """``value`` as an array of rank ``1 + len(shape_tail)`` with the given trailing shape and finite entries."""
     try:
@@ -51,6 +71,7 @@ class Material:
             value = getattr(self, key)
             if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value) or value <= 0:
                 raise ValueError(f"material {self.name!r}: {key} = {value!r}: must be a finite number > 0")
+            check_range(f"material {self.name!r}: {key}", np.float64(value), *PROPERTY_RANGE)
 
 
 COPPER = Material(394.0, 8960.0, 385.0, "copper")
@@ -86,8 +107,11 @@ class Particles:
         n = len(pos)
         if n == 0:
             raise ValueError(f"{prefix}{sep}position: at least one particle is required")
+        check_range(f"{prefix}{sep}position", pos, None, POSITION_MAX, " m")
         rad = check_positive_entries(f"{prefix}{sep}radius", finite_array(f"{prefix}{sep}radius", radius))
-        temp = finite_array(f"{prefix}{sep}temperature", temperature)
+        check_range(f"{prefix}{sep}radius", rad, *RADIUS_RANGE, " m")
+        temp = check_range(f"{prefix}{sep}temperature", finite_array(f"{prefix}{sep}temperature", temperature),
+                           None, TEMPERATURE_MAX)
         mat = np.zeros(n, dtype=np.int64) if material is None else finite_array(f"{prefix}{sep}material", material,
                                                                                 dtype=np.int64)
         fix = np.zeros(n, dtype=bool) if fixed is None else _bool_array(f"{prefix}{sep}fixed", fixed)

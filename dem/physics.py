@@ -40,6 +40,29 @@ class ThermalModel:
         self.network = Network(p, self.bonds, self.K_pairs, self.K_walls, wall_T, scene.sources)
 
     def run(self, observer=None, progress=None) -> dict:
+        try:
+            return self._run(observer, progress)
+        except RuntimeError as exc:  # e.g. SuperLU "Factor is exactly singular": explain it as a property of the scene
+            raise ValueError(self._singular_message(exc)) from None
+
+    def _singular_message(self, exc: Exception) -> str:
+        """Why a factorisation failed: the capacities vanish next to the conductances in ``C/dt + theta A``."""
+        s, p = self.scene.solver, self.scene.particles
+        diag = np.bincount(self.bonds.i, self.K_pairs, p.n) + np.bincount(self.bonds.j, self.K_pairs, p.n)
+        diag += np.bincount(self.bonds.wall_particle, self.K_walls, p.n)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            tau = float(np.min(p.capacity / diag, initial=np.inf))
+        step = s.t_end if s.dt == "auto" else s.dt
+        what = "solver.t_end (the largest step dt = \"auto\" can take)" if s.dt == "auto" else "solver.dt"
+        return (f"the linear system became numerically singular ({' '.join(str(exc).split())}): {what} = "
+                f"{step:.6g} s against a smallest particle time constant C/K = {tau:.6g} s, so the capacities are "
+                f"lost to round-off; use a step (or t_end) below about 1e12 times that time constant, or "
+                f"mode = \"steady\"" if s.mode == "transient" else
+                f"the steady linear system is numerically singular ({' '.join(str(exc).split())}); check that "
+                f"conductances, ambient coefficients and fixed temperatures are within a few orders of magnitude "
+                f"of each other")
+
+    def _run(self, observer=None, progress=None) -> dict:
         s = self.scene.solver
         out = {"law": self.scene.conductance.law, "contact": self.bonds.contact,
                "bonds_clipped": self.bonds.clipped, "bonds_dropped": self.bonds.dropped,

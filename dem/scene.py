@@ -18,13 +18,14 @@ import numpy as np
 from dem import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.particles import COPPER, Material, Particles
-from dem.sources import Convection, Radiation, Sources, Wall
+from dem.sources import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
 from dem.thermal import INTEGRATORS
 from dem.linsolve import BACKENDS
 
 SCENE_DIR = pathlib.Path(__file__).with_name("scenes")
 MODES = ("transient", "steady")
 BOUNDARIES = ("plates", "fixed", "none")
+RTOL_MIN = 1e-9  # [solver] rtol of dt = "auto"
 
 ALLOWED = {
     "scene": {"name", "description", "physics"},
@@ -58,7 +59,7 @@ class SolverSpec:
     rtol: float = 1e-3
     linear: str = "auto"
     floating: str = "error"
-    max_steps: int = 1_000_000
+    max_steps: int = 100_000
 
     def __post_init__(self):
         if self.mode not in MODES:
@@ -79,8 +80,9 @@ class SolverSpec:
                 raise ValueError("[solver] t_end: required in transient mode (s)")
             if not _is_number(self.t_end) or not math.isfinite(self.t_end) or self.t_end <= 0:
                 raise ValueError(f"[solver] t_end = {self.t_end!r}: must be a finite number > 0 (s)")
-        if not _is_number(self.rtol) or not (0 < self.rtol < 1):
-            raise ValueError(f"[solver] rtol = {self.rtol!r}: must be in (0, 1)")
+        if not _is_number(self.rtol) or not (RTOL_MIN <= self.rtol < 1):
+            raise ValueError(f"[solver] rtol = {self.rtol!r}: must be in [{RTOL_MIN:g}, 1) (a tighter tolerance "
+                             f"only shrinks dt = \"auto\" to round-off)")
         if not isinstance(self.max_steps, int) or isinstance(self.max_steps, bool) or self.max_steps < 1:
             raise ValueError(f"[solver] max_steps = {self.max_steps!r}: must be an integer >= 1")
 
@@ -292,11 +294,13 @@ def _walls(doc) -> tuple:
     return tuple(out)
 
 
-def _spec(cls, table, section, numeric=(), integer=()):
+def _spec(cls, table, section, numeric=(), integer=(), words=()):
+    """``cls(**table)``; keys in ``numeric`` must be finite numbers (or, if also in ``words``, a string that the
+    class checks, e.g. ``dt = "auto"``), keys in ``integer`` integers."""
     _check_keys(table, section, ALLOWED[section])
     kwargs = {}
     for key, v in table.items():
-        if key in numeric and not isinstance(v, str):
+        if key in numeric and not (key in words and isinstance(v, str)):
             v = _number(table, section, key)
         if key in integer and (not isinstance(v, int) or isinstance(v, bool)):
             raise ValueError(f"[{section}] {key} = {v!r}: must be an integer")
@@ -341,25 +345,29 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     rad = (_spec(Radiation, doc["radiation"], "radiation", numeric=("emissivity", "T_inf"))
            if "radiation" in doc else None)
     if rad is not None:
-        _check_above_absolute_zero(rad, particles.temperature, walls)
+        _check_radiation_temperatures(rad, particles.temperature, walls)
     solver = _spec(SolverSpec, doc.get("solver", {}), "solver", numeric=("dt", "t_end", "rtol"),
-                   integer=("max_steps",))
+                   integer=("max_steps",), words=("dt",))
     output = _spec(OutputSpec, doc.get("output", {}), "output", integer=("every", "vtu_every"))
     return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
                  str(meta.get("name", source)), str(meta.get("description", "")), specimen)
 
 
-def _check_above_absolute_zero(rad: Radiation, temperature: np.ndarray, walls) -> None:
-    """Radiation works in absolute temperature: every prescribed temperature must be at or above 0 K."""
+def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls) -> None:
+    """Radiation works in absolute temperature: every prescribed temperature must lie between 0 K and
+    :data:`dem.sources.RADIATION_T_MAX`."""
     named = [("particles.temperature", np.asarray(temperature, dtype=float))]
     named += [(f"walls.{w.name}.temperature", np.asarray([w.temperature], dtype=float)) for w in walls]
     for name, values in named:
-        below = np.flatnonzero(rad.kelvin(values) < 0.0)
-        if below.size:
-            k = int(below[0])
+        kelvin = rad.kelvin(values)
+        bad = np.flatnonzero((kelvin < 0.0) | (kelvin > RADIATION_T_MAX))
+        if bad.size:
+            k = int(bad[0])
             where = f"[{k}]" if name == "particles.temperature" else ""
-            raise ValueError(f"{name}{where} = {values[k]:g} {rad.unit}: below absolute zero "
-                             f"(radiation.unit = {rad.unit!r}); valid range >= {-rad.kelvin(0.0):g} {rad.unit}")
+            raise ValueError(f"{name}{where} = {values[k]:g} {rad.unit}: outside the range of the radiation model "
+                             f"(radiation.unit = {rad.unit!r}); valid range {0.0 - rad.kelvin(0.0):g} to "
+                             f"{RADIATION_T_MAX - rad.kelvin(0.0):g} {rad.unit} (absolute zero to "
+                             f"{RADIATION_T_MAX:g} K)")
 
 
 def builtin_scenes() -> dict:

@@ -19,15 +19,36 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dem.particles import POSITION_MAX, TEMPERATURE_MAX, check_range
+
 STEFAN_BOLTZMANN = 5.670374419e-8  # W/(m^2 K^4), CODATA 2018 (exact)
 KELVIN_OFFSET = {"K": 0.0, "C": 273.15}
+RADIATION_T_MAX = 1e4  # K: no solid particle exists above; beyond ~1e5 K the steady Newton on T^4 stalls
+HEAT_TRANSFER_MAX = 1e10  # W/(m^2 K), convection coefficient (boiling water is ~1e5)
+
+
+def _vector(name: str, value) -> np.ndarray:
+    """``value`` as a finite 3-vector of at most POSITION_MAX per component, else ``ValueError`` naming it."""
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        v = np.full(1, np.nan)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} = {value!r}: must be a finite 3-vector")
+    return check_range(name, v, None, POSITION_MAX, " m")
 
 
 def _unit_vector(name: str, value) -> np.ndarray:
-    v = np.asarray(value, dtype=float)
-    if v.shape != (3,) or not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0.0:
+    v = _vector(name, value)
+    if np.linalg.norm(v) == 0.0:
         raise ValueError(f"{name} = {value!r}: must be a finite non-zero 3-vector")
     return v / np.linalg.norm(v)
+
+
+def _temperature(name: str, value) -> float:
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
+        raise ValueError(f"{name} = {value!r}: must be a finite number")
+    return float(check_range(name, np.float64(value), None, TEMPERATURE_MAX))
 
 
 @dataclass(frozen=True)
@@ -44,12 +65,9 @@ class Wall:
     temperature: float
 
     def __post_init__(self):
-        object.__setattr__(self, "point", np.asarray(self.point, dtype=float))
-        if self.point.shape != (3,) or not np.all(np.isfinite(self.point)):
-            raise ValueError(f"wall {self.name!r}: point = {self.point.tolist()}: must be a finite 3-vector")
+        object.__setattr__(self, "point", _vector(f"wall {self.name!r}: point", self.point))
         object.__setattr__(self, "normal", _unit_vector(f"wall {self.name!r}: normal", self.normal))
-        if not np.isfinite(self.temperature):
-            raise ValueError(f"wall {self.name!r}: temperature = {self.temperature!r}: must be finite")
+        _temperature(f"wall {self.name!r}: temperature", self.temperature)
 
     def distance(self, position: np.ndarray) -> np.ndarray:
         """Signed distance of each point from the plane (positive on the packing's side)."""
@@ -75,10 +93,9 @@ class Convection:
     area_fraction: object = 1.0
 
     def __post_init__(self):
-        if not (np.isfinite(self.h) and self.h >= 0):
-            raise ValueError(f"convection.h = {self.h!r}: must be finite and >= 0 (W/(m^2 K))")
-        if not np.isfinite(self.T_inf):
-            raise ValueError(f"convection.T_inf = {self.T_inf!r}: must be finite")
+        if not (np.isfinite(self.h) and 0 <= self.h <= HEAT_TRANSFER_MAX):
+            raise ValueError(f"convection.h = {self.h!r}: must be in [0, {HEAT_TRANSFER_MAX:g}] (W/(m^2 K))")
+        _temperature("convection.T_inf", self.T_inf)
 
     def coefficient(self, radius: np.ndarray) -> np.ndarray:
         """``h A_i`` in W/K."""
@@ -99,8 +116,10 @@ class Radiation:
             raise ValueError(f"radiation.emissivity = {self.emissivity!r}: must be in [0, 1]")
         if not isinstance(self.unit, str) or self.unit not in KELVIN_OFFSET:
             raise ValueError(f"radiation.unit = {self.unit!r}: must be one of {', '.join(KELVIN_OFFSET)}")
-        if not (np.isfinite(self.T_inf) and self.T_inf + KELVIN_OFFSET[self.unit] >= 0):
-            raise ValueError(f"radiation.T_inf = {self.T_inf!r}: must be finite and >= absolute zero")
+        if not (np.isfinite(self.T_inf) and 0 <= self.T_inf + KELVIN_OFFSET[self.unit] <= RADIATION_T_MAX):
+            raise ValueError(f"radiation.T_inf = {self.T_inf!r}: must be finite and in "
+                             f"[{0.0 - KELVIN_OFFSET[self.unit]:g}, {RADIATION_T_MAX - KELVIN_OFFSET[self.unit]:g}] "
+                             f"{self.unit} (absolute zero to {RADIATION_T_MAX:g} K)")
 
     def kelvin(self, T):
         return np.asarray(T, dtype=float) + KELVIN_OFFSET[self.unit]
