@@ -157,3 +157,52 @@ def test_step_tolerance_is_the_documented_rule():
             assert tau == pytest.approx(min(rtol, dem.thermal.AUTO_LOCAL[q] * rtol ** ((q + 1) / q)))
             assert tau <= rtol
     assert math.isclose(dem.thermal.step_tolerance(1.0, 1), 1.0)
+
+
+def test_linear_auto_rule_and_jacobi_cg_at_its_condition_limit():
+    """``linear = "auto"`` picks Jacobi-CG only where the diagonal-dominance bound guarantees convergence: a chain
+    with conductances spread over 1e8 and ``C/dt`` at exactly the bound JACOBI_MAX_CONDITION still solves to the
+    direct answer; without the capacity term (steady) the same chain goes to direct (small) or AMG (large)."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spl
+
+    from dem.linsolve import DIRECT_MAX, JACOBI_MAX_CONDITION, JACOBI_MIN, choose_backend, make_solver
+
+    rng = np.random.default_rng(3)
+    for n in (JACOBI_MIN + 500, DIRECT_MAX + 500):
+        K = 10.0 ** rng.uniform(-4, 4, n - 1)
+        L = dem.thermal.laplacian(n, np.arange(n - 1), np.arange(1, n), K).tocsr()
+        L = (L + sp.diags(np.r_[K[0], np.zeros(n - 1)])).tocsr()  # first particle tied to a fixed one: SPD
+        Ld = L.diagonal()
+        assert choose_backend(L, Ld) == ("direct" if n <= DIRECT_MAX else "amg")
+        C = rng.uniform(0.5, 2.0, n)
+        rho = 2.0 / (JACOBI_MAX_CONDITION - 1.0) * 1.001  # just inside the bound
+        inv_dt = rho * np.max(Ld / C)  # min_i (C_i/dt) / L_ii = rho: the bound is just JACOBI_MAX_CONDITION
+        M = (L + sp.diags(C * inv_dt)).tocsr()
+        assert choose_backend(M, Ld) == "cg"
+        assert choose_backend((L + sp.diags(C * inv_dt / 1.01)).tocsr(), Ld) != "cg"
+        b = rng.normal(size=n)
+        x = make_solver(M, "auto", Ld, rtol=1e-10).solve(b)
+        exact = spl.spsolve(M.tocsc(), b)
+        assert np.linalg.norm(x - exact) <= 1e-7 * np.linalg.norm(exact)
+
+
+def test_auto_cg_falls_back_when_it_cannot_converge():
+    """Far outside the dominance bound (conductances over 1e8, tiny C/dt) Jacobi-CG cannot reach the residual
+    target; the solver behind "auto" then hands the matrix to the fallback and still returns the right answer."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spl
+
+    from dem.linsolve import AutoCGSolver
+
+    rng = np.random.default_rng(3)
+    n = 1500
+    K = 10.0 ** rng.uniform(-4, 4, n - 1)
+    L = dem.thermal.laplacian(n, np.arange(n - 1), np.arange(1, n), K)
+    M = (L + sp.diags(1e-8 * np.r_[1.0, rng.uniform(0.5, 2.0, n - 1)])).tocsr()
+    b = rng.normal(size=n)
+    solver = AutoCGSolver(M, rtol=1e-10, fallback="direct")
+    x = solver.solve(b)
+    assert solver.name == "direct"
+    exact = spl.spsolve(M.tocsc(), b)
+    assert np.linalg.norm(x - exact) <= 1e-5 * np.linalg.norm(exact)  # condition number ~1e12
