@@ -70,8 +70,16 @@ def main(argv=None) -> int:
         sys.stderr.write(f"{PROG} {args.command}: not available: verification.{args.command} is not installed yet\n")
         return 2
     out = pathlib.Path(args.out)
+    if not args.out.strip():
+        sys.stderr.write(f"{PROG} {args.command}: error: --out {args.out!r}: must name a directory\n")
+        return 2
     if out.exists() and not out.is_dir():
         sys.stderr.write(f"{PROG} {args.command}: error: --out {args.out}: exists and is not a directory\n")
+        return 2
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # e.g. a parent is a file, or no permission
+        sys.stderr.write(f"{PROG} {args.command}: error: --out {args.out}: cannot be created ({exc.strerror})\n")
         return 2
     options = {k: getattr(args, k) for k in extra}
     if args.no_progress:
