@@ -29,18 +29,19 @@ matrix; it is SPD when every connected group of free particles reaches a fixed p
       integrator      rtol   old: steps   error     seconds   new: steps  rejected  error    seconds
       explicit        1e-2         391    5.6e-4    0.03            266     0       5.9e-4   0.02
       explicit        1e-3        2573    2.9e-4    0.16            958     0       4.1e-4   0.06
-      explicit        1e-4       25559    3.5e-5    1.5            9344     0       4.7e-5   0.53
-      implicit        1e-2         260    3.1e-3    0.15            104     0       2.3e-3   0.20
-      implicit        1e-3        2561    3.4e-4    0.73            958     0       2.5e-4   0.69
-      implicit        1e-4       25558    3.5e-5    6.3            9509     0       2.4e-5   5.6
-      crank-nicolson  1e-2         261    7.6e-5    0.22             22     0       6.9e-4   0.16
-      crank-nicolson  1e-3        2561    9.4e-7    0.92             44     0       1.7e-4   0.19
-      crank-nicolson  1e-4       25558    2.3e-9    6.3             115     0       2.7e-5   0.29
+      explicit        1e-4       25559    3.5e-5    1.5            9344     0       4.7e-5   0.51
+      implicit        1e-2         260    3.1e-3    0.15            104     0       2.3e-3   0.11
+      implicit        1e-3        2561    3.4e-4    0.73            958     0       2.5e-4   0.49
+      implicit        1e-4       25558    3.5e-5    6.3            9506     0       2.4e-5   3.3
+      crank-nicolson  1e-2         261    7.6e-5    0.22             22     0       6.9e-4   0.04
+      crank-nicolson  1e-3        2561    9.4e-7    0.92             44     0       1.7e-4   0.05
+      crank-nicolson  1e-4       25558    2.3e-9    6.3             115     0       2.7e-5   0.10
 
-  (old: the largest temperature change per step held near rtol x range.) The dyadic grid rounds every step
-  down to a power of 2: without it the implicit runs take 0.7x the steps for 1.3x the error (about 7 % (implicit)
-  and 15 % (Crank-Nicolson) more steps for the same error) but need two factorisations per step (12 s instead
-  of 0.7 s for implicit at rtol 1e-3).
+  (old: the largest temperature change per step held near rtol x range, direct solves; new: Jacobi-CG, see
+  :mod:`dem.linsolve`; a new implicit step costs three solves.) The dyadic grid rounds every step down to a power
+  of 2: without it the implicit runs take 0.7x the steps for 1.3x the error (about 7 % (implicit) and 15 %
+  (Crank-Nicolson) more steps for the same error) but need two factorisations per step (12 s instead of 0.7 s
+  for implicit at rtol 1e-3, direct solves).
 
 Energy bookkeeping: the heat flowing into the free particles through each boundary (fixed particles, walls,
 convection, radiation, internal sources) is integrated with the same theta weighting as the step, so the change
@@ -70,6 +71,7 @@ AUTO_LOCAL = {1: 10.0, 2: 15.0}  # dt = "auto": local tolerance k_q rtol^((q+1)/
 AUTO_SAFETY = 0.9  # dt = "auto": safety factor of the step controller; explicit stays below this x the stable limit
 AUTO_MIN_FACTOR, AUTO_MAX_FACTOR = 0.2, 5.0  # dt = "auto": bounds of the change of step per step
 AUTO_LEVELS = 40  # implicit dt = "auto": steps t_end / 2^k, k <= AUTO_LEVELS
+AUTO_PROJECTION = 10.0  # dt = "auto": refuse once the current step projects this many x max_steps (after 100)
 AUTO_MIN_STEP = 2.0**-AUTO_LEVELS  # dt = "auto": steps this small (x t_end) are accepted whatever their error
 
 
@@ -532,6 +534,11 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
             progress(t)
         if auto:
             dt_want = min(h * factor, dt_cap)
+            projected = steps + (t_end - t) / dt_want
+            if steps >= max(100, max_steps // 100) and projected > AUTO_PROJECTION * max_steps:
+                raise ValueError(f"solver.rtol = {rtol:g}: at t = {t:.4g} s dt = \"auto\" takes steps of {h:.3g} s, "
+                                 f"so t_end = {t_end:g} s needs ~{projected:.3g} steps, far beyond solver.max_steps "
+                                 f"= {max_steps}; raise rtol or max_steps, or shorten t_end")
         if steps >= max_steps and t < t_end:
             raise ValueError(f"more than solver.max_steps = {max_steps} steps before t_end = {t_end:g} s")
     energy = float(net.C @ T)

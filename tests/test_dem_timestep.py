@@ -206,3 +206,13 @@ def test_auto_cg_falls_back_when_it_cannot_converge():
     assert solver.name == "direct"
     exact = spl.spsolve(M.tocsc(), b)
     assert np.linalg.norm(x - exact) <= 1e-5 * np.linalg.norm(exact)  # condition number ~1e12
+
+
+def test_hopeless_tolerance_refused_early():
+    """A tolerance that would need ~1e8 steps is refused after a hundred steps, not after max_steps."""
+    net = chain_network(6)
+    seen = []
+    with pytest.raises(ValueError, match="far beyond solver.max_steps"):
+        integrate(net, "implicit", "auto", 5 * decay_time(net), rtol=1e-9, max_steps=100_000,
+                  observer=lambda step, t, T, flows: seen.append(step))
+    assert len(seen) <= 1002
