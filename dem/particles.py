@@ -26,7 +26,7 @@ def check_range(name: str, arr: np.ndarray, low: float | None, high: float, what
     bad = (np.abs(arr) > high) if low is None else ((arr < low) | (arr > high))
     if np.any(bad):
         k = int(np.flatnonzero(bad)[0])
-        where = f"[{k}]" if np.ndim(arr) else ""
+        where = "".join(f"[{i}]" for i in np.unravel_index(k, np.shape(arr)))
         valid = f"|value| <= {high:g}" if low is None else f"{low:g} <= value <= {high:g}"
         raise ValueError(f"{name}{where} = {np.ravel(arr)[k]:.9g}: outside the valid range {valid}{what}")
     return arr
