@@ -433,12 +433,25 @@ def fem_neck_cli_cases() -> list[StressCase]:
                                      "--json"], "error"),
         ("chain: empty radii", ["chain", "--radii", "", "--overlaps", "", "--kappa", "394", "--json"], "error"),
         ("chain: garbage list", ["chain", "--radii", "1e-3,x", "--overlaps", "1e-4", "--kappa", "394"], "error"),
+        ("neck: radii 1e600 apart (overflow warnings stay off the error line)",
+         ["neck", "--ri", "1e-300", "--rj", "1e300", "--h", "1e-301", "--json"], "error"),
+        ("chain: 200 spheres (refused up front, not a 10-minute solve)",
+         ["chain", "--radii", ",".join(["1e-3"] * 200), "--overlaps", ",".join(["1e-4"] * 199), "--kappa", "394",
+          "--json"], "error"),
+        ("fit: 10^12 points (refused before allocating)", ["fit", "--points", "1000000000000", "--json"], "error"),
         ("fit: zero points", ["fit", "--points", "0", "--json"], "error"),
         ("fit: negative points", ["fit", "--points", "-5", "--json"], "error"),
         ("unknown command", ["frobnicate"], "error"),
     ]
     afile = pathlib.Path(tempfile.gettempdir()) / "stability-out-is-a-file"
     afile.write_text("")
+    cluster = pathlib.Path(tempfile.gettempdir()) / "stability-cluster.json"
+    cluster.write_text(json.dumps({"centres": [[0, 0, 0], [0, 0, 1.92e-3]], "radii": [1e-3, 1e-3],
+                                   "bonds": [[0.5, 1]], "terminals": [{"particle": 0, "T": 1.0},
+                                                                      {"particle": 1, "T": 0.0}]}))
+    specs.append(("cluster: fractional bond index", ["cluster", str(cluster), "--json"], "error"))
+    specs.append(("cluster: --size-far 1e-300 (a mesh that never ends)", ["cluster", str(cluster), "--size-far",
+                                                                          "1e-300", "--json"], "error"))
     specs.append(("semisphere: --out is an existing file", ["semisphere", "--h-over-r", "0.2", "--out", str(afile),
                                                            "--json"], "error"))
     return [cli_case(f"fem_neck CLI {name}", m + argv, expect) for name, argv, expect in specs]
@@ -514,12 +527,29 @@ floating = "mean"
         "generator n = 2.5": gen.format(n=2.5, overlap=0.1),
         "generator overlap 0.7 (beyond 2/3)": gen.format(n=100, overlap=0.7),
         "generator overlap negative": gen.format(n=100, overlap=-0.1),
+        "chain generator overlap 5 (was: no bonds)": gen.format(n=3, overlap=5.0).replace('"random"', '"chain"')
+        .replace("seed = 1\n", ""),
+        "lattice shape overflowing int64": gen.replace('kind = "random"\nn = {n}', 'kind = "lattice"\nshape = '
+                                                       '[9223372036854775807, 2, 2]').replace("seed = 1\n", "")
+        .format(overlap=0.1),
         "radiation negative emissivity": base + "\n[radiation]\nemissivity = -0.5\nT_inf = 20.0\n",
         "convection NaN h": base + "\n[convection]\nh = nan\nT_inf = 20.0\n",
         "duplicate key": base.replace("t_end = 0.01", "t_end = 0.01\nt_end = 0.02"),
         "binary garbage": "\x00\x01\x02 = [[[",
         "radiation with a temperature below absolute zero": base.replace("temperature = [100.0", "temperature = [-400.0")
         + '\n[radiation]\nemissivity = 0.5\nT_inf = 20.0\nunit = "C"\n',
+        "radiation ambient at 1e80 K (was NaN)": base.replace('mode = "transient"', 'mode = "steady"')
+        + "\n[radiation]\nemissivity = 1.0\nT_inf = 1e80\n",
+        "text for a number (slope)": base.replace('law = "rojek"', 'law = "rojek"\nslope = "x"'),
+        "conductivity 1e300": base.replace("conductivity = 394.0", "conductivity = 1e300"),
+        "temperatures +-1e308": base.replace("temperature = [100.0, 0.0]", "temperature = [1e308, -1e308]"),
+        "lens clip, coincident particles": base.replace("3.94e-3]]", "0.0]]").replace(
+            'law = "rojek"', 'law = "zohdi"\nout_of_range = "clip"'),
+        "lens clip, centre behind a wall": base.replace('law = "rojek"', 'law = "zohdi"\nout_of_range = "clip"')
+        + "\n[[walls]]\npoint = [0.0, 0.0, 0.5e-3]\nnormal = [0.0, 0.0, 1.0]\ntemperature = 1.0\n",
+        "rtol 1e-300 with dt auto": base.replace("dt = 1.0e-3", 'dt = "auto"\nrtol = 1e-300'),
+        "1e6 fixed steps (default max_steps 1e5)": base.replace("dt = 1.0e-3", "dt = 1.0e-5").replace(
+            "t_end = 0.01", "t_end = 10.0"),
     })
     long_run = {
         "generator single particle, steady": gen.format(n=1, overlap=0.1),
@@ -528,6 +558,14 @@ floating = "mean"
         "implicit auto, t_end 1e6 s": SCENE_OK.format(integrator="implicit", dt='"auto"', t_end="1.0e6"),
         # would take ~1e12 steps: must be refused or capped, never a hang
         "explicit t_end 1e9 s": SCENE_OK.format(integrator="explicit", dt="1.0e-6", t_end="1.0e9"),
+        "lens clip, sphere inside a sphere": base.replace("3.94e-3]]", "1.0e-4]]").replace(
+            "radius = [1.0e-3, 3.0e-3]", "radius = [1.0e-3, 1.0e-5]").replace(
+            'law = "rojek"', 'law = "zohdi"\nout_of_range = "clip"'),
+        "singular implicit step (capacities 1e-56 J/K, dt 1e6 s)": SCENE_OK.format(
+            integrator="implicit", dt="1.0e6", t_end="1.0e6").replace("conductivity = 394.0", "conductivity = 1e10")
+        .replace("density = 8960.0", "density = 1e-10").replace("specific_heat = 385.0", "specific_heat = 1e-10")
+        .replace("[[0.0, 0.0, 0.0], [0.0, 0.0, 3.94e-3]]", "[[0.0, 0.0, 0.0], [0.0, 0.0, 1.9e-12]]")
+        .replace("radius = [1.0e-3, 3.0e-3]", "radius = [1.0e-12, 1.0e-12]"),
     }
     cases = []
     for name, text in {**bad, **long_run}.items():
