@@ -19,6 +19,9 @@ from dem.bonds import find_bonds
 from dem.laws.conductance import bond_conductances
 from dem.thermal import Network, boundary_heat_flow, integrate, steady
 
+WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
+SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
+
 PLANNED = {
     "mechanical": "the Luding 2005 sintering contact (hysteretic normal law, temperature-dependent stiffness)",
     "electrical": "the Zohdi 2014 current flow and Joule heating (eqs. 38-44)",
@@ -32,6 +35,8 @@ class ThermalModel:
 
     def __init__(self, scene):
         self.scene = scene
+        if scene.solver.mode == "transient":
+            self._check_work()  # before the bond search: a refused run costs nothing
         p = scene.particles
         spec = scene.conductance
         self.bonds = find_bonds(p, scene.walls, spec.contact, spec.out_of_range)
@@ -44,6 +49,20 @@ class ThermalModel:
             return self._run(observer, progress)
         except RuntimeError as exc:  # e.g. SuperLU "Factor is exactly singular": explain it as a property of the scene
             raise ValueError(self._singular_message(exc)) from None
+
+    def _check_work(self) -> None:
+        """Refuse a fixed-step run whose particle-steps exceed ``WORK_PER_STEP_LIMIT * max_steps`` up front, with a
+        time estimate (:data:`SECONDS_PER_PARTICLE_STEP`)."""
+        s, n = self.scene.solver, self.scene.particles.n
+        if s.dt == "auto":
+            return  # the step count is not known in advance; max_steps bounds it while running
+        work = s.t_end / s.dt * n
+        if work > WORK_PER_STEP_LIMIT * s.max_steps:
+            raise ValueError(f"solver: t_end / dt = {s.t_end / s.dt:.3g} steps x {n} particles = {work:.3g} "
+                             f"particle-steps (about {SECONDS_PER_PARTICLE_STEP * work:.3g} s) exceeds "
+                             f"{WORK_PER_STEP_LIMIT} x solver.max_steps = {WORK_PER_STEP_LIMIT * s.max_steps:.3g}; "
+                             f"raise max_steps to run it anyway, or use a larger dt, a shorter t_end or fewer "
+                             f"particles")
 
     def _singular_message(self, exc: Exception) -> str:
         """Why a factorisation failed: the capacities vanish next to the conductances in ``C/dt + theta A``."""

@@ -164,6 +164,13 @@ def test_step_count_refused_before_running(tmp_path, capsys):
     refuse_scene(tmp_path, scene(dt="1e-5", t_end="10.0"), capsys, "max_steps", "1e+06")
 
 
+def test_particle_steps_refused_with_an_estimate(tmp_path, capsys):
+    """10^6 particles x 1000 implicit steps (~100-600 s) was attempted; now refused before the bond search."""
+    text = (MATERIAL.format(k="394.0") + '[generator]\nkind = "lattice"\nshape = [100, 100, 100]\nradius = 1e-3\n'
+            'overlap = 0.1\n' + TRANSIENT.format(integ="implicit", dt="1e-3", t_end="1.0"))
+    refuse_scene(tmp_path, text, capsys, "particle-steps", "max_steps")
+
+
 def test_explicit_step_around_the_stable_limit(tmp_path, capsys):
     """0.99x the limit runs and stays inside the initial range (maximum principle); 1.01x is refused."""
     from dem.physics import ThermalModel
