@@ -205,6 +205,8 @@ def test_warnings_on_success_are_one_line_each(capsys):
     (["fit", "--points", "1000000000000", "--json"], "points"),               # was: MemoryError traceback
     (["chain", "--radii", ",".join(["1e-3"] * 200), "--overlaps", ",".join(["1e-4"] * 199), "--kappa", "394"],
      "radii"),                                                                  # was: > 120 s
+    (["pair", "--ri", "1e-3", "--rj", "1e300", "--h", "6e-5", "--kappa", "394"], "r_j / r_i"),  # OverflowError
+    (["pair", "--ri", "1e-3", "--rj", "1e6", "--h", "6e-5", "--kappa", "394"], "r_j / r_i"),   # unconverged K
     (["unequal", "--ratios", ",".join(["2"] * 100), "--necks", "0.1,0.2,0.3"], "ratios x necks"),
 ])
 def test_huge_fe_requests_refused_up_front(capsys, argv, needle):
