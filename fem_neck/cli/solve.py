@@ -95,11 +95,12 @@ def check_radius_ratio(radii, names=None) -> None:
 
 
 def _mesh_errors_as_value_errors(call):
-    """A mesh that gmsh cannot make is reported like bad input: one line, exit code 2."""
+    """A mesh that gmsh cannot make is reported like bad input: one line, exit code 2, saying what to change."""
     try:
         return call()
     except RuntimeError as exc:
-        raise ValueError(str(exc)) from exc
+        raise ValueError(f"{exc} (the geometry is degenerate for the mesher, typically a neck at the model's limit "
+                         f"a = min(r_i, r_j); an overlap a little below max_overlap meshes)") from exc
 
 
 def _output_dir(args):
