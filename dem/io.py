@@ -11,12 +11,14 @@
 from __future__ import annotations
 
 import json
+import math
 import pathlib
 
 import meshio
 import numpy as np
 
 CSV_FLOWS = ("fixed", "walls", "convection", "radiation", "internal")
+MAX_SNAPSHOTS = 1000  # VTU snapshots per run (each is two files): more is refused up front (fixed dt) or thinned (auto)
 
 
 def write_pvd(path: pathlib.Path, entries: list[tuple[float, str]]) -> None:
@@ -30,6 +32,13 @@ class RunWriter:
     """Observer for the integrators: CSV row every ``every`` steps, snapshots every ``vtu_every`` steps."""
 
     def __init__(self, out_dir, scene, model):
+        o, s = scene.output, scene.solver
+        if o.vtu and o.vtu_every and s.mode == "transient" and s.dt != "auto":
+            snapshots = math.ceil(s.t_end / s.dt * (1 - 1e-12)) // o.vtu_every
+            if snapshots > MAX_SNAPSHOTS:
+                raise ValueError(f"[output] vtu_every = {o.vtu_every}: {snapshots} snapshots of t_end / dt = "
+                                 f"{s.t_end / s.dt:.6g} steps exceed the limit of {MAX_SNAPSHOTS}; valid: vtu_every >= "
+                                 f"{math.ceil(s.t_end / s.dt / MAX_SNAPSHOTS)}, 0 (first and last) or vtu = false")
         self.out = pathlib.Path(out_dir)
         self.out.mkdir(parents=True, exist_ok=True)
         self.scene, self.model = scene, model
@@ -45,6 +54,8 @@ class RunWriter:
         if step % self.scene.output.every == 0:
             self._row(step, t, T, flows)
         every = self.scene.output.vtu_every
+        if every and len(self.snapshots) >= MAX_SNAPSHOTS:  # dt = "auto": the step count was not known up front
+            every *= 2 ** (len(self.snapshots) // MAX_SNAPSHOTS)  # thin the snapshots, keep their number bounded
         if self.scene.output.vtu and (step == 0 or (every and step % every == 0)):
             self._snapshot(step, t, T)
 
@@ -77,6 +88,11 @@ class RunWriter:
                        "heat_flow": [np.concatenate([q_pairs, q_walls])],
                        "neck_radius": [np.concatenate([b.a, b.wall_a])]}))
         self.snapshots.append((t, step))
+        count = len(self.snapshots)
+        if count & (count - 1) == 0:  # rewrite the collection at 1, 2, 4, ... snapshots (and at the end): O(n) total
+            self._write_pvd()
+
+    def _write_pvd(self):
         for kind in ("particles", "bonds"):
             write_pvd(self.out / f"{kind}.pvd", [(tt, f"{kind}_{s:05d}.vtu") for tt, s in self.snapshots])
 
@@ -87,6 +103,8 @@ class RunWriter:
                 self._row(step, t, T, flows)
             if self.scene.output.vtu:
                 self._snapshot(step, t, T)
+        if self.snapshots:
+            self._write_pvd()
         self.csv.close()
         write_summary(self.out / "summary.json", summary)
 

@@ -171,6 +171,20 @@ def test_particle_steps_refused_with_an_estimate(tmp_path, capsys):
     refuse_scene(tmp_path, text, capsys, "particle-steps", "max_steps")
 
 
+def test_snapshot_flood_refused_and_collection_complete(tmp_path, capsys):
+    """vtu_every = 1 over 1e4 steps wrote 2e4 files and rewrote the PVD each time (~100 s, quadratic); now refused.
+    A short run still lists every snapshot in its PVD (the collection is rewritten at powers of two and at the end)."""
+    out = str(tmp_path / "out")
+    text = scene(dt="1e-4", t_end="1.0") + "[output]\nvtu_every = 1\n"
+    (tmp_path / "flood.toml").write_text(text)
+    assert_refused(dem_main, ["run", str(tmp_path / "flood.toml"), "--out", out], capsys, "vtu_every", ">= 10")
+    (tmp_path / "short.toml").write_text(scene(dt="1e-3", t_end="0.007") + "[output]\nvtu_every = 1\n")
+    code, _, _ = run_cli(dem_main, ["run", str(tmp_path / "short.toml"), "--out", out, "--json"], capsys)
+    files = sorted(p.name for p in (tmp_path / "out").glob("particles_*.vtu"))
+    listed = (tmp_path / "out" / "particles.pvd").read_text().count("<DataSet")
+    assert code == 0 and len(files) == 8 and listed == 8
+
+
 def test_explicit_step_around_the_stable_limit(tmp_path, capsys):
     """0.99x the limit runs and stays inside the initial range (maximum principle); 1.01x is refused."""
     from dem.physics import ThermalModel
