@@ -286,3 +286,14 @@ def test_cluster_extreme_kappa_scales_exactly(tmp_path, capsys):
 def test_verification_out_that_cannot_be_created(capsys, out):
     """Was a NotADirectoryError traceback; an empty --out ran the section into the current directory."""
     assert_refused(verification_main, ["paper", "--quick", "--out", out, "--no-progress"], capsys, "--out")
+
+
+def test_printed_results_never_contain_nan(capsys):
+    """Every CLI prints through print_result: a non-finite number (e.g. converge's observed order fitted from fewer
+    than two points) is null in JSON, not the invalid token NaN."""
+    from fem_neck.cli import print_result
+
+    print_result({"order": float("nan"), "K": [1.5, float("inf")], "nested": {"x": -float("inf")}}, as_json=True)
+    out = capsys.readouterr().out
+    assert json.loads(out) == {"order": None, "K": [1.5, None], "nested": {"x": None}}
+    assert "NaN" not in out and "Infinity" not in out

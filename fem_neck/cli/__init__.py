@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import math
 import os
 import re
 import sys
@@ -83,7 +84,20 @@ def print_result(result: dict, as_json: bool) -> None:
         sys.stdout = open(os.devnull, "w")  # nothing more can reach the reader; keep interpreter exit quiet
 
 
+def finite_or_none(value):
+    """``value`` with every non-finite float (NaN, +-inf) replaced by ``None``: JSON has no NaN, and a number that
+    is not defined (e.g. an order fitted from fewer than two points) is reported as null, never as NaN."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: finite_or_none(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite_or_none(v) for v in value]
+    return value
+
+
 def _write_result(result: dict, as_json: bool) -> None:
+    result = finite_or_none(result)
     if as_json:
         json.dump(result, sys.stdout)
         sys.stdout.write("\n")
