@@ -297,3 +297,17 @@ def test_printed_results_never_contain_nan(capsys):
     out = capsys.readouterr().out
     assert json.loads(out) == {"order": None, "K": [1.5, None], "nested": {"x": None}}
     assert "NaN" not in out and "Infinity" not in out
+
+
+def test_fit_file_with_nan_parameters_named(tmp_path, capsys):
+    """A fit.json whose law has a NaN parameter gave NaN conductances, reported as a 'numerically singular' system."""
+    import pathlib
+
+    import fem_neck
+
+    data = json.loads((pathlib.Path(fem_neck.__file__).parent / "data" / "fit.json").read_text())
+    data["law"]["parameters"]["A"] = float("nan")
+    fit = tmp_path / "fit.json"
+    fit.write_text(json.dumps(data))
+    refuse_scene(tmp_path, scene(extra=f'[conductance]\nlaw = "fit"\nfit_file = "{fit}"\n'), capsys,
+                 "fit_file", "finite")

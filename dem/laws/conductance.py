@@ -115,4 +115,17 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds)
     k_pair = series(k_i, k_j)
     if spec.law == "fit" and spec.unequal and bonds.n_pairs:
         k_pair = k_pair * fem_law.unequal_factor(r[bonds.i], r[bonds.j], bonds.a)
-    return series(k_pair, kc), series(k_w, kc)
+    k_pair, k_wall = series(k_pair, kc), series(k_w, kc)
+    _check_finite(spec, k_pair, bonds.a, lambda k: f"bond ({bonds.i[k]}, {bonds.j[k]})")
+    _check_finite(spec, k_wall, bonds.wall_a, lambda k: f"wall bond of particle {bonds.wall_particle[k]}")
+    return k_pair, k_wall
+
+
+def _check_finite(spec: ConductanceSpec, K: np.ndarray, a: np.ndarray, name) -> None:
+    """Every conductance a finite number >= 0 W/K; else the law (e.g. a fit_file with NaN parameters) is named."""
+    bad = ~(np.isfinite(K) & (K >= 0.0))
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        source = f" from fit_file = {spec.fit_file!r}" if spec.law == "fit" else ""
+        raise ValueError(f"conductance.law = {spec.law!r}{source} gives K = {float(K[k])!r} W/K for {name(k)} (neck radius "
+                         f"a = {a[k]:.6g} m): conductances must be finite and >= 0")
