@@ -33,6 +33,7 @@ import numpy as np
 
 METHODS = ("newton", "first", "coble")
 _MAX_ITERATIONS = 60
+_RATIO_CAP = 1e100  # radius ratios above this are solved at this ratio (see _validated)
 _STEP_TOL = 1e-8  # relative Newton step after which the iterate is at round-off (quadratic convergence)
 _LIMIT_SLACK = 1e-12  # relative round-off tolerated beyond the model's largest overlap
 
@@ -88,14 +89,18 @@ def check_positive(name: str, value, upper=None, upper_name: str | None = None) 
 def cap_height(r, a):
     """Height of the spherical cap of radius ``r`` with base radius ``a`` (Rojek 2022, eqs. 28-29).
 
-    Written as ``a^2 / (r + sqrt(r^2 - a^2))`` so that small caps keep full relative precision.
+    Written as ``a q / (1 + sqrt((1 - q)(1 + q)))`` with ``q = a / r`` (``= a^2 / (r + sqrt(r^2 - a^2))``): small
+    caps keep full relative precision and no square of a length is formed, so any radius a float holds works.
     """
-    return a * a / (r + np.sqrt(np.maximum((r - a) * (r + a), 0.0)))
+    q = a / r
+    return a * q / (1.0 + np.sqrt(np.maximum((1.0 - q) * (1.0 + q), 0.0)))
 
 
 def _phi(h_c, r):
-    """Cap height minus the share of the neck length it fills; ``sum(phi) = h`` at the volume-conserving root."""
-    return h_c * (3.0 * r - 2.0 * h_c) / (3.0 * (2.0 * r - h_c))
+    """Cap height minus the share of the neck length it fills; ``sum(phi) = h`` at the volume-conserving root.
+    ``h_c (3r - 2h_c) / (3(2r - h_c))``, written in ``h_c / r`` so that huge radii do not overflow."""
+    s = h_c / r
+    return h_c * (3.0 - 2.0 * s) / (3.0 * (2.0 - s))
 
 
 def max_overlap(r_i, r_j):
@@ -163,7 +168,11 @@ def _validated(r_i, r_j, h):
     if not (h.ndim == 0 and r_i.ndim == 0 and r_j.ndim == 0):
         r_i, r_j, h = np.broadcast_arrays(r_i, r_j, h)
     scale = np.minimum(r_i, r_j)
-    r_i, r_j, h_s = r_i / scale, r_j / scale, h / scale  # x / x is exactly 1: the smaller radius is exactly 1
+    # x / x is exactly 1: the smaller radius is exactly 1; the larger may overflow to inf (a plane), which every
+    # scale-free formula here handles
+    with np.errstate(over="ignore"):
+        r_i, r_j = r_i / scale, r_j / scale
+    h_s = h / scale
     r_max = np.maximum(r_i, r_j)
     h_max = 1.0 / 3.0 + _phi(cap_height(r_max, 1.0), r_max)  # max_overlap in these units (smaller radius 1)
     # An overlap at the limit computed in another way may exceed h_max by round-off: that is the limit itself.
@@ -174,7 +183,11 @@ def _validated(r_i, r_j, h):
 
 
 def _solve(r_i, r_j, h, method):
-    """Neck radius and Newton iteration count (Rojek 2022, eqs. 32-34) for the output of :func:`_validated`."""
+    """Neck radius and Newton iteration count (Rojek 2022, eqs. 32-34) for the output of :func:`_validated`.
+
+    Beyond a radius ratio of ~1e16 the larger sphere is a plane to double precision: the ratio is capped at
+    ``_RATIO_CAP`` so that the Newton's squares of lengths stay finite, without changing any result."""
+    r_i, r_j = np.minimum(r_i, _RATIO_CAP), np.minimum(r_j, _RATIO_CAP)
     a = coble_radius(r_i, r_j, h)
     if method == "coble":
         return a, 0
@@ -219,17 +232,22 @@ def neck_geometry(r_i, r_j, h, method: str = "newton") -> NeckGeometry:
     """All of the neck geometry (Rojek 2022, eqs. 21-29); see :class:`NeckGeometry`."""
     if method not in METHODS:
         raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
+    R_i, R_j, H = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (r_i, r_j, h)))
     r_i, r_j, h, scale = _validated(r_i, r_j, h)
     a, iterations = _solve(r_i, r_j, h, method)
-    h_ci = cap_height(r_i, a)
-    h_cj = cap_height(r_j, a)
-    h_n = h_ci + h_cj - h
-    # |V_cyl - V_caps| / V_cyl = |Z| / (3 a^2 h_n) = |G| / h_n  (eq. 27 divided by 3 a^2)
-    residual = np.abs(_phi(h_ci, r_i) + _phi(h_cj, r_j) - h) / np.abs(h_n)
-    z_i = np.sqrt((r_i - a) * (r_i + a))
-    z_j = np.sqrt((r_j - a) * (r_j + a))
+    # |V_cyl - V_caps| / V_cyl = |Z| / (3 a^2 h_n) = |G| / h_n  (eq. 27 divided by 3 a^2), in units of r_min
+    h_ci, h_cj = cap_height(r_i, a), cap_height(r_j, a)
+    residual = np.abs(_phi(h_ci, r_i) + _phi(h_cj, r_j) - h) / np.abs(h_ci + h_cj - h)
+    a = a * scale
+    h_ci, h_cj = cap_height(R_i, a), cap_height(R_j, a)  # in metres from the inputs: finite for any radii
     return NeckGeometry(
-        r_i=r_i * scale, r_j=r_j * scale, h=h * scale, a=a * scale, h_ci=h_ci * scale, h_cj=h_cj * scale,
-        h_n=h_n * scale, d=(r_i + r_j - h) * scale, z_i=z_i * scale, z_j=z_j * scale, volume_residual=residual,
+        r_i=R_i[()], r_j=R_j[()], h=h * scale, a=a, h_ci=h_ci, h_cj=h_cj, h_n=h_ci + h_cj - h * scale,
+        d=R_i[()] + R_j[()] - h * scale, z_i=_base_distance(R_i, a), z_j=_base_distance(R_j, a), volume_residual=residual,
         iterations=iterations, method=method,
     )
+
+
+def _base_distance(r, a):
+    """Distance from a sphere's centre to its cap base, ``sqrt(r^2 - a^2)`` written as ``r sqrt((1-q)(1+q))``."""
+    q = a / r
+    return r * np.sqrt(np.maximum((1.0 - q) * (1.0 + q), 0.0))
