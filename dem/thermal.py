@@ -474,6 +474,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
                              f"integrator")
         check_step_count(t_end, dt, max_steps, f"solver.dt = {dt:.6g} s")
         dt_want = dt
+        n_fixed = max(1, math.ceil(t_end / dt * (1.0 - 1e-12)))  # the last step ends exactly on t_end
     # implicit dt = "auto": steps t_end / 2^k on the dyadic grid of [0, t_end] (a step only grows where the grid
     # allows it), so the solvers of the few step sizes used are built once and the run ends exactly on t_end
     dyadic = auto and theta > 0.0
@@ -495,6 +496,9 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
                 level += 1
             h = t_end / 2**level
             last = units + (grid >> level) == grid
+        elif not auto:  # fixed steps: t = k dt (not a running sum, whose round-off could add a step at the end)
+            last = steps + 1 >= n_fixed
+            h = t_end - steps * dt_want if last else dt_want
         else:
             last = dt_want >= remaining * (1 - 1e-9)
             h = remaining if dt_want > remaining * (1 + 1e-9) else dt_want
@@ -524,7 +528,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
             units += grid >> level
             t = t_end * (units / grid)
         else:
-            t = t_end if last else t + h
+            t = t_end if last else (steps * dt_want if not auto else t + h)
         dt_min, dt_max = min(dt_min, h), max(dt_max, h)
         if not np.all(np.isfinite(T)):
             raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {steps})")

@@ -216,3 +216,11 @@ def test_hopeless_tolerance_refused_early():
         integrate(net, "implicit", "auto", 5 * decay_time(net), rtol=1e-9, max_steps=100_000,
                   observer=lambda step, t, T, flows: seen.append(step))
     assert len(seen) <= 1002
+
+
+def test_fixed_steps_land_on_t_end_without_an_extra_step():
+    """t_end / dt = max_steps exactly: the run takes exactly max_steps steps (a running sum of dt used to add one
+    more at the end and refuse the run there)."""
+    net = chain_network(2)
+    res = integrate(net, "implicit", dt=0.00033, t_end=3.3, max_steps=10_000)  # a running sum takes 10 001
+    assert res.steps == 10_000 and res.t == 3.3
