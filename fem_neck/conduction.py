@@ -279,15 +279,17 @@ def pair_conductance(r_i: float, r_j: float, h: float, kappa: float, rtol: float
     kappa = float(check_positive("kappa", kappa))
     if method not in ("auto", *METHODS):
         raise ValueError(f"method = {method!r}: must be one of auto, {', '.join(METHODS)}")
+    shapes.check_radius_ratio([r_i, r_j], ("r_i", "r_j"))
     r_min = min(float(r_i), float(r_j))
-    hp_applies = float(geo.a) <= hpmesh.SMALL_NECK_MAX * r_min and float(geo.a) >= shapes.MIN_NECK_RATIO * r_min
+    hp_applies = shapes.MIN_NECK_RATIO * r_min <= float(geo.a) <= hpmesh.SMALL_NECK_MAX * r_min
     if method == "gmsh" or (method == "auto" and not hp_applies):
         return chain_conductance([r_i, r_j], [h], kappa, rtol=rtol, order=order)
     rtol = accuracy.check_rtol(rtol)
     order = accuracy.check_hp_order(order, rtol)
-    if float(geo.a) < shapes.MIN_NECK_RATIO * r_min:
-        raise ValueError(f"h = {h!r}: neck radius {float(geo.a):.6g} is below {shapes.MIN_NECK_RATIO:g} of the "
-                         "smaller radius (K is the constriction limit there)")
+    if not hp_applies:
+        raise ValueError(f"h = {h!r}: the hp pair mesh covers necks {shapes.MIN_NECK_RATIO:g} <= a / r_min <= "
+                         f"{hpmesh.SMALL_NECK_MAX} (here a = {float(geo.a):.6g}, r_min = {r_min:.6g}); use method "
+                         "'gmsh'")
     start = time.perf_counter()
     levels = accuracy.hp_corner_levels(float(geo.a) / r_min, rtol)
     mesh, scale, bottom, top, a = hpmesh.pair_quad_mesh(float(r_i), float(r_j), float(h), levels)

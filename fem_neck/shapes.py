@@ -39,6 +39,9 @@ DEFAULT_GRADING = 0.3
 # Smallest neck radius over sphere radius that is meshed: the half neck is a^2/(4r) high, ~2.5e-9 r at the limit
 # (meshing takes ~10 s there, ~2 s at 3e-4, 0.3 s at 1e-3). Below it K is the constriction limit 4 kappa a to O(a/r).
 MIN_NECK_RATIO = 1e-4
+# Largest radius ratio of neighbouring spheres: beyond it the graded mesh of the larger sphere spans too many decades
+# (1e6 converges; 1e9 returned an unconverged K 700x too large).
+MAX_RADIUS_RATIO = 1e6
 
 
 @dataclass(frozen=True)
@@ -164,6 +167,7 @@ def chain_profile(radii, overlaps):
     overlaps = np.atleast_1d(np.asarray(overlaps, dtype=float))
     if radii.ndim != 1 or radii.size < 2:
         raise ValueError(f"radii: need at least 2 spheres, got {radii.size}")
+    check_radius_ratio(radii)
     if overlaps.shape != (radii.size - 1,):
         raise ValueError(f"overlaps: need {radii.size - 1} values (one per bond), got {overlaps.size}")
     geos = [_bond_geometry(radii, overlaps, k) for k in range(overlaps.size)]
@@ -191,6 +195,16 @@ def chain_profile(radii, overlaps):
             necks.append((a, z_hi, z_top_neck))
             z_lo = z_top_neck
     return (radii[0], 0.0), segments, np.array(corners), necks
+
+
+def check_radius_ratio(radii, names=None) -> None:
+    """Neighbouring radii at most :data:`MAX_RADIUS_RATIO` apart (``ValueError`` naming the pair otherwise)."""
+    for k in range(len(radii) - 1):
+        r_i, r_j = float(radii[k]), float(radii[k + 1])
+        if not (1.0 / MAX_RADIUS_RATIO <= r_j / r_i <= MAX_RADIUS_RATIO):
+            name_i, name_j = names or (f"radii[{k}]", f"radii[{k + 1}]")
+            raise ValueError(f"{name_j} / {name_i} = {r_j / r_i:.3g}: valid range {1 / MAX_RADIUS_RATIO:g} to "
+                             f"{MAX_RADIUS_RATIO:g} for the FE mesh")
 
 
 def _bond_geometry(radii, overlaps, k):

@@ -51,10 +51,6 @@ class QuadMesh:
     circles: tuple
     origin: tuple = (0.0, 0.0)
 
-    @property
-    def n_elements(self) -> int:
-        return int(self.quads.shape[0])
-
 
 @functools.lru_cache(maxsize=None)
 def reference(order: int):
