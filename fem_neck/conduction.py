@@ -222,9 +222,7 @@ def semisphere_conductance(a_over_r: float, rtol: float = 1e-4, order: int | Non
     order = accuracy.check_hp_order(order, rtol)
     start = time.perf_counter()
     mesh, shape = hpmesh.semisphere_quad_mesh(a_over_r, accuracy.hp_corner_levels(a_over_r, rtol))
-    z = mesh.points[:, 1]
-    fixed = {0.0: z == -shape.z_i, 1.0: z == shape.t}  # T = 0 on the equator, 1 on the neck's end disk
-    return _hp_to_tolerance(mesh, fixed, rtol, order, start, 1.0, 1.0, 1.0, [a_over_r])
+    return _hp_to_tolerance(mesh, hpmesh.end_disks(mesh, shape), rtol, order, start, 1.0, 1.0, 1.0, [a_over_r])
 
 
 def _hp_to_tolerance(mesh, fixed: dict, rtol: float, p: int, start: float, kappa: float, length_scale: float,

@@ -187,6 +187,13 @@ def semisphere_quad_mesh(a: float, levels: int, sigma: float = SIGMA) -> tuple[Q
     return half_body(shape, corner_radius(shape), levels, sigma), shape
 
 
+def end_disks(mesh: QuadMesh, shape: SemisphereShape) -> dict:
+    """The fixed temperatures of the semisphere, as :func:`fem_neck.spectral.conductance` takes them: ``T = 0`` on
+    the equatorial disk, ``1`` on the neck's end disk (vertex masks; both planes are built exactly)."""
+    z = mesh.points[:, 1]
+    return {0.0: z == -shape.z_i, 1.0: z == shape.t}
+
+
 def corner_radius(shape: SemisphereShape) -> float:
     """Radius ``R`` of the corner cells: the neck height ``t`` for small necks, at most half of ``z_i`` otherwise."""
     return shape.t if shape.a <= SMALL_NECK_MAX else min(shape.t, 0.5 * shape.z_i)

@@ -368,8 +368,7 @@ def _hp_config(a_over_r: float, order: int, levels: int) -> tuple[float, int]:
     from fem_neck import hpmesh, spectral
 
     mesh, shape = hpmesh.semisphere_quad_mesh(a_over_r, levels)
-    z = mesh.points[:, 1]
-    sol = spectral.conductance(mesh, order, {0.0: z == -shape.z_i, 1.0: z == shape.t})
+    sol = spectral.conductance(mesh, order, hpmesh.end_disks(mesh, shape))
     return sol.K_over_kappa / math.pi, sol.dofs
 
 

@@ -77,9 +77,9 @@ def _levels(a: float, progress):
     from fem_neck import hpmesh, spectral
 
     mesh, shape = hpmesh.semisphere_quad_mesh(a, HP_LEVELS)
-    z = mesh.points[:, 1]
+    fixed = hpmesh.end_disks(mesh, shape)
     for order in HP_ORDERS:
-        sol = spectral.conductance(mesh, order, {0.0: z == -shape.z_i, 1.0: z == shape.t})
+        sol = spectral.conductance(mesh, order, fixed)
         levels.append({
             "series": HP_SERIES, "order": order, "grading": "geometric", "curved": True,
             "size_parameter": hpmesh.SIGMA, "dofs": sol.dofs, "h_min": None, "elements_across_neck": None,
