@@ -268,10 +268,10 @@ def pair_conductance(r_i: float, r_j: float, h: float, kappa: float, rtol: float
                      order: int | None = None, method: str = "auto") -> Result:
     """Conductance (W/K) of two sintered spheres between their outer equatorial planes (Rojek 2022, Sec. 6).
 
-    ``method``: ``"hp"`` -- the two halves of :func:`fem_neck.hpmesh.pair_quad_mesh` (necks up to 0.6 of the
-    smaller radius), order raised until two orders agree; ``"gmsh"`` -- the chain of two,
-    :func:`chain_conductance` ``([r_i, r_j], [h], kappa)``; ``"auto"`` (default) -- hp where it applies, else gmsh.
-    ``K_over_Kcyl`` uses the smaller radius.
+    ``method``: ``"hp"`` -- the two halves of :func:`fem_neck.hpmesh.pair_quad_mesh`, order raised until two orders
+    agree (necks ``1e-4 <= a / r_min < 1``); ``"gmsh"`` -- the chain of two, :func:`chain_conductance` ``([r_i,
+    r_j], [h], kappa)``; ``"auto"`` (default) -- hp where it applies (everywhere but a neck at the model's limit,
+    where the smaller sphere's surface vanishes), else gmsh. ``K_over_Kcyl`` uses the smaller radius.
     """
     geo = neck_geometry(check_positive("r_i", r_i), check_positive("r_j", r_j), h)  # names the bad argument
     kappa = float(check_positive("kappa", kappa))
@@ -279,15 +279,14 @@ def pair_conductance(r_i: float, r_j: float, h: float, kappa: float, rtol: float
         raise ValueError(f"method = {method!r}: must be one of auto, {', '.join(METHODS)}")
     shapes.check_radius_ratio([r_i, r_j], ("r_i", "r_j"))
     r_min = min(float(r_i), float(r_j))
-    hp_applies = shapes.MIN_NECK_RATIO * r_min <= float(geo.a) <= hpmesh.SMALL_NECK_MAX * r_min
+    hp_applies = shapes.MIN_NECK_RATIO * r_min <= float(geo.a) < (1.0 - 1e-9) * r_min
     if method == "gmsh" or (method == "auto" and not hp_applies):
         return chain_conductance([r_i, r_j], [h], kappa, rtol=rtol, order=order)
     rtol = accuracy.check_rtol(rtol)
     order = accuracy.check_hp_order(order, rtol)
     if not hp_applies:
-        raise ValueError(f"h = {h!r}: the hp pair mesh covers necks {shapes.MIN_NECK_RATIO:g} <= a / r_min <= "
-                         f"{hpmesh.SMALL_NECK_MAX} (here a = {float(geo.a):.6g}, r_min = {r_min:.6g}); use method "
-                         "'gmsh'")
+        raise ValueError(f"h = {h!r}: the hp pair mesh covers necks {shapes.MIN_NECK_RATIO:g} <= a / r_min < 1 "
+                         f"(here a / r_min = {float(geo.a) / r_min:.9g}: the smaller sphere's surface is gone)")
     start = time.perf_counter()
     levels = accuracy.hp_corner_levels(float(geo.a) / r_min, rtol)
     mesh, scale, bottom, top, a = hpmesh.pair_quad_mesh(float(r_i), float(r_j), float(h), levels)

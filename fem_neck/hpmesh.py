@@ -204,6 +204,8 @@ def half_body(shape: SemisphereShape, R: float, levels: int, sigma: float = SIGM
     radius ``R <= t``. The neck cylinder is a tensor grid whose columns end at ``x = a - rho`` for the ring radii
     ``rho`` from ``R`` to ``a`` -- so two halves with the same ``a``, ``t`` and ``R`` share their end disk's nodes
     (:func:`pair_quad_mesh`)."""
+    if R >= shape.t * (1.0 - 1e-9):  # a corner radius computed in another sphere's units may miss t by round-off
+        R = shape.t
     b = _Builder(shape)
     corner = b.sphere(0.0)
     down, mid, on_sphere = _corner_cells(b, shape, corner, R, levels, sigma)
@@ -305,19 +307,19 @@ def pair_quad_mesh(r_i: float, r_j: float, h: float, levels: int, sigma: float =
     """The hp mesh of two sintered spheres (Rojek 2022, Sec. 6): sphere ``i`` below, ``j`` above, each built by
     :func:`half_body` in its own radius and glued at the neck's mid-plane (both halves have the same neck radius,
     half-neck height and corner radius, hence the same nodes there). Lengths in units of ``s = min(r_i, r_j)``, ``z``
-    from the mid-plane. Small necks only (``a <= 0.6 min(r)``, the layout whose end disk depends on ``a`` and ``t``
-    alone); ``mesh.origin`` puts absolute ``z`` at sphere ``i``'s centre, as on the gmsh path. Returns ``(mesh, s,
-    bottom vertex mask, top vertex mask, a)``."""
+    from the mid-plane. The corner radius is the smaller of the two halves' own (:func:`corner_radius`), so the
+    neck's columns, which depend on ``a``, ``t`` and ``R`` alone, are the same in both; ``mesh.origin`` puts absolute
+    ``z`` at sphere ``i``'s centre, as on the gmsh path. Returns ``(mesh, s, bottom vertex mask, top vertex mask,
+    a)``."""
     geo = neck_geometry(r_i, r_j, h)
     a, t = float(geo.a), 0.5 * float(geo.h_n)
     s = min(r_i, r_j)
-    if a > SMALL_NECK_MAX * s:
-        raise ValueError(f"h = {h!r}: the hp pair mesh covers necks a <= {SMALL_NECK_MAX} min(r_i, r_j) (here a = "
-                         f"{a:.6g}, a/r_min = {a / s:.4g}); use method 'gmsh'")
+    shapes = [SemisphereShape(a=a / r, z_i=z / r, t=t / r, phi_c=math.atan2(z, a))
+              for r, z in ((r_i, float(geo.z_i)), (r_j, float(geo.z_j)))]
+    R = min(corner_radius(shape) * r for shape, r in zip(shapes, (r_i, r_j)))  # common: same end-disk nodes
     halves = []
-    for r, z_cap, mirror in ((r_i, float(geo.z_i), False), (r_j, float(geo.z_j), True)):
-        shape = SemisphereShape(a=a / r, z_i=z_cap / r, t=t / r, phi_c=math.atan2(z_cap, a))
-        halves.append((half_body(shape, shape.t, levels, sigma), shape, r / s, mirror))
+    for r, shape, mirror in ((r_i, shapes[0], False), (r_j, shapes[1], True)):
+        halves.append((half_body(shape, R / r, levels, sigma), shape, r / s, mirror))
     points, quads, angles, circles, index = [], [], [], [], []
     masks, offset, interface = [], 0, None
     for number, (mesh, shape, k, mirror) in enumerate(halves):

@@ -37,7 +37,7 @@ def _add_accuracy(p, methods: tuple = ()) -> None:
     if methods:
         p.add_argument("--method", choices=methods, default=methods[0],
                        help="hp: spectral elements on a geometric mesh with the exact sphere, order raised until two "
-                       "orders agree (milliseconds; pairs: necks up to 0.6 r_min); gmsh: the graded triangle mesh "
+                       "orders agree (milliseconds); gmsh: the graded triangle mesh "
                        "of chains" + ("; auto: hp where it applies, else gmsh" if "auto" in methods else "")
                        + f" (default {methods[0]})")
         p.add_argument("--order", type=int, default=None,
