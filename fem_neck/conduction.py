@@ -270,8 +270,9 @@ def pair_conductance(r_i: float, r_j: float, h: float, kappa: float, rtol: float
 
     ``method``: ``"hp"`` -- the two halves of :func:`fem_neck.hpmesh.pair_quad_mesh`, order raised until two orders
     agree (necks ``1e-4 <= a / r_min < 1``); ``"gmsh"`` -- the chain of two, :func:`chain_conductance` ``([r_i,
-    r_j], [h], kappa)``; ``"auto"`` (default) -- hp where it applies (everywhere but a neck at the model's limit,
-    where the smaller sphere's surface vanishes), else gmsh. ``K_over_Kcyl`` uses the smaller radius.
+    r_j], [h], kappa)``; ``"auto"`` (default) -- hp (the gmsh path only to refuse too thin a neck). At the model's
+    limit ``h = max_overlap`` (``a = r_min``, the smaller sphere's surface vanishes) both refuse.
+    ``K_over_Kcyl`` uses the smaller radius.
     """
     geo = neck_geometry(check_positive("r_i", r_i), check_positive("r_j", r_j), h)  # names the bad argument
     kappa = float(check_positive("kappa", kappa))
@@ -279,14 +280,14 @@ def pair_conductance(r_i: float, r_j: float, h: float, kappa: float, rtol: float
         raise ValueError(f"method = {method!r}: must be one of auto, {', '.join(METHODS)}")
     shapes.check_radius_ratio([r_i, r_j], ("r_i", "r_j"))
     r_min = min(float(r_i), float(r_j))
-    hp_applies = shapes.MIN_NECK_RATIO * r_min <= float(geo.a) < (1.0 - 1e-9) * r_min
-    if method == "gmsh" or (method == "auto" and not hp_applies):
-        return chain_conductance([r_i, r_j], [h], kappa, rtol=rtol, order=order)
+    if method == "gmsh" or (method == "auto" and float(geo.a) < shapes.MIN_NECK_RATIO * r_min):
+        return chain_conductance([r_i, r_j], [h], kappa, rtol=rtol, order=order)  # (refuses too thin a neck)
     rtol = accuracy.check_rtol(rtol)
     order = accuracy.check_hp_order(order, rtol)
-    if not hp_applies:
-        raise ValueError(f"h = {h!r}: the hp pair mesh covers necks {shapes.MIN_NECK_RATIO:g} <= a / r_min < 1 "
-                         f"(here a / r_min = {float(geo.a) / r_min:.9g}: the smaller sphere's surface is gone)")
+    if not shapes.MIN_NECK_RATIO * r_min <= float(geo.a) < (1.0 - 1e-9) * r_min:
+        raise ValueError(f"h = {h!r}: valid range for the FE: neck radius {shapes.MIN_NECK_RATIO:g} <= a / r_min < 1 "
+                         f"(here a / r_min = {float(geo.a) / r_min:.9g}; at h = max_overlap the smaller sphere's "
+                         "surface is gone)")
     start = time.perf_counter()
     levels = accuracy.hp_corner_levels(float(geo.a) / r_min, rtol)
     mesh, scale, bottom, top, a = hpmesh.pair_quad_mesh(float(r_i), float(r_j), float(h), levels)

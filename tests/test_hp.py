@@ -160,10 +160,11 @@ def test_large_neck_pairs_agree_with_the_gmsh_pair(ratio, a_over_r):
     assert abs(hp.K - tri.K) / hp.K <= hp.error_estimate + tri.error_estimate
 
 
-def test_pair_at_the_model_limit_falls_back_to_gmsh():
+def test_pair_at_the_model_limit_is_refused_clearly():
     h = float(max_overlap(1.0, 2.0))
-    with pytest.raises(ValueError, match="the smaller sphere's surface is gone"):
-        conduction.pair_conductance(1.0, 2.0, h, 1.0, method="hp")
+    for method in ("auto", "hp"):
+        with pytest.raises(ValueError, match="at h = max_overlap the smaller sphere's surface is gone"):
+            conduction.pair_conductance(1.0, 2.0, h, 1.0, method=method)
 
 
 def test_pair_with_a_huge_partner_and_the_ratio_limit():
