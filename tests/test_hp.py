@@ -152,7 +152,8 @@ def test_hp_pair_agrees_with_the_gmsh_pair(ratio, a_over_r):
 @pytest.mark.parametrize("ratio, a_over_r", [(1.0, 0.8), (1.5, 0.7), (3.0, 0.95), (10.0, 0.99)])
 def test_large_neck_pairs_agree_with_the_gmsh_pair(ratio, a_over_r):
     """Large necks: the halves' corner radii differ (min(t, z/2) each), the common one keeps the neck's nodes shared;
-    hp and gmsh agreed to 3e-9 or better over ratios 1-10 and a/r_min 0.7-0.99 (measured)."""
+    hp and gmsh agreed to <= 5e-9 in 15 of 16 cases over ratios 1-10 and a/r_min 0.7-0.99, 9e-8 at ratio 1.5 and
+    a/r_min 0.99, where hp converges more slowly (measured)."""
     h = float(overlap_for_neck(1.0, ratio, a_over_r))
     hp = conduction.pair_conductance(1.0, ratio, h, 1.0, rtol=1e-8)
     tri = conduction.pair_conductance(1.0, ratio, h, 1.0, rtol=1e-6, method="gmsh")
