@@ -499,6 +499,8 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
         elif not auto:  # fixed steps: t = k dt (not a running sum, whose round-off could add a step at the end)
             last = steps + 1 >= n_fixed
             h = t_end - steps * dt_want if last else dt_want
+            if abs(h - dt_want) <= 1e-9 * dt_want:  # a full last step: the same size, the same factorisation
+                h = dt_want
         else:
             last = dt_want >= remaining * (1 - 1e-9)
             h = remaining if dt_want > remaining * (1 + 1e-9) else dt_want

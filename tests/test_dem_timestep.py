@@ -224,3 +224,4 @@ def test_fixed_steps_land_on_t_end_without_an_extra_step():
     net = chain_network(2)
     res = integrate(net, "implicit", dt=0.00033, t_end=3.3, max_steps=10_000)  # a running sum takes 10 001
     assert res.steps == 10_000 and res.t == 3.3
+    assert res.factorizations == 1  # the last step is a full one: the same matrix
