@@ -225,3 +225,14 @@ def test_fixed_steps_land_on_t_end_without_an_extra_step():
     res = integrate(net, "implicit", dt=0.00033, t_end=3.3, max_steps=10_000)  # a running sum takes 10 001
     assert res.steps == 10_000 and res.t == 3.3
     assert res.factorizations == 1  # the last step is a full one: the same matrix
+
+
+def test_auto_steps_are_capped_for_conditioning():
+    """A free pair (no fixed temperature) run for 1e15 s: C/dt would fall ~1e-13 below the bond conductance and the
+    heat balance drift (mean T 50 -> 49.95 at 1e12 s before the cap); now steps stop at 1e8 x the fastest time
+    constant and a t_end that needs more than max_steps of them is refused at once, saying why."""
+    net = chain_network(2)
+    res = integrate(net, "implicit", dt="auto", t_end=1e9, rtol=1e-3, max_steps=100_000)
+    assert abs(float(np.mean(res.T)) - 50.0) < 1e-4 and res.energy_error < 1e-6
+    with pytest.raises(ValueError, match="steps are capped at .* fastest time constant"):
+        integrate(chain_network(2), "implicit", dt="auto", t_end=1e15, rtol=1e-3, max_steps=100_000)
