@@ -465,7 +465,8 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
         # temperature makes A singular): measured energy errors 1e-10, 1e-7, 5e-4 at C/dt = 2e-7, 2e-10, 1e-11 of
         # the bond conductance of a free pair. Steps stay below AUTO_CONDITION x the fastest time constant.
         diagonal = net.matrix(net.sinks(T)).diagonal() if net.n_free else np.zeros(0)
-        tau_min = float(np.min(net.C / diagonal)) if diagonal.size and diagonal.max() > 0 else math.inf
+        coupled = diagonal > 0.0  # an unbonded particle without sinks has no time constant
+        tau_min = float(np.min(net.C[coupled] / diagonal[coupled])) if np.any(coupled) else math.inf
         dt_condition = AUTO_CONDITION * tau_min
         dt_cap = min(dt_cap, dt_condition)
         dt_want = min(t_end, tol / rate if rate > 0 else t_end, dt_cap)
