@@ -153,6 +153,93 @@ class ClusterMesh:
     neck_a: np.ndarray = field(repr=False)
 
 
+def add_neck_cylinders(occ, cluster: Cluster, geo) -> list:
+    """One OCC cylinder per bond: the neck of radius ``a`` from ``z_i`` to ``z_i + h_n`` along the bond, extended by
+    ``_EXTEND * z`` into both spheres (hidden inside them) so that its side meets each sphere transversally."""
+    e = cluster.directions()
+    c = cluster.centres
+    bi = cluster.bonds[:, 0]
+    out = []
+    for b in range(len(bi)):
+        start = c[bi[b]] + (geo.z_i[b] - _EXTEND * geo.z_i[b]) * e[b]
+        length = geo.h_n[b] + _EXTEND * (geo.z_i[b] + geo.z_j[b])
+        out.append((3, occ.addCylinder(*start, *(length * e[b]), geo.a[b])))
+    return out
+
+
+def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, size_far: float, neck_cells: float,
+                     tol: float, every_bond: bool = True) -> list:
+    """gmsh size fields graded toward every neck circle found on the boundary ``surfaces`` (set as the background
+    mesh): ``min(size_neck a, h_n / neck_cells)`` at the circle, growing linearly to ``size_far`` times the smaller
+    radius at a distance ``2 a`` (Distance + Threshold fields). The circles are the curves all of whose sample points
+    lie at distance ``a`` from the bond axis and at the neck's ends (possibly split into arcs at seams or cut by
+    planes). ``every_bond``: each bond must have its two circles on the boundary (else ``RuntimeError``); otherwise
+    bonds without any are skipped (a neck cut away by a cell face). Returns the Threshold field tags.
+    """
+    c, r = cluster.centres, cluster.radii
+    bi, bj = cluster.bonds.T
+    e = cluster.directions()
+    curves = [tag for _, tag in gmsh.model.getBoundary([(2, s) for s in surfaces], combined=False, oriented=False)]
+    samples = {}
+    for tag in sorted(set(abs(x) for x in curves)):
+        lo, hi = gmsh.model.getParametrizationBounds(1, tag)
+        samples[tag] = np.reshape(gmsh.model.getValue(1, tag, np.linspace(lo[0], hi[0], 5)), (-1, 3))
+    thresholds = []
+    for b in range(len(bi)):
+        found = []
+        for tag, xyz in samples.items():
+            rel = xyz - c[bi[b]]
+            axial = rel @ e[b]
+            radial = np.linalg.norm(rel - axial[:, None] * e[b], axis=1)
+            on_radius = np.all(np.abs(radial - geo.a[b]) < 10 * tol)
+            for z in (geo.z_i[b], geo.z_i[b] + geo.h_n[b]):
+                if on_radius and np.all(np.abs(axial - z) < 10 * tol):
+                    found.append(tag)
+        if len(found) < 2 and every_bond:
+            raise RuntimeError(f"bond {b}: found {len(found)} neck-circle curves after the union, expected >= 2")
+        if not found:
+            continue
+        dist = gmsh.model.mesh.field.add("Distance")
+        gmsh.model.mesh.field.setNumbers(dist, "CurvesList", found)
+        gmsh.model.mesh.field.setNumber(dist, "Sampling", 200)
+        thr = gmsh.model.mesh.field.add("Threshold")
+        gmsh.model.mesh.field.setNumber(thr, "InField", dist)
+        gmsh.model.mesh.field.setNumber(thr, "SizeMin", min(size_neck * geo.a[b], geo.h_n[b] / neck_cells))
+        gmsh.model.mesh.field.setNumber(thr, "SizeMax", size_far * min(r[bi[b]], r[bj[b]]))
+        gmsh.model.mesh.field.setNumber(thr, "DistMin", 0.0)
+        gmsh.model.mesh.field.setNumber(thr, "DistMax", 2.0 * geo.a[b])
+        thresholds.append(thr)
+    fmin = gmsh.model.mesh.field.add("Min")
+    gmsh.model.mesh.field.setNumbers(fmin, "FieldsList", thresholds)
+    gmsh.model.mesh.field.setAsBackgroundMesh(fmin)
+    return thresholds
+
+
+def mesh_tetrahedra(gmsh, curvature: int, size_max: float) -> None:
+    """Generate the 3D mesh from the background size field: ``curvature`` elements per 2 pi of surface curvature,
+    at most ``size_max``; one thread and fixed algorithms (Frontal-Delaunay surfaces, Delaunay volume), so the same
+    input gives the same mesh."""
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", curvature)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size_max)
+    gmsh.option.setNumber("Mesh.Algorithm", 6)
+    gmsh.option.setNumber("Mesh.Algorithm3D", 1)
+    gmsh.option.setNumber("Mesh.Optimize", 1)
+    gmsh.model.mesh.generate(3)
+
+
+def tetrahedra(gmsh, vol_tag: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(points (N, 3), tets (M, 4) indices into points, index)`` of the meshed volume ``vol_tag``; ``index`` maps
+    gmsh node tags to rows of ``points``."""
+    node_tags, coords, _ = gmsh.model.mesh.getNodes()
+    points = np.asarray(coords).reshape(-1, 3)
+    index = np.full(int(node_tags.max()) + 1, -1, dtype=np.int64)
+    index[node_tags.astype(np.int64)] = np.arange(len(node_tags))
+    _, _, elem_nodes = gmsh.model.mesh.getElements(3, vol_tag)
+    return points, index[np.asarray(elem_nodes[0], dtype=np.int64)].reshape(-1, 4), index
+
+
 def _surface_of(cx, tags, centre, area, kind, tol):
     """The tag of the surface of type ``kind`` centred at ``centre`` with area ``area`` (found by position)."""
     import gmsh
@@ -244,10 +331,7 @@ def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size
             else:
                 s = occ.addSphere(*c[k], r[k])
             solids.append((3, s))
-        for b in range(len(bi)):
-            start = c[bi[b]] + (geo.z_i[b] - _EXTEND * geo.z_i[b]) * e[b]
-            length = geo.h_n[b] + _EXTEND * (geo.z_i[b] + geo.z_j[b])
-            solids.append((3, occ.addCylinder(*start, *(length * e[b]), geo.a[b])))
+        solids += add_neck_cylinders(occ, cluster, geo)
         out, _ = occ.fuse(solids[:1], solids[1:])
         if len(out) != 1:
             raise RuntimeError(f"cluster solid has {len(out)} volumes after the union: the cluster must be connected")
@@ -275,56 +359,9 @@ def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size
                 named["cold"].append(tag)
             else:
                 raise ValueError(f"terminal T = {t.T}: only two temperature levels are supported")
-        # Grading toward each neck circle: the curves whose centre of mass is a neck-circle centre.
-        curves = [tag for _, tag in gmsh.model.getBoundary(
-            [(2, s) for s in surfaces], combined=False, oriented=False)]
-        curves = sorted(set(abs(x) for x in curves))
-        samples = {}
-        for tag in curves:
-            lo, hi = gmsh.model.getParametrizationBounds(1, tag)
-            samples[tag] = np.reshape(gmsh.model.getValue(1, tag, np.linspace(lo[0], hi[0], 5)), (-1, 3))
-        thresholds = []
-        for b in range(len(bi)):
-            # The neck circles (possibly split into arcs at the sphere's seam): every sample point at axial
-            # position z_i or z_i + h_n and distance a from the bond axis.
-            found = []
-            for tag, xyz in samples.items():
-                rel = xyz - c[bi[b]]
-                axial = rel @ e[b]
-                radial = np.linalg.norm(rel - axial[:, None] * e[b], axis=1)
-                on_radius = np.all(np.abs(radial - geo.a[b]) < 10 * tol)
-                for z in (geo.z_i[b], geo.z_i[b] + geo.h_n[b]):
-                    if on_radius and np.all(np.abs(axial - z) < 10 * tol):
-                        found.append(tag)
-            if len(found) < 2:
-                raise RuntimeError(f"bond {b}: found {len(found)} neck-circle curves after the union, expected >= 2")
-            dist = gmsh.model.mesh.field.add("Distance")
-            gmsh.model.mesh.field.setNumbers(dist, "CurvesList", found)
-            gmsh.model.mesh.field.setNumber(dist, "Sampling", 200)
-            thr = gmsh.model.mesh.field.add("Threshold")
-            gmsh.model.mesh.field.setNumber(thr, "InField", dist)
-            gmsh.model.mesh.field.setNumber(thr, "SizeMin", min(size_neck * geo.a[b], geo.h_n[b] / neck_cells))
-            gmsh.model.mesh.field.setNumber(thr, "SizeMax", size_far * min(r[bi[b]], r[bj[b]]))
-            gmsh.model.mesh.field.setNumber(thr, "DistMin", 0.0)
-            gmsh.model.mesh.field.setNumber(thr, "DistMax", 2.0 * geo.a[b])
-            thresholds.append(thr)
-        fmin = gmsh.model.mesh.field.add("Min")
-        gmsh.model.mesh.field.setNumbers(fmin, "FieldsList", thresholds)
-        gmsh.model.mesh.field.setAsBackgroundMesh(fmin)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", curvature)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", size_far * float(r.max()))
-        gmsh.option.setNumber("Mesh.Algorithm", 6)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 1)
-        gmsh.option.setNumber("Mesh.Optimize", 1)
-        gmsh.model.mesh.generate(3)
-        node_tags, coords, _ = gmsh.model.mesh.getNodes()
-        points = np.asarray(coords).reshape(-1, 3)
-        index = np.full(int(node_tags.max()) + 1, -1, dtype=np.int64)
-        index[node_tags.astype(np.int64)] = np.arange(len(node_tags))
-        _, _, elem_nodes = gmsh.model.mesh.getElements(3, vol_tag)
-        tets = index[np.asarray(elem_nodes[0], dtype=np.int64)].reshape(-1, 4)
+        neck_size_fields(gmsh, cluster, geo, surfaces, size_neck, size_far, neck_cells, tol)
+        mesh_tetrahedra(gmsh, curvature, size_far * float(r.max()))
+        points, tets, index = tetrahedra(gmsh, vol_tag)
         facets = {}
         for name, tags in named.items():
             tris = []
