@@ -23,6 +23,11 @@ the smaller radius) and ``"drop"`` removes them; the counts go into the summary.
 
 Every bond also stores ``l_i``, ``l_j``: the distances from the centres to the plane of the contact circle (the
 lens' radical plane), which Zohdi's law uses as the pipe length.
+
+Periodic boxes (:class:`dem.periodic.PeriodicBox`): a bond may join a particle to an image of another (or of itself,
+in a box shorter than a bond) across the boundary; it stores that image's integer ``shift``, and its centre distance
+is that of the image. The search adds the images of the particles near each periodic face, so a periodic block has
+exactly the bonds of an explicit larger block.
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ from scipy.spatial import cKDTree
 from fem_neck.geometry import max_overlap, neck_radius
 
 from dem.particles import Particles
+from dem.periodic import PeriodicBox, canonical_bonds
 
 CONTACT_MODELS = ("newton", "first", "coble", "lens")
 OUT_OF_RANGE = ("error", "clip", "drop")
@@ -45,8 +51,9 @@ class Bonds:
     """Pair bonds ``(i, j)`` with ``i < j`` and wall bonds ``(wall_particle, wall_index)`` as index arrays.
 
     Per pair bond: overlap ``h``, centre distance ``d``, contact radius ``a``, centre-to-contact-plane distances
-    ``l_i``, ``l_j``. Per wall bond: ``wall_h`` (overlap ``delta``), ``wall_a``, ``wall_l``. ``clipped`` and
-    ``dropped`` count the bonds the out-of-range policy changed.
+    ``l_i``, ``l_j`` and, in a periodic box, the ``shift`` (m, 3) of the image of ``j`` (None: no periodic box,
+    all zero). Per wall bond: ``wall_h`` (overlap ``delta``), ``wall_a``, ``wall_l``. ``clipped`` and ``dropped``
+    count the bonds the out-of-range policy changed.
     """
 
     i: np.ndarray
@@ -64,6 +71,18 @@ class Bonds:
     contact: str = "newton"
     clipped: int = 0
     dropped: int = 0
+    shift: np.ndarray | None = None
+
+    @property
+    def shifts(self) -> np.ndarray:
+        """The image shift of every pair bond, (m, 3) integers (zeros without a periodic box)."""
+        return np.zeros((len(self.i), 3), dtype=np.int64) if self.shift is None else self.shift
+
+    def vectors(self, position: np.ndarray, box: PeriodicBox | None = None) -> np.ndarray:
+        """``x_j (+ shift L) - x_i`` of every pair bond (m, 3)."""
+        if box is None or self.shift is None:
+            return position[self.j] - position[self.i]
+        return box.bond_vectors(position, self.i, self.j, self.shift)
 
     @property
     def n_pairs(self) -> int:
@@ -100,6 +119,21 @@ def candidate_pairs(position: np.ndarray, radius: np.ndarray) -> tuple[np.ndarra
     diff = position[i] - position[j]
     keep = np.einsum("ij,ij->i", diff, diff) < (radius[i] + radius[j]) ** 2
     return sorted_pairs(i[keep], j[keep], n)
+
+
+def periodic_pairs(position: np.ndarray, radius: np.ndarray, box: PeriodicBox) -> tuple:
+    """All bonds ``(i, j, shift)`` with ``|x_j + shift L - x_i| < r_i + r_j`` in a periodic box: the overlaps among
+    the particles and their images near the faces (:meth:`PeriodicBox.images`), each bond once
+    (:func:`dem.periodic.canonical_bonds`)."""
+    n = len(radius)
+    points, owner, shift = box.images(position, 2.0 * float(radius.max()))
+    p, q = candidate_pairs(points, radius[owner])
+    keep = (p < n) | (q < n)  # pairs of two images repeat a pair with an original
+    p, q = p[keep], q[keep]
+    # shifts between the wrapped positions, made shifts between the positions as given
+    wrapped = np.round((points[:n] - position) / box.lengths).astype(np.int64)
+    shift = shift + wrapped[owner]
+    return canonical_bonds(owner[p], owner[q], shift[q] - shift[p])
 
 
 def sorted_pairs(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -140,9 +174,9 @@ def _apply_policy(bad, what: str, first: str, policy: str, total: int):
     return int(bad.sum())
 
 
-def _pair_contacts(p: Particles, i, j, contact, policy):
+def _pair_contacts(p: Particles, i, j, vec, contact, policy):
     r_i, r_j = p.radius[i], p.radius[j]
-    d = np.linalg.norm(p.position[j] - p.position[i], axis=1)
+    d = np.linalg.norm(vec, axis=1)
     h = r_i + r_j - d
     l_i, l_j = _lens_planes(r_i, r_j, d)
     if contact == "lens":
@@ -158,6 +192,7 @@ def _pair_contacts(p: Particles, i, j, contact, policy):
                  f"h = {h[k]:.6g} m; valid: {limit}")
     count = _apply_policy(bad, "particle pairs", first, policy, len(i))
     clipped = dropped = 0
+    keep = np.ones(len(i), dtype=bool)
     if count and policy == "drop":
         keep = ~bad
         i, j, r_i, r_j, d, h, l_i, l_j = (x[keep] for x in (i, j, r_i, r_j, d, h, l_i, l_j))
@@ -181,7 +216,7 @@ def _pair_contacts(p: Particles, i, j, contact, policy):
     else:
         h_model = np.minimum(h, max_overlap(r_i, r_j)) if clipped else h
         a = np.asarray(neck_radius(r_i, r_j, h_model, method=contact)) if len(h) else np.zeros(0)
-    return i, j, h, d, a, np.maximum(l_i, 0.0), np.maximum(l_j, 0.0), clipped, dropped
+    return i, j, h, d, a, np.maximum(l_i, 0.0), np.maximum(l_j, 0.0), clipped, dropped, keep
 
 
 def _wall_contacts(p: Particles, walls, contact, policy):
@@ -231,26 +266,36 @@ def _wall_contacts(p: Particles, walls, contact, policy):
 
 
 def find_bonds(particles: Particles, walls=(), contact: str = "newton", out_of_range: str = "error",
-               pairs=None) -> Bonds:
+               pairs=None, box: PeriodicBox | None = None) -> Bonds:
     """Bonds of ``particles`` (and ``walls``) with contact radii from ``contact`` (module docstring).
 
     ``pairs = (i, j)`` gives the pair bonds explicitly instead of searching for overlaps (duplicates and reversed
-    duplicates are removed; every listed pair must overlap).
+    duplicates are removed; every listed pair must overlap; in a periodic ``box``, through its nearest image).
+    With a periodic ``box`` bonds cross its faces (:func:`periodic_pairs`).
     """
     if contact not in CONTACT_MODELS:
         raise ValueError(f"contact = {contact!r}: must be one of {', '.join(CONTACT_MODELS)}")
     if out_of_range not in OUT_OF_RANGE:
         raise ValueError(f"out_of_range = {out_of_range!r}: must be one of {', '.join(OUT_OF_RANGE)}")
+    periodic = box is not None and box.any_periodic
+    x = particles.position
     if pairs is None:
-        i, j = candidate_pairs(particles.position, particles.radius)
+        if periodic:
+            i, j, shift = periodic_pairs(x, particles.radius, box)
+        else:
+            i, j = candidate_pairs(x, particles.radius)
     else:
         i, j = unique_pairs(*pairs, particles.n)
-        d = np.linalg.norm(particles.position[j] - particles.position[i], axis=1)
+        if periodic:
+            shift = np.where(box.mask, -np.round((x[j] - x[i]) / box.lengths), 0).astype(np.int64)
+        d = np.linalg.norm(box.bond_vectors(x, i, j, shift) if periodic else x[j] - x[i], axis=1)
         apart = d >= particles.radius[i] + particles.radius[j]
         if np.any(apart):
             k = int(np.flatnonzero(apart)[0])
             raise ValueError(f"bonds: particles {i[k]} and {j[k]} do not overlap (d = {d[k]:.6g} m >= "
                              f"r_i + r_j = {particles.radius[i[k]] + particles.radius[j[k]]:.6g} m)")
-    i, j, h, d, a, l_i, l_j, c1, d1 = _pair_contacts(particles, i, j, contact, out_of_range)
+    vec = box.bond_vectors(x, i, j, shift) if periodic else x[j] - x[i]
+    i, j, h, d, a, l_i, l_j, c1, d1, keep = _pair_contacts(particles, i, j, vec, contact, out_of_range)
     wp, wi, wh, wa, wl, c2, d2 = _wall_contacts(particles, tuple(walls), contact, out_of_range)
-    return Bonds(i, j, h, d, a, l_i, l_j, wp, wi, wh, wa, wl, contact, c1 + c2, d1 + d2)
+    return Bonds(i, j, h, d, a, l_i, l_j, wp, wi, wh, wa, wl, contact, c1 + c2, d1 + d2,
+                 shift[keep] if periodic else None)

@@ -1,8 +1,11 @@
-"""Particle arrangements for scenes: a chain, a cubic lattice block and a random sintered packing.
+"""Particle arrangements for scenes: a chain, a cubic lattice block (simple, body- or face-centred cubic) and a
+random sintered packing.
 
 Every generator returns a :class:`Layout`: positions, radii, the indices of the bottom and top layers and the
 specimen's cross-section, so that a scene can hold the two ends at different temperatures (hot and cold plates,
-or fixed end particles) and read off an effective conductivity ``k_eff = Q L / (A dT)``.
+or fixed end particles) and read off an effective conductivity ``k_eff = Q L / (A dT)``. The lattice block and the
+random packing also give the ``period`` of the block: repeated with it along every axis they tile space (a
+periodic scene, :mod:`dem.periodic`).
 
 Overlaps are relative to the smaller radius of a pair: ``h = overlap * min(r_i, r_j)``.
 
@@ -44,6 +47,8 @@ class Layout:
     z_low: float
     z_high: float
     area: float
+    period: np.ndarray | None = None
+    origin: np.ndarray | None = None
 
 
 def _positive(name, value):
@@ -92,24 +97,40 @@ def chain(n: int, radius, overlap) -> Layout:
                   float(np.pi * r.max() ** 2))
 
 
-def lattice(shape, radius, overlap) -> Layout:
-    """A simple cubic block of ``shape = [nx, ny, nz]`` equal spheres, spacing ``2r - h``."""
+STRUCTURES = ("sc", "bcc", "fcc")
+# sites of the cubic cell (units of its edge), and the edge over the nearest-neighbour distance
+CELL_SITES = {"sc": [[0.0, 0.0, 0.0]],
+              "bcc": [[0.0, 0.0, 0.0], [0.5, 0.5, 0.5]],
+              "fcc": [[0.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5], [0.0, 0.5, 0.5]]}
+CELL_EDGE = {"sc": 1.0, "bcc": 2.0 / np.sqrt(3.0), "fcc": np.sqrt(2.0)}
+
+
+def lattice(shape, radius, overlap, structure: str = "sc") -> Layout:
+    """A block of ``shape = [nx, ny, nz]`` cubic cells of equal spheres: simple cubic (one sphere per cell, so the
+    block is nx x ny x nz spheres), body-centred (two) or face-centred cubic (four), nearest neighbours ``2r - h``
+    apart (``h = overlap * r``). Its ``period`` is the block's size: shape times the cell edge."""
+    if structure not in STRUCTURES:
+        raise ValueError(f"[generator] structure = {structure!r}: must be one of {', '.join(STRUCTURES)}")
     if (not isinstance(shape, (list, tuple)) or len(shape) != 3
             or not all(isinstance(k, int) and not isinstance(k, bool) and k >= 1 for k in shape)):
         raise ValueError(f"[generator] shape = {shape!r}: must be three integers >= 1")
-    _check_count(shape[0] * shape[1] * shape[2], "shape")  # Python integers: no overflow
+    sites = np.asarray(CELL_SITES[structure])
+    _check_count(shape[0] * shape[1] * shape[2] * len(sites), "shape")  # Python integers: no overflow
     r = _positive("radius", radius)
     rel = float(_overlap(overlap, 1)[0])
     if rel > 2.0 / 3.0:
         raise ValueError(f"[generator] overlap = {overlap!r}: valid range 0 < overlap <= 2/3 (relative to the radius; "
                          f"at 2/3 the neck reaches the radius)")
     s = 2.0 * r - rel * r
+    edge = CELL_EDGE[structure] * s
     nx, ny, nz = shape
     ix, iy, iz = np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij")
-    pos = s * np.column_stack([ix.ravel(), iy.ravel(), iz.ravel()]).astype(float)
-    k = iz.ravel()
-    return Layout(pos, np.full(len(pos), r), np.flatnonzero(k == 0), np.flatnonzero(k == nz - 1), -r,
-                  (nz - 1) * s + r, nx * ny * s * s)
+    cells = np.column_stack([ix.ravel(), iy.ravel(), iz.ravel()]).astype(float)
+    pos = edge * (cells[:, None, :] + sites[None, :, :]).reshape(-1, 3)
+    z = np.round(pos[:, 2] / (0.5 * edge)).astype(np.int64)  # layer index: every site is on a half-edge plane
+    period = edge * np.array(shape, dtype=float)
+    return Layout(pos, np.full(len(pos), r), np.flatnonzero(z == z.min()), np.flatnonzero(z == z.max()), -r,
+                  float(pos[:, 2].max()) + r, nx * ny * edge * edge, period, np.full(3, -0.25 * edge))
 
 
 def _shape_radii(rng, n, distribution, spread):
@@ -126,10 +147,12 @@ def _shape_radii(rng, n, distribution, spread):
 
 
 def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float = 0.1,
-                   distribution: str = "uniform", jitter: float = 0.02) -> Layout:
+                   distribution: str = "uniform", jitter: float = 0.02, periodic: bool = False) -> Layout:
     """Random sintered packing (module docstring); ``radius`` is the mean radius, ``overlap`` the target mean of
     ``h / min(r_i, r_j)`` over bonded pairs, ``jitter`` the half-width of the position noise over the neighbour
-    distance."""
+    distance. ``periodic``: the block tiles space with its ``period`` (complete FCC cells along z as well, so the
+    layer count is even; at least 2 x 2 x 2 cells, n >= 32), the overlaps across its faces count in the mean, and
+    the positions are wrapped into the period box."""
     if not isinstance(n, int) or isinstance(n, bool) or n < 1:
         raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
     _check_count(n, "n")
@@ -149,6 +172,8 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
     rng = np.random.default_rng(seed)
     m = max(1, int(round((n / 4.0) ** (1.0 / 3.0))))
     layers = int(np.ceil(n / (2.0 * m * m)))  # FCC: 2 m^2 sites per (001) layer; complete layers only
+    if periodic:
+        m, layers = max(m, 2), max(layers + layers % 2, 4)  # whole cells, and the period at least two cells wide
     cell = np.sqrt(2.0)  # FCC cell edge for a neighbour distance of 1
     basis = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]])
     g, gz = np.arange(m), np.arange((layers + 1) // 2)
@@ -162,9 +187,17 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
     shape = _shape_radii(rng, n, distribution, radius_spread)
     # candidate neighbours: every pair that could overlap for radii up to the 2/3-overlap scale
     cutoff = (1.0 + 2.0 * np.sqrt(3.0) * jitter) * 1.05
-    pairs = cKDTree(pos).query_pairs(cutoff, output_type="ndarray")
+    period = np.array([m, m, layers // 2], dtype=float) * cell
+    if periodic:  # the nearest image of each pair (the period is wider than twice the cutoff)
+        pos = np.mod(pos, period)
+        pos = np.where(pos >= period, 0.0, pos)
+        pairs = cKDTree(pos, boxsize=period).query_pairs(cutoff, output_type="ndarray")
+        diff = pos[pairs[:, 0]] - pos[pairs[:, 1]]
+        d = np.linalg.norm(diff - period * np.round(diff / period), axis=1)
+    else:
+        pairs = cKDTree(pos).query_pairs(cutoff, output_type="ndarray")
+        d = np.linalg.norm(pos[pairs[:, 0]] - pos[pairs[:, 1]], axis=1)
     i, j = pairs[:, 0], pairs[:, 1]
-    d = np.linalg.norm(pos[i] - pos[j], axis=1)
     ssum, smin = shape[i] + shape[j], np.minimum(shape[i], shape[j])
 
     def mean_overlap(sigma):
@@ -185,4 +218,5 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
     layer = np.round(sites[:, 2] / (0.5 * cell)).astype(np.int64)
     bottom, top = np.flatnonzero(layer == layer.min()), np.flatnonzero(layer == layer.max())
     side = m * cell * scale
-    return Layout(pos, r, bottom, top, float(np.min(pos[:, 2] - r)), float(np.max(pos[:, 2] + r)), side * side)
+    return Layout(pos, r, bottom, top, float(np.min(pos[:, 2] - r)), float(np.max(pos[:, 2] + r)), side * side,
+                  period * scale, np.zeros(3))

@@ -5,7 +5,8 @@
 * ``particles.pvd`` + ``particles_NNNNN.vtu`` -- particles as points (vertex cells) with radius, temperature,
   fixed and material.
 * ``bonds.pvd`` + ``bonds_NNNNN.vtu`` -- bonds as lines with conductance, heat flow and neck radius; a wall bond
-  joins the particle to its foot point on the wall.
+  joins the particle to its foot point on the wall, a bond across a periodic face joins the particle to the image
+  of its partner (outside the box).
 """
 
 from __future__ import annotations
@@ -79,8 +80,12 @@ class RunWriter:
         normal = np.array([walls[w].normal for w in b.wall_index]).reshape(-1, 3)
         x = p.position[b.wall_particle]
         foot = x - np.sum((x - foot) * normal, axis=1, keepdims=True) * normal
-        points = np.vstack([p.position, foot])
-        lines = np.vstack([np.column_stack([b.i, b.j]),
+        crossing = np.flatnonzero(np.any(b.shifts != 0, axis=1))
+        image = b.vectors(p.position, self.scene.box)[crossing] + p.position[b.i[crossing]]
+        points = np.vstack([p.position, foot, image])
+        partner = b.j.copy()
+        partner[crossing] = p.n + b.n_walls + np.arange(len(crossing))
+        lines = np.vstack([np.column_stack([b.i, partner]),
                            np.column_stack([b.wall_particle, p.n + np.arange(b.n_walls)])]).astype(np.int64)
         meshio.write(self.out / f"bonds_{step:05d}.vtu", meshio.Mesh(
             points, [("line", lines.reshape(-1, 2))],

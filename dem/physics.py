@@ -17,7 +17,7 @@ import numpy as np
 
 from dem.bonds import find_bonds
 from dem.laws.conductance import bond_conductances
-from dem.thermal import Network, boundary_heat_flow, integrate, steady
+from dem.thermal import Network, boundary_heat_flow, integrate, periodic_heat_flow, steady
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
@@ -39,10 +39,10 @@ class ThermalModel:
             self._check_work()  # before the bond search: a refused run costs nothing
         p = scene.particles
         spec = scene.conductance
-        self.bonds = find_bonds(p, scene.walls, spec.contact, spec.out_of_range)
-        self.K_pairs, self.K_walls = bond_conductances(spec, p, self.bonds)
+        self.bonds = find_bonds(p, scene.walls, spec.contact, spec.out_of_range, box=scene.box)
+        self.K_pairs, self.K_walls = bond_conductances(spec, p, self.bonds, scene.box)
         wall_T = np.array([w.temperature for w in scene.walls], dtype=float)
-        self.network = Network(p, self.bonds, self.K_pairs, self.K_walls, wall_T, scene.sources)
+        self.network = Network(p, self.bonds, self.K_pairs, self.K_walls, wall_T, scene.sources, scene.box)
 
     def run(self, observer=None, progress=None) -> dict:
         try:
@@ -95,6 +95,8 @@ class ThermalModel:
                        newton_iterations=res.iterations, floating_groups=res.floating)
             if len(self.network.fixed) or len(self.scene.walls):
                 out["boundary_heat_flow"] = self._boundary(res.T)
+            if self.scene.box is not None:
+                out["periodic_heat_flow"] = periodic_heat_flow(self.network, res.T).tolist()
         else:
             res = integrate(self.network, s.integrator, s.dt, s.t_end, s.rtol, s.linear, s.max_steps, observer,
                             progress)
@@ -117,7 +119,7 @@ class ThermalModel:
         """Heat flow (W) along each pair bond from i to j, and from each wall-bonded particle into its wall."""
         b, T = self.bonds, self.T
         wall_T = self.network.wall_temperature[b.wall_index]
-        return self.K_pairs * (T[b.i] - T[b.j]), self.K_walls * (T[b.wall_particle] - wall_T)
+        return self.K_pairs * (T[b.i] - T[b.j] + self.network.jump), self.K_walls * (T[b.wall_particle] - wall_T)
 
 
 REGISTRY = {"thermal": ThermalModel}

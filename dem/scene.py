@@ -18,13 +18,14 @@ import numpy as np
 from dem import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.particles import COPPER, Material, Particles
+from dem.periodic import AXES, PeriodicBox
 from dem.sources import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
 from dem.thermal import INTEGRATORS
 from dem.linsolve import BACKENDS
 
 SCENE_DIR = pathlib.Path(__file__).with_name("scenes")
 MODES = ("transient", "steady")
-BOUNDARIES = ("plates", "fixed", "none")
+BOUNDARIES = ("plates", "fixed", "periodic", "none")
 RTOL_MIN = 1e-9  # [solver] rtol of dt = "auto"
 
 ALLOWED = {
@@ -32,7 +33,8 @@ ALLOWED = {
     "material": {"name", "conductivity", "density", "specific_heat"},
     "particles": {"position", "radius", "temperature", "fixed", "material", "heat"},
     "generator": {"kind", "n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter",
-                  "temperature", "boundary", "hot", "cold", "heat"},
+                  "structure", "temperature", "boundary", "hot", "cold", "heat"},
+    "periodic": {"lengths", "axes", "origin", "drop"},
     "walls": {"name", "point", "normal", "temperature"},
     "conductance": {"law", "slope", "fit_file", "neck", "contact_conductance", "out_of_range", "unequal"},
     "convection": {"h", "T_inf", "area_fraction"},
@@ -42,7 +44,7 @@ ALLOWED = {
 }
 GENERATOR_KEYS = {
     "chain": {"n", "radius", "overlap"},
-    "lattice": {"shape", "radius", "overlap"},
+    "lattice": {"shape", "radius", "overlap", "structure"},
     "random": {"n", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter"},
 }
 
@@ -107,13 +109,15 @@ class OutputSpec:
 @dataclass(frozen=True)
 class Specimen:
     """For generated scenes with hot/cold ends: length L (m) and cross-section A (m^2) for ``k_eff = Q L/(A dT)``,
-    and where the heat enters: the wall named ``hot`` or the fixed particles ``hot_particles``."""
+    and where the heat enters: the wall named ``hot``, the fixed particles ``hot_particles``, or (``periodic``) the
+    period's face normal to z, across which the temperature drops by ``hot - cold``."""
 
     length: float
     area: float
     hot: float
     cold: float
     hot_particles: tuple = ()
+    periodic: bool = False
 
 
 @dataclass(frozen=True)
@@ -130,6 +134,7 @@ class Scene:
     name: str = "scene"
     description: str = ""
     specimen: Specimen | None = None
+    box: PeriodicBox | None = None
 
 
 def _is_number(v) -> bool:
@@ -139,17 +144,18 @@ def _is_number(v) -> bool:
 def make_scene(position, radius, temperature, *, materials=(COPPER,), material=None, fixed=None, heat=None,
                walls=(), law="rojek", conductance: ConductanceSpec | None = None, sources: Sources | None = None,
                solver: SolverSpec | None = None, output: OutputSpec | None = None, name="scene",
-               **solver_options) -> Scene:
+               box: PeriodicBox | None = None, **solver_options) -> Scene:
     """A :class:`Scene` from explicit arrays, e.g. for a chain or cluster to compare with FE::
 
         make_scene(x, r, T, fixed=mask, law="fit", mode="steady")
         make_scene(x, r, T, mode="transient", integrator="implicit", dt=1e-3, t_end=0.1)
+        make_scene(x, r, T, box=PeriodicBox(L, drop=[0, 0, 1.0]), law="fit")      # periodic, 1 K drop along z
 
     Keyword ``solver_options`` are :class:`SolverSpec` fields (``mode``, ``integrator``, ``dt``, ...).
     """
     particles = Particles.from_arrays(position, radius, temperature, materials, material, fixed, heat)
     return Scene(particles, tuple(walls), conductance or ConductanceSpec(law=law), sources or Sources(),
-                 solver or SolverSpec(**solver_options), output or OutputSpec(), name=name)
+                 solver or SolverSpec(**solver_options), output or OutputSpec(), name=name, box=box)
 
 
 # --------------------------------------------------------------------------------------------------- TOML
@@ -222,7 +228,7 @@ def _explicit_particles(t: dict, materials):
     n = len(t["position"]) if isinstance(t["position"], list) else 0
     return Particles.from_arrays(t["position"], t["radius"], t["temperature"], materials,
                                  _material_index(t.get("material"), materials, n), t.get("fixed"), t.get("heat"),
-                                 prefix="[particles]"), (), None
+                                 prefix="[particles]"), (), None, None
 
 
 def _generated_particles(t: dict, materials):
@@ -239,6 +245,14 @@ def _generated_particles(t: dict, materials):
     missing = sorted({"radius", "overlap", "shape" if kind == "lattice" else "n"} - set(args))
     if missing:
         raise ValueError(f"[generator] {missing[0]}: required for kind = {kind!r}")
+    boundary = t.get("boundary", "none")
+    if boundary not in BOUNDARIES:
+        raise ValueError(f"[generator] boundary = {boundary!r}: must be one of {', '.join(BOUNDARIES)}")
+    if boundary == "periodic" and kind == "chain":
+        raise ValueError("[generator] boundary = 'periodic': only for kind = 'lattice' or 'random' (a chain has no "
+                         "period)")
+    if boundary == "periodic" and kind == "random":
+        args["periodic"] = True
     try:
         layout = {"chain": generators.chain, "lattice": generators.lattice,
                   "random": generators.random_packing}[kind](**args)
@@ -247,17 +261,23 @@ def _generated_particles(t: dict, materials):
         raise ValueError(msg if msg.startswith("[") else f"[generator] kind = {kind!r}: bad parameter ({msg})") from None
     n = len(layout.radius)
     T0 = _number(t, "generator", "temperature", 0.0)
-    boundary = t.get("boundary", "none")
-    if boundary not in BOUNDARIES:
-        raise ValueError(f"[generator] boundary = {boundary!r}: must be one of {', '.join(BOUNDARIES)}")
     hot = _number(t, "generator", "hot", required=boundary != "none")
     cold = _number(t, "generator", "cold", required=boundary != "none")
     heat = _number(t, "generator", "heat", 0.0)
     temperature = np.full(n, T0)
     fixed = np.zeros(n, dtype=bool)
-    walls, specimen = (), None
+    walls, specimen, box = (), None, None
     mean_overlap = float(np.mean(np.atleast_1d(t["overlap"])))
-    if boundary == "fixed":
+    if boundary == "periodic":
+        # the block repeats along every axis; the temperature drops by hot - cold per period along z. Without a
+        # given temperature the particles start on that gradient about (hot + cold) / 2 (the mean a steady run
+        # keeps, for equal capacities)
+        box = PeriodicBox(layout.period, (True, True, True), layout.origin, [0.0, 0.0, hot - cold])
+        if "temperature" not in t:
+            z = layout.position[:, 2]
+            temperature = 0.5 * (hot + cold) - (hot - cold) * (z - z.mean()) / layout.period[2]
+        specimen = Specimen(float(layout.period[2]), box.cross_section(2), hot, cold, periodic=True)
+    elif boundary == "fixed":
         fixed[layout.bottom] = fixed[layout.top] = True
         temperature[layout.bottom], temperature[layout.top] = hot, cold
         length = float(np.mean(layout.position[layout.top, 2]) - np.mean(layout.position[layout.bottom, 2]))
@@ -273,7 +293,30 @@ def _generated_particles(t: dict, materials):
         specimen = Specimen(z_t - z_b, layout.area, hot, cold)
     particles = Particles.from_arrays(layout.position, layout.radius, temperature, materials, None, fixed,
                                       np.full(n, heat), prefix="[generator]")
-    return particles, walls, specimen
+    return particles, walls, specimen, box
+
+
+def _periodic_box(t: dict) -> PeriodicBox:
+    """``[periodic]``: ``lengths`` (m), ``axes`` (the periodic ones, default all), ``origin``, ``drop`` (the
+    temperature drop per period along each axis)."""
+    _check_keys(t, "periodic", ALLOWED["periodic"])
+    if "lengths" not in t:
+        raise ValueError("[periodic] lengths: required (the period along x, y and z, m)")
+    axes = t.get("axes", list(AXES))
+    if not isinstance(axes, list) or not all(isinstance(a, str) and a in AXES for a in axes) or not axes:
+        raise ValueError(f"[periodic] axes = {axes!r}: must be a non-empty list of \"x\", \"y\", \"z\"")
+    values = {}
+    for key in ("lengths", "origin", "drop"):
+        if key in t:
+            v = t[key]
+            if (not isinstance(v, list) or len(v) != 3
+                    or not all(_is_number(x) and math.isfinite(x) for x in v)):
+                raise ValueError(f"[periodic] {key} = {v!r}: must be a list of three finite numbers")
+            values[key] = v
+    try:
+        return PeriodicBox(values["lengths"], tuple(a in axes for a in AXES), values.get("origin"), values.get("drop"))
+    except ValueError as exc:
+        raise ValueError(f"[periodic] {exc}") from None
 
 
 def _walls(doc) -> tuple:
@@ -331,9 +374,14 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     if ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
     if "particles" in doc:
-        particles, walls, specimen = _explicit_particles(doc["particles"], materials)
+        particles, walls, specimen, box = _explicit_particles(doc["particles"], materials)
     else:
-        particles, walls, specimen = _generated_particles(doc["generator"], materials)
+        particles, walls, specimen, box = _generated_particles(doc["generator"], materials)
+    if "periodic" in doc:
+        if box is not None:
+            raise ValueError("[periodic]: the generator's boundary = \"periodic\" already makes the block periodic; "
+                             "give one or the other")
+        box = _periodic_box(doc["periodic"])
     walls = walls + _walls(doc)
     cond = dict(doc.get("conductance", {}))
     if "fit_file" in cond and not isinstance(cond["fit_file"], str):
@@ -350,7 +398,7 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
                    integer=("max_steps",), words=("dt",))
     output = _spec(OutputSpec, doc.get("output", {}), "output", integer=("every", "vtu_every"))
     return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
-                 str(meta.get("name", source)), str(meta.get("description", "")), specimen)
+                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, box)
 
 
 def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls) -> None:

@@ -43,11 +43,19 @@ def _progress_bar(scene: Scene, enabled: bool):
     return bar, (lambda t: bar.update(t - bar.n))
 
 
-def effective_conductivity(scene: Scene, boundary: dict) -> float | None:
-    """``k_eff = Q L / (A (T_hot - T_cold))`` of a generated specimen with hot and cold ends (steady)."""
-    sp = scene.specimen
-    if sp is None or sp.hot == sp.cold:
+def effective_conductivity(scene: Scene, summary: dict) -> float | None:
+    """``k_eff = Q L / (A dT)`` (steady): of a generated specimen between hot and cold ends, or along the one axis
+    of a periodic box with a temperature drop per period (``Q`` the heat flow across the period)."""
+    box, sp = scene.box, scene.specimen
+    if box is not None and "periodic_heat_flow" in summary:
+        axes = np.flatnonzero(box.drop)
+        if len(axes) != 1:
+            return None
+        k = int(axes[0])
+        return summary["periodic_heat_flow"][k] * box.lengths[k] / (box.cross_section(k) * box.drop[k])
+    if sp is None or sp.hot == sp.cold or "boundary_heat_flow" not in summary:
         return None
+    boundary = summary["boundary_heat_flow"]
     if sp.hot_particles:
         q = -sum(boundary.get("particles", {}).get(str(k), 0.0) for k in sp.hot_particles)
     else:
@@ -77,11 +85,12 @@ def run(scene: Scene, out=None, progress: bool = False) -> RunResult:
                "seconds": None, "physics": [m.name for m in models], "static": True}
     if p.n <= T_LIST_MAX:
         summary["T"] = thermal.T.tolist()
-    if "boundary_heat_flow" in details:
-        summary["boundary_heat_flow"] = details.pop("boundary_heat_flow")
-        k_eff = effective_conductivity(scene, summary["boundary_heat_flow"])
-        if k_eff is not None:
-            summary["effective_conductivity"] = k_eff
+    for key in ("boundary_heat_flow", "periodic_heat_flow"):
+        if key in details:
+            summary[key] = details.pop(key)
+    k_eff = effective_conductivity(scene, summary)
+    if k_eff is not None:
+        summary["effective_conductivity"] = k_eff
     summary.update(T_mean=float(thermal.T.mean()), T_min=float(thermal.T.min()), T_max=float(thermal.T.max()))
     summary.update(details)
     summary = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in summary.items()}

@@ -43,6 +43,14 @@ matrix; it is SPD when every connected group of free particles reaches a fixed p
   (Crank-Nicolson) more steps for the same error) but need two factorisations per step (12 s instead of 0.7 s
   for implicit at rtol 1e-3, direct solves).
 
+Periodic packings (:mod:`dem.periodic`): a bond to the image ``shift`` of particle ``j`` sees that image at
+``T_j - g``, ``g = drop . shift`` (the temperature drop per period of the box), so it adds the constant flow
+``-K g`` to ``i`` and ``+K g`` to ``j``; these enter ``r`` as the heat flow ``periodic``, which sums to zero over a
+group of free particles. Such a group (no fixed particle, wall or ambient) has a steady state only up to a constant:
+:func:`steady` fixes it by keeping the group's capacity-weighted mean temperature at its initial value (heat is
+conserved, so the transient ends there too), and :func:`periodic_heat_flow` gives the heat flow across the period
+along each axis.
+
 Energy bookkeeping: the heat flowing into the free particles through each boundary (fixed particles, walls,
 convection, radiation, internal sources) is integrated with the same theta weighting as the step, so the change
 of ``sum C_i T_i`` must match it to round-off; the relative mismatch is ``energy_error``. (An iterative linear
@@ -62,6 +70,7 @@ from scipy.sparse.csgraph import connected_components
 from dem.bonds import Bonds
 from dem.linsolve import make_solver
 from dem.particles import Particles
+from dem.periodic import PeriodicBox
 from dem.sources import Sources, linear_sink_terms
 
 INTEGRATORS = {"explicit": 0.0, "implicit": 1.0, "crank-nicolson": 0.5}
@@ -95,10 +104,16 @@ class Network:
     K_walls: np.ndarray
     wall_temperature: np.ndarray
     sources: Sources = field(default_factory=Sources)
+    box: PeriodicBox | None = None
 
     def __post_init__(self):
         p = self.particles
         n = p.n
+        # the temperature jump of every bond across a periodic face (module docstring), zero without one
+        self.jump = (self.bonds.shifts @ self.box.drop if self.box is not None else np.zeros(self.bonds.n_pairs))
+        self.periodic = bool(np.any(self.jump != 0.0))
+        jump_flow = self.K_pairs * self.jump
+        self.jump_rhs = np.bincount(self.bonds.j, jump_flow, n) - np.bincount(self.bonds.i, jump_flow, n)
         self.free = np.flatnonzero(~p.fixed)
         self.fixed = np.flatnonzero(p.fixed)
         self.L = laplacian(n, self.bonds.i, self.bonds.j, self.K_pairs)
@@ -120,11 +135,17 @@ class Network:
         self.C = p.capacity[self.free]
         self.radius = p.radius[self.free]
         self.base_diag = self.L_FF.diagonal()
-        self.r_const = self.fixed_rhs + self.wall_rhs + self.heat
+        self.periodic_rhs = self.jump_rhs[self.free]
+        self.r_const = self.fixed_rhs + self.wall_rhs + self.heat + self.periodic_rhs
 
     @property
     def n_free(self) -> int:
         return len(self.free)
+
+    @property
+    def flow_names(self) -> tuple:
+        """The boundaries through which heat enters the free particles (keys of :meth:`flows`)."""
+        return ("fixed", "walls", "internal", *self.sources.names) + (("periodic",) if self.periodic else ())
 
     def sinks(self, T_F: np.ndarray) -> dict:
         return linear_sink_terms(self.sources, self.radius, T_F)
@@ -144,6 +165,8 @@ class Network:
                "internal": float(self.heat.sum())}
         for name, (g, b) in sinks.items():
             out[name] = float(b.sum() - g @ T_F)
+        if self.periodic:
+            out["periodic"] = float(self.periodic_rhs.sum())
         return out
 
     def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
@@ -155,7 +178,7 @@ class Network:
         ``sqrt(eps) sum |K T|``: temperature differences below ~1e-8 of the temperatures count as no flow.
         """
         pairs = [(self.fixed_diag, self.fixed_rhs), (self.wall_diag, self.wall_rhs), *sinks.values()]  # (g, b)
-        net = gross = float(np.abs(self.heat).sum())
+        net = gross = float(np.abs(self.heat).sum() + np.abs(self.periodic_rhs).sum())
         for g, b in pairs:
             net += float(np.abs(b - g * T_F).sum())
             gross += float(np.abs(b).sum() + np.abs(g * T_F).sum())
@@ -181,13 +204,21 @@ class Network:
 def boundary_heat_flow(net: Network, T: np.ndarray) -> dict:
     """W into each fixed particle (from its bonds and walls) and into each wall, at full temperatures ``T``."""
     p, b = net.particles, net.bonds
-    into_fixed = -(net.L @ T)
+    into_fixed = -(net.L @ T) + net.jump_rhs
     to_wall = net.K_walls * (T[b.wall_particle] - net.wall_temperature[b.wall_index])
     into_fixed -= np.bincount(b.wall_particle, to_wall, p.n)
     n_walls = len(net.wall_temperature)
     walls = np.bincount(b.wall_index, to_wall, n_walls) if n_walls else np.zeros(0)
     return {"particles": {int(k): float(into_fixed[k]) for k in net.fixed}, "walls": walls}
 
+
+def periodic_heat_flow(net: Network, T: np.ndarray) -> np.ndarray:
+    """Heat flow (W) across the period along x, y and z at full temperatures ``T``: every bond's flow from ``i``
+    to the image ``shift`` of ``j``, ``K (T_i - T_j + g)``, times ``shift`` (a bond spanning ``s`` periods crosses
+    ``s`` of the period's planes). In a steady state it is the flow through any plane normal to that axis."""
+    b = net.bonds
+    q = net.K_pairs * (T[b.i] - T[b.j] + net.jump)
+    return q @ b.shifts
 
 # -------------------------------------------------------------------------------------------------- steady
 @dataclass
@@ -201,7 +232,8 @@ class SteadyResult:
 
 
 def _components(net: Network):
-    """Connected components of the free particles and whether each is anchored (reaches a fixed temperature)."""
+    """Connected components of the free particles, whether each is anchored (reaches a fixed temperature), and
+    whether it holds a bond across a periodic face with a temperature jump."""
     n_comp, label = connected_components(net.L_FF, directed=False)
     anchor = net.fixed_diag + net.wall_diag
     sinks = net.sinks(net.particles.temperature[net.free])
@@ -209,7 +241,14 @@ def _components(net: Network):
         anchor = anchor + g
     anchored = np.zeros(n_comp, dtype=bool)
     anchored[label[anchor > 0]] = True
-    return n_comp, label, anchored
+    jumping = np.zeros(n_comp, dtype=bool)
+    if net.periodic:
+        position = np.full(net.particles.n, -1)
+        position[net.free] = np.arange(net.n_free)
+        b = net.bonds
+        free_i = position[b.i[net.jump != 0.0]]
+        jumping[label[free_i[free_i >= 0]]] = True
+    return n_comp, label, anchored, jumping
 
 
 def steady(net: Network, floating: str = "error", linear: str = "auto", max_newton: int = 50,
@@ -217,14 +256,26 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
     """Steady temperatures ``A T = r`` (Rojek 2022, eq. 2 with dT/dt = 0).
 
     A connected group of free particles with no fixed particle, wall or ambient exchange makes ``A`` singular.
+    Where the group holds bonds across a periodic face with a temperature jump it has a steady state up to a
+    constant, fixed by keeping its capacity-weighted mean temperature at the initial one. Otherwise
     ``floating = "error"`` explains and refuses; ``"mean"`` keeps such a group at the capacity-weighted mean of its
     initial temperatures (the long-time limit of the transient), provided its internal sources sum to zero.
     """
     T_F = net.particles.temperature[net.free].astype(float)
-    n_comp, label, anchored = _components(net)
-    n_float = int((~anchored).sum())
+    n_comp, label, anchored, jumping = _components(net)
+    gauged = ~anchored & jumping
+    n_float = int((~anchored & ~jumping).sum())
+
+    def no_solution(lost):
+        comp = label[lost]
+        net_heat = np.bincount(comp, net.heat[lost], n_comp)
+        scale = np.bincount(comp, np.abs(net.heat[lost]), n_comp)
+        if np.any(np.abs(net_heat) > 1e-12 * np.maximum(scale, 1e-300)):
+            raise ValueError("steady problem has no solution: a floating group of particles (no fixed temperature, "
+                             "wall or ambient) has a net internal heat source, so it heats up forever")
+
     if n_float:
-        lost = np.flatnonzero(~anchored[label])
+        lost = np.flatnonzero(~anchored[label] & ~jumping[label])
         if floating == "error":
             first = net.free[lost[:8]].tolist()
             raise ValueError(f"steady problem is singular: {n_float} of {n_comp} connected group(s) of free particles "
@@ -233,16 +284,24 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
                              f"wall or an ambient, set solver.floating = \"mean\", or use mode = \"transient\"")
         if floating != "mean":
             raise ValueError(f"solver.floating = {floating!r}: must be error or mean")
+        no_solution(lost)
         comp = label[lost]
-        net_heat = np.bincount(comp, net.heat[lost], n_comp)
-        scale = np.bincount(comp, np.abs(net.heat[lost]), n_comp)
-        if np.any(np.abs(net_heat) > 1e-12 * np.maximum(scale, 1e-300)):
-            raise ValueError("steady problem has no solution: a floating group of particles (no fixed temperature, "
-                             "wall or ambient) has a net internal heat source, so it heats up forever")
         energy = np.bincount(comp, net.C[lost] * T_F[lost], n_comp)
         cap = np.bincount(comp, net.C[lost], n_comp)
         T_F[lost] = energy[comp] / cap[comp]
-    solve_idx = np.flatnonzero(anchored[label])
+    # a gauged group is solved with one particle (its first) held at 0, then shifted to its initial mean
+    solve = anchored[label] | gauged[label]
+    ground = np.zeros(net.n_free, dtype=bool)
+    if np.any(gauged):
+        no_solution(np.flatnonzero(gauged[label]))
+        first = np.full(n_comp, -1)
+        members = np.flatnonzero(gauged[label])
+        first[label[members[::-1]]] = members[::-1]
+        ground[first[gauged]] = True
+        target = np.bincount(label, net.C * T_F, n_comp)
+        T_F[ground] = 0.0
+        solve &= ~ground
+    solve_idx = np.flatnonzero(solve)
     T_sub = T_F[solve_idx]
     restrict = None if len(solve_idx) == net.n_free else solve_idx
     iterations, backend = 0, "none"
@@ -264,6 +323,11 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
     else:
         raise ValueError(f"steady radiation (Newton) did not converge in {max_newton} iterations")
     T_F[solve_idx] = T_sub
+    if np.any(gauged):
+        cap = np.bincount(label, net.C, n_comp)
+        shift = (target - np.bincount(label, net.C * T_F, n_comp)) / cap
+        in_gauged = gauged[label]
+        T_F[in_gauged] += shift[label[in_gauged]]
     # radiation: report the exact T^4 flow at the solution
     sinks = net.sinks(T_F)
     flows = net.flows(T_F, sinks)
@@ -490,7 +554,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     grid = 2**AUTO_LEVELS
     units = 0  # dyadic: the time t = t_end * units / grid
     energy0 = float(net.C @ T)
-    heat_in = {k: 0.0 for k in ("fixed", "walls", "internal", *net.sources.names)}
+    heat_in = {k: 0.0 for k in net.flow_names}
     abs_in = 0.0
     t, steps, rejected = 0.0, 0, 0
     dt_min, dt_max = math.inf, 0.0

@@ -104,8 +104,10 @@ def series(*halves):
     return 1.0 / resistance
 
 
-def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds) -> tuple[np.ndarray, np.ndarray]:
-    """``(K_pairs, K_walls)`` in W/K for every pair bond and wall bond."""
+def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
+                      box=None) -> tuple[np.ndarray, np.ndarray]:
+    """``(K_pairs, K_walls)`` in W/K for every pair bond and wall bond (``box``: the periodic box the bonds' image
+    shifts refer to, :mod:`dem.periodic`)."""
     kappa, r = particles.conductivity, particles.radius
     kc = spec.contact_conductance
     k_i = half_conductance(spec, kappa[bonds.i], r[bonds.i], bonds.a, bonds.l_i)
