@@ -19,7 +19,7 @@ import re
 import sys
 import warnings
 
-COMMAND_MODULES = ("neck", "solve", "converge", "fit", "unequal", "cluster")  # each module imports its heavy dependencies (gmsh, scikit-fem) inside run()
+COMMAND_MODULES = ("neck", "solve", "converge", "fit", "unequal", "cluster", "lattice")  # each module imports its heavy dependencies (gmsh, scikit-fem) inside run()
 
 
 class OneLineParser(argparse.ArgumentParser):
