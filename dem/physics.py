@@ -40,7 +40,7 @@ class ThermalModel:
         p = scene.particles
         spec = scene.conductance
         self.bonds = find_bonds(p, scene.walls, spec.contact, spec.out_of_range, box=scene.box)
-        self.K_pairs, self.K_walls = bond_conductances(spec, p, self.bonds, scene.box)
+        self.K_pairs, self.K_walls = bond_conductances(spec, p, self.bonds, scene.box, scene.walls)
         wall_T = np.array([w.temperature for w in scene.walls], dtype=float)
         self.network = Network(p, self.bonds, self.K_pairs, self.K_walls, wall_T, scene.sources, scene.box)
 

@@ -2,6 +2,7 @@
 
     python -m dem run SCENE [--out DIR] [--json]     SCENE: a TOML file or a built-in name
     python -m dem scenes [--json]
+    python -m dem laws [--json]                      the conductance laws a scene can select
 
 Each sub-command is a module of this package exposing ``register(subparsers)``; the plumbing is that of
 :mod:`fem_neck.cli` (one JSON object with ``--json``; bad input: one line on stderr, exit code 2).
@@ -9,7 +10,7 @@ Each sub-command is a module of this package exposing ``register(subparsers)``; 
 
 from fem_neck.cli import main as _main
 
-COMMANDS = ("run", "scenes")
+COMMANDS = ("run", "scenes", "laws")
 
 
 def main(argv=None) -> int:

@@ -14,6 +14,9 @@ Laws (``ConductanceSpec.law``):
   ``python -m fem_neck fit`` (``fit_file``; default: the fit shipped in ``fem_neck/data/fit.json``), each half at
   its own ``a/r_i``; for unequal radii the series is multiplied by the FE correction
   :func:`fem_neck.law.unequal_factor` (``unequal = true``, default), as :func:`fem_neck.law.pair_conductance` does.
+* ``"shared-body"`` -- the ``fit`` law's halves, each particle's scaled by one factor for the necks that share its
+  body (the particle as a multi-terminal conductor, from the Neumann function of the sphere;
+  :mod:`dem.laws.shared_body`); pairs and chains get the ``fit`` law's numbers exactly.
 * ``"zohdi"`` -- ``K_ij = kappa A_c / |x_i - x_j|`` with the lens contact area ``A_c = pi a^2`` (Zohdi 2014,
   eqs. 11-12, 33), written as halves ``K_i = kappa_i pi a^2 / L_i`` (``L_i + L_j = |x_i - x_j|``, eq. 9), which
   is eq. (33) exactly for one material. (Zohdi's footnote 4 averages two conductivities arithmetically; the halves
@@ -34,7 +37,16 @@ from fem_neck import law as fem_law
 from dem.bonds import OUT_OF_RANGE, Bonds
 from dem.particles import Particles
 
-LAWS = ("rojek", "argento-bouvard", "fit", "zohdi")
+LAWS = ("rojek", "argento-bouvard", "fit", "shared-body", "zohdi")
+FIT_LAWS = ("fit", "shared-body")  # the laws built on the full-range fit (fit_file, unequal)
+DESCRIPTIONS = {
+    "rojek": "1.064 kappa pi a per half, halves in series (Rojek 2022, eqs. 40, 43-45)",
+    "argento-bouvard": "1.112 kappa pi a per half, halves in series (Argento & Bouvard 1996; Rojek 2022, eq. 42)",
+    "fit": "kappa pi r f(a/r) per half from the full-range FE fit (fit.json), halves in series, unequal-radii factor",
+    "shared-body": "the fit law with each particle's halves scaled for the necks sharing its body (sphere Neumann "
+                   "function; exact for pairs and chains, never above the Wiener bound)",
+    "zohdi": "kappa pi a^2 / |x_i - x_j| with the lens contact circle (Zohdi 2014, eqs. 11-12, 33)",
+}
 NECK_MODELS = ("newton", "first", "coble")
 LINEAR_SLOPES = {"rojek": fem_law.ROJEK.slope, "argento-bouvard": fem_law.ARGENTO_BOUVARD.slope}
 
@@ -66,12 +78,12 @@ class ConductanceSpec:
                              f"argento-bouvard")
         if not isinstance(self.unequal, bool):
             raise ValueError(f"conductance.unequal = {self.unequal!r}: must be true or false")
-        if self.fit_file is not None and self.law != "fit":
-            raise ValueError(f"conductance.fit_file = {self.fit_file!r}: only with law = \"fit\"")
+        if self.fit_file is not None and self.law not in FIT_LAWS:
+            raise ValueError(f"conductance.fit_file = {self.fit_file!r}: only with law = \"fit\" or \"shared-body\"")
         kc = self.contact_conductance
         if kc is not None and (not np.isfinite(kc) or kc <= 0):
             raise ValueError(f"conductance.contact_conductance = {kc!r}: must be finite and > 0 (W/K)")
-        if self.law == "fit":
+        if self.law in FIT_LAWS:
             fit_law(self.fit_file)  # a missing or malformed fit file is reported when the scene is read
 
     @property
@@ -91,7 +103,7 @@ def half_conductance(spec: ConductanceSpec, kappa, r, a, length):
     kappa, r, a, length = (np.asarray(x, dtype=float) for x in (kappa, r, a, length))
     if spec.law in LINEAR_SLOPES:
         return (spec.slope or LINEAR_SLOPES[spec.law]) * kappa * np.pi * a          # eqs. (43), (42)
-    if spec.law == "fit":
+    if spec.law in FIT_LAWS:
         return kappa * np.pi * r * np.asarray(fit_law(spec.fit_file).k_over_kcyl(np.minimum(a / r, 1.0)))
     with np.errstate(divide="ignore"):
         return kappa * np.pi * a * a / length                                         # Zohdi 2014, eq. (33)
@@ -104,18 +116,28 @@ def series(*halves):
     return 1.0 / resistance
 
 
-def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
-                      box=None) -> tuple[np.ndarray, np.ndarray]:
+def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds, box=None,
+                      walls=()) -> tuple[np.ndarray, np.ndarray]:
     """``(K_pairs, K_walls)`` in W/K for every pair bond and wall bond (``box``: the periodic box the bonds' image
-    shifts refer to, :mod:`dem.periodic`)."""
+    shifts refer to, :mod:`dem.periodic`; ``walls``: the walls of the wall bonds, whose normals the
+    ``shared-body`` law needs)."""
     kappa, r = particles.conductivity, particles.radius
     kc = spec.contact_conductance
     k_i = half_conductance(spec, kappa[bonds.i], r[bonds.i], bonds.a, bonds.l_i)
     k_j = half_conductance(spec, kappa[bonds.j], r[bonds.j], bonds.a, bonds.l_j)
     p = bonds.wall_particle
     k_w = half_conductance(spec, kappa[p], r[p], bonds.wall_a, bonds.wall_l)
+    if spec.law == "shared-body":
+        from dem.laws.shared_body import body_factors
+
+        if bonds.n_walls and not len(walls):
+            raise ValueError("conductance.law = \"shared-body\": the wall bonds' walls are needed (their normals)")
+        normals = np.array([w.normal for w in walls])[bonds.wall_index] if bonds.n_walls else np.zeros((0, 3))
+        s = body_factors(particles.n, r, bonds, bonds.vectors(particles.position, box), k_i, k_j, k_w, kappa,
+                         normals)
+        k_i, k_j, k_w = s[bonds.i] * k_i, s[bonds.j] * k_j, s[p] * k_w
     k_pair = series(k_i, k_j)
-    if spec.law == "fit" and spec.unequal and bonds.n_pairs:
+    if spec.law in FIT_LAWS and spec.unequal and bonds.n_pairs:
         k_pair = k_pair * fem_law.unequal_factor(r[bonds.i], r[bonds.j], bonds.a)
     k_pair, k_wall = series(k_pair, kc), series(k_w, kc)
     _check_finite(spec, k_pair, bonds.a, lambda k: f"bond ({bonds.i[k]}, {bonds.j[k]})")
@@ -128,6 +150,6 @@ def _check_finite(spec: ConductanceSpec, K: np.ndarray, a: np.ndarray, name) -> 
     bad = ~(np.isfinite(K) & (K >= 0.0))
     if np.any(bad):
         k = int(np.flatnonzero(bad)[0])
-        source = f" from fit_file = {spec.fit_file!r}" if spec.law == "fit" else ""
+        source = f" from fit_file = {spec.fit_file!r}" if spec.law in FIT_LAWS else ""
         raise ValueError(f"conductance.law = {spec.law!r}{source} gives K = {float(K[k])!r} W/K for {name(k)} (neck radius "
                          f"a = {a[k]:.6g} m): conductances must be finite and >= 0")

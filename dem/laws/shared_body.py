@@ -1,0 +1,170 @@
+"""The ``shared-body`` law: the pipe network corrected for the necks of one particle sharing its body.
+
+The pipe network (Rojek 2022, eqs. 4-9) gives every bond two half-conductances in series, each calibrated on one
+sintered pair: the half body from the particle's equatorial plane to the neck (eq. 36). That is exact for chains, but
+a particle with necks in several directions passes heat between them through one body, and the network counts that
+body once per bond: a dense packing conducts less than the network says (FCC by ~35 % at a/r = 0.4).
+
+**The particle as a multi-terminal conductor.** Heat ``Q_c`` entering a ball of radius ``r`` (conductivity kappa)
+through small contacts ``c`` on its surface raises the temperature at contact ``b`` by ``sum_c R_bc Q_c`` (with
+``sum Q = 0`` in steady state). For point contacts ``R_bc`` is the ball's Neumann function between two surface
+points at the angle ``gamma``; from its spherical-harmonic series, ``sum_(l>=1) (2l+1)/l P_l(cos gamma) /
+(4 pi kappa r)`` and the generating functions of ``P_l`` and ``P_l / l``,
+
+    G(gamma) = (1/s - 2 - ln(s (1 + s))) / (4 pi kappa r),    s = sin(gamma / 2) = |n_b - n_c| / 2:
+
+the ``1/s`` is twice the free-space source (a source on a surface), the logarithm the ball's finite size (the term
+that gives the fit law its ``x ln(1/x)``, :mod:`fem_neck.law`). The model keeps the pair-calibrated half resistance
+``R_b = 1 / K_b`` of the fit law on the diagonal (a neck's own constriction, its half neck and the sphere) and adds
+the interaction of every other neck relative to an antipodal one,
+
+    R_bb = 1 / K_b,    R_bc = G(gamma_bc) - G(pi) = (1/s - 1 - ln(s (1 + s) / 2)) / (4 pi kappa r),
+
+so that a particle whose necks are collinear (a pair, a chain) has ``R = diag(1/K_b)``: today's network exactly.
+
+**Back to one temperature per particle.** The network keeps one node per particle, so the multi-terminal conductor
+is reduced to one factor ``s_k`` on all half-conductances of particle ``k``, chosen so that the particle passes the
+same heat in a uniform field: neck ``b`` sits at ``x_k + l_b n_b`` (``l_b`` the centre-to-contact-plane distance),
+a field ``g`` drives the flows ``Q = Y (N g)`` with ``N`` the rows ``l_b n_b`` and ``Y`` the conductance matrix of
+``R`` on flows that sum to zero (``Y = R^-1 - R^-1 1 1^T R^-1 / (1^T R^-1 1)``); the particle's conductivity tensor
+is ``N^T Y N``. With ``s_k`` the ratio of its trace to that of the plain network's (``R = diag(1/K_b)``)::
+
+    s_k = tr(N^T Y_R N) / tr(N^T Y_D N).
+
+For a cubic lattice both tensors are isotropic, so this is exact there for the multi-terminal model; for the simple
+cubic lattice the interactions cancel in every uniform field (``s = 1``, as the FE says: the network is within
+0.03 % there). Chains and pairs give ``s = 1`` exactly: interactions below 1e-12 of the half resistances (collinear
+bonds to round-off) count as none, so those results are today's ``fit`` law bit for bit.
+
+**Never above the Wiener bound.** For the uniform field the network's energy is at most the sum over particles of
+``sum_b s_k K_b l_b^2 (n_b . g)^2`` (the halves of a bond in series, Cauchy-Schwarz), and the Wiener bound ``phi
+kappa`` is the same field's energy in the solid, ``kappa V_k |g|^2`` per particle. So ``s_k`` is capped at
+``kappa V_k / lambda_max(sum_b K_b l_b^2 n_b n_b^T)`` (``V_k = 4/3 pi r^3``, the volume each particle keeps
+under the volume-conserving neck): a periodic network then never conducts more than ``phi kappa``. The cap binds
+only where the correction falls short (it is applied to particles with non-collinear necks).
+
+A wall bond is a neck too (toward the wall, the mirror pair's neck), so it takes part in its particle's factor.
+
+The factors are computed per particle in one compiled loop (numba): a Cholesky solve of the ``z x z`` matrix ``R``
+with four right-hand sides.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from dem.bonds import Bonds
+
+ROUNDOFF = 1e-12  # interactions below this x the smallest half resistance are round-off of collinear bonds
+
+
+@numba.njit(cache=True)
+def interaction(cos_gamma: float) -> float:
+    """``4 pi kappa r (G(gamma) - G(pi))`` for two point contacts at the angle ``gamma`` (module docstring)."""
+    s = np.sqrt(max(0.5 * (1.0 - cos_gamma), 0.0))
+    if s >= 1.0:
+        return 0.0
+    s = max(s, 1e-12)
+    return 1.0 / s - 1.0 - np.log(s * (1.0 + s) / 2.0)
+
+
+@numba.njit(cache=True)
+def _factors(offsets, normal, arm, half_r, n_particles):
+    """``s_k`` for every particle (module docstring). Per particle ``k`` its necks are ``offsets[k]:offsets[k+1]``
+    with unit ``normal`` (m, 3), ``arm`` ``l_b / r_k`` and ``half_r`` ``= 4 pi kappa r_k / K_b`` (the half
+    resistance in units of ``1 / (4 pi kappa r_k)``). Also returns which particles have interacting necks."""
+    out = np.ones(n_particles)
+    interacting = np.zeros(n_particles, dtype=np.bool_)
+    for k in range(n_particles):
+        lo, hi = offsets[k], offsets[k + 1]
+        z = hi - lo
+        if z < 2:
+            continue
+        R = np.zeros((z, z))
+        small = np.inf
+        largest = 0.0
+        for b in range(z):
+            R[b, b] = half_r[lo + b]
+            small = min(small, half_r[lo + b])
+            for c in range(b):
+                cos_g = (normal[lo + b, 0] * normal[lo + c, 0] + normal[lo + b, 1] * normal[lo + c, 1]
+                         + normal[lo + b, 2] * normal[lo + c, 2])
+                g = interaction(cos_g)
+                R[b, c] = g
+                R[c, b] = g
+                largest = max(largest, abs(g))
+        if largest <= ROUNDOFF * small:
+            continue
+        interacting[k] = True
+        rhs = np.empty((z, 4))
+        for b in range(z):
+            for a in range(3):
+                rhs[b, a] = arm[lo + b] * normal[lo + b, a]
+            rhs[b, 3] = 1.0
+        x = np.linalg.solve(R, rhs)
+        tr_r = 0.0
+        dip = np.zeros(3)
+        ones = 0.0
+        for b in range(z):
+            for a in range(3):
+                tr_r += rhs[b, a] * x[b, a]
+                dip[a] += rhs[b, a] * x[b, 3]
+            ones += x[b, 3]
+        tr_r -= (dip[0] ** 2 + dip[1] ** 2 + dip[2] ** 2) / ones
+        tr_d = 0.0
+        dip[:] = 0.0
+        ones = 0.0
+        for b in range(z):
+            w = 1.0 / half_r[lo + b]
+            for a in range(3):
+                tr_d += w * rhs[b, a] ** 2
+                dip[a] += w * rhs[b, a]
+            ones += w
+        tr_d -= (dip[0] ** 2 + dip[1] ** 2 + dip[2] ** 2) / ones
+        if tr_d > 0.0:
+            out[k] = tr_r / tr_d
+    return out, interacting
+
+
+@numba.njit(cache=True)
+def _wiener_caps(offsets, normal, arm, half_r, factor, interacting):
+    """``min(s_k, kappa V_k / lambda_max(sum_b K_b l_b^2 n_b n_b^T))`` for the particles with interacting necks,
+    in units where ``K_b = 4 pi / half_r`` and ``V_k = 4/3 pi``."""
+    out = factor.copy()
+    for k in range(len(factor)):
+        if not interacting[k]:
+            continue
+        M = np.zeros((3, 3))
+        for b in range(offsets[k], offsets[k + 1]):
+            w = 4.0 * np.pi / half_r[b] * arm[b] ** 2
+            for p in range(3):
+                for q in range(3):
+                    M[p, q] += w * normal[b, p] * normal[b, q]
+        lam = np.linalg.eigvalsh(M)[2]
+        if lam > 0.0:
+            out[k] = min(out[k], 4.0 / 3.0 * np.pi / lam)
+    return out
+
+
+def body_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray, k_j: np.ndarray,
+                 k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray) -> np.ndarray:
+    """``s_k`` of every particle (module docstring) from its necks: the pair bonds (``vectors`` from ``i`` to the
+    partner, half conductances ``k_i``, ``k_j`` in W/K) and the wall bonds (unit ``wall_normals`` pointing into
+    the packing, half conductances ``k_wall``)."""
+    d = np.linalg.norm(vectors, axis=1)
+    e = vectors / np.where(d > 0, d, 1.0)[:, None]
+    owner = np.concatenate([bonds.i, bonds.j, bonds.wall_particle]).astype(np.int64)
+    normal = np.concatenate([e, -e, -np.asarray(wall_normals, dtype=float).reshape(-1, 3)])
+    arm = np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l])
+    half = np.concatenate([k_i, k_j, k_wall])
+    r, kappa = radius[owner], conductivity[owner]
+    with np.errstate(divide="ignore"):
+        half_r = 4.0 * np.pi * kappa * r / half
+    order = np.argsort(owner, kind="stable")
+    offsets = np.zeros(n + 1, dtype=np.int64)
+    offsets[1:] = np.cumsum(np.bincount(owner, minlength=n))
+    normal, arm, half_r = normal[order], (arm / r)[order], half_r[order]
+    normal = np.ascontiguousarray(normal)
+    factor, interacting = _factors(offsets, normal, arm, half_r, n)
+    return _wiener_caps(offsets, normal, arm, half_r, factor, interacting)
