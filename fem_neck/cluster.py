@@ -168,10 +168,11 @@ def add_neck_cylinders(occ, cluster: Cluster, geo) -> list:
 
 
 def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, size_far: float, neck_cells: float,
-                     tol: float, every_bond: bool = True) -> list:
+                     tol: float, every_bond: bool = True, grading: float | None = None) -> list:
     """gmsh size fields graded toward every neck circle found on the boundary ``surfaces`` (set as the background
     mesh): ``min(size_neck a, h_n / neck_cells)`` at the circle, growing linearly to ``size_far`` times the smaller
-    radius at a distance ``2 a`` (Distance + Threshold fields). The circles are the curves all of whose sample points
+    radius at a distance ``2 a`` (Distance + Threshold fields), or, with ``grading``, growing by ``grading`` per unit
+    distance (the same relative grading around small and large necks). The circles are the curves all of whose sample points
     lie at distance ``a`` from the bond axis and at the neck's ends (possibly split into arcs at seams or cut by
     planes). ``every_bond``: each bond must have its two circles on the boundary (else ``RuntimeError``); otherwise
     bonds without any are skipped (a neck cut away by a cell face). Returns the Threshold field tags.
@@ -203,11 +204,14 @@ def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, si
         gmsh.model.mesh.field.setNumbers(dist, "CurvesList", found)
         gmsh.model.mesh.field.setNumber(dist, "Sampling", 200)
         thr = gmsh.model.mesh.field.add("Threshold")
+        size_min = min(size_neck * geo.a[b], geo.h_n[b] / neck_cells)
+        size_max = size_far * min(r[bi[b]], r[bj[b]])
         gmsh.model.mesh.field.setNumber(thr, "InField", dist)
-        gmsh.model.mesh.field.setNumber(thr, "SizeMin", min(size_neck * geo.a[b], geo.h_n[b] / neck_cells))
-        gmsh.model.mesh.field.setNumber(thr, "SizeMax", size_far * min(r[bi[b]], r[bj[b]]))
+        gmsh.model.mesh.field.setNumber(thr, "SizeMin", size_min)
+        gmsh.model.mesh.field.setNumber(thr, "SizeMax", size_max)
         gmsh.model.mesh.field.setNumber(thr, "DistMin", 0.0)
-        gmsh.model.mesh.field.setNumber(thr, "DistMax", 2.0 * geo.a[b])
+        gmsh.model.mesh.field.setNumber(thr, "DistMax", 2.0 * geo.a[b] if grading is None
+                                        else max(size_max - size_min, 0.0) / grading)
         thresholds.append(thr)
     fmin = gmsh.model.mesh.field.add("Min")
     gmsh.model.mesh.field.setNumbers(fmin, "FieldsList", thresholds)
