@@ -58,7 +58,7 @@ COORDINATION = {"sc": 6, "bcc": 8, "fcc": 12}
 # exact in the limit of small necks (independent constrictions), which the FE shows from here up
 MIN_NECK_RATIO = 0.05
 # the refinement ladder: level sizes relative to the particle radius (far) and to the neck radius (at the circles)
-SIZE_FAR0, SIZE_NECK0, LEVEL_FACTOR = 0.25, 0.06, 0.8
+SIZE_FAR0, SIZE_NECK0, GRADING0, LEVEL_FACTOR = 0.25, 0.06, 0.25, 0.8
 MAX_ELEMENTS = 3_000_000  # ~10 GB and ~15 min on 2 cores: finer meshes are refused
 GAP_ORDER = 1.65  # the gap between the bounds falls like size^GAP_ORDER (:func:`effective_conductivity`)
 LINEAR_RTOL = 1e-11
@@ -255,11 +255,12 @@ def _local_cluster(cell: PeriodicCell, box: np.ndarray):
     return Cluster(x, r, np.column_stack([p[use], q[use]]))
 
 
-def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curvature: int,
+def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curvature: int, grading: float,
                     neck_cells: float = 2.0, method: str = "newton") -> CellMesh:
     """Mesh the computational cell (module docstring): the union of the spheres and necks near it, intersected with
     the box ``[0, P/2]^3`` (or its wedge ``y <= x``), graded toward every neck circle (sizes as in
-    :func:`fem_neck.cluster.neck_size_fields`). Lengths are scaled to the largest radius while meshing."""
+    :func:`fem_neck.cluster.neck_size_fields`: ``size_neck a`` at the circles, growing by ``grading`` per unit
+    distance up to ``size_far r``). Lengths are scaled to the largest radius while meshing."""
     from skfem import MeshTet
 
     from fem_neck.cluster import add_neck_cylinders, curved_mesh, mesh_tetrahedra, neck_size_fields, tetrahedra
@@ -289,14 +290,15 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curva
             domain = [(3, occ.addBox(0, 0, 0, *box))]
         volume, _ = occ.intersect(union, domain)
         occ.synchronize()
-        if len(volume) != 1:
-            raise RuntimeError(f"{cell.name}: the solid in the cell has {len(volume)} parts, expected one")
-        vol_tag = volume[0][1]
-        volume_cad = occ.getMass(3, vol_tag)
-        surfaces = [tag for _, tag in gmsh.model.getBoundary(volume, oriented=False)]
-        neck_size_fields(gmsh, local, geo, surfaces, size_neck, size_far, neck_cells, tol, every_bond=False)
+        # the solid may reach the cell in several pieces, joined outside it; a piece touching neither isothermal
+        # face carries no heat (its temperature is constant; the solvers leave it at the initial guess)
+        volume_cad = sum(occ.getMass(3, tag) for _, tag in volume)
+        surfaces = [tag for _, tag in gmsh.model.getBoundary(volume, combined=False, oriented=False)]
+        neck_size_fields(gmsh, local, geo, surfaces, size_neck, size_far, neck_cells, tol, every_bond=False,
+                         grading=grading)
         mesh_tetrahedra(gmsh, curvature, size_far)
-        points, tets, _ = tetrahedra(gmsh, vol_tag)
+        pieces = [tetrahedra(gmsh, tag) for _, tag in volume]
+        points, tets = pieces[0][0], np.vstack([piece[1] for piece in pieces])
     used = np.unique(tets)
     remap = np.full(len(points), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
@@ -347,7 +349,10 @@ class Bounds:
 
 
 def solve_bounds(cm: CellMesh, rtol: float = LINEAR_RTOL) -> Bounds:
-    """Upper (P2 energy) and lower (CR complementary energy) bounds of the cell's heat flow (module docstring)."""
+    """Upper (P2 energy) and lower (CR complementary energy) bounds of the cell's heat flow (module docstring).
+
+    Pieces of the solid that touch neither isothermal face make the systems singular but consistent: conjugate
+    gradients keep them at their constant initial value, which carries no heat."""
     from skfem import Basis, ElementTetCR, ElementTetP2, Functional
 
     p2 = Basis(cm.curved, ElementTetP2())
@@ -416,7 +421,8 @@ def level_sizes(level: float) -> dict:
     """Mesh sizes of refinement ``level`` (0 is the coarsest): all lengths shrink by ``LEVEL_FACTOR`` per level."""
     f = LEVEL_FACTOR**level
     size_far = SIZE_FAR0 * f
-    return {"size_neck": SIZE_NECK0 * f, "size_far": size_far, "curvature": int(round(2 * math.pi / size_far))}
+    return {"size_neck": SIZE_NECK0 * f, "size_far": size_far, "curvature": int(round(2 * math.pi / size_far)),
+            "grading": GRADING0 * f}
 
 
 def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-3, start_level: float = 2.0, max_levels: int = 4,

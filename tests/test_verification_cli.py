@@ -73,7 +73,7 @@ def test_all_quick_under_three_minutes(tmp_path):
     t0 = time.perf_counter()
     proc = _run("all", "--quick", "--json", "--no-progress", "--out", str(out))
     seconds = time.perf_counter() - t0
-    summary, _ = _check_run(out, proc, ["paper", "chains", "clusters", "transient"])
+    summary, _ = _check_run(out, proc, ["paper", "chains", "clusters", "transient", "lattices"])
     assert any(k.startswith("chains.") for k in summary)
     assert seconds < 180.0, seconds
 

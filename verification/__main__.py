@@ -3,8 +3,9 @@
 Commands (each writes ``report.md``, ``summary.json`` and ``run.json`` plus PNG figures into ``--out DIR``):
 
 * ``paper``      -- Rojek et al. 2022 reproduced, our numbers beside theirs (section ``paper``);
-* ``dem-vs-fe``  -- DEM pipe network against FE: collinear chains, 3D clusters, transient pair
-  (sections ``chains``, ``clusters``, ``transient``);
+* ``dem-vs-fe``  -- DEM pipe network against FE: collinear chains, 3D clusters, transient pair, periodic lattices
+  and random packings (sections ``chains``, ``clusters``, ``transient``, ``lattices``);
+* ``lattices``   -- only the periodic packings (section ``lattices``: FE results are cached in its folder);
 * ``all``        -- ``paper`` and ``dem-vs-fe``;
 * ``bench``, ``stability`` -- run time against error, and stress tests (sections of the same names; they may add
   options of their own, see ``python -m verification bench --help``).
@@ -30,8 +31,10 @@ PROG = "python -m verification"
 DEFAULT_OUT = "verification-results"
 COMMANDS = {
     "paper": (("paper",), "reproduce the quantitative claims of Rojek et al. 2022"),
-    "dem-vs-fe": (("chains", "clusters", "transient"), "DEM pipe network against FE: chains, 3D clusters, transient"),
-    "all": (("paper", "chains", "clusters", "transient"), "paper and dem-vs-fe"),
+    "dem-vs-fe": (("chains", "clusters", "transient", "lattices"),
+                  "DEM pipe network against FE: chains, 3D clusters, transient, periodic lattices and packings"),
+    "lattices": (("lattices",), "DEM pipe network against FE of periodic SC, BCC, FCC lattices and random packings"),
+    "all": (("paper", "chains", "clusters", "transient", "lattices"), "paper and dem-vs-fe"),
     "bench": (("bench",), "run time against error for FE, neck radius and DEM, with peers"),
     "stability": (("stability",), "numerical stability stress tests"),
 }

@@ -14,13 +14,18 @@ points at the angle ``gamma``; from its spherical-harmonic series, ``sum_(l>=1) 
     G(gamma) = (1/s - 2 - ln(s (1 + s))) / (4 pi kappa r),    s = sin(gamma / 2) = |n_b - n_c| / 2:
 
 the ``1/s`` is twice the free-space source (a source on a surface), the logarithm the ball's finite size (the term
-that gives the fit law its ``x ln(1/x)``, :mod:`fem_neck.law`). The model keeps the pair-calibrated half resistance
-``R_b = 1 / K_b`` of the fit law on the diagonal (a neck's own constriction, its half neck and the sphere) and adds
-the interaction of every other neck relative to an antipodal one,
+that gives the fit law its ``x ln(1/x)``, :mod:`fem_neck.law`). A neck is not a point: its heat crosses the disk of
+radius ``a_b`` on the cap base plane, at ``z_b = sqrt(r^2 - a_b^2)`` from the centre, so the free-space part is taken
+between the disk centres ``z_b n_b`` (chord ``l_bc = |z_b n_b - z_c n_c|``), which is exact as ``a -> 0`` and brings
+wide necks closer. The model keeps the pair-calibrated half resistance ``R_b = 1 / K_b`` of the fit law on the
+diagonal (a neck's own constriction, its half neck and the sphere) and adds the interaction of every other neck
+relative to the same two necks on opposite poles (``l = z_b + z_c``, ``s = 1``)::
 
-    R_bb = 1 / K_b,    R_bc = G(gamma_bc) - G(pi) = (1/s - 1 - ln(s (1 + s) / 2)) / (4 pi kappa r),
+    R_bb = 1 / K_b,    R_bc = (2 r / l_bc - 2 r / (z_b + z_c) - ln(s (1 + s) / 2)) / (4 pi kappa r),
 
 so that a particle whose necks are collinear (a pair, a chain) has ``R = diag(1/K_b)``: today's network exactly.
+Nothing is fitted; ``python -m verification lattices`` measures the residuals against periodic-cell FE (the
+disk-centre chord removes most of what point contacts leave at large necks).
 
 **Back to one temperature per particle.** The network keeps one node per particle, so the multi-terminal conductor
 is reduced to one factor ``s_k`` on all half-conductances of particle ``k``, chosen so that the particle passes the
@@ -32,8 +37,8 @@ is ``N^T Y N``. With ``s_k`` the ratio of its trace to that of the plain network
     s_k = tr(N^T Y_R N) / tr(N^T Y_D N).
 
 For a cubic lattice both tensors are isotropic, so this is exact there for the multi-terminal model; for the simple
-cubic lattice the interactions cancel in every uniform field (``s = 1``, as the FE says: the network is within
-0.03 % there). Chains and pairs give ``s = 1`` exactly: interactions below 1e-12 of the half resistances (collinear
+cubic lattice the interactions cancel in every uniform field (``s = 1``: the plain network, which the FE finds
+accurate there). Chains and pairs give ``s = 1`` exactly: interactions below 1e-12 of the half resistances (collinear
 bonds to round-off) count as none, so those results are today's ``fit`` law bit for bit.
 
 **Never above the Wiener bound.** For the uniform field the network's energy is at most the sum over particles of
@@ -45,8 +50,8 @@ only where the correction falls short (it is applied to particles with non-colli
 
 A wall bond is a neck too (toward the wall, the mirror pair's neck), so it takes part in its particle's factor.
 
-The factors are computed per particle in one compiled loop (numba): a Cholesky solve of the ``z x z`` matrix ``R``
-with four right-hand sides.
+The factors are computed per particle in one compiled loop (numba): a solve of the ``z x z`` matrix ``R`` with four
+right-hand sides.
 """
 
 from __future__ import annotations
@@ -60,20 +65,27 @@ ROUNDOFF = 1e-12  # interactions below this x the smallest half resistance are r
 
 
 @numba.njit(cache=True)
-def interaction(cos_gamma: float) -> float:
-    """``4 pi kappa r (G(gamma) - G(pi))`` for two point contacts at the angle ``gamma`` (module docstring)."""
-    s = np.sqrt(max(0.5 * (1.0 - cos_gamma), 0.0))
+def interaction(normal_b, normal_c, base_b: float, base_c: float) -> float:
+    """``4 pi kappa r R_bc`` of two necks with unit normals ``normal_b``, ``normal_c`` and cap-base distances
+    ``base_b``, ``base_c`` (in units of ``r``), relative to the same necks on opposite poles (module docstring)."""
+    cos_g = normal_b[0] * normal_c[0] + normal_b[1] * normal_c[1] + normal_b[2] * normal_c[2]
+    s = np.sqrt(max(0.5 * (1.0 - cos_g), 0.0))
     if s >= 1.0:
         return 0.0
+    chord = 0.0
+    for a in range(3):
+        chord += (base_b * normal_b[a] - base_c * normal_c[a]) ** 2
+    chord = max(np.sqrt(chord), 1e-12)
     s = max(s, 1e-12)
-    return 1.0 / s - 1.0 - np.log(s * (1.0 + s) / 2.0)
+    return 2.0 / chord - 2.0 / (base_b + base_c) - np.log(s * (1.0 + s) / 2.0)
 
 
 @numba.njit(cache=True)
-def _factors(offsets, normal, arm, half_r, n_particles):
+def _factors(offsets, normal, base, arm, half_r, n_particles):
     """``s_k`` for every particle (module docstring). Per particle ``k`` its necks are ``offsets[k]:offsets[k+1]``
-    with unit ``normal`` (m, 3), ``arm`` ``l_b / r_k`` and ``half_r`` ``= 4 pi kappa r_k / K_b`` (the half
-    resistance in units of ``1 / (4 pi kappa r_k)``). Also returns which particles have interacting necks."""
+    with unit ``normal`` (m, 3), cap-base distance ``base`` and ``arm`` ``l_b`` (both over ``r_k``) and ``half_r``
+    ``= 4 pi kappa r_k / K_b`` (the half resistance in units of ``1 / (4 pi kappa r_k)``). Also returns which
+    particles have interacting necks."""
     out = np.ones(n_particles)
     interacting = np.zeros(n_particles, dtype=np.bool_)
     for k in range(n_particles):
@@ -88,9 +100,7 @@ def _factors(offsets, normal, arm, half_r, n_particles):
             R[b, b] = half_r[lo + b]
             small = min(small, half_r[lo + b])
             for c in range(b):
-                cos_g = (normal[lo + b, 0] * normal[lo + c, 0] + normal[lo + b, 1] * normal[lo + c, 1]
-                         + normal[lo + b, 2] * normal[lo + c, 2])
-                g = interaction(cos_g)
+                g = interaction(normal[lo + b], normal[lo + c], base[lo + b], base[lo + c])
                 R[b, c] = g
                 R[c, b] = g
                 largest = max(largest, abs(g))
@@ -150,21 +160,24 @@ def _wiener_caps(offsets, normal, arm, half_r, factor, interacting):
 def body_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray, k_j: np.ndarray,
                  k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray) -> np.ndarray:
     """``s_k`` of every particle (module docstring) from its necks: the pair bonds (``vectors`` from ``i`` to the
-    partner, half conductances ``k_i``, ``k_j`` in W/K) and the wall bonds (unit ``wall_normals`` pointing into
-    the packing, half conductances ``k_wall``)."""
+    partner, neck radii ``bonds.a``, half conductances ``k_i``, ``k_j`` in W/K) and the wall bonds (unit
+    ``wall_normals`` pointing into the packing, ``bonds.wall_a``, half conductances ``k_wall``)."""
     d = np.linalg.norm(vectors, axis=1)
     e = vectors / np.where(d > 0, d, 1.0)[:, None]
     owner = np.concatenate([bonds.i, bonds.j, bonds.wall_particle]).astype(np.int64)
     normal = np.concatenate([e, -e, -np.asarray(wall_normals, dtype=float).reshape(-1, 3)])
     arm = np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l])
+    neck = np.concatenate([bonds.a, bonds.a, bonds.wall_a])
     half = np.concatenate([k_i, k_j, k_wall])
     r, kappa = radius[owner], conductivity[owner]
+    q = np.minimum(neck / r, 1.0)
+    base = np.sqrt((1.0 - q) * (1.0 + q))  # cap-base distance over r
     with np.errstate(divide="ignore"):
         half_r = 4.0 * np.pi * kappa * r / half
     order = np.argsort(owner, kind="stable")
     offsets = np.zeros(n + 1, dtype=np.int64)
     offsets[1:] = np.cumsum(np.bincount(owner, minlength=n))
-    normal, arm, half_r = normal[order], (arm / r)[order], half_r[order]
+    normal, base, arm, half_r = normal[order], base[order], (arm / r)[order], half_r[order]
     normal = np.ascontiguousarray(normal)
-    factor, interacting = _factors(offsets, normal, arm, half_r, n)
+    factor, interacting = _factors(offsets, normal, base, arm, half_r, n)
     return _wiener_caps(offsets, normal, arm, half_r, factor, interacting)
