@@ -5,10 +5,9 @@ A scene names its physics (``[scene] physics = ["thermal"]``); only those are bu
 ``run(observer, progress)`` returns a summary dict. The thermal model of a static packing builds its bonds once,
 never moves a particle and allocates no mechanical state.
 
-Next to plug in (see :data:`PLANNED`): the mechanical sintering contact of Luding et al. 2005 (positions,
-velocities, the hysteretic normal law; bonds rebuilt as particles move, then the thermal network re-assembled) and
-the electrical current flow with Joule heating of Zohdi 2014 (eqs. 38-44; a second network Laplacian on the same
-bonds, feeding ``Particles.heat``), staggered with the thermal model as in Zohdi's Algorithm 1.
+Particles that move (``"mechanical"``, the Luding 2005 contact law) run in the engine of :mod:`dem.engine`, where
+the thermal network follows the contacts as the necks grow. Next to plug in (see :data:`PLANNED`): the electrical
+current flow with Joule heating of Zohdi 2014 (eqs. 38-44).
 """
 
 from __future__ import annotations
@@ -23,9 +22,9 @@ WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_step
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
 
 PLANNED = {
-    "mechanical": "the Luding 2005 sintering contact (hysteretic normal law, temperature-dependent stiffness)",
     "electrical": "the Zohdi 2014 current flow and Joule heating (eqs. 38-44)",
 }
+MOVING = ("mechanical",)  # built by the engine for moving particles (dem.engine), not here
 
 
 class ThermalModel:
@@ -121,19 +120,23 @@ class ThermalModel:
 
 
 REGISTRY = {"thermal": ThermalModel}
+PHYSICS_NAMES = (*REGISTRY, *MOVING)
+
+
+def check_physics(names) -> None:
+    """Every name a submodel that exists (``thermal``, ``mechanical``); planned and unknown ones are refused."""
+    available = (*REGISTRY, *MOVING)
+    for name in names:
+        if name in PLANNED:
+            raise ValueError(f"[scene] physics = {name!r}: not implemented yet ({PLANNED[name]}); available: "
+                             f"{', '.join(available)}")
+        if name not in available:
+            raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(available)})")
+    if not names:
+        raise ValueError(f"[scene] physics: names no submodel (available: {', '.join(available)})")
 
 
 def build(scene) -> list:
-    """The submodels the scene names, in order; unknown or planned names raise ValueError."""
-    models = []
-    for name in scene.physics:
-        if name in REGISTRY:
-            models.append(REGISTRY[name](scene))
-        elif name in PLANNED:
-            raise ValueError(f"[scene] physics = {name!r}: not implemented yet ({PLANNED[name]}); available: "
-                             f"{', '.join(REGISTRY)}")
-        else:
-            raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(REGISTRY)})")
-    if not models:
-        raise ValueError("[scene] physics: names no submodel (available: thermal)")
-    return models
+    """The submodels of a static scene (only ``thermal``), in order; unknown or planned names raise ValueError."""
+    check_physics(scene.physics)
+    return [REGISTRY[name](scene) for name in scene.physics]

@@ -21,6 +21,8 @@ from dem.particles import COPPER, Material, Particles
 from dem.sources import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
 from dem.thermal import INTEGRATORS
 from dem.linsolve import BACKENDS
+from dem.physics import PHYSICS_NAMES as PHYSICS, check_physics
+from dem.moving_scene import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
 
 SCENE_DIR = pathlib.Path(__file__).with_name("scenes")
 MODES = ("transient", "steady")
@@ -130,6 +132,7 @@ class Scene:
     name: str = "scene"
     description: str = ""
     specimen: Specimen | None = None
+    motion: MotionSpec | None = None  # particles that move ([scene] physics with "mechanical"), else None
 
 
 def _is_number(v) -> bool:
@@ -172,22 +175,22 @@ def _number(table, section, key, default=None, required=False):
     return float(v)
 
 
-def _materials(doc) -> tuple:
+def _materials(doc, thermal: bool = True) -> tuple:
     if "material" in doc and "materials" in doc:
         raise ValueError("[material] and [[materials]]: give one or the other")
     tables = doc.get("materials", [doc["material"]] if "material" in doc else None)
     if tables is None:
-        raise ValueError("[material]: required (conductivity, density, specific_heat)")
+        raise ValueError("[material]: required (density; conductivity and specific_heat for thermal physics)")
     if not isinstance(tables, list) or not tables:
         raise ValueError("[[materials]]: must be a non-empty array of tables")
     out = []
     for k, t in enumerate(tables):
         section = "material" if "material" in doc else f"materials[{k}]"
         _check_keys(t, section, ALLOWED["material"])
-        props = {key: _number(t, section, key, required=True) for key in ("conductivity", "density",
-                                                                          "specific_heat")}
+        props = {key: _number(t, section, key, required=thermal or key == "density")
+                 for key in ("conductivity", "density", "specific_heat")}
         for key, v in props.items():
-            if v <= 0:
+            if v is not None and v <= 0:
                 raise ValueError(f"[{section}] {key} = {v!r}: must be > 0")
         out.append(Material(**props, name=str(t.get("name", f"material{k}"))))
     return tuple(out)
@@ -314,27 +317,59 @@ def _spec(cls, table, section, numeric=(), integer=(), words=()):
         raise ValueError(msg if msg.startswith("[") else f"[{section}] {msg}") from None
 
 
+def _moving_keys(doc: dict, moving: bool) -> dict:
+    """``doc`` without the keys and tables of moving particles (:mod:`dem.moving_scene`), which a scene without
+    ``"mechanical"`` physics refuses by name."""
+    out = dict(doc)
+    for table in MOVING_TABLES:
+        if table in out and not moving:
+            raise ValueError(f"[{table}]: only for moving particles ([scene] physics with \"mechanical\")")
+        out.pop(table, None)
+    for section, keys in MOVING_KEYS.items():
+        tables = out.get(section)
+        if tables is None:
+            continue
+        many = isinstance(tables, list)
+        cleaned = []
+        for t in (tables if many else [tables]):
+            if not isinstance(t, dict):
+                cleaned.append(t)
+                continue
+            extra = sorted(set(t) & keys)
+            if extra and not moving:
+                raise ValueError(f"[{section}] {extra[0]}: only for moving particles ([scene] physics with "
+                                 f"\"mechanical\")")
+            cleaned.append({k: v for k, v in t.items() if k not in keys})
+        out[section] = cleaned if many else cleaned[0]
+    return out
+
+
 def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None) -> Scene:
     """Validate a parsed TOML document into a :class:`Scene` (schema: README, "Scene schema")."""
-    top = set(ALLOWED) | {"materials"}
+    top = set(ALLOWED) | {"materials"} | set(MOVING_TABLES)
     unknown = sorted(set(doc) - top)
     if unknown:
         raise ValueError(f"[{unknown[0]}]: unknown table (allowed: {', '.join(sorted(top))})")
-    meta = doc.get("scene", {})
-    _check_keys(meta, "scene", ALLOWED["scene"])
-    physics = meta.get("physics", ["thermal"])
+    physics = doc.get("scene", {}).get("physics", ["thermal"]) if isinstance(doc.get("scene", {}), dict) else None
     if isinstance(physics, str):
         physics = [physics]
     if not isinstance(physics, list) or not all(isinstance(x, str) for x in physics):
-        raise ValueError(f"[scene] physics = {physics!r}: must be a list of names (available: thermal)")
-    materials = _materials(doc)
+        raise ValueError(f"[scene] physics = {physics!r}: must be a list of names (available: "
+                         f"{', '.join(PHYSICS)})")
+    check_physics(physics)
+    moving = "mechanical" in physics
+    full, doc = doc, _moving_keys(doc, moving)
+    meta = doc.get("scene", {})
+    _check_keys(meta, "scene", ALLOWED["scene"])
+    materials = _materials(doc, thermal="thermal" in physics)
     if ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
     if "particles" in doc:
         particles, walls, specimen = _explicit_particles(doc["particles"], materials)
     else:
         particles, walls, specimen = _generated_particles(doc["generator"], materials)
-    walls = walls + _walls(doc)
+    if not moving:
+        walls = walls + _walls(doc)
     cond = dict(doc.get("conductance", {}))
     if "fit_file" in cond and not isinstance(cond["fit_file"], str):
         raise ValueError(f"[conductance] fit_file = {cond['fit_file']!r}: must be a path (string)")
@@ -349,8 +384,9 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     solver = _spec(SolverSpec, doc.get("solver", {}), "solver", numeric=("dt", "t_end", "rtol"),
                    integer=("max_steps",), words=("dt",))
     output = _spec(OutputSpec, doc.get("output", {}), "output", integer=("every", "vtu_every"))
+    motion = parse_motion(full, particles, solver, physics) if moving else None
     return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
-                 str(meta.get("name", source)), str(meta.get("description", "")), specimen)
+                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, motion)
 
 
 def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls) -> None:

@@ -105,22 +105,58 @@ class Network:
         if len(self.fixed):
             rows = self.L[self.free]
             self.L_FF = rows[:, self.free].tocsr()
-            L_FD = rows[:, self.fixed].tocsr()
+            self.L_FD = rows[:, self.fixed].tocsr()
         else:
-            self.L_FF, L_FD = self.L, sp.csr_matrix((n, 0))
+            self.L_FF, self.L_FD = self.L, sp.csr_matrix((n, 0))
         self.T_D = p.temperature[self.fixed]
+        self.heat = p.heat[self.free]
+        self.C = p.capacity[self.free]
+        self.radius = p.radius[self.free]
+        self._slots = None  # where each Laplacian entry sits in L, L_FF, L_FD: built by the first refresh()
+        self._boundary_terms()
+
+    def _boundary_terms(self):
+        """The terms that follow from the conductances: wall and fixed-particle coefficients and the constant
+        right-hand side."""
+        n = self.particles.n
         wp = self.bonds.wall_particle
         kw_diag = np.bincount(wp, self.K_walls, n)
         kw_rhs = np.bincount(wp, self.K_walls * self.wall_temperature[self.bonds.wall_index], n)
         self.wall_diag = kw_diag[self.free]
         self.wall_rhs = kw_rhs[self.free]
-        self.fixed_rhs = -(L_FD @ self.T_D)
-        self.fixed_diag = -np.asarray(L_FD.sum(axis=1)).ravel()
-        self.heat = p.heat[self.free]
-        self.C = p.capacity[self.free]
-        self.radius = p.radius[self.free]
+        self.fixed_rhs = -(self.L_FD @ self.T_D)
+        self.fixed_diag = -np.asarray(self.L_FD.sum(axis=1)).ravel()
         self.base_diag = self.L_FF.diagonal()
         self.r_const = self.fixed_rhs + self.wall_rhs + self.heat
+
+    def refresh(self, bonds: Bonds, K_pairs: np.ndarray, K_walls: np.ndarray) -> None:
+        """New conductances (and bond geometry) on the same bonds, in the same order: the matrices keep their
+        sparsity and only their entries are rewritten (no re-assembly, no new sparsity analysis)."""
+        if not (np.array_equal(bonds.i, self.bonds.i) and np.array_equal(bonds.j, self.bonds.j)
+                and np.array_equal(bonds.wall_particle, self.bonds.wall_particle)
+                and np.array_equal(bonds.wall_index, self.bonds.wall_index)):
+            raise ValueError("Network.refresh: the bonds changed; build a new Network")
+        n = self.particles.n
+        if self._slots is None:
+            # an index matrix with the Laplacian's sparsity: entry k of (rows, cols) stored as k + 1
+            rows = np.concatenate([bonds.i, bonds.j, np.arange(n)])
+            cols = np.concatenate([bonds.j, bonds.i, np.arange(n)])
+            index = sp.csr_matrix((np.arange(1.0, len(rows) + 1.0), (rows, cols)), shape=(n, n))
+            if len(self.fixed):
+                part = index[self.free]
+                parts = (index, part[:, self.free].tocsr(), part[:, self.fixed].tocsr())
+            else:
+                parts = (index, index, sp.csr_matrix((n, 0)))
+            self._slots = [m.data.astype(np.int64) - 1 for m in parts]
+            self.L, self.L_FF, self.L_FD = (m.copy() for m in parts)
+            if not len(self.fixed):
+                self.L_FF = self.L
+        self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
+        diag = np.bincount(bonds.i, K_pairs, n) + np.bincount(bonds.j, K_pairs, n)
+        values = np.concatenate([-K_pairs, -K_pairs, diag])
+        for matrix, slots in zip((self.L, self.L_FF, self.L_FD), self._slots):
+            matrix.data[:] = values[slots]
+        self._boundary_terms()
 
     @property
     def n_free(self) -> int:
@@ -404,6 +440,16 @@ class _Stepper:
         q = ORDER[self.theta]
         err = float(np.max(np.abs(T_b - T_1), initial=0.0)) / (2.0**q - 1.0)
         return T_b, [(half, th_a, s_a), (half, th_b, s_b)], err
+
+
+def theta_step(net: Network, T_F: np.ndarray, dt: float, integrator: str = "implicit", linear: str = "auto",
+               rtol_linear: float = 1e-10) -> tuple[np.ndarray, dict]:
+    """One theta-method step of size ``dt`` from the free temperatures ``T_F`` on ``net`` (a network whose
+    conductances change between steps, e.g. necks that grow): ``(T_new, heat)`` with ``heat`` the energy (J) that
+    entered the free particles through each boundary during the step, integrated with the step's own weighting so
+    that ``C . (T_new - T_F)`` equals its sum to round-off."""
+    T_new, T_theta, sinks = _Stepper(net, INTEGRATORS[integrator], linear, rtol_linear).step(T_F, dt)
+    return T_new, {k: dt * v for k, v in net.flows(T_theta, sinks).items()}
 
 
 def check_step_count(t_end: float, dt: float, max_steps: int, what: str):
