@@ -1,4 +1,5 @@
-"""Particle arrangements for scenes: a chain, a cubic lattice block and a random sintered packing.
+"""Particle arrangements for scenes: a chain, a cubic lattice block, a random sintered packing, and particles
+scattered in a box (for scenes that move).
 
 Every generator returns a :class:`Layout`: positions, radii, the indices of the bottom and top layers and the
 specimen's cross-section, so that a scene can hold the two ends at different temperatures (hot and cold plates,
@@ -44,6 +45,7 @@ class Layout:
     z_low: float
     z_high: float
     area: float
+    velocity: np.ndarray | None = None
 
 
 def _positive(name, value):
@@ -186,3 +188,69 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
     bottom, top = np.flatnonzero(layer == layer.min()), np.flatnonzero(layer == layer.max())
     side = m * cell * scale
     return Layout(pos, r, bottom, top, float(np.min(pos[:, 2] - r)), float(np.max(pos[:, 2] + r)), side * side)
+
+
+def random_box(n: int, radius, box, radius_spread: float = 0.0, seed: int = 0, speed: float = 0.0,
+               dimension: int = 3) -> Layout:
+    """``n`` particles placed one after the other at uniformly random positions inside the box ``[[x, y, z]_lo,
+    [x, y, z]_hi]`` without overlapping each other or the box faces (random sequential addition, Zohdi 2014,
+    Sec. 7; Luding 2005, Sec. 4: "randomly placed in a box with random initial velocity"). Radii uniform in
+    ``radius (1 +- radius_spread)`` (Luding's w0); velocities of magnitude ``speed`` in random directions (in the
+    x-z plane for 2D disks, which keep ``y = 0``). Refused when the box is too full for the particles to fit."""
+    if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+        raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
+    _check_count(n, "n")
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise ValueError(f"[generator] seed = {seed!r}: must be an integer >= 0")
+    r_mean = _positive("radius", radius)
+    spread = float(_floats("radius_spread", radius_spread))
+    if not (np.isfinite(spread) and 0 <= spread < 1):
+        raise ValueError(f"[generator] radius_spread = {radius_spread!r}: must be in [0, 1) (relative)")
+    v = float(_floats("speed", speed))
+    if not (np.isfinite(v) and v >= 0):
+        raise ValueError(f"[generator] speed = {speed!r}: must be a finite number >= 0 (m/s)")
+    b = _floats("box", box)
+    axes = [0, 2] if dimension == 2 else [0, 1, 2]
+    if b.shape != (2, 3) or not np.all(np.isfinite(b)) or np.any(b[1][axes] <= b[0][axes]):
+        raise ValueError(f"[generator] box = {box!r}: must be [[x, y, z]_low, [x, y, z]_high] with low < high"
+                         f"{' in x and z (2D disks: y is ignored)' if dimension == 2 else ''}")
+    rng = np.random.default_rng(seed)
+    r = rng.uniform(r_mean * (1.0 - spread), r_mean * (1.0 + spread), n)
+    if np.any(2.0 * r.max() > (b[1] - b[0])[axes]):
+        raise ValueError(f"[generator] box = {box!r}: narrower than the largest particle ({2 * r.max():.6g} m)")
+    pos = np.zeros((n, 3))
+    cell = 2.0 * r.max()
+    grid: dict = {}
+    attempts, limit = 0, 1000 * n
+    for k in range(n):
+        while True:
+            attempts += 1
+            if attempts > limit:
+                filled = np.sum(np.pi * r[:k] ** 2) / np.prod((b[1] - b[0])[axes]) if dimension == 2 else \
+                    np.sum(4 / 3 * np.pi * r[:k] ** 3) / np.prod(b[1] - b[0])
+                raise ValueError(f"[generator] n = {n}: only {k} particles fit by random sequential addition "
+                                 f"(volume fraction {filled:.3f}); enlarge the box or use fewer particles")
+            p = np.zeros(3)
+            p[axes] = rng.uniform(b[0][axes] + r[k], b[1][axes] - r[k])
+            key = tuple(np.floor(p / cell).astype(int))
+            ok = True
+            for off in np.ndindex(*(3,) * 3):
+                nb = tuple(key[a] + off[a] - 1 for a in range(3))
+                for m in grid.get(nb, ()):
+                    if np.sum((pos[m] - p) ** 2) < (r[m] + r[k]) ** 2:
+                        ok = False
+                        break
+                if not ok:
+                    break
+            if ok:
+                pos[k] = p
+                grid.setdefault(key, []).append(k)
+                break
+    direction = rng.normal(size=(n, 3))
+    if dimension == 2:
+        direction[:, 1] = 0.0
+    direction /= np.linalg.norm(direction, axis=1)[:, None]
+    span = b[1] - b[0]
+    area = span[0] * span[1] if dimension == 3 else span[0]  # normal to z (2D: a length)
+    empty = np.zeros(0, dtype=np.int64)
+    return Layout(pos, r, empty, empty, float(b[0][2]), float(b[1][2]), float(area), v * direction if v > 0 else None)

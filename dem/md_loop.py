@@ -1,8 +1,11 @@
 """The compiled time loop of the mechanics: velocity-Verlet steps with the Luding 2005 contact law.
 
 One call advances the particles (and the walls) by up to ``n_steps`` steps of ``dt``, entirely in compiled code
-(numba), and returns early only when the caller must act: the Verlet list is about to become invalid, a position
-became non-finite, or a particle left through a wall. Each step:
+(numba), and returns early only when the caller must act: the Verlet lists are about to become invalid (a
+particle, plus the farthest-moved wall, has moved more than half the skin since they were built), a position became
+non-finite, or a particle left through a wall. Besides the pair list there is a particle-wall list: the particles
+within ``radius + skin`` of each wall (the only ones that can touch it or cross it before the next rebuild). Each
+step:
 
 1. half kick and drift: ``v += dt/2 f/m``, ``x += dt v`` (and ``omega += dt/2 tau/I``); walls move by their law
    (:mod:`dem.walls`);
@@ -34,39 +37,27 @@ STATUS = {DONE: "done", REBUILD: "rebuild", NONFINITE: "non-finite", ESCAPED: "e
 
 
 @njit(cache=True)
-def _contact(i, n0, n1, n2, ri, vr0, vr1, vr2, delta, k1f, dmax, k1last, xi, c, reff, is_wall, params, dt, f, tau):
-    """Normal and tangential force of one contact on particle ``i`` (and the torque on it); updates the contact's
-    history row ``c`` in ``dmax``, ``k1last``, ``xi``. Returns ``(f_n, f_t0, f_t1, f_t2)`` (the partner gets the
-    opposite force)."""
+def _contact(n0, n1, n2, vr0, vr1, vr2, delta, k1f, dmax, k1last, xi0, xi1, xi2, delta_fluid, is_wall, params, dt):
+    """One contact: ``(f_n, f_t0, f_t1, f_t2, delta_max, xi0, xi1, xi2)`` -- the normal and tangential force on
+    particle i and the contact's new history. Scalars in, scalars out: array arguments in the hot loop would cost
+    reference counting on every call (measured: 4x slower)."""
     vn = vr0 * n0 + vr1 * n1 + vr2 * n2
     vt0, vt1, vt2 = vr0 - vn * n0, vr1 - vn * n1, vr2 - vn * n2
-    f_n, dmax_new, f_min, k2_now, kc_now = normal_force(delta, -vn, k1f, dmax[c], k1last[c],
-                                                        params[P_PHI] * 2.0 * reff if not is_wall
-                                                        else params[P_PHI] * reff, params)
-    ft0, ft1, ft2, x0, x1, x2, sliding, f_n = tangential_force(xi[c, 0], xi[c, 1], xi[c, 2], n0, n1, n2,
-                                                               vt0, vt1, vt2, f_n, f_min, k2_now, k1f, dt, params,
-                                                               is_wall)
-    dmax[c] = dmax_new
-    k1last[c] = k1f
-    xi[c, 0], xi[c, 1], xi[c, 2] = x0, x1, x2
-    f[i, 0] += f_n * n0 + ft0
-    f[i, 1] += f_n * n1 + ft1
-    f[i, 2] += f_n * n2 + ft2
-    # torque -a_i n x f_t
-    tau[i, 0] -= ri * (n1 * ft2 - n2 * ft1)
-    tau[i, 1] -= ri * (n2 * ft0 - n0 * ft2)
-    tau[i, 2] -= ri * (n0 * ft1 - n1 * ft0)
-    return f_n, ft0, ft1, ft2
+    f_n, dmax_new, f_min, k2_now, kc_now = normal_force(delta, -vn, k1f, dmax, k1last, delta_fluid, params)
+    ft0, ft1, ft2, x0, x1, x2, sliding, f_n = tangential_force(xi0, xi1, xi2, n0, n1, n2, vt0, vt1, vt2, f_n, f_min,
+                                                               k2_now, k1f, dt, params, is_wall)
+    return f_n, ft0, ft1, ft2, dmax_new, x0, x1, x2
 
 
 @njit(cache=True)
 def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn, p_ft,
-            wn, wq, wdq, wforce, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt):
-    """Forces and torques of the current state (gravity, pairs, walls); the normal forces on the walls go into
-    ``wforce``. Returns ``k * n_walls + m`` for the first particle ``k`` whose centre lies behind wall ``m``, else
-    -1."""
+            wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt):
+    """Forces and torques of the current state (gravity, pairs, the listed particle-wall pairs ``(wk, wm)``); the
+    normal forces on the walls go into ``wforce``. Returns the index into the wall list of the first particle whose
+    centre lies behind its wall, else -1."""
     escaped = -1
     n = x.shape[0]
+    phi = params[P_PHI]
     for k in range(n):
         f[k, 0] = mass[k] * gravity[0]
         f[k, 1] = mass[k] * gravity[1]
@@ -98,43 +89,65 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
         vr1 = v[i, 1] - v[j, 1] + n2 * c0 - n0 * c2
         vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
         k1c = 0.5 * (k1f[i] + k1f[j])
-        reff = ri * rj / (ri + rj)
-        f_n, ft0, ft1, ft2 = _contact(i, n0, n1, n2, ri, vr0, vr1, vr2, ri + rj - d, k1c, p_dmax, p_k1last, p_xi,
-                                      c, reff, False, params, dt, f, tau)
+        f_n, ft0, ft1, ft2, dmax, x0, x1, x2 = _contact(
+            n0, n1, n2, vr0, vr1, vr2, ri + rj - d, k1c, p_dmax[c], p_k1last[c], p_xi[c, 0], p_xi[c, 1], p_xi[c, 2],
+            phi * 2.0 * ri * rj / (ri + rj), False, params, dt)
+        p_dmax[c] = dmax
+        p_k1last[c] = k1c
+        p_xi[c, 0], p_xi[c, 1], p_xi[c, 2] = x0, x1, x2
         p_fn[c] = f_n
         p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
-        f[j, 0] -= f_n * n0 + ft0
-        f[j, 1] -= f_n * n1 + ft1
-        f[j, 2] -= f_n * n2 + ft2
-        tau[j, 0] -= rj * (n1 * ft2 - n2 * ft1)
-        tau[j, 1] -= rj * (n2 * ft0 - n0 * ft2)
-        tau[j, 2] -= rj * (n0 * ft1 - n1 * ft0)
+        g0, g1, g2 = f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2
+        f[i, 0] += g0
+        f[i, 1] += g1
+        f[i, 2] += g2
+        f[j, 0] -= g0
+        f[j, 1] -= g1
+        f[j, 2] -= g2
+        # torques -a n x f_t on both (the lever arms -a_i n and +a_j n, the forces f_t and -f_t)
+        m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
+        tau[i, 0] -= ri * m0
+        tau[i, 1] -= ri * m1
+        tau[i, 2] -= ri * m2
+        tau[j, 0] -= rj * m0
+        tau[j, 1] -= rj * m1
+        tau[j, 2] -= rj * m2
     n_w = wn.shape[0]
     for m in range(n_w):
         wforce[m] = 0.0
-    for k in range(n):
-        for m in range(n_w):
-            dist = wn[m, 0] * x[k, 0] + wn[m, 1] * x[k, 1] + wn[m, 2] * x[k, 2] - wq[m]
-            if dist < 0.0 and escaped < 0:
-                escaped = k * n_w + m
-            delta = radius[k] - dist
-            if delta <= 0.0:
-                if w_dmax[k, m] != 0.0:
-                    w_dmax[k, m] = 0.0
-                    w_xi[k, m, 0], w_xi[k, m, 1], w_xi[k, m, 2] = 0.0, 0.0, 0.0
+    for e in range(wk.shape[0]):
+        k, m = wk[e], wm[e]
+        rk = radius[k]
+        n0, n1, n2 = wn[m, 0], wn[m, 1], wn[m, 2]
+        dist = n0 * x[k, 0] + n1 * x[k, 1] + n2 * x[k, 2] - wq[m]
+        if dist < 0.0 and escaped < 0:
+            escaped = e
+        delta = rk - dist
+        if delta <= 0.0:
+            if w_dmax[k, m] != 0.0:
+                w_dmax[k, m] = 0.0
+                w_xi[k, m, 0], w_xi[k, m, 1], w_xi[k, m, 2] = 0.0, 0.0, 0.0
                 w_fn[k, m] = 0.0
                 w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = 0.0, 0.0, 0.0
-                continue
-            n0, n1, n2 = wn[m, 0], wn[m, 1], wn[m, 2]
-            rk = radius[k]
-            vr0 = v[k, 0] - wdq[m] * n0 + rk * (n1 * w[k, 2] - n2 * w[k, 1])
-            vr1 = v[k, 1] - wdq[m] * n1 + rk * (n2 * w[k, 0] - n0 * w[k, 2])
-            vr2 = v[k, 2] - wdq[m] * n2 + rk * (n0 * w[k, 1] - n1 * w[k, 0])
-            f_n, ft0, ft1, ft2 = _contact(k, n0, n1, n2, rk, vr0, vr1, vr2, delta, k1f[k], w_dmax[k], w_k1last[k],
-                                          w_xi[k], m, rk, True, params, dt, f, tau)
-            w_fn[k, m] = f_n
-            w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = ft0, ft1, ft2
-            wforce[m] += f_n
+            continue
+        vr0 = v[k, 0] - wdq[m] * n0 + rk * (n1 * w[k, 2] - n2 * w[k, 1])
+        vr1 = v[k, 1] - wdq[m] * n1 + rk * (n2 * w[k, 0] - n0 * w[k, 2])
+        vr2 = v[k, 2] - wdq[m] * n2 + rk * (n0 * w[k, 1] - n1 * w[k, 0])
+        f_n, ft0, ft1, ft2, dmax, x0, x1, x2 = _contact(
+            n0, n1, n2, vr0, vr1, vr2, delta, k1f[k], w_dmax[k, m], w_k1last[k, m], w_xi[k, m, 0],
+            w_xi[k, m, 1], w_xi[k, m, 2], phi * rk, True, params, dt)
+        w_dmax[k, m] = dmax
+        w_k1last[k, m] = k1f[k]
+        w_xi[k, m, 0], w_xi[k, m, 1], w_xi[k, m, 2] = x0, x1, x2
+        w_fn[k, m] = f_n
+        w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = ft0, ft1, ft2
+        f[k, 0] += f_n * n0 + ft0
+        f[k, 1] += f_n * n1 + ft1
+        f[k, 2] += f_n * n2 + ft2
+        tau[k, 0] -= rk * (n1 * ft2 - n2 * ft1)
+        tau[k, 1] -= rk * (n2 * ft0 - n0 * ft2)
+        tau[k, 2] -= rk * (n0 * ft1 - n1 * ft0)
+        wforce[m] += f_n
     return escaped
 
 
@@ -175,7 +188,7 @@ def _material_state(t, t_start, T0, T_rate, T, radius, radius_ref, k1f, uniform,
 @njit(cache=True)
 def advance(n_steps, dt, t_start, x, v, w, f, tau, mass, inertia, lin, rot, radius, radius_ref, T0, T_rate, T, k1f,
             uniform_T, t0, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn, p_ft,
-            wn, wq, wdq, wacc, wmode, wpress, wmass, wdamp, wq0, wamp, wfreq, wspan, wforce,
+            wn, wq, wdq, wacc, wmode, wpress, wmass, wdamp, wq0, wamp, wfreq, wspan, wforce, wk, wm, wq_ref,
             w_dmax, w_k1last, w_xi, w_fn, w_ft, params, x_ref, skin, info):
     """Up to ``n_steps`` velocity-Verlet steps (module docstring); ``f``/``tau``/``wacc`` must hold the forces of
     the current state on entry. Returns ``(steps done, status)``; ``info`` receives the particle (and wall) index of
@@ -183,7 +196,6 @@ def advance(n_steps, dt, t_start, x, v, w, f, tau, mass, inertia, lin, rot, radi
     n = x.shape[0]
     n_w = wn.shape[0]
     h = 0.5 * dt
-    half_skin2 = (0.5 * skin) ** 2
     for s in range(n_steps):
         t = t_start + s * dt
         for k in range(n):
@@ -204,7 +216,7 @@ def advance(n_steps, dt, t_start, x, v, w, f, tau, mass, inertia, lin, rot, radi
                 wdq[m] = 2.0 * math.pi * wfreq[m] * wamp[m] * math.cos(phase)
         _material_state(t + dt, t_start, T0, T_rate, T, radius, radius_ref, k1f, uniform_T, params, t0, dt)
         escaped = _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn,
-                          p_ft, wn, wq, wdq, wforce, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt)
+                          p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt)
         worst = 0.0
         for k in range(n):
             im, ii = 1.0 / mass[k], 1.0 / inertia[k]
@@ -218,14 +230,16 @@ def advance(n_steps, dt, t_start, x, v, w, f, tau, mass, inertia, lin, rot, radi
                 info[0] = k
                 return s + 1, 2
             worst = max(worst, d2)
+        wall_moved = 0.0
         for m in range(n_w):
             if wmode[m] == 1:
                 wacc[m] = _wall_acceleration(m, wq, wdq, wmode, wpress, wmass, wdamp, wspan, wforce)
                 wdq[m] += h * wacc[m]
+            wall_moved = max(wall_moved, abs(wq[m] + dt * wdq[m] - wq_ref[m]))
         if escaped >= 0:
-            info[0] = escaped // n_w
-            info[1] = escaped % n_w
+            info[0] = wk[escaped]
+            info[1] = wm[escaped]
             return s + 1, 3
-        if worst > half_skin2:
+        if math.sqrt(worst) + wall_moved > 0.5 * skin:
             return s + 1, 1
     return n_steps, 0

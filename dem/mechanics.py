@@ -26,7 +26,7 @@ import numpy as np
 from dem import md_loop
 from dem.laws.luding import k1_factor
 from dem.motion import MotionState
-from dem.neighbours import carry_history, verlet_pairs
+from dem.neighbours import carry_history, verlet_pairs, wall_pairs
 from dem.walls import WallArrays
 
 
@@ -78,13 +78,16 @@ class MechanicalModel:
             self.rebuilds += 1
         self.pi, self.pj = i, j
         self.x_ref = s.x.copy()
+        self.wk, self.wm = wall_pairs(s.x, s.radius, self.w.normal, self.w.q, self.skin)
+        self.wq_ref = self.w.q.copy()
 
     def _initial_forces(self):
         """Forces of the initial state (dt = 0: no history increment)."""
         s, w = self.state, self.w
         md_loop._forces(s.x, s.v, s.w, s.f, s.tau, s.mass, s.radius, self.k1f, self.gravity, self.box, self.pi,
                         self.pj, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft, w.normal, w.q, w.dq,
-                        w.force, self.w_dmax, self.w_k1last, self.w_xi, self.w_fn, self.w_ft, self.params, 0.0)
+                        w.force, self.wk, self.wm, self.w_dmax, self.w_k1last, self.w_xi, self.w_fn, self.w_ft,
+                        self.params, 0.0)
         for m in range(len(self.walls)):
             w.acc[m] = md_loop._wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span,
                                                   w.force)
@@ -110,8 +113,8 @@ class MechanicalModel:
                 s.angular_dof, s.radius, s.radius_ref, T0 + T_rate * (t_call - t_start), T_rate, s.T, self.k1f,
                 uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_dmax, self.p_k1last, self.p_xi,
                 self.p_fn, self.p_ft, w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0,
-                w.amplitude, w.frequency, w.span, w.force, self.w_dmax, self.w_k1last, self.w_xi, self.w_fn,
-                self.w_ft, self.params, self.x_ref, self.skin, self._info)
+                w.amplitude, w.frequency, w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_dmax,
+                self.w_k1last, self.w_xi, self.w_fn, self.w_ft, self.params, self.x_ref, self.skin, self._info)
             done += steps
             self.steps += steps
             if status == md_loop.REBUILD:

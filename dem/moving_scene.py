@@ -119,8 +119,9 @@ def time_steps(params: np.ndarray, mass: np.ndarray, inertia: np.ndarray, radius
     return t_md, stable
 
 
-def parse_motion(doc: dict, particles, solver, physics) -> MotionSpec:
-    """The moving part of a scene (module docstring); ``particles`` and ``solver`` are already parsed."""
+def parse_motion(doc: dict, particles, solver, physics, velocity=None) -> MotionSpec:
+    """The moving part of a scene (module docstring); ``particles`` and ``solver`` are already parsed;
+    ``velocity`` comes from a generator (its random ``speed``)."""
     meta = doc.get("scene", {})
     dimension = meta.get("dimension", 3)
     if dimension not in (2, 3) or isinstance(dimension, bool):
@@ -137,7 +138,7 @@ def parse_motion(doc: dict, particles, solver, physics) -> MotionSpec:
         raise ValueError("[solver] mode = \"transient\" and t_end are required for moving particles")
     ptable = doc.get("particles", {})
     n = particles.n
-    velocity = angular = None
+    angular = None
     if "velocity" in ptable:
         velocity = finite_array("[particles] velocity", ptable["velocity"], (3,))
     if "angular_velocity" in ptable:

@@ -165,3 +165,15 @@ def carry_history(old_i, old_j, new_i, new_j, n: int, *columns):
         new[found] = col[pos_c[found]]
         out.append(new)
     return out
+
+
+def wall_pairs(x: np.ndarray, radius: np.ndarray, normal: np.ndarray, offset: np.ndarray,
+               skin: float) -> tuple[np.ndarray, np.ndarray]:
+    """Particle-wall pairs ``(k, m)`` with particle k closer than ``r_k + skin`` to the plane ``n_m . x = q_m`` (or
+    behind it): the Verlet list of the walls."""
+    if len(offset) == 0:
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty
+    dist = x @ normal.T - offset[None, :]
+    k, m = np.nonzero(dist < radius[:, None] + skin)
+    return k.astype(np.int64), m.astype(np.int64)

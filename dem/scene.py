@@ -34,7 +34,7 @@ ALLOWED = {
     "material": {"name", "conductivity", "density", "specific_heat"},
     "particles": {"position", "radius", "temperature", "fixed", "material", "heat"},
     "generator": {"kind", "n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter",
-                  "temperature", "boundary", "hot", "cold", "heat"},
+                  "temperature", "boundary", "hot", "cold", "heat", "box", "speed"},
     "walls": {"name", "point", "normal", "temperature"},
     "conductance": {"law", "slope", "fit_file", "neck", "contact_conductance", "out_of_range", "unequal"},
     "convection": {"h", "T_inf", "area_fraction"},
@@ -46,6 +46,7 @@ GENERATOR_KEYS = {
     "chain": {"n", "radius", "overlap"},
     "lattice": {"shape", "radius", "overlap"},
     "random": {"n", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter"},
+    "box": {"n", "radius", "box", "seed", "radius_spread", "speed"},
 }
 
 
@@ -225,26 +226,29 @@ def _explicit_particles(t: dict, materials):
     n = len(t["position"]) if isinstance(t["position"], list) else 0
     return Particles.from_arrays(t["position"], t["radius"], t["temperature"], materials,
                                  _material_index(t.get("material"), materials, n), t.get("fixed"), t.get("heat"),
-                                 prefix="[particles]"), (), None
+                                 prefix="[particles]"), (), None, None
 
 
-def _generated_particles(t: dict, materials):
+def _generated_particles(t: dict, materials, dimension: int = 3):
     _check_keys(t, "generator", ALLOWED["generator"])
     kind = t.get("kind")
     if not isinstance(kind, str) or kind not in GENERATOR_KEYS:
         raise ValueError(f"[generator] kind = {kind!r}: must be one of {', '.join(GENERATOR_KEYS)}")
-    geometry_keys = {"n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter"}
+    geometry_keys = {"n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter", "box", "speed"}
     extra = sorted((set(t) & geometry_keys) - GENERATOR_KEYS[kind])
     if extra:
         raise ValueError(f"[generator] {extra[0]}: not a parameter of kind = {kind!r} "
                          f"(its parameters: {', '.join(sorted(GENERATOR_KEYS[kind]))})")
     args = {k: t[k] for k in GENERATOR_KEYS[kind] if k in t}
-    missing = sorted({"radius", "overlap", "shape" if kind == "lattice" else "n"} - set(args))
+    required = {"n", "radius", "box"} if kind == "box" else {"radius", "overlap", "shape" if kind == "lattice" else "n"}
+    missing = sorted(required - set(args))
     if missing:
         raise ValueError(f"[generator] {missing[0]}: required for kind = {kind!r}")
     try:
-        layout = {"chain": generators.chain, "lattice": generators.lattice,
-                  "random": generators.random_packing}[kind](**args)
+        if kind == "box":
+            args["dimension"] = dimension
+        layout = {"chain": generators.chain, "lattice": generators.lattice, "random": generators.random_packing,
+                  "box": generators.random_box}[kind](**args)
     except (TypeError, ValueError) as exc:
         msg = str(exc)
         raise ValueError(msg if msg.startswith("[") else f"[generator] kind = {kind!r}: bad parameter ({msg})") from None
@@ -259,7 +263,8 @@ def _generated_particles(t: dict, materials):
     temperature = np.full(n, T0)
     fixed = np.zeros(n, dtype=bool)
     walls, specimen = (), None
-    mean_overlap = float(np.mean(np.atleast_1d(t["overlap"])))
+    if boundary != "none" and kind == "box":
+        raise ValueError("[generator] boundary: not for kind = \"box\" (give [[walls]] instead)")
     if boundary == "fixed":
         fixed[layout.bottom] = fixed[layout.top] = True
         temperature[layout.bottom], temperature[layout.top] = hot, cold
@@ -268,6 +273,7 @@ def _generated_particles(t: dict, materials):
     elif boundary == "plates":
         # plane walls touching the end layers with overlap delta = overlap * r / 2: the mirror pair's neck equals
         # that of a pair with the generator's relative overlap
+        mean_overlap = float(np.mean(np.atleast_1d(t["overlap"])))
         r_b, r_t = layout.radius[layout.bottom], layout.radius[layout.top]
         z_b = float(np.mean(layout.position[layout.bottom, 2] - r_b * (1.0 - 0.5 * mean_overlap)))
         z_t = float(np.mean(layout.position[layout.top, 2] + r_t * (1.0 - 0.5 * mean_overlap)))
@@ -276,7 +282,7 @@ def _generated_particles(t: dict, materials):
         specimen = Specimen(z_t - z_b, layout.area, hot, cold)
     particles = Particles.from_arrays(layout.position, layout.radius, temperature, materials, None, fixed,
                                       np.full(n, heat), prefix="[generator]")
-    return particles, walls, specimen
+    return particles, walls, specimen, layout.velocity
 
 
 def _walls(doc) -> tuple:
@@ -365,9 +371,10 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     if ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
     if "particles" in doc:
-        particles, walls, specimen = _explicit_particles(doc["particles"], materials)
+        particles, walls, specimen, velocity = _explicit_particles(doc["particles"], materials)
     else:
-        particles, walls, specimen = _generated_particles(doc["generator"], materials)
+        dimension = full.get("scene", {}).get("dimension", 3) if moving else 3
+        particles, walls, specimen, velocity = _generated_particles(doc["generator"], materials, dimension)
     if not moving:
         walls = walls + _walls(doc)
     cond = dict(doc.get("conductance", {}))
@@ -384,7 +391,9 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     solver = _spec(SolverSpec, doc.get("solver", {}), "solver", numeric=("dt", "t_end", "rtol"),
                    integer=("max_steps",), words=("dt",))
     output = _spec(OutputSpec, doc.get("output", {}), "output", integer=("every", "vtu_every"))
-    motion = parse_motion(full, particles, solver, physics) if moving else None
+    if velocity is not None and not moving:
+        raise ValueError("[generator] speed: only for moving particles ([scene] physics with \"mechanical\")")
+    motion = parse_motion(full, particles, solver, physics, velocity) if moving else None
     return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
                  str(meta.get("name", source)), str(meta.get("description", "")), specimen, motion)
 

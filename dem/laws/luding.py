@@ -28,7 +28,7 @@ def radius_at(a_melt, T, T_melt, expansion):
     return a_melt * (1.0 - expansion * (T_melt - T))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def normal_force(delta, delta_dot, k1f, delta_max, k1f_last, delta_fluid, p):
     k1 = p[P_K1] * k1f
     k2 = p[P_K2]
@@ -45,7 +45,7 @@ def normal_force(delta, delta_dot, k1f, delta_max, k1f_last, delta_fluid, p):
     return f + p[P_GAMMA_N] * delta_dot, delta_max, f_min, k2, kc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def tangential_force(xi0, xi1, xi2, n0, n1, n2, vt0, vt1, vt2, f_n, f_min, k2_now, k1f, dt, p, is_wall):
     dot = xi0 * n0 + xi1 * n1 + xi2 * n2
     xi0 -= dot * n0
