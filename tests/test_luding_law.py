@@ -143,6 +143,23 @@ def test_relax_k1_steps_reproduce_eq11(t0, dt_over_t0, k0, K):
     assert min(k0, K) <= k <= max(k0, K)
 
 
+@pytest.mark.parametrize("k0, K", [(1.0, 0.6), (0.1, 0.9)])
+def test_relax_k1_against_eq12_integrated_numerically(k0, K):
+    """An independent solve of eq. (12) (adaptive Runge-Kutta, tight tolerances) against relax_k1 stepped at
+    t0/7 and against eq. (11)."""
+    from scipy.integrate import solve_ivp
+
+    t0 = 10.0
+    times = np.arange(1, 36) * t0 / 7
+    sol = solve_ivp(lambda t, k: (K - k) * abs(K - k) / (K * t0), (0.0, times[-1]), [k0], t_eval=times,
+                    rtol=1e-12, atol=1e-14, method="DOP853")
+    k = k0
+    for t, reference in zip(times, sol.y[0]):
+        k = law.relax_k1(k, K, t0 / 7, t0, False)
+        assert k == pytest.approx(reference, rel=1e-9)
+        assert reference == pytest.approx(eq11(k0, K, t, t0), rel=1e-9)
+
+
 def test_relax_k1_rate_is_eq12():
     """d k/dt = (K - k)|K - k|/(K t0), from the step's own change over a small dt."""
     for k, K in ((1.0, 0.6), (0.2, 0.7)):
