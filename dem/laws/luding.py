@@ -139,6 +139,7 @@ LUDING_TABLE1 = LudingMaterial(k1=1.0e5, k2=2.0e5, kc=1.0e5, kt_ratio=0.2, gamma
                                brittle_sliding=True, density=2000.0)
 
 
+@njit(**JIT)
 def pair_delta_fluid(a_i, a_j, fluid_overlap):
     """``delta_fluid = fluid_overlap * 2 a_i a_j/(a_i + a_j)`` of a pair (``fluid_overlap * a`` for equal radii)."""
     return fluid_overlap * 2.0 * a_i * a_j / (a_i + a_j)
