@@ -35,12 +35,10 @@ class Simulation:
         self.scene = scene
         m = scene.motion
         p = scene.particles
-        params = m.contact_params
+        params = scene.contact.params()
         T_init = p.temperature.astype(float)
         scale = np.array([radius_at(1.0, float(T), params[P_T_MELT], params[P_EXPANSION]) for T in T_init])
-        density = p.materials[0].density if len(p.materials) == 1 else np.array(
-            [mat.density for mat in p.materials])[p.material]
-        state = MotionState.create(m.dimension, p.position, p.radius, density, T_init, m.velocity,
+        state = MotionState.create(m.dimension, p.position, p.radius, scene.contact.density, T_init, m.velocity,
                                    m.angular_velocity, m.height, radius_ref=p.radius / scale)
         self.mechanics = MechanicalModel(state, m.walls, params, m.dt, m.skin, m.gravity, m.box,
                                          relaxation_time=float(params[P_T0]))

@@ -16,9 +16,11 @@ step:
 4. second half kick (velocities at the end of the step); stress-controlled walls from eq. 1.
 
 Contact geometry (Luding 2005, eqs. 3, 17-18): ``n`` points from j to i, the overlap is ``delta = a_i + a_j -
-|x_i - x_j|``, the relative surface velocity ``v_ij = v_i - v_j + a_i n x omega_i + a_j n x omega_j``; the force
-on i is ``f_n n + f_t`` and the torque ``-a_i n x f_t`` (the lever arm ``-a_i n`` points from i's centre to the
-contact). A wall is the partner j with an infinite radius, moving along its normal.
+|x_i - x_j|``, the relative surface velocity ``v_ij = v_i - v_j + l_i n x omega_i + l_j n x omega_j``; the force on
+i is ``f_n n + f_t`` and the torque ``-l_i n x f_t``. The lever arms reach the middle of the overlap, ``l = a -
+delta/2`` (as LAMMPS does), rather than the paper's ``a``: then ``l_i + l_j = |x_i - x_j|`` and a contact conserves
+angular momentum exactly (with ``a`` it would create ``-delta n x f_t``; the difference is of order delta/a). A
+wall is the partner j with an infinite radius, moving along its normal.
 """
 
 from __future__ import annotations
@@ -28,8 +30,8 @@ import math
 import numpy as np
 from numba import njit
 
-from dem.laws.luding import (P_EXPANSION, P_PHI, P_T_MELT, P_T_VAR, k1_factor, normal_force, radius_at, relax_k1,
-                             tangential_force)
+from dem.laws.luding import (P_EXPANSION, P_FLUID_OVERLAP, P_T_MELT, P_T_VAR, k1_factor, normal_force, radius_at,
+                             relax_k1, tangential_force)
 from dem.neighbours import min_image
 
 DONE, REBUILD, NONFINITE, ESCAPED = 0, 1, 2, 3
@@ -42,11 +44,11 @@ def _contact(n0, n1, n2, vr0, vr1, vr2, delta, k1f, dmax, k1last, xi0, xi1, xi2,
     particle i and the contact's new history. Scalars in, scalars out: array arguments in the hot loop would cost
     reference counting on every call (measured: 4x slower)."""
     vn = vr0 * n0 + vr1 * n1 + vr2 * n2
-    vt0, vt1, vt2 = vr0 - vn * n0, vr1 - vn * n1, vr2 - vn * n2
-    f_n, dmax_new, f_min, k2_now, kc_now = normal_force(delta, -vn, k1f, dmax, k1last, delta_fluid, params)
-    ft0, ft1, ft2, x0, x1, x2, sliding, f_n = tangential_force(xi0, xi1, xi2, n0, n1, n2, vt0, vt1, vt2, f_n, f_min,
-                                                               k2_now, k1f, dt, params, is_wall)
-    return f_n, ft0, ft1, ft2, dmax_new, x0, x1, x2
+    f_n, dmax_new, f_min, k2_now, kc_now, d0 = normal_force(delta, -vn, k1f, dmax, k1last, delta_fluid, params)
+    ft, xi, sliding, f_n = tangential_force((xi0, xi1, xi2), (n0, n1, n2), (vr0 - vn * n0, vr1 - vn * n1,
+                                                                               vr2 - vn * n2),
+                                            f_n, f_min, k2_now, k1f, dt, params, is_wall)
+    return f_n, ft[0], ft[1], ft[2], dmax_new, xi[0], xi[1], xi[2]
 
 
 @njit(cache=True)
@@ -57,7 +59,7 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
     centre lies behind its wall, else -1."""
     escaped = -1
     n = x.shape[0]
-    phi = params[P_PHI]
+    phi = params[P_FLUID_OVERLAP]
     for k in range(n):
         f[k, 0] = mass[k] * gravity[0]
         f[k, 1] = mass[k] * gravity[1]
@@ -81,16 +83,18 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
             continue
         d = math.sqrt(d2)
         n0, n1, n2 = dx / d, dy / d, dz / d
-        # v_ij = v_i - v_j + a_i n x w_i + a_j n x w_j  (Luding 2005, eq. 18)
-        c0 = ri * w[i, 0] + rj * w[j, 0]
-        c1 = ri * w[i, 1] + rj * w[j, 1]
-        c2 = ri * w[i, 2] + rj * w[j, 2]
+        delta = ri + rj - d
+        li, lj = ri - 0.5 * delta, rj - 0.5 * delta  # lever arms to the middle of the overlap: li + lj = d
+        # v_ij = v_i - v_j + l_i n x w_i + l_j n x w_j  (Luding 2005, eq. 18)
+        c0 = li * w[i, 0] + lj * w[j, 0]
+        c1 = li * w[i, 1] + lj * w[j, 1]
+        c2 = li * w[i, 2] + lj * w[j, 2]
         vr0 = v[i, 0] - v[j, 0] + n1 * c2 - n2 * c1
         vr1 = v[i, 1] - v[j, 1] + n2 * c0 - n0 * c2
         vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
         k1c = 0.5 * (k1f[i] + k1f[j])
         f_n, ft0, ft1, ft2, dmax, x0, x1, x2 = _contact(
-            n0, n1, n2, vr0, vr1, vr2, ri + rj - d, k1c, p_dmax[c], p_k1last[c], p_xi[c, 0], p_xi[c, 1], p_xi[c, 2],
+            n0, n1, n2, vr0, vr1, vr2, delta, k1c, p_dmax[c], p_k1last[c], p_xi[c, 0], p_xi[c, 1], p_xi[c, 2],
             phi * 2.0 * ri * rj / (ri + rj), False, params, dt)
         p_dmax[c] = dmax
         p_k1last[c] = k1c
@@ -104,14 +108,14 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
         f[j, 0] -= g0
         f[j, 1] -= g1
         f[j, 2] -= g2
-        # torques -a n x f_t on both (the lever arms -a_i n and +a_j n, the forces f_t and -f_t)
+        # torques -l n x f_t on both (the lever arms -l_i n and +l_j n, the forces f_t and -f_t)
         m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
-        tau[i, 0] -= ri * m0
-        tau[i, 1] -= ri * m1
-        tau[i, 2] -= ri * m2
-        tau[j, 0] -= rj * m0
-        tau[j, 1] -= rj * m1
-        tau[j, 2] -= rj * m2
+        tau[i, 0] -= li * m0
+        tau[i, 1] -= li * m1
+        tau[i, 2] -= li * m2
+        tau[j, 0] -= lj * m0
+        tau[j, 1] -= lj * m1
+        tau[j, 2] -= lj * m2
     n_w = wn.shape[0]
     for m in range(n_w):
         wforce[m] = 0.0
@@ -130,9 +134,10 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
                 w_fn[k, m] = 0.0
                 w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = 0.0, 0.0, 0.0
             continue
-        vr0 = v[k, 0] - wdq[m] * n0 + rk * (n1 * w[k, 2] - n2 * w[k, 1])
-        vr1 = v[k, 1] - wdq[m] * n1 + rk * (n2 * w[k, 0] - n0 * w[k, 2])
-        vr2 = v[k, 2] - wdq[m] * n2 + rk * (n0 * w[k, 1] - n1 * w[k, 0])
+        lk = rk - 0.5 * delta
+        vr0 = v[k, 0] - wdq[m] * n0 + lk * (n1 * w[k, 2] - n2 * w[k, 1])
+        vr1 = v[k, 1] - wdq[m] * n1 + lk * (n2 * w[k, 0] - n0 * w[k, 2])
+        vr2 = v[k, 2] - wdq[m] * n2 + lk * (n0 * w[k, 1] - n1 * w[k, 0])
         f_n, ft0, ft1, ft2, dmax, x0, x1, x2 = _contact(
             n0, n1, n2, vr0, vr1, vr2, delta, k1f[k], w_dmax[k, m], w_k1last[k, m], w_xi[k, m, 0],
             w_xi[k, m, 1], w_xi[k, m, 2], phi * rk, True, params, dt)
@@ -144,9 +149,9 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
         f[k, 0] += f_n * n0 + ft0
         f[k, 1] += f_n * n1 + ft1
         f[k, 2] += f_n * n2 + ft2
-        tau[k, 0] -= rk * (n1 * ft2 - n2 * ft1)
-        tau[k, 1] -= rk * (n2 * ft0 - n0 * ft2)
-        tau[k, 2] -= rk * (n0 * ft1 - n1 * ft0)
+        tau[k, 0] -= lk * (n1 * ft2 - n2 * ft1)
+        tau[k, 1] -= lk * (n2 * ft0 - n0 * ft2)
+        tau[k, 2] -= lk * (n0 * ft1 - n1 * ft0)
         wforce[m] += f_n
     return escaped
 

@@ -38,11 +38,7 @@ MOVING_KEYS = {
     "solver": {"skin", "thermal_interval"},
     "output": {"interval", "vtu_interval"},
 }
-MOVING_TABLES = {"contact": None, "gravity": {"acceleration"}, "temperature": {"time", "value", "relaxation_time"}}
-CONTACT_KEYS = {"law", "k1", "k2", "kc", "kt_ratio", "gamma_n", "gamma_t", "mu", "mu_wall", "T_melt", "T_var",
-                "expansion", "fluid_overlap", "t0", "brittle_sliding"}
-
-
+MOVING_TABLES = {"gravity": {"acceleration"}, "temperature": {"time", "value", "relaxation_time"}}
 @dataclass(frozen=True)
 class MotionSpec:
     dimension: int
@@ -52,7 +48,6 @@ class MotionSpec:
     walls: tuple
     gravity: tuple
     schedule: TemperatureSchedule | None
-    contact_params: np.ndarray
     dt: float
     stable_dt: float
     skin: float
@@ -76,52 +71,31 @@ def _num(table, section, key, default=None, positive=False, nonnegative=False):
     return float(v)
 
 
-def contact_params(table: dict) -> np.ndarray:
-    """The ``[contact]`` table as the kernels' parameter array (Luding 2005; :mod:`dem.laws.luding`)."""
-    unknown = sorted(set(table) - CONTACT_KEYS)
-    if unknown:
-        raise ValueError(f"[contact] {unknown[0]}: unknown key (allowed: {', '.join(sorted(CONTACT_KEYS))})")
-    if table.get("law", "luding") != "luding":
-        raise ValueError(f"[contact] law = {table.get('law')!r}: must be luding")
-    p = np.zeros(luding.N_PARAMS)
-    names = {"k1": luding.P_K1, "k2": luding.P_K2, "kc": luding.P_KC, "kt_ratio": luding.P_KT_RATIO,
-             "gamma_n": luding.P_GAMMA_N, "gamma_t": luding.P_GAMMA_T, "mu": luding.P_MU, "mu_wall": luding.P_MU_WALL,
-             "T_melt": luding.P_T_MELT, "T_var": luding.P_T_VAR, "expansion": luding.P_EXPANSION,
-             "fluid_overlap": luding.P_PHI, "t0": luding.P_T0}
-    defaults = {"T_melt": 1e9, "T_var": 1.0, "fluid_overlap": 0.2, "t0": 1e3}
-    for key, k in names.items():
-        v = _num(table, "contact", key, defaults.get(key))
-        if v is None:
-            raise ValueError(f"[contact] {key}: required")
-        p[k] = v
-    if not (0 < p[luding.P_K1] <= p[luding.P_K2]):
-        raise ValueError(f"[contact] k1 = {p[luding.P_K1]:g}: must satisfy 0 < k1 <= k2 = {p[luding.P_K2]:g}")
-    return p
+def time_steps(contact, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray, dimension: int,
+               height: float | None) -> tuple[float, float]:
+    """``(t_MD, stable)``.
 
-
-def time_steps(params: np.ndarray, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray,
-               dimension: int) -> tuple[float, float]:
-    """``(t_MD, stable)``: the step pi/(50 omega) of Luding 2005 eq. 6 for the smallest reduced mass of two
-    particles, and the largest stable velocity-Verlet step 2/omega_max (normal stiffness k2, or the tangential
-    spring with rotation, whichever is stiffer; and the viscous rate)."""
+    ``t_MD = pi/(50 omega)`` is the "typical time-step" of Luding 2005 (eq. 6 and below,
+    :func:`dem.laws.luding.time_step`) for a contact of two particles of the mean radius. The lightest pair of a
+    polydisperse sample vibrates faster: with Table 1's radii (a0 +- 50 %) its contact still takes 25 steps per
+    half period. ``stable`` is the largest velocity-Verlet step that stays stable for the stiffest contact,
+    ``2/(omega_max + eta)``: the lightest pair, with the normal stiffness k2 or the tangential spring acting with
+    rotation (``alpha k2 (1 + m a^2/I)``), whichever is stiffer, and the viscous rate ``eta = gamma_n/(2 m12)``.
+    A ``dt`` above it is refused.
+    """
     order = np.argsort(mass)
+    m_mean = float(particle_mass(dimension, contact.density, np.mean(radius), height))
+    t_md = luding.time_step(contact.k2, contact.gamma_n, 0.5 * m_mean)
     m12 = mass[order[0]] * mass[order[1]] / (mass[order[0]] + mass[order[1]]) if len(mass) > 1 else mass[0]
-    k2, gamma = params[luding.P_K2], params[luding.P_GAMMA_N]
-    eta = gamma / (2.0 * m12)
-    omega2 = k2 / m12 - eta**2
-    if omega2 <= 0:
-        raise ValueError(f"[contact] gamma_n = {gamma:g} kg/s: overdamped contact (gamma_n >= 2 sqrt(k2 m12) = "
-                         f"{2 * math.sqrt(k2 * m12):.6g} kg/s for the lightest pair); eq. 6 has no step")
-    t_md = math.pi / (50.0 * math.sqrt(omega2))
     rotational = 1.0 + float(np.max(mass * radius**2 / inertia))
-    k_max = k2 * max(1.0, params[luding.P_KT_RATIO] * rotational)
-    stable = 2.0 / (math.sqrt(k_max / m12) + eta)
-    return t_md, stable
+    k_max = contact.k2 * max(1.0, contact.kt_ratio * rotational)
+    stable = 2.0 / (math.sqrt(k_max / m12) + contact.gamma_n / (2.0 * m12))
+    return min(t_md, stable), stable
 
 
-def parse_motion(doc: dict, particles, solver, physics, velocity=None) -> MotionSpec:
-    """The moving part of a scene (module docstring); ``particles`` and ``solver`` are already parsed;
-    ``velocity`` comes from a generator (its random ``speed``)."""
+def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None) -> MotionSpec:
+    """The moving part of a scene (module docstring); ``particles``, ``solver`` and the ``contact`` material are
+    already parsed; ``velocity`` comes from a generator (its random ``speed``)."""
     meta = doc.get("scene", {})
     dimension = meta.get("dimension", 3)
     if dimension not in (2, 3) or isinstance(dimension, bool):
@@ -146,9 +120,12 @@ def parse_motion(doc: dict, particles, solver, physics, velocity=None) -> Motion
     for name, arr in (("velocity", velocity), ("angular_velocity", angular)):
         if arr is not None and len(arr) != n:
             raise ValueError(f"[particles] {name} has {len(arr)} entries but position has {n}")
-    if "contact" not in doc:
+    if contact is None:
         raise ValueError("[contact]: required for mechanical physics (law = \"luding\" and its parameters)")
-    params = contact_params(doc["contact"])
+    densities = {m.density for m in particles.materials}
+    if densities != {contact.density}:
+        raise ValueError(f"[contact] density = {contact.density:g}: differs from [material] density "
+                         f"{', '.join(f'{d:g}' for d in sorted(densities))} kg/m^3; give it once, in [material]")
     walls = tuple(_moving_wall(k, w) for k, w in enumerate(doc.get("walls", [])))
     gravity = (0.0, 0.0, 0.0)
     if "gravity" in doc:
@@ -165,12 +142,11 @@ def parse_motion(doc: dict, particles, solver, physics, velocity=None) -> Motion
         for key in ("time", "value"):
             if key not in t:
                 raise ValueError(f"[temperature] {key}: required")
-        schedule = TemperatureSchedule.build(t["time"], t["value"], t.get("relaxation_time",
-                                                                            params[luding.P_T0]))
+        schedule = TemperatureSchedule.build(t["time"], t["value"], t.get("relaxation_time", contact.t0))
     density = np.array([m.density for m in particles.materials])[particles.material]
     mass = particle_mass(dimension, density, particles.radius, height)
-    t_md, stable = time_steps(params, mass, moment_of_inertia(dimension, mass, particles.radius), particles.radius,
-                              dimension)
+    t_md, stable = time_steps(contact, mass, moment_of_inertia(dimension, mass, particles.radius), particles.radius,
+                              dimension, height)
     if solver.dt == "auto":
         dt = t_md
     else:
@@ -189,7 +165,7 @@ def parse_motion(doc: dict, particles, solver, physics, velocity=None) -> Motion
     vtu_interval = _num(out, "output", "vtu_interval", 0.0, nonnegative=True)
     thermal_interval = _num(solver_table, "solver", "thermal_interval",
                             min(output_interval, DEFAULT_THERMAL_STEPS * dt), positive=True)
-    return MotionSpec(dimension, height, velocity, angular, walls, gravity, schedule, params, dt, stable, skin,
+    return MotionSpec(dimension, height, velocity, angular, walls, gravity, schedule, dt, stable, skin,
                       thermal_interval, solver.integrator, output_interval, vtu_interval)
 
 

@@ -11,12 +11,13 @@ from __future__ import annotations
 import math
 import pathlib
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
 from dem import generators
 from dem.laws.conductance import ConductanceSpec
+from dem.laws.luding import LudingMaterial
 from dem.particles import COPPER, Material, Particles
 from dem.sources import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
 from dem.thermal import INTEGRATORS
@@ -41,7 +42,9 @@ ALLOWED = {
     "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
     "solver": {"mode", "integrator", "dt", "t_end", "rtol", "linear", "floating", "max_steps"},
     "output": {"every", "vtu_every", "vtu"},
+    "contact": {"law"} | {f.name for f in fields(LudingMaterial)},
 }
+CONTACT_LAWS = ("luding",)
 GENERATOR_KEYS = {
     "chain": {"n", "radius", "overlap"},
     "lattice": {"shape", "radius", "overlap"},
@@ -121,7 +124,8 @@ class Specimen:
 
 @dataclass(frozen=True)
 class Scene:
-    """One DEM run: particles (+ walls), conductance law, ambient sources, solver, outputs, the physics to run."""
+    """One DEM run: particles (+ walls), conductance law, ambient sources, solver, outputs, the physics to run;
+    ``contact`` the Luding 2005 material of a ``[contact]`` table, or None."""
 
     particles: Particles
     walls: tuple = ()
@@ -133,6 +137,7 @@ class Scene:
     name: str = "scene"
     description: str = ""
     specimen: Specimen | None = None
+    contact: LudingMaterial | None = None
     motion: MotionSpec | None = None  # particles that move ([scene] physics with "mechanical"), else None
 
 
@@ -393,9 +398,38 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     output = _spec(OutputSpec, doc.get("output", {}), "output", integer=("every", "vtu_every"))
     if velocity is not None and not moving:
         raise ValueError("[generator] speed: only for moving particles ([scene] physics with \"mechanical\")")
-    motion = parse_motion(full, particles, solver, physics, velocity) if moving else None
+    contact = luding_material_from_scene(doc) if "contact" in doc else None
+    motion = parse_motion(full, particles, solver, physics, contact, velocity) if moving else None
     return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
-                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, motion)
+                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact, motion)
+
+
+def luding_material_from_scene(doc_or_scene) -> LudingMaterial:
+    """The Luding 2005 contact material of a :class:`Scene` (its ``contact``) or of a TOML document (its
+    ``[contact]`` table: ``law = "luding"`` and the :class:`~dem.laws.luding.LudingMaterial` fields in SI units;
+    ``density`` defaults to that of a single ``[material]``). Independent of how the particles are given.
+    Raises ``ValueError`` when there is none or a value is bad."""
+    if isinstance(doc_or_scene, Scene):
+        if doc_or_scene.contact is None:
+            raise ValueError(f"scene {doc_or_scene.name!r}: has no [contact] table with law = \"luding\" (the Luding "
+                             f"2005 sintering contact material)")
+        return doc_or_scene.contact
+    table = doc_or_scene.get("contact") if isinstance(doc_or_scene, dict) else None
+    if table is None:
+        raise ValueError("[contact]: required, with law = \"luding\" and the material (k1, k2, kc, ...)")
+    _check_keys(table, "contact", ALLOWED["contact"])
+    if table.get("law") not in CONTACT_LAWS:
+        raise ValueError(f"[contact] law = {table.get('law')!r}: must be one of {', '.join(CONTACT_LAWS)}")
+    values = {key: v for key, v in table.items() if key != "law"}
+    material = doc_or_scene.get("material")
+    if "density" not in values and isinstance(material, dict) and "density" in material:
+        values["density"] = material["density"]
+    missing = [f.name for f in fields(LudingMaterial) if f.name not in values]
+    if missing:
+        raise ValueError(f"[contact] {missing[0]}: required (law = \"luding\" needs "
+                         f"{', '.join(f.name for f in fields(LudingMaterial))})")
+    numeric = tuple(key for key in values if key != "brittle_sliding")
+    return _spec(LudingMaterial, values, "contact", numeric=numeric)
 
 
 def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls) -> None:
