@@ -205,10 +205,15 @@ def advance(n_steps, dt, t_start, x, v, w, f, tau, mass, inertia, lin, rot, radi
         t = t_start + s * dt
         for k in range(n):
             im, ii = 1.0 / mass[k], 1.0 / inertia[k]
+            moved = 0.0
             for a in range(3):
                 v[k, a] += h * f[k, a] * im * lin[a]
                 w[k, a] += h * tau[k, a] * ii * rot[a]
                 x[k, a] += dt * v[k, a]
+                moved += abs(x[k, a]) + abs(w[k, a])
+            if not moved < math.inf:  # NaN or inf: name the particle before its neighbours are contaminated
+                info[0] = k
+                return s + 1, 2
         for m in range(n_w):
             if wmode[m] == 1:
                 wdq[m] += h * wacc[m]
