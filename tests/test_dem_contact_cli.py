@@ -177,7 +177,7 @@ def test_contact_table_density_from_material_and_from_a_dict():
 @pytest.mark.parametrize("edit, words", [
     ({"law": "hertz"}, "[contact] law = 'hertz'"),
     ({"k1": None}, "[contact] k1: required"),
-    ({"k1": 3e5}, "[contact] k1 = 300000.0: must be < k2"),
+    ({"k1": 3e5}, "[contact] k1 = 300000.0: must be <= k2"),
     ({"fluid_overlap": 1.5}, "[contact] fluid_overlap = 1.5: must be in (0, 1)"),
     ({"mu": "high"}, "[contact] mu = 'high': must be a finite number"),
     ({"brittle_sliding": "yes"}, "[contact] brittle_sliding = 'yes': must be true or false"),

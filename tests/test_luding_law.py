@@ -73,8 +73,7 @@ def test_table1_material_and_params_layout():
 
 
 @pytest.mark.parametrize("field, value, words", [
-    ("k1", 3e5, ["k1", "3", "< k2"]),
-    ("k1", 2e5, ["k1", "< k2"]),
+    ("k1", 3e5, ["k1", "3", "<= k2"]),
     ("k2", -1.0, ["k2", "-1.0", "> 0"]),
     ("kc", -1.0, ["kc", ">= 0"]),
     ("kt_ratio", -0.1, ["kt_ratio", ">= 0"]),
@@ -470,3 +469,17 @@ def test_spring_projected_when_the_normal_rotates():
     assert not sliding and xi_new == pytest.approx(tuple(projected), rel=1e-14, abs=1e-22)
     assert abs(np.dot(xi_new, n)) < 1e-22
     assert ft == pytest.approx(tuple(-MAT.kt_ratio * 1e5 * projected), rel=1e-14, abs=1e-20)
+
+
+def test_k1_equal_k2_is_the_elastic_limit():
+    """k1 = k2: no plastic deformation (delta_0 = 0, k2(delta_max) = k2, delta_max^fluid infinite) in the cold
+    limit; the force is k2 delta on loading and unloading alike."""
+    m = law.LudingMaterial(**{**{f: getattr(law.LUDING_TABLE1, f) for f in law.LUDING_TABLE1.__dataclass_fields__},
+                              "k1": 2e5, "kc": 0.0, "gamma_n": 0.0})
+    p = m.params()
+    s = 1.0
+    dm = 0.0
+    for delta in (1e-6, 3e-6, 2e-6, 0.5e-6):
+        f, dm, f_min, k2m, kcm, d0 = law.normal_force(delta, 0.0, s, dm, s, 2e-4, p)
+        assert f == pytest.approx(2e5 * delta, rel=1e-14) and d0 == 0.0 and k2m == 2e5 and f_min == 0.0
+    assert dm == 3e-6

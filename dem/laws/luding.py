@@ -206,10 +206,10 @@ def k2_of_delta_max(delta_max, delta_fluid, params):
     limit, ``k2`` at and above it."""
     k1 = params[P_K1]
     k2 = params[P_K2]
-    dmf = k2 * delta_fluid / (k2 - k1)
-    if delta_max >= dmf:
+    x = (k2 - k1) * delta_max  # delta_max >= delta_max^fluid  <=>  x >= k2 delta_fluid (one division, none if k1 = k2)
+    if x >= k2 * delta_fluid:
         return k2
-    return k1 + (k2 - k1) * delta_max / dmf
+    return k1 + (k2 - k1) * x / (k2 * delta_fluid)
 
 
 @njit(**JIT)
