@@ -96,6 +96,7 @@ class Simulation:
             mech.advance(steps, T0, rate, t0)
             if self.thermal is not None:
                 self.thermal.step(mech, steps * mech.dt)
+                mech.state.T[:] = self.thermal.T  # the next interval starts from these
             if observer is not None and (end % out_every == 0 or end == n_end):
                 observer(self)
             if progress is not None:

@@ -108,7 +108,11 @@ def run_moving(scene: Scene, out=None, progress: bool = False) -> RunResult:
         bar = tqdm(total=scene.solver.t_end, unit="s", desc=f"dem {scene.name}", file=sys.stderr, delay=2.0,
                    bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s simulated [{elapsed}<{remaining}]")
     try:
-        details = sim.run(writer, (lambda t: bar.update(t - bar.n)) if bar is not None else None)
+        details = sim.run(writer, (lambda t: bar.update(min(t, bar.total) - bar.n)) if bar is not None else None)
+    except ValueError as exc:  # the run stopped (a particle through a wall, a neck beyond its model): keep what exists
+        if writer is not None:
+            writer.finish({"scene": scene.name, "stopped": " ".join(str(exc).split()), **sim.summary()})
+        raise
     finally:
         if bar is not None:
             bar.close()

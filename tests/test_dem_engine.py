@@ -195,3 +195,55 @@ def test_cli_run_writes_outputs(tmp_path):
     listed = pvd.count("<DataSet")
     assert listed == len(list(tmp_path.glob("particles_*.vtu"))) == 3
     assert (tmp_path / "contacts.pvd").exists() and (tmp_path / "summary.json").exists()
+
+
+def test_a_stopped_run_keeps_its_outputs(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    doc_text = """
+[scene]
+physics = ["mechanical"]
+[material]
+density = 2000.0
+[particles]
+position = [[0.0, 0.0, 2e-3]]
+radius = [1e-3]
+temperature = [20.0]
+velocity = [[0.0, 0.0, -400.0]]
+[contact]
+law = "luding"
+k1 = 2e5
+k2 = 2e5
+kc = 0.0
+kt_ratio = 0.2
+gamma_n = 0.0
+gamma_t = 0.0
+mu = 0.5
+mu_wall = 0.5
+T_melt = 120.0
+T_var = 10.0
+expansion = 0.0
+fluid_overlap = 0.2
+t0 = 1e3
+brittle_sliding = false
+[[walls]]
+name = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[solver]
+mode = "transient"
+t_end = 1e-3
+[output]
+interval = 1e-6
+"""
+    path = tmp_path / "escape.toml"
+    path.write_text(doc_text)
+    proc = subprocess.run([sys.executable, "-m", "dem", "run", str(path), "--out", str(tmp_path / "out")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and "left the box through wall 'floor'" in proc.stderr
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert "left the box" in summary["stopped"] and summary["steps"] > 0
+    assert len((tmp_path / "out" / "timeseries.csv").read_text().splitlines()) > 2
