@@ -26,6 +26,8 @@ from dem.contact_heat import ContactThermalModel
 from dem.laws.luding import P_T0, P_EXPANSION, P_T_MELT, radius_at
 from dem.mechanics import MechanicalModel
 from dem.motion import MotionState
+from dem.thermal import boundary_heat_flow, steady
+from fem_neck.geometry import neck_radius
 
 
 class Simulation:
@@ -128,8 +130,8 @@ class Simulation:
         return None if volume is None else self.mechanics.state.solid_volume() / volume
 
     def wall_stress(self) -> dict:
-        """Normal force per unit extent (2D, N/m) or per unit area (3D, Pa) that the particles exert on each
-        stress- or strain-controlled wall (the one whose load the test controls)."""
+        """Normal stress the particles exert on each wall of an axis-aligned box: force per unit length (2D, N/m,
+        the paper's pressure unit) or per unit area (3D, Pa); the bare force (N) on a wall outside such a box."""
         mech = self.mechanics
         out = {}
         for k, wall in enumerate(mech.walls):
@@ -138,8 +140,67 @@ class Simulation:
             for a in range(2):
                 if lo_hi[2 * a] >= 0:
                     extent *= mech.w.extent(lo_hi[2 * a], lo_hi[2 * a + 1])
-            out[wall.name] = float(mech.w.force[k] / extent) if wall.motion == "stress" else float(mech.w.force[k])
+            out[wall.name] = float(mech.w.force[k] / extent)
         return out
+
+    def heated_walls(self):
+        """``(hot, cold)`` wall indices when exactly two walls carry different temperatures and face each other
+        (the specimen of an effective conductivity), else None."""
+        mech = self.mechanics
+        walls = [k for k, w in enumerate(mech.walls) if w.temperature is not None]
+        if len(walls) != 2:
+            return None
+        a, b = (mech.walls[k] for k in walls)
+        if a.temperature == b.temperature or not np.allclose(a.normal, -b.normal, atol=1e-12):
+            return None
+        return tuple(walls) if a.temperature > b.temperature else tuple(reversed(walls))
+
+    def effective_conductivity(self) -> float | None:
+        """``k_eff = Q L / (A (T_hot - T_cold))`` of the contact network as it is now, from a steady solve between
+        the hot and the cold wall (W/(m K)); None without two such walls, a closed box or a network (or with
+        ambient sources, which are not conduction). Groups of particles touching neither wall carry no heat."""
+        th, pair = self.thermal, self.heated_walls()
+        volume = self.box_volume()
+        if th is None or th.net is None or pair is None or volume is None or self.scene.sources.names:
+            return None
+        mech = self.mechanics
+        hot, cold = pair
+        length = -(mech.w.q[hot] + mech.w.q[cold])
+        res = steady(th.net, floating="mean", linear=self.scene.solver.linear)
+        into = boundary_heat_flow(th.net, res.T)["walls"]
+        q = -into[th.thermal_walls.index(hot)]  # heat leaving the hot wall
+        delta_T = mech.walls[hot].temperature - mech.walls[cold].temperature
+        return float(q * length / (volume / length * delta_T))
+
+    def profile(self, bins: int = 8) -> dict | None:
+        """Solid fraction and mean neck radius (Rojek's volume-conserving neck of each contact's overlap, a/r of
+        the smaller particle) in slabs parallel to the hot wall, against the distance from it; None without a hot
+        wall and a closed box."""
+        pair = self.heated_walls()
+        volume = self.box_volume()
+        if pair is None or volume is None:
+            return None
+        mech = self.mechanics
+        s = mech.state
+        hot, cold = pair
+        normal = mech.walls[hot].normal
+        length = -(mech.w.q[hot] + mech.w.q[cold])
+        area = volume / length
+        edges = np.linspace(0.0, length, bins + 1)
+        dist = s.x @ normal - mech.w.q[hot]
+        v = 4.0 / 3.0 * np.pi * s.radius**3
+        slab = np.clip(np.searchsorted(edges, dist) - 1, 0, bins - 1)
+        density = np.bincount(slab, v, bins) / (area * np.diff(edges))
+        i, j, overlap = mech.contacts()[:3]
+        r_min = np.minimum(s.radius[i], s.radius[j])
+        h = np.minimum(overlap, 0.999 * (2.0 / 3.0) * r_min)  # within the neck model's range, for the profile
+        neck = np.asarray(neck_radius(s.radius[i], s.radius[j], h)) / r_min if len(i) else np.zeros(0)
+        mid = np.clip(np.searchsorted(edges, 0.5 * (dist[i] + dist[j])) - 1, 0, bins - 1)
+        count = np.bincount(mid, minlength=bins)
+        with np.errstate(invalid="ignore"):
+            neck_mean = np.bincount(mid, neck, bins) / count
+        return {"distance": (0.5 * (edges[1:] + edges[:-1])).tolist(), "solid_fraction": density.tolist(),
+                "neck_over_radius": [None if c == 0 else float(x) for c, x in zip(count, neck_mean)]}
 
     def record(self) -> dict:
         """The scalar observables of the current state (one row of ``timeseries.csv``)."""
@@ -150,6 +211,8 @@ class Simulation:
                "volume_fraction": self.volume_fraction(), "coordination": 2.0 * len(i) / s.n,
                "k1_factor": float(np.mean(mech.k1f)), "T_mean": float(np.mean(s.T)),
                "T_min": float(np.min(s.T)), "T_max": float(np.max(s.T))}
+        if self.thermal is not None and self.heated_walls() is not None:
+            row["effective_conductivity"] = self.effective_conductivity()
         for name, value in self.wall_stress().items():
             row[f"wall_{name}"] = value
         for k, wall in enumerate(mech.walls):
@@ -160,6 +223,9 @@ class Simulation:
         mech = self.mechanics
         s = mech.state
         out = {k: v for k, v in self.record().items() if k not in ("step",)}
+        profile = self.profile()
+        if profile is not None:
+            out["profile"] = profile
         out.update(steps=mech.steps, dt=mech.dt, particles=s.n, contacts=len(mech.contacts()[0]),
                    wall_contacts=len(mech.wall_contacts()[0]), dimension=s.dimension,
                    momentum=s.momentum().tolist(), neighbour_rebuilds=mech.rebuilds, skin=mech.skin,

@@ -148,6 +148,17 @@ class MotionWriter:
     def snapshot(self, sim, t: float, step: int):
         if self.snapshots and self.snapshots[-1][1] == step:
             return
+        profile = sim.profile()
+        if profile is not None:
+            new = not (self.out / "profiles.csv").exists()
+            with (self.out / "profiles.csv").open("a") as fh:
+                if new:
+                    fh.write("t,distance,solid_fraction,neck_over_radius\n")
+                for d, phi, a in zip(profile["distance"], profile["solid_fraction"], profile["neck_over_radius"]):
+                    fh.write(f"{t:.12g},{d:.12g},{phi:.12g},{'' if a is None else f'{a:.12g}'}\n")
+        self.snapshots.append((t, step))
+        if not self.scene.output.vtu:
+            return
         s = sim.mechanics.state
         fields = sim.particle_fields()
         meshio.write(self.out / f"particles_{step:09d}.vtu", meshio.Mesh(
@@ -156,11 +167,14 @@ class MotionWriter:
         meshio.write(self.out / f"contacts_{step:09d}.vtu", meshio.Mesh(
             s.x, [("line", np.column_stack([i, j]).astype(np.int64).reshape(-1, 2))],
             cell_data={k: [v] for k, v in cfields.items()}))
-        self.snapshots.append((t, step))
         for kind in ("particles", "contacts"):
             write_pvd(self.out / f"{kind}.pvd", [(tt, f"{kind}_{k:09d}.vtu") for tt, k in self.snapshots])
 
-    def finish(self, summary: dict):
+    def finish(self, summary: dict, plots: bool = True):
         if self.csv is not None:
             self.csv.close()
+        if plots:
+            from dem.plots import motion_plots
+
+            summary = {**summary, "plots": motion_plots(self.out)}
         write_summary(self.out / "summary.json", summary)

@@ -109,8 +109,11 @@ class WallArrays:
                      np.array([w.mass for w in walls], dtype=float), np.array([w.damping for w in walls], dtype=float),
                      q.copy(), amp, freq, -np.ones((n_w, 4), dtype=np.int64), np.zeros(n_w))
         for k, wall in enumerate(walls):
-            if wall.motion == "stress":
+            try:
                 arrays.span[k] = _span(walls, k, dimension)
+            except ValueError:
+                if wall.motion == "stress":  # a stress wall needs its extent; the others report a force then
+                    raise
         return arrays
 
     def extent(self, lo: int, hi: int) -> float:
