@@ -22,8 +22,6 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.spatial import cKDTree
 
-from numba import njit
-
 from fem_neck.geometry import max_overlap
 
 DISTRIBUTIONS = ("constant", "uniform", "lognormal")
@@ -224,7 +222,9 @@ def random_box(n: int, radius, box, radius_spread: float = 0.0, seed: int = 0, s
     lo, hi = b[0].copy(), b[1].copy()
     if dimension == 2:
         lo[1] = hi[1] = 0.0
-    pos, placed = _sequential_addition(r, lo, hi, rng.random((RSA_CANDIDATES * n, 3)))
+    from dem.neighbours import sequential_addition  # compiled: loaded only by scenes that place particles so
+
+    pos, placed = sequential_addition(r, lo, hi, rng.random((RSA_CANDIDATES * n, 3)))
     if placed < n:
         filled = np.sum(np.pi * r[:placed] ** 2) / np.prod((b[1] - b[0])[axes]) if dimension == 2 else \
             np.sum(4 / 3 * np.pi * r[:placed] ** 3) / np.prod(b[1] - b[0])
@@ -239,50 +239,3 @@ def random_box(n: int, radius, box, radius_spread: float = 0.0, seed: int = 0, s
     empty = np.zeros(0, dtype=np.int64)
     return Layout(pos, r, empty, empty, float(b[0][2]), float(b[1][2]), float(area), v * direction if v > 0 else None)
 
-
-@njit(cache=True)
-def _sequential_addition(r, lo, hi, uniform):
-    """Place particles of radii ``r`` one by one at the next candidate points ``lo + u (hi - lo)`` (``u`` rows of
-    ``uniform``, kept inside the box by each radius) that overlap no particle placed before; cell binning makes each
-    test O(1). Returns the positions and the number placed before the candidates ran out."""
-    n = r.shape[0]
-    size = 2.0 * r.max()
-    ncell = np.empty(3, dtype=np.int64)
-    for a in range(3):
-        ncell[a] = max(1, int((hi[a] - lo[a]) / size) + 1)
-    head = -np.ones(ncell[0] * ncell[1] * ncell[2], dtype=np.int64)
-    nxt = -np.ones(n, dtype=np.int64)
-    pos = np.zeros((n, 3))
-    c = np.empty(3, dtype=np.int64)
-    trial = 0
-    for k in range(n):
-        placed = False
-        while trial < uniform.shape[0]:
-            p = np.empty(3)
-            for a in range(3):
-                span = hi[a] - lo[a] - 2.0 * r[k]
-                p[a] = lo[a] + r[k] + uniform[trial, a] * span if span > 0 else lo[a]
-                c[a] = min(ncell[a] - 1, int((p[a] - lo[a]) / size))
-            trial += 1
-            free = True
-            for d0 in range(max(0, c[0] - 1), min(ncell[0], c[0] + 2)):
-                for d1 in range(max(0, c[1] - 1), min(ncell[1], c[1] + 2)):
-                    for d2 in range(max(0, c[2] - 1), min(ncell[2], c[2] + 2)):
-                        m = head[(d0 * ncell[1] + d1) * ncell[2] + d2]
-                        while m >= 0 and free:
-                            s = 0.0
-                            for a in range(3):
-                                s += (pos[m, a] - p[a]) ** 2
-                            if s < (r[m] + r[k]) ** 2:
-                                free = False
-                            m = nxt[m]
-            if free:
-                pos[k] = p
-                cell = (c[0] * ncell[1] + c[1]) * ncell[2] + c[2]
-                nxt[k] = head[cell]
-                head[cell] = k
-                placed = True
-                break
-        if not placed:
-            return pos, k
-    return pos, n

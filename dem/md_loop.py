@@ -30,8 +30,8 @@ import math
 import numpy as np
 from numba import njit
 
-from dem.laws.luding import (P_EXPANSION, P_FLUID_OVERLAP, P_T_MELT, P_T_VAR, k1_factor, normal_force, radius_at,
-                             relax_k1, tangential_force)
+from dem.laws.luding import P_EXPANSION, P_FLUID_OVERLAP, P_T_MELT, P_T_VAR
+from dem.laws.luding_kernels import k1_factor, normal_force, radius_at, relax_k1, tangential_force
 from dem.neighbours import min_image
 
 DONE, REBUILD, NONFINITE, ESCAPED = 0, 1, 2, 3

@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from dem import md_loop
-from dem.laws.luding import k1_factor
+from dem.laws.luding_kernels import k1_factor
 from dem.motion import MotionState
 from dem.neighbours import carry_history, verlet_pairs, wall_pairs
 from dem.walls import WallArrays

@@ -8,6 +8,9 @@ rebuild bins the particles into cubic cells of edge ``2 r_max + skin`` and compa
 own and the neighbouring cells: O(N) per rebuild. Periodic axes (``box[k] > 0``) wrap the cells and use the
 minimum image.
 
+The same binning places particles at random without overlaps (:func:`sequential_addition`, random sequential
+addition for the box generator).
+
 Per-pair history (the contact state that a contact law carries from step to step) lives in rows aligned with the
 list; :func:`carry_history` moves it to the rows of a rebuilt list, matching pairs by their key ``i * N + j``.
 """
@@ -177,3 +180,51 @@ def wall_pairs(x: np.ndarray, radius: np.ndarray, normal: np.ndarray, offset: np
     dist = x @ normal.T - offset[None, :]
     k, m = np.nonzero(dist < radius[:, None] + skin)
     return k.astype(np.int64), m.astype(np.int64)
+
+
+@njit(cache=True)
+def sequential_addition(r, lo, hi, uniform):
+    """Place particles of radii ``r`` one by one at the next candidate points ``lo + u (hi - lo)`` (``u`` rows of
+    ``uniform``, kept inside the box by each radius) that overlap no particle placed before; cell binning makes each
+    test O(1). Returns the positions and the number placed before the candidates ran out."""
+    n = r.shape[0]
+    size = 2.0 * r.max()
+    ncell = np.empty(3, dtype=np.int64)
+    for a in range(3):
+        ncell[a] = max(1, int((hi[a] - lo[a]) / size) + 1)
+    head = -np.ones(ncell[0] * ncell[1] * ncell[2], dtype=np.int64)
+    nxt = -np.ones(n, dtype=np.int64)
+    pos = np.zeros((n, 3))
+    c = np.empty(3, dtype=np.int64)
+    trial = 0
+    for k in range(n):
+        placed = False
+        while trial < uniform.shape[0]:
+            p = np.empty(3)
+            for a in range(3):
+                span = hi[a] - lo[a] - 2.0 * r[k]
+                p[a] = lo[a] + r[k] + uniform[trial, a] * span if span > 0 else lo[a]
+                c[a] = min(ncell[a] - 1, int((p[a] - lo[a]) / size))
+            trial += 1
+            free = True
+            for d0 in range(max(0, c[0] - 1), min(ncell[0], c[0] + 2)):
+                for d1 in range(max(0, c[1] - 1), min(ncell[1], c[1] + 2)):
+                    for d2 in range(max(0, c[2] - 1), min(ncell[2], c[2] + 2)):
+                        m = head[(d0 * ncell[1] + d1) * ncell[2] + d2]
+                        while m >= 0 and free:
+                            s = 0.0
+                            for a in range(3):
+                                s += (pos[m, a] - p[a]) ** 2
+                            if s < (r[m] + r[k]) ** 2:
+                                free = False
+                            m = nxt[m]
+            if free:
+                pos[k] = p
+                cell = (c[0] * ncell[1] + c[1]) * ncell[2] + c[2]
+                nxt[k] = head[cell]
+                head[cell] = k
+                placed = True
+                break
+        if not placed:
+            return pos, k
+    return pos, n

@@ -27,14 +27,14 @@ import time
 import numpy as np
 from numba import njit
 
-from dem.laws import luding as law
+from dem.laws import luding, luding_kernels as law
 
 FIRST_CALLS = """
 import time
 t = time.perf_counter()
-from dem.laws import luding as law
+from dem.laws import luding, luding_kernels as law
 imported = time.perf_counter()
-p = law.LUDING_TABLE1.params()
+p = luding.LUDING_TABLE1.params()
 law.radius_at(1e-3, 80.0, 120.0, 1e-4)
 law.relax_k1(law.k1_factor(130.0, 120.0, 10.0), 0.5, 1e-3, 1e3, False)
 law.delta_0(1e-4, 1.0, 2e-4, p), law.delta_min(1e-4, 1.0, 2e-4, p), law.f_min(1e-4, 1.0, 2e-4, p)
@@ -104,7 +104,7 @@ def contact_loop(delta, delta_dot, s, delta_max, s_last, delta_fluid, xi, normal
 
 def ns_per_contact(n: int = 10**6, repeat: int = 5) -> dict:
     data = random_contacts(n)
-    params = law.LUDING_TABLE1.params()
+    params = luding.LUDING_TABLE1.params()
     force, xi_out, dm_out = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
     args = (*data.values(), 1e-7, params, force, xi_out, dm_out)
     contact_loop(*args)  # compile or load from the cache
