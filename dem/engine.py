@@ -43,8 +43,12 @@ class Simulation:
         scale = np.array([radius_at(1.0, float(T), params[P_T_MELT], params[P_EXPANSION]) for T in T_init])
         state = MotionState.create(m.dimension, p.position, p.radius, scene.contact.density, T_init, m.velocity,
                                    m.angular_velocity, m.height, radius_ref=p.radius / scale)
+        if m.start is not None:
+            for key in ("f", "tau", "mass", "inertia", "radius", "radius_ref", "T"):
+                setattr(state, key, np.ascontiguousarray(m.start[key], dtype=float).copy())
+        self.base_params = params
         self.mechanics = MechanicalModel(state, m.walls, params, m.dt, m.skin, m.gravity, m.box,
-                                         relaxation_time=float(params[P_T0]))
+                                         relaxation_time=float(params[P_T0]), history=m.start)
         self.thermal = None
         if "thermal" in scene.physics:
             self.thermal = ContactThermalModel(p, m.walls, scene.conductance, scene.sources, m.thermal_integrator,
@@ -70,8 +74,18 @@ class Simulation:
             return np.array([T[0]]), np.zeros(1), mech.relaxation_time
         return T.copy(), np.zeros(len(T)), mech.relaxation_time
 
+    def _params_at(self, t: float) -> np.ndarray:
+        """The material at time ``t``: the scene's, with the overrides of every ``[[phases]]`` entry started."""
+        params = self.base_params.copy()
+        for start, overrides in self.scene.motion.phases:
+            if start <= t * (1 + 1e-12) + 1e-300:
+                for k, value in overrides.items():
+                    params[k] = value
+        return params
+
     def _interval_ends(self, n_end: int) -> list[int]:
-        """Step indices at which an interval ends: output times, thermal updates, schedule knots, the end."""
+        """Step indices at which an interval ends: output times, thermal updates, schedule knots, phase starts,
+        the end."""
         m, dt = self.scene.motion, self.mechanics.dt
         ends = {n_end}
         every = max(1, round(m.output_interval / dt))
@@ -81,6 +95,7 @@ class Simulation:
             ends.update(range(every, n_end, every))
         if self.schedule is not None:
             ends.update(k for k in (round(t / dt) for t in self.schedule.time) if 0 < k < n_end)
+        ends.update(k for k in (round(start / dt) for start, _ in m.phases) if 0 < k < n_end)
         return sorted(ends)
 
     def run(self, observer=None, progress=None) -> dict:
@@ -96,6 +111,7 @@ class Simulation:
             if steps <= 0:
                 continue
             T0, rate, t0 = self._interval_temperatures(mech.t)
+            mech.params = self._params_at(mech.t)
             mech.advance(steps, T0, rate, t0)
             if self.thermal is not None:
                 self.thermal.step(mech, steps * mech.dt)

@@ -40,7 +40,9 @@ class MechanicalModel:
     name = "mechanical"
 
     def __init__(self, state: MotionState, walls, params: np.ndarray, dt: float, skin: float,
-                 gravity=(0.0, 0.0, 0.0), box=(0.0, 0.0, 0.0), relaxation_time: float = 1e3):
+                 gravity=(0.0, 0.0, 0.0), box=(0.0, 0.0, 0.0), relaxation_time: float = 1e3, history=None):
+        """``history``: a saved state (:func:`dem.state_file.load`) whose stiffness factors and contact histories
+        (pairs, and particle-wall pairs matched by wall name) the model starts from."""
         self.state = state
         self.walls = tuple(walls)
         self.params = np.ascontiguousarray(params, dtype=float)
@@ -62,7 +64,28 @@ class MechanicalModel:
         self.rebuilds = 0
         self._info = np.zeros(2, dtype=np.int64)
         self._build_list(first=True)
-        self._initial_forces()
+        if history is not None:
+            self._restore(history)  # with the forces of its last step: the run goes on as if it had not stopped
+        else:
+            self._initial_forces()
+
+    def _restore(self, saved: dict):
+        """Stiffness factors and contact histories from a saved state (the list is rebuilt here, so the pairs'
+        histories are carried by key; walls by name)."""
+        self.k1f = np.array(saved["k1f"], dtype=float)
+        self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft = carry_history(
+            saved["pi"], saved["pj"], self.pi, self.pj, self.state.n, saved["p_dmax"], saved["p_k1last"],
+            saved["p_xi"], np.zeros(len(saved["pi"])), np.zeros((len(saved["pi"]), 3)))
+        names = [w.name for w in self.walls]
+        for m_old, name in enumerate(saved["wall_names"]):
+            if name in names:
+                m = names.index(name)
+                self.w_dmax[:, m] = saved["w_dmax"][:, m_old]
+                self.w_k1last[:, m] = saved["w_k1last"][:, m_old]
+                self.w_xi[:, m] = saved["w_xi"][:, m_old]
+                if self.walls[m].motion == "stress":
+                    self.w.dq[m] = saved["wall_dq"][m_old]
+                    self.w.acc[m] = saved["wall_acc"][m_old]
 
     # ------------------------------------------------------------------------------------------------ list
     def _build_list(self, first: bool = False):

@@ -10,6 +10,9 @@ Tables and keys (SI units; the README's scene schema lists them with their defau
   ``damping``, ``velocity``, ``amplitude``, ``frequency`` (:mod:`dem.walls`); ``temperature`` optional;
 * ``[gravity] acceleration`` (m/s^2, a 3-vector);
 * ``[temperature]`` -- a prescribed schedule ``time``, ``value``, ``relaxation_time`` (:mod:`dem.schedule`);
+* ``[[phases]]`` -- from time ``start`` on, other friction or damping (``mu``, ``mu_wall``, ``gamma_n``,
+  ``gamma_t``): Luding 2005 prepares frictionless and switches the friction at t_heat;
+* ``[start] state`` -- begin from a saved state (:mod:`dem.state_file`) instead of ``[particles]``;
 * ``[solver]`` -- ``t_end``; ``dt`` (s, or "auto": t_MD = pi/(50 omega), Luding 2005 eq. 6); ``skin`` (m);
   ``thermal_interval`` (s) and ``integrator`` (implicit | crank-nicolson) of a coupled thermal network;
 * ``[output]`` -- ``interval`` (s between rows of ``timeseries.csv``), ``vtu_interval`` (s between snapshots).
@@ -18,7 +21,7 @@ Tables and keys (SI units; the README's scene schema lists them with their defau
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -38,7 +41,10 @@ MOVING_KEYS = {
     "solver": {"skin", "thermal_interval"},
     "output": {"interval", "vtu_interval"},
 }
-MOVING_TABLES = {"gravity": {"acceleration"}, "temperature": {"time", "value", "relaxation_time"}}
+MOVING_TABLES = {"gravity": {"acceleration"}, "temperature": {"time", "value", "relaxation_time"},
+                 "start": {"state"}, "phases": {"start", *("mu", "mu_wall", "gamma_n", "gamma_t")}}
+PHASE_KEYS = {"mu": luding.P_MU, "mu_wall": luding.P_MU_WALL, "gamma_n": luding.P_GAMMA_N,
+              "gamma_t": luding.P_GAMMA_T}
 @dataclass(frozen=True)
 class MotionSpec:
     dimension: int
@@ -56,6 +62,8 @@ class MotionSpec:
     output_interval: float
     vtu_interval: float
     box: tuple = (0.0, 0.0, 0.0)
+    phases: tuple = ()        # (start time, {parameter index: value}), sorted by start
+    start: dict | None = None  # a saved state (dem.state_file.load) the run begins from
 
 
 def _num(table, section, key, default=None, positive=False, nonnegative=False):
@@ -93,9 +101,9 @@ def time_steps(contact, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarra
     return min(t_md, stable), stable
 
 
-def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None) -> MotionSpec:
+def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, start=None) -> MotionSpec:
     """The moving part of a scene (module docstring); ``particles``, ``solver`` and the ``contact`` material are
-    already parsed; ``velocity`` comes from a generator (its random ``speed``)."""
+    already parsed; ``velocity`` comes from a generator (its random ``speed``); ``start`` is a saved state."""
     meta = doc.get("scene", {})
     dimension = meta.get("dimension", 3)
     if dimension not in (2, 3) or isinstance(dimension, bool):
@@ -127,6 +135,13 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None) 
         raise ValueError(f"[contact] density = {contact.density:g}: differs from [material] density "
                          f"{', '.join(f'{d:g}' for d in sorted(densities))} kg/m^3; give it once, in [material]")
     walls = tuple(_moving_wall(k, w) for k, w in enumerate(doc.get("walls", [])))
+    if start is not None:
+        if start["dimension"] != dimension or (dimension == 2 and start["height"] != height):
+            raise ValueError(f"[start] state: saved for dimension {start['dimension']} (height {start['height']}), "
+                             f"the scene has dimension {dimension} (height {height})")
+        saved = dict(zip(start["wall_names"], start["wall_q"]))
+        walls = tuple(replace(w, point=w.normal * saved[w.name]) if w.name in saved else w for w in walls)
+        velocity, angular = start["v"], start["w"]
     gravity = (0.0, 0.0, 0.0)
     if "gravity" in doc:
         g = finite_array("[gravity] acceleration", doc["gravity"].get("acceleration", [0.0, 0.0, 0.0]), ())
@@ -165,8 +180,23 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None) 
     vtu_interval = _num(out, "output", "vtu_interval", 0.0, nonnegative=True)
     thermal_interval = _num(solver_table, "solver", "thermal_interval",
                             min(output_interval, DEFAULT_THERMAL_STEPS * dt), positive=True)
+    phases = tuple(sorted((_phase(k, t) for k, t in enumerate(doc.get("phases", []))), key=lambda p: p[0]))
     return MotionSpec(dimension, height, velocity, angular, walls, gravity, schedule, dt, stable, skin,
-                      thermal_interval, solver.integrator, output_interval, vtu_interval)
+                      thermal_interval, solver.integrator, output_interval, vtu_interval, phases=phases, start=start)
+
+
+def _phase(k: int, table: dict) -> tuple:
+    if not isinstance(table, dict):
+        raise ValueError("[[phases]]: must be an array of tables")
+    unknown = sorted(set(table) - MOVING_TABLES["phases"])
+    if unknown:
+        raise ValueError(f"[phases][{k}] {unknown[0]}: unknown key (allowed: "
+                         f"{', '.join(sorted(MOVING_TABLES['phases']))})")
+    start = _num(table, f"phases][{k}", "start", nonnegative=True)
+    if start is None:
+        raise ValueError(f"[phases][{k}] start: required (s)")
+    return start, {PHASE_KEYS[key]: _num(table, f"phases][{k}", key, nonnegative=True) for key in table
+                   if key != "start"}
 
 
 def _moving_wall(k: int, table: dict) -> MovingWall:

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from dem import generators
+from dem import generators, state_file
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.luding import LudingMaterial
 from dem.particles import COPPER, Material, Particles
@@ -373,9 +373,21 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     meta = doc.get("scene", {})
     _check_keys(meta, "scene", ALLOWED["scene"])
     materials = _materials(doc, thermal="thermal" in physics)
-    if ("particles" in doc) == ("generator" in doc):
+    start = None
+    if "start" in full:
+        if "particles" in doc or "generator" in doc:
+            raise ValueError("[start] state: the particles come from the saved state; remove [particles] or "
+                             "[generator]")
+        name = full["start"].get("state") if isinstance(full["start"], dict) else None
+        if not isinstance(name, str):
+            raise ValueError("[start] state: required, the path of a saved state (.npz)")
+        start = state_file.load(base_dir / name if base_dir is not None else name)
+        particles = Particles.from_arrays(start["x"], start["radius"], start["T"], materials,
+                                          prefix="[start] state")
+        walls, specimen, velocity = (), None, None
+    elif ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
-    if "particles" in doc:
+    elif "particles" in doc:
         particles, walls, specimen, velocity = _explicit_particles(doc["particles"], materials)
     else:
         dimension = full.get("scene", {}).get("dimension", 3) if moving else 3
@@ -399,7 +411,7 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     if velocity is not None and not moving:
         raise ValueError("[generator] speed: only for moving particles ([scene] physics with \"mechanical\")")
     contact = luding_material_from_scene(doc) if "contact" in doc else None
-    motion = parse_motion(full, particles, solver, physics, contact, velocity) if moving else None
+    motion = parse_motion(full, particles, solver, physics, contact, velocity, start) if moving else None
     return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
                  str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact, motion)
 

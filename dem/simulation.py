@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import pathlib
 import sys
 import time
 from dataclasses import dataclass
@@ -117,6 +118,10 @@ def run_moving(scene: Scene, out=None, progress: bool = False) -> RunResult:
         if bar is not None:
             bar.close()
     summary = {"scene": scene.name, "mode": "transient", "physics": list(scene.physics), "static": False, **details}
+    if out is not None:
+        from dem import state_file
+
+        summary["state"] = state_file.save(sim, pathlib.Path(out) / "state.npz").name
     if scene.particles.n <= T_LIST_MAX:
         summary["T"] = sim.mechanics.state.T.tolist()
     summary = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in summary.items()}

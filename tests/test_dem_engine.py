@@ -247,3 +247,57 @@ interval = 1e-6
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert "left the box" in summary["stopped"] and summary["steps"] > 0
     assert len((tmp_path / "out" / "timeseries.csv").read_text().splitlines()) > 2
+
+
+def test_a_saved_state_goes_on_as_if_the_run_had_not_stopped(tmp_path):
+    """Run 2 ms; run 1 ms, save, start a second scene from the state for 1 ms: bit-identical (pairs, walls,
+    histories, stress wall and forces of the last step all carried)."""
+    from dem import state_file
+
+    rng = np.random.default_rng(5)
+    x = np.array([[1.0e-3, 0, 1.0e-3], [3.0e-3, 0, 1.0e-3], [2.0e-3, 0, (1 + math.sqrt(3)) * 1e-3]])
+    walls = [{"name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]},
+             {"name": "left", "point": [0, 0, 0], "normal": [1, 0, 0]},
+             {"name": "right", "point": [4.2e-3, 0, 0], "normal": [-1, 0, 0], "motion": "stress",
+              "pressure": 20.0, "mass": 1e-3, "damping": 0.5},
+             {"name": "top", "point": [0, 0, 5e-3], "normal": [0, 0, -1]}]
+
+    def doc(t_end):
+        d = scene_doc(x, [1e-3] * 3, rng.normal(0, 0.01, x.shape), TABLE1, t_end=t_end, temperature=115.0,
+                      walls=walls, gravity={"acceleration": [0.0, 0.0, -9.81]})
+        d["scene"].update(dimension=2, height=6e-3)
+        d["particles"]["velocity"] = [[0.001, 0, -0.002], [-0.001, 0, 0.0], [0.0, 0, 0.001]]
+        d["solver"]["dt"] = 2e-7
+        return d
+
+    whole = Simulation(parse_scene(doc(2e-3)))
+    whole.run()
+    first = Simulation(parse_scene(doc(1e-3)))
+    first.run()
+    state_file.save(first, tmp_path / "half.npz")
+    second_doc = doc(1e-3)
+    del second_doc["particles"]
+    second_doc["start"] = {"state": str(tmp_path / "half.npz")}
+    second = Simulation(parse_scene(second_doc))
+    second.run()
+    a, b = whole.mechanics, second.mechanics
+    assert a.steps == first.mechanics.steps + b.steps
+    assert np.array_equal(a.state.x, b.state.x) and np.array_equal(a.state.v, b.state.v)
+    assert np.array_equal(a.w.q, b.w.q) and len(a.contacts()[0]) > 0
+
+
+def test_phases_switch_the_friction_on():
+    """A sphere on a tilted floor slides while mu_wall = 0 and rolls once a phase switches friction on."""
+    g, theta, r = 9.81, math.radians(15.0), 1e-3
+    contact = {**ELASTIC, "gamma_n": 0.05, "gamma_t": 0.1, "mu_wall": 0.0}
+    sag = 2000.0 * 4 / 3 * math.pi * r**3 * g * math.cos(theta) / ELASTIC["k2"]
+    doc = scene_doc([[0, 0, r - sag]], [r], contact=contact, t_end=0.02,
+                    walls=[{"name": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]}],
+                    gravity={"acceleration": [g * math.sin(theta), 0.0, -g * math.cos(theta)]})
+    doc["phases"] = [{"start": 0.01, "mu_wall": 0.8}]
+    sim = Simulation(parse_scene(doc))
+    sim.mechanics.advance(round(0.01 / sim.mechanics.dt), np.array([20.0]), np.zeros(1))
+    assert abs(sim.mechanics.state.w[0, 1]) < 1e-9  # frictionless: no spin
+    sim.run()
+    s = sim.mechanics.state
+    assert s.w[0, 1] > 0 and abs(s.w[0, 1] * r / s.v[0, 0]) > 0.5
