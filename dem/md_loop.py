@@ -38,25 +38,15 @@ DONE, REBUILD, NONFINITE, ESCAPED = 0, 1, 2, 3
 STATUS = {DONE: "done", REBUILD: "rebuild", NONFINITE: "non-finite", ESCAPED: "escaped"}
 
 
-@njit(cache=True)
-def _contact(n0, n1, n2, vr0, vr1, vr2, delta, k1f, dmax, k1last, xi0, xi1, xi2, delta_fluid, is_wall, params, dt):
-    """One contact: ``(f_n, f_t0, f_t1, f_t2, delta_max, xi0, xi1, xi2)`` -- the normal and tangential force on
-    particle i and the contact's new history. Scalars in, scalars out: array arguments in the hot loop would cost
-    reference counting on every call (measured: 4x slower)."""
-    vn = vr0 * n0 + vr1 * n1 + vr2 * n2
-    f_n, dmax_new, f_min, k2_now, kc_now, d0 = normal_force(delta, -vn, k1f, dmax, k1last, delta_fluid, params)
-    ft, xi, sliding, f_n = tangential_force((xi0, xi1, xi2), (n0, n1, n2), (vr0 - vn * n0, vr1 - vn * n1,
-                                                                               vr2 - vn * n2),
-                                            f_n, f_min, k2_now, k1f, dt, params, is_wall)
-    return f_n, ft[0], ft[1], ft[2], dmax_new, xi[0], xi[1], xi[2]
-
-
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn, p_ft,
             wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt):
     """Forces and torques of the current state (gravity, pairs, the listed particle-wall pairs ``(wk, wm)``); the
     normal forces on the walls go into ``wforce``. Returns the index into the wall list of the first particle whose
-    centre lies behind its wall, else -1."""
+    centre lies behind its wall, else -1.
+
+    The contact kernels are called right here, scalars and 3-tuples in and out: wrapped in a helper returning its
+    eight results they cost 30 % more, and with array arguments (reference counting on every call) 4x more."""
     escaped = -1
     n = x.shape[0]
     phi = params[P_FLUID_OVERLAP]
@@ -93,12 +83,16 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
         vr1 = v[i, 1] - v[j, 1] + n2 * c0 - n0 * c2
         vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
         k1c = 0.5 * (k1f[i] + k1f[j])
-        f_n, ft0, ft1, ft2, dmax, x0, x1, x2 = _contact(
-            n0, n1, n2, vr0, vr1, vr2, delta, k1c, p_dmax[c], p_k1last[c], p_xi[c, 0], p_xi[c, 1], p_xi[c, 2],
-            phi * 2.0 * ri * rj / (ri + rj), False, params, dt)
+        vn = vr0 * n0 + vr1 * n1 + vr2 * n2
+        f_n, dmax, f_min, k2_now, kc_now, d0 = normal_force(delta, -vn, k1c, p_dmax[c], p_k1last[c],
+                                                            phi * 2.0 * ri * rj / (ri + rj), params)
+        ft, xi, sliding, f_n = tangential_force((p_xi[c, 0], p_xi[c, 1], p_xi[c, 2]), (n0, n1, n2),
+                                                (vr0 - vn * n0, vr1 - vn * n1, vr2 - vn * n2), f_n, f_min, k2_now,
+                                                k1c, dt, params, False)
+        ft0, ft1, ft2 = ft
         p_dmax[c] = dmax
         p_k1last[c] = k1c
-        p_xi[c, 0], p_xi[c, 1], p_xi[c, 2] = x0, x1, x2
+        p_xi[c, 0], p_xi[c, 1], p_xi[c, 2] = xi
         p_fn[c] = f_n
         p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
         g0, g1, g2 = f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2
@@ -138,12 +132,16 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
         vr0 = v[k, 0] - wdq[m] * n0 + lk * (n1 * w[k, 2] - n2 * w[k, 1])
         vr1 = v[k, 1] - wdq[m] * n1 + lk * (n2 * w[k, 0] - n0 * w[k, 2])
         vr2 = v[k, 2] - wdq[m] * n2 + lk * (n0 * w[k, 1] - n1 * w[k, 0])
-        f_n, ft0, ft1, ft2, dmax, x0, x1, x2 = _contact(
-            n0, n1, n2, vr0, vr1, vr2, delta, k1f[k], w_dmax[k, m], w_k1last[k, m], w_xi[k, m, 0],
-            w_xi[k, m, 1], w_xi[k, m, 2], phi * rk, True, params, dt)
+        vn = vr0 * n0 + vr1 * n1 + vr2 * n2
+        f_n, dmax, f_min, k2_now, kc_now, d0 = normal_force(delta, -vn, k1f[k], w_dmax[k, m], w_k1last[k, m],
+                                                            phi * rk, params)
+        ft, xi, sliding, f_n = tangential_force((w_xi[k, m, 0], w_xi[k, m, 1], w_xi[k, m, 2]), (n0, n1, n2),
+                                                (vr0 - vn * n0, vr1 - vn * n1, vr2 - vn * n2), f_n, f_min, k2_now,
+                                                k1f[k], dt, params, True)
+        ft0, ft1, ft2 = ft
         w_dmax[k, m] = dmax
         w_k1last[k, m] = k1f[k]
-        w_xi[k, m, 0], w_xi[k, m, 1], w_xi[k, m, 2] = x0, x1, x2
+        w_xi[k, m, 0], w_xi[k, m, 1], w_xi[k, m, 2] = xi
         w_fn[k, m] = f_n
         w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = ft0, ft1, ft2
         f[k, 0] += f_n * n0 + ft0
@@ -156,7 +154,7 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
     return escaped
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _wall_acceleration(m, wq, wdq, wmode, wpress, wmass, wdamp, wspan, wforce):
     """Eq. (1) of Luding 2005 for stress wall ``m``: ``(p L - F_w - gamma_w dq/dt) / m_w``."""
     if wmode[m] != 1:
@@ -169,7 +167,7 @@ def _wall_acceleration(m, wq, wdq, wmode, wpress, wmass, wdamp, wspan, wforce):
     return (wpress[m] * extent - wforce[m] - wdamp[m] * wdq[m]) / wmass[m]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _material_state(t, t_start, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt):
     """Temperatures at ``t``, radii (eq. 9) and stiffness factors relaxed over one step (eqs. 10-12)."""
     T_melt, T_var, expansion = params[P_T_MELT], params[P_T_VAR], params[P_EXPANSION]
@@ -190,7 +188,7 @@ def _material_state(t, t_start, T0, T_rate, T, radius, radius_ref, k1f, uniform,
             k1f[k] = relax_k1(k1f[k], k1_factor(T[k], T_melt, T_var), dt, t0, T_rate[k] < 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def advance(n_steps, dt, t_start, x, v, w, f, tau, mass, inertia, lin, rot, radius, radius_ref, T0, T_rate, T, k1f,
             uniform_T, t0, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn, p_ft,
             wn, wq, wdq, wacc, wmode, wpress, wmass, wdamp, wq0, wamp, wfreq, wspan, wforce, wk, wm, wq_ref,

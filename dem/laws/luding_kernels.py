@@ -167,37 +167,51 @@ def normal_force(delta, delta_dot, k1_factor_now, delta_max, k1_factor_last, del
       ``delta (1 + kc/k2)`` (kc/k2 = k1(T, t) kc/(k1 k2) by eq. 13, whatever delta_max), delta_max to the matching
       root, so that reloading departs into the cone on that new k2 line.
     """
+    # Written with two divisions per call (this runs for every contact at every step): with c = k2 delta_fluid,
+    # k2(x) = k1 + (k2 - k1)^2 x / c below the fluid limit (k2 - k1) x < c, 1/k2 = delta_fluid / c, and the
+    # comparisons of force-free overlaps with delta_fluid multiplied out by k2(x) > 0.
     k1 = params[P_K1]
     k2 = params[P_K2]
     kc = params[P_KC]
     s = k1_factor_now
     dm = delta_max
+    dk = k2 - k1
+    inv_c = 1.0 / (k2 * delta_fluid)
+    kc_over_k2 = kc * delta_fluid * inv_c
     if delta > 0.0:
         if s > k1_factor_last:  # cooling: delta_0 kept
             d0_last = min(_plastic_overlap(dm, k1_factor_last, delta_fluid, params), delta_fluid)
             dm = max(dm, delta_max_for_delta_0(d0_last, s, delta_fluid, params))
-        if delta > dm and _plastic_overlap(dm, s, delta_fluid, params) < delta_fluid:  # loading
-            if _plastic_overlap(delta, s, delta_fluid, params) <= delta_fluid:
-                dm = delta
-            else:  # the fluid limit is reached within this step
-                dm = delta_max_for_delta_0(delta_fluid, s, delta_fluid, params)
-        k2m = k2_of_delta_max(dm, delta_fluid, params)
-        d0 = min((1.0 - s * k1 / k2m) * dm, delta_fluid)
-        kcm = s * k2m / k2 * kc
+        if delta > dm:
+            k2m = k2 if dk * dm >= k2 * delta_fluid else k1 + dk * dk * dm * inv_c
+            if (k2m - s * k1) * dm < delta_fluid * k2m:  # loading: not yet on the fluid branch
+                k2d = k2 if dk * delta >= k2 * delta_fluid else k1 + dk * dk * delta * inv_c
+                if (k2d - s * k1) * delta <= delta_fluid * k2d:
+                    dm = delta
+                else:  # the fluid limit is reached within this step
+                    dm = delta_max_for_delta_0(delta_fluid, s, delta_fluid, params)
+        k2m = k2 if dk * dm >= k2 * delta_fluid else k1 + dk * dk * dm * inv_c
+        q = 1.0 + s * kc_over_k2  # kc/k2(delta_max) = s kc/k2 by eq. 13
+        inv_kq = 1.0 / (k2m * q)
+        d0 = min((k2m - s * k1) * dm * q * inv_kq, delta_fluid)
+        kcm = s * k2m * kc_over_k2
         f = k2m * (delta - d0)
         if f < -kcm * delta:  # tension branch: a new k2 line through (delta, -kc delta)
-            d0 = delta * (1.0 + s * kc / k2)
+            d0 = delta * q
             dm = delta_max_for_delta_0(d0, s, delta_fluid, params)
             k2m = k2_of_delta_max(dm, delta_fluid, params)
-            kcm = s * k2m / k2 * kc
+            kcm = s * k2m * kc_over_k2
+            inv_kq = 1.0 / (k2m * q)
             f = -kcm * delta
         f += params[P_GAMMA_N] * delta_dot
     else:
         f = 0.0
-        k2m = k2_of_delta_max(dm, delta_fluid, params)
-        d0 = min((1.0 - s * k1 / k2m) * dm, delta_fluid)
-        kcm = s * k2m / k2 * kc
-    attraction = kcm * k2m * d0 / (k2m + kcm)
+        k2m = k2 if dk * dm >= k2 * delta_fluid else k1 + dk * dk * dm * inv_c
+        q = 1.0 + s * kc_over_k2
+        inv_kq = 1.0 / (k2m * q)
+        d0 = min((k2m - s * k1) * dm * q * inv_kq, delta_fluid)
+        kcm = s * k2m * kc_over_k2
+    attraction = kcm * k2m * d0 * inv_kq  # kc k2 d0 / (k2 + kc), the largest attraction (eq. 15)
     return f, dm, -attraction if attraction > 0.0 else 0.0, k2m, kcm, d0
 
 
@@ -259,7 +273,8 @@ def tangential_force(xi, n, vt, f_n, f_min_now, k2_now, k1_factor_now, dt, param
     f1 *= scale
     f2 *= scale
     if kt > 0.0:
-        xi_new = (-(f0 + gt * vt[0]) / kt, -(f1 + gt * vt[1]) / kt, -(f2 + gt * vt[2]) / kt)
+        inv_kt = 1.0 / kt
+        xi_new = (-(f0 + gt * vt[0]) * inv_kt, -(f1 + gt * vt[1]) * inv_kt, -(f2 + gt * vt[2]) * inv_kt)
     else:
         xi_new = (0.0, 0.0, 0.0)
     if params[P_BRITTLE_SLIDING] != 0.0 and f_n < 0.0:
