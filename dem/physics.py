@@ -101,7 +101,7 @@ class ThermalModel:
             out.update(t=res.t, steps=res.steps, energy_error=res.energy_error, heat_in=res.heat_in,
                        integrator=s.integrator, dt=s.dt, dt_min=res.dt_min, dt_max=res.dt_max,
                        rejected_steps=res.rejected, stable_limit=res.stable_limit, linear_solver=res.solver,
-                       factorizations=res.factorizations)
+                       factorizations=res.factorizations, max_principle_violation=res.max_principle_violation)
         return out
 
     def _boundary(self, T: np.ndarray) -> dict:

@@ -112,6 +112,7 @@ class Network:
         self.heat = p.heat[self.free]
         self.C = p.capacity[self.free]
         self.radius = p.radius[self.free]
+        self.sources = self.sources.resolved(p.position, p.radius, self.free)  # "exposed" areas from the packing
         self._slots = None  # where each Laplacian entry sits in L, L_FF, L_FD: built by the first refresh()
         self._boundary_terms()
 
@@ -345,6 +346,7 @@ class TransientResult:
     dt_max: float
     solver: str
     factorizations: int
+    max_principle_violation: float | None = None
 
 
 class _Stepper:
@@ -536,6 +538,12 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     grid = 2**AUTO_LEVELS
     units = 0  # dyadic: the time t = t_end * units / grid
     energy0 = float(net.C @ T)
+    # maximum principle: without internal sources the temperatures stay within the prescribed ones (initial, fixed,
+    # walls, ambient); backward Euler keeps them there exactly (an M-matrix), Crank-Nicolson and explicit steps only
+    # for small enough steps. The largest excursion (in the scene's temperature unit) is reported.
+    lo, hi = net.temperature_bounds()
+    bounded = not np.any(net.heat)
+    violation = 0.0
     heat_in = {k: 0.0 for k in ("fixed", "walls", "internal", *net.sources.names)}
     abs_in = 0.0
     t, steps, rejected = 0.0, 0, 0
@@ -589,6 +597,8 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
         dt_min, dt_max = min(dt_min, h), max(dt_max, h)
         if not np.all(np.isfinite(T)):
             raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {steps})")
+        if bounded and len(T):
+            violation = max(violation, float(T.max()) - hi, lo - float(T.min()))
         if observer is not None:
             observer(steps, t, T, flows)
         if progress is not None:
@@ -614,4 +624,4 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     err = abs(energy - energy0 - sum(heat_in.values())) / scale_e if scale_e > 0 else 0.0
     heat_in = {k: float(v) for k, v in heat_in.items()}
     return TransientResult(net.full(T), t, steps, rejected, err, heat_in, limit, dt_min, dt_max, stepper.backend,
-                           stepper.factorizations)
+                           stepper.factorizations, violation if bounded else None)
