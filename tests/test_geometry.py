@@ -8,6 +8,7 @@ from scipy.optimize import brentq
 
 from fem_neck import coble_radius, max_overlap, neck_geometry, neck_radius, overlap_for_neck
 from fem_neck.geometry import equal_neck_radius
+from verification.cases import SEC6, SEC43, SEMISPHERE
 
 MM = 1e-3
 
@@ -16,10 +17,10 @@ MM = 1e-3
 @pytest.mark.parametrize(
     "h, method, expected",
     [
-        (0.2 * MM, "newton", 0.741466 * MM),
-        (0.2 * MM, "coble", 0.774597 * MM),
-        (0.2 * MM, "first", 0.745039 * MM),
-        (0.06 * MM, "newton", 0.419186 * MM),
+        (0.2 * MM, "newton", SEC43["newton"].value),
+        (0.2 * MM, "coble", SEC43["coble"].value),
+        (0.2 * MM, "first", SEC43["first"].value),
+        (0.06 * MM, "newton", SEC6["a"].value),
     ],
 )
 def test_paper_section_4_3(h, method, expected):
@@ -27,8 +28,8 @@ def test_paper_section_4_3(h, method, expected):
 
 
 @pytest.mark.parametrize(
-    "h_over_r, a_over_r",  # shared/reference/README.md, semisphere table (from eqs 19-20 to 12 digits)
-    [(0.02, 0.199331088562), (0.08, 0.394592534534), (0.2, 0.610588366343), (0.4, 0.829667696190)],
+    "h_over_r, a_over_r",  # verification.cases.SEMISPHERE (from eqs 19-20 to 12 digits)
+    [(row.h_over_r, row.a_over_r) for row in SEMISPHERE],
 )
 def test_equal_spheres_reference_table(h_over_r, a_over_r):
     assert neck_radius(1.0, 1.0, h_over_r) == pytest.approx(a_over_r, rel=1e-11)

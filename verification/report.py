@@ -98,7 +98,7 @@ class Report:
     def summary(self) -> dict:
         """All comparisons of the sections that ran, under the sections' own keys.
 
-        Sections name their keys (e.g. ``paper.sec6.K_fe``; the bench's keys are fixed by its issue); a key that an
+        Sections name their keys (e.g. ``paper.sec6.K_fe``; the benchmarks' keys are documented in the README); a key that an
         earlier section already used is prefixed with ``"<section>:"`` rather than overwritten.
         """
         out = {}
