@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import pathlib
 import subprocess
 import sys
@@ -370,7 +369,7 @@ def study_startup(section, quick: bool, setting: dict | None) -> None:
         def ours():
             out = pathlib.Path(tmp) / f"fit{next(runs)}"  # a fresh folder every time (no resume)
             subprocess.run([sys.executable, "-m", "fem_neck", "fit", "--out", str(out)], check=True,
-                           capture_output=True, env=dict(os.environ, TQDM_DISABLE="1"))
+                           capture_output=True)
             return json.loads((out / "fit.json").read_text())
 
         def theirs():
