@@ -20,8 +20,7 @@ import sys
 from benchmarks import SUBJECTS
 from benchmarks.timing import available, package_version
 from fem_neck.cli import OneLineParser
-from verification.__main__ import add_run_options, prepare_out, print_report
-from verification.report import OK, Report
+from verification.report import OK, Report, add_run_options, prepare_out, print_report
 
 PROG = "python -m benchmarks"
 DEFAULT_OUT = "benchmark-results"

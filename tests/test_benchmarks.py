@@ -54,6 +54,8 @@ def fake_subject(monkeypatch):
         from matplotlib.figure import Figure
 
         seen["quick"] = quick
+        if "seconds" not in seen:
+            raise RuntimeError("the timed call failed")
         fig = Figure(figsize=(2, 2))
         fig.subplots().plot([0, 1], [0, 1])
         figure = section.figure(fig, "line")
@@ -95,9 +97,10 @@ def test_a_missed_target_fails_the_command(fake_subject, tmp_path, capsys):
 
 
 def test_a_subject_that_raises_is_an_error(fake_subject, tmp_path, capsys):
-    code = cli.main(["fake", "--no-progress", "--out", str(tmp_path)])  # no "seconds": KeyError inside run
+    code = cli.main(["fake", "--no-progress", "--out", str(tmp_path)])  # no "seconds": run raises
     assert code == 1
-    assert "error" in capsys.readouterr().out
+    out, err = capsys.readouterr()
+    assert "error" in out and "RuntimeError: the timed call failed" in err
     assert "Traceback" in (tmp_path / "fake" / "error.txt").read_text()
 
 
@@ -110,3 +113,14 @@ def test_neck_quick_writes_a_report_that_opens(tmp_path):
     for key in ("neck_newton_over_plain", "neck_newton_seconds", "neck_plain_newton_seconds", "neck_bonds"):
         assert key in summary
     assert_report_links_resolve(out)
+
+
+def test_ngsolve_startup_setting_reaches_1e_minus_4_at_the_reference_cases():
+    pytest.importorskip("ngsolve")
+    from benchmarks.fe import FE_CASES, NGSOLVE_STARTUP, ngsolve_semisphere
+    from verification.cases import SEMISPHERE_BY_H
+
+    for h_over_r in FE_CASES:
+        row = SEMISPHERE_BY_H[h_over_r]
+        k, _ = ngsolve_semisphere(row.a_over_r, **NGSOLVE_STARTUP)
+        assert abs(k / row.K_over_Kcyl - 1) < 1e-4, h_over_r

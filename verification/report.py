@@ -16,6 +16,9 @@ time limit) is missed; ``error`` when it raised (its one-line message in the sta
 ``<section>/error.txt``); ``not available`` when its module is absent. Commands exit with 1 when any section is
 ``fail`` or ``error``.
 
+:func:`add_run_options`, :func:`prepare_out` and :func:`print_report` are the options, output folder and printout
+the two commands share.
+
 Two ways to fill a section: the verification sections are modules with ``run(out_dir, quick) -> dict`` returning
 ``title``, ``markdown``, ``summary`` and ``figures`` (:func:`run_sections`); the benchmark subjects write into the
 section as they go (``section.csv``, ``section.figure``, ``section.add_text``, ``section.summary``,
@@ -42,6 +45,8 @@ import traceback
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from fem_neck.cli import print_result
 
 CONTRACT_KEYS = ("title", "markdown", "summary", "figures")
 OK, FAIL, ERROR, NOT_AVAILABLE, RUNNING = "ok", "fail", "error", "not available", "running"
@@ -389,3 +394,40 @@ def records_table(rows: list[dict], columns: list[str] | None = None, fmt: str =
         return "(no rows)"
     columns = columns or list(dict.fromkeys(k for row in rows for k in row))
     return md_table(columns, [[row.get(c) for c in columns] for row in rows], fmt)
+
+
+# --- the commands that write reports (python -m verification, python -m benchmarks) ---------------------------------
+def add_run_options(parser, default_out: str, quick_help: str) -> None:
+    """The options of a report command: ``--quick``, ``--out DIR``, ``--json`` and ``--no-progress``."""
+    parser.add_argument("--quick", action="store_true", help=quick_help)
+    parser.add_argument("--out", metavar="DIR", default=default_out, help=f"output folder (default: {default_out})")
+    parser.add_argument("--json", action="store_true", help="print summary.json as one JSON object on stdout")
+    parser.add_argument("--no-progress", action="store_true",
+                        help="no progress bars on stderr (none of the sections' either)")
+
+
+def prepare_out(prog: str, out_text: str) -> pathlib.Path | None:
+    """The output folder, created; ``None`` after one line on stderr when it cannot be (the caller exits 2)."""
+    out = pathlib.Path(out_text)
+    if not out_text.strip():
+        sys.stderr.write(f"{prog}: error: --out {out_text!r}: must name a directory\n")
+        return None
+    if out.exists() and not out.is_dir():
+        sys.stderr.write(f"{prog}: error: --out {out_text}: exists and is not a directory\n")
+        return None
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # e.g. a parent is a file, or no permission
+        sys.stderr.write(f"{prog}: error: --out {out_text}: cannot be created ({exc.strerror})\n")
+        return None
+    return out
+
+
+def print_report(report, as_json: bool) -> None:
+    """``--json``: the summary as one object; otherwise one line per section and the report's path."""
+    if as_json:
+        print_result(report.summary(), as_json=True)
+        return
+    for s in report.sections:
+        print(f"{s.name:<10} {s.status:<14} {s.seconds:7.1f} s  {s.title if not s.error else s.error}")
+    print(f"report: {report.out_dir / 'report.md'}")
