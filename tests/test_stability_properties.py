@@ -24,6 +24,7 @@ from dem.particles import Particles
 from dem.thermal import Network, build_network, integrate, stable_limit, steady
 
 SPACING = 1e-4  # m
+pytestmark = pytest.mark.stress
 
 
 def make_network(seed: int, shape, vacancy: float, n_fixed: int, law: str = "rojek", order=None) -> Network:
