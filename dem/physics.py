@@ -14,9 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dem.bonds import find_bonds
-from dem.laws.conductance import bond_conductances
-from dem.thermal import Network, boundary_heat_flow, integrate, steady
+from dem.thermal import boundary_heat_flow, build_network, integrate, steady
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
@@ -36,12 +34,8 @@ class ThermalModel:
         self.scene = scene
         if scene.solver.mode == "transient":
             self._check_work()  # before the bond search: a refused run costs nothing
-        p = scene.particles
-        spec = scene.conductance
-        self.bonds = find_bonds(p, scene.walls, spec.contact, spec.out_of_range)
-        self.K_pairs, self.K_walls = bond_conductances(spec, p, self.bonds)
-        wall_T = np.array([w.temperature for w in scene.walls], dtype=float)
-        self.network = Network(p, self.bonds, self.K_pairs, self.K_walls, wall_T, scene.sources)
+        self.network = build_network(scene.particles, scene.walls, scene.conductance, scene.sources)
+        self.bonds, self.K_pairs, self.K_walls = self.network.bonds, self.network.K_pairs, self.network.K_walls
 
     def run(self, observer=None, progress=None) -> dict:
         try:

@@ -23,25 +23,10 @@ matrix; it is SPD when every connected group of free particles reaches a fixed p
   grid of [0, t_end], so the few step sizes used are factorised once each and the run ends exactly on t_end;
   explicit steps stay below 0.9 of the stable limit.
 
-  Measured (2026-11-22, 2-core machine) on the decay of a 2048-particle packing between plates (the bench's
-  DEM transient, t_end = 200 x the explicit limit), error = max |T - T_ref| with the plates 1 apart::
-
-      integrator      rtol   old: steps   error     seconds   new: steps  rejected  error    seconds
-      explicit        1e-2         391    5.6e-4    0.03            266     0       5.9e-4   0.02
-      explicit        1e-3        2573    2.9e-4    0.16            958     0       4.1e-4   0.06
-      explicit        1e-4       25559    3.5e-5    1.5            9344     0       4.7e-5   0.51
-      implicit        1e-2         260    3.1e-3    0.15            104     0       2.3e-3   0.11
-      implicit        1e-3        2561    3.4e-4    0.73            958     0       2.5e-4   0.49
-      implicit        1e-4       25558    3.5e-5    6.3            9506     0       2.4e-5   3.3
-      crank-nicolson  1e-2         261    7.6e-5    0.22             22     0       6.9e-4   0.04
-      crank-nicolson  1e-3        2561    9.4e-7    0.92             44     0       1.7e-4   0.05
-      crank-nicolson  1e-4       25558    2.3e-9    6.3             115     0       2.7e-5   0.10
-
-  (old: the largest temperature change per step held near rtol x range, direct solves; new: Jacobi-CG, see
-  :mod:`dem.linsolve`; a new implicit step costs three solves.) The dyadic grid rounds every step down to a power
-  of 2: without it the implicit runs take 0.7x the steps for 1.3x the error (about 7 % (implicit) and 15 %
-  (Crank-Nicolson) more steps for the same error) but need two factorisations per step (12 s instead of 0.7 s
-  for implicit at rtol 1e-3, direct solves).
+  ``python -m benchmarks dem`` measures steps, error and time of each integrator, fixed and ``"auto"`` at rtol
+  1e-2 ... 1e-4, on the decay of a 2048-particle packing between plates (section "DEM transient: error against
+  time"). The dyadic grid rounds every step down to a power of 2: it costs some more steps for the same error, but
+  saves the second factorisation per step that free step sizes would need.
 
 Energy bookkeeping: the heat flowing into the free particles through each boundary (fixed particles, walls,
 convection, radiation, internal sources) is integrated with the same theta weighting as the step, so the change
@@ -59,7 +44,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 from scipy.sparse.csgraph import connected_components
 
-from dem.bonds import Bonds
+from dem.bonds import Bonds, find_bonds
+from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.linsolve import make_solver
 from dem.particles import Particles
 from dem.sources import Sources, linear_sink_terms
@@ -213,6 +199,27 @@ class Network:
     def temperature_range(self) -> float:
         lo, hi = self.temperature_bounds()
         return hi - lo
+
+
+def build_network(particles: Particles, walls=(), spec=None, sources: Sources | None = None, *, pairs=None,
+                  bonds: Bonds | None = None) -> Network:
+    """The thermal network of a packing in one call: bonds from the overlaps (:func:`dem.bonds.find_bonds`, with the
+    contact model and out-of-range policy of ``spec``), their conductances (:func:`dem.laws.conductance.
+    bond_conductances`, Rojek 2022 eqs. 5-9), and the assembled :class:`Network` holding both.
+
+    ``walls`` are :class:`dem.sources.Wall` planes, ``spec`` a :class:`~dem.laws.conductance.ConductanceSpec`
+    (default: the ``rojek`` law), ``sources`` the ambient exchange and ``pairs = (i, j)`` the pair bonds to use
+    instead of searching for overlaps. ``bonds`` already found (e.g. to time the search apart) skip the search. To
+    impose other pair conductances, replace them: ``dataclasses.replace(net, K_pairs=K)``.
+    """
+    spec = ConductanceSpec() if spec is None else spec
+    walls = tuple(walls)
+    if bonds is None:
+        bonds = find_bonds(particles, walls, spec.contact, spec.out_of_range, pairs=pairs)
+    K_pairs, K_walls = bond_conductances(spec, particles, bonds)
+    wall_temperature = np.array([w.temperature for w in walls], dtype=float)
+    return Network(particles, bonds, K_pairs, K_walls, wall_temperature,
+                   Sources() if sources is None else sources)
 
 
 def boundary_heat_flow(net: Network, T: np.ndarray) -> dict:

@@ -114,20 +114,15 @@ def test_out_of_range_reported_or_by_policy():
 
 def test_large_network_iterative_matches_direct():
     from dem.generators import random_packing
-    from dem.bonds import find_bonds
-    from dem.laws.conductance import bond_conductances
     from dem.particles import Particles
-    from dem.thermal import Network, steady
+    from dem.thermal import build_network, steady
 
     lay = random_packing(3000, 1e-4, 0.12, seed=3)
     T = np.zeros(len(lay.radius))
     fixed = np.zeros(len(T), bool)
     fixed[lay.bottom] = fixed[lay.top] = True
     T[lay.bottom] = 1.0
-    p = Particles.from_arrays(lay.position, lay.radius, T, fixed=fixed)
-    b = find_bonds(p)
-    kp, kw = bond_conductances(ConductanceSpec(), p, b)
-    net = Network(p, b, kp, kw, np.zeros(0))
+    net = build_network(Particles.from_arrays(lay.position, lay.radius, T, fixed=fixed), spec=ConductanceSpec())
     ref = steady(net, floating="mean", linear="direct").T
     for backend in ("amg", "cg"):
         assert np.max(np.abs(steady(net, floating="mean", linear=backend, rtol=1e-12).T - ref)) < 1e-9
