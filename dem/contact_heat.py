@@ -22,11 +22,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from dem.bonds import find_bonds
-from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.laws.conductance import ConductanceSpec
 from dem.particles import Particles
 from dem.sources import Sources, Wall
-from dem.thermal import Network, theta_step
+from dem.thermal import Network, bonds_and_conductances, theta_step
 
 
 class ContactThermalModel:
@@ -53,14 +52,19 @@ class ContactThermalModel:
 
     def bonds(self, mechanics):
         """Bonds and conductances ``(bonds, K_pairs, K_walls)`` of the contacts of ``mechanics`` now."""
-        s = mechanics.state
         i, j = mechanics.contacts()[:2]
-        now = Particles(s.x, s.radius, self.T, self.particles.material, self.particles.fixed, self.particles.heat,
-                        self.particles.materials)
-        walls = [Wall(self.walls[k].name, self.walls[k].normal * mechanics.w.q[k], self.walls[k].normal,
-                      self.walls[k].temperature) for k in self.thermal_walls]
-        bonds = find_bonds(now, walls, self.spec.contact, self.spec.out_of_range, pairs=(i, j))
-        return (bonds, *bond_conductances(self.spec, now, bonds))
+        return bonds_and_conductances(self._particles_now(mechanics, mechanics.state.radius),
+                                      self._walls_now(mechanics), self.spec, pairs=(i, j))
+
+    def _particles_now(self, mechanics, radius) -> Particles:
+        """The particles at their current positions with ``radius``: the current radii for the contact geometry,
+        the initial ones (the mass) for the capacities and the exposed surface."""
+        p = self.particles
+        return Particles(mechanics.state.x, radius, self.T, p.material, p.fixed, p.heat, p.materials)
+
+    def _walls_now(self, mechanics) -> list:
+        return [Wall(self.walls[k].name, self.walls[k].normal * mechanics.w.q[k], self.walls[k].normal,
+                     self.walls[k].temperature) for k in self.thermal_walls]
 
     def step(self, mechanics, dt: float) -> None:
         """Advance the temperatures by ``dt`` on the network of the contacts of ``mechanics`` now."""
@@ -74,7 +78,8 @@ class ContactThermalModel:
             self.refreshes += 1
         else:
             wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
-            self.net = Network(self.particles, bonds, K_pairs, K_walls, wall_T, self.sources)
+            self.net = Network(self._particles_now(mechanics, self.particles.radius), bonds, K_pairs, K_walls,
+                               wall_T, self.sources)
             self.assemblies += 1
         T_F, heat = theta_step(self.net, self.T[self.free], dt, self.integrator, self.linear)
         for k, v in heat.items():

@@ -214,12 +214,19 @@ def build_network(particles: Particles, walls=(), spec=None, sources: Sources | 
     """
     spec = ConductanceSpec() if spec is None else spec
     walls = tuple(walls)
-    if bonds is None:
-        bonds = find_bonds(particles, walls, spec.contact, spec.out_of_range, pairs=pairs)
-    K_pairs, K_walls = bond_conductances(spec, particles, bonds)
+    bonds, K_pairs, K_walls = bonds_and_conductances(particles, walls, spec, pairs=pairs, bonds=bonds)
     wall_temperature = np.array([w.temperature for w in walls], dtype=float)
     return Network(particles, bonds, K_pairs, K_walls, wall_temperature,
                    Sources() if sources is None else sources)
+
+
+def bonds_and_conductances(particles: Particles, walls, spec, *, pairs=None,
+                           bonds: Bonds | None = None) -> tuple[Bonds, np.ndarray, np.ndarray]:
+    """The bonds of ``particles`` (and ``walls``) and their pair and wall conductances: the first half of
+    :func:`build_network`, for a network whose bonds change while its particles stay (:mod:`dem.contact_heat`)."""
+    if bonds is None:
+        bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, pairs=pairs)
+    return (bonds, *bond_conductances(spec, particles, bonds))
 
 
 def boundary_heat_flow(net: Network, T: np.ndarray) -> dict:
