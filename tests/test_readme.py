@@ -7,7 +7,8 @@ wrote the README the numbers agree to all printed digits; 1e-6 leaves room for p
 solves (BLAS, libm, SuperLU orderings) while staying 100x tighter than the loosest solver tolerance shown (rtol
 1e-4), so a changed algorithm or a stale README fails. Timings are ignored: ``seconds`` entries, and numbers with
 the unit ``s`` (``1.8 s``). Commands are run with ``python`` replaced by this interpreter, the repository on
-``PYTHONPATH``, and stdout and stderr together, as a terminal shows them (progress bars left out).
+``PYTHONPATH``, and stdout and stderr together, as a terminal shows them (progress bars left out). Input files the
+README shows (a fenced block right after ``<!-- file: NAME -->``) are written into the folder first.
 """
 
 from __future__ import annotations
@@ -91,7 +92,16 @@ def test_number_extraction_ignores_timings_and_keeps_the_rest():
     assert close(5.4e-17, -2e-16) and close(1.0, 1.0 + 5e-7) and not close(1.0, 1.0 + 2e-6)
 
 
+def shown_files(text: str) -> dict:
+    """``{name: content}`` of every fenced block that follows a ``<!-- file: NAME -->`` line."""
+    out = {}
+    for match in re.finditer(r"<!-- file: (\S+) -->\s*\n```\w*\n(.*?)\n```", text, re.S):
+        out[match.group(1)] = match.group(2) + "\n"
+    return out
+
+
 COMMANDS = console_commands(README.read_text())
+FILES = shown_files(README.read_text())
 
 
 def test_readme_has_console_blocks():
@@ -106,6 +116,8 @@ def test_console_block(tmp_path, command, expected, line):
     assert argv[0] == "python", f"README line {line}: only python commands are run"
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep),
                MPLBACKEND="Agg")
+    for name, content in FILES.items():
+        (tmp_path / name).write_text(content)
     proc = subprocess.run([sys.executable, *argv[1:]], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
                           stderr=subprocess.STDOUT, text=True, timeout=1800)
     got, want = numbers(proc.stdout), numbers(expected)
