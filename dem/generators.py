@@ -1,5 +1,5 @@
-"""Particle arrangements for scenes: a chain, a cubic lattice block (simple, body- or face-centred cubic) and a
-random sintered packing.
+"""Particle arrangements for scenes: a chain, a cubic lattice block (simple, body- or face-centred cubic), a
+random sintered packing, and particles scattered in a box (for scenes that move).
 
 Every generator returns a :class:`Layout`: positions, radii, the indices of the bottom and top layers and the
 specimen's cross-section, so that a scene can hold the two ends at different temperatures (hot and cold plates,
@@ -28,6 +28,7 @@ from fem_neck.geometry import max_overlap
 
 DISTRIBUTIONS = ("constant", "uniform", "lognormal")
 MAX_PARTICLES = 5_000_000  # ~1.7 GiB peak per 10^6 particles (steady, AMG): larger packings need a distributed backend
+RSA_CANDIDATES = 3000  # random points tried per particle by random_box (jamming near a solid fraction of 0.3 in 3D)
 
 
 def _check_count(n: int, name: str):
@@ -38,7 +39,8 @@ def _check_count(n: int, name: str):
 @dataclass(frozen=True)
 class Layout:
     """Generated geometry: ``position`` (N,3), ``radius`` (N,), ``bottom``/``top`` layer indices, the z of the
-    lowest/highest particle surfaces, the cross-section ``area`` (m^2) normal to z."""
+    lowest/highest particle surfaces, the cross-section ``area`` (m^2) normal to z; ``period`` (3,) and ``origin``
+    (3,) of the box that tiles space with the block (None where it does not), initial ``velocity`` (N,3) or None."""
 
     position: np.ndarray
     radius: np.ndarray
@@ -49,6 +51,7 @@ class Layout:
     area: float
     period: np.ndarray | None = None
     origin: np.ndarray | None = None
+    velocity: np.ndarray | None = None
 
 
 def _positive(name, value):
@@ -220,3 +223,54 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
     side = m * cell * scale
     return Layout(pos, r, bottom, top, float(np.min(pos[:, 2] - r)), float(np.max(pos[:, 2] + r)), side * side,
                   period * scale, np.zeros(3))
+
+
+def random_box(n: int, radius, box, radius_spread: float = 0.0, seed: int = 0, speed: float = 0.0,
+               dimension: int = 3) -> Layout:
+    """``n`` particles placed one after the other at uniformly random positions inside the box ``[[x, y, z]_lo,
+    [x, y, z]_hi]`` without overlapping each other or the box faces (random sequential addition, Zohdi 2014,
+    Sec. 7; Luding 2005, Sec. 4: "randomly placed in a box with random initial velocity"). Radii uniform in
+    ``radius (1 +- radius_spread)`` (Luding's w0); velocities of magnitude ``speed`` in random directions (in the
+    x-z plane for 2D disks, which keep ``y = 0``). Refused when the box is too full for the particles to fit."""
+    if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+        raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
+    _check_count(n, "n")
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise ValueError(f"[generator] seed = {seed!r}: must be an integer >= 0")
+    r_mean = _positive("radius", radius)
+    spread = float(_floats("radius_spread", radius_spread))
+    if not (np.isfinite(spread) and 0 <= spread < 1):
+        raise ValueError(f"[generator] radius_spread = {radius_spread!r}: must be in [0, 1) (relative)")
+    v = float(_floats("speed", speed))
+    if not (np.isfinite(v) and v >= 0):
+        raise ValueError(f"[generator] speed = {speed!r}: must be a finite number >= 0 (m/s)")
+    b = _floats("box", box)
+    axes = [0, 2] if dimension == 2 else [0, 1, 2]
+    if b.shape != (2, 3) or not np.all(np.isfinite(b)) or np.any(b[1][axes] <= b[0][axes]):
+        raise ValueError(f"[generator] box = {box!r}: must be [[x, y, z]_low, [x, y, z]_high] with low < high"
+                         f"{' in x and z (2D disks: y is ignored)' if dimension == 2 else ''}")
+    rng = np.random.default_rng(seed)
+    r = rng.uniform(r_mean * (1.0 - spread), r_mean * (1.0 + spread), n)
+    if np.any(2.0 * r.max() > (b[1] - b[0])[axes]):
+        raise ValueError(f"[generator] box = {box!r}: narrower than the largest particle ({2 * r.max():.6g} m)")
+    lo, hi = b[0].copy(), b[1].copy()
+    if dimension == 2:
+        lo[1] = hi[1] = 0.0
+    from dem.neighbours import sequential_addition  # compiled: loaded only by scenes that place particles so
+
+    pos, placed = sequential_addition(r, lo, hi, rng.random((RSA_CANDIDATES * n, 3)))
+    if placed < n:
+        filled = np.sum(np.pi * r[:placed] ** 2) / np.prod((b[1] - b[0])[axes]) if dimension == 2 else \
+            np.sum(4 / 3 * np.pi * r[:placed] ** 3) / np.prod(b[1] - b[0])
+        raise ValueError(f"[generator] n = {n}: only {placed} particles fit by random sequential addition "
+                         f"(volume fraction {filled:.3f}); enlarge the box or use fewer particles")
+    direction = rng.normal(size=(n, 3))
+    if dimension == 2:
+        direction[:, 1] = 0.0
+    direction /= np.linalg.norm(direction, axis=1)[:, None]
+    span = b[1] - b[0]
+    area = span[0] * span[1] if dimension == 3 else span[0]  # normal to z (2D: a length)
+    empty = np.zeros(0, dtype=np.int64)
+    return Layout(pos, r, empty, empty, float(b[0][2]), float(b[1][2]), float(area),
+                  velocity=v * direction if v > 0 else None)
+

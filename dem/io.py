@@ -116,3 +116,70 @@ class RunWriter:
 
 def write_summary(path, summary: dict) -> None:
     pathlib.Path(path).write_text(json.dumps(summary, indent=2) + "\n")
+
+
+class MotionWriter:
+    """Observer of the engine for moving particles: a ``timeseries.csv`` row per output time and snapshots every
+    ``[output] vtu_interval`` (and at the start and end): ``particles_NNNNN.vtu`` (points with the fields the
+    submodels offer) and ``contacts_NNNNN.vtu`` (lines with normal and tangential force and overlap), each listed in
+    its PVD collection as soon as it is written."""
+
+    def __init__(self, out_dir, scene):
+        self.out = pathlib.Path(out_dir)
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.scene = scene
+        self.csv = None
+        self.columns: list[str] = []
+        self.snapshots: list[tuple[float, int]] = []
+        self.next_vtu = 0.0
+
+    def __call__(self, sim):
+        row = sim.record()
+        if self.csv is None:
+            self.columns = list(row)
+            self.csv = (self.out / "timeseries.csv").open("w")
+            self.csv.write(",".join(self.columns) + "\n")
+        self.csv.write(",".join("" if row.get(k) is None else f"{row[k]:.12g}" for k in self.columns) + "\n")
+        self.csv.flush()
+        m = self.scene.motion
+        t_end = self.scene.solver.t_end
+        if m.vtu_interval > 0 and row["t"] >= self.next_vtu - 1e-12 * t_end or row["t"] == 0.0 \
+                or row["t"] >= t_end * (1 - 1e-12):
+            self.snapshot(sim, row["t"], row["step"])
+            if m.vtu_interval > 0:
+                while self.next_vtu <= row["t"] + 1e-12 * t_end:
+                    self.next_vtu += m.vtu_interval
+
+    def snapshot(self, sim, t: float, step: int):
+        if self.snapshots and self.snapshots[-1][1] == step:
+            return
+        profile = sim.profile()
+        if profile is not None:
+            new = not (self.out / "profiles.csv").exists()
+            with (self.out / "profiles.csv").open("a") as fh:
+                if new:
+                    fh.write("t,distance,solid_fraction,neck_over_radius\n")
+                for d, phi, a in zip(profile["distance"], profile["solid_fraction"], profile["neck_over_radius"]):
+                    fh.write(f"{t:.12g},{d:.12g},{phi:.12g},{'' if a is None else f'{a:.12g}'}\n")
+        self.snapshots.append((t, step))
+        if not self.scene.output.vtu:
+            return
+        s = sim.mechanics.state
+        fields = sim.particle_fields()
+        meshio.write(self.out / f"particles_{step:09d}.vtu", meshio.Mesh(
+            s.x, [("vertex", np.arange(s.n).reshape(-1, 1))], point_data=fields))
+        i, j, cfields = sim.contact_fields()
+        meshio.write(self.out / f"contacts_{step:09d}.vtu", meshio.Mesh(
+            s.x, [("line", np.column_stack([i, j]).astype(np.int64).reshape(-1, 2))],
+            cell_data={k: [v] for k, v in cfields.items()}))
+        for kind in ("particles", "contacts"):
+            write_pvd(self.out / f"{kind}.pvd", [(tt, f"{kind}_{k:09d}.vtu") for tt, k in self.snapshots])
+
+    def finish(self, summary: dict, plots: bool = True):
+        if self.csv is not None:
+            self.csv.close()
+        if plots:
+            from dem.plots import motion_plots
+
+            summary = {**summary, "plots": motion_plots(self.out)}
+        write_summary(self.out / "summary.json", summary)

@@ -20,61 +20,16 @@ at the bound took at most 504 iterations). The target is on the unscaled residua
 reach on badly scaled systems: should CG fail, the matrix falls back to direct or AMG (:class:`AutoCGSolver`).
 Otherwise (steady networks, very large time steps) direct up to :data:`DIRECT_MAX` unknowns, AMG above.
 
-Measured (2026-11-22, 2-core machine, shared; ``nice``) on random sintered packings between fixed plates
-(``verification.bench.packing_network``, rojek law, seed 1), solving to rtol 1e-10 from zero: seconds of the
-setup (factorisation or hierarchy) and of one solve, CG/AMG iterations in parentheses. Steady: the network
-matrix ``A`` (no capacity term); transient: ``C/dt + A`` with dt in units of the cheap explicit bound
-``2 min C_i / L_ii``; ``cond <=`` is the bound above. old: the rule before (direct up to 20 000, condition 200)::
-
-    unknowns  matrix             cond <=  direct: setup + solve  cg: solve (its)  amg: setup + solve (its)  old   new
-        1792  steady                 inf      0.009 + 0.0002      0.0019 (74)     0.041 + 0.0012 (7)      direct direct
-        1792  C/dt + A, dt = 10x      41      0.009 + 0.0002      0.0011 (43)     0.006 + 0.0010 (6)      direct cg
-        1792  C/dt + A, dt = 1000x  4001      0.009 + 0.0002      0.0019 (73)     0.010 + 0.0012 (7)      direct direct
-        4598  steady                 inf      0.079 + 0.0009      0.0048 (100)    0.008 + 0.0029 (8)      direct direct
-        4598  C/dt + A, dt = 1x        5      0.051 + 0.0010      0.0011 (19)     0.009 + 0.0015 (4)      direct cg
-        4598  C/dt + A, dt = 10x      41      0.071 + 0.0008      0.0024 (48)     0.008 + 0.0026 (7)      direct cg
-        4598  C/dt + A, dt = 100x    401      0.052 + 0.0009      0.0084 (88)     0.016 + 0.0028 (8)      direct cg
-        9408  steady                 inf      0.355 + 0.0050      0.0114 (125)    0.048 + 0.0145 (9)      direct amg
-        9408  C/dt + A, dt = 1x        5      0.337 + 0.0045      0.0019 (19)     0.019 + 0.0070 (4)      direct cg
-        9408  C/dt + A, dt = 10x      41      0.357 + 0.0045      0.0045 (50)     0.018 + 0.0112 (7)      direct cg
-        9408  C/dt + A, dt = 100x    401      0.339 + 0.0046      0.0094 (103)    0.019 + 0.0125 (8)      direct cg
-        9408  C/dt + A, dt = 1000x  4001      0.342 + 0.0047      0.0110 (121)    0.020 + 0.0143 (9)      direct amg
-       19074  steady                 inf      0.905 + 0.0107      0.0280 (157)    0.033 + 0.0307 (9)      direct amg
-       19074  C/dt + A, dt = 1x        5      0.871 + 0.0106      0.0033 (18)     0.037 + 0.0144 (4)      direct cg
-       19074  C/dt + A, dt = 10x      41      0.861 + 0.0105      0.0093 (51)     0.032 + 0.0230 (7)      direct cg
-       19074  C/dt + A, dt = 100x    401      0.862 + 0.0105      0.0209 (117)    0.038 + 0.0268 (8)      direct cg
-       19074  C/dt + A, dt = 1000x  4001      0.881 + 0.0108      0.0267 (152)    0.033 + 0.0298 (9)      direct amg
-       48668  steady                 inf     13.06  + 0.057       0.096 (213)     0.077 + 0.086 (10)      amg    amg
-       48668  C/dt + A, dt = 1x        5     12.93  + 0.055       0.0086 (18)     0.074 + 0.039 (4)       cg     cg
-       48668  C/dt + A, dt = 10x      41     13.42  + 0.12        0.037 (52)      2.05  + 0.23 (7)        cg     cg
-       48668  C/dt + A, dt = 100x    401     13.70  + 0.23        0.058 (126)     0.67  + 0.17 (8)        amg    cg
-       48668  C/dt + A, dt = 1000x  4001     15.40  + 0.23        0.095 (199)     2.30  + 0.40 (10)       amg    amg
-       97556  steady                 inf         -                0.23 (263)      0.26  + 0.19 (10)       amg    amg
-
-SuperLU's fill-in on these 3D networks makes the factorisation grow about as N^2 (0.9 s at 19 000 unknowns,
-13 s at 49 000), while a Jacobi-CG solve costs about as much as a direct back-substitution from ~10 000 unknowns
-on whenever ``C/dt`` dominates. In a time integration CG is also warm-started from the extrapolated previous
-steps, and with ``dt = "auto"`` every step size gets its own solver, which tips the balance much further. Whole
-runs on the same decay (``dem.thermal.integrate``, same machine; seconds)::
-
-    unknowns  run                                       direct    cg     amg
-        400   Crank-Nicolson, auto, rtol 1e-3 (42 steps)   0.03    0.04
-        400   implicit, auto, rtol 1e-3 (870 steps)        0.15    0.21
-       1792   Crank-Nicolson, auto, rtol 1e-3 (44 steps)   0.31    0.08
-       1792   implicit, auto, rtol 1e-3 (958 steps)        0.96    0.74
-       1792   implicit, dt = 10x bound, 1000 steps         0.21    0.16
-       4598   Crank-Nicolson, auto, rtol 1e-3 (44 steps)   1.24    0.11
-       4598   implicit, auto, rtol 1e-3 (966 steps)        6.2     1.3
-       4598   implicit, dt = 10x bound, 1000 steps         0.96    0.32
-      19074   Crank-Nicolson, auto, rtol 1e-3 (44 steps)  28      1.7    11
-      19074   implicit, auto, rtol 1e-3 (957 steps)       82      2.8    47
-      19074   implicit, dt = 10x bound, 1000 steps        38     11
-
-Hence CG for diagonally dominant matrices from :data:`JACOBI_MIN` unknowns on (the old rule used direct up to
-20 000 unknowns). Without diagonal dominance (steady networks, very large dt) a single solve decides: direct
-costs milliseconds up to a few thousand unknowns; above, AMG is chosen for its robustness to conductance
-contrasts, although plain Jacobi-CG converged faster on these benign packings (its iterations grow as ~N^0.3:
-74 at 1 800, 263 at 98 000 unknowns) -- it has no convergence guarantee there.
+The thresholds come from timing the three backends on random sintered packings between fixed plates, steady and
+with the capacity term ``C/dt`` for steps of 1 to 1000 times the cheap explicit bound ``2 min C_i / L_ii``:
+``python -m benchmarks dem`` prints that table with the choice of ``"auto"`` beside each row (section "DEM linear
+solvers"). What it shows: SuperLU's fill-in on 3D networks makes the factorisation grow about as N^2, while a
+Jacobi-CG solve costs about as much as a direct back-substitution from ~10 000 unknowns on whenever ``C/dt``
+dominates; in a time integration CG is also warm-started from the extrapolated previous steps, and with
+``dt = "auto"`` every step size gets its own solver, which tips the balance further. Without diagonal dominance
+(steady networks, very large dt) a single solve decides: direct costs milliseconds up to a few thousand unknowns;
+above, AMG is chosen for its robustness to conductance contrasts, although plain Jacobi-CG often converges faster
+on benign packings -- it has no convergence guarantee there.
 """
 
 from __future__ import annotations

@@ -61,14 +61,16 @@ def check_positive_entries(name: str, arr: np.ndarray, allow_zero: bool = False)
 class Material:
     """Thermal properties of one material (SI units): conductivity kappa W/(m K), density kg/m^3, c J/(kg K)."""
 
-    conductivity: float
+    conductivity: float | None
     density: float
-    specific_heat: float
+    specific_heat: float | None
     name: str = "material"
 
     def __post_init__(self):
         for key in ("conductivity", "density", "specific_heat"):
             value = getattr(self, key)
+            if value is None and key != "density":  # a scene without thermal physics needs only the density
+                continue
             if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value) or value <= 0:
                 raise ValueError(f"material {self.name!r}: {key} = {value!r}: must be a finite number > 0")
             check_range(f"material {self.name!r}: {key}", np.float64(value), *PROPERTY_RANGE)
@@ -123,6 +125,8 @@ class Particles:
             k = int(np.flatnonzero((mat < 0) | (mat >= len(materials)))[0])
             raise ValueError(f"{prefix}{sep}material[{k}] = {mat[k]}: must index one of {len(materials)} material(s)")
         out = cls(pos, rad, temp, mat, fix, q, materials)
+        if any(m.specific_heat is None for m in materials):
+            return out  # no thermal physics: no capacities to check
         cap = out.capacity
         bad = ~np.isfinite(cap) | (cap <= 0)
         if np.any(bad):
@@ -136,7 +140,11 @@ class Particles:
         return len(self.radius)
 
     def _property(self, key: str) -> np.ndarray:
-        return np.array([getattr(m, key) for m in self.materials])[self.material]
+        values = [getattr(m, key) for m in self.materials]
+        if any(v is None for v in values):
+            name = next(m.name for m in self.materials if getattr(m, key) is None)
+            raise ValueError(f"material {name!r}: {key} is required for thermal physics")
+        return np.array(values, dtype=float)[self.material]
 
     @property
     def conductivity(self) -> np.ndarray:

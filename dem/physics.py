@@ -5,27 +5,24 @@ A scene names its physics (``[scene] physics = ["thermal"]``); only those are bu
 ``run(observer, progress)`` returns a summary dict. The thermal model of a static packing builds its bonds once,
 never moves a particle and allocates no mechanical state.
 
-Next to plug in (see :data:`PLANNED`): the mechanical sintering contact of Luding et al. 2005 (positions,
-velocities, the hysteretic normal law; bonds rebuilt as particles move, then the thermal network re-assembled) and
-the electrical current flow with Joule heating of Zohdi 2014 (eqs. 38-44; a second network Laplacian on the same
-bonds, feeding ``Particles.heat``), staggered with the thermal model as in Zohdi's Algorithm 1.
+Particles that move (``"mechanical"``, the Luding 2005 contact law) run in the engine of :mod:`dem.engine`, where
+the thermal network follows the contacts as the necks grow. Next to plug in (see :data:`PLANNED`): the electrical
+current flow with Joule heating of Zohdi 2014 (eqs. 38-44).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from dem.bonds import find_bonds
-from dem.laws.conductance import bond_conductances
-from dem.thermal import Network, boundary_heat_flow, integrate, periodic_heat_flow, steady
+from dem.thermal import boundary_heat_flow, build_network, integrate, periodic_heat_flow, steady
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
 
 PLANNED = {
-    "mechanical": "the Luding 2005 sintering contact (hysteretic normal law, temperature-dependent stiffness)",
     "electrical": "the Zohdi 2014 current flow and Joule heating (eqs. 38-44)",
 }
+MOVING = ("mechanical",)  # built by the engine for moving particles (dem.engine), not here
 
 
 class ThermalModel:
@@ -37,12 +34,8 @@ class ThermalModel:
         self.scene = scene
         if scene.solver.mode == "transient":
             self._check_work()  # before the bond search: a refused run costs nothing
-        p = scene.particles
-        spec = scene.conductance
-        self.bonds = find_bonds(p, scene.walls, spec.contact, spec.out_of_range, box=scene.box)
-        self.K_pairs, self.K_walls = bond_conductances(spec, p, self.bonds, scene.box, scene.walls)
-        wall_T = np.array([w.temperature for w in scene.walls], dtype=float)
-        self.network = Network(p, self.bonds, self.K_pairs, self.K_walls, wall_T, scene.sources, scene.box)
+        self.network = build_network(scene.particles, scene.walls, scene.conductance, scene.sources, box=scene.box)
+        self.bonds, self.K_pairs, self.K_walls = self.network.bonds, self.network.K_pairs, self.network.K_walls
 
     def run(self, observer=None, progress=None) -> dict:
         try:
@@ -104,7 +97,7 @@ class ThermalModel:
             out.update(t=res.t, steps=res.steps, energy_error=res.energy_error, heat_in=res.heat_in,
                        integrator=s.integrator, dt=s.dt, dt_min=res.dt_min, dt_max=res.dt_max,
                        rejected_steps=res.rejected, stable_limit=res.stable_limit, linear_solver=res.solver,
-                       factorizations=res.factorizations)
+                       factorizations=res.factorizations, max_principle_violation=res.max_principle_violation)
         return out
 
     def _boundary(self, T: np.ndarray) -> dict:
@@ -123,19 +116,23 @@ class ThermalModel:
 
 
 REGISTRY = {"thermal": ThermalModel}
+PHYSICS_NAMES = (*REGISTRY, *MOVING)
+
+
+def check_physics(names) -> None:
+    """Every name a submodel that exists (``thermal``, ``mechanical``); planned and unknown ones are refused."""
+    available = (*REGISTRY, *MOVING)
+    for name in names:
+        if name in PLANNED:
+            raise ValueError(f"[scene] physics = {name!r}: not implemented yet ({PLANNED[name]}); available: "
+                             f"{', '.join(available)}")
+        if name not in available:
+            raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(available)})")
+    if not names:
+        raise ValueError(f"[scene] physics: names no submodel (available: {', '.join(available)})")
 
 
 def build(scene) -> list:
-    """The submodels the scene names, in order; unknown or planned names raise ValueError."""
-    models = []
-    for name in scene.physics:
-        if name in REGISTRY:
-            models.append(REGISTRY[name](scene))
-        elif name in PLANNED:
-            raise ValueError(f"[scene] physics = {name!r}: not implemented yet ({PLANNED[name]}); available: "
-                             f"{', '.join(REGISTRY)}")
-        else:
-            raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(REGISTRY)})")
-    if not models:
-        raise ValueError("[scene] physics: names no submodel (available: thermal)")
-    return models
+    """The submodels of a static scene (only ``thermal``), in order; unknown or planned names raise ValueError."""
+    check_physics(scene.physics)
+    return [REGISTRY[name](scene) for name in scene.physics]

@@ -11,17 +11,20 @@ from __future__ import annotations
 import math
 import pathlib
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from dem import generators
+from dem import generators, state_file
 from dem.laws.conductance import ConductanceSpec
+from dem.laws.luding import LudingMaterial
 from dem.particles import COPPER, Material, Particles
 from dem.periodic import AXES, PeriodicBox
 from dem.sources import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
 from dem.thermal import INTEGRATORS
 from dem.linsolve import BACKENDS
+from dem.physics import PHYSICS_NAMES as PHYSICS, check_physics
+from dem.moving_scene import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
 
 SCENE_DIR = pathlib.Path(__file__).with_name("scenes")
 MODES = ("transient", "steady")
@@ -33,7 +36,7 @@ ALLOWED = {
     "material": {"name", "conductivity", "density", "specific_heat"},
     "particles": {"position", "radius", "temperature", "fixed", "material", "heat"},
     "generator": {"kind", "n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter",
-                  "structure", "temperature", "boundary", "hot", "cold", "heat"},
+                  "structure", "temperature", "boundary", "hot", "cold", "heat", "box", "speed"},
     "periodic": {"lengths", "axes", "origin", "drop"},
     "walls": {"name", "point", "normal", "temperature"},
     "conductance": {"law", "slope", "fit_file", "neck", "contact_conductance", "out_of_range", "unequal"},
@@ -41,11 +44,14 @@ ALLOWED = {
     "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
     "solver": {"mode", "integrator", "dt", "t_end", "rtol", "linear", "floating", "max_steps"},
     "output": {"every", "vtu_every", "vtu"},
+    "contact": {"law"} | {f.name for f in fields(LudingMaterial)},
 }
+CONTACT_LAWS = ("luding",)
 GENERATOR_KEYS = {
     "chain": {"n", "radius", "overlap"},
     "lattice": {"shape", "radius", "overlap", "structure"},
     "random": {"n", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter"},
+    "box": {"n", "radius", "box", "seed", "radius_spread", "speed"},
 }
 
 
@@ -122,7 +128,8 @@ class Specimen:
 
 @dataclass(frozen=True)
 class Scene:
-    """One DEM run: particles (+ walls), conductance law, ambient sources, solver, outputs, the physics to run."""
+    """One DEM run: particles (+ walls), conductance law, ambient sources, solver, outputs, the physics to run;
+    ``contact`` the Luding 2005 material of a ``[contact]`` table, or None."""
 
     particles: Particles
     walls: tuple = ()
@@ -134,7 +141,9 @@ class Scene:
     name: str = "scene"
     description: str = ""
     specimen: Specimen | None = None
-    box: PeriodicBox | None = None
+    contact: LudingMaterial | None = None
+    motion: MotionSpec | None = None  # particles that move ([scene] physics with "mechanical"), else None
+    box: PeriodicBox | None = None  # a periodic box (dem.periodic), else None
 
 
 def _is_number(v) -> bool:
@@ -178,22 +187,22 @@ def _number(table, section, key, default=None, required=False):
     return float(v)
 
 
-def _materials(doc) -> tuple:
+def _materials(doc, thermal: bool = True) -> tuple:
     if "material" in doc and "materials" in doc:
         raise ValueError("[material] and [[materials]]: give one or the other")
     tables = doc.get("materials", [doc["material"]] if "material" in doc else None)
     if tables is None:
-        raise ValueError("[material]: required (conductivity, density, specific_heat)")
+        raise ValueError("[material]: required (density; conductivity and specific_heat for thermal physics)")
     if not isinstance(tables, list) or not tables:
         raise ValueError("[[materials]]: must be a non-empty array of tables")
     out = []
     for k, t in enumerate(tables):
         section = "material" if "material" in doc else f"materials[{k}]"
         _check_keys(t, section, ALLOWED["material"])
-        props = {key: _number(t, section, key, required=True) for key in ("conductivity", "density",
-                                                                          "specific_heat")}
+        props = {key: _number(t, section, key, required=thermal or key == "density")
+                 for key in ("conductivity", "density", "specific_heat")}
         for key, v in props.items():
-            if v <= 0:
+            if v is not None and v <= 0:
                 raise ValueError(f"[{section}] {key} = {v!r}: must be > 0")
         out.append(Material(**props, name=str(t.get("name", f"material{k}"))))
     return tuple(out)
@@ -228,34 +237,37 @@ def _explicit_particles(t: dict, materials):
     n = len(t["position"]) if isinstance(t["position"], list) else 0
     return Particles.from_arrays(t["position"], t["radius"], t["temperature"], materials,
                                  _material_index(t.get("material"), materials, n), t.get("fixed"), t.get("heat"),
-                                 prefix="[particles]"), (), None, None
+                                 prefix="[particles]"), (), None, None, None
 
 
-def _generated_particles(t: dict, materials):
+def _generated_particles(t: dict, materials, dimension: int = 3):
     _check_keys(t, "generator", ALLOWED["generator"])
     kind = t.get("kind")
     if not isinstance(kind, str) or kind not in GENERATOR_KEYS:
         raise ValueError(f"[generator] kind = {kind!r}: must be one of {', '.join(GENERATOR_KEYS)}")
-    geometry_keys = {"n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter"}
+    geometry_keys = {"n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter", "box", "speed"}
     extra = sorted((set(t) & geometry_keys) - GENERATOR_KEYS[kind])
     if extra:
         raise ValueError(f"[generator] {extra[0]}: not a parameter of kind = {kind!r} "
                          f"(its parameters: {', '.join(sorted(GENERATOR_KEYS[kind]))})")
     args = {k: t[k] for k in GENERATOR_KEYS[kind] if k in t}
-    missing = sorted({"radius", "overlap", "shape" if kind == "lattice" else "n"} - set(args))
+    required = {"n", "radius", "box"} if kind == "box" else {"radius", "overlap", "shape" if kind == "lattice" else "n"}
+    missing = sorted(required - set(args))
     if missing:
         raise ValueError(f"[generator] {missing[0]}: required for kind = {kind!r}")
     boundary = t.get("boundary", "none")
     if boundary not in BOUNDARIES:
         raise ValueError(f"[generator] boundary = {boundary!r}: must be one of {', '.join(BOUNDARIES)}")
-    if boundary == "periodic" and kind == "chain":
-        raise ValueError("[generator] boundary = 'periodic': only for kind = 'lattice' or 'random' (a chain has no "
+    if boundary == "periodic" and kind not in ("lattice", "random"):
+        raise ValueError(f"[generator] boundary = 'periodic': only for kind = 'lattice' or 'random' (a {kind} has no "
                          "period)")
     if boundary == "periodic" and kind == "random":
         args["periodic"] = True
     try:
-        layout = {"chain": generators.chain, "lattice": generators.lattice,
-                  "random": generators.random_packing}[kind](**args)
+        if kind == "box":
+            args["dimension"] = dimension
+        layout = {"chain": generators.chain, "lattice": generators.lattice, "random": generators.random_packing,
+                  "box": generators.random_box}[kind](**args)
     except (TypeError, ValueError) as exc:
         msg = str(exc)
         raise ValueError(msg if msg.startswith("[") else f"[generator] kind = {kind!r}: bad parameter ({msg})") from None
@@ -267,7 +279,8 @@ def _generated_particles(t: dict, materials):
     temperature = np.full(n, T0)
     fixed = np.zeros(n, dtype=bool)
     walls, specimen, box = (), None, None
-    mean_overlap = float(np.mean(np.atleast_1d(t["overlap"])))
+    if boundary != "none" and kind == "box":
+        raise ValueError("[generator] boundary: not for kind = \"box\" (give [[walls]] instead)")
     if boundary == "periodic":
         # the block repeats along every axis; the temperature drops by hot - cold per period along z. Without a
         # given temperature the particles start on that gradient about (hot + cold) / 2 (the mean a steady run
@@ -285,6 +298,7 @@ def _generated_particles(t: dict, materials):
     elif boundary == "plates":
         # plane walls touching the end layers with overlap delta = overlap * r / 2: the mirror pair's neck equals
         # that of a pair with the generator's relative overlap
+        mean_overlap = float(np.mean(np.atleast_1d(t["overlap"])))
         r_b, r_t = layout.radius[layout.bottom], layout.radius[layout.top]
         z_b = float(np.mean(layout.position[layout.bottom, 2] - r_b * (1.0 - 0.5 * mean_overlap)))
         z_t = float(np.mean(layout.position[layout.top, 2] + r_t * (1.0 - 0.5 * mean_overlap)))
@@ -293,7 +307,7 @@ def _generated_particles(t: dict, materials):
         specimen = Specimen(z_t - z_b, layout.area, hot, cold)
     particles = Particles.from_arrays(layout.position, layout.radius, temperature, materials, None, fixed,
                                       np.full(n, heat), prefix="[generator]")
-    return particles, walls, specimen, box
+    return particles, walls, specimen, layout.velocity, box
 
 
 def _periodic_box(t: dict) -> PeriodicBox:
@@ -357,32 +371,80 @@ def _spec(cls, table, section, numeric=(), integer=(), words=()):
         raise ValueError(msg if msg.startswith("[") else f"[{section}] {msg}") from None
 
 
+def _moving_keys(doc: dict, moving: bool) -> dict:
+    """``doc`` without the keys and tables of moving particles (:mod:`dem.moving_scene`), which a scene without
+    ``"mechanical"`` physics refuses by name."""
+    out = dict(doc)
+    for table in MOVING_TABLES:
+        if table in out and not moving:
+            raise ValueError(f"[{table}]: only for moving particles ([scene] physics with \"mechanical\")")
+        out.pop(table, None)
+    for section, keys in MOVING_KEYS.items():
+        tables = out.get(section)
+        if tables is None:
+            continue
+        many = isinstance(tables, list)
+        cleaned = []
+        for t in (tables if many else [tables]):
+            if not isinstance(t, dict):
+                cleaned.append(t)
+                continue
+            extra = sorted(set(t) & keys)
+            if extra and not moving:
+                raise ValueError(f"[{section}] {extra[0]}: only for moving particles ([scene] physics with "
+                                 f"\"mechanical\")")
+            cleaned.append({k: v for k, v in t.items() if k not in keys})
+        out[section] = cleaned if many else cleaned[0]
+    return out
+
+
 def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None) -> Scene:
     """Validate a parsed TOML document into a :class:`Scene` (schema: README, "Scene schema")."""
-    top = set(ALLOWED) | {"materials"}
+    top = set(ALLOWED) | {"materials"} | set(MOVING_TABLES)
     unknown = sorted(set(doc) - top)
     if unknown:
         raise ValueError(f"[{unknown[0]}]: unknown table (allowed: {', '.join(sorted(top))})")
-    meta = doc.get("scene", {})
-    _check_keys(meta, "scene", ALLOWED["scene"])
-    physics = meta.get("physics", ["thermal"])
+    physics = doc.get("scene", {}).get("physics", ["thermal"]) if isinstance(doc.get("scene", {}), dict) else None
     if isinstance(physics, str):
         physics = [physics]
     if not isinstance(physics, list) or not all(isinstance(x, str) for x in physics):
-        raise ValueError(f"[scene] physics = {physics!r}: must be a list of names (available: thermal)")
-    materials = _materials(doc)
-    if ("particles" in doc) == ("generator" in doc):
+        raise ValueError(f"[scene] physics = {physics!r}: must be a list of names (available: "
+                         f"{', '.join(PHYSICS)})")
+    check_physics(physics)
+    moving = "mechanical" in physics
+    full, doc = doc, _moving_keys(doc, moving)
+    meta = doc.get("scene", {})
+    _check_keys(meta, "scene", ALLOWED["scene"])
+    materials = _materials(doc, thermal="thermal" in physics)
+    start = None
+    if "start" in full:
+        if "particles" in doc or "generator" in doc:
+            raise ValueError("[start] state: the particles come from the saved state; remove [particles] or "
+                             "[generator]")
+        name = full["start"].get("state") if isinstance(full["start"], dict) else None
+        if not isinstance(name, str):
+            raise ValueError("[start] state: required, the path of a saved state (.npz)")
+        start = state_file.load(base_dir / name if base_dir is not None else name)
+        particles = Particles.from_arrays(start["x"], start["radius"], start["T"], materials,
+                                          prefix="[start] state")
+        walls, specimen, velocity, box = (), None, None, None
+    elif ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
-    if "particles" in doc:
-        particles, walls, specimen, box = _explicit_particles(doc["particles"], materials)
+    elif "particles" in doc:
+        particles, walls, specimen, velocity, box = _explicit_particles(doc["particles"], materials)
     else:
-        particles, walls, specimen, box = _generated_particles(doc["generator"], materials)
+        dimension = full.get("scene", {}).get("dimension", 3) if moving else 3
+        particles, walls, specimen, velocity, box = _generated_particles(doc["generator"], materials, dimension)
     if "periodic" in doc:
         if box is not None:
             raise ValueError("[periodic]: the generator's boundary = \"periodic\" already makes the block periodic; "
                              "give one or the other")
         box = _periodic_box(doc["periodic"])
-    walls = walls + _walls(doc)
+    if box is not None and moving:
+        raise ValueError("[periodic]: periodic boxes are for static packings so far (the neighbour list of moving "
+                         "particles does not use dem.periodic yet)")
+    if not moving:
+        walls = walls + _walls(doc)
     cond = dict(doc.get("conductance", {}))
     if "fit_file" in cond and not isinstance(cond["fit_file"], str):
         raise ValueError(f"[conductance] fit_file = {cond['fit_file']!r}: must be a path (string)")
@@ -397,8 +459,40 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     solver = _spec(SolverSpec, doc.get("solver", {}), "solver", numeric=("dt", "t_end", "rtol"),
                    integer=("max_steps",), words=("dt",))
     output = _spec(OutputSpec, doc.get("output", {}), "output", integer=("every", "vtu_every"))
+    if velocity is not None and not moving:
+        raise ValueError("[generator] speed: only for moving particles ([scene] physics with \"mechanical\")")
+    contact = luding_material_from_scene(doc) if "contact" in doc else None
+    motion = parse_motion(full, particles, solver, physics, contact, velocity, start) if moving else None
     return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
-                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, box)
+                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact, motion, box)
+
+
+def luding_material_from_scene(doc_or_scene) -> LudingMaterial:
+    """The Luding 2005 contact material of a :class:`Scene` (its ``contact``) or of a TOML document (its
+    ``[contact]`` table: ``law = "luding"`` and the :class:`~dem.laws.luding.LudingMaterial` fields in SI units;
+    ``density`` defaults to that of a single ``[material]``). Independent of how the particles are given.
+    Raises ``ValueError`` when there is none or a value is bad."""
+    if isinstance(doc_or_scene, Scene):
+        if doc_or_scene.contact is None:
+            raise ValueError(f"scene {doc_or_scene.name!r}: has no [contact] table with law = \"luding\" (the Luding "
+                             f"2005 sintering contact material)")
+        return doc_or_scene.contact
+    table = doc_or_scene.get("contact") if isinstance(doc_or_scene, dict) else None
+    if table is None:
+        raise ValueError("[contact]: required, with law = \"luding\" and the material (k1, k2, kc, ...)")
+    _check_keys(table, "contact", ALLOWED["contact"])
+    if table.get("law") not in CONTACT_LAWS:
+        raise ValueError(f"[contact] law = {table.get('law')!r}: must be one of {', '.join(CONTACT_LAWS)}")
+    values = {key: v for key, v in table.items() if key != "law"}
+    material = doc_or_scene.get("material")
+    if "density" not in values and isinstance(material, dict) and "density" in material:
+        values["density"] = material["density"]
+    missing = [f.name for f in fields(LudingMaterial) if f.name not in values]
+    if missing:
+        raise ValueError(f"[contact] {missing[0]}: required (law = \"luding\" needs "
+                         f"{', '.join(f.name for f in fields(LudingMaterial))})")
+    numeric = tuple(key for key in values if key != "brittle_sliding")
+    return _spec(LudingMaterial, values, "contact", numeric=numeric)
 
 
 def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls) -> None:

@@ -15,7 +15,7 @@ Particles held at a fixed temperature are a mask of :class:`dem.particles.Partic
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -74,25 +74,34 @@ class Wall:
         return (position - self.point) @ self.normal
 
 
+EXPOSED = "exposed"  # area_fraction: the exposed fraction of each surface (dem.exposure), computed from the packing
+
+
 def _area(name: str, fraction, radius: np.ndarray) -> np.ndarray:
+    if isinstance(fraction, str):
+        raise ValueError(f"{name}.area_fraction = {fraction!r}: resolve {EXPOSED!r} against the packing first "
+                         f"(Sources.resolved)")
     try:
         frac = np.broadcast_to(np.asarray(fraction, dtype=float), radius.shape)
     except (TypeError, ValueError):
         frac = np.full(radius.shape, np.nan)
     if not np.all(np.isfinite(frac)) or np.any((frac < 0) | (frac > 1)):
-        raise ValueError(f"{name}.area_fraction = {fraction!r}: must be in [0, 1] (scalar or one per particle)")
+        raise ValueError(f"{name}.area_fraction = {fraction!r}: must be \"{EXPOSED}\" or in [0, 1] (scalar or one "
+                         f"per particle)")
     return frac * 4.0 * np.pi * radius**2
 
 
 @dataclass(frozen=True)
 class Convection:
-    """``Q_i^conv = h A_i (T_inf - T_i)`` with ``A_i = area_fraction * 4 pi r_i^2`` (the exposed surface)."""
+    """``Q_i^conv = h A_i (T_inf - T_i)`` with ``A_i = area_fraction * 4 pi r_i^2``: by default the exposed part of
+    each surface (``"exposed"``, :mod:`dem.exposure`); ``area_fraction = 1`` opts in to the whole surface."""
 
     h: float
     T_inf: float
-    area_fraction: object = 1.0
+    area_fraction: object = EXPOSED
 
     def __post_init__(self):
+        _check_fraction("convection", self.area_fraction)
         if not (np.isfinite(self.h) and 0 <= self.h <= HEAT_TRANSFER_MAX):
             raise ValueError(f"convection.h = {self.h!r}: must be in [0, {HEAT_TRANSFER_MAX:g}] (W/(m^2 K))")
         _temperature("convection.T_inf", self.T_inf)
@@ -108,10 +117,11 @@ class Radiation:
 
     emissivity: float
     T_inf: float
-    area_fraction: object = 1.0
+    area_fraction: object = EXPOSED
     unit: str = "K"
 
     def __post_init__(self):
+        _check_fraction("radiation", self.area_fraction)
         if not (np.isfinite(self.emissivity) and 0 <= self.emissivity <= 1):
             raise ValueError(f"radiation.emissivity = {self.emissivity!r}: must be in [0, 1]")
         if not isinstance(self.unit, str) or self.unit not in KELVIN_OFFSET:
@@ -133,12 +143,31 @@ class Radiation:
         return self.coefficient(radius) * (self.kelvin(T) ** 4 - self.kelvin(self.T_inf) ** 4)
 
 
+def _check_fraction(name: str, fraction) -> None:
+    if isinstance(fraction, str) and fraction != EXPOSED:
+        raise ValueError(f"{name}.area_fraction = {fraction!r}: must be \"{EXPOSED}\" (the default) or a number "
+                         f"in [0, 1] (1: the whole surface)")
+
+
 @dataclass(frozen=True)
 class Sources:
     """The ambient exchanges of a scene; ``None`` means the term is absent (and never evaluated)."""
 
     convection: Convection | None = None
     radiation: Radiation | None = None
+
+    def resolved(self, position: np.ndarray, radius: np.ndarray, keep: np.ndarray) -> "Sources":
+        """The same exchanges with every ``"exposed"`` area fraction replaced by the fractions of the particles
+        ``keep`` (indices) computed from the packing (:func:`dem.exposure.exposed_fraction`, once for both)."""
+        if not any(s is not None and isinstance(s.area_fraction, str) for s in (self.convection, self.radiation)):
+            return self
+        from dem.exposure import exposed_fraction
+
+        fraction = exposed_fraction(position, radius)[keep]
+        swap = {k: replace(s, area_fraction=fraction) for k, s in (("convection", self.convection),
+                                                                    ("radiation", self.radiation))
+                if s is not None and isinstance(s.area_fraction, str)}
+        return replace(self, **swap)
 
     @property
     def names(self) -> list[str]:

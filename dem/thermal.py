@@ -23,25 +23,10 @@ matrix; it is SPD when every connected group of free particles reaches a fixed p
   grid of [0, t_end], so the few step sizes used are factorised once each and the run ends exactly on t_end;
   explicit steps stay below 0.9 of the stable limit.
 
-  Measured (2026-11-22, 2-core machine) on the decay of a 2048-particle packing between plates (the bench's
-  DEM transient, t_end = 200 x the explicit limit), error = max |T - T_ref| with the plates 1 apart::
-
-      integrator      rtol   old: steps   error     seconds   new: steps  rejected  error    seconds
-      explicit        1e-2         391    5.6e-4    0.03            266     0       5.9e-4   0.02
-      explicit        1e-3        2573    2.9e-4    0.16            958     0       4.1e-4   0.06
-      explicit        1e-4       25559    3.5e-5    1.5            9344     0       4.7e-5   0.51
-      implicit        1e-2         260    3.1e-3    0.15            104     0       2.3e-3   0.11
-      implicit        1e-3        2561    3.4e-4    0.73            958     0       2.5e-4   0.49
-      implicit        1e-4       25558    3.5e-5    6.3            9506     0       2.4e-5   3.3
-      crank-nicolson  1e-2         261    7.6e-5    0.22             22     0       6.9e-4   0.04
-      crank-nicolson  1e-3        2561    9.4e-7    0.92             44     0       1.7e-4   0.05
-      crank-nicolson  1e-4       25558    2.3e-9    6.3             115     0       2.7e-5   0.10
-
-  (old: the largest temperature change per step held near rtol x range, direct solves; new: Jacobi-CG, see
-  :mod:`dem.linsolve`; a new implicit step costs three solves.) The dyadic grid rounds every step down to a power
-  of 2: without it the implicit runs take 0.7x the steps for 1.3x the error (about 7 % (implicit) and 15 %
-  (Crank-Nicolson) more steps for the same error) but need two factorisations per step (12 s instead of 0.7 s
-  for implicit at rtol 1e-3, direct solves).
+  ``python -m benchmarks dem`` measures steps, error and time of each integrator, fixed and ``"auto"`` at rtol
+  1e-2 ... 1e-4, on the decay of a 2048-particle packing between plates (section "DEM transient: error against
+  time"). The dyadic grid rounds every step down to a power of 2: it costs some more steps for the same error, but
+  saves the second factorisation per step that free step sizes would need.
 
 Periodic packings (:mod:`dem.periodic`): a bond to the image ``shift`` of particle ``j`` sees that image at
 ``T_j - g``, ``g = drop . shift`` (the temperature drop per period of the box), so it adds the constant flow
@@ -67,7 +52,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 from scipy.sparse.csgraph import connected_components
 
-from dem.bonds import Bonds
+from dem.bonds import Bonds, find_bonds
+from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.linsolve import make_solver
 from dem.particles import Particles
 from dem.periodic import PeriodicBox
@@ -109,34 +95,71 @@ class Network:
     def __post_init__(self):
         p = self.particles
         n = p.n
-        # the temperature jump of every bond across a periodic face (module docstring), zero without one
-        self.jump = (self.bonds.shifts @ self.box.drop if self.box is not None else np.zeros(self.bonds.n_pairs))
-        self.periodic = bool(np.any(self.jump != 0.0))
-        jump_flow = self.K_pairs * self.jump
-        self.jump_rhs = np.bincount(self.bonds.j, jump_flow, n) - np.bincount(self.bonds.i, jump_flow, n)
         self.free = np.flatnonzero(~p.fixed)
         self.fixed = np.flatnonzero(p.fixed)
         self.L = laplacian(n, self.bonds.i, self.bonds.j, self.K_pairs)
         if len(self.fixed):
             rows = self.L[self.free]
             self.L_FF = rows[:, self.free].tocsr()
-            L_FD = rows[:, self.fixed].tocsr()
+            self.L_FD = rows[:, self.fixed].tocsr()
         else:
-            self.L_FF, L_FD = self.L, sp.csr_matrix((n, 0))
+            self.L_FF, self.L_FD = self.L, sp.csr_matrix((n, 0))
         self.T_D = p.temperature[self.fixed]
+        self.heat = p.heat[self.free]
+        self.C = p.capacity[self.free]
+        self.radius = p.radius[self.free]
+        self.sources = self.sources.resolved(p.position, p.radius, self.free)  # "exposed" areas from the packing
+        self._slots = None  # where each Laplacian entry sits in L, L_FF, L_FD: built by the first refresh()
+        self._boundary_terms()
+
+    def _boundary_terms(self):
+        """The terms that follow from the conductances: wall and fixed-particle coefficients and the constant
+        right-hand side."""
+        n = self.particles.n
         wp = self.bonds.wall_particle
         kw_diag = np.bincount(wp, self.K_walls, n)
         kw_rhs = np.bincount(wp, self.K_walls * self.wall_temperature[self.bonds.wall_index], n)
         self.wall_diag = kw_diag[self.free]
         self.wall_rhs = kw_rhs[self.free]
-        self.fixed_rhs = -(L_FD @ self.T_D)
-        self.fixed_diag = -np.asarray(L_FD.sum(axis=1)).ravel()
-        self.heat = p.heat[self.free]
-        self.C = p.capacity[self.free]
-        self.radius = p.radius[self.free]
+        self.fixed_rhs = -(self.L_FD @ self.T_D)
+        self.fixed_diag = -np.asarray(self.L_FD.sum(axis=1)).ravel()
         self.base_diag = self.L_FF.diagonal()
+        # the temperature jump of every bond across a periodic face (module docstring), zero without one
+        self.jump = self.bonds.shifts @ self.box.drop if self.box is not None else np.zeros(self.bonds.n_pairs)
+        self.periodic = bool(np.any(self.jump != 0.0))
+        jump_flow = self.K_pairs * self.jump
+        self.jump_rhs = np.bincount(self.bonds.j, jump_flow, n) - np.bincount(self.bonds.i, jump_flow, n)
         self.periodic_rhs = self.jump_rhs[self.free]
         self.r_const = self.fixed_rhs + self.wall_rhs + self.heat + self.periodic_rhs
+
+    def refresh(self, bonds: Bonds, K_pairs: np.ndarray, K_walls: np.ndarray) -> None:
+        """New conductances (and bond geometry) on the same bonds, in the same order: the matrices keep their
+        sparsity and only their entries are rewritten (no re-assembly, no new sparsity analysis)."""
+        if not (np.array_equal(bonds.i, self.bonds.i) and np.array_equal(bonds.j, self.bonds.j)
+                and np.array_equal(bonds.wall_particle, self.bonds.wall_particle)
+                and np.array_equal(bonds.wall_index, self.bonds.wall_index)):
+            raise ValueError("Network.refresh: the bonds changed; build a new Network")
+        n = self.particles.n
+        if self._slots is None:
+            # an index matrix with the Laplacian's sparsity: entry k of (rows, cols) stored as k + 1
+            rows = np.concatenate([bonds.i, bonds.j, np.arange(n)])
+            cols = np.concatenate([bonds.j, bonds.i, np.arange(n)])
+            index = sp.csr_matrix((np.arange(1.0, len(rows) + 1.0), (rows, cols)), shape=(n, n))
+            if len(self.fixed):
+                part = index[self.free]
+                parts = (index, part[:, self.free].tocsr(), part[:, self.fixed].tocsr())
+            else:
+                parts = (index, index, sp.csr_matrix((n, 0)))
+            self._slots = [m.data.astype(np.int64) - 1 for m in parts]
+            self.L, self.L_FF, self.L_FD = (m.copy() for m in parts)
+            if not len(self.fixed):
+                self.L_FF = self.L
+        self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
+        diag = np.bincount(bonds.i, K_pairs, n) + np.bincount(bonds.j, K_pairs, n)
+        values = np.concatenate([-K_pairs, -K_pairs, diag])
+        for matrix, slots in zip((self.L, self.L_FF, self.L_FD), self._slots):
+            matrix.data[:] = values[slots]
+        self._boundary_terms()
 
     @property
     def n_free(self) -> int:
@@ -199,6 +222,35 @@ class Network:
     def temperature_range(self) -> float:
         lo, hi = self.temperature_bounds()
         return hi - lo
+
+
+def build_network(particles: Particles, walls=(), spec=None, sources: Sources | None = None, *, pairs=None,
+                  bonds: Bonds | None = None, box: PeriodicBox | None = None) -> Network:
+    """The thermal network of a packing in one call: bonds from the overlaps (:func:`dem.bonds.find_bonds`, with the
+    contact model and out-of-range policy of ``spec``), their conductances (:func:`dem.laws.conductance.
+    bond_conductances`, Rojek 2022 eqs. 5-9), and the assembled :class:`Network` holding both.
+
+    ``walls`` are :class:`dem.sources.Wall` planes, ``spec`` a :class:`~dem.laws.conductance.ConductanceSpec`
+    (default: the ``rojek`` law), ``sources`` the ambient exchange and ``pairs = (i, j)`` the pair bonds to use
+    instead of searching for overlaps. ``bonds`` already found (e.g. to time the search apart) skip the search. To
+    impose other pair conductances, replace them: ``dataclasses.replace(net, K_pairs=K)``. ``box``: a periodic box
+    (:mod:`dem.periodic`), whose faces bonds cross and whose temperature drop per period drives the network.
+    """
+    spec = ConductanceSpec() if spec is None else spec
+    walls = tuple(walls)
+    bonds, K_pairs, K_walls = bonds_and_conductances(particles, walls, spec, pairs=pairs, bonds=bonds, box=box)
+    wall_temperature = np.array([w.temperature for w in walls], dtype=float)
+    return Network(particles, bonds, K_pairs, K_walls, wall_temperature,
+                   Sources() if sources is None else sources, box)
+
+
+def bonds_and_conductances(particles: Particles, walls, spec, *, pairs=None, bonds: Bonds | None = None,
+                           box: PeriodicBox | None = None) -> tuple[Bonds, np.ndarray, np.ndarray]:
+    """The bonds of ``particles`` (and ``walls``) and their pair and wall conductances: the first half of
+    :func:`build_network`, for a network whose bonds change while its particles stay (:mod:`dem.contact_heat`)."""
+    if bonds is None:
+        bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, pairs=pairs, box=box)
+    return (bonds, *bond_conductances(spec, particles, bonds, box, tuple(walls)))
 
 
 def boundary_heat_flow(net: Network, T: np.ndarray) -> dict:
@@ -373,6 +425,7 @@ class TransientResult:
     dt_max: float
     solver: str
     factorizations: int
+    max_principle_violation: float | None = None
 
 
 class _Stepper:
@@ -470,6 +523,16 @@ class _Stepper:
         return T_b, [(half, th_a, s_a), (half, th_b, s_b)], err
 
 
+def theta_step(net: Network, T_F: np.ndarray, dt: float, integrator: str = "implicit", linear: str = "auto",
+               rtol_linear: float = 1e-10) -> tuple[np.ndarray, dict]:
+    """One theta-method step of size ``dt`` from the free temperatures ``T_F`` on ``net`` (a network whose
+    conductances change between steps, e.g. necks that grow): ``(T_new, heat)`` with ``heat`` the energy (J) that
+    entered the free particles through each boundary during the step, integrated with the step's own weighting so
+    that ``C . (T_new - T_F)`` equals its sum to round-off."""
+    T_new, T_theta, sinks = _Stepper(net, INTEGRATORS[integrator], linear, rtol_linear).step(T_F, dt)
+    return T_new, {k: dt * v for k, v in net.flows(T_theta, sinks).items()}
+
+
 def check_step_count(t_end: float, dt: float, max_steps: int, what: str):
     steps = t_end / dt
     if steps > max_steps:
@@ -554,6 +617,12 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     grid = 2**AUTO_LEVELS
     units = 0  # dyadic: the time t = t_end * units / grid
     energy0 = float(net.C @ T)
+    # maximum principle: without internal sources the temperatures stay within the prescribed ones (initial, fixed,
+    # walls, ambient); backward Euler keeps them there exactly (an M-matrix), Crank-Nicolson and explicit steps only
+    # for small enough steps. The largest excursion (in the scene's temperature unit) is reported.
+    lo, hi = net.temperature_bounds()
+    bounded = not np.any(net.heat)
+    violation = 0.0
     heat_in = {k: 0.0 for k in net.flow_names}
     abs_in = 0.0
     t, steps, rejected = 0.0, 0, 0
@@ -607,6 +676,8 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
         dt_min, dt_max = min(dt_min, h), max(dt_max, h)
         if not np.all(np.isfinite(T)):
             raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {steps})")
+        if bounded and len(T):
+            violation = max(violation, float(T.max()) - hi, lo - float(T.min()))
         if observer is not None:
             observer(steps, t, T, flows)
         if progress is not None:
@@ -632,4 +703,4 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     err = abs(energy - energy0 - sum(heat_in.values())) / scale_e if scale_e > 0 else 0.0
     heat_in = {k: float(v) for k, v in heat_in.items()}
     return TransientResult(net.full(T), t, steps, rejected, err, heat_in, limit, dt_min, dt_max, stepper.backend,
-                           stepper.factorizations)
+                           stepper.factorizations, violation if bounded else None)

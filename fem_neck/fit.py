@@ -24,6 +24,7 @@ import multiprocessing
 import os
 import pathlib
 import sys
+import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
@@ -117,12 +118,14 @@ def _pool_context():
     return multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
 
 
-def in_processes(jobs, workers: int | None = None, *, desc: str = "", progress: bool = True, done: int = 0):
+def in_processes(jobs, workers: int | None = None, *, desc: str = "", progress: bool = True, done: int = 0,
+                 meanwhile=None):
     """Run ``func(*args)`` for every ``(func, args)`` of ``jobs`` in a process pool; yield results as they finish.
 
     Processes, not threads: gmsh is one global, thread-unsafe state per process. ``workers`` defaults to all cores;
     one worker (or one job) runs in this process. A tqdm bar on stderr counts ``done`` jobs finished earlier plus
-    these.
+    these. ``meanwhile()`` runs in a thread of this process once the workers are forked (e.g. importing what the
+    caller needs next, while this process would otherwise only wait).
     """
     from tqdm import tqdm
 
@@ -138,17 +141,21 @@ def in_processes(jobs, workers: int | None = None, *, desc: str = "", progress: 
                 yield result
             return
         with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=_pool_context()) as pool:
-            for fut in as_completed([pool.submit(func, *args) for func, args in jobs]):
+            futures = [pool.submit(func, *args) for func, args in jobs]  # every worker is started by now
+            if meanwhile is not None:
+                threading.Thread(target=meanwhile, daemon=True).start()
+            for fut in as_completed(futures):
                 bar.update()
                 yield fut.result()
 
 
 def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int | None = None,
-          solver: str = SOLVER, progress: bool = True) -> list[FitPoint]:
+          solver: str = SOLVER, progress: bool = True, meanwhile=None) -> list[FitPoint]:
     """Solve the semisphere at every a/r to ``rtol`` on ``workers`` processes (default: all cores).
 
     With ``csv_path`` each point is appended to that CSV as soon as it is solved, and points already there with a
-    tolerance at least as tight are reused (resume). Returns the points sorted by a/r.
+    tolerance at least as tight are reused (resume). ``meanwhile``: see :func:`in_processes`. Returns the points
+    sorted by a/r.
     """
     if not (isinstance(rtol, float) and 0.0 < rtol < 0.1):
         raise ValueError(f"rtol = {rtol!r}: must be a float in (0, 0.1)")
@@ -167,7 +174,8 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
         importlib.import_module(solver.split(":")[0])  # fail early in the parent, and let fork start warm
     jobs = [(_solve_point, (solver, xi, rtol)) for xi, _ in todo]
     uniform_of = {_key(xi): ui for xi, ui in todo}
-    for res in in_processes(jobs, workers, desc="fit sweep", progress=progress, done=len(points)):
+    for res in in_processes(jobs, workers, desc="fit sweep", progress=progress, done=len(points),
+                            meanwhile=meanwhile):
         p = FitPoint(**res, uniform=uniform_of[_key(res["a_over_r"])])
         points[_key(p.a_over_r)] = p
         if csv_path is not None:
@@ -248,16 +256,20 @@ def slope_sensitivity(law: ConductanceLaw) -> dict:
 
 
 def plot(points: list[FitPoint], slope: float, law: ConductanceLaw, path) -> None:
-    """The Fig. 16 analogue: FE points, the linear fits and the law; below, relative deviations from FE."""
-    import matplotlib
+    """The Fig. 16 analogue: FE points, the linear fits and the law; below, relative deviations from FE.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    Drawn on a bare Agg figure with fixed margins (no pyplot, no layout engine: they cost more than the 40 solves of
+    the sweep)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     x = np.array([p.a_over_r for p in points])
     f = np.array([p.K_over_Kcyl for p in points])
     xs = np.linspace(0.0, 1.0, 401)
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(6.4, 7.2), height_ratios=(3, 2), constrained_layout=True)
+    fig = Figure(figsize=(6.4, 7.2))
+    FigureCanvasAgg(fig)
+    ax, axr = fig.subplots(2, 1, height_ratios=(3, 2))
+    fig.subplots_adjust(left=0.11, right=0.87, top=0.98, bottom=0.07, hspace=0.22)
     ax.plot(x, f, "o", ms=4, mfc="none", color="k", label="FE (this work)")
     ax.plot(xs, law.k_over_kcyl(xs), "-", color="C0", label="full-range law")
     ax.plot(xs, slope * xs, "--", color="C1", label=f"linear fit, c = {slope:.4f} (a/r <= {LINEAR_RANGE})")
@@ -279,7 +291,12 @@ def plot(points: list[FitPoint], slope: float, law: ConductanceLaw, path) -> Non
     more = axl.get_legend_handles_labels()
     axr.legend(handles[0] + more[0], handles[1] + more[1], fontsize=8, loc="lower right")
     fig.savefig(path, dpi=130)
-    plt.close(fig)
+
+
+def import_plotting() -> None:
+    """Import what :func:`plot` needs (run in a thread while the sweep's workers solve)."""
+    import matplotlib.backends.backend_agg  # noqa: F401
+    import matplotlib.figure  # noqa: F401
 
 
 def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | None = None,
@@ -289,7 +306,8 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
     x, uniform = sweep_points(n_points)
     out = pathlib.Path(out) if out is not None else None
     csv_path = out / "fit.csv" if out is not None else None
-    points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, progress=progress)
+    points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, progress=progress,
+                   meanwhile=import_plotting if out is not None and plot_png else None)
     xa = np.array([p.a_over_r for p in points])
     fa = np.array([p.K_over_Kcyl for p in points])
     um = np.array([p.uniform for p in points])
@@ -324,5 +342,5 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
     return result
 
 
-__all__ = ["FitPoint", "SOLVER", "fit_law", "in_processes", "linear_slope", "plot", "read_points", "run_fit",
-           "slope_sensitivity", "sweep", "sweep_points"]
+__all__ = ["FitPoint", "SOLVER", "fit_law", "import_plotting", "in_processes", "linear_slope", "plot", "read_points",
+           "run_fit", "slope_sensitivity", "sweep", "sweep_points"]

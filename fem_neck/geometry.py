@@ -6,7 +6,8 @@ Two spheres of radii ``r_i`` and ``r_j`` overlap by ``h = r_i + r_j - d`` (eq. 2
   (eqs. 10-12). It does not conserve volume and over-estimates the neck.
 * ``"newton"`` -- the volume-conserving cylindrical neck: a cylinder of radius ``a`` and height ``h_n`` whose
   volume equals the two spherical caps it replaces (eqs. 22-29). Solved by Newton's method on ``Z(a)`` (eqs. 27,
-  31, 32) from Coble's start (eq. 33). For equal radii it reproduces the closed form of eqs. (18)-(20).
+  31, 32); the paper starts from Coble's radius (eq. 33), we start from a closer one (:func:`newton_start`). For
+  equal radii it reproduces the closed form of eqs. (18)-(20).
 * ``"first"`` -- the first Newton iterate from Coble's start (eq. 34), a cheap approximation.
 
 Numerics. With ``h_c(a) = r - sqrt(r^2 - a^2)`` (eqs. 28-29) the identity ``d/dh_c [h_c^2 (3r - h_c)] = 3 a^2``
@@ -16,10 +17,11 @@ reduces the derivative of eq. (31) to ``Z'(a) = 6 a h_n``. Dividing eq. (27) by 
 
 strictly increasing in ``a`` on ``[0, min(r_i, r_j)]``: the root is unique, and ``h = phi_i + phi_j`` inverts the
 model (:func:`overlap_for_neck`, :func:`max_overlap`). ``Z`` is convex where ``h_n > 0``, so Newton started to the
-right of the root decreases monotonically onto it. Coble's start lies to the right in every case tested (radius
-ratios up to 100, see the tests); where it does not, or lies beyond the smaller radius, the iteration starts from
-the bracket's right end ``a = min(r_i, r_j)`` instead, so it never diverges. Cap heights are computed as
-``a^2 / (r + sqrt(r^2 - a^2))`` so that small necks keep full relative precision.
+right of the root decreases monotonically onto it, and a step from the left of the root (with ``Z' > 0``) lands to
+its right. Where the start has ``Z' <= 0`` the iteration starts from the bracket's right end ``a = min(r_i, r_j)``
+instead, so it never diverges. Cap heights are computed as ``a^2 / (r + sqrt(r^2 - a^2))`` so that small necks
+keep full relative precision. Large arrays are solved in blocks of cache size (:data:`_CHUNK` bonds), each block
+stopping as soon as its own bonds have converged.
 
 The model's range: a solution exists for ``0 < h <= max_overlap(r_i, r_j)``, where ``a`` reaches the smaller radius
 (``2r/3`` for equal spheres, Section 4.2).
@@ -36,6 +38,8 @@ _MAX_ITERATIONS = 60
 _RATIO_CAP = 1e100  # radius ratios above this are solved at this ratio (see _validated)
 _STEP_TOL = 1e-8  # relative Newton step after which the iterate is at round-off (quadratic convergence)
 _LIMIT_SLACK = 1e-12  # relative round-off tolerated beyond the model's largest overlap
+_TINY = np.finfo(float).tiny
+_CHUNK = 1 << 14  # neck_radius solves large arrays in blocks of this many bonds (cache-sized temporaries)
 
 
 @dataclass(frozen=True)
@@ -157,7 +161,8 @@ def _z_and_slope(a, r_i, r_j, h):
 
 
 def _validated(r_i, r_j, h):
-    """Checked, broadcast input in units of the smaller radius, and that radius (the length scale).
+    """Checked, broadcast input in units of the smaller radius, that radius (the length scale) and the largest
+    overlap in those units.
 
     The model is scale-free; working in units of ``min(r_i, r_j)`` keeps squares of lengths representable for
     any radius a float can hold.
@@ -179,33 +184,53 @@ def _validated(r_i, r_j, h):
     h_limit = h_max * (1.0 + _LIMIT_SLACK)
     if not np.all((h_s > 0.0) & (h_s <= h_limit)):  # False for NaN too
         check_positive("h", h, upper=h_limit * scale, upper_name="the neck reaches the smaller radius")
-    return r_i, r_j, np.minimum(h_s, h_max), scale
+    return r_i, r_j, np.minimum(h_s, h_max), scale, h_max
 
 
-def _solve(r_i, r_j, h, method):
+def newton_start(r_i, r_j, h, h_max):
+    """Start of the Newton iteration for ``"newton"``, in units of the smaller radius: a cheap root of a cubic model
+    of ``G`` in ``u = a^2`` that is exact at both ends of the range.
+
+    ``G(u) = c1 u + c2 u^2 + O(u^3) - h`` with ``c1 = (1/r_i + 1/r_j)/4`` (Coble's linearisation, eq. 11) and
+    ``c2 = (1/r_i^3 + 1/r_j^3)/24``; the model ``c1 u + c2 u^2 + c3 u^3`` takes ``c3`` so that ``u = 1`` gives
+    ``h_max``. Its root is approximated by the root of the quadratic ``c1 u + (h_max - c1) u^2 = h`` (also exact at
+    both ends) and one Newton step on the cubic. The start is within ~1 % of the root over the whole range
+    (Coble's within ~10 %), which saves two of the six Newton iterations Coble's start needs.
+    """
+    inv_i, inv_j = 1.0 / r_i, 1.0 / r_j
+    c1 = 0.25 * (inv_i + inv_j)
+    c2 = (inv_i * inv_i * inv_i + inv_j * inv_j * inv_j) * (1.0 / 24.0)
+    q2 = h_max - c1  # > 0: h_max lies between 5/12 (r_j -> inf, +c1 1/4) and 2/3 (equal, c1 1/2)
+    u = 2.0 * h / (c1 + np.sqrt(c1 * c1 + 4.0 * q2 * h))
+    c3 = q2 - c2  # > 0, so the cubic model's slope is positive and its value at u is c3 u^2 (u - 1) <= 0
+    u = u - c3 * u * u * (u - 1.0) / (c1 + u * (2.0 * c2 + 3.0 * c3 * u))
+    return np.sqrt(np.minimum(u, 1.0))
+
+
+def _solve(r_i, r_j, h, method, h_max):
     """Neck radius and Newton iteration count (Rojek 2022, eqs. 32-34) for the output of :func:`_validated`.
 
     Beyond a radius ratio of ~1e16 the larger sphere is a plane to double precision: the ratio is capped at
     ``_RATIO_CAP`` so that the Newton's squares of lengths stay finite, without changing any result."""
     r_i, r_j = np.minimum(r_i, _RATIO_CAP), np.minimum(r_j, _RATIO_CAP)
-    a = coble_radius(r_i, r_j, h)
     if method == "coble":
-        return a, 0
-    # Lengths are in units of the smaller radius (see _validated), so the bracket's right end is a = 1. Coble's
-    # radius may lie beyond it, where eqs. (28)-(29) have no answer: start at 1 there.
-    a = np.minimum(a, 1.0)
+        return coble_radius(r_i, r_j, h), 0
+    if method == "first":  # eq. (34): one Newton step from Coble's radius, which may lie beyond the smaller one
+        a = np.minimum(coble_radius(r_i, r_j, h), 1.0)
+        z, slope = _z_and_slope(a, r_i, r_j, h)
+        return a - z / slope, 1
+    # Lengths are in units of the smaller radius (see _validated), so the bracket's right end is a = 1. Z is convex
+    # where Z' = 6 a h_n > 0: a Newton step from there lands right of the root, and from the right the iteration
+    # descends monotonically onto it. A start where Z' <= 0 is replaced by the bracket's right end, where Z >= 0.
+    a = newton_start(r_i, r_j, h, h_max)
     for iterations in range(1, _MAX_ITERATIONS + 1):
         z, slope = _z_and_slope(a, r_i, r_j, h)
         if iterations == 1:
-            if method == "first":  # eq. (34)
-                return a - z / slope, 1
-            # Bracketing fallback: Newton descends monotonically onto the root only from its right (Z >= 0);
-            # a start on the left is replaced by the bracket's right end, where Z >= 0 within the range.
-            left = z < 0.0
-            if np.any(left):
-                a = np.where(left, 1.0, a)
+            flat = ~(slope > 0.0)
+            if np.any(flat):
+                a = np.where(flat, 1.0, a)
                 z, slope = _z_and_slope(a, r_i, r_j, h)
-        step = np.divide(z, slope, out=np.zeros_like(z), where=slope > 0.0)
+        step = z / np.maximum(slope, _TINY)  # slope > 0 from here on, unless it underflows (z does too, then)
         a = np.minimum(a - step, 1.0)  # at the range's end round-off may step past the smaller radius
         # Quadratic convergence: after a relative step s the error is ~ s^2 (measured: 3.4e-8 -> 4e-15), so a
         # step below 1e-8 leaves the root at round-off and one more iteration would change nothing.
@@ -223,9 +248,29 @@ def neck_radius(r_i, r_j, h, method: str = "newton"):
     """
     if method not in METHODS:
         raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
-    r_i, r_j, h, scale = _validated(r_i, r_j, h)
-    a = _solve(r_i, r_j, h, method)[0] * scale
+    r_i, r_j, h = (np.asarray(v, dtype=float) for v in (r_i, r_j, h))
+    if max(r_i.size, r_j.size, h.size) > _CHUNK:
+        return _neck_radius_blocked(r_i, r_j, h, method)
+    r_i, r_j, h, scale, h_max = _validated(r_i, r_j, h)
+    a = _solve(r_i, r_j, h, method, h_max)[0] * scale
     return float(a) if np.ndim(a) == 0 else a
+
+
+def _neck_radius_blocked(r_i, r_j, h, method):
+    """:func:`neck_radius` of large arrays, :data:`_CHUNK` bonds at a time: every temporary of the Newton stays in
+    the processor's cache instead of being a fresh multi-megabyte array per operation (3-4x faster for 10^6
+    bonds), and each block stops iterating as soon as its own bonds have converged."""
+    R_i, R_j, H = (np.ascontiguousarray(v).ravel() for v in np.broadcast_arrays(r_i, r_j, h))
+    a = np.empty(H.size)
+    try:
+        for start in range(0, H.size, _CHUNK):
+            block = slice(start, start + _CHUNK)
+            ri, rj, hb, scale, h_max = _validated(R_i[block], R_j[block], H[block])
+            a[block] = _solve(ri, rj, hb, method, h_max)[0] * scale
+    except ValueError:
+        _validated(r_i, r_j, h)  # the whole input again: the message names the first bad entry by its own index
+        raise
+    return a.reshape(np.broadcast_shapes(r_i.shape, r_j.shape, h.shape))
 
 
 def neck_geometry(r_i, r_j, h, method: str = "newton") -> NeckGeometry:
@@ -233,8 +278,8 @@ def neck_geometry(r_i, r_j, h, method: str = "newton") -> NeckGeometry:
     if method not in METHODS:
         raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
     R_i, R_j, H = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (r_i, r_j, h)))
-    r_i, r_j, h, scale = _validated(r_i, r_j, h)
-    a, iterations = _solve(r_i, r_j, h, method)
+    r_i, r_j, h, scale, h_max = _validated(r_i, r_j, h)
+    a, iterations = _solve(r_i, r_j, h, method, h_max)
     # |V_cyl - V_caps| / V_cyl = |Z| / (3 a^2 h_n) = |G| / h_n  (eq. 27 divided by 3 a^2), in units of r_min
     h_ci, h_cj = cap_height(r_i, a), cap_height(r_j, a)
     residual = np.abs(_phi(h_ci, r_i) + _phi(h_cj, r_j) - h) / np.abs(h_ci + h_cj - h)

@@ -327,7 +327,12 @@ def _solve_dirichlet(basis, hot_dofs, cold_dofs, rtol: float):
     u[hot_dofs] = 1.0
     Ai, b, _, interior = condense(A, np.zeros(basis.N), x=u, D=np.concatenate([hot_dofs, cold_dofs]))
     ml = pyamg.smoothed_aggregation_solver(Ai.tocsr(), symmetry="symmetric")
-    u[interior] = ml.solve(b, x0=np.full(len(interior), 0.5), tol=rtol, accel="cg", maxiter=2000)
+    residuals = []
+    u[interior] = ml.solve(b, x0=np.full(len(interior), 0.5), tol=rtol, accel="cg", maxiter=2000,
+                           residuals=residuals)
+    if residuals and residuals[-1] > 100.0 * rtol * max(residuals[0], 1e-300):
+        raise RuntimeError(f"the FE system ({len(interior)} unknowns) did not converge: relative residual "
+                           f"{residuals[-1] / residuals[0]:.1e} after {len(residuals) - 1} AMG-CG iterations")
     return u, A
 
 

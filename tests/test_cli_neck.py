@@ -6,6 +6,8 @@ import sys
 
 import pytest
 
+from verification.cases import SEC43
+
 
 def run_cli(*args):
     return subprocess.run([sys.executable, "-m", "fem_neck", *args], capture_output=True, text=True, timeout=120)
@@ -17,11 +19,11 @@ def test_neck_json_has_the_documented_keys_and_paper_value():
     out = json.loads(proc.stdout)
     for key in ("a", "h_ci", "h_cj", "h_n", "iterations", "volume_residual"):
         assert key in out
-    assert out["a"] == pytest.approx(0.741466e-3, abs=1e-9)
+    assert out["a"] == pytest.approx(SEC43["newton"].value, abs=1e-9)
     assert out["volume_residual"] < 1e-12
 
 
-@pytest.mark.parametrize("method, expected", [("coble", 0.774597e-3), ("first", 0.745039e-3)])
+@pytest.mark.parametrize("method, expected", [("coble", SEC43["coble"].value), ("first", SEC43["first"].value)])
 def test_neck_methods(method, expected):
     proc = run_cli("neck", "--ri", "1e-3", "--rj", "3e-3", "--h", "0.2e-3", "--method", method, "--json")
     assert json.loads(proc.stdout)["a"] == pytest.approx(expected, abs=1e-9)

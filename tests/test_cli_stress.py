@@ -1,6 +1,6 @@
 """Regression tests for the CLI stress defects found by fuzzing ``python -m fem_neck | dem | verification``.
 
-Every case calls the CLI ``main`` in process and requires what the issue asks of hidden stress cases: exit code 2
+Every case calls the CLI ``main`` in process and requires what the project asks of bad input: exit code 2
 with one line on stderr naming the parameter (and its range), or a correct answer -- never a traceback, a NaN or
 a hang. The defect each test guards is in its docstring or comment.
 """

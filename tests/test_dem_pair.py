@@ -1,17 +1,17 @@
 """Two copper particles (r = 1 and 3 mm, h = 0.06 mm, Rojek 2022 Sec. 6) equalising their temperatures.
 
 The lumped pair obeys d(T_i - T_j)/dt = -K_ij (1/C_i + 1/C_j) (T_i - T_j): the difference decays exactly as
-exp(-lambda t). Each integrator must follow it (issue 4's tolerances) and conserve energy to round-off.
+exp(-lambda t). Each integrator must follow it (to the tolerances below) and conserve energy to round-off.
 """
 
 import numpy as np
 import pytest
 
 from dem import make_scene, run
-from dem.bonds import find_bonds
-from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.laws.conductance import ConductanceSpec
 from dem.particles import Particles
-from dem.thermal import Network, integrate, stable_limit
+from dem.thermal import build_network, integrate, stable_limit
+from verification.cases import SEC6
 
 X = [[0.0, 0.0, 0.0], [0.0, 0.0, 3.94e-3]]
 R = [1.0e-3, 3.0e-3]
@@ -20,15 +20,12 @@ T0 = [100.0, 0.0]
 
 def pair_network(law="rojek"):
     p = Particles.from_arrays(X, R, T0)
-    spec = ConductanceSpec(law=law)
-    b = find_bonds(p, (), spec.contact)
-    k_pairs, k_walls = bond_conductances(spec, p, b)
-    return Network(p, b, k_pairs, k_walls, np.zeros(0)), p
+    return build_network(p, spec=ConductanceSpec(law=law)), p
 
 
 def test_pair_conductance_is_the_papers():
     net, _ = pair_network()
-    assert net.K_pairs[0] == pytest.approx(0.276035, abs=5e-7)  # Rojek 2022, Sec. 6: K_ij = 0.276035 W/K
+    assert net.K_pairs[0] == pytest.approx(SEC6["K_model"].value, abs=5e-7)  # Rojek 2022, Sec. 6: K_ij = 0.276035 W/K
 
 
 def decay_error(integrator, dt, law="rojek", t_end=0.2):
@@ -83,7 +80,7 @@ def test_stable_limit_is_the_pair_eigenvalue_and_larger_dt_refused():
     assert abs(res.T[0] - res.T[1]) < 100.0
 
 
-def test_run_summary_of_issue_example(tmp_path):
+def test_run_summary_of_the_pair_scene(tmp_path):
     scene = make_scene(X, R, T0, mode="transient", integrator="crank-nicolson", dt=1e-3, t_end=0.1)
     res = run(scene, out=tmp_path)
     s = res.summary

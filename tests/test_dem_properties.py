@@ -4,10 +4,9 @@ Laplacian, energy conservation, maximum principle, independence from particle or
 import numpy as np
 from hypothesis import given, settings, strategies as st
 
-from dem.bonds import find_bonds
-from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.laws.conductance import ConductanceSpec
 from dem.particles import Particles
-from dem.thermal import Network, integrate, steady
+from dem.thermal import build_network, integrate, steady
 
 
 @st.composite
@@ -26,10 +25,7 @@ def clusters(draw):
 
 def network(x, r, T, law, fixed=None):
     p = Particles.from_arrays(x, r, T, fixed=fixed)
-    spec = ConductanceSpec(law=law, out_of_range="drop")
-    b = find_bonds(p, (), spec.contact, spec.out_of_range)
-    kp, kw = bond_conductances(spec, p, b)
-    return Network(p, b, kp, kw, np.zeros(0))
+    return build_network(p, spec=ConductanceSpec(law=law, out_of_range="drop"))
 
 
 @settings(max_examples=40, deadline=None)

@@ -1,4 +1,4 @@
-"""TOML scenes and the ``python -m dem`` CLI: the issue's example, built-ins, generators, bad input -> exit 2."""
+"""TOML scenes and the ``python -m dem`` CLI: the pair example, built-ins, generators, bad input -> exit 2."""
 
 import json
 import subprocess
@@ -34,7 +34,7 @@ def dem_cli(*args, cwd=None):
     return subprocess.run([sys.executable, "-m", "dem", *args], capture_output=True, text=True, cwd=cwd, timeout=120)
 
 
-def test_issue_example_runs_from_cli(tmp_path):
+def test_pair_example_runs_from_cli(tmp_path):
     path = tmp_path / "pair.toml"
     path.write_text(EXAMPLE)
     proc = dem_cli("run", str(path), "--json", "--out", str(tmp_path / "out"))

@@ -77,10 +77,10 @@ def test_convection_and_radiation_steady():
     x, r, h = chain_arrays([1e-3, 1e-3], [0.1])
     K = fem_law.pair_conductance(394.0, 1e-3, 1e-3, neck_radius(1e-3, 1e-3, h[0]), fem_law.ROJEK)
     A = 4 * np.pi * 1e-6
-    conv = Sources(convection=Convection(1e4, 20.0))
+    conv = Sources(convection=Convection(1e4, 20.0, area_fraction=1.0))  # the whole surface, opted in
     res = run(make_scene(x, r, [500.0, 0.0], fixed=[True, False], sources=conv, mode="steady"))
     assert res.T[1] == pytest.approx((K * 500 + 1e4 * A * 20) / (K + 1e4 * A), rel=1e-12)
-    rad = Sources(radiation=Radiation(0.8, 300.0))
+    rad = Sources(radiation=Radiation(0.8, 300.0, area_fraction=1.0))
     res = run(make_scene(x, r, [1500.0, 0.0], fixed=[True, False], sources=rad, mode="steady"))
     f = lambda T: K * (1500 - T) - 0.8 * STEFAN_BOLTZMANN * A * (T**4 - 300.0**4)
     assert res.T[1] == pytest.approx(brentq(f, 300, 1500, xtol=1e-13), rel=1e-12)
@@ -114,20 +114,15 @@ def test_out_of_range_reported_or_by_policy():
 
 def test_large_network_iterative_matches_direct():
     from dem.generators import random_packing
-    from dem.bonds import find_bonds
-    from dem.laws.conductance import bond_conductances
     from dem.particles import Particles
-    from dem.thermal import Network, steady
+    from dem.thermal import build_network, steady
 
     lay = random_packing(3000, 1e-4, 0.12, seed=3)
     T = np.zeros(len(lay.radius))
     fixed = np.zeros(len(T), bool)
     fixed[lay.bottom] = fixed[lay.top] = True
     T[lay.bottom] = 1.0
-    p = Particles.from_arrays(lay.position, lay.radius, T, fixed=fixed)
-    b = find_bonds(p)
-    kp, kw = bond_conductances(ConductanceSpec(), p, b)
-    net = Network(p, b, kp, kw, np.zeros(0))
+    net = build_network(Particles.from_arrays(lay.position, lay.radius, T, fixed=fixed), spec=ConductanceSpec())
     ref = steady(net, floating="mean", linear="direct").T
     for backend in ("amg", "cg"):
         assert np.max(np.abs(steady(net, floating="mean", linear=backend, rtol=1e-12).T - ref)) < 1e-9

@@ -12,10 +12,9 @@ import numpy as np
 import pytest
 
 import dem.thermal
-from dem.bonds import find_bonds
-from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.laws.conductance import ConductanceSpec
 from dem.particles import Particles
-from dem.thermal import Network, integrate, stable_limit
+from dem.thermal import Network, build_network, integrate, stable_limit
 
 INTEGRATORS = ("explicit", "implicit", "crank-nicolson")
 
@@ -31,10 +30,7 @@ def chain_network(n: int, hot: float = 100.0, fixed_ends: bool = False, radii=No
     if fixed_ends:
         fixed[[0, -1]] = True
     p = Particles.from_arrays(x, r, T0, fixed=fixed)
-    spec = ConductanceSpec(law="rojek")
-    b = find_bonds(p, (), spec.contact)
-    k_pairs, k_walls = bond_conductances(spec, p, b)
-    return Network(p, b, k_pairs, k_walls, np.zeros(0))
+    return build_network(p, spec=ConductanceSpec(law="rojek"))
 
 
 def run_against_exact(net: Network, integrator: str, rtol: float, t_end: float):

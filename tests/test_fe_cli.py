@@ -4,7 +4,9 @@ import json
 
 import pytest
 
-from fem_neck.cli import converge, main
+from fem_neck import convergence
+from fem_neck.cli import main
+from verification.cases import SEC6, SEMISPHERE_BY_H
 
 
 def _run(capsys, argv):
@@ -17,7 +19,7 @@ def test_semisphere_json(capsys, tmp_path):
     rc, out = _run(capsys, ["semisphere", "--h-over-r", "0.08", "--json", "--out", str(tmp_path)])
     assert rc == 0
     assert {"h_over_r", "a_over_r", "K_over_Kcyl", "dofs", "error_estimate", "seconds"} <= out.keys()
-    assert out["K_over_Kcyl"] == pytest.approx(0.412739950539, rel=3e-4)  # reference README, h/r = 0.08
+    assert out["K_over_Kcyl"] == pytest.approx(SEMISPHERE_BY_H[0.08].K_over_Kcyl, rel=3e-4)
     assert {p.name for p in tmp_path.iterdir()} >= {"semisphere.vtu", "semisphere.png", "semisphere.json"}
     import meshio
 
@@ -28,9 +30,9 @@ def test_semisphere_json(capsys, tmp_path):
 
 
 def test_semisphere_by_neck_radius(capsys):
-    rc, out = _run(capsys, ["semisphere", "--a-over-r", "0.610588366343", "--rtol", "1e-5", "--json"])
+    rc, out = _run(capsys, ["semisphere", "--a-over-r", repr(SEMISPHERE_BY_H[0.2].a_over_r), "--rtol", "1e-5", "--json"])
     assert rc == 0 and out["h_over_r"] == pytest.approx(0.2, rel=1e-9)
-    assert out["K_over_Kcyl"] == pytest.approx(0.655577629373, rel=3e-5)
+    assert out["K_over_Kcyl"] == pytest.approx(SEMISPHERE_BY_H[0.2].K_over_Kcyl, rel=3e-5)
 
 
 def test_pair_json_paper_case(capsys):
@@ -38,8 +40,8 @@ def test_pair_json_paper_case(capsys):
     rc, out = _run(capsys, ["pair", "--ri", "1e-3", "--rj", "3e-3", "--h", "0.06e-3", "--kappa", "394", "--json"])
     assert rc == 0
     assert {"a", "K_fe", "K_model", "rel_diff", "error_estimate"} <= out.keys()
-    assert out["a"] == pytest.approx(0.419186e-3, abs=1e-9)
-    assert out["K_model"] == pytest.approx(0.276035, abs=1e-6)
+    assert out["a"] == pytest.approx(SEC6["a"].value, abs=1e-9)
+    assert out["K_model"] == pytest.approx(SEC6["K_model"].value, abs=1e-6)
     assert out["rel_diff"] == pytest.approx((out["K_model"] - out["K_fe"]) / out["K_fe"], rel=1e-12)
 
 
@@ -74,12 +76,12 @@ def test_bad_input_exits_2_with_one_line(capsys, argv):
 
 
 def test_converge_json_and_plot(capsys, tmp_path, monkeypatch):
-    monkeypatch.setattr(converge, "GRADINGS", (0.6, 0.45, 0.3))
-    monkeypatch.setattr(converge, "UNIFORM_SIZES", (0.2, 0.1))
+    monkeypatch.setattr(convergence, "GRADINGS", (0.6, 0.45, 0.3))
+    monkeypatch.setattr(convergence, "UNIFORM_SIZES", (0.2, 0.1))
     rc, out = _run(capsys, ["converge", "--h-over-r", "0.08", "--json", "--out", str(tmp_path)])
     assert rc == 0
     assert {"levels", "extrapolated", "observed_order"} <= out.keys()
     for level in out["levels"]:
         assert {"order", "grading", "dofs", "h_min", "elements_across_neck", "K_over_Kcyl"} <= level.keys()
-    assert out["extrapolated"] == pytest.approx(0.412739950539, rel=1e-4)
+    assert out["extrapolated"] == pytest.approx(SEMISPHERE_BY_H[0.08].K_over_Kcyl, rel=1e-4)
     assert (tmp_path / "converge.png").stat().st_size > 10_000

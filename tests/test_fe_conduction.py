@@ -1,7 +1,7 @@
 """FE conductance of sintered necks against reference numbers, identities and independent solves.
 
-Reference values: /work/shared/reference/README.md, table "Semisphere with a cylindrical neck" (independent
-hp-FE, 12 digits) and "Other anchors" (flux-tube constriction, Rohsenow et al. 1998).
+Reference values: ``verification.cases`` -- the semisphere table (independent hp-FE, 12 digits) and the
+flux-tube constriction (Rohsenow et al. 1998).
 """
 
 import math
@@ -13,13 +13,8 @@ import pytest
 from fem_neck import conduction, shapes
 from fem_neck.geometry import equal_neck_radius
 
-# (h/r, a/r, K/K_cyl) -- reference README, semisphere table
-REFERENCE = [
-    (0.02, 0.199331088562, 0.216136324118),
-    (0.08, 0.394592534534, 0.412739950539),
-    (0.2, 0.610588366343, 0.655577629373),
-    (0.4, 0.829667696190, 0.992974073489),
-]
+from verification.cases import FLUX_TUBE_CONSTRICTION
+from verification.cases import SEMISPHERE as REFERENCE  # (h/r, a/r, K/K_cyl)
 
 
 @pytest.mark.parametrize("h_over_r, a_ref, k_ref", REFERENCE)
@@ -145,13 +140,13 @@ def test_chain_of_three_is_two_bonds_in_series_with_a_shared_middle():
 
 def test_flux_tube_constriction():
     """Isothermal disk a = 1 into an insulated tube b = 2 (kappa = 1): extra resistance ~0.0849 K/W
-    (Rohsenow et al. 1998 correlation, ~0.1 %). The disturbance decays like exp(-3.83 z / b): L = 3b suffices."""
+    (:data:`verification.cases.FLUX_TUBE_CONSTRICTION`, Rohsenow et al. 1998 correlation, ~0.1 %). The disturbance decays like exp(-3.83 z / b): L = 3b suffices."""
     length = 6.0
     profile = shapes.profile_mesh((1.0, 0.0), [("line", (2.0, 0.0), "annulus"), ("line", (2.0, length), "wall")],
                                   [[1.0, 0.0]], sizes=shapes.SizeField(grading=0.3))
     sol = conduction.solve_profile(profile, order=3)
     extra = 1.0 / sol.K - length / (math.pi * 2.0**2)
-    assert extra == pytest.approx(0.0849, rel=2e-3)
+    assert extra == pytest.approx(FLUX_TUBE_CONSTRICTION.value, rel=2e-3)
 
 
 def test_result_pickles_without_the_field():

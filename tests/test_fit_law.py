@@ -9,9 +9,9 @@ from fem_neck import fit, law
 from fem_neck.cli import main
 from fem_neck.geometry import neck_geometry, overlap_for_neck
 
-# /work/shared/reference/README.md, "Semisphere with a cylindrical neck": (a/r, K/K_cyl), independent hp-FE code.
-REFERENCE = [(0.199331088562, 0.216136324118), (0.394592534534, 0.412739950539),
-             (0.610588366343, 0.655577629373), (0.829667696190, 0.992974073489)]
+from verification.cases import SEC6, SEMISPHERE
+
+REFERENCE = [(row.a_over_r, row.K_over_Kcyl) for row in SEMISPHERE]  # independent hp-FE, 12 digits
 
 
 @pytest.fixture(scope="module")
@@ -20,7 +20,7 @@ def default():
 
 
 def test_small_neck_limit_is_the_isothermal_disk(default):
-    # K -> 4 kappa a (disk on a half-space, reference README "Other anchors"), i.e. K/K_cyl -> (4/pi) a/r
+    # K -> 4 kappa a (disk on a half-space, verification.cases.CONSTRICTION_LIMIT), i.e. K/K_cyl -> (4/pi) a/r
     x = np.array([1e-9, 1e-7, 1e-5])
     ratio = default.k_over_kcyl(x) / (4 / np.pi * x)
     assert ratio == pytest.approx(1.0, abs=2e-4)
@@ -37,7 +37,7 @@ def test_full_neck_is_a_cylinder_of_length_two_thirds_r(default):
 
 @pytest.mark.parametrize("x, k", REFERENCE)
 def test_default_law_matches_reference_values(default, x, k):
-    assert default.k_over_kcyl(x) == pytest.approx(k, rel=5e-3)  # the issue's target
+    assert default.k_over_kcyl(x) == pytest.approx(k, rel=5e-3)  # the law's target (0.5 %)
     assert default.k_over_kcyl(x) == pytest.approx(k, rel=5e-4)  # what the fit actually achieves
 
 
@@ -69,8 +69,9 @@ def test_fit_json_table_matches_the_closed_form(default):
 
 
 def test_paper_pair_with_the_linear_law():
-    # Rojek 2022, Sec. 6 (reference README): r_i = 1 mm, r_j = 3 mm, a = 0.419186 mm, kappa = 394 -> 0.276035 W/K
-    assert law.pair_conductance(394.0, 1e-3, 3e-3, 0.419186e-3, law.ROJEK) == pytest.approx(0.276035, rel=2e-6)
+    # Rojek 2022, Sec. 6: r_i = 1 mm, r_j = 3 mm, a = 0.419186 mm, kappa = 394 -> 0.276035 W/K
+    assert law.pair_conductance(394.0, 1e-3, 3e-3, SEC6["a"].value, law.ROJEK) == pytest.approx(SEC6["K_model"].value,
+                                                                                                 rel=2e-6)
     assert law.ARGENTO_BOUVARD.slope == pytest.approx(1.112, abs=5e-4)
 
 
@@ -157,5 +158,5 @@ def test_unequal_pairs_against_fe(tmp_path):
     assert dev["3"]["corrected"] < 1e-3  # ... and the fitted correction removes most of it
     assert res["a_only_spread"]["0.5"] > 0.01  # eq. 43's "K depends on a only" is off by percents
     paper = res["paper_case"]  # Rojek 2022 Sec. 6: r_i = 1 mm, r_j = 3 mm, h = 0.06 mm, kappa = 394
-    assert paper["a"] == pytest.approx(0.419186e-3, rel=2e-6)
+    assert paper["a"] == pytest.approx(SEC6["a"].value, rel=2e-6)
     assert paper["K_law"] == pytest.approx(paper["K_fe"], rel=2e-3)

@@ -8,6 +8,7 @@ from scipy.optimize import brentq
 
 from fem_neck import coble_radius, max_overlap, neck_geometry, neck_radius, overlap_for_neck
 from fem_neck.geometry import equal_neck_radius
+from verification.cases import SEC6, SEC43, SEMISPHERE
 
 MM = 1e-3
 
@@ -16,10 +17,10 @@ MM = 1e-3
 @pytest.mark.parametrize(
     "h, method, expected",
     [
-        (0.2 * MM, "newton", 0.741466 * MM),
-        (0.2 * MM, "coble", 0.774597 * MM),
-        (0.2 * MM, "first", 0.745039 * MM),
-        (0.06 * MM, "newton", 0.419186 * MM),
+        (0.2 * MM, "newton", SEC43["newton"].value),
+        (0.2 * MM, "coble", SEC43["coble"].value),
+        (0.2 * MM, "first", SEC43["first"].value),
+        (0.06 * MM, "newton", SEC6["a"].value),
     ],
 )
 def test_paper_section_4_3(h, method, expected):
@@ -27,8 +28,8 @@ def test_paper_section_4_3(h, method, expected):
 
 
 @pytest.mark.parametrize(
-    "h_over_r, a_over_r",  # shared/reference/README.md, semisphere table (from eqs 19-20 to 12 digits)
-    [(0.02, 0.199331088562), (0.08, 0.394592534534), (0.2, 0.610588366343), (0.4, 0.829667696190)],
+    "h_over_r, a_over_r",  # verification.cases.SEMISPHERE (from eqs 19-20 to 12 digits)
+    [(row.h_over_r, row.a_over_r) for row in SEMISPHERE],
 )
 def test_equal_spheres_reference_table(h_over_r, a_over_r):
     assert neck_radius(1.0, 1.0, h_over_r) == pytest.approx(a_over_r, rel=1e-11)
@@ -178,14 +179,47 @@ def test_overlap_for_neck_inverts_neck_radius(pair):
 
 
 def test_bracketing_fallback_converges_from_a_start_left_of_the_root(monkeypatch):
-    """Were Coble's start ever left of the root (Z < 0), Newton restarts from the smaller radius, never diverges."""
+    """Were the start ever left of the root where Z' <= 0 (Z < 0 too), Newton restarts from the smaller radius and
+    never diverges."""
     import fem_neck.geometry as geometry
 
     r_i = np.full(5, 1.0)
     r_j = np.array([1.0, 2.0, 3.0, 10.0, 100.0])
     h = 0.5 * max_overlap(r_i, r_j)
     expected = neck_radius(r_i, r_j, h)
-    monkeypatch.setattr(geometry, "coble_radius", lambda r_i, r_j, h: 1e-3 * np.sqrt(h))
+    monkeypatch.setattr(geometry, "newton_start", lambda r_i, r_j, h, h_max: 1e-3 * np.sqrt(h))
     g = neck_geometry(r_i, r_j, h)
     assert np.allclose(g.a, expected, rtol=1e-13, atol=0)
     assert np.all(g.volume_residual < 1e-12)
+
+
+def test_large_arrays_solved_in_blocks_match_small_calls():
+    """neck_radius of > _CHUNK bonds runs block by block: same roots as the unblocked solve (to round-off), the
+    broadcast shape kept, and a bad entry named by its index in the whole input."""
+    from fem_neck import geometry
+
+    rng = np.random.default_rng(5)
+    r_j = 1e-3 * rng.uniform(1.0, 10.0, (300, 100))  # 30 000 bonds against one r_i: broadcast
+    h = max_overlap(1e-3, r_j) * rng.uniform(1e-6, 1.0, r_j.shape)
+    a = neck_radius(1e-3, r_j, h)
+    assert a.shape == (300, 100) and r_j.size > geometry._CHUNK
+    rows = np.concatenate([neck_radius(1e-3, r_j[k:k + 10], h[k:k + 10]).ravel() for k in range(0, 300, 10)])
+    assert np.max(np.abs(a.ravel() - rows) / rows) <= 4 * np.finfo(float).eps
+    h_bad = h.copy()
+    h_bad[250, 7] = -1.0
+    with pytest.raises(ValueError, match=r"h\[25007\]"):
+        neck_radius(1e-3, r_j, h_bad)
+
+
+@pytest.mark.parametrize("ratio", [1.0, 1.5, 3.0, 10.0, 1e3, 1e8])
+def test_newton_start_is_close_and_newton_needs_few_iterations(ratio):
+    """The start (a cubic model of G in a^2, exact at both ends of the range) is within 1.5 % of the root over the
+    whole range, so Newton stops after at most 4 iterations (Coble's start, off by up to 10 %, needs 6)."""
+    from fem_neck import geometry
+
+    h = max_overlap(1.0, ratio) * np.geomspace(1e-9, 1.0, 2000)
+    ri, rj = np.ones_like(h), np.full_like(h, ratio)
+    a = neck_radius(ri, rj, h)
+    start = geometry.newton_start(ri, rj, h, float(max_overlap(1.0, ratio)))
+    assert np.max(np.abs(start / a - 1.0)) < 0.015
+    assert neck_geometry(ri, rj, h).iterations <= 4

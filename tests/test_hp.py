@@ -9,8 +9,9 @@ import pytest
 from fem_neck import conduction, hpmesh, spectral
 from fem_neck.geometry import equal_neck_radius, max_overlap, neck_geometry, overlap_for_neck
 
-# (h/r, K/K_cyl) -- /work/shared/reference/README.md, semisphere table (independent hp-FE, 12 digits)
-REFERENCE = [(0.02, 0.216136324118), (0.08, 0.412739950539), (0.2, 0.655577629373), (0.4, 0.992974073489)]
+from verification.cases import SEMISPHERE, SEMISPHERE_BY_H
+
+REFERENCE = [(row.h_over_r, row.K_over_Kcyl) for row in SEMISPHERE]  # independent hp-FE, 12 digits
 SWEEP = np.concatenate([np.geomspace(1e-4, 0.1, 13), np.linspace(0.12, 0.98, 44), [0.59999, 0.60001, 0.995, 0.999]])
 
 
@@ -84,7 +85,7 @@ def test_constriction_limit():
 
 def test_exponential_convergence_in_the_order():
     """On one geometric mesh the error falls by >= 5x per order from p = 3 to 8 (a/r = 0.39; measured 18x to 7x)."""
-    mesh, shape = hpmesh.semisphere_quad_mesh(0.394592534534, 8)
+    mesh, shape = hpmesh.semisphere_quad_mesh(SEMISPHERE_BY_H[0.08].a_over_r, 8)
     fixed = hpmesh.end_disks(mesh, shape)
     k_ref = REFERENCE[1][1] * math.pi
     errors = [abs(spectral.conductance(mesh, p, fixed).K_over_kappa - k_ref) / k_ref for p in range(3, 9)]
@@ -113,7 +114,7 @@ def test_bad_input(call, match):
 
 def test_equal_pair_is_half_the_semisphere():
     """Two equal halves in series: K_pair = K_semisphere / 2 exactly (kappa = r = 1)."""
-    a = 0.394592534534
+    a = SEMISPHERE_BY_H[0.08].a_over_r
     h = float(overlap_for_neck(1.0, 1.0, a))
     pair = conduction.pair_conductance(1.0, 1.0, h, 1.0, rtol=1e-8)
     assert pair.K == pytest.approx(0.5 * math.pi * REFERENCE[1][1], rel=1e-8)

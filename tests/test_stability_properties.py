@@ -1,4 +1,4 @@
-"""Property-based stress tests of the pipe-network DEM over random scenes (issue 6, section 3).
+"""Property-based stress tests of the pipe-network DEM over random scenes.
 
 Scenes: particles on a cubic lattice of spacing s with random radii in [0.52 s, 0.6 s], so every lattice neighbour
 overlaps by 0.04 s .. 0.2 s (inside the neck model's range) and no diagonal pair touches; random vacancies split the
@@ -12,17 +12,19 @@ packing into clusters and leave isolated particles. Properties that must hold fo
 * independence from particle ordering: a permuted scene gives the permuted temperatures.
 """
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from dem.bonds import find_bonds
-from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.laws.conductance import ConductanceSpec
 from dem.particles import Particles
-from dem.thermal import Network, integrate, stable_limit, steady
+from dem.thermal import Network, build_network, integrate, stable_limit, steady
 
 SPACING = 1e-4  # m
+pytestmark = pytest.mark.stress
 
 
 def make_network(seed: int, shape, vacancy: float, n_fixed: int, law: str = "rojek", order=None) -> Network:
@@ -39,10 +41,7 @@ def make_network(seed: int, shape, vacancy: float, n_fixed: int, law: str = "roj
     particles = Particles.from_arrays(pos, radius, temperature, fixed=fixed)
     if order is not None:
         particles = particles.permuted(order(n))
-    bonds = find_bonds(particles)
-    spec = ConductanceSpec(law=law)
-    k_pairs, k_walls = bond_conductances(spec, particles, bonds)
-    return Network(particles, bonds, k_pairs, k_walls, np.zeros(0))
+    return build_network(particles, spec=ConductanceSpec(law=law))
 
 
 scenes = st.fixed_dictionaries({
@@ -135,7 +134,7 @@ def test_anchored_network_matrix_positive_definite(scene):
     fixed[first] = True
     assume(not fixed.all())
     p2 = Particles.from_arrays(p.position, p.radius, p.temperature, fixed=fixed)
-    net2 = Network(p2, net.bonds, net.K_pairs, net.K_walls, net.wall_temperature)
+    net2 = replace(net, particles=p2)
     A = net2.matrix(net2.sinks(p2.temperature[net2.free])).toarray()
     assert np.linalg.eigvalsh(A).min() > 0
 

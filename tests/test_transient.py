@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from fem_neck.transient import first_decay_rate, lumped_pair, pair_mesh, solve_transient, time_grid
+from verification.cases import SEMISPHERE_BY_H
 
 KAPPA, RHO, C = 394.0, 8960.0, 385.0  # copper
 R_I, R_J, H = 1e-3, 3e-3, 0.06e-3  # Rojek 2022, Sec. 6
@@ -51,11 +52,11 @@ def test_time_stepping_decays_at_the_first_eigenvalue(pair):
 
 
 def test_small_neck_tends_to_the_lumped_model():
-    # Equal spheres, reference semisphere rows (shared/reference/README.md): K_pair = f kappa pi r / 2.
+    # Equal spheres, reference semisphere rows (verification.cases): K_pair = f kappa pi r / 2.
     # The lumped decay rate K (1/C_i + 1/C_j) and the FE's lambda_1 differ by O(a/r) (the pipe K is defined
     # between equatorial disks, the lumped one between particle means): the gap must shrink with the neck.
     gaps = []
-    for h_over_r, f in ((0.02, 0.216136324118), (0.2, 0.655577629373)):
+    for h_over_r, f in ((hr, SEMISPHERE_BY_H[hr].K_over_Kcyl) for hr in (0.02, 0.2)):
         pm = pair_mesh(1.0, 1.0, h_over_r, size_max=0.15)
         lam_lumped = f * np.pi / 2 * 2 / (4 / 3 * np.pi)
         gaps.append(first_decay_rate(pm, 1.0, 1.0, 1.0) / lam_lumped - 1)

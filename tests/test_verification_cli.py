@@ -9,6 +9,7 @@ import time
 import matplotlib.image
 import pytest
 
+from test_verification_report import assert_report_links_resolve
 from verification import __main__ as cli
 
 
@@ -48,6 +49,7 @@ def _check_run(out, proc, sections):
         assert sec["status"] == "ok", (name, sec["error"])
         for fig in sec["figures"]:
             assert matplotlib.image.imread(out / fig).shape[0] > 50  # every figure opens
+    assert_report_links_resolve(out)
     return summary, (out / "report.md").read_text()
 
 
@@ -76,24 +78,3 @@ def test_all_quick_under_three_minutes(tmp_path):
     summary, _ = _check_run(out, proc, ["paper", "chains", "clusters", "transient", "lattices"])
     assert any(k.startswith("chains.") for k in summary)
     assert seconds < 180.0, seconds
-
-
-def test_plugin_options_reach_run(monkeypatch, tmp_path, capsys):
-    import importlib.machinery
-    import types
-
-    monkeypatch.setenv("TQDM_DISABLE", "")  # main() sets it for --no-progress; monkeypatch restores it
-    seen = {}
-    mod = types.ModuleType("verification.stability")
-    mod.__spec__ = importlib.machinery.ModuleSpec(mod.__name__, None)
-    mod.add_arguments = lambda p: p.add_argument("--cases", type=int, default=1)
-
-    def run(out_dir, quick=False, cases=1):
-        seen.update(quick=quick, cases=cases)
-        return {"title": "S", "markdown": "", "summary": {"stress": 0.0}, "figures": []}
-
-    mod.run = run
-    monkeypatch.setitem(sys.modules, mod.__name__, mod)
-    code = cli.main(["stability", "--quick", "--cases", "7", "--json", "--no-progress", "--out", str(tmp_path)])
-    assert code == 0 and seen == {"quick": True, "cases": 7}
-    assert json.loads(capsys.readouterr().out) == {"stress": 0.0}

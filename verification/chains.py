@@ -1,4 +1,4 @@
-"""Collinear chains: the DEM pipe network against the FE of the same chain (issue 5, item 1).
+"""Collinear chains: the DEM pipe network against the FE of the same chain.
 
 Each chain is N = 2..8 spheres on one axis with mixed radii (ratios up to 5) and mixed necks, given as
 ``a / min(r_k, r_k+1)`` per bond; the overlaps follow from the volume-conserving neck

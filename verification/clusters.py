@@ -1,4 +1,4 @@
-"""3D clusters: the pipe-network DEM against full 3D finite-element conduction (issue 5, item 2).
+"""3D clusters: the pipe-network DEM against full 3D finite-element conduction.
 
 Clusters (radii ~1 mm, copper kappa = 394 W/(m K); relative errors do not depend on either):
 
@@ -34,7 +34,7 @@ from __future__ import annotations
 import functools
 import pathlib
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -237,13 +237,12 @@ def dem_steady(cluster: Cluster, terminals, law: str) -> tuple[float, np.ndarray
     """The DEM's steady pipe network of the same cluster (Rojek 2022, eqs. 2-4 with dT/dt = 0): the effective
     conductance (W/K) and every particle's temperature.
 
-    The DEM finds the bonds itself from the overlaps (:func:`dem.bonds.find_bonds`); they must be the cluster's.
+    The DEM finds the bonds itself from the overlaps (:func:`dem.thermal.build_network`); they must be the cluster's.
     The terminals are its fixed particles. ``law`` is a DEM conductance law, or :data:`NETWORK_ONLY`.
     """
-    from dem.bonds import find_bonds
-    from dem.laws.conductance import ConductanceSpec, bond_conductances
+    from dem.laws.conductance import ConductanceSpec
     from dem.particles import Material, Particles
-    from dem.thermal import Network, boundary_heat_flow, steady
+    from dem.thermal import boundary_heat_flow, build_network, steady
 
     T0 = np.zeros(cluster.n)
     fixed = np.zeros(cluster.n, dtype=bool)
@@ -252,17 +251,15 @@ def dem_steady(cluster: Cluster, terminals, law: str) -> tuple[float, np.ndarray
         fixed[t.particle] = True
     copper = Material(KAPPA, 8960.0, 385.0, "copper")
     particles = Particles.from_arrays(cluster.centres, cluster.radii, T0, materials=(copper,), fixed=fixed)
-    spec = ConductanceSpec(law="rojek" if law == NETWORK_ONLY else law)
-    bonds = find_bonds(particles, contact=spec.contact)
+    net = build_network(particles, spec=ConductanceSpec(law="rojek" if law == NETWORK_ONLY else law))
+    bonds = net.bonds
     found = {(int(i), int(j)) for i, j in zip(bonds.i, bonds.j)}
     if found != {tuple(sorted(map(int, b))) for b in cluster.bonds}:
         raise RuntimeError(f"the DEM found bonds {sorted(found)}, the cluster has {cluster.bonds.tolist()}")
     if law == NETWORK_ONLY:
-        K = np.array([fe_pair_conductance(float(cluster.radii[i]), float(cluster.radii[j]), float(h))
-                      for i, j, h in zip(bonds.i, bonds.j, bonds.h)])
-    else:
-        K = bond_conductances(spec, particles, bonds)[0]
-    net = Network(particles, bonds, K, np.zeros(0), np.zeros(0))
+        net = replace(net, K_pairs=np.array([
+            fe_pair_conductance(float(cluster.radii[i]), float(cluster.radii[j]), float(h))
+            for i, j, h in zip(bonds.i, bonds.j, bonds.h)]))
     T = steady(net).T
     into = boundary_heat_flow(net, T)["particles"]
     t_hot = max(t.T for t in terminals)

@@ -273,7 +273,7 @@ def semispheres_fig13(out_dir: pathlib.Path, quick: bool) -> Part:
         "",
         "- The printed a/r of Figs. 13–14 differ from the paper's own eqs. (19)–(20) in the 5th digit (up to "
         f"{100 * max(abs(v['rel_error']) for k, v in summary.items() if '.a_over_r.' in k):.3f} %): a slip in the "
-        "paper (see `shared/seeds/README.md`); we use the equations.",
+        "paper (see `verification.cases`); we use the equations.",
         f"- Our FE agrees with the independent reference table (hp-FE with energy and dual bounds) to "
         f"{max(abs(v['rel_error']) for k, v in summary.items() if '.K_over_Kcyl.' in k):.1e}; the error estimate "
         f"{'covers' if covered else 'does NOT cover'} the true error in all four cases.",
@@ -289,7 +289,7 @@ RTOL_LADDER = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 
 def convergence_fig15(out_dir: pathlib.Path, quick: bool) -> Part:
     """The tolerance ladder of the default solver at h/r = 0.08 (true error vs estimate), and in full mode the
-    P1/P2, graded/uniform mesh study of ``python -m fem_neck converge`` (the analogue of the paper's Fig. 15)."""
+    P1/P2, graded/uniform mesh study of :func:`fem_neck.convergence.study` (the analogue of the paper's Fig. 15)."""
     from fem_neck.conduction import semisphere_conductance
 
     hr = cases.FIG15_H_OVER_R
@@ -324,12 +324,10 @@ def convergence_fig15(out_dir: pathlib.Path, quick: bool) -> Part:
                   for r in ladder]),
     ]
     if not quick:
-        import argparse
+        from fem_neck import convergence
 
-        from fem_neck.cli import converge
-
-        study = converge.run(argparse.Namespace(h_over_r=hr, a_over_r=None, out=str(out_dir / "converge"),
-                                                json=True))
+        study = convergence.study(a, out_dir / "converge", progress=False,
+                                  title=f"semisphere h/r={hr:g}, a/r={a:.4g}")
         figures.append(pathlib.Path(study["plot"]))
         summary["paper.fig15.mesh_study_extrapolated"] = compare(study["extrapolated"], ref)
         last = {}
@@ -337,7 +335,7 @@ def convergence_fig15(out_dir: pathlib.Path, quick: bool) -> Part:
             last[lv["series"]] = lv
         md += [
             "",
-            "Mesh study (`python -m fem_neck converge`): the finest level of each series, and the observed order "
+            "Mesh study (`fem_neck.convergence.study`, as `python -m fem_neck converge`): the finest level of each series, and the observed order "
             "q of |K − K_ref| ~ dofs^−q over its three finest levels:",
             "",
             md_table(["series", "dofs", "elements across neck", "K/K_cyl", "rel. error", "observed q"],

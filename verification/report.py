@@ -1,20 +1,34 @@
-"""Run verification sections and assemble their results into one folder.
+"""Reports: sections run one after another into one folder, rewritten after every step so that an interrupted run
+keeps what finished. Used by ``python -m verification`` (the evidence) and ``python -m benchmarks`` (the timings).
 
-A *section* is a module of this package with ``run(out_dir: pathlib.Path, quick: bool = False) -> dict`` returning
-``title`` (str), ``markdown`` (str), ``summary`` (dict: comparison name -> relative error, or a small dict holding
-one) and ``figures`` (list of PNG paths). :func:`run_sections` runs the sections one after another, each in its own
-sub-folder ``out_dir/<section>/``, and :class:`Report` rewrites after every section
+A :class:`Report` is the folder ``out_dir`` with
 
-* ``report.md`` -- a header with the status of every section, then each section's title, markdown and figures;
-* ``summary.json`` -- every comparison of every section, under the keys the sections chose;
-* ``run.json`` -- the command, the options and each section's status, run time and error,
+* ``report.md`` -- a header with the status of every section and a table of every target, then each section's
+  title, markdown, targets and figures;
+* ``summary.json`` -- every comparison or measurement of every section, under the keys the sections chose;
+* ``run.json`` -- the command, the options and each section's status, run time, error, targets and figures.
 
-so that an interrupted run keeps what finished. A section whose module is absent is reported as not available; a
-section that raises is reported as failed with its one-line message, and the run goes on.
+A :class:`Section` is one part of it, with its own sub-folder ``out_dir/<name>/``. Its markdown and its image links
+are written relative to that sub-folder; the report rebases the links, so every image link of ``report.md``
+resolves from the report's own folder, and each figure appears once (those the markdown does not show are appended
+to the section). A section's *status* is ``ok``; ``fail`` when one of its targets (:meth:`Section.target`, e.g. a
+time limit) is missed; ``error`` when it raised (its one-line message in the status, its traceback in
+``<section>/error.txt``); ``not available`` when its module is absent. Commands exit with 1 when any section is
+``fail`` or ``error``.
+
+:func:`add_run_options`, :func:`prepare_out` and :func:`print_report` are the options, output folder and printout
+the two commands share.
+
+Two ways to fill a section: the verification sections are modules with ``run(out_dir, quick) -> dict`` returning
+``title``, ``markdown``, ``summary`` and ``figures`` (:func:`run_sections`); the benchmark subjects write into the
+section as they go (``section.csv``, ``section.figure``, ``section.add_text``, ``section.summary``,
+``section.target``) inside ``with section.running():``.
 """
 
 from __future__ import annotations
 
+import contextlib
+import csv
 import datetime
 import importlib
 import importlib.util
@@ -23,6 +37,8 @@ import math
 import os
 import pathlib
 import platform
+import posixpath
+import re
 import sys
 import time
 import traceback
@@ -30,13 +46,33 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fem_neck.cli import print_result
+
 CONTRACT_KEYS = ("title", "markdown", "summary", "figures")
-OK, FAILED, NOT_AVAILABLE = "ok", "failed", "not available"
+OK, FAIL, ERROR, NOT_AVAILABLE, RUNNING = "ok", "fail", "error", "not available", "running"
+PASS, NOT_MEASURED = "pass", "not measured"
+IMAGE_LINK = re.compile(r"!\[([^\]]*)\]\(([^)\s]+)\)")
 
 
 @dataclass
-class SectionRecord:
-    """What one section produced, or why it did not."""
+class Target:
+    """A limit a measured value must not exceed (``measured <= limit``); ``measured`` None: not measured here."""
+
+    label: str
+    measured: float | None
+    limit: float
+    unit: str = ""
+
+    @property
+    def verdict(self) -> str:
+        if self.measured is None:
+            return NOT_MEASURED
+        return PASS if self.measured <= self.limit else FAIL
+
+
+@dataclass
+class Section:
+    """One section of a report: what it produced (markdown, summary, figures, targets) or why it did not."""
 
     name: str
     status: str
@@ -46,6 +82,69 @@ class SectionRecord:
     figures: list = field(default_factory=list)
     seconds: float = 0.0
     error: str = ""
+    targets: list = field(default_factory=list)
+    out_dir: pathlib.Path | None = None
+    report: Report | None = field(default=None, repr=False, compare=False)
+
+    # -- writing into the section ------------------------------------------------------------------------------------
+    def folder(self) -> pathlib.Path:
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        return self.out_dir
+
+    def csv(self, stem: str, rows: list[dict]) -> pathlib.Path:
+        """Write ``rows`` (dicts; columns in order of appearance) to ``<stem>.csv`` in the section's folder."""
+        path = self.folder() / f"{stem}.csv"
+        if rows:
+            columns = list(dict.fromkeys(k for row in rows for k in row))
+            with path.open("w", newline="") as fh:
+                writer = csv.DictWriter(fh, fieldnames=columns)
+                writer.writeheader()
+                writer.writerows(rows)
+        return path
+
+    def figure(self, fig, stem: str) -> pathlib.Path:
+        """Save ``fig`` as ``<stem>.png`` in the section's folder and list it; returns the path."""
+        path = save_figure(fig, self.folder() / f"{stem}.png", bbox_inches="tight")
+        self.figures.append(path)
+        return path
+
+    def add_text(self, heading: str, text: str, figures=()) -> None:
+        """Append a ``###`` subsection (and links to ``figures``, paths in the section's folder); rewrite the report."""
+        links = "".join(f"\n\n![{pathlib.Path(f).stem}]({pathlib.Path(f).name})" for f in figures)
+        self.markdown += f"### {heading}\n\n{text.strip()}{links}\n\n"
+        self.flush()
+
+    def target(self, label: str, measured: float | None, limit: float, unit: str = "") -> str:
+        """Record a target (``measured <= limit``); a missed one makes the section ``fail``. Returns the verdict."""
+        target = Target(label, None if measured is None else float(measured), float(limit), unit)
+        self.targets.append(target)
+        self.flush()
+        return target.verdict
+
+    def flush(self) -> None:
+        if self.report is not None:
+            self.report.write()
+
+    @contextlib.contextmanager
+    def running(self):
+        """Time the body; an exception is recorded (``error``, traceback in ``error.txt``), not raised; at the end
+        the status is ``fail`` if a target was missed, else ``ok``. The report is rewritten."""
+        t0 = time.perf_counter()
+        self.status = RUNNING
+        self.flush()
+        try:
+            yield self
+        except Exception as exc:  # a failing section is reported and the run goes on
+            self.status = ERROR
+            self.error = f"{type(exc).__name__}: {exc}".splitlines()[0]
+            (self.folder() / "error.txt").write_text(traceback.format_exc())
+        else:
+            missed = [t.label for t in self.targets if t.verdict == FAIL]
+            self.status = FAIL if missed else OK
+            self.error = f"target missed: {'; '.join(missed)}" if missed else ""
+        finally:
+            self.seconds = time.perf_counter() - t0
+            self.flush()
 
 
 def jsonable(value):
@@ -80,26 +179,40 @@ def check_section_result(name: str, result) -> dict:
 
 
 class Report:
-    """The output folder of one verification run; every call of :meth:`add` rewrites the three files."""
+    """The output folder of one run; every change of a section rewrites the three files."""
 
-    def __init__(self, out_dir: pathlib.Path, command: str, quick: bool):
+    def __init__(self, out_dir: pathlib.Path, command: str, quick: bool, program: str = "python -m verification",
+                 title: str = "Verification report", preamble: str = ""):
         self.out_dir = pathlib.Path(out_dir)
         self.out_dir.mkdir(parents=True, exist_ok=True)
         self.command = command
         self.quick = quick
+        self.program = program
+        self.title = title
+        self.preamble = preamble
         self.started = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
-        self.sections: list[SectionRecord] = []
+        self.sections: list[Section] = []
 
     # -- assembling -------------------------------------------------------------------------------------------------
-    def add(self, record: SectionRecord) -> None:
-        self.sections.append(record)
+    def section(self, name: str, title: str) -> Section:
+        """A new section writing into ``out_dir/<name>/`` and into this report."""
+        section = Section(name, RUNNING, title, out_dir=self.out_dir / name, report=self)
+        self.sections.append(section)
+        return section
+
+    def add(self, section: Section) -> None:
+        """Append a section that has finished elsewhere; rewrite the files."""
+        if section.out_dir is None:
+            section.out_dir = self.out_dir / section.name
+        section.report = self
+        self.sections.append(section)
         self.write()
 
     def summary(self) -> dict:
         """All comparisons of the sections that ran, under the sections' own keys.
 
-        Sections name their keys (e.g. ``paper.sec6.K_fe``; the bench's keys are fixed by its issue); a key that an
-        earlier section already used is prefixed with ``"<section>:"`` rather than overwritten.
+        Sections name their keys (e.g. ``paper.sec6.K_fe``; the benchmarks' keys are documented in the README); a
+        key that an earlier section already used is prefixed with ``"<section>:"`` rather than overwritten.
         """
         out = {}
         for s in self.sections:
@@ -108,21 +221,30 @@ class Report:
         return out
 
     def _relative(self, path) -> str:
-        path = pathlib.Path(path)
-        if not path.is_absolute():
-            return path.as_posix()
-        try:
-            return path.relative_to(self.out_dir.resolve()).as_posix()
-        except ValueError:
-            return os.path.relpath(path, self.out_dir.resolve())
+        """``path`` (absolute, or relative to the working directory) relative to the report's folder."""
+        return pathlib.Path(os.path.relpath(pathlib.Path(path).resolve(), self.out_dir.resolve())).as_posix()
+
+    def _section_markdown(self, s: Section) -> tuple[str, set]:
+        """The section's markdown with its image links rebased from its folder onto the report's; the link set."""
+        base = self._relative(s.out_dir) if s.out_dir is not None else "."
+        linked = set()
+
+        def rebase(match):
+            alt, target = match.groups()
+            if not (target.startswith(("/", "http://", "https://", "data:"))):
+                target = posixpath.normpath(posixpath.join(base, target))
+            linked.add(target)
+            return f"![{alt}]({target})"
+
+        return IMAGE_LINK.sub(rebase, s.markdown), linked
 
     def markdown(self) -> str:
         lines = [
-            "# Verification report",
+            f"# {self.title}",
             "",
-            f"`python -m verification {self.command}{' --quick' if self.quick else ''}` -- started "
+            f"`{self.program} {self.command}{' --quick' if self.quick else ''}` -- started "
             f"{self.started.isoformat()}, Python {platform.python_version()}, {platform.machine()}, "
-            f"{os.cpu_count()} cores.",
+            f"{os.cpu_count()} cores." + (f" {self.preamble}" if self.preamble else ""),
             "",
             "| section | status | seconds |",
             "|---|---|---|",
@@ -130,17 +252,23 @@ class Report:
         for s in self.sections:
             status = s.status if not s.error else f"{s.status}: {s.error}"
             lines.append(f"| [{s.title}](#{_anchor(s.title)}) | {status.replace('|', '/')} | {s.seconds:.1f} |")
+        targets = [(s, t) for s in self.sections for t in s.targets]
+        if targets:
+            lines += ["", "Targets:", "", targets_table([t for _, t in targets], [s.name for s, _ in targets])]
         lines.append("")
         for s in self.sections:
             lines += [f"## {s.title}", ""]
-            if s.status != OK:
+            if s.status in (ERROR, NOT_AVAILABLE):
                 lines += [f"*{s.status}*: {s.error}", ""]
                 continue
-            lines += [s.markdown.rstrip(), ""]
-            for fig in s.figures:
-                rel = self._relative(fig)
-                if rel not in s.markdown:
-                    lines += [f"![{pathlib.Path(rel).stem}]({rel})", ""]
+            text, linked = self._section_markdown(s)
+            if text.strip():
+                lines += [text.rstrip(), ""]
+            if s.targets:
+                lines += [targets_table(s.targets), ""]
+            for fig in dict.fromkeys(self._relative(f) for f in s.figures):
+                if fig not in linked:
+                    lines += [f"![{pathlib.Path(fig).stem}]({fig})", ""]
         return "\n".join(lines)
 
     def write(self) -> None:
@@ -151,7 +279,9 @@ class Report:
             "started": self.started.isoformat(),
             "sections": {
                 s.name: {"status": s.status, "title": s.title, "seconds": round(s.seconds, 3), "error": s.error,
-                         "figures": [self._relative(f) for f in s.figures]}
+                         "targets": [{"label": t.label, "measured": jsonable(t.measured), "limit": t.limit,
+                                      "unit": t.unit, "verdict": t.verdict} for t in s.targets],
+                         "figures": list(dict.fromkeys(self._relative(f) for f in s.figures))}
                 for s in self.sections
             },
         }
@@ -160,8 +290,25 @@ class Report:
         _write_atomic(self.out_dir / "run.json", json.dumps(run, indent=2) + "\n")
 
     @property
-    def failed(self) -> list[SectionRecord]:
-        return [s for s in self.sections if s.status == FAILED]
+    def failed(self) -> list[Section]:
+        """Sections that raised or missed a target."""
+        return [s for s in self.sections if s.status in (FAIL, ERROR)]
+
+
+def image_links(markdown: str) -> list[str]:
+    """The targets of the image links ``![alt](target)`` of a markdown text, in order."""
+    return [target for _, target in IMAGE_LINK.findall(markdown)]
+
+
+def targets_table(targets: list[Target], sections: list[str] | None = None) -> str:
+    """A markdown table of targets: what, measured, limit, verdict (and the section, if given)."""
+    header = (["section"] if sections else []) + ["target", "measured", "limit", "verdict"]
+    rows = []
+    for k, t in enumerate(targets):
+        measured = "—" if t.measured is None else f"{t.measured:.3g} {t.unit}".strip()
+        rows.append(([sections[k]] if sections else []) + [t.label, measured, f"<= {t.limit:g} {t.unit}".strip(),
+                                                           t.verdict.upper() if t.verdict == FAIL else t.verdict])
+    return md_table(header, rows)
 
 
 def _anchor(title: str) -> str:
@@ -181,50 +328,48 @@ def section_available(name: str) -> bool:
     return importlib.util.find_spec(f"verification.{name}") is not None
 
 
-def run_section(name: str, out_dir: pathlib.Path, quick: bool, options: dict | None = None) -> SectionRecord:
-    """Import ``verification.<name>`` and call its ``run(out_dir / name, quick, **options)``; never raises."""
+def run_section(name: str, out_dir: pathlib.Path, quick: bool, options: dict | None = None,
+                report: Report | None = None) -> Section:
+    """Import ``verification.<name>`` and call its ``run(out_dir / name, quick, **options)``; never raises. With
+    ``report`` the section is part of it (and rewrites it as it goes)."""
+    if report is not None:
+        section = report.section(name, name)
+    else:
+        section = Section(name, RUNNING, name, out_dir=pathlib.Path(out_dir) / name)
     if not section_available(name):
-        return SectionRecord(name, NOT_AVAILABLE, name, error=f"verification.{name} is not available yet")
-    t0 = time.perf_counter()
-    try:
+        section.status, section.error = NOT_AVAILABLE, f"verification.{name} is not available yet"
+        section.flush()
+        return section
+    with section.running():
         module = importlib.import_module(f"verification.{name}")
-        section_dir = pathlib.Path(out_dir) / name
-        section_dir.mkdir(parents=True, exist_ok=True)
-        result = check_section_result(name, module.run(section_dir, quick=quick, **(options or {})))
-        summary = jsonable(result["summary"])
-    except Exception as exc:  # a failing section is reported (traceback in <section>/error.txt), the run goes on
-        message = f"{type(exc).__name__}: {exc}".splitlines()[0]
-        error_file = pathlib.Path(out_dir) / name / "error.txt"
-        error_file.parent.mkdir(parents=True, exist_ok=True)
-        error_file.write_text(traceback.format_exc())
-        return SectionRecord(name, FAILED, name, seconds=time.perf_counter() - t0, error=message)
-    return SectionRecord(name, OK, str(result["title"]), markdown=str(result["markdown"]), summary=summary,
-                         figures=[str(f) for f in result["figures"]], seconds=time.perf_counter() - t0)
+        result = check_section_result(name, module.run(section.folder(), quick=quick, **(options or {})))
+        section.summary.update(jsonable(result["summary"]))
+        section.title, section.markdown = str(result["title"]), str(result["markdown"])
+        section.figures += [pathlib.Path(f) for f in result["figures"]]
+    return section
 
 
 def run_sections(names, out_dir: pathlib.Path, command: str, quick: bool = False, options: dict | None = None,
                  progress: bool = True) -> Report:
-    """Run ``names`` in order into ``out_dir``; the report files are rewritten after each section."""
+    """Run the verification sections ``names`` in order into ``out_dir``; the report is rewritten as they go."""
     from tqdm import tqdm
 
     report = Report(out_dir, command, quick)
     bar = tqdm(names, desc="verification", unit="section", file=sys.stderr, disable=not progress)
     for name in bar:
         bar.set_postfix_str(name)
-        record = run_section(name, report.out_dir, quick, options)
-        if record.status != OK:
-            bar.write(f"python -m verification {command}: {name}: {record.status}: {record.error}", file=sys.stderr)
-        report.add(record)
+        section = run_section(name, report.out_dir, quick, options, report=report)
+        if section.status != OK:
+            bar.write(f"python -m verification {command}: {name}: {section.status}: {section.error}", file=sys.stderr)
     return report
 
 
 def save_figure(fig, path: pathlib.Path, dpi: int = 110, **savefig_options) -> pathlib.Path:
     """Write ``fig`` as a PNG at ``path`` and release it (pyplot figures are closed; a bare ``Figure`` needs
     nothing); returns ``path``."""
-    import matplotlib.pyplot as plt
-
     fig.savefig(path, dpi=dpi, **savefig_options)
-    plt.close(fig)
+    if "matplotlib.pyplot" in sys.modules:
+        sys.modules["matplotlib.pyplot"].close(fig)
     return path
 
 
@@ -236,8 +381,53 @@ def md_table(header, rows, fmt: str = "{:.6g}") -> str:
             return "—"
         if isinstance(v, (float, np.floating)):
             return fmt.format(v)
-        return str(v)
+        return str(v).replace("|", "/")
 
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in rows]
     return "\n".join(lines)
+
+
+def records_table(rows: list[dict], columns: list[str] | None = None, fmt: str = "{:.4g}") -> str:
+    """A markdown table of dict ``rows`` (columns: given, or every key in order of appearance)."""
+    if not rows:
+        return "(no rows)"
+    columns = columns or list(dict.fromkeys(k for row in rows for k in row))
+    return md_table(columns, [[row.get(c) for c in columns] for row in rows], fmt)
+
+
+# --- the commands that write reports (python -m verification, python -m benchmarks) ---------------------------------
+def add_run_options(parser, default_out: str, quick_help: str) -> None:
+    """The options of a report command: ``--quick``, ``--out DIR``, ``--json`` and ``--no-progress``."""
+    parser.add_argument("--quick", action="store_true", help=quick_help)
+    parser.add_argument("--out", metavar="DIR", default=default_out, help=f"output folder (default: {default_out})")
+    parser.add_argument("--json", action="store_true", help="print summary.json as one JSON object on stdout")
+    parser.add_argument("--no-progress", action="store_true",
+                        help="no progress bars on stderr (none of the sections' either)")
+
+
+def prepare_out(prog: str, out_text: str) -> pathlib.Path | None:
+    """The output folder, created; ``None`` after one line on stderr when it cannot be (the caller exits 2)."""
+    out = pathlib.Path(out_text)
+    if not out_text.strip():
+        sys.stderr.write(f"{prog}: error: --out {out_text!r}: must name a directory\n")
+        return None
+    if out.exists() and not out.is_dir():
+        sys.stderr.write(f"{prog}: error: --out {out_text}: exists and is not a directory\n")
+        return None
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # e.g. a parent is a file, or no permission
+        sys.stderr.write(f"{prog}: error: --out {out_text}: cannot be created ({exc.strerror})\n")
+        return None
+    return out
+
+
+def print_report(report, as_json: bool) -> None:
+    """``--json``: the summary as one object; otherwise one line per section and the report's path."""
+    if as_json:
+        print_result(report.summary(), as_json=True)
+        return
+    for s in report.sections:
+        print(f"{s.name:<10} {s.status:<14} {s.seconds:7.1f} s  {s.title if not s.error else s.error}")
+    print(f"report: {report.out_dir / 'report.md'}")

@@ -1,4 +1,4 @@
-"""Transient: the lumped-capacity pipe pair against an axisymmetric FE transient of the same pair (issue 5, item 3).
+"""Transient: the lumped-capacity pipe pair against an axisymmetric FE transient of the same pair.
 
 The pair is insulated; particle i starts at 1 K, particle j at 0 K (uniform in each particle's own share of the
 solid, the neck split by cap volume: :mod:`fem_neck.transient`). The DEM's lumped model (Rojek 2022, eqs. 2-4,
@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import pathlib
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -65,21 +66,20 @@ def dem_pair(r_i: float, r_j: float, h: float, law: str, t_end: float, K: float 
     needs dense points, not only accurate ones; 1e-3 gives ~26 points and 5e-3 interpolation error). ``law`` is a
     DEM conductance law; ``K`` (W/K) overrides the pipe conductance. Returns ``(K, t, T)`` with ``T`` of shape
     (len(t), 2)."""
-    from dem.bonds import find_bonds
-    from dem.laws.conductance import ConductanceSpec, bond_conductances
+    from dem.laws.conductance import ConductanceSpec
     from dem.particles import Material, Particles
-    from dem.thermal import Network, integrate
+    from dem.thermal import build_network, integrate
 
     d = r_i + r_j - h
     particles = Particles.from_arrays([[0.0, 0.0, 0.0], [0.0, 0.0, d]], [r_i, r_j], [1.0, 0.0],
                                       materials=(Material(KAPPA, RHO, CP, "copper"),))
-    spec = ConductanceSpec(law=law)
-    bonds = find_bonds(particles, contact=spec.contact)
-    K_pairs = bond_conductances(spec, particles, bonds)[0] if K is None else np.array([K])
+    net = build_network(particles, spec=ConductanceSpec(law=law))
+    if K is not None:
+        net = replace(net, K_pairs=np.array([K]))
     times, temps = [], []
-    integrate(Network(particles, bonds, K_pairs, np.zeros(0), np.zeros(0)), "crank-nicolson", dt="auto",
-              t_end=t_end, rtol=1e-5, observer=lambda step, t, T, flows: (times.append(t), temps.append(T.copy())))
-    return float(K_pairs[0]), np.array(times), np.array(temps)
+    integrate(net, "crank-nicolson", dt="auto", t_end=t_end, rtol=1e-5,
+              observer=lambda step, t, T, flows: (times.append(t), temps.append(T.copy())))
+    return float(net.K_pairs[0]), np.array(times), np.array(temps)
 
 
 def study_case(r_i, r_j, x, quick: bool, laws: tuple, refine: int = 1) -> dict:

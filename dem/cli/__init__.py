@@ -1,8 +1,9 @@
-"""``python -m dem``: run a pipe-network thermal DEM scene, or list the built-in scenes.
+"""``python -m dem``: run a pipe-network thermal DEM scene, list the built-in scenes, or drive one contact.
 
     python -m dem run SCENE [--out DIR] [--json]     SCENE: a TOML file or a built-in name
     python -m dem scenes [--json]
     python -m dem laws [--json]                      the conductance laws a scene can select
+    python -m dem contact SCENE --history FILE.csv [--no-damping] [--out DIR] [--json]
 
 Each sub-command is a module of this package exposing ``register(subparsers)``; the plumbing is that of
 :mod:`fem_neck.cli` (one JSON object with ``--json``; bad input: one line on stderr, exit code 2).
@@ -10,7 +11,7 @@ Each sub-command is a module of this package exposing ``register(subparsers)``; 
 
 from fem_neck.cli import main as _main
 
-COMMANDS = ("run", "scenes", "laws")
+COMMANDS = ("run", "scenes", "contact", "laws")
 
 
 def main(argv=None) -> int:

@@ -1,0 +1,100 @@
+"""Timing helpers of the benchmarks: best-of timings, side-by-side rounds, fresh-process workers, peak memory."""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+
+def best_time(fn, repeat: int = 3):
+    """Smallest wall time of ``repeat`` calls of ``fn()`` and the last return value."""
+    best, value = np.inf, None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        value = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, value
+
+
+def side_by_side(fns: dict, rounds: int) -> tuple[dict, dict]:
+    """Time every ``fns[name]()`` once per round, alternating, so that load from other processes hits all alike;
+    returns the best time of each and its last return value."""
+    best = {name: np.inf for name in fns}
+    values = {}
+    for _ in range(rounds):
+        for name, fn in fns.items():
+            t, values[name] = best_time(fn, 1)
+            best[name] = min(best[name], t)
+    return best, values
+
+
+def fastest(rows: list[dict], tol: float, key: str = "rel_error") -> dict | None:
+    """The row with the smallest ``seconds`` among those with ``key <= tol`` (None if none)."""
+    ok = [row for row in rows if row[key] is not None and row[key] <= tol]
+    return min(ok, key=lambda row: row["seconds"]) if ok else None
+
+
+def growth_exponent(n, t) -> float | None:
+    """Least-squares slope of log t against log n (None from fewer than two positive points)."""
+    n, t = np.asarray(n, float), np.asarray(t, float)
+    ok = (n > 0) & (t > 0)
+    return float(np.polyfit(np.log(n[ok]), np.log(t[ok]), 1)[0]) if ok.sum() >= 2 else None
+
+
+def ratio(a, b):
+    return None if a is None or b is None else a / b
+
+
+def peak_rss_mib() -> float:
+    """Peak resident memory of this process in MiB: ``VmHWM`` (reset by exec, unlike ``ru_maxrss``, which a
+    forked child inherits from its parent)."""
+    try:
+        for line in pathlib.Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return float(line.split()[1]) / 1024.0
+    except OSError:
+        pass
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def run_worker(module: str, func: str, n: int, timeout: float) -> dict:
+    """Run ``module.func(n)`` in a fresh interpreter (its own peak memory) and return the JSON line it prints, or
+    ``{"particles": n, "error": ...}``."""
+    code = f"from {module} import {func}; {func}({int(n)})"
+    try:
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return {"particles": n, "error": f"timeout after {timeout:g} s"}
+    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("{")]
+    if proc.returncode != 0 or not lines:
+        tail = (proc.stderr.strip().splitlines() or ["no output"])[-1]
+        return {"particles": n, "error": f"exit {proc.returncode}: {tail[:200]}"}
+    return json.loads(lines[-1])
+
+
+def emit(record: dict) -> None:
+    """A worker's result: one JSON line on stdout."""
+    print(json.dumps(record))
+
+
+def package_version(package: str) -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version(package)
+    except PackageNotFoundError:
+        return "(not installed)"
+
+
+def available(package: str) -> bool:
+    """Whether ``package`` (an optional peer) is importable."""
+    import importlib.util
+
+    return importlib.util.find_spec(package) is not None

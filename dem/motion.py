@@ -1,0 +1,110 @@
+"""State of particles that move, as arrays: positions, velocities, angular velocities, forces, torques, masses,
+moments of inertia, radii and temperatures.
+
+Two kinds of particle:
+
+* ``dimension = 3`` -- spheres, ``m = rho (4/3) pi a^3``, ``I = (2/5) m a^2``;
+* ``dimension = 2`` -- disks (cylinders) of height ``height`` lying in the x-z plane, as in Luding 2005
+  (Sec. 2): ``m = rho pi a^2 h``, ``I = m a^2 / 2`` about the y axis. Their centres keep ``y = 0``; they translate
+  in x and z and rotate about y only (the masks :attr:`MotionState.linear_dof`, :attr:`MotionState.angular_dof`).
+
+The radius follows the temperature by thermal expansion (Luding 2005, eq. 9) while the mass stays constant, so the
+radius at the reference (melting) temperature ``radius_ref`` is kept beside the current ``radius``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+DIMENSIONS = (2, 3)
+
+
+def particle_mass(dimension: int, density, radius, height: float | None = None) -> np.ndarray:
+    """``rho (4/3) pi a^3`` (spheres) or ``rho pi a^2 h`` (disks of height h), kg."""
+    radius = np.asarray(radius, dtype=float)
+    if dimension == 3:
+        return density * 4.0 / 3.0 * np.pi * radius**3
+    return density * np.pi * radius**2 * height
+
+
+def moment_of_inertia(dimension: int, mass, radius) -> np.ndarray:
+    """``(2/5) m a^2`` (sphere) or ``m a^2 / 2`` (disk about its axis), kg m^2."""
+    return (0.4 if dimension == 3 else 0.5) * np.asarray(mass) * np.asarray(radius) ** 2
+
+
+@dataclass
+class MotionState:
+    """Arrays of N particles (C-contiguous float64, ``(N, 3)`` vectors); mutated in place by the integrator."""
+
+    dimension: int
+    height: float | None
+    x: np.ndarray
+    v: np.ndarray
+    w: np.ndarray
+    f: np.ndarray
+    tau: np.ndarray
+    mass: np.ndarray
+    inertia: np.ndarray
+    radius: np.ndarray
+    radius_ref: np.ndarray
+    T: np.ndarray
+
+    @classmethod
+    def create(cls, dimension, position, radius, density, temperature, velocity=None, angular_velocity=None,
+               height=None, radius_ref=None) -> "MotionState":
+        """A state at rest unless ``velocity``/``angular_velocity`` are given; ``density`` kg/m^3 (scalar or per
+        particle); 2D disks need ``height`` (m) and positions with ``y = 0``."""
+        if dimension not in DIMENSIONS:
+            raise ValueError(f"[scene] dimension = {dimension!r}: must be 2 (disks) or 3 (spheres)")
+        x = np.ascontiguousarray(position, dtype=float).copy()
+        n = len(x)
+        r = np.ascontiguousarray(radius, dtype=float).copy()
+        if dimension == 2:
+            if height is None or not np.isfinite(height) or height <= 0:
+                raise ValueError(f"[scene] height = {height!r}: 2D disks need a height > 0 (m)")
+            off = np.flatnonzero(x[:, 1] != 0.0)
+            if off.size:
+                k = int(off[0])
+                raise ValueError(f"particles.position[{k}] = {x[k].tolist()}: 2D disks lie in the x-z plane "
+                                 f"(y = 0)")
+        mass = particle_mass(dimension, np.broadcast_to(np.asarray(density, dtype=float), (n,)), r, height)
+        v = np.zeros((n, 3)) if velocity is None else np.ascontiguousarray(velocity, dtype=float).copy()
+        w = np.zeros((n, 3)) if angular_velocity is None else np.ascontiguousarray(angular_velocity,
+                                                                                      dtype=float).copy()
+        state = cls(dimension, height if dimension == 2 else None, x, v, w, np.zeros((n, 3)), np.zeros((n, 3)),
+                    mass, moment_of_inertia(dimension, mass, r), r,
+                    r.copy() if radius_ref is None else np.asarray(radius_ref, dtype=float).copy(),
+                    np.asarray(temperature, dtype=float).copy())
+        state.v *= state.linear_dof
+        state.w *= state.angular_dof
+        return state
+
+    @property
+    def n(self) -> int:
+        return len(self.mass)
+
+    @property
+    def linear_dof(self) -> np.ndarray:
+        """1 for the axes a particle translates along (2D: x and z)."""
+        return np.array([1.0, 0.0, 1.0]) if self.dimension == 2 else np.ones(3)
+
+    @property
+    def angular_dof(self) -> np.ndarray:
+        """1 for the axes a particle rotates about (2D: y)."""
+        return np.array([0.0, 1.0, 0.0]) if self.dimension == 2 else np.ones(3)
+
+    def kinetic_energy(self) -> float:
+        """Translational plus rotational kinetic energy, J."""
+        return float(0.5 * self.mass @ np.einsum("ij,ij->i", self.v, self.v)
+                     + 0.5 * self.inertia @ np.einsum("ij,ij->i", self.w, self.w))
+
+    def momentum(self) -> np.ndarray:
+        return self.mass @ self.v
+
+    def solid_volume(self) -> float:
+        """Sum of the particle volumes (2D: disk areas times the height), m^3."""
+        if self.dimension == 3:
+            return float(np.sum(4.0 / 3.0 * np.pi * self.radius**3))
+        return float(np.sum(np.pi * self.radius**2) * self.height)

@@ -1,0 +1,230 @@
+"""Neighbour search for particles that move: cell binning and a Verlet list with a skin (Zohdi 2014, Sec. 8;
+Allen & Tildesley 1987, the "Verlet table" of Luding 2005, Sec. 3).
+
+The list holds every pair ``i < j`` whose surfaces are closer than ``skin``: ``|x_i - x_j| < r_i + r_j + skin``.
+It stays valid as long as no particle has moved more than ``skin / 2`` since it was built (two particles then
+approach by less than ``skin``), so it is rebuilt only when some particle has (:func:`max_displacement`). A
+rebuild bins the particles into cubic cells of edge ``2 r_max + skin`` and compares each particle with those in its
+own and the neighbouring cells: O(N) per rebuild. Periodic axes (``box[k] > 0``) wrap the cells and use the
+minimum image.
+
+The same binning places particles at random without overlaps (:func:`sequential_addition`, random sequential
+addition for the box generator).
+
+Per-pair history (the contact state that a contact law carries from step to step) lives in rows aligned with the
+list; :func:`carry_history` moves it to the rows of a rebuilt list, matching pairs by their key ``i * N + j``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def min_image(d, length):
+    """``d`` wrapped into ``[-length/2, length/2]`` on a periodic axis (``length > 0``); unchanged otherwise."""
+    if length > 0.0:
+        return d - length * math.floor(d / length + 0.5)
+    return d
+
+
+@njit(cache=True)
+def _cell_of(x, lo, size, n):
+    c = int((x - lo) / size)
+    if c < 0:
+        return 0
+    if c >= n:
+        return n - 1
+    return c
+
+
+@njit(cache=True)
+def _pairs_in_cells(x, radius, skin, box, count_only, out_i, out_j):
+    """Count (``count_only``) or list the pairs within ``r_i + r_j + skin`` by cell binning."""
+    n = x.shape[0]
+    r_max = 0.0
+    for k in range(n):
+        r_max = max(r_max, radius[k])
+    size = 2.0 * r_max + skin
+    lo = np.empty(3)
+    ncell = np.empty(3, dtype=np.int64)
+    wrap = np.zeros(3, dtype=np.bool_)
+    for a in range(3):
+        if box[a] > 0.0:
+            lo[a] = 0.0
+            ncell[a] = max(1, int(box[a] / size))
+            wrap[a] = ncell[a] >= 3
+            if not wrap[a]:  # fewer than 3 cells across a periodic axis: one cell, every pair compared
+                ncell[a] = 1
+        else:
+            xmin, xmax = x[0, a], x[0, a]
+            for k in range(n):
+                xmin = min(xmin, x[k, a])
+                xmax = max(xmax, x[k, a])
+            lo[a] = xmin
+            ncell[a] = max(1, min(int((xmax - xmin) / size) + 1, 1 << 20))
+    csize = np.empty(3)
+    for a in range(3):
+        if box[a] > 0.0:
+            csize[a] = box[a] / ncell[a]
+        else:
+            csize[a] = size
+    total = ncell[0] * ncell[1] * ncell[2]
+    head = -np.ones(total, dtype=np.int64)
+    nxt = -np.ones(n, dtype=np.int64)
+    cell = np.empty((n, 3), dtype=np.int64)
+    for k in range(n):
+        for a in range(3):
+            xa = x[k, a]
+            if box[a] > 0.0:
+                xa = xa - box[a] * math.floor(xa / box[a])
+            cell[k, a] = _cell_of(xa, lo[a], csize[a], ncell[a])
+        c = (cell[k, 0] * ncell[1] + cell[k, 1]) * ncell[2] + cell[k, 2]
+        nxt[k] = head[c]
+        head[c] = k
+    found = 0
+    for k in range(n):
+        for d0 in range(-1, 2):
+            c0 = cell[k, 0] + d0
+            if c0 < 0 or c0 >= ncell[0]:
+                if not wrap[0]:
+                    continue
+                c0 %= ncell[0]
+            if ncell[0] == 1 and d0 != 0:
+                continue
+            for d1 in range(-1, 2):
+                c1 = cell[k, 1] + d1
+                if c1 < 0 or c1 >= ncell[1]:
+                    if not wrap[1]:
+                        continue
+                    c1 %= ncell[1]
+                if ncell[1] == 1 and d1 != 0:
+                    continue
+                for d2 in range(-1, 2):
+                    c2 = cell[k, 2] + d2
+                    if c2 < 0 or c2 >= ncell[2]:
+                        if not wrap[2]:
+                            continue
+                        c2 %= ncell[2]
+                    if ncell[2] == 1 and d2 != 0:
+                        continue
+                    m = head[(c0 * ncell[1] + c1) * ncell[2] + c2]
+                    while m >= 0:
+                        if m > k:
+                            dx = min_image(x[k, 0] - x[m, 0], box[0])
+                            dy = min_image(x[k, 1] - x[m, 1], box[1])
+                            dz = min_image(x[k, 2] - x[m, 2], box[2])
+                            cut = radius[k] + radius[m] + skin
+                            if dx * dx + dy * dy + dz * dz < cut * cut:
+                                if not count_only:
+                                    out_i[found] = k
+                                    out_j[found] = m
+                                found += 1
+                        m = nxt[m]
+    return found
+
+
+def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j + skin`` (minimum image on periodic axes), sorted by
+    ``(i, j)``."""
+    dummy = np.zeros(0, dtype=np.int64)
+    if len(radius) < 2:
+        return dummy, dummy
+    count = _pairs_in_cells(x, radius, skin, box, True, dummy, dummy)
+    i = np.empty(count, dtype=np.int64)
+    j = np.empty(count, dtype=np.int64)
+    _pairs_in_cells(x, radius, skin, box, False, i, j)
+    order = np.lexsort((j, i))
+    return i[order], j[order]
+
+
+@njit(cache=True)
+def max_displacement(x, x_ref, box):
+    """The largest distance any particle has moved since ``x_ref`` (minimum image on periodic axes)."""
+    worst = 0.0
+    for k in range(x.shape[0]):
+        s = 0.0
+        for a in range(3):
+            d = min_image(x[k, a] - x_ref[k, a], box[a])
+            s += d * d
+        worst = max(worst, s)
+    return math.sqrt(worst)
+
+
+def carry_history(old_i, old_j, new_i, new_j, n: int, *columns):
+    """History rows of the pairs ``(new_i, new_j)`` taken from the rows of the same pairs in ``(old_i, old_j)``
+    (both sorted by key ``i * n + j``); pairs new to the list start from zeros. Returns the new columns."""
+    old_key = old_i * n + old_j
+    new_key = new_i * n + new_j
+    pos = np.searchsorted(old_key, new_key)
+    pos_c = np.minimum(pos, max(len(old_key) - 1, 0))
+    found = (pos < len(old_key)) & (old_key[pos_c] == new_key) if len(old_key) else np.zeros(len(new_key), bool)
+    out = []
+    for col in columns:
+        new = np.zeros((len(new_key),) + col.shape[1:], dtype=col.dtype)
+        new[found] = col[pos_c[found]]
+        out.append(new)
+    return out
+
+
+def wall_pairs(x: np.ndarray, radius: np.ndarray, normal: np.ndarray, offset: np.ndarray,
+               skin: float) -> tuple[np.ndarray, np.ndarray]:
+    """Particle-wall pairs ``(k, m)`` with particle k closer than ``r_k + skin`` to the plane ``n_m . x = q_m`` (or
+    behind it): the Verlet list of the walls."""
+    if len(offset) == 0:
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty
+    dist = x @ normal.T - offset[None, :]
+    k, m = np.nonzero(dist < radius[:, None] + skin)
+    return k.astype(np.int64), m.astype(np.int64)
+
+
+@njit(cache=True)
+def sequential_addition(r, lo, hi, uniform):
+    """Place particles of radii ``r`` one by one at the next candidate points ``lo + u (hi - lo)`` (``u`` rows of
+    ``uniform``, kept inside the box by each radius) that overlap no particle placed before; cell binning makes each
+    test O(1). Returns the positions and the number placed before the candidates ran out."""
+    n = r.shape[0]
+    size = 2.0 * r.max()
+    ncell = np.empty(3, dtype=np.int64)
+    for a in range(3):
+        ncell[a] = max(1, int((hi[a] - lo[a]) / size) + 1)
+    head = -np.ones(ncell[0] * ncell[1] * ncell[2], dtype=np.int64)
+    nxt = -np.ones(n, dtype=np.int64)
+    pos = np.zeros((n, 3))
+    c = np.empty(3, dtype=np.int64)
+    trial = 0
+    for k in range(n):
+        placed = False
+        while trial < uniform.shape[0]:
+            p = np.empty(3)
+            for a in range(3):
+                span = hi[a] - lo[a] - 2.0 * r[k]
+                p[a] = lo[a] + r[k] + uniform[trial, a] * span if span > 0 else lo[a]
+                c[a] = min(ncell[a] - 1, int((p[a] - lo[a]) / size))
+            trial += 1
+            free = True
+            for d0 in range(max(0, c[0] - 1), min(ncell[0], c[0] + 2)):
+                for d1 in range(max(0, c[1] - 1), min(ncell[1], c[1] + 2)):
+                    for d2 in range(max(0, c[2] - 1), min(ncell[2], c[2] + 2)):
+                        m = head[(d0 * ncell[1] + d1) * ncell[2] + d2]
+                        while m >= 0 and free:
+                            s = 0.0
+                            for a in range(3):
+                                s += (pos[m, a] - p[a]) ** 2
+                            if s < (r[m] + r[k]) ** 2:
+                                free = False
+                            m = nxt[m]
+            if free:
+                pos[k] = p
+                cell = (c[0] * ncell[1] + c[1]) * ncell[2] + c[2]
+                nxt[k] = head[cell]
+                head[cell] = k
+                placed = True
+                break
+        if not placed:
+            return pos, k
+    return pos, n

@@ -1,0 +1,81 @@
+"""The plots a run folder gets at its end (matplotlib, imported only here, only when a run writes plots).
+
+* :func:`motion_plots` -- a run with moving particles: ``timeseries.png`` (solid fraction, coordination number,
+  kinetic energy, stiffness factor k1(T, t)/k1, temperatures, wall stresses and, with heated walls, the effective
+  conductivity, each against time) and ``profiles.png`` (solid fraction and neck radius against the distance from
+  the hot wall, one curve per snapshot time).
+"""
+
+from __future__ import annotations
+
+import csv
+import pathlib
+
+
+def _read_csv(path: pathlib.Path) -> dict:
+    with path.open() as fh:
+        rows = list(csv.DictReader(fh))
+    if not rows:
+        return {}
+    return {k: [float(r[k]) if r[k] not in ("", None) else float("nan") for r in rows] for k in rows[0]}
+
+
+def motion_plots(out_dir) -> list[str]:
+    """Write the plots of a moving-particle run folder; returns the file names written."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = pathlib.Path(out_dir)
+    data = _read_csv(out / "timeseries.csv") if (out / "timeseries.csv").exists() else {}
+    written = []
+    if data:
+        t = data["t"]
+        panels = [("volume_fraction", "solid fraction"), ("coordination", "coordination number"),
+                  ("kinetic_energy", "kinetic energy (J)"), ("k1_factor", "k1(T, t) / k1 (mean)"),
+                  ("T_mean", "temperature"), ("effective_conductivity", "k_eff (W/(m K))")]
+        panels = [(k, label) for k, label in panels if k in data and any(v == v for v in data[k])]
+        walls = [k for k in data if k.startswith("wall_")]
+        if walls:
+            panels.append(("walls", "wall load (N/m, Pa or N)"))
+        fig, axes = plt.subplots(len(panels), 1, figsize=(7, 2.0 * len(panels)), sharex=True, squeeze=False)
+        for ax, (key, label) in zip(axes[:, 0], panels):
+            if key == "walls":
+                for w in walls:
+                    ax.plot(t, data[w], label=w[5:])
+                ax.legend(fontsize=7)
+            elif key == "T_mean":
+                ax.plot(t, data["T_mean"], label="mean")
+                ax.fill_between(t, data["T_min"], data["T_max"], alpha=0.3, label="min-max")
+                ax.legend(fontsize=7)
+            else:
+                ax.plot(t, data[key])
+            if key == "kinetic_energy":
+                ax.set_yscale("log")
+            ax.set_ylabel(label, fontsize=8)
+        axes[-1, 0].set_xlabel("t (s)")
+        fig.tight_layout()
+        fig.savefig(out / "timeseries.png", dpi=120)
+        plt.close(fig)
+        written.append("timeseries.png")
+    if (out / "profiles.csv").exists():
+        prof = _read_csv(out / "profiles.csv")
+        if prof:
+            fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
+            times = sorted(set(prof["t"]))
+            for time in times:
+                rows = [k for k, tt in enumerate(prof["t"]) if tt == time]
+                d = [prof["distance"][k] * 1e3 for k in rows]
+                a1.plot(d, [prof["solid_fraction"][k] for k in rows], "o-", ms=3, label=f"t = {time:.3g} s")
+                a2.plot(d, [prof["neck_over_radius"][k] for k in rows], "o-", ms=3, label=f"t = {time:.3g} s")
+            a1.set_xlabel("distance from the hot wall (mm)")
+            a2.set_xlabel("distance from the hot wall (mm)")
+            a1.set_ylabel("solid fraction")
+            a2.set_ylabel("neck radius a / r (mean over contacts)")
+            a2.legend(fontsize=7)
+            fig.tight_layout()
+            fig.savefig(out / "profiles.png", dpi=120)
+            plt.close(fig)
+            written.append("profiles.png")
+    return written

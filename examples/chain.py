@@ -1,0 +1,19 @@
+"""A collinear chain of three sintered spheres: FE of the whole chain against its pipes in series."""
+
+import numpy as np
+
+from fem_neck import law, neck_radius
+from fem_neck.conduction import chain_conductance
+
+radii = [1e-3, 5e-3, 2e-3]  # m
+overlaps = [0.02e-3, 0.3e-3]  # m, one per bond
+kappa = 394.0  # W/(m K)
+
+fe = chain_conductance(radii, overlaps, kappa)  # end particles cut at their outer equatorial planes, T fixed there
+K_fe = fe.K
+
+necks = [neck_radius(r_i, r_j, h) for r_i, r_j, h in zip(radii, radii[1:], overlaps)]
+pipes = [law.pair_conductance(kappa, r_i, r_j, a) for r_i, r_j, a in zip(radii, radii[1:], necks)]
+K_pipes = 1.0 / np.sum(1.0 / np.array(pipes))  # the bonds in series, as the DEM's network sees them
+print(f"K_fe = {K_fe:.6f} W/K (estimate {fe.error_estimate:.0e}), pipes in series (fit law) {K_pipes:.6f} W/K "
+      f"({K_pipes / K_fe - 1:+.2%})")

@@ -1,0 +1,21 @@
+"""The FE-fitted conductance law inside a DEM scene: a steady chain of four copper particles between 100 C and 0 C.
+
+``law="fit"`` gives every pipe half kappa pi r_i f(a/r_i) from the fit shipped in ``fem_neck/data/fit.json`` (or the
+one ``python -m fem_neck fit`` wrote: ``conductance=ConductanceSpec(law="fit", fit_file=...)``).
+"""
+
+import numpy as np
+
+from dem import make_scene, run
+
+radius = np.array([1.0e-3, 1.5e-3, 1.0e-3, 2.0e-3])  # m
+overlap = 0.1 * np.minimum(radius[:-1], radius[1:])  # h = 0.1 r_min per bond
+z = np.concatenate([[0.0], np.cumsum(radius[:-1] + radius[1:] - overlap)])
+position = np.column_stack([np.zeros(4), np.zeros(4), z])
+
+result = run(make_scene(position, radius, [100.0, 0.0, 0.0, 0.0], fixed=[True, False, False, True], law="fit",
+                        mode="steady"))
+Q = -result.summary["boundary_heat_flow"]["particles"]["0"]  # W leaving the hot end particle into the chain
+K_chain = Q / 100.0  # W/K
+print(f"T = {np.round(result.T, 3)} C; heat flow {Q:.4f} W; chain conductance {K_chain:.6f} W/K "
+      f"(pipes {np.round(result.thermal.K_pairs, 5)} W/K)")

@@ -1,0 +1,17 @@
+"""Two sintered copper spheres of unequal radii (Rojek 2022, Sec. 6): FE against the pipe model of eqs. 43-45 and
+against the FE-fitted full-range law the DEM's ``fit`` law uses."""
+
+import math
+
+from fem_neck import law, neck_radius
+from fem_neck.conduction import pair_conductance
+
+r_i, r_j, h, kappa = 1e-3, 3e-3, 0.06e-3, 394.0  # m, m, m, W/(m K)
+a = neck_radius(r_i, r_j, h)  # volume-conserving neck, eqs. 27-33
+fe = pair_conductance(r_i, r_j, h, kappa, rtol=1e-6)  # T fixed on both equatorial disks
+K_fe = fe.K  # W/K
+
+K_model = 1.064 * kappa * math.pi * a / 2  # eq. 43 per half, halves in series (eq. 45)
+K_law = law.pair_conductance(kappa, r_i, r_j, a)  # the full-range law, each half at its own a/r, corrected
+print(f"a = {a * 1e3:.6f} mm; K_fe = {K_fe:.7f} W/K (estimate {fe.error_estimate:.0e}); eq. 45: {K_model:.6f} W/K "
+      f"({K_model / K_fe - 1:+.2%}); fit law: {K_law:.6f} W/K ({K_law / K_fe - 1:+.2%})")

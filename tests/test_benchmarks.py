@@ -1,0 +1,126 @@
+"""``python -m benchmarks``: subjects, options, exit codes, and reports whose links resolve (the timings themselves
+are the benchmarks' business, never asserted here)."""
+
+import importlib.machinery
+import json
+import subprocess
+import sys
+import types
+
+import pytest
+
+from benchmarks import SUBJECTS
+from benchmarks import __main__ as cli
+from benchmarks.neck import plain_newton, random_bonds
+from fem_neck import neck_radius
+from test_verification_report import assert_report_links_resolve
+
+
+def _run(*args, timeout=600):
+    return subprocess.run([sys.executable, "-m", "benchmarks", *args], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+@pytest.mark.parametrize("args", [["nonsense"], ["neck", "--bogus"], ["neck", "--out"]])
+def test_bad_options_one_line_exit_2(args):
+    proc = _run(*args)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
+
+
+def test_every_subject_has_the_interface():
+    import importlib
+
+    for name, module in SUBJECTS.items():
+        mod = importlib.import_module(module)
+        assert isinstance(mod.TITLE, str) and callable(mod.run), name
+
+
+def test_plain_newton_baseline_finds_the_same_roots():
+    r_i, r_j, h = random_bonds(2000)
+    a = neck_radius(r_i, r_j, h)
+    assert abs(plain_newton(r_i, r_j, h) / a - 1).max() < 1e-14
+
+
+@pytest.fixture
+def fake_subject(monkeypatch):
+    """A subject ``fake`` whose behaviour the test sets: ``seen`` records the options that reached ``run``."""
+    seen = {}
+    mod = types.ModuleType("fake_subject")
+    mod.__spec__ = importlib.machinery.ModuleSpec(mod.__name__, None)
+    mod.TITLE = "Fake timings"
+
+    def run(section, quick):
+        from matplotlib.figure import Figure
+
+        seen["quick"] = quick
+        if "seconds" not in seen:
+            raise RuntimeError("the timed call failed")
+        fig = Figure(figsize=(2, 2))
+        fig.subplots().plot([0, 1], [0, 1])
+        figure = section.figure(fig, "line")
+        section.add_text("A study", "text", figures=[figure])
+        section.figure(Figure(figsize=(2, 2)), "unlinked")
+        section.summary["fake_seconds"] = seen["seconds"]
+        section.target("fake under a second", seen["seconds"], 1.0, "s")
+
+    mod.run = run
+    monkeypatch.setitem(sys.modules, mod.__name__, mod)
+    monkeypatch.setitem(SUBJECTS, "fake", mod.__name__)
+    monkeypatch.setenv("TQDM_DISABLE", "")  # main() sets it for --no-progress; monkeypatch restores it
+    return seen
+
+
+def test_options_reach_run_and_json_is_the_summary(fake_subject, tmp_path, capsys):
+    fake_subject["seconds"] = 0.25
+    code = cli.main(["fake", "--quick", "--json", "--no-progress", "--out", str(tmp_path)])
+    out, err = capsys.readouterr()
+    assert code == 0 and fake_subject["quick"] is True, err
+    assert json.loads(out) == {"fake_seconds": 0.25} == json.loads((tmp_path / "summary.json").read_text())
+    run = json.loads((tmp_path / "run.json").read_text())
+    assert run["sections"]["fake"]["status"] == "ok"
+    assert_report_links_resolve(tmp_path)
+
+
+def test_a_missed_target_fails_the_command(fake_subject, tmp_path, capsys):
+    fake_subject["seconds"] = 2.5
+    code = cli.main(["fake", "--no-progress", "--out", str(tmp_path)])
+    out, err = capsys.readouterr()
+    assert code == 1
+    assert "fail" in out.splitlines()[0] and "fake under a second" in out
+    assert err.strip() == "python -m benchmarks: fake: fail: target missed: fake under a second"
+    md = (tmp_path / "report.md").read_text()
+    assert "| [Fake timings](#fake-timings) | fail: target missed: fake under a second |" in md
+    assert "| fake | fake under a second | 2.5 s | <= 1 s | FAIL |" in md
+    assert json.loads((tmp_path / "run.json").read_text())["sections"]["fake"]["status"] == "fail"
+    assert_report_links_resolve(tmp_path)
+
+
+def test_a_subject_that_raises_is_an_error(fake_subject, tmp_path, capsys):
+    code = cli.main(["fake", "--no-progress", "--out", str(tmp_path)])  # no "seconds": run raises
+    assert code == 1
+    out, err = capsys.readouterr()
+    assert "error" in out and "RuntimeError: the timed call failed" in err
+    assert "Traceback" in (tmp_path / "fake" / "error.txt").read_text()
+
+
+@pytest.mark.slow
+def test_neck_quick_writes_a_report_that_opens(tmp_path):
+    out = tmp_path / "res"
+    proc = _run("neck", "--quick", "--json", "--no-progress", "--out", str(out))
+    assert proc.returncode in (0, 1), proc.stderr[-2000:]  # 1: the machine was too busy for the target
+    summary = json.loads(proc.stdout)
+    for key in ("neck_newton_over_plain", "neck_newton_seconds", "neck_plain_newton_seconds", "neck_bonds"):
+        assert key in summary
+    assert_report_links_resolve(out)
+
+
+def test_ngsolve_startup_setting_reaches_1e_minus_4_at_the_reference_cases():
+    pytest.importorskip("ngsolve")
+    from benchmarks.fe import FE_CASES, NGSOLVE_STARTUP, ngsolve_semisphere
+    from verification.cases import SEMISPHERE_BY_H
+
+    for h_over_r in FE_CASES:
+        row = SEMISPHERE_BY_H[h_over_r]
+        k, _ = ngsolve_semisphere(row.a_over_r, **NGSOLVE_STARTUP)
+        assert abs(k / row.K_over_Kcyl - 1) < 1e-4, h_over_r

@@ -1,0 +1,63 @@
+"""Every script of ``examples/`` runs, and the number it leaves behind is right (each is copied by researchers, so
+each must work as printed)."""
+
+import math
+import pathlib
+import runpy
+
+import numpy as np
+import pytest
+
+from verification.cases import SEC6, SEMISPHERE_BY_H
+
+EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
+
+
+def run_example(name: str) -> dict:
+    """The example's module namespace after running it as a script."""
+    return runpy.run_path(str(EXAMPLES / f"{name}.py"), run_name="__main__")
+
+
+def test_every_example_is_tested():
+    tested = {name[len("test_"):] for name in globals() if name.startswith("test_") and name != "test_every_example_is_tested"}
+    assert {p.stem for p in EXAMPLES.glob("*.py")} <= tested
+
+
+def test_semisphere():
+    ns = run_example("semisphere")
+    assert ns["K_over_Kcyl"] == pytest.approx(SEMISPHERE_BY_H[0.08].K_over_Kcyl, rel=1e-6)  # rtol 1e-6 asked
+
+
+def test_unequal_pair():
+    ns = run_example("unequal_pair")
+    assert ns["K_model"] == pytest.approx(SEC6["K_model"].value, rel=2e-6)  # eq. 45 as printed in the paper
+    assert ns["K_fe"] == pytest.approx(0.27916769625, rel=1e-6)  # our converged FE (hp at rtol 1e-8, README)
+
+
+def test_chain():
+    ns = run_example("chain")
+    assert ns["K_pipes"] == pytest.approx(ns["K_fe"], rel=1e-3)  # the fit law's pipes in series vs the chain's FE
+
+
+def test_fit_law_in_dem():
+    ns = run_example("fit_law_in_dem")
+    K = ns["result"].thermal.K_pairs
+    assert ns["K_chain"] == pytest.approx(1.0 / np.sum(1.0 / K), rel=1e-10)  # steady chain = pipes in series
+
+
+def test_packing_conductivity():
+    ns = run_example("packing_conductivity")
+    assert 0.0 < ns["k_eff"] < 394.0  # below solid copper, and the seeded run's value:
+    assert ns["k_eff"] == pytest.approx(219.720135, rel=1e-6)
+
+
+def test_transient_pair():
+    ns = run_example("transient_pair")
+    assert ns["difference_error"] < 1e-3  # rtol 1e-4 of the temperature range, global error within 10 x
+    assert ns["T_i"] + 3**3 * ns["T_j"] == pytest.approx(100.0, rel=1e-12)  # energy: C ~ r^3, r_j = 3 r_i
+
+
+def test_cluster():
+    ns = run_example("cluster")
+    assert ns["middle_T"] == pytest.approx(0.5, abs=1e-3)  # symmetry of the L
+    assert math.isfinite(ns["K_cluster"]) and abs(ns["K_dem"] / ns["K_cluster"] - 1) < 0.1

@@ -1,0 +1,127 @@
+"""The README's console blocks, run: every ```` ```console ```` block's ``$ `` commands run in a fresh folder, and every
+number they print must match the README's.
+
+Tolerance: relative 1e-6 (and absolute 1e-12 for numbers at round-off level, such as an energy error of 5e-17).
+Every command shown is deterministic (seeded, fixed meshes, no timing-dependent choices), so on the machine that
+wrote the README the numbers agree to all printed digits; 1e-6 leaves room for platform round-off amplified by the
+solves (BLAS, libm, SuperLU orderings) while staying 100x tighter than the loosest solver tolerance shown (rtol
+1e-4), so a changed algorithm or a stale README fails. Timings are ignored: ``seconds`` entries, and numbers with
+the unit ``s`` (``1.8 s``). Commands are run with ``python`` replaced by this interpreter, the repository on
+``PYTHONPATH``, and stdout and stderr together, as a terminal shows them (progress bars left out). Input files the
+README shows (a fenced block right after ``<!-- file: NAME -->``) are written into the folder first.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import pathlib
+import re
+import shlex
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+RTOL, ATOL = 1e-6, 1e-12
+SLOW = ("fem_neck converge", "verification")  # commands of more than a few seconds: marked slow
+NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
+TIMING = re.compile(r"(?<![\w.])\d+(?:\.\d+)?\s?s\b")  # "1.8 s": a wall time in a table
+PROGRESS = re.compile(r"\d+%\||it/s\]|s/it\]")  # a tqdm bar on stderr (a terminal overwrites it in place)
+
+
+def shown(output: str) -> list[str]:
+    """The lines a terminal keeps: progress bars dropped, blank lines too."""
+    return [line.rstrip() for line in output.splitlines() if line.strip() and not PROGRESS.search(line)]
+
+
+def console_commands(text: str) -> list[tuple[str, str, int]]:
+    """``(command, expected output, line number)`` for every ``$ `` line of every console block."""
+    out = []
+    lines = text.splitlines()
+    k = 0
+    while k < len(lines):
+        if lines[k].strip() == "```console":
+            k += 1
+            while k < len(lines) and lines[k].strip() != "```":
+                if lines[k].startswith("$ "):
+                    command, start, expected = lines[k][2:], k + 1, []
+                    k += 1
+                    while k < len(lines) and lines[k].strip() != "```" and not lines[k].startswith("$ "):
+                        expected.append(lines[k])
+                        k += 1
+                    out.append((command, "\n".join(expected), start))
+                else:
+                    k += 1
+        k += 1
+    return out
+
+
+def _drop_seconds(value):
+    if isinstance(value, dict):
+        return {k: _drop_seconds(v) for k, v in value.items() if k != "seconds"}
+    if isinstance(value, list):
+        return [_drop_seconds(v) for v in value]
+    return value
+
+
+def numbers(output: str) -> list[float]:
+    """The numbers of a command's output, timings left out (see the module docstring)."""
+    text = "\n".join(shown(output))
+    if text.startswith("{"):
+        text = json.dumps(_drop_seconds(json.loads(text)))
+    else:
+        text = "\n".join(line for line in text.splitlines() if line.split()[:1] != ["seconds"])
+    return [float(x) for x in NUMBER.findall(TIMING.sub("", text))]
+
+
+def close(a: float, b: float) -> bool:
+    if abs(a) < ATOL and abs(b) < ATOL:
+        return True
+    return math.isclose(a, b, rel_tol=RTOL, abs_tol=0.0)
+
+
+def test_number_extraction_ignores_timings_and_keeps_the_rest():
+    assert numbers("a  1.5e-3\nseconds  0.4\nb  [2 items]") == [1.5e-3, 2.0]
+    assert numbers('{"K": 0.25, "seconds": 3.1, "n": [1, 2]}') == [0.25, 1.0, 2.0]
+    assert numbers("paper      ok        1.8 s  Rojek 2022") == [2022.0]
+    assert numbers("fit sweep:  50%|#####     | 20/40 [00:00<00:00, 32.95solve/s]\nslope  1.07") == [1.07]
+    assert close(5.4e-17, -2e-16) and close(1.0, 1.0 + 5e-7) and not close(1.0, 1.0 + 2e-6)
+
+
+def shown_files(text: str) -> dict:
+    """``{name: content}`` of every fenced block that follows a ``<!-- file: NAME -->`` line."""
+    out = {}
+    for match in re.finditer(r"<!-- file: (\S+) -->\s*\n```\w*\n(.*?)\n```", text, re.S):
+        out[match.group(1)] = match.group(2) + "\n"
+    return out
+
+
+COMMANDS = console_commands(README.read_text())
+FILES = shown_files(README.read_text())
+
+
+def test_readme_has_console_blocks():
+    assert len(COMMANDS) >= 8
+
+
+@pytest.mark.parametrize("command, expected, line", [
+    pytest.param(c, e, n, id=f"README:{n} {c[:60]}", marks=[pytest.mark.slow] if any(s in c for s in SLOW) else [])
+    for c, e, n in COMMANDS])
+def test_console_block(tmp_path, command, expected, line):
+    argv = shlex.split(command)
+    assert argv[0] == "python", f"README line {line}: only python commands are run"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep),
+               MPLBACKEND="Agg")
+    for name, content in FILES.items():
+        (tmp_path / name).write_text(content)
+    proc = subprocess.run([sys.executable, *argv[1:]], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, text=True, timeout=1800)
+    got, want = numbers(proc.stdout), numbers(expected)
+    message = f"README line {line}: `{command}` printed\n{proc.stdout}"
+    assert len(got) == len(want), message
+    bad = [(w, g) for w, g in zip(want, got) if not close(w, g)]
+    assert not bad, f"{message}\n(README, now): {bad}"
