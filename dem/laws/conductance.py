@@ -128,14 +128,14 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     p = bonds.wall_particle
     k_w = half_conductance(spec, kappa[p], r[p], bonds.wall_a, bonds.wall_l)
     if spec.law == "shared-body":
-        from dem.laws.shared_body import body_factors
+        from dem.laws.shared_body import neck_factors
 
         if bonds.n_walls and not len(walls):
             raise ValueError("conductance.law = \"shared-body\": the wall bonds' walls are needed (their normals)")
         normals = np.array([w.normal for w in walls])[bonds.wall_index] if bonds.n_walls else np.zeros((0, 3))
-        s = body_factors(particles.n, r, bonds, bonds.vectors(particles.position, box), k_i, k_j, k_w, kappa,
-                         normals)
-        k_i, k_j, k_w = s[bonds.i] * k_i, s[bonds.j] * k_j, s[p] * k_w
+        s_i, s_j, s_w = neck_factors(particles.n, r, bonds, bonds.vectors(particles.position, box), k_i, k_j, k_w,
+                                     kappa, normals)
+        k_i, k_j, k_w = s_i * k_i, s_j * k_j, s_w * k_w
     k_pair = series(k_i, k_j)
     if spec.law in FIT_LAWS and spec.unequal and bonds.n_pairs:
         k_pair = k_pair * fem_law.unequal_factor(r[bonds.i], r[bonds.j], bonds.a)

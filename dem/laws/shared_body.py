@@ -28,25 +28,31 @@ Nothing is fitted; ``python -m verification lattices`` measures the residuals ag
 disk-centre chord removes most of what point contacts leave at large necks).
 
 **Back to one temperature per particle.** The network keeps one node per particle, so the multi-terminal conductor
-is reduced to one factor ``s_k`` on all half-conductances of particle ``k``, chosen so that the particle passes the
-same heat in a uniform field: neck ``b`` sits at ``x_k + l_b n_b`` (``l_b`` the centre-to-contact-plane distance),
-a field ``g`` drives the flows ``Q = Y (N g)`` with ``N`` the rows ``l_b n_b`` and ``Y`` the conductance matrix of
-``R`` on flows that sum to zero (``Y = R^-1 - R^-1 1 1^T R^-1 / (1^T R^-1 1)``); the particle's conductivity tensor
-is ``N^T Y N``. With ``s_k`` the ratio of its trace to that of the plain network's (``R = diag(1/K_b)``)::
+is reduced to one factor ``s_b`` per neck on the fit law's half conductance ``K_b``. Neck ``b`` sits at
+``x_k + l_b n_b`` (``l_b`` the centre-to-contact-plane distance); a uniform field ``g`` drives the flows
+``Q = Y N g`` (``N`` the rows ``l_b n_b``, ``Y`` the conductance matrix of ``R`` on flows that sum to zero,
+``Y = R^-1 - R^-1 1 1^T R^-1 / (1^T R^-1 1)``). In the field along its own neck, ``g = n_b``, neck ``b`` carries
+``(Y N N^T)_bb``: the factor is that flow over the plain network's (``R = diag(1/K_b)``)::
 
-    s_k = tr(N^T Y_R N) / tr(N^T Y_D N).
+    s_b = (Y_R N N^T)_bb / (Y_D N N^T)_bb.
 
-For a cubic lattice both tensors are isotropic, so this is exact there for the multi-terminal model; for the simple
-cubic lattice the interactions cancel in every uniform field (``s = 1``: the plain network, which the FE finds
-accurate there). Chains and pairs give ``s = 1`` exactly: interactions below 1e-12 of the half resistances (collinear
-bonds to round-off) count as none, so those results are today's ``fit`` law bit for bit.
+Summed over the necks these are the traces of the particle's conductivity tensors ``N^T Y N``: for a cubic lattice,
+whose tensors are isotropic and whose necks are all alike, every ``s_b`` is the ratio of the traces and the
+reduction is exact; for the simple cubic lattice the interactions cancel in every uniform field (``s = 1``, the
+plain network, which the FE finds accurate). Necks close to one another share the body (``s < 1``); two necks
+closer than opposite poles, as in a bent chain, pass heat between them more easily than two equatorial half bodies
+in series (``s > 1``). Where the plain network's own flow in that field is nearly nil (other necks pointing the same
+way) the particle's trace ratio is used instead. Chains and pairs give ``s = 1`` exactly: interactions below 1e-12
+of the half resistances (collinear bonds to round-off) count as none, so those results are today's ``fit`` law bit
+for bit.
 
 **Never above the Wiener bound.** For the uniform field the network's energy is at most the sum over particles of
-``sum_b s_k K_b l_b^2 (n_b . g)^2`` (the halves of a bond in series, Cauchy-Schwarz), and the Wiener bound ``phi
-kappa`` is the same field's energy in the solid, ``kappa V_k |g|^2`` per particle. So ``s_k`` is capped at
-``kappa V_k / lambda_max(sum_b K_b l_b^2 n_b n_b^T)`` (``V_k = 4/3 pi r^3``, the volume each particle keeps
-under the volume-conserving neck): a periodic network then never conducts more than ``phi kappa``. The cap binds
-only where the correction falls short (it is applied to particles with non-collinear necks).
+``sum_b s_b K_b l_b^2 (n_b . g)^2`` (the halves of a bond in series, Cauchy-Schwarz), and the Wiener bound ``phi
+kappa`` is the same field's energy in the solid, ``kappa V_k |g|^2`` per particle. So a particle's factors are
+scaled down together wherever ``lambda_max(sum_b s_b K_b l_b^2 n_b n_b^T)`` exceeds ``kappa V_k`` (``V_k = 4/3 pi
+r^3``, the volume each particle keeps under the volume-conserving neck): a periodic network then never conducts
+more than ``phi kappa``. The cap binds only where the necks overlap (beyond the pair model); it is applied to
+particles with non-collinear necks.
 
 A wall bond is a neck too (toward the wall, the mirror pair's neck), so it takes part in its particle's factor.
 
@@ -81,13 +87,29 @@ def interaction(normal_b, normal_c, base_b: float, base_c: float) -> float:
 
 
 @numba.njit(cache=True)
+def _own_flux(x, N):
+    """``(Y N)_b . N_b`` for every neck ``b``, from ``x = R^-1 [N 1]``: ``Y N = X_N - y (1^T X_N) / (1^T y)``."""
+    z = len(N)
+    ones = 0.0
+    total = np.zeros(3)
+    for b in range(z):
+        ones += x[b, 3]
+        for a in range(3):
+            total[a] += x[b, a]
+    flux = np.zeros(z)
+    for b in range(z):
+        for a in range(3):
+            flux[b] += (x[b, a] - x[b, 3] * total[a] / ones) * N[b, a]
+    return flux
+
+
+@numba.njit(cache=True)
 def _factors(offsets, normal, base, arm, half_r, n_particles):
-    """``s_k`` for every particle (module docstring). Per particle ``k`` its necks are ``offsets[k]:offsets[k+1]``
-    with unit ``normal`` (m, 3), cap-base distance ``base`` and ``arm`` ``l_b`` (both over ``r_k``) and ``half_r``
-    ``= 4 pi kappa r_k / K_b`` (the half resistance in units of ``1 / (4 pi kappa r_k)``). Also returns which
-    particles have interacting necks."""
-    out = np.ones(n_particles)
-    interacting = np.zeros(n_particles, dtype=np.bool_)
+    """The factor ``s_b`` of every neck end (module docstring), in the order of ``offsets``: particle ``k`` has the
+    necks ``offsets[k]:offsets[k+1]`` with unit ``normal`` (m, 3), cap-base distance ``base`` and ``arm`` ``l_b``
+    (both over ``r_k``) and ``half_r = 4 pi kappa r_k / K_b`` (the half resistance in units of
+    ``1 / (4 pi kappa r_k)``)."""
+    out = np.ones(len(half_r))
     for k in range(n_particles):
         lo, hi = offsets[k], offsets[k + 1]
         z = hi - lo
@@ -105,63 +127,48 @@ def _factors(offsets, normal, base, arm, half_r, n_particles):
                 R[c, b] = g
                 largest = max(largest, abs(g))
         if largest <= ROUNDOFF * small:
-            continue
-        interacting[k] = True
-        rhs = np.empty((z, 4))
+            continue  # collinear necks: the plain network, bit for bit
+        N = np.empty((z, 4))  # the neck positions l_b n_b, and ones
         for b in range(z):
             for a in range(3):
-                rhs[b, a] = arm[lo + b] * normal[lo + b, a]
-            rhs[b, 3] = 1.0
-        x = np.linalg.solve(R, rhs)
-        tr_r = 0.0
-        dip = np.zeros(3)
-        ones = 0.0
+                N[b, a] = arm[lo + b] * normal[lo + b, a]
+            N[b, 3] = 1.0
+        x = np.linalg.solve(R, N)  # R^-1 [N 1], and the same for the plain network's diagonal R
+        xd = np.empty((z, 4))
         for b in range(z):
-            for a in range(3):
-                tr_r += rhs[b, a] * x[b, a]
-                dip[a] += rhs[b, a] * x[b, 3]
-            ones += x[b, 3]
-        tr_r -= (dip[0] ** 2 + dip[1] ** 2 + dip[2] ** 2) / ones
-        tr_d = 0.0
-        dip[:] = 0.0
-        ones = 0.0
+            for a in range(4):
+                xd[b, a] = N[b, a] / half_r[lo + b]
+        num = _own_flux(x, N)
+        den = _own_flux(xd, N)
+        trace = num.sum() / den.sum() if den.sum() > 0.0 else 1.0
+        scale = 0.0
         for b in range(z):
-            w = 1.0 / half_r[lo + b]
-            for a in range(3):
-                tr_d += w * rhs[b, a] ** 2
-                dip[a] += w * rhs[b, a]
-            ones += w
-        tr_d -= (dip[0] ** 2 + dip[1] ** 2 + dip[2] ** 2) / ones
-        if tr_d > 0.0:
-            out[k] = tr_r / tr_d
-    return out, interacting
-
-
-@numba.njit(cache=True)
-def _wiener_caps(offsets, normal, arm, half_r, factor, interacting):
-    """``min(s_k, kappa V_k / lambda_max(sum_b K_b l_b^2 n_b n_b^T))`` for the particles with interacting necks,
-    in units where ``K_b = 4 pi / half_r`` and ``V_k = 4/3 pi``."""
-    out = factor.copy()
-    for k in range(len(factor)):
-        if not interacting[k]:
-            continue
+            scale = max(scale, abs(den[b]))
+        for b in range(z):
+            # a neck whose own flux the plain network barely moves (others pointing its way) takes the trace
+            ok = den[b] > 1e-6 * scale and num[b] > 0.0
+            out[lo + b] = num[b] / den[b] if ok else trace
+        # Wiener: sum_b s_b K_b l_b^2 n_b n_b^T at most kappa V_k (units K_b = 4 pi / half_r, V_k = 4/3 pi)
         M = np.zeros((3, 3))
-        for b in range(offsets[k], offsets[k + 1]):
-            w = 4.0 * np.pi / half_r[b] * arm[b] ** 2
+        for b in range(z):
+            w = out[lo + b] * 4.0 * np.pi / half_r[lo + b] * arm[lo + b] ** 2
             for p in range(3):
                 for q in range(3):
-                    M[p, q] += w * normal[b, p] * normal[b, q]
+                    M[p, q] += w * normal[lo + b, p] * normal[lo + b, q]
         lam = np.linalg.eigvalsh(M)[2]
-        if lam > 0.0:
-            out[k] = min(out[k], 4.0 / 3.0 * np.pi / lam)
+        cap = 4.0 / 3.0 * np.pi / lam if lam > 0.0 else np.inf
+        if cap < 1.0:
+            for b in range(z):
+                out[lo + b] *= cap
     return out
 
 
-def body_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray, k_j: np.ndarray,
-                 k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray) -> np.ndarray:
-    """``s_k`` of every particle (module docstring) from its necks: the pair bonds (``vectors`` from ``i`` to the
-    partner, neck radii ``bonds.a``, half conductances ``k_i``, ``k_j`` in W/K) and the wall bonds (unit
-    ``wall_normals`` pointing into the packing, ``bonds.wall_a``, half conductances ``k_wall``)."""
+def neck_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray, k_j: np.ndarray,
+                 k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray):
+    """The factors ``(s_i, s_j, s_wall)`` of every pair bond's two halves and every wall bond's half (module
+    docstring) from the particles' necks: the pair bonds (``vectors`` from ``i`` to the partner, neck radii
+    ``bonds.a``, half conductances ``k_i``, ``k_j`` in W/K) and the wall bonds (unit ``wall_normals`` pointing into
+    the packing, ``bonds.wall_a``, half conductances ``k_wall``)."""
     d = np.linalg.norm(vectors, axis=1)
     e = vectors / np.where(d > 0, d, 1.0)[:, None]
     owner = np.concatenate([bonds.i, bonds.j, bonds.wall_particle]).astype(np.int64)
@@ -177,7 +184,9 @@ def body_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, 
     order = np.argsort(owner, kind="stable")
     offsets = np.zeros(n + 1, dtype=np.int64)
     offsets[1:] = np.cumsum(np.bincount(owner, minlength=n))
-    normal, base, arm, half_r = normal[order], base[order], (arm / r)[order], half_r[order]
-    normal = np.ascontiguousarray(normal)
-    factor, interacting = _factors(offsets, normal, base, arm, half_r, n)
-    return _wiener_caps(offsets, normal, arm, half_r, factor, interacting)
+    sorted_factor = _factors(offsets, np.ascontiguousarray(normal[order]), base[order], (arm / r)[order],
+                             half_r[order], n)
+    factor = np.empty_like(sorted_factor)
+    factor[order] = sorted_factor
+    m = bonds.n_pairs
+    return factor[:m], factor[m:2 * m], factor[2 * m:]
