@@ -203,20 +203,20 @@ def all_cases(quick: bool) -> list[Case]:
 # The DEM side
 # ---------------------------------------------------------------------------------------------------------------
 
-LAWS = ("rojek", "argento-bouvard", "fit", "zohdi")
+LAWS = ("rojek", "argento-bouvard", "fit", "shared-body", "zohdi")
 
 
 NETWORK_ONLY = "fe-pair"  # every pipe gets the FE conductance of its own pair: no law error, only the network's
 
 
 def available_laws() -> tuple:
-    """The laws of :data:`LAWS` that can be evaluated here (``fit`` needs the shipped fit file)."""
+    """The laws of :data:`LAWS` that can be evaluated here (``fit`` and ``shared-body`` need the shipped fit file)."""
     from fem_neck import law as laws
 
     try:
         laws.ConductanceLaw.default()
     except ValueError:
-        return tuple(x for x in LAWS if x != "fit")
+        return tuple(x for x in LAWS if x not in ("fit", "shared-body"))
     return LAWS
 
 
