@@ -299,11 +299,12 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curva
         mesh_tetrahedra(gmsh, curvature, size_far)
         pieces = [tetrahedra(gmsh, tag) for _, tag in volume]
         points, tets = pieces[0][0], np.vstack([piece[1] for piece in pieces])
+    tets = _conducting(points, tets, box[2], tol)
     used = np.unique(tets)
     remap = np.full(len(points), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
     mesh = MeshTet(points[used].T.copy(), remap[tets].T.copy())
-    curved = curved_mesh(mesh, local, geo, ())
+    curved = _untangled(curved_mesh(mesh, local, geo, ()), mesh)
     bf = mesh.boundary_facets()
     fz = mesh.p[2, mesh.facets[:, bf]]
     hot = bf[np.all(np.abs(fz) < tol, axis=0)]
@@ -314,6 +315,42 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curva
     curved = type(curved)(curved.doflocs * unit, curved.t)
     return CellMesh(mesh, curved, hot, cold, float(box[2] * unit), float(area * unit**2), diagonal,
                     float(volume_exact * unit**3), float(volume_cad * unit**3), np.asarray(geo.a) * unit)
+
+
+def _conducting(points: np.ndarray, tets: np.ndarray, height: float, tol: float) -> np.ndarray:
+    """The tetrahedra of the pieces of the solid that touch an isothermal face (``z = 0`` or ``z = height``): a
+    piece joined to the rest only outside the cell and touching neither carries no heat (its temperature is
+    undetermined, its energy zero), so it is left out."""
+    import scipy.sparse as sparse
+    from scipy.sparse.csgraph import connected_components
+
+    n = len(points)
+    rows = np.repeat(tets[:, :1], 3, axis=1).ravel()
+    graph = sparse.coo_matrix((np.ones(len(rows)), (rows, tets[:, 1:].ravel())), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    z = points[:, 2]
+    touching = np.unique(label[(np.abs(z) < tol) | (np.abs(z - height) < tol)])
+    return tets[np.isin(label[tets[:, 0]], touching)]
+
+
+def _untangled(curved, straight):
+    """The curved mesh with the edges of any element whose curved map folds (Jacobian <= 0 at a quadrature point)
+    put back straight: on a coarse mesh a thin element next to a curved face can turn inside out, which would make
+    the stiffness matrix indefinite."""
+    from skfem import Basis, ElementTetP1, MeshTet2
+
+    doflocs = curved.doflocs.copy()
+    nv = straight.p.shape[1]
+    for _ in range(5):
+        mesh = MeshTet2(doflocs, curved.t)
+        detj = Basis(mesh, ElementTetP1(), intorder=4).mapping.detDF(Basis(mesh, ElementTetP1(), intorder=4).X)
+        bad = np.flatnonzero(np.min(detj, axis=1) <= 0.0)
+        if not len(bad):
+            return mesh
+        edges = np.unique(straight.t2e[:, bad])
+        ends = straight.edges[:, edges]
+        doflocs[:, nv + edges] = 0.5 * (straight.p[:, ends[0]] + straight.p[:, ends[1]])
+    return MeshTet2(doflocs, curved.t)
 
 
 def _solve_dirichlet(basis, hot_dofs, cold_dofs, rtol: float):
