@@ -56,8 +56,8 @@ particles with non-collinear necks.
 
 A wall bond is a neck too (toward the wall, the mirror pair's neck), so it takes part in its particle's factor.
 
-The factors are computed per particle in one compiled loop (numba): a solve of the ``z x z`` matrix ``R`` with four
-right-hand sides.
+The factors are computed per particle in one compiled loop (numba, the particles shared among the threads): a
+Gaussian elimination of the ``z x z`` matrix ``R`` with four right-hand sides, without allocating.
 """
 
 from __future__ import annotations
@@ -87,80 +87,142 @@ def interaction(normal_b, normal_c, base_b: float, base_c: float) -> float:
 
 
 @numba.njit(cache=True)
-def _own_flux(x, N):
-    """``(Y N)_b . N_b`` for every neck ``b``, from ``x = R^-1 [N 1]``: ``Y N = X_N - y (1^T X_N) / (1^T y)``."""
-    z = len(N)
-    ones = 0.0
-    total = np.zeros(3)
-    for b in range(z):
-        ones += x[b, 3]
-        for a in range(3):
-            total[a] += x[b, a]
-    flux = np.zeros(z)
-    for b in range(z):
-        for a in range(3):
-            flux[b] += (x[b, a] - x[b, 3] * total[a] / ones) * N[b, a]
-    return flux
+def _solve_in_place(A, X, z):
+    """Solve ``A[:z, :z] Y = X[:z]`` by Gaussian elimination with partial pivoting, overwriting ``X`` with ``Y`` (and
+    ``A``); a small dense system per particle, solved without allocating."""
+    m = X.shape[1]
+    for c in range(z):
+        p = c
+        for r in range(c + 1, z):
+            if abs(A[r, c]) > abs(A[p, c]):
+                p = r
+        if p != c:
+            for k in range(z):
+                A[c, k], A[p, k] = A[p, k], A[c, k]
+            for k in range(m):
+                X[c, k], X[p, k] = X[p, k], X[c, k]
+        for r in range(c + 1, z):
+            f = A[r, c] / A[c, c]
+            for k in range(c, z):
+                A[r, k] -= f * A[c, k]
+            for k in range(m):
+                X[r, k] -= f * X[c, k]
+    for c in range(z - 1, -1, -1):
+        for k in range(m):
+            v = X[c, k]
+            for j in range(c + 1, z):
+                v -= A[c, j] * X[j, k]
+            X[c, k] = v / A[c, c]
 
 
 @numba.njit(cache=True)
-def _factors(offsets, normal, base, arm, half_r, n_particles):
-    """The factor ``s_b`` of every neck end (module docstring), in the order of ``offsets``: particle ``k`` has the
-    necks ``offsets[k]:offsets[k+1]`` with unit ``normal`` (m, 3), cap-base distance ``base`` and ``arm`` ``l_b``
-    (both over ``r_k``) and ``half_r = 4 pi kappa r_k / K_b`` (the half resistance in units of
-    ``1 / (4 pi kappa r_k)``)."""
-    out = np.ones(len(half_r))
-    for k in range(n_particles):
+def _own_flux(x, N, z, flux):
+    """``flux[b] = (Y N)_b . N_b`` for every neck ``b`` from ``x = R^-1 [N 1]``:
+    ``Y N = X_N - y (1^T X_N) / (1^T y)``."""
+    ones = 0.0
+    t0 = t1 = t2 = 0.0
+    for b in range(z):
+        ones += x[b, 3]
+        t0 += x[b, 0]
+        t1 += x[b, 1]
+        t2 += x[b, 2]
+    for b in range(z):
+        y = x[b, 3] / ones
+        flux[b] = (x[b, 0] - y * t0) * N[b, 0] + (x[b, 1] - y * t1) * N[b, 1] + (x[b, 2] - y * t2) * N[b, 2]
+
+
+@numba.njit(cache=True, parallel=True)
+def _factors(owner, normal, base, arm, half_r, n_particles):
+    """The factor ``s_b`` of every neck end (module docstring). Neck end ``e`` belongs to particle ``owner[e]``,
+    with unit ``normal`` (m, 3), cap-base distance ``base`` and ``arm`` ``l_b`` (both over the particle's radius)
+    and ``half_r = 4 pi kappa r / K_b`` (the half resistance in units of ``1 / (4 pi kappa r)``). The particles
+    are shared among the threads in chunks, each with its own work arrays."""
+    m = len(owner)
+    out = np.ones(m)
+    counts = np.zeros(n_particles + 1, dtype=np.int64)
+    for e in range(m):
+        counts[owner[e] + 1] += 1
+    offsets = np.cumsum(counts)
+    fill = offsets[:-1].copy()
+    ends = np.empty(m, dtype=np.int64)  # the neck ends grouped by particle (counting sort)
+    for e in range(m):
+        ends[fill[owner[e]]] = e
+        fill[owner[e]] += 1
+    z_max = int(np.max(counts)) if m else 0
+    chunk = 4096
+    for block in numba.prange((n_particles + chunk - 1) // chunk):
+        _block_factors(block * chunk, min((block + 1) * chunk, n_particles), offsets, ends, normal, base, arm,
+                       half_r, z_max, out)
+    return out
+
+
+@numba.njit(cache=True)
+def _block_factors(first, last, offsets, ends, normal, base, arm, half_r, z_max, out):
+    """:func:`_factors` for the particles ``first:last``."""
+    R = np.empty((z_max, z_max))
+    N = np.empty((z_max, 4))
+    x = np.empty((z_max, 4))
+    num = np.empty(z_max)
+    den = np.empty(z_max)
+    M = np.empty((3, 3))
+    for k in range(first, last):
         lo, hi = offsets[k], offsets[k + 1]
         z = hi - lo
         if z < 2:
             continue
-        R = np.zeros((z, z))
         small = np.inf
         largest = 0.0
         for b in range(z):
-            R[b, b] = half_r[lo + b]
-            small = min(small, half_r[lo + b])
+            eb = ends[lo + b]
+            R[b, b] = half_r[eb]
+            small = min(small, half_r[eb])
             for c in range(b):
-                g = interaction(normal[lo + b], normal[lo + c], base[lo + b], base[lo + c])
+                ec = ends[lo + c]
+                g = interaction(normal[eb], normal[ec], base[eb], base[ec])
                 R[b, c] = g
                 R[c, b] = g
                 largest = max(largest, abs(g))
         if largest <= ROUNDOFF * small:
             continue  # collinear necks: the plain network, bit for bit
-        N = np.empty((z, 4))  # the neck positions l_b n_b, and ones
-        for b in range(z):
+        for b in range(z):  # the neck positions l_b n_b, and ones
+            eb = ends[lo + b]
             for a in range(3):
-                N[b, a] = arm[lo + b] * normal[lo + b, a]
+                N[b, a] = arm[eb] * normal[eb, a]
+                x[b, a] = N[b, a]
             N[b, 3] = 1.0
-        x = np.linalg.solve(R, N)  # R^-1 [N 1], and the same for the plain network's diagonal R
-        xd = np.empty((z, 4))
-        for b in range(z):
+            x[b, 3] = 1.0
+        _solve_in_place(R, x, z)  # R^-1 [N 1]
+        _own_flux(x, N, z, num)
+        for b in range(z):  # the same for the plain network, R = diag(half_r)
+            w = 1.0 / half_r[ends[lo + b]]
             for a in range(4):
-                xd[b, a] = N[b, a] / half_r[lo + b]
-        num = _own_flux(x, N)
-        den = _own_flux(xd, N)
-        trace = num.sum() / den.sum() if den.sum() > 0.0 else 1.0
-        scale = 0.0
+                x[b, a] = N[b, a] * w
+        _own_flux(x, N, z, den)
+        total_num = total_den = scale = 0.0
         for b in range(z):
+            total_num += num[b]
+            total_den += den[b]
             scale = max(scale, abs(den[b]))
+        trace = total_num / total_den if total_den > 0.0 else 1.0
         for b in range(z):
-            # a neck whose own flux the plain network barely moves (others pointing its way) takes the trace
+            # a neck whose own flow the plain network barely moves (others pointing its way) takes the trace
             ok = den[b] > 1e-6 * scale and num[b] > 0.0
-            out[lo + b] = num[b] / den[b] if ok else trace
-        # Wiener: sum_b s_b K_b l_b^2 n_b n_b^T at most kappa V_k (units K_b = 4 pi / half_r, V_k = 4/3 pi)
-        M = np.zeros((3, 3))
+            out[ends[lo + b]] = num[b] / den[b] if ok else trace
+        # Wiener: sum_b s_b K_b l_b^2 n_b n_b^T at most kappa V_k (units K_b = 4 pi / half_r, V_k = 4/3 pi); its
+        # trace bounds its largest eigenvalue, which is only computed when the trace exceeds the limit
+        M[:, :] = 0.0
         for b in range(z):
-            w = out[lo + b] * 4.0 * np.pi / half_r[lo + b] * arm[lo + b] ** 2
+            eb = ends[lo + b]
+            w = out[eb] * 4.0 * np.pi / half_r[eb] * arm[eb] ** 2
             for p in range(3):
                 for q in range(3):
-                    M[p, q] += w * normal[lo + b, p] * normal[lo + b, q]
-        lam = np.linalg.eigvalsh(M)[2]
-        cap = 4.0 / 3.0 * np.pi / lam if lam > 0.0 else np.inf
-        if cap < 1.0:
-            for b in range(z):
-                out[lo + b] *= cap
-    return out
+                    M[p, q] += w * normal[eb, p] * normal[eb, q]
+        limit = 4.0 / 3.0 * np.pi
+        if M[0, 0] + M[1, 1] + M[2, 2] > limit:
+            lam = np.linalg.eigvalsh(M)[2]
+            if lam > limit:
+                for b in range(z):
+                    out[ends[lo + b]] *= limit / lam
 
 
 def neck_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray, k_j: np.ndarray,
@@ -181,12 +243,6 @@ def neck_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, 
     base = np.sqrt((1.0 - q) * (1.0 + q))  # cap-base distance over r
     with np.errstate(divide="ignore"):
         half_r = 4.0 * np.pi * kappa * r / half
-    order = np.argsort(owner, kind="stable")
-    offsets = np.zeros(n + 1, dtype=np.int64)
-    offsets[1:] = np.cumsum(np.bincount(owner, minlength=n))
-    sorted_factor = _factors(offsets, np.ascontiguousarray(normal[order]), base[order], (arm / r)[order],
-                             half_r[order], n)
-    factor = np.empty_like(sorted_factor)
-    factor[order] = sorted_factor
+    factor = _factors(owner, np.ascontiguousarray(normal), base, arm / r, half_r, n)
     m = bonds.n_pairs
     return factor[:m], factor[m:2 * m], factor[2 * m:]
