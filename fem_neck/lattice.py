@@ -14,7 +14,8 @@ The computational cell. A macroscopic gradient along z through a packing that is
 isothermal (the temperature fluctuation is odd under the z mirror) and the planes normal to x and y insulated (it
 is even under those). The FE therefore solves the box ``[0, P/2]^3`` -- an eighth of the period -- with ``T = 1`` on
 ``z = 0``, ``T = 0`` on ``z = P_z/2`` and no flux elsewhere; when the packing is also symmetric under ``x <-> y``
-(the cubic lattices) only the wedge ``0 <= y <= x`` of that box is solved (a sixteenth). Then
+(the cubic lattices) only the wedge ``0 <= y <= x`` of that box is solved (a sixteenth), and when also under
+``(x, y) -> (P/2 - y, P/2 - x)`` (face-centred cubic) only its half with ``x + y <= P/2``. Then
 ``k_eff = Q (P_z / 2) / A`` with ``Q`` the heat flow and ``A`` the cell's cross-section, for ``kappa = 1``.
 
 Two bounds (the error estimate). With ``K`` the exact heat flow of the cell for a unit temperature difference:
@@ -199,9 +200,10 @@ def check_cell(cell: PeriodicCell, method: str = "newton") -> None:
                         f"{math.degrees(need):.2f} deg; the pair neck model has no answer there")
 
 
-def mirror_symmetry(cell: PeriodicCell) -> tuple[bool, bool]:
-    """``(mirror, diagonal)``: whether the packing is symmetric under ``x -> -x``, ``y -> -y`` and ``z -> -z`` (each
-    modulo the period), and whether it is also symmetric under ``x <-> y``."""
+def mirror_symmetry(cell: PeriodicCell) -> tuple[bool, bool, bool]:
+    """``(mirror, diagonal, antidiagonal)``: whether the packing is symmetric under ``x -> -x``, ``y -> -y`` and
+    ``z -> -z`` (each modulo the period); whether it is also symmetric under ``x <-> y``; and whether also under
+    ``(x, y) -> (P/2 - y, P/2 - x)`` (the face-centred cubic lattice)."""
 
     def same(mapped) -> bool:
         mapped = np.mod(mapped, cell.period)
@@ -212,15 +214,19 @@ def mirror_symmetry(cell: PeriodicCell) -> tuple[bool, bool]:
         return bool(np.all(close.any(axis=1)))
 
     mirror = all(same(cell.centres * np.where(np.arange(3) == ax, -1.0, 1.0)) for ax in range(3))
-    diagonal = bool(abs(cell.period[0] - cell.period[1]) < _TOL * cell.period[0]) and same(cell.centres[:, [1, 0, 2]])
-    return mirror, diagonal
+    square = bool(abs(cell.period[0] - cell.period[1]) < _TOL * cell.period[0])
+    diagonal = square and same(cell.centres[:, [1, 0, 2]])
+    half = 0.5 * cell.period[0]
+    anti = diagonal and same(np.column_stack([half - cell.centres[:, 1], half - cell.centres[:, 0], cell.centres[:, 2]]))
+    return mirror, diagonal, anti
 
 
 @dataclass
 class CellMesh:
     """The meshed computational cell: ``mesh`` straight P1 tetrahedra (inscribed), ``curved`` the isoparametric
     quadratic mesh, ``hot``/``cold`` boundary facet indices (``z = 0`` and ``z = height``), the cross-section
-    ``area``, ``wedge`` (the half ``y <= x`` of the box), the exact and the CAD volume of the solid in the cell."""
+    ``area``, ``wedge`` (the fraction of the box meshed: 1, the half ``y <= x``, or the quarter with also
+    ``x + y <= P/2``), the exact and the CAD volume of the solid in the cell."""
 
     mesh: object
     curved: object
@@ -228,7 +234,7 @@ class CellMesh:
     cold: np.ndarray
     height: float
     area: float
-    wedge: bool
+    wedge: float
     volume_exact: float
     volume_cad: float
     neck_a: np.ndarray = field(repr=False)
@@ -266,7 +272,7 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curva
     from fem_neck.cluster import add_neck_cylinders, curved_mesh, mesh_tetrahedra, neck_size_fields, tetrahedra
     from fem_neck.shapes import gmsh_session
 
-    mirror, diagonal = mirror_symmetry(cell)
+    mirror, diagonal, anti = mirror_symmetry(cell)
     if not mirror:
         raise ValueError(f"{cell.name}: the packing is not mirror-symmetric about x = 0, y = 0 and z = 0 (modulo the "
                          "period); this FE solves the mirror cell [0, P/2]^3 and needs those mirror planes")
@@ -281,8 +287,9 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curva
         solids = [(3, occ.addSphere(*local.centres[k], local.radii[k])) for k in range(local.n)]
         solids += add_neck_cylinders(occ, local, geo)
         union, _ = occ.fuse(solids[:1], solids[1:]) if len(solids) > 1 else (solids, None)
-        if diagonal:  # the prism 0 <= y <= x <= P_x/2, 0 <= z <= P_z/2
-            corners = [occ.addPoint(0, 0, 0), occ.addPoint(box[0], 0, 0), occ.addPoint(box[0], box[1], 0)]
+        if diagonal:  # the prism 0 <= y <= x <= P_x/2 (and x + y <= P_x/2), 0 <= z <= P_z/2
+            apex = (0.5 * box[0], 0.5 * box[1]) if anti else (box[0], box[1])
+            corners = [occ.addPoint(0, 0, 0), occ.addPoint(box[0], 0, 0), occ.addPoint(*apex, 0)]
             lines = [occ.addLine(corners[k], corners[(k + 1) % 3]) for k in range(3)]
             face = occ.addPlaneSurface([occ.addCurveLoop(lines)])
             domain = [d for d in occ.extrude([(2, face)], 0, 0, box[2]) if d[0] == 3]
@@ -290,8 +297,7 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curva
             domain = [(3, occ.addBox(0, 0, 0, *box))]
         volume, _ = occ.intersect(union, domain)
         occ.synchronize()
-        # the solid may reach the cell in several pieces, joined outside it; a piece touching neither isothermal
-        # face carries no heat (its temperature is constant; the solvers leave it at the initial guess)
+        # the solid may reach the cell in several pieces, joined outside it (see _conducting)
         volume_cad = sum(occ.getMass(3, tag) for _, tag in volume)
         surfaces = [tag for _, tag in gmsh.model.getBoundary(volume, combined=False, oriented=False)]
         neck_size_fields(gmsh, local, geo, surfaces, size_neck, size_far, neck_cells, tol, every_bond=False,
@@ -309,11 +315,12 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curva
     fz = mesh.p[2, mesh.facets[:, bf]]
     hot = bf[np.all(np.abs(fz) < tol, axis=0)]
     cold = bf[np.all(np.abs(fz - box[2]) < tol, axis=0)]
-    area = box[0] * box[1] * (0.5 if diagonal else 1.0)
+    fraction = 0.25 if anti else 0.5 if diagonal else 1.0
+    area = box[0] * box[1] * fraction
     volume_exact = cell.phi * area * box[2]
     mesh = MeshTet(mesh.p * unit, mesh.t)
     curved = type(curved)(curved.doflocs * unit, curved.t)
-    return CellMesh(mesh, curved, hot, cold, float(box[2] * unit), float(area * unit**2), diagonal,
+    return CellMesh(mesh, curved, hot, cold, float(box[2] * unit), float(area * unit**2), fraction,
                     float(volume_exact * unit**3), float(volume_cad * unit**3), np.asarray(geo.a) * unit)
 
 

@@ -39,7 +39,7 @@ NECKS = {"sc": (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.68),
 QUICK_NECKS = {"sc": (0.4,), "bcc": (0.4,), "fcc": (0.4,)}
 RANDOM = ((1, 0.05), (2, 0.07), (3, 0.1))  # (seed, mean overlap h / r_min) of the mirror packings
 RTOL, QUICK_RTOL = 3e-3, 3e-2  # gap of the FE bounds
-RANDOM_RTOL = 1e-2
+RANDOM_RTOL, RANDOM_START = 2.5e-2, -1.0  # the random cells hold ~40 necks: coarser meshes (the gap is reported)
 
 
 def _code_version() -> str:
@@ -128,7 +128,8 @@ def random_rows(cases, rtol: float, cache: FECache, names: tuple) -> list:
     rows = []
     for seed, overlap in cases:
         cell = mirror_packing(10, overlap=overlap, seed=seed)
-        fe = cache.get(f"mirror packing seed={seed} overlap={overlap:g} rtol={rtol:g}", lambda: fe_cell(cell, rtol))
+        fe = cache.get(f"mirror packing seed={seed} overlap={overlap:g} rtol={rtol:g} start={RANDOM_START:g}",
+                       lambda: fe_cell(cell, rtol, RANDOM_START))
         i, j, s = cell.bonds()
         d = np.linalg.norm(cell.centres[j] + s * cell.period - cell.centres[i], axis=1)
         r_min = np.minimum(cell.radii[i], cell.radii[j])
