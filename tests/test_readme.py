@@ -27,7 +27,7 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 RTOL, ATOL = 1e-6, 1e-12
-SLOW = ("fem_neck converge", "verification")  # commands of more than a few seconds: marked slow
+SLOW = ("fem_neck converge", "fem_neck lattice", "verification")  # commands of more than a few seconds: marked slow
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 TIMING = re.compile(r"(?<![\w.])\d+(?:\.\d+)?\s?s\b")  # "1.8 s": a wall time in a table
 PROGRESS = re.compile(r"\d+%\||it/s\]|s/it\]")  # a tqdm bar on stderr (a terminal overwrites it in place)

@@ -54,7 +54,7 @@ def run(args) -> dict:
     cell = lattice.lattice_cell(args.kind, h)
     with tqdm(desc=f"lattice {args.kind}", unit="mesh", leave=False, delay=2.0) as bar:
         res = lattice.effective_conductivity(cell, rtol=args.rtol,
-                                             progress=lambda text: (bar.set_postfix_str(text), bar.update(1)))
+                                             progress=lambda text: (bar.set_postfix_str(text, refresh=False), bar.update(1)))
     network = lattice.network_conductivity(cell, lambda r_i, r_j, a: pair_conductance(1.0, r_i, r_j, a))
     out = {"kind": args.kind, "h_over_r": h, "a_over_r": neck_radius(1.0, 1.0, h),
            "coordination": lattice.COORDINATION[args.kind], "k_eff_over_kappa": res.k_eff_over_kappa,
