@@ -125,3 +125,35 @@ def test_small_necks_and_asymmetric_cells_are_refused():
         lattice.build_cell_mesh(cell, **COARSE)
     with pytest.raises(ValueError, match="nothing conducts"):
         lattice.check_cell(lattice.PeriodicCell([[0.0, 0.0, 0.0]], [0.5], [2.0, 2.0, 2.0]))
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--kind", "fcc", "--h-over-r", "0.2"], "necks of one particle touch"),
+    (["--kind", "bcc", "--a-over-r", "0.6"], "a_over_r = 0.6"),
+    (["--kind", "sc", "--a-over-r", "0.01"], "a_over_r = 0.01"),
+    (["--kind", "sc", "--h-over-r", "nan"], "h_over_r = nan"),
+    (["--kind", "sc", "--h-over-r", "0.08", "--rtol", "0"], "rtol = 0"),
+    (["--kind", "hcp", "--h-over-r", "0.08"], "invalid choice"),
+])
+def test_lattice_cli_refuses_bad_input_in_one_line(capsys, argv, match):
+    from fem_neck.cli import main
+
+    try:
+        rc = main(["lattice", *argv])
+    except SystemExit as exc:  # argparse's own refusals
+        rc = exc.code
+    err = capsys.readouterr().err
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and match in err
+
+
+def test_lattice_cli_json_and_files(capsys, tmp_path):
+    import json
+
+    from fem_neck.cli import main
+
+    rc = main(["lattice", "--kind", "sc", "--h-over-r", "0.2", "--rtol", "0.05", "--json", "--out", str(tmp_path)])
+    out = json.loads(capsys.readouterr().out)
+    assert rc == 0 and out["converged"] and out["error_estimate"] <= 0.05
+    assert out["k_lower_over_kappa"] <= out["k_eff_over_kappa"] < out["phi"]
+    assert out["coordination"] == 6 and abs(out["network_rel_error"]) < 0.01  # SC: the network holds
+    assert {p.name for p in tmp_path.iterdir()} == {"lattice.json", "cell.vtu"}
