@@ -88,15 +88,13 @@ class RunWriter:
                        "heat_flow": [np.concatenate([q_pairs, q_walls])],
                        "neck_radius": [np.concatenate([b.a, b.wall_a])]}))
         self.snapshots.append((t, step))
-        count = len(self.snapshots)
-        if count & (count - 1) == 0:  # rewrite the collection at 1, 2, 4, ... snapshots (and at the end): O(n) total
-            self._write_pvd()
+        self._write_pvd()  # every snapshot listed at once: an interrupted run's collection holds all it wrote
 
     def _write_pvd(self):
         for kind in ("particles", "bonds"):
             write_pvd(self.out / f"{kind}.pvd", [(tt, f"{kind}_{s:05d}.vtu") for tt, s in self.snapshots])
 
-    def finish(self, summary: dict):
+    def finish(self, summary: dict, plots: bool = True):
         if self.last is not None:
             step, t, T, flows = self.last
             if step % self.scene.output.every:
@@ -106,7 +104,12 @@ class RunWriter:
         if self.snapshots:
             self._write_pvd()
         self.csv.close()
-        write_summary(self.out / "summary.json", summary)
+        write_summary(self.out / "summary.json", summary)  # first: the profile plot reads k_eff from it
+        if plots:
+            from dem.plots import thermal_plots
+
+            write_summary(self.out / "summary.json",
+                          {**summary, "plots": thermal_plots(self.out, self.scene, self.model.T)})
 
 
 def write_summary(path, summary: dict) -> None:

@@ -31,7 +31,10 @@ class RunResult:
 
 
 def _progress_bar(scene: Scene, enabled: bool):
-    """A tqdm bar on stderr that appears only after 2 s: simulated time (transient) or the build/solve stages."""
+    """A tqdm bar on stderr that appears only after 2 s: simulated time (transient) or the build/solve stages.
+
+    The time left is estimated only where steps are of one size (fixed ``dt``, and moving particles): adaptive steps
+    start small and grow by orders of magnitude, so a linear extrapolation of their early pace means nothing."""
     if not enabled:
         return None, None
     from tqdm import tqdm
@@ -39,9 +42,11 @@ def _progress_bar(scene: Scene, enabled: bool):
     if scene.solver.mode != "transient":
         bar = tqdm(total=2, desc=f"dem {scene.name}: bonds, solve", file=sys.stderr, delay=2.0)
         return bar, (lambda stage: bar.update(1))
+    uniform = scene.motion is not None or scene.solver.dt != "auto"
+    tail = " [{elapsed}<{remaining}]" if uniform else " [{elapsed}]"
     bar = tqdm(total=scene.solver.t_end, unit="s", desc=f"dem {scene.name}", file=sys.stderr, delay=2.0,
-               bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s simulated [{elapsed}<{remaining}]")
-    return bar, (lambda t: bar.update(t - bar.n))
+               bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s simulated" + tail)
+    return bar, (lambda t: bar.update(min(t, bar.total) - bar.n))
 
 
 def effective_conductivity(scene: Scene, boundary: dict) -> float | None:
@@ -102,14 +107,9 @@ def run_moving(scene: Scene, out=None, progress: bool = False) -> RunResult:
     start = time.perf_counter()
     sim = Simulation(scene)
     writer = MotionWriter(out, scene) if out is not None else None
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=scene.solver.t_end, unit="s", desc=f"dem {scene.name}", file=sys.stderr, delay=2.0,
-                   bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s simulated [{elapsed}<{remaining}]")
+    bar, report = _progress_bar(scene, progress)
     try:
-        details = sim.run(writer, (lambda t: bar.update(min(t, bar.total) - bar.n)) if bar is not None else None)
+        details = sim.run(writer, report)
     except ValueError as exc:  # the run stopped (a particle through a wall, a neck beyond its model): keep what exists
         if writer is not None:
             writer.finish({"scene": scene.name, "stopped": " ".join(str(exc).split()), **sim.summary()})
