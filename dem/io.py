@@ -108,8 +108,8 @@ class RunWriter:
         if plots:
             from dem.plots import thermal_plots
 
-            write_summary(self.out / "summary.json",
-                          {**summary, "plots": thermal_plots(self.out, self.scene, self.model.T)})
+            summary["plots"] = thermal_plots(self.out, self.scene, self.model.T)
+            write_summary(self.out / "summary.json", summary)
 
 
 def write_summary(path, summary: dict) -> None:
@@ -179,5 +179,5 @@ class MotionWriter:
         if plots:
             from dem.plots import motion_plots
 
-            summary = {**summary, "plots": motion_plots(self.out)}
+            summary["plots"] = motion_plots(self.out)
         write_summary(self.out / "summary.json", summary)
