@@ -242,7 +242,7 @@ def time_ours(make, steps: int, warmup: int) -> dict:
             "kinetic_energy": mech.state.kinetic_energy(), "dt": mech.dt}
 
 
-@njit(cache=True)
+@njit  # not cached: numba's cache follows only this file, so a cached copy would keep an old engine's code
 def _force_passes(count, x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn,
                   p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt):
     """``count`` force passes of the engine's loop (:func:`dem.md_loop._forces`) in one compiled call."""
@@ -251,7 +251,7 @@ def _force_passes(count, x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, p
                         wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt)
 
 
-@njit(cache=True)
+@njit  # not cached (as above)
 def _material_passes(count, t, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt):
     """``count`` material-state updates of the engine's loop (:func:`dem.md_loop._material_state`)."""
     for k in range(count):
@@ -641,7 +641,7 @@ def random_contacts(n: int, seed: int = 0) -> dict:
             "delta_fluid": np.full(n, 2e-4), "xi": rng.normal(0.0, 1e-6, (n, 3)), "normal": normal, "vt": vt}
 
 
-@njit(cache=True, error_model="numpy")
+@njit(error_model="numpy")  # not cached (as _force_passes): it times the kernels as they are now
 def contact_loop(delta, delta_dot, s, delta_max, s_last, delta_fluid, xi, normal, vt, dt, params, force, xi_out,
                  delta_max_out):
     """Normal + tangential force of every contact (force on i, new spring, new delta_max) into the out arrays."""

@@ -25,8 +25,13 @@ from numba import njit
 
 @njit(cache=True)
 def min_image(d, length):
-    """``d`` wrapped into ``[-length/2, length/2]`` on a periodic axis (``length > 0``); unchanged otherwise."""
+    """``d`` wrapped into ``[-length/2, length/2]`` on a periodic axis (``length > 0``); unchanged otherwise.
+
+    A listed pair's separation is far below a quarter of the box: there ``floor(d/length + 0.5) = 0`` and the
+    result is ``d`` to the bit, so the division and the floor are skipped."""
     if length > 0.0:
+        if abs(d) < 0.25 * length:
+            return d
         return d - length * math.floor(d / length + 0.5)
     return d
 

@@ -247,3 +247,19 @@ interval = 1e-6
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert "left the box" in summary["stopped"] and summary["steps"] > 0
     assert len((tmp_path / "out" / "timeseries.csv").read_text().splitlines()) > 2
+
+
+def test_min_image_is_the_wrapping_formula_to_the_bit():
+    """The shortcut for separations below a quarter of the box (no division, no floor) changes no bit."""
+    from dem.neighbours import min_image
+
+    rng = np.random.default_rng(7)
+    length = 3.7e-3
+    quarter = 0.25 * length
+    d = np.concatenate([rng.uniform(-3 * length, 3 * length, 2000), rng.uniform(-1e-9, 1e-9, 200),
+                        np.nextafter(quarter, 0.0) * np.array([1.0, -1.0]), [quarter, -quarter, 0.5 * length,
+                                                                              -0.5 * length, 0.0, -0.0]])
+    expected = d - length * np.floor(d / length + 0.5)
+    got = np.array([min_image(float(x), length) for x in d])
+    assert np.array_equal(got.view(np.int64), expected.view(np.int64))
+    assert min_image(5.0, 0.0) == 5.0  # not periodic: unchanged
