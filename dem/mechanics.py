@@ -67,14 +67,15 @@ class MechanicalModel:
     # ------------------------------------------------------------------------------------------------ list
     def _build_list(self, first: bool = False):
         s = self.state
-        i, j = verlet_pairs(s.x, s.radius, self.skin, self.box)
+        expected = 0 if first else len(self.pi) + len(self.pi) // 8 + 16  # the last list, with room to grow
+        i, j = verlet_pairs(s.x, s.radius, self.skin, self.box, expected)
         if first:
             m = len(i)
             self.p_dmax, self.p_k1last, self.p_fn = np.zeros(m), np.zeros(m), np.zeros(m)
             self.p_xi, self.p_ft = np.zeros((m, 3)), np.zeros((m, 3))
         else:
             self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft = carry_history(
-                self.pi, self.pj, i, j, s.n, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft)
+                self.pi, self.pj, i, j, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft)
             self.rebuilds += 1
         self.pi, self.pj = i, j
         self.x_ref = s.x.copy()
