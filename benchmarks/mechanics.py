@@ -580,8 +580,8 @@ def study_stages(section, spheres: dict, sizes: Sizes, lammps: dict | None) -> N
         f"(positions and box x 3: {stages['spread_listed']:.0f} listed pairs) for all but the pairs; the force "
         f"pass and the material state alone as cross-checks. `without pairs`: kicks, drift, material state, "
         f"checks; `pairs`: the rest, less the rebuilds. {stages['contacts_per_particle']:.2f} contacts and "
-        f"{stages['listed_per_particle']:.2f} listed pairs per particle; {stages['rebuilds']} rebuilds of the "
-        f"Verlet list, {stages['rebuild_ms']:.1f} ms each.\n\n"
+        f"{stages['listed_per_particle']:.2f} listed pairs per particle; Verlet-list rebuilds in the run: "
+        f"{stages['rebuilds']}, {stages['rebuild_ms']:.1f} ms each.\n\n"
         + md_table(["stage", "ns/particle-step", "share"], [[k, v, v / whole] for k, v in stages["ns"].items()],
                    fmt="{:.3g}") + peer)
 
