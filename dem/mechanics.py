@@ -74,7 +74,7 @@ class MechanicalModel:
         histories are carried by key; walls by name)."""
         self.k1f = np.array(saved["k1f"], dtype=float)
         self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft = carry_history(
-            saved["pi"], saved["pj"], self.pi, self.pj, self.state.n, saved["p_dmax"], saved["p_k1last"],
+            saved["pi"], saved["pj"], self.pi, self.pj, saved["p_dmax"], saved["p_k1last"],
             saved["p_xi"], np.zeros(len(saved["pi"])), np.zeros((len(saved["pi"]), 3)))
         names = [w.name for w in self.walls]
         for m_old, name in enumerate(saved["wall_names"]):
@@ -90,14 +90,15 @@ class MechanicalModel:
     # ------------------------------------------------------------------------------------------------ list
     def _build_list(self, first: bool = False):
         s = self.state
-        i, j = verlet_pairs(s.x, s.radius, self.skin, self.box)
+        expected = 0 if first else len(self.pi) + len(self.pi) // 8 + 16  # the last list, with room to grow
+        i, j = verlet_pairs(s.x, s.radius, self.skin, self.box, expected)
         if first:
             m = len(i)
             self.p_dmax, self.p_k1last, self.p_fn = np.zeros(m), np.zeros(m), np.zeros(m)
             self.p_xi, self.p_ft = np.zeros((m, 3)), np.zeros((m, 3))
         else:
             self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft = carry_history(
-                self.pi, self.pj, i, j, s.n, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft)
+                self.pi, self.pj, i, j, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft)
             self.rebuilds += 1
         self.pi, self.pj = i, j
         self.x_ref = s.x.copy()
