@@ -2,7 +2,8 @@
 
 Subjects (all when none is named): ``neck`` (the neck radius against a plain numpy Newton), ``fe`` (FE conductance:
 error against time, NGSolve side by side, the fit, the main command's start-up), ``dem`` (the DEM's thermal solvers
-to 10^6 particles, OpenPNM side by side). Writes ``report.md``, ``summary.json`` and ``run.json`` plus CSV and PNG
+to 10^6 particles, OpenPNM side by side), ``mechanics`` (the moving-particle loop in ns per particle-step, 2D and 3D,
+LAMMPS side by side; numba's compile cost; the thermal-only path). Writes ``report.md``, ``summary.json`` and ``run.json`` plus CSV and PNG
 per subject into ``--out DIR``, rewritten as the subjects go. ``--quick``: reduced sizes (targets that need the full
 size are then not measured). ``--json``: ``summary.json`` as one object on stdout, nothing else.
 
@@ -48,7 +49,7 @@ def main(argv=None) -> int:
     if args.no_progress:
         os.environ["TQDM_DISABLE"] = "1"
     peers = ", ".join(f"{name} {package_version(name) if available(name) else 'absent (its rows skipped)'}"
-                      for name in ("ngsolve", "openpnm"))
+                      for name in ("ngsolve", "openpnm", "lammps"))
     report = Report(out, " ".join(subjects), args.quick, program=PROG, title=TITLE,
                     preamble=f"Peers: {peers}. Load average at start {os.getloadavg()[0]:.1f}: other processes "
                              "inflate wall times, so comparisons are timed side by side and given as ratios.")

@@ -739,15 +739,10 @@ def engine_modules_loaded(scenes) -> tuple[list[str], float]:
 def direct_thermal(scene):
     """The thermal-only run as the lower-level calls :func:`dem.simulation.run` makes: bonds, conductances,
     network, then the steady solve (and the boundary heat flows it reports) or the time integration."""
-    from dem.bonds import find_bonds
-    from dem.laws.conductance import bond_conductances
-    from dem.thermal import Network, boundary_heat_flow, integrate, steady
+    from dem.thermal import boundary_heat_flow, build_network, integrate, steady
 
-    p, spec, s = scene.particles, scene.conductance, scene.solver
-    bonds = find_bonds(p, scene.walls, spec.contact, spec.out_of_range)
-    K_pairs, K_walls = bond_conductances(spec, p, bonds)
-    net = Network(p, bonds, K_pairs, K_walls, np.array([w.temperature for w in scene.walls], dtype=float),
-                  scene.sources)
+    s = scene.solver
+    net = build_network(scene.particles, scene.walls, scene.conductance, scene.sources)
     if s.mode != "steady":
         return integrate(net, s.integrator, s.dt, s.t_end, s.rtol, s.linear, s.max_steps).T
     T = steady(net, s.floating, s.linear).T
