@@ -568,11 +568,13 @@ def cluster_conductance(cluster: Cluster, terminals, kappa: float = 1.0, size_ne
     import time
 
     from fem_neck import accuracy
+    from fem_neck.interrupt import where
 
     factors = accuracy.mesh_levels(levels)
     curvature = 4.0 / size_far if curvature is None else curvature
     runs = []
-    for f in factors:
+    for k, f in enumerate(factors):
+        where().update(step=f"mesh level {k + 1} of {levels}")
         t0 = time.perf_counter()
         cmesh = build_cluster_mesh(cluster, terminals, size_neck=size_neck * f, size_far=size_far * f,
                                    curvature=max(4, int(round(curvature / f))), method=method,

@@ -33,6 +33,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from fem_neck.interrupt import ignore_interrupts, shielded, stop_pool, where
 from fem_neck.law import A_LOG, ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, neck_resistance
 
 SOLVER = "fem_neck.conduction:semisphere_conductance"
@@ -143,25 +144,40 @@ def in_processes(jobs, workers: int | None = None, *, desc: str = "", progress: 
 
     Processes, not threads: gmsh is one global, thread-unsafe state per process. ``workers`` defaults to all cores;
     one worker (or one job) runs in this process. A tqdm bar on stderr counts ``done`` jobs finished earlier plus
-    these.
+    these, and so does the run's :func:`fem_neck.interrupt.where` (its step). Workers ignore Ctrl-C; on an
+    interrupt (or any error, or when the caller stops iterating) the pool is stopped at once.
     """
     from tqdm import tqdm
 
+    here = where()
+    label = f"{desc}: " if desc else ""
+    total = done + len(jobs)
+    here.update(step=f"{label}{done} of {total} solves done")
     workers = workers or os.cpu_count() or 1
-    with tqdm(total=done + len(jobs), initial=done, desc=desc, unit="solve", file=sys.stderr,
-              disable=not progress) as bar:
+    with tqdm(total=total, initial=done, desc=desc, unit="solve", file=sys.stderr, disable=not progress) as bar:
         if not jobs:
             return
-        if workers == 1 or len(jobs) == 1:  # no pool to start: fast solves (the hp path) finish before it would
-            for func, args in jobs:
-                result = func(*args)
+        pool = None
+        try:
+            if workers == 1 or len(jobs) == 1:  # no pool to start: fast solves (the hp path) finish before it would
+                results = (func(*args) for func, args in jobs)
+            else:
+                pool = ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=_pool_context(),
+                                           initializer=ignore_interrupts)
+                with shielded():  # the workers are forked here: none can catch the Ctrl-C meant for this process
+                    futures = [pool.submit(func, *args) for func, args in jobs]
+                results = (fut.result() for fut in as_completed(futures))
+            for result in results:
                 bar.update()
                 yield result
-            return
-        with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=_pool_context()) as pool:
-            for fut in as_completed([pool.submit(func, *args) for func, args in jobs]):
-                bar.update()
-                yield fut.result()
+                done += 1  # counted once the caller has taken it (e.g. written it to a file)
+                here.update(step=f"{label}{done} of {total} solves done")
+        except BaseException:
+            if pool is not None:
+                stop_pool(pool)
+            raise
+        if pool is not None:
+            pool.shutdown()
 
 
 def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int | None = None,
@@ -180,11 +196,14 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
     done = reuse or {}
     points = {_key(xi): done[_key(xi)] for xi in x if _key(xi) in done}
     todo = [(float(xi), bool(ui)) for xi, ui in zip(x, uniform) if _key(xi) not in points]
+    here = where()
     if csv_path is not None:  # rewrite the CSV with the reused points only, then append as results arrive
         csv_path.parent.mkdir(parents=True, exist_ok=True)
         csv_path.unlink(missing_ok=True)
         for p in points.values():
             _append(csv_path, p)
+        if points:
+            here.update(out=csv_path.parent)
     if todo:
         importlib.import_module(solver.split(":")[0])  # fail early in the parent, and let fork start warm
     jobs = [(_solve_point, (solver, method, xi, rtol)) for xi, _ in todo]
@@ -194,6 +213,7 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
         points[_key(p.a_over_r)] = p
         if csv_path is not None:
             _append(csv_path, p)
+            here.update(out=csv_path.parent)
     return sorted(points.values(), key=lambda p: p.a_over_r)
 
 

@@ -29,6 +29,7 @@ SERIES = (  # (label, order, graded, curved)
 HP_SERIES = "hp, geometric mesh, exact sphere"
 HP_ORDERS = tuple(range(2, 10))
 HP_LEVELS = 4
+LEVEL_COUNT = sum(len(GRADINGS if graded else UNIFORM_SIZES) for _, _, graded, _ in SERIES) + len(HP_ORDERS)
 
 
 def register(subparsers) -> None:
@@ -59,11 +60,14 @@ def observed_order(dofs, values, reference: float) -> float:
 
 def _levels(a: float, progress):
     from fem_neck import conduction, shapes
+    from fem_neck.interrupt import where
 
     levels = []
+    here = where()
     for label, order, graded, curved in SERIES:
         steps = GRADINGS if graded else UNIFORM_SIZES
         for step in steps:
+            here.update(step=f"level {len(levels) + 1} of {LEVEL_COUNT} ({label})")
             sizes = shapes.SizeField(grading=step) if graded else shapes.SizeField(uniform=step)
             profile = shapes.semisphere_mesh(a, sizes=sizes)
             sol = conduction.solve_profile(profile, order=order, curved=curved)
@@ -79,6 +83,7 @@ def _levels(a: float, progress):
     mesh, shape = hpmesh.semisphere_quad_mesh(a, HP_LEVELS)
     fixed = hpmesh.end_disks(mesh, shape)
     for order in HP_ORDERS:
+        here.update(step=f"level {len(levels) + 1} of {LEVEL_COUNT} (hp order {order})")
         sol = spectral.conductance(mesh, order, fixed)
         levels.append({
             "series": HP_SERIES, "order": order, "grading": "geometric", "curved": True,
@@ -138,9 +143,7 @@ def run(args) -> dict:
     h, a = semisphere_case(args)
     try:
         reference = conduction.semisphere_conductance(a, rtol=1e-9)
-        total = sum(len(GRADINGS if s[2] else UNIFORM_SIZES) for s in SERIES) + len(HP_ORDERS)
-        with tqdm(total=total, desc="converge",
-                  file=__import__("sys").stderr, disable=None) as progress:
+        with tqdm(total=LEVEL_COUNT, desc="converge", file=__import__("sys").stderr, disable=None) as progress:
             levels = _levels(a, progress)
     except RuntimeError as exc:
         raise ValueError(str(exc)) from exc
