@@ -12,7 +12,8 @@ Commands (each writes ``report.md``, ``summary.json`` and ``run.json`` plus PNG 
 ``--quick`` runs reduced versions (``all --quick`` in under 3 minutes on 2 cores). ``--json`` prints the content of
 ``summary.json`` (comparison name -> relative error) as one object and nothing else on stdout. Progress goes to
 stderr. Exit code: 0 when every section ran, 1 when a section failed (its one-line error on stderr, its traceback
-in ``DIR/<section>/error.txt``), 2 for bad options or a command whose module is not available.
+in ``DIR/<section>/error.txt``), 2 for bad options or a command whose module is not available, 130 after Ctrl-C
+(one line on stderr naming the section; the report keeps the finished sections, :mod:`fem_neck.interrupt`).
 """
 
 from __future__ import annotations
@@ -61,10 +62,18 @@ def build_parser(command: str | None = None) -> tuple[argparse.ArgumentParser, l
 
 
 def main(argv=None) -> int:
+    from fem_neck.interrupt import Where, run_command
+
+    here = Where(PROG)
+    return run_command(here, _main, argv, here)
+
+
+def _main(argv, here) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     command = next((a for a in argv if a in COMMANDS), None)
     parser, extra = build_parser(command)
     args = parser.parse_args(argv)
+    here.command = f"{PROG} {args.command}"
     sections = COMMANDS[args.command][0]
     if args.command in PLUGINS and not section_available(args.command):
         sys.stderr.write(f"{PROG} {args.command}: not available: verification.{args.command} is not installed yet\n")
@@ -96,4 +105,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from fem_neck.interrupt import exit_process
+
+    exit_process(main())

@@ -10,7 +10,8 @@ sub-folder ``out_dir/<section>/``, and :class:`Report` rewrites after every sect
 * ``run.json`` -- the command, the options and each section's status, run time and error,
 
 so that an interrupted run keeps what finished. A section whose module is absent is reported as not available; a
-section that raises is reported as failed with its one-line message, and the run goes on.
+section that raises is reported as failed with its one-line message, and the run goes on. Ctrl-C marks the running
+section as interrupted in the three files and ends the run (:mod:`fem_neck.interrupt`).
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 CONTRACT_KEYS = ("title", "markdown", "summary", "figures")
-OK, FAILED, NOT_AVAILABLE = "ok", "failed", "not available"
+OK, FAILED, NOT_AVAILABLE, INTERRUPTED = "ok", "failed", "not available", "interrupted"
 
 
 @dataclass
@@ -193,6 +194,10 @@ def run_section(name: str, out_dir: pathlib.Path, quick: bool, options: dict | N
         result = check_section_result(name, module.run(section_dir, quick=quick, **(options or {})))
         summary = jsonable(result["summary"])
     except Exception as exc:  # a failing section is reported (traceback in <section>/error.txt), the run goes on
+        from fem_neck.interrupt import where
+
+        if where().signalled:  # not a failure: an interrupt that C code turned into this error
+            raise KeyboardInterrupt from exc
         message = f"{type(exc).__name__}: {exc}".splitlines()[0]
         error_file = pathlib.Path(out_dir) / name / "error.txt"
         error_file.parent.mkdir(parents=True, exist_ok=True)
@@ -207,14 +212,26 @@ def run_sections(names, out_dir: pathlib.Path, command: str, quick: bool = False
     """Run ``names`` in order into ``out_dir``; the report files are rewritten after each section."""
     from tqdm import tqdm
 
+    from fem_neck.interrupt import where
+
     report = Report(out_dir, command, quick)
+    here = where()
     bar = tqdm(names, desc="verification", unit="section", file=sys.stderr, disable=not progress)
-    for name in bar:
+    for k, name in enumerate(bar):
         bar.set_postfix_str(name)
-        record = run_section(name, report.out_dir, quick, options)
+        here.update(stage=f"section {name}", step=f"{k} of {len(names)} sections done")
+        t0 = time.perf_counter()
+        try:
+            record = run_section(name, report.out_dir, quick, options)
+        except KeyboardInterrupt:  # the finished sections stay in the files, this one is marked
+            report.add(SectionRecord(name, INTERRUPTED, name, seconds=time.perf_counter() - t0,
+                                     error="interrupted (Ctrl-C)"))
+            here.update(out=report.out_dir)
+            raise
         if record.status != OK:
             bar.write(f"python -m verification {command}: {name}: {record.status}: {record.error}", file=sys.stderr)
         report.add(record)
+        here.update(out=report.out_dir)
     return report
 
 
