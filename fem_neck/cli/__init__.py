@@ -127,6 +127,9 @@ def main(argv=None, *, prog="python -m fem_neck", description=None, modules=COMM
 
 
 def _main(argv, here, prog, description, modules, package) -> int:
+    named = next((a for a in (sys.argv[1:] if argv is None else argv) if a in modules), None)
+    if named is not None:  # the command's name, for an interrupt that comes before parsing ends
+        here.command = f"{prog} {named}"
     parser = build_parser(prog, description or __doc__.splitlines()[0], modules, package)
     args = parser.parse_args(argv)
     here.command = f"{prog} {args.command}"
