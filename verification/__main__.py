@@ -71,6 +71,8 @@ def main(argv=None) -> int:
 def _main(argv, here) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     command = next((a for a in argv if a in COMMANDS), None)
+    if command is not None:  # named early, for an interrupt that comes before parsing ends
+        here.command = f"{PROG} {command}"
     parser, extra = build_parser(command)
     args = parser.parse_args(argv)
     here.command = f"{PROG} {args.command}"
