@@ -8,8 +8,8 @@ per subject into ``--out DIR``, rewritten as the subjects go. ``--quick``: reduc
 size are then not measured). ``--json``: ``summary.json`` as one object on stdout, nothing else.
 
 Exit code: 0 when every target that was measured passed, 1 when a target was missed or a subject failed (one line
-on stderr each), 2 for bad options. The peers are optional (``pip install '.[peers]'``); their rows are skipped
-with a note when absent.
+on stderr each), 2 for bad options, 130 after Ctrl-C (one line naming the subject; the report keeps what
+finished). The peers are optional (``pip install '.[peers]'``); their rows are skipped with a note when absent.
 """
 
 from __future__ import annotations
@@ -37,6 +37,13 @@ def build_parser() -> OneLineParser:
 
 
 def main(argv=None) -> int:
+    from fem_neck.interrupt import Where, run_command
+
+    here = Where(PROG)
+    return run_command(here, _main, argv, here)
+
+
+def _main(argv, here) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     unknown = [name for name in args.subjects if name not in SUBJECTS]
@@ -53,7 +60,8 @@ def main(argv=None) -> int:
     report = Report(out, " ".join(subjects), args.quick, program=PROG, title=TITLE,
                     preamble=f"Peers: {peers}. Load average at start {os.getloadavg()[0]:.1f}: other processes "
                              "inflate wall times, so comparisons are timed side by side and given as ratios.")
-    for name in subjects:
+    for k, name in enumerate(subjects):
+        here.update(stage=f"subject {name}", step=f"{k} of {len(subjects)} subjects done", out=out)
         module = importlib.import_module(SUBJECTS[name])
         section = report.section(name, module.TITLE)
         with section.running():
@@ -65,4 +73,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from fem_neck.interrupt import exit_process
+
+    exit_process(main())
