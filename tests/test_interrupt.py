@@ -100,7 +100,8 @@ def test_verification_interrupted_keeps_the_finished_sections(tmp_path):
     run_json = tmp_path / "v" / "run.json"
     deadline = time.perf_counter() + 90
     while time.perf_counter() < deadline:  # until the paper section has finished, then up to 1 s later
-        if run_json.exists() and "paper" in json.loads(run_json.read_text())["sections"]:
+        sections = json.loads(run_json.read_text())["sections"] if run_json.exists() else {}
+        if sections.get("paper", {}).get("status") == "ok":  # written as "running" when it starts
             break
         time.sleep(0.05)
     time.sleep(random.Random(5).uniform(0.0, 1.0))
