@@ -259,7 +259,7 @@ def _force_passes(count, x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, p
 def _material_passes(count, t, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt):
     """``count`` material-state updates of the engine's loop (:func:`dem.md_loop._material_state`)."""
     for k in range(count):
-        md_loop._material_state(t + k * dt, t, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt)
+        md_loop._material_state(k * dt, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt)
 
 
 def stage_costs(sample: dict, material: LudingMaterial, steps: int) -> dict:

@@ -102,7 +102,11 @@ class MechanicalModel:
             self.rebuilds += 1
         self.pi, self.pj = i, j
         self.x_ref = s.x.copy()
-        self.wk, self.wm = wall_pairs(s.x, s.radius, self.w.normal, self.w.q, self.skin)
+        self.walls_moved()
+
+    def walls_moved(self):
+        """The walls were set elsewhere (a resumed run): their Verlet list follows."""
+        self.wk, self.wm = wall_pairs(self.state.x, self.state.radius, self.w.normal, self.w.q, self.skin)
         self.wq_ref = self.w.q.copy()
 
     def _initial_forces(self):
@@ -128,13 +132,12 @@ class MechanicalModel:
         T0 = np.ascontiguousarray(T0, dtype=float)
         T_rate = np.ascontiguousarray(T_rate, dtype=float)
         uniform = len(T0) == 1
-        t_start = self.t
+        first = self.steps
         done = 0
         while done < n_steps:
-            t_call = self.t
             steps, status = md_loop.advance(
-                n_steps - done, self.dt, t_call, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia, s.linear_dof,
-                s.angular_dof, s.radius, s.radius_ref, T0 + T_rate * (t_call - t_start), T_rate, s.T, self.k1f,
+                n_steps - done, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia,
+                s.linear_dof, s.angular_dof, s.radius, s.radius_ref, T0, T_rate, s.T, self.k1f,
                 uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_dmax, self.p_k1last, self.p_xi,
                 self.p_fn, self.p_ft, w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0,
                 w.amplitude, w.frequency, w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_dmax,
