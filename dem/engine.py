@@ -6,7 +6,8 @@ submodels act in order:
 
 1. ``mechanical`` (:class:`dem.mechanics.MechanicalModel`) -- contact forces, walls, gravity and velocity-Verlet
    steps, in compiled code, with the temperatures of the interval: prescribed by the schedule (linear in time,
-   uniform), computed by the thermal network (constant over the interval), or the initial ones;
+   uniform), computed by the thermal network (its latest temperatures extrapolated with the rate of its last step),
+   or the initial ones;
 2. ``thermal`` (:class:`dem.contact_heat.ContactThermalModel`) -- one implicit step of the pipe network over the
    interval, on the contacts as they are at its end;
 3. observers -- the output writer and the progress bar.
@@ -74,6 +75,7 @@ class Simulation:
         if self.thermal is not None:
             th = self.thermal
             th.T = np.array(saved["thermal_T"], dtype=float)
+            th.rate = np.array(saved["thermal_rate"], dtype=float)
             th.energy0 = float(saved["thermal_energy0"])
             th.heat_in = {str(k): float(v) for k, v in zip(saved["heat_keys"], saved["heat_values"])}
 
@@ -90,10 +92,13 @@ class Simulation:
         if self.schedule is not None:
             return (np.array([self.schedule.at(t)]), np.array([self.schedule.rate(t)]),
                     self.schedule.relaxation(t))
-        T = self.thermal.T if self.thermal is not None else mech.state.T
-        if np.all(T == T[0]):
-            return np.array([T[0]]), np.zeros(1), mech.relaxation_time
-        return T.copy(), np.zeros(len(T)), mech.relaxation_time
+        if self.thermal is not None:  # the network's temperatures, extrapolated with its last rate (cooling is
+            T, rate = self.thermal.T, self.thermal.rate  # then seen as cooling: k1(T, t) freezes, Sec. 3.4)
+        else:
+            T, rate = mech.state.T, np.zeros(len(mech.state.T))
+        if np.all(T == T[0]) and np.all(rate == rate[0]):
+            return np.array([T[0]]), np.array([rate[0]]), mech.relaxation_time
+        return T.copy(), rate.copy(), mech.relaxation_time
 
     def _params_at(self, t: float) -> np.ndarray:
         """The material at time ``t``: the scene's, with the overrides of every ``[[phases]]`` entry started."""

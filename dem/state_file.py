@@ -39,7 +39,7 @@ def arrays(sim) -> dict:
     data.update({k: getattr(mech, k) for k in PAIR_KEYS + WALL_KEYS})
     if sim.thermal is not None:
         th = sim.thermal
-        data.update(thermal_T=th.T, thermal_energy0=np.array(th.energy0),
+        data.update(thermal_T=th.T, thermal_rate=th.rate, thermal_energy0=np.array(th.energy0),
                     heat_keys=np.array(list(th.heat_in), dtype=str),
                     heat_values=np.array(list(th.heat_in.values()), dtype=float))
     return data
