@@ -17,5 +17,6 @@ SUBJECTS = {
     "neck": "benchmarks.neck",  # fem_neck.neck_radius against a plain numpy Newton
     "fe": "benchmarks.fe",  # FE conductance: error against time, NGSolve, the fit, the main command's start-up
     "dem": "benchmarks.dem",  # DEM solvers: transient accuracy, steady scaling, linear solvers, OpenPNM
+    "mechanics": "benchmarks.mechanics",  # the moving-particle loop against LAMMPS, compile cost, thermal-only path
     "laws": "benchmarks.shared_body",  # the shared-body conductance law against today's, same packing, to 10^6
 }

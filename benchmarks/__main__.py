@@ -2,13 +2,14 @@
 
 Subjects (all when none is named): ``neck`` (the neck radius against a plain numpy Newton), ``fe`` (FE conductance:
 error against time, NGSolve side by side, the fit, the main command's start-up), ``dem`` (the DEM's thermal solvers
-to 10^6 particles, OpenPNM side by side). Writes ``report.md``, ``summary.json`` and ``run.json`` plus CSV and PNG
+to 10^6 particles, OpenPNM side by side), ``mechanics`` (the moving-particle loop in ns per particle-step, 2D and 3D,
+LAMMPS side by side; numba's compile cost; the thermal-only path). Writes ``report.md``, ``summary.json`` and ``run.json`` plus CSV and PNG
 per subject into ``--out DIR``, rewritten as the subjects go. ``--quick``: reduced sizes (targets that need the full
 size are then not measured). ``--json``: ``summary.json`` as one object on stdout, nothing else.
 
 Exit code: 0 when every target that was measured passed, 1 when a target was missed or a subject failed (one line
-on stderr each), 2 for bad options. The peers are optional (``pip install '.[peers]'``); their rows are skipped
-with a note when absent.
+on stderr each), 2 for bad options, 130 after Ctrl-C (one line naming the subject; the report keeps what
+finished). The peers are optional (``pip install '.[peers]'``); their rows are skipped with a note when absent.
 """
 
 from __future__ import annotations
@@ -36,6 +37,13 @@ def build_parser() -> OneLineParser:
 
 
 def main(argv=None) -> int:
+    from fem_neck.interrupt import Where, run_command
+
+    here = Where(PROG)
+    return run_command(here, _main, argv, here)
+
+
+def _main(argv, here) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     unknown = [name for name in args.subjects if name not in SUBJECTS]
@@ -48,11 +56,12 @@ def main(argv=None) -> int:
     if args.no_progress:
         os.environ["TQDM_DISABLE"] = "1"
     peers = ", ".join(f"{name} {package_version(name) if available(name) else 'absent (its rows skipped)'}"
-                      for name in ("ngsolve", "openpnm"))
+                      for name in ("ngsolve", "openpnm", "lammps"))
     report = Report(out, " ".join(subjects), args.quick, program=PROG, title=TITLE,
                     preamble=f"Peers: {peers}. Load average at start {os.getloadavg()[0]:.1f}: other processes "
                              "inflate wall times, so comparisons are timed side by side and given as ratios.")
-    for name in subjects:
+    for k, name in enumerate(subjects):
+        here.update(stage=f"subject {name}", step=f"{k} of {len(subjects)} subjects done", out=out)
         module = importlib.import_module(SUBJECTS[name])
         section = report.section(name, module.TITLE)
         with section.running():
@@ -64,4 +73,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from fem_neck.interrupt import exit_process
+
+    exit_process(main())

@@ -9,9 +9,13 @@ Python use::
 ``dem`` needs no gmsh or FE code: it imports only :mod:`fem_neck.geometry` and :mod:`fem_neck.law`.
 """
 
-from dem.particles import COPPER, Material, Particles
-from dem.scene import Scene, SolverSpec, load_scene, make_scene, parse_scene
-from dem.simulation import RunResult, run
+from dem import jit_cache
+
+jit_cache.configure()  # before numba is imported: compiled kernels cached per version of their source
+
+from dem.particles import COPPER, Material, Particles  # noqa: E402
+from dem.scene import Scene, SolverSpec, load_scene, make_scene, parse_scene  # noqa: E402
+from dem.simulation import RunResult, run  # noqa: E402
 
 __all__ = ["COPPER", "Material", "Particles", "RunResult", "Scene", "SolverSpec", "load_scene", "make_scene",
            "parse_scene", "run"]

@@ -1,8 +1,7 @@
 """``python -m dem``: see :mod:`dem.cli`."""
 
-import sys
-
 from dem.cli import main
+from fem_neck.interrupt import exit_process
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_process(main())

@@ -44,6 +44,7 @@ class ContactThermalModel:
         self.spec, self.sources = spec, sources
         self.integrator, self.linear = integrator, linear
         self.T = particles.temperature.astype(float).copy()
+        self.rate = np.zeros_like(self.T)  # dT/dt over the last step: the mechanics extrapolates with it
         self.net: Network | None = None
         self.free = np.flatnonzero(~particles.fixed)
         self.heat_in: dict = {}
@@ -84,6 +85,7 @@ class ContactThermalModel:
         T_F, heat = theta_step(self.net, self.T[self.free], dt, self.integrator, self.linear)
         for k, v in heat.items():
             self.heat_in[k] = self.heat_in.get(k, 0.0) + v
+        self.rate[self.free] = (T_F - self.T[self.free]) / dt
         self.T[self.free] = T_F
 
     def energy_error(self) -> float:

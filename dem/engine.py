@@ -6,7 +6,8 @@ submodels act in order:
 
 1. ``mechanical`` (:class:`dem.mechanics.MechanicalModel`) -- contact forces, walls, gravity and velocity-Verlet
    steps, in compiled code, with the temperatures of the interval: prescribed by the schedule (linear in time,
-   uniform), computed by the thermal network (constant over the interval), or the initial ones;
+   uniform), computed by the thermal network (its latest temperatures extrapolated with the rate of its last step),
+   or the initial ones;
 2. ``thermal`` (:class:`dem.contact_heat.ContactThermalModel`) -- one implicit step of the pipe network over the
    interval, on the contacts as they are at its end;
 3. observers -- the output writer and the progress bar.
@@ -29,12 +30,15 @@ from dem.mechanics import MechanicalModel
 from dem.motion import MotionState
 from dem.thermal import boundary_heat_flow, steady
 from fem_neck.geometry import neck_radius
+from fem_neck.interrupt import where
 
 
 class Simulation:
     """A moving-particle run built from a scene with ``"mechanical"`` physics."""
 
-    def __init__(self, scene):
+    def __init__(self, scene, resume: dict | None = None):
+        """``resume``: a checkpoint of this scene's run (:func:`dem.state_file.arrays` as loaded by
+        :func:`dem.run_folder.load`): the run goes on from its step as if it had not stopped."""
         self.scene = scene
         m = scene.motion
         p = scene.particles
@@ -43,18 +47,37 @@ class Simulation:
         scale = np.array([radius_at(1.0, float(T), params[P_T_MELT], params[P_EXPANSION]) for T in T_init])
         state = MotionState.create(m.dimension, p.position, p.radius, scene.contact.density, T_init, m.velocity,
                                    m.angular_velocity, m.height, radius_ref=p.radius / scale)
-        if m.start is not None:
-            for key in ("f", "tau", "mass", "inertia", "radius", "radius_ref", "T"):
-                setattr(state, key, np.ascontiguousarray(m.start[key], dtype=float).copy())
+        saved = resume if resume is not None else m.start
+        if saved is not None:
+            for key in ("x", "v", "w", "f", "tau", "mass", "inertia", "radius", "radius_ref", "T"):
+                setattr(state, key, np.ascontiguousarray(saved[key], dtype=float).copy())
         self.base_params = params
         self.mechanics = MechanicalModel(state, m.walls, params, m.dt, m.skin, m.gravity, m.box,
-                                         relaxation_time=float(params[P_T0]), history=m.start)
+                                         relaxation_time=float(params[P_T0]), history=saved)
         self.thermal = None
         if "thermal" in scene.physics:
             self.thermal = ContactThermalModel(p, m.walls, scene.conductance, scene.sources, m.thermal_integrator,
                                                scene.solver.linear)
         self.schedule = m.schedule
         self.models = [self.mechanics] + ([self.thermal] if self.thermal is not None else [])
+        if resume is not None:
+            self._resume(resume)
+
+    def _resume(self, saved: dict) -> None:
+        """The clock, the walls' motion and the heat balance of a checkpoint (the particles came in above)."""
+        mech = self.mechanics
+        mech.steps = int(saved["steps"])
+        names = list(saved["wall_names"])
+        for k, wall in enumerate(mech.walls):
+            m = names.index(wall.name)
+            mech.w.q[k], mech.w.dq[k], mech.w.acc[k] = saved["wall_q"][m], saved["wall_dq"][m], saved["wall_acc"][m]
+        mech.walls_moved()
+        if self.thermal is not None:
+            th = self.thermal
+            th.T = np.array(saved["thermal_T"], dtype=float)
+            th.rate = np.array(saved["thermal_rate"], dtype=float)
+            th.energy0 = float(saved["thermal_energy0"])
+            th.heat_in = {str(k): float(v) for k, v in zip(saved["heat_keys"], saved["heat_values"])}
 
     @property
     def temperature_source(self) -> str:
@@ -69,10 +92,13 @@ class Simulation:
         if self.schedule is not None:
             return (np.array([self.schedule.at(t)]), np.array([self.schedule.rate(t)]),
                     self.schedule.relaxation(t))
-        T = self.thermal.T if self.thermal is not None else mech.state.T
-        if np.all(T == T[0]):
-            return np.array([T[0]]), np.zeros(1), mech.relaxation_time
-        return T.copy(), np.zeros(len(T)), mech.relaxation_time
+        if self.thermal is not None:  # the network's temperatures, extrapolated with its last rate (cooling is
+            T, rate = self.thermal.T, self.thermal.rate  # then seen as cooling: k1(T, t) freezes, Sec. 3.4)
+        else:
+            T, rate = mech.state.T, np.zeros(len(mech.state.T))
+        if np.all(T == T[0]) and np.all(rate == rate[0]):
+            return np.array([T[0]]), np.array([rate[0]]), mech.relaxation_time
+        return T.copy(), rate.copy(), mech.relaxation_time
 
     def _params_at(self, t: float) -> np.ndarray:
         """The material at time ``t``: the scene's, with the overrides of every ``[[phases]]`` entry started."""
@@ -98,13 +124,17 @@ class Simulation:
         ends.update(k for k in (round(start / dt) for start, _ in m.phases) if 0 < k < n_end)
         return sorted(ends)
 
-    def run(self, observer=None, progress=None) -> dict:
+    def run(self, observer=None, progress=None, checkpoint=None) -> dict:
         """Advance to ``[solver] t_end``; ``observer(sim)`` after each interval that ends on an output time (and at
-        t = 0), ``progress(t)`` after every interval."""
+        t = 0), ``progress(t)`` after every interval, ``checkpoint(make)`` after every interval and at the end
+        (:class:`dem.run_folder.Checkpointer`)."""
+        from dem.state_file import arrays
+
         m, mech = self.scene.motion, self.mechanics
         n_end = max(1, math.ceil(self.scene.solver.t_end / mech.dt - 1e-9))
         out_every = max(1, round(m.output_interval / mech.dt))
-        if observer is not None:
+        here = where()
+        if observer is not None and mech.steps == 0:
             observer(self)
         for end in self._interval_ends(n_end):
             steps = end - mech.steps
@@ -120,6 +150,9 @@ class Simulation:
                 observer(self)
             if progress is not None:
                 progress(mech.t)
+            here.update(step=mech.steps, t=mech.t)
+            if checkpoint is not None:
+                checkpoint(lambda: arrays(self), final=end == n_end)
         return self.summary()
 
     # -------------------------------------------------------------------------------------------- outputs

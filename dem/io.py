@@ -11,15 +11,63 @@
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import pathlib
+import re
 
 import meshio
 import numpy as np
 
 CSV_FLOWS = ("fixed", "walls", "convection", "radiation", "internal")
 MAX_SNAPSHOTS = 1000  # VTU snapshots per run (each is two files): more is refused up front (fixed dt) or thinned (auto)
+
+
+def resumed_csv(path: pathlib.Path, keep) -> "io.TextIOBase":
+    """``path`` opened for appending after dropping the rows (dicts) ``keep`` refuses: the rows written after the
+    checkpoint a run resumes from."""
+    with path.open() as fh:
+        lines = fh.read().splitlines()
+    header = lines[0].split(",") if lines else []
+    kept = lines[:1] + [line for line in lines[1:] if keep(dict(zip(header, line.split(","))))]
+    path.write_text("".join(line + "\n" for line in kept))
+    return path.open("a")
+
+
+def resumed_snapshots(out: pathlib.Path, kinds, last_step: int) -> list[tuple[float, int]]:
+    """The ``(t, step)`` of the snapshots listed in ``out/<kind>.pvd`` up to ``last_step``; the files of later ones
+    (written after the checkpoint a run resumes from) are deleted."""
+    listed = []
+    pvd = out / f"{kinds[0]}.pvd"
+    if pvd.exists():
+        listed = [(float(t), int(step)) for t, step in
+                  re.findall(r'timestep="([^"]+)"[^>]*file="[a-z]+_(\d+)\.vtu"', pvd.read_text())]
+    for kind in kinds:
+        for f in out.glob(f"{kind}_*.vtu"):
+            if int(f.stem.split("_")[-1]) > last_step:
+                f.unlink()
+    return [(t, step) for t, step in listed if step <= last_step]
+
+
+def write_vtu(path: pathlib.Path, mesh) -> None:
+    """``mesh`` to ``path``, written aside and renamed: a VTU file on disk is always whole."""
+    tmp = path.with_name(path.name + ".part")
+    meshio.write(tmp, mesh, file_format="vtu")
+    tmp.replace(path)
+
+
+def settle_snapshots(out: pathlib.Path, kinds, snapshots, digits: int) -> None:
+    """After an interrupt: the half-written files and the files of a snapshot left unfinished are deleted and every
+    PVD collection lists exactly the snapshots on disk."""
+    steps = {step for _, step in snapshots}
+    for f in out.glob("*.vtu.part"):
+        f.unlink()
+    for kind in kinds:
+        for f in out.glob(f"{kind}_*.vtu"):
+            if int(f.stem.split("_")[-1]) not in steps:
+                f.unlink()
+        write_pvd(out / f"{kind}.pvd", [(t, f"{kind}_{step:0{digits}d}.vtu") for t, step in snapshots])
 
 
 def write_pvd(path: pathlib.Path, entries: list[tuple[float, str]]) -> None:
@@ -32,7 +80,8 @@ def write_pvd(path: pathlib.Path, entries: list[tuple[float, str]]) -> None:
 class RunWriter:
     """Observer for the integrators: CSV row every ``every`` steps, snapshots every ``vtu_every`` steps."""
 
-    def __init__(self, out_dir, scene, model):
+    def __init__(self, out_dir, scene, model, resume_step: int | None = None):
+        """``resume_step``: go on with the files of a run resumed from the checkpoint at that step."""
         o, s = scene.output, scene.solver
         if o.vtu and o.vtu_every and s.mode == "transient" and s.dt != "auto":
             snapshots = math.ceil(s.t_end / s.dt * (1 - 1e-12)) // o.vtu_every
@@ -43,10 +92,14 @@ class RunWriter:
         self.out = pathlib.Path(out_dir)
         self.out.mkdir(parents=True, exist_ok=True)
         self.scene, self.model = scene, model
-        self.csv = (self.out / "timeseries.csv").open("w")
-        self.csv.write("step,t,T_mean,T_min,T_max," + ",".join(f"Q_{k}" for k in CSV_FLOWS) + "\n")
         self.snapshots: list[tuple[float, int]] = []
         self.last = None
+        if resume_step is None:
+            self.csv = (self.out / "timeseries.csv").open("w")
+            self.csv.write("step,t,T_mean,T_min,T_max," + ",".join(f"Q_{k}" for k in CSV_FLOWS) + "\n")
+        else:
+            self.csv = resumed_csv(self.out / "timeseries.csv", lambda row: int(row["step"]) <= resume_step)
+            self.snapshots = resumed_snapshots(self.out, ("particles", "bonds"), resume_step)
 
     def __call__(self, step, t, T_free, flows):
         net = self.model.network
@@ -69,7 +122,7 @@ class RunWriter:
         if self.snapshots and self.snapshots[-1][1] == step:
             return
         p, b = self.scene.particles, self.model.bonds
-        meshio.write(self.out / f"particles_{step:05d}.vtu", meshio.Mesh(
+        write_vtu(self.out / f"particles_{step:05d}.vtu", meshio.Mesh(
             p.position, [("vertex", np.arange(p.n).reshape(-1, 1))],
             point_data={"radius": p.radius, "temperature": T, "fixed": p.fixed.astype(np.int8),
                         "material": p.material.astype(np.int32)}))
@@ -87,21 +140,30 @@ class RunWriter:
         partner[crossing] = p.n + b.n_walls + np.arange(len(crossing))
         lines = np.vstack([np.column_stack([b.i, partner]),
                            np.column_stack([b.wall_particle, p.n + np.arange(b.n_walls)])]).astype(np.int64)
-        meshio.write(self.out / f"bonds_{step:05d}.vtu", meshio.Mesh(
+        write_vtu(self.out / f"bonds_{step:05d}.vtu", meshio.Mesh(
             points, [("line", lines.reshape(-1, 2))],
             cell_data={"conductance": [np.concatenate([self.model.K_pairs, self.model.K_walls])],
                        "heat_flow": [np.concatenate([q_pairs, q_walls])],
                        "neck_radius": [np.concatenate([b.a, b.wall_a])]}))
         self.snapshots.append((t, step))
-        count = len(self.snapshots)
-        if count & (count - 1) == 0:  # rewrite the collection at 1, 2, 4, ... snapshots (and at the end): O(n) total
-            self._write_pvd()
+        self._write_pvd()  # every snapshot listed at once: an interrupted run's collection holds all it wrote
 
     def _write_pvd(self):
         for kind in ("particles", "bonds"):
             write_pvd(self.out / f"{kind}.pvd", [(tt, f"{kind}_{s:05d}.vtu") for tt, s in self.snapshots])
 
-    def finish(self, summary: dict):
+    def interrupted(self, summary: dict) -> None:
+        """Close the files of a run stopped by Ctrl-C: ``summary.json`` marked ``"interrupted": true`` with the state
+        reached (the last step's time, step and temperatures) and where a resume starts (the last checkpoint)."""
+        if self.last is not None:
+            step, t, T, _ = self.last
+            summary.update(t=t, steps=step, T_mean=float(T.mean()), T_min=float(T.min()), T_max=float(T.max()))
+        summary["resume_from"] = checkpoint_reached(self.out)
+        self.csv.close()
+        settle_snapshots(self.out, ("particles", "bonds"), self.snapshots, 5)
+        write_summary(self.out / "summary.json", summary)
+
+    def finish(self, summary: dict, plots: bool = True):
         if self.last is not None:
             step, t, T, flows = self.last
             if step % self.scene.output.every:
@@ -111,7 +173,23 @@ class RunWriter:
         if self.snapshots:
             self._write_pvd()
         self.csv.close()
-        write_summary(self.out / "summary.json", summary)
+        write_summary(self.out / "summary.json", summary)  # first: the profile plot reads k_eff from it
+        if plots:
+            from dem.plots import thermal_plots
+
+            summary["plots"] = thermal_plots(self.out, self.scene, self.model.T)
+            write_summary(self.out / "summary.json", summary)
+
+
+def checkpoint_reached(out: pathlib.Path) -> dict | None:
+    """``{"t", "steps"}`` of the checkpoint in ``out`` (where ``--resume`` goes on from), or None."""
+    path = out / "checkpoint.npz"
+    if not path.exists():
+        return None
+    import numpy as np
+
+    with np.load(path, allow_pickle=False) as f:
+        return {"t": float(f["t"]), "steps": int(f["steps"])}
 
 
 def write_summary(path, summary: dict) -> None:
@@ -124,7 +202,8 @@ class MotionWriter:
     submodels offer) and ``contacts_NNNNN.vtu`` (lines with normal and tangential force and overlap), each listed in
     its PVD collection as soon as it is written."""
 
-    def __init__(self, out_dir, scene):
+    def __init__(self, out_dir, scene, resume_step: int | None = None):
+        """``resume_step``: go on with the files of a run resumed from the checkpoint at that step."""
         self.out = pathlib.Path(out_dir)
         self.out.mkdir(parents=True, exist_ok=True)
         self.scene = scene
@@ -132,6 +211,17 @@ class MotionWriter:
         self.columns: list[str] = []
         self.snapshots: list[tuple[float, int]] = []
         self.next_vtu = 0.0
+        if resume_step is not None:
+            with (self.out / "timeseries.csv").open() as fh:
+                self.columns = fh.readline().strip().split(",")
+            self.csv = resumed_csv(self.out / "timeseries.csv", lambda row: int(row["step"]) <= resume_step)
+            self.snapshots = resumed_snapshots(self.out, ("particles", "contacts"), resume_step)
+            t_last = max((t for t, _ in self.snapshots), default=0.0)
+            if (self.out / "profiles.csv").exists():
+                resumed_csv(self.out / "profiles.csv", lambda row: float(row["t"]) <= t_last).close()
+            interval = scene.motion.vtu_interval
+            while interval > 0 and self.next_vtu <= t_last + 1e-12 * scene.solver.t_end:
+                self.next_vtu += interval  # as the run advanced it: the same sums, the same snapshot times
 
     def __call__(self, sim):
         row = sim.record()
@@ -161,19 +251,27 @@ class MotionWriter:
                     fh.write("t,distance,solid_fraction,neck_over_radius\n")
                 for d, phi, a in zip(profile["distance"], profile["solid_fraction"], profile["neck_over_radius"]):
                     fh.write(f"{t:.12g},{d:.12g},{phi:.12g},{'' if a is None else f'{a:.12g}'}\n")
-        self.snapshots.append((t, step))
         if not self.scene.output.vtu:
+            self.snapshots.append((t, step))
             return
         s = sim.mechanics.state
         fields = sim.particle_fields()
-        meshio.write(self.out / f"particles_{step:09d}.vtu", meshio.Mesh(
+        write_vtu(self.out / f"particles_{step:09d}.vtu", meshio.Mesh(
             s.x, [("vertex", np.arange(s.n).reshape(-1, 1))], point_data=fields))
         i, j, cfields = sim.contact_fields()
-        meshio.write(self.out / f"contacts_{step:09d}.vtu", meshio.Mesh(
+        write_vtu(self.out / f"contacts_{step:09d}.vtu", meshio.Mesh(
             s.x, [("line", np.column_stack([i, j]).astype(np.int64).reshape(-1, 2))],
             cell_data={k: [v] for k, v in cfields.items()}))
+        self.snapshots.append((t, step))
         for kind in ("particles", "contacts"):
             write_pvd(self.out / f"{kind}.pvd", [(tt, f"{kind}_{k:09d}.vtu") for tt, k in self.snapshots])
+
+    def interrupted(self, summary: dict) -> None:
+        """Close the files of a run stopped by Ctrl-C (:meth:`RunWriter.interrupted`)."""
+        summary["resume_from"] = checkpoint_reached(self.out)
+        if self.scene.output.vtu:
+            settle_snapshots(self.out, ("particles", "contacts"), self.snapshots, 9)
+        self.finish(summary, plots=False)
 
     def finish(self, summary: dict, plots: bool = True):
         if self.csv is not None:
@@ -181,5 +279,5 @@ class MotionWriter:
         if plots:
             from dem.plots import motion_plots
 
-            summary = {**summary, "plots": motion_plots(self.out)}
+            summary["plots"] = motion_plots(self.out)
         write_summary(self.out / "summary.json", summary)

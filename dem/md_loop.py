@@ -9,7 +9,7 @@ step:
 
 1. half kick and drift: ``v += dt/2 f/m``, ``x += dt v`` (and ``omega += dt/2 tau/I``); walls move by their law
    (:mod:`dem.walls`);
-2. material state: the temperature ``T_i(t) = T0_i + rate_i (t - t_start)``, the radius ``a(T)`` (Luding 2005,
+2. material state: the temperature ``T_i(t) = T0_i + rate_i (t - t_first)``, the radius ``a(T)`` (Luding 2005,
    eq. 9), the stiffness factor ``k1(T, t)/k1`` relaxed towards ``k1(T)/k1`` (eqs. 10-12);
 3. forces: gravity, every listed pair (normal law eqs. 3-13, tangential eqs. 14-24) and every particle-wall
    contact, summed into forces and torques;
@@ -168,12 +168,12 @@ def _wall_acceleration(m, wq, wdq, wmode, wpress, wmass, wdamp, wspan, wforce):
 
 
 @njit(cache=True, error_model="numpy")
-def _material_state(t, t_start, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt):
+def _material_state(elapsed, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt):
     """Temperatures at ``t``, radii (eq. 9) and stiffness factors relaxed over one step (eqs. 10-12)."""
     T_melt, T_var, expansion = params[P_T_MELT], params[P_T_VAR], params[P_EXPANSION]
     n = T.shape[0]
     if uniform:
-        Tu = T0[0] + T_rate[0] * (t - t_start)
+        Tu = T0[0] + T_rate[0] * elapsed
         target = k1_factor(Tu, T_melt, T_var)
         scale = radius_at(1.0, Tu, T_melt, expansion)
         cooling = T_rate[0] < 0.0
@@ -183,24 +183,26 @@ def _material_state(t, t_start, T0, T_rate, T, radius, radius_ref, k1f, uniform,
             k1f[k] = relax_k1(k1f[k], target, dt, t0, cooling)
     else:
         for k in range(n):
-            T[k] = T0[k] + T_rate[k] * (t - t_start)
+            T[k] = T0[k] + T_rate[k] * elapsed
             radius[k] = radius_at(radius_ref[k], T[k], T_melt, expansion)
             k1f[k] = relax_k1(k1f[k], k1_factor(T[k], T_melt, T_var), dt, t0, T_rate[k] < 0.0)
 
 
 @njit(cache=True, error_model="numpy")
-def advance(n_steps, dt, t_start, x, v, w, f, tau, mass, inertia, lin, rot, radius, radius_ref, T0, T_rate, T, k1f,
+def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, lin, rot, radius, radius_ref, T0, T_rate, T, k1f,
             uniform_T, t0, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn, p_ft,
             wn, wq, wdq, wacc, wmode, wpress, wmass, wdamp, wq0, wamp, wfreq, wspan, wforce, wk, wm, wq_ref,
             w_dmax, w_k1last, w_xi, w_fn, w_ft, params, x_ref, skin, info):
-    """Up to ``n_steps`` velocity-Verlet steps (module docstring); ``f``/``tau``/``wacc`` must hold the forces of
-    the current state on entry. Returns ``(steps done, status)``; ``info`` receives the particle (and wall) index of
-    a non-finite or escaped particle."""
+    """Up to ``n_steps`` velocity-Verlet steps (module docstring) from global step ``step0`` (t = step0 dt) of an
+    interval that began at step ``first`` with temperatures ``T0`` (``T0 + T_rate (t - first dt)`` after it): times
+    come from step counts, so where a run is split into calls (rebuilds, a resume) never changes its arithmetic.
+    ``f``/``tau``/``wacc`` must hold the forces of the current state on entry. Returns ``(steps done, status)``;
+    ``info`` receives the particle (and wall) index of a non-finite or escaped particle."""
     n = x.shape[0]
     n_w = wn.shape[0]
     h = 0.5 * dt
     for s in range(n_steps):
-        t = t_start + s * dt
+        t = (step0 + s) * dt
         for k in range(n):
             im, ii = 1.0 / mass[k], 1.0 / inertia[k]
             moved = 0.0
@@ -222,7 +224,8 @@ def advance(n_steps, dt, t_start, x, v, w, f, tau, mass, inertia, lin, rot, radi
                 phase = 2.0 * math.pi * wfreq[m] * (t + dt)
                 wq[m] = wq0[m] + wamp[m] * math.sin(phase)
                 wdq[m] = 2.0 * math.pi * wfreq[m] * wamp[m] * math.cos(phase)
-        _material_state(t + dt, t_start, T0, T_rate, T, radius, radius_ref, k1f, uniform_T, params, t0, dt)
+        _material_state((step0 + s + 1 - first) * dt, T0, T_rate, T, radius, radius_ref, k1f, uniform_T, params, t0,
+                        dt)
         escaped = _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn,
                           p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt)
         worst = 0.0

@@ -74,7 +74,7 @@ class MechanicalModel:
         histories are carried by key; walls by name)."""
         self.k1f = np.array(saved["k1f"], dtype=float)
         self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft = carry_history(
-            saved["pi"], saved["pj"], self.pi, self.pj, self.state.n, saved["p_dmax"], saved["p_k1last"],
+            saved["pi"], saved["pj"], self.pi, self.pj, saved["p_dmax"], saved["p_k1last"],
             saved["p_xi"], np.zeros(len(saved["pi"])), np.zeros((len(saved["pi"]), 3)))
         names = [w.name for w in self.walls]
         for m_old, name in enumerate(saved["wall_names"]):
@@ -90,18 +90,23 @@ class MechanicalModel:
     # ------------------------------------------------------------------------------------------------ list
     def _build_list(self, first: bool = False):
         s = self.state
-        i, j = verlet_pairs(s.x, s.radius, self.skin, self.box)
+        expected = 0 if first else len(self.pi) + len(self.pi) // 8 + 16  # the last list, with room to grow
+        i, j = verlet_pairs(s.x, s.radius, self.skin, self.box, expected)
         if first:
             m = len(i)
             self.p_dmax, self.p_k1last, self.p_fn = np.zeros(m), np.zeros(m), np.zeros(m)
             self.p_xi, self.p_ft = np.zeros((m, 3)), np.zeros((m, 3))
         else:
             self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft = carry_history(
-                self.pi, self.pj, i, j, s.n, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft)
+                self.pi, self.pj, i, j, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft)
             self.rebuilds += 1
         self.pi, self.pj = i, j
         self.x_ref = s.x.copy()
-        self.wk, self.wm = wall_pairs(s.x, s.radius, self.w.normal, self.w.q, self.skin)
+        self.walls_moved()
+
+    def walls_moved(self):
+        """The walls were set elsewhere (a resumed run): their Verlet list follows."""
+        self.wk, self.wm = wall_pairs(self.state.x, self.state.radius, self.w.normal, self.w.q, self.skin)
         self.wq_ref = self.w.q.copy()
 
     def _initial_forces(self):
@@ -127,13 +132,12 @@ class MechanicalModel:
         T0 = np.ascontiguousarray(T0, dtype=float)
         T_rate = np.ascontiguousarray(T_rate, dtype=float)
         uniform = len(T0) == 1
-        t_start = self.t
+        first = self.steps
         done = 0
         while done < n_steps:
-            t_call = self.t
             steps, status = md_loop.advance(
-                n_steps - done, self.dt, t_call, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia, s.linear_dof,
-                s.angular_dof, s.radius, s.radius_ref, T0 + T_rate * (t_call - t_start), T_rate, s.T, self.k1f,
+                n_steps - done, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia,
+                s.linear_dof, s.angular_dof, s.radius, s.radius_ref, T0, T_rate, s.T, self.k1f,
                 uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_dmax, self.p_k1last, self.p_xi,
                 self.p_fn, self.p_ft, w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0,
                 w.amplitude, w.frequency, w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_dmax,

@@ -12,7 +12,7 @@ The same binning places particles at random without overlaps (:func:`sequential_
 addition for the box generator).
 
 Per-pair history (the contact state that a contact law carries from step to step) lives in rows aligned with the
-list; :func:`carry_history` moves it to the rows of a rebuilt list, matching pairs by their key ``i * N + j``.
+list; :func:`carry_history` moves it to the rows of a rebuilt list, matching the pairs of the two sorted lists.
 """
 
 from __future__ import annotations
@@ -25,8 +25,13 @@ from numba import njit
 
 @njit(cache=True)
 def min_image(d, length):
-    """``d`` wrapped into ``[-length/2, length/2]`` on a periodic axis (``length > 0``); unchanged otherwise."""
+    """``d`` wrapped into ``[-length/2, length/2]`` on a periodic axis (``length > 0``); unchanged otherwise.
+
+    A listed pair's separation is far below a quarter of the box: there ``floor(d/length + 0.5) = 0`` and the
+    result is ``d`` to the bit, so the division and the floor are skipped."""
     if length > 0.0:
+        if abs(d) < 0.25 * length:
+            return d
         return d - length * math.floor(d / length + 0.5)
     return d
 
@@ -42,8 +47,9 @@ def _cell_of(x, lo, size, n):
 
 
 @njit(cache=True)
-def _pairs_in_cells(x, radius, skin, box, count_only, out_i, out_j):
-    """Count (``count_only``) or list the pairs within ``r_i + r_j + skin`` by cell binning."""
+def _pairs_in_cells(x, radius, skin, box, out_i, out_j):
+    """The pairs within ``r_i + r_j + skin`` by cell binning, sorted by ``(i, j)``, written into ``out_i``,
+    ``out_j`` while they have room; returns how many there are (arrays that large hold them all)."""
     n = x.shape[0]
     r_max = 0.0
     for k in range(n):
@@ -86,7 +92,9 @@ def _pairs_in_cells(x, radius, skin, box, count_only, out_i, out_j):
         nxt[k] = head[c]
         head[c] = k
     found = 0
+    room = out_i.shape[0]
     for k in range(n):
+        first = found
         for d0 in range(-1, 2):
             c0 = cell[k, 0] + d0
             if c0 < 0 or c0 >= ncell[0]:
@@ -119,26 +127,37 @@ def _pairs_in_cells(x, radius, skin, box, count_only, out_i, out_j):
                             dz = min_image(x[k, 2] - x[m, 2], box[2])
                             cut = radius[k] + radius[m] + skin
                             if dx * dx + dy * dy + dz * dz < cut * cut:
-                                if not count_only:
+                                if found < room:
                                     out_i[found] = k
                                     out_j[found] = m
                                 found += 1
                         m = nxt[m]
+        for a in range(first + 1, min(found, room)):  # k's partners in order (a handful: insertion sort)
+            partner = out_j[a]
+            b = a - 1
+            while b >= first and out_j[b] > partner:
+                out_j[b + 1] = out_j[b]
+                b -= 1
+            out_j[b + 1] = partner
     return found
 
 
-def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray,
+                 capacity: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j + skin`` (minimum image on periodic axes), sorted by
-    ``(i, j)``."""
-    dummy = np.zeros(0, dtype=np.int64)
+    ``(i, j)``. ``capacity``: the number of pairs expected (a rebuild passes its last list's length with some
+    room): one pass over the cells when they fit, else a second one."""
     if len(radius) < 2:
-        return dummy, dummy
-    count = _pairs_in_cells(x, radius, skin, box, True, dummy, dummy)
-    i = np.empty(count, dtype=np.int64)
-    j = np.empty(count, dtype=np.int64)
-    _pairs_in_cells(x, radius, skin, box, False, i, j)
-    order = np.lexsort((j, i))
-    return i[order], j[order]
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty
+    i = np.empty(capacity, dtype=np.int64)
+    j = np.empty(capacity, dtype=np.int64)
+    count = _pairs_in_cells(x, radius, skin, box, i, j)
+    if count > capacity:
+        i = np.empty(count, dtype=np.int64)
+        j = np.empty(count, dtype=np.int64)
+        _pairs_in_cells(x, radius, skin, box, i, j)
+    return i[:count], j[:count]
 
 
 @njit(cache=True)
@@ -154,18 +173,28 @@ def max_displacement(x, x_ref, box):
     return math.sqrt(worst)
 
 
-def carry_history(old_i, old_j, new_i, new_j, n: int, *columns):
+@njit(cache=True)
+def _rows_in(old_i, old_j, new_i, new_j):
+    """The row of each pair ``(new_i, new_j)`` in ``(old_i, old_j)``, -1 where it is new (both sorted by
+    ``(i, j)``: one merge)."""
+    rows = np.empty(new_i.shape[0], dtype=np.int64)
+    p, m = 0, old_i.shape[0]
+    for q in range(new_i.shape[0]):
+        while p < m and (old_i[p] < new_i[q] or (old_i[p] == new_i[q] and old_j[p] < new_j[q])):
+            p += 1
+        rows[q] = p if p < m and old_i[p] == new_i[q] and old_j[p] == new_j[q] else -1
+    return rows
+
+
+def carry_history(old_i, old_j, new_i, new_j, *columns):
     """History rows of the pairs ``(new_i, new_j)`` taken from the rows of the same pairs in ``(old_i, old_j)``
-    (both sorted by key ``i * n + j``); pairs new to the list start from zeros. Returns the new columns."""
-    old_key = old_i * n + old_j
-    new_key = new_i * n + new_j
-    pos = np.searchsorted(old_key, new_key)
-    pos_c = np.minimum(pos, max(len(old_key) - 1, 0))
-    found = (pos < len(old_key)) & (old_key[pos_c] == new_key) if len(old_key) else np.zeros(len(new_key), bool)
+    (both sorted by ``(i, j)``); pairs new to the list start from zeros. Returns the new columns."""
+    rows = _rows_in(old_i, old_j, new_i, new_j)
+    found = rows >= 0
     out = []
     for col in columns:
-        new = np.zeros((len(new_key),) + col.shape[1:], dtype=col.dtype)
-        new[found] = col[pos_c[found]]
+        new = np.zeros((len(new_i),) + col.shape[1:], dtype=col.dtype)
+        new[found] = col[rows[found]]
         out.append(new)
     return out
 

@@ -62,6 +62,12 @@ class PeriodicBox:
     def any_periodic(self) -> bool:
         return any(self.periodic)
 
+    @property
+    def kernel_lengths(self) -> np.ndarray:
+        """The lengths with 0 on the non-periodic axes: the form the compiled neighbour list of moving particles
+        takes (``dem.neighbours.min_image``)."""
+        return np.where(self.mask, self.lengths, 0.0)
+
     def wrap(self, x: np.ndarray) -> np.ndarray:
         """Positions moved into ``[origin, origin + lengths)`` along the periodic axes."""
         x = np.asarray(x, dtype=float)

@@ -37,9 +37,10 @@ class ThermalModel:
         self.network = build_network(scene.particles, scene.walls, scene.conductance, scene.sources, box=scene.box)
         self.bonds, self.K_pairs, self.K_walls = self.network.bonds, self.network.K_pairs, self.network.K_walls
 
-    def run(self, observer=None, progress=None) -> dict:
+    def run(self, observer=None, progress=None, resume=None, checkpoint=None) -> dict:
+        """Solve (steady) or integrate (transient); ``resume``/``checkpoint``: :func:`dem.thermal.integrate`."""
         try:
-            return self._run(observer, progress)
+            return self._run(observer, progress, resume, checkpoint)
         except RuntimeError as exc:  # e.g. SuperLU "Factor is exactly singular": explain it as a property of the scene
             raise ValueError(self._singular_message(exc)) from None
 
@@ -74,7 +75,7 @@ class ThermalModel:
                 f"conductances, ambient coefficients and fixed temperatures are within a few orders of magnitude "
                 f"of each other")
 
-    def _run(self, observer=None, progress=None) -> dict:
+    def _run(self, observer=None, progress=None, resume=None, checkpoint=None) -> dict:
         s = self.scene.solver
         out = {"law": self.scene.conductance.law, "contact": self.bonds.contact,
                "bonds_clipped": self.bonds.clipped, "bonds_dropped": self.bonds.dropped,
@@ -92,7 +93,7 @@ class ThermalModel:
                 out["periodic_heat_flow"] = periodic_heat_flow(self.network, res.T).tolist()
         else:
             res = integrate(self.network, s.integrator, s.dt, s.t_end, s.rtol, s.linear, s.max_steps, observer,
-                            progress)
+                            progress, resume=resume, checkpoint=checkpoint)
             self.T = res.T
             out.update(t=res.t, steps=res.steps, energy_error=res.energy_error, heat_in=res.heat_in,
                        integrator=s.integrator, dt=s.dt, dt_min=res.dt_min, dt_max=res.dt_max,

@@ -79,3 +79,72 @@ def motion_plots(out_dir) -> list[str]:
             plt.close(fig)
             written.append("profiles.png")
     return written
+
+
+def thermal_plots(out_dir, scene, T) -> list[str]:
+    """Write the plots of a thermal (static packing) run folder; returns the file names written.
+
+    * ``temperature.png`` -- mean, min and max temperature against time (transient);
+    * ``heat_flow.png`` -- heat flow into the particles through fixed particles, walls, convection, radiation and
+      internal sources against time (transient; the boundaries the scene has);
+    * ``profile.png`` -- the temperature of every particle against its height along the heat-flow axis (z) with
+      the mean of slabs, and the effective conductivity when the run reports one (scenes with a hot and a cold end).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    out = pathlib.Path(out_dir)
+    written = []
+    data = _read_csv(out / "timeseries.csv") if (out / "timeseries.csv").exists() else {}
+    if scene.solver.mode == "transient" and data:
+        fig, ax = plt.subplots(figsize=(7, 4))
+        ax.plot(data["t"], data["T_mean"], label="mean")
+        ax.fill_between(data["t"], data["T_min"], data["T_max"], alpha=0.3, label="min-max")
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel("temperature")
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(out / "temperature.png", dpi=120)
+        plt.close(fig)
+        written.append("temperature.png")
+        flows = [k for k in data if k.startswith("Q_") and any(abs(v) > 0 for v in data[k])]
+        if flows:
+            fig, ax = plt.subplots(figsize=(7, 4))
+            for k in flows:
+                ax.plot(data["t"], data[k], label=k[2:])
+            ax.set_xlabel("t (s)")
+            ax.set_ylabel("heat flow into the particles (W)")
+            ax.legend()
+            fig.tight_layout()
+            fig.savefig(out / "heat_flow.png", dpi=120)
+            plt.close(fig)
+            written.append("heat_flow.png")
+    if scene.specimen is not None:
+        z = scene.particles.position[:, 2]
+        fig, ax = plt.subplots(figsize=(7, 4))
+        ax.plot(z * 1e3, T, ".", ms=2, alpha=0.4, label="particles")
+        edges = np.linspace(z.min(), z.max(), 21)
+        slab = np.clip(np.searchsorted(edges, z) - 1, 0, 19)
+        count = np.bincount(slab, minlength=20)
+        with np.errstate(invalid="ignore"):
+            mean = np.bincount(slab, T, 20) / count
+        ax.plot(0.5 * (edges[1:] + edges[:-1]) * 1e3, mean, "o-", label="slab mean")
+        ax.set_xlabel("z (mm), along the heat flow")
+        ax.set_ylabel("temperature")
+        summary = out / "summary.json"
+        title = ""
+        if summary.exists():
+            import json
+
+            k_eff = json.loads(summary.read_text()).get("effective_conductivity")
+            title = f"k_eff = {k_eff:.6g} W/(m K)" if k_eff is not None else ""
+        ax.set_title(title)
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(out / "profile.png", dpi=120)
+        plt.close(fig)
+        written.append("profile.png")
+    return written

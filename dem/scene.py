@@ -43,7 +43,7 @@ ALLOWED = {
     "convection": {"h", "T_inf", "area_fraction"},
     "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
     "solver": {"mode", "integrator", "dt", "t_end", "rtol", "linear", "floating", "max_steps"},
-    "output": {"every", "vtu_every", "vtu"},
+    "output": {"every", "vtu_every", "vtu", "checkpoint_every"},
     "contact": {"law"} | {f.name for f in fields(LudingMaterial)},
 }
 CONTACT_LAWS = ("luding",)
@@ -97,11 +97,13 @@ class SolverSpec:
 
 @dataclass(frozen=True)
 class OutputSpec:
-    """CSV row every ``every`` steps; VTU snapshot every ``vtu_every`` steps (0: first and last only)."""
+    """CSV row every ``every`` steps; VTU snapshot every ``vtu_every`` steps (0: first and last only); a checkpoint
+    of a transient run every ``checkpoint_every`` seconds of wall time (:mod:`dem.run_folder`)."""
 
     every: int = 1
     vtu_every: int = 0
     vtu: bool = True
+    checkpoint_every: float = 5.0
 
     def __post_init__(self):
         for key in ("every", "vtu_every"):
@@ -110,6 +112,9 @@ class OutputSpec:
                 raise ValueError(f"[output] {key} = {v!r}: must be an integer >= {1 if key == 'every' else 0}")
         if not isinstance(self.vtu, bool):
             raise ValueError(f"[output] vtu = {self.vtu!r}: must be true or false")
+        if not (isinstance(self.checkpoint_every, (int, float)) and not isinstance(self.checkpoint_every, bool)
+                and self.checkpoint_every > 0 and math.isfinite(self.checkpoint_every)):
+            raise ValueError(f"[output] checkpoint_every = {self.checkpoint_every!r}: must be a number of seconds > 0")
 
 
 @dataclass(frozen=True)
@@ -458,7 +463,8 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         _check_radiation_temperatures(rad, particles.temperature, walls)
     solver = _spec(SolverSpec, doc.get("solver", {}), "solver", numeric=("dt", "t_end", "rtol"),
                    integer=("max_steps",), words=("dt",))
-    output = _spec(OutputSpec, doc.get("output", {}), "output", integer=("every", "vtu_every"))
+    output = _spec(OutputSpec, doc.get("output", {}), "output", numeric=("checkpoint_every",),
+                   integer=("every", "vtu_every"))
     if velocity is not None and not moving:
         raise ValueError("[generator] speed: only for moving particles ([scene] physics with \"mechanical\")")
     contact = luding_material_from_scene(doc) if "contact" in doc else None

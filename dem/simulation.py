@@ -10,9 +10,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dem import physics
+from dem import physics, run_folder
 from dem.io import RunWriter
 from dem.scene import Scene
+from dem.thermal import Checkpoint
+from fem_neck.interrupt import where
 
 T_LIST_MAX = 1000  # the summary lists the final temperatures for scenes up to this many particles
 
@@ -31,7 +33,10 @@ class RunResult:
 
 
 def _progress_bar(scene: Scene, enabled: bool):
-    """A tqdm bar on stderr that appears only after 2 s: simulated time (transient) or the build/solve stages."""
+    """A tqdm bar on stderr that appears only after 2 s: simulated time (transient) or the build/solve stages.
+
+    The time left is estimated only where steps are of one size (fixed ``dt``, and moving particles): adaptive steps
+    start small and grow by orders of magnitude, so a linear extrapolation of their early pace means nothing."""
     if not enabled:
         return None, None
     from tqdm import tqdm
@@ -39,9 +44,11 @@ def _progress_bar(scene: Scene, enabled: bool):
     if scene.solver.mode != "transient":
         bar = tqdm(total=2, desc=f"dem {scene.name}: bonds, solve", file=sys.stderr, delay=2.0)
         return bar, (lambda stage: bar.update(1))
+    uniform = scene.motion is not None or scene.solver.dt != "auto"
+    tail = " [{elapsed}<{remaining}]" if uniform else " [{elapsed}]"
     bar = tqdm(total=scene.solver.t_end, unit="s", desc=f"dem {scene.name}", file=sys.stderr, delay=2.0,
-               bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s simulated [{elapsed}<{remaining}]")
-    return bar, (lambda t: bar.update(t - bar.n))
+               bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s simulated" + tail)
+    return bar, (lambda t: bar.update(min(t, bar.total) - bar.n))
 
 
 def effective_conductivity(scene: Scene, summary: dict) -> float | None:
@@ -64,21 +71,49 @@ def effective_conductivity(scene: Scene, summary: dict) -> float | None:
     return q * sp.length / (sp.area * (sp.hot - sp.cold))
 
 
-def run(scene: Scene, out=None, progress: bool = False) -> RunResult:
-    """Run ``scene``; with ``out`` write summary.json, timeseries.csv and VTU/PVD snapshots into that folder."""
+def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, overwrite: bool = False) -> RunResult:
+    """Run ``scene``; with ``out`` write summary.json, timeseries.csv, VTU/PVD snapshots and plots into that folder
+    (refused if it holds a run, unless ``resume``: go on from its last checkpoint, or ``overwrite``: clear it first;
+    :mod:`dem.run_folder`). Ctrl-C leaves the folder usable: the rows and snapshots written so far, the last
+    checkpoint, and ``summary.json`` marked ``"interrupted": true``."""
+    if out is not None:
+        out = run_folder.prepare(out, resume, overwrite)
+    elif resume or overwrite:
+        raise ValueError("--resume and --overwrite need --out (the folder of the run)")
     if scene.motion is not None:
-        return run_moving(scene, out, progress)
+        return run_moving(scene, out, progress, resume)
     start = time.perf_counter()
+    here = where()
+    here.update(stage=f"dem run {scene.name}", out=str(out) if out is not None else None)
     bar, report = _progress_bar(scene, progress)
+    transient = scene.solver.mode == "transient"
+    writer = None
     try:
         models = physics.build(scene)
         thermal = next(m for m in models if m.name == "thermal")
-        writer = RunWriter(out, scene, thermal) if out is not None else None
-        if scene.solver.mode != "transient" and report is not None:
+        checkpoint = restart = None
+        if out is not None and transient:
+            checkpoint = run_folder.Checkpointer(out, scene, "thermal", scene.output.checkpoint_every)
+            if resume:
+                restart = Checkpoint.from_arrays(run_folder.load(out, scene, "thermal"))
+        if out is not None:
+            writer = RunWriter(out, scene, thermal, resume_step=restart.steps if restart is not None else None)
+
+        def observe(step, t, T_free, flows):
+            here.update(step=step, t=t)
+            if writer is not None:
+                writer(step, t, T_free, flows)
+
+        if not transient and report is not None:
             report("bonds")
-        details = thermal.run(writer, report if scene.solver.mode == "transient" else None)
-        if scene.solver.mode != "transient" and report is not None:
+        details = thermal.run(observe, report if transient else None, restart, checkpoint)
+        if not transient and report is not None:
             report("solve")
+    except KeyboardInterrupt:
+        if writer is not None:
+            writer.interrupted({"scene": scene.name, "mode": scene.solver.mode, "interrupted": True,
+                                "physics": list(scene.physics)})
+        raise
     finally:
         if bar is not None:
             bar.close()
@@ -96,6 +131,8 @@ def run(scene: Scene, out=None, progress: bool = False) -> RunResult:
         summary["effective_conductivity"] = k_eff
     summary.update(T_mean=float(thermal.T.mean()), T_min=float(thermal.T.min()), T_max=float(thermal.T.max()))
     summary.update(details)
+    if resume:
+        summary["resumed_from"] = {"t": restart.t, "steps": restart.steps}
     summary = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in summary.items()}
     summary["seconds"] = time.perf_counter() - start
     if writer is not None:
@@ -103,22 +140,29 @@ def run(scene: Scene, out=None, progress: bool = False) -> RunResult:
     return RunResult(summary, thermal.T, models)
 
 
-def run_moving(scene: Scene, out=None, progress: bool = False) -> RunResult:
-    """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engine`."""
+def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = False) -> RunResult:
+    """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engine` (``out`` prepared
+    by :func:`run`)."""
+    from dem import state_file
     from dem.engine import Simulation
     from dem.io import MotionWriter
 
     start = time.perf_counter()
-    sim = Simulation(scene)
-    writer = MotionWriter(out, scene) if out is not None else None
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=scene.solver.t_end, unit="s", desc=f"dem {scene.name}", file=sys.stderr, delay=2.0,
-                   bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s simulated [{elapsed}<{remaining}]")
+    here = where()
+    here.update(stage=f"dem run {scene.name}", out=str(out) if out is not None else None)
+    saved = state_file.normalised(run_folder.load(out, scene, "moving")) if resume else None
+    sim = Simulation(scene, resume=saved)
+    writer = MotionWriter(out, scene, resume_step=sim.mechanics.steps if resume else None) if out is not None \
+        else None
+    checkpoint = run_folder.Checkpointer(out, scene, "moving", scene.output.checkpoint_every) if out is not None \
+        else None
+    bar, report = _progress_bar(scene, progress)
     try:
-        details = sim.run(writer, (lambda t: bar.update(min(t, bar.total) - bar.n)) if bar is not None else None)
+        details = sim.run(writer, report, checkpoint)
+    except KeyboardInterrupt:
+        if writer is not None:
+            writer.interrupted({"scene": scene.name, "interrupted": True, **sim.summary()})
+        raise
     except ValueError as exc:  # the run stopped (a particle through a wall, a neck beyond its model): keep what exists
         if writer is not None:
             writer.finish({"scene": scene.name, "stopped": " ".join(str(exc).split()), **sim.summary()})
@@ -127,9 +171,9 @@ def run_moving(scene: Scene, out=None, progress: bool = False) -> RunResult:
         if bar is not None:
             bar.close()
     summary = {"scene": scene.name, "mode": "transient", "physics": list(scene.physics), "static": False, **details}
+    if resume:
+        summary["resumed_from"] = {"t": float(saved["t"]), "steps": int(saved["steps"])}
     if out is not None:
-        from dem import state_file
-
         summary["state"] = state_file.save(sim, pathlib.Path(out) / "state.npz").name
     if scene.particles.n <= T_LIST_MAX:
         summary["T"] = sim.mechanics.state.T.tolist()

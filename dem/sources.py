@@ -113,17 +113,21 @@ class Convection:
 
 @dataclass(frozen=True)
 class Radiation:
-    """``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)``; temperatures in ``unit`` ("K" or "C"), T^4 in kelvin."""
+    """``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)``; temperatures in ``unit`` ("K" or "C", required), T^4 in
+    kelvin."""
 
     emissivity: float
     T_inf: float
     area_fraction: object = EXPOSED
-    unit: str = "K"
+    unit: str | None = None
 
     def __post_init__(self):
         _check_fraction("radiation", self.area_fraction)
         if not (np.isfinite(self.emissivity) and 0 <= self.emissivity <= 1):
             raise ValueError(f"radiation.emissivity = {self.emissivity!r}: must be in [0, 1]")
+        if self.unit is None:
+            raise ValueError("radiation.unit: required: \"K\" or \"C\", the unit of the scene's temperatures (T^4 is "
+                             "taken in kelvin, so 20 C and 20 K radiate very differently)")
         if not isinstance(self.unit, str) or self.unit not in KELVIN_OFFSET:
             raise ValueError(f"radiation.unit = {self.unit!r}: must be one of {', '.join(KELVIN_OFFSET)}")
         if not (np.isfinite(self.T_inf) and 0 <= self.T_inf + KELVIN_OFFSET[self.unit] <= RADIATION_T_MAX):

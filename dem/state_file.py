@@ -24,12 +24,11 @@ PAIR_KEYS = ("pi", "pj", "p_dmax", "p_k1last", "p_xi")
 WALL_KEYS = ("w_dmax", "w_k1last", "w_xi")
 
 
-def save(sim, path) -> pathlib.Path:
-    """Write the state of ``sim`` (a :class:`dem.engine.Simulation`) to ``path`` (``.npz``)."""
+def arrays(sim) -> dict:
+    """The state of ``sim`` (a :class:`dem.engine.Simulation`) as a dict of arrays (what :func:`save` writes; a
+    checkpoint adds the thermal network's temperatures and heat balance)."""
     mech = sim.mechanics
     s = mech.state
-    path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     data = {"format": np.array(FORMAT), "dimension": np.array(s.dimension),
             "height": np.array(np.nan if s.height is None else s.height), "t": np.array(mech.t),
             "steps": np.array(mech.steps), "dt": np.array(mech.dt),
@@ -38,6 +37,19 @@ def save(sim, path) -> pathlib.Path:
     data.update({k: getattr(s, k) for k in PARTICLE_KEYS if hasattr(s, k)})
     data["k1f"] = mech.k1f
     data.update({k: getattr(mech, k) for k in PAIR_KEYS + WALL_KEYS})
+    if sim.thermal is not None:
+        th = sim.thermal
+        data.update(thermal_T=th.T, thermal_rate=th.rate, thermal_energy0=np.array(th.energy0),
+                    heat_keys=np.array(list(th.heat_in), dtype=str),
+                    heat_values=np.array(list(th.heat_in.values()), dtype=float))
+    return data
+
+
+def save(sim, path) -> pathlib.Path:
+    """Write the state of ``sim`` (a :class:`dem.engine.Simulation`) to ``path`` (``.npz``)."""
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    data = arrays(sim)
     tmp = path.with_name(path.name + ".part")
     with tmp.open("wb") as fh:  # written aside, then renamed: an interrupted save never leaves half a state
         np.savez(fh, **data)
@@ -58,6 +70,11 @@ def load(path) -> dict:
     missing = [k for k in PARTICLE_KEYS + PAIR_KEYS + WALL_KEYS if k not in data]
     if missing:
         raise ValueError(f"[start] state = {str(path)!r}: incomplete (no {missing[0]})")
+    return normalised(data)
+
+
+def normalised(data: dict) -> dict:
+    """The scalars and names of a loaded state as Python values."""
     data["height"] = None if not np.isfinite(data["height"]) else float(data["height"])
     data["dimension"] = int(data["dimension"])
     data["wall_names"] = [str(x) for x in data["wall_names"]]

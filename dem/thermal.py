@@ -558,13 +558,54 @@ def _controller_factor(err: float, tol: float, order: int) -> float:
     return min(AUTO_MAX_FACTOR, max(AUTO_MIN_FACTOR, AUTO_SAFETY * (tol / err) ** (1.0 / (order + 1))))
 
 
+@dataclass
+class Checkpoint:
+    """Where :func:`integrate` stands after an accepted step: everything its loop carries, so that a run resumed
+    from it ends bit for bit where the uninterrupted run ends (the linear solvers' warm starts included)."""
+
+    T: np.ndarray
+    t: float
+    steps: int
+    rejected: int
+    units: int
+    dt_want: float
+    heat_in: dict
+    abs_in: float
+    dt_min: float
+    dt_max: float
+    violation: float
+    energy0: float
+    history: list  # the stepper's (T, dt) of the last accepted steps
+
+    def arrays(self) -> dict:
+        """As arrays for ``numpy.savez`` (:meth:`from_arrays` reads them back)."""
+        out = {"T": self.T, "heat_keys": np.array(list(self.heat_in), dtype=str),
+               "heat_values": np.array(list(self.heat_in.values()), dtype=float),
+               "history_T": np.array([h[0] for h in self.history]).reshape(len(self.history), -1),
+               "history_dt": np.array([h[1] for h in self.history], dtype=float)}
+        for key in ("t", "steps", "rejected", "units", "dt_want", "abs_in", "dt_min", "dt_max", "violation",
+                    "energy0"):
+            out[key] = np.array(getattr(self, key))
+        return out
+
+    @classmethod
+    def from_arrays(cls, data: dict) -> "Checkpoint":
+        history = [(data["history_T"][k], float(data["history_dt"][k])) for k in range(len(data["history_dt"]))]
+        heat = {str(k): float(v) for k, v in zip(data["heat_keys"], data["heat_values"])}
+        return cls(np.array(data["T"], dtype=float), float(data["t"]), int(data["steps"]), int(data["rejected"]),
+                   int(data["units"]), float(data["dt_want"]), heat, float(data["abs_in"]), float(data["dt_min"]),
+                   float(data["dt_max"]), float(data["violation"]), float(data["energy0"]), history)
+
+
 def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end: float = 1.0, rtol: float = 1e-3,
               linear: str = "auto", max_steps: int = 1_000_000, observer=None, progress=None,
-              rtol_linear: float = 1e-10) -> TransientResult:
+              rtol_linear: float = 1e-10, resume: Checkpoint | None = None, checkpoint=None) -> TransientResult:
     """Integrate from the particles' initial temperatures to ``t_end`` (module docstring).
 
     ``observer(step, t, T_F, flows)`` is called after every accepted step (and at t = 0 with step 0);
-    ``progress(t)`` reports the simulated time.
+    ``progress(t)`` reports the simulated time. ``checkpoint(make)`` is called after every accepted step and at the
+    end with ``make()`` building the :class:`Checkpoint` (the caller decides how often to build and keep one);
+    ``resume`` starts from such a checkpoint instead of t = 0.
     """
     if integrator not in INTEGRATORS:
         raise ValueError(f"solver.integrator = {integrator!r}: must be one of {', '.join(INTEGRATORS)}")
@@ -628,8 +669,19 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     t, steps, rejected = 0.0, 0, 0
     dt_min, dt_max = math.inf, 0.0
     order = ORDER[theta]
-    if observer is not None:
+    if resume is not None:
+        r = resume
+        T, t, steps, rejected, units, dt_want = r.T.astype(float), r.t, r.steps, r.rejected, r.units, r.dt_want
+        heat_in, abs_in, dt_min, dt_max, violation = dict(r.heat_in), r.abs_in, r.dt_min, r.dt_max, r.violation
+        energy0 = r.energy0
+        stepper.history = [(np.array(h[0]), h[1]) for h in r.history]
+    elif observer is not None:
         observer(0, 0.0, T, net.flows(T, net.sinks(T)))
+
+    def state():
+        return Checkpoint(T.copy(), t, steps, rejected, units, dt_want, dict(heat_in), abs_in, dt_min, dt_max,
+                          violation, energy0, [(h[0].copy(), h[1]) for h in stepper.history])
+
     while t < t_end:
         remaining = t_end - t
         if dyadic:
@@ -698,6 +750,10 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
                                  f"= {max_steps}; raise rtol or max_steps, or shorten t_end")
         if steps >= max_steps and t < t_end:
             raise ValueError(f"more than solver.max_steps = {max_steps} steps before t_end = {t_end:g} s")
+        if checkpoint is not None and t < t_end:
+            checkpoint(state)
+    if checkpoint is not None:
+        checkpoint(state, final=True)
     energy = float(net.C @ T)
     scale_e = float(net.C.sum()) * net.temperature_range() + abs_in
     err = abs(energy - energy0 - sum(heat_in.values())) / scale_e if scale_e > 0 else 0.0

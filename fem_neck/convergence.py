@@ -65,10 +65,12 @@ def levels_count() -> int:
 def mesh_levels(a_over_r: float, progress=None) -> list[dict]:
     """One row per solve of every series (module docstring); ``progress.update()`` after each, if given."""
     from fem_neck import conduction, hpmesh, shapes, spectral
+    from fem_neck.interrupt import where
 
-    levels = []
+    levels, here, total = [], where(), levels_count()
     for label, order, graded, curved in SERIES:
         for step in GRADINGS if graded else UNIFORM_SIZES:
+            here.update(step=f"level {len(levels) + 1} of {total} ({label})")
             sizes = shapes.SizeField(grading=step) if graded else shapes.SizeField(uniform=step)
             profile = shapes.semisphere_mesh(a_over_r, sizes=sizes)
             sol = conduction.solve_profile(profile, order=order, curved=curved)
@@ -83,6 +85,7 @@ def mesh_levels(a_over_r: float, progress=None) -> list[dict]:
     mesh, shape = hpmesh.semisphere_quad_mesh(a_over_r, HP_LEVELS)
     fixed = hpmesh.end_disks(mesh, shape)
     for order in HP_ORDERS:
+        here.update(step=f"level {len(levels) + 1} of {total} ({HP_SERIES}, order {order})")
         sol = spectral.conductance(mesh, order, fixed)
         levels.append({
             "series": HP_SERIES, "order": order, "grading": "geometric", "curved": True,

@@ -4,6 +4,8 @@
   end, the rest uniform in a/r on (0, 0.97] (``0.97 k / m``, k = 1..m), the sampling of Rojek 2022, Fig. 16.
 * :func:`sweep` -- solves every point to the tolerance in a process pool (gmsh is one global, thread-unsafe state
   per process), appending each result to ``fit.csv`` as it arrives so an interrupted run resumes where it stopped.
+  A point is reused only when it was computed by the same solver and method to the same tolerance
+  (:func:`reusable_points`; the CSV records all three); ``run_fit(..., fresh=True)`` recomputes every point.
 * :func:`linear_slope` -- ``K/K_cyl = c a/r`` by least squares through the origin on the uniform points with
   ``a/r <= 0.7`` (Rojek 2022, eq. 40); :func:`slope_sensitivity` shows how c moves with the sampling.
 * :func:`fit_law` -- B, C, E of :class:`fem_neck.law.ConductanceLaw` (A = 5/(4 pi) is derived), least squares on
@@ -12,7 +14,8 @@
   analogue) into one folder.
 
 The FE solver is named by ``"module:function"`` (default :data:`SOLVER`, ``semisphere_conductance(a_over_r,
-rtol)`` returning an object with ``K_over_Kcyl``, ``error_estimate`` and ``dofs``), so worker processes import it.
+rtol, method=...)`` returning an object with ``K_over_Kcyl``, ``error_estimate`` and ``dofs``), so worker processes
+import it; ``method`` (default :data:`METHOD`) is passed to it.
 """
 
 from __future__ import annotations
@@ -31,14 +34,16 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from fem_neck.interrupt import ignore_interrupts, shielded, stop_pool, where
 from fem_neck.law import A_LOG, ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, neck_resistance
 
 SOLVER = "fem_neck.conduction:semisphere_conductance"
+METHOD = "hp"
 X_MAX = 0.97  # the sweep's largest a/r
 X_SMALL = (0.001, 0.02)  # the log-spaced small-neck block
 LINEAR_RANGE = 0.7  # Rojek 2022, Section 5: "up to nearly a/r = 0.7 ... linear"
 PAPER_H_OVER_R = (0.02, 0.08, 0.2, 0.4)  # the four cases of Rojek 2022, Figs. 13-14
-CSV_FIELDS = ("a_over_r", "K_over_Kcyl", "error_estimate", "dofs", "seconds", "rtol", "uniform")
+CSV_FIELDS = ("a_over_r", "K_over_Kcyl", "error_estimate", "dofs", "seconds", "rtol", "uniform", "solver", "method")
 
 
 @dataclass(frozen=True)
@@ -52,6 +57,8 @@ class FitPoint:
     seconds: float
     rtol: float
     uniform: bool  # part of the uniform-in-a/r sampling used by the linear fit
+    solver: str = SOLVER  # "module:function" that solved it
+    method: str = METHOD  # the method passed to the solver
 
 
 def sweep_points(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -76,18 +83,19 @@ def _key(x: float) -> str:
     return f"{x:.12g}"
 
 
-def _solve_point(solver: str, a_over_r: float, rtol: float) -> dict:
+def _solve_point(solver: str, method: str, a_over_r: float, rtol: float) -> dict:
     """Worker: import the solver by name and solve one point (runs in a child process)."""
     module, func = solver.split(":")
     t0 = time.perf_counter()
-    res = getattr(importlib.import_module(module), func)(a_over_r, rtol=rtol)
+    res = getattr(importlib.import_module(module), func)(a_over_r, rtol=rtol, method=method)
     return {"a_over_r": a_over_r, "K_over_Kcyl": float(res.K_over_Kcyl),
             "error_estimate": float(res.error_estimate), "dofs": int(res.dofs),
-            "seconds": time.perf_counter() - t0, "rtol": rtol}
+            "seconds": time.perf_counter() - t0, "rtol": rtol, "solver": solver, "method": method}
 
 
 def read_points(path) -> dict:
-    """Points already in a ``fit.csv`` (for resuming), keyed by a/r."""
+    """Points already in a ``fit.csv``, keyed by a/r (a CSV without solver and method columns -- written before
+    they were recorded -- gives points of unknown provenance: empty ``solver`` and ``method``)."""
     path = pathlib.Path(path)
     if not path.exists():
         return {}
@@ -97,11 +105,25 @@ def read_points(path) -> dict:
             try:
                 p = FitPoint(float(row["a_over_r"]), float(row["K_over_Kcyl"]), float(row["error_estimate"]),
                              int(row["dofs"]), float(row["seconds"]), float(row["rtol"]),
-                             row["uniform"] in ("1", "True", "true"))
+                             row["uniform"] in ("1", "True", "true"), row.get("solver") or "",
+                             row.get("method") or "")
             except (KeyError, ValueError, TypeError):
                 continue  # a half-written last line of an interrupted run
             out[_key(p.a_over_r)] = p
     return out
+
+
+def reusable_points(path, rtol: float, solver: str = SOLVER, method: str = METHOD) -> tuple[dict, int]:
+    """The points of a ``fit.csv`` computed by ``solver`` with ``method`` to exactly ``rtol`` (keyed by a/r), and
+    how many other points the file holds (other solver, method or tolerance: they are not reused)."""
+    points = read_points(path)
+    same = {k: p for k, p in points.items() if (p.solver, p.method, p.rtol) == (solver, method, rtol)}
+    return same, len(points) - len(same)
+
+
+def _csv_row(point: FitPoint) -> list:
+    """Floats in full precision (``repr``), flags as 0/1, names as they are."""
+    return [repr(v) if isinstance(v, float) else v if isinstance(v, str) else int(v) for v in asdict(point).values()]
 
 
 def _append(path: pathlib.Path, point: FitPoint) -> None:
@@ -110,7 +132,7 @@ def _append(path: pathlib.Path, point: FitPoint) -> None:
         w = csv.writer(fh)
         if new:
             w.writerow(CSV_FIELDS)
-        w.writerow([repr(v) if isinstance(v, float) else int(v) for v in asdict(point).values()])
+        w.writerow(_csv_row(point))
 
 
 def _pool_context():
@@ -124,55 +146,75 @@ def in_processes(jobs, workers: int | None = None, *, desc: str = "", progress: 
 
     Processes, not threads: gmsh is one global, thread-unsafe state per process. ``workers`` defaults to all cores;
     one worker (or one job) runs in this process. A tqdm bar on stderr counts ``done`` jobs finished earlier plus
-    these. ``meanwhile()`` runs in a thread of this process once the workers are forked (e.g. importing what the
-    caller needs next, while this process would otherwise only wait).
+    these, and so does the run's :func:`fem_neck.interrupt.where` (its step). Workers ignore Ctrl-C; on an
+    interrupt (or any error, or when the caller stops iterating) the pool is stopped at once. ``meanwhile()`` runs
+    in a thread of this process once the workers are forked (e.g. importing what the caller needs next, while this
+    process would otherwise only wait).
     """
     from tqdm import tqdm
 
+    here = where()
+    label = f"{desc}: " if desc else ""
+    total = done + len(jobs)
+    here.update(step=f"{label}{done} of {total} solves done")
     workers = workers or os.cpu_count() or 1
-    with tqdm(total=done + len(jobs), initial=done, desc=desc, unit="solve", file=sys.stderr,
-              disable=not progress) as bar:
+    with tqdm(total=total, initial=done, desc=desc, unit="solve", file=sys.stderr, disable=not progress) as bar:
         if not jobs:
             return
-        if workers == 1 or len(jobs) == 1:  # no pool to start: fast solves (the hp path) finish before it would
-            for func, args in jobs:
-                result = func(*args)
+        pool = None
+        try:
+            if workers == 1 or len(jobs) == 1:  # no pool to start: fast solves (the hp path) finish before it would
+                results = (func(*args) for func, args in jobs)
+            else:
+                pool = ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=_pool_context(),
+                                           initializer=ignore_interrupts)
+                with shielded():  # the workers are forked here: none can catch the Ctrl-C meant for this process
+                    futures = [pool.submit(func, *args) for func, args in jobs]
+                if meanwhile is not None:
+                    threading.Thread(target=meanwhile, daemon=True).start()
+                results = (fut.result() for fut in as_completed(futures))
+            for result in results:
                 bar.update()
                 yield result
-            return
-        with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=_pool_context()) as pool:
-            futures = [pool.submit(func, *args) for func, args in jobs]  # every worker is started by now
-            if meanwhile is not None:
-                threading.Thread(target=meanwhile, daemon=True).start()
-            for fut in as_completed(futures):
-                bar.update()
-                yield fut.result()
+                done += 1  # counted once the caller has taken it (e.g. written it to a file)
+                here.update(step=f"{label}{done} of {total} solves done")
+        except BaseException:
+            if pool is not None:
+                stop_pool(pool)
+            raise
+        if pool is not None:
+            pool.shutdown()
 
 
 def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int | None = None,
-          solver: str = SOLVER, progress: bool = True, meanwhile=None) -> list[FitPoint]:
+          solver: str = SOLVER, method: str = METHOD, progress: bool = True, reuse=None,
+          meanwhile=None) -> list[FitPoint]:
     """Solve the semisphere at every a/r to ``rtol`` on ``workers`` processes (default: all cores).
 
-    With ``csv_path`` each point is appended to that CSV as soon as it is solved, and points already there with a
-    tolerance at least as tight are reused (resume). ``meanwhile``: see :func:`in_processes`. Returns the points
-    sorted by a/r.
+    ``reuse``: points solved before, keyed by a/r (:func:`reusable_points`); those at the sweep's a/r are kept
+    instead of solved. With ``csv_path`` the CSV is rewritten with the kept points and each new point is appended
+    as soon as it is solved, so an interrupted sweep loses nothing. ``meanwhile``: see :func:`in_processes`.
+    Returns the points sorted by a/r.
     """
     if not (isinstance(rtol, float) and 0.0 < rtol < 0.1):
         raise ValueError(f"rtol = {rtol!r}: must be a float in (0, 0.1)")
     x = np.asarray(a_over_r, dtype=float)
     uniform = np.asarray(uniform, dtype=bool)
     csv_path = pathlib.Path(csv_path) if csv_path is not None else None
-    done = {k: p for k, p in (read_points(csv_path) if csv_path else {}).items() if p.rtol <= rtol}
+    done = reuse or {}
     points = {_key(xi): done[_key(xi)] for xi in x if _key(xi) in done}
     todo = [(float(xi), bool(ui)) for xi, ui in zip(x, uniform) if _key(xi) not in points]
+    here = where()
     if csv_path is not None:  # rewrite the CSV with the reused points only, then append as results arrive
         csv_path.parent.mkdir(parents=True, exist_ok=True)
         csv_path.unlink(missing_ok=True)
         for p in points.values():
             _append(csv_path, p)
+        if points:
+            here.update(out=csv_path.parent)
     if todo:
         importlib.import_module(solver.split(":")[0])  # fail early in the parent, and let fork start warm
-    jobs = [(_solve_point, (solver, xi, rtol)) for xi, _ in todo]
+    jobs = [(_solve_point, (solver, method, xi, rtol)) for xi, _ in todo]
     uniform_of = {_key(xi): ui for xi, ui in todo}
     for res in in_processes(jobs, workers, desc="fit sweep", progress=progress, done=len(points),
                             meanwhile=meanwhile):
@@ -180,6 +222,7 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
         points[_key(p.a_over_r)] = p
         if csv_path is not None:
             _append(csv_path, p)
+            here.update(out=csv_path.parent)
     return sorted(points.values(), key=lambda p: p.a_over_r)
 
 
@@ -300,14 +343,23 @@ def import_plotting() -> None:
 
 
 def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | None = None,
-            solver: str = SOLVER, progress: bool = True, plot_png: bool = True) -> dict:
-    """Sweep, fit and (with ``out``) write fit.json, fit.csv and fit.png; returns the content of fit.json."""
+            solver: str = SOLVER, method: str = METHOD, progress: bool = True, plot_png: bool = True,
+            fresh: bool = False) -> dict:
+    """Sweep, fit and (with ``out``) write fit.json, fit.csv and fit.png; returns the content of fit.json.
+
+    Points of an existing ``out/fit.csv`` solved by the same ``solver`` and ``method`` to the same ``rtol`` are
+    reused unless ``fresh``; ``reused`` in the result says how many (``points``, ``of``, and ``not_matching``: the
+    file's points from other settings, recomputed).
+    """
     t0 = time.perf_counter()
     x, uniform = sweep_points(n_points)
     out = pathlib.Path(out) if out is not None else None
     csv_path = out / "fit.csv" if out is not None else None
-    points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, progress=progress,
+    reuse, other = reusable_points(csv_path, rtol, solver, method) if csv_path and not fresh else ({}, 0)
+    points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, method=method,
+                   progress=progress, reuse=reuse,
                    meanwhile=import_plotting if out is not None and plot_png else None)
+    reused = sum(_key(xi) in reuse for xi in x)
     xa = np.array([p.a_over_r for p in points])
     fa = np.array([p.K_over_Kcyl for p in points])
     um = np.array([p.uniform for p in points])
@@ -325,6 +377,8 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
         "law": {**law.to_dict(), "table": law.table(200)},
         "paper": {"rojek_eq40": ROJEK.slope, "argento_bouvard_eq42": ARGENTO_BOUVARD.slope},
         "solver": solver,
+        "method": method,
+        "reused": {"points": reused, "of": len(x), "not_matching": other},
         "cpu_seconds": float(sum(p.seconds for p in points)),
         "seconds": time.perf_counter() - t0,
     }
@@ -335,12 +389,11 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
             w = csv.writer(fh)
             w.writerow(CSV_FIELDS + ("law", "law_rel_residual"))
             for p, r in zip(points, resid):
-                w.writerow([repr(v) if isinstance(v, float) else int(v) for v in asdict(p).values()]
-                           + [repr(float(p.K_over_Kcyl * (1 + r))), repr(float(r))])
+                w.writerow(_csv_row(p) + [repr(float(p.K_over_Kcyl * (1 + r))), repr(float(r))])
         if plot_png:
             plot(points, slope, law, out / "fit.png")
     return result
 
 
-__all__ = ["FitPoint", "SOLVER", "fit_law", "import_plotting", "in_processes", "linear_slope", "plot", "read_points",
-           "run_fit", "slope_sensitivity", "sweep", "sweep_points"]
+__all__ = ["FitPoint", "METHOD", "SOLVER", "fit_law", "import_plotting", "in_processes", "linear_slope", "plot",
+           "read_points", "reusable_points", "run_fit", "slope_sensitivity", "sweep", "sweep_points"]

@@ -95,13 +95,19 @@ def test_magnitudes_outside_the_documented_range(tmp_path, capsys, kwargs, needl
     ("[1e6, 300.0]", "300.0", "temperature[0]"),
 ])
 def test_radiation_temperatures_beyond_the_model(tmp_path, capsys, T, T_inf, needle):
-    rad = f"[radiation]\nemissivity = 1.0\nT_inf = {T_inf}\n"
+    rad = f"[radiation]\nemissivity = 1.0\nT_inf = {T_inf}\nunit = \"K\"\n"
     refuse_scene(tmp_path, scene(T=T, extra=rad, solver=STEADY), capsys, needle, "10000")
+
+
+def test_radiation_without_a_temperature_unit_is_refused(tmp_path, capsys):
+    """20 C and 20 K radiate very differently: a scene with radiation must say which it means."""
+    rad = "[radiation]\nemissivity = 1.0\nT_inf = 20.0\n"
+    refuse_scene(tmp_path, scene(T="[300.0, 300.0]", extra=rad, solver=STEADY), capsys, "radiation", "unit")
 
 
 def test_radiation_at_the_range_limit_balances(tmp_path, capsys):
     """A particle fixed at 1e4 K radiating, its neighbour between: steady answer with a closed energy balance."""
-    rad = "[radiation]\nemissivity = 1.0\nT_inf = 300.0\n"
+    rad = "[radiation]\nemissivity = 1.0\nT_inf = 300.0\nunit = \"K\"\n"
     code, out, _ = run_scene(tmp_path, scene(T="[1e4, 300.0]", extra=rad + "", solver=STEADY)
                              .replace("temperature = [1e4, 300.0]\n", "temperature = [1e4, 300.0]\nfixed = [true, false]\n"),
                              capsys)

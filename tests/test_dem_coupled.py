@@ -93,3 +93,19 @@ def test_overlap_beyond_the_neck_model_is_named():
     pos[1][2] = pos[0][2] + 1.2e-3  # overlap 0.8 mm > 2r/3
     with pytest.raises(ValueError, match="particles 0 and 1.*h = 0.000795"):
         Simulation(parse_scene(doc)).run()
+
+
+def test_cooling_by_the_network_freezes_the_contacts():
+    """Hot particles on a cold floor: the network cools them, the mechanics sees the temperature fall (the rate of
+    the network's last step) and the stiffness factor follows k1(T) at once (the rapid freeze of Sec. 3.4), instead
+    of relaxing with t0."""
+    doc = pile(t_end=0.01, hot=20.0)
+    doc["particles"]["temperature"] = [150.0] * len(doc["particles"]["temperature"])
+    doc["contact"]["t0"] = 1e6  # relaxing would take for ever: only the freeze can raise the factor
+    sim = Simulation(parse_scene(doc))
+    start = sim.mechanics.k1f.copy()
+    sim.run()
+    assert np.all(sim.thermal.rate <= 0.0) and np.any(sim.thermal.rate < 0.0)
+    cooled = sim.mechanics.state.T < 149.0
+    assert np.any(cooled)
+    assert np.all(sim.mechanics.k1f[cooled] > start[cooled])

@@ -301,3 +301,45 @@ def test_phases_switch_the_friction_on():
     sim.run()
     s = sim.mechanics.state
     assert s.w[0, 1] > 0 and abs(s.w[0, 1] * r / s.v[0, 0]) > 0.5
+
+
+def test_min_image_is_the_wrapping_formula_to_the_bit():
+    """The shortcut for separations below a quarter of the box (no division, no floor) changes no bit."""
+    from dem.neighbours import min_image
+
+    rng = np.random.default_rng(7)
+    length = 3.7e-3
+    quarter = 0.25 * length
+    d = np.concatenate([rng.uniform(-3 * length, 3 * length, 2000), rng.uniform(-1e-9, 1e-9, 200),
+                        np.nextafter(quarter, 0.0) * np.array([1.0, -1.0]), [quarter, -quarter, 0.5 * length,
+                                                                              -0.5 * length, 0.0, -0.0]])
+    expected = d - length * np.floor(d / length + 0.5)
+    got = np.array([min_image(float(x), length) for x in d])
+    assert np.array_equal(got.view(np.int64), expected.view(np.int64))
+    assert min_image(5.0, 0.0) == 5.0  # not periodic: unchanged
+
+
+@pytest.mark.parametrize("box", [(0.0, 0.0, 0.0), (8e-3, 0.0, 6e-3), (8e-3, 8e-3, 8e-3)])
+def test_verlet_list_is_every_close_pair_sorted_whatever_room_it_is_given(box):
+    """The cell-binned list against all pairs by brute force (minimum image on periodic axes), in (i, j) order, for
+    a capacity too small (second pass), exact and too large; history carried by matching pairs."""
+    from dem.neighbours import carry_history, verlet_pairs
+
+    rng = np.random.default_rng(11)
+    box = np.array(box)
+    x = rng.uniform(0.0, 8e-3, (150, 3))
+    r = rng.uniform(0.3e-3, 0.8e-3, 150)
+    skin = 2e-4
+    d = x[:, None, :] - x[None, :, :]
+    d -= np.where(box > 0, box, 1.0) * np.round(d / np.where(box > 0, box, np.inf))
+    close = np.linalg.norm(d, axis=2) < r[:, None] + r[None, :] + skin
+    i_ref, j_ref = np.nonzero(np.triu(close, k=1))  # row-major: sorted by (i, j)
+    assert len(i_ref) > 50
+    for capacity in (0, len(i_ref) // 3, len(i_ref), 2 * len(i_ref)):
+        i, j = verlet_pairs(x, r, skin, box, capacity)
+        assert np.array_equal(i, i_ref) and np.array_equal(j, j_ref), capacity
+    keep = rng.random(len(i_ref)) < 0.7  # an older list: some of these pairs, and one that is gone
+    old_i, old_j = np.append(i_ref[keep], 149), np.append(j_ref[keep], 149)
+    history = np.arange(len(old_i), dtype=float) + 1.0
+    (carried,) = carry_history(old_i, old_j, i_ref, j_ref, history)
+    assert np.array_equal(carried[keep], history[:-1]) and np.all(carried[~keep] == 0.0)

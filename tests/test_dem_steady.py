@@ -80,7 +80,7 @@ def test_convection_and_radiation_steady():
     conv = Sources(convection=Convection(1e4, 20.0, area_fraction=1.0))  # the whole surface, opted in
     res = run(make_scene(x, r, [500.0, 0.0], fixed=[True, False], sources=conv, mode="steady"))
     assert res.T[1] == pytest.approx((K * 500 + 1e4 * A * 20) / (K + 1e4 * A), rel=1e-12)
-    rad = Sources(radiation=Radiation(0.8, 300.0, area_fraction=1.0))
+    rad = Sources(radiation=Radiation(0.8, 300.0, area_fraction=1.0, unit="K"))
     res = run(make_scene(x, r, [1500.0, 0.0], fixed=[True, False], sources=rad, mode="steady"))
     f = lambda T: K * (1500 - T) - 0.8 * STEFAN_BOLTZMANN * A * (T**4 - 300.0**4)
     assert res.T[1] == pytest.approx(brentq(f, 300, 1500, xtol=1e-13), rel=1e-12)

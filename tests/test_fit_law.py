@@ -1,5 +1,6 @@
 """The conductance laws (fem_neck.law) and the fit (fem_neck.fit): limits, reference values, the fit machinery."""
 
+import csv
 import json
 
 import numpy as np
@@ -136,9 +137,55 @@ def test_small_fit_run_writes_files_and_resumes(tmp_path):
         law.ConductanceLaw.from_dict(on_disk["law"]).k_over_kcyl(0.5))
     for x, k in REFERENCE:  # even an 8-point fit interpolates the reference values well
         assert law.ConductanceLaw.from_dict(on_disk["law"]).k_over_kcyl(x) == pytest.approx(k, rel=5e-3)
-    # resume: every point is read back from fit.csv, so a solver that cannot even be imported is never called
-    again = fit.run_fit(8, 1e-4, out, solver="no_such_module:f", progress=False, plot_png=False)
-    assert again["points"] == first["points"]
+    assert first["reused"] == {"points": 0, "of": 8, "not_matching": 0}
+
+
+def _tamper(csv_path, factor):
+    """Scale every K/K_cyl in a fit.csv by ``factor``: a reused point then shows it, a recomputed one does not."""
+    rows = list(csv.DictReader(csv_path.open(newline="")))
+    for row in rows:
+        row["K_over_Kcyl"] = repr(float(row["K_over_Kcyl"]) * factor)
+    with csv_path.open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    return rows
+
+
+def test_fit_reuses_only_points_of_the_same_solver_and_tolerance(tmp_path, capsys):
+    out = tmp_path / "fit"
+    first = fit.run_fit(6, 1e-4, out, workers=1, progress=False, plot_png=False)
+    truth = np.array(first["points"])
+    _tamper(out / "fit.csv", 2.0)
+    # same solver, method and tolerance: all six are reused (the tampered values come back)
+    again = fit.run_fit(6, 1e-4, out, workers=1, progress=False, plot_png=False)
+    assert again["reused"] == {"points": 6, "of": 6, "not_matching": 0}
+    assert np.allclose(np.array(again["points"])[:, 1], 2.0 * truth[:, 1], rtol=1e-15)
+    # another tolerance or method: nothing is reused, every point is solved again
+    for options in ({"rtol": 1e-5}, {"method": "gmsh"}):
+        _tamper(out / "fit.csv", 2.0)
+        rtol = options.get("rtol", 1e-4)
+        other = fit.run_fit(6, rtol, out, workers=1, progress=False, plot_png=False, method=options.get("method", "hp"))
+        assert other["reused"] == {"points": 0, "of": 6, "not_matching": 6}
+        assert np.allclose(np.array(other["points"])[:, 1], truth[:, 1], rtol=1e-4)
+    # an older fit.csv without solver and method columns: provenance unknown, not reused
+    rows = _tamper(out / "fit.csv", 1.0)
+    with (out / "fit.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=[k for k in rows[0] if k not in ("solver", "method")], extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    assert fit.run_fit(6, 1e-4, out, workers=1, progress=False, plot_png=False)["reused"]["points"] == 0
+    # the CLI says it on stderr, keeps stdout one JSON object, and --fresh recomputes
+    _tamper(out / "fit.csv", 2.0)
+    assert main(["fit", "--points", "6", "--workers", "1", "--out", str(out), "--json"]) == 0
+    cap = capsys.readouterr()
+    assert json.loads(cap.out)["reused"] == {"points": 6, "of": 6, "not_matching": 0}
+    assert "reused 6 of 6 points from fit.csv; --fresh recomputes\n" in cap.err
+    assert main(["fit", "--points", "6", "--workers", "1", "--out", str(out), "--json", "--fresh"]) == 0
+    cap = capsys.readouterr()
+    fresh = json.loads(cap.out)
+    assert fresh["reused"]["points"] == 0 and "reused" not in cap.err
+    assert np.allclose(np.array(fresh["points"])[:, 1], truth[:, 1], rtol=1e-12)
 
 
 def test_cli_rejects_bad_input(capsys):

@@ -12,7 +12,8 @@ Run time against error is ``python -m benchmarks``; the stress cases are tests (
 ``--quick`` runs reduced versions (``all --quick`` in under 3 minutes on 2 cores). ``--json`` prints the content of
 ``summary.json`` (comparison name -> relative error) as one object and nothing else on stdout. Progress goes to
 stderr. Exit code: 0 when every section ran, 1 when a section failed (its one-line error on stderr, its traceback
-in ``DIR/<section>/error.txt``), 2 for bad options.
+in ``DIR/<section>/error.txt``), 2 for bad options, 130 after Ctrl-C (one line on stderr naming the section; the
+report keeps the finished sections, :mod:`fem_neck.interrupt`).
 """
 
 from __future__ import annotations
@@ -46,7 +47,19 @@ def build_parser() -> OneLineParser:
 
 
 def main(argv=None) -> int:
+    from fem_neck.interrupt import Where, run_command
+
+    here = Where(PROG)
+    return run_command(here, _main, argv, here)
+
+
+def _main(argv, here) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    command = next((a for a in argv if a in COMMANDS), None)
+    if command is not None:  # named early, for an interrupt that comes before parsing ends
+        here.command = f"{PROG} {command}"
     args = build_parser().parse_args(argv)
+    here.command = f"{PROG} {args.command}"
     out = prepare_out(f"{PROG} {args.command}", args.out)
     if out is None:
         return 2
@@ -59,4 +72,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from fem_neck.interrupt import exit_process
+
+    exit_process(main())

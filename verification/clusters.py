@@ -21,8 +21,12 @@ much that choice alone costs.
 
 Measured: the effective conductance ``K = Q/(T_hot - T_cold)`` and each free particle's mean temperature (volume
 average over the particle's own share, ``4/3 pi r^3``), FE against the DEM steady network for each conductance law.
-The FE error bar is the change between two mesh levels (full run). The error map puts the per-particle temperature
-error against the particle's coordination number and its mean neck size a/r.
+The FE error bar (full run) comes from three mesh levels, every size 1.6x apart
+(:func:`fem_neck.cluster.cluster_conductance`, :func:`fem_neck.accuracy.mesh_sequence_estimate`): the last change
+over the slower of the observed and the neck-corner convergence rate, times 1.25. Checked against axisymmetric
+chains and pairs (``tests/test_cluster.py``), it covers the true FE error of K by 1.2-3.2x and that of the
+particle mean temperatures by 2.2-6.2x. A network error is *resolved* when it exceeds the FE error. The error map puts the per-particle temperature error against
+the particle's coordination number and its mean neck size a/r.
 
 The pseudo-law ``fe-pair`` gives every pipe the axisymmetric FE conductance of its own pair
 (``fem_neck.conduction.pair_conductance``, between equatorial disks): no law error is left, so its error is that of
@@ -38,15 +42,15 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from fem_neck.cluster import Cluster, Terminal, build_cluster_mesh, solve_cluster
+from fem_neck.cluster import Cluster, Terminal, cluster_conductance
 from fem_neck.geometry import overlap_for_neck
+from fem_neck.interrupt import where
 from verification.report import save_figure
 
 KAPPA = 394.0
 R0 = 1.0e-3
-MESH_QUICK = {"size_neck": 0.3, "size_far": 0.5, "curvature": 12, "neck_cells": 0.5}
-MESH_LEVELS = ({"size_neck": 0.3, "size_far": 0.5, "curvature": 12, "neck_cells": 1.0},
-               {"size_neck": 0.2, "size_far": 0.35, "curvature": 16, "neck_cells": 2.0})
+MESH_QUICK = {"size_neck": 0.3, "size_far": 0.5, "curvature": 12, "neck_cells": 0.5, "levels": 1}
+MESH_FULL = {"size_neck": 0.2, "size_far": 0.35, "curvature": 16, "neck_cells": 2.0, "levels": 3}  # finest level
 
 
 @dataclass(frozen=True)
@@ -274,21 +278,16 @@ def dem_steady(cluster: Cluster, terminals, law: str) -> tuple[float, np.ndarray
 
 
 def fe_solve(case: Case, quick: bool) -> dict:
-    """FE of one case: ``K`` and particle means on the finest level, and the change from the level before."""
-    levels = (MESH_QUICK,) if quick else MESH_LEVELS
-    out = {}
+    """FE of one case: ``K`` and particle means on the finest level, with their error estimates (full run)."""
     t0 = time.perf_counter()
-    for opts in levels:
-        cmesh = build_cluster_mesh(case.cluster, case.terminals, **opts)
-        sol = solve_cluster(cmesh, kappa=KAPPA, order=2)
-        if out:
-            out["mesh_change"] = abs(sol.K - out["K"]) / sol.K
-            out["T_change"] = float(np.max(np.abs(sol.particle_T - out["T"])))
-        out.update(K=sol.K, T=sol.particle_T, dofs=sol.dofs, cmesh=cmesh, sol=sol)
-    out.setdefault("mesh_change", float("nan"))
-    out.setdefault("T_change", float("nan"))
-    out["seconds"] = time.perf_counter() - t0
-    return out
+    res = cluster_conductance(case.cluster, case.terminals, kappa=KAPPA, **(MESH_QUICK if quick else MESH_FULL))
+    nan = float("nan")
+    return {"K": res.K, "T": res.particle_T, "dofs": res.solution.dofs, "cmesh": res.cmesh, "sol": res.solution,
+            "error": nan if res.error_estimate is None else res.error_estimate,
+            "T_error": nan if res.T_error_estimate is None else res.T_error_estimate,
+            "observed_order": nan if res.sequence is None or res.sequence.observed_order is None
+            else res.sequence.observed_order,
+            "seconds": time.perf_counter() - t0}
 
 
 def particle_neck_ratio(cluster: Cluster) -> np.ndarray:
@@ -309,8 +308,8 @@ def compare(case: Case, fe: dict, names: tuple) -> tuple[dict, list]:
     a = cl.necks().a
     row = {"case": case.name, "family": case.family, "n": cl.n, "bonds": len(i),
            "a_over_r_mean": float(np.mean(a / np.minimum(cl.radii[i], cl.radii[j]))),
-           "z_max": int(cl.degree().max()), "K_fe": fe["K"], "fe_mesh_change": fe["mesh_change"],
-           "fe_T_change": fe["T_change"], "dofs": fe["dofs"], "fe_seconds": fe["seconds"], "laws": {}}
+           "z_max": int(cl.degree().max()), "K_fe": fe["K"], "fe_error": fe["error"], "fe_T_error": fe["T_error"],
+           "fe_observed_order": fe["observed_order"], "dofs": fe["dofs"], "fe_seconds": fe["seconds"], "laws": {}}
     particles = []
     z = cl.degree()
     ratio = particle_neck_ratio(cl)
@@ -326,15 +325,35 @@ def compare(case: Case, fe: dict, names: tuple) -> tuple[dict, list]:
 
 
 def _table(rows, names) -> str:
-    head = ("| cluster | n | bonds | z max | mean a/r | K_FE (W/K) | FE mesh change | "
-            + " | ".join(f"K {law} rel. err" for law in names) + " | "
+    """One row per cluster: the FE K with its error estimate, each law's K error with the FE error beside it
+    (``±``), and the largest particle-temperature error with the FE's own temperature error estimate."""
+    head = ("| cluster | n | bonds | z max | mean a/r | K_FE (W/K) | FE error | "
+            + " | ".join(f"K {law} rel. err" for law in names) + " | FE T error | "
             + " | ".join(f"max abs dT {law}" for law in names) + " |")
-    lines = [head, "|" + "---|" * (7 + 2 * len(names))]
+    lines = [head, "|" + "---|" * (8 + 2 * len(names))]
     for r in rows:
+        known = np.isfinite(r["fe_error"])  # not in a quick run (one mesh level)
+        pm = f" ± {r['fe_error']:.2%}" if known else ""
+        fe_K = f"{r['fe_error']:.2%}" if known else "—"
+        fe_T = f"{r['fe_T_error']:.4f}" if known else "—"
         lines.append(f"| {r['case']} | {r['n']} | {r['bonds']} | {r['z_max']} | {r['a_over_r_mean']:.3f} | "
-                     f"{r['K_fe']:.5g} | {r['fe_mesh_change']:.1e} | "
-                     + " | ".join(f"{r['laws'][law]['K_rel_err']:+.2%}" for law in names) + " | "
+                     f"{r['K_fe']:.5g} | {fe_K} | "
+                     + " | ".join(f"{r['laws'][law]['K_rel_err']:+.2%}{pm}" for law in names) + " | "
+                     + f"{fe_T} | "
                      + " | ".join(f"{r['laws'][law]['T_max_err']:.3f}" for law in names) + " |")
+    return "\n".join(lines)
+
+
+def conclusions(rows, law: str = NETWORK_ONLY) -> str:
+    """Per family: the range of ``law``'s K error, the largest FE error beside it, and how many of the clusters'
+    errors the FE resolves (error larger than the FE's own estimate)."""
+    lines = [f"| family | K {law} rel. err (range) | FE error (largest) | resolved |", "|---|---|---|---|"]
+    for fam in dict.fromkeys(r["family"] for r in rows):
+        sel = [r for r in rows if r["family"] == fam]
+        err = [r["laws"][law]["K_rel_err"] for r in sel]
+        fe = [r["fe_error"] for r in sel]
+        resolved = sum(abs(e) > f for e, f in zip(err, fe))
+        lines.append(f"| {fam} | {min(err):+.2%} … {max(err):+.2%} | {max(fe):.2%} | {resolved} of {len(sel)} |")
     return "\n".join(lines)
 
 
@@ -371,8 +390,9 @@ def _figures(rows, particles, out_dir: pathlib.Path, names) -> list:
         for fam, mk in markers.items():
             sel = [r for r in rows if r["family"] == fam]
             if sel:
-                ax.plot([r["a_over_r_mean"] for r in sel], [100 * r["laws"][law]["K_rel_err"] for r in sel],
-                        mk, label=fam, ms=8)
+                fe = [100 * r["fe_error"] for r in sel]  # NaN in a quick run: no bar drawn
+                ax.errorbar([r["a_over_r_mean"] for r in sel], [100 * r["laws"][law]["K_rel_err"] for r in sel],
+                            yerr=fe, fmt=mk, label=fam, ms=8, capsize=3)
         sel = [r for r in rows if "centre balls" in r["family"]]
         if sel:
             ax.plot([r["a_over_r_mean"] for r in sel], [100 * r["laws"][law]["K_rel_err"] for r in sel],
@@ -381,7 +401,7 @@ def _figures(rows, particles, out_dir: pathlib.Path, names) -> list:
         ax.set_title(f"law: {law}")
         ax.set_xlabel("mean neck size a/r")
         ax.grid(alpha=0.3)
-    axes[0].set_ylabel("K_DEM / K_FE - 1  (%)")
+    axes[0].set_ylabel("K_DEM / K_FE - 1  (%), bars: FE error")
     axes[0].legend(fontsize=7)
     fig.tight_layout()
     figs.append(save_figure(fig, out_dir / "clusters_K_error.png"))
@@ -439,13 +459,16 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
     out_dir.mkdir(parents=True, exist_ok=True)
     rows, particles, summary = [], [], {}
     last_random = None
-    for case in tqdm(all_cases(quick), desc="3D clusters", unit="cluster", leave=False):
+    cases = all_cases(quick)
+    for k, case in enumerate(tqdm(cases, desc="3D clusters", unit="cluster", leave=False)):
+        where().update(step=f"cluster {k + 1} of {len(cases)} ({case.name})")
         fe = fe_solve(case, quick)
         row, parts = compare(case, fe, names)
         rows.append(row)
         particles += parts
         summary[f"cluster {case.name}"] = {
-            "K_fe": row["K_fe"], **{f"K_rel_err_{law}": row["laws"][law]["K_rel_err"] for law in names},
+            "K_fe": row["K_fe"], "K_fe_error_estimate": row["fe_error"],
+            **{f"K_rel_err_{law}": row["laws"][law]["K_rel_err"] for law in names},
             **{f"T_max_err_{law}": row["laws"][law]["T_max_err"] for law in names}}
         if case.family == "random":
             last_random = (case, fe)
@@ -457,12 +480,22 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
     worst = {law: max(abs(r["laws"][law]["K_rel_err"]) for r in rows if "centre balls" not in r["family"])
              for law in names}
     summary.update({f"clusters worst K rel err {law}": worst[law] for law in names})
+    if not quick:
+        summary["clusters worst FE error estimate"] = max(r["fe_error"] for r in rows)
     md = [__doc__.split("\n\n", 1)[1].strip(), "",
           "Relative errors are DEM minus FE over FE; temperature errors are in units of the imposed difference "
           "(1 K). FE: P2 on curved tetrahedra, "
-          + ("one mesh level (quick)." if quick else "two mesh levels; the change between them is the FE error bar."),
-          "", _table(rows, names), "",
-          "### Error map: RMS particle-temperature error by coordination number and neck size", ""]
+          + ("one mesh level (quick: no FE error estimate)." if quick else
+             "three mesh levels; the FE error estimate of K stands beside every K error (±), that of the particle "
+             "temperatures in the column FE T error."),
+          "", _table(rows, names), ""]
+    if not quick:
+        md += ["### The network error against the FE error", "",
+               f"Law `{NETWORK_ONLY}` (every pipe its own FE pair conductance: what is left is the network's error). "
+               "A network error is resolved when it exceeds the FE error. The FE K converges from above (in every "
+               "check against axisymmetric pairs and chains), so against the exact solution the network error lies "
+               "between the listed value and that value plus the FE error.", "", conclusions(rows), ""]
+    md += ["### Error map: RMS particle-temperature error by coordination number and neck size", ""]
     for law in [x for x in (NETWORK_ONLY, "fit", "rojek") if x in names]:
         md += [f"Law `{law}`:", "", error_map(particles, law), ""]
     md += [f"![K error]({figures[0].name})", "", f"![T error map]({figures[1].name})", ""]

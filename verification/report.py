@@ -13,8 +13,9 @@ are written relative to that sub-folder; the report rebases the links, so every 
 resolves from the report's own folder, and each figure appears once (those the markdown does not show are appended
 to the section). A section's *status* is ``ok``; ``fail`` when one of its targets (:meth:`Section.target`, e.g. a
 time limit) is missed; ``error`` when it raised (its one-line message in the status, its traceback in
-``<section>/error.txt``); ``not available`` when its module is absent. Commands exit with 1 when any section is
-``fail`` or ``error``.
+``<section>/error.txt``); ``not available`` when its module is absent; ``interrupted`` when Ctrl-C stopped it (the
+finished sections stay in the files, and the run ends: :mod:`fem_neck.interrupt`). Commands exit with 1 when any
+section is ``fail`` or ``error``.
 
 :func:`add_run_options`, :func:`prepare_out` and :func:`print_report` are the options, output folder and printout
 the two commands share.
@@ -49,7 +50,8 @@ import numpy as np
 from fem_neck.cli import print_result
 
 CONTRACT_KEYS = ("title", "markdown", "summary", "figures")
-OK, FAIL, ERROR, NOT_AVAILABLE, RUNNING = "ok", "fail", "error", "not available", "running"
+OK, FAIL, ERROR, NOT_AVAILABLE, RUNNING, INTERRUPTED = "ok", "fail", "error", "not available", "running", \
+    "interrupted"
 PASS, NOT_MEASURED = "pass", "not measured"
 IMAGE_LINK = re.compile(r"!\[([^\]]*)\]\(([^)\s]+)\)")
 
@@ -129,12 +131,22 @@ class Section:
     def running(self):
         """Time the body; an exception is recorded (``error``, traceback in ``error.txt``), not raised; at the end
         the status is ``fail`` if a target was missed, else ``ok``. The report is rewritten."""
+        from fem_neck.interrupt import where
+
         t0 = time.perf_counter()
         self.status = RUNNING
         self.flush()
         try:
             yield self
+        except KeyboardInterrupt:
+            self.status, self.error = INTERRUPTED, "interrupted (Ctrl-C)"
+            where().update(out=self.out_dir.parent)
+            raise
         except Exception as exc:  # a failing section is reported and the run goes on
+            if where().signalled:  # not a failure: an interrupt that C code turned into this error
+                self.status, self.error = INTERRUPTED, "interrupted (Ctrl-C)"
+                where().update(out=self.out_dir.parent)
+                raise KeyboardInterrupt from exc
             self.status = ERROR
             self.error = f"{type(exc).__name__}: {exc}".splitlines()[0]
             (self.folder() / "error.txt").write_text(traceback.format_exc())
@@ -354,11 +366,16 @@ def run_sections(names, out_dir: pathlib.Path, command: str, quick: bool = False
     """Run the verification sections ``names`` in order into ``out_dir``; the report is rewritten as they go."""
     from tqdm import tqdm
 
+    from fem_neck.interrupt import where
+
     report = Report(out_dir, command, quick)
+    here = where()
     bar = tqdm(names, desc="verification", unit="section", file=sys.stderr, disable=not progress)
-    for name in bar:
+    for k, name in enumerate(bar):
         bar.set_postfix_str(name)
+        here.update(stage=f"section {name}", step=f"{k} of {len(names)} sections done")
         section = run_section(name, report.out_dir, quick, options, report=report)
+        here.update(out=report.out_dir)
         if section.status != OK:
             bar.write(f"python -m verification {command}: {name}: {section.status}: {section.error}", file=sys.stderr)
     return report

@@ -1,4 +1,11 @@
-"""``python -m dem run SCENE [--out DIR] [--json]``: run a scene (TOML path or built-in name), print its summary."""
+"""``python -m dem run SCENE [--out DIR [--resume | --overwrite]] [--json]``: run a scene (TOML path or built-in
+name), print its summary.
+
+With ``--out`` the run writes its folder as it goes (``dem.run_folder``): a folder that holds a run already is
+refused unless ``--resume`` (go on from its last checkpoint, written every few seconds: a run with a fixed step ends
+bit for bit as if it had not stopped) or ``--overwrite`` (delete that run's files first). Ctrl-C stops the run with
+one line saying where, leaving the folder usable and resumable.
+"""
 
 from fem_neck.cli import add_output_options
 
@@ -7,6 +14,8 @@ def register(sub):
     parser = sub.add_parser("run", help="run a scene (TOML file or built-in name)", description=__doc__)
     parser.add_argument("scene", help="path to a scene TOML file, or a built-in name (see `python -m dem scenes`)")
     add_output_options(parser)
+    parser.add_argument("--resume", action="store_true", help="go on with the interrupted run in --out")
+    parser.add_argument("--overwrite", action="store_true", help="delete the run already in --out first")
     parser.set_defaults(run=run)
 
 
@@ -16,7 +25,7 @@ def run(args) -> dict:
 
     try:
         scene = load_scene(args.scene)
-        return run_scene(scene, args.out, progress=True).summary
+        return run_scene(scene, args.out, progress=True, resume=args.resume, overwrite=args.overwrite).summary
     except MemoryError:
         raise ValueError(f"scene = {args.scene!r}: out of memory (about 1.7 GiB per 10^6 particles for a steady "
                          f"solve); use a smaller scene") from None

@@ -5,7 +5,9 @@ parser and sets ``run``: a function of the parsed arguments returning a JSON-rea
 dict (``--json``: one object on stdout, nothing else), turns a ``ValueError`` into one line on stderr with exit code
 2, and never shows a traceback for bad input (an ``OSError``, e.g. ``--out`` naming a file, is treated the same).
 Warnings raised while a command runs (e.g. numpy overflow in an extreme input) are collected: after an error only
-the one error line is printed; after success each distinct warning is one ``warning:`` line on stderr.
+the one error line is printed; after success each distinct warning is one ``warning:`` line on stderr. Ctrl-C ends
+any command with one line saying where it stopped and exit code 130 (:mod:`fem_neck.interrupt`); commands report
+their progress with ``fem_neck.interrupt.where().update(...)``.
 """
 
 from __future__ import annotations
@@ -118,14 +120,30 @@ def build_parser(prog: str, description: str, modules, package: str) -> argparse
 
 def main(argv=None, *, prog="python -m fem_neck", description=None, modules=COMMAND_MODULES,
          package="fem_neck.cli") -> int:
+    from fem_neck.interrupt import Where, run_command
+
+    here = Where(prog)
+    return run_command(here, _main, argv, here, prog, description, modules, package)
+
+
+def _main(argv, here, prog, description, modules, package) -> int:
+    named = next((a for a in (sys.argv[1:] if argv is None else argv) if a in modules), None)
+    if named is not None:  # the command's name, for an interrupt that comes before parsing ends
+        here.command = f"{prog} {named}"
     parser = build_parser(prog, description or __doc__.splitlines()[0], modules, package)
     args = parser.parse_args(argv)
+    here.command = f"{prog} {args.command}"
+    here.update(stage=args.command)
     with warnings.catch_warnings(record=True) as caught:
         try:
             result = args.run(args)
         except (ValueError, OSError) as exc:  # bad input, or an output path that cannot be written
+            if here.signalled:  # not bad input: an interrupt that C code turned into this error
+                raise
             sys.stderr.write(f"{prog} {args.command}: error: {_one_line(exc)}\n")
             return 2
+    if here.signalled:  # the command finished, but the user asked it to stop: no result is printed
+        raise KeyboardInterrupt
     for text in dict.fromkeys(f"{w.category.__name__}: {_one_line(w.message)}" for w in caught):
         sys.stderr.write(f"{prog} {args.command}: warning: {text}\n")
     print_result(result, args.json)

@@ -14,9 +14,11 @@ MAX_SECONDS = 300.0
 
 def estimate_seconds(n: int, size_neck: float, size_far: float, levels: int) -> float:
     """Rough run time (s) of a cluster solve on 2 cores: per particle ~0.75 s x ((0.25/size_far)^2.2 +
-    (0.12/size_neck)^2); the coarser level of ``--levels 2`` adds about 40 %."""
+    (0.12/size_neck)^2) for the finest level; the coarser levels (sizes x1.6, x2.56) add about 35 % and 12 %."""
     per_level = 0.75 * n * ((0.25 / size_far) ** 2.2 + (0.12 / size_neck) ** 2)
-    return per_level * (1.4 if levels == 2 else 1.0)
+    return per_level * (1.0, 1.35, 1.5)[levels - 1]
+
+
 TERMINAL_KEYS = {"particle", "T", "kind", "rho"}
 
 
@@ -30,7 +32,9 @@ def register(subparsers) -> None:
         '"kind": "plane"}, {"particle": m, "T": 0.0, "kind": "core", "rho": 0.25}]} (SI units). A "plane" terminal '
         "(one-bond particles only) is cut at its centre plane normal to its bond, a \"core\" terminal holds a "
         "centre ball of radius rho*r. Output: K = Q/(T_hot - T_cold) in W/K and each particle's mean temperature; "
-        "with --levels 2 also the change from a coarser mesh (an error bar).",
+        "with --levels 2 or 3 their error estimates: every mesh size is also taken 1.6x (and 2.56x) coarser, and "
+        "the change of K between the two finest levels, over the convergence rate (the slower of the observed one "
+        "and the neck edges' corner rate) and times 1.25, is the error bar of K (fem_neck.accuracy).",
     )
     p.add_argument("file", help=f"cluster JSON file (at most {MAX_PARTICLES} particles)")
     p.add_argument("--kappa", type=float, default=394.0, help="thermal conductivity [W/(m K)] (default 394)")
@@ -38,7 +42,9 @@ def register(subparsers) -> None:
                    help=f"element size at the neck circles / a, in [{SIZE_NECK[0]:g}, {SIZE_NECK[1]:g}]")
     p.add_argument("--size-far", type=float, default=0.25,
                    help=f"element size away from the necks / r, in [{SIZE_FAR[0]:g}, {SIZE_FAR[1]:g}]")
-    p.add_argument("--levels", type=int, choices=(1, 2), default=2, help="mesh levels (2: error bar)")
+    p.add_argument("--levels", type=int, choices=(1, 2, 3), default=3,
+                   help="mesh levels (default 3: error bar with the observed convergence rate; 2: with the corner "
+                        "rate alone; 1: none)")
     add_output_options(p)
     p.set_defaults(run=run)
 
@@ -48,16 +54,22 @@ def run(args) -> dict:
     import pathlib
     import time
 
-    from fem_neck.cluster import build_cluster_mesh, load_cluster_json, solve_cluster, write_vtu
+    from fem_neck.accuracy import MESH_RATIO
+    from fem_neck.cluster import cluster_conductance, load_cluster_json, write_vtu
 
     try:
         data = json.loads(pathlib.Path(args.file).read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ValueError(f"file = {args.file!r}: cannot be read as JSON ({exc})") from exc
+    coarsest = MESH_RATIO ** (args.levels - 1)
     for name, (low, high) in (("size_neck", SIZE_NECK), ("size_far", SIZE_FAR)):
         value = getattr(args, name)
         if not low <= value <= high:  # False for NaN
             raise ValueError(f"{name} = {value!r}: valid range {low:g} <= {name} <= {high:g}")
+        if value * coarsest > high:
+            raise ValueError(f"{name} = {value!r} with --levels {args.levels}: the coarsest level would use "
+                             f"{value * coarsest:.3g} > {high:g}; valid range {low:g} <= {name} <= "
+                             f"{high / coarsest:.3g} with {args.levels} levels (or use fewer levels)")
     if not (0.0 < args.kappa < math.inf):
         raise ValueError(f"kappa = {args.kappa!r}: must be finite and > 0")
     data = checked_cluster_data(data)
@@ -68,25 +80,23 @@ def run(args) -> dict:
                          f"{MAX_SECONDS:.0f} s for one run; use coarser sizes, --levels 1 or fewer particles")
     cluster, terminals = load_cluster_json(data)
     t0 = time.perf_counter()
-    sizes = [(args.size_neck, args.size_far)]
-    if args.levels == 2:
-        sizes.insert(0, (args.size_neck * 1.6, args.size_far * 1.4))
-    results = []
-    for size_neck, size_far in sizes:
-        cmesh = build_cluster_mesh(cluster, terminals, size_neck=size_neck, size_far=size_far,
-                                   curvature=max(12, int(round(4.0 / size_far))))
-        # K is linear in kappa: solve with kappa = 1 and scale, so any kappa a float holds keeps full precision
-        results.append((cmesh, solve_cluster(cmesh, kappa=1.0, order=2)))
-    cmesh, sol = results[-1]
-    out = {"K": args.kappa * sol.K, "Q": args.kappa * sol.Q, "particle_T": sol.particle_T.tolist(), "necks": cmesh.neck_a.tolist(),
-           "dofs": int(sol.dofs), "error_estimate": (abs(sol.K - results[0][1].K) / sol.K if len(results) > 1
-                                                else None),
-           "volume_exact": float(cmesh.volume_exact), "seconds": time.perf_counter() - t0}
+    # K is linear in kappa: solve with kappa = 1 and scale, so any kappa a float holds keeps full precision
+    res = cluster_conductance(cluster, terminals, kappa=1.0, size_neck=args.size_neck, size_far=args.size_far,
+                              levels=args.levels)
+    seq = res.sequence
+    out = {"K": args.kappa * res.K, "Q": args.kappa * res.solution.Q, "particle_T": res.particle_T.tolist(),
+           "necks": res.cmesh.neck_a.tolist(), "dofs": int(res.solution.dofs), "error_estimate": res.error_estimate,
+           "T_error_estimate": res.T_error_estimate,
+           "observed_order": seq.observed_order if seq is not None else None,
+           "corner_order": seq.corner_order if seq is not None else None,
+           "levels": [{"size_factor": lv["size_factor"], "dofs": lv["dofs"], "K": args.kappa * lv["K"]}
+                      for lv in res.levels],
+           "volume_exact": float(res.cmesh.volume_exact), "seconds": time.perf_counter() - t0}
     if args.out:
         path = pathlib.Path(args.out)
         path.mkdir(parents=True, exist_ok=True)
         (path / "cluster.json").write_text(json.dumps(out, indent=2) + "\n")
-        write_vtu(cmesh, sol, path / "cluster.vtu")
+        write_vtu(res.cmesh, res.solution, path / "cluster.vtu")
     return out
 
 

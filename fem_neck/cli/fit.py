@@ -1,10 +1,14 @@
 """``python -m fem_neck fit``: FE sweep of the semisphere over a/r, Rojek's linear fit (eq. 40) and the full-range law.
 
 Writes fit.json (the file the DEM's ``fit`` law reads), fit.csv (written point by point: rerunning with the same
---out resumes an interrupted sweep) and fit.png (the Fig. 16 analogue) into --out (default: results/fit).
+--out resumes an interrupted sweep) and fit.png (the Fig. 16 analogue) into --out (default: results/fit). Points of
+an existing fit.csv are reused only when they were solved by the same solver and method to the same --rtol; the run
+says how many on stderr ("reused 38 of 40 points from fit.csv; --fresh recomputes"), and --fresh recomputes all.
 """
 
 from __future__ import annotations
+
+import sys
 
 from fem_neck.cli import add_output_options, add_workers_option
 
@@ -17,6 +21,7 @@ def register(subparsers) -> None:
                    help="number of FE points (4 to 200; default 40: 5 log-spaced on [0.001, 0.02), 35 uniform on "
                         "(0, 0.97])")
     p.add_argument("--rtol", type=float, default=1e-4, help="relative tolerance of each FE point (default 1e-4)")
+    p.add_argument("--fresh", action="store_true", help="recompute every point (ignore an existing fit.csv)")
     add_workers_option(p)
     add_output_options(p)
     p.set_defaults(run=run, out="results/fit")
@@ -32,7 +37,14 @@ def run(args) -> dict:
         raise ValueError(f"points = {args.points}: valid range 4 <= points <= {MAX_POINTS} (each point is an FE solve "
                          f"of ~0.5 s; the fit's slope is converged well before)")
 
-    result = run_fit(args.points, args.rtol, args.out, workers=args.workers)
+    result = run_fit(args.points, args.rtol, args.out, workers=args.workers, fresh=args.fresh)
+    reused = result["reused"]
+    if reused["points"]:
+        sys.stderr.write(f"reused {reused['points']} of {reused['of']} points from fit.csv; --fresh recomputes\n")
+    if reused["not_matching"]:
+        sys.stderr.write(f"fit.csv: {reused['not_matching']} points from another solver, method or tolerance were "
+                         f"not reused (this run: {result['method']}, rtol {args.rtol:g})\n")
     return {"slope": result["slope"], "sampling": result["sampling"], "points": result["points"],
             "law": result["law"], "slope_sensitivity": result["slope_sensitivity"],
-            "unconverged": result["unconverged"], "seconds": result["seconds"], "out": str(args.out)}
+            "unconverged": result["unconverged"], "reused": reused, "seconds": result["seconds"],
+            "out": str(args.out)}

@@ -1,0 +1,176 @@
+"""Runs that stop and go on: one run per folder, Ctrl-C at a random moment, --resume ends bit for bit where the
+uninterrupted run ends (a thermal run with a fixed step; moving particles)."""
+
+import json
+import os
+import pathlib
+import random
+import re
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from dem import load_scene, run
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+THERMAL = """
+[material]
+conductivity = 394.0
+density = 8960.0
+specific_heat = 385.0
+[generator]
+kind = "random"
+n = 3000
+radius = 5e-5
+overlap = 0.1
+seed = 1
+boundary = "plates"
+hot = 100.0
+cold = 0.0
+[conductance]
+law = "fit"
+[solver]
+mode = "transient"
+integrator = "crank-nicolson"
+linear = "cg"
+dt = 2e-5
+t_end = 0.01
+[output]
+vtu_every = 50
+checkpoint_every = 0.2
+"""
+MOVING = """
+[scene]
+physics = ["mechanical"]
+dimension = 2
+height = 6e-3
+[material]
+density = 2000.0
+[generator]
+kind = "box"
+n = 60
+radius = 1e-3
+radius_spread = 0.5
+box = [[0.0, 0.0, 0.0], [0.03, 0.0, 0.03]]
+speed = 0.01
+seed = 2
+temperature = 80.0
+[contact]
+law = "luding"
+k1 = 1e5
+k2 = 2e5
+kc = 1e5
+kt_ratio = 0.2
+gamma_n = 0.2
+gamma_t = 0.05
+mu = 0.5
+mu_wall = 0.0
+T_melt = 120.0
+T_var = 10.0
+expansion = 1e-4
+fluid_overlap = 0.2
+t0 = 1e3
+brittle_sliding = true
+[temperature]
+time = [0.0, 0.02, 0.04]
+value = [80.0, 140.0, 80.0]
+relaxation_time = [0.1, 0.1]
+[[walls]]
+name = "left"
+point = [0.0, 0.0, 0.0]
+normal = [1.0, 0.0, 0.0]
+[[walls]]
+name = "bottom"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[[walls]]
+name = "right"
+point = [0.03, 0.0, 0.0]
+normal = [-1.0, 0.0, 0.0]
+motion = "stress"
+pressure = 100.0
+mass = 0.01
+damping = 0.2
+[[walls]]
+name = "top"
+point = [0.0, 0.0, 0.03]
+normal = [0.0, 0.0, -1.0]
+motion = "stress"
+pressure = 100.0
+mass = 0.01
+damping = 0.2
+[solver]
+mode = "transient"
+t_end = 0.04
+[output]
+interval = 2e-3
+vtu_interval = 0.01
+checkpoint_every = 0.2
+"""
+
+
+def interrupted_run(scene, out, seed):
+    """``python -m dem run SCENE --out OUT`` stopped by SIGINT at a random moment after its first checkpoint."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    proc = subprocess.Popen([sys.executable, "-m", "dem", "run", str(scene), "--out", str(out)], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300
+    while not (out / "checkpoint.npz").exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    time.sleep(random.Random(seed).uniform(0.0, 0.6))
+    proc.send_signal(signal.SIGINT)
+    _, stderr = proc.communicate(timeout=300)
+    return proc.returncode, stderr
+
+
+def listed(pvd: pathlib.Path) -> list[str]:
+    return re.findall(r'file="([^"]+)"', pvd.read_text())
+
+
+@pytest.mark.parametrize("text, seed", [(THERMAL, 3), (MOVING, 4)], ids=["thermal", "moving"])
+def test_interrupted_then_resumed_ends_as_the_uninterrupted_run(tmp_path, text, seed):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(text)
+    whole = run(load_scene(scene), out=tmp_path / "whole")
+    part = tmp_path / "part"
+    code, err = interrupted_run(scene, part, seed)
+    if code == 0:
+        pytest.skip("the run finished before the interrupt reached it")
+    assert code == 130 and "Traceback" not in err and err.count("\n") == 1, err
+    assert re.match(r"python -m dem run: interrupted at .*; partial results in .*part", err.strip()), err
+    summary = json.loads((part / "summary.json").read_text())
+    assert summary["interrupted"] is True and summary["resume_from"]["steps"] > 0
+    for pvd in part.glob("*.pvd"):
+        kind = pvd.stem
+        assert listed(pvd) == sorted(p.name for p in part.glob(f"{kind}_*.vtu"))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    refused = subprocess.run([sys.executable, "-m", "dem", "run", str(scene), "--out", str(part)], env=env,
+                             capture_output=True, text=True, timeout=300)
+    assert refused.returncode == 2 and "holds a run already" in refused.stderr and "Traceback" not in refused.stderr
+    resumed = run(load_scene(scene), out=part, resume=True)
+    assert resumed.summary["resumed_from"]["steps"] == summary["resume_from"]["steps"]
+    assert np.array_equal(resumed.T, whole.T)
+    if "moving" in str(resumed.summary.get("physics")) or text is MOVING:
+        assert resumed.summary["volume_fraction"] == whole.summary["volume_fraction"]
+    assert (part / "timeseries.csv").read_text() == (tmp_path / "whole" / "timeseries.csv").read_text()
+    for pvd in (tmp_path / "whole").glob("*.pvd"):
+        assert listed(part / pvd.name) == listed(pvd)
+
+
+def test_overwrite_clears_and_resume_needs_a_checkpoint(tmp_path):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(THERMAL.replace("t_end = 0.01", "t_end = 0.001"))
+    first = run(load_scene(scene), out=tmp_path / "out")
+    (tmp_path / "out" / "notes.txt").write_text("mine")
+    again = run(load_scene(scene), out=tmp_path / "out", overwrite=True)
+    assert np.array_equal(first.T, again.T) and (tmp_path / "out" / "notes.txt").exists()
+    with pytest.raises(ValueError, match="no checkpoint"):
+        run(load_scene(scene), out=tmp_path / "empty", resume=True)
+    other = tmp_path / "other.toml"
+    other.write_text(THERMAL.replace("t_end = 0.01", "t_end = 0.002"))
+    with pytest.raises(ValueError, match="another scene"):
+        run(load_scene(other), out=tmp_path / "out", resume=True)
