@@ -33,7 +33,7 @@ Two bounds (the error estimate). With ``K`` the exact heat flow of the cell for 
   (Cauchy-Schwarz). This bound is rigorous up to the linear solver's residual (solved to 1e-11).
 
 ``error_estimate = (upper - lower) / upper`` bounds the error of the reported value (the upper, P2, which is the
-more accurate of the two). The mesh is refined (all sizes by one factor, the CR gap falling like size^2) until the
+more accurate of the two). The mesh is refined (all sizes by one factor, the gap falling like size^1.65) until the
 estimate meets ``rtol``.
 """
 

@@ -132,33 +132,43 @@ def _own_flux(x, N, z, flux):
 
 
 @numba.njit(cache=True, parallel=True)
-def _factors(owner, normal, base, arm, half_r, n_particles):
-    """The factor ``s_b`` of every neck end (module docstring). Neck end ``e`` belongs to particle ``owner[e]``,
-    with unit ``normal`` (m, 3), cap-base distance ``base`` and ``arm`` ``l_b`` (both over the particle's radius)
-    and ``half_r = 4 pi kappa r / K_b`` (the half resistance in units of ``1 / (4 pi kappa r)``). The particles
-    are shared among the threads in chunks, each with its own work arrays."""
-    m = len(owner)
-    out = np.ones(m)
+def _factors(n_particles, i, j, vec, a, l_i, l_j, k_i, k_j, wall_particle, wall_normal, wall_a, wall_l, k_wall,
+             radius, kappa):
+    """The factor of every neck end (module docstring): end ``e < m`` is bond ``e``'s half on particle ``i``,
+    ``m <= e < 2m`` its half on ``j``, and the rest the wall bonds' halves. Bonds: ``vec`` (m, 3) from ``i`` to the
+    partner, neck radius ``a``, centre-to-contact distances ``l_i``, ``l_j``, half conductances ``k_i``, ``k_j``;
+    wall bonds: ``wall_normal`` into the packing, ``wall_a``, ``wall_l``, ``k_wall``. The neck ends are grouped by
+    particle (a counting sort) and the particles shared among the threads in chunks."""
+    m, mw = len(i), len(wall_particle)
+    total = 2 * m + mw
+    out = np.ones(total)
     counts = np.zeros(n_particles + 1, dtype=np.int64)
-    for e in range(m):
-        counts[owner[e] + 1] += 1
+    for e in range(total):
+        k = i[e] if e < m else (j[e - m] if e < 2 * m else wall_particle[e - 2 * m])
+        counts[k + 1] += 1
     offsets = np.cumsum(counts)
     fill = offsets[:-1].copy()
-    ends = np.empty(m, dtype=np.int64)  # the neck ends grouped by particle (counting sort)
-    for e in range(m):
-        ends[fill[owner[e]]] = e
-        fill[owner[e]] += 1
-    z_max = int(np.max(counts)) if m else 0
+    ends = np.empty(total, dtype=np.int64)
+    for e in range(total):
+        k = i[e] if e < m else (j[e - m] if e < 2 * m else wall_particle[e - 2 * m])
+        ends[fill[k]] = e
+        fill[k] += 1
+    z_max = int(np.max(counts)) if total else 0
     chunk = 4096
     for block in numba.prange((n_particles + chunk - 1) // chunk):
-        _block_factors(block * chunk, min((block + 1) * chunk, n_particles), offsets, ends, normal, base, arm,
-                       half_r, z_max, out)
+        _block_factors(block * chunk, min((block + 1) * chunk, n_particles), offsets, ends, m, vec, a, l_i, l_j,
+                       k_i, k_j, wall_normal, wall_a, wall_l, k_wall, radius, kappa, z_max, out)
     return out
 
 
 @numba.njit(cache=True)
-def _block_factors(first, last, offsets, ends, normal, base, arm, half_r, z_max, out):
-    """:func:`_factors` for the particles ``first:last``."""
+def _block_factors(first, last, offsets, ends, m, vec, a, l_i, l_j, k_i, k_j, wall_normal, wall_a, wall_l, k_wall,
+                   radius, kappa, z_max, out):
+    """:func:`_factors` for the particles ``first:last``, with work arrays of their own."""
+    normal = np.empty((z_max, 3))
+    base = np.empty(z_max)
+    arm = np.empty(z_max)
+    half_r = np.empty(z_max)
     R = np.empty((z_max, z_max))
     N = np.empty((z_max, 4))
     x = np.empty((z_max, 4))
@@ -170,33 +180,48 @@ def _block_factors(first, last, offsets, ends, normal, base, arm, half_r, z_max,
         z = hi - lo
         if z < 2:
             continue
+        r = radius[k]
+        for b in range(z):  # the necks of particle k: unit normal, and over r the cap-base distance and the arm
+            e = ends[lo + b]
+            if e < 2 * m:
+                bond = e if e < m else e - m
+                sign = 1.0 if e < m else -1.0
+                length = np.sqrt(vec[bond, 0] ** 2 + vec[bond, 1] ** 2 + vec[bond, 2] ** 2)
+                for c in range(3):
+                    normal[b, c] = sign * vec[bond, c] / length
+                neck, arm[b] = a[bond], (l_i[bond] if e < m else l_j[bond]) / r
+                half = k_i[bond] if e < m else k_j[bond]
+            else:
+                w = e - 2 * m
+                for c in range(3):
+                    normal[b, c] = -wall_normal[w, c]
+                neck, arm[b], half = wall_a[w], wall_l[w] / r, k_wall[w]
+            q = min(neck / r, 1.0)
+            base[b] = np.sqrt((1.0 - q) * (1.0 + q))
+            half_r[b] = 4.0 * np.pi * kappa[k] * r / half
         small = np.inf
         largest = 0.0
         for b in range(z):
-            eb = ends[lo + b]
-            R[b, b] = half_r[eb]
-            small = min(small, half_r[eb])
+            R[b, b] = half_r[b]
+            small = min(small, half_r[b])
             for c in range(b):
-                ec = ends[lo + c]
-                g = interaction(normal[eb], normal[ec], base[eb], base[ec])
+                g = interaction(normal[b], normal[c], base[b], base[c])
                 R[b, c] = g
                 R[c, b] = g
                 largest = max(largest, abs(g))
         if largest <= ROUNDOFF * small:
             continue  # collinear necks: the plain network, bit for bit
         for b in range(z):  # the neck positions l_b n_b, and ones
-            eb = ends[lo + b]
-            for a in range(3):
-                N[b, a] = arm[eb] * normal[eb, a]
-                x[b, a] = N[b, a]
+            for c in range(3):
+                N[b, c] = arm[b] * normal[b, c]
+                x[b, c] = N[b, c]
             N[b, 3] = 1.0
             x[b, 3] = 1.0
         _solve_in_place(R, x, z)  # R^-1 [N 1]
         _own_flux(x, N, z, num)
         for b in range(z):  # the same for the plain network, R = diag(half_r)
-            w = 1.0 / half_r[ends[lo + b]]
-            for a in range(4):
-                x[b, a] = N[b, a] * w
+            for c in range(4):
+                x[b, c] = N[b, c] / half_r[b]
         _own_flux(x, N, z, den)
         total_num = total_den = scale = 0.0
         for b in range(z):
@@ -204,25 +229,27 @@ def _block_factors(first, last, offsets, ends, normal, base, arm, half_r, z_max,
             total_den += den[b]
             scale = max(scale, abs(den[b]))
         trace = total_num / total_den if total_den > 0.0 else 1.0
+        factor = num  # reused: the factors of particle k's necks
         for b in range(z):
             # a neck whose own flow the plain network barely moves (others pointing its way) takes the trace
             ok = den[b] > 1e-6 * scale and num[b] > 0.0
-            out[ends[lo + b]] = num[b] / den[b] if ok else trace
+            factor[b] = num[b] / den[b] if ok else trace
         # Wiener: sum_b s_b K_b l_b^2 n_b n_b^T at most kappa V_k (units K_b = 4 pi / half_r, V_k = 4/3 pi); its
         # trace bounds its largest eigenvalue, which is only computed when the trace exceeds the limit
         M[:, :] = 0.0
         for b in range(z):
-            eb = ends[lo + b]
-            w = out[eb] * 4.0 * np.pi / half_r[eb] * arm[eb] ** 2
+            w = factor[b] * 4.0 * np.pi / half_r[b] * arm[b] ** 2
             for p in range(3):
-                for q in range(3):
-                    M[p, q] += w * normal[eb, p] * normal[eb, q]
+                for c in range(3):
+                    M[p, c] += w * normal[b, p] * normal[b, c]
         limit = 4.0 / 3.0 * np.pi
+        shrink = 1.0
         if M[0, 0] + M[1, 1] + M[2, 2] > limit:
             lam = np.linalg.eigvalsh(M)[2]
             if lam > limit:
-                for b in range(z):
-                    out[ends[lo + b]] *= limit / lam
+                shrink = limit / lam
+        for b in range(z):
+            out[ends[lo + b]] = factor[b] * shrink
 
 
 def neck_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray, k_j: np.ndarray,
@@ -231,18 +258,12 @@ def neck_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, 
     docstring) from the particles' necks: the pair bonds (``vectors`` from ``i`` to the partner, neck radii
     ``bonds.a``, half conductances ``k_i``, ``k_j`` in W/K) and the wall bonds (unit ``wall_normals`` pointing into
     the packing, ``bonds.wall_a``, half conductances ``k_wall``)."""
-    d = np.linalg.norm(vectors, axis=1)
-    e = vectors / np.where(d > 0, d, 1.0)[:, None]
-    owner = np.concatenate([bonds.i, bonds.j, bonds.wall_particle]).astype(np.int64)
-    normal = np.concatenate([e, -e, -np.asarray(wall_normals, dtype=float).reshape(-1, 3)])
-    arm = np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l])
-    neck = np.concatenate([bonds.a, bonds.a, bonds.wall_a])
-    half = np.concatenate([k_i, k_j, k_wall])
-    r, kappa = radius[owner], conductivity[owner]
-    q = np.minimum(neck / r, 1.0)
-    base = np.sqrt((1.0 - q) * (1.0 + q))  # cap-base distance over r
-    with np.errstate(divide="ignore"):
-        half_r = 4.0 * np.pi * kappa * r / half
-    factor = _factors(owner, np.ascontiguousarray(normal), base, arm / r, half_r, n)
+    f = np.ascontiguousarray
+    out = _factors(n, f(bonds.i, dtype=np.int64), f(bonds.j, dtype=np.int64), f(vectors, dtype=float),
+                   f(bonds.a, dtype=float), f(bonds.l_i, dtype=float), f(bonds.l_j, dtype=float), f(k_i, dtype=float),
+                   f(k_j, dtype=float), f(bonds.wall_particle, dtype=np.int64),
+                   f(np.reshape(wall_normals, (-1, 3)), dtype=float), f(bonds.wall_a, dtype=float),
+                   f(bonds.wall_l, dtype=float), f(k_wall, dtype=float), f(radius, dtype=float),
+                   f(conductivity, dtype=float))
     m = bonds.n_pairs
-    return factor[:m], factor[m:2 * m], factor[2 * m:]
+    return out[:m], out[m:2 * m], out[2 * m:]
