@@ -107,7 +107,7 @@ def test_verification_interrupted_keeps_the_finished_sections(tmp_path):
     time.sleep(random.Random(5).uniform(0.0, 1.0))
     proc.send_signal(signal.SIGINT)
     match = _interrupted(proc)
-    assert re.match(r"section (chains|clusters), 1 of 4 sections done", match["at"]) and match["out"] == "v"
+    assert re.match(r"section (chains|clusters), 1 of 5 sections done", match["at"]) and match["out"] == "v"
     sections = json.loads(run_json.read_text())["sections"]
     assert sections["paper"]["status"] == "ok" and list(sections.values())[-1]["status"] == "interrupted"
     summary = json.loads((tmp_path / "v" / "summary.json").read_text())
