@@ -167,7 +167,7 @@ def _figure(rows, out_dir: pathlib.Path, names) -> list:
     colours = {"sc": "tab:blue", "bcc": "tab:orange", "fcc": "tab:green", "random": "tab:red"}
     styles = {"fit": "--", NETWORK_ONLY: ":", "shared-body": "-"}
     shown = [law for law in styles if law in names]
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 5.6))
     for kind in ("sc", "bcc", "fcc"):
         sel = sorted((r for r in rows if r["kind"] == kind), key=lambda r: r["a_over_r"])
         if not sel:
@@ -189,8 +189,8 @@ def _figure(rows, out_dir: pathlib.Path, names) -> list:
     ax1.set_xlabel("a / r (random: mean over bonds)")
     ax1.set_ylabel("k_network / k_FE - 1  (%)")
     ax1.set_yscale("symlog", linthresh=2.0)
-    ax1.set_title("network error against the periodic-cell FE")
-    ax1.legend(fontsize=6, ncol=2)
+    ax1.set_title("network error against the periodic-cell FE (dashed: +-2 %)")
+    ax1.legend(fontsize=6, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.16))
     for law, marker in zip(shown, "o*s"):
         zs = [r["z"] for r in rows]
         sc = ax2.scatter(np.asarray(zs) + (shown.index(law) - 1) * 0.15, [100 * r["rel"][law] for r in rows],
@@ -198,6 +198,8 @@ def _figure(rows, out_dir: pathlib.Path, names) -> list:
                          label=law)
     ax2.axhline(0, color="grey", lw=0.8)
     ax2.set_yscale("symlog", linthresh=2.0)
+    for y in (-2, 2):
+        ax2.axhline(y, color="grey", lw=0.6, ls="--")
     ax2.set_xlabel("coordination number z (random: mean)")
     ax2.set_ylabel("k_network / k_FE - 1  (%)")
     ax2.legend(fontsize=7)

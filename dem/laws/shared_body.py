@@ -75,15 +75,18 @@ def interaction(normal_b, normal_c, base_b: float, base_c: float) -> float:
     """``4 pi kappa r R_bc`` of two necks with unit normals ``normal_b``, ``normal_c`` and cap-base distances
     ``base_b``, ``base_c`` (in units of ``r``), relative to the same necks on opposite poles (module docstring)."""
     cos_g = normal_b[0] * normal_c[0] + normal_b[1] * normal_c[1] + normal_b[2] * normal_c[2]
-    s = np.sqrt(max(0.5 * (1.0 - cos_g), 0.0))
-    if s >= 1.0:
+    return _interaction(cos_g, base_b, base_c)
+
+
+@numba.njit(cache=True)
+def _interaction(cos_g: float, base_b: float, base_c: float) -> float:
+    """:func:`interaction` from the cosine of the angle between the necks."""
+    s2 = 0.5 * (1.0 - cos_g)
+    if s2 >= 1.0:
         return 0.0
-    chord = 0.0
-    for a in range(3):
-        chord += (base_b * normal_b[a] - base_c * normal_c[a]) ** 2
-    chord = max(np.sqrt(chord), 1e-12)
-    s = max(s, 1e-12)
-    return 2.0 / chord - 2.0 / (base_b + base_c) - np.log(s * (1.0 + s) / 2.0)
+    s = np.sqrt(max(s2, 1e-24))
+    chord = np.sqrt(max(base_b * base_b + base_c * base_c - 2.0 * base_b * base_c * cos_g, 1e-24))
+    return 2.0 / chord - 2.0 / (base_b + base_c) - np.log(s * (1.0 + s) * 0.5)
 
 
 @numba.njit(cache=True)
@@ -205,7 +208,8 @@ def _block_factors(first, last, offsets, ends, m, vec, a, l_i, l_j, k_i, k_j, wa
             R[b, b] = half_r[b]
             small = min(small, half_r[b])
             for c in range(b):
-                g = interaction(normal[b], normal[c], base[b], base[c])
+                cos_g = normal[b, 0] * normal[c, 0] + normal[b, 1] * normal[c, 1] + normal[b, 2] * normal[c, 2]
+                g = _interaction(cos_g, base[b], base[c])
                 R[b, c] = g
                 R[c, b] = g
                 largest = max(largest, abs(g))
