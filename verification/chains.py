@@ -31,7 +31,7 @@ from fem_neck.geometry import overlap_for_neck
 from verification.report import md_table, save_figure
 
 TITLE = "DEM against FE: collinear chains"
-LAWS = ("rojek", "argento-bouvard", "fit", "shared-body", "zohdi")
+LAWS = ("rojek", "argento-bouvard", "fit", "zohdi")
 KAPPA = COPPER.conductivity  # 394 W/(m K), copper as in Rojek 2022
 RTOL = 1e-4
 MM = 1e-3
