@@ -30,7 +30,6 @@ from dem.mechanics import MechanicalModel
 from dem.motion import MotionState
 from dem.thermal import boundary_heat_flow, steady
 from fem_neck.geometry import neck_radius
-from fem_neck.interrupt import where
 
 
 class Simulation:
@@ -124,16 +123,16 @@ class Simulation:
         ends.update(k for k in (round(start / dt) for start, _ in m.phases) if 0 < k < n_end)
         return sorted(ends)
 
-    def run(self, observer=None, progress=None, checkpoint=None) -> dict:
+    def run(self, observer=None, progress=None, checkpoint=None, position=None) -> dict:
         """Advance to ``[solver] t_end``; ``observer(sim)`` after each interval that ends on an output time (and at
         t = 0), ``progress(t)`` after every interval, ``checkpoint(make)`` after every interval and at the end
-        (:class:`dem.run_folder.Checkpointer`)."""
+        (:class:`dem.run_folder.Checkpointer`); ``position`` (:class:`fem_neck.interrupt.Where`) learns the step and
+        time after every interval."""
         from dem.state_file import arrays
 
         m, mech = self.scene.motion, self.mechanics
         n_end = max(1, math.ceil(self.scene.solver.t_end / mech.dt - 1e-9))
         out_every = max(1, round(m.output_interval / mech.dt))
-        here = where()
         if observer is not None and mech.steps == 0:
             observer(self)
         for end in self._interval_ends(n_end):
@@ -150,7 +149,8 @@ class Simulation:
                 observer(self)
             if progress is not None:
                 progress(mech.t)
-            here.update(step=mech.steps, t=mech.t)
+            if position is not None:
+                position.update(step=mech.steps, t=mech.t)
             if checkpoint is not None:
                 checkpoint(lambda: arrays(self), final=end == n_end)
         return self.summary()

@@ -51,6 +51,19 @@ def _progress_bar(scene: Scene, enabled: bool):
     return bar, (lambda t: bar.update(min(t, bar.total) - bar.n))
 
 
+def _position(scene: Scene, out, progress: bool):
+    """The run's position for the line an interrupt prints (:func:`fem_neck.interrupt.where`) -- only for a run
+    that reports its progress (the CLI's): a run inside another command (a verification section) leaves that
+    command's position alone."""
+    if not progress:
+        from fem_neck.interrupt import Where
+
+        return Where()  # a throw-away position
+    here = where()
+    here.update(stage=f"dem run {scene.name}", out=str(out) if out is not None else None)
+    return here
+
+
 def effective_conductivity(scene: Scene, boundary: dict) -> float | None:
     """``k_eff = Q L / (A (T_hot - T_cold))`` of a generated specimen with hot and cold ends (steady)."""
     sp = scene.specimen
@@ -67,7 +80,8 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     """Run ``scene``; with ``out`` write summary.json, timeseries.csv, VTU/PVD snapshots and plots into that folder
     (refused if it holds a run, unless ``resume``: go on from its last checkpoint, or ``overwrite``: clear it first;
     :mod:`dem.run_folder`). Ctrl-C leaves the folder usable: the rows and snapshots written so far, the last
-    checkpoint, and ``summary.json`` marked ``"interrupted": true``."""
+    checkpoint, and ``summary.json`` marked ``"interrupted": true``. ``progress``: a bar on stderr, and the run's
+    position in the line an interrupt prints."""
     if out is not None:
         out = run_folder.prepare(out, resume, overwrite)
     elif resume or overwrite:
@@ -75,8 +89,7 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     if scene.motion is not None:
         return run_moving(scene, out, progress, resume)
     start = time.perf_counter()
-    here = where()
-    here.update(stage=f"dem run {scene.name}", out=str(out) if out is not None else None)
+    here = _position(scene, out, progress)
     bar, report = _progress_bar(scene, progress)
     transient = scene.solver.mode == "transient"
     writer = None
@@ -139,8 +152,7 @@ def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = Fa
     from dem.io import MotionWriter
 
     start = time.perf_counter()
-    here = where()
-    here.update(stage=f"dem run {scene.name}", out=str(out) if out is not None else None)
+    here = _position(scene, out, progress)
     saved = state_file.normalised(run_folder.load(out, scene, "moving")) if resume else None
     sim = Simulation(scene, resume=saved)
     writer = MotionWriter(out, scene, resume_step=sim.mechanics.steps if resume else None) if out is not None \
@@ -149,7 +161,7 @@ def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = Fa
         else None
     bar, report = _progress_bar(scene, progress)
     try:
-        details = sim.run(writer, report, checkpoint)
+        details = sim.run(writer, report, checkpoint, here)
     except KeyboardInterrupt:
         if writer is not None:
             writer.interrupted({"scene": scene.name, "interrupted": True, **sim.summary()})
