@@ -137,3 +137,21 @@ def test_tension_capacity_is_eq_15_and_fragments_split_at_the_threshold():
     assert fragments(mech)[1].tolist() == [2, 1, 1, 1]
     with pytest.raises(ValueError, match="min_tension = -1.0"):
         fragments(mech, min_tension=-1.0)
+
+
+@pytest.mark.parametrize("name, n, p, t_s", [("luding-table1", 300, 100.0, 0.1), ("luding-three-particles", 3, 100.0, 1.0)])
+def test_builtin_scenes_are_the_protocols_schedule(name, n, p, t_s):
+    from dem.scene import load_scene
+
+    builtin, made = load_scene(name), parse_scene(sp.schedule_doc(n, p, t_s))
+    assert builtin.contact == made.contact == MAT
+    assert np.array_equal(builtin.particles.position, made.particles.position)
+    assert np.array_equal(builtin.particles.radius, made.particles.radius)
+    a, b = builtin.motion, made.motion
+    assert np.array_equal(a.velocity, b.velocity)
+    def walls(m):
+        return [(w.name, w.motion, w.point.tolist(), w.normal.tolist(), w.pressure, w.mass, w.damping) for w in m.walls]
+
+    assert walls(a) == walls(b) and len(a.walls) == 4
+    assert (a.schedule, a.phases, a.dt, a.dimension, a.height) == (b.schedule, b.phases, b.dt, b.dimension, b.height)
+    assert builtin.solver.t_end == made.solver.t_end
