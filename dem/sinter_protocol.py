@@ -17,7 +17,9 @@ Each function returns a scene as a dict (the parsed form of a TOML scene; :func:
 * :func:`compression_doc` -- the compression test of Sec. 4.4: the right wall holds ``sigma_xx = p``, the top wall
   moves down at a constant speed, ``eps_zz = 1 - z/z0`` rising at ``strain_rate``;
 * :func:`vibration_doc` -- the vibration test of Figs. 21-22: the confining walls removed, the sample on a flat
-  floor vibrating at 100 Hz with 0.2 mm amplitude for 0.1 s, in gravity.
+  floor vibrating at 100 Hz with 0.2 mm amplitude for 0.1 s, in gravity;
+* :func:`heated_walls_doc` -- beyond the paper: 3D spheres with the thermal network on, heated and cooled through
+  two walls held at given temperatures instead of a prescribed schedule.
 
 Ambiguities of the paper, resolved here (and overridable): the preparation is frictionless throughout, walls
 included (``prep_mu_wall = 0``, Table 1's mu_w): the paper switches the wall friction off at t_heat without saying

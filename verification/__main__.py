@@ -34,6 +34,7 @@ COMMANDS = {
     "all": (("paper", "chains", "clusters", "transient"), "paper and dem-vs-fe"),
     "bench": (("bench",), "run time against error for FE, neck radius and DEM, with peers"),
     "stability": (("stability",), "numerical stability stress tests"),
+    "sintering": (("sintering",), "Luding 2005 Sec. 4 reproduced: sintering, compression and vibration tests"),
 }
 PLUGINS = ("bench", "stability")  # their modules may define add_arguments(parser) for options of their own
 
