@@ -97,18 +97,25 @@ def contact_table(material: LudingMaterial = LUDING_TABLE1) -> dict:
     return {"law": "luding", **{k: v for k, v in asdict(material).items() if k != "density"}}
 
 
+FILL = {2: 0.3, 3: 0.2}  # solid fraction of the random placement (random sequential addition in a box jams near
+                        # 0.5 in 2D and below 0.3 in 3D)
+
+
 def box_side(n: int, fill: float, dimension: int = 2, mean_radius: float = MEAN_RADIUS,
              spread: float = RADIUS_SPREAD) -> float:
     """Edge of the square (cube) that ``n`` particles with radii uniform in ``a0 (1 +- w0)`` fill to the solid
-    fraction ``fill`` on average: ``<a^2> = a0^2 (1 + w0^2/3)``, ``<a^3> = a0^3 (1 + w0^2)``."""
+    fraction ``fill`` on average (``<a^2> = a0^2 (1 + w0^2/3)``, ``<a^3> = a0^3 (1 + w0^2)``), and at least
+    ``n^(1/d) + 1`` of the largest diameters, so that a few particles always find room."""
     if not isinstance(n, int) or isinstance(n, bool) or n < 1:
         raise ValueError(f"n = {n!r}: must be an integer >= 1")
     if not (isinstance(fill, (int, float)) and 0 < fill < 0.5):
-        raise ValueError(f"fill = {fill!r}: must be in (0, 0.5) (random sequential addition jams near 0.55 in 2D "
-                         f"and 0.38 in 3D)")
+        raise ValueError(f"fill = {fill!r}: must be in (0, 0.5) (random sequential addition jams near 0.5 in 2D "
+                         f"and below 0.3 in 3D)")
     if dimension == 2:
-        return math.sqrt(n * math.pi * mean_radius**2 * (1 + spread**2 / 3) / fill)
-    return (n * 4.0 / 3.0 * math.pi * mean_radius**3 * (1 + spread**2) / fill) ** (1.0 / 3.0)
+        side = math.sqrt(n * math.pi * mean_radius**2 * (1 + spread**2 / 3) / fill)
+    else:
+        side = (n * 4.0 / 3.0 * math.pi * mean_radius**3 * (1 + spread**2) / fill) ** (1.0 / 3.0)
+    return max(side, 2.0 * mean_radius * (1.0 + spread) * (n ** (1.0 / dimension) + 1.0))
 
 
 def _axes(dimension: int) -> list[int]:
@@ -142,15 +149,15 @@ def _base(name: str, material: LudingMaterial, dimension: int, t_end: float, out
             "output": {"interval": output_interval, "vtu": False}}
 
 
-def preparation_doc(n: int, p: float, *, seed: int = 1, times: Times | None = None, fill: float = 0.3,
+def preparation_doc(n: int, p: float, *, seed: int = 1, times: Times | None = None, fill: float | None = None,
                     spread: float = RADIUS_SPREAD, speed: float = 0.01, prep_mu_wall: float = 0.0, material: LudingMaterial = LUDING_TABLE1,
                     dimension: int = 2, output_interval: float = 2.5e-3) -> dict:
     """The preparation (module docstring): random placement of radii uniform in ``a0 (1 +- spread)`` at solid
-    fraction ``fill`` with speeds ``speed`` (m/s), frictionless compression at ``p`` and 80 °C until ``times.t_heat``; wall friction ``prep_mu_wall``
-    (default 0)."""
+    fraction ``fill`` (default :data:`FILL`) with speeds ``speed`` (m/s), frictionless compression at ``p`` and
+    80 °C until ``times.t_heat``; wall friction ``prep_mu_wall`` (default 0)."""
     p = _check_pressure(p)
     times = times or Times(t_s=1.0)
-    side = box_side(n, fill, dimension, spread=spread)
+    side = box_side(n, FILL[dimension] if fill is None else fill, dimension, spread=spread)
     doc = _base(f"luding2005-preparation-n{n}-p{p:g}", material, dimension, times.t_heat, output_interval)
     hi = [side if a in _axes(dimension) else 0.0 for a in range(3)]
     doc["generator"] = {"kind": "box", "n": n, "radius": MEAN_RADIUS, "radius_spread": spread,
@@ -204,7 +211,8 @@ def cooling_doc(state: str, p: float, *, times: Times | None = None, material: L
     return doc
 
 
-def schedule_doc(n: int, p: float, t_s: float, *, seed: int = 1, times: Times | None = None, fill: float = 0.3,
+def schedule_doc(n: int, p: float, t_s: float, *, seed: int = 1, times: Times | None = None,
+                 fill: float | None = None,
                  speed: float = 0.01, prep_mu_wall: float = 0.0, material: LudingMaterial = LUDING_TABLE1,
                  output_interval: float = 5e-3) -> dict:
     """The whole of Fig. 7 in one 2D scene: preparation (:func:`preparation_doc`), then from t_heat friction on,

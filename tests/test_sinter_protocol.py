@@ -15,7 +15,7 @@ from dem.simulation import run
 
 def test_schedule_scene_has_the_times_temperatures_and_box_of_sec_4_1():
     t_s = 0.05
-    scene = parse_scene(sp.schedule_doc(50, 100.0, t_s))
+    scene = parse_scene(sp.schedule_doc(150, 100.0, t_s))
     m = scene.motion
     assert scene.contact == MAT and m.dimension == 2 and m.height == 6e-3
     assert scene.solver.t_end == pytest.approx(0.2 + 0.1 + t_s + 0.1 + 0.1)
@@ -32,7 +32,8 @@ def test_schedule_scene_has_the_times_temperatures_and_box_of_sec_4_1():
         w = walls[name]
         assert (w.motion, w.pressure, w.mass, w.damping) == ("stress", 100.0, 0.01, 0.2)
     side = walls["right"].point[0]
-    assert side == walls["top"].point[2] == pytest.approx(math.sqrt(50 * math.pi * 1e-6 * (1 + 0.25 / 3) / 0.3))
+    assert side == walls["top"].point[2] == pytest.approx(math.sqrt(150 * math.pi * 1e-6 * (1 + 0.25 / 3) / 0.3))
+    assert sp.box_side(3, 0.3) == pytest.approx(2 * 1.5e-3 * (math.sqrt(3) + 1))  # a few particles: room for them
     r = scene.particles.radius
     assert r.min() >= 0.5e-3 and r.max() <= 1.5e-3
 
