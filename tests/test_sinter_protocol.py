@@ -140,7 +140,8 @@ def test_tension_capacity_is_eq_15_and_fragments_split_at_the_threshold():
         fragments(mech, min_tension=-1.0)
 
 
-@pytest.mark.parametrize("name, n, p, t_s", [("luding-table1", 300, 100.0, 0.1), ("luding-three-particles", 3, 100.0, 1.0)])
+@pytest.mark.parametrize("name, n, p, t_s", [("luding-table1", 300, 100.0, 0.1),
+                                              ("luding-three-particles", 3, 100.0, 1.0)])
 def test_builtin_scenes_are_the_protocols_schedule(name, n, p, t_s):
     from dem.scene import load_scene
 

@@ -2,12 +2,15 @@
 
 import json
 import pathlib
+from dataclasses import asdict
 
 import numpy as np
 import pytest
 
 from verification import sintering as S
 from verification import sintering_runs as sr
+from verification import sintering_statements as T
+from verification import sintering_study as Y
 from verification.__main__ import COMMANDS
 from verification.report import check_section_result, jsonable
 
@@ -25,24 +28,25 @@ def test_tasks_start_from_their_parents_and_name_their_folders():
     assert task.parent.parent.parent == sr.Task(sr.PREPARE, 100, 10.0)
     chain = sr.with_parents([task, sr.Task(sr.COMPRESS, 100, 10.0, 0.02)])
     assert [t.kind for t in chain] == [sr.PREPARE, sr.SINTER, sr.COOL, sr.VIBRATE, sr.COMPRESS]
-    assert sr.Task(sr.SCHEDULE, 3, 100.0, 1.0, seed=2, variant="no-expansion").sample == "n3-p100-ts1-seed2-no-expansion"
+    control = sr.Task(sr.SCHEDULE, 3, 100.0, 1.0, seed=2, variant="no-expansion")
+    assert control.sample == "n3-p100-ts1-seed2-no-expansion"
     full = sr.FULL.tasks()
     assert len(set(full)) == len(full)
     assert {(t.n, t.p) for t in full if t.kind == sr.COMPRESS} == {(100, 10.0), (100, 100.0), (300, 10.0), (300, 100.0)}
 
 
 def test_every_statement_needs_runs_and_says_which():
-    st = S.Study(pathlib.Path("nowhere"), TINY, {})
-    items, skipped = S.statements(st)
-    assert items == [] and len(skipped) == len(S.CHECKS)
+    st = Y.Study(pathlib.Path("nowhere"), TINY, {})
+    items, skipped = T.statements(st)
+    assert items == [] and len(skipped) == len(T.CHECKS)
     assert all("(needs " in line for line in skipped)
 
 
 def test_statement_rows_carry_the_json_fields():
-    s = S.Statement("Sec. 4.1.4", "density after sintering", "≈ 0.92", "0.915", True, "±0.015")
-    row = jsonable(S.asdict(s))
+    s = T.Statement("Sec. 4.1.4", "density after sintering", "≈ 0.92", "0.915", True, "±0.015")
+    row = jsonable(asdict(s))
     assert {"statement", "paper", "ours", "holds"} <= set(row) and row["holds"] is True
-    table = S._statements_table([s])
+    table = T.statements_table([s])
     assert "| 1 | Sec. 4.1.4 | density after sintering | ≈ 0.92 | 0.915 | yes | ±0.015 |" in table
 
 
@@ -61,3 +65,15 @@ def test_tiny_grid_runs_resumes_and_fills_the_contract(tmp_path, monkeypatch):
     assert again["summary"]["statements"] == statements
     vib = json.loads((tmp_path / sr.Task(sr.VIBRATE, 12, 10.0, 1e-4).folder / "result.json").read_text())
     assert vib["volume_fraction"] is None and vib["fragments"] >= 1 and np.isfinite(vib["seconds"])
+
+
+def test_rattlers_are_peeled_off_until_every_particle_has_two_contacts():
+    # a triangle 0-1-2 with a tail 2-3-4 and a lone particle 5: the tail peels off (4 first, then 3)
+    i, j = np.array([0, 1, 0, 2, 3]), np.array([1, 2, 2, 3, 4])
+    c, removed = Y.without_rattlers(i, j, 6)
+    assert (c, removed) == (2.0, 3)
+
+
+def test_failure_is_the_peak_before_the_first_load_drop():
+    assert Y.failure([10, 40, 55, 50, 20, 80, 90]) == 2  # 20 < 55/2: failed at 55, the later 90 is rubble
+    assert Y.failure([10, 20, 30, 25, 28, 35, 20]) == 5  # never below half: the largest

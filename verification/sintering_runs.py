@@ -5,7 +5,7 @@ A :class:`Task` is one stage of :mod:`dem.sinter_protocol` for one sample: ``pre
 and sintering for t_s, from the prepared state), ``cool`` (cooling and relaxation), ``compress`` and ``vibrate``
 (the tests of Sec. 4.4, from the cooled state), ``schedule`` (the whole of Fig. 7 in one scene: the three-particle
 control of Sec. 4.1.3, the control without thermal expansion), and the 3D stages with heated walls (``prepare3d``,
-``sinter3d``, ``cool3d``). Each task runs in its own folder ``runs/<kind>/<sample>/``: the engine's
+``sinter3d``). Each task runs in its own folder ``runs/<kind>/<sample>/``: the engine's
 ``timeseries.csv``, ``summary.json`` and ``state.npz``, then ``analysis.npz`` (contacts, forces, fragments and
 snapshots at the stage's end) and, last, ``result.json``. A folder holding ``result.json`` is finished: a rerun
 skips it. The preparation of each (N, p) runs once and every t_s starts from its state; each cooled state is the
@@ -31,24 +31,23 @@ import numpy as np
 from dem.laws.luding import LUDING_TABLE1, P_MU
 
 PREPARE, SINTER, COOL, COMPRESS, VIBRATE, SCHEDULE = "prepare", "sinter", "cool", "compress", "vibrate", "schedule"
-PREPARE3D, SINTER3D, COOL3D = "prepare3d", "sinter3d", "cool3d"
-PARENT = {SINTER: PREPARE, COOL: SINTER, COMPRESS: COOL, VIBRATE: COOL, SINTER3D: PREPARE3D, COOL3D: SINTER3D}
+PREPARE3D, SINTER3D = "prepare3d", "sinter3d"
+PARENT = {SINTER: PREPARE, COOL: SINTER, COMPRESS: COOL, VIBRATE: COOL, SINTER3D: PREPARE3D}
 
 COMPRESSION_RATE = 1.0      # 1/s: eps_zz = t (the times of Fig. 20 are then strains)
 COMPRESSION_STRAIN = 0.06
+COMPRESSION_OUTPUT = 1e-4   # s between rows: failure strains at p = 10 are a few 1e-3
 FIG20_TIMES = (0.005, 0.02, 0.03, 0.035, 0.04)  # s, Fig. 20
 VIBRATION = {"frequency": 100.0, "amplitude": 2.0e-4, "duration": 0.1}  # Figs. 21-22
 
 # 3D beyond the paper: Table 1's spheres (w0 = 0.2: the lightest pair sets the stable step), p in Pa chosen so that
 # the mean contact force 2 a0 p_2D of the paper's p = 100 N/m is about that of a sphere in the cube, p_3D = 4 a0^2
-# sigma; heat capacity time-scaled (as t0) so that heat crosses the 8 mm sample within a few ms.
+# sigma; heat capacity time-scaled (as t0 scales the sintering) so that the heat crosses the sample within the run.
 P3D = 5.0e4
 SPREAD3D = 0.2
 HOT3D = (150.0, 130.0)   # bottom, top wall while sintering (°C; mean 140 °C, the paper's sintering temperature)
-COOL_3D = (90.0, 70.0)   # while cooling (mean 80 °C)
-SINTER3D_TIME, COOL3D_TIME = 0.3, 0.1
+SINTER3D_TIME = 0.3
 CONDUCTIVITY3D, SPECIFIC_HEAT3D = 20.0, 10.0
-T0_COOL3D = 1e-3  # s: the network's temperatures carry no cooling rate, so k1 follows k1(T) at once this way
 
 
 @dataclass(frozen=True)
@@ -88,7 +87,7 @@ class Task:
         """Simulated time times particles: the order in which ready tasks start (longest first)."""
         seconds = {PREPARE: 0.2, SINTER: 0.1 + (self.t_s or 0), COOL: 0.2, COMPRESS: COMPRESSION_STRAIN,
                    VIBRATE: 0.5 * VIBRATION["duration"], SCHEDULE: 0.5 + (self.t_s or 0), PREPARE3D: 0.4,
-                   SINTER3D: 2.0 * SINTER3D_TIME, COOL3D: 2.0 * COOL3D_TIME}[self.kind]
+                   SINTER3D: 2.0 * SINTER3D_TIME}[self.kind]
         return seconds * self.n
 
 
@@ -114,7 +113,7 @@ class Grid:
         out += [Task(SCHEDULE, 3, p, t_max, seed) for p in self.p for seed in self.three_seeds]
         if self.no_expansion:
             out += [Task(SCHEDULE, min(self.n), p, t_max, variant="no-expansion") for p in self.p]
-        out.append(Task(COOL3D, self.n3d, P3D))
+        out.append(Task(SINTER3D, self.n3d, P3D))
         return out
 
 
@@ -161,18 +160,16 @@ def scene_doc(task: Task, root: pathlib.Path) -> dict:
     if task.kind == COMPRESS:
         z0 = -sp.wall_offset(state_file.load(parent), "top")
         return sp.compression_doc(parent, task.p, strain_rate=COMPRESSION_RATE, strain=COMPRESSION_STRAIN, z0=z0,
-                                  material=material)
+                                  material=material, output_interval=COMPRESSION_OUTPUT)
     if task.kind == VIBRATE:
         return sp.vibration_doc(parent, sp.floor_height(state_file.load(parent)), material=material, **VIBRATION)
     if task.kind == SCHEDULE:
         return sp.schedule_doc(task.n, task.p, task.t_s, seed=task.seed, material=material)
     if task.kind == PREPARE3D:
         return sp.preparation_doc(task.n, task.p, seed=task.seed, material=material, dimension=3, spread=SPREAD3D)
-    hot, cold = HOT3D if task.kind == SINTER3D else COOL_3D
-    return sp.heated_walls_doc(parent, task.p, hot=hot, cold=cold,
-                               duration=SINTER3D_TIME if task.kind == SINTER3D else COOL3D_TIME,
-                               t0=sp.T0_SINTER if task.kind == SINTER3D else T0_COOL3D,
-                               conductivity=CONDUCTIVITY3D, specific_heat=SPECIFIC_HEAT3D, material=material)
+    return sp.heated_walls_doc(parent, task.p, hot=HOT3D[0], cold=HOT3D[1], duration=SINTER3D_TIME,
+                               t0=sp.T0_SINTER, conductivity=CONDUCTIVITY3D, specific_heat=SPECIFIC_HEAT3D,
+                               material=material)
 
 
 def snapshot(sim) -> dict:
@@ -233,12 +230,13 @@ def run_task(task: Task, root) -> dict:
     sim = Simulation(scene)
     writer = MotionWriter(out, scene)
     interval = scene.motion.output_interval
-    captures = FIG20_TIMES if task.kind == COMPRESS else ()
+    captures = list(FIG20_TIMES) if task.kind == COMPRESS else []
     snaps = []
 
     def observer(s):
         writer(s)
-        if any(abs(s.mechanics.t - tc) < 0.25 * interval for tc in captures):
+        if captures and s.mechanics.t >= captures[0] - 0.5 * interval:  # the first row at (or just before) it
+            captures.pop(0)
             snaps.append(snapshot(s))
 
     summary = sim.run(observer)
