@@ -30,6 +30,9 @@ class Statement:
     tolerance: str
     note: str = ""
 
+    def __post_init__(self):
+        self.holds = bool(self.holds)  # numpy comparisons give numpy booleans; the summary wants true or false
+
 
 def pct(x: float) -> str:
     return f"{100.0 * x:.2f} %"
