@@ -85,12 +85,15 @@ class Simulation:
         return "network" if self.thermal is not None else "initial"
 
     # ------------------------------------------------------------------------------------------------ loop
-    def _interval_temperatures(self, t: float):
-        """``(T0, rate, relaxation_time)`` over the interval starting at ``t`` (length-1 arrays: uniform)."""
+    def _interval_temperatures(self, t: float, t_end: float):
+        """``(T0, rate, relaxation_time)`` over the interval ``[t, t_end]`` (length-1 arrays: uniform). The
+        schedule's segment is the one holding the interval's middle: an interval ends at every knot, but its start
+        ``k dt`` may fall a little before the knot it begins at (the knot rounded to the step grid)."""
         mech = self.mechanics
         if self.schedule is not None:
-            return (np.array([self.schedule.at(t)]), np.array([self.schedule.rate(t)]),
-                    self.schedule.relaxation(t))
+            middle = 0.5 * (t + t_end)
+            return (np.array([self.schedule.at(t)]), np.array([self.schedule.rate(middle)]),
+                    self.schedule.relaxation(middle))
         if self.thermal is not None:  # the network's temperatures, extrapolated with its last rate (cooling is
             T, rate = self.thermal.T, self.thermal.rate  # then seen as cooling: k1(T, t) freezes, Sec. 3.4)
         else:
@@ -139,7 +142,7 @@ class Simulation:
             steps = end - mech.steps
             if steps <= 0:
                 continue
-            T0, rate, t0 = self._interval_temperatures(mech.t)
+            T0, rate, t0 = self._interval_temperatures(mech.t, end * mech.dt)
             mech.params = self._params_at(mech.t)
             mech.advance(steps, T0, rate, t0)
             if self.thermal is not None:

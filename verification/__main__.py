@@ -29,6 +29,7 @@ COMMANDS = {
     "paper": (("paper",), "reproduce the quantitative claims of Rojek et al. 2022"),
     "dem-vs-fe": (("chains", "clusters", "transient"), "DEM pipe network against FE: chains, 3D clusters, transient"),
     "all": (("paper", "chains", "clusters", "transient"), "paper and dem-vs-fe"),
+    "sintering": (("sintering",), "Luding 2005 Sec. 4 reproduced: sintering, compression and vibration tests"),
 }
 
 
