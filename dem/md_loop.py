@@ -177,10 +177,12 @@ def _material_state(elapsed, T0, T_rate, T, radius, radius_ref, k1f, uniform, pa
         target = k1_factor(Tu, T_melt, T_var)
         scale = radius_at(1.0, Tu, T_melt, expansion)
         cooling = T_rate[0] < 0.0
+        old = k1f[0]
+        new = relax_k1(old, target, dt, t0, cooling)  # the factors of a uniform temperature are all equal
         for k in range(n):
             T[k] = Tu
             radius[k] = radius_ref[k] * scale
-            k1f[k] = relax_k1(k1f[k], target, dt, t0, cooling)
+            k1f[k] = new if k1f[k] == old else relax_k1(k1f[k], target, dt, t0, cooling)
     else:
         for k in range(n):
             T[k] = T0[k] + T_rate[k] * elapsed
