@@ -72,7 +72,7 @@ class BoundedLaplacian:
         self.K_plane = np.asarray(K_plane, dtype=float)
 
     def _plane_terms(self):
-        self.plane_diag = np.bincount(self.plane_node, self.K_plane, self.n)[self.free]
+        self.plane_diag = np.bincount(self.plane_node, self.K_plane, self.n).astype(float)[self.free]
         self.fixed_diag = -np.asarray(self.L_FD.sum(axis=1)).ravel()
 
     def same_edges(self, i, j, plane_node, plane_index) -> bool:
@@ -163,6 +163,8 @@ def solve_anchored(system: BoundedLaplacian, rhs: np.ndarray, subset: np.ndarray
     """Solve ``A x = rhs`` on the free nodes listed by ``subset`` (positions in ``system.free``; all when None),
     e.g. the anchored groups, where ``A`` is definite. Returns ``(x on the subset, solver)``; pass the solver back
     to reuse its factorisation for another right-hand side of the same matrix."""
+    if subset is not None and len(subset) == 0:
+        return np.zeros(0), solver
     if solver is None:
         A, diag = system.matrix(), system.laplacian_diagonal
         if subset is not None and len(subset) != len(system.free):
