@@ -1,0 +1,81 @@
+"""The electrical submodel of the engine: the current through the contacts as they are, and the Joule heating it
+makes in each particle (Zohdi 2014, eqs. 35, 38-44), by either scheme of :mod:`dem.electrical`.
+
+* ``scheme = "kirchhoff"`` -- potentials from one sparse solve per refresh; each contact's electrical conductance is
+  the thermal neck law of the scene with sigma in place of kappa (no interface conductance); electrodes are walls at
+  a fixed ``potential`` (V) or driving a fixed ``current`` (A into the packing). The heating of a particle is the
+  absorption ``a`` times the Joule heat made in it, ``a sum I^2/G`` over its share of its contacts.
+* ``scheme = "zohdi"`` -- the paper's area-weighted iteration (eq. 43) over the lens contact areas, warm-started from
+  the last refresh; an electrified wall's ``current`` is its ``J_ext``; heating ``a J_i^2 V_i / sigma_i`` (eq. 35).
+
+The current settles far faster than anything moves (Appendix B: dP/dt = 0), so it is refreshed once per accepted
+step (Algorithm 1, step 6d), and held while the next step is solved.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from dem.electrical import Electrodes, area_weighted_current, kirchhoff, zohdi_joule
+from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.particles import Particles
+from dem.zohdi.heat import contact_bonds
+
+
+class ContactCurrent:
+    """The current of the configuration last refreshed and its heating (module docstring)."""
+
+    name = "electrical"
+
+    def __init__(self, particles: Particles, walls, electrodes: Electrodes, spec: ConductanceSpec, scheme: str,
+                 absorption: float, tolerance: float = 1e-8, sweeps: int = 10_000, linear: str = "auto"):
+        self.particles, self.walls, self.electrodes = particles, tuple(walls), electrodes
+        self.spec = replace(spec, contact_conductance=None)
+        self.scheme, self.absorption = scheme, absorption
+        self.tolerance, self.sweeps, self.linear = tolerance, sweeps, linear
+        self.sigma = particles.electrical_conductivity
+        self.volume = particles.volume
+        n = particles.n
+        self.heating = np.zeros(n)         # H_i, W
+        self.J = np.zeros(n)               # Zohdi's current per particle; Kirchhoff: the potential (V)
+        self.flow = None                   # the last Kirchhoff solution
+        self.last_sweeps, self.total_sweeps, self.refreshes, self.open_refreshes = 0, 0, 0, 0
+        self.joule_heat, self.electrode_power = 0.0, None
+
+    def refresh(self, mech) -> np.ndarray:
+        """The current at the state of the mechanics ``mech``: updates :attr:`heating`."""
+        lens = self.scheme == "zohdi"
+        now, b = contact_bonds(self.particles, mech, mech.state.x, mech.state.T, self.electrodes.walls,
+                               "lens" if lens else self.spec.contact, self.spec.out_of_range)
+        n = self.particles.n
+        self.refreshes += 1
+        if lens:
+            res = area_weighted_current(n, b.i, b.j, np.pi * b.a**2, b.wall_particle, b.wall_index,
+                                        self.electrodes.current, self.J, self.tolerance, self.sweeps)
+            self.J, self.last_sweeps = res.J, res.sweeps
+            self.total_sweeps += res.sweeps
+            joule = zohdi_joule(self.J, self.volume, self.sigma, 1.0)
+            self.joule_heat, self.electrode_power = float(joule.sum()), None
+        else:
+            G, G_w, share = bond_conductances(self.spec, now, b, self.sigma, shares=True)
+            self.flow = kirchhoff(n, b.i, b.j, G, share, b.wall_particle, b.wall_index, G_w, self.electrodes,
+                                  self.linear)
+            self.J = self.flow.potential
+            joule = self.flow.joule_particles
+            self.joule_heat, self.electrode_power = self.flow.joule_heat, self.flow.electrode_power
+            if self.flow.no_path or not np.any(self.flow.electrode_current):
+                self.open_refreshes += 1
+        self.heating = self.absorption * joule
+        return self.heating
+
+    def electrode_currents(self) -> dict:
+        """Current into the packing (A) and potential (V) of each electrode (Kirchhoff), by name."""
+        if self.flow is None:
+            return {}
+        out = {}
+        for k, name in enumerate(self.electrodes.names):
+            out[f"I_{name}"] = float(self.flow.electrode_current[k])
+            out[f"V_{name}"] = float(self.flow.electrode_potential[k])
+        return out
