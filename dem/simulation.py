@@ -95,9 +95,14 @@ def run(scene: Scene, out=None, progress: bool = False) -> RunResult:
 
 
 def run_moving(scene: Scene, out=None, progress: bool = False) -> RunResult:
-    """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engine`."""
-    from dem.engine import Simulation
+    """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engine`, or with
+    ``[contact] law = "zohdi"`` the staggered scheme of :mod:`dem.zohdi.simulation`."""
     from dem.io import MotionWriter
+
+    if scene.contact.law == "zohdi":
+        from dem.zohdi.simulation import ZohdiSimulation as Simulation
+    else:
+        from dem.engine import Simulation
 
     start = time.perf_counter()
     sim = Simulation(scene)
@@ -118,7 +123,7 @@ def run_moving(scene: Scene, out=None, progress: bool = False) -> RunResult:
         if bar is not None:
             bar.close()
     summary = {"scene": scene.name, "mode": "transient", "physics": list(scene.physics), "static": False, **details}
-    if out is not None:
+    if out is not None and scene.contact.law == "luding":
         from dem import state_file
 
         summary["state"] = state_file.save(sim, pathlib.Path(out) / "state.npz").name
