@@ -181,12 +181,14 @@ def wall_values(n: int, plane_node, plane_index, values) -> tuple[np.ndarray, np
 @dataclass
 class AreaWeightedCurrent:
     """Zohdi's scheme: ``J`` (N,) per particle, the Gauss-Seidel ``sweeps`` taken, the last sweep's largest
-    ``change`` (relative to the largest wall value) and whether it reached the tolerance."""
+    ``change`` (relative to the largest wall value), whether it reached the tolerance, and the ``floating``
+    particles."""
 
     J: np.ndarray
     sweeps: int
     change: float
     converged: bool
+    floating: np.ndarray  # particles in groups that touch no electrified wall (they carry no current)
 
 
 def area_weighted_current(n: int, i, j, area, plane_node, plane_index, J_ext, J0=None, tol: float = 1e-8,
@@ -210,12 +212,13 @@ def area_weighted_current(n: int, i, j, area, plane_node, plane_index, J_ext, J0
     J[~electrified] = 0.0
     scale = float(np.max(np.abs(np.asarray(J_ext, dtype=float)), initial=0.0))
     free = np.flatnonzero(electrified & ~touching).astype(np.int64)
+    floating = np.flatnonzero(~electrified)
     if scale == 0.0 or len(free) == 0:
         J[free] = 0.0 if scale == 0.0 else J[free]
-        return AreaWeightedCurrent(J, 0, 0.0, True)
+        return AreaWeightedCurrent(J, 0, 0.0, True, floating)
     sweeps, change = gauss_seidel(adjacency.indptr.astype(np.int64), adjacency.indices.astype(np.int64),
                                   adjacency.data, free, J, tol * scale, max_sweeps)
-    return AreaWeightedCurrent(J, int(sweeps), change / scale, change <= tol * scale)
+    return AreaWeightedCurrent(J, int(sweeps), change / scale, change <= tol * scale, floating)
 
 
 def zohdi_joule(J, volume, sigma, absorption: float) -> np.ndarray:

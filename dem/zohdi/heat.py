@@ -69,7 +69,7 @@ class LumpedHeat:
         self.C = particles.capacity
         self.free = ~particles.fixed
         self.T = particles.temperature.astype(float).copy()  # theta^L
-        self.T0_energy = float(self.C[self.free] @ self.T[self.free])
+        self.T0 = self.T.copy()
         self.heat_in = {"boundaries": 0.0, "joule": 0.0}
         self.Q = np.zeros(particles.n)  # conducted heat at the start of the step, Q^L (W per particle)
         self._Q_iter = np.zeros(particles.n)
@@ -115,7 +115,7 @@ class LumpedHeat:
         """``|sum C (theta - theta_0) - heat in| / scale`` over the free particles (relative; the scale is the
         capacity times the temperature range plus the heat exchanged)."""
         f = self.free
-        change = float(self.C[f] @ self.T[f]) - self.T0_energy
+        change = float(self.C[f] @ (self.T[f] - self.T0[f]))
         heat = sum(self.heat_in.values())
         scale = float(self.C[f].sum()) * max(float(np.ptp(self.T)), 1e-300) + sum(abs(v) for v in self.heat_in.values())
         return abs(change - heat) / scale if scale > 0 else 0.0

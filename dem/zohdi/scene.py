@@ -6,7 +6,8 @@ current in ``[electrical]`` and the electrodes in ``[[walls]]``.
   ``E_star``, ``mu_d``, ``c_env``, ``v_slip``; ``density`` defaults to the ``[material]`` one);
 * ``[solver]`` -- ``dt`` (the first step, s), ``dt_max`` (Delta t_lim, default ``dt``), ``phi``, ``iterations``
   (K_d), ``tolerance`` (TOL), ``order`` (p), ``growth``, ``shrink``, ``dt_min`` (:class:`ZohdiStepping`);
-* ``[electrical]`` -- ``scheme`` (``"kirchhoff"`` or ``"zohdi"``), ``absorption`` (a of eq. 35), and for Zohdi's
+* ``[electrical]`` -- ``scheme`` (``"kirchhoff"`` or ``"zohdi"``), ``absorption`` (a of eq. 35), ``floating``
+  (``"allow"``: particles touching no electrode carry no current; ``"error"``: stop, naming them), and for Zohdi's
   iteration ``tolerance`` (largest change per sweep relative to the largest wall value) and ``sweeps`` (at most
   per refresh);
 * ``[[walls]]`` -- ``potential`` (V) or ``current`` (A into the packing; Zohdi's scheme: the wall's J_ext) makes a
@@ -30,7 +31,7 @@ from dem.zohdi.material import ZohdiMaterial, ZohdiStepping
 STEPPING_KEYS = {f.name for f in fields(ZohdiStepping)}
 OUTPUT_KEYS = {"fraction_axis", "frames"}
 DEFAULT_SKIN = 0.5  # x the mean radius: a step of the implicit scheme moves particles far more than a Verlet step
-ELECTRICAL_KEYS = {"scheme", "absorption", "tolerance", "sweeps"}
+ELECTRICAL_KEYS = {"scheme", "absorption", "tolerance", "sweeps", "floating"}
 ELECTRODE_KEYS = {"potential", "current"}
 
 
@@ -43,6 +44,7 @@ class ElectricalSpec:
     electrodes: Electrodes
     tolerance: float = 1e-8
     sweeps: int = 10_000
+    floating: str = "allow"
 
 
 def _number(table, section, key, default=None):
@@ -96,6 +98,10 @@ def parse_electrical(doc: dict, walls, physics) -> ElectricalSpec | None:
     sweeps = table.get("sweeps", 10_000)
     if not isinstance(sweeps, int) or isinstance(sweeps, bool) or sweeps < 1:
         raise ValueError(f"[electrical] sweeps = {sweeps!r}: must be an integer >= 1")
+    floating = table.get("floating", "allow")
+    if floating not in ("allow", "error"):
+        raise ValueError(f"[electrical] floating = {floating!r}: must be \"allow\" (groups touching no electrode carry "
+                         f"no current) or \"error\" (stop, naming them)")
     if not marked:
         raise ValueError("[[walls]] potential or current: \"electrical\" physics needs at least one electrode (a wall "
                          "with a potential in V or a current in A)")
@@ -116,7 +122,7 @@ def parse_electrical(doc: dict, walls, physics) -> ElectricalSpec | None:
     if scheme == "kirchhoff" and not np.any(electrodes.fixed_potential):
         raise ValueError("[[walls]] potential: scheme = \"kirchhoff\" needs one electrode at a fixed potential (e.g. "
                          "potential = 0.0 on the grounded wall) as the reference")
-    return ElectricalSpec(scheme, absorption, electrodes, float(tolerance), sweeps)
+    return ElectricalSpec(scheme, absorption, electrodes, float(tolerance), sweeps, floating)
 
 
 def strip_electrodes(tables: list) -> list:

@@ -56,7 +56,7 @@ class ZohdiSimulation:
         if "electrical" in scene.physics:
             e = scene.electrical
             self.current = ContactCurrent(p, m.walls, e.electrodes, scene.conductance, e.scheme, e.absorption,
-                                          e.tolerance, e.sweeps, scene.solver.linear)
+                                          e.tolerance, e.sweeps, scene.solver.linear, e.floating)
         self.models = [x for x in (self.mechanics, self.thermal, self.current) if x is not None]
         self.t, self.steps, self.restarts, self.iterations = 0.0, 0, 0, 0
         self.last_iterations, self.max_iterations = 0, 0
@@ -150,7 +150,8 @@ class ZohdiSimulation:
         if self.scene.motion.control is not None:
             self._lowest = min(self._lowest, -mech.w.q[self._top])
         if self.current is not None:
-            self.current.refresh(mech)
+            self.current.book(dt)
+            self.current.refresh(mech, self.t)
 
     def run(self, observer=None, progress=None) -> dict:
         """Advance to ``[solver] t_end``; ``observer(sim)`` at t = 0, whenever an output time is passed, and at the
@@ -245,6 +246,24 @@ class ZohdiSimulation:
     def profile(self):
         return None
 
+    def plates(self) -> list:
+        """The bottom and top walls of ``[output] fraction_axis`` as ``(centre, normal, sizes)`` for pictures
+        (:mod:`dem.frames`); none without that axis."""
+        axis = self.scene.motion.control
+        section = self._cross_section(axis) if axis is not None else None
+        if section is None:
+            return []
+        _, spans = section
+        out = []
+        for k in (self._bottom, self._top):
+            centre = np.zeros(3)
+            for a, lo, hi in spans:
+                centre[a] = 0.5 * (lo + hi)
+            normal = self.mechanics.w.normal[k]
+            centre[axis] = self.mechanics.w.q[k] * normal[axis]
+            out.append((centre, normal, tuple(hi - lo for _, lo, hi in spans)))
+        return out
+
     def summary(self) -> dict:
         mech = self.mechanics
         out = {k: v for k, v in self.record().items() if k not in ("step", "dt", "iterations")}
@@ -260,11 +279,12 @@ class ZohdiSimulation:
                        heat_in={k: float(v) for k, v in self.thermal.heat_in.items()}, law=self.scene.conductance.law)
         if self.current is not None:
             c = self.current
-            out.update(scheme=c.scheme, current_refreshes=c.refreshes)
+            out.update(scheme=c.scheme, current_refreshes=c.refreshes, joule_energy=c.joule_energy,
+                       peak_joule_heat=c.peak_power)
             if c.scheme == "zohdi":
                 out.update(current_sweeps=c.total_sweeps)
             else:
-                out.update(open_circuit_refreshes=c.open_refreshes,
+                out.update(electrode_energy=c.electrode_energy, open_circuit_refreshes=c.open_refreshes,
                            floating_particles=int(len(c.flow.floating)) if c.flow is not None else 0)
         return out
 
