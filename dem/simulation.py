@@ -107,6 +107,10 @@ def run_moving(scene: Scene, out=None, progress: bool = False) -> RunResult:
     start = time.perf_counter()
     sim = Simulation(scene)
     writer = MotionWriter(out, scene) if out is not None else None
+    if writer is not None and scene.motion.frames:
+        from dem.frames import WithFrames
+
+        writer = WithFrames(writer, scene, out)
     bar = None
     if progress:
         from tqdm import tqdm
