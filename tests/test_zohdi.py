@@ -330,3 +330,29 @@ def test_cli_bad_input_is_one_line_and_exit_2(tmp_path, capsys, table, key, valu
     assert main(["run", str(path)]) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+@pytest.mark.slow
+def test_section_7_three_phases_of_fig_9():
+    """The built-in scene (1000 spheres, 1 s): poured to 0.5-0.6, pressed to near full density, sprung back to
+    between the two; the temperature rises while pouring and pressing and falls after the release."""
+    from dem.scene import load_scene
+
+    rows = []
+    sim = ZohdiSimulation(load_scene("zohdi-compaction"))
+    sim.run(observer=lambda s: rows.append(s.record()))
+    t = np.array([r["t"] for r in rows])
+    vf = np.array([r["volume_fraction"] for r in rows])
+    T = np.array([r["T_mean"] for r in rows])
+    first = next(k for k, r in enumerate(rows) if r["joule_heat"] > 1.0)  # the top wall reaches the powder
+    poured, pressed, final = vf[first], vf.max(), vf[-1]
+    assert 0.5 <= poured <= 0.6
+    assert pressed >= 0.97
+    assert poured + 0.1 < final < pressed - 0.05
+    rising = (t <= 0.8) & (t > 0.0)
+    assert np.all(np.diff(T[rising]) >= -1e-9 * T[rising][1:])  # phases 1-2: never falls
+    assert T[first] > T[0] + 20.0 and T[t <= 0.8][-1] > T[first] + 1000.0
+    cooling = t >= t[np.argmax(T)]
+    assert t[np.argmax(T)] < 0.85 and np.all(np.diff(T[cooling]) < 0.0) and T[-1] < T.max() - 50.0
+    assert sim.thermal.energy_error() < 1e-12
+    assert sim.current.joule_energy == pytest.approx(sim.current.electrode_energy, rel=1e-12)
