@@ -158,7 +158,8 @@ def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrod
         heat_walls = np.where(G_plane > 0, wall_current**2 / G_plane, 0.0)
     joule_particles = (np.bincount(i, share * heat_pairs, n) + np.bincount(j, (1.0 - share) * heat_pairs, n)
                        + np.bincount(plane_node, heat_walls, n))
-    balance = np.bincount(plane_node, wall_current, n) - np.bincount(i, pair_current, n) + np.bincount(j, pair_current, n)
+    balance = (np.bincount(plane_node, wall_current, n) - np.bincount(i, pair_current, n)
+               + np.bincount(j, pair_current, n))
     # relative to the largest contact current, or (when almost none flows) to the largest G |V|
     scale = max(float(np.max(np.abs(pair_current), initial=0.0)), float(np.max(np.abs(wall_current), initial=0.0)),
                 1e-12 * float(np.max(G_plane, initial=0.0)) * float(np.max(np.abs(V), initial=0.0)))

@@ -81,11 +81,11 @@ class ContactCurrent:
                       if self.electrodes.current[self.electrodes.names.index(name)] != 0.0]
             if driven:
                 k = self.electrodes.names.index(driven[0])
+                touches = "only a group that reaches none" if np.any(b.wall_index == k) else "no particle"
                 raise ValueError(f"walls.{driven[0]}.current = {self.electrodes.current[k]:g} A at t = {t:.6g} s: no "
                                  f"path through the particles to an electrode at a fixed potential (the wall touches "
-                                 f"{'no particle' if not np.any(b.wall_index == k) else 'only a group that reaches none'})"
-                                 f"; a fixed current needs a closed circuit -- give the wall a potential (an open "
-                                 f"circuit then carries nothing) or start it in contact")
+                                 f"{touches}); a fixed current needs a closed circuit -- give the wall a potential "
+                                 f"(an open circuit then carries nothing) or start it in contact")
             self._check_floating(self.flow.floating, t)
             self.J = self.flow.potential
             joule = self.flow.joule_particles
@@ -98,9 +98,9 @@ class ContactCurrent:
     def _check_floating(self, floating: np.ndarray, t: float) -> None:
         if self.floating == "error" and len(floating):
             shown = ", ".join(str(int(k)) for k in floating[:10]) + (", ..." if len(floating) > 10 else "")
-            raise ValueError(f"[electrical] floating = \"error\": at t = {t:.6g} s {len(floating)} particle(s) touch no "
-                             f"electrode through their contacts (floating: their potential is undetermined and they "
-                             f"carry no current): {shown}")
+            raise ValueError(f"[electrical] floating = \"error\": at t = {t:.6g} s {len(floating)} particle(s) touch "
+                             f"no electrode through their contacts (floating: their potential is undetermined and "
+                             f"they carry no current): {shown}")
 
     def electrode_currents(self) -> dict:
         """Current into the packing (A) and potential (V) of each electrode (Kirchhoff), by name."""
