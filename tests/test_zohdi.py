@@ -356,3 +356,18 @@ def test_section_7_three_phases_of_fig_9():
     assert t[np.argmax(T)] < 0.85 and np.all(np.diff(T[cooling]) < 0.0) and T[-1] < T.max() - 50.0
     assert sim.thermal.energy_error() < 1e-12
     assert sim.current.joule_energy == pytest.approx(sim.current.electrode_energy, rel=1e-12)
+
+
+def test_compiled_lens_conduction_is_the_conductance_law_on_the_bonds():
+    """The paper's law evaluated on the Verlet list in compiled code gives the heat flows of the general path
+    (dem.bonds.find_bonds + dem.laws.conductance with law = "zohdi"), here on a pressed column with hot walls."""
+    doc = column()
+    doc["walls"][0]["temperature"] = 900.0
+    sim = ZohdiSimulation(parse_scene(doc))
+    th, mech = sim.thermal, sim.mechanics
+    T = np.random.default_rng(0).uniform(300.0, 700.0, mech.state.n)
+    assert th.compiled
+    compiled = th.conduction(mech, mech.state.x, T)
+    th.compiled = False
+    general = th.conduction(mech, mech.state.x, T)
+    assert np.all(compiled != 0.0) and np.allclose(compiled, general, rtol=1e-12, atol=0.0)
