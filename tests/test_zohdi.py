@@ -371,3 +371,17 @@ def test_compiled_lens_conduction_is_the_conductance_law_on_the_bonds():
     th.compiled = False
     general = th.conduction(mech, mech.state.x, T)
     assert np.all(compiled != 0.0) and np.allclose(compiled, general, rtol=1e-12, atol=0.0)
+
+
+@pytest.mark.slow
+def test_frames_are_rendered_off_screen(tmp_path):
+    from dem.frames import FrameWriter
+
+    doc = column()
+    doc["output"] = {"fraction_axis": "x"}
+    sim = ZohdiSimulation(parse_scene(doc))
+    frames = FrameWriter(tmp_path, 2, 0.01, 0, 300.0, 1000.0)
+    frames(sim)
+    sim.run(observer=frames)
+    assert frames.written == ["frame_00.png", "frame_01.png"]
+    assert all((tmp_path / "frames" / name).stat().st_size > 10_000 for name in frames.written)
