@@ -90,18 +90,29 @@ class CurrentFlow:
     no_path: tuple
     residual: float
 
+    @property
+    def closed(self) -> bool:
+        """Whether any current flows (a group of particles joins two electrodes)."""
+        return bool(np.any(self.electrode_current != 0.0))
+
 
 def _grounded(n, i, j, plane_node, plane_index, electrodes: Electrodes):
     """Which particles and which electrodes are connected (through particles and electrodes) to an electrode at a
-    fixed potential: ``(particle mask, electrode mask)``."""
+    fixed potential: ``(particle mask, electrode mask, lone)``, ``lone`` the electrode each particle of a group
+    that reaches exactly one electrode shares its potential with (-1 elsewhere): such a group carries no current."""
     n_e = len(electrodes)
     rows = np.concatenate([i, plane_node])
     cols = np.concatenate([j, n + plane_index])
     graph = sp.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(n + n_e, n + n_e))
-    _, label = connected_components(graph, directed=False)
+    n_comp, label = connected_components(graph, directed=False)
     grounded_labels = np.unique(label[n + np.flatnonzero(electrodes.fixed_potential)])
     reached = np.isin(label, grounded_labels)
-    return reached[:n], reached[n:]
+    electrode_label = label[n:]
+    count = np.bincount(electrode_label, minlength=n_comp)
+    owner = np.full(n_comp, -1)
+    owner[electrode_label] = np.arange(n_e)
+    lone = np.where(count[label[:n]] == 1, owner[label[:n]], -1)
+    return reached[:n], reached[n:], lone
 
 
 def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrodes: Electrodes,
@@ -117,7 +128,7 @@ def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrod
     if not np.any(electrodes.fixed_potential):
         raise ValueError("[electrical] no electrode at a fixed potential: give one wall a potential (e.g. "
                          "potential = 0.0, the ground) as the reference of the others")
-    on_particles, on_electrodes = _grounded(n, i, j, plane_node, plane_index, electrodes)
+    on_particles, on_electrodes, lone = _grounded(n, i, j, plane_node, plane_index, electrodes)
     driven = ~electrodes.fixed_potential
     no_path = tuple(name for name, d, r in zip(electrodes.names, driven, on_electrodes) if d and not r)
     floating = np.flatnonzero(~on_particles)
@@ -147,6 +158,8 @@ def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrod
         Y = np.column_stack([into_packing(x, e) for x, e in unit])
         V[active] = np.linalg.solve(Y, electrodes.current[active] - I0)
         potential[subset] = x0 + sum(V[m] * x[subset] for m, (x, _) in zip(active, unit))
+    held = (lone >= 0) & on_particles  # a group reaching one electrode only: at its potential, exactly
+    potential[held] = V[lone[held]]
     electrode_potential = np.where(electrodes.fixed_potential | on_electrodes, V, np.nan)
     x = np.nan_to_num(potential)  # floating particles carry nothing: their contacts join equal (zero) values
     pair_current = G * (x[i] - x[j])

@@ -90,7 +90,7 @@ class ContactCurrent:
             self.J = self.flow.potential
             joule = self.flow.joule_particles
             self.joule_heat, self.electrode_power = self.flow.joule_heat, self.flow.electrode_power
-            if self.flow.no_path or not np.any(self.flow.electrode_current):
+            if not self.flow.closed:
                 self.open_refreshes += 1
         self.heating = self.absorption * joule
         return self.heating
