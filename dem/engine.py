@@ -123,8 +123,17 @@ class Simulation:
             ends.update(range(every, n_end, every))
         if self.schedule is not None:
             ends.update(k for k in (round(t / dt) for t in self.schedule.time) if 0 < k < n_end)
-        ends.update(k for k in (round(start / dt) for start, _ in m.phases) if 0 < k < n_end)
+        ends.update(k for k in (round(start / dt) for start, _ in m.phases + m.wall_phases) if 0 < k < n_end)
         return sorted(ends)
+
+    def _wall_speeds_at(self, t: float) -> None:
+        """Strain walls at the speeds of every ``[[phases]]`` ``wall_velocity`` entry started by time ``t``."""
+        mech = self.mechanics
+        names = [w.name for w in mech.walls]
+        for start, speeds in self.scene.motion.wall_phases:
+            if start <= t * (1 + 1e-12) + 1e-300:
+                for name, velocity in speeds.items():
+                    mech.w.dq[names.index(name)] = velocity
 
     def run(self, observer=None, progress=None, checkpoint=None, position=None) -> dict:
         """Advance to ``[solver] t_end``; ``observer(sim)`` after each interval that ends on an output time (and at
@@ -144,6 +153,7 @@ class Simulation:
                 continue
             T0, rate, t0 = self._interval_temperatures(mech.t, end * mech.dt)
             mech.params = self._params_at(mech.t)
+            self._wall_speeds_at(mech.t)
             mech.advance(steps, T0, rate, t0)
             if self.thermal is not None:
                 self.thermal.step(mech, steps * mech.dt)

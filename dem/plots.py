@@ -3,7 +3,9 @@
 * :func:`motion_plots` -- a run with moving particles: ``timeseries.png`` (solid fraction, coordination number,
   kinetic energy, stiffness factor k1(T, t)/k1, temperatures, wall stresses and, with heated walls, the effective
   conductivity, each against time) and ``profiles.png`` (solid fraction and neck radius against the distance from
-  the hot wall, one curve per snapshot time);
+  the hot wall, one curve per snapshot time); with a Joule-heated run (a ``joule_heat`` column),
+  ``fraction_temperature.png``: the volume fraction and the mean temperature against time on two axes, the times
+  when current flows shaded (Zohdi 2014, Fig. 9);
 * :func:`draw_packing` -- a 2D packing with its contacts in the style of Luding 2005, Figs. 20-22.
 """
 
@@ -99,6 +101,8 @@ def motion_plots(out_dir) -> list[str]:
         fig.savefig(out / "timeseries.png", dpi=120)
         plt.close(fig)
         written.append("timeseries.png")
+    if data and "joule_heat" in data and "volume_fraction" in data and "T_mean" in data:
+        written.append(_fraction_temperature(plt, out, data))
     if (out / "profiles.csv").exists():
         prof = _read_csv(out / "profiles.csv")
         if prof:
@@ -188,3 +192,24 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
         plt.close(fig)
         written.append("profile.png")
     return written
+
+
+def _fraction_temperature(plt, out: pathlib.Path, data: dict) -> str:
+    """Volume fraction and mean temperature against time, the times with current shaded (Zohdi 2014, Fig. 9)."""
+    t = data["t"]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(t, data["volume_fraction"], color="tab:blue")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("volume fraction", color="tab:blue")
+    other = ax.twinx()
+    other.plot(t, data["T_mean"], color="tab:red")
+    other.set_ylabel("mean temperature", color="tab:red")
+    peak = max((v for v in data["joule_heat"] if v == v), default=0.0)
+    on = [v == v and v > 1e-9 * peak for v in data["joule_heat"]]  # not the round-off of an open circuit
+    ax.fill_between(t, 0, 1, where=on, transform=ax.get_xaxis_transform(), color="gold", alpha=0.25,
+                    label="current flowing")
+    ax.legend(loc="upper left", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "fraction_temperature.png", dpi=120)
+    plt.close(fig)
+    return "fraction_temperature.png"

@@ -145,23 +145,36 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
 
 
 def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = False) -> RunResult:
-    """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engine` (``out`` prepared
-    by :func:`run`)."""
+    """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engine`, or with
+    ``[contact] law = "zohdi"`` the staggered scheme of :mod:`dem.zohdi.simulation` (``out`` prepared by
+    :func:`run`)."""
     from dem import state_file
-    from dem.engine import Simulation
     from dem.io import MotionWriter
+
+    zohdi = scene.contact.law == "zohdi"
+    if zohdi:
+        from dem.zohdi.simulation import ZohdiSimulation as Simulation
+
+        if resume:
+            raise ValueError("--resume: runs of the zohdi contact law write no checkpoints; run again with --overwrite")
+    else:
+        from dem.engine import Simulation
 
     start = time.perf_counter()
     here = _position(scene, out, progress)
     saved = state_file.normalised(run_folder.load(out, scene, "moving")) if resume else None
-    sim = Simulation(scene, resume=saved)
+    sim = Simulation(scene) if zohdi else Simulation(scene, resume=saved)
     writer = MotionWriter(out, scene, resume_step=sim.mechanics.steps if resume else None) if out is not None \
         else None
-    checkpoint = run_folder.Checkpointer(out, scene, "moving", scene.output.checkpoint_every) if out is not None \
-        else None
+    if writer is not None and scene.motion.frames:
+        from dem.frames import WithFrames
+
+        writer = WithFrames(writer, scene, out)
+    checkpoint = run_folder.Checkpointer(out, scene, "moving", scene.output.checkpoint_every) \
+        if out is not None and not zohdi else None
     bar, report = _progress_bar(scene, progress)
     try:
-        details = sim.run(writer, report, checkpoint, here)
+        details = sim.run(writer, report) if zohdi else sim.run(writer, report, checkpoint, here)
     except KeyboardInterrupt:
         if writer is not None:
             writer.interrupted({"scene": scene.name, "interrupted": True, **sim.summary()})
@@ -176,7 +189,7 @@ def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = Fa
     summary = {"scene": scene.name, "mode": "transient", "physics": list(scene.physics), "static": False, **details}
     if resume:
         summary["resumed_from"] = {"t": float(saved["t"]), "steps": int(saved["steps"])}
-    if out is not None:
+    if out is not None and not zohdi:
         summary["state"] = state_file.save(sim, pathlib.Path(out) / "state.npz").name
     if scene.particles.n <= T_LIST_MAX:
         summary["T"] = sim.mechanics.state.T.tolist()

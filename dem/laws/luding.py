@@ -78,6 +78,8 @@ class LudingMaterial:
     brittle_sliding: bool
     density: float
 
+    law = "luding"
+
     def __post_init__(self):
         for f in fields(self):
             value = getattr(self, f.name)
