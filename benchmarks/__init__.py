@@ -18,4 +18,5 @@ SUBJECTS = {
     "fe": "benchmarks.fe",  # FE conductance: error against time, NGSolve, the fit, the main command's start-up
     "dem": "benchmarks.dem",  # DEM solvers: transient accuracy, steady scaling, linear solvers, OpenPNM
     "mechanics": "benchmarks.mechanics",  # the moving-particle loop against LAMMPS, compile cost, thermal-only path
+    "electrical": "benchmarks.electrical",  # Zohdi 2014's Section 7 example, step cost, Kirchhoff against eq. 43
 }

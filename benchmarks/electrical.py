@@ -1,7 +1,7 @@
 """Speed of the Zohdi 2014 engine: the Section 7 example, the cost of its steps against the velocity-Verlet loop of
 the Luding engine, and the Kirchhoff solve against the paper's current iteration at equal accuracy.
 
-``python -m verification.bench_zohdi [--repeat R] [--json]`` measures, in one process:
+The ``electrical`` subject of ``python -m benchmarks`` (:func:`run`) measures, in one process:
 
 * ``section7`` -- the built-in scene ``zohdi-compaction`` (1000 spheres, 1 s, Sec. 7) run end to end (the wall time
   of :meth:`dem.zohdi.simulation.ZohdiSimulation.run`, no outputs written), with its steps, fixed-point iterations,
@@ -20,18 +20,21 @@ the Luding engine, and the Kirchhoff solve against the paper's current iteration
   the height, the direct solve with its fill-in.
 
 :func:`section7_row` is the row a benchmark table needs (seconds, steps, iterations, restarts, ns per
-particle-iteration). Timings on a shared machine are noisy: compare the ratios measured here side by side.
+particle-iteration); its seconds are held against :data:`SECTION7_LIMIT`. Timings on a shared machine are noisy:
+compare the ratios measured here side by side.
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
-import sys
 import time
 
 import numpy as np
+
+from verification.report import md_table
+
+TITLE = "Electrically aided sintering (Zohdi 2014): the Section 7 example, step cost, current solves"
+SECTION7_LIMIT = 60.0  # s: the Section 7 example end to end
 
 
 def _scene():
@@ -226,25 +229,31 @@ def current_scaling(sizes=(1000, 4000, 16000), accuracy: float = 1e-6, repeat: i
     return rows
 
 
-def measure(repeat: int = 5) -> dict:
+def run(section, quick: bool) -> None:
+    """The studies of the module docstring into ``section`` (:mod:`benchmarks`' subject interface); ``quick``:
+    fewer repeats and the current scaling to 4000 particles."""
+    repeat = 2 if quick else 5
     row = section7_row()
+    section.summary["zohdi_section7"] = row
+    section.target("the Section 7 example (1000 spheres, 1 s) end to end", row["seconds"], SECTION7_LIMIT, "s")
     sim = compacted()
-    return {"section7": row, "step_cost": step_cost(sim, repeat), "current_solve": current_solve(sim, repeat),
-            "current_scaling": current_scaling(repeat=min(repeat, 3)), "cores": os.cpu_count(),
-            "load_average": os.getloadavg()[0]}
-
-
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m verification.bench_zohdi", description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=5, help="best of R (default 5)")
-    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout, nothing else")
-    args = parser.parse_args(argv)
-    if args.repeat < 1:
-        parser.error(f"--repeat = {args.repeat}: must be >= 1")
-    result = measure(args.repeat)
-    print(json.dumps(result) if args.json else "\n".join(f"{k}: {v}" for k, v in result.items()))
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    cost = step_cost(sim, repeat)
+    solve = current_solve(sim, repeat)
+    scaling = current_scaling(sizes=(1000, 4000) if quick else (1000, 4000, 16000), repeat=min(repeat, 3))
+    section.summary.update(zohdi_step_cost=cost, zohdi_current_solve=solve, zohdi_current_scaling=scaling)
+    section.csv("current_scaling", scaling)
+    phases = row["phases"]
+    section.add_text("The Section 7 example", (
+        f"{row['particles']} spheres, 1 s: {row['seconds']:.1f} s end to end, {row['steps']} steps, "
+        f"{row['iterations']} fixed-point iterations ({row['iterations_per_step']:.1f} per step), {row['restarts']} "
+        f"restarts, steps {row['dt_min']:.2g} ... {row['dt_max']:.2g} s. Volume fraction poured "
+        f"{phases['poured']['volume_fraction']:.3f}, pressed {phases['compacted']['volume_fraction']:.3f}, released "
+        f"{phases['released']['volume_fraction']:.3f}; energy error {row['energy_error']:.1e}, Joule energy "
+        f"{row['joule_energy']:.4g} J = electrode energy {row['electrode_energy']:.4g} J."))
+    section.add_text("Cost per particle against the Luding loop", (
+        f"On the pressed packing ({cost['particles']} spheres, {cost['contacts']} contacts, {cost['listed_pairs']} "
+        f"listed pairs), best of {repeat}; a step takes {cost['iterations_per_step']:.1f} iterations.\n\n"
+        + md_table(["piece", "ns per particle"], [[k, v] for k, v in cost["ns_per_particle"].items()])))
+    section.add_text("The network solve against the paper's current iteration (eq. 43)", md_table(
+        ["particles", *[k for k in scaling[0] if k != "particles"]],
+        [[r["particles"], *[r[k] for k in r if k != "particles"]] for r in scaling]))
