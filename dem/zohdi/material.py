@@ -18,6 +18,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from dem.laws.fields import check_fields
+
 # Indices into ZohdiMaterial.params()
 Z_KP = 0           # K_p0, particle-particle contact stiffness, cold (N/m^2, eq. 2)
 Z_PP = 1           # p_p, exponent of the particle contact law (eq. 2)
@@ -72,16 +74,7 @@ class ZohdiMaterial:
     law = "zohdi"
 
     def __post_init__(self):
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if (not isinstance(value, (int, float, np.floating, np.integer)) or isinstance(value, bool)
-                    or not math.isfinite(value)):
-                raise ValueError(f"contact.{f.name} = {value!r}: must be a finite number")
-        for limits, bound in ((_POSITIVE, "> 0"), (_NONNEGATIVE, ">= 0")):
-            for name, unit in limits.items():
-                value = getattr(self, name)
-                if value < 0 or (value == 0 and bound == "> 0"):
-                    raise ValueError(f"contact.{name} = {value!r}: must be {bound}{f' ({unit})' if unit else ''}")
+        check_fields(self, "contact", _POSITIVE, _NONNEGATIVE)
         for cold, floor in (("K_p", "K_p_lim"), ("K_w", "K_w_lim")):
             if getattr(self, floor) > getattr(self, cold):
                 raise ValueError(f"contact.{floor} = {getattr(self, floor)!r}: must be <= {cold} = "

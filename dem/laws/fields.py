@@ -1,0 +1,27 @@
+"""The checks every contact-law material makes of its fields: booleans where a flag is meant, finite numbers
+elsewhere, and the sign each number must have -- one ``ValueError`` naming the field, the value and the rule."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import fields
+
+import numpy as np
+
+
+def check_fields(material, section: str, positive: dict, nonnegative: dict, flags=()) -> None:
+    """Raise for the first field of the dataclass ``material`` that is not a finite number (or a bool, for the names
+    in ``flags``), or breaks its sign: ``positive``/``nonnegative`` map field names to their units."""
+    for f in fields(material):
+        value = getattr(material, f.name)
+        if f.name in flags:
+            if not isinstance(value, (bool, np.bool_)):
+                raise ValueError(f"{section}.{f.name} = {value!r}: must be true or false")
+        elif (not isinstance(value, (int, float, np.floating, np.integer)) or isinstance(value, bool)
+              or not math.isfinite(value)):
+            raise ValueError(f"{section}.{f.name} = {value!r}: must be a finite number")
+    for limits, bound in ((positive, "> 0"), (nonnegative, ">= 0")):
+        for name, unit in limits.items():
+            value = getattr(material, name)
+            if value < 0 or (value == 0 and bound == "> 0"):
+                raise ValueError(f"{section}.{name} = {value!r}: must be {bound}{f' ({unit})' if unit else ''}")
