@@ -17,6 +17,7 @@ import numpy as np
 
 from dem import generators, state_file
 from dem.laws.conductance import ConductanceSpec
+from dem.laws.fields import material_from_table
 from dem.laws.luding import LudingMaterial
 from dem.zohdi.material import ZohdiMaterial
 from dem.zohdi.scene import ElectricalSpec, parse_electrical, zohdi_material
@@ -464,16 +465,7 @@ def luding_material_from_scene(doc_or_scene) -> LudingMaterial:
         values["density"] = material["density"]
     if table["law"] != "luding":
         raise ValueError(f"[contact] law = {table['law']!r}: not the Luding 2005 sintering contact (law = \"luding\")")
-    extra = sorted(set(values) - {f.name for f in fields(LudingMaterial)})
-    if extra:
-        raise ValueError(f"[contact] {extra[0]}: not a parameter of law = \"luding\" (its parameters: "
-                         f"{', '.join(f.name for f in fields(LudingMaterial))})")
-    missing = [f.name for f in fields(LudingMaterial) if f.name not in values]
-    if missing:
-        raise ValueError(f"[contact] {missing[0]}: required (law = \"luding\" needs "
-                         f"{', '.join(f.name for f in fields(LudingMaterial))})")
-    numeric = tuple(key for key in values if key != "brittle_sliding")
-    return _spec(LudingMaterial, values, "contact", numeric=numeric)
+    return material_from_table(LudingMaterial, "luding", values)
 
 
 def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls) -> None:

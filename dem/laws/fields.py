@@ -25,3 +25,21 @@ def check_fields(material, section: str, positive: dict, nonnegative: dict, flag
             value = getattr(material, name)
             if value < 0 or (value == 0 and bound == "> 0"):
                 raise ValueError(f"{section}.{name} = {value!r}: must be {bound}{f' ({unit})' if unit else ''}")
+
+
+def material_from_table(cls, law: str, values: dict):
+    """The material ``cls`` of the contact law ``law`` from a scene's ``[contact]`` values (without ``law``): every
+    field required, no other; a bad value is reported as ``[contact] name = value: rule``."""
+    names = [f.name for f in fields(cls)]
+    extra = sorted(set(values) - set(names))
+    if extra:
+        raise ValueError(f"[contact] {extra[0]}: not a parameter of law = \"{law}\" (its parameters: "
+                         f"{', '.join(names)})")
+    missing = [name for name in names if name not in values]
+    if missing:
+        raise ValueError(f"[contact] {missing[0]}: required (law = \"{law}\" needs {', '.join(names)})")
+    try:
+        return cls(**values)
+    except ValueError as exc:
+        msg = str(exc)
+        raise ValueError(f"[contact] {msg[len('contact.'):]}" if msg.startswith("contact.") else msg) from None

@@ -26,6 +26,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from dem.electrical import Electrodes, check_absorption, check_scheme
+from dem.laws.fields import material_from_table
 from dem.zohdi.material import ZohdiMaterial, ZohdiStepping
 
 STEPPING_KEYS = {f.name for f in fields(ZohdiStepping)}
@@ -132,22 +133,7 @@ def strip_electrodes(tables: list) -> list:
 
 def zohdi_material(values: dict) -> ZohdiMaterial:
     """A :class:`ZohdiMaterial` from the ``[contact]`` values (without ``law``)."""
-    allowed = {f.name for f in fields(ZohdiMaterial)}
-    extra = sorted(set(values) - allowed)
-    if extra:
-        raise ValueError(f"[contact] {extra[0]}: not a parameter of law = \"zohdi\" (its parameters: "
-                         f"{', '.join(sorted(allowed))})")
-    missing = [f.name for f in fields(ZohdiMaterial) if f.name not in values]
-    if missing:
-        raise ValueError(f"[contact] {missing[0]}: required (law = \"zohdi\" needs "
-                         f"{', '.join(f.name for f in fields(ZohdiMaterial))})")
-    for key, v in values.items():
-        _number(values, "contact", key)
-    try:
-        return ZohdiMaterial(**values)
-    except ValueError as exc:
-        msg = str(exc)
-        raise ValueError(f"[contact] {msg[len('contact.'):]}" if msg.startswith("contact.") else msg) from None
+    return material_from_table(ZohdiMaterial, "zohdi", values)
 
 
 def refuse_zohdi_keys(doc: dict, physics) -> None:
