@@ -18,5 +18,6 @@ SUBJECTS = {
     "fe": "benchmarks.fe",  # FE conductance: error against time, NGSolve, the fit, the main command's start-up
     "dem": "benchmarks.dem",  # DEM solvers: transient accuracy, steady scaling, linear solvers, OpenPNM
     "mechanics": "benchmarks.mechanics",  # the moving-particle loop against LAMMPS, compile cost, thermal-only path
+    "electrical": "benchmarks.electrical",  # Zohdi 2014's Section 7 example, step cost, Kirchhoff against eq. 43
     "laws": "benchmarks.shared_body",  # the shared-body conductance law against today's, same packing, to 10^6
 }

@@ -82,11 +82,12 @@ class Sizes:
     thermal_scenes: tuple = ("lattice", "packing-transient")
     thermal_rounds: int = 5
     full_size: bool = True  # the 3D target is defined on ~10^4 spheres
+    schedule: tuple = (300, 1.0)  # (N, t_s) of the whole sintering schedule; the target is defined on (300, 1 s)
 
 
 FULL = Sizes()
 QUICK = Sizes(cells=(8, 8, 8), steps_2d=5_000, steps_3d=500, rounds=2, kernel_contacts=10**5, thermal_rounds=3,
-              full_size=False)
+              full_size=False, schedule=(100, 0.1))
 
 
 def linear_limit(material: LudingMaterial) -> LudingMaterial:
@@ -799,3 +800,26 @@ def run(section, quick: bool, sizes: Sizes | None = None, cache: pathlib.Path | 
     study_loop(section, sizes, cache)
     study_compile(section, sizes)
     study_thermal_only(section, sizes)
+    study_schedule(section, sizes)
+
+
+SCHEDULE_LIMIT = 60.0  # s: the whole schedule of Luding 2005 Fig. 7, t_s = 1, N = 300
+
+
+def study_schedule(section, sizes: Sizes) -> None:
+    """The whole sintering schedule of Luding 2005 (Fig. 7: preparation, heating, sintering for t_s, cooling,
+    relaxation; ``sizes.schedule`` = (N, t_s) disks and seconds, p = 100 N/m) in a fresh process, with its seconds
+    against the target where it is defined, (300, 1 s)."""
+    n, t_s = sizes.schedule
+    code = ("import json; from verification.sintering_runs import schedule_seconds; "
+            f"print(json.dumps(schedule_seconds({n}, 100.0, {t_s})))")
+    row = json.loads(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                                    timeout=3600).stdout.strip().splitlines()[-1])
+    section.summary["sintering_schedule"] = row
+    section.target("the whole sintering schedule (Luding 2005 Fig. 7), N = 300, t_s = 1 s",
+                   row["seconds"] if (n, t_s) == (300, 1.0) else None, SCHEDULE_LIMIT, "s")
+    section.add_text("The whole sintering schedule", (
+        f"Luding 2005's protocol in one run (`verification.sintering_runs.schedule_seconds`): N = {n} disks, p = "
+        f"100 N/m, t_s = {t_s:g} s; {row['steps']} steps of t_MD, {row['seconds']:.1f} s in all "
+        f"({row['ns_per_particle_step']:.0f} ns per particle-step in the loop), final solid fraction "
+        f"{row['volume_fraction']:.4f}, coordination {row['coordination']:.2f}."))

@@ -30,7 +30,6 @@ from dem.mechanics import MechanicalModel
 from dem.motion import MotionState
 from dem.thermal import boundary_heat_flow, steady
 from fem_neck.geometry import neck_radius
-from fem_neck.interrupt import where
 
 
 class Simulation:
@@ -86,12 +85,15 @@ class Simulation:
         return "network" if self.thermal is not None else "initial"
 
     # ------------------------------------------------------------------------------------------------ loop
-    def _interval_temperatures(self, t: float):
-        """``(T0, rate, relaxation_time)`` over the interval starting at ``t`` (length-1 arrays: uniform)."""
+    def _interval_temperatures(self, t: float, t_end: float):
+        """``(T0, rate, relaxation_time)`` over the interval ``[t, t_end]`` (length-1 arrays: uniform). The
+        schedule's segment is the one holding the interval's middle: an interval ends at every knot, but its start
+        ``k dt`` may fall a little before the knot it begins at (the knot rounded to the step grid)."""
         mech = self.mechanics
         if self.schedule is not None:
-            return (np.array([self.schedule.at(t)]), np.array([self.schedule.rate(t)]),
-                    self.schedule.relaxation(t))
+            middle = 0.5 * (t + t_end)
+            return (np.array([self.schedule.at(t)]), np.array([self.schedule.rate(middle)]),
+                    self.schedule.relaxation(middle))
         if self.thermal is not None:  # the network's temperatures, extrapolated with its last rate (cooling is
             T, rate = self.thermal.T, self.thermal.rate  # then seen as cooling: k1(T, t) freezes, Sec. 3.4)
         else:
@@ -121,27 +123,37 @@ class Simulation:
             ends.update(range(every, n_end, every))
         if self.schedule is not None:
             ends.update(k for k in (round(t / dt) for t in self.schedule.time) if 0 < k < n_end)
-        ends.update(k for k in (round(start / dt) for start, _ in m.phases) if 0 < k < n_end)
+        ends.update(k for k in (round(start / dt) for start, _ in m.phases + m.wall_phases) if 0 < k < n_end)
         return sorted(ends)
 
-    def run(self, observer=None, progress=None, checkpoint=None) -> dict:
+    def _wall_speeds_at(self, t: float) -> None:
+        """Strain walls at the speeds of every ``[[phases]]`` ``wall_velocity`` entry started by time ``t``."""
+        mech = self.mechanics
+        names = [w.name for w in mech.walls]
+        for start, speeds in self.scene.motion.wall_phases:
+            if start <= t * (1 + 1e-12) + 1e-300:
+                for name, velocity in speeds.items():
+                    mech.w.dq[names.index(name)] = velocity
+
+    def run(self, observer=None, progress=None, checkpoint=None, position=None) -> dict:
         """Advance to ``[solver] t_end``; ``observer(sim)`` after each interval that ends on an output time (and at
         t = 0), ``progress(t)`` after every interval, ``checkpoint(make)`` after every interval and at the end
-        (:class:`dem.run_folder.Checkpointer`)."""
+        (:class:`dem.run_folder.Checkpointer`); ``position`` (:class:`fem_neck.interrupt.Where`) learns the step and
+        time after every interval."""
         from dem.state_file import arrays
 
         m, mech = self.scene.motion, self.mechanics
         n_end = max(1, math.ceil(self.scene.solver.t_end / mech.dt - 1e-9))
         out_every = max(1, round(m.output_interval / mech.dt))
-        here = where()
         if observer is not None and mech.steps == 0:
             observer(self)
         for end in self._interval_ends(n_end):
             steps = end - mech.steps
             if steps <= 0:
                 continue
-            T0, rate, t0 = self._interval_temperatures(mech.t)
+            T0, rate, t0 = self._interval_temperatures(mech.t, end * mech.dt)
             mech.params = self._params_at(mech.t)
+            self._wall_speeds_at(mech.t)
             mech.advance(steps, T0, rate, t0)
             if self.thermal is not None:
                 self.thermal.step(mech, steps * mech.dt)
@@ -150,7 +162,8 @@ class Simulation:
                 observer(self)
             if progress is not None:
                 progress(mech.t)
-            here.update(step=mech.steps, t=mech.t)
+            if position is not None:
+                position.update(step=mech.steps, t=mech.t)
             if checkpoint is not None:
                 checkpoint(lambda: arrays(self), final=end == n_end)
         return self.summary()

@@ -40,10 +40,11 @@ STATUS = {DONE: "done", REBUILD: "rebuild", NONFINITE: "non-finite", ESCAPED: "e
 
 @njit(cache=True, error_model="numpy")
 def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn, p_ft,
-            wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt):
+            wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt, record=True):
     """Forces and torques of the current state (gravity, pairs, the listed particle-wall pairs ``(wk, wm)``); the
     normal forces on the walls go into ``wforce``. Returns the index into the wall list of the first particle whose
-    centre lies behind its wall, else -1.
+    centre lies behind its wall, else -1. With ``record`` the contact forces are kept (``p_fn``, ``p_ft``, ``w_fn``,
+    ``w_ft``: outputs only, so the time loop records them on the last step of a call).
 
     The contact kernels are called right here, scalars and 3-tuples in and out: wrapped in a helper returning its
     eight results they cost 30 % more, and with array arguments (reference counting on every call) 4x more."""
@@ -68,8 +69,9 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
             if p_dmax[c] != 0.0:  # the contact opened: it forgets its history
                 p_dmax[c] = 0.0
                 p_xi[c, 0], p_xi[c, 1], p_xi[c, 2] = 0.0, 0.0, 0.0
-            p_fn[c] = 0.0
-            p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = 0.0, 0.0, 0.0
+            if record:
+                p_fn[c] = 0.0
+                p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = 0.0, 0.0, 0.0
             continue
         d = math.sqrt(d2)
         n0, n1, n2 = dx / d, dy / d, dz / d
@@ -93,8 +95,9 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
         p_dmax[c] = dmax
         p_k1last[c] = k1c
         p_xi[c, 0], p_xi[c, 1], p_xi[c, 2] = xi
-        p_fn[c] = f_n
-        p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
+        if record:
+            p_fn[c] = f_n
+            p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
         g0, g1, g2 = f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2
         f[i, 0] += g0
         f[i, 1] += g1
@@ -125,7 +128,7 @@ def _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_
             if w_dmax[k, m] != 0.0:
                 w_dmax[k, m] = 0.0
                 w_xi[k, m, 0], w_xi[k, m, 1], w_xi[k, m, 2] = 0.0, 0.0, 0.0
-                w_fn[k, m] = 0.0
+                w_fn[k, m] = 0.0  # (rare: a wall contact opening; kept unconditionally)
                 w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = 0.0, 0.0, 0.0
             continue
         lk = rk - 0.5 * delta
@@ -177,10 +180,12 @@ def _material_state(elapsed, T0, T_rate, T, radius, radius_ref, k1f, uniform, pa
         target = k1_factor(Tu, T_melt, T_var)
         scale = radius_at(1.0, Tu, T_melt, expansion)
         cooling = T_rate[0] < 0.0
+        old = k1f[0]
+        new = relax_k1(old, target, dt, t0, cooling)  # the factors of a uniform temperature are all equal
         for k in range(n):
             T[k] = Tu
             radius[k] = radius_ref[k] * scale
-            k1f[k] = relax_k1(k1f[k], target, dt, t0, cooling)
+            k1f[k] = new if k1f[k] == old else relax_k1(k1f[k], target, dt, t0, cooling)
     else:
         for k in range(n):
             T[k] = T0[k] + T_rate[k] * elapsed
@@ -227,7 +232,8 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, lin, rot,
         _material_state((step0 + s + 1 - first) * dt, T0, T_rate, T, radius, radius_ref, k1f, uniform_T, params, t0,
                         dt)
         escaped = _forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn,
-                          p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt)
+                          p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt,
+                          s == n_steps - 1)
         worst = 0.0
         for k in range(n):
             im, ii = 1.0 / mass[k], 1.0 / inertia[k]

@@ -5,13 +5,16 @@ Tables and keys (SI units; the README's scene schema lists them with their defau
 
 * ``[scene] dimension`` (3: spheres; 2: disks in the x-z plane) and ``height`` (m, the disks' height);
 * ``[particles] velocity``, ``angular_velocity`` (lists of 3-vectors; or the generator's random ``speed``);
-* ``[contact]`` -- the contact law and its parameters (``law = "luding"``, Luding 2005);
+* ``[contact]`` -- the contact law and its parameters (``law = "luding"``, Luding 2005; ``law = "zohdi"``,
+  Zohdi 2014: its stepping, current and electrode keys are those of :mod:`dem.zohdi.scene`);
 * ``[[walls]]`` -- planes that move: ``motion`` fixed | stress | strain | vibrate with ``pressure``, ``mass``,
   ``damping``, ``velocity``, ``amplitude``, ``frequency`` (:mod:`dem.walls`); ``temperature`` optional;
 * ``[gravity] acceleration`` (m/s^2, a 3-vector);
 * ``[temperature]`` -- a prescribed schedule ``time``, ``value``, ``relaxation_time`` (:mod:`dem.schedule`);
 * ``[[phases]]`` -- from time ``start`` on, other friction or damping (``mu``, ``mu_wall``, ``gamma_n``,
-  ``gamma_t``): Luding 2005 prepares frictionless and switches the friction at t_heat;
+  ``gamma_t``): Luding 2005 prepares frictionless and switches the friction at t_heat; and other wall speeds
+  (``wall_velocity = {name = v}``, m/s inward, for strain walls): a wall pushed, held and pulled away (Zohdi 2014,
+  Sec. 7);
 * ``[start] state`` -- begin from a saved state (:mod:`dem.state_file`) instead of ``[particles]``;
 * ``[solver]`` -- ``t_end``; ``dt`` (s, or "auto": t_MD = pi/(50 omega), Luding 2005 eq. 6); ``skin`` (m);
   ``thermal_interval`` (s) and ``integrator`` (implicit | crank-nicolson) of a coupled thermal network;
@@ -30,6 +33,7 @@ from dem.motion import particle_mass, moment_of_inertia
 from dem.particles import finite_array
 from dem.schedule import TemperatureSchedule
 from dem.walls import MovingWall
+from dem.zohdi import scene as zscene
 
 DEFAULT_SKIN = 0.1            # x the mean radius
 DEFAULT_OUTPUT_ROWS = 100     # rows of timeseries.csv when [output] interval is not given
@@ -37,12 +41,13 @@ DEFAULT_THERMAL_STEPS = 1000  # mechanical steps per thermal step when [solver] 
 MOVING_KEYS = {
     "scene": {"dimension", "height"},
     "particles": {"velocity", "angular_velocity"},
-    "walls": {"motion", "pressure", "mass", "damping", "velocity", "amplitude", "frequency"},
-    "solver": {"skin", "thermal_interval"},
-    "output": {"interval", "vtu_interval"},
+    "walls": {"motion", "pressure", "mass", "damping", "velocity", "amplitude", "frequency", *zscene.ELECTRODE_KEYS},
+    "solver": {"skin", "thermal_interval", *(zscene.STEPPING_KEYS - {"dt"})},
+    "output": {"interval", "vtu_interval", *zscene.OUTPUT_KEYS},
 }
 MOVING_TABLES = {"gravity": {"acceleration"}, "temperature": {"time", "value", "relaxation_time"},
-                 "start": {"state"}, "phases": {"start", *("mu", "mu_wall", "gamma_n", "gamma_t")}}
+                 "start": {"state"}, "phases": {"start", "wall_velocity", *("mu", "mu_wall", "gamma_n", "gamma_t")},
+                 "electrical": zscene.ELECTRICAL_KEYS}
 PHASE_KEYS = {"mu": luding.P_MU, "mu_wall": luding.P_MU_WALL, "gamma_n": luding.P_GAMMA_N,
               "gamma_t": luding.P_GAMMA_T}
 @dataclass(frozen=True)
@@ -64,6 +69,10 @@ class MotionSpec:
     box: tuple = (0.0, 0.0, 0.0)
     phases: tuple = ()        # (start time, {parameter index: value}), sorted by start
     start: dict | None = None  # a saved state (dem.state_file.load) the run begins from
+    wall_phases: tuple = ()   # (start time, {wall name: inward velocity}), sorted by start
+    stepping: object = None   # law = "zohdi": its implicit stepping (dem.zohdi.material.ZohdiStepping)
+    control: int | None = None  # law = "zohdi": the axis the powder bed stands and is pressed along
+    frames: int = 0           # law = "zohdi": rendered frames (PNG) over the run
 
 
 def _num(table, section, key, default=None, positive=False, nonnegative=False):
@@ -129,7 +138,8 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
         if arr is not None and len(arr) != n:
             raise ValueError(f"[particles] {name} has {len(arr)} entries but position has {n}")
     if contact is None:
-        raise ValueError("[contact]: required for mechanical physics (law = \"luding\" and its parameters)")
+        raise ValueError("[contact]: required for mechanical physics (law = \"luding\" or \"zohdi\" and its "
+                         "parameters)")
     densities = {m.density for m in particles.materials}
     if densities != {contact.density}:
         raise ValueError(f"[contact] density = {contact.density:g}: differs from [material] density "
@@ -148,6 +158,13 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
         if g.shape != (3,):
             raise ValueError("[gravity] acceleration: must be a 3-vector (m/s^2)")
         gravity = tuple(float(x) for x in g)
+    phases = tuple(sorted((_phase(k, t) for k, t in enumerate(doc.get("phases", []))), key=lambda p: p[0]))
+    wall_phases = tuple((start, walls_v) for start, _, walls_v in phases if walls_v)
+    _check_wall_phases(wall_phases, walls)
+    if contact.law == "zohdi":
+        return zscene.zohdi_motion(doc, particles, solver, physics, start, walls, gravity, velocity,
+                                   tuple(p[:2] for p in phases), wall_phases, dimension)
+    zscene.refuse_zohdi_keys(doc, physics)
     schedule = None
     if "temperature" in doc:
         t = doc["temperature"]
@@ -180,9 +197,9 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
     vtu_interval = _num(out, "output", "vtu_interval", 0.0, nonnegative=True)
     thermal_interval = _num(solver_table, "solver", "thermal_interval",
                             min(output_interval, DEFAULT_THERMAL_STEPS * dt), positive=True)
-    phases = tuple(sorted((_phase(k, t) for k, t in enumerate(doc.get("phases", []))), key=lambda p: p[0]))
     return MotionSpec(dimension, height, velocity, angular, walls, gravity, schedule, dt, stable, skin,
-                      thermal_interval, solver.integrator, output_interval, vtu_interval, phases=phases, start=start)
+                      thermal_interval, solver.integrator, output_interval, vtu_interval,
+                      phases=tuple(p[:2] for p in phases if p[1]), start=start, wall_phases=wall_phases)
 
 
 def _phase(k: int, table: dict) -> tuple:
@@ -195,8 +212,23 @@ def _phase(k: int, table: dict) -> tuple:
     start = _num(table, f"phases][{k}", "start", nonnegative=True)
     if start is None:
         raise ValueError(f"[phases][{k}] start: required (s)")
+    walls = table.get("wall_velocity", {})
+    if not isinstance(walls, dict):
+        raise ValueError(f"[phases][{k}] wall_velocity: must be a table {{wall name = velocity (m/s, inward)}}")
     return start, {PHASE_KEYS[key]: _num(table, f"phases][{k}", key, nonnegative=True) for key in table
-                   if key != "start"}
+                   if key not in ("start", "wall_velocity")}, \
+        {str(name): _num(walls, f"phases][{k}] wall_velocity", name) for name in walls}
+
+
+def _check_wall_phases(wall_phases, walls) -> None:
+    """Every wall a phase changes the speed of exists and moves at a constant speed (``motion = "strain"``)."""
+    motions = {w.name: w.motion for w in walls}
+    for start, speeds in wall_phases:
+        for name in speeds:
+            if motions.get(name) != "strain":
+                raise ValueError(f"[phases] wall_velocity.{name}: " + (
+                    f"no wall named {name!r} (walls: {', '.join(motions) or 'none'})" if name not in motions else
+                    f"the wall's motion is {motions[name]!r}; only strain walls (constant speed) change speed"))
 
 
 def _moving_wall(k: int, table: dict) -> MovingWall:

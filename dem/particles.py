@@ -59,15 +59,17 @@ def check_positive_entries(name: str, arr: np.ndarray, allow_zero: bool = False)
 
 @dataclass(frozen=True)
 class Material:
-    """Thermal properties of one material (SI units): conductivity kappa W/(m K), density kg/m^3, c J/(kg K)."""
+    """Thermal properties of one material (SI units): conductivity kappa W/(m K), density kg/m^3, c J/(kg K); the
+    electrical conductivity sigma S/m for electrical physics."""
 
     conductivity: float | None
     density: float
     specific_heat: float | None
     name: str = "material"
+    electrical_conductivity: float | None = None
 
     def __post_init__(self):
-        for key in ("conductivity", "density", "specific_heat"):
+        for key in ("conductivity", "density", "specific_heat", "electrical_conductivity"):
             value = getattr(self, key)
             if value is None and key != "density":  # a scene without thermal physics needs only the density
                 continue
@@ -139,16 +141,21 @@ class Particles:
     def n(self) -> int:
         return len(self.radius)
 
-    def _property(self, key: str) -> np.ndarray:
+    def _property(self, key: str, physics: str = "thermal") -> np.ndarray:
         values = [getattr(m, key) for m in self.materials]
         if any(v is None for v in values):
             name = next(m.name for m in self.materials if getattr(m, key) is None)
-            raise ValueError(f"material {name!r}: {key} is required for thermal physics")
+            raise ValueError(f"material {name!r}: {key} is required for {physics} physics")
         return np.array(values, dtype=float)[self.material]
 
     @property
     def conductivity(self) -> np.ndarray:
         return self._property("conductivity")
+
+    @property
+    def electrical_conductivity(self) -> np.ndarray:
+        """sigma of each particle, S/m."""
+        return self._property("electrical_conductivity", "electrical")
 
     @property
     def volume(self) -> np.ndarray:

@@ -6,8 +6,8 @@ A scene names its physics (``[scene] physics = ["thermal"]``); only those are bu
 never moves a particle and allocates no mechanical state.
 
 Particles that move (``"mechanical"``, the Luding 2005 contact law) run in the engine of :mod:`dem.engine`, where
-the thermal network follows the contacts as the necks grow. Next to plug in (see :data:`PLANNED`): the electrical
-current flow with Joule heating of Zohdi 2014 (eqs. 38-44).
+the thermal network follows the contacts as the necks grow; with ``[contact] law = "zohdi"`` the staggered scheme of
+Zohdi 2014 (:mod:`dem.zohdi.simulation`) runs the mechanics, the heat and the current (``"electrical"``).
 """
 
 from __future__ import annotations
@@ -19,10 +19,8 @@ from dem.thermal import boundary_heat_flow, build_network, integrate, periodic_h
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
 
-PLANNED = {
-    "electrical": "the Zohdi 2014 current flow and Joule heating (eqs. 38-44)",
-}
-MOVING = ("mechanical",)  # built by the engine for moving particles (dem.engine), not here
+PLANNED: dict = {}  # names reserved for submodels still to come: refused with what they will be
+MOVING = ("mechanical", "electrical")  # built by the engines for moving particles (dem.engine, dem.zohdi), not here
 
 
 class ThermalModel:
@@ -121,7 +119,8 @@ PHYSICS_NAMES = (*REGISTRY, *MOVING)
 
 
 def check_physics(names) -> None:
-    """Every name a submodel that exists (``thermal``, ``mechanical``); planned and unknown ones are refused."""
+    """Every name a submodel that exists (``thermal``, ``mechanical``, ``electrical``); planned and unknown ones are
+    refused; ``electrical`` runs with moving particles."""
     available = (*REGISTRY, *MOVING)
     for name in names:
         if name in PLANNED:
@@ -131,6 +130,10 @@ def check_physics(names) -> None:
             raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(available)})")
     if not names:
         raise ValueError(f"[scene] physics: names no submodel (available: {', '.join(available)})")
+    if "electrical" in names and "mechanical" not in names:
+        raise ValueError("[scene] physics: \"electrical\" runs with moving particles: [\"mechanical\", \"thermal\", "
+                         "\"electrical\"] with [contact] law = \"zohdi\" (the current on a static packing: "
+                         "dem.electrical.kirchhoff)")
 
 
 def build(scene) -> list:

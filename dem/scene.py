@@ -17,7 +17,10 @@ import numpy as np
 
 from dem import generators, state_file
 from dem.laws.conductance import ConductanceSpec
+from dem.laws.fields import material_from_table
 from dem.laws.luding import LudingMaterial
+from dem.zohdi.material import ZohdiMaterial
+from dem.zohdi.scene import ElectricalSpec, parse_electrical, zohdi_material
 from dem.particles import COPPER, Material, Particles
 from dem.periodic import AXES, PeriodicBox
 from dem.sources import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
@@ -33,7 +36,7 @@ RTOL_MIN = 1e-9  # [solver] rtol of dt = "auto"
 
 ALLOWED = {
     "scene": {"name", "description", "physics"},
-    "material": {"name", "conductivity", "density", "specific_heat"},
+    "material": {"name", "conductivity", "density", "specific_heat", "electrical_conductivity"},
     "particles": {"position", "radius", "temperature", "fixed", "material", "heat"},
     "generator": {"kind", "n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter",
                   "structure", "temperature", "boundary", "hot", "cold", "heat", "box", "speed"},
@@ -44,9 +47,9 @@ ALLOWED = {
     "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
     "solver": {"mode", "integrator", "dt", "t_end", "rtol", "linear", "floating", "max_steps"},
     "output": {"every", "vtu_every", "vtu", "checkpoint_every"},
-    "contact": {"law"} | {f.name for f in fields(LudingMaterial)},
+    "contact": {"law"} | {f.name for f in fields(LudingMaterial)} | {f.name for f in fields(ZohdiMaterial)},
 }
-CONTACT_LAWS = ("luding",)
+CONTACT_LAWS = ("luding", "zohdi")
 GENERATOR_KEYS = {
     "chain": {"n", "radius", "overlap"},
     "lattice": {"shape", "radius", "overlap", "structure"},
@@ -146,8 +149,9 @@ class Scene:
     name: str = "scene"
     description: str = ""
     specimen: Specimen | None = None
-    contact: LudingMaterial | None = None
+    contact: LudingMaterial | ZohdiMaterial | None = None
     motion: MotionSpec | None = None  # particles that move ([scene] physics with "mechanical"), else None
+    electrical: ElectricalSpec | None = None  # the current's scheme and electrodes ("electrical" physics)
     box: PeriodicBox | None = None  # a periodic box (dem.periodic), else None
 
 
@@ -192,7 +196,7 @@ def _number(table, section, key, default=None, required=False):
     return float(v)
 
 
-def _materials(doc, thermal: bool = True) -> tuple:
+def _materials(doc, thermal: bool = True, electrical: bool = False) -> tuple:
     if "material" in doc and "materials" in doc:
         raise ValueError("[material] and [[materials]]: give one or the other")
     tables = doc.get("materials", [doc["material"]] if "material" in doc else None)
@@ -206,6 +210,7 @@ def _materials(doc, thermal: bool = True) -> tuple:
         _check_keys(t, section, ALLOWED["material"])
         props = {key: _number(t, section, key, required=thermal or key == "density")
                  for key in ("conductivity", "density", "specific_heat")}
+        props["electrical_conductivity"] = _number(t, section, "electrical_conductivity", required=electrical)
         for key, v in props.items():
             if v is not None and v <= 0:
                 raise ValueError(f"[{section}] {key} = {v!r}: must be > 0")
@@ -420,7 +425,7 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     full, doc = doc, _moving_keys(doc, moving)
     meta = doc.get("scene", {})
     _check_keys(meta, "scene", ALLOWED["scene"])
-    materials = _materials(doc, thermal="thermal" in physics)
+    materials = _materials(doc, thermal="thermal" in physics, electrical="electrical" in physics)
     start = None
     if "start" in full:
         if "particles" in doc or "generator" in doc:
@@ -467,10 +472,26 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
                    integer=("every", "vtu_every"))
     if velocity is not None and not moving:
         raise ValueError("[generator] speed: only for moving particles ([scene] physics with \"mechanical\")")
-    contact = luding_material_from_scene(doc) if "contact" in doc else None
+    contact = contact_material_from_scene(doc) if "contact" in doc else None
     motion = parse_motion(full, particles, solver, physics, contact, velocity, start) if moving else None
+    electrical = parse_electrical(full, motion.walls if moving else (), physics)
     return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
-                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact, motion, box)
+                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact, motion,
+                 electrical, box)
+
+
+def contact_material_from_scene(doc: dict) -> LudingMaterial | ZohdiMaterial:
+    """The contact material of a TOML document's ``[contact]`` table: :func:`luding_material_from_scene` for
+    ``law = "luding"``, :func:`dem.zohdi.scene.zohdi_material` for ``law = "zohdi"``."""
+    table = doc.get("contact")
+    if isinstance(table, dict) and table.get("law") == "zohdi":
+        _check_keys(table, "contact", ALLOWED["contact"])
+        values = {key: v for key, v in table.items() if key != "law"}
+        material = doc.get("material")
+        if "density" not in values and isinstance(material, dict) and "density" in material:
+            values["density"] = material["density"]
+        return zohdi_material(values)
+    return luding_material_from_scene(doc)
 
 
 def luding_material_from_scene(doc_or_scene) -> LudingMaterial:
@@ -479,7 +500,7 @@ def luding_material_from_scene(doc_or_scene) -> LudingMaterial:
     ``density`` defaults to that of a single ``[material]``). Independent of how the particles are given.
     Raises ``ValueError`` when there is none or a value is bad."""
     if isinstance(doc_or_scene, Scene):
-        if doc_or_scene.contact is None:
+        if doc_or_scene.contact is None or doc_or_scene.contact.law != "luding":
             raise ValueError(f"scene {doc_or_scene.name!r}: has no [contact] table with law = \"luding\" (the Luding "
                              f"2005 sintering contact material)")
         return doc_or_scene.contact
@@ -493,12 +514,9 @@ def luding_material_from_scene(doc_or_scene) -> LudingMaterial:
     material = doc_or_scene.get("material")
     if "density" not in values and isinstance(material, dict) and "density" in material:
         values["density"] = material["density"]
-    missing = [f.name for f in fields(LudingMaterial) if f.name not in values]
-    if missing:
-        raise ValueError(f"[contact] {missing[0]}: required (law = \"luding\" needs "
-                         f"{', '.join(f.name for f in fields(LudingMaterial))})")
-    numeric = tuple(key for key in values if key != "brittle_sliding")
-    return _spec(LudingMaterial, values, "contact", numeric=numeric)
+    if table["law"] != "luding":
+        raise ValueError(f"[contact] law = {table['law']!r}: not the Luding 2005 sintering contact (law = \"luding\")")
+    return material_from_table(LudingMaterial, "luding", values)
 
 
 def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls) -> None:

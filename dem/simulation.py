@@ -51,6 +51,19 @@ def _progress_bar(scene: Scene, enabled: bool):
     return bar, (lambda t: bar.update(min(t, bar.total) - bar.n))
 
 
+def _position(scene: Scene, out, progress: bool):
+    """The run's position for the line an interrupt prints (:func:`fem_neck.interrupt.where`) -- only for a run
+    that reports its progress (the CLI's): a run inside another command (a verification section) leaves that
+    command's position alone."""
+    if not progress:
+        from fem_neck.interrupt import Where
+
+        return Where()  # a throw-away position
+    here = where()
+    here.update(stage=f"dem run {scene.name}", out=str(out) if out is not None else None)
+    return here
+
+
 def effective_conductivity(scene: Scene, summary: dict) -> float | None:
     """``k_eff = Q L / (A dT)`` (steady): of a generated specimen between hot and cold ends, or along the one axis
     of a periodic box with a temperature drop per period (``Q`` the heat flow across the period)."""
@@ -75,7 +88,8 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     """Run ``scene``; with ``out`` write summary.json, timeseries.csv, VTU/PVD snapshots and plots into that folder
     (refused if it holds a run, unless ``resume``: go on from its last checkpoint, or ``overwrite``: clear it first;
     :mod:`dem.run_folder`). Ctrl-C leaves the folder usable: the rows and snapshots written so far, the last
-    checkpoint, and ``summary.json`` marked ``"interrupted": true``."""
+    checkpoint, and ``summary.json`` marked ``"interrupted": true``. ``progress``: a bar on stderr, and the run's
+    position in the line an interrupt prints."""
     if out is not None:
         out = run_folder.prepare(out, resume, overwrite)
     elif resume or overwrite:
@@ -83,8 +97,7 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     if scene.motion is not None:
         return run_moving(scene, out, progress, resume)
     start = time.perf_counter()
-    here = where()
-    here.update(stage=f"dem run {scene.name}", out=str(out) if out is not None else None)
+    here = _position(scene, out, progress)
     bar, report = _progress_bar(scene, progress)
     transient = scene.solver.mode == "transient"
     writer = None
@@ -141,24 +154,36 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
 
 
 def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = False) -> RunResult:
-    """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engine` (``out`` prepared
-    by :func:`run`)."""
+    """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engine`, or with
+    ``[contact] law = "zohdi"`` the staggered scheme of :mod:`dem.zohdi.simulation` (``out`` prepared by
+    :func:`run`)."""
     from dem import state_file
-    from dem.engine import Simulation
     from dem.io import MotionWriter
 
+    zohdi = scene.contact.law == "zohdi"
+    if zohdi:
+        from dem.zohdi.simulation import ZohdiSimulation as Simulation
+
+        if resume:
+            raise ValueError("--resume: runs of the zohdi contact law write no checkpoints; run again with --overwrite")
+    else:
+        from dem.engine import Simulation
+
     start = time.perf_counter()
-    here = where()
-    here.update(stage=f"dem run {scene.name}", out=str(out) if out is not None else None)
+    here = _position(scene, out, progress)
     saved = state_file.normalised(run_folder.load(out, scene, "moving")) if resume else None
-    sim = Simulation(scene, resume=saved)
+    sim = Simulation(scene) if zohdi else Simulation(scene, resume=saved)
     writer = MotionWriter(out, scene, resume_step=sim.mechanics.steps if resume else None) if out is not None \
         else None
-    checkpoint = run_folder.Checkpointer(out, scene, "moving", scene.output.checkpoint_every) if out is not None \
-        else None
+    if writer is not None and scene.motion.frames:
+        from dem.frames import WithFrames
+
+        writer = WithFrames(writer, scene, out)
+    checkpoint = run_folder.Checkpointer(out, scene, "moving", scene.output.checkpoint_every) \
+        if out is not None and not zohdi else None
     bar, report = _progress_bar(scene, progress)
     try:
-        details = sim.run(writer, report, checkpoint)
+        details = sim.run(writer, report) if zohdi else sim.run(writer, report, checkpoint, here)
     except KeyboardInterrupt:
         if writer is not None:
             writer.interrupted({"scene": scene.name, "interrupted": True, **sim.summary()})
@@ -173,7 +198,7 @@ def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = Fa
     summary = {"scene": scene.name, "mode": "transient", "physics": list(scene.physics), "static": False, **details}
     if resume:
         summary["resumed_from"] = {"t": float(saved["t"]), "steps": int(saved["steps"])}
-    if out is not None:
+    if out is not None and not zohdi:
         summary["state"] = state_file.save(sim, pathlib.Path(out) / "state.npz").name
     if scene.particles.n <= T_LIST_MAX:
         summary["T"] = sim.mechanics.state.T.tolist()

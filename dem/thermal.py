@@ -50,11 +50,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
-from scipy.sparse.csgraph import connected_components
 
 from dem.bonds import Bonds, find_bonds
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.linsolve import make_solver
+from dem.network import BoundedLaplacian, laplacian  # noqa: F401  (laplacian: part of this module's API)
 from dem.particles import Particles
 from dem.periodic import PeriodicBox
 from dem.sources import Sources, linear_sink_terms
@@ -71,18 +71,11 @@ AUTO_PROJECTION = 10.0  # dt = "auto": refuse once the current step projects thi
 AUTO_MIN_STEP = 2.0**-AUTO_LEVELS  # dt = "auto": steps this small (x t_end) are accepted whatever their error
 
 
-def laplacian(n: int, i: np.ndarray, j: np.ndarray, K: np.ndarray) -> sp.csr_matrix:
-    """Weighted graph Laplacian ``L_ii = sum_j K_ij``, ``L_ij = -K_ij`` (symmetric, rows sum to zero)."""
-    diag = np.bincount(i, K, n) + np.bincount(j, K, n)
-    rows = np.concatenate([i, j, np.arange(n)])
-    cols = np.concatenate([j, i, np.arange(n)])
-    vals = np.concatenate([-K, -K, diag])
-    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
-
-
 @dataclass
 class Network:
-    """The linear(ised) heat balance of the free particles (module docstring), assembled once."""
+    """The linear(ised) heat balance of the free particles (module docstring), assembled once: the generic
+    :class:`dem.network.BoundedLaplacian` (the same solve serves the electrical current) with the particles'
+    capacities, sources and fixed temperatures."""
 
     particles: Particles
     bonds: Bonds
@@ -93,38 +86,33 @@ class Network:
     box: PeriodicBox | None = None
 
     def __post_init__(self):
-        p = self.particles
-        n = p.n
-        self.free = np.flatnonzero(~p.fixed)
-        self.fixed = np.flatnonzero(p.fixed)
-        self.L = laplacian(n, self.bonds.i, self.bonds.j, self.K_pairs)
-        if len(self.fixed):
-            rows = self.L[self.free]
-            self.L_FF = rows[:, self.free].tocsr()
-            self.L_FD = rows[:, self.fixed].tocsr()
-        else:
-            self.L_FF, self.L_FD = self.L, sp.csr_matrix((n, 0))
+        p, b = self.particles, self.bonds
+        self.graph = BoundedLaplacian(p.n, b.i, b.j, self.K_pairs, p.fixed, b.wall_particle, b.wall_index,
+                                      self.K_walls, len(self.wall_temperature))
+        self.free, self.fixed = self.graph.free, self.graph.fixed
         self.T_D = p.temperature[self.fixed]
         self.heat = p.heat[self.free]
         self.C = p.capacity[self.free]
         self.radius = p.radius[self.free]
         self.sources = self.sources.resolved(p.position, p.radius, self.free)  # "exposed" areas from the packing
-        self._slots = None  # where each Laplacian entry sits in L, L_FF, L_FD: built by the first refresh()
         self._boundary_terms()
+
+    # the Laplacian and its blocks live in the graph (refresh() rewrites them in place)
+    L = property(lambda self: self.graph.L)
+    L_FF = property(lambda self: self.graph.L_FF)
+    L_FD = property(lambda self: self.graph.L_FD)
 
     def _boundary_terms(self):
         """The terms that follow from the conductances: wall and fixed-particle coefficients and the constant
         right-hand side."""
-        n = self.particles.n
-        wp = self.bonds.wall_particle
-        kw_diag = np.bincount(wp, self.K_walls, n)
-        kw_rhs = np.bincount(wp, self.K_walls * self.wall_temperature[self.bonds.wall_index], n)
-        self.wall_diag = kw_diag[self.free]
-        self.wall_rhs = kw_rhs[self.free]
-        self.fixed_rhs = -(self.L_FD @ self.T_D)
-        self.fixed_diag = -np.asarray(self.L_FD.sum(axis=1)).ravel()
-        self.base_diag = self.L_FF.diagonal()
+        g = self.graph
+        self.wall_diag = g.plane_diag
+        self.wall_rhs = g.plane_rhs(self.wall_temperature)
+        self.fixed_rhs = -(g.L_FD @ self.T_D)
+        self.fixed_diag = g.fixed_diag
+        self.base_diag = g.laplacian_diagonal
         # the temperature jump of every bond across a periodic face (module docstring), zero without one
+        n = self.particles.n
         self.jump = self.bonds.shifts @ self.box.drop if self.box is not None else np.zeros(self.bonds.n_pairs)
         self.periodic = bool(np.any(self.jump != 0.0))
         jump_flow = self.K_pairs * self.jump
@@ -135,30 +123,10 @@ class Network:
     def refresh(self, bonds: Bonds, K_pairs: np.ndarray, K_walls: np.ndarray) -> None:
         """New conductances (and bond geometry) on the same bonds, in the same order: the matrices keep their
         sparsity and only their entries are rewritten (no re-assembly, no new sparsity analysis)."""
-        if not (np.array_equal(bonds.i, self.bonds.i) and np.array_equal(bonds.j, self.bonds.j)
-                and np.array_equal(bonds.wall_particle, self.bonds.wall_particle)
-                and np.array_equal(bonds.wall_index, self.bonds.wall_index)):
+        if not self.graph.same_edges(bonds.i, bonds.j, bonds.wall_particle, bonds.wall_index):
             raise ValueError("Network.refresh: the bonds changed; build a new Network")
-        n = self.particles.n
-        if self._slots is None:
-            # an index matrix with the Laplacian's sparsity: entry k of (rows, cols) stored as k + 1
-            rows = np.concatenate([bonds.i, bonds.j, np.arange(n)])
-            cols = np.concatenate([bonds.j, bonds.i, np.arange(n)])
-            index = sp.csr_matrix((np.arange(1.0, len(rows) + 1.0), (rows, cols)), shape=(n, n))
-            if len(self.fixed):
-                part = index[self.free]
-                parts = (index, part[:, self.free].tocsr(), part[:, self.fixed].tocsr())
-            else:
-                parts = (index, index, sp.csr_matrix((n, 0)))
-            self._slots = [m.data.astype(np.int64) - 1 for m in parts]
-            self.L, self.L_FF, self.L_FD = (m.copy() for m in parts)
-            if not len(self.fixed):
-                self.L_FF = self.L
+        self.graph.refresh(bonds.i, bonds.j, K_pairs, bonds.wall_particle, bonds.wall_index, K_walls)
         self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
-        diag = np.bincount(bonds.i, K_pairs, n) + np.bincount(bonds.j, K_pairs, n)
-        values = np.concatenate([-K_pairs, -K_pairs, diag])
-        for matrix, slots in zip((self.L, self.L_FF, self.L_FD), self._slots):
-            matrix.data[:] = values[slots]
         self._boundary_terms()
 
     @property
@@ -175,8 +143,7 @@ class Network:
 
     def matrix(self, sinks: dict) -> sp.csr_matrix:
         """The system matrix ``A = L_FF + diag(K_wall + g)``, CSR."""
-        extra = self.wall_diag + sum((g for g, _ in sinks.values()), np.zeros(self.n_free))
-        return (self.L_FF + sp.diags(extra)).tocsr()
+        return self.graph.matrix(sum((g for g, _ in sinks.values()), np.zeros(self.n_free)))
 
     def rhs(self, sinks: dict) -> np.ndarray:
         return self.r_const + sum((b for _, b in sinks.values()), np.zeros(self.n_free))
@@ -250,7 +217,7 @@ def bonds_and_conductances(particles: Particles, walls, spec, *, pairs=None, bon
     :func:`build_network`, for a network whose bonds change while its particles stay (:mod:`dem.contact_heat`)."""
     if bonds is None:
         bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, pairs=pairs, box=box)
-    return (bonds, *bond_conductances(spec, particles, bonds, box, tuple(walls)))
+    return (bonds, *bond_conductances(spec, particles, bonds, box=box, walls=tuple(walls)))
 
 
 def boundary_heat_flow(net: Network, T: np.ndarray) -> dict:
@@ -284,21 +251,15 @@ class SteadyResult:
 
 
 def _components(net: Network):
-    """Connected components of the free particles, whether each is anchored (reaches a fixed temperature), and
-    whether it holds a bond across a periodic face with a temperature jump."""
-    n_comp, label = connected_components(net.L_FF, directed=False)
-    anchor = net.fixed_diag + net.wall_diag
+    """Connected components of the free particles, whether each is anchored (reaches a fixed temperature, a wall
+    or an ambient), and whether it holds a bond across a periodic face with a temperature jump."""
     sinks = net.sinks(net.particles.temperature[net.free])
-    for g, _ in sinks.values():
-        anchor = anchor + g
-    anchored = np.zeros(n_comp, dtype=bool)
-    anchored[label[anchor > 0]] = True
+    n_comp, label, anchored = net.graph.components(sum((g for g, _ in sinks.values()), np.zeros(net.n_free)))
     jumping = np.zeros(n_comp, dtype=bool)
     if net.periodic:
         position = np.full(net.particles.n, -1)
         position[net.free] = np.arange(net.n_free)
-        b = net.bonds
-        free_i = position[b.i[net.jump != 0.0]]
+        free_i = position[net.bonds.i[net.jump != 0.0]]
         jumping[label[free_i[free_i >= 0]]] = True
     return n_comp, label, anchored, jumping
 

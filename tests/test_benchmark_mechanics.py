@@ -11,7 +11,7 @@ from benchmarks import mechanics
 
 TINY = mechanics.Sizes(disks=40, compaction_time=0.02, cells=(3, 3, 3), steps_2d=100, steps_3d=50, warmup=10,
                        rounds=1, kernel_contacts=1000, fresh_cache=False, thermal_scenes=("lattice",),
-                       thermal_rounds=1, full_size=False)
+                       thermal_rounds=1, full_size=False, schedule=(20, 1e-3))
 
 LAMMPS_LOG = """LAMMPS (22 Jul 2025 - Update 4)
 Per MPI rank memory allocation (min/avg/max) = 10.07 | 10.07 | 10.07 Mbytes
@@ -123,7 +123,11 @@ def test_quick_path_on_tiny_sizes_writes_every_row(tmp_path):
     assert [h for h, _, _ in section.texts] == ["The time loop: ours and LAMMPS side by side",
                                                 "Where our time goes (3D, Luding)",
                                                 "Compile cost and the Luding kernels",
-                                                "Thermal-only scenes keep their path"]
+                                                "Thermal-only scenes keep their path",
+                                                "The whole sintering schedule"]
+    schedule = s["sintering_schedule"]
+    assert schedule["n"] == 20 and schedule["steps"] > 0 and 0 < schedule["volume_fraction"] < 1
+    assert targets["the whole sintering schedule (Luding 2005 Fig. 7), N = 300, t_s = 1 s"] is None
     assert {p.name for p in section.figures} == {"mechanics_loop.png"}
     rows = list(csv.DictReader((section.out_dir / "mechanics_loop.csv").open()))
     assert len(rows) == 3 + 2 * with_lammps

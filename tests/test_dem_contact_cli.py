@@ -7,6 +7,7 @@ import math
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from dem.cli import main
@@ -14,7 +15,7 @@ from dem.laws.luding import LUDING_TABLE1 as MAT
 from dem.scene import builtin_scenes, load_scene, luding_material_from_scene, parse_scene
 
 K1, K2, KC = MAT.k1, MAT.k2, MAT.kc
-A = 1e-3  # luding-table1: radii 0.5, 1 and 1.5 mm, mean 1 mm
+A = float(np.mean(load_scene("luding-table1").particles.radius))  # 300 random radii in 1 mm (1 +- 0.5)
 DMF = K2 * MAT.fluid_overlap * A / (K2 - K1)
 
 HISTORY = """t,overlap,T

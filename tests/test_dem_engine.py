@@ -343,3 +343,24 @@ def test_verlet_list_is_every_close_pair_sorted_whatever_room_it_is_given(box):
     history = np.arange(len(old_i), dtype=float) + 1.0
     (carried,) = carry_history(old_i, old_j, i_ref, j_ref, history)
     assert np.array_equal(carried[keep], history[:-1]) and np.all(carried[~keep] == 0.0)
+
+
+def test_phases_change_the_speed_of_a_strain_wall():
+    """[[phases]] wall_velocity: a lid pushed in at 0.1 m/s, held from 1 ms, pulled back from 2 ms."""
+    doc = {"scene": {"physics": ["mechanical"]}, "material": {"density": 1000.0},
+           "particles": {"position": [[0.0, 0.0, 0.0]], "radius": [1e-3], "temperature": [20.0]},
+           "contact": {"law": "luding", "k1": 1e4, "k2": 2e4, "kc": 0.0, "kt_ratio": 0.2, "gamma_n": 0.0,
+                       "gamma_t": 0.0, "mu": 0.0, "mu_wall": 0.0, "T_melt": 120.0, "T_var": 10.0, "expansion": 0.0,
+                       "fluid_overlap": 0.2, "t0": 1.0, "brittle_sliding": True},
+           "walls": [{"name": "lid", "point": [0.0, 0.0, 0.01], "normal": [0.0, 0.0, -1.0], "motion": "strain",
+                      "velocity": 0.1}],
+           "phases": [{"start": 1e-3, "wall_velocity": {"lid": 0.0}},
+                      {"start": 2e-3, "wall_velocity": {"lid": -0.05}}],
+           "solver": {"mode": "transient", "t_end": 3e-3, "dt": 1e-5}}
+    sim = Simulation(parse_scene(doc))
+    sim.run()
+    # in 0.1 mm, held, out 0.05 mm: the lid's offset n . x = q went from -0.01 to -0.01 + 1e-4 - 5e-5
+    assert sim.mechanics.w.q[0] == pytest.approx(-0.01 + 1e-4 - 5e-5, rel=1e-9)
+    doc["phases"][0]["wall_velocity"] = {"floor": 0.0}
+    with pytest.raises(ValueError, match="wall_velocity.floor: no wall named 'floor'"):
+        parse_scene(doc)

@@ -24,7 +24,7 @@ def _conductances(law, x, r, box=None, walls=()):
     p = Particles.from_arrays(x, r, np.zeros(len(r)), materials=(UNIT,))
     spec = ConductanceSpec(law=law)
     b = find_bonds(p, walls, spec.contact, box=box)
-    return bond_conductances(spec, p, b, box, walls)
+    return bond_conductances(spec, p, b, box=box, walls=walls)
 
 
 @pytest.mark.parametrize("radii, overlaps", [

@@ -32,6 +32,7 @@ COMMANDS = {
                   "DEM pipe network against FE: chains, 3D clusters, transient, periodic lattices and packings"),
     "lattices": (("lattices",), "DEM pipe network against FE of periodic SC, BCC, FCC lattices and random packings"),
     "all": (("paper", "chains", "clusters", "transient", "lattices"), "paper and dem-vs-fe"),
+    "sintering": (("sintering",), "Luding 2005 Sec. 4 reproduced: sintering, compression and vibration tests"),
 }
 
 

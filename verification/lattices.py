@@ -97,7 +97,7 @@ def dem_periodic(cell: lattice.PeriodicCell, law: str) -> float:
         K = np.array([fe_pair_conductance(*sorted((float(cell.radii[i]), float(cell.radii[j]))), float(h))
                       for i, j, h in zip(bonds.i, bonds.j, bonds.h)])
     else:
-        K = bond_conductances(spec, particles, bonds, box)[0]
+        K = bond_conductances(spec, particles, bonds, box=box)[0]
     net = Network(particles, bonds, K, np.zeros(0), np.zeros(0), box=box)
     T = steady(net, floating="mean").T
     return float(periodic_heat_flow(net, T)[2] * box.lengths[2] / box.cross_section(2))

@@ -116,12 +116,19 @@ def series(*halves):
     return 1.0 / resistance
 
 
-def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds, box=None,
-                      walls=()) -> tuple[np.ndarray, np.ndarray]:
-    """``(K_pairs, K_walls)`` in W/K for every pair bond and wall bond (``box``: the periodic box the bonds' image
-    shifts refer to, :mod:`dem.periodic`; ``walls``: the walls of the wall bonds, whose normals the
-    ``shared-body`` law needs)."""
-    kappa, r = particles.conductivity, particles.radius
+def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds, conductivity=None,
+                      shares: bool = False, *, box=None, walls=()):
+    """``(K_pairs, K_walls)`` in W/K for every pair bond and wall bond.
+
+    ``conductivity`` (per particle) replaces the materials' kappa: the same law with the electrical conductivity
+    sigma gives each contact's electrical conductance in S (the neck is the same Laplace problem, sigma in place of
+    kappa). With ``shares = True`` a third array gives each pair bond's fraction of its resistance on the side of
+    particle i, ``R_i / (R_i + R_j)`` (where that part of the bond's Joule heat is made). ``box``: the periodic box
+    the bonds' image shifts refer to (:mod:`dem.periodic`); ``walls``: the walls of the wall bonds, whose normals
+    the ``shared-body`` law needs.
+    """
+    kappa = particles.conductivity if conductivity is None else np.asarray(conductivity, dtype=float)
+    r = particles.radius
     kc = spec.contact_conductance
     k_i = half_conductance(spec, kappa[bonds.i], r[bonds.i], bonds.a, bonds.l_i)
     k_j = half_conductance(spec, kappa[bonds.j], r[bonds.j], bonds.a, bonds.l_j)
@@ -142,7 +149,12 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     k_pair, k_wall = series(k_pair, kc), series(k_w, kc)
     _check_finite(spec, k_pair, bonds.a, lambda k: f"bond ({bonds.i[k]}, {bonds.j[k]})")
     _check_finite(spec, k_wall, bonds.wall_a, lambda k: f"wall bond of particle {bonds.wall_particle[k]}")
-    return k_pair, k_wall
+    if not shares:
+        return k_pair, k_wall
+    with np.errstate(divide="ignore", invalid="ignore"):
+        share = k_j / (k_i + k_j)  # R_i / (R_i + R_j); an infinite half (a centre on the contact plane) makes none
+    share = np.where(np.isfinite(share), share, np.where(np.isinf(k_i), 0.0, 1.0))
+    return k_pair, k_wall, share
 
 
 def _check_finite(spec: ConductanceSpec, K: np.ndarray, a: np.ndarray, name) -> None:

@@ -23,9 +23,11 @@ k1)`` with the constant cold-limit k1 (eq. 7: k2 is not changed directly when k1
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
+
+from dem.laws.fields import check_fields
 
 # Indices into LudingMaterial.params()
 P_K1 = 0               # k1, loading stiffness, cold limit (N/m)
@@ -78,20 +80,10 @@ class LudingMaterial:
     brittle_sliding: bool
     density: float
 
+    law = "luding"
+
     def __post_init__(self):
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.name == "brittle_sliding":
-                if not isinstance(value, (bool, np.bool_)):
-                    raise ValueError(f"contact.brittle_sliding = {value!r}: must be true or false")
-            elif (not isinstance(value, (int, float, np.floating, np.integer)) or isinstance(value, bool)
-                  or not math.isfinite(value)):
-                raise ValueError(f"contact.{f.name} = {value!r}: must be a finite number")
-        for limits, bound in ((_POSITIVE, "> 0"), (_NONNEGATIVE, ">= 0")):
-            for name, unit in limits.items():
-                value = getattr(self, name)
-                if value < 0 or (value == 0 and bound == "> 0"):
-                    raise ValueError(f"contact.{name} = {value!r}: must be {bound}{f' ({unit})' if unit else ''}")
+        check_fields(self, "contact", _POSITIVE, _NONNEGATIVE, flags=("brittle_sliding",))
         if self.k1 > self.k2:
             raise ValueError(f"contact.k1 = {self.k1!r}: must be <= k2 = {self.k2!r} N/m (Luding 2005, eq. 4: "
                              f"plastic loading is no stiffer than un/reloading)")

@@ -1,0 +1,133 @@
+"""The finished runs of the sintering section read back: time series, contacts and snapshots, and what is derived
+from them (the joined history of Fig. 7, the compression test's failure and stiffness, the three-particle control,
+the coordination number without rattlers). :class:`Missing` is raised for a run that is not there.
+"""
+
+from __future__ import annotations
+
+import csv
+import functools
+import math
+import pathlib
+
+import numpy as np
+
+from dem.sinter_protocol import T_PREPARE, Times
+from verification import sintering_runs as sr
+
+
+class Missing(LookupError):
+    """A statement needs a run this grid does not hold (or that failed)."""
+
+
+def read_csv(path: pathlib.Path) -> dict:
+    with path.open() as fh:
+        rows = list(csv.DictReader(fh))
+    return {k: np.array([float(r[k]) if r[k] not in ("", None) else np.nan for r in rows]) for k in rows[0]}
+
+
+class Study:
+    """The finished runs of one grid, read on demand (every accessor raises :class:`Missing` for a run that is not
+    there)."""
+
+    def __init__(self, root: pathlib.Path, grid: sr.Grid, results: dict):
+        self.root = pathlib.Path(root)
+        self.grid = grid
+        self.results = results
+        self.n_max, self.t_max, self.t_min = max(grid.n), max(grid.t_s), min(grid.t_s)
+
+    def task(self, kind, n, p, t_s=None, seed=1, variant="") -> sr.Task:
+        return sr.Task(kind, n, float(p), t_s, seed, variant)
+
+    def res(self, kind, n, p, t_s=None, seed=1, variant="") -> dict:
+        r = self.results.get(self.task(kind, n, p, t_s, seed, variant))
+        if r is None or "error" in r:
+            raise Missing(f"{kind} n={n} p={p:g} t_s={t_s}")
+        return r
+
+    @functools.lru_cache(maxsize=None)
+    def series(self, task: sr.Task) -> dict:
+        self.res(task.kind, task.n, task.p, task.t_s, task.seed, task.variant)
+        return read_csv(self.root / task.folder / "timeseries.csv")
+
+    @functools.lru_cache(maxsize=None)
+    def arrays(self, task: sr.Task) -> dict:
+        self.res(task.kind, task.n, task.p, task.t_s, task.seed, task.variant)
+        with np.load(self.root / task.folder / "analysis.npz") as f:
+            return {k: f[k] for k in f.files}
+
+    def contacts(self, kind, n, p, t_s) -> dict:
+        return self.arrays(self.task(kind, n, p, t_s))
+
+    def history(self, n, p, t_s) -> dict:
+        """The time series of preparation, sintering and cooling joined on the time axis of Fig. 7 (a continued
+        stage's first row, which repeats the previous stage's last, is dropped)."""
+        times = Times(t_s=t_s)
+        parts = [(self.series(self.task(sr.PREPARE, n, p)), 0.0, 0),
+                 (self.series(self.task(sr.SINTER, n, p, t_s)), times.t_heat, 1),
+                 (self.series(self.task(sr.COOL, n, p, t_s)), times.t_cool, 1)]
+        keys = [k for k in parts[0][0] if all(k in s for s, _, _ in parts)]
+        out = {k: np.concatenate([s[k][skip:] + (offset if k == "t" else 0.0) for s, offset, skip in parts])
+               for k in keys}
+        scale = 1.0 - 1e-4 * (120.0 - out["T_mean"])  # eq. 9 with Table 1's delta a_T
+        out["mass_fraction"] = out["volume_fraction"] * ((1.0 - 1e-4 * (120.0 - T_PREPARE)) / scale) ** 2
+        return out
+
+    def compression(self, n, p, t_s) -> dict:
+        """eps_zz = 1 - z/z0, sigma_zz (top wall), sigma_xx (right wall), nu; the failure (:func:`failure`) and the
+        stiffness, the slope of sigma_zz against eps_zz while the stress rises from p to half way to failure."""
+        s = self.series(self.task(sr.COMPRESS, n, p, t_s))
+        before = self.res(sr.COOL, n, p, t_s)
+        z = -s["q_top"]
+        eps = 1.0 - z / z[0]
+        szz, sxx = s["wall_top"].copy(), s["wall_right"].copy()
+        szz[0], sxx[0] = before["wall_stress"]["top"], before["wall_stress"]["right"]  # forces of the saved state
+        k = failure(szz)
+        rise = np.arange(len(szz)) <= max(2, int(np.argmax(szz[:k + 1] >= szz[0] + 0.5 * (szz[k] - szz[0]))))
+        stiffness = float(np.polyfit(eps[rise], szz[rise], 1)[0])
+        width = -(s["q_right"] + s["q_left"])
+        work = np.concatenate([[0.0], np.cumsum(0.5 * (szz[1:] * width[1:] + szz[:-1] * width[:-1]) * np.diff(-z))])
+        return {"eps": eps, "szz": szz, "sxx": sxx, "nu": s["volume_fraction"], "t": s["t"],
+                "failure_stress": float(szz[k]), "failure_strain": float(eps[k]), "stiffness": stiffness,
+                "kinetic_over_work": float(np.max(s["kinetic_energy"][:k + 1]) / work[k]) if work[k] > 0 else math.nan}
+
+    def three(self, p) -> list[float]:
+        """Densification nu(t_f)/nu(t_heat) - 1 of the three-particle controls (one per seed)."""
+        out = []
+        times = Times(t_s=self.t_max)
+        for seed in self.grid.three_seeds:
+            s = self.series(self.task(sr.SCHEDULE, 3, p, self.t_max, seed))
+            out.append(float(s["volume_fraction"][-1] / at(s, times.t_heat)["volume_fraction"] - 1.0))
+        return out
+
+
+def failure(stress) -> int:
+    """Index of the failure of a stress-strain curve: the largest stress reached before the stress first falls
+    below half of it (the first load drop); the largest of all when it never does."""
+    stress = np.asarray(stress, dtype=float)
+    peak = 0
+    for k, value in enumerate(stress):
+        if value > stress[peak]:
+            peak = k
+        elif value < 0.5 * stress[peak]:
+            return peak
+    return int(np.argmax(stress))
+
+
+def at(series: dict, t: float) -> dict:
+    """The row of ``series`` nearest to time ``t``."""
+    k = int(np.argmin(np.abs(series["t"] - t)))
+    return {key: v[k] for key, v in series.items()}
+
+
+def without_rattlers(i, j, n: int) -> tuple[float, int]:
+    """``(2 M'/N', N - N')``: the coordination number of the particles left after removing, again and again, those
+    with fewer than two particle contacts (rattlers cannot carry a load), and how many were removed."""
+    keep = np.ones(n, dtype=bool)
+    while True:
+        both = keep[i] & keep[j]
+        degree = np.bincount(i[both], minlength=n) + np.bincount(j[both], minlength=n)
+        drop = keep & (degree < 2)
+        if not np.any(drop):
+            return (2.0 * np.count_nonzero(both) / max(1, np.count_nonzero(keep))), int(n - np.count_nonzero(keep))
+        keep &= ~drop
