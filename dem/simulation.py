@@ -119,10 +119,18 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
 
         if not transient and report is not None:
             report("bonds")
-        details = thermal.run(observe, report if transient else None, restart, checkpoint)
-        if not transient and report is not None:
-            report("solve")
-    except KeyboardInterrupt:
+        try:
+            details = thermal.run(observe, report if transient else None, restart, checkpoint)
+            if not transient and report is not None:
+                report("solve")
+        finally:
+            if bar is not None:
+                bar.close()
+        summary = _thermal_summary(scene, models, thermal, details, restart)
+        summary["seconds"] = time.perf_counter() - start
+        if writer is not None:
+            writer.finish(summary)
+    except KeyboardInterrupt:  # also while the run's last files are written: the folder says it was interrupted
         if writer is not None:
             writer.interrupted({"scene": scene.name, "mode": scene.solver.mode, "interrupted": True,
                                 "physics": list(scene.physics)})
@@ -130,6 +138,11 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     finally:
         if bar is not None:
             bar.close()
+    return RunResult(summary, thermal.T, models)
+
+
+def _thermal_summary(scene: Scene, models, thermal, details: dict, restart) -> dict:
+    """The summary of a thermal run (static packing) from what its model returned."""
     p = scene.particles
     summary = {"scene": scene.name, "mode": scene.solver.mode, "t": details.pop("t"), "steps": details.pop("steps"),
                "particles": p.n, "bonds": thermal.bonds.n_pairs, "energy_error": details.pop("energy_error"),
@@ -144,13 +157,9 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
         summary["effective_conductivity"] = k_eff
     summary.update(T_mean=float(thermal.T.mean()), T_min=float(thermal.T.min()), T_max=float(thermal.T.max()))
     summary.update(details)
-    if resume:
+    if restart is not None:
         summary["resumed_from"] = {"t": restart.t, "steps": restart.steps}
-    summary = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in summary.items()}
-    summary["seconds"] = time.perf_counter() - start
-    if writer is not None:
-        writer.finish(summary)
-    return RunResult(summary, thermal.T, models)
+    return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in summary.items()}
 
 
 def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = False) -> RunResult:
@@ -183,8 +192,24 @@ def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = Fa
         if out is not None and not zohdi else None
     bar, report = _progress_bar(scene, progress)
     try:
-        details = sim.run(writer, report) if zohdi else sim.run(writer, report, checkpoint, here)
-    except KeyboardInterrupt:
+        try:
+            details = sim.run(writer, report) if zohdi else sim.run(writer, report, checkpoint, here)
+        finally:
+            if bar is not None:
+                bar.close()
+        summary = {"scene": scene.name, "mode": "transient", "physics": list(scene.physics), "static": False,
+                   **details}
+        if resume:
+            summary["resumed_from"] = {"t": float(saved["t"]), "steps": int(saved["steps"])}
+        if out is not None and not zohdi:
+            summary["state"] = state_file.save(sim, pathlib.Path(out) / "state.npz").name
+        if scene.particles.n <= T_LIST_MAX:
+            summary["T"] = sim.mechanics.state.T.tolist()
+        summary = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in summary.items()}
+        summary["seconds"] = time.perf_counter() - start
+        if writer is not None:
+            writer.finish(summary)
+    except KeyboardInterrupt:  # also while the run's last files are written: the folder says it was interrupted
         if writer is not None:
             writer.interrupted({"scene": scene.name, "interrupted": True, **sim.summary()})
         raise
@@ -192,18 +217,4 @@ def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = Fa
         if writer is not None:
             writer.finish({"scene": scene.name, "stopped": " ".join(str(exc).split()), **sim.summary()})
         raise
-    finally:
-        if bar is not None:
-            bar.close()
-    summary = {"scene": scene.name, "mode": "transient", "physics": list(scene.physics), "static": False, **details}
-    if resume:
-        summary["resumed_from"] = {"t": float(saved["t"]), "steps": int(saved["steps"])}
-    if out is not None and not zohdi:
-        summary["state"] = state_file.save(sim, pathlib.Path(out) / "state.npz").name
-    if scene.particles.n <= T_LIST_MAX:
-        summary["T"] = sim.mechanics.state.T.tolist()
-    summary = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in summary.items()}
-    summary["seconds"] = time.perf_counter() - start
-    if writer is not None:
-        writer.finish(summary)
     return RunResult(summary, sim.mechanics.state.T.copy(), sim.models)

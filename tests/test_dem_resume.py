@@ -76,7 +76,7 @@ fluid_overlap = 0.2
 t0 = 1e3
 brittle_sliding = true
 [temperature]
-time = [0.0, 0.02, 0.04]
+time = [0.0, 0.1, 0.2]
 value = [80.0, 140.0, 80.0]
 relaxation_time = [0.1, 0.1]
 [[walls]]
@@ -105,10 +105,10 @@ mass = 0.01
 damping = 0.2
 [solver]
 mode = "transient"
-t_end = 0.04
+t_end = 0.2
 [output]
-interval = 2e-3
-vtu_interval = 0.01
+interval = 5e-3
+vtu_interval = 0.04
 checkpoint_every = 0.2
 """
 
