@@ -248,12 +248,12 @@ def time_ours(make, steps: int, warmup: int) -> dict:
 
 
 @njit  # not cached: numba's cache follows only this file, so a cached copy would keep an old engine's code
-def _force_passes(count, x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn,
-                  p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt):
+def _force_passes(count, x, v, w, f, tau, spin_axes, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last,
+                  p_xi, p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt):
     """``count`` force passes of the engine's loop (:func:`dem.md_loop._forces`) in one compiled call."""
     for _ in range(count):
-        md_loop._forces(x, v, w, f, tau, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi, p_fn, p_ft,
-                        wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt)
+        md_loop._forces(x, v, w, f, tau, spin_axes, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi,
+                        p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt)
 
 
 @njit  # not cached (as above)
@@ -281,9 +281,10 @@ def stage_costs(sample: dict, material: LudingMaterial, steps: int) -> dict:
     mech.advance(steps, T0, rate)
     whole = time.process_time() - t0
     rebuilds = mech.rebuilds - rebuilds
-    forces_args = (s.x, s.v, s.w, s.f, s.tau, s.mass, s.radius, mech.k1f, mech.gravity, mech.box, mech.pi, mech.pj,
-                   mech.p_dmax, mech.p_k1last, mech.p_xi, mech.p_fn, mech.p_ft, w.normal, w.q, w.dq, w.force, mech.wk,
-                   mech.wm, mech.w_dmax, mech.w_k1last, mech.w_xi, mech.w_fn, mech.w_ft, mech.params, mech.dt)
+    forces_args = (s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, mech.k1f, mech.gravity, mech.box,
+                   mech.pi, mech.pj, mech.p_dmax, mech.p_k1last, mech.p_xi, mech.p_fn, mech.p_ft, w.normal, w.q, w.dq,
+                   w.force, mech.wk, mech.wm, mech.w_dmax, mech.w_k1last, mech.w_xi, mech.w_fn, mech.w_ft,
+                   mech.params, mech.dt)
     material_args = (mech.t, T0, rate, s.T, s.radius, s.radius_ref, mech.k1f, True, mech.params,
                      mech.relaxation_time, mech.dt)
     _force_passes(0, *forces_args)  # compile
@@ -678,7 +679,8 @@ def contact_loop(delta, delta_dot, s, delta_max, s_last, delta_fluid, xi, normal
 def ns_per_contact(n: int, repeat: int = 5) -> dict:
     """Best and median ns (CPU time) per contact of :func:`contact_loop` over ``n`` random contacts, warm."""
     data = random_contacts(n)
-    args = (*data.values(), 1e-7, LUDING_TABLE1.params(), np.empty((n, 3)), np.empty((n, 3)), np.empty(n))
+    material = tuple(LUDING_TABLE1.params())  # as the engine's loop passes it (an array: a reference count per call)
+    args = (*data.values(), 1e-7, material, np.empty((n, 3)), np.empty((n, 3)), np.empty(n))
     contact_loop(*args)  # compile or load from the cache
     times = []
     for _ in range(repeat):

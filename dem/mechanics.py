@@ -112,10 +112,10 @@ class MechanicalModel:
     def _initial_forces(self):
         """Forces of the initial state (dt = 0: no history increment)."""
         s, w = self.state, self.w
-        md_loop._forces(s.x, s.v, s.w, s.f, s.tau, s.mass, s.radius, self.k1f, self.gravity, self.box, self.pi,
-                        self.pj, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft, w.normal, w.q, w.dq,
-                        w.force, self.wk, self.wm, self.w_dmax, self.w_k1last, self.w_xi, self.w_fn, self.w_ft,
-                        self.params, 0.0)
+        md_loop._forces(s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, self.k1f, self.gravity,
+                        self.box, self.pi, self.pj, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft,
+                        w.normal, w.q, w.dq, w.force, self.wk, self.wm, self.w_dmax, self.w_k1last, self.w_xi,
+                        self.w_fn, self.w_ft, self.params, 0.0)
         for m in range(len(self.walls)):
             w.acc[m] = md_loop._wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span,
                                                   w.force)
@@ -137,7 +137,7 @@ class MechanicalModel:
         while done < n_steps:
             steps, status = md_loop.advance(
                 n_steps - done, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia,
-                s.linear_dof, s.angular_dof, s.radius, s.radius_ref, T0, T_rate, s.T, self.k1f,
+                s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.k1f,
                 uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_dmax, self.p_k1last, self.p_xi,
                 self.p_fn, self.p_ft, w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0,
                 w.amplitude, w.frequency, w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_dmax,

@@ -6,7 +6,7 @@ Two kinds of particle:
 * ``dimension = 3`` -- spheres, ``m = rho (4/3) pi a^3``, ``I = (2/5) m a^2``;
 * ``dimension = 2`` -- disks (cylinders) of height ``height`` lying in the x-z plane, as in Luding 2005
   (Sec. 2): ``m = rho pi a^2 h``, ``I = m a^2 / 2`` about the y axis. Their centres keep ``y = 0``; they translate
-  in x and z and rotate about y only (the masks :attr:`MotionState.linear_dof`, :attr:`MotionState.angular_dof`).
+  in x and z and rotate about y only (:attr:`MotionState.axes`, :attr:`MotionState.spin_axes`).
 
 The radius follows the temperature by thermal expansion (Luding 2005, eq. 9) while the mass stays constant, so the
 radius at the reference (melting) temperature ``radius_ref`` is kept beside the current ``radius``.
@@ -32,6 +32,12 @@ def particle_mass(dimension: int, density, radius, height: float | None = None) 
 def moment_of_inertia(dimension: int, mass, radius) -> np.ndarray:
     """``(2/5) m a^2`` (sphere) or ``m a^2 / 2`` (disk about its axis), kg m^2."""
     return (0.4 if dimension == 3 else 0.5) * np.asarray(mass) * np.asarray(radius) ** 2
+
+
+def _mask(axes: tuple[int, ...]) -> np.ndarray:
+    mask = np.zeros(3)
+    mask[list(axes)] = 1.0
+    return mask
 
 
 @dataclass
@@ -86,14 +92,24 @@ class MotionState:
         return len(self.mass)
 
     @property
+    def axes(self) -> tuple[int, ...]:
+        """The axes a particle translates along (2D: x and z)."""
+        return (0, 2) if self.dimension == 2 else (0, 1, 2)
+
+    @property
+    def spin_axes(self) -> tuple[int, ...]:
+        """The axes a particle rotates about (2D: y)."""
+        return (1,) if self.dimension == 2 else (0, 1, 2)
+
+    @property
     def linear_dof(self) -> np.ndarray:
-        """1 for the axes a particle translates along (2D: x and z)."""
-        return np.array([1.0, 0.0, 1.0]) if self.dimension == 2 else np.ones(3)
+        """1 for the :attr:`axes`, 0 for the others."""
+        return _mask(self.axes)
 
     @property
     def angular_dof(self) -> np.ndarray:
-        """1 for the axes a particle rotates about (2D: y)."""
-        return np.array([0.0, 1.0, 0.0]) if self.dimension == 2 else np.ones(3)
+        """1 for the :attr:`spin_axes`, 0 for the others."""
+        return _mask(self.spin_axes)
 
     def kinetic_energy(self) -> float:
         """Translational plus rotational kinetic energy, J."""

@@ -22,8 +22,8 @@ How it holds. The first SIGINT raises ``KeyboardInterrupt`` and any further one 
 (``finally`` blocks, the report files, an open gmsh session, which :func:`interrupted` also finalizes) cannot be
 cut short. C code may turn the interrupt into another error (numpy's import raises ``ImportError`` when it lands
 there) or swallow it (in a weakref callback it is only "ignored"; in an extension module's import it can end as a
-caught ``ImportError``): any error after a SIGINT counts as the interrupt, and a swallowed one is raised again --
-from the unraisable hook, at the next :meth:`Where.update`, or when the command returns. tqdm bars still open are
+caught ``ImportError``): any error after a SIGINT counts as the interrupt, and a swallowed one is raised again at
+the next :meth:`Where.update` or when the command returns (the unraisable hook keeps it off stderr). tqdm bars still open are
 closed before the line is written, so it starts a line of its own. Workers of a process pool ignore SIGINT
 (:func:`ignore_interrupts` as the pool's initializer, forked inside :func:`shielded` so that no fork races the
 signal); the parent stops them (:func:`stop_pool`). :func:`exit_process` then leaves with code 130 (Python's own
@@ -100,11 +100,9 @@ def _raise_once(signum, frame):
 
 def _unraisable(previous):
     def hook(unraisable):
-        state = _current.get()
-        if issubclass(unraisable.exc_type, KeyboardInterrupt) and state is not None:
-            state.signalled = False  # swallowed (e.g. raised in a weakref callback): raise it again where it counts
-            signal.raise_signal(signal.SIGINT)
-            return
+        if issubclass(unraisable.exc_type, KeyboardInterrupt) and _current.get() is not None:
+            return  # swallowed (raised in a destructor or a weakref callback): the flag the handler set raises it
+            # again at the next Where.update or when the command returns (raised in here, it would only be printed)
         previous(unraisable)
 
     return hook

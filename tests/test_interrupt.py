@@ -140,6 +140,31 @@ def test_gmsh_is_finalized_and_the_handler_restored_in_process(tmp_path, capsys)
     assert signal.getsignal(signal.SIGINT) is before
 
 
+def test_an_interrupt_swallowed_in_a_destructor_ends_the_run_at_the_next_update(capsys):
+    # Python only reports a KeyboardInterrupt raised in a destructor as "ignored": the run still stops, in one line
+    class Collected:
+        def __del__(self):
+            signal.raise_signal(signal.SIGINT)  # the Ctrl-C lands here
+
+    after = []
+
+    def body():
+        Collected()
+        after.append("update reached")
+        interrupt.where().update(stage="after the destructor")
+        after.append("went on")
+        return 0
+
+    before = signal.getsignal(signal.SIGINT)
+    try:
+        code = interrupt.run_command(interrupt.Where("python -m dem run"), body)
+    finally:
+        signal.signal(signal.SIGINT, before)
+    assert code == interrupt.EXIT_CODE and after == ["update reached"]
+    assert capsys.readouterr().err == ("python -m dem run: interrupted at after the destructor; "
+                                       "no results written\n")
+
+
 def test_where_message():
     here = interrupt.Where("python -m dem run")
     assert here.message() == "python -m dem run: interrupted at start-up; no results written"
