@@ -383,7 +383,8 @@ def _spec(cls, table, section, numeric=(), integer=(), words=()):
 
 def _moving_keys(doc: dict, moving: bool) -> dict:
     """``doc`` without the keys and tables of moving particles (:mod:`dem.moving_scene`), which a scene without
-    ``"mechanical"`` physics refuses by name."""
+    ``"mechanical"`` physics refuses by name; in a scene with it, an unknown key is refused here, naming every key
+    such a scene allows."""
     out = dict(doc)
     for table in MOVING_TABLES:
         if table in out and not moving:
@@ -395,10 +396,12 @@ def _moving_keys(doc: dict, moving: bool) -> dict:
             continue
         many = isinstance(tables, list)
         cleaned = []
-        for t in (tables if many else [tables]):
+        for k, t in enumerate(tables if many else [tables]):
             if not isinstance(t, dict):
                 cleaned.append(t)
                 continue
+            if moving:
+                _check_keys(t, f"{section}[{k}]" if many else section, ALLOWED[section] | keys)
             extra = sorted(set(t) & keys)
             if extra and not moving:
                 raise ValueError(f"[{section}] {extra[0]}: only for moving particles ([scene] physics with "

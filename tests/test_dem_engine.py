@@ -184,6 +184,15 @@ def test_moving_keys_are_refused_in_a_static_scene():
         parse_scene(doc)
 
 
+@pytest.mark.parametrize("section, key, meant", [("solver", "skinn", "skin"), ("walls", "presure", "pressure")])
+def test_an_unknown_key_of_a_moving_scene_lists_the_keys_it_allows(section, key, meant):
+    doc = copy.deepcopy(scene_doc([[0, 0, 0], [2.1e-3, 0, 0]], [1e-3, 1e-3], contact=TABLE1))
+    doc["walls"] = [{"name": "floor", "point": [0, 0, -1e-3], "normal": [0, 0, 1]}]
+    (doc[section][0] if section == "walls" else doc[section])[key] = 1.0
+    with pytest.raises(ValueError, match=rf"{key}: unknown key \(allowed: .*\b{meant}\b"):
+        parse_scene(doc)
+
+
 def test_cli_run_writes_outputs(tmp_path):
     doc = scene_doc([[0, 0, 0], [2.1e-3, 0, 0]], [1e-3, 1e-3], [[0.05, 0, 0], [-0.05, 0, 0]], TABLE1, t_end=1e-3)
     doc["output"] = {"interval": 1e-4, "vtu_interval": 5e-4}
