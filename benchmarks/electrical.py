@@ -135,7 +135,6 @@ def current_solve(sim, repeat: int = 3) -> dict:
     """The area-weighted Laplace problem of eq. (43) by the network solve and by Gauss-Seidel sweeps to 1e-3, 1e-6,
     1e-9 of it; the physical Kirchhoff refresh for comparison (module docstring)."""
     from dem.electrical import area_weighted_current
-    from dem.network import BoundedLaplacian, solve_anchored
     from dem.zohdi.heat import contact_bonds
 
     mech, cur = sim.mechanics, sim.current
@@ -146,17 +145,7 @@ def current_solve(sim, repeat: int = 3) -> dict:
     J_ext = J_ext / max(np.max(np.abs(J_ext)), 1e-300)  # 1 at the driven wall, 0 at the ground
 
     def direct():
-        touching = np.zeros(n, dtype=bool)
-        touching[b.wall_particle] = True
-        value = np.zeros(n)
-        value[b.wall_particle] = J_ext[b.wall_index]
-        system = BoundedLaplacian(n, b.i, b.j, area, touching, [], [], [], 0)
-        _, label, anchored = system.components()
-        subset = np.flatnonzero(anchored[label])
-        x, _ = solve_anchored(system, system.boundary_rhs(value[system.fixed], []), subset, "direct")
-        out = value.copy()
-        out[system.free[subset]] = x
-        return out, system.free[subset]
+        return _direct(n, b, area, b.wall_particle, b.wall_index, J_ext)
 
     reference, free = direct()
     seconds_direct = _best(direct, repeat)
@@ -171,6 +160,24 @@ def current_solve(sim, repeat: int = 3) -> dict:
     kirchhoff = _best(lambda: cur.refresh(mech, sim.t), repeat) if cur.scheme == "kirchhoff" else None
     return {"unknowns": int(len(free)), "contacts": int(b.n_pairs), "seconds_direct": seconds_direct,
             "gauss_seidel": sweeps, "seconds_kirchhoff_refresh": kirchhoff}
+
+
+def _direct(n, b, area, node, index, values):
+    """The area-weighted Laplace problem of eq. 43 (bonds ``b``, weights ``area``) with the potential of particle
+    ``node[k]`` held at ``values[index[k]]``, solved directly on the components that hold a fixed particle: the
+    potentials and the free particles solved for."""
+    from dem.network import BoundedLaplacian, solve_anchored
+
+    fixed = np.zeros(n, dtype=bool)
+    fixed[node] = True
+    value = np.zeros(n)
+    value[node] = values[index]
+    system = BoundedLaplacian(n, b.i, b.j, area, fixed, [], [], [], 0)
+    _, label, anchored = system.components()
+    subset = np.flatnonzero(anchored[label])
+    x, _ = solve_anchored(system, system.boundary_rhs(value[system.fixed], []), subset, "direct")
+    value[system.free[subset]] = x
+    return value, system.free[subset]
 
 
 def _sweeps_to(n, b, area, plane_node, plane_index, values, reference, free, accuracy):
@@ -190,7 +197,6 @@ def current_scaling(sizes=(1000, 4000, 16000), accuracy: float = 1e-6, repeat: i
     from dem.bonds import find_bonds
     from dem.electrical import area_weighted_current
     from dem.generators import random_packing
-    from dem.network import BoundedLaplacian, solve_anchored
     from dem.particles import Particles
 
     rows = []
@@ -205,17 +211,7 @@ def current_scaling(sizes=(1000, 4000, 16000), accuracy: float = 1e-6, repeat: i
         values = np.array([0.0, 1.0])
 
         def direct():
-            fixed = np.zeros(n, dtype=bool)
-            fixed[plane_node] = True
-            value = np.zeros(n)
-            value[plane_node] = values[plane_index]
-            system = BoundedLaplacian(n, b.i, b.j, area, fixed, [], [], [], 0)
-            _, label, anchored = system.components()
-            subset = np.flatnonzero(anchored[label])
-            x, _ = solve_anchored(system, system.boundary_rhs(value[system.fixed], []), subset, "direct")
-            out = value.copy()
-            out[system.free[subset]] = x
-            return out, system.free[subset]
+            return _direct(n, b, area, plane_node, plane_index, values)
 
         reference, free = direct()
         seconds_direct = _best(direct, repeat)
