@@ -12,7 +12,7 @@ import time
 import numpy as np
 
 from benchmarks.timing import (available, best_time, emit, growth_exponent, package_version, peak_rss_mib, ratio,
-                               run_worker)
+                               run_worker, worker_sweep)
 from verification.report import records_table
 
 TITLE = "DEM thermal solvers"
@@ -258,10 +258,7 @@ def study_steady_scaling(section, quick: bool) -> None:
     from matplotlib.figure import Figure
 
     sizes = (1_000, 10_000) if quick else (1_000, 10_000, 100_000, 1_000_000)
-    rows = []
-    for n in sizes:
-        rows.append(run_worker("benchmarks.dem", "steady_worker", n, timeout=900))
-        section.csv("dem_steady_scaling", rows)
+    rows = worker_sweep(section, "dem_steady_scaling", "benchmarks.dem", "steady_worker", sizes, timeout=900)
     good = [r for r in rows if "error" not in r]
     section.summary["dem_steady_seconds"] = {str(r["particles"]): r["steady_seconds"] for r in good}
     section.summary["dem_steady_peak_rss_mib"] = {str(r["particles"]): r["peak_rss_mib"] for r in good}
@@ -318,12 +315,8 @@ def study_openpnm(section, quick: bool) -> None:
     # 10^6 is left out: OpenPNM's default PARDISO factorisation of the 3D network passed 14 GiB resident after
     # 8 minutes on a 2-core machine (stopped), which would starve everything else of memory.
     sizes = (1_000, 10_000) if quick else (10_000, 100_000)
-    rows = []
-    for n in sizes:
-        rows.append(run_worker("benchmarks.dem", "openpnm_worker", n, timeout=600))
-        section.csv("openpnm_same_network", rows)
-        if "error" in rows[-1]:
-            break
+    rows = worker_sweep(section, "openpnm_same_network", "benchmarks.dem", "openpnm_worker", sizes, timeout=600,
+                        stop_at_error=True)
     good = [r for r in rows if "error" not in r]
     for r in good:
         r["ratio_ours_over_openpnm"] = r["ours_seconds"] / r["openpnm_seconds"]

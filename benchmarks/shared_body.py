@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from benchmarks.timing import emit, peak_rss_mib, run_worker
+from benchmarks.timing import emit, peak_rss_mib, worker_sweep
 from verification.report import records_table
 
 TITLE = "DEM steady solve: the shared-body law against today's"
@@ -67,10 +67,7 @@ def laws_worker(n: int) -> None:
 
 def run(section, quick: bool) -> None:
     sizes = (10_000, 100_000) if quick else (10_000, 100_000, 1_000_000)
-    rows = []
-    for n in sizes:
-        rows.append(run_worker("benchmarks.shared_body", "laws_worker", n, timeout=1800))
-        section.csv("shared_body_steady", rows)
+    rows = worker_sweep(section, "shared_body_steady", "benchmarks.shared_body", "laws_worker", sizes, timeout=1800)
     good = [r for r in rows if "error" not in r]
     section.summary["shared_body_over_rojek"] = {str(r["particles"]): r["shared_over_rojek"] for r in good}
     section.summary["shared_body_over_fit"] = {str(r["particles"]): r["shared_over_fit"] for r in good}

@@ -79,6 +79,20 @@ def run_worker(module: str, func: str, n: int, timeout: float) -> dict:
     return json.loads(lines[-1])
 
 
+def worker_sweep(section, name: str, module: str, func: str, sizes, timeout: float,
+                 stop_at_error: bool = False) -> list[dict]:
+    """:func:`run_worker` for each of ``sizes`` in turn, the rows so far written to ``section``'s CSV ``name`` after
+    each (an interrupted bench keeps them); with ``stop_at_error`` the larger sizes are skipped after a failed one.
+    Returns every row, failed ones included (they hold ``error``)."""
+    rows = []
+    for n in sizes:
+        rows.append(run_worker(module, func, n, timeout))
+        section.csv(name, rows)
+        if stop_at_error and "error" in rows[-1]:
+            break
+    return rows
+
+
 def emit(record: dict) -> None:
     """A worker's result: one JSON line on stdout."""
     print(json.dumps(record))
