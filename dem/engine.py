@@ -138,7 +138,7 @@ class Simulation:
     def run(self, observer=None, progress=None, checkpoint=None, position=None) -> dict:
         """Advance to ``[solver] t_end``; ``observer(sim)`` after each interval that ends on an output time (and at
         t = 0), ``progress(t)`` after every interval, ``checkpoint(make)`` after every interval and at the end
-        (:class:`dem.run_folder.Checkpointer`); ``position`` (:class:`fem_neck.interrupt.Where`) learns the step and
+        (:class:`dem.run_folder.Checkpointer`); ``position`` (:class:`sinterheat.interrupt.Where`) learns the step and
         time after every interval."""
         from dem.state_file import arrays
 

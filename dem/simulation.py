@@ -14,7 +14,7 @@ from dem import physics, run_folder
 from dem.io import RunWriter
 from dem.scene import Scene
 from dem.thermal import Checkpoint
-from fem_neck.interrupt import where
+from sinterheat.interrupt import where
 
 T_LIST_MAX = 1000  # the summary lists the final temperatures for scenes up to this many particles
 
@@ -52,11 +52,11 @@ def _progress_bar(scene: Scene, enabled: bool):
 
 
 def _position(scene: Scene, out, progress: bool):
-    """The run's position for the line an interrupt prints (:func:`fem_neck.interrupt.where`) -- only for a run
+    """The run's position for the line an interrupt prints (:func:`sinterheat.interrupt.where`) -- only for a run
     that reports its progress (the CLI's): a run inside another command (a verification section) leaves that
     command's position alone."""
     if not progress:
-        from fem_neck.interrupt import Where
+        from sinterheat.interrupt import Where
 
         return Where()  # a throw-away position
     here = where()

@@ -302,7 +302,7 @@ def test_verification_out_that_cannot_be_created(capsys, out):
 def test_printed_results_never_contain_nan(capsys):
     """Every CLI prints through print_result: a non-finite number (e.g. converge's observed order fitted from fewer
     than two points) is null in JSON, not the invalid token NaN."""
-    from fem_neck.cli import print_result
+    from sinterheat.cli import print_result
 
     print_result({"order": float("nan"), "K": [1.5, float("inf")], "nested": {"x": -float("inf")}}, as_json=True)
     out = capsys.readouterr().out

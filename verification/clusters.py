@@ -44,7 +44,7 @@ import numpy as np
 
 from fem_neck.cluster import Cluster, Terminal, cluster_conductance
 from fem_neck.geometry import overlap_for_neck
-from fem_neck.interrupt import where
+from sinterheat.interrupt import where
 from verification.report import save_figure
 
 KAPPA = 394.0

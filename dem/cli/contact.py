@@ -26,7 +26,7 @@ import pathlib
 
 import numpy as np
 
-from fem_neck.cli import add_output_options
+from sinterheat.cli import add_output_options
 
 COLUMNS = ("t", "overlap", "T")
 OUTPUTS = ("force", "delta_max", "delta_0", "k1", "k2", "kc", "f_min")

@@ -7,7 +7,7 @@ bit for bit as if it had not stopped) or ``--overwrite`` (delete that run's file
 one line saying where, leaving the folder usable and resumable.
 """
 
-from fem_neck.cli import add_output_options
+from sinterheat.cli import add_output_options
 
 
 def register(sub):

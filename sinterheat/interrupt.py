@@ -11,7 +11,7 @@ never a traceback::
 Long work says where it is by updating the current run's :class:`Where` (outside a CLI run :func:`where` returns a
 throw-away one, so library code can always call it)::
 
-    from fem_neck.interrupt import where
+    from sinterheat.interrupt import where
     where().update(stage="transient", step=k, t=t, out=folder)   # out: once usable files are in folder
 
 Fields: ``stage`` (what is running), ``step`` (an int is shown as "step k"; a string as it is, e.g. "12 of 40
@@ -42,7 +42,7 @@ import threading
 from dataclasses import dataclass, field
 
 EXIT_CODE = 130  # 128 + SIGINT
-_current: contextvars.ContextVar[Where | None] = contextvars.ContextVar("fem_neck_where", default=None)
+_current: contextvars.ContextVar[Where | None] = contextvars.ContextVar("sinterheat_where", default=None)
 
 
 @dataclass
