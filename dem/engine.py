@@ -37,7 +37,7 @@ class Simulation:
 
     def __init__(self, scene, resume: dict | None = None):
         """``resume``: a checkpoint of this scene's run (:func:`dem.state_file.arrays` as loaded by
-        :func:`dem.run_folder.load`): the run goes on from its step as if it had not stopped."""
+        :func:`dem.output.folder.load`): the run goes on from its step as if it had not stopped."""
         self.scene = scene
         m = scene.motion
         p = scene.particles
@@ -138,7 +138,7 @@ class Simulation:
     def run(self, observer=None, progress=None, checkpoint=None, position=None) -> dict:
         """Advance to ``[solver] t_end``; ``observer(sim)`` after each interval that ends on an output time (and at
         t = 0), ``progress(t)`` after every interval, ``checkpoint(make)`` after every interval and at the end
-        (:class:`dem.run_folder.Checkpointer`); ``position`` (:class:`sinterheat.interrupt.Where`) learns the step and
+        (:class:`dem.output.folder.Checkpointer`); ``position`` (:class:`sinterheat.interrupt.Where`) learns the step and
         time after every interval."""
         from dem.state_file import arrays
 

@@ -101,7 +101,7 @@ class SolverSpec:
 @dataclass(frozen=True)
 class OutputSpec:
     """CSV row every ``every`` steps; VTU snapshot every ``vtu_every`` steps (0: first and last only); a checkpoint
-    of a transient run every ``checkpoint_every`` seconds of wall time (:mod:`dem.run_folder`)."""
+    of a transient run every ``checkpoint_every`` seconds of wall time (:mod:`dem.output.folder`)."""
 
     every: int = 1
     vtu_every: int = 0

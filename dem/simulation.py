@@ -10,8 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dem import physics, run_folder
-from dem.io import RunWriter
+from dem import physics
+from dem.output import folder as run_folder
+from dem.output.writer import RunWriter
 from dem.scene import Scene
 from dem.thermal import Checkpoint
 from sinterheat.interrupt import where
@@ -87,7 +88,7 @@ def effective_conductivity(scene: Scene, summary: dict) -> float | None:
 def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, overwrite: bool = False) -> RunResult:
     """Run ``scene``; with ``out`` write summary.json, timeseries.csv, VTU/PVD snapshots and plots into that folder
     (refused if it holds a run, unless ``resume``: go on from its last checkpoint, or ``overwrite``: clear it first;
-    :mod:`dem.run_folder`). Ctrl-C leaves the folder usable: the rows and snapshots written so far, the last
+    :mod:`dem.output.folder`). Ctrl-C leaves the folder usable: the rows and snapshots written so far, the last
     checkpoint, and ``summary.json`` marked ``"interrupted": true``. ``progress``: a bar on stderr, and the run's
     position in the line an interrupt prints."""
     if out is not None:
@@ -167,7 +168,7 @@ def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = Fa
     ``[contact] law = "zohdi"`` the staggered scheme of :mod:`dem.zohdi.simulation` (``out`` prepared by
     :func:`run`)."""
     from dem import state_file
-    from dem.io import MotionWriter
+    from dem.output.writer import MotionWriter
 
     zohdi = scene.contact.law == "zohdi"
     if zohdi:
@@ -185,7 +186,7 @@ def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = Fa
     writer = MotionWriter(out, scene, resume_step=sim.mechanics.steps if resume else None) if out is not None \
         else None
     if writer is not None and scene.motion.frames:
-        from dem.frames import WithFrames
+        from dem.output.frames import WithFrames
 
         writer = WithFrames(writer, scene, out)
     checkpoint = run_folder.Checkpointer(out, scene, "moving", scene.output.checkpoint_every) \

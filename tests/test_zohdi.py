@@ -375,7 +375,7 @@ def test_compiled_lens_conduction_is_the_conductance_law_on_the_bonds():
 
 @pytest.mark.slow
 def test_frames_are_rendered_off_screen(tmp_path):
-    from dem.frames import FrameWriter
+    from dem.output.frames import FrameWriter
 
     doc = column()
     doc["output"] = {"fraction_axis": "x"}

@@ -206,7 +206,7 @@ def wall_segments(snap: dict) -> list:
 
 
 def _draw(ax, a: dict, k: int, title: str, stress_range=None):
-    from dem.plots import draw_packing
+    from dem.output.plots import draw_packing
 
     snap = {key[len(f"snap{k}_"):]: v for key, v in a.items() if key.startswith(f"snap{k}_")}
     draw_packing(ax, snap["x"], snap["radius"], snap["mean_stress"], snap["i"], snap["j"], snap["fn"], snap["ft"],

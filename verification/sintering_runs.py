@@ -219,7 +219,7 @@ def run_task(task: Task, root) -> dict:
     from dem import state_file
     from dem.engine import Simulation
     from dem.fragments import fragments
-    from dem.io import MotionWriter
+    from dem.output.writer import MotionWriter
     from dem.scene import parse_scene
 
     root = pathlib.Path(root)

@@ -20,7 +20,7 @@ temperature change below 1e-12 of the temperatures) counts as none, and a step b
 converge stops the run. Steps end exactly on the start of every ``[[phases]]`` entry (a wall changing speed) and on
 ``t_end``.
 
-The simulation offers what the outputs ask of an engine (:class:`dem.io.MotionWriter`): ``record()``,
+The simulation offers what the outputs ask of an engine (:class:`dem.output.writer.MotionWriter`): ``record()``,
 ``particle_fields()``, ``contact_fields()``, ``profile()``, ``summary()`` and ``mechanics.state``.
 """
 
@@ -249,7 +249,7 @@ class ZohdiSimulation:
 
     def plates(self) -> list:
         """The bottom and top walls of ``[output] fraction_axis`` as ``(centre, normal, sizes)`` for pictures
-        (:mod:`dem.frames`); none without that axis."""
+        (:mod:`dem.output.frames`); none without that axis."""
         axis = self.scene.motion.control
         section = self._cross_section(axis) if axis is not None else None
         if section is None:

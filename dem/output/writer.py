@@ -175,7 +175,7 @@ class RunWriter:
         self.csv.close()
         write_summary(self.out / "summary.json", summary)  # first: the profile plot reads k_eff from it
         if plots:
-            from dem.plots import thermal_plots
+            from dem.output.plots import thermal_plots
 
             summary["plots"] = thermal_plots(self.out, self.scene, self.model.T)
             write_summary(self.out / "summary.json", summary)
@@ -277,7 +277,7 @@ class MotionWriter:
         if self.csv is not None:
             self.csv.close()
         if plots:
-            from dem.plots import motion_plots
+            from dem.output.plots import motion_plots
 
             summary["plots"] = motion_plots(self.out)
         write_summary(self.out / "summary.json", summary)

@@ -87,7 +87,7 @@ class FrameWriter:
 
 
 class WithFrames:
-    """A run's output observer (:class:`dem.io.MotionWriter`) that also renders ``[output] frames`` pictures, the
+    """A run's output observer (:class:`dem.output.writer.MotionWriter`) that also renders ``[output] frames`` pictures, the
     colours from the coldest to the hottest prescribed temperature (initial, walls) or hotter."""
 
     def __init__(self, writer, scene, out_dir):
