@@ -22,7 +22,7 @@ LIMITS = {"dem_steady_1e6_seconds": 30.0, "dem_steady_1e6_peak_gib": 8.0, "dem_t
 
 
 def packing_network(n: int, seed: int = 0, connected_only: bool = False, t_hot: float = 1.0):
-    """A random sintered packing of ~n copper particles (``dem.generators.random_packing``) between a hot bottom
+    """A random sintered packing of ~n copper particles (``dem.geometry.generators.random_packing``) between a hot bottom
     layer (fixed at ``t_hot``) and a cold top layer (fixed at 0), free particles starting at 0, rojek law.
 
     ``connected_only`` keeps only the particles connected to a fixed layer (what a pore-network code can solve).
@@ -31,9 +31,9 @@ def packing_network(n: int, seed: int = 0, connected_only: bool = False, t_hot: 
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    from dem.bonds import find_bonds
-    from dem.generators import random_packing
-    from dem.particles import Particles
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.generators import random_packing
+    from dem.geometry.particles import Particles
     from dem.thermal import build_network
 
     times = {}

@@ -16,7 +16,7 @@ The ``electrical`` subject of ``python -m benchmarks`` (:func:`run`) measures, i
   the paper's Gauss-Seidel sweeps from zero until they are within 1e-3, 1e-6 and 1e-9 of it; and the physical
   Kirchhoff solve of :mod:`dem.electrical` (bonds, conductances, potentials, Joule heat);
 * ``current_scaling`` -- the same two solves to 1e-6 on random sintered packings of 1000 to 16 000 particles
-  (:func:`dem.generators.random_packing`, bottom layer at 0, top layer at 1): the sweeps grow with the square of
+  (:func:`dem.geometry.generators.random_packing`, bottom layer at 0, top layer at 1): the sweeps grow with the square of
   the height, the direct solve with its fill-in.
 
 :func:`section7_row` is the row a benchmark table needs (seconds, steps, iterations, restarts, ns per
@@ -97,7 +97,7 @@ def step_cost(sim, repeat: int = 5, luding_steps: int = 200) -> dict:
     """ns per particle of the pieces of a Zohdi step and of a Luding velocity-Verlet step, same packing."""
     from dem.laws.luding import LUDING_TABLE1
     from dem.mechanics import MechanicalModel
-    from dem.motion import MotionState
+    from dem.geometry.motion import MotionState
 
     mech, th, cur = sim.mechanics, sim.thermal, sim.current
     n = mech.state.n
@@ -194,10 +194,10 @@ def _sweeps_to(n, b, area, plane_node, plane_index, values, reference, free, acc
 
 def current_scaling(sizes=(1000, 4000, 16000), accuracy: float = 1e-6, repeat: int = 3) -> list:
     """Direct network solve against Gauss-Seidel sweeps of eq. (43) on random packings (module docstring)."""
-    from dem.bonds import find_bonds
+    from dem.geometry.bonds import find_bonds
     from dem.electrical import area_weighted_current
-    from dem.generators import random_packing
-    from dem.particles import Particles
+    from dem.geometry.generators import random_packing
+    from dem.geometry.particles import Particles
 
     rows = []
     for size in sizes:

@@ -63,7 +63,7 @@ HEIGHT_2D = 6e-3  # Luding 2005, Table 1: disk height (m)
 PRESSURE_2D = 10.0  # N/m: the paper's smaller side stress, whose samples reach coordination ~4 (its Fig. 10)
 WALL_2D = {"mass": 0.01, "damping": 0.2}  # Table 1: wall mass (kg) and damping (kg/s)
 T_RUN = 80.0  # °C: the preparation temperature of Luding 2005, Sec. 4.1 (below the melting range)
-ENGINE_MODULES = ("numba", "dem.engine", "dem.mechanics", "dem.md_loop", "dem.neighbours", "dem.laws.luding_kernels")
+ENGINE_MODULES = ("numba", "dem.engine", "dem.mechanics", "dem.md_loop", "dem.geometry.neighbours", "dem.laws.luding_kernels")
 
 
 @dataclass(frozen=True)
@@ -126,7 +126,7 @@ def _biaxial_walls(q_right: float, q_top: float) -> list[dict]:
 
 def biaxial_sample(sizes: Sizes, cache: pathlib.Path, seed: int = 1) -> dict:
     """The 2D sample (module docstring): disks placed at random in a square box at a solid fraction of ~0.35
-    (:func:`dem.generators.random_box`), compacted by the engine with frictionless Table 1 disks under the stress
+    (:func:`dem.geometry.generators.random_box`), compacted by the engine with frictionless Table 1 disks under the stress
     walls. Cached; returns ``position``, ``radius``, ``q_right``, ``q_top``, ``volume_fraction`` and the seconds
     the compaction took (0 when read from the cache)."""
     path = cache / f"biaxial_{PREPARATION}_n{sizes.disks}_t{sizes.compaction_time:g}_s{seed}.npz"
@@ -167,9 +167,9 @@ def periodic_packing(sizes: Sizes, cache: pathlib.Path, seed: int = 0, coordinat
         with np.load(path) as data:
             return {**{k: data[k] for k in data.files}, "seconds": 0.0}
     from dem.mechanics import MechanicalModel
-    from dem.motion import MotionState
+    from dem.geometry.motion import MotionState
     from dem.moving_scene import time_steps
-    from dem.neighbours import verlet_pairs
+    from dem.geometry.neighbours import verlet_pairs
 
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)

@@ -24,10 +24,10 @@ LIMIT = 1.5  # shared-body steady time over today's (rojek), same packing
 def laws_worker(n: int) -> None:
     """Steady solves of one packing of ~n particles with each law of :data:`LAWS`; one JSON line."""
     from benchmarks.dem import PACKING
-    from dem.bonds import find_bonds
-    from dem.generators import random_packing
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.generators import random_packing
     from dem.laws.conductance import ConductanceSpec
-    from dem.particles import Particles
+    from dem.geometry.particles import Particles
     from dem.thermal import build_network, steady
 
     lay = random_packing(n, PACKING["radius"], PACKING["overlap"], seed=0)

@@ -8,7 +8,7 @@ within ``radius + skin`` of each wall (the only ones that can touch it or cross 
 step:
 
 1. half kick and drift: ``v += dt/2 f/m``, ``x += dt v`` (and ``omega += dt/2 tau/I``); walls move by their law
-   (:mod:`dem.walls`);
+   (:mod:`dem.geometry.walls`);
 2. material state: the temperature ``T_i(t) = T0_i + rate_i (t - t_first)``, the radius ``a(T)`` (Luding 2005,
    eq. 9), the stiffness factor ``k1(T, t)/k1`` relaxed towards ``k1(T)/k1`` (eqs. 10-12);
 3. forces: gravity, every listed pair (normal law eqs. 3-13, tangential eqs. 14-24) and every particle-wall
@@ -34,7 +34,7 @@ from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from dem.laws.luding import N_PARAMS, P_EXPANSION, P_FLUID_OVERLAP, P_T_MELT, P_T_VAR
 from dem.laws.luding_kernels import k1_factor, normal_force, radius_at, relax_k1, tangential_force
-from dem.neighbours import min_image
+from dem.geometry.neighbours import min_image
 
 DONE, REBUILD, NONFINITE, ESCAPED = 0, 1, 2, 3
 # The force loop's floating-point flags: no NaN, no infinity (positions are checked finite before forces are
@@ -52,7 +52,7 @@ def _forces(x, v, w, f, tau, spin_axes, mass, radius, k1f, gravity, box, pi, pj,
     normal forces on the walls go into ``wforce``. Returns the index into the wall list of the first particle whose
     centre lies behind its wall, else -1. With ``record`` the contact forces are kept (``p_fn``, ``p_ft``, ``w_fn``,
     ``w_ft``: outputs only, so the time loop records them on the last step of a call). ``spin_axes``
-    (:attr:`dem.motion.MotionState.spin_axes`): ``(1,)`` for 2D disks in the x-z plane, whose pair terms along y
+    (:attr:`dem.geometry.motion.MotionState.spin_axes`): ``(1,)`` for 2D disks in the x-z plane, whose pair terms along y
     vanish.
 
     The contact kernels are inlined right here, scalars and 3-tuples in and out, with the material as a tuple: an

@@ -9,7 +9,7 @@ particle.
 History (Luding 2005, Sec. 3): per pair in the list the largest overlap ``delta_max``, the stiffness factor the
 contact saw at its last step (``k1_last``: heating keeps delta_max, cooling keeps delta_0, Fig. 5) and the
 tangential spring ``xi`` (eqs. 16, 20-21); the same per particle-wall pair. A rebuild carries the history of every
-pair that stays listed (:func:`dem.neighbours.carry_history`); a contact that opens forgets it.
+pair that stays listed (:func:`dem.geometry.neighbours.carry_history`); a contact that opens forgets it.
 
 The stiffness factor ``k1(T, t)/k1`` (eqs. 10-12) is a property of each particle's material (the healing of its
 defects): a contact uses the mean of its two particles' factors, which for a uniform temperature is exactly the
@@ -25,9 +25,9 @@ import numpy as np
 
 from dem import md_loop
 from dem.laws.luding_kernels import k1_factor
-from dem.motion import MotionState
-from dem.neighbours import carry_history, verlet_pairs, wall_pairs
-from dem.walls import WallArrays
+from dem.geometry.motion import MotionState
+from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
+from dem.geometry.walls import WallArrays
 
 
 class MechanicsError(ValueError):

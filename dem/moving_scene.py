@@ -8,7 +8,7 @@ Tables and keys (SI units; the README's scene schema lists them with their defau
 * ``[contact]`` -- the contact law and its parameters (``law = "luding"``, Luding 2005; ``law = "zohdi"``,
   Zohdi 2014: its stepping, current and electrode keys are those of :mod:`dem.zohdi.scene`);
 * ``[[walls]]`` -- planes that move: ``motion`` fixed | stress | strain | vibrate with ``pressure``, ``mass``,
-  ``damping``, ``velocity``, ``amplitude``, ``frequency`` (:mod:`dem.walls`); ``temperature`` optional;
+  ``damping``, ``velocity``, ``amplitude``, ``frequency`` (:mod:`dem.geometry.walls`); ``temperature`` optional;
 * ``[gravity] acceleration`` (m/s^2, a 3-vector);
 * ``[temperature]`` -- a prescribed schedule ``time``, ``value``, ``relaxation_time`` (:mod:`dem.schedule`);
 * ``[[phases]]`` -- from time ``start`` on, other friction or damping (``mu``, ``mu_wall``, ``gamma_n``,
@@ -29,10 +29,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from dem.laws import luding
-from dem.motion import particle_mass, moment_of_inertia
-from dem.particles import finite_array
+from dem.geometry.motion import particle_mass, moment_of_inertia
+from dem.geometry.particles import finite_array
 from dem.schedule import TemperatureSchedule
-from dem.walls import MovingWall
+from dem.geometry.walls import MovingWall
 from dem.zohdi import scene as zscene
 
 DEFAULT_SKIN = 0.1            # x the mean radius

@@ -15,14 +15,15 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from dem import generators, state_file
+from dem import state_file
+from dem.geometry import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.fields import material_from_table
 from dem.laws.luding import LudingMaterial
 from dem.zohdi.material import ZohdiMaterial
 from dem.zohdi.scene import ElectricalSpec, parse_electrical, zohdi_material
-from dem.particles import COPPER, Material, Particles
-from dem.periodic import AXES, PeriodicBox
+from dem.geometry.particles import COPPER, Material, Particles
+from dem.geometry.periodic import AXES, PeriodicBox
 from dem.sources import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
 from dem.thermal import INTEGRATORS
 from dem.linsolve import BACKENDS
@@ -152,7 +153,7 @@ class Scene:
     contact: LudingMaterial | ZohdiMaterial | None = None
     motion: MotionSpec | None = None  # particles that move ([scene] physics with "mechanical"), else None
     electrical: ElectricalSpec | None = None  # the current's scheme and electrodes ("electrical" physics)
-    box: PeriodicBox | None = None  # a periodic box (dem.periodic), else None
+    box: PeriodicBox | None = None  # a periodic box (dem.geometry.periodic), else None
 
 
 def _is_number(v) -> bool:
@@ -455,7 +456,7 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         box = _periodic_box(doc["periodic"])
     if box is not None and moving:
         raise ValueError("[periodic]: periodic boxes are for static packings so far (the neighbour list of moving "
-                         "particles does not use dem.periodic yet)")
+                         "particles does not use dem.geometry.periodic yet)")
     if not moving:
         walls = walls + _walls(doc)
     cond = dict(doc.get("conductance", {}))

@@ -8,7 +8,7 @@ heat with
 * an ambient by radiation ``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)`` in absolute temperature (:class:`Radiation`),
 * isothermal plane walls it touches (:class:`Wall`; the contact conductance comes from the conductance law).
 
-Particles held at a fixed temperature are a mask of :class:`dem.particles.Particles`. Every term is linear in
+Particles held at a fixed temperature are a mask of :class:`dem.geometry.particles.Particles`. Every term is linear in
 ``T_i`` except radiation, which the solvers use linearised about the current temperature
 (:func:`linear_sink_terms`); a scene without radiation never evaluates ``T^4``.
 """
@@ -19,7 +19,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dem.particles import POSITION_MAX, TEMPERATURE_MAX, check_range
+from dem.geometry.particles import POSITION_MAX, TEMPERATURE_MAX, check_range
 
 STEFAN_BOLTZMANN = 5.670374419e-8  # W/(m^2 K^4), CODATA 2018 (exact)
 KELVIN_OFFSET = {"K": 0.0, "C": 273.15}
@@ -74,7 +74,7 @@ class Wall:
         return (position - self.point) @ self.normal
 
 
-EXPOSED = "exposed"  # area_fraction: the exposed fraction of each surface (dem.exposure), computed from the packing
+EXPOSED = "exposed"  # area_fraction: the exposed fraction of each surface (dem.geometry.exposure), computed from the packing
 
 
 def _area(name: str, fraction, radius: np.ndarray) -> np.ndarray:
@@ -94,7 +94,7 @@ def _area(name: str, fraction, radius: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class Convection:
     """``Q_i^conv = h A_i (T_inf - T_i)`` with ``A_i = area_fraction * 4 pi r_i^2``: by default the exposed part of
-    each surface (``"exposed"``, :mod:`dem.exposure`); ``area_fraction = 1`` opts in to the whole surface."""
+    each surface (``"exposed"``, :mod:`dem.geometry.exposure`); ``area_fraction = 1`` opts in to the whole surface."""
 
     h: float
     T_inf: float
@@ -162,10 +162,10 @@ class Sources:
 
     def resolved(self, position: np.ndarray, radius: np.ndarray, keep: np.ndarray) -> "Sources":
         """The same exchanges with every ``"exposed"`` area fraction replaced by the fractions of the particles
-        ``keep`` (indices) computed from the packing (:func:`dem.exposure.exposed_fraction`, once for both)."""
+        ``keep`` (indices) computed from the packing (:func:`dem.geometry.exposure.exposed_fraction`, once for both)."""
         if not any(s is not None and isinstance(s.area_fraction, str) for s in (self.convection, self.radiation)):
             return self
-        from dem.exposure import exposed_fraction
+        from dem.geometry.exposure import exposed_fraction
 
         fraction = exposed_fraction(position, radius)[keep]
         swap = {k: replace(s, area_fraction=fraction) for k, s in (("convection", self.convection),

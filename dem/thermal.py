@@ -28,7 +28,7 @@ matrix; it is SPD when every connected group of free particles reaches a fixed p
   time"). The dyadic grid rounds every step down to a power of 2: it costs some more steps for the same error, but
   saves the second factorisation per step that free step sizes would need.
 
-Periodic packings (:mod:`dem.periodic`): a bond to the image ``shift`` of particle ``j`` sees that image at
+Periodic packings (:mod:`dem.geometry.periodic`): a bond to the image ``shift`` of particle ``j`` sees that image at
 ``T_j - g``, ``g = drop . shift`` (the temperature drop per period of the box), so it adds the constant flow
 ``-K g`` to ``i`` and ``+K g`` to ``j``; these enter ``r`` as the heat flow ``periodic``, which sums to zero over a
 group of free particles. Such a group (no fixed particle, wall or ambient) has a steady state only up to a constant:
@@ -51,12 +51,12 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
-from dem.bonds import Bonds, find_bonds
+from dem.geometry.bonds import Bonds, find_bonds
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.linsolve import make_solver
 from dem.network import BoundedLaplacian, laplacian  # noqa: F401  (laplacian: part of this module's API)
-from dem.particles import Particles
-from dem.periodic import PeriodicBox
+from dem.geometry.particles import Particles
+from dem.geometry.periodic import PeriodicBox
 from dem.sources import Sources, linear_sink_terms
 
 INTEGRATORS = {"explicit": 0.0, "implicit": 1.0, "crank-nicolson": 0.5}
@@ -193,7 +193,7 @@ class Network:
 
 def build_network(particles: Particles, walls=(), spec=None, sources: Sources | None = None, *, pairs=None,
                   bonds: Bonds | None = None, box: PeriodicBox | None = None) -> Network:
-    """The thermal network of a packing in one call: bonds from the overlaps (:func:`dem.bonds.find_bonds`, with the
+    """The thermal network of a packing in one call: bonds from the overlaps (:func:`dem.geometry.bonds.find_bonds`, with the
     contact model and out-of-range policy of ``spec``), their conductances (:func:`dem.laws.conductance.
     bond_conductances`, Rojek 2022 eqs. 5-9), and the assembled :class:`Network` holding both.
 
@@ -201,7 +201,7 @@ def build_network(particles: Particles, walls=(), spec=None, sources: Sources | 
     (default: the ``rojek`` law), ``sources`` the ambient exchange and ``pairs = (i, j)`` the pair bonds to use
     instead of searching for overlaps. ``bonds`` already found (e.g. to time the search apart) skip the search. To
     impose other pair conductances, replace them: ``dataclasses.replace(net, K_pairs=K)``. ``box``: a periodic box
-    (:mod:`dem.periodic`), whose faces bonds cross and whose temperature drop per period drives the network.
+    (:mod:`dem.geometry.periodic`), whose faces bonds cross and whose temperature drop per period drives the network.
     """
     spec = ConductanceSpec() if spec is None else spec
     walls = tuple(walls)

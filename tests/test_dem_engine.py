@@ -314,7 +314,7 @@ def test_phases_switch_the_friction_on():
 
 def test_min_image_is_the_wrapping_formula_to_the_bit():
     """The shortcut for separations below a quarter of the box (no division, no floor) changes no bit."""
-    from dem.neighbours import min_image
+    from dem.geometry.neighbours import min_image
 
     rng = np.random.default_rng(7)
     length = 3.7e-3
@@ -332,7 +332,7 @@ def test_min_image_is_the_wrapping_formula_to_the_bit():
 def test_verlet_list_is_every_close_pair_sorted_whatever_room_it_is_given(box):
     """The cell-binned list against all pairs by brute force (minimum image on periodic axes), in (i, j) order, for
     a capacity too small (second pass), exact and too large; history carried by matching pairs."""
-    from dem.neighbours import carry_history, verlet_pairs
+    from dem.geometry.neighbours import carry_history, verlet_pairs
 
     rng = np.random.default_rng(11)
     box = np.array(box)

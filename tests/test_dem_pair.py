@@ -9,7 +9,7 @@ import pytest
 
 from dem import make_scene, run
 from dem.laws.conductance import ConductanceSpec
-from dem.particles import Particles
+from dem.geometry.particles import Particles
 from dem.thermal import build_network, integrate, stable_limit
 from verification.cases import SEC6
 

@@ -113,8 +113,8 @@ def test_out_of_range_reported_or_by_policy():
 
 
 def test_large_network_iterative_matches_direct():
-    from dem.generators import random_packing
-    from dem.particles import Particles
+    from dem.geometry.generators import random_packing
+    from dem.geometry.particles import Particles
     from dem.thermal import build_network, steady
 
     lay = random_packing(3000, 1e-4, 0.12, seed=3)
@@ -138,8 +138,8 @@ def test_zohdi_wall_contact_is_lens_area_over_distance():
 
 
 def test_explicit_pairs_deduplicated():
-    from dem.bonds import find_bonds
-    from dem.particles import Particles
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.particles import Particles
 
     x, r, h = chain_arrays([1e-3, 1e-3, 1e-3], [0.1, 0.1])
     p = Particles.from_arrays(x, r, [0, 0, 0])

@@ -13,7 +13,7 @@ import pytest
 
 import dem.thermal
 from dem.laws.conductance import ConductanceSpec
-from dem.particles import Particles
+from dem.geometry.particles import Particles
 from dem.thermal import Network, build_network, integrate, stable_limit
 
 INTEGRATORS = ("explicit", "implicit", "crank-nicolson")

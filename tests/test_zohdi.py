@@ -360,7 +360,7 @@ def test_section_7_three_phases_of_fig_9():
 
 def test_compiled_lens_conduction_is_the_conductance_law_on_the_bonds():
     """The paper's law evaluated on the Verlet list in compiled code gives the heat flows of the general path
-    (dem.bonds.find_bonds + dem.laws.conductance with law = "zohdi"), here on a pressed column with hot walls."""
+    (dem.geometry.bonds.find_bonds + dem.laws.conductance with law = "zohdi"), here on a pressed column with hot walls."""
     doc = column()
     doc["walls"][0]["temperature"] = 900.0
     sim = ZohdiSimulation(parse_scene(doc))

@@ -245,7 +245,7 @@ def dem_steady(cluster: Cluster, terminals, law: str) -> tuple[float, np.ndarray
     The terminals are its fixed particles. ``law`` is a DEM conductance law, or :data:`NETWORK_ONLY`.
     """
     from dem.laws.conductance import ConductanceSpec
-    from dem.particles import Material, Particles
+    from dem.geometry.particles import Material, Particles
     from dem.thermal import boundary_heat_flow, build_network, steady
 
     T0 = np.zeros(cluster.n)

@@ -67,7 +67,7 @@ def dem_pair(r_i: float, r_j: float, h: float, law: str, t_end: float, K: float 
     DEM conductance law; ``K`` (W/K) overrides the pipe conductance. Returns ``(K, t, T)`` with ``T`` of shape
     (len(t), 2)."""
     from dem.laws.conductance import ConductanceSpec
-    from dem.particles import Material, Particles
+    from dem.geometry.particles import Material, Particles
     from dem.thermal import build_network, integrate
 
     d = r_i + r_j - h

@@ -24,7 +24,7 @@ import numpy as np
 
 from dem.electrical import Electrodes, area_weighted_current, kirchhoff, zohdi_joule
 from dem.laws.conductance import ConductanceSpec, bond_conductances
-from dem.particles import Particles
+from dem.geometry.particles import Particles
 from dem.zohdi.heat import contact_bonds
 
 

@@ -3,7 +3,7 @@
 ``m_i C_i dtheta_i/dt = Q_i + H_i`` (eq. 31): ``Q_i`` the heat conducted through the particle's contacts (with
 walls that carry a temperature: isothermal planes) and ``H_i`` its Joule heating (eq. 35; :mod:`dem.zohdi.current`).
 The contact conductance is the scene's ``[conductance] law`` on each contact as it is, exactly as for a static
-packing (:func:`dem.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`): ``law = "zohdi"`` is the
+packing (:func:`dem.geometry.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`): ``law = "zohdi"`` is the
 paper's ``K_ij A_ij / |r_i - r_j|`` (eq. 33 with the lens area of eqs. 7-12), ``"fit"`` the FE-verified neck law.
 
 Integrated by the trapezoidal rule of eq. (36) with the weight phi of the mechanics, and solved -- as the positions
@@ -24,15 +24,15 @@ import numpy as np
 
 from dataclasses import dataclass
 
-from dem.bonds import find_bonds
+from dem.geometry.bonds import find_bonds
 from dem.laws.conductance import ConductanceSpec, bond_conductances
-from dem.particles import Particles
+from dem.geometry.particles import Particles
 from dem.zohdi import kernels
 
 
 @dataclass(frozen=True)
 class Plane:
-    """A wall where the mechanics has it now: what :func:`dem.bonds.find_bonds` asks of a wall."""
+    """A wall where the mechanics has it now: what :func:`dem.geometry.bonds.find_bonds` asks of a wall."""
 
     name: str
     normal: np.ndarray
@@ -45,7 +45,7 @@ class Plane:
 def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_of_range: str):
     """``(particles at x, bonds)``: the touching pairs of the Verlet list of ``mech`` at positions ``x`` and the
     particles touching the walls ``wall_ids`` (where the mechanics has them), with contact radii from the geometry
-    ``contact`` (:func:`dem.bonds.find_bonds`)."""
+    ``contact`` (:func:`dem.geometry.bonds.find_bonds`)."""
     closed = kernels.closed_pairs(x, particles.radius, mech.pi, mech.pj)
     now = Particles(x, particles.radius, T, particles.material, particles.fixed, particles.heat, particles.materials)
     planes = [Plane(mech.walls[k].name, mech.w.normal[k], float(mech.w.q[k])) for k in wall_ids]

@@ -5,10 +5,10 @@ A step from ``t`` to ``t + dt`` is a sequence of iterations (:meth:`ZohdiMechani
 forces at the previous iterate with the temperatures frozen at theirs; the staggered scheme
 (:mod:`dem.zohdi.simulation`) decides when the iterates have converged and then :meth:`~ZohdiMechanics.accept`\\ s
 the last one, or :meth:`~ZohdiMechanics.restart`\\ s the step with a smaller ``dt``. Walls move by prescribed
-kinematics (fixed, strain at a constant speed, vibrating; :mod:`dem.walls`), so where they are at the end of the
+kinematics (fixed, strain at a constant speed, vibrating; :mod:`dem.geometry.walls`), so where they are at the end of the
 step is known before it is solved.
 
-Neighbours (Zohdi 2014, Sec. 8): a Verlet list with a skin built by cell binning (:mod:`dem.neighbours`); an
+Neighbours (Zohdi 2014, Sec. 8): a Verlet list with a skin built by cell binning (:mod:`dem.geometry.neighbours`); an
 iterate that takes a particle (plus the farthest-moved wall) more than half the skin from where the list was built
 rebuilds it there, carrying each pair's bond flag. A bond (eq. 19) becomes part of the pair's history when a step
 that reached ``E*`` is accepted (it acts from the next step on); it is forgotten when the pair separates.
@@ -20,9 +20,9 @@ import math
 
 import numpy as np
 
-from dem.motion import MotionState
-from dem.neighbours import carry_history, max_displacement, verlet_pairs, wall_pairs
-from dem.walls import MOTIONS, WallArrays
+from dem.geometry.motion import MotionState
+from dem.geometry.neighbours import carry_history, max_displacement, verlet_pairs, wall_pairs
+from dem.geometry.walls import MOTIONS, WallArrays
 from dem.zohdi import kernels
 
 

@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from dem.motion import MotionState
+from dem.geometry.motion import MotionState
 from dem.zohdi.current import ContactCurrent
 from dem.zohdi.heat import LumpedHeat
 from dem.zohdi.mechanics import ZohdiMechanics

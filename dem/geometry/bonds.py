@@ -24,7 +24,7 @@ the smaller radius) and ``"drop"`` removes them; the counts go into the summary.
 Every bond also stores ``l_i``, ``l_j``: the distances from the centres to the plane of the contact circle (the
 lens' radical plane), which Zohdi's law uses as the pipe length.
 
-Periodic boxes (:class:`dem.periodic.PeriodicBox`): a bond may join a particle to an image of another (or of itself,
+Periodic boxes (:class:`dem.geometry.periodic.PeriodicBox`): a bond may join a particle to an image of another (or of itself,
 in a box shorter than a bond) across the boundary; it stores that image's integer ``shift``, and its centre distance
 is that of the image. The search adds the images of the particles near each periodic face, so a periodic block has
 exactly the bonds of an explicit larger block.
@@ -39,8 +39,8 @@ from scipy.spatial import cKDTree
 
 from fem_neck.geometry import max_overlap, neck_radius
 
-from dem.particles import Particles
-from dem.periodic import PeriodicBox, canonical_bonds
+from dem.geometry.particles import Particles
+from dem.geometry.periodic import PeriodicBox, canonical_bonds
 
 CONTACT_MODELS = ("newton", "first", "coble", "lens")
 OUT_OF_RANGE = ("error", "clip", "drop")
@@ -124,7 +124,7 @@ def candidate_pairs(position: np.ndarray, radius: np.ndarray) -> tuple[np.ndarra
 def periodic_pairs(position: np.ndarray, radius: np.ndarray, box: PeriodicBox) -> tuple:
     """All bonds ``(i, j, shift)`` with ``|x_j + shift L - x_i| < r_i + r_j`` in a periodic box: the overlaps among
     the particles and their images near the faces (:meth:`PeriodicBox.images`), each bond once
-    (:func:`dem.periodic.canonical_bonds`)."""
+    (:func:`dem.geometry.periodic.canonical_bonds`)."""
     n = len(radius)
     points, owner, shift = box.images(position, 2.0 * float(radius.max()))
     p, q = candidate_pairs(points, radius[owner])

@@ -3,7 +3,7 @@
 A packing periodic along axis k repeats itself every ``lengths[k]``: particle ``j`` has images at ``x_j + s L`` for
 every integer vector ``s`` that is zero on the non-periodic axes. A bond joins particle ``i`` to one image of
 ``j``, stored as the integer *shift* ``s``; its vector is ``x_j + s L - x_i`` (:meth:`PeriodicBox.bond_vectors`).
-The bond search (:func:`dem.bonds.find_bonds`) finds bonds across the boundary by adding the images of the particles
+The bond search (:func:`dem.geometry.bonds.find_bonds`) finds bonds across the boundary by adding the images of the particles
 near each periodic face (:meth:`PeriodicBox.images`), so that a periodic block gives the same bonds as an explicit
 larger block, for boxes of any size (a box shorter than a bond has a particle bonded to its own image). The
 neighbour list of moving particles can use the same :meth:`images` and :meth:`minimum_image`.
@@ -65,7 +65,7 @@ class PeriodicBox:
     @property
     def kernel_lengths(self) -> np.ndarray:
         """The lengths with 0 on the non-periodic axes: the form the compiled neighbour list of moving particles
-        takes (``dem.neighbours.min_image``)."""
+        takes (``dem.geometry.neighbours.min_image``)."""
         return np.where(self.mask, self.lengths, 0.0)
 
     def wrap(self, x: np.ndarray) -> np.ndarray:

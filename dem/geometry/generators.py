@@ -5,7 +5,7 @@ Every generator returns a :class:`Layout`: positions, radii, the indices of the 
 specimen's cross-section, so that a scene can hold the two ends at different temperatures (hot and cold plates,
 or fixed end particles) and read off an effective conductivity ``k_eff = Q L / (A dT)``. The lattice block and the
 random packing also give the ``period`` of the block: repeated with it along every axis they tile space (a
-periodic scene, :mod:`dem.periodic`).
+periodic scene, :mod:`dem.geometry.periodic`).
 
 Overlaps are relative to the smaller radius of a pair: ``h = overlap * min(r_i, r_j)``.
 
@@ -256,7 +256,7 @@ def random_box(n: int, radius, box, radius_spread: float = 0.0, seed: int = 0, s
     lo, hi = b[0].copy(), b[1].copy()
     if dimension == 2:
         lo[1] = hi[1] = 0.0
-    from dem.neighbours import sequential_addition  # compiled: loaded only by scenes that place particles so
+    from dem.geometry.neighbours import sequential_addition  # compiled: loaded only by scenes that place particles so
 
     pos, placed = sequential_addition(r, lo, hi, rng.random((RSA_CANDIDATES * n, 3)))
     if placed < n:
