@@ -95,7 +95,7 @@ def compacted(t: float = 0.79):
 
 def step_cost(sim, repeat: int = 5, luding_steps: int = 200) -> dict:
     """ns per particle of the pieces of a Zohdi step and of a Luding velocity-Verlet step, same packing."""
-    from dem.laws.luding import LUDING_TABLE1
+    from dem.laws.contact.luding import LUDING_TABLE1
     from dem.mechanics import MechanicalModel
     from dem.geometry.motion import MotionState
 

@@ -51,8 +51,8 @@ import numpy as np
 from numba import njit
 
 from dem import md_loop
-from dem.laws import luding_kernels as law
-from dem.laws.luding import LUDING_TABLE1, LudingMaterial
+from dem.laws.contact import luding_kernels as law
+from dem.laws.contact.luding import LUDING_TABLE1, LudingMaterial
 from verification.report import md_table
 
 TITLE = "DEM mechanics: the time loop against LAMMPS, compile cost, thermal-only path"
@@ -63,7 +63,7 @@ HEIGHT_2D = 6e-3  # Luding 2005, Table 1: disk height (m)
 PRESSURE_2D = 10.0  # N/m: the paper's smaller side stress, whose samples reach coordination ~4 (its Fig. 10)
 WALL_2D = {"mass": 0.01, "damping": 0.2}  # Table 1: wall mass (kg) and damping (kg/s)
 T_RUN = 80.0  # °C: the preparation temperature of Luding 2005, Sec. 4.1 (below the melting range)
-ENGINE_MODULES = ("numba", "dem.engine", "dem.mechanics", "dem.md_loop", "dem.geometry.neighbours", "dem.laws.luding_kernels")
+ENGINE_MODULES = ("numba", "dem.engine", "dem.mechanics", "dem.md_loop", "dem.geometry.neighbours", "dem.laws.contact.luding_kernels")
 
 
 @dataclass(frozen=True)
@@ -599,7 +599,8 @@ FIRST_CALLS = """
 import dataclasses, json, time
 t = time.perf_counter()
 import numpy as np
-from dem.laws import luding, luding_kernels as law
+from dem.laws.contact import luding_kernels as law
+from dem.laws.contact import luding
 from dem.engine import Simulation
 from dem.scene import parse_scene
 imported = time.perf_counter()

@@ -24,7 +24,7 @@ import numpy as np
 
 from dem.laws.conductance import ConductanceSpec
 from dem.geometry.particles import Particles
-from dem.sources import Sources, Wall
+from dem.laws.ambient import Sources, Wall
 from dem.thermal import Network, bonds_and_conductances, theta_step
 
 

@@ -24,8 +24,8 @@ import math
 import numpy as np
 
 from dem.contact_heat import ContactThermalModel
-from dem.laws.luding import P_EXPANSION, P_T0, P_T_MELT
-from dem.laws.luding_kernels import radius_at
+from dem.laws.contact.luding import P_EXPANSION, P_T0, P_T_MELT
+from dem.laws.contact.luding_kernels import radius_at
 from dem.mechanics import MechanicalModel
 from dem.geometry.motion import MotionState
 from dem.thermal import boundary_heat_flow, steady

@@ -19,8 +19,8 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from dem.laws.luding import P_FLUID_OVERLAP
-from dem.laws.luding_kernels import f_min, pair_delta_fluid
+from dem.laws.contact.luding import P_FLUID_OVERLAP
+from dem.laws.contact.luding_kernels import f_min, pair_delta_fluid
 
 
 def clusters(n: int, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -32,8 +32,8 @@ from numba import njit
 
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
-from dem.laws.luding import N_PARAMS, P_EXPANSION, P_FLUID_OVERLAP, P_T_MELT, P_T_VAR
-from dem.laws.luding_kernels import k1_factor, normal_force, radius_at, relax_k1, tangential_force
+from dem.laws.contact.luding import N_PARAMS, P_EXPANSION, P_FLUID_OVERLAP, P_T_MELT, P_T_VAR
+from dem.laws.contact.luding_kernels import k1_factor, normal_force, radius_at, relax_k1, tangential_force
 from dem.geometry.neighbours import min_image
 
 DONE, REBUILD, NONFINITE, ESCAPED = 0, 1, 2, 3

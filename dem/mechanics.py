@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from dem import md_loop
-from dem.laws.luding_kernels import k1_factor
+from dem.laws.contact.luding_kernels import k1_factor
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
 from dem.geometry.walls import WallArrays

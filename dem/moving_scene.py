@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dem.laws import luding
+from dem.laws.contact import luding
 from dem.geometry.motion import particle_mass, moment_of_inertia
 from dem.geometry.particles import finite_array
 from dem.schedule import TemperatureSchedule
@@ -70,7 +70,7 @@ class MotionSpec:
     phases: tuple = ()        # (start time, {parameter index: value}), sorted by start
     start: dict | None = None  # a saved state (dem.state_file.load) the run begins from
     wall_phases: tuple = ()   # (start time, {wall name: inward velocity}), sorted by start
-    stepping: object = None   # law = "zohdi": its implicit stepping (dem.zohdi.material.ZohdiStepping)
+    stepping: object = None   # law = "zohdi": its implicit stepping (dem.laws.contact.zohdi.ZohdiStepping)
     control: int | None = None  # law = "zohdi": the axis the powder bed stands and is pressed along
     frames: int = 0           # law = "zohdi": rendered frames (PNG) over the run
 
@@ -93,7 +93,7 @@ def time_steps(contact, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarra
     """``(t_MD, stable)``.
 
     ``t_MD = pi/(50 omega)`` is the "typical time-step" of Luding 2005 (eq. 6 and below,
-    :func:`dem.laws.luding.time_step`) for a contact of two particles of the mean radius. The lightest pair of a
+    :func:`dem.laws.contact.luding.time_step`) for a contact of two particles of the mean radius. The lightest pair of a
     polydisperse sample vibrates faster: with Table 1's radii (a0 +- 50 %) its contact still takes 25 steps per
     half period. ``stable`` is the largest velocity-Verlet step that stays stable for the stiffest contact,
     ``2/(omega_max + eta)``: the lightest pair, with the normal stiffness k2 or the tangential spring acting with

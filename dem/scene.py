@@ -19,12 +19,12 @@ from dem import state_file
 from dem.geometry import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.fields import material_from_table
-from dem.laws.luding import LudingMaterial
-from dem.zohdi.material import ZohdiMaterial
+from dem.laws.contact.luding import LudingMaterial
+from dem.laws.contact.zohdi import ZohdiMaterial
 from dem.zohdi.scene import ElectricalSpec, parse_electrical, zohdi_material
 from dem.geometry.particles import COPPER, Material, Particles
 from dem.geometry.periodic import AXES, PeriodicBox
-from dem.sources import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
+from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
 from dem.thermal import INTEGRATORS
 from dem.linsolve import BACKENDS
 from dem.physics import PHYSICS_NAMES as PHYSICS, check_physics
@@ -500,7 +500,7 @@ def contact_material_from_scene(doc: dict) -> LudingMaterial | ZohdiMaterial:
 
 def luding_material_from_scene(doc_or_scene) -> LudingMaterial:
     """The Luding 2005 contact material of a :class:`Scene` (its ``contact``) or of a TOML document (its
-    ``[contact]`` table: ``law = "luding"`` and the :class:`~dem.laws.luding.LudingMaterial` fields in SI units;
+    ``[contact]`` table: ``law = "luding"`` and the :class:`~dem.laws.contact.luding.LudingMaterial` fields in SI units;
     ``density`` defaults to that of a single ``[material]``). Independent of how the particles are given.
     Raises ``ValueError`` when there is none or a value is bad."""
     if isinstance(doc_or_scene, Scene):
@@ -525,7 +525,7 @@ def luding_material_from_scene(doc_or_scene) -> LudingMaterial:
 
 def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls) -> None:
     """Radiation works in absolute temperature: every prescribed temperature must lie between 0 K and
-    :data:`dem.sources.RADIATION_T_MAX`."""
+    :data:`dem.laws.ambient.RADIATION_T_MAX`."""
     named = [("particles.temperature", np.asarray(temperature, dtype=float))]
     named += [(f"walls.{w.name}.temperature", np.asarray([w.temperature], dtype=float)) for w in walls]
     for name, values in named:

@@ -40,7 +40,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from dem.laws.luding import LUDING_TABLE1, LudingMaterial
+from dem.laws.contact.luding import LUDING_TABLE1, LudingMaterial
 
 T_PREPARE = 80.0        # °C, preparation, cooled sample and tests (Sec. 4.1)
 T_SINTER = 140.0        # °C, sintering (Sec. 4.1)

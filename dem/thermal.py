@@ -7,7 +7,7 @@ apart from radiation::
 
 with ``L`` the weighted graph Laplacian of the bonds (symmetric positive semidefinite, rows summing to zero),
 ``F``/``D`` the free/fixed particles, ``(g, b)`` the ambient exchange ``Q = b - g T`` (convection; radiation
-linearised about the current temperature, :func:`dem.sources.linear_sink_terms`). ``A`` is built once as a CSR
+linearised about the current temperature, :func:`dem.laws.ambient.linear_sink_terms`). ``A`` is built once as a CSR
 matrix; it is SPD when every connected group of free particles reaches a fixed particle, a wall or the ambient.
 
 * :func:`steady` -- ``A T = r`` (Newton on the radiation term); singular systems are detected and explained.
@@ -57,7 +57,7 @@ from dem.linsolve import make_solver
 from dem.network import BoundedLaplacian, laplacian  # noqa: F401  (laplacian: part of this module's API)
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
-from dem.sources import Sources, linear_sink_terms
+from dem.laws.ambient import Sources, linear_sink_terms
 
 INTEGRATORS = {"explicit": 0.0, "implicit": 1.0, "crank-nicolson": 0.5}
 FLOW_NAMES = ("fixed", "walls", "convection", "radiation", "internal")
@@ -197,7 +197,7 @@ def build_network(particles: Particles, walls=(), spec=None, sources: Sources | 
     contact model and out-of-range policy of ``spec``), their conductances (:func:`dem.laws.conductance.
     bond_conductances`, Rojek 2022 eqs. 5-9), and the assembled :class:`Network` holding both.
 
-    ``walls`` are :class:`dem.sources.Wall` planes, ``spec`` a :class:`~dem.laws.conductance.ConductanceSpec`
+    ``walls`` are :class:`dem.laws.ambient.Wall` planes, ``spec`` a :class:`~dem.laws.conductance.ConductanceSpec`
     (default: the ``rojek`` law), ``sources`` the ambient exchange and ``pairs = (i, j)`` the pair bonds to use
     instead of searching for overlaps. ``bonds`` already found (e.g. to time the search apart) skip the search. To
     impose other pair conductances, replace them: ``dataclasses.replace(net, K_pairs=K)``. ``box``: a periodic box

@@ -10,7 +10,7 @@ from dem.electrical import Electrodes, area_weighted_current, kirchhoff
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.network import BoundedLaplacian, solve_anchored
 from dem.geometry.particles import Material, Particles
-from dem.sources import Wall
+from dem.laws.ambient import Wall
 
 SIGMA = 0.1  # S/m (Zohdi 2014, Sec. 7)
 LENS = ConductanceSpec("zohdi")

@@ -8,7 +8,7 @@ import pytest
 from dem import sinter_protocol as sp
 from dem.engine import Simulation
 from dem.fragments import clusters, fragments, tension_capacity
-from dem.laws.luding import LUDING_TABLE1 as MAT
+from dem.laws.contact.luding import LUDING_TABLE1 as MAT
 from dem.scene import parse_scene
 from dem.simulation import run
 

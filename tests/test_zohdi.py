@@ -11,7 +11,7 @@ import pytest
 
 from dem.scene import parse_scene
 from dem.zohdi import kernels
-from dem.zohdi.material import ZohdiMaterial, ZohdiStepping
+from dem.laws.contact.zohdi import ZohdiMaterial, ZohdiStepping
 from dem.zohdi.simulation import ZohdiSimulation
 
 R = 0.075

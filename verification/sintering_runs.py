@@ -28,7 +28,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from dem.laws.luding import LUDING_TABLE1, P_MU
+from dem.laws.contact.luding import LUDING_TABLE1, P_MU
 
 PREPARE, SINTER, COOL, COMPRESS, VIBRATE, SCHEDULE = "prepare", "sinter", "cool", "compress", "vibrate", "schedule"
 PREPARE3D, SINTER3D = "prepare3d", "sinter3d"

@@ -14,7 +14,7 @@ so its state is the offset ``q`` and the normal velocity ``dq/dt`` (positive: th
   initial height ``z0`` is ``velocity = e z0`` (Luding 2005, Sec. 4.4: ``eps_zz = 1 - z/z0``).
 * ``"vibrate"`` -- ``q(t) = q0 + A sin(2 pi f t)``: a vibrating base (Luding 2005, Figs. 21-22).
 
-A wall may also carry a ``temperature`` (an isothermal plane of the thermal network, as :class:`dem.sources.Wall`).
+A wall may also carry a ``temperature`` (an isothermal plane of the thermal network, as :class:`dem.laws.ambient.Wall`).
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dem.sources import _temperature, _unit_vector, _vector
+from dem.laws.ambient import _temperature, _unit_vector, _vector
 
 MOTIONS = {"fixed": 0, "stress": 1, "strain": 2, "vibrate": 3}
 

@@ -1,6 +1,6 @@
 """Electrically aided sintering (Zohdi 2014) on the engine for moving particles.
 
-* :mod:`dem.zohdi.material` -- the contact material (eqs. 2-21, Sec. 7) and the implicit stepping (eqs. 22-30);
+* :mod:`dem.laws.contact.zohdi` -- the contact material (eqs. 2-21, Sec. 7) and the implicit stepping (eqs. 22-30);
 * :mod:`dem.zohdi.kernels` -- compiled forces, one fixed-point iteration of the trapezoidal step, the paper's
   conduction law on the Verlet list;
 * :mod:`dem.zohdi.mechanics` -- the mechanical submodel (state, Verlet list, walls, iterate/accept/restart);

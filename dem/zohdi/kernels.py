@@ -30,7 +30,7 @@ import math
 import numpy as np
 from numba import njit
 
-from dem.zohdi.material import (Z_C_ENV, Z_E_STAR, Z_KB, Z_KP, Z_KP_LIM, Z_KW, Z_KW_LIM, Z_MU, Z_PB, Z_PP, Z_PW,
+from dem.laws.contact.zohdi import (Z_C_ENV, Z_E_STAR, Z_KB, Z_KP, Z_KP_LIM, Z_KW, Z_KW_LIM, Z_MU, Z_PB, Z_PP, Z_PW,
                                 Z_THETA_STAR, Z_V_SLIP)
 
 

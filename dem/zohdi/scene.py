@@ -1,7 +1,7 @@
 """The keys of a scene that runs Zohdi 2014: ``[contact] law = "zohdi"``, the implicit stepping in ``[solver]``, the
 current in ``[electrical]`` and the electrodes in ``[[walls]]``.
 
-* ``[contact]`` -- ``law = "zohdi"`` and the :class:`~dem.zohdi.material.ZohdiMaterial` fields (the paper's
+* ``[contact]`` -- ``law = "zohdi"`` and the :class:`~dem.laws.contact.zohdi.ZohdiMaterial` fields (the paper's
   symbols: ``K_p``, ``p_p``, ``K_p_lim``, ``K_w``, ``p_w``, ``K_w_lim``, ``theta_star``, ``K_b``, ``p_b``,
   ``E_star``, ``mu_d``, ``c_env``, ``v_slip``; ``density`` defaults to the ``[material]`` one);
 * ``[solver]`` -- ``dt`` (the first step, s), ``dt_max`` (Delta t_lim, default ``dt``), ``phi``, ``iterations``
@@ -27,7 +27,7 @@ import numpy as np
 
 from dem.electrical import Electrodes, check_absorption, check_scheme
 from dem.laws.fields import material_from_table
-from dem.zohdi.material import ZohdiMaterial, ZohdiStepping
+from dem.laws.contact.zohdi import ZohdiMaterial, ZohdiStepping
 
 STEPPING_KEYS = {f.name for f in fields(ZohdiStepping)}
 OUTPUT_KEYS = {"fraction_axis", "frames"}

@@ -1,7 +1,7 @@
 """The sintering contact material of Luding, Manetsberger & Müllers 2005 and the time step it needs.
 
 :class:`LudingMaterial` holds the material (SI units); :meth:`LudingMaterial.params` packs it into the float64 array
-that every kernel of :mod:`dem.laws.luding_kernels` takes as ``params`` (indices ``P_*`` below). This module needs
+that every kernel of :mod:`dem.laws.contact.luding_kernels` takes as ``params`` (indices ``P_*`` below). This module needs
 no compiler: a scene that only reads the material (or runs no mechanics) never loads numba.
 
 Conventions (Luding 2005, Sec. 3.1): the unit normal ``n`` points from particle j to particle i (eq. 3), the overlap

@@ -1,10 +1,10 @@
 """The sintering contact law of Luding, Manetsberger & Müllers 2005 as compiled scalar kernels.
 
 The kernels are ``numba.njit(cache=True)`` functions of plain floats and 3-tuples and the material ``params``
-(:meth:`dem.laws.luding.LudingMaterial.params`, indices ``P_*``; an array, or the same numbers as a tuple), called
+(:meth:`dem.laws.contact.luding.LudingMaterial.params`, indices ``P_*``; an array, or the same numbers as a tuple), called
 per contact from the engine's compiled loop (:mod:`dem.md_loop`, which passes a tuple and gets the kernels it calls
 inlined) and, unchanged, from Python (the contact-law tool ``python -m dem contact`` and the tests). Conventions and
-the history each contact carries: :mod:`dem.laws.luding`.
+the history each contact carries: :mod:`dem.laws.contact.luding`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import math
 
 from numba import njit
 
-from dem.laws.luding import (P_BRITTLE_SLIDING, P_GAMMA_N, P_GAMMA_T, P_K1, P_K2, P_KC, P_KT_RATIO, P_MU,
+from dem.laws.contact.luding import (P_BRITTLE_SLIDING, P_GAMMA_N, P_GAMMA_T, P_K1, P_K2, P_KC, P_KT_RATIO, P_MU,
                              P_MU_WALL)
 
 JIT = {"cache": True, "error_model": "numpy"}  # fastmath stays off: the tests compare closely
