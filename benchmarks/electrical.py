@@ -14,7 +14,7 @@ The ``electrical`` subject of ``python -m benchmarks`` (:func:`run`) measures, i
 * ``current_solve`` -- on the same packing, the Laplace problem of Zohdi's eq. (43) (contact areas as weights, the
   particles touching the electrodes held at 1 and 0) solved by the generic network solve (sparse direct) and by
   the paper's Gauss-Seidel sweeps from zero until they are within 1e-3, 1e-6 and 1e-9 of it; and the physical
-  Kirchhoff solve of :mod:`dem.electrical` (bonds, conductances, potentials, Joule heat);
+  Kirchhoff solve of :mod:`dem.network.current` (bonds, conductances, potentials, Joule heat);
 * ``current_scaling`` -- the same two solves to 1e-6 on random sintered packings of 1000 to 16 000 particles
   (:func:`dem.geometry.generators.random_packing`, bottom layer at 0, top layer at 1): the sweeps grow with the square of
   the height, the direct solve with its fill-in.
@@ -134,7 +134,7 @@ def step_cost(sim, repeat: int = 5, luding_steps: int = 200) -> dict:
 def current_solve(sim, repeat: int = 3) -> dict:
     """The area-weighted Laplace problem of eq. (43) by the network solve and by Gauss-Seidel sweeps to 1e-3, 1e-6,
     1e-9 of it; the physical Kirchhoff refresh for comparison (module docstring)."""
-    from dem.electrical import area_weighted_current
+    from dem.network.current import area_weighted_current
     from dem.zohdi.heat import contact_bonds
 
     mech, cur = sim.mechanics, sim.current
@@ -166,7 +166,7 @@ def _direct(n, b, area, node, index, values):
     """The area-weighted Laplace problem of eq. 43 (bonds ``b``, weights ``area``) with the potential of particle
     ``node[k]`` held at ``values[index[k]]``, solved directly on the components that hold a fixed particle: the
     potentials and the free particles solved for."""
-    from dem.network import BoundedLaplacian, solve_anchored
+    from dem.network.laplacian import BoundedLaplacian, solve_anchored
 
     fixed = np.zeros(n, dtype=bool)
     fixed[node] = True
@@ -182,7 +182,7 @@ def _direct(n, b, area, node, index, values):
 
 def _sweeps_to(n, b, area, plane_node, plane_index, values, reference, free, accuracy):
     """Gauss-Seidel sweeps of eq. (43) from zero until within ``accuracy`` of ``reference``: ``(result, tol)``."""
-    from dem.electrical import area_weighted_current
+    from dem.network.current import area_weighted_current
 
     tol = accuracy
     while True:  # the stopping rule is on the change per sweep; tighten it until the error is within the accuracy
@@ -195,7 +195,7 @@ def _sweeps_to(n, b, area, plane_node, plane_index, values, reference, free, acc
 def current_scaling(sizes=(1000, 4000, 16000), accuracy: float = 1e-6, repeat: int = 3) -> list:
     """Direct network solve against Gauss-Seidel sweeps of eq. (43) on random packings (module docstring)."""
     from dem.geometry.bonds import find_bonds
-    from dem.electrical import area_weighted_current
+    from dem.network.current import area_weighted_current
     from dem.geometry.generators import random_packing
     from dem.geometry.particles import Particles
 

@@ -743,7 +743,7 @@ def engine_modules_loaded(scenes) -> tuple[list[str], float]:
 def direct_thermal(scene):
     """The thermal-only run as the lower-level calls :func:`dem.simulation.run` makes: bonds, conductances,
     network, then the steady solve (and the boundary heat flows it reports) or the time integration."""
-    from dem.thermal import boundary_heat_flow, build_network, integrate, steady
+    from dem.network.heat import boundary_heat_flow, build_network, integrate, steady
 
     s = scene.solver
     net = build_network(scene.particles, scene.walls, scene.conductance, scene.sources)

@@ -28,7 +28,7 @@ def laws_worker(n: int) -> None:
     from dem.geometry.generators import random_packing
     from dem.laws.conductance import ConductanceSpec
     from dem.geometry.particles import Particles
-    from dem.thermal import build_network, steady
+    from dem.network.heat import build_network, steady
 
     lay = random_packing(n, PACKING["radius"], PACKING["overlap"], seed=0)
     fixed = np.zeros(len(lay.radius), dtype=bool)
@@ -78,7 +78,7 @@ def run(section, quick: bool) -> None:
     section.add_text(
         "Steady solve, same packing, three laws",
         "Each N in a fresh subprocess; bonds found once; per law: conductances + network assembly "
-        "(`*_network_seconds`) and `dem.thermal.steady` (`*_solve_seconds`), alternating, the best of 2-3 rounds "
+        "(`*_network_seconds`) and `dem.network.heat.steady` (`*_solve_seconds`), alternating, the best of 2-3 rounds "
         "(its parts shown); "
         "`*_steady_seconds` adds the bond search, as the `dem` subject's steady time does.\n\n"
         + records_table(rows, columns, fmt="{:.3g}"))

@@ -12,8 +12,8 @@ The network takes its own implicit steps (backward Euler or Crank-Nicolson), eac
 steps, so neither physics forces the other's step down: the engine advances the mechanics over an interval, then
 the temperatures over the same interval with the conductances of the contacts at its end (a sequential splitting).
 When the set of contacts has not changed, the network keeps its matrices and only rewrites their entries
-(:meth:`dem.thermal.Network.refresh`); a new or lost contact re-assembles it. Each step's heat balance holds to
-round-off (:func:`dem.thermal.theta_step`), so the energy bookkeeping stays exact through contact changes.
+(:meth:`dem.network.heat.Network.refresh`); a new or lost contact re-assembles it. Each step's heat balance holds to
+round-off (:func:`dem.network.heat.theta_step`), so the energy bookkeeping stays exact through contact changes.
 
 The capacities use each particle's mass (constant: thermal expansion changes the radius, not the mass).
 """
@@ -25,7 +25,7 @@ import numpy as np
 from dem.laws.conductance import ConductanceSpec
 from dem.geometry.particles import Particles
 from dem.laws.ambient import Sources, Wall
-from dem.thermal import Network, bonds_and_conductances, theta_step
+from dem.network.heat import Network, bonds_and_conductances, theta_step
 
 
 class ContactThermalModel:

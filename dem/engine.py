@@ -28,7 +28,7 @@ from dem.laws.contact.luding import P_EXPANSION, P_T0, P_T_MELT
 from dem.laws.contact.luding_kernels import radius_at
 from dem.mechanics import MechanicalModel
 from dem.geometry.motion import MotionState
-from dem.thermal import boundary_heat_flow, steady
+from dem.network.heat import boundary_heat_flow, steady
 from fem_neck.geometry import neck_radius
 
 

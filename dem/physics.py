@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dem.thermal import boundary_heat_flow, build_network, integrate, periodic_heat_flow, steady
+from dem.network.heat import boundary_heat_flow, build_network, integrate, periodic_heat_flow, steady
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
@@ -36,7 +36,7 @@ class ThermalModel:
         self.bonds, self.K_pairs, self.K_walls = self.network.bonds, self.network.K_pairs, self.network.K_walls
 
     def run(self, observer=None, progress=None, resume=None, checkpoint=None) -> dict:
-        """Solve (steady) or integrate (transient); ``resume``/``checkpoint``: :func:`dem.thermal.integrate`."""
+        """Solve (steady) or integrate (transient); ``resume``/``checkpoint``: :func:`dem.network.heat.integrate`."""
         try:
             return self._run(observer, progress, resume, checkpoint)
         except RuntimeError as exc:  # e.g. SuperLU "Factor is exactly singular": explain it as a property of the scene
@@ -133,7 +133,7 @@ def check_physics(names) -> None:
     if "electrical" in names and "mechanical" not in names:
         raise ValueError("[scene] physics: \"electrical\" runs with moving particles: [\"mechanical\", \"thermal\", "
                          "\"electrical\"] with [contact] law = \"zohdi\" (the current on a static packing: "
-                         "dem.electrical.kirchhoff)")
+                         "dem.network.current.kirchhoff)")
 
 
 def build(scene) -> list:

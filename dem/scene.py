@@ -25,8 +25,8 @@ from dem.zohdi.scene import ElectricalSpec, parse_electrical, zohdi_material
 from dem.geometry.particles import COPPER, Material, Particles
 from dem.geometry.periodic import AXES, PeriodicBox
 from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
-from dem.thermal import INTEGRATORS
-from dem.linsolve import BACKENDS
+from dem.network.heat import INTEGRATORS
+from dem.network.linsolve import BACKENDS
 from dem.physics import PHYSICS_NAMES as PHYSICS, check_physics
 from dem.moving_scene import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
 
@@ -62,7 +62,7 @@ GENERATOR_KEYS = {
 @dataclass(frozen=True)
 class SolverSpec:
     """``mode`` steady|transient; transient: ``integrator``, ``dt`` (s or "auto"), ``t_end``, ``rtol`` (auto dt);
-    ``linear`` backend (:mod:`dem.linsolve`); ``floating`` steady policy; ``max_steps`` guard."""
+    ``linear`` backend (:mod:`dem.network.linsolve`); ``floating`` steady policy; ``max_steps`` guard."""
 
     mode: str = "steady"
     integrator: str = "crank-nicolson"

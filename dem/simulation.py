@@ -14,7 +14,7 @@ from dem import physics
 from dem.output import folder as run_folder
 from dem.output.writer import RunWriter
 from dem.scene import Scene
-from dem.thermal import Checkpoint
+from dem.network.heat import Checkpoint
 from sinterheat.interrupt import where
 
 T_LIST_MAX = 1000  # the summary lists the final temperatures for scenes up to this many particles

@@ -196,7 +196,7 @@ def test_explicit_step_around_the_stable_limit(tmp_path, capsys):
     """0.99x the limit runs and stays inside the initial range (maximum principle); 1.01x is refused."""
     from dem.physics import ThermalModel
     from dem.scene import parse_scene
-    from dem.thermal import stable_limit
+    from dem.network.heat import stable_limit
 
     import tomllib
 

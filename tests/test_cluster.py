@@ -196,7 +196,7 @@ def test_cli_cluster(tmp_path, capsys):
 def test_dem_network_of_a_pair_equals_the_fe_pair():
     # verification.clusters against the DEM: for one bonded pair cut at both equators the pipe network with the
     # FE pair conductance is exact, so DEM (network-only) and the 3D FE must agree to the 3D mesh accuracy.
-    pytest.importorskip("dem.thermal")
+    pytest.importorskip("dem.network.heat")
     pytest.importorskip("fem_neck.conduction")
     from verification.clusters import NETWORK_ONLY, dem_steady
 

@@ -6,7 +6,7 @@ from hypothesis import given, settings, strategies as st
 
 from dem.laws.conductance import ConductanceSpec
 from dem.geometry.particles import Particles
-from dem.thermal import build_network, integrate, steady
+from dem.network.heat import build_network, integrate, steady
 
 
 @st.composite

@@ -115,7 +115,7 @@ def test_out_of_range_reported_or_by_policy():
 def test_large_network_iterative_matches_direct():
     from dem.geometry.generators import random_packing
     from dem.geometry.particles import Particles
-    from dem.thermal import build_network, steady
+    from dem.network.heat import build_network, steady
 
     lay = random_packing(3000, 1e-4, 0.12, seed=3)
     T = np.zeros(len(lay.radius))

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from dem.geometry.bonds import find_bonds
-from dem.electrical import Electrodes, area_weighted_current, kirchhoff
+from dem.network.current import Electrodes, area_weighted_current, kirchhoff
 from dem.laws.conductance import ConductanceSpec, bond_conductances
-from dem.network import BoundedLaplacian, solve_anchored
+from dem.network.laplacian import BoundedLaplacian, solve_anchored
 from dem.geometry.particles import Material, Particles
 from dem.laws.ambient import Wall
 

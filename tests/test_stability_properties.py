@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 
 from dem.laws.conductance import ConductanceSpec
 from dem.geometry.particles import Particles
-from dem.thermal import Network, build_network, integrate, stable_limit, steady
+from dem.network.heat import Network, build_network, integrate, stable_limit, steady
 
 SPACING = 1e-4  # m
 pytestmark = pytest.mark.stress

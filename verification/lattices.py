@@ -86,7 +86,7 @@ def dem_periodic(cell: lattice.PeriodicCell, law: str) -> float:
     from dem.laws.conductance import ConductanceSpec, bond_conductances
     from dem.geometry.particles import Material, Particles
     from dem.geometry.periodic import PeriodicBox
-    from dem.thermal import Network, periodic_heat_flow, steady
+    from dem.network.heat import Network, periodic_heat_flow, steady
 
     box = PeriodicBox(cell.period, drop=[0.0, 0.0, 1.0])
     unit = Material(1.0, 1.0, 1.0, "unit")

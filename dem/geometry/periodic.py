@@ -10,7 +10,7 @@ neighbour list of moving particles can use the same :meth:`images` and :meth:`mi
 
 A macroscopic temperature gradient through a periodic packing is a temperature *drop* per period:
 ``T(x + L_k e_k) = T(x) - drop_k``, so the image ``x_j + s L`` of particle ``j`` is at ``T_j - drop . s``
-(:mod:`dem.thermal`).
+(:mod:`dem.network.heat`).
 """
 
 from __future__ import annotations

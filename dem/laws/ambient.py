@@ -1,6 +1,6 @@
 """Heat sources and boundaries of the particle heat balance (Rojek 2022, eq. 3).
 
-``Q_i = sum_j Q_ij^cond + Q_i^int + Q_i^conv + Q_i^rad``. Besides the pipes (``dem.thermal``) a particle exchanges
+``Q_i = sum_j Q_ij^cond + Q_i^int + Q_i^conv + Q_i^rad``. Besides the pipes (``dem.network.heat``) a particle exchanges
 heat with
 
 * its internal source ``Q_i^int`` (W, ``Particles.heat``),

@@ -5,8 +5,8 @@
   conduction law on the Verlet list;
 * :mod:`dem.zohdi.mechanics` -- the mechanical submodel (state, Verlet list, walls, iterate/accept/restart);
 * :mod:`dem.zohdi.heat` -- the thermal submodel (the lumped heat balance, eqs. 31-37);
-* :mod:`dem.zohdi.current` -- the electrical submodel (Kirchhoff or eq. 43, :mod:`dem.electrical`);
-* :mod:`dem.zohdi.current_sweep` -- the compiled Gauss-Seidel sweep of eq. (43);
+* :mod:`dem.zohdi.current` -- the electrical submodel (Kirchhoff or eq. 43, :mod:`dem.network.current`);
+* :mod:`dem.network.gauss_seidel` -- the compiled Gauss-Seidel sweep of eq. (43);
 * :mod:`dem.zohdi.simulation` -- the staggered adaptive scheme of Algorithm 1 and the run's observables;
 * :mod:`dem.zohdi.scene` -- the scene keys that select and parametrise it.
 """

@@ -1,5 +1,5 @@
 """The electrical submodel of the engine: the current through the contacts as they are, and the Joule heating it
-makes in each particle (Zohdi 2014, eqs. 35, 38-44), by either scheme of :mod:`dem.electrical`.
+makes in each particle (Zohdi 2014, eqs. 35, 38-44), by either scheme of :mod:`dem.network.current`.
 
 * ``scheme = "kirchhoff"`` -- potentials from one sparse solve per refresh; each contact's electrical conductance is
   the thermal neck law of the scene with sigma in place of kappa (no interface conductance); electrodes are walls at
@@ -22,7 +22,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from dem.electrical import Electrodes, area_weighted_current, kirchhoff, zohdi_joule
+from dem.network.current import Electrodes, area_weighted_current, kirchhoff, zohdi_joule
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.geometry.particles import Particles
 from dem.zohdi.heat import contact_bonds

@@ -25,7 +25,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from dem.electrical import Electrodes, check_absorption, check_scheme
+from dem.network.current import Electrodes, check_absorption, check_scheme
 from dem.laws.fields import material_from_table
 from dem.laws.contact.zohdi import ZohdiMaterial, ZohdiStepping
 

@@ -53,8 +53,8 @@ import scipy.sparse.linalg as spl
 
 from dem.geometry.bonds import Bonds, find_bonds
 from dem.laws.conductance import ConductanceSpec, bond_conductances
-from dem.linsolve import make_solver
-from dem.network import BoundedLaplacian, laplacian  # noqa: F401  (laplacian: part of this module's API)
+from dem.network.linsolve import make_solver
+from dem.network.laplacian import BoundedLaplacian, laplacian  # noqa: F401  (laplacian: part of this module's API)
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources, linear_sink_terms
@@ -74,7 +74,7 @@ AUTO_MIN_STEP = 2.0**-AUTO_LEVELS  # dt = "auto": steps this small (x t_end) are
 @dataclass
 class Network:
     """The linear(ised) heat balance of the free particles (module docstring), assembled once: the generic
-    :class:`dem.network.BoundedLaplacian` (the same solve serves the electrical current) with the particles'
+    :class:`dem.network.laplacian.BoundedLaplacian` (the same solve serves the electrical current) with the particles'
     capacities, sources and fixed temperatures."""
 
     particles: Particles

@@ -16,7 +16,7 @@ on every connected group of free nodes that reaches a fixed node or a plane (an 
 
 :class:`BoundedLaplacian` assembles this once as CSR matrices and rewrites their entries in place when only the
 conductances change (:meth:`~BoundedLaplacian.refresh`: contacts whose necks grow, particles that move a little).
-The thermal network (:class:`dem.thermal.Network`) and the Kirchhoff current solve (:mod:`dem.electrical`) are
+The thermal network (:class:`dem.network.heat.Network`) and the Kirchhoff current solve (:mod:`dem.network.current`) are
 both built on it; :func:`solve_anchored` is the steady solve the current uses.
 """
 
@@ -26,7 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from dem.linsolve import make_solver
+from dem.network.linsolve import make_solver
 
 
 def laplacian(n: int, i: np.ndarray, j: np.ndarray, K: np.ndarray) -> sp.csr_matrix:

@@ -7,7 +7,7 @@ current:
   conductance ``G`` (the thermal neck law with the electrical conductivity sigma in place of kappa,
   :func:`dem.laws.conductance.bond_conductances`), electrodes at a fixed potential (V) or driving a fixed total
   current (A into the packing). One sparse solve (the same network solve as the heat,
-  :class:`dem.network.BoundedLaplacian`) gives the potentials; every contact carries ``I = G (phi_i - phi_j)`` and
+  :class:`dem.network.laplacian.BoundedLaplacian`) gives the potentials; every contact carries ``I = G (phi_i - phi_j)`` and
   makes the Joule heat ``I^2 / G``, shared by its two particles in proportion to the resistances of their halves
   (a wall contact's heat is made in the particle's half). The current is conserved at every particle, and the
   Joule heat of all contacts equals the power the electrodes deliver, ``sum_e V_e I_e`` (Tellegen's theorem), to
@@ -41,7 +41,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from dem.network import BoundedLaplacian, solve_anchored
+from dem.network.laplacian import BoundedLaplacian, solve_anchored
 
 SCHEMES = ("kirchhoff", "zohdi")
 
@@ -211,7 +211,7 @@ def area_weighted_current(n: int, i, j, area, plane_node, plane_index, J_ext, J0
     wall take its value ``J_ext`` (per electrode), the others the area-weighted mean of their neighbours, by
     Gauss-Seidel sweeps from ``J0`` (the previous solution: a warm start; zeros when None) until no value changes by
     more than ``tol`` times the largest ``|J_ext|``. Groups that touch no electrified wall carry no current."""
-    from dem.zohdi.current_sweep import gauss_seidel  # compiled: loaded by the schemes that sweep
+    from dem.network.gauss_seidel import gauss_seidel  # compiled: loaded by the schemes that sweep
 
     i, j = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64)
     area = np.asarray(area, dtype=float)
