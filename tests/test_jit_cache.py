@@ -1,7 +1,9 @@
 """The compiled kernels' cache follows every module whose code or constants reach compiled code (numba alone follows
 only a function's own file, so a kernel would keep its callees' old code and the constants it was compiled with)."""
 
+import importlib
 import os
+import pathlib
 import re
 import shutil
 import subprocess
@@ -11,6 +13,9 @@ import pytest
 
 from dem import jit_cache
 
+LUDING_MATERIAL = "dem.laws.contact.luding"  # the module that holds the parameter indices of the Luding law
+ZOHDI_MATERIAL = "dem.laws.contact.zohdi"
+
 
 @pytest.fixture
 def copy(tmp_path):
@@ -19,6 +24,11 @@ def copy(tmp_path):
     for name in jit_cache.PROJECT_PACKAGES:
         shutil.copytree(root / name, tmp_path / name, ignore=shutil.ignore_patterns("__pycache__"))
     return tmp_path / "dem"
+
+
+def _in_copy(copy, module):
+    """The file of ``module`` (a dotted name) in the copy."""
+    return copy / pathlib.Path(importlib.import_module(module).__file__).relative_to(jit_cache.PACKAGE)
 
 
 def _edit(path, old, new):
@@ -39,7 +49,7 @@ def test_swapping_two_parameter_indices_changes_the_key(copy):
     """A change that alters no physics but every compiled kernel that reads the material (the indices are constants
     compiled into them): a cache that missed it would read k2 where k1 is meant."""
     before = jit_cache.digest(copy)
-    path = copy / "laws" / "luding.py"
+    path = _in_copy(copy, LUDING_MATERIAL)
     text = path.read_text()
     text = re.sub(r"^P_K1 = 0 ", "P_K1 = 1 ", text, count=1, flags=re.M)
     text = re.sub(r"^P_K2 = 1 ", "P_K2 = 0 ", text, count=1, flags=re.M)
@@ -50,9 +60,9 @@ def test_swapping_two_parameter_indices_changes_the_key(copy):
 
 def test_an_edit_outside_compiled_code_keeps_the_key(copy):
     before = jit_cache.digest(copy)
-    _edit(copy / "cli" / "scenes.py", '"""', '"""An edit. ')
+    _edit(_in_copy(copy, "dem.cli.scenes"), '"""', '"""An edit. ')
     assert jit_cache.digest(copy) == before
-    _edit(copy / "zohdi" / "material.py", "LEAST_FACTOR = 0.05", "LEAST_FACTOR = 0.06")
+    _edit(_in_copy(copy, ZOHDI_MATERIAL), "LEAST_FACTOR = 0.05", "LEAST_FACTOR = 0.06")
     assert jit_cache.digest(copy) != before
 
 
