@@ -100,7 +100,7 @@ def linear_limit(material: LudingMaterial) -> LudingMaterial:
 # ------------------------------------------------------------------------------------------------------ samples
 def _scene(material: LudingMaterial, dimension: int, particles: dict, walls=(), t_end: float = 1.0,
            box=(0.0, 0.0, 0.0)):
-    """A mechanical scene (:func:`dem.scene.parse_scene`) of ``material`` at :data:`T_RUN`; ``particles`` is the
+    """A mechanical scene (:func:`dem.scene.parse.parse_scene`) of ``material`` at :data:`T_RUN`; ``particles`` is the
     ``[particles]`` or ``[generator]`` table; ``box`` the periodic lengths (no TOML key: set on the parsed scene)."""
     from dem.scene import parse_scene
 
@@ -168,7 +168,7 @@ def periodic_packing(sizes: Sizes, cache: pathlib.Path, seed: int = 0, coordinat
             return {**{k: data[k] for k in data.files}, "seconds": 0.0}
     from dem.mechanics import MechanicalModel
     from dem.geometry.motion import MotionState
-    from dem.moving_scene import time_steps
+    from dem.scene.motion import time_steps
     from dem.geometry.neighbours import verlet_pairs
 
     t0 = time.perf_counter()

@@ -36,7 +36,7 @@ class Simulation:
     """A moving-particle run built from a scene with ``"mechanical"`` physics."""
 
     def __init__(self, scene, resume: dict | None = None):
-        """``resume``: a checkpoint of this scene's run (:func:`dem.state_file.arrays` as loaded by
+        """``resume``: a checkpoint of this scene's run (:func:`dem.scene.state_file.arrays` as loaded by
         :func:`dem.output.folder.load`): the run goes on from its step as if it had not stopped."""
         self.scene = scene
         m = scene.motion
@@ -140,7 +140,7 @@ class Simulation:
         t = 0), ``progress(t)`` after every interval, ``checkpoint(make)`` after every interval and at the end
         (:class:`dem.output.folder.Checkpointer`); ``position`` (:class:`sinterheat.interrupt.Where`) learns the step and
         time after every interval."""
-        from dem.state_file import arrays
+        from dem.scene.state_file import arrays
 
         m, mech = self.scene.motion, self.mechanics
         n_end = max(1, math.ceil(self.scene.solver.t_end / mech.dt - 1e-9))

@@ -41,7 +41,7 @@ class MechanicalModel:
 
     def __init__(self, state: MotionState, walls, params: np.ndarray, dt: float, skin: float,
                  gravity=(0.0, 0.0, 0.0), box=(0.0, 0.0, 0.0), relaxation_time: float = 1e3, history=None):
-        """``history``: a saved state (:func:`dem.state_file.load`) whose stiffness factors and contact histories
+        """``history``: a saved state (:func:`dem.scene.state_file.load`) whose stiffness factors and contact histories
         (pairs, and particle-wall pairs matched by wall name) the model starts from."""
         self.state = state
         self.walls = tuple(walls)

@@ -1,7 +1,7 @@
 """The submodels a scene can ask for, and where new ones plug in.
 
 A scene names its physics (``[scene] physics = ["thermal"]``); only those are built. Each entry of
-:data:`REGISTRY` is a class constructed from the :class:`~dem.scene.Scene` that builds its own state, and whose
+:data:`REGISTRY` is a class constructed from the :class:`~dem.scene.parse.Scene` that builds its own state, and whose
 ``run(observer, progress)`` returns a summary dict. The thermal model of a static packing builds its bonds once,
 never moves a particle and allocates no mechanical state.
 

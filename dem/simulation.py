@@ -167,7 +167,7 @@ def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = Fa
     """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engine`, or with
     ``[contact] law = "zohdi"`` the staggered scheme of :mod:`dem.zohdi.simulation` (``out`` prepared by
     :func:`run`)."""
-    from dem import state_file
+    from dem.scene import state_file
     from dem.output.writer import MotionWriter
 
     zohdi = scene.contact.law == "zohdi"

@@ -1,6 +1,6 @@
 """The sintering protocol of Luding, Manetsberger & Müllers 2005 (Sec. 4) as scene documents.
 
-Each function returns a scene as a dict (the parsed form of a TOML scene; :func:`dem.scene.parse_scene` takes it,
+Each function returns a scene as a dict (the parsed form of a TOML scene; :func:`dem.scene.parse.parse_scene` takes it,
 :func:`dem.simulation.run` runs it) for one stage of the paper's protocol:
 
 * :func:`preparation_doc` -- ``n`` disks (Table 1: a0 = 1 mm, radii uniform in a0 (1 +- w0), w0 = 0.5, height
@@ -299,7 +299,7 @@ def heated_walls_doc(state: str, p: float, *, hot: float, cold: float, duration:
 
 
 def floor_height(saved: dict) -> float:
-    """The height (m) at which a floor touches the lowest particle of a saved state (:func:`dem.state_file.load`)."""
+    """The height (m) at which a floor touches the lowest particle of a saved state (:func:`dem.scene.state_file.load`)."""
     return float(np.min(saved["x"][:, 2] - saved["radius"]))
 
 

@@ -261,7 +261,7 @@ interval = 1e-6
 def test_a_saved_state_goes_on_as_if_the_run_had_not_stopped(tmp_path):
     """Run 2 ms; run 1 ms, save, start a second scene from the state for 1 ms: bit-identical (pairs, walls,
     histories, stress wall and forces of the last step all carried)."""
-    from dem import state_file
+    from dem.scene import state_file
 
     rng = np.random.default_rng(5)
     x = np.array([[1.0e-3, 0, 1.0e-3], [3.0e-3, 0, 1.0e-3], [2.0e-3, 0, (1 + math.sqrt(3)) * 1e-3]])

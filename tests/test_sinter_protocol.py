@@ -48,7 +48,7 @@ def test_stage_scenes_continue_from_a_state(tmp_path):
     assert sinter.motion.phases == ()  # Table 1 friction from the start (t_heat)
     saved_right = prep.models[0].w.q[2]
     assert {w.name: w for w in sinter.motion.walls}["right"].offset == saved_right
-    from dem import state_file
+    from dem.scene import state_file
 
     saved = state_file.load(state)
     z0 = -sp.wall_offset(saved, "top")

@@ -148,7 +148,7 @@ def _material(task: Task):
 def scene_doc(task: Task, root: pathlib.Path) -> dict:
     """The scene of ``task`` (its parent's state under ``root``)."""
     from dem import sinter_protocol as sp
-    from dem import state_file
+    from dem.scene import state_file
 
     material = _material(task)
     parent = None if task.parent is None else str(root / task.parent.folder / "state.npz")
@@ -216,7 +216,7 @@ def neck_statistics(sim) -> dict:
 
 def run_task(task: Task, root) -> dict:
     """Run ``task`` into ``root/task.folder`` (module docstring); returns what ``result.json`` holds."""
-    from dem import state_file
+    from dem.scene import state_file
     from dem.engine import Simulation
     from dem.fragments import fragments
     from dem.output.writer import MotionWriter

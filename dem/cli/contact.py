@@ -109,7 +109,7 @@ def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> 
 
 def run(args) -> dict:
     from dem.laws.contact.luding_kernels import pair_delta_fluid
-    from dem.scene import load_scene, luding_material_from_scene
+    from dem.scene.parse import load_scene, luding_material_from_scene
 
     scene = load_scene(args.scene)
     material = luding_material_from_scene(scene)

@@ -8,5 +8,5 @@
 * :mod:`dem.zohdi.current` -- the electrical submodel (Kirchhoff or eq. 43, :mod:`dem.network.current`);
 * :mod:`dem.network.gauss_seidel` -- the compiled Gauss-Seidel sweep of eq. (43);
 * :mod:`dem.zohdi.simulation` -- the staggered adaptive scheme of Algorithm 1 and the run's observables;
-* :mod:`dem.zohdi.scene` -- the scene keys that select and parametrise it.
+* :mod:`dem.scene.zohdi` -- the scene keys that select and parametrise it.
 """

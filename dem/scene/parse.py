@@ -1,6 +1,6 @@
 """Scenes: everything one DEM run needs, read from TOML (``tomllib``) or built from arrays in Python.
 
-:func:`load_scene` reads a file path or a built-in name (``dem/scenes/*.toml``); :func:`parse_scene` validates a
+:func:`load_scene` reads a file path or a built-in name (``dem/scene/builtin/*.toml``); :func:`parse_scene` validates a
 TOML document (a dict) into a :class:`Scene`; :func:`make_scene` builds one from explicit arrays. The schema is
 documented in the README (section "Scene schema"). Every problem raises ``ValueError`` naming the table and key (and, for malformed
 TOML, the line).
@@ -15,22 +15,22 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from dem import state_file
+from dem.scene import state_file
 from dem.geometry import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.fields import material_from_table
 from dem.laws.contact.luding import LudingMaterial
 from dem.laws.contact.zohdi import ZohdiMaterial
-from dem.zohdi.scene import ElectricalSpec, parse_electrical, zohdi_material
+from dem.scene.zohdi import ElectricalSpec, parse_electrical, zohdi_material
 from dem.geometry.particles import COPPER, Material, Particles
 from dem.geometry.periodic import AXES, PeriodicBox
 from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
 from dem.network.heat import INTEGRATORS
 from dem.network.linsolve import BACKENDS
 from dem.physics import PHYSICS_NAMES as PHYSICS, check_physics
-from dem.moving_scene import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
+from dem.scene.motion import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
 
-SCENE_DIR = pathlib.Path(__file__).with_name("scenes")
+SCENE_DIR = pathlib.Path(__file__).with_name("builtin")
 MODES = ("transient", "steady")
 BOUNDARIES = ("plates", "fixed", "periodic", "none")
 RTOL_MIN = 1e-9  # [solver] rtol of dt = "auto"
@@ -383,7 +383,7 @@ def _spec(cls, table, section, numeric=(), integer=(), words=()):
 
 
 def _moving_keys(doc: dict, moving: bool) -> dict:
-    """``doc`` without the keys and tables of moving particles (:mod:`dem.moving_scene`), which a scene without
+    """``doc`` without the keys and tables of moving particles (:mod:`dem.scene.motion`), which a scene without
     ``"mechanical"`` physics refuses by name; in a scene with it, an unknown key is refused here, naming every key
     such a scene allows."""
     out = dict(doc)
@@ -486,7 +486,7 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
 
 def contact_material_from_scene(doc: dict) -> LudingMaterial | ZohdiMaterial:
     """The contact material of a TOML document's ``[contact]`` table: :func:`luding_material_from_scene` for
-    ``law = "luding"``, :func:`dem.zohdi.scene.zohdi_material` for ``law = "zohdi"``."""
+    ``law = "luding"``, :func:`dem.scene.zohdi.zohdi_material` for ``law = "zohdi"``."""
     table = doc.get("contact")
     if isinstance(table, dict) and table.get("law") == "zohdi":
         _check_keys(table, "contact", ALLOWED["contact"])
@@ -541,7 +541,7 @@ def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls
 
 
 def builtin_scenes() -> dict:
-    """``{name: description}`` of the scenes shipped in ``dem/scenes``."""
+    """``{name: description}`` of the scenes shipped in ``dem/scene/builtin``."""
     out = {}
     for path in sorted(SCENE_DIR.glob("*.toml")):
         with path.open("rb") as fh:

@@ -6,16 +6,16 @@ Tables and keys (SI units; the README's scene schema lists them with their defau
 * ``[scene] dimension`` (3: spheres; 2: disks in the x-z plane) and ``height`` (m, the disks' height);
 * ``[particles] velocity``, ``angular_velocity`` (lists of 3-vectors; or the generator's random ``speed``);
 * ``[contact]`` -- the contact law and its parameters (``law = "luding"``, Luding 2005; ``law = "zohdi"``,
-  Zohdi 2014: its stepping, current and electrode keys are those of :mod:`dem.zohdi.scene`);
+  Zohdi 2014: its stepping, current and electrode keys are those of :mod:`dem.scene.zohdi`);
 * ``[[walls]]`` -- planes that move: ``motion`` fixed | stress | strain | vibrate with ``pressure``, ``mass``,
   ``damping``, ``velocity``, ``amplitude``, ``frequency`` (:mod:`dem.geometry.walls`); ``temperature`` optional;
 * ``[gravity] acceleration`` (m/s^2, a 3-vector);
-* ``[temperature]`` -- a prescribed schedule ``time``, ``value``, ``relaxation_time`` (:mod:`dem.schedule`);
+* ``[temperature]`` -- a prescribed schedule ``time``, ``value``, ``relaxation_time`` (:mod:`dem.scene.events`);
 * ``[[phases]]`` -- from time ``start`` on, other friction or damping (``mu``, ``mu_wall``, ``gamma_n``,
   ``gamma_t``): Luding 2005 prepares frictionless and switches the friction at t_heat; and other wall speeds
   (``wall_velocity = {name = v}``, m/s inward, for strain walls): a wall pushed, held and pulled away (Zohdi 2014,
   Sec. 7);
-* ``[start] state`` -- begin from a saved state (:mod:`dem.state_file`) instead of ``[particles]``;
+* ``[start] state`` -- begin from a saved state (:mod:`dem.scene.state_file`) instead of ``[particles]``;
 * ``[solver]`` -- ``t_end``; ``dt`` (s, or "auto": t_MD = pi/(50 omega), Luding 2005 eq. 6); ``skin`` (m);
   ``thermal_interval`` (s) and ``integrator`` (implicit | crank-nicolson) of a coupled thermal network;
 * ``[output]`` -- ``interval`` (s between rows of ``timeseries.csv``), ``vtu_interval`` (s between snapshots).
@@ -31,9 +31,9 @@ import numpy as np
 from dem.laws.contact import luding
 from dem.geometry.motion import particle_mass, moment_of_inertia
 from dem.geometry.particles import finite_array
-from dem.schedule import TemperatureSchedule
+from dem.scene.events import TemperatureSchedule
 from dem.geometry.walls import MovingWall
-from dem.zohdi import scene as zscene
+from dem.scene import zohdi as zscene
 
 DEFAULT_SKIN = 0.1            # x the mean radius
 DEFAULT_OUTPUT_ROWS = 100     # rows of timeseries.csv when [output] interval is not given
@@ -68,7 +68,7 @@ class MotionSpec:
     vtu_interval: float
     box: tuple = (0.0, 0.0, 0.0)
     phases: tuple = ()        # (start time, {parameter index: value}), sorted by start
-    start: dict | None = None  # a saved state (dem.state_file.load) the run begins from
+    start: dict | None = None  # a saved state (dem.scene.state_file.load) the run begins from
     wall_phases: tuple = ()   # (start time, {wall name: inward velocity}), sorted by start
     stepping: object = None   # law = "zohdi": its implicit stepping (dem.laws.contact.zohdi.ZohdiStepping)
     control: int | None = None  # law = "zohdi": the axis the powder bed stands and is pressed along

@@ -152,8 +152,8 @@ def refuse_zohdi_keys(doc: dict, physics) -> None:
 
 def zohdi_motion(doc: dict, particles, solver, physics, start, walls, gravity, velocity, phases, wall_phases,
                  dimension):
-    """The :class:`~dem.moving_scene.MotionSpec` of a scene with ``[contact] law = "zohdi"``."""
-    from dem.moving_scene import MotionSpec, _num
+    """The :class:`~dem.scene.motion.MotionSpec` of a scene with ``[contact] law = "zohdi"``."""
+    from dem.scene.motion import MotionSpec, _num
 
     if dimension != 3:
         raise ValueError("[scene] dimension: law = \"zohdi\" moves spheres (dimension = 3)")
