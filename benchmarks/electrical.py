@@ -4,12 +4,12 @@ the Luding engine, and the Kirchhoff solve against the paper's current iteration
 The ``electrical`` subject of ``python -m benchmarks`` (:func:`run`) measures, in one process:
 
 * ``section7`` -- the built-in scene ``zohdi-compaction`` (1000 spheres, 1 s, Sec. 7) run end to end (the wall time
-  of :meth:`dem.zohdi.simulation.ZohdiSimulation.run`, no outputs written), with its steps, fixed-point iterations,
+  of :meth:`dem.engines.staggered.engine.ZohdiSimulation.run`, no outputs written), with its steps, fixed-point iterations,
   restarts and step sizes, and the three phases of Fig. 9 (volume fraction when the wall first carries current,
   the largest, the last; mean temperature then);
 * ``step_cost`` -- on the compacted packing of that run (t = 0.79 s, both electrodes touching): ns per particle of
   one fixed-point iteration of the mechanics (forces and update, compiled), of one iteration of the heat balance,
-  of one refresh of the current, and of one velocity-Verlet step of the Luding 2005 loop (:mod:`dem.md_loop`) on
+  of one refresh of the current, and of one velocity-Verlet step of the Luding 2005 loop (:mod:`dem.engines.verlet.loop`) on
   the same positions; best of R;
 * ``current_solve`` -- on the same packing, the Laplace problem of Zohdi's eq. (43) (contact areas as weights, the
   particles touching the electrodes held at 1 and 0) solved by the generic network solve (sparse direct) and by
@@ -45,7 +45,7 @@ def _scene():
 
 def section7_row() -> dict:
     """The Section 7 example run end to end: wall time and what it took (module docstring)."""
-    from dem.zohdi.simulation import ZohdiSimulation
+    from dem.engines.staggered.engine import ZohdiSimulation
 
     scene = _scene()
     rows = []
@@ -85,7 +85,7 @@ def _best(fn, repeat: int) -> float:
 
 def compacted(t: float = 0.79):
     """The Section 7 run stepped to ``t`` (the powder pressed, both electrodes touching)."""
-    from dem.zohdi.simulation import ZohdiSimulation
+    from dem.engines.staggered.engine import ZohdiSimulation
 
     sim = ZohdiSimulation(_scene())
     while sim.t < t:
@@ -96,7 +96,7 @@ def compacted(t: float = 0.79):
 def step_cost(sim, repeat: int = 5, luding_steps: int = 200) -> dict:
     """ns per particle of the pieces of a Zohdi step and of a Luding velocity-Verlet step, same packing."""
     from dem.laws.contact.luding import LUDING_TABLE1
-    from dem.mechanics import MechanicalModel
+    from dem.engines.verlet.mechanics import MechanicalModel
     from dem.geometry.motion import MotionState
 
     mech, th, cur = sim.mechanics, sim.thermal, sim.current
@@ -135,7 +135,7 @@ def current_solve(sim, repeat: int = 3) -> dict:
     """The area-weighted Laplace problem of eq. (43) by the network solve and by Gauss-Seidel sweeps to 1e-3, 1e-6,
     1e-9 of it; the physical Kirchhoff refresh for comparison (module docstring)."""
     from dem.network.current import area_weighted_current
-    from dem.zohdi.heat import contact_bonds
+    from dem.engines.staggered.heat import contact_bonds
 
     mech, cur = sim.mechanics, sim.current
     n = mech.state.n

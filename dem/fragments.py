@@ -37,7 +37,7 @@ def clusters(n: int, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 
 def tension_capacity(mech) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(i, j, -f_min)`` of the closed pair contacts of a :class:`dem.mechanics.MechanicalModel`: the largest
+    """``(i, j, -f_min)`` of the closed pair contacts of a :class:`dem.engines.verlet.mechanics.MechanicalModel`: the largest
     attraction each can carry now (eq. 15 with its delta_max and the mean stiffness factor of its particles), N."""
     s = mech.state
     d = s.x[mech.pi] - s.x[mech.pj]

@@ -1,7 +1,7 @@
 """The sintering protocol of Luding, Manetsberger & Müllers 2005 (Sec. 4) as scene documents.
 
 Each function returns a scene as a dict (the parsed form of a TOML scene; :func:`dem.scene.parse.parse_scene` takes it,
-:func:`dem.simulation.run` runs it) for one stage of the paper's protocol:
+:func:`dem.driver.run` runs it) for one stage of the paper's protocol:
 
 * :func:`preparation_doc` -- ``n`` disks (Table 1: a0 = 1 mm, radii uniform in a0 (1 +- w0), w0 = 0.5, height
   6 mm) placed at random with random velocities in a square box (random sequential addition, solid fraction

@@ -194,7 +194,7 @@ def test_snapshot_flood_refused_and_collection_complete(tmp_path, capsys):
 
 def test_explicit_step_around_the_stable_limit(tmp_path, capsys):
     """0.99x the limit runs and stays inside the initial range (maximum principle); 1.01x is refused."""
-    from dem.physics import ThermalModel
+    from dem.engines.static import ThermalModel
     from dem.scene import parse_scene
     from dem.network.heat import stable_limit
 

@@ -6,10 +6,10 @@ import math
 import numpy as np
 import pytest
 
-from dem.engine import Simulation
-from dem.mechanics import MechanicsError
+from dem.engines.verlet.engine import Simulation
+from dem.engines.verlet.mechanics import MechanicsError
 from dem.scene import parse_scene
-from dem.simulation import run
+from dem.driver import run
 
 ELASTIC = {"law": "luding", "k1": 2.0e5, "k2": 2.0e5, "kc": 0.0, "kt_ratio": 0.2, "gamma_n": 0.0, "gamma_t": 0.0,
            "mu": 0.5, "mu_wall": 0.5, "T_melt": 120.0, "T_var": 10.0, "expansion": 0.0, "fluid_overlap": 0.2,

@@ -40,8 +40,8 @@ def _edit(path, old, new):
 def test_the_compiled_modules_are_found_from_their_imports():
     names = {str(p.relative_to(jit_cache.PACKAGE.parent)) for p in jit_cache.compiled_sources()}
     # the loop, its contact law's kernels, and the module whose parameter indices the kernels compile in
-    assert {"dem/md_loop.py", "dem/laws/contact/luding_kernels.py", "dem/laws/contact/luding.py", "dem/laws/contact/zohdi.py",
-            "dem/zohdi/kernels.py", "dem/network/gauss_seidel.py"} <= names
+    assert {"dem/engines/verlet/loop.py", "dem/laws/contact/luding_kernels.py", "dem/laws/contact/luding.py", "dem/laws/contact/zohdi.py",
+            "dem/engines/staggered/kernels.py", "dem/network/gauss_seidel.py"} <= names
     assert "dem/cli/scenes.py" not in names and "dem/__init__.py" not in names
 
 

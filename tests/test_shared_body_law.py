@@ -14,7 +14,7 @@ from dem.laws.shared_body import interaction
 from dem.geometry.particles import Material, Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.scene import make_scene, parse_scene
-from dem.simulation import run
+from dem.driver import run
 from dem.laws.ambient import Wall
 
 UNIT = Material(1.0, 1.0, 1.0, "unit")

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from dem import sinter_protocol as sp
-from dem.engine import Simulation
+from dem.engines.verlet.engine import Simulation
 from dem.fragments import clusters, fragments, tension_capacity
 from dem.laws.contact.luding import LUDING_TABLE1 as MAT
 from dem.scene import parse_scene
-from dem.simulation import run
+from dem.driver import run
 
 
 def test_schedule_scene_has_the_times_temperatures_and_box_of_sec_4_1():

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from dem.scene import parse_scene
-from dem.zohdi import kernels
+from dem.engines.staggered import kernels
 from dem.laws.contact.zohdi import ZohdiMaterial, ZohdiStepping
-from dem.zohdi.simulation import ZohdiSimulation
+from dem.engines.staggered.engine import ZohdiSimulation
 
 R = 0.075
 RHO = 2000.0

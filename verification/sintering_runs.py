@@ -217,7 +217,7 @@ def neck_statistics(sim) -> dict:
 def run_task(task: Task, root) -> dict:
     """Run ``task`` into ``root/task.folder`` (module docstring); returns what ``result.json`` holds."""
     from dem.scene import state_file
-    from dem.engine import Simulation
+    from dem.engines.verlet.engine import Simulation
     from dem.fragments import fragments
     from dem.output.writer import MotionWriter
     from dem.scene import parse_scene
@@ -333,7 +333,7 @@ def schedule_seconds(n: int = 300, p: float = 100.0, t_s: float = 1.0, seed: int
     ``seconds`` of the run (building the simulation, loading the compiled kernels and the time loop),
     ``loop_seconds`` (the time loop alone), ``steps``, ``ns_per_particle_step`` (of the loop) and the final solid
     fraction and coordination number. For the bench row of "the whole schedule, t_s = 1, N = 300"."""
-    from dem.engine import Simulation
+    from dem.engines.verlet.engine import Simulation
     from dem.scene import parse_scene
     from dem.sinter_protocol import schedule_doc
 

@@ -21,7 +21,7 @@ def register(sub):
 
 def run(args) -> dict:
     from dem.scene import load_scene
-    from dem.simulation import run as run_scene
+    from dem.driver import run as run_scene
 
     try:
         scene = load_scene(args.scene)

@@ -214,7 +214,7 @@ def build_network(particles: Particles, walls=(), spec=None, sources: Sources | 
 def bonds_and_conductances(particles: Particles, walls, spec, *, pairs=None, bonds: Bonds | None = None,
                            box: PeriodicBox | None = None) -> tuple[Bonds, np.ndarray, np.ndarray]:
     """The bonds of ``particles`` (and ``walls``) and their pair and wall conductances: the first half of
-    :func:`build_network`, for a network whose bonds change while its particles stay (:mod:`dem.contact_heat`)."""
+    :func:`build_network`, for a network whose bonds change while its particles stay (:mod:`dem.engines.contact_heat`)."""
     if bonds is None:
         bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, pairs=pairs, box=box)
     return (bonds, *bond_conductances(spec, particles, bonds, box=box, walls=tuple(walls)))

@@ -27,7 +27,7 @@ from dem.geometry.periodic import AXES, PeriodicBox
 from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
 from dem.network.heat import INTEGRATORS
 from dem.network.linsolve import BACKENDS
-from dem.physics import PHYSICS_NAMES as PHYSICS, check_physics
+from dem.engines.static import PHYSICS_NAMES as PHYSICS, check_physics
 from dem.scene.motion import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
 
 SCENE_DIR = pathlib.Path(__file__).with_name("builtin")

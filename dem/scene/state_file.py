@@ -25,7 +25,7 @@ WALL_KEYS = ("w_dmax", "w_k1last", "w_xi")
 
 
 def arrays(sim) -> dict:
-    """The state of ``sim`` (a :class:`dem.engine.Simulation`) as a dict of arrays (what :func:`save` writes; a
+    """The state of ``sim`` (a :class:`dem.engines.verlet.engine.Simulation`) as a dict of arrays (what :func:`save` writes; a
     checkpoint adds the thermal network's temperatures and heat balance)."""
     mech = sim.mechanics
     s = mech.state
@@ -46,7 +46,7 @@ def arrays(sim) -> dict:
 
 
 def save(sim, path) -> pathlib.Path:
-    """Write the state of ``sim`` (a :class:`dem.engine.Simulation`) to ``path`` (``.npz``)."""
+    """Write the state of ``sim`` (a :class:`dem.engines.verlet.engine.Simulation`) to ``path`` (``.npz``)."""
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     data = arrays(sim)

@@ -2,7 +2,7 @@
 
 The kernels are ``numba.njit(cache=True)`` functions of plain floats and 3-tuples and the material ``params``
 (:meth:`dem.laws.contact.luding.LudingMaterial.params`, indices ``P_*``; an array, or the same numbers as a tuple), called
-per contact from the engine's compiled loop (:mod:`dem.md_loop`, which passes a tuple and gets the kernels it calls
+per contact from the engine's compiled loop (:mod:`dem.engines.verlet.loop`, which passes a tuple and gets the kernels it calls
 inlined) and, unchanged, from Python (the contact-law tool ``python -m dem contact`` and the tests). Conventions and
 the history each contact carries: :mod:`dem.laws.contact.luding`.
 """

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dem import physics
+from dem.engines import static as physics
 from dem.output import folder as run_folder
 from dem.output.writer import RunWriter
 from dem.scene import Scene
@@ -164,20 +164,20 @@ def _thermal_summary(scene: Scene, models, thermal, details: dict, restart) -> d
 
 
 def run_moving(scene: Scene, out=None, progress: bool = False, resume: bool = False) -> RunResult:
-    """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engine`, or with
-    ``[contact] law = "zohdi"`` the staggered scheme of :mod:`dem.zohdi.simulation` (``out`` prepared by
+    """A scene with moving particles (``"mechanical"`` physics): the engine of :mod:`dem.engines.verlet.engine`, or with
+    ``[contact] law = "zohdi"`` the staggered scheme of :mod:`dem.engines.staggered.engine` (``out`` prepared by
     :func:`run`)."""
     from dem.scene import state_file
     from dem.output.writer import MotionWriter
 
     zohdi = scene.contact.law == "zohdi"
     if zohdi:
-        from dem.zohdi.simulation import ZohdiSimulation as Simulation
+        from dem.engines.staggered.engine import ZohdiSimulation as Simulation
 
         if resume:
             raise ValueError("--resume: runs of the zohdi contact law write no checkpoints; run again with --overwrite")
     else:
-        from dem.engine import Simulation
+        from dem.engines.verlet.engine import Simulation
 
     start = time.perf_counter()
     here = _position(scene, out, progress)

@@ -3,9 +3,9 @@ Algorithm 1 (eqs. 45-49) over the mechanical, thermal and electrical submodels.
 
 Each step from ``t`` to ``t + dt`` iterates, K = 1, 2, ...:
 
-1. positions ``r^K`` with the temperatures frozen at ``theta^(K-1)`` (:class:`dem.zohdi.mechanics.ZohdiMechanics`,
+1. positions ``r^K`` with the temperatures frozen at ``theta^(K-1)`` (:class:`dem.engines.staggered.mechanics.ZohdiMechanics`,
    eqs. 22-27, 45);
-2. temperatures ``theta^K`` with the positions frozen at ``r^K`` (:class:`dem.zohdi.heat.LumpedHeat`, eqs. 36-37,
+2. temperatures ``theta^K`` with the positions frozen at ``r^K`` (:class:`dem.engines.staggered.heat.LumpedHeat`, eqs. 36-37,
    46), with the Joule heating of the current refreshed at the last accepted step;
 3. the normalised changes ``D_r = sum |r^K - r^(K-1)| / sum |r^K - r^L|`` and ``D_theta`` alike (Algorithm 1, step
    4a; eq. 47), the violation ratio ``Z_K = max(D_r, D_theta) / TOL`` (eq. 48) and the step factor ``Phi_K =
@@ -31,9 +31,9 @@ import math
 import numpy as np
 
 from dem.geometry.motion import MotionState
-from dem.zohdi.current import ContactCurrent
-from dem.zohdi.heat import LumpedHeat
-from dem.zohdi.mechanics import ZohdiMechanics
+from dem.engines.contact_current import ContactCurrent
+from dem.engines.staggered.heat import LumpedHeat
+from dem.engines.staggered.mechanics import ZohdiMechanics
 
 NO_MOTION = 1e-12  # displacements below this x the mean radius (temperature changes below this x |theta|) are none
 

@@ -5,9 +5,9 @@ A scene names its physics (``[scene] physics = ["thermal"]``); only those are bu
 ``run(observer, progress)`` returns a summary dict. The thermal model of a static packing builds its bonds once,
 never moves a particle and allocates no mechanical state.
 
-Particles that move (``"mechanical"``, the Luding 2005 contact law) run in the engine of :mod:`dem.engine`, where
+Particles that move (``"mechanical"``, the Luding 2005 contact law) run in the engine of :mod:`dem.engines.verlet.engine`, where
 the thermal network follows the contacts as the necks grow; with ``[contact] law = "zohdi"`` the staggered scheme of
-Zohdi 2014 (:mod:`dem.zohdi.simulation`) runs the mechanics, the heat and the current (``"electrical"``).
+Zohdi 2014 (:mod:`dem.engines.staggered.engine`) runs the mechanics, the heat and the current (``"electrical"``).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_step
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
 
 PLANNED: dict = {}  # names reserved for submodels still to come: refused with what they will be
-MOVING = ("mechanical", "electrical")  # built by the engines for moving particles (dem.engine, dem.zohdi), not here
+MOVING = ("mechanical", "electrical")  # built by the engines for moving particles (dem.engines.verlet, dem.engines.staggered), not here
 
 
 class ThermalModel:

@@ -4,17 +4,17 @@ A run is a sequence of *intervals* on the mechanical step grid ``t = k dt``. An 
 time, the next thermal update and the next knot of the temperature schedule, whichever comes first; in each the
 submodels act in order:
 
-1. ``mechanical`` (:class:`dem.mechanics.MechanicalModel`) -- contact forces, walls, gravity and velocity-Verlet
+1. ``mechanical`` (:class:`dem.engines.verlet.mechanics.MechanicalModel`) -- contact forces, walls, gravity and velocity-Verlet
    steps, in compiled code, with the temperatures of the interval: prescribed by the schedule (linear in time,
    uniform), computed by the thermal network (its latest temperatures extrapolated with the rate of its last step),
    or the initial ones;
-2. ``thermal`` (:class:`dem.contact_heat.ContactThermalModel`) -- one implicit step of the pipe network over the
+2. ``thermal`` (:class:`dem.engines.contact_heat.ContactThermalModel`) -- one implicit step of the pipe network over the
    interval, on the contacts as they are at its end;
 3. observers -- the output writer and the progress bar.
 
 The thermal interval is many mechanical steps long (``[solver] thermal_interval``), so neither physics forces the
 other's step down. A scene whose physics is only ``thermal`` never comes here: it runs on the static path of
-:mod:`dem.physics`, exactly as before.
+:mod:`dem.engines.static`, exactly as before.
 """
 
 from __future__ import annotations
@@ -23,10 +23,10 @@ import math
 
 import numpy as np
 
-from dem.contact_heat import ContactThermalModel
+from dem.engines.contact_heat import ContactThermalModel
 from dem.laws.contact.luding import P_EXPANSION, P_T0, P_T_MELT
 from dem.laws.contact.luding_kernels import radius_at
-from dem.mechanics import MechanicalModel
+from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.motion import MotionState
 from dem.network.heat import boundary_heat_flow, steady
 from fem_neck.geometry import neck_radius

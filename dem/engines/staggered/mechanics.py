@@ -3,7 +3,7 @@ trapezoidal rule (eqs. 22-24) whose implicit equations are solved by fixed-point
 
 A step from ``t`` to ``t + dt`` is a sequence of iterations (:meth:`ZohdiMechanics.iterate`), each evaluating the
 forces at the previous iterate with the temperatures frozen at theirs; the staggered scheme
-(:mod:`dem.zohdi.simulation`) decides when the iterates have converged and then :meth:`~ZohdiMechanics.accept`\\ s
+(:mod:`dem.engines.staggered.engine`) decides when the iterates have converged and then :meth:`~ZohdiMechanics.accept`\\ s
 the last one, or :meth:`~ZohdiMechanics.restart`\\ s the step with a smaller ``dt``. Walls move by prescribed
 kinematics (fixed, strain at a constant speed, vibrating; :mod:`dem.geometry.walls`), so where they are at the end of the
 step is known before it is solved.
@@ -23,7 +23,7 @@ import numpy as np
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, max_displacement, verlet_pairs, wall_pairs
 from dem.geometry.walls import MOTIONS, WallArrays
-from dem.zohdi import kernels
+from dem.engines.staggered import kernels
 
 
 class ZohdiMechanics:

@@ -1,7 +1,7 @@
 """The thermal submodel of Zohdi 2014: the lumped heat balance of each particle (eqs. 31-37).
 
 ``m_i C_i dtheta_i/dt = Q_i + H_i`` (eq. 31): ``Q_i`` the heat conducted through the particle's contacts (with
-walls that carry a temperature: isothermal planes) and ``H_i`` its Joule heating (eq. 35; :mod:`dem.zohdi.current`).
+walls that carry a temperature: isothermal planes) and ``H_i`` its Joule heating (eq. 35; :mod:`dem.engines.contact_current`).
 The contact conductance is the scene's ``[conductance] law`` on each contact as it is, exactly as for a static
 packing (:func:`dem.geometry.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`): ``law = "zohdi"`` is the
 paper's ``K_ij A_ij / |r_i - r_j|`` (eq. 33 with the lens area of eqs. 7-12), ``"fit"`` the FE-verified neck law.
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from dem.geometry.bonds import find_bonds
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.geometry.particles import Particles
-from dem.zohdi import kernels
+from dem.engines.staggered import kernels
 
 
 @dataclass(frozen=True)

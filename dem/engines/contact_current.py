@@ -25,7 +25,7 @@ import numpy as np
 from dem.network.current import Electrodes, area_weighted_current, kirchhoff, zohdi_joule
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.geometry.particles import Particles
-from dem.zohdi.heat import contact_bonds
+from dem.engines.staggered.heat import contact_bonds
 
 
 class ContactCurrent:

@@ -1,7 +1,7 @@
 """The mechanical submodel: particles that move under the Luding 2005 sintering contact law, walls and gravity.
 
 It owns the Verlet list and the per-contact history and advances the state with the compiled loop of
-:mod:`dem.md_loop`, returning to Python only to rebuild the list (when some particle has moved more than half the
+:mod:`dem.engines.verlet.loop`, returning to Python only to rebuild the list (when some particle has moved more than half the
 skin), at the times the engine asks for (output, a thermal update, a change of schedule), or to stop a run that
 went wrong (a non-finite position, a particle through a wall) with a one-line message naming the step and the
 particle.
@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from dem import md_loop
+from dem.engines.verlet import loop as md_loop
 from dem.laws.contact.luding_kernels import k1_factor
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
