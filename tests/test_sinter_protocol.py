@@ -1,13 +1,13 @@
-"""Luding 2005's protocol as scenes (dem.sinter_protocol) and the fragment counter (dem.fragments)."""
+"""Luding 2005's protocol as scenes (verification.sinter_protocol) and the fragment counter (verification.fragments)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from dem import sinter_protocol as sp
+from verification import sinter_protocol as sp
 from dem.engines.verlet.engine import Simulation
-from dem.fragments import clusters, fragments, tension_capacity
+from verification.fragments import clusters, fragments, tension_capacity
 from dem.laws.contact.luding import LUDING_TABLE1 as MAT
 from dem.scene import parse_scene
 from dem.driver import run
