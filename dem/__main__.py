@@ -1,7 +1,6 @@
 """``python -m dem``: see :mod:`dem.cli`."""
 
-from dem.cli import main
-from sinterheat.interrupt import exit_process
+from sinterheat.startup import run_main
 
 if __name__ == "__main__":
-    exit_process(main())
+    run_main("python -m dem", "dem.cli")

@@ -1,7 +1,6 @@
 """``python -m fem_neck``: neck geometry, FE conductance solves, convergence studies and the conductance fit."""
 
-from fem_neck.cli import main
-from sinterheat.interrupt import exit_process
+from sinterheat.startup import run_main
 
 if __name__ == "__main__":
-    exit_process(main(description=__doc__))
+    run_main("python -m fem_neck", "fem_neck.cli", description=__doc__)

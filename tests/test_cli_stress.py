@@ -16,7 +16,7 @@ import pytest
 from dem.cli import main as dem_main
 from fem_neck import neck_radius
 from fem_neck.cli import main as fem_main
-from verification.__main__ import main as verification_main
+from verification.cli import main as verification_main
 
 MATERIAL = "[material]\nconductivity = {k}\ndensity = 8960.0\nspecific_heat = 385.0\n"
 PAIR = ("[particles]\nposition = {pos}\nradius = {r}\ntemperature = {T}\n")

@@ -10,7 +10,7 @@ import matplotlib.image
 import pytest
 
 from test_verification_report import assert_report_links_resolve
-from verification import __main__ as cli
+from verification import cli
 
 
 def _run(*args, timeout=600):

@@ -11,7 +11,7 @@ from verification import sintering as S
 from verification import sintering_runs as sr
 from verification import sintering_statements as T
 from verification import sintering_study as Y
-from verification.__main__ import COMMANDS
+from verification.cli import COMMANDS
 from verification.report import check_section_result, jsonable
 
 TINY = sr.Grid(n=(12,), p=(10.0, 100.0), t_s=(1e-4, 2e-3), three_seeds=(1,), no_expansion=False, n3d=12)
