@@ -50,8 +50,8 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 from numba import njit
 
-from dem.engines.verlet import loop as md_loop
-from dem.laws.contact import luding_kernels as law
+from dem.engines.contact_forces import forces
+from dem.laws.contact import luding as law
 from dem.laws.contact.luding import LUDING_TABLE1, LudingMaterial
 from verification.report import md_table
 
@@ -63,7 +63,8 @@ HEIGHT_2D = 6e-3  # Luding 2005, Table 1: disk height (m)
 PRESSURE_2D = 10.0  # N/m: the paper's smaller side stress, whose samples reach coordination ~4 (its Fig. 10)
 WALL_2D = {"mass": 0.01, "damping": 0.2}  # Table 1: wall mass (kg) and damping (kg/s)
 T_RUN = 80.0  # °C: the preparation temperature of Luding 2005, Sec. 4.1 (below the melting range)
-ENGINE_MODULES = ("numba", "dem.engines.verlet.engine", "dem.engines.verlet.mechanics", "dem.engines.verlet.loop", "dem.geometry.neighbours", "dem.laws.contact.luding_kernels")
+ENGINE_MODULES = ("numba", "dem.engines.verlet.engine", "dem.engines.verlet.mechanics", "dem.engines.verlet.loop",
+                  "dem.engines.contact_forces", "dem.geometry.neighbours", "dem.laws.contact.luding")
 
 
 @dataclass(frozen=True)
@@ -189,12 +190,12 @@ def periodic_packing(sizes: Sizes, cache: pathlib.Path, seed: int = 0, coordinat
     material = replace(linear_limit(LUDING_TABLE1), mu=0.0, mu_wall=0.0, gamma_n=1.0, gamma_t=0.0, expansion=0.0)
     state = MotionState.create(3, x * unit, touch * shape * unit, material.density, np.full(len(x), T_RUN))
     dt = time_steps(material, state.mass, state.inertia, state.radius, 3, None)[0]
-    params, skin, T0, rate = material.params(), 0.1e-3, np.array([T_RUN]), np.zeros(1)
-    mech = MechanicalModel(state, (), params, dt, skin, box=box * unit)
+    skin, T0, rate = 0.1e-3, np.array([T_RUN]), np.zeros(1)
+    mech = MechanicalModel(state, (), material, dt, skin, box=box * unit)
     while mech.coordination() < coordination:
         state.radius_ref *= 1.002 if mech.coordination() < 3.0 else 1.0002
         state.radius[:] = state.radius_ref
-        mech = MechanicalModel(state, (), params, dt, skin, box=box * unit)  # a new list for the grown radii
+        mech = MechanicalModel(state, (), material, dt, skin, box=box * unit)  # a new list for the grown radii
         mech.advance(50, T0, rate)
     mech.advance(4000, T0, rate)
     out = {"position": state.x % (box * unit), "radius": state.radius.copy(), "box": box * unit}
@@ -248,19 +249,19 @@ def time_ours(make, steps: int, warmup: int) -> dict:
 
 
 @njit  # not cached: numba's cache follows only this file, so a cached copy would keep an old engine's code
-def _force_passes(count, x, v, w, f, tau, spin_axes, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last,
-                  p_xi, p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt):
-    """``count`` force passes of the engine's loop (:func:`dem.engines.verlet.loop._forces`) in one compiled call."""
+def _force_passes(count, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_fn, p_ft,
+                  wn, wq, wdq, wforce, wk, wm, w_hist, w_fn, w_ft, params, dt):
+    """``count`` force passes of the engine's loop (:func:`dem.engines.contact_forces.forces`) in one compiled call."""
     for _ in range(count):
-        md_loop._forces(x, v, w, f, tau, spin_axes, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi,
-                        p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt)
+        forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist, p_fn, p_ft,
+               wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params, dt)
 
 
 @njit  # not cached (as above)
-def _material_passes(count, t, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt):
-    """``count`` material-state updates of the engine's loop (:func:`dem.engines.verlet.loop._material_state`)."""
+def _material_passes(count, t, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt):
+    """``count`` material-state updates of the engine's loop (the law's ``update_particles``)."""
     for k in range(count):
-        md_loop._material_state(k * dt, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt)
+        law.update_particles(k * dt, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt)
 
 
 def stage_costs(sample: dict, material: LudingMaterial, steps: int) -> dict:
@@ -281,11 +282,10 @@ def stage_costs(sample: dict, material: LudingMaterial, steps: int) -> dict:
     mech.advance(steps, T0, rate)
     whole = time.process_time() - t0
     rebuilds = mech.rebuilds - rebuilds
-    forces_args = (s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, mech.k1f, mech.gravity, mech.box,
-                   mech.pi, mech.pj, mech.p_dmax, mech.p_k1last, mech.p_xi, mech.p_fn, mech.p_ft, w.normal, w.q, w.dq,
-                   w.force, mech.wk, mech.wm, mech.w_dmax, mech.w_k1last, mech.w_xi, mech.w_fn, mech.w_ft,
-                   mech.params, mech.dt)
-    material_args = (mech.t, T0, rate, s.T, s.radius, s.radius_ref, mech.k1f, True, mech.params,
+    forces_args = (s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, mech.particle_state, s.T,
+                   mech.gravity, mech.box, mech.pi, mech.pj, mech.p_hist, mech.p_fn, mech.p_ft, w.normal, w.q, w.dq,
+                   w.force, mech.wk, mech.wm, mech.w_hist, mech.w_fn, mech.w_ft, mech.params, mech.dt)
+    material_args = (mech.t, T0, rate, s.T, s.radius, s.radius_ref, mech.particle_state, True, mech.params,
                      mech.relaxation_time, mech.dt)
     _force_passes(0, *forces_args)  # compile
     _material_passes(0, *material_args)
@@ -599,7 +599,7 @@ FIRST_CALLS = """
 import dataclasses, json, time
 t = time.perf_counter()
 import numpy as np
-from dem.laws.contact import luding_kernels as law
+from dem.laws.contact import luding as law
 from dem.laws.contact import luding
 from dem.engines.verlet.engine import Simulation
 from dem.scene import parse_scene

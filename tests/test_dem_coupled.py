@@ -68,7 +68,7 @@ def test_temperatures_reach_the_mechanics_and_soften_the_hot_contacts():
     bottom = s.x[:, 2] < 1.5e-3
     assert s.T[bottom].mean() > s.T[~bottom].mean() > 80.0
     # the stiffness factor relaxes towards k1(T) of eq. 10: lower where it is hotter
-    assert mech.k1f[bottom].mean() < mech.k1f[~bottom].mean()
+    assert mech.particle_column("k1_factor")[bottom].mean() < mech.particle_column("k1_factor")[~bottom].mean()
     assert sim.temperature_source == "network"
 
 
@@ -103,9 +103,9 @@ def test_cooling_by_the_network_freezes_the_contacts():
     doc["particles"]["temperature"] = [150.0] * len(doc["particles"]["temperature"])
     doc["contact"]["t0"] = 1e6  # relaxing would take for ever: only the freeze can raise the factor
     sim = Simulation(parse_scene(doc))
-    start = sim.mechanics.k1f.copy()
+    start = sim.mechanics.particle_column("k1_factor").copy()
     sim.run()
     assert np.all(sim.thermal.rate <= 0.0) and np.any(sim.thermal.rate < 0.0)
     cooled = sim.mechanics.state.T < 149.0
     assert np.any(cooled)
-    assert np.all(sim.mechanics.k1f[cooled] > start[cooled])
+    assert np.all(sim.mechanics.particle_column("k1_factor")[cooled] > start[cooled])

@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq as _brentq
 
-from dem.laws.contact import luding_kernels as law
+from dem.laws.contact import luding as law
 from dem.laws.contact import luding
 from dem.laws.contact.luding import LUDING_TABLE1 as MAT
 

@@ -80,7 +80,7 @@ def test_tiny_schedule_sinters_and_cools_back():
     times = sp.Times(t_s=0.02, t_heat=0.03, heat=0.01, cool=0.01, relax=0.01)
     sim = Simulation(parse_scene(sp.schedule_doc(16, 100.0, 0.02, times=times)))
     rows = []
-    sim.run(lambda s: rows.append((s.mechanics.t, s.volume_fraction(), float(np.mean(s.mechanics.k1f)))))
+    sim.run(lambda s: rows.append((s.mechanics.t, s.volume_fraction(), float(np.mean(s.mechanics.particle_column("k1_factor"))))))
     t, nu, k1 = map(np.array, zip(*rows))
     at = lambda time: int(np.argmin(abs(t - time)))  # noqa: E731
     k1_80 = 1.0 / (1.0 + math.exp(-2.0 * (120.0 - 80.0) / 10.0))  # eq. 10

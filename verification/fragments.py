@@ -20,7 +20,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from dem.laws.contact.luding import P_FLUID_OVERLAP
-from dem.laws.contact.luding_kernels import f_min, pair_delta_fluid
+from dem.laws.contact.luding import f_min, pair_delta_fluid
 
 
 def clusters(n: int, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -45,10 +45,11 @@ def tension_capacity(mech) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         if mech.box[a] > 0:
             d[:, a] -= mech.box[a] * np.floor(d[:, a] / mech.box[a] + 0.5)
     closed = s.radius[mech.pi] + s.radius[mech.pj] - np.linalg.norm(d, axis=1) > 0
-    i, j, dmax = mech.pi[closed], mech.pj[closed], mech.p_dmax[closed]
+    i, j, dmax = mech.pi[closed], mech.pj[closed], mech.pair_column("delta_max")[closed]
     phi = mech.params[P_FLUID_OVERLAP]
-    cap = np.array([-f_min(dm, 0.5 * (mech.k1f[a] + mech.k1f[b]), pair_delta_fluid(s.radius[a], s.radius[b], phi),
-                           mech.params) for a, b, dm in zip(i, j, dmax)])
+    k1f = mech.particle_column("k1_factor")
+    cap = np.array([-f_min(dm, 0.5 * (k1f[a] + k1f[b]), pair_delta_fluid(s.radius[a], s.radius[b], phi), mech.params)
+                    for a, b, dm in zip(i, j, dmax)])
     return i, j, cap.reshape(-1)
 
 

@@ -193,12 +193,13 @@ def contact_statistics(sim) -> dict:
     s = mech.state
     i, j, overlap, fn, ft = mech.contacts()
     _, _, capacity = tension_capacity(mech)
+    k1f = mech.particle_column("k1_factor")
     ft = np.linalg.norm(ft, axis=1)
     excess = fn + capacity
     with np.errstate(divide="ignore", invalid="ignore"):
         mu_t = np.where(excess > 0, ft / excess, np.nan)
     return {"overlap_rel": overlap / (s.radius[i] + s.radius[j]), "fn": fn, "ft": ft, "fmin": -capacity,
-            "mu_t": mu_t, "mu_T": 0.5 * (mech.k1f[i] + mech.k1f[j]) * mech.params[P_MU]}
+            "mu_t": mu_t, "mu_T": 0.5 * (k1f[i] + k1f[j]) * mech.params[P_MU]}
 
 
 def neck_statistics(sim) -> dict:
@@ -259,7 +260,8 @@ def run_task(task: Task, root) -> dict:
         "ns_per_particle_step": 1e9 * seconds / max(1, sim.mechanics.steps * s.n), "t": sim.mechanics.t,
         "volume_fraction": sim.volume_fraction(),
         "mass_fraction": None if volume is None else float(np.sum(s.mass) / (scene.contact.density * volume)),
-        "coordination": sim.mechanics.coordination(), "k1_factor": float(np.mean(sim.mechanics.k1f)),
+        "coordination": sim.mechanics.coordination(),
+        "k1_factor": float(np.mean(sim.mechanics.particle_column("k1_factor"))),
         "kinetic_energy": s.kinetic_energy(), "wall_stress": sim.wall_stress(), "snapshots": len(snaps),
         "fragments": int(len(sizes)), "largest_fragment": int(sizes[0]), "single_particles": int(np.sum(sizes == 1)),
         "effective_conductivity": summary.get("effective_conductivity"),

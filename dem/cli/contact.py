@@ -85,7 +85,7 @@ def read_history(path) -> dict:
 def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> dict:
     """One pair contact of two equal particles of radius ``radius`` through the history (see the module
     docstring); returns the per-row arrays named in :data:`OUTPUTS`."""
-    from dem.laws.contact import luding_kernels as law
+    from dem.laws.contact import luding as law
 
     params = material.params()
     delta_fluid = law.pair_delta_fluid(radius, radius, material.fluid_overlap)
@@ -108,7 +108,7 @@ def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> 
 
 
 def run(args) -> dict:
-    from dem.laws.contact.luding_kernels import pair_delta_fluid
+    from dem.laws.contact.luding import pair_delta_fluid
     from dem.scene.parse import load_scene, luding_material_from_scene
 
     scene = load_scene(args.scene)
@@ -158,7 +158,7 @@ def plot(path: pathlib.Path, material, radius: float, history: dict, rows: dict)
     -kc(T, t, delta_max) lines of the last row, and the path through the rows."""
     from matplotlib.figure import Figure
 
-    from dem.laws.contact import luding_kernels as law
+    from dem.laws.contact import luding as law
 
     delta_fluid = law.pair_delta_fluid(radius, radius, material.fluid_overlap)
     x = history["overlap"]

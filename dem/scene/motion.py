@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dem.laws.contact import luding
+from dem.laws.contact import law_module
 from dem.geometry.motion import particle_mass, moment_of_inertia
 from dem.geometry.particles import finite_array
 from dem.scene.events import TemperatureSchedule
@@ -48,8 +48,6 @@ MOVING_KEYS = {
 MOVING_TABLES = {"gravity": {"acceleration"}, "temperature": {"time", "value", "relaxation_time"},
                  "start": {"state"}, "phases": {"start", "wall_velocity", *("mu", "mu_wall", "gamma_n", "gamma_t")},
                  "electrical": zscene.ELECTRICAL_KEYS}
-PHASE_KEYS = {"mu": luding.P_MU, "mu_wall": luding.P_MU_WALL, "gamma_n": luding.P_GAMMA_N,
-              "gamma_t": luding.P_GAMMA_T}
 @dataclass(frozen=True)
 class MotionSpec:
     dimension: int
@@ -67,12 +65,13 @@ class MotionSpec:
     output_interval: float
     vtu_interval: float
     box: tuple = (0.0, 0.0, 0.0)
-    phases: tuple = ()        # (start time, {parameter index: value}), sorted by start
+    phases: tuple = ()        # (start time, {material field: value}), sorted by start
     start: dict | None = None  # a saved state (dem.scene.state_file.load) the run begins from
     wall_phases: tuple = ()   # (start time, {wall name: inward velocity}), sorted by start
-    stepping: object = None   # law = "zohdi": its implicit stepping (dem.laws.contact.zohdi.ZohdiStepping)
+    stepping: object = None   # law = "zohdi": its implicit stepping (dem.scene.zohdi.ZohdiStepping)
     control: int | None = None  # law = "zohdi": the axis the powder bed stands and is pressed along
     frames: int = 0           # law = "zohdi": rendered frames (PNG) over the run
+    relaxation_time: float = 1e3  # law = "luding": t0 of k1(T, t) (eqs. 11-12) when no schedule gives one
 
 
 def _num(table, section, key, default=None, positive=False, nonnegative=False):
@@ -90,24 +89,11 @@ def _num(table, section, key, default=None, positive=False, nonnegative=False):
 
 def time_steps(contact, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray, dimension: int,
                height: float | None) -> tuple[float, float]:
-    """``(t_MD, stable)``.
-
-    ``t_MD = pi/(50 omega)`` is the "typical time-step" of Luding 2005 (eq. 6 and below,
-    :func:`dem.laws.contact.luding.time_step`) for a contact of two particles of the mean radius. The lightest pair of a
-    polydisperse sample vibrates faster: with Table 1's radii (a0 +- 50 %) its contact still takes 25 steps per
-    half period. ``stable`` is the largest velocity-Verlet step that stays stable for the stiffest contact,
-    ``2/(omega_max + eta)``: the lightest pair, with the normal stiffness k2 or the tangential spring acting with
-    rotation (``alpha k2 (1 + m a^2/I)``), whichever is stiffer, and the viscous rate ``eta = gamma_n/(2 m12)``.
-    A ``dt`` above it is refused.
-    """
-    order = np.argsort(mass)
+    """``(dt, stable)`` of the contact law ``contact.law`` (its ``time_steps``): the step ``dt = "auto"`` takes, and
+    the largest velocity-Verlet step that stays stable for the stiffest contact; a two-particle contact of the mean
+    radius sets the typical mass."""
     m_mean = float(particle_mass(dimension, contact.density, np.mean(radius), height))
-    t_md = luding.time_step(contact.k2, contact.gamma_n, 0.5 * m_mean)
-    m12 = mass[order[0]] * mass[order[1]] / (mass[order[0]] + mass[order[1]]) if len(mass) > 1 else mass[0]
-    rotational = 1.0 + float(np.max(mass * radius**2 / inertia))
-    k_max = contact.k2 * max(1.0, contact.kt_ratio * rotational)
-    stable = 2.0 / (math.sqrt(k_max / m12) + contact.gamma_n / (2.0 * m12))
-    return min(t_md, stable), stable
+    return law_module(contact.law).time_steps(contact, mass, inertia, radius, m_mean)
 
 
 def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, start=None) -> MotionSpec:
@@ -199,7 +185,8 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
                             min(output_interval, DEFAULT_THERMAL_STEPS * dt), positive=True)
     return MotionSpec(dimension, height, velocity, angular, walls, gravity, schedule, dt, stable, skin,
                       thermal_interval, solver.integrator, output_interval, vtu_interval,
-                      phases=tuple(p[:2] for p in phases if p[1]), start=start, wall_phases=wall_phases)
+                      phases=tuple(p[:2] for p in phases if p[1]), start=start, wall_phases=wall_phases,
+                      relaxation_time=contact.t0)
 
 
 def _phase(k: int, table: dict) -> tuple:
@@ -215,7 +202,7 @@ def _phase(k: int, table: dict) -> tuple:
     walls = table.get("wall_velocity", {})
     if not isinstance(walls, dict):
         raise ValueError(f"[phases][{k}] wall_velocity: must be a table {{wall name = velocity (m/s, inward)}}")
-    return start, {PHASE_KEYS[key]: _num(table, f"phases][{k}", key, nonnegative=True) for key in table
+    return start, {key: _num(table, f"phases][{k}", key, nonnegative=True) for key in table
                    if key not in ("start", "wall_velocity")}, \
         {str(name): _num(walls, f"phases][{k}] wall_velocity", name) for name in walls}
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import pathlib
 import tomllib
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -19,9 +19,8 @@ from dem.scene import state_file
 from dem.geometry import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.fields import material_from_table
-from dem.laws.contact.luding import LudingMaterial
-from dem.laws.contact.zohdi import ZohdiMaterial
-from dem.scene.zohdi import ElectricalSpec, parse_electrical, zohdi_material
+from dem.laws.contact import law_module
+from dem.scene.zohdi import ElectricalSpec, parse_electrical
 from dem.geometry.particles import COPPER, Material, Particles
 from dem.geometry.periodic import AXES, PeriodicBox
 from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
@@ -48,9 +47,7 @@ ALLOWED = {
     "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
     "solver": {"mode", "integrator", "dt", "t_end", "rtol", "linear", "floating", "max_steps"},
     "output": {"every", "vtu_every", "vtu", "checkpoint_every"},
-    "contact": {"law"} | {f.name for f in fields(LudingMaterial)} | {f.name for f in fields(ZohdiMaterial)},
 }
-CONTACT_LAWS = ("luding", "zohdi")
 GENERATOR_KEYS = {
     "chain": {"n", "radius", "overlap"},
     "lattice": {"shape", "radius", "overlap", "structure"},
@@ -150,7 +147,7 @@ class Scene:
     name: str = "scene"
     description: str = ""
     specimen: Specimen | None = None
-    contact: LudingMaterial | ZohdiMaterial | None = None
+    contact: object = None  # the material of the contact law (dem.laws.contact), or None
     motion: MotionSpec | None = None  # particles that move ([scene] physics with "mechanical"), else None
     electrical: ElectricalSpec | None = None  # the current's scheme and electrodes ("electrical" physics)
     box: PeriodicBox | None = None  # a periodic box (dem.geometry.periodic), else None
@@ -414,7 +411,7 @@ def _moving_keys(doc: dict, moving: bool) -> dict:
 
 def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None) -> Scene:
     """Validate a parsed TOML document into a :class:`Scene` (schema: README, "Scene schema")."""
-    top = set(ALLOWED) | {"materials"} | set(MOVING_TABLES)
+    top = set(ALLOWED) | {"materials", "contact"} | set(MOVING_TABLES)
     unknown = sorted(set(doc) - top)
     if unknown:
         raise ValueError(f"[{unknown[0]}]: unknown table (allowed: {', '.join(sorted(top))})")
@@ -484,43 +481,38 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
                  electrical, box)
 
 
-def contact_material_from_scene(doc: dict) -> LudingMaterial | ZohdiMaterial:
-    """The contact material of a TOML document's ``[contact]`` table: :func:`luding_material_from_scene` for
-    ``law = "luding"``, :func:`dem.scene.zohdi.zohdi_material` for ``law = "zohdi"``."""
+def contact_material_from_scene(doc: dict):
+    """The contact material of a TOML document's ``[contact]`` table: ``law`` names the contact law
+    (:data:`dem.laws.contact.CONTACT_LAWS`), the other keys are its material's fields in SI units (``density``
+    defaults to that of a single ``[material]``)."""
     table = doc.get("contact")
-    if isinstance(table, dict) and table.get("law") == "zohdi":
-        _check_keys(table, "contact", ALLOWED["contact"])
-        values = {key: v for key, v in table.items() if key != "law"}
-        material = doc.get("material")
-        if "density" not in values and isinstance(material, dict) and "density" in material:
-            values["density"] = material["density"]
-        return zohdi_material(values)
-    return luding_material_from_scene(doc)
-
-
-def luding_material_from_scene(doc_or_scene) -> LudingMaterial:
-    """The Luding 2005 contact material of a :class:`Scene` (its ``contact``) or of a TOML document (its
-    ``[contact]`` table: ``law = "luding"`` and the :class:`~dem.laws.contact.luding.LudingMaterial` fields in SI units;
-    ``density`` defaults to that of a single ``[material]``). Independent of how the particles are given.
-    Raises ``ValueError`` when there is none or a value is bad."""
-    if isinstance(doc_or_scene, Scene):
-        if doc_or_scene.contact is None or doc_or_scene.contact.law != "luding":
-            raise ValueError(f"scene {doc_or_scene.name!r}: has no [contact] table with law = \"luding\" (the Luding "
-                             f"2005 sintering contact material)")
-        return doc_or_scene.contact
-    table = doc_or_scene.get("contact") if isinstance(doc_or_scene, dict) else None
-    if table is None:
-        raise ValueError("[contact]: required, with law = \"luding\" and the material (k1, k2, kc, ...)")
-    _check_keys(table, "contact", ALLOWED["contact"])
-    if table.get("law") not in CONTACT_LAWS:
-        raise ValueError(f"[contact] law = {table.get('law')!r}: must be one of {', '.join(CONTACT_LAWS)}")
+    if not isinstance(table, dict):
+        raise ValueError("[contact]: must be a table with law = \"luding\" or \"zohdi\" and the material")
+    law = law_module(table.get("law"))
     values = {key: v for key, v in table.items() if key != "law"}
-    material = doc_or_scene.get("material")
+    material = doc.get("material")
     if "density" not in values and isinstance(material, dict) and "density" in material:
         values["density"] = material["density"]
-    if table["law"] != "luding":
-        raise ValueError(f"[contact] law = {table['law']!r}: not the Luding 2005 sintering contact (law = \"luding\")")
-    return material_from_table(LudingMaterial, "luding", values)
+    return material_from_table(law.Material, law.NAME, values)
+
+
+def luding_material_from_scene(doc_or_scene):
+    """The Luding 2005 contact material of a :class:`Scene` (its ``contact``) or of a TOML document (its
+    ``[contact]`` table, :func:`contact_material_from_scene`). Raises ``ValueError`` when there is none or a value
+    is bad."""
+    if isinstance(doc_or_scene, Scene):
+        material = doc_or_scene.contact
+        if material is None or material.law != "luding":
+            raise ValueError(f"scene {doc_or_scene.name!r}: has no [contact] table with law = \"luding\" (the Luding "
+                             f"2005 sintering contact material)")
+        return material
+    if not isinstance(doc_or_scene, dict) or doc_or_scene.get("contact") is None:
+        raise ValueError("[contact]: required, with law = \"luding\" and the material (k1, k2, kc, ...)")
+    law = doc_or_scene["contact"].get("law") if isinstance(doc_or_scene["contact"], dict) else None
+    if law != "luding":
+        law_module(law)  # an unknown law is named as such
+        raise ValueError(f"[contact] law = {law!r}: not the Luding 2005 sintering contact (law = \"luding\")")
+    return contact_material_from_scene(doc_or_scene)
 
 
 def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls) -> None:

@@ -18,10 +18,11 @@ import pathlib
 
 import numpy as np
 
-FORMAT = "dem-moving-state-1"
-PARTICLE_KEYS = ("x", "v", "w", "f", "tau", "mass", "inertia", "radius", "radius_ref", "T", "k1f")
-PAIR_KEYS = ("pi", "pj", "p_dmax", "p_k1last", "p_xi")
-WALL_KEYS = ("w_dmax", "w_k1last", "w_xi")
+FORMAT = "dem-moving-state-2"
+FORMAT_1 = "dem-moving-state-1"  # the Luding law's histories as separate arrays (read and converted)
+PARTICLE_KEYS = ("x", "v", "w", "f", "tau", "mass", "inertia", "radius", "radius_ref", "T", "particle_state")
+PAIR_KEYS = ("pi", "pj", "p_hist")
+WALL_KEYS = ("w_hist",)
 
 
 def arrays(sim) -> dict:
@@ -35,7 +36,7 @@ def arrays(sim) -> dict:
             "wall_names": np.array([w.name for w in mech.walls], dtype=str), "wall_q": mech.w.q,
             "wall_dq": mech.w.dq, "wall_acc": mech.w.acc}
     data.update({k: getattr(s, k) for k in PARTICLE_KEYS if hasattr(s, k)})
-    data["k1f"] = mech.k1f
+    data.update(contact_law=np.array(mech.law.NAME), particle_state=mech.particle_state)
     data.update({k: getattr(mech, k) for k in PAIR_KEYS + WALL_KEYS})
     if sim.thermal is not None:
         th = sim.thermal
@@ -65,6 +66,8 @@ def load(path) -> dict:
             data = {k: f[k] for k in f.files}
     except (OSError, ValueError) as exc:
         raise ValueError(f"[start] state = {str(path)!r}: cannot be read as a saved state ({exc})") from None
+    if str(data.get("format", "")) == FORMAT_1:
+        data = _from_format_1(data)
     if str(data.get("format", "")) != FORMAT:
         raise ValueError(f"[start] state = {str(path)!r}: not a saved moving-particle state (format {FORMAT})")
     missing = [k for k in PARTICLE_KEYS + PAIR_KEYS + WALL_KEYS if k not in data]
@@ -73,9 +76,22 @@ def load(path) -> dict:
     return normalised(data)
 
 
+def _from_format_1(data: dict) -> dict:
+    """A state of the first format (the Luding 2005 law, its histories as separate arrays) in today's."""
+    out = {k: v for k, v in data.items() if k not in ("k1f", "p_dmax", "p_k1last", "p_xi", "w_dmax", "w_k1last",
+                                                      "w_xi")}
+    if "k1f" in data:
+        out.update(format=np.array(FORMAT), contact_law=np.array("luding"), particle_state=data["k1f"][:, None],
+                   p_hist=np.column_stack([data["p_dmax"], data["p_k1last"], data["p_xi"]]),
+                   w_hist=np.concatenate([data["w_dmax"][..., None], data["w_k1last"][..., None], data["w_xi"]],
+                                         axis=-1))
+    return out
+
+
 def normalised(data: dict) -> dict:
     """The scalars and names of a loaded state as Python values."""
     data["height"] = None if not np.isfinite(data["height"]) else float(data["height"])
     data["dimension"] = int(data["dimension"])
     data["wall_names"] = [str(x) for x in data["wall_names"]]
+    data["contact_law"] = str(data["contact_law"])
     return data

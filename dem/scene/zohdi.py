@@ -26,14 +26,81 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from dem.network.current import Electrodes, check_absorption, check_scheme
-from dem.laws.fields import material_from_table
-from dem.laws.contact.zohdi import ZohdiMaterial, ZohdiStepping
 
-STEPPING_KEYS = {f.name for f in fields(ZohdiStepping)}
+LEAST_FACTOR = 0.05  # the step factor Phi never goes below this (one restart shrinks the step at most 20 x)
 OUTPUT_KEYS = {"fraction_axis", "frames"}
 DEFAULT_SKIN = 0.5  # x the mean radius: a step of the implicit scheme moves particles far more than a Verlet step
 ELECTRICAL_KEYS = {"scheme", "absorption", "tolerance", "sweeps", "floating"}
 ELECTRODE_KEYS = {"potential", "current"}
+
+
+@dataclass(frozen=True)
+class ZohdiStepping:
+    """The implicit scheme of Zohdi 2014: trapezoidal weight ``phi`` (eqs. 22-24; 0 explicit, 1/2 the trapezoid, 1
+    backward), the fixed-point iteration within a step to ``tolerance`` (TOL of eqs. 47-48, for positions and
+    temperatures) in a target of ``iterations`` (K_d) iterations, the exponent ``order`` (p of eq. 30, 2 for this
+    second-order system), the first step ``dt`` and its upper bound ``dt_max`` (Delta t_lim) and, beyond the paper,
+    bounds on the step factor Phi: an accepted step grows by at most ``growth`` (>= 1), a restart shrinks it by at
+    least ``shrink`` (in [LEAST_FACTOR, 1)) and at most :data:`LEAST_FACTOR` -- eq. (30) assumes the error falls as
+    ``(S dt^p)^K``; where an iteration stalls instead (a force that is steep in the velocity, such as friction below
+    ``v_slip``), Phi of a failed step is close to 1 and the restarts would creep -- and a floor ``dt_min`` below
+    which a step that cannot converge stops the run."""
+
+    dt: float
+    dt_max: float
+    phi: float = 0.5
+    iterations: int = 10
+    tolerance: float = 5e-4
+    order: float = 2.0
+    growth: float = 1.25
+    shrink: float = 0.5
+    dt_min: float = 1e-9
+
+    def __post_init__(self):
+        def bad(name, rule):
+            raise ValueError(f"[solver] {name} = {getattr(self, name)!r}: {rule}")
+
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if (not isinstance(value, (int, float, np.floating, np.integer)) or isinstance(value, bool)
+                    or not math.isfinite(value)):
+                bad(f.name, "must be a finite number")
+        if not 0.0 <= self.phi <= 1.0:
+            bad("phi", "must be in [0, 1] (the trapezoidal weight of Zohdi 2014, eq. 22)")
+        if not isinstance(self.iterations, (int, np.integer)) or self.iterations < 2:
+            bad("iterations", "must be an integer >= 2 (K_d, the target number of fixed-point iterations, eq. 30: "
+                "the first iterate's relative change is 1 by construction, so one iteration never meets a tolerance)")
+        if self.tolerance <= 0.0:
+            bad("tolerance", "must be > 0 (TOL of the fixed-point iteration, eqs. 47-48)")
+        if self.order <= 0.0:
+            bad("order", "must be > 0 (p of eq. 30; 2 for a second-order system)")
+        if self.dt <= 0.0:
+            bad("dt", "must be > 0 (s, the first step)")
+        if self.dt_max < self.dt:
+            bad("dt_max", f"must be >= dt = {self.dt!r} s (the upper bound Delta t_lim of the step)")
+        if self.growth < 1.0:
+            bad("growth", "must be >= 1 (the largest factor by which a step may grow)")
+        if not LEAST_FACTOR <= self.shrink < 1.0:
+            bad("shrink", f"must be in [{LEAST_FACTOR}, 1) (a restarted step shrinks at least by this factor)")
+        if not 0.0 < self.dt_min <= self.dt:
+            bad("dt_min", f"must be in (0, dt = {self.dt!r}] s")
+
+    def factor(self, error: float, K: int) -> float:
+        """The step factor Phi_K of eq. (30) / Algorithm 1 (4c) for the relative iteration error ``error`` after
+        ``K`` iterations: ``(TOL/D0)^(1/(p K_d)) / (D_K/D0)^(1/(p K))`` with ``D0 = 1`` (the first iterate's relative
+        change is 1 by construction), clipped to ``[LEAST_FACTOR, growth]``."""
+        if error <= 0.0:
+            return self.growth
+        p = self.order
+        phi = self.tolerance ** (1.0 / (p * self.iterations)) / error ** (1.0 / (p * K))
+        return min(self.growth, max(LEAST_FACTOR, phi))
+
+    def restart_factor(self, phi: float) -> float:
+        """The factor of a restarted step: Phi_K, but at least ``shrink`` and at most :data:`LEAST_FACTOR`."""
+        return max(LEAST_FACTOR, min(phi, self.shrink))
+
+
+STEPPING_KEYS = {f.name for f in fields(ZohdiStepping)}
 
 
 @dataclass(frozen=True)
@@ -129,11 +196,6 @@ def parse_electrical(doc: dict, walls, physics) -> ElectricalSpec | None:
 def strip_electrodes(tables: list) -> list:
     """The ``[[walls]]`` tables without their electrode keys (a wall's motion is parsed from the rest)."""
     return [{k: v for k, v in t.items() if k not in ELECTRODE_KEYS} if isinstance(t, dict) else t for t in tables]
-
-
-def zohdi_material(values: dict) -> ZohdiMaterial:
-    """A :class:`ZohdiMaterial` from the ``[contact]`` values (without ``law``)."""
-    return material_from_table(ZohdiMaterial, "zohdi", values)
 
 
 def refuse_zohdi_keys(doc: dict, physics) -> None:

@@ -15,7 +15,7 @@ Each step from ``t`` to ``t + dt`` iterates, K = 1, 2, ...:
 ``Z_K <= 1``: the step is accepted, the current refreshed at the new configuration (step 6d), and the next step is
 ``min(Phi_K dt, dt_lim)`` (steps 6a-c). ``Z_K > 1`` after ``K_d`` iterations: the step restarts from ``t`` with
 ``Phi_K dt`` (step 7). Beyond the paper: an accepted step grows by at most ``growth``, a restart shrinks it by at
-least ``shrink`` (:class:`dem.laws.contact.zohdi.ZohdiStepping`), a displacement below 1e-12 of the mean radius (a
+least ``shrink`` (:class:`dem.scene.zohdi.ZohdiStepping`), a displacement below 1e-12 of the mean radius (a
 temperature change below 1e-12 of the temperatures) counts as none, and a step below ``dt_min`` that still cannot
 converge stops the run. Steps end exactly on the start of every ``[[phases]]`` entry (a wall changing speed) and on
 ``t_end``.
@@ -51,7 +51,7 @@ class ZohdiSimulation:
         self.stepping = m.stepping
         material = scene.contact
         state = MotionState.create(3, p.position, p.radius, material.density, p.temperature, m.velocity)
-        self.mechanics = ZohdiMechanics(state, m.walls, material.params(), m.gravity, m.skin)
+        self.mechanics = ZohdiMechanics(state, m.walls, material, m.gravity, m.skin)
         self.thermal = LumpedHeat(p, m.walls, scene.conductance) if "thermal" in scene.physics else None
         self.current = None
         if "electrical" in scene.physics:

@@ -20,10 +20,11 @@ import math
 
 import numpy as np
 
+from dem.engines import compiled
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, max_displacement, verlet_pairs, wall_pairs
 from dem.geometry.walls import MOTIONS, WallArrays
-from dem.engines.staggered import kernels
+from dem.laws.contact import law_module
 
 
 class ZohdiMechanics:
@@ -31,14 +32,19 @@ class ZohdiMechanics:
 
     name = "mechanical"
 
-    def __init__(self, state: MotionState, walls, params: np.ndarray, gravity, skin: float):
+    def __init__(self, state: MotionState, walls, material, gravity, skin: float):
+        """``material``: the contact law's material (``material.law`` names the law: one whose particles do not
+        rotate)."""
         self.state = state
         self.walls = tuple(walls)
         for wall in self.walls:
             if wall.motion == "stress":
                 raise ValueError(f"walls.{wall.name}.motion = \"stress\": the Zohdi 2014 scheme moves walls by "
                                  f"prescribed kinematics only (fixed, strain, vibrate)")
-        self.params = np.ascontiguousarray(params, dtype=float)
+        self.law = law_module(material.law)
+        self._forces = compiled.module(material.law, "dem.engines.contact_forces").forces
+        self._iterate = compiled.module(material.law, "dem.engines.staggered.kernels").iterate
+        self.params = np.ascontiguousarray(material.params(), dtype=float)
         self.gravity = np.asarray(gravity, dtype=float)
         self.skin = float(skin)
         self.w = WallArrays.build(self.walls, 3)
@@ -51,7 +57,14 @@ class ZohdiMechanics:
         self.wforce = np.zeros(len(self.walls))
         self.stats = np.zeros(4)
         self.rebuilds = 0
-        self.bonded = np.zeros(0, dtype=np.int8)
+        # the particles do not rotate: no spin, no torque (the force loop's arrays for them stay zero)
+        self._spin, self._torque = np.zeros((n, 3)), np.zeros((n, 3))
+        self.particle_state = self.law.initial_state(material, state.T)
+        n_w = len(self.walls)
+        self.w_hist = np.zeros((n, n_w, len(self.law.WALL_HISTORY)))  # committed at each accepted step
+        self._w_hist_iter = self.w_hist.copy()
+        self.w_fn, self.w_ft = np.zeros((n, n_w)), np.zeros((n, n_w, 3))
+        self.p_hist = np.zeros((0, len(self.law.PAIR_HISTORY)))
         self.pi = self.pj = np.zeros(0, dtype=np.int64)
         self._build_list(state.x)
         self._evaluate(state.x, state.v, state.T, self.f)
@@ -61,13 +74,13 @@ class ZohdiMechanics:
         s = self.state
         i, j = verlet_pairs(x, s.radius, self.skin, np.zeros(3))
         if len(self.pi):
-            (self.bonded,) = carry_history(self.pi, self.pj, i, j, self.bonded)
+            (self.p_hist,) = carry_history(self.pi, self.pj, i, j, self.p_hist)
             self.rebuilds += 1
         else:
-            self.bonded = np.zeros(len(i), dtype=np.int8)
+            self.p_hist = np.zeros((len(i), len(self.law.PAIR_HISTORY)))
         self.pi, self.pj = i, j
-        self.p_fn, self.p_area = np.zeros(len(i)), np.zeros(len(i))
-        self.p_bond = np.zeros(len(i), dtype=np.int8)
+        self.p_fn, self.p_ft = np.zeros(len(i)), np.zeros((len(i), 3))
+        self._p_hist_iter = np.zeros_like(self.p_hist)  # the histories an iterate would leave
         self.x_ref = x.copy()
         self.wk, self.wm = wall_pairs(x, s.radius, self.w.normal, self.w.q, self.skin)
         self.wq_ref = self.w.q.copy()
@@ -77,10 +90,11 @@ class ZohdiMechanics:
 
     def _evaluate(self, x, v, T, out):
         """Forces at ``(x, v, T)`` with the walls where they are now; checks that no particle left the box."""
-        w = self.w
-        escaped = kernels.forces(x, v, T, self.state.mass, self.state.radius, self.gravity, self.pi, self.pj,
-                                 self.bonded, w.normal, w.q, self.wk, self.wm, self.params, out, self.p_fn,
-                                 self.p_area, self.p_bond, self.wforce)
+        w, s = self.w, self.state
+        escaped = self._forces(x, v, self._spin, out, self._torque, (0, 1, 2), s.mass, s.radius, self.particle_state, T,
+                               self.gravity, np.zeros(3), self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn,
+                               self.p_ft, w.normal, w.q, w.dq, self.wforce, self.wk, self.wm, self.w_hist,
+                               self._w_hist_iter, self.w_fn, self.w_ft, self.params, 0.0)
         self._check_escape(escaped, x)
 
     def _check_escape(self, escaped, x):
@@ -119,10 +133,12 @@ class ZohdiMechanics:
         """One fixed-point iteration at the temperatures ``T`` (those of the previous iterate): the new iterate is
         :attr:`x_new`, :attr:`v_new`. Returns ``(sum |r^K - r^(K-1)|, sum |r^K - r^L|)``."""
         s, w = self.state, self.w
-        escaped = kernels.iterate(dt, phi, s.x, s.v, self.f, self.x_prev, self.v_prev, T, s.mass, s.radius,
-                                  self.gravity, self.pi, self.pj, self.bonded, w.normal, w.q, self.wk, self.wm,
-                                  self.params, self._f_iter, self.p_fn, self.p_area, self.p_bond, self.wforce,
-                                  self.x_new, self.v_new, self.x_ref, self.stats)
+        escaped = self._iterate(dt, phi, s.x, s.v, self.f, self.x_prev, self.v_prev, T, s.mass, s.radius,
+                                self.gravity, self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn, self.p_ft,
+                                w.normal, w.q, w.dq, self.wk, self.wm, self.w_hist, self._w_hist_iter, self.w_fn,
+                                self.w_ft, self.params, self._f_iter, self._spin, self._torque, (0, 1, 2),
+                                self.particle_state, np.zeros(3), self.wforce, self.x_new, self.v_new, self.x_ref,
+                                self.stats)
         self._check_escape(escaped, self.x_prev)
         change, motion, reach, finite = self.stats
         if not finite:
@@ -141,13 +157,15 @@ class ZohdiMechanics:
 
     def accept(self, T: np.ndarray) -> None:
         """The latest iterate becomes the state (with the temperatures ``T`` of the step's end); its forces become
-        F^L of the next step and the bonds it activated are kept."""
+        F^L of the next step and the histories it made are kept (Zohdi 2014: the bonds it activated)."""
         s = self.state
         s.x[:] = self.x_prev
         s.v[:] = self.v_prev
         self._evaluate(s.x, s.v, T, self.f)
-        if np.any(self.p_bond != self.bonded):  # bonds activated (or broken) by this step act from the next one on
-            self.bonded[:] = self.p_bond
+        changed = not (np.array_equal(self._p_hist_iter, self.p_hist) and np.array_equal(self._w_hist_iter, self.w_hist))
+        if changed:  # histories changed by this step (bonds activated or broken) act from the next one on
+            self.p_hist[:] = self._p_hist_iter
+            self.w_hist[:] = self._w_hist_iter
             self._evaluate(s.x, s.v, T, self.f)
         self.q_start = self.w.q.copy()
 
@@ -158,11 +176,22 @@ class ZohdiMechanics:
             self._build_list(self.state.x)
 
     # -------------------------------------------------------------------------------------------- outputs
+    def pair_column(self, name: str) -> np.ndarray:
+        """The column ``name`` of the listed pairs' committed history (``law.PAIR_HISTORY``; e.g. ``"bonded"``)."""
+        return self.p_hist[:, self.law.PAIR_HISTORY.index(name)]
+
     def contacts(self):
         """The touching pairs of the state: ``(i, j, normal force (N, > 0 repulsive), contact area (m^2), bonded)``
         (as the forces of the last accepted step saw them)."""
-        closed = self.p_area > 0.0
-        return self.pi[closed], self.pj[closed], self.p_fn[closed], self.p_area[closed], self.p_bond[closed]
+        s = self.state
+        ri, rj = s.radius[self.pi], s.radius[self.pj]
+        d = np.sqrt(np.sum((s.x[self.pi] - s.x[self.pj]) ** 2, axis=1))
+        closed = (d < ri + rj) & (d > 0.0)
+        d, ri, rj = d[closed], ri[closed], rj[closed]
+        li = 0.5 * (d - (rj * rj - ri * ri) / d)
+        area = np.pi * np.maximum(ri * ri - li * li, 0.0)  # the lens of Zohdi 2014, eqs. 7-12
+        bonded = self._p_hist_iter[closed, 0] != 0.0
+        return self.pi[closed], self.pj[closed], self.p_fn[closed], area, bonded
 
     def wall_contacts(self):
         """``(particle, wall)`` of the particle-wall contacts of the state."""

@@ -23,11 +23,12 @@ import math
 
 import numpy as np
 
+from dataclasses import replace
+
 from dem.engines.contact_heat import ContactThermalModel
-from dem.laws.contact.luding import P_EXPANSION, P_T0, P_T_MELT
-from dem.laws.contact.luding_kernels import radius_at
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.motion import MotionState
+from dem.laws.contact import law_module
 from dem.network.heat import boundary_heat_flow, steady
 from fem_neck.geometry import neck_radius
 
@@ -41,18 +42,19 @@ class Simulation:
         self.scene = scene
         m = scene.motion
         p = scene.particles
-        params = scene.contact.params()
+        material = scene.contact
         T_init = p.temperature.astype(float)
-        scale = np.array([radius_at(1.0, float(T), params[P_T_MELT], params[P_EXPANSION]) for T in T_init])
-        state = MotionState.create(m.dimension, p.position, p.radius, scene.contact.density, T_init, m.velocity,
-                                   m.angular_velocity, m.height, radius_ref=p.radius / scale)
+        law = law_module(material.law)
+        state = MotionState.create(m.dimension, p.position, p.radius, material.density, T_init, m.velocity,
+                                   m.angular_velocity, m.height, radius_ref=law.reference_radius(material, p.radius,
+                                                                                                   T_init))
         saved = resume if resume is not None else m.start
         if saved is not None:
             for key in ("x", "v", "w", "f", "tau", "mass", "inertia", "radius", "radius_ref", "T"):
                 setattr(state, key, np.ascontiguousarray(saved[key], dtype=float).copy())
-        self.base_params = params
-        self.mechanics = MechanicalModel(state, m.walls, params, m.dt, m.skin, m.gravity, m.box,
-                                         relaxation_time=float(params[P_T0]), history=saved)
+        self.material = material
+        self.mechanics = MechanicalModel(state, m.walls, material, m.dt, m.skin, m.gravity, m.box,
+                                         relaxation_time=m.relaxation_time, history=saved)
         self.thermal = None
         if "thermal" in scene.physics:
             self.thermal = ContactThermalModel(p, m.walls, scene.conductance, scene.sources, m.thermal_integrator,
@@ -104,12 +106,11 @@ class Simulation:
 
     def _params_at(self, t: float) -> np.ndarray:
         """The material at time ``t``: the scene's, with the overrides of every ``[[phases]]`` entry started."""
-        params = self.base_params.copy()
+        values = {}
         for start, overrides in self.scene.motion.phases:
             if start <= t * (1 + 1e-12) + 1e-300:
-                for k, value in overrides.items():
-                    params[k] = value
-        return params
+                values.update(overrides)
+        return replace(self.material, **values).params()
 
     def _interval_ends(self, n_end: int) -> list[int]:
         """Step indices at which an interval ends: output times, thermal updates, schedule knots, phase starts,
@@ -272,7 +273,8 @@ class Simulation:
         i = mech.contacts()[0]
         row = {"t": mech.t, "step": mech.steps, "kinetic_energy": s.kinetic_energy(),
                "volume_fraction": self.volume_fraction(), "coordination": 2.0 * len(i) / s.n,
-               "k1_factor": float(np.mean(mech.k1f)), "T_mean": float(np.mean(s.T)),
+               **{name: float(np.mean(mech.particle_column(name))) for name in mech.law.PARTICLE_STATE},
+               "T_mean": float(np.mean(s.T)),
                "T_min": float(np.min(s.T)), "T_max": float(np.max(s.T))}
         if self.thermal is not None and self.heated_walls() is not None:
             row["effective_conductivity"] = self.effective_conductivity()
@@ -324,7 +326,8 @@ class Simulation:
         sigma = -sigma
         mean = np.trace(sigma, axis1=1, axis2=2) / s.dimension
         return {"radius": s.radius, "velocity": s.v, "angular_velocity": s.w, "force": s.f, "temperature": s.T,
-                "k1_factor": mech.k1f, "stress": sigma.reshape(-1, 9), "mean_stress": mean}
+                **{name: mech.particle_column(name) for name in mech.law.PARTICLE_STATE},
+                "stress": sigma.reshape(-1, 9), "mean_stress": mean}
 
     def contact_fields(self):
         """``(i, j, fields)`` of the closed pair contacts: normal force (> 0 repulsive), tangential force magnitude,

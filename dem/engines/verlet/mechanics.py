@@ -1,33 +1,28 @@
-"""The mechanical submodel: particles that move under the Luding 2005 sintering contact law, walls and gravity.
+"""The mechanical submodel: particles that move under a contact law (:mod:`dem.laws.contact`), walls and gravity.
 
 It owns the Verlet list and the per-contact history and advances the state with the compiled loop of
-:mod:`dem.engines.verlet.loop`, returning to Python only to rebuild the list (when some particle has moved more than half the
-skin), at the times the engine asks for (output, a thermal update, a change of schedule), or to stop a run that
-went wrong (a non-finite position, a particle through a wall) with a one-line message naming the step and the
-particle.
+:mod:`dem.engines.verlet.loop` (compiled for the law, :mod:`dem.engines.compiled`), returning to Python only to rebuild
+the list (when some particle has moved more than half the skin), at the times the engine asks for (output, a thermal
+update, a change of schedule), or to stop a run that went wrong (a non-finite position, a particle through a wall)
+with a one-line message naming the step and the particle.
 
-History (Luding 2005, Sec. 3): per pair in the list the largest overlap ``delta_max``, the stiffness factor the
-contact saw at its last step (``k1_last``: heating keeps delta_max, cooling keeps delta_0, Fig. 5) and the
-tangential spring ``xi`` (eqs. 16, 20-21); the same per particle-wall pair. A rebuild carries the history of every
-pair that stays listed (:func:`dem.geometry.neighbours.carry_history`); a contact that opens forgets it.
-
-The stiffness factor ``k1(T, t)/k1`` (eqs. 10-12) is a property of each particle's material (the healing of its
-defects): a contact uses the mean of its two particles' factors, which for a uniform temperature is exactly the
-single ``k1(T, t)`` of the paper, and a contact that forms during sintering starts from the state the material has
-reached.
+History: per pair in the list the numbers the law carries (``law.PAIR_HISTORY``; Luding 2005: the largest overlap,
+the stiffness factor the contact saw at its last step and the tangential spring), the same per particle-wall pair
+(``law.WALL_HISTORY``), and per particle the law's state (``law.PARTICLE_STATE``; Luding 2005: the stiffness factor
+``k1(T, t)/k1``). A rebuild carries the history of every pair that stays listed
+(:func:`dem.geometry.neighbours.carry_history`); a contact that opens forgets it.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from dem.engines.verlet import loop as md_loop
-from dem.laws.contact.luding_kernels import k1_factor
+from dem.engines import compiled
+from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
 from dem.geometry.walls import WallArrays
+from dem.laws.contact import law_module
 
 
 class MechanicsError(ValueError):
@@ -35,17 +30,21 @@ class MechanicsError(ValueError):
 
 
 class MechanicalModel:
-    """Velocity-Verlet dynamics with the Luding contact law (module docstring)."""
+    """Velocity-Verlet dynamics with a contact law (module docstring)."""
 
     name = "mechanical"
 
-    def __init__(self, state: MotionState, walls, params: np.ndarray, dt: float, skin: float,
-                 gravity=(0.0, 0.0, 0.0), box=(0.0, 0.0, 0.0), relaxation_time: float = 1e3, history=None):
-        """``history``: a saved state (:func:`dem.scene.state_file.load`) whose stiffness factors and contact histories
-        (pairs, and particle-wall pairs matched by wall name) the model starts from."""
+    def __init__(self, state: MotionState, walls, material, dt: float, skin: float, gravity=(0.0, 0.0, 0.0),
+                 box=(0.0, 0.0, 0.0), relaxation_time: float = 1e3, history=None):
+        """``material``: the contact law's material (``material.law`` names the law); ``history``: a saved state
+        (:func:`dem.scene.state_file.load`) whose particle state and contact histories (pairs, and particle-wall
+        pairs matched by wall name) the model starts from."""
         self.state = state
         self.walls = tuple(walls)
-        self.params = np.ascontiguousarray(params, dtype=float)
+        self.law = law_module(material.law)
+        self._forces = compiled.module(material.law, "dem.engines.contact_forces").forces
+        self._advance = compiled.module(material.law, "dem.engines.verlet.loop").advance
+        self.params = np.ascontiguousarray(material.params(), dtype=float)
         self.dt = float(dt)
         self.skin = float(skin)
         self.gravity = np.asarray(gravity, dtype=float) * state.linear_dof
@@ -53,11 +52,8 @@ class MechanicalModel:
         self.relaxation_time = float(relaxation_time)
         self.w = WallArrays.build(self.walls, state.dimension)
         n, n_w = state.n, len(self.walls)
-        T_melt, T_var = self.params[md_loop.P_T_MELT], self.params[md_loop.P_T_VAR]
-        self.k1f = np.array([k1_factor(float(T), T_melt, T_var) for T in state.T])  # relaxed at the initial T
-        self.w_dmax = np.zeros((n, n_w))
-        self.w_k1last = np.zeros((n, n_w))
-        self.w_xi = np.zeros((n, n_w, 3))
+        self.particle_state = self.law.initial_state(material, state.T)  # relaxed at the initial temperatures
+        self.w_hist = np.zeros((n, n_w, len(self.law.WALL_HISTORY)))
         self.w_fn = np.zeros((n, n_w))
         self.w_ft = np.zeros((n, n_w, 3))
         self.steps = 0
@@ -70,19 +66,21 @@ class MechanicalModel:
             self._initial_forces()
 
     def _restore(self, saved: dict):
-        """Stiffness factors and contact histories from a saved state (the list is rebuilt here, so the pairs'
-        histories are carried by key; walls by name)."""
-        self.k1f = np.array(saved["k1f"], dtype=float)
-        self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft = carry_history(
-            saved["pi"], saved["pj"], self.pi, self.pj, saved["p_dmax"], saved["p_k1last"],
-            saved["p_xi"], np.zeros(len(saved["pi"])), np.zeros((len(saved["pi"]), 3)))
+        """Particle state and contact histories from a saved state (the list is rebuilt here, so the pairs'
+        histories are carried by key; walls by name). A state saved with another contact law gives its particles
+        only: the contacts start afresh."""
+        if saved["contact_law"] != self.law.NAME:
+            self._initial_forces()
+            return
+        self.particle_state = np.array(saved["particle_state"], dtype=float)
+        self.p_hist, self.p_fn, self.p_ft = carry_history(saved["pi"], saved["pj"], self.pi, self.pj,
+                                                          saved["p_hist"], np.zeros(len(saved["pi"])),
+                                                          np.zeros((len(saved["pi"]), 3)))
         names = [w.name for w in self.walls]
         for m_old, name in enumerate(saved["wall_names"]):
             if name in names:
                 m = names.index(name)
-                self.w_dmax[:, m] = saved["w_dmax"][:, m_old]
-                self.w_k1last[:, m] = saved["w_k1last"][:, m_old]
-                self.w_xi[:, m] = saved["w_xi"][:, m_old]
+                self.w_hist[:, m] = saved["w_hist"][:, m_old]
                 if self.walls[m].motion == "stress":
                     self.w.dq[m] = saved["wall_dq"][m_old]
                     self.w.acc[m] = saved["wall_acc"][m_old]
@@ -94,11 +92,9 @@ class MechanicalModel:
         i, j = verlet_pairs(s.x, s.radius, self.skin, self.box, expected)
         if first:
             m = len(i)
-            self.p_dmax, self.p_k1last, self.p_fn = np.zeros(m), np.zeros(m), np.zeros(m)
-            self.p_xi, self.p_ft = np.zeros((m, 3)), np.zeros((m, 3))
+            self.p_hist, self.p_fn, self.p_ft = np.zeros((m, len(self.law.PAIR_HISTORY))), np.zeros(m), np.zeros((m, 3))
         else:
-            self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft = carry_history(
-                self.pi, self.pj, i, j, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft)
+            self.p_hist, self.p_fn, self.p_ft = carry_history(self.pi, self.pj, i, j, self.p_hist, self.p_fn, self.p_ft)
             self.rebuilds += 1
         self.pi, self.pj = i, j
         self.x_ref = s.x.copy()
@@ -112,13 +108,12 @@ class MechanicalModel:
     def _initial_forces(self):
         """Forces of the initial state (dt = 0: no history increment)."""
         s, w = self.state, self.w
-        md_loop._forces(s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, self.k1f, self.gravity,
-                        self.box, self.pi, self.pj, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft,
-                        w.normal, w.q, w.dq, w.force, self.wk, self.wm, self.w_dmax, self.w_k1last, self.w_xi,
-                        self.w_fn, self.w_ft, self.params, 0.0)
+        self._forces(s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, self.particle_state, s.T,
+                     self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_hist, self.p_fn, self.p_ft,
+                     w.normal, w.q, w.dq, w.force, self.wk, self.wm, self.w_hist, self.w_hist, self.w_fn, self.w_ft,
+                     self.params, 0.0)
         for m in range(len(self.walls)):
-            w.acc[m] = md_loop._wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span,
-                                                  w.force)
+            w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
 
     # --------------------------------------------------------------------------------------------- advance
     @property
@@ -135,23 +130,23 @@ class MechanicalModel:
         first = self.steps
         done = 0
         while done < n_steps:
-            steps, status = md_loop.advance(
+            steps, status = self._advance(
                 n_steps - done, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia,
-                s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.k1f,
-                uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_dmax, self.p_k1last, self.p_xi,
-                self.p_fn, self.p_ft, w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0,
-                w.amplitude, w.frequency, w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_dmax,
-                self.w_k1last, self.w_xi, self.w_fn, self.w_ft, self.params, self.x_ref, self.skin, self._info)
+                s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.particle_state,
+                uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_fn, self.p_ft,
+                w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
+                w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_hist, self.w_fn, self.w_ft, self.params,
+                self.x_ref, self.skin, self._info)
             done += steps
             self.steps += steps
-            if status == md_loop.REBUILD:
+            if status == REBUILD:
                 self._build_list()
-            elif status == md_loop.NONFINITE:
+            elif status == NONFINITE:
                 k = int(self._info[0])
                 raise MechanicsError(f"the run stopped at step {self.steps} (t = {self.t:.6g} s): particle {k} has a "
                                      f"non-finite position or velocity; the step dt = {self.dt:.6g} s is too large "
                                      f"or a parameter is extreme")
-            elif status == md_loop.ESCAPED:
+            elif status == ESCAPED:
                 k, m = int(self._info[0]), int(self._info[1])
                 raise MechanicsError(f"the run stopped at step {self.steps} (t = {self.t:.6g} s): particle {k} "
                                      f"(centre {s.x[k].tolist()}) left the box through wall "
@@ -176,6 +171,15 @@ class MechanicalModel:
         overlap = s.radius[:, None] - dist
         k, m = np.nonzero(overlap > 0)
         return k, m, overlap[k, m], self.w_fn[k, m]
+
+    def particle_column(self, name: str) -> np.ndarray:
+        """The column ``name`` of the contact law's particle state (``law.PARTICLE_STATE``; e.g. the stiffness factor
+        ``"k1_factor"`` of Luding 2005), a view."""
+        return self.particle_state[:, self.law.PARTICLE_STATE.index(name)]
+
+    def pair_column(self, name: str) -> np.ndarray:
+        """The column ``name`` of the listed pairs' history (``law.PAIR_HISTORY``; e.g. ``"delta_max"``), a view."""
+        return self.p_hist[:, self.law.PAIR_HISTORY.index(name)]
 
     def coordination(self) -> float:
         """Mean number of particle contacts per particle, ``2 M / N``."""

@@ -1,2 +1,47 @@
-"""Contact laws of particles that move: each a material (its parameters, checked) and the compiled kernels of the
-force between two particles and between a particle and a wall."""
+"""Contact laws of particles that move, as plug-ins: each law is one module, registered by one line of
+:data:`CONTACT_LAWS`, and the engines' compiled loops take its kernels in at compile time
+(:mod:`dem.engines.compiled`).
+
+A contact law module defines (SI units; forces on particle i, the unit normal ``n`` from j to i, 3-vectors as
+3-tuples; the compiled kernels ``numba.njit`` with ``inline="always"``):
+
+* ``NAME``; ``Material``, a frozen dataclass of its parameters with ``params()`` (a float64 array; ``N_PARAMS``
+  entries) and a ``density``; ``PAIR_HISTORY``, ``WALL_HISTORY`` (the names of the numbers each pair and each
+  particle-wall contact carries from step to step) and ``PARTICLE_STATE`` (those each particle carries); ``SPINS``
+  (its tangential forces make torques) and ``DRAG`` (it has a drag on every particle);
+* ``initial_state(material, T)`` -- the particles' state columns at their initial temperatures, (N, S);
+  ``reference_radius(material, radius, T)`` -- the radii the law's thermal expansion starts from;
+  ``time_steps(material, mass, inertia, radius, m_mean)`` -- ``(dt, stable)``: the step ``dt = "auto"`` takes and the
+  largest a velocity-Verlet step may take;
+* ``pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params) -> (f_n, f_t0,
+  f_t1, f_t2)`` -- the force on i of pair ``c`` at overlap ``delta`` (centre distance ``d``) with relative surface velocity ``vr`` (normal part
+  ``vn``), reading the pair's history from row ``c`` of ``hist_in`` and writing it to row ``c`` of ``hist``;
+  ``forget_pair(c, hist_in, hist)`` -- the pair opened (returns whether it had a history); ``reach(c, hist, ri, rj,
+  params)`` -- how far beyond touching the pair still acts (0 for a law without forces at a distance);
+* ``wall_force(k, m, hist_in, hist, state, T, delta, dist, n, vr, vn, rk, dt, params)`` and ``forget_wall(k, m, hist_in,
+  hist)`` -- the same for particle k on wall m (histories indexed ``[k, m]``);
+* ``update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt)`` -- before the
+  forces of every step: the temperatures ``T0 + T_rate elapsed`` and what the law makes of them (radii, state);
+  ``drag(k, radius, params)`` -- the drag coefficient of particle k (kg/s) where ``DRAG``.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+CONTACT_LAWS = {
+    "luding": "dem.laws.contact.luding",  # Luding, Manetsberger & Mueller 2005: sintering, hysteretic normal law
+    "zohdi": "dem.laws.contact.zohdi",  # Zohdi 2014: power law on the contact area, bonds, thermal softening
+}
+
+
+def law_module_name(name) -> str:
+    """The module of the contact law ``name``; ``ValueError`` naming the laws for an unknown one."""
+    if not isinstance(name, str) or name not in CONTACT_LAWS:
+        raise ValueError(f"[contact] law = {name!r}: must be one of {', '.join(CONTACT_LAWS)}")
+    return CONTACT_LAWS[name]
+
+
+def law_module(name):
+    """The contact law ``name`` (:data:`CONTACT_LAWS`), imported."""
+    return importlib.import_module(law_module_name(name))

@@ -2,8 +2,30 @@
 22-30, 45-49).
 
 :class:`ZohdiMaterial` holds the material in SI units, named by the paper's symbols; :meth:`ZohdiMaterial.params`
-packs it into the float64 array the compiled kernels take (indices ``Z_*``). :class:`ZohdiStepping` holds the
-parameters of the adaptive trapezoidal fixed-point scheme. No compiler is needed here.
+packs it into the float64 array the compiled kernels take (indices ``Z_*``); the plug-in kernels at the end give the
+engines' loops its forces (:mod:`dem.laws.contact`). The adaptive trapezoidal fixed-point scheme the paper steps it with
+is the staggered engine's (:mod:`dem.engines.staggered`, its parameters :class:`dem.scene.zohdi.ZohdiStepping`).
+
+Conventions (Zohdi 2014, eqs. 3-4): ``n_ij = (r_j - r_i)/|r_j - r_i|`` points from i to j (the engines' ``n`` is the
+opposite, from j to i); the strain ``E_ij = (|r_i - r_j| - (R_i + R_j))/(R_i + R_j)`` is negative in contact; the
+contact force on i is ``-K_p |E|^p_p A_ij n_ij`` (it pushes i away from j), the bond force ``+K_b |E|^p_b A_ij n_ij``
+pulls it back. The particles do not rotate (Sec. 2: "the effects of their rotation ... unimportant").
+
+A wall is the plane ``n_w . x = q_w`` (normal into the packing); its contact force on particle k is ``K_w E^p_w A_k
+n_w`` with ``E = (R_k - dist)/R_k`` (eq. 14: the overlap over the radius, as a pair's strain is its overlap over R_i +
+R_j) and ``A_k = pi (R_k^2 - dist^2)`` the circle the plane cuts from the sphere (the lens of eqs. 7-12 with the plane
+for the second particle).
+
+Friction (eqs. 5-6): ``mu_d |F_con| t`` with ``t = (v_j - v_i)/|v_j - v_i|`` the whole relative velocity, as the
+paper writes it (so friction also opposes the approach of two particles, which is what makes their collisions
+inelastic: the law has no normal damping). At a wall only the tangential velocity counts (eq. 17). The direction is
+regularised, ``t = dv / sqrt(|dv|^2 + v_slip^2)``: a unit vector while sliding faster than ``v_slip``, proportional
+to the slip below it, so that the fixed-point map stays continuous where the relative velocity passes through zero.
+
+Bonds (eqs. 18-19): a pair whose strain reaches ``E*`` is bonded from the next step on (the flag is the pair's
+history, committed when a step is accepted) and stays bonded while it touches. Within a step the flags are fixed: a
+bond switched on between two iterates makes the force jump by ``K_b E*^p_b A``, and the fixed-point iteration then
+stalls at the size of that jump instead of converging.
 
 Units (Sec. 7 states them: "K_po = 10^7 N/m^2"): the contact force ``K_p |E|^p_p A_c`` is in newtons with the
 contact area ``A_c`` in m^2 and the strain ``E`` dimensionless, so ``K_p``, ``K_w`` and ``K_b`` are in N/m^2 (Pa).
@@ -17,6 +39,7 @@ import math
 from dataclasses import dataclass, fields
 
 import numpy as np
+from numba import njit
 
 from dem.laws.fields import check_fields
 
@@ -35,8 +58,7 @@ Z_MU = 10          # mu_d, dynamic friction, particles and walls (eqs. 5, 16)
 Z_C_ENV = 11       # c_env^o: drag c_env = c_env^o 6 pi R (kg/(m s), eq. 20 and Sec. 7)
 Z_V_SLIP = 12      # regularisation speed of the friction direction (m/s)
 Z_DENSITY = 13     # particle density (kg/m^3)
-N_ZPARAMS = 14
-LEAST_FACTOR = 0.05  # the step factor Phi never goes below this (one restart shrinks the step at most 20 x)
+N_PARAMS = 14
 
 _POSITIVE = {"K_p": "N/m^2", "p_p": "", "K_w": "N/m^2", "p_w": "", "theta_star": "K", "p_b": "", "v_slip": "m/s",
              "density": "kg/m^3"}
@@ -82,7 +104,7 @@ class ZohdiMaterial:
 
     def params(self) -> np.ndarray:
         """The material as the float64 array the kernels take (indices ``Z_*`` of this module)."""
-        out = np.empty(N_ZPARAMS)
+        out = np.empty(N_PARAMS)
         out[Z_KP], out[Z_PP], out[Z_KP_LIM] = self.K_p, self.p_p, self.K_p_lim
         out[Z_KW], out[Z_PW], out[Z_KW_LIM] = self.K_w, self.p_w, self.K_w_lim
         out[Z_THETA_STAR], out[Z_KB], out[Z_PB], out[Z_E_STAR] = self.theta_star, self.K_b, self.p_b, self.E_star
@@ -95,67 +117,115 @@ class ZohdiMaterial:
         return np.maximum(k0 * (1.0 - np.asarray(theta, dtype=float) / self.theta_star), floor)
 
 
-@dataclass(frozen=True)
-class ZohdiStepping:
-    """The implicit scheme of Zohdi 2014: trapezoidal weight ``phi`` (eqs. 22-24; 0 explicit, 1/2 the trapezoid, 1
-    backward), the fixed-point iteration within a step to ``tolerance`` (TOL of eqs. 47-48, for positions and
-    temperatures) in a target of ``iterations`` (K_d) iterations, the exponent ``order`` (p of eq. 30, 2 for this
-    second-order system), the first step ``dt`` and its upper bound ``dt_max`` (Delta t_lim) and, beyond the paper,
-    bounds on the step factor Phi: an accepted step grows by at most ``growth`` (>= 1), a restart shrinks it by at
-    least ``shrink`` (in [LEAST_FACTOR, 1)) and at most :data:`LEAST_FACTOR` -- eq. (30) assumes the error falls as
-    ``(S dt^p)^K``; where an iteration stalls instead (a force that is steep in the velocity, such as friction below
-    ``v_slip``), Phi of a failed step is close to 1 and the restarts would creep -- and a floor ``dt_min`` below
-    which a step that cannot converge stops the run."""
+# ------------------------------------------------------------------------------------------ the plug-in
+# What the engines' compiled loops call (:mod:`dem.laws.contact` lists the names every contact law defines).
+NAME = "zohdi"
+Material = ZohdiMaterial
+PAIR_HISTORY = ("bonded",)  # 1: the bond of eq. 19 acts (activated by an accepted step that reached E*)
+WALL_HISTORY = ()
+PARTICLE_STATE = ()
+SPINS = False  # the particles do not rotate (Sec. 2)
+DRAG = True  # eq. 20
+JIT = {"cache": True, "error_model": "numpy"}
+IN_LOOP = {**JIT, "inline": "always"}
 
-    dt: float
-    dt_max: float
-    phi: float = 0.5
-    iterations: int = 10
-    tolerance: float = 5e-4
-    order: float = 2.0
-    growth: float = 1.25
-    shrink: float = 0.5
-    dt_min: float = 1e-9
 
-    def __post_init__(self):
-        def bad(name, rule):
-            raise ValueError(f"[solver] {name} = {getattr(self, name)!r}: {rule}")
+def initial_state(material: ZohdiMaterial, T: np.ndarray) -> np.ndarray:
+    """No state per particle: the temperatures themselves soften the contacts."""
+    return np.zeros((len(T), 0))
 
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if (not isinstance(value, (int, float, np.floating, np.integer)) or isinstance(value, bool)
-                    or not math.isfinite(value)):
-                bad(f.name, "must be a finite number")
-        if not 0.0 <= self.phi <= 1.0:
-            bad("phi", "must be in [0, 1] (the trapezoidal weight of Zohdi 2014, eq. 22)")
-        if not isinstance(self.iterations, (int, np.integer)) or self.iterations < 2:
-            bad("iterations", "must be an integer >= 2 (K_d, the target number of fixed-point iterations, eq. 30: "
-                "the first iterate's relative change is 1 by construction, so one iteration never meets a tolerance)")
-        if self.tolerance <= 0.0:
-            bad("tolerance", "must be > 0 (TOL of the fixed-point iteration, eqs. 47-48)")
-        if self.order <= 0.0:
-            bad("order", "must be > 0 (p of eq. 30; 2 for a second-order system)")
-        if self.dt <= 0.0:
-            bad("dt", "must be > 0 (s, the first step)")
-        if self.dt_max < self.dt:
-            bad("dt_max", f"must be >= dt = {self.dt!r} s (the upper bound Delta t_lim of the step)")
-        if self.growth < 1.0:
-            bad("growth", "must be >= 1 (the largest factor by which a step may grow)")
-        if not LEAST_FACTOR <= self.shrink < 1.0:
-            bad("shrink", f"must be in [{LEAST_FACTOR}, 1) (a restarted step shrinks at least by this factor)")
-        if not 0.0 < self.dt_min <= self.dt:
-            bad("dt_min", f"must be in (0, dt = {self.dt!r}] s")
 
-    def factor(self, error: float, K: int) -> float:
-        """The step factor Phi_K of eq. (30) / Algorithm 1 (4c) for the relative iteration error ``error`` after
-        ``K`` iterations: ``(TOL/D0)^(1/(p K_d)) / (D_K/D0)^(1/(p K))`` with ``D0 = 1`` (the first iterate's relative
-        change is 1 by construction), clipped to ``[LEAST_FACTOR, growth]``."""
-        if error <= 0.0:
-            return self.growth
-        p = self.order
-        phi = self.tolerance ** (1.0 / (p * self.iterations)) / error ** (1.0 / (p * K))
-        return min(self.growth, max(LEAST_FACTOR, phi))
+def reference_radius(material: ZohdiMaterial, radius: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """The radii do not change with temperature."""
+    return np.array(radius, dtype=float)
 
-    def restart_factor(self, phi: float) -> float:
-        """The factor of a restarted step: Phi_K, but at least ``shrink`` and at most :data:`LEAST_FACTOR`."""
-        return max(LEAST_FACTOR, min(phi, self.shrink))
+
+def time_steps(material: ZohdiMaterial, mass, inertia, radius, m_mean: float):
+    """The law is stepped by the implicit scheme of the paper (:mod:`dem.engines.staggered`), not by velocity
+    Verlet."""
+    raise ValueError("[contact] law = \"zohdi\": runs on the staggered implicit scheme of Zohdi 2014 (its [solver] "
+                     "keys dt, dt_max, phi, iterations, tolerance), not on velocity-Verlet steps")
+
+
+@njit(**JIT)
+def softened(k0, k_lim, theta, theta_star):
+    """``max(K_0 (1 - theta/theta*), K_lim)`` (Zohdi 2014, Sec. 7)."""
+    return max(k0 * (1.0 - theta / theta_star), k_lim)
+
+
+@njit(**JIT)
+def lens_area(ri, rj, d):
+    """``pi a^2 = pi (R_i^2 - L_i^2)``, ``L_i = (d - (R_j^2 - R_i^2)/d)/2`` (Zohdi 2014, eqs. 7-12); 0 apart."""
+    if d >= ri + rj or d <= 0.0:
+        return 0.0
+    li = 0.5 * (d - (rj * rj - ri * ri) / d)
+    return math.pi * max(ri * ri - li * li, 0.0)
+
+
+@njit(**IN_LOOP)
+def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params):
+    """Force on particle i of the pair ``c`` = (i, j) at centre distance ``d``: the contact force on the lens area
+    (eqs. 2-12) softened by the pair's mean temperature (Sec. 7), less the bond's pull where the pair is bonded
+    (eq. 19, ``hist_in[c, 0]``), and the friction ``mu_d |F_con|`` against the relative velocity ``-vr`` (eqs. 5-6,
+    regularised). The bond flag written to ``hist[c, 0]`` is set once the strain reaches ``E*`` (eq. 18)."""
+    area = lens_area(ri, rj, d)
+    if area == 0.0:
+        hist[c, 0] = 0.0
+        return 0.0, 0.0, 0.0, 0.0
+    strain = delta / (ri + rj)  # |E_ij| (eq. 3)
+    stiffness = softened(params[Z_KP], params[Z_KP_LIM], 0.5 * (T[i] + T[j]), params[Z_THETA_STAR])
+    f_con = stiffness * strain ** params[Z_PP] * area  # eq. 2
+    bond = hist_in[c, 0] != 0.0  # eq. 19, activated by an earlier accepted step (eq. 18)
+    f_n = f_con - (params[Z_KB] * strain ** params[Z_PB] * area if bond else 0.0)
+    u0, u1, u2 = -vr[0], -vr[1], -vr[2]  # v_j - v_i (eq. 6)
+    scale = params[Z_MU] * f_con / math.sqrt(u0 * u0 + u1 * u1 + u2 * u2 + params[Z_V_SLIP] ** 2)
+    hist[c, 0] = 1.0 if bond or strain >= params[Z_E_STAR] else 0.0
+    return f_n, scale * u0, scale * u1, scale * u2
+
+
+@njit(**IN_LOOP)
+def forget_pair(c, hist_in, hist):
+    """A pair that separated forgets its bond."""
+    had = hist_in[c, 0] != 0.0
+    hist[c, 0] = 0.0
+    return had
+
+
+@njit(**IN_LOOP)
+def wall_force(k, m, hist_in, hist, state, T, delta, dist, n, vr, vn, rk, dt, params):
+    """Force on particle k from wall m at the distance ``dist`` of its centre: the wall law on the circle the plane
+    cuts from the sphere (eqs. 13-15), softened by the particle's temperature, and the friction against the
+    tangential velocity (eqs. 16-17)."""
+    strain = delta / rk  # eq. 14
+    stiffness = softened(params[Z_KW], params[Z_KW_LIM], T[k], params[Z_THETA_STAR])
+    f_con = stiffness * strain ** params[Z_PW] * math.pi * max(rk * rk - dist * dist, 0.0)  # eq. 13
+    n0, n1, n2 = n
+    t0, t1, t2 = vr[0] - vn * n0, vr[1] - vn * n1, vr[2] - vn * n2  # the wall slides along none of these
+    scale = params[Z_MU] * f_con / math.sqrt(t0 * t0 + t1 * t1 + t2 * t2 + params[Z_V_SLIP] ** 2)  # eqs. 16-17
+    return f_con, -scale * t0, -scale * t1, -scale * t2
+
+
+@njit(**IN_LOOP)
+def forget_wall(k, m, hist_in, hist):
+    """Wall contacts carry nothing."""
+    return False
+
+
+@njit(**IN_LOOP)
+def reach(c, hist, ri, rj, params):
+    """The law acts on touching pairs only."""
+    return 0.0
+
+
+@njit(**JIT)
+def update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt):
+    """The temperatures ``T0 + T_rate elapsed``; the radii do not change."""
+    n = T.shape[0]
+    for k in range(n):
+        T[k] = T0[0] + T_rate[0] * elapsed if uniform else T0[k] + T_rate[k] * elapsed
+
+
+@njit(**IN_LOOP)
+def drag(k, radius, params):
+    """``c_env = c_env^o 6 pi R`` (eq. 20 with Sec. 7's drag on a sphere), kg/s."""
+    return params[Z_C_ENV] * 6.0 * math.pi * radius[k]

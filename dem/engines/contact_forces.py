@@ -1,0 +1,152 @@
+"""The forces and torques on particles that touch each other and plane walls, for any contact law: the one force
+loop of every engine that moves particles.
+
+The loop does the geometry and the bookkeeping; the contact law (:mod:`dem.laws.contact`) does the physics through its
+kernels, bound at compile time: this module is written against the law imported as ``law`` below, and
+:mod:`dem.engines.compiled` makes a copy of it for every other law, with only that import changed, so that numba
+inlines each law's kernels into a loop of its own (no dispatch at run time) and caches it like any other module.
+
+Contact geometry (Luding 2005, eqs. 3, 17-18): ``n`` points from j to i, the overlap is ``delta = a_i + a_j -
+|x_i - x_j|``, the relative surface velocity ``v_ij = v_i - v_j + l_i n x omega_i + l_j n x omega_j``; the force on
+i is ``f_n n + f_t`` and the torque ``-l_i n x f_t``. The lever arms reach the middle of the overlap, ``l = a -
+delta/2`` (as LAMMPS does), rather than the paper's ``a``: then ``l_i + l_j = |x_i - x_j|`` and a contact conserves
+angular momentum exactly (with ``a`` it would create ``-delta n x f_t``; the difference is of order delta/a). A
+wall is the partner j with an infinite radius, moving along its normal. A pair acts while its surfaces are closer
+than the law's ``reach`` (0: while they overlap); the laws whose particles do not rotate (``law.SPINS`` false) get
+no torques.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+from numba.np.unsafe.ndarray import to_fixed_tuple
+
+from dem.geometry.neighbours import min_image
+from dem.laws.contact import luding as law
+
+# The force loop's floating-point flags: no NaN, no infinity (positions are checked finite before forces are
+# computed), no signed zeros. They let the compiler drop products with a zero it knows (the y terms of 2D disks),
+# and change no result: without reassociation, contraction or approximate reciprocals every operation on finite
+# numbers stays the IEEE one.
+FINITE_MATH = {"nnan", "ninf", "nsz"}
+N_PARAMS = law.N_PARAMS
+
+
+@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH)
+def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft,
+           wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True):
+    """Forces and torques of the current state (gravity, the law's drag, pairs, the listed particle-wall pairs
+    ``(wk, wm)``); the normal forces on the walls go into ``wforce``. Returns the index into the wall list of the
+    first particle whose centre lies behind its wall, else -1.
+
+    Each contact's history is read from ``p_hist_in``/``w_hist_in`` and written to ``p_hist``/``w_hist``: the same
+    arrays for a step that is taken (velocity Verlet), others for an iterate that may be discarded (the implicit
+    scheme). With ``record`` the contact forces are kept (``p_fn``, ``p_ft``, ``w_fn``, ``w_ft``: outputs only, so
+    a time loop records them on the last step of a call). ``spin_axes`` (:attr:`dem.geometry.motion.MotionState.spin_axes`):
+    ``(1,)`` for 2D disks in the x-z plane, whose pair terms along y vanish.
+
+    The law's kernels are inlined right here, scalars and 3-tuples in and out, with the material as a tuple: an
+    array argument costs an atomic reference count per call (a quarter of the loop). The length of ``spin_axes`` is
+    part of its type, so 2D and 3D get code of their own, the 2D one without the terms that vanish (a fifth
+    faster)."""
+    planar = len(spin_axes) == 1
+    escaped = -1
+    n = x.shape[0]
+    params = to_fixed_tuple(params, N_PARAMS)
+    for k in range(n):
+        if law.DRAG:
+            drag = law.drag(k, radius, params)
+            f[k, 0] = mass[k] * gravity[0] - drag * v[k, 0]
+            f[k, 1] = mass[k] * gravity[1] - drag * v[k, 1]
+            f[k, 2] = mass[k] * gravity[2] - drag * v[k, 2]
+        else:
+            f[k, 0] = mass[k] * gravity[0]
+            f[k, 1] = mass[k] * gravity[1]
+            f[k, 2] = mass[k] * gravity[2]
+        tau[k, 0] = 0.0
+        tau[k, 1] = 0.0
+        tau[k, 2] = 0.0
+    for c in range(pi.shape[0]):
+        i, j = pi[c], pj[c]
+        dx = min_image(x[i, 0] - x[j, 0], box[0])
+        dy = 0.0 if planar else min_image(x[i, 1] - x[j, 1], box[1])
+        dz = min_image(x[i, 2] - x[j, 2], box[2])
+        ri, rj = radius[i], radius[j]
+        d2 = dx * dx + dy * dy + dz * dz
+        cut = ri + rj + law.reach(c, p_hist_in, ri, rj, params)
+        if d2 >= cut * cut or d2 == 0.0:
+            law.forget_pair(c, p_hist_in, p_hist)  # the contact opened: it forgets its history
+            if record:
+                p_fn[c] = 0.0
+                p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = 0.0, 0.0, 0.0
+            continue
+        d = math.sqrt(d2)
+        n0, n1, n2 = dx / d, dy / d, dz / d
+        delta = ri + rj - d
+        li, lj = ri - 0.5 * delta, rj - 0.5 * delta  # lever arms to the middle of the overlap: li + lj = d
+        # v_ij = v_i - v_j + l_i n x w_i + l_j n x w_j  (Luding 2005, eq. 18)
+        c0 = 0.0 if planar else li * w[i, 0] + lj * w[j, 0]
+        c1 = li * w[i, 1] + lj * w[j, 1]
+        c2 = 0.0 if planar else li * w[i, 2] + lj * w[j, 2]
+        vr0 = v[i, 0] - v[j, 0] + n1 * c2 - n2 * c1
+        vr1 = 0.0 if planar else v[i, 1] - v[j, 1] + n2 * c0 - n0 * c2
+        vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
+        vn = vr0 * n0 + vr1 * n1 + vr2 * n2
+        f_n, ft0, ft1, ft2 = law.pair_force(c, i, j, p_hist_in, p_hist, state, T, delta, d, (n0, n1, n2),
+                                            (vr0, vr1, vr2), vn, ri, rj, planar, dt, params)
+        if record:
+            p_fn[c] = f_n
+            p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
+        g0, g1, g2 = f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2
+        f[i, 0] += g0
+        f[i, 1] += g1
+        f[i, 2] += g2
+        f[j, 0] -= g0
+        f[j, 1] -= g1
+        f[j, 2] -= g2
+        if law.SPINS:
+            # torques -l n x f_t on both (the lever arms -l_i n and +l_j n, the forces f_t and -f_t)
+            m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
+            tau[i, 1] -= li * m1
+            tau[j, 1] -= lj * m1
+            if not planar:
+                tau[i, 0] -= li * m0
+                tau[i, 2] -= li * m2
+                tau[j, 0] -= lj * m0
+                tau[j, 2] -= lj * m2
+    n_w = wn.shape[0]
+    for m in range(n_w):
+        wforce[m] = 0.0
+    for e in range(wk.shape[0]):
+        k, m = wk[e], wm[e]
+        rk = radius[k]
+        n0, n1, n2 = wn[m, 0], wn[m, 1], wn[m, 2]
+        dist = n0 * x[k, 0] + n1 * x[k, 1] + n2 * x[k, 2] - wq[m]
+        if dist < 0.0 and escaped < 0:
+            escaped = e
+        delta = rk - dist
+        if delta <= 0.0:
+            if law.forget_wall(k, m, w_hist_in, w_hist):  # (rare: a wall contact opening)
+                w_fn[k, m] = 0.0
+                w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = 0.0, 0.0, 0.0
+            continue
+        lk = rk - 0.5 * delta
+        vr0 = v[k, 0] - wdq[m] * n0 + lk * (n1 * w[k, 2] - n2 * w[k, 1])
+        vr1 = v[k, 1] - wdq[m] * n1 + lk * (n2 * w[k, 0] - n0 * w[k, 2])
+        vr2 = v[k, 2] - wdq[m] * n2 + lk * (n0 * w[k, 1] - n1 * w[k, 0])
+        vn = vr0 * n0 + vr1 * n1 + vr2 * n2
+        f_n, ft0, ft1, ft2 = law.wall_force(k, m, w_hist_in, w_hist, state, T, delta, dist, (n0, n1, n2),
+                                            (vr0, vr1, vr2), vn, rk, dt, params)
+        w_fn[k, m] = f_n
+        w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = ft0, ft1, ft2
+        f[k, 0] += f_n * n0 + ft0
+        f[k, 1] += f_n * n1 + ft1
+        f[k, 2] += f_n * n2 + ft2
+        if law.SPINS:
+            tau[k, 0] -= lk * (n1 * ft2 - n2 * ft1)
+            tau[k, 1] -= lk * (n2 * ft0 - n0 * ft2)
+            tau[k, 2] -= lk * (n0 * ft1 - n1 * ft0)
+        wforce[m] += f_n
+    return escaped
