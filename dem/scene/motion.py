@@ -71,7 +71,7 @@ class MotionSpec:
     stepping: object = None   # law = "zohdi": its implicit stepping (dem.scene.zohdi.ZohdiStepping)
     control: int | None = None  # law = "zohdi": the axis the powder bed stands and is pressed along
     frames: int = 0           # law = "zohdi": rendered frames (PNG) over the run
-    relaxation_time: float = 1e3  # law = "luding": t0 of k1(T, t) (eqs. 11-12) when no schedule gives one
+    relaxation_time: float = 0.0  # a law with a relaxing material (Luding 2005: t0 of k1(T, t), eqs. 11-12)
 
 
 def _num(table, section, key, default=None, positive=False, nonnegative=False):
@@ -151,6 +151,7 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
         return zscene.zohdi_motion(doc, particles, solver, physics, start, walls, gravity, velocity,
                                    tuple(p[:2] for p in phases), wall_phases, dimension)
     zscene.refuse_zohdi_keys(doc, physics)
+    relaxation_time = float(getattr(contact, "t0", 0.0))  # the material's relaxation time, where its law has one
     schedule = None
     if "temperature" in doc:
         t = doc["temperature"]
@@ -160,7 +161,7 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
         for key in ("time", "value"):
             if key not in t:
                 raise ValueError(f"[temperature] {key}: required")
-        schedule = TemperatureSchedule.build(t["time"], t["value"], t.get("relaxation_time", contact.t0))
+        schedule = TemperatureSchedule.build(t["time"], t["value"], t.get("relaxation_time", relaxation_time))
     density = np.array([m.density for m in particles.materials])[particles.material]
     mass = particle_mass(dimension, density, particles.radius, height)
     t_md, stable = time_steps(contact, mass, moment_of_inertia(dimension, mass, particles.radius), particles.radius,
@@ -186,7 +187,7 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
     return MotionSpec(dimension, height, velocity, angular, walls, gravity, schedule, dt, stable, skin,
                       thermal_interval, solver.integrator, output_interval, vtu_interval,
                       phases=tuple(p[:2] for p in phases if p[1]), start=start, wall_phases=wall_phases,
-                      relaxation_time=contact.t0)
+                      relaxation_time=relaxation_time)
 
 
 def _phase(k: int, table: dict) -> tuple:
