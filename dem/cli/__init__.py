@@ -4,6 +4,7 @@
     python -m dem scenes [--json]
     python -m dem laws [--json]                      the conductance laws a scene can select
     python -m dem contact SCENE --history FILE.csv [--no-damping] [--out DIR] [--json]
+    python -m dem convert IN OUT [--format F] [--length-unit U] [--json]   a packing, state or scene for LAMMPS, CSV, VTU
 
 Each sub-command is a module of this package exposing ``register(subparsers)``; the plumbing is that of
 :mod:`fem_neck.cli` (one JSON object with ``--json``; bad input: one line on stderr, exit code 2).
@@ -11,7 +12,7 @@ Each sub-command is a module of this package exposing ``register(subparsers)``; 
 
 from fem_neck.cli import main as _main
 
-COMMANDS = ("run", "scenes", "contact", "laws")
+COMMANDS = ("run", "scenes", "contact", "laws", "convert")
 
 
 def main(argv=None) -> int:
