@@ -205,46 +205,102 @@ def _checked(p: Packing, path, fmt: str) -> Packing:
     return replace(p, source=str(path), format=fmt)
 
 
-def _floats(path, texts, lines, column: int, name: str) -> np.ndarray:
-    """The strings ``texts`` (from the file's lines ``lines``, one per entry) as finite floats; a bad entry raises
-    :class:`FileError` naming its line and ``column``."""
+# A table of numbers is parsed at C speed (np.loadtxt); only a table that fails is read again, line by line, to name
+# the line and column of the first bad entry.
+def _table(path, text: str, first_line: int, names, widths, what: str, delimiter=None, usecols=None) -> np.ndarray:
+    """The numbers of ``text`` -- rows of ``delimiter``-separated entries (whitespace by default; blank lines and
+    ``#`` comments skipped) that start on the file's line ``first_line`` -- as an array (rows, columns): every row
+    has the same number of entries, one of ``widths`` (``what`` says which in an error); ``usecols``: only these
+    columns are converted (the others may hold words). ``names`` name the columns in errors."""
+    if not text.strip():
+        return np.empty((0, len(usecols) if usecols is not None else widths[0]))
     try:
-        values = np.array(texts, dtype=float)
+        arr = np.loadtxt(io.StringIO(text), dtype=float, comments="#", delimiter=delimiter, ndmin=2, usecols=usecols,
+                         quotechar='"' if delimiter else None)
     except ValueError:
-        values = None
-    if values is None or not np.all(np.isfinite(values)):
-        for k, text in enumerate(texts):
+        arr = None
+    if arr is None or (usecols is None and arr.shape[1] not in widths) or not np.all(np.isfinite(arr)):
+        _locate(path, text, first_line, names, widths, what, delimiter, usecols)
+        raise FileError(path, "cannot be read as a table of numbers", first_line)  # _locate found nothing: unlikely
+    return arr
+
+
+def _data_lines(text: str, first_line: int):
+    """``(file line, entries text)`` of the lines of ``text`` that hold entries (not blank, not a comment)."""
+    for k, line in enumerate(text.split("\n")):
+        body = line.split("#")[0]
+        if body.strip():
+            yield first_line + k, body
+
+
+def _locate(path, text, first_line, names, widths, what, delimiter, usecols) -> None:
+    """Raise :class:`FileError` at the first row of ``text`` with a number of entries not in ``widths`` (or unlike
+    the first row's), or an entry (of ``usecols``) that is not a finite number."""
+    width = None
+    for line, body in _data_lines(text, first_line):
+        words = next(csv.reader([body])) if delimiter else body.split()
+        if len(words) not in widths or (width is not None and len(words) != width):
+            raise FileError(path, f"{len(words)} values; expected {what}", line)
+        width = len(words)
+        for c in (range(len(words)) if usecols is None else usecols):
+            word = words[c].strip()
             try:
-                v = float(text)
+                value = float(word)
             except ValueError:
-                raise FileError(path, f"{text!r} is not a number", lines[k], column, name) from None
-            if not math.isfinite(v):
-                raise FileError(path, f"{text!r}: must be finite", lines[k], column, name)
-    return values
+                raise FileError(path, f"{word!r} is not a number", line, c + 1, names[c]) from None
+            if not math.isfinite(value):
+                raise FileError(path, f"{word!r}: must be finite", line, c + 1, names[c])
 
 
-def _integers(path, texts, lines, column: int, name: str) -> np.ndarray:
-    values = _floats(path, texts, lines, column, name)
-    bad = np.flatnonzero(values != np.round(values))
-    if bad.size:
-        k = int(bad[0])
-        raise FileError(path, f"{texts[k]!r} is not an integer", lines[k], column, name)
+def _row_line(text: str, first_line: int, row: int) -> int:
+    """The file line of row ``row`` of the table ``text`` (which starts on line ``first_line``)."""
+    for k, (line, _) in enumerate(_data_lines(text, first_line)):
+        if k == row:
+            return line
+    return first_line
+
+
+def _check_rows(path, bad: np.ndarray, text: str, first_line: int, column: int, name: str, message) -> None:
+    """Raise :class:`FileError` at the first row where ``bad`` holds, ``message(row)`` saying what is wrong."""
+    if np.any(bad):
+        row = int(np.flatnonzero(bad)[0])
+        raise FileError(path, message(row), _row_line(text, first_line, row), column, name)
+
+
+def _integers(path, values: np.ndarray, text: str, first_line: int, column: int, name: str) -> np.ndarray:
+    """The column ``values`` of the table ``text`` as integers; a fraction raises :class:`FileError`."""
+    _check_rows(path, values != np.round(values), text, first_line, column, name,
+                lambda row: f"{float(values[row])!r} is not an integer")
     return values.astype(np.int64)
+
+
+def _header_line(text: str, start: int = 0) -> tuple[int, int, str]:
+    """``(offset after it, its line number, the line)`` of the first line of ``text`` that is neither blank nor a
+    ``#`` comment, from offset ``start`` (line numbers from 1 at offset 0); ``(-1, line, "")`` when there is none."""
+    line = text.count("\n", 0, start) + 1
+    while start < len(text):
+        end = text.find("\n", start)
+        end = len(text) if end < 0 else end
+        here = text[start:end]
+        if here.strip() and not here.lstrip().startswith("#"):
+            return end + 1, line, here
+        start, line = end + 1, line + 1
+    return -1, line, ""
 
 
 # ------------------------------------------------------------------------------------------------------ CSV
 CSV_ALIASES = {"points:0": "x", "points:1": "y", "points:2": "z"}
-CSV_COLUMNS = ("id", "x", "y", "z", "radius", "diameter", "temperature", "fixed", "material", "density")
-TRUE, FALSE = {"true", "1", "yes", "t"}, {"false", "0", "no", "f", ""}
+CSV_NUMBERS = ("id", "x", "y", "z", "radius", "diameter", "temperature", "density")
+CSV_COLUMNS = CSV_NUMBERS + ("fixed", "material")
+TRUE, FALSE = ("true", "1", "yes", "t", "1.0"), ("false", "0", "no", "f", "", "0.0")
 
 
 def _read_csv(path: pathlib.Path, length_unit: float, _timestep=None) -> Packing:
-    with path.open(newline="") as fh:
-        numbered = [(k + 1, line) for k, line in enumerate(fh) if line.strip() and not line.lstrip().startswith("#")]
-    if not numbered:
+    text = path.read_text()
+    body_start, header_line, line = _header_line(text)
+    if body_start < 0:
         raise FileError(path, "empty: needs a header row (x, y, z, radius, ...) and a row per particle")
-    rows = list(csv.reader(line for _, line in numbered))
-    header_line, header = numbered[0][0], [h.strip() for h in rows[0]]
+    header = [h.strip() for h in next(csv.reader([line]))]
     names = [CSV_ALIASES.get(h.lower(), h.lower()) for h in header]
     for k, name in enumerate(names):
         if name in CSV_COLUMNS and names.index(name) != k:
@@ -256,54 +312,44 @@ def _read_csv(path: pathlib.Path, length_unit: float, _timestep=None) -> Packing
                         "radius or diameter", header_line)
     if "radius" in names and "diameter" in names:
         raise FileError(path, "both radius and diameter columns: give one", header_line)
-    body, lines = rows[1:], [line for line, _ in numbered[1:]]
-    if not body:
+    body, first = text[body_start:], header_line + 1
+    numeric = [k for k, name in enumerate(names) if name in CSV_NUMBERS]
+    what = f"{len(header)}, the columns of the header"
+    table = _table(path, body, first, header, (len(header),), what, ",", numeric)
+    if len(table) == 0:
         raise FileError(path, "no particle rows after the header", header_line)
-    for row, line in zip(body, lines):
-        if len(row) != len(header):
-            raise FileError(path, f"{len(row)} values, but the header names {len(header)} columns", line)
-    columns = list(zip(*body))
-
-    def column(name):
-        k = names.index(name)
-        return [t.strip() for t in columns[k]], k + 1
-
-    def numbers(name):
-        texts, col = column(name)
-        return _floats(path, texts, lines, col, header[col - 1])
-
-    position = np.column_stack([numbers(a) for a in AXES])
-    radius = numbers("radius") if size == "radius" else 0.5 * numbers("diameter")
-    out = {}
-    if "id" in names:
-        texts, col = column("id")
-        out["id"] = _integers(path, texts, lines, col, header[col - 1])
-    if "temperature" in names:
-        out["temperature"] = numbers("temperature")
-    if "density" in names:
-        out["density"] = numbers("density")
-    if "fixed" in names:
-        texts, col = column("fixed")
-        words = [t.lower() for t in texts]
-        bad = [k for k, w in enumerate(words) if w not in TRUE | FALSE]
-        if bad:
-            raise FileError(path, f"{texts[bad[0]]!r}: must be true or false (or 1, 0)", lines[bad[0]], col, "fixed")
-        out["fixed"] = np.array([w in TRUE for w in words])
-    if "material" in names:
-        texts, col = column("material")
-        if all(re.fullmatch(r"[+-]?\d+", t) for t in texts):
-            out["material"] = _integers(path, texts, lines, col, "material")
-            if np.any(out["material"] < 0):
-                k = int(np.flatnonzero(out["material"] < 0)[0])
-                raise FileError(path, f"{texts[k]!r}: a material index must be >= 0", lines[k], col, "material")
-        else:
-            empty = [k for k, t in enumerate(texts) if not t]
-            if empty:
-                raise FileError(path, "empty: a material index or name", lines[empty[0]], col, "material")
-            out["material"] = np.array(texts, dtype=str)
+    if body.count(",") != len(table) * (len(header) - 1):  # a row of another width (or commas in comments)
+        _locate(path, body, first, header, (len(header),), what, ",", numeric)
+    columns = {names[k]: table[:, j] for j, k in enumerate(numeric)}
+    position = np.column_stack([columns[a] for a in AXES])
+    radius = columns["radius"] if size == "radius" else 0.5 * columns["diameter"]
+    out = {key: columns[key] for key in ("temperature", "density") if key in columns}
+    ids = (_integers(path, columns["id"], body, first, names.index("id") + 1, header[names.index("id")])
+           if "id" in columns else np.arange(len(radius), dtype=np.int64))
+    for key in ("fixed", "material"):
+        if key in names:
+            k = names.index(key)
+            words = np.char.strip(np.loadtxt(io.StringIO(body), dtype=str, comments="#", delimiter=",", ndmin=2,
+                                             usecols=[k], quotechar='"')[:, 0])
+            out[key] = _csv_words(path, key, words, body, first, k + 1)
     ignored = tuple(h for h, name in zip(header, names) if name not in CSV_COLUMNS)
-    ids = out.pop("id", np.arange(len(radius), dtype=np.int64))
     return _scaled(Packing(ids, position, radius, ignored=ignored, **out), length_unit)
+
+
+def _csv_words(path, key: str, words: np.ndarray, body: str, first: int, column: int) -> np.ndarray:
+    """``fixed`` as bools; ``material`` as indices (all integers) or names."""
+    if key == "fixed":
+        lower = np.char.lower(words)
+        _check_rows(path, ~np.isin(lower, TRUE + FALSE), body, first, column, key,
+                    lambda row: f"{str(words[row])!r}: must be true or false (or 1, 0)")
+        return np.isin(lower, TRUE)
+    _check_rows(path, words == "", body, first, column, key, lambda row: "empty: a material index or name")
+    if all(re.fullmatch(r"[+-]?\d+", w) for w in words.tolist()):
+        index = words.astype(np.int64)
+        _check_rows(path, index < 0, body, first, column, key,
+                    lambda row: f"{str(words[row])!r}: a material index must be >= 0")
+        return index
+    return words
 
 
 # ------------------------------------------------------------------------------------------------ LAMMPS data
@@ -312,7 +358,10 @@ DATA_SECTIONS = ("Atoms", "Velocities", "Masses", "Ellipsoids", "Lines", "Triang
                  "Dihedral Coeffs", "Improper Coeffs", "BondBond Coeffs", "BondAngle Coeffs",
                  "MiddleBondTorsion Coeffs", "EndBondTorsion Coeffs", "AngleTorsion Coeffs", "AngleAngleTorsion Coeffs",
                  "BondBond13 Coeffs", "AngleAngle Coeffs")
+# a section's keyword line (after the title line: the pattern starts with its newline, which re finds fast)
+SECTION_LINE = re.compile(r"\n[ \t]*(" + "|".join(DATA_SECTIONS) + r")[ \t]*(?:#([^\n]*))?(?=\r?\n|$)")
 SPHERE_COLUMNS = ("id", "type", "diameter", "density", "x", "y", "z", "ix", "iy", "iz")
+SPHERE_LAYOUT = "7 or 10 (atom_style sphere: id type diameter density x y z [ix iy iz])"
 VELOCITY_COLUMNS = ("id", "vx", "vy", "vz", "wx", "wy", "wz")
 UNITS_TITLE = re.compile(r"units\s*=\s*(\w+)")
 
@@ -332,104 +381,74 @@ def _lammps_units(path, style: str | None, line: int, length_unit: float) -> tup
 
 
 def _read_data(path: pathlib.Path, length_unit: float, _timestep=None) -> Packing:
-    with path.open() as fh:
-        lines = fh.read().splitlines()
-    if not lines:
+    text = path.read_text()
+    if not text.strip():
         raise FileError(path, "empty: not a LAMMPS data file")
-    title = UNITS_TITLE.search(lines[0])
+    title = UNITS_TITLE.search(text[:text.find("\n") if "\n" in text else len(text)])
     units = title.group(1) if title else None
     length, density_unit = _lammps_units(path, units, 1, length_unit)
-    n_atoms, lo, hi = None, [None] * 3, [None] * 3
-    k = 1
-    while k < len(lines):  # the header: counts and box bounds, up to the first section keyword
-        text = lines[k].split("#")[0].strip()
-        if text in DATA_SECTIONS:
-            break
-        words = text.split()
-        if len(words) == 2 and words[1] == "atoms":
-            n_atoms = int(_integers(path, [words[0]], [k + 1], 1, "atoms")[0])
-        elif len(words) == 4 and words[2][1:] == "lo" and words[3][1:] == "hi" and words[2][0] in AXES:
-            a = AXES.index(words[2][0])
-            lo[a], hi[a] = (float(_floats(path, [w], [k + 1], c + 1, f"{words[2][0]}{s}")[0])
-                            for c, (w, s) in enumerate(zip(words[:2], ("lo", "hi"))))
-        elif len(words) == 6 and words[3:] == ["xy", "xz", "yz"]:
-            tilt = _floats(path, words[:3], [k + 1] * 3, 1, "xy xz yz")
-            if np.any(tilt != 0):
-                raise FileError(path, "a triclinic box (tilt factors xy xz yz not zero): only orthogonal boxes are "
-                                "read", k + 1)
-        elif words and words[0] in ("avec", "bvec", "cvec", "abc"):
-            raise FileError(path, "a general triclinic box: only orthogonal boxes are read", k + 1)
-        k += 1
-    if n_atoms is None:
-        raise FileError(path, "no 'N atoms' line in the header: not a LAMMPS data file")
-    sections = _data_sections(lines, k)
+    marks = list(SECTION_LINE.finditer(text))
+    sections = {}  # keyword: (its line, style comment, body text, the body's first line)
+    for m, after in zip(marks, marks[1:] + [None]):
+        line = text.count("\n", 0, m.start()) + 2
+        sections[m.group(1)] = (line, (m.group(2) or "").strip(), text[m.end():after.start() if after else None],
+                                line)
+    n_atoms, lo, hi = _data_header(path, text[:marks[0].start()] if marks else text)
     if "Atoms" not in sections:
         raise FileError(path, "no Atoms section")
-    start, style, rows = sections["Atoms"]
+    start, style, body, first = sections["Atoms"]
     if style and style.split()[0] != "sphere":
         raise FileError(path, f"atom_style {style}: only atom_style sphere (id type diameter density x y z) is read",
                         start)
-    if len(rows) != n_atoms:
-        raise FileError(path, f"the Atoms section has {len(rows)} lines but the header says {n_atoms} atoms", start)
-    columns = _table(path, rows, (7, 10), SPHERE_COLUMNS, "atom_style sphere: id type diameter density x y z "
-                     "[ix iy iz]")
-    nums = [row[0] for row in rows]
-    ids = _integers(path, columns[0], nums, 1, "id")
-    diameter = _floats(path, columns[2], nums, 3, "diameter")
-    bad = np.flatnonzero(diameter <= 0)
-    if bad.size:  # diameter 0 is a LAMMPS point particle, whose density column is its mass
-        raise FileError(path, f"diameter = {columns[2][bad[0]]}: must be > 0 (a sphere)", nums[bad[0]], 3, "diameter")
-    out = {"material": _integers(path, columns[1], nums, 2, "type") - 1,
-           "density": _floats(path, columns[3], nums, 4, "density") * density_unit}
-    position = np.column_stack([_floats(path, columns[4 + a], nums, 5 + a, AXES[a]) for a in range(3)])
-    if len(columns) == 10:
-        out["image"] = np.column_stack([_integers(path, columns[7 + a], nums, 8 + a, f"i{AXES[a]}") for a in range(3)])
+    atoms = _table(path, body, first, SPHERE_COLUMNS, (7, 10), SPHERE_LAYOUT)
+    if len(atoms) != n_atoms:
+        raise FileError(path, f"the Atoms section has {len(atoms)} lines but the header says {n_atoms} atoms", start)
+    ids = _integers(path, atoms[:, 0], body, first, 1, "id")
+    diameter = atoms[:, 2]
+    _check_rows(path, diameter <= 0, body, first, 3, "diameter",  # diameter 0: a LAMMPS point particle
+                lambda row: f"diameter = {float(diameter[row])!r}: must be > 0 (a sphere)")
+    out = {"material": _integers(path, atoms[:, 1], body, first, 2, "type") - 1,
+           "density": atoms[:, 3] * density_unit}
+    if atoms.shape[1] == 10:
+        out["image"] = np.column_stack([_integers(path, atoms[:, 7 + a], body, first, 8 + a, f"i{AXES[a]}")
+                                        for a in range(3)])
     if "Velocities" in sections:
-        vstart, _, vrows = sections["Velocities"]
-        vcols = _table(path, vrows, (7,), VELOCITY_COLUMNS, "atom_style sphere: id vx vy vz wx wy wz")
-        vnums = [row[0] for row in vrows]
-        vids = _integers(path, vcols[0], vnums, 1, "id")
-        where = {int(i): k for k, i in enumerate(ids)}
-        missing = [int(i) for i in vids if int(i) not in where]
-        if missing or len(vids) != len(ids):
+        vstart, _, vbody, vfirst = sections["Velocities"]
+        v = _table(path, vbody, vfirst, VELOCITY_COLUMNS, (7,), "7 (atom_style sphere: id vx vy vz wx wy wz)")
+        vids = _integers(path, v[:, 0], vbody, vfirst, 1, "id")
+        order, where = np.argsort(ids), np.argsort(vids)
+        if len(vids) != len(ids) or np.any(ids[order] != vids[where]):
             raise FileError(path, "the Velocities section must list every atom of the Atoms section once", vstart)
-        order = np.array([where[int(i)] for i in vids])
-        velocity, omega = np.zeros((len(ids), 3)), np.zeros((len(ids), 3))
-        for a in range(3):
-            velocity[order, a] = _floats(path, vcols[1 + a], vnums, 2 + a, VELOCITY_COLUMNS[1 + a])
-            omega[order, a] = _floats(path, vcols[4 + a], vnums, 5 + a, VELOCITY_COLUMNS[4 + a])
+        velocity, omega = np.empty((len(ids), 3)), np.empty((len(ids), 3))
+        velocity[order], omega[order] = v[where, 1:4], v[where, 4:7]
         out.update(velocity=velocity, angular_velocity=omega)
+    packing = Packing(ids, atoms[:, 4:7], 0.5 * diameter, box_lo=lo, box_hi=hi, units=units, **out)
+    return _sorted(_scaled(packing, length), np.argsort(ids, kind="stable"))
+
+
+def _data_header(path, header: str) -> tuple[int, np.ndarray, np.ndarray]:
+    """The atom count and the box bounds of a data file's header (the lines before its first section)."""
+    n_atoms, lo, hi = None, [None] * 3, [None] * 3
+    for k, line in enumerate(header.split("\n")[1:], start=2):
+        words = line.split("#")[0].split()
+        if len(words) == 2 and words[1] == "atoms":
+            n_atoms = int(_integers(path, _table(path, words[0], k, ("atoms",), (1,), "1")[0], words[0], k, 1,
+                                    "atoms")[0])
+        elif len(words) == 4 and words[2][1:] == "lo" and words[3][1:] == "hi" and words[2][0] in AXES:
+            a = AXES.index(words[2][0])
+            lo[a], hi[a] = _table(path, " ".join(words[:2]), k, (words[2], words[3]), (2,), "2")[0]
+        elif len(words) == 6 and words[3:] == ["xy", "xz", "yz"]:
+            if np.any(_table(path, " ".join(words[:3]), k, ("xy", "xz", "yz"), (3,), "3") != 0):
+                raise FileError(path, "a triclinic box (tilt factors xy xz yz not zero): only orthogonal boxes are "
+                                "read", k)
+        elif words and words[0] in ("avec", "bvec", "cvec", "abc"):
+            raise FileError(path, "a general triclinic box: only orthogonal boxes are read", k)
+    if n_atoms is None:
+        raise FileError(path, "no 'N atoms' line in the header: not a LAMMPS data file")
     if any(v is None for v in lo):
         a = next(a for a in range(3) if lo[a] is None)
         raise FileError(path, f"no '{AXES[a]}lo {AXES[a]}hi' line in the header")
-    order = np.argsort(ids, kind="stable")
-    packing = Packing(ids, position, 0.5 * diameter, box_lo=np.array(lo, dtype=float),
-                      box_hi=np.array(hi, dtype=float), units=units, **out)
-    return _sorted(_scaled(packing, length), order)
-
-
-def _data_sections(lines, first: int) -> dict:
-    """``{keyword: (line number, style comment, [(line number, words), ...])}`` of the sections from ``lines[first]``
-    on."""
-    sections, current = {}, None
-    for k in range(first, len(lines)):
-        text, _, comment = lines[k].partition("#")
-        text = text.strip()
-        if text in DATA_SECTIONS:
-            current = []
-            sections[text] = (k + 1, comment.strip(), current)
-        elif text and current is not None:
-            current.append((k + 1, text.split()))
-    return sections
-
-
-def _table(path, rows, counts, names, layout) -> list[list[str]]:
-    """The columns of the rows ``[(line, words)]``, each row with one of ``counts`` words."""
-    width = len(rows[0][1]) if rows else counts[0]
-    for line, words in rows:
-        if len(words) not in counts or len(words) != width:
-            raise FileError(path, f"{len(words)} values; expected {' or '.join(map(str, counts))} ({layout})", line)
-    return [list(c) for c in zip(*(words for _, words in rows))] if rows else [[] for _ in names[:width]]
+    return n_atoms, np.array(lo, dtype=float), np.array(hi, dtype=float)
 
 
 def _sorted(p: Packing, order: np.ndarray) -> Packing:
@@ -463,9 +482,9 @@ def _read_dump(path: pathlib.Path, length_unit: float, timestep: int | None) -> 
             listed = ", ".join(map(str, steps[:10])) + (", ..." if len(steps) > 10 else "")
             raise ValueError(f"{path}: timestep = {timestep}: not in the dump (its timesteps: {listed})")
         begin = starts[pick]
-        before = data.rfind(b"ITEM: UNITS", 0, begin)  # LAMMPS writes it once, before the first snapshot
         end = starts[pick + 1] if pick + 1 < len(starts) else len(data)
         first_line = data[:begin].count(b"\n") + 1
+        before = data.rfind(b"ITEM: UNITS", 0, begin)  # LAMMPS writes it once, before the first snapshot
         units, unit_line = None, None
         if before >= 0:
             unit_line = data[:before].count(b"\n") + 2
@@ -488,71 +507,48 @@ def _frame_step(path, data, start: int) -> int:
     end = data.find(b"\n", data.find(b"\n", start) + 1)
     text = data[start:end if end >= 0 else len(data)].decode(errors="replace").split("\n")
     line = data[:start].count(b"\n") + 2
-    if len(text) < 2:
-        raise FileError(path, "ITEM: TIMESTEP without a timestep", line - 1)
-    return int(_integers(path, [text[1].strip()], [line], 1, "timestep")[0])
+    if len(text) < 2 or not re.fullmatch(r"\s*\d+\s*", text[1]):
+        raise FileError(path, f"ITEM: TIMESTEP: {text[1].strip() if len(text) > 1 else ''!r} is not a timestep",
+                        line)
+    return int(text[1])
 
 
 def _parse_frame(path, frame: str, first_line: int, step: int, units: str | None, scales) -> Packing:
-    lines = frame.split("\n")
-    items, k = {}, 0
-    while k < len(lines):
-        if lines[k].startswith("ITEM:"):
-            items[lines[k][5:].strip().split(" ")[0]] = k
-            if lines[k].startswith("ITEM: ATOMS"):
-                break
-        k += 1
-    if "NUMBER" not in items or "BOX" not in items or "ATOMS" not in items:
-        missing = next(m for m in ("NUMBER OF ATOMS", "BOX BOUNDS", "ATOMS") if m.split()[0] not in items)
+    atoms_at = frame.find("ITEM: ATOMS")
+    if atoms_at < 0:
+        raise FileError(path, f"timestep {step}: no 'ITEM: ATOMS' line", first_line)
+    head = frame[:atoms_at].split("\n")
+    items = {line[5:].strip().split(" ")[0]: k for k, line in enumerate(head) if line.startswith("ITEM:")}
+    if "NUMBER" not in items or "BOX" not in items:
+        missing = "NUMBER OF ATOMS" if "NUMBER" not in items else "BOX BOUNDS"
         raise FileError(path, f"timestep {step}: no 'ITEM: {missing}' line", first_line)
-    line_of = lambda j: first_line + j  # noqa: E731 -- file line of the frame's line j
-    n = int(_integers(path, [lines[items["NUMBER"] + 1].strip()], [line_of(items["NUMBER"] + 1)], 1, "atoms")[0])
-    box_head = lines[items["BOX"]].split()[3:]
-    flags = [w for w in box_head if w not in ("xy", "xz", "yz")]
-    if box_head and box_head[0] == "abc":
-        raise FileError(path, "a general triclinic box: only orthogonal boxes are read", line_of(items["BOX"]))
-    lo, hi, tilted = np.zeros(3), np.zeros(3), len(flags) != len(box_head)
-    for a in range(3):
-        j = items["BOX"] + 1 + a
-        words = lines[j].split() if j < len(lines) else []
-        if len(words) != (3 if tilted else 2):
-            raise FileError(path, f"box bounds of {AXES[a]}: expected {'3' if tilted else '2'} numbers", line_of(j))
-        lo[a], hi[a] = (_floats(path, [w], [line_of(j)], c + 1, f"{AXES[a]}{s}")[0]
-                        for c, (w, s) in enumerate(zip(words[:2], ("lo", "hi"))))
-        if tilted and float(words[2]) != 0.0:
-            raise FileError(path, "a triclinic box (tilt factors not zero): only orthogonal boxes are read",
-                            line_of(j), 3)
-    periodic = tuple(f == "pp" for f in flags) if len(flags) == 3 else None
-    names = lines[items["ATOMS"]].split()[2:]
+    k = items["NUMBER"] + 1
+    n = int(_integers(path, _table(path, head[k], first_line + k, ("atoms",), (1,), "1")[0], head[k],
+                      first_line + k, 1, "atoms")[0])
+    lo, hi, periodic = _dump_box(path, head, items["BOX"], first_line)
+    header_end = frame.find("\n", atoms_at)
+    header_end = len(frame) if header_end < 0 else header_end
+    names = frame[atoms_at:header_end].split()[2:]
+    atoms_line = first_line + frame.count("\n", 0, atoms_at)
+    body_end = frame.find("\nITEM:", header_end)  # the next snapshot's UNITS or TIME lines, if any
+    body = frame[header_end + 1:body_end + 1 if body_end >= 0 else None]
+    table = _table(path, body, atoms_line + 1, names, (len(names),), f"{len(names)}, the columns of ITEM: ATOMS")
+    if len(table) != n:
+        raise FileError(path, f"timestep {step}: {len(table)} atom lines, but ITEM: NUMBER OF ATOMS says {n}",
+                        atoms_line)
     keys = [name.lower() for name in names]
-    head = items["ATOMS"]
-    rows = [line for line in lines[head + 1:head + 1 + n]]
-    if len(rows) < n or any(not r.strip() for r in rows):
-        got = sum(1 for r in rows if r.strip())
-        raise FileError(path, f"timestep {step}: {got} atom lines, but ITEM: NUMBER OF ATOMS says {n}",
-                        line_of(head))
-    after = head + 1 + n
-    if after < len(lines) and lines[after].strip() and not lines[after].startswith("ITEM:"):
-        raise FileError(path, f"timestep {step}: more atom lines than ITEM: NUMBER OF ATOMS says ({n})",
-                        line_of(after))
-    words = [r.split() for r in rows]
-    for j, w in enumerate(words):
-        if len(w) != len(names):
-            raise FileError(path, f"{len(w)} values, but ITEM: ATOMS names {len(names)} columns", line_of(head + 1 + j))
-    columns = list(zip(*words))
-    numbers = [line_of(head + 1 + j) for j in range(n)]
 
     def col(name, integer=False):
         k = keys.index(name)
-        return (_integers if integer else _floats)(path, columns[k], numbers, k + 1, names[k])
+        return _integers(path, table[:, k], body, atoms_line + 1, k + 1, names[k]) if integer else table[:, k]
 
     length, density_unit = scales
     position_names = next((c for c in DUMP_POSITIONS if all(a in keys for a in c)), None)
     if position_names is None:
         raise FileError(path, f"no position columns in ITEM: ATOMS ({' '.join(names)}); needs x y z (or xu yu zu, "
-                        "xs ys zs, xsu ysu zsu)", line_of(head))
+                        "xs ys zs, xsu ysu zsu)", atoms_line)
     if "radius" not in keys and "diameter" not in keys:
-        raise FileError(path, f"no radius or diameter column in ITEM: ATOMS ({' '.join(names)})", line_of(head))
+        raise FileError(path, f"no radius or diameter column in ITEM: ATOMS ({' '.join(names)})", atoms_line)
     position = np.column_stack([col(a) for a in position_names])
     if position_names[0].startswith("xs"):
         position = lo + position * (hi - lo)
@@ -586,6 +582,31 @@ def _parse_frame(path, frame: str, first_line: int, step: int, units: str | None
     packing = Packing(ids, position, radius, box_lo=lo, box_hi=hi, periodic=periodic, timestep=step, units=units,
                       ignored=ignored, **out)
     return _sorted(_scaled(packing, length), np.argsort(ids, kind="stable"))
+
+
+def _dump_box(path, head: list, k: int, first_line: int):
+    """Bounds and periodic axes (``pp`` flags; None when the dump gives no flags) of ``ITEM: BOX BOUNDS`` on the
+    snapshot's line ``k``."""
+    box_head = head[k].split()[3:]
+    if box_head and box_head[0] == "abc":
+        raise FileError(path, "a general triclinic box: only orthogonal boxes are read", first_line + k)
+    flags = [w for w in box_head if w not in ("xy", "xz", "yz")]
+    tilted = len(flags) != len(box_head)
+    width = 3 if tilted else 2
+    bounds = np.empty((3, width))
+    for a in range(3):
+        j = k + 1 + a
+        text = head[j] if j < len(head) else ""
+        if not text.strip():
+            raise FileError(path, f"no box bounds of {AXES[a]} (ITEM: BOX BOUNDS is followed by one line per axis)",
+                            first_line + j)
+        bounds[a] = _table(path, text, first_line + j, (f"{AXES[a]}lo", f"{AXES[a]}hi", "tilt"), (width,),
+                           f"{width}, the bounds of {AXES[a]}{' and a tilt factor' if tilted else ''}")[0]
+    if tilted and np.any(bounds[:, 2] != 0):
+        raise FileError(path, "a triclinic box (tilt factors not zero): only orthogonal boxes are read",
+                        first_line + k)
+    periodic = tuple(f == "pp" for f in flags) if len(flags) == 3 else None
+    return bounds[:, 0], bounds[:, 1], periodic
 
 
 # ------------------------------------------------------------------------------------------------------ VTK
@@ -710,6 +731,14 @@ def scene_particles(table: dict, materials, base_dir=None):
         values[key] = value
     if values["temperature"] is None:
         raise ValueError(f"[particles] temperature: required (a number or a list); {name!r} has no temperature column")
+    if "material" not in table and packing.material is not None and packing.material.dtype.kind in "iu":
+        beyond = np.flatnonzero(packing.material >= len(materials))
+        if beyond.size:
+            k = int(beyond[0])
+            raise ValueError(f"[particles] file {name!r}: particle id {packing.id[k]} is of material "
+                             f"{packing.material[k]} (LAMMPS type {packing.material[k] + 1}) but the scene has "
+                             f"{len(materials)} material(s); give [[materials]] (LAMMPS type k is material k - 1) or "
+                             "[particles] material")
     material = material_indices("[particles] material" if "material" in table else f"[particles] file {name!r}: "
                                 "material", table.get("material", packing.material), materials, n)
     particles = Particles.from_arrays(packing.position, packing.radius, values["temperature"], materials, material,
@@ -767,7 +796,7 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
     (names: their order of appearance); ``density`` kg/m^3 (one number or per particle) where the packing has none.
     The box is the packing's, or the particles' bounding box grown by ``pad`` (m) beyond the largest radius; the
     periodicity is not part of a data file: the input script's ``boundary`` command sets it. Numbers are written
-    to round-trip (17 significant digits)."""
+    to round-trip (the shortest digits that read back to the same double)."""
     path = pathlib.Path(path)
     n = packing.n
     if packing.density is not None:
@@ -787,20 +816,31 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
         lo, hi = (x - r[:, None]).min(axis=0) - pad, (x + r[:, None]).max(axis=0) + pad
     image = packing.image if packing.image is not None else np.zeros((n, 3), dtype=np.int64)
     ids = lammps_ids(packing.id)
+    lo, hi = (np.asarray(b, dtype=float).tolist() for b in (lo, hi))
     head = [f"LAMMPS data file of {n} spheres written by sinterheat (dem.packing_files), units = si", "",
             f"{n} atoms", f"{int(types.max())} atom types", ""]
-    g = "{:.17g}".format
-    head += [f"{g(lo[a])} {g(hi[a])} {c}lo {c}hi" for a, c in enumerate(AXES)]
-    rows = [f"{ids[k]} {types[k]} {g(2.0 * r[k])} {g(rho[k])} {g(x[k, 0])} {g(x[k, 1])} {g(x[k, 2])} "
-            f"{image[k, 0]} {image[k, 1]} {image[k, 2]}" for k in range(n)]
-    text = head + ["", "Atoms # sphere", ""] + rows
+    head += [f"{lo[a]!r} {hi[a]!r} {c}lo {c}hi" for a, c in enumerate(AXES)]
+    parts = ["\n".join(head + ["", "Atoms # sphere", ""]) + "\n",
+             _rows_text([ids, types, 2.0 * r, rho, *x.T, *np.asarray(image).T], " ")]
     if packing.velocity is not None:
-        v = packing.velocity
         w = packing.angular_velocity if packing.angular_velocity is not None else np.zeros((n, 3))
-        text += ["", "Velocities", ""] + [f"{ids[k]} {g(v[k, 0])} {g(v[k, 1])} {g(v[k, 2])} {g(w[k, 0])} "
-                                          f"{g(w[k, 1])} {g(w[k, 2])}" for k in range(n)]
-    _write_text(path, "\n".join(text) + "\n")
+        parts += ["\nVelocities\n\n", _rows_text([ids, *packing.velocity.T, *w.T], " ")]
+    _write_text(path, parts)
     return path
+
+
+def _rows_text(columns, sep: str, chunk: int = 100_000):
+    """The rows of ``columns`` (arrays of one length) as lines of text, ``chunk`` rows per string yielded: floats as
+    the shortest digits that read back to the same double (``repr``), integers as they are, bools as true/false."""
+    columns = [np.asarray(c) for c in columns]
+    for start in range(0, len(columns[0]), chunk):
+        words = []
+        for column in (c[start:start + chunk] for c in columns):
+            if column.dtype.kind == "b":
+                words.append(np.where(column, "true", "false").tolist())
+            else:
+                words.append(list(map(repr if column.dtype.kind == "f" else str, column.tolist())))
+        yield "\n".join(map(sep.join, zip(*words))) + "\n"
 
 
 def _types(material, n: int) -> np.ndarray:
@@ -814,28 +854,19 @@ def _types(material, n: int) -> np.ndarray:
 
 
 def write_csv(path, packing: Packing) -> pathlib.Path:
-    """Write ``packing`` as CSV (``id, x, y, z, radius`` and its optional columns), numbers to round-trip."""
+    """Write ``packing`` as CSV (``id, x, y, z, radius`` and its optional columns), numbers that read back to the
+    same doubles."""
     path = pathlib.Path(path)
     columns = {"id": packing.id, "x": packing.position[:, 0], "y": packing.position[:, 1],
                "z": packing.position[:, 2], "radius": packing.radius}
     for key in ("temperature", "fixed", "material", "density"):
         if getattr(packing, key) is not None:
             columns[key] = getattr(packing, key)
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(columns)
-    for row in zip(*columns.values()):
-        writer.writerow([_csv_value(v) for v in row])
-    _write_text(path, buffer.getvalue())
+    names = np.asarray(columns.get("material", [])).tolist()
+    if any("," in str(name) or '"' in str(name) for name in names):
+        raise ValueError(f"{path.name}: material names with commas or quotes cannot be written as CSV")
+    _write_text(path, [",".join(columns) + "\n", _rows_text(list(columns.values()), ",")])
     return path
-
-
-def _csv_value(v) -> str:
-    if isinstance(v, (bool, np.bool_)):
-        return "true" if v else "false"
-    if isinstance(v, (float, np.floating)):
-        return f"{float(v):.17g}"
-    return str(v)
 
 
 def write_vtu(path, packing: Packing) -> pathlib.Path:
@@ -859,7 +890,11 @@ def write_vtu(path, packing: Packing) -> pathlib.Path:
     return path
 
 
-def _write_text(path: pathlib.Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".part")  # written aside, then renamed: a file on disk is always whole
-    tmp.write_text(text)
+def _write_text(path: pathlib.Path, parts) -> None:
+    """Write the strings (or iterables of strings) ``parts`` to ``path``: aside, then renamed, so that a file on disk
+    is always whole."""
+    tmp = path.with_name(path.name + ".part")
+    with tmp.open("w") as fh:
+        for part in parts:
+            fh.writelines([part] if isinstance(part, str) else part)
     tmp.replace(path)

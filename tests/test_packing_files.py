@@ -10,20 +10,29 @@ import math
 import pathlib
 import subprocess
 import sys
+from dataclasses import asdict
 
 import meshio
 import numpy as np
 import pytest
 
 from dem import generators, read_packing, state_file
+from dem.laws.luding import LUDING_TABLE1
 from dem.packing_files import (Packing, lammps_ids, packing_from_particles, packing_from_state, write_csv,
                                write_lammps_data, write_vtu)
 from dem.periodic import PeriodicBox
-from dem.scene import load_scene, make_scene
+from dem.scene import load_scene, make_scene, parse_scene
 from dem.simulation import run
 
 DATA = pathlib.Path(__file__).with_name("data") / "lammps"
 COPPER = {"conductivity": 394.0, "density": 8960.0, "specific_heat": 385.0}
+CONTACT = {"law": "luding", **{k: v for k, v in asdict(LUDING_TABLE1).items() if k != "density"}}
+
+
+def moving_doc(particles: dict, t_end: float) -> dict:
+    """A scene of moving particles (Luding 2005 Table 1 contact, density 2000 kg/m^3) with ``particles``."""
+    return {"scene": {"physics": ["mechanical"]}, "material": {"density": 2000.0}, "particles": particles,
+            "contact": dict(CONTACT), "solver": {"mode": "transient", "t_end": t_end}}
 
 
 def lammps():
@@ -213,14 +222,14 @@ def test_every_format_gives_the_same_particles_and_the_same_conductivity(lammps_
 def test_a_saved_state_runs_in_lammps_with_its_masses_and_velocities(tmp_path):
     """A moving run's state.npz -> our LAMMPS data file -> LAMMPS read_data: LAMMPS's masses are the saved masses,
     and its write_data gives back positions, radii, velocities and angular velocities."""
-    from tests.test_dem_engine import TABLE1, scene_doc
-    from dem.scene import parse_scene
-
     r = 1e-3
-    x = [[0, 0, 0], [2.1 * r, 0, 0.3 * r], [0, 2.2 * r, -0.2 * r]]
-    doc = scene_doc(x, [r, 0.8 * r, 1.1 * r], [[0.05, 0, 0], [-0.05, 0.01, 0], [0, -0.03, 0.02]], TABLE1, t_end=3e-4)
+    doc = moving_doc({"position": [[0, 0, 0], [2.1 * r, 0, 0.3 * r], [0, 2.2 * r, -0.2 * r]],
+                      "radius": [r, 0.8 * r, 1.1 * r], "temperature": [20.0] * 3,
+                      "velocity": [[0.05, 0, 0], [-0.05, 0.01, 0], [0, -0.03, 0.02]],
+                      "angular_velocity": [[0, 0, 30.0], [-20.0, 5.0, 0], [1.0, 2.0, 3.0]]}, t_end=3e-4)
     run(parse_scene(doc), out=tmp_path / "moving")
     saved = state_file.load(tmp_path / "moving" / "state.npz")
+    assert np.all(np.abs(saved["w"]).max(axis=1) > 0) and np.all(np.abs(saved["v"]).max(axis=1) > 0)
     state = packing_from_state(saved)
     write_lammps_data(tmp_path / "state.data", state)
     run_lammps(tmp_path, "\n".join([
@@ -248,14 +257,10 @@ def test_ids_are_kept_through_scenes_and_outputs(tmp_path):
     np.testing.assert_array_equal(s.particles.fixed, [True, False])
     res = run(s, out=tmp_path / "static")
     assert res.T[1] == pytest.approx(100.0)  # the free particle takes the fixed one's temperature
+    assert list(res.summary["boundary_heat_flow"]["particles"]) == ["7"]  # fixed particles by id
     vtu = meshio.read(tmp_path / "static" / "particles_00000.vtu")
     np.testing.assert_array_equal(vtu.point_data["id"], [7, 3])
-    from tests.test_dem_engine import ELASTIC
-    from dem.scene import parse_scene
-
-    doc = {"scene": {"physics": ["mechanical"]}, "material": {"density": 2000.0},
-           "particles": {"file": str(csv), "temperature": 20.0}, "contact": dict(ELASTIC),
-           "solver": {"mode": "transient", "t_end": 1e-4}}
+    doc = moving_doc({"file": str(csv), "temperature": 20.0}, t_end=1e-4)
     with pytest.raises(ValueError, match=r"particle id 7 has density 8960 .* its material 'material0' 2000"):
         parse_scene({**doc, "particles": {"file": str(write_csv(tmp_path / "dense.csv", packing_from_particles(
             s.particles))), "temperature": 20.0}})
@@ -297,7 +302,7 @@ def test_the_cli_converts_a_scene_for_lammps(tmp_path):
 BAD = [
     ("p.csv", "x,y,z,radius\n0,0,0,1e-3\n0,abc,0,1e-3\n", r"p\.csv, line 3, column 2 \(y\): 'abc' is not a number"),
     ("p.csv", "# made by hand\nx,y,radius\n0,0,1e-3\n", r"p\.csv, line 2: no column 'z' in the header \(x, y, "),
-    ("p.csv", "x,y,z,radius\n0,0,0,1e-3\n0,0,0\n", r"p\.csv, line 3: 3 values, but the header names 4 columns"),
+    ("p.csv", "x,y,z,radius\n0,0,0,1e-3\n0,0,0\n", r"p\.csv, line 3: 3 values; expected 4, the columns of the header"),
     ("p.csv", "x,y,z,radius,fixed\n0,0,0,1e-3,maybe\n", r"p\.csv, line 2, column 5 \(fixed\): 'maybe': must be"),
     ("p.csv", "x,y,z,radius\n0,0,0,nan\n", r"p\.csv, line 2, column 4 \(radius\): 'nan': must be finite"),
     ("p.csv", "id,x,y,z,radius\n1,0,0,0,1e-3\n1,1,0,0,1e-3\n", r"p\.csv: id 1 is given to 2 particles"),
@@ -309,6 +314,11 @@ BAD = [
      "1 1 0.1 1000 0.5 0.5 0.5\n", r"p\.data, line 9: the Atoms section has 1 lines but the header says 2 atoms"),
     ("p.data", "LAMMPS data file\n\n1 atoms\n1 atom types\n0 1 xlo xhi\n0 1 ylo yhi\n0 1 zlo zhi\n\nAtoms\n\n"
      "1 1 0.1 1000 0.5 0.5\n", r"p\.data, line 11: 6 values; expected 7 or 10 \(atom_style sphere"),
+    ("p.data", "LAMMPS data file\n\n2 atoms\n1 atom types\n0 1 xlo xhi\n0 1 ylo yhi\n0 1 zlo zhi\n\nAtoms\n\n"
+     "1 1 0.1 1000 0.5 0.5 0.5\n2.5 1 0.1 1000 0.2 0.5 0.5\n", r"p\.data, line 12, column 1 \(id\): 2\.5 is not an "),
+    ("p.data", "LAMMPS data file\n\n2 atoms\n1 atom types\n0 1 xlo xhi\n0 1 ylo yhi\n0 1 zlo zhi\n\nAtoms\n\n"
+     "1 1 0.1 1000 0.5 0.5 0.5\n\n2 1 0 1000 0.2 0.5 0.5\n", r"p\.data, line 13, column 3 \(diameter\): diameter = "
+     r"0\.0: must be > 0"),
     ("p.dump", None, r"p\.dump, line 38, column 6 \(radius\): '0\.00075e' is not a number"),
     ("p.dump", "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS pp pp pp\n0 1\n0 1\n0 1\n"
      "ITEM: ATOMS id x y z radius\n1 0 0 0 0.1\n", r"p\.dump, line 9: timestep 0: 1 atom lines, but ITEM: NUMBER OF"),
@@ -362,11 +372,40 @@ def test_a_bad_file_in_a_scene_is_one_line_and_exit_2(tmp_path):
      r"\[particles\] length_unit: only with file"),
 ])
 def test_scene_keys_of_a_packing_file(tmp_path, table, message):
-    from dem.scene import parse_scene
-
     (tmp_path / "p.csv").write_text("x,y,z,radius\n0,0,0,1e-3\n")
     with pytest.raises(ValueError, match=message):
         parse_scene({"material": dict(COPPER), "particles": table}, base_dir=tmp_path)
+
+
+def test_the_box_of_a_file_in_a_scene():
+    """A dump's pp axes make a static scene periodic; a data file's box is periodic only through [periodic] (all
+    axes unless given); LAMMPS types pick [[materials]], whose densities must be the file's."""
+    materials = [{**COPPER, "name": "copper"}, {**COPPER, "density": 2700.0, "name": "aluminium"}]
+
+    def scene(name, **tables):
+        return parse_scene({"materials": materials, "particles": {"file": name, "temperature": 20.0}, **tables},
+                           base_dir=DATA)
+
+    dump = scene("full.dump")
+    assert dump.box.periodic == (True, True, False) and dump.box.lengths.tolist() == [0.01] * 3
+    np.testing.assert_array_equal(dump.particles.material, [0, 1, 0, 1])
+    np.testing.assert_array_equal(dump.particles.id, [1, 2, 3, 4])
+    assert scene("packing.data").box is None
+    data = scene("packing.data", periodic={"drop": [0.0, 0.0, 0.0]})
+    assert data.box.periodic == (True, True, True) and data.box.origin.tolist() == [0.0] * 3
+    assert scene("full.dump", periodic={"axes": ["x"]}).box.periodic == (True, False, False)
+    with pytest.raises(ValueError, match=r"'packing.data': particle id 2 is of material 1 \(LAMMPS type 2\) but the "
+                       r"scene has 1 material\(s\); give \[\[materials\]\]"):
+        parse_scene({"materials": materials[:1], "particles": {"file": "packing.data", "temperature": 20.0}},
+                    base_dir=DATA)
+    with pytest.raises(ValueError, match=r"particle id 2 has density 2700 kg/m\^3 but its material 'copper' 8960"):
+        parse_scene({"materials": materials, "particles": {"file": "packing.data", "temperature": 20.0,
+                                                           "material": "copper"}}, base_dir=DATA)
+    moving = moving_doc({"file": "plain.dump", "temperature": 20.0, "material": 0}, 1e-4)  # no densities
+    moving["material"]["density"] = 8960.0
+    with pytest.raises(ValueError, match=r"\[particles\] file: its box is periodic, and: periodic boxes are for "
+                       "static packings"):
+        parse_scene(moving, base_dir=DATA)
 
 
 def test_format_from_the_name():
