@@ -185,37 +185,47 @@ def test_lammps_reads_our_data_file_and_writes_it_back(lammps_written):
     np.testing.assert_allclose(read_packing(folder / "lammps.data").density, 8960.0, rtol=1e-15)
 
 
-def test_every_format_gives_the_same_particles_and_the_same_conductivity(lammps_written, tmp_path):
-    """The packing from LAMMPS (data file, dump), a ParaView-style CSV, a Yade-style VTU and the VTU of a run:
-    the same particles, and the same steady k_eff (1 K drop per period along z) as the packing given as arrays."""
-    folder, packing = lammps_written
+def reference_k_eff(packing: Packing) -> float:
+    """k_eff of the packing given as arrays, 1 K drop per period along z."""
     box = PeriodicBox(packing.box_hi - packing.box_lo, (True, True, True), packing.box_lo, [0.0, 0.0, 1.0])
-    reference = run(make_scene(packing.position, packing.radius, np.zeros(packing.n), box=box, law="rojek",
-                               mode="steady")).summary["effective_conductivity"]
-    assert 0 < reference < 394.0
-    for name in ("lammps.data", "lammps.dump"):
-        (tmp_path / name).write_bytes((folder / name).read_bytes())
+    k_eff = run(make_scene(packing.position, packing.radius, np.zeros(packing.n), box=box, law="rojek",
+                           mode="steady")).summary["effective_conductivity"]
+    assert 0 < k_eff < 394.0
+    return k_eff
+
+
+def test_csv_vtu_and_a_runs_vtu_give_the_same_particles_and_conductivity(tmp_path):
+    """A ParaView-style CSV, a Yade-style VTU and the VTU a run writes: the same particles, and the same steady k_eff
+    (1 K drop per period along z; the box given by [periodic]) as the packing given as arrays."""
+    packing = periodic_packing()
+    reference = reference_k_eff(packing)
     write_paraview_csv(tmp_path / "paraview.csv", packing)
     write_yade_vtu(tmp_path / "yade.vtu", packing)
-    lengths = (packing.box_hi - packing.box_lo).tolist()
-    origin = packing.box_lo.tolist()
+    lengths, origin = (packing.box_hi - packing.box_lo).tolist(), packing.box_lo.tolist()
     given = {"lengths": lengths, "origin": origin, "drop": [0.0, 0.0, 1.0]}
-    cases = {"lammps.data": {"drop": [0.0, 0.0, 1.0]},  # the box from the file; periodic: the [periodic] table
-             "lammps.dump": {"drop": [0.0, 0.0, 1.0]},  # the box and its periodic axes from the file
-             "paraview.csv": given, "yade.vtu": given}
-    for name, periodic in cases.items():
-        same_particles(packing, read_packing(tmp_path / name), name.startswith("lammps"), np.array(lengths))
-        k_eff = steady_k_eff({"file": name, "temperature": 0.0}, periodic, tmp_path)
+    for name in ("paraview.csv", "yade.vtu"):
+        same_particles(packing, read_packing(tmp_path / name), lengths=np.array(lengths))
+        k_eff = steady_k_eff({"file": name, "temperature": 0.0}, given, tmp_path)
         assert k_eff == pytest.approx(reference, rel=1e-9), name
-    # the VTU a run writes: the ids of the file, read back as a packing
     doc = tmp_path / "from_csv.toml"
     doc.write_text("\n".join(["[material]"] + [f"{k} = {v!r}" for k, v in COPPER.items()] + [
         "[particles]", 'file = "paraview.csv"', "temperature = 0.0", "[periodic]",
         f"lengths = {lengths}", f"origin = {origin}", "drop = [0.0, 0.0, 1.0]", "[solver]", 'mode = "steady"']))
     result = run(load_scene(doc), out=tmp_path / "run")
-    written = read_packing(tmp_path / "run" / "particles_00000.vtu")
+    written = read_packing(tmp_path / "run" / "particles_00000.vtu")  # with the file's ids and the temperatures
     same_particles(packing, written, lengths=np.array(lengths))
     np.testing.assert_allclose(written.temperature, result.T, rtol=1e-15)
+
+
+def test_the_packing_written_by_lammps_gives_the_same_conductivity(lammps_written, tmp_path):
+    """LAMMPS's write_data and write_dump of the packing: the same steady k_eff as the packing given as arrays, the
+    box from the file (the data file's periodicity from [periodic], the dump's from its pp flags)."""
+    folder, packing = lammps_written
+    reference = reference_k_eff(packing)
+    for name in ("lammps.data", "lammps.dump"):
+        (tmp_path / name).write_bytes((folder / name).read_bytes())
+        k_eff = steady_k_eff({"file": name, "temperature": 0.0}, {"drop": [0.0, 0.0, 1.0]}, tmp_path)
+        assert k_eff == pytest.approx(reference, rel=1e-9), name
 
 
 # ---------------------------------------------------------------------------------- our writer, LAMMPS's reader
