@@ -333,13 +333,13 @@ def lammps_command() -> tuple[list[str], dict] | None:
 
 
 def write_lammps_data(path: pathlib.Path, sample: dict, density: float) -> None:
-    """``atom_style sphere`` data file of the periodic packing: id, type, diameter, density, x, y, z."""
-    box, x, r = sample["box"], sample["position"], sample["radius"]
-    head = ["sinterheat periodic packing", "", f"{len(r)} atoms", "1 atom types", ""]
-    head += [f"0 {float(box[a])!r} {c}lo {c}hi" for a, c in enumerate("xyz")]
-    rows = [f"{k + 1} 1 {2.0 * r[k]:.17g} {float(density)!r} {x[k, 0]:.17g} {x[k, 1]:.17g} {x[k, 2]:.17g}"
-            for k in range(len(r))]
-    path.write_text("\n".join(head + ["", "Atoms # sphere", ""] + rows) + "\n")
+    """``atom_style sphere`` data file of the periodic packing in the box from 0 to ``sample["box"]``
+    (:func:`dem.scene.packing_files.write_lammps_data`; atoms 1..N)."""
+    from dem.scene.packing_files import Packing, write_lammps_data as write_data
+
+    n = len(sample["radius"])
+    write_data(path, Packing(np.arange(1, n + 1), sample["position"], sample["radius"], box_lo=np.zeros(3),
+                             box_hi=np.asarray(sample["box"], dtype=float)), density)
 
 
 def lammps_input(data: pathlib.Path, material: LudingMaterial, style: str, dt: float, skin: float, m_eff: float,

@@ -79,7 +79,8 @@ def effective_conductivity(scene: Scene, summary: dict) -> float | None:
         return None
     boundary = summary["boundary_heat_flow"]
     if sp.hot_particles:
-        q = -sum(boundary.get("particles", {}).get(str(k), 0.0) for k in sp.hot_particles)
+        ids = scene.particles.id
+        q = -sum(boundary.get("particles", {}).get(str(ids[k]), 0.0) for k in sp.hot_particles)
     else:
         q = -boundary["walls"]["hot"]
     return q * sp.length / (sp.area * (sp.hot - sp.cold))

@@ -103,8 +103,9 @@ class ThermalModel:
         flows = boundary_heat_flow(self.network, T)
         out = {"walls": {w.name: float(q) for w, q in zip(self.scene.walls, flows["walls"])},
                "fixed_total": float(sum(flows["particles"].values()))}
-        if len(flows["particles"]) <= 1000:
-            out["particles"] = {str(k): v for k, v in flows["particles"].items()}
+        if len(flows["particles"]) <= 1000:  # by particle id (the index unless a packing file gave ids)
+            ids = self.scene.particles.id
+            out["particles"] = {str(ids[k]): v for k, v in flows["particles"].items()}
         return out
 
     def bond_heat_flow(self) -> tuple[np.ndarray, np.ndarray]:

@@ -2,7 +2,7 @@
 
 * ``timeseries.csv`` -- step, t, mean/min/max temperature, and the heat flow into the particles (W) through
   each boundary: fixed particles, walls, convection, radiation, internal sources.
-* ``particles.pvd`` + ``particles_NNNNN.vtu`` -- particles as points (vertex cells) with radius, temperature,
+* ``particles.pvd`` + ``particles_NNNNN.vtu`` -- particles as points (vertex cells) with id, radius, temperature,
   fixed and material.
 * ``bonds.pvd`` + ``bonds_NNNNN.vtu`` -- bonds as lines with conductance, heat flow and neck radius; a wall bond
   joins the particle to its foot point on the wall, a bond across a periodic face joins the particle to the image
@@ -124,7 +124,7 @@ class RunWriter:
         p, b = self.scene.particles, self.model.bonds
         write_vtu(self.out / f"particles_{step:05d}.vtu", meshio.Mesh(
             p.position, [("vertex", np.arange(p.n).reshape(-1, 1))],
-            point_data={"radius": p.radius, "temperature": T, "fixed": p.fixed.astype(np.int8),
+            point_data={"id": p.id, "radius": p.radius, "temperature": T, "fixed": p.fixed.astype(np.int8),
                         "material": p.material.astype(np.int32)}))
         self.model.T = T
         q_pairs, q_walls = self.model.bond_heat_flow()
@@ -198,9 +198,9 @@ def write_summary(path, summary: dict) -> None:
 
 class MotionWriter:
     """Observer of the engine for moving particles: a ``timeseries.csv`` row per output time and snapshots every
-    ``[output] vtu_interval`` (and at the start and end): ``particles_NNNNN.vtu`` (points with the fields the
-    submodels offer) and ``contacts_NNNNN.vtu`` (lines with normal and tangential force and overlap), each listed in
-    its PVD collection as soon as it is written."""
+    ``[output] vtu_interval`` (and at the start and end): ``particles_NNNNN.vtu`` (points with their ids and the
+    fields the submodels offer) and ``contacts_NNNNN.vtu`` (lines with normal and tangential force and overlap),
+    each listed in its PVD collection as soon as it is written."""
 
     def __init__(self, out_dir, scene, resume_step: int | None = None):
         """``resume_step``: go on with the files of a run resumed from the checkpoint at that step."""
@@ -255,7 +255,7 @@ class MotionWriter:
             self.snapshots.append((t, step))
             return
         s = sim.mechanics.state
-        fields = sim.particle_fields()
+        fields = {"id": self.scene.particles.id, **sim.particle_fields()}
         write_vtu(self.out / f"particles_{step:09d}.vtu", meshio.Mesh(
             s.x, [("vertex", np.arange(s.n).reshape(-1, 1))], point_data=fields))
         i, j, cfields = sim.contact_fields()

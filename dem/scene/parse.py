@@ -15,13 +15,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from dem.scene import state_file
+from dem.scene import packing_files, state_file
 from dem.geometry import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.fields import material_from_table
 from dem.laws.contact import law_module
 from dem.scene.zohdi import ElectricalSpec, parse_electrical
-from dem.geometry.particles import COPPER, Material, Particles
+from dem.geometry.particles import COPPER, Material, Particles, material_indices
 from dem.geometry.periodic import AXES, PeriodicBox
 from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
 from dem.network.heat import INTEGRATORS
@@ -37,7 +37,7 @@ RTOL_MIN = 1e-9  # [solver] rtol of dt = "auto"
 ALLOWED = {
     "scene": {"name", "description", "physics"},
     "material": {"name", "conductivity", "density", "specific_heat", "electrical_conductivity"},
-    "particles": {"position", "radius", "temperature", "fixed", "material", "heat"},
+    "particles": {"position", "radius", "temperature", "fixed", "material", "heat", *packing_files.SCENE_KEYS},
     "generator": {"kind", "n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter",
                   "structure", "temperature", "boundary", "hot", "cold", "heat", "box", "speed"},
     "periodic": {"lengths", "axes", "origin", "drop"},
@@ -216,36 +216,21 @@ def _materials(doc, thermal: bool = True, electrical: bool = False) -> tuple:
     return tuple(out)
 
 
-def _material_index(value, materials, n):
-    if value is None:
-        return None
-    names = [m.name for m in materials]
-    if isinstance(value, (str, int)) and not isinstance(value, bool):
-        value = [value] * n
-    if not isinstance(value, list):
-        raise ValueError("[particles] material: must be a material name/index or a list of them")
-    out = []
-    for k, v in enumerate(value):
-        if isinstance(v, str):
-            if v not in names:
-                raise ValueError(f"[particles] material[{k}] = {v!r}: unknown (materials: {', '.join(names)})")
-            out.append(names.index(v))
-        elif isinstance(v, int) and not isinstance(v, bool):
-            out.append(v)
-        else:
-            raise ValueError(f"[particles] material[{k}] = {v!r}: must be a material name or index")
-    return out
-
-
-def _explicit_particles(t: dict, materials):
+def _explicit_particles(t: dict, materials, base_dir=None):
     _check_keys(t, "particles", ALLOWED["particles"])
+    if "file" in t:  # a packing file (dem.scene.packing_files); its box, periodic or not, is returned as the box
+        particles, box = packing_files.scene_particles(t, materials, base_dir)
+        return particles, (), None, None, box
+    extra = sorted(set(t) & set(packing_files.SCENE_KEYS))
+    if extra:
+        raise ValueError(f"[particles] {extra[0]}: only with file = \"...\" (a packing file)")
     for key in ("position", "radius", "temperature"):
         if key not in t:
             raise ValueError(f"[particles] {key}: required")
     n = len(t["position"]) if isinstance(t["position"], list) else 0
-    return Particles.from_arrays(t["position"], t["radius"], t["temperature"], materials,
-                                 _material_index(t.get("material"), materials, n), t.get("fixed"), t.get("heat"),
-                                 prefix="[particles]"), (), None, None, None
+    material = material_indices("[particles] material", t.get("material"), materials, n)
+    return Particles.from_arrays(t["position"], t["radius"], t["temperature"], materials, material, t.get("fixed"),
+                                 t.get("heat"), prefix="[particles]"), (), None, None, None
 
 
 def _generated_particles(t: dict, materials, dimension: int = 3):
@@ -318,13 +303,15 @@ def _generated_particles(t: dict, materials, dimension: int = 3):
     return particles, walls, specimen, layout.velocity, box
 
 
-def _periodic_box(t: dict) -> PeriodicBox:
+def _periodic_box(t: dict, file_box: PeriodicBox | None = None) -> PeriodicBox:
     """``[periodic]``: ``lengths`` (m), ``axes`` (the periodic ones, default all), ``origin``, ``drop`` (the
-    temperature drop per period along each axis)."""
+    temperature drop per period along each axis). With a packing file's box ``file_box``, ``lengths`` and
+    ``origin`` default to its box and ``axes`` to its periodic axes (all where it has none)."""
     _check_keys(t, "periodic", ALLOWED["periodic"])
-    if "lengths" not in t:
+    if "lengths" not in t and file_box is None:
         raise ValueError("[periodic] lengths: required (the period along x, y and z, m)")
-    axes = t.get("axes", list(AXES))
+    default_axes = [a for a, p in zip(AXES, file_box.periodic) if p] if file_box is not None else []
+    axes = t.get("axes", default_axes or list(AXES))
     if not isinstance(axes, list) or not all(isinstance(a, str) and a in AXES for a in axes) or not axes:
         raise ValueError(f"[periodic] axes = {axes!r}: must be a non-empty list of \"x\", \"y\", \"z\"")
     values = {}
@@ -335,6 +322,9 @@ def _periodic_box(t: dict) -> PeriodicBox:
                     or not all(_is_number(x) and math.isfinite(x) for x in v)):
                 raise ValueError(f"[periodic] {key} = {v!r}: must be a list of three finite numbers")
             values[key] = v
+    if file_box is not None:
+        values.setdefault("lengths", file_box.lengths)
+        values.setdefault("origin", file_box.origin)
     try:
         return PeriodicBox(values["lengths"], tuple(a in axes for a in AXES), values.get("origin"), values.get("drop"))
     except ValueError as exc:
@@ -437,23 +427,26 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
             raise ValueError("[start] state: required, the path of a saved state (.npz)")
         start = state_file.load(base_dir / name if base_dir is not None else name)
         particles = Particles.from_arrays(start["x"], start["radius"], start["T"], materials,
-                                          prefix="[start] state")
+                                          prefix="[start] state", id=start.get("id"))
         walls, specimen, velocity, box = (), None, None, None
     elif ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
     elif "particles" in doc:
-        particles, walls, specimen, velocity, box = _explicit_particles(doc["particles"], materials)
+        particles, walls, specimen, velocity, box = _explicit_particles(doc["particles"], materials, base_dir)
     else:
         dimension = full.get("scene", {}).get("dimension", 3) if moving else 3
         particles, walls, specimen, velocity, box = _generated_particles(doc["generator"], materials, dimension)
     if "periodic" in doc:
-        if box is not None:
+        if box is not None and "generator" in doc:
             raise ValueError("[periodic]: the generator's boundary = \"periodic\" already makes the block periodic; "
                              "give one or the other")
-        box = _periodic_box(doc["periodic"])
+        box = _periodic_box(doc["periodic"], box)
+    elif box is not None and not box.any_periodic:
+        box = None  # a packing file's box that is not periodic (or that cannot say): only [periodic] uses it
     if box is not None and moving:
-        raise ValueError("[periodic]: periodic boxes are for static packings so far (the neighbour list of moving "
-                         "particles does not use dem.geometry.periodic yet)")
+        raise ValueError(f"{'[periodic]' if 'periodic' in doc else '[particles] file: its box is periodic, and'}: "
+                         "periodic boxes are for static packings so far (the neighbour list of moving particles does "
+                         "not use dem.geometry.periodic yet)")
     if not moving:
         walls = walls + _walls(doc)
     cond = dict(doc.get("conductance", {}))

@@ -2,8 +2,9 @@
 
 ``save(sim, path)`` writes one ``.npz`` with everything a run needs to go on as if it had not stopped: positions,
 velocities, angular velocities, the forces and torques of the last step (velocity Verlet starts a step from them),
-masses, moments of inertia, reference radii, temperatures and stiffness factors of the particles; the contact history of every listed pair (``delta_max``, the factor of the last step, the tangential
-spring) and of every particle-wall pair; each wall's name, offset, velocity and acceleration; the time, the step
+masses, moments of inertia, reference radii, temperatures, stiffness factors and ids of the particles; the contact
+history of every listed pair (``delta_max``, the factor of the last step, the tangential spring) and of every
+particle-wall pair; each wall's name, offset, velocity and acceleration; the time, the step
 count and the time step. ``load(path)`` reads it back as a dict (refusing files that are not such a state).
 
 A scene starts from a saved state with ``[start] state = "file.npz"`` (Luding 2005, Sec. 4: a prepared sample is
@@ -37,6 +38,7 @@ def arrays(sim) -> dict:
             "wall_dq": mech.w.dq, "wall_acc": mech.w.acc}
     data.update({k: getattr(s, k) for k in PARTICLE_KEYS if hasattr(s, k)})
     data.update(contact_law=np.array(mech.law.NAME), particle_state=mech.particle_state)
+    data["id"] = sim.scene.particles.id  # optional on load: states written before ids were kept have none
     data.update({k: getattr(mech, k) for k in PAIR_KEYS + WALL_KEYS})
     if sim.thermal is not None:
         th = sim.thermal
