@@ -26,6 +26,7 @@ K_pipes = 1.0 / np.sum(1.0 / np.array(pipes))  # the bonds in series, as the DEM
 print(f"K_fe = {K_fe:.6f} W/K (estimate {fe.error_estimate:.0e}), pipes in series (fit law) {K_pipes:.6f} W/K "
       f"({K_pipes / K_fe - 1:+.2%})")
 
+# %%
 # The temperature in the meridian half-plane (x radial, y along the chain, in m), 1 K across the chain.
 points, triangles, T, _ = sampled_fields(fe, delta_t=1.0)
 fig, ax = plt.subplots(figsize=(4.8, 7), layout="constrained")

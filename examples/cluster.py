@@ -44,6 +44,7 @@ K_dem = -dem.summary["boundary_heat_flow"]["particles"]["0"] / 1.0  # W/K: heat 
 print(f"{path}: 3D FE K = {K_cluster:.5f} W/K ({solution.dofs} dofs, middle particle at {middle_T:.4f}); "
       f"DEM pipe network (fit law) {K_dem:.5f} W/K ({K_dem / K_cluster - 1:+.2%})")
 
+# %%
 # Each particle's mean temperature, FE (colour) and DEM (label), in the plane of the L (y = 0). The DEM holds the
 # terminals at 1 and 0; the FE holds their centre planes there, so its means are those of the halves beyond them.
 centres_mm = [(x * 1e3, z * 1e3) for x, _, z in data["centres"]]

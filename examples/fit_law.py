@@ -25,6 +25,8 @@ print(f"slope {slope:.4f} (Rojek 2022: {ROJEK.slope}, Argento & Bouvard: {ARGENT
       f"full-range law B = {law.B:.5f}, C = {law.C:.5f}, E = {law.E:.5f}, "
       f"within {law.max_rel_residual:.1e} of the FE over {law.fit_range[0]} <= a/r <= {law.fit_range[1]}")
 
+# %%
+# The Fig. 16 analogue: the FE points and the laws; below, each law against the FE.
 xs = np.linspace(0.0, 1.0, 401)
 fig, (ax, ax_dev) = plt.subplots(2, 1, figsize=(6.4, 7), height_ratios=(3, 2), layout="constrained")
 ax.plot(x, f, "o", ms=4, mfc="none", color="k", label="FE, semisphere with a neck")

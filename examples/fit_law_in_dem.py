@@ -25,6 +25,7 @@ K_chain = Q / 100.0  # W/K
 print(f"T = {np.round(result.T, 3)} C; heat flow {Q:.4f} W; chain conductance {K_chain:.6f} W/K "
       f"(pipes {np.round(result.thermal.K_pairs, 5)} W/K)")
 
+# %%
 # Each particle is one temperature (lumped), drawn over its extent along the chain; the drops are at the necks.
 fig, ax = plt.subplots(figsize=(6.4, 4), layout="constrained")
 for k, (z_k, r_k, T_k) in enumerate(zip(z, radius, result.T)):

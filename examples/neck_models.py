@@ -21,6 +21,8 @@ coble_error = a_coble / a - 1
 print(f"a = {a * 1e3:.6f} mm, Coble {a_coble * 1e3:.6f} mm ({coble_error:+.2%}), "
       f"first iterate {a_first * 1e3:.6f} mm ({a_first / a - 1:+.2%})")
 
+# %%
+# Figs. 10 and 11: the neck against the overlap, and how far Coble's neck and the first iterate are from it.
 r_i = 1e-3  # m
 fig, (ax_a, ax_err) = plt.subplots(1, 2, figsize=(10, 4.2), layout="constrained")
 for ratio in (1, 2, 3, 5, 10):

@@ -24,6 +24,7 @@ k_eff = result.summary["effective_conductivity"]  # Q L / (A dT), W/(m K)
 print(f"{result.summary['particles']} particles, {result.summary['bonds']} bonds: k_eff = {k_eff:.3f} W/(m K), "
       f"{k_eff / 394.0:.4f} of solid copper")
 
+# %%
 # Every particle's temperature against its height between the plates (hot below, cold above).
 height_mm = result.thermal.network.particles.position[:, 2] * 1e3
 fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")

@@ -27,6 +27,7 @@ reference = SEMISPHERE_BY_H[h_over_r].K_over_Kcyl
 print(f"a/r = {a_over_r:.9f}: K/K_cyl = {K_over_Kcyl:.10f} (estimate {result.error_estimate:.1e}), "
       f"reference {reference:.12f}, error {abs(K_over_Kcyl / reference - 1):.1e}")
 
+# %%
 # The fields in the meridian half-plane (x radial, y axial; the solve has r = 1 and kappa = 1).
 r, kappa, delta_T = 10e-3, 394.0, 10.0  # m, W/(m K), °C: Rojek 2022, Sec. 5
 points, triangles, T, q = sampled_fields(result, delta_t=delta_T)

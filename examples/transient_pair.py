@@ -33,6 +33,7 @@ difference_error = abs((T_i - T_j) - exact) / 100.0
 print(f"t = 0.1 s: T = {T_i:.5f}, {T_j:.5f} C; T_i - T_j = {T_i - T_j:.5f} (closed form {exact:.5f}), "
       f"{result.summary['steps']} steps, energy error {result.summary['energy_error']:.0e}")
 
+# %%
 # Every step of the run against the closed form (the small particle is the hotter one: T_max).
 steps = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
 t = np.linspace(0.0, 0.1, 400)

@@ -26,6 +26,7 @@ K_law = law.pair_conductance(kappa, r_i, r_j, a)  # the full-range law, each hal
 print(f"a = {a * 1e3:.6f} mm; K_fe = {K_fe:.7f} W/K (estimate {fe.error_estimate:.0e}); eq. 45: {K_model:.6f} W/K "
       f"({K_model / K_fe - 1:+.2%}); fit law: {K_law:.6f} W/K ({K_law / K_fe - 1:+.2%})")
 
+# %%
 # The axial section: the meridian half-plane (x radial, y axial, in m) mirrored across the axis.
 points, triangles, T, _ = sampled_fields(fe, delta_t=10.0)  # T in °C above the cold disk
 x_mm = np.concatenate([points[:, 0], -points[:, 0]]) * 1e3
