@@ -11,10 +11,6 @@ import importlib
 import inspect
 import pkgutil
 
-from sphinx.util import logging
-
-logger = logging.getLogger(__name__)
-
 
 def public_objects(package: str) -> list[str]:
     """Dotted names of the public functions and classes defined in ``package`` and its modules (``__main__``
@@ -36,6 +32,9 @@ def public_objects(package: str) -> list[str]:
 
 
 def check(app, env):
+    from sphinx.util import logging  # here, so that the tests import this module without Sphinx
+
+    logger = logging.getLogger(__name__)
     documented = set(env.get_domain("py").objects)
     for package in app.config.api_packages:
         missing = [name for name in public_objects(package) if name not in documented]
