@@ -21,7 +21,7 @@ import sys
 
 from benchmarks import SUBJECTS
 from benchmarks.timing import available, package_version
-from fem_neck.cli import OneLineParser
+from sinterheat.cli import OneLineParser
 from verification.report import OK, Report, add_run_options, prepare_out, print_report
 
 PROG = "python -m benchmarks"
@@ -38,7 +38,7 @@ def build_parser() -> OneLineParser:
 
 
 def main(argv=None) -> int:
-    from fem_neck.interrupt import Where, run_command
+    from sinterheat.interrupt import Where, run_command
 
     here = Where(PROG)
     return run_command(here, _main, argv, here)
@@ -74,6 +74,6 @@ def _main(argv, here) -> int:
 
 
 if __name__ == "__main__":
-    from fem_neck.interrupt import exit_process
+    from sinterheat.interrupt import exit_process
 
     exit_process(main())

@@ -22,7 +22,7 @@ LIMITS = {"dem_steady_1e6_seconds": 30.0, "dem_steady_1e6_peak_gib": 8.0, "dem_t
 
 
 def packing_network(n: int, seed: int = 0, connected_only: bool = False, t_hot: float = 1.0):
-    """A random sintered packing of ~n copper particles (``dem.generators.random_packing``) between a hot bottom
+    """A random sintered packing of ~n copper particles (``dem.geometry.generators.random_packing``) between a hot bottom
     layer (fixed at ``t_hot``) and a cold top layer (fixed at 0), free particles starting at 0, rojek law.
 
     ``connected_only`` keeps only the particles connected to a fixed layer (what a pore-network code can solve).
@@ -31,10 +31,10 @@ def packing_network(n: int, seed: int = 0, connected_only: bool = False, t_hot: 
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    from dem.bonds import find_bonds
-    from dem.generators import random_packing
-    from dem.particles import Particles
-    from dem.thermal import build_network
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.generators import random_packing
+    from dem.geometry.particles import Particles
+    from dem.network.heat import build_network
 
     times = {}
     t0 = time.perf_counter()
@@ -66,7 +66,7 @@ def packing_network(n: int, seed: int = 0, connected_only: bool = False, t_hot: 
 # ------------------------------------------------------------------------------------------- fresh-process workers
 def steady_worker(n: int) -> None:
     """One steady solve of a packing of ~n particles; one JSON line."""
-    from dem.thermal import steady
+    from dem.network.heat import steady
 
     base = peak_rss_mib()
     net, times = packing_network(n)
@@ -112,7 +112,7 @@ def openpnm_worker(n: int) -> None:
     """Ours and OpenPNM on the same connected network of ~n particles; one JSON line."""
     from dataclasses import replace
 
-    from dem.thermal import steady
+    from dem.network.heat import steady
 
     net, _ = packing_network(n, connected_only=True)
     p, b = net.particles, net.bonds
@@ -135,7 +135,7 @@ def cheap_explicit_bound(net) -> float:
 
 def transient_worker(n: int) -> None:
     """Implicit Euler, ~n particles x 1000 steps at dt = 10 x the cheap explicit bound; one JSON line."""
-    from dem.thermal import integrate
+    from dem.network.heat import integrate
 
     net, times = packing_network(n)
     bound = cheap_explicit_bound(net)
@@ -153,7 +153,7 @@ def transient_worker(n: int) -> None:
 def study_transient_accuracy(section, quick: bool) -> None:
     from matplotlib.figure import Figure
 
-    from dem.thermal import integrate, stable_limit
+    from dem.network.heat import integrate, stable_limit
 
     net, _ = packing_network(500 if quick else 2000, seed=1)
     limit = stable_limit(net)
@@ -186,21 +186,21 @@ def study_transient_accuracy(section, quick: bool) -> None:
         "DEM transient: error against time",
         f"Random sintered packing ({net.particles.n} copper particles, mean radius {PACKING['radius']:g} m, mean "
         f"relative overlap {PACKING['overlap']}, rojek law), bottom layer fixed at 1, top at 0, free particles "
-        f"starting at 0; explicit stable limit {limit:.4g} s (dem.thermal.stable_limit); t_end = 200 x limit. "
+        f"starting at 0; explicit stable limit {limit:.4g} s (dem.network.heat.stable_limit); t_end = 200 x limit. "
         f"Reference: Crank-Nicolson at dt = limit/16 ({t_ref:.2f} s; its own error ~{ref_error:.1e} from the "
         "dt/8 run). Error: max over particles of |T - T_ref|; `auto` is the error-controlled step "
-        "(dem.thermal.integrate).\n\n"
+        "(dem.network.heat.integrate).\n\n"
         + records_table(rows, ["integrator", "dt", "steps", "rejected", "error", "energy_error", "solver", "seconds"]),
         figures=[figure],
     )
 
 
 def study_linear_solvers(section, quick: bool) -> None:
-    """The backends of ``dem.linsolve`` on the matrices the DEM solves, with the choice of ``"auto"``."""
+    """The backends of ``dem.network.linsolve`` on the matrices the DEM solves, with the choice of ``"auto"``."""
     import scipy.sparse as sp
 
-    from dem.linsolve import BACKENDS, DIRECT_MAX, choose_backend
-    from dem.thermal import integrate
+    from dem.network.linsolve import BACKENDS, DIRECT_MAX, choose_backend
+    from dem.network.heat import integrate
 
     sizes = (2_000, 5_000) if quick else (2_000, 5_000, 10_000, 20_000, 50_000)
     direct_max = 25_000  # SuperLU's fill-in: ~1 s at 2e4 unknowns, ~15 s at 5e4
@@ -243,14 +243,14 @@ def study_linear_solvers(section, quick: bool) -> None:
                "amg_setup_s", "amg_solve_s", "amg_iterations"]
     section.add_text(
         "DEM linear solvers",
-        "The backends of `dem.linsolve` on random sintered packings between fixed plates (rojek law, seed 1), "
+        "The backends of `dem.network.linsolve` on random sintered packings between fixed plates (rojek law, seed 1), "
         "solving to rtol 1e-10 from zero: seconds of the setup (factorisation or multigrid hierarchy) and of one "
         "solve, CG/AMG iterations. `steady`: the network matrix A; `C/dt + A`: an implicit step with dt in units "
         "of the cheap explicit bound 2 min C_i / L_ii. `auto` is the backend `\"auto\"` picks (Jacobi-CG when the "
         f"capacity term makes the matrix diagonally dominant enough, else direct up to {DIRECT_MAX} unknowns and "
         f"AMG above); direct is not run above {direct_max} unknowns.\n\n"
         + records_table(rows, columns, fmt="{:.3g}")
-        + "\n\nWhole runs on the same decay (`dem.thermal.integrate`):\n\n" + records_table(runs, fmt="{:.3g}"),
+        + "\n\nWhole runs on the same decay (`dem.network.heat.integrate`):\n\n" + records_table(runs, fmt="{:.3g}"),
     )
 
 
@@ -286,7 +286,7 @@ def study_steady_scaling(section, quick: bool) -> None:
     section.add_text(
         "DEM steady solve: cost against N",
         "Each N in a fresh subprocess: random sintered packing with hot/cold fixed layers; `steady_seconds` = bonds "
-        "(k-d tree + neck radii) + conductances and network assembly + `dem.thermal.steady` (floating = \"mean\" "
+        "(k-d tree + neck radii) + conductances and network assembly + `dem.network.heat.steady` (floating = \"mean\" "
         "for the few particles the packing leaves unbonded); the packing generation is listed apart. Peak memory "
         "is the process's maximum RSS, the baseline after imports alongside.\n\n"
         + records_table(rows, ["particles", "bonds", "packing_seconds", "bonds_seconds", "network_seconds",
@@ -329,7 +329,7 @@ def study_openpnm(section, quick: bool) -> None:
         f"OpenPNM {package_version('openpnm')} `FourierConduction` (its default solver) on exactly our network: the "
         "particles connected to the fixed layers, our bonds as throats, our bond conductances as "
         "`throat.thermal_conductance`, the hot/cold layers as value boundary conditions; each N in a fresh "
-        "subprocess. Ours = network assembly + `dem.thermal.steady`; OpenPNM = network/phase/algorithm set-up + "
+        "subprocess. Ours = network assembly + `dem.network.heat.steady`; OpenPNM = network/phase/algorithm set-up + "
         "`run()`. The two solutions agree to `max_abs_difference` (temperatures in [0, 1]). N = 10^6 is not run: "
         "OpenPNM's default PARDISO factorisation passed 14 GiB resident after 8 minutes there.\n\n"
         + records_table(rows, ["particles", "bonds", "ours_seconds", "ours_solver", "openpnm_setup_seconds",
@@ -353,7 +353,7 @@ def study_transient_big(section, quick: bool) -> None:
     section.summary["dem_transient_big"] = row
     section.add_text(
         "DEM transient: implicit, 10^5 particles x 1000 steps" + (" (quick: 10^4)" if quick else ""),
-        "Random sintered packing with hot/cold fixed layers; backward Euler (`dem.thermal.integrate`, linear "
+        "Random sintered packing with hot/cold fixed layers; backward Euler (`dem.network.heat.integrate`, linear "
         "backend auto) at dt = 10 x the cheap explicit bound 2 min C_i / sum_j K_ij, 1000 steps, in a fresh "
         "subprocess; `integrate_seconds` excludes building the bonds (`setup_seconds`).\n\n"
         + records_table([row], ["particles", "bonds", "steps", "dt", "solver", "integrate_seconds",

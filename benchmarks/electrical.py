@@ -4,19 +4,19 @@ the Luding engine, and the Kirchhoff solve against the paper's current iteration
 The ``electrical`` subject of ``python -m benchmarks`` (:func:`run`) measures, in one process:
 
 * ``section7`` -- the built-in scene ``zohdi-compaction`` (1000 spheres, 1 s, Sec. 7) run end to end (the wall time
-  of :meth:`dem.zohdi.simulation.ZohdiSimulation.run`, no outputs written), with its steps, fixed-point iterations,
+  of :meth:`dem.engines.staggered.engine.ZohdiSimulation.run`, no outputs written), with its steps, fixed-point iterations,
   restarts and step sizes, and the three phases of Fig. 9 (volume fraction when the wall first carries current,
   the largest, the last; mean temperature then);
 * ``step_cost`` -- on the compacted packing of that run (t = 0.79 s, both electrodes touching): ns per particle of
   one fixed-point iteration of the mechanics (forces and update, compiled), of one iteration of the heat balance,
-  of one refresh of the current, and of one velocity-Verlet step of the Luding 2005 loop (:mod:`dem.md_loop`) on
+  of one refresh of the current, and of one velocity-Verlet step of the Luding 2005 loop (:mod:`dem.engines.verlet.loop`) on
   the same positions; best of R;
 * ``current_solve`` -- on the same packing, the Laplace problem of Zohdi's eq. (43) (contact areas as weights, the
   particles touching the electrodes held at 1 and 0) solved by the generic network solve (sparse direct) and by
   the paper's Gauss-Seidel sweeps from zero until they are within 1e-3, 1e-6 and 1e-9 of it; and the physical
-  Kirchhoff solve of :mod:`dem.electrical` (bonds, conductances, potentials, Joule heat);
+  Kirchhoff solve of :mod:`dem.network.current` (bonds, conductances, potentials, Joule heat);
 * ``current_scaling`` -- the same two solves to 1e-6 on random sintered packings of 1000 to 16 000 particles
-  (:func:`dem.generators.random_packing`, bottom layer at 0, top layer at 1): the sweeps grow with the square of
+  (:func:`dem.geometry.generators.random_packing`, bottom layer at 0, top layer at 1): the sweeps grow with the square of
   the height, the direct solve with its fill-in.
 
 :func:`section7_row` is the row a benchmark table needs (seconds, steps, iterations, restarts, ns per
@@ -45,7 +45,7 @@ def _scene():
 
 def section7_row() -> dict:
     """The Section 7 example run end to end: wall time and what it took (module docstring)."""
-    from dem.zohdi.simulation import ZohdiSimulation
+    from dem.engines.staggered.engine import ZohdiSimulation
 
     scene = _scene()
     rows = []
@@ -85,7 +85,7 @@ def _best(fn, repeat: int) -> float:
 
 def compacted(t: float = 0.79):
     """The Section 7 run stepped to ``t`` (the powder pressed, both electrodes touching)."""
-    from dem.zohdi.simulation import ZohdiSimulation
+    from dem.engines.staggered.engine import ZohdiSimulation
 
     sim = ZohdiSimulation(_scene())
     while sim.t < t:
@@ -95,9 +95,9 @@ def compacted(t: float = 0.79):
 
 def step_cost(sim, repeat: int = 5, luding_steps: int = 200) -> dict:
     """ns per particle of the pieces of a Zohdi step and of a Luding velocity-Verlet step, same packing."""
-    from dem.laws.luding import LUDING_TABLE1
-    from dem.mechanics import MechanicalModel
-    from dem.motion import MotionState
+    from dem.laws.contact.luding import LUDING_TABLE1
+    from dem.engines.verlet.mechanics import MechanicalModel
+    from dem.geometry.motion import MotionState
 
     mech, th, cur = sim.mechanics, sim.thermal, sim.current
     n = mech.state.n
@@ -134,8 +134,8 @@ def step_cost(sim, repeat: int = 5, luding_steps: int = 200) -> dict:
 def current_solve(sim, repeat: int = 3) -> dict:
     """The area-weighted Laplace problem of eq. (43) by the network solve and by Gauss-Seidel sweeps to 1e-3, 1e-6,
     1e-9 of it; the physical Kirchhoff refresh for comparison (module docstring)."""
-    from dem.electrical import area_weighted_current
-    from dem.zohdi.heat import contact_bonds
+    from dem.network.current import area_weighted_current
+    from dem.engines.staggered.heat import contact_bonds
 
     mech, cur = sim.mechanics, sim.current
     n = mech.state.n
@@ -166,7 +166,7 @@ def _direct(n, b, area, node, index, values):
     """The area-weighted Laplace problem of eq. 43 (bonds ``b``, weights ``area``) with the potential of particle
     ``node[k]`` held at ``values[index[k]]``, solved directly on the components that hold a fixed particle: the
     potentials and the free particles solved for."""
-    from dem.network import BoundedLaplacian, solve_anchored
+    from dem.network.laplacian import BoundedLaplacian, solve_anchored
 
     fixed = np.zeros(n, dtype=bool)
     fixed[node] = True
@@ -182,7 +182,7 @@ def _direct(n, b, area, node, index, values):
 
 def _sweeps_to(n, b, area, plane_node, plane_index, values, reference, free, accuracy):
     """Gauss-Seidel sweeps of eq. (43) from zero until within ``accuracy`` of ``reference``: ``(result, tol)``."""
-    from dem.electrical import area_weighted_current
+    from dem.network.current import area_weighted_current
 
     tol = accuracy
     while True:  # the stopping rule is on the change per sweep; tighten it until the error is within the accuracy
@@ -194,10 +194,10 @@ def _sweeps_to(n, b, area, plane_node, plane_index, values, reference, free, acc
 
 def current_scaling(sizes=(1000, 4000, 16000), accuracy: float = 1e-6, repeat: int = 3) -> list:
     """Direct network solve against Gauss-Seidel sweeps of eq. (43) on random packings (module docstring)."""
-    from dem.bonds import find_bonds
-    from dem.electrical import area_weighted_current
-    from dem.generators import random_packing
-    from dem.particles import Particles
+    from dem.geometry.bonds import find_bonds
+    from dem.network.current import area_weighted_current
+    from dem.geometry.generators import random_packing
+    from dem.geometry.particles import Particles
 
     rows = []
     for size in sizes:

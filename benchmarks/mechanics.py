@@ -1,7 +1,7 @@
 """The engine for moving particles: the cost of its time loop against LAMMPS, its compile cost, and the thermal-only
 path it must leave alone.
 
-* **The loop** -- ns per particle-step of the whole velocity-Verlet step (:meth:`dem.mechanics.MechanicalModel.
+* **The loop** -- ns per particle-step of the whole velocity-Verlet step (:meth:`dem.engines.verlet.mechanics.MechanicalModel.
   advance`: kicks, material state, contacts, walls, and the Verlet-list rebuilds it asks for), warm, best of a few
   rounds, on
 
@@ -26,7 +26,7 @@ path it must leave alone.
   with an empty numba cache (``NUMBA_CACHE_DIR`` a new folder), then in a second fresh process on that cache.
 * **Kernels** -- ns per contact of the Luding normal + tangential kernels on random contacts that visit every branch.
 * **Thermal-only path** -- a scene whose physics is only ``thermal`` loads no numba and no engine module (a
-  subprocess with ``-X importtime``), and :func:`dem.simulation.run` costs what the lower-level calls it makes
+  subprocess with ``-X importtime``), and :func:`dem.driver.run` costs what the lower-level calls it makes
   (bond search, conductances, network, steady or implicit solve) cost on the same scene, side by side.
 
 The compacted samples are cached (``.npz``, keyed by their parameters) in a folder that outlives the run, so that
@@ -50,9 +50,9 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 from numba import njit
 
-from dem import md_loop
-from dem.laws import luding_kernels as law
-from dem.laws.luding import LUDING_TABLE1, LudingMaterial
+from dem.engines.verlet import loop as md_loop
+from dem.laws.contact import luding_kernels as law
+from dem.laws.contact.luding import LUDING_TABLE1, LudingMaterial
 from verification.report import md_table
 
 TITLE = "DEM mechanics: the time loop against LAMMPS, compile cost, thermal-only path"
@@ -63,7 +63,7 @@ HEIGHT_2D = 6e-3  # Luding 2005, Table 1: disk height (m)
 PRESSURE_2D = 10.0  # N/m: the paper's smaller side stress, whose samples reach coordination ~4 (its Fig. 10)
 WALL_2D = {"mass": 0.01, "damping": 0.2}  # Table 1: wall mass (kg) and damping (kg/s)
 T_RUN = 80.0  # °C: the preparation temperature of Luding 2005, Sec. 4.1 (below the melting range)
-ENGINE_MODULES = ("numba", "dem.engine", "dem.mechanics", "dem.md_loop", "dem.neighbours", "dem.laws.luding_kernels")
+ENGINE_MODULES = ("numba", "dem.engines.verlet.engine", "dem.engines.verlet.mechanics", "dem.engines.verlet.loop", "dem.geometry.neighbours", "dem.laws.contact.luding_kernels")
 
 
 @dataclass(frozen=True)
@@ -100,7 +100,7 @@ def linear_limit(material: LudingMaterial) -> LudingMaterial:
 # ------------------------------------------------------------------------------------------------------ samples
 def _scene(material: LudingMaterial, dimension: int, particles: dict, walls=(), t_end: float = 1.0,
            box=(0.0, 0.0, 0.0)):
-    """A mechanical scene (:func:`dem.scene.parse_scene`) of ``material`` at :data:`T_RUN`; ``particles`` is the
+    """A mechanical scene (:func:`dem.scene.parse.parse_scene`) of ``material`` at :data:`T_RUN`; ``particles`` is the
     ``[particles]`` or ``[generator]`` table; ``box`` the periodic lengths (no TOML key: set on the parsed scene)."""
     from dem.scene import parse_scene
 
@@ -126,14 +126,14 @@ def _biaxial_walls(q_right: float, q_top: float) -> list[dict]:
 
 def biaxial_sample(sizes: Sizes, cache: pathlib.Path, seed: int = 1) -> dict:
     """The 2D sample (module docstring): disks placed at random in a square box at a solid fraction of ~0.35
-    (:func:`dem.generators.random_box`), compacted by the engine with frictionless Table 1 disks under the stress
+    (:func:`dem.geometry.generators.random_box`), compacted by the engine with frictionless Table 1 disks under the stress
     walls. Cached; returns ``position``, ``radius``, ``q_right``, ``q_top``, ``volume_fraction`` and the seconds
     the compaction took (0 when read from the cache)."""
     path = cache / f"biaxial_{PREPARATION}_n{sizes.disks}_t{sizes.compaction_time:g}_s{seed}.npz"
     if path.exists():
         with np.load(path) as data:
             return {**{k: data[k] for k in data.files}, "seconds": 0.0}
-    from dem.engine import Simulation
+    from dem.engines.verlet.engine import Simulation
 
     a0, w0 = 1e-3, 0.5  # Table 1: mean radius, relative width of the uniform distribution
     side = math.sqrt(sizes.disks * math.pi * a0**2 * (1.0 + w0**2 / 3.0) / 0.35)
@@ -166,10 +166,10 @@ def periodic_packing(sizes: Sizes, cache: pathlib.Path, seed: int = 0, coordinat
     if path.exists():
         with np.load(path) as data:
             return {**{k: data[k] for k in data.files}, "seconds": 0.0}
-    from dem.mechanics import MechanicalModel
-    from dem.motion import MotionState
-    from dem.moving_scene import time_steps
-    from dem.neighbours import verlet_pairs
+    from dem.engines.verlet.mechanics import MechanicalModel
+    from dem.geometry.motion import MotionState
+    from dem.scene.motion import time_steps
+    from dem.geometry.neighbours import verlet_pairs
 
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
@@ -212,7 +212,7 @@ def _at_rest(sample: dict) -> dict:
 
 def biaxial_simulation(sample: dict, material: LudingMaterial):
     """The engine on the compacted 2D sample, at rest, with ``material`` and the stress walls."""
-    from dem.engine import Simulation
+    from dem.engines.verlet.engine import Simulation
 
     walls = _biaxial_walls(float(sample["q_right"]), float(sample["q_top"]))
     return Simulation(_scene(material, 2, _at_rest(sample), walls))
@@ -220,7 +220,7 @@ def biaxial_simulation(sample: dict, material: LudingMaterial):
 
 def periodic_simulation(sample: dict, material: LudingMaterial):
     """The engine on the 3D packing, at rest, with ``material``, periodic on every axis."""
-    from dem.engine import Simulation
+    from dem.engines.verlet.engine import Simulation
 
     return Simulation(_scene(material, 3, _at_rest(sample), box=sample["box"]))
 
@@ -250,7 +250,7 @@ def time_ours(make, steps: int, warmup: int) -> dict:
 @njit  # not cached: numba's cache follows only this file, so a cached copy would keep an old engine's code
 def _force_passes(count, x, v, w, f, tau, spin_axes, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last,
                   p_xi, p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt):
-    """``count`` force passes of the engine's loop (:func:`dem.md_loop._forces`) in one compiled call."""
+    """``count`` force passes of the engine's loop (:func:`dem.engines.verlet.loop._forces`) in one compiled call."""
     for _ in range(count):
         md_loop._forces(x, v, w, f, tau, spin_axes, mass, radius, k1f, gravity, box, pi, pj, p_dmax, p_k1last, p_xi,
                         p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_dmax, w_k1last, w_xi, w_fn, w_ft, params, dt)
@@ -258,7 +258,7 @@ def _force_passes(count, x, v, w, f, tau, spin_axes, mass, radius, k1f, gravity,
 
 @njit  # not cached (as above)
 def _material_passes(count, t, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt):
-    """``count`` material-state updates of the engine's loop (:func:`dem.md_loop._material_state`)."""
+    """``count`` material-state updates of the engine's loop (:func:`dem.engines.verlet.loop._material_state`)."""
     for k in range(count):
         md_loop._material_state(k * dt, T0, T_rate, T, radius, radius_ref, k1f, uniform, params, t0, dt)
 
@@ -599,8 +599,9 @@ FIRST_CALLS = """
 import dataclasses, json, time
 t = time.perf_counter()
 import numpy as np
-from dem.laws import luding, luding_kernels as law
-from dem.engine import Simulation
+from dem.laws.contact import luding_kernels as law
+from dem.laws.contact import luding
+from dem.engines.verlet.engine import Simulation
 from dem.scene import parse_scene
 imported = time.perf_counter()
 p = luding.LUDING_TABLE1.params()
@@ -740,9 +741,9 @@ def engine_modules_loaded(scenes) -> tuple[list[str], float]:
 
 
 def direct_thermal(scene):
-    """The thermal-only run as the lower-level calls :func:`dem.simulation.run` makes: bonds, conductances,
+    """The thermal-only run as the lower-level calls :func:`dem.driver.run` makes: bonds, conductances,
     network, then the steady solve (and the boundary heat flows it reports) or the time integration."""
-    from dem.thermal import boundary_heat_flow, build_network, integrate, steady
+    from dem.network.heat import boundary_heat_flow, build_network, integrate, steady
 
     s = scene.solver
     net = build_network(scene.particles, scene.walls, scene.conductance, scene.sources)
@@ -756,7 +757,7 @@ def direct_thermal(scene):
 
 def study_thermal_only(section, sizes: Sizes) -> None:
     from dem import load_scene
-    from dem.simulation import run as run_scene
+    from dem.driver import run as run_scene
 
     loaded, dem_import = engine_modules_loaded(sizes.thermal_scenes)
     rows = []
@@ -780,17 +781,17 @@ def study_thermal_only(section, sizes: Sizes) -> None:
     section.summary["thermal_only_run_over_direct"] = {r["scene"]: r["run_over_direct"] for r in rows}
     section.add_text(
         "Thermal-only scenes keep their path",
-        f"A fresh process running {', '.join(sizes.thermal_scenes)} through `dem.simulation.run` (`python -X "
+        f"A fresh process running {', '.join(sizes.thermal_scenes)} through `dem.driver.run` (`python -X "
         f"importtime`) imports {len(loaded)} of the engine's modules ({', '.join(ENGINE_MODULES)})"
         f"{': ' + ', '.join(loaded) if loaded else ''}; `import dem` takes {dem_import:.2f} s. The same scenes "
-        f"through `dem.simulation.run` and through the calls it makes (bonds, conductances, network, solve), "
+        f"through `dem.driver.run` and through the calls it makes (bonds, conductances, network, solve), "
         f"alternating, best of {sizes.thermal_rounds} (CPU seconds):\n\n"
         + md_table(["scene", "N", "mode", "run (s)", "direct (s)", "run / direct", "same T"],
                    [[r["scene"], r["particles"], r["mode"], r["run_seconds"], r["direct_seconds"],
                      r["run_over_direct"], r["same_temperatures"]] for r in rows], fmt="{:.3g}"))
     section.target("engine modules imported by a thermal-only run", len(loaded),
                    LIMITS["engine_modules_in_thermal_run"])
-    section.target("thermal-only: dem.simulation.run / its direct calls (worst scene)", worst,
+    section.target("thermal-only: dem.driver.run / its direct calls (worst scene)", worst,
                    LIMITS["thermal_run_over_direct"])
 
 

@@ -24,11 +24,11 @@ LIMIT = 1.5  # shared-body steady time over today's (rojek), same packing
 def laws_worker(n: int) -> None:
     """Steady solves of one packing of ~n particles with each law of :data:`LAWS`; one JSON line."""
     from benchmarks.dem import PACKING
-    from dem.bonds import find_bonds
-    from dem.generators import random_packing
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.generators import random_packing
     from dem.laws.conductance import ConductanceSpec
-    from dem.particles import Particles
-    from dem.thermal import build_network, steady
+    from dem.geometry.particles import Particles
+    from dem.network.heat import build_network, steady
 
     lay = random_packing(n, PACKING["radius"], PACKING["overlap"], seed=0)
     fixed = np.zeros(len(lay.radius), dtype=bool)
@@ -78,7 +78,7 @@ def run(section, quick: bool) -> None:
     section.add_text(
         "Steady solve, same packing, three laws",
         "Each N in a fresh subprocess; bonds found once; per law: conductances + network assembly "
-        "(`*_network_seconds`) and `dem.thermal.steady` (`*_solve_seconds`), alternating, the best of 2-3 rounds "
+        "(`*_network_seconds`) and `dem.network.heat.steady` (`*_solve_seconds`), alternating, the best of 2-3 rounds "
         "(its parts shown); "
         "`*_steady_seconds` adds the bond search, as the `dem` subject's steady time does.\n\n"
         + records_table(rows, columns, fmt="{:.3g}"))

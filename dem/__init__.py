@@ -13,9 +13,9 @@ from dem import jit_cache
 
 jit_cache.configure()  # before numba is imported: compiled kernels cached per version of their source
 
-from dem.particles import COPPER, Material, Particles  # noqa: E402
+from dem.geometry.particles import COPPER, Material, Particles  # noqa: E402
 from dem.scene import Scene, SolverSpec, load_scene, make_scene, parse_scene  # noqa: E402
-from dem.simulation import RunResult, run  # noqa: E402
+from dem.driver import RunResult, run  # noqa: E402
 
 __all__ = ["COPPER", "Material", "Particles", "RunResult", "Scene", "SolverSpec", "load_scene", "make_scene",
            "parse_scene", "run"]

@@ -1,7 +1,7 @@
 """``python -m dem``: see :mod:`dem.cli`."""
 
 from dem.cli import main
-from fem_neck.interrupt import exit_process
+from sinterheat.interrupt import exit_process
 
 if __name__ == "__main__":
     exit_process(main())

@@ -1,11 +1,13 @@
 """numba's on-disk cache for the compiled kernels, kept from going stale.
 
 ``numba.njit(cache=True)`` keeps a compiled function until *its own* source file changes: a kernel that calls
-functions of another module (the time loop of :mod:`dem.md_loop` calls the contact law of
-:mod:`dem.laws.luding_kernels` and the binning of :mod:`dem.neighbours`) keeps the old callees' machine code after
-only they were edited -- a researcher who changes the contact law would run the old one. So the cache lives in a
-folder named by a digest of every compiled module's source (:data:`SOURCES`): any edit to any of them starts a fresh
-cache, and an unchanged installation reuses its compiled kernels across runs.
+functions of another module (the time loop calls the contact law's kernels and the binning of the neighbour list), or
+reads another module's constants (the parameter indices of a contact law are compile-time constants of every kernel
+that uses them), keeps the old code after only those were edited -- a researcher who changes the contact law would
+run the old one. So the cache lives in a folder named by a digest of the source of every module whose code or
+constants can reach compiled code: the modules that import numba and, transitively, every module of this project they
+import (:func:`compiled_sources`, found by reading the import statements, not listed by hand). Any edit to any of them
+starts a fresh cache; an unchanged installation reuses its compiled kernels across runs.
 
 :func:`configure` sets ``NUMBA_CACHE_DIR`` before numba is first imported (``import dem`` calls it); a cache folder
 the user chose (``NUMBA_CACHE_DIR`` set already) is left alone.
@@ -13,24 +15,130 @@ the user chose (``NUMBA_CACHE_DIR`` set already) is left alone.
 
 from __future__ import annotations
 
+import ast
 import hashlib
+import json
 import os
 import pathlib
 import sys
 import tempfile
 
 PACKAGE = pathlib.Path(__file__).resolve().parent
-SOURCES = ("md_loop.py", "neighbours.py", "exposure.py", "laws/luding_kernels.py", "laws/shared_body.py")
+PROJECT_PACKAGES = ("dem", "fem_neck", "sinterheat")  # the top-level packages of this project, beside dem
 
 
-def digest() -> str:
-    """A short hash of the compiled modules' source."""
+def _module_file(root: pathlib.Path, dotted: str) -> pathlib.Path | None:
+    """The source file of the project module ``dotted`` under ``root`` (a module or a package's ``__init__``)."""
+    parts = dotted.split(".")
+    if parts[0] not in PROJECT_PACKAGES:
+        return None
+    base = root.joinpath(*parts)
+    for path in (base.with_suffix(".py"), base / "__init__.py"):
+        if path.is_file():
+            return path
+    return None
+
+
+def _dotted(root: pathlib.Path, path: pathlib.Path) -> str:
+    parts = list(path.relative_to(root).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _statements(body):
+    """Every statement in ``body`` and the blocks nested in it (imports are statements: no expression is visited)."""
+    for node in body:
+        yield node
+        for block in ("body", "orelse", "finalbody", "handlers", "cases"):
+            inner = getattr(node, block, None)
+            if isinstance(inner, list):
+                yield from _statements(inner)
+
+
+def _imports(root: pathlib.Path, path: pathlib.Path) -> tuple[set[pathlib.Path], bool]:
+    """The project modules ``path`` imports (anywhere in it, also inside functions: an over-approximation is safe),
+    and whether it imports numba."""
+    tree = ast.parse(path.read_bytes(), str(path))
+    package = _dotted(root, path) if path.name == "__init__.py" else _dotted(root, path).rpartition(".")[0]
+    found, compiled = set(), False
+    for node in _statements(tree.body):
+        if isinstance(node, ast.Import):
+            names = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:  # relative: from the module's own package upwards
+                anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join(anchor + ([base] if base else []))
+            # ``from a.b import c``: c is a submodule when it has a file, else a name defined in a.b
+            names = [f"{base}.{alias.name}" if _module_file(root, f"{base}.{alias.name}") else base
+                     for alias in node.names]
+        else:
+            continue
+        for name in names:
+            compiled |= name == "numba" or name.startswith("numba.")
+            target = _module_file(root, name)
+            if target is not None:
+                found.add(target)
+    return found, compiled
+
+
+def compiled_sources(package: pathlib.Path = PACKAGE) -> list[pathlib.Path]:
+    """Every module whose code or constants can reach compiled code: the modules of ``package`` that import numba,
+    and every project module they import, transitively (module docstring)."""
+    root = package.parent
+    seeds = []
+    for path in sorted(package.rglob("*.py")):
+        if b"numba" in path.read_bytes() and _imports(root, path)[1]:
+            seeds.append(path)
+    closure, todo = set(seeds), list(seeds)
+    while todo:
+        for target in _imports(root, todo.pop())[0]:
+            if target not in closure:
+                closure.add(target)
+                todo.append(target)
+    return sorted(closure)
+
+
+def digest(package: pathlib.Path = PACKAGE) -> str:
+    """A short hash of the source of :func:`compiled_sources`."""
     h = hashlib.sha1()
-    for name in SOURCES:
-        path = PACKAGE / name
-        h.update(name.encode())
-        h.update(path.read_bytes() if path.exists() else b"")
+    root = package.parent
+    for path in compiled_sources(package):
+        h.update(str(path.relative_to(root)).encode())
+        h.update(path.read_bytes())
     return h.hexdigest()[:12]
+
+
+def _stamp(package: pathlib.Path) -> str:
+    """A hash of the name, size and modification time of every source file of the project's packages."""
+    h = hashlib.sha1()
+    for name in PROJECT_PACKAGES:
+        for path in sorted((package.parent / name).rglob("*.py")):
+            st = path.stat()
+            h.update(f"{path.relative_to(package.parent)}:{st.st_size}:{st.st_mtime_ns};".encode())
+    return h.hexdigest()
+
+
+def remembered_digest(package: pathlib.Path = PACKAGE) -> str:
+    """:func:`digest`, remembered in ``__pycache__/jit_digest.json`` for as long as no source file of the project
+    changed its size or modification time (as Python's own ``.pyc`` files are): reading the imports of the compiled
+    modules takes a tenth of a second, a look at the files' times a millisecond."""
+    memo = package / "__pycache__" / "jit_digest.json"
+    stamp = _stamp(package)
+    try:
+        saved = json.loads(memo.read_text())
+        if saved.get("stamp") == stamp:
+            return saved["digest"]
+    except (OSError, ValueError, KeyError, AttributeError):
+        pass
+    key = digest(package)
+    try:
+        memo.parent.mkdir(parents=True, exist_ok=True)
+        part = memo.with_name(f"{memo.name}.{os.getpid()}.part")
+        part.write_text(json.dumps({"stamp": stamp, "digest": key}))
+        part.replace(memo)
+    except OSError:
+        pass  # a read-only installation computes it each time
+    return key
 
 
 def configure() -> None:
@@ -38,12 +146,13 @@ def configure() -> None:
     package is read-only), unless the user set ``NUMBA_CACHE_DIR`` or numba is imported already."""
     if "NUMBA_CACHE_DIR" in os.environ or "numba" in sys.modules:
         return
-    folder = PACKAGE / "__pycache__" / f"numba-{digest()}"
+    key = remembered_digest()
+    folder = PACKAGE / "__pycache__" / f"numba-{key}"
     try:
         folder.mkdir(parents=True, exist_ok=True)
         probe = folder / ".writable"
         probe.touch()
     except OSError:
-        folder = pathlib.Path(tempfile.gettempdir()) / "sinterheat-numba" / digest()
+        folder = pathlib.Path(tempfile.gettempdir()) / "sinterheat-numba" / key
         folder.mkdir(parents=True, exist_ok=True)
     os.environ["NUMBA_CACHE_DIR"] = str(folder)

@@ -2,7 +2,7 @@
 
 ``fem_neck.geometry`` is light (numpy only); the meshing and FE solves live in their own modules and import gmsh and
 scikit-fem only when used. The names below are loaded from ``fem_neck.geometry`` on first use, so that importing
-the package (as ``python -m fem_neck`` does before its CLI takes over Ctrl-C, :mod:`fem_neck.interrupt`) costs
+the package (as ``python -m fem_neck`` does before its CLI takes over Ctrl-C, :mod:`sinterheat.interrupt`) costs
 nothing.
 """
 

@@ -628,7 +628,7 @@ def cluster_conductance(cluster: Cluster, terminals, kappa: float = 1.0, size_ne
     import time
 
     from fem_neck import accuracy
-    from fem_neck.interrupt import where
+    from sinterheat.interrupt import where
 
     factors = accuracy.mesh_levels(levels)
     curvature = 4.0 / size_far if curvature is None else curvature

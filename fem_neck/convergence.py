@@ -65,7 +65,7 @@ def levels_count() -> int:
 def mesh_levels(a_over_r: float, progress=None) -> list[dict]:
     """One row per solve of every series (module docstring); ``progress.update()`` after each, if given."""
     from fem_neck import conduction, hpmesh, shapes, spectral
-    from fem_neck.interrupt import where
+    from sinterheat.interrupt import where
 
     levels, here, total = [], where(), levels_count()
     for label, order, graded, curved in SERIES:

@@ -34,7 +34,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from fem_neck.interrupt import ignore_interrupts, shielded, stop_pool, where
+from sinterheat.interrupt import ignore_interrupts, shielded, stop_pool, where
 from fem_neck.law import A_LOG, ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, neck_resistance
 
 SOLVER = "fem_neck.conduction:semisphere_conductance"  #: the FE solver of a sweep point
@@ -146,7 +146,7 @@ def in_processes(jobs, workers: int | None = None, *, desc: str = "", progress: 
 
     Processes, not threads: gmsh is one global, thread-unsafe state per process. ``workers`` defaults to all cores;
     one worker (or one job) runs in this process. A tqdm bar on stderr counts ``done`` jobs finished earlier plus
-    these, and so does the run's :func:`fem_neck.interrupt.where` (its step). Workers ignore Ctrl-C; on an
+    these, and so does the run's :func:`sinterheat.interrupt.where` (its step). Workers ignore Ctrl-C; on an
     interrupt (or any error, or when the caller stops iterating) the pool is stopped at once. ``meanwhile()`` runs
     in a thread of this process once the workers are forked (e.g. importing what the caller needs next, while this
     process would otherwise only wait).

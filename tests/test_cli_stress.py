@@ -194,9 +194,9 @@ def test_snapshot_flood_refused_and_collection_complete(tmp_path, capsys):
 
 def test_explicit_step_around_the_stable_limit(tmp_path, capsys):
     """0.99x the limit runs and stays inside the initial range (maximum principle); 1.01x is refused."""
-    from dem.physics import ThermalModel
+    from dem.engines.static import ThermalModel
     from dem.scene import parse_scene
-    from dem.thermal import stable_limit
+    from dem.network.heat import stable_limit
 
     import tomllib
 
@@ -302,7 +302,7 @@ def test_verification_out_that_cannot_be_created(capsys, out):
 def test_printed_results_never_contain_nan(capsys):
     """Every CLI prints through print_result: a non-finite number (e.g. converge's observed order fitted from fewer
     than two points) is null in JSON, not the invalid token NaN."""
-    from fem_neck.cli import print_result
+    from sinterheat.cli import print_result
 
     print_result({"order": float("nan"), "K": [1.5, float("inf")], "nested": {"x": -float("inf")}}, as_json=True)
     out = capsys.readouterr().out

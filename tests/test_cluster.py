@@ -184,19 +184,19 @@ def test_cli_cluster(tmp_path, capsys):
     f.write_text(json.dumps({"centres": [[0, 0, 0], [0, 0, 1.92e-3]], "radii": [1e-3, 1e-3], "bonds": [[0, 1]],
                              "terminals": [{"particle": 0, "T": 1.0}, {"particle": 1, "T": 0.0}]}))
     args = ["cluster", str(f), "--json", "--levels", "1", "--size-neck", "0.3", "--size-far", "0.5"]
-    assert main(args, modules=("cluster",)) == 0
+    assert main(args) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["K"] == pytest.approx(SEMISPHERE_BY_H[0.08].K_over_Kcyl * 394.0 * np.pi * 1e-3 / 2, rel=3e-2)
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"centres": [[0, 0, 0]], "radii": [-1.0], "bonds": [], "terminals": []}))
-    assert main(["cluster", str(bad), "--json"], modules=("cluster",)) == 2
+    assert main(["cluster", str(bad), "--json"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
 
 
 def test_dem_network_of_a_pair_equals_the_fe_pair():
     # verification.clusters against the DEM: for one bonded pair cut at both equators the pipe network with the
     # FE pair conductance is exact, so DEM (network-only) and the 3D FE must agree to the 3D mesh accuracy.
-    pytest.importorskip("dem.thermal")
+    pytest.importorskip("dem.network.heat")
     pytest.importorskip("fem_neck.conduction")
     from verification.clusters import NETWORK_ONLY, dem_steady
 

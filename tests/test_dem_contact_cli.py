@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from dem.cli import main
-from dem.laws.luding import LUDING_TABLE1 as MAT
-from dem.scene import builtin_scenes, load_scene, luding_material_from_scene, parse_scene
+from dem.laws.contact.luding import LUDING_TABLE1 as MAT
+from dem.scene.parse import builtin_scenes, load_scene, luding_material_from_scene, parse_scene
 
 K1, K2, KC = MAT.k1, MAT.k2, MAT.kc
 A = float(np.mean(load_scene("luding-table1").particles.radius))  # 300 random radii in 1 mm (1 +- 0.5)

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from dem.engine import Simulation
+from dem.engines.verlet.engine import Simulation
 from dem.laws.conductance import bond_conductances
 from dem.scene import parse_scene
 from fem_neck import neck_radius

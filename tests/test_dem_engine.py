@@ -6,10 +6,10 @@ import math
 import numpy as np
 import pytest
 
-from dem.engine import Simulation
-from dem.mechanics import MechanicsError
+from dem.engines.verlet.engine import Simulation
+from dem.engines.verlet.mechanics import MechanicsError
 from dem.scene import parse_scene
-from dem.simulation import run
+from dem.driver import run
 
 ELASTIC = {"law": "luding", "k1": 2.0e5, "k2": 2.0e5, "kc": 0.0, "kt_ratio": 0.2, "gamma_n": 0.0, "gamma_t": 0.0,
            "mu": 0.5, "mu_wall": 0.5, "T_melt": 120.0, "T_var": 10.0, "expansion": 0.0, "fluid_overlap": 0.2,
@@ -261,7 +261,7 @@ interval = 1e-6
 def test_a_saved_state_goes_on_as_if_the_run_had_not_stopped(tmp_path):
     """Run 2 ms; run 1 ms, save, start a second scene from the state for 1 ms: bit-identical (pairs, walls,
     histories, stress wall and forces of the last step all carried)."""
-    from dem import state_file
+    from dem.scene import state_file
 
     rng = np.random.default_rng(5)
     x = np.array([[1.0e-3, 0, 1.0e-3], [3.0e-3, 0, 1.0e-3], [2.0e-3, 0, (1 + math.sqrt(3)) * 1e-3]])
@@ -314,7 +314,7 @@ def test_phases_switch_the_friction_on():
 
 def test_min_image_is_the_wrapping_formula_to_the_bit():
     """The shortcut for separations below a quarter of the box (no division, no floor) changes no bit."""
-    from dem.neighbours import min_image
+    from dem.geometry.neighbours import min_image
 
     rng = np.random.default_rng(7)
     length = 3.7e-3
@@ -332,7 +332,7 @@ def test_min_image_is_the_wrapping_formula_to_the_bit():
 def test_verlet_list_is_every_close_pair_sorted_whatever_room_it_is_given(box):
     """The cell-binned list against all pairs by brute force (minimum image on periodic axes), in (i, j) order, for
     a capacity too small (second pass), exact and too large; history carried by matching pairs."""
-    from dem.neighbours import carry_history, verlet_pairs
+    from dem.geometry.neighbours import carry_history, verlet_pairs
 
     rng = np.random.default_rng(11)
     box = np.array(box)

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from dem import load_scene, run
-from dem.exposure import exposed_fraction, fibonacci_directions
-from dem.generators import lattice
+from dem.geometry.exposure import exposed_fraction, fibonacci_directions
+from dem.geometry.generators import lattice
 from dem.scene import parse_scene
 
 

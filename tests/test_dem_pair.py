@@ -9,8 +9,8 @@ import pytest
 
 from dem import make_scene, run
 from dem.laws.conductance import ConductanceSpec
-from dem.particles import Particles
-from dem.thermal import build_network, integrate, stable_limit
+from dem.geometry.particles import Particles
+from dem.network.heat import build_network, integrate, stable_limit
 from verification.cases import SEC6
 
 X = [[0.0, 0.0, 0.0], [0.0, 0.0, 3.94e-3]]

@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from dem.bonds import candidate_pairs, find_bonds
-from dem.generators import lattice, random_packing
-from dem.particles import Material, Particles
-from dem.periodic import PeriodicBox, canonical_bonds
+from dem.geometry.bonds import candidate_pairs, find_bonds
+from dem.geometry.generators import lattice, random_packing
+from dem.geometry.particles import Material, Particles
+from dem.geometry.periodic import PeriodicBox, canonical_bonds
 from dem.scene import make_scene, parse_scene
-from dem.simulation import run
+from dem.driver import run
 from fem_neck.geometry import neck_radius
 from fem_neck.law import pair_conductance
 

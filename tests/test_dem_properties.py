@@ -5,8 +5,8 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 
 from dem.laws.conductance import ConductanceSpec
-from dem.particles import Particles
-from dem.thermal import build_network, integrate, steady
+from dem.geometry.particles import Particles
+from dem.network.heat import build_network, integrate, steady
 
 
 @st.composite

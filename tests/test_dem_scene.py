@@ -109,12 +109,12 @@ def test_lattice_plates_effective_conductivity():
 
 
 def test_random_packing_hits_target_overlap_and_is_seeded():
-    from dem.generators import random_packing
+    from dem.geometry.generators import random_packing
 
     a = random_packing(2000, 1e-4, 0.1, seed=5, radius_spread=0.1)
     b = random_packing(2000, 1e-4, 0.1, seed=5, radius_spread=0.1)
     assert np.array_equal(a.position, b.position)
-    from dem.bonds import candidate_pairs
+    from dem.geometry.bonds import candidate_pairs
 
     i, j = candidate_pairs(a.position, a.radius)
     h = a.radius[i] + a.radius[j] - np.linalg.norm(a.position[i] - a.position[j], axis=1)

@@ -1,4 +1,4 @@
-"""The error-controlled step of ``dt = "auto"`` (dem.thermal.integrate).
+"""The error-controlled step of ``dt = "auto"`` (dem.network.heat.integrate).
 
 The insulated pair and chain have exact solutions ``T(t) = expm(-t C^-1 L) T0`` (by eigenvectors); the global error of every
 integrator must track ``rtol`` (relative to the temperature range), Crank-Nicolson must take few steps, rejected
@@ -11,10 +11,10 @@ import math
 import numpy as np
 import pytest
 
-import dem.thermal
+import dem.network.heat
 from dem.laws.conductance import ConductanceSpec
-from dem.particles import Particles
-from dem.thermal import Network, build_network, integrate, stable_limit
+from dem.geometry.particles import Particles
+from dem.network.heat import Network, build_network, integrate, stable_limit
 
 INTEGRATORS = ("explicit", "implicit", "crank-nicolson")
 
@@ -102,8 +102,8 @@ def test_rejected_steps_are_redone(monkeypatch):
     """A controller that always asks for 4x the step overshoots, so steps are rejected and redone; the rejected
     attempts leave no trace (observer, energy), and the answer still meets the tolerance. (On linear decays the
     real controller seldom rejects: the error of a step falls smoothly as the modes decay.)"""
-    factor = dem.thermal._controller_factor
-    monkeypatch.setattr(dem.thermal, "_controller_factor", lambda err, tol, q: max(4.0, factor(err, tol, q)))
+    factor = dem.network.heat._controller_factor
+    monkeypatch.setattr(dem.network.heat, "_controller_factor", lambda err, tol, q: max(4.0, factor(err, tol, q)))
     net = chain_network(6)
     for integrator in INTEGRATORS:
         err, res, seen = run_against_exact(net, integrator, 1e-3, 2.0 * decay_time(net))
@@ -132,8 +132,8 @@ def test_explicit_auto_stays_below_the_stable_limit():
     net = chain_network(6)
     limit = stable_limit(net)
     res = integrate(net, "explicit", "auto", 2000 * limit, rtol=1e-1)
-    assert res.dt_max <= dem.thermal.AUTO_SAFETY * limit * (1 + 1e-12)
-    assert res.steps >= 2000 / dem.thermal.AUTO_SAFETY - 1
+    assert res.dt_max <= dem.network.heat.AUTO_SAFETY * limit * (1 + 1e-12)
+    assert res.steps >= 2000 / dem.network.heat.AUTO_SAFETY - 1
 
 
 def test_runs_beyond_max_steps_are_refused():
@@ -149,10 +149,10 @@ def test_runs_beyond_max_steps_are_refused():
 def test_step_tolerance_is_the_documented_rule():
     for q in (1, 2):
         for rtol in (1e-2, 1e-3, 1e-4):
-            tau = dem.thermal.step_tolerance(rtol, q)
-            assert tau == pytest.approx(min(rtol, dem.thermal.AUTO_LOCAL[q] * rtol ** ((q + 1) / q)))
+            tau = dem.network.heat.step_tolerance(rtol, q)
+            assert tau == pytest.approx(min(rtol, dem.network.heat.AUTO_LOCAL[q] * rtol ** ((q + 1) / q)))
             assert tau <= rtol
-    assert math.isclose(dem.thermal.step_tolerance(1.0, 1), 1.0)
+    assert math.isclose(dem.network.heat.step_tolerance(1.0, 1), 1.0)
 
 
 def test_linear_auto_rule_and_jacobi_cg_at_its_condition_limit():
@@ -162,12 +162,12 @@ def test_linear_auto_rule_and_jacobi_cg_at_its_condition_limit():
     import scipy.sparse as sp
     import scipy.sparse.linalg as spl
 
-    from dem.linsolve import DIRECT_MAX, JACOBI_MAX_CONDITION, JACOBI_MIN, choose_backend, make_solver
+    from dem.network.linsolve import DIRECT_MAX, JACOBI_MAX_CONDITION, JACOBI_MIN, choose_backend, make_solver
 
     rng = np.random.default_rng(3)
     for n in (JACOBI_MIN + 500, DIRECT_MAX + 500):
         K = 10.0 ** rng.uniform(-4, 4, n - 1)
-        L = dem.thermal.laplacian(n, np.arange(n - 1), np.arange(1, n), K).tocsr()
+        L = dem.network.heat.laplacian(n, np.arange(n - 1), np.arange(1, n), K).tocsr()
         L = (L + sp.diags(np.r_[K[0], np.zeros(n - 1)])).tocsr()  # first particle tied to a fixed one: SPD
         Ld = L.diagonal()
         assert choose_backend(L, Ld) == ("direct" if n <= DIRECT_MAX else "amg")
@@ -189,12 +189,12 @@ def test_auto_cg_falls_back_when_it_cannot_converge():
     import scipy.sparse as sp
     import scipy.sparse.linalg as spl
 
-    from dem.linsolve import AutoCGSolver
+    from dem.network.linsolve import AutoCGSolver
 
     rng = np.random.default_rng(3)
     n = 1500
     K = 10.0 ** rng.uniform(-4, 4, n - 1)
-    L = dem.thermal.laplacian(n, np.arange(n - 1), np.arange(1, n), K)
+    L = dem.network.heat.laplacian(n, np.arange(n - 1), np.arange(1, n), K)
     M = (L + sp.diags(1e-8 * np.r_[1.0, rng.uniform(0.5, 2.0, n - 1)])).tocsr()
     b = rng.normal(size=n)
     solver = AutoCGSolver(M, rtol=1e-10, fallback="direct")

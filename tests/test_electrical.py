@@ -5,12 +5,12 @@ solve with contact areas as weights; floating groups and electrodes without a pa
 import numpy as np
 import pytest
 
-from dem.bonds import find_bonds
-from dem.electrical import Electrodes, area_weighted_current, kirchhoff
+from dem.geometry.bonds import find_bonds
+from dem.network.current import Electrodes, area_weighted_current, kirchhoff
 from dem.laws.conductance import ConductanceSpec, bond_conductances
-from dem.network import BoundedLaplacian, solve_anchored
-from dem.particles import Material, Particles
-from dem.sources import Wall
+from dem.network.laplacian import BoundedLaplacian, solve_anchored
+from dem.geometry.particles import Material, Particles
+from dem.laws.ambient import Wall
 
 SIGMA = 0.1  # S/m (Zohdi 2014, Sec. 7)
 LENS = ConductanceSpec("zohdi")

@@ -1,4 +1,4 @@
-"""Ctrl-C (fem_neck.interrupt): a real SIGINT at random moments ends every CLI with one line on stderr, exit code 130,
+"""Ctrl-C (sinterheat.interrupt): a real SIGINT at random moments ends every CLI with one line on stderr, exit code 130,
 no traceback, and partial results that can be used."""
 
 import json
@@ -14,7 +14,7 @@ import time
 
 import pytest
 
-from fem_neck import interrupt
+from sinterheat import interrupt
 from fem_neck.fit import read_points, reusable_points
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]

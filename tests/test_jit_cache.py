@@ -1,30 +1,86 @@
-"""The compiled kernels' cache follows every compiled module's source (numba alone follows only a function's own
-file, so a kernel would keep its callees' old code)."""
+"""The compiled kernels' cache follows every module whose code or constants reach compiled code (numba alone follows
+only a function's own file, so a kernel would keep its callees' old code and the constants it was compiled with)."""
 
+import importlib
 import os
+import pathlib
+import re
+import shutil
 import subprocess
 import sys
 
+import pytest
+
 from dem import jit_cache
 
+LUDING_MATERIAL = "dem.laws.contact.luding"  # the module that holds the parameter indices of the Luding law
+ZOHDI_MATERIAL = "dem.laws.contact.zohdi"
 
-def test_cache_folder_is_named_by_every_compiled_source(tmp_path, monkeypatch):
-    before = jit_cache.digest()
-    copy = tmp_path / "dem"
-    (copy / "laws").mkdir(parents=True)
-    for name in jit_cache.SOURCES:
-        (copy / name).write_bytes((jit_cache.PACKAGE / name).read_bytes())
-    monkeypatch.setattr(jit_cache, "PACKAGE", copy)
-    assert jit_cache.digest() == before
-    (copy / "laws" / "luding_kernels.py").write_text((copy / "laws" / "luding_kernels.py").read_text() + "\n# edit\n")
-    assert jit_cache.digest() != before
+
+@pytest.fixture
+def copy(tmp_path):
+    """A copy of the project's packages, to edit."""
+    root = jit_cache.PACKAGE.parent
+    for name in jit_cache.PROJECT_PACKAGES:
+        shutil.copytree(root / name, tmp_path / name, ignore=shutil.ignore_patterns("__pycache__"))
+    return tmp_path / "dem"
+
+
+def _in_copy(copy, module):
+    """The file of ``module`` (a dotted name) in the copy."""
+    return copy / pathlib.Path(importlib.import_module(module).__file__).relative_to(jit_cache.PACKAGE)
+
+
+def _edit(path, old, new):
+    text = path.read_text()
+    assert old in text
+    path.write_text(text.replace(old, new, 1))
+
+
+def test_the_compiled_modules_are_found_from_their_imports():
+    names = {str(p.relative_to(jit_cache.PACKAGE.parent)) for p in jit_cache.compiled_sources()}
+    # the loop, its contact law's kernels, and the module whose parameter indices the kernels compile in
+    assert {"dem/engines/verlet/loop.py", "dem/laws/contact/luding_kernels.py", "dem/laws/contact/luding.py", "dem/laws/contact/zohdi.py",
+            "dem/engines/staggered/kernels.py", "dem/network/gauss_seidel.py"} <= names
+    assert "dem/cli/scenes.py" not in names and "dem/__init__.py" not in names
+
+
+def test_swapping_two_parameter_indices_changes_the_key(copy):
+    """A change that alters no physics but every compiled kernel that reads the material (the indices are constants
+    compiled into them): a cache that missed it would read k2 where k1 is meant."""
+    before = jit_cache.digest(copy)
+    path = _in_copy(copy, LUDING_MATERIAL)
+    text = path.read_text()
+    text = re.sub(r"^P_K1 = 0 ", "P_K1 = 1 ", text, count=1, flags=re.M)
+    text = re.sub(r"^P_K2 = 1 ", "P_K2 = 0 ", text, count=1, flags=re.M)
+    assert text != path.read_text()
+    path.write_text(text)
+    assert jit_cache.digest(copy) != before
+
+
+def test_an_edit_outside_compiled_code_keeps_the_key(copy):
+    before = jit_cache.digest(copy)
+    _edit(_in_copy(copy, "dem.cli.scenes"), '"""', '"""An edit. ')
+    assert jit_cache.digest(copy) == before
+    _edit(_in_copy(copy, ZOHDI_MATERIAL), "LEAST_FACTOR = 0.05", "LEAST_FACTOR = 0.06")
+    assert jit_cache.digest(copy) != before
+
+
+def test_the_remembered_key_follows_an_edit(copy):
+    first = jit_cache.remembered_digest(copy)
+    assert (copy / "__pycache__" / "jit_digest.json").exists()
+    assert jit_cache.remembered_digest(copy) == first == jit_cache.digest(copy)
+    path = next(p for p in jit_cache.compiled_sources(copy) if p.name == "neighbours.py")
+    path.write_text(path.read_text() + "\n# an edit\n")
+    os.utime(path, ns=(path.stat().st_atime_ns, path.stat().st_mtime_ns + 10**9))  # a later modification time
+    assert jit_cache.remembered_digest(copy) == jit_cache.digest(copy) != first
 
 
 def test_import_sets_the_cache_folder_unless_the_user_did():
     code = "import os, dem; print(os.environ['NUMBA_CACHE_DIR'])"
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
-    assert f"numba-{jit_cache.digest()}" in out or jit_cache.digest() in out
+    assert jit_cache.digest() in out
     env["NUMBA_CACHE_DIR"] = "/tmp/mine"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
     assert out.strip() == "/tmp/mine"

@@ -1,4 +1,4 @@
-"""The Luding 2005 sintering contact law (dem.laws.luding): every branch against closed forms written out here.
+"""The Luding 2005 sintering contact law (dem.laws.contact.luding): every branch against closed forms written out here.
 
 The kernels are numba-compiled with ``cache=True``: the first run of this file compiles them (about 10 s cold on
 2 cores); later runs load the cache.
@@ -14,8 +14,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq as _brentq
 
-from dem.laws import luding, luding_kernels as law
-from dem.laws.luding import LUDING_TABLE1 as MAT
+from dem.laws.contact import luding_kernels as law
+from dem.laws.contact import luding
+from dem.laws.contact.luding import LUDING_TABLE1 as MAT
 
 P = MAT.params()
 K1, K2, KC = MAT.k1, MAT.k2, MAT.kc

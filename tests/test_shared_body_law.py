@@ -7,15 +7,15 @@ import sys
 import numpy as np
 import pytest
 
-from dem.bonds import find_bonds
-from dem.generators import chain, lattice, random_packing
+from dem.geometry.bonds import find_bonds
+from dem.geometry.generators import chain, lattice, random_packing
 from dem.laws.conductance import LAWS, ConductanceSpec, bond_conductances
 from dem.laws.shared_body import interaction
-from dem.particles import Material, Particles
-from dem.periodic import PeriodicBox
+from dem.geometry.particles import Material, Particles
+from dem.geometry.periodic import PeriodicBox
 from dem.scene import make_scene, parse_scene
-from dem.simulation import run
-from dem.sources import Wall
+from dem.driver import run
+from dem.laws.ambient import Wall
 
 UNIT = Material(1.0, 1.0, 1.0, "unit")
 

@@ -1,16 +1,16 @@
-"""Luding 2005's protocol as scenes (dem.sinter_protocol) and the fragment counter (dem.fragments)."""
+"""Luding 2005's protocol as scenes (verification.sinter_protocol) and the fragment counter (verification.fragments)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from dem import sinter_protocol as sp
-from dem.engine import Simulation
-from dem.fragments import clusters, fragments, tension_capacity
-from dem.laws.luding import LUDING_TABLE1 as MAT
+from verification import sinter_protocol as sp
+from dem.engines.verlet.engine import Simulation
+from verification.fragments import clusters, fragments, tension_capacity
+from dem.laws.contact.luding import LUDING_TABLE1 as MAT
 from dem.scene import parse_scene
-from dem.simulation import run
+from dem.driver import run
 
 
 def test_schedule_scene_has_the_times_temperatures_and_box_of_sec_4_1():
@@ -48,7 +48,7 @@ def test_stage_scenes_continue_from_a_state(tmp_path):
     assert sinter.motion.phases == ()  # Table 1 friction from the start (t_heat)
     saved_right = prep.models[0].w.q[2]
     assert {w.name: w for w in sinter.motion.walls}["right"].offset == saved_right
-    from dem import state_file
+    from dem.scene import state_file
 
     saved = state_file.load(state)
     z0 = -sp.wall_offset(saved, "top")

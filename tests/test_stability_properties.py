@@ -20,8 +20,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from dem.laws.conductance import ConductanceSpec
-from dem.particles import Particles
-from dem.thermal import Network, build_network, integrate, stable_limit, steady
+from dem.geometry.particles import Particles
+from dem.network.heat import Network, build_network, integrate, stable_limit, steady
 
 SPACING = 1e-4  # m
 pytestmark = pytest.mark.stress

@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from dem.laws.conductance import ConductanceSpec
-from dem.particles import Material, Particles
-from dem.thermal import build_network, integrate, stable_limit, steady
+from dem.geometry.particles import Material, Particles
+from dem.network.heat import build_network, integrate, stable_limit, steady
 from fem_neck import conduction
 from fem_neck.geometry import max_overlap, neck_geometry, neck_radius, overlap_for_neck
 from verification.cases import CONSTRICTION_LIMIT

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from dem.scene import parse_scene
-from dem.zohdi import kernels
-from dem.zohdi.material import ZohdiMaterial, ZohdiStepping
-from dem.zohdi.simulation import ZohdiSimulation
+from dem.engines.staggered import kernels
+from dem.laws.contact.zohdi import ZohdiMaterial, ZohdiStepping
+from dem.engines.staggered.engine import ZohdiSimulation
 
 R = 0.075
 RHO = 2000.0
@@ -360,7 +360,7 @@ def test_section_7_three_phases_of_fig_9():
 
 def test_compiled_lens_conduction_is_the_conductance_law_on_the_bonds():
     """The paper's law evaluated on the Verlet list in compiled code gives the heat flows of the general path
-    (dem.bonds.find_bonds + dem.laws.conductance with law = "zohdi"), here on a pressed column with hot walls."""
+    (dem.geometry.bonds.find_bonds + dem.laws.conductance with law = "zohdi"), here on a pressed column with hot walls."""
     doc = column()
     doc["walls"][0]["temperature"] = 900.0
     sim = ZohdiSimulation(parse_scene(doc))
@@ -375,7 +375,7 @@ def test_compiled_lens_conduction_is_the_conductance_law_on_the_bonds():
 
 @pytest.mark.slow
 def test_frames_are_rendered_off_screen(tmp_path):
-    from dem.frames import FrameWriter
+    from dem.output.frames import FrameWriter
 
     doc = column()
     doc["output"] = {"fraction_axis": "x"}

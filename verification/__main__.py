@@ -13,7 +13,7 @@ Run time against error is ``python -m benchmarks``; the stress cases are tests (
 ``summary.json`` (comparison name -> relative error) as one object and nothing else on stdout. Progress goes to
 stderr. Exit code: 0 when every section ran, 1 when a section failed (its one-line error on stderr, its traceback
 in ``DIR/<section>/error.txt``), 2 for bad options, 130 after Ctrl-C (one line on stderr naming the section; the
-report keeps the finished sections, :mod:`fem_neck.interrupt`).
+report keeps the finished sections, :mod:`sinterheat.interrupt`).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from __future__ import annotations
 import os
 import sys
 
-from fem_neck.cli import OneLineParser
+from sinterheat.cli import OneLineParser
 from verification.report import add_run_options, prepare_out, print_report, run_sections
 
 PROG = "python -m verification"
@@ -48,7 +48,7 @@ def build_parser() -> OneLineParser:
 
 
 def main(argv=None) -> int:
-    from fem_neck.interrupt import Where, run_command
+    from sinterheat.interrupt import Where, run_command
 
     here = Where(PROG)
     return run_command(here, _main, argv, here)
@@ -73,6 +73,6 @@ def _main(argv, here) -> int:
 
 
 if __name__ == "__main__":
-    from fem_neck.interrupt import exit_process
+    from sinterheat.interrupt import exit_process
 
     exit_process(main())

@@ -44,7 +44,7 @@ import numpy as np
 
 from fem_neck.cluster import Cluster, Terminal, cluster_conductance
 from fem_neck.geometry import overlap_for_neck
-from fem_neck.interrupt import where
+from sinterheat.interrupt import where
 from verification.report import save_figure
 
 KAPPA = 394.0
@@ -241,12 +241,12 @@ def dem_steady(cluster: Cluster, terminals, law: str) -> tuple[float, np.ndarray
     """The DEM's steady pipe network of the same cluster (Rojek 2022, eqs. 2-4 with dT/dt = 0): the effective
     conductance (W/K) and every particle's temperature.
 
-    The DEM finds the bonds itself from the overlaps (:func:`dem.thermal.build_network`); they must be the cluster's.
+    The DEM finds the bonds itself from the overlaps (:func:`dem.network.heat.build_network`); they must be the cluster's.
     The terminals are its fixed particles. ``law`` is a DEM conductance law, or :data:`NETWORK_ONLY`.
     """
     from dem.laws.conductance import ConductanceSpec
-    from dem.particles import Material, Particles
-    from dem.thermal import boundary_heat_flow, build_network, steady
+    from dem.geometry.particles import Material, Particles
+    from dem.network.heat import boundary_heat_flow, build_network, steady
 
     T0 = np.zeros(cluster.n)
     fixed = np.zeros(cluster.n, dtype=bool)

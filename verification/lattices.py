@@ -2,7 +2,7 @@
 
 Every packing here is periodic and mirror-symmetric, so the FE (:mod:`fem_neck.lattice`) solves its mirror cell
 with two-sided bounds, and the DEM runs the same packing in a periodic box with a temperature drop per period along
-z (:mod:`dem.periodic`): both give the infinite packing's ``k_eff`` along z with no wall or side effect, and any
+z (:mod:`dem.geometry.periodic`): both give the infinite packing's ``k_eff`` along z with no wall or side effect, and any
 difference is the network's own error.
 
 * **Lattices**: simple, body- and face-centred cubic (coordination 6, 8, 12) over the necks their geometry allows,
@@ -82,11 +82,11 @@ def fe_pair_conductance(r_i: float, r_j: float, h: float) -> float:
 def dem_periodic(cell: lattice.PeriodicCell, law: str) -> float:
     """The DEM's ``k_eff / kappa`` of the periodic packing along z (drop of 1 K per period), for a conductance law
     or :data:`NETWORK_ONLY`."""
-    from dem.bonds import find_bonds
+    from dem.geometry.bonds import find_bonds
     from dem.laws.conductance import ConductanceSpec, bond_conductances
-    from dem.particles import Material, Particles
-    from dem.periodic import PeriodicBox
-    from dem.thermal import Network, periodic_heat_flow, steady
+    from dem.geometry.particles import Material, Particles
+    from dem.geometry.periodic import PeriodicBox
+    from dem.network.heat import Network, periodic_heat_flow, steady
 
     box = PeriodicBox(cell.period, drop=[0.0, 0.0, 1.0])
     unit = Material(1.0, 1.0, 1.0, "unit")

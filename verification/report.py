@@ -14,7 +14,7 @@ resolves from the report's own folder, and each figure appears once (those the m
 to the section). A section's *status* is ``ok``; ``fail`` when one of its targets (:meth:`Section.target`, e.g. a
 time limit) is missed; ``error`` when it raised (its one-line message in the status, its traceback in
 ``<section>/error.txt``); ``not available`` when its module is absent; ``interrupted`` when Ctrl-C stopped it (the
-finished sections stay in the files, and the run ends: :mod:`fem_neck.interrupt`). Commands exit with 1 when any
+finished sections stay in the files, and the run ends: :mod:`sinterheat.interrupt`). Commands exit with 1 when any
 section is ``fail`` or ``error``.
 
 :func:`add_run_options`, :func:`prepare_out` and :func:`print_report` are the options, output folder and printout
@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fem_neck.cli import print_result
+from sinterheat.cli import print_result
 
 CONTRACT_KEYS = ("title", "markdown", "summary", "figures")
 OK, FAIL, ERROR, NOT_AVAILABLE, RUNNING, INTERRUPTED = "ok", "fail", "error", "not available", "running", \
@@ -131,7 +131,7 @@ class Section:
     def running(self):
         """Time the body; an exception is recorded (``error``, traceback in ``error.txt``), not raised; at the end
         the status is ``fail`` if a target was missed, else ``ok``. The report is rewritten."""
-        from fem_neck.interrupt import where
+        from sinterheat.interrupt import where
 
         t0 = time.perf_counter()
         self.status = RUNNING
@@ -366,7 +366,7 @@ def run_sections(names, out_dir: pathlib.Path, command: str, quick: bool = False
     """Run the verification sections ``names`` in order into ``out_dir``; the report is rewritten as they go."""
     from tqdm import tqdm
 
-    from fem_neck.interrupt import where
+    from sinterheat.interrupt import where
 
     report = Report(out_dir, command, quick)
     here = where()

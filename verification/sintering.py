@@ -1,6 +1,6 @@
 """Luding, Manetsberger & Müllers 2005, Section 4, reproduced with the engine for moving particles.
 
-The samples of Sec. 4 (Table 1, the bi-axial box of Fig. 1, the schedule of Fig. 7; :mod:`dem.sinter_protocol`)
+The samples of Sec. 4 (Table 1, the bi-axial box of Fig. 1, the schedule of Fig. 7; :mod:`verification.sinter_protocol`)
 are prepared, sintered for t_s, cooled and tested over the grid of :mod:`verification.sintering_runs` (N = 100 and
 300, p = 10 and 100 N/m, t_s from 1e-4 to 1 s; ``--quick``: N = 100 and three t_s), in parallel and resumed where a
 previous run stopped. The section draws the paper's figures from the runs -- nu(t), k1(t), the coordination number
@@ -20,7 +20,7 @@ from dataclasses import asdict
 
 import numpy as np
 
-from dem.sinter_protocol import Times
+from verification.sinter_protocol import Times
 from verification import sintering_runs as sr
 from verification.report import md_table, save_figure
 from verification.sintering_statements import pct, statements, statements_table
@@ -206,7 +206,7 @@ def wall_segments(snap: dict) -> list:
 
 
 def _draw(ax, a: dict, k: int, title: str, stress_range=None):
-    from dem.plots import draw_packing
+    from verification.packing_picture import draw_packing
 
     snap = {key[len(f"snap{k}_"):]: v for key, v in a.items() if key.startswith(f"snap{k}_")}
     draw_packing(ax, snap["x"], snap["radius"], snap["mean_stress"], snap["i"], snap["j"], snap["fn"], snap["ft"],
@@ -518,7 +518,7 @@ def run(out_dir: pathlib.Path, quick: bool = False, workers: int = 2) -> dict:
 
 
 PROTOCOL_TEXT = """\
-**Protocol** (`dem.sinter_protocol`, every stage a scene; the runs in `runs/<stage>/<sample>/`). Disks of height
+**Protocol** (`verification.sinter_protocol`, every stage a scene; the runs in `runs/<stage>/<sample>/`). Disks of height
 6 mm, a0 = 1 mm, radii uniform in a0 (1 ± 0.5), Table 1's material (`LUDING_TABLE1`), placed at random (solid
 fraction 0.3) with speeds of 0.01 m/s in a square box whose left and bottom walls are fixed and whose right and top
 walls are stress-controlled at p (eq. 1, m_w = 0.01 kg, γ_w = 0.2 kg/s). *Preparation* at 80 °C, frictionless,
@@ -529,7 +529,7 @@ both tests. *Compression* (Sec. 4.4): right wall at σ_xx = p, top wall moving i
 that the times of Fig. 20 are strains. *Vibration* (Figs. 21-22): the box walls removed, the sample on a floor
 vibrating at 100 Hz with 0.2 mm amplitude for 0.1 s in gravity. ν is the solid fraction of the walls' box with the
 current radii (eq. 9); the *mass density* divides the sample's mass by ρ_p at 80 °C times the box volume.
-*Fragments* (`dem.fragments`): clusters joined by closed contacts whose tension capacity −f_min (eq. 15) holds at
+*Fragments* (`verification.fragments`): clusters joined by closed contacts whose tension capacity −f_min (eq. 15) holds at
 least the weight of the lighter particle (a disk resting on another under its weight has a capacity ~10⁻⁹ of it, a
 sintered contact ~10³-10⁴ of it). *Failure*: the largest σ_zz before σ_zz first falls below half of it; the
 *stiffness* is the slope of σ_zz against ε_zz while σ_zz rises from p half way to that."""

@@ -1,7 +1,7 @@
 """The runs behind the sintering section: Luding 2005's protocol over a grid of N, p and t_s, in worker processes,
 resumed where it stopped.
 
-A :class:`Task` is one stage of :mod:`dem.sinter_protocol` for one sample: ``prepare`` (N, p), ``sinter`` (heating
+A :class:`Task` is one stage of :mod:`verification.sinter_protocol` for one sample: ``prepare`` (N, p), ``sinter`` (heating
 and sintering for t_s, from the prepared state), ``cool`` (cooling and relaxation), ``compress`` and ``vibrate``
 (the tests of Sec. 4.4, from the cooled state), ``schedule`` (the whole of Fig. 7 in one scene: the three-particle
 control of Sec. 4.1.3, the control without thermal expansion), and the 3D stages with heated walls (``prepare3d``,
@@ -28,7 +28,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from dem.laws.luding import LUDING_TABLE1, P_MU
+from dem.laws.contact.luding import LUDING_TABLE1, P_MU
 
 PREPARE, SINTER, COOL, COMPRESS, VIBRATE, SCHEDULE = "prepare", "sinter", "cool", "compress", "vibrate", "schedule"
 PREPARE3D, SINTER3D = "prepare3d", "sinter3d"
@@ -147,8 +147,8 @@ def _material(task: Task):
 
 def scene_doc(task: Task, root: pathlib.Path) -> dict:
     """The scene of ``task`` (its parent's state under ``root``)."""
-    from dem import sinter_protocol as sp
-    from dem import state_file
+    from verification import sinter_protocol as sp
+    from dem.scene import state_file
 
     material = _material(task)
     parent = None if task.parent is None else str(root / task.parent.folder / "state.npz")
@@ -187,7 +187,7 @@ def snapshot(sim) -> dict:
 def contact_statistics(sim) -> dict:
     """Per closed contact: overlap over a_i + a_j (Figs. 12-13), normal force (Figs. 14-15), tangential force,
     f_min (eq. 15), the activated friction ``mu_t = f_t/(f_n - f_min)`` and ``mu(T, t)`` (eq. 24, Sec. 4.3.3)."""
-    from dem.fragments import tension_capacity
+    from verification.fragments import tension_capacity
 
     mech = sim.mechanics
     s = mech.state
@@ -216,10 +216,10 @@ def neck_statistics(sim) -> dict:
 
 def run_task(task: Task, root) -> dict:
     """Run ``task`` into ``root/task.folder`` (module docstring); returns what ``result.json`` holds."""
-    from dem import state_file
-    from dem.engine import Simulation
-    from dem.fragments import fragments
-    from dem.io import MotionWriter
+    from dem.scene import state_file
+    from dem.engines.verlet.engine import Simulation
+    from verification.fragments import fragments
+    from dem.output.writer import MotionWriter
     from dem.scene import parse_scene
 
     root = pathlib.Path(root)
@@ -329,13 +329,13 @@ def run_tasks(tasks, root, workers: int = 2, progress: bool = True) -> dict:
 
 
 def schedule_seconds(n: int = 300, p: float = 100.0, t_s: float = 1.0, seed: int = 1) -> dict:
-    """The whole schedule of Fig. 7 (:func:`dem.sinter_protocol.schedule_doc`) in this process, without output:
+    """The whole schedule of Fig. 7 (:func:`verification.sinter_protocol.schedule_doc`) in this process, without output:
     ``seconds`` of the run (building the simulation, loading the compiled kernels and the time loop),
     ``loop_seconds`` (the time loop alone), ``steps``, ``ns_per_particle_step`` (of the loop) and the final solid
     fraction and coordination number. For the bench row of "the whole schedule, t_s = 1, N = 300"."""
-    from dem.engine import Simulation
+    from dem.engines.verlet.engine import Simulation
     from dem.scene import parse_scene
-    from dem.sinter_protocol import schedule_doc
+    from verification.sinter_protocol import schedule_doc
 
     t0 = time.perf_counter()
     sim = Simulation(parse_scene(schedule_doc(n, p, t_s, seed=seed), "schedule"))

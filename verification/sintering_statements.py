@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dem.sinter_protocol import T_PREPARE, Times
+from verification.sinter_protocol import T_PREPARE, Times
 from verification import sintering_runs as sr
 from verification.report import md_table
 from verification.sintering_study import Missing, Study, at, without_rattlers

@@ -12,7 +12,7 @@ import pathlib
 
 import numpy as np
 
-from dem.sinter_protocol import T_PREPARE, Times
+from verification.sinter_protocol import T_PREPARE, Times
 from verification import sintering_runs as sr
 
 

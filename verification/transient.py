@@ -67,8 +67,8 @@ def dem_pair(r_i: float, r_j: float, h: float, law: str, t_end: float, K: float 
     DEM conductance law; ``K`` (W/K) overrides the pipe conductance. Returns ``(K, t, T)`` with ``T`` of shape
     (len(t), 2)."""
     from dem.laws.conductance import ConductanceSpec
-    from dem.particles import Material, Particles
-    from dem.thermal import build_network, integrate
+    from dem.geometry.particles import Material, Particles
+    from dem.network.heat import build_network, integrate
 
     d = r_i + r_j - h
     particles = Particles.from_arrays([[0.0, 0.0, 0.0], [0.0, 0.0, d]], [r_i, r_j], [1.0, 0.0],
@@ -254,7 +254,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
              f"FE error check on {name}: halving the mesh size and every time step changes the normalised "
              f"difference by at most {fe_check:.1e} and lambda_1 by {rate_check:.1e}. ")
           + "The lumped curves are DEM runs "
-          "(`dem.thermal.integrate`, Crank-Nicolson, dt = auto, rtol 1e-5; with K = K_FE the DEM pipe is given that "
+          "(`dem.network.heat.integrate`, Crank-Nicolson, dt = auto, rtol 1e-5; with K = K_FE the DEM pipe is given that "
           "conductance), interpolated onto the FE times; they match the lumped closed form to "
           f"{max(r['dem_vs_closed_form'] for _, r in results):.1e} of the initial difference.",
           "'rate err' is lambda_1,FE / lambda_lumped - 1: positive means the FE pair equilibrates faster than the "

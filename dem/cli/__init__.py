@@ -6,14 +6,14 @@
     python -m dem contact SCENE --history FILE.csv [--no-damping] [--out DIR] [--json]
 
 Each sub-command is a module of this package exposing ``register(subparsers)``; the plumbing is that of
-:mod:`fem_neck.cli` (one JSON object with ``--json``; bad input: one line on stderr, exit code 2).
+:mod:`sinterheat.cli` (one JSON object with ``--json``; bad input: one line on stderr, exit code 2).
 """
 
-from fem_neck.cli import main as _main
+from sinterheat import cli
 
 COMMANDS = ("run", "scenes", "contact", "laws")
 
 
 def main(argv=None) -> int:
-    return _main(argv, prog="python -m dem", description=__doc__.splitlines()[0], modules=COMMANDS,
-                 package="dem.cli")
+    return cli.main(argv, prog="python -m dem", description=__doc__.splitlines()[0], modules=COMMANDS,
+                    package="dem.cli")

@@ -9,7 +9,7 @@ repulsive), ``delta_max``, ``delta_0``, ``k1`` = k1(T, t), ``k2`` = k2(delta_max
 (all in N/m) and ``f_min`` (eq. 15).
 
 k1(T, t) starts at its equilibrium k1(T) of the first row's temperature and relaxes row by row towards k1(T) of
-each row's temperature (eq. 12, :func:`dem.laws.luding.relax_k1`; cooling freezes at once). The viscous force
+each row's temperature (eq. 12, :func:`dem.laws.contact.luding.relax_k1`; cooling freezes at once). The viscous force
 ``gamma_0 delta_dot`` (eq. 5) uses the backward difference of the overlap between rows (0 on the first row);
 ``--no-damping`` leaves it out, giving the elastic-plastic force of Figs. 2, 3 and 5 alone.
 
@@ -26,7 +26,7 @@ import pathlib
 
 import numpy as np
 
-from fem_neck.cli import add_output_options
+from sinterheat.cli import add_output_options
 
 COLUMNS = ("t", "overlap", "T")
 OUTPUTS = ("force", "delta_max", "delta_0", "k1", "k2", "kc", "f_min")
@@ -85,7 +85,7 @@ def read_history(path) -> dict:
 def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> dict:
     """One pair contact of two equal particles of radius ``radius`` through the history (see the module
     docstring); returns the per-row arrays named in :data:`OUTPUTS`."""
-    from dem.laws import luding_kernels as law
+    from dem.laws.contact import luding_kernels as law
 
     params = material.params()
     delta_fluid = law.pair_delta_fluid(radius, radius, material.fluid_overlap)
@@ -108,8 +108,8 @@ def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> 
 
 
 def run(args) -> dict:
-    from dem.laws.luding_kernels import pair_delta_fluid
-    from dem.scene import load_scene, luding_material_from_scene
+    from dem.laws.contact.luding_kernels import pair_delta_fluid
+    from dem.scene.parse import load_scene, luding_material_from_scene
 
     scene = load_scene(args.scene)
     material = luding_material_from_scene(scene)
@@ -158,7 +158,7 @@ def plot(path: pathlib.Path, material, radius: float, history: dict, rows: dict)
     -kc(T, t, delta_max) lines of the last row, and the path through the rows."""
     from matplotlib.figure import Figure
 
-    from dem.laws import luding_kernels as law
+    from dem.laws.contact import luding_kernels as law
 
     delta_fluid = law.pair_delta_fluid(radius, radius, material.fluid_overlap)
     x = history["overlap"]

@@ -1,13 +1,13 @@
 """``python -m dem run SCENE [--out DIR [--resume | --overwrite]] [--json]``: run a scene (TOML path or built-in
 name), print its summary.
 
-With ``--out`` the run writes its folder as it goes (``dem.run_folder``): a folder that holds a run already is
+With ``--out`` the run writes its folder as it goes (``dem.output.folder``): a folder that holds a run already is
 refused unless ``--resume`` (go on from its last checkpoint, written every few seconds: a run with a fixed step ends
 bit for bit as if it had not stopped) or ``--overwrite`` (delete that run's files first). Ctrl-C stops the run with
 one line saying where, leaving the folder usable and resumable.
 """
 
-from fem_neck.cli import add_output_options
+from sinterheat.cli import add_output_options
 
 
 def register(sub):
@@ -21,7 +21,7 @@ def register(sub):
 
 def run(args) -> dict:
     from dem.scene import load_scene
-    from dem.simulation import run as run_scene
+    from dem.driver import run as run_scene
 
     try:
         scene = load_scene(args.scene)

@@ -1,2 +1,3 @@
-"""Constitutive laws of the DEM as pure functions over bond arrays (conductance now; contact mechanics and
-electrical conduction plug in beside it)."""
+"""Constitutive laws of the DEM: the conductance of a bond (:mod:`~dem.laws.conductance`, the dense-packing
+:mod:`~dem.laws.shared_body`), the exchange with an ambient (:mod:`~dem.laws.ambient`) and the contact laws of
+particles that move (:mod:`dem.laws.contact`)."""

@@ -34,8 +34,8 @@ import numpy as np
 
 from fem_neck import law as fem_law
 
-from dem.bonds import OUT_OF_RANGE, Bonds
-from dem.particles import Particles
+from dem.geometry.bonds import OUT_OF_RANGE, Bonds
+from dem.geometry.particles import Particles
 
 LAWS = ("rojek", "argento-bouvard", "fit", "shared-body", "zohdi")
 FIT_LAWS = ("fit", "shared-body")  # the laws built on the full-range fit (fit_file, unequal)
@@ -88,7 +88,7 @@ class ConductanceSpec:
 
     @property
     def contact(self) -> str:
-        """The contact geometry the law needs (:mod:`dem.bonds`)."""
+        """The contact geometry the law needs (:mod:`dem.geometry.bonds`)."""
         return "lens" if self.law == "zohdi" else self.neck
 
 
@@ -124,7 +124,7 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     sigma gives each contact's electrical conductance in S (the neck is the same Laplace problem, sigma in place of
     kappa). With ``shares = True`` a third array gives each pair bond's fraction of its resistance on the side of
     particle i, ``R_i / (R_i + R_j)`` (where that part of the bond's Joule heat is made). ``box``: the periodic box
-    the bonds' image shifts refer to (:mod:`dem.periodic`); ``walls``: the walls of the wall bonds, whose normals
+    the bonds' image shifts refer to (:mod:`dem.geometry.periodic`); ``walls``: the walls of the wall bonds, whose normals
     the ``shared-body`` law needs.
     """
     kappa = particles.conductivity if conductivity is None else np.asarray(conductivity, dtype=float)

@@ -65,7 +65,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from dem.bonds import Bonds
+from dem.geometry.bonds import Bonds
 
 ROUNDOFF = 1e-12  # interactions below this x the smallest half resistance are round-off of collinear bonds
 

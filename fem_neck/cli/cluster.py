@@ -2,7 +2,7 @@
 
 import math
 
-from fem_neck.cli import add_output_options
+from sinterheat.cli import add_output_options
 
 # What one 3D solve can afford: the mesh sizes' range, the particle count, and a run-time budget. Measured on 2 cores
 # for two spheres: defaults ~1.5 s, size_far 0.1 ~9 s, 0.06 ~39 s, size_neck 0.04 ~14 s; estimate_seconds fits that.

@@ -5,7 +5,7 @@ The study is :func:`fem_neck.convergence.study` (series, extrapolation and obser
 
 from __future__ import annotations
 
-from fem_neck.cli import add_output_options
+from sinterheat.cli import add_output_options
 
 
 def register(subparsers) -> None:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sys
 
-from fem_neck.cli import add_output_options, add_workers_option
+from sinterheat.cli import add_output_options, add_workers_option
 
 
 def register(subparsers) -> None:

@@ -3,7 +3,7 @@ spheres from 3D FE of its mirror cell, with two-sided bounds (:mod:`fem_neck.lat
 
 import math
 
-from fem_neck.cli import add_output_options
+from sinterheat.cli import add_output_options
 
 
 def register(subparsers) -> None:

@@ -1,6 +1,6 @@
 """``python -m fem_neck neck``: the neck of two sintered spheres (Rojek 2022, Section 4)."""
 
-from fem_neck.cli import add_output_options
+from sinterheat.cli import add_output_options
 from fem_neck.geometry import METHODS, neck_geometry, neck_radius
 
 

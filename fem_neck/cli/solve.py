@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from fem_neck.cli import add_output_options
+from sinterheat.cli import add_output_options
 
 PAPER_SLOPE = 1.064  # Rojek 2022, eq. (40)
 MAX_CHAIN = 50  # spheres in one chain solve (40 take ~28 s and 1.4 GB on 2 cores)

@@ -5,7 +5,7 @@ Writes unequal.json, unequal.csv and unequal.png into --out (default: results/un
 
 from __future__ import annotations
 
-from fem_neck.cli import add_output_options, add_workers_option
+from sinterheat.cli import add_output_options, add_workers_option
 
 
 def register(subparsers) -> None:

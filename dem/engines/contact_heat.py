@@ -1,0 +1,97 @@
+"""Heat flow through the contacts of particles that move: the pipe network of Rojek 2022 (eqs. 1-9) on the
+contacts of the mechanical submodel, with necks that grow as the particles sinter.
+
+Every closed contact is a bond whose overlap is Rojek's ``h``: its neck radius comes from the scene's contact
+geometry (the volume-conserving neck, :func:`fem_neck.neck_radius`, by default) and its conductance from the scene's
+law, exactly as for a static packing (:func:`dem.geometry.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`);
+an overlap beyond the neck model's range stops the run with the contact named (or is clipped/dropped by
+``conductance.out_of_range``). Walls that carry a temperature are isothermal planes bonded to the particles that
+touch them.
+
+The network takes its own implicit steps (backward Euler or Crank-Nicolson), each as long as many mechanical
+steps, so neither physics forces the other's step down: the engine advances the mechanics over an interval, then
+the temperatures over the same interval with the conductances of the contacts at its end (a sequential splitting).
+When the set of contacts has not changed, the network keeps its matrices and only rewrites their entries
+(:meth:`dem.network.heat.Network.refresh`); a new or lost contact re-assembles it. Each step's heat balance holds to
+round-off (:func:`dem.network.heat.theta_step`), so the energy bookkeeping stays exact through contact changes.
+
+The capacities use each particle's mass (constant: thermal expansion changes the radius, not the mass).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dem.laws.conductance import ConductanceSpec
+from dem.geometry.particles import Particles
+from dem.laws.ambient import Sources, Wall
+from dem.network.heat import Network, bonds_and_conductances, theta_step
+
+
+class ContactThermalModel:
+    """The thermal network on the current contacts (module docstring)."""
+
+    name = "thermal"
+
+    def __init__(self, particles: Particles, walls, spec: ConductanceSpec, sources: Sources,
+                 integrator: str = "implicit", linear: str = "auto"):
+        if integrator not in ("implicit", "crank-nicolson"):
+            raise ValueError(f"[solver] thermal_integrator = {integrator!r}: a network coupled to moving particles "
+                             f"steps implicitly: implicit or crank-nicolson")
+        self.particles = particles  # capacities, materials, fixed temperatures and sources
+        self.walls = tuple(walls)
+        self.thermal_walls = [k for k, w in enumerate(self.walls) if w.temperature is not None]
+        self.spec, self.sources = spec, sources
+        self.integrator, self.linear = integrator, linear
+        self.T = particles.temperature.astype(float).copy()
+        self.rate = np.zeros_like(self.T)  # dT/dt over the last step: the mechanics extrapolates with it
+        self.net: Network | None = None
+        self.free = np.flatnonzero(~particles.fixed)
+        self.heat_in: dict = {}
+        self.energy0 = float(particles.capacity @ self.T)
+        self.assemblies = self.refreshes = 0
+
+    def bonds(self, mechanics):
+        """Bonds and conductances ``(bonds, K_pairs, K_walls)`` of the contacts of ``mechanics`` now."""
+        i, j = mechanics.contacts()[:2]
+        return bonds_and_conductances(self._particles_now(mechanics, mechanics.state.radius),
+                                      self._walls_now(mechanics), self.spec, pairs=(i, j))
+
+    def _particles_now(self, mechanics, radius) -> Particles:
+        """The particles at their current positions with ``radius``: the current radii for the contact geometry,
+        the initial ones (the mass) for the capacities and the exposed surface."""
+        p = self.particles
+        return Particles(mechanics.state.x, radius, self.T, p.material, p.fixed, p.heat, p.materials)
+
+    def _walls_now(self, mechanics) -> list:
+        return [Wall(self.walls[k].name, self.walls[k].normal * mechanics.w.q[k], self.walls[k].normal,
+                     self.walls[k].temperature) for k in self.thermal_walls]
+
+    def step(self, mechanics, dt: float) -> None:
+        """Advance the temperatures by ``dt`` on the network of the contacts of ``mechanics`` now."""
+        bonds, K_pairs, K_walls = self.bonds(mechanics)
+        same = (self.net is not None and np.array_equal(bonds.i, self.net.bonds.i)
+                and np.array_equal(bonds.j, self.net.bonds.j)
+                and np.array_equal(bonds.wall_particle, self.net.bonds.wall_particle)
+                and np.array_equal(bonds.wall_index, self.net.bonds.wall_index))
+        if same:
+            self.net.refresh(bonds, K_pairs, K_walls)
+            self.refreshes += 1
+        else:
+            wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
+            self.net = Network(self._particles_now(mechanics, self.particles.radius), bonds, K_pairs, K_walls,
+                               wall_T, self.sources)
+            self.assemblies += 1
+        T_F, heat = theta_step(self.net, self.T[self.free], dt, self.integrator, self.linear)
+        for k, v in heat.items():
+            self.heat_in[k] = self.heat_in.get(k, 0.0) + v
+        self.rate[self.free] = (T_F - self.T[self.free]) / dt
+        self.T[self.free] = T_F
+
+    def energy_error(self) -> float:
+        """``|sum C (T - T0) - heat in| / scale`` (relative; the scale is the capacity times the temperature range
+        plus the heat exchanged)."""
+        C = self.particles.capacity
+        change = float(C @ self.T) - self.energy0
+        scale = float(C.sum()) * max(float(np.ptp(self.T)), 1e-300) + sum(abs(v) for v in self.heat_in.values())
+        return abs(change - sum(self.heat_in.values())) / scale if scale > 0 else 0.0

@@ -1,0 +1,121 @@
+"""The thermal submodel of Zohdi 2014: the lumped heat balance of each particle (eqs. 31-37).
+
+``m_i C_i dtheta_i/dt = Q_i + H_i`` (eq. 31): ``Q_i`` the heat conducted through the particle's contacts (with
+walls that carry a temperature: isothermal planes) and ``H_i`` its Joule heating (eq. 35; :mod:`dem.engines.contact_current`).
+The contact conductance is the scene's ``[conductance] law`` on each contact as it is, exactly as for a static
+packing (:func:`dem.geometry.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`): ``law = "zohdi"`` is the
+paper's ``K_ij A_ij / |r_i - r_j|`` (eq. 33 with the lens area of eqs. 7-12), ``"fit"`` the FE-verified neck law.
+
+Integrated by the trapezoidal rule of eq. (36) with the weight phi of the mechanics, and solved -- as the positions
+are -- by the fixed-point iteration of eq. (37), with the positions frozen at the iterate of the mechanics (the
+staggering of eqs. 45-46)::
+
+    theta^K = theta^L + dt/C (phi (Q(theta^(K-1); r^K) + H) + (1 - phi) (Q^L + H^L)).
+
+The current is refreshed when a step is accepted (Algorithm 1, step 6d), so ``H`` is the Joule heating of the
+configuration at the start of the step, at both ends of it. Every iteration's heat balance is exact: the change of
+``sum C theta`` equals the heat that entered through the walls (and from fixed particles), weighted as in the step,
+plus the Joule heat, to round-off (:meth:`LumpedHeat.energy_error`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dataclasses import dataclass
+
+from dem.geometry.bonds import find_bonds
+from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.geometry.particles import Particles
+from dem.engines.staggered import kernels
+
+
+@dataclass(frozen=True)
+class Plane:
+    """A wall where the mechanics has it now: what :func:`dem.geometry.bonds.find_bonds` asks of a wall."""
+
+    name: str
+    normal: np.ndarray
+    offset: float
+
+    def distance(self, position: np.ndarray) -> np.ndarray:
+        return position @ self.normal - self.offset
+
+
+def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_of_range: str):
+    """``(particles at x, bonds)``: the touching pairs of the Verlet list of ``mech`` at positions ``x`` and the
+    particles touching the walls ``wall_ids`` (where the mechanics has them), with contact radii from the geometry
+    ``contact`` (:func:`dem.geometry.bonds.find_bonds`)."""
+    closed = kernels.closed_pairs(x, particles.radius, mech.pi, mech.pj)
+    now = Particles(x, particles.radius, T, particles.material, particles.fixed, particles.heat, particles.materials)
+    planes = [Plane(mech.walls[k].name, mech.w.normal[k], float(mech.w.q[k])) for k in wall_ids]
+    return now, find_bonds(now, planes, contact, out_of_range, pairs=(mech.pi[closed], mech.pj[closed]))
+
+
+class LumpedHeat:
+    """The temperatures of the particles (module docstring)."""
+
+    name = "thermal"
+
+    def __init__(self, particles: Particles, walls, spec: ConductanceSpec):
+        self.particles, self.walls, self.spec = particles, tuple(walls), spec
+        self.thermal_walls = [k for k, w in enumerate(self.walls) if w.temperature is not None]
+        self.wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
+        # the paper's law on equal spheres (no lens out of range) is evaluated in compiled code on the Verlet list
+        self.compiled = spec.law == "zohdi" and (spec.out_of_range != "error" or np.ptp(particles.radius) == 0.0)
+        self.kappa = particles.conductivity
+        self.wall_T_all = np.array([np.nan if w.temperature is None else w.temperature for w in self.walls])
+        self.contact_conductance = np.inf if spec.contact_conductance is None else spec.contact_conductance
+        self.C = particles.capacity
+        self.free = ~particles.fixed
+        self.T = particles.temperature.astype(float).copy()  # theta^L
+        self.T0 = self.T.copy()
+        self.heat_in = {"boundaries": 0.0, "joule": 0.0}
+        self.Q = np.zeros(particles.n)  # conducted heat at the start of the step, Q^L (W per particle)
+        self._Q_iter = np.zeros(particles.n)
+
+    def conduction(self, mech, x, T) -> np.ndarray:
+        """``Q_i`` (W) of eq. (33) at positions ``x`` (the contacts of the Verlet list of the mechanics ``mech``,
+        the walls where it has them) and temperatures ``T``."""
+        n = self.particles.n
+        if self.compiled:
+            Q = np.empty(n)
+            kernels.lens_conduction(x, T, self.particles.radius, self.kappa, self.contact_conductance, mech.pi,
+                                    mech.pj, mech.w.normal, mech.w.q, self.wall_T_all, mech.wk, mech.wm, Q)
+            return Q
+        now, b = contact_bonds(self.particles, mech, x, T, self.thermal_walls, self.spec.contact,
+                               self.spec.out_of_range)
+        K, K_w = bond_conductances(self.spec, now, b)
+        flow = K * (T[b.j] - T[b.i])  # from j into i
+        into_wall = K_w * (self.wall_T[b.wall_index] - T[b.wall_particle]) if b.n_walls else np.zeros(0)
+        return np.bincount(b.i, flow, n) - np.bincount(b.j, flow, n) + np.bincount(b.wall_particle, into_wall, n)
+
+    def start(self, mech) -> None:
+        """``Q^L`` at the state of ``mech`` (the first step)."""
+        self.Q = self.conduction(mech, mech.state.x, self.T)
+
+    def iterate(self, dt: float, phi: float, mech, T_prev, H) -> np.ndarray:
+        """``theta^K`` of eq. (37) from the previous iterate ``T_prev`` at the positions of the latest iterate of
+        the mechanics ``mech`` with the Joule heating ``H`` (W per particle)."""
+        self._Q_iter = self.conduction(mech, mech.x_iterate, T_prev)
+        T = self.T + dt / self.C * (phi * self._Q_iter + (1.0 - phi) * self.Q + H)
+        T[~self.free] = self.T[~self.free]
+        return T
+
+    def accept(self, dt: float, phi: float, T, mech, H) -> None:
+        """The iterate ``T`` becomes the state: the heat of the step is booked (with the flows the iteration used)
+        and ``Q^L`` of the next step is taken at the accepted state."""
+        f = self.free
+        self.heat_in["boundaries"] += dt * float(phi * self._Q_iter[f].sum() + (1.0 - phi) * self.Q[f].sum())
+        self.heat_in["joule"] += dt * float(np.sum(H[f]))
+        self.T = np.array(T, dtype=float)
+        self.Q = self.conduction(mech, mech.state.x, self.T)
+
+    def energy_error(self) -> float:
+        """``|sum C (theta - theta_0) - heat in| / scale`` over the free particles (relative; the scale is the
+        capacity times the temperature range plus the heat exchanged)."""
+        f = self.free
+        change = float(self.C[f] @ (self.T[f] - self.T0[f]))
+        heat = sum(self.heat_in.values())
+        scale = float(self.C[f].sum()) * max(float(np.ptp(self.T)), 1e-300) + sum(abs(v) for v in self.heat_in.values())
+        return abs(change - heat) / scale if scale > 0 else 0.0

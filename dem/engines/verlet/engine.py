@@ -1,0 +1,333 @@
+"""The engine for particles that move: the simulation owns the time loop, the submodels plug into it.
+
+A run is a sequence of *intervals* on the mechanical step grid ``t = k dt``. An interval ends at the next output
+time, the next thermal update and the next knot of the temperature schedule, whichever comes first; in each the
+submodels act in order:
+
+1. ``mechanical`` (:class:`dem.engines.verlet.mechanics.MechanicalModel`) -- contact forces, walls, gravity and velocity-Verlet
+   steps, in compiled code, with the temperatures of the interval: prescribed by the schedule (linear in time,
+   uniform), computed by the thermal network (its latest temperatures extrapolated with the rate of its last step),
+   or the initial ones;
+2. ``thermal`` (:class:`dem.engines.contact_heat.ContactThermalModel`) -- one implicit step of the pipe network over the
+   interval, on the contacts as they are at its end;
+3. observers -- the output writer and the progress bar.
+
+The thermal interval is many mechanical steps long (``[solver] thermal_interval``), so neither physics forces the
+other's step down. A scene whose physics is only ``thermal`` never comes here: it runs on the static path of
+:mod:`dem.engines.static`, exactly as before.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from dem.engines.contact_heat import ContactThermalModel
+from dem.laws.contact.luding import P_EXPANSION, P_T0, P_T_MELT
+from dem.laws.contact.luding_kernels import radius_at
+from dem.engines.verlet.mechanics import MechanicalModel
+from dem.geometry.motion import MotionState
+from dem.network.heat import boundary_heat_flow, steady
+from fem_neck.geometry import neck_radius
+
+
+class Simulation:
+    """A moving-particle run built from a scene with ``"mechanical"`` physics."""
+
+    def __init__(self, scene, resume: dict | None = None):
+        """``resume``: a checkpoint of this scene's run (:func:`dem.scene.state_file.arrays` as loaded by
+        :func:`dem.output.folder.load`): the run goes on from its step as if it had not stopped."""
+        self.scene = scene
+        m = scene.motion
+        p = scene.particles
+        params = scene.contact.params()
+        T_init = p.temperature.astype(float)
+        scale = np.array([radius_at(1.0, float(T), params[P_T_MELT], params[P_EXPANSION]) for T in T_init])
+        state = MotionState.create(m.dimension, p.position, p.radius, scene.contact.density, T_init, m.velocity,
+                                   m.angular_velocity, m.height, radius_ref=p.radius / scale)
+        saved = resume if resume is not None else m.start
+        if saved is not None:
+            for key in ("x", "v", "w", "f", "tau", "mass", "inertia", "radius", "radius_ref", "T"):
+                setattr(state, key, np.ascontiguousarray(saved[key], dtype=float).copy())
+        self.base_params = params
+        self.mechanics = MechanicalModel(state, m.walls, params, m.dt, m.skin, m.gravity, m.box,
+                                         relaxation_time=float(params[P_T0]), history=saved)
+        self.thermal = None
+        if "thermal" in scene.physics:
+            self.thermal = ContactThermalModel(p, m.walls, scene.conductance, scene.sources, m.thermal_integrator,
+                                               scene.solver.linear)
+        self.schedule = m.schedule
+        self.models = [self.mechanics] + ([self.thermal] if self.thermal is not None else [])
+        if resume is not None:
+            self._resume(resume)
+
+    def _resume(self, saved: dict) -> None:
+        """The clock, the walls' motion and the heat balance of a checkpoint (the particles came in above)."""
+        mech = self.mechanics
+        mech.steps = int(saved["steps"])
+        names = list(saved["wall_names"])
+        for k, wall in enumerate(mech.walls):
+            m = names.index(wall.name)
+            mech.w.q[k], mech.w.dq[k], mech.w.acc[k] = saved["wall_q"][m], saved["wall_dq"][m], saved["wall_acc"][m]
+        mech.walls_moved()
+        if self.thermal is not None:
+            th = self.thermal
+            th.T = np.array(saved["thermal_T"], dtype=float)
+            th.rate = np.array(saved["thermal_rate"], dtype=float)
+            th.energy0 = float(saved["thermal_energy0"])
+            th.heat_in = {str(k): float(v) for k, v in zip(saved["heat_keys"], saved["heat_values"])}
+
+    @property
+    def temperature_source(self) -> str:
+        if self.schedule is not None:
+            return "schedule"
+        return "network" if self.thermal is not None else "initial"
+
+    # ------------------------------------------------------------------------------------------------ loop
+    def _interval_temperatures(self, t: float, t_end: float):
+        """``(T0, rate, relaxation_time)`` over the interval ``[t, t_end]`` (length-1 arrays: uniform). The
+        schedule's segment is the one holding the interval's middle: an interval ends at every knot, but its start
+        ``k dt`` may fall a little before the knot it begins at (the knot rounded to the step grid)."""
+        mech = self.mechanics
+        if self.schedule is not None:
+            middle = 0.5 * (t + t_end)
+            return (np.array([self.schedule.at(t)]), np.array([self.schedule.rate(middle)]),
+                    self.schedule.relaxation(middle))
+        if self.thermal is not None:  # the network's temperatures, extrapolated with its last rate (cooling is
+            T, rate = self.thermal.T, self.thermal.rate  # then seen as cooling: k1(T, t) freezes, Sec. 3.4)
+        else:
+            T, rate = mech.state.T, np.zeros(len(mech.state.T))
+        if np.all(T == T[0]) and np.all(rate == rate[0]):
+            return np.array([T[0]]), np.array([rate[0]]), mech.relaxation_time
+        return T.copy(), rate.copy(), mech.relaxation_time
+
+    def _params_at(self, t: float) -> np.ndarray:
+        """The material at time ``t``: the scene's, with the overrides of every ``[[phases]]`` entry started."""
+        params = self.base_params.copy()
+        for start, overrides in self.scene.motion.phases:
+            if start <= t * (1 + 1e-12) + 1e-300:
+                for k, value in overrides.items():
+                    params[k] = value
+        return params
+
+    def _interval_ends(self, n_end: int) -> list[int]:
+        """Step indices at which an interval ends: output times, thermal updates, schedule knots, phase starts,
+        the end."""
+        m, dt = self.scene.motion, self.mechanics.dt
+        ends = {n_end}
+        every = max(1, round(m.output_interval / dt))
+        ends.update(range(every, n_end, every))
+        if self.thermal is not None:
+            every = max(1, round(m.thermal_interval / dt))
+            ends.update(range(every, n_end, every))
+        if self.schedule is not None:
+            ends.update(k for k in (round(t / dt) for t in self.schedule.time) if 0 < k < n_end)
+        ends.update(k for k in (round(start / dt) for start, _ in m.phases + m.wall_phases) if 0 < k < n_end)
+        return sorted(ends)
+
+    def _wall_speeds_at(self, t: float) -> None:
+        """Strain walls at the speeds of every ``[[phases]]`` ``wall_velocity`` entry started by time ``t``."""
+        mech = self.mechanics
+        names = [w.name for w in mech.walls]
+        for start, speeds in self.scene.motion.wall_phases:
+            if start <= t * (1 + 1e-12) + 1e-300:
+                for name, velocity in speeds.items():
+                    mech.w.dq[names.index(name)] = velocity
+
+    def run(self, observer=None, progress=None, checkpoint=None, position=None) -> dict:
+        """Advance to ``[solver] t_end``; ``observer(sim)`` after each interval that ends on an output time (and at
+        t = 0), ``progress(t)`` after every interval, ``checkpoint(make)`` after every interval and at the end
+        (:class:`dem.output.folder.Checkpointer`); ``position`` (:class:`sinterheat.interrupt.Where`) learns the step and
+        time after every interval."""
+        from dem.scene.state_file import arrays
+
+        m, mech = self.scene.motion, self.mechanics
+        n_end = max(1, math.ceil(self.scene.solver.t_end / mech.dt - 1e-9))
+        out_every = max(1, round(m.output_interval / mech.dt))
+        if observer is not None and mech.steps == 0:
+            observer(self)
+        for end in self._interval_ends(n_end):
+            steps = end - mech.steps
+            if steps <= 0:
+                continue
+            T0, rate, t0 = self._interval_temperatures(mech.t, end * mech.dt)
+            mech.params = self._params_at(mech.t)
+            self._wall_speeds_at(mech.t)
+            mech.advance(steps, T0, rate, t0)
+            if self.thermal is not None:
+                self.thermal.step(mech, steps * mech.dt)
+                mech.state.T[:] = self.thermal.T  # the next interval starts from these
+            if observer is not None and (end % out_every == 0 or end == n_end):
+                observer(self)
+            if progress is not None:
+                progress(mech.t)
+            if position is not None:
+                position.update(step=mech.steps, t=mech.t)
+            if checkpoint is not None:
+                checkpoint(lambda: arrays(self), final=end == n_end)
+        return self.summary()
+
+    # -------------------------------------------------------------------------------------------- outputs
+    def box_volume(self) -> float | None:
+        """Volume of the box the walls (or the periodic lengths) enclose (2D: area times height), m^3; None when
+        the walls do not close an axis-aligned box."""
+        mech = self.mechanics
+        s, w = mech.state, mech.w
+        axes = (0, 2) if s.dimension == 2 else (0, 1, 2)
+        volume = s.height if s.dimension == 2 else 1.0
+        for a in axes:
+            if mech.box[a] > 0:
+                volume *= mech.box[a]
+                continue
+            lo = [k for k, wall in enumerate(mech.walls) if abs(wall.normal[a] - 1.0) < 1e-12]
+            hi = [k for k, wall in enumerate(mech.walls) if abs(wall.normal[a] + 1.0) < 1e-12]
+            if len(lo) != 1 or len(hi) != 1:
+                return None
+            volume *= w.extent(lo[0], hi[0])
+        return volume
+
+    def volume_fraction(self) -> float | None:
+        """Solid volume over box volume (Luding 2005's density nu)."""
+        volume = self.box_volume()
+        return None if volume is None else self.mechanics.state.solid_volume() / volume
+
+    def wall_stress(self) -> dict:
+        """Normal stress the particles exert on each wall of an axis-aligned box: force per unit length (2D, N/m,
+        the paper's pressure unit) or per unit area (3D, Pa); the bare force (N) on a wall outside such a box."""
+        mech = self.mechanics
+        out = {}
+        for k, wall in enumerate(mech.walls):
+            lo_hi = mech.w.span[k]
+            extent = 1.0
+            for a in range(2):
+                if lo_hi[2 * a] >= 0:
+                    extent *= mech.w.extent(lo_hi[2 * a], lo_hi[2 * a + 1])
+            out[wall.name] = float(mech.w.force[k] / extent)
+        return out
+
+    def heated_walls(self):
+        """``(hot, cold)`` wall indices when exactly two walls carry different temperatures and face each other
+        (the specimen of an effective conductivity), else None."""
+        mech = self.mechanics
+        walls = [k for k, w in enumerate(mech.walls) if w.temperature is not None]
+        if len(walls) != 2:
+            return None
+        a, b = (mech.walls[k] for k in walls)
+        if a.temperature == b.temperature or not np.allclose(a.normal, -b.normal, atol=1e-12):
+            return None
+        return tuple(walls) if a.temperature > b.temperature else tuple(reversed(walls))
+
+    def effective_conductivity(self) -> float | None:
+        """``k_eff = Q L / (A (T_hot - T_cold))`` of the contact network as it is now, from a steady solve between
+        the hot and the cold wall (W/(m K)); None without two such walls, a closed box or a network (or with
+        ambient sources, which are not conduction). Groups of particles touching neither wall carry no heat."""
+        th, pair = self.thermal, self.heated_walls()
+        volume = self.box_volume()
+        if th is None or th.net is None or pair is None or volume is None or self.scene.sources.names:
+            return None
+        mech = self.mechanics
+        hot, cold = pair
+        length = -(mech.w.q[hot] + mech.w.q[cold])
+        res = steady(th.net, floating="mean", linear=self.scene.solver.linear)
+        into = boundary_heat_flow(th.net, res.T)["walls"]
+        q = -into[th.thermal_walls.index(hot)]  # heat leaving the hot wall
+        delta_T = mech.walls[hot].temperature - mech.walls[cold].temperature
+        return float(q * length / (volume / length * delta_T))
+
+    def profile(self, bins: int = 8) -> dict | None:
+        """Solid fraction and mean neck radius (Rojek's volume-conserving neck of each contact's overlap, a/r of
+        the smaller particle) in slabs parallel to the hot wall, against the distance from it; None without a hot
+        wall and a closed box."""
+        pair = self.heated_walls()
+        volume = self.box_volume()
+        if pair is None or volume is None:
+            return None
+        mech = self.mechanics
+        s = mech.state
+        hot, cold = pair
+        normal = mech.walls[hot].normal
+        length = -(mech.w.q[hot] + mech.w.q[cold])
+        area = volume / length
+        edges = np.linspace(0.0, length, bins + 1)
+        dist = s.x @ normal - mech.w.q[hot]
+        v = 4.0 / 3.0 * np.pi * s.radius**3
+        slab = np.clip(np.searchsorted(edges, dist) - 1, 0, bins - 1)
+        density = np.bincount(slab, v, bins) / (area * np.diff(edges))
+        i, j, overlap = mech.contacts()[:3]
+        r_min = np.minimum(s.radius[i], s.radius[j])
+        h = np.minimum(overlap, 0.999 * (2.0 / 3.0) * r_min)  # within the neck model's range, for the profile
+        neck = np.asarray(neck_radius(s.radius[i], s.radius[j], h)) / r_min if len(i) else np.zeros(0)
+        mid = np.clip(np.searchsorted(edges, 0.5 * (dist[i] + dist[j])) - 1, 0, bins - 1)
+        count = np.bincount(mid, minlength=bins)
+        with np.errstate(invalid="ignore"):
+            neck_mean = np.bincount(mid, neck, bins) / count
+        return {"distance": (0.5 * (edges[1:] + edges[:-1])).tolist(), "solid_fraction": density.tolist(),
+                "neck_over_radius": [None if c == 0 else float(x) for c, x in zip(count, neck_mean)]}
+
+    def record(self) -> dict:
+        """The scalar observables of the current state (one row of ``timeseries.csv``)."""
+        mech = self.mechanics
+        s = mech.state
+        i = mech.contacts()[0]
+        row = {"t": mech.t, "step": mech.steps, "kinetic_energy": s.kinetic_energy(),
+               "volume_fraction": self.volume_fraction(), "coordination": 2.0 * len(i) / s.n,
+               "k1_factor": float(np.mean(mech.k1f)), "T_mean": float(np.mean(s.T)),
+               "T_min": float(np.min(s.T)), "T_max": float(np.max(s.T))}
+        if self.thermal is not None and self.heated_walls() is not None:
+            row["effective_conductivity"] = self.effective_conductivity()
+        for name, value in self.wall_stress().items():
+            row[f"wall_{name}"] = value
+        for k, wall in enumerate(mech.walls):
+            row[f"q_{wall.name}"] = float(mech.w.q[k])
+        return row
+
+    def summary(self) -> dict:
+        mech = self.mechanics
+        s = mech.state
+        out = {k: v for k, v in self.record().items() if k not in ("step",)}
+        profile = self.profile()
+        if profile is not None:
+            out["profile"] = profile
+        out.update(steps=mech.steps, dt=mech.dt, particles=s.n, contacts=len(mech.contacts()[0]),
+                   wall_contacts=len(mech.wall_contacts()[0]), dimension=s.dimension,
+                   momentum=s.momentum().tolist(), neighbour_rebuilds=mech.rebuilds, skin=mech.skin,
+                   temperature_source=self.temperature_source)
+        if self.thermal is not None:
+            th = self.thermal
+            out.update(energy_error=th.energy_error(), heat_in={k: float(v) for k, v in th.heat_in.items()},
+                       network_assemblies=th.assemblies, network_refreshes=th.refreshes, law=self.scene.conductance.law)
+        return out
+
+    def particle_fields(self) -> dict:
+        """Per-particle fields for snapshots: velocity, angular velocity, force, temperature, stiffness factor, and
+        the particle stress ``sigma_i = (1/V_i) sum_c l_c (x) f_c`` (l_c from the centre to contact c, f_c the force
+        on i there) with its mean ``tr(sigma)/dim`` (positive in compression)."""
+        mech = self.mechanics
+        s = mech.state
+        i, j, overlap, fn, ft = mech.contacts()
+        d = s.x[i] - s.x[j]
+        for a in range(3):
+            if mech.box[a] > 0:
+                d[:, a] -= mech.box[a] * np.floor(d[:, a] / mech.box[a] + 0.5)
+        n = d / np.linalg.norm(d, axis=1)[:, None]
+        f_i = fn[:, None] * n + ft
+        sigma = np.zeros((s.n, 3, 3))
+        np.add.at(sigma, i, -s.radius[i, None, None] * n[:, :, None] * f_i[:, None, :])
+        np.add.at(sigma, j, -s.radius[j, None, None] * n[:, :, None] * f_i[:, None, :])  # l_j = a_j n, f_j = -f_i
+        k, m, _, wfn = mech.wall_contacts()
+        wn = mech.w.normal[m]
+        np.add.at(sigma, k, -s.radius[k, None, None] * wn[:, :, None] * (wfn[:, None] * wn)[:, None, :])
+        volume = (4.0 / 3.0 * np.pi * s.radius**3) if s.dimension == 3 else np.pi * s.radius**2 * s.height
+        sigma /= volume[:, None, None]
+        # sign: compression positive (the lever arm points against the compressive force)
+        sigma = -sigma
+        mean = np.trace(sigma, axis1=1, axis2=2) / s.dimension
+        return {"radius": s.radius, "velocity": s.v, "angular_velocity": s.w, "force": s.f, "temperature": s.T,
+                "k1_factor": mech.k1f, "stress": sigma.reshape(-1, 9), "mean_stress": mean}
+
+    def contact_fields(self):
+        """``(i, j, fields)`` of the closed pair contacts: normal force (> 0 repulsive), tangential force magnitude,
+        overlap."""
+        i, j, overlap, fn, ft = self.mechanics.contacts()
+        return i, j, {"normal_force": fn, "tangential_force": np.linalg.norm(ft, axis=1), "overlap": overlap}

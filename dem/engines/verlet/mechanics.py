@@ -1,0 +1,182 @@
+"""The mechanical submodel: particles that move under the Luding 2005 sintering contact law, walls and gravity.
+
+It owns the Verlet list and the per-contact history and advances the state with the compiled loop of
+:mod:`dem.engines.verlet.loop`, returning to Python only to rebuild the list (when some particle has moved more than half the
+skin), at the times the engine asks for (output, a thermal update, a change of schedule), or to stop a run that
+went wrong (a non-finite position, a particle through a wall) with a one-line message naming the step and the
+particle.
+
+History (Luding 2005, Sec. 3): per pair in the list the largest overlap ``delta_max``, the stiffness factor the
+contact saw at its last step (``k1_last``: heating keeps delta_max, cooling keeps delta_0, Fig. 5) and the
+tangential spring ``xi`` (eqs. 16, 20-21); the same per particle-wall pair. A rebuild carries the history of every
+pair that stays listed (:func:`dem.geometry.neighbours.carry_history`); a contact that opens forgets it.
+
+The stiffness factor ``k1(T, t)/k1`` (eqs. 10-12) is a property of each particle's material (the healing of its
+defects): a contact uses the mean of its two particles' factors, which for a uniform temperature is exactly the
+single ``k1(T, t)`` of the paper, and a contact that forms during sintering starts from the state the material has
+reached.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from dem.engines.verlet import loop as md_loop
+from dem.laws.contact.luding_kernels import k1_factor
+from dem.geometry.motion import MotionState
+from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
+from dem.geometry.walls import WallArrays
+
+
+class MechanicsError(ValueError):
+    """A run that cannot go on (non-finite state, a particle through a wall); the message names step and particle."""
+
+
+class MechanicalModel:
+    """Velocity-Verlet dynamics with the Luding contact law (module docstring)."""
+
+    name = "mechanical"
+
+    def __init__(self, state: MotionState, walls, params: np.ndarray, dt: float, skin: float,
+                 gravity=(0.0, 0.0, 0.0), box=(0.0, 0.0, 0.0), relaxation_time: float = 1e3, history=None):
+        """``history``: a saved state (:func:`dem.scene.state_file.load`) whose stiffness factors and contact histories
+        (pairs, and particle-wall pairs matched by wall name) the model starts from."""
+        self.state = state
+        self.walls = tuple(walls)
+        self.params = np.ascontiguousarray(params, dtype=float)
+        self.dt = float(dt)
+        self.skin = float(skin)
+        self.gravity = np.asarray(gravity, dtype=float) * state.linear_dof
+        self.box = np.asarray(box, dtype=float)
+        self.relaxation_time = float(relaxation_time)
+        self.w = WallArrays.build(self.walls, state.dimension)
+        n, n_w = state.n, len(self.walls)
+        T_melt, T_var = self.params[md_loop.P_T_MELT], self.params[md_loop.P_T_VAR]
+        self.k1f = np.array([k1_factor(float(T), T_melt, T_var) for T in state.T])  # relaxed at the initial T
+        self.w_dmax = np.zeros((n, n_w))
+        self.w_k1last = np.zeros((n, n_w))
+        self.w_xi = np.zeros((n, n_w, 3))
+        self.w_fn = np.zeros((n, n_w))
+        self.w_ft = np.zeros((n, n_w, 3))
+        self.steps = 0
+        self.rebuilds = 0
+        self._info = np.zeros(2, dtype=np.int64)
+        self._build_list(first=True)
+        if history is not None:
+            self._restore(history)  # with the forces of its last step: the run goes on as if it had not stopped
+        else:
+            self._initial_forces()
+
+    def _restore(self, saved: dict):
+        """Stiffness factors and contact histories from a saved state (the list is rebuilt here, so the pairs'
+        histories are carried by key; walls by name)."""
+        self.k1f = np.array(saved["k1f"], dtype=float)
+        self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft = carry_history(
+            saved["pi"], saved["pj"], self.pi, self.pj, saved["p_dmax"], saved["p_k1last"],
+            saved["p_xi"], np.zeros(len(saved["pi"])), np.zeros((len(saved["pi"]), 3)))
+        names = [w.name for w in self.walls]
+        for m_old, name in enumerate(saved["wall_names"]):
+            if name in names:
+                m = names.index(name)
+                self.w_dmax[:, m] = saved["w_dmax"][:, m_old]
+                self.w_k1last[:, m] = saved["w_k1last"][:, m_old]
+                self.w_xi[:, m] = saved["w_xi"][:, m_old]
+                if self.walls[m].motion == "stress":
+                    self.w.dq[m] = saved["wall_dq"][m_old]
+                    self.w.acc[m] = saved["wall_acc"][m_old]
+
+    # ------------------------------------------------------------------------------------------------ list
+    def _build_list(self, first: bool = False):
+        s = self.state
+        expected = 0 if first else len(self.pi) + len(self.pi) // 8 + 16  # the last list, with room to grow
+        i, j = verlet_pairs(s.x, s.radius, self.skin, self.box, expected)
+        if first:
+            m = len(i)
+            self.p_dmax, self.p_k1last, self.p_fn = np.zeros(m), np.zeros(m), np.zeros(m)
+            self.p_xi, self.p_ft = np.zeros((m, 3)), np.zeros((m, 3))
+        else:
+            self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft = carry_history(
+                self.pi, self.pj, i, j, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft)
+            self.rebuilds += 1
+        self.pi, self.pj = i, j
+        self.x_ref = s.x.copy()
+        self.walls_moved()
+
+    def walls_moved(self):
+        """The walls were set elsewhere (a resumed run): their Verlet list follows."""
+        self.wk, self.wm = wall_pairs(self.state.x, self.state.radius, self.w.normal, self.w.q, self.skin)
+        self.wq_ref = self.w.q.copy()
+
+    def _initial_forces(self):
+        """Forces of the initial state (dt = 0: no history increment)."""
+        s, w = self.state, self.w
+        md_loop._forces(s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, self.k1f, self.gravity,
+                        self.box, self.pi, self.pj, self.p_dmax, self.p_k1last, self.p_xi, self.p_fn, self.p_ft,
+                        w.normal, w.q, w.dq, w.force, self.wk, self.wm, self.w_dmax, self.w_k1last, self.w_xi,
+                        self.w_fn, self.w_ft, self.params, 0.0)
+        for m in range(len(self.walls)):
+            w.acc[m] = md_loop._wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span,
+                                                  w.force)
+
+    # --------------------------------------------------------------------------------------------- advance
+    @property
+    def t(self) -> float:
+        return self.steps * self.dt
+
+    def advance(self, n_steps: int, T0: np.ndarray, T_rate: np.ndarray, relaxation_time: float | None = None):
+        """``n_steps`` steps with temperatures ``T0 + T_rate (t - t_now)`` (uniform when both have one entry)."""
+        s, w = self.state, self.w
+        t0 = self.relaxation_time if relaxation_time is None else relaxation_time
+        T0 = np.ascontiguousarray(T0, dtype=float)
+        T_rate = np.ascontiguousarray(T_rate, dtype=float)
+        uniform = len(T0) == 1
+        first = self.steps
+        done = 0
+        while done < n_steps:
+            steps, status = md_loop.advance(
+                n_steps - done, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia,
+                s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.k1f,
+                uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_dmax, self.p_k1last, self.p_xi,
+                self.p_fn, self.p_ft, w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0,
+                w.amplitude, w.frequency, w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_dmax,
+                self.w_k1last, self.w_xi, self.w_fn, self.w_ft, self.params, self.x_ref, self.skin, self._info)
+            done += steps
+            self.steps += steps
+            if status == md_loop.REBUILD:
+                self._build_list()
+            elif status == md_loop.NONFINITE:
+                k = int(self._info[0])
+                raise MechanicsError(f"the run stopped at step {self.steps} (t = {self.t:.6g} s): particle {k} has a "
+                                     f"non-finite position or velocity; the step dt = {self.dt:.6g} s is too large "
+                                     f"or a parameter is extreme")
+            elif status == md_loop.ESCAPED:
+                k, m = int(self._info[0]), int(self._info[1])
+                raise MechanicsError(f"the run stopped at step {self.steps} (t = {self.t:.6g} s): particle {k} "
+                                     f"(centre {s.x[k].tolist()}) left the box through wall "
+                                     f"{self.walls[m].name!r}; reduce dt or the wall speed, or enlarge the box")
+
+    # --------------------------------------------------------------------------------------------- outputs
+    def contacts(self):
+        """The closed pair contacts: ``(i, j, overlap, f_n, f_t)`` with f_t the (M, 3) tangential forces on i."""
+        s = self.state
+        d = s.x[self.pi] - s.x[self.pj]
+        for a in range(3):
+            if self.box[a] > 0:
+                d[:, a] -= self.box[a] * np.floor(d[:, a] / self.box[a] + 0.5)
+        overlap = s.radius[self.pi] + s.radius[self.pj] - np.linalg.norm(d, axis=1)
+        closed = overlap > 0
+        return self.pi[closed], self.pj[closed], overlap[closed], self.p_fn[closed], self.p_ft[closed]
+
+    def wall_contacts(self):
+        """The closed particle-wall contacts: ``(particle, wall, overlap, f_n)``."""
+        s, w = self.state, self.w
+        dist = s.x @ w.normal.T - w.q[None, :]
+        overlap = s.radius[:, None] - dist
+        k, m = np.nonzero(overlap > 0)
+        return k, m, overlap[k, m], self.w_fn[k, m]
+
+    def coordination(self) -> float:
+        """Mean number of particle contacts per particle, ``2 M / N``."""
+        return 2.0 * len(self.contacts()[0]) / self.state.n

@@ -1,0 +1,198 @@
+"""Heat sources and boundaries of the particle heat balance (Rojek 2022, eq. 3).
+
+``Q_i = sum_j Q_ij^cond + Q_i^int + Q_i^conv + Q_i^rad``. Besides the pipes (``dem.network.heat``) a particle exchanges
+heat with
+
+* its internal source ``Q_i^int`` (W, ``Particles.heat``),
+* an ambient by convection ``Q_i^conv = h A_i (T_inf - T_i)`` (:class:`Convection`),
+* an ambient by radiation ``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)`` in absolute temperature (:class:`Radiation`),
+* isothermal plane walls it touches (:class:`Wall`; the contact conductance comes from the conductance law).
+
+Particles held at a fixed temperature are a mask of :class:`dem.geometry.particles.Particles`. Every term is linear in
+``T_i`` except radiation, which the solvers use linearised about the current temperature
+(:func:`linear_sink_terms`); a scene without radiation never evaluates ``T^4``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from dem.geometry.particles import POSITION_MAX, TEMPERATURE_MAX, check_range
+
+STEFAN_BOLTZMANN = 5.670374419e-8  # W/(m^2 K^4), CODATA 2018 (exact)
+KELVIN_OFFSET = {"K": 0.0, "C": 273.15}
+RADIATION_T_MAX = 1e4  # K: no solid particle exists above; beyond ~1e5 K the steady Newton on T^4 stalls
+HEAT_TRANSFER_MAX = 1e10  # W/(m^2 K), convection coefficient (boiling water is ~1e5)
+
+
+def _vector(name: str, value) -> np.ndarray:
+    """``value`` as a finite 3-vector of at most POSITION_MAX per component, else ``ValueError`` naming it."""
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        v = np.full(1, np.nan)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} = {value!r}: must be a finite 3-vector")
+    return check_range(name, v, None, POSITION_MAX, " m")
+
+
+def _unit_vector(name: str, value) -> np.ndarray:
+    v = _vector(name, value)
+    if np.linalg.norm(v) == 0.0:
+        raise ValueError(f"{name} = {value!r}: must be a finite non-zero 3-vector")
+    return v / np.linalg.norm(v)
+
+
+def _temperature(name: str, value) -> float:
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
+        raise ValueError(f"{name} = {value!r}: must be a finite number")
+    return float(check_range(name, np.float64(value), None, TEMPERATURE_MAX))
+
+
+@dataclass(frozen=True)
+class Wall:
+    """An isothermal plane through ``point`` with unit ``normal`` pointing into the packing, at ``temperature``.
+
+    A particle touches the wall when its centre lies closer than its radius to the plane; the overlap is
+    ``delta = r - distance``.
+    """
+
+    name: str
+    point: np.ndarray
+    normal: np.ndarray
+    temperature: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "point", _vector(f"wall {self.name!r}: point", self.point))
+        object.__setattr__(self, "normal", _unit_vector(f"wall {self.name!r}: normal", self.normal))
+        _temperature(f"wall {self.name!r}: temperature", self.temperature)
+
+    def distance(self, position: np.ndarray) -> np.ndarray:
+        """Signed distance of each point from the plane (positive on the packing's side)."""
+        return (position - self.point) @ self.normal
+
+
+EXPOSED = "exposed"  # area_fraction: the exposed fraction of each surface (dem.geometry.exposure), computed from the packing
+
+
+def _area(name: str, fraction, radius: np.ndarray) -> np.ndarray:
+    if isinstance(fraction, str):
+        raise ValueError(f"{name}.area_fraction = {fraction!r}: resolve {EXPOSED!r} against the packing first "
+                         f"(Sources.resolved)")
+    try:
+        frac = np.broadcast_to(np.asarray(fraction, dtype=float), radius.shape)
+    except (TypeError, ValueError):
+        frac = np.full(radius.shape, np.nan)
+    if not np.all(np.isfinite(frac)) or np.any((frac < 0) | (frac > 1)):
+        raise ValueError(f"{name}.area_fraction = {fraction!r}: must be \"{EXPOSED}\" or in [0, 1] (scalar or one "
+                         f"per particle)")
+    return frac * 4.0 * np.pi * radius**2
+
+
+@dataclass(frozen=True)
+class Convection:
+    """``Q_i^conv = h A_i (T_inf - T_i)`` with ``A_i = area_fraction * 4 pi r_i^2``: by default the exposed part of
+    each surface (``"exposed"``, :mod:`dem.geometry.exposure`); ``area_fraction = 1`` opts in to the whole surface."""
+
+    h: float
+    T_inf: float
+    area_fraction: object = EXPOSED
+
+    def __post_init__(self):
+        _check_fraction("convection", self.area_fraction)
+        if not (np.isfinite(self.h) and 0 <= self.h <= HEAT_TRANSFER_MAX):
+            raise ValueError(f"convection.h = {self.h!r}: must be in [0, {HEAT_TRANSFER_MAX:g}] (W/(m^2 K))")
+        _temperature("convection.T_inf", self.T_inf)
+
+    def coefficient(self, radius: np.ndarray) -> np.ndarray:
+        """``h A_i`` in W/K."""
+        return self.h * _area("convection", self.area_fraction, radius)
+
+
+@dataclass(frozen=True)
+class Radiation:
+    """``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)``; temperatures in ``unit`` ("K" or "C", required), T^4 in
+    kelvin."""
+
+    emissivity: float
+    T_inf: float
+    area_fraction: object = EXPOSED
+    unit: str | None = None
+
+    def __post_init__(self):
+        _check_fraction("radiation", self.area_fraction)
+        if not (np.isfinite(self.emissivity) and 0 <= self.emissivity <= 1):
+            raise ValueError(f"radiation.emissivity = {self.emissivity!r}: must be in [0, 1]")
+        if self.unit is None:
+            raise ValueError("radiation.unit: required: \"K\" or \"C\", the unit of the scene's temperatures (T^4 is "
+                             "taken in kelvin, so 20 C and 20 K radiate very differently)")
+        if not isinstance(self.unit, str) or self.unit not in KELVIN_OFFSET:
+            raise ValueError(f"radiation.unit = {self.unit!r}: must be one of {', '.join(KELVIN_OFFSET)}")
+        if not (np.isfinite(self.T_inf) and 0 <= self.T_inf + KELVIN_OFFSET[self.unit] <= RADIATION_T_MAX):
+            raise ValueError(f"radiation.T_inf = {self.T_inf!r}: must be finite and in "
+                             f"[{0.0 - KELVIN_OFFSET[self.unit]:g}, {RADIATION_T_MAX - KELVIN_OFFSET[self.unit]:g}] "
+                             f"{self.unit} (absolute zero to {RADIATION_T_MAX:g} K)")
+
+    def kelvin(self, T):
+        return np.asarray(T, dtype=float) + KELVIN_OFFSET[self.unit]
+
+    def coefficient(self, radius: np.ndarray) -> np.ndarray:
+        """``eps sigma A_i`` in W/K^4."""
+        return self.emissivity * STEFAN_BOLTZMANN * _area("radiation", self.area_fraction, radius)
+
+    def outflow(self, radius: np.ndarray, T: np.ndarray) -> np.ndarray:
+        """Exact radiated power per particle ``eps sigma A_i (T_i^4 - T_inf^4)`` (W)."""
+        return self.coefficient(radius) * (self.kelvin(T) ** 4 - self.kelvin(self.T_inf) ** 4)
+
+
+def _check_fraction(name: str, fraction) -> None:
+    if isinstance(fraction, str) and fraction != EXPOSED:
+        raise ValueError(f"{name}.area_fraction = {fraction!r}: must be \"{EXPOSED}\" (the default) or a number "
+                         f"in [0, 1] (1: the whole surface)")
+
+
+@dataclass(frozen=True)
+class Sources:
+    """The ambient exchanges of a scene; ``None`` means the term is absent (and never evaluated)."""
+
+    convection: Convection | None = None
+    radiation: Radiation | None = None
+
+    def resolved(self, position: np.ndarray, radius: np.ndarray, keep: np.ndarray) -> "Sources":
+        """The same exchanges with every ``"exposed"`` area fraction replaced by the fractions of the particles
+        ``keep`` (indices) computed from the packing (:func:`dem.geometry.exposure.exposed_fraction`, once for both)."""
+        if not any(s is not None and isinstance(s.area_fraction, str) for s in (self.convection, self.radiation)):
+            return self
+        from dem.geometry.exposure import exposed_fraction
+
+        fraction = exposed_fraction(position, radius)[keep]
+        swap = {k: replace(s, area_fraction=fraction) for k, s in (("convection", self.convection),
+                                                                    ("radiation", self.radiation))
+                if s is not None and isinstance(s.area_fraction, str)}
+        return replace(self, **swap)
+
+    @property
+    def names(self) -> list[str]:
+        return [k for k in ("convection", "radiation") if getattr(self, k) is not None]
+
+
+def linear_sink_terms(sources: Sources, radius: np.ndarray, T_lin: np.ndarray | None) -> dict:
+    """Ambient exchange as ``Q_i = b_i - g_i T_i`` (W): ``{name: (g, b)}`` for each term the scene has.
+
+    Convection is linear: ``g = h A``, ``b = h A T_inf``. Radiation is linearised about ``T_lin`` (a Newton step
+    of ``T^4``): ``T^4 ~ 4 T0^3 T - 3 T0^4`` in kelvin, so ``g = 4 eps sigma A T0^3 >= 0`` keeps the system
+    matrix symmetric positive definite and the implicit integrators unconditionally stable.
+    """
+    terms = {}
+    if sources.convection is not None:
+        g = sources.convection.coefficient(radius)
+        terms["convection"] = (g, g * sources.convection.T_inf)
+    if sources.radiation is not None:
+        rad = sources.radiation
+        coef = rad.coefficient(radius)
+        t0 = np.maximum(rad.kelvin(T_lin), 0.0)
+        g = 4.0 * coef * t0**3
+        terms["radiation"] = (g, coef * (rad.kelvin(rad.T_inf) ** 4 + 3.0 * t0**4) - g * rad.kelvin(0.0))
+    return terms

@@ -1,0 +1,5 @@
+"""One network problem, two fields: heat (temperatures, thermal conductances) and current (potentials, electrical
+conductances) between particles on the same weighted graph Laplacian with fixed nodes and planes
+(:mod:`~dem.network.laplacian`), its linear solvers (:mod:`~dem.network.linsolve`), the heat balance steady and in
+time (:mod:`~dem.network.heat`) and the current (:mod:`~dem.network.current`, Zohdi 2014's iteration in
+:mod:`~dem.network.gauss_seidel`)."""

@@ -1,0 +1,252 @@
+"""Current through the contacts of a packing and the Joule heat it makes: two schemes side by side.
+
+Electrodes are walls: a particle touching an electrified wall exchanges current with it. Two ways to compute the
+current:
+
+* :func:`kirchhoff` -- the physical one (Kirchhoff's laws): a potential on every particle, each contact a
+  conductance ``G`` (the thermal neck law with the electrical conductivity sigma in place of kappa,
+  :func:`dem.laws.conductance.bond_conductances`), electrodes at a fixed potential (V) or driving a fixed total
+  current (A into the packing). One sparse solve (the same network solve as the heat,
+  :class:`dem.network.laplacian.BoundedLaplacian`) gives the potentials; every contact carries ``I = G (phi_i - phi_j)`` and
+  makes the Joule heat ``I^2 / G``, shared by its two particles in proportion to the resistances of their halves
+  (a wall contact's heat is made in the particle's half). The current is conserved at every particle, and the
+  Joule heat of all contacts equals the power the electrodes deliver, ``sum_e V_e I_e`` (Tellegen's theorem), to
+  round-off. A fixed-current electrode is solved by superposition: a unit-potential solve per such electrode with
+  the same factorisation, then the small system ``Y V = I`` for their potentials.
+* :func:`area_weighted_current` -- the scheme of Zohdi 2014 (eqs. 40-43, Remarks 2 and 4): a scalar "current"
+  ``J_i`` per particle; a particle touching an electrified wall takes the wall's value ``J_ext`` (Remark 2), every
+  other one the contact-area-weighted mean of its neighbours, ``J_i = sum_j A_ij J_j / sum_j A_ij`` (eq. 43),
+  found by Gauss-Seidel sweeps ("the solution method sweeps through the system, particle by particle, updating the
+  variables as it progresses"). Joule heating ``H_i = a J_i^2 V_i / sigma_i`` (eq. 35).
+
+Where they agree, and where not: eq. (43) is the discrete Laplace equation with weights ``A_ij`` and the wall
+particles held at ``J_ext`` -- the equation Kirchhoff's potential obeys with conductances ``G_ij`` and electrodes at
+fixed potentials. The converged ``J`` therefore *is* a potential (:func:`kirchhoff` with ``G = A`` and the wall
+particles fixed reproduces it to round-off); in a chain of equal contacts both are linear from one end to the other
+(Remark 4: each interior value the mean of its neighbours). But Zohdi reads ``J`` as a current magnitude: two walls
+at the same ``J_ext`` make every connected particle carry ``J_ext`` (Kirchhoff: no potential difference, no
+current), the heat is made in the particles by ``J^2`` rather than at the necks by ``I^2/G`` (where the narrow
+necks get most of it), the weights ignore the neck length and the conductivity, and nothing conserves charge.
+
+Particles in a group that touches no electrode carry no current in both schemes (Kirchhoff: their potential is
+undetermined; they are reported as floating).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from dem.network.laplacian import BoundedLaplacian, solve_anchored
+
+SCHEMES = ("kirchhoff", "zohdi")
+
+
+@dataclass(frozen=True)
+class Electrodes:
+    """The electrified walls: ``names``, and per electrode either a ``potential`` (V) or a ``current`` (A, into the
+    packing; Zohdi's scheme: the wall's ``J_ext``), the other NaN. ``walls``: their indices in the scene's walls."""
+
+    names: tuple
+    walls: tuple
+    potential: np.ndarray
+    current: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    @property
+    def fixed_potential(self) -> np.ndarray:
+        return np.isfinite(self.potential)
+
+
+@dataclass
+class CurrentFlow:
+    """A Kirchhoff solution.
+
+    ``potential`` (N,) V, NaN on floating particles; ``pair_current`` (M,) A from i to j; ``wall_current`` (B,) A
+    from each electrode into the particle of its contact; ``electrode_potential`` and ``electrode_current`` (E,) V
+    and A into the packing (NaN potential: an electrode with no path); ``joule_particles`` (N,) W made in each
+    particle; ``joule_heat`` (W, all contacts) and ``electrode_power`` (W, ``sum V_e I_e``); ``floating``: indices
+    of particles in groups that touch no electrode with a path; ``no_path``: names of fixed-current electrodes that
+    reach no electrode at a fixed potential (they carry no current); ``residual``: the largest current imbalance at a
+    particle relative to the largest contact current (or, when almost none flows, to 1e-12 of the largest electrode
+    conductance times the largest electrode potential).
+    """
+
+    potential: np.ndarray
+    pair_current: np.ndarray
+    wall_current: np.ndarray
+    electrode_potential: np.ndarray
+    electrode_current: np.ndarray
+    joule_particles: np.ndarray
+    joule_heat: float
+    electrode_power: float
+    floating: np.ndarray
+    no_path: tuple
+    residual: float
+
+    @property
+    def closed(self) -> bool:
+        """Whether any current flows (a group of particles joins two electrodes)."""
+        return bool(np.any(self.electrode_current != 0.0))
+
+
+def _grounded(n, i, j, plane_node, plane_index, electrodes: Electrodes):
+    """Which particles and which electrodes are connected (through particles and electrodes) to an electrode at a
+    fixed potential: ``(particle mask, electrode mask, lone)``, ``lone`` the electrode each particle of a group
+    that reaches exactly one electrode shares its potential with (-1 elsewhere): such a group carries no current."""
+    n_e = len(electrodes)
+    rows = np.concatenate([i, plane_node])
+    cols = np.concatenate([j, n + plane_index])
+    graph = sp.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(n + n_e, n + n_e))
+    n_comp, label = connected_components(graph, directed=False)
+    grounded_labels = np.unique(label[n + np.flatnonzero(electrodes.fixed_potential)])
+    reached = np.isin(label, grounded_labels)
+    electrode_label = label[n:]
+    count = np.bincount(electrode_label, minlength=n_comp)
+    owner = np.full(n_comp, -1)
+    owner[electrode_label] = np.arange(n_e)
+    lone = np.where(count[label[:n]] == 1, owner[label[:n]], -1)
+    return reached[:n], reached[n:], lone
+
+
+def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrodes: Electrodes,
+              linear: str = "auto") -> CurrentFlow:
+    """Potentials and currents of ``n`` particles joined by contacts ``(i, j)`` of conductance ``G`` (S; ``share``:
+    the fraction of each contact's resistance on the side of i) and to the electrodes by ``(plane_node,
+    plane_index)`` of conductance ``G_plane`` (module docstring). At least one electrode must be at a fixed
+    potential (the reference)."""
+    i, j = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64)
+    plane_node, plane_index = np.asarray(plane_node, dtype=np.int64), np.asarray(plane_index, dtype=np.int64)
+    G, G_plane, share = (np.asarray(x, dtype=float) for x in (G, G_plane, share))
+    n_e = len(electrodes)
+    if not np.any(electrodes.fixed_potential):
+        raise ValueError("[electrical] no electrode at a fixed potential: give one wall a potential (e.g. "
+                         "potential = 0.0, the ground) as the reference of the others")
+    on_particles, on_electrodes, lone = _grounded(n, i, j, plane_node, plane_index, electrodes)
+    driven = ~electrodes.fixed_potential
+    no_path = tuple(name for name, d, r in zip(electrodes.names, driven, on_electrodes) if d and not r)
+    floating = np.flatnonzero(~on_particles)
+    # solve on the grounded particles only; bonds to electrodes without a path belong to floating groups
+    system = BoundedLaplacian(n, i, j, G, None, plane_node, plane_index, G_plane, n_e)
+    subset = np.flatnonzero(on_particles)
+    V = np.where(electrodes.fixed_potential, electrodes.potential, 0.0)
+    x0, solver = solve_anchored(system, system.plane_rhs(V), subset, linear)
+    potential = np.full(n, np.nan)
+    potential[subset] = x0
+    active = np.flatnonzero(driven & on_electrodes)
+    if len(active):
+        def into_packing(x_particles, x_electrodes):
+            flows = G_plane * (x_electrodes[plane_index] - np.nan_to_num(x_particles[plane_node]))
+            return np.bincount(plane_index, flows, n_e)[active]
+
+        unit = []
+        for m in active:
+            e = np.zeros(n_e)
+            e[m] = 1.0
+            x_m, _ = solve_anchored(system, system.plane_rhs(e), subset, solver=solver)
+            full = np.zeros(n)
+            full[subset] = x_m
+            unit.append((full, e))
+        full0 = np.where(on_particles, potential, 0.0)
+        I0 = into_packing(full0, V)
+        Y = np.column_stack([into_packing(x, e) for x, e in unit])
+        V[active] = np.linalg.solve(Y, electrodes.current[active] - I0)
+        potential[subset] = x0 + sum(V[m] * x[subset] for m, (x, _) in zip(active, unit))
+    held = (lone >= 0) & on_particles  # a group reaching one electrode only: at its potential, exactly
+    potential[held] = V[lone[held]]
+    electrode_potential = np.where(electrodes.fixed_potential | on_electrodes, V, np.nan)
+    x = np.nan_to_num(potential)  # floating particles carry nothing: their contacts join equal (zero) values
+    pair_current = G * (x[i] - x[j])
+    live = on_particles[plane_node]
+    wall_current = np.where(live, G_plane * (V[plane_index] - x[plane_node]), 0.0)
+    electrode_current = np.bincount(plane_index, wall_current, n_e)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        heat_pairs = np.where(G > 0, pair_current**2 / G, 0.0)
+        heat_walls = np.where(G_plane > 0, wall_current**2 / G_plane, 0.0)
+    joule_particles = (np.bincount(i, share * heat_pairs, n) + np.bincount(j, (1.0 - share) * heat_pairs, n)
+                       + np.bincount(plane_node, heat_walls, n))
+    balance = (np.bincount(plane_node, wall_current, n) - np.bincount(i, pair_current, n)
+               + np.bincount(j, pair_current, n))
+    # relative to the largest contact current, or (when almost none flows) to the largest G |V|
+    scale = max(float(np.max(np.abs(pair_current), initial=0.0)), float(np.max(np.abs(wall_current), initial=0.0)),
+                1e-12 * float(np.max(G_plane, initial=0.0)) * float(np.max(np.abs(V), initial=0.0)))
+    residual = float(np.max(np.abs(balance), initial=0.0)) / scale if scale > 0 else 0.0
+    power = float(np.nansum(np.where(np.isfinite(electrode_potential), electrode_potential, 0.0) * electrode_current))
+    return CurrentFlow(potential, pair_current, wall_current, electrode_potential, electrode_current, joule_particles,
+                       float(heat_pairs.sum() + heat_walls.sum()), power, floating, no_path, residual)
+
+
+def wall_values(n: int, plane_node, plane_index, values) -> tuple[np.ndarray, np.ndarray]:
+    """``(touching, value)``: which particles touch an electrified wall and the wall's value each takes (the mean
+    of the walls' values when it touches several; Zohdi 2014, Remark 2)."""
+    plane_node = np.asarray(plane_node, dtype=np.int64)
+    count = np.bincount(plane_node, minlength=n)
+    total = np.bincount(plane_node, np.asarray(values, dtype=float)[plane_index], n)
+    touching = count > 0
+    return touching, np.where(touching, total / np.maximum(count, 1), 0.0)
+
+
+@dataclass
+class AreaWeightedCurrent:
+    """Zohdi's scheme: ``J`` (N,) per particle, the Gauss-Seidel ``sweeps`` taken, the last sweep's largest
+    ``change`` (relative to the largest wall value), whether it reached the tolerance, and the ``floating``
+    particles."""
+
+    J: np.ndarray
+    sweeps: int
+    change: float
+    converged: bool
+    floating: np.ndarray  # particles in groups that touch no electrified wall (they carry no current)
+
+
+def area_weighted_current(n: int, i, j, area, plane_node, plane_index, J_ext, J0=None, tol: float = 1e-8,
+                          max_sweeps: int = 10_000) -> AreaWeightedCurrent:
+    """The current of Zohdi 2014, eqs. (42)-(43) with Remark 2 (module docstring): particles touching an electrified
+    wall take its value ``J_ext`` (per electrode), the others the area-weighted mean of their neighbours, by
+    Gauss-Seidel sweeps from ``J0`` (the previous solution: a warm start; zeros when None) until no value changes by
+    more than ``tol`` times the largest ``|J_ext|``. Groups that touch no electrified wall carry no current."""
+    from dem.network.gauss_seidel import gauss_seidel  # compiled: loaded by the schemes that sweep
+
+    i, j = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64)
+    area = np.asarray(area, dtype=float)
+    touching, value = wall_values(n, plane_node, plane_index, J_ext)
+    rows = np.concatenate([i, j])
+    cols = np.concatenate([j, i])
+    adjacency = sp.csr_matrix((np.concatenate([area, area]), (rows, cols)), shape=(n, n))
+    _, label = connected_components(adjacency, directed=False)
+    electrified = np.isin(label, np.unique(label[touching]))
+    J = np.zeros(n) if J0 is None else np.array(J0, dtype=float)
+    J[touching] = value[touching]
+    J[~electrified] = 0.0
+    scale = float(np.max(np.abs(np.asarray(J_ext, dtype=float)), initial=0.0))
+    free = np.flatnonzero(electrified & ~touching).astype(np.int64)
+    floating = np.flatnonzero(~electrified)
+    if scale == 0.0 or len(free) == 0:
+        J[free] = 0.0 if scale == 0.0 else J[free]
+        return AreaWeightedCurrent(J, 0, 0.0, True, floating)
+    sweeps, change = gauss_seidel(adjacency.indptr.astype(np.int64), adjacency.indices.astype(np.int64),
+                                  adjacency.data, free, J, tol * scale, max_sweeps)
+    return AreaWeightedCurrent(J, int(sweeps), change / scale, change <= tol * scale, floating)
+
+
+def zohdi_joule(J, volume, sigma, absorption: float) -> np.ndarray:
+    """``H_i = a J_i^2 V_i / sigma_i`` (Zohdi 2014, eq. 35), W."""
+    return absorption * np.asarray(J) ** 2 * np.asarray(volume) / np.asarray(sigma)
+
+
+def check_scheme(scheme: str) -> str:
+    if scheme not in SCHEMES:
+        raise ValueError(f"[electrical] scheme = {scheme!r}: must be one of {', '.join(SCHEMES)}")
+    return scheme
+
+
+def check_absorption(a) -> float:
+    if not isinstance(a, (int, float)) or isinstance(a, bool) or not math.isfinite(a) or not 0.0 <= a <= 1.0:
+        raise ValueError(f"[electrical] absorption = {a!r}: must be in [0, 1] (Zohdi 2014, eq. 35)")
+    return float(a)

@@ -1,0 +1,723 @@
+"""The thermal pipe network: steady solve and time integration of ``C_i dT_i/dt = Q_i`` (Rojek 2022, eqs. 2-4).
+
+With the pipes ``Q_ij = K_ij (T_j - T_i)`` (eq. 4), the heat balance of the free (not fixed) particles is linear
+apart from radiation::
+
+    C dT/dt = r - A T,    A = L_FF + diag(K_wall + g),    r = -L_FD T_D + K_wall T_wall + Q_int + b,
+
+with ``L`` the weighted graph Laplacian of the bonds (symmetric positive semidefinite, rows summing to zero),
+``F``/``D`` the free/fixed particles, ``(g, b)`` the ambient exchange ``Q = b - g T`` (convection; radiation
+linearised about the current temperature, :func:`dem.laws.ambient.linear_sink_terms`). ``A`` is built once as a CSR
+matrix; it is SPD when every connected group of free particles reaches a fixed particle, a wall or the ambient.
+
+* :func:`steady` -- ``A T = r`` (Newton on the radiation term); singular systems are detected and explained.
+* :func:`integrate` -- the theta method ``(C/dt + theta A) T+ = (C/dt - (1-theta) A) T + r`` with theta = 0
+  (explicit forward Euler), 1 (implicit backward Euler), 1/2 (Crank-Nicolson); the matrix is factorised once per
+  step size and reused. Explicit steps are stable only for ``dt <= 2/lambda_max(C^-1 A)``: a larger ``dt`` is
+  refused with a message giving the limit. ``dt = "auto"`` controls the error: each step estimates its local
+  error (explicit: the difference to Heun's step, free; implicit and Crank-Nicolson: step doubling, one step of
+  dt against two of dt/2, the latter kept), rejects and redoes a step whose error exceeds the per-step tolerance
+  and sets the next step by ``dt * clip(0.9 (tol/err)^(1/(q+1)), 0.2, 5)`` (q the order: 1 for explicit and
+  implicit, 2 for Crank-Nicolson). The per-step tolerance :func:`step_tolerance` is set so that the global
+  error, relative to the temperature range, is about ``rtol``. Implicit steps are ``t_end / 2^k`` on the dyadic
+  grid of [0, t_end], so the few step sizes used are factorised once each and the run ends exactly on t_end;
+  explicit steps stay below 0.9 of the stable limit.
+
+  ``python -m benchmarks dem`` measures steps, error and time of each integrator, fixed and ``"auto"`` at rtol
+  1e-2 ... 1e-4, on the decay of a 2048-particle packing between plates (section "DEM transient: error against
+  time"). The dyadic grid rounds every step down to a power of 2: it costs some more steps for the same error, but
+  saves the second factorisation per step that free step sizes would need.
+
+Periodic packings (:mod:`dem.geometry.periodic`): a bond to the image ``shift`` of particle ``j`` sees that image at
+``T_j - g``, ``g = drop . shift`` (the temperature drop per period of the box), so it adds the constant flow
+``-K g`` to ``i`` and ``+K g`` to ``j``; these enter ``r`` as the heat flow ``periodic``, which sums to zero over a
+group of free particles. Such a group (no fixed particle, wall or ambient) has a steady state only up to a constant:
+:func:`steady` fixes it by keeping the group's capacity-weighted mean temperature at its initial value (heat is
+conserved, so the transient ends there too), and :func:`periodic_heat_flow` gives the heat flow across the period
+along each axis.
+
+Energy bookkeeping: the heat flowing into the free particles through each boundary (fixed particles, walls,
+convection, radiation, internal sources) is integrated with the same theta weighting as the step, so the change
+of ``sum C_i T_i`` must match it to round-off; the relative mismatch is ``energy_error``. (An iterative linear
+solve is shifted uniformly, by an amount of the order of its tolerance, so that its residuals sum to zero.)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spl
+
+from dem.geometry.bonds import Bonds, find_bonds
+from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.network.linsolve import make_solver
+from dem.network.laplacian import BoundedLaplacian, laplacian  # noqa: F401  (laplacian: part of this module's API)
+from dem.geometry.particles import Particles
+from dem.geometry.periodic import PeriodicBox
+from dem.laws.ambient import Sources, linear_sink_terms
+
+INTEGRATORS = {"explicit": 0.0, "implicit": 1.0, "crank-nicolson": 0.5}
+FLOW_NAMES = ("fixed", "walls", "convection", "radiation", "internal")
+ORDER = {0.0: 1, 1.0: 1, 0.5: 2}  # order q of the theta method
+AUTO_LOCAL = {1: 10.0, 2: 15.0}  # dt = "auto": local tolerance k_q rtol^((q+1)/q) per step, :func:`step_tolerance`
+AUTO_SAFETY = 0.9  # dt = "auto": safety factor of the step controller; explicit stays below this x the stable limit
+AUTO_MIN_FACTOR, AUTO_MAX_FACTOR = 0.2, 5.0  # dt = "auto": bounds of the change of step per step
+AUTO_LEVELS = 40  # implicit dt = "auto": steps t_end / 2^k, k <= AUTO_LEVELS
+AUTO_CONDITION = 1e8  # dt = "auto": steps at most this x min(C_i / A_ii), the fastest time constant (conditioning)
+AUTO_PROJECTION = 10.0  # dt = "auto": refuse once the current step projects this many x max_steps (after 100)
+AUTO_MIN_STEP = 2.0**-AUTO_LEVELS  # dt = "auto": steps this small (x t_end) are accepted whatever their error
+
+
+@dataclass
+class Network:
+    """The linear(ised) heat balance of the free particles (module docstring), assembled once: the generic
+    :class:`dem.network.laplacian.BoundedLaplacian` (the same solve serves the electrical current) with the particles'
+    capacities, sources and fixed temperatures."""
+
+    particles: Particles
+    bonds: Bonds
+    K_pairs: np.ndarray
+    K_walls: np.ndarray
+    wall_temperature: np.ndarray
+    sources: Sources = field(default_factory=Sources)
+    box: PeriodicBox | None = None
+
+    def __post_init__(self):
+        p, b = self.particles, self.bonds
+        self.graph = BoundedLaplacian(p.n, b.i, b.j, self.K_pairs, p.fixed, b.wall_particle, b.wall_index,
+                                      self.K_walls, len(self.wall_temperature))
+        self.free, self.fixed = self.graph.free, self.graph.fixed
+        self.T_D = p.temperature[self.fixed]
+        self.heat = p.heat[self.free]
+        self.C = p.capacity[self.free]
+        self.radius = p.radius[self.free]
+        self.sources = self.sources.resolved(p.position, p.radius, self.free)  # "exposed" areas from the packing
+        self._boundary_terms()
+
+    # the Laplacian and its blocks live in the graph (refresh() rewrites them in place)
+    L = property(lambda self: self.graph.L)
+    L_FF = property(lambda self: self.graph.L_FF)
+    L_FD = property(lambda self: self.graph.L_FD)
+
+    def _boundary_terms(self):
+        """The terms that follow from the conductances: wall and fixed-particle coefficients and the constant
+        right-hand side."""
+        g = self.graph
+        self.wall_diag = g.plane_diag
+        self.wall_rhs = g.plane_rhs(self.wall_temperature)
+        self.fixed_rhs = -(g.L_FD @ self.T_D)
+        self.fixed_diag = g.fixed_diag
+        self.base_diag = g.laplacian_diagonal
+        # the temperature jump of every bond across a periodic face (module docstring), zero without one
+        n = self.particles.n
+        self.jump = self.bonds.shifts @ self.box.drop if self.box is not None else np.zeros(self.bonds.n_pairs)
+        self.periodic = bool(np.any(self.jump != 0.0))
+        jump_flow = self.K_pairs * self.jump
+        self.jump_rhs = np.bincount(self.bonds.j, jump_flow, n) - np.bincount(self.bonds.i, jump_flow, n)
+        self.periodic_rhs = self.jump_rhs[self.free]
+        self.r_const = self.fixed_rhs + self.wall_rhs + self.heat + self.periodic_rhs
+
+    def refresh(self, bonds: Bonds, K_pairs: np.ndarray, K_walls: np.ndarray) -> None:
+        """New conductances (and bond geometry) on the same bonds, in the same order: the matrices keep their
+        sparsity and only their entries are rewritten (no re-assembly, no new sparsity analysis)."""
+        if not self.graph.same_edges(bonds.i, bonds.j, bonds.wall_particle, bonds.wall_index):
+            raise ValueError("Network.refresh: the bonds changed; build a new Network")
+        self.graph.refresh(bonds.i, bonds.j, K_pairs, bonds.wall_particle, bonds.wall_index, K_walls)
+        self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
+        self._boundary_terms()
+
+    @property
+    def n_free(self) -> int:
+        return len(self.free)
+
+    @property
+    def flow_names(self) -> tuple:
+        """The boundaries through which heat enters the free particles (keys of :meth:`flows`)."""
+        return ("fixed", "walls", "internal", *self.sources.names) + (("periodic",) if self.periodic else ())
+
+    def sinks(self, T_F: np.ndarray) -> dict:
+        return linear_sink_terms(self.sources, self.radius, T_F)
+
+    def matrix(self, sinks: dict) -> sp.csr_matrix:
+        """The system matrix ``A = L_FF + diag(K_wall + g)``, CSR."""
+        return self.graph.matrix(sum((g for g, _ in sinks.values()), np.zeros(self.n_free)))
+
+    def rhs(self, sinks: dict) -> np.ndarray:
+        return self.r_const + sum((b for _, b in sinks.values()), np.zeros(self.n_free))
+
+    def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
+        """Heat flow into the free particles (W) through each boundary at temperatures ``T_F``."""
+        out = {"fixed": float(self.fixed_rhs.sum() - self.fixed_diag @ T_F),
+               "walls": float(self.wall_rhs.sum() - self.wall_diag @ T_F),
+               "internal": float(self.heat.sum())}
+        for name, (g, b) in sinks.items():
+            out[name] = float(b.sum() - g @ T_F)
+        if self.periodic:
+            out["periodic"] = float(self.periodic_rhs.sum())
+        return out
+
+    def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
+        """Sum of the absolute heat flows into or out of each free particle through its boundaries (W): the scale
+        of the energy balance (hot and cold ends do not cancel in it).
+
+        Each flow is a difference of terms ``K T``. Where (almost) no heat flows, the flows are the round-off of
+        those terms and a balance relative to them means nothing, so the scale is never taken below
+        ``sqrt(eps) sum |K T|``: temperature differences below ~1e-8 of the temperatures count as no flow.
+        """
+        pairs = [(self.fixed_diag, self.fixed_rhs), (self.wall_diag, self.wall_rhs), *sinks.values()]  # (g, b)
+        net = gross = float(np.abs(self.heat).sum() + np.abs(self.periodic_rhs).sum())
+        for g, b in pairs:
+            net += float(np.abs(b - g * T_F).sum())
+            gross += float(np.abs(b).sum() + np.abs(g * T_F).sum())
+        return float(max(net, np.sqrt(np.finfo(float).eps) * gross))
+
+    def full(self, T_F: np.ndarray) -> np.ndarray:
+        T = self.particles.temperature.copy()
+        T[self.free] = T_F
+        return T
+
+    def temperature_bounds(self) -> tuple[float, float]:
+        """Lowest and highest temperature the scene prescribes (initial, fixed, walls, ambient)."""
+        temps = [self.particles.temperature, self.wall_temperature]
+        temps += [[s.T_inf] for s in (self.sources.convection, self.sources.radiation) if s is not None]
+        allt = np.concatenate([np.ravel(t) for t in temps])
+        return float(allt.min()), float(allt.max())
+
+    def temperature_range(self) -> float:
+        lo, hi = self.temperature_bounds()
+        return hi - lo
+
+
+def build_network(particles: Particles, walls=(), spec=None, sources: Sources | None = None, *, pairs=None,
+                  bonds: Bonds | None = None, box: PeriodicBox | None = None) -> Network:
+    """The thermal network of a packing in one call: bonds from the overlaps (:func:`dem.geometry.bonds.find_bonds`, with the
+    contact model and out-of-range policy of ``spec``), their conductances (:func:`dem.laws.conductance.
+    bond_conductances`, Rojek 2022 eqs. 5-9), and the assembled :class:`Network` holding both.
+
+    ``walls`` are :class:`dem.laws.ambient.Wall` planes, ``spec`` a :class:`~dem.laws.conductance.ConductanceSpec`
+    (default: the ``rojek`` law), ``sources`` the ambient exchange and ``pairs = (i, j)`` the pair bonds to use
+    instead of searching for overlaps. ``bonds`` already found (e.g. to time the search apart) skip the search. To
+    impose other pair conductances, replace them: ``dataclasses.replace(net, K_pairs=K)``. ``box``: a periodic box
+    (:mod:`dem.geometry.periodic`), whose faces bonds cross and whose temperature drop per period drives the network.
+    """
+    spec = ConductanceSpec() if spec is None else spec
+    walls = tuple(walls)
+    bonds, K_pairs, K_walls = bonds_and_conductances(particles, walls, spec, pairs=pairs, bonds=bonds, box=box)
+    wall_temperature = np.array([w.temperature for w in walls], dtype=float)
+    return Network(particles, bonds, K_pairs, K_walls, wall_temperature,
+                   Sources() if sources is None else sources, box)
+
+
+def bonds_and_conductances(particles: Particles, walls, spec, *, pairs=None, bonds: Bonds | None = None,
+                           box: PeriodicBox | None = None) -> tuple[Bonds, np.ndarray, np.ndarray]:
+    """The bonds of ``particles`` (and ``walls``) and their pair and wall conductances: the first half of
+    :func:`build_network`, for a network whose bonds change while its particles stay (:mod:`dem.engines.contact_heat`)."""
+    if bonds is None:
+        bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, pairs=pairs, box=box)
+    return (bonds, *bond_conductances(spec, particles, bonds, box=box, walls=tuple(walls)))
+
+
+def boundary_heat_flow(net: Network, T: np.ndarray) -> dict:
+    """W into each fixed particle (from its bonds and walls) and into each wall, at full temperatures ``T``."""
+    p, b = net.particles, net.bonds
+    into_fixed = -(net.L @ T) + net.jump_rhs
+    to_wall = net.K_walls * (T[b.wall_particle] - net.wall_temperature[b.wall_index])
+    into_fixed -= np.bincount(b.wall_particle, to_wall, p.n)
+    n_walls = len(net.wall_temperature)
+    walls = np.bincount(b.wall_index, to_wall, n_walls) if n_walls else np.zeros(0)
+    return {"particles": {int(k): float(into_fixed[k]) for k in net.fixed}, "walls": walls}
+
+
+def periodic_heat_flow(net: Network, T: np.ndarray) -> np.ndarray:
+    """Heat flow (W) across the period along x, y and z at full temperatures ``T``: every bond's flow from ``i``
+    to the image ``shift`` of ``j``, ``K (T_i - T_j + g)``, times ``shift`` (a bond spanning ``s`` periods crosses
+    ``s`` of the period's planes). In a steady state it is the flow through any plane normal to that axis."""
+    b = net.bonds
+    q = net.K_pairs * (T[b.i] - T[b.j] + net.jump)
+    return q @ b.shifts
+
+# -------------------------------------------------------------------------------------------------- steady
+@dataclass
+class SteadyResult:
+    T: np.ndarray
+    flows: dict
+    energy_error: float
+    iterations: int
+    solver: str
+    floating: int = 0
+
+
+def _components(net: Network):
+    """Connected components of the free particles, whether each is anchored (reaches a fixed temperature, a wall
+    or an ambient), and whether it holds a bond across a periodic face with a temperature jump."""
+    sinks = net.sinks(net.particles.temperature[net.free])
+    n_comp, label, anchored = net.graph.components(sum((g for g, _ in sinks.values()), np.zeros(net.n_free)))
+    jumping = np.zeros(n_comp, dtype=bool)
+    if net.periodic:
+        position = np.full(net.particles.n, -1)
+        position[net.free] = np.arange(net.n_free)
+        free_i = position[net.bonds.i[net.jump != 0.0]]
+        jumping[label[free_i[free_i >= 0]]] = True
+    return n_comp, label, anchored, jumping
+
+
+def steady(net: Network, floating: str = "error", linear: str = "auto", max_newton: int = 50,
+           rtol: float = 1e-10) -> SteadyResult:
+    """Steady temperatures ``A T = r`` (Rojek 2022, eq. 2 with dT/dt = 0).
+
+    A connected group of free particles with no fixed particle, wall or ambient exchange makes ``A`` singular.
+    Where the group holds bonds across a periodic face with a temperature jump it has a steady state up to a
+    constant, fixed by keeping its capacity-weighted mean temperature at the initial one. Otherwise
+    ``floating = "error"`` explains and refuses; ``"mean"`` keeps such a group at the capacity-weighted mean of its
+    initial temperatures (the long-time limit of the transient), provided its internal sources sum to zero.
+    """
+    T_F = net.particles.temperature[net.free].astype(float)
+    n_comp, label, anchored, jumping = _components(net)
+    gauged = ~anchored & jumping
+    n_float = int((~anchored & ~jumping).sum())
+
+    def no_solution(lost):
+        comp = label[lost]
+        net_heat = np.bincount(comp, net.heat[lost], n_comp)
+        scale = np.bincount(comp, np.abs(net.heat[lost]), n_comp)
+        if np.any(np.abs(net_heat) > 1e-12 * np.maximum(scale, 1e-300)):
+            raise ValueError("steady problem has no solution: a floating group of particles (no fixed temperature, "
+                             "wall or ambient) has a net internal heat source, so it heats up forever")
+
+    if n_float:
+        lost = np.flatnonzero(~anchored[label] & ~jumping[label])
+        if floating == "error":
+            first = net.free[lost[:8]].tolist()
+            raise ValueError(f"steady problem is singular: {n_float} of {n_comp} connected group(s) of free particles "
+                             f"({len(lost)} particles, e.g. {first}) touch no fixed particle, wall, convection or "
+                             f"radiation, so their temperature is undetermined; fix a particle's temperature, add a "
+                             f"wall or an ambient, set solver.floating = \"mean\", or use mode = \"transient\"")
+        if floating != "mean":
+            raise ValueError(f"solver.floating = {floating!r}: must be error or mean")
+        no_solution(lost)
+        comp = label[lost]
+        energy = np.bincount(comp, net.C[lost] * T_F[lost], n_comp)
+        cap = np.bincount(comp, net.C[lost], n_comp)
+        T_F[lost] = energy[comp] / cap[comp]
+    # a gauged group is solved with one particle (its first) held at 0, then shifted to its initial mean
+    solve = anchored[label] | gauged[label]
+    ground = np.zeros(net.n_free, dtype=bool)
+    if np.any(gauged):
+        no_solution(np.flatnonzero(gauged[label]))
+        first = np.full(n_comp, -1)
+        members = np.flatnonzero(gauged[label])
+        first[label[members[::-1]]] = members[::-1]
+        ground[first[gauged]] = True
+        target = np.bincount(label, net.C * T_F, n_comp)
+        T_F[ground] = 0.0
+        solve &= ~ground
+    solve_idx = np.flatnonzero(solve)
+    T_sub = T_F[solve_idx]
+    restrict = None if len(solve_idx) == net.n_free else solve_idx
+    iterations, backend = 0, "none"
+    for iterations in range(1, max_newton + 1):
+        T_F[solve_idx] = T_sub
+        sinks = net.sinks(T_F)
+        A, r = net.matrix(sinks), net.rhs(sinks)
+        if restrict is not None:
+            A, r = A[restrict][:, restrict], r[restrict]
+        if len(r) == 0:
+            break
+        solver = make_solver(A, linear, net.base_diag if restrict is None else net.base_diag[restrict], rtol)
+        backend = solver.name
+        T_new = solver.solve(r, T_sub)
+        change = np.max(np.abs(T_new - T_sub)) if net.sources.radiation is not None else 0.0
+        T_sub = T_new
+        if change <= 1e-12 * max(net.temperature_range(), np.max(np.abs(T_sub)), 1e-300):
+            break
+    else:
+        raise ValueError(f"steady radiation (Newton) did not converge in {max_newton} iterations")
+    T_F[solve_idx] = T_sub
+    if np.any(gauged):
+        cap = np.bincount(label, net.C, n_comp)
+        shift = (target - np.bincount(label, net.C * T_F, n_comp)) / cap
+        in_gauged = gauged[label]
+        T_F[in_gauged] += shift[label[in_gauged]]
+    # radiation: report the exact T^4 flow at the solution
+    sinks = net.sinks(T_F)
+    flows = net.flows(T_F, sinks)
+    total = net.flow_magnitude(T_F, sinks)
+    err = abs(sum(flows.values())) / total if total > 0 else 0.0
+    return SteadyResult(net.full(T_F), flows, err, iterations, backend, n_float)
+
+
+# ------------------------------------------------------------------------------------------------ transient
+def stable_limit(net: Network, sinks: dict | None = None) -> float:
+    """Largest stable explicit step ``2 / lambda_max(C^-1 A)`` (``inf`` without any coupling).
+
+    ``lambda_max`` from Lanczos on the symmetric ``C^-1/2 A C^-1/2`` (dense for small systems); where Lanczos
+    fails the Gershgorin bound ``lambda_max <= max_i 2 A_ii / C_i`` gives a safe (smaller) limit.
+    """
+    sinks = net.sinks(net.particles.temperature[net.free]) if sinks is None else sinks
+    A = net.matrix(sinks)
+    if net.n_free == 0 or A.nnz == 0 or not np.any(A.diagonal() > 0):
+        return math.inf
+    s = 1.0 / np.sqrt(net.C)
+    S = sp.diags(s) @ A @ sp.diags(s)
+    if net.n_free <= 400:
+        lam = float(np.linalg.eigvalsh(S.toarray())[-1])
+    else:
+        try:
+            lam = float(spl.eigsh(S, k=1, which="LA", tol=1e-8, return_eigenvectors=False,
+                                  maxiter=5000)[0]) * (1 + 1e-7)
+        except spl.ArpackNoConvergence:
+            lam = float(np.max(2.0 * A.diagonal() / net.C))
+    return 2.0 / lam if lam > 0 else math.inf
+
+
+@dataclass
+class TransientResult:
+    T: np.ndarray
+    t: float
+    steps: int
+    rejected: int
+    energy_error: float
+    heat_in: dict
+    stable_limit: float | None
+    dt_min: float
+    dt_max: float
+    solver: str
+    factorizations: int
+    max_principle_violation: float | None = None
+
+
+class _Stepper:
+    """Theta-method steps; the system solver is built once per step size (cached, least recently used dropped)."""
+
+    def __init__(self, net: Network, theta: float, linear: str, rtol_linear: float):
+        self.net, self.theta, self.linear, self.rtol_linear = net, theta, linear, rtol_linear
+        self.linear_sinks = net.sources.radiation is None
+        self._cache: dict = {}
+        self.factorizations = 0
+        self.backend = "none"
+        self.A0 = net.matrix(net.sinks(net.particles.temperature[net.free])) if self.linear_sinks else None
+        self.history: list = []  # (T, dt) at the start of the last two accepted steps: warm starts for CG
+        self._rate: tuple = (None, None)
+
+    def _solver(self, dt: float, A: sp.csr_matrix, reuse: bool):
+        key = dt if reuse else None
+        if key is not None and key in self._cache:
+            self._cache[key] = self._cache.pop(key)  # most recently used last
+            return self._cache[key]
+        M = A * self.theta
+        M = (M + sp.diags(self.net.C / dt)).tocsr()
+        solver = make_solver(M, self.linear, self.net.base_diag * self.theta, self.rtol_linear)
+        self.factorizations += 1
+        self.backend = solver.name
+        if key is not None:
+            if len(self._cache) >= 8:
+                self._cache.pop(next(iter(self._cache)))
+            self._cache[key] = solver
+        return solver
+
+    def guess(self, T: np.ndarray, dt: float) -> np.ndarray:
+        """Start of the iterative solve: quadratic extrapolation at a constant step, else linear, else ``T``."""
+        h = self.history
+        if len(h) == 2 and h[0][1] == dt and h[1][1] == dt:
+            return 3.0 * (T - h[0][0]) + h[1][0]
+        if h:
+            return T + (T - h[0][0]) * (dt / h[0][1])
+        return T
+
+    def accept(self, T: np.ndarray, dt: float):
+        """Record an accepted step of size ``dt`` that started from ``T``."""
+        self.history = [(T, dt)] + self.history[:1]
+
+    def rate(self, T: np.ndarray):
+        """``(dT/dt, sinks)`` at ``T``; the last one is kept (an explicit step and its error estimate share it)."""
+        if self._rate[0] is not T:
+            sinks = self.net.sinks(T)
+            A = self.A0 if self.linear_sinks else self.net.matrix(sinks)
+            self._rate = (T, ((self.net.rhs(sinks) - A @ T) / self.net.C, sinks))
+        return self._rate[1]
+
+    def step(self, T: np.ndarray, dt: float, guess: np.ndarray | None = None):
+        """``(T_new, T_theta, sinks)`` for one step of size ``dt`` from ``T``."""
+        net = self.net
+        if net.n_free == 0:  # every particle fixed: nothing evolves
+            return T, T, net.sinks(T)
+        if self.theta == 0.0:
+            f, sinks = self.rate(T)
+            return T + dt * f, T, sinks
+        sinks = net.sinks(T)
+        A = self.A0 if self.linear_sinks else net.matrix(sinks)
+        rhs = net.C / dt * T + net.rhs(sinks)
+        if self.theta < 1.0:
+            rhs -= (1.0 - self.theta) * (A @ T)
+        solver = self._solver(dt, A, self.linear_sinks)
+        T_new = solver.solve(rhs, self.guess(T, dt) if guess is None else guess)
+        self.backend = solver.name
+        if solver.name != "direct":
+            # iterative solve: a uniform shift of the order of its tolerance makes the residuals sum to zero, so
+            # the heat balance of the step (and energy_error) holds to round-off
+            T_new += float(np.sum(rhs - solver.A @ T_new)) / float(solver.A.sum())
+        return T_new, self.theta * T_new + (1.0 - self.theta) * T, sinks
+
+    def estimated_step(self, T: np.ndarray, dt: float):
+        """One step with an estimate of its local error: ``(T_new, parts, error)`` with ``parts`` the
+        ``(dt, T_theta, sinks)`` of the sub-steps taken (for the energy bookkeeping) and ``error`` the max-norm
+        estimate of the local error of a step of size ``dt``.
+
+        Explicit (forward Euler): the difference to Heun's step, ``dt/2 |f(T_new) - f(T)|``; ``f(T_new)`` starts
+        the next step, so the estimate costs nothing. Implicit and Crank-Nicolson: step doubling, ``|T_2 - T_1| /
+        (2^q - 1)`` with ``T_1`` one step of ``dt`` and ``T_2`` two of ``dt/2`` (the solution kept, the more
+        accurate one); with ``dt`` a power of 2 times a base step both solvers stay cached as the step grows.
+        """
+        if self.theta == 0.0:
+            T_new, T_theta, sinks = self.step(T, dt)
+            f0, f1 = self.rate(T)[0], self.rate(T_new)[0]
+            return T_new, [(dt, T_theta, sinks)], 0.5 * dt * float(np.max(np.abs(f1 - f0), initial=0.0))
+        half = 0.5 * dt
+        T_a, th_a, s_a = self.step(T, half)
+        T_b, th_b, s_b = self.step(T_a, half, 2.0 * T_a - T)
+        T_1 = self.step(T, dt, T_b)[0]
+        q = ORDER[self.theta]
+        err = float(np.max(np.abs(T_b - T_1), initial=0.0)) / (2.0**q - 1.0)
+        return T_b, [(half, th_a, s_a), (half, th_b, s_b)], err
+
+
+def theta_step(net: Network, T_F: np.ndarray, dt: float, integrator: str = "implicit", linear: str = "auto",
+               rtol_linear: float = 1e-10) -> tuple[np.ndarray, dict]:
+    """One theta-method step of size ``dt`` from the free temperatures ``T_F`` on ``net`` (a network whose
+    conductances change between steps, e.g. necks that grow): ``(T_new, heat)`` with ``heat`` the energy (J) that
+    entered the free particles through each boundary during the step, integrated with the step's own weighting so
+    that ``C . (T_new - T_F)`` equals its sum to round-off."""
+    T_new, T_theta, sinks = _Stepper(net, INTEGRATORS[integrator], linear, rtol_linear).step(T_F, dt)
+    return T_new, {k: dt * v for k, v in net.flows(T_theta, sinks).items()}
+
+
+def check_step_count(t_end: float, dt: float, max_steps: int, what: str):
+    steps = t_end / dt
+    if steps > max_steps:
+        raise ValueError(f"{what}: t_end / dt = {steps:.3g} steps exceeds solver.max_steps = {max_steps}; "
+                         f"raise max_steps, shorten t_end or use a larger dt (implicit or crank-nicolson)")
+
+
+def step_tolerance(rtol: float, order: int) -> float:
+    """Local error allowed per step (relative to the temperature range) for a global error of about ``rtol``.
+
+    An order-q method whose steps each make a local error ``tau`` ends ``~ c tau^(q/(q+1))`` off (the steps shrink
+    with ``tau^(1/(q+1))``), so ``tau = min(rtol, k_q rtol^((q+1)/q))``; ``k_q`` (:data:`AUTO_LOCAL`) is calibrated
+    on the decay of a pair and of a packing between plates (global errors 0.1-1 x rtol for rtol 1e-2 ... 1e-4).
+    """
+    return min(rtol, AUTO_LOCAL[order] * rtol ** ((order + 1) / order))
+
+
+def _controller_factor(err: float, tol: float, order: int) -> float:
+    """The standard step-size factor ``clip(safety (tol/err)^(1/(q+1)), 0.2, 5)`` (Hairer, Norsett & Wanner,
+    Solving ODEs I, sec. II.4)."""
+    if err <= 0.0:
+        return AUTO_MAX_FACTOR
+    return min(AUTO_MAX_FACTOR, max(AUTO_MIN_FACTOR, AUTO_SAFETY * (tol / err) ** (1.0 / (order + 1))))
+
+
+@dataclass
+class Checkpoint:
+    """Where :func:`integrate` stands after an accepted step: everything its loop carries, so that a run resumed
+    from it ends bit for bit where the uninterrupted run ends (the linear solvers' warm starts included)."""
+
+    T: np.ndarray
+    t: float
+    steps: int
+    rejected: int
+    units: int
+    dt_want: float
+    heat_in: dict
+    abs_in: float
+    dt_min: float
+    dt_max: float
+    violation: float
+    energy0: float
+    history: list  # the stepper's (T, dt) of the last accepted steps
+
+    def arrays(self) -> dict:
+        """As arrays for ``numpy.savez`` (:meth:`from_arrays` reads them back)."""
+        out = {"T": self.T, "heat_keys": np.array(list(self.heat_in), dtype=str),
+               "heat_values": np.array(list(self.heat_in.values()), dtype=float),
+               "history_T": np.array([h[0] for h in self.history]).reshape(len(self.history), -1),
+               "history_dt": np.array([h[1] for h in self.history], dtype=float)}
+        for key in ("t", "steps", "rejected", "units", "dt_want", "abs_in", "dt_min", "dt_max", "violation",
+                    "energy0"):
+            out[key] = np.array(getattr(self, key))
+        return out
+
+    @classmethod
+    def from_arrays(cls, data: dict) -> "Checkpoint":
+        history = [(data["history_T"][k], float(data["history_dt"][k])) for k in range(len(data["history_dt"]))]
+        heat = {str(k): float(v) for k, v in zip(data["heat_keys"], data["heat_values"])}
+        return cls(np.array(data["T"], dtype=float), float(data["t"]), int(data["steps"]), int(data["rejected"]),
+                   int(data["units"]), float(data["dt_want"]), heat, float(data["abs_in"]), float(data["dt_min"]),
+                   float(data["dt_max"]), float(data["violation"]), float(data["energy0"]), history)
+
+
+def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end: float = 1.0, rtol: float = 1e-3,
+              linear: str = "auto", max_steps: int = 1_000_000, observer=None, progress=None,
+              rtol_linear: float = 1e-10, resume: Checkpoint | None = None, checkpoint=None) -> TransientResult:
+    """Integrate from the particles' initial temperatures to ``t_end`` (module docstring).
+
+    ``observer(step, t, T_F, flows)`` is called after every accepted step (and at t = 0 with step 0);
+    ``progress(t)`` reports the simulated time. ``checkpoint(make)`` is called after every accepted step and at the
+    end with ``make()`` building the :class:`Checkpoint` (the caller decides how often to build and keep one);
+    ``resume`` starts from such a checkpoint instead of t = 0.
+    """
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"solver.integrator = {integrator!r}: must be one of {', '.join(INTEGRATORS)}")
+    if not (np.isfinite(t_end) and t_end > 0):
+        raise ValueError(f"solver.t_end = {t_end!r}: must be finite and > 0 (s)")
+    theta = INTEGRATORS[integrator]
+    stepper = _Stepper(net, theta, linear, rtol_linear)
+    T = net.particles.temperature[net.free].astype(float)
+    limit = None
+    if theta < 0.5:
+        # radiation: the stiffest linearisation within the prescribed temperatures (maximum principle)
+        t_hot = np.full(net.n_free, net.temperature_bounds()[1])
+        limit = stable_limit(net, net.sinks(t_hot if net.sources.radiation else T))
+    auto = isinstance(dt, str)
+    if auto:
+        if dt != "auto":
+            raise ValueError(f"solver.dt = {dt!r}: must be a number (s) or \"auto\"")
+        if not (np.isfinite(rtol) and rtol > 0):
+            raise ValueError(f"solver.rtol = {rtol!r}: must be finite and > 0")
+        scale = net.temperature_range() or max(float(np.max(np.abs(T), initial=0.0)), 1.0)
+        tol = step_tolerance(rtol, ORDER[theta]) * scale
+        rate = np.max(np.abs(stepper.rate(T)[0]), initial=0.0)
+        dt_cap = AUTO_SAFETY * limit if limit is not None else math.inf
+        # conditioning: C/dt + theta A loses the heat balance once C/dt falls far below A (a group with no fixed
+        # temperature makes A singular): measured energy errors 1e-10, 1e-7, 5e-4 at C/dt = 2e-7, 2e-10, 1e-11 of
+        # the bond conductance of a free pair. Steps stay below AUTO_CONDITION x the fastest time constant.
+        diagonal = net.matrix(net.sinks(T)).diagonal() if net.n_free else np.zeros(0)
+        coupled = diagonal > 0.0  # an unbonded particle without sinks has no time constant
+        tau_min = float(np.min(net.C[coupled] / diagonal[coupled])) if np.any(coupled) else math.inf
+        dt_condition = AUTO_CONDITION * tau_min
+        dt_cap = min(dt_cap, dt_condition)
+        dt_want = min(t_end, tol / rate if rate > 0 else t_end, dt_cap)
+        if limit is not None and math.isfinite(limit):
+            check_step_count(t_end, dt_cap, max_steps, "explicit dt = \"auto\" at 0.9 x the stable limit "
+                                                       f"{limit:.6g} s")
+    else:
+        dt = float(dt)
+        if not (np.isfinite(dt) and dt > 0):
+            raise ValueError(f"solver.dt = {dt!r}: must be finite and > 0 (s) or \"auto\"")
+        if limit is not None and dt > limit:
+            raise ValueError(f"solver.dt = {dt:.6g} s exceeds the explicit stability limit {limit:.6g} s "
+                             f"(2/lambda_max of C^-1 A); use dt <= {limit:.6g}, dt = \"auto\", or an implicit "
+                             f"integrator")
+        check_step_count(t_end, dt, max_steps, f"solver.dt = {dt:.6g} s")
+        dt_want = dt
+        n_fixed = max(1, math.ceil(t_end / dt * (1.0 - 1e-12)))  # the last step ends exactly on t_end
+    # implicit dt = "auto": steps t_end / 2^k on the dyadic grid of [0, t_end] (a step only grows where the grid
+    # allows it), so the solvers of the few step sizes used are built once and the run ends exactly on t_end
+    dyadic = auto and theta > 0.0
+    grid = 2**AUTO_LEVELS
+    units = 0  # dyadic: the time t = t_end * units / grid
+    energy0 = float(net.C @ T)
+    # maximum principle: without internal sources the temperatures stay within the prescribed ones (initial, fixed,
+    # walls, ambient); backward Euler keeps them there exactly (an M-matrix), Crank-Nicolson and explicit steps only
+    # for small enough steps. The largest excursion (in the scene's temperature unit) is reported.
+    lo, hi = net.temperature_bounds()
+    bounded = not np.any(net.heat)
+    violation = 0.0
+    heat_in = {k: 0.0 for k in net.flow_names}
+    abs_in = 0.0
+    t, steps, rejected = 0.0, 0, 0
+    dt_min, dt_max = math.inf, 0.0
+    order = ORDER[theta]
+    if resume is not None:
+        r = resume
+        T, t, steps, rejected, units, dt_want = r.T.astype(float), r.t, r.steps, r.rejected, r.units, r.dt_want
+        heat_in, abs_in, dt_min, dt_max, violation = dict(r.heat_in), r.abs_in, r.dt_min, r.dt_max, r.violation
+        energy0 = r.energy0
+        stepper.history = [(np.array(h[0]), h[1]) for h in r.history]
+    elif observer is not None:
+        observer(0, 0.0, T, net.flows(T, net.sinks(T)))
+
+    def state():
+        return Checkpoint(T.copy(), t, steps, rejected, units, dt_want, dict(heat_in), abs_in, dt_min, dt_max,
+                          violation, energy0, [(h[0].copy(), h[1]) for h in stepper.history])
+
+    while t < t_end:
+        remaining = t_end - t
+        if dyadic:
+            level = min(AUTO_LEVELS, max(0, math.ceil(math.log2(t_end / dt_want) - 1e-9)))
+            while units % (grid >> level):
+                level += 1
+            h = t_end / 2**level
+            last = units + (grid >> level) == grid
+        elif not auto:  # fixed steps: t = k dt (not a running sum, whose round-off could add a step at the end)
+            last = steps + 1 >= n_fixed
+            h = t_end - steps * dt_want if last else dt_want
+            if abs(h - dt_want) <= 1e-9 * dt_want:  # a full last step: the same size, the same factorisation
+                h = dt_want
+        else:
+            last = dt_want >= remaining * (1 - 1e-9)
+            h = remaining if dt_want > remaining * (1 + 1e-9) else dt_want
+        if auto:
+            T_new, parts, err = stepper.estimated_step(T, h)
+            factor = _controller_factor(err, tol, order)
+            if err > tol and h > AUTO_MIN_STEP * t_end:
+                rejected += 1
+                if rejected > max_steps:
+                    raise ValueError(f"more than solver.max_steps = {max_steps} rejected steps before t_end = "
+                                     f"{t_end:g} s")
+                dt_want = h * min(factor, AUTO_SAFETY)
+                continue
+        else:
+            T_new, T_theta, sinks = stepper.step(T, h)
+            parts = [(h, T_theta, sinks)]
+        flows = {}
+        for h_part, T_theta, sinks in parts:
+            part = net.flows(T_theta, sinks)
+            for k, v in part.items():
+                heat_in[k] += h_part * v
+                flows[k] = flows.get(k, 0.0) + h_part * v / h
+            abs_in += h_part * net.flow_magnitude(T_theta, sinks)
+        stepper.accept(T, h)
+        T, steps = T_new, steps + 1
+        if dyadic:
+            units += grid >> level
+            t = t_end * (units / grid)
+        else:
+            t = t_end if last else (steps * dt_want if not auto else t + h)
+        dt_min, dt_max = min(dt_min, h), max(dt_max, h)
+        if not np.all(np.isfinite(T)):
+            raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {steps})")
+        if bounded and len(T):
+            violation = max(violation, float(T.max()) - hi, lo - float(T.min()))
+        if observer is not None:
+            observer(steps, t, T, flows)
+        if progress is not None:
+            progress(t)
+        if auto:
+            dt_want = min(h * factor, dt_cap)
+            projected = steps + (t_end - t) / dt_want
+            capped = dt_want >= dt_condition
+            if capped and projected > max_steps:
+                raise ValueError(f"solver.t_end = {t_end:g} s: dt = \"auto\" steps are capped at {dt_condition:.3g}"
+                                 f" s ({AUTO_CONDITION:g} x the fastest time constant, beyond which the solve "
+                                 f"loses the heat balance), so t_end needs ~{projected:.3g} steps, beyond "
+                                 f"solver.max_steps = {max_steps}; the network is steady long before: shorten "
+                                 "t_end (or use mode = \"steady\")")
+            if steps >= max(100, max_steps // 100) and projected > AUTO_PROJECTION * max_steps:
+                raise ValueError(f"solver.rtol = {rtol:g}: at t = {t:.4g} s dt = \"auto\" takes steps of {h:.3g} s, "
+                                 f"so t_end = {t_end:g} s needs ~{projected:.3g} steps, far beyond solver.max_steps "
+                                 f"= {max_steps}; raise rtol or max_steps, or shorten t_end")
+        if steps >= max_steps and t < t_end:
+            raise ValueError(f"more than solver.max_steps = {max_steps} steps before t_end = {t_end:g} s")
+        if checkpoint is not None and t < t_end:
+            checkpoint(state)
+    if checkpoint is not None:
+        checkpoint(state, final=True)
+    energy = float(net.C @ T)
+    scale_e = float(net.C.sum()) * net.temperature_range() + abs_in
+    err = abs(energy - energy0 - sum(heat_in.values())) / scale_e if scale_e > 0 else 0.0
+    heat_in = {k: float(v) for k, v in heat_in.items()}
+    return TransientResult(net.full(T), t, steps, rejected, err, heat_in, limit, dt_min, dt_max, stepper.backend,
+                           stepper.factorizations, violation if bounded else None)

@@ -1,0 +1,176 @@
+"""One network problem, two fields: a weighted graph Laplacian with fixed nodes and planes at a given value.
+
+Heat between particles (Rojek 2022, eqs. 2-4: temperatures, thermal conductances K in W/K) and current between
+particles (Kirchhoff's laws: potentials, electrical conductances G in S) are the same linear problem on the contact
+graph. Each edge ``c = (i, j)`` carries the flow ``K_c (x_i - x_j)`` from i to j; a node may also be joined to a
+*plane* (a wall at a prescribed temperature, an electrode at a prescribed potential) by ``K_kw``, carrying
+``K_kw (x_k - x_w)`` into the plane; some nodes may be *fixed* (prescribed values). The balance of the free nodes
+``F`` (with the fixed ones ``D``) is::
+
+    A x_F = b,     A = L_FF + diag(sum of the plane conductances of each node),
+                   b = -L_FD x_D + sum_w K_kw x_w (+ sources),
+
+with ``L`` the weighted graph Laplacian (:func:`laplacian`). ``A`` is symmetric positive semidefinite, and definite
+on every connected group of free nodes that reaches a fixed node or a plane (an *anchored* group,
+:meth:`BoundedLaplacian.components`); a group that reaches none floats: its values are undetermined.
+
+:class:`BoundedLaplacian` assembles this once as CSR matrices and rewrites their entries in place when only the
+conductances change (:meth:`~BoundedLaplacian.refresh`: contacts whose necks grow, particles that move a little).
+The thermal network (:class:`dem.network.heat.Network`) and the Kirchhoff current solve (:mod:`dem.network.current`) are
+both built on it; :func:`solve_anchored` is the steady solve the current uses.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from dem.network.linsolve import make_solver
+
+
+def laplacian(n: int, i: np.ndarray, j: np.ndarray, K: np.ndarray) -> sp.csr_matrix:
+    """Weighted graph Laplacian ``L_ii = sum_j K_ij``, ``L_ij = -K_ij`` (symmetric, rows sum to zero)."""
+    diag = np.bincount(i, K, n) + np.bincount(j, K, n)
+    rows = np.concatenate([i, j, np.arange(n)])
+    cols = np.concatenate([j, i, np.arange(n)])
+    vals = np.concatenate([-K, -K, diag])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+
+class BoundedLaplacian:
+    """The matrices of the module docstring for ``n`` nodes, edges ``(i, j)`` with conductances ``K``, the
+    ``fixed`` nodes (bool mask) and plane bonds ``(plane_node, plane_index)`` with conductances ``K_plane`` to
+    ``n_planes`` planes.
+
+    Attributes: ``free``, ``fixed`` (node indices), ``L`` (all nodes), ``L_FF``, ``L_FD`` (CSR), ``plane_diag``
+    (per free node: the sum of its plane conductances), ``fixed_diag`` (per free node: the sum of its conductances to
+    fixed nodes).
+    """
+
+    def __init__(self, n: int, i, j, K, fixed, plane_node, plane_index, K_plane, n_planes: int):
+        self.n, self.n_planes = int(n), int(n_planes)
+        fixed = np.zeros(self.n, dtype=bool) if fixed is None else np.asarray(fixed, dtype=bool)
+        self.free = np.flatnonzero(~fixed)
+        self.fixed = np.flatnonzero(fixed)
+        self._set(i, j, K, plane_node, plane_index, K_plane)
+        self.L = laplacian(self.n, self.i, self.j, self.K)
+        if len(self.fixed):
+            rows = self.L[self.free]
+            self.L_FF = rows[:, self.free].tocsr()
+            self.L_FD = rows[:, self.fixed].tocsr()
+        else:
+            self.L_FF, self.L_FD = self.L, sp.csr_matrix((self.n, 0))
+        self._slots = None  # where each Laplacian entry sits in L, L_FF, L_FD: built by the first refresh()
+        self._plane_terms()
+
+    def _set(self, i, j, K, plane_node, plane_index, K_plane):
+        self.i, self.j = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64)
+        self.K = np.asarray(K, dtype=float)
+        self.plane_node = np.asarray(plane_node, dtype=np.int64)
+        self.plane_index = np.asarray(plane_index, dtype=np.int64)
+        self.K_plane = np.asarray(K_plane, dtype=float)
+
+    def _plane_terms(self):
+        self.plane_diag = np.bincount(self.plane_node, self.K_plane, self.n).astype(float)[self.free]
+        self.fixed_diag = -np.asarray(self.L_FD.sum(axis=1)).ravel()
+
+    def same_edges(self, i, j, plane_node, plane_index) -> bool:
+        """Whether these edges and plane bonds are those of the assembled matrices (same order)."""
+        return (np.array_equal(i, self.i) and np.array_equal(j, self.j)
+                and np.array_equal(plane_node, self.plane_node) and np.array_equal(plane_index, self.plane_index))
+
+    def refresh(self, i, j, K, plane_node, plane_index, K_plane) -> None:
+        """New conductances on the same edges and plane bonds, in the same order: the matrices keep their sparsity
+        and only their entries are rewritten (no re-assembly, no new sparsity analysis)."""
+        if not self.same_edges(i, j, plane_node, plane_index):
+            raise ValueError("BoundedLaplacian.refresh: the edges changed; build a new one")
+        n = self.n
+        if self._slots is None:
+            # an index matrix with the Laplacian's sparsity: entry k of (rows, cols) stored as k + 1
+            rows = np.concatenate([self.i, self.j, np.arange(n)])
+            cols = np.concatenate([self.j, self.i, np.arange(n)])
+            index = sp.csr_matrix((np.arange(1.0, len(rows) + 1.0), (rows, cols)), shape=(n, n))
+            if len(self.fixed):
+                part = index[self.free]
+                parts = (index, part[:, self.free].tocsr(), part[:, self.fixed].tocsr())
+            else:
+                parts = (index, index, sp.csr_matrix((n, 0)))
+            self._slots = [m.data.astype(np.int64) - 1 for m in parts]
+            self.L, self.L_FF, self.L_FD = (m.copy() for m in parts)
+            if not len(self.fixed):
+                self.L_FF = self.L
+        self._set(i, j, K, plane_node, plane_index, K_plane)
+        diag = np.bincount(self.i, self.K, n) + np.bincount(self.j, self.K, n)
+        values = np.concatenate([-self.K, -self.K, diag])
+        for matrix, slots in zip((self.L, self.L_FF, self.L_FD), self._slots):
+            matrix.data[:] = values[slots]
+        self._plane_terms()
+
+    @property
+    def laplacian_diagonal(self) -> np.ndarray:
+        """Diagonal of ``L_FF`` (the part of ``A`` that edges make; for the choice of linear solver)."""
+        return self.L_FF.diagonal()
+
+    def matrix(self, extra_diag=None) -> sp.csr_matrix:
+        """``A = L_FF + diag(plane conductances + extra_diag)``, CSR."""
+        extra = self.plane_diag if extra_diag is None else self.plane_diag + extra_diag
+        return (self.L_FF + sp.diags(extra)).tocsr()
+
+    def plane_rhs(self, x_planes) -> np.ndarray:
+        """``sum_w K_kw x_w`` per free node: what the planes at values ``x_planes`` drive into it."""
+        x_planes = np.asarray(x_planes, dtype=float)
+        if not len(self.plane_node):
+            return np.zeros(len(self.free))
+        return np.bincount(self.plane_node, self.K_plane * x_planes[self.plane_index], self.n)[self.free]
+
+    def boundary_rhs(self, x_fixed, x_planes) -> np.ndarray:
+        """``b = -L_FD x_D + sum_w K_kw x_w`` per free node."""
+        b = self.plane_rhs(x_planes)
+        if len(self.fixed):
+            b = b - self.L_FD @ np.asarray(x_fixed, dtype=float)
+        return b
+
+    def components(self, anchor_extra=None):
+        """Connected groups of free nodes: ``(count, label per free node, anchored per group)``; a group is
+        anchored when one of its nodes is joined to a fixed node, a plane or (``anchor_extra > 0``) an ambient."""
+        n_comp, label = connected_components(self.L_FF, directed=False)
+        anchor = self.fixed_diag + self.plane_diag
+        if anchor_extra is not None:
+            anchor = anchor + anchor_extra
+        anchored = np.zeros(n_comp, dtype=bool)
+        anchored[label[anchor > 0]] = True
+        return n_comp, label, anchored
+
+    def full(self, x_free, x_fixed) -> np.ndarray:
+        """Values on all nodes from those of the free and the fixed nodes."""
+        x = np.empty(self.n)
+        x[self.free] = x_free
+        x[self.fixed] = x_fixed
+        return x
+
+    def edge_flows(self, x) -> np.ndarray:
+        """Flow along every edge from i to j, ``K_c (x_i - x_j)``, at node values ``x`` (all nodes)."""
+        return self.K * (x[self.i] - x[self.j])
+
+    def plane_flows(self, x, x_planes) -> np.ndarray:
+        """Flow from each plane-bonded node into its plane, ``K_kw (x_k - x_w)``."""
+        return self.K_plane * (x[self.plane_node] - np.asarray(x_planes, dtype=float)[self.plane_index])
+
+
+def solve_anchored(system: BoundedLaplacian, rhs: np.ndarray, subset: np.ndarray | None = None, linear: str = "auto",
+                   rtol: float = 1e-12, solver=None):
+    """Solve ``A x = rhs`` on the free nodes listed by ``subset`` (positions in ``system.free``; all when None),
+    e.g. the anchored groups, where ``A`` is definite. Returns ``(x on the subset, solver)``; pass the solver back
+    to reuse its factorisation for another right-hand side of the same matrix."""
+    if subset is not None and len(subset) == 0:
+        return np.zeros(0), solver
+    if solver is None:
+        A, diag = system.matrix(), system.laplacian_diagonal
+        if subset is not None and len(subset) != len(system.free):
+            A, diag = A[subset][:, subset], diag[subset]
+        solver = make_solver(A, linear, diag, rtol)
+    r = rhs if subset is None or len(subset) == len(system.free) else rhs[subset]
+    if len(r) == 0:
+        return np.zeros(0), solver
+    return solver.solve(r), solver

@@ -1,0 +1,246 @@
+"""The part of a scene that makes particles move (``[scene] physics`` with ``"mechanical"``): TOML into a
+:class:`MotionSpec`.
+
+Tables and keys (SI units; the README's scene schema lists them with their defaults):
+
+* ``[scene] dimension`` (3: spheres; 2: disks in the x-z plane) and ``height`` (m, the disks' height);
+* ``[particles] velocity``, ``angular_velocity`` (lists of 3-vectors; or the generator's random ``speed``);
+* ``[contact]`` -- the contact law and its parameters (``law = "luding"``, Luding 2005; ``law = "zohdi"``,
+  Zohdi 2014: its stepping, current and electrode keys are those of :mod:`dem.scene.zohdi`);
+* ``[[walls]]`` -- planes that move: ``motion`` fixed | stress | strain | vibrate with ``pressure``, ``mass``,
+  ``damping``, ``velocity``, ``amplitude``, ``frequency`` (:mod:`dem.geometry.walls`); ``temperature`` optional;
+* ``[gravity] acceleration`` (m/s^2, a 3-vector);
+* ``[temperature]`` -- a prescribed schedule ``time``, ``value``, ``relaxation_time`` (:mod:`dem.scene.events`);
+* ``[[phases]]`` -- from time ``start`` on, other friction or damping (``mu``, ``mu_wall``, ``gamma_n``,
+  ``gamma_t``): Luding 2005 prepares frictionless and switches the friction at t_heat; and other wall speeds
+  (``wall_velocity = {name = v}``, m/s inward, for strain walls): a wall pushed, held and pulled away (Zohdi 2014,
+  Sec. 7);
+* ``[start] state`` -- begin from a saved state (:mod:`dem.scene.state_file`) instead of ``[particles]``;
+* ``[solver]`` -- ``t_end``; ``dt`` (s, or "auto": t_MD = pi/(50 omega), Luding 2005 eq. 6); ``skin`` (m);
+  ``thermal_interval`` (s) and ``integrator`` (implicit | crank-nicolson) of a coupled thermal network;
+* ``[output]`` -- ``interval`` (s between rows of ``timeseries.csv``), ``vtu_interval`` (s between snapshots).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from dem.laws.contact import luding
+from dem.geometry.motion import particle_mass, moment_of_inertia
+from dem.geometry.particles import finite_array
+from dem.scene.events import TemperatureSchedule
+from dem.geometry.walls import MovingWall
+from dem.scene import zohdi as zscene
+
+DEFAULT_SKIN = 0.1            # x the mean radius
+DEFAULT_OUTPUT_ROWS = 100     # rows of timeseries.csv when [output] interval is not given
+DEFAULT_THERMAL_STEPS = 1000  # mechanical steps per thermal step when [solver] thermal_interval is not given
+MOVING_KEYS = {
+    "scene": {"dimension", "height"},
+    "particles": {"velocity", "angular_velocity"},
+    "walls": {"motion", "pressure", "mass", "damping", "velocity", "amplitude", "frequency", *zscene.ELECTRODE_KEYS},
+    "solver": {"skin", "thermal_interval", *(zscene.STEPPING_KEYS - {"dt"})},
+    "output": {"interval", "vtu_interval", *zscene.OUTPUT_KEYS},
+}
+MOVING_TABLES = {"gravity": {"acceleration"}, "temperature": {"time", "value", "relaxation_time"},
+                 "start": {"state"}, "phases": {"start", "wall_velocity", *("mu", "mu_wall", "gamma_n", "gamma_t")},
+                 "electrical": zscene.ELECTRICAL_KEYS}
+PHASE_KEYS = {"mu": luding.P_MU, "mu_wall": luding.P_MU_WALL, "gamma_n": luding.P_GAMMA_N,
+              "gamma_t": luding.P_GAMMA_T}
+@dataclass(frozen=True)
+class MotionSpec:
+    dimension: int
+    height: float | None
+    velocity: np.ndarray | None
+    angular_velocity: np.ndarray | None
+    walls: tuple
+    gravity: tuple
+    schedule: TemperatureSchedule | None
+    dt: float
+    stable_dt: float
+    skin: float
+    thermal_interval: float
+    thermal_integrator: str
+    output_interval: float
+    vtu_interval: float
+    box: tuple = (0.0, 0.0, 0.0)
+    phases: tuple = ()        # (start time, {parameter index: value}), sorted by start
+    start: dict | None = None  # a saved state (dem.scene.state_file.load) the run begins from
+    wall_phases: tuple = ()   # (start time, {wall name: inward velocity}), sorted by start
+    stepping: object = None   # law = "zohdi": its implicit stepping (dem.laws.contact.zohdi.ZohdiStepping)
+    control: int | None = None  # law = "zohdi": the axis the powder bed stands and is pressed along
+    frames: int = 0           # law = "zohdi": rendered frames (PNG) over the run
+
+
+def _num(table, section, key, default=None, positive=False, nonnegative=False):
+    if key not in table:
+        return default
+    v = table[key]
+    if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
+        raise ValueError(f"[{section}] {key} = {v!r}: must be a finite number")
+    if positive and v <= 0:
+        raise ValueError(f"[{section}] {key} = {v!r}: must be > 0")
+    if nonnegative and v < 0:
+        raise ValueError(f"[{section}] {key} = {v!r}: must be >= 0")
+    return float(v)
+
+
+def time_steps(contact, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray, dimension: int,
+               height: float | None) -> tuple[float, float]:
+    """``(t_MD, stable)``.
+
+    ``t_MD = pi/(50 omega)`` is the "typical time-step" of Luding 2005 (eq. 6 and below,
+    :func:`dem.laws.contact.luding.time_step`) for a contact of two particles of the mean radius. The lightest pair of a
+    polydisperse sample vibrates faster: with Table 1's radii (a0 +- 50 %) its contact still takes 25 steps per
+    half period. ``stable`` is the largest velocity-Verlet step that stays stable for the stiffest contact,
+    ``2/(omega_max + eta)``: the lightest pair, with the normal stiffness k2 or the tangential spring acting with
+    rotation (``alpha k2 (1 + m a^2/I)``), whichever is stiffer, and the viscous rate ``eta = gamma_n/(2 m12)``.
+    A ``dt`` above it is refused.
+    """
+    order = np.argsort(mass)
+    m_mean = float(particle_mass(dimension, contact.density, np.mean(radius), height))
+    t_md = luding.time_step(contact.k2, contact.gamma_n, 0.5 * m_mean)
+    m12 = mass[order[0]] * mass[order[1]] / (mass[order[0]] + mass[order[1]]) if len(mass) > 1 else mass[0]
+    rotational = 1.0 + float(np.max(mass * radius**2 / inertia))
+    k_max = contact.k2 * max(1.0, contact.kt_ratio * rotational)
+    stable = 2.0 / (math.sqrt(k_max / m12) + contact.gamma_n / (2.0 * m12))
+    return min(t_md, stable), stable
+
+
+def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, start=None) -> MotionSpec:
+    """The moving part of a scene (module docstring); ``particles``, ``solver`` and the ``contact`` material are
+    already parsed; ``velocity`` comes from a generator (its random ``speed``); ``start`` is a saved state."""
+    meta = doc.get("scene", {})
+    dimension = meta.get("dimension", 3)
+    if dimension not in (2, 3) or isinstance(dimension, bool):
+        raise ValueError(f"[scene] dimension = {dimension!r}: must be 2 (disks) or 3 (spheres)")
+    height = _num(meta, "scene", "height", positive=True)
+    if dimension == 2 and height is None:
+        raise ValueError("[scene] height: required for 2D disks (m)")
+    if dimension == 3 and height is not None:
+        raise ValueError("[scene] height: only for 2D disks (dimension = 2)")
+    if dimension == 2 and "thermal" in physics:
+        raise ValueError("[scene] physics: thermal coupling needs 3D spheres (dimension = 3): the neck conductance "
+                         "laws are for spheres, and 2D disks joined by a neck have no such law here")
+    if solver.mode != "transient" or solver.t_end is None:
+        raise ValueError("[solver] mode = \"transient\" and t_end are required for moving particles")
+    ptable = doc.get("particles", {})
+    n = particles.n
+    angular = None
+    if "velocity" in ptable:
+        velocity = finite_array("[particles] velocity", ptable["velocity"], (3,))
+    if "angular_velocity" in ptable:
+        angular = finite_array("[particles] angular_velocity", ptable["angular_velocity"], (3,))
+    for name, arr in (("velocity", velocity), ("angular_velocity", angular)):
+        if arr is not None and len(arr) != n:
+            raise ValueError(f"[particles] {name} has {len(arr)} entries but position has {n}")
+    if contact is None:
+        raise ValueError("[contact]: required for mechanical physics (law = \"luding\" or \"zohdi\" and its "
+                         "parameters)")
+    densities = {m.density for m in particles.materials}
+    if densities != {contact.density}:
+        raise ValueError(f"[contact] density = {contact.density:g}: differs from [material] density "
+                         f"{', '.join(f'{d:g}' for d in sorted(densities))} kg/m^3; give it once, in [material]")
+    walls = tuple(_moving_wall(k, w) for k, w in enumerate(doc.get("walls", [])))
+    if start is not None:
+        if start["dimension"] != dimension or (dimension == 2 and start["height"] != height):
+            raise ValueError(f"[start] state: saved for dimension {start['dimension']} (height {start['height']}), "
+                             f"the scene has dimension {dimension} (height {height})")
+        saved = dict(zip(start["wall_names"], start["wall_q"]))
+        walls = tuple(replace(w, point=w.normal * saved[w.name]) if w.name in saved else w for w in walls)
+        velocity, angular = start["v"], start["w"]
+    gravity = (0.0, 0.0, 0.0)
+    if "gravity" in doc:
+        g = finite_array("[gravity] acceleration", doc["gravity"].get("acceleration", [0.0, 0.0, 0.0]), ())
+        if g.shape != (3,):
+            raise ValueError("[gravity] acceleration: must be a 3-vector (m/s^2)")
+        gravity = tuple(float(x) for x in g)
+    phases = tuple(sorted((_phase(k, t) for k, t in enumerate(doc.get("phases", []))), key=lambda p: p[0]))
+    wall_phases = tuple((start, walls_v) for start, _, walls_v in phases if walls_v)
+    _check_wall_phases(wall_phases, walls)
+    if contact.law == "zohdi":
+        return zscene.zohdi_motion(doc, particles, solver, physics, start, walls, gravity, velocity,
+                                   tuple(p[:2] for p in phases), wall_phases, dimension)
+    zscene.refuse_zohdi_keys(doc, physics)
+    schedule = None
+    if "temperature" in doc:
+        t = doc["temperature"]
+        if "thermal" in physics:
+            raise ValueError("[temperature]: a prescribed schedule and a thermal network both set the temperature; "
+                             "give one (heat the walls or fix particles instead)")
+        for key in ("time", "value"):
+            if key not in t:
+                raise ValueError(f"[temperature] {key}: required")
+        schedule = TemperatureSchedule.build(t["time"], t["value"], t.get("relaxation_time", contact.t0))
+    density = np.array([m.density for m in particles.materials])[particles.material]
+    mass = particle_mass(dimension, density, particles.radius, height)
+    t_md, stable = time_steps(contact, mass, moment_of_inertia(dimension, mass, particles.radius), particles.radius,
+                              dimension, height)
+    if solver.dt == "auto":
+        dt = t_md
+    else:
+        dt = float(solver.dt)
+        if dt > stable:
+            raise ValueError(f"[solver] dt = {dt:.6g} s: above the stable step {stable:.6g} s of the stiffest contact "
+                             f"(2/omega with k2 and the lightest pair); use dt <= {stable:.6g} s or dt = \"auto\" "
+                             f"(t_MD = {t_md:.6g} s, Luding 2005 eq. 6)")
+    stable_steps = solver.t_end / dt
+    if stable_steps > 1e10:
+        raise ValueError(f"[solver] t_end / dt = {stable_steps:.3g} steps: beyond what one run can take; shorten t_end")
+    solver_table = doc.get("solver", {})
+    skin = _num(solver_table, "solver", "skin", DEFAULT_SKIN * float(np.mean(particles.radius)), positive=True)
+    out = doc.get("output", {})
+    output_interval = _num(out, "output", "interval", solver.t_end / DEFAULT_OUTPUT_ROWS, positive=True)
+    vtu_interval = _num(out, "output", "vtu_interval", 0.0, nonnegative=True)
+    thermal_interval = _num(solver_table, "solver", "thermal_interval",
+                            min(output_interval, DEFAULT_THERMAL_STEPS * dt), positive=True)
+    return MotionSpec(dimension, height, velocity, angular, walls, gravity, schedule, dt, stable, skin,
+                      thermal_interval, solver.integrator, output_interval, vtu_interval,
+                      phases=tuple(p[:2] for p in phases if p[1]), start=start, wall_phases=wall_phases)
+
+
+def _phase(k: int, table: dict) -> tuple:
+    if not isinstance(table, dict):
+        raise ValueError("[[phases]]: must be an array of tables")
+    unknown = sorted(set(table) - MOVING_TABLES["phases"])
+    if unknown:
+        raise ValueError(f"[phases][{k}] {unknown[0]}: unknown key (allowed: "
+                         f"{', '.join(sorted(MOVING_TABLES['phases']))})")
+    start = _num(table, f"phases][{k}", "start", nonnegative=True)
+    if start is None:
+        raise ValueError(f"[phases][{k}] start: required (s)")
+    walls = table.get("wall_velocity", {})
+    if not isinstance(walls, dict):
+        raise ValueError(f"[phases][{k}] wall_velocity: must be a table {{wall name = velocity (m/s, inward)}}")
+    return start, {PHASE_KEYS[key]: _num(table, f"phases][{k}", key, nonnegative=True) for key in table
+                   if key not in ("start", "wall_velocity")}, \
+        {str(name): _num(walls, f"phases][{k}] wall_velocity", name) for name in walls}
+
+
+def _check_wall_phases(wall_phases, walls) -> None:
+    """Every wall a phase changes the speed of exists and moves at a constant speed (``motion = "strain"``)."""
+    motions = {w.name: w.motion for w in walls}
+    for start, speeds in wall_phases:
+        for name in speeds:
+            if motions.get(name) != "strain":
+                raise ValueError(f"[phases] wall_velocity.{name}: " + (
+                    f"no wall named {name!r} (walls: {', '.join(motions) or 'none'})" if name not in motions else
+                    f"the wall's motion is {motions[name]!r}; only strain walls (constant speed) change speed"))
+
+
+def _moving_wall(k: int, table: dict) -> MovingWall:
+    allowed = {"name", "point", "normal", "temperature"} | MOVING_KEYS["walls"]
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise ValueError(f"[walls][{k}] {unknown[0]}: unknown key (allowed: {', '.join(sorted(allowed))})")
+    for key in ("point", "normal"):
+        if key not in table:
+            raise ValueError(f"[[walls]] {k}: {key}: required")
+    numbers = {key: _num(table, f"walls][{k}", key) for key in ("pressure", "mass", "damping", "velocity",
+                                                                 "amplitude", "frequency") if key in table}
+    return MovingWall(str(table.get("name", f"wall{k}")), table["point"], table["normal"],
+                      str(table.get("motion", "fixed")), temperature=_num(table, f"walls][{k}", "temperature"),
+                      **numbers)

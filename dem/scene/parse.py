@@ -1,0 +1,572 @@
+"""Scenes: everything one DEM run needs, read from TOML (``tomllib``) or built from arrays in Python.
+
+:func:`load_scene` reads a file path or a built-in name (``dem/scene/builtin/*.toml``); :func:`parse_scene` validates a
+TOML document (a dict) into a :class:`Scene`; :func:`make_scene` builds one from explicit arrays. The schema is
+documented in the README (section "Scene schema"). Every problem raises ``ValueError`` naming the table and key (and, for malformed
+TOML, the line).
+"""
+
+from __future__ import annotations
+
+import math
+import pathlib
+import tomllib
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+
+from dem.scene import state_file
+from dem.geometry import generators
+from dem.laws.conductance import ConductanceSpec
+from dem.laws.fields import material_from_table
+from dem.laws.contact.luding import LudingMaterial
+from dem.laws.contact.zohdi import ZohdiMaterial
+from dem.scene.zohdi import ElectricalSpec, parse_electrical, zohdi_material
+from dem.geometry.particles import COPPER, Material, Particles
+from dem.geometry.periodic import AXES, PeriodicBox
+from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
+from dem.network.heat import INTEGRATORS
+from dem.network.linsolve import BACKENDS
+from dem.engines.static import PHYSICS_NAMES as PHYSICS, check_physics
+from dem.scene.motion import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
+
+SCENE_DIR = pathlib.Path(__file__).with_name("builtin")
+MODES = ("transient", "steady")
+BOUNDARIES = ("plates", "fixed", "periodic", "none")
+RTOL_MIN = 1e-9  # [solver] rtol of dt = "auto"
+
+ALLOWED = {
+    "scene": {"name", "description", "physics"},
+    "material": {"name", "conductivity", "density", "specific_heat", "electrical_conductivity"},
+    "particles": {"position", "radius", "temperature", "fixed", "material", "heat"},
+    "generator": {"kind", "n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter",
+                  "structure", "temperature", "boundary", "hot", "cold", "heat", "box", "speed"},
+    "periodic": {"lengths", "axes", "origin", "drop"},
+    "walls": {"name", "point", "normal", "temperature"},
+    "conductance": {"law", "slope", "fit_file", "neck", "contact_conductance", "out_of_range", "unequal"},
+    "convection": {"h", "T_inf", "area_fraction"},
+    "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
+    "solver": {"mode", "integrator", "dt", "t_end", "rtol", "linear", "floating", "max_steps"},
+    "output": {"every", "vtu_every", "vtu", "checkpoint_every"},
+    "contact": {"law"} | {f.name for f in fields(LudingMaterial)} | {f.name for f in fields(ZohdiMaterial)},
+}
+CONTACT_LAWS = ("luding", "zohdi")
+GENERATOR_KEYS = {
+    "chain": {"n", "radius", "overlap"},
+    "lattice": {"shape", "radius", "overlap", "structure"},
+    "random": {"n", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter"},
+    "box": {"n", "radius", "box", "seed", "radius_spread", "speed"},
+}
+
+
+@dataclass(frozen=True)
+class SolverSpec:
+    """``mode`` steady|transient; transient: ``integrator``, ``dt`` (s or "auto"), ``t_end``, ``rtol`` (auto dt);
+    ``linear`` backend (:mod:`dem.network.linsolve`); ``floating`` steady policy; ``max_steps`` guard."""
+
+    mode: str = "steady"
+    integrator: str = "crank-nicolson"
+    dt: object = "auto"
+    t_end: float | None = None
+    rtol: float = 1e-3
+    linear: str = "auto"
+    floating: str = "error"
+    max_steps: int = 100_000
+
+    def __post_init__(self):
+        if self.mode not in MODES:
+            raise ValueError(f"[solver] mode = {self.mode!r}: must be one of {', '.join(MODES)}")
+        if self.integrator not in INTEGRATORS:
+            raise ValueError(f"[solver] integrator = {self.integrator!r}: must be one of {', '.join(INTEGRATORS)}")
+        if self.linear not in ("auto", *BACKENDS):
+            raise ValueError(f"[solver] linear = {self.linear!r}: must be one of auto, {', '.join(BACKENDS)}")
+        if self.floating not in ("error", "mean"):
+            raise ValueError(f"[solver] floating = {self.floating!r}: must be error or mean")
+        if isinstance(self.dt, str):
+            if self.dt != "auto":
+                raise ValueError(f"[solver] dt = {self.dt!r}: must be a number > 0 (s) or \"auto\"")
+        elif not _is_number(self.dt) or not math.isfinite(self.dt) or self.dt <= 0:
+            raise ValueError(f"[solver] dt = {self.dt!r}: must be a number > 0 (s) or \"auto\"")
+        if self.mode == "transient":
+            if self.t_end is None:
+                raise ValueError("[solver] t_end: required in transient mode (s)")
+            if not _is_number(self.t_end) or not math.isfinite(self.t_end) or self.t_end <= 0:
+                raise ValueError(f"[solver] t_end = {self.t_end!r}: must be a finite number > 0 (s)")
+        if not _is_number(self.rtol) or not (RTOL_MIN <= self.rtol < 1):
+            raise ValueError(f"[solver] rtol = {self.rtol!r}: must be in [{RTOL_MIN:g}, 1) (a tighter tolerance "
+                             f"only shrinks dt = \"auto\" to round-off)")
+        if not isinstance(self.max_steps, int) or isinstance(self.max_steps, bool) or self.max_steps < 1:
+            raise ValueError(f"[solver] max_steps = {self.max_steps!r}: must be an integer >= 1")
+
+
+@dataclass(frozen=True)
+class OutputSpec:
+    """CSV row every ``every`` steps; VTU snapshot every ``vtu_every`` steps (0: first and last only); a checkpoint
+    of a transient run every ``checkpoint_every`` seconds of wall time (:mod:`dem.output.folder`)."""
+
+    every: int = 1
+    vtu_every: int = 0
+    vtu: bool = True
+    checkpoint_every: float = 5.0
+
+    def __post_init__(self):
+        for key in ("every", "vtu_every"):
+            v = getattr(self, key)
+            if not isinstance(v, int) or isinstance(v, bool) or v < (1 if key == "every" else 0):
+                raise ValueError(f"[output] {key} = {v!r}: must be an integer >= {1 if key == 'every' else 0}")
+        if not isinstance(self.vtu, bool):
+            raise ValueError(f"[output] vtu = {self.vtu!r}: must be true or false")
+        if not (isinstance(self.checkpoint_every, (int, float)) and not isinstance(self.checkpoint_every, bool)
+                and self.checkpoint_every > 0 and math.isfinite(self.checkpoint_every)):
+            raise ValueError(f"[output] checkpoint_every = {self.checkpoint_every!r}: must be a number of seconds > 0")
+
+
+@dataclass(frozen=True)
+class Specimen:
+    """For generated scenes with hot/cold ends: length L (m) and cross-section A (m^2) for ``k_eff = Q L/(A dT)``,
+    and where the heat enters: the wall named ``hot``, the fixed particles ``hot_particles``, or (``periodic``) the
+    period's face normal to z, across which the temperature drops by ``hot - cold``."""
+
+    length: float
+    area: float
+    hot: float
+    cold: float
+    hot_particles: tuple = ()
+    periodic: bool = False
+
+
+@dataclass(frozen=True)
+class Scene:
+    """One DEM run: particles (+ walls), conductance law, ambient sources, solver, outputs, the physics to run;
+    ``contact`` the Luding 2005 material of a ``[contact]`` table, or None."""
+
+    particles: Particles
+    walls: tuple = ()
+    conductance: ConductanceSpec = field(default_factory=ConductanceSpec)
+    sources: Sources = field(default_factory=Sources)
+    solver: SolverSpec = field(default_factory=SolverSpec)
+    output: OutputSpec = field(default_factory=OutputSpec)
+    physics: tuple = ("thermal",)
+    name: str = "scene"
+    description: str = ""
+    specimen: Specimen | None = None
+    contact: LudingMaterial | ZohdiMaterial | None = None
+    motion: MotionSpec | None = None  # particles that move ([scene] physics with "mechanical"), else None
+    electrical: ElectricalSpec | None = None  # the current's scheme and electrodes ("electrical" physics)
+    box: PeriodicBox | None = None  # a periodic box (dem.geometry.periodic), else None
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def make_scene(position, radius, temperature, *, materials=(COPPER,), material=None, fixed=None, heat=None,
+               walls=(), law="rojek", conductance: ConductanceSpec | None = None, sources: Sources | None = None,
+               solver: SolverSpec | None = None, output: OutputSpec | None = None, name="scene",
+               box: PeriodicBox | None = None, **solver_options) -> Scene:
+    """A :class:`Scene` from explicit arrays, e.g. for a chain or cluster to compare with FE::
+
+        make_scene(x, r, T, fixed=mask, law="fit", mode="steady")
+        make_scene(x, r, T, mode="transient", integrator="implicit", dt=1e-3, t_end=0.1)
+        make_scene(x, r, T, box=PeriodicBox(L, drop=[0, 0, 1.0]), law="fit")      # periodic, 1 K drop along z
+
+    Keyword ``solver_options`` are :class:`SolverSpec` fields (``mode``, ``integrator``, ``dt``, ...).
+    """
+    particles = Particles.from_arrays(position, radius, temperature, materials, material, fixed, heat)
+    return Scene(particles, tuple(walls), conductance or ConductanceSpec(law=law), sources or Sources(),
+                 solver or SolverSpec(**solver_options), output or OutputSpec(), name=name, box=box)
+
+
+# --------------------------------------------------------------------------------------------------- TOML
+def _check_keys(table: dict, section: str, allowed: set):
+    if not isinstance(table, dict):
+        raise ValueError(f"[{section}]: must be a table")
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise ValueError(f"[{section}] {unknown[0]}: unknown key (allowed: {', '.join(sorted(allowed))})")
+
+
+def _number(table, section, key, default=None, required=False):
+    if key not in table:
+        if required:
+            raise ValueError(f"[{section}] {key}: required")
+        return default
+    v = table[key]
+    if not _is_number(v) or not math.isfinite(v):
+        raise ValueError(f"[{section}] {key} = {v!r}: must be a finite number")
+    return float(v)
+
+
+def _materials(doc, thermal: bool = True, electrical: bool = False) -> tuple:
+    if "material" in doc and "materials" in doc:
+        raise ValueError("[material] and [[materials]]: give one or the other")
+    tables = doc.get("materials", [doc["material"]] if "material" in doc else None)
+    if tables is None:
+        raise ValueError("[material]: required (density; conductivity and specific_heat for thermal physics)")
+    if not isinstance(tables, list) or not tables:
+        raise ValueError("[[materials]]: must be a non-empty array of tables")
+    out = []
+    for k, t in enumerate(tables):
+        section = "material" if "material" in doc else f"materials[{k}]"
+        _check_keys(t, section, ALLOWED["material"])
+        props = {key: _number(t, section, key, required=thermal or key == "density")
+                 for key in ("conductivity", "density", "specific_heat")}
+        props["electrical_conductivity"] = _number(t, section, "electrical_conductivity", required=electrical)
+        for key, v in props.items():
+            if v is not None and v <= 0:
+                raise ValueError(f"[{section}] {key} = {v!r}: must be > 0")
+        out.append(Material(**props, name=str(t.get("name", f"material{k}"))))
+    return tuple(out)
+
+
+def _material_index(value, materials, n):
+    if value is None:
+        return None
+    names = [m.name for m in materials]
+    if isinstance(value, (str, int)) and not isinstance(value, bool):
+        value = [value] * n
+    if not isinstance(value, list):
+        raise ValueError("[particles] material: must be a material name/index or a list of them")
+    out = []
+    for k, v in enumerate(value):
+        if isinstance(v, str):
+            if v not in names:
+                raise ValueError(f"[particles] material[{k}] = {v!r}: unknown (materials: {', '.join(names)})")
+            out.append(names.index(v))
+        elif isinstance(v, int) and not isinstance(v, bool):
+            out.append(v)
+        else:
+            raise ValueError(f"[particles] material[{k}] = {v!r}: must be a material name or index")
+    return out
+
+
+def _explicit_particles(t: dict, materials):
+    _check_keys(t, "particles", ALLOWED["particles"])
+    for key in ("position", "radius", "temperature"):
+        if key not in t:
+            raise ValueError(f"[particles] {key}: required")
+    n = len(t["position"]) if isinstance(t["position"], list) else 0
+    return Particles.from_arrays(t["position"], t["radius"], t["temperature"], materials,
+                                 _material_index(t.get("material"), materials, n), t.get("fixed"), t.get("heat"),
+                                 prefix="[particles]"), (), None, None, None
+
+
+def _generated_particles(t: dict, materials, dimension: int = 3):
+    _check_keys(t, "generator", ALLOWED["generator"])
+    kind = t.get("kind")
+    if not isinstance(kind, str) or kind not in GENERATOR_KEYS:
+        raise ValueError(f"[generator] kind = {kind!r}: must be one of {', '.join(GENERATOR_KEYS)}")
+    geometry_keys = {"n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter", "box", "speed"}
+    extra = sorted((set(t) & geometry_keys) - GENERATOR_KEYS[kind])
+    if extra:
+        raise ValueError(f"[generator] {extra[0]}: not a parameter of kind = {kind!r} "
+                         f"(its parameters: {', '.join(sorted(GENERATOR_KEYS[kind]))})")
+    args = {k: t[k] for k in GENERATOR_KEYS[kind] if k in t}
+    required = {"n", "radius", "box"} if kind == "box" else {"radius", "overlap", "shape" if kind == "lattice" else "n"}
+    missing = sorted(required - set(args))
+    if missing:
+        raise ValueError(f"[generator] {missing[0]}: required for kind = {kind!r}")
+    boundary = t.get("boundary", "none")
+    if boundary not in BOUNDARIES:
+        raise ValueError(f"[generator] boundary = {boundary!r}: must be one of {', '.join(BOUNDARIES)}")
+    if boundary == "periodic" and kind not in ("lattice", "random"):
+        raise ValueError(f"[generator] boundary = 'periodic': only for kind = 'lattice' or 'random' (a {kind} has no "
+                         "period)")
+    if boundary == "periodic" and kind == "random":
+        args["periodic"] = True
+    try:
+        if kind == "box":
+            args["dimension"] = dimension
+        layout = {"chain": generators.chain, "lattice": generators.lattice, "random": generators.random_packing,
+                  "box": generators.random_box}[kind](**args)
+    except (TypeError, ValueError) as exc:
+        msg = str(exc)
+        raise ValueError(msg if msg.startswith("[") else f"[generator] kind = {kind!r}: bad parameter ({msg})") from None
+    n = len(layout.radius)
+    T0 = _number(t, "generator", "temperature", 0.0)
+    hot = _number(t, "generator", "hot", required=boundary != "none")
+    cold = _number(t, "generator", "cold", required=boundary != "none")
+    heat = _number(t, "generator", "heat", 0.0)
+    temperature = np.full(n, T0)
+    fixed = np.zeros(n, dtype=bool)
+    walls, specimen, box = (), None, None
+    if boundary != "none" and kind == "box":
+        raise ValueError("[generator] boundary: not for kind = \"box\" (give [[walls]] instead)")
+    if boundary == "periodic":
+        # the block repeats along every axis; the temperature drops by hot - cold per period along z. Without a
+        # given temperature the particles start on that gradient about (hot + cold) / 2 (the mean a steady run
+        # keeps, for equal capacities)
+        box = PeriodicBox(layout.period, (True, True, True), layout.origin, [0.0, 0.0, hot - cold])
+        if "temperature" not in t:
+            z = layout.position[:, 2]
+            temperature = 0.5 * (hot + cold) - (hot - cold) * (z - z.mean()) / layout.period[2]
+        specimen = Specimen(float(layout.period[2]), box.cross_section(2), hot, cold, periodic=True)
+    elif boundary == "fixed":
+        fixed[layout.bottom] = fixed[layout.top] = True
+        temperature[layout.bottom], temperature[layout.top] = hot, cold
+        length = float(np.mean(layout.position[layout.top, 2]) - np.mean(layout.position[layout.bottom, 2]))
+        specimen = Specimen(length, layout.area, hot, cold, tuple(int(k) for k in layout.bottom))
+    elif boundary == "plates":
+        # plane walls touching the end layers with overlap delta = overlap * r / 2: the mirror pair's neck equals
+        # that of a pair with the generator's relative overlap
+        mean_overlap = float(np.mean(np.atleast_1d(t["overlap"])))
+        r_b, r_t = layout.radius[layout.bottom], layout.radius[layout.top]
+        z_b = float(np.mean(layout.position[layout.bottom, 2] - r_b * (1.0 - 0.5 * mean_overlap)))
+        z_t = float(np.mean(layout.position[layout.top, 2] + r_t * (1.0 - 0.5 * mean_overlap)))
+        walls = (Wall("hot", [0.0, 0.0, z_b], [0.0, 0.0, 1.0], hot), Wall("cold", [0.0, 0.0, z_t], [0.0, 0.0, -1.0],
+                                                                          cold))
+        specimen = Specimen(z_t - z_b, layout.area, hot, cold)
+    particles = Particles.from_arrays(layout.position, layout.radius, temperature, materials, None, fixed,
+                                      np.full(n, heat), prefix="[generator]")
+    return particles, walls, specimen, layout.velocity, box
+
+
+def _periodic_box(t: dict) -> PeriodicBox:
+    """``[periodic]``: ``lengths`` (m), ``axes`` (the periodic ones, default all), ``origin``, ``drop`` (the
+    temperature drop per period along each axis)."""
+    _check_keys(t, "periodic", ALLOWED["periodic"])
+    if "lengths" not in t:
+        raise ValueError("[periodic] lengths: required (the period along x, y and z, m)")
+    axes = t.get("axes", list(AXES))
+    if not isinstance(axes, list) or not all(isinstance(a, str) and a in AXES for a in axes) or not axes:
+        raise ValueError(f"[periodic] axes = {axes!r}: must be a non-empty list of \"x\", \"y\", \"z\"")
+    values = {}
+    for key in ("lengths", "origin", "drop"):
+        if key in t:
+            v = t[key]
+            if (not isinstance(v, list) or len(v) != 3
+                    or not all(_is_number(x) and math.isfinite(x) for x in v)):
+                raise ValueError(f"[periodic] {key} = {v!r}: must be a list of three finite numbers")
+            values[key] = v
+    try:
+        return PeriodicBox(values["lengths"], tuple(a in axes for a in AXES), values.get("origin"), values.get("drop"))
+    except ValueError as exc:
+        raise ValueError(f"[periodic] {exc}") from None
+
+
+def _walls(doc) -> tuple:
+    tables = doc.get("walls", [])
+    if not isinstance(tables, list):
+        raise ValueError("[[walls]]: must be an array of tables")
+    out = []
+    for k, w in enumerate(tables):
+        _check_keys(w, f"walls[{k}]", ALLOWED["walls"])
+        for key in ("point", "normal", "temperature"):
+            if key not in w:
+                raise ValueError(f"[[walls]] {k}: {key}: required")
+        out.append(Wall(str(w.get("name", f"wall{k}")), w["point"], w["normal"],
+                        _number(w, f"walls[{k}]", "temperature", required=True)))
+    names = [w.name for w in out]
+    if len(set(names)) != len(names):
+        raise ValueError(f"[[walls]] name: names must be unique, got {names}")
+    return tuple(out)
+
+
+def _spec(cls, table, section, numeric=(), integer=(), words=()):
+    """``cls(**table)``; keys in ``numeric`` must be finite numbers (or, if also in ``words``, a string that the
+    class checks, e.g. ``dt = "auto"``), keys in ``integer`` integers."""
+    _check_keys(table, section, ALLOWED[section])
+    kwargs = {}
+    for key, v in table.items():
+        if key in numeric and not (key in words and isinstance(v, str)):
+            v = _number(table, section, key)
+        if key in integer and (not isinstance(v, int) or isinstance(v, bool)):
+            raise ValueError(f"[{section}] {key} = {v!r}: must be an integer")
+        kwargs[key] = v
+    try:
+        return cls(**kwargs)
+    except ValueError as exc:
+        msg = str(exc)
+        if msg.startswith(f"{section}."):
+            msg = f"[{section}] {msg[len(section) + 1:]}"
+        raise ValueError(msg if msg.startswith("[") else f"[{section}] {msg}") from None
+
+
+def _moving_keys(doc: dict, moving: bool) -> dict:
+    """``doc`` without the keys and tables of moving particles (:mod:`dem.scene.motion`), which a scene without
+    ``"mechanical"`` physics refuses by name; in a scene with it, an unknown key is refused here, naming every key
+    such a scene allows."""
+    out = dict(doc)
+    for table in MOVING_TABLES:
+        if table in out and not moving:
+            raise ValueError(f"[{table}]: only for moving particles ([scene] physics with \"mechanical\")")
+        out.pop(table, None)
+    for section, keys in MOVING_KEYS.items():
+        tables = out.get(section)
+        if tables is None:
+            continue
+        many = isinstance(tables, list)
+        cleaned = []
+        for k, t in enumerate(tables if many else [tables]):
+            if not isinstance(t, dict):
+                cleaned.append(t)
+                continue
+            if moving:
+                _check_keys(t, f"{section}[{k}]" if many else section, ALLOWED[section] | keys)
+            extra = sorted(set(t) & keys)
+            if extra and not moving:
+                raise ValueError(f"[{section}] {extra[0]}: only for moving particles ([scene] physics with "
+                                 f"\"mechanical\")")
+            cleaned.append({k: v for k, v in t.items() if k not in keys})
+        out[section] = cleaned if many else cleaned[0]
+    return out
+
+
+def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None) -> Scene:
+    """Validate a parsed TOML document into a :class:`Scene` (schema: README, "Scene schema")."""
+    top = set(ALLOWED) | {"materials"} | set(MOVING_TABLES)
+    unknown = sorted(set(doc) - top)
+    if unknown:
+        raise ValueError(f"[{unknown[0]}]: unknown table (allowed: {', '.join(sorted(top))})")
+    physics = doc.get("scene", {}).get("physics", ["thermal"]) if isinstance(doc.get("scene", {}), dict) else None
+    if isinstance(physics, str):
+        physics = [physics]
+    if not isinstance(physics, list) or not all(isinstance(x, str) for x in physics):
+        raise ValueError(f"[scene] physics = {physics!r}: must be a list of names (available: "
+                         f"{', '.join(PHYSICS)})")
+    check_physics(physics)
+    moving = "mechanical" in physics
+    full, doc = doc, _moving_keys(doc, moving)
+    meta = doc.get("scene", {})
+    _check_keys(meta, "scene", ALLOWED["scene"])
+    materials = _materials(doc, thermal="thermal" in physics, electrical="electrical" in physics)
+    start = None
+    if "start" in full:
+        if "particles" in doc or "generator" in doc:
+            raise ValueError("[start] state: the particles come from the saved state; remove [particles] or "
+                             "[generator]")
+        name = full["start"].get("state") if isinstance(full["start"], dict) else None
+        if not isinstance(name, str):
+            raise ValueError("[start] state: required, the path of a saved state (.npz)")
+        start = state_file.load(base_dir / name if base_dir is not None else name)
+        particles = Particles.from_arrays(start["x"], start["radius"], start["T"], materials,
+                                          prefix="[start] state")
+        walls, specimen, velocity, box = (), None, None, None
+    elif ("particles" in doc) == ("generator" in doc):
+        raise ValueError("[particles] or [generator]: give exactly one of them")
+    elif "particles" in doc:
+        particles, walls, specimen, velocity, box = _explicit_particles(doc["particles"], materials)
+    else:
+        dimension = full.get("scene", {}).get("dimension", 3) if moving else 3
+        particles, walls, specimen, velocity, box = _generated_particles(doc["generator"], materials, dimension)
+    if "periodic" in doc:
+        if box is not None:
+            raise ValueError("[periodic]: the generator's boundary = \"periodic\" already makes the block periodic; "
+                             "give one or the other")
+        box = _periodic_box(doc["periodic"])
+    if box is not None and moving:
+        raise ValueError("[periodic]: periodic boxes are for static packings so far (the neighbour list of moving "
+                         "particles does not use dem.geometry.periodic yet)")
+    if not moving:
+        walls = walls + _walls(doc)
+    cond = dict(doc.get("conductance", {}))
+    if "fit_file" in cond and not isinstance(cond["fit_file"], str):
+        raise ValueError(f"[conductance] fit_file = {cond['fit_file']!r}: must be a path (string)")
+    if "fit_file" in cond and base_dir is not None:
+        cond["fit_file"] = str((base_dir / cond["fit_file"]).resolve())
+    conductance = _spec(ConductanceSpec, cond, "conductance", numeric=("slope", "contact_conductance"))
+    conv = _spec(Convection, doc["convection"], "convection", numeric=("h", "T_inf")) if "convection" in doc else None
+    rad = (_spec(Radiation, doc["radiation"], "radiation", numeric=("emissivity", "T_inf"))
+           if "radiation" in doc else None)
+    if rad is not None:
+        _check_radiation_temperatures(rad, particles.temperature, walls)
+    solver = _spec(SolverSpec, doc.get("solver", {}), "solver", numeric=("dt", "t_end", "rtol"),
+                   integer=("max_steps",), words=("dt",))
+    output = _spec(OutputSpec, doc.get("output", {}), "output", numeric=("checkpoint_every",),
+                   integer=("every", "vtu_every"))
+    if velocity is not None and not moving:
+        raise ValueError("[generator] speed: only for moving particles ([scene] physics with \"mechanical\")")
+    contact = contact_material_from_scene(doc) if "contact" in doc else None
+    motion = parse_motion(full, particles, solver, physics, contact, velocity, start) if moving else None
+    electrical = parse_electrical(full, motion.walls if moving else (), physics)
+    return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
+                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact, motion,
+                 electrical, box)
+
+
+def contact_material_from_scene(doc: dict) -> LudingMaterial | ZohdiMaterial:
+    """The contact material of a TOML document's ``[contact]`` table: :func:`luding_material_from_scene` for
+    ``law = "luding"``, :func:`dem.scene.zohdi.zohdi_material` for ``law = "zohdi"``."""
+    table = doc.get("contact")
+    if isinstance(table, dict) and table.get("law") == "zohdi":
+        _check_keys(table, "contact", ALLOWED["contact"])
+        values = {key: v for key, v in table.items() if key != "law"}
+        material = doc.get("material")
+        if "density" not in values and isinstance(material, dict) and "density" in material:
+            values["density"] = material["density"]
+        return zohdi_material(values)
+    return luding_material_from_scene(doc)
+
+
+def luding_material_from_scene(doc_or_scene) -> LudingMaterial:
+    """The Luding 2005 contact material of a :class:`Scene` (its ``contact``) or of a TOML document (its
+    ``[contact]`` table: ``law = "luding"`` and the :class:`~dem.laws.contact.luding.LudingMaterial` fields in SI units;
+    ``density`` defaults to that of a single ``[material]``). Independent of how the particles are given.
+    Raises ``ValueError`` when there is none or a value is bad."""
+    if isinstance(doc_or_scene, Scene):
+        if doc_or_scene.contact is None or doc_or_scene.contact.law != "luding":
+            raise ValueError(f"scene {doc_or_scene.name!r}: has no [contact] table with law = \"luding\" (the Luding "
+                             f"2005 sintering contact material)")
+        return doc_or_scene.contact
+    table = doc_or_scene.get("contact") if isinstance(doc_or_scene, dict) else None
+    if table is None:
+        raise ValueError("[contact]: required, with law = \"luding\" and the material (k1, k2, kc, ...)")
+    _check_keys(table, "contact", ALLOWED["contact"])
+    if table.get("law") not in CONTACT_LAWS:
+        raise ValueError(f"[contact] law = {table.get('law')!r}: must be one of {', '.join(CONTACT_LAWS)}")
+    values = {key: v for key, v in table.items() if key != "law"}
+    material = doc_or_scene.get("material")
+    if "density" not in values and isinstance(material, dict) and "density" in material:
+        values["density"] = material["density"]
+    if table["law"] != "luding":
+        raise ValueError(f"[contact] law = {table['law']!r}: not the Luding 2005 sintering contact (law = \"luding\")")
+    return material_from_table(LudingMaterial, "luding", values)
+
+
+def _check_radiation_temperatures(rad: Radiation, temperature: np.ndarray, walls) -> None:
+    """Radiation works in absolute temperature: every prescribed temperature must lie between 0 K and
+    :data:`dem.laws.ambient.RADIATION_T_MAX`."""
+    named = [("particles.temperature", np.asarray(temperature, dtype=float))]
+    named += [(f"walls.{w.name}.temperature", np.asarray([w.temperature], dtype=float)) for w in walls]
+    for name, values in named:
+        kelvin = rad.kelvin(values)
+        bad = np.flatnonzero((kelvin < 0.0) | (kelvin > RADIATION_T_MAX))
+        if bad.size:
+            k = int(bad[0])
+            where = f"[{k}]" if name == "particles.temperature" else ""
+            raise ValueError(f"{name}{where} = {values[k]:g} {rad.unit}: outside the range of the radiation model "
+                             f"(radiation.unit = {rad.unit!r}); valid range {0.0 - rad.kelvin(0.0):g} to "
+                             f"{RADIATION_T_MAX - rad.kelvin(0.0):g} {rad.unit} (absolute zero to "
+                             f"{RADIATION_T_MAX:g} K)")
+
+
+def builtin_scenes() -> dict:
+    """``{name: description}`` of the scenes shipped in ``dem/scene/builtin``."""
+    out = {}
+    for path in sorted(SCENE_DIR.glob("*.toml")):
+        with path.open("rb") as fh:
+            out[path.stem] = tomllib.load(fh).get("scene", {}).get("description", "")
+    return out
+
+
+def load_scene(name_or_path) -> Scene:
+    """Read a scene from a TOML file path or a built-in name (``python -m dem scenes`` lists them)."""
+    path = pathlib.Path(name_or_path)
+    if not path.exists() and (SCENE_DIR / f"{name_or_path}.toml").exists():
+        path = SCENE_DIR / f"{name_or_path}.toml"
+    if not path.exists():
+        raise ValueError(f"scene = {str(name_or_path)!r}: no such file or built-in scene "
+                         f"(built-ins: {', '.join(builtin_scenes())})")
+    if not path.is_file():
+        raise ValueError(f"scene = {str(name_or_path)!r}: not a file")
+    try:
+        with path.open("rb") as fh:
+            doc = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{path.name}: malformed TOML: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path.name}: cannot be read ({exc})") from None
+    try:
+        return parse_scene(doc, path.stem, path.parent)
+    except ValueError as exc:
+        raise ValueError(f"{path.name}: {exc}") from None

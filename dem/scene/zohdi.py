@@ -1,0 +1,195 @@
+"""The keys of a scene that runs Zohdi 2014: ``[contact] law = "zohdi"``, the implicit stepping in ``[solver]``, the
+current in ``[electrical]`` and the electrodes in ``[[walls]]``.
+
+* ``[contact]`` -- ``law = "zohdi"`` and the :class:`~dem.laws.contact.zohdi.ZohdiMaterial` fields (the paper's
+  symbols: ``K_p``, ``p_p``, ``K_p_lim``, ``K_w``, ``p_w``, ``K_w_lim``, ``theta_star``, ``K_b``, ``p_b``,
+  ``E_star``, ``mu_d``, ``c_env``, ``v_slip``; ``density`` defaults to the ``[material]`` one);
+* ``[solver]`` -- ``dt`` (the first step, s), ``dt_max`` (Delta t_lim, default ``dt``), ``phi``, ``iterations``
+  (K_d), ``tolerance`` (TOL), ``order`` (p), ``growth``, ``shrink``, ``dt_min`` (:class:`ZohdiStepping`);
+* ``[electrical]`` -- ``scheme`` (``"kirchhoff"`` or ``"zohdi"``), ``absorption`` (a of eq. 35), ``floating``
+  (``"allow"``: particles touching no electrode carry no current; ``"error"``: stop, naming them), and for Zohdi's
+  iteration ``tolerance`` (largest change per sweep relative to the largest wall value) and ``sweeps`` (at most
+  per refresh);
+* ``[[walls]]`` -- ``potential`` (V) or ``current`` (A into the packing; Zohdi's scheme: the wall's J_ext) makes a
+  wall an electrode; ``[material] electrical_conductivity`` (S/m) is sigma;
+* ``[output]`` -- ``fraction_axis`` (``"x"``, ``"y"`` or ``"z"``): the axis along which the powder stands on its
+  bottom wall and is pressed by its top wall; the run's ``volume_fraction`` is then that of the volume between the
+  bottom wall and the lowest point the top wall has reached (Sec. 7, Remark 1), and ``bed_fraction`` the bulk
+  fraction of the bed up to its surface; ``frames`` (PNG renderings over the run, in the style of Fig. 8).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from dem.network.current import Electrodes, check_absorption, check_scheme
+from dem.laws.fields import material_from_table
+from dem.laws.contact.zohdi import ZohdiMaterial, ZohdiStepping
+
+STEPPING_KEYS = {f.name for f in fields(ZohdiStepping)}
+OUTPUT_KEYS = {"fraction_axis", "frames"}
+DEFAULT_SKIN = 0.5  # x the mean radius: a step of the implicit scheme moves particles far more than a Verlet step
+ELECTRICAL_KEYS = {"scheme", "absorption", "tolerance", "sweeps", "floating"}
+ELECTRODE_KEYS = {"potential", "current"}
+
+
+@dataclass(frozen=True)
+class ElectricalSpec:
+    """The ``[electrical]`` table and the electrodes of the ``[[walls]]``."""
+
+    scheme: str
+    absorption: float
+    electrodes: Electrodes
+    tolerance: float = 1e-8
+    sweeps: int = 10_000
+    floating: str = "allow"
+
+
+def _number(table, section, key, default=None):
+    if key not in table:
+        return default
+    v = table[key]
+    if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
+        raise ValueError(f"[{section}] {key} = {v!r}: must be a finite number")
+    return v
+
+
+def parse_stepping(table: dict) -> ZohdiStepping:
+    """The stepping parameters of ``[solver]`` (``dt`` required)."""
+    if "dt" not in table:
+        raise ValueError("[solver] dt: required with [contact] law = \"zohdi\" (the first step, s)")
+    if isinstance(table["dt"], str):
+        raise ValueError(f"[solver] dt = {table['dt']!r}: with law = \"zohdi\" a number (s, the first step; the "
+                         f"fixed-point iteration adapts it)")
+    values = {k: _number(table, "solver", k) for k in STEPPING_KEYS if k in table}
+    values.setdefault("dt_max", values["dt"])
+    if "iterations" in values and float(values["iterations"]).is_integer():
+        values["iterations"] = int(values["iterations"])
+    return ZohdiStepping(**values)
+
+
+def parse_electrical(doc: dict, walls, physics) -> ElectricalSpec | None:
+    """The current's scheme and electrodes, or None without ``"electrical"`` physics (where electrode keys are
+    refused)."""
+    tables = doc.get("walls", [])
+    names = [w.name for w in walls]
+    marked = [(k, t) for k, t in enumerate(tables) if isinstance(t, dict) and set(t) & ELECTRODE_KEYS]
+    if "electrical" not in physics:
+        if marked:
+            raise ValueError(f"[walls][{marked[0][0]}] {sorted(set(marked[0][1]) & ELECTRODE_KEYS)[0]}: only with "
+                             f"\"electrical\" in [scene] physics")
+        if "electrical" in doc:
+            raise ValueError("[electrical]: only with \"electrical\" in [scene] physics")
+        return None
+    table = doc.get("electrical", {})
+    if not isinstance(table, dict):
+        raise ValueError("[electrical]: must be a table")
+    unknown = sorted(set(table) - ELECTRICAL_KEYS)
+    if unknown:
+        raise ValueError(f"[electrical] {unknown[0]}: unknown key (allowed: {', '.join(sorted(ELECTRICAL_KEYS))})")
+    scheme = check_scheme(table.get("scheme", "kirchhoff"))
+    absorption = check_absorption(table.get("absorption", 1.0))
+    tolerance = _number(table, "electrical", "tolerance", 1e-8)
+    if tolerance <= 0:
+        raise ValueError(f"[electrical] tolerance = {tolerance!r}: must be > 0 (largest change per sweep relative to "
+                         f"the largest wall value)")
+    sweeps = table.get("sweeps", 10_000)
+    if not isinstance(sweeps, int) or isinstance(sweeps, bool) or sweeps < 1:
+        raise ValueError(f"[electrical] sweeps = {sweeps!r}: must be an integer >= 1")
+    floating = table.get("floating", "allow")
+    if floating not in ("allow", "error"):
+        raise ValueError(f"[electrical] floating = {floating!r}: must be \"allow\" (groups touching no electrode carry "
+                         f"no current) or \"error\" (stop, naming them)")
+    if not marked:
+        raise ValueError("[[walls]] potential or current: \"electrical\" physics needs at least one electrode (a wall "
+                         "with a potential in V or a current in A)")
+    potential, current, which = [], [], []
+    for k, t in marked:
+        keys = set(t) & ELECTRODE_KEYS
+        if len(keys) > 1:
+            raise ValueError(f"[walls][{k}]: give potential or current, not both")
+        if scheme == "zohdi" and "potential" in keys:
+            raise ValueError(f"[walls][{k}] potential: scheme = \"zohdi\" takes each electrified wall's current "
+                             f"J_ext (Zohdi 2014, Remark 2), not a potential")
+        value = _number(t, f"walls][{k}", keys.pop())
+        potential.append(value if "potential" in t else np.nan)
+        current.append(value if "current" in t else np.nan)
+        which.append(k)
+    electrodes = Electrodes(tuple(names[k] for k in which), tuple(which), np.array(potential, dtype=float),
+                            np.array(current, dtype=float))
+    if scheme == "kirchhoff" and not np.any(electrodes.fixed_potential):
+        raise ValueError("[[walls]] potential: scheme = \"kirchhoff\" needs one electrode at a fixed potential (e.g. "
+                         "potential = 0.0 on the grounded wall) as the reference")
+    return ElectricalSpec(scheme, absorption, electrodes, float(tolerance), sweeps, floating)
+
+
+def strip_electrodes(tables: list) -> list:
+    """The ``[[walls]]`` tables without their electrode keys (a wall's motion is parsed from the rest)."""
+    return [{k: v for k, v in t.items() if k not in ELECTRODE_KEYS} if isinstance(t, dict) else t for t in tables]
+
+
+def zohdi_material(values: dict) -> ZohdiMaterial:
+    """A :class:`ZohdiMaterial` from the ``[contact]`` values (without ``law``)."""
+    return material_from_table(ZohdiMaterial, "zohdi", values)
+
+
+def refuse_zohdi_keys(doc: dict, physics) -> None:
+    """A scene with another contact law names none of the keys of this module."""
+    if "electrical" in physics:
+        raise ValueError("[scene] physics: \"electrical\" runs with [contact] law = \"zohdi\" (Zohdi 2014)")
+    for section, keys in (("solver", STEPPING_KEYS - {"dt"}), ("output", OUTPUT_KEYS)):
+        extra = sorted(set(doc.get(section, {})) & keys)
+        if extra:
+            raise ValueError(f"[{section}] {extra[0]}: only with [contact] law = \"zohdi\"")
+    for k, t in enumerate(doc.get("walls", [])):
+        extra = sorted(set(t) & ELECTRODE_KEYS) if isinstance(t, dict) else []
+        if extra:
+            raise ValueError(f"[walls][{k}] {extra[0]}: only with \"electrical\" physics ([contact] law = \"zohdi\")")
+
+
+def zohdi_motion(doc: dict, particles, solver, physics, start, walls, gravity, velocity, phases, wall_phases,
+                 dimension):
+    """The :class:`~dem.scene.motion.MotionSpec` of a scene with ``[contact] law = "zohdi"``."""
+    from dem.scene.motion import MotionSpec, _num
+
+    if dimension != 3:
+        raise ValueError("[scene] dimension: law = \"zohdi\" moves spheres (dimension = 3)")
+    for table, why in (("temperature", "the temperatures come from the thermal submodel or stay at the initial ones"),
+                       ("start", "saved states are those of the Luding engine")):
+        if table in doc:
+            raise ValueError(f"[{table}]: not with law = \"zohdi\" ({why})")
+    if any(p[1] for p in phases):
+        raise ValueError("[phases] mu, mu_wall, gamma_n, gamma_t: parameters of law = \"luding\"; with law = "
+                         "\"zohdi\" a phase changes wall speeds (wall_velocity)")
+    if ("convection" in doc or "radiation" in doc):
+        raise ValueError("[convection], [radiation]: not with law = \"zohdi\" (its heat balance, eq. 31, has "
+                         "conduction and Joule heating only)")
+    solver_table = doc.get("solver", {})
+    for key in ("thermal_interval", "integrator"):
+        if key in solver_table:
+            raise ValueError(f"[solver] {key}: not with law = \"zohdi\" (the heat is stepped with the positions, "
+                             f"by the same trapezoidal rule and fixed-point iteration)")
+    stepping = parse_stepping(solver_table)
+    skin = _num(solver_table, "solver", "skin", DEFAULT_SKIN * float(np.mean(particles.radius)), positive=True)
+    out = doc.get("output", {})
+    output_interval = _num(out, "output", "interval", solver.t_end / 100, positive=True)
+    vtu_interval = _num(out, "output", "vtu_interval", 0.0, nonnegative=True)
+    frames = out.get("frames", 0)
+    if not isinstance(frames, int) or isinstance(frames, bool) or not 0 <= frames <= 1000:
+        raise ValueError(f"[output] frames = {frames!r}: must be an integer in [0, 1000] (PNG renderings)")
+    control = None
+    if "fraction_axis" in out:
+        axis = out["fraction_axis"]
+        if axis not in ("x", "y", "z"):
+            raise ValueError(f"[output] fraction_axis = {axis!r}: must be \"x\", \"y\" or \"z\"")
+        control = "xyz".index(axis)
+        ends = [w for w in walls if abs(abs(w.normal[control]) - 1.0) < 1e-12]
+        if sorted(np.sign(w.normal[control]) for w in ends) != [-1.0, 1.0]:
+            raise ValueError(f"[output] fraction_axis = {axis!r}: needs one wall facing +{axis} (the bottom) and one "
+                             f"facing -{axis} (the top, which presses)")
+    return MotionSpec(dimension, None, velocity, None, walls, gravity, None, stepping.dt, math.inf, skin, 0.0,
+                      "trapezoidal", output_interval, vtu_interval, phases=(), start=None, wall_phases=wall_phases,
+                      stepping=stepping, control=control, frames=frames)

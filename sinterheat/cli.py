@@ -1,0 +1,154 @@
+"""Command-line plumbing shared by the packages' CLIs (``python -m fem_neck``, ``python -m dem``, ...).
+
+Each sub-command lives in its own module of this package and exposes ``register(subparsers)``, which adds its
+parser and sets ``run``: a function of the parsed arguments returning a JSON-ready dict. :func:`main` prints that
+dict (``--json``: one object on stdout, nothing else), turns a ``ValueError`` into one line on stderr with exit code
+2, and never shows a traceback for bad input (an ``OSError``, e.g. ``--out`` naming a file, is treated the same).
+Warnings raised while a command runs (e.g. numpy overflow in an extreme input) are collected: after an error only
+the one error line is printed; after success each distinct warning is one ``warning:`` line on stderr. Ctrl-C ends
+any command with one line saying where it stopped and exit code 130 (:mod:`sinterheat.interrupt`); commands report
+their progress with ``sinterheat.interrupt.where().update(...)``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import math
+import os
+import re
+import sys
+import warnings
+
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An argparse parser whose usage errors are one line on stderr and exit code 2.
+
+    Negative numbers in scientific notation (``--ri -1e-3``) are read as values, not as options, so that the
+    command can reject them with a message about the value.
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$", re.I)
+
+    def error(self, message):
+        """Print ``PROG: error: MESSAGE`` as one line on stderr and exit with code 2 (no usage block)."""
+        sys.stderr.write(f"{self.prog}: error: {message}\n")
+        raise SystemExit(2)
+
+
+def add_output_options(parser: argparse.ArgumentParser) -> None:
+    """The options every sub-command shares: ``--json`` and ``--out DIR``."""
+    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout, nothing else")
+    parser.add_argument("--out", metavar="DIR", default=None, help="write result files into DIR")
+
+
+def _worker_count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"workers = {text!r}: must be an integer >= 1") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"workers = {value!r}: must be >= 1")
+    return value
+
+
+def add_workers_option(parser: argparse.ArgumentParser) -> None:
+    """``--workers W``: processes of a parallel sweep (default: all cores), checked to be >= 1."""
+    parser.add_argument("--workers", type=_worker_count, default=None, metavar="W",
+                        help="processes (default: all cores)")
+
+
+def _format(value) -> str:
+    if isinstance(value, float):
+        return f"{value:.10g}"
+    if isinstance(value, (list, tuple)) and len(value) > 8:
+        return f"[{len(value)} items]"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_format(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k}: {_format(v)}" for k, v in value.items()) + "}"
+    return str(value)
+
+
+def print_result(result: dict, as_json: bool) -> None:
+    """``--json``: one JSON object; otherwise one ``key: value`` line per entry.
+
+    A reader that closes the pipe early (``| head``) ends the output quietly, as for any Unix filter.
+    """
+    try:
+        _write_result(result, as_json)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        sys.stdout = open(os.devnull, "w")  # nothing more can reach the reader; keep interpreter exit quiet
+
+
+def finite_or_none(value):
+    """``value`` with every non-finite float (NaN, +-inf) replaced by ``None``: JSON has no NaN, and a number that
+    is not defined (e.g. an order fitted from fewer than two points) is reported as null, never as NaN."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: finite_or_none(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite_or_none(v) for v in value]
+    return value
+
+
+def _write_result(result: dict, as_json: bool) -> None:
+    result = finite_or_none(result)
+    if as_json:
+        json.dump(result, sys.stdout)
+        sys.stdout.write("\n")
+    else:
+        width = max((len(k) for k in result), default=0)
+        for key, value in result.items():
+            print(f"{key:<{width}}  {_format(value)}")
+
+
+def build_parser(prog: str, description: str, modules, package: str) -> argparse.ArgumentParser:
+    parser = OneLineParser(prog=prog, description=description)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=OneLineParser)
+    sub.required = True
+    for name in modules:
+        importlib.import_module(f"{package}.{name}").register(sub)
+    return parser
+
+
+def main(argv=None, *, prog: str, description=None, modules, package: str) -> int:
+    """Run the sub-command named in ``argv`` among ``modules`` of ``package`` (each exposing ``register``)."""
+    from sinterheat.interrupt import Where, run_command
+
+    here = Where(prog)
+    return run_command(here, _main, argv, here, prog, description, modules, package)
+
+
+def _main(argv, here, prog, description, modules, package) -> int:
+    named = next((a for a in (sys.argv[1:] if argv is None else argv) if a in modules), None)
+    if named is not None:  # the command's name, for an interrupt that comes before parsing ends
+        here.command = f"{prog} {named}"
+    parser = build_parser(prog, description or __doc__.splitlines()[0], modules, package)
+    args = parser.parse_args(argv)
+    here.command = f"{prog} {args.command}"
+    here.update(stage=args.command)
+    with warnings.catch_warnings(record=True) as caught:
+        try:
+            result = args.run(args)
+        except (ValueError, OSError) as exc:  # bad input, or an output path that cannot be written
+            if here.signalled:  # not bad input: an interrupt that C code turned into this error
+                raise
+            sys.stderr.write(f"{prog} {args.command}: error: {_one_line(exc)}\n")
+            return 2
+    if here.signalled:  # the command finished, but the user asked it to stop: no result is printed
+        raise KeyboardInterrupt
+    for text in dict.fromkeys(f"{w.category.__name__}: {_one_line(w.message)}" for w in caught):
+        sys.stderr.write(f"{prog} {args.command}: warning: {text}\n")
+    print_result(result, args.json)
+    return 0
+
+
+def _one_line(message) -> str:
+    return " ".join(str(message).split())

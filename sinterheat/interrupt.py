@@ -1,0 +1,211 @@
+"""Ctrl-C is part of the interface: an interrupted run says where it stopped and where its partial results are.
+
+The CLIs (``python -m fem_neck``, ``python -m dem``, ``python -m verification``) run their command through
+:func:`run_command`. A Ctrl-C (SIGINT) anywhere in it -- in Python code, in a numpy, scipy or gmsh call (the
+interrupt is raised when the call returns), in a tqdm bar, or while waiting for the worker processes of a parallel
+sweep -- ends the run with one line on stderr and exit code 130 (128 + SIGINT, what a shell reports for Ctrl-C),
+never a traceback::
+
+    python -m fem_neck fit: interrupted at fit, fit sweep: 12 of 40 solves done; partial results in results/fit
+
+Long work says where it is by updating the current run's :class:`Where` (outside a CLI run :func:`where` returns a
+throw-away one, so library code can always call it)::
+
+    from sinterheat.interrupt import where
+    where().update(stage="transient", step=k, t=t, out=folder)   # out: once usable files are in folder
+
+Fields: ``stage`` (what is running), ``step`` (an int is shown as "step k"; a string as it is, e.g. "12 of 40
+solves done"), ``t`` (simulated time, s) and ``out`` (the folder holding usable partial results; while it is
+``None`` the line says "no results written").
+
+How it holds. The first SIGINT raises ``KeyboardInterrupt`` and any further one is ignored, so clean-up
+(``finally`` blocks, the report files, an open gmsh session, which :func:`interrupted` also finalizes) cannot be
+cut short. C code may turn the interrupt into another error (numpy's import raises ``ImportError`` when it lands
+there) or swallow it (in a weakref callback it is only "ignored"; in an extension module's import it can end as a
+caught ``ImportError``): any error after a SIGINT counts as the interrupt, and a swallowed one is raised again at
+the next :meth:`Where.update` or when the command returns (the unraisable hook keeps it off stderr). tqdm bars still open are
+closed before the line is written, so it starts a line of its own. Workers of a process pool ignore SIGINT
+(:func:`ignore_interrupts` as the pool's initializer, forked inside :func:`shielded` so that no fork races the
+signal); the parent stops them (:func:`stop_pool`). :func:`exit_process` then leaves with code 130 (Python's own
+exit would report a kill by SIGINT once the interrupt has passed through some C-level imports). Before the CLI's
+``main`` runs (interpreter start-up, a few tens of ms) Python's default handler is still in place.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import os
+import signal
+import sys
+import threading
+from dataclasses import dataclass, field
+
+EXIT_CODE = 130  #: 128 + SIGINT
+_current: contextvars.ContextVar[Where | None] = contextvars.ContextVar("sinterheat_where", default=None)
+
+
+@dataclass
+class Where:
+    """Where a run is: ``command`` (e.g. ``"python -m fem_neck fit"``), ``stage``, ``step``, ``t`` (simulated
+    time, s) and ``out`` (folder with usable partial results, or ``None``)."""
+
+    command: str = ""
+    stage: str = ""
+    step: int | str | None = None
+    t: float | None = None
+    out: str | None = None
+    signalled: bool = field(default=False, repr=False)  # a SIGINT has arrived (set by the handler)
+
+    _FIELDS = ("stage", "step", "t", "out")
+
+    def update(self, **fields) -> Where:
+        """Set any of ``stage``, ``step``, ``t``, ``out`` (an unknown name is a programming error: ``TypeError``).
+
+        After a Ctrl-C it raises ``KeyboardInterrupt`` (once the fields are set): an interrupt that C code swallowed
+        surfaces at the next update.
+        """
+        for name, value in fields.items():
+            if name not in self._FIELDS:
+                raise TypeError(f"Where.update: unknown field {name!r} (fields: {', '.join(self._FIELDS)})")
+            setattr(self, name, str(value) if name == "out" and value is not None else value)
+        if self.signalled:
+            raise KeyboardInterrupt
+        return self
+
+    def message(self) -> str:
+        """The one line: ``<command>: interrupted at <where>; partial results in <out>`` (or no results written)."""
+        at = [self.stage] if self.stage else []
+        if self.step is not None:
+            at.append(f"step {self.step}" if isinstance(self.step, int) else str(self.step))
+        if self.t is not None:
+            at.append(f"t = {self.t:.6g} s")
+        results = f"partial results in {self.out}" if self.out else "no results written"
+        return f"{self.command}: interrupted at {', '.join(at) or 'start-up'}; {results}"
+
+
+def where() -> Where:
+    """The :class:`Where` of the run in progress (a throw-away one outside :func:`interruptible`)."""
+    return _current.get() or Where()
+
+
+def _raise_once(signum, frame):
+    state = _current.get()
+    if state is not None:
+        if state.signalled:
+            return  # a second Ctrl-C must not cut the clean-up short
+        state.signalled = True
+    raise KeyboardInterrupt
+
+
+def _unraisable(previous):
+    def hook(unraisable):
+        if issubclass(unraisable.exc_type, KeyboardInterrupt) and _current.get() is not None:
+            return  # swallowed (raised in a destructor or a weakref callback): the flag the handler set raises it
+            # again at the next Where.update or when the command returns (raised in here, it would only be printed)
+        previous(unraisable)
+
+    return hook
+
+
+@contextlib.contextmanager
+def interruptible(state: Where):
+    """Run a command's body with ``state`` as the current :class:`Where` and the SIGINT handler of this module
+    (:func:`run_command` is the usual way). The previous handler is restored unless the run was interrupted (then
+    the process is on its way out, and a further Ctrl-C during its exit stays ignored)."""
+    token = _current.set(state)
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, _raise_once) if main_thread else None
+    hook, sys.unraisablehook = sys.unraisablehook, _unraisable(sys.unraisablehook)
+    try:
+        yield state
+    finally:
+        sys.unraisablehook = hook
+        _current.reset(token)
+        if previous is not None and not state.signalled:
+            signal.signal(signal.SIGINT, previous)
+
+
+def run_command(state: Where, func, *args) -> int:
+    """``func(*args)`` (a command's body, returning its exit code) under :func:`interruptible`; after Ctrl-C the
+    one line of :func:`interrupted` and its exit code instead::
+
+        here = Where("python -m fem_neck fit")
+        return run_command(here, body, argv, here)   # body updates here.command, here.update(...)
+    """
+    try:
+        with interruptible(state):
+            code = func(*args)
+    except BaseException as exc:
+        if isinstance(exc, KeyboardInterrupt) or state.signalled:  # also an interrupt C code turned into an error
+            return interrupted(state)
+        raise
+    return interrupted(state) if state.signalled else code  # an interrupt that C code swallowed
+
+
+def interrupted(state: Where) -> int:
+    """After a ``KeyboardInterrupt``: finalize gmsh if a session is open, close open tqdm bars, write the one line
+    on stderr; returns :data:`EXIT_CODE`."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    gmsh = sys.modules.get("gmsh")
+    if gmsh is not None:
+        with contextlib.suppress(Exception):
+            if gmsh.isInitialized():
+                gmsh.finalize()
+    tqdm = sys.modules.get("tqdm")
+    if tqdm is not None:
+        for bar in list(getattr(tqdm.tqdm, "_instances", ())):
+            with contextlib.suppress(Exception):
+                bar.close()
+    with contextlib.suppress(OSError, ValueError):
+        sys.stderr.write(state.message() + "\n")
+        sys.stderr.flush()
+    return EXIT_CODE
+
+
+def ignore_interrupts() -> None:
+    """Initializer of pool workers: ignore SIGINT (a terminal's Ctrl-C reaches the whole process group; the parent
+    handles it and stops the pool) and undo the block :func:`shielded` handed down."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+@contextlib.contextmanager
+def shielded():
+    """Hold back SIGINT while worker processes are being started: a fork inherits the blocked signal, so a worker
+    cannot be interrupted before :func:`ignore_interrupts` runs; a Ctrl-C meanwhile reaches this process on exit."""
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def stop_pool(pool) -> None:
+    """Stop a ``concurrent.futures.ProcessPoolExecutor`` at once: cancel what has not started and terminate the
+    workers (their running jobs are abandoned)."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())  # no public handle before Python 3.14
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        with contextlib.suppress(Exception):
+            process.terminate()
+    for process in processes:
+        with contextlib.suppress(Exception):
+            process.join(timeout=5.0)
+
+
+def exit_process(code: int):
+    """``sys.exit(code)`` for a CLI's ``__main__``; after an interrupt (:data:`EXIT_CODE`) stdout and stderr are
+    flushed and the process leaves at once with that code (``os._exit``): the run has unwound, and Python's own
+    exit would report a kill by SIGINT instead once the interrupt has passed through some C-level imports."""
+    if code == EXIT_CODE:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        os._exit(code)
+    sys.exit(code)
