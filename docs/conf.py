@@ -1,10 +1,10 @@
 """Sphinx configuration of the sinterheat documentation.
 
-Build (offline, warnings as errors): ``python -m sphinx -W -b html docs docs/_build`` after
-``pip install '.[docs]'``. The pages are Markdown (MyST), so ``tests/test_readme.py`` runs their console blocks as it
-runs the README's; the gallery is built by running every script of ``examples/`` (sphinx-gallery); the API
-reference is autodoc (napoleon) over the packages in :data:`api_packages`, and :mod:`api_check` fails the build
-when one of their public functions or classes is missing from it.
+Build (offline, warnings as errors): ``python -m sphinx -W -b html docs docs/_build`` after ``pip install '.[docs]'``.
+The pages are Markdown (MyST), so ``tests/test_console_blocks.py`` runs their console blocks as it runs the README's;
+the gallery is built by running every script of ``examples/`` (sphinx-gallery); the API reference is autodoc
+(napoleon) over the packages in ``api_packages``, and ``_ext/api_check.py`` fails the build when one of their public
+functions or classes is missing from it.
 """
 
 import logging
@@ -54,7 +54,7 @@ napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 
 # The packages whose every public function and class must appear in the API reference (api_check).
-api_packages = ["fem_neck"]
+api_packages = ["fem_neck", "sinterheat"]
 
 sphinx_gallery_conf = {
     "examples_dirs": str(DOCS.parent / "examples"),
