@@ -2,8 +2,8 @@
 
 Geometry. A :class:`PeriodicCell` holds the particles of one period (centres, radii, the period box); every
 overlapping pair of particle images is bonded (Rojek 2022, eq. 21) and gets the volume-conserving cylindrical neck of
-:func:`fem_neck.neck_geometry` (eqs. 22-33). The solid is the union of all spheres and all neck cylinders, exactly as
-in :mod:`fem_neck.cluster`; it conserves each particle's volume, so the solid volume fraction is
+:func:`fem_neck.geometry.neck_geometry` (eqs. 22-33). The solid is the union of all spheres and all neck cylinders,
+exactly as in :mod:`fem_neck.cluster`; it conserves each particle's volume, so the solid volume fraction is
 ``phi = sum 4/3 pi r^3 / |period|`` exactly. The pair neck model has an answer only while the necks of one particle
 stay apart: :func:`check_cell` refuses a cell where two neck circles on one sphere touch (for the cubic lattices from
 ``a/r = sin(theta/2)``, theta the smallest angle between bonds: SC 90 deg, BCC 70.5 deg, FCC 60 deg; see
@@ -60,7 +60,7 @@ COORDINATION = {"sc": 6, "bcc": 8, "fcc": 12}
 MIN_NECK_RATIO = 0.05
 # the refinement ladder: level sizes relative to the particle radius (far) and to the neck radius (at the circles)
 SIZE_FAR0, SIZE_NECK0, GRADING0, LEVEL_FACTOR = 0.25, 0.06, 0.25, 0.8
-MAX_ELEMENTS = 3_000_000  # ~10 GB and ~15 min on 2 cores: finer meshes are refused
+MAX_ELEMENTS = 3_000_000  #: finer meshes are refused (~10 GB and ~15 min on 2 cores)
 GAP_ORDER = 1.65  # the gap between the bounds falls like size^GAP_ORDER (:func:`effective_conductivity`)
 LINEAR_RTOL = 1e-11
 _TOL = 1e-9  # geometric tolerance in units of the largest radius
