@@ -32,6 +32,32 @@ def check_range(name: str, arr: np.ndarray, low: float | None, high: float, what
     return arr
 
 
+def check_vector(name: str, value) -> np.ndarray:
+    """``value`` as a finite 3-vector of at most POSITION_MAX per component, else ``ValueError`` naming it."""
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        v = np.full(1, np.nan)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} = {value!r}: must be a finite 3-vector")
+    return check_range(name, v, None, POSITION_MAX, " m")
+
+
+def check_unit_vector(name: str, value) -> np.ndarray:
+    """``value`` as a unit 3-vector (a finite, non-zero 3-vector, normalised), else ``ValueError`` naming it."""
+    v = check_vector(name, value)
+    if np.linalg.norm(v) == 0.0:
+        raise ValueError(f"{name} = {value!r}: must be a finite non-zero 3-vector")
+    return v / np.linalg.norm(v)
+
+
+def check_temperature(name: str, value) -> float:
+    """``value`` as a finite temperature within :data:`TEMPERATURE_MAX`, else ``ValueError`` naming it."""
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
+        raise ValueError(f"{name} = {value!r}: must be a finite number")
+    return float(check_range(name, np.float64(value), None, TEMPERATURE_MAX))
+
+
 def finite_array(name: str, value, shape_tail=(), dtype=float) -> np.ndarray:
     """``value`` as an array of rank ``1 + len(shape_tail)`` with the given trailing shape and finite entries."""
     try:

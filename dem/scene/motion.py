@@ -32,7 +32,7 @@ from dem.laws.contact import law_module
 from dem.geometry.motion import particle_mass, moment_of_inertia
 from dem.geometry.particles import finite_array
 from dem.scene.events import TemperatureSchedule
-from dem.geometry.walls import MovingWall
+from dem.geometry.walls import Wall
 from dem.scene import zohdi as zscene
 
 DEFAULT_SKIN = 0.1            # x the mean radius
@@ -219,7 +219,7 @@ def _check_wall_phases(wall_phases, walls) -> None:
                     f"the wall's motion is {motions[name]!r}; only strain walls (constant speed) change speed"))
 
 
-def _moving_wall(k: int, table: dict) -> MovingWall:
+def _moving_wall(k: int, table: dict) -> Wall:
     allowed = {"name", "point", "normal", "temperature"} | MOVING_KEYS["walls"]
     unknown = sorted(set(table) - allowed)
     if unknown:
@@ -229,6 +229,6 @@ def _moving_wall(k: int, table: dict) -> MovingWall:
             raise ValueError(f"[[walls]] {k}: {key}: required")
     numbers = {key: _num(table, f"walls][{k}", key) for key in ("pressure", "mass", "damping", "velocity",
                                                                  "amplitude", "frequency") if key in table}
-    return MovingWall(str(table.get("name", f"wall{k}")), table["point"], table["normal"],
-                      str(table.get("motion", "fixed")), temperature=_num(table, f"walls][{k}", "temperature"),
-                      **numbers)
+    return Wall(str(table.get("name", f"wall{k}")), table["point"], table["normal"],
+                temperature=_num(table, f"walls][{k}", "temperature"), motion=str(table.get("motion", "fixed")),
+                **numbers)

@@ -23,7 +23,8 @@ from dem.laws.contact import law_module
 from dem.scene.zohdi import ElectricalSpec, parse_electrical
 from dem.geometry.particles import COPPER, Material, Particles, material_indices
 from dem.geometry.periodic import AXES, PeriodicBox
-from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
+from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources
+from dem.geometry.walls import Wall
 from dem.network.heat import INTEGRATORS
 from dem.network.linsolve import BACKENDS
 from dem.engines.static import PHYSICS_NAMES as PHYSICS, check_physics

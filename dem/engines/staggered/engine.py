@@ -31,6 +31,7 @@ import math
 import numpy as np
 
 from dem.geometry.motion import MotionState
+from dem.geometry.walls import box_axes
 from dem.engines.contact_current import ContactCurrent
 from dem.engines.staggered.heat import LumpedHeat
 from dem.engines.staggered.mechanics import ZohdiMechanics
@@ -177,15 +178,15 @@ class ZohdiSimulation:
         """``(area, (lo, hi) per lateral axis)`` of the box the walls perpendicular to ``axis`` enclose, or None."""
         mech = self.mechanics
         area, spans = 1.0, []
+        box = box_axes(mech.walls)
         for a in range(3):
             if a == axis:
                 continue
-            lo = [k for k, wall in enumerate(mech.walls) if abs(wall.normal[a] - 1.0) < 1e-12]
-            hi = [k for k, wall in enumerate(mech.walls) if abs(wall.normal[a] + 1.0) < 1e-12]
-            if len(lo) != 1 or len(hi) != 1:
+            if a not in box:
                 return None
-            spans.append((a, mech.w.q[lo[0]], -mech.w.q[hi[0]]))
-            area *= mech.w.extent(lo[0], hi[0])
+            lo, hi = box[a]
+            spans.append((a, mech.w.q[lo], -mech.w.q[hi]))
+            area *= mech.w.extent(lo, hi)
         return area, spans
 
     def bed(self) -> dict:

@@ -28,6 +28,7 @@ from dataclasses import replace
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.motion import MotionState
+from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
 from dem.network.heat import boundary_heat_flow, steady
 from fem_neck.geometry import neck_radius
@@ -177,15 +178,14 @@ class Simulation:
         s, w = mech.state, mech.w
         axes = (0, 2) if s.dimension == 2 else (0, 1, 2)
         volume = s.height if s.dimension == 2 else 1.0
+        box = box_axes(mech.walls)
         for a in axes:
             if mech.box[a] > 0:
                 volume *= mech.box[a]
                 continue
-            lo = [k for k, wall in enumerate(mech.walls) if abs(wall.normal[a] - 1.0) < 1e-12]
-            hi = [k for k, wall in enumerate(mech.walls) if abs(wall.normal[a] + 1.0) < 1e-12]
-            if len(lo) != 1 or len(hi) != 1:
+            if a not in box:
                 return None
-            volume *= w.extent(lo[0], hi[0])
+            volume *= w.extent(*box[a])
         return volume
 
     def volume_fraction(self) -> float | None:
