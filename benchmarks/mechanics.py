@@ -134,14 +134,14 @@ def biaxial_sample(sizes: Sizes, cache: pathlib.Path, seed: int = 1) -> dict:
     if path.exists():
         with np.load(path) as data:
             return {**{k: data[k] for k in data.files}, "seconds": 0.0}
-    from dem.engines.verlet.engine import Simulation
+    from dem.engines.verlet.engine import VerletEngine
 
     a0, w0 = 1e-3, 0.5  # Table 1: mean radius, relative width of the uniform distribution
     side = math.sqrt(sizes.disks * math.pi * a0**2 * (1.0 + w0**2 / 3.0) / 0.35)
     generator = {"kind": "box", "n": sizes.disks, "radius": a0, "radius_spread": w0, "seed": seed,
                  "box": [[0.0, 0.0, 0.0], [side, 0.0, side]], "temperature": T_RUN}
     t0 = time.perf_counter()
-    sim = Simulation(_scene(replace(LUDING_TABLE1, mu=0.0), 2, generator, _biaxial_walls(-side, -side),
+    sim = VerletEngine(_scene(replace(LUDING_TABLE1, mu=0.0), 2, generator, _biaxial_walls(-side, -side),
                             sizes.compaction_time))
     sim.run()
     mech = sim.mechanics
@@ -213,17 +213,17 @@ def _at_rest(sample: dict) -> dict:
 
 def biaxial_simulation(sample: dict, material: LudingMaterial):
     """The engine on the compacted 2D sample, at rest, with ``material`` and the stress walls."""
-    from dem.engines.verlet.engine import Simulation
+    from dem.engines.verlet.engine import VerletEngine
 
     walls = _biaxial_walls(float(sample["q_right"]), float(sample["q_top"]))
-    return Simulation(_scene(material, 2, _at_rest(sample), walls))
+    return VerletEngine(_scene(material, 2, _at_rest(sample), walls))
 
 
 def periodic_simulation(sample: dict, material: LudingMaterial):
     """The engine on the 3D packing, at rest, with ``material``, periodic on every axis."""
-    from dem.engines.verlet.engine import Simulation
+    from dem.engines.verlet.engine import VerletEngine
 
-    return Simulation(_scene(material, 3, _at_rest(sample), box=sample["box"]))
+    return VerletEngine(_scene(material, 3, _at_rest(sample), box=sample["box"]))
 
 
 def time_ours(make, steps: int, warmup: int) -> dict:
@@ -601,7 +601,7 @@ t = time.perf_counter()
 import numpy as np
 from dem.laws.contact import luding as law
 from dem.laws.contact import luding
-from dem.engines.verlet.engine import Simulation
+from dem.engines.verlet.engine import VerletEngine
 from dem.scene import parse_scene
 imported = time.perf_counter()
 p = luding.LUDING_TABLE1.params()
@@ -621,7 +621,7 @@ doc = {"scene": {"physics": ["mechanical"]}, "material": {"density": 2000.0},
        "contact": {"law": "luding", **contact}, "walls": [{"name": "floor", "point": [0, 0, -1e-3],
                                                           "normal": [0, 0, 1]}],
        "solver": {"mode": "transient", "t_end": 1e-6}}
-sim = Simulation(parse_scene(doc))
+sim = VerletEngine(parse_scene(doc))
 sim.mechanics.advance(1, np.array([80.0]), np.zeros(1))
 engine = time.perf_counter()
 print(json.dumps({"import": imported - t, "kernels": kernels - imported, "engine": engine - kernels}))

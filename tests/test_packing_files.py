@@ -214,7 +214,7 @@ def test_csv_vtu_and_a_runs_vtu_give_the_same_particles_and_conductivity(tmp_pat
         "[particles]", 'file = "paraview.csv"', "temperature = 0.0", "[periodic]",
         f"lengths = {lengths}", f"origin = {origin}", "drop = [0.0, 0.0, 1.0]", "[solver]", 'mode = "steady"']))
     result = run(load_scene(doc), out=tmp_path / "run")
-    written = read_packing(tmp_path / "run" / "particles_00000.vtu")  # with the file's ids and the temperatures
+    written = read_packing(tmp_path / "run" / "particles_000000000.vtu")  # with the file's ids and the temperatures
     same_particles(packing, written, lengths=np.array(lengths))
     np.testing.assert_allclose(written.temperature, result.T, rtol=1e-15)
 
@@ -270,7 +270,7 @@ def test_ids_are_kept_through_scenes_and_outputs(tmp_path):
     res = run(s, out=tmp_path / "static")
     assert res.T[1] == pytest.approx(100.0)  # the free particle takes the fixed one's temperature
     assert list(res.summary["boundary_heat_flow"]["particles"]) == ["7"]  # fixed particles by id
-    vtu = meshio.read(tmp_path / "static" / "particles_00000.vtu")
+    vtu = meshio.read(tmp_path / "static" / "particles_000000000.vtu")
     np.testing.assert_array_equal(vtu.point_data["id"], [7, 3])
     doc = moving_doc({"file": str(csv), "temperature": 20.0}, t_end=1e-4)
     with pytest.raises(ValueError, match=r"particle id 7 has density 8960 .* its material 'material0' 2000"):

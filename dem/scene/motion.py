@@ -46,7 +46,7 @@ MOVING_KEYS = {
     "output": {"interval", "vtu_interval", *zscene.OUTPUT_KEYS},
 }
 MOVING_TABLES = {"gravity": {"acceleration"}, "temperature": {"time", "value", "relaxation_time"},
-                 "start": {"state"}, "phases": {"start", "wall_velocity", *("mu", "mu_wall", "gamma_n", "gamma_t")},
+                 "phases": {"start", "wall_velocity", *("mu", "mu_wall", "gamma_n", "gamma_t")},
                  "electrical": zscene.ELECTRICAL_KEYS}
 @dataclass(frozen=True)
 class MotionSpec:

@@ -24,10 +24,9 @@ from dem.scene.zohdi import ElectricalSpec, parse_electrical
 from dem.geometry.particles import COPPER, Material, Particles, material_indices
 from dem.geometry.periodic import AXES, PeriodicBox
 from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources
-from dem.geometry.walls import Wall
+from dem.geometry.walls import Wall, axis_of, box_axes, extent
 from dem.network.heat import INTEGRATORS
 from dem.network.linsolve import BACKENDS
-from dem.engines.static import PHYSICS_NAMES as PHYSICS, check_physics
 from dem.scene.motion import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
 
 SCENE_DIR = pathlib.Path(__file__).with_name("builtin")
@@ -43,6 +42,7 @@ ALLOWED = {
                   "structure", "temperature", "boundary", "hot", "cold", "heat", "box", "speed"},
     "periodic": {"lengths", "axes", "origin", "drop"},
     "walls": {"name", "point", "normal", "temperature"},
+    "start": {"state"},
     "conductance": {"law", "slope", "fit_file", "neck", "contact_conductance", "out_of_range", "unequal"},
     "convection": {"h", "T_inf", "area_fraction"},
     "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
@@ -131,6 +131,7 @@ class Specimen:
     cold: float
     hot_particles: tuple = ()
     periodic: bool = False
+    hot_wall: str = "hot"  # the name of the wall the heat enters through
 
 
 @dataclass(frozen=True)
@@ -152,6 +153,29 @@ class Scene:
     motion: MotionSpec | None = None  # particles that move ([scene] physics with "mechanical"), else None
     electrical: ElectricalSpec | None = None  # the current's scheme and electrodes ("electrical" physics)
     box: PeriodicBox | None = None  # a periodic box (dem.geometry.periodic), else None
+    engine: str = "static"  # the engine that runs it (dem.engines)
+    start: dict | None = None  # the saved state it starts from (dem.scene.state_file.load), else None
+
+    @property
+    def start_time(self) -> float:
+        """The time the run starts at: the saved state's, or 0."""
+        return 0.0 if self.start is None else self.start["t"]
+
+
+PHYSICS = ("thermal", "mechanical", "electrical")  # the submodels a scene can name ([scene] physics)
+
+
+def check_physics(names) -> None:
+    """Every name a submodel that exists (:data:`PHYSICS`); ``electrical`` runs with moving particles."""
+    for name in names:
+        if name not in PHYSICS:
+            raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(PHYSICS)})")
+    if not names:
+        raise ValueError(f"[scene] physics: names no submodel (available: {', '.join(PHYSICS)})")
+    if "electrical" in names and "mechanical" not in names:
+        raise ValueError("[scene] physics: \"electrical\" runs with moving particles: [\"mechanical\", \"thermal\", "
+                         "\"electrical\"] with [contact] law = \"zohdi\" (the current on a static packing: "
+                         "dem.network.current.kirchhoff)")
 
 
 def _is_number(v) -> bool:
@@ -332,7 +356,9 @@ def _periodic_box(t: dict, file_box: PeriodicBox | None = None) -> PeriodicBox:
         raise ValueError(f"[periodic] {exc}") from None
 
 
-def _walls(doc) -> tuple:
+def _walls(doc, start: dict | None = None) -> tuple:
+    """The isothermal walls of a static scene; a wall named like a wall of the saved state ``start`` stands where
+    that one stood."""
     tables = doc.get("walls", [])
     if not isinstance(tables, list):
         raise ValueError("[[walls]]: must be an array of tables")
@@ -347,7 +373,38 @@ def _walls(doc) -> tuple:
     names = [w.name for w in out]
     if len(set(names)) != len(names):
         raise ValueError(f"[[walls]] name: names must be unique, got {names}")
+    if start is not None and start["moving"]:
+        saved = dict(zip(start["wall_names"], start["wall_q"]))
+        out = [w.at(float(saved[w.name])) if w.name in saved else w for w in out]
     return tuple(out)
+
+
+def _specimen_between(walls, start: dict, particles) -> Specimen | None:
+    """The specimen of a static scene started from a saved state (its effective conductivity, ``k_eff = Q L / (A
+    dT)``): between the only two walls that carry a temperature, facing each other along an axis; its cross-section
+    from the saved state's walls along the other axes, else from the particles' extent along them."""
+    heated = [w for w in walls if w.temperature is not None]
+    if len(heated) != 2 or heated[0].temperature == heated[1].temperature:
+        return None
+    hot, cold = sorted(heated, key=lambda w: -w.temperature)
+    axis = axis_of(hot.normal)
+    if axis is None or not np.allclose(hot.normal, -cold.normal, atol=1e-12):
+        return None
+    length = -(hot.offset + cold.offset)
+    saved = [Wall(name, normal * q, normal) for name, normal, q in
+             zip(start["wall_names"], start["wall_normal"], start["wall_q"])] \
+        if start["moving"] and np.any(start["wall_normal"]) else []
+    box = box_axes(saved)
+    area = 1.0
+    for a in range(3):
+        if a == axis:
+            continue
+        if a in box:
+            area *= extent(np.array([w.offset for w in saved]), *box[a])
+        else:
+            x, r = particles.position[:, a], particles.radius
+            area *= float(np.max(x + r) - np.min(x - r))
+    return Specimen(length, area, hot.temperature, cold.temperature, hot_wall=hot.name)
 
 
 def _spec(cls, table, section, numeric=(), integer=(), words=()):
@@ -426,8 +483,12 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         name = full["start"].get("state") if isinstance(full["start"], dict) else None
         if not isinstance(name, str):
             raise ValueError("[start] state: required, the path of a saved state (.npz)")
+        _check_keys(full["start"], "start", ALLOWED["start"])
         start = state_file.load(base_dir / name if base_dir is not None else name)
-        particles = Particles.from_arrays(start["x"], start["radius"], start["T"], materials,
+        material = start.get("material")
+        if material is not None and int(np.max(material, initial=0)) >= len(materials):
+            material = None  # the state's materials are not this scene's: the scene's first, as for [particles]
+        particles = Particles.from_arrays(start["x"], start["radius"], start["T"], materials, material,
                                           prefix="[start] state", id=start.get("id"))
         walls, specimen, velocity, box = (), None, None, None
     elif ("particles" in doc) == ("generator" in doc):
@@ -449,7 +510,9 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
                          "periodic boxes are for static packings so far (the neighbour list of moving particles does "
                          "not use dem.geometry.periodic yet)")
     if not moving:
-        walls = walls + _walls(doc)
+        walls = walls + _walls(doc, start)
+        if specimen is None and start is not None:
+            specimen = _specimen_between(walls, start, particles)
     cond = dict(doc.get("conductance", {}))
     if "fit_file" in cond and not isinstance(cond["fit_file"], str):
         raise ValueError(f"[conductance] fit_file = {cond['fit_file']!r}: must be a path (string)")
@@ -470,9 +533,13 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     contact = contact_material_from_scene(doc) if "contact" in doc else None
     motion = parse_motion(full, particles, solver, physics, contact, velocity, start) if moving else None
     electrical = parse_electrical(full, motion.walls if moving else (), physics)
+    if start is not None and solver.mode == "transient" and solver.t_end <= start["t"]:
+        raise ValueError(f"[solver] t_end = {solver.t_end:g} s: must be beyond the saved state's time "
+                         f"{start['t']:.6g} s (the run's clock goes on from the state's)")
+    engine = "static" if not moving else ("staggered" if contact.law == "zohdi" else "verlet")
     return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
                  str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact, motion,
-                 electrical, box)
+                 electrical, box, engine, start)
 
 
 def contact_material_from_scene(doc: dict):

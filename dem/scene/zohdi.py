@@ -219,8 +219,7 @@ def zohdi_motion(doc: dict, particles, solver, physics, start, walls, gravity, v
 
     if dimension != 3:
         raise ValueError("[scene] dimension: law = \"zohdi\" moves spheres (dimension = 3)")
-    for table, why in (("temperature", "the temperatures come from the thermal submodel or stay at the initial ones"),
-                       ("start", "saved states are those of the Luding engine")):
+    for table, why in (("temperature", "the temperatures come from the thermal submodel or stay at the initial ones"),):
         if table in doc:
             raise ValueError(f"[{table}]: not with law = \"zohdi\" ({why})")
     if any(p[1] for p in phases):
