@@ -343,8 +343,9 @@ def schedule_seconds(n: int = 300, p: float = 100.0, t_s: float = 1.0, seed: int
     t0 = time.perf_counter()
     sim = VerletEngine(parse_scene(schedule_doc(n, p, t_s, seed=seed), "schedule"))
     t1 = time.perf_counter()
-    summary = sim.run()
+    sim.run()
     t2 = time.perf_counter()
+    summary = sim.summary()
     steps = sim.mechanics.steps
     return {"n": n, "p": p, "t_s": t_s, "seconds": t2 - t0, "loop_seconds": t2 - t1, "steps": steps,
             "ns_per_particle_step": 1e9 * (t2 - t1) / (steps * n), "volume_fraction": summary["volume_fraction"],
