@@ -52,7 +52,7 @@ def section7_row() -> dict:
     start = time.perf_counter()
     sim = StaggeredEngine(scene)
     built = time.perf_counter()
-    sim.run(observer=lambda s: rows.append(s.record()))
+    sim.run(lambda: rows.append(sim.record()))
     seconds = time.perf_counter() - start
     n = sim.mechanics.state.n
     contact = next(r for r in rows if (r.get("joule_heat") or 0.0) > 1.0)  # the wall reaches the powder
