@@ -481,6 +481,15 @@ def memory_estimate(elements: float, order: int) -> float:
     return BASE_BYTES + BYTES_PER_ELEMENT[order] * elements
 
 
+def peak_memory() -> float:
+    """Peak resident bytes of this process plus the largest of its finished children (the lower-bound solves): at
+    least what the run held at any one time."""
+    import resource
+
+    kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss + resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return kib * 1024.0
+
+
 def available_memory() -> float:
     """Bytes the machine can still give (``MemAvailable``), or all of its memory where that is unknown."""
     try:

@@ -22,7 +22,8 @@ class TwoLevel:
         self.P = P.tocsr()
         self.PT = self.P.T.tocsr()
         coarse = (self.PT @ A @ self.P).tocsr()
-        self.amg = pyamg.smoothed_aggregation_solver(coarse, symmetry="symmetric", max_coarse=500)
+        self.amg = pyamg.smoothed_aggregation_solver(coarse, symmetry="symmetric", max_coarse=500).aspreconditioner(
+            cycle="V")
         if blocks is None:
             self.blocks = None
             self.inv_diag = 1.0 / A.diagonal()
@@ -36,18 +37,21 @@ class TwoLevel:
             self.inverses = np.linalg.inv(sub)
             self.mask = mask
             self.idx = idx
+            self.covered = blocks[mask]
+            if len(np.unique(self.covered)) != len(self.covered):
+                raise ValueError("blocks: a dof belongs to two blocks")
             covered = np.zeros(A.shape[0], dtype=bool)
-            covered[blocks[mask]] = True
+            covered[self.covered] = True
             self.rest = np.flatnonzero(~covered)
             self.inv_diag_rest = 1.0 / A.diagonal()[self.rest]
 
     def __call__(self, r: np.ndarray) -> np.ndarray:
-        z = self.P @ self.amg.solve(self.PT @ r, maxiter=1, cycle="V", tol=1e-30)
+        z = self.P @ self.amg(self.PT @ r)
         if self.blocks is None:
             return z + self.inv_diag * r
         local = np.where(self.mask, r[self.idx], 0.0)
-        corr = np.einsum("bij,bj->bi", self.inverses, local)
-        np.add.at(z, self.idx[self.mask], corr[self.mask])
+        corr = np.matmul(self.inverses, local[:, :, None])[:, :, 0]
+        z[self.covered] += corr[self.mask]  # the blocks do not overlap
         z[self.rest] += self.inv_diag_rest * r[self.rest]
         return z
 

@@ -55,6 +55,8 @@ def ngsolve_cell(cell, order: int, maxh: float = 0.5, hp_levels: int | None = No
         elif abs(z - box[2]) < 1e-7:
             face.name = "cold"
     for edge in shape.edges:  # the neck circles: all their points at distance a from a bond axis, at a neck end
+        if edge.mass < 1e-9:  # a degenerate edge (a sphere's pole) has no curve to evaluate
+            continue
         lo, hi = edge.parameter_interval
         pts = np.array([[q.x, q.y, q.z] for q in (edge.Value(lo + t * (hi - lo)) for t in (0.1, 0.5, 0.9))])
         for b in range(len(bi)):

@@ -72,7 +72,8 @@ def run(args) -> dict:
     if args.out:
         path = pathlib.Path(args.out)
         path.mkdir(parents=True, exist_ok=True)
-        (path / "lattice.json").write_text(json.dumps({**out, "levels": res.levels}, indent=2) + "\n")
+        (path / "lattice.json").write_text(json.dumps({**out, "peak_memory_gb": lattice.peak_memory() / 1e9,
+                                                       "levels": res.levels}, indent=2) + "\n")
         lattice.write_vtu(res, path / "cell.vtu")
         out["out"] = str(path)
     return out
