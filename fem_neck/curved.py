@@ -165,12 +165,16 @@ class CurvedMesh:
     face_projector: np.ndarray
 
     @property
-    def curved(self) -> np.ndarray:
-        return np.flatnonzero(np.any(self.edge_projector >= 0, axis=1))
+    def is_curved(self) -> np.ndarray:
+        return np.any(self.edge_projector >= 0, axis=1)
 
-    def affine_jacobians(self) -> np.ndarray:
-        """``J (M, 3, 3)`` of the straight elements (columns ``v_i - v_0``)."""
-        v = self.points[self.tets]
+    @property
+    def curved(self) -> np.ndarray:
+        return np.flatnonzero(self.is_curved)
+
+    def affine_jacobians(self, elements: np.ndarray | None = None) -> np.ndarray:
+        """``J (E, 3, 3)`` of the straight ``elements`` (default all; columns ``v_i - v_0``)."""
+        v = self.points[self.tets if elements is None else self.tets[elements]]
         return np.transpose(v[:, 1:] - v[:, :1], (0, 2, 1))
 
     def map(self, elements: np.ndarray, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

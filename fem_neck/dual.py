@@ -23,24 +23,21 @@ from fem_neck.curved import CurvedMesh
 from fem_neck.primal import quadrature_degree, symmetric_products
 from fem_neck.simplex import RaviartThomas, raviart_thomas, tet_quadrature
 
-CHUNK = 512
+CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arrays)
 
 
-def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int) -> np.ndarray:
-    """Element flux mass matrices ``(M, m, m)``: ``int sigma^T J^T J tau / |det J|`` on the reference element (exact
-    on straight elements, quadrature of ``degree`` on curved ones)."""
-    J = mesh.affine_jacobians()
-    det = np.linalg.det(J)
-    G = np.einsum("eai,eaj->eij", J, J) / np.abs(det)[:, None, None]
+def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np.ndarray) -> np.ndarray:
+    """Flux mass matrices ``(E, m, m)`` of ``elements``: ``int sigma^T J^T J tau / |det J|`` on the reference element
+    (exact on straight elements, quadrature of ``degree`` on curved ones)."""
+    J = mesh.affine_jacobians(elements)
+    G = np.einsum("eai,eaj->eij", J, J) / np.abs(np.linalg.det(J))[:, None, None]
     A = np.einsum("eij,ijab->eab", G, rt.mass)
-    curved = mesh.curved
+    curved = np.flatnonzero(mesh.is_curved[elements])
     if len(curved):
         xi, w = tet_quadrature(degree)
         products = symmetric_products(rt.values(xi))                          # (6 Q, m m)
-        for start in range(0, len(curved), CHUNK):
-            el = curved[start:start + CHUNK]
-            G = mesh.metric(el, xi, w, inverse=False).reshape(len(el), -1)
-            A[el] = (G @ products).reshape(len(el), rt.m, rt.m)
+        G = mesh.metric(elements[curved], xi, w, inverse=False).reshape(len(curved), -1)
+        A[curved] = (G @ products).reshape(len(curved), rt.m, rt.m)
     return A
 
 
@@ -48,7 +45,7 @@ def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int) -> np.ndarra
 class Solution:
     """``lower = P^2 / E*`` (the lower bound of the conductance for a unit temperature difference, kappa = 1), the
     heat flow ``P`` through the hot faces, ``E*``, face dofs, CG iterations, the relative residual and the largest
-    normal-flux jump across a face relative to the mean flux density through the hot face."""
+    normal-flux jump across a face relative to the mean flux per hot face."""
 
     lower: float
     heat_flow: float
@@ -62,39 +59,37 @@ class Solution:
 def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, rtol: float = 1e-10,
           degree: int | None = None) -> Solution:
     """The hybridised ``RT_k`` flux with temperature 1 on the ``hot`` faces and 0 on the ``cold`` ones (indices
-    into ``mesh.faces``); see the module docstring."""
+    into ``mesh.faces``; quadrature of ``degree`` on curved elements); see the module docstring. The element fluxes
+    are eliminated chunk by chunk (``H_K = T A_K^-1 T^T``); the net flux moments of the faces are the face system's
+    ``-H lambda``: its residual on the free faces (the normal-flux jumps) and the heat flow on the hot ones."""
     import scipy.sparse as sp
 
     from fem_neck import pcg
 
     rt = raviart_thomas(k)
     nf = rt.n_face
-    A = mass_matrices(mesh, rt, degree or quadrature_degree(k + 1))
     T = rt.traces                                                           # (4 nf, m)
-    Ainv_Tt = np.linalg.solve(A, np.broadcast_to(T.T, A.shape[:1] + T.T.shape))  # A^-1 T^T (M, m, 4 nf)
-    H = np.matmul(T, Ainv_Tt)                                               # (M, 4 nf, 4 nf)
     l2g = (mesh.t2f[:, :, None] * nf + np.arange(nf)).reshape(len(mesh.tets), -1)
-    n = len(mesh.faces) * nf
     constant = 1.0 / rt.face_basis(np.zeros((1, 2)))[0, 0]                # coefficient of the function 1
     fixed_face = np.zeros(len(mesh.faces), dtype=bool)
     fixed_face[hot] = fixed_face[cold] = True
     fixed = np.repeat(fixed_face, nf)
-    lam = np.zeros(n)
+    lam = np.zeros(len(mesh.faces) * nf)
     lam[hot * nf] = constant
-    Hff, b, free = pcg.assemble(H, l2g, fixed, lam)
+    system = pcg.Assembly(l2g, fixed, lam)
+    for start in range(0, len(mesh.tets), CHUNK):
+        elements = np.arange(start, min(start + CHUNK, len(mesh.tets)))
+        A = mass_matrices(mesh, rt, degree or quadrature_degree(k + 1), elements)
+        system.add(np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape))), elements)
+    H = system.matrix()
     free_faces = np.flatnonzero(~fixed_face)
     coarse = sp.csr_matrix((np.ones(len(free_faces)), (np.arange(len(free_faces)) * nf, np.arange(len(free_faces)))),
-                           shape=(len(free), len(free_faces)))
-    blocks = np.arange(len(free)).reshape(-1, nf)
-    x, iterations, residual = pcg.solve(Hff, b, pcg.two_level(Hff, coarse, blocks), rtol=rtol)
-    lam[free] = x
-    # element fluxes (coefficients of the divergence-free basis) and their face moments
-    alpha = -np.einsum("emf,ef->em", Ainv_Tt, lam[l2g])
-    moments = np.einsum("fm,em->ef", T, alpha).reshape(len(mesh.tets), 4, nf)
-    energy = pcg.element_energy(H, l2g, lam)                               # = sum alpha^T A alpha
-    net = np.zeros((len(mesh.faces), nf))
-    np.add.at(net, mesh.t2f, moments)
-    heat = -float(net[hot, 0].sum()) * constant                              # into the solid at the hot faces
-    per_face = abs(heat) / max(len(hot), 1)
-    defect = float(np.max(np.abs(net[free_faces])) * constant / per_face) if len(free_faces) else 0.0
-    return Solution(heat**2 / energy, heat, energy, len(free), iterations, residual, defect)
+                           shape=(len(system.free), len(free_faces)))
+    blocks = np.arange(len(system.free)).reshape(-1, nf)
+    x, iterations, residual = pcg.solve(H, system.b, pcg.two_level(H, coarse, blocks), rtol=rtol)
+    lam[system.free] = x
+    energy = system.energy(H, x)                                            # = sum alpha^T A alpha
+    heat = float(np.sum(system.boundary_rows(lam)[hot * nf])) * constant    # into the solid at the hot faces
+    jumps = np.abs(H @ x - system.b) * constant
+    defect = float(jumps.max() / (abs(heat) / max(len(hot), 1))) if len(jumps) else 0.0
+    return Solution(heat**2 / energy, heat, energy, len(system.free), iterations, residual, defect)

@@ -65,7 +65,7 @@ SIZE_NECK0, SIZE_FAR, GRADING = 0.05, 0.5, 0.8
 # size_neck^-ELEMENT_ORDER (:func:`effective_conductivity`)
 GAP_ORDER, ELEMENT_ORDER = 1.25, 1.0
 # peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured)
-BASE_BYTES, BYTES_PER_ELEMENT = 0.6e9, {2: 20e3, 3: 40e3, 4: 80e3}
+BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 70e3}
 _TOL = 1e-9  # geometric tolerance in units of the largest radius
 
 

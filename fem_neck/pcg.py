@@ -68,31 +68,65 @@ def entries(A, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     return np.where(keys[pos] == want, A.data[pos], 0.0)
 
 
-def assemble(K: np.ndarray, l2g: np.ndarray, fixed: np.ndarray, values: np.ndarray):
-    """The system of the free unknowns from element matrices ``K (E, n, n)`` on the global dofs ``l2g (E, n)``,
-    with the dofs marked ``fixed`` held at ``values``: ``(A_ff (CSR), b, free)`` so that ``A_ff x = b`` gives the
-    free values ``x`` (``free``: their global indices). Only the free block is ever built."""
-    import scipy.sparse as sp
+class Assembly:
+    """The system of the free unknowns, assembled chunk by chunk from element matrices on the global dofs ``l2g (E,
+    n)``, the dofs marked ``fixed`` held at ``values``. Only the free block is stored (COO with 32-bit indices,
+    allocated once, then CSR); the element matrices of a chunk can be dropped after :meth:`add`, except those of
+    elements with a fixed dof, kept for :meth:`boundary_rows`. ``A_ff x = b`` gives the free values; :meth:`energy`
+    is ``u^T A u`` of the full vector exactly, whatever ``x``."""
 
-    free = np.flatnonzero(~fixed)
-    index = np.full(len(fixed), -1, dtype=np.int32)
-    index[free] = np.arange(len(free), dtype=np.int32)
-    loc = index[l2g]                                                           # (E, n), -1 on fixed dofs
-    known = np.where(fixed[l2g], values[l2g], 0.0)
-    load = -np.einsum("eij,ej->ei", K, known)
-    on = loc >= 0
-    b = np.bincount(loc[on], load[on], minlength=len(free))
-    pair = on[:, :, None] & on[:, None, :]
-    rows = np.broadcast_to(loc[:, :, None], K.shape)[pair]
-    cols = np.broadcast_to(loc[:, None, :], K.shape)[pair]
-    A = sp.csr_matrix((K[pair], (rows, cols)), shape=(len(free), len(free)))
-    return A, b, free
+    def __init__(self, l2g: np.ndarray, fixed: np.ndarray, values: np.ndarray):
+        self.free = np.flatnonzero(~fixed)
+        index = np.full(len(fixed), -1, dtype=np.int32)
+        index[self.free] = np.arange(len(self.free), dtype=np.int32)
+        self.l2g, self.fixed, self.values = l2g, fixed, values
+        self.loc = index[l2g]                                                  # (E, n), -1 on fixed dofs
+        count = np.sum(self.loc >= 0, axis=1) ** 2
+        self.offset = np.concatenate([[0], np.cumsum(count)])
+        self.rows = np.empty(self.offset[-1], dtype=np.int32)
+        self.cols = np.empty(self.offset[-1], dtype=np.int32)
+        self.data = np.empty(self.offset[-1])
+        self.b = np.zeros(len(self.free))
+        self.constant = 0.0
+        self.touching = np.flatnonzero(np.any(fixed[l2g], axis=1))            # elements with a fixed dof
+        self.kept = {}
 
+    def add(self, K: np.ndarray, elements: np.ndarray) -> None:
+        loc = self.loc[elements]
+        known = np.where(self.fixed[self.l2g[elements]], self.values[self.l2g[elements]], 0.0)
+        load = -np.matmul(K, known[:, :, None])[:, :, 0]
+        on = loc >= 0
+        self.b += np.bincount(loc[on], load[on], minlength=len(self.free))
+        self.constant -= float(np.sum(known * load))
+        pair = on[:, :, None] & on[:, None, :]
+        span = slice(self.offset[elements[0]], self.offset[elements[-1] + 1])
+        self.rows[span] = np.broadcast_to(loc[:, :, None], K.shape)[pair]
+        self.cols[span] = np.broadcast_to(loc[:, None, :], K.shape)[pair]
+        self.data[span] = K[pair]
+        for k in np.flatnonzero(np.isin(elements, self.touching)):
+            self.kept[int(elements[k])] = K[k].copy()
 
-def element_energy(K: np.ndarray, l2g: np.ndarray, u: np.ndarray) -> float:
-    """``sum_K u_K^T K u_K``: the energy of the global vector ``u``."""
-    uK = u[l2g]
-    return float(np.einsum("ei,eij,ej->", uK, K, uK))
+    def matrix(self):
+        """``A_ff`` (CSR); frees the COO arrays."""
+        import scipy.sparse as sp
+
+        A = sp.csr_matrix((self.data, (self.rows, self.cols)), shape=(len(self.free), len(self.free)))
+        del self.rows, self.cols, self.data
+        return A
+
+    def energy(self, A, x: np.ndarray) -> float:
+        """``u^T A u`` of ``u`` = ``x`` on the free dofs, the fixed values elsewhere: ``x A_ff x - 2 x b + u_d A_dd
+        u_d`` (``A_fd u_d = -b``)."""
+        return float(x @ (A @ x) - 2.0 * (x @ self.b) + self.constant)
+
+    def boundary_rows(self, u: np.ndarray) -> np.ndarray:
+        """``(A u)`` at the fixed dofs (zero elsewhere), from the kept element matrices."""
+        out = np.zeros(len(self.fixed))
+        for e, K in self.kept.items():
+            dofs = self.l2g[e]
+            np.add.at(out, dofs, K @ u[dofs])
+        out[~self.fixed] = 0.0
+        return out
 
 
 def two_level(A, P, blocks: np.ndarray | None = None) -> TwoLevel:

@@ -17,7 +17,7 @@ import numpy as np
 from fem_neck.curved import CurvedMesh
 from fem_neck.simplex import Lagrange, lagrange, tet_quadrature
 
-CHUNK = 512  # elements per batch of curved element matrices (bounds the temporary arrays)
+CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arrays)
 
 
 def quadrature_degree(p: int) -> int:
@@ -26,27 +26,21 @@ def quadrature_degree(p: int) -> int:
     return 2 * p
 
 
-def element_jacobians(mesh: CurvedMesh) -> tuple[np.ndarray, np.ndarray]:
-    """``(J, det J)`` of the straight elements, ``(M, 3, 3)`` and ``(M,)``."""
-    J = mesh.affine_jacobians()
-    return J, np.linalg.det(J)
-
-
-def stiffness_matrices(mesh: CurvedMesh, basis: Lagrange, degree: int | None = None) -> np.ndarray:
-    """Element matrices ``(M, n, n)`` of ``int grad phi_a . grad phi_b``: exact on straight elements (a combination
-    of the reference matrices), quadrature of ``degree`` on the curved ones."""
-    J, det = element_jacobians(mesh)
+def stiffness_matrices(mesh: CurvedMesh, basis: Lagrange, degree: int | None = None,
+                       elements: np.ndarray | None = None) -> np.ndarray:
+    """Element matrices ``(E, n, n)`` of ``int grad phi_a . grad phi_b`` of ``elements`` (default all): exact on
+    straight elements (a combination of the reference matrices), quadrature of ``degree`` on the curved ones."""
+    elements = np.arange(len(mesh.tets)) if elements is None else elements
+    J = mesh.affine_jacobians(elements)
     inv = np.linalg.inv(J)
-    G = np.abs(det)[:, None, None] * np.einsum("eia,eja->eij", inv, inv)       # |det J| J^-1 J^-T
+    G = np.abs(np.linalg.det(J))[:, None, None] * np.einsum("eia,eja->eij", inv, inv)   # |det J| J^-1 J^-T
     K = np.einsum("eij,ijab->eab", G, basis.stiffness)
-    curved = mesh.curved
+    curved = np.flatnonzero(mesh.is_curved[elements])
     if len(curved):
         xi, w = tet_quadrature(degree or quadrature_degree(basis.p))
         products = symmetric_products(basis.gradients(xi))                     # (6 Q, n n)
-        for start in range(0, len(curved), CHUNK):
-            el = curved[start:start + CHUNK]
-            G = mesh.metric(el, xi, w, inverse=True).reshape(len(el), -1)
-            K[el] = (G @ products).reshape(len(el), basis.n, basis.n)
+        G = mesh.metric(elements[curved], xi, w, inverse=True).reshape(len(curved), -1)
+        K[curved] = (G @ products).reshape(len(curved), basis.n, basis.n)
     return K
 
 
@@ -63,8 +57,7 @@ def symmetric_products(g: np.ndarray) -> np.ndarray:
 
 def volume(mesh: CurvedMesh, degree: int = 10) -> float:
     """Volume of the mapped mesh (a check of the geometry against the exact solid)."""
-    _, det = element_jacobians(mesh)
-    vol = np.abs(det) / 6.0
+    vol = np.abs(np.linalg.det(mesh.affine_jacobians())) / 6.0
     curved = mesh.curved
     if len(curved):
         xi, w = tet_quadrature(degree)
@@ -130,24 +123,27 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, rtol: flo
     from fem_neck import pcg
 
     basis = lagrange(p)
-    K = stiffness_matrices(mesh, basis, degree)
     skel = basis.n - basis.n_interior
-    if basis.n_interior:
-        Kbb, Kbi, Kii = K[:, :skel, :skel], K[:, :skel, skel:], K[:, skel:, skel:]
-        K = Kbb - np.matmul(Kbi, np.linalg.solve(Kii, np.transpose(Kbi, (0, 2, 1))))
     num = numbering(mesh, basis)
     fixed = np.zeros(num.n, dtype=bool)
     values = np.zeros(num.n)
     hot_dofs = face_dofs(mesh, basis, hot)
     fixed[hot_dofs] = fixed[face_dofs(mesh, basis, cold)] = True
     values[hot_dofs] = 1.0
-    A, b, free = pcg.assemble(K, num.l2g, fixed, values)
-    P = hat_prolongation(mesh, basis, num)[free]
-    x, iterations, residual = pcg.solve(A, b, pcg.two_level(A, P), rtol=rtol)
+    system = pcg.Assembly(num.l2g, fixed, values)
+    for start in range(0, len(mesh.tets), CHUNK):
+        elements = np.arange(start, min(start + CHUNK, len(mesh.tets)))
+        K = stiffness_matrices(mesh, basis, degree, elements)
+        if basis.n_interior:  # condense the interior nodes
+            Kbb, Kbi, Kii = K[:, :skel, :skel], K[:, :skel, skel:], K[:, skel:, skel:]
+            K = Kbb - np.matmul(Kbi, np.linalg.solve(Kii, np.transpose(Kbi, (0, 2, 1))))
+        system.add(K, elements)
+    A = system.matrix()
+    P = hat_prolongation(mesh, basis, num)[system.free]
+    x, iterations, residual = pcg.solve(A, system.b, pcg.two_level(A, P), rtol=rtol)
     u = values.copy()
-    u[free] = x
-    return Solution(pcg.element_energy(K, num.l2g, u), u, num.n + basis.n_interior * len(mesh.tets), num.n,
-                    iterations, residual)
+    u[system.free] = x
+    return Solution(system.energy(A, x), u, num.n + basis.n_interior * len(mesh.tets), num.n, iterations, residual)
 
 
 def hat_prolongation(mesh: CurvedMesh, basis: Lagrange, num: Numbering):
