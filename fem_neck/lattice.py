@@ -58,9 +58,9 @@ COORDINATION = {"sc": 6, "bcc": 8, "fcc": 12}
 # smallest neck meshed: below it the neck is thinner than 1.3e-3 r and the mesh of its disk explodes; the network is
 # exact in the limit of small necks (independent constrictions), which the FE shows from here up
 MIN_NECK_RATIO = 0.05
-# the meshes: element size at the neck circles over the neck radius (first mesh), far size over the particle radius,
-# growth of the size per unit distance from the circles
-SIZE_NECK0, SIZE_FAR, GRADING = 0.05, 0.5, 0.8
+# the meshes: element size at the neck circles over the neck radius (of the first mesh at rtol = 1e-3, and the
+# range of first meshes), far size over the particle radius, growth of the size per unit distance from the circles
+SIZE_NECK0, FIRST_SIZES, SIZE_FAR, GRADING = 0.05, (0.01, 0.3), 0.5, 0.8
 # measured on the lattice cells: the gap falls like size_neck^GAP_ORDER, the tetrahedra grow like
 # size_neck^-ELEMENT_ORDER (:func:`effective_conductivity`)
 GAP_ORDER, ELEMENT_ORDER = 1.25, 1.0
@@ -506,7 +506,8 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
                            progress=None) -> CellResult:
     """``k_eff / kappa`` along z of the periodic ``cell`` with two-sided bounds (module docstring).
 
-    The first mesh has neck size :data:`SIZE_NECK0`; while the bounds are more than ``rtol`` apart it predicts the
+    The first mesh has neck size :data:`SIZE_NECK0` scaled to ``rtol`` (within :data:`FIRST_SIZES`); while the
+    bounds are more than ``rtol`` apart it predicts the
     neck size that meets ``rtol`` (the gap falls like ``size_neck^GAP_ORDER``, the tetrahedra grow like
     ``size_neck^-ELEMENT_ORDER``) and solves there, at most ``max_meshes`` meshes. Before each mesh the memory of
     its solve is estimated (:func:`memory_estimate`); one that would not fit in ``max_memory`` bytes (default: what
@@ -520,7 +521,7 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
         raise ValueError(f"order = {order!r}: must be one of {', '.join(map(str, BYTES_PER_ELEMENT))}")
     budget = available_memory() if max_memory is None else float(max_memory)
     t0 = time.perf_counter()
-    size = SIZE_NECK0
+    size = float(np.clip(SIZE_NECK0 * (rtol / 1e-3) ** (1.0 / GAP_ORDER), *FIRST_SIZES))
     history = []
     for _ in range(max_meshes):
         if progress is not None:
@@ -528,9 +529,12 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
         cm = build_cell_mesh(cell, **mesh_sizes(size))
         need = memory_estimate(len(cm.curved.tets), order)
         if need > budget:
+            # the first mesh's neck size that fits, and the rtol that starts there (tetrahedra ~ 1 / size)
+            fit = size * len(cm.curved.tets) * BYTES_PER_ELEMENT[order] / max(budget - BASE_BYTES, 1.0)
+            reach = 1e-3 * (fit / SIZE_NECK0) ** GAP_ORDER
             raise ValueError(f"{cell.name}: the mesh of neck size {size:.3g} a has {len(cm.curved.tets)} tetrahedra "
-                             f"and needs ~{need / 1e9:.1f} GB, more than the {budget / 1e9:.1f} GB available; use a "
-                             "larger rtol")
+                             f"and needs ~{need / 1e9:.1f} GB, more than the {budget / 1e9:.1f} GB available; "
+                             f"rtol = {reach:.1e} would fit")
         b = solve_bounds(cm, order, workers)
         history.append({"size_neck": size, "elements": b.elements, "k_upper": b.upper, "k_lower": b.lower,
                         "gap": b.gap, "seconds": time.perf_counter() - t0})

@@ -90,11 +90,11 @@ def test_finer_quadrature_moves_the_bounds_by_less_than_1e7():
 
 
 def test_effective_conductivity_refines_to_its_tolerance():
-    res = lattice.effective_conductivity(_chain_cell(0.2), rtol=1e-4, workers=1)
-    assert len(res.levels) >= 2 and res.levels[0]["gap"] > 1e-4  # the first mesh was too coarse
-    assert res.converged and res.error_estimate <= 1e-4
-    assert res.k_lower_over_kappa <= _chain_reference(0.2) <= res.k_eff_over_kappa == res.k_upper_over_kappa
-    assert res.phi == pytest.approx(4 / 3 * math.pi / (16 * 1.8), rel=1e-12)
+    res = lattice.effective_conductivity(_chain_cell(0.02), rtol=1e-3, workers=1)
+    assert len(res.levels) >= 2 and res.levels[0]["gap"] > 1e-3  # the first mesh was too coarse
+    assert res.converged and res.error_estimate <= 1e-3
+    assert res.k_lower_over_kappa <= _chain_reference(0.02) <= res.k_eff_over_kappa == res.k_upper_over_kappa
+    assert res.phi == pytest.approx(4 / 3 * math.pi / (16 * 1.98), rel=1e-12)
     assert res.k_eff_over_kappa < res.phi  # Wiener: no microstructure beats the parallel bound
 
 

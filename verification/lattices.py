@@ -41,9 +41,10 @@ RANDOM = ((1, 0.05), (2, 0.07), (3, 0.1))  # (seed, mean overlap h / r_min) of t
 RTOL, QUICK_RTOL = 3e-4, 1e-2  # gap of the FE bounds
 RANDOM_RTOL = 2e-3
 # k_eff / kappa of lattice cells from NGSolve (verification.ngsolve_cell: its own OCC geometry, mesh and hp refinement
-# toward the neck circles, H1 of order 6 curved to order 6), the independent references of the periodic-cell FE;
-# the last digit is where orders 5 and 6 differ. Rebuilt by `python -m verification.lattice_references`.
-REFERENCES = {("sc", 0.08): 0.3375952}
+# toward the neck circles, H1 of order p curved to order p, hp levels = p): the independent references of the
+# periodic-cell FE. Order 6 (orders 4, 5, 6 converge geometrically; the next digit is where 5 and 6 differ,
+# at most 3e-6 relative).
+REFERENCES = {("sc", 0.08): 0.3375947, ("sc", 0.02): 0.1714669, ("bcc", 0.08): 0.5280913}
 
 
 FE_MODULES = ("lattice", "curved", "primal", "dual", "pcg", "simplex")
