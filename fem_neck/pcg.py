@@ -1,11 +1,11 @@
-"""Sparse assembly of element matrices, and preconditioned conjugate gradients with a two-level additive Schwarz preconditioner (memory linear in the
-unknowns).
+"""Sparse assembly of element matrices (:class:`Assembly`), and conjugate gradients with a two-level additive
+Schwarz preconditioner (memory linear in the unknowns).
 
 ``M^-1 r = P (P^T A P)^-1 P^T r + D^-1 r``: a coarse space ``P`` (for high-order elements the piecewise-linear hats,
-for the hybridised fluxes the face means), whose Galerkin matrix is solved by one smoothed-aggregation AMG V-cycle
-(pyamg), plus block Jacobi on small groups of unknowns (``blocks``: one row of dof indices per group, -1 padded).
-The coarse space removes the low-frequency error, the blocks the high-order one within an edge, face or element
-(Toselli & Widlund 2005, Ch. 2; Pavarino 1994 for the p-version).
+for the hybridised fluxes the face means), whose Galerkin matrix gets one smoothed-aggregation AMG V-cycle (pyamg),
+plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (``blocks``: one row of dof indices per
+group, -1 padded; the moments of one face). The coarse space removes the low-frequency error, the local part the
+high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994 for the p-version).
 """
 
 from __future__ import annotations

@@ -240,6 +240,9 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
                                            **{f"rel_err_{law}": r["rel"][law] for law in names}}
     for law in names:
         summary[f"lattices worst |rel err| {law}"] = max(abs(r["rel"][law]) for r in rows)
+    random = [r["fe"]["error_estimate"] for r in rows if r["kind"] == "random"]
+    if random:
+        summary["random packings widest FE gap"] = max(random)
     summary["lattices above Wiener bound shared-body"] = sum(
         (1.0 + r["rel"]["shared-body"]) * r["fe"]["k"] > r["phi"] for r in rows)
     md = [__doc__.split("\n\n", 1)[1].strip(), "",
