@@ -56,6 +56,23 @@ class Surface:
         return np.abs(x @ self.axis - self.radius)
 
 
+def distinct(surfaces: list, tol: float) -> list:
+    """The surfaces without repeats: two collinear necks of one sphere (opposite bonds of a lattice) lie on one
+    cylinder, which must be one surface for the curves between its patches to be found."""
+    out = []
+    for s in surfaces:
+        if s.kind == CYLINDER:
+            same = [t for t in out if t.kind == CYLINDER and abs(t.radius - s.radius) < tol
+                    and np.linalg.norm(np.cross(t.axis, s.axis)) < tol
+                    and np.linalg.norm(np.cross(t.axis, s.centre - t.centre)) < tol]
+        else:
+            same = [t for t in out if t.kind == s.kind and abs(t.radius - s.radius) < tol
+                    and np.linalg.norm(t.centre - s.centre) < tol and np.linalg.norm(t.axis - s.axis) < tol]
+        if not same:
+            out.append(s)
+    return out
+
+
 def sphere(centre, radius) -> Surface:
     return Surface(SPHERE, np.asarray(centre, dtype=float), np.zeros(3), float(radius))
 

@@ -318,6 +318,7 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, gradi
     surfaces += [curved.cylinder(c, d, a) for c, d, a in zip(local.centres[bi], e, geo.a)]
     surfaces += [curved.plane(n, d) for n, d in halfspaces]
     tol = 1e-6
+    surfaces = curved.distinct(surfaces, tol)
     with gmsh_session() as gmsh:
         occ = gmsh.model.occ
         solids = [(3, occ.addSphere(*local.centres[k], local.radii[k])) for k in np.flatnonzero(use_sphere)]

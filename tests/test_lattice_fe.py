@@ -78,6 +78,18 @@ def test_mapped_mesh_fills_the_exact_solid():
         assert surface.distance(x[0]).max() < 1e-12
 
 
+def test_collinear_necks_share_one_cylinder():
+    # opposite bonds of a lattice put two necks of one sphere on one cylinder: one surface, so that the edges between
+    # its patches are surface edges (at BCC a/r = 0.52 the mesher splits the cylinder there)
+    from fem_neck import curved
+
+    a, b = curved.cylinder([0, 0, 0], [1, 1, 1], 0.5), curved.cylinder([-1, -1, -1], [-1, -1, -1], 0.5)
+    assert len(curved.distinct([a, b, curved.cylinder([0, 0, 0.1], [1, 1, 1], 0.5)], 1e-9)) == 2
+    cm = lattice.build_cell_mesh(lattice.lattice_cell("bcc", overlap_for_neck(1.0, 1.0, 0.52)),
+                                 **lattice.mesh_sizes(0.0155))
+    assert len(cm.curved.tets) > 0
+
+
 def test_finer_quadrature_moves_the_bounds_by_less_than_1e7():
     from fem_neck import dual, primal
 
