@@ -162,7 +162,8 @@ def _three_particles(st: Study):
                              f"{', '.join(pct(x) for x in d)})", _within(float(np.mean(d)), paper,
                                                                          max(0.3 * paper, 0.005)),
                              "±30 % of the paper's value or ±0.5 points",
-                             "our walls sinter too: with three particles the wall contacts are half the contacts"))
+                             "walls that keep the cold law, prepared for 0.5 s without wall friction "
+                             "(verification.sinter_protocol.control_doc); the isolating runs show walls that sinter"))
     return out
 
 

@@ -91,13 +91,13 @@ class Study:
                 "failure_stress": float(szz[k]), "failure_strain": float(eps[k]), "stiffness": stiffness,
                 "kinetic_over_work": float(np.max(s["kinetic_energy"][:k + 1]) / work[k]) if work[k] > 0 else math.nan}
 
-    def three(self, p) -> list[float]:
+    def three(self, p, variant: str = "", seeds=None) -> list[float]:
         """Densification nu(t_f)/nu(t_heat) - 1 of the three-particle controls (one per seed)."""
         out = []
-        times = Times(t_s=self.t_max)
-        for seed in self.grid.three_seeds:
-            s = self.series(self.task(sr.SCHEDULE, 3, p, self.t_max, seed))
-            out.append(float(s["volume_fraction"][-1] / at(s, times.t_heat)["volume_fraction"] - 1.0))
+        for seed in self.grid.three_seeds if seeds is None else seeds:
+            task = self.task(sr.SCHEDULE, 3, p, self.t_max, seed, variant)
+            s = self.series(task)
+            out.append(float(s["volume_fraction"][-1] / at(s, task.times.t_heat)["volume_fraction"] - 1.0))
         return out
 
 
