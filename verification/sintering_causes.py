@@ -8,7 +8,9 @@ Three mechanisms stand behind the statements that did not hold (:mod:`verificati
 2. *Cool-down* -- the protocol's cool-down against the same with the box held and without thermal contraction
    (delta a_T = 0), and :func:`contact_cooling`: one pair contact sintered under a force and cooled with its centres
    held, by the kernels of the law against the closed form of eqs. 4, 7, 9, 10, 13 and Fig. 5;
-3. *Microstructure numbers* -- the coordination number with the wall contacts counted beside the one without.
+3. *Microstructure numbers* -- the coordination number with the wall contacts counted, and of the particles
+   touching no wall, beside the one of the statements; the compression test of an unsintered sample carried on
+   to 15 % strain.
 
 :func:`section` writes the tables of these runs (the grid's ``isolation`` decides which ran) and their summary.
 """
@@ -27,7 +29,7 @@ from verification.sinter_protocol import T0_SINTER, T_PREPARE, T_SINTER
 from verification import sintering_runs as sr
 from verification.report import md_table
 from verification.sintering_statements import pct
-from verification.sintering_study import Missing, Study, at
+from verification.sintering_study import Missing, Study, at, bulk_coordination
 
 # ------------------------------------------------------------------------------------------------ one contact
 
@@ -221,16 +223,6 @@ def contact_table() -> tuple[str, dict]:
                      "f cold, held, δa_T = 0 (N)", "predicted (N)", "f cold, force held (N)"], rows), summary
 
 
-def bulk_coordination(a: dict, k: int = 0) -> tuple[float, int]:
-    """``(C, n)``: the mean number of pair contacts of the ``n`` particles of snapshot ``k`` of an ``analysis.npz``
-    (:func:`verification.sintering_runs.snapshot`) that touch no wall."""
-    x, r, i, j = a[f"snap{k}_x"], a[f"snap{k}_radius"], a[f"snap{k}_i"], a[f"snap{k}_j"]
-    gap = x @ a[f"snap{k}_wall_normal"].T - a[f"snap{k}_wall_q"][None, :]
-    bulk = ~np.any(gap < r[:, None], axis=1)
-    degree = np.bincount(i, minlength=len(r)) + np.bincount(j, minlength=len(r))
-    return float(np.mean(degree[bulk])), int(np.count_nonzero(bulk))
-
-
 def coordination_table(st: Study) -> tuple[str, dict]:
     rows, summary = [], {}
     for n in st.grid.n:
@@ -253,6 +245,25 @@ def coordination_table(st: Study) -> tuple[str, dict]:
                      "(2 M + M_w)/N", "C of the particles touching no wall (how many)"], rows), summary
 
 
+def failure_table(st: Study) -> tuple[str, dict]:
+    """The shortest-sintered sample at p = 100 compressed to 6 % (the test) and to 15 %: σ_zz in strain windows and
+    the failure (:func:`verification.sintering_study.failure`) of each."""
+    n, t_s = st.n_max, st.t_min
+    rows, summary = [], {}
+    windows = ((0.0, 0.02), (0.02, 0.06), (0.06, 0.15))
+    for variant, label in (("", "the test, to 6 %"), ("long", "to 15 %")):
+        c = st.compression(n, 100.0, t_s, variant)
+        eps, szz = c["eps"], c["szz"]
+        cells = []
+        for lo, hi in windows:
+            inside = (eps > lo) & (eps <= hi + 1e-9)
+            cells.append(f"{np.min(szz[inside]):.0f}-{np.max(szz[inside]):.0f}" if np.any(inside) else "—")
+        rows.append([label] + cells + [f"{c['failure_strain']:.4f}", f"{c['failure_stress']:.0f}"])
+        summary[variant or "test"] = {"failure_strain": c["failure_strain"], "failure_stress": c["failure_stress"]}
+    return md_table(["compression (N = %d, p = 100, t_s = %g)" % (n, t_s), "σ_zz for ε ≤ 0.02 (N/m)",
+                     "0.02 < ε ≤ 0.06", "0.06 < ε ≤ 0.15", "ε_f", "σ_f (N/m)"], rows), summary
+
+
 # ------------------------------------------------------------------------------------------------ the section
 def _part(build, st=None) -> tuple[str, dict]:
     try:
@@ -268,6 +279,7 @@ def section(st: Study) -> tuple[str, dict]:
     cool, cool_s = _part(cooling_table, st)
     contact, contact_s = _part(contact_table)
     coord, coord_s = _part(coordination_table, st)
+    fail, fail_s = _part(failure_table, st)
     md = [
         "**1. Preparation and densification.** Each preparation runs to t_heat = 0.2 s at 80 °C; the protocol's "
         "and the frictionless one then sinter for the longest t_s and cool down. ν in the first 10 ms after t_heat "
@@ -291,7 +303,11 @@ def section(st: Study) -> tuple[str, dict]:
         "**3. Coordination number.** C counts the pair contacts per particle (every particle, no wall contacts), after "
         "the longest sintering; beside it the count with each wall contact added once, and C of the particles that "
         "touch no wall.",
-        "", coord,
+        "", coord, "",
+        "*Failure strain.* The shortest-sintered sample at p = 100 in the compression test (ε̇_zz = 1/s) and in the "
+        "same test carried on to 15 %: σ_zz in three windows of strain, and the failure as the statements define it "
+        "(the largest σ_zz before it first falls below half of it).",
+        "", fail,
     ]
     return "\n".join(md), {"preparation": prep_s, "three_particles": three_s, "cooling": cool_s,
-                           "contact": contact_s, "coordination": coord_s}
+                           "contact": contact_s, "coordination": coord_s, "failure": fail_s}

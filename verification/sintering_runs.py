@@ -31,7 +31,7 @@ from dataclasses import asdict, dataclass, field, replace
 import numpy as np
 
 from dem.laws.contact.luding import LUDING_TABLE1, P_MU
-from verification.sinter_protocol import CONTROL_T_HEAT, Times
+from verification.sinter_protocol import CONTROL_T_HEAT, WALL_DAMPING, Times
 
 PREPARE, SINTER, COOL, COMPRESS, VIBRATE, SCHEDULE = "prepare", "sinter", "cool", "compress", "vibrate", "schedule"
 PREPARE3D, SINTER3D = "prepare3d", "sinter3d"
@@ -54,13 +54,12 @@ SINTER3D_TIME = 0.3
 CONDUCTIVITY3D, SPECIFIC_HEAT3D = 20.0, 10.0
 
 
-
 @dataclass(frozen=True)
 class Variant:
     """A change of the protocol (:mod:`verification.sinter_protocol`) that isolates one cause: ``prep`` keyword arguments of
     the preparation, ``material`` fields changed in every stage (``prep_material``: in the preparation only),
-    ``walls_held`` in the cool-down, ``t_heat`` of the three-particle control; ``cool_only``: the variant changes
-    the cool-down alone and starts from the protocol's sintered state."""
+    ``walls_held`` in the cool-down, ``t_heat`` of the three-particle control, ``strain`` of the compression test;
+    ``stage_only``: the variant changes its own stage alone and starts from the protocol's state."""
 
     label: str
     prep: dict = field(default_factory=dict)
@@ -68,14 +67,15 @@ class Variant:
     prep_material: dict = field(default_factory=dict)
     walls_held: bool = False
     t_heat: float | None = None
-    cool_only: bool = False
+    strain: float | None = None
+    stage_only: bool = False
 
 
 FRICTIONLESS = {"prep_mu": 0.0, "prep_mu_wall": 0.0}
 VARIANTS = {v.label: v for v in (
     Variant("frictionless", FRICTIONLESS),                                   # the paper's text (Sec. 4)
     Variant("frictionless-fast", {**FRICTIONLESS, "speed": 1.0}),            # random speeds 100x ours
-    Variant("frictionless-slow", {**FRICTIONLESS, "wall_damping": 10 * 0.2}),  # the walls come in 10x slower
+    Variant("frictionless-slow", {**FRICTIONLESS, "wall_damping": 10 * WALL_DAMPING}),  # walls 10x slower
     Variant("frictionless-cohesive", FRICTIONLESS, prep_material={"brittle_sliding": False}),  # Table 1's cohesion
     Variant("frictionless-wall-friction", {**FRICTIONLESS, "prep_mu_wall": LUDING_TABLE1.mu}),
     Variant("no-wall-friction", {"prep_mu_wall": 0.0}),                      # particles frictional, walls not
@@ -83,9 +83,10 @@ VARIANTS = {v.label: v for v in (
     Variant("short-prep", t_heat=0.2),                                       # the control prepared for 0.2 s only
     Variant("control-wall-friction", {"prep_mu_wall": LUDING_TABLE1.mu}),    # the control with the walls' friction
     Variant("no-expansion", material={"expansion": 0.0}),                    # delta a_T = 0 (Sec. 4.1.3)
-    Variant("held", walls_held=True, cool_only=True),                        # cool-down, the box held
-    Variant("cool-no-expansion", material={"expansion": 0.0}, cool_only=True),
-    Variant("held-no-expansion", material={"expansion": 0.0}, walls_held=True, cool_only=True),
+    Variant("held", walls_held=True, stage_only=True),                        # cool-down, the box held
+    Variant("cool-no-expansion", material={"expansion": 0.0}, stage_only=True),
+    Variant("held-no-expansion", material={"expansion": 0.0}, walls_held=True, stage_only=True),
+    Variant("long", strain=0.15, stage_only=True),                             # the compression test to 15 %
 )}
 
 
@@ -119,7 +120,7 @@ class Task:
         if kind is None:
             return None
         t_s = None if kind in (PREPARE, PREPARE3D) else self.t_s
-        variant = "" if self.variant and VARIANTS[self.variant].cool_only else self.variant
+        variant = "" if self.variant and VARIANTS[self.variant].stage_only else self.variant
         return Task(kind, self.n, self.p, t_s, self.seed, variant)
 
     @property
@@ -134,7 +135,8 @@ class Task:
     @property
     def cost(self) -> float:
         """Simulated time times particles: the order in which ready tasks start (longest first)."""
-        seconds = {PREPARE: 0.2, SINTER: 0.1 + (self.t_s or 0), COOL: 0.2, COMPRESS: COMPRESSION_STRAIN,
+        strain = VARIANTS[self.variant].strain if self.variant else None
+        seconds = {PREPARE: 0.2, SINTER: 0.1 + (self.t_s or 0), COOL: 0.2, COMPRESS: strain or COMPRESSION_STRAIN,
                    VIBRATE: 0.5 * VIBRATION["duration"], SCHEDULE: self.times.t_f, PREPARE3D: 0.4,
                    SINTER3D: 2.0 * SINTER3D_TIME}[self.kind]
         return seconds * self.n
@@ -157,10 +159,13 @@ class Grid:
     def isolating_tasks(self) -> list[Task]:
         """The runs that isolate the causes of the differences from the paper (:data:`VARIANTS`): the paper's
         frictionless preparation through sintering and cool-down, the three-particle control with walls that sinter,
-        and the cool-down of the longest-sintered sample with the box held and without thermal contraction
-        (``"quick"``: N max, p = 10 for the preparation, p = 100 for the cool-down, the first seed); ``"full"``
-        adds every other preparation (initial speeds, compression rate, cohesion, wall friction) for every N and p
-        with their densification at p = 10, the control prepared for 0.2 s only, and every seed and p."""
+        the cool-down of the longest-sintered sample with the box held and without thermal contraction, and the
+        compression test of the shortest-sintered sample at p = 100 carried to 15 % strain (``"quick"``: N max,
+        p = 10 for the preparation, p = 100 for the cool-down, the first seed); ``"full"``
+        adds every other preparation (initial speeds, compression rate, cohesion, wall friction) for every N at
+        p = 10, the densification of the frictionless one for every N and p and of those with friction on the
+        particles or on the walls only (N min, p = 10), the control prepared for 0.2 s only or with wall friction,
+        every seed and p."""
         if not self.isolation:
             return []
         n, t_max, full = max(self.n), max(self.t_s), self.isolation == "full"
@@ -168,13 +173,14 @@ class Grid:
         seeds = self.three_seeds if full else self.three_seeds[:1]
         out += [Task(SCHEDULE, 3, p, t_max, seed, "walls-sinter") for p in self.p for seed in seeds]
         out += [Task(COOL, n, 100.0, t_max, variant=v) for v in ("held", "cool-no-expansion", "held-no-expansion")]
+        out.append(Task(COMPRESS, n, 100.0, min(self.t_s), variant="long"))
         if full:
             preps = ("frictionless", "frictionless-fast", "frictionless-slow", "frictionless-cohesive",
                      "frictionless-wall-friction", "no-wall-friction")
-            out += [Task(PREPARE, m, p, variant=v) for m in self.n for p in self.p for v in preps]
-            out += [Task(COOL, m, 10.0, t_max, variant=v) for m in self.n for v in preps
-                    if v != "frictionless-cohesive"]
+            out += [Task(PREPARE, m, 10.0, variant=v) for m in self.n for v in preps]
             out += [Task(COOL, m, p, t_max, variant="frictionless") for m in self.n for p in self.p]
+            out += [Task(COOL, min(self.n), 10.0, t_max, variant=v)
+                    for v in ("frictionless-wall-friction", "no-wall-friction")]
             out += [Task(SCHEDULE, 3, p, t_max, seed, v) for p in self.p for seed in seeds
                     for v in ("short-prep", "control-wall-friction")]
             out += [Task(COOL, n, 10.0, t_max, variant=v) for v in ("held", "cool-no-expansion", "held-no-expansion")]
@@ -248,10 +254,10 @@ def scene_doc(task: Task, root: pathlib.Path) -> dict:
     variant = VARIANTS.get(task.variant)
     prep = dict(variant.prep) if variant else {}
     parent = None if task.parent is None else str(root / task.parent.folder / "state.npz")
-    if task.kind == COOL and variant and variant.cool_only and "expansion" in variant.material:
+    if task.kind == COOL and variant and variant.stage_only and "expansion" in variant.material:
         parent = _frozen_radii(pathlib.Path(parent), root / task.folder / "start.npz")
     if task.kind == PREPARE:
-        damping = prep.pop("wall_damping", sp.WALL_DAMPING)
+        damping = prep.pop("wall_damping", WALL_DAMPING)
         doc = sp.preparation_doc(task.n, task.p, seed=task.seed, material=material, **prep)
         for wall in doc["walls"]:
             if wall.get("motion") == "stress":
@@ -263,7 +269,8 @@ def scene_doc(task: Task, root: pathlib.Path) -> dict:
         return sp.cooling_doc(parent, task.p, material=material, walls_held=bool(variant and variant.walls_held))
     if task.kind == COMPRESS:
         z0 = -sp.wall_offset(state_file.load(parent), "top")
-        return sp.compression_doc(parent, task.p, strain_rate=COMPRESSION_RATE, strain=COMPRESSION_STRAIN, z0=z0,
+        strain = variant.strain if variant and variant.strain else COMPRESSION_STRAIN
+        return sp.compression_doc(parent, task.p, strain_rate=COMPRESSION_RATE, strain=strain, z0=z0,
                                   material=material, output_interval=COMPRESSION_OUTPUT)
     if task.kind == VIBRATE:
         return sp.vibration_doc(parent, sp.floor_height(state_file.load(parent)), material=material, **VIBRATION)

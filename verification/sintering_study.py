@@ -1,6 +1,6 @@
 """The finished runs of the sintering section read back: time series, contacts and snapshots, and what is derived
 from them (the joined history of Fig. 7, the compression test's failure and stiffness, the three-particle control,
-the coordination number without rattlers). :class:`Missing` is raised for a run that is not there.
+the coordination number without rattlers and away from the walls). :class:`Missing` is raised for a run that is not there.
 """
 
 from __future__ import annotations
@@ -73,10 +73,10 @@ class Study:
         out["mass_fraction"] = out["volume_fraction"] * ((1.0 - 1e-4 * (120.0 - T_PREPARE)) / scale) ** 2
         return out
 
-    def compression(self, n, p, t_s) -> dict:
+    def compression(self, n, p, t_s, variant: str = "") -> dict:
         """eps_zz = 1 - z/z0, sigma_zz (top wall), sigma_xx (right wall), nu; the failure (:func:`failure`) and the
         stiffness, the slope of sigma_zz against eps_zz while the stress rises from p to half way to failure."""
-        s = self.series(self.task(sr.COMPRESS, n, p, t_s))
+        s = self.series(self.task(sr.COMPRESS, n, p, t_s, variant=variant))
         before = self.res(sr.COOL, n, p, t_s)
         z = -s["q_top"]
         eps = 1.0 - z / z[0]
@@ -131,3 +131,13 @@ def without_rattlers(i, j, n: int) -> tuple[float, int]:
         if not np.any(drop):
             return (2.0 * np.count_nonzero(both) / max(1, np.count_nonzero(keep))), int(n - np.count_nonzero(keep))
         keep &= ~drop
+
+
+def bulk_coordination(a: dict, k: int = 0) -> tuple[float, int]:
+    """``(C, n)``: the mean number of pair contacts of the ``n`` particles of snapshot ``k`` of an ``analysis.npz``
+    (:func:`verification.sintering_runs.snapshot`) that touch no wall."""
+    x, r, i, j = a[f"snap{k}_x"], a[f"snap{k}_radius"], a[f"snap{k}_i"], a[f"snap{k}_j"]
+    gap = x @ a[f"snap{k}_wall_normal"].T - a[f"snap{k}_wall_q"][None, :]
+    bulk = ~np.any(gap < r[:, None], axis=1)
+    degree = np.bincount(i, minlength=len(r)) + np.bincount(j, minlength=len(r))
+    return float(np.mean(degree[bulk])), int(np.count_nonzero(bulk))
