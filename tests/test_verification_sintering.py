@@ -133,3 +133,21 @@ def test_a_contact_cooled_with_its_centres_held_goes_into_tension_as_eqs_9_10_13
     assert strong["no_expansion"] > 0.2  # without contraction: repulsive, stiffer (k2(delta_max) grew)
     weak = contact_cooling(0.02)  # p = 10: the overlap (10 um) is gone before 80 C
     assert weak["cold_overlap"] < 0 and weak["held"] == 0.0 == weak["held_predicted"]
+
+
+def test_a_stage_run_from_a_state_is_read_on_its_own_clock(tmp_path):
+    """A stage started from a saved state goes on with the state's clock; the study counts each stage's time from
+    its start, so the joined history of Fig. 7 puts the sintering at t_heat, not at twice it."""
+    rows = {sr.PREPARE: (0.0, 0.1, 0.2), sr.SINTER: (0.2, 0.25, 0.3), sr.COOL: (0.3, 0.4, 0.5)}
+    results = {}
+    for kind, times in rows.items():
+        task = sr.Task(kind, 12, 10.0, None if kind == sr.PREPARE else 1e-4)
+        folder = tmp_path / task.folder
+        folder.mkdir(parents=True)
+        (folder / "timeseries.csv").write_text("t,volume_fraction,T_mean\n" + "".join(f"{t},0.8,80\n" for t in times))
+        results[task] = {"t": times[-1]}
+    st = Y.Study(tmp_path, TINY, results)
+    assert st.series(sr.Task(sr.SINTER, 12, 10.0, 1e-4))["t"].tolist() == pytest.approx([0.0, 0.05, 0.1])
+    t_heat, t_cool = sr.Task(sr.SINTER, 12, 10.0, 1e-4).times.t_heat, sr.Times(t_s=1e-4).t_cool
+    assert st.history(12, 10.0, 1e-4)["t"].tolist() == pytest.approx([0.0, 0.1, 0.2, t_heat + 0.05, t_heat + 0.1,
+                                                                       t_cool + 0.1, t_cool + 0.2])

@@ -352,7 +352,8 @@ def run_task(task: Task, root) -> dict:
 
     def observe():
         writer.observe()
-        if captures and sim.mechanics.t >= captures[0] - 0.5 * interval:  # the first row at (or just before) it
+        elapsed = sim.mechanics.t - sim.mechanics.t_start  # the stage's time (the clock goes on from the state)
+        if captures and elapsed >= captures[0] - 0.5 * interval:  # the first row at (or just before) it
             captures.pop(0)
             snaps.append(snapshot(sim))
 

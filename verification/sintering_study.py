@@ -47,8 +47,12 @@ class Study:
 
     @functools.lru_cache(maxsize=None)
     def series(self, task: sr.Task) -> dict:
+        """The time series of ``task`` with ``t`` counted from the stage's start (its first row): a stage run from
+        a saved state goes on with the state's clock."""
         self.res(task.kind, task.n, task.p, task.t_s, task.seed, task.variant)
-        return read_csv(self.root / task.folder / "timeseries.csv")
+        s = read_csv(self.root / task.folder / "timeseries.csv")
+        s["t"] = s["t"] - s["t"][0]
+        return s
 
     @functools.lru_cache(maxsize=None)
     def arrays(self, task: sr.Task) -> dict:
