@@ -293,7 +293,8 @@ def snapshot(sim) -> dict:
     mech = sim.mechanics
     s = mech.state
     fields = sim.particle_fields()
-    i, j, cf = sim.contact_fields()
+    _, pairs, cf = sim.links()
+    i, j = pairs[:, 0], pairs[:, 1]
     return {"t": np.array(mech.t), "x": s.x.copy(), "radius": s.radius.copy(), "mean_stress": fields["mean_stress"],
             "i": i, "j": j, "fn": cf["normal_force"], "ft": cf["tangential_force"],
             "wall_normal": mech.w.normal.copy(), "wall_q": mech.w.q.copy()}
