@@ -154,7 +154,8 @@ def test_real_command_line(history):
 def scene_doc(**contact):
     table = {"law": "luding", **{k: getattr(MAT, k) for k in ("k1", "k2", "kc", "kt_ratio", "gamma_n", "gamma_t",
                                                              "mu", "mu_wall", "T_melt", "T_var", "expansion",
-                                                             "fluid_overlap", "t0", "brittle_sliding")}}
+                                                             "fluid_overlap", "t0", "brittle_sliding",
+                                                             "wall_sintering")}}
     table.update(contact)
     return {"scene": {"physics": ["mechanical"]}, "material": {"density": 2000.0},
             "particles": {"position": [[0.0, 0.0, 0.0]], "radius": [1e-3], "temperature": [20.0]},

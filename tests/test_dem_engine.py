@@ -374,3 +374,22 @@ def test_phases_change_the_speed_of_a_strain_wall():
     doc["phases"][0]["wall_velocity"] = {"floor": 0.0}
     with pytest.raises(ValueError, match="wall_velocity.floor: no wall named 'floor'"):
         parse_scene(doc)
+
+
+@pytest.mark.parametrize("sintering", [True, False])
+def test_a_wall_that_does_not_sinter_keeps_the_cold_loading_stiffness(sintering):
+    """A disk set down on a floor at 140 °C with the overlap that carries its weight on the loading line: with
+    ``wall_sintering`` k1(T) delta (eq. 10, the particle's factor), without it the cold-limit k1 delta; it stays."""
+    r, h, g = 1e-3, 6e-3, 9.81
+    weight = 2000.0 * math.pi * r**2 * h * g
+    s = 1.0 / (1.0 + math.exp(-2.0 * (120.0 - 140.0) / 10.0)) if sintering else 1.0
+    doc = scene_doc([[0, 0, r - weight / (s * TABLE1["k1"])]], [r], contact={**TABLE1, "wall_sintering": sintering},
+                    t_end=0.01,
+                    temperature=140.0, walls=[{"name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]}],
+                    gravity={"acceleration": [0.0, 0.0, -g]})
+    doc["scene"].update(dimension=2, height=h)
+    sim = VerletEngine(parse_scene(doc))
+    sim.run()
+    (overlap,), (force,) = sim.mechanics.wall_contacts()[2:]
+    assert force == pytest.approx(weight, rel=1e-6)
+    assert overlap == pytest.approx(weight / (s * TABLE1["k1"]), rel=1e-6)

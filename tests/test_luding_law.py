@@ -71,6 +71,19 @@ def test_table1_material_and_params_layout():
     assert p[luding.P_MU] == 0.5 and p[luding.P_MU_WALL] == 0.0 and p[luding.P_T_MELT] == 120 and p[luding.P_T_VAR] == 10
     assert p[luding.P_EXPANSION] == 1e-4 and p[luding.P_FLUID_OVERLAP] == 0.2 and p[luding.P_T0] == 1e3
     assert p[luding.P_BRITTLE_SLIDING] == 1.0 and p[luding.P_DENSITY] == 2000
+    assert p[luding.P_WALL_SINTERING] == 0.0  # the walls of Sec. 4 keep the cold law
+
+
+def test_a_contact_table_may_leave_out_wall_sintering_and_then_walls_sinter():
+    from dataclasses import asdict
+
+    from dem.laws.fields import material_from_table
+
+    table = {k: v for k, v in asdict(MAT).items() if k != "wall_sintering"}
+    assert material_from_table(luding.LudingMaterial, "luding", table).wall_sintering is True
+    assert material_from_table(luding.LudingMaterial, "luding", {**table, "wall_sintering": False}) == MAT
+    with pytest.raises(ValueError, match=r"\[contact\] k2: required"):
+        material_from_table(luding.LudingMaterial, "luding", {k: v for k, v in table.items() if k != "k2"})
 
 
 @pytest.mark.parametrize("field, value, words", [
@@ -87,6 +100,7 @@ def test_table1_material_and_params_layout():
     ("t0", 0.0, ["t0", "> 0"]),
     ("density", -2000.0, ["density", "> 0"]),
     ("brittle_sliding", 1, ["brittle_sliding", "true or false"]),
+    ("wall_sintering", "no", ["wall_sintering", "true or false"]),
     ("T_melt", "hot", ["T_melt", "finite number"]),
 ])
 def test_material_refuses_bad_values_naming_them(field, value, words):

@@ -25,7 +25,7 @@ def test_schedule_scene_has_the_times_temperatures_and_box_of_sec_4_1():
     assert sched.relaxation_time == (1e3, 1e3, 0.1, 1e3, 1e3)  # t0 = 0.1 s only while sintering (Table 1)
     (s0, prep), (s1, after) = m.phases
     assert (s0, s1) == (0.0, 0.2)
-    assert list(prep.values()) == [0.0, 0.0] and list(after.values()) == [MAT.mu, MAT.mu_wall]
+    assert list(prep.values()) == [MAT.mu, MAT.mu] and list(after.values()) == [MAT.mu, MAT.mu_wall]  # walls off
     walls = {w.name: w for w in m.walls}
     assert walls["left"].motion == walls["bottom"].motion == "fixed"
     for name in ("right", "top"):
@@ -144,12 +144,12 @@ def test_tension_capacity_is_eq_15_and_fragments_split_at_the_threshold():
         fragments(mech, min_tension=-1.0)
 
 
-@pytest.mark.parametrize("name, n, p, t_s", [("luding-table1", 300, 100.0, 0.1),
-                                              ("luding-three-particles", 3, 100.0, 1.0)])
-def test_builtin_scenes_are_the_protocols_schedule(name, n, p, t_s):
+@pytest.mark.parametrize("name, doc", [("luding-table1", lambda: sp.schedule_doc(300, 100.0, 0.1)),
+                                       ("luding-three-particles", lambda: sp.control_doc(100.0, 1.0))])
+def test_builtin_scenes_are_the_protocols_schedule(name, doc):
     from dem.scene import load_scene
 
-    builtin, made = load_scene(name), parse_scene(sp.schedule_doc(n, p, t_s))
+    builtin, made = load_scene(name), parse_scene(doc())
     assert builtin.contact == made.contact == MAT
     assert np.array_equal(builtin.particles.position, made.particles.position)
     assert np.array_equal(builtin.particles.radius, made.particles.radius)
@@ -161,3 +161,13 @@ def test_builtin_scenes_are_the_protocols_schedule(name, n, p, t_s):
     assert walls(a) == walls(b) and len(a.walls) == 4
     assert (a.schedule, a.phases, a.dt, a.dimension, a.height) == (b.schedule, b.phases, b.dt, b.dimension, b.height)
     assert builtin.solver.t_end == made.solver.t_end
+
+
+def test_preparation_takes_table1_friction_on_particles_and_walls_unless_told():
+    assert sp.preparation_doc(10, 10.0)["phases"] == [{"start": 0.0, "mu": MAT.mu, "mu_wall": MAT.mu}]
+    assert sp.preparation_doc(10, 10.0, prep_mu=0.0)["phases"] == [{"start": 0.0, "mu": 0.0, "mu_wall": 0.0}]
+    assert sp.preparation_doc(10, 10.0, prep_mu_wall=0.0)["phases"][0]["mu_wall"] == 0.0
+    with pytest.raises(ValueError, match=r"prep_mu = -0.1: must be a finite friction coefficient >= 0"):
+        sp.preparation_doc(10, 10.0, prep_mu=-0.1)
+    with pytest.raises(ValueError, match=r"prep_mu_wall = nan"):
+        sp.schedule_doc(10, 10.0, 0.1, prep_mu_wall=float("nan"))

@@ -77,3 +77,77 @@ def test_rattlers_are_peeled_off_until_every_particle_has_two_contacts():
 def test_failure_is_the_peak_before_the_first_load_drop():
     assert Y.failure([10, 40, 55, 50, 20, 80, 90]) == 2  # 20 < 55/2: failed at 55, the later 90 is rubble
     assert Y.failure([10, 20, 30, 25, 28, 35, 20]) == 5  # never below half: the largest
+
+
+def test_isolating_variants_start_where_they_should():
+    held = sr.Task(sr.COOL, 100, 100.0, 1.0, variant="held")
+    assert held.parent == sr.Task(sr.SINTER, 100, 100.0, 1.0)  # the cool-down alone changes: the protocol's state
+    fr = sr.Task(sr.COOL, 100, 10.0, 1.0, variant="frictionless")
+    assert fr.parent.parent == sr.Task(sr.PREPARE, 100, 10.0, variant="frictionless")
+    assert sr.Task(sr.SCHEDULE, 3, 10.0, 1.0).times.t_heat == 0.5
+    assert sr.Task(sr.SCHEDULE, 3, 10.0, 1.0, variant="short-prep").times.t_heat == 0.2
+    assert sr.Task(sr.PREPARE, 100, 10.0).times.t_heat == 0.2
+    for grid in (sr.QUICK, sr.FULL):
+        tasks = grid.isolating_tasks()
+        assert tasks and len(set(tasks)) == len(tasks) and all(t.variant in sr.VARIANTS for t in tasks)
+    assert TINY.isolating_tasks() == []
+    quick = set(sr.QUICK.isolating_tasks())
+    assert held in quick and sr.Task(sr.SCHEDULE, 3, 100.0, 1.0, 1, "walls-sinter") in quick
+
+
+def test_scene_docs_of_the_variants(tmp_path, monkeypatch):
+    from verification import sinter_protocol as sp
+
+    prep = sr.scene_doc(sr.Task(sr.PREPARE, 20, 10.0, variant="frictionless-slow"), tmp_path)
+    assert prep["phases"] == [{"start": 0.0, "mu": 0.0, "mu_wall": 0.0}]
+    assert {w["damping"] for w in prep["walls"] if w.get("motion") == "stress"} == {2.0}
+    assert sr.scene_doc(sr.Task(sr.PREPARE, 20, 10.0), tmp_path)["phases"] == [{"start": 0.0, "mu": 0.5,
+                                                                                  "mu_wall": 0.5}]
+    assert sr.scene_doc(sr.Task(sr.PREPARE, 20, 10.0, variant="frictionless-cohesive"),
+                        tmp_path)["contact"]["brittle_sliding"] is False
+    control = sr.scene_doc(sr.Task(sr.SCHEDULE, 3, 100.0, 1.0, 1, "walls-sinter"), tmp_path)
+    assert control["contact"]["wall_sintering"] is True and control["temperature"]["time"][1] == 0.5
+    assert control["phases"][0] == {"start": 0.0, "mu": 0.5, "mu_wall": 0.0}
+    monkeypatch.setattr(sp.state_file, "load", lambda path: {"t": 1.3})  # a sintered state's clock
+    held = sp.cooling_doc("s.npz", 100.0, walls_held=True)
+    assert all("motion" not in w for w in held["walls"]) and len(held["walls"]) == 4
+    assert held["solver"]["t_end"] == pytest.approx(1.5) and held["temperature"]["time"][0] == 1.3
+
+
+def test_frozen_radii_keep_each_particle_its_size(tmp_path):
+    state = tmp_path / "state.npz"
+    np.savez(state, radius=np.array([1.002e-3, 0.5e-3]), radius_ref=np.array([1e-3, 0.499e-3]), x=np.zeros((2, 3)))
+    out = np.load(sr._frozen_radii(state, tmp_path / "frozen" / "start.npz"))
+    assert np.array_equal(out["radius_ref"], out["radius"]) and np.array_equal(out["x"], np.zeros((2, 3)))
+
+
+def test_a_contact_cooled_with_its_centres_held_goes_into_tension_as_eqs_9_10_13_predict():
+    from verification.sintering_causes import contact_cooling
+
+    strong = contact_cooling(0.2)  # the paper's mean contact force at p = 100 N/m
+    assert strong["hot"]["force"] == pytest.approx(0.2, rel=1e-12)
+    assert strong["shrink"] == pytest.approx(2 * 1e-3 * 1e-4 * 60.0, rel=1e-12)  # eq. 9, both radii, 60 K
+    assert strong["held"] == pytest.approx(strong["held_predicted"], rel=1e-9)
+    assert strong["held"] < -5 * 0.2  # attraction far beyond the force it carried hot
+    assert strong["no_expansion"] == pytest.approx(strong["no_expansion_predicted"], rel=1e-9)
+    assert strong["no_expansion"] > 0.2  # without contraction: repulsive, stiffer (k2(delta_max) grew)
+    weak = contact_cooling(0.02)  # p = 10: the overlap (10 um) is gone before 80 C
+    assert weak["cold_overlap"] < 0 and weak["held"] == 0.0 == weak["held_predicted"]
+
+
+def test_a_stage_run_from_a_state_is_read_on_its_own_clock(tmp_path):
+    """A stage started from a saved state goes on with the state's clock; the study counts each stage's time from
+    its start, so the joined history of Fig. 7 puts the sintering at t_heat, not at twice it."""
+    rows = {sr.PREPARE: (0.0, 0.1, 0.2), sr.SINTER: (0.2, 0.25, 0.3), sr.COOL: (0.3, 0.4, 0.5)}
+    results = {}
+    for kind, times in rows.items():
+        task = sr.Task(kind, 12, 10.0, None if kind == sr.PREPARE else 1e-4)
+        folder = tmp_path / task.folder
+        folder.mkdir(parents=True)
+        (folder / "timeseries.csv").write_text("t,volume_fraction,T_mean\n" + "".join(f"{t},0.8,80\n" for t in times))
+        results[task] = {"t": times[-1]}
+    st = Y.Study(tmp_path, TINY, results)
+    assert st.series(sr.Task(sr.SINTER, 12, 10.0, 1e-4))["t"].tolist() == pytest.approx([0.0, 0.05, 0.1])
+    t_heat, t_cool = sr.Task(sr.SINTER, 12, 10.0, 1e-4).times.t_heat, sr.Times(t_s=1e-4).t_cool
+    assert st.history(12, 10.0, 1e-4)["t"].tolist() == pytest.approx([0.0, 0.1, 0.2, t_heat + 0.05, t_heat + 0.1,
+                                                                       t_cool + 0.1, t_cool + 0.2])

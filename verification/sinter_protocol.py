@@ -6,14 +6,16 @@ Each function returns a scene as a dict (the parsed form of a TOML scene; :func:
 * :func:`preparation_doc` -- ``n`` disks (Table 1: a0 = 1 mm, radii uniform in a0 (1 +- w0), w0 = 0.5, height
   6 mm) placed at random with random velocities in a square box (random sequential addition, solid fraction
   ``fill``) and compressed by the bi-axial box of Fig. 1: left and bottom walls fixed, right and top walls
-  stress-controlled (eq. 1, pressure ``p`` in N/m, wall mass 0.01 kg, damping 0.2 kg/s), at 80 °C, the particles
-  frictionless ("we used frictionless particles for the initial compression", Sec. 4), until ``t_heat``;
+  stress-controlled (eq. 1, pressure ``p`` in N/m, wall mass 0.01 kg, damping 0.2 kg/s), at 80 °C, with friction
+  on particles and walls (below), until ``t_heat``;
 * :func:`sintering_doc` -- from a prepared state: friction on and wall friction off (Sec. 4.1.2: at t_heat "the wall
   friction is switched off"), heating to 140 °C in 0.1 s, sintering for ``t_s`` with the relaxation time
   t0 = 0.1 s of eqs. 11-12 (Table 1), and optionally the cooling to 80 °C in 0.1 s and the relaxation for 0.1 s
   (the times of Sec. 4.1, Fig. 7);
 * :func:`cooling_doc` -- from a sintered state (at ``t_cool``): the cooling and the relaxation alone;
 * :func:`schedule_doc` -- the whole of Fig. 7 in one scene (preparation, heating, sintering, cooling, relaxation);
+* :func:`control_doc` -- the three-particle control of Sec. 4.1.3 (the schedule for three disks, prepared until
+  they are at rest);
 * :func:`compression_doc` -- the compression test of Sec. 4.4: the right wall holds ``sigma_xx = p``, the top wall
   moves down at a constant speed, ``eps_zz = 1 - z/z0`` rising at ``strain_rate``;
 * :func:`vibration_doc` -- the vibration test of Figs. 21-22: the confining walls removed, the sample on a flat
@@ -21,13 +23,18 @@ Each function returns a scene as a dict (the parsed form of a TOML scene; :func:
 * :func:`heated_walls_doc` -- beyond the paper: 3D spheres with the thermal network on, heated and cooled through
   two walls held at given temperatures instead of a prescribed schedule.
 
-Ambiguities of the paper, resolved here (and overridable): the preparation is frictionless throughout, walls
-included (``prep_mu_wall = 0``, Table 1's mu_w): the paper switches the wall friction off at t_heat without saying
-what it was before, and frictional walls acting on frictionless disks spin the wall particles up, a rotational
-energy that nothing dissipates until the friction comes on (8e-5 J against 2e-9 J for 100 disks at p = 100 at
-t_heat). The particle friction mu = 0.5 of Table 1 starts at t_heat. The vibration floor is a new wall placed where
-the lowest particle just touches it (the sample is set down on it; the sintered wall contacts of the box stay
-behind).
+Ambiguities of the paper, resolved here (and overridable). *The preparation's friction.* The paper says it
+"used frictionless particles for the initial compression", then switches "the wall friction" off at t_heat ("an
+immediate effect, a slight increase in density") and reports nu ~ 0.80 after the preparation and densifications of
+5 % (p = 10) and 16 % (p = 100). Its numbers and its wall friction follow from a preparation with friction, not
+from a frictionless one, which packs 300 disks denser and then densifies far less at p = 10 (``python -m
+verification sintering`` runs both, and frictionless variants with other speeds, compression rates, cohesion and
+wall friction). The numbers are followed: ``prep_mu`` and ``prep_mu_wall`` default to Table 1's mu (the paper gives
+the preparation's wall friction no value), and at t_heat the wall friction goes to Table 1's mu_w = 0 while the
+particles keep mu. *The walls* keep the cold law (``LUDING_TABLE1.wall_sintering``). *The three-particle control*
+(:func:`control_doc`) is prepared until it is at rest and without wall friction. The vibration floor is a new wall
+placed where the lowest particle just touches it (the sample is set down on it; the sintered wall contacts of the
+box stay behind).
 
 ``dimension = 3`` gives the same protocol for spheres in a cube (three fixed walls, three stress walls with
 ``p`` in Pa).
@@ -51,6 +58,7 @@ MEAN_RADIUS = 1.0e-3    # m, a0 (Table 1)
 RADIUS_SPREAD = 0.5     # w0 (Table 1)
 WALL_MASS = 0.01        # kg, m_w (Table 1)
 WALL_DAMPING = 0.2      # kg/s, gamma_w (Table 1)
+CONTROL_T_HEAT = 0.5    # s, preparation of the three-particle control (control_doc)
 
 
 @dataclass(frozen=True)
@@ -165,14 +173,27 @@ def _continue_from(doc: dict, state: str) -> dict:
     return doc
 
 
+def _prep_friction(material: LudingMaterial, prep_mu, prep_mu_wall) -> dict:
+    """The ``[[phases]]`` entry of the preparation: friction ``prep_mu`` on the particles and ``prep_mu_wall`` on
+    the walls, both Table 1's mu unless given (module docstring)."""
+    mu = material.mu if prep_mu is None else prep_mu
+    mu_wall = mu if prep_mu_wall is None else prep_mu_wall
+    for name, value in (("prep_mu", mu), ("prep_mu_wall", mu_wall)):
+        if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value) or value < 0:
+            raise ValueError(f"{name} = {value!r}: must be a finite friction coefficient >= 0")
+    return {"start": 0.0, "mu": float(mu), "mu_wall": float(mu_wall)}
+
+
 def preparation_doc(n: int, p: float, *, seed: int = 1, times: Times | None = None, fill: float | None = None,
-                    spread: float = RADIUS_SPREAD, speed: float = 0.01, prep_mu_wall: float = 0.0,
-                    material: LudingMaterial = LUDING_TABLE1,
+                    spread: float = RADIUS_SPREAD, speed: float = 0.01, prep_mu: float | None = None,
+                    prep_mu_wall: float | None = None, material: LudingMaterial = LUDING_TABLE1,
                     dimension: int = 2, output_interval: float = 2.5e-3) -> dict:
     """The preparation (module docstring): random placement of radii uniform in ``a0 (1 +- spread)`` at solid
-    fraction ``fill`` (default :data:`FILL`) with speeds ``speed`` (m/s), frictionless compression at ``p`` and
-    80 °C until ``times.t_heat``; wall friction ``prep_mu_wall`` (default 0)."""
+    fraction ``fill`` (default :data:`FILL`) with speeds ``speed`` (m/s), compression at ``p`` and 80 °C until
+    ``times.t_heat`` with friction ``prep_mu`` on the particles and ``prep_mu_wall`` on the walls (default: Table 1's
+    mu for both; 0 and 0 is the frictionless preparation the paper's text names)."""
     p = _check_pressure(p)
+    phase = _prep_friction(material, prep_mu, prep_mu_wall)
     times = times or Times(t_s=1.0)
     side = box_side(n, FILL[dimension] if fill is None else fill, dimension, spread=spread)
     doc = _base(f"luding2005-preparation-n{n}-p{p:g}", material, dimension, times.t_heat, output_interval)
@@ -180,7 +201,7 @@ def preparation_doc(n: int, p: float, *, seed: int = 1, times: Times | None = No
     doc["generator"] = {"kind": "box", "n": n, "radius": MEAN_RADIUS, "radius_spread": spread,
                         "box": [[0.0, 0.0, 0.0], hi], "speed": speed, "seed": seed, "temperature": T_PREPARE}
     doc["walls"] = box_walls(side, p, dimension)
-    doc["phases"] = [{"start": 0.0, "mu": 0.0, "mu_wall": prep_mu_wall}]
+    doc["phases"] = [phase]
     return doc
 
 
@@ -214,12 +235,16 @@ def sintering_doc(state: str, p: float, t_s: float, *, cooling: bool = False, ti
 
 
 def cooling_doc(state: str, p: float, *, times: Times | None = None, material: LudingMaterial = LUDING_TABLE1,
-                dimension: int = 2, output_interval: float = 2.5e-3) -> dict:
-    """From a sintered ``state`` (at t_cool, 140 °C): cooling to 80 °C and relaxation (Sec. 4.1)."""
+                dimension: int = 2, walls_held: bool = False, output_interval: float = 2.5e-3) -> dict:
+    """From a sintered ``state`` (at t_cool, 140 °C): cooling to 80 °C and relaxation (Sec. 4.1). With
+    ``walls_held`` the stress-controlled walls stay where the state left them instead of following ``p`` (a
+    control: the box cannot follow the particles' thermal contraction, eq. 9)."""
     p = _check_pressure(p)
     times = times or Times(t_s=1.0)
     doc = _base(f"luding2005-cooling-p{p:g}", material, dimension, times.cool + times.relax, output_interval)
     doc["walls"] = box_walls(1.0, p, dimension)
+    if walls_held:
+        doc["walls"] = [{key: w[key] for key in ("name", "point", "normal")} for w in doc["walls"]]
     doc["temperature"] = {"time": [0.0, times.cool, times.cool + times.relax], "value": [T_SINTER, T_PREPARE,
                                                                                           T_PREPARE],
                           "relaxation_time": [material.t0, material.t0]}
@@ -227,22 +252,38 @@ def cooling_doc(state: str, p: float, *, times: Times | None = None, material: L
 
 
 def schedule_doc(n: int, p: float, t_s: float, *, seed: int = 1, times: Times | None = None,
-                 fill: float | None = None,
-                 speed: float = 0.01, prep_mu_wall: float = 0.0, material: LudingMaterial = LUDING_TABLE1,
+                 fill: float | None = None, speed: float = 0.01, prep_mu: float | None = None,
+                 prep_mu_wall: float | None = None, material: LudingMaterial = LUDING_TABLE1,
                  output_interval: float = 5e-3) -> dict:
-    """The whole of Fig. 7 in one 2D scene: preparation (:func:`preparation_doc`), then from t_heat friction on,
-    wall friction off, heating, sintering for ``t_s``, cooling and relaxation, to t_f."""
+    """The whole of Fig. 7 in one 2D scene: preparation (:func:`preparation_doc`), then from t_heat Table 1's
+    friction (the wall friction off), heating, sintering for ``t_s``, cooling and relaxation, to t_f."""
     times = times or Times(t_s=t_s)
     if times.t_s != t_s:
         raise ValueError(f"t_s = {t_s!r}: differs from times.t_s = {times.t_s!r}")
-    doc = preparation_doc(n, p, seed=seed, times=times, fill=fill, speed=speed, prep_mu_wall=prep_mu_wall,
-                          material=material, output_interval=output_interval)
+    doc = preparation_doc(n, p, seed=seed, times=times, fill=fill, speed=speed, prep_mu=prep_mu,
+                          prep_mu_wall=prep_mu_wall, material=material, output_interval=output_interval)
     doc["scene"]["name"] = f"luding2005-schedule-n{n}-p{p:g}-ts{t_s:g}"
     doc["solver"]["t_end"] = times.t_f
     sched = _schedule(times, material, cooling=True, start=times.t_heat)
     doc["temperature"] = {"time": [0.0] + sched["time"], "value": [T_PREPARE] + sched["value"],
                           "relaxation_time": [material.t0] + sched["relaxation_time"]}
     doc["phases"].append({"start": times.t_heat, "mu": material.mu, "mu_wall": material.mu_wall})
+    return doc
+
+
+def control_doc(p: float, t_s: float, *, seed: int = 1, t_heat: float = CONTROL_T_HEAT,
+                prep_mu: float | None = None, prep_mu_wall: float = 0.0,
+                material: LudingMaterial = LUDING_TABLE1) -> dict:
+    """The three-particle control of Sec. 4.1.3: :func:`schedule_doc` for three disks, "sintered in the same way as
+    the larger samples", whose three particles "did not change their configuration". Two choices keep them so: the
+    preparation lasts ``t_heat`` = 0.5 s (pressed by walls of 0.01 kg, three disks still bounce at 0.2 s and are at
+    rest, with the same contacts, from 0.4 s on; the paper prepares "until a quasi-static situation is reached"),
+    and the walls have no friction while preparing (``prep_mu_wall`` = 0: wall friction holds three disks in loose
+    arches that collapse when it is switched off at t_heat, a rearrangement the control must not have)."""
+    times = Times(t_s=t_s, t_heat=t_heat)
+    doc = schedule_doc(3, p, t_s, seed=seed, times=times, prep_mu=prep_mu, prep_mu_wall=prep_mu_wall,
+                       material=material)
+    doc["scene"]["name"] = f"luding2005-control-p{p:g}-ts{t_s:g}"
     return doc
 
 

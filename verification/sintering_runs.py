@@ -5,7 +5,9 @@ A :class:`Task` is one stage of :mod:`verification.sinter_protocol` for one samp
 and sintering for t_s, from the prepared state), ``cool`` (cooling and relaxation), ``compress`` and ``vibrate``
 (the tests of Sec. 4.4, from the cooled state), ``schedule`` (the whole of Fig. 7 in one scene: the three-particle
 control of Sec. 4.1.3, the control without thermal expansion), and the 3D stages with heated walls (``prepare3d``,
-``sinter3d``). Each task runs in its own folder ``runs/<kind>/<sample>/``: the engine's
+``sinter3d``). A task's ``variant`` names a change of the protocol that isolates a cause (:data:`VARIANTS`: another
+preparation, walls that sinter, a cool-down with the walls held or without thermal contraction). Each task runs in
+its own folder ``runs/<kind>/<sample>/``: the engine's
 ``timeseries.csv``, ``summary.json`` and ``state.npz``, then ``analysis.npz`` (contacts, forces, fragments and
 snapshots at the stage's end) and, last, ``result.json``. A folder holding ``result.json`` is finished: a rerun
 skips it. The preparation of each (N, p) runs once and every t_s starts from its state; each cooled state is the
@@ -24,11 +26,12 @@ import sys
 import time
 import traceback
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
 from dem.laws.contact.luding import LUDING_TABLE1, P_MU
+from verification.sinter_protocol import CONTROL_T_HEAT, WALL_DAMPING, Times
 
 PREPARE, SINTER, COOL, COMPRESS, VIBRATE, SCHEDULE = "prepare", "sinter", "cool", "compress", "vibrate", "schedule"
 PREPARE3D, SINTER3D = "prepare3d", "sinter3d"
@@ -52,8 +55,44 @@ CONDUCTIVITY3D, SPECIFIC_HEAT3D = 20.0, 10.0
 
 
 @dataclass(frozen=True)
+class Variant:
+    """A change of the protocol (:mod:`verification.sinter_protocol`) that isolates one cause: ``prep`` keyword arguments of
+    the preparation, ``material`` fields changed in every stage (``prep_material``: in the preparation only),
+    ``walls_held`` in the cool-down, ``t_heat`` of the three-particle control, ``strain`` of the compression test;
+    ``stage_only``: the variant changes its own stage alone and starts from the protocol's state."""
+
+    label: str
+    prep: dict = field(default_factory=dict)
+    material: dict = field(default_factory=dict)
+    prep_material: dict = field(default_factory=dict)
+    walls_held: bool = False
+    t_heat: float | None = None
+    strain: float | None = None
+    stage_only: bool = False
+
+
+FRICTIONLESS = {"prep_mu": 0.0, "prep_mu_wall": 0.0}
+VARIANTS = {v.label: v for v in (
+    Variant("frictionless", FRICTIONLESS),                                   # the paper's text (Sec. 4)
+    Variant("frictionless-fast", {**FRICTIONLESS, "speed": 1.0}),            # random speeds 100x ours
+    Variant("frictionless-slow", {**FRICTIONLESS, "wall_damping": 10 * WALL_DAMPING}),  # walls 10x slower
+    Variant("frictionless-cohesive", FRICTIONLESS, prep_material={"brittle_sliding": False}),  # Table 1's cohesion
+    Variant("frictionless-wall-friction", {**FRICTIONLESS, "prep_mu_wall": LUDING_TABLE1.mu}),
+    Variant("no-wall-friction", {"prep_mu_wall": 0.0}),                      # particles frictional, walls not
+    Variant("walls-sinter", material={"wall_sintering": True}),              # wall contacts soften like pairs
+    Variant("short-prep", t_heat=0.2),                                       # the control prepared for 0.2 s only
+    Variant("control-wall-friction", {"prep_mu_wall": LUDING_TABLE1.mu}),    # the control with the walls' friction
+    Variant("no-expansion", material={"expansion": 0.0}),                    # delta a_T = 0 (Sec. 4.1.3)
+    Variant("held", walls_held=True, stage_only=True),                        # cool-down, the box held
+    Variant("cool-no-expansion", material={"expansion": 0.0}, stage_only=True),
+    Variant("held-no-expansion", material={"expansion": 0.0}, walls_held=True, stage_only=True),
+    Variant("long", strain=0.15, stage_only=True),                             # the compression test to 15 %
+)}
+
+
+@dataclass(frozen=True)
 class Task:
-    """One stage for one sample. ``variant``: ``""`` (Table 1) or ``"no-expansion"`` (delta a_T = 0)."""
+    """One stage for one sample. ``variant``: ``""`` (the protocol) or a key of :data:`VARIANTS`."""
 
     kind: str
     n: int
@@ -81,13 +120,24 @@ class Task:
         if kind is None:
             return None
         t_s = None if kind in (PREPARE, PREPARE3D) else self.t_s
-        return Task(kind, self.n, self.p, t_s, self.seed, self.variant)
+        variant = "" if self.variant and VARIANTS[self.variant].stage_only else self.variant
+        return Task(kind, self.n, self.p, t_s, self.seed, variant)
+
+    @property
+    def times(self) -> Times:
+        """The times of the protocol for this task (the three-particle control prepares for longer:
+        :data:`verification.sinter_protocol.CONTROL_T_HEAT`)."""
+        t_heat = VARIANTS[self.variant].t_heat if self.variant else None
+        if t_heat is None:
+            t_heat = CONTROL_T_HEAT if (self.kind == SCHEDULE and self.n == 3) else 0.2
+        return Times(t_s=1.0 if self.t_s is None else self.t_s, t_heat=t_heat)
 
     @property
     def cost(self) -> float:
         """Simulated time times particles: the order in which ready tasks start (longest first)."""
-        seconds = {PREPARE: 0.2, SINTER: 0.1 + (self.t_s or 0), COOL: 0.2, COMPRESS: COMPRESSION_STRAIN,
-                   VIBRATE: 0.5 * VIBRATION["duration"], SCHEDULE: 0.5 + (self.t_s or 0), PREPARE3D: 0.4,
+        strain = VARIANTS[self.variant].strain if self.variant else None
+        seconds = {PREPARE: 0.2, SINTER: 0.1 + (self.t_s or 0), COOL: 0.2, COMPRESS: strain or COMPRESSION_STRAIN,
+                   VIBRATE: 0.5 * VIBRATION["duration"], SCHEDULE: self.times.t_f, PREPARE3D: 0.4,
                    SINTER3D: 2.0 * SINTER3D_TIME}[self.kind]
         return seconds * self.n
 
@@ -95,7 +145,8 @@ class Task:
 @dataclass(frozen=True)
 class Grid:
     """The samples of a verification run: particle numbers, pressures (N/m), sintering times (s), the seeds of the
-    three-particle control, whether to run the control without thermal expansion, the 3D sample's size."""
+    three-particle control, whether to run the control without thermal expansion, the 3D sample's size, and which
+    isolating runs (:meth:`isolating_tasks`): none, ``"quick"`` or ``"full"``."""
 
     n: tuple
     p: tuple
@@ -103,6 +154,37 @@ class Grid:
     three_seeds: tuple
     no_expansion: bool
     n3d: int
+    isolation: str = ""
+
+    def isolating_tasks(self) -> list[Task]:
+        """The runs that isolate the causes of the differences from the paper (:data:`VARIANTS`): the paper's
+        frictionless preparation through sintering and cool-down, the three-particle control with walls that sinter,
+        the cool-down of the longest-sintered sample with the box held and without thermal contraction, and the
+        compression test of the shortest-sintered sample at p = 100 carried to 15 % strain (``"quick"``: N max,
+        p = 10 for the preparation, p = 100 for the cool-down, the first seed); ``"full"``
+        adds every other preparation (initial speeds, compression rate, cohesion, wall friction) for every N at
+        p = 10, the densification of the frictionless one for every N and p and of those with friction on the
+        particles or on the walls only (N min, p = 10), the control prepared for 0.2 s only or with wall friction,
+        every seed and p."""
+        if not self.isolation:
+            return []
+        n, t_max, full = max(self.n), max(self.t_s), self.isolation == "full"
+        out = [Task(COOL, n, 10.0, t_max, variant="frictionless")]
+        seeds = self.three_seeds if full else self.three_seeds[:1]
+        out += [Task(SCHEDULE, 3, p, t_max, seed, "walls-sinter") for p in self.p for seed in seeds]
+        out += [Task(COOL, n, 100.0, t_max, variant=v) for v in ("held", "cool-no-expansion", "held-no-expansion")]
+        out.append(Task(COMPRESS, n, 100.0, min(self.t_s), variant="long"))
+        if full:
+            preps = ("frictionless", "frictionless-fast", "frictionless-slow", "frictionless-cohesive",
+                     "frictionless-wall-friction", "no-wall-friction")
+            out += [Task(PREPARE, m, 10.0, variant=v) for m in self.n for v in preps]
+            out += [Task(COOL, m, p, t_max, variant="frictionless") for m in self.n for p in self.p]
+            out += [Task(COOL, min(self.n), 10.0, t_max, variant=v)
+                    for v in ("frictionless-wall-friction", "no-wall-friction")]
+            out += [Task(SCHEDULE, 3, p, t_max, seed, v) for p in self.p for seed in seeds
+                    for v in ("short-prep", "control-wall-friction")]
+            out += [Task(COOL, n, 10.0, t_max, variant=v) for v in ("held", "cool-no-expansion", "held-no-expansion")]
+        return list(dict.fromkeys(out))
 
     def tasks(self) -> list[Task]:
         out = []
@@ -115,12 +197,13 @@ class Grid:
         if self.no_expansion:
             out += [Task(SCHEDULE, min(self.n), p, t_max, variant="no-expansion") for p in self.p]
         out.append(Task(SINTER3D, self.n3d, P3D))
-        return out
+        return out + self.isolating_tasks()
 
 
 FULL = Grid(n=(100, 300), p=(10.0, 100.0), t_s=(1e-4, 1e-3, 0.01, 0.02, 0.05, 0.1, 0.5, 1.0),
-            three_seeds=(1, 2, 3, 4), no_expansion=True, n3d=250)
-QUICK = Grid(n=(100,), p=(10.0, 100.0), t_s=(1e-4, 0.01, 1.0), three_seeds=(1, 2), no_expansion=False, n3d=40)
+            three_seeds=(1, 2, 3, 4), no_expansion=True, n3d=250, isolation="full")
+QUICK = Grid(n=(100,), p=(10.0, 100.0), t_s=(1e-4, 0.01, 1.0), three_seeds=(1, 2), no_expansion=False, n3d=40,
+             isolation="quick")
 
 
 def with_parents(tasks) -> list[Task]:
@@ -141,8 +224,25 @@ def with_parents(tasks) -> list[Task]:
 
 
 # ------------------------------------------------------------------------------------------------ one stage
-def _material(task: Task):
-    return replace(LUDING_TABLE1, expansion=0.0) if task.variant == "no-expansion" else LUDING_TABLE1
+def _material(task: Task, kind: str | None = None):
+    """The material of ``task`` (of its stage ``kind``, default its own): the protocol's, changed by the variant."""
+    if not task.variant:
+        return LUDING_TABLE1
+    v = VARIANTS[task.variant]
+    changes = {**v.material, **(v.prep_material if (kind or task.kind) in (PREPARE, SCHEDULE) else {})}
+    return replace(LUDING_TABLE1, **changes)
+
+
+def _frozen_radii(state: pathlib.Path, out: pathlib.Path) -> str:
+    """``state`` with the reference radii set to the radii it holds, written to ``out``: a run with delta a_T = 0
+    from a state saved with thermal expansion keeps each particle's size (eq. 9 would otherwise jump it to
+    a(T_melt))."""
+    with np.load(state) as f:
+        data = {k: f[k] for k in f.files}
+    data["radius_ref"] = data["radius"].copy()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    np.savez(out, **data)
+    return str(out)
 
 
 def scene_doc(task: Task, root: pathlib.Path) -> dict:
@@ -151,21 +251,36 @@ def scene_doc(task: Task, root: pathlib.Path) -> dict:
     from dem.scene import state_file
 
     material = _material(task)
+    variant = VARIANTS.get(task.variant)
+    prep = dict(variant.prep) if variant else {}
     parent = None if task.parent is None else str(root / task.parent.folder / "state.npz")
+    if task.kind == COOL and variant and variant.stage_only and "expansion" in variant.material:
+        parent = _frozen_radii(pathlib.Path(parent), root / task.folder / "start.npz")
     if task.kind == PREPARE:
-        return sp.preparation_doc(task.n, task.p, seed=task.seed, material=material)
+        damping = prep.pop("wall_damping", WALL_DAMPING)
+        doc = sp.preparation_doc(task.n, task.p, seed=task.seed, material=material, **prep)
+        for wall in doc["walls"]:
+            if wall.get("motion") == "stress":
+                wall["damping"] = damping
+        return doc
     if task.kind == SINTER:
         return sp.sintering_doc(parent, task.p, task.t_s, material=material)
     if task.kind == COOL:
-        return sp.cooling_doc(parent, task.p, material=material)
+        return sp.cooling_doc(parent, task.p, material=material, walls_held=bool(variant and variant.walls_held))
     if task.kind == COMPRESS:
         z0 = -sp.wall_offset(state_file.load(parent), "top")
-        return sp.compression_doc(parent, task.p, strain_rate=COMPRESSION_RATE, strain=COMPRESSION_STRAIN, z0=z0,
+        strain = variant.strain if variant and variant.strain else COMPRESSION_STRAIN
+        return sp.compression_doc(parent, task.p, strain_rate=COMPRESSION_RATE, strain=strain, z0=z0,
                                   material=material, output_interval=COMPRESSION_OUTPUT)
     if task.kind == VIBRATE:
         return sp.vibration_doc(parent, sp.floor_height(state_file.load(parent)), material=material, **VIBRATION)
     if task.kind == SCHEDULE:
-        return sp.schedule_doc(task.n, task.p, task.t_s, seed=task.seed, material=material)
+        if variant and variant.prep_material:
+            raise ValueError(f"variant {task.variant!r}: a preparation-only material needs separate stages")
+        if task.n == 3:
+            return sp.control_doc(task.p, task.t_s, seed=task.seed, t_heat=task.times.t_heat,
+                                  material=_material(task, SINTER), **prep)
+        return sp.schedule_doc(task.n, task.p, task.t_s, seed=task.seed, material=_material(task, SINTER), **prep)
     if task.kind == PREPARE3D:
         return sp.preparation_doc(task.n, task.p, seed=task.seed, material=material, dimension=3, spread=SPREAD3D)
     return sp.heated_walls_doc(parent, task.p, hot=HOT3D[0], cold=HOT3D[1], duration=SINTER3D_TIME,
@@ -178,7 +293,8 @@ def snapshot(sim) -> dict:
     mech = sim.mechanics
     s = mech.state
     fields = sim.particle_fields()
-    i, j, cf = sim.contact_fields()
+    _, pairs, cf = sim.links()
+    i, j = pairs[:, 0], pairs[:, 1]
     return {"t": np.array(mech.t), "x": s.x.copy(), "radius": s.radius.copy(), "mean_stress": fields["mean_stress"],
             "i": i, "j": j, "fn": cf["normal_force"], "ft": cf["tangential_force"],
             "wall_normal": mech.w.normal.copy(), "wall_q": mech.w.q.copy()}
@@ -237,7 +353,8 @@ def run_task(task: Task, root) -> dict:
 
     def observe():
         writer.observe()
-        if captures and sim.mechanics.t >= captures[0] - 0.5 * interval:  # the first row at (or just before) it
+        elapsed = sim.mechanics.t - sim.mechanics.t_start  # the stage's time (the clock goes on from the state)
+        if captures and elapsed >= captures[0] - 0.5 * interval:  # the first row at (or just before) it
             captures.pop(0)
             snaps.append(snapshot(sim))
 

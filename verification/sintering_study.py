@@ -1,6 +1,6 @@
 """The finished runs of the sintering section read back: time series, contacts and snapshots, and what is derived
 from them (the joined history of Fig. 7, the compression test's failure and stiffness, the three-particle control,
-the coordination number without rattlers). :class:`Missing` is raised for a run that is not there.
+the coordination number without rattlers and away from the walls). :class:`Missing` is raised for a run that is not there.
 """
 
 from __future__ import annotations
@@ -47,8 +47,12 @@ class Study:
 
     @functools.lru_cache(maxsize=None)
     def series(self, task: sr.Task) -> dict:
+        """The time series of ``task`` with ``t`` counted from the stage's start (its first row): a stage run from
+        a saved state goes on with the state's clock."""
         self.res(task.kind, task.n, task.p, task.t_s, task.seed, task.variant)
-        return read_csv(self.root / task.folder / "timeseries.csv")
+        s = read_csv(self.root / task.folder / "timeseries.csv")
+        s["t"] = s["t"] - s["t"][0]
+        return s
 
     @functools.lru_cache(maxsize=None)
     def arrays(self, task: sr.Task) -> dict:
@@ -73,10 +77,10 @@ class Study:
         out["mass_fraction"] = out["volume_fraction"] * ((1.0 - 1e-4 * (120.0 - T_PREPARE)) / scale) ** 2
         return out
 
-    def compression(self, n, p, t_s) -> dict:
+    def compression(self, n, p, t_s, variant: str = "") -> dict:
         """eps_zz = 1 - z/z0, sigma_zz (top wall), sigma_xx (right wall), nu; the failure (:func:`failure`) and the
         stiffness, the slope of sigma_zz against eps_zz while the stress rises from p to half way to failure."""
-        s = self.series(self.task(sr.COMPRESS, n, p, t_s))
+        s = self.series(self.task(sr.COMPRESS, n, p, t_s, variant=variant))
         before = self.res(sr.COOL, n, p, t_s)
         z = -s["q_top"]
         eps = 1.0 - z / z[0]
@@ -91,13 +95,13 @@ class Study:
                 "failure_stress": float(szz[k]), "failure_strain": float(eps[k]), "stiffness": stiffness,
                 "kinetic_over_work": float(np.max(s["kinetic_energy"][:k + 1]) / work[k]) if work[k] > 0 else math.nan}
 
-    def three(self, p) -> list[float]:
+    def three(self, p, variant: str = "", seeds=None) -> list[float]:
         """Densification nu(t_f)/nu(t_heat) - 1 of the three-particle controls (one per seed)."""
         out = []
-        times = Times(t_s=self.t_max)
-        for seed in self.grid.three_seeds:
-            s = self.series(self.task(sr.SCHEDULE, 3, p, self.t_max, seed))
-            out.append(float(s["volume_fraction"][-1] / at(s, times.t_heat)["volume_fraction"] - 1.0))
+        for seed in self.grid.three_seeds if seeds is None else seeds:
+            task = self.task(sr.SCHEDULE, 3, p, self.t_max, seed, variant)
+            s = self.series(task)
+            out.append(float(s["volume_fraction"][-1] / at(s, task.times.t_heat)["volume_fraction"] - 1.0))
         return out
 
 
@@ -131,3 +135,13 @@ def without_rattlers(i, j, n: int) -> tuple[float, int]:
         if not np.any(drop):
             return (2.0 * np.count_nonzero(both) / max(1, np.count_nonzero(keep))), int(n - np.count_nonzero(keep))
         keep &= ~drop
+
+
+def bulk_coordination(a: dict, k: int = 0) -> tuple[float, int]:
+    """``(C, n)``: the mean number of pair contacts of the ``n`` particles of snapshot ``k`` of an ``analysis.npz``
+    (:func:`verification.sintering_runs.snapshot`) that touch no wall."""
+    x, r, i, j = a[f"snap{k}_x"], a[f"snap{k}_radius"], a[f"snap{k}_i"], a[f"snap{k}_j"]
+    gap = x @ a[f"snap{k}_wall_normal"].T - a[f"snap{k}_wall_q"][None, :]
+    bulk = ~np.any(gap < r[:, None], axis=1)
+    degree = np.bincount(i, minlength=len(r)) + np.bincount(j, minlength=len(r))
+    return float(np.mean(degree[bulk])), int(np.count_nonzero(bulk))

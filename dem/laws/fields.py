@@ -4,7 +4,7 @@ elsewhere, and the sign each number must have -- one ``ValueError`` naming the f
 from __future__ import annotations
 
 import math
-from dataclasses import fields
+from dataclasses import MISSING, fields
 
 import numpy as np
 
@@ -29,15 +29,16 @@ def check_fields(material, section: str, positive: dict, nonnegative: dict, flag
 
 def material_from_table(cls, law: str, values: dict):
     """The material ``cls`` of the contact law ``law`` from a scene's ``[contact]`` values (without ``law``): every
-    field required, no other; a bad value is reported as ``[contact] name = value: rule``."""
+    field without a default required, no other; a bad value is reported as ``[contact] name = value: rule``."""
     names = [f.name for f in fields(cls)]
     extra = sorted(set(values) - set(names))
     if extra:
         raise ValueError(f"[contact] {extra[0]}: not a parameter of law = \"{law}\" (its parameters: "
                          f"{', '.join(names)})")
-    missing = [name for name in names if name not in values]
+    required = [f.name for f in fields(cls) if f.default is MISSING]
+    missing = [name for name in required if name not in values]
     if missing:
-        raise ValueError(f"[contact] {missing[0]}: required (law = \"{law}\" needs {', '.join(names)})")
+        raise ValueError(f"[contact] {missing[0]}: required (law = \"{law}\" needs {', '.join(required)})")
     try:
         return cls(**values)
     except ValueError as exc:
