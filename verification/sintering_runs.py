@@ -176,9 +176,9 @@ def snapshot(sim) -> dict:
     mech = sim.mechanics
     s = mech.state
     fields = sim.particle_fields()
-    i, j, cf = sim.contact_fields()
+    _, pairs, cf = sim.links()
     return {"t": np.array(mech.t), "x": s.x.copy(), "radius": s.radius.copy(), "mean_stress": fields["mean_stress"],
-            "i": i, "j": j, "fn": cf["normal_force"], "ft": cf["tangential_force"],
+            "i": pairs[:, 0], "j": pairs[:, 1], "fn": cf["normal_force"], "ft": cf["tangential_force"],
             "wall_normal": mech.w.normal.copy(), "wall_q": mech.w.q.copy()}
 
 
