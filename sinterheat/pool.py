@@ -33,6 +33,7 @@ to its end there (Dask does not stop a running task), so its files may still lan
 from __future__ import annotations
 
 import contextlib
+import logging
 import multiprocessing
 import os
 import sys
@@ -44,7 +45,7 @@ from sinterheat.interrupt import ignore_interrupts, shielded, stop_pool, where
 
 INSTALL = "pip install '.[dask]' (in the repository; or pip install 'dask[distributed]')"  #: how to get Dask
 LOCAL = "local"  #: the ``--scheduler`` value that starts a LocalCluster on this machine
-CONNECT_TIMEOUT = 20.0  # s to reach a scheduler before giving up
+CONNECT_TIMEOUT = 10.0  # s to reach a scheduler before giving up
 _client = None  # the Dask client of the enclosing use_dask(), if any
 
 
@@ -67,34 +68,51 @@ def check_scheduler(scheduler: str) -> str:
 
 
 @contextlib.contextmanager
-def use_dask(scheduler: str | None, workers: int | None = None):
-    """Within the block, every :func:`pool` is the Dask cluster ``scheduler`` (module docstring); ``None`` changes
-    nothing. ``workers``: processes of a ``"local"`` cluster (default: all cores). A scheduler that cannot be
-    reached within :data:`CONNECT_TIMEOUT` is an ``OSError``."""
+def use_dask(scheduler, workers: int | None = None):
+    """Within the block, every :func:`pool` is the Dask cluster ``scheduler`` (module docstring): ``"local"`` (a
+    ``LocalCluster`` of ``workers`` processes, default all cores, closed at the end), a scheduler's address (a
+    scheduler that cannot be reached within :data:`CONNECT_TIMEOUT` is an ``OSError``), or a
+    ``distributed.Client`` of the caller's (used as it is); ``None`` changes nothing. When the block ends by an
+    error or an interrupt, Dask's log lines while it closes (jobs cancelled, workers killed) are silenced: the
+    error's one line is what the user reads."""
     global _client
     if scheduler is None:
         yield None
         return
+    log = logging.getLogger("distributed")
+    level = log.level
+    try:
+        with contextlib.ExitStack() as stack:
+            client = scheduler if not isinstance(scheduler, str) else _connect(stack, scheduler, workers)
+            previous, _client = _client, client
+            try:
+                yield client
+            except BaseException:
+                log.setLevel(logging.CRITICAL)
+                raise
+            finally:
+                _client = previous
+    finally:
+        log.setLevel(level)
+
+
+def _connect(stack: contextlib.ExitStack, scheduler: str, workers: int | None):
+    """A ``distributed.Client`` of ``scheduler`` (``"local"``: on a new ``LocalCluster``), closed with ``stack``."""
     check_scheduler(scheduler)
     from distributed import Client, LocalCluster
 
-    with contextlib.ExitStack() as stack:
-        if scheduler == LOCAL:
-            with shielded():  # its event-loop thread and so every worker process it spawns block SIGINT
-                cluster = stack.enter_context(LocalCluster(
-                    n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                    dashboard_address=None, scheduler_kwargs={"dashboard": False}))
-            client = stack.enter_context(Client(cluster))
-        else:
-            try:
-                client = stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT))
-            except OSError as exc:
-                raise OSError(f"scheduler {scheduler}: cannot connect ({' '.join(str(exc).split())})") from None
-        previous, _client = _client, client
-        try:
-            yield client
-        finally:
-            _client = previous
+    if scheduler == LOCAL:
+        # SIGINT blocked in its event-loop thread and so in every worker process it spawns; its HTTP server on a
+        # free port (another cluster may hold the default 8787)
+        with shielded():
+            cluster = stack.enter_context(LocalCluster(
+                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                dashboard_address=":0", scheduler_kwargs={"dashboard": False}, silence_logs=logging.ERROR))
+        return stack.enter_context(Client(cluster))
+    try:
+        return stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT))
+    except OSError as exc:
+        raise OSError(f"scheduler {scheduler}: cannot connect ({' '.join(str(exc).split())})") from None
 
 
 def pool(workers: int | None = None, *, start: str = "fork"):

@@ -450,7 +450,7 @@ def enter_scheduler(stack: contextlib.ExitStack, prog: str, scheduler: str | Non
     try:
         stack.enter_context(use_dask(scheduler))
     except OSError as exc:
-        sys.stderr.write(f"{prog}: error: --scheduler {scheduler}: {' '.join(str(exc).split())}\n")
+        sys.stderr.write(f"{prog}: error: {' '.join(str(exc).split())}\n")  # names the scheduler
         return False
     return True
 
