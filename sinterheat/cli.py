@@ -7,7 +7,9 @@ dict (``--json``: one object on stdout, nothing else), turns a ``ValueError`` in
 Warnings raised while a command runs (e.g. numpy overflow in an extreme input) are collected: after an error only
 the one error line is printed; after success each distinct warning is one ``warning:`` line on stderr. Ctrl-C ends
 any command with one line saying where it stopped and exit code 130 (:mod:`sinterheat.interrupt`); commands report
-their progress with ``sinterheat.interrupt.where().update(...)``.
+their progress with ``sinterheat.interrupt.where().update(...)``. A command with ``--scheduler``
+(:func:`add_scheduler_option`) runs inside that Dask cluster (:func:`sinterheat.pool.use_dask`); one that cannot be
+reached is an ``OSError``: one line, exit code 2.
 """
 
 from __future__ import annotations
