@@ -45,7 +45,7 @@ from sinterheat.interrupt import ignore_interrupts, shielded, stop_pool, where
 
 INSTALL = "pip install '.[dask]' (in the repository; or pip install 'dask[distributed]')"  #: how to get Dask
 LOCAL = "local"  #: the ``--scheduler`` value that starts a LocalCluster on this machine
-CONNECT_TIMEOUT = 10.0  # s to reach a scheduler before giving up
+CONNECT_TIMEOUT = 10.0  #: s to reach a scheduler before giving up
 _client = None  # the Dask client of the enclosing use_dask(), if any
 
 
