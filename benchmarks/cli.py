@@ -15,6 +15,7 @@ finished). The peers are optional (``pip install '.[peers]'``); their rows are s
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
 import sys
@@ -22,7 +23,7 @@ import sys
 from benchmarks import SUBJECTS
 from benchmarks.timing import available, package_version
 from sinterheat.cli import OneLineParser
-from verification.report import OK, Report, add_run_options, prepare_out, print_report
+from verification.report import OK, Report, add_run_options, enter_scheduler, prepare_out, print_report
 
 PROG = "python -m benchmarks"
 DEFAULT_OUT = "benchmark-results"
@@ -61,13 +62,16 @@ def _main(argv, here) -> int:
     report = Report(out, " ".join(subjects), args.quick, program=PROG, title=TITLE,
                     preamble=f"Peers: {peers}. Load average at start {os.getloadavg()[0]:.1f}: other processes "
                              "inflate wall times, so comparisons are timed side by side and given as ratios.")
-    for k, name in enumerate(subjects):
-        here.update(stage=f"subject {name}", step=f"{k} of {len(subjects)} subjects done", out=out)
-        module = importlib.import_module(SUBJECTS[name])
-        section = report.section(name, module.TITLE)
-        with section.running():
-            module.run(section, args.quick)
-        if section.status != OK:
-            sys.stderr.write(f"{PROG}: {name}: {section.status}: {section.error}\n")
+    with contextlib.ExitStack() as cluster:
+        if not enter_scheduler(cluster, PROG, args.scheduler):
+            return 2
+        for k, name in enumerate(subjects):
+            here.update(stage=f"subject {name}", step=f"{k} of {len(subjects)} subjects done", out=out)
+            module = importlib.import_module(SUBJECTS[name])
+            section = report.section(name, module.TITLE)
+            with section.running():
+                module.run(section, args.quick)
+            if section.status != OK:
+                sys.stderr.write(f"{PROG}: {name}: {section.status}: {section.error}\n")
     print_report(report, args.json)
     return 1 if report.failed else 0

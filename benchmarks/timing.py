@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import pathlib
 import subprocess
 import sys
@@ -79,18 +80,30 @@ def run_worker(module: str, func: str, n: int, timeout: float) -> dict:
     return json.loads(lines[-1])
 
 
+def _sized_row(module: str, func: str, n: int, timeout: float) -> tuple[int, dict]:
+    """A size sweep's job: ``n`` and its :func:`run_worker` row."""
+    return n, run_worker(module, func, n, timeout)
+
+
 def worker_sweep(section, name: str, module: str, func: str, sizes, timeout: float,
                  stop_at_error: bool = False) -> list[dict]:
-    """:func:`run_worker` for each of ``sizes`` in turn, the rows so far written to ``section``'s CSV ``name`` after
-    each (an interrupted bench keeps them); with ``stop_at_error`` the larger sizes are skipped after a failed one.
-    Returns every row, failed ones included (they hold ``error``)."""
-    rows = []
-    for n in sizes:
-        rows.append(run_worker(module, func, n, timeout))
-        section.csv(name, rows)
-        if stop_at_error and "error" in rows[-1]:
-            break
-    return rows
+    """:func:`run_worker` for each of ``sizes`` (ascending), independent jobs of :func:`sinterheat.pool.run_jobs`:
+    one after another here (timings must not share the cores), all at once on a Dask cluster (each size on a worker
+    of its own). The rows so far, in order of size, are written to ``section``'s CSV ``name`` after each (an
+    interrupted bench keeps them); with ``stop_at_error`` the sizes above a failed one are left out (here: not run).
+    Returns the rows, failed ones included (they hold ``error``)."""
+    from sinterheat.pool import run_jobs
+
+    rows, failed_at = {}, math.inf
+    jobs = [(_sized_row, (module, func, n, timeout)) for n in sizes]
+    for n, row in run_jobs(jobs, workers=1, desc=name, unit="size"):
+        rows[n] = row
+        if stop_at_error and "error" in row:
+            failed_at = min(failed_at, n)
+        section.csv(name, [rows[m] for m in sorted(rows) if m <= failed_at])
+        if all(m in rows for m in sizes if m < failed_at) and failed_at < math.inf:
+            break  # the sizes below the failed one are in: stop the others
+    return [rows[m] for m in sorted(rows) if m <= failed_at]
 
 
 def emit(record: dict) -> None:

@@ -2,10 +2,11 @@
 
 * :func:`sweep_points` -- the a/r of the sweep: ``n // 8`` points log-spaced on [0.001, 0.02) for the small-neck
   end, the rest uniform in a/r on (0, 0.97] (``0.97 k / m``, k = 1..m), the sampling of Rojek 2022, Fig. 16.
-* :func:`sweep` -- solves every point to the tolerance in a process pool (gmsh is one global, thread-unsafe state
-  per process), appending each result to ``fit.csv`` as it arrives so an interrupted run resumes where it stopped.
-  A point is reused only when it was computed by the same solver and method to the same tolerance
-  (:func:`reusable_points`; the CSV records all three); ``run_fit(..., fresh=True)`` recomputes every point.
+* :func:`sweep` -- solves every point to the tolerance in a process pool or on a Dask cluster
+  (:mod:`sinterheat.pool`; processes: gmsh is one global, thread-unsafe state per process), appending each result
+  to ``fit.csv`` as it arrives so an interrupted run resumes where it stopped. A point is reused only when it was
+  computed by the same solver and method to the same tolerance (:func:`reusable_points`; the CSV records all
+  three); ``run_fit(..., fresh=True)`` recomputes every point.
 * :func:`linear_slope` -- ``K/K_cyl = c a/r`` by least squares through the origin on the uniform points with
   ``a/r <= 0.7`` (Rojek 2022, eq. 40); :func:`slope_sensitivity` shows how c moves with the sampling.
 * :func:`fit_law` -- B, C, E of :class:`fem_neck.law.ConductanceLaw` (A = 5/(4 pi) is derived), least squares on
@@ -23,18 +24,14 @@ from __future__ import annotations
 import csv
 import importlib
 import json
-import multiprocessing
-import os
 import pathlib
-import sys
-import threading
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from sinterheat.interrupt import ignore_interrupts, shielded, stop_pool, where
+from sinterheat.interrupt import where
+from sinterheat.pool import run_jobs
 from fem_neck.law import A_LOG, ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, neck_resistance
 
 SOLVER = "fem_neck.conduction:semisphere_conductance"  #: the FE solver of a sweep point
@@ -135,66 +132,16 @@ def _append(path: pathlib.Path, point: FitPoint) -> None:
         w.writerow(_csv_row(point))
 
 
-def _pool_context():
-    # fork starts workers warm (the solver module is imported in the parent first); spawn where fork is absent.
-    return multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-
-
-def in_processes(jobs, workers: int | None = None, *, desc: str = "", progress: bool = True, done: int = 0,
-                 meanwhile=None):
-    """Run ``func(*args)`` for every ``(func, args)`` of ``jobs`` in a process pool; yield results as they finish.
-
-    Processes, not threads: gmsh is one global, thread-unsafe state per process. ``workers`` defaults to all cores;
-    one worker (or one job) runs in this process. A tqdm bar on stderr counts ``done`` jobs finished earlier plus
-    these, and so does the run's :func:`sinterheat.interrupt.where` (its step). Workers ignore Ctrl-C; on an
-    interrupt (or any error, or when the caller stops iterating) the pool is stopped at once. ``meanwhile()`` runs
-    in a thread of this process once the workers are forked (e.g. importing what the caller needs next, while this
-    process would otherwise only wait).
-    """
-    from tqdm import tqdm
-
-    here = where()
-    label = f"{desc}: " if desc else ""
-    total = done + len(jobs)
-    here.update(step=f"{label}{done} of {total} solves done")
-    workers = workers or os.cpu_count() or 1
-    with tqdm(total=total, initial=done, desc=desc, unit="solve", file=sys.stderr, disable=not progress) as bar:
-        if not jobs:
-            return
-        pool = None
-        try:
-            if workers == 1 or len(jobs) == 1:  # no pool to start: fast solves (the hp path) finish before it would
-                results = (func(*args) for func, args in jobs)
-            else:
-                pool = ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=_pool_context(),
-                                           initializer=ignore_interrupts)
-                with shielded():  # the workers are forked here: none can catch the Ctrl-C meant for this process
-                    futures = [pool.submit(func, *args) for func, args in jobs]
-                if meanwhile is not None:
-                    threading.Thread(target=meanwhile, daemon=True).start()
-                results = (fut.result() for fut in as_completed(futures))
-            for result in results:
-                bar.update()
-                yield result
-                done += 1  # counted once the caller has taken it (e.g. written it to a file)
-                here.update(step=f"{label}{done} of {total} solves done")
-        except BaseException:
-            if pool is not None:
-                stop_pool(pool)
-            raise
-        if pool is not None:
-            pool.shutdown()
-
-
 def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int | None = None,
           solver: str = SOLVER, method: str = METHOD, progress: bool = True, reuse=None,
           meanwhile=None) -> list[FitPoint]:
-    """Solve the semisphere at every a/r to ``rtol`` on ``workers`` processes (default: all cores).
+    """Solve the semisphere at every a/r to ``rtol`` on ``workers`` processes (default: all cores), or on the Dask
+    cluster of :func:`sinterheat.pool.use_dask`.
 
     ``reuse``: points solved before, keyed by a/r (:func:`reusable_points`); those at the sweep's a/r are kept
     instead of solved. With ``csv_path`` the CSV is rewritten with the kept points and each new point is appended
-    as soon as it is solved, so an interrupted sweep loses nothing. ``meanwhile``: see :func:`in_processes`.
-    Returns the points sorted by a/r.
+    as soon as it is solved, so an interrupted sweep loses nothing. ``meanwhile``: see
+    :func:`sinterheat.pool.run_jobs`. Returns the points sorted by a/r.
     """
     if not (isinstance(rtol, float) and 0.0 < rtol < 0.1):
         raise ValueError(f"rtol = {rtol!r}: must be a float in (0, 0.1)")
@@ -216,8 +163,8 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
         importlib.import_module(solver.split(":")[0])  # fail early in the parent, and let fork start warm
     jobs = [(_solve_point, (solver, method, xi, rtol)) for xi, _ in todo]
     uniform_of = {_key(xi): ui for xi, ui in todo}
-    for res in in_processes(jobs, workers, desc="fit sweep", progress=progress, done=len(points),
-                            meanwhile=meanwhile):
+    for res in run_jobs(jobs, workers, desc="fit sweep", unit="solve", progress=progress, done=len(points),
+                        meanwhile=meanwhile):
         p = FitPoint(**res, uniform=uniform_of[_key(res["a_over_r"])])
         points[_key(p.a_over_r)] = p
         if csv_path is not None:
@@ -395,5 +342,5 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
     return result
 
 
-__all__ = ["FitPoint", "METHOD", "SOLVER", "fit_law", "import_plotting", "in_processes", "linear_slope", "plot",
+__all__ = ["FitPoint", "METHOD", "SOLVER", "fit_law", "import_plotting", "linear_slope", "plot",
            "read_points", "reusable_points", "run_fit", "slope_sensitivity", "sweep", "sweep_points"]

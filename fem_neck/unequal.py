@@ -22,8 +22,8 @@ import time
 import numpy as np
 
 from fem_neck import law as laws
-from fem_neck.fit import in_processes
 from fem_neck.geometry import overlap_for_neck
+from sinterheat.pool import run_jobs
 
 RATIOS = (1.0, 2.0, 3.0, 5.0, 10.0)
 NECKS = (0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95)
@@ -61,7 +61,7 @@ def study(ratios=RATIOS, necks=NECKS, rtol: float = 1e-4, out=None, *, workers: 
     jobs = [(_solve_pair, (1.0, q, float(overlap_for_neck(1.0, q, x)), 1.0, rtol)) for q in ratios for x in necks]
     p = PAPER_CASE
     jobs.append((_solve_pair, (p["r_i"], p["r_j"], p["h"], p["kappa"], paper_rtol)))
-    results = list(in_processes(jobs, workers, desc="unequal pairs", progress=progress))
+    results = list(run_jobs(jobs, workers, desc="unequal pairs", unit="solve", progress=progress))
     paper = next(r for r in results if r["kappa"] == p["kappa"])
     rows = sorted((r for r in results if r is not paper), key=lambda r: (r["r_j"], r["a"]))
 

@@ -7,12 +7,15 @@ dict (``--json``: one object on stdout, nothing else), turns a ``ValueError`` in
 Warnings raised while a command runs (e.g. numpy overflow in an extreme input) are collected: after an error only
 the one error line is printed; after success each distinct warning is one ``warning:`` line on stderr. Ctrl-C ends
 any command with one line saying where it stopped and exit code 130 (:mod:`sinterheat.interrupt`); commands report
-their progress with ``sinterheat.interrupt.where().update(...)``.
+their progress with ``sinterheat.interrupt.where().update(...)``. A command with ``--scheduler``
+(:func:`add_scheduler_option`) runs inside that Dask cluster (:func:`sinterheat.pool.use_dask`); one that cannot be
+reached is an ``OSError``: one line, exit code 2.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import json
 import math
@@ -60,6 +63,23 @@ def add_workers_option(parser: argparse.ArgumentParser) -> None:
     """``--workers W``: processes of a parallel sweep (default: all cores), checked to be >= 1."""
     parser.add_argument("--workers", type=_worker_count, default=None, metavar="W",
                         help="processes (default: all cores)")
+
+
+def _scheduler(text: str) -> str:
+    from sinterheat.pool import check_scheduler
+
+    try:
+        return check_scheduler(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def add_scheduler_option(parser: argparse.ArgumentParser) -> None:
+    """``--scheduler ADDRESS``: the sweep's jobs on a Dask cluster (:func:`sinterheat.pool.use_dask`); without Dask
+    installed the option is refused with how to install it."""
+    parser.add_argument("--scheduler", type=_scheduler, default=None, metavar="ADDRESS",
+                        help="run the independent jobs on a Dask cluster: a scheduler's address (tcp://host:8786) or "
+                             "'local' (a LocalCluster of --workers processes here); needs pip install '.[dask]'")
 
 
 def _format(value) -> str:
@@ -136,7 +156,8 @@ def _main(argv, here, prog, description, modules, package) -> int:
     here.update(stage=args.command)
     with warnings.catch_warnings(record=True) as caught:
         try:
-            result = args.run(args)
+            with _cluster(args):
+                result = args.run(args)
         except (ValueError, OSError) as exc:  # bad input, or an output path that cannot be written
             if here.signalled:  # not bad input: an interrupt that C code turned into this error
                 raise
@@ -148,6 +169,16 @@ def _main(argv, here, prog, description, modules, package) -> int:
         sys.stderr.write(f"{prog} {args.command}: warning: {text}\n")
     print_result(result, args.json)
     return 0
+
+
+def _cluster(args):
+    """The Dask cluster of ``--scheduler`` around the command, if the option is given."""
+    scheduler = getattr(args, "scheduler", None)
+    if scheduler is None:
+        return contextlib.nullcontext()
+    from sinterheat.pool import use_dask
+
+    return use_dask(scheduler, getattr(args, "workers", None))
 
 
 def _one_line(message) -> str:

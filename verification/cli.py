@@ -18,11 +18,12 @@ report keeps the finished sections, :mod:`sinterheat.interrupt`).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 
 from sinterheat.cli import OneLineParser
-from verification.report import add_run_options, prepare_out, print_report, run_sections
+from verification.report import add_run_options, enter_scheduler, prepare_out, print_report, run_sections
 
 PROG = "python -m verification"
 DEFAULT_OUT = "verification-results"
@@ -66,7 +67,10 @@ def _main(argv, here) -> int:
         return 2
     if args.no_progress:
         os.environ["TQDM_DISABLE"] = "1"  # also silences the sections' own bars (and those of worker processes)
-    report = run_sections(COMMANDS[args.command][0], out, args.command, quick=args.quick,
-                          progress=not args.no_progress)
+    with contextlib.ExitStack() as cluster:
+        if not enter_scheduler(cluster, f"{PROG} {args.command}", args.scheduler):
+            return 2
+        report = run_sections(COMMANDS[args.command][0], out, args.command, quick=args.quick,
+                              progress=not args.no_progress)
     print_report(report, args.json)
     return 1 if report.failed else 0

@@ -66,20 +66,48 @@ class FECache:
         self.data = json.loads(path.read_text()) if path.exists() else {}
         self.version = _code_version()
 
-    def get(self, key: str, compute):
-        full = f"{key} @{self.version}"
-        if full not in self.data:
-            self.data[full] = compute()
-            self.path.write_text(json.dumps(jsonable(self.data), indent=1))
-        return self.data[full]
+    def _full(self, key: str) -> str:
+        return f"{key} @{self.version}"
+
+    def __contains__(self, key: str) -> bool:
+        return self._full(key) in self.data
+
+    def put(self, key: str, value) -> None:
+        """Store ``value`` under ``key`` and rewrite the file."""
+        self.data[self._full(key)] = value
+        self.path.write_text(json.dumps(jsonable(self.data), indent=1))
+
+    def __getitem__(self, key: str):
+        return self.data[self._full(key)]
 
 
-def fe_cell(cell: lattice.PeriodicCell, rtol: float) -> dict:
-    """``k_eff / kappa`` of the cell along z with its bounds (:func:`fem_neck.lattice.effective_conductivity`)."""
-    res = lattice.effective_conductivity(cell, rtol=rtol)
+def fe_cell(cell: lattice.PeriodicCell, rtol: float, workers: int = 2) -> dict:
+    """``k_eff / kappa`` of the cell along z with its bounds (:func:`fem_neck.lattice.effective_conductivity`, its
+    two bounds in ``workers`` processes)."""
+    res = lattice.effective_conductivity(cell, rtol=rtol, workers=workers)
     return {"k": res.k_eff_over_kappa, "lower": res.k_lower_over_kappa, "upper": res.k_upper_over_kappa,
             "error_estimate": res.error_estimate, "converged": res.converged, "elements": res.elements,
             "order": res.order, "seconds": res.seconds}
+
+
+def _fe_job(key: str, cell: lattice.PeriodicCell, rtol: float) -> tuple[str, dict]:
+    """One FE cell of the sweep, a pool's job: its cache key and :func:`fe_cell` (in a daemonic process -- a Dask
+    worker -- both bounds in that process: it may not start another)."""
+    import multiprocessing
+
+    return key, fe_cell(cell, rtol, workers=1 if multiprocessing.current_process().daemon else 2)
+
+
+def solve_cells(cells: dict, rtol: float, cache: FECache) -> list[dict]:
+    """:func:`fe_cell` of every cell of ``cells`` (cache key -> cell), in their order; those not in ``cache`` are
+    independent jobs of :func:`sinterheat.pool.run_jobs` -- here one after another, in this process (each FE
+    already solves its two bounds in two processes), on a Dask cluster all at once -- each cached as it arrives."""
+    from sinterheat.pool import run_jobs
+
+    jobs = [(_fe_job, (key, cell, rtol)) for key, cell in cells.items() if key not in cache]
+    for key, fe in run_jobs(jobs, workers=1, desc="lattice FE", unit="cell", done=len(cells) - len(jobs)):
+        cache.put(key, fe)
+    return [cache[key] for key in cells]
 
 
 @functools.lru_cache(maxsize=None)
@@ -119,26 +147,25 @@ def _rel(value: float, ref: float) -> float:
 
 
 def lattice_rows(necks: dict, rtol: float, cache: FECache, names: tuple) -> list:
+    cases = [(kind, x, overlap_for_neck(1.0, 1.0, x)) for kind, xs in necks.items() for x in xs]
+    cells = {f"{kind} a/r={x:g} rtol={rtol:g}": lattice.lattice_cell(kind, h) for kind, x, h in cases}
     rows = []
-    for kind, xs in necks.items():
-        for x in xs:
-            h = overlap_for_neck(1.0, 1.0, x)
-            cell = lattice.lattice_cell(kind, h)
-            fe = cache.get(f"{kind} a/r={x:g} rtol={rtol:g}", lambda: fe_cell(cell, rtol))
-            nets = {law: dem_periodic(cell, law) for law in names}
-            rows.append({"case": f"{kind.upper()} a/r={x:g}", "kind": kind, "z": lattice.COORDINATION[kind],
-                         "a_over_r": x, "h_over_r": h, "phi": cell.phi, "fe": fe, "network": nets,
-                         "rel": {law: _rel(v, fe["k"]) for law, v in nets.items()}})
+    for (kind, x, h), cell, fe in zip(cases, cells.values(), solve_cells(cells, rtol, cache)):
+        nets = {law: dem_periodic(cell, law) for law in names}
+        rows.append({"case": f"{kind.upper()} a/r={x:g}", "kind": kind, "z": lattice.COORDINATION[kind],
+                     "a_over_r": x, "h_over_r": h, "phi": cell.phi, "fe": fe, "network": nets,
+                     "rel": {law: _rel(v, fe["k"]) for law, v in nets.items()}})
     return rows
 
 
 def random_rows(cases, rtol: float, cache: FECache, names: tuple) -> list:
     from verification.packings import mirror_packing
 
+    cells = {f"mirror packing seed={seed} overlap={overlap:g} rtol={rtol:g}": mirror_packing(10, overlap=overlap,
+                                                                                         seed=seed)
+             for seed, overlap in cases}
     rows = []
-    for seed, overlap in cases:
-        cell = mirror_packing(10, overlap=overlap, seed=seed)
-        fe = cache.get(f"mirror packing seed={seed} overlap={overlap:g} rtol={rtol:g}", lambda: fe_cell(cell, rtol))
+    for (seed, overlap), cell, fe in zip(cases, cells.values(), solve_cells(cells, rtol, cache)):
         i, j, s = cell.bonds()
         d = np.linalg.norm(cell.centres[j] + s * cell.period - cell.centres[i], axis=1)
         r_min = np.minimum(cell.radii[i], cell.radii[j])

@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sinterheat.cli import print_result
+from sinterheat.cli import add_scheduler_option, print_result
 
 CONTRACT_KEYS = ("title", "markdown", "summary", "figures")
 OK, FAIL, ERROR, NOT_AVAILABLE, RUNNING, INTERRUPTED = "ok", "fail", "error", "not available", "running", \
@@ -415,12 +415,14 @@ def records_table(rows: list[dict], columns: list[str] | None = None, fmt: str =
 
 # --- the commands that write reports (python -m verification, python -m benchmarks) ---------------------------------
 def add_run_options(parser, default_out: str, quick_help: str) -> None:
-    """The options of a report command: ``--quick``, ``--out DIR``, ``--json`` and ``--no-progress``."""
+    """The options of a report command: ``--quick``, ``--out DIR``, ``--json``, ``--no-progress`` and
+    ``--scheduler`` (the sweeps' jobs on a Dask cluster, :mod:`sinterheat.pool`)."""
     parser.add_argument("--quick", action="store_true", help=quick_help)
     parser.add_argument("--out", metavar="DIR", default=default_out, help=f"output folder (default: {default_out})")
     parser.add_argument("--json", action="store_true", help="print summary.json as one JSON object on stdout")
     parser.add_argument("--no-progress", action="store_true",
                         help="no progress bars on stderr (none of the sections' either)")
+    add_scheduler_option(parser)
 
 
 def prepare_out(prog: str, out_text: str) -> pathlib.Path | None:
@@ -438,6 +440,19 @@ def prepare_out(prog: str, out_text: str) -> pathlib.Path | None:
         sys.stderr.write(f"{prog}: error: --out {out_text}: cannot be created ({exc.strerror})\n")
         return None
     return out
+
+
+def enter_scheduler(stack: contextlib.ExitStack, prog: str, scheduler: str | None) -> bool:
+    """Enter the Dask cluster of ``--scheduler`` (if given) on ``stack``; ``False`` after one line on stderr when it
+    cannot be reached (the caller exits 2)."""
+    from sinterheat.pool import use_dask
+
+    try:
+        stack.enter_context(use_dask(scheduler))
+    except OSError as exc:
+        sys.stderr.write(f"{prog}: error: {' '.join(str(exc).split())}\n")  # names the scheduler
+        return False
+    return True
 
 
 def print_report(report, as_json: bool) -> None:

@@ -13,19 +13,17 @@ snapshots at the stage's end) and, last, ``result.json``. A folder holding ``res
 skips it. The preparation of each (N, p) runs once and every t_s starts from its state; each cooled state is the
 start of both tests.
 
-:func:`run_tasks` runs a list of tasks (and the tasks they need) in a pool of worker processes, each task as soon
-as the one it starts from has finished, the longest first.
+:func:`run_tasks` runs a list of tasks (and the tasks they need) in a pool of worker processes or on a Dask cluster
+(:mod:`sinterheat.pool`), each task as soon as the one it starts from has finished, the longest first.
 """
 
 from __future__ import annotations
 
 import json
-import multiprocessing
 import pathlib
 import sys
 import time
 import traceback
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
@@ -294,9 +292,8 @@ def snapshot(sim) -> dict:
     s = mech.state
     fields = sim.particle_fields()
     _, pairs, cf = sim.links()
-    i, j = pairs[:, 0], pairs[:, 1]
     return {"t": np.array(mech.t), "x": s.x.copy(), "radius": s.radius.copy(), "mean_stress": fields["mean_stress"],
-            "i": i, "j": j, "fn": cf["normal_force"], "ft": cf["tangential_force"],
+            "i": pairs[:, 0], "j": pairs[:, 1], "fn": cf["normal_force"], "ft": cf["tangential_force"],
             "wall_normal": mech.w.normal.copy(), "wall_q": mech.w.q.copy()}
 
 
@@ -410,19 +407,21 @@ def load_result(root, task: Task) -> dict | None:
 
 
 def run_tasks(tasks, root, workers: int = 2, progress: bool = True) -> dict:
-    """Run ``tasks`` (and their parents) under ``root`` in ``workers`` processes; finished ones are skipped.
-    Returns ``{task: result}``; a failed task's result holds ``error`` and its dependents are not run."""
+    """Run ``tasks`` (and their parents) under ``root`` in ``workers`` processes, or on the Dask cluster of
+    :func:`sinterheat.pool.use_dask` (its workers must share ``root``); finished ones are skipped. Returns ``{task:
+    result}``; a failed task's result holds ``error`` and its dependents are not run."""
     from tqdm import tqdm
 
-    root = pathlib.Path(root)
+    from sinterheat.pool import pool
+
+    root = pathlib.Path(root).resolve()  # the same path on every worker
     everything = with_parents(tasks)
     results = {t: r for t in everything if (r := load_result(root, t)) is not None}
     pending = [t for t in everything if t not in results]
     bar = tqdm(total=len(everything), initial=len(results), desc="sintering runs", unit="run", file=sys.stderr,
                disable=not progress)
     running = {}
-    context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+    with pool(workers, start="spawn") as runs:
         while pending or running:
             finished = {t for t, r in results.items() if "error" not in r}
             ready = sorted((t for t in pending if t.parent is None or t.parent in finished), key=lambda t: -t.cost)
@@ -431,13 +430,13 @@ def run_tasks(tasks, root, workers: int = 2, progress: bool = True) -> dict:
                 results[t] = {"task": asdict(t), "error": f"not run: {t.parent.folder} failed"}
                 pending.remove(t)
                 bar.update(1)
-            for t in ready[:max(0, workers - len(running))]:
-                running[pool.submit(_run_in_worker, t, str(root))] = t
+            free = len(ready) if runs.slots is None else max(0, runs.slots - len(running))
+            for t in ready[:free]:
+                running[runs.submit(_run_in_worker, t, str(root), priority=t.cost)] = t
                 pending.remove(t)
             if not running:
                 continue
-            done, _ = wait(running, return_when=FIRST_COMPLETED)
-            for future in done:
+            for future in runs.wait(running):
                 task = running.pop(future)
                 results[task] = future.result()
                 bar.update(1)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sys
 
-from sinterheat.cli import add_output_options, add_workers_option
+from sinterheat.cli import add_output_options, add_scheduler_option, add_workers_option
 
 
 def register(subparsers) -> None:
@@ -23,6 +23,7 @@ def register(subparsers) -> None:
     p.add_argument("--rtol", type=float, default=1e-4, help="relative tolerance of each FE point (default 1e-4)")
     p.add_argument("--fresh", action="store_true", help="recompute every point (ignore an existing fit.csv)")
     add_workers_option(p)
+    add_scheduler_option(p)
     add_output_options(p)
     p.set_defaults(run=run, out="results/fit")
 

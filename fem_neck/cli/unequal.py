@@ -5,7 +5,7 @@ Writes unequal.json, unequal.csv and unequal.png into --out (default: results/un
 
 from __future__ import annotations
 
-from sinterheat.cli import add_output_options, add_workers_option
+from sinterheat.cli import add_output_options, add_scheduler_option, add_workers_option
 
 
 def register(subparsers) -> None:
@@ -19,6 +19,7 @@ def register(subparsers) -> None:
                    help="neck radii a/r_i in [0.001, 0.99] (default %(default)s)")
     p.add_argument("--rtol", type=float, default=1e-4, help="relative tolerance of each FE solve (default 1e-4)")
     add_workers_option(p)
+    add_scheduler_option(p)
     add_output_options(p)
     p.set_defaults(run=run, out="results/unequal")
 

@@ -1,0 +1,257 @@
+"""Independent jobs over worker processes: a pool on this machine, or a Dask cluster.
+
+The sweeps of the CLIs -- ``python -m fem_neck fit`` and ``unequal``, ``python -m verification sintering`` and
+``lattices``, the size sweeps of ``python -m benchmarks`` -- hand their independent jobs to the pool of
+:func:`pool`:
+
+* by default, worker processes of this machine (``concurrent.futures``: started in a fraction of a second), or this
+  process itself when one worker (or one job) is asked for;
+* inside :func:`use_dask` -- what the CLIs' ``--scheduler`` does -- a ``dask.distributed`` cluster: ``"local"``
+  starts a ``LocalCluster`` of one-thread worker processes on this machine (several seconds), any other value is the
+  address of a running scheduler (``tcp://host:8786``, e.g. one that dask-jobqueue started on SLURM). Dask is an
+  optional extra (``pip install '.[dask]'``); nothing imports it outside :func:`use_dask`.
+
+A job is a module-level function with picklable arguments, so that a worker on another machine imports it by name:
+those workers need the same sinterheat installed, and a job that writes files writes them on its worker's file
+system (a folder that jobs write into must be one the workers share, as a cluster's home or scratch is). A Dask
+worker runs one of these jobs at a time, whatever its thread count (gmsh and the solvers hold one state per
+process).
+
+:func:`run_jobs` runs a list of jobs and yields their results as they finish (a tqdm bar, the run's
+:func:`sinterheat.interrupt.where`); a pool itself serves callers that submit more as results arrive (a grid whose
+runs start from other runs' states): ``submit(func, *args, priority=...)`` returns a future (``result()``),
+``wait(futures)`` blocks until at least one has finished and returns those that have, ``slots`` is how many jobs
+run at once (``None``: as many as are submitted; a Dask scheduler starts the waiting job of highest ``priority``
+first, a local pool the one submitted first).
+
+Ctrl-C. Local workers ignore SIGINT (:func:`sinterheat.interrupt.ignore_interrupts`, started under
+:func:`sinterheat.interrupt.shielded`, as are a ``LocalCluster``'s); the parent stops the pool. On Dask the jobs not
+started are cancelled and a ``LocalCluster`` started here is closed; a job already running on a remote cluster runs
+to its end there (Dask does not stop a running task), so its files may still land after the command has left.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import multiprocessing
+import os
+import sys
+import threading
+import uuid
+from concurrent import futures as cf
+
+from sinterheat.interrupt import ignore_interrupts, shielded, stop_pool, where
+
+INSTALL = "pip install '.[dask]' (in the repository; or pip install 'dask[distributed]')"  #: how to get Dask
+LOCAL = "local"  #: the ``--scheduler`` value that starts a LocalCluster on this machine
+CONNECT_TIMEOUT = 10.0  #: s to reach a scheduler before giving up
+_client = None  # the Dask client of the enclosing use_dask(), if any
+
+
+def dask_available() -> bool:
+    """Whether ``dask.distributed`` can be imported (without importing it)."""
+    import importlib.util
+
+    return importlib.util.find_spec("distributed") is not None
+
+
+def check_scheduler(scheduler: str) -> str:
+    """``scheduler`` if Dask is installed and the value can name one (``"local"`` or an address), else
+    ``ValueError`` saying what is wrong (and how to install Dask)."""
+    if not dask_available():
+        raise ValueError(f"scheduler = {scheduler!r}: Dask is not installed; {INSTALL}")
+    if not scheduler or scheduler != scheduler.strip() or " " in scheduler:
+        raise ValueError(f"scheduler = {scheduler!r}: must be {LOCAL!r} or a scheduler address such as "
+                         "tcp://host:8786")
+    return scheduler
+
+
+@contextlib.contextmanager
+def use_dask(scheduler, workers: int | None = None):
+    """Within the block, every :func:`pool` is the Dask cluster ``scheduler`` (module docstring): ``"local"`` (a
+    ``LocalCluster`` of ``workers`` processes, default all cores, closed at the end), a scheduler's address (a
+    scheduler that cannot be reached within :data:`CONNECT_TIMEOUT` is an ``OSError``), or a
+    ``distributed.Client`` of the caller's (used as it is); ``None`` changes nothing. When the block ends by an
+    error or an interrupt, Dask's log lines while it closes (jobs cancelled, workers killed) are silenced: the
+    error's one line is what the user reads."""
+    global _client
+    if scheduler is None:
+        yield None
+        return
+    log = logging.getLogger("distributed")
+    level = log.level
+    try:
+        with contextlib.ExitStack() as stack:
+            client = scheduler if not isinstance(scheduler, str) else _connect(stack, scheduler, workers)
+            previous, _client = _client, client
+            try:
+                yield client
+            except BaseException:
+                log.setLevel(logging.CRITICAL)
+                raise
+            finally:
+                _client = previous
+    finally:
+        log.setLevel(level)
+
+
+def _connect(stack: contextlib.ExitStack, scheduler: str, workers: int | None):
+    """A ``distributed.Client`` of ``scheduler`` (``"local"``: on a new ``LocalCluster``), closed with ``stack``."""
+    check_scheduler(scheduler)
+    from distributed import Client, LocalCluster
+
+    if scheduler == LOCAL:
+        # SIGINT blocked in its event-loop thread and so in every worker process it spawns; its HTTP server on a
+        # free port (another cluster may hold the default 8787)
+        with shielded():
+            cluster = stack.enter_context(LocalCluster(
+                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                dashboard_address=":0", scheduler_kwargs={"dashboard": False}, silence_logs=logging.ERROR))
+        return stack.enter_context(Client(cluster))
+    try:
+        return stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT))
+    except OSError as exc:
+        raise OSError(f"scheduler {scheduler}: cannot connect ({' '.join(str(exc).split())})") from None
+
+
+def pool(workers: int | None = None, *, start: str = "fork"):
+    """The pool jobs go to, as a context manager (module docstring): the Dask cluster of :func:`use_dask` if one is
+    in use, else ``workers`` local processes (default: all cores), started by ``start`` (``"fork"``: warm, with what
+    this process imported; ``"spawn"``: fresh interpreters), or this process itself for one worker."""
+    if _client is not None:
+        return DaskPool(_client)
+    workers = workers or os.cpu_count() or 1
+    return InProcess() if workers == 1 else ProcessPool(workers, start)
+
+
+class InProcess:
+    """Jobs run in this process, one by one, each when it is waited for (so results still come one at a time)."""
+
+    slots = 1
+
+    def __init__(self):
+        self._queued = {}
+
+    def submit(self, func, *args, priority: float = 0.0) -> cf.Future:
+        future = cf.Future()
+        self._queued[future] = (func, args)
+        return future
+
+    def wait(self, futures) -> set:
+        done = {f for f in futures if f.done()}
+        if done:
+            return done
+        future = next(f for f in futures if f in self._queued)
+        func, args = self._queued.pop(future)
+        try:
+            future.set_result(func(*args))
+        except Exception as exc:  # raised by result(), as from a worker
+            future.set_exception(exc)
+        return {future}
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self._queued.clear()
+
+
+class ProcessPool:
+    """``workers`` processes of this machine that ignore SIGINT; stopped at once when the block ends by an error."""
+
+    def __init__(self, workers: int, start: str):
+        method = start if start in multiprocessing.get_all_start_methods() else "spawn"
+        self.slots = workers
+        self._executor = cf.ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method),
+                                                initializer=ignore_interrupts)
+
+    def submit(self, func, *args, priority: float = 0.0) -> cf.Future:
+        with shielded():  # a worker started here cannot catch the Ctrl-C meant for this process
+            return self._executor.submit(func, *args)
+
+    def wait(self, futures) -> set:
+        return cf.wait(list(futures), return_when=cf.FIRST_COMPLETED).done
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, *exc):
+        if exc_type is None:
+            self._executor.shutdown()
+        else:
+            stop_pool(self._executor)
+
+
+_ONE_AT_A_TIME = threading.Lock()
+
+
+def _alone(func, *args):
+    """A job on a Dask worker: one at a time in its process, whatever the worker's thread count."""
+    with _ONE_AT_A_TIME:
+        return func(*args)
+
+
+class DaskPool:
+    """Jobs on the cluster of a ``distributed.Client``; those not started are cancelled when the block ends by an
+    error (Ctrl-C included)."""
+
+    slots = None
+
+    def __init__(self, client):
+        self._client = client
+        self._submitted = []
+
+    def submit(self, func, *args, priority: float = 0.0):
+        key = f"{getattr(func, '__name__', 'job')}-{uuid.uuid4().hex}"
+        future = self._client.submit(_alone, func, *args, key=key, priority=priority, pure=False)
+        self._submitted.append(future)
+        return future
+
+    def wait(self, futures) -> set:
+        from distributed import wait
+
+        return set(wait(list(futures), return_when="FIRST_COMPLETED").done)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, *exc):
+        if exc_type is not None:
+            with contextlib.suppress(Exception):
+                self._client.cancel([f for f in self._submitted if not f.done()])
+        self._submitted.clear()
+
+
+def run_jobs(jobs, workers: int | None = None, *, start: str = "fork", desc: str = "", unit: str = "job",
+             progress: bool = True, done: int = 0, meanwhile=None):
+    """Run ``func(*args)`` for every ``(func, args)`` of ``jobs`` on :func:`pool` (one job: in this process unless
+    on Dask); yield the results as they finish.
+
+    A tqdm bar on stderr counts ``done`` jobs finished earlier plus these, and so does the run's
+    :func:`sinterheat.interrupt.where` (its step: ``"<desc>: k of n <unit>s done"``). On an interrupt, an error, or
+    when the caller stops iterating, the pool is stopped at once. ``meanwhile()`` runs in a thread of this process
+    once the jobs are submitted (e.g. importing what the caller needs next, while this process would only wait).
+    """
+    from tqdm import tqdm
+
+    here = where()
+    label = f"{desc}: " if desc else ""
+    total = done + len(jobs)
+    here.update(step=f"{label}{done} of {total} {unit}s done")
+    if not jobs:
+        return
+    with tqdm(total=total, initial=done, desc=desc, unit=unit, file=sys.stderr, disable=not progress) as bar, \
+            pool(min(workers or os.cpu_count() or 1, len(jobs)), start=start) as jobs_pool:
+        running = [jobs_pool.submit(func, *args) for func, args in jobs]
+        if meanwhile is not None:
+            threading.Thread(target=meanwhile, daemon=True).start()
+        while running:
+            finished = jobs_pool.wait(running)
+            running = [f for f in running if f not in finished]
+            for future in finished:
+                result = future.result()
+                bar.update()
+                yield result
+                done += 1  # counted once the caller has taken it (e.g. written it to a file)
+                here.update(step=f"{label}{done} of {total} {unit}s done")
