@@ -35,6 +35,7 @@ import importlib
 CONTACT_LAWS = {
     "luding": "dem.laws.contact.luding",  # Luding, Manetsberger & Mueller 2005: sintering, hysteretic normal law
     "zohdi": "dem.laws.contact.zohdi",  # Zohdi 2014: power law on the contact area, bonds, thermal softening
+    "hertz_mindlin": "dem.laws.contact.hertz_mindlin",  # Hertz, Tsuji's damping (restitution e), Mindlin, Coulomb
 }
 
 
