@@ -36,6 +36,7 @@ CONTACT_LAWS = {
     "luding": "dem.laws.contact.luding",  # Luding, Manetsberger & Mueller 2005: sintering, hysteretic normal law
     "zohdi": "dem.laws.contact.zohdi",  # Zohdi 2014: power law on the contact area, bonds, thermal softening
     "hertz_mindlin": "dem.laws.contact.hertz_mindlin",  # Hertz, Tsuji's damping (restitution e), Mindlin, Coulomb
+    "jkr": "dem.laws.contact.jkr",  # Johnson-Kendall-Roberts 1971 adhesion, with Hertz-Mindlin's damping and friction
 }
 
 
