@@ -14,9 +14,9 @@ agrees to round-off):
   contact conserve angular momentum exactly), in LAMMPS with the radii (and at a wall LAMMPS's torque too): a
   difference of order delta/a wherever friction and spin meet;
 * friction while the damped normal force pulls (the end of a damped contact): none here, ``mu |F_n|`` in LAMMPS;
-* the JKR break: here at delta_c, the end of the stable branch under displacement control (Johnson 1985, a = a_0/6^(2/3),
-  force -5/6 pi w R*); LAMMPS breaks at the largest pull (a = a_0/4^(1/3), force -3/2 pi w R*), sooner: the
-  parting speeds of both codes are checked against the closed form of their own break.
+* the JKR break: here at delta_c, the end of the stable branch under displacement control (Johnson 1985,
+  a = a_0/6^(2/3), force -5/6 pi w R*); LAMMPS breaks sooner, at the largest pull (a = a_0/4^(1/3), force
+  -3/2 pi w R*): the parting speeds of both codes are checked against the closed form of their own break.
 
 Without friction (and for JKR without parting) the trajectories are the same to round-off.
 """
@@ -186,8 +186,8 @@ def test_jkr_sticking_collision_with_friction_is_lammps_up_to_the_lever_arm(tmp_
 
 def test_jkr_parting_speed_of_each_code_is_the_closed_form_of_its_break(tmp_path):
     """A head-on collision fast enough to part: the pair snaps in at touching (a^(3/2) = c R*), rebounds and
-    breaks at a_b, losing ``U(a_b) - U(a_touch)`` (the energy of the JKR curve, tests/test_jkr.py): here a_b = a_0/6^(2/3),
-    in LAMMPS a_b = a_0/4^(1/3)."""
+    breaks at a_b, losing ``U(a_b) - U(a_touch)`` (the energy of the JKR curve, tests/test_jkr.py): here
+    a_b = a_0/6^(2/3), in LAMMPS a_b = a_0/4^(1/3)."""
     r1, r2 = PAIR["r"]
     r_eff = r1 * r2 / (r1 + r2)
     m1, m2 = RHO * 4 / 3 * np.pi * r1**3, RHO * 4 / 3 * np.pi * r2**3

@@ -61,3 +61,11 @@ def test_cluster():
     ns = run_example("cluster")
     assert ns["middle_T"] == pytest.approx(0.5, abs=1e-3)  # symmetry of the L
     assert math.isfinite(ns["K_cluster"]) and abs(ns["K_dem"] / ns["K_cluster"] - 1) < 0.1
+
+
+def test_contact_laws():
+    ns = run_example("contact_laws")
+    assert all(abs(e - 0.8) < 2e-3 for e in ns["e_hertz_mindlin"])  # the material's e at every speed (dt = auto)
+    assert ns["stuck"] == (True, True, False, False, False)  # JKR: the slow ones stick
+    rebounds = ns["e_jkr"][2:]
+    assert list(rebounds) == sorted(rebounds) and rebounds[-1] == pytest.approx(0.8, abs=0.03)  # towards e

@@ -272,7 +272,8 @@ def _hertz_energy(sim):
     i, j, overlap = mech.contacts()[:3]
     r_eff = s.radius[i] * s.radius[j] / (s.radius[i] + s.radius[j])
     k, _, wall_overlap, _ = mech.wall_contacts()
-    elastic = 8 / 15 * E_STAR * (np.sum(np.sqrt(r_eff) * overlap**2.5) + np.sum(np.sqrt(s.radius[k]) * wall_overlap**2.5))
+    elastic = 8 / 15 * E_STAR * (np.sum(np.sqrt(r_eff) * overlap**2.5)
+                                 + np.sum(np.sqrt(s.radius[k]) * wall_overlap**2.5))
     return s.kinetic_energy() + elastic
 
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dem.laws.contact import law_module
+from dem.laws.contact import CONTACT_LAWS, law_module
 from dem.geometry.motion import particle_mass, moment_of_inertia
 from dem.geometry.particles import finite_array
 from dem.scene.events import TemperatureSchedule
@@ -124,8 +124,8 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
         if arr is not None and len(arr) != n:
             raise ValueError(f"[particles] {name} has {len(arr)} entries but position has {n}")
     if contact is None:
-        raise ValueError("[contact]: required for mechanical physics (law = \"luding\" or \"zohdi\" and its "
-                         "parameters)")
+        raise ValueError(f"[contact]: required for mechanical physics (law = one of {', '.join(CONTACT_LAWS)}, and its "
+                         f"parameters)")
     densities = {m.density for m in particles.materials}
     if densities != {contact.density}:
         raise ValueError(f"[contact] density = {contact.density:g}: differs from [material] density "
@@ -172,8 +172,8 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
         dt = float(solver.dt)
         if dt > stable:
             raise ValueError(f"[solver] dt = {dt:.6g} s: above the stable step {stable:.6g} s of the stiffest contact "
-                             f"(2/omega with k2 and the lightest pair); use dt <= {stable:.6g} s or dt = \"auto\" "
-                             f"(t_MD = {t_md:.6g} s, Luding 2005 eq. 6)")
+                             f"(2/omega of law = \"{contact.law}\" for the lightest pair); use dt <= {stable:.6g} s or "
+                             f"dt = \"auto\" ({t_md:.6g} s)")
     stable_steps = solver.t_end / dt
     if stable_steps > 1e10:
         raise ValueError(f"[solver] t_end / dt = {stable_steps:.3g} steps: beyond what one run can take; shorten t_end")

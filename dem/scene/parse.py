@@ -19,7 +19,7 @@ from dem.scene import state_file
 from dem.geometry import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.fields import material_from_table
-from dem.laws.contact import law_module
+from dem.laws.contact import CONTACT_LAWS, law_module
 from dem.scene.zohdi import ElectricalSpec, parse_electrical
 from dem.geometry.particles import COPPER, Material, Particles
 from dem.geometry.periodic import AXES, PeriodicBox
@@ -487,7 +487,7 @@ def contact_material_from_scene(doc: dict):
     defaults to that of a single ``[material]``)."""
     table = doc.get("contact")
     if not isinstance(table, dict):
-        raise ValueError("[contact]: must be a table with law = \"luding\" or \"zohdi\" and the material")
+        raise ValueError(f"[contact]: must be a table with law = one of {', '.join(CONTACT_LAWS)}, and the material")
     law = law_module(table.get("law"))
     values = {key: v for key, v in table.items() if key != "law"}
     material = doc.get("material")
