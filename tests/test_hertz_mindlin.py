@@ -249,7 +249,8 @@ def test_a_stuck_contact_oscillates_with_mindlins_stiffness():
     assert np.abs(f_t).max() == pytest.approx(1e-4 * k_t / omega, rel=2e-3)  # amplitude: slip speed / omega
 
 
-def _box_of_spheres(material, n=24, speed=0.5, seed=4, t_end=4e-3, side=8e-3):
+def spheres_in_a_box(n, side, seed):
+    """``n`` spheres (radii 0.6-1 mm) at random, apart, in a box of side ``side``; its six walls; the generator."""
     rng = np.random.default_rng(seed)
     x, r = [], []
     while len(x) < n:
@@ -258,11 +259,15 @@ def _box_of_spheres(material, n=24, speed=0.5, seed=4, t_end=4e-3, side=8e-3):
         if all(np.linalg.norm(p - q) > radius + s + 1e-4 for q, s in zip(x, r)):
             x.append(p)
             r.append(radius)
-    v = rng.normal(0.0, speed, (n, 3))
     walls = [{"name": f"{axis}{end}", "point": [side * end * (a == k) for k in range(3)],
               "normal": [(1 - 2 * end) * (a == k) for k in range(3)]}
              for a, axis in enumerate("xyz") for end in (0, 1)]
-    return scene_doc(x, r, v, material, t_end=t_end, walls=walls)
+    return x, r, walls, rng
+
+
+def _box_of_spheres(material, n=24, speed=0.5, seed=4, t_end=4e-3, side=8e-3):
+    x, r, walls, rng = spheres_in_a_box(n, side, seed)
+    return scene_doc(x, r, rng.normal(0.0, speed, (n, 3)), material, t_end=t_end, walls=walls)
 
 
 def _hertz_energy(sim):
