@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, minimize_scalar
 
+from dem.driver import run
 from dem.engines.verlet.engine import Simulation
 from dem.laws.contact import jkr
-from dem.scene import parse_scene
-from test_hertz_mindlin import (DENSITY, E_STAR, MATERIAL, RATE, T0, contact, head_on, run_recording, scene_doc,
-                                sphere_mass)
+from dem.scene import parse_scene, state_file
+from test_hertz_mindlin import DENSITY, E_STAR, MATERIAL, contact, head_on, run_recording, scene_doc, sphere_mass
 
 W = 0.1  # J/m^2, the work of adhesion
 R = 1e-3
@@ -26,12 +26,12 @@ def jkr_contact(**changes):
 
 
 def overlap(a, r_eff):
-    """``delta = a^2/R* - sqrt(2 pi w a/E*)`` (Johnson 1985, eq. 5.62)."""
+    """``delta = a^2/R* - sqrt(2 pi w a/E*)`` (Johnson 1985, Sec. 5.5)."""
     return a * a / r_eff - C * math.sqrt(a)
 
 
 def force(a, r_eff):
-    """``F = 4 E* a^3/(3 R*) - sqrt(8 pi w E* a^3)`` (Johnson 1985, eqs. 5.60-5.61)."""
+    """``F = 4 E* a^3/(3 R*) - sqrt(8 pi w E* a^3)`` (Johnson 1985, Sec. 5.5)."""
     return 4 * E_STAR * a**3 / (3 * r_eff) - math.sqrt(8 * math.pi * W * E_STAR * a**3)
 
 
@@ -112,17 +112,22 @@ def test_friction_limit_adds_twice_the_pull_off_force(params):
 
 
 # ------------------------------------------------------------------------------------------ through the engine
-def adhered_pair(speed, dt_per_period=400, t_end=2e-3, material=None):
+def adhered_doc(speed, dt_per_period=400, t_end=2e-3):
     """Two spheres of radius R at rest in contact at the zero-force overlap delta_0, pulled apart at the relative
-    speed ``speed`` (momentum zero)."""
+    speed ``speed`` (momentum zero), undamped; the step a ``dt_per_period``-th of the contact's small oscillation."""
     r_eff = R / 2
     a0, _ = radii(r_eff)
     delta0 = a0 * a0 / (3 * r_eff)
-    m_eff = sphere_mass(R) / 2
-    period = 2 * math.pi * math.sqrt(m_eff / (2 * E_STAR * a0))  # of the contact's small oscillation
-    doc = scene_doc([[0, 0, 0], [2 * R - delta0, 0, 0]], [R, R], [[-speed / 2, 0, 0], [speed / 2, 0, 0]],
-                    material or jkr_contact(restitution=1.0), t_end=t_end, dt=period / dt_per_period)
-    return Simulation(parse_scene(doc)), r_eff, a0, delta0
+    period = 2 * math.pi * math.sqrt(sphere_mass(R) / 2 / (2 * E_STAR * a0))
+    return scene_doc([[0, 0, 0], [2 * R - delta0, 0, 0]], [R, R], [[-speed / 2, 0, 0], [speed / 2, 0, 0]],
+                     jkr_contact(restitution=1.0), t_end=t_end, dt=period / dt_per_period)
+
+
+def adhered_pair(speed, dt_per_period=400, t_end=2e-3):
+    """The pair of :func:`adhered_doc` as a simulation, its R*, a_0 and delta_0."""
+    r_eff = R / 2
+    a0, _ = radii(r_eff)
+    return Simulation(parse_scene(adhered_doc(speed, dt_per_period, t_end))), r_eff, a0, a0 * a0 / (3 * r_eff)
 
 
 def _work_to_part(r_eff):
@@ -177,6 +182,26 @@ def test_energy_is_conserved_while_adhered_without_damping():
     total = np.array(total) - energy(a0, r_eff)
     assert np.ptp(total) < 1e-4 * total[0]  # velocity Verlet: O(dt^2)
     assert np.all(rec["fn"][:, 0] != 0.0)
+
+
+def test_a_run_continued_from_its_state_keeps_a_stretched_contact_and_ends_as_the_uninterrupted_run(tmp_path):
+    """Saved while the contact is stretched beyond touching (the pull-off distance is in the pair's history, which
+    the state carries), the continued run ends bit for bit where the uninterrupted run ends."""
+    speed = 1.5 * math.sqrt(2 * _work_to_part(R / 2) / (sphere_mass(R) / 2))
+    doc = adhered_doc(speed)
+    dt = doc["solver"]["dt"]
+    first, rest = 60, 140  # 60 steps: 0.12 um beyond touching, still pulling; the contact breaks at step ~75
+    run(parse_scene({**doc, "solver": {**doc["solver"], "t_end": first * dt}}), out=tmp_path / "first")
+    saved = state_file.load(tmp_path / "first" / "state.npz")
+    assert 2 * R - (saved["x"][1, 0] - saved["x"][0, 0]) < 0 and saved["p_hist"][0, 3] > 0
+    continued = {k: v for k, v in doc.items() if k != "particles"}
+    continued.update(start={"state": str(tmp_path / "first" / "state.npz")},
+                     solver={**doc["solver"], "t_end": rest * dt})
+    run(parse_scene(continued), out=tmp_path / "continued")
+    run(parse_scene({**doc, "solver": {**doc["solver"], "t_end": (first + rest) * dt}}), out=tmp_path / "whole")
+    a, b = (state_file.load(tmp_path / name / "state.npz") for name in ("continued", "whole"))
+    assert np.array_equal(a["x"], b["x"]) and np.array_equal(a["v"], b["v"])
+    assert b["p_hist"][0, 3] == 0.0 and b["x"][1, 0] - b["x"][0, 0] > 2 * R + 4e-7  # it did break, later
 
 
 def test_weak_adhesion_rebounds_with_the_materials_restitution():

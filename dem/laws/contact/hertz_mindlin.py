@@ -9,9 +9,9 @@ is positive in contact, the forces are those on i. Two spheres of radii a_i, a_j
 radius and mass made of the same material: ``R* = a_k``, ``m* = m_k``, the same E* and G* (as LAMMPS's ``fix
 wall/gran`` takes a wall).
 
-* **Normal** (Hertz 1882; Johnson, Contact Mechanics, 1985, eqs. 4.22-4.23): the contact radius ``a = sqrt(R*
+* **Normal** (Hertz 1882; Johnson, Contact Mechanics, 1985, Sec. 4.2): the contact radius ``a = sqrt(R*
   delta)`` and ``F_el = 4/3 E* a delta = 4/3 E* sqrt(R*) delta^(3/2)``.
-* **Damping** (Tsuji, Tanaka & Ishida 1992, Powder Technol. 71, 239, eq. 13): ``F_d = eta_n d(delta)/dt`` with
+* **Damping** (Tsuji, Tanaka & Ishida 1992, Powder Technol. 71, 239): ``F_d = eta_n d(delta)/dt`` with
   ``eta_n = alpha sqrt(m* k_n)``, ``k_n = F_el/delta = 4/3 E* a``: the damping grows as ``delta^(1/4)``, so the
   coefficient of restitution of a head-on collision does not depend on the impact speed. Antypov & Elliott 2011
   (EPL 94, 50004) solved that collision exactly: ``e = exp(-pi b / sqrt(1 - b^2))``, ``b = alpha/sqrt(5)``, i.e.
@@ -25,9 +25,9 @@ wall/gran`` takes a wall).
   force ``F_t = -k_t xi - eta_t v_t`` with ``eta_t = tangential_damping * eta_n`` (LAMMPS's ``x_gamma,t``). Coulomb:
   where ``|F_t| > mu F_n`` (``mu_wall`` at a wall; no friction while F_n pulls) the contact slides, ``F_t`` is
   scaled to ``mu F_n`` and the spring set to what gives that force, ``xi = -(F_t + eta_t v_t)/k_t`` (as LAMMPS's
-  ``tangential mindlin``, Luding 2008, Granular Matter 10, 235, eq. 17).
+  ``tangential mindlin``).
 
-The time step (:func:`time_steps`): ``dt = "auto"`` is a fifth of the Rayleigh time ``T_R = pi a sqrt(rho/G)/(0.1631
+The time step (:func:`time_steps`): ``dt = "auto"`` is a tenth of the Rayleigh time ``T_R = pi a sqrt(rho/G)/(0.1631
 nu + 0.8766)`` of the smallest particle (the time a Rayleigh wave takes across it; LIGGGHTS's ``check/timestep/gran``
 warns above fractions of it); a Hertz contact of an impact speed of 1 m/s lasts several T_R.
 """

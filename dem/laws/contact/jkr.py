@@ -7,7 +7,7 @@ Conventions, R*, m*, E* and G* (a wall: a partner of infinite radius and mass of
 part the two surfaces, ``w = gamma_1 + gamma_2 - gamma_12`` (Johnson 1985's Delta gamma; twice the surface energy
 gamma of identical surfaces -- LAMMPS's ``jkr`` takes that gamma).
 
-* **Normal** (Johnson, Contact Mechanics, 1985, Sec. 5.5, eqs. 5.60-5.62 with P_1 = 4 E* a^3/(3 R*)): at contact
+* **Normal** (Johnson, Contact Mechanics, 1985, Sec. 5.5, with P_1 = 4 E* a^3/(3 R*)): at contact
   radius a, the overlap ``delta = a^2/R* - sqrt(2 pi w a/E*)`` and the force ``F_el = 4 E* a^3/(3 R*) - sqrt(8 pi
   w E* a^3)``. At ``F_el = 0``, ``a_0^3 = 9 pi w R*^2/(2 E*)``. The largest pull, ``-3/2 pi w R*`` (the pull-off
   force of a load-controlled test), is reached at ``delta = -a^2/(3 R*)``, ``a^3 = 9 pi w R*^2/(8 E*)``.
@@ -38,8 +38,8 @@ import numpy as np
 from numba import njit
 
 from dem.laws.contact import hertz_mindlin as hm
-from dem.laws.contact.hertz_mindlin import (HertzMindlinMaterial, IN_LOOP, JIT, P_ALPHA, P_KN, P_KT, P_MU, P_MU_WALL,
-                                            P_XT, mindlin_force)
+from dem.laws.contact.hertz_mindlin import (HertzMindlinMaterial, IN_LOOP, P_ALPHA, P_KN, P_KT, P_MU, P_MU_WALL, P_XT,
+                                            mindlin_force)
 
 # Indices into JKRMaterial.params(): those of hertz_mindlin (P_*), then
 J_E_STAR = hm.N_PARAMS      # E* (Pa)
