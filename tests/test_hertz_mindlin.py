@@ -342,9 +342,14 @@ def test_auto_step_is_a_tenth_of_the_rayleigh_time_and_a_larger_step_is_refused(
     ({"youngs_modulus": -1.0}, r"\[contact\] youngs_modulus = -1.0: must be > 0 \(Pa\)"),
     ({"mu": float("nan")}, r"\[contact\] mu = nan: must be a finite number"),
     ({"gamma_n": 0.1}, r"\[contact\] gamma_n: not a parameter of law = \"hertz_mindlin\""),
+    ({"phases": [{"start": 0.0, "gamma_n": 0.1}]}, r"\[phases\] gamma_n: not a parameter of law = \"hertz_mindlin\""),
 ])
 def test_bad_material_is_refused_in_one_line_naming_the_key(change, message):
-    doc = copy.deepcopy(scene_doc([[0, 0, 0], [2.1e-3, 0, 0]], [1e-3, 1e-3], contact={**contact(), **change}))
+    phases = change.get("phases")
+    material = {**contact(), **{k: v for k, v in change.items() if k != "phases"}}
+    doc = copy.deepcopy(scene_doc([[0, 0, 0], [2.1e-3, 0, 0]], [1e-3, 1e-3], contact=material))
+    if phases is not None:
+        doc["phases"] = phases
     with pytest.raises(ValueError, match=message):
         parse_scene(doc)
     doc["contact"] = {k: v for k, v in contact().items() if k != "restitution"}

@@ -24,7 +24,7 @@ Tables and keys (SI units; the README's scene schema lists them with their defau
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -151,6 +151,12 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
         return zscene.zohdi_motion(doc, particles, solver, physics, start, walls, gravity, velocity,
                                    tuple(p[:2] for p in phases), wall_phases, dimension)
     zscene.refuse_zohdi_keys(doc, physics)
+    material_fields = {f.name for f in fields(contact)}
+    for phase in phases:  # (start, material overrides, wall speeds): the overrides are fields of the contact law
+        for key in phase[1]:
+            if key not in material_fields:
+                raise ValueError(f"[phases] {key}: not a parameter of law = \"{contact.law}\" (its parameters: "
+                                 f"{', '.join(sorted(material_fields))})")
     relaxation_time = float(getattr(contact, "t0", 0.0))  # the material's relaxation time, where its law has one
     schedule = None
     if "temperature" in doc:
