@@ -4,7 +4,7 @@ the Luding engine, and the Kirchhoff solve against the paper's current iteration
 The ``electrical`` subject of ``python -m benchmarks`` (:func:`run`) measures, in one process:
 
 * ``section7`` -- the built-in scene ``zohdi-compaction`` (1000 spheres, 1 s, Sec. 7) run end to end (the wall time
-  of :meth:`dem.engines.staggered.engine.ZohdiSimulation.run`, no outputs written), with its steps, fixed-point iterations,
+  of :meth:`dem.engines.staggered.engine.StaggeredEngine.run`, no outputs written), with its steps, fixed-point iterations,
   restarts and step sizes, and the three phases of Fig. 9 (volume fraction when the wall first carries current,
   the largest, the last; mean temperature then);
 * ``step_cost`` -- on the compacted packing of that run (t = 0.79 s, both electrodes touching): ns per particle of
@@ -45,14 +45,14 @@ def _scene():
 
 def section7_row() -> dict:
     """The Section 7 example run end to end: wall time and what it took (module docstring)."""
-    from dem.engines.staggered.engine import ZohdiSimulation
+    from dem.engines.staggered.engine import StaggeredEngine
 
     scene = _scene()
     rows = []
     start = time.perf_counter()
-    sim = ZohdiSimulation(scene)
+    sim = StaggeredEngine(scene)
     built = time.perf_counter()
-    sim.run(observer=lambda s: rows.append(s.record()))
+    sim.run(lambda: rows.append(sim.record()))
     seconds = time.perf_counter() - start
     n = sim.mechanics.state.n
     contact = next(r for r in rows if (r.get("joule_heat") or 0.0) > 1.0)  # the wall reaches the powder
@@ -85,9 +85,9 @@ def _best(fn, repeat: int) -> float:
 
 def compacted(t: float = 0.79):
     """The Section 7 run stepped to ``t`` (the powder pressed, both electrodes touching)."""
-    from dem.engines.staggered.engine import ZohdiSimulation
+    from dem.engines.staggered.engine import StaggeredEngine
 
-    sim = ZohdiSimulation(_scene())
+    sim = StaggeredEngine(_scene())
     while sim.t < t:
         sim.step()
     return sim

@@ -134,14 +134,14 @@ def biaxial_sample(sizes: Sizes, cache: pathlib.Path, seed: int = 1) -> dict:
     if path.exists():
         with np.load(path) as data:
             return {**{k: data[k] for k in data.files}, "seconds": 0.0}
-    from dem.engines.verlet.engine import Simulation
+    from dem.engines.verlet.engine import VerletEngine
 
     a0, w0 = 1e-3, 0.5  # Table 1: mean radius, relative width of the uniform distribution
     side = math.sqrt(sizes.disks * math.pi * a0**2 * (1.0 + w0**2 / 3.0) / 0.35)
     generator = {"kind": "box", "n": sizes.disks, "radius": a0, "radius_spread": w0, "seed": seed,
                  "box": [[0.0, 0.0, 0.0], [side, 0.0, side]], "temperature": T_RUN}
     t0 = time.perf_counter()
-    sim = Simulation(_scene(replace(LUDING_TABLE1, mu=0.0), 2, generator, _biaxial_walls(-side, -side),
+    sim = VerletEngine(_scene(replace(LUDING_TABLE1, mu=0.0), 2, generator, _biaxial_walls(-side, -side),
                             sizes.compaction_time))
     sim.run()
     mech = sim.mechanics
@@ -213,17 +213,17 @@ def _at_rest(sample: dict) -> dict:
 
 def biaxial_simulation(sample: dict, material: LudingMaterial):
     """The engine on the compacted 2D sample, at rest, with ``material`` and the stress walls."""
-    from dem.engines.verlet.engine import Simulation
+    from dem.engines.verlet.engine import VerletEngine
 
     walls = _biaxial_walls(float(sample["q_right"]), float(sample["q_top"]))
-    return Simulation(_scene(material, 2, _at_rest(sample), walls))
+    return VerletEngine(_scene(material, 2, _at_rest(sample), walls))
 
 
 def periodic_simulation(sample: dict, material: LudingMaterial):
     """The engine on the 3D packing, at rest, with ``material``, periodic on every axis."""
-    from dem.engines.verlet.engine import Simulation
+    from dem.engines.verlet.engine import VerletEngine
 
-    return Simulation(_scene(material, 3, _at_rest(sample), box=sample["box"]))
+    return VerletEngine(_scene(material, 3, _at_rest(sample), box=sample["box"]))
 
 
 def time_ours(make, steps: int, warmup: int) -> dict:
@@ -333,13 +333,13 @@ def lammps_command() -> tuple[list[str], dict] | None:
 
 
 def write_lammps_data(path: pathlib.Path, sample: dict, density: float) -> None:
-    """``atom_style sphere`` data file of the periodic packing: id, type, diameter, density, x, y, z."""
-    box, x, r = sample["box"], sample["position"], sample["radius"]
-    head = ["sinterheat periodic packing", "", f"{len(r)} atoms", "1 atom types", ""]
-    head += [f"0 {float(box[a])!r} {c}lo {c}hi" for a, c in enumerate("xyz")]
-    rows = [f"{k + 1} 1 {2.0 * r[k]:.17g} {float(density)!r} {x[k, 0]:.17g} {x[k, 1]:.17g} {x[k, 2]:.17g}"
-            for k in range(len(r))]
-    path.write_text("\n".join(head + ["", "Atoms # sphere", ""] + rows) + "\n")
+    """``atom_style sphere`` data file of the periodic packing in the box from 0 to ``sample["box"]``
+    (:func:`dem.scene.packing_files.write_lammps_data`; atoms 1..N)."""
+    from dem.scene.packing_files import Packing, write_lammps_data as write_data
+
+    n = len(sample["radius"])
+    write_data(path, Packing(np.arange(1, n + 1), sample["position"], sample["radius"], box_lo=np.zeros(3),
+                             box_hi=np.asarray(sample["box"], dtype=float)), density)
 
 
 def lammps_input(data: pathlib.Path, material: LudingMaterial, style: str, dt: float, skin: float, m_eff: float,
@@ -601,7 +601,7 @@ t = time.perf_counter()
 import numpy as np
 from dem.laws.contact import luding as law
 from dem.laws.contact import luding
-from dem.engines.verlet.engine import Simulation
+from dem.engines.verlet.engine import VerletEngine
 from dem.scene import parse_scene
 imported = time.perf_counter()
 p = luding.LUDING_TABLE1.params()
@@ -621,7 +621,7 @@ doc = {"scene": {"physics": ["mechanical"]}, "material": {"density": 2000.0},
        "contact": {"law": "luding", **contact}, "walls": [{"name": "floor", "point": [0, 0, -1e-3],
                                                           "normal": [0, 0, 1]}],
        "solver": {"mode": "transient", "t_end": 1e-6}}
-sim = Simulation(parse_scene(doc))
+sim = VerletEngine(parse_scene(doc))
 sim.mechanics.advance(1, np.array([80.0]), np.zeros(1))
 engine = time.perf_counter()
 print(json.dumps({"import": imported - t, "kernels": kernels - imported, "engine": engine - kernels}))

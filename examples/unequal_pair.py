@@ -1,10 +1,20 @@
-"""Two sintered copper spheres of unequal radii (Rojek 2022, Sec. 6): FE against the pipe model of eqs. 43-45 and
-against the FE-fitted full-range law the DEM's ``fit`` law uses."""
+"""
+Two sintered spheres of unequal radii
+=====================================
+
+Rojek 2022, Sec. 6: copper spheres of 1 and 3 mm overlapping by 0.06 mm. FE against the pipe model of eqs. 43-45
+and against the FE-fitted full-range law the DEM's ``fit`` law uses; the temperature field is the analogue of the
+paper's Fig. 17 (10 °C across).
+"""
 
 import math
 
+import matplotlib.pyplot as plt
+import numpy as np
+
 from fem_neck import law, neck_radius
 from fem_neck.conduction import pair_conductance
+from fem_neck.render import sampled_fields
 
 r_i, r_j, h, kappa = 1e-3, 3e-3, 0.06e-3, 394.0  # m, m, m, W/(m K)
 a = neck_radius(r_i, r_j, h)  # volume-conserving neck, eqs. 27-33
@@ -15,3 +25,18 @@ K_model = 1.064 * kappa * math.pi * a / 2  # eq. 43 per half, halves in series (
 K_law = law.pair_conductance(kappa, r_i, r_j, a)  # the full-range law, each half at its own a/r, corrected
 print(f"a = {a * 1e3:.6f} mm; K_fe = {K_fe:.7f} W/K (estimate {fe.error_estimate:.0e}); eq. 45: {K_model:.6f} W/K "
       f"({K_model / K_fe - 1:+.2%}); fit law: {K_law:.6f} W/K ({K_law / K_fe - 1:+.2%})")
+
+# %%
+# The axial section: the meridian half-plane (x radial, y axial, in m) mirrored across the axis.
+points, triangles, T, _ = sampled_fields(fe, delta_t=10.0)  # T in °C above the cold disk
+x_mm = np.concatenate([points[:, 0], -points[:, 0]]) * 1e3
+y_mm = np.concatenate([points[:, 1], points[:, 1]]) * 1e3
+fig, ax = plt.subplots(figsize=(6.4, 4.6), layout="constrained")
+shown = ax.tripcolor(x_mm, y_mm, np.vstack([triangles, triangles + len(points)]), np.concatenate([T, T]),
+                     shading="gouraud", cmap="turbo")
+fig.colorbar(shown, ax=ax, label="temperature T (°C)")
+ax.set_aspect("equal")
+ax.set_xlabel("radial position x (mm)")
+ax.set_ylabel("axial position y (mm)")
+ax.set_title(f"K_fe = {K_fe:.6f} W/K, eq. 45 {K_model:.6f} W/K")
+plt.show()

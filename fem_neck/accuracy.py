@@ -1,7 +1,7 @@
 """Solve to a tolerance: the order-difference error estimate and the grading controller.
 
 The conductance is computed on one graded mesh with two element orders, ``p - 1`` and ``p`` (curved, isoparametric
-boundary). The reported value is the order-``p`` one; its error estimate is the relative difference of the two,
+boundary). The reported value is the order-``p`` one; its error estimate is the relative difference of the two::
 
     error_estimate = |K_p - K_(p-1)| / K_p,
 
@@ -19,7 +19,7 @@ energy or the reaction, a volume mean of the temperature) then converge like ``s
 corner exponent's ``2 lambda`` (the re-entrant neck edge of interior angle ``pi + arccos(a/r)`` has
 ``lambda = pi / (pi + arccos(a/r))``, :func:`corner_exponent`; the 3D edge along the neck circle has the 2D
 exponent), and faster before the asymptotic range. :func:`mesh_sequence_estimate` turns the last change into the
-error of the finest value,
+error of the finest value::
 
     error = SAFETY * |v_(L-1) - v_L| / (rate - 1),       rate = min(observed, ratio^(2 lambda)),
 
@@ -154,8 +154,8 @@ def corner_exponent(a_over_r):
     return np.pi / (np.pi + np.arccos(np.clip(a_over_r, 0.0, 1.0)))
 
 
-MESH_RATIO = 1.6  # sizes shrink by this factor per level of a mesh sequence
-SAFETY = 1.25  # on the extrapolated error of a mesh sequence (Roache's factor for three or more levels)
+MESH_RATIO = 1.6  #: sizes shrink by this factor per level of a mesh sequence
+SAFETY = 1.25  #: on the extrapolated error of a mesh sequence (Roache's factor for three or more levels)
 
 
 @dataclass(frozen=True)

@@ -1,8 +1,9 @@
 """3D finite-element conduction through small clusters of sintered spheres (gmsh OCC + scikit-fem tetrahedra).
 
 Geometry (Rojek, Kasztelan & Tharmaraj 2022, Sections 4.3, Fig. 8). Each bonded pair ``(i, j)`` with overlap
-``h = r_i + r_j - |c_j - c_i|`` gets the volume-conserving cylindrical neck of :func:`fem_neck.neck_geometry`: radius
-``a``, spanning ``c_i + z_i e .. c_i + (z_i + h_n) e`` along the unit vector ``e`` from ``c_i`` to ``c_j``. The solid is
+``h = r_i + r_j - |c_j - c_i|`` gets the volume-conserving cylindrical neck of
+:func:`fem_neck.geometry.neck_geometry`: radius ``a``, spanning ``c_i + z_i e .. c_i + (z_i + h_n) e`` along the unit
+vector ``e`` from ``c_i`` to ``c_j``. The solid is
 
     union of the full spheres  U  union of the neck cylinders.
 
@@ -84,7 +85,8 @@ class Cluster:
         return self.radii[i] + self.radii[j] - np.linalg.norm(self.centres[j] - self.centres[i], axis=1)
 
     def necks(self, method: str = "newton"):
-        """:class:`fem_neck.NeckGeometry` of every bond (raises ``ValueError`` outside the neck model's range)."""
+        """:class:`fem_neck.geometry.NeckGeometry` of every bond (raises ``ValueError`` outside the neck model's
+        range)."""
         i, j = self.bonds.T
         return neck_geometry(self.radii[i], self.radii[j], self.overlaps(), method=method)
 

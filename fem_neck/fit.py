@@ -37,8 +37,8 @@ import numpy as np
 from sinterheat.interrupt import ignore_interrupts, shielded, stop_pool, where
 from fem_neck.law import A_LOG, ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, neck_resistance
 
-SOLVER = "fem_neck.conduction:semisphere_conductance"
-METHOD = "hp"
+SOLVER = "fem_neck.conduction:semisphere_conductance"  #: the FE solver of a sweep point
+METHOD = "hp"  #: the discretisation passed to it
 X_MAX = 0.97  # the sweep's largest a/r
 X_SMALL = (0.001, 0.02)  # the log-spaced small-neck block
 LINEAR_RANGE = 0.7  # Rojek 2022, Section 5: "up to nearly a/r = 0.7 ... linear"

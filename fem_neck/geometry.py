@@ -20,7 +20,7 @@ model (:func:`overlap_for_neck`, :func:`max_overlap`). ``Z`` is convex where ``h
 right of the root decreases monotonically onto it, and a step from the left of the root (with ``Z' > 0``) lands to
 its right. Where the start has ``Z' <= 0`` the iteration starts from the bracket's right end ``a = min(r_i, r_j)``
 instead, so it never diverges. Cap heights are computed as ``a^2 / (r + sqrt(r^2 - a^2))`` so that small necks
-keep full relative precision. Large arrays are solved in blocks of cache size (:data:`_CHUNK` bonds), each block
+keep full relative precision. Large arrays are solved in blocks of cache size (``_CHUNK`` bonds), each block
 stopping as soon as its own bonds have converged.
 
 The model's range: a solution exists for ``0 < h <= max_overlap(r_i, r_j)``, where ``a`` reaches the smaller radius
@@ -257,7 +257,7 @@ def neck_radius(r_i, r_j, h, method: str = "newton"):
 
 
 def _neck_radius_blocked(r_i, r_j, h, method):
-    """:func:`neck_radius` of large arrays, :data:`_CHUNK` bonds at a time: every temporary of the Newton stays in
+    """:func:`neck_radius` of large arrays, ``_CHUNK`` bonds at a time: every temporary of the Newton stays in
     the processor's cache instead of being a fresh multi-megabyte array per operation (3-4x faster for 10^6
     bonds), and each block stops iterating as soon as its own bonds have converged."""
     R_i, R_j, H = (np.ascontiguousarray(v).ravel() for v in np.broadcast_arrays(r_i, r_j, h))

@@ -47,7 +47,7 @@ import numpy as np
 
 FORM = "1/f = lambda(x) + pi/(4x) * (1 + A x ln(1/x) + B x + C x^2 + E x^3 - (1 + B + C + E)(1 - sqrt(1 - x^2)))"
 PARAMETERS = ("A", "B", "C", "E")
-A_LOG = 5.0 / (4.0 * np.pi)  # the x ln(1/x) coefficient of P(x) (module docstring); the fit keeps A = A_LOG
+A_LOG = 5.0 / (4.0 * np.pi)  #: the x ln(1/x) coefficient of P(x) (module docstring); the fit keeps A = A_LOG
 DEFAULT_FIT = pathlib.Path(__file__).with_name("data") / "fit.json"
 
 
@@ -88,8 +88,8 @@ class LinearLaw:
         return _out(self.slope * check_neck_ratio(a_over_r))
 
 
-ROJEK = LinearLaw(1.064, "Rojek 2022, eq. (40)")
-ARGENTO_BOUVARD = LinearLaw(1.0 / 0.899, "Argento & Bouvard 1996, eq. (42)")
+ROJEK = LinearLaw(1.064, "Rojek 2022, eq. (40)")  #: K/K_cyl = 1.064 a/r
+ARGENTO_BOUVARD = LinearLaw(1.0 / 0.899, "Argento & Bouvard 1996, eq. (42)")  #: K/K_cyl = (1/0.899) a/r
 
 
 @dataclass(frozen=True)

@@ -39,8 +39,8 @@ DEFAULT_GRADING = 0.3
 # Smallest neck radius over sphere radius that is meshed: the half neck is a^2/(4r) high, ~2.5e-9 r at the limit
 # (meshing takes ~10 s there, ~2 s at 3e-4, 0.3 s at 1e-3). Below it K is the constriction limit 4 kappa a to O(a/r).
 MIN_NECK_RATIO = 1e-4
-# Largest radius ratio of neighbouring spheres: beyond it the graded mesh of the larger sphere spans too many decades
-# (1e6 converges; 1e9 returned an unconverged K 700x too large).
+#: Largest radius ratio of neighbouring spheres; beyond it the graded mesh of the larger sphere spans too many decades
+#: (1e6 converges; 1e9 returned an unconverged K 700x too large).
 MAX_RADIUS_RATIO = 1e6
 
 

@@ -35,7 +35,7 @@ _EXTEND = 0.25  # the neck rectangle reaches this fraction of z into each disk (
 class PairMesh:
     """Meridian-plane mesh of the closed pair: ``mesh`` (``skfem.MeshTri1``, metres), ``particle`` (0 or 1 per
     element), ``z_split`` (axial position of the neck split), ``volume_exact`` (``4/3 pi (r_i^3 + r_j^3)``) and the
-    :class:`fem_neck.NeckGeometry` ``geometry``."""
+    :class:`fem_neck.geometry.NeckGeometry` ``geometry``."""
 
     mesh: object
     particle: np.ndarray

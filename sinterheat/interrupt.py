@@ -41,7 +41,7 @@ import sys
 import threading
 from dataclasses import dataclass, field
 
-EXIT_CODE = 130  # 128 + SIGINT
+EXIT_CODE = 130  #: 128 + SIGINT
 _current: contextvars.ContextVar[Where | None] = contextvars.ContextVar("sinterheat_where", default=None)
 
 

@@ -10,7 +10,7 @@ import types
 import pytest
 
 from benchmarks import SUBJECTS
-from benchmarks import __main__ as cli
+from benchmarks import cli
 from benchmarks.neck import plain_newton, random_bonds
 from fem_neck import neck_radius
 from test_verification_report import assert_report_links_resolve

@@ -194,13 +194,13 @@ def test_snapshot_flood_refused_and_collection_complete(tmp_path, capsys):
 
 def test_explicit_step_around_the_stable_limit(tmp_path, capsys):
     """0.99x the limit runs and stays inside the initial range (maximum principle); 1.01x is refused."""
-    from dem.engines.static import ThermalModel
+    from dem.engines.static import StaticEngine
     from dem.scene import parse_scene
     from dem.network.heat import stable_limit
 
     import tomllib
 
-    limit = stable_limit(ThermalModel(parse_scene(tomllib.loads(scene()))).network)
+    limit = stable_limit(StaticEngine(parse_scene(tomllib.loads(scene()))).network)
     code, out, _ = run_scene(tmp_path, scene(integ="explicit", dt=repr(0.99 * limit), t_end=repr(50 * limit)),
                              capsys)
     s = finite_json(out)

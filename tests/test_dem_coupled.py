@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from dem.engines.verlet.engine import Simulation
+from dem.engines.verlet.engine import VerletEngine
 from dem.laws.conductance import bond_conductances
 from dem.scene import parse_scene
 from fem_neck import neck_radius
@@ -37,7 +37,7 @@ def pile(n_side=3, t_end=0.01, hot=150.0, law="fit", velocity=0.0, **solver):
 
 
 def test_every_contact_conductance_is_the_law_at_its_overlap():
-    sim = Simulation(parse_scene(pile(t_end=0.005)))
+    sim = VerletEngine(parse_scene(pile(t_end=0.005)))
     sim.run()
     th, mech = sim.thermal, sim.mechanics
     i, j, overlap = mech.contacts()[:3]
@@ -51,7 +51,7 @@ def test_every_contact_conductance_is_the_law_at_its_overlap():
 
 def test_heat_balance_exact_through_contact_changes():
     """Particles shaken so that contacts open and close while heat flows in from the floor."""
-    sim = Simulation(parse_scene(pile(t_end=0.01, velocity=0.05, thermal_interval=2e-4)))
+    sim = VerletEngine(parse_scene(pile(t_end=0.01, velocity=0.05, thermal_interval=2e-4)))
     sim.run()
     th = sim.thermal
     assert th.assemblies > 3, "the contact set must have changed"
@@ -61,7 +61,7 @@ def test_heat_balance_exact_through_contact_changes():
 
 
 def test_temperatures_reach_the_mechanics_and_soften_the_hot_contacts():
-    sim = Simulation(parse_scene(pile(t_end=0.02)))
+    sim = VerletEngine(parse_scene(pile(t_end=0.02)))
     sim.run()
     s, mech = sim.mechanics.state, sim.mechanics
     assert np.array_equal(s.T, sim.thermal.T)
@@ -92,7 +92,7 @@ def test_overlap_beyond_the_neck_model_is_named():
     pos = doc["particles"]["position"]
     pos[1][2] = pos[0][2] + 1.2e-3  # overlap 0.8 mm > 2r/3
     with pytest.raises(ValueError, match="particles 0 and 1.*h = 0.000795"):
-        Simulation(parse_scene(doc)).run()
+        VerletEngine(parse_scene(doc)).run()
 
 
 def test_cooling_by_the_network_freezes_the_contacts():
@@ -102,7 +102,7 @@ def test_cooling_by_the_network_freezes_the_contacts():
     doc = pile(t_end=0.01, hot=20.0)
     doc["particles"]["temperature"] = [150.0] * len(doc["particles"]["temperature"])
     doc["contact"]["t0"] = 1e6  # relaxing would take for ever: only the freeze can raise the factor
-    sim = Simulation(parse_scene(doc))
+    sim = VerletEngine(parse_scene(doc))
     start = sim.mechanics.particle_column("k1_factor").copy()
     sim.run()
     assert np.all(sim.thermal.rate <= 0.0) and np.any(sim.thermal.rate < 0.0)

@@ -87,8 +87,8 @@ def test_run_summary_of_the_pair_scene(tmp_path):
     for key in ("t", "steps", "particles", "bonds", "energy_error", "seconds", "physics", "T"):
         assert key in s
     assert s["steps"] == 100 and s["bonds"] == 1 and s["physics"] == ["thermal"]
-    for name in ("summary.json", "timeseries.csv", "particles.pvd", "bonds.pvd", "particles_00000.vtu",
-                 "bonds_00100.vtu"):
+    for name in ("summary.json", "timeseries.csv", "particles.pvd", "bonds.pvd", "particles_000000000.vtu",
+                 "bonds_000000100.vtu"):
         assert (tmp_path / name).exists()
     rows = (tmp_path / "timeseries.csv").read_text().splitlines()
     assert len(rows) == 102

@@ -7,7 +7,8 @@ from scipy.optimize import brentq
 
 from dem import Material, make_scene, run
 from dem.laws.conductance import ConductanceSpec
-from dem.laws.ambient import STEFAN_BOLTZMANN, Convection, Radiation, Sources, Wall
+from dem.laws.ambient import STEFAN_BOLTZMANN, Convection, Radiation, Sources
+from dem.geometry.walls import Wall
 from fem_neck import law as fem_law
 from fem_neck.geometry import neck_radius
 

@@ -10,7 +10,7 @@ from dem.network.current import Electrodes, area_weighted_current, kirchhoff
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.network.laplacian import BoundedLaplacian, solve_anchored
 from dem.geometry.particles import Material, Particles
-from dem.laws.ambient import Wall
+from dem.geometry.walls import Wall
 
 SIGMA = 0.1  # S/m (Zohdi 2014, Sec. 7)
 LENS = ConductanceSpec("zohdi")

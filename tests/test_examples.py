@@ -8,7 +8,7 @@ import runpy
 import numpy as np
 import pytest
 
-from verification.cases import SEC6, SEMISPHERE_BY_H
+from verification.cases import SEC6, SEC43, SEMISPHERE_BY_H
 
 EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
 
@@ -26,6 +26,21 @@ def test_every_example_is_tested():
 def test_semisphere():
     ns = run_example("semisphere")
     assert ns["K_over_Kcyl"] == pytest.approx(SEMISPHERE_BY_H[0.08].K_over_Kcyl, rel=1e-6)  # rtol 1e-6 asked
+
+
+def test_neck_models():
+    ns = run_example("neck_models")
+    assert ns["a"] == pytest.approx(SEC43["newton"].value, rel=1e-6)  # the paper's 6 digits: 0.741466 mm
+    assert ns["a_coble"] == pytest.approx(SEC43["coble"].value, rel=1e-6)
+    assert ns["a_first"] == pytest.approx(SEC43["first"].value, rel=1e-6)
+
+
+def test_fit_law():
+    ns = run_example("fit_law")
+    assert ns["slope"] == pytest.approx(1.069802648, rel=1e-6)  # python -m fem_neck fit (the same 40 points)
+    assert ns["law"].max_rel_residual < 5e-3  # the law's target: 0.5 % of the FE over its range
+    shipped = ns["law"].default()  # fem_neck/data/fit.json, from the same sweep
+    assert (ns["law"].B, ns["law"].C, ns["law"].E) == pytest.approx((shipped.B, shipped.C, shipped.E), rel=1e-6)
 
 
 def test_unequal_pair():

@@ -15,7 +15,7 @@ from dem.geometry.particles import Material, Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.scene import make_scene, parse_scene
 from dem.driver import run
-from dem.laws.ambient import Wall
+from dem.geometry.walls import Wall
 
 UNIT = Material(1.0, 1.0, 1.0, "unit")
 

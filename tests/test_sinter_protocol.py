@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from verification import sinter_protocol as sp
-from dem.engines.verlet.engine import Simulation
+from dem.engines.verlet.engine import VerletEngine
 from verification.fragments import clusters, fragments, tension_capacity
 from dem.laws.contact.luding import LUDING_TABLE1 as MAT
 from dem.scene import parse_scene
@@ -43,10 +43,13 @@ def test_stage_scenes_continue_from_a_state(tmp_path):
     prep = run(parse_scene(sp.preparation_doc(12, 100.0, times=times)), tmp_path / "prep")
     state = str(tmp_path / "prep" / "state.npz")
     sinter = parse_scene(sp.sintering_doc(state, 100.0, 0.004, times=times, cooling=True))
-    assert sinter.solver.t_end == pytest.approx(0.002 + 0.004 + 0.004)
+    t_heat = prep.summary["t"]  # the clock goes on from the prepared state's
+    assert 0 <= t_heat - times.t_heat < prep.summary["dt"]  # the first step at or after t_end
+    assert sinter.start_time == t_heat and sinter.solver.t_end == pytest.approx(t_heat + 0.002 + 0.004 + 0.004)
+    assert sinter.motion.schedule.time[0] == t_heat
     assert sinter.motion.schedule.value == (80.0, 140.0, 140.0, 80.0, 80.0)
     assert sinter.motion.phases == ()  # Table 1 friction from the start (t_heat)
-    saved_right = prep.models[0].w.q[2]
+    saved_right = prep.engine.mechanics.w.q[2]
     assert {w.name: w for w in sinter.motion.walls}["right"].offset == saved_right
     from dem.scene import state_file
 
@@ -54,12 +57,13 @@ def test_stage_scenes_continue_from_a_state(tmp_path):
     z0 = -sp.wall_offset(saved, "top")
     comp = parse_scene(sp.compression_doc(state, 10.0, z0=z0, strain_rate=2.0, strain=0.04))
     top = {w.name: w for w in comp.motion.walls}["top"]
-    assert (top.motion, top.velocity, comp.solver.t_end) == ("strain", pytest.approx(2.0 * z0), pytest.approx(0.02))
+    assert (top.motion, top.velocity, comp.solver.t_end) == ("strain", pytest.approx(2.0 * z0),
+                                                            pytest.approx(t_heat + 0.02))
     vib = parse_scene(sp.vibration_doc(state, sp.floor_height(saved)))
     (floor,) = vib.motion.walls
     assert (floor.motion, floor.frequency, floor.amplitude) == ("vibrate", 100.0, 2e-4)
     assert floor.offset == pytest.approx(np.min(saved["x"][:, 2] - saved["radius"]))
-    assert vib.motion.gravity == (0.0, 0.0, -9.81) and vib.solver.t_end == 0.1
+    assert vib.motion.gravity == (0.0, 0.0, -9.81) and vib.solver.t_end == pytest.approx(t_heat + 0.1)
 
 
 @pytest.mark.parametrize("call, words", [
@@ -78,9 +82,9 @@ def test_bad_protocol_input_names_the_parameter(call, words):
 
 def test_tiny_schedule_sinters_and_cools_back():
     times = sp.Times(t_s=0.02, t_heat=0.03, heat=0.01, cool=0.01, relax=0.01)
-    sim = Simulation(parse_scene(sp.schedule_doc(16, 100.0, 0.02, times=times)))
+    sim = VerletEngine(parse_scene(sp.schedule_doc(16, 100.0, 0.02, times=times)))
     rows = []
-    sim.run(lambda s: rows.append((s.mechanics.t, s.volume_fraction(), float(np.mean(s.mechanics.particle_column("k1_factor"))))))
+    sim.run(lambda: rows.append((sim.mechanics.t, sim.volume_fraction(), float(np.mean(sim.mechanics.particle_column("k1_factor"))))))
     t, nu, k1 = map(np.array, zip(*rows))
     at = lambda time: int(np.argmin(abs(t - time)))  # noqa: E731
     k1_80 = 1.0 / (1.0 + math.exp(-2.0 * (120.0 - 80.0) / 10.0))  # eq. 10
@@ -100,9 +104,9 @@ def test_an_interval_starting_just_before_a_knot_takes_the_next_segment():
            "particles": {"position": [[0, 0, 0], [5e-3, 0, 0]], "radius": [1e-3, 1e-3], "temperature": [80.0] * 2},
            "contact": sp.contact_table(MAT), "temperature": {"time": [0.0, 1e-3, 2e-3], "value": [80.0, 140.0, 140.0]},
            "solver": {"mode": "transient", "t_end": 2e-3, "dt": 3e-7}, "output": {"interval": 5e-4}}
-    sim = Simulation(parse_scene(doc))
+    sim = VerletEngine(parse_scene(doc))
     rows = []
-    sim.run(lambda s: rows.append((s.mechanics.t, s.mechanics.state.T[0])))
+    sim.run(lambda: rows.append((sim.mechanics.t, sim.mechanics.state.T[0])))
     assert round(1e-3 / 3e-7) * 3e-7 < 1e-3
     assert max(T for _, T in rows) == pytest.approx(140.0, abs=1e-9)
     assert rows[-1][1] == 140.0
@@ -123,7 +127,7 @@ def test_tension_capacity_is_eq_15_and_fragments_split_at_the_threshold():
     doc = {"scene": {"physics": ["mechanical"], "dimension": 2, "height": h}, "material": {"density": 2000.0},
            "particles": {"position": x, "radius": [a] * 5, "temperature": [80.0] * 5},
            "contact": sp.contact_table(MAT), "solver": {"mode": "transient", "t_end": 1e-6}}
-    mech = Simulation(parse_scene(doc)).mechanics
+    mech = VerletEngine(parse_scene(doc)).mechanics
     i, j, cap = tension_capacity(mech)
     s = 1.0 / (1.0 + math.exp(-2.0 * (120.0 - 80.0) / 10.0))
     dmf = MAT.k2 * MAT.fluid_overlap * a / (MAT.k2 - MAT.k1)

@@ -13,7 +13,7 @@ from dem.scene import parse_scene
 from dem.laws.contact import zohdi as zohdi_law
 from dem.laws.contact.zohdi import ZohdiMaterial
 from dem.scene.zohdi import ZohdiStepping
-from dem.engines.staggered.engine import ZohdiSimulation
+from dem.engines.staggered.engine import StaggeredEngine
 
 R = 0.075
 RHO = 2000.0
@@ -59,7 +59,7 @@ def test_free_fall_with_drag_follows_the_trapezoidal_recurrence():
     recurrence v+ = ((1 - h k/2) v + h g)/(1 + h k/2) to the iteration tolerance, and it approaches the exact
     solution as dt^2."""
     g = 9.81
-    sim = ZohdiSimulation(parse_scene(scene([[0.0, 0.0, 0.0]], gravity=(-g, 0.0, 0.0), t_end=0.2,
+    sim = StaggeredEngine(parse_scene(scene([[0.0, 0.0, 0.0]], gravity=(-g, 0.0, 0.0), t_end=0.2,
                                             contact={"c_env": 2.0}, solver={"tolerance": 1e-12})))
     sim.run()
     k = 2.0 * 6.0 * math.pi * R / MASS
@@ -77,7 +77,7 @@ def test_collision_conserves_momentum_and_the_elastic_law_returns_the_energy():
     equal and opposite); the contact is elastic, so the trapezoidal rule gives the kinetic energy back."""
     doc = scene([[0.0, 0.0, 0.0], [0.2, 0.0, 0.0]], velocity=[[1.0, 0.1, 0.0], [-0.5, 0.0, 0.0]], t_end=0.3,
                 contact={"mu_d": 0.0, "c_env": 0.0})
-    sim = ZohdiSimulation(parse_scene(doc))
+    sim = StaggeredEngine(parse_scene(doc))
     p0 = sim.mechanics.state.momentum().copy()
     e0 = sim.mechanics.state.kinetic_energy()
     touched = False
@@ -101,7 +101,7 @@ def test_sliding_on_the_floor_decelerates_at_mu_g():
         dist += (force - MASS * g) / 2e6
     doc = scene([[-1.0 + dist, 0.0, 0.0]], velocity=[[0.0, 1.0, 0.0]], walls=[FLOOR], gravity=(-g, 0.0, 0.0),
                 t_end=0.2, contact={"mu_d": mu, "c_env": 0.0, "v_slip": 0.01})
-    sim = ZohdiSimulation(parse_scene(doc))
+    sim = StaggeredEngine(parse_scene(doc))
     sim.run()
     assert sim.mechanics.state.v[0, 1] == pytest.approx(1.0 - mu * g * 0.2, rel=5e-3)
 
@@ -111,7 +111,7 @@ def test_a_bond_is_kept_from_the_step_after_E_star_and_cancels_part_of_the_repul
     normal force is (K_p(theta) - K_b) |E|^2 A (eq. 19)."""
     gap = 2 * R * (1 - 0.12)
     doc = scene([[0.0, 0.0, 0.0], [gap, 0.0, 0.0]], t_end=0.01, contact={"E_star": 0.1, "c_env": 50.0})
-    sim = ZohdiSimulation(parse_scene(doc))
+    sim = StaggeredEngine(parse_scene(doc))
     i, j, fn, area, bond = sim.mechanics.contacts()
     strain = (2 * R - gap) / (2 * R)
     assert fn[0] == pytest.approx(4.0e6 * strain**2 * area[0], rel=1e-12)  # not bonded yet
@@ -132,7 +132,7 @@ def settling(tolerance, dt_max=0.002, t_end=0.15):
              {"name": "y+", "point": [0, 0.2, 0], "normal": [0, -1, 0]}]
     doc = scene(pos, walls=walls, gravity=(-9.81, 0.0, 0.0), t_end=t_end,
                 solver={"dt": dt_max, "dt_max": dt_max, "tolerance": tolerance})
-    sim = ZohdiSimulation(parse_scene(doc))
+    sim = StaggeredEngine(parse_scene(doc))
     x0 = sim.mechanics.state.x.copy()
     sim.run()
     return sim, x0
@@ -155,7 +155,7 @@ def test_a_step_that_cannot_converge_in_K_d_iterations_restarts_smaller():
     doc = scene([[0.0, 0.0, 0.0], [0.16, 0.0, 0.0]], velocity=[[3.0, 0.0, 0.0], [-3.0, 0.0, 0.0]], t_end=0.1,
                 contact={"K_p": 1e9, "K_p_lim": 1e8, "mu_d": 0.0, "c_env": 0.0},
                 solver={"dt": 0.005, "dt_max": 0.005, "iterations": 5})
-    sim = ZohdiSimulation(parse_scene(doc))
+    sim = StaggeredEngine(parse_scene(doc))
     sim.run()
     assert sim.restarts > 0
     assert min(sim.dt_taken) < 0.005 / 2
@@ -194,7 +194,7 @@ def column(n=6, **kwargs):
 def test_joule_heat_equals_electrode_power_and_the_heat_balance_is_exact():
     doc = column(t_end=0.05)
     doc["walls"][1]["potential"] = 5000.0  # heats by ~10 K per step: the balance is not lost in T's round-off
-    sim = ZohdiSimulation(parse_scene(doc))
+    sim = StaggeredEngine(parse_scene(doc))
     c = sim.current
     assert c.joule_heat > 0 and c.joule_heat == pytest.approx(c.electrode_power, rel=1e-12)
     assert c.flow.residual < 1e-12  # current conserved at every particle
@@ -210,7 +210,7 @@ def test_joule_heat_equals_electrode_power_and_the_heat_balance_is_exact():
 def test_current_in_the_engine_is_the_direct_kirchhoff_solve_of_the_column():
     """The column in series: the current is 50 V over the sum of the contact resistances sigma pi a^2 / d (the
     thermal lens law with sigma for kappa) and the two electrode contacts."""
-    sim = ZohdiSimulation(parse_scene(column()))
+    sim = StaggeredEngine(parse_scene(column()))
     s = sim.mechanics.state
     sigma = 0.1
     d = np.linalg.norm(np.diff(s.x, axis=0), axis=1)
@@ -228,7 +228,7 @@ def test_zohdi_scheme_in_the_engine_heats_by_J_squared():
     doc["walls"][1].pop("potential")
     doc["walls"][0]["current"] = 10.0
     doc["walls"][1]["current"] = 40.0
-    sim = ZohdiSimulation(parse_scene(doc))
+    sim = StaggeredEngine(parse_scene(doc))
     J = sim.current.J
     assert J[0] == 10.0 and J[-1] == 40.0 and np.allclose(J, np.linspace(10.0, 40.0, len(J)), rtol=1e-6)
     V = 4.0 / 3.0 * math.pi * R**3
@@ -249,7 +249,7 @@ def test_volume_fraction_of_remark_1():
     doc = scene(pos, velocity=[[0, 0, 0], [0, 0, 0], [1.2, 0, 0]], walls=walls, t_end=0.1,
                 output={"fraction_axis": "x"}, solver={"dt": 0.01, "dt_max": 0.01})
     doc["phases"] = [{"start": 0.05, "wall_velocity": {"top": -1.0}}]
-    sim = ZohdiSimulation(parse_scene(doc))
+    sim = StaggeredEngine(parse_scene(doc))
     sim.run()
     x = sim.mechanics.state.x[:, 0]
     assert x[2] + R > -0.55 > x[2] - R  # the third one crosses the lowest compression point
@@ -282,13 +282,13 @@ def test_fixed_current_without_a_path_and_floating_particles_stop_the_run():
     doc["walls"][1]["current"] = 2.0
     doc["walls"][1]["point"] = [0.5, 0.0, 0.0]  # lifted off the column
     with pytest.raises(ValueError, match="walls.top.current = 2 A at t = 0 s: no path"):
-        ZohdiSimulation(parse_scene(doc))
+        StaggeredEngine(parse_scene(doc))
     doc = column(electrical={"scheme": "kirchhoff", "absorption": 0.5, "floating": "error"})
     doc["particles"]["position"].append([-0.5, 0.5, 0.5])
     doc["particles"]["radius"].append(R)
     doc["particles"]["temperature"].append(300.0)
     with pytest.raises(ValueError, match=r"1 particle\(s\) touch no electrode .*: 6$"):
-        ZohdiSimulation(parse_scene(doc))
+        StaggeredEngine(parse_scene(doc))
 
 
 def to_toml(doc: dict) -> str:
@@ -341,8 +341,8 @@ def test_section_7_three_phases_of_fig_9():
     from dem.scene import load_scene
 
     rows = []
-    sim = ZohdiSimulation(load_scene("zohdi-compaction"))
-    sim.run(observer=lambda s: rows.append(s.record()))
+    sim = StaggeredEngine(load_scene("zohdi-compaction"))
+    sim.run(lambda: rows.append(sim.record()))
     t = np.array([r["t"] for r in rows])
     vf = np.array([r["volume_fraction"] for r in rows])
     T = np.array([r["T_mean"] for r in rows])
@@ -365,7 +365,7 @@ def test_compiled_lens_conduction_is_the_conductance_law_on_the_bonds():
     (dem.geometry.bonds.find_bonds + dem.laws.conductance with law = "zohdi"), here on a pressed column with hot walls."""
     doc = column()
     doc["walls"][0]["temperature"] = 900.0
-    sim = ZohdiSimulation(parse_scene(doc))
+    sim = StaggeredEngine(parse_scene(doc))
     th, mech = sim.thermal, sim.mechanics
     T = np.random.default_rng(0).uniform(300.0, 700.0, mech.state.n)
     assert th.compiled
@@ -381,9 +381,9 @@ def test_frames_are_rendered_off_screen(tmp_path):
 
     doc = column()
     doc["output"] = {"fraction_axis": "x"}
-    sim = ZohdiSimulation(parse_scene(doc))
+    sim = StaggeredEngine(parse_scene(doc))
     frames = FrameWriter(tmp_path, 2, 0.01, 0, 300.0, 1000.0)
     frames(sim)
-    sim.run(observer=frames)
+    sim.run(lambda: frames(sim))
     assert frames.written == ["frame_00.png", "frame_01.png"]
     assert all((tmp_path / "frames" / name).stat().st_size > 10_000 for name in frames.written)

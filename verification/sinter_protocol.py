@@ -41,6 +41,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 from dem.laws.contact.luding import LUDING_TABLE1, LudingMaterial
+from dem.scene import state_file
 
 T_PREPARE = 80.0        # °C, preparation, cooled sample and tests (Sec. 4.1)
 T_SINTER = 140.0        # °C, sintering (Sec. 4.1)
@@ -150,6 +151,20 @@ def _base(name: str, material: LudingMaterial, dimension: int, t_end: float, out
             "output": {"interval": output_interval, "vtu": False}}
 
 
+def _continue_from(doc: dict, state: str) -> dict:
+    """``doc`` (its times counted from the stage's start) started from the saved ``state``: the run's clock goes on
+    from the state's (:mod:`dem.scene.state_file`), so ``t_end``, the schedule's knots and the phases' starts are
+    moved by its time."""
+    t0 = state_file.load(state)["t"]
+    doc["start"] = {"state": str(state)}
+    doc["solver"]["t_end"] = t0 + doc["solver"]["t_end"]
+    if "temperature" in doc:
+        doc["temperature"]["time"] = [t0 + t for t in doc["temperature"]["time"]]
+    for phase in doc.get("phases", []):
+        phase["start"] = t0 + phase["start"]
+    return doc
+
+
 def preparation_doc(n: int, p: float, *, seed: int = 1, times: Times | None = None, fill: float | None = None,
                     spread: float = RADIUS_SPREAD, speed: float = 0.01, prep_mu_wall: float = 0.0,
                     material: LudingMaterial = LUDING_TABLE1,
@@ -185,18 +200,17 @@ def _schedule(times: Times, material: LudingMaterial, cooling: bool, start: floa
 def sintering_doc(state: str, p: float, t_s: float, *, cooling: bool = False, times: Times | None = None,
                   material: LudingMaterial = LUDING_TABLE1, dimension: int = 2,
                   output_interval: float = 2.5e-3) -> dict:
-    """From the prepared ``state`` (a ``state.npz`` path): heating and sintering for ``t_s`` (to t_cool), and with
-    ``cooling`` the cooling and relaxation too (to t_f). The clock starts at t_heat = 0."""
+    """From the prepared ``state`` (a ``state.npz`` path, at t_heat): heating and sintering for ``t_s`` (to t_cool),
+    and with ``cooling`` the cooling and relaxation too (to t_f)."""
     p = _check_pressure(p)
     times = times or Times(t_s=t_s)
     if times.t_s != t_s:
         raise ValueError(f"t_s = {t_s!r}: differs from times.t_s = {times.t_s!r}")
     t_end = times.heat + times.t_s + ((times.cool + times.relax) if cooling else 0.0)
     doc = _base(f"luding2005-sintering-p{p:g}-ts{t_s:g}", material, dimension, t_end, output_interval)
-    doc["start"] = {"state": str(state)}
     doc["walls"] = box_walls(1.0, p, dimension)  # the saved walls keep their places (by name)
     doc["temperature"] = _schedule(times, material, cooling)
-    return doc
+    return _continue_from(doc, state)
 
 
 def cooling_doc(state: str, p: float, *, times: Times | None = None, material: LudingMaterial = LUDING_TABLE1,
@@ -205,12 +219,11 @@ def cooling_doc(state: str, p: float, *, times: Times | None = None, material: L
     p = _check_pressure(p)
     times = times or Times(t_s=1.0)
     doc = _base(f"luding2005-cooling-p{p:g}", material, dimension, times.cool + times.relax, output_interval)
-    doc["start"] = {"state": str(state)}
     doc["walls"] = box_walls(1.0, p, dimension)
     doc["temperature"] = {"time": [0.0, times.cool, times.cool + times.relax], "value": [T_SINTER, T_PREPARE,
                                                                                           T_PREPARE],
                           "relaxation_time": [material.t0, material.t0]}
-    return doc
+    return _continue_from(doc, state)
 
 
 def schedule_doc(n: int, p: float, t_s: float, *, seed: int = 1, times: Times | None = None,
@@ -245,14 +258,13 @@ def compression_doc(state: str, p: float, *, strain_rate: float = 1.0, strain: f
     if strain >= 1:
         raise ValueError(f"strain = {strain!r}: must be < 1 (eps_zz = 1 - z/z0)")
     doc = _base(f"luding2005-compression-p{p:g}", material, 2, strain / strain_rate, output_interval)
-    doc["start"] = {"state": str(state)}
     walls = box_walls(1.0, p, 2)
     top = next(w for w in walls if w["name"] == "top")
     for key in ("pressure", "mass", "damping"):
         del top[key]
     top.update(motion="strain", velocity=strain_rate * z0)
     doc["walls"] = walls
-    return doc
+    return _continue_from(doc, state)
 
 
 def vibration_doc(state: str, floor: float, *, frequency: float = 100.0, amplitude: float = 2.0e-4,
@@ -267,11 +279,10 @@ def vibration_doc(state: str, floor: float, *, frequency: float = 100.0, amplitu
                 or (value == 0 and name == "duration"):
             raise ValueError(f"{name} = {value!r}: must be a finite number {'> 0' if name == 'duration' else '>= 0'}")
     doc = _base("luding2005-vibration", material, 2, duration, output_interval)
-    doc["start"] = {"state": str(state)}
     doc["walls"] = [{"name": "floor", "point": [0.0, 0.0, float(floor)], "normal": [0.0, 0.0, 1.0],
                      "motion": "vibrate", "amplitude": amplitude, "frequency": frequency}]
     doc["gravity"] = {"acceleration": [0.0, 0.0, -gravity]}
-    return doc
+    return _continue_from(doc, state)
 
 
 def heated_walls_doc(state: str, p: float, *, hot: float, cold: float, duration: float, t0: float,
@@ -288,14 +299,13 @@ def heated_walls_doc(state: str, p: float, *, hot: float, cold: float, duration:
     doc = _base("luding2005-heated-walls-3d", replace(material, t0=t0), 3, duration, output_interval)
     doc["scene"]["physics"] = ["mechanical", "thermal"]
     doc["material"].update(conductivity=conductivity, specific_heat=specific_heat)
-    doc["start"] = {"state": str(state)}
     walls = box_walls(1.0, p, 3)
     next(w for w in walls if w["name"] == "bottom")["temperature"] = hot
     next(w for w in walls if w["name"] == "top")["temperature"] = cold
     doc["walls"] = walls
     doc["conductance"] = {"law": "fit", "out_of_range": "clip"}
     doc["solver"].update(integrator="implicit", thermal_interval=thermal_interval)
-    return doc
+    return _continue_from(doc, state)
 
 
 def floor_height(saved: dict) -> float:

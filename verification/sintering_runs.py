@@ -218,9 +218,9 @@ def neck_statistics(sim) -> dict:
 def run_task(task: Task, root) -> dict:
     """Run ``task`` into ``root/task.folder`` (module docstring); returns what ``result.json`` holds."""
     from dem.scene import state_file
-    from dem.engines.verlet.engine import Simulation
+    from dem.engines.verlet.engine import VerletEngine
     from verification.fragments import fragments
-    from dem.output.writer import MotionWriter
+    from dem.output.writer import RunWriter
     from dem.scene import parse_scene
 
     root = pathlib.Path(root)
@@ -229,21 +229,22 @@ def run_task(task: Task, root) -> dict:
     (out / "result.json").unlink(missing_ok=True)
     scene = parse_scene(scene_doc(task, root), task.kind)
     t_start = time.perf_counter()
-    sim = Simulation(scene)
-    writer = MotionWriter(out, scene)
+    sim = VerletEngine(scene)
+    writer = RunWriter(out, scene, sim)
     interval = scene.motion.output_interval
     captures = list(FIG20_TIMES) if task.kind == COMPRESS else []
     snaps = []
 
-    def observer(s):
-        writer(s)
-        if captures and s.mechanics.t >= captures[0] - 0.5 * interval:  # the first row at (or just before) it
+    def observe():
+        writer.observe()
+        if captures and sim.mechanics.t >= captures[0] - 0.5 * interval:  # the first row at (or just before) it
             captures.pop(0)
-            snaps.append(snapshot(s))
+            snaps.append(snapshot(sim))
 
-    summary = sim.run(observer)
+    sim.run(observe)
+    summary = sim.summary()
     seconds = time.perf_counter() - t_start
-    state_file.save(sim, out / "state.npz")
+    state_file.save(sim.state(), out / "state.npz")
     writer.finish({"scene": scene.name, **summary, "seconds": seconds}, plots=False)
     snaps.append(snapshot(sim))
     arrays = {f"snap{k}_{key}": v for k, snap in enumerate(snaps) for key, v in snap.items()}
@@ -335,15 +336,16 @@ def schedule_seconds(n: int = 300, p: float = 100.0, t_s: float = 1.0, seed: int
     ``seconds`` of the run (building the simulation, loading the compiled kernels and the time loop),
     ``loop_seconds`` (the time loop alone), ``steps``, ``ns_per_particle_step`` (of the loop) and the final solid
     fraction and coordination number. For the bench row of "the whole schedule, t_s = 1, N = 300"."""
-    from dem.engines.verlet.engine import Simulation
+    from dem.engines.verlet.engine import VerletEngine
     from dem.scene import parse_scene
     from verification.sinter_protocol import schedule_doc
 
     t0 = time.perf_counter()
-    sim = Simulation(parse_scene(schedule_doc(n, p, t_s, seed=seed), "schedule"))
+    sim = VerletEngine(parse_scene(schedule_doc(n, p, t_s, seed=seed), "schedule"))
     t1 = time.perf_counter()
-    summary = sim.run()
+    sim.run()
     t2 = time.perf_counter()
+    summary = sim.summary()
     steps = sim.mechanics.steps
     return {"n": n, "p": p, "t_s": t_s, "seconds": t2 - t0, "loop_seconds": t2 - t1, "steps": steps,
             "ns_per_particle_step": 1e9 * (t2 - t1) / (steps * n), "volume_fraction": summary["volume_fraction"],

@@ -1,9 +1,12 @@
-"""``python -m dem``: run a pipe-network thermal DEM scene, list the built-in scenes, or drive one contact.
+"""``python -m dem``: run a pipe-network thermal DEM scene, list the built-in scenes, drive one contact, or convert a
+packing (for LAMMPS).
 
     python -m dem run SCENE [--out DIR] [--json]     SCENE: a TOML file or a built-in name
     python -m dem scenes [--json]
     python -m dem laws [--json]                      the conductance laws a scene can select
     python -m dem contact SCENE --history FILE.csv [--no-damping] [--out DIR] [--json]
+    python -m dem convert IN OUT [--format F] [--length-unit U] [--json]   IN: a packing file, state.npz or scene;
+                                                                          OUT: a LAMMPS data file, CSV or VTU
 
 Each sub-command is a module of this package exposing ``register(subparsers)``; the plumbing is that of
 :mod:`sinterheat.cli` (one JSON object with ``--json``; bad input: one line on stderr, exit code 2).
@@ -11,7 +14,7 @@ Each sub-command is a module of this package exposing ``register(subparsers)``; 
 
 from sinterheat import cli
 
-COMMANDS = ("run", "scenes", "contact", "laws")
+COMMANDS = ("run", "scenes", "contact", "laws", "convert")
 
 
 def main(argv=None) -> int:

@@ -24,7 +24,7 @@ import numpy as np
 
 from dem.laws.conductance import ConductanceSpec
 from dem.geometry.particles import Particles
-from dem.laws.ambient import Sources, Wall
+from dem.laws.ambient import Sources
 from dem.network.heat import Network, bonds_and_conductances, theta_step
 
 
@@ -64,8 +64,7 @@ class ContactThermalModel:
         return Particles(mechanics.state.x, radius, self.T, p.material, p.fixed, p.heat, p.materials)
 
     def _walls_now(self, mechanics) -> list:
-        return [Wall(self.walls[k].name, self.walls[k].normal * mechanics.w.q[k], self.walls[k].normal,
-                     self.walls[k].temperature) for k in self.thermal_walls]
+        return [self.walls[k].at(mechanics.w.q[k]) for k in self.thermal_walls]
 
     def step(self, mechanics, dt: float) -> None:
         """Advance the temperatures by ``dt`` on the network of the contacts of ``mechanics`` now."""

@@ -1,44 +1,67 @@
-"""The submodels a scene can ask for, and where new ones plug in.
-
-A scene names its physics (``[scene] physics = ["thermal"]``); only those are built. Each entry of
-:data:`REGISTRY` is a class constructed from the :class:`~dem.scene.parse.Scene` that builds its own state, and whose
-``run(observer, progress)`` returns a summary dict. The thermal model of a static packing builds its bonds once,
-never moves a particle and allocates no mechanical state.
-
-Particles that move (``"mechanical"``, the Luding 2005 contact law) run in the engine of :mod:`dem.engines.verlet.engine`, where
-the thermal network follows the contacts as the necks grow; with ``[contact] law = "zohdi"`` the staggered scheme of
-Zohdi 2014 (:mod:`dem.engines.staggered.engine`) runs the mechanics, the heat and the current (``"electrical"``).
+"""The engine of a static packing: the pipe network of Rojek 2022 (eqs. 1-9) on bonds found once from the scene's
+geometry, solved steady or integrated in time (:mod:`dem.network.heat`). It never moves a particle and allocates
+no mechanical state; a scene whose physics is only ``"thermal"`` runs here.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from dem.network.heat import boundary_heat_flow, build_network, integrate, periodic_heat_flow, steady
+from dem.network.heat import Checkpoint, boundary_heat_flow, build_network, integrate, periodic_heat_flow, steady
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
-
-PLANNED: dict = {}  # names reserved for submodels still to come: refused with what they will be
-MOVING = ("mechanical", "electrical")  # built by the engines for moving particles (dem.engines.verlet, dem.engines.staggered), not here
+CSV_FLOWS = ("fixed", "walls", "convection", "radiation", "internal")  # the heat-flow columns of timeseries.csv
 
 
-class ThermalModel:
-    """The pipe network of Rojek 2022 (eqs. 1-9) on bonds found once from the scene's geometry."""
+def effective_conductivity(scene, summary: dict) -> float | None:
+    """``k_eff = Q L / (A dT)`` (steady): of a generated specimen between hot and cold ends, or along the one axis
+    of a periodic box with a temperature drop per period (``Q`` the heat flow across the period)."""
+    box, sp = scene.box, scene.specimen
+    if box is not None and "periodic_heat_flow" in summary:
+        axes = np.flatnonzero(box.drop)
+        if len(axes) != 1:
+            return None
+        k = int(axes[0])
+        return summary["periodic_heat_flow"][k] * box.lengths[k] / (box.cross_section(k) * box.drop[k])
+    if sp is None or sp.hot == sp.cold or "boundary_heat_flow" not in summary:
+        return None
+    boundary = summary["boundary_heat_flow"]
+    if sp.hot_particles:
+        ids = scene.particles.id
+        q = -sum(boundary.get("particles", {}).get(str(ids[k]), 0.0) for k in sp.hot_particles)
+    else:
+        q = -boundary["walls"][sp.hot_wall]
+    return q * sp.length / (sp.area * (sp.hot - sp.cold))
 
-    name = "thermal"
 
-    def __init__(self, scene):
+class StaticEngine:
+    """The thermal network of a static packing (module docstring), as the driver asks of an engine
+    (:mod:`dem.engines`)."""
+
+    name = "static"
+    link_kind = "bonds"
+
+    def __init__(self, scene, restart: dict | None = None):
+        """``restart``: the checkpoint of this scene's transient run (:func:`dem.output.folder.load`)."""
         self.scene = scene
         if scene.solver.mode == "transient":
             self._check_work()  # before the bond search: a refused run costs nothing
         self.network = build_network(scene.particles, scene.walls, scene.conductance, scene.sources, box=scene.box)
         self.bonds, self.K_pairs, self.K_walls = self.network.bonds, self.network.K_pairs, self.network.K_walls
+        self.restart = Checkpoint.from_arrays(restart) if restart is not None else None
+        self.t_start = float(scene.start_time)
+        self.T = scene.particles.temperature.astype(float)
+        self.t, self.steps = (self.restart.t, self.restart.steps) if self.restart is not None else (self.t_start, 0)
+        self.flows: dict = {}
+        self.details: dict = {}
 
-    def run(self, observer=None, progress=None, resume=None, checkpoint=None) -> dict:
-        """Solve (steady) or integrate (transient); ``resume``/``checkpoint``: :func:`dem.network.heat.integrate`."""
+    def run(self, observe=None, progress=None, checkpoint=None) -> None:
+        """Solve (steady) or integrate (transient) to ``[solver] t_end``; ``observe()`` after every step (and at the
+        start), ``progress(t)`` with the simulated time, ``checkpoint(make, final)`` after every step and at the end
+        (:func:`dem.network.heat.integrate`)."""
         try:
-            return self._run(observer, progress, resume, checkpoint)
+            self._run(observe, progress, checkpoint)
         except RuntimeError as exc:  # e.g. SuperLU "Factor is exactly singular": explain it as a property of the scene
             raise ValueError(self._singular_message(exc)) from None
 
@@ -73,70 +96,124 @@ class ThermalModel:
                 f"conductances, ambient coefficients and fixed temperatures are within a few orders of magnitude "
                 f"of each other")
 
-    def _run(self, observer=None, progress=None, resume=None, checkpoint=None) -> dict:
+    def _observed(self, observe):
+        """The integrator's observer: keeps the step's state for :meth:`record` and passes it on."""
+        def observer(step, t, T_free, flows):
+            self.steps, self.t, self.flows = step, self.t_start + t, flows
+            self.T = self.network.full(T_free)
+            if observe is not None:
+                observe()
+        return observer
+
+    def _run(self, observe, progress, checkpoint) -> None:
         s = self.scene.solver
         out = {"law": self.scene.conductance.law, "contact": self.bonds.contact,
                "bonds_clipped": self.bonds.clipped, "bonds_dropped": self.bonds.dropped,
                "wall_bonds": self.bonds.n_walls}
+        observer = self._observed(observe)
+        t0 = self.t_start
         if s.mode == "steady":
             res = steady(self.network, s.floating, s.linear)
-            self.T = res.T
-            if observer is not None:
-                observer(0, 0.0, res.T[self.network.free], res.flows)
-            out.update(t=0.0, steps=0, energy_error=res.energy_error, heat_flow=res.flows, linear_solver=res.solver,
+            observer(0, 0.0, res.T[self.network.free], res.flows)
+            out.update(energy_error=res.energy_error, heat_flow=res.flows, linear_solver=res.solver,
                        newton_iterations=res.iterations, floating_groups=res.floating)
             if len(self.network.fixed) or len(self.scene.walls):
                 out["boundary_heat_flow"] = self._boundary(res.T)
             if self.scene.box is not None:
                 out["periodic_heat_flow"] = periodic_heat_flow(self.network, res.T).tolist()
         else:
-            res = integrate(self.network, s.integrator, s.dt, s.t_end, s.rtol, s.linear, s.max_steps, observer,
-                            progress, resume=resume, checkpoint=checkpoint)
-            self.T = res.T
-            out.update(t=res.t, steps=res.steps, energy_error=res.energy_error, heat_in=res.heat_in,
+            res = integrate(self.network, s.integrator, s.dt, s.t_end - t0, s.rtol, s.linear, s.max_steps, observer,
+                            None if progress is None else (lambda t: progress(t0 + t)), resume=self.restart,
+                            checkpoint=checkpoint)
+            self.T, self.t, self.steps = res.T, t0 + res.t, res.steps
+            out.update(energy_error=res.energy_error, heat_in=res.heat_in,
                        integrator=s.integrator, dt=s.dt, dt_min=res.dt_min, dt_max=res.dt_max,
                        rejected_steps=res.rejected, stable_limit=res.stable_limit, linear_solver=res.solver,
                        factorizations=res.factorizations, max_principle_violation=res.max_principle_violation)
-        return out
+        self.details = out
 
     def _boundary(self, T: np.ndarray) -> dict:
         flows = boundary_heat_flow(self.network, T)
         out = {"walls": {w.name: float(q) for w, q in zip(self.scene.walls, flows["walls"])},
                "fixed_total": float(sum(flows["particles"].values()))}
-        if len(flows["particles"]) <= 1000:
-            out["particles"] = {str(k): v for k, v in flows["particles"].items()}
+        if len(flows["particles"]) <= 1000:  # by particle id (the index unless a packing file gave ids)
+            ids = self.scene.particles.id
+            out["particles"] = {str(ids[k]): v for k, v in flows["particles"].items()}
         return out
+
+    # -------------------------------------------------------------------------------------------- outputs
+    def record(self) -> dict:
+        """One row of ``timeseries.csv``: step, time, temperatures and the heat flow (W) into the particles through
+        each boundary."""
+        T = self.T
+        return {"step": self.steps, "t": self.t, "T_mean": float(T.mean()), "T_min": float(T.min()),
+                "T_max": float(T.max()), **{f"Q_{k}": float(self.flows.get(k, 0.0)) for k in CSV_FLOWS}}
+
+    def positions(self) -> np.ndarray:
+        return self.scene.particles.position
+
+    def temperatures(self) -> np.ndarray:
+        return self.T
+
+    def particle_fields(self) -> dict:
+        p = self.scene.particles
+        return {"id": p.id, "radius": p.radius, "temperature": self.T, "fixed": p.fixed.astype(np.int8),
+                "material": p.material.astype(np.int32)}
+
+    def links(self):
+        """The bonds as lines: a pair bond joins its particles, a wall bond joins the particle to its foot point on
+        the wall, a bond across a periodic face joins the particle to the image of its partner (outside the box);
+        with their conductance, heat flow and neck radius."""
+        p, b = self.scene.particles, self.bonds
+        q_pairs, q_walls = self.bond_heat_flow()
+        walls = self.scene.walls
+        x = p.position[b.wall_particle]
+        foot = np.array([walls[w].point for w in b.wall_index]).reshape(-1, 3)
+        normal = np.array([walls[w].normal for w in b.wall_index]).reshape(-1, 3)
+        foot = x - np.sum((x - foot) * normal, axis=1, keepdims=True) * normal
+        crossing = np.flatnonzero(np.any(b.shifts != 0, axis=1))
+        image = b.vectors(p.position, self.scene.box)[crossing] + p.position[b.i[crossing]]
+        points = np.vstack([p.position, foot, image])
+        partner = b.j.copy()
+        partner[crossing] = p.n + b.n_walls + np.arange(len(crossing))
+        lines = np.vstack([np.column_stack([b.i, partner]),
+                           np.column_stack([b.wall_particle, p.n + np.arange(b.n_walls)])]).astype(np.int64)
+        return points, lines, {"conductance": np.concatenate([self.K_pairs, self.K_walls]),
+                               "heat_flow": np.concatenate([q_pairs, q_walls]),
+                               "neck_radius": np.concatenate([b.a, b.wall_a])}
+
+    def profile(self):
+        return None
+
+    def plots(self, out, summary: dict) -> list[str]:
+        from dem.output.plots import thermal_plots
+
+        return thermal_plots(out, self.scene, self.T)
+
+    def summary(self) -> dict:
+        """What the run found (the driver adds the scene's name, times and the state file)."""
+        p = self.scene.particles
+        d = dict(self.details)
+        out = {"mode": self.scene.solver.mode, "t": self.t, "steps": self.steps, "particles": p.n,
+               "bonds": self.bonds.n_pairs, "energy_error": d.pop("energy_error", None), "static": True}
+        for key in ("boundary_heat_flow", "periodic_heat_flow"):
+            if key in d:
+                out[key] = d.pop(key)
+        k_eff = effective_conductivity(self.scene, out)
+        if k_eff is not None:
+            out["effective_conductivity"] = k_eff
+        out.update(T_mean=float(self.T.mean()), T_min=float(self.T.min()), T_max=float(self.T.max()))
+        out.update(d)
+        return out
+
+    def state(self) -> dict:
+        """The particles as they end (:mod:`dem.scene.state_file`): positions, radii, temperatures, ids, the time."""
+        p = self.scene.particles
+        return {"engine": np.array(self.name), "t": np.array(self.t), "steps": np.array(self.steps),
+                "x": p.position, "radius": p.radius, "T": self.T, "id": p.id, "material": p.material}
 
     def bond_heat_flow(self) -> tuple[np.ndarray, np.ndarray]:
         """Heat flow (W) along each pair bond from i to j, and from each wall-bonded particle into its wall."""
         b, T = self.bonds, self.T
         wall_T = self.network.wall_temperature[b.wall_index]
         return self.K_pairs * (T[b.i] - T[b.j] + self.network.jump), self.K_walls * (T[b.wall_particle] - wall_T)
-
-
-REGISTRY = {"thermal": ThermalModel}
-PHYSICS_NAMES = (*REGISTRY, *MOVING)
-
-
-def check_physics(names) -> None:
-    """Every name a submodel that exists (``thermal``, ``mechanical``, ``electrical``); planned and unknown ones are
-    refused; ``electrical`` runs with moving particles."""
-    available = (*REGISTRY, *MOVING)
-    for name in names:
-        if name in PLANNED:
-            raise ValueError(f"[scene] physics = {name!r}: not implemented yet ({PLANNED[name]}); available: "
-                             f"{', '.join(available)}")
-        if name not in available:
-            raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(available)})")
-    if not names:
-        raise ValueError(f"[scene] physics: names no submodel (available: {', '.join(available)})")
-    if "electrical" in names and "mechanical" not in names:
-        raise ValueError("[scene] physics: \"electrical\" runs with moving particles: [\"mechanical\", \"thermal\", "
-                         "\"electrical\"] with [contact] law = \"zohdi\" (the current on a static packing: "
-                         "dem.network.current.kirchhoff)")
-
-
-def build(scene) -> list:
-    """The submodels of a static scene (only ``thermal``), in order; unknown or planned names raise ValueError."""
-    check_physics(scene.physics)
-    return [REGISTRY[name](scene) for name in scene.physics]

@@ -32,6 +32,32 @@ def check_range(name: str, arr: np.ndarray, low: float | None, high: float, what
     return arr
 
 
+def check_vector(name: str, value) -> np.ndarray:
+    """``value`` as a finite 3-vector of at most POSITION_MAX per component, else ``ValueError`` naming it."""
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        v = np.full(1, np.nan)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} = {value!r}: must be a finite 3-vector")
+    return check_range(name, v, None, POSITION_MAX, " m")
+
+
+def check_unit_vector(name: str, value) -> np.ndarray:
+    """``value`` as a unit 3-vector (a finite, non-zero 3-vector, normalised), else ``ValueError`` naming it."""
+    v = check_vector(name, value)
+    if np.linalg.norm(v) == 0.0:
+        raise ValueError(f"{name} = {value!r}: must be a finite non-zero 3-vector")
+    return v / np.linalg.norm(v)
+
+
+def check_temperature(name: str, value) -> float:
+    """``value`` as a finite temperature within :data:`TEMPERATURE_MAX`, else ``ValueError`` naming it."""
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
+        raise ValueError(f"{name} = {value!r}: must be a finite number")
+    return float(check_range(name, np.float64(value), None, TEMPERATURE_MAX))
+
+
 def finite_array(name: str, value, shape_tail=(), dtype=float) -> np.ndarray:
     """``value`` as an array of rank ``1 + len(shape_tail)`` with the given trailing shape and finite entries."""
     try:
@@ -84,7 +110,9 @@ COPPER = Material(394.0, 8960.0, 385.0, "copper")
 @dataclass(frozen=True)
 class Particles:
     """N spheres: ``position`` (N, 3) m, ``radius`` (N,) m, ``temperature`` (N,), ``material`` (N,) index into
-    ``materials``, ``fixed`` (N,) bool (held at the initial temperature), ``heat`` (N,) internal heat W (eq. 3).
+    ``materials``, ``fixed`` (N,) bool (held at the initial temperature), ``heat`` (N,) internal heat W (eq. 3),
+    ``id`` (N,) the particles' ids (integers >= 0, unique; 0..N-1 unless given, e.g. by a packing file), written
+    to the outputs.
 
     Build with :meth:`from_arrays`, which validates every array and names the first bad entry.
     """
@@ -96,11 +124,17 @@ class Particles:
     fixed: np.ndarray
     heat: np.ndarray
     materials: tuple = field(default=(COPPER,))
+    id: np.ndarray = None
+
+    def __post_init__(self):
+        if self.id is None:
+            object.__setattr__(self, "id", np.arange(len(self.radius), dtype=np.int64))
 
     @classmethod
     def from_arrays(cls, position, radius, temperature, materials=(COPPER,), material=None, fixed=None,
-                    heat=None, prefix: str = "particles") -> "Particles":
-        """Validated particle state; ``material`` defaults to 0, ``fixed`` to False, ``heat`` to 0 W."""
+                    heat=None, prefix: str = "particles", id=None) -> "Particles":
+        """Validated particle state; ``material`` defaults to 0, ``fixed`` to False, ``heat`` to 0 W, ``id`` to
+        0..N-1."""
         sep = " " if prefix.startswith("[") else "."
         if isinstance(materials, Material):
             materials = (materials,)
@@ -120,13 +154,16 @@ class Particles:
                                                                                 dtype=np.int64)
         fix = np.zeros(n, dtype=bool) if fixed is None else _bool_array(f"{prefix}{sep}fixed", fixed)
         q = np.zeros(n) if heat is None else finite_array(f"{prefix}{sep}heat", heat)
-        for key, arr in (("radius", rad), ("temperature", temp), ("material", mat), ("fixed", fix), ("heat", q)):
+        ids = np.arange(n, dtype=np.int64) if id is None else finite_array(f"{prefix}{sep}id", id, dtype=np.int64)
+        for key, arr in (("radius", rad), ("temperature", temp), ("material", mat), ("fixed", fix), ("heat", q),
+                         ("id", ids)):
             if len(arr) != n:
                 raise ValueError(f"{prefix}{sep}{key} has {len(arr)} entries but {prefix}{sep}position has {n}")
         if np.any((mat < 0) | (mat >= len(materials))):
             k = int(np.flatnonzero((mat < 0) | (mat >= len(materials)))[0])
             raise ValueError(f"{prefix}{sep}material[{k}] = {mat[k]}: must index one of {len(materials)} material(s)")
-        out = cls(pos, rad, temp, mat, fix, q, materials)
+        _check_ids(f"{prefix}{sep}id", ids)
+        out = cls(pos, rad, temp, mat, fix, q, materials, ids)
         if any(m.specific_heat is None for m in materials):
             return out  # no thermal physics: no capacities to check
         cap = out.capacity
@@ -175,7 +212,45 @@ class Particles:
     def permuted(self, order: np.ndarray) -> "Particles":
         """The same particles in the order ``order`` (used to test independence from ordering)."""
         return Particles(self.position[order], self.radius[order], self.temperature[order], self.material[order],
-                         self.fixed[order], self.heat[order], self.materials)
+                         self.fixed[order], self.heat[order], self.materials, self.id[order])
+
+
+def material_indices(name: str, value, materials, n: int) -> list | None:
+    """The indices into ``materials`` of ``value``: a material's name or index, or a list (or array) of them for
+    ``n`` particles; None stays None (material 0). Indices are range-checked by :meth:`Particles.from_arrays`."""
+    if value is None:
+        return None
+    names = [m.name for m in materials]
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, (str, int)) and not isinstance(value, bool):
+        value = [value] * n
+    if not isinstance(value, list):
+        raise ValueError(f"{name}: must be a material name/index or a list of them")
+    out = []
+    for k, v in enumerate(value):
+        if isinstance(v, str):
+            if v not in names:
+                raise ValueError(f"{name}[{k}] = {v!r}: unknown (materials: {', '.join(names)})")
+            out.append(names.index(v))
+        elif isinstance(v, int) and not isinstance(v, bool):
+            out.append(v)
+        else:
+            raise ValueError(f"{name}[{k}] = {v!r}: must be a material name or index")
+    return out
+
+
+def _check_ids(name: str, ids: np.ndarray) -> None:
+    """Raise ``ValueError`` naming the first id that is negative or given twice."""
+    if np.any(ids < 0):
+        k = int(np.flatnonzero(ids < 0)[0])
+        raise ValueError(f"{name}[{k}] = {ids[k]}: must be >= 0")
+    order = np.argsort(ids, kind="stable")
+    twice = np.flatnonzero(np.diff(ids[order]) == 0)
+    if twice.size:
+        k = int(order[twice[0] + 1])
+        raise ValueError(f"{name}[{k}] = {ids[k]}: given to particle {int(order[twice[0]])} already; ids must be "
+                         "unique")
 
 
 def _bool_array(name: str, value) -> np.ndarray:

@@ -1,7 +1,9 @@
-"""Plane walls that move: fixed, stress-controlled (Luding 2005, eq. 1), strain-controlled, vibrating.
+"""Plane walls, and the box they enclose -- one wall for every engine.
 
-A wall is the plane ``n . x = q`` with unit normal ``n`` pointing into the packing; it moves along its normal only,
-so its state is the offset ``q`` and the normal velocity ``dq/dt`` (positive: the wall moves into the packing).
+A wall is the plane ``n . x = q`` with unit normal ``n`` pointing into the packing, through ``point``. Particles that
+touch it exchange heat with it when it carries a ``temperature`` (an isothermal plane of the thermal network: the
+static scenes' plates, the heated walls of moving scenes), and push on it when they move. It moves along its normal
+only, so its state is the offset ``q`` and the normal velocity ``dq/dt`` (positive: into the packing):
 
 * ``"fixed"`` -- never moves.
 * ``"stress"`` -- ``m_w d^2q/dt^2 = p L - F_w - gamma_w dq/dt`` (Luding 2005, eq. 1): the external pressure ``p``
@@ -14,17 +16,19 @@ so its state is the offset ``q`` and the normal velocity ``dq/dt`` (positive: th
   initial height ``z0`` is ``velocity = e z0`` (Luding 2005, Sec. 4.4: ``eps_zz = 1 - z/z0``).
 * ``"vibrate"`` -- ``q(t) = q0 + A sin(2 pi f t)``: a vibrating base (Luding 2005, Figs. 21-22).
 
-A wall may also carry a ``temperature`` (an isothermal plane of the thermal network, as :class:`dem.laws.ambient.Wall`).
+The box (:func:`box_axes`): along each axis, the wall facing +axis and the one facing -axis, where there is exactly
+one of each; the box's extent along that axis is ``-(q_lo + q_hi)`` (:func:`extent`). Stress walls take their
+extent from it, and the outputs their volume, cross-sections and lengths.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dem.laws.ambient import _temperature, _unit_vector, _vector
+from dem.geometry.particles import check_temperature, check_unit_vector, check_vector
 
 MOTIONS = {"fixed": 0, "stress": 1, "strain": 2, "vibrate": 3}
 
@@ -37,13 +41,15 @@ def _nonnegative(name: str, value, positive: bool = False) -> float:
 
 
 @dataclass(frozen=True)
-class MovingWall:
-    """One plane wall (module docstring). ``pressure`` N/m (2D) or Pa (3D); ``mass`` kg; ``damping`` kg/s;
-    ``velocity`` m/s; ``amplitude`` m; ``frequency`` Hz; ``temperature`` optional (thermal runs)."""
+class Wall:
+    """One plane wall (module docstring). ``temperature`` (optional): an isothermal plane; ``motion`` and its
+    parameters: ``pressure`` N/m (2D) or Pa (3D), ``mass`` kg, ``damping`` kg/s, ``velocity`` m/s, ``amplitude`` m,
+    ``frequency`` Hz."""
 
     name: str
     point: np.ndarray
     normal: np.ndarray
+    temperature: float | None = None
     motion: str = "fixed"
     pressure: float = 0.0
     mass: float = 0.0
@@ -51,12 +57,13 @@ class MovingWall:
     velocity: float = 0.0
     amplitude: float = 0.0
     frequency: float = 0.0
-    temperature: float | None = None
 
     def __post_init__(self):
         pre = f"walls.{self.name}"
-        object.__setattr__(self, "point", _vector(f"{pre}.point", self.point))
-        object.__setattr__(self, "normal", _unit_vector(f"{pre}.normal", self.normal))
+        object.__setattr__(self, "point", check_vector(f"{pre}.point", self.point))
+        object.__setattr__(self, "normal", check_unit_vector(f"{pre}.normal", self.normal))
+        if self.temperature is not None:
+            check_temperature(f"{pre}.temperature", self.temperature)
         if self.motion not in MOTIONS:
             raise ValueError(f"{pre}.motion = {self.motion!r}: must be one of {', '.join(MOTIONS)}")
         if self.motion == "stress":
@@ -69,17 +76,47 @@ class MovingWall:
         if self.motion == "vibrate":
             _nonnegative(f"{pre}.amplitude", self.amplitude)
             _nonnegative(f"{pre}.frequency", self.frequency)
-        if self.temperature is not None:
-            _temperature(f"{pre}.temperature", self.temperature)
 
     @property
     def offset(self) -> float:
+        """``q`` of the plane ``n . x = q``."""
         return float(self.normal @ self.point)
+
+    def distance(self, position: np.ndarray) -> np.ndarray:
+        """Signed distance of each point from the plane, ``n . x - q`` (positive on the packing's side)."""
+        return position @ self.normal - self.offset
+
+    def at(self, offset: float) -> "Wall":
+        """The same wall moved along its normal to the plane ``n . x = offset``."""
+        return replace(self, point=self.normal * offset)
+
+
+def axis_of(normal: np.ndarray) -> int | None:
+    """The axis an axis-aligned normal points along, else None."""
+    k = int(np.argmax(np.abs(normal)))
+    return k if abs(abs(normal[k]) - 1.0) < 1e-12 else None
+
+
+def box_axes(walls) -> dict[int, tuple[int, int]]:
+    """``{axis: (lo, hi)}``: along each axis the index of the one wall facing +axis (``lo``) and of the one facing
+    -axis (``hi``), for the axes that have exactly one of each."""
+    out = {}
+    for a in range(3):
+        lo = [m for m, w in enumerate(walls) if axis_of(w.normal) == a and w.normal[a] > 0]
+        hi = [m for m, w in enumerate(walls) if axis_of(w.normal) == a and w.normal[a] < 0]
+        if len(lo) == 1 and len(hi) == 1:
+            out[a] = (lo[0], hi[0])
+    return out
+
+
+def extent(q: np.ndarray, lo: int, hi: int) -> float:
+    """Distance between two opposite axis-aligned walls at offsets ``q``."""
+    return float(-(q[lo] + q[hi]))
 
 
 @dataclass
 class WallArrays:
-    """The walls' state and parameters as arrays for the compiled loop (mutated in place)."""
+    """The walls' state and parameters as arrays for the compiled loops (mutated in place)."""
 
     normal: np.ndarray     # (W, 3)
     q: np.ndarray          # (W,) offsets n . x = q
@@ -108,38 +145,24 @@ class WallArrays:
         arrays = cls(normal, q, dq, np.zeros(n_w), mode, np.array([w.pressure for w in walls], dtype=float),
                      np.array([w.mass for w in walls], dtype=float), np.array([w.damping for w in walls], dtype=float),
                      q.copy(), amp, freq, -np.ones((n_w, 4), dtype=np.int64), np.zeros(n_w))
+        box = box_axes(walls)
         for k, wall in enumerate(walls):
-            try:
-                arrays.span[k] = _span(walls, k, dimension)
-            except ValueError:
-                if wall.motion == "stress":  # a stress wall needs its extent; the others report a force then
-                    raise
+            axis = axis_of(wall.normal)
+            perpendicular = [a for a in range(3) if a != axis and not (dimension == 2 and a == 1)]
+            if wall.motion == "stress":  # a stress wall needs its extent; the others report a force then
+                if axis is None:
+                    raise ValueError(f"walls.{wall.name}: a stress-controlled wall must be axis-aligned (normal "
+                                     f"along x, y or z)")
+                missing = [a for a in perpendicular if a not in box]
+                if missing:
+                    raise ValueError(f"walls.{wall.name}: a stress-controlled wall needs one wall facing each way "
+                                     f"along the {'xyz'[missing[0]]} axis (the box that gives its "
+                                     f"{'length' if dimension == 2 else 'area'})")
+            if axis is not None and all(a in box for a in perpendicular):
+                pairs = [m for a in perpendicular for m in box[a]]
+                arrays.span[k] = pairs + [-1] * (4 - len(pairs))
         return arrays
 
     def extent(self, lo: int, hi: int) -> float:
         """Distance between two opposite axis-aligned walls."""
-        return -(self.q[lo] + self.q[hi])
-
-
-def _axis(normal: np.ndarray) -> int | None:
-    """The axis an axis-aligned normal points along, else None."""
-    k = int(np.argmax(np.abs(normal)))
-    return k if abs(abs(normal[k]) - 1.0) < 1e-12 else None
-
-
-def _span(walls, k: int, dimension: int) -> list[int]:
-    """Indices of the walls bounding the perpendicular axes of stress wall ``k`` (module docstring)."""
-    wall = walls[k]
-    axis = _axis(wall.normal)
-    if axis is None:
-        raise ValueError(f"walls.{wall.name}: a stress-controlled wall must be axis-aligned (normal along x, y or z)")
-    perpendicular = [a for a in range(3) if a != axis and not (dimension == 2 and a == 1)]
-    out = []
-    for a in perpendicular:
-        lo = [m for m, w in enumerate(walls) if _axis(w.normal) == a and w.normal[a] > 0]
-        hi = [m for m, w in enumerate(walls) if _axis(w.normal) == a and w.normal[a] < 0]
-        if len(lo) != 1 or len(hi) != 1:
-            raise ValueError(f"walls.{wall.name}: a stress-controlled wall needs one wall facing each way along the "
-                             f"{'xyz'[a]} axis (the box that gives its {'length' if dimension == 2 else 'area'})")
-        out += [lo[0], hi[0]]
-    return out + [-1] * (4 - len(out))
+        return extent(self.q, lo, hi)

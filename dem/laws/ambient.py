@@ -6,7 +6,8 @@ heat with
 * its internal source ``Q_i^int`` (W, ``Particles.heat``),
 * an ambient by convection ``Q_i^conv = h A_i (T_inf - T_i)`` (:class:`Convection`),
 * an ambient by radiation ``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)`` in absolute temperature (:class:`Radiation`),
-* isothermal plane walls it touches (:class:`Wall`; the contact conductance comes from the conductance law).
+* isothermal plane walls it touches (:class:`dem.geometry.walls.Wall` with a temperature; the contact conductance
+  comes from the conductance law).
 
 Particles held at a fixed temperature are a mask of :class:`dem.geometry.particles.Particles`. Every term is linear in
 ``T_i`` except radiation, which the solvers use linearised about the current temperature
@@ -19,59 +20,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dem.geometry.particles import POSITION_MAX, TEMPERATURE_MAX, check_range
+from dem.geometry.particles import check_temperature
 
 STEFAN_BOLTZMANN = 5.670374419e-8  # W/(m^2 K^4), CODATA 2018 (exact)
 KELVIN_OFFSET = {"K": 0.0, "C": 273.15}
 RADIATION_T_MAX = 1e4  # K: no solid particle exists above; beyond ~1e5 K the steady Newton on T^4 stalls
 HEAT_TRANSFER_MAX = 1e10  # W/(m^2 K), convection coefficient (boiling water is ~1e5)
-
-
-def _vector(name: str, value) -> np.ndarray:
-    """``value`` as a finite 3-vector of at most POSITION_MAX per component, else ``ValueError`` naming it."""
-    try:
-        v = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        v = np.full(1, np.nan)
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise ValueError(f"{name} = {value!r}: must be a finite 3-vector")
-    return check_range(name, v, None, POSITION_MAX, " m")
-
-
-def _unit_vector(name: str, value) -> np.ndarray:
-    v = _vector(name, value)
-    if np.linalg.norm(v) == 0.0:
-        raise ValueError(f"{name} = {value!r}: must be a finite non-zero 3-vector")
-    return v / np.linalg.norm(v)
-
-
-def _temperature(name: str, value) -> float:
-    if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
-        raise ValueError(f"{name} = {value!r}: must be a finite number")
-    return float(check_range(name, np.float64(value), None, TEMPERATURE_MAX))
-
-
-@dataclass(frozen=True)
-class Wall:
-    """An isothermal plane through ``point`` with unit ``normal`` pointing into the packing, at ``temperature``.
-
-    A particle touches the wall when its centre lies closer than its radius to the plane; the overlap is
-    ``delta = r - distance``.
-    """
-
-    name: str
-    point: np.ndarray
-    normal: np.ndarray
-    temperature: float
-
-    def __post_init__(self):
-        object.__setattr__(self, "point", _vector(f"wall {self.name!r}: point", self.point))
-        object.__setattr__(self, "normal", _unit_vector(f"wall {self.name!r}: normal", self.normal))
-        _temperature(f"wall {self.name!r}: temperature", self.temperature)
-
-    def distance(self, position: np.ndarray) -> np.ndarray:
-        """Signed distance of each point from the plane (positive on the packing's side)."""
-        return (position - self.point) @ self.normal
 
 
 EXPOSED = "exposed"  # area_fraction: the exposed fraction of each surface (dem.geometry.exposure), computed from the packing
@@ -104,7 +58,7 @@ class Convection:
         _check_fraction("convection", self.area_fraction)
         if not (np.isfinite(self.h) and 0 <= self.h <= HEAT_TRANSFER_MAX):
             raise ValueError(f"convection.h = {self.h!r}: must be in [0, {HEAT_TRANSFER_MAX:g}] (W/(m^2 K))")
-        _temperature("convection.T_inf", self.T_inf)
+        check_temperature("convection.T_inf", self.T_inf)
 
     def coefficient(self, radius: np.ndarray) -> np.ndarray:
         """``h A_i`` in W/K."""

@@ -3,10 +3,10 @@
 * A folder that already holds a run (:data:`RUN_FILES`) is refused unless the run is resumed (``resume``: go on
   from its last checkpoint) or cleared first (``overwrite``: the run's own files are deleted, nothing else). So two
   runs never mix their rows and snapshots.
-* While a transient run goes, :class:`Checkpointer` writes the state between two steps (or intervals) to
-  ``checkpoint.npz`` every ``[output] checkpoint_every`` seconds of wall time (default 5) and at the end, written aside and renamed, so a
-  checkpoint on disk is always whole; an interrupted run resumes from the last one. It carries a digest of the
-  scene: a checkpoint is resumed only by the scene that wrote it.
+* While a transient run goes, :class:`Checkpointer` keeps the state between two steps (or intervals) and writes it
+  to ``checkpoint.npz`` every ``[output] checkpoint_every`` seconds of wall time (default 5), at the end and after
+  Ctrl-C, written aside and renamed, so a checkpoint on disk is always whole; an interrupted run resumes from the
+  last completed step. It carries a digest of the scene: a checkpoint is resumed only by the scene that wrote it.
 """
 
 from __future__ import annotations
@@ -74,20 +74,36 @@ def load(out, scene, kind: str) -> dict:
 
 
 class Checkpointer:
-    """Writes ``make()`` (a dict of arrays, built only when it is written) to ``out/checkpoint.npz`` once ``every``
-    seconds have passed since the last write, and at the end (``final``)."""
+    """Keeps the checkpoint of the last completed step and writes it to ``out/checkpoint.npz`` once ``every`` seconds
+    have passed since the last write, at the end (``final``) and after Ctrl-C (:meth:`last`): a run interrupted at any
+    moment -- in its first seconds too -- resumes from the step it had completed."""
 
     def __init__(self, out, scene, kind: str, every: float):
         self.path = pathlib.Path(out) / CHECKPOINT
         self.header = {"kind": np.array(kind), "scene_digest": np.array(scene_digest(scene))}
         self.every = every
         self.written_at = time.monotonic()
+        self.latest = None  # the arrays of the last completed step (copies: the run goes on changing its own)
+        self.written = True
 
     def __call__(self, make, final: bool = False) -> None:
+        """After a completed step: ``make()`` builds its checkpoint (an object with ``arrays()`` or a dict)."""
+        state = make()
+        arrays = state.arrays() if hasattr(state, "arrays") else state
+        self.latest = {k: np.array(v, copy=True) for k, v in arrays.items()}
+        self.written = False
         if final or time.monotonic() - self.written_at >= self.every:
-            state = make()
-            tmp = self.path.with_name(self.path.name + ".part")
-            with tmp.open("wb") as fh:
-                np.savez(fh, **self.header, **(state.arrays() if hasattr(state, "arrays") else state))
-            tmp.replace(self.path)
-            self.written_at = time.monotonic()
+            self._write()
+
+    def last(self) -> None:
+        """Write the checkpoint of the last completed step, unless it is on disk already."""
+        if self.latest is not None and not self.written:
+            self._write()
+
+    def _write(self) -> None:
+        tmp = self.path.with_name(self.path.name + ".part")
+        with tmp.open("wb") as fh:
+            np.savez(fh, **self.header, **self.latest)
+        tmp.replace(self.path)
+        self.written_at = time.monotonic()
+        self.written = True

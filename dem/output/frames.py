@@ -87,7 +87,7 @@ class FrameWriter:
 
 
 class WithFrames:
-    """A run's output observer (:class:`dem.output.writer.MotionWriter`) that also renders ``[output] frames`` pictures, the
+    """A run's writer (:class:`dem.output.writer.RunWriter`) that also renders ``[output] frames`` pictures, the
     colours from the coldest to the hottest prescribed temperature (initial, walls) or hotter."""
 
     def __init__(self, writer, scene, out_dir):
@@ -98,13 +98,17 @@ class WithFrames:
         self.frames = FrameWriter(out_dir, m.frames, scene.solver.t_end, m.control or 0, min(temperatures),
                                   max(temperatures))
 
-    def __call__(self, sim) -> None:
-        self.writer(sim)
-        self.frames(sim)
+    @property
+    def last(self):
+        return self.writer.last
 
-    def finish(self, summary: dict) -> None:
+    def observe(self) -> None:
+        self.writer.observe()
+        self.frames(self.writer.engine)
+
+    def finish(self, summary: dict, plots: bool = True) -> dict:
         summary["frames"] = self.frames.written
-        self.writer.finish(summary)
+        return self.writer.finish(summary, plots)
 
     def interrupted(self, summary: dict) -> None:
         self.writer.interrupted({**summary, "frames": self.frames.written})

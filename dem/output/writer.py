@@ -1,12 +1,20 @@
-"""Run outputs, written as the run goes: a CSV time series, VTU/PVD snapshots for ParaView, ``summary.json``.
+"""Run outputs, written as the run goes, by one writer for every engine (:class:`RunWriter`):
 
-* ``timeseries.csv`` -- step, t, mean/min/max temperature, and the heat flow into the particles (W) through
-  each boundary: fixed particles, walls, convection, radiation, internal sources.
-* ``particles.pvd`` + ``particles_NNNNN.vtu`` -- particles as points (vertex cells) with radius, temperature,
-  fixed and material.
-* ``bonds.pvd`` + ``bonds_NNNNN.vtu`` -- bonds as lines with conductance, heat flow and neck radius; a wall bond
-  joins the particle to its foot point on the wall, a bond across a periodic face joins the particle to the image
-  of its partner (outside the box).
+* ``timeseries.csv`` -- one row of the engine's observables (``engine.record()``: step, t, temperatures, the heat flow
+  through each boundary, for moving particles the solid fraction, coordination, wall stresses, ...);
+* ``particles.pvd`` + ``particles_NNNNNNNNN.vtu`` -- the particles as points (vertex cells) with their ids and the
+  fields the engine offers (``engine.particle_fields()``);
+* ``bonds.pvd`` + ``bonds_NNNNNNNNN.vtu`` (a static packing) or ``contacts.pvd`` + ``contacts_NNNNNNNNN.vtu`` (particles
+  that move) -- the links between particles as lines with their fields (``engine.links()``);
+* ``profiles.csv`` -- profiles against the distance from a heated wall, where the engine offers them;
+* ``summary.json`` at the end (and after Ctrl-C, marked ``"interrupted": true``), and the engine's plots.
+
+When rows and snapshots are written follows the scene's ``[output]`` table: a static run every ``every`` steps and
+snapshots every ``vtu_every`` steps; particles that move at every output time (the engine reports at those) and
+snapshots every ``vtu_interval`` seconds; both at the start and at the end. Every file is written aside and renamed,
+or appended and flushed row by row, so what is on disk is whole at any moment. The steps after the run each keep what
+the run produced: one that fails (a plot, a snapshot) is named in ``summary.json`` under ``output_errors`` and the
+others still happen.
 """
 
 from __future__ import annotations
@@ -20,8 +28,8 @@ import re
 import meshio
 import numpy as np
 
-CSV_FLOWS = ("fixed", "walls", "convection", "radiation", "internal")
 MAX_SNAPSHOTS = 1000  # VTU snapshots per run (each is two files): more is refused up front (fixed dt) or thinned (auto)
+DIGITS = 9  # of the step in a snapshot's file name
 
 
 def resumed_csv(path: pathlib.Path, keep) -> "io.TextIOBase":
@@ -57,19 +65,6 @@ def write_vtu(path: pathlib.Path, mesh) -> None:
     tmp.replace(path)
 
 
-def settle_snapshots(out: pathlib.Path, kinds, snapshots, digits: int) -> None:
-    """After an interrupt: the half-written files and the files of a snapshot left unfinished are deleted and every
-    PVD collection lists exactly the snapshots on disk."""
-    steps = {step for _, step in snapshots}
-    for f in out.glob("*.vtu.part"):
-        f.unlink()
-    for kind in kinds:
-        for f in out.glob(f"{kind}_*.vtu"):
-            if int(f.stem.split("_")[-1]) not in steps:
-                f.unlink()
-        write_pvd(out / f"{kind}.pvd", [(t, f"{kind}_{step:0{digits}d}.vtu") for t, step in snapshots])
-
-
 def write_pvd(path: pathlib.Path, entries: list[tuple[float, str]]) -> None:
     """A ParaView collection of ``(time, file)`` entries."""
     rows = "\n".join(f'    <DataSet timestep="{t:.17g}" group="" part="0" file="{f}"/>' for t, f in entries)
@@ -77,173 +72,108 @@ def write_pvd(path: pathlib.Path, entries: list[tuple[float, str]]) -> None:
                     f"  <Collection>\n{rows}\n  </Collection>\n</VTKFile>\n")
 
 
-class RunWriter:
-    """Observer for the integrators: CSV row every ``every`` steps, snapshots every ``vtu_every`` steps."""
-
-    def __init__(self, out_dir, scene, model, resume_step: int | None = None):
-        """``resume_step``: go on with the files of a run resumed from the checkpoint at that step."""
-        o, s = scene.output, scene.solver
-        if o.vtu and o.vtu_every and s.mode == "transient" and s.dt != "auto":
-            snapshots = math.ceil(s.t_end / s.dt * (1 - 1e-12)) // o.vtu_every
-            if snapshots > MAX_SNAPSHOTS:
-                raise ValueError(f"[output] vtu_every = {o.vtu_every}: {snapshots} snapshots of t_end / dt = "
-                                 f"{s.t_end / s.dt:.6g} steps exceed the limit of {MAX_SNAPSHOTS}; valid: vtu_every >= "
-                                 f"{math.ceil(s.t_end / s.dt / MAX_SNAPSHOTS)}, 0 (first and last) or vtu = false")
-        self.out = pathlib.Path(out_dir)
-        self.out.mkdir(parents=True, exist_ok=True)
-        self.scene, self.model = scene, model
-        self.snapshots: list[tuple[float, int]] = []
-        self.last = None
-        if resume_step is None:
-            self.csv = (self.out / "timeseries.csv").open("w")
-            self.csv.write("step,t,T_mean,T_min,T_max," + ",".join(f"Q_{k}" for k in CSV_FLOWS) + "\n")
-        else:
-            self.csv = resumed_csv(self.out / "timeseries.csv", lambda row: int(row["step"]) <= resume_step)
-            self.snapshots = resumed_snapshots(self.out, ("particles", "bonds"), resume_step)
-
-    def __call__(self, step, t, T_free, flows):
-        net = self.model.network
-        T = net.full(T_free)
-        self.last = (step, t, T, flows)
-        if step % self.scene.output.every == 0:
-            self._row(step, t, T, flows)
-        every = self.scene.output.vtu_every
-        if every and len(self.snapshots) >= MAX_SNAPSHOTS:  # dt = "auto": the step count was not known up front
-            every *= 2 ** (len(self.snapshots) // MAX_SNAPSHOTS)  # thin the snapshots, keep their number bounded
-        if self.scene.output.vtu and (step == 0 or (every and step % every == 0)):
-            self._snapshot(step, t, T)
-
-    def _row(self, step, t, T, flows):
-        q = ",".join(f"{flows.get(k, 0.0):.12g}" for k in CSV_FLOWS)
-        self.csv.write(f"{step},{t:.12g},{T.mean():.12g},{T.min():.12g},{T.max():.12g},{q}\n")
-        self.csv.flush()
-
-    def _snapshot(self, step, t, T):
-        if self.snapshots and self.snapshots[-1][1] == step:
-            return
-        p, b = self.scene.particles, self.model.bonds
-        write_vtu(self.out / f"particles_{step:05d}.vtu", meshio.Mesh(
-            p.position, [("vertex", np.arange(p.n).reshape(-1, 1))],
-            point_data={"radius": p.radius, "temperature": T, "fixed": p.fixed.astype(np.int8),
-                        "material": p.material.astype(np.int32)}))
-        self.model.T = T
-        q_pairs, q_walls = self.model.bond_heat_flow()
-        walls = self.scene.walls
-        foot = np.array([walls[w].point for w in b.wall_index]).reshape(-1, 3)
-        normal = np.array([walls[w].normal for w in b.wall_index]).reshape(-1, 3)
-        x = p.position[b.wall_particle]
-        foot = x - np.sum((x - foot) * normal, axis=1, keepdims=True) * normal
-        crossing = np.flatnonzero(np.any(b.shifts != 0, axis=1))
-        image = b.vectors(p.position, self.scene.box)[crossing] + p.position[b.i[crossing]]
-        points = np.vstack([p.position, foot, image])
-        partner = b.j.copy()
-        partner[crossing] = p.n + b.n_walls + np.arange(len(crossing))
-        lines = np.vstack([np.column_stack([b.i, partner]),
-                           np.column_stack([b.wall_particle, p.n + np.arange(b.n_walls)])]).astype(np.int64)
-        write_vtu(self.out / f"bonds_{step:05d}.vtu", meshio.Mesh(
-            points, [("line", lines.reshape(-1, 2))],
-            cell_data={"conductance": [np.concatenate([self.model.K_pairs, self.model.K_walls])],
-                       "heat_flow": [np.concatenate([q_pairs, q_walls])],
-                       "neck_radius": [np.concatenate([b.a, b.wall_a])]}))
-        self.snapshots.append((t, step))
-        self._write_pvd()  # every snapshot listed at once: an interrupted run's collection holds all it wrote
-
-    def _write_pvd(self):
-        for kind in ("particles", "bonds"):
-            write_pvd(self.out / f"{kind}.pvd", [(tt, f"{kind}_{s:05d}.vtu") for tt, s in self.snapshots])
-
-    def interrupted(self, summary: dict) -> None:
-        """Close the files of a run stopped by Ctrl-C: ``summary.json`` marked ``"interrupted": true`` with the state
-        reached (the last step's time, step and temperatures) and where a resume starts (the last checkpoint)."""
-        if self.last is not None:
-            step, t, T, _ = self.last
-            summary.update(t=t, steps=step, T_mean=float(T.mean()), T_min=float(T.min()), T_max=float(T.max()))
-        summary["resume_from"] = checkpoint_reached(self.out)
-        self.csv.close()
-        settle_snapshots(self.out, ("particles", "bonds"), self.snapshots, 5)
-        write_summary(self.out / "summary.json", summary)
-
-    def finish(self, summary: dict, plots: bool = True):
-        if self.last is not None:
-            step, t, T, flows = self.last
-            if step % self.scene.output.every:
-                self._row(step, t, T, flows)
-            if self.scene.output.vtu:
-                self._snapshot(step, t, T)
-        if self.snapshots:
-            self._write_pvd()
-        self.csv.close()
-        write_summary(self.out / "summary.json", summary)  # first: the profile plot reads k_eff from it
-        if plots:
-            from dem.output.plots import thermal_plots
-
-            summary["plots"] = thermal_plots(self.out, self.scene, self.model.T)
-            write_summary(self.out / "summary.json", summary)
-
-
 def checkpoint_reached(out: pathlib.Path) -> dict | None:
     """``{"t", "steps"}`` of the checkpoint in ``out`` (where ``--resume`` goes on from), or None."""
     path = out / "checkpoint.npz"
     if not path.exists():
         return None
-    import numpy as np
-
     with np.load(path, allow_pickle=False) as f:
         return {"t": float(f["t"]), "steps": int(f["steps"])}
 
 
 def write_summary(path, summary: dict) -> None:
-    pathlib.Path(path).write_text(json.dumps(summary, indent=2) + "\n")
+    """``summary`` as JSON, written aside and renamed."""
+    path = pathlib.Path(path)
+    tmp = path.with_name(path.name + ".part")
+    tmp.write_text(json.dumps(summary, indent=2) + "\n")
+    tmp.replace(path)
 
 
-class MotionWriter:
-    """Observer of the engine for moving particles: a ``timeseries.csv`` row per output time and snapshots every
-    ``[output] vtu_interval`` (and at the start and end): ``particles_NNNNN.vtu`` (points with the fields the
-    submodels offer) and ``contacts_NNNNN.vtu`` (lines with normal and tangential force and overlap), each listed in
-    its PVD collection as soon as it is written."""
+def _cell(value) -> str:
+    return "" if value is None else f"{value:.12g}"
 
-    def __init__(self, out_dir, scene, resume_step: int | None = None):
+
+class RunWriter:
+    """The files of one run (module docstring), fed by the engine: :meth:`observe` after every step or output time,
+    :meth:`finish` at the end, :meth:`interrupted` after Ctrl-C."""
+
+    def __init__(self, out_dir, scene, engine, resume_step: int | None = None):
         """``resume_step``: go on with the files of a run resumed from the checkpoint at that step."""
         self.out = pathlib.Path(out_dir)
         self.out.mkdir(parents=True, exist_ok=True)
-        self.scene = scene
+        self.scene, self.engine = scene, engine
+        self.kinds = ("particles", engine.link_kind)
+        self.by_time = scene.motion is not None  # particles that move: rows and snapshots by simulated time
+        o, s = scene.output, scene.solver
+        if not self.by_time and o.vtu and o.vtu_every and s.mode == "transient" and s.dt != "auto":
+            snapshots = math.ceil(s.t_end / s.dt * (1 - 1e-12)) // o.vtu_every
+            if snapshots > MAX_SNAPSHOTS:
+                raise ValueError(f"[output] vtu_every = {o.vtu_every}: {snapshots} snapshots of t_end / dt = "
+                                 f"{s.t_end / s.dt:.6g} steps exceed the limit of {MAX_SNAPSHOTS}; valid: vtu_every >= "
+                                 f"{math.ceil(s.t_end / s.dt / MAX_SNAPSHOTS)}, 0 (first and last) or vtu = false")
         self.csv = None
         self.columns: list[str] = []
         self.snapshots: list[tuple[float, int]] = []
-        self.next_vtu = 0.0
+        self.last = None  # the last row observed
+        self.next_vtu = engine.t_start
+        self.errors: dict = {}
         if resume_step is not None:
-            with (self.out / "timeseries.csv").open() as fh:
+            path = self.out / "timeseries.csv"
+            with path.open() as fh:
                 self.columns = fh.readline().strip().split(",")
-            self.csv = resumed_csv(self.out / "timeseries.csv", lambda row: int(row["step"]) <= resume_step)
-            self.snapshots = resumed_snapshots(self.out, ("particles", "contacts"), resume_step)
-            t_last = max((t for t, _ in self.snapshots), default=0.0)
+            self.csv = resumed_csv(path, lambda row: int(row["step"]) <= resume_step)
+            self.snapshots = resumed_snapshots(self.out, self.kinds, resume_step)
+            t_last = max((t for t, _ in self.snapshots), default=engine.t)
             if (self.out / "profiles.csv").exists():
                 resumed_csv(self.out / "profiles.csv", lambda row: float(row["t"]) <= t_last).close()
-            interval = scene.motion.vtu_interval
+            interval = getattr(scene.motion, "vtu_interval", 0.0)
             while interval > 0 and self.next_vtu <= t_last + 1e-12 * scene.solver.t_end:
                 self.next_vtu += interval  # as the run advanced it: the same sums, the same snapshot times
 
-    def __call__(self, sim):
-        row = sim.record()
+    # ------------------------------------------------------------------------------------------------ rows
+    def observe(self) -> None:
+        """The engine has reached a step or an output time: a row, and a snapshot where one is due."""
+        row = self.engine.record()
+        self.last = row
+        step, t = row["step"], row["t"]
+        if self.by_time or step % self.scene.output.every == 0:
+            self._row(row)
+        if self._snapshot_due(step, t):
+            self.snapshot()
+
+    def _row(self, row: dict) -> None:
         if self.csv is None:
             self.columns = list(row)
             self.csv = (self.out / "timeseries.csv").open("w")
             self.csv.write(",".join(self.columns) + "\n")
-        self.csv.write(",".join("" if row.get(k) is None else f"{row[k]:.12g}" for k in self.columns) + "\n")
+        self.csv.write(",".join(_cell(row.get(k)) for k in self.columns) + "\n")
         self.csv.flush()
-        m = self.scene.motion
-        t_end = self.scene.solver.t_end
-        if m.vtu_interval > 0 and row["t"] >= self.next_vtu - 1e-12 * t_end or row["t"] == 0.0 \
-                or row["t"] >= t_end * (1 - 1e-12):
-            self.snapshot(sim, row["t"], row["step"])
-            if m.vtu_interval > 0:
-                while self.next_vtu <= row["t"] + 1e-12 * t_end:
-                    self.next_vtu += m.vtu_interval
 
-    def snapshot(self, sim, t: float, step: int):
+    def _snapshot_due(self, step: int, t: float) -> bool:
+        if self.by_time:
+            t_end = self.scene.solver.t_end
+            m = self.scene.motion
+            due = (m.vtu_interval > 0 and t >= self.next_vtu - 1e-12 * t_end) or t == self.engine.t_start \
+                or t >= t_end * (1 - 1e-12)
+            if due and m.vtu_interval > 0:
+                while self.next_vtu <= t + 1e-12 * t_end:
+                    self.next_vtu += m.vtu_interval
+            return due
+        o = self.scene.output
+        every = o.vtu_every
+        if every and len(self.snapshots) >= MAX_SNAPSHOTS:  # dt = "auto": the step count was not known up front
+            every *= 2 ** (len(self.snapshots) // MAX_SNAPSHOTS)  # thin the snapshots, keep their number bounded
+        return step == 0 or bool(every and step % every == 0)
+
+    # ------------------------------------------------------------------------------------------- snapshots
+    def snapshot(self) -> None:
+        """The particles and their links now (and the engine's profiles), listed in the PVD collections at once: an
+        interrupted run's collections hold all it wrote."""
+        e = self.engine
+        step, t = e.steps, e.t
         if self.snapshots and self.snapshots[-1][1] == step:
             return
-        profile = sim.profile()
+        profile = e.profile()
         if profile is not None:
             new = not (self.out / "profiles.csv").exists()
             with (self.out / "profiles.csv").open("a") as fh:
@@ -254,30 +184,69 @@ class MotionWriter:
         if not self.scene.output.vtu:
             self.snapshots.append((t, step))
             return
-        s = sim.mechanics.state
-        fields = sim.particle_fields()
-        write_vtu(self.out / f"particles_{step:09d}.vtu", meshio.Mesh(
-            s.x, [("vertex", np.arange(s.n).reshape(-1, 1))], point_data=fields))
-        i, j, cfields = sim.contact_fields()
-        write_vtu(self.out / f"contacts_{step:09d}.vtu", meshio.Mesh(
-            s.x, [("line", np.column_stack([i, j]).astype(np.int64).reshape(-1, 2))],
-            cell_data={k: [v] for k, v in cfields.items()}))
+        x = e.positions()
+        write_vtu(self.out / f"particles_{step:0{DIGITS}d}.vtu", meshio.Mesh(
+            x, [("vertex", np.arange(len(x)).reshape(-1, 1))], point_data=e.particle_fields()))
+        points, lines, fields = e.links()
+        write_vtu(self.out / f"{e.link_kind}_{step:0{DIGITS}d}.vtu", meshio.Mesh(
+            points, [("line", np.asarray(lines, dtype=np.int64).reshape(-1, 2))],
+            cell_data={k: [v] for k, v in fields.items()}))
         self.snapshots.append((t, step))
-        for kind in ("particles", "contacts"):
-            write_pvd(self.out / f"{kind}.pvd", [(tt, f"{kind}_{k:09d}.vtu") for tt, k in self.snapshots])
+        self._write_pvd()
 
-    def interrupted(self, summary: dict) -> None:
-        """Close the files of a run stopped by Ctrl-C (:meth:`RunWriter.interrupted`)."""
-        summary["resume_from"] = checkpoint_reached(self.out)
-        if self.scene.output.vtu:
-            settle_snapshots(self.out, ("particles", "contacts"), self.snapshots, 9)
-        self.finish(summary, plots=False)
+    def _write_pvd(self) -> None:
+        for kind in self.kinds:
+            write_pvd(self.out / f"{kind}.pvd", [(tt, f"{kind}_{s:0{DIGITS}d}.vtu") for tt, s in self.snapshots])
 
-    def finish(self, summary: dict, plots: bool = True):
+    # --------------------------------------------------------------------------------------------- the end
+    def _guarded(self, what: str, action):
+        """Run one output step; its failure is recorded (``output_errors``), not raised: the others still happen."""
+        try:
+            return action()
+        except (OSError, ValueError, RuntimeError, ArithmeticError) as exc:
+            self.errors[what] = " ".join(str(exc).split())
+            return None
+
+    def finish(self, summary: dict, plots: bool = True) -> dict:
+        """Close the run's files: the last row and snapshot where they are not written yet, ``summary.json``, then
+        the plots; returns the summary as written."""
+        if self.last is not None and not self.by_time and self.last["step"] % self.scene.output.every:
+            self._guarded("timeseries.csv", lambda: self._row(self.last))
         if self.csv is not None:
             self.csv.close()
+        if self.last is not None or self.by_time:
+            self._guarded("snapshot", self.snapshot)
+        if self.snapshots:
+            self._guarded("pvd", self._write_pvd)
+        write_summary(self.out / "summary.json", self._with_errors(summary))  # first: a plot may read it
         if plots:
-            from dem.output.plots import motion_plots
+            written = self._guarded("plots", lambda: self.engine.plots(self.out, summary))
+            if written is not None:
+                summary["plots"] = written
+            write_summary(self.out / "summary.json", self._with_errors(summary))
+        return summary
 
-            summary["plots"] = motion_plots(self.out)
-        write_summary(self.out / "summary.json", summary)
+    def _with_errors(self, summary: dict) -> dict:
+        if self.errors:
+            summary["output_errors"] = dict(self.errors)
+        return summary
+
+    def interrupted(self, summary: dict) -> None:
+        """Close the files of a run stopped by Ctrl-C: ``summary.json`` marked ``"interrupted": true`` with the state
+        the last row reached and where a resume starts (the last checkpoint); half-written files and the files of an
+        unfinished snapshot are deleted and every PVD collection lists exactly the snapshots on disk."""
+        if self.last is not None:
+            summary.update(t=self.last["t"], steps=self.last["step"])
+        summary["resume_from"] = checkpoint_reached(self.out)
+        if self.csv is not None:
+            self.csv.close()
+        steps = {step for _, step in self.snapshots}
+        for f in self.out.glob("*.vtu.part"):
+            f.unlink()
+        for kind in self.kinds:
+            for f in self.out.glob(f"{kind}_*.vtu"):
+                if int(f.stem.split("_")[-1]) not in steps:
+                    f.unlink()
+        if self.scene.output.vtu:
+            self._write_pvd()
+        write_summary(self.out / "summary.json", self._with_errors(summary))

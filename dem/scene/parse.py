@@ -11,43 +11,30 @@ from __future__ import annotations
 import math
 import pathlib
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from dem.scene import state_file
+from dem.scene import packing_files, state_file
 from dem.geometry import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.fields import material_from_table
 from dem.laws.contact import CONTACT_LAWS, law_module
 from dem.scene.zohdi import ElectricalSpec, parse_electrical
-from dem.geometry.particles import COPPER, Material, Particles
+from dem.geometry.particles import COPPER, Material, Particles, material_indices
 from dem.geometry.periodic import AXES, PeriodicBox
-from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources, Wall
+from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources
+from dem.geometry.walls import Wall, axis_of, box_axes, extent
 from dem.network.heat import INTEGRATORS
 from dem.network.linsolve import BACKENDS
-from dem.engines.static import PHYSICS_NAMES as PHYSICS, check_physics
-from dem.scene.motion import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
+from dem.scene.motion import MotionSpec, parse_motion
+from dem.scene.schema import ENGINE_NAMES, TABLES, check
 
 SCENE_DIR = pathlib.Path(__file__).with_name("builtin")
 MODES = ("transient", "steady")
 BOUNDARIES = ("plates", "fixed", "periodic", "none")
 RTOL_MIN = 1e-9  # [solver] rtol of dt = "auto"
 
-ALLOWED = {
-    "scene": {"name", "description", "physics"},
-    "material": {"name", "conductivity", "density", "specific_heat", "electrical_conductivity"},
-    "particles": {"position", "radius", "temperature", "fixed", "material", "heat"},
-    "generator": {"kind", "n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter",
-                  "structure", "temperature", "boundary", "hot", "cold", "heat", "box", "speed"},
-    "periodic": {"lengths", "axes", "origin", "drop"},
-    "walls": {"name", "point", "normal", "temperature"},
-    "conductance": {"law", "slope", "fit_file", "neck", "contact_conductance", "out_of_range", "unequal"},
-    "convection": {"h", "T_inf", "area_fraction"},
-    "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
-    "solver": {"mode", "integrator", "dt", "t_end", "rtol", "linear", "floating", "max_steps"},
-    "output": {"every", "vtu_every", "vtu", "checkpoint_every"},
-}
 GENERATOR_KEYS = {
     "chain": {"n", "radius", "overlap"},
     "lattice": {"shape", "radius", "overlap", "structure"},
@@ -130,6 +117,7 @@ class Specimen:
     cold: float
     hot_particles: tuple = ()
     periodic: bool = False
+    hot_wall: str = "hot"  # the name of the wall the heat enters through
 
 
 @dataclass(frozen=True)
@@ -151,6 +139,29 @@ class Scene:
     motion: MotionSpec | None = None  # particles that move ([scene] physics with "mechanical"), else None
     electrical: ElectricalSpec | None = None  # the current's scheme and electrodes ("electrical" physics)
     box: PeriodicBox | None = None  # a periodic box (dem.geometry.periodic), else None
+    engine: str = "static"  # the engine that runs it (dem.engines)
+    start: dict | None = None  # the saved state it starts from (dem.scene.state_file.load), else None
+
+    @property
+    def start_time(self) -> float:
+        """The time the run starts at: the saved state's, or 0."""
+        return 0.0 if self.start is None else self.start["t"]
+
+
+PHYSICS = ("thermal", "mechanical", "electrical")  # the submodels a scene can name ([scene] physics)
+
+
+def check_physics(names) -> None:
+    """Every name a submodel that exists (:data:`PHYSICS`); ``electrical`` runs with moving particles."""
+    for name in names:
+        if name not in PHYSICS:
+            raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(PHYSICS)})")
+    if not names:
+        raise ValueError(f"[scene] physics: names no submodel (available: {', '.join(PHYSICS)})")
+    if "electrical" in names and "mechanical" not in names:
+        raise ValueError("[scene] physics: \"electrical\" runs with moving particles: [\"mechanical\", \"thermal\", "
+                         "\"electrical\"] with [contact] law = \"zohdi\" (the current on a static packing: "
+                         "dem.network.current.kirchhoff)")
 
 
 def _is_number(v) -> bool:
@@ -175,14 +186,6 @@ def make_scene(position, radius, temperature, *, materials=(COPPER,), material=N
 
 
 # --------------------------------------------------------------------------------------------------- TOML
-def _check_keys(table: dict, section: str, allowed: set):
-    if not isinstance(table, dict):
-        raise ValueError(f"[{section}]: must be a table")
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ValueError(f"[{section}] {unknown[0]}: unknown key (allowed: {', '.join(sorted(allowed))})")
-
-
 def _number(table, section, key, default=None, required=False):
     if key not in table:
         if required:
@@ -205,7 +208,6 @@ def _materials(doc, thermal: bool = True, electrical: bool = False) -> tuple:
     out = []
     for k, t in enumerate(tables):
         section = "material" if "material" in doc else f"materials[{k}]"
-        _check_keys(t, section, ALLOWED["material"])
         props = {key: _number(t, section, key, required=thermal or key == "density")
                  for key in ("conductivity", "density", "specific_heat")}
         props["electrical_conductivity"] = _number(t, section, "electrical_conductivity", required=electrical)
@@ -216,40 +218,23 @@ def _materials(doc, thermal: bool = True, electrical: bool = False) -> tuple:
     return tuple(out)
 
 
-def _material_index(value, materials, n):
-    if value is None:
-        return None
-    names = [m.name for m in materials]
-    if isinstance(value, (str, int)) and not isinstance(value, bool):
-        value = [value] * n
-    if not isinstance(value, list):
-        raise ValueError("[particles] material: must be a material name/index or a list of them")
-    out = []
-    for k, v in enumerate(value):
-        if isinstance(v, str):
-            if v not in names:
-                raise ValueError(f"[particles] material[{k}] = {v!r}: unknown (materials: {', '.join(names)})")
-            out.append(names.index(v))
-        elif isinstance(v, int) and not isinstance(v, bool):
-            out.append(v)
-        else:
-            raise ValueError(f"[particles] material[{k}] = {v!r}: must be a material name or index")
-    return out
-
-
-def _explicit_particles(t: dict, materials):
-    _check_keys(t, "particles", ALLOWED["particles"])
+def _explicit_particles(t: dict, materials, base_dir=None):
+    if "file" in t:  # a packing file (dem.scene.packing_files); its box, periodic or not, is returned as the box
+        particles, box = packing_files.scene_particles(t, materials, base_dir)
+        return particles, (), None, None, box
+    extra = sorted(set(t) & set(packing_files.SCENE_KEYS))
+    if extra:
+        raise ValueError(f"[particles] {extra[0]}: only with file = \"...\" (a packing file)")
     for key in ("position", "radius", "temperature"):
         if key not in t:
             raise ValueError(f"[particles] {key}: required")
     n = len(t["position"]) if isinstance(t["position"], list) else 0
-    return Particles.from_arrays(t["position"], t["radius"], t["temperature"], materials,
-                                 _material_index(t.get("material"), materials, n), t.get("fixed"), t.get("heat"),
-                                 prefix="[particles]"), (), None, None, None
+    material = material_indices("[particles] material", t.get("material"), materials, n)
+    return Particles.from_arrays(t["position"], t["radius"], t["temperature"], materials, material, t.get("fixed"),
+                                 t.get("heat"), prefix="[particles]"), (), None, None, None
 
 
 def _generated_particles(t: dict, materials, dimension: int = 3):
-    _check_keys(t, "generator", ALLOWED["generator"])
     kind = t.get("kind")
     if not isinstance(kind, str) or kind not in GENERATOR_KEYS:
         raise ValueError(f"[generator] kind = {kind!r}: must be one of {', '.join(GENERATOR_KEYS)}")
@@ -318,13 +303,14 @@ def _generated_particles(t: dict, materials, dimension: int = 3):
     return particles, walls, specimen, layout.velocity, box
 
 
-def _periodic_box(t: dict) -> PeriodicBox:
+def _periodic_box(t: dict, file_box: PeriodicBox | None = None) -> PeriodicBox:
     """``[periodic]``: ``lengths`` (m), ``axes`` (the periodic ones, default all), ``origin``, ``drop`` (the
-    temperature drop per period along each axis)."""
-    _check_keys(t, "periodic", ALLOWED["periodic"])
-    if "lengths" not in t:
+    temperature drop per period along each axis). With a packing file's box ``file_box``, ``lengths`` and
+    ``origin`` default to its box and ``axes`` to its periodic axes (all where it has none)."""
+    if "lengths" not in t and file_box is None:
         raise ValueError("[periodic] lengths: required (the period along x, y and z, m)")
-    axes = t.get("axes", list(AXES))
+    default_axes = [a for a, p in zip(AXES, file_box.periodic) if p] if file_box is not None else []
+    axes = t.get("axes", default_axes or list(AXES))
     if not isinstance(axes, list) or not all(isinstance(a, str) and a in AXES for a in axes) or not axes:
         raise ValueError(f"[periodic] axes = {axes!r}: must be a non-empty list of \"x\", \"y\", \"z\"")
     values = {}
@@ -335,36 +321,76 @@ def _periodic_box(t: dict) -> PeriodicBox:
                     or not all(_is_number(x) and math.isfinite(x) for x in v)):
                 raise ValueError(f"[periodic] {key} = {v!r}: must be a list of three finite numbers")
             values[key] = v
+    if file_box is not None:
+        values.setdefault("lengths", file_box.lengths)
+        values.setdefault("origin", file_box.origin)
     try:
         return PeriodicBox(values["lengths"], tuple(a in axes for a in AXES), values.get("origin"), values.get("drop"))
     except ValueError as exc:
         raise ValueError(f"[periodic] {exc}") from None
 
 
-def _walls(doc) -> tuple:
+WALL_NUMBERS = ("pressure", "mass", "damping", "velocity", "amplitude", "frequency")
+
+
+def _walls(doc, start: dict | None, static: bool) -> tuple:
+    """The ``[[walls]]`` of any scene (:class:`dem.geometry.walls.Wall`; a static scene's carry a temperature); a
+    wall named like a wall of the saved state ``start`` stands where that one stood."""
     tables = doc.get("walls", [])
-    if not isinstance(tables, list):
-        raise ValueError("[[walls]]: must be an array of tables")
     out = []
     for k, w in enumerate(tables):
-        _check_keys(w, f"walls[{k}]", ALLOWED["walls"])
-        for key in ("point", "normal", "temperature"):
+        for key in ("point", "normal") + (("temperature",) if static else ()):
             if key not in w:
-                raise ValueError(f"[[walls]] {k}: {key}: required")
+                raise ValueError(f"[walls][{k}] {key}: required")
+        numbers = {key: _number(w, f"walls][{k}", key) for key in WALL_NUMBERS if key in w}
         out.append(Wall(str(w.get("name", f"wall{k}")), w["point"], w["normal"],
-                        _number(w, f"walls[{k}]", "temperature", required=True)))
+                        _number(w, f"walls][{k}", "temperature"), str(w.get("motion", "fixed")), **numbers))
     names = [w.name for w in out]
     if len(set(names)) != len(names):
         raise ValueError(f"[[walls]] name: names must be unique, got {names}")
+    if start is not None and start["moving"]:
+        saved = dict(zip(start["wall_names"], start["wall_q"]))
+        out = [w.at(float(saved[w.name])) if w.name in saved else w for w in out]
     return tuple(out)
 
 
+def _specimen_between(walls, start: dict, particles) -> Specimen | None:
+    """The specimen of a static scene started from a saved state (its effective conductivity, ``k_eff = Q L / (A
+    dT)``): between the only two walls that carry a temperature, facing each other along an axis; its cross-section
+    from the saved state's walls along the other axes, else from the particles' extent along them."""
+    heated = [w for w in walls if w.temperature is not None]
+    if len(heated) != 2 or heated[0].temperature == heated[1].temperature:
+        return None
+    hot, cold = sorted(heated, key=lambda w: -w.temperature)
+    axis = axis_of(hot.normal)
+    if axis is None or not np.allclose(hot.normal, -cold.normal, atol=1e-12):
+        return None
+    length = -(hot.offset + cold.offset)
+    saved = [Wall(name, normal * q, normal) for name, normal, q in
+             zip(start["wall_names"], start["wall_normal"], start["wall_q"])] \
+        if start["moving"] and np.any(start["wall_normal"]) else []
+    box = box_axes(saved)
+    area = 1.0
+    for a in range(3):
+        if a == axis:
+            continue
+        if a in box:
+            area *= extent(np.array([w.offset for w in saved]), *box[a])
+        else:
+            x, r = particles.position[:, a], particles.radius
+            area *= float(np.max(x + r) - np.min(x - r))
+    return Specimen(length, area, hot.temperature, cold.temperature, hot_wall=hot.name)
+
+
 def _spec(cls, table, section, numeric=(), integer=(), words=()):
-    """``cls(**table)``; keys in ``numeric`` must be finite numbers (or, if also in ``words``, a string that the
-    class checks, e.g. ``dt = "auto"``), keys in ``integer`` integers."""
-    _check_keys(table, section, ALLOWED[section])
+    """``cls(**table)`` with the keys of ``table`` that are fields of ``cls`` (the schema has checked them all);
+    keys in ``numeric`` must be finite numbers (or, if also in ``words``, a string that the class checks, e.g.
+    ``dt = "auto"``), keys in ``integer`` integers."""
+    names = {f.name for f in fields(cls)}
     kwargs = {}
     for key, v in table.items():
+        if key not in names:
+            continue
         if key in numeric and not (key in words and isinstance(v, str)):
             v = _number(table, section, key)
         if key in integer and (not isinstance(v, int) or isinstance(v, bool)):
@@ -379,43 +405,38 @@ def _spec(cls, table, section, numeric=(), integer=(), words=()):
         raise ValueError(msg if msg.startswith("[") else f"[{section}] {msg}") from None
 
 
-def _moving_keys(doc: dict, moving: bool) -> dict:
-    """``doc`` without the keys and tables of moving particles (:mod:`dem.scene.motion`), which a scene without
-    ``"mechanical"`` physics refuses by name; in a scene with it, an unknown key is refused here, naming every key
-    such a scene allows."""
-    out = dict(doc)
-    for table in MOVING_TABLES:
-        if table in out and not moving:
-            raise ValueError(f"[{table}]: only for moving particles ([scene] physics with \"mechanical\")")
-        out.pop(table, None)
-    for section, keys in MOVING_KEYS.items():
-        tables = out.get(section)
-        if tables is None:
-            continue
-        many = isinstance(tables, list)
-        cleaned = []
-        for k, t in enumerate(tables if many else [tables]):
-            if not isinstance(t, dict):
-                cleaned.append(t)
-                continue
-            if moving:
-                _check_keys(t, f"{section}[{k}]" if many else section, ALLOWED[section] | keys)
-            extra = sorted(set(t) & keys)
-            if extra and not moving:
-                raise ValueError(f"[{section}] {extra[0]}: only for moving particles ([scene] physics with "
-                                 f"\"mechanical\")")
-            cleaned.append({k: v for k, v in t.items() if k not in keys})
-        out[section] = cleaned if many else cleaned[0]
-    return out
+def _engine(doc: dict, physics, law) -> str:
+    """The engine a scene runs on (:mod:`dem.engines`): ``[solver] engine`` if it names one, else the one its physics
+    and contact law call for; the combination checked."""
+    moving = "mechanical" in physics
+    solver = doc.get("solver", {})
+    named = solver.get("engine") if isinstance(solver, dict) else None
+    if named is None:
+        return "static" if not moving else ("verlet" if law.SPINS else "staggered")
+    if named not in ENGINE_NAMES:
+        raise ValueError(f"[solver] engine = {named!r}: must be one of {', '.join(ENGINE_NAMES)}")
+    if (named == "static") == moving:
+        raise ValueError(f"[solver] engine = {named!r}: " + ("a packing that does not move runs on the static engine"
+                         if not moving else "particles that move (\"mechanical\" physics) run on \"verlet\" or "
+                                            "\"staggered\""))
+    if named == "staggered" and law.SPINS:
+        raise ValueError(f"[solver] engine = \"staggered\": steps particles that do not rotate; [contact] law = "
+                         f"{law.NAME!r} makes torques (use engine = \"verlet\")")
+    return named
 
 
 def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None) -> Scene:
-    """Validate a parsed TOML document into a :class:`Scene` (schema: README, "Scene schema")."""
-    top = set(ALLOWED) | {"materials", "contact"} | set(MOVING_TABLES)
-    unknown = sorted(set(doc) - top)
+    """Validate a parsed TOML document into a :class:`Scene`: every table and key against the schema of the engine
+    the scene runs on (:mod:`dem.scene.schema`), then each table into its part of the scene."""
+    if not isinstance(doc, dict):
+        raise ValueError("scene: must be a table of tables")
+    unknown = sorted(set(doc) - set(TABLES))
     if unknown:
-        raise ValueError(f"[{unknown[0]}]: unknown table (allowed: {', '.join(sorted(top))})")
-    physics = doc.get("scene", {}).get("physics", ["thermal"]) if isinstance(doc.get("scene", {}), dict) else None
+        raise ValueError(f"[{unknown[0]}]: unknown table (allowed: {', '.join(sorted(TABLES))})")
+    meta = doc.get("scene", {})
+    if not isinstance(meta, dict):
+        raise ValueError("[scene]: must be a table")
+    physics = meta.get("physics", ["thermal"])
     if isinstance(physics, str):
         physics = [physics]
     if not isinstance(physics, list) or not all(isinstance(x, str) for x in physics):
@@ -423,39 +444,49 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
                          f"{', '.join(PHYSICS)})")
     check_physics(physics)
     moving = "mechanical" in physics
-    full, doc = doc, _moving_keys(doc, moving)
-    meta = doc.get("scene", {})
-    _check_keys(meta, "scene", ALLOWED["scene"])
+    if moving and not isinstance(doc.get("contact"), dict):
+        raise ValueError(f"[contact]: required for mechanical physics (law = one of {', '.join(CONTACT_LAWS)}, and its "
+                         f"parameters)")
+    law = law_module(doc["contact"].get("law")) if moving else None
+    engine = _engine(doc, physics, law)
+    check(doc, engine, law)
     materials = _materials(doc, thermal="thermal" in physics, electrical="electrical" in physics)
     start = None
-    if "start" in full:
+    if "start" in doc:
         if "particles" in doc or "generator" in doc:
             raise ValueError("[start] state: the particles come from the saved state; remove [particles] or "
                              "[generator]")
-        name = full["start"].get("state") if isinstance(full["start"], dict) else None
+        name = doc["start"].get("state")
         if not isinstance(name, str):
             raise ValueError("[start] state: required, the path of a saved state (.npz)")
         start = state_file.load(base_dir / name if base_dir is not None else name)
-        particles = Particles.from_arrays(start["x"], start["radius"], start["T"], materials,
-                                          prefix="[start] state")
+        material = start.get("material")
+        if material is not None and int(np.max(material, initial=0)) >= len(materials):
+            material = None  # the state's materials are not this scene's: the scene's first, as for [particles]
+        particles = Particles.from_arrays(start["x"], start["radius"], start["T"], materials, material,
+                                          prefix="[start] state", id=start.get("id"))
         walls, specimen, velocity, box = (), None, None, None
     elif ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
     elif "particles" in doc:
-        particles, walls, specimen, velocity, box = _explicit_particles(doc["particles"], materials)
+        particles, walls, specimen, velocity, box = _explicit_particles(doc["particles"], materials, base_dir)
     else:
-        dimension = full.get("scene", {}).get("dimension", 3) if moving else 3
-        particles, walls, specimen, velocity, box = _generated_particles(doc["generator"], materials, dimension)
+        particles, walls, specimen, velocity, box = _generated_particles(doc["generator"], materials,
+                                                                         meta.get("dimension", 3))
     if "periodic" in doc:
-        if box is not None:
+        if box is not None and "generator" in doc:
             raise ValueError("[periodic]: the generator's boundary = \"periodic\" already makes the block periodic; "
                              "give one or the other")
-        box = _periodic_box(doc["periodic"])
+        box = _periodic_box(doc["periodic"], box)
+    elif box is not None and not box.any_periodic:
+        box = None  # a packing file's box that is not periodic (or that cannot say): only [periodic] uses it
     if box is not None and moving:
-        raise ValueError("[periodic]: periodic boxes are for static packings so far (the neighbour list of moving "
-                         "particles does not use dem.geometry.periodic yet)")
-    if not moving:
-        walls = walls + _walls(doc)
+        raise ValueError(f"{'[periodic]' if 'periodic' in doc else '[particles] file: its box is periodic, and'}: "
+                         "periodic boxes are for static packings so far (the neighbour list of moving particles does "
+                         "not use dem.geometry.periodic yet)")
+    walls = walls + _walls(doc, start, static=not moving)
+    if not moving and specimen is None and start is not None:
+        specimen = _specimen_between(walls, start, particles)
     cond = dict(doc.get("conductance", {}))
     if "fit_file" in cond and not isinstance(cond["fit_file"], str):
         raise ValueError(f"[conductance] fit_file = {cond['fit_file']!r}: must be a path (string)")
@@ -471,14 +502,15 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
                    integer=("max_steps",), words=("dt",))
     output = _spec(OutputSpec, doc.get("output", {}), "output", numeric=("checkpoint_every",),
                    integer=("every", "vtu_every"))
-    if velocity is not None and not moving:
-        raise ValueError("[generator] speed: only for moving particles ([scene] physics with \"mechanical\")")
-    contact = contact_material_from_scene(doc) if "contact" in doc else None
-    motion = parse_motion(full, particles, solver, physics, contact, velocity, start) if moving else None
-    electrical = parse_electrical(full, motion.walls if moving else (), physics)
-    return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
-                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact, motion,
-                 electrical, box)
+    contact = contact_material_from_scene(doc) if moving else None
+    motion = parse_motion(doc, particles, solver, physics, contact, velocity, start, walls) if moving else None
+    electrical = parse_electrical(doc, walls, physics)
+    if start is not None and solver.mode == "transient" and solver.t_end <= start["t"]:
+        raise ValueError(f"[solver] t_end = {solver.t_end:g} s: must be beyond the saved state's time "
+                         f"{start['t']:.6g} s (the run's clock goes on from the state's)")
+    return Scene(particles, () if moving else walls, conductance, Sources(conv, rad), solver, output,
+                 tuple(physics), str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact,
+                 motion, electrical, box, engine, start)
 
 
 def contact_material_from_scene(doc: dict):

@@ -3,7 +3,7 @@ Algorithm 1 (eqs. 45-49) over the mechanical, thermal and electrical submodels.
 
 Each step from ``t`` to ``t + dt`` iterates, K = 1, 2, ...:
 
-1. positions ``r^K`` with the temperatures frozen at ``theta^(K-1)`` (:class:`dem.engines.staggered.mechanics.ZohdiMechanics`,
+1. positions ``r^K`` with the temperatures frozen at ``theta^(K-1)`` (:class:`dem.engines.staggered.mechanics.StaggeredMechanics`,
    eqs. 22-27, 45);
 2. temperatures ``theta^K`` with the positions frozen at ``r^K`` (:class:`dem.engines.staggered.heat.LumpedHeat`, eqs. 36-37,
    46), with the Joule heating of the current refreshed at the last accepted step;
@@ -31,9 +31,12 @@ import math
 import numpy as np
 
 from dem.geometry.motion import MotionState
+from dem.geometry.neighbours import list_arrays
+from dem.geometry.walls import box_axes
 from dem.engines.contact_current import ContactCurrent
 from dem.engines.staggered.heat import LumpedHeat
-from dem.engines.staggered.mechanics import ZohdiMechanics
+from dem.engines.staggered.mechanics import StaggeredMechanics
+from dem.scene.state_file import moving_arrays, normalised
 
 NO_MOTION = 1e-12  # displacements below this x the mean radius (temperature changes below this x |theta|) are none
 
@@ -42,41 +45,82 @@ class ConvergenceError(ValueError):
     """A step that cannot converge even at ``dt_min``."""
 
 
-class ZohdiSimulation:
-    """A scene with ``[contact] law = "zohdi"`` (module docstring)."""
+class StaggeredEngine:
+    """A scene with ``[contact] law = "zohdi"`` (module docstring), as the driver asks of an engine
+    (:mod:`dem.engines`)."""
 
-    def __init__(self, scene):
+    name = "staggered"
+    link_kind = "contacts"
+
+    def __init__(self, scene, restart: dict | None = None):
+        """``restart``: a checkpoint of this scene's run (:meth:`checkpoint`): the run goes on from its step, bit for
+        bit. A scene that starts from a saved state goes on from its positions, velocities, temperatures, time and
+        counters."""
         self.scene = scene
         m, p = scene.motion, scene.particles
         self.stepping = m.stepping
         material = scene.contact
+        saved = normalised(dict(restart)) if restart is not None else m.start
         state = MotionState.create(3, p.position, p.radius, material.density, p.temperature, m.velocity)
-        self.mechanics = ZohdiMechanics(state, m.walls, material, m.gravity, m.skin)
+        if saved is not None and saved["moving"]:
+            state.x[:], state.v[:], state.T[:] = saved["x"], saved["v"], saved["T"]
+        self.mechanics = StaggeredMechanics(state, m.walls, material, m.gravity, m.skin,
+                                            history=saved if saved is not None and saved["moving"] else None)
         self.thermal = LumpedHeat(p, m.walls, scene.conductance) if "thermal" in scene.physics else None
+        if self.thermal is not None and restart is not None:
+            self.thermal.T, self.thermal.T0 = saved["T"].copy(), saved["thermal_T0"].copy()
+            self.thermal.heat_in = {str(k): float(v) for k, v in zip(saved["heat_keys"], saved["heat_values"])}
         self.current = None
         if "electrical" in scene.physics:
             e = scene.electrical
             self.current = ContactCurrent(p, m.walls, e.electrodes, scene.conductance, e.scheme, e.absorption,
                                           e.tolerance, e.sweeps, scene.solver.linear, e.floating)
-        self.models = [x for x in (self.mechanics, self.thermal, self.current) if x is not None]
-        self.t, self.steps, self.restarts, self.iterations = 0.0, 0, 0, 0
+        self.t = self.t_start = scene.start_time
+        self.steps, self.restarts, self.iterations = 0 if saved is None else saved["steps"], 0, 0
+        self.steps_start = self.steps
         self.last_iterations, self.max_iterations = 0, 0
         self.dt = self.stepping.dt
         self.dt_taken: list[float] = []
         self._phase = 0
+        if saved is not None:
+            self.mechanics.rebuilds = saved.get("neighbour_rebuilds", 0)
+        if restart is not None:
+            self._resume(saved)
         self._apply_phases()
         axis = m.control
         if axis is not None:  # the walls facing +axis (bottom) and -axis (top) of the bed's fractions
             normals = self.mechanics.w.normal[:, axis]
             self._bottom = int(np.flatnonzero(np.abs(normals - 1.0) < 1e-12)[0])
             self._top = int(np.flatnonzero(np.abs(normals + 1.0) < 1e-12)[0])
-            self._lowest = -self.mechanics.w.q[self._top]
+            self._lowest = -self.mechanics.w.q[self._top] if restart is None else float(saved["lowest"])
         if self.thermal is not None:
             self.thermal.start(self.mechanics)
         if self.current is not None:
-            self.current.refresh(self.mechanics)
+            if restart is not None:
+                self.current.J = saved["current_J"].copy()  # the warm start of Zohdi's iteration
+            self.current.refresh(self.mechanics, self.t)
+            if restart is not None:
+                self._resume_current(saved)
         self._floor_r = NO_MOTION * float(np.mean(state.radius)) * state.n
 
+    def _resume(self, saved: dict) -> None:
+        """The scheme's clock and counters of a checkpoint (the particles and walls came in above)."""
+        self.t, self.t_start, self.steps = float(saved["t"]), float(saved["t_start"]), int(saved["steps"])
+        self.steps_start = int(saved["steps_start"])
+        self.restarts, self.iterations = int(saved["restarts"]), int(saved["iterations"])
+        self.last_iterations, self.max_iterations = int(saved["last_iterations"]), int(saved["max_iterations"])
+        self.dt = float(saved["next_dt"])
+        self.dt_taken = [float(x) for x in saved["dt_taken"]]
+        self._phase = int(saved["phase"])
+        self.mechanics.resume_lists(saved)
+
+    def _resume_current(self, saved: dict) -> None:
+        """The current's energies and counters of a checkpoint (its refresh at the restored state counted once)."""
+        c = self.current
+        for key in ("refreshes", "total_sweeps", "open_refreshes"):
+            setattr(c, key, int(saved[f"current_{key}"]))
+        for key in ("joule_energy", "electrode_energy", "peak_power"):
+            setattr(c, key, float(saved[f"current_{key}"]))
     # ------------------------------------------------------------------------------------------------ loop
     def _apply_phases(self) -> None:
         """Wall speeds of every ``[[phases]]`` entry that has started."""
@@ -154,38 +198,65 @@ class ZohdiSimulation:
             self.current.book(dt)
             self.current.refresh(mech, self.t)
 
-    def run(self, observer=None, progress=None) -> dict:
-        """Advance to ``[solver] t_end``; ``observer(sim)`` at t = 0, whenever an output time is passed, and at the
-        end; ``progress(t)`` after every step."""
+    def run(self, observe=None, progress=None, checkpoint=None) -> None:
+        """Advance to ``[solver] t_end``; ``observe()`` at the start, whenever an output time is passed, and at the
+        end; ``progress(t)`` and ``checkpoint(make, final)`` after every step."""
         t_end = self.scene.solver.t_end
         every = self.scene.motion.output_interval
-        next_out = every
-        if observer is not None:
-            observer(self)
+        next_out = self.t_start + every
+        while next_out <= self.t * (1 + 1e-12):  # a resumed run: the output times as the run advanced them
+            next_out += every
+        if observe is not None and self.t == self.t_start:
+            observe()
         while self.t < t_end * (1 - 1e-12):
             self.step()
-            if observer is not None and (self.t >= next_out * (1 - 1e-12) or self.t >= t_end * (1 - 1e-12)):
-                observer(self)
+            if observe is not None and (self.t >= next_out * (1 - 1e-12) or self.t >= t_end * (1 - 1e-12)):
+                observe()
                 while next_out <= self.t * (1 + 1e-12):
                     next_out += every
             if progress is not None:
                 progress(self.t)
-        return self.summary()
+            if checkpoint is not None:
+                checkpoint(self.checkpoint, final=self.t >= t_end * (1 - 1e-12))
+
+    def state(self) -> dict:
+        """The sample as it is (:mod:`dem.scene.state_file`): another run starts from it."""
+        return moving_arrays(self)
+
+    def checkpoint(self) -> dict:
+        """Everything the scheme carries, to go on bit for bit: the state, the clock and counters, the heat balance
+        and the current's warm start and energies."""
+        data = self.state()
+        data.update(t_start=np.array(self.t_start), steps_start=np.array(self.steps_start),
+                    restarts=np.array(self.restarts),
+                    iterations=np.array(self.iterations), last_iterations=np.array(self.last_iterations),
+                    max_iterations=np.array(self.max_iterations), next_dt=np.array(self.dt),
+                    dt_taken=np.array(self.dt_taken, dtype=float), phase=np.array(self._phase),
+                    lowest=np.array(getattr(self, "_lowest", np.nan)), **list_arrays(self.mechanics))
+        if self.thermal is not None:
+            th = self.thermal
+            data.update(thermal_T0=th.T0, heat_keys=np.array(list(th.heat_in), dtype=str),
+                        heat_values=np.array(list(th.heat_in.values()), dtype=float))
+        if self.current is not None:
+            c = self.current
+            data.update(current_J=c.J, **{f"current_{k}": np.array(getattr(c, k)) for k in (
+                "refreshes", "total_sweeps", "open_refreshes", "joule_energy", "electrode_energy", "peak_power")})
+        return data
 
     # -------------------------------------------------------------------------------------------- outputs
     def _cross_section(self, axis):
         """``(area, (lo, hi) per lateral axis)`` of the box the walls perpendicular to ``axis`` enclose, or None."""
         mech = self.mechanics
         area, spans = 1.0, []
+        box = box_axes(mech.walls)
         for a in range(3):
             if a == axis:
                 continue
-            lo = [k for k, wall in enumerate(mech.walls) if abs(wall.normal[a] - 1.0) < 1e-12]
-            hi = [k for k, wall in enumerate(mech.walls) if abs(wall.normal[a] + 1.0) < 1e-12]
-            if len(lo) != 1 or len(hi) != 1:
+            if a not in box:
                 return None
-            spans.append((a, mech.w.q[lo[0]], -mech.w.q[hi[0]]))
-            area *= mech.w.extent(lo[0], hi[0])
+            lo, hi = box[a]
+            spans.append((a, mech.w.q[lo], -mech.w.q[hi]))
+            area *= mech.w.extent(lo, hi)
         return area, spans
 
     def bed(self) -> dict:
@@ -269,8 +340,10 @@ class ZohdiSimulation:
         mech = self.mechanics
         out = {k: v for k, v in self.record().items() if k not in ("step", "dt", "iterations")}
         dts = np.array(self.dt_taken) if self.dt_taken else np.zeros(1)
-        out.update(contact_law="zohdi", steps=self.steps, restarts=self.restarts, iterations=self.iterations,
-                   iterations_per_step=self.iterations / max(self.steps, 1), iterations_max=self.max_iterations,
+        out.update(mode="transient", static=False, contact_law="zohdi", steps=self.steps, restarts=self.restarts,
+                   iterations=self.iterations,
+                   iterations_per_step=self.iterations / max(self.steps - self.steps_start, 1),
+                   iterations_max=self.max_iterations,
                    dt_min=float(dts.min()), dt_max=float(dts.max()), dt_mean=float(dts.mean()),
                    particles=mech.state.n, contacts=len(mech.contacts()[0]), neighbour_rebuilds=mech.rebuilds,
                    skin=mech.skin, phi=self.stepping.phi, tolerance=self.stepping.tolerance,
@@ -289,18 +362,33 @@ class ZohdiSimulation:
                            floating_particles=int(len(c.flow.floating)) if c.flow is not None else 0)
         return out
 
+    def positions(self) -> np.ndarray:
+        return self.mechanics.state.x
+
+    def temperatures(self) -> np.ndarray:
+        return self.mechanics.state.T.copy()
+
+    def plots(self, out, summary: dict) -> list[str]:
+        from dem.output.plots import motion_plots
+
+        return motion_plots(out)
+
+    def links(self):
+        """The touching pairs as lines between the particles: normal force (N, > 0 repulsive), contact area (m^2),
+        bonded."""
+        i, j, fn, area, bond = self.mechanics.contacts()
+        return self.mechanics.state.x, np.column_stack([i, j]), {"normal_force": fn, "area": area,
+                                                                  "bonded": bond.astype(np.int8)}
+
     def particle_fields(self) -> dict:
         s = self.mechanics.state
-        out = {"radius": s.radius, "velocity": s.v, "force": self.mechanics.f, "temperature": s.T}
+        out = {"id": self.scene.particles.id, "radius": s.radius, "velocity": s.v, "force": self.mechanics.f,
+               "temperature": s.T}
         if self.current is not None:
             out["heating"] = self.current.heating
             out["current" if self.current.scheme == "zohdi" else "potential"] = np.nan_to_num(self.current.J)
         return out
 
-    def contact_fields(self):
-        """``(i, j, fields)`` of the touching pairs: normal force (N, > 0 repulsive), contact area (m^2), bonded."""
-        i, j, fn, area, bond = self.mechanics.contacts()
-        return i, j, {"normal_force": fn, "area": area, "bonded": bond.astype(np.int8)}
 
 
 def cap_volume(centre, radius, level):

@@ -22,24 +22,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataclasses import dataclass
-
 from dem.geometry.bonds import find_bonds
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.geometry.particles import Particles
 from dem.engines.staggered import kernels
-
-
-@dataclass(frozen=True)
-class Plane:
-    """A wall where the mechanics has it now: what :func:`dem.geometry.bonds.find_bonds` asks of a wall."""
-
-    name: str
-    normal: np.ndarray
-    offset: float
-
-    def distance(self, position: np.ndarray) -> np.ndarray:
-        return position @ self.normal - self.offset
 
 
 def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_of_range: str):
@@ -48,7 +34,7 @@ def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_
     ``contact`` (:func:`dem.geometry.bonds.find_bonds`)."""
     closed = kernels.closed_pairs(x, particles.radius, mech.pi, mech.pj)
     now = Particles(x, particles.radius, T, particles.material, particles.fixed, particles.heat, particles.materials)
-    planes = [Plane(mech.walls[k].name, mech.w.normal[k], float(mech.w.q[k])) for k in wall_ids]
+    planes = [mech.walls[k].at(float(mech.w.q[k])) for k in wall_ids]
     return now, find_bonds(now, planes, contact, out_of_range, pairs=(mech.pi[closed], mech.pj[closed]))
 
 

@@ -1,10 +1,10 @@
 """The mechanical submodel of Zohdi 2014: particles that move under the forces of eqs. (2)-(21), stepped by the
 trapezoidal rule (eqs. 22-24) whose implicit equations are solved by fixed-point iteration (eqs. 25-27).
 
-A step from ``t`` to ``t + dt`` is a sequence of iterations (:meth:`ZohdiMechanics.iterate`), each evaluating the
+A step from ``t`` to ``t + dt`` is a sequence of iterations (:meth:`StaggeredMechanics.iterate`), each evaluating the
 forces at the previous iterate with the temperatures frozen at theirs; the staggered scheme
-(:mod:`dem.engines.staggered.engine`) decides when the iterates have converged and then :meth:`~ZohdiMechanics.accept`\\ s
-the last one, or :meth:`~ZohdiMechanics.restart`\\ s the step with a smaller ``dt``. Walls move by prescribed
+(:mod:`dem.engines.staggered.engine`) decides when the iterates have converged and then :meth:`~StaggeredMechanics.accept`\\ s
+the last one, or :meth:`~StaggeredMechanics.restart`\\ s the step with a smaller ``dt``. Walls move by prescribed
 kinematics (fixed, strain at a constant speed, vibrating; :mod:`dem.geometry.walls`), so where they are at the end of the
 step is known before it is solved.
 
@@ -22,19 +22,20 @@ import numpy as np
 
 from dem.engines import compiled
 from dem.geometry.motion import MotionState
-from dem.geometry.neighbours import carry_history, max_displacement, verlet_pairs, wall_pairs
+from dem.geometry.neighbours import carry_history, max_displacement, restore_lists, verlet_pairs, wall_pairs
 from dem.geometry.walls import MOTIONS, WallArrays
 from dem.laws.contact import law_module
 
 
-class ZohdiMechanics:
+class StaggeredMechanics:
     """The particles, their Verlet list and the walls, advanced by fixed-point iterations (module docstring)."""
 
     name = "mechanical"
 
-    def __init__(self, state: MotionState, walls, material, gravity, skin: float):
+    def __init__(self, state: MotionState, walls, material, gravity, skin: float, history: dict | None = None):
         """``material``: the contact law's material (``material.law`` names the law: one whose particles do not
-        rotate)."""
+        rotate); ``history``: a saved state (:mod:`dem.scene.state_file`) whose walls (by name: offset and speed)
+        and, for the same contact law, contact histories the model starts from."""
         self.state = state
         self.walls = tuple(walls)
         for wall in self.walls:
@@ -66,8 +67,22 @@ class ZohdiMechanics:
         self.w_fn, self.w_ft = np.zeros((n, n_w)), np.zeros((n, n_w, 3))
         self.p_hist = np.zeros((0, len(self.law.PAIR_HISTORY)))
         self.pi = self.pj = np.zeros(0, dtype=np.int64)
+        if history is not None:
+            self._restore_walls(history)
         self._build_list(state.x)
+        if history is not None and history["contact_law"] == self.law.NAME:
+            (self.p_hist,) = carry_history(history["pi"], history["pj"], self.pi, self.pj, history["p_hist"])
+            self.w_hist[:] = history["w_hist"]
         self._evaluate(state.x, state.v, state.T, self.f)
+
+    def _restore_walls(self, saved: dict) -> None:
+        """Walls named like walls of the saved state take their offsets and speeds."""
+        names = list(saved["wall_names"])
+        for k, wall in enumerate(self.walls):
+            if wall.name in names:
+                m = names.index(wall.name)
+                self.w.q[k], self.w.dq[k] = saved["wall_q"][m], saved["wall_dq"][m]
+        self.q_start = self.w.q.copy()
 
     # ------------------------------------------------------------------------------------------------ list
     def _build_list(self, x):
@@ -84,6 +99,14 @@ class ZohdiMechanics:
         self.x_ref = x.copy()
         self.wk, self.wm = wall_pairs(x, s.radius, self.w.normal, self.w.q, self.skin)
         self.wq_ref = self.w.q.copy()
+
+    def resume_lists(self, saved: dict) -> None:
+        """The Verlet lists of a checkpoint (a resumed run rebuilds them at the uninterrupted run's steps), with the
+        forces of the start of the step on them."""
+        restore_lists(self, saved)
+        self._p_hist_iter = np.zeros_like(self.p_hist)
+        s = self.state
+        self._evaluate(s.x, s.v, s.T, self.f)
 
     def _wall_reach(self) -> float:
         return float(np.max(np.abs(self.w.q - self.wq_ref), initial=0.0))

@@ -28,17 +28,25 @@ from dataclasses import replace
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.motion import MotionState
+from dem.geometry.neighbours import list_arrays, restore_lists
+from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
+from dem.scene.state_file import moving_arrays, normalised
 from dem.network.heat import boundary_heat_flow, steady
 from fem_neck.geometry import neck_radius
 
 
-class Simulation:
-    """A moving-particle run built from a scene with ``"mechanical"`` physics."""
+class VerletEngine:
+    """A moving-particle run built from a scene with ``"mechanical"`` physics, as the driver asks of an engine
+    (:mod:`dem.engines`)."""
 
-    def __init__(self, scene, resume: dict | None = None):
-        """``resume``: a checkpoint of this scene's run (:func:`dem.scene.state_file.arrays` as loaded by
-        :func:`dem.output.folder.load`): the run goes on from its step as if it had not stopped."""
+    name = "verlet"
+    link_kind = "contacts"
+
+    def __init__(self, scene, restart: dict | None = None):
+        """``restart``: a checkpoint of this scene's run (:meth:`checkpoint` as loaded by
+        :func:`dem.output.folder.load`): the run goes on from its step as if it had not stopped. A scene that starts
+        from a saved state (``[start] state``) goes on from that state's time and counters."""
         self.scene = scene
         m = scene.motion
         p = scene.particles
@@ -48,7 +56,9 @@ class Simulation:
         state = MotionState.create(m.dimension, p.position, p.radius, material.density, T_init, m.velocity,
                                    m.angular_velocity, m.height, radius_ref=law.reference_radius(material, p.radius,
                                                                                                    T_init))
-        saved = resume if resume is not None else m.start
+        if restart is not None:
+            restart = normalised(dict(restart))
+        saved = restart if restart is not None else m.start
         if saved is not None:
             for key in ("x", "v", "w", "f", "tau", "mass", "inertia", "radius", "radius_ref", "T"):
                 setattr(state, key, np.ascontiguousarray(saved[key], dtype=float).copy())
@@ -60,25 +70,52 @@ class Simulation:
             self.thermal = ContactThermalModel(p, m.walls, scene.conductance, scene.sources, m.thermal_integrator,
                                                scene.solver.linear)
         self.schedule = m.schedule
-        self.models = [self.mechanics] + ([self.thermal] if self.thermal is not None else [])
-        if resume is not None:
-            self._resume(resume)
+        self.steps_start = 0
+        if restart is not None:
+            self._resume(restart)
+        elif m.start is not None:
+            self._go_on_from(m.start)
+
+    @property
+    def t(self) -> float:
+        return self.mechanics.t
+
+    @property
+    def t_start(self) -> float:
+        return self.mechanics.t_start
+
+    @property
+    def steps(self) -> int:
+        """Steps since the first run of the sample (a run from a saved state goes on counting from its steps)."""
+        return self.steps_start + self.mechanics.steps
+
+    def _go_on_from(self, saved: dict) -> None:
+        """A saved state's clock and counters: the run starts at its time and goes on counting."""
+        mech = self.mechanics
+        mech.t_start, self.steps_start = float(saved["t"]), int(saved["steps"])
+        mech.rebuilds = int(saved.get("neighbour_rebuilds", 0))
+        if self.thermal is not None:
+            self.thermal.assemblies = int(saved.get("network_assemblies", 0))
+            self.thermal.refreshes = int(saved.get("network_refreshes", 0))
 
     def _resume(self, saved: dict) -> None:
         """The clock, the walls' motion and the heat balance of a checkpoint (the particles came in above)."""
         mech = self.mechanics
-        mech.steps = int(saved["steps"])
+        mech.steps, mech.t_start = int(saved["run_steps"]), float(saved["t_start"])
+        self.steps_start = int(saved["steps_start"])
+        mech.rebuilds = int(saved["neighbour_rebuilds"])
         names = list(saved["wall_names"])
         for k, wall in enumerate(mech.walls):
             m = names.index(wall.name)
             mech.w.q[k], mech.w.dq[k], mech.w.acc[k] = saved["wall_q"][m], saved["wall_dq"][m], saved["wall_acc"][m]
-        mech.walls_moved()
+        restore_lists(mech, saved)
         if self.thermal is not None:
             th = self.thermal
             th.T = np.array(saved["thermal_T"], dtype=float)
             th.rate = np.array(saved["thermal_rate"], dtype=float)
             th.energy0 = float(saved["thermal_energy0"])
             th.heat_in = {str(k): float(v) for k, v in zip(saved["heat_keys"], saved["heat_values"])}
+            th.assemblies, th.refreshes = int(saved["network_assemblies"]), int(saved["network_refreshes"])
 
     @property
     def temperature_source(self) -> str:
@@ -113,9 +150,9 @@ class Simulation:
         return replace(self.material, **values).params()
 
     def _interval_ends(self, n_end: int) -> list[int]:
-        """Step indices at which an interval ends: output times, thermal updates, schedule knots, phase starts,
-        the end."""
-        m, dt = self.scene.motion, self.mechanics.dt
+        """Step indices (of this run) at which an interval ends: output times, thermal updates, schedule knots, phase
+        starts, the end."""
+        m, dt, t0 = self.scene.motion, self.mechanics.dt, self.mechanics.t_start
         ends = {n_end}
         every = max(1, round(m.output_interval / dt))
         ends.update(range(every, n_end, every))
@@ -123,8 +160,8 @@ class Simulation:
             every = max(1, round(m.thermal_interval / dt))
             ends.update(range(every, n_end, every))
         if self.schedule is not None:
-            ends.update(k for k in (round(t / dt) for t in self.schedule.time) if 0 < k < n_end)
-        ends.update(k for k in (round(start / dt) for start, _ in m.phases + m.wall_phases) if 0 < k < n_end)
+            ends.update(k for k in (round((t - t0) / dt) for t in self.schedule.time) if 0 < k < n_end)
+        ends.update(k for k in (round((start - t0) / dt) for start, _ in m.phases + m.wall_phases) if 0 < k < n_end)
         return sorted(ends)
 
     def _wall_speeds_at(self, t: float) -> None:
@@ -136,38 +173,32 @@ class Simulation:
                 for name, velocity in speeds.items():
                     mech.w.dq[names.index(name)] = velocity
 
-    def run(self, observer=None, progress=None, checkpoint=None, position=None) -> dict:
-        """Advance to ``[solver] t_end``; ``observer(sim)`` after each interval that ends on an output time (and at
-        t = 0), ``progress(t)`` after every interval, ``checkpoint(make)`` after every interval and at the end
-        (:class:`dem.output.folder.Checkpointer`); ``position`` (:class:`sinterheat.interrupt.Where`) learns the step and
-        time after every interval."""
-        from dem.scene.state_file import arrays
-
+    def run(self, observe=None, progress=None, checkpoint=None) -> None:
+        """Advance to ``[solver] t_end``; ``observe()`` after each interval that ends on an output time (and at the
+        start), ``progress(t)`` after every interval, ``checkpoint(make, final)`` after every interval and at the end
+        (:class:`dem.output.folder.Checkpointer`)."""
         m, mech = self.scene.motion, self.mechanics
-        n_end = max(1, math.ceil(self.scene.solver.t_end / mech.dt - 1e-9))
+        n_end = max(1, math.ceil((self.scene.solver.t_end - mech.t_start) / mech.dt - 1e-9))
         out_every = max(1, round(m.output_interval / mech.dt))
-        if observer is not None and mech.steps == 0:
-            observer(self)
+        if observe is not None and mech.steps == 0:
+            observe()
         for end in self._interval_ends(n_end):
             steps = end - mech.steps
             if steps <= 0:
                 continue
-            T0, rate, t0 = self._interval_temperatures(mech.t, end * mech.dt)
+            T0, rate, t0 = self._interval_temperatures(mech.t, mech.t_start + end * mech.dt)
             mech.params = self._params_at(mech.t)
             self._wall_speeds_at(mech.t)
             mech.advance(steps, T0, rate, t0)
             if self.thermal is not None:
                 self.thermal.step(mech, steps * mech.dt)
                 mech.state.T[:] = self.thermal.T  # the next interval starts from these
-            if observer is not None and (end % out_every == 0 or end == n_end):
-                observer(self)
+            if observe is not None and (end % out_every == 0 or end == n_end):
+                observe()
             if progress is not None:
                 progress(mech.t)
-            if position is not None:
-                position.update(step=mech.steps, t=mech.t)
             if checkpoint is not None:
-                checkpoint(lambda: arrays(self), final=end == n_end)
-        return self.summary()
+                checkpoint(self.checkpoint, final=end == n_end)
 
     # -------------------------------------------------------------------------------------------- outputs
     def box_volume(self) -> float | None:
@@ -177,15 +208,14 @@ class Simulation:
         s, w = mech.state, mech.w
         axes = (0, 2) if s.dimension == 2 else (0, 1, 2)
         volume = s.height if s.dimension == 2 else 1.0
+        box = box_axes(mech.walls)
         for a in axes:
             if mech.box[a] > 0:
                 volume *= mech.box[a]
                 continue
-            lo = [k for k, wall in enumerate(mech.walls) if abs(wall.normal[a] - 1.0) < 1e-12]
-            hi = [k for k, wall in enumerate(mech.walls) if abs(wall.normal[a] + 1.0) < 1e-12]
-            if len(lo) != 1 or len(hi) != 1:
+            if a not in box:
                 return None
-            volume *= w.extent(lo[0], hi[0])
+            volume *= w.extent(*box[a])
         return volume
 
     def volume_fraction(self) -> float | None:
@@ -271,7 +301,7 @@ class Simulation:
         mech = self.mechanics
         s = mech.state
         i = mech.contacts()[0]
-        row = {"t": mech.t, "step": mech.steps, "kinetic_energy": s.kinetic_energy(),
+        row = {"t": mech.t, "step": self.steps, "kinetic_energy": s.kinetic_energy(),
                "volume_fraction": self.volume_fraction(), "coordination": 2.0 * len(i) / s.n,
                **{name: float(np.mean(mech.particle_column(name))) for name in mech.law.PARTICLE_STATE},
                "T_mean": float(np.mean(s.T)),
@@ -287,11 +317,12 @@ class Simulation:
     def summary(self) -> dict:
         mech = self.mechanics
         s = mech.state
-        out = {k: v for k, v in self.record().items() if k not in ("step",)}
+        out = {"mode": "transient", "static": False,
+               **{k: v for k, v in self.record().items() if k not in ("step",)}}
         profile = self.profile()
         if profile is not None:
             out["profile"] = profile
-        out.update(steps=mech.steps, dt=mech.dt, particles=s.n, contacts=len(mech.contacts()[0]),
+        out.update(steps=self.steps, dt=mech.dt, particles=s.n, contacts=len(mech.contacts()[0]),
                    wall_contacts=len(mech.wall_contacts()[0]), dimension=s.dimension,
                    momentum=s.momentum().tolist(), neighbour_rebuilds=mech.rebuilds, skin=mech.skin,
                    temperature_source=self.temperature_source)
@@ -325,12 +356,47 @@ class Simulation:
         # sign: compression positive (the lever arm points against the compressive force)
         sigma = -sigma
         mean = np.trace(sigma, axis1=1, axis2=2) / s.dimension
-        return {"radius": s.radius, "velocity": s.v, "angular_velocity": s.w, "force": s.f, "temperature": s.T,
+        return {"id": self.scene.particles.id, "radius": s.radius, "velocity": s.v, "angular_velocity": s.w,
+                "force": s.f, "temperature": s.T,
                 **{name: mech.particle_column(name) for name in mech.law.PARTICLE_STATE},
                 "stress": sigma.reshape(-1, 9), "mean_stress": mean}
 
-    def contact_fields(self):
-        """``(i, j, fields)`` of the closed pair contacts: normal force (> 0 repulsive), tangential force magnitude,
-        overlap."""
+    def positions(self) -> np.ndarray:
+        return self.mechanics.state.x
+
+    def temperatures(self) -> np.ndarray:
+        return self.mechanics.state.T.copy()
+
+    def links(self):
+        """The closed pair contacts as lines between the particles: normal force (> 0 repulsive), tangential force
+        magnitude, overlap."""
         i, j, overlap, fn, ft = self.mechanics.contacts()
-        return i, j, {"normal_force": fn, "tangential_force": np.linalg.norm(ft, axis=1), "overlap": overlap}
+        return self.mechanics.state.x, np.column_stack([i, j]), {
+            "normal_force": fn, "tangential_force": np.linalg.norm(ft, axis=1), "overlap": overlap}
+
+    def plots(self, out, summary: dict) -> list[str]:
+        from dem.output.plots import motion_plots
+
+        return motion_plots(out)
+
+    @property
+    def dt(self) -> float:
+        return self.mechanics.dt
+
+    def state(self) -> dict:
+        """The sample as it is (:mod:`dem.scene.state_file`): another run starts from it."""
+        return moving_arrays(self)
+
+    def checkpoint(self) -> dict:
+        """Everything the run carries, to go on bit for bit: the state, the run's own clock and the thermal
+        network's heat balance."""
+        data = self.state()
+        mech = self.mechanics
+        data.update(run_steps=np.array(mech.steps), t_start=np.array(mech.t_start),
+                    steps_start=np.array(self.steps_start), **list_arrays(mech))
+        if self.thermal is not None:
+            th = self.thermal
+            data.update(thermal_T=th.T, thermal_rate=th.rate, thermal_energy0=np.array(th.energy0),
+                        heat_keys=np.array(list(th.heat_in), dtype=str),
+                        heat_values=np.array(list(th.heat_in.values()), dtype=float))
+        return data

@@ -60,7 +60,8 @@ class MechanicalModel:
         self.w_hist = np.zeros((n, n_w, len(self.law.WALL_HISTORY)))
         self.w_fn = np.zeros((n, n_w))
         self.w_ft = np.zeros((n, n_w, 3))
-        self.steps = 0
+        self.steps = 0  # of this run
+        self.t_start = 0.0  # the time the run started at (a saved state's, when it goes on from one)
         self.rebuilds = 0
         self._info = np.zeros(2, dtype=np.int64)
         self._build_list(first=True)
@@ -122,7 +123,7 @@ class MechanicalModel:
     # --------------------------------------------------------------------------------------------- advance
     @property
     def t(self) -> float:
-        return self.steps * self.dt
+        return self.t_start + self.steps * self.dt
 
     def advance(self, n_steps: int, T0: np.ndarray, T_rate: np.ndarray, relaxation_time: float | None = None):
         """``n_steps`` steps with temperatures ``T0 + T_rate (t - t_now)`` (uniform when both have one entry)."""

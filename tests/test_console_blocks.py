@@ -1,5 +1,5 @@
-"""The README's console blocks, run: every ```` ```console ```` block's ``$ `` commands run in a fresh folder, and every
-number they print must match the README's.
+"""The console blocks of the README and of the documentation's pages (``docs/**/*.md``), run: every ```` ```console ````
+block's ``$ `` commands run in a fresh folder, and every number they print must match the page's.
 
 Tolerance: relative 1e-6 (and absolute 1e-12 for numbers at round-off level, such as an energy error of 5e-17).
 Every command shown is deterministic (seeded, fixed meshes, no timing-dependent choices), so on the machine that
@@ -8,7 +8,8 @@ solves (BLAS, libm, SuperLU orderings) while staying 100x tighter than the loose
 1e-4), so a changed algorithm or a stale README fails. Timings are ignored: ``seconds`` entries, and numbers with
 the unit ``s`` (``1.8 s``). Commands are run with ``python`` replaced by this interpreter, the repository on
 ``PYTHONPATH``, and stdout and stderr together, as a terminal shows them (progress bars left out). Input files the
-README shows (a fenced block right after ``<!-- file: NAME -->``) are written into the folder first.
+page shows (a fenced block right after ``<!-- file: NAME -->``) are written into the folder first. A command shown
+with the same output (and the same files it names) on several pages runs once, for all of them.
 """
 
 from __future__ import annotations
@@ -26,8 +27,9 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
+PAGES = [README, *sorted(p for p in (ROOT / "docs").rglob("*.md") if "_build" not in p.parts)]
 RTOL, ATOL = 1e-6, 1e-12
-SLOW = ("fem_neck converge", "fem_neck lattice", "verification")  # commands of more than a few seconds: marked slow
+SLOW = ("fem_neck converge", "fem_neck lattice", "fem_neck cluster", "verification")  # commands of more than a few seconds: marked slow
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 TIMING = re.compile(r"(?<![\w.])\d+(?:\.\d+)?\s?s\b")  # "1.8 s": a wall time in a table
 PROGRESS = re.compile(r"\d+%\||it/s\]|s/it\]")  # a tqdm bar on stderr (a terminal overwrites it in place)
@@ -100,28 +102,52 @@ def shown_files(text: str) -> dict:
     return out
 
 
-COMMANDS = console_commands(README.read_text())
-FILES = shown_files(README.read_text())
+def shown_commands(pages, root=ROOT) -> list[tuple[str, str, dict, list[str]]]:
+    """``(command, expected output, files, places)`` for every distinct console command of ``pages``: ``files`` are
+    the input files its page shows, ``places`` every ``page:line`` that shows it with that output and those of the
+    files it names (pages named relative to ``root``)."""
+    found = {}
+    for page in pages:
+        text = page.read_text()
+        files = shown_files(text)
+        for command, expected, line in console_commands(text):
+            named = tuple(sorted((name, content) for name, content in files.items() if name in command))
+            key = (command, "\n".join(shown(expected)), named)
+            found.setdefault(key, (command, expected, files, []))[3].append(f"{page.relative_to(root)}:{line}")
+    return list(found.values())
 
 
-def test_readme_has_console_blocks():
+COMMANDS = shown_commands(PAGES)
+
+
+def test_pages_have_console_blocks():
     assert len(COMMANDS) >= 8
 
 
-@pytest.mark.parametrize("command, expected, line", [
-    pytest.param(c, e, n, id=f"README:{n} {c[:60]}", marks=[pytest.mark.slow] if any(s in c for s in SLOW) else [])
-    for c, e, n in COMMANDS])
-def test_console_block(tmp_path, command, expected, line):
+def test_a_command_shown_twice_runs_once(tmp_path):
+    page = "```console\n$ python -m x --a 1\nK  0.5\n```\n"
+    other = "<!-- file: s.toml -->\n```toml\nn = 1\n```\n" + page  # shows a file the command does not name
+    paths = [tmp_path / name for name in ("a.md", "b.md", "c.md")]
+    for path, text in zip(paths, (page, other, page.replace("0.5", "0.6"))):
+        path.write_text(text)
+    commands = shown_commands(paths, root=tmp_path)
+    assert [places for *_, places in commands] == [["a.md:2", "b.md:6"], ["c.md:2"]]  # c.md prints another number
+
+
+@pytest.mark.parametrize("command, expected, files, places", [
+    pytest.param(c, e, f, p, id=f"{p[0]} {c[:60]}", marks=[pytest.mark.slow] if any(s in c for s in SLOW) else [])
+    for c, e, f, p in COMMANDS])
+def test_console_block(tmp_path, command, expected, files, places):
     argv = shlex.split(command)
-    assert argv[0] == "python", f"README line {line}: only python commands are run"
+    assert argv[0] == "python", f"{places[0]}: only python commands are run"
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep),
                MPLBACKEND="Agg")
-    for name, content in FILES.items():
+    for name, content in files.items():
         (tmp_path / name).write_text(content)
     proc = subprocess.run([sys.executable, *argv[1:]], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
                           stderr=subprocess.STDOUT, text=True, timeout=1800)
     got, want = numbers(proc.stdout), numbers(expected)
-    message = f"README line {line}: `{command}` printed\n{proc.stdout}"
+    message = f"{', '.join(places)}: `{command}` printed\n{proc.stdout}"
     assert len(got) == len(want), message
     bad = [(w, g) for w, g in zip(want, got) if not close(w, g)]
-    assert not bad, f"{message}\n(README, now): {bad}"
+    assert not bad, f"{message}\n(page, now): {bad}"

@@ -1,0 +1,83 @@
+"""``python -m dem convert IN OUT [--format F] [--length-unit U] [--timestep N] [--periodic AXES] [--density RHO]
+[--json]``: a packing written in another format, e.g. for LAMMPS.
+
+IN is a packing file (CSV, LAMMPS data file or dump, VTK point set: :func:`dem.scene.packing_files.read_packing`, the
+format from the name or ``--format``), a saved moving state (``state.npz``: positions, radii, temperatures,
+velocities, and densities from the saved masses) or a scene (a TOML file or a built-in name: its particles,
+generated ones included, with its materials' densities and its periodic box). OUT is written by its name: a LAMMPS
+data file of ``atom_style sphere`` (``.data``, ``.lmp``, ``data.*``; ``read_data`` reads it, ``units si``; LAMMPS
+numbers atoms from 1, so ids 0..N-1 become 1..N), ``.csv`` or ``.vtu``. A data file does not say which axes are
+periodic: the input script's ``boundary`` command does (the summary lists the periodic axes IN records).
+"""
+
+from __future__ import annotations
+
+import pathlib
+
+OUTPUTS = {"lammps-data": "LAMMPS data file (atom_style sphere)", "csv": "CSV", "vtk": "VTU"}
+
+
+def register(sub):
+    parser = sub.add_parser("convert", help="write a packing, a saved state or a scene's particles as a LAMMPS "
+                            "data file, CSV or VTU", description=__doc__)
+    parser.add_argument("input", metavar="IN", help="packing file, state.npz, or scene (TOML file or built-in name)")
+    parser.add_argument("output", metavar="OUT", help="file to write: .data / .lmp / data.* (LAMMPS), .csv or .vtu")
+    parser.add_argument("--format", default=None, help="format of IN: csv, lammps-data, lammps-dump or vtk "
+                        "(default: from its name)")
+    parser.add_argument("--length-unit", type=float, default=1.0, metavar="U",
+                        help="metres per length unit of IN (0.001 for mm; default 1)")
+    parser.add_argument("--timestep", type=int, default=None, metavar="N",
+                        help="the snapshot of a dump (default: the last)")
+    parser.add_argument("--periodic", default=None, metavar="AXES",
+                        help="periodic axes of IN, e.g. xyz or xy (a LAMMPS data file does not record them)")
+    parser.add_argument("--density", type=float, default=None, metavar="RHO",
+                        help="kg/m^3 of every particle, for a LAMMPS data file when IN gives none")
+    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout, nothing else")
+    parser.set_defaults(run=run)
+
+
+def read_input(args):
+    """The :class:`dem.scene.packing_files.Packing` of IN and what it was (``packing``, ``state`` or ``scene``)."""
+    from dem.scene import packing_files, state_file
+
+    source = pathlib.Path(args.input)
+    if source.suffix.lower() == ".npz":
+        return packing_files.packing_from_state(state_file.load(source)), "state"
+    if source.suffix.lower() == ".toml" or (not source.exists() and not source.suffix):
+        from dem.scene import load_scene
+
+        scene = load_scene(args.input)
+        return packing_files.packing_from_particles(scene.particles, scene.box), "scene"
+    return packing_files.read_packing(source, args.format, args.length_unit, args.timestep, args.periodic), "packing"
+
+
+def run(args) -> dict:
+    from dem.scene import packing_files
+
+    target = pathlib.Path(args.output)
+    try:
+        out_format = packing_files.format_of(target)
+    except ValueError:
+        out_format = None
+    if out_format not in OUTPUTS or target.suffix.lower() in (".vtk", ".vtp", ".pvtu", ".pvtp"):
+        raise ValueError(f"OUT = {args.output!r}: writes a LAMMPS data file (.data, .lmp, data.*), .csv or .vtu")
+    if args.density is not None and not args.density > 0:
+        raise ValueError(f"--density = {args.density!r}: must be > 0 (kg/m^3)")
+    packing, kind = read_input(args)
+    if out_format == "lammps-data":
+        packing_files.write_lammps_data(target, packing, args.density)
+    elif out_format == "csv":
+        packing_files.write_csv(target, packing)
+    else:
+        packing_files.write_vtu(target, packing)
+    ids = packing_files.lammps_ids(packing.id) if out_format == "lammps-data" else packing.id
+    result = {"input": args.input, "input_kind": kind, "input_format": packing.format or kind, "output": str(target),
+              "output_format": OUTPUTS[out_format], "particles": packing.n,
+              "ids": [int(ids.min()), int(ids.max())]}
+    if packing.box_lo is not None:
+        result["box"] = [packing.box_lo.tolist(), packing.box_hi.tolist()]
+    result["periodic"] = (None if packing.periodic is None
+                          else "".join(a for a, p in zip(packing_files.AXES, packing.periodic) if p) or "none")
+    if packing.ignored:
+        result["ignored"] = list(packing.ignored)
+    return result

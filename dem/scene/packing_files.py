@@ -1,0 +1,900 @@
+"""Packings from the files DEM users have, and packings written for LAMMPS.
+
+:func:`read_packing` reads one packing of spheres into a :class:`Packing` (numpy arrays, SI units):
+
+* ``csv`` -- a header row naming the columns ``x, y, z, radius`` (or ``diameter``), optionally ``id``,
+  ``temperature``, ``fixed`` (true/false, 1/0), ``material`` (an index into the scene's materials, from 0, or a
+  material's name) and ``density``; ParaView's ``Points:0``, ``Points:1``, ``Points:2`` name x, y, z. Other columns
+  are ignored (listed in :attr:`Packing.ignored`); lines starting with ``#`` are comments.
+* ``lammps-data`` -- a LAMMPS data file of ``atom_style sphere`` (``Atoms`` lines ``id type diameter density x y z``
+  with optional image flags ``ix iy iz``; a ``Velocities`` section ``id vx vy vz wx wy wz`` is read too). The box
+  is the ``xlo xhi``, ``ylo yhi``, ``zlo zhi`` header; a data file does not record which axes are periodic (LAMMPS's
+  ``write_data`` writes the bounds only; the periodicity is the ``boundary`` command of the input script), so
+  :attr:`Packing.periodic` is None unless ``periodic`` is given. ``type`` k becomes material index k - 1.
+* ``lammps-dump`` -- a LAMMPS or LIGGGHTS text dump (``dump custom``): the last snapshot or the one at
+  ``timestep``; columns ``id``, ``type``, positions ``x y z`` (or unwrapped ``xu yu zu``, scaled ``xs ys zs``,
+  scaled unwrapped ``xsu ysu zsu``; unwrapped positions are wrapped into the box along its periodic axes),
+  ``radius`` or ``diameter``, optional ``mass`` or ``density``, ``temperature`` (LIGGGHTS: ``f_Temp``), ``vx vy vz``,
+  ``omegax omegay omegaz``, ``ix iy iz``. ``ITEM: BOX BOUNDS`` gives the box and, with its ``pp``/``ff``/``ss``
+  flags, the periodic axes.
+* ``vtk`` -- a VTK point set (``.vtu``, ``.vtp``, legacy ``.vtk``: what LIGGGHTS, Yade, ParaView and this toolkit's
+  runs write), read by VTK itself (pyvista): the points are the centres, a point field ``radius`` (Yade: ``radii``)
+  or ``diameter`` the sizes, and the fields ``id``, ``temperature``, ``fixed``, ``material`` (Yade:
+  ``materialId``; LIGGGHTS: ``type``, from 1), ``density`` or ``mass``, ``velocity`` (Yade: ``linVelVec``; LIGGGHTS:
+  ``v``) are read where present.
+
+The format comes from the file's name (``.csv``; ``.data``, ``.lmp`` or a name ``data.*``; ``.dump``,
+``.lammpstrj`` or ``dump.*``; ``.vtu``, ``.vtp``, ``.vtk``) or an explicit ``format``. Lengths are multiplied by
+``length_unit`` (0.001 for a file in mm, 1e-6 in um; densities stay kg/m^3); a LAMMPS file that records its unit
+style (the title line ``units = cgs`` of ``write_data``, ``ITEM: UNITS`` of a dump) is converted from it. Particles
+read from LAMMPS files are sorted by id (LAMMPS writes them in the order of its processors); other files keep their
+order. A bad file raises ``ValueError`` with one line naming the file, the line and the column.
+
+The other way: :func:`write_lammps_data` writes a packing (read here, from a scene's particles, or from a saved
+moving state, :func:`packing_from_state`) as a LAMMPS data file of ``atom_style sphere`` that ``read_data`` reads;
+:func:`write_csv` and :func:`write_vtu` write the two other formats.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import mmap
+import pathlib
+import re
+import warnings
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+FORMATS = ("csv", "lammps-data", "lammps-dump", "vtk")
+AXES = "xyz"
+# LAMMPS unit styles a granular packing can be in: metres and kg/m^3 per unit of length and of density
+LAMMPS_UNITS = {"si": (1.0, 1.0), "cgs": (1e-2, 1e3), "micro": (1e-6, 1e3), "nano": (1e-9, 1e6)}
+SPHERE_VOLUME = 4.0 * math.pi / 3.0
+
+
+@dataclass(frozen=True)
+class Packing:
+    """N spheres read from a file (SI units). ``id`` (N,) int; ``position`` (N, 3) m; ``radius`` (N,) m; the
+    optional per-particle arrays are None where the file has no such column: ``temperature`` (N,), ``fixed`` (N,)
+    bool, ``material`` (N,) an index from 0 (int) or a material's name (str), ``density`` (N,) kg/m^3, ``velocity``
+    and ``angular_velocity`` (N, 3), ``image`` (N, 3) int, the periodic images (LAMMPS image flags).
+    ``box_lo``, ``box_hi`` (3,) m: the box, where the file gives one; ``periodic``: its periodic axes (3 bools), None
+    where the file cannot say. ``source`` the file, ``format`` its format, ``timestep`` that of a dump's snapshot,
+    ``units`` the LAMMPS unit style the file records (converted from), ``ignored`` the columns or fields that were
+    not read."""
+
+    id: np.ndarray
+    position: np.ndarray
+    radius: np.ndarray
+    temperature: np.ndarray | None = None
+    fixed: np.ndarray | None = None
+    material: np.ndarray | None = None
+    density: np.ndarray | None = None
+    velocity: np.ndarray | None = None
+    angular_velocity: np.ndarray | None = None
+    image: np.ndarray | None = None
+    box_lo: np.ndarray | None = None
+    box_hi: np.ndarray | None = None
+    periodic: tuple | None = None
+    source: str = ""
+    format: str = ""
+    timestep: int | None = None
+    units: str | None = None
+    ignored: tuple = field(default=())
+
+    @property
+    def n(self) -> int:
+        return len(self.radius)
+
+    def periodic_box(self, axes=None, drop=None):
+        """The file's box as a :class:`dem.geometry.periodic.PeriodicBox`, periodic along ``axes`` (default: the file's
+        periodic axes); ``drop`` the temperature drop per period. ``ValueError`` when the file gives no box."""
+        from dem.geometry.periodic import PeriodicBox
+
+        if self.box_lo is None:
+            raise ValueError(f"{self.source}: gives no box (a LAMMPS data file or dump does)")
+        if axes is None:
+            axes = self.periodic if self.periodic is not None else (False, False, False)
+        return PeriodicBox(self.box_hi - self.box_lo, tuple(axes), self.box_lo, drop)
+
+
+class FileError(ValueError):
+    """A bad file: one line naming the file, the line and the column."""
+
+    def __init__(self, path, message: str, line: int | None = None, column: int | None = None,
+                 name: str | None = None):
+        where = [str(path)]
+        if line is not None:
+            where.append(f"line {line}")
+        if column is not None:
+            where.append(f"column {column}" + (f" ({name})" if name else ""))
+        super().__init__(f"{', '.join(where)}: {message}")
+
+
+# --------------------------------------------------------------------------------------------------- reading
+def format_of(path) -> str:
+    """The format of a packing file, from its name (module docstring); ``ValueError`` when the name does not say."""
+    p = pathlib.Path(path)
+    name, suffix = p.name.lower(), p.suffix.lower()
+    if suffix == ".csv":
+        return "csv"
+    if suffix in (".data", ".lmp") or name.startswith("data."):
+        return "lammps-data"
+    if suffix in (".dump", ".lammpstrj") or name.startswith("dump."):
+        return "lammps-dump"
+    if suffix in (".vtu", ".vtp", ".vtk", ".pvtu", ".pvtp"):
+        return "vtk"
+    raise ValueError(f"{path}: the format is not known from the name; give format = one of {', '.join(FORMATS)} "
+                     "(extensions: .csv; .data, .lmp, data.*; .dump, .lammpstrj, dump.*; .vtu, .vtp, .vtk)")
+
+
+def read_packing(path, format: str | None = None, length_unit: float = 1.0, timestep: int | None = None,
+                 periodic=None) -> Packing:
+    """The packing in the file ``path`` (module docstring). ``format``: one of :data:`FORMATS` (default: from the
+    name); ``length_unit``: metres per length unit of the file; ``timestep``: the snapshot of a dump (default: the
+    last); ``periodic``: the periodic axes, as ``"xyz"``-letters or three bools, for files that do not record them
+    (a LAMMPS data file) or to override them."""
+    path = pathlib.Path(path)
+    fmt = format_of(path) if format is None else format
+    if fmt not in FORMATS:
+        raise ValueError(f"format = {fmt!r}: must be one of {', '.join(FORMATS)}")
+    if not (isinstance(length_unit, (int, float)) and not isinstance(length_unit, bool)
+            and math.isfinite(length_unit) and length_unit > 0):
+        raise ValueError(f"length_unit = {length_unit!r}: must be a number > 0 (metres per length unit of the file)")
+    if timestep is not None and fmt != "lammps-dump":
+        raise ValueError(f"timestep = {timestep!r}: only for LAMMPS dumps (format = 'lammps-dump')")
+    axes = None if periodic is None else _axes(periodic)
+    if not path.is_file():
+        raise ValueError(f"{path}: no such file")
+    reader = {"csv": _read_csv, "lammps-data": _read_data, "lammps-dump": _read_dump, "vtk": _read_vtk}[fmt]
+    try:
+        packing = reader(path, float(length_unit), timestep)
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{path}: cannot be read as text ({exc.reason} at byte {exc.start})") from None
+    if axes is not None:
+        packing = replace(packing, periodic=axes)
+    return _checked(packing, path, fmt)
+
+
+def _axes(periodic) -> tuple:
+    if isinstance(periodic, str):
+        if not set(periodic) <= set(AXES):
+            raise ValueError(f"periodic = {periodic!r}: must name axes among x, y, z (e.g. \"xy\")")
+        return tuple(a in periodic for a in AXES)
+    values = tuple(periodic)
+    if len(values) != 3 or not all(isinstance(v, (bool, np.bool_)) for v in values):
+        raise ValueError(f"periodic = {periodic!r}: must be axis letters (\"xyz\") or three true/false values")
+    return tuple(bool(v) for v in values)
+
+
+def _scaled(p: Packing, unit: float) -> Packing:
+    """``p`` with its lengths (and velocities) multiplied by ``unit``; densities are kg/m^3 already."""
+    if unit == 1.0:
+        return p
+    scale = {k: getattr(p, k) * unit for k in ("position", "radius", "velocity", "box_lo", "box_hi")
+             if getattr(p, k) is not None}
+    return replace(p, **scale)
+
+
+def _density_from_mass(mass: np.ndarray, radius_m: np.ndarray) -> np.ndarray:
+    """kg/m^3 of spheres of ``mass`` kg and radius ``radius_m`` m (how LAMMPS's atom_style sphere relates them)."""
+    return mass / (SPHERE_VOLUME * radius_m**3)
+
+
+def _checked(p: Packing, path, fmt: str) -> Packing:
+    """Checks that hold whatever the format: at least one particle, radii > 0, unique ids, a box that holds the
+    centres along its periodic axes."""
+    if p.n == 0:
+        raise ValueError(f"{path}: holds no particles")
+    bad = np.flatnonzero(~(p.radius > 0))
+    if bad.size:
+        k = int(bad[0])
+        raise ValueError(f"{path}: particle id {p.id[k]}: radius = {p.radius[k]:.9g} m: must be > 0")
+    unique, counts = np.unique(p.id, return_counts=True)
+    if np.any(counts > 1):
+        raise ValueError(f"{path}: id {unique[counts > 1][0]} is given to {counts[counts > 1][0]} particles; ids "
+                         "must be unique")
+    if np.any(p.id < 0):
+        raise ValueError(f"{path}: id {p.id[p.id < 0][0]}: ids must be >= 0")
+    if p.box_lo is not None and np.any(p.box_hi <= p.box_lo):
+        a = int(np.flatnonzero(p.box_hi <= p.box_lo)[0])
+        raise ValueError(f"{path}: box {AXES[a]}lo = {p.box_lo[a]:.9g} >= {AXES[a]}hi = {p.box_hi[a]:.9g}")
+    return replace(p, source=str(path), format=fmt)
+
+
+# A table of numbers is parsed at C speed (np.loadtxt); only a table that fails is read again, line by line, to name
+# the line and column of the first bad entry.
+def _table(path, text: str, first_line: int, names, widths, what: str, delimiter=None, usecols=None) -> np.ndarray:
+    """The numbers of ``text`` -- rows of ``delimiter``-separated entries (whitespace by default; blank lines and
+    ``#`` comments skipped) that start on the file's line ``first_line`` -- as an array (rows, columns): every row
+    has the same number of entries, one of ``widths`` (``what`` says which in an error); ``usecols``: only these
+    columns are converted (the others may hold words). ``names`` name the columns in errors."""
+    if not text.strip():
+        return np.empty((0, len(usecols) if usecols is not None else widths[0]))
+    try:
+        arr = np.loadtxt(io.StringIO(text), dtype=float, comments="#", delimiter=delimiter, ndmin=2, usecols=usecols,
+                         quotechar='"' if delimiter else None)
+    except ValueError:
+        arr = None
+    if arr is None or (usecols is None and arr.shape[1] not in widths) or not np.all(np.isfinite(arr)):
+        _locate(path, text, first_line, names, widths, what, delimiter, usecols)
+        raise FileError(path, "cannot be read as a table of numbers", first_line)  # _locate found nothing: unlikely
+    return arr
+
+
+def _data_lines(text: str, first_line: int):
+    """``(file line, entries text)`` of the lines of ``text`` that hold entries (not blank, not a comment)."""
+    for k, line in enumerate(text.split("\n")):
+        body = line.split("#")[0]
+        if body.strip():
+            yield first_line + k, body
+
+
+def _locate(path, text, first_line, names, widths, what, delimiter, usecols) -> None:
+    """Raise :class:`FileError` at the first row of ``text`` with a number of entries not in ``widths`` (or unlike
+    the first row's), or an entry (of ``usecols``) that is not a finite number."""
+    width = None
+    for line, body in _data_lines(text, first_line):
+        words = next(csv.reader([body])) if delimiter else body.split()
+        if len(words) not in widths or (width is not None and len(words) != width):
+            raise FileError(path, f"{len(words)} values; expected {what}", line)
+        width = len(words)
+        for c in (range(len(words)) if usecols is None else usecols):
+            word = words[c].strip()
+            try:
+                value = float(word)
+            except ValueError:
+                raise FileError(path, f"{word!r} is not a number", line, c + 1, names[c]) from None
+            if not math.isfinite(value):
+                raise FileError(path, f"{word!r}: must be finite", line, c + 1, names[c])
+
+
+def _row_line(text: str, first_line: int, row: int) -> int:
+    """The file line of row ``row`` of the table ``text`` (which starts on line ``first_line``)."""
+    for k, (line, _) in enumerate(_data_lines(text, first_line)):
+        if k == row:
+            return line
+    return first_line
+
+
+def _check_rows(path, bad: np.ndarray, text: str, first_line: int, column: int, name: str, message) -> None:
+    """Raise :class:`FileError` at the first row where ``bad`` holds, ``message(row)`` saying what is wrong."""
+    if np.any(bad):
+        row = int(np.flatnonzero(bad)[0])
+        raise FileError(path, message(row), _row_line(text, first_line, row), column, name)
+
+
+def _integers(path, values: np.ndarray, text: str, first_line: int, column: int, name: str) -> np.ndarray:
+    """The column ``values`` of the table ``text`` as integers; a fraction raises :class:`FileError`."""
+    _check_rows(path, values != np.round(values), text, first_line, column, name,
+                lambda row: f"{float(values[row])!r} is not an integer")
+    return values.astype(np.int64)
+
+
+def _header_line(text: str, start: int = 0) -> tuple[int, int, str]:
+    """``(offset after it, its line number, the line)`` of the first line of ``text`` that is neither blank nor a
+    ``#`` comment, from offset ``start`` (line numbers from 1 at offset 0); ``(-1, line, "")`` when there is none."""
+    line = text.count("\n", 0, start) + 1
+    while start < len(text):
+        end = text.find("\n", start)
+        end = len(text) if end < 0 else end
+        here = text[start:end]
+        if here.strip() and not here.lstrip().startswith("#"):
+            return end + 1, line, here
+        start, line = end + 1, line + 1
+    return -1, line, ""
+
+
+# ------------------------------------------------------------------------------------------------------ CSV
+CSV_ALIASES = {"points:0": "x", "points:1": "y", "points:2": "z"}
+CSV_NUMBERS = ("id", "x", "y", "z", "radius", "diameter", "temperature", "density")
+CSV_COLUMNS = CSV_NUMBERS + ("fixed", "material")
+TRUE, FALSE = ("true", "1", "yes", "t", "1.0"), ("false", "0", "no", "f", "", "0.0")
+
+
+def _read_csv(path: pathlib.Path, length_unit: float, _timestep=None) -> Packing:
+    text = path.read_text()
+    body_start, header_line, line = _header_line(text)
+    if body_start < 0:
+        raise FileError(path, "empty: needs a header row (x, y, z, radius, ...) and a row per particle")
+    header = [h.strip() for h in next(csv.reader([line]))]
+    names = [CSV_ALIASES.get(h.lower(), h.lower()) for h in header]
+    for k, name in enumerate(names):
+        if name in CSV_COLUMNS and names.index(name) != k:
+            raise FileError(path, f"column {header[k]!r} appears twice", header_line, k + 1)
+    size = "radius" if "radius" in names else "diameter"
+    missing = [c for c in ("x", "y", "z", size) if c not in names]
+    if missing:
+        raise FileError(path, f"no column {missing[0]!r} in the header ({', '.join(header)}); needs x, y, z and "
+                        "radius or diameter", header_line)
+    if "radius" in names and "diameter" in names:
+        raise FileError(path, "both radius and diameter columns: give one", header_line)
+    body, first = text[body_start:], header_line + 1
+    numeric = [k for k, name in enumerate(names) if name in CSV_NUMBERS]
+    what = f"{len(header)}, the columns of the header"
+    table = _table(path, body, first, header, (len(header),), what, ",", numeric)
+    if len(table) == 0:
+        raise FileError(path, "no particle rows after the header", header_line)
+    if body.count(",") != len(table) * (len(header) - 1):  # a row of another width (or commas in comments)
+        _locate(path, body, first, header, (len(header),), what, ",", numeric)
+    columns = {names[k]: table[:, j] for j, k in enumerate(numeric)}
+    position = np.column_stack([columns[a] for a in AXES])
+    radius = columns["radius"] if size == "radius" else 0.5 * columns["diameter"]
+    out = {key: columns[key] for key in ("temperature", "density") if key in columns}
+    ids = (_integers(path, columns["id"], body, first, names.index("id") + 1, header[names.index("id")])
+           if "id" in columns else np.arange(len(radius), dtype=np.int64))
+    for key in ("fixed", "material"):
+        if key in names:
+            k = names.index(key)
+            words = np.char.strip(np.loadtxt(io.StringIO(body), dtype=str, comments="#", delimiter=",", ndmin=2,
+                                             usecols=[k], quotechar='"')[:, 0])
+            out[key] = _csv_words(path, key, words, body, first, k + 1)
+    ignored = tuple(h for h, name in zip(header, names) if name not in CSV_COLUMNS)
+    return _scaled(Packing(ids, position, radius, ignored=ignored, **out), length_unit)
+
+
+def _csv_words(path, key: str, words: np.ndarray, body: str, first: int, column: int) -> np.ndarray:
+    """``fixed`` as bools; ``material`` as indices (all integers) or names."""
+    if key == "fixed":
+        lower = np.char.lower(words)
+        _check_rows(path, ~np.isin(lower, TRUE + FALSE), body, first, column, key,
+                    lambda row: f"{str(words[row])!r}: must be true or false (or 1, 0)")
+        return np.isin(lower, TRUE)
+    _check_rows(path, words == "", body, first, column, key, lambda row: "empty: a material index or name")
+    if all(re.fullmatch(r"[+-]?\d+", w) for w in words.tolist()):
+        index = words.astype(np.int64)
+        _check_rows(path, index < 0, body, first, column, key,
+                    lambda row: f"{str(words[row])!r}: a material index must be >= 0")
+        return index
+    return words
+
+
+# ------------------------------------------------------------------------------------------------ LAMMPS data
+DATA_SECTIONS = ("Atoms", "Velocities", "Masses", "Ellipsoids", "Lines", "Triangles", "Bodies", "Bonds", "Angles",
+                 "Dihedrals", "Impropers", "Pair Coeffs", "PairIJ Coeffs", "Bond Coeffs", "Angle Coeffs",
+                 "Dihedral Coeffs", "Improper Coeffs", "BondBond Coeffs", "BondAngle Coeffs",
+                 "MiddleBondTorsion Coeffs", "EndBondTorsion Coeffs", "AngleTorsion Coeffs", "AngleAngleTorsion Coeffs",
+                 "BondBond13 Coeffs", "AngleAngle Coeffs")
+# a section's keyword line (after the title line: the pattern starts with its newline, which re finds fast)
+SECTION_LINE = re.compile(r"\n[ \t]*(" + "|".join(DATA_SECTIONS) + r")[ \t]*(?:#([^\n]*))?(?=\r?\n|$)")
+SPHERE_COLUMNS = ("id", "type", "diameter", "density", "x", "y", "z", "ix", "iy", "iz")
+SPHERE_LAYOUT = "7 or 10 (atom_style sphere: id type diameter density x y z [ix iy iz])"
+VELOCITY_COLUMNS = ("id", "vx", "vy", "vz", "wx", "wy", "wz")
+UNITS_TITLE = re.compile(r"units\s*=\s*(\w+)")
+
+
+def _lammps_units(path, style: str | None, line: int, length_unit: float) -> tuple[float, float]:
+    """Metres per length unit and kg/m^3 per density unit of a LAMMPS file that records its unit ``style`` (on
+    ``line``), else ``(length_unit, 1)``."""
+    if style is None:
+        return length_unit, 1.0
+    if style not in LAMMPS_UNITS:
+        raise FileError(path, f"written in LAMMPS units {style}; packings are read in units {', '.join(LAMMPS_UNITS)} "
+                        "(granular models use si or cgs)", line)
+    if length_unit != 1.0:
+        raise FileError(path, f"records LAMMPS units {style} (converted from): leave length_unit at 1, not "
+                        f"{length_unit:g}", line)
+    return LAMMPS_UNITS[style]
+
+
+def _read_data(path: pathlib.Path, length_unit: float, _timestep=None) -> Packing:
+    text = path.read_text()
+    if not text.strip():
+        raise FileError(path, "empty: not a LAMMPS data file")
+    title = UNITS_TITLE.search(text[:text.find("\n") if "\n" in text else len(text)])
+    units = title.group(1) if title else None
+    length, density_unit = _lammps_units(path, units, 1, length_unit)
+    marks = list(SECTION_LINE.finditer(text))
+    sections = {}  # keyword: (its line, style comment, body text, the body's first line)
+    for m, after in zip(marks, marks[1:] + [None]):
+        line = text.count("\n", 0, m.start()) + 2
+        sections[m.group(1)] = (line, (m.group(2) or "").strip(), text[m.end():after.start() if after else None],
+                                line)
+    n_atoms, lo, hi = _data_header(path, text[:marks[0].start()] if marks else text)
+    if "Atoms" not in sections:
+        raise FileError(path, "no Atoms section")
+    start, style, body, first = sections["Atoms"]
+    if style and style.split()[0] != "sphere":
+        raise FileError(path, f"atom_style {style}: only atom_style sphere (id type diameter density x y z) is read",
+                        start)
+    atoms = _table(path, body, first, SPHERE_COLUMNS, (7, 10), SPHERE_LAYOUT)
+    if len(atoms) != n_atoms:
+        raise FileError(path, f"the Atoms section has {len(atoms)} lines but the header says {n_atoms} atoms", start)
+    ids = _integers(path, atoms[:, 0], body, first, 1, "id")
+    diameter = atoms[:, 2]
+    _check_rows(path, diameter <= 0, body, first, 3, "diameter",  # diameter 0: a LAMMPS point particle
+                lambda row: f"diameter = {float(diameter[row])!r}: must be > 0 (a sphere)")
+    out = {"material": _integers(path, atoms[:, 1], body, first, 2, "type") - 1,
+           "density": atoms[:, 3] * density_unit}
+    if atoms.shape[1] == 10:
+        out["image"] = np.column_stack([_integers(path, atoms[:, 7 + a], body, first, 8 + a, f"i{AXES[a]}")
+                                        for a in range(3)])
+    if "Velocities" in sections:
+        vstart, _, vbody, vfirst = sections["Velocities"]
+        v = _table(path, vbody, vfirst, VELOCITY_COLUMNS, (7,), "7 (atom_style sphere: id vx vy vz wx wy wz)")
+        vids = _integers(path, v[:, 0], vbody, vfirst, 1, "id")
+        order, where = np.argsort(ids), np.argsort(vids)
+        if len(vids) != len(ids) or np.any(ids[order] != vids[where]):
+            raise FileError(path, "the Velocities section must list every atom of the Atoms section once", vstart)
+        velocity, omega = np.empty((len(ids), 3)), np.empty((len(ids), 3))
+        velocity[order], omega[order] = v[where, 1:4], v[where, 4:7]
+        out.update(velocity=velocity, angular_velocity=omega)
+    packing = Packing(ids, atoms[:, 4:7], 0.5 * diameter, box_lo=lo, box_hi=hi, units=units, **out)
+    return _sorted(_scaled(packing, length), np.argsort(ids, kind="stable"))
+
+
+def _data_header(path, header: str) -> tuple[int, np.ndarray, np.ndarray]:
+    """The atom count and the box bounds of a data file's header (the lines before its first section)."""
+    n_atoms, lo, hi = None, [None] * 3, [None] * 3
+    for k, line in enumerate(header.split("\n")[1:], start=2):
+        words = line.split("#")[0].split()
+        if len(words) == 2 and words[1] == "atoms":
+            n_atoms = int(_integers(path, _table(path, words[0], k, ("atoms",), (1,), "1")[0], words[0], k, 1,
+                                    "atoms")[0])
+        elif len(words) == 4 and words[2][1:] == "lo" and words[3][1:] == "hi" and words[2][0] in AXES:
+            a = AXES.index(words[2][0])
+            lo[a], hi[a] = _table(path, " ".join(words[:2]), k, (words[2], words[3]), (2,), "2")[0]
+        elif len(words) == 6 and words[3:] == ["xy", "xz", "yz"]:
+            if np.any(_table(path, " ".join(words[:3]), k, ("xy", "xz", "yz"), (3,), "3") != 0):
+                raise FileError(path, "a triclinic box (tilt factors xy xz yz not zero): only orthogonal boxes are "
+                                "read", k)
+        elif words and words[0] in ("avec", "bvec", "cvec", "abc"):
+            raise FileError(path, "a general triclinic box: only orthogonal boxes are read", k)
+    if n_atoms is None:
+        raise FileError(path, "no 'N atoms' line in the header: not a LAMMPS data file")
+    if any(v is None for v in lo):
+        a = next(a for a in range(3) if lo[a] is None)
+        raise FileError(path, f"no '{AXES[a]}lo {AXES[a]}hi' line in the header")
+    return n_atoms, np.array(lo, dtype=float), np.array(hi, dtype=float)
+
+
+def _sorted(p: Packing, order: np.ndarray) -> Packing:
+    arrays = {k: getattr(p, k)[order] for k in ("id", "position", "radius", "temperature", "fixed", "material",
+                                                 "density", "velocity", "angular_velocity", "image")
+              if getattr(p, k) is not None}
+    return replace(p, **arrays)
+
+
+# ------------------------------------------------------------------------------------------------ LAMMPS dump
+DUMP_POSITIONS = (("x", "y", "z"), ("xu", "yu", "zu"), ("xs", "ys", "zs"), ("xsu", "ysu", "zsu"))
+DUMP_TEMPERATURE = ("temperature", "temp", "f_temp", "f_temperature")
+
+
+def _read_dump(path: pathlib.Path, length_unit: float, timestep: int | None) -> Packing:
+    with path.open("rb") as fh:
+        try:
+            data = mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
+        except ValueError:  # an empty file cannot be mapped
+            raise FileError(path, "empty: not a LAMMPS dump") from None
+    with data:
+        starts = _frame_starts(data)
+        if not starts:
+            raise FileError(path, "no 'ITEM: TIMESTEP' line: not a LAMMPS dump")
+        steps = [_frame_step(path, data, s) for s in starts]
+        if timestep is None:
+            pick = len(starts) - 1
+        elif timestep in steps:
+            pick = steps.index(timestep)
+        else:
+            listed = ", ".join(map(str, steps[:10])) + (", ..." if len(steps) > 10 else "")
+            raise ValueError(f"{path}: timestep = {timestep}: not in the dump (its timesteps: {listed})")
+        begin = starts[pick]
+        end = starts[pick + 1] if pick + 1 < len(starts) else len(data)
+        first_line = data[:begin].count(b"\n") + 1
+        before = data.rfind(b"ITEM: UNITS", 0, begin)  # LAMMPS writes it once, before the first snapshot
+        units, unit_line = None, None
+        if before >= 0:
+            unit_line = data[:before].count(b"\n") + 2
+            units = data[before:begin].split(b"\n")[1].decode().strip()
+        scales = _lammps_units(path, units, unit_line, length_unit)
+        frame = data[begin:end].decode()
+    return _parse_frame(path, frame, first_line, steps[pick], units, scales)
+
+
+def _frame_starts(data) -> list[int]:
+    out, k = [], data.find(b"ITEM: TIMESTEP")
+    while k >= 0:
+        if k == 0 or data[k - 1:k] == b"\n":
+            out.append(k)
+        k = data.find(b"ITEM: TIMESTEP", k + 1)
+    return out
+
+
+def _frame_step(path, data, start: int) -> int:
+    end = data.find(b"\n", data.find(b"\n", start) + 1)
+    text = data[start:end if end >= 0 else len(data)].decode(errors="replace").split("\n")
+    line = data[:start].count(b"\n") + 2
+    if len(text) < 2 or not re.fullmatch(r"\s*\d+\s*", text[1]):
+        raise FileError(path, f"ITEM: TIMESTEP: {text[1].strip() if len(text) > 1 else ''!r} is not a timestep",
+                        line)
+    return int(text[1])
+
+
+def _parse_frame(path, frame: str, first_line: int, step: int, units: str | None, scales) -> Packing:
+    atoms_at = frame.find("ITEM: ATOMS")
+    if atoms_at < 0:
+        raise FileError(path, f"timestep {step}: no 'ITEM: ATOMS' line", first_line)
+    head = frame[:atoms_at].split("\n")
+    items = {line[5:].strip().split(" ")[0]: k for k, line in enumerate(head) if line.startswith("ITEM:")}
+    if "NUMBER" not in items or "BOX" not in items:
+        missing = "NUMBER OF ATOMS" if "NUMBER" not in items else "BOX BOUNDS"
+        raise FileError(path, f"timestep {step}: no 'ITEM: {missing}' line", first_line)
+    k = items["NUMBER"] + 1
+    n = int(_integers(path, _table(path, head[k], first_line + k, ("atoms",), (1,), "1")[0], head[k],
+                      first_line + k, 1, "atoms")[0])
+    lo, hi, periodic = _dump_box(path, head, items["BOX"], first_line)
+    header_end = frame.find("\n", atoms_at)
+    header_end = len(frame) if header_end < 0 else header_end
+    names = frame[atoms_at:header_end].split()[2:]
+    atoms_line = first_line + frame.count("\n", 0, atoms_at)
+    body_end = frame.find("\nITEM:", header_end)  # the next snapshot's UNITS or TIME lines, if any
+    body = frame[header_end + 1:body_end + 1 if body_end >= 0 else None]
+    table = _table(path, body, atoms_line + 1, names, (len(names),), f"{len(names)}, the columns of ITEM: ATOMS")
+    if len(table) != n:
+        raise FileError(path, f"timestep {step}: {len(table)} atom lines, but ITEM: NUMBER OF ATOMS says {n}",
+                        atoms_line)
+    keys = [name.lower() for name in names]
+
+    def col(name, integer=False):
+        k = keys.index(name)
+        return _integers(path, table[:, k], body, atoms_line + 1, k + 1, names[k]) if integer else table[:, k]
+
+    length, density_unit = scales
+    position_names = next((c for c in DUMP_POSITIONS if all(a in keys for a in c)), None)
+    if position_names is None:
+        raise FileError(path, f"no position columns in ITEM: ATOMS ({' '.join(names)}); needs x y z (or xu yu zu, "
+                        "xs ys zs, xsu ysu zsu)", atoms_line)
+    if "radius" not in keys and "diameter" not in keys:
+        raise FileError(path, f"no radius or diameter column in ITEM: ATOMS ({' '.join(names)})", atoms_line)
+    position = np.column_stack([col(a) for a in position_names])
+    if position_names[0].startswith("xs"):
+        position = lo + position * (hi - lo)
+    out = {}
+    if position_names[0].endswith("u") and periodic is not None:  # unwrapped: into the box along periodic axes
+        shift = np.floor((position - lo) / (hi - lo))
+        shift[:, ~np.array(periodic)] = 0
+        position = position - shift * (hi - lo)
+        out["image"] = shift.astype(np.int64)
+    elif all(a in keys for a in ("ix", "iy", "iz")):
+        out["image"] = np.column_stack([col(a, True) for a in ("ix", "iy", "iz")])
+    radius = col("radius") if "radius" in keys else 0.5 * col("diameter")
+    ids = col("id", True) if "id" in keys else np.arange(n, dtype=np.int64)
+    if "type" in keys:
+        out["material"] = col("type", True) - 1
+    if "density" in keys:
+        out["density"] = col("density") * density_unit
+    elif "mass" in keys:
+        mass_unit = density_unit * length**3 if units is not None else 1.0  # kg per mass unit of the file
+        out["density"] = _density_from_mass(col("mass") * mass_unit, radius * length)
+    temperature = next((t for t in DUMP_TEMPERATURE if t in keys), None)
+    if temperature is not None:
+        out["temperature"] = col(temperature)
+    if all(v in keys for v in ("vx", "vy", "vz")):
+        out["velocity"] = np.column_stack([col(v) for v in ("vx", "vy", "vz")])
+    if all(w in keys for w in ("omegax", "omegay", "omegaz")):
+        out["angular_velocity"] = np.column_stack([col(w) for w in ("omegax", "omegay", "omegaz")])
+    read = set(position_names) | {"radius", "diameter", "id", "type", "density", "mass", temperature, "ix", "iy", "iz",
+                                  "vx", "vy", "vz", "omegax", "omegay", "omegaz"}
+    ignored = tuple(name for name, key in zip(names, keys) if key not in read)
+    packing = Packing(ids, position, radius, box_lo=lo, box_hi=hi, periodic=periodic, timestep=step, units=units,
+                      ignored=ignored, **out)
+    return _sorted(_scaled(packing, length), np.argsort(ids, kind="stable"))
+
+
+def _dump_box(path, head: list, k: int, first_line: int):
+    """Bounds and periodic axes (``pp`` flags; None when the dump gives no flags) of ``ITEM: BOX BOUNDS`` on the
+    snapshot's line ``k``."""
+    box_head = head[k].split()[3:]
+    if box_head and box_head[0] == "abc":
+        raise FileError(path, "a general triclinic box: only orthogonal boxes are read", first_line + k)
+    flags = [w for w in box_head if w not in ("xy", "xz", "yz")]
+    tilted = len(flags) != len(box_head)
+    width = 3 if tilted else 2
+    bounds = np.empty((3, width))
+    for a in range(3):
+        j = k + 1 + a
+        text = head[j] if j < len(head) else ""
+        if not text.strip():
+            raise FileError(path, f"no box bounds of {AXES[a]} (ITEM: BOX BOUNDS is followed by one line per axis)",
+                            first_line + j)
+        bounds[a] = _table(path, text, first_line + j, (f"{AXES[a]}lo", f"{AXES[a]}hi", "tilt"), (width,),
+                           f"{width}, the bounds of {AXES[a]}{' and a tilt factor' if tilted else ''}")[0]
+    if tilted and np.any(bounds[:, 2] != 0):
+        raise FileError(path, "a triclinic box (tilt factors not zero): only orthogonal boxes are read",
+                        first_line + k)
+    periodic = tuple(f == "pp" for f in flags) if len(flags) == 3 else None
+    return bounds[:, 0], bounds[:, 1], periodic
+
+
+# ------------------------------------------------------------------------------------------------------ VTK
+VTK_FIELDS = {"radius": ("radius", "radii"), "diameter": ("diameter", "diameters"), "id": ("id", "ids"),
+              "temperature": ("temperature", "temp", "f_temp"), "fixed": ("fixed",),
+              "material": ("material", "materialid"), "type": ("type",), "density": ("density",), "mass": ("mass",),
+              "velocity": ("velocity", "v", "linvelvec"), "angular_velocity": ("angular_velocity", "omega",
+                                                                               "angvelvec")}
+
+
+def _read_vtk(path: pathlib.Path, length_unit: float, _timestep=None) -> Packing:
+    import pyvista as pv
+    from vtkmodules.vtkCommonCore import vtkLogger
+
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)  # a bad file: our one line, not VTK's log
+    with warnings.catch_warnings(record=True) as caught:  # pyvista reports a reader's error as a warning
+        warnings.simplefilter("always")
+        try:
+            mesh = pv.read(str(path))
+        except Exception as exc:  # VTK's readers raise many kinds; the file is what is wrong
+            raise ValueError(f"{path}: cannot be read as VTK ({' '.join(str(exc).split())})") from None
+    if mesh is None or not hasattr(mesh, "point_data") or mesh.n_points == 0:
+        if caught:
+            raise ValueError(f"{path}: cannot be read as VTK ({' '.join(str(caught[0].message).split())})")
+        raise ValueError(f"{path}: holds no points (a VTK point set: the particle centres, with a radius or diameter "
+                         "point field)")
+    fields = {name.lower(): name for name in mesh.point_data.keys()}
+
+    def get(key, components=1):
+        name = next((fields[a] for a in VTK_FIELDS[key] if a in fields), None)
+        if name is None:
+            return None
+        values = np.asarray(mesh.point_data[name])
+        shape = (mesh.n_points,) if components == 1 else (mesh.n_points, components)
+        if values.shape != shape:
+            raise ValueError(f"{path}: point field {name!r} has shape {values.shape}, expected {shape}")
+        if values.dtype.kind == "f" and not np.all(np.isfinite(values)):
+            k = int(np.flatnonzero(~np.isfinite(values.reshape(mesh.n_points, -1)).any(axis=1))[0])
+            raise ValueError(f"{path}: point field {name!r}: point {k} = {values[k]}: must be finite")
+        used.add(name)
+        return values
+
+    used: set = set()
+    radius = get("radius")
+    if radius is None:
+        diameter = get("diameter")
+        if diameter is None:
+            raise ValueError(f"{path}: no radius or diameter point field (fields: "
+                             f"{', '.join(mesh.point_data.keys()) or 'none'})")
+        radius = 0.5 * diameter
+    radius = radius.astype(float)
+    out = {}
+    ids = get("id")
+    for key in ("temperature", "density"):
+        v = get(key)
+        if v is not None:
+            out[key] = v.astype(float)
+    fixed = get("fixed")
+    if fixed is not None:
+        out["fixed"] = fixed.astype(bool)
+    material, type_ = get("material"), get("type")
+    if material is not None:
+        out["material"] = _whole(path, material, "material")
+    elif type_ is not None:
+        out["material"] = _whole(path, type_, "type") - 1
+    mass = get("mass")
+    if "density" not in out and mass is not None:
+        out["density"] = _density_from_mass(mass.astype(float), radius * length_unit)
+    for key in ("velocity", "angular_velocity"):
+        v = get(key, 3)
+        if v is not None:
+            out[key] = v.astype(float)
+    points = np.asarray(mesh.points, dtype=float)
+    ids = np.arange(len(radius), dtype=np.int64) if ids is None else _whole(path, ids, "id")
+    ignored = tuple(name for name in mesh.point_data.keys() if name not in used)
+    return _scaled(Packing(ids, points, radius, ignored=ignored, **out), length_unit)
+
+
+def _whole(path, values: np.ndarray, name: str) -> np.ndarray:
+    if values.dtype.kind == "f" and np.any(values != np.round(values)):
+        k = int(np.flatnonzero(values != np.round(values))[0])
+        raise ValueError(f"{path}: point field {name!r}: point {k} = {values[k]!r}: must be an integer")
+    return np.round(values).astype(np.int64)
+
+
+# ----------------------------------------------------------------------------------------------------- scenes
+SCENE_KEYS = ("file", "format", "length_unit", "timestep")  # [particles] keys of a packing file
+DENSITY_RTOL = 1e-3  # a file's density against its material's: printed digits (LAMMPS dumps: 6) pass, a mix-up fails
+
+
+def scene_particles(table: dict, materials, base_dir=None):
+    """``[particles] file = "..."`` of a scene: the :class:`dem.geometry.particles.Particles` of the file (``format``,
+    ``length_unit``, ``timestep`` as for :func:`read_packing`; the path relative to ``base_dir``, the scene's folder)
+    and the file's box as a :class:`dem.geometry.periodic.PeriodicBox` (periodic along the axes the file says are, none where
+    it cannot say), or None. ``temperature`` (a number or a list), ``fixed``, ``material`` (a name or index, or a
+    list of them) and ``heat`` come from the table where given, else from the file; a density the file gives must be
+    its material's."""
+    from dem.geometry.particles import Particles, material_indices
+
+    name = table["file"]
+    if not isinstance(name, str):
+        raise ValueError(f"[particles] file = {name!r}: must be a path (string)")
+    for key in ("position", "radius"):
+        if key in table:
+            raise ValueError(f"[particles] {key}: the particles come from file = {name!r}; give one or the other")
+    options = {k: table[k] for k in ("format", "length_unit", "timestep") if k in table}
+    if "timestep" in options and (not isinstance(options["timestep"], int) or isinstance(options["timestep"], bool)):
+        raise ValueError(f"[particles] timestep = {options['timestep']!r}: must be an integer (a dump's timestep)")
+    path = pathlib.Path(base_dir) / name if base_dir is not None else pathlib.Path(name)
+    try:
+        packing = read_packing(path, **options)
+    except ValueError as exc:
+        raise ValueError(f"[particles] file: {exc}") from None
+    n = packing.n
+    values = {}
+    for key in ("temperature", "fixed", "heat"):
+        value = table.get(key, getattr(packing, key, None))
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and key != "fixed":
+            value = np.full(n, float(value))
+        elif isinstance(value, bool) and key == "fixed":
+            value = np.full(n, value)
+        values[key] = value
+    if values["temperature"] is None:
+        raise ValueError(f"[particles] temperature: required (a number or a list); {name!r} has no temperature column")
+    if "material" not in table and packing.material is not None and packing.material.dtype.kind in "iu":
+        beyond = np.flatnonzero(packing.material >= len(materials))
+        if beyond.size:
+            k = int(beyond[0])
+            raise ValueError(f"[particles] file {name!r}: particle id {packing.id[k]} is of material "
+                             f"{packing.material[k]} (LAMMPS type {packing.material[k] + 1}) but the scene has "
+                             f"{len(materials)} material(s); give [[materials]] (LAMMPS type k is material k - 1) or "
+                             "[particles] material")
+    material = material_indices("[particles] material" if "material" in table else f"[particles] file {name!r}: "
+                                "material", table.get("material", packing.material), materials, n)
+    particles = Particles.from_arrays(packing.position, packing.radius, values["temperature"], materials, material,
+                                      values["fixed"], values["heat"], prefix="[particles]", id=packing.id)
+    if packing.density is not None:
+        expected = np.array([m.density for m in particles.materials])[particles.material]
+        off = np.flatnonzero(np.abs(packing.density - expected) > DENSITY_RTOL * expected)
+        if off.size:
+            k = int(off[0])
+            m = particles.materials[particles.material[k]]
+            raise ValueError(f"[particles] file {name!r}: particle id {packing.id[k]} has density "
+                             f"{packing.density[k]:.6g} kg/m^3 but its material {m.name!r} {m.density:.6g}; give the "
+                             "material that density (with [[materials]] for several: LAMMPS type k is material k - 1)")
+    box = packing.periodic_box() if packing.box_lo is not None else None
+    return particles, box
+
+
+# --------------------------------------------------------------------------------------------------- writing
+def packing_from_particles(particles, box=None) -> Packing:
+    """A :class:`Packing` of a scene's :class:`dem.geometry.particles.Particles` (densities from its materials) in the
+    periodic box ``box`` (:class:`dem.geometry.periodic.PeriodicBox`) or none."""
+    density = np.array([m.density for m in particles.materials], dtype=float)[particles.material]
+    lo = hi = periodic = None
+    if box is not None:
+        lo, hi, periodic = box.origin, box.origin + box.lengths, tuple(box.periodic)
+    return Packing(particles.id, particles.position, particles.radius, particles.temperature, particles.fixed,
+                   particles.material, density, box_lo=lo, box_hi=hi, periodic=periodic)
+
+
+def packing_from_state(state: dict) -> Packing:
+    """A :class:`Packing` of a saved moving state (:func:`dem.scene.state_file.load`): positions, radii, temperatures,
+    velocities and angular velocities; the density is the one that gives each particle its saved mass as a sphere
+    (``m / (4/3 pi r^3)``, also what LAMMPS computes the mass from). 3D states only: a 2D state's disks lie in the
+    x-z plane with a height, which LAMMPS's 2D spheres (x-y plane) do not have."""
+    if int(state["dimension"]) != 3:
+        raise ValueError("state: a 2D state (disks in the x-z plane): only 3D states can be written as packings")
+    radius = np.asarray(state["radius"], dtype=float)
+    ids = state["id"] if "id" in state else np.arange(len(radius), dtype=np.int64)
+    return Packing(np.asarray(ids, dtype=np.int64), np.asarray(state["x"], dtype=float), radius,
+                   np.asarray(state["T"], dtype=float), density=state["mass"] / (SPHERE_VOLUME * radius**3),
+                   velocity=np.asarray(state["v"], dtype=float), angular_velocity=np.asarray(state["w"], dtype=float))
+
+
+def lammps_ids(ids: np.ndarray) -> np.ndarray:
+    """The atom ids a packing gets in LAMMPS, which numbers atoms from 1: its own ids where all are >= 1, else its
+    ids + 1 (this toolkit numbers particles from 0)."""
+    ids = np.asarray(ids, dtype=np.int64)
+    return ids if ids.min() >= 1 else ids + 1 - min(int(ids.min()), 0)
+
+
+def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) -> pathlib.Path:
+    """Write ``packing`` as a LAMMPS data file of ``atom_style sphere`` (``units si``): the header (atoms, atom
+    types, box), ``Atoms # sphere`` (``id type diameter density x y z ix iy iz``) and, where the packing has
+    velocities, ``Velocities`` (``id vx vy vz wx wy wz``). Ids from :func:`lammps_ids`; type = material index + 1
+    (names: their order of appearance); ``density`` kg/m^3 (one number or per particle) where the packing has none.
+    The box is the packing's, or the particles' bounding box grown by ``pad`` (m) beyond the largest radius; the
+    periodicity is not part of a data file: the input script's ``boundary`` command sets it. Numbers are written
+    to round-trip (the shortest digits that read back to the same double)."""
+    path = pathlib.Path(path)
+    n = packing.n
+    if packing.density is not None:
+        rho = np.asarray(packing.density, dtype=float)
+    elif density is not None:
+        rho = np.broadcast_to(np.asarray(density, dtype=float), (n,))
+    else:
+        raise ValueError(f"{path.name}: a LAMMPS data file needs each particle's density: give density (kg/m^3)")
+    if not np.all(np.isfinite(rho) & (rho > 0)):
+        k = int(np.flatnonzero(~(np.isfinite(rho) & (rho > 0)))[0])
+        raise ValueError(f"density[{k}] = {rho[k]!r}: must be a finite number > 0 (kg/m^3)")
+    types = _types(packing.material, n)
+    x, r = packing.position, packing.radius
+    if packing.box_lo is not None:
+        lo, hi = packing.box_lo, packing.box_hi
+    else:
+        lo, hi = (x - r[:, None]).min(axis=0) - pad, (x + r[:, None]).max(axis=0) + pad
+    image = packing.image if packing.image is not None else np.zeros((n, 3), dtype=np.int64)
+    ids = lammps_ids(packing.id)
+    lo, hi = (np.asarray(b, dtype=float).tolist() for b in (lo, hi))
+    head = [f"LAMMPS data file of {n} spheres written by sinterheat (dem.scene.packing_files), units = si", "",
+            f"{n} atoms", f"{int(types.max())} atom types", ""]
+    head += [f"{lo[a]!r} {hi[a]!r} {c}lo {c}hi" for a, c in enumerate(AXES)]
+    parts = ["\n".join(head + ["", "Atoms # sphere", ""]) + "\n",
+             _rows_text([ids, types, 2.0 * r, rho, *x.T, *np.asarray(image).T], " ")]
+    if packing.velocity is not None:
+        w = packing.angular_velocity if packing.angular_velocity is not None else np.zeros((n, 3))
+        parts += ["\nVelocities\n\n", _rows_text([ids, *packing.velocity.T, *w.T], " ")]
+    _write_text(path, parts)
+    return path
+
+
+def _rows_text(columns, sep: str, chunk: int = 100_000):
+    """The rows of ``columns`` (arrays of one length) as lines of text, ``chunk`` rows per string yielded: floats as
+    the shortest digits that read back to the same double (``repr``), integers as they are, bools as true/false."""
+    columns = [np.asarray(c) for c in columns]
+    for start in range(0, len(columns[0]), chunk):
+        words = []
+        for column in (c[start:start + chunk] for c in columns):
+            if column.dtype.kind == "b":
+                words.append(np.where(column, "true", "false").tolist())
+            else:
+                words.append(list(map(repr if column.dtype.kind == "f" else str, column.tolist())))
+        yield "\n".join(map(sep.join, zip(*words))) + "\n"
+
+
+def _types(material, n: int) -> np.ndarray:
+    if material is None:
+        return np.ones(n, dtype=np.int64)
+    material = np.asarray(material)
+    if material.dtype.kind in "iu":
+        return material.astype(np.int64) + 1
+    names = list(dict.fromkeys(material.tolist()))
+    return np.array([names.index(m) + 1 for m in material.tolist()], dtype=np.int64)
+
+
+def write_csv(path, packing: Packing) -> pathlib.Path:
+    """Write ``packing`` as CSV (``id, x, y, z, radius`` and its optional columns), numbers that read back to the
+    same doubles."""
+    path = pathlib.Path(path)
+    columns = {"id": packing.id, "x": packing.position[:, 0], "y": packing.position[:, 1],
+               "z": packing.position[:, 2], "radius": packing.radius}
+    for key in ("temperature", "fixed", "material", "density"):
+        if getattr(packing, key) is not None:
+            columns[key] = getattr(packing, key)
+    names = np.asarray(columns.get("material", [])).tolist()
+    if any("," in str(name) or '"' in str(name) for name in names):
+        raise ValueError(f"{path.name}: material names with commas or quotes cannot be written as CSV")
+    _write_text(path, [",".join(columns) + "\n", _rows_text(list(columns.values()), ",")])
+    return path
+
+
+def write_vtu(path, packing: Packing) -> pathlib.Path:
+    """Write ``packing`` as a VTU point set (vertex cells) with the point fields ``id``, ``radius`` and its
+    optional ones: what ParaView opens and :func:`read_packing` reads back."""
+    import meshio
+
+    from dem.output.writer import write_vtu as write_whole
+
+    fields = {"id": packing.id, "radius": packing.radius}
+    for key in ("temperature", "density", "velocity", "angular_velocity"):
+        if getattr(packing, key) is not None:
+            fields[key] = getattr(packing, key)
+    if packing.fixed is not None:
+        fields["fixed"] = packing.fixed.astype(np.int8)
+    if packing.material is not None and np.asarray(packing.material).dtype.kind in "iu":
+        fields["material"] = np.asarray(packing.material, dtype=np.int32)
+    path = pathlib.Path(path)
+    write_whole(path, meshio.Mesh(packing.position, [("vertex", np.arange(packing.n).reshape(-1, 1))],
+                                  point_data=fields))
+    return path
+
+
+def _write_text(path: pathlib.Path, parts) -> None:
+    """Write the strings (or iterables of strings) ``parts`` to ``path``: aside, then renamed, so that a file on disk
+    is always whole."""
+    tmp = path.with_name(path.name + ".part")
+    with tmp.open("w") as fh:
+        for part in parts:
+            fh.writelines([part] if isinstance(part, str) else part)
+    tmp.replace(path)

@@ -1,0 +1,75 @@
+"""Sphinx configuration of the sinterheat documentation.
+
+Build (offline, warnings as errors): ``python -m sphinx -W -b html docs docs/_build`` after ``pip install '.[docs]'``.
+The pages are Markdown (MyST), so ``tests/test_console_blocks.py`` runs their console blocks as it runs the README's;
+the gallery is built by running every script of ``examples/`` (sphinx-gallery); the API reference is autodoc
+(napoleon) over the packages in ``api_packages``, and ``_ext/api_check.py`` fails the build when one of their public
+functions or classes is missing from it.
+"""
+
+import logging
+import pathlib
+import sys
+
+DOCS = pathlib.Path(__file__).resolve().parent
+sys.path.insert(0, str(DOCS / "_ext"))  # the local extensions (api_check, gallery_order)
+logging.getLogger("skfem").setLevel(logging.WARNING)  # its INFO lines (each assembly) would flood the build log
+
+project = "sinterheat"
+author = "the sinterheat authors"
+copyright = "the sinterheat authors"
+
+extensions = [
+    "myst_parser",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.napoleon",
+    "sphinx.ext.mathjax",
+    "sphinx.ext.viewcode",
+    "sphinx_gallery.gen_gallery",
+    "sphinx_copybutton",
+    "api_check",
+]
+
+source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "gallery/*.ipynb", "gallery/*.py"]
+
+# MyST: $...$ and $$...$$ maths, heading anchors for [text](page.md#heading) links
+myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
+myst_heading_anchors = 3
+myst_dmath_double_inline = True
+
+# Every cross-reference must resolve (a broken one is a warning, so an error under -W). Names of other projects
+# (numpy, scipy, skfem ...) are not linked: the build is offline, without intersphinx.
+nitpicky = True
+nitpick_ignore_regex = [
+    (r"py:.*", r"(np|numpy|scipy|skfem|meshio|pyvista|gmsh|argparse|pathlib|concurrent|typing|collections)\b.*"),
+    (r"py:.*", r"(optional|callable|array|array_like|array-like|ndarray|sequence|iterable|mapping|path|object)"),
+]
+
+autodoc_default_options = {"undoc-members": True, "member-order": "bysource"}  # each automodule says :members:
+autodoc_typehints = "description"
+autodoc_typehints_format = "short"
+autodoc_preserve_defaults = True
+napoleon_google_docstring = False
+napoleon_numpy_docstring = True
+
+# The packages whose every public function and class must appear in the API reference (api_check).
+api_packages = ["fem_neck", "sinterheat"]
+
+sphinx_gallery_conf = {
+    "examples_dirs": str(DOCS.parent / "examples"),
+    "gallery_dirs": "gallery",
+    "filename_pattern": r"\.py$",  # run every example (the default runs only plot_*.py)
+    "within_subsection_order": "gallery_order.ExampleOrder",
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "show_signature": False,
+    "only_warn_on_example_error": False,  # an example that raises fails the build
+    "min_reported_time": 0,
+}
+
+html_theme = "furo"
+html_title = "sinterheat"
+html_static_path = []
+copybutton_prompt_text = "$ "
+copybutton_only_copy_prompt_lines = False
