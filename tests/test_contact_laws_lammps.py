@@ -29,7 +29,7 @@ import numpy as np
 import pytest
 
 from benchmarks.mechanics import lammps_command
-from dem.engines.verlet.engine import Simulation
+from dem.engines.verlet.engine import VerletEngine
 from dem.scene import parse_scene
 from test_hertz_mindlin import spheres_in_a_box
 
@@ -97,7 +97,7 @@ def run_ours(contact, x, r, v, w, dt, steps, walls=(), gravity=None):
            "walls": list(walls)}
     if gravity is not None:
         doc["gravity"] = {"acceleration": list(gravity)}
-    sim = Simulation(parse_scene(doc))
+    sim = VerletEngine(parse_scene(doc))
     sim.mechanics.advance(steps, np.array([20.0]), np.zeros(1))
     s = sim.mechanics.state
     return {"x": s.x.copy(), "v": s.v.copy(), "w": s.w.copy()}

@@ -11,7 +11,7 @@ import pytest
 from scipy.optimize import brentq, minimize_scalar
 
 from dem.driver import run
-from dem.engines.verlet.engine import Simulation
+from dem.engines.verlet.engine import VerletEngine
 from dem.laws.contact import jkr
 from dem.scene import parse_scene, state_file
 from test_hertz_mindlin import DENSITY, E_STAR, MATERIAL, contact, head_on, run_recording, scene_doc, sphere_mass
@@ -127,7 +127,7 @@ def adhered_pair(speed, dt_per_period=400, t_end=2e-3):
     """The pair of :func:`adhered_doc` as a simulation, its R*, a_0 and delta_0."""
     r_eff = R / 2
     a0, _ = radii(r_eff)
-    return Simulation(parse_scene(adhered_doc(speed, dt_per_period, t_end))), r_eff, a0, a0 * a0 / (3 * r_eff)
+    return VerletEngine(parse_scene(adhered_doc(speed, dt_per_period, t_end))), r_eff, a0, a0 * a0 / (3 * r_eff)
 
 
 def _work_to_part(r_eff):
@@ -196,7 +196,7 @@ def test_a_run_continued_from_its_state_keeps_a_stretched_contact_and_ends_as_th
     assert 2 * R - (saved["x"][1, 0] - saved["x"][0, 0]) < 0 and saved["p_hist"][0, 3] > 0
     continued = {k: v for k, v in doc.items() if k != "particles"}
     continued.update(start={"state": str(tmp_path / "first" / "state.npz")},
-                     solver={**doc["solver"], "t_end": rest * dt})
+                     solver={**doc["solver"], "t_end": (first + rest) * dt})  # the clock goes on from the state
     run(parse_scene(continued), out=tmp_path / "continued")
     run(parse_scene({**doc, "solver": {**doc["solver"], "t_end": (first + rest) * dt}}), out=tmp_path / "whole")
     a, b = (state_file.load(tmp_path / name / "state.npz") for name in ("continued", "whole"))
@@ -225,7 +225,7 @@ def test_a_sphere_hangs_from_a_ceiling_while_its_weight_is_below_the_pull_off_fo
     doc = scene_doc([[0, 0, -(R - delta)]], [R], contact=jkr_contact(restitution=0.3), t_end=0.01,
                     walls=[{"name": "ceiling", "point": [0, 0, 0], "normal": [0, 0, -1]}],
                     gravity={"acceleration": [0.0, 0.0, -g]})
-    sim = Simulation(parse_scene(doc))
+    sim = VerletEngine(parse_scene(doc))
     sim.mechanics.w_hist[0, 0, 3] = jkr.pulloff_distance(R, sim.mechanics.params)  # in contact from the start
     sim.run()
     z = sim.mechanics.state.x[0, 2]
@@ -241,7 +241,7 @@ def test_a_skin_below_the_pull_off_distance_is_refused():
     doc = scene_doc([[0, 0, 0], [2.1e-3, 0, 0]], [R, R], contact=jkr_contact())
     doc["solver"]["skin"] = 1e-8
     with pytest.raises(ValueError, match=r"\[solver\] skin = 1e-08 m: must exceed .* pull-off distance"):
-        Simulation(parse_scene(doc))
+        VerletEngine(parse_scene(doc))
 
 
 @pytest.mark.parametrize("value, message", [(0.0, "must be > 0"), (-1.0, "must be > 0"),
