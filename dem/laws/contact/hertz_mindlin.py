@@ -207,6 +207,16 @@ PAIR_HISTORY = ("xi_x", "xi_y", "xi_z")  # the tangential spring
 WALL_HISTORY = PAIR_HISTORY
 PARTICLE_STATE = ("mass",)  # each particle's mass (kg): the damping needs m*
 SPINS = True
+SCHEMA_ROWS = (  # the scene keys of the material (dem.scene.schema): keys, type and unit, meaning
+    (("youngs_modulus", "poisson_ratio"), "Pa, -; required, E > 0, -1 < ν < 0.5",
+     "E and ν of the particles and the walls: Hertz's F = 4/3 E* √R* δ^(3/2), E* = E/(2(1 - ν²)) (Johnson 1985, "
+     "Sec. 4.2); Mindlin's tangential stiffness 8 G* a, G* = G/(2(2 - ν))"),
+    (("restitution",), "0 < e ≤ 1, required", "the coefficient of restitution of a head-on collision, at every "
+     "impact speed: Tsuji's damping η_n = α √(m* k_n) with α from e (Antypov & Elliott 2011)"),
+    (("tangential_damping",), "≥ 0, required", "η_t/η_n, the damping of the tangential spring"),
+    (("mu", "mu_wall"), "≥ 0, required", "particle-particle and particle-wall Coulomb friction, ‖F_t‖ ≤ μ F_n"),
+    (("density",), "kg/m³, the `[material]` density", "particle density"),
+)
 DRAG = False
 
 

@@ -131,6 +131,17 @@ PAIR_HISTORY = ("xi_x", "xi_y", "xi_z", "pulloff")  # the tangential spring; the
 WALL_HISTORY = PAIR_HISTORY
 PARTICLE_STATE = hm.PARTICLE_STATE  # each particle's mass: the damping needs m*
 SPINS = True
+_JKR_ROWS = {  # where the meaning of a Hertz-Mindlin key differs with adhesion
+    ("restitution",): ("0 < e ≤ 1, required", "the coefficient of restitution of a head-on collision whose adhesion "
+                       "is negligible (slow ones stick)"),
+    ("mu", "mu_wall"): ("≥ 0, required", "particle-particle and particle-wall Coulomb friction, ‖F_t‖ ≤ μ (F_n + "
+                        "3πwR*) (Thornton & Yin 1991)"),
+}
+SCHEMA_ROWS = tuple((keys, *_JKR_ROWS.get(keys, (unit, meaning))) for keys, unit, meaning in hm.SCHEMA_ROWS) + (
+    (("work_of_adhesion",), "J/m², > 0, required", "w, the energy per area that parts the surfaces (twice the surface "
+     "energy of identical ones; LAMMPS's `jkr` takes the surface energy): pull-off force 3/2 πwR*, the contact "
+     "breaks 3/4 (π²w²R*/E*²)^(1/3) beyond touching (Johnson, Kendall & Roberts 1971)"),
+)
 DRAG = False
 initial_state = hm.initial_state
 reference_radius = hm.reference_radius
