@@ -5,12 +5,13 @@ and momentum conservation, and bad input."""
 
 import copy
 import math
+import re
 
 import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from dem.engines.verlet.engine import Simulation
+from dem.engines.verlet.engine import VerletEngine
 from dem.laws.contact import hertz_mindlin as hm
 from dem.scene import parse_scene
 
@@ -65,7 +66,7 @@ def head_on(law_contact, speed, r1=1e-3, r2=1e-3, steps=1000, dimension=3, heigh
                     t_end=gap / speed + 1.5 * t_c, dt=t_c / steps)
     if dimension == 2:
         doc["scene"].update(dimension=2, height=height)
-    return Simulation(parse_scene(doc))
+    return VerletEngine(parse_scene(doc))
 
 
 def run_recording(sim, n_steps=None):
@@ -194,7 +195,7 @@ def test_restitution_against_a_wall_and_between_disks():
     doc = scene_doc([[0, 0, r + 0.01 * r]], [r], [[0, 0, -speed]], contact(restitution=e),
                     t_end=0.01 * r / speed + 1.5 * t_c, dt=t_c / 1000,
                     walls=[{"name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]}])
-    sim = Simulation(parse_scene(doc))
+    sim = VerletEngine(parse_scene(doc))
     sim.run()
     assert sim.mechanics.state.v[0, 2] / speed == pytest.approx(e, abs=4e-4)
     disks = head_on(contact(restitution=e), speed, dimension=2, height=1e-3)
@@ -209,7 +210,7 @@ def _resting_sphere(r, material, v0=(0.0, 0.0, 0.0), t_end=0.01, g=9.81):
     doc = scene_doc([[0, 0, r - sag]], [r], [v0], material, t_end=t_end,
                     walls=[{"name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]}],
                     gravity={"acceleration": [0.0, 0.0, -g]})
-    return Simulation(parse_scene(doc)), sag
+    return VerletEngine(parse_scene(doc)), sag
 
 
 def test_a_sliding_sphere_decelerates_at_mu_g_and_rolls_on_at_five_sevenths_of_its_speed():
@@ -283,7 +284,7 @@ def _hertz_energy(sim):
 
 
 def test_energy_is_conserved_without_damping_or_friction():
-    sim = Simulation(parse_scene(_box_of_spheres(contact(restitution=1.0, mu=0.0, mu_wall=0.0))))
+    sim = VerletEngine(parse_scene(_box_of_spheres(contact(restitution=1.0, mu=0.0, mu_wall=0.0))))
     mech = sim.mechanics
     mech.dt /= 4  # a quarter of dt = "auto" (a tenth of the Rayleigh time)
     energy0 = _hertz_energy(sim)
@@ -293,7 +294,7 @@ def test_energy_is_conserved_without_damping_or_friction():
         collisions += len(mech.contacts()[0]) + len(mech.wall_contacts()[0])
         assert _hertz_energy(sim) == pytest.approx(energy0, rel=1e-5)
     assert collisions > 20  # contacts were caught in the middle of a collision
-    damped = Simulation(parse_scene(_box_of_spheres(contact(restitution=0.9, mu=0.0, mu_wall=0.0))))
+    damped = VerletEngine(parse_scene(_box_of_spheres(contact(restitution=0.9, mu=0.0, mu_wall=0.0))))
     damped.mechanics.advance(4000, T0, RATE)
     assert _hertz_energy(damped) < 0.99 * energy0  # the check can fail: damping loses energy
 
@@ -305,7 +306,7 @@ def test_momentum_and_angular_momentum_are_conserved_with_friction_and_damping()
     doc["particles"]["angular_velocity"] = rng.normal(0, 300.0, (30, 3)).tolist()
     x = np.array(doc["particles"]["position"])
     doc["particles"]["velocity"] = (0.3 * (4e-3 - x) / 4e-3 + rng.normal(0, 0.05, x.shape)).tolist()  # converge
-    sim = Simulation(parse_scene(doc))
+    sim = VerletEngine(parse_scene(doc))
     s = sim.mechanics.state
 
     def angular(state):
@@ -326,7 +327,7 @@ def test_momentum_and_angular_momentum_are_conserved_with_friction_and_damping()
 # ------------------------------------------------------------------------------------------ time step, input
 def test_auto_step_is_a_tenth_of_the_rayleigh_time_and_a_larger_step_is_refused():
     doc = scene_doc([[0, 0, 0], [2.1e-3, 0, 0]], [1e-3, 0.5e-3], contact=contact())
-    sim = Simulation(parse_scene(doc))
+    sim = VerletEngine(parse_scene(doc))
     G = MATERIAL["youngs_modulus"] / (2 * 1.3)
     rayleigh = math.pi * 0.5e-3 * math.sqrt(DENSITY / G) / (0.1631 * 0.3 + 0.8766)
     assert sim.mechanics.dt == pytest.approx(0.1 * rayleigh, rel=1e-14)
@@ -341,8 +342,6 @@ def test_auto_step_is_a_tenth_of_the_rayleigh_time_and_a_larger_step_is_refused(
     ({"restitution": 1.5}, r"\[contact\] restitution = 1.5: must be in \(0, 1\]"),
     ({"youngs_modulus": -1.0}, r"\[contact\] youngs_modulus = -1.0: must be > 0 \(Pa\)"),
     ({"mu": float("nan")}, r"\[contact\] mu = nan: must be a finite number"),
-    ({"gamma_n": 0.1}, r"\[contact\] gamma_n: not a parameter of law = \"hertz_mindlin\""),
-    ({"phases": [{"start": 0.0, "gamma_n": 0.1}]}, r"\[phases\] gamma_n: not a parameter of law = \"hertz_mindlin\""),
 ])
 def test_bad_material_is_refused_in_one_line_naming_the_key(change, message):
     phases = change.get("phases")
@@ -355,3 +354,26 @@ def test_bad_material_is_refused_in_one_line_naming_the_key(change, message):
     doc["contact"] = {k: v for k, v in contact().items() if k != "restitution"}
     with pytest.raises(ValueError, match=r"\[contact\] restitution: required"):
         parse_scene(doc)
+
+
+@pytest.mark.parametrize("law", ["hertz_mindlin", "jkr"])
+@pytest.mark.parametrize("where", ["contact", "phases"])
+def test_a_luding_key_is_refused_in_one_line_naming_the_law(law, where):
+    """A key of Luding's material (gamma_n, k1) in [contact] or in a phase of a Hertz-Mindlin or JKR scene: one line
+    naming the key, the scene's law and the law that does take it."""
+    material = contact(law, **({"work_of_adhesion": 0.1} if law == "jkr" else {}))
+    doc = scene_doc([[0, 0, 0], [2.1e-3, 0, 0]], [1e-3, 1e-3], contact=material)
+    for key, value in (("gamma_n", 0.1), ("k1", 1e5)):
+        bad = copy.deepcopy(doc)
+        if where == "contact":
+            bad["contact"][key] = value
+        else:
+            bad["phases"] = [{"start": 0.0, "mu": 0.2, key: value}]
+        with pytest.raises(ValueError) as raised:
+            parse_scene(bad)
+        prefix = r"\[contact\]" if where == "contact" else r"\[phases\]\[0\]"
+        assert re.fullmatch(rf'{prefix} {key}: not a parameter of law = "{law}" \(.*; {key} is one of law = "luding"\)',
+                            str(raised.value)), str(raised.value)
+    good = copy.deepcopy(doc)
+    good["phases"] = [{"start": 1e-4, "mu": 0.2, "restitution": 0.9}]
+    assert parse_scene(good).motion.phases == ((1e-4, {"mu": 0.2, "restitution": 0.9}),)

@@ -236,10 +236,20 @@ def check(doc: dict, engine: str, law=None) -> None:
                 if readers:
                     raise ValueError(f"[{where}] {key}: not read by the {engine} engine (read by "
                                      f"{', '.join(readers)}; this scene's keys there: {', '.join(sorted(allowed))})")
-                if table == "contact" and law is not None:
-                    raise ValueError(f"[contact] {key}: not a parameter of law = \"{law.NAME}\" (its parameters: "
-                                     f"{', '.join(sorted(allowed - {'law'}))})")
+                if table in LAW_TABLES and law is not None and key not in law_keys("contact", engine, law):
+                    listed = (f"its parameters: {', '.join(sorted(allowed - {'law'}))}" if table == "contact" else
+                              f"this scene's keys there: {', '.join(sorted(allowed))}")
+                    others = ", ".join(f'"{name}"' for name in _laws_taking(key))
+                    raise ValueError(f"[{where}] {key}: not a parameter of law = \"{law.NAME}\" ({listed}"
+                                     f"{f'; {key} is one of law = {others}' if others else ''})")
                 raise ValueError(f"[{where}] {key}: unknown key (allowed: {', '.join(sorted(allowed))})")
+
+
+def _laws_taking(key: str) -> list[str]:
+    """The registered contact laws whose material has the field ``key``."""
+    from dem.laws.contact import CONTACT_LAWS, law_module
+
+    return [name for name in CONTACT_LAWS if key in {f.name for f in fields(law_module(name).Material)}]
 
 
 def law_rows() -> tuple:
