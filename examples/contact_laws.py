@@ -1,12 +1,17 @@
-"""Contact laws are plug-ins: the same scene with another ``[contact] law``.
+"""
+One collision, two contact laws
+===============================
 
-Two silica microspheres (r = 10 um) meet head on. With ``law = "hertz_mindlin"`` they rebound with the coefficient
-of restitution the material names, at every impact speed (Tsuji's damping with Antypov & Elliott's alpha(e)); with
-``law = "jkr"`` and the work of adhesion of the surfaces, slow ones stick and fast ones rebound, ever closer to that
-e. Only the ``[contact]`` table changes (``python -m dem run FILE.toml`` reads the same keys).
+Contact laws are plug-ins: the same scene with another ``[contact] law``. Two silica microspheres (r = 10 um) meet
+head on. With ``law = "hertz_mindlin"`` they rebound with the coefficient of restitution the material names, at every
+impact speed (Tsuji's damping with Antypov & Elliott's alpha(e)); with ``law = "jkr"`` and the work of adhesion of
+the surfaces, slow ones stick and fast ones rebound, ever closer to that e. Only the ``[contact]`` table changes
+(``python -m dem run FILE.toml`` reads the same keys).
 """
 
 import math
+
+import matplotlib.pyplot as plt
 
 from dem import parse_scene, run
 
@@ -37,3 +42,16 @@ e_jkr, stuck = zip(*(rebound({"law": "jkr", **silica, "work_of_adhesion": 0.1}, 
 print("speed (m/s)  Hertz-Mindlin  JKR (w = 0.1 J/m^2)")
 for v, e_hm, e_sticky, together in zip(speeds, e_hertz_mindlin, e_jkr, stuck):
     print(f"{v:11.3f}  {e_hm:13.4f}  {'stuck' if together else f'{e_sticky:.4f}'}")
+
+# %%
+# The rebound against the impact speed: Hertz-Mindlin's at the material's e throughout, JKR's stuck pairs at 0.
+fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
+ax.axhline(silica["restitution"], color="k", lw=1, label="the material's restitution e")
+ax.plot(speeds, e_hertz_mindlin, "o", label='law = "hertz_mindlin"')
+ax.plot(speeds, [0.0 if together else e for e, together in zip(e_jkr, stuck)], "s-", label='law = "jkr" (w = 0.1 J/m²)')
+ax.set_xscale("log")
+ax.set_xlabel("impact speed, relative (m/s)")
+ax.set_ylabel("coefficient of restitution (-)")
+ax.set_ylim(-0.05, 1.0)
+ax.legend(loc="lower right")
+plt.show()

@@ -56,7 +56,7 @@ class MechanicalModel:
         self.relaxation_time = float(relaxation_time)
         self.w = WallArrays.build(self.walls, state.dimension)
         n, n_w = state.n, len(self.walls)
-        self.particle_state = self.law.initial_state(material, state.T, state.mass)  # relaxed at the initial temperatures
+        self.particle_state = self.law.initial_state(material, state.T, state.mass)  # each particle's state at the start
         self.w_hist = np.zeros((n, n_w, len(self.law.WALL_HISTORY)))
         self.w_fn = np.zeros((n, n_w))
         self.w_ft = np.zeros((n, n_w, 3))
