@@ -266,6 +266,11 @@ def law_rows() -> tuple:
     return tuple(out)
 
 
+def _cell(text: str) -> str:
+    """``text`` in a cell of a Markdown table: its bars (``|E|``) escaped, which would otherwise end the cell."""
+    return text.replace("|", "\\|")
+
+
 def markdown() -> str:
     """The schema as a Markdown table (table, keys, engines, type/default and unit, meaning), the contact laws'
     materials after the ``[contact]`` table's own row."""
@@ -279,7 +284,8 @@ def markdown() -> str:
     for row in rows:
         name = f"`[[{row.table}]]`" if row.table in ARRAYS else f"`[{row.table}]`"
         lines.append(f"| {name if row.table != last else ''} | {', '.join(f'`{k}`' for k in row.keys)} | "
-                     f"{ENGINE_WORDS.get(row.engines, ', '.join(row.engines))} | {row.type} | {row.meaning} |")
+                     f"{ENGINE_WORDS.get(row.engines, ', '.join(row.engines))} | {_cell(row.type)} | "
+                     f"{_cell(row.meaning)} |")
         last = row.table
         if row.table == "phases" and row.keys == ("wall_velocity",):
             lines.append("|  | a field of the contact law's material but `density` | verlet | as in `[contact]` | its "
