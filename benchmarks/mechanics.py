@@ -99,10 +99,9 @@ def linear_limit(material: LudingMaterial) -> LudingMaterial:
 
 
 # ------------------------------------------------------------------------------------------------------ samples
-def _scene(material: LudingMaterial, dimension: int, particles: dict, walls=(), t_end: float = 1.0,
-           box=(0.0, 0.0, 0.0)):
+def _scene(material: LudingMaterial, dimension: int, particles: dict, walls=(), t_end: float = 1.0, box=None):
     """A mechanical scene (:func:`dem.scene.parse.parse_scene`) of ``material`` at :data:`T_RUN`; ``particles`` is the
-    ``[particles]`` or ``[generator]`` table; ``box`` the periodic lengths (no TOML key: set on the parsed scene)."""
+    ``[particles]`` or ``[generator]`` table; ``box`` the lengths of a box periodic along x, y and z."""
     from dem.scene import parse_scene
 
     contact = {k: v for k, v in asdict(material).items() if k != "density"}
@@ -112,8 +111,9 @@ def _scene(material: LudingMaterial, dimension: int, particles: dict, walls=(), 
     if dimension == 2:
         doc["scene"]["height"] = HEIGHT_2D
     doc["generator" if "kind" in particles else "particles"] = particles
-    scene = parse_scene(doc)
-    return replace(scene, motion=replace(scene.motion, box=tuple(float(b) for b in box)))
+    if box is not None:
+        doc["periodic"] = {"lengths": [float(b) for b in box]}
+    return parse_scene(doc)
 
 
 def _biaxial_walls(q_right: float, q_top: float) -> list[dict]:

@@ -78,6 +78,39 @@ def test_cluster():
     assert math.isfinite(ns["K_cluster"]) and abs(ns["K_dem"] / ns["K_cluster"] - 1) < 0.1
 
 
+def test_kirchhoff_current():
+    ns = run_example("kirchhoff_current")
+    flow = ns["flow"]
+    assert flow.electrode_current[0] == pytest.approx(-flow.electrode_current[1], rel=1e-12)  # charge conserved
+    assert flow.joule_heat == pytest.approx(flow.electrode_power, rel=1e-9)  # energy conserved
+    assert flow.electrode_current[0] == pytest.approx(133.8, abs=0.05)  # the README's numbers
+
+
+def test_the_readme_current_snippet_runs_as_printed():
+    readme = (EXAMPLES.parent / "README.md").read_text()
+    block = readme.split("`examples/kirchhoff_current.py`):\n\n```python\n", 1)[1].split("```", 1)[0]
+    *code, shown = block.strip().split("\n")
+    ns: dict = {}
+    exec("\n".join(code), ns)  # noqa: S102 -- the README's snippet, pasted as a user would
+    current, heat, power = eval(shown.split("#")[0], ns)  # noqa: S307
+    assert "[133.8, -133.8] A, 0.1338 W, 0.1338 W" in shown
+    assert (round(current[0], 1), round(current[1], 1), round(heat, 4), round(power, 4)) == (133.8, -133.8, 0.1338,
+                                                                                             0.1338)
+
+
+def test_moving_particles():
+    ns = run_example("moving_particles")
+    assert ns["kinetic"] < 1e-12 * ns["weight"] * 1e-3  # at rest: far below the weight times a millimetre
+    assert ns["floor"] == pytest.approx(ns["weight"], rel=1e-6)  # frictionless side walls: the floor carries it all
+
+
+def test_pack_sinter_measure():
+    ns = run_example("pack_sinter_measure")
+    assert ns["sinter"].summary["volume_fraction"] > ns["press"].summary["volume_fraction"] + 0.05  # it densified
+    assert 0.0 < ns["k_pressed"] < ns["k_sintered"] < 20.0  # necks grew; below the solid's 20 W/(m K)
+    assert ns["sinter"].summary["started_from"]["t"] == ns["t_pressed"]  # each stage from the one before
+
+
 def test_contact_laws():
     ns = run_example("contact_laws")
     assert all(abs(e - 0.8) < 2e-3 for e in ns["e_hertz_mindlin"])  # the material's e at every speed (dt = auto)

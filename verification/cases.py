@@ -119,8 +119,6 @@ SEC6 = {
 }
 
 # --- Section 5: semisphere with a neck (Fig. 12), r = 10 mm, copper, 10 degC / 0 degC --------------------------------
-SEC5_RADIUS = 10.0e-3  # m
-SEC5_KAPPA = 394.0  # W/(m K)
 FIG13_H_OVER_R = tuple(row.h_over_r for row in SEMISPHERE)
 FIG13_A_OVER_R = {
     hr: Reference(v, "-", f"{ROJEK_2022}, Fig. 13/14 captions")
@@ -132,7 +130,6 @@ FIG15_H_OVER_R = 0.08  # Fig. 15: convergence study at h/r = 0.08 (a/r = 0.3946)
 SLOPE_ROJEK = Reference(1.064, "-", f"{ROJEK_2022}, eq. (40), fitted on a/r up to ~0.7")
 SLOPE_ARGENTO_BOUVARD = Reference(1.112, "-", f"{ROJEK_2022}, eq. (42) (= 1/0.899, Argento & Bouvard 1996, eq. 41)")
 SLOPE_DIFFERENCE_PERCENT = Reference(3.0, "%", f"{ROJEK_2022}, Sec. 5 ('around 3%')")
-LINEAR_RANGE_A_OVER_R = 0.7  # "up to nearly a/r = 0.7 has a linear character" (Sec. 5)
 
 # --- Figures with curves only (no printed numbers); the parameters the paper used ---------------------------------
 FIG10_RADIUS_RATIOS = (1.0, 2.0, 3.0, 5.0, 10.0)  # r_j / r_i, Figs. 10-11 (the paper's legend values are not in the text)

@@ -24,6 +24,7 @@ import numpy as np
 
 from dem.laws.conductance import ConductanceSpec
 from dem.geometry.particles import Particles
+from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources
 from dem.network.heat import Network, bonds_and_conductances, theta_step
 
@@ -34,7 +35,7 @@ class ContactThermalModel:
     name = "thermal"
 
     def __init__(self, particles: Particles, walls, spec: ConductanceSpec, sources: Sources,
-                 integrator: str = "implicit", linear: str = "auto"):
+                 integrator: str = "implicit", linear: str = "auto", box: PeriodicBox | None = None):
         if integrator not in ("implicit", "crank-nicolson"):
             raise ValueError(f"[solver] thermal_integrator = {integrator!r}: a network coupled to moving particles "
                              f"steps implicitly: implicit or crank-nicolson")
@@ -43,6 +44,7 @@ class ContactThermalModel:
         self.thermal_walls = [k for k, w in enumerate(self.walls) if w.temperature is not None]
         self.spec, self.sources = spec, sources
         self.integrator, self.linear = integrator, linear
+        self.box = box  # a periodic box: bonds across its faces, its temperature drop per period
         self.T = particles.temperature.astype(float).copy()
         self.rate = np.zeros_like(self.T)  # dT/dt over the last step: the mechanics extrapolates with it
         self.net: Network | None = None
@@ -55,7 +57,7 @@ class ContactThermalModel:
         """Bonds and conductances ``(bonds, K_pairs, K_walls)`` of the contacts of ``mechanics`` now."""
         i, j = mechanics.contacts()[:2]
         return bonds_and_conductances(self._particles_now(mechanics, mechanics.state.radius),
-                                      self._walls_now(mechanics), self.spec, pairs=(i, j))
+                                      self._walls_now(mechanics), self.spec, pairs=(i, j), box=self.box)
 
     def _particles_now(self, mechanics, radius) -> Particles:
         """The particles at their current positions with ``radius``: the current radii for the contact geometry,
@@ -79,7 +81,7 @@ class ContactThermalModel:
         else:
             wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
             self.net = Network(self._particles_now(mechanics, self.particles.radius), bonds, K_pairs, K_walls,
-                               wall_T, self.sources)
+                               wall_T, self.sources, self.box)
             self.assemblies += 1
         T_F, heat = theta_step(self.net, self.T[self.free], dt, self.integrator, self.linear)
         for k, v in heat.items():

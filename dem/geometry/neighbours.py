@@ -211,9 +211,6 @@ def wall_pairs(x: np.ndarray, radius: np.ndarray, normal: np.ndarray, offset: np
     return k.astype(np.int64), m.astype(np.int64)
 
 
-LIST_KEYS = ("pi", "pj", "list_x_ref", "wall_list_k", "wall_list_m", "wall_list_q_ref")
-
-
 def list_arrays(mech) -> dict:
     """The Verlet lists of ``mech`` (its pairs ``pi, pj``, particle-wall pairs ``wk, wm`` and the positions
     ``x_ref`` and wall offsets ``wq_ref`` they were built at), for a checkpoint: a resumed run rebuilds its lists at

@@ -96,10 +96,6 @@ class Radiation:
         """``eps sigma A_i`` in W/K^4."""
         return self.emissivity * STEFAN_BOLTZMANN * _area("radiation", self.area_fraction, radius)
 
-    def outflow(self, radius: np.ndarray, T: np.ndarray) -> np.ndarray:
-        """Exact radiated power per particle ``eps sigma A_i (T_i^4 - T_inf^4)`` (W)."""
-        return self.coefficient(radius) * (self.kelvin(T) ** 4 - self.kelvin(self.T_inf) ** 4)
-
 
 def _check_fraction(name: str, fraction) -> None:
     if isinstance(fraction, str) and fraction != EXPOSED:

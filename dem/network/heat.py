@@ -60,7 +60,6 @@ from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources, linear_sink_terms
 
 INTEGRATORS = {"explicit": 0.0, "implicit": 1.0, "crank-nicolson": 0.5}
-FLOW_NAMES = ("fixed", "walls", "convection", "radiation", "internal")
 ORDER = {0.0: 1, 1.0: 1, 0.5: 2}  # order q of the theta method
 AUTO_LOCAL = {1: 10.0, 2: 15.0}  # dt = "auto": local tolerance k_q rtol^((q+1)/q) per step, :func:`step_tolerance`
 AUTO_SAFETY = 0.9  # dt = "auto": safety factor of the step controller; explicit stays below this x the stable limit

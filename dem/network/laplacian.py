@@ -149,14 +149,6 @@ class BoundedLaplacian:
         x[self.fixed] = x_fixed
         return x
 
-    def edge_flows(self, x) -> np.ndarray:
-        """Flow along every edge from i to j, ``K_c (x_i - x_j)``, at node values ``x`` (all nodes)."""
-        return self.K * (x[self.i] - x[self.j])
-
-    def plane_flows(self, x, x_planes) -> np.ndarray:
-        """Flow from each plane-bonded node into its plane, ``K_kw (x_k - x_w)``."""
-        return self.K_plane * (x[self.plane_node] - np.asarray(x_planes, dtype=float)[self.plane_index])
-
 
 def solve_anchored(system: BoundedLaplacian, rhs: np.ndarray, subset: np.ndarray | None = None, linear: str = "auto",
                    rtol: float = 1e-12, solver=None):

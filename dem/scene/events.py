@@ -9,7 +9,6 @@ temperature is constant (and the last segment's relaxation time holds).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -63,7 +62,3 @@ class TemperatureSchedule:
     def relaxation(self, t: float) -> float:
         return self.relaxation_time[self.segment(t)]
 
-    def next_knot(self, t: float) -> float:
-        """The first knot strictly after ``t`` (inf if none): the engine never lets a step interval cross one."""
-        later = [k for k in self.time if k > t]
-        return later[0] if later else math.inf

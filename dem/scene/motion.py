@@ -53,7 +53,6 @@ class MotionSpec:
     thermal_integrator: str
     output_interval: float
     vtu_interval: float
-    box: tuple = (0.0, 0.0, 0.0)
     phases: tuple = ()        # (start time, {material field: value}), sorted by start
     start: dict | None = None  # a saved state (dem.scene.state_file.load) the run begins from
     wall_phases: tuple = ()   # (start time, {wall name: inward velocity}), sorted by start

@@ -480,11 +480,12 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         box = _periodic_box(doc["periodic"], box)
     elif box is not None and not box.any_periodic:
         box = None  # a packing file's box that is not periodic (or that cannot say): only [periodic] uses it
-    if box is not None and moving:
+    if box is not None and engine == "staggered":
         raise ValueError(f"{'[periodic]' if 'periodic' in doc else '[particles] file: its box is periodic, and'}: "
-                         "periodic boxes are for static packings so far (the neighbour list of moving particles does "
-                         "not use dem.geometry.periodic yet)")
+                         "the staggered engine (Zohdi 2014) has no periodic box; the static and verlet engines do")
     walls = walls + _walls(doc, start, static=not moving)
+    if box is not None and moving:
+        _check_walls_across(walls, box)
     if not moving and specimen is None and start is not None:
         specimen = _specimen_between(walls, start, particles)
     cond = dict(doc.get("conductance", {}))
@@ -511,6 +512,16 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     return Scene(particles, () if moving else walls, conductance, Sources(conv, rad), solver, output,
                  tuple(physics), str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact,
                  motion, electrical, box, engine, start)
+
+
+def _check_walls_across(walls, box: PeriodicBox) -> None:
+    """A wall of particles that move must lie along the periodic axes (a wall across one would face its own
+    images)."""
+    for wall in walls:
+        across = [AXES[a] for a in range(3) if box.periodic[a] and abs(wall.normal[a]) > 1e-12]
+        if across:
+            raise ValueError(f"walls.{wall.name}: its normal {list(map(float, wall.normal))} has a component along the "
+                             f"periodic axis {across[0]}; a wall must be parallel to every periodic axis")
 
 
 def contact_material_from_scene(doc: dict):

@@ -18,8 +18,9 @@ MOVING = ("verlet", "staggered")
 STATIC = ("static",)
 VERLET = ("verlet",)
 STAGGERED = ("staggered",)
+STATIC_VERLET = ("static", "verlet")
 ENGINE_WORDS = {ALL: "all", MOVING: "moving", STATIC: "static", VERLET: "verlet", STAGGERED: "staggered",
-                ("static", "verlet"): "static, verlet"}
+                STATIC_VERLET: "static, verlet"}
 ARRAYS = ("materials", "walls", "phases")  # tables given as arrays of tables ([[walls]])
 LAW_TABLES = ("contact", "phases")  # tables whose keys (beyond those listed) are the contact law's material fields
 
@@ -103,11 +104,15 @@ ROWS = (
         "from the run's start t_0"),
     Row("walls", ("potential", "current"), STAGGERED, "V or A", 'an electrode ("electrical" physics): a fixed '
         "potential, or a current into the packing"),
-    Row("periodic", ("lengths",), STATIC, "[Lx, Ly, Lz] m, required (default: the box of a `[particles] file`)",
+    Row("periodic", ("lengths",), STATIC_VERLET,
+        "[Lx, Ly, Lz] m, required (default: the box of a `[particles] file`)",
         "a periodic box (`dem.geometry.periodic.PeriodicBox`): bonds cross its faces to the neighbours' images (the "
-        "same bonds as an explicit larger block, also in boxes shorter than a bond)"),
-    Row("periodic", ("axes", "origin"), STATIC, "all, [0, 0, 0]", "the periodic axes and the box's lower corner"),
-    Row("periodic", ("drop",), STATIC, "[0, 0, 0]", "temperature drop per period, T(x + L_k e_k) = T(x) - drop_k: a "
+        "same bonds as an explicit larger block, also in boxes shorter than a bond); moving particles touch across "
+        "them by the minimum image and are wrapped back into the box, walls must be parallel to its periodic axes"),
+    Row("periodic", ("axes", "origin"), STATIC_VERLET, "all, [0, 0, 0]",
+        "the periodic axes and the box's lower corner"),
+    Row("periodic", ("drop",), STATIC_VERLET, "[0, 0, 0]",
+        "temperature drop per period, T(x + L_k e_k) = T(x) - drop_k: a "
         "bond to an image sees T_j - drop·shift. A group of particles with no fixed temperature, wall or ambient is "
         "then solved up to a constant, kept at its capacity-weighted mean initial temperature; with one axis "
         "dropping, a steady run reports `effective_conductivity` = Q L / (A drop) from the heat flow Q across the "
@@ -129,12 +134,12 @@ ROWS = (
     Row("conductance", ("out_of_range",), ALL, '`"error"`', 'bonds beyond the contact model\'s range (h > '
         'max_overlap; wall overlap > r/3): `"error"` reports their count and the first pair, `"clip"` sets a to the '
         'smaller radius, `"drop"` removes them'),
-    Row("convection", ("h", "T_inf", "area_fraction"), ("static", "verlet"), 'W/(m² K), K or °C, `"exposed"`',
+    Row("convection", ("h", "T_inf", "area_fraction"), STATIC_VERLET, 'W/(m² K), K or °C, `"exposed"`',
         "Q = h A (T_inf - T), A = fraction · 4πr²; `\"exposed\"`: the fraction of each particle's surface whose "
         "outward normal ray leaves the packing (`dem.geometry.exposure`: 1 for an isolated particle, 0 inside a "
         "block, 0.29/0.5/0.66 on a face/edge/corner of a simple cubic block at h/r = 0.1); a number or list: that "
         "fraction (`1`: the whole surface, opted in)"),
-    Row("radiation", ("emissivity", "T_inf", "area_fraction", "unit"), ("static", "verlet"),
+    Row("radiation", ("emissivity", "T_inf", "area_fraction", "unit"), STATIC_VERLET,
         '-, K or °C, `"exposed"`, `"K"` or `"C"` (required)', "Q = εσA (T_inf⁴ - T⁴) in kelvin; `unit`: the unit "
         "of the scene's temperatures (a scene with radiation must say which)"),
     Row("solver", ("engine",), ALL, "from the physics and the contact law",
@@ -148,7 +153,7 @@ ROWS = (
         "never above 0.9 × the stable limit, and an explicit `dt` above 2/λ_max(C⁻¹A) is refused with the limit in "
         "the message. Verlet: `\"auto\"` is t_MD = π/(50ω) (Luding 2005, eq. 6); a `dt` above the stable step of the "
         "stiffest, lightest contact is refused. Staggered: the first step"),
-    Row("solver", ("integrator",), ("static", "verlet"), '`"crank-nicolson"`',
+    Row("solver", ("integrator",), STATIC_VERLET, '`"crank-nicolson"`',
         '`"explicit"`, `"implicit"`, `"crank-nicolson"` (verlet: of the thermal network)'),
     Row("solver", ("rtol",), STATIC, "1e-3", 'tolerance of `dt = "auto"`: the global error of the temperatures '
         "relative to the temperature range (initial, fixed, wall and ambient temperatures); measured on decaying "

@@ -4,8 +4,8 @@ example not listed here comes last, by file name."""
 import os
 
 ORDER = ["neck_models.py", "semisphere.py", "fit_law.py", "unequal_pair.py", "chain.py", "cluster.py",
-         "fit_law_in_dem.py", "packing_conductivity.py", "transient_pair.py",
-         "contact_laws.py"]
+         "fit_law_in_dem.py", "packing_conductivity.py", "transient_pair.py", "kirchhoff_current.py",
+         "moving_particles.py", "pack_sinter_measure.py", "contact_laws.py"]
 
 
 class ExampleOrder:

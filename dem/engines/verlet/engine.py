@@ -63,12 +63,12 @@ class VerletEngine:
             for key in ("x", "v", "w", "f", "tau", "mass", "inertia", "radius", "radius_ref", "T"):
                 setattr(state, key, np.ascontiguousarray(saved[key], dtype=float).copy())
         self.material = material
-        self.mechanics = MechanicalModel(state, m.walls, material, m.dt, m.skin, m.gravity, m.box,
+        self.mechanics = MechanicalModel(state, m.walls, material, m.dt, m.skin, m.gravity, scene.box,
                                          relaxation_time=m.relaxation_time, history=saved)
         self.thermal = None
         if "thermal" in scene.physics:
             self.thermal = ContactThermalModel(p, m.walls, scene.conductance, scene.sources, m.thermal_integrator,
-                                               scene.solver.linear)
+                                               scene.solver.linear, scene.box)
         self.schedule = m.schedule
         self.steps_start = 0
         if restart is not None:

@@ -21,6 +21,7 @@ from dem.engines import compiled
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
+from dem.geometry.periodic import PeriodicBox
 from dem.geometry.walls import WallArrays
 from dem.laws.contact import law_module
 
@@ -35,8 +36,10 @@ class MechanicalModel:
     name = "mechanical"
 
     def __init__(self, state: MotionState, walls, material, dt: float, skin: float, gravity=(0.0, 0.0, 0.0),
-                 box=(0.0, 0.0, 0.0), relaxation_time: float = 1e3, history=None):
-        """``material``: the contact law's material (``material.law`` names the law); ``history``: a saved state
+                 box: PeriodicBox | None = None, relaxation_time: float = 1e3, history=None):
+        """``material``: the contact law's material (``material.law`` names the law); ``box``: a periodic box
+        (:class:`dem.geometry.periodic.PeriodicBox`): contacts across its faces by the minimum image, the particles
+        wrapped into it at every rebuild of the Verlet list; ``history``: a saved state
         (:func:`dem.scene.state_file.load`) whose particle state and contact histories (pairs, and particle-wall
         pairs matched by wall name) the model starts from."""
         self.state = state
@@ -52,7 +55,8 @@ class MechanicalModel:
             raise ValueError(f"[solver] skin = {self.skin:.6g} m: must exceed {reach:.6g} m, the farthest a contact "
                              f"of law = \"{self.law.NAME}\" acts beyond touching (its pull-off distance)")
         self.gravity = np.asarray(gravity, dtype=float) * state.linear_dof
-        self.box = np.asarray(box, dtype=float)
+        self.periodic_box = box
+        self.box = box.kernel_lengths if box is not None else np.zeros(3)  # 0: not periodic
         self.relaxation_time = float(relaxation_time)
         self.w = WallArrays.build(self.walls, state.dimension)
         n, n_w = state.n, len(self.walls)
@@ -93,6 +97,10 @@ class MechanicalModel:
     # ------------------------------------------------------------------------------------------------ list
     def _build_list(self, first: bool = False):
         s = self.state
+        box = self.periodic_box
+        if box is not None:  # those that left it back into the box (the others keep their bits: a resume is exact)
+            outside = box.mask & ((s.x < box.origin) | (s.x >= box.origin + box.lengths))
+            s.x[:] = np.where(outside, box.wrap(s.x), s.x)
         expected = 0 if first else len(self.pi) + len(self.pi) // 8 + 16  # the last list, with room to grow
         i, j = verlet_pairs(s.x, s.radius, self.skin, self.box, expected)
         if first:

@@ -1,0 +1,33 @@
+"""
+Electric current through a static packing
+=========================================
+
+Kirchhoff's laws on the contact network of a sintered copper packing between two electrodes 1 mV apart, without a
+scene: the functions the staggered engine (Zohdi 2014) calls at every accepted step. The contact conductances are the
+FE-verified neck law with the electrical conductivity in place of the thermal one (the neck is the same Laplace
+problem); ``share`` is the part of each contact's resistance on the side of its first particle, where that part of
+its Joule heat is made. The current in equals the current out, and the Joule heat in the contacts equals the power the
+electrodes deliver.
+"""
+
+import numpy as np
+
+from dem import Material, Particles
+from dem.geometry.bonds import find_bonds
+from dem.geometry.generators import random_packing
+from dem.geometry.walls import Wall
+from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.network.current import Electrodes, kirchhoff
+
+layout = random_packing(1000, 1e-3, 0.1, seed=1)                       # sintered, h/r = 0.1
+p = Particles.from_arrays(layout.position, layout.radius, np.zeros(len(layout.radius)),
+                          Material(394.0, 8960.0, 385.0, "copper", electrical_conductivity=5.96e7))
+walls = [Wall("top", [0, 0, layout.z_high - 5e-5], [0, 0, -1], 0.0),
+         Wall("bottom", [0, 0, layout.z_low + 5e-5], [0, 0, 1], 0.0)]
+spec = ConductanceSpec("fit")                                             # the FE-verified neck law, sigma for kappa
+bonds = find_bonds(p, walls, spec.contact, "clip")
+G, G_w, share = bond_conductances(spec, p, bonds, p.electrical_conductivity, shares=True)
+flow = kirchhoff(p.n, bonds.i, bonds.j, G, share, bonds.wall_particle, bonds.wall_index, G_w,
+                 Electrodes(("top", "bottom"), (0, 1), np.array([1e-3, 0.0]), np.full(2, np.nan)))
+print(f"current into the electrodes {flow.electrode_current} A, Joule heat {flow.joule_heat:.4f} W, "
+      f"electrode power {flow.electrode_power:.4f} W")
