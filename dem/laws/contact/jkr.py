@@ -73,10 +73,6 @@ class JKRMaterial(HertzMindlinMaterial):
         out[J_C] = math.sqrt(2.0 * math.pi * self.work_of_adhesion / e_star)
         return out
 
-    def pulloff_force(self, r_eff: float) -> float:
-        """The largest pull a contact of effective radius ``R*`` holds, ``3/2 pi w R*`` (N)."""
-        return 1.5 * math.pi * self.work_of_adhesion * r_eff
-
     def pulloff_distance(self, r_eff):
         """How far beyond touching a contact of effective radius ``R*`` breaks, ``3/4 (pi^2 w^2 R*/E*^2)^(1/3)`` (m)."""
         return 0.75 * np.cbrt(math.pi**2 * self.work_of_adhesion**2 * r_eff / self.effective_modulus**2)
