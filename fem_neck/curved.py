@@ -164,7 +164,7 @@ class CurvedMesh:
     """A tetrahedral mesh whose boundary lies exactly on analytic surfaces (module docstring).
 
     ``points (N, 3)``, ``tets (M, 4)`` (vertices ascending), ``edges (NE, 2)``, ``faces (NF, 3)`` (ascending),
-    ``t2e (M, 6)`` and ``t2f (M, 4)`` (local edges :data:`fem_neck.simplex.EDGES`, face ``l`` opposite vertex
+    ``t2e (M, 6)`` and ``t2f (M, 4)`` (local edges ``fem_neck.simplex.EDGES``, face ``l`` opposite vertex
     ``l``), ``boundary_faces`` with their ``face_surface`` index into ``surfaces``; ``edge_projector (M, 6)`` and
     ``face_projector (M, 4)``: rows of ``projectors`` (-1: straight); ``curved``: elements with any curved edge."""
 
@@ -196,7 +196,7 @@ class CurvedMesh:
 
     def map(self, elements: np.ndarray, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(x (E, Q, 3), J (E, Q, 3, 3))`` of ``elements (E,)`` at reference points ``xi (Q, 3)`` (compiled
-        kernel :func:`_map_kernel`)."""
+        kernel ``_map_kernel``)."""
         pr = self.projectors
         return _map_kernel(self.points, self.tets, self.edge_projector, self.face_projector, pr.kind, pr.c, pr.e,
                            pr.r, pr.n, pr.d, np.ascontiguousarray(elements, dtype=np.int64),

@@ -2,7 +2,7 @@
 
 Geometry. A :class:`PeriodicCell` holds the particles of one period (centres, radii, the period box); every
 overlapping pair of particle images is bonded (Rojek 2022, eq. 21) and gets the volume-conserving cylindrical neck of
-:func:`fem_neck.neck_geometry` (eqs. 22-33). The solid is the union of all spheres and all neck cylinders, exactly as
+:func:`fem_neck.geometry.neck_geometry` (eqs. 22-33). The solid is the union of all spheres and all neck cylinders, exactly as
 in :mod:`fem_neck.cluster`; it conserves each particle's volume, so the solid volume fraction is
 ``phi = sum 4/3 pi r^3 / |period|`` exactly. The pair neck model has an answer only while the necks of one particle
 stay apart: :func:`check_cell` refuses a cell where two neck circles on one sphere touch (for the cubic lattices from
@@ -32,7 +32,7 @@ Both converge at one rate, so ``error_estimate = (upper - lower) / upper`` bound
 (the upper) and is 2-3 times it (the two errors are about equal, measured on the lattice cells). The bounds hold up
 to the quadrature of the curved elements (degree ``2 p``: ~5e-8 relative, measured against ``2 p + 4``) and the
 solvers' residuals (1e-10). The mesh is graded toward every neck circle, where the temperature is singular
-(``size_neck a`` at the circles, growing by :data:`GRADING` per unit distance); it is refined until the estimate
+(``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined until the estimate
 meets ``rtol``, and the memory of each solve is estimated before it starts (:func:`effective_conductivity`).
 """
 
@@ -472,13 +472,13 @@ class CellResult:
 
 def mesh_sizes(size_neck: float) -> dict:
     """The mesh of neck size ``size_neck`` (element size at the neck circles over the neck radius): far size and
-    grading fixed (:data:`SIZE_FAR`, :data:`GRADING`)."""
+    grading fixed (``SIZE_FAR``, ``GRADING``)."""
     return {"size_neck": size_neck, "size_far": SIZE_FAR, "grading": GRADING}
 
 
 def memory_estimate(elements: float, order: int) -> float:
     """Peak bytes of one :func:`solve_bounds` on ``elements`` tetrahedra (both processes; measured, see
-    :data:`BYTES_PER_ELEMENT`)."""
+    ``BYTES_PER_ELEMENT``)."""
     return BASE_BYTES + BYTES_PER_ELEMENT[order] * elements
 
 
@@ -507,7 +507,7 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
                            progress=None) -> CellResult:
     """``k_eff / kappa`` along z of the periodic ``cell`` with two-sided bounds (module docstring).
 
-    The first mesh has neck size :data:`SIZE_NECK0` scaled to ``rtol`` (within :data:`FIRST_SIZES`); while the
+    The first mesh has neck size ``SIZE_NECK0`` scaled to ``rtol`` (within ``FIRST_SIZES``); while the
     bounds are more than ``rtol`` apart it predicts the
     neck size that meets ``rtol`` (the gap falls like ``size_neck^GAP_ORDER``, the tetrahedra grow like
     ``size_neck^-ELEMENT_ORDER``) and solves there, at most ``max_meshes`` meshes. Before each mesh the memory of

@@ -48,7 +48,7 @@ UPPER = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
 
 def symmetric_products(g: np.ndarray) -> np.ndarray:
-    """``g_i g_j^T`` of reference fields ``g (Q, 3, n)`` for the six ``(i, j)`` of :data:`UPPER`, as ``(Q 6, n n)``
+    """``g_i g_j^T`` of reference fields ``g (Q, 3, n)`` for the six ``(i, j)`` of ``UPPER``, as ``(Q 6, n n)``
     (symmetrised for ``i != j``), so that ``sum_q g^T G_q g`` is one matrix product with the entries of
     :meth:`fem_neck.curved.CurvedMesh.metric`."""
     out = np.stack([0.5 * (np.einsum("qa,qb->qab", g[:, i], g[:, j]) + np.einsum("qa,qb->qab", g[:, j], g[:, i]))
