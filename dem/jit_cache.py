@@ -81,12 +81,18 @@ def _imports(root: pathlib.Path, path: pathlib.Path) -> tuple[set[pathlib.Path],
     return found, compiled
 
 
+def _sources(package: pathlib.Path) -> list[pathlib.Path]:
+    """The package's source files, without ``__pycache__`` (where the cache itself lives, and with it the loops
+    :mod:`dem.engines.compiled` copies for each contact law: were they sources, writing them would change the key)."""
+    return sorted(p for p in package.rglob("*.py") if "__pycache__" not in p.relative_to(package).parts)
+
+
 def compiled_sources(package: pathlib.Path = PACKAGE) -> list[pathlib.Path]:
     """Every module whose code or constants can reach compiled code: the modules of ``package`` that import numba,
     and every project module they import, transitively (module docstring)."""
     root = package.parent
     seeds = []
-    for path in sorted(package.rglob("*.py")):
+    for path in _sources(package):
         if b"numba" in path.read_bytes() and _imports(root, path)[1]:
             seeds.append(path)
     closure, todo = set(seeds), list(seeds)
@@ -112,7 +118,7 @@ def _stamp(package: pathlib.Path) -> str:
     """A hash of the name, size and modification time of every source file of the project's packages."""
     h = hashlib.sha1()
     for name in PROJECT_PACKAGES:
-        for path in sorted((package.parent / name).rglob("*.py")):
+        for path in _sources(package.parent / name):
             st = path.stat()
             h.update(f"{path.relative_to(package.parent)}:{st.st_size}:{st.st_mtime_ns};".encode())
     return h.hexdigest()

@@ -109,3 +109,11 @@ def test_pack_sinter_measure():
     assert ns["sinter"].summary["volume_fraction"] > ns["press"].summary["volume_fraction"] + 0.05  # it densified
     assert 0.0 < ns["k_pressed"] < ns["k_sintered"] < 20.0  # necks grew; below the solid's 20 W/(m K)
     assert ns["sinter"].summary["started_from"]["t"] == ns["t_pressed"]  # each stage from the one before
+
+
+def test_contact_laws():
+    ns = run_example("contact_laws")
+    assert all(abs(e - 0.8) < 2e-3 for e in ns["e_hertz_mindlin"])  # the material's e at every speed (dt = auto)
+    assert ns["stuck"] == (True, True, False, False, False)  # JKR: the slow ones stick
+    rebounds = ns["e_jkr"][2:]
+    assert list(rebounds) == sorted(rebounds) and rebounds[-1] == pytest.approx(0.8, abs=0.03)  # towards e

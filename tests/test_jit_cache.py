@@ -66,6 +66,16 @@ def test_an_edit_outside_compiled_code_keeps_the_key(copy):
     assert jit_cache.digest(copy) != before
 
 
+def test_the_loops_copied_into_the_cache_keep_the_key(copy):
+    """dem.engines.compiled writes a copy of the loops for each contact law into the cache folder, inside the
+    package: the key of that folder must not follow them (else every run of such a law would compile afresh)."""
+    before = jit_cache.remembered_digest(copy)
+    copied = copy / "__pycache__" / f"numba-{before}" / "specialised-x" / "jkr" / "contact_forces.py"
+    copied.parent.mkdir(parents=True)
+    copied.write_text((copy / "engines" / "contact_forces.py").read_text())
+    assert jit_cache.digest(copy) == jit_cache.remembered_digest(copy) == before
+
+
 def test_the_remembered_key_follows_an_edit(copy):
     first = jit_cache.remembered_digest(copy)
     assert (copy / "__pycache__" / "jit_digest.json").exists()

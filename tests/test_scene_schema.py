@@ -26,6 +26,12 @@ def test_the_readme_key_table_is_the_schema():
     assert table.group(1) == schema.markdown(), "README.md's key table differs from dem.scene.schema.markdown()"
 
 
+def test_every_row_of_the_key_table_has_its_five_cells():
+    """A bar in a meaning (Zohdi's |E|) is escaped: unescaped, it would end the cell and cut the meaning short."""
+    for line in schema.markdown().splitlines():
+        assert len(re.findall(r"(?<!\\)\|", line)) == 6, line
+
+
 @pytest.mark.parametrize("table, names", [
     ("solver", {f.name for f in fields(SolverSpec)} | {f.name for f in fields(ZohdiStepping)}),
     ("output", {f.name for f in fields(OutputSpec)}),

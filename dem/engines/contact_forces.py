@@ -12,8 +12,9 @@ i is ``f_n n + f_t`` and the torque ``-l_i n x f_t``. The lever arms reach the m
 delta/2`` (as LAMMPS does), rather than the paper's ``a``: then ``l_i + l_j = |x_i - x_j|`` and a contact conserves
 angular momentum exactly (with ``a`` it would create ``-delta n x f_t``; the difference is of order delta/a). A
 wall is the partner j with an infinite radius, moving along its normal. A pair acts while its surfaces are closer
-than the law's ``reach`` (0: while they overlap); the laws whose particles do not rotate (``law.SPINS`` false) get
-no torques.
+than the law's ``reach``, a particle-wall pair while closer than its ``wall_reach`` (0: while they overlap; an
+adhesive law holds a contact beyond touching until it breaks); the laws whose particles do not rotate
+(``law.SPINS`` false) get no torques.
 """
 
 from __future__ import annotations
@@ -127,7 +128,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         if dist < 0.0 and escaped < 0:
             escaped = e
         delta = rk - dist
-        if delta <= 0.0:
+        if delta <= -law.wall_reach(k, m, w_hist_in, rk, params):
             if law.forget_wall(k, m, w_hist_in, w_hist):  # (rare: a wall contact opening)
                 w_fn[k, m] = 0.0
                 w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = 0.0, 0.0, 0.0

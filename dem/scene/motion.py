@@ -156,8 +156,8 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
         dt = float(solver.dt)
         if dt > stable:
             raise ValueError(f"[solver] dt = {dt:.6g} s: above the stable step {stable:.6g} s of the stiffest contact "
-                             f"(2/omega with k2 and the lightest pair); use dt <= {stable:.6g} s or dt = \"auto\" "
-                             f"(t_MD = {t_md:.6g} s, Luding 2005 eq. 6)")
+                             f"(2/omega of law = \"{contact.law}\" for the lightest pair); use dt <= {stable:.6g} s or "
+                             f"dt = \"auto\" ({t_md:.6g} s)")
     stable_steps = solver.t_end / dt
     if stable_steps > 1e10:
         raise ValueError(f"[solver] t_end / dt = {stable_steps:.3g} steps: beyond what one run can take; shorten t_end")

@@ -19,7 +19,7 @@ from dem.scene import packing_files, state_file
 from dem.geometry import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.fields import material_from_table
-from dem.laws.contact import law_module
+from dem.laws.contact import CONTACT_LAWS, law_module
 from dem.scene.zohdi import ElectricalSpec, parse_electrical
 from dem.geometry.particles import COPPER, Material, Particles, material_indices
 from dem.geometry.periodic import AXES, PeriodicBox
@@ -445,8 +445,8 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     check_physics(physics)
     moving = "mechanical" in physics
     if moving and not isinstance(doc.get("contact"), dict):
-        raise ValueError("[contact]: required for mechanical physics (law = \"luding\" or \"zohdi\" and its "
-                         "parameters)")
+        raise ValueError(f"[contact]: required for mechanical physics (law = one of {', '.join(CONTACT_LAWS)}, and its "
+                         f"parameters)")
     law = law_module(doc["contact"].get("law")) if moving else None
     engine = _engine(doc, physics, law)
     check(doc, engine, law)
@@ -530,7 +530,7 @@ def contact_material_from_scene(doc: dict):
     defaults to that of a single ``[material]``)."""
     table = doc.get("contact")
     if not isinstance(table, dict):
-        raise ValueError("[contact]: must be a table with law = \"luding\" or \"zohdi\" and the material")
+        raise ValueError(f"[contact]: must be a table with law = one of {', '.join(CONTACT_LAWS)}, and the material")
     law = law_module(table.get("law"))
     values = {key: v for key, v in table.items() if key != "law"}
     material = doc.get("material")

@@ -241,10 +241,20 @@ def check(doc: dict, engine: str, law=None) -> None:
                 if readers:
                     raise ValueError(f"[{where}] {key}: not read by the {engine} engine (read by "
                                      f"{', '.join(readers)}; this scene's keys there: {', '.join(sorted(allowed))})")
-                if table == "contact" and law is not None:
-                    raise ValueError(f"[contact] {key}: not a parameter of law = \"{law.NAME}\" (its parameters: "
-                                     f"{', '.join(sorted(allowed - {'law'}))})")
+                if table in LAW_TABLES and law is not None and key not in law_keys("contact", engine, law):
+                    listed = (f"its parameters: {', '.join(sorted(allowed - {'law'}))}" if table == "contact" else
+                              f"this scene's keys there: {', '.join(sorted(allowed))}")
+                    others = ", ".join(f'"{name}"' for name in _laws_taking(key))
+                    raise ValueError(f"[{where}] {key}: not a parameter of law = \"{law.NAME}\" ({listed}"
+                                     f"{f'; {key} is one of law = {others}' if others else ''})")
                 raise ValueError(f"[{where}] {key}: unknown key (allowed: {', '.join(sorted(allowed))})")
+
+
+def _laws_taking(key: str) -> list[str]:
+    """The registered contact laws whose material has the field ``key``."""
+    from dem.laws.contact import CONTACT_LAWS, law_module
+
+    return [name for name in CONTACT_LAWS if key in {f.name for f in fields(law_module(name).Material)}]
 
 
 def law_rows() -> tuple:
@@ -261,6 +271,11 @@ def law_rows() -> tuple:
     return tuple(out)
 
 
+def _cell(text: str) -> str:
+    """``text`` in a cell of a Markdown table: its bars (``|E|``) escaped, which would otherwise end the cell."""
+    return text.replace("|", "\\|")
+
+
 def markdown() -> str:
     """The schema as a Markdown table (table, keys, engines, type/default and unit, meaning), the contact laws'
     materials after the ``[contact]`` table's own row."""
@@ -274,7 +289,8 @@ def markdown() -> str:
     for row in rows:
         name = f"`[[{row.table}]]`" if row.table in ARRAYS else f"`[{row.table}]`"
         lines.append(f"| {name if row.table != last else ''} | {', '.join(f'`{k}`' for k in row.keys)} | "
-                     f"{ENGINE_WORDS.get(row.engines, ', '.join(row.engines))} | {row.type} | {row.meaning} |")
+                     f"{ENGINE_WORDS.get(row.engines, ', '.join(row.engines))} | {_cell(row.type)} | "
+                     f"{_cell(row.meaning)} |")
         last = row.table
         if row.table == "phases" and row.keys == ("wall_velocity",):
             lines.append("|  | a field of the contact law's material but `density` | verlet | as in `[contact]` | its "

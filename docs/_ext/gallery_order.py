@@ -5,7 +5,7 @@ import os
 
 ORDER = ["neck_models.py", "semisphere.py", "fit_law.py", "unequal_pair.py", "chain.py", "cluster.py",
          "fit_law_in_dem.py", "packing_conductivity.py", "transient_pair.py", "kirchhoff_current.py",
-         "moving_particles.py", "pack_sinter_measure.py"]
+         "moving_particles.py", "pack_sinter_measure.py", "contact_laws.py"]
 
 
 class ExampleOrder:

@@ -60,7 +60,7 @@ class StaggeredMechanics:
         self.rebuilds = 0
         # the particles do not rotate: no spin, no torque (the force loop's arrays for them stay zero)
         self._spin, self._torque = np.zeros((n, 3)), np.zeros((n, 3))
-        self.particle_state = self.law.initial_state(material, state.T)
+        self.particle_state = self.law.initial_state(material, state.T, state.mass)
         n_w = len(self.walls)
         self.w_hist = np.zeros((n, n_w, len(self.law.WALL_HISTORY)))  # committed at each accepted step
         self._w_hist_iter = self.w_hist.copy()

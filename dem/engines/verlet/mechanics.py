@@ -50,13 +50,17 @@ class MechanicalModel:
         self.params = np.ascontiguousarray(material.params(), dtype=float)
         self.dt = float(dt)
         self.skin = float(skin)
+        reach = self.law.largest_reach(material, state.radius)
+        if not self.skin > reach:  # a listed pair must stay listed for as long as it acts
+            raise ValueError(f"[solver] skin = {self.skin:.6g} m: must exceed {reach:.6g} m, the farthest a contact "
+                             f"of law = \"{self.law.NAME}\" acts beyond touching (its pull-off distance)")
         self.gravity = np.asarray(gravity, dtype=float) * state.linear_dof
         self.periodic_box = box
         self.box = box.kernel_lengths if box is not None else np.zeros(3)  # 0: not periodic
         self.relaxation_time = float(relaxation_time)
         self.w = WallArrays.build(self.walls, state.dimension)
         n, n_w = state.n, len(self.walls)
-        self.particle_state = self.law.initial_state(material, state.T)  # relaxed at the initial temperatures
+        self.particle_state = self.law.initial_state(material, state.T, state.mass)  # each particle's state at the start
         self.w_hist = np.zeros((n, n_w, len(self.law.WALL_HISTORY)))
         self.w_fn = np.zeros((n, n_w))
         self.w_ft = np.zeros((n, n_w, 3))

@@ -10,17 +10,20 @@ A contact law module defines (SI units; forces on particle i, the unit normal ``
   particle-wall contact carries from step to step) and ``PARTICLE_STATE`` (those each particle carries); ``SPINS``
   (its tangential forces make torques) and ``DRAG`` (it has a drag on every particle); ``SCHEMA_ROWS``, its
   material's fields documented for the scene schema (:mod:`dem.scene.schema`: keys, type and unit, meaning);
-* ``initial_state(material, T)`` -- the particles' state columns at their initial temperatures, (N, S);
-  ``reference_radius(material, radius, T)`` -- the radii the law's thermal expansion starts from;
+* ``initial_state(material, T, mass)`` -- the particles' state columns from their initial temperatures and masses,
+  (N, S); ``reference_radius(material, radius, T)`` -- the radii the law's thermal expansion starts from;
   ``time_steps(material, mass, inertia, radius, m_mean)`` -- ``(dt, stable)``: the step ``dt = "auto"`` takes and the
-  largest a velocity-Verlet step may take;
+  largest a velocity-Verlet step may take; ``largest_reach(material, radius)`` -- the farthest beyond touching any
+  contact of these particles acts (the neighbour lists' skin must exceed it; 0 for a law without forces at a
+  distance);
 * ``pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params) -> (f_n, f_t0,
   f_t1, f_t2)`` -- the force on i of pair ``c`` at overlap ``delta`` (centre distance ``d``) with relative surface velocity ``vr`` (normal part
   ``vn``), reading the pair's history from row ``c`` of ``hist_in`` and writing it to row ``c`` of ``hist``;
   ``forget_pair(c, hist_in, hist)`` -- the pair opened (returns whether it had a history); ``reach(c, hist, ri, rj,
   params)`` -- how far beyond touching the pair still acts (0 for a law without forces at a distance);
-* ``wall_force(k, m, hist_in, hist, state, T, delta, dist, n, vr, vn, rk, dt, params)`` and ``forget_wall(k, m, hist_in,
-  hist)`` -- the same for particle k on wall m (histories indexed ``[k, m]``);
+* ``wall_force(k, m, hist_in, hist, state, T, delta, dist, n, vr, vn, rk, dt, params)``, ``forget_wall(k, m, hist_in,
+  hist)`` and ``wall_reach(k, m, hist, rk, params)`` -- the same for particle k on wall m (histories indexed
+  ``[k, m]``);
 * ``update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt)`` -- before the
   forces of every step: the temperatures ``T0 + T_rate elapsed`` and what the law makes of them (radii, state);
   ``drag(k, radius, params)`` -- the drag coefficient of particle k (kg/s) where ``DRAG``.
@@ -33,6 +36,8 @@ import importlib
 CONTACT_LAWS = {
     "luding": "dem.laws.contact.luding",  # Luding, Manetsberger & Mueller 2005: sintering, hysteretic normal law
     "zohdi": "dem.laws.contact.zohdi",  # Zohdi 2014: power law on the contact area, bonds, thermal softening
+    "hertz_mindlin": "dem.laws.contact.hertz_mindlin",  # Hertz, Tsuji's damping (restitution e), Mindlin, Coulomb
+    "jkr": "dem.laws.contact.jkr",  # Johnson-Kendall-Roberts 1971 adhesion, with Hertz-Mindlin's damping and friction
 }
 
 

@@ -450,7 +450,7 @@ SCHEMA_ROWS = (  # the scene keys of the material (dem.scene.schema): keys, type
 DRAG = False
 
 
-def initial_state(material: LudingMaterial, T: np.ndarray) -> np.ndarray:
+def initial_state(material: LudingMaterial, T: np.ndarray, mass: np.ndarray) -> np.ndarray:
     """Each particle's stiffness factor relaxed at its initial temperature, ``k1(T)/k1`` (eq. 10)."""
     return np.array([[k1_factor(float(t), material.T_melt, material.T_var)] for t in T]).reshape(len(T), 1)
 
@@ -459,6 +459,11 @@ def reference_radius(material: LudingMaterial, radius: np.ndarray, T: np.ndarray
     """The radii at the melting temperature that give ``radius`` at ``T`` (eq. 9): thermal expansion changes the
     radius, not the mass."""
     return radius / np.array([radius_at(1.0, float(t), material.T_melt, material.expansion) for t in T])
+
+
+def largest_reach(material: LudingMaterial, radius: np.ndarray) -> float:
+    """The law acts on overlapping particles only."""
+    return 0.0
 
 
 def time_steps(material: LudingMaterial, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray,
@@ -543,6 +548,12 @@ def forget_wall(k, m, hist_in, hist):
 @njit(**IN_LOOP)
 def reach(c, hist, ri, rj, params):
     """How far beyond touching the pair still acts: the law has no force at a distance."""
+    return 0.0
+
+
+@njit(**IN_LOOP)
+def wall_reach(k, m, hist, rk, params):
+    """A wall contact acts while it overlaps."""
     return 0.0
 
 

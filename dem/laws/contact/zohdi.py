@@ -141,7 +141,7 @@ JIT = {"cache": True, "error_model": "numpy"}
 IN_LOOP = {**JIT, "inline": "always"}
 
 
-def initial_state(material: ZohdiMaterial, T: np.ndarray) -> np.ndarray:
+def initial_state(material: ZohdiMaterial, T: np.ndarray, mass: np.ndarray) -> np.ndarray:
     """No state per particle: the temperatures themselves soften the contacts."""
     return np.zeros((len(T), 0))
 
@@ -149,6 +149,11 @@ def initial_state(material: ZohdiMaterial, T: np.ndarray) -> np.ndarray:
 def reference_radius(material: ZohdiMaterial, radius: np.ndarray, T: np.ndarray) -> np.ndarray:
     """The radii do not change with temperature."""
     return np.array(radius, dtype=float)
+
+
+def largest_reach(material: ZohdiMaterial, radius: np.ndarray) -> float:
+    """The law acts on touching particles only."""
+    return 0.0
 
 
 def time_steps(material: ZohdiMaterial, mass, inertia, radius, m_mean: float):
@@ -225,6 +230,12 @@ def forget_wall(k, m, hist_in, hist):
 @njit(**IN_LOOP)
 def reach(c, hist, ri, rj, params):
     """The law acts on touching pairs only."""
+    return 0.0
+
+
+@njit(**IN_LOOP)
+def wall_reach(k, m, hist, rk, params):
+    """A wall contact acts while it overlaps."""
     return 0.0
 
 
