@@ -171,6 +171,7 @@ def periodic_packing(sizes: Sizes, cache: pathlib.Path, seed: int = 0, coordinat
     from dem.geometry.motion import MotionState
     from dem.scene.motion import time_steps
     from dem.geometry.neighbours import verlet_pairs
+    from dem.geometry.periodic import PeriodicBox
 
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
@@ -191,11 +192,12 @@ def periodic_packing(sizes: Sizes, cache: pathlib.Path, seed: int = 0, coordinat
     state = MotionState.create(3, x * unit, touch * shape * unit, material.density, np.full(len(x), T_RUN))
     dt = time_steps(material, state.mass, state.inertia, state.radius, 3, None)[0]
     skin, T0, rate = 0.1e-3, np.array([T_RUN]), np.zeros(1)
-    mech = MechanicalModel(state, (), material, dt, skin, box=box * unit)
+    mech = MechanicalModel(state, (), material, dt, skin, box=PeriodicBox(box * unit))
     while mech.coordination() < coordination:
         state.radius_ref *= 1.002 if mech.coordination() < 3.0 else 1.0002
         state.radius[:] = state.radius_ref
-        mech = MechanicalModel(state, (), material, dt, skin, box=box * unit)  # a new list for the grown radii
+        mech = MechanicalModel(  # a new list for the grown radii
+            state, (), material, dt, skin, box=PeriodicBox(box * unit))
         mech.advance(50, T0, rate)
     mech.advance(4000, T0, rate)
     out = {"position": state.x % (box * unit), "radius": state.radius.copy(), "box": box * unit}
