@@ -3,7 +3,8 @@ driven through a prescribed history.
 
 The pair: two equal particles of the scene's mean radius ``a`` (so ``delta_fluid = fluid_overlap * a``), made of
 the scene's ``[contact]`` material. The history CSV has the columns ``t`` (s, strictly increasing), ``overlap``
-(m; <= 0 opens the contact: no force, and a later overlap starts a fresh contact) and ``T`` (the scene's
+(m; <= 0 opens the contact: no force, and a later overlap starts a fresh contact; below the pair's size ``2 a``,
+where the centres meet) and ``T`` (the scene's
 temperature unit); other columns are ignored. Per row the tool reports the normal force on a particle (N, > 0
 repulsive), ``delta_max``, ``delta_0``, ``k1`` = k1(T, t), ``k2`` = k2(delta_max), ``kc`` = kc(T, t, delta_max)
 (all in N/m) and ``f_min`` (eq. 15).
@@ -82,6 +83,17 @@ def read_history(path) -> dict:
     return out
 
 
+def check_overlaps(path, overlap, radius: float) -> None:
+    """Refuse an overlap of the pair of radius ``radius`` at or beyond the pair's size ``2 radius`` (the centres meet
+    there), naming the file and the row."""
+    beyond = np.flatnonzero(np.asarray(overlap) >= 2.0 * radius)
+    if beyond.size:
+        k = int(beyond[0])
+        raise ValueError(f"history {pathlib.Path(path).name}: row {k + 1}: overlap = {float(overlap[k])!r} m: valid "
+                         f"range overlap < 2 a = {2.0 * radius:.6g} m (the pair's size: two particles of the scene's "
+                         f"mean radius a = {radius:.6g} m, whose centres meet at 2 a)")
+
+
 def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> dict:
     """One pair contact of two equal particles of radius ``radius`` through the history (see the module
     docstring); returns the per-row arrays named in :data:`OUTPUTS`."""
@@ -116,6 +128,7 @@ def run(args) -> dict:
     history = read_history(args.history)
     material.check_temperatures(history["T"], name="history T")
     radius = float(np.mean(scene.particles.radius))
+    check_overlaps(args.history, history["overlap"], radius)
     rows = drive_pair(material, radius, history["t"], history["overlap"], history["T"], not args.no_damping)
     result = {
         "pair": f"two equal particles of the scene's mean radius a = {radius:.6g} m",
