@@ -24,7 +24,7 @@ from dem.scene.zohdi import ElectricalSpec, parse_electrical
 from dem.geometry.particles import COPPER, Material, Particles, material_indices
 from dem.geometry.periodic import AXES, PeriodicBox
 from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources
-from dem.geometry.walls import Wall, axis_of, box_axes, extent
+from dem.geometry.walls import Wall, axis_of, box_axes, check_inside, extent
 from dem.network.heat import INTEGRATORS
 from dem.network.linsolve import BACKENDS
 from dem.scene.motion import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
@@ -155,6 +155,10 @@ class Scene:
     box: PeriodicBox | None = None  # a periodic box (dem.geometry.periodic), else None
     engine: str = "static"  # the engine that runs it (dem.engines)
     start: dict | None = None  # the saved state it starts from (dem.scene.state_file.load), else None
+
+    def __post_init__(self):
+        walls = self.motion.walls if self.motion is not None else self.walls
+        check_inside(walls, self.particles.position, self.particles.id)
 
     @property
     def start_time(self) -> float:
