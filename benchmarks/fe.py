@@ -10,6 +10,10 @@ sweep, and the main command's start-up beside NGSolve's.
 * The fit sweep (``fem_neck.fit.run_fit``, 44 points to 1e-4 on both cores).
 * Start-up: the whole process of ``python -m fem_neck fit --out DIR`` (fresh folder; imports, 40 solves, fit.json,
   fit.csv and fit.png) against the whole process of NGSolve solving the same 40 points, alternating.
+* Periodic cells: ``python -m fem_neck lattice --rtol 1e-4`` on SC, BCC and FCC at h/r = 0.02 and 0.08 as a whole
+  process (wall time, peak memory, true error against :data:`verification.lattices.REFERENCES`, the estimate over
+  the true error), and NGSolve on the same cell (:func:`verification.ngsolve_cell.ngsolve_cell`) at the lowest order
+  whose error is no larger than ours, timed in the same round.
 """
 
 from __future__ import annotations
@@ -36,7 +40,10 @@ SIDE_BY_SIDE_ROUNDS = 15
 # such setting of a full study on a quiet machine; fixed, so that the comparison does not follow timing noise
 NGSOLVE_STARTUP = {"order": 3, "maxh": 0.3, "hp_levels": 2}
 STARTUP_POINTS = 40  # the main command's default sweep
-LIMITS = {"fe_seconds_to_1e-4": 0.5, "fit_seconds": 15.0, "fe_over_ngsolve": 1.0, "startup_ratio": 1.5}
+LIMITS = {"fe_seconds_to_1e-4": 0.5, "fit_seconds": 15.0, "fe_over_ngsolve": 1.0, "startup_ratio": 1.5,
+          "lattice_seconds": 60.0, "lattice_gb": 4.0, "lattice_estimate_ratio": 3.0, "lattice_over_ngsolve": 2.0}
+LATTICE_RTOL = 1e-4
+NGSOLVE_ORDERS = (3, 4, 5)  # NGSolve's orders tried for equal accuracy (hp levels = order, maxh 0.5)
 
 
 def reference(h_over_r: float) -> tuple[float, float]:
@@ -399,6 +406,80 @@ def study_startup(section, quick: bool) -> None:
     section.target(label, ratio, LIMITS["startup_ratio"])
 
 
+# ------------------------------------------------------------------------------------------------- periodic cells
+def lattice_process(kind: str, h_over_r: float, rtol: float) -> dict:
+    """``python -m fem_neck lattice --json`` as a fresh process: its output, wall seconds and peak memory (GB)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "fem_neck", "lattice", "--kind", kind, "--h-over-r", str(h_over_r),
+                        "--rtol", str(rtol), "--json", "--out", tmp], capture_output=True, check=True)
+        seconds = time.perf_counter() - t0
+        out = json.loads((pathlib.Path(tmp) / "lattice.json").read_text())
+    # peak_memory_gb: the process's peak plus its lower-bound child's (fem_neck.lattice.peak_memory)
+    return {**out, "wall_seconds": seconds, "peak_gb": out["peak_memory_gb"]}
+
+
+def study_lattice(section, quick: bool) -> None:
+    """Our periodic-cell FE to 1e-4 against the references, and NGSolve at equal accuracy in the same round."""
+    from fem_neck import lattice
+    from verification.lattices import REFERENCES
+
+    cases = [("sc", 0.08)] if quick else sorted(REFERENCES)
+    have_ngsolve = available("ngsolve")
+    rows = []
+    for kind, h in cases:
+        ref = REFERENCES[(kind, h)]
+        ours = lattice_process(kind, h, LATTICE_RTOL)
+        cell = lattice.lattice_cell(kind, h)
+        t0 = time.perf_counter()  # in this process, warm like NGSolve below: geometry, meshes, both bounds
+        lattice.effective_conductivity(cell, rtol=LATTICE_RTOL)
+        warm = time.perf_counter() - t0
+        error = ours["k_eff_over_kappa"] / ref - 1.0
+        row = {"case": f"{kind.upper()} h/r={h:g}", "reference": ref, "k_upper": ours["k_upper_over_kappa"],
+               "k_lower": ours["k_lower_over_kappa"], "rel_error": error, "error_estimate": ours["error_estimate"],
+               "estimate_over_error": ours["error_estimate"] / abs(error) if error else None,
+               "bracketed": ours["k_lower_over_kappa"] < ref < ours["k_upper_over_kappa"],
+               "order": ours["order"], "elements": ours["elements"], "seconds": ours["wall_seconds"],
+               "peak_gb": ours["peak_gb"], "warm_seconds": warm}
+        if have_ngsolve:
+            from verification.ngsolve_cell import ngsolve_cell
+
+            for order in NGSOLVE_ORDERS:
+                ng = ngsolve_cell(cell, order)
+                if abs(ng["k"] / ref - 1.0) <= abs(error):
+                    row.update({"ngsolve_order": order, "ngsolve_ndof": ng["ndof"],
+                                "ngsolve_rel_error": ng["k"] / ref - 1.0, "ngsolve_seconds": ng["seconds"],
+                                "ours_over_ngsolve": warm / ng["seconds"]})
+                    break
+        rows.append(row)
+        section.csv("lattice", rows)
+    worst = {"seconds": max(r["seconds"] for r in rows), "peak_gb": max(r["peak_gb"] for r in rows),
+             "estimate_over_error": max(r["estimate_over_error"] or 0.0 for r in rows),
+             "ours_over_ngsolve": max((r.get("ours_over_ngsolve") or 0.0 for r in rows), default=0.0) or None}
+    section.summary.update({f"lattice_worst_{k}": v for k, v in worst.items()})
+    section.summary["lattice_all_bracketed"] = all(r["bracketed"] for r in rows)
+    section.add_text(
+        "Periodic cells: ours against the references and NGSolve",
+        f"`python -m fem_neck lattice --kind K --h-over-r H --rtol {LATTICE_RTOL:g} --json` as a whole process "
+        "(imports, meshes, both bounds; wall time `seconds` and peak memory of the process and its solver child), "
+        "then `effective_conductivity(cell, rtol)` again in this process, warm (`warm_seconds`: geometry, meshes, "
+        "both bounds). Reference: NGSolve of order 6 on its own hp mesh (`verification.lattices.REFERENCES`). "
+        f"NGSolve: the lowest order of {list(NGSOLVE_ORDERS)} (hp levels = order, maxh 0.5, warm: geometry, mesh, "
+        "solve) whose error is no larger than ours, timed right after ours; it gives no error bound. "
+        "`ours_over_ngsolve` = warm_seconds / ngsolve_seconds.\n\n"
+        + records_table(rows, ["case", "reference", "k_lower", "k_upper", "bracketed", "rel_error", "error_estimate",
+                               "estimate_over_error", "order", "elements", "seconds", "peak_gb", "warm_seconds",
+                               "ngsolve_order",
+                               "ngsolve_rel_error", "ngsolve_seconds", "ours_over_ngsolve"]))
+    section.target(f"lattice cells to rtol {LATTICE_RTOL:g}: slowest whole run", worst["seconds"],
+                   LIMITS["lattice_seconds"], "s")
+    section.target("lattice cells: largest peak memory", worst["peak_gb"], LIMITS["lattice_gb"], "GB")
+    section.target("lattice cells: largest estimate over true error", worst["estimate_over_error"],
+                   LIMITS["lattice_estimate_ratio"])
+    section.target("lattice cells: ours / NGSolve at equal accuracy (largest)", worst["ours_over_ngsolve"],
+                   LIMITS["lattice_over_ngsolve"])
+
+
 def run(section, quick: bool) -> None:
     section.summary.update({"fe_seconds_to_1e-4": None, "ngsolve_seconds_to_1e-4": None, "fit_seconds": None,
                             "fe_over_ngsolve_side_by_side": None, "startup_fit_over_ngsolve": None})
@@ -412,3 +493,4 @@ def run(section, quick: bool) -> None:
     section.target("the full fit, >= 40 points to 1e-4, both cores", None if quick else section.summary["fit_seconds"],
                    LIMITS["fit_seconds"], "s")
     study_startup(section, quick)
+    study_lattice(section, quick)

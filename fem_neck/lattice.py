@@ -2,8 +2,8 @@
 
 Geometry. A :class:`PeriodicCell` holds the particles of one period (centres, radii, the period box); every
 overlapping pair of particle images is bonded (Rojek 2022, eq. 21) and gets the volume-conserving cylindrical neck of
-:func:`fem_neck.geometry.neck_geometry` (eqs. 22-33). The solid is the union of all spheres and all neck cylinders,
-exactly as in :mod:`fem_neck.cluster`; it conserves each particle's volume, so the solid volume fraction is
+:func:`fem_neck.neck_geometry` (eqs. 22-33). The solid is the union of all spheres and all neck cylinders, exactly as
+in :mod:`fem_neck.cluster`; it conserves each particle's volume, so the solid volume fraction is
 ``phi = sum 4/3 pi r^3 / |period|`` exactly. The pair neck model has an answer only while the necks of one particle
 stay apart: :func:`check_cell` refuses a cell where two neck circles on one sphere touch (for the cubic lattices from
 ``a/r = sin(theta/2)``, theta the smallest angle between bonds: SC 90 deg, BCC 70.5 deg, FCC 60 deg; see
@@ -18,28 +18,28 @@ is even under those). The FE therefore solves the box ``[0, P/2]^3`` -- an eight
 ``(x, y) -> (P/2 - y, P/2 - x)`` (face-centred cubic) only its half with ``x + y <= P/2``. Then
 ``k_eff = Q (P_z / 2) / A`` with ``Q`` the heat flow and ``A`` the cell's cross-section, for ``kappa = 1``.
 
-Two bounds (the error estimate). With ``K`` the exact heat flow of the cell for a unit temperature difference:
+Two bounds (the error estimate). With ``K`` the exact heat flow of the cell for a unit temperature difference, both
+are computed on one mesh whose tetrahedra fill the exact solid (:mod:`fem_neck.curved`: every boundary edge and
+face mapped onto its sphere, cylinder, plane or their intersection curve), so there is no geometric error:
 
-* **upper**: conforming P2 on curved (isoparametric quadratic) tetrahedra. By Dirichlet's principle the discrete
-  energy ``u_h . A u_h`` is never below ``K`` on the same domain; the curved boundary reproduces the spheres and
-  cylinders to third order, and that geometric error is far below the discretisation error (measured: the quadratic
-  boundary moves ``K`` by ~1e-4 relative to straight sides at the default meshes).
-* **lower**: Crouzeix-Raviart (nonconforming P1) on the *straight* tetrahedra. Every boundary facet has its three
-  vertices on one sphere or one neck cylinder, and each sphere and each cylinder lies inside the solid, so the straight
-  mesh is inscribed in the exact solid. The CR equations at a facet say that the elementwise-constant flux
-  ``q = -grad u_h`` has the same normal component on both sides of every interior facet and none on the insulated
-  facets: ``q`` is divergence-free and, extended by zero, admissible in the complementary (Thomson) principle on the
-  exact solid, so ``K >= P^2 / E*`` with ``P`` the flux ``q`` carries through the hot face and ``E* = int |q|^2``
-  (Cauchy-Schwarz). This bound is rigorous up to the linear solver's residual (solved to 1e-11).
+* **upper**: conforming ``P_p`` elements (:mod:`fem_neck.primal`). By Dirichlet's principle the energy of any
+  admissible temperature is at least ``K``.
+* **lower**: the hybridised Raviart-Thomas flux of degree ``p - 1`` (:mod:`fem_neck.dual`): divergence-free in every
+  element, normal-continuous across faces and zero on the insulated ones, hence admissible in the complementary
+  (Thomson) principle: ``K >= P^2 / E*`` with ``P`` the heat it carries through the hot face and ``E* = int |q|^2``.
 
-``error_estimate = (upper - lower) / upper`` bounds the error of the reported value (the upper, P2, which is the
-more accurate of the two). The mesh is refined (all sizes by one factor, the gap falling like size^1.65) until the
-estimate meets ``rtol``.
+Both converge at one rate, so ``error_estimate = (upper - lower) / upper`` bounds the error of the reported value
+(the upper) and is 2-3 times it (the two errors are about equal, measured on the lattice cells). The bounds hold up
+to the quadrature of the curved elements (degree ``2 p``: ~5e-8 relative, measured against ``2 p + 4``) and the
+solvers' residuals (1e-10). The mesh is graded toward every neck circle, where the temperature is singular
+(``size_neck a`` at the circles, growing by :data:`GRADING` per unit distance); it is refined until the estimate
+meets ``rtol``, and the memory of each solve is estimated before it starts (:func:`effective_conductivity`).
 """
 
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass, field
 
@@ -58,11 +58,14 @@ COORDINATION = {"sc": 6, "bcc": 8, "fcc": 12}
 # smallest neck meshed: below it the neck is thinner than 1.3e-3 r and the mesh of its disk explodes; the network is
 # exact in the limit of small necks (independent constrictions), which the FE shows from here up
 MIN_NECK_RATIO = 0.05
-# the refinement ladder: level sizes relative to the particle radius (far) and to the neck radius (at the circles)
-SIZE_FAR0, SIZE_NECK0, GRADING0, LEVEL_FACTOR = 0.25, 0.06, 0.25, 0.8
-MAX_ELEMENTS = 3_000_000  #: finer meshes are refused (~10 GB and ~15 min on 2 cores)
-GAP_ORDER = 1.65  # the gap between the bounds falls like size^GAP_ORDER (:func:`effective_conductivity`)
-LINEAR_RTOL = 1e-11
+# the meshes: element size at the neck circles over the neck radius (of the first mesh at rtol = 1e-3, and the
+# range of first meshes), far size over the particle radius, growth of the size per unit distance from the circles
+SIZE_NECK0, FIRST_SIZES, SIZE_FAR, GRADING = 0.05, (0.01, 0.3), 0.5, 0.8
+# measured on the lattice cells: the gap falls like size_neck^GAP_ORDER, the tetrahedra grow like
+# size_neck^-ELEMENT_ORDER (:func:`effective_conductivity`)
+GAP_ORDER, ELEMENT_ORDER = 1.25, 1.0
+# peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured)
+BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 70e3}
 _TOL = 1e-9  # geometric tolerance in units of the largest radius
 
 
@@ -223,12 +226,11 @@ def mirror_symmetry(cell: PeriodicCell) -> tuple[bool, bool, bool]:
 
 @dataclass
 class CellMesh:
-    """The meshed computational cell: ``mesh`` straight P1 tetrahedra (inscribed), ``curved`` the isoparametric
-    quadratic mesh, ``hot``/``cold`` boundary facet indices (``z = 0`` and ``z = height``), the cross-section
-    ``area``, ``wedge`` (the fraction of the box meshed: 1, the half ``y <= x``, or the quarter with also
-    ``x + y <= P/2``), the exact and the CAD volume of the solid in the cell."""
+    """The meshed computational cell: ``curved`` (:class:`fem_neck.curved.CurvedMesh`, exact geometry), ``hot`` and
+    ``cold`` its face indices on ``z = 0`` and ``z = height``, the cross-section ``area``, ``wedge`` (the fraction
+    of the box meshed: 1, the half ``y <= x``, or the quarter with also ``x + y <= P/2``), the exact and the CAD
+    volume of the solid in the cell and the neck radii. Lengths in units of the largest radius ``unit``."""
 
-    mesh: object
     curved: object
     hot: np.ndarray
     cold: np.ndarray
@@ -237,10 +239,11 @@ class CellMesh:
     wedge: float
     volume_exact: float
     volume_cad: float
+    unit: float
     neck_a: np.ndarray = field(repr=False)
 
 
-def _local_cluster(cell: PeriodicCell, box: np.ndarray):
+def local_cluster(cell: PeriodicCell, box: np.ndarray):
     """The particle images whose spheres or necks can reach the box ``[0, box]``, with their bonds, as a
     :class:`fem_neck.cluster.Cluster` (a neck point lies within ``sqrt(2) r_max`` of its nearer centre)."""
     from fem_neck.cluster import Cluster
@@ -261,15 +264,38 @@ def _local_cluster(cell: PeriodicCell, box: np.ndarray):
     return Cluster(x, r, np.column_stack([p[use], q[use]]))
 
 
-def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curvature: int, grading: float,
-                    neck_cells: float = 2.0, method: str = "newton") -> CellMesh:
-    """Mesh the computational cell (module docstring): the union of the spheres and necks near it, intersected with
-    the box ``[0, P/2]^3`` (or its wedge ``y <= x``), graded toward every neck circle (sizes as in
-    :func:`fem_neck.cluster.neck_size_fields`: ``size_neck a`` at the circles, growing by ``grading`` per unit
-    distance up to ``size_far r``). Lengths are scaled to the largest radius while meshing."""
-    from skfem import MeshTet
+def _domain(box: np.ndarray, diagonal: bool, anti: bool) -> list:
+    """The half-spaces ``n . x <= d`` of the computational cell (the box, or its wedge ``y <= x``, and ``x + y <=
+    box_x`` too for face-centred cubic), as ``(n, d)``."""
+    planes = [((0, 0, -1.0), 0.0), ((0, 0, 1.0), box[2]), ((0, -1.0, 0), 0.0)]
+    if diagonal:
+        planes.append(((-1.0, 1.0, 0), 0.0))
+        planes.append(((1.0, 1.0, 0), box[0]) if anti else ((1.0, 0, 0), box[0]))
+    else:
+        planes += [((-1.0, 0, 0), 0.0), ((1.0, 0, 0), box[0]), ((0, 1.0, 0), box[1])]
+    return [(np.asarray(n) / np.linalg.norm(n), d / np.linalg.norm(n)) for n, d in planes]
 
-    from fem_neck.cluster import add_neck_cylinders, curved_mesh, mesh_tetrahedra, neck_size_fields, tetrahedra
+
+def _reaches(halfspaces: list, points: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """Whether the balls (or, with ``points (k, 2, 3)``, capsules) of ``radius`` can meet the cell: no half-space
+    leaves them wholly outside (a necessary condition; enough to leave out the far images)."""
+    keep = np.ones(len(radius), dtype=bool)
+    for n, d in halfspaces:
+        near = points @ n
+        if near.ndim > 1:
+            near = near.min(axis=1)
+        keep &= near - d < radius
+    return keep
+
+
+def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, grading: float,
+                    curvature: int = 12, neck_cells: float = 1.0, method: str = "newton") -> CellMesh:
+    """Mesh the computational cell (module docstring): the union of the spheres and necks that reach it, cut to the
+    cell, graded toward every neck circle (``size_neck a`` at the circles, growing by ``grading`` per unit
+    distance up to ``size_far r``; :func:`fem_neck.cluster.neck_size_fields`), its boundary classified onto the
+    exact spheres, cylinders and planes (:mod:`fem_neck.curved`). Lengths are scaled to the largest radius."""
+    from fem_neck import curved
+    from fem_neck.cluster import mesh_tetrahedra, neck_size_fields, tetrahedra
     from fem_neck.shapes import gmsh_session
 
     mirror, diagonal, anti = mirror_symmetry(cell)
@@ -279,13 +305,24 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curva
     unit = float(cell.radii.max())
     scaled = PeriodicCell(cell.centres / unit, cell.radii / unit, cell.period / unit, cell.name)
     box = scaled.period / 2.0
-    local = _local_cluster(scaled, box)
+    local = local_cluster(scaled, box)
     geo = local.necks(method)
+    e = local.directions()
+    halfspaces = _domain(box, diagonal, anti)
+    bi, bj = local.bonds.T
+    start = local.centres[bi] + (0.75 * geo.z_i)[:, None] * e
+    end = start + (geo.h_n + 0.25 * (geo.z_i + geo.z_j))[:, None] * e
+    use_sphere = _reaches(halfspaces, local.centres, local.radii)
+    use_neck = _reaches(halfspaces, np.stack([start, end], axis=1), geo.a)
+    surfaces = [curved.sphere(c, r) for c, r in zip(local.centres, local.radii)]
+    surfaces += [curved.cylinder(c, d, a) for c, d, a in zip(local.centres[bi], e, geo.a)]
+    surfaces += [curved.plane(n, d) for n, d in halfspaces]
     tol = 1e-6
+    surfaces = curved.distinct(surfaces, tol)
     with gmsh_session() as gmsh:
         occ = gmsh.model.occ
-        solids = [(3, occ.addSphere(*local.centres[k], local.radii[k])) for k in range(local.n)]
-        solids += add_neck_cylinders(occ, local, geo)
+        solids = [(3, occ.addSphere(*local.centres[k], local.radii[k])) for k in np.flatnonzero(use_sphere)]
+        solids += [(3, occ.addCylinder(*start[b], *(end[b] - start[b]), geo.a[b])) for b in np.flatnonzero(use_neck)]
         union, _ = occ.fuse(solids[:1], solids[1:]) if len(solids) > 1 else (solids, None)
         if diagonal:  # the prism 0 <= y <= x <= P_x/2 (and x + y <= P_x/2), 0 <= z <= P_z/2
             apex = (0.5 * box[0], 0.5 * box[1]) if anti else (box[0], box[1])
@@ -297,31 +334,40 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, curva
             domain = [(3, occ.addBox(0, 0, 0, *box))]
         volume, _ = occ.intersect(union, domain)
         occ.synchronize()
-        # the solid may reach the cell in several pieces, joined outside it (see _conducting)
         volume_cad = sum(occ.getMass(3, tag) for _, tag in volume)
-        surfaces = [tag for _, tag in gmsh.model.getBoundary(volume, combined=False, oriented=False)]
-        neck_size_fields(gmsh, local, geo, surfaces, size_neck, size_far, neck_cells, tol, every_bond=False,
+        boundary = [tag for _, tag in gmsh.model.getBoundary(volume, combined=False, oriented=False)]
+        neck_size_fields(gmsh, local, geo, boundary, size_neck, size_far, neck_cells, tol, every_bond=False,
                          grading=grading)
         mesh_tetrahedra(gmsh, curvature, size_far)
         pieces = [tetrahedra(gmsh, tag) for _, tag in volume]
-        points, tets = pieces[0][0], np.vstack([piece[1] for piece in pieces])
+        points, index = pieces[0][0], pieces[0][2]
+        tets = np.vstack([piece[1] for piece in pieces])
+        triangles, owner = [], []
+        for tag in sorted(set(abs(t) for t in boundary)):
+            _, _, nodes = gmsh.model.mesh.getElements(2, tag)
+            tri = index[np.asarray(nodes[0], dtype=np.int64)].reshape(-1, 3)
+            xyz = points[np.unique(tri)]
+            dist = np.array([s.distance(xyz).max() for s in surfaces])
+            best = int(np.argmin(dist))
+            if dist[best] > 10 * tol:
+                raise RuntimeError(f"{cell.name}: boundary surface {tag} lies on none of the spheres, necks and cell "
+                                   f"planes (closest {dist[best]:.1e} away)")
+            triangles.append(tri)
+            owner.append(np.full(len(tri), best))
+    triangles, owner = np.vstack(triangles), np.concatenate(owner)
     tets = _conducting(points, tets, box[2], tol)
     used = np.unique(tets)
     remap = np.full(len(points), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
-    mesh = MeshTet(points[used].T.copy(), remap[tets].T.copy())
-    curved = _untangled(curved_mesh(mesh, local, geo, ()), mesh)
-    bf = mesh.boundary_facets()
-    fz = mesh.p[2, mesh.facets[:, bf]]
-    hot = bf[np.all(np.abs(fz) < tol, axis=0)]
-    cold = bf[np.all(np.abs(fz - box[2]) < tol, axis=0)]
+    inside = np.all(remap[triangles] >= 0, axis=1)
+    mesh = curved.build(points[used], remap[tets], remap[triangles[inside]], owner[inside], surfaces, 10 * tol)
+    fz = mesh.points[mesh.faces[mesh.boundary_faces], 2]
+    hot = mesh.boundary_faces[np.all(np.abs(fz) < tol, axis=1)]
+    cold = mesh.boundary_faces[np.all(np.abs(fz - box[2]) < tol, axis=1)]
     fraction = 0.25 if anti else 0.5 if diagonal else 1.0
     area = box[0] * box[1] * fraction
-    volume_exact = cell.phi * area * box[2]
-    mesh = MeshTet(mesh.p * unit, mesh.t)
-    curved = type(curved)(curved.doflocs * unit, curved.t)
-    return CellMesh(mesh, curved, hot, cold, float(box[2] * unit), float(area * unit**2), fraction,
-                    float(volume_exact * unit**3), float(volume_cad * unit**3), np.asarray(geo.a) * unit)
+    return CellMesh(mesh, hot, cold, float(box[2]), float(area), fraction, float(scaled.phi * area * box[2]),
+                    float(volume_cad), unit, np.asarray(geo.a))
 
 
 def _conducting(points: np.ndarray, tets: np.ndarray, height: float, tol: float) -> np.ndarray:
@@ -340,115 +386,72 @@ def _conducting(points: np.ndarray, tets: np.ndarray, height: float, tol: float)
     return tets[np.isin(label[tets[:, 0]], touching)]
 
 
-def _untangled(curved, straight):
-    """The curved mesh with the edges of any element whose curved map folds (Jacobian <= 0 at a quadrature point)
-    put back straight: on a coarse mesh a thin element next to a curved face can turn inside out, which would make
-    the stiffness matrix indefinite."""
-    from skfem import Basis, ElementTetP1, MeshTet2
-
-    doflocs = curved.doflocs.copy()
-    nv = straight.p.shape[1]
-    for _ in range(5):
-        mesh = MeshTet2(doflocs, curved.t)
-        detj = Basis(mesh, ElementTetP1(), intorder=4).mapping.detDF(Basis(mesh, ElementTetP1(), intorder=4).X)
-        bad = np.flatnonzero(np.min(detj, axis=1) <= 0.0)
-        if not len(bad):
-            return mesh
-        edges = np.unique(straight.t2e[:, bad])
-        ends = straight.edges[:, edges]
-        doflocs[:, nv + edges] = 0.5 * (straight.p[:, ends[0]] + straight.p[:, ends[1]])
-    return MeshTet2(doflocs, curved.t)
-
-
-def _solve_dirichlet(basis, hot_dofs, cold_dofs, rtol: float):
-    """``(u, A)``: the Laplace solution with u = 1 on the hot dofs and 0 on the cold ones (AMG-preconditioned CG)."""
-    import pyamg
-    from skfem import condense
-    from skfem.models.poisson import laplace
-
-    A = laplace.assemble(basis).tocsr()
-    u = np.zeros(basis.N)
-    u[hot_dofs] = 1.0
-    Ai, b, _, interior = condense(A, np.zeros(basis.N), x=u, D=np.concatenate([hot_dofs, cold_dofs]))
-    ml = pyamg.smoothed_aggregation_solver(Ai.tocsr(), symmetry="symmetric")
-    residuals = []
-    u[interior] = ml.solve(b, x0=np.full(len(interior), 0.5), tol=rtol, accel="cg", maxiter=2000,
-                           residuals=residuals)
-    if residuals and residuals[-1] > 100.0 * rtol * max(residuals[0], 1e-300):
-        raise RuntimeError(f"the FE system ({len(interior)} unknowns) did not converge: relative residual "
-                           f"{residuals[-1] / residuals[0]:.1e} after {len(residuals) - 1} AMG-CG iterations")
-    return u, A
-
-
 @dataclass(frozen=True)
 class Bounds:
-    """Heat flow bounds of one mesh for a unit temperature difference and kappa = 1 (W/K per W/(m K)): ``upper``
-    (P2, curved), ``lower`` (CR flux, straight), the CR flux's largest normal-flux defect relative to its mean flux
-    density (admissibility, ~solver tolerance), dofs of both solves, the mesh volume of the curved mesh and the P2
-    temperature at the mesh vertices."""
+    """Both bounds of one mesh, as ``k / kappa`` of the cell: ``upper`` (P_p energy) and ``lower`` (RT_(p-1) flux),
+    the flux's largest normal-flux jump relative to its mean flux per hot face (admissibility, ~solver tolerance),
+    unknowns of both solves, tetrahedra, the mapped mesh's volume over the exact one minus 1, seconds."""
 
     upper: float
     lower: float
     flux_defect: float
-    dofs_p2: int
-    dofs_cr: int
+    dofs_upper: int
+    dofs_lower: int
     elements: int
-    volume_curved: float
-    temperature: np.ndarray = field(repr=False)
+    volume_error: float
+    seconds: float
+
+    @property
+    def gap(self) -> float:
+        return (self.upper - self.lower) / self.upper
 
 
-def solve_bounds(cm: CellMesh, rtol: float = LINEAR_RTOL) -> Bounds:
-    """Upper (P2 energy) and lower (CR complementary energy) bounds of the cell's heat flow (module docstring).
+def _dual(mesh, order: int, hot, cold):
+    from fem_neck import dual
 
-    Pieces of the solid that touch neither isothermal face make the systems singular but consistent: conjugate
-    gradients keep them at their constant initial value, which carries no heat."""
-    from skfem import Basis, ElementTetCR, ElementTetP2, Functional
-
-    p2 = Basis(cm.curved, ElementTetP2())
-    u, A = _solve_dirichlet(p2, p2.get_dofs(cm.hot).all(), p2.get_dofs(cm.cold).all(), rtol)
-    upper = float(u @ (A @ u))
-    volume_curved = float(Functional(lambda w: 1.0 + 0.0 * w.x[0]).assemble(p2))
-
-    cr = Basis(cm.mesh, ElementTetCR())
-    v, _ = _solve_dirichlet(cr, cr.get_dofs(cm.hot).all(), cr.get_dofs(cm.cold).all(), rtol)
-    mesh = cm.mesh
-    q = -cr.interpolate(v).grad[:, :, 0].T                          # (nel, 3): the CR flux, constant per element
-    vol = _tet_volumes(mesh)
-    energy = float(np.sum(vol * np.sum(q**2, axis=1)))
-    # outward flux through each facet of each element, q . n_out |F|; summed per facet it cancels inside
-    area, normal, centre = _facet_geometry(mesh)
-    t2f = mesh.t2f                                                  # (4, nel)
-    inward = mesh.p[:, mesh.t].mean(axis=1)                         # element centroids (3, nel)
-    side = np.sign(np.einsum("ife,ife->fe", centre[:, t2f] - inward[:, None, :], normal[:, t2f]))
-    out = side * np.einsum("ei,ife->fe", q, normal[:, t2f]) * area[t2f]
-    net = np.bincount(t2f.ravel(), out.ravel(), mesh.facets.shape[1])
-    boundary = mesh.boundary_facets()
-    free = np.setdiff1d(np.arange(mesh.facets.shape[1]), np.concatenate([cm.hot, cm.cold]))
-    through = -float(net[cm.hot].sum())                             # heat flow entering at the hot face
-    defect = float(np.max(np.abs(net[free])) / (abs(through) / area[cm.hot].sum() * np.median(area[boundary])))
-    lower = through**2 / energy
-    return Bounds(upper, lower, defect, int(p2.N), int(cr.N), int(mesh.t.shape[1]), volume_curved,
-                  u[:mesh.p.shape[1]])
+    with _one_blas_thread():
+        return dual.solve(mesh, order - 1, hot, cold)
 
 
-def _tet_volumes(mesh) -> np.ndarray:
-    x = mesh.p[:, mesh.t]                                           # (3, 4, nel)
-    return np.abs(np.einsum("ie,ie->e", x[:, 1] - x[:, 0], np.cross(x[:, 2] - x[:, 0], x[:, 3] - x[:, 0], axis=0))) / 6
+def _one_blas_thread():
+    """One BLAS thread: the dense work is many small products (see :func:`fem_neck.spectral.conductance`)."""
+    from fem_neck.spectral import _blas
+
+    return _blas().limit(limits=1, user_api="blas")
 
 
-def _facet_geometry(mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Area, (arbitrarily oriented) unit normal and centroid of every facet."""
-    x = mesh.p[:, mesh.facets]                                      # (3, 3, nf)
-    n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0], axis=0)
-    area = 0.5 * np.linalg.norm(n, axis=0)
-    return area, n / (2.0 * area), x.mean(axis=1)
+def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
+    """Upper and lower bound of the cell's ``k / kappa`` on the mesh ``cm`` (module docstring), the two solves in
+    parallel processes when ``workers >= 2``."""
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    from fem_neck import primal
+
+    t0 = time.perf_counter()
+    mesh = cm.curved
+    if workers >= 2:
+        with ProcessPoolExecutor(1, mp_context=get_context("fork")) as pool:
+            future = pool.submit(_dual, mesh, order, cm.hot, cm.cold)
+            with _one_blas_thread():
+                up = primal.solve(mesh, order, cm.hot, cm.cold)
+            low = future.result()
+    else:
+        with _one_blas_thread():
+            up = primal.solve(mesh, order, cm.hot, cm.cold)
+        low = _dual(mesh, order, cm.hot, cm.cold)
+    scale = cm.height / cm.area
+    with _one_blas_thread():
+        volume = primal.volume(mesh)
+    return Bounds(float(up.energy * scale), float(low.lower * scale), float(low.flux_defect), int(up.dofs),
+                  int(low.dofs), len(mesh.tets), float(volume / cm.volume_exact - 1.0), time.perf_counter() - t0)
 
 
 @dataclass
 class CellResult:
-    """Effective conductivity of a periodic cell (module docstring): the best value ``k_eff_over_kappa`` (P2, the
+    """Effective conductivity of a periodic cell (module docstring): the best value ``k_eff_over_kappa`` (P_p, the
     upper bound), its bounds, ``error_estimate = (upper - lower) / upper``, the solid fraction ``phi`` (also the
-    Wiener bound of ``k_eff / kappa``), and what the last mesh cost."""
+    Wiener bound of ``k_eff / kappa``), what the last mesh cost and every mesh solved (``levels``)."""
 
     k_eff_over_kappa: float
     k_lower_over_kappa: float
@@ -456,66 +459,104 @@ class CellResult:
     error_estimate: float
     converged: bool
     phi: float
+    order: int
     dofs: int
     elements: int
     levels: list
     seconds: float
     volume_error: float
     flux_defect: float
+    memory_estimate: float
     mesh: CellMesh | None = field(default=None, repr=False)
-    temperature: np.ndarray | None = field(default=None, repr=False)
 
 
-def level_sizes(level: float) -> dict:
-    """Mesh sizes of refinement ``level`` (0 is the coarsest): all lengths shrink by ``LEVEL_FACTOR`` per level."""
-    f = LEVEL_FACTOR**level
-    size_far = SIZE_FAR0 * f
-    return {"size_neck": SIZE_NECK0 * f, "size_far": size_far, "curvature": int(round(2 * math.pi / size_far)),
-            "grading": GRADING0 * f}
+def mesh_sizes(size_neck: float) -> dict:
+    """The mesh of neck size ``size_neck`` (element size at the neck circles over the neck radius): far size and
+    grading fixed (:data:`SIZE_FAR`, :data:`GRADING`)."""
+    return {"size_neck": size_neck, "size_far": SIZE_FAR, "grading": GRADING}
 
 
-def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-3, start_level: float = 2.0, max_levels: int = 4,
+def memory_estimate(elements: float, order: int) -> float:
+    """Peak bytes of one :func:`solve_bounds` on ``elements`` tetrahedra (both processes; measured, see
+    :data:`BYTES_PER_ELEMENT`)."""
+    return BASE_BYTES + BYTES_PER_ELEMENT[order] * elements
+
+
+def peak_memory() -> float:
+    """Peak resident bytes of this process plus the largest of its finished children (the lower-bound solves): at
+    least what the run held at any one time."""
+    import resource
+
+    kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss + resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return kib * 1024.0
+
+
+def available_memory() -> float:
+    """Bytes the machine can still give (``MemAvailable``), or all of its memory where that is unknown."""
+    try:
+        for line in open("/proc/meminfo"):
+            if line.startswith("MemAvailable:"):
+                return float(line.split()[1]) * 1024.0
+    except OSError:
+        pass
+    return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+
+
+def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | None = None,
+                           max_memory: float | None = None, max_meshes: int = 4, workers: int = 2,
                            progress=None) -> CellResult:
     """``k_eff / kappa`` along z of the periodic ``cell`` with two-sided bounds (module docstring).
 
-    Starts on the mesh of ``start_level``; while the gap between the bounds exceeds ``rtol`` it predicts the level
-    that meets ``rtol`` and solves there, at most ``max_levels`` meshes; meshes above :data:`MAX_ELEMENTS`
-    tetrahedra are refused. The prediction takes the gap to fall like size^GAP_ORDER (the CR flux is first order,
-    its energy second; measured from the coarse levels: size^1.65 to size^1.8). ``progress(text)`` reports each mesh.
+    The first mesh has neck size :data:`SIZE_NECK0` scaled to ``rtol`` (within :data:`FIRST_SIZES`); while the
+    bounds are more than ``rtol`` apart it predicts the
+    neck size that meets ``rtol`` (the gap falls like ``size_neck^GAP_ORDER``, the tetrahedra grow like
+    ``size_neck^-ELEMENT_ORDER``) and solves there, at most ``max_meshes`` meshes. Before each mesh the memory of
+    its solve is estimated (:func:`memory_estimate`); one that would not fit in ``max_memory`` bytes (default: what
+    the machine has available) is refused with a ``ValueError`` naming the estimate and the ``rtol`` that would fit.
+    ``order``: of the upper bound (default 3 for ``rtol >= 3e-4``, else 4). ``progress(text)`` reports each mesh.
     """
     check_positive("rtol", rtol)
     check_cell(cell)
+    order = order or (3 if rtol >= 3e-4 else 4)
+    if order not in BYTES_PER_ELEMENT:
+        raise ValueError(f"order = {order!r}: must be one of {', '.join(map(str, BYTES_PER_ELEMENT))}")
+    budget = available_memory() if max_memory is None else float(max_memory)
     t0 = time.perf_counter()
-    phi = cell.phi
-    level = float(start_level)
+    size = float(np.clip(SIZE_NECK0 * (rtol / 1e-3) ** (1.0 / GAP_ORDER), *FIRST_SIZES))
     history = []
-    for _ in range(max_levels):
+    for _ in range(max_meshes):
         if progress is not None:
-            progress(f"level {level:.2f}")
-        cm = build_cell_mesh(cell, **level_sizes(level))
-        if cm.mesh.t.shape[1] > MAX_ELEMENTS:
-            raise ValueError(f"{cell.name}: rtol = {rtol:g} needs more than {MAX_ELEMENTS} tetrahedra "
-                             f"(level {level:.2f}); use a larger rtol")
-        b = solve_bounds(cm)
-        scale = cm.height / cm.area
-        upper, lower = b.upper * scale, b.lower * scale
-        gap = (upper - lower) / upper
-        history.append({"level": level, "elements": b.elements, "k_upper": upper, "k_lower": lower, "gap": gap,
-                        "seconds": time.perf_counter() - t0})
-        if gap <= rtol:
+            progress(f"neck size {size:.3g} a")
+        cm = build_cell_mesh(cell, **mesh_sizes(size))
+        need = memory_estimate(len(cm.curved.tets), order)
+        if need > budget:
+            # the first mesh's neck size that fits, and the rtol that starts there (tetrahedra ~ 1 / size)
+            fit = size * len(cm.curved.tets) * BYTES_PER_ELEMENT[order] / max(budget - BASE_BYTES, 1.0)
+            reach = 1e-3 * (fit / SIZE_NECK0) ** GAP_ORDER
+            raise ValueError(f"{cell.name}: the mesh of neck size {size:.3g} a has {len(cm.curved.tets)} tetrahedra "
+                             f"and needs ~{need / 1e9:.1f} GB, more than the {budget / 1e9:.1f} GB available; "
+                             f"rtol = {reach:.1e} would fit")
+        b = solve_bounds(cm, order, workers)
+        history.append({"size_neck": size, "elements": b.elements, "k_upper": b.upper, "k_lower": b.lower,
+                        "gap": b.gap, "seconds": time.perf_counter() - t0})
+        if b.gap <= rtol:
             break
-        # the level that meets rtol, with a 20 % margin
-        step = math.log((0.8 * rtol / gap) ** (1.0 / GAP_ORDER)) / math.log(LEVEL_FACTOR)
-        grow = LEVEL_FACTOR ** (-3 * step)
-        if b.elements * grow > MAX_ELEMENTS:
-            raise ValueError(f"{cell.name}: rtol = {rtol:g} needs ~{b.elements * grow:.3g} tetrahedra (the bounds are "
-                             f"{gap:.2e} apart on {b.elements}), above the limit of {MAX_ELEMENTS}; use a larger rtol")
-        level += max(step, 0.5)
-    return CellResult(k_eff_over_kappa=upper, k_lower_over_kappa=lower, k_upper_over_kappa=upper,
-                      error_estimate=gap, converged=gap <= rtol, phi=phi, dofs=b.dofs_p2, elements=b.elements,
-                      levels=history, seconds=time.perf_counter() - t0,
-                      volume_error=b.volume_curved / cm.volume_exact - 1.0, flux_defect=b.flux_defect, mesh=cm,
-                      temperature=b.temperature)
+        # the neck size that meets rtol with a 30 % margin, at least 1.5x finer, at most 8x
+        new = size * min(max((0.7 * rtol / b.gap) ** (1.0 / GAP_ORDER), 1.0 / 8.0), 1.0 / 1.5)
+        elements = b.elements * (size / new) ** ELEMENT_ORDER
+        need = memory_estimate(elements, order)
+        if need > budget:
+            fit = size * ((budget - BASE_BYTES) / BYTES_PER_ELEMENT[order] / b.elements) ** (-1.0 / ELEMENT_ORDER)
+            reach = b.gap * (fit / size) ** GAP_ORDER / 0.7
+            raise ValueError(f"{cell.name}: rtol = {rtol:g} needs ~{elements:.3g} tetrahedra and ~{need / 1e9:.1f} GB "
+                             f"(the bounds are {b.gap:.2e} apart on {b.elements}), more than the {budget / 1e9:.1f} GB "
+                             f"available; rtol = {reach:.1e} would fit")
+        size = new
+    return CellResult(k_eff_over_kappa=b.upper, k_lower_over_kappa=b.lower, k_upper_over_kappa=b.upper,
+                      error_estimate=b.gap, converged=bool(b.gap <= rtol), phi=cell.phi, order=order, dofs=b.dofs_upper,
+                      elements=b.elements, levels=history, seconds=time.perf_counter() - t0,
+                      volume_error=b.volume_error, flux_defect=b.flux_defect,
+                      memory_estimate=memory_estimate(b.elements, order), mesh=cm)
 
 
 def network_conductivity(cell: PeriodicCell, pair_conductance) -> float:
@@ -532,8 +573,9 @@ def network_conductivity(cell: PeriodicCell, pair_conductance) -> float:
 
 
 def write_vtu(result: CellResult, path) -> None:
-    """The cell's straight mesh with the P2 temperature at its vertices (VTU for ParaView)."""
+    """The cell's mesh (straight tetrahedra, vertices on the exact surfaces) for ParaView (VTU)."""
     import meshio
 
-    mesh = result.mesh.mesh
-    meshio.Mesh(mesh.p.T, [("tetra", mesh.t.T)], point_data={"T": result.temperature}).write(str(path))
+    mesh = result.mesh.curved
+    unit = result.mesh.unit
+    meshio.Mesh(mesh.points * unit, [("tetra", mesh.tets)]).write(str(path))

@@ -158,9 +158,10 @@ def scene_doc(**contact):
                                                              "mu", "mu_wall", "T_melt", "T_var", "expansion",
                                                              "fluid_overlap", "t0", "brittle_sliding")}}
     table.update(contact)
-    return {"material": {"conductivity": 0.25, "density": 2000.0, "specific_heat": 1700.0},
+    return {"scene": {"physics": ["mechanical"]}, "material": {"density": 2000.0},
             "particles": {"position": [[0.0, 0.0, 0.0]], "radius": [1e-3], "temperature": [20.0]},
-            "contact": {k: v for k, v in table.items() if v is not None}}
+            "contact": {k: v for k, v in table.items() if v is not None},
+            "solver": {"mode": "transient", "t_end": 1e-3}}
 
 
 def test_builtin_scene_carries_table1():
@@ -174,7 +175,11 @@ def test_contact_table_density_from_material_and_from_a_dict():
     assert luding_material_from_scene(scene_doc()) == MAT
     assert parse_scene(scene_doc()).contact == MAT
     assert luding_material_from_scene(scene_doc(density=1000.0)).density == 1000.0
-    assert parse_scene({k: v for k, v in scene_doc().items() if k != "contact"}).contact is None
+    static = {k: v for k, v in scene_doc().items() if k not in ("contact", "scene", "solver")}
+    static["material"] = {"conductivity": 0.25, "density": 2000.0, "specific_heat": 1700.0}
+    assert parse_scene(static).contact is None
+    with pytest.raises(ValueError, match=r"\[contact\]: not read by the static engine"):
+        parse_scene({**static, "contact": scene_doc()["contact"]})
 
 
 @pytest.mark.parametrize("edit, words", [

@@ -154,9 +154,9 @@ def test_interrupted_then_resumed_ends_as_the_uninterrupted_run(tmp_path, text, 
     code, err = interrupted_run(scene, part, seed)
     if code == 0:
         pytest.skip("the run finished before the interrupt reached it")
-    text = [line for line in err.split("\n") if line.strip() and "%|" not in line]  # besides progress bars
-    assert code == 130 and "Traceback" not in err and len(text) == 1, err
-    assert re.match(r"python -m dem run: interrupted at .*; partial results in .*part", text[0]), err
+    lines = [line for line in err.split("\n") if line.strip() and "%|" not in line]  # besides progress bars
+    assert code == 130 and "Traceback" not in err and len(lines) == 1, err
+    assert re.match(r"python -m dem run: interrupted at .*; partial results in .*part", lines[0]), err
     summary = json.loads((part / "summary.json").read_text())
     assert summary["interrupted"] is True and summary["resume_from"]["steps"] > 0
     for pvd in part.glob("*.pvd"):

@@ -211,6 +211,27 @@ def wall_pairs(x: np.ndarray, radius: np.ndarray, normal: np.ndarray, offset: np
     return k.astype(np.int64), m.astype(np.int64)
 
 
+LIST_KEYS = ("pi", "pj", "list_x_ref", "wall_list_k", "wall_list_m", "wall_list_q_ref")
+
+
+def list_arrays(mech) -> dict:
+    """The Verlet lists of ``mech`` (its pairs ``pi, pj``, particle-wall pairs ``wk, wm`` and the positions
+    ``x_ref`` and wall offsets ``wq_ref`` they were built at), for a checkpoint: a resumed run rebuilds its lists at
+    the steps the uninterrupted run does."""
+    return {"pi": mech.pi, "pj": mech.pj, "list_x_ref": mech.x_ref, "wall_list_k": mech.wk, "wall_list_m": mech.wm,
+            "wall_list_q_ref": mech.wq_ref}
+
+
+def restore_lists(mech, saved: dict) -> None:
+    """The Verlet lists of a checkpoint (:func:`list_arrays`) back into ``mech``, with the saved pair histories."""
+    mech.pi, mech.pj = (np.array(saved[k], dtype=np.int64) for k in ("pi", "pj"))
+    mech.p_hist = np.array(saved["p_hist"], dtype=float)
+    mech.p_fn, mech.p_ft = np.zeros(len(mech.pi)), np.zeros((len(mech.pi), 3))
+    mech.x_ref = np.array(saved["list_x_ref"], dtype=float)
+    mech.wk, mech.wm = (np.array(saved[k], dtype=np.int64) for k in ("wall_list_k", "wall_list_m"))
+    mech.wq_ref = np.array(saved["wall_list_q_ref"], dtype=float)
+
+
 @njit(cache=True)
 def addition_grid(r, lo, hi):
     """The cells of :func:`sequential_addition` for particles of radii ``r`` in the box ``[lo, hi]``: ``(size,

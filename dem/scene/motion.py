@@ -32,22 +32,11 @@ from dem.laws.contact import law_module
 from dem.geometry.motion import particle_mass, moment_of_inertia
 from dem.geometry.particles import finite_array
 from dem.scene.events import TemperatureSchedule
-from dem.geometry.walls import Wall
 from dem.scene import zohdi as zscene
 
 DEFAULT_SKIN = 0.1            # x the mean radius
 DEFAULT_OUTPUT_ROWS = 100     # rows of timeseries.csv when [output] interval is not given
 DEFAULT_THERMAL_STEPS = 1000  # mechanical steps per thermal step when [solver] thermal_interval is not given
-MOVING_KEYS = {
-    "scene": {"dimension", "height"},
-    "particles": {"velocity", "angular_velocity"},
-    "walls": {"motion", "pressure", "mass", "damping", "velocity", "amplitude", "frequency", *zscene.ELECTRODE_KEYS},
-    "solver": {"skin", "thermal_interval", *(zscene.STEPPING_KEYS - {"dt"})},
-    "output": {"interval", "vtu_interval", *zscene.OUTPUT_KEYS},
-}
-MOVING_TABLES = {"gravity": {"acceleration"}, "temperature": {"time", "value", "relaxation_time"},
-                 "phases": {"start", "wall_velocity", *("mu", "mu_wall", "gamma_n", "gamma_t")},
-                 "electrical": zscene.ELECTRICAL_KEYS}
 @dataclass(frozen=True)
 class MotionSpec:
     dimension: int
@@ -96,9 +85,10 @@ def time_steps(contact, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarra
     return law_module(contact.law).time_steps(contact, mass, inertia, radius, m_mean)
 
 
-def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, start=None) -> MotionSpec:
-    """The moving part of a scene (module docstring); ``particles``, ``solver`` and the ``contact`` material are
-    already parsed; ``velocity`` comes from a generator (its random ``speed``); ``start`` is a saved state."""
+def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, start=None, walls=()) -> MotionSpec:
+    """The moving part of a scene (module docstring); ``particles``, ``solver``, the ``contact`` material and the
+    ``walls`` are already parsed (the schema has checked every key); ``velocity`` comes from a generator (its random
+    ``speed``); ``start`` is a saved state."""
     meta = doc.get("scene", {})
     dimension = meta.get("dimension", 3)
     if dimension not in (2, 3) or isinstance(dimension, bool):
@@ -123,34 +113,29 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
     for name, arr in (("velocity", velocity), ("angular_velocity", angular)):
         if arr is not None and len(arr) != n:
             raise ValueError(f"[particles] {name} has {len(arr)} entries but position has {n}")
-    if contact is None:
-        raise ValueError("[contact]: required for mechanical physics (law = \"luding\" or \"zohdi\" and its "
-                         "parameters)")
     densities = {m.density for m in particles.materials}
     if densities != {contact.density}:
         raise ValueError(f"[contact] density = {contact.density:g}: differs from [material] density "
                          f"{', '.join(f'{d:g}' for d in sorted(densities))} kg/m^3; give it once, in [material]")
-    walls = tuple(_moving_wall(k, w) for k, w in enumerate(doc.get("walls", [])))
     if start is not None:
-        if start["dimension"] != dimension or (dimension == 2 and start["height"] != height):
-            raise ValueError(f"[start] state: saved for dimension {start['dimension']} (height {start['height']}), "
+        saved_dimension, saved_height = (start["dimension"], start["height"]) if start["moving"] else (3, None)
+        if saved_dimension != dimension or (dimension == 2 and saved_height != height):
+            raise ValueError(f"[start] state: saved for dimension {saved_dimension} (height {saved_height}), "
                              f"the scene has dimension {dimension} (height {height})")
-        saved = dict(zip(start["wall_names"], start["wall_q"]))
-        walls = tuple(replace(w, point=w.normal * saved[w.name]) if w.name in saved else w for w in walls)
-        velocity, angular = start["v"], start["w"]
+        if start["moving"]:
+            velocity, angular = start["v"], start["w"]
     gravity = (0.0, 0.0, 0.0)
     if "gravity" in doc:
         g = finite_array("[gravity] acceleration", doc["gravity"].get("acceleration", [0.0, 0.0, 0.0]), ())
         if g.shape != (3,):
             raise ValueError("[gravity] acceleration: must be a 3-vector (m/s^2)")
         gravity = tuple(float(x) for x in g)
-    phases = tuple(sorted((_phase(k, t) for k, t in enumerate(doc.get("phases", []))), key=lambda p: p[0]))
+    phases = tuple(sorted((_phase(k, t, contact) for k, t in enumerate(doc.get("phases", []))), key=lambda p: p[0]))
     wall_phases = tuple((start, walls_v) for start, _, walls_v in phases if walls_v)
     _check_wall_phases(wall_phases, walls)
     if contact.law == "zohdi":
         return zscene.zohdi_motion(doc, particles, solver, physics, start, walls, gravity, velocity,
                                    tuple(p[:2] for p in phases), wall_phases, dimension)
-    zscene.refuse_zohdi_keys(doc, physics)
     relaxation_time = float(getattr(contact, "t0", 0.0))  # the material's relaxation time, where its law has one
     schedule = None
     if "temperature" in doc:
@@ -190,22 +175,22 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
                       relaxation_time=relaxation_time)
 
 
-def _phase(k: int, table: dict) -> tuple:
-    if not isinstance(table, dict):
-        raise ValueError("[[phases]]: must be an array of tables")
-    unknown = sorted(set(table) - MOVING_TABLES["phases"])
-    if unknown:
-        raise ValueError(f"[phases][{k}] {unknown[0]}: unknown key (allowed: "
-                         f"{', '.join(sorted(MOVING_TABLES['phases']))})")
+def _phase(k: int, table: dict, contact) -> tuple:
+    """``(start, {material field: value}, {wall: velocity})`` of ``[[phases]]`` entry ``k`` (the schema has checked
+    its keys); the material it makes is checked now, not when the phase starts."""
     start = _num(table, f"phases][{k}", "start", nonnegative=True)
     if start is None:
         raise ValueError(f"[phases][{k}] start: required (s)")
     walls = table.get("wall_velocity", {})
     if not isinstance(walls, dict):
         raise ValueError(f"[phases][{k}] wall_velocity: must be a table {{wall name = velocity (m/s, inward)}}")
-    return start, {key: _num(table, f"phases][{k}", key, nonnegative=True) for key in table
-                   if key not in ("start", "wall_velocity")}, \
-        {str(name): _num(walls, f"phases][{k}] wall_velocity", name) for name in walls}
+    values = {key: v if isinstance(v, bool) else _num(table, f"phases][{k}", key) for key, v in table.items()
+              if key not in ("start", "wall_velocity")}
+    try:
+        replace(contact, **values)
+    except ValueError as exc:
+        raise ValueError(f"[phases][{k}] {str(exc).removeprefix('contact.')}") from None
+    return start, values, {str(name): _num(walls, f"phases][{k}] wall_velocity", name) for name in walls}
 
 
 def _check_wall_phases(wall_phases, walls) -> None:
@@ -217,18 +202,3 @@ def _check_wall_phases(wall_phases, walls) -> None:
                 raise ValueError(f"[phases] wall_velocity.{name}: " + (
                     f"no wall named {name!r} (walls: {', '.join(motions) or 'none'})" if name not in motions else
                     f"the wall's motion is {motions[name]!r}; only strain walls (constant speed) change speed"))
-
-
-def _moving_wall(k: int, table: dict) -> Wall:
-    allowed = {"name", "point", "normal", "temperature"} | MOVING_KEYS["walls"]
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ValueError(f"[walls][{k}] {unknown[0]}: unknown key (allowed: {', '.join(sorted(allowed))})")
-    for key in ("point", "normal"):
-        if key not in table:
-            raise ValueError(f"[[walls]] {k}: {key}: required")
-    numbers = {key: _num(table, f"walls][{k}", key) for key in ("pressure", "mass", "damping", "velocity",
-                                                                 "amplitude", "frequency") if key in table}
-    return Wall(str(table.get("name", f"wall{k}")), table["point"], table["normal"],
-                temperature=_num(table, f"walls][{k}", "temperature"), motion=str(table.get("motion", "fixed")),
-                **numbers)

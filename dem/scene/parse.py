@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import pathlib
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -27,28 +27,14 @@ from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources
 from dem.geometry.walls import Wall, axis_of, box_axes, check_inside, extent
 from dem.network.heat import INTEGRATORS
 from dem.network.linsolve import BACKENDS
-from dem.scene.motion import MOVING_KEYS, MOVING_TABLES, MotionSpec, parse_motion
+from dem.scene.motion import MotionSpec, parse_motion
+from dem.scene.schema import ENGINE_NAMES, TABLES, check
 
 SCENE_DIR = pathlib.Path(__file__).with_name("builtin")
 MODES = ("transient", "steady")
 BOUNDARIES = ("plates", "fixed", "periodic", "none")
 RTOL_MIN = 1e-9  # [solver] rtol of dt = "auto"
 
-ALLOWED = {
-    "scene": {"name", "description", "physics"},
-    "material": {"name", "conductivity", "density", "specific_heat", "electrical_conductivity"},
-    "particles": {"position", "radius", "temperature", "fixed", "material", "heat", *packing_files.SCENE_KEYS},
-    "generator": {"kind", "n", "shape", "radius", "overlap", "seed", "radius_spread", "distribution", "jitter",
-                  "structure", "temperature", "boundary", "hot", "cold", "heat", "box", "speed"},
-    "periodic": {"lengths", "axes", "origin", "drop"},
-    "walls": {"name", "point", "normal", "temperature"},
-    "start": {"state"},
-    "conductance": {"law", "slope", "fit_file", "neck", "contact_conductance", "out_of_range", "unequal"},
-    "convection": {"h", "T_inf", "area_fraction"},
-    "radiation": {"emissivity", "T_inf", "area_fraction", "unit"},
-    "solver": {"mode", "integrator", "dt", "t_end", "rtol", "linear", "floating", "max_steps"},
-    "output": {"every", "vtu_every", "vtu", "checkpoint_every"},
-}
 GENERATOR_KEYS = {
     "chain": {"n", "radius", "overlap"},
     "lattice": {"shape", "radius", "overlap", "structure"},
@@ -204,14 +190,6 @@ def make_scene(position, radius, temperature, *, materials=(COPPER,), material=N
 
 
 # --------------------------------------------------------------------------------------------------- TOML
-def _check_keys(table: dict, section: str, allowed: set):
-    if not isinstance(table, dict):
-        raise ValueError(f"[{section}]: must be a table")
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ValueError(f"[{section}] {unknown[0]}: unknown key (allowed: {', '.join(sorted(allowed))})")
-
-
 def _number(table, section, key, default=None, required=False):
     if key not in table:
         if required:
@@ -234,7 +212,6 @@ def _materials(doc, thermal: bool = True, electrical: bool = False) -> tuple:
     out = []
     for k, t in enumerate(tables):
         section = "material" if "material" in doc else f"materials[{k}]"
-        _check_keys(t, section, ALLOWED["material"])
         props = {key: _number(t, section, key, required=thermal or key == "density")
                  for key in ("conductivity", "density", "specific_heat")}
         props["electrical_conductivity"] = _number(t, section, "electrical_conductivity", required=electrical)
@@ -246,7 +223,6 @@ def _materials(doc, thermal: bool = True, electrical: bool = False) -> tuple:
 
 
 def _explicit_particles(t: dict, materials, base_dir=None):
-    _check_keys(t, "particles", ALLOWED["particles"])
     if "file" in t:  # a packing file (dem.scene.packing_files); its box, periodic or not, is returned as the box
         particles, box = packing_files.scene_particles(t, materials, base_dir)
         return particles, (), None, None, box
@@ -263,7 +239,6 @@ def _explicit_particles(t: dict, materials, base_dir=None):
 
 
 def _generated_particles(t: dict, materials, dimension: int = 3):
-    _check_keys(t, "generator", ALLOWED["generator"])
     kind = t.get("kind")
     if not isinstance(kind, str) or kind not in GENERATOR_KEYS:
         raise ValueError(f"[generator] kind = {kind!r}: must be one of {', '.join(GENERATOR_KEYS)}")
@@ -336,7 +311,6 @@ def _periodic_box(t: dict, file_box: PeriodicBox | None = None) -> PeriodicBox:
     """``[periodic]``: ``lengths`` (m), ``axes`` (the periodic ones, default all), ``origin``, ``drop`` (the
     temperature drop per period along each axis). With a packing file's box ``file_box``, ``lengths`` and
     ``origin`` default to its box and ``axes`` to its periodic axes (all where it has none)."""
-    _check_keys(t, "periodic", ALLOWED["periodic"])
     if "lengths" not in t and file_box is None:
         raise ValueError("[periodic] lengths: required (the period along x, y and z, m)")
     default_axes = [a for a, p in zip(AXES, file_box.periodic) if p] if file_box is not None else []
@@ -360,20 +334,21 @@ def _periodic_box(t: dict, file_box: PeriodicBox | None = None) -> PeriodicBox:
         raise ValueError(f"[periodic] {exc}") from None
 
 
-def _walls(doc, start: dict | None = None) -> tuple:
-    """The isothermal walls of a static scene; a wall named like a wall of the saved state ``start`` stands where
-    that one stood."""
+WALL_NUMBERS = ("pressure", "mass", "damping", "velocity", "amplitude", "frequency")
+
+
+def _walls(doc, start: dict | None, static: bool) -> tuple:
+    """The ``[[walls]]`` of any scene (:class:`dem.geometry.walls.Wall`; a static scene's carry a temperature); a
+    wall named like a wall of the saved state ``start`` stands where that one stood."""
     tables = doc.get("walls", [])
-    if not isinstance(tables, list):
-        raise ValueError("[[walls]]: must be an array of tables")
     out = []
     for k, w in enumerate(tables):
-        _check_keys(w, f"walls[{k}]", ALLOWED["walls"])
-        for key in ("point", "normal", "temperature"):
+        for key in ("point", "normal") + (("temperature",) if static else ()):
             if key not in w:
-                raise ValueError(f"[[walls]] {k}: {key}: required")
+                raise ValueError(f"[walls][{k}] {key}: required")
+        numbers = {key: _number(w, f"walls][{k}", key) for key in WALL_NUMBERS if key in w}
         out.append(Wall(str(w.get("name", f"wall{k}")), w["point"], w["normal"],
-                        _number(w, f"walls[{k}]", "temperature", required=True)))
+                        _number(w, f"walls][{k}", "temperature"), str(w.get("motion", "fixed")), **numbers))
     names = [w.name for w in out]
     if len(set(names)) != len(names):
         raise ValueError(f"[[walls]] name: names must be unique, got {names}")
@@ -412,11 +387,14 @@ def _specimen_between(walls, start: dict, particles) -> Specimen | None:
 
 
 def _spec(cls, table, section, numeric=(), integer=(), words=()):
-    """``cls(**table)``; keys in ``numeric`` must be finite numbers (or, if also in ``words``, a string that the
-    class checks, e.g. ``dt = "auto"``), keys in ``integer`` integers."""
-    _check_keys(table, section, ALLOWED[section])
+    """``cls(**table)`` with the keys of ``table`` that are fields of ``cls`` (the schema has checked them all);
+    keys in ``numeric`` must be finite numbers (or, if also in ``words``, a string that the class checks, e.g.
+    ``dt = "auto"``), keys in ``integer`` integers."""
+    names = {f.name for f in fields(cls)}
     kwargs = {}
     for key, v in table.items():
+        if key not in names:
+            continue
         if key in numeric and not (key in words and isinstance(v, str)):
             v = _number(table, section, key)
         if key in integer and (not isinstance(v, int) or isinstance(v, bool)):
@@ -431,43 +409,38 @@ def _spec(cls, table, section, numeric=(), integer=(), words=()):
         raise ValueError(msg if msg.startswith("[") else f"[{section}] {msg}") from None
 
 
-def _moving_keys(doc: dict, moving: bool) -> dict:
-    """``doc`` without the keys and tables of moving particles (:mod:`dem.scene.motion`), which a scene without
-    ``"mechanical"`` physics refuses by name; in a scene with it, an unknown key is refused here, naming every key
-    such a scene allows."""
-    out = dict(doc)
-    for table in MOVING_TABLES:
-        if table in out and not moving:
-            raise ValueError(f"[{table}]: only for moving particles ([scene] physics with \"mechanical\")")
-        out.pop(table, None)
-    for section, keys in MOVING_KEYS.items():
-        tables = out.get(section)
-        if tables is None:
-            continue
-        many = isinstance(tables, list)
-        cleaned = []
-        for k, t in enumerate(tables if many else [tables]):
-            if not isinstance(t, dict):
-                cleaned.append(t)
-                continue
-            if moving:
-                _check_keys(t, f"{section}[{k}]" if many else section, ALLOWED[section] | keys)
-            extra = sorted(set(t) & keys)
-            if extra and not moving:
-                raise ValueError(f"[{section}] {extra[0]}: only for moving particles ([scene] physics with "
-                                 f"\"mechanical\")")
-            cleaned.append({k: v for k, v in t.items() if k not in keys})
-        out[section] = cleaned if many else cleaned[0]
-    return out
+def _engine(doc: dict, physics, law) -> str:
+    """The engine a scene runs on (:mod:`dem.engines`): ``[solver] engine`` if it names one, else the one its physics
+    and contact law call for; the combination checked."""
+    moving = "mechanical" in physics
+    solver = doc.get("solver", {})
+    named = solver.get("engine") if isinstance(solver, dict) else None
+    if named is None:
+        return "static" if not moving else ("verlet" if law.SPINS else "staggered")
+    if named not in ENGINE_NAMES:
+        raise ValueError(f"[solver] engine = {named!r}: must be one of {', '.join(ENGINE_NAMES)}")
+    if (named == "static") == moving:
+        raise ValueError(f"[solver] engine = {named!r}: " + ("a packing that does not move runs on the static engine"
+                         if not moving else "particles that move (\"mechanical\" physics) run on \"verlet\" or "
+                                            "\"staggered\""))
+    if named == "staggered" and law.SPINS:
+        raise ValueError(f"[solver] engine = \"staggered\": steps particles that do not rotate; [contact] law = "
+                         f"{law.NAME!r} makes torques (use engine = \"verlet\")")
+    return named
 
 
 def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None) -> Scene:
-    """Validate a parsed TOML document into a :class:`Scene` (schema: README, "Scene schema")."""
-    top = set(ALLOWED) | {"materials", "contact"} | set(MOVING_TABLES)
-    unknown = sorted(set(doc) - top)
+    """Validate a parsed TOML document into a :class:`Scene`: every table and key against the schema of the engine
+    the scene runs on (:mod:`dem.scene.schema`), then each table into its part of the scene."""
+    if not isinstance(doc, dict):
+        raise ValueError("scene: must be a table of tables")
+    unknown = sorted(set(doc) - set(TABLES))
     if unknown:
-        raise ValueError(f"[{unknown[0]}]: unknown table (allowed: {', '.join(sorted(top))})")
-    physics = doc.get("scene", {}).get("physics", ["thermal"]) if isinstance(doc.get("scene", {}), dict) else None
+        raise ValueError(f"[{unknown[0]}]: unknown table (allowed: {', '.join(sorted(TABLES))})")
+    meta = doc.get("scene", {})
+    if not isinstance(meta, dict):
+        raise ValueError("[scene]: must be a table")
+    physics = meta.get("physics", ["thermal"])
     if isinstance(physics, str):
         physics = [physics]
     if not isinstance(physics, list) or not all(isinstance(x, str) for x in physics):
@@ -475,19 +448,21 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
                          f"{', '.join(PHYSICS)})")
     check_physics(physics)
     moving = "mechanical" in physics
-    full, doc = doc, _moving_keys(doc, moving)
-    meta = doc.get("scene", {})
-    _check_keys(meta, "scene", ALLOWED["scene"])
+    if moving and not isinstance(doc.get("contact"), dict):
+        raise ValueError("[contact]: required for mechanical physics (law = \"luding\" or \"zohdi\" and its "
+                         "parameters)")
+    law = law_module(doc["contact"].get("law")) if moving else None
+    engine = _engine(doc, physics, law)
+    check(doc, engine, law)
     materials = _materials(doc, thermal="thermal" in physics, electrical="electrical" in physics)
     start = None
-    if "start" in full:
+    if "start" in doc:
         if "particles" in doc or "generator" in doc:
             raise ValueError("[start] state: the particles come from the saved state; remove [particles] or "
                              "[generator]")
-        name = full["start"].get("state") if isinstance(full["start"], dict) else None
+        name = doc["start"].get("state")
         if not isinstance(name, str):
             raise ValueError("[start] state: required, the path of a saved state (.npz)")
-        _check_keys(full["start"], "start", ALLOWED["start"])
         start = state_file.load(base_dir / name if base_dir is not None else name)
         material = start.get("material")
         if material is not None and int(np.max(material, initial=0)) >= len(materials):
@@ -500,8 +475,8 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     elif "particles" in doc:
         particles, walls, specimen, velocity, box = _explicit_particles(doc["particles"], materials, base_dir)
     else:
-        dimension = full.get("scene", {}).get("dimension", 3) if moving else 3
-        particles, walls, specimen, velocity, box = _generated_particles(doc["generator"], materials, dimension)
+        particles, walls, specimen, velocity, box = _generated_particles(doc["generator"], materials,
+                                                                         meta.get("dimension", 3))
     if "periodic" in doc:
         if box is not None and "generator" in doc:
             raise ValueError("[periodic]: the generator's boundary = \"periodic\" already makes the block periodic; "
@@ -513,10 +488,9 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         raise ValueError(f"{'[periodic]' if 'periodic' in doc else '[particles] file: its box is periodic, and'}: "
                          "periodic boxes are for static packings so far (the neighbour list of moving particles does "
                          "not use dem.geometry.periodic yet)")
-    if not moving:
-        walls = walls + _walls(doc, start)
-        if specimen is None and start is not None:
-            specimen = _specimen_between(walls, start, particles)
+    walls = walls + _walls(doc, start, static=not moving)
+    if not moving and specimen is None and start is not None:
+        specimen = _specimen_between(walls, start, particles)
     cond = dict(doc.get("conductance", {}))
     if "fit_file" in cond and not isinstance(cond["fit_file"], str):
         raise ValueError(f"[conductance] fit_file = {cond['fit_file']!r}: must be a path (string)")
@@ -532,18 +506,15 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
                    integer=("max_steps",), words=("dt",))
     output = _spec(OutputSpec, doc.get("output", {}), "output", numeric=("checkpoint_every",),
                    integer=("every", "vtu_every"))
-    if velocity is not None and not moving:
-        raise ValueError("[generator] speed: only for moving particles ([scene] physics with \"mechanical\")")
-    contact = contact_material_from_scene(doc) if "contact" in doc else None
-    motion = parse_motion(full, particles, solver, physics, contact, velocity, start) if moving else None
-    electrical = parse_electrical(full, motion.walls if moving else (), physics)
+    contact = contact_material_from_scene(doc) if moving else None
+    motion = parse_motion(doc, particles, solver, physics, contact, velocity, start, walls) if moving else None
+    electrical = parse_electrical(doc, walls, physics)
     if start is not None and solver.mode == "transient" and solver.t_end <= start["t"]:
         raise ValueError(f"[solver] t_end = {solver.t_end:g} s: must be beyond the saved state's time "
                          f"{start['t']:.6g} s (the run's clock goes on from the state's)")
-    engine = "static" if not moving else ("staggered" if contact.law == "zohdi" else "verlet")
-    return Scene(particles, walls, conductance, Sources(conv, rad), solver, output, tuple(physics),
-                 str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact, motion,
-                 electrical, box, engine, start)
+    return Scene(particles, () if moving else walls, conductance, Sources(conv, rad), solver, output,
+                 tuple(physics), str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact,
+                 motion, electrical, box, engine, start)
 
 
 def contact_material_from_scene(doc: dict):

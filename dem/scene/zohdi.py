@@ -28,9 +28,7 @@ import numpy as np
 from dem.network.current import Electrodes, check_absorption, check_scheme
 
 LEAST_FACTOR = 0.05  # the step factor Phi never goes below this (one restart shrinks the step at most 20 x)
-OUTPUT_KEYS = {"fraction_axis", "frames"}
 DEFAULT_SKIN = 0.5  # x the mean radius: a step of the implicit scheme moves particles far more than a Verlet step
-ELECTRICAL_KEYS = {"scheme", "absorption", "tolerance", "sweeps", "floating"}
 ELECTRODE_KEYS = {"potential", "current"}
 
 
@@ -154,9 +152,6 @@ def parse_electrical(doc: dict, walls, physics) -> ElectricalSpec | None:
     table = doc.get("electrical", {})
     if not isinstance(table, dict):
         raise ValueError("[electrical]: must be a table")
-    unknown = sorted(set(table) - ELECTRICAL_KEYS)
-    if unknown:
-        raise ValueError(f"[electrical] {unknown[0]}: unknown key (allowed: {', '.join(sorted(ELECTRICAL_KEYS))})")
     scheme = check_scheme(table.get("scheme", "kirchhoff"))
     absorption = check_absorption(table.get("absorption", 1.0))
     tolerance = _number(table, "electrical", "tolerance", 1e-8)
@@ -193,25 +188,6 @@ def parse_electrical(doc: dict, walls, physics) -> ElectricalSpec | None:
     return ElectricalSpec(scheme, absorption, electrodes, float(tolerance), sweeps, floating)
 
 
-def strip_electrodes(tables: list) -> list:
-    """The ``[[walls]]`` tables without their electrode keys (a wall's motion is parsed from the rest)."""
-    return [{k: v for k, v in t.items() if k not in ELECTRODE_KEYS} if isinstance(t, dict) else t for t in tables]
-
-
-def refuse_zohdi_keys(doc: dict, physics) -> None:
-    """A scene with another contact law names none of the keys of this module."""
-    if "electrical" in physics:
-        raise ValueError("[scene] physics: \"electrical\" runs with [contact] law = \"zohdi\" (Zohdi 2014)")
-    for section, keys in (("solver", STEPPING_KEYS - {"dt"}), ("output", OUTPUT_KEYS)):
-        extra = sorted(set(doc.get(section, {})) & keys)
-        if extra:
-            raise ValueError(f"[{section}] {extra[0]}: only with [contact] law = \"zohdi\"")
-    for k, t in enumerate(doc.get("walls", [])):
-        extra = sorted(set(t) & ELECTRODE_KEYS) if isinstance(t, dict) else []
-        if extra:
-            raise ValueError(f"[walls][{k}] {extra[0]}: only with \"electrical\" physics ([contact] law = \"zohdi\")")
-
-
 def zohdi_motion(doc: dict, particles, solver, physics, start, walls, gravity, velocity, phases, wall_phases,
                  dimension):
     """The :class:`~dem.scene.motion.MotionSpec` of a scene with ``[contact] law = "zohdi"``."""
@@ -219,20 +195,7 @@ def zohdi_motion(doc: dict, particles, solver, physics, start, walls, gravity, v
 
     if dimension != 3:
         raise ValueError("[scene] dimension: law = \"zohdi\" moves spheres (dimension = 3)")
-    for table, why in (("temperature", "the temperatures come from the thermal submodel or stay at the initial ones"),):
-        if table in doc:
-            raise ValueError(f"[{table}]: not with law = \"zohdi\" ({why})")
-    if any(p[1] for p in phases):
-        raise ValueError("[phases] mu, mu_wall, gamma_n, gamma_t: parameters of law = \"luding\"; with law = "
-                         "\"zohdi\" a phase changes wall speeds (wall_velocity)")
-    if ("convection" in doc or "radiation" in doc):
-        raise ValueError("[convection], [radiation]: not with law = \"zohdi\" (its heat balance, eq. 31, has "
-                         "conduction and Joule heating only)")
     solver_table = doc.get("solver", {})
-    for key in ("thermal_interval", "integrator"):
-        if key in solver_table:
-            raise ValueError(f"[solver] {key}: not with law = \"zohdi\" (the heat is stepped with the positions, "
-                             f"by the same trapezoidal rule and fixed-point iteration)")
     stepping = parse_stepping(solver_table)
     skin = _num(solver_table, "solver", "skin", DEFAULT_SKIN * float(np.mean(particles.radius)), positive=True)
     out = doc.get("output", {})

@@ -12,8 +12,10 @@ def register(subparsers) -> None:
         description="Steady conduction through an infinite cubic lattice of equal spheres joined by the "
         "volume-conserving pair necks of every nearest-neighbour bond (Rojek 2022, eqs. 21-33), under a uniform "
         "gradient along z. The FE solves a sixteenth of the cubic cell bounded by mirror planes (the planes normal "
-        "to z isothermal, the others insulated): P2 on curved tetrahedra gives an upper bound, the Crouzeix-Raviart "
-        "flux on the inscribed straight mesh a lower bound; the mesh is refined until they are --rtol apart. "
+        "to z isothermal, the others insulated) on tetrahedra that fill the exact solid: conforming P_p elements give "
+        "an upper bound, a divergence-free Raviart-Thomas flux of degree p - 1 a lower bound; the mesh is refined "
+        "toward the neck circles until they are --rtol apart. The memory of each mesh is estimated before it is "
+        "solved, and a run that would not fit is refused with the rtol that would. "
         "Prints k_eff/kappa (the upper bound, the more accurate), its bounds, error_estimate = (upper - lower) / "
         "upper, the solid fraction phi (phi kappa is the Wiener upper bound of k_eff) and the pipe network's k_eff "
         "with the full-range fit law beside it.")
@@ -21,9 +23,11 @@ def register(subparsers) -> None:
     size = p.add_mutually_exclusive_group(required=True)
     size.add_argument("--h-over-r", type=float, metavar="X", help="overlap of neighbours over the radius")
     size.add_argument("--a-over-r", type=float, metavar="X", help="neck radius over the particle radius")
-    p.add_argument("--rtol", type=float, default=1e-3,
-                   help="relative gap of the bounds to reach (default 1e-3; 1e-3 takes ~1-4 min on 2 cores, each "
-                   "halving of rtol ~3x longer)")
+    p.add_argument("--rtol", type=float, default=1e-4,
+                   help="relative gap of the bounds to reach (default 1e-4: 0.5-3 min and 1-3 GB for the cubic "
+                   "lattices on a busy 2-core machine; 1e-3 a few seconds)")
+    p.add_argument("--max-memory", type=float, metavar="GB",
+                   help="memory the solve may use (default: what the machine has available)")
     add_output_options(p)
     p.set_defaults(run=run)
 
@@ -40,6 +44,8 @@ def run(args) -> dict:
 
     if not (1e-6 <= args.rtol < 0.1):  # False for NaN
         raise ValueError(f"rtol = {args.rtol!r}: valid range 1e-6 <= rtol < 0.1")
+    if args.max_memory is not None and not (0.1 <= args.max_memory < 1e6):
+        raise ValueError(f"max_memory = {args.max_memory!r}: valid range 0.1 <= max_memory < 1e6 (GB)")
     if args.a_over_r is not None:
         x = args.a_over_r
         limit = lattice.max_neck_ratio(args.kind)
@@ -54,6 +60,7 @@ def run(args) -> dict:
     cell = lattice.lattice_cell(args.kind, h)
     with tqdm(desc=f"lattice {args.kind}", unit="mesh", leave=False, delay=2.0) as bar:
         res = lattice.effective_conductivity(cell, rtol=args.rtol,
+                                             max_memory=None if args.max_memory is None else args.max_memory * 1e9,
                                              progress=lambda text: (bar.set_postfix_str(text, refresh=False), bar.update(1)))
     network = lattice.network_conductivity(cell, lambda r_i, r_j, a: pair_conductance(1.0, r_i, r_j, a))
     out = {"kind": args.kind, "h_over_r": h, "a_over_r": neck_radius(1.0, 1.0, h),
@@ -61,12 +68,13 @@ def run(args) -> dict:
            "k_lower_over_kappa": res.k_lower_over_kappa, "k_upper_over_kappa": res.k_upper_over_kappa,
            "error_estimate": res.error_estimate, "converged": res.converged, "phi": res.phi,
            "k_network_fit_over_kappa": network, "network_rel_error": network / res.k_eff_over_kappa - 1.0,
-           "dofs": res.dofs, "elements": res.elements, "meshes": len(res.levels), "volume_error": res.volume_error,
-           "seconds": res.seconds}
+           "order": res.order, "dofs": res.dofs, "elements": res.elements, "meshes": len(res.levels),
+           "volume_error": res.volume_error, "memory_estimate_gb": res.memory_estimate / 1e9, "seconds": res.seconds}
     if args.out:
         path = pathlib.Path(args.out)
         path.mkdir(parents=True, exist_ok=True)
-        (path / "lattice.json").write_text(json.dumps({**out, "levels": res.levels}, indent=2) + "\n")
+        (path / "lattice.json").write_text(json.dumps({**out, "peak_memory_gb": lattice.peak_memory() / 1e9,
+                                                       "levels": res.levels}, indent=2) + "\n")
         lattice.write_vtu(res, path / "cell.vtu")
         out["out"] = str(path)
     return out

@@ -31,6 +31,7 @@ import math
 import numpy as np
 
 from dem.geometry.motion import MotionState
+from dem.geometry.neighbours import list_arrays
 from dem.geometry.walls import box_axes
 from dem.engines.contact_current import ContactCurrent
 from dem.engines.staggered.heat import LumpedHeat
@@ -111,6 +112,7 @@ class StaggeredEngine:
         self.dt = float(saved["next_dt"])
         self.dt_taken = [float(x) for x in saved["dt_taken"]]
         self._phase = int(saved["phase"])
+        self.mechanics.resume_lists(saved)
 
     def _resume_current(self, saved: dict) -> None:
         """The current's energies and counters of a checkpoint (its refresh at the restored state counted once)."""
@@ -230,7 +232,7 @@ class StaggeredEngine:
                     iterations=np.array(self.iterations), last_iterations=np.array(self.last_iterations),
                     max_iterations=np.array(self.max_iterations), next_dt=np.array(self.dt),
                     dt_taken=np.array(self.dt_taken, dtype=float), phase=np.array(self._phase),
-                    lowest=np.array(getattr(self, "_lowest", np.nan)))
+                    lowest=np.array(getattr(self, "_lowest", np.nan)), **list_arrays(self.mechanics))
         if self.thermal is not None:
             th = self.thermal
             data.update(thermal_T0=th.T0, heat_keys=np.array(list(th.heat_in), dtype=str),

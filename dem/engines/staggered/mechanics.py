@@ -22,7 +22,7 @@ import numpy as np
 
 from dem.engines import compiled
 from dem.geometry.motion import MotionState
-from dem.geometry.neighbours import carry_history, max_displacement, verlet_pairs, wall_pairs
+from dem.geometry.neighbours import carry_history, max_displacement, restore_lists, verlet_pairs, wall_pairs
 from dem.geometry.walls import MOTIONS, WallArrays
 from dem.laws.contact import law_module
 
@@ -99,6 +99,14 @@ class StaggeredMechanics:
         self.x_ref = x.copy()
         self.wk, self.wm = wall_pairs(x, s.radius, self.w.normal, self.w.q, self.skin)
         self.wq_ref = self.w.q.copy()
+
+    def resume_lists(self, saved: dict) -> None:
+        """The Verlet lists of a checkpoint (a resumed run rebuilds them at the uninterrupted run's steps), with the
+        forces of the start of the step on them."""
+        restore_lists(self, saved)
+        self._p_hist_iter = np.zeros_like(self.p_hist)
+        s = self.state
+        self._evaluate(s.x, s.v, s.T, self.f)
 
     def _wall_reach(self) -> float:
         return float(np.max(np.abs(self.w.q - self.wq_ref), initial=0.0))

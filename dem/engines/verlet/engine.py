@@ -28,6 +28,7 @@ from dataclasses import replace
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.motion import MotionState
+from dem.geometry.neighbours import list_arrays, restore_lists
 from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
 from dem.scene.state_file import moving_arrays, normalised
@@ -107,7 +108,7 @@ class VerletEngine:
         for k, wall in enumerate(mech.walls):
             m = names.index(wall.name)
             mech.w.q[k], mech.w.dq[k], mech.w.acc[k] = saved["wall_q"][m], saved["wall_dq"][m], saved["wall_acc"][m]
-        mech.walls_moved()
+        restore_lists(mech, saved)
         if self.thermal is not None:
             th = self.thermal
             th.T = np.array(saved["thermal_T"], dtype=float)
@@ -392,7 +393,7 @@ class VerletEngine:
         data = self.state()
         mech = self.mechanics
         data.update(run_steps=np.array(mech.steps), t_start=np.array(mech.t_start),
-                    steps_start=np.array(self.steps_start))
+                    steps_start=np.array(self.steps_start), **list_arrays(mech))
         if self.thermal is not None:
             th = self.thermal
             data.update(thermal_T=th.T, thermal_rate=th.rate, thermal_energy0=np.array(th.energy0),

@@ -8,7 +8,8 @@ A contact law module defines (SI units; forces on particle i, the unit normal ``
 * ``NAME``; ``Material``, a frozen dataclass of its parameters with ``params()`` (a float64 array; ``N_PARAMS``
   entries) and a ``density``; ``PAIR_HISTORY``, ``WALL_HISTORY`` (the names of the numbers each pair and each
   particle-wall contact carries from step to step) and ``PARTICLE_STATE`` (those each particle carries); ``SPINS``
-  (its tangential forces make torques) and ``DRAG`` (it has a drag on every particle);
+  (its tangential forces make torques) and ``DRAG`` (it has a drag on every particle); ``SCHEMA_ROWS``, its
+  material's fields documented for the scene schema (:mod:`dem.scene.schema`: keys, type and unit, meaning);
 * ``initial_state(material, T)`` -- the particles' state columns at their initial temperatures, (N, S);
   ``reference_radius(material, radius, T)`` -- the radii the law's thermal expansion starts from;
   ``time_steps(material, mass, inertia, radius, m_mean)`` -- ``(dt, stable)``: the step ``dt = "auto"`` takes and the

@@ -422,6 +422,21 @@ PAIR_HISTORY = ("delta_max", "k1_last", "xi_x", "xi_y", "xi_z")
 WALL_HISTORY = PAIR_HISTORY
 PARTICLE_STATE = ("k1_factor",)  # k1(T, t)/k1 of each particle's material (eqs. 10-12)
 SPINS = True  # the tangential forces act at the contact point: torques
+SCHEMA_ROWS = (  # the scene keys of the material (dem.scene.schema): keys, type and unit, meaning
+    (("k1", "k2", "kc"), "N/m, required", "loading, largest un/reloading and cohesion stiffness (cold limit), "
+     "0 < k1 ≤ k2 (k1 = k2: elastic), kc ≥ 0 (eqs. 4, 7, 13)"),
+    (("kt_ratio",), "≥ 0, required", "α = k_t/k2(δmax) (eq. 23)"),
+    (("gamma_n", "gamma_t"), "kg/s, ≥ 0, required", "normal (eq. 5) and tangential (eq. 19) viscous damping"),
+    (("mu", "mu_wall"), "≥ 0, required", "particle-particle and particle-wall friction, cold limit (eqs. 14, 24)"),
+    (("T_melt", "T_var"), "required, T_var > 0", "k1(T) = k1[1 + tanh((T_melt - T)/T_var)]/2 (eq. 10); the scene's "
+     "temperature unit"),
+    (("expansion",), "1/K, ≥ 0, required", "δa_T of a(T) = a(T_melt)[1 - δa_T(T_melt - T)] (eq. 9)"),
+    (("fluid_overlap",), "0 < φ < 1, required", "δ_fluid = φ·2R_eff for a pair (φa for equal radii), φa_i for a wall "
+     "contact (Sec. 3.1.3)"),
+    (("t0",), "s, > 0, required", "relaxation time of k1(T, t) (eqs. 11-12)"),
+    (("brittle_sliding",), "bool, required", "a sliding contact keeps no cohesion, f_n ≥ 0 (footnote 5)"),
+    (("density",), "kg/m³, the `[material]` density", "particle density"),
+)
 DRAG = False
 
 

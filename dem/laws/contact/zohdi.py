@@ -125,6 +125,17 @@ PAIR_HISTORY = ("bonded",)  # 1: the bond of eq. 19 acts (activated by an accept
 WALL_HISTORY = ()
 PARTICLE_STATE = ()
 SPINS = False  # the particles do not rotate (Sec. 2)
+SCHEMA_ROWS = (  # the scene keys of the material (dem.scene.schema): keys, type and unit, meaning
+    (("K_p", "p_p", "K_p_lim"), "N/m², -, N/m²; required", "particle contact force K_p |E|^p_p A (eqs. 2-12), softened "
+     "to max(K_p (1 - θ/θ*), K_p_lim) (Sec. 7)"),
+    (("K_w", "p_w", "K_w_lim"), "N/m², -, N/m²; required", "the same for a wall (eqs. 13-15)"),
+    (("theta_star",), "K, required", "θ*, the softening temperature (Sec. 7; absolute temperatures)"),
+    (("K_b", "p_b", "E_star"), "N/m², -, -; required", "the bond K_b |E|^p_b A (eq. 19), activated once |E| ≥ E* "
+     "(eq. 18)"),
+    (("mu_d", "c_env", "v_slip"), "-, kg/(m s), m/s; required", "dynamic friction (eqs. 5, 16), drag c_env^o of c_env "
+     "= c_env^o 6πR (eq. 20, Sec. 7), the friction's regularisation speed"),
+    (("density",), "kg/m³, the `[material]` density", "particle density"),
+)
 DRAG = True  # eq. 20
 JIT = {"cache": True, "error_model": "numpy"}
 IN_LOOP = {**JIT, "inline": "always"}

@@ -1,0 +1,165 @@
+"""The upper bound: conforming ``P_p`` finite elements on an exactly curved tetrahedral mesh (Dirichlet's principle).
+
+The temperature is held at 1 on the hot faces and 0 on the cold ones; every other boundary is insulated. The
+discrete energy ``u^T A u`` of *any* admissible ``u`` is at least the exact conductance ``K`` (Dirichlet's principle),
+and the elements of :mod:`fem_neck.curved` fill the exact solid, so ``u^T A u >= K`` holds for the computed ``u``
+whatever the solver's residual (which only makes the bound less sharp). The ``(p - 1)(p - 2)(p - 3) / 6`` interior
+nodes of every element are condensed (Schur complement, batched); the skeleton system is solved by conjugate
+gradients preconditioned by :func:`fem_neck.pcg.two_level` (the piecewise-linear hats as coarse space).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fem_neck.curved import CurvedMesh
+from fem_neck.simplex import Lagrange, lagrange, tet_quadrature
+
+CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arrays)
+
+
+def quadrature_degree(p: int) -> int:
+    """Quadrature degree on curved elements: ``2 p`` (the polynomial part is ``2 p - 2``; two more for the map's
+    variation move the bounds by ~5e-8 relative against ``2 p + 4``, measured on the lattice cells)."""
+    return 2 * p
+
+
+def stiffness_matrices(mesh: CurvedMesh, basis: Lagrange, degree: int | None = None,
+                       elements: np.ndarray | None = None) -> np.ndarray:
+    """Element matrices ``(E, n, n)`` of ``int grad phi_a . grad phi_b`` of ``elements`` (default all): exact on
+    straight elements (a combination of the reference matrices), quadrature of ``degree`` on the curved ones."""
+    elements = np.arange(len(mesh.tets)) if elements is None else elements
+    J = mesh.affine_jacobians(elements)
+    inv = np.linalg.inv(J)
+    G = np.abs(np.linalg.det(J))[:, None, None] * np.einsum("eia,eja->eij", inv, inv)   # |det J| J^-1 J^-T
+    K = np.einsum("eij,ijab->eab", G, basis.stiffness)
+    curved = np.flatnonzero(mesh.is_curved[elements])
+    if len(curved):
+        xi, w = tet_quadrature(degree or quadrature_degree(basis.p))
+        products = symmetric_products(basis.gradients(xi))                     # (6 Q, n n)
+        G = mesh.metric(elements[curved], xi, w, inverse=True).reshape(len(curved), -1)
+        K[curved] = (G @ products).reshape(len(curved), basis.n, basis.n)
+    return K
+
+
+UPPER = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+
+
+def symmetric_products(g: np.ndarray) -> np.ndarray:
+    """``g_i g_j^T`` of reference fields ``g (Q, 3, n)`` for the six ``(i, j)`` of :data:`UPPER`, as ``(Q 6, n n)``
+    (symmetrised for ``i != j``), so that ``sum_q g^T G_q g`` is one matrix product with the entries of
+    :meth:`fem_neck.curved.CurvedMesh.metric`."""
+    out = np.stack([0.5 * (np.einsum("qa,qb->qab", g[:, i], g[:, j]) + np.einsum("qa,qb->qab", g[:, j], g[:, i]))
+                    for i, j in UPPER], axis=1)
+    return out.reshape(g.shape[0] * 6, -1)
+
+
+def volume(mesh: CurvedMesh, degree: int = 10) -> float:
+    """Volume of the mapped mesh (a check of the geometry against the exact solid)."""
+    vol = np.abs(np.linalg.det(mesh.affine_jacobians())) / 6.0
+    curved = mesh.curved
+    if len(curved):
+        xi, w = tet_quadrature(degree)
+        for start in range(0, len(curved), CHUNK):
+            el = curved[start:start + CHUNK]
+            vol[el] = np.abs(np.linalg.det(mesh.map(el, xi)[1])) @ w
+    return float(vol.sum())
+
+
+@dataclass(frozen=True)
+class Numbering:
+    """Global dofs of the skeleton nodes (vertices, edges, faces) of every element ``(M, n_skeleton)`` in the local
+    order of :class:`fem_neck.simplex.Lagrange`, and their count."""
+
+    l2g: np.ndarray
+    n: int
+
+
+def numbering(mesh: CurvedMesh, basis: Lagrange) -> Numbering:
+    M = len(mesh.tets)
+    nv, ne = len(mesh.points), len(mesh.edges)
+    cols = [mesh.tets]
+    pe, pf = basis.n_edge, basis.n_face
+    for k in range(6):
+        cols.append(nv + mesh.t2e[:, k:k + 1] * pe + np.arange(pe))
+    for f in range(4):
+        cols.append(nv + ne * pe + mesh.t2f[:, f:f + 1] * pf + np.arange(pf))
+    l2g = np.concatenate(cols, axis=1)
+    return Numbering(l2g.reshape(M, -1), nv + ne * pe + len(mesh.faces) * pf)
+
+
+def face_dofs(mesh: CurvedMesh, basis: Lagrange, faces: np.ndarray) -> np.ndarray:
+    """Global dofs of every node on the given faces."""
+    nv, ne = len(mesh.points), len(mesh.edges)
+    pe, pf = basis.n_edge, basis.n_face
+    verts = mesh.faces[faces]
+    ekey = mesh.edges[:, 0] * nv + mesh.edges[:, 1]
+    pairs = verts[:, [[0, 1], [0, 2], [1, 2]]].reshape(-1, 2)
+    edges = np.searchsorted(ekey, pairs[:, 0] * nv + pairs[:, 1])
+    out = [verts.ravel(), (nv + edges[:, None] * pe + np.arange(pe)).ravel(),
+           (nv + ne * pe + faces[:, None] * pf + np.arange(pf)).ravel()]
+    return np.unique(np.concatenate(out))
+
+
+@dataclass
+class Solution:
+    """``energy = u^T A u`` (the upper bound of the conductance for a unit temperature difference, kappa = 1), the
+    skeleton temperature ``u``, dofs (all nodes), skeleton dofs, CG iterations and the relative residual."""
+
+    energy: float
+    u: np.ndarray
+    dofs: int
+    skeleton_dofs: int
+    iterations: int
+    residual: float
+
+
+def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, rtol: float = 1e-10,
+          degree: int | None = None) -> Solution:
+    """The conforming ``P_p`` solution with ``u = 1`` on the ``hot`` faces and 0 on the ``cold`` ones (indices into
+    ``mesh.faces``; quadrature of ``degree`` on curved elements, default :func:`quadrature_degree`); see the module
+    docstring."""
+    from fem_neck import pcg
+
+    basis = lagrange(p)
+    skel = basis.n - basis.n_interior
+    num = numbering(mesh, basis)
+    fixed = np.zeros(num.n, dtype=bool)
+    values = np.zeros(num.n)
+    hot_dofs = face_dofs(mesh, basis, hot)
+    fixed[hot_dofs] = fixed[face_dofs(mesh, basis, cold)] = True
+    values[hot_dofs] = 1.0
+    system = pcg.Assembly(num.l2g, fixed, values)
+    for start in range(0, len(mesh.tets), CHUNK):
+        elements = np.arange(start, min(start + CHUNK, len(mesh.tets)))
+        K = stiffness_matrices(mesh, basis, degree, elements)
+        if basis.n_interior:  # condense the interior nodes
+            Kbb, Kbi, Kii = K[:, :skel, :skel], K[:, :skel, skel:], K[:, skel:, skel:]
+            K = Kbb - np.matmul(Kbi, np.linalg.solve(Kii, np.transpose(Kbi, (0, 2, 1))))
+        system.add(K, elements)
+    A = system.matrix()
+    P = hat_prolongation(mesh, basis, num)[system.free]
+    x, iterations, residual = pcg.solve(A, system.b, pcg.two_level(A, P), rtol=rtol)
+    u = values.copy()
+    u[system.free] = x
+    return Solution(system.energy(A, x), u, num.n + basis.n_interior * len(mesh.tets), num.n, iterations, residual)
+
+
+def hat_prolongation(mesh: CurvedMesh, basis: Lagrange, num: Numbering):
+    """The piecewise-linear hats in the skeleton basis, ``(n_skeleton, n_vertices)``: a hat's coefficient at a node
+    is its barycentric coordinate there."""
+    import scipy.sparse as sp
+
+    skel = basis.n - basis.n_interior
+    lam = np.concatenate([1.0 - basis.nodes[:skel].sum(axis=1, keepdims=True), basis.nodes[:skel]], axis=1)
+    M = len(mesh.tets)
+    rows = np.broadcast_to(num.l2g[:, :, None], (M, skel, 4))
+    cols = np.broadcast_to(mesh.tets[:, None, :], (M, skel, 4))
+    vals = np.broadcast_to(lam[None], (M, skel, 4))
+    keep = vals > 0.0
+    key = rows[keep].astype(np.int64) * len(mesh.points) + cols[keep]
+    key, first = np.unique(key, return_index=True)
+    return sp.csr_matrix((vals[keep][first], (key // len(mesh.points), key % len(mesh.points))),
+                         shape=(num.n, len(mesh.points)))
