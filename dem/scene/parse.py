@@ -141,6 +141,7 @@ class Scene:
     box: PeriodicBox | None = None  # a periodic box (dem.geometry.periodic), else None
     engine: str = "static"  # the engine that runs it (dem.engines)
     start: dict | None = None  # the saved state it starts from (dem.scene.state_file.load), else None
+    temperature_unit: str = "C"  # the unit of its temperatures, "C" or "K" (:func:`temperature_unit`)
 
     def __post_init__(self):
         walls = self.motion.walls if self.motion is not None else self.walls
@@ -514,7 +515,25 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
                          f"{start['t']:.6g} s (the run's clock goes on from the state's)")
     return Scene(particles, () if moving else walls, conductance, Sources(conv, rad), solver, output,
                  tuple(physics), str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact,
-                 motion, electrical, box, engine, start)
+                 motion, electrical, box, engine, start,
+                 temperature_unit(meta, rad, zohdi=law is not None and law.NAME == "zohdi"))
+
+
+TEMPERATURE_UNITS = {"C": "°C", "K": "K"}  # [scene] temperature_unit: the symbol on the plots' axes
+
+
+def temperature_unit(meta: dict, rad: Radiation | None, zohdi: bool) -> str:
+    """``[scene] temperature_unit``: "C" or "K"; by default ``radiation.unit`` where the scene has radiation, "K"
+    for scenes with Zohdi 2014's contact law (``zohdi``: its thermal softening and Joule heating work in kelvin),
+    else "C". Only labels the outputs: every law takes the scene's temperatures as they are."""
+    default = rad.unit if rad is not None else "K" if zohdi else "C"
+    unit = meta.get("temperature_unit", default)
+    if unit not in TEMPERATURE_UNITS:
+        raise ValueError(f"[scene] temperature_unit = {unit!r}: must be \"C\" or \"K\"")
+    if rad is not None and unit != rad.unit:
+        raise ValueError(f"[scene] temperature_unit = {unit!r}: differs from radiation.unit = {rad.unit!r} (the unit "
+                         f"of the same temperatures)")
+    return unit
 
 
 def contact_material_from_scene(doc: dict):

@@ -224,18 +224,33 @@ class VerletEngine:
         return None if volume is None else self.mechanics.state.solid_volume() / volume
 
     def wall_stress(self) -> dict:
-        """Normal stress the particles exert on each wall of an axis-aligned box: force per unit length (2D, N/m,
-        the paper's pressure unit) or per unit area (3D, Pa); the bare force (N) on a wall outside such a box."""
+        """Normal load the particles exert on each wall, in one unit for every wall (:meth:`wall_load_unit`): the
+        force per unit length (2D, N/m, the paper's pressure unit) or per unit area (3D, Pa) when every wall spans the
+        same number of box axes, else the bare force (N) on every wall."""
         mech = self.mechanics
-        out = {}
-        for k, wall in enumerate(mech.walls):
-            lo_hi = mech.w.span[k]
-            extent = 1.0
+        extents, _ = self._wall_extents()
+        return {wall.name: float(mech.w.force[k] / extents[k]) for k, wall in enumerate(mech.walls)}
+
+    def wall_load_unit(self) -> str:
+        """The unit of :meth:`wall_stress`: "Pa", "N/m" or "N"."""
+        return ("N", "N/m", "Pa")[self._wall_extents()[1]]
+
+    def _wall_extents(self) -> tuple[list, int]:
+        """Per wall the length (one box axis along it) or area (two) its load is divided by, and that number of
+        axes; all 1 and 0 axes when the walls span different numbers of axes (N/m beside Pa would share no axis)."""
+        mech = self.mechanics
+        extents, spanned = [], set()
+        for k in range(len(mech.walls)):
+            lo_hi, extent, axes = mech.w.span[k], 1.0, 0
             for a in range(2):
                 if lo_hi[2 * a] >= 0:
                     extent *= mech.w.extent(lo_hi[2 * a], lo_hi[2 * a + 1])
-            out[wall.name] = float(mech.w.force[k] / extent)
-        return out
+                    axes += 1
+            extents.append(extent)
+            spanned.add(axes)
+        if len(spanned) > 1:
+            return [1.0] * len(extents), 0
+        return extents, spanned.pop() if spanned else 0
 
     def heated_walls(self):
         """``(hot, cold)`` wall indices when exactly two walls carry different temperatures and face each other
@@ -377,7 +392,7 @@ class VerletEngine:
     def plots(self, out, summary: dict) -> list[str]:
         from dem.output.plots import motion_plots
 
-        return motion_plots(out)
+        return motion_plots(out, self.scene.temperature_unit, self.wall_load_unit())
 
     @property
     def dt(self) -> float:
