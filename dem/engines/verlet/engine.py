@@ -33,7 +33,7 @@ from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
 from dem.scene.state_file import moving_arrays, normalised
 from dem.network.heat import boundary_heat_flow, steady
-from fem_neck.geometry import neck_radius
+from fem_neck.geometry import max_overlap, neck_radius
 
 
 class VerletEngine:
@@ -302,7 +302,8 @@ class VerletEngine:
         density = np.bincount(slab, v, bins) / (area * np.diff(edges))
         i, j, overlap = mech.contacts()[:3]
         r_min = np.minimum(s.radius[i], s.radius[j])
-        h = np.minimum(overlap, 0.999 * (2.0 / 3.0) * r_min)  # within the neck model's range, for the profile
+        # within the neck model's range (the neck reaches the smaller radius), for the profile
+        h = np.minimum(overlap, 0.999 * max_overlap(s.radius[i], s.radius[j]))
         neck = np.asarray(neck_radius(s.radius[i], s.radius[j], h)) / r_min if len(i) else np.zeros(0)
         mid = np.clip(np.searchsorted(edges, 0.5 * (dist[i] + dist[j])) - 1, 0, bins - 1)
         count = np.bincount(mid, minlength=bins)
