@@ -151,3 +151,35 @@ def test_console_block(tmp_path, command, expected, files, places):
     assert len(got) == len(want), message
     bad = [(w, g) for w, g in zip(want, got) if not close(w, g)]
     assert not bad, f"{message}\n(page, now): {bad}"
+
+
+# ------------------------------------------------------------------------------------------ numbers in paragraphs
+HOT_WALL = re.compile(
+    r"After 0\.15 s the solid fraction is (?P<hot>[\d.]+) next to the hot wall and (?P<top>[\d.]+) at the\s+top, the "
+    r"mean neck radius a/r (?P<neck_hot>[\d.]+) against (?P<neck_top>[\d.]+), and the effective conductivity between "
+    r"the walls has risen to\s+(?P<k_eff>[\d.]+) W/\(m K\).*?(?P<steps>[\d.]+)·10⁵ steps", re.S)
+
+
+def _as_printed(value: float, shown: str) -> bool:
+    """``value`` rounds to the digits ``shown`` prints (a paragraph's precision, not the console blocks' 1e-6)."""
+    decimals = len(shown.split(".")[1]) if "." in shown else 0
+    return abs(value - float(shown)) <= 0.5 * 10.0 ** -decimals * (1 + 1e-9)
+
+
+@pytest.mark.slow
+def test_hot_wall_sintering_paragraph(tmp_path):
+    """The README's paragraph on the built-in hot-wall-sintering run: its numbers are those of a run of this code
+    (deterministic: the same to the last bit with numba compiled for a generic x86-64 or the host's CPU, and with one
+    thread or two)."""
+    shown = HOT_WALL.search(README.read_text())
+    assert shown, "README.md: the hot-wall-sintering paragraph moved or was reworded; update HOT_WALL"
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    proc = subprocess.run([sys.executable, "-m", "dem", "run", "hot-wall-sintering", "--json"], cwd=tmp_path, env=env,
+                          stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, timeout=3600)
+    summary = json.loads(proc.stdout)
+    profile = summary["profile"]
+    ran = {"hot": profile["solid_fraction"][0], "top": profile["solid_fraction"][-1],
+           "neck_hot": profile["neck_over_radius"][0], "neck_top": profile["neck_over_radius"][-1],
+           "k_eff": summary["effective_conductivity"], "steps": summary["steps"] / 1e5}
+    bad = {key: (shown[key], value) for key, value in ran.items() if not _as_printed(value, shown[key])}
+    assert not bad, f"README.md hot-wall-sintering paragraph (shown, now): {bad}"
