@@ -154,25 +154,23 @@ def test_console_block(tmp_path, command, expected, files, places):
 
 
 # ------------------------------------------------------------------------------------------ numbers in paragraphs
+PM = r"(?P<{0}>[\d.]+) ± (?P<{0}_pm>[\d.]+)"  # a figure and its spread, as a paragraph prints it
 HOT_WALL = re.compile(
-    r"After 0\.15 s the solid fraction is (?P<hot>[\d.]+) next to the hot wall and (?P<top>[\d.]+) at the\s+top, the "
-    r"mean neck radius a/r (?P<neck_hot>[\d.]+) against (?P<neck_top>[\d.]+), and the effective conductivity between "
-    r"the walls has risen to\s+(?P<k_eff>[\d.]+) W/\(m K\).*?(?P<steps>[\d.]+)·10⁵ steps", re.S)
-
-
-def _as_printed(value: float, shown: str) -> bool:
-    """``value`` rounds to the digits ``shown`` prints (a paragraph's precision, not the console blocks' 1e-6)."""
-    decimals = len(shown.split(".")[1]) if "." in shown else 0
-    return abs(value - float(shown)) <= 0.5 * 10.0 ** -decimals * (1 + 1e-9)
+    (r"After 0\.15 s the solid fraction is {hot} next to the hot wall and {top} at the top, the mean neck radius "
+     r"a/r {neck_hot} against {neck_top}, and the effective conductivity between the walls has risen to {k_eff} "
+     r"W/\(m K\).*?(?P<steps>[\d.]+)·10⁵ steps").format(**{k: PM.format(k) for k in
+                                                        ("hot", "top", "neck_hot", "neck_top", "k_eff")})
+    .replace(" ", r"\s+"), re.S)  # wrapped anywhere
 
 
 @pytest.mark.slow
 def test_hot_wall_sintering_paragraph(tmp_path):
-    """The README's paragraph on the built-in hot-wall-sintering run: its numbers are those of a run of this code
-    (deterministic: the same to the last bit with numba compiled for a generic x86-64 or the host's CPU, and with one
-    thread or two)."""
-    shown = HOT_WALL.search(README.read_text())
-    assert shown, "README.md: the hot-wall-sintering paragraph moved or was reworded; update HOT_WALL"
+    """The paragraph on the built-in hot-wall-sintering run (README and docs): a run of this code lies within the spread the
+    paragraph states for each figure (the packing is chaotic: round-off differences between machines grow into
+    different trajectories), and takes the step count it states."""
+    pages = {page.relative_to(ROOT): HOT_WALL.search(page.read_text()) for page in PAGES}
+    pages = {page: shown for page, shown in pages.items() if shown}
+    assert pathlib.Path("README.md") in pages, "README.md: the hot-wall-sintering paragraph moved or was reworded"
     env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
     proc = subprocess.run([sys.executable, "-m", "dem", "run", "hot-wall-sintering", "--json"], cwd=tmp_path, env=env,
                           stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, timeout=3600)
@@ -180,6 +178,9 @@ def test_hot_wall_sintering_paragraph(tmp_path):
     profile = summary["profile"]
     ran = {"hot": profile["solid_fraction"][0], "top": profile["solid_fraction"][-1],
            "neck_hot": profile["neck_over_radius"][0], "neck_top": profile["neck_over_radius"][-1],
-           "k_eff": summary["effective_conductivity"], "steps": summary["steps"] / 1e5}
-    bad = {key: (shown[key], value) for key, value in ran.items() if not _as_printed(value, shown[key])}
-    assert not bad, f"README.md hot-wall-sintering paragraph (shown, now): {bad}"
+           "k_eff": summary["effective_conductivity"]}
+    for page, shown in pages.items():
+        bad = {key: (f"{shown[key]} ± {shown[key + '_pm']}", value) for key, value in ran.items()
+               if abs(value - float(shown[key])) > float(shown[key + "_pm"]) * (1 + 1e-9)}
+        assert not bad, f"{page}: the hot-wall-sintering paragraph (shown, now): {bad}"
+        assert round(summary["steps"] / 1e5, 1) == float(shown["steps"]), page
