@@ -135,10 +135,12 @@ def test_lens_clip_contained_sphere_equalises_to_the_energy_mean(tmp_path, capsy
 
 
 def test_lens_clip_centre_behind_a_wall_refused(tmp_path, capsys):
-    """Was exit 0 with NaN temperatures (infinite wall conductance)."""
-    wall = "[[walls]]\npoint = [0.0, 0.0, 0.5e-3]\nnormal = [0.0, 0.0, 1.0]\ntemperature = 1.0\n"
-    text = scene(extra='[conductance]\nlaw = "zohdi"\nout_of_range = "clip"\n' + wall, solver=STEADY)
-    refuse_scene(tmp_path, text, capsys, "wall", "drop")
+    """Was exit 0 with NaN temperatures (infinite wall conductance). A centre behind the wall is refused with the
+    scene; one on the wall's plane by its infinite conductance."""
+    for z, needles in (("0.5e-3", ("particle 0", "behind wall 'wall0'")), ("0.0", ("wall bond of particle 0", "finite"))):
+        wall = f"[[walls]]\npoint = [0.0, 0.0, {z}]\nnormal = [0.0, 0.0, 1.0]\ntemperature = 1.0\n"
+        text = scene(extra='[conductance]\nlaw = "zohdi"\nout_of_range = "clip"\n' + wall, solver=STEADY)
+        refuse_scene(tmp_path, text, capsys, *needles)
 
 
 def test_numerically_singular_step_is_explained(tmp_path, capsys):

@@ -151,3 +151,36 @@ def test_console_block(tmp_path, command, expected, files, places):
     assert len(got) == len(want), message
     bad = [(w, g) for w, g in zip(want, got) if not close(w, g)]
     assert not bad, f"{message}\n(page, now): {bad}"
+
+
+# ------------------------------------------------------------------------------------------ numbers in paragraphs
+PM = r"(?P<{0}>[\d.]+) ± (?P<{0}_pm>[\d.]+)"  # a figure and its spread, as a paragraph prints it
+HOT_WALL = re.compile(
+    (r"After 0\.15 s the solid fraction is {hot} next to the hot wall and {top} at the top, the mean neck radius "
+     r"a/r {neck_hot} against {neck_top}, and the effective conductivity between the walls has risen to {k_eff} "
+     r"W/\(m K\).*?(?P<steps>[\d.]+)·10⁵ steps").format(**{k: PM.format(k) for k in
+                                                        ("hot", "top", "neck_hot", "neck_top", "k_eff")})
+    .replace(" ", r"\s+"), re.S)  # wrapped anywhere
+
+
+@pytest.mark.slow
+def test_hot_wall_sintering_paragraph(tmp_path):
+    """The paragraph on the built-in hot-wall-sintering run (README and docs): a run of this code lies within the spread the
+    paragraph states for each figure (the packing is chaotic: round-off differences between machines grow into
+    different trajectories), and takes the step count it states."""
+    pages = {page.relative_to(ROOT): HOT_WALL.search(page.read_text()) for page in PAGES}
+    pages = {page: shown for page, shown in pages.items() if shown}
+    assert pathlib.Path("README.md") in pages, "README.md: the hot-wall-sintering paragraph moved or was reworded"
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    proc = subprocess.run([sys.executable, "-m", "dem", "run", "hot-wall-sintering", "--json"], cwd=tmp_path, env=env,
+                          stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, timeout=3600)
+    summary = json.loads(proc.stdout)
+    profile = summary["profile"]
+    ran = {"hot": profile["solid_fraction"][0], "top": profile["solid_fraction"][-1],
+           "neck_hot": profile["neck_over_radius"][0], "neck_top": profile["neck_over_radius"][-1],
+           "k_eff": summary["effective_conductivity"]}
+    for page, shown in pages.items():
+        bad = {key: (f"{shown[key]} ± {shown[key + '_pm']}", value) for key, value in ran.items()
+               if abs(value - float(shown[key])) > float(shown[key + "_pm"]) * (1 + 1e-9)}
+        assert not bad, f"{page}: the hot-wall-sintering paragraph (shown, now): {bad}"
+        assert round(summary["steps"] / 1e5, 1) == float(shown["steps"]), page

@@ -123,6 +123,8 @@ BAD = {
     "no rows": ("t,overlap,T\n", "no data rows"),
     "empty file": ("", "column 't' missing"),
     "radius vanishes": ("t,overlap,T\n0,1e-5,-1e5\n", "T_melt - 1/expansion"),
+    "overlap beyond the pair": ("t,overlap,T\n0,1e-5,20\n1,0.5,20\n", "row 2: overlap = 0.5 m: valid range overlap "
+                                f"< 2 a = {2 * A:.6g} m"),
 }
 
 

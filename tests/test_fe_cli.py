@@ -85,3 +85,12 @@ def test_converge_json_and_plot(capsys, tmp_path, monkeypatch):
         assert {"order", "grading", "dofs", "h_min", "elements_across_neck", "K_over_Kcyl"} <= level.keys()
     assert out["extrapolated"] == pytest.approx(SEMISPHERE_BY_H[0.08].K_over_Kcyl, rel=1e-4)
     assert (tmp_path / "converge.png").stat().st_size > 10_000
+
+
+def test_unequal_writes_nothing_without_out(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    rc, result = _run(capsys, ["unequal", "--ratios", "2", "--necks", "0.2", "--workers", "1", "--json"])
+    assert rc == 0 and "out" not in result and list(tmp_path.iterdir()) == []
+    rc, result = _run(capsys, ["unequal", "--ratios", "2", "--necks", "0.2", "--workers", "1", "--json", "--out", "u"])
+    assert rc == 0 and result["out"] == "u" and sorted(p.name for p in (tmp_path / "u").iterdir()) == [
+        "unequal.csv", "unequal.json", "unequal.png"]

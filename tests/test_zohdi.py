@@ -376,14 +376,21 @@ def test_compiled_lens_conduction_is_the_conductance_law_on_the_bonds():
 
 
 @pytest.mark.slow
-def test_frames_are_rendered_off_screen(tmp_path):
+def test_frames_are_rendered_off_screen_in_one_colour_range(tmp_path, monkeypatch):
+    from dem.output import frames as frames_module
     from dem.output.frames import FrameWriter
 
+    ranges = []
+    draw = frames_module.render
+    monkeypatch.setattr(frames_module, "render", lambda *args: ranges.append(args[6]) or draw(*args))
     doc = column()
     doc["output"] = {"fraction_axis": "x"}
     sim = StaggeredEngine(parse_scene(doc))
-    frames = FrameWriter(tmp_path, 2, 0.01, 0, 300.0, 1000.0)
+    frames = FrameWriter(tmp_path, 2, 0.01, 0, 300.0, 300.0)
     frames(sim)
     sim.run(lambda: frames(sim))
-    assert frames.written == ["frame_00.png", "frame_01.png"]
+    assert frames.render() == ["frame_00.png", "frame_01.png"]
     assert all((tmp_path / "frames" / name).stat().st_size > 10_000 for name in frames.written)
+    first, last = (float(np.max(np.load(tmp_path / "frames" / f"frame_{k:02d}.npz")["T"])) for k in range(2))
+    assert first == 300.0 < last and ranges == [(300.0, last)] * 2  # Joule-heated: the first frame on the last's scale
+    assert FrameWriter(tmp_path, 2, 0.01, 0, 300.0, 300.0).next == 2  # resumed: the frames taken are kept

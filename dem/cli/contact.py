@@ -3,7 +3,8 @@ driven through a prescribed history.
 
 The pair: two equal particles of the scene's mean radius ``a`` (so ``delta_fluid = fluid_overlap * a``), made of
 the scene's ``[contact]`` material. The history CSV has the columns ``t`` (s, strictly increasing), ``overlap``
-(m; <= 0 opens the contact: no force, and a later overlap starts a fresh contact) and ``T`` (the scene's
+(m; <= 0 opens the contact: no force, and a later overlap starts a fresh contact; below the pair's size ``2 a``,
+where the centres meet) and ``T`` (the scene's
 temperature unit); other columns are ignored. Per row the tool reports the normal force on a particle (N, > 0
 repulsive), ``delta_max``, ``delta_0``, ``k1`` = k1(T, t), ``k2`` = k2(delta_max), ``kc`` = kc(T, t, delta_max)
 (all in N/m) and ``f_min`` (eq. 15).
@@ -15,7 +16,7 @@ each row's temperature (eq. 12, :func:`dem.laws.contact.luding.relax_k1`; coolin
 
 Without ``--json`` the rows are printed as a table; ``--out DIR`` writes ``contact.csv`` and ``contact.png`` (force
 against overlap with the cold k1 line, the k1(T, t) and -kc(T, t, delta_max) lines of the last row and the
-path taken).
+path taken; beside it the temperature history and k1(T, t)/k1).
 """
 
 from __future__ import annotations
@@ -82,6 +83,17 @@ def read_history(path) -> dict:
     return out
 
 
+def check_overlaps(path, overlap, radius: float) -> None:
+    """Refuse an overlap of the pair of radius ``radius`` at or beyond the pair's size ``2 radius`` (the centres meet
+    there), naming the file and the row."""
+    beyond = np.flatnonzero(np.asarray(overlap) >= 2.0 * radius)
+    if beyond.size:
+        k = int(beyond[0])
+        raise ValueError(f"history {pathlib.Path(path).name}: row {k + 1}: overlap = {float(overlap[k])!r} m: valid "
+                         f"range overlap < 2 a = {2.0 * radius:.6g} m (the pair's size: two particles of the scene's "
+                         f"mean radius a = {radius:.6g} m, whose centres meet at 2 a)")
+
+
 def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> dict:
     """One pair contact of two equal particles of radius ``radius`` through the history (see the module
     docstring); returns the per-row arrays named in :data:`OUTPUTS`."""
@@ -116,6 +128,7 @@ def run(args) -> dict:
     history = read_history(args.history)
     material.check_temperatures(history["T"], name="history T")
     radius = float(np.mean(scene.particles.radius))
+    check_overlaps(args.history, history["overlap"], radius)
     rows = drive_pair(material, radius, history["t"], history["overlap"], history["T"], not args.no_damping)
     result = {
         "pair": f"two equal particles of the scene's mean radius a = {radius:.6g} m",
@@ -129,7 +142,7 @@ def run(args) -> dict:
         out = pathlib.Path(args.out)
         out.mkdir(parents=True, exist_ok=True)
         write_csv(out / "contact.csv", history, rows)
-        plot(out / "contact.png", material, radius, history, rows)
+        plot(out / "contact.png", material, radius, history, rows, scene.temperature_unit)
         result["files"] = [str(out / "contact.csv"), str(out / "contact.png")]
     if not args.json:
         print_table(history, rows)
@@ -153,19 +166,21 @@ def print_table(history: dict, rows: dict) -> None:
         print("  ".join(f"{v:>12.6g}" for v in values))
 
 
-def plot(path: pathlib.Path, material, radius: float, history: dict, rows: dict) -> None:
-    """Force against overlap in the style of Luding 2005, Figs. 2, 3 and 5: the cold k1 line, the k1(T, t) and
-    -kc(T, t, delta_max) lines of the last row, and the path through the rows."""
+def plot(path: pathlib.Path, material, radius: float, history: dict, rows: dict, temperature_unit: str) -> None:
+    """Left: force against overlap in the style of Luding 2005, Figs. 2, 3 and 5 -- the cold k1 line, the k1(T, t)
+    and -kc(T, t, delta_max) lines of the last row and the path through the rows. Right: the temperature history
+    (in the scene's ``temperature_unit``) and the stiffness factor k1(T, t)/k1 it drives (eqs. 10, 12)."""
     from matplotlib.figure import Figure
 
     from dem.laws.contact import luding as law
+    from dem.output.plots import temperature_label
 
     delta_fluid = law.pair_delta_fluid(radius, radius, material.fluid_overlap)
     x = history["overlap"]
     top = max(float(np.max(x)), float(np.max(rows["delta_max"])), 1e-300)
     line = np.array([0.0, 1.1 * top])
-    fig = Figure(figsize=(6.4, 4.8))
-    ax = fig.add_subplot()
+    fig = Figure(figsize=(11.0, 4.8))
+    ax, heat = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.3, 1.0]})
     ax.plot(line, material.k1 * line, "k--", lw=1, label="$k_1\\delta$ (cold)")
     if abs(rows["k1"][-1] / material.k1 - 1.0) > 1e-3:
         ax.plot(line, rows["k1"][-1] * line, "C1--", lw=1, label="$k_1(T,t)\\delta$ (last row)")
@@ -178,5 +193,13 @@ def plot(path: pathlib.Path, material, radius: float, history: dict, rows: dict)
     ax.set_ylabel("normal force $f$ (N)")
     ax.set_title(f"Luding 2005 contact, equal pair a = {radius:.3g} m")
     ax.legend(fontsize=8)
+    heat.plot(history["t"], history["T"], "C3.-", lw=1.2, ms=3)
+    heat.set_xlabel("t (s)")
+    heat.set_ylabel(temperature_label(temperature_unit), color="C3")
+    heat.set_title("temperature history")
+    factor = heat.twinx()
+    factor.plot(history["t"], rows["k1"] / material.k1, "C0--", lw=1)
+    factor.set_ylabel("$k_1(T,t)/k_1$", color="C0")
+    factor.set_ylim(-0.05, 1.05)
     fig.tight_layout()
     fig.savefig(path, dpi=120)

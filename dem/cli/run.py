@@ -22,10 +22,11 @@ def register(sub):
 def run(args) -> dict:
     from dem.scene import load_scene
     from dem.driver import run as run_scene
+    from dem.memory import available_bytes
 
     try:
         scene = load_scene(args.scene)
         return run_scene(scene, args.out, progress=True, resume=args.resume, overwrite=args.overwrite).summary
-    except MemoryError:
-        raise ValueError(f"scene = {args.scene!r}: out of memory (about 1.7 GiB per 10^6 particles for a steady "
-                         f"solve); use a smaller scene") from None
+    except MemoryError:  # beyond the estimate checked up front (dem.memory): say so in one line all the same
+        raise ValueError(f"scene = {args.scene!r}: ran out of memory (the machine had "
+                         f"{(available_bytes() or 0.0) / 2**30:.3g} GiB available); use fewer particles") from None

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from dem import memory
 from dem.network.heat import Checkpoint, boundary_heat_flow, build_network, integrate, periodic_heat_flow, steady
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
@@ -45,8 +46,9 @@ class StaticEngine:
     def __init__(self, scene, restart: dict | None = None):
         """``restart``: the checkpoint of this scene's transient run (:func:`dem.output.folder.load`)."""
         self.scene = scene
+        memory.check(scene.particles.n, "particles")  # before the bond search: a refused run costs nothing
         if scene.solver.mode == "transient":
-            self._check_work()  # before the bond search: a refused run costs nothing
+            self._check_work()
         self.network = build_network(scene.particles, scene.walls, scene.conductance, scene.sources, box=scene.box)
         self.bonds, self.K_pairs, self.K_walls = self.network.bonds, self.network.K_pairs, self.network.K_walls
         self.restart = Checkpoint.from_arrays(restart) if restart is not None else None

@@ -18,22 +18,30 @@ seconds.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq
 from scipy.spatial import cKDTree
 
+from dem import memory
 from fem_neck.geometry import max_overlap
 
 DISTRIBUTIONS = ("constant", "uniform", "lognormal")
-MAX_PARTICLES = 5_000_000  # ~1.7 GiB peak per 10^6 particles (steady, AMG): larger packings need a distributed backend
+MAX_PARTICLES = 5_000_000  # larger packings need a distributed backend (the memory: dem.memory)
 RSA_CANDIDATES = 3000  # random points tried per particle by random_box (jamming near a solid fraction of 0.3 in 3D)
+RSA_BLOCK = 1 << 16    # random_box draws its candidates in blocks of this many points
+# the fractions of space that random sequential addition of equal spheres (3) and disks (2) fills when it jams, the
+# saturation limit of infinitely many attempts (Zhang & Torquato 2013, Phys. Rev. E 88, 053312)
+RSA_JAMMING = {3: 0.384130, 2: 0.547070}
 
 
 def _check_count(n: int, name: str):
+    """Refuse ``n`` particles beyond :data:`MAX_PARTICLES` or the machine's memory, before they are generated."""
     if n > MAX_PARTICLES:
         raise ValueError(f"[generator] {name}: {n} particles exceeds the limit of {MAX_PARTICLES} for one machine")
+    memory.check(n, f"[generator] {name}")
 
 
 @dataclass(frozen=True)
@@ -225,6 +233,24 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
                   period * scale, np.zeros(3))
 
 
+def _mean_size(radius: float, spread: float, dimension: int) -> float:
+    """The mean volume (3D) or area (2D) of a particle with a radius uniform in ``radius (1 +- spread)``:
+    ``E[r^3] = radius^3 (1 + spread^2)``, ``E[r^2] = radius^2 (1 + spread^2 / 3)``."""
+    if dimension == 2:
+        return math.pi * radius**2 * (1.0 + spread**2 / 3.0)
+    return 4.0 / 3.0 * math.pi * radius**3 * (1.0 + spread**2)
+
+
+def box_capacity(radius: float, spread: float, box, dimension: int = 3) -> int:
+    """About how many particles :func:`random_box` can place at most in ``box``: the box's volume (area of the x-z
+    face for 2D disks) filled to the jamming fraction of random sequential addition (:data:`RSA_JAMMING`), over
+    the particles' mean volume (area). An upper estimate: the box's faces and a finite number of attempts leave
+    it emptier (about 0.30 for the spheres of ``hot-wall-sintering``)."""
+    b = np.asarray(box, dtype=float)
+    span = (b[1] - b[0])[[0, 2] if dimension == 2 else [0, 1, 2]]
+    return int(RSA_JAMMING[dimension] * float(np.prod(span)) / _mean_size(radius, spread, dimension))
+
+
 def random_box(n: int, radius, box, radius_spread: float = 0.0, seed: int = 0, speed: float = 0.0,
                dimension: int = 3) -> Layout:
     """``n`` particles placed one after the other at uniformly random positions inside the box ``[[x, y, z]_lo,
@@ -249,21 +275,39 @@ def random_box(n: int, radius, box, radius_spread: float = 0.0, seed: int = 0, s
     if b.shape != (2, 3) or not np.all(np.isfinite(b)) or np.any(b[1][axes] <= b[0][axes]):
         raise ValueError(f"[generator] box = {box!r}: must be [[x, y, z]_low, [x, y, z]_high] with low < high"
                          f"{' in x and z (2D disks: y is ignored)' if dimension == 2 else ''}")
+    lo, hi = b[0].copy(), b[1].copy()
+    if dimension == 2:
+        lo[1] = hi[1] = 0.0
+    capacity = box_capacity(r_mean, spread, b, dimension)
+    if n > capacity:
+        shape = "disks" if dimension == 2 else "spheres"
+        size = " x ".join(f"{1e3 * s:.4g}" for s in (b[1] - b[0])[axes])
+        need = n * _mean_size(r_mean, spread, dimension) / np.prod((b[1] - b[0])[axes])
+        raise ValueError(f"[generator] n = {n}: about {capacity} {shape} of radius {r_mean:.4g} m "
+                         f"(+-{100 * spread:.3g} %) at most fit in the {size} mm box{' (x-z)' if dimension == 2 else ''}"
+                         f" by random sequential addition, which jams at {'an area' if dimension == 2 else 'a solid'}"
+                         f" fraction of {RSA_JAMMING[dimension]:.3f}; n = {n} would need a fraction of {need:.3g}: "
+                         f"use n <= {capacity} or a larger box")
     rng = np.random.default_rng(seed)
     r = rng.uniform(r_mean * (1.0 - spread), r_mean * (1.0 + spread), n)
     if np.any(2.0 * r.max() > (b[1] - b[0])[axes]):
         raise ValueError(f"[generator] box = {box!r}: narrower than the largest particle ({2 * r.max():.6g} m)")
-    lo, hi = b[0].copy(), b[1].copy()
-    if dimension == 2:
-        lo[1] = hi[1] = 0.0
-    from dem.geometry.neighbours import sequential_addition  # compiled: loaded only by scenes that place particles so
+    from dem.geometry.neighbours import addition_grid, sequential_addition  # compiled: loaded only when placing
 
-    pos, placed = sequential_addition(r, lo, hi, rng.random((RSA_CANDIDATES * n, 3)))
+    pos, grid = np.zeros((n, 3)), addition_grid(r, lo, hi)
+    placed, drawn, budget = 0, 0, RSA_CANDIDATES * n
+    while placed < n and drawn < budget:  # the candidates in blocks: memory O(block), not O(RSA_CANDIDATES n)
+        block = min(RSA_BLOCK, budget - drawn)
+        placed = sequential_addition(r, lo, hi, rng.random((block, 3)), pos, placed, *grid)
+        drawn += block
     if placed < n:
         filled = np.sum(np.pi * r[:placed] ** 2) / np.prod((b[1] - b[0])[axes]) if dimension == 2 else \
             np.sum(4 / 3 * np.pi * r[:placed] ** 3) / np.prod(b[1] - b[0])
-        raise ValueError(f"[generator] n = {n}: only {placed} particles fit by random sequential addition "
-                         f"(volume fraction {filled:.3f}); enlarge the box or use fewer particles")
+        raise ValueError(f"[generator] n = {n}: only {placed} {'disks' if dimension == 2 else 'spheres'} fit by "
+                         f"random sequential addition ({RSA_CANDIDATES} attempts per particle; "
+                         f"{'area' if dimension == 2 else 'solid'} fraction {filled:.3f}): use n <= {placed} or a "
+                         f"larger box")
+    rng.bit_generator.advance(3 * (budget - drawn))  # the velocities: as if every candidate had been drawn
     direction = rng.normal(size=(n, 3))
     if dimension == 2:
         direction[:, 1] = 0.0

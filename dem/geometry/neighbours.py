@@ -230,48 +230,55 @@ def restore_lists(mech, saved: dict) -> None:
 
 
 @njit(cache=True)
-def sequential_addition(r, lo, hi, uniform):
-    """Place particles of radii ``r`` one by one at the next candidate points ``lo + u (hi - lo)`` (``u`` rows of
-    ``uniform``, kept inside the box by each radius) that overlap no particle placed before; cell binning makes each
-    test O(1). Returns the positions and the number placed before the candidates ran out."""
+def addition_grid(r, lo, hi):
+    """The cells of :func:`sequential_addition` for particles of radii ``r`` in the box ``[lo, hi]``: ``(size,
+    ncell, head, nxt)``, cubic cells of edge at least the largest diameter (a candidate then meets only particles in
+    its own and the neighbouring cells), and no more cells than particles (a sparse box allocates O(N))."""
     n = r.shape[0]
-    size = 2.0 * r.max()
+    volume = 1.0
+    for a in range(3):
+        volume *= max(hi[a] - lo[a], 2.0 * r.max())
+    size = max(2.0 * r.max(), (volume / n) ** (1.0 / 3.0))
     ncell = np.empty(3, dtype=np.int64)
     for a in range(3):
         ncell[a] = max(1, int((hi[a] - lo[a]) / size) + 1)
-    head = -np.ones(ncell[0] * ncell[1] * ncell[2], dtype=np.int64)
-    nxt = -np.ones(n, dtype=np.int64)
-    pos = np.zeros((n, 3))
+    return size, ncell, -np.ones(ncell[0] * ncell[1] * ncell[2], dtype=np.int64), -np.ones(n, dtype=np.int64)
+
+
+@njit(cache=True)
+def sequential_addition(r, lo, hi, uniform, pos, placed, size, ncell, head, nxt):
+    """Place particles ``placed, placed + 1, ...`` of radii ``r`` one by one at the next candidate points ``lo + u
+    (hi - lo)`` (``u`` rows of ``uniform``, kept inside the box by each radius) that overlap no particle placed
+    before; the cells of :func:`addition_grid` make each test O(1). Writes ``pos`` and the cells in place and returns
+    the number placed when the candidates ran out (or all were): called again with more candidates, it goes on as if
+    it had been given them all at once."""
+    n = r.shape[0]
     c = np.empty(3, dtype=np.int64)
+    p = np.empty(3)
     trial = 0
-    for k in range(n):
-        placed = False
-        while trial < uniform.shape[0]:
-            p = np.empty(3)
-            for a in range(3):
-                span = hi[a] - lo[a] - 2.0 * r[k]
-                p[a] = lo[a] + r[k] + uniform[trial, a] * span if span > 0 else lo[a]
-                c[a] = min(ncell[a] - 1, int((p[a] - lo[a]) / size))
-            trial += 1
-            free = True
-            for d0 in range(max(0, c[0] - 1), min(ncell[0], c[0] + 2)):
-                for d1 in range(max(0, c[1] - 1), min(ncell[1], c[1] + 2)):
-                    for d2 in range(max(0, c[2] - 1), min(ncell[2], c[2] + 2)):
-                        m = head[(d0 * ncell[1] + d1) * ncell[2] + d2]
-                        while m >= 0 and free:
-                            s = 0.0
-                            for a in range(3):
-                                s += (pos[m, a] - p[a]) ** 2
-                            if s < (r[m] + r[k]) ** 2:
-                                free = False
-                            m = nxt[m]
-            if free:
-                pos[k] = p
-                cell = (c[0] * ncell[1] + c[1]) * ncell[2] + c[2]
-                nxt[k] = head[cell]
-                head[cell] = k
-                placed = True
-                break
-        if not placed:
-            return pos, k
-    return pos, n
+    k = placed
+    while k < n and trial < uniform.shape[0]:
+        for a in range(3):
+            span = hi[a] - lo[a] - 2.0 * r[k]
+            p[a] = lo[a] + r[k] + uniform[trial, a] * span if span > 0 else lo[a]
+            c[a] = min(ncell[a] - 1, int((p[a] - lo[a]) / size))
+        trial += 1
+        free = True
+        for d0 in range(max(0, c[0] - 1), min(ncell[0], c[0] + 2)):
+            for d1 in range(max(0, c[1] - 1), min(ncell[1], c[1] + 2)):
+                for d2 in range(max(0, c[2] - 1), min(ncell[2], c[2] + 2)):
+                    m = head[(d0 * ncell[1] + d1) * ncell[2] + d2]
+                    while m >= 0 and free:
+                        s = 0.0
+                        for a in range(3):
+                            s += (pos[m, a] - p[a]) ** 2
+                        if s < (r[m] + r[k]) ** 2:
+                            free = False
+                        m = nxt[m]
+        if free:
+            pos[k] = p
+            cell = (c[0] * ncell[1] + c[1]) * ncell[2] + c[2]
+            nxt[k] = head[cell]
+            head[cell] = k
+            k += 1
+    return k

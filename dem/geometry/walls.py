@@ -91,6 +91,27 @@ class Wall:
         return replace(self, point=self.normal * offset)
 
 
+def check_inside(walls, position: np.ndarray, ids: np.ndarray | None = None) -> None:
+    """Refuse a particle whose centre starts behind a wall (``n . x < q``: outside the box the walls enclose),
+    naming the particle, the wall and how far behind it lies. Such a particle would be bonded to that wall with an
+    overlap beyond its radius (a static network), or be reported as leaving the box at the first step (moving
+    particles)."""
+    if not walls or len(position) == 0:
+        return
+    normal = np.array([w.normal for w in walls])
+    depth = np.array([w.offset for w in walls])[None, :] - np.asarray(position) @ normal.T  # > 0: behind
+    behind = np.argwhere(depth > 0.0)
+    if behind.size:
+        k, m = (int(v) for v in behind[0])
+        label = f"particle {k}" + (f" (id {int(ids[k])})" if ids is not None and int(ids[k]) != k else "")
+        centre = ", ".join(f"{v:.6g}" for v in position[k])
+        others = len(np.unique(behind[:, 0])) - 1
+        more = f" (and {others} other particle{'s' if others > 1 else ''})" if others else ""
+        raise ValueError(f"{label}: its centre [{centre}] m lies {depth[k, m]:.6g} m behind wall {walls[m].name!r}"
+                         f"{more}: every particle must start on the packing's side of every wall (inside the box they "
+                         f"enclose); move the particle or the wall")
+
+
 def axis_of(normal: np.ndarray) -> int | None:
     """The axis an axis-aligned normal points along, else None."""
     k = int(np.argmax(np.abs(normal)))

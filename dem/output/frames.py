@@ -3,8 +3,9 @@ the spheres coloured by temperature, the two walls the powder is pressed between
 left out so that the powder can be seen.
 
 :class:`FrameWriter` is an observer of a run (``[output] frames = N``): it renders ``frames/frame_KK.png`` at ``N``
-evenly spaced times from start to end (at the first output time at or after each). pyvista (and VTK) are imported
-only here, only when frames are asked for.
+evenly spaced times from start to end (at the first output time at or after each), all in one colour range: the
+particles of each frame are saved when it is taken (``frame_KK.npz``) and drawn at the end of the run, also of an
+interrupted one. pyvista (and VTK) are imported only here, only when frames are asked for.
 """
 
 from __future__ import annotations
@@ -25,24 +26,28 @@ def _quiet_pyvista():
     return pv
 
 
-def render(path, x, radius, T, plates, up: int, clim, title: str, sphere_resolution: int = 12) -> None:
-    """Write one PNG: spheres at ``x`` of ``radius`` coloured by ``T`` (colour range ``clim``), the ``plates``
-    (``(centre, normal, (size_1, size_2))``) in grey, axis ``up`` vertical, ``title`` at the top."""
+def render(path, x, radius, T, plates, up: int, clim, title: str, unit: str = "K", sphere_resolution: int = 12) -> None:
+    """Write one PNG: spheres at ``x`` of ``radius`` coloured by ``T`` (colour range ``clim``, temperatures in
+    ``unit``: "K" or "C"), the ``plates`` (``(centre, normal, (size_1, size_2))``) in grey, axis ``up`` vertical,
+    ``title`` at the top, clear of the picture's edges."""
+    from dem.output.plots import TEMPERATURE_UNITS
+
     pv = _quiet_pyvista()
     points = pv.PolyData(np.asarray(x, dtype=float))
     points["radius"] = np.asarray(radius, dtype=float)
-    points["temperature (K)"] = np.asarray(T, dtype=float)
+    label = f"temperature ({TEMPERATURE_UNITS[unit]})"
+    points[label] = np.asarray(T, dtype=float)
     spheres = points.glyph(scale="radius", orient=False, factor=1.0,
                            geom=pv.Sphere(radius=1.0, theta_resolution=sphere_resolution,
                                           phi_resolution=sphere_resolution))
     plotter = pv.Plotter(off_screen=True, window_size=WINDOW)
     plotter.set_background("white")
-    plotter.add_mesh(spheres, scalars="temperature (K)", cmap="inferno", clim=clim, smooth_shading=True,
-                     scalar_bar_args={"title": "temperature (K)", "color": "black", "vertical": False,
+    plotter.add_mesh(spheres, scalars=label, cmap="inferno", clim=clim, smooth_shading=True,
+                     scalar_bar_args={"title": label, "color": "black", "vertical": False,
                                       "position_x": 0.2, "position_y": 0.04, "width": 0.6, "fmt": "%.0f"})
     for centre, normal, (a, b) in plates:
         plotter.add_mesh(pv.Plane(center=centre, direction=normal, i_size=a, j_size=b), color="grey", opacity=0.5)
-    plotter.add_text(title, font_size=12, color="black")
+    plotter.add_text(title, position=(16, WINDOW[1] - 40), font_size=12, color="black")  # pixels from lower left
     up_vector = np.zeros(3)
     up_vector[up] = 1.0
     side = (up + 2) % 3  # look along the third axis: the side view of Fig. 8
@@ -59,36 +64,56 @@ def render(path, x, radius, T, plates, up: int, clim, title: str, sphere_resolut
 
 
 class FrameWriter:
-    """Observer of a run: ``count`` frames at evenly spaced times (module docstring)."""
+    """Observer of a run: ``count`` frames at evenly spaced times (module docstring). Each frame's particles are
+    saved as it is taken (``frames/frame_KK.npz``: a resumed run keeps those taken before); :meth:`render` draws them
+    all with one colour range for the whole run, from ``T_low`` to the hottest of ``T_high`` and every frame's
+    particles, so that colours compare across frames."""
 
-    def __init__(self, out_dir, count: int, t_end: float, up: int, T_low: float, T_high: float):
-        """``up``: the vertical axis; the colours run from ``T_low`` to ``T_high`` or, where hotter, the 98th
-        percentile of the particles' temperatures of the frame."""
+    def __init__(self, out_dir, count: int, t_end: float, up: int, T_low: float, T_high: float, unit: str = "K"):
+        """``up``: the vertical axis; ``unit``: the temperatures' ("K" or "C")."""
         self.dir = pathlib.Path(out_dir) / "frames"
         self.dir.mkdir(parents=True, exist_ok=True)
         self.times = list(np.linspace(0.0, t_end, count)) if count > 1 else [t_end]
-        self.up, self.T_low, self.T_high = up, T_low, T_high
+        self.up, self.T_low, self.T_high, self.unit = up, T_low, T_high, unit
+        self.next = 0  # the next frame to take: past those a run before this one (resumed) took
+        while self.next < len(self.times) and self._data(self.next).exists():
+            self.next += 1
         self.written: list[str] = []
 
+    def _data(self, k: int) -> pathlib.Path:
+        return self.dir / f"frame_{k:02d}.npz"
+
     def __call__(self, sim) -> None:
-        t = sim.t
-        if not self.times or t < self.times[0] - 1e-12 * max(self.times[-1], 1.0):
+        t, tol = sim.t, 1e-12 * max(self.times[-1], 1.0)
+        if self.next >= len(self.times) or t < self.times[self.next] - tol:
             return
-        while self.times and self.times[0] <= t + 1e-12 * max(self.times[-1], 1.0):
-            self.times.pop(0)
+        while self.next + 1 < len(self.times) and self.times[self.next + 1] <= t + tol:
+            self.next += 1  # several frame times passed since the last output: one frame, of the latest
         s = sim.mechanics.state
-        row = sim.record()
-        fraction = row.get("volume_fraction")
-        title = f"t = {t:.3f} s" + (f"   volume fraction {fraction:.3f}" if fraction is not None else "")
-        path = self.dir / f"frame_{len(self.written):02d}.png"
-        clim = (self.T_low, max(self.T_high, float(np.percentile(s.T, 98))))
-        render(path, s.x, s.radius, s.T, sim.plates(), self.up, clim, title)
-        self.written.append(path.name)
+        fraction = sim.record().get("volume_fraction")
+        title = f"t = {t:.3f} s" + (f",  volume fraction {fraction:.3f}" if fraction is not None else "")
+        plates = sim.plates()
+        np.savez(self._data(self.next), x=s.x, radius=s.radius, T=s.T, title=np.array(title),
+                 plates=np.array([np.concatenate([c, n, size]) for c, n, size in plates]).reshape(-1, 8))
+        self.next += 1
+
+    def render(self) -> list[str]:
+        """Draw every saved frame as ``frame_KK.png`` with one colour range (class docstring); returns the names."""
+        frames = [(k, np.load(self._data(k))) for k in range(len(self.times)) if self._data(k).exists()]
+        hottest = max((float(np.max(f["T"])) for _, f in frames), default=self.T_high)
+        clim = (self.T_low, max(self.T_high, hottest))
+        self.written = []
+        for k, f in frames:
+            plates = [(p[0:3], p[3:6], (p[6], p[7])) for p in f["plates"]]
+            render(self.dir / f"frame_{k:02d}.png", f["x"], f["radius"], f["T"], plates, self.up, clim,
+                   str(f["title"]), self.unit)
+            self.written.append(f"frame_{k:02d}.png")
+        return self.written
 
 
 class WithFrames:
     """A run's writer (:class:`dem.output.writer.RunWriter`) that also renders ``[output] frames`` pictures, the
-    colours from the coldest to the hottest prescribed temperature (initial, walls) or hotter."""
+    colours from the coldest prescribed temperature (initial, walls) to the hottest prescribed or reached."""
 
     def __init__(self, writer, scene, out_dir):
         m = scene.motion
@@ -96,7 +121,7 @@ class WithFrames:
         temperatures += [w.temperature for w in m.walls if w.temperature is not None]
         self.writer = writer
         self.frames = FrameWriter(out_dir, m.frames, scene.solver.t_end, m.control or 0, min(temperatures),
-                                  max(temperatures))
+                                  max(temperatures), scene.temperature_unit)
 
     @property
     def last(self):
@@ -107,8 +132,8 @@ class WithFrames:
         self.frames(self.writer.engine)
 
     def finish(self, summary: dict, plots: bool = True) -> dict:
-        summary["frames"] = self.frames.written
+        summary["frames"] = self.frames.render()
         return self.writer.finish(summary, plots)
 
     def interrupted(self, summary: dict) -> None:
-        self.writer.interrupted({**summary, "frames": self.frames.written})
+        self.writer.interrupted({**summary, "frames": self.frames.render()})

@@ -24,8 +24,17 @@ def _read_csv(path: pathlib.Path) -> dict:
     return {k: [float(r[k]) if r[k] not in ("", None) else float("nan") for r in rows] for k in rows[0]}
 
 
-def motion_plots(out_dir) -> list[str]:
-    """Write the plots of a moving-particle run folder; returns the file names written."""
+TEMPERATURE_UNITS = {"C": "°C", "K": "K"}  # [scene] temperature_unit: the symbol on the plots' axes
+
+
+def temperature_label(unit: str, what: str = "temperature") -> str:
+    """An axis label with the scene's temperature unit (``[scene] temperature_unit``: "C" or "K")."""
+    return f"{what} ({TEMPERATURE_UNITS[unit]})"
+
+
+def motion_plots(out_dir, temperature_unit: str, wall_unit: str) -> list[str]:
+    """Write the plots of a moving-particle run folder; returns the file names written. ``temperature_unit``: the
+    scene's ("C" or "K"); ``wall_unit``: that of the ``wall_*`` columns ("Pa", "N/m" or "N", one for all walls)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -38,11 +47,11 @@ def motion_plots(out_dir) -> list[str]:
         t = data["t"]
         panels = [("volume_fraction", "solid fraction"), ("coordination", "coordination number"),
                   ("kinetic_energy", "kinetic energy (J)"), ("k1_factor", "k1(T, t) / k1 (mean)"),
-                  ("T_mean", "temperature"), ("effective_conductivity", "k_eff (W/(m K))")]
+                  ("T_mean", temperature_label(temperature_unit)), ("effective_conductivity", "k_eff (W/(m K))")]
         panels = [(k, label) for k, label in panels if k in data and any(v == v for v in data[k])]
         walls = [k for k in data if k.startswith("wall_")]
         if walls:
-            panels.append(("walls", "wall load (N/m, Pa or N)"))
+            panels.append(("walls", f"wall load ({wall_unit})"))
         fig, axes = plt.subplots(len(panels), 1, figsize=(7, 2.0 * len(panels)), sharex=True, squeeze=False)
         for ax, (key, label) in zip(axes[:, 0], panels):
             if key == "walls":
@@ -64,7 +73,7 @@ def motion_plots(out_dir) -> list[str]:
         plt.close(fig)
         written.append("timeseries.png")
     if data and "joule_heat" in data and "volume_fraction" in data and "T_mean" in data:
-        written.append(_fraction_temperature(plt, out, data))
+        written.append(_fraction_temperature(plt, out, data, temperature_unit))
     if (out / "profiles.csv").exists():
         prof = _read_csv(out / "profiles.csv")
         if prof:
@@ -100,7 +109,6 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
 
     out = pathlib.Path(out_dir)
     written = []
@@ -110,7 +118,7 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
         ax.plot(data["t"], data["T_mean"], label="mean")
         ax.fill_between(data["t"], data["T_min"], data["T_max"], alpha=0.3, label="min-max")
         ax.set_xlabel("t (s)")
-        ax.set_ylabel("temperature")
+        ax.set_ylabel(temperature_label(scene.temperature_unit))
         ax.legend()
         fig.tight_layout()
         fig.savefig(out / "temperature.png", dpi=120)
@@ -139,7 +147,7 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
             mean = np.bincount(slab, T, 20) / count
         ax.plot(0.5 * (edges[1:] + edges[:-1]) * 1e3, mean, "o-", label="slab mean")
         ax.set_xlabel("z (mm), along the heat flow")
-        ax.set_ylabel("temperature")
+        ax.set_ylabel(temperature_label(scene.temperature_unit))
         summary = out / "summary.json"
         title = ""
         if summary.exists():
@@ -156,7 +164,7 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
     return written
 
 
-def _fraction_temperature(plt, out: pathlib.Path, data: dict) -> str:
+def _fraction_temperature(plt, out: pathlib.Path, data: dict, temperature_unit: str) -> str:
     """Volume fraction and mean temperature against time, the times with current shaded (Zohdi 2014, Fig. 9)."""
     t = data["t"]
     fig, ax = plt.subplots(figsize=(7, 4))
@@ -165,7 +173,7 @@ def _fraction_temperature(plt, out: pathlib.Path, data: dict) -> str:
     ax.set_ylabel("volume fraction", color="tab:blue")
     other = ax.twinx()
     other.plot(t, data["T_mean"], color="tab:red")
-    other.set_ylabel("mean temperature", color="tab:red")
+    other.set_ylabel(temperature_label(temperature_unit, "mean temperature"), color="tab:red")
     peak = max((v for v in data["joule_heat"] if v == v), default=0.0)
     on = [v == v and v > 1e-9 * peak for v in data["joule_heat"]]  # not the round-off of an open circuit
     ax.fill_between(t, 0, 1, where=on, transform=ax.get_xaxis_transform(), color="gold", alpha=0.25,

@@ -24,9 +24,10 @@ from dem.scene.zohdi import ElectricalSpec, parse_electrical
 from dem.geometry.particles import COPPER, Material, Particles, material_indices
 from dem.geometry.periodic import AXES, PeriodicBox
 from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources
-from dem.geometry.walls import Wall, axis_of, box_axes, extent
+from dem.geometry.walls import Wall, axis_of, box_axes, check_inside, extent
 from dem.network.heat import INTEGRATORS
 from dem.network.linsolve import BACKENDS
+from dem.output.plots import TEMPERATURE_UNITS
 from dem.scene.motion import MotionSpec, parse_motion
 from dem.scene.schema import ENGINE_NAMES, TABLES, check
 
@@ -141,6 +142,11 @@ class Scene:
     box: PeriodicBox | None = None  # a periodic box (dem.geometry.periodic), else None
     engine: str = "static"  # the engine that runs it (dem.engines)
     start: dict | None = None  # the saved state it starts from (dem.scene.state_file.load), else None
+    temperature_unit: str = "C"  # the unit of its temperatures, "C" or "K" (:func:`temperature_unit`)
+
+    def __post_init__(self):
+        walls = self.motion.walls if self.motion is not None else self.walls
+        check_inside(walls, self.particles.position, self.particles.id)
 
     @property
     def start_time(self) -> float:
@@ -511,7 +517,24 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
                          f"{start['t']:.6g} s (the run's clock goes on from the state's)")
     return Scene(particles, () if moving else walls, conductance, Sources(conv, rad), solver, output,
                  tuple(physics), str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact,
-                 motion, electrical, box, engine, start)
+                 motion, electrical, box, engine, start,
+                 temperature_unit(meta, rad, zohdi=law is not None and law.NAME == "zohdi"))
+
+
+
+
+def temperature_unit(meta: dict, rad: Radiation | None, zohdi: bool) -> str:
+    """``[scene] temperature_unit``: "C" or "K"; by default ``radiation.unit`` where the scene has radiation, "K"
+    for scenes with Zohdi 2014's contact law (``zohdi``: its thermal softening and Joule heating work in kelvin),
+    else "C". Only labels the outputs: every law takes the scene's temperatures as they are."""
+    default = rad.unit if rad is not None else "K" if zohdi else "C"
+    unit = meta.get("temperature_unit", default)
+    if unit not in TEMPERATURE_UNITS:
+        raise ValueError(f"[scene] temperature_unit = {unit!r}: must be \"C\" or \"K\"")
+    if rad is not None and unit != rad.unit:
+        raise ValueError(f"[scene] temperature_unit = {unit!r}: differs from radiation.unit = {rad.unit!r} (the unit "
+                         f"of the same temperatures)")
+    return unit
 
 
 def _check_walls_across(walls, box: PeriodicBox) -> None:

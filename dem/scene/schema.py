@@ -42,6 +42,9 @@ ROWS = (
     Row("scene", ("physics",), ALL, 'list, `["thermal"]`',
         'submodels: `"thermal"`, `"mechanical"` (particles that move), `"electrical"` (the current and its Joule heat, '
         'with `[contact] law = "zohdi"`)'),
+    Row("scene", ("temperature_unit",), ALL, '`"C"`; `"K"` with `[contact] law = "zohdi"`; radiation.unit where given',
+        'the unit of the scene\'s temperatures, `"C"` or `"K"`: the plots\' axes say it (the laws take the '
+        'temperatures as given)'),
     Row("scene", ("dimension",), MOVING, "3", "3: spheres; 2: disks in the x-z plane (velocity Verlet only)"),
     Row("scene", ("height",), VERLET, "m, required with dimension = 2", "the disks' height (Luding 2005's cylinders)"),
     Row("material", ("conductivity", "density", "specific_heat"), ALL, "numbers > 0",

@@ -1,6 +1,6 @@
 """``python -m fem_neck unequal``: FE of unequal sintered pairs against eq. 43 (K from a only) and the law per half.
 
-Writes unequal.json, unequal.csv and unequal.png into --out (default: results/unequal).
+Writes unequal.json, unequal.csv and unequal.png into --out when given (nothing otherwise).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ def register(subparsers) -> None:
     add_workers_option(p)
     add_scheduler_option(p)
     add_output_options(p)
-    p.set_defaults(run=run, out="results/unequal")
+    p.set_defaults(run=run)
 
 
 MAX_PAIRS = 200  # FE pair solves in one study (~1 s each of one core)
@@ -36,4 +36,4 @@ def run(args) -> dict:
                          f"is an FE solve of ~1 s); run fewer ratios or necks at a time")
 
     result = study(args.ratios.split(","), args.necks.split(","), args.rtol, args.out, workers=args.workers)
-    return {k: v for k, v in result.items() if k != "cases"} | {"out": str(args.out)}
+    return {k: v for k, v in result.items() if k != "cases"} | ({"out": str(args.out)} if args.out else {})

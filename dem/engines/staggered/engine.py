@@ -371,7 +371,7 @@ class StaggeredEngine:
     def plots(self, out, summary: dict) -> list[str]:
         from dem.output.plots import motion_plots
 
-        return motion_plots(out)
+        return motion_plots(out, self.scene.temperature_unit, "N")  # the walls' loads: forces
 
     def links(self):
         """The touching pairs as lines between the particles: normal force (N, > 0 repulsive), contact area (m^2),

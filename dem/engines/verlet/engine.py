@@ -33,7 +33,7 @@ from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
 from dem.scene.state_file import moving_arrays, normalised
 from dem.network.heat import boundary_heat_flow, steady
-from fem_neck.geometry import neck_radius
+from fem_neck.geometry import max_overlap, neck_radius
 
 
 class VerletEngine:
@@ -224,18 +224,33 @@ class VerletEngine:
         return None if volume is None else self.mechanics.state.solid_volume() / volume
 
     def wall_stress(self) -> dict:
-        """Normal stress the particles exert on each wall of an axis-aligned box: force per unit length (2D, N/m,
-        the paper's pressure unit) or per unit area (3D, Pa); the bare force (N) on a wall outside such a box."""
+        """Normal load the particles exert on each wall, in one unit for every wall (:meth:`wall_load_unit`): the
+        force per unit length (2D, N/m, the paper's pressure unit) or per unit area (3D, Pa) when every wall spans the
+        same number of box axes, else the bare force (N) on every wall."""
         mech = self.mechanics
-        out = {}
-        for k, wall in enumerate(mech.walls):
-            lo_hi = mech.w.span[k]
-            extent = 1.0
+        extents, _ = self._wall_extents()
+        return {wall.name: float(mech.w.force[k] / extents[k]) for k, wall in enumerate(mech.walls)}
+
+    def wall_load_unit(self) -> str:
+        """The unit of :meth:`wall_stress`: "Pa", "N/m" or "N"."""
+        return ("N", "N/m", "Pa")[self._wall_extents()[1]]
+
+    def _wall_extents(self) -> tuple[list, int]:
+        """Per wall the length (one box axis along it) or area (two) its load is divided by, and that number of
+        axes; all 1 and 0 axes when the walls span different numbers of axes (N/m beside Pa would share no axis)."""
+        mech = self.mechanics
+        extents, spanned = [], set()
+        for k in range(len(mech.walls)):
+            lo_hi, extent, axes = mech.w.span[k], 1.0, 0
             for a in range(2):
                 if lo_hi[2 * a] >= 0:
                     extent *= mech.w.extent(lo_hi[2 * a], lo_hi[2 * a + 1])
-            out[wall.name] = float(mech.w.force[k] / extent)
-        return out
+                    axes += 1
+            extents.append(extent)
+            spanned.add(axes)
+        if len(spanned) > 1:
+            return [1.0] * len(extents), 0
+        return extents, spanned.pop() if spanned else 0
 
     def heated_walls(self):
         """``(hot, cold)`` wall indices when exactly two walls carry different temperatures and face each other
@@ -287,7 +302,8 @@ class VerletEngine:
         density = np.bincount(slab, v, bins) / (area * np.diff(edges))
         i, j, overlap = mech.contacts()[:3]
         r_min = np.minimum(s.radius[i], s.radius[j])
-        h = np.minimum(overlap, 0.999 * (2.0 / 3.0) * r_min)  # within the neck model's range, for the profile
+        # within the neck model's range (the neck reaches the smaller radius), for the profile
+        h = np.minimum(overlap, 0.999 * max_overlap(s.radius[i], s.radius[j]))
         neck = np.asarray(neck_radius(s.radius[i], s.radius[j], h)) / r_min if len(i) else np.zeros(0)
         mid = np.clip(np.searchsorted(edges, 0.5 * (dist[i] + dist[j])) - 1, 0, bins - 1)
         count = np.bincount(mid, minlength=bins)
@@ -377,7 +393,7 @@ class VerletEngine:
     def plots(self, out, summary: dict) -> list[str]:
         from dem.output.plots import motion_plots
 
-        return motion_plots(out)
+        return motion_plots(out, self.scene.temperature_unit, self.wall_load_unit())
 
     @property
     def dt(self) -> float:
