@@ -17,13 +17,19 @@ on every connected group of free nodes that reaches a fixed node or a plane (an 
 :class:`BoundedLaplacian` assembles this once as CSR matrices and rewrites their entries in place when only the
 conductances change (:meth:`~BoundedLaplacian.refresh`: contacts whose necks grow, particles that move a little).
 The thermal network (:class:`dem.network.heat.Network`) and the Kirchhoff current solve (:mod:`dem.network.current`) are
-both built on it; :func:`solve_anchored` is the steady solve the current uses.
+both built on it; :func:`solve_anchored` is the steady solve the current uses. :meth:`~BoundedLaplacian.flux` is the
+net flow into every node at given node values, ``-(L x)_k + sum_w K_kw (x_w - x_k)``: the conducted heat of the
+lumped balance of particles that move (:class:`dem.engines.staggered.heat.LumpedHeat`), whose edges are the pairs of
+a Verlet list, those not in contact with ``K = 0`` (so the graph is refreshed in place until the list is rebuilt). An
+edge with ``K = 0`` carries nothing and joins nothing: :meth:`~BoundedLaplacian.components` counts only edges with
+``K > 0``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 from scipy.sparse.csgraph import connected_components
 
 from dem.network.linsolve import make_solver
@@ -133,14 +139,31 @@ class BoundedLaplacian:
 
     def components(self, anchor_extra=None):
         """Connected groups of free nodes: ``(count, label per free node, anchored per group)``; a group is
-        anchored when one of its nodes is joined to a fixed node, a plane or (``anchor_extra > 0``) an ambient."""
-        n_comp, label = connected_components(self.L_FF, directed=False)
+        anchored when one of its nodes is joined to a fixed node, a plane or (``anchor_extra > 0``) an ambient.
+        Only edges with ``K > 0`` join nodes (an edge with ``K = 0``, an open contact, is none)."""
+        where = np.full(self.n, -1, dtype=np.int64)
+        where[self.free] = np.arange(len(self.free))
+        a, b = where[self.i], where[self.j]
+        live = (self.K > 0.0) & (a >= 0) & (b >= 0)
+        nf = len(self.free)
+        graph = sp.csr_matrix((np.ones(int(live.sum())), (a[live], b[live])), shape=(nf, nf))
+        n_comp, label = connected_components(graph, directed=False)
         anchor = self.fixed_diag + self.plane_diag
         if anchor_extra is not None:
             anchor = anchor + anchor_extra
         anchored = np.zeros(n_comp, dtype=bool)
         anchored[label[anchor > 0]] = True
         return n_comp, label, anchored
+
+    def flux(self, x, x_planes, out=None) -> np.ndarray:
+        """Net flow into every node (fixed ones too) at node values ``x`` (all nodes) with the planes at
+        ``x_planes``: ``-(L x)_k + sum_w K_kw (x_w - x_k)`` (W for heat: the conducted heat ``Q_k``). Summed edge by
+        edge in the order of the edges, then the plane bonds (:func:`edge_flux`), from the conductances as they
+        are (right after :meth:`refresh`, without the matrices). ``out``: an array of ``n`` to write into."""
+        out = np.empty(self.n) if out is None else out
+        edge_flux(self.i, self.j, self.K, self.plane_node, self.plane_index, self.K_plane,
+                  np.asarray(x, dtype=float), np.asarray(x_planes, dtype=float), out)
+        return out
 
     def full(self, x_free, x_fixed) -> np.ndarray:
         """Values on all nodes from those of the free and the fixed nodes."""
@@ -156,6 +179,22 @@ class BoundedLaplacian:
     def plane_flows(self, x, x_planes) -> np.ndarray:
         """Flow from each plane-bonded node into its plane, ``K_kw (x_k - x_w)``."""
         return self.K_plane * (x[self.plane_node] - np.asarray(x_planes, dtype=float)[self.plane_index])
+
+
+@njit(cache=True)
+def edge_flux(i, j, K, plane_node, plane_index, K_plane, x, x_planes, out):
+    """``out_k = -(L x)_k + sum_w K_kw (x_w - x_k)`` (:meth:`BoundedLaplacian.flux`): every edge's flow
+    ``K_c (x_i - x_j)`` leaves i and enters j, in the order of the edges; then every plane bond's flow
+    ``K_kw (x_k - x_w)`` leaves k."""
+    for k in range(out.shape[0]):
+        out[k] = 0.0
+    for c in range(i.shape[0]):
+        flow = K[c] * (x[i[c]] - x[j[c]])
+        out[i[c]] -= flow
+        out[j[c]] += flow
+    for e in range(plane_node.shape[0]):
+        k = plane_node[e]
+        out[k] -= K_plane[e] * (x[k] - x_planes[plane_index[e]])
 
 
 def solve_anchored(system: BoundedLaplacian, rhs: np.ndarray, subset: np.ndarray | None = None, linear: str = "auto",
