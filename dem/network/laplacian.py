@@ -51,7 +51,7 @@ class BoundedLaplacian:
 
     Attributes: ``free``, ``fixed`` (node indices), ``L`` (all nodes), ``L_FF``, ``L_FD`` (CSR), ``plane_diag``
     (per free node: the sum of its plane conductances), ``fixed_diag`` (per free node: the sum of its conductances to
-    fixed nodes).
+    fixed nodes); the matrices and sums are made when first asked for (:meth:`flux` needs none of them).
     """
 
     def __init__(self, n: int, i, j, K, fixed, plane_node, plane_index, K_plane, n_planes: int):
@@ -60,15 +60,9 @@ class BoundedLaplacian:
         self.free = np.flatnonzero(~fixed)
         self.fixed = np.flatnonzero(fixed)
         self._set(i, j, K, plane_node, plane_index, K_plane)
-        self.L = laplacian(self.n, self.i, self.j, self.K)
-        if len(self.fixed):
-            rows = self.L[self.free]
-            self.L_FF = rows[:, self.free].tocsr()
-            self.L_FD = rows[:, self.fixed].tocsr()
-        else:
-            self.L_FF, self.L_FD = self.L, sp.csr_matrix((self.n, 0))
-        self._slots = None  # where each Laplacian entry sits in L, L_FF, L_FD: built by the first refresh()
-        self._plane_terms()
+        self._matrices = None  # (L, L_FF, L_FD), assembled when first asked for (the flux needs none)
+        self._slots = None  # where each Laplacian entry sits in L, L_FF, L_FD: built by the first rewrite
+        self._stale = False  # the conductances changed since the matrices were written
 
     def _set(self, i, j, K, plane_node, plane_index, K_plane):
         self.i, self.j = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64)
@@ -76,42 +70,68 @@ class BoundedLaplacian:
         self.plane_node = np.asarray(plane_node, dtype=np.int64)
         self.plane_index = np.asarray(plane_index, dtype=np.int64)
         self.K_plane = np.asarray(K_plane, dtype=float)
+        self._diags = None  # (plane_diag, fixed_diag) of these conductances, when first asked for
 
-    def _plane_terms(self):
-        self.plane_diag = np.bincount(self.plane_node, self.K_plane, self.n).astype(float)[self.free]
-        self.fixed_diag = -np.asarray(self.L_FD.sum(axis=1)).ravel()
+    def _current(self):
+        """``(L, L_FF, L_FD)`` of the conductances as they are: assembled the first time, afterwards rewritten in
+        place (same sparsity) when :meth:`refresh` changed the conductances."""
+        if self._matrices is None:
+            L = laplacian(self.n, self.i, self.j, self.K)
+            if len(self.fixed):
+                rows = L[self.free]
+                self._matrices = (L, rows[:, self.free].tocsr(), rows[:, self.fixed].tocsr())
+            else:
+                self._matrices = (L, L, sp.csr_matrix((self.n, 0)))
+        elif self._stale:
+            n = self.n
+            if self._slots is None:
+                # an index matrix with the Laplacian's sparsity: entry k of (rows, cols) stored as k + 1
+                rows = np.concatenate([self.i, self.j, np.arange(n)])
+                cols = np.concatenate([self.j, self.i, np.arange(n)])
+                index = sp.csr_matrix((np.arange(1.0, len(rows) + 1.0), (rows, cols)), shape=(n, n))
+                if len(self.fixed):
+                    part = index[self.free]
+                    parts = (index, part[:, self.free].tocsr(), part[:, self.fixed].tocsr())
+                else:
+                    parts = (index, index, sp.csr_matrix((n, 0)))
+                self._slots = [m.data.astype(np.int64) - 1 for m in parts]
+                L = parts[0].copy()
+                self._matrices = (L, L if not len(self.fixed) else parts[1].copy(), parts[2].copy())
+            diag = np.bincount(self.i, self.K, n) + np.bincount(self.j, self.K, n)
+            values = np.concatenate([-self.K, -self.K, diag])
+            for matrix, slots in zip(self._matrices, self._slots):
+                matrix.data[:] = values[slots]
+        self._stale = False
+        return self._matrices
+
+    L = property(lambda self: self._current()[0], doc="The weighted graph Laplacian of all nodes (CSR).")
+    L_FF = property(lambda self: self._current()[1], doc="Its free-free block (CSR).")
+    L_FD = property(lambda self: self._current()[2], doc="Its free-fixed block (CSR).")
+
+    def _diagonals(self):
+        if self._diags is None:
+            plane = np.bincount(self.plane_node, self.K_plane, self.n).astype(float)[self.free]
+            self._diags = (plane, -np.asarray(self.L_FD.sum(axis=1)).ravel())
+        return self._diags
+
+    plane_diag = property(lambda self: self._diagonals()[0],
+                          doc="Per free node: the sum of its plane conductances.")
+    fixed_diag = property(lambda self: self._diagonals()[1],
+                          doc="Per free node: the sum of its conductances to fixed nodes.")
 
     def same_edges(self, i, j, plane_node, plane_index) -> bool:
         """Whether these edges and plane bonds are those of the assembled matrices (same order)."""
-        return (np.array_equal(i, self.i) and np.array_equal(j, self.j)
-                and np.array_equal(plane_node, self.plane_node) and np.array_equal(plane_index, self.plane_index))
+        return all(a is b or np.array_equal(a, b) for a, b in ((i, self.i), (j, self.j),
+                                                               (plane_node, self.plane_node),
+                                                               (plane_index, self.plane_index)))
 
     def refresh(self, i, j, K, plane_node, plane_index, K_plane) -> None:
         """New conductances on the same edges and plane bonds, in the same order: the matrices keep their sparsity
-        and only their entries are rewritten (no re-assembly, no new sparsity analysis)."""
+        and only their entries are rewritten (no re-assembly, no new sparsity analysis), when next asked for."""
         if not self.same_edges(i, j, plane_node, plane_index):
             raise ValueError("BoundedLaplacian.refresh: the edges changed; build a new one")
-        n = self.n
-        if self._slots is None:
-            # an index matrix with the Laplacian's sparsity: entry k of (rows, cols) stored as k + 1
-            rows = np.concatenate([self.i, self.j, np.arange(n)])
-            cols = np.concatenate([self.j, self.i, np.arange(n)])
-            index = sp.csr_matrix((np.arange(1.0, len(rows) + 1.0), (rows, cols)), shape=(n, n))
-            if len(self.fixed):
-                part = index[self.free]
-                parts = (index, part[:, self.free].tocsr(), part[:, self.fixed].tocsr())
-            else:
-                parts = (index, index, sp.csr_matrix((n, 0)))
-            self._slots = [m.data.astype(np.int64) - 1 for m in parts]
-            self.L, self.L_FF, self.L_FD = (m.copy() for m in parts)
-            if not len(self.fixed):
-                self.L_FF = self.L
         self._set(i, j, K, plane_node, plane_index, K_plane)
-        diag = np.bincount(self.i, self.K, n) + np.bincount(self.j, self.K, n)
-        values = np.concatenate([-self.K, -self.K, diag])
-        for matrix, slots in zip((self.L, self.L_FF, self.L_FD), self._slots):
-            matrix.data[:] = values[slots]
-        self._plane_terms()
+        self._stale = True
 
     @property
     def laplacian_diagonal(self) -> np.ndarray:
