@@ -208,8 +208,11 @@ def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pi, pj
     for c in range(pi.shape[0]):
         i, j = pi[c], pj[c]
         K[c] = 0.0
-        d = math.sqrt((x[j, 0] - x[i, 0]) ** 2 + (x[j, 1] - x[i, 1]) ** 2 + (x[j, 2] - x[i, 2]) ** 2)
+        d2 = (x[j, 0] - x[i, 0]) ** 2 + (x[j, 1] - x[i, 1]) ** 2 + (x[j, 2] - x[i, 2]) ** 2
         ri, rj = radius[i], radius[j]
+        if d2 > (ri + rj) ** 2 * (1.0 + 1e-10):  # surely apart: no square root (the exact test follows)
+            continue
+        d = math.sqrt(d2)
         if d >= ri + rj:
             continue
         if d <= 0.0:

@@ -209,6 +209,8 @@ def edge_flux(i, j, K, plane_node, plane_index, K_plane, x, x_planes, out):
     for k in range(out.shape[0]):
         out[k] = 0.0
     for c in range(i.shape[0]):
+        if K[c] == 0.0:  # an open contact carries nothing
+            continue
         flow = K[c] * (x[i[c]] - x[j[c]])
         out[i[c]] -= flow
         out[j[c]] += flow

@@ -84,8 +84,7 @@ class LumpedHeat:
         """``(K, K_w, plane_node, plane_index)``: the conductances (W/K) of the listed pairs (0 where they do not
         touch) and of the plane bonds, at positions ``x``."""
         plane_node, plane_index, wall = self._plane_bonds(mech)
-        n_pairs = len(mech.pi)
-        K, K_w = np.empty(n_pairs), np.empty(len(plane_node))
+        K, K_w = np.empty(len(mech.pi)), np.empty(len(plane_node))
         if self.spec.law == "zohdi":
             bad = lens_list_conductances(x, self.particles.radius, self.kappa, self.contact_conductance,
                                          LENS_POLICY[self.spec.out_of_range], mech.pi, mech.pj, mech.w.normal,
