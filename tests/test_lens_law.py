@@ -1,4 +1,4 @@
-"""The compiled zohdi lens law on a Verlet list (dem.laws.conductance.lens_list_conductances) is the law of
+"""The compiled zohdi lens law on a Verlet list (dem.laws.lens_conductance.lens_list_conductances) is the law of
 find_bonds + bond_conductances on the touching pairs, with the out_of_range policies as find_bonds has them."""
 
 import numpy as np
@@ -7,7 +7,8 @@ import pytest
 from dem.geometry.bonds import find_bonds
 from dem.geometry.particles import Particles
 from dem.geometry.walls import Wall
-from dem.laws.conductance import LENS_POLICY, ConductanceSpec, bond_conductances, lens_list_conductances
+from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.laws.lens_conductance import LENS_POLICY, lens_list_conductances
 
 # unequal spheres: (0, 1) with the small centre inside the large sphere's cap (a lens out of range), (2, 3) a valid
 # lens, 4 alone on the wall; 0 touches the wall too; the other listed pairs are apart

@@ -361,7 +361,7 @@ def test_section_7_three_phases_of_fig_9():
 
 
 def test_conducted_heat_is_the_conductance_law_on_the_bonds():
-    """The paper's law compiled on the Verlet list (dem.laws.conductance.lens_list_conductances, the open pairs at
+    """The paper's law compiled on the Verlet list (dem.laws.lens_conductance.lens_list_conductances, the open pairs at
     K = 0) gives the conductances of the general path (dem.geometry.bonds.find_bonds + bond_conductances with law =
     "zohdi") on the touching pairs and walls, and Q is their flows summed per particle, here on a pressed column with
     hot walls."""

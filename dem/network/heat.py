@@ -221,13 +221,13 @@ def bonds_and_conductances(particles: Particles, walls, spec, *, pairs=None, bon
 
 
 def boundary_heat_flow(net: Network, T: np.ndarray) -> dict:
-    """W into each fixed particle (from its bonds and walls: the network's flux,
-    :meth:`dem.network.laplacian.BoundedLaplacian.flux`) and into each wall, at full temperatures ``T``."""
-    g = net.graph
-    into_fixed = g.flux(T, net.wall_temperature) + net.jump_rhs
-    to_wall = g.plane_flows(T, net.wall_temperature)
+    """W into each fixed particle (from its bonds and walls) and into each wall, at full temperatures ``T``."""
+    p, b = net.particles, net.bonds
+    into_fixed = -(net.L @ T) + net.jump_rhs
+    to_wall = net.K_walls * (T[b.wall_particle] - net.wall_temperature[b.wall_index])
+    into_fixed -= np.bincount(b.wall_particle, to_wall, p.n)
     n_walls = len(net.wall_temperature)
-    walls = np.bincount(g.plane_index, to_wall, n_walls) if n_walls else np.zeros(0)
+    walls = np.bincount(b.wall_index, to_wall, n_walls) if n_walls else np.zeros(0)
     return {"particles": {int(k): float(into_fixed[k]) for k in net.fixed}, "walls": walls}
 
 

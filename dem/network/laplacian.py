@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
 from scipy.sparse.csgraph import connected_components
 
 from dem.network.linsolve import make_solver
@@ -178,8 +177,10 @@ class BoundedLaplacian:
     def flux(self, x, x_planes, out=None) -> np.ndarray:
         """Net flow into every node (fixed ones too) at node values ``x`` (all nodes) with the planes at
         ``x_planes``: ``-(L x)_k + sum_w K_kw (x_w - x_k)`` (W for heat: the conducted heat ``Q_k``). Summed edge by
-        edge in the order of the edges, then the plane bonds (:func:`edge_flux`), from the conductances as they
+        edge in the order of the edges, then the plane bonds (:func:`dem.network.flux.edge_flux`), from the conductances as they
         are (right after :meth:`refresh`, without the matrices). ``out``: an array of ``n`` to write into."""
+        from dem.network.flux import edge_flux  # compiled: imported by the moving engines only (a static run loads no numba)
+
         out = np.empty(self.n) if out is None else out
         edge_flux(self.i, self.j, self.K, self.plane_node, self.plane_index, self.K_plane,
                   np.asarray(x, dtype=float), np.asarray(x_planes, dtype=float), out)
@@ -199,24 +200,6 @@ class BoundedLaplacian:
     def plane_flows(self, x, x_planes) -> np.ndarray:
         """Flow from each plane-bonded node into its plane, ``K_kw (x_k - x_w)``."""
         return self.K_plane * (x[self.plane_node] - np.asarray(x_planes, dtype=float)[self.plane_index])
-
-
-@njit(cache=True)
-def edge_flux(i, j, K, plane_node, plane_index, K_plane, x, x_planes, out):
-    """``out_k = -(L x)_k + sum_w K_kw (x_w - x_k)`` (:meth:`BoundedLaplacian.flux`): every edge's flow
-    ``K_c (x_i - x_j)`` leaves i and enters j, in the order of the edges; then every plane bond's flow
-    ``K_kw (x_k - x_w)`` leaves k."""
-    for k in range(out.shape[0]):
-        out[k] = 0.0
-    for c in range(i.shape[0]):
-        if K[c] == 0.0:  # an open contact carries nothing
-            continue
-        flow = K[c] * (x[i[c]] - x[j[c]])
-        out[i[c]] -= flow
-        out[j[c]] += flow
-    for e in range(plane_node.shape[0]):
-        k = plane_node[e]
-        out[k] -= K_plane[e] * (x[k] - x_planes[plane_index[e]])
 
 
 def solve_anchored(system: BoundedLaplacian, rhs: np.ndarray, subset: np.ndarray | None = None, linear: str = "auto",

@@ -4,7 +4,7 @@
 walls that carry a temperature: isothermal planes) and ``H_i`` its Joule heating (eq. 35; :mod:`dem.engines.contact_current`).
 The contact conductance is the scene's ``[conductance] law`` on each contact as it is, exactly as for a static
 packing: ``law = "zohdi"`` is the paper's ``K_ij A_ij / |r_i - r_j|`` (eq. 33 with the lens area of eqs. 7-12;
-compiled on the Verlet list, :func:`dem.laws.conductance.lens_list_conductances`), any other law is evaluated on the
+compiled on the Verlet list, :func:`dem.laws.lens_conductance.lens_list_conductances`), any other law is evaluated on the
 bonds of the touching pairs (:func:`dem.geometry.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`),
 ``"fit"`` the FE-verified neck law.
 
@@ -30,7 +30,8 @@ from __future__ import annotations
 import numpy as np
 
 from dem.geometry.bonds import find_bonds
-from dem.laws.conductance import LENS_POLICY, ConductanceSpec, bond_conductances, lens_list_conductances
+from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.laws.lens_conductance import LENS_POLICY, lens_list_conductances
 from dem.geometry.particles import Particles
 from dem.engines.staggered import kernels
 from dem.network.laplacian import BoundedLaplacian
