@@ -360,19 +360,49 @@ def test_section_7_three_phases_of_fig_9():
     assert sim.current.joule_energy == pytest.approx(sim.current.electrode_energy, rel=1e-12)
 
 
-def test_compiled_lens_conduction_is_the_conductance_law_on_the_bonds():
-    """The paper's law evaluated on the Verlet list in compiled code gives the heat flows of the general path
-    (dem.geometry.bonds.find_bonds + dem.laws.conductance with law = "zohdi"), here on a pressed column with hot walls."""
+def test_conducted_heat_is_the_conductance_law_on_the_bonds():
+    """The paper's law compiled on the Verlet list (dem.laws.lens_conductance.lens_list_conductances, the open pairs at
+    K = 0) gives the conductances of the general path (dem.geometry.bonds.find_bonds + bond_conductances with law =
+    "zohdi") on the touching pairs and walls, and Q is their flows summed per particle, here on a pressed column with
+    hot walls."""
+    from dem.engines.staggered.heat import contact_bonds
+    from dem.laws.conductance import bond_conductances
+
     doc = column()
     doc["walls"][0]["temperature"] = 900.0
     sim = StaggeredEngine(parse_scene(doc))
     th, mech = sim.thermal, sim.mechanics
+    x = mech.state.x.copy()
+    x[-1, 0] += 0.15 * R  # the top particle off its neighbour (overlap 0.1 R): a listed pair that does not touch
     T = np.random.default_rng(0).uniform(300.0, 700.0, mech.state.n)
-    assert th.compiled
-    compiled = th.conduction(mech, mech.state.x, T)
-    th.compiled = False
-    general = th.conduction(mech, mech.state.x, T)
-    assert np.all(compiled != 0.0) and np.allclose(compiled, general, rtol=1e-12, atol=0.0)
+    K, K_w, plane_node, plane_index = th.conductances(mech, x, T)
+    now, b = contact_bonds(th.particles, mech, x, T, th.thermal_walls, "lens", "error")
+    K_b, K_wb = bond_conductances(th.spec, now, b)
+    closed = K > 0.0
+    assert len(K) == closed.sum() + 1 == 5 and b.n_walls == 2  # open listed pairs are edges with K = 0
+    assert np.array_equal(mech.pi[closed], b.i) and np.array_equal(mech.pj[closed], b.j)
+    assert np.allclose(K[closed], K_b, rtol=1e-13, atol=0.0)
+    assert np.allclose(K_w[K_w > 0], K_wb, rtol=1e-13, atol=0.0)
+    Q = th.conduction(mech, x, T)
+    flow = K_b * (T[b.j] - T[b.i])
+    into_wall = K_wb * (th.wall_T[b.wall_index] - T[b.wall_particle])
+    n = mech.state.n
+    direct = np.bincount(b.i, flow, n) - np.bincount(b.j, flow, n) + np.bincount(b.wall_particle, into_wall, n)
+    assert np.all(Q != 0.0) and np.allclose(Q, direct, rtol=1e-12, atol=0.0)
+    # another law runs on the bonds and lands on the same edges of the list
+    law_fit = StaggeredEngine(parse_scene({**doc, "conductance": {"law": "fit", "out_of_range": "clip"}})).thermal
+    K_fit = law_fit.conductances(mech, x, T)[0]
+    assert np.array_equal(K_fit > 0.0, closed)
+
+
+def test_heat_network_is_refreshed_in_place_between_list_rebuilds():
+    """The network's edges are the Verlet list's pairs: iterations and steps on the same list rewrite its
+    conductances; it is assembled again only when the list is rebuilt."""
+    doc = column(t_end=0.02)
+    sim = StaggeredEngine(parse_scene(doc))
+    sim.run()
+    th = sim.thermal
+    assert th.refreshes > 10 * th.assemblies and th.assemblies <= sim.mechanics.rebuilds + 1
 
 
 @pytest.mark.slow

@@ -71,11 +71,7 @@ class ContactThermalModel:
     def step(self, mechanics, dt: float) -> None:
         """Advance the temperatures by ``dt`` on the network of the contacts of ``mechanics`` now."""
         bonds, K_pairs, K_walls = self.bonds(mechanics)
-        same = (self.net is not None and np.array_equal(bonds.i, self.net.bonds.i)
-                and np.array_equal(bonds.j, self.net.bonds.j)
-                and np.array_equal(bonds.wall_particle, self.net.bonds.wall_particle)
-                and np.array_equal(bonds.wall_index, self.net.bonds.wall_index))
-        if same:
+        if self.net is not None and self.net.graph.same_edges(bonds.i, bonds.j, bonds.wall_particle, bonds.wall_index):
             self.net.refresh(bonds, K_pairs, K_walls)
             self.refreshes += 1
         else:

@@ -23,6 +23,10 @@ Laws (``ConductanceSpec.law``):
   in series are the harmonic combination this project uses for every law.)
 
 A wall bond is one half (the particle's side; the wall is isothermal) in series with ``K_c``.
+
+The ``zohdi`` law on the pairs and particle-wall pairs of a Verlet list, contact geometry included, is compiled
+(:func:`dem.laws.lens_conductance.lens_list_conductances`, apart so that a static run loads no numba): particles that move evaluate it at every fixed-point iteration of their step
+(:mod:`dem.engines.staggered.heat`), on the list as it is, without building bonds.
 """
 
 from __future__ import annotations
@@ -165,3 +169,4 @@ def _check_finite(spec: ConductanceSpec, K: np.ndarray, a: np.ndarray, name) -> 
         source = f" from fit_file = {spec.fit_file!r}" if spec.law in FIT_LAWS else ""
         raise ValueError(f"conductance.law = {spec.law!r}{source} gives K = {float(K[k])!r} W/K for {name(k)} (neck radius "
                          f"a = {a[k]:.6g} m): conductances must be finite and >= 0")
+

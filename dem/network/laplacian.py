@@ -17,7 +17,12 @@ on every connected group of free nodes that reaches a fixed node or a plane (an 
 :class:`BoundedLaplacian` assembles this once as CSR matrices and rewrites their entries in place when only the
 conductances change (:meth:`~BoundedLaplacian.refresh`: contacts whose necks grow, particles that move a little).
 The thermal network (:class:`dem.network.heat.Network`) and the Kirchhoff current solve (:mod:`dem.network.current`) are
-both built on it; :func:`solve_anchored` is the steady solve the current uses.
+both built on it; :func:`solve_anchored` is the steady solve the current uses. :meth:`~BoundedLaplacian.flux` is the
+net flow into every node at given node values, ``-(L x)_k + sum_w K_kw (x_w - x_k)``: the conducted heat of the
+lumped balance of particles that move (:class:`dem.engines.staggered.heat.LumpedHeat`), whose edges are the pairs of
+a Verlet list, those not in contact with ``K = 0`` (so the graph is refreshed in place until the list is rebuilt). An
+edge with ``K = 0`` carries nothing and joins nothing: :meth:`~BoundedLaplacian.components` counts only edges with
+``K > 0``.
 """
 
 from __future__ import annotations
@@ -45,7 +50,7 @@ class BoundedLaplacian:
 
     Attributes: ``free``, ``fixed`` (node indices), ``L`` (all nodes), ``L_FF``, ``L_FD`` (CSR), ``plane_diag``
     (per free node: the sum of its plane conductances), ``fixed_diag`` (per free node: the sum of its conductances to
-    fixed nodes).
+    fixed nodes); the matrices and sums are made when first asked for (:meth:`flux` needs none of them).
     """
 
     def __init__(self, n: int, i, j, K, fixed, plane_node, plane_index, K_plane, n_planes: int):
@@ -54,15 +59,9 @@ class BoundedLaplacian:
         self.free = np.flatnonzero(~fixed)
         self.fixed = np.flatnonzero(fixed)
         self._set(i, j, K, plane_node, plane_index, K_plane)
-        self.L = laplacian(self.n, self.i, self.j, self.K)
-        if len(self.fixed):
-            rows = self.L[self.free]
-            self.L_FF = rows[:, self.free].tocsr()
-            self.L_FD = rows[:, self.fixed].tocsr()
-        else:
-            self.L_FF, self.L_FD = self.L, sp.csr_matrix((self.n, 0))
-        self._slots = None  # where each Laplacian entry sits in L, L_FF, L_FD: built by the first refresh()
-        self._plane_terms()
+        self._matrices = None  # (L, L_FF, L_FD), assembled when first asked for (the flux needs none)
+        self._slots = None  # where each Laplacian entry sits in L, L_FF, L_FD: built by the first rewrite
+        self._stale = False  # the conductances changed since the matrices were written
 
     def _set(self, i, j, K, plane_node, plane_index, K_plane):
         self.i, self.j = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64)
@@ -70,42 +69,68 @@ class BoundedLaplacian:
         self.plane_node = np.asarray(plane_node, dtype=np.int64)
         self.plane_index = np.asarray(plane_index, dtype=np.int64)
         self.K_plane = np.asarray(K_plane, dtype=float)
+        self._diags = None  # (plane_diag, fixed_diag) of these conductances, when first asked for
 
-    def _plane_terms(self):
-        self.plane_diag = np.bincount(self.plane_node, self.K_plane, self.n).astype(float)[self.free]
-        self.fixed_diag = -np.asarray(self.L_FD.sum(axis=1)).ravel()
+    def _current(self):
+        """``(L, L_FF, L_FD)`` of the conductances as they are: assembled the first time, afterwards rewritten in
+        place (same sparsity) when :meth:`refresh` changed the conductances."""
+        if self._matrices is None:
+            L = laplacian(self.n, self.i, self.j, self.K)
+            if len(self.fixed):
+                rows = L[self.free]
+                self._matrices = (L, rows[:, self.free].tocsr(), rows[:, self.fixed].tocsr())
+            else:
+                self._matrices = (L, L, sp.csr_matrix((self.n, 0)))
+        elif self._stale:
+            n = self.n
+            if self._slots is None:
+                # an index matrix with the Laplacian's sparsity: entry k of (rows, cols) stored as k + 1
+                rows = np.concatenate([self.i, self.j, np.arange(n)])
+                cols = np.concatenate([self.j, self.i, np.arange(n)])
+                index = sp.csr_matrix((np.arange(1.0, len(rows) + 1.0), (rows, cols)), shape=(n, n))
+                if len(self.fixed):
+                    part = index[self.free]
+                    parts = (index, part[:, self.free].tocsr(), part[:, self.fixed].tocsr())
+                else:
+                    parts = (index, index, sp.csr_matrix((n, 0)))
+                self._slots = [m.data.astype(np.int64) - 1 for m in parts]
+                L = parts[0].copy()
+                self._matrices = (L, L if not len(self.fixed) else parts[1].copy(), parts[2].copy())
+            diag = np.bincount(self.i, self.K, n) + np.bincount(self.j, self.K, n)
+            values = np.concatenate([-self.K, -self.K, diag])
+            for matrix, slots in zip(self._matrices, self._slots):
+                matrix.data[:] = values[slots]
+        self._stale = False
+        return self._matrices
+
+    L = property(lambda self: self._current()[0], doc="The weighted graph Laplacian of all nodes (CSR).")
+    L_FF = property(lambda self: self._current()[1], doc="Its free-free block (CSR).")
+    L_FD = property(lambda self: self._current()[2], doc="Its free-fixed block (CSR).")
+
+    def _diagonals(self):
+        if self._diags is None:
+            plane = np.bincount(self.plane_node, self.K_plane, self.n).astype(float)[self.free]
+            self._diags = (plane, -np.asarray(self.L_FD.sum(axis=1)).ravel())
+        return self._diags
+
+    plane_diag = property(lambda self: self._diagonals()[0],
+                          doc="Per free node: the sum of its plane conductances.")
+    fixed_diag = property(lambda self: self._diagonals()[1],
+                          doc="Per free node: the sum of its conductances to fixed nodes.")
 
     def same_edges(self, i, j, plane_node, plane_index) -> bool:
         """Whether these edges and plane bonds are those of the assembled matrices (same order)."""
-        return (np.array_equal(i, self.i) and np.array_equal(j, self.j)
-                and np.array_equal(plane_node, self.plane_node) and np.array_equal(plane_index, self.plane_index))
+        return all(a is b or np.array_equal(a, b) for a, b in ((i, self.i), (j, self.j),
+                                                               (plane_node, self.plane_node),
+                                                               (plane_index, self.plane_index)))
 
     def refresh(self, i, j, K, plane_node, plane_index, K_plane) -> None:
         """New conductances on the same edges and plane bonds, in the same order: the matrices keep their sparsity
-        and only their entries are rewritten (no re-assembly, no new sparsity analysis)."""
+        and only their entries are rewritten (no re-assembly, no new sparsity analysis), when next asked for."""
         if not self.same_edges(i, j, plane_node, plane_index):
             raise ValueError("BoundedLaplacian.refresh: the edges changed; build a new one")
-        n = self.n
-        if self._slots is None:
-            # an index matrix with the Laplacian's sparsity: entry k of (rows, cols) stored as k + 1
-            rows = np.concatenate([self.i, self.j, np.arange(n)])
-            cols = np.concatenate([self.j, self.i, np.arange(n)])
-            index = sp.csr_matrix((np.arange(1.0, len(rows) + 1.0), (rows, cols)), shape=(n, n))
-            if len(self.fixed):
-                part = index[self.free]
-                parts = (index, part[:, self.free].tocsr(), part[:, self.fixed].tocsr())
-            else:
-                parts = (index, index, sp.csr_matrix((n, 0)))
-            self._slots = [m.data.astype(np.int64) - 1 for m in parts]
-            self.L, self.L_FF, self.L_FD = (m.copy() for m in parts)
-            if not len(self.fixed):
-                self.L_FF = self.L
         self._set(i, j, K, plane_node, plane_index, K_plane)
-        diag = np.bincount(self.i, self.K, n) + np.bincount(self.j, self.K, n)
-        values = np.concatenate([-self.K, -self.K, diag])
-        for matrix, slots in zip((self.L, self.L_FF, self.L_FD), self._slots):
-            matrix.data[:] = values[slots]
-        self._plane_terms()
+        self._stale = True
 
     @property
     def laplacian_diagonal(self) -> np.ndarray:
@@ -133,14 +158,33 @@ class BoundedLaplacian:
 
     def components(self, anchor_extra=None):
         """Connected groups of free nodes: ``(count, label per free node, anchored per group)``; a group is
-        anchored when one of its nodes is joined to a fixed node, a plane or (``anchor_extra > 0``) an ambient."""
-        n_comp, label = connected_components(self.L_FF, directed=False)
+        anchored when one of its nodes is joined to a fixed node, a plane or (``anchor_extra > 0``) an ambient.
+        Only edges with ``K > 0`` join nodes (an edge with ``K = 0``, an open contact, is none)."""
+        where = np.full(self.n, -1, dtype=np.int64)
+        where[self.free] = np.arange(len(self.free))
+        a, b = where[self.i], where[self.j]
+        live = (self.K > 0.0) & (a >= 0) & (b >= 0)
+        nf = len(self.free)
+        graph = sp.csr_matrix((np.ones(int(live.sum())), (a[live], b[live])), shape=(nf, nf))
+        n_comp, label = connected_components(graph, directed=False)
         anchor = self.fixed_diag + self.plane_diag
         if anchor_extra is not None:
             anchor = anchor + anchor_extra
         anchored = np.zeros(n_comp, dtype=bool)
         anchored[label[anchor > 0]] = True
         return n_comp, label, anchored
+
+    def flux(self, x, x_planes, out=None) -> np.ndarray:
+        """Net flow into every node (fixed ones too) at node values ``x`` (all nodes) with the planes at
+        ``x_planes``: ``-(L x)_k + sum_w K_kw (x_w - x_k)`` (W for heat: the conducted heat ``Q_k``). Summed edge by
+        edge in the order of the edges, then the plane bonds (:func:`dem.network.flux.edge_flux`), from the conductances as they
+        are (right after :meth:`refresh`, without the matrices). ``out``: an array of ``n`` to write into."""
+        from dem.network.flux import edge_flux  # compiled: imported by the moving engines only (a static run loads no numba)
+
+        out = np.empty(self.n) if out is None else out
+        edge_flux(self.i, self.j, self.K, self.plane_node, self.plane_index, self.K_plane,
+                  np.asarray(x, dtype=float), np.asarray(x_planes, dtype=float), out)
+        return out
 
     def full(self, x_free, x_fixed) -> np.ndarray:
         """Values on all nodes from those of the free and the fixed nodes."""

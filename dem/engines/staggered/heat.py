@@ -3,8 +3,15 @@
 ``m_i C_i dtheta_i/dt = Q_i + H_i`` (eq. 31): ``Q_i`` the heat conducted through the particle's contacts (with
 walls that carry a temperature: isothermal planes) and ``H_i`` its Joule heating (eq. 35; :mod:`dem.engines.contact_current`).
 The contact conductance is the scene's ``[conductance] law`` on each contact as it is, exactly as for a static
-packing (:func:`dem.geometry.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`): ``law = "zohdi"`` is the
-paper's ``K_ij A_ij / |r_i - r_j|`` (eq. 33 with the lens area of eqs. 7-12), ``"fit"`` the FE-verified neck law.
+packing: ``law = "zohdi"`` is the paper's ``K_ij A_ij / |r_i - r_j|`` (eq. 33 with the lens area of eqs. 7-12;
+compiled on the Verlet list, :func:`dem.laws.lens_conductance.lens_list_conductances`), any other law is evaluated on the
+bonds of the touching pairs (:func:`dem.geometry.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`),
+``"fit"`` the FE-verified neck law.
+
+``Q`` is the flux of the contact network (:meth:`dem.network.laplacian.BoundedLaplacian.flux`, ``-L theta`` plus the
+walls' terms) whose edges are the pairs of the mechanics' Verlet list and its particle-wall pairs with the
+temperature-carrying walls, the pairs not in contact with ``K = 0``: between two rebuilds of the list the network
+keeps its edges and only its conductances are rewritten (:meth:`~dem.network.laplacian.BoundedLaplacian.refresh`).
 
 Integrated by the trapezoidal rule of eq. (36) with the weight phi of the mechanics, and solved -- as the positions
 are -- by the fixed-point iteration of eq. (37), with the positions frozen at the iterate of the mechanics (the
@@ -24,8 +31,10 @@ import numpy as np
 
 from dem.geometry.bonds import find_bonds
 from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.laws.lens_conductance import LENS_POLICY, lens_list_conductances
 from dem.geometry.particles import Particles
 from dem.engines.staggered import kernels
+from dem.network.laplacian import BoundedLaplacian
 
 
 def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_of_range: str):
@@ -47,10 +56,9 @@ class LumpedHeat:
         self.particles, self.walls, self.spec = particles, tuple(walls), spec
         self.thermal_walls = [k for k, w in enumerate(self.walls) if w.temperature is not None]
         self.wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
-        # the paper's law on equal spheres (no lens out of range) is evaluated in compiled code on the Verlet list
-        self.compiled = spec.law == "zohdi" and (spec.out_of_range != "error" or np.ptp(particles.radius) == 0.0)
+        self._plane_of_wall = np.full(len(self.walls), -1, dtype=np.int64)  # wall -> its index among thermal walls
+        self._plane_of_wall[self.thermal_walls] = np.arange(len(self.thermal_walls))
         self.kappa = particles.conductivity
-        self.wall_T_all = np.array([np.nan if w.temperature is None else w.temperature for w in self.walls])
         self.contact_conductance = np.inf if spec.contact_conductance is None else spec.contact_conductance
         self.C = particles.capacity
         self.free = ~particles.fixed
@@ -59,22 +67,60 @@ class LumpedHeat:
         self.heat_in = {"boundaries": 0.0, "joule": 0.0}
         self.Q = np.zeros(particles.n)  # conducted heat at the start of the step, Q^L (W per particle)
         self._Q_iter = np.zeros(particles.n)
+        self.graph: BoundedLaplacian | None = None  # the network on the Verlet list (module docstring)
+        self._lists = None  # the mechanics' wall list (wk, wm) the plane bonds come from
+        self.assemblies = self.refreshes = 0
+
+    def _plane_bonds(self, mech):
+        """The network's plane bonds: the listed particle-wall pairs of the walls with a temperature, as
+        ``(particle, index among those walls, wall)`` (made again when the mechanics rebuilds its wall list)."""
+        if self._lists is None or self._lists[0] is not mech.wk or self._lists[1] is not mech.wm:
+            on_plane = self._plane_of_wall[mech.wm] >= 0
+            wall = mech.wm[on_plane]
+            self._planes = (mech.wk[on_plane], self._plane_of_wall[wall], wall)
+            self._lists = (mech.wk, mech.wm)
+        return self._planes
+
+    def conductances(self, mech, x, T):
+        """``(K, K_w, plane_node, plane_index)``: the conductances (W/K) of the listed pairs (0 where they do not
+        touch) and of the plane bonds, at positions ``x``."""
+        plane_node, plane_index, wall = self._plane_bonds(mech)
+        K, K_w = np.empty(len(mech.pi)), np.empty(len(plane_node))
+        if self.spec.law == "zohdi":
+            bad = lens_list_conductances(x, self.particles.radius, self.kappa, self.contact_conductance,
+                                         LENS_POLICY[self.spec.out_of_range], mech.pi, mech.pj, mech.w.normal,
+                                         mech.w.q, plane_node, wall, K, K_w)
+            if bad:  # find_bonds names the first contact the policy cannot take
+                contact_bonds(self.particles, mech, x, T, self.thermal_walls, "lens", self.spec.out_of_range)
+                raise RuntimeError(f"{bad} lens contacts out of range that find_bonds accepts")
+            return K, K_w, plane_node, plane_index
+        now, b = contact_bonds(self.particles, mech, x, T, self.thermal_walls, self.spec.contact,
+                               self.spec.out_of_range)
+        K_b, K_wb = bond_conductances(self.spec, now, b, walls=[self.walls[k].at(float(mech.w.q[k]))
+                                                                  for k in self.thermal_walls])
+        n = self.particles.n
+        K[:] = 0.0
+        K[np.searchsorted(mech.pi * n + mech.pj, b.i * n + b.j)] = K_b  # the list is sorted by (i, j)
+        K_w[:] = 0.0
+        if b.n_walls:
+            key = plane_index * n + plane_node
+            order = np.argsort(key, kind="stable")
+            K_w[order[np.searchsorted(key[order], b.wall_index * n + b.wall_particle)]] = K_wb
+        return K, K_w, plane_node, plane_index
 
     def conduction(self, mech, x, T) -> np.ndarray:
         """``Q_i`` (W) of eq. (33) at positions ``x`` (the contacts of the Verlet list of the mechanics ``mech``,
-        the walls where it has them) and temperatures ``T``."""
-        n = self.particles.n
-        if self.compiled:
-            Q = np.empty(n)
-            kernels.lens_conduction(x, T, self.particles.radius, self.kappa, self.contact_conductance, mech.pi,
-                                    mech.pj, mech.w.normal, mech.w.q, self.wall_T_all, mech.wk, mech.wm, Q)
-            return Q
-        now, b = contact_bonds(self.particles, mech, x, T, self.thermal_walls, self.spec.contact,
-                               self.spec.out_of_range)
-        K, K_w = bond_conductances(self.spec, now, b)
-        flow = K * (T[b.j] - T[b.i])  # from j into i
-        into_wall = K_w * (self.wall_T[b.wall_index] - T[b.wall_particle]) if b.n_walls else np.zeros(0)
-        return np.bincount(b.i, flow, n) - np.bincount(b.j, flow, n) + np.bincount(b.wall_particle, into_wall, n)
+        the walls where it has them) and temperatures ``T``: the flux of the network (module docstring)."""
+        K, K_w, plane_node, plane_index = self.conductances(mech, x, T)
+        g = self.graph
+        if g is not None and g.same_edges(mech.pi, mech.pj, plane_node, plane_index):
+            g.refresh(mech.pi, mech.pj, K, plane_node, plane_index, K_w)
+            self.refreshes += 1
+        else:
+            self.graph = g = BoundedLaplacian(self.particles.n, mech.pi, mech.pj, K, self.particles.fixed,
+                                              plane_node, plane_index, K_w, len(self.thermal_walls))
+            self.assemblies += 1
+        return g.flux(T, self.wall_T)
 
     def start(self, mech) -> None:
         """``Q^L`` at the state of ``mech`` (the first step)."""

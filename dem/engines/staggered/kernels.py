@@ -1,6 +1,6 @@
 """The compiled kernels of the staggered implicit scheme (Zohdi 2014): one fixed-point iteration of the trapezoidal
-step (eqs. 22-27) with the forces of the contact law (:func:`dem.engines.contact_forces.forces`), and the paper's
-conduction law on the Verlet list.
+step (eqs. 22-27) with the forces of the contact law (:func:`dem.engines.contact_forces.forces`), and the touching
+pairs of the Verlet list.
 
 Like :mod:`dem.engines.contact_forces`, this module is compiled for each contact law (:mod:`dem.engines.compiled`):
 its import of the force loop is pointed at the law's copy.
@@ -14,7 +14,6 @@ import numpy as np
 from numba import njit
 
 from dem.engines.contact_forces import forces
-from dem.laws.contact.zohdi import lens_area
 
 
 @njit(cache=True, error_model="numpy")
@@ -64,50 +63,3 @@ def closed_pairs(x, radius, pi, pj):
         s = radius[i] + radius[j]
         out[c] = d2 < s * s
     return out
-
-
-@njit(cache=True, error_model="numpy")
-def lens_conduction(x, T, radius, kappa, contact_conductance, pi, pj, wn, wq, wall_T, wk, wm, Q):
-    """``Q_i`` (W) of Zohdi 2014, eq. (33): ``K A_ij (theta_j - theta_i) / |r_i - r_j|`` over the touching listed
-    pairs, written as the halves ``kappa_i A_ij / L_i`` in series (``L_i`` the centre-to-contact-plane distance of
-    eq. 12; one material: exactly eq. 33) and a contact conductance ``contact_conductance`` in series (W/K; inf:
-    none), and ``kappa_k A_k (theta_w - theta_k) / dist`` from every listed wall with a temperature (``wall_T``
-    finite). The same law as :func:`dem.laws.conductance.half_conductance` with ``law = "zohdi"``, evaluated where
-    the mechanics is, without building bonds. Returns the number of conducting pairs and wall contacts."""
-    n = x.shape[0]
-    for k in range(n):
-        Q[k] = 0.0
-    count = 0
-    for c in range(pi.shape[0]):
-        i, j = pi[c], pj[c]
-        d = math.sqrt((x[j, 0] - x[i, 0]) ** 2 + (x[j, 1] - x[i, 1]) ** 2 + (x[j, 2] - x[i, 2]) ** 2)
-        ri, rj = radius[i], radius[j]
-        if d >= ri + rj or d <= 0.0:
-            continue
-        li = max(0.5 * (d - (rj * rj - ri * ri) / d), 0.0)
-        lj = max(d - li, 0.0)
-        small, l_small = (ri, li) if ri <= rj else (rj, lj)
-        area = math.pi * max(small * small - l_small * l_small, 0.0)
-        resistance = 1.0 / contact_conductance
-        if li > 0.0:
-            resistance += li / (kappa[i] * area)
-        if lj > 0.0:
-            resistance += lj / (kappa[j] * area)
-        g = 1.0 / resistance
-        flow = g * (T[j] - T[i])
-        Q[i] += flow
-        Q[j] -= flow
-        count += 1
-    for e in range(wk.shape[0]):
-        k, m = wk[e], wm[e]
-        if not math.isfinite(wall_T[m]):
-            continue
-        dist = wn[m, 0] * x[k, 0] + wn[m, 1] * x[k, 1] + wn[m, 2] * x[k, 2] - wq[m]
-        rk = radius[k]
-        if dist >= rk or dist <= 0.0:
-            continue
-        area = math.pi * (rk * rk - dist * dist)
-        g = 1.0 / (dist / (kappa[k] * area) + 1.0 / contact_conductance)
-        Q[k] += g * (wall_T[m] - T[k])
-        count += 1
-    return count
