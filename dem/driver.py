@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dem.engines import engine_class
+from dem.engines.launch import launched, on_root, world
 from dem.output import folder as run_folder
 from dem.output.writer import RunWriter
 from dem.scene import Scene
@@ -75,24 +76,32 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     it first; :mod:`dem.output.folder`). Ctrl-C leaves the folder usable and resumable: the rows and snapshots written
     so far, the checkpoint of the last completed step, and ``summary.json`` marked ``"interrupted": true``.
     ``progress``: a bar on stderr, and the run's position in the line an interrupt prints."""
+    comm = world() if launched() else None  # under mpiexec: the ranks share the particles, rank 0 writes
+    cls = engine_class(scene.engine)
+    if comm is not None:
+        from dem.engines.verlet.ranks import RankVerletEngine, refuse_unsupported
+
+        refuse_unsupported(scene, comm.Get_size(), resume)
+        cls = RankVerletEngine
+    root = comm is None or comm.Get_rank() == 0
     if out is not None:
-        out = run_folder.prepare(out, resume, overwrite)
+        out = on_root(comm, lambda: run_folder.prepare(out, resume, overwrite))
     elif resume or overwrite:
         raise ValueError("--resume and --overwrite need --out (the folder of the run)")
     start = time.perf_counter()
-    here = _position(scene, out, progress)
+    here = _position(scene, out, progress and root)
     restart = run_folder.load(out, scene, scene.engine) if resume else None
-    engine = engine_class(scene.engine)(scene, restart)
+    engine = cls(scene, restart)
     writer = None
-    if out is not None:
+    if out is not None and root:
         writer = RunWriter(out, scene, engine, resume_step=engine.steps if resume else None)
         if scene.motion is not None and scene.motion.frames:
             from dem.output.frames import WithFrames
 
             writer = WithFrames(writer, scene, out)
     checkpointer = run_folder.Checkpointer(out, scene, scene.engine, scene.output.checkpoint_every) \
-        if out is not None and (scene.solver.mode == "transient") else None
-    bar = _progress_bar(scene, engine, progress)
+        if writer is not None and (scene.solver.mode == "transient") else None
+    bar = _progress_bar(scene, engine, progress and root)
 
     def advanced(t):
         if writer is None:  # with a folder the position is that of its last row (observed below)
@@ -106,7 +115,7 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
 
     try:
         try:
-            engine.run(observed if writer is not None else None,
+            engine.run(observed if writer is not None else (_nothing if out is not None else None),
                        advanced if scene.solver.mode == "transient" else None, checkpointer)
         finally:
             if bar is not None:
@@ -131,6 +140,10 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
                           plots=False)
         raise
     return RunResult(summary, engine.temperatures(), engine)
+
+
+def _nothing():
+    """The observer of a rank that writes nothing (rank 0 writes the run's folder)."""
 
 
 def _summary(scene: Scene, engine, restart) -> dict:
