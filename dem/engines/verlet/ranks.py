@@ -70,6 +70,7 @@ class RankMechanics(MechanicalModel):
         self.n_global = state.n
         self.slabs = self._slabs(state, box)
         self.send_idx, self.recv_idx = {}, {}
+        self.migrated = 0  # particles this rank took over from others at rebuilds
         super().__init__(state, walls, material, dt, skin, gravity, box, relaxation_time, history)
 
     def _slabs(self, state: MotionState, box) -> Slabs:
@@ -139,7 +140,9 @@ class RankMechanics(MechanicalModel):
         own_rows = rows[owned[dest[owned] == self.rank]]
         if not first:  # the particles that left the slab to their new owners; pair histories to both partners'
             leaving = [rows[owned[dest[owned] == r]] if r != self.rank else rows[:0] for r in range(self.size)]
-            own_rows = _gather_rows([own_rows] + comm.alltoall(leaving))
+            arrived = comm.alltoall(leaving)
+            self.migrated += sum(len(a) for a in arrived)
+            own_rows = _gather_rows([own_rows] + arrived)
             hist = np.column_stack([self.gid[self.pi], self.gid[self.pj], self.p_hist, self.p_fn, self.p_ft])
             hist = _gather_rows(comm.alltoall([hist[(dest[self.pi] == r) | (dest[self.pj] == r)]
                                                for r in range(self.size)]))
@@ -210,19 +213,6 @@ class RankMechanics(MechanicalModel):
         for r, idx in self.recv_idx.items():
             self._unpack(arrays, buffers[r], idx)
 
-    def _wall_loads(self, wdq_half: np.ndarray) -> None:
-        """The walls' loads summed over ranks; stress walls accelerated by the sum (eq. 1) from their velocity
-        ``wdq_half`` after the step's first half kick, as the compiled loop does with its own load."""
-        w = self.w
-        if len(w.force) == 0:
-            return
-        w.force[:] = self.comm.allreduce(w.force, op=_sum())
-        h = 0.5 * self.dt
-        for m in np.flatnonzero(w.mode == 1):
-            w.dq[m] = wdq_half[m]  # eq. (1)'s damping acts on the half-kicked velocity, as in the loop
-            w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
-            w.dq[m] = wdq_half[m] + h * w.acc[m]
-
     def _initial_forces(self):
         super()._initial_forces()
         w = self.w
@@ -252,25 +242,30 @@ class RankMechanics(MechanicalModel):
                 w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_hist, self.w_fn, self.w_ft, self.params,
                 self.x_ref, self.skin, self._info)
             self.steps += 1
-            self._wall_loads(wdq_half)
-            status = self._agreed(status)
+            status = self._agreed(status, wdq_half)
             if status == REBUILD:
                 self._build_list()
             else:
                 self._refresh_ghosts()
 
-    def _agreed(self, status: int) -> int:
-        """The status all ranks act on: a failure anywhere stops every rank with its message; a rebuild anywhere
-        rebuilds everywhere."""
-        k, m = int(self._info[0]), int(self._info[1])
-        failure = (status, int(self.gid[k]), m) if status in (NONFINITE, ESCAPED) else None
-        if self.size > 1:
-            worst = self.comm.allreduce(status, op=_max())
-            if worst in (NONFINITE, ESCAPED):
-                failure = min(f for f in self.comm.allgather(failure) if f is not None)
-            status = worst
-        if failure is not None:
-            status, k, m = failure
+    def _agreed(self, status: int, wdq_half: np.ndarray) -> int:
+        """After a step, in one reduction over the ranks: the walls' loads summed (and stress walls accelerated by
+        the sum, eq. 1, from their velocity ``wdq_half`` after the step's first half kick, as the compiled loop does
+        with its own load), and the status all ranks act on: a failure anywhere stops every rank with its message,
+        a rebuild anywhere rebuilds everywhere."""
+        w = self.w
+        failed = status in (NONFINITE, ESCAPED)
+        total = self.comm.allreduce(np.concatenate([[status == REBUILD, failed], w.force]), op=_sum())
+        w.force[:] = total[2:]
+        h = 0.5 * self.dt
+        for m in np.flatnonzero(w.mode == 1):
+            w.dq[m] = wdq_half[m]  # eq. (1)'s damping acts on the half-kicked velocity, as in the loop
+            w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
+            w.dq[m] = wdq_half[m] + h * w.acc[m]
+        if total[1] > 0:
+            k, m = int(self._info[0]), int(self._info[1])
+            status, k, m = min(f for f in self.comm.allgather((status, int(self.gid[k]), m) if failed else None)
+                               if f is not None)
             if status == NONFINITE:
                 raise MechanicsError(f"the run stopped at step {self.steps} (t = {self.t:.6g} s): particle {k} has "
                                      f"a non-finite position or velocity; the step dt = {self.dt:.6g} s is too large "
@@ -278,7 +273,7 @@ class RankMechanics(MechanicalModel):
             raise MechanicsError(f"the run stopped at step {self.steps} (t = {self.t:.6g} s): particle {k} left the "
                                  f"box through wall {self.walls[m].name!r}; reduce dt or the wall speed, or enlarge "
                                  f"the box")
-        return status
+        return REBUILD if total[0] > 0 else status
 
     # --------------------------------------------------------------------------------------------- outputs
     def gathered(self, everyone: bool = False) -> MechanicalModel | None:

@@ -1,0 +1,112 @@
+"""Moving particles across MPI ranks (dem.engines.verlet.ranks), launched with mpiexec -n 1 and -n 2 on
+tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserve momentum (periodic box) and the
+energy of elastic collisions as the serial run does, to round-off, lose and duplicate no particle through
+migration, and write the run's folder from rank 0. Skipped where mpi4py or mpiexec is missing."""
+
+import json
+import os
+import pathlib
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+HERE = pathlib.Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+
+import ranks_worker  # noqa: E402
+
+ENV = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+       "OMPI_MCA_rmaps_base_oversubscribe": "1", "PYTHONPATH": os.pathsep.join([str(ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep)
+                                                    if p])}
+
+
+def _mpi_works() -> bool:
+    if shutil.which("mpiexec") is None:
+        return False
+    try:
+        import mpi4py  # noqa: F401
+    except ImportError:
+        return False
+    probe = subprocess.run(["mpiexec", "-n", "2", sys.executable, "-c",
+                            "from mpi4py import MPI; assert MPI.COMM_WORLD.Get_size() == 2"],
+                           env=ENV, capture_output=True, timeout=120)
+    return probe.returncode == 0
+
+
+pytestmark = pytest.mark.skipif(not _mpi_works(), reason="mpi4py or a working mpiexec is missing")
+
+
+def ranks(n: int, *args, timeout: float = 900) -> subprocess.CompletedProcess:
+    return subprocess.run(["mpiexec", "-n", str(n), sys.executable, str(HERE / "ranks_worker.py"), *map(str, args)],
+                          env=ENV, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
+
+
+def launched(n: int, *args) -> dict:
+    done = ranks(n, *args)
+    assert done.returncode == 0, done.stderr[-3000:]
+    with np.load(args[-1]) as data:
+        return {k: data[k] for k in data.files}
+
+
+@pytest.mark.parametrize("name, t_end", [("luding-three-particles", 0.01), ("luding-table1", 0.0005),
+                                         ("hot-wall-sintering", 0.0005)])
+def test_one_rank_is_the_serial_run_bit_for_bit(tmp_path, name, t_end):
+    serial = ranks_worker.run_builtin(name, t_end, tmp_path / "serial")
+    one = launched(1, "scene", name, t_end, tmp_path / "one", tmp_path / "one.npz")
+    for key in ("x", "v", "w", "f", "T"):
+        assert np.array_equal(serial[key], one[key]), key
+    assert list(one["summary_keys"]) == list(serial["summary_keys"])
+    assert np.array_equal(one["summary_values"], serial["summary_values"], equal_nan=True)
+
+
+def test_two_ranks_conserve_momentum_and_keep_every_particle(tmp_path):
+    from dem.engines.verlet.engine import VerletEngine
+
+    two = launched(2, "gas", tmp_path / "two.npz")
+    assert two["migrated"] > 0 and two["rebuilds"] > 0  # particles crossed the slabs' boundaries
+    assert two["ids_intact"].all()  # after every chunk, each global id on exactly one rank
+    p = two["momentum"]
+    scale = float(np.sum(two["mass"] * np.linalg.norm(two["v"], axis=1)))
+    assert np.max(np.abs(p - p[0])) <= 1e-13 * scale
+    serial = ranks_worker.trace(VerletEngine, "gas")
+    assert np.max(np.abs(serial["momentum"] - serial["momentum"][0])) <= 1e-13 * scale
+
+
+def test_two_ranks_follow_the_serial_elastic_collisions_to_round_off(tmp_path):
+    from dem.engines.verlet.engine import VerletEngine
+
+    two = launched(2, "elastic", tmp_path / "two.npz")
+    serial = ranks_worker.trace(VerletEngine, "elastic")
+    assert two["migrated"] > 0 and two["ids_intact"].all()
+    # the same collisions: kinetic energy after every chunk the serial run's to round-off (the sums over a
+    # particle's contacts run in another order on two ranks)
+    np.testing.assert_allclose(two["energy"], serial["energy"], rtol=1e-12, atol=0)
+    np.testing.assert_allclose(two["x"], serial["x"], rtol=0, atol=1e-12)
+
+
+def test_two_ranks_write_the_gathered_run_folder(tmp_path):
+    out = tmp_path / "two"
+    launched(2, "scene", "luding-three-particles", 0.002, out, tmp_path / "two.npz")
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["particles"] == 3 and summary["engine"] == "verlet"
+    pvd = (out / "particles.pvd").read_text() if (out / "particles.pvd").exists() else ""
+    assert ".vtu" in pvd
+    assert (out / "timeseries.csv").read_text().count("\n") > 2
+
+
+def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):
+    from dem.engines.verlet.ranks import refuse_unsupported
+
+    scene = ranks_worker.builtin("hot-wall-sintering", 0.001)
+    with pytest.raises(ValueError, match=r"heat on moving contacts runs on one rank only"):
+        refuse_unsupported(scene, 2, resume=False)
+    with pytest.raises(ValueError, match=r"--resume: a run on 2 ranks"):
+        refuse_unsupported(ranks_worker.builtin("luding-three-particles", 0.001), 2, resume=True)
+    refuse_unsupported(scene, 1, resume=False)  # heat on one rank: the serial run
+    staggered = ranks_worker.builtin("zohdi-compaction", 0.01)
+    with pytest.raises(ValueError, match=r"engine = 'staggered': under mpiexec only the verlet engine"):
+        refuse_unsupported(staggered, 1, resume=False)
