@@ -60,10 +60,8 @@ class Slabs:
         """How far each centre lies from the slab of ``rank`` along the axis (0 inside it)."""
         u = self.wrapped(x[:, self.axis])
         lo, hi = self.cuts[rank], self.cuts[rank + 1]
-        d = np.maximum(np.maximum(lo - u, u - hi), 0.0)
-        if self.period > 0:  # the other way round the box
-            d = np.minimum(d, np.maximum(np.maximum(lo - (u - self.period), (u + self.period) - hi), 0.0))
-        return d
+        images = (u - self.period, u, u + self.period) if self.period > 0 else (u,)  # both ways round the box
+        return np.min([np.maximum(np.maximum(lo - v, v - hi), 0.0) for v in images], axis=0)
 
     def within_halo(self, x: np.ndarray, rank: int, halo: float) -> np.ndarray:
         """Indices of the particles at ``x`` closer than ``halo`` to the slab of ``rank`` (those of another rank's
