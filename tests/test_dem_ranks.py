@@ -1,7 +1,8 @@
 """Moving particles across MPI ranks (dem.engines.verlet.ranks), launched with mpiexec -n 1 and -n 2 on
-tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserve momentum (periodic box) and the
-energy of elastic collisions as the serial run does, to round-off, lose and duplicate no particle through
-migration, and write the run's folder from rank 0. Skipped where mpi4py or mpiexec is missing."""
+tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserve momentum (periodic box), follow
+the serial elastic collisions (energy and all) to the bit, lose and duplicate no particle through migration, move
+stress walls as the serial run to round-off, and write the run's folder from rank 0. Skipped where mpi4py or
+mpiexec is missing."""
 
 import json
 import os

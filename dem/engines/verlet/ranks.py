@@ -1,10 +1,10 @@
 """Particles that move, across MPI ranks: spatial slabs, ghosts, migration (mpi4py).
 
 Under ``mpiexec`` every rank reads the scene, keeps the particles of its slab (:mod:`dem.engines.verlet.decomposition`)
-and runs the compiled loop of :mod:`dem.engines.verlet.loop` on its *local* particles: those it owns and, after them
-in the same arrays, *ghosts* -- copies of the particles of other ranks within the halo ``2 r_max + skin`` of its
-slab. The local particles are ordered by global id (the particle's index in the scene), so that a local pair ``i <
-j`` is also a pair of lower global id first, as the serial list orders it.
+and runs the compiled loop of :mod:`dem.engines.verlet.loop` on its *local* particles: those it owns and, in the
+same arrays, *ghosts* -- copies of the particles of other ranks within the halo ``2 r_max + skin`` of its slab. The
+local particles are ordered by global id (the particle's index in the scene), so that a local pair ``i < j`` is
+also a pair of lower global id first, as the serial list orders it.
 
 Forces: a rank lists every pair with at least one owned partner; a pair across two slabs is thus computed on both
 ranks, with the same inputs in the same order (ghosts are copies to the bit), and each keeps the force on its own
@@ -18,11 +18,17 @@ torques, radii, temperatures and law state (the second half kick of a ghost used
 needs a new Verlet list, all rebuild: particles whose centre left the slab migrate to their new owner with
 everything they carry (the law's particle state, the particle-wall histories), the pair histories (keyed by the
 global ids of the pair) go to the new owners of both partners, ghosts are exchanged afresh and the list is built
-from the local particles. On one rank this is the serial run step by step, bit for bit.
+from the local particles.
+
+On one rank this is the serial run step by step, bit for bit. On more, each owned particle still sums its contacts
+in the serial order (its local pairs are sorted by global id), so a periodic run is the serial one to the bit too;
+with walls only the walls' loads differ, at round-off (the ranks' partial sums are added in another order), and a
+stress wall's motion carries that difference into the packing.
 
 Outputs are gathered on rank 0 in global order (:meth:`RankMechanics.gathered`), which writes the run folder as a
-serial run does. Heat on moving contacts, the ``staggered`` and ``static`` engines, resuming and checkpoints run on
-one rank only (refused on more, :func:`refuse_unsupported`).
+serial run does (not as PVTU pieces). Heat on moving contacts, resuming and checkpoints run on one rank only
+(:func:`refuse_unsupported` refuses them on more, where no checkpoint is written); the ``staggered`` and ``static``
+engines do not run under ``mpiexec``.
 """
 
 from __future__ import annotations
