@@ -17,6 +17,18 @@ GAS = {"scene": {"physics": ["mechanical"]}, "material": {"density": 7800.0}, "c
        "generator": {"kind": "box", "n": 60, "radius": 5e-4, "radius_spread": 0.1, "seed": 2, "speed": 0.5,
                      "box": [[0.0, 0.0, 0.0], [L, L, L]]},
        "periodic": {"lengths": [L, L, L]}, "solver": {"mode": "transient", "t_end": 0.004}}
+COMPACTION_SIDE = 0.03  # m, the square box the disks start in (solid fraction ~0.35)
+STRESS_WALL = {"motion": "stress", "pressure": 100.0, "mass": 0.01, "damping": 0.2}
+COMPACTION = {  # 100 disks of Luding 2005's Table 1 sizes, stiffer-than-soft linear contact, pressed at 100 N/m
+    "scene": {"physics": ["mechanical"], "dimension": 2, "height": 6e-3}, "material": {"density": 2000.0},
+    "contact": {**LUDING, "k1": 2e4, "k2": 2e4, "kc": 0.0, "gamma_n": 2e-2, "gamma_t": 5e-3},
+    "generator": {"kind": "box", "n": 100, "radius": 1e-3, "radius_spread": 0.5, "seed": 1, "speed": 0.01,
+                  "box": [[0.0, 0.0, 0.0], [COMPACTION_SIDE, 0.0, COMPACTION_SIDE]], "temperature": 20.0},
+    "walls": [{"name": "left", "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]},
+              {"name": "bottom", "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
+              {"name": "right", "point": [COMPACTION_SIDE, 0.0, 0.0], "normal": [-1.0, 0.0, 0.0], **STRESS_WALL},
+              {"name": "top", "point": [0.0, 0.0, COMPACTION_SIDE], "normal": [0.0, 0.0, -1.0], **STRESS_WALL}],
+    "solver": {"mode": "transient", "t_end": 0.1}}
 CASES = {
     # frictional, damped, sintering law: momentum is what a periodic box conserves
     "gas": GAS,
@@ -67,9 +79,25 @@ def builtin(name: str, t_end: float):
 def run_builtin(name: str, t_end: float, out) -> dict:
     """The built-in scene through the driver (the ranks engine under mpiexec), its folder written into ``out``:
     the final particles and the summary's numbers."""
+    return run_scene(builtin(name, t_end), out)
+
+
+def pressed(relative: float = 0.0):
+    """:data:`COMPACTION` with the walls' pressure changed by ``relative`` (a few ulps: another sample of the
+    same compaction, as two ranks' loads summed in another order are)."""
+    from dem import parse_scene
+
+    doc = copy.deepcopy(COMPACTION)
+    for wall in doc["walls"][2:]:
+        wall["pressure"] *= 1.0 + relative
+    return parse_scene(doc)
+
+
+def run_scene(scene, out=None) -> dict:
+    """``scene`` through the driver: the final particles and the summary's numbers."""
     from dem import run
 
-    result = run(builtin(name, t_end), out=out)
+    result = run(scene, out=out)
     s = result.engine.mechanics.state
     numbers = {k: v for k, v in result.summary.items() if isinstance(v, (int, float)) and k != "seconds"}
     return {"x": s.x, "v": s.v, "w": s.w, "f": s.f, "T": s.T, "summary_keys": np.array(list(numbers)),
@@ -84,6 +112,8 @@ if __name__ == "__main__":
     comm = MPI.COMM_WORLD
     if sys.argv[1] == "scene":  # scene NAME T_END FOLDER RESULT
         result = run_builtin(sys.argv[2], float(sys.argv[3]), sys.argv[4])
+    elif sys.argv[1] == "compaction":  # compaction RESULT
+        result = run_scene(pressed())
     else:  # CASE RESULT
         result = trace(RankVerletEngine, sys.argv[1], comm)
     if comm.Get_rank() == 0:
