@@ -261,7 +261,8 @@ class RankMechanics(MechanicalModel):
         a rebuild anywhere rebuilds everywhere."""
         w = self.w
         failed = status in (NONFINITE, ESCAPED)
-        total = self.comm.allreduce(np.concatenate([[status == REBUILD, failed], w.force]), op=_sum())
+        total = np.concatenate([[status == REBUILD, failed], w.force])
+        self.comm.Allreduce(total.copy(), total, op=_sum())  # buffers, not pickles: once per step
         w.force[:] = total[2:]
         h = 0.5 * self.dt
         for m in np.flatnonzero(w.mode == 1):
