@@ -65,7 +65,8 @@ class StaggeredEngine:
         if saved is not None and saved["moving"]:
             state.x[:], state.v[:], state.T[:] = saved["x"], saved["v"], saved["T"]
         self.mechanics = StaggeredMechanics(state, m.walls, material, m.gravity, m.skin,
-                                            history=saved if saved is not None and saved["moving"] else None)
+                                            history=saved if saved is not None and saved["moving"] else None,
+                                            box=scene.box)
         self.thermal = LumpedHeat(p, m.walls, scene.conductance) if "thermal" in scene.physics else None
         if self.thermal is not None and restart is not None:
             self.thermal.T, self.thermal.T0 = saved["T"].copy(), saved["thermal_T0"].copy()
@@ -245,12 +246,18 @@ class StaggeredEngine:
 
     # -------------------------------------------------------------------------------------------- outputs
     def _cross_section(self, axis):
-        """``(area, (lo, hi) per lateral axis)`` of the box the walls perpendicular to ``axis`` enclose, or None."""
+        """``(area, (lo, hi) per lateral axis)`` of the box the walls (or the periods of a periodic box)
+        perpendicular to ``axis`` enclose, or None."""
         mech = self.mechanics
         area, spans = 1.0, []
         box = box_axes(mech.walls)
+        periodic = mech.periodic_box
         for a in range(3):
             if a == axis:
+                continue
+            if mech.box[a] > 0:
+                spans.append((a, periodic.origin[a], periodic.origin[a] + periodic.lengths[a]))
+                area *= periodic.lengths[a]
                 continue
             if a not in box:
                 return None

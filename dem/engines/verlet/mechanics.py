@@ -98,9 +98,8 @@ class MechanicalModel:
     def _build_list(self, first: bool = False):
         s = self.state
         box = self.periodic_box
-        if box is not None:  # those that left it back into the box (the others keep their bits: a resume is exact)
-            outside = box.mask & ((s.x < box.origin) | (s.x >= box.origin + box.lengths))
-            s.x[:] = np.where(outside, box.wrap(s.x), s.x)
+        if box is not None:  # those that left it back into the box
+            box.wrap_outside(s.x)
         expected = 0 if first else len(self.pi) + len(self.pi) // 8 + 16  # the last list, with room to grow
         i, j = verlet_pairs(s.x, s.radius, self.skin, self.box, expected)
         if first:
