@@ -159,3 +159,17 @@ def test_what_cannot_work_is_refused_in_one_line():
     doc["periodic"]["drop"] = [0.0, 0.0, 1.0]
     with pytest.raises(ValueError, match=r"\[periodic\] drop: not read by the staggered engine"):
         parse_scene(doc)
+
+
+def test_the_solid_fraction_counts_the_periods():
+    """Between a floor and a ceiling along x, periodic along y and z: the box is the walls' gap times the periods."""
+    position = [[0.2, 0.1, 0.1], [0.2, 0.5, 0.9], [0.3, 0.8, 0.4]]
+    doc = {"scene": {"physics": ["mechanical"]}, "material": MATERIAL, "contact": ZOHDI,
+           "particles": {"position": position, "radius": [R] * 3, "temperature": [300.0] * 3},
+           "walls": [{"name": "floor", "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]},
+                     {"name": "ceiling", "point": [0.5, 0.0, 0.0], "normal": [-1.0, 0.0, 0.0]}],
+           "periodic": {"lengths": [L, 0.8, 1.2], "axes": ["y", "z"]},
+           "solver": {"mode": "transient", "t_end": 0.01, "dt": 0.005, "dt_max": 0.005}}
+    engine = StaggeredEngine(parse_scene(doc))
+    solid = 3 * 4.0 / 3.0 * np.pi * R**3
+    assert engine.bed()["volume_fraction"] == pytest.approx(solid / (0.5 * 0.8 * 1.2), rel=1e-14)

@@ -292,10 +292,11 @@ class StaggeredEngine:
         ceiling = -mech.w.q[self._top]
         inside = cap_volume(s.x[:, axis], s.radius, self._lowest) - cap_volume(s.x[:, axis], s.radius, floor)
         width = 2.0 * float(np.mean(s.radius))
+        x = s.x if mech.periodic_box is None else mech.periodic_box.wrap(s.x)  # columns over the periods
         column = np.zeros(len(s.x), dtype=np.int64)
         for (a, lo, hi) in spans:
             count = max(1, int((hi - lo) / width))
-            column = column * count + np.clip(((s.x[:, a] - lo) / (hi - lo) * count).astype(np.int64), 0, count - 1)
+            column = column * count + np.clip(((x[:, a] - lo) / (hi - lo) * count).astype(np.int64), 0, count - 1)
         tops = np.full(column.max() + 1, -np.inf)
         np.maximum.at(tops, column, s.x[:, axis] + s.radius)
         surface = min(float(np.mean(tops[np.isfinite(tops)])), ceiling)

@@ -169,9 +169,8 @@ class MechanicalModel:
         """The closed pair contacts: ``(i, j, overlap, f_n, f_t)`` with f_t the (M, 3) tangential forces on i."""
         s = self.state
         d = s.x[self.pi] - s.x[self.pj]
-        for a in range(3):
-            if self.box[a] > 0:
-                d[:, a] -= self.box[a] * np.floor(d[:, a] / self.box[a] + 0.5)
+        if self.periodic_box is not None:
+            d = self.periodic_box.minimum_image(d)
         overlap = s.radius[self.pi] + s.radius[self.pj] - np.linalg.norm(d, axis=1)
         closed = overlap > 0
         return self.pi[closed], self.pj[closed], overlap[closed], self.p_fn[closed], self.p_ft[closed]
