@@ -146,6 +146,10 @@ def test_the_state_keeps_the_box_and_a_run_from_it_has_it(tmp_path):
     assert np.array_equal(scene.particles.position, first.engine.mechanics.state.x)
     then = run(scene)
     assert then.engine.mechanics.periodic_box is scene.box and then.summary["t"] == pytest.approx(0.04)
+    thermal = {k: v for k, v in MATERIAL.items() if k != "electrical_conductivity"}
+    static = parse_scene({"scene": {"physics": ["thermal"]}, "material": thermal, "start": {"state": str(state)},
+                          "conductance": {"law": "zohdi"}})
+    assert static.engine == "static" and static.box.periodic == (True, True, True)  # bonds across the faces too
 
 
 def test_what_cannot_work_is_refused_in_one_line():
