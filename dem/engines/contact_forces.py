@@ -16,11 +16,12 @@ than the law's ``reach``, a particle-wall pair while closer than its ``wall_reac
 adhesive law holds a contact beyond touching until it breaks); the laws whose particles do not rotate
 (``law.SPINS`` false) get no torques.
 
-Two loops share the geometry and the law (:func:`pair_contact`, :func:`body_force`, :func:`wall_contacts`):
-:func:`forces` adds each pair's force into both particles as it goes (one thread), :func:`threaded_forces` works on
-all threads in two conflict-free passes -- every pair's force and torque arms into a row of its own, then every
-particle sums the rows of its pairs (:func:`incident_pairs`) in the order of the pair list. Both add the same numbers
-in the same order into each particle, so their results are the same to the bit, on any number of threads.
+Threads: in the copies of this module for more than one thread (:mod:`dem.engines.compiled`) :data:`THREADED` is
+true and the loop runs on all of numba's threads in conflict-free passes: every pair's force and torque arms into a
+row of its own (``load``), then every particle sums the rows of its pairs (:func:`incident_pairs`) in the order of
+the list. That is the order in which the one-thread loop adds them into each particle, so the results are the same
+to the bit on any number of threads. The flag is a compile-time constant: the one-thread loop carries nothing of
+the threaded one.
 """
 
 from __future__ import annotations
@@ -40,73 +41,144 @@ from dem.laws.contact import luding as law
 # numbers stays the IEEE one.
 FINITE_MATH = {"nnan", "ninf", "nsz"}
 N_PARAMS = law.N_PARAMS
+THREADED = False  # True in the copies for more than one thread (dem.engines.compiled)
+LOAD_COLUMNS = 8  # a pair's row of the threaded loop's buffer: g = f_n n + f_t (3), n x f_t (3), l_i, l_j
 
 
-@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="always")
-def body_force(k, f, tau, v, mass, radius, gravity, params):
-    """Gravity and the law's drag on particle ``k`` into ``f[k]``; ``tau[k]`` zeroed (the start of its sums)."""
-    if law.DRAG:
-        drag = law.drag(k, radius, params)
-        f[k, 0] = mass[k] * gravity[0] - drag * v[k, 0]
-        f[k, 1] = mass[k] * gravity[1] - drag * v[k, 1]
-        f[k, 2] = mass[k] * gravity[2] - drag * v[k, 2]
-    else:
-        f[k, 0] = mass[k] * gravity[0]
-        f[k, 1] = mass[k] * gravity[1]
-        f[k, 2] = mass[k] * gravity[2]
-    tau[k, 0] = 0.0
-    tau[k, 1] = 0.0
-    tau[k, 2] = 0.0
+@njit(cache=True)
+def incident_pairs(pi, pj, n):
+    """Each particle's pairs in the order of the list, as ``(start, pairs)``: particle k's are
+    ``pairs[start[k]:start[k + 1]]``, ``c`` where k is the pair's i, ``~c`` (= -1 - c) where it is its j."""
+    start = np.zeros(n + 1, dtype=np.int64)
+    for c in range(pi.shape[0]):
+        start[pi[c] + 1] += 1
+        start[pj[c] + 1] += 1
+    for k in range(n):
+        start[k + 1] += start[k]
+    fill = start[:-1].copy()
+    pairs = np.empty(2 * pi.shape[0], dtype=np.int64)
+    for c in range(pi.shape[0]):
+        pairs[fill[pi[c]]] = c
+        fill[pi[c]] += 1
+        pairs[fill[pj[c]]] = ~c
+        fill[pj[c]] += 1
+    return start, pairs
 
 
-@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="always")
-def pair_contact(c, planar, x, v, w, radius, state, T, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft, params, dt,
-                 record):
-    """Listed pair ``c``: ``(closed, g0, g1, g2, m0, m1, m2, l_i, l_j)`` -- whether it acts, the force ``g = f_n n +
-    f_t`` on i (on j: -g), ``m = n x f_t`` and the lever arms (the torques are ``-l_i m`` on i and ``-l_j m`` on j).
-    Its history goes from ``p_hist_in`` into ``p_hist``, its forces (with ``record``) into ``p_fn``, ``p_ft``."""
-    i, j = pi[c], pj[c]
-    dx = min_image(x[i, 0] - x[j, 0], box[0])
-    dy = 0.0 if planar else min_image(x[i, 1] - x[j, 1], box[1])
-    dz = min_image(x[i, 2] - x[j, 2], box[2])
-    ri, rj = radius[i], radius[j]
-    d2 = dx * dx + dy * dy + dz * dz
-    cut = ri + rj + law.reach(c, p_hist_in, ri, rj, params)
-    if d2 >= cut * cut or d2 == 0.0:
-        law.forget_pair(c, p_hist_in, p_hist)  # the contact opened: it forgets its history
-        if record:
-            p_fn[c] = 0.0
-            p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = 0.0, 0.0, 0.0
-        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    d = math.sqrt(d2)
-    n0, n1, n2 = dx / d, dy / d, dz / d
-    delta = ri + rj - d
-    li, lj = ri - 0.5 * delta, rj - 0.5 * delta  # lever arms to the middle of the overlap: li + lj = d
-    # v_ij = v_i - v_j + l_i n x w_i + l_j n x w_j  (Luding 2005, eq. 18)
-    c0 = 0.0 if planar else li * w[i, 0] + lj * w[j, 0]
-    c1 = li * w[i, 1] + lj * w[j, 1]
-    c2 = 0.0 if planar else li * w[i, 2] + lj * w[j, 2]
-    vr0 = v[i, 0] - v[j, 0] + n1 * c2 - n2 * c1
-    vr1 = 0.0 if planar else v[i, 1] - v[j, 1] + n2 * c0 - n0 * c2
-    vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
-    vn = vr0 * n0 + vr1 * n1 + vr2 * n2
-    f_n, ft0, ft1, ft2 = law.pair_force(c, i, j, p_hist_in, p_hist, state, T, delta, d, (n0, n1, n2),
-                                        (vr0, vr1, vr2), vn, ri, rj, planar, dt, params)
-    if record:
-        p_fn[c] = f_n
-        p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
-    # the torques -l n x f_t on both (the lever arms -l_i n and +l_j n, the forces f_t and -f_t)
-    m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
-    return True, f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2, m0, m1, m2, li, lj
+@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, parallel=THREADED)
+def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft,
+           wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True, start=None,
+           pairs=None, load=None):
+    """Forces and torques of the current state (gravity, the law's drag, pairs, the listed particle-wall pairs
+    ``(wk, wm)``); the normal forces on the walls go into ``wforce``. Returns the index into the wall list of the
+    first particle whose centre lies behind its wall, else -1.
 
+    Each contact's history is read from ``p_hist_in``/``w_hist_in`` and written to ``p_hist``/``w_hist``: the same
+    arrays for a step that is taken (velocity Verlet), others for an iterate that may be discarded (the implicit
+    scheme). With ``record`` the contact forces are kept (``p_fn``, ``p_ft``, ``w_fn``, ``w_ft``: outputs only, so
+    a time loop records them on the last step of a call). ``spin_axes`` (:attr:`dem.geometry.motion.MotionState.spin_axes`):
+    ``(1,)`` for 2D disks in the x-z plane, whose pair terms along y vanish.
 
-@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="always")
-def wall_contacts(x, v, w, f, tau, radius, state, T, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft,
-                  params, dt):
-    """The listed particle-wall pairs ``(wk, wm)`` in their order: forces and torques added into ``f``, ``tau``, the
-    normal forces on the walls into ``wforce``. Returns the index into the wall list of the first particle whose
-    centre lies behind its wall, else -1."""
+    The law's kernels are inlined right here, scalars and 3-tuples in and out, with the material as a tuple: an
+    array argument costs an atomic reference count per call (a quarter of the loop). The length of ``spin_axes`` is
+    part of its type, so 2D and 3D get code of their own, the 2D one without the terms that vanish (a fifth
+    faster).
+
+    Where :data:`THREADED` (module docstring), ``start`` and ``pairs`` are the pairs by particle
+    (:func:`incident_pairs`) and ``load`` a ``(len(pi), LOAD_COLUMNS)`` buffer; the walls stay on one thread (a few
+    particles: the surface's)."""
+    planar = len(spin_axes) == 1
     escaped = -1
+    n = x.shape[0]
+    params = to_fixed_tuple(params, N_PARAMS)
+    for k in prange(n):
+        if law.DRAG:
+            drag = law.drag(k, radius, params)
+            f[k, 0] = mass[k] * gravity[0] - drag * v[k, 0]
+            f[k, 1] = mass[k] * gravity[1] - drag * v[k, 1]
+            f[k, 2] = mass[k] * gravity[2] - drag * v[k, 2]
+        else:
+            f[k, 0] = mass[k] * gravity[0]
+            f[k, 1] = mass[k] * gravity[1]
+            f[k, 2] = mass[k] * gravity[2]
+        tau[k, 0] = 0.0
+        tau[k, 1] = 0.0
+        tau[k, 2] = 0.0
+    for c in prange(pi.shape[0]):
+        i, j = pi[c], pj[c]
+        dx = min_image(x[i, 0] - x[j, 0], box[0])
+        dy = 0.0 if planar else min_image(x[i, 1] - x[j, 1], box[1])
+        dz = min_image(x[i, 2] - x[j, 2], box[2])
+        ri, rj = radius[i], radius[j]
+        d2 = dx * dx + dy * dy + dz * dz
+        cut = ri + rj + law.reach(c, p_hist_in, ri, rj, params)
+        if d2 >= cut * cut or d2 == 0.0:
+            law.forget_pair(c, p_hist_in, p_hist)  # the contact opened: it forgets its history
+            if record:
+                p_fn[c] = 0.0
+                p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = 0.0, 0.0, 0.0
+            if THREADED:
+                load[c, 6] = -1.0  # open: no load
+            continue
+        d = math.sqrt(d2)
+        n0, n1, n2 = dx / d, dy / d, dz / d
+        delta = ri + rj - d
+        li, lj = ri - 0.5 * delta, rj - 0.5 * delta  # lever arms to the middle of the overlap: li + lj = d
+        # v_ij = v_i - v_j + l_i n x w_i + l_j n x w_j  (Luding 2005, eq. 18)
+        c0 = 0.0 if planar else li * w[i, 0] + lj * w[j, 0]
+        c1 = li * w[i, 1] + lj * w[j, 1]
+        c2 = 0.0 if planar else li * w[i, 2] + lj * w[j, 2]
+        vr0 = v[i, 0] - v[j, 0] + n1 * c2 - n2 * c1
+        vr1 = 0.0 if planar else v[i, 1] - v[j, 1] + n2 * c0 - n0 * c2
+        vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
+        vn = vr0 * n0 + vr1 * n1 + vr2 * n2
+        f_n, ft0, ft1, ft2 = law.pair_force(c, i, j, p_hist_in, p_hist, state, T, delta, d, (n0, n1, n2),
+                                            (vr0, vr1, vr2), vn, ri, rj, planar, dt, params)
+        if record:
+            p_fn[c] = f_n
+            p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
+        g0, g1, g2 = f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2
+        # torques -l n x f_t on both (the lever arms -l_i n and +l_j n, the forces f_t and -f_t)
+        m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
+        if THREADED:  # into the pair's row; its particles add it below
+            load[c, 0], load[c, 1], load[c, 2], load[c, 3], load[c, 4], load[c, 5] = g0, g1, g2, m0, m1, m2
+            load[c, 6], load[c, 7] = li, lj
+            continue
+        f[i, 0] += g0
+        f[i, 1] += g1
+        f[i, 2] += g2
+        f[j, 0] -= g0
+        f[j, 1] -= g1
+        f[j, 2] -= g2
+        if law.SPINS:
+            tau[i, 1] -= li * m1
+            tau[j, 1] -= lj * m1
+            if not planar:
+                tau[i, 0] -= li * m0
+                tau[i, 2] -= li * m2
+                tau[j, 0] -= lj * m0
+                tau[j, 2] -= lj * m2
+    if THREADED:
+        for k in prange(n):  # each particle its pairs' rows, in the order of the list (as the loop above adds them)
+            for e in range(start[k], start[k + 1]):
+                c = pairs[e]
+                arm = 6 if c >= 0 else 7
+                c = c if c >= 0 else ~c
+                if load[c, 6] < 0.0:
+                    continue
+                if arm == 6:
+                    f[k, 0] += load[c, 0]
+                    f[k, 1] += load[c, 1]
+                    f[k, 2] += load[c, 2]
+                else:
+                    f[k, 0] -= load[c, 0]
+                    f[k, 1] -= load[c, 1]
+                    f[k, 2] -= load[c, 2]
+                if law.SPINS:
+                    tau[k, 1] -= load[c, arm] * load[c, 4]
+                    if not planar:
+                        tau[k, 0] -= load[c, arm] * load[c, 3]
+                        tau[k, 2] -= load[c, arm] * load[c, 5]
     n_w = wn.shape[0]
     for m in range(n_w):
         wforce[m] = 0.0
@@ -141,113 +213,3 @@ def wall_contacts(x, v, w, f, tau, radius, state, T, wn, wq, wdq, wforce, wk, wm
             tau[k, 2] -= lk * (n0 * ft1 - n1 * ft0)
         wforce[m] += f_n
     return escaped
-
-
-@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH)
-def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft,
-           wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True):
-    """Forces and torques of the current state (gravity, the law's drag, pairs, the listed particle-wall pairs
-    ``(wk, wm)``); the normal forces on the walls go into ``wforce``. Returns the index into the wall list of the
-    first particle whose centre lies behind its wall, else -1.
-
-    Each contact's history is read from ``p_hist_in``/``w_hist_in`` and written to ``p_hist``/``w_hist``: the same
-    arrays for a step that is taken (velocity Verlet), others for an iterate that may be discarded (the implicit
-    scheme). With ``record`` the contact forces are kept (``p_fn``, ``p_ft``, ``w_fn``, ``w_ft``: outputs only, so
-    a time loop records them on the last step of a call). ``spin_axes`` (:attr:`dem.geometry.motion.MotionState.spin_axes`):
-    ``(1,)`` for 2D disks in the x-z plane, whose pair terms along y vanish.
-
-    The law's kernels are inlined right here, scalars and 3-tuples in and out, with the material as a tuple: an
-    array argument costs an atomic reference count per call (a quarter of the loop). The length of ``spin_axes`` is
-    part of its type, so 2D and 3D get code of their own, the 2D one without the terms that vanish (a fifth
-    faster)."""
-    planar = len(spin_axes) == 1
-    params = to_fixed_tuple(params, N_PARAMS)
-    for k in range(x.shape[0]):
-        body_force(k, f, tau, v, mass, radius, gravity, params)
-    for c in range(pi.shape[0]):
-        closed, g0, g1, g2, m0, m1, m2, li, lj = pair_contact(c, planar, x, v, w, radius, state, T, box, pi, pj,
-                                                              p_hist_in, p_hist, p_fn, p_ft, params, dt, record)
-        if not closed:
-            continue
-        i, j = pi[c], pj[c]
-        f[i, 0] += g0
-        f[i, 1] += g1
-        f[i, 2] += g2
-        f[j, 0] -= g0
-        f[j, 1] -= g1
-        f[j, 2] -= g2
-        if law.SPINS:
-            tau[i, 1] -= li * m1
-            tau[j, 1] -= lj * m1
-            if not planar:
-                tau[i, 0] -= li * m0
-                tau[i, 2] -= li * m2
-                tau[j, 0] -= lj * m0
-                tau[j, 2] -= lj * m2
-    return wall_contacts(x, v, w, f, tau, radius, state, T, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn,
-                         w_ft, params, dt)
-
-
-LOAD_COLUMNS = 8  # a pair's row of threaded_forces' buffer: g (3), n x f_t (3), l_i, l_j (l_i < 0: open)
-
-
-@njit(cache=True)
-def incident_pairs(pi, pj, n):
-    """Each particle's pairs in the order of the list, as ``(start, pairs)``: particle k's are
-    ``pairs[start[k]:start[k + 1]]``, ``c`` where k is the pair's i, ``~c`` (= -1 - c) where it is its j."""
-    start = np.zeros(n + 1, dtype=np.int64)
-    for c in range(pi.shape[0]):
-        start[pi[c] + 1] += 1
-        start[pj[c] + 1] += 1
-    for k in range(n):
-        start[k + 1] += start[k]
-    fill = start[:-1].copy()
-    pairs = np.empty(2 * pi.shape[0], dtype=np.int64)
-    for c in range(pi.shape[0]):
-        pairs[fill[pi[c]]] = c
-        fill[pi[c]] += 1
-        pairs[fill[pj[c]]] = ~c
-        fill[pj[c]] += 1
-    return start, pairs
-
-
-@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, parallel=True)
-def threaded_forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist,
-                    p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record,
-                    start, pairs, load):
-    """:func:`forces` on all of numba's threads, the same to the bit: the pairs in parallel, each into its row of
-    ``load`` (``(len(pi), LOAD_COLUMNS)``), then the particles in parallel, each summing its rows (``start``,
-    ``pairs`` of :func:`incident_pairs`) in the order of the list -- the order in which :func:`forces` adds them;
-    the walls last, in one thread (a few particles: the surface's)."""
-    planar = len(spin_axes) == 1
-    params = to_fixed_tuple(params, N_PARAMS)
-    for c in prange(pi.shape[0]):
-        closed, g0, g1, g2, m0, m1, m2, li, lj = pair_contact(c, planar, x, v, w, radius, state, T, box, pi, pj,
-                                                              p_hist_in, p_hist, p_fn, p_ft, params, dt, record)
-        load[c, 0], load[c, 1], load[c, 2] = g0, g1, g2
-        load[c, 3], load[c, 4], load[c, 5] = m0, m1, m2
-        load[c, 6], load[c, 7] = li if closed else -1.0, lj
-    for k in prange(x.shape[0]):
-        body_force(k, f, tau, v, mass, radius, gravity, params)
-        for e in range(start[k], start[k + 1]):
-            c = pairs[e]
-            side = 6 if c >= 0 else 7
-            c = c if c >= 0 else ~c
-            if load[c, 6] < 0.0:
-                continue
-            if side == 6:
-                f[k, 0] += load[c, 0]
-                f[k, 1] += load[c, 1]
-                f[k, 2] += load[c, 2]
-            else:
-                f[k, 0] -= load[c, 0]
-                f[k, 1] -= load[c, 1]
-                f[k, 2] -= load[c, 2]
-            if law.SPINS:
-                arm = load[c, side]
-                tau[k, 1] -= arm * load[c, 4]
-                if not planar:
-                    tau[k, 0] -= arm * load[c, 3]
-                    tau[k, 2] -= arm * load[c, 5]
-    return wall_contacts(x, v, w, f, tau, radius, state, T, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn,
-                         w_ft, params, dt)

@@ -17,10 +17,9 @@ step:
 4. second half kick (velocities at the end of the step); stress-controlled walls from eq. 1.
 
 Like :mod:`dem.engines.contact_forces`, this module is written against the contact law imported as ``law`` and
-copied for every other law by :mod:`dem.engines.compiled`; the copies for more than one thread have
-:data:`THREADED` true: the loops over particles and the force pass (:func:`dem.engines.contact_forces.threaded_forces`)
-run on all of numba's threads, with the same results to the bit. The flag is a compile-time constant: the one-thread
-loop is today's, with nothing of the threaded one in it.
+copied for every other law by :mod:`dem.engines.compiled`; in the copies for more than one thread :data:`THREADED`
+is true: the loops over particles and the force pass run on all of numba's threads, with the same results to the
+bit (:mod:`dem.engines.contact_forces`).
 """
 
 from __future__ import annotations
@@ -29,7 +28,7 @@ import math
 
 from numba import njit, prange
 
-from dem.engines.contact_forces import forces, threaded_forces
+from dem.engines.contact_forces import forces
 from dem.geometry.neighbours import min_image
 from dem.laws.contact import luding as law
 
@@ -60,8 +59,8 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
     come from step counts, so where a run is split into calls (rebuilds, a resume) never changes its arithmetic.
     ``f``/``tau``/``wacc`` must hold the forces of the current state on entry. Returns ``(steps done, status)``;
     ``info`` receives the particle (and wall) index of a non-finite or escaped particle (the first such). ``start``,
-    ``pairs``, ``load``: the pairs by particle and the buffer of :func:`dem.engines.contact_forces.threaded_forces`
-    (used where :data:`THREADED`)."""
+    ``pairs``, ``load``: the pairs by particle and the buffer of the threaded force pass (used where
+    :data:`THREADED`)."""
     n = x.shape[0]
     n_w = wn.shape[0]
     h = 0.5 * dt
@@ -95,14 +94,9 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
                 wdq[m] = 2.0 * math.pi * wfreq[m] * wamp[m] * math.cos(phase)
         law.update_particles((step0 + s + 1 - first) * dt, T0, T_rate, T, radius, radius_ref, state, uniform_T,
                              params, t0, dt)
-        if THREADED:
-            escaped = threaded_forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj,
-                                      p_hist, p_hist, p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn,
-                                      w_ft, params, dt, s == n_steps - 1, start, pairs, load)
-        else:
-            escaped = forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist,
-                             p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params, dt,
-                             s == n_steps - 1)
+        escaped = forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist,
+                         p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params, dt,
+                         s == n_steps - 1, start, pairs, load)
         worst = 0.0
         for k in prange(n):
             im, ii = 1.0 / mass[k], 1.0 / inertia[k]
