@@ -104,9 +104,11 @@ def test_the_environment_variable_sets_the_count_and_the_option_wins(monkeypatch
     with pytest.raises(ValueError, match="SINTERHEAT_THREADS"):
         threads.count()
     monkeypatch.setenv(threads.ENVIRONMENT, "1")
-    threads.use(threads.cores())
-    assert threads.count() == threads.cores() and os.environ["OPENBLAS_NUM_THREADS"] == str(threads.cores())
-    monkeypatch.setattr(threads, "_chosen", None)
+    for variable in threads.BLAS_VARIABLES:
+        monkeypatch.delenv(variable, raising=False)  # restored after the test
+    threads.use(threads.cores())  # the option wins over the environment, which child processes then inherit
+    assert threads.count() == threads.cores()
+    assert os.environ[threads.ENVIRONMENT] == os.environ["OPENBLAS_NUM_THREADS"] == str(threads.cores())
 
 
 @pytest.mark.skipif(threads.cores() < 2, reason="needs two cores")
