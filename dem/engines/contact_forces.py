@@ -42,7 +42,7 @@ from dem.laws.contact import luding as law
 FINITE_MATH = {"nnan", "ninf", "nsz"}
 N_PARAMS = law.N_PARAMS
 THREADED = False  # True in the copies for more than one thread (dem.engines.compiled)
-LOAD_COLUMNS = 8  # a pair's row of the threaded loop's buffer: g = f_n n + f_t (3), n x f_t (3), l_i, l_j
+LOAD_COLUMNS = 9  # a pair's row of the threaded loop's buffer: g = f_n n + f_t (3), n x f_t (3), l_i, l_j, closed
 
 
 @njit(cache=True)
@@ -118,7 +118,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
                 p_fn[c] = 0.0
                 p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = 0.0, 0.0, 0.0
             if THREADED:
-                load[c, 6] = -1.0  # open: no load
+                load[c, 8] = 0.0  # open: no load
             continue
         d = math.sqrt(d2)
         n0, n1, n2 = dx / d, dy / d, dz / d
@@ -142,7 +142,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
         if THREADED:  # into the pair's row; its particles add it below
             load[c, 0], load[c, 1], load[c, 2], load[c, 3], load[c, 4], load[c, 5] = g0, g1, g2, m0, m1, m2
-            load[c, 6], load[c, 7] = li, lj
+            load[c, 6], load[c, 7], load[c, 8] = li, lj, 1.0
             continue
         f[i, 0] += g0
         f[i, 1] += g1
@@ -164,7 +164,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
                 c = pairs[e]
                 arm = 6 if c >= 0 else 7
                 c = c if c >= 0 else ~c
-                if load[c, 6] < 0.0:
+                if load[c, 8] == 0.0:
                     continue
                 if arm == 6:
                     f[k, 0] += load[c, 0]
