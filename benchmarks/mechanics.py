@@ -2,8 +2,8 @@
 path it must leave alone.
 
 * **The loop** -- ns per particle-step of the whole velocity-Verlet step (:meth:`dem.engines.verlet.mechanics.MechanicalModel.
-  advance`: kicks, material state, contacts, walls, and the Verlet-list rebuilds it asks for), warm, best of a few
-  rounds, on
+  advance`: kicks, material state, contacts, walls, and the Verlet-list rebuilds it asks for) on one thread, warm,
+  best of a few rounds, on
 
   - a 2D sample of 300 disks with Luding 2005's Table 1 material (height 6 mm, radii 1 mm +- 50 %) compacted by the
     engine in a bi-axial box (fixed left and bottom walls, stress walls on the right and top, p = 10 N/m,
@@ -39,6 +39,7 @@ the timed part starts from the dense state at once.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import json
 import math
@@ -477,13 +478,13 @@ def study_loop(section, sizes: Sizes, cache: pathlib.Path) -> None:
     disks = biaxial_sample(sizes, cache)
     spheres = periodic_packing(sizes, cache)
     luding, linear = LUDING_TABLE1, linear_limit(LUDING_TABLE1)
-    runs = {
-        "ours, Luding, 2D": lambda: time_ours(lambda: biaxial_simulation(disks, luding), sizes.steps_2d,
-                                              sizes.warmup),
-        "ours, Luding, 3D": lambda: time_ours(lambda: periodic_simulation(spheres, luding), sizes.steps_3d,
-                                              sizes.warmup),
-        "ours, linear, 3D": lambda: time_ours(lambda: periodic_simulation(spheres, linear), sizes.steps_3d,
-                                              sizes.warmup),
+    runs = {  # one thread, as LAMMPS here (study_threads: more)
+        "ours, Luding, 2D": lambda: time_ours_on_threads(1, lambda: biaxial_simulation(disks, luding),
+                                                         sizes.steps_2d, sizes.warmup),
+        "ours, Luding, 3D": lambda: time_ours_on_threads(1, lambda: periodic_simulation(spheres, luding),
+                                                         sizes.steps_3d, sizes.warmup),
+        "ours, linear, 3D": lambda: time_ours_on_threads(1, lambda: periodic_simulation(spheres, linear),
+                                                         sizes.steps_3d, sizes.warmup),
     }
     probe = periodic_simulation(spheres, linear).mechanics
     dt, skin, m_eff = probe.dt, probe.skin, float(np.mean(probe.state.mass) / 2.0)
@@ -569,16 +570,23 @@ def study_loop(section, sizes: Sizes, cache: pathlib.Path) -> None:
     study_stages(section, spheres, sizes, lammps)
 
 
-def time_ours_on_threads(number: int, make, steps: int, warmup: int) -> dict:
-    """:func:`time_ours` with the engine built on ``number`` threads (the process's count restored after)."""
+@contextlib.contextmanager
+def on_threads(number: int):
+    """Engines built inside run on ``number`` threads (the process's count restored after)."""
     from sinterheat import threads
 
     before = threads.count()
     threads.use(number)
     try:
-        return time_ours(make, steps, warmup)
+        yield
     finally:
         threads.use(before)
+
+
+def time_ours_on_threads(number: int, make, steps: int, warmup: int) -> dict:
+    """:func:`time_ours` with the engine built on ``number`` threads."""
+    with on_threads(number):
+        return time_ours(make, steps, warmup)
 
 
 def study_threads(section, sizes: Sizes, cache: pathlib.Path) -> None:
@@ -656,7 +664,8 @@ def frictionless_agreement(spheres: dict, linear: LudingMaterial, command, folde
 
 
 def study_stages(section, spheres: dict, sizes: Sizes, lammps: dict | None) -> None:
-    stages = stage_costs(spheres, LUDING_TABLE1, sizes.steps_3d)
+    with on_threads(1):
+        stages = stage_costs(spheres, LUDING_TABLE1, sizes.steps_3d)
     whole = stages["ns"]["whole step"]
     peer = ""
     if lammps is not None:
