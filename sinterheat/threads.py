@@ -5,9 +5,9 @@ core this process may run on.
 :func:`count` is read when an engine is built (the engine binds its one-thread or its threaded loop then, never
 inside the loop: :mod:`dem.engines.compiled`); :func:`use` sets the number for the rest of the process: numba's
 threads, the BLAS libraries already loaded (threadpoolctl) and, through ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS``
-and ``MKL_NUM_THREADS``, those loaded later and child processes (which also inherit ``SINTERHEAT_THREADS``). numba's threading layer is ``workqueue`` (numba's
-own, present everywhere; it needs neither TBB nor OpenMP, and its idle threads sleep) unless
-``NUMBA_THREADING_LAYER`` names another.
+and ``MKL_NUM_THREADS``, those loaded later and child processes (which also inherit ``SINTERHEAT_THREADS``).
+numba's threading layer is ``workqueue`` (numba's own, present everywhere; it needs neither TBB nor OpenMP, and its
+idle threads sleep) unless ``NUMBA_THREADING_LAYER`` names another.
 """
 
 from __future__ import annotations
