@@ -127,6 +127,20 @@ def openpnm_worker(n: int) -> None:
           "max_abs_difference": float(np.max(np.abs(T_pnm - res.T)))})
 
 
+def amg_peers_worker(n: int) -> None:
+    """Our AMG before and after its tuning and PETSc's (when importable) on the steady network of ~n particles,
+    side by side (:mod:`benchmarks.amg_peers`); one JSON line."""
+    from benchmarks.amg_peers import side_by_side_rows
+
+    net, _ = packing_network(n)
+    _, label, anchored = net.graph.components()
+    solve = np.flatnonzero(anchored[label])  # what dem.network.heat.steady solves (floating particles apart)
+    A = net.matrix({})[solve][:, solve].tocsr()
+    b = net.rhs({})[solve]
+    rows = side_by_side_rows(A, b, rounds=2)
+    emit({"particles": net.particles.n, "unknowns": A.shape[0], "nonzeros": int(A.nnz), "rows": rows})
+
+
 def cheap_explicit_bound(net) -> float:
     """``2 min C_i / sum_j K_ij`` over bonded particles: a cheap lower bound of the explicit stable step."""
     cap, diag = net.particles.capacity, np.asarray(net.L.diagonal())
