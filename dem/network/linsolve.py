@@ -42,6 +42,7 @@ DIRECT_MAX = 5_000  # without diagonal dominance: direct up to this many unknown
 JACOBI_MIN = 1_000  # with diagonal dominance: Jacobi-CG above this many unknowns, direct below
 JACOBI_MAX_CONDITION = 4000.0  # diagonally dominant: Jacobi condition-number bound 1 + 2/rho at most this
 AMG_SEED = 0  # the random start vector of pyamg's spectral-radius estimates (AMGSolver)
+AMG_REUSE_GROWTH = 2.0  # a reused AMG hierarchy is dropped once a solve takes this x its own first solve's iterations
 AMG_SMOOTHER = ("gauss_seidel", {"sweep": "symmetric"})  # one symmetric sweep before and after each coarse correction
 AMG_OPTIONS = {  # pyamg.smoothed_aggregation_solver's settings (AMGSolver): the finest level's smoother row-weighted
     "symmetry": "hermitian", "max_coarse": 500, "improve_candidates": None, "presmoother": AMG_SMOOTHER,
@@ -146,15 +147,41 @@ class AMGSolver(PCGSolver):
     * the constant vector is the near-null space of a graph Laplacian as it is: no relaxation sweeps improve it;
     * the coarse levels are converted from BSR with 1 x 1 blocks to CSR once built, and their Gauss-Seidel
       smoothers set up again: pyamg's block Gauss-Seidel on 1 x 1 blocks takes four times the time of the scalar
-      kernel on the same entries (the same iterates, to the bit);
+      kernel on the same entries (the same iterates to round-off);
 
     and setup and solves run with one BLAS thread: the Arnoldi and the coarse solve call BLAS on vectors, whose
     spinning threads multiplied the setup time by four on a loaded two-core machine.
+
+    ``hierarchy_of``: the solver of an earlier matrix of the same size (the same network refreshed, the next Newton
+    or time step), whose hierarchy then preconditions this one, with no setup. A fixed V-cycle with symmetric
+    smoothing is a symmetric positive definite operator, a valid CG preconditioner for any SPD matrix, and CG
+    stops on this matrix's own residual: the criterion is the same as with a fresh hierarchy, only the iterations
+    may grow (:meth:`solve` bounds them).
     """
 
     name = "amg"
 
+    def __init__(self, A: sp.spmatrix, rtol: float = 1e-12, max_iterations: int | None = None,
+                 hierarchy_of: "AMGSolver | None" = None):
+        # an earlier matrix's solver whose hierarchy preconditions (reuse): the one that built it, so that a chain of
+        # reuses holds one earlier matrix, not all of them
+        self.hierarchy_of = hierarchy_of if hierarchy_of is None else (hierarchy_of.hierarchy_of or hierarchy_of)
+        super().__init__(A, rtol, max_iterations)
+        self.fresh_max_iterations = self.max_iterations
+        # iterations of the first solve on the hierarchy's own matrix; a reuse may take AMG_REUSE_GROWTH x as many
+        self.fresh_iterations = None if hierarchy_of is None else hierarchy_of.fresh_iterations
+        if self.fresh_iterations is not None:
+            self.max_iterations = int(AMG_REUSE_GROWTH * self.fresh_iterations) + 1
+
+    @property
+    def reused(self) -> bool:
+        """Whether the hierarchy preconditioning this matrix is an earlier matrix's."""
+        return self.hierarchy_of is not None
+
     def _preconditioner(self):
+        if self.hierarchy_of is not None:
+            self.hierarchy = self.hierarchy_of.hierarchy
+            return self.hierarchy_of.precondition
         import pyamg
         from pyamg.relaxation.smoothing import change_smoothers
 
@@ -176,8 +203,28 @@ class AMGSolver(PCGSolver):
         return self.hierarchy.aspreconditioner(cycle="V")
 
     def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
+        """CG to the criterion. A reused hierarchy (``hierarchy_of``) that needs more than :data:`AMG_REUSE_GROWTH`
+        times the iterations of its own matrix's first solve (plus one) is dropped there and a fresh one built for
+        this matrix, which then solves from ``x0`` again."""
         with one_blas_thread():
-            return super().solve(b, x0)
+            if self.fresh_iterations is None:
+                return self._first_solve(b, x0)
+            try:
+                return super().solve(b, x0)
+            except SolverError:
+                if not self.reused:
+                    raise
+                self.hierarchy_of = None
+                self.precondition = self._preconditioner()
+                self.max_iterations = self.fresh_max_iterations
+                return self._first_solve(b, x0)
+
+    def _first_solve(self, b, x0):
+        """A solve on the hierarchy of this matrix; its iterations bound those of a reuse."""
+        before = self.iterations
+        x = super().solve(b, x0)
+        self.fresh_iterations = self.iterations - before
+        return x
 
 
 BACKENDS = {"direct": DirectSolver, "cg": PCGSolver, "amg": AMGSolver}
@@ -213,12 +260,16 @@ def choose_backend(A: sp.spmatrix, laplacian_diagonal: np.ndarray) -> str:
 
 
 def make_solver(A: sp.spmatrix, backend: str = "auto", laplacian_diagonal: np.ndarray | None = None,
-                rtol: float = 1e-12):
-    """A solver for the SPD matrix ``A`` (module docstring)."""
+                rtol: float = 1e-12, previous=None):
+    """A solver for the SPD matrix ``A`` (module docstring). ``previous``: the solver of an earlier matrix of the same
+    size that changed little since (a refreshed network, the next Newton or time step); when both are AMG, its
+    hierarchy preconditions ``A`` (no setup; :class:`AMGSolver`, ``hierarchy_of``)."""
     if backend == "auto":
         backend = choose_backend(A, A.diagonal() if laplacian_diagonal is None else laplacian_diagonal)
         if backend == "cg":
             return AutoCGSolver(A, rtol, "direct" if A.shape[0] <= DIRECT_MAX else "amg")
     if backend not in BACKENDS:
         raise ValueError(f"solver.linear = {backend!r}: must be one of auto, {', '.join(BACKENDS)}")
+    if backend == "amg" and isinstance(previous, AMGSolver) and previous.A.shape == A.shape:
+        return AMGSolver(A, rtol=rtol, hierarchy_of=previous)
     return BACKENDS[backend](A, rtol=rtol)
