@@ -32,7 +32,7 @@ def packing_system(n=8000, seed=3):
     return net.matrix({})[keep][:, keep].tocsr(), net.rhs({})[keep]
 
 
-def lattice_system(shape=(24, 24, 24), contrast=1e4, seed=0):
+def lattice_system(shape=(20, 20, 20), contrast=1e4, seed=0):
     """A simple cubic lattice of nodes with bond conductances spread log-uniformly over ``contrast``, the bottom
     layer at 1 and the top at 0 (fixed), as a BoundedLaplacian's steady matrix."""
     from dem.network.laplacian import BoundedLaplacian
