@@ -391,7 +391,8 @@ class TransientResult:
 
 
 class _Stepper:
-    """Theta-method steps; the system solver is built once per step size (cached, least recently used dropped)."""
+    """Theta-method steps; the system solver is built once per step size (cached, least recently used dropped), and
+    where the matrix changes every step (radiation) the new step's solver reuses the cached one's AMG hierarchy."""
 
     def __init__(self, net: Network, theta: float, linear: str, rtol_linear: float):
         self.net, self.theta, self.linear, self.rtol_linear = net, theta, linear, rtol_linear

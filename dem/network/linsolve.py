@@ -9,7 +9,12 @@ Backends (:data:`BACKENDS`; a PETSc/MPI backend is one more entry with the same 
 * ``"cg"`` -- conjugate gradients with a Jacobi (diagonal) preconditioner. Converges in a handful of iterations
   when the capacity term ``C/dt`` dominates the diagonal (implicit steps of large packings).
 * ``"amg"`` -- conjugate gradients preconditioned by a smoothed-aggregation algebraic multigrid V-cycle (pyamg),
-  for large steady networks.
+  for large steady networks, with settings tuned for network matrices (:class:`AMGSolver`); a matrix that changed
+  a little since an earlier one of the same size (``make_solver(previous=...)``: a refresh, radiation's Newton and
+  time steps) is preconditioned by the earlier hierarchy, with no setup. ``python -m benchmarks dem`` times it
+  beside its previous settings and PETSc's CG with ML, hypre BoomerAMG and GAMG on the steady network of the
+  10^6-particle bench packing (section "DEM steady network: AMG side by side"; PETSc's rows where petsc4py
+  imports).
 
 ``"auto"`` (:func:`choose_backend`) looks at the diagonal dominance first: the Jacobi-scaled matrix has condition
 number at most ``1 + 2/rho`` with ``rho = min_i m_i / L_ii`` (``m_i`` the part of the diagonal beyond the
