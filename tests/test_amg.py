@@ -187,3 +187,30 @@ def test_petsc_peers_reach_the_same_criterion():
     for name in peers.PETSC_PRECONDITIONERS:
         assert rows[name]["relative_residual"] <= RTOL
         assert rows[name]["max_difference_to_amg"] < 1e-7
+
+
+def test_kirchhoff_refresh_reuses_the_hierarchy_with_the_fresh_answer():
+    """A refresh of the contact current (conductances changed by up to 10 %): the solution that reuses the last
+    refresh's hierarchy is the fresh one and sparse LU's, to the tolerance, the driven electrode's potential too."""
+    from dem.network.current import Electrodes, kirchhoff
+
+    shape = (20, 20, 20)
+    index = np.arange(np.prod(shape)).reshape(shape)
+    i = np.concatenate([index[:-1].ravel(), index[:, :-1].ravel(), index[:, :, :-1].ravel()])
+    j = np.concatenate([index[1:].ravel(), index[:, 1:].ravel(), index[:, :, 1:].ravel()])
+    bottom, top = index[:, :, 0].ravel(), index[:, :, -1].ravel()
+    plane_node, plane_index = np.concatenate([bottom, top]), np.repeat([0, 1], len(bottom))
+    rng = np.random.default_rng(4)
+    G, G_w = 10.0 ** (2 * rng.random(len(i))), np.full(len(plane_node), 50.0)
+    # the bottom grounded, the top driving 2 A (its potential found by the unit solves on the same solver)
+    el = Electrodes(("bottom", "top"), (0, 1), np.array([0.0, np.nan]), np.array([np.nan, 2.0]))
+    share = np.full(len(i), 0.5)
+    first = kirchhoff(index.size, i, j, G, share, plane_node, plane_index, G_w, el, "amg")
+    G_new = G * rng.uniform(0.9, 1.1, len(i))
+    again = kirchhoff(index.size, i, j, G_new, share, plane_node, plane_index, G_w, el, "amg", previous=first.solver)
+    assert again.solver.reused and again.solver.hierarchy is first.solver.hierarchy
+    for linear in ("amg", "direct"):
+        fresh = kirchhoff(index.size, i, j, G_new, share, plane_node, plane_index, G_w, el, linear)
+        scale = np.max(np.abs(fresh.potential))
+        assert np.max(np.abs(again.potential - fresh.potential)) < 1e-8 * scale
+        assert again.electrode_potential[1] == pytest.approx(fresh.electrode_potential[1], rel=1e-8)

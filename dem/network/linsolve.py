@@ -47,7 +47,7 @@ DIRECT_MAX = 5_000  # without diagonal dominance: direct up to this many unknown
 JACOBI_MIN = 1_000  # with diagonal dominance: Jacobi-CG above this many unknowns, direct below
 JACOBI_MAX_CONDITION = 4000.0  # diagonally dominant: Jacobi condition-number bound 1 + 2/rho at most this
 AMG_SEED = 0  # the random start vector of pyamg's spectral-radius estimates (AMGSolver)
-AMG_REUSE_GROWTH = 2.0  # a reused AMG hierarchy is dropped once a solve takes this x its own first solve's iterations
+AMG_REUSE_GROWTH = 2.0  # a reused AMG hierarchy is dropped once a solve takes this x the most its own matrix took
 AMG_SMOOTHER = ("gauss_seidel", {"sweep": "symmetric"})  # one symmetric sweep before and after each coarse correction
 AMG_OPTIONS = {  # pyamg.smoothed_aggregation_solver's settings (AMGSolver): the finest level's smoother row-weighted
     "symmetry": "hermitian", "max_coarse": 500, "improve_candidates": None, "presmoother": AMG_SMOOTHER,
@@ -173,10 +173,7 @@ class AMGSolver(PCGSolver):
         self.hierarchy_of = hierarchy_of if hierarchy_of is None else (hierarchy_of.hierarchy_of or hierarchy_of)
         super().__init__(A, rtol, max_iterations)
         self.fresh_max_iterations = self.max_iterations
-        # iterations of the first solve on the hierarchy's own matrix; a reuse may take AMG_REUSE_GROWTH x as many
-        self.fresh_iterations = None if hierarchy_of is None else hierarchy_of.fresh_iterations
-        if self.fresh_iterations is not None:
-            self.max_iterations = int(AMG_REUSE_GROWTH * self.fresh_iterations) + 1
+        self.fresh_iterations = None  # the most iterations a solve on this matrix's own hierarchy took (bounds reuses)
 
     @property
     def reused(self) -> bool:
@@ -209,26 +206,28 @@ class AMGSolver(PCGSolver):
 
     def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
         """CG to the criterion. A reused hierarchy (``hierarchy_of``) that needs more than :data:`AMG_REUSE_GROWTH`
-        times the iterations of its own matrix's first solve (plus one) is dropped there and a fresh one built for
-        this matrix, which then solves from ``x0`` again."""
+        times the most iterations a solve on its own matrix took (plus one) is dropped there and a fresh one built
+        for this matrix, which then solves from ``x0`` again."""
         with one_blas_thread():
-            if self.fresh_iterations is None:
-                return self._first_solve(b, x0)
+            if not self.reused:
+                return self._own_solve(b, x0)
+            fresh = self.hierarchy_of.fresh_iterations
+            self.max_iterations = (self.fresh_max_iterations if fresh is None
+                                   else int(AMG_REUSE_GROWTH * fresh) + 1)
             try:
                 return super().solve(b, x0)
             except SolverError:
-                if not self.reused:
-                    raise
                 self.hierarchy_of = None
                 self.precondition = self._preconditioner()
                 self.max_iterations = self.fresh_max_iterations
-                return self._first_solve(b, x0)
+                return self._own_solve(b, x0)
 
-    def _first_solve(self, b, x0):
-        """A solve on the hierarchy of this matrix; its iterations bound those of a reuse."""
+    def _own_solve(self, b, x0):
+        """A solve on the hierarchy of this matrix; the most iterations one took bound those of a reuse."""
         before = self.iterations
         x = super().solve(b, x0)
-        self.fresh_iterations = self.iterations - before
+        if self.iterations > before:  # a zero right-hand side or a converged start says nothing
+            self.fresh_iterations = max(self.fresh_iterations or 0, self.iterations - before)
         return x
 
 
