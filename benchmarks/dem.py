@@ -343,6 +343,8 @@ def study_amg_peers(section, quick: bool) -> None:
         f"The steady network of the bench packing (~{n:.0e} particles, rojek law, hot/cold fixed layers: "
         f"{record.get('unknowns', '?')} unknowns, {record.get('nonzeros', '?')} nonzeros) solved from zero to "
         "|b - A x| <= 1e-10 |b| by: `amg`, our CG + smoothed aggregation (`dem.network.linsolve.AMGSolver`); "
+        "`amg_reused`, the same on the hierarchy of an earlier matrix of the network (entries changed by up to 10 %, "
+        "as between refreshes; no setup); "
         "`amg_previous`, the same CG with pyamg's default smoothed aggregation as the project used it before "
         "(max_coarse 500); and, when petsc4py imports (run `python -m benchmarks dem` in an environment with "
         f"PETSc), PETSc's CG + ML, + hypre BoomerAMG ({hypre}) and + GAMG (defaults), on one rank. Setup "
