@@ -164,7 +164,8 @@ ROWS = (
         "relative to the temperature range (initial, fixed, wall and ambient temperatures); measured on decaying "
         "pairs, chains and a 2048-particle packing: 0.06-1 × `rtol` for rtol 1e-2 … 1e-4"),
     Row("solver", ("linear",), ALL, '`"auto"`', '`"direct"` (sparse LU), `"cg"` (Jacobi-CG), `"amg"` '
-        "(pyamg-preconditioned CG); auto: Jacobi-CG above 1 000 unknowns when the time step's capacity term C/dt "
+        "(pyamg-preconditioned CG; its multigrid hierarchy reused while the matrix changes a little: radiation's "
+        "Newton and time steps, Kirchhoff refreshes); auto: Jacobi-CG above 1 000 unknowns when the time step's capacity term C/dt "
         "makes the matrix diagonally dominant enough (Jacobi condition bound ≤ 4000), otherwise direct up to 5 000 "
         'unknowns and AMG above (`python -m benchmarks dem`, "DEM linear solvers")'),
     Row("solver", ("floating",), STATIC, '`"error"`', 'steady: groups of particles with no fixed temperature, wall '
