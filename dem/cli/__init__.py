@@ -24,5 +24,5 @@ COMMANDS = ("run", "scenes", "contact", "laws", "convert")
 def main(argv=None) -> int:
     if launched() and world().Get_rank() != 0:  # under mpiexec rank 0 speaks for the run (the others say the same)
         sys.stdout = sys.stderr = open(os.devnull, "w")
-    return cli.main(argv, prog="python -m dem", description=__doc__.splitlines()[0], modules=COMMANDS,
+    return cli.main(argv, prog="python -m dem", description=" ".join(__doc__.split("\n\n")[0].split()), modules=COMMANDS,
                     package="dem.cli")

@@ -136,9 +136,8 @@ class RankMechanics(MechanicalModel):
         """Migration, ghosts and the Verlet list (module docstring); ``first``: every rank holds every particle
         and keeps those of its slab."""
         s, box, comm = self.state, self.periodic_box, self.comm
-        if box is not None:  # as the serial model: those that left the box back into it, the others keep their bits
-            outside = box.mask & ((s.x < box.origin) | (s.x >= box.origin + box.lengths))
-            s.x[:] = np.where(outside, box.wrap(s.x), s.x)
+        if box is not None:  # as the serial model: those that left the box back into it
+            box.wrap_outside(s.x)
         dest = self.slabs.owner(s.x)
         rows = np.column_stack([self._pack(self._arrays(), np.arange(s.n)), self.gid])
         owned = np.flatnonzero(self.owned)
@@ -181,9 +180,7 @@ class RankMechanics(MechanicalModel):
                 key // self.n_global, key % self.n_global, self.gid[i], self.gid[j], hist[:, 2:2 + n_hist],
                 hist[:, 2 + n_hist], hist[:, 3 + n_hist:])
             self.rebuilds += 1
-        self.pi, self.pj = i, j
-        self.x_ref = s.x.copy()
-        self.walls_moved()
+        self._listed(i, j)
 
     def walls_moved(self):
         """The particle-wall list of the owned particles."""
@@ -244,7 +241,7 @@ class RankMechanics(MechanicalModel):
                 1, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia,
                 s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.particle_state,
                 uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_fn, self.p_ft,
-                w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
+                self.pair_start, self.pair_order, self.pair_load, w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
                 w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_hist, self.w_fn, self.w_ft, self.params,
                 self.x_ref, self.skin, self._info)
             self.steps += 1
