@@ -82,8 +82,11 @@ def main(argv=None) -> int:
               file=sys.stderr)
         return 2
     from dem.engines.launch import launched, on_root, world
+    from sinterheat import threads
 
     comm = world() if launched() else None
+    if comm is None:
+        threads.use(1)  # the serial run on one core (the ranks engine takes its share of the cores by itself)
     sizes = FULL if args.full else QUICK
     try:
         sample = on_root(comm, lambda: periodic_packing(sizes, CACHE))  # prepared (or read) once

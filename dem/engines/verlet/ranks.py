@@ -33,6 +33,8 @@ engines do not run under ``mpiexec``.
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from dem.engines.launch import world
@@ -42,6 +44,7 @@ from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_accelerati
 from dem.engines.verlet.mechanics import MechanicalModel, MechanicsError
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
+from sinterheat import threads
 
 
 def refuse_unsupported(scene, ranks: int, resume: bool) -> None:
@@ -331,7 +334,12 @@ class RankVerletEngine(VerletEngine):
     mechanics_class = RankMechanics
 
     def __init__(self, scene, restart: dict | None = None):
-        refuse_unsupported(scene, world().Get_size(), restart is not None)
+        """As :class:`VerletEngine`; unless told (``SINTERHEAT_THREADS``, ``--threads``), each rank's contact loop
+        takes its share of the cores, not all of them."""
+        size = world().Get_size()
+        refuse_unsupported(scene, size, restart is not None)
+        if not os.environ.get(threads.ENVIRONMENT):
+            threads.use(max(1, threads.cores() // size))
         super().__init__(scene, restart)
 
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
