@@ -5,7 +5,13 @@ With ``--out`` the run writes its folder as it goes (``dem.output.folder``): a f
 refused unless ``--resume`` (go on from its last checkpoint, written every few seconds: a run with a fixed step ends
 bit for bit as if it had not stopped) or ``--overwrite`` (delete that run's files first). Ctrl-C stops the run with
 one line saying where, leaving the folder usable and resumable.
+
+Under ``mpiexec -n N`` (N > 1) a static scene runs on N ranks (:mod:`dem.engines.distributed`; PETSc options through
+``PETSC_OPTIONS``); rank 0 prints the summary and the one-line errors, the other ranks print nothing.
 """
+
+import os
+import sys
 
 from sinterheat.cli import add_output_options
 
@@ -23,6 +29,10 @@ def run(args) -> dict:
     from dem.scene import load_scene
     from dem.driver import run as run_scene
     from dem.memory import available_bytes
+    from dem.network.comm import launched, launcher_rank
+
+    if launched() and launcher_rank() > 0:  # one summary, one error line: rank 0's
+        sys.stdout = sys.stderr = open(os.devnull, "w")
 
     try:
         scene = load_scene(args.scene)
