@@ -111,9 +111,3 @@ class PetscSolver:
                              f"{self.ksp.getResidualNorm() / max(self._b.norm(), 1e-300):.3g}); set other options "
                              f"in PETSC_OPTIONS (e.g. -pc_type gamg)")
         return self._x.getArray().copy()
-
-    def product(self, x: np.ndarray) -> np.ndarray:
-        """``A x`` on this rank's rows (``x``: this rank's entries)."""
-        self._x.setArray(x)
-        self.A.mult(self._x, self._b)
-        return self._b.getArray().copy()

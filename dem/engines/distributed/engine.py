@@ -70,7 +70,7 @@ class DistributedStaticEngine(StaticEngine):
             raise ValueError(why)
         self.comm = mpi.world()
         self.ranks, rank = self.comm.Get_size(), self.comm.Get_rank()
-        self.full_scene = scene
+        self.full_scene = self.scene = scene  # self.scene: the local particles once built
         self.t_start = float(scene.start_time)
         self.t, self.steps = self.t_start, 0
         self.flows, self.details, self.restart = {}, {}, None
