@@ -159,3 +159,19 @@ def test_the_pieces_open_as_one_data_set():
         bonds = pyvista.read(out / "bonds_000000000.pvtu")
         assert bonds.n_cells == result.summary["bonds"] + result.summary["wall_bonds"]
         assert (out / "summary.json").exists() and (out / "timeseries.csv").exists()
+
+
+def test_a_bond_out_of_range_on_one_rank_stops_every_rank():
+    """The overlap of one pair (in the first rank's cell) beyond the neck model's range: refused on all ranks with
+    the serial run's message, none left waiting."""
+    scene = _isolated_pairs_scene("mean")
+    p = scene.particles
+    x = p.position.copy()
+    x[-1] = x[-2] + [0.2e-3, 0.0, 0.0]  # h = 1.8 mm of r = 1 mm: beyond the range
+    scene = dataclasses.replace(scene, particles=dataclasses.replace(p, position=x))
+    with pytest.raises(ValueError) as serial_error:
+        serial(scene)
+    with pytest.raises(ValueError) as ours:
+        run(scene)
+    beyond = "particle pairs lie beyond the contact model's range"
+    assert beyond in str(serial_error.value) and beyond in str(ours.value) and "rank 0 of" in str(ours.value)

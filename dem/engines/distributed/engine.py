@@ -74,10 +74,14 @@ class DistributedStaticEngine(StaticEngine):
         self.t_start = float(scene.start_time)
         self.t, self.steps = self.t_start, 0
         self.flows, self.details, self.restart = {}, {}, None
-        mpi.agree(self.comm, lambda: self._build(scene, rank))
+        owner = mpi.agree(self.comm, lambda: self._build(scene, rank))  # no collective call inside: a bond out of
+        self.part = DistributedNetwork(self.comm, self.network, self.held, owner)  # range stops every rank alike
 
-    def _build(self, scene, rank: int) -> None:
+    def _build(self, scene, rank: int) -> np.ndarray:
+        """This rank's particles, bonds and network (no communication); returns the owner of each held particle."""
         p, box = scene.particles, scene.box
+        if p.n < self.ranks:
+            raise ValueError(f"{p.n} particles on {self.ranks} ranks: use at most {p.n} ranks")
         if scene.solver.mode == "transient":
             self._check_work()
         lengths = None if box is None else np.where(box.mask, box.lengths, np.inf)
@@ -90,14 +94,18 @@ class DistributedStaticEngine(StaticEngine):
         local = p.permuted(held)
         self.scene = replace(scene, particles=local)
         mine = owner[held] == rank
-        bonds, K_pairs, K_walls = bonds_and_conductances(local, scene.walls, scene.conductance, box=box)
+        try:
+            bonds, K_pairs, K_walls = bonds_and_conductances(local, scene.walls, scene.conductance, box=box)
+        except ValueError as exc:  # its counts and indices are of this rank's particles
+            raise ValueError(f"rank {rank} of {self.ranks}, its {len(held)} particles numbered from 0 in the "
+                             f"scene's order: {exc}") from None
         pairs, walls = mine[bonds.i] | mine[bonds.j], mine[bonds.wall_particle]
         self.bonds, self.K_pairs, self.K_walls = _kept(bonds, pairs, walls), K_pairs[pairs], K_walls[walls]
         wall_temperature = np.array([w.temperature for w in scene.walls], dtype=float)
         self.network = Network(local, self.bonds, self.K_pairs, self.K_walls, wall_temperature, scene.sources, box)
-        self.part = DistributedNetwork(self.comm, self.network, held, owner[held])
-        self.mine = mine
+        self.held, self.mine = held, mine
         self.T = local.temperature.astype(float)
+        return owner[held]
 
     # ------------------------------------------------------------------------------------------------ run
     def _observed(self, observe):
