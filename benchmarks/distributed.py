@@ -75,9 +75,9 @@ def run_ranks(n: int, ranks: int, timeout: float) -> dict:
     return row
 
 
-def measure(n: int, rounds: int, timeout: float) -> dict:
+def measure(n: int, rounds: int, timeout: float, written=None) -> dict:
     """The best of ``rounds`` alternating runs of each case: ``{(particles, ranks): row}`` for n on 1 and 2 ranks
-    and 2n on 2 ranks."""
+    and 2n on 2 ranks; ``written(best)`` after every run (the rows so far, kept should the bench stop)."""
     cases = ((n, 1), (n, 2), (2 * n, 2))
     best: dict = {}
     for _ in range(rounds):
@@ -87,6 +87,8 @@ def measure(n: int, rounds: int, timeout: float) -> dict:
             if key not in best or ("error" not in row and row["total_seconds"] < best[key].get("total_seconds",
                                                                                              math.inf)):
                 best[key] = row
+            if written is not None:
+                written(best)
     return best
 
 
@@ -118,9 +120,9 @@ def run(section, quick: bool) -> None:
                                          f"after `mpi-command`) and run `python -m benchmarks mpi` in its venv.")
         return
     n = 100_000 if quick else 1_000_000
-    best = measure(n, 1 if quick else 2, timeout=1800)
+    best = measure(n, 1 if quick else 2, timeout=1800,
+                   written=lambda rows: section.csv("distributed_scaling", [rows[key] for key in sorted(rows)]))
     rows = [best[key] for key in sorted(best)]
-    section.csv("distributed_scaling", rows)
     one, two, weak = best[(n, 1)], best[(n, 2)], best[(2 * n, 2)]
     text = (records_table(rows, ["particles", "ranks", "bonds", "solver", "iterations", "packing_seconds",
                                  "setup_seconds", "solve_seconds", "total_seconds", "peak_rss_mib_per_rank",
