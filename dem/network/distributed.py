@@ -158,7 +158,7 @@ class DistributedNetwork:
     def steady(self, floating: str = "error", rtol: float = 1e-10):
         """Steady temperatures of the free particles (this rank's entries: over the local free ones, owned ones
         valid): :func:`dem.network.heat.steady` over the ranks, without radiation. Returns ``(T_F, flows,
-        energy_error, floating groups)``."""
+        energy_error, floating groups, solver name)``."""
         net = self.net
         T_F = net.particles.temperature[net.free].astype(float)
         sinks = net.sinks(T_F)
