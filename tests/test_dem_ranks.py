@@ -20,7 +20,7 @@ sys.path.insert(0, str(HERE))
 
 import ranks_worker  # noqa: E402
 
-ENV = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+ENV = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1", "DEM_MPI": "1",  # 1 rank too
        "OMPI_MCA_rmaps_base_oversubscribe": "1", "PYTHONPATH": os.pathsep.join([str(ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep)
                                                     if p])}
 
@@ -113,7 +113,7 @@ def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):
         refuse_unsupported(ranks_worker.builtin("luding-three-particles", 0.001), 2, resume=True)
     refuse_unsupported(scene, 1, resume=False)  # heat on one rank: the serial run
     staggered = ranks_worker.builtin("zohdi-compaction", 0.01)
-    with pytest.raises(ValueError, match=r"engine = 'staggered': under mpiexec only the verlet engine"):
+    with pytest.raises(ValueError, match=r"engine = 'staggered': under mpiexec run static packings and the verlet engine"):
         refuse_unsupported(staggered, 1, resume=False)
 
 

@@ -12,17 +12,11 @@ Each sub-command is a module of this package exposing ``register(subparsers)``; 
 :mod:`sinterheat.cli` (one JSON object with ``--json``; bad input: one line on stderr, exit code 2).
 """
 
-import os
-import sys
-
-from dem.engines.launch import launched, world
 from sinterheat import cli
 
 COMMANDS = ("run", "scenes", "contact", "laws", "convert")
 
 
 def main(argv=None) -> int:
-    if launched() and world().Get_rank() != 0:  # under mpiexec rank 0 speaks for the run (the others say the same)
-        sys.stdout = sys.stderr = open(os.devnull, "w")
-    return cli.main(argv, prog="python -m dem", description=" ".join(__doc__.split("\n\n")[0].split()), modules=COMMANDS,
-                    package="dem.cli")
+    return cli.main(argv, prog="python -m dem", description=" ".join(__doc__.split("\n\n")[0].split()),
+                    modules=COMMANDS, package="dem.cli")

@@ -37,7 +37,7 @@ import os
 
 import numpy as np
 
-from dem.engines.launch import world
+from dem.network.comm import world
 from dem.engines.verlet.decomposition import Slabs
 from dem.engines.verlet.engine import VerletEngine
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
@@ -50,8 +50,8 @@ from sinterheat import threads
 def refuse_unsupported(scene, ranks: int, resume: bool) -> None:
     """A ``ValueError`` naming what a run on ``ranks`` ranks cannot do with ``scene``."""
     if scene.engine != "verlet":
-        raise ValueError(f"[solver] engine = {scene.engine!r}: under mpiexec only the verlet engine (particles that "
-                         f"move) runs; run this scene without mpiexec")
+        raise ValueError(f"[solver] engine = {scene.engine!r}: under mpiexec run static packings and the verlet "
+                         f"engine (particles that move), not this one; run this scene without mpiexec")
     if ranks > 1 and "thermal" in scene.physics:
         raise ValueError(f"physics = {list(scene.physics)}: heat on moving contacts runs on one rank only; run with "
                          f"mpiexec -n 1 or without mpiexec")
