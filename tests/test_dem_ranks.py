@@ -133,3 +133,12 @@ def test_two_ranks_compact_as_the_serial_runs_do(tmp_path):
         serial = np.array([statistic(r, name) for r in ensemble])
         assert np.std(serial) > 0  # the ensemble spreads: round-off changes the packing
         assert abs(statistic(two, name) - serial.mean()) <= 4.0 * np.std(serial, ddof=1), name
+
+
+def test_a_rank_that_owns_no_particle_packs_empty_rows():
+    # three particles on two ranks: one rank may own none at an output time (it crashed gathering them)
+    from dem.engines.verlet.ranks import RankMechanics
+
+    arrays = [np.zeros((3, 3)), np.zeros(3), np.zeros((3, 2, 3))]
+    assert RankMechanics._pack(arrays, np.array([], dtype=np.int64)).shape == (0, 10)
+    assert RankMechanics._pack(arrays, np.array([2])).shape == (1, 10)

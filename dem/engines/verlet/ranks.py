@@ -107,7 +107,9 @@ class RankMechanics(MechanicalModel):
 
     @staticmethod
     def _pack(arrays: list, idx: np.ndarray) -> np.ndarray:
-        return np.hstack([a[idx].reshape(len(idx), -1) for a in arrays]) if len(arrays) else np.zeros((len(idx), 0))
+        """The rows ``idx`` of ``arrays`` side by side (no rows: a rank may own no particle at some moment)."""
+        columns = [a[idx].reshape(len(idx), int(np.prod(a.shape[1:]))) for a in arrays]
+        return np.hstack(columns) if columns else np.zeros((len(idx), 0))
 
     @staticmethod
     def _unpack(arrays: list, rows: np.ndarray, idx=None) -> list:
