@@ -111,9 +111,8 @@ class MechanicalModel:
     def _build_list(self, first: bool = False):
         s = self.state
         box = self.periodic_box
-        if box is not None:  # those that left it back into the box (the others keep their bits: a resume is exact)
-            outside = box.mask & ((s.x < box.origin) | (s.x >= box.origin + box.lengths))
-            s.x[:] = np.where(outside, box.wrap(s.x), s.x)
+        if box is not None:  # those that left it back into the box
+            box.wrap_outside(s.x)
         expected = 0 if first else len(self.pi) + len(self.pi) // 8 + 16  # the last list, with room to grow
         i, j = verlet_pairs(s.x, s.radius, self.skin, self.box, expected)
         if first:
@@ -122,6 +121,11 @@ class MechanicalModel:
         else:
             self.p_hist, self.p_fn, self.p_ft = carry_history(self.pi, self.pj, i, j, self.p_hist, self.p_fn, self.p_ft)
             self.rebuilds += 1
+        self._listed(i, j)
+
+    def _listed(self, i: np.ndarray, j: np.ndarray):
+        """The pairs ``(i, j)`` as the list (with the threads' view of it), built at the positions of now."""
+        s = self.state
         self.pi, self.pj = i, j
         if self.threaded:
             self.pair_start, self.pair_order = incident_pairs(i, j, s.n)
@@ -190,9 +194,8 @@ class MechanicalModel:
         """The closed pair contacts: ``(i, j, overlap, f_n, f_t)`` with f_t the (M, 3) tangential forces on i."""
         s = self.state
         d = s.x[self.pi] - s.x[self.pj]
-        for a in range(3):
-            if self.box[a] > 0:
-                d[:, a] -= self.box[a] * np.floor(d[:, a] / self.box[a] + 0.5)
+        if self.periodic_box is not None:
+            d = self.periodic_box.minimum_image(d)
         overlap = s.radius[self.pi] + s.radius[self.pj] - np.linalg.norm(d, axis=1)
         closed = overlap > 0
         return self.pi[closed], self.pj[closed], overlap[closed], self.p_fn[closed], self.p_ft[closed]
