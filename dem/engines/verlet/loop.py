@@ -78,8 +78,12 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
                 w[k, a] += h * tau[k, a] * ii
                 moved += abs(w[k, a])
             if not moved < math.inf:  # NaN or inf: name the particle before its neighbours are contaminated
-                bad = min(bad, k)
-        if bad < n:
+                if THREADED:  # (a parallel loop cannot return: the first such particle, after it)
+                    bad = min(bad, k)
+                else:
+                    info[0] = k
+                    return s + 1, 2
+        if THREADED and bad < n:
             info[0] = bad
             return s + 1, 2
         for m in range(n_w):
@@ -108,9 +112,13 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
             for a in spin_axes:
                 w[k, a] += h * tau[k, a] * ii
             if not (d2 < math.inf):  # NaN or inf
-                bad = min(bad, k)
+                if THREADED:
+                    bad = min(bad, k)
+                else:
+                    info[0] = k
+                    return s + 1, 2
             worst = max(worst, d2)
-        if bad < n:
+        if THREADED and bad < n:
             info[0] = bad
             return s + 1, 2
         wall_moved = 0.0
