@@ -42,7 +42,7 @@ myst_dmath_double_inline = True
 # (numpy, scipy, skfem ...) are not linked: the build is offline, without intersphinx.
 nitpicky = True
 nitpick_ignore_regex = [
-    (r"py:.*", r"(np|numpy|scipy|skfem|meshio|pyvista|gmsh|argparse|pathlib|concurrent|typing|collections)\b.*"),
+    (r"py:.*", r"(np|numpy|sp|scipy|skfem|meshio|pyvista|gmsh|argparse|pathlib|concurrent|typing|collections|io)\b.*"),
     (r"py:.*", r"(optional|callable|array|array_like|array-like|ndarray|sequence|iterable|mapping|path|object)"),
 ]
 
@@ -54,7 +54,7 @@ napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 
 # The packages whose every public function and class must appear in the API reference (api_check).
-api_packages = ["fem_neck", "sinterheat"]
+api_packages = ["fem_neck", "dem", "sinterheat"]
 
 sphinx_gallery_conf = {
     "examples_dirs": str(DOCS.parent / "examples"),

@@ -40,7 +40,7 @@ def _folder(law: str) -> pathlib.Path:
 
 
 def module(law: str, template: str):
-    """The module ``template`` (one of :data:`TEMPLATES`) compiled for the contact law named ``law``."""
+    """The module ``template`` (one of ``TEMPLATES``) compiled for the contact law named ``law``."""
     law_path = law_module_name(law)
     if law_path == TEMPLATE_LAW:
         return importlib.import_module(template)
