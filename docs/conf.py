@@ -12,7 +12,7 @@ import pathlib
 import sys
 
 DOCS = pathlib.Path(__file__).resolve().parent
-sys.path.insert(0, str(DOCS / "_ext"))  # the local extensions (api_check, gallery_order)
+sys.path.insert(0, str(DOCS / "_ext"))  # the local extensions (api_check, gallery_order, scene_schema)
 logging.getLogger("skfem").setLevel(logging.WARNING)  # its INFO lines (each assembly) would flood the build log
 
 project = "sinterheat"
@@ -28,6 +28,7 @@ extensions = [
     "sphinx_gallery.gen_gallery",
     "sphinx_copybutton",
     "api_check",
+    "scene_schema",
 ]
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
