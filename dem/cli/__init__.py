@@ -18,5 +18,5 @@ COMMANDS = ("run", "scenes", "contact", "laws", "convert")
 
 
 def main(argv=None) -> int:
-    return cli.main(argv, prog="python -m dem", description=__doc__.splitlines()[0], modules=COMMANDS,
+    return cli.main(argv, prog="python -m dem", description=" ".join(__doc__.split("\n\n")[0].split()), modules=COMMANDS,
                     package="dem.cli")
