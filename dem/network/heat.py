@@ -317,7 +317,7 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
     solve_idx = np.flatnonzero(solve)
     T_sub = T_F[solve_idx]
     restrict = None if len(solve_idx) == net.n_free else solve_idx
-    iterations, backend = 0, "none"
+    iterations, backend, solver = 0, "none", None
     for iterations in range(1, max_newton + 1):
         T_F[solve_idx] = T_sub
         sinks = net.sinks(T_F)
@@ -326,7 +326,9 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
             A, r = A[restrict][:, restrict], r[restrict]
         if len(r) == 0:
             break
-        solver = make_solver(A, linear, net.base_diag if restrict is None else net.base_diag[restrict], rtol)
+        # Newton on radiation: the matrix changes on the diagonal only, the last AMG hierarchy serves again
+        solver = make_solver(A, linear, net.base_diag if restrict is None else net.base_diag[restrict], rtol,
+                             previous=solver)
         backend = solver.name
         T_new = solver.solve(r, T_sub)
         change = np.max(np.abs(T_new - T_sub)) if net.sources.radiation is not None else 0.0
@@ -390,7 +392,8 @@ class TransientResult:
 
 
 class _Stepper:
-    """Theta-method steps; the system solver is built once per step size (cached, least recently used dropped)."""
+    """Theta-method steps; the system solver is built once per step size (cached, least recently used dropped), and
+    where the matrix changes every step (radiation) the new step's solver reuses the cached one's AMG hierarchy."""
 
     def __init__(self, net: Network, theta: float, linear: str, rtol_linear: float):
         self.net, self.theta, self.linear, self.rtol_linear = net, theta, linear, rtol_linear
@@ -402,20 +405,22 @@ class _Stepper:
         self.history: list = []  # (T, dt) at the start of the last two accepted steps: warm starts for CG
         self._rate: tuple = (None, None)
 
-    def _solver(self, dt: float, A: sp.csr_matrix, reuse: bool):
-        key = dt if reuse else None
-        if key is not None and key in self._cache:
-            self._cache[key] = self._cache.pop(key)  # most recently used last
-            return self._cache[key]
+    def _solver(self, dt: float, A: sp.csr_matrix, same_matrix: bool):
+        """The solver of the step size ``dt``: the cached one when the matrix is that of the last step of this size
+        (``same_matrix``: no radiation), else one for the new matrix, which reuses the cached one's AMG hierarchy
+        (radiation's linearisation changes the diagonal a little from step to step)."""
+        last = self._cache.pop(dt, None)
+        if last is not None and same_matrix:
+            self._cache[dt] = last  # most recently used last
+            return last
         M = A * self.theta
         M = (M + sp.diags(self.net.C / dt)).tocsr()
-        solver = make_solver(M, self.linear, self.net.base_diag * self.theta, self.rtol_linear)
-        self.factorizations += 1
+        solver = make_solver(M, self.linear, self.net.base_diag * self.theta, self.rtol_linear, previous=last)
+        self.factorizations += 0 if getattr(solver, "reused", False) else 1
         self.backend = solver.name
-        if key is not None:
-            if len(self._cache) >= 8:
-                self._cache.pop(next(iter(self._cache)))
-            self._cache[key] = solver
+        if len(self._cache) >= 8:
+            self._cache.pop(next(iter(self._cache)))
+        self._cache[dt] = solver
         return solver
 
     def guess(self, T: np.ndarray, dt: float) -> np.ndarray:
