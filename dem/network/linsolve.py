@@ -139,7 +139,7 @@ _THREADPOOLS = None  # the ThreadpoolController of one_blas_thread, made when fi
 
 
 class AMGSolver(PCGSolver):
-    """CG preconditioned by one smoothed-aggregation V-cycle (pyamg), hierarchy built once (:data:`AMG_OPTIONS`).
+    """CG preconditioned by one smoothed-aggregation V-cycle (pyamg), hierarchy built once (``AMG_OPTIONS``).
 
     Three things make it cheap on the network matrices (weighted graph Laplacians plus a positive diagonal):
 
@@ -205,7 +205,7 @@ class AMGSolver(PCGSolver):
         return self.hierarchy.aspreconditioner(cycle="V")
 
     def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
-        """CG to the criterion. A reused hierarchy (``hierarchy_of``) that needs more than :data:`AMG_REUSE_GROWTH`
+        """CG to the criterion. A reused hierarchy (``hierarchy_of``) that needs more than ``AMG_REUSE_GROWTH``
         times the most iterations a solve on its own matrix took (plus one) is dropped there and a fresh one built
         for this matrix, which then solves from ``x0`` again."""
         with one_blas_thread():
