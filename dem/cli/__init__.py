@@ -20,5 +20,5 @@ COMMANDS = ("run", "scenes", "contact", "laws", "convert")
 
 
 def main(argv=None) -> int:
-    return cli.main(argv, prog="python -m dem", description=" ".join(__doc__.split("\n\n")[0].split()), modules=COMMANDS,
-                    package="dem.cli")
+    return cli.main(argv, prog="python -m dem", description=" ".join(__doc__.split("\n\n")[0].split()),
+                    modules=COMMANDS, package="dem.cli")

@@ -7,9 +7,13 @@ bit for bit as if it had not stopped) or ``--overwrite`` (delete that run's file
 one line saying where, leaving the folder usable and resumable. ``--threads N``: the compiled loops (and BLAS) on N
 threads, the same results on any number (default ``SINTERHEAT_THREADS``, else every core); ``--quiet``: no progress
 bar.
+
+Under ``mpiexec -n N`` (N > 1) a static scene runs on N ranks (:mod:`dem.engines.distributed`; PETSc options through
+``PETSC_OPTIONS``); rank 0 prints the summary and the one-line errors, the other ranks print nothing.
 """
 
 import os
+import sys
 
 from sinterheat.cli import add_output_options, add_quiet_option, add_threads_option
 
@@ -29,6 +33,10 @@ def run(args) -> dict:
     from dem.scene import load_scene
     from dem.driver import run as run_scene
     from dem.memory import available_bytes
+    from dem.network.comm import launched, launcher_rank
+
+    if launched() and launcher_rank() > 0:  # one summary, one error line: rank 0's
+        sys.stdout = sys.stderr = open(os.devnull, "w")
 
     if args.quiet:  # no bar; the run keeps its position for the line an interrupt prints
         os.environ["TQDM_DISABLE"] = "1"

@@ -147,15 +147,17 @@ class Network:
     def rhs(self, sinks: dict) -> np.ndarray:
         return self.r_const + sum((b for _, b in sinks.values()), np.zeros(self.n_free))
 
-    def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
-        """Heat flow into the free particles (W) through each boundary at temperatures ``T_F``."""
-        out = {"fixed": float(self.fixed_rhs.sum() - self.fixed_diag @ T_F),
-               "walls": float(self.wall_rhs.sum() - self.wall_diag @ T_F),
-               "internal": float(self.heat.sum())}
+    def flows(self, T_F: np.ndarray, sinks: dict, rows=None) -> dict:
+        """Heat flow into the free particles (W) through each boundary at temperatures ``T_F``; ``rows``: into
+        those free particles only (a mask over them: a rank's own in a distributed run)."""
+        s = slice(None) if rows is None else rows
+        out = {"fixed": float(self.fixed_rhs[s].sum() - self.fixed_diag[s] @ T_F[s]),
+               "walls": float(self.wall_rhs[s].sum() - self.wall_diag[s] @ T_F[s]),
+               "internal": float(self.heat[s].sum())}
         for name, (g, b) in sinks.items():
-            out[name] = float(b.sum() - g @ T_F)
+            out[name] = float(b[s].sum() - g[s] @ T_F[s])
         if self.periodic:
-            out["periodic"] = float(self.periodic_rhs.sum())
+            out["periodic"] = float(self.periodic_rhs[s].sum())
         return out
 
     def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
@@ -166,12 +168,19 @@ class Network:
         those terms and a balance relative to them means nothing, so the scale is never taken below
         ``sqrt(eps) sum |K T|``: temperature differences below ~1e-8 of the temperatures count as no flow.
         """
-        pairs = [(self.fixed_diag, self.fixed_rhs), (self.wall_diag, self.wall_rhs), *sinks.values()]  # (g, b)
-        net = gross = float(np.abs(self.heat).sum() + np.abs(self.periodic_rhs).sum())
-        for g, b in pairs:
-            net += float(np.abs(b - g * T_F).sum())
-            gross += float(np.abs(b).sum() + np.abs(g * T_F).sum())
+        net, gross = self.flow_sums(T_F, sinks)
         return float(max(net, np.sqrt(np.finfo(float).eps) * gross))
+
+    def flow_sums(self, T_F: np.ndarray, sinks: dict, rows=None) -> tuple[float, float]:
+        """``(sum |flow|, sum |K T|)`` over the boundaries of the free particles (or of ``rows``, as in
+        :meth:`flows`): the two sums behind :meth:`flow_magnitude`."""
+        s = slice(None) if rows is None else rows
+        pairs = [(self.fixed_diag, self.fixed_rhs), (self.wall_diag, self.wall_rhs), *sinks.values()]  # (g, b)
+        net = gross = float(np.abs(self.heat[s]).sum() + np.abs(self.periodic_rhs[s]).sum())
+        for g, b in pairs:
+            net += float(np.abs(b[s] - g[s] * T_F[s]).sum())
+            gross += float(np.abs(b[s]).sum() + np.abs(g[s] * T_F[s]).sum())
+        return net, gross
 
     def full(self, T_F: np.ndarray) -> np.ndarray:
         T = self.particles.temperature.copy()

@@ -18,7 +18,8 @@ import time
 import numpy as np
 
 CHECKPOINT = "checkpoint.npz"
-RUN_FILES = ("summary.json", "timeseries.csv", "profiles.csv", CHECKPOINT, "state.npz", "*.pvd", "*.vtu", "*.png")
+RUN_FILES = ("summary.json", "timeseries.csv", "profiles.csv", CHECKPOINT, "state.npz", "*.pvd", "*.vtu", "*.pvtu",
+             "*.png")
 
 
 def scene_digest(scene) -> str:

@@ -121,6 +121,11 @@ class MechanicalModel:
         else:
             self.p_hist, self.p_fn, self.p_ft = carry_history(self.pi, self.pj, i, j, self.p_hist, self.p_fn, self.p_ft)
             self.rebuilds += 1
+        self._listed(i, j)
+
+    def _listed(self, i: np.ndarray, j: np.ndarray):
+        """The pairs ``(i, j)`` as the list (with the threads' view of it), built at the positions of now."""
+        s = self.state
         self.pi, self.pj = i, j
         if self.threaded:
             self.pair_start, self.pair_order = incident_pairs(i, j, s.n)
