@@ -34,7 +34,7 @@ class RunResult:
 
     @property
     def thermal(self):
-        """The thermal network (bonds, conductances): the static engine itself, or the moving engines' network."""
+        """The thermal network (bonds, conductances) -- the static engine itself, or the moving engines' network."""
         return self.engine if self.engine.name == "static" else self.engine.thermal
 
 

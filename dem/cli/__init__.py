@@ -1,6 +1,8 @@
 """``python -m dem``: run a pipe-network thermal DEM scene, list the built-in scenes, drive one contact, or convert a
 packing (for LAMMPS).
 
+Usage::
+
     python -m dem run SCENE [--out DIR] [--json]     SCENE: a TOML file or a built-in name
     python -m dem scenes [--json]
     python -m dem laws [--json]                      the conductance laws a scene can select

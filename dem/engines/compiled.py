@@ -47,7 +47,7 @@ def _folder(law: str, threaded: bool) -> pathlib.Path:
 
 
 def module(law: str, template: str, threaded: bool = False):
-    """The module ``template`` (one of :data:`TEMPLATES`) compiled for the contact law named ``law``; ``threaded``:
+    """The module ``template`` (one of ``TEMPLATES``) compiled for the contact law named ``law``; ``threaded``:
     its copy for more than one thread (module docstring)."""
     law_path = law_module_name(law)
     if law_path == TEMPLATE_LAW and not threaded:

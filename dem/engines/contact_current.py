@@ -59,7 +59,7 @@ class ContactCurrent:
 
     def refresh(self, mech, t: float = 0.0) -> np.ndarray:
         """The current at the state of the mechanics ``mech`` (at time ``t``, for messages): updates
-        :attr:`heating`."""
+        ``heating``."""
         lens = self.scheme == "zohdi"
         now, b = contact_bonds(self.particles, mech, mech.state.x, mech.state.T, self.electrodes.walls,
                                "lens" if lens else self.spec.contact, self.spec.out_of_range)

@@ -16,7 +16,7 @@ than the law's ``reach``, a particle-wall pair while closer than its ``wall_reac
 adhesive law holds a contact beyond touching until it breaks); the laws whose particles do not rotate
 (``law.SPINS`` false) get no torques.
 
-Threads: in the copies of this module for more than one thread (:mod:`dem.engines.compiled`) :data:`THREADED` is
+Threads: in the copies of this module for more than one thread (:mod:`dem.engines.compiled`) ``THREADED`` is
 true and the loop runs on all of numba's threads in conflict-free passes: every pair's force and torque arms into a
 row of its own (``load``), then every particle sums the rows of its pairs (:func:`incident_pairs`) in the order of
 the list. That is the order in which the one-thread loop adds them into each particle, so the results are the same
@@ -84,7 +84,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
     part of its type, so 2D and 3D get code of their own, the 2D one without the terms that vanish (a fifth
     faster).
 
-    Where :data:`THREADED` (module docstring), ``start`` and ``pairs`` are the pairs by particle
+    Where ``THREADED`` (module docstring), ``start`` and ``pairs`` are the pairs by particle
     (:func:`incident_pairs`) and ``load`` a ``(len(pi), LOAD_COLUMNS)`` buffer; the walls stay on one thread (a few
     particles: the surface's)."""
     planar = len(spin_axes) == 1

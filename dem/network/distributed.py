@@ -46,7 +46,8 @@ class Groups:
 
 
 class DistributedNetwork:
-    """This rank's part of the network (module docstring). ``net``: the :class:`Network` of the held particles,
+    """This rank's part of the network (module docstring). ``net``: the
+    :class:`~dem.network.heat.Network` of the held particles,
     ``held`` their global indices (sorted), ``owner`` the rank owning each of them."""
 
     def __init__(self, comm, net: Network, held: np.ndarray, owner: np.ndarray):
@@ -66,7 +67,8 @@ class DistributedNetwork:
         return self.exchange.fill(self.net.full(T_F))
 
     def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
-        """Heat flow (W) into all free particles through each boundary (:meth:`Network.flows` over the ranks)."""
+        """Heat flow (W) into all free particles through each boundary
+        (:meth:`~dem.network.heat.Network.flows` over the ranks)."""
         part = self.net.flows(T_F, sinks, self.own_free)
         sums = self.total(np.array(list(part.values())))
         return dict(zip(part, map(float, sums)))

@@ -201,11 +201,12 @@ class Network:
 
 def build_network(particles: Particles, walls=(), spec=None, sources: Sources | None = None, *, pairs=None,
                   bonds: Bonds | None = None, box: PeriodicBox | None = None) -> Network:
-    """The thermal network of a packing in one call: bonds from the overlaps (:func:`dem.geometry.bonds.find_bonds`, with the
-    contact model and out-of-range policy of ``spec``), their conductances (:func:`dem.laws.conductance.
-    bond_conductances`, Rojek 2022 eqs. 5-9), and the assembled :class:`Network` holding both.
+    """The thermal network of a packing in one call: bonds from the overlaps (:func:`dem.geometry.bonds.find_bonds`,
+    with the contact model and out-of-range policy of ``spec``), their conductances
+    (:func:`~dem.laws.conductance.bond_conductances`, Rojek 2022 eqs. 5-9), and the assembled :class:`Network`
+    holding both.
 
-    ``walls`` are :class:`dem.laws.ambient.Wall` planes, ``spec`` a :class:`~dem.laws.conductance.ConductanceSpec`
+    ``walls`` are :class:`dem.geometry.walls.Wall` planes, ``spec`` a :class:`~dem.laws.conductance.ConductanceSpec`
     (default: the ``rojek`` law), ``sources`` the ambient exchange and ``pairs = (i, j)`` the pair bonds to use
     instead of searching for overlaps. ``bonds`` already found (e.g. to time the search apart) skip the search. To
     impose other pair conductances, replace them: ``dataclasses.replace(net, K_pairs=K)``. ``box``: a periodic box
@@ -518,7 +519,7 @@ def step_tolerance(rtol: float, order: int) -> float:
     """Local error allowed per step (relative to the temperature range) for a global error of about ``rtol``.
 
     An order-q method whose steps each make a local error ``tau`` ends ``~ c tau^(q/(q+1))`` off (the steps shrink
-    with ``tau^(1/(q+1))``), so ``tau = min(rtol, k_q rtol^((q+1)/q))``; ``k_q`` (:data:`AUTO_LOCAL`) is calibrated
+    with ``tau^(1/(q+1))``), so ``tau = min(rtol, k_q rtol^((q+1)/q))``; ``k_q`` (``AUTO_LOCAL``) is calibrated
     on the decay of a pair and of a packing between plates (global errors 0.1-1 x rtol for rtol 1e-2 ... 1e-4).
     """
     return min(rtol, AUTO_LOCAL[order] * rtol ** ((order + 1) / order))

@@ -114,9 +114,9 @@ class BoundedLaplacian:
         return self._diags
 
     plane_diag = property(lambda self: self._diagonals()[0],
-                          doc="Per free node: the sum of its plane conductances.")
+                          doc="The sum of each free node's plane conductances.")
     fixed_diag = property(lambda self: self._diagonals()[1],
-                          doc="Per free node: the sum of its conductances to fixed nodes.")
+                          doc="The sum of each free node's conductances to fixed nodes.")
 
     def same_edges(self, i, j, plane_node, plane_index) -> bool:
         """Whether these edges and plane bonds are those of the assembled matrices (same order)."""

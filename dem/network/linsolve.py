@@ -2,7 +2,7 @@
 
 ``make_solver(A, backend)`` returns an object with ``solve(b, x0=None) -> x`` for a fixed matrix, so a
 factorisation or a multigrid hierarchy is built once and reused for every right-hand side (every time step).
-Backends (:data:`BACKENDS`; a PETSc/MPI backend is one more entry with the same two methods):
+Backends (``BACKENDS``; a PETSc/MPI backend is one more entry with the same two methods):
 
 * ``"direct"`` -- sparse LU (SuperLU, symmetric mode with a minimum-degree ordering of ``A + A^T``); exact to
   round-off. Fill-in grows fast on 3D networks, so ``"auto"`` uses it for small systems only.
@@ -18,12 +18,12 @@ Backends (:data:`BACKENDS`; a PETSc/MPI backend is one more entry with the same 
 
 ``"auto"`` (:func:`choose_backend`) looks at the diagonal dominance first: the Jacobi-scaled matrix has condition
 number at most ``1 + 2/rho`` with ``rho = min_i m_i / L_ii`` (``m_i`` the part of the diagonal beyond the
-Laplacian: ``C_i/dt`` in a time step). When that bound is at most :data:`JACOBI_MAX_CONDITION`, Jacobi-CG reaches a
+Laplacian: ``C_i/dt`` in a time step). When that bound is at most ``JACOBI_MAX_CONDITION``, Jacobi-CG reaches a
 relative residual of 1e-10 within about ``sqrt(4000)/2 ln(2 sqrt(4000) / 1e-10) ~ 880`` iterations (1000 are
-allowed), and it is chosen above :data:`JACOBI_MIN` unknowns (chains with conductances spread over 1e4 ... 1e12
+allowed), and it is chosen above ``JACOBI_MIN`` unknowns (chains with conductances spread over 1e4 ... 1e12
 at the bound took at most 504 iterations). The target is on the unscaled residual, which floating point may not
 reach on badly scaled systems: should CG fail, the matrix falls back to direct or AMG (:class:`AutoCGSolver`).
-Otherwise (steady networks, very large time steps) direct up to :data:`DIRECT_MAX` unknowns, AMG above.
+Otherwise (steady networks, very large time steps) direct up to ``DIRECT_MAX`` unknowns, AMG above.
 
 The thresholds come from timing the three backends on random sintered packings between fixed plates, steady and
 with the capacity term ``C/dt`` for steps of 1 to 1000 times the cheap explicit bound ``2 min C_i / L_ii``:
@@ -139,7 +139,7 @@ _THREADPOOLS = None  # the ThreadpoolController of one_blas_thread, made when fi
 
 
 class AMGSolver(PCGSolver):
-    """CG preconditioned by one smoothed-aggregation V-cycle (pyamg), hierarchy built once (:data:`AMG_OPTIONS`).
+    """CG preconditioned by one smoothed-aggregation V-cycle (pyamg), hierarchy built once (``AMG_OPTIONS``).
 
     Three things make it cheap on the network matrices (weighted graph Laplacians plus a positive diagonal):
 
@@ -205,7 +205,7 @@ class AMGSolver(PCGSolver):
         return self.hierarchy.aspreconditioner(cycle="V")
 
     def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
-        """CG to the criterion. A reused hierarchy (``hierarchy_of``) that needs more than :data:`AMG_REUSE_GROWTH`
+        """CG to the criterion. A reused hierarchy (``hierarchy_of``) that needs more than ``AMG_REUSE_GROWTH``
         times the most iterations a solve on its own matrix took (plus one) is dropped there and a fresh one built
         for this matrix, which then solves from ``x0`` again."""
         with one_blas_thread():

@@ -3,7 +3,7 @@ algebraic multigrid preconditioner (petsc4py, imported only by a distributed run
 
 Each rank gives its own rows, in CSR with global column numbers (:func:`matrix`); :class:`PetscSolver` solves with
 them to the project's criterion ``|b - A x| <= rtol |b|`` (the unpreconditioned residual, as
-:class:`dem.network.linsolve.PCGSolver`). The preconditioner by default (:data:`DEFAULTS`) is the first available of
+:class:`dem.network.linsolve.PCGSolver`). The preconditioner by default (``DEFAULTS``) is the first available of
 
 * Trilinos ML (smoothed aggregation): the fastest on the project's 10^6-particle steady network, 2.8-3.0 s for setup
   and solve on one rank and 1.6-1.75 s on two;
@@ -56,7 +56,7 @@ def matrix(comm, rows, n_global: int):
 
 
 def _preconditioner(PETSc) -> tuple[str, dict]:
-    """The first preconditioner of :data:`DEFAULTS` this PETSc has."""
+    """The first preconditioner of ``DEFAULTS`` this PETSc has."""
     probe = PETSc.PC().create(comm=PETSc.COMM_SELF)
     try:
         for name, options in DEFAULTS:

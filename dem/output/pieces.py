@@ -44,7 +44,7 @@ def write_pvtu(path, pieces: list[str], point_fields: dict, cell_fields: dict) -
 
 
 class PieceWriter(RunWriter):
-    """:class:`RunWriter` on rank ``rank`` of ``ranks`` (module docstring)."""
+    """:class:`~dem.output.writer.RunWriter` on rank ``rank`` of ``ranks`` (module docstring)."""
 
     def __init__(self, out_dir, scene, engine, rank: int, ranks: int):
         self.rank, self.ranks = rank, ranks

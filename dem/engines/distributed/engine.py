@@ -188,7 +188,8 @@ class DistributedStaticEngine(StaticEngine):
         return {k: v[self.mine] for k, v in super().particle_fields().items()}
 
     def links(self):
-        """The bonds of :meth:`StaticEngine.links` this rank writes: pair bonds whose first particle it owns, the
+        """The bonds of
+        :meth:`~dem.engines.static.StaticEngine.links` this rank writes: pair bonds whose first particle it owns, the
         wall bonds of its particles."""
         points, lines, fields = super().links()
         keep = np.concatenate([self.mine[self.bonds.i], np.ones(self.bonds.n_walls, dtype=bool)])

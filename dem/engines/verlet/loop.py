@@ -17,7 +17,7 @@ step:
 4. second half kick (velocities at the end of the step); stress-controlled walls from eq. 1.
 
 Like :mod:`dem.engines.contact_forces`, this module is written against the contact law imported as ``law`` and
-copied for every other law by :mod:`dem.engines.compiled`; in the copies for more than one thread :data:`THREADED`
+copied for every other law by :mod:`dem.engines.compiled`; in the copies for more than one thread ``THREADED``
 is true: the loops over particles and the force pass run on all of numba's threads, with the same results to the
 bit (:mod:`dem.engines.contact_forces`).
 """
@@ -60,7 +60,7 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
     ``f``/``tau``/``wacc`` must hold the forces of the current state on entry. Returns ``(steps done, status)``;
     ``info`` receives the particle (and wall) index of a non-finite or escaped particle (the first such). ``start``,
     ``pairs``, ``load``: the pairs by particle and the buffer of the threaded force pass (used where
-    :data:`THREADED`)."""
+    ``THREADED``)."""
     n = x.shape[0]
     n_w = wn.shape[0]
     h = 0.5 * dt

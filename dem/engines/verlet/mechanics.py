@@ -6,7 +6,7 @@ the list (when some particle has moved more than half the skin), at the times th
 update, a change of schedule), or to stop a run that went wrong (a non-finite position, a particle through a wall)
 with a one-line message naming the step and the particle.
 
-Threads: with more than one (:func:`sinterheat.threads.count`) and at least :data:`THREADED_MIN_PARTICLES`
+Threads: with more than one (:func:`sinterheat.threads.count`) and at least ``THREADED_MIN_PARTICLES``
 particles the model binds the threaded copy of the loop (:mod:`dem.engines.compiled`), which needs each particle's
 pairs in the order of the list (:func:`dem.engines.contact_forces.incident_pairs`, made at every rebuild); its
 results are those of one thread to the bit. Below that size a step is too short to share: the threads would cost

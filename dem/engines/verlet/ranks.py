@@ -65,13 +65,15 @@ def _gather_rows(parts: list) -> np.ndarray:
 
 
 class RankMechanics(MechanicalModel):
-    """The mechanical submodel of one rank (module docstring): :class:`MechanicalModel` on the local particles,
+    """The mechanical submodel of one rank (module docstring):
+    :class:`~dem.engines.verlet.mechanics.MechanicalModel` on the local particles,
     with the exchanges between ranks around each step and each rebuild."""
 
     def __init__(self, state: MotionState, walls, material, dt: float, skin: float, gravity=(0.0, 0.0, 0.0),
                  box=None, relaxation_time: float = 1e3, history=None, comm=None):
         """``state``: every particle of the scene (each rank reads them all and keeps its slab); ``comm``: the
-        communicator (MPI's world by default); the rest as for :class:`MechanicalModel`."""
+        communicator (MPI's world by default); the rest as for
+        :class:`~dem.engines.verlet.mechanics.MechanicalModel`."""
         self.comm = world() if comm is None else comm
         self.rank, self.size = self.comm.Get_rank(), self.comm.Get_size()
         self.gid = np.arange(state.n)
@@ -345,7 +347,8 @@ class RankVerletEngine(VerletEngine):
         super().__init__(scene, restart)
 
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
-        """As :meth:`VerletEngine.run`; ``observe`` sees the gathered sample (every rank calls it, rank 0 with its
+        """As :meth:`~dem.engines.verlet.engine.VerletEngine.run`;
+        ``observe`` sees the gathered sample (every rank calls it, rank 0 with its
         writer, the others with a callable that writes nothing); checkpoints on one rank only."""
         mech = self.mechanics
 
