@@ -23,7 +23,8 @@ def listed(policy, kc=None):
     K, K_w = np.empty(len(PI)), np.empty(5)
     bad = lens_list_conductances(X, R, KAPPA, np.inf if kc is None else kc, LENS_POLICY[policy], PI.astype(np.int64),
                                  PJ.astype(np.int64), np.array([WALL.normal]), np.array([-0.2]),
-                                 np.arange(5, dtype=np.int64), np.zeros(5, dtype=np.int64), K, K_w)
+                                 np.arange(5, dtype=np.int64), np.zeros(5, dtype=np.int64), K, K_w,
+                                 np.zeros(3))
     return bad, K, K_w
 
 

@@ -9,6 +9,7 @@ import numpy as np
 
 from dem import memory
 from dem.network.heat import Checkpoint, boundary_heat_flow, build_network, integrate, periodic_heat_flow, steady
+from dem.scene.state_file import box_arrays
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
@@ -209,10 +210,12 @@ class StaticEngine:
         return out
 
     def state(self) -> dict:
-        """The particles as they end (:mod:`dem.scene.state_file`): positions, radii, temperatures, ids, the time."""
+        """The particles as they end (:mod:`dem.scene.state_file`): positions, radii, temperatures, ids, the time,
+        the periodic box."""
         p = self.scene.particles
         return {"engine": np.array(self.name), "t": np.array(self.t), "steps": np.array(self.steps),
-                "x": p.position, "radius": p.radius, "T": self.T, "id": p.id, "material": p.material}
+                "x": p.position, "radius": p.radius, "T": self.T, "id": p.id, "material": p.material,
+                **box_arrays(self.scene.box)}
 
     def bond_heat_flow(self) -> tuple[np.ndarray, np.ndarray]:
         """Heat flow (W) along each pair bond from i to j, and from each wall-bonded particle into its wall."""

@@ -220,7 +220,10 @@ def list_arrays(mech) -> dict:
 
 
 def restore_lists(mech, saved: dict) -> None:
-    """The Verlet lists of a checkpoint (:func:`list_arrays`) back into ``mech``, with the saved pair histories."""
+    """The Verlet lists of a checkpoint (:func:`list_arrays`) back into ``mech``, with the saved pair histories and
+    the positions they go with (in a periodic box the list built before may have wrapped particles the uninterrupted
+    run wraps only at its next rebuild)."""
+    mech.state.x[:] = saved["x"]
     mech.pi, mech.pj = (np.array(saved[k], dtype=np.int64) for k in ("pi", "pj"))
     mech.p_hist = np.array(saved["p_hist"], dtype=float)
     mech.p_fn, mech.p_ft = np.zeros(len(mech.pi)), np.zeros((len(mech.pi), 3))

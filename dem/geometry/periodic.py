@@ -64,8 +64,8 @@ class PeriodicBox:
 
     @property
     def kernel_lengths(self) -> np.ndarray:
-        """The lengths with 0 on the non-periodic axes: the form the compiled neighbour list of moving particles
-        takes (``dem.geometry.neighbours.min_image``)."""
+        """The lengths with 0 on the non-periodic axes: the form the compiled kernels of moving particles take
+        (``dem.geometry.neighbours.min_image``)."""
         return np.where(self.mask, self.lengths, 0.0)
 
     def wrap(self, x: np.ndarray) -> np.ndarray:
@@ -74,6 +74,18 @@ class PeriodicBox:
         offset = np.mod(x - self.origin, self.lengths)
         offset = np.where(offset >= self.lengths, 0.0, offset)  # mod of a tiny negative number rounds up to L
         return np.where(self.mask, self.origin + offset, x)
+
+    def wrap_outside(self, x: np.ndarray) -> np.ndarray:
+        """Moves the positions ``x`` (N, 3) that have left the box along a periodic axis back into it, in place (the
+        others keep their bits, so a resumed run wraps as the uninterrupted one did); returns the displacement each
+        got (a multiple of the lengths; zero for the others)."""
+        outside = self.mask & ((x < self.origin) | (x >= self.origin + self.lengths))
+        if not outside.any():
+            return np.zeros_like(x)
+        wrapped = np.where(outside, self.wrap(x), x)
+        moved = wrapped - x
+        x[:] = wrapped
+        return moved
 
     def minimum_image(self, dx: np.ndarray) -> np.ndarray:
         """The shortest image of each displacement ``dx`` (N, 3) along the periodic axes."""

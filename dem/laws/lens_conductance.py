@@ -8,6 +8,8 @@ import math
 
 from numba import njit
 
+from dem.geometry.neighbours import min_image
+
 LENS_POLICY = {"error": 0, "clip": 1, "drop": 2}  # out_of_range as the compiled lens law takes it
 
 
@@ -26,11 +28,12 @@ def lens_conductance(l_i, l_j, area, kappa_i, kappa_j, contact_conductance):
 
 
 @njit(cache=True, error_model="numpy")
-def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pi, pj, wn, wq, wk, wm, K, K_w):
+def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pi, pj, wn, wq, wk, wm, K, K_w, box):
     """The ``zohdi`` law (:func:`lens_conductance`) on every listed pair ``(pi, pj)`` into ``K`` and every listed
     particle-wall pair ``(wk, wm)`` (walls ``n_m . x = q_m``) into ``K_w``, with the lens geometry of
     :func:`dem.geometry.bonds.find_bonds` (``contact = "lens"``) at positions ``x``; ``K = 0`` where the pair does not
-    touch (``|x_i - x_j| >= R_i + R_j``, a wall ``dist >= R_k``).
+    touch (``|x_i - x_j| >= R_i + R_j``, a wall ``dist >= R_k``). Along the axes where ``box`` holds a period (else
+    0) a pair is joined by the minimum image (:func:`dem.geometry.neighbours.min_image`).
 
     A lens beyond its range (a centre inside the other sphere's cap, ``L_i < 0``) is, by ``policy``
     (:data:`LENS_POLICY`), clipped as ``find_bonds`` clips it (the smaller sphere's centre on the contact plane) or
@@ -41,7 +44,8 @@ def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pi, pj
     for c in range(pi.shape[0]):
         i, j = pi[c], pj[c]
         K[c] = 0.0
-        d2 = (x[j, 0] - x[i, 0]) ** 2 + (x[j, 1] - x[i, 1]) ** 2 + (x[j, 2] - x[i, 2]) ** 2
+        d2 = (min_image(x[j, 0] - x[i, 0], box[0]) ** 2 + min_image(x[j, 1] - x[i, 1], box[1]) ** 2
+              + min_image(x[j, 2] - x[i, 2], box[2]) ** 2)
         ri, rj = radius[i], radius[j]
         if d2 > (ri + rj) ** 2 * (1.0 + 1e-10):  # surely apart: no square root (the exact test follows)
             continue

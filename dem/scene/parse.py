@@ -471,7 +471,7 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
             material = None  # the state's materials are not this scene's: the scene's first, as for [particles]
         particles = Particles.from_arrays(start["x"], start["radius"], start["T"], materials, material,
                                           prefix="[start] state", id=start.get("id"))
-        walls, specimen, velocity, box = (), None, None, None
+        walls, specimen, velocity, box = (), None, None, state_file.saved_box(start)
     elif ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
     elif "particles" in doc:
@@ -486,9 +486,6 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         box = _periodic_box(doc["periodic"], box)
     elif box is not None and not box.any_periodic:
         box = None  # a packing file's box that is not periodic (or that cannot say): only [periodic] uses it
-    if box is not None and engine == "staggered":
-        raise ValueError(f"{'[periodic]' if 'periodic' in doc else '[particles] file: its box is periodic, and'}: "
-                         "the staggered engine (Zohdi 2014) has no periodic box; the static and verlet engines do")
     walls = walls + _walls(doc, start, static=not moving)
     if box is not None and moving:
         _check_walls_across(walls, box)

@@ -107,12 +107,14 @@ ROWS = (
         "from the run's start t_0"),
     Row("walls", ("potential", "current"), STAGGERED, "V or A", 'an electrode ("electrical" physics): a fixed '
         "potential, or a current into the packing"),
-    Row("periodic", ("lengths",), STATIC_VERLET,
-        "[Lx, Ly, Lz] m, required (default: the box of a `[particles] file`)",
+    Row("periodic", ("lengths",), ALL,
+        "[Lx, Ly, Lz] m, required (default: the box of a `[particles] file` or a `[start] state`)",
         "a periodic box (`dem.geometry.periodic.PeriodicBox`): bonds cross its faces to the neighbours' images (the "
-        "same bonds as an explicit larger block, also in boxes shorter than a bond); moving particles touch across "
-        "them by the minimum image and are wrapped back into the box, walls must be parallel to its periodic axes"),
-    Row("periodic", ("axes", "origin"), STATIC_VERLET, "all, [0, 0, 0]",
+        "same bonds as an explicit larger block, also in boxes shorter than a bond); moving particles touch (forces, "
+        "bonds, heat, current) across them by the minimum image and are wrapped back into the box at the rebuilds "
+        "of their neighbour list, walls (and electrodes) must be parallel to its periodic axes; a run's state "
+        "keeps the box"),
+    Row("periodic", ("axes", "origin"), ALL, "all, [0, 0, 0]",
         "the periodic axes and the box's lower corner"),
     Row("periodic", ("drop",), STATIC_VERLET, "[0, 0, 0]",
         "temperature drop per period, T(x + L_k e_k) = T(x) - drop_k: a "

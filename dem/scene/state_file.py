@@ -5,13 +5,15 @@ if it had not stopped -- positions, velocities, angular velocities, the forces a
 Verlet starts a step from them), masses, moments of inertia, reference radii, temperatures and ids of the particles,
 the contact law's state of each particle and its history of every listed pair and particle-wall pair, each wall's
 name, offset, velocity and acceleration, the time, the step count, the time step and the run's counters. A static
-packing's state holds its particles only (positions, radii, temperatures, materials, ids, the time). :func:`save`
+packing's state holds its particles only (positions, radii, temperatures, materials, ids, the time). Either holds the
+periodic box the particles are in, if any (its lengths, periodic axes and origin, :func:`box_arrays`; a temperature
+drop per period is the scene's, not the sample's). :func:`save`
 writes either (with the engine's name), :func:`load` reads it back as a dict, refusing files that are not such a
 state.
 
 A scene starts from a saved state with ``[start] state = "file.npz"`` (Luding 2005, Sec. 4: a prepared sample is
 sintered, a sintered sample is tested; a sintered compact's effective conductivity is measured): its particles come
-from the file, its walls from the scene, where a wall with the name of a saved wall starts at the saved offset (so the
+from the file (with its periodic box, :func:`saved_box`), its walls from the scene, where a wall with the name of a saved wall starts at the saved offset (so the
 box stays as it was) and moves by the scene's law. The run's clock and counters go on from the state's: the scene's
 times (``t_end``, ``[[phases]]``, ``[temperature]``) are on that clock. Particles that move take their velocities and
 contact histories along when the scene has the state's contact law; a static packing takes positions, radii and
@@ -23,6 +25,8 @@ from __future__ import annotations
 import pathlib
 
 import numpy as np
+
+from dem.geometry.periodic import PeriodicBox
 
 FORMAT = "dem-state-2"
 FORMAT_1 = "dem-moving-state-1"  # the Luding law's histories as separate arrays (read and converted)
@@ -48,11 +52,25 @@ def moving_arrays(engine) -> dict:
             "wall_normal": mech.w.normal,
             "wall_dq": mech.w.dq, "wall_acc": mech.w.acc, "dimension": np.array(s.dimension),
             "height": np.array(np.nan if s.height is None else s.height), "dt": np.array(engine.dt),
-            "neighbour_rebuilds": np.array(mech.rebuilds)}
+            "neighbour_rebuilds": np.array(mech.rebuilds), **box_arrays(mech.periodic_box)}
     thermal = getattr(engine, "thermal", None)
     if thermal is not None and hasattr(thermal, "assemblies"):
         data.update(network_assemblies=np.array(thermal.assemblies), network_refreshes=np.array(thermal.refreshes))
     return data
+
+
+def box_arrays(box: PeriodicBox | None) -> dict:
+    """The periodic box ``box`` as arrays of a state (none without a box)."""
+    if box is None:
+        return {}
+    return {"box_lengths": box.lengths, "box_periodic": np.array(box.periodic), "box_origin": box.origin}
+
+
+def saved_box(data: dict) -> PeriodicBox | None:
+    """The periodic box of a loaded state (:func:`box_arrays`), or None."""
+    if "box_lengths" not in data:
+        return None
+    return PeriodicBox(data["box_lengths"], tuple(bool(p) for p in data["box_periodic"]), data["box_origin"])
 
 
 def save(data: dict, path) -> pathlib.Path:

@@ -65,7 +65,8 @@ class StaggeredEngine:
         if saved is not None and saved["moving"]:
             state.x[:], state.v[:], state.T[:] = saved["x"], saved["v"], saved["T"]
         self.mechanics = StaggeredMechanics(state, m.walls, material, m.gravity, m.skin,
-                                            history=saved if saved is not None and saved["moving"] else None)
+                                            history=saved if saved is not None and saved["moving"] else None,
+                                            box=scene.box)
         self.thermal = LumpedHeat(p, m.walls, scene.conductance) if "thermal" in scene.physics else None
         if self.thermal is not None and restart is not None:
             self.thermal.T, self.thermal.T0 = saved["T"].copy(), saved["thermal_T0"].copy()
@@ -245,12 +246,18 @@ class StaggeredEngine:
 
     # -------------------------------------------------------------------------------------------- outputs
     def _cross_section(self, axis):
-        """``(area, (lo, hi) per lateral axis)`` of the box the walls perpendicular to ``axis`` enclose, or None."""
+        """``(area, (lo, hi) per lateral axis)`` of the box the walls (or the periods of a periodic box)
+        perpendicular to ``axis`` enclose, or None."""
         mech = self.mechanics
         area, spans = 1.0, []
         box = box_axes(mech.walls)
+        periodic = mech.periodic_box
         for a in range(3):
             if a == axis:
+                continue
+            if mech.box[a] > 0:
+                spans.append((a, periodic.origin[a], periodic.origin[a] + periodic.lengths[a]))
+                area *= periodic.lengths[a]
                 continue
             if a not in box:
                 return None
@@ -285,10 +292,11 @@ class StaggeredEngine:
         ceiling = -mech.w.q[self._top]
         inside = cap_volume(s.x[:, axis], s.radius, self._lowest) - cap_volume(s.x[:, axis], s.radius, floor)
         width = 2.0 * float(np.mean(s.radius))
+        x = s.x if mech.periodic_box is None else mech.periodic_box.wrap(s.x)  # columns over the periods
         column = np.zeros(len(s.x), dtype=np.int64)
         for (a, lo, hi) in spans:
             count = max(1, int((hi - lo) / width))
-            column = column * count + np.clip(((s.x[:, a] - lo) / (hi - lo) * count).astype(np.int64), 0, count - 1)
+            column = column * count + np.clip(((x[:, a] - lo) / (hi - lo) * count).astype(np.int64), 0, count - 1)
         tops = np.full(column.max() + 1, -np.inf)
         np.maximum.at(tops, column, s.x[:, axis] + s.radius)
         surface = min(float(np.mean(tops[np.isfinite(tops)])), ceiling)

@@ -40,11 +40,12 @@ from dem.network.laplacian import BoundedLaplacian
 def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_of_range: str):
     """``(particles at x, bonds)``: the touching pairs of the Verlet list of ``mech`` at positions ``x`` and the
     particles touching the walls ``wall_ids`` (where the mechanics has them), with contact radii from the geometry
-    ``contact`` (:func:`dem.geometry.bonds.find_bonds`)."""
-    closed = kernels.closed_pairs(x, particles.radius, mech.pi, mech.pj)
+    ``contact`` (:func:`dem.geometry.bonds.find_bonds`; in the periodic box of ``mech`` across its faces)."""
+    closed = kernels.closed_pairs(x, particles.radius, mech.pi, mech.pj, mech.box)
     now = Particles(x, particles.radius, T, particles.material, particles.fixed, particles.heat, particles.materials)
     planes = [mech.walls[k].at(float(mech.w.q[k])) for k in wall_ids]
-    return now, find_bonds(now, planes, contact, out_of_range, pairs=(mech.pi[closed], mech.pj[closed]))
+    return now, find_bonds(now, planes, contact, out_of_range, pairs=(mech.pi[closed], mech.pj[closed]),
+                           box=mech.periodic_box)
 
 
 class LumpedHeat:
@@ -89,7 +90,7 @@ class LumpedHeat:
         if self.spec.law == "zohdi":
             bad = lens_list_conductances(x, self.particles.radius, self.kappa, self.contact_conductance,
                                          LENS_POLICY[self.spec.out_of_range], mech.pi, mech.pj, mech.w.normal,
-                                         mech.w.q, plane_node, wall, K, K_w)
+                                         mech.w.q, plane_node, wall, K, K_w, mech.box)
             if bad:  # find_bonds names the first contact the policy cannot take
                 contact_bonds(self.particles, mech, x, T, self.thermal_walls, "lens", self.spec.out_of_range)
                 raise RuntimeError(f"{bad} lens contacts out of range that find_bonds accepts")

@@ -14,6 +14,7 @@ import numpy as np
 from numba import njit
 
 from dem.engines.contact_forces import forces
+from dem.geometry.neighbours import min_image
 
 
 @njit(cache=True, error_model="numpy")
@@ -54,12 +55,14 @@ def iterate(dt, phi, x_L, v_L, f_L, x_prev, v_prev, T, mass, radius, gravity, pi
 
 
 @njit(cache=True)
-def closed_pairs(x, radius, pi, pj):
-    """Mask of the listed pairs that touch (``|x_i - x_j| < R_i + R_j``)."""
+def closed_pairs(x, radius, pi, pj, box):
+    """Mask of the listed pairs that touch (``|x_i - x_j| < R_i + R_j``; the minimum image along the axes where
+    ``box`` holds a period, :func:`dem.geometry.neighbours.min_image`)."""
     out = np.zeros(pi.shape[0], dtype=np.bool_)
     for c in range(pi.shape[0]):
         i, j = pi[c], pj[c]
-        d2 = (x[i, 0] - x[j, 0]) ** 2 + (x[i, 1] - x[j, 1]) ** 2 + (x[i, 2] - x[j, 2]) ** 2
+        d2 = (min_image(x[i, 0] - x[j, 0], box[0]) ** 2 + min_image(x[i, 1] - x[j, 1], box[1]) ** 2
+              + min_image(x[i, 2] - x[j, 2], box[2]) ** 2)
         s = radius[i] + radius[j]
         out[c] = d2 < s * s
     return out

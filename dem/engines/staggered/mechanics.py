@@ -10,7 +10,10 @@ step is known before it is solved.
 
 Neighbours (Zohdi 2014, Sec. 8): a Verlet list with a skin built by cell binning (:mod:`dem.geometry.neighbours`); an
 iterate that takes a particle (plus the farthest-moved wall) more than half the skin from where the list was built
-rebuilds it there, carrying each pair's bond flag. A bond (eq. 19) becomes part of the pair's history when a step
+rebuilds it there, carrying each pair's bond flag. In a periodic box (:class:`dem.geometry.periodic.PeriodicBox`)
+pairs touch across its faces by the minimum image, and a rebuild moves the particles that left the box back into it
+-- at a rebuild within a step both the iterate and the step's start, by the same period, so the step goes on as it
+was. A bond (eq. 19) becomes part of the pair's history when a step
 that reached ``E*`` is accepted (it acts from the next step on); it is forgotten when the pair separates.
 """
 
@@ -23,6 +26,7 @@ import numpy as np
 from dem.engines import compiled
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, max_displacement, restore_lists, verlet_pairs, wall_pairs
+from dem.geometry.periodic import PeriodicBox
 from dem.geometry.walls import MOTIONS, WallArrays
 from dem.laws.contact import law_module
 
@@ -32,10 +36,12 @@ class StaggeredMechanics:
 
     name = "mechanical"
 
-    def __init__(self, state: MotionState, walls, material, gravity, skin: float, history: dict | None = None):
+    def __init__(self, state: MotionState, walls, material, gravity, skin: float, history: dict | None = None,
+                 box: PeriodicBox | None = None):
         """``material``: the contact law's material (``material.law`` names the law: one whose particles do not
         rotate); ``history``: a saved state (:mod:`dem.scene.state_file`) whose walls (by name: offset and speed)
-        and, for the same contact law, contact histories the model starts from."""
+        and, for the same contact law, contact histories the model starts from; ``box``: a periodic box (module
+        docstring)."""
         self.state = state
         self.walls = tuple(walls)
         for wall in self.walls:
@@ -48,6 +54,8 @@ class StaggeredMechanics:
         self.params = np.ascontiguousarray(material.params(), dtype=float)
         self.gravity = np.asarray(gravity, dtype=float)
         self.skin = float(skin)
+        self.periodic_box = box
+        self.box = box.kernel_lengths if box is not None else np.zeros(3)  # 0: not periodic
         self.w = WallArrays.build(self.walls, 3)
         n = state.n
         self.f = np.zeros((n, 3))          # forces at the start of the step, F^L
@@ -86,8 +94,14 @@ class StaggeredMechanics:
 
     # ------------------------------------------------------------------------------------------------ list
     def _build_list(self, x):
+        """The lists at positions ``x`` (the state's, or the latest iterate's: then the state moves with it when
+        the box wraps it)."""
         s = self.state
-        i, j = verlet_pairs(x, s.radius, self.skin, np.zeros(3))
+        if self.periodic_box is not None:
+            moved = self.periodic_box.wrap_outside(x)
+            if x is not s.x:
+                s.x += moved
+        i, j = verlet_pairs(x, s.radius, self.skin, self.box)
         if len(self.pi):
             (self.p_hist,) = carry_history(self.pi, self.pj, i, j, self.p_hist)
             self.rebuilds += 1
@@ -115,7 +129,7 @@ class StaggeredMechanics:
         """Forces at ``(x, v, T)`` with the walls where they are now; checks that no particle left the box."""
         w, s = self.w, self.state
         escaped = self._forces(x, v, self._spin, out, self._torque, (0, 1, 2), s.mass, s.radius, self.particle_state, T,
-                               self.gravity, np.zeros(3), self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn,
+                               self.gravity, self.box, self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn,
                                self.p_ft, w.normal, w.q, w.dq, self.wforce, self.wk, self.wm, self.w_hist,
                                self._w_hist_iter, self.w_fn, self.w_ft, self.params, 0.0)
         self._check_escape(escaped, x)
@@ -147,10 +161,10 @@ class StaggeredMechanics:
         """Start a step of ``dt`` from the state now: walls to their end-of-step place, iterate 0 = the state."""
         self.q_start = self.w.q.copy()
         self.w.q[:] = self.wall_offsets(t, dt)
+        if max_displacement(self.state.x, self.x_ref, self.box) + self._wall_reach() > 0.5 * self.skin:
+            self._build_list(self.state.x)
         self.x_prev[:] = self.state.x
         self.v_prev[:] = self.state.v
-        if max_displacement(self.state.x, self.x_ref, np.zeros(3)) + self._wall_reach() > 0.5 * self.skin:
-            self._build_list(self.state.x)
 
     def iterate(self, dt: float, phi: float, T: np.ndarray) -> tuple[float, float]:
         """One fixed-point iteration at the temperatures ``T`` (those of the previous iterate): the new iterate is
@@ -160,7 +174,7 @@ class StaggeredMechanics:
                                 self.gravity, self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn, self.p_ft,
                                 w.normal, w.q, w.dq, self.wk, self.wm, self.w_hist, self._w_hist_iter, self.w_fn,
                                 self.w_ft, self.params, self._f_iter, self._spin, self._torque, (0, 1, 2),
-                                self.particle_state, np.zeros(3), self.wforce, self.x_new, self.v_new, self.x_ref,
+                                self.particle_state, self.box, self.wforce, self.x_new, self.v_new, self.x_ref,
                                 self.stats)
         self._check_escape(escaped, self.x_prev)
         change, motion, reach, finite = self.stats
@@ -195,7 +209,7 @@ class StaggeredMechanics:
     def restart(self) -> None:
         """Undo the iterations of a step that did not converge: the walls go back to where the step started."""
         self.w.q[:] = self.q_start
-        if max_displacement(self.state.x, self.x_ref, np.zeros(3)) + self._wall_reach() > 0.5 * self.skin:
+        if max_displacement(self.state.x, self.x_ref, self.box) + self._wall_reach() > 0.5 * self.skin:
             self._build_list(self.state.x)
 
     # -------------------------------------------------------------------------------------------- outputs
@@ -208,7 +222,10 @@ class StaggeredMechanics:
         (as the forces of the last accepted step saw them)."""
         s = self.state
         ri, rj = s.radius[self.pi], s.radius[self.pj]
-        d = np.sqrt(np.sum((s.x[self.pi] - s.x[self.pj]) ** 2, axis=1))
+        dx = s.x[self.pi] - s.x[self.pj]
+        if self.periodic_box is not None:
+            dx = self.periodic_box.minimum_image(dx)
+        d = np.sqrt(np.sum(dx ** 2, axis=1))
         closed = (d < ri + rj) & (d > 0.0)
         d, ri, rj = d[closed], ri[closed], rj[closed]
         li = 0.5 * (d - (rj * rj - ri * ri) / d)

@@ -356,9 +356,8 @@ class VerletEngine:
         s = mech.state
         i, j, overlap, fn, ft = mech.contacts()
         d = s.x[i] - s.x[j]
-        for a in range(3):
-            if mech.box[a] > 0:
-                d[:, a] -= mech.box[a] * np.floor(d[:, a] / mech.box[a] + 0.5)
+        if mech.periodic_box is not None:
+            d = mech.periodic_box.minimum_image(d)
         n = d / np.linalg.norm(d, axis=1)[:, None]
         f_i = fn[:, None] * n + ft
         sigma = np.zeros((s.n, 3, 3))
