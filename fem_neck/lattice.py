@@ -46,6 +46,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fem_neck.geometry import check_positive, max_overlap, neck_geometry, overlap_for_neck
+from sinterheat.threads import one_blas_thread
 
 KINDS = ("sc", "bcc", "fcc")
 # particle sites of the cubic cell (units of the cell edge) and the cell edge in units of the neighbour distance
@@ -409,15 +410,8 @@ class Bounds:
 def _dual(mesh, order: int, hot, cold):
     from fem_neck import dual
 
-    with _one_blas_thread():
+    with one_blas_thread():  # the dense work is many small products (see fem_neck.spectral.conductance)
         return dual.solve(mesh, order - 1, hot, cold)
-
-
-def _one_blas_thread():
-    """One BLAS thread: the dense work is many small products (see :func:`fem_neck.spectral.conductance`)."""
-    from fem_neck.spectral import _blas
-
-    return _blas().limit(limits=1, user_api="blas")
 
 
 def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
@@ -433,15 +427,15 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
     if workers >= 2:
         with ProcessPoolExecutor(1, mp_context=get_context("fork")) as pool:
             future = pool.submit(_dual, mesh, order, cm.hot, cm.cold)
-            with _one_blas_thread():
+            with one_blas_thread():
                 up = primal.solve(mesh, order, cm.hot, cm.cold)
             low = future.result()
     else:
-        with _one_blas_thread():
+        with one_blas_thread():
             up = primal.solve(mesh, order, cm.hot, cm.cold)
         low = _dual(mesh, order, cm.hot, cm.cold)
     scale = cm.height / cm.area
-    with _one_blas_thread():
+    with one_blas_thread():
         volume = primal.volume(mesh)
     return Bounds(float(up.energy * scale), float(low.lower * scale), float(low.flux_defect), int(up.dofs),
                   int(low.dofs), len(mesh.tets), float(volume / cm.volume_exact - 1.0), time.perf_counter() - t0)

@@ -26,6 +26,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from sinterheat.threads import one_blas_thread
+
 MAX_ORDER = 12
 
 
@@ -242,19 +244,11 @@ class Solution:
     jacobian_min: float
 
 
-@functools.lru_cache(maxsize=None)
-def _blas():
-    """The BLAS thread-pool controller (threadpoolctl), made once: limiting a pool then costs ~20 us."""
-    from threadpoolctl import ThreadpoolController
-
-    return ThreadpoolController()
-
-
 def conductance(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
     """:func:`solve` with BLAS on one thread: the dense work here is many small products, for which a second BLAS
     thread only adds synchronisation -- on a busy 2-core machine it made the element matrices 3-6x slower and a
     dense 300 x 300 Cholesky 5-50x slower (measured); parallel sweeps use processes instead."""
-    with _blas().limit(limits=1, user_api="blas"):
+    with one_blas_thread():
         return solve(mesh, order, fixed_vertices)
 
 

@@ -6,12 +6,13 @@ core this process may run on.
 inside the loop: :mod:`dem.engines.compiled`); :func:`use` sets the number for the rest of the process: numba's
 threads, the BLAS libraries already loaded (threadpoolctl) and, through ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS``
 and ``MKL_NUM_THREADS``, those loaded later and child processes (which also inherit ``SINTERHEAT_THREADS``).
-numba's threading layer is ``workqueue`` (numba's own, present everywhere; it needs neither TBB nor OpenMP, and its
+:func:`one_blas_thread` pins BLAS to one thread for a block of work. numba's threading layer is ``workqueue`` (numba's own, present everywhere; it needs neither TBB nor OpenMP, and its
 idle threads sleep) unless ``NUMBA_THREADING_LAYER`` names another.
 """
 
 from __future__ import annotations
 
+import functools
 import os
 
 ENVIRONMENT = "SINTERHEAT_THREADS"
@@ -59,6 +60,21 @@ def use(number: int) -> None:
     from threadpoolctl import threadpool_limits
 
     threadpool_limits(_chosen)
+
+
+@functools.lru_cache(maxsize=None)
+def _blas_pools():
+    """The BLAS thread-pool controller (threadpoolctl), made once: limiting a pool then costs ~20 us."""
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
+
+
+def one_blas_thread():
+    """A context in which BLAS runs on one thread, whatever :func:`use` chose: for work of many small products or
+    vector operations between compiled kernels (the hp element matrices, the AMG setup), where a second BLAS thread
+    only adds synchronisation and, on a busy machine, spins while waiting for a core."""
+    return _blas_pools().limit(limits=1, user_api="blas")
 
 
 def bind_numba() -> int:

@@ -43,6 +43,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
+from sinterheat.threads import one_blas_thread
+
 DIRECT_MAX = 5_000  # without diagonal dominance: direct up to this many unknowns, AMG above
 JACOBI_MIN = 1_000  # with diagonal dominance: Jacobi-CG above this many unknowns, direct below
 JACOBI_MAX_CONDITION = 4000.0  # diagonally dominant: Jacobi condition-number bound 1 + 2/rho at most this
@@ -123,19 +125,6 @@ class PCGSolver:
         raise SolverError(f"{self.name} did not reach rtol = {self.rtol:g} in {self.max_iterations} iterations "
                           f"(relative residual {np.sqrt(rr / _dot(b, b)):.3g}); try solver.linear = "
                           f"\"direct\" or \"amg\"")
-
-
-def one_blas_thread():
-    """A context in which BLAS runs on one thread (threadpoolctl; the libraries are looked up once)."""
-    global _THREADPOOLS
-    if _THREADPOOLS is None:
-        from threadpoolctl import ThreadpoolController
-
-        _THREADPOOLS = ThreadpoolController()
-    return _THREADPOOLS.limit(limits=1, user_api="blas")
-
-
-_THREADPOOLS = None  # the ThreadpoolController of one_blas_thread, made when first needed
 
 
 class AMGSolver(PCGSolver):
