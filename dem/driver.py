@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dem.engines import engine_class
+from dem.network.comm import launched, on_root, world
 from dem.output import folder as run_folder
 from dem.output.writer import RunWriter
 from dem.scene import Scene
@@ -33,7 +34,7 @@ class RunResult:
 
     @property
     def thermal(self):
-        """The thermal network (bonds, conductances): the static engine itself, or the moving engines' network."""
+        """The thermal network (bonds, conductances) -- the static engine itself, or the moving engines' network."""
         return self.engine if self.engine.name == "static" else self.engine.thermal
 
 
@@ -75,24 +76,34 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     it first; :mod:`dem.output.folder`). Ctrl-C leaves the folder usable and resumable: the rows and snapshots written
     so far, the checkpoint of the last completed step, and ``summary.json`` marked ``"interrupted": true``.
     ``progress``: a bar on stderr, and the run's position in the line an interrupt prints."""
-    if out is not None:
-        out = run_folder.prepare(out, resume, overwrite)
-    elif resume or overwrite:
+    if out is None and (resume or overwrite):
         raise ValueError("--resume and --overwrite need --out (the folder of the run)")
-    start = time.perf_counter()
-    here = _position(scene, out, progress)
-    restart = run_folder.load(out, scene, scene.engine) if resume else None
-    engine = engine_class(scene.engine)(scene, restart)
-    writer = None
+    if launched() and scene.engine == "static":  # under MPI a static packing's network is solved on PETSc
+        return _run_distributed(scene, out, progress, resume, overwrite)
+    comm = world() if launched() else None  # under MPI moving particles are shared by the ranks, rank 0 writes
+    cls = engine_class(scene.engine)
+    if comm is not None:
+        from dem.engines.verlet.ranks import RankVerletEngine, refuse_unsupported
+
+        refuse_unsupported(scene, comm.Get_size(), resume)
+        cls = RankVerletEngine
+    root = comm is None or comm.Get_rank() == 0
     if out is not None:
+        out = on_root(comm, lambda: run_folder.prepare(out, resume, overwrite))
+    start = time.perf_counter()
+    here = _position(scene, out, progress and root)
+    restart = run_folder.load(out, scene, scene.engine) if resume else None
+    engine = cls(scene, restart)
+    writer = None
+    if out is not None and root:
         writer = RunWriter(out, scene, engine, resume_step=engine.steps if resume else None)
         if scene.motion is not None and scene.motion.frames:
             from dem.output.frames import WithFrames
 
             writer = WithFrames(writer, scene, out)
     checkpointer = run_folder.Checkpointer(out, scene, scene.engine, scene.output.checkpoint_every) \
-        if out is not None and (scene.solver.mode == "transient") else None
-    bar = _progress_bar(scene, engine, progress)
+        if writer is not None and (scene.solver.mode == "transient") else None
+    bar = _progress_bar(scene, engine, progress and root)
 
     def advanced(t):
         if writer is None:  # with a folder the position is that of its last row (observed below)
@@ -106,7 +117,7 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
 
     try:
         try:
-            engine.run(observed if writer is not None else None,
+            engine.run(observed if writer is not None else (_nothing if out is not None else None),
                        advanced if scene.solver.mode == "transient" else None, checkpointer)
         finally:
             if bar is not None:
@@ -130,6 +141,57 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
             writer.finish({"scene": scene.name, "stopped": " ".join(str(exc).split()), **_safe_summary(engine)},
                           plots=False)
         raise
+    return RunResult(summary, engine.temperatures(), engine)
+
+
+def _nothing():
+    """The observer of a rank that writes nothing (rank 0 writes the run's folder)."""
+
+
+def _run_distributed(scene: Scene, out, progress: bool, resume: bool, overwrite: bool) -> RunResult:
+    """:func:`run` on several MPI ranks (:mod:`dem.engines.distributed`): every rank builds and solves its part;
+    rank 0 prepares the folder, shows the bar and writes the summary, every rank its pieces of the snapshots.
+    ``RunResult.T`` holds the temperatures of the particles this rank owns (``engine.owned``: their indices); no
+    ``state.npz`` and no plots (they need every particle in one process)."""
+    from dem.engines.distributed.engine import DistributedStaticEngine, unsupported
+    from dem.network import comm as mpi
+
+    why = unsupported(scene, resume)
+    if why is not None:  # before MPI is touched: a refused run costs nothing
+        raise ValueError(why)
+    comm = mpi.world()
+    rank = comm.Get_rank()
+    start = time.perf_counter()
+    if out is not None:
+        out = mpi.agree(comm, lambda: run_folder.prepare(out, False, overwrite) if rank == 0 else None)
+        out = comm.bcast(out)
+    engine = DistributedStaticEngine(scene)
+    writer = None
+    if out is not None:
+        from dem.output.pieces import PieceWriter
+
+        writer = PieceWriter(out, scene, engine, rank, comm.Get_size())
+    bar = _progress_bar(scene, engine, progress and rank == 0)
+
+    def advanced(t):
+        if bar is not None:
+            bar.update(min(t - engine.t_start, bar.total) - bar.n)
+
+    try:
+        engine.run(writer.observe if writer is not None else None,
+                   advanced if scene.solver.mode == "transient" else None)
+    finally:
+        if bar is not None:
+            if scene.solver.mode != "transient":
+                bar.update(1)
+            bar.close()
+    summary = _summary(scene, engine, None)
+    summary.pop("T", None)
+    if scene.particles.n <= T_LIST_MAX:
+        summary["T"] = engine.gathered_temperatures().tolist()
+    summary["seconds"] = mpi.maximum(comm, time.perf_counter() - start)
+    if writer is not None:
+        writer.finish(summary)
     return RunResult(summary, engine.temperatures(), engine)
 
 

@@ -5,7 +5,7 @@ out-of-memory killer).
 The figure is the peak of the largest run per particle: a steady solve of a random sintered packing (the bond search,
 the network, the AMG hierarchy) peaks at 0.47 GB for 2.5 * 10^5 particles and 1.40 GB for 10^6 (resident set,
 ``python -m dem run`` of the ``packing`` scene with ``n`` raised): about 1.25 kB per particle above the interpreter's
-0.15 GB; :data:`BYTES_PER_PARTICLE` leaves a fifth more for denser packings.
+0.15 GB; ``BYTES_PER_PARTICLE`` leaves a fifth more for denser packings.
 """
 
 from __future__ import annotations

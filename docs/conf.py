@@ -12,7 +12,7 @@ import pathlib
 import sys
 
 DOCS = pathlib.Path(__file__).resolve().parent
-sys.path.insert(0, str(DOCS / "_ext"))  # the local extensions (api_check, gallery_order)
+sys.path.insert(0, str(DOCS / "_ext"))  # the local extensions (api_check, gallery_order, scene_schema)
 logging.getLogger("skfem").setLevel(logging.WARNING)  # its INFO lines (each assembly) would flood the build log
 
 project = "sinterheat"
@@ -28,6 +28,7 @@ extensions = [
     "sphinx_gallery.gen_gallery",
     "sphinx_copybutton",
     "api_check",
+    "scene_schema",
 ]
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
@@ -42,7 +43,7 @@ myst_dmath_double_inline = True
 # (numpy, scipy, skfem ...) are not linked: the build is offline, without intersphinx.
 nitpicky = True
 nitpick_ignore_regex = [
-    (r"py:.*", r"(np|numpy|scipy|skfem|meshio|pyvista|gmsh|argparse|pathlib|concurrent|typing|collections)\b.*"),
+    (r"py:.*", r"(np|numpy|sp|scipy|skfem|meshio|pyvista|gmsh|argparse|pathlib|concurrent|typing|collections|io)\b.*"),
     (r"py:.*", r"(optional|callable|array|array_like|array-like|ndarray|sequence|iterable|mapping|path|object)"),
 ]
 
@@ -54,7 +55,7 @@ napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 
 # The packages whose every public function and class must appear in the API reference (api_check).
-api_packages = ["fem_neck", "sinterheat"]
+api_packages = ["fem_neck", "dem", "sinterheat"]
 
 sphinx_gallery_conf = {
     "examples_dirs": str(DOCS.parent / "examples"),

@@ -9,7 +9,9 @@ the one error line is printed; after success each distinct warning is one ``warn
 any command with one line saying where it stopped and exit code 130 (:mod:`sinterheat.interrupt`); commands report
 their progress with ``sinterheat.interrupt.where().update(...)``. A command with ``--scheduler``
 (:func:`add_scheduler_option`) runs inside that Dask cluster (:func:`sinterheat.pool.use_dask`); one that cannot be
-reached is an ``OSError``: one line, exit code 2.
+reached is an ``OSError``: one line, exit code 2. A command with ``--threads`` (:func:`add_threads_option`) runs its
+compiled loops and BLAS on that many threads, by default ``SINTERHEAT_THREADS`` or every core
+(:mod:`sinterheat.threads`); one with ``--quiet`` (:func:`add_quiet_option`) draws no progress bars.
 """
 
 from __future__ import annotations
@@ -63,6 +65,35 @@ def add_workers_option(parser: argparse.ArgumentParser) -> None:
     """``--workers W``: processes of a parallel sweep (default: all cores), checked to be >= 1."""
     parser.add_argument("--workers", type=_worker_count, default=None, metavar="W",
                         help="processes (default: all cores)")
+
+
+def _thread_count(text: str) -> int:
+    from sinterheat.threads import check
+
+    try:
+        return check(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def add_threads_option(parser: argparse.ArgumentParser) -> None:
+    """``--threads N``: the threads of the compiled loops and of BLAS, 1 to the cores (:mod:`sinterheat.threads`)."""
+    parser.add_argument("--threads", type=_thread_count, default=None, metavar="N",
+                        help="threads of the compiled loops and BLAS, 1 to the cores (default: the environment "
+                             "variable SINTERHEAT_THREADS, else every core); results are the same on any number")
+
+
+def use_threads(args) -> None:
+    """The threads of ``--threads``, or of :func:`sinterheat.threads.count` (a bad ``SINTERHEAT_THREADS``: a
+    ``ValueError`` naming it), for the rest of the process."""
+    from sinterheat import threads
+
+    threads.use(threads.count() if args.threads is None else args.threads)
+
+
+def add_quiet_option(parser: argparse.ArgumentParser) -> None:
+    """``--quiet``: no progress bars; only the result and errors."""
+    parser.add_argument("--quiet", action="store_true", help="no progress bars: only the result and errors")
 
 
 def _scheduler(text: str) -> str:
@@ -156,6 +187,8 @@ def _main(argv, here, prog, description, modules, package) -> int:
     here.update(stage=args.command)
     with warnings.catch_warnings(record=True) as caught:
         try:
+            if hasattr(args, "threads"):
+                use_threads(args)
             with _cluster(args):
                 result = args.run(args)
         except (ValueError, OSError) as exc:  # bad input, or an output path that cannot be written

@@ -38,6 +38,7 @@ import multiprocessing
 import os
 import sys
 import threading
+import time
 import uuid
 from concurrent import futures as cf
 
@@ -46,6 +47,7 @@ from sinterheat.interrupt import ignore_interrupts, shielded, stop_pool, where
 INSTALL = "pip install '.[dask]' (in the repository; or pip install 'dask[distributed]')"  #: how to get Dask
 LOCAL = "local"  #: the ``--scheduler`` value that starts a LocalCluster on this machine
 CONNECT_TIMEOUT = 10.0  #: s to reach a scheduler before giving up
+POLL_INTERVAL = 0.02  #: s between looks at the Dask jobs' states (:meth:`DaskPool.wait`)
 _client = None  # the Dask client of the enclosing use_dask(), if any
 
 
@@ -79,8 +81,8 @@ def use_dask(scheduler, workers: int | None = None):
     if scheduler is None:
         yield None
         return
-    log = logging.getLogger("distributed")
-    level = log.level
+    logs = [logging.getLogger(name) for name in ("distributed", "tornado.application")]  # Dask and its event loop
+    levels = [log.level for log in logs]
     try:
         with contextlib.ExitStack() as stack:
             client = scheduler if not isinstance(scheduler, str) else _connect(stack, scheduler, workers)
@@ -88,12 +90,14 @@ def use_dask(scheduler, workers: int | None = None):
             try:
                 yield client
             except BaseException:
-                log.setLevel(logging.CRITICAL)
+                for log in logs:
+                    log.setLevel(logging.CRITICAL)
                 raise
             finally:
                 _client = previous
     finally:
-        log.setLevel(level)
+        for log, level in zip(logs, levels):
+            log.setLevel(level)
 
 
 def _connect(stack: contextlib.ExitStack, scheduler: str, workers: int | None):
@@ -209,9 +213,14 @@ class DaskPool:
         return future
 
     def wait(self, futures) -> set:
-        from distributed import wait
-
-        return set(wait(list(futures), return_when="FIRST_COMPLETED").done)
+        """The futures of ``futures`` that are done, once one is. Polled here rather than waited for in
+        ``distributed.wait``: a Ctrl-C that lands inside distributed's blocking call leaves its event loop a callback
+        that fails with a traceback on stderr; here it lands in ``time.sleep``."""
+        while True:
+            done = {future for future in futures if future.done()}  # the client's own state: no round trip
+            if done:
+                return done
+            time.sleep(POLL_INTERVAL)
 
     def __enter__(self):
         return self

@@ -7,6 +7,8 @@ from dataclasses import replace
 
 import pytest
 
+from sinterheat.threads import cores
+
 from benchmarks import mechanics
 
 TINY = mechanics.Sizes(disks=40, compaction_time=0.02, cells=(3, 3, 3), steps_2d=100, steps_3d=50, warmup=10,
@@ -117,11 +119,13 @@ def test_quick_path_on_tiny_sizes_writes_every_row(tmp_path):
     assert s["mechanics_compile_seconds"]["cached"] > 0
     assert s["thermal_only_engine_modules"] == []  # a thermal-only run loads no numba, no engine
     targets = {label: measured for label, measured, _ in section.targets}
-    assert sum(label.startswith("ours (") for label in targets) == 2
+    counts = [k for k in (1, 2) if k <= cores()]
+    assert sum(label.startswith("ours (") for label in targets) == 2 + (len(counts) > 1)  # Luding, linear; 2 cores
     assert all(targets[label] is None for label in targets if label.startswith("ours ("))  # not at full size
     assert targets["engine modules imported by a thermal-only run"] == 0
     assert [h for h, _, _ in section.texts] == ["The time loop: ours and LAMMPS side by side",
                                                 "Where our time goes (3D, Luding)",
+                                                "Every core: threads against MPI ranks",
                                                 "Compile cost and the Luding kernels",
                                                 "Thermal-only scenes keep their path",
                                                 "The whole sintering schedule"]
@@ -131,12 +135,19 @@ def test_quick_path_on_tiny_sizes_writes_every_row(tmp_path):
     assert {p.name for p in section.figures} == {"mechanics_loop.png"}
     rows = list(csv.DictReader((section.out_dir / "mechanics_loop.csv").open()))
     assert len(rows) == 3 + 2 * with_lammps
+    threaded = list(csv.DictReader((section.out_dir / "mechanics_threads.csv").open()))
+    ranks = [k for k in counts if mechanics.lammps_command(k) is not None]
+    assert [(r["run"], int(r["cores"])) for r in threaded] == [
+        *((f"ours, {law}, {k} thread{'s' * (k > 1)}", k) for k in counts for law in ("linear", "Luding")),
+        *((f"LAMMPS granular, {k} rank{'s' * (k > 1)}", k) for k in ranks)]
+    assert all(float(r["wall_ns_per_particle_step"]) > 0 for r in threaded)
+    assert all(r["threaded_loop"] == "False" for r in threaded if r["run"].startswith("ours"))  # 108: too few
     assert sorted(p.name for p in (tmp_path / "cache").iterdir()) == sorted(
         [f"biaxial_{mechanics.PREPARATION}_n40_t0.02_s1.npz", f"periodic_{mechanics.PREPARATION}_3x3x3_z6.5_s0.npz"])
 
 
 def test_lammps_rows_are_skipped_with_a_note_when_it_is_absent(tmp_path, monkeypatch):
-    monkeypatch.setattr(mechanics, "lammps_command", lambda: None)
+    monkeypatch.setattr(mechanics, "lammps_command", lambda ranks=1: None)
     section = StandInSection(tmp_path / "mechanics")
     mechanics.study_loop(section, replace(TINY, steps_2d=10, steps_3d=10), tmp_path / "cache")
     assert section.summary["lammps_ns_per_particle_step_3d"] is None

@@ -165,12 +165,13 @@ HOT_WALL = re.compile(
 
 @pytest.mark.slow
 def test_hot_wall_sintering_paragraph(tmp_path):
-    """The paragraph on the built-in hot-wall-sintering run (README and docs): a run of this code lies within the spread the
-    paragraph states for each figure (the packing is chaotic: round-off differences between machines grow into
-    different trajectories), and takes the step count it states."""
+    """The paragraph on the built-in hot-wall-sintering run (the guide's sintering page): a run of this code lies
+    within the spread the paragraph states for each figure (the packing is chaotic: round-off differences between
+    machines grow into different trajectories), and takes the step count it states."""
     pages = {page.relative_to(ROOT): HOT_WALL.search(page.read_text()) for page in PAGES}
     pages = {page: shown for page, shown in pages.items() if shown}
-    assert pathlib.Path("README.md") in pages, "README.md: the hot-wall-sintering paragraph moved or was reworded"
+    page = pathlib.Path("docs/guide/dem/sintering.md")
+    assert page in pages, f"{page}: the hot-wall-sintering paragraph moved or was reworded"
     env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
     proc = subprocess.run([sys.executable, "-m", "dem", "run", "hot-wall-sintering", "--json"], cwd=tmp_path, env=env,
                           stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, timeout=3600)

@@ -398,7 +398,8 @@ def test_cycle_dissipates_the_area_of_the_hysteresis_loop(dmax):
                            np.linspace(d0, 0.0, 101)[1:]])
     res = drive(list(path[1:]), params=p)
     force = np.array([0.0] + [r[0] for r in res])
-    assert np.trapezoid(force, path) == pytest.approx(0.5 * K1 * dmax * d0, rel=1e-12)
+    work = float(np.sum(np.diff(path) * (force[1:] + force[:-1]) / 2.0))  # the trapezoid rule (numpy 1.26 and 2)
+    assert work == pytest.approx(0.5 * K1 * dmax * d0, rel=1e-12)
     assert np.all(force[-100:] == 0.0)
     # the retreating force-free overlap drags delta_max down with it (as sqrt(delta_0): k2(x) -> k1 for small x)
     last = res[-2]

@@ -1,9 +1,10 @@
-"""The scene schema is one table: the parser checks every key against it, the README's key table is made from it,
-and keys the scene's engine does not read are refused, naming the engine."""
+"""The scene schema is one table: the parser checks every key against it, the documentation's schema page is made
+from it, and keys the scene's engine does not read are refused, naming the engine."""
 
 import copy
 import pathlib
 import re
+import sys
 from dataclasses import fields
 
 import pytest
@@ -17,19 +18,33 @@ from dem.scene.parse import GENERATOR_KEYS as KIND_KEYS
 from dem.scene.zohdi import ELECTRODE_KEYS, ZohdiStepping
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "docs" / "_ext"))
+
+import scene_schema  # noqa: E402  (the documentation's schema page: docs/_ext/scene_schema.py)
 
 
-def test_the_readme_key_table_is_the_schema():
-    text = (ROOT / "README.md").read_text()
-    table = re.search(r"<!-- schema-table:[^\n]*-->\n(.*?)<!-- /schema-table -->", text, re.S)
-    assert table, "README.md: no schema table between <!-- schema-table --> markers"
-    assert table.group(1) == schema.markdown(), "README.md's key table differs from dem.scene.schema.markdown()"
+def test_the_schema_page_shows_every_table_and_key():
+    """The documentation's schema page is the directive that renders the schema (docs/_ext/scene_schema.py): one
+    section per table, every key of it, and under ``[contact]`` every field of every contact law's material."""
+    from dem.laws.contact import CONTACT_LAWS, law_module
+
+    page = (ROOT / "docs" / "reference" / "dem" / "schema.md").read_text()
+    assert "```{scene-schema}\n```" in page, "docs/reference/dem/schema.md: the scene-schema directive went"
+    sections = dict(scene_schema.sections())
+    assert list(sections) == list(schema.TABLES)
+    for table in schema.TABLES:
+        missing = [key for key in schema.keys(table) if f"`{key}`" not in sections[table]]
+        assert not missing, (table, missing)
+    for name in CONTACT_LAWS:
+        missing = [f.name for f in fields(law_module(name).Material) if f"`{f.name}`" not in sections["contact"]]
+        assert f'`law = "{name}"`' in sections["contact"] and not missing, (name, missing)
 
 
-def test_every_row_of_the_key_table_has_its_five_cells():
+def test_every_row_of_the_key_tables_has_its_four_cells():
     """A bar in a meaning (Zohdi's |E|) is escaped: unescaped, it would end the cell and cut the meaning short."""
-    for line in schema.markdown().splitlines():
-        assert len(re.findall(r"(?<!\\)\|", line)) == 6, line
+    for table, text in scene_schema.sections():
+        for line in text.splitlines():
+            assert len(re.findall(r"(?<!\\)\|", line)) == 5, (table, line)
 
 
 @pytest.mark.parametrize("table, names", [

@@ -23,7 +23,8 @@ import os
 import sys
 
 from sinterheat.cli import OneLineParser
-from verification.report import add_run_options, enter_scheduler, prepare_out, print_report, run_sections
+from verification.report import (add_run_options, enter_scheduler, prepare_out, prepare_threads, print_report,
+                                 run_sections)
 
 PROG = "python -m verification"
 DEFAULT_OUT = "verification-results"
@@ -63,7 +64,7 @@ def _main(argv, here) -> int:
     args = build_parser().parse_args(argv)
     here.command = f"{PROG} {args.command}"
     out = prepare_out(f"{PROG} {args.command}", args.out)
-    if out is None:
+    if out is None or not prepare_threads(f"{PROG} {args.command}", args):
         return 2
     if args.no_progress:
         os.environ["TQDM_DISABLE"] = "1"  # also silences the sections' own bars (and those of worker processes)

@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sinterheat.cli import add_scheduler_option, print_result
+from sinterheat.cli import add_scheduler_option, add_threads_option, print_result, use_threads
 
 CONTRACT_KEYS = ("title", "markdown", "summary", "figures")
 OK, FAIL, ERROR, NOT_AVAILABLE, RUNNING, INTERRUPTED = "ok", "fail", "error", "not available", "running", \
@@ -415,14 +415,27 @@ def records_table(rows: list[dict], columns: list[str] | None = None, fmt: str =
 
 # --- the commands that write reports (python -m verification, python -m benchmarks) ---------------------------------
 def add_run_options(parser, default_out: str, quick_help: str) -> None:
-    """The options of a report command: ``--quick``, ``--out DIR``, ``--json``, ``--no-progress`` and
-    ``--scheduler`` (the sweeps' jobs on a Dask cluster, :mod:`sinterheat.pool`)."""
+    """The options of a report command: ``--quick``, ``--out DIR``, ``--json``, ``--no-progress`` (or ``--quiet``),
+    ``--threads`` (:func:`sinterheat.cli.add_threads_option`) and ``--scheduler`` (the sweeps' jobs on a Dask cluster,
+    :mod:`sinterheat.pool`)."""
     parser.add_argument("--quick", action="store_true", help=quick_help)
     parser.add_argument("--out", metavar="DIR", default=default_out, help=f"output folder (default: {default_out})")
     parser.add_argument("--json", action="store_true", help="print summary.json as one JSON object on stdout")
-    parser.add_argument("--no-progress", action="store_true",
+    parser.add_argument("--no-progress", "--quiet", action="store_true",
                         help="no progress bars on stderr (none of the sections' either)")
+    add_threads_option(parser)
     add_scheduler_option(parser)
+
+
+def prepare_threads(prog: str, args) -> bool:
+    """The threads of ``--threads`` (or ``SINTERHEAT_THREADS``) for the run (:func:`sinterheat.cli.use_threads`);
+    ``False`` after one line on stderr when the environment variable is bad (the caller exits 2)."""
+    try:
+        use_threads(args)
+    except ValueError as exc:
+        sys.stderr.write(f"{prog}: error: {exc}\n")
+        return False
+    return True
 
 
 def prepare_out(prog: str, out_text: str) -> pathlib.Path | None:

@@ -1,6 +1,8 @@
 """``python -m dem``: run a pipe-network thermal DEM scene, list the built-in scenes, drive one contact, or convert a
 packing (for LAMMPS).
 
+Usage::
+
     python -m dem run SCENE [--out DIR] [--json]     SCENE: a TOML file or a built-in name
     python -m dem scenes [--json]
     python -m dem laws [--json]                      the conductance laws a scene can select
@@ -18,5 +20,5 @@ COMMANDS = ("run", "scenes", "contact", "laws", "convert")
 
 
 def main(argv=None) -> int:
-    return cli.main(argv, prog="python -m dem", description=__doc__.splitlines()[0], modules=COMMANDS,
-                    package="dem.cli")
+    return cli.main(argv, prog="python -m dem", description=" ".join(__doc__.split("\n\n")[0].split()),
+                    modules=COMMANDS, package="dem.cli")

@@ -96,7 +96,7 @@ def check_overlaps(path, overlap, radius: float) -> None:
 
 def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> dict:
     """One pair contact of two equal particles of radius ``radius`` through the history (see the module
-    docstring); returns the per-row arrays named in :data:`OUTPUTS`."""
+    docstring); returns the per-row arrays named in ``OUTPUTS``."""
     from dem.laws.contact import luding as law
 
     params = material.params()

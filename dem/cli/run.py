@@ -1,13 +1,21 @@
-"""``python -m dem run SCENE [--out DIR [--resume | --overwrite]] [--json]``: run a scene (TOML path or built-in
-name), print its summary.
+"""``python -m dem run SCENE [--out DIR [--resume | --overwrite]] [--threads N] [--quiet] [--json]``: run a scene
+(TOML path or built-in name), print its summary.
 
 With ``--out`` the run writes its folder as it goes (``dem.output.folder``): a folder that holds a run already is
 refused unless ``--resume`` (go on from its last checkpoint, written every few seconds: a run with a fixed step ends
 bit for bit as if it had not stopped) or ``--overwrite`` (delete that run's files first). Ctrl-C stops the run with
-one line saying where, leaving the folder usable and resumable.
+one line saying where, leaving the folder usable and resumable. ``--threads N``: the compiled loops (and BLAS) on N
+threads, the same results on any number (default ``SINTERHEAT_THREADS``, else every core); ``--quiet``: no progress
+bar.
+
+Under ``mpiexec -n N`` (N > 1) a static scene runs on N ranks (:mod:`dem.engines.distributed`; PETSc options through
+``PETSC_OPTIONS``); rank 0 prints the summary and the one-line errors, the other ranks print nothing.
 """
 
-from sinterheat.cli import add_output_options
+import os
+import sys
+
+from sinterheat.cli import add_output_options, add_quiet_option, add_threads_option
 
 
 def register(sub):
@@ -16,6 +24,8 @@ def register(sub):
     add_output_options(parser)
     parser.add_argument("--resume", action="store_true", help="go on with the interrupted run in --out")
     parser.add_argument("--overwrite", action="store_true", help="delete the run already in --out first")
+    add_threads_option(parser)
+    add_quiet_option(parser)
     parser.set_defaults(run=run)
 
 
@@ -23,7 +33,13 @@ def run(args) -> dict:
     from dem.scene import load_scene
     from dem.driver import run as run_scene
     from dem.memory import available_bytes
+    from dem.network.comm import launched, launcher_rank
 
+    if launched() and launcher_rank() > 0:  # one summary, one error line: rank 0's
+        sys.stdout = sys.stderr = open(os.devnull, "w")
+
+    if args.quiet:  # no bar; the run keeps its position for the line an interrupt prints
+        os.environ["TQDM_DISABLE"] = "1"
     try:
         scene = load_scene(args.scene)
         return run_scene(scene, args.out, progress=True, resume=args.resume, overwrite=args.overwrite).summary

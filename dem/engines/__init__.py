@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import importlib
 
+#: The engines by name, each as ``module:class`` (imported when a scene runs it).
 ENGINES = {
     "static": "dem.engines.static:StaticEngine",
     "verlet": "dem.engines.verlet.engine:VerletEngine",

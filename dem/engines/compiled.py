@@ -11,6 +11,12 @@ module, which it cannot do for a loop made by a Python closure (a closure's comp
 by another process). The copies live in the cache folder of :mod:`dem.jit_cache`, named by the digest of the sources
 they come from, so an edit to a template or a law makes new ones; a law is copied and compiled only when a scene
 uses it.
+
+For more than one thread, ``module(law, template, threaded=True)`` is a copy (for every law, the template's own
+too) with the template's ``THREADED = False`` made true: a compile-time constant that turns its loops over particles
+and pairs into numba's parallel loops (numba drops the branches it rules out, so the one-thread loop carries nothing
+of the threaded one). Which of the two a run gets is decided when the engine is built
+(:func:`sinterheat.threads.count`), never inside the loop.
 """
 
 from __future__ import annotations
@@ -28,34 +34,38 @@ from dem.laws.contact import law_module_name
 TEMPLATES = ("dem.engines.contact_forces", "dem.engines.verlet.loop", "dem.engines.staggered.kernels")
 TEMPLATE_LAW = "dem.laws.contact.luding"
 LAW_IMPORT = "from dem.laws.contact import luding as law"
+SERIAL_FLAG, THREADED_FLAG = "\nTHREADED = False", "\nTHREADED = True"
 
 
-def _copy_name(law: str, template: str) -> str:
-    return f"_dem_compiled_{law}_{template.replace('.', '_')}"
+def _copy_name(law: str, template: str, threaded: bool) -> str:
+    return f"_dem_compiled_{law}{'_threaded' if threaded else ''}_{template.replace('.', '_')}"
 
 
-def _folder(law: str) -> pathlib.Path:
+def _folder(law: str, threaded: bool) -> pathlib.Path:
     base = pathlib.Path(os.environ.get("NUMBA_CACHE_DIR") or pathlib.Path(tempfile.gettempdir()) / "sinterheat-numba")
-    return base / f"specialised-{jit_cache.remembered_digest()}" / law
+    return base / f"specialised-{jit_cache.remembered_digest()}" / (f"{law}-threaded" if threaded else law)
 
 
-def module(law: str, template: str):
-    """The module ``template`` (one of :data:`TEMPLATES`) compiled for the contact law named ``law``."""
+def module(law: str, template: str, threaded: bool = False):
+    """The module ``template`` (one of ``TEMPLATES``) compiled for the contact law named ``law``; ``threaded``:
+    its copy for more than one thread (module docstring)."""
     law_path = law_module_name(law)
-    if law_path == TEMPLATE_LAW:
+    if law_path == TEMPLATE_LAW and not threaded:
         return importlib.import_module(template)
-    name = _copy_name(law, template)
+    name = _copy_name(law, template, threaded)
     if name in sys.modules:
         return sys.modules[name]
     source = pathlib.Path(importlib.util.find_spec(template).origin).read_text()
     if source.count(LAW_IMPORT) > 1:
         raise RuntimeError(f"{template}: imports its contact law more than once as {LAW_IMPORT!r}")
     source = source.replace(LAW_IMPORT, f"import {law_path} as law")
+    if threaded:
+        source = source.replace(SERIAL_FLAG, THREADED_FLAG)
     for other in TEMPLATES:
         if f"from {other} import" in source:
-            module(law, other)  # loaded first: the copy imports it by name
-            source = source.replace(f"from {other} import", f"from {_copy_name(law, other)} import")
-    path = _folder(law) / f"{template.rsplit('.', 1)[1]}.py"
+            module(law, other, threaded)  # loaded first: the copy imports it by name
+            source = source.replace(f"from {other} import", f"from {_copy_name(law, other, threaded)} import")
+    path = _folder(law, threaded) / f"{template.rsplit('.', 1)[1]}.py"
     if not path.exists() or path.read_text() != source:
         path.parent.mkdir(parents=True, exist_ok=True)
         part = path.with_name(f"{path.name}.{os.getpid()}.part")

@@ -59,7 +59,7 @@ class ContactCurrent:
 
     def refresh(self, mech, t: float = 0.0) -> np.ndarray:
         """The current at the state of the mechanics ``mech`` (at time ``t``, for messages): updates
-        :attr:`heating`."""
+        ``heating``."""
         lens = self.scheme == "zohdi"
         now, b = contact_bonds(self.particles, mech, mech.state.x, mech.state.T, self.electrodes.walls,
                                "lens" if lens else self.spec.contact, self.spec.out_of_range)
@@ -76,7 +76,7 @@ class ContactCurrent:
         else:
             G, G_w, share = bond_conductances(self.spec, now, b, self.sigma, shares=True)
             self.flow = kirchhoff(n, b.i, b.j, G, share, b.wall_particle, b.wall_index, G_w, self.electrodes,
-                                  self.linear)
+                                  self.linear, previous=None if self.flow is None else self.flow.solver)
             driven = [name for name in self.flow.no_path
                       if self.electrodes.current[self.electrodes.names.index(name)] != 0.0]
             if driven:

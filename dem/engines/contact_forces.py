@@ -15,13 +15,21 @@ wall is the partner j with an infinite radius, moving along its normal. A pair a
 than the law's ``reach``, a particle-wall pair while closer than its ``wall_reach`` (0: while they overlap; an
 adhesive law holds a contact beyond touching until it breaks); the laws whose particles do not rotate
 (``law.SPINS`` false) get no torques.
+
+Threads: in the copies of this module for more than one thread (:mod:`dem.engines.compiled`) ``THREADED`` is
+true and the loop runs on all of numba's threads in conflict-free passes: every pair's force and torque arms into a
+row of its own (``load``), then every particle sums the rows of its pairs (:func:`incident_pairs`) in the order of
+the list. That is the order in which the one-thread loop adds them into each particle, so the results are the same
+to the bit on any number of threads. The flag is a compile-time constant: the one-thread loop carries nothing of
+the threaded one.
 """
 
 from __future__ import annotations
 
 import math
 
-from numba import njit
+import numpy as np
+from numba import njit, prange
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from dem.geometry.neighbours import min_image
@@ -33,11 +41,34 @@ from dem.laws.contact import luding as law
 # numbers stays the IEEE one.
 FINITE_MATH = {"nnan", "ninf", "nsz"}
 N_PARAMS = law.N_PARAMS
+THREADED = False  # True in the copies for more than one thread (dem.engines.compiled)
+LOAD_COLUMNS = 9  # a pair's row of the threaded loop's buffer: g = f_n n + f_t (3), n x f_t (3), l_i, l_j, closed
 
 
-@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH)
+@njit(cache=True)
+def incident_pairs(pi, pj, n):
+    """Each particle's pairs in the order of the list, as ``(start, pairs)``: particle k's are
+    ``pairs[start[k]:start[k + 1]]``, ``c`` where k is the pair's i, ``~c`` (= -1 - c) where it is its j."""
+    start = np.zeros(n + 1, dtype=np.int64)
+    for c in range(pi.shape[0]):
+        start[pi[c] + 1] += 1
+        start[pj[c] + 1] += 1
+    for k in range(n):
+        start[k + 1] += start[k]
+    fill = start[:-1].copy()
+    pairs = np.empty(2 * pi.shape[0], dtype=np.int64)
+    for c in range(pi.shape[0]):
+        pairs[fill[pi[c]]] = c
+        fill[pi[c]] += 1
+        pairs[fill[pj[c]]] = ~c
+        fill[pj[c]] += 1
+    return start, pairs
+
+
+@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, parallel=THREADED)
 def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft,
-           wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True):
+           wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True, start=None,
+           pairs=None, load=None):
     """Forces and torques of the current state (gravity, the law's drag, pairs, the listed particle-wall pairs
     ``(wk, wm)``); the normal forces on the walls go into ``wforce``. Returns the index into the wall list of the
     first particle whose centre lies behind its wall, else -1.
@@ -51,12 +82,16 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
     The law's kernels are inlined right here, scalars and 3-tuples in and out, with the material as a tuple: an
     array argument costs an atomic reference count per call (a quarter of the loop). The length of ``spin_axes`` is
     part of its type, so 2D and 3D get code of their own, the 2D one without the terms that vanish (a fifth
-    faster)."""
+    faster).
+
+    Where ``THREADED`` (module docstring), ``start`` and ``pairs`` are the pairs by particle
+    (:func:`incident_pairs`) and ``load`` a ``(len(pi), LOAD_COLUMNS)`` buffer; the walls stay on one thread (a few
+    particles: the surface's)."""
     planar = len(spin_axes) == 1
     escaped = -1
     n = x.shape[0]
     params = to_fixed_tuple(params, N_PARAMS)
-    for k in range(n):
+    for k in prange(n):
         if law.DRAG:
             drag = law.drag(k, radius, params)
             f[k, 0] = mass[k] * gravity[0] - drag * v[k, 0]
@@ -69,7 +104,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         tau[k, 0] = 0.0
         tau[k, 1] = 0.0
         tau[k, 2] = 0.0
-    for c in range(pi.shape[0]):
+    for c in prange(pi.shape[0]):
         i, j = pi[c], pj[c]
         dx = min_image(x[i, 0] - x[j, 0], box[0])
         dy = 0.0 if planar else min_image(x[i, 1] - x[j, 1], box[1])
@@ -82,6 +117,8 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
             if record:
                 p_fn[c] = 0.0
                 p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = 0.0, 0.0, 0.0
+            if THREADED:
+                load[c, 8] = 0.0  # open: no load
             continue
         d = math.sqrt(d2)
         n0, n1, n2 = dx / d, dy / d, dz / d
@@ -101,6 +138,12 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
             p_fn[c] = f_n
             p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
         g0, g1, g2 = f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2
+        # torques -l n x f_t on both (the lever arms -l_i n and +l_j n, the forces f_t and -f_t)
+        m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
+        if THREADED:  # into the pair's row; its particles add it below
+            load[c, 0], load[c, 1], load[c, 2], load[c, 3], load[c, 4], load[c, 5] = g0, g1, g2, m0, m1, m2
+            load[c, 6], load[c, 7], load[c, 8] = li, lj, 1.0
+            continue
         f[i, 0] += g0
         f[i, 1] += g1
         f[i, 2] += g2
@@ -108,8 +151,6 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         f[j, 1] -= g1
         f[j, 2] -= g2
         if law.SPINS:
-            # torques -l n x f_t on both (the lever arms -l_i n and +l_j n, the forces f_t and -f_t)
-            m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
             tau[i, 1] -= li * m1
             tau[j, 1] -= lj * m1
             if not planar:
@@ -117,6 +158,27 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
                 tau[i, 2] -= li * m2
                 tau[j, 0] -= lj * m0
                 tau[j, 2] -= lj * m2
+    if THREADED:
+        for k in prange(n):  # each particle its pairs' rows, in the order of the list (as the loop above adds them)
+            for e in range(start[k], start[k + 1]):
+                c = pairs[e]
+                arm = 6 if c >= 0 else 7
+                c = c if c >= 0 else ~c
+                if load[c, 8] == 0.0:
+                    continue
+                if arm == 6:
+                    f[k, 0] += load[c, 0]
+                    f[k, 1] += load[c, 1]
+                    f[k, 2] += load[c, 2]
+                else:
+                    f[k, 0] -= load[c, 0]
+                    f[k, 1] -= load[c, 1]
+                    f[k, 2] -= load[c, 2]
+                if law.SPINS:
+                    tau[k, 1] -= load[c, arm] * load[c, 4]
+                    if not planar:
+                        tau[k, 0] -= load[c, arm] * load[c, 3]
+                        tau[k, 2] -= load[c, arm] * load[c, 5]
     n_w = wn.shape[0]
     for m in range(n_w):
         wforce[m] = 0.0

@@ -2,8 +2,9 @@
 contacts of the mechanical submodel, with necks that grow as the particles sinter.
 
 Every closed contact is a bond whose overlap is Rojek's ``h``: its neck radius comes from the scene's contact
-geometry (the volume-conserving neck, :func:`fem_neck.neck_radius`, by default) and its conductance from the scene's
-law, exactly as for a static packing (:func:`dem.geometry.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`);
+geometry (the volume-conserving neck, :func:`fem_neck.geometry.neck_radius`, by default) and its conductance from
+the scene's law, exactly as for a static packing (:func:`dem.geometry.bonds.find_bonds`,
+:func:`dem.laws.conductance.bond_conductances`);
 an overlap beyond the neck model's range stops the run with the contact named (or is clipped/dropped by
 ``conductance.out_of_range``). Walls that carry a temperature are isothermal planes bonded to the particles that
 touch them.

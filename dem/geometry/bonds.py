@@ -6,7 +6,7 @@ polydisperse packing never searches with twice the largest radius among its smal
 
 The contact radius ``a`` of a bond is given by the *contact geometry* that the conductance law asks for:
 
-* ``"newton"``, ``"first"``, ``"coble"`` -- the neck of :func:`fem_neck.neck_radius` (volume-conserving neck,
+* ``"newton"``, ``"first"``, ``"coble"`` -- the neck of :func:`fem_neck.geometry.neck_radius` (volume-conserving neck,
   Rojek 2022 eqs. 27-33, its first iterate eq. 34, or Coble's eqs. 11-12). Its range is
   ``0 < h <= max_overlap(r_i, r_j)``.
 * ``"lens"`` -- the intersection circle of the two spheres (Zohdi 2014, eqs. 7-12): ``a^2 = r_i^2 - L_i^2`` with
@@ -123,8 +123,8 @@ def candidate_pairs(position: np.ndarray, radius: np.ndarray) -> tuple[np.ndarra
 
 def periodic_pairs(position: np.ndarray, radius: np.ndarray, box: PeriodicBox) -> tuple:
     """All bonds ``(i, j, shift)`` with ``|x_j + shift L - x_i| < r_i + r_j`` in a periodic box: the overlaps among
-    the particles and their images near the faces (:meth:`PeriodicBox.images`), each bond once
-    (:func:`dem.geometry.periodic.canonical_bonds`)."""
+    the particles and their images near the faces (:meth:`~dem.geometry.periodic.PeriodicBox.images`), each bond
+    once (:func:`dem.geometry.periodic.canonical_bonds`)."""
     n = len(radius)
     points, owner, shift = box.images(position, 2.0 * float(radius.max()))
     p, q = candidate_pairs(points, radius[owner])

@@ -243,7 +243,7 @@ def _mean_size(radius: float, spread: float, dimension: int) -> float:
 
 def box_capacity(radius: float, spread: float, box, dimension: int = 3) -> int:
     """About how many particles :func:`random_box` can place at most in ``box``: the box's volume (area of the x-z
-    face for 2D disks) filled to the jamming fraction of random sequential addition (:data:`RSA_JAMMING`), over
+    face for 2D disks) filled to the jamming fraction of random sequential addition (``RSA_JAMMING``), over
     the particles' mean volume (area). An upper estimate: the box's faces and a finite number of attempts leave
     it emptier (about 0.30 for the spheres of ``hot-wall-sintering``)."""
     b = np.asarray(box, dtype=float)

@@ -93,12 +93,12 @@ class MotionState:
 
     @property
     def axes(self) -> tuple[int, ...]:
-        """The axes a particle translates along (2D: x and z)."""
+        """The axes a particle translates along (x and z in 2D)."""
         return (0, 2) if self.dimension == 2 else (0, 1, 2)
 
     @property
     def spin_axes(self) -> tuple[int, ...]:
-        """The axes a particle rotates about (2D: y)."""
+        """The axes a particle rotates about (y in 2D)."""
         return (1,) if self.dimension == 2 else (0, 1, 2)
 
     @property

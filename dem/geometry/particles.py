@@ -52,7 +52,7 @@ def check_unit_vector(name: str, value) -> np.ndarray:
 
 
 def check_temperature(name: str, value) -> float:
-    """``value`` as a finite temperature within :data:`TEMPERATURE_MAX`, else ``ValueError`` naming it."""
+    """``value`` as a finite temperature within ``TEMPERATURE_MAX``, else ``ValueError`` naming it."""
     if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
         raise ValueError(f"{name} = {value!r}: must be a finite number")
     return float(check_range(name, np.float64(value), None, TEMPERATURE_MAX))

@@ -6,7 +6,7 @@ every integer vector ``s`` that is zero on the non-periodic axes. A bond joins p
 The bond search (:func:`dem.geometry.bonds.find_bonds`) finds bonds across the boundary by adding the images of the particles
 near each periodic face (:meth:`PeriodicBox.images`), so that a periodic block gives the same bonds as an explicit
 larger block, for boxes of any size (a box shorter than a bond has a particle bonded to its own image). The
-neighbour list of moving particles can use the same :meth:`images` and :meth:`minimum_image`.
+neighbour list of moving particles can use the same :meth:`PeriodicBox.images` and :meth:`PeriodicBox.minimum_image`.
 
 A macroscopic temperature gradient through a periodic packing is a temperature *drop* per period:
 ``T(x + L_k e_k) = T(x) - drop_k``, so the image ``x_j + s L`` of particle ``j`` is at ``T_j - drop . s``
@@ -64,7 +64,7 @@ class PeriodicBox:
 
     @property
     def kernel_lengths(self) -> np.ndarray:
-        """The lengths with 0 on the non-periodic axes: the form the compiled kernels of moving particles take
+        """The lengths with 0 on the non-periodic axes -- the form the compiled kernels of moving particles take
         (``dem.geometry.neighbours.min_image``)."""
         return np.where(self.mask, self.lengths, 0.0)
 

@@ -36,7 +36,7 @@ def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pi, pj
     0) a pair is joined by the minimum image (:func:`dem.geometry.neighbours.min_image`).
 
     A lens beyond its range (a centre inside the other sphere's cap, ``L_i < 0``) is, by ``policy``
-    (:data:`LENS_POLICY`), clipped as ``find_bonds`` clips it (the smaller sphere's centre on the contact plane) or
+    (``LENS_POLICY``), clipped as ``find_bonds`` clips it (the smaller sphere's centre on the contact plane) or
     dropped (``K = 0``). Returns the number of contacts that ``policy`` cannot take (``"error"``: a lens beyond its
     range; any policy but ``"drop"``: coincident centres, a centre on or behind a wall), whose ``K`` is left 0:
     ``find_bonds`` then names the first and says what to do."""

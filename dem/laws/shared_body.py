@@ -9,7 +9,7 @@ body once per bond: a dense packing conducts less than the network says (FCC by 
 through small contacts ``c`` on its surface raises the temperature at contact ``b`` by ``sum_c R_bc Q_c`` (with
 ``sum Q = 0`` in steady state). For point contacts ``R_bc`` is the ball's Neumann function between two surface
 points at the angle ``gamma``; from its spherical-harmonic series, ``sum_(l>=1) (2l+1)/l P_l(cos gamma) /
-(4 pi kappa r)`` and the generating functions of ``P_l`` and ``P_l / l``,
+(4 pi kappa r)`` and the generating functions of ``P_l`` and ``P_l / l``::
 
     G(gamma) = (1/s - 2 - ln(s (1 + s))) / (4 pi kappa r),    s = sin(gamma / 2) = |n_b - n_c| / 2:
 

@@ -75,7 +75,8 @@ class CurrentFlow:
     of particles in groups that touch no electrode with a path; ``no_path``: names of fixed-current electrodes that
     reach no electrode at a fixed potential (they carry no current); ``residual``: the largest current imbalance at a
     particle relative to the largest contact current (or, when almost none flows, to 1e-12 of the largest electrode
-    conductance times the largest electrode potential).
+    conductance times the largest electrode potential). ``solver``: the linear solver of the particles' matrix, for
+    the next refresh to reuse (``kirchhoff(previous=...)``; None when no particle has a path).
     """
 
     potential: np.ndarray
@@ -89,6 +90,7 @@ class CurrentFlow:
     floating: np.ndarray
     no_path: tuple
     residual: float
+    solver: object = None
 
     @property
     def closed(self) -> bool:
@@ -116,11 +118,12 @@ def _grounded(n, i, j, plane_node, plane_index, electrodes: Electrodes):
 
 
 def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrodes: Electrodes,
-              linear: str = "auto") -> CurrentFlow:
+              linear: str = "auto", previous=None) -> CurrentFlow:
     """Potentials and currents of ``n`` particles joined by contacts ``(i, j)`` of conductance ``G`` (S; ``share``:
     the fraction of each contact's resistance on the side of i) and to the electrodes by ``(plane_node,
     plane_index)`` of conductance ``G_plane`` (module docstring). At least one electrode must be at a fixed
-    potential (the reference)."""
+    potential (the reference). ``previous``: the ``solver`` of an earlier solution of (about) the same network, whose
+    AMG hierarchy then serves again (:func:`dem.network.linsolve.make_solver`)."""
     i, j = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64)
     plane_node, plane_index = np.asarray(plane_node, dtype=np.int64), np.asarray(plane_index, dtype=np.int64)
     G, G_plane, share = (np.asarray(x, dtype=float) for x in (G, G_plane, share))
@@ -136,7 +139,7 @@ def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrod
     system = BoundedLaplacian(n, i, j, G, None, plane_node, plane_index, G_plane, n_e)
     subset = np.flatnonzero(on_particles)
     V = np.where(electrodes.fixed_potential, electrodes.potential, 0.0)
-    x0, solver = solve_anchored(system, system.plane_rhs(V), subset, linear)
+    x0, solver = solve_anchored(system, system.plane_rhs(V), subset, linear, previous=previous)
     potential = np.full(n, np.nan)
     potential[subset] = x0
     active = np.flatnonzero(driven & on_electrodes)
@@ -179,7 +182,7 @@ def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrod
     residual = float(np.max(np.abs(balance), initial=0.0)) / scale if scale > 0 else 0.0
     power = float(np.nansum(np.where(np.isfinite(electrode_potential), electrode_potential, 0.0) * electrode_current))
     return CurrentFlow(potential, pair_current, wall_current, electrode_potential, electrode_current, joule_particles,
-                       float(heat_pairs.sum() + heat_walls.sum()), power, floating, no_path, residual)
+                       float(heat_pairs.sum() + heat_walls.sum()), power, floating, no_path, residual, solver)
 
 
 def wall_values(n: int, plane_node, plane_index, values) -> tuple[np.ndarray, np.ndarray]:

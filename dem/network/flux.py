@@ -9,9 +9,9 @@ from numba import njit
 
 @njit(cache=True)
 def edge_flux(i, j, K, plane_node, plane_index, K_plane, x, x_planes, out):
-    """``out_k = -(L x)_k + sum_w K_kw (x_w - x_k)`` (:meth:`BoundedLaplacian.flux`): every edge's flow
-    ``K_c (x_i - x_j)`` leaves i and enters j, in the order of the edges; then every plane bond's flow
-    ``K_kw (x_k - x_w)`` leaves k."""
+    """``out_k = -(L x)_k + sum_w K_kw (x_w - x_k)`` (:meth:`~dem.network.laplacian.BoundedLaplacian.flux`):
+    every edge's flow ``K_c (x_i - x_j)`` leaves i and enters j, in the order of the edges; then every plane bond's
+    flow ``K_kw (x_k - x_w)`` leaves k."""
     for k in range(out.shape[0]):
         out[k] = 0.0
     for c in range(i.shape[0]):

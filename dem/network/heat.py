@@ -147,15 +147,17 @@ class Network:
     def rhs(self, sinks: dict) -> np.ndarray:
         return self.r_const + sum((b for _, b in sinks.values()), np.zeros(self.n_free))
 
-    def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
-        """Heat flow into the free particles (W) through each boundary at temperatures ``T_F``."""
-        out = {"fixed": float(self.fixed_rhs.sum() - self.fixed_diag @ T_F),
-               "walls": float(self.wall_rhs.sum() - self.wall_diag @ T_F),
-               "internal": float(self.heat.sum())}
+    def flows(self, T_F: np.ndarray, sinks: dict, rows=None) -> dict:
+        """Heat flow into the free particles (W) through each boundary at temperatures ``T_F``; ``rows``: into
+        those free particles only (a mask over them: a rank's own in a distributed run)."""
+        s = slice(None) if rows is None else rows
+        out = {"fixed": float(self.fixed_rhs[s].sum() - self.fixed_diag[s] @ T_F[s]),
+               "walls": float(self.wall_rhs[s].sum() - self.wall_diag[s] @ T_F[s]),
+               "internal": float(self.heat[s].sum())}
         for name, (g, b) in sinks.items():
-            out[name] = float(b.sum() - g @ T_F)
+            out[name] = float(b[s].sum() - g[s] @ T_F[s])
         if self.periodic:
-            out["periodic"] = float(self.periodic_rhs.sum())
+            out["periodic"] = float(self.periodic_rhs[s].sum())
         return out
 
     def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
@@ -166,12 +168,19 @@ class Network:
         those terms and a balance relative to them means nothing, so the scale is never taken below
         ``sqrt(eps) sum |K T|``: temperature differences below ~1e-8 of the temperatures count as no flow.
         """
-        pairs = [(self.fixed_diag, self.fixed_rhs), (self.wall_diag, self.wall_rhs), *sinks.values()]  # (g, b)
-        net = gross = float(np.abs(self.heat).sum() + np.abs(self.periodic_rhs).sum())
-        for g, b in pairs:
-            net += float(np.abs(b - g * T_F).sum())
-            gross += float(np.abs(b).sum() + np.abs(g * T_F).sum())
+        net, gross = self.flow_sums(T_F, sinks)
         return float(max(net, np.sqrt(np.finfo(float).eps) * gross))
+
+    def flow_sums(self, T_F: np.ndarray, sinks: dict, rows=None) -> tuple[float, float]:
+        """``(sum |flow|, sum |K T|)`` over the boundaries of the free particles (or of ``rows``, as in
+        :meth:`flows`): the two sums behind :meth:`flow_magnitude`."""
+        s = slice(None) if rows is None else rows
+        pairs = [(self.fixed_diag, self.fixed_rhs), (self.wall_diag, self.wall_rhs), *sinks.values()]  # (g, b)
+        net = gross = float(np.abs(self.heat[s]).sum() + np.abs(self.periodic_rhs[s]).sum())
+        for g, b in pairs:
+            net += float(np.abs(b[s] - g[s] * T_F[s]).sum())
+            gross += float(np.abs(b[s]).sum() + np.abs(g[s] * T_F[s]).sum())
+        return net, gross
 
     def full(self, T_F: np.ndarray) -> np.ndarray:
         T = self.particles.temperature.copy()
@@ -192,11 +201,12 @@ class Network:
 
 def build_network(particles: Particles, walls=(), spec=None, sources: Sources | None = None, *, pairs=None,
                   bonds: Bonds | None = None, box: PeriodicBox | None = None) -> Network:
-    """The thermal network of a packing in one call: bonds from the overlaps (:func:`dem.geometry.bonds.find_bonds`, with the
-    contact model and out-of-range policy of ``spec``), their conductances (:func:`dem.laws.conductance.
-    bond_conductances`, Rojek 2022 eqs. 5-9), and the assembled :class:`Network` holding both.
+    """The thermal network of a packing in one call: bonds from the overlaps (:func:`dem.geometry.bonds.find_bonds`,
+    with the contact model and out-of-range policy of ``spec``), their conductances
+    (:func:`~dem.laws.conductance.bond_conductances`, Rojek 2022 eqs. 5-9), and the assembled :class:`Network`
+    holding both.
 
-    ``walls`` are :class:`dem.laws.ambient.Wall` planes, ``spec`` a :class:`~dem.laws.conductance.ConductanceSpec`
+    ``walls`` are :class:`dem.geometry.walls.Wall` planes, ``spec`` a :class:`~dem.laws.conductance.ConductanceSpec`
     (default: the ``rojek`` law), ``sources`` the ambient exchange and ``pairs = (i, j)`` the pair bonds to use
     instead of searching for overlaps. ``bonds`` already found (e.g. to time the search apart) skip the search. To
     impose other pair conductances, replace them: ``dataclasses.replace(net, K_pairs=K)``. ``box``: a periodic box
@@ -316,7 +326,7 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
     solve_idx = np.flatnonzero(solve)
     T_sub = T_F[solve_idx]
     restrict = None if len(solve_idx) == net.n_free else solve_idx
-    iterations, backend = 0, "none"
+    iterations, backend, solver = 0, "none", None
     for iterations in range(1, max_newton + 1):
         T_F[solve_idx] = T_sub
         sinks = net.sinks(T_F)
@@ -325,7 +335,9 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
             A, r = A[restrict][:, restrict], r[restrict]
         if len(r) == 0:
             break
-        solver = make_solver(A, linear, net.base_diag if restrict is None else net.base_diag[restrict], rtol)
+        # Newton on radiation: the matrix changes on the diagonal only, the last AMG hierarchy serves again
+        solver = make_solver(A, linear, net.base_diag if restrict is None else net.base_diag[restrict], rtol,
+                             previous=solver)
         backend = solver.name
         T_new = solver.solve(r, T_sub)
         change = np.max(np.abs(T_new - T_sub)) if net.sources.radiation is not None else 0.0
@@ -389,7 +401,8 @@ class TransientResult:
 
 
 class _Stepper:
-    """Theta-method steps; the system solver is built once per step size (cached, least recently used dropped)."""
+    """Theta-method steps; the system solver is built once per step size (cached, least recently used dropped), and
+    where the matrix changes every step (radiation) the new step's solver reuses the cached one's AMG hierarchy."""
 
     def __init__(self, net: Network, theta: float, linear: str, rtol_linear: float):
         self.net, self.theta, self.linear, self.rtol_linear = net, theta, linear, rtol_linear
@@ -401,20 +414,22 @@ class _Stepper:
         self.history: list = []  # (T, dt) at the start of the last two accepted steps: warm starts for CG
         self._rate: tuple = (None, None)
 
-    def _solver(self, dt: float, A: sp.csr_matrix, reuse: bool):
-        key = dt if reuse else None
-        if key is not None and key in self._cache:
-            self._cache[key] = self._cache.pop(key)  # most recently used last
-            return self._cache[key]
+    def _solver(self, dt: float, A: sp.csr_matrix, same_matrix: bool):
+        """The solver of the step size ``dt``: the cached one when the matrix is that of the last step of this size
+        (``same_matrix``: no radiation), else one for the new matrix, which reuses the cached one's AMG hierarchy
+        (radiation's linearisation changes the diagonal a little from step to step)."""
+        last = self._cache.pop(dt, None)
+        if last is not None and same_matrix:
+            self._cache[dt] = last  # most recently used last
+            return last
         M = A * self.theta
         M = (M + sp.diags(self.net.C / dt)).tocsr()
-        solver = make_solver(M, self.linear, self.net.base_diag * self.theta, self.rtol_linear)
-        self.factorizations += 1
+        solver = make_solver(M, self.linear, self.net.base_diag * self.theta, self.rtol_linear, previous=last)
+        self.factorizations += 0 if getattr(solver, "reused", False) else 1
         self.backend = solver.name
-        if key is not None:
-            if len(self._cache) >= 8:
-                self._cache.pop(next(iter(self._cache)))
-            self._cache[key] = solver
+        if len(self._cache) >= 8:
+            self._cache.pop(next(iter(self._cache)))
+        self._cache[dt] = solver
         return solver
 
     def guess(self, T: np.ndarray, dt: float) -> np.ndarray:
@@ -504,7 +519,7 @@ def step_tolerance(rtol: float, order: int) -> float:
     """Local error allowed per step (relative to the temperature range) for a global error of about ``rtol``.
 
     An order-q method whose steps each make a local error ``tau`` ends ``~ c tau^(q/(q+1))`` off (the steps shrink
-    with ``tau^(1/(q+1))``), so ``tau = min(rtol, k_q rtol^((q+1)/q))``; ``k_q`` (:data:`AUTO_LOCAL`) is calibrated
+    with ``tau^(1/(q+1))``), so ``tau = min(rtol, k_q rtol^((q+1)/q))``; ``k_q`` (``AUTO_LOCAL``) is calibrated
     on the decay of a pair and of a packing between plates (global errors 0.1-1 x rtol for rtol 1e-2 ... 1e-4).
     """
     return min(rtol, AUTO_LOCAL[order] * rtol ** ((order + 1) / order))

@@ -114,9 +114,9 @@ class BoundedLaplacian:
         return self._diags
 
     plane_diag = property(lambda self: self._diagonals()[0],
-                          doc="Per free node: the sum of its plane conductances.")
+                          doc="The sum of each free node's plane conductances.")
     fixed_diag = property(lambda self: self._diagonals()[1],
-                          doc="Per free node: the sum of its conductances to fixed nodes.")
+                          doc="The sum of each free node's conductances to fixed nodes.")
 
     def same_edges(self, i, j, plane_node, plane_index) -> bool:
         """Whether these edges and plane bonds are those of the assembled matrices (same order)."""
@@ -195,17 +195,18 @@ class BoundedLaplacian:
 
 
 def solve_anchored(system: BoundedLaplacian, rhs: np.ndarray, subset: np.ndarray | None = None, linear: str = "auto",
-                   rtol: float = 1e-12, solver=None):
+                   rtol: float = 1e-12, solver=None, previous=None):
     """Solve ``A x = rhs`` on the free nodes listed by ``subset`` (positions in ``system.free``; all when None),
     e.g. the anchored groups, where ``A`` is definite. Returns ``(x on the subset, solver)``; pass the solver back
-    to reuse its factorisation for another right-hand side of the same matrix."""
+    to reuse its factorisation for another right-hand side of the same matrix, or as ``previous`` for a matrix
+    that changed a little (its AMG hierarchy serves again, :func:`dem.network.linsolve.make_solver`)."""
     if subset is not None and len(subset) == 0:
         return np.zeros(0), solver
     if solver is None:
         A, diag = system.matrix(), system.laplacian_diagonal
         if subset is not None and len(subset) != len(system.free):
             A, diag = A[subset][:, subset], diag[subset]
-        solver = make_solver(A, linear, diag, rtol)
+        solver = make_solver(A, linear, diag, rtol, previous)
     r = rhs if subset is None or len(subset) == len(system.free) else rhs[subset]
     if len(r) == 0:
         return np.zeros(0), solver

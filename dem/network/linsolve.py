@@ -2,23 +2,28 @@
 
 ``make_solver(A, backend)`` returns an object with ``solve(b, x0=None) -> x`` for a fixed matrix, so a
 factorisation or a multigrid hierarchy is built once and reused for every right-hand side (every time step).
-Backends (:data:`BACKENDS`; a PETSc/MPI backend is one more entry with the same two methods):
+Backends (``BACKENDS``; a PETSc/MPI backend is one more entry with the same two methods):
 
 * ``"direct"`` -- sparse LU (SuperLU, symmetric mode with a minimum-degree ordering of ``A + A^T``); exact to
   round-off. Fill-in grows fast on 3D networks, so ``"auto"`` uses it for small systems only.
 * ``"cg"`` -- conjugate gradients with a Jacobi (diagonal) preconditioner. Converges in a handful of iterations
   when the capacity term ``C/dt`` dominates the diagonal (implicit steps of large packings).
 * ``"amg"`` -- conjugate gradients preconditioned by a smoothed-aggregation algebraic multigrid V-cycle (pyamg),
-  for large steady networks.
+  for large steady networks, with settings tuned for network matrices (:class:`AMGSolver`); a matrix that changed
+  a little since an earlier one of the same size (``make_solver(previous=...)``: a refresh, radiation's Newton and
+  time steps) is preconditioned by the earlier hierarchy, with no setup. ``python -m benchmarks dem`` times it
+  beside its previous settings and PETSc's CG with ML, hypre BoomerAMG and GAMG on the steady network of the
+  10^6-particle bench packing (section "DEM steady network: AMG side by side"; PETSc's rows where petsc4py
+  imports).
 
 ``"auto"`` (:func:`choose_backend`) looks at the diagonal dominance first: the Jacobi-scaled matrix has condition
 number at most ``1 + 2/rho`` with ``rho = min_i m_i / L_ii`` (``m_i`` the part of the diagonal beyond the
-Laplacian: ``C_i/dt`` in a time step). When that bound is at most :data:`JACOBI_MAX_CONDITION`, Jacobi-CG reaches a
+Laplacian: ``C_i/dt`` in a time step). When that bound is at most ``JACOBI_MAX_CONDITION``, Jacobi-CG reaches a
 relative residual of 1e-10 within about ``sqrt(4000)/2 ln(2 sqrt(4000) / 1e-10) ~ 880`` iterations (1000 are
-allowed), and it is chosen above :data:`JACOBI_MIN` unknowns (chains with conductances spread over 1e4 ... 1e12
+allowed), and it is chosen above ``JACOBI_MIN`` unknowns (chains with conductances spread over 1e4 ... 1e12
 at the bound took at most 504 iterations). The target is on the unscaled residual, which floating point may not
 reach on badly scaled systems: should CG fail, the matrix falls back to direct or AMG (:class:`AutoCGSolver`).
-Otherwise (steady networks, very large time steps) direct up to :data:`DIRECT_MAX` unknowns, AMG above.
+Otherwise (steady networks, very large time steps) direct up to ``DIRECT_MAX`` unknowns, AMG above.
 
 The thresholds come from timing the three backends on random sintered packings between fixed plates, steady and
 with the capacity term ``C/dt`` for steps of 1 to 1000 times the cheap explicit bound ``2 min C_i / L_ii``:
@@ -42,6 +47,12 @@ DIRECT_MAX = 5_000  # without diagonal dominance: direct up to this many unknown
 JACOBI_MIN = 1_000  # with diagonal dominance: Jacobi-CG above this many unknowns, direct below
 JACOBI_MAX_CONDITION = 4000.0  # diagonally dominant: Jacobi condition-number bound 1 + 2/rho at most this
 AMG_SEED = 0  # the random start vector of pyamg's spectral-radius estimates (AMGSolver)
+AMG_REUSE_GROWTH = 2.0  # a reused AMG hierarchy is dropped once a solve takes this x the most its own matrix took
+AMG_SMOOTHER = ("gauss_seidel", {"sweep": "symmetric"})  # one symmetric sweep before and after each coarse correction
+AMG_OPTIONS = {  # pyamg.smoothed_aggregation_solver's settings (AMGSolver): the finest level's smoother row-weighted
+    "symmetry": "hermitian", "max_coarse": 500, "improve_candidates": None, "presmoother": AMG_SMOOTHER,
+    "postsmoother": AMG_SMOOTHER,
+    "smooth": [("jacobi", {"omega": 1.8, "weighting": "local"})] + [("jacobi", {"omega": 4.0 / 3.0})] * 9}
 
 
 class SolverError(ValueError):
@@ -114,24 +125,110 @@ class PCGSolver:
                           f"\"direct\" or \"amg\"")
 
 
+def one_blas_thread():
+    """A context in which BLAS runs on one thread (threadpoolctl; the libraries are looked up once)."""
+    global _THREADPOOLS
+    if _THREADPOOLS is None:
+        from threadpoolctl import ThreadpoolController
+
+        _THREADPOOLS = ThreadpoolController()
+    return _THREADPOOLS.limit(limits=1, user_api="blas")
+
+
+_THREADPOOLS = None  # the ThreadpoolController of one_blas_thread, made when first needed
+
+
 class AMGSolver(PCGSolver):
-    """CG preconditioned by one smoothed-aggregation V-cycle (pyamg), hierarchy built once."""
+    """CG preconditioned by one smoothed-aggregation V-cycle (pyamg), hierarchy built once (``AMG_OPTIONS``).
+
+    Three things make it cheap on the network matrices (weighted graph Laplacians plus a positive diagonal):
+
+    * the prolongation smoother of the finest level weights each row by its Gershgorin row sum ``sum_j |A_ij|``
+      (pyamg's ``weighting="local"``) instead of estimating ``rho(D^-1 A)`` by restarted Arnoldi, which costs as
+      much as the rest of the setup on 10^6 unknowns. A Laplacian row sums to ``2 A_ii``, so ``omega = 1.8`` is
+      a damping of 0.9 / A_ii, next to pyamg's default ``4/3 / rho(D^-1 A) = 0.84`` (rho = 1.59 on the bench
+      packing). Coarse levels (pyamg holds them as BSR, whose ``abs`` is a Python loop) keep the default weighting;
+      their Arnoldi is cheap;
+    * the constant vector is the near-null space of a graph Laplacian as it is: no relaxation sweeps improve it;
+    * the coarse levels are converted from BSR with 1 x 1 blocks to CSR once built, and their Gauss-Seidel
+      smoothers set up again: pyamg's block Gauss-Seidel on 1 x 1 blocks takes four times the time of the scalar
+      kernel on the same entries (the same iterates to round-off);
+
+    and setup and solves run with one BLAS thread: the Arnoldi and the coarse solve call BLAS on vectors, whose
+    spinning threads multiplied the setup time by four on a loaded two-core machine.
+
+    ``hierarchy_of``: the solver of an earlier matrix of the same size (the same network refreshed, the next Newton
+    or time step), whose hierarchy then preconditions this one, with no setup. A fixed V-cycle with symmetric
+    smoothing is a symmetric positive definite operator, a valid CG preconditioner for any SPD matrix, and CG
+    stops on this matrix's own residual: the criterion is the same as with a fresh hierarchy, only the iterations
+    may grow (:meth:`solve` bounds them).
+    """
 
     name = "amg"
 
-    def _preconditioner(self):
-        import pyamg
+    def __init__(self, A: sp.spmatrix, rtol: float = 1e-12, max_iterations: int | None = None,
+                 hierarchy_of: "AMGSolver | None" = None):
+        # an earlier matrix's solver whose hierarchy preconditions (reuse): the one that built it, so that a chain of
+        # reuses holds one earlier matrix, not all of them
+        self.hierarchy_of = hierarchy_of if hierarchy_of is None else (hierarchy_of.hierarchy_of or hierarchy_of)
+        super().__init__(A, rtol, max_iterations)
+        self.fresh_max_iterations = self.max_iterations
+        self.fresh_iterations = None  # the most iterations a solve on this matrix's own hierarchy took (bounds reuses)
 
-        # pyamg estimates the spectral radius behind its smoothers' weights by Arnoldi from a random vector of numpy's
-        # global generator: seeded here (and the caller's generator state restored), so that a solve is the same on
-        # every run, to the bit
+    @property
+    def reused(self) -> bool:
+        """Whether the hierarchy preconditioning this matrix is an earlier matrix's."""
+        return self.hierarchy_of is not None
+
+    def _preconditioner(self):
+        if self.hierarchy_of is not None:
+            self.hierarchy = self.hierarchy_of.hierarchy
+            return self.hierarchy_of.precondition
+        import pyamg
+        from pyamg.relaxation.smoothing import change_smoothers
+
+        # pyamg estimates the spectral radius behind the coarse levels' weights by Arnoldi from a random vector of
+        # numpy's global generator: seeded here (and the caller's generator state restored), so that a solve is
+        # the same on every run, to the bit
         state = np.random.get_state()
         np.random.seed(AMG_SEED)
         try:
-            self.hierarchy = pyamg.smoothed_aggregation_solver(self.A, symmetry="hermitian", max_coarse=500)
+            with one_blas_thread():
+                self.hierarchy = pyamg.smoothed_aggregation_solver(self.A, **AMG_OPTIONS)
         finally:
             np.random.set_state(state)
+        for level in self.hierarchy.levels:
+            level.A = level.A.tocsr()
+            if hasattr(level, "P"):
+                level.P, level.R = level.P.tocsr(), level.R.tocsr()
+        change_smoothers(self.hierarchy, AMG_SMOOTHER, AMG_SMOOTHER)
         return self.hierarchy.aspreconditioner(cycle="V")
+
+    def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
+        """CG to the criterion. A reused hierarchy (``hierarchy_of``) that needs more than ``AMG_REUSE_GROWTH``
+        times the most iterations a solve on its own matrix took (plus one) is dropped there and a fresh one built
+        for this matrix, which then solves from ``x0`` again."""
+        with one_blas_thread():
+            if not self.reused:
+                return self._own_solve(b, x0)
+            fresh = self.hierarchy_of.fresh_iterations
+            self.max_iterations = (self.fresh_max_iterations if fresh is None
+                                   else int(AMG_REUSE_GROWTH * fresh) + 1)
+            try:
+                return super().solve(b, x0)
+            except SolverError:
+                self.hierarchy_of = None
+                self.precondition = self._preconditioner()
+                self.max_iterations = self.fresh_max_iterations
+                return self._own_solve(b, x0)
+
+    def _own_solve(self, b, x0):
+        """A solve on the hierarchy of this matrix; the most iterations one took bound those of a reuse."""
+        before = self.iterations
+        x = super().solve(b, x0)
+        if self.iterations > before:  # a zero right-hand side or a converged start says nothing
+            self.fresh_iterations = max(self.fresh_iterations or 0, self.iterations - before)
+        return x
 
 
 BACKENDS = {"direct": DirectSolver, "cg": PCGSolver, "amg": AMGSolver}
@@ -167,12 +264,16 @@ def choose_backend(A: sp.spmatrix, laplacian_diagonal: np.ndarray) -> str:
 
 
 def make_solver(A: sp.spmatrix, backend: str = "auto", laplacian_diagonal: np.ndarray | None = None,
-                rtol: float = 1e-12):
-    """A solver for the SPD matrix ``A`` (module docstring)."""
+                rtol: float = 1e-12, previous=None):
+    """A solver for the SPD matrix ``A`` (module docstring). ``previous``: the solver of an earlier matrix of the same
+    size that changed little since (a refreshed network, the next Newton or time step); when both are AMG, its
+    hierarchy preconditions ``A`` (no setup; :class:`AMGSolver`, ``hierarchy_of``)."""
     if backend == "auto":
         backend = choose_backend(A, A.diagonal() if laplacian_diagonal is None else laplacian_diagonal)
         if backend == "cg":
             return AutoCGSolver(A, rtol, "direct" if A.shape[0] <= DIRECT_MAX else "amg")
     if backend not in BACKENDS:
         raise ValueError(f"solver.linear = {backend!r}: must be one of auto, {', '.join(BACKENDS)}")
+    if backend == "amg" and isinstance(previous, AMGSolver) and previous.A.shape == A.shape:
+        return AMGSolver(A, rtol=rtol, hierarchy_of=previous)
     return BACKENDS[backend](A, rtol=rtol)

@@ -1,6 +1,6 @@
 """A run's output folder: one run per folder, checkpoints while it runs, resumed where it stopped.
 
-* A folder that already holds a run (:data:`RUN_FILES`) is refused unless the run is resumed (``resume``: go on
+* A folder that already holds a run (``RUN_FILES``) is refused unless the run is resumed (``resume``: go on
   from its last checkpoint) or cleared first (``overwrite``: the run's own files are deleted, nothing else). So two
   runs never mix their rows and snapshots.
 * While a transient run goes, :class:`Checkpointer` keeps the state between two steps (or intervals) and writes it
@@ -18,7 +18,8 @@ import time
 import numpy as np
 
 CHECKPOINT = "checkpoint.npz"
-RUN_FILES = ("summary.json", "timeseries.csv", "profiles.csv", CHECKPOINT, "state.npz", "*.pvd", "*.vtu", "*.png")
+RUN_FILES = ("summary.json", "timeseries.csv", "profiles.csv", CHECKPOINT, "state.npz", "*.pvd", "*.vtu", "*.pvtu",
+             "*.png")
 
 
 def scene_digest(scene) -> str:

@@ -133,7 +133,7 @@ def format_of(path) -> str:
 
 def read_packing(path, format: str | None = None, length_unit: float = 1.0, timestep: int | None = None,
                  periodic=None) -> Packing:
-    """The packing in the file ``path`` (module docstring). ``format``: one of :data:`FORMATS` (default: from the
+    """The packing in the file ``path`` (module docstring). ``format``: one of ``FORMATS`` (default: from the
     name); ``length_unit``: metres per length unit of the file; ``timestep``: the snapshot of a dump (default: the
     last); ``periodic``: the periodic axes, as ``"xyz"``-letters or three bools, for files that do not record them
     (a LAMMPS data file) or to override them."""

@@ -150,7 +150,7 @@ class Scene:
 
     @property
     def start_time(self) -> float:
-        """The time the run starts at: the saved state's, or 0."""
+        """The time the run starts at -- the saved state's, or 0."""
         return 0.0 if self.start is None else self.start["t"]
 
 
@@ -158,7 +158,7 @@ PHYSICS = ("thermal", "mechanical", "electrical")  # the submodels a scene can n
 
 
 def check_physics(names) -> None:
-    """Every name a submodel that exists (:data:`PHYSICS`); ``electrical`` runs with moving particles."""
+    """Every name a submodel that exists (``PHYSICS``); ``electrical`` runs with moving particles."""
     for name in names:
         if name not in PHYSICS:
             raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(PHYSICS)})")

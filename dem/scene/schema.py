@@ -1,6 +1,6 @@
 """The scene schema: every table and key of a scene, its type and default, its unit, and which engine reads it -- the
-one table the parser checks a scene against (:func:`check`), the README's and the documentation's key tables are made
-from (:func:`markdown`), and a test holds them together.
+one table the parser checks a scene against (:func:`check`) and the documentation's schema page is made from
+(:func:`display_rows`, rendered by ``docs/_ext/scene_schema.py``).
 
 Engines (:mod:`dem.engines`): ``static`` (a packing that does not move), ``verlet`` (particles that move, velocity
 Verlet) and ``staggered`` (Zohdi 2014's implicit scheme). A key the scene's engine does not read is refused, naming the
@@ -164,7 +164,8 @@ ROWS = (
         "relative to the temperature range (initial, fixed, wall and ambient temperatures); measured on decaying "
         "pairs, chains and a 2048-particle packing: 0.06-1 × `rtol` for rtol 1e-2 … 1e-4"),
     Row("solver", ("linear",), ALL, '`"auto"`', '`"direct"` (sparse LU), `"cg"` (Jacobi-CG), `"amg"` '
-        "(pyamg-preconditioned CG); auto: Jacobi-CG above 1 000 unknowns when the time step's capacity term C/dt "
+        "(pyamg-preconditioned CG; its multigrid hierarchy reused while the matrix changes a little: radiation's "
+        "Newton and time steps, Kirchhoff refreshes); auto: Jacobi-CG above 1 000 unknowns when the time step's capacity term C/dt "
         "makes the matrix diagonally dominant enough (Jacobi condition bound ≤ 4000), otherwise direct up to 5 000 "
         'unknowns and AMG above (`python -m benchmarks dem`, "DEM linear solvers")'),
     Row("solver", ("floating",), STATIC, '`"error"`', 'steady: groups of particles with no fixed temperature, wall '
@@ -276,28 +277,20 @@ def law_rows() -> tuple:
     return tuple(out)
 
 
-def _cell(text: str) -> str:
-    """``text`` in a cell of a Markdown table: its bars (``|E|``) escaped, which would otherwise end the cell."""
-    return text.replace("|", "\\|")
-
-
-def markdown() -> str:
-    """The schema as a Markdown table (table, keys, engines, type/default and unit, meaning), the contact laws'
-    materials after the ``[contact]`` table's own row."""
-    lines = ["| table | key | engines | type / default | meaning |", "|---|---|---|---|---|"]
-    last = None
+def display_rows() -> list[tuple[str, str, str, str, str]]:
+    """Every row as the key tables show it, cells in Markdown: ``(table, keys, engines, type / default and unit,
+    meaning)``, the contact laws' materials after the ``[contact]`` table's own row and the fields a phase may change
+    after the ``[[phases]]`` keys."""
     rows = []
     for row in ROWS:
         rows.append(row)
         if row.table == "contact":
             rows.extend(law_rows())
+    out = []
     for row in rows:
-        name = f"`[[{row.table}]]`" if row.table in ARRAYS else f"`[{row.table}]`"
-        lines.append(f"| {name if row.table != last else ''} | {', '.join(f'`{k}`' for k in row.keys)} | "
-                     f"{ENGINE_WORDS.get(row.engines, ', '.join(row.engines))} | {_cell(row.type)} | "
-                     f"{_cell(row.meaning)} |")
-        last = row.table
+        engines = ENGINE_WORDS.get(row.engines, ", ".join(row.engines))
+        out.append((row.table, ", ".join(f"`{k}`" for k in row.keys), engines, row.type, row.meaning))
         if row.table == "phases" and row.keys == ("wall_velocity",):
-            lines.append("|  | a field of the contact law's material but `density` | verlet | as in `[contact]` | its "
-                         "value from `start` on (Luding 2005: the friction `mu` switched on at t_heat) |")
-    return "\n".join(lines) + "\n"
+            out.append(("phases", "a field of the contact law's material but `density`", "verlet", "as in `[contact]`",
+                        "its value from `start` on (Luding 2005: the friction `mu` switched on at t_heat)"))
+    return out

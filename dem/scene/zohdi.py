@@ -39,7 +39,7 @@ class ZohdiStepping:
     temperatures) in a target of ``iterations`` (K_d) iterations, the exponent ``order`` (p of eq. 30, 2 for this
     second-order system), the first step ``dt`` and its upper bound ``dt_max`` (Delta t_lim) and, beyond the paper,
     bounds on the step factor Phi: an accepted step grows by at most ``growth`` (>= 1), a restart shrinks it by at
-    least ``shrink`` (in [LEAST_FACTOR, 1)) and at most :data:`LEAST_FACTOR` -- eq. (30) assumes the error falls as
+    least ``shrink`` (in [LEAST_FACTOR, 1)) and at most ``LEAST_FACTOR`` -- eq. (30) assumes the error falls as
     ``(S dt^p)^K``; where an iteration stalls instead (a force that is steep in the velocity, such as friction below
     ``v_slip``), Phi of a failed step is close to 1 and the restarts would creep -- and a floor ``dt_min`` below
     which a step that cannot converge stops the run."""
@@ -94,7 +94,7 @@ class ZohdiStepping:
         return min(self.growth, max(LEAST_FACTOR, phi))
 
     def restart_factor(self, phi: float) -> float:
-        """The factor of a restarted step: Phi_K, but at least ``shrink`` and at most :data:`LEAST_FACTOR`."""
+        """The factor of a restarted step: Phi_K, but at least ``shrink`` and at most ``LEAST_FACTOR``."""
         return max(LEAST_FACTOR, min(phi, self.shrink))
 
 

@@ -20,7 +20,7 @@ temperature change below 1e-12 of the temperatures) counts as none, and a step b
 converge stops the run. Steps end exactly on the start of every ``[[phases]]`` entry (a wall changing speed) and on
 ``t_end``.
 
-The simulation offers what the outputs ask of an engine (:class:`dem.output.writer.MotionWriter`): ``record()``,
+The simulation offers what the outputs ask of an engine (:class:`dem.output.writer.RunWriter`): ``record()``,
 ``particle_fields()``, ``contact_fields()``, ``profile()``, ``summary()`` and ``mechanics.state``.
 """
 

@@ -30,7 +30,7 @@ def iterate(dt, phi, x_L, v_L, f_L, x_prev, v_prev, T, mass, radius, gravity, pi
 
     ``stats`` receives ``sum |r^K - r^(K-1)|``, ``sum |r^K - r^L|`` (Algorithm 1, step 4a), the largest distance of
     any particle from ``x_ref`` (where the Verlet list was built) and a NaN flag. Returns the escaped wall pair index
-    of :func:`forces` (-1 if none)."""
+    of :func:`~dem.engines.contact_forces.forces` (-1 if none)."""
     escaped = forces(x_prev, v_prev, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in,
                      p_hist, p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt)
     change, motion, reach, finite = 0.0, 0.0, 0.0, 1.0

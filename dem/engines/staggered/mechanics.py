@@ -142,7 +142,7 @@ class StaggeredMechanics:
 
     # --------------------------------------------------------------------------------------------- walls
     def wall_offsets(self, t: float, dt: float) -> np.ndarray:
-        """Where the walls are at ``t + dt`` when the step starts at ``t`` with them at :attr:`q_start`."""
+        """Where the walls are at ``t + dt`` when the step starts at ``t`` with them at ``q_start``."""
         w = self.w
         q = self.q_start.copy()
         strain = w.mode == MOTIONS["strain"]
@@ -168,7 +168,7 @@ class StaggeredMechanics:
 
     def iterate(self, dt: float, phi: float, T: np.ndarray) -> tuple[float, float]:
         """One fixed-point iteration at the temperatures ``T`` (those of the previous iterate): the new iterate is
-        :attr:`x_new`, :attr:`v_new`. Returns ``(sum |r^K - r^(K-1)|, sum |r^K - r^L|)``."""
+        ``x_new``, ``v_new``. Returns ``(sum |r^K - r^(K-1)|, sum |r^K - r^L|)``."""
         s, w = self.state, self.w
         escaped = self._iterate(dt, phi, s.x, s.v, self.f, self.x_prev, self.v_prev, T, s.mass, s.radius,
                                 self.gravity, self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn, self.p_ft,

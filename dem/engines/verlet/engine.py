@@ -42,6 +42,7 @@ class VerletEngine:
 
     name = "verlet"
     link_kind = "contacts"
+    mechanics_class = MechanicalModel  # the particles of one process (the ranks engine sets its own)
 
     def __init__(self, scene, restart: dict | None = None):
         """``restart``: a checkpoint of this scene's run (:meth:`checkpoint` as loaded by
@@ -63,8 +64,8 @@ class VerletEngine:
             for key in ("x", "v", "w", "f", "tau", "mass", "inertia", "radius", "radius_ref", "T"):
                 setattr(state, key, np.ascontiguousarray(saved[key], dtype=float).copy())
         self.material = material
-        self.mechanics = MechanicalModel(state, m.walls, material, m.dt, m.skin, m.gravity, scene.box,
-                                         relaxation_time=m.relaxation_time, history=saved)
+        self.mechanics = self.mechanics_class(state, m.walls, material, m.dt, m.skin, m.gravity, scene.box,
+                                              relaxation_time=m.relaxation_time, history=saved)
         self.thermal = None
         if "thermal" in scene.physics:
             self.thermal = ContactThermalModel(p, m.walls, scene.conductance, scene.sources, m.thermal_integrator,

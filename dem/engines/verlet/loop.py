@@ -17,20 +17,23 @@ step:
 4. second half kick (velocities at the end of the step); stress-controlled walls from eq. 1.
 
 Like :mod:`dem.engines.contact_forces`, this module is written against the contact law imported as ``law`` and
-copied for every other law by :mod:`dem.engines.compiled`.
+copied for every other law by :mod:`dem.engines.compiled`; in the copies for more than one thread ``THREADED``
+is true: the loops over particles and the force pass run on all of numba's threads, with the same results to the
+bit (:mod:`dem.engines.contact_forces`).
 """
 
 from __future__ import annotations
 
 import math
 
-from numba import njit
+from numba import njit, prange
 
 from dem.engines.contact_forces import forces
 from dem.geometry.neighbours import min_image
 from dem.laws.contact import luding as law
 
 DONE, REBUILD, NONFINITE, ESCAPED = 0, 1, 2, 3  # how a call of advance() ended
+THREADED = False  # True in the copies for more than one thread (dem.engines.compiled)
 
 
 @njit(cache=True, error_model="numpy")
@@ -46,22 +49,25 @@ def wall_acceleration(m, wq, wdq, wmode, wpress, wmass, wdamp, wspan, wforce):
     return (wpress[m] * extent - wforce[m] - wdamp[m] * wdq[m]) / wmass[m]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", parallel=THREADED)
 def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spin_axes, radius, radius_ref, T0, T_rate,
-            T, state, uniform_T, t0, gravity, box, pi, pj, p_hist, p_fn, p_ft,
+            T, state, uniform_T, t0, gravity, box, pi, pj, p_hist, p_fn, p_ft, start, pairs, load,
             wn, wq, wdq, wacc, wmode, wpress, wmass, wdamp, wq0, wamp, wfreq, wspan, wforce, wk, wm, wq_ref,
             w_hist, w_fn, w_ft, params, x_ref, skin, info):
     """Up to ``n_steps`` velocity-Verlet steps (module docstring) from global step ``step0`` (t = step0 dt) of an
     interval that began at step ``first`` with temperatures ``T0`` (``T0 + T_rate (t - first dt)`` after it): times
     come from step counts, so where a run is split into calls (rebuilds, a resume) never changes its arithmetic.
     ``f``/``tau``/``wacc`` must hold the forces of the current state on entry. Returns ``(steps done, status)``;
-    ``info`` receives the particle (and wall) index of a non-finite or escaped particle."""
+    ``info`` receives the particle (and wall) index of a non-finite or escaped particle (the first such). ``start``,
+    ``pairs``, ``load``: the pairs by particle and the buffer of the threaded force pass (used where
+    ``THREADED``)."""
     n = x.shape[0]
     n_w = wn.shape[0]
     h = 0.5 * dt
     for s in range(n_steps):
         t = (step0 + s) * dt
-        for k in range(n):
+        bad = n
+        for k in prange(n):
             im, ii = 1.0 / mass[k], 1.0 / inertia[k]
             moved = 0.0
             for a in axes:
@@ -72,8 +78,14 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
                 w[k, a] += h * tau[k, a] * ii
                 moved += abs(w[k, a])
             if not moved < math.inf:  # NaN or inf: name the particle before its neighbours are contaminated
-                info[0] = k
-                return s + 1, 2
+                if THREADED:  # (a parallel loop cannot return: the first such particle, after it)
+                    bad = min(bad, k)
+                else:
+                    info[0] = k
+                    return s + 1, 2
+        if THREADED and bad < n:
+            info[0] = bad
+            return s + 1, 2
         for m in range(n_w):
             if wmode[m] == 1:
                 wdq[m] += h * wacc[m]
@@ -88,9 +100,9 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
                              params, t0, dt)
         escaped = forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist,
                          p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params, dt,
-                         s == n_steps - 1)
+                         s == n_steps - 1, start, pairs, load)
         worst = 0.0
-        for k in range(n):
+        for k in prange(n):
             im, ii = 1.0 / mass[k], 1.0 / inertia[k]
             d2 = 0.0
             for a in axes:
@@ -100,9 +112,15 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
             for a in spin_axes:
                 w[k, a] += h * tau[k, a] * ii
             if not (d2 < math.inf):  # NaN or inf
-                info[0] = k
-                return s + 1, 2
+                if THREADED:
+                    bad = min(bad, k)
+                else:
+                    info[0] = k
+                    return s + 1, 2
             worst = max(worst, d2)
+        if THREADED and bad < n:
+            info[0] = bad
+            return s + 1, 2
         wall_moved = 0.0
         for m in range(n_w):
             if wmode[m] == 1:

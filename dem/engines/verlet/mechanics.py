@@ -6,6 +6,12 @@ the list (when some particle has moved more than half the skin), at the times th
 update, a change of schedule), or to stop a run that went wrong (a non-finite position, a particle through a wall)
 with a one-line message naming the step and the particle.
 
+Threads: with more than one (:func:`sinterheat.threads.count`) and at least ``THREADED_MIN_PARTICLES``
+particles the model binds the threaded copy of the loop (:mod:`dem.engines.compiled`), which needs each particle's
+pairs in the order of the list (:func:`dem.engines.contact_forces.incident_pairs`, made at every rebuild); its
+results are those of one thread to the bit. Below that size a step is too short to share: the threads would cost
+more than they save.
+
 History: per pair in the list the numbers the law carries (``law.PAIR_HISTORY``; Luding 2005: the largest overlap,
 the stiffness factor the contact saw at its last step and the tangential spring), the same per particle-wall pair
 (``law.WALL_HISTORY``), and per particle the law's state (``law.PARTICLE_STATE``; Luding 2005: the stiffness factor
@@ -17,13 +23,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from sinterheat import threads
+
 from dem.engines import compiled
+from dem.engines.contact_forces import LOAD_COLUMNS, incident_pairs
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
 from dem.geometry.periodic import PeriodicBox
 from dem.geometry.walls import WallArrays
 from dem.laws.contact import law_module
+
+
+THREADED_MIN_PARTICLES = 2000
 
 
 class MechanicsError(ValueError):
@@ -46,7 +58,8 @@ class MechanicalModel:
         self.walls = tuple(walls)
         self.law = law_module(material.law)
         self._forces = compiled.module(material.law, "dem.engines.contact_forces").forces
-        self._advance = compiled.module(material.law, "dem.engines.verlet.loop").advance
+        self.threaded = threads.bind_numba() > 1 and state.n >= THREADED_MIN_PARTICLES
+        self._advance = compiled.module(material.law, "dem.engines.verlet.loop", self.threaded).advance
         self.params = np.ascontiguousarray(material.params(), dtype=float)
         self.dt = float(dt)
         self.skin = float(skin)
@@ -108,7 +121,18 @@ class MechanicalModel:
         else:
             self.p_hist, self.p_fn, self.p_ft = carry_history(self.pi, self.pj, i, j, self.p_hist, self.p_fn, self.p_ft)
             self.rebuilds += 1
+        self._listed(i, j)
+
+    def _listed(self, i: np.ndarray, j: np.ndarray):
+        """The pairs ``(i, j)`` as the list (with the threads' view of it), built at the positions of now."""
+        s = self.state
         self.pi, self.pj = i, j
+        if self.threaded:
+            self.pair_start, self.pair_order = incident_pairs(i, j, s.n)
+            self.pair_load = np.empty((len(i), LOAD_COLUMNS))
+        else:  # the one-thread loop reads none of them
+            self.pair_start, self.pair_order, self.pair_load = np.zeros(1, np.int64), np.zeros(0, np.int64), \
+                np.zeros((0, LOAD_COLUMNS))
         self.x_ref = s.x.copy()
         self.walls_moved()
 
@@ -146,6 +170,7 @@ class MechanicalModel:
                 n_steps - done, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia,
                 s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.particle_state,
                 uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_fn, self.p_ft,
+                self.pair_start, self.pair_order, self.pair_load,
                 w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
                 w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_hist, self.w_fn, self.w_ft, self.params,
                 self.x_ref, self.skin, self._info)

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import importlib
 
+#: The contact laws by the name ``[contact] law`` gives, each as the module that implements it.
 CONTACT_LAWS = {
     "luding": "dem.laws.contact.luding",  # Luding, Manetsberger & Mueller 2005: sintering, hysteretic normal law
     "zohdi": "dem.laws.contact.zohdi",  # Zohdi 2014: power law on the contact area, bonds, thermal softening

@@ -133,10 +133,10 @@ def restitution_of(alpha: float) -> float:
 
 def time_steps(material: HertzMindlinMaterial, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray,
                m_mean: float) -> tuple[float, float]:
-    """``(dt, stable)``: ``dt = "auto"`` is :data:`RAYLEIGH_FRACTION` of the Rayleigh time of the smallest particle
+    """``(dt, stable)``: ``dt = "auto"`` is ``RAYLEIGH_FRACTION`` of the Rayleigh time of the smallest particle
     (module docstring). Hertz's stiffness ``k = dF/d delta = 2 E* a`` grows with the overlap, so no step is stable at
     every overlap: ``stable`` is the largest velocity-Verlet step, ``2/(omega + eta_n/(2 m*))``, for the lightest
-    pair at an overlap of :data:`STABLE_OVERLAP` R* (beyond the small strains Hertz's law is for), with its
+    pair at an overlap of ``STABLE_OVERLAP`` R* (beyond the small strains Hertz's law is for), with its
     stiffest mode: normal, ``2 E* a``, or tangential with rotation, ``8 G* a (1 + m a^2/I)``."""
     order = np.argsort(mass)
     lo, hi = order[0], order[1] if len(mass) > 1 else order[0]

@@ -50,9 +50,9 @@ N_PARAMS = hm.N_PARAMS + 3
 
 @dataclass(frozen=True)
 class JKRMaterial(HertzMindlinMaterial):
-    """Material of the JKR contact: that of Hertz-Mindlin (:class:`dem.laws.contact.hertz_mindlin.
-    HertzMindlinMaterial`) and ``work_of_adhesion`` w > 0 (J/m^2; twice the surface energy of identical surfaces).
-    ``restitution`` is that of a collision whose adhesion is negligible."""
+    """Material of the JKR contact: that of Hertz-Mindlin
+    (:class:`~dem.laws.contact.hertz_mindlin.HertzMindlinMaterial`) and ``work_of_adhesion`` w > 0 (J/m^2; twice the
+    surface energy of identical surfaces). ``restitution`` is that of a collision whose adhesion is negligible."""
 
     work_of_adhesion: float
 

@@ -13,10 +13,10 @@ particles approach, and every force returned is the force **on particle i** (on 
 k1(T, t), or with ``wall_sintering`` off the cold-limit k1). Temperatures only enter as differences (T - T_melt), so °C and K both work.
 
 Stiffness history is carried as the dimensionless factor ``s = k1(T, t)/k1`` (eq. 10-12): ``k1(T, t) = s k1``, a
-property of each particle's material (the healing of its defects, :data:`PARTICLE_STATE`): a contact uses the mean of
+property of each particle's material (the healing of its defects, ``PARTICLE_STATE``): a contact uses the mean of
 its two particles' factors, which for a uniform temperature is exactly the single ``k1(T, t)`` of the paper. Each
 contact stores ``delta_max`` (eq. 4), the factor it saw at its previous step (Fig. 5: heating keeps ``delta_max``,
-cooling keeps ``delta_0``) and the tangential spring ``xi`` (eq. 16-21): :data:`PAIR_HISTORY`.
+cooling keeps ``delta_0``) and the tangential spring ``xi`` (eq. 16-21): ``PAIR_HISTORY``.
 
 The fluid overlap of a contact (Sec. 3.1.3) is ``delta_fluid = fluid_overlap * 2 R_eff`` for a pair,
 ``R_eff = a_i a_j/(a_i + a_j)`` (``fluid_overlap * a`` for equal radii; :func:`pair_delta_fluid`), and
@@ -491,7 +491,7 @@ def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, pl
     """Force on particle i of the closed pair ``c`` = (i, j): ``(f_n, f_t0, f_t1, f_t2)`` (normal eqs. 3-13,
     tangential eqs. 14-24) from the overlap ``delta`` (centre distance ``d``), the unit normal ``n`` (j to i), the relative surface velocity
     ``vr`` and its normal part ``vn``; the pair's history is read from row ``c`` of ``hist_in`` and written to row
-    ``c`` of ``hist`` (:data:`PAIR_HISTORY`). ``planar``: 2D disks in the x-z plane (no y terms)."""
+    ``c`` of ``hist`` (``PAIR_HISTORY``). ``planar``: 2D disks in the x-z plane (no y terms)."""
     k1c = 0.5 * (state[i, 0] + state[j, 0])
     f_n, dmax, f_min_now, k2_now, kc_now, d0 = normal_force(delta, -vn, k1c, hist_in[c, 0], hist_in[c, 1],
                                                           params[P_FLUID_OVERLAP] * 2.0 * ri * rj / (ri + rj), params)

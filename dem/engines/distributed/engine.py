@@ -1,0 +1,226 @@
+"""The static engine on several MPI ranks: the pipe network of a packing that does not move (Rojek 2022, eqs. 1-9),
+steady or in implicit steps of a fixed size, its particles shared out in space and its matrix solved on PETSc.
+
+Every rank reads the scene, keeps the particles of its cell of a recursive coordinate bisection
+(:func:`dem.geometry.partition.bisection`) and a halo of one bond length around them
+(:func:`dem.geometry.partition.halo`), finds their bonds and conductances as the serial engine does, and keeps those
+with an owned particle (:mod:`dem.network.distributed`: its rows are the serial matrix's to the bit). The summary and
+the effective conductivity are reduced over the ranks; the snapshots are one piece per rank
+(:class:`dem.output.pieces.PieceWriter`).
+
+What it does not do, refused up front with the reason: moving particles (another engine's), radiation (a Newton
+iteration), explicit steps and ``dt = "auto"`` (fixed implicit or Crank-Nicolson steps only), the ``clip`` and
+``drop`` bond policies, ``--resume``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from dem import memory
+from dem.engines.static import CSV_FLOWS, StaticEngine, effective_conductivity
+from dem.geometry.bonds import Bonds
+from dem.geometry.partition import bisection, halo
+from dem.network import comm as mpi
+from dem.network.distributed import DistributedNetwork
+from dem.network.heat import Network, bonds_and_conductances
+
+HALO_MARGIN = 1.0 + 1e-9  # the halo's reach: this x one bond length (two largest radii), against round-off
+
+
+def unsupported(scene, resume: bool = False) -> str | None:
+    """Why ``scene`` cannot run on several ranks (module docstring), or None."""
+    s = scene.solver
+    if scene.sources.radiation is not None:
+        return f"scene {scene.name!r}: radiation (a Newton iteration) does not run under MPI; run it without mpiexec"
+    if scene.conductance.out_of_range != "error":
+        return (f"conductance.out_of_range = {scene.conductance.out_of_range!r} does not run under MPI (valid there: "
+                f"\"error\"); run it without mpiexec")
+    if s.mode == "transient" and (s.integrator == "explicit" or s.dt == "auto"):
+        return (f"[solver] integrator = {s.integrator!r}, dt = {s.dt!r}: under MPI transient runs take fixed "
+                f"implicit or crank-nicolson steps (a number for dt); run it without mpiexec")
+    if resume:
+        return "--resume does not run under MPI; run the scene again"
+    return None
+
+
+def _kept(bonds: Bonds, pairs: np.ndarray, walls: np.ndarray) -> Bonds:
+    """The bonds of ``bonds`` at the positions ``pairs`` and wall bonds at ``walls`` (masks)."""
+    return replace(bonds, i=bonds.i[pairs], j=bonds.j[pairs], h=bonds.h[pairs], d=bonds.d[pairs], a=bonds.a[pairs],
+                   l_i=bonds.l_i[pairs], l_j=bonds.l_j[pairs], shift=None if bonds.shift is None else
+                   bonds.shift[pairs], wall_particle=bonds.wall_particle[walls], wall_index=bonds.wall_index[walls],
+                   wall_h=bonds.wall_h[walls], wall_a=bonds.wall_a[walls], wall_l=bonds.wall_l[walls])
+
+
+class DistributedStaticEngine(StaticEngine):
+    """The static engine's protocol (:mod:`dem.engines`) on this rank's particles (module docstring);
+    ``positions()``, ``particle_fields()`` and ``temperatures()`` are those of the particles it owns
+    (``owned``: their indices in the scene)."""
+
+    name = "static"
+
+    def __init__(self, scene, restart: dict | None = None):
+        why = unsupported(scene, restart is not None)
+        if why is not None:
+            raise ValueError(why)
+        self.comm = mpi.world()
+        self.ranks, rank = self.comm.Get_size(), self.comm.Get_rank()
+        self.full_scene = self.scene = scene  # self.scene: the local particles once built
+        self.t_start = float(scene.start_time)
+        self.t, self.steps = self.t_start, 0
+        self.flows, self.details, self.restart = {}, {}, None
+        owner = mpi.agree(self.comm, lambda: self._build(scene, rank))  # no collective call inside: a bond out of
+        self.part = DistributedNetwork(self.comm, self.network, self.held, owner)  # range stops every rank alike
+
+    def _build(self, scene, rank: int) -> np.ndarray:
+        """This rank's particles, bonds and network (no communication); returns the owner of each held particle."""
+        p, box = scene.particles, scene.box
+        if p.n < self.ranks:
+            raise ValueError(f"{p.n} particles on {self.ranks} ranks: use at most {p.n} ranks")
+        if scene.solver.mode == "transient":
+            self._check_work()
+        lengths = None if box is None else np.where(box.mask, box.lengths, np.inf)
+        owner = bisection(p.position, self.ranks, lengths)
+        reach = 2.0 * float(p.radius.max()) * HALO_MARGIN
+        self.owned = np.flatnonzero(owner == rank)
+        held = np.union1d(self.owned, halo(p.position, owner, rank, reach, None if box is None else box.lengths,
+                                          None if box is None else box.mask))
+        memory.check(len(held), "particles")
+        local = p.permuted(held)
+        self.scene = replace(scene, particles=local)
+        mine = owner[held] == rank
+        try:
+            bonds, K_pairs, K_walls = bonds_and_conductances(local, scene.walls, scene.conductance, box=box)
+        except ValueError as exc:  # its counts and indices are of this rank's particles
+            raise ValueError(f"rank {rank} of {self.ranks}, its {len(held)} particles numbered from 0 in the "
+                             f"scene's order: {exc}") from None
+        pairs, walls = mine[bonds.i] | mine[bonds.j], mine[bonds.wall_particle]
+        self.bonds, self.K_pairs, self.K_walls = _kept(bonds, pairs, walls), K_pairs[pairs], K_walls[walls]
+        wall_temperature = np.array([w.temperature for w in scene.walls], dtype=float)
+        self.network = Network(local, self.bonds, self.K_pairs, self.K_walls, wall_temperature, scene.sources, box)
+        self.held, self.mine = held, mine
+        self.T = local.temperature.astype(float)
+        return owner[held]
+
+    # ------------------------------------------------------------------------------------------------ run
+    def _observed(self, observe):
+        def observer(step, t, T_free, flows):
+            self.steps, self.t, self.flows = step, self.t_start + t, flows
+            self.T = self.network.full(T_free)
+            if observe is not None:
+                observe()
+        return observer
+
+    def run(self, observe=None, progress=None, checkpoint=None) -> None:
+        """Solve (steady) or step (transient) to ``[solver] t_end`` on all ranks together (``checkpoint`` unused:
+        a distributed run does not resume)."""
+        s = self.scene.solver
+        out = {"law": self.scene.conductance.law, "contact": self.bonds.contact, "bonds_clipped": 0,
+               "bonds_dropped": 0, "wall_bonds": self.part.total(int(self.bonds.n_walls)), "ranks": self.ranks}
+        observer = self._observed(observe)
+        if s.mode == "steady":
+            T_F, flows, err, n_float, solver = mpi.agree(
+                self.comm, lambda: self.part.steady(s.floating))
+            observer(0, 0.0, T_F, flows)
+            out.update(energy_error=err, heat_flow=flows, linear_solver=solver, newton_iterations=1,
+                       floating_groups=n_float)
+            if self.part.total(len(self.network.fixed)) or len(self.scene.walls):
+                out["boundary_heat_flow"] = self._boundary(self.T)
+            if self.scene.box is not None:
+                out["periodic_heat_flow"] = self._periodic(self.T).tolist()
+        else:
+            t0 = self.t_start
+            res = mpi.agree(self.comm, lambda: self.part.integrate(
+                s.integrator, float(s.dt), s.t_end - t0, observer=observer,
+                progress=None if progress is None else (lambda t: progress(t0 + t))))
+            out.update(energy_error=res["energy_error"], heat_in=res["heat_in"], integrator=s.integrator, dt=s.dt,
+                       dt_min=res["dt_min"], dt_max=res["dt_max"], rejected_steps=0, stable_limit=None,
+                       linear_solver=res["solver"], factorizations=res["factorizations"],
+                       max_principle_violation=res["violation"])
+        out["linear_iterations"] = self.part.linear_iterations
+        self.details = out
+
+    def _boundary(self, T: np.ndarray) -> dict:
+        """Heat flow into each wall and each fixed particle (:func:`dem.network.heat.boundary_heat_flow`), summed
+        over the ranks."""
+        net, b = self.network, self.bonds
+        into = -(net.L @ T) + net.jump_rhs
+        to_wall = net.K_walls * (T[b.wall_particle] - net.wall_temperature[b.wall_index])
+        into -= np.bincount(b.wall_particle, to_wall, len(T))
+        n_walls = len(net.wall_temperature)
+        walls = self.part.total(np.bincount(b.wall_index, to_wall, n_walls)) if n_walls else np.zeros(0)
+        mine = net.fixed[self.mine[net.fixed]]
+        fixed = {int(k): float(v) for part in self.comm.allgather(
+            dict(zip(self.part.held[mine].tolist(), into[mine].tolist()))) for k, v in part.items()}
+        out = {"walls": {w.name: float(q) for w, q in zip(self.scene.walls, walls)},
+               "fixed_total": float(sum(fixed[k] for k in sorted(fixed)))}
+        if len(fixed) <= 1000:
+            ids = self.full_scene.particles.id
+            out["particles"] = {str(ids[k]): fixed[k] for k in sorted(fixed)}
+        return out
+
+    def _periodic(self, T: np.ndarray) -> np.ndarray:
+        """Heat flow across the period along x, y, z (:func:`dem.network.heat.periodic_heat_flow`) over the
+        ranks: each bond counted by the rank owning its first particle."""
+        b, net = self.bonds, self.network
+        first = self.mine[b.i]
+        q = net.K_pairs[first] * (T[b.i[first]] - T[b.j[first]] + net.jump[first])
+        return self.part.total(q @ b.shifts[first])
+
+    # -------------------------------------------------------------------------------------------- outputs
+    def record(self) -> dict:
+        T = self.T[self.mine]
+        n = self.part.total(len(T))
+        return {"step": self.steps, "t": self.t, "T_mean": float(self.part.total(float(T.sum())) / n),
+                "T_min": mpi.minimum(self.comm, float(T.min(initial=np.inf))),
+                "T_max": mpi.maximum(self.comm, float(T.max(initial=-np.inf))),
+                **{f"Q_{k}": float(self.flows.get(k, 0.0)) for k in CSV_FLOWS}}
+
+    def positions(self) -> np.ndarray:
+        return self.scene.particles.position[self.mine]
+
+    def temperatures(self) -> np.ndarray:
+        return self.T[self.mine]
+
+    def particle_fields(self) -> dict:
+        return {k: v[self.mine] for k, v in super().particle_fields().items()}
+
+    def links(self):
+        """The bonds of
+        :meth:`~dem.engines.static.StaticEngine.links` this rank writes: pair bonds whose first particle it owns, the
+        wall bonds of its particles."""
+        points, lines, fields = super().links()
+        keep = np.concatenate([self.mine[self.bonds.i], np.ones(self.bonds.n_walls, dtype=bool)])
+        return points, lines[keep], {k: v[keep] for k, v in fields.items()}
+
+    def plots(self, out, summary: dict) -> list[str]:
+        return []  # the plots need every particle on one rank
+
+    def summary(self) -> dict:
+        d = dict(self.details)
+        own = self.T[self.mine]
+        n = self.full_scene.particles.n
+        out = {"mode": self.scene.solver.mode, "t": self.t, "steps": self.steps, "particles": n,
+               "bonds": self.part.total(int(np.sum(self.mine[self.bonds.i]))),
+               "energy_error": d.pop("energy_error", None), "static": True}
+        for key in ("boundary_heat_flow", "periodic_heat_flow"):
+            if key in d:
+                out[key] = d.pop(key)
+        k_eff = effective_conductivity(self.full_scene, out)
+        if k_eff is not None:
+            out["effective_conductivity"] = k_eff
+        out.update(T_mean=float(self.part.total(float(own.sum())) / n),
+                   T_min=mpi.minimum(self.comm, float(own.min(initial=np.inf))),
+                   T_max=mpi.maximum(self.comm, float(own.max(initial=-np.inf))))
+        out.update(d)
+        return out
+
+    def gathered_temperatures(self) -> np.ndarray:
+        """The final temperatures of all particles in the scene's order, on every rank (for small scenes: the
+        summary's list, tests)."""
+        T = np.empty(self.full_scene.particles.n)
+        for index, values in self.comm.allgather((self.owned, self.T[self.mine])):
+            T[index] = values
+        return T

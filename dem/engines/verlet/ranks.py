@@ -1,0 +1,366 @@
+"""Particles that move, across MPI ranks: spatial slabs, ghosts, migration (mpi4py).
+
+Under ``mpiexec`` every rank reads the scene, keeps the particles of its slab (:mod:`dem.engines.verlet.decomposition`)
+and runs the compiled loop of :mod:`dem.engines.verlet.loop` on its *local* particles: those it owns and, in the
+same arrays, *ghosts* -- copies of the particles of other ranks within the halo ``2 r_max + skin`` of its slab. The
+local particles are ordered by global id (the particle's index in the scene), so that a local pair ``i < j`` is
+also a pair of lower global id first, as the serial list orders it.
+
+Forces: a rank lists every pair with at least one owned partner; a pair across two slabs is thus computed on both
+ranks, with the same inputs in the same order (ghosts are copies to the bit), and each keeps the force on its own
+particle -- the force on a ghost is dropped. Both ranks carry the same history for such a pair. Particle-wall
+contacts are computed for owned particles only; the walls' loads are summed over ranks every step, and a
+stress-controlled wall's acceleration (Luding 2005, eq. 1) computed from the sum, the same on every rank.
+
+Each step is one call of the compiled loop. A ghost's drift in it reproduces the owner's to the bit (same position,
+velocity and force, same arithmetic); after the call the owners send their ghosts' positions, velocities, forces,
+torques, radii, temperatures and law state (the second half kick of a ghost used the dropped force). When any rank
+needs a new Verlet list, all rebuild: particles whose centre left the slab migrate to their new owner with
+everything they carry (the law's particle state, the particle-wall histories), the pair histories (keyed by the
+global ids of the pair) go to the new owners of both partners, ghosts are exchanged afresh and the list is built
+from the local particles.
+
+On one rank this is the serial run step by step, bit for bit. On more, each owned particle still sums its contacts
+in the serial order (its local pairs are sorted by global id), so a periodic run is the serial one to the bit too;
+with walls only the walls' loads differ, at round-off (the ranks' partial sums are added in another order), and a
+stress wall's motion carries that difference into the packing.
+
+Outputs are gathered on rank 0 in global order (:meth:`RankMechanics.gathered`), which writes the run folder as a
+serial run does (not as PVTU pieces). Heat on moving contacts, resuming and checkpoints run on one rank only
+(:func:`refuse_unsupported` refuses them on more, where no checkpoint is written); the ``staggered`` and ``static``
+engines do not run under ``mpiexec``.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from dem.network.comm import world
+from dem.engines.verlet.decomposition import Slabs
+from dem.engines.verlet.engine import VerletEngine
+from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
+from dem.engines.verlet.mechanics import MechanicalModel, MechanicsError
+from dem.geometry.motion import MotionState
+from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
+from sinterheat import threads
+
+
+def refuse_unsupported(scene, ranks: int, resume: bool) -> None:
+    """A ``ValueError`` naming what a run on ``ranks`` ranks cannot do with ``scene``."""
+    if scene.engine != "verlet":
+        raise ValueError(f"[solver] engine = {scene.engine!r}: under mpiexec run static packings and the verlet "
+                         f"engine (particles that move), not this one; run this scene without mpiexec")
+    if ranks > 1 and "thermal" in scene.physics:
+        raise ValueError(f"physics = {list(scene.physics)}: heat on moving contacts runs on one rank only; run with "
+                         f"mpiexec -n 1 or without mpiexec")
+    if ranks > 1 and resume:
+        raise ValueError(f"--resume: a run on {ranks} ranks keeps no checkpoints; run without --resume")
+
+
+def _gather_rows(parts: list) -> np.ndarray:
+    rows = [p for p in parts if len(p)]
+    return np.concatenate(rows) if rows else parts[0]
+
+
+class RankMechanics(MechanicalModel):
+    """The mechanical submodel of one rank (module docstring):
+    :class:`~dem.engines.verlet.mechanics.MechanicalModel` on the local particles,
+    with the exchanges between ranks around each step and each rebuild."""
+
+    def __init__(self, state: MotionState, walls, material, dt: float, skin: float, gravity=(0.0, 0.0, 0.0),
+                 box=None, relaxation_time: float = 1e3, history=None, comm=None):
+        """``state``: every particle of the scene (each rank reads them all and keeps its slab); ``comm``: the
+        communicator (MPI's world by default); the rest as for
+        :class:`~dem.engines.verlet.mechanics.MechanicalModel`."""
+        self.comm = world() if comm is None else comm
+        self.rank, self.size = self.comm.Get_rank(), self.comm.Get_size()
+        self.gid = np.arange(state.n)
+        self.owned = np.ones(state.n, dtype=bool)
+        self.n_global = state.n
+        self.slabs = self._slabs(state, box)
+        self.send_idx, self.recv_idx = {}, {}
+        self.migrated = 0  # particles this rank took over from others at rebuilds
+        super().__init__(state, walls, material, dt, skin, gravity, box, relaxation_time, history)
+
+    def _slabs(self, state: MotionState, box) -> Slabs:
+        """Slabs along the periodic axis if there is one among those the particles move along, else along the
+        longest extent of the particles."""
+        axes = state.axes
+        periodic = [a for a in axes if box is not None and box.periodic[a]]
+        if periodic:
+            a = periodic[0]
+            return Slabs.balanced(state.x[:, a], self.size, a, float(box.lengths[a]), float(box.origin[a]))
+        a = axes[int(np.argmax(np.ptp(state.x[:, axes], axis=0)))] if state.n else 0
+        return Slabs.balanced(state.x[:, a], self.size, a)
+
+    # ------------------------------------------------------------------------------------------ particle rows
+    def _arrays(self) -> list:
+        """Every per-particle array, local order (a migrating particle takes them all)."""
+        s = self.state
+        return [s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia, s.radius, s.radius_ref, s.T, self.particle_state,
+                self.w_hist, self.w_fn, self.w_ft]
+
+    def _moving(self) -> list:
+        """What changes from step to step: what a ghost is refreshed with."""
+        s = self.state
+        return [s.x, s.v, s.w, s.f, s.tau, s.radius, s.T, self.particle_state]
+
+    @staticmethod
+    def _pack(arrays: list, idx: np.ndarray) -> np.ndarray:
+        """The rows ``idx`` of ``arrays`` side by side (no rows: a rank may own no particle at some moment)."""
+        columns = [a[idx].reshape(len(idx), int(np.prod(a.shape[1:]))) for a in arrays]
+        return np.hstack(columns) if columns else np.zeros((len(idx), 0))
+
+    @staticmethod
+    def _unpack(arrays: list, rows: np.ndarray, idx=None) -> list:
+        """The columns of ``rows`` into ``arrays`` at ``idx`` (in place), or as new arrays shaped like them."""
+        out, start = [], 0
+        for a in arrays:
+            width = int(np.prod(a.shape[1:], dtype=int))
+            block = rows[:, start:start + width].reshape((len(rows),) + a.shape[1:])
+            start += width
+            if idx is None:
+                out.append(np.ascontiguousarray(block))
+            else:
+                a[idx] = block
+        return out
+
+    def _set_particles(self, rows: np.ndarray, gid: np.ndarray, owned: np.ndarray) -> None:
+        """The local particles from full rows (:meth:`_arrays` columns), ordered by global id."""
+        order = np.argsort(gid, kind="stable")
+        x, v, w, f, tau, mass, inertia, radius, radius_ref, T, ps, wh, wfn, wft = self._unpack(self._arrays(),
+                                                                                             rows[order])
+        s = self.state
+        s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia = x, v, w, f, tau, mass, inertia
+        s.radius, s.radius_ref, s.T = radius, radius_ref, T
+        self.particle_state, self.w_hist, self.w_fn, self.w_ft = ps, wh, wfn, wft
+        self.gid, self.owned = gid[order], owned[order]
+
+    # ------------------------------------------------------------------------------------------------ list
+    def _build_list(self, first: bool = False):
+        """Migration, ghosts and the Verlet list (module docstring); ``first``: every rank holds every particle
+        and keeps those of its slab."""
+        s, box, comm = self.state, self.periodic_box, self.comm
+        if box is not None:  # as the serial model: those that left the box back into it
+            box.wrap_outside(s.x)
+        dest = self.slabs.owner(s.x)
+        rows = np.column_stack([self._pack(self._arrays(), np.arange(s.n)), self.gid])
+        owned = np.flatnonzero(self.owned)
+        r_max = comm.allreduce(float(np.max(s.radius[owned], initial=0.0)), op=_max())
+        own_rows = rows[owned[dest[owned] == self.rank]]
+        if not first:  # the particles that left the slab to their new owners; pair histories to both partners'
+            leaving = [rows[owned[dest[owned] == r]] if r != self.rank else rows[:0] for r in range(self.size)]
+            arrived = comm.alltoall(leaving)
+            self.migrated += sum(len(a) for a in arrived)
+            own_rows = _gather_rows([own_rows] + arrived)
+            hist = np.column_stack([self.gid[self.pi], self.gid[self.pj], self.p_hist, self.p_fn, self.p_ft])
+            hist = _gather_rows(comm.alltoall([hist[(dest[self.pi] == r) | (dest[self.pj] == r)]
+                                               for r in range(self.size)]))
+        # ghosts: the owned particles within the halo of another rank's slab
+        halo = 2.0 * r_max + self.skin
+        to = [self.slabs.within_halo(own_rows[:, :3], r, halo) if r != self.rank else np.zeros(0, dtype=np.int64)
+              for r in range(self.size)]
+        ghosts = comm.alltoall([own_rows[k] for k in to])
+        local = _gather_rows([own_rows] + ghosts)
+        gid = local[:, -1].astype(np.int64)
+        self._set_particles(local[:, :-1], gid, np.arange(len(local)) < len(own_rows))
+        own_gid = own_rows[:, -1].astype(np.int64)
+        self.send_idx = {r: np.searchsorted(self.gid, own_gid[k]) for r, k in enumerate(to) if len(k)}
+        self.recv_idx = {r: np.searchsorted(self.gid, g[:, -1].astype(np.int64)) for r, g in enumerate(ghosts)
+                         if len(g)}
+        # the list: pairs with an owned partner, their histories found by global ids
+        expected = 0 if first else len(self.pi) + len(self.pi) // 8 + 16
+        i, j = verlet_pairs(s.x, s.radius, self.skin, self.box, expected)
+        keep = self.owned[i] | self.owned[j]
+        i, j = i[keep], j[keep]
+        n_hist = len(self.law.PAIR_HISTORY)
+        if first:
+            m = len(i)
+            self.p_hist, self.p_fn, self.p_ft = np.zeros((m, n_hist)), np.zeros(m), np.zeros((m, 3))
+        else:
+            key = hist[:, 0].astype(np.int64) * self.n_global + hist[:, 1].astype(np.int64)
+            key, first_row = np.unique(key, return_index=True)  # a pair across two slabs came from both
+            hist = hist[first_row]
+            self.p_hist, self.p_fn, self.p_ft = carry_history(
+                key // self.n_global, key % self.n_global, self.gid[i], self.gid[j], hist[:, 2:2 + n_hist],
+                hist[:, 2 + n_hist], hist[:, 3 + n_hist:])
+            self.rebuilds += 1
+        self._listed(i, j)
+
+    def walls_moved(self):
+        """The particle-wall list of the owned particles."""
+        k, m = wall_pairs(self.state.x, self.state.radius, self.w.normal, self.w.q, self.skin)
+        keep = self.owned[k]
+        self.wk, self.wm = k[keep], m[keep]
+        self.wq_ref = self.w.q.copy()
+
+    def _restore(self, saved: dict):
+        """A saved state's histories (global rows and pairs) for the local particles."""
+        local = np.full(self.n_global, -1, dtype=np.int64)
+        local[self.gid] = np.arange(len(self.gid))
+        pi, pj = local[np.asarray(saved["pi"])], local[np.asarray(saved["pj"])]
+        keep = (pi >= 0) & (pj >= 0)
+        super()._restore({**saved, "pi": pi[keep], "pj": pj[keep], "p_hist": np.asarray(saved["p_hist"])[keep],
+                          "particle_state": np.asarray(saved["particle_state"])[self.gid],
+                          "w_hist": np.asarray(saved["w_hist"])[self.gid]})
+        self._refresh_ghosts()
+
+    # ------------------------------------------------------------------------------------------- exchanges
+    def _refresh_ghosts(self) -> None:
+        """The ghosts' moving columns from their owners (:meth:`_moving`)."""
+        from mpi4py import MPI
+
+        arrays = self._moving()
+        requests, buffers = [], {}
+        for r, idx in self.recv_idx.items():
+            buffers[r] = np.empty((len(idx), sum(int(np.prod(a.shape[1:], dtype=int)) for a in arrays)))
+            requests.append(self.comm.Irecv(buffers[r], source=r, tag=7))
+        for r, idx in self.send_idx.items():
+            requests.append(self.comm.Isend(self._pack(arrays, idx), dest=r, tag=7))
+        MPI.Request.Waitall(requests)
+        for r, idx in self.recv_idx.items():
+            self._unpack(arrays, buffers[r], idx)
+
+    def _initial_forces(self):
+        super()._initial_forces()
+        w = self.w
+        if len(w.force):
+            w.force[:] = self.comm.allreduce(w.force, op=_sum())
+            for m in range(len(self.walls)):
+                w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
+        self._refresh_ghosts()
+
+    def advance(self, n_steps: int, T0: np.ndarray, T_rate: np.ndarray, relaxation_time: float | None = None):
+        """``n_steps`` steps, one call of the compiled loop each, with the exchanges between them (module
+        docstring)."""
+        s, w = self.state, self.w
+        t0 = self.relaxation_time if relaxation_time is None else relaxation_time
+        T0 = np.ascontiguousarray(T0, dtype=float)
+        T_rate = np.ascontiguousarray(T_rate, dtype=float)
+        uniform = len(T0) == 1
+        first = self.steps
+        h = 0.5 * self.dt
+        for _ in range(n_steps):
+            wdq_half = np.where(w.mode == 1, w.dq + h * w.acc, w.dq)
+            _, status = self._advance(
+                1, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia,
+                s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.particle_state,
+                uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_fn, self.p_ft,
+                self.pair_start, self.pair_order, self.pair_load, w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
+                w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_hist, self.w_fn, self.w_ft, self.params,
+                self.x_ref, self.skin, self._info)
+            self.steps += 1
+            status = self._agreed(status, wdq_half)
+            if status == REBUILD:
+                self._build_list()
+            else:
+                self._refresh_ghosts()
+
+    def _agreed(self, status: int, wdq_half: np.ndarray) -> int:
+        """After a step, in one reduction over the ranks: the walls' loads summed (and stress walls accelerated by
+        the sum, eq. 1, from their velocity ``wdq_half`` after the step's first half kick, as the compiled loop does
+        with its own load), and the status all ranks act on: a failure anywhere stops every rank with its message,
+        a rebuild anywhere rebuilds everywhere."""
+        w = self.w
+        failed = status in (NONFINITE, ESCAPED)
+        total = np.concatenate([[status == REBUILD, failed], w.force])
+        self.comm.Allreduce(total.copy(), total, op=_sum())  # buffers, not pickles: once per step
+        w.force[:] = total[2:]
+        h = 0.5 * self.dt
+        for m in np.flatnonzero(w.mode == 1):
+            w.dq[m] = wdq_half[m]  # eq. (1)'s damping acts on the half-kicked velocity, as in the loop
+            w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
+            w.dq[m] = wdq_half[m] + h * w.acc[m]
+        if total[1] > 0:
+            k, m = int(self._info[0]), int(self._info[1])
+            status, k, m = min(f for f in self.comm.allgather((status, int(self.gid[k]), m) if failed else None)
+                               if f is not None)
+            if status == NONFINITE:
+                raise MechanicsError(f"the run stopped at step {self.steps} (t = {self.t:.6g} s): particle {k} has "
+                                     f"a non-finite position or velocity; the step dt = {self.dt:.6g} s is too large "
+                                     f"or a parameter is extreme")
+            raise MechanicsError(f"the run stopped at step {self.steps} (t = {self.t:.6g} s): particle {k} left the "
+                                 f"box through wall {self.walls[m].name!r}; reduce dt or the wall speed, or enlarge "
+                                 f"the box")
+        return REBUILD if total[0] > 0 else status
+
+    # --------------------------------------------------------------------------------------------- outputs
+    def gathered(self, everyone: bool = False) -> MechanicalModel | None:
+        """The whole sample as one serial model, in global order (its particles, the pairs each counted once, by
+        the rank owning their lower-id partner), on rank 0 (or on every rank with ``everyone``); None elsewhere."""
+        own = np.flatnonzero(self.owned)
+        rows = np.column_stack([self._pack(self._arrays(), own), self.gid[own]])
+        mine = self.owned[self.pi]
+        pairs = np.column_stack([self.gid[self.pi[mine]], self.gid[self.pj[mine]], self.p_hist[mine],
+                                 self.p_fn[mine], self.p_ft[mine]])
+        parts = self.comm.allgather((rows, pairs)) if everyone else self.comm.gather((rows, pairs), root=0)
+        if parts is None:
+            return None
+        rows = _gather_rows([p[0] for p in parts])
+        rows = rows[np.argsort(rows[:, -1], kind="stable")]
+        pairs = _gather_rows([p[1] for p in parts])
+        pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+        view = MechanicalModel.__new__(MechanicalModel)
+        view.__dict__.update({k: v for k, v in self.__dict__.items() if k not in ("comm", "state")})
+        x, v, w, f, tau, mass, inertia, radius, radius_ref, T, ps, wh, wfn, wft = self._unpack(self._arrays(),
+                                                                                             rows[:, :-1])
+        s = self.state
+        view.state = MotionState(s.dimension, s.height, x, v, w, f, tau, mass, inertia, radius, radius_ref, T)
+        view.particle_state, view.w_hist, view.w_fn, view.w_ft = ps, wh, wfn, wft
+        n_hist = len(self.law.PAIR_HISTORY)
+        view.pi, view.pj = pairs[:, 0].astype(np.int64), pairs[:, 1].astype(np.int64)
+        view.p_hist, view.p_fn = pairs[:, 2:2 + n_hist], pairs[:, 2 + n_hist]
+        view.p_ft = np.ascontiguousarray(pairs[:, 3 + n_hist:])
+        view.x_ref = x.copy()
+        view.wk, view.wm = wall_pairs(x, radius, self.w.normal, self.w.q, self.skin)
+        return view
+
+
+def _max():
+    from mpi4py import MPI
+
+    return MPI.MAX
+
+
+def _sum():
+    from mpi4py import MPI
+
+    return MPI.SUM
+
+
+class RankVerletEngine(VerletEngine):
+    """The verlet engine with its particles spread over the MPI ranks (module docstring). Outputs come from the
+    sample gathered on rank 0 at every output time; after the run every rank holds the gathered sample, so the
+    summary is the same everywhere."""
+
+    mechanics_class = RankMechanics
+
+    def __init__(self, scene, restart: dict | None = None):
+        """As :class:`VerletEngine`; unless told (``SINTERHEAT_THREADS``, ``--threads``), each rank's contact loop
+        takes its share of the cores, not all of them."""
+        size = world().Get_size()
+        refuse_unsupported(scene, size, restart is not None)
+        if not os.environ.get(threads.ENVIRONMENT):
+            threads.use(max(1, threads.cores() // size))
+        super().__init__(scene, restart)
+
+    def run(self, observe=None, progress=None, checkpoint=None) -> None:
+        """As :meth:`~dem.engines.verlet.engine.VerletEngine.run`;
+        ``observe`` sees the gathered sample (every rank calls it, rank 0 with its
+        writer, the others with a callable that writes nothing); checkpoints on one rank only."""
+        mech = self.mechanics
+
+        def observed():
+            view = mech.gathered()
+            if view is not None:
+                self.mechanics = view
+                try:
+                    observe()
+                finally:
+                    self.mechanics = mech
+
+        super().run(observed if observe is not None else None, progress,
+                    checkpoint if mech.size == 1 else None)
+        self.mechanics = mech.gathered(everyone=True)

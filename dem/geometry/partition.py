@@ -1,0 +1,59 @@
+"""Particles shared out in space among the ranks of a distributed run, and the halo each rank needs.
+
+:func:`bisection` is recursive coordinate bisection (Berger & Bokhari 1987): the particles are split across their
+longest extent at the count that gives each side its share of the parts, and each side again, until there are
+``parts`` cells of (almost) equal counts. On two ranks it is one cut across the longest axis (two slabs); on many
+ranks the cells stay compact, so the bonds that cross a cell face (the off-rank matrix entries) grow as the faces,
+not as the slabs' ever larger share.
+
+:func:`halo` lists the particles within ``reach`` of a cell's particles that another rank owns: with ``reach`` one
+bond length (twice the largest radius: two spheres bond only when ``d < r_i + r_j``), every bond of an owned particle
+has its partner among the owned and the halo particles, so a bond search over those finds all of them. On periodic
+axes the distance is taken to the nearest image.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def bisection(position: np.ndarray, parts: int, lengths: np.ndarray | None = None) -> np.ndarray:
+    """The rank (0 ... ``parts - 1``) of every particle: recursive coordinate bisection (module docstring).
+    ``lengths``: the extent of each axis where it is known (a periodic box), else the particles' span."""
+    if parts < 1:
+        raise ValueError(f"parts = {parts}: must be >= 1")
+    owner = np.zeros(len(position), dtype=np.int64)
+    _split(position, np.arange(len(position)), 0, parts, owner, lengths)
+    return owner
+
+
+def _split(position, members, first, parts, owner, lengths):
+    if parts == 1 or len(members) == 0:
+        owner[members] = first
+        return
+    x = position[members]
+    span = np.ptp(x, axis=0) if lengths is None else np.minimum(np.ptp(x, axis=0), lengths)
+    axis = int(np.argmax(span))
+    low_parts = parts // 2
+    cut = len(members) * low_parts // parts
+    order = members[np.argsort(x[:, axis], kind="stable")]
+    _split(position, order[:cut], first, low_parts, owner, lengths)
+    _split(position, order[cut:], first + low_parts, parts - low_parts, owner, lengths)
+
+
+def halo(position: np.ndarray, owner: np.ndarray, rank: int, reach: float, lengths=None, periodic=None) -> np.ndarray:
+    """Indices of the particles that ``rank`` does not own within ``reach`` (per axis) of the bounding box of those it
+    owns (module docstring); ``lengths`` and ``periodic`` (3,): the box, whose periodic axes wrap."""
+    mine = owner == rank
+    if not np.any(mine):
+        return np.zeros(0, dtype=np.int64)
+    lo, hi = position[mine].min(axis=0) - reach, position[mine].max(axis=0) + reach
+    near = np.ones(len(position), dtype=bool)
+    for axis in range(position.shape[1]):
+        x = position[:, axis]
+        inside = (x >= lo[axis]) & (x <= hi[axis])
+        if periodic is not None and periodic[axis]:
+            L = lengths[axis]
+            inside |= ((x + L >= lo[axis]) & (x + L <= hi[axis])) | ((x - L >= lo[axis]) & (x - L <= hi[axis]))
+        near &= inside
+    return np.flatnonzero(near & ~mine)

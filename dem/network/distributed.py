@@ -1,0 +1,295 @@
+"""The heat network of a packing shared out among MPI ranks: each rank's rows, the groups that span ranks, the steady
+solve and the theta-method steps, all on PETSc (:mod:`dem.network.petsc`).
+
+Each rank holds the particles it owns and a halo (:mod:`dem.geometry.partition`), and a
+:class:`dem.network.heat.Network` of them whose bonds are those with at least one owned particle. An owned particle
+has all its bonds there, in the order of the serial run's (both sorted by particle index), so its row of the matrix,
+its boundary terms and its right-hand side are those of the serial network to the bit; the halo's rows are
+incomplete and never used. The unknowns are numbered rank after rank, each rank's in the order of its particles.
+
+Groups of free particles (:meth:`DistributedNetwork.groups`) are the connected components of the graph over all
+ranks: each rank labels its local components with their smallest particle index, passes the labels of its owned
+particles to the ranks that hold them as halo, and takes the smallest label in each local component again, until no
+label changes anywhere. Anchored, gauged (periodic) and floating groups are then treated as the serial
+:func:`dem.network.heat.steady` treats them: a floating group at its capacity-weighted mean temperature, a gauged
+one solved with its first particle at 0 and shifted to keep its mean.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from dem.network import comm as mpi
+from dem.network.heat import INTEGRATORS, Network
+from dem.network.petsc import PetscSolver, matrix
+
+
+@dataclass
+class Groups:
+    """The groups of free particles over all ranks: ``label`` per local free particle (the smallest particle index
+    of its group), and the labels of the groups that are ``anchored``, ``jumping`` (a periodic temperature jump)
+    and ``floating`` (neither), each sorted."""
+
+    label: np.ndarray
+    anchored: np.ndarray
+    jumping: np.ndarray
+    floating: np.ndarray
+
+    def member(self, labels: np.ndarray) -> np.ndarray:
+        """Mask over the local free particles: in one of the groups ``labels``."""
+        return np.isin(self.label, labels)
+
+
+class DistributedNetwork:
+    """This rank's part of the network (module docstring). ``net``: the
+    :class:`~dem.network.heat.Network` of the held particles,
+    ``held`` their global indices (sorted), ``owner`` the rank owning each of them."""
+
+    def __init__(self, comm, net: Network, held: np.ndarray, owner: np.ndarray):
+        self.comm, self.net, self.held = comm, net, held
+        self.rank, self.size = comm.Get_rank(), comm.Get_size()
+        self.mine = owner == self.rank  # over the held particles
+        self.own_free = self.mine[net.free]  # over the local free particles
+        self.exchange = mpi.HaloExchange(comm, held, owner)
+        self.linear_iterations = 0
+
+    # ------------------------------------------------------------------------------------------- reductions
+    def total(self, value):
+        return mpi.total(self.comm, value)
+
+    def halo_filled(self, T_F: np.ndarray) -> np.ndarray:
+        """All held temperatures (fixed ones too) from the owned entries of ``T_F`` (over the local free ones)."""
+        return self.exchange.fill(self.net.full(T_F))
+
+    def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
+        """Heat flow (W) into all free particles through each boundary
+        (:meth:`~dem.network.heat.Network.flows` over the ranks)."""
+        part = self.net.flows(T_F, sinks, self.own_free)
+        sums = self.total(np.array(list(part.values())))
+        return dict(zip(part, map(float, sums)))
+
+    def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
+        net, gross = self.total(np.array(self.net.flow_sums(T_F, sinks, self.own_free)))
+        return float(max(net, np.sqrt(np.finfo(float).eps) * gross))
+
+    # ------------------------------------------------------------------------------------------ numbering
+    def numbering(self, unknown: np.ndarray) -> tuple[np.ndarray, int]:
+        """Global row of every local free particle in ``unknown`` (a mask over them; -1 elsewhere), rank after rank,
+        and the global count. The halo's rows come from their owners."""
+        mine = unknown & self.own_free
+        count = int(mine.sum())
+        offset = self.comm.exscan(count) or 0  # None on rank 0
+        n_global = self.total(count)
+        row = np.full(len(self.net.free), -1.0)
+        row[mine] = offset + np.arange(count)
+        held = np.full(self.net.particles.n, -1.0)
+        held[self.net.free] = row
+        self.exchange.fill(held)
+        return held[self.net.free].astype(np.int64), n_global
+
+    def rows(self, M: sp.csr_matrix, row: np.ndarray) -> sp.csr_matrix:
+        """The owned rows of ``M`` (over the local free particles) among the unknowns numbered ``row``, with their
+        columns numbered globally (sorted)."""
+        take = np.flatnonzero(self.own_free & (row >= 0))
+        cols = np.flatnonzero(row >= 0)
+        local = M[take][:, cols].tocsr()
+        out = sp.csr_matrix((local.data, row[cols][local.indices], local.indptr), shape=(len(take), len(cols)))
+        out.has_sorted_indices = False
+        out.sort_indices()
+        return out
+
+    def solver(self, M: sp.csr_matrix, row: np.ndarray, n_global: int, rtol: float) -> PetscSolver:
+        """CG + AMG on the unknowns numbered ``row`` of the system ``M`` (over the local free particles)."""
+        return PetscSolver(matrix(self.comm, self.rows(M, row), n_global), rtol)
+
+    # --------------------------------------------------------------------------------------------- groups
+    def groups(self, anchor: np.ndarray) -> Groups:
+        """The groups over all ranks (module docstring); ``anchor`` (per local free particle) > 0 where a particle
+        is joined to a fixed one, a wall or an ambient."""
+        net, n_free = self.net, len(self.net.free)
+        g = net.graph
+        where = np.full(net.particles.n, -1, dtype=np.int64)
+        where[net.free] = np.arange(n_free)
+        a, b = where[g.i], where[g.j]
+        live = (g.K > 0.0) & (a >= 0) & (b >= 0)
+        graph = sp.csr_matrix((np.ones(int(live.sum())), (a[live], b[live])), shape=(n_free, n_free))
+        n_comp, comp = connected_components(graph, directed=False)
+        label = self.held[net.free].astype(float)
+        while True:
+            smallest = np.full(n_comp, np.inf)
+            np.minimum.at(smallest, comp, label)
+            new = smallest[comp]
+            held = np.full(net.particles.n, -1.0)
+            held[net.free] = new
+            new = self.exchange.fill(held)[net.free]
+            changed = self.total(int(np.any(new != label)))
+            label = new
+            if not changed:
+                break
+        label = label.astype(np.int64)
+        own = self.own_free
+        anchored = self._union(label[own & (anchor > 0)])
+        jumping = np.zeros(0, dtype=np.int64)
+        if net.periodic:
+            position = np.full(net.particles.n, -1)
+            position[net.free] = np.arange(n_free)
+            free_i = position[net.bonds.i[(net.jump != 0.0) & self.mine[net.bonds.i]]]
+            jumping = self._union(label[free_i[free_i >= 0]])
+        others = self._union(label[own])
+        floating = np.setdiff1d(others, np.union1d(anchored, jumping))
+        return Groups(label, anchored, np.setdiff1d(jumping, anchored), floating)
+
+    def _union(self, labels: np.ndarray) -> np.ndarray:
+        """The labels found on any rank, sorted and once each."""
+        parts = self.comm.allgather(np.unique(labels))
+        return np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
+
+    def group_sums(self, labels: np.ndarray, group: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """Per group of ``labels`` (sorted): the sum of ``values`` over its owned members (``group`` per local free
+        particle, the groups' labels)."""
+        inside = self.own_free & np.isin(group, labels)
+        where = np.searchsorted(labels, group[inside])
+        return self.total(np.bincount(where, values[inside], len(labels)))
+
+    # --------------------------------------------------------------------------------------------- steady
+    def steady(self, floating: str = "error", rtol: float = 1e-10):
+        """Steady temperatures of the free particles (this rank's entries: over the local free ones, owned ones
+        valid): :func:`dem.network.heat.steady` over the ranks, without radiation. Returns ``(T_F, flows,
+        energy_error, floating groups, solver name)``."""
+        net = self.net
+        T_F = net.particles.temperature[net.free].astype(float)
+        sinks = net.sinks(T_F)
+        extra = sum((gs for gs, _ in sinks.values()), np.zeros(len(T_F)))
+        anchor = net.fixed_diag + net.wall_diag + extra
+        G = self.groups(anchor)
+        n_groups = len(self._union(G.label[self.own_free]))
+        gauged_labels = G.jumping
+
+        def no_solution(labels):
+            heat = self.group_sums(labels, G.label, net.heat)
+            scale = self.group_sums(labels, G.label, np.abs(net.heat))
+            if np.any(np.abs(heat) > 1e-12 * np.maximum(scale, 1e-300)):
+                raise ValueError("steady problem has no solution: a floating group of particles (no fixed "
+                                 "temperature, wall or ambient) has a net internal heat source, so it heats up "
+                                 "forever")
+
+        n_float = len(G.floating)
+        if n_float:
+            lost = G.member(G.floating)
+            if floating == "error":
+                count = self.total(int(np.sum(lost & self.own_free)))
+                first = sorted(np.concatenate(self.comm.allgather(self.held[net.free][lost & self.own_free][:8])))
+                raise ValueError(f"steady problem is singular: {n_float} of {n_groups} connected group(s) of free "
+                                 f"particles ({count} particles, e.g. {[int(k) for k in first[:8]]}) touch no fixed "
+                                 f"particle, wall, convection or radiation, so their temperature is undetermined; fix "
+                                 f"a particle's temperature, add a wall or an ambient, set solver.floating = "
+                                 f"\"mean\", or use mode = \"transient\"")
+            no_solution(G.floating)
+            energy = self.group_sums(G.floating, G.label, net.C * T_F)
+            cap = self.group_sums(G.floating, G.label, net.C)
+            where = np.searchsorted(G.floating, G.label[lost])
+            T_F[lost] = energy[where] / cap[where]
+        ground = np.zeros(len(T_F), dtype=bool)
+        if len(gauged_labels):
+            no_solution(gauged_labels)
+            ground = G.label == self.held[net.free]  # a gauged group's first particle holds it at 0
+            ground &= G.member(gauged_labels)
+            target = self.group_sums(gauged_labels, G.label, net.C * T_F)
+            T_F[ground] = 0.0
+        unknown = (G.member(G.anchored) | G.member(gauged_labels)) & ~ground
+        row, n_global = self.numbering(unknown)
+        solver_name = "none"
+        if n_global:
+            A = net.matrix(sinks)
+            solver = self.solver(A, row, n_global, rtol)
+            solver_name = solver.name
+            take = self.own_free & unknown
+            T_F[take] = solver.solve(net.rhs(sinks)[take], T_F[take])
+            self.linear_iterations += solver.iterations
+        if len(gauged_labels):
+            cap = self.group_sums(gauged_labels, G.label, net.C)
+            shift = (target - self.group_sums(gauged_labels, G.label, net.C * T_F)) / cap
+            inside = G.member(gauged_labels)
+            T_F[inside] += shift[np.searchsorted(gauged_labels, G.label[inside])]
+        T_F = self.halo_filled(T_F)[net.free]
+        flows = self.flows(T_F, sinks)
+        total = self.flow_magnitude(T_F, sinks)
+        err = abs(sum(flows.values())) / total if total > 0 else 0.0
+        return T_F, flows, err, n_float, solver_name
+
+    # ------------------------------------------------------------------------------------------ transient
+    def integrate(self, integrator: str, dt: float, t_end: float, rtol_linear: float = 1e-10, observer=None,
+                  progress=None):
+        """Theta-method steps of fixed size ``dt`` to ``t_end`` (:func:`dem.network.heat.integrate` with a fixed
+        step, over the ranks; ``integrator`` implicit or crank-nicolson). ``observer(step, t, T_F, flows)`` after
+        every step and at the start. Returns a dict of what the serial integrator reports."""
+        net, theta = self.net, INTEGRATORS[integrator]
+        T = net.particles.temperature[net.free].astype(float)
+        sinks = net.sinks(T)
+        A = net.matrix(sinks)
+        r = net.rhs(sinks)
+        row, n_global = self.numbering(np.ones(len(T), dtype=bool))
+        n_steps = max(1, math.ceil(t_end / dt * (1.0 - 1e-12)))
+        solvers = {}
+        lo, hi = net.temperature_bounds()
+        lo, hi = mpi.minimum(self.comm, lo), mpi.maximum(self.comm, hi)
+        dt_min, dt_max = math.inf, 0.0
+        bounded = self.total(int(np.any(net.heat[self.own_free]))) == 0
+        violation, abs_in = 0.0, 0.0
+        heat_in = {k: 0.0 for k in net.flow_names}
+        own = self.own_free
+        energy0 = self.total(float(net.C[own] @ T[own]))
+        if observer is not None:
+            observer(0, 0.0, T, self.flows(T, sinks))
+        t = 0.0
+        for step in range(1, n_steps + 1):
+            last = step == n_steps
+            h = t_end - (step - 1) * dt if last else dt
+            if abs(h - dt) <= 1e-9 * dt:
+                h = dt
+            if h not in solvers:
+                M = (A * theta + sp.diags(net.C / h)).tocsr()
+                solvers[h] = (M, self.solver(M, row, n_global, rtol_linear))
+            M, solver = solvers[h]
+            rhs = net.C / h * T + r
+            if theta < 1.0:
+                rhs -= (1.0 - theta) * (A @ T)
+            T_new = T.copy()
+            T_new[own] = solver.solve(rhs[own], T[own])
+            T_new = self.halo_filled(T_new)[net.free]
+            # a uniform shift of the order of the solver's tolerance makes the residuals sum to zero (the heat
+            # balance of the step to round-off), as in the serial stepper
+            residual, weight = self.total(np.array([float(np.sum((rhs - M @ T_new)[own])),
+                                                    float(M[own].sum())]))
+            T_new += residual / weight
+            dt_min, dt_max = min(dt_min, h), max(dt_max, h)
+            T_theta = theta * T_new + (1.0 - theta) * T
+            flows = self.flows(T_theta, sinks)
+            for k, v in flows.items():
+                heat_in[k] += h * v
+            abs_in += h * self.flow_magnitude(T_theta, sinks)
+            T = T_new
+            t = t_end if last else step * dt
+            if not self.total(int(np.all(np.isfinite(T[own])))) == self.size:
+                raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {step})")
+            if bounded:
+                top = mpi.maximum(self.comm, float(T[own].max(initial=-np.inf)))
+                bottom = mpi.minimum(self.comm, float(T[own].min(initial=np.inf)))
+                violation = max(violation, top - hi, lo - bottom)
+            if observer is not None:
+                observer(step, t, T, flows)
+            if progress is not None:
+                progress(t)
+        self.linear_iterations = sum(s.iterations for _, s in solvers.values())
+        energy = self.total(float(net.C[own] @ T[own]))
+        scale = self.total(float(net.C[own].sum())) * (hi - lo) + abs_in
+        err = abs(energy - energy0 - sum(heat_in.values())) / scale if scale > 0 else 0.0
+        name = next(iter(solvers.values()))[1].name if solvers else "none"
+        return {"T_F": T, "t": t, "steps": n_steps, "energy_error": err, "heat_in": heat_in,
+                "dt_min": dt_min, "dt_max": dt_max, "solver": name, "factorizations": len(solvers),
+                "violation": violation if bounded else None}

@@ -1,0 +1,120 @@
+"""The runs that tests/test_dem_ranks.py compares, as one script for ``mpiexec -n N python ranks_worker.py CASE
+OUT``: the same function runs the serial engine in the test's own process and the ranks engine here. Rank 0 writes
+``OUT`` (``.npz``)."""
+
+import copy
+import sys
+
+import numpy as np
+
+L = 6e-3  # m, the period of the boxes
+LUDING = {"law": "luding", "k1": 1.0e3, "k2": 2.0e3, "kc": 1.0e3, "kt_ratio": 0.2, "gamma_n": 1e-4,
+          "gamma_t": 5e-5, "mu": 0.5, "mu_wall": 0.0, "T_melt": 1000.0, "T_var": 10.0, "expansion": 1.0e-4,
+          "fluid_overlap": 0.2, "t0": 1.0e3, "brittle_sliding": True}
+ELASTIC = {"law": "hertz_mindlin", "youngs_modulus": 1.0e7, "poisson_ratio": 0.3, "restitution": 1.0,
+           "tangential_damping": 0.0, "mu": 0.0, "mu_wall": 0.0}
+GAS = {"scene": {"physics": ["mechanical"]}, "material": {"density": 7800.0}, "contact": LUDING,
+       "generator": {"kind": "box", "n": 60, "radius": 5e-4, "radius_spread": 0.1, "seed": 2, "speed": 0.5,
+                     "box": [[0.0, 0.0, 0.0], [L, L, L]]},
+       "periodic": {"lengths": [L, L, L]}, "solver": {"mode": "transient", "t_end": 0.004}}
+COMPACTION_SIDE = 0.03  # m, the square box the disks start in (solid fraction ~0.35)
+STRESS_WALL = {"motion": "stress", "pressure": 100.0, "mass": 0.01, "damping": 0.2}
+COMPACTION = {  # 100 disks of Luding 2005's Table 1 sizes, stiffer-than-soft linear contact, pressed at 100 N/m
+    "scene": {"physics": ["mechanical"], "dimension": 2, "height": 6e-3}, "material": {"density": 2000.0},
+    "contact": {**LUDING, "k1": 2e4, "k2": 2e4, "kc": 0.0, "gamma_n": 2e-2, "gamma_t": 5e-3},
+    "generator": {"kind": "box", "n": 100, "radius": 1e-3, "radius_spread": 0.5, "seed": 1, "speed": 0.01,
+                  "box": [[0.0, 0.0, 0.0], [COMPACTION_SIDE, 0.0, COMPACTION_SIDE]], "temperature": 20.0},
+    "walls": [{"name": "left", "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]},
+              {"name": "bottom", "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
+              {"name": "right", "point": [COMPACTION_SIDE, 0.0, 0.0], "normal": [-1.0, 0.0, 0.0], **STRESS_WALL},
+              {"name": "top", "point": [0.0, 0.0, COMPACTION_SIDE], "normal": [0.0, 0.0, -1.0], **STRESS_WALL}],
+    "solver": {"mode": "transient", "t_end": 0.1}}
+CASES = {
+    # frictional, damped, sintering law: momentum is what a periodic box conserves
+    "gas": GAS,
+    # elastic and frictionless (Hertz, e = 1): the energy of the collisions comes back
+    "elastic": {**GAS, "contact": ELASTIC},
+}
+CHUNK = 100  # steps between the samples of a trace
+
+
+def trace(engine_class, case: str, comm=None) -> dict:
+    """Run ``CASES[case]`` on ``engine_class`` in chunks of :data:`CHUNK` steps; after each chunk the momentum, the
+    kinetic energy and the global ids held by the ranks (every id once: none lost, none duplicated)."""
+    from dem import parse_scene
+
+    engine = engine_class(parse_scene(copy.deepcopy(CASES[case])))
+    mech = engine.mechanics
+    n_end = round(engine.scene.solver.t_end / mech.dt)
+    T0, rate = np.array([20.0]), np.zeros(1)
+    momentum, energy, ids_intact = [], [], []
+    while mech.steps < n_end:
+        mech.advance(min(CHUNK, n_end - mech.steps), T0, rate)
+        whole = mech.gathered(everyone=True) if comm is not None else mech
+        momentum.append(whole.state.momentum())
+        energy.append(whole.state.kinetic_energy())
+        if comm is not None:
+            held = np.sort(np.concatenate(comm.allgather(mech.gid[mech.owned])))
+            ids_intact.append(np.array_equal(held, np.arange(mech.n_global)))
+    whole = mech.gathered(everyone=True) if comm is not None else mech
+    s = whole.state
+    return {"x": s.x, "v": s.v, "w": s.w, "f": s.f, "momentum": np.array(momentum), "energy": np.array(energy),
+            "ids_intact": np.array(ids_intact), "mass": s.mass, "rebuilds": mech.rebuilds,
+            "migrated": comm.allreduce(mech.migrated) if comm is not None else 0,
+            "contacts": len(whole.contacts()[0])}
+
+
+def builtin(name: str, t_end: float):
+    """The built-in scene ``name`` ended at ``t_end``."""
+    import tomllib
+
+    from dem import parse_scene
+    from dem.scene.parse import SCENE_DIR
+
+    doc = tomllib.loads((SCENE_DIR / f"{name}.toml").read_text())
+    doc["solver"]["t_end"] = t_end
+    return parse_scene(doc, base_dir=SCENE_DIR)
+
+
+def run_builtin(name: str, t_end: float, out) -> dict:
+    """The built-in scene through the driver (the ranks engine under mpiexec), its folder written into ``out``:
+    the final particles and the summary's numbers."""
+    return run_scene(builtin(name, t_end), out)
+
+
+def pressed(relative: float = 0.0):
+    """:data:`COMPACTION` with the walls' pressure changed by ``relative`` (a few ulps: another sample of the
+    same compaction, as two ranks' loads summed in another order are)."""
+    from dem import parse_scene
+
+    doc = copy.deepcopy(COMPACTION)
+    for wall in doc["walls"][2:]:
+        wall["pressure"] *= 1.0 + relative
+    return parse_scene(doc)
+
+
+def run_scene(scene, out=None) -> dict:
+    """``scene`` through the driver: the final particles and the summary's numbers."""
+    from dem import run
+
+    result = run(scene, out=out)
+    s = result.engine.mechanics.state
+    numbers = {k: v for k, v in result.summary.items() if isinstance(v, (int, float)) and k != "seconds"}
+    return {"x": s.x, "v": s.v, "w": s.w, "f": s.f, "T": s.T, "summary_keys": np.array(list(numbers)),
+            "summary_values": np.array(list(numbers.values()), dtype=float)}
+
+
+if __name__ == "__main__":
+    from mpi4py import MPI
+
+    from dem.engines.verlet.ranks import RankVerletEngine
+
+    comm = MPI.COMM_WORLD
+    if sys.argv[1] == "scene":  # scene NAME T_END FOLDER RESULT
+        result = run_builtin(sys.argv[2], float(sys.argv[3]), sys.argv[4])
+    elif sys.argv[1] == "compaction":  # compaction RESULT
+        result = run_scene(pressed())
+    else:  # CASE RESULT
+        result = trace(RankVerletEngine, sys.argv[1], comm)
+    if comm.Get_rank() == 0:
+        np.savez(sys.argv[-1], ranks=comm.Get_size(), **result)

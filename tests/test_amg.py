@@ -1,0 +1,216 @@
+"""The tuned smoothed-aggregation AMG (dem.network.linsolve.AMGSolver): the criterion on a packing and on a lattice
+checked against sparse LU, its hierarchy reused across refreshes and radiation's Newton and time steps with the same
+answer as a fresh one, and the benchmark's PETSc rows left out cleanly without petsc4py."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spl
+
+from benchmarks.amg_peers import PreviousAMG
+from dem.laws.conductance import ConductanceSpec
+from dem.network.linsolve import AMG_REUSE_GROWTH, AMGSolver, make_solver
+
+RTOL = 1e-10  # dem.network.heat.steady's criterion
+
+
+def packing_system(n=8000, seed=3):
+    """The steady matrix and right-hand side of a random sintered packing between a hot and a cold layer (rojek
+    law), on its anchored free particles."""
+    from dem.geometry.generators import random_packing
+    from dem.geometry.particles import Particles
+    from dem.network.heat import build_network
+
+    lay = random_packing(n, 1e-4, 0.12, seed=seed)
+    T = np.zeros(len(lay.radius))
+    fixed = np.zeros(len(T), bool)
+    fixed[lay.bottom] = fixed[lay.top] = True
+    T[lay.bottom] = 1.0
+    net = build_network(Particles.from_arrays(lay.position, lay.radius, T, fixed=fixed), spec=ConductanceSpec())
+    _, label, anchored = net.graph.components()
+    keep = np.flatnonzero(anchored[label])
+    return net.matrix({})[keep][:, keep].tocsr(), net.rhs({})[keep]
+
+
+def lattice_system(shape=(20, 20, 20), contrast=1e4, seed=0):
+    """A simple cubic lattice of nodes with bond conductances spread log-uniformly over ``contrast``, the bottom
+    layer at 1 and the top at 0 (fixed), as a BoundedLaplacian's steady matrix."""
+    from dem.network.laplacian import BoundedLaplacian
+
+    nx, ny, nz = shape
+    index = np.arange(nx * ny * nz).reshape(shape)
+    pairs = [(index[:-1].ravel(), index[1:].ravel()), (index[:, :-1].ravel(), index[:, 1:].ravel()),
+             (index[:, :, :-1].ravel(), index[:, :, 1:].ravel())]
+    i = np.concatenate([p[0] for p in pairs])
+    j = np.concatenate([p[1] for p in pairs])
+    K = contrast ** np.random.default_rng(seed).random(len(i))
+    fixed = np.zeros(index.size, bool)
+    fixed[index[:, :, 0].ravel()] = fixed[index[:, :, -1].ravel()] = True
+    value = np.where(np.isin(np.arange(index.size), index[:, :, 0].ravel()), 1.0, 0.0)
+    system = BoundedLaplacian(index.size, i, j, K, fixed, [], [], [], 0)
+    return system.matrix(), system.boundary_rhs(value[system.fixed], [])
+
+
+def relative_residual(A, x, b):
+    return float(np.linalg.norm(b - A @ x) / np.linalg.norm(b))
+
+
+@pytest.mark.parametrize("make", [packing_system, lattice_system], ids=["packing", "lattice"])
+def test_tuned_amg_reaches_the_criterion_and_agrees_with_lu(make):
+    A, b = make()
+    solver = AMGSolver(A, rtol=RTOL)
+    assert len(solver.hierarchy.levels) >= 3  # a real multilevel hierarchy, not a coarse solve
+    x = solver.solve(b)
+    assert relative_residual(A, x, b) <= RTOL
+    exact = spl.spsolve(sp.csc_matrix(A), b)
+    # the error is at most cond(A) x the relative residual; the solution lies in [0, 1]
+    assert np.max(np.abs(x - exact)) < 1e-7
+    # the cheaper setup costs few iterations, if any, against pyamg's defaults (the previous settings)
+    previous = PreviousAMG(A, rtol=RTOL)
+    assert relative_residual(A, previous.solve(b), b) <= RTOL
+    assert solver.iterations <= 1.2 * previous.iterations
+
+
+def test_coarse_levels_are_csr_and_the_cycle_is_that_of_pyamgs_bsr_levels():
+    """Converting the coarse levels from 1 x 1 BSR to CSR changes the kernels, not the cycle: the same result to
+    round-off (the block kernel multiplies by the inverted 1 x 1 block where the scalar one divides)."""
+    import pyamg
+    from pyamg.relaxation.smoothing import change_smoothers
+
+    from dem.network.linsolve import AMG_OPTIONS, AMG_SEED, AMG_SMOOTHER
+
+    A, b = packing_system()
+    ours = AMGSolver(A, rtol=RTOL)
+    assert all(level.A.format == "csr" for level in ours.hierarchy.levels)
+    state = np.random.get_state()
+    np.random.seed(AMG_SEED)
+    plain = pyamg.smoothed_aggregation_solver(A, **AMG_OPTIONS)
+    np.random.set_state(state)
+    assert plain.levels[1].A.format == "bsr"
+    change_smoothers(plain, AMG_SMOOTHER, AMG_SMOOTHER)
+    ours_cycle, plain_cycle = ours.precondition(b), plain.aspreconditioner(cycle="V")(b)
+    assert np.max(np.abs(ours_cycle - plain_cycle)) <= 1e-13 * np.max(np.abs(plain_cycle))
+
+
+def test_reused_hierarchy_gives_the_fresh_answer_to_the_tolerance():
+    """A refresh (conductances changed by up to 10 %, a capacity term added): the earlier hierarchy preconditions
+    the new matrix with no setup and the solution is that of a fresh hierarchy to the criterion."""
+    A, b = packing_system()
+    first = make_solver(A, "amg", rtol=RTOL)
+    first.solve(b)
+    rng = np.random.default_rng(1)
+    scale = sp.diags(np.sqrt(rng.uniform(0.9, 1.1, A.shape[0])))
+    changed = (scale @ A @ scale + sp.diags(1e-3 * A.diagonal())).tocsr()
+    reused = make_solver(changed, "amg", rtol=RTOL, previous=first)
+    assert reused.reused and reused.hierarchy is first.hierarchy
+    x = reused.solve(b)
+    assert reused.reused  # it served: no fresh hierarchy was needed
+    assert reused.iterations <= AMG_REUSE_GROWTH * first.iterations + 1
+    fresh = make_solver(changed, "amg", rtol=RTOL)
+    y = fresh.solve(b)
+    assert relative_residual(changed, x, b) <= RTOL
+    assert relative_residual(changed, y, b) <= RTOL
+    exact = spl.spsolve(sp.csc_matrix(changed), b)
+    assert np.max(np.abs(x - exact)) < 1e-7 and np.max(np.abs(y - exact)) < 1e-7
+    # a chain of reuses holds the one solver that built the hierarchy, not every earlier matrix
+    again = make_solver(changed, "amg", rtol=RTOL, previous=reused)
+    assert again.hierarchy_of is first
+
+
+def test_a_hierarchy_that_no_longer_serves_is_rebuilt_and_the_criterion_met():
+    """Another network of the same size (a lattice against a packing's hierarchy): the reuse stops at its iteration
+    bound and a fresh hierarchy solves it."""
+    A_lattice, b = lattice_system(shape=(20, 20, 20))
+    n = A_lattice.shape[0]
+    A_packing, b_packing = packing_system()
+    A_packing, b_packing = A_packing[:n][:, :n].tocsr(), b_packing[:n]  # the same size: a different graph
+    first = make_solver(A_packing + sp.diags(np.full(n, A_packing.diagonal().mean())), "amg", rtol=RTOL)
+    first.solve(b_packing)
+    other = make_solver(A_lattice, "amg", rtol=RTOL, previous=first)
+    assert other.reused
+    x = other.solve(b)
+    assert not other.reused and other.hierarchy is not first.hierarchy
+    assert relative_residual(A_lattice, x, b) <= RTOL
+
+
+def test_other_backends_ignore_previous():
+    A, b = lattice_system(shape=(10, 10, 10))
+    first = make_solver(A, "amg", rtol=RTOL)
+    assert type(make_solver(A, "direct", rtol=RTOL, previous=first)).__name__ == "DirectSolver"
+    assert type(make_solver(A, "cg", rtol=RTOL, previous=first)).__name__ == "PCGSolver"
+
+
+def test_radiation_newton_and_steps_reuse_the_hierarchy_with_the_direct_answer():
+    """Radiation changes the matrix at every Newton iteration and time step (its linearisation): steady and implicit
+    runs on AMG, reusing the hierarchy, end where sparse LU ends, to the tolerance."""
+    from dem.geometry.generators import random_packing
+    from dem.geometry.particles import Particles
+    from dem.laws.ambient import Radiation, Sources
+    from dem.network.heat import build_network, integrate, steady
+
+    lay = random_packing(6000, 1e-4, 0.12, seed=2)
+    T = np.full(len(lay.radius), 300.0)
+    fixed = np.zeros(len(T), bool)
+    fixed[lay.bottom] = True
+    T[lay.bottom] = 1200.0
+    net = build_network(Particles.from_arrays(lay.position, lay.radius, T, fixed=fixed), spec=ConductanceSpec(),
+                        sources=Sources(radiation=Radiation(emissivity=0.8, T_inf=300.0, unit="K")))
+    ref = steady(net, floating="mean", linear="direct", rtol=1e-12)
+    amg = steady(net, floating="mean", linear="amg", rtol=1e-12)
+    assert amg.iterations == ref.iterations > 2  # several Newton iterations, each an AMG solve
+    assert np.max(np.abs(amg.T - ref.T)) < 1e-6 * 1200.0
+    runs = {linear: integrate(net, "implicit", dt=1e-3, t_end=5e-3, linear=linear, rtol_linear=1e-12)
+            for linear in ("direct", "amg")}
+    assert runs["amg"].solver == "amg"
+    assert runs["amg"].factorizations < runs["direct"].factorizations == 5  # one hierarchy served several steps
+    assert np.max(np.abs(runs["amg"].T - runs["direct"].T)) < 1e-6 * 1200.0
+
+
+def test_benchmark_leaves_petsc_out_cleanly_without_petsc4py(monkeypatch):
+    import benchmarks.amg_peers as peers
+
+    monkeypatch.setattr(peers, "available", lambda name: False)
+    assert set(peers.contenders()) == {"amg", "amg_previous"}
+    A, b = lattice_system(shape=(12, 12, 12))
+    rows = peers.side_by_side_rows(A, b, rounds=1)
+    assert [r["solver"] for r in rows] == ["amg", "amg_reused", "amg_previous"]
+    assert all(r["relative_residual"] <= RTOL and r["over_fastest_petsc"] is None for r in rows)
+    assert all(r["max_difference_to_amg"] < 1e-7 for r in rows)
+
+
+@pytest.mark.skipif(not __import__("benchmarks.timing").timing.available("petsc4py"), reason="petsc4py absent")
+def test_petsc_peers_reach_the_same_criterion():
+    import benchmarks.amg_peers as peers
+
+    A, b = lattice_system(shape=(12, 12, 12))
+    rows = {r["solver"]: r for r in peers.side_by_side_rows(A, b, rounds=1)}
+    for name in peers.PETSC_PRECONDITIONERS:
+        assert rows[name]["relative_residual"] <= RTOL
+        assert rows[name]["max_difference_to_amg"] < 1e-7
+
+
+def test_kirchhoff_refresh_reuses_the_hierarchy_with_the_fresh_answer():
+    """A refresh of the contact current (conductances changed by up to 10 %): the solution that reuses the last
+    refresh's hierarchy is the fresh one and sparse LU's, to the tolerance, the driven electrode's potential too."""
+    from dem.network.current import Electrodes, kirchhoff
+
+    shape = (20, 20, 20)
+    index = np.arange(np.prod(shape)).reshape(shape)
+    i = np.concatenate([index[:-1].ravel(), index[:, :-1].ravel(), index[:, :, :-1].ravel()])
+    j = np.concatenate([index[1:].ravel(), index[:, 1:].ravel(), index[:, :, 1:].ravel()])
+    bottom, top = index[:, :, 0].ravel(), index[:, :, -1].ravel()
+    plane_node, plane_index = np.concatenate([bottom, top]), np.repeat([0, 1], len(bottom))
+    rng = np.random.default_rng(4)
+    G, G_w = 10.0 ** (2 * rng.random(len(i))), np.full(len(plane_node), 50.0)
+    # the bottom grounded, the top driving 2 A (its potential found by the unit solves on the same solver)
+    el = Electrodes(("bottom", "top"), (0, 1), np.array([0.0, np.nan]), np.array([np.nan, 2.0]))
+    share = np.full(len(i), 0.5)
+    first = kirchhoff(index.size, i, j, G, share, plane_node, plane_index, G_w, el, "amg")
+    G_new = G * rng.uniform(0.9, 1.1, len(i))
+    again = kirchhoff(index.size, i, j, G_new, share, plane_node, plane_index, G_w, el, "amg", previous=first.solver)
+    assert again.solver.reused and again.solver.hierarchy is first.solver.hierarchy
+    for linear in ("amg", "direct"):
+        fresh = kirchhoff(index.size, i, j, G_new, share, plane_node, plane_index, G_w, el, linear)
+        scale = np.max(np.abs(fresh.potential))
+        assert np.max(np.abs(again.potential - fresh.potential)) < 1e-8 * scale
+        assert again.electrode_potential[1] == pytest.approx(fresh.electrode_potential[1], rel=1e-8)

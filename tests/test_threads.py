@@ -1,0 +1,150 @@
+"""Threads: the velocity-Verlet loop gives the same bits on 1, 2 and 3 threads (its threaded copy sums each
+particle's pair forces in the order of the list, as the one-thread loop does), ``--threads`` is checked, the
+environment variable ``SINTERHEAT_THREADS`` is honoured, ``--quiet`` draws no progress bar."""
+
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from sinterheat import threads
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+# In a fresh process (numba's thread pool is sized when it starts): each scene's first steps on 1, 2 and 3 threads
+# (3 beyond this machine's 2 cores: the pool is made larger), the threaded copy bound for any size. The state after
+# the steps, as lists of the bytes' hex digests.
+SAME_BITS = """
+import hashlib, json, sys
+import numpy as np
+from sinterheat import threads
+import dem.engines.verlet.mechanics as mechanics
+from dem.engines.verlet.engine import VerletEngine
+from dem.scene import load_scene
+
+threads.cores = lambda: 3
+mechanics.THREADED_MIN_PARTICLES = 0
+out = {}
+for name, steps in (("hot-wall-sintering", 3000), ("luding-table1", 3000)):
+    for number in (1, 2, 3):
+        threads.use(number)
+        mech = VerletEngine(load_scene(name)).mechanics
+        s = mech.state
+        T0 = 80.0 + 90.0 * (s.x[:, 2] - s.x[:, 2].min()) / np.ptp(s.x[:, 2])  # 80-170 C: every branch of the law
+        mech.advance(steps, T0, np.full(s.n, 200.0))
+        arrays = (s.x, s.v, s.w, s.f, s.tau, s.radius, mech.particle_state, mech.p_hist, mech.p_fn, mech.p_ft,
+                  mech.w_hist, mech.w_fn, mech.w.q, mech.w.dq)
+        out[f"{name} {number}"] = {"threaded": mech.threaded, "rebuilds": mech.rebuilds,
+                                   "bits": [hashlib.sha1(np.ascontiguousarray(a).tobytes()).hexdigest()
+                                            for a in arrays]}
+print(json.dumps(out))
+"""
+
+
+def _env(**extra):
+    path = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p)
+    return {**os.environ, "PYTHONPATH": path, **extra}
+
+
+def test_one_two_and_three_threads_give_the_same_bits():
+    proc = subprocess.run([sys.executable, "-c", SAME_BITS], env=_env(NUMBA_NUM_THREADS="3"), capture_output=True,
+                          text=True, timeout=1800)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    runs = json.loads(proc.stdout.strip().splitlines()[-1])
+    for name in ("hot-wall-sintering", "luding-table1"):
+        one, two, three = (runs[f"{name} {k}"] for k in (1, 2, 3))
+        assert not one["threaded"] and two["threaded"] and three["threaded"]  # the two loops are compared
+        assert one["rebuilds"] > 0  # the pairs by particle were made again along the way
+        assert one == {**two, "threaded": False} == {**three, "threaded": False}, name
+
+
+def test_pairs_by_particle_in_the_order_of_the_list():
+    from dem.engines.contact_forces import incident_pairs
+
+    rng = np.random.default_rng(1)
+    n = 50
+    i = rng.integers(0, n, 400)
+    j = (i + rng.integers(1, n, 400)) % n
+    start, pairs = incident_pairs(i, j, n)
+    for k in range(n):
+        mine = pairs[start[k]:start[k + 1]]
+        as_i, as_j = mine[mine >= 0], ~mine[mine < 0]
+        assert np.array_equal(as_i, np.flatnonzero(i == k)) and np.array_equal(as_j, np.flatnonzero(j == k))
+        assert np.all(np.diff(np.where(mine >= 0, mine, ~mine)) > 0)  # one ascending sequence of pairs
+
+
+@pytest.mark.parametrize("value", ["0", str(threads.cores() + 1), "two", "-1"])
+def test_a_thread_count_outside_the_cores_is_one_line_and_exit_2(value):
+    proc = subprocess.run([sys.executable, "-m", "dem", "run", "lattice", "--threads", value], env=_env(),
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    shown = repr(value) if value == "two" else value
+    assert f"--threads: threads = {shown}: must be" in proc.stderr and f"from 1 to {threads.cores()}" in proc.stderr
+
+
+def test_a_bad_environment_variable_is_refused_naming_it():
+    proc = subprocess.run([sys.executable, "-m", "dem", "run", "lattice"], env=_env(SINTERHEAT_THREADS="0"),
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1
+    assert "SINTERHEAT_THREADS = 0: must be from 1 to" in proc.stderr
+
+
+def test_the_environment_variable_sets_the_count_and_the_option_wins(monkeypatch):
+    monkeypatch.setattr(threads, "_chosen", None)
+    monkeypatch.setenv(threads.ENVIRONMENT, "1")
+    assert threads.count() == 1
+    monkeypatch.delenv(threads.ENVIRONMENT)
+    assert threads.count() == threads.cores()
+    monkeypatch.setenv(threads.ENVIRONMENT, str(threads.cores() + 1))
+    with pytest.raises(ValueError, match="SINTERHEAT_THREADS"):
+        threads.count()
+    monkeypatch.setenv(threads.ENVIRONMENT, "1")
+    for variable in threads.BLAS_VARIABLES:
+        monkeypatch.delenv(variable, raising=False)  # restored after the test
+    threads.use(threads.cores())  # the option wins over the environment, which child processes then inherit
+    assert threads.count() == threads.cores()
+    assert os.environ[threads.ENVIRONMENT] == os.environ["OPENBLAS_NUM_THREADS"] == str(threads.cores())
+
+
+@pytest.mark.skipif(threads.cores() < 2, reason="needs two cores")
+def test_the_engine_binds_its_loop_by_the_thread_count(monkeypatch):
+    import dem.engines.verlet.mechanics as mechanics
+    from dem.engines.verlet.engine import VerletEngine
+    from dem.scene import load_scene
+
+    monkeypatch.setattr(threads, "_chosen", None)
+    monkeypatch.setattr(mechanics, "THREADED_MIN_PARTICLES", 0)
+    scene = load_scene("luding-three-particles")
+    for value, threaded in (("1", False), ("2", True)):
+        monkeypatch.setenv(threads.ENVIRONMENT, value)
+        assert VerletEngine(scene).mechanics.threaded is threaded
+    monkeypatch.setattr(mechanics, "THREADED_MIN_PARTICLES", 10)  # three particles: too few to share
+    assert VerletEngine(scene).mechanics.threaded is False
+
+
+def quick_moving_scene() -> str:
+    """The built-in hot-wall-sintering scene (a moving run with its thermal network) cut to 0.04 s: about 6 s of
+    steps on a quiet machine, so that the progress bar (drawn after 2 s) shows (at 0.02 s the run ended in 1.7 s)."""
+    text = (ROOT / "dem" / "scene" / "builtin" / "hot-wall-sintering.toml").read_text()
+    assert "t_end = 0.15\n" in text
+    return text.replace("t_end = 0.15\n", "t_end = 0.04\n")
+
+
+def test_quiet_prints_the_result_and_no_progress_bar(tmp_path):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(quick_moving_scene())
+    runs = {}
+    for quiet in (False, True):
+        argv = [sys.executable, "-m", "dem", "run", str(scene), "--json"] + (["--quiet"] if quiet else [])
+        runs[quiet] = subprocess.run(argv, env=_env(), capture_output=True, text=True, timeout=600)
+        assert runs[quiet].returncode == 0, runs[quiet].stderr[-2000:]
+    loud, quiet = runs[False], runs[True]
+    assert "s simulated" in loud.stderr  # the bar, drawn after 2 s
+    assert quiet.stderr == ""
+    timeless = [{k: v for k, v in json.loads(r.stdout).items() if k != "seconds"} for r in (quiet, loud)]
+    assert timeless[0] == timeless[1]
