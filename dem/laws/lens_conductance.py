@@ -41,11 +41,15 @@ def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pi, pj
     range; any policy but ``"drop"``: coincident centres, a centre on or behind a wall), whose ``K`` is left 0:
     ``find_bonds`` then names the first and says what to do."""
     bad = 0
+    periodic = box[0] > 0.0 or box[1] > 0.0 or box[2] > 0.0  # without a box the loop stays the plain one
     for c in range(pi.shape[0]):
         i, j = pi[c], pj[c]
         K[c] = 0.0
-        d2 = (min_image(x[j, 0] - x[i, 0], box[0]) ** 2 + min_image(x[j, 1] - x[i, 1], box[1]) ** 2
-              + min_image(x[j, 2] - x[i, 2], box[2]) ** 2)
+        if periodic:
+            d2 = (min_image(x[j, 0] - x[i, 0], box[0]) ** 2 + min_image(x[j, 1] - x[i, 1], box[1]) ** 2
+                  + min_image(x[j, 2] - x[i, 2], box[2]) ** 2)
+        else:
+            d2 = (x[j, 0] - x[i, 0]) ** 2 + (x[j, 1] - x[i, 1]) ** 2 + (x[j, 2] - x[i, 2]) ** 2
         ri, rj = radius[i], radius[j]
         if d2 > (ri + rj) ** 2 * (1.0 + 1e-10):  # surely apart: no square root (the exact test follows)
             continue
