@@ -116,14 +116,8 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
         here.update(step=writer.last["step"], t=writer.last["t"])
 
     try:
-        try:
-            engine.run(observed if writer is not None else (_nothing if out is not None else None),
-                       advanced if scene.solver.mode == "transient" else None, checkpointer)
-        finally:
-            if bar is not None:
-                if scene.solver.mode != "transient":
-                    bar.update(1)
-                bar.close()
+        _advance(engine, scene, bar, observed if writer is not None else (_nothing if out is not None else None),
+                 advanced, checkpointer)
         summary = _summary(scene, engine, restart)
         summary["seconds"] = time.perf_counter() - start
         if writer is not None:
@@ -142,6 +136,19 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
                           plots=False)
         raise
     return RunResult(summary, engine.temperatures(), engine)
+
+
+def _advance(engine, scene: Scene, bar, observe, advanced, checkpointer) -> None:
+    """``engine.run``, ``advanced(t)`` told the simulated time of a transient run; the bar closed however it ends (a
+    steady run's bar filled first)."""
+    transient = scene.solver.mode == "transient"
+    try:
+        engine.run(observe, advanced if transient else None, checkpointer)
+    finally:
+        if bar is not None:
+            if not transient:
+                bar.update(1)
+            bar.close()
 
 
 def _nothing():
@@ -177,14 +184,7 @@ def _run_distributed(scene: Scene, out, progress: bool, resume: bool, overwrite:
         if bar is not None:
             bar.update(min(t - engine.t_start, bar.total) - bar.n)
 
-    try:
-        engine.run(writer.observe if writer is not None else None,
-                   advanced if scene.solver.mode == "transient" else None)
-    finally:
-        if bar is not None:
-            if scene.solver.mode != "transient":
-                bar.update(1)
-            bar.close()
+    _advance(engine, scene, bar, writer.observe if writer is not None else None, advanced, None)
     summary = _summary(scene, engine, None)
     summary.pop("T", None)
     if scene.particles.n <= T_LIST_MAX:

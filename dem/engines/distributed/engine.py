@@ -105,14 +105,6 @@ class DistributedStaticEngine(StaticEngine):
         return owner[held]
 
     # ------------------------------------------------------------------------------------------------ run
-    def _observed(self, observe):
-        def observer(step, t, T_free, flows):
-            self.steps, self.t, self.flows = step, self.t_start + t, flows
-            self.T = self.network.full(T_free)
-            if observe is not None:
-                observe()
-        return observer
-
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """Solve (steady) or step (transient) to ``[solver] t_end`` on all ranks together (``checkpoint`` unused:
         a distributed run does not resume)."""

@@ -156,13 +156,17 @@ class MechanicalModel:
     def t(self) -> float:
         return self.t_start + self.steps * self.dt
 
+    def _temperature_arguments(self, T0, T_rate, relaxation_time: float | None):
+        """The compiled loop's temperature arguments: ``T0`` and ``T_rate`` as contiguous arrays, whether they are
+        uniform (one entry), and the relaxation time (the model's unless given)."""
+        T0 = np.ascontiguousarray(T0, dtype=float)
+        return (T0, np.ascontiguousarray(T_rate, dtype=float), len(T0) == 1,
+                self.relaxation_time if relaxation_time is None else relaxation_time)
+
     def advance(self, n_steps: int, T0: np.ndarray, T_rate: np.ndarray, relaxation_time: float | None = None):
         """``n_steps`` steps with temperatures ``T0 + T_rate (t - t_now)`` (uniform when both have one entry)."""
         s, w = self.state, self.w
-        t0 = self.relaxation_time if relaxation_time is None else relaxation_time
-        T0 = np.ascontiguousarray(T0, dtype=float)
-        T_rate = np.ascontiguousarray(T_rate, dtype=float)
-        uniform = len(T0) == 1
+        T0, T_rate, uniform, t0 = self._temperature_arguments(T0, T_rate, relaxation_time)
         first = self.steps
         done = 0
         while done < n_steps:

@@ -236,10 +236,7 @@ class RankMechanics(MechanicalModel):
         """``n_steps`` steps, one call of the compiled loop each, with the exchanges between them (module
         docstring)."""
         s, w = self.state, self.w
-        t0 = self.relaxation_time if relaxation_time is None else relaxation_time
-        T0 = np.ascontiguousarray(T0, dtype=float)
-        T_rate = np.ascontiguousarray(T_rate, dtype=float)
-        uniform = len(T0) == 1
+        T0, T_rate, uniform, t0 = self._temperature_arguments(T0, T_rate, relaxation_time)
         first = self.steps
         h = 0.5 * self.dt
         for _ in range(n_steps):
