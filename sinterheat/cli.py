@@ -67,18 +67,20 @@ def add_workers_option(parser: argparse.ArgumentParser) -> None:
                         help="processes (default: all cores)")
 
 
-def _thread_count(text: str) -> int:
-    from sinterheat.threads import check
-
-    try:
-        return check(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+def _checked_by(module: str, check: str):
+    """An argparse ``type``: the option's text passed to ``module.check`` (imported only when the option is given),
+    whose ``ValueError`` becomes argparse's one-line error."""
+    def convert(text: str):
+        try:
+            return getattr(importlib.import_module(module), check)(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+    return convert
 
 
 def add_threads_option(parser: argparse.ArgumentParser) -> None:
     """``--threads N``: the threads of the compiled loops and of BLAS, 1 to the cores (:mod:`sinterheat.threads`)."""
-    parser.add_argument("--threads", type=_thread_count, default=None, metavar="N",
+    parser.add_argument("--threads", type=_checked_by("sinterheat.threads", "check"), default=None, metavar="N",
                         help="threads of the compiled loops and BLAS, 1 to the cores (default: the environment "
                              "variable SINTERHEAT_THREADS, else every core); results are the same on any number")
 
@@ -96,19 +98,11 @@ def add_quiet_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress bars: only the result and errors")
 
 
-def _scheduler(text: str) -> str:
-    from sinterheat.pool import check_scheduler
-
-    try:
-        return check_scheduler(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
 def add_scheduler_option(parser: argparse.ArgumentParser) -> None:
     """``--scheduler ADDRESS``: the sweep's jobs on a Dask cluster (:func:`sinterheat.pool.use_dask`); without Dask
     installed the option is refused with how to install it."""
-    parser.add_argument("--scheduler", type=_scheduler, default=None, metavar="ADDRESS",
+    parser.add_argument("--scheduler", type=_checked_by("sinterheat.pool", "check_scheduler"), default=None,
+                        metavar="ADDRESS",
                         help="run the independent jobs on a Dask cluster: a scheduler's address (tcp://host:8786) or "
                              "'local' (a LocalCluster of --workers processes here); needs pip install '.[dask]'")
 
