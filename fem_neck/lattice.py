@@ -59,12 +59,18 @@ COORDINATION = {"sc": 6, "bcc": 8, "fcc": 12}
 # smallest neck meshed: below it the neck is thinner than 1.3e-3 r and the mesh of its disk explodes; the network is
 # exact in the limit of small necks (independent constrictions), which the FE shows from here up
 MIN_NECK_RATIO = 0.05
-# the meshes: element size at the neck circles over the neck radius (of the first mesh at rtol = 1e-3, and the
-# range of first meshes), far size over the particle radius, growth of the size per unit distance from the circles
-SIZE_NECK0, FIRST_SIZES, SIZE_FAR, GRADING = 0.05, (0.01, 0.3), 0.5, 0.8
+# the meshes: element size at the neck circles over the neck radius (the range of first meshes), far size over the
+# particle radius, growth of the size per unit distance from the circles
+FIRST_SIZES, SIZE_FAR, GRADING = (0.005, 0.3), 0.5, 0.8
 # measured on the lattice cells: the gap falls like size_neck^GAP_ORDER, the tetrahedra grow like
 # size_neck^-ELEMENT_ORDER (:func:`effective_conductivity`)
 GAP_ORDER, ELEMENT_ORDER = 1.25, 1.0
+# the first mesh (:func:`first_neck_size`): at neck size SIZE_NECK0 the bounds of a cell whose smallest neck has
+# a/r = NECK0 are about RTOL0 apart (p = 4; the cubic lattices at h/r = 0.02: 0.9-1.1e-4); larger necks need a
+# coarser mesh, the gap falling like (a/r)^-NECK_ORDER (SC, BCC, FCC at a/r = 0.2 and 0.39: 4.4e-5, 4.2e-5,
+# 3.3e-5 at a/r = 0.39), used only over NECK_RANGE (not extrapolated to necks smaller than measured); the first
+# mesh aims at FIRST_MARGIN rtol
+SIZE_NECK0, RTOL0, NECK0, NECK_RANGE, NECK_ORDER, FIRST_MARGIN = 0.01, 1e-4, 0.2, (0.2, 0.5), 1.3, 0.75
 # peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured)
 BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 70e3}
 _TOL = 1e-9  # geometric tolerance in units of the largest radius
@@ -496,14 +502,39 @@ def available_memory() -> float:
     return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
 
 
+def smallest_neck_ratio(cell: PeriodicCell) -> float:
+    """The smallest ``a / r`` of the cell's bonds (``r`` the smaller radius of the pair)."""
+    i, j, s = cell.bonds()
+    d = np.linalg.norm(cell.centres[j] + s * cell.period - cell.centres[i], axis=1)
+    r_i, r_j = cell.radii[i], cell.radii[j]
+    return float(np.min(neck_geometry(r_i, r_j, r_i + r_j - d).a / np.minimum(r_i, r_j)))
+
+
+def _neck_factor(neck_ratio: float) -> float:
+    """How much coarser than at ``NECK0`` a mesh may be for the same gap when the smallest neck is ``neck_ratio``."""
+    return (float(np.clip(neck_ratio, *NECK_RANGE)) / NECK0) ** (NECK_ORDER / GAP_ORDER)
+
+
+def first_neck_size(rtol: float, neck_ratio: float) -> float:
+    """Neck size of the first mesh of a cell whose smallest neck has ``a / r = neck_ratio``: the size whose gap is
+    predicted at ``FIRST_MARGIN rtol`` (``RTOL0`` at ``SIZE_NECK0`` for ``a / r = NECK0``, the gap falling like
+    ``size^GAP_ORDER`` and like ``(a / r)^-NECK_ORDER``), within ``FIRST_SIZES``."""
+    size = SIZE_NECK0 * (FIRST_MARGIN * rtol / RTOL0) ** (1.0 / GAP_ORDER) * _neck_factor(neck_ratio)
+    return float(np.clip(size, *FIRST_SIZES))
+
+
+def first_rtol(size: float, neck_ratio: float) -> float:
+    """The ``rtol`` whose first mesh (:func:`first_neck_size`) has neck size ``size``."""
+    return RTOL0 * (size / (SIZE_NECK0 * _neck_factor(neck_ratio))) ** GAP_ORDER / FIRST_MARGIN
+
+
 def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | None = None,
                            max_memory: float | None = None, max_meshes: int = 4, workers: int = 2,
                            progress=None) -> CellResult:
     """``k_eff / kappa`` along z of the periodic ``cell`` with two-sided bounds (module docstring).
 
-    The first mesh has neck size ``SIZE_NECK0`` scaled to ``rtol`` (within ``FIRST_SIZES``); while the
-    bounds are more than ``rtol`` apart it predicts the
-    neck size that meets ``rtol`` (the gap falls like ``size_neck^GAP_ORDER``, the tetrahedra grow like
+    The first mesh has the neck size :func:`first_neck_size` (from ``rtol`` and the cell's smallest neck); while
+    the bounds are more than ``rtol`` apart it predicts the neck size that meets ``rtol`` (the gap falls like ``size_neck^GAP_ORDER``, the tetrahedra grow like
     ``size_neck^-ELEMENT_ORDER``) and solves there, at most ``max_meshes`` meshes. Before each mesh the memory of
     its solve is estimated (:func:`memory_estimate`); one that would not fit in ``max_memory`` bytes (default: what
     the machine has available) is refused with a ``ValueError`` naming the estimate and the ``rtol`` that would fit.
@@ -516,7 +547,8 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
         raise ValueError(f"order = {order!r}: must be one of {', '.join(map(str, BYTES_PER_ELEMENT))}")
     budget = available_memory() if max_memory is None else float(max_memory)
     t0 = time.perf_counter()
-    size = float(np.clip(SIZE_NECK0 * (rtol / 1e-3) ** (1.0 / GAP_ORDER), *FIRST_SIZES))
+    neck = smallest_neck_ratio(cell)
+    size = first_neck_size(rtol, neck)
     history = []
     for _ in range(max_meshes):
         if progress is not None:
@@ -526,7 +558,7 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
         if need > budget:
             # the first mesh's neck size that fits, and the rtol that starts there (tetrahedra ~ 1 / size)
             fit = size * len(cm.curved.tets) * BYTES_PER_ELEMENT[order] / max(budget - BASE_BYTES, 1.0)
-            reach = 1e-3 * (fit / SIZE_NECK0) ** GAP_ORDER
+            reach = first_rtol(fit, neck)
             raise ValueError(f"{cell.name}: the mesh of neck size {size:.3g} a has {len(cm.curved.tets)} tetrahedra "
                              f"and needs ~{need / 1e9:.1f} GB, more than the {budget / 1e9:.1f} GB available; "
                              f"rtol = {reach:.1e} would fit")

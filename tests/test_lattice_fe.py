@@ -110,6 +110,18 @@ def test_effective_conductivity_refines_to_its_tolerance():
     assert res.k_eff_over_kappa < res.phi  # Wiener: no microstructure beats the parallel bound
 
 
+def test_first_mesh_is_coarser_for_larger_necks_and_looser_tolerances():
+    # the smallest neck of a lattice is its pair neck; of a random packing, its smallest bond's
+    assert lattice.smallest_neck_ratio(lattice.lattice_cell("bcc", 0.08)) == pytest.approx(neck_radius(1, 1, 0.08))
+    small, large = (lattice.first_neck_size(1e-4, x) for x in (0.2, 0.4))
+    assert large / small == pytest.approx(2.0 ** (lattice.NECK_ORDER / lattice.GAP_ORDER), rel=1e-12)
+    # not extrapolated below the smallest neck measured: a smaller neck gets the a/r = 0.2 mesh
+    assert lattice.first_neck_size(1e-4, 0.1) == small
+    assert lattice.first_neck_size(1e-3, 0.2) / small == pytest.approx(10 ** (1 / lattice.GAP_ORDER), rel=1e-12)
+    # first_rtol inverts it (what the refusal names)
+    assert lattice.first_rtol(lattice.first_neck_size(3e-4, 0.3), 0.3) == pytest.approx(3e-4, rel=1e-12)
+
+
 def test_a_run_that_would_not_fit_is_refused_with_the_rtol_that_would():
     with pytest.raises(ValueError, match=r"GB available; rtol = \d\.\de-\d\d would fit") as info:
         lattice.effective_conductivity(_chain_cell(0.2), rtol=1e-6, max_memory=0.8e9, workers=1)
@@ -126,6 +138,7 @@ def test_lattices_to_1e4_bracket_the_reference_with_a_sharp_estimate(case):
     res = lattice.effective_conductivity(lattice.lattice_cell(kind, h), rtol=1e-4)
     ref = REFERENCES[case]
     assert res.converged and res.error_estimate <= 1e-4
+    assert len(res.levels) == 1  # the first mesh, sized from rtol and the neck, meets rtol: no mesh is wasted
     assert res.k_lower_over_kappa < ref < res.k_upper_over_kappa
     assert (res.k_upper_over_kappa - res.k_lower_over_kappa) / (res.k_upper_over_kappa - ref) < 3.0
     assert res.k_eff_over_kappa < res.phi
