@@ -31,7 +31,8 @@ face mapped onto its sphere, cylinder, plane or their intersection curve), so th
 Both converge at one rate, so ``error_estimate = (upper - lower) / upper`` bounds the error of the reported value
 (the upper) and is 2-3 times it (the two errors are about equal, measured on the lattice cells). The bounds hold up
 to the quadrature of the curved elements (degree ``2 p``: ~5e-8 relative, measured against ``2 p + 4``) and the
-solvers' residuals (1e-10). The mesh is graded toward every neck circle, where the temperature is singular
+flux solver's residual (1e-10; the upper bound's CG stops when its energy has settled to 1e-9, and the energy of
+any iterate is an upper bound). The mesh is graded toward every neck circle, where the temperature is singular
 (``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined until the estimate
 meets ``rtol``, and the memory of each solve is estimated before it starts (:func:`effective_conductivity`).
 """

@@ -101,6 +101,19 @@ def test_finer_quadrature_moves_the_bounds_by_less_than_1e7():
     assert up[0] == pytest.approx(up[1], rel=1e-7)
 
 
+def test_primal_cg_stops_when_the_energy_has_settled():
+    # the upper bound's CG stops on its energy (an upper bound whatever the iterate): within the tolerance of the
+    # energy solved to round-off, above it, in fewer iterations
+    from fem_neck import primal
+
+    cm = lattice.build_cell_mesh(_chain_cell(0.08), **COARSE)
+    loose = primal.solve(cm.curved, 3, cm.hot, cm.cold)
+    tight = primal.solve(cm.curved, 3, cm.hot, cm.cold, etol=1e-15)
+    assert loose.energy == pytest.approx(tight.energy, rel=10 * primal.ENERGY_RTOL)
+    assert loose.energy >= tight.energy * (1.0 - 1e-12)  # CG lowers the energy (up to its round-off)
+    assert loose.iterations < tight.iterations
+
+
 def test_effective_conductivity_refines_to_its_tolerance():
     res = lattice.effective_conductivity(_chain_cell(0.02), rtol=1e-3, workers=1)
     assert len(res.levels) >= 2 and res.levels[0]["gap"] > 1e-3  # the first mesh was too coarse
