@@ -66,12 +66,14 @@ FIRST_SIZES, SIZE_FAR, GRADING = (0.005, 0.3), 0.5, 0.8
 # measured on the lattice cells: the gap falls like size_neck^GAP_ORDER, the tetrahedra grow like
 # size_neck^-ELEMENT_ORDER (:func:`effective_conductivity`)
 GAP_ORDER, ELEMENT_ORDER = 1.25, 1.0
-# the first mesh (:func:`first_neck_size`): at neck size SIZE_NECK0 the bounds of a cell whose smallest neck has
-# a/r = NECK0 are about RTOL0 apart (p = 4; the cubic lattices at h/r = 0.02: 0.9-1.1e-4); larger necks need a
-# coarser mesh, the gap falling like (a/r)^-NECK_ORDER (SC, BCC, FCC at a/r = 0.2 and 0.39: 4.4e-5, 4.2e-5,
-# 3.3e-5 at a/r = 0.39), used only over NECK_RANGE (not extrapolated to necks smaller than measured); the first
-# mesh aims at FIRST_MARGIN rtol
-SIZE_NECK0, RTOL0, NECK0, NECK_RANGE, NECK_ORDER, FIRST_MARGIN = 0.01, 1e-4, 0.2, (0.2, 0.5), 1.3, 0.75
+# the first mesh (:func:`first_neck_size`), by order p: (size0, rtol0, neck_order, margin): at neck size size0 the
+# bounds of a cell whose smallest neck has a/r = NECK0 are about rtol0 apart; larger necks need a coarser mesh, the
+# gap falling like (a/r)^-neck_order, used only over NECK_RANGE (not extrapolated to necks smaller than measured);
+# the first mesh aims at margin rtol. p = 4: the cubic lattices at h/r = 0.02 (a/r = 0.2) are 0.9-1.1e-4 apart at
+# size 0.01, at h/r = 0.08 (a/r = 0.39) 3.3-4.4e-5. p = 3: no dependence on the neck measured (a random packing
+# with a/r >= 0.25 was 2.2e-3 apart at size 0.087, the size this rule gives for 2e-3).
+FIRST_MESH = {3: (0.05, 1e-3, 0.0, 1.0), 4: (0.01, 1e-4, 1.3, 0.75)}
+NECK0, NECK_RANGE = 0.2, (0.2, 0.5)
 # peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured)
 BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 70e3}
 _TOL = 1e-9  # geometric tolerance in units of the largest radius
@@ -511,22 +513,25 @@ def smallest_neck_ratio(cell: PeriodicCell) -> float:
     return float(np.min(neck_geometry(r_i, r_j, r_i + r_j - d).a / np.minimum(r_i, r_j)))
 
 
-def _neck_factor(neck_ratio: float) -> float:
+def _neck_factor(neck_ratio: float, order: int) -> float:
     """How much coarser than at ``NECK0`` a mesh may be for the same gap when the smallest neck is ``neck_ratio``."""
-    return (float(np.clip(neck_ratio, *NECK_RANGE)) / NECK0) ** (NECK_ORDER / GAP_ORDER)
+    neck_order = FIRST_MESH[order][2]
+    return (float(np.clip(neck_ratio, *NECK_RANGE)) / NECK0) ** (neck_order / GAP_ORDER)
 
 
-def first_neck_size(rtol: float, neck_ratio: float) -> float:
-    """Neck size of the first mesh of a cell whose smallest neck has ``a / r = neck_ratio``: the size whose gap is
-    predicted at ``FIRST_MARGIN rtol`` (``RTOL0`` at ``SIZE_NECK0`` for ``a / r = NECK0``, the gap falling like
-    ``size^GAP_ORDER`` and like ``(a / r)^-NECK_ORDER``), within ``FIRST_SIZES``."""
-    size = SIZE_NECK0 * (FIRST_MARGIN * rtol / RTOL0) ** (1.0 / GAP_ORDER) * _neck_factor(neck_ratio)
+def first_neck_size(rtol: float, neck_ratio: float, order: int) -> float:
+    """Neck size of the first mesh at ``order`` of a cell whose smallest neck has ``a / r = neck_ratio``: the size
+    whose gap is predicted at ``margin rtol`` (``FIRST_MESH``: ``rtol0`` at ``size0`` for ``a / r = NECK0``, the gap
+    falling like ``size^GAP_ORDER`` and like ``(a / r)^-neck_order``), within ``FIRST_SIZES``."""
+    size0, rtol0, _, margin = FIRST_MESH[order]
+    size = size0 * (margin * rtol / rtol0) ** (1.0 / GAP_ORDER) * _neck_factor(neck_ratio, order)
     return float(np.clip(size, *FIRST_SIZES))
 
 
-def first_rtol(size: float, neck_ratio: float) -> float:
-    """The ``rtol`` whose first mesh (:func:`first_neck_size`) has neck size ``size``."""
-    return RTOL0 * (size / (SIZE_NECK0 * _neck_factor(neck_ratio))) ** GAP_ORDER / FIRST_MARGIN
+def first_rtol(size: float, neck_ratio: float, order: int) -> float:
+    """The ``rtol`` whose first mesh at ``order`` (:func:`first_neck_size`) has neck size ``size``."""
+    size0, rtol0, _, margin = FIRST_MESH[order]
+    return rtol0 * (size / (size0 * _neck_factor(neck_ratio, order))) ** GAP_ORDER / margin
 
 
 def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | None = None,
@@ -549,7 +554,7 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
     budget = available_memory() if max_memory is None else float(max_memory)
     t0 = time.perf_counter()
     neck = smallest_neck_ratio(cell)
-    size = first_neck_size(rtol, neck)
+    size = first_neck_size(rtol, neck, order)
     history = []
     for _ in range(max_meshes):
         if progress is not None:
@@ -559,7 +564,7 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
         if need > budget:
             # the first mesh's neck size that fits, and the rtol that starts there (tetrahedra ~ 1 / size)
             fit = size * len(cm.curved.tets) * BYTES_PER_ELEMENT[order] / max(budget - BASE_BYTES, 1.0)
-            reach = first_rtol(fit, neck)
+            reach = first_rtol(fit, neck, order)
             raise ValueError(f"{cell.name}: the mesh of neck size {size:.3g} a has {len(cm.curved.tets)} tetrahedra "
                              f"and needs ~{need / 1e9:.1f} GB, more than the {budget / 1e9:.1f} GB available; "
                              f"rtol = {reach:.1e} would fit")

@@ -126,13 +126,15 @@ def test_effective_conductivity_refines_to_its_tolerance():
 def test_first_mesh_is_coarser_for_larger_necks_and_looser_tolerances():
     # the smallest neck of a lattice is its pair neck; of a random packing, its smallest bond's
     assert lattice.smallest_neck_ratio(lattice.lattice_cell("bcc", 0.08)) == pytest.approx(neck_radius(1, 1, 0.08))
-    small, large = (lattice.first_neck_size(1e-4, x) for x in (0.2, 0.4))
-    assert large / small == pytest.approx(2.0 ** (lattice.NECK_ORDER / lattice.GAP_ORDER), rel=1e-12)
+    small, large = (lattice.first_neck_size(1e-4, x, 4) for x in (0.2, 0.4))
+    assert large / small == pytest.approx(2.0 ** (lattice.FIRST_MESH[4][2] / lattice.GAP_ORDER), rel=1e-12)
     # not extrapolated below the smallest neck measured: a smaller neck gets the a/r = 0.2 mesh
-    assert lattice.first_neck_size(1e-4, 0.1) == small
-    assert lattice.first_neck_size(1e-3, 0.2) / small == pytest.approx(10 ** (1 / lattice.GAP_ORDER), rel=1e-12)
+    assert lattice.first_neck_size(1e-4, 0.1, 4) == small
+    assert lattice.first_neck_size(2e-4, 0.2, 4) / small == pytest.approx(2.0 ** (1 / lattice.GAP_ORDER), rel=1e-12)
+    # p = 3: no dependence on the neck measured
+    assert lattice.first_neck_size(1e-3, 0.2, 3) == lattice.first_neck_size(1e-3, 0.4, 3)
     # first_rtol inverts it (what the refusal names)
-    assert lattice.first_rtol(lattice.first_neck_size(3e-4, 0.3), 0.3) == pytest.approx(3e-4, rel=1e-12)
+    assert lattice.first_rtol(lattice.first_neck_size(1e-4, 0.3, 4), 0.3, 4) == pytest.approx(1e-4, rel=1e-12)
 
 
 def test_a_run_that_would_not_fit_is_refused_with_the_rtol_that_would():
