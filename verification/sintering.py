@@ -388,6 +388,14 @@ def discussion(st: Study) -> str:
                      f"frictionless preparation, for N = 300 too).")
         except Missing:
             pass
+        try:
+            other = [st.res(sr.PREPARE, n, 10.0, seed=seed)["volume_fraction"] for seed in sr.PREP_SEEDS]
+            text += (f" One sample of N = {n} is a noisy measure: the same preparation from other random placements "
+                     f"ends at ν(t_heat) = {', '.join(f'{v:.3f}' for v in other)} (p = 10, seeds "
+                     f"{', '.join(str(seed) for seed in sr.PREP_SEEDS)}) against {prep[10.0]:.3f}, and the "
+                     f"densification ν(t_f)/ν(t_heat) − 1 moves with the start; the paper's Fig. 9 is of N = 300.")
+        except Missing:
+            pass
         return text
 
     def cooling():

@@ -69,6 +69,7 @@ class Variant:
     stage_only: bool = False
 
 
+PREP_SEEDS = (2, 3)  # other random placements of the protocol's preparation: the spread of nu(t_heat) of one sample
 FRICTIONLESS = {"prep_mu": 0.0, "prep_mu_wall": 0.0}
 VARIANTS = {v.label: v for v in (
     Variant("frictionless", FRICTIONLESS),                                   # the paper's text (Sec. 4)
@@ -168,10 +169,12 @@ class Grid:
             return []
         n, t_max = max(self.n), max(self.t_s)
         out = [Task(PREPARE, n, 10.0, variant=v) for v in ("frictionless", "frictionless-wall-friction")]
+        out += [Task(PREPARE, n, 10.0, seed=seed) for seed in PREP_SEEDS]
         if self.isolation == "full":
             preps = ("frictionless", "frictionless-fast", "frictionless-slow", "frictionless-cohesive",
                      "frictionless-wall-friction", "no-wall-friction")
             out += [Task(PREPARE, m, 10.0, variant=v) for m in self.n for v in preps]
+            out += [Task(PREPARE, m, p, seed=seed) for m in self.n for p in self.p for seed in PREP_SEEDS]
             out += [Task(COOL, m, p, t_max, variant="frictionless") for m in self.n for p in self.p]
             out += [Task(COOL, min(self.n), 10.0, t_max, variant=v)
                     for v in ("frictionless-wall-friction", "no-wall-friction")]
