@@ -35,6 +35,11 @@ CASES = {
     # elastic and frictionless (Hertz, e = 1): the energy of the collisions comes back
     "elastic": {**GAS, "contact": ELASTIC},
 }
+HEAT = {**GAS, "scene": {"physics": ["mechanical", "thermal"]},  # the elastic gas with heat through its contacts,
+        "contact": ELASTIC,  # insulated (a law whose forces do not depend on the temperature: the serial motion)
+        "material": {"density": 7800.0, "conductivity": 40.0, "specific_heat": 450.0},
+        "generator": {**GAS["generator"], "n": 50, "radius": 6e-4, "speed": 0.2},
+        "solver": {"mode": "transient", "t_end": 0.004, "thermal_interval": 1e-4}}
 CHUNK = 100  # steps between the samples of a trace
 
 
@@ -93,6 +98,18 @@ def pressed(relative: float = 0.0):
     return parse_scene(doc)
 
 
+def hot_and_cold():
+    """:data:`HEAT`, the particles' temperatures 20 to 100 (by id): heat flows wherever two of them touch."""
+    import dataclasses
+
+    from dem import parse_scene
+
+    scene = parse_scene(copy.deepcopy(HEAT))
+    p = scene.particles
+    T = 20.0 + 80.0 * (np.arange(p.n) * 37 % p.n) / p.n
+    return dataclasses.replace(scene, particles=dataclasses.replace(p, temperature=T))
+
+
 def run_scene(scene, out=None) -> dict:
     """``scene`` through the driver: the final particles and the summary's numbers."""
     from dem import run
@@ -114,6 +131,8 @@ if __name__ == "__main__":
         result = run_builtin(sys.argv[2], float(sys.argv[3]), sys.argv[4])
     elif sys.argv[1] == "compaction":  # compaction RESULT
         result = run_scene(pressed())
+    elif sys.argv[1] == "heat":  # heat RESULT
+        result = run_scene(hot_and_cold())
     else:  # CASE RESULT
         result = trace(RankVerletEngine, sys.argv[1], comm)
     if comm.Get_rank() == 0:

@@ -1,6 +1,7 @@
 """Moving particles across MPI ranks (dem.engines.verlet.ranks), launched with mpiexec -n 1 and -n 2 on
 tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserve momentum (periodic box), follow
-the serial elastic collisions (energy and all) to the bit, lose and duplicate no particle through migration, move
+the serial elastic collisions (energy and all) to the bit, carry the heat of the contacts as the serial run does
+(conserving it), lose and duplicate no particle through migration, move
 stress walls as the serial run to round-off, and write the run's folder from rank 0. Skipped where mpi4py or
 mpiexec is missing."""
 
@@ -41,13 +42,13 @@ def _mpi_works() -> bool:
 pytestmark = pytest.mark.skipif(not _mpi_works(), reason="mpi4py or a working mpiexec is missing")
 
 
-def ranks(n: int, *args, timeout: float = 900) -> subprocess.CompletedProcess:
+def ranks(n: int, *args, timeout: float = 900, env=None) -> subprocess.CompletedProcess:
     return subprocess.run(["mpiexec", "-n", str(n), sys.executable, str(HERE / "ranks_worker.py"), *map(str, args)],
-                          env=ENV, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
+                          env={**ENV, **(env or {})}, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
 
 
-def launched(n: int, *args) -> dict:
-    done = ranks(n, *args)
+def launched(n: int, *args, env=None) -> dict:
+    done = ranks(n, *args, env=env)
     assert done.returncode == 0, done.stderr[-3000:]
     with np.load(args[-1]) as data:
         return {k: data[k] for k in data.files}
@@ -89,6 +90,27 @@ def test_two_ranks_follow_the_serial_elastic_collisions_to_the_bit(tmp_path):
         assert np.array_equal(two[key], serial[key]), key
 
 
+def test_two_ranks_carry_the_heat_of_the_contacts(tmp_path):
+    """An insulated periodic gas whose particles start at 20-100 C: on two ranks each thermal step is solved on
+    PETSc (dem.engines.verlet.ranks.RankContactThermal). The mechanics of a periodic run is the serial one, so are
+    the contacts; the temperatures equal the serial run's to CG's tolerance with the default AMG, to round-off with
+    a direct solver, and the heat the particles hold stays what it was."""
+    serial = ranks_worker.run_scene(ranks_worker.hot_and_cold())
+    scene = ranks_worker.hot_and_cold()
+    p = scene.particles
+    heat0 = float(p.capacity @ p.temperature)
+    spread = float(np.ptp(p.temperature))
+    assert np.ptp(serial["T"]) < spread * (1 - 1e-4)  # heat flowed: the extremes moved in
+    for env, tolerance in (({}, 1e-8), ({"PETSC_OPTIONS": "-pc_type lu -pc_factor_mat_solver_type mumps"}, 1e-13)):
+        two = launched(2, "heat", tmp_path / "two.npz", env=env)
+        assert np.max(np.abs(two["T"] - serial["T"])) <= tolerance * spread, env
+        np.testing.assert_allclose(two["x"], serial["x"], rtol=0, atol=1e-15)
+        assert abs(float(p.capacity @ two["T"]) - heat0) <= 1e-12 * heat0  # insulated: total heat conserved
+        keys = list(two["summary_keys"])
+        assert two["summary_values"][keys.index("energy_error")] < 1e-12
+        assert keys == list(serial["summary_keys"])
+
+
 def test_two_ranks_with_stress_walls_write_the_gathered_run_folder(tmp_path):
     out = tmp_path / "two"
     two = launched(2, "scene", "luding-three-particles", 0.002, out, tmp_path / "two.npz")
@@ -106,12 +128,8 @@ def test_two_ranks_with_stress_walls_write_the_gathered_run_folder(tmp_path):
 def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):
     from dem.engines.verlet.ranks import refuse_unsupported
 
-    scene = ranks_worker.builtin("hot-wall-sintering", 0.001)
-    with pytest.raises(ValueError, match=r"heat on moving contacts runs on one rank only"):
-        refuse_unsupported(scene, 2, resume=False)
     with pytest.raises(ValueError, match=r"--resume: a run on 2 ranks"):
         refuse_unsupported(ranks_worker.builtin("luding-three-particles", 0.001), 2, resume=True)
-    refuse_unsupported(scene, 1, resume=False)  # heat on one rank: the serial run
     staggered = ranks_worker.builtin("zohdi-compaction", 0.01)
     with pytest.raises(ValueError, match=r"engine = 'staggered': under mpiexec run static packings and the verlet engine"):
         refuse_unsupported(staggered, 1, resume=False)

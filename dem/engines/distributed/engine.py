@@ -29,7 +29,6 @@ import numpy as np
 
 from dem import memory
 from dem.engines.static import CSV_FLOWS, StaticEngine, effective_conductivity
-from dem.geometry.bonds import Bonds
 from dem.geometry.partition import bisection, halo
 from dem.network import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
@@ -58,14 +57,6 @@ def unsupported(scene, resume: bool = False) -> str | None:
     if resume:
         return "--resume does not run under MPI; run the scene again"
     return None
-
-
-def _kept(bonds: Bonds, pairs: np.ndarray, walls: np.ndarray) -> Bonds:
-    """The bonds of ``bonds`` at the positions ``pairs`` and wall bonds at ``walls`` (masks)."""
-    return replace(bonds, i=bonds.i[pairs], j=bonds.j[pairs], h=bonds.h[pairs], d=bonds.d[pairs], a=bonds.a[pairs],
-                   l_i=bonds.l_i[pairs], l_j=bonds.l_j[pairs], shift=None if bonds.shift is None else
-                   bonds.shift[pairs], wall_particle=bonds.wall_particle[walls], wall_index=bonds.wall_index[walls],
-                   wall_h=bonds.wall_h[walls], wall_a=bonds.wall_a[walls], wall_l=bonds.wall_l[walls])
 
 
 class DistributedStaticEngine(StaticEngine):
@@ -118,7 +109,7 @@ class DistributedStaticEngine(StaticEngine):
             raise ValueError(f"rank {rank} of {self.ranks}, its {len(held)} particles numbered from 0 in the "
                              f"scene's order: {exc}") from None
         pairs, walls = mine[bonds.i] | mine[bonds.j], mine[bonds.wall_particle]
-        self.bonds, self.K_pairs, self.K_walls = _kept(bonds, pairs, walls), K_pairs[pairs], K_walls[walls]
+        self.bonds, self.K_pairs, self.K_walls = bonds.subset(pairs, walls), K_pairs[pairs], K_walls[walls]
         self.held, self.mine = held, mine
         self.T = local.temperature.astype(float)
         return owner[held]
@@ -131,7 +122,7 @@ class DistributedStaticEngine(StaticEngine):
         wires = electrode_bonds(particles, b, self.scene.walls, self.scene.conductance, e.electrodes, self.scene.box)
         neutral = replace(particles, temperature=np.zeros(particles.n), fixed=np.zeros(particles.n, dtype=bool),
                           heat=np.zeros(particles.n))
-        through = replace(_kept(b, np.ones(b.n_pairs, dtype=bool), wires.on_electrode), wall_index=wires.plane_index)
+        through = replace(b.subset(slice(None), wires.on_electrode), wall_index=wires.plane_index)
         network = Network(neutral, through, wires.G, wires.G_plane, e.electrodes.potential)
         part = DistributedNetwork(self.comm, network, self.held, owner)
         x, _, _, n_float, _ = part.steady("mean")

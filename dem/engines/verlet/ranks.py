@@ -25,10 +25,21 @@ in the serial order (its local pairs are sorted by global id), so a periodic run
 with walls only the walls' loads differ, at round-off (the ranks' partial sums are added in another order), and a
 stress wall's motion carries that difference into the packing.
 
+Heat on moving contacts (:class:`RankContactThermal`): on one rank the serial network
+(:class:`dem.engines.contact_heat.ContactThermalModel`, bit for bit); on more, each thermal step is one implicit
+(or Crank-Nicolson) step of the network of every rank's contacts with an owned partner and of its owned particles'
+wall contacts, solved on PETSc across the ranks (:meth:`dem.network.distributed.DistributedNetwork.integrate`, the
+static engine's path), the ghosts being its halo. An owned particle has all its contacts on its rank (the list holds
+every pair with an owned partner), so its row is the serial row; the solution equals the serial step's to the
+linear solver's tolerance (to round-off with a direct solver in ``PETSC_OPTIONS``), and the step's heat balance holds
+to round-off as in the serial step. The temperatures (and their rates) are kept for every particle of the scene on
+every rank (one allgather of the owned values per thermal step: n floats per rank), so a migrating particle takes
+nothing thermal with it. The effective conductivity of the contact network (a further steady solve at each output)
+is not computed on several ranks.
+
 Outputs are gathered on rank 0 in global order (:meth:`RankMechanics.gathered`), which writes the run folder as a
-serial run does (not as PVTU pieces). Heat on moving contacts, resuming and checkpoints run on one rank only
-(:func:`refuse_unsupported` refuses them on more, where no checkpoint is written); the ``staggered`` and ``static``
-engines do not run under ``mpiexec``.
+serial run does (not as PVTU pieces). Resuming and checkpoints run on one rank only (:func:`refuse_unsupported`
+refuses them on more, where no checkpoint is written); the ``staggered`` engine does not run under ``mpiexec``.
 """
 
 from __future__ import annotations
@@ -37,7 +48,11 @@ import os
 
 import numpy as np
 
+from dem.network import comm as mpi
 from dem.network.comm import world
+from dem.network.distributed import DistributedNetwork
+from dem.network.heat import Network
+from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.decomposition import Slabs
 from dem.engines.verlet.engine import VerletEngine
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
@@ -52,9 +67,6 @@ def refuse_unsupported(scene, ranks: int, resume: bool) -> None:
     if scene.engine != "verlet":
         raise ValueError(f"[solver] engine = {scene.engine!r}: under mpiexec run static packings and the verlet "
                          f"engine (particles that move), not this one; run this scene without mpiexec")
-    if ranks > 1 and "thermal" in scene.physics:
-        raise ValueError(f"physics = {list(scene.physics)}: heat on moving contacts runs on one rank only; run with "
-                         f"mpiexec -n 1 or without mpiexec")
     if ranks > 1 and resume:
         raise ValueError(f"--resume: a run on {ranks} ranks keeps no checkpoints; run without --resume")
 
@@ -327,6 +339,39 @@ def _sum():
     return MPI.SUM
 
 
+class RankContactThermal(ContactThermalModel):
+    """The heat of the contacts on several ranks (module docstring): ``T`` and ``rate`` over every particle of the
+    scene on every rank, each thermal step solved on PETSc by all ranks together."""
+
+    def local(self, mechanics, values: np.ndarray) -> np.ndarray:
+        return values[mechanics.gid]
+
+    def step(self, mechanics, dt: float) -> None:
+        """Advance the temperatures by ``dt`` on the network of the contacts the ranks hold now."""
+        comm = mechanics.comm
+        bonds, K_pairs, K_walls = self.bonds(mechanics)
+        walls = mechanics.owned[bonds.wall_particle]  # a ghost's wall contacts are its owner's
+        bonds, K_walls = bonds.subset(slice(None), walls), K_walls[walls]
+        wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
+        self.net = Network(self._particles_now(mechanics, self.local(mechanics, self.particles.radius)), bonds,
+                           K_pairs, K_walls, wall_T, self.sources, self.box)
+        owner = np.full(len(mechanics.gid), mechanics.rank)
+        for rank, ghosts in mechanics.recv_idx.items():
+            owner[ghosts] = rank
+        part = DistributedNetwork(comm, self.net, mechanics.gid, owner)
+        res = mpi.agree(comm, lambda: part.integrate(self.integrator, dt, dt))
+        self.assemblies += 1
+        for k, v in res["heat_in"].items():
+            self.heat_in[k] = self.heat_in.get(k, 0.0) + v
+        T_local = self.net.full(res["T_F"])
+        T = self.T.copy()
+        own = mechanics.owned
+        for index, values in comm.allgather((mechanics.gid[own], T_local[own])):
+            T[index] = values
+        self.rate = (T - self.T) / dt
+        self.T = T
+
+
 class RankVerletEngine(VerletEngine):
     """The verlet engine with its particles spread over the MPI ranks (module docstring). Outputs come from the
     sample gathered on rank 0 at every output time; after the run every rank holds the gathered sample, so the
@@ -341,7 +386,14 @@ class RankVerletEngine(VerletEngine):
         refuse_unsupported(scene, size, restart is not None)
         if not os.environ.get(threads.ENVIRONMENT):
             threads.use(max(1, threads.cores() // size))
+        if size > 1:
+            self.thermal_class = RankContactThermal
         super().__init__(scene, restart)
+
+    def effective_conductivity(self) -> float | None:
+        """As :meth:`~dem.engines.verlet.engine.VerletEngine.effective_conductivity` on one rank; None on more
+        (module docstring)."""
+        return super().effective_conductivity() if self.mechanics.size == 1 else None
 
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """As :meth:`~dem.engines.verlet.engine.VerletEngine.run`;
