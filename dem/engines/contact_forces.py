@@ -105,7 +105,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         tau[k, 1] = 0.0
         tau[k, 2] = 0.0
     for c in prange(pi.shape[0]):
-        i, j = pi[c], pj[c]
+        i, j = np.uint64(pi[c]), np.uint64(pj[c])  # unsigned: no wrap-around of negative indices
         dx = min_image(x[i, 0] - x[j, 0], box[0])
         dy = 0.0 if planar else min_image(x[i, 1] - x[j, 1], box[1])
         dz = min_image(x[i, 2] - x[j, 2], box[2])

@@ -64,19 +64,30 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
     n = x.shape[0]
     n_w = wn.shape[0]
     h = 0.5 * dt
+    planar = len(spin_axes) == 1  # 2D disks in the x-z plane: axes (0, 2), spin about y
     for s in range(n_steps):
         t = (step0 + s) * dt
         bad = n
         for k in prange(n):
             im, ii = 1.0 / mass[k], 1.0 / inertia[k]
-            moved = 0.0
-            for a in axes:
-                v[k, a] += h * f[k, a] * im
-                x[k, a] += dt * v[k, a]
-                moved += abs(x[k, a])
-            for a in spin_axes:
-                w[k, a] += h * tau[k, a] * ii
-                moved += abs(w[k, a])
+            v[k, 0] += h * f[k, 0] * im
+            x[k, 0] += dt * v[k, 0]
+            moved = abs(x[k, 0])
+            if not planar:
+                v[k, 1] += h * f[k, 1] * im
+                x[k, 1] += dt * v[k, 1]
+                moved += abs(x[k, 1])
+            v[k, 2] += h * f[k, 2] * im
+            x[k, 2] += dt * v[k, 2]
+            moved += abs(x[k, 2])
+            if not planar:
+                w[k, 0] += h * tau[k, 0] * ii
+                moved += abs(w[k, 0])
+            w[k, 1] += h * tau[k, 1] * ii
+            moved += abs(w[k, 1])
+            if not planar:
+                w[k, 2] += h * tau[k, 2] * ii
+                moved += abs(w[k, 2])
             if not moved < math.inf:  # NaN or inf: name the particle before its neighbours are contaminated
                 if THREADED:  # (a parallel loop cannot return: the first such particle, after it)
                     bad = min(bad, k)
@@ -104,13 +115,21 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
         worst = 0.0
         for k in prange(n):
             im, ii = 1.0 / mass[k], 1.0 / inertia[k]
-            d2 = 0.0
-            for a in axes:
-                v[k, a] += h * f[k, a] * im
-                d = min_image(x[k, a] + dt * v[k, a] - x_ref[k, a], box[a])
+            v[k, 0] += h * f[k, 0] * im
+            d = min_image(x[k, 0] + dt * v[k, 0] - x_ref[k, 0], box[0])
+            d2 = d * d
+            if not planar:
+                v[k, 1] += h * f[k, 1] * im
+                d = min_image(x[k, 1] + dt * v[k, 1] - x_ref[k, 1], box[1])
                 d2 += d * d
-            for a in spin_axes:
-                w[k, a] += h * tau[k, a] * ii
+            v[k, 2] += h * f[k, 2] * im
+            d = min_image(x[k, 2] + dt * v[k, 2] - x_ref[k, 2], box[2])
+            d2 += d * d
+            if not planar:
+                w[k, 0] += h * tau[k, 0] * ii
+            w[k, 1] += h * tau[k, 1] * ii
+            if not planar:
+                w[k, 2] += h * tau[k, 2] * ii
             if not (d2 < math.inf):  # NaN or inf
                 if THREADED:
                     bad = min(bad, k)
