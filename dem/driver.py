@@ -85,7 +85,7 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     if comm is not None:
         from dem.engines.verlet.ranks import RankVerletEngine, refuse_unsupported
 
-        refuse_unsupported(scene, comm.Get_size(), resume)
+        refuse_unsupported(scene, comm.Get_size())
         cls = RankVerletEngine
     root = comm is None or comm.Get_rank() == 0
     if out is not None:

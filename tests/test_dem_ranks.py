@@ -1,7 +1,7 @@
 """Moving particles across MPI ranks (dem.engines.verlet.ranks), launched with mpiexec -n 1 and -n 2 on
 tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserve momentum (periodic box), follow
 the serial elastic collisions (energy and all) to the bit, carry the heat of the contacts as the serial run does
-(conserving it), lose and duplicate no particle through migration, move
+(conserving it), resume from their checkpoints to the bit, lose and duplicate no particle through migration, move
 stress walls as the serial run to round-off, and write the run's folder from rank 0. Skipped where mpi4py or
 mpiexec is missing."""
 
@@ -111,6 +111,21 @@ def test_two_ranks_carry_the_heat_of_the_contacts(tmp_path):
         assert keys == list(serial["summary_keys"])
 
 
+@pytest.mark.parametrize("case, stop", [("compaction", 0.0045), ("heat", 0.002)])
+def test_two_ranks_interrupted_and_resumed_end_as_the_uninterrupted_run(tmp_path, case, stop):
+    """Stress walls pressing 100 disks (particles migrating, hundreds of rebuilds after the checkpoint) and the gas
+    with heat on PETSc: each rank takes again the particles, ghosts and lists it held at the last rebuild, so the
+    resumed run is the uninterrupted one to the bit, its folder too."""
+    whole = launched(2, "whole", case, tmp_path / "whole", tmp_path / "whole.npz")
+    resumed = launched(2, "resumed", case, stop, tmp_path / "part", tmp_path / "resumed.npz")
+    summary = json.loads((tmp_path / "part" / "summary.json").read_text())
+    assert 0 < summary["resumed_from"]["steps"] < summary["steps"]
+    for key in ("x", "v", "w", "f", "T", "summary_values"):
+        assert np.array_equal(resumed[key], whole[key], equal_nan=True), key
+    assert ((tmp_path / "part" / "timeseries.csv").read_text()
+            == (tmp_path / "whole" / "timeseries.csv").read_text())
+
+
 def test_two_ranks_with_stress_walls_write_the_gathered_run_folder(tmp_path):
     out = tmp_path / "two"
     two = launched(2, "scene", "luding-three-particles", 0.002, out, tmp_path / "two.npz")
@@ -128,11 +143,16 @@ def test_two_ranks_with_stress_walls_write_the_gathered_run_folder(tmp_path):
 def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):
     from dem.engines.verlet.ranks import refuse_unsupported
 
-    with pytest.raises(ValueError, match=r"--resume: a run on 2 ranks"):
-        refuse_unsupported(ranks_worker.builtin("luding-three-particles", 0.001), 2, resume=True)
+    three = ranks_worker.builtin("luding-three-particles", 0.001)
+    with pytest.raises(ValueError, match=r"--resume: the checkpoint was written by 1 rank\(s\), this run has 2; "
+                                         r"resume without mpiexec or with mpiexec -n 1"):
+        refuse_unsupported(three, 2, {"t": 0.0})
+    with pytest.raises(ValueError, match=r"written by 2 rank\(s\), this run has 1; resume with mpiexec -n 2"):
+        refuse_unsupported(three, 1, {"ranks": 2})
+    refuse_unsupported(three, 2, {"ranks": 2})
     staggered = ranks_worker.builtin("zohdi-compaction", 0.01)
     with pytest.raises(ValueError, match=r"engine = 'staggered': under mpiexec run static packings and the verlet engine"):
-        refuse_unsupported(staggered, 1, resume=False)
+        refuse_unsupported(staggered, 1)
 
 
 @pytest.mark.slow

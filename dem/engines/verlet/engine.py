@@ -28,7 +28,7 @@ from dataclasses import replace
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.motion import MotionState
-from dem.geometry.neighbours import list_arrays, restore_lists
+from dem.geometry.neighbours import list_arrays
 from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
 from dem.scene.state_file import moving_arrays, normalised
@@ -110,7 +110,7 @@ class VerletEngine:
         for k, wall in enumerate(mech.walls):
             m = names.index(wall.name)
             mech.w.q[k], mech.w.dq[k], mech.w.acc[k] = saved["wall_q"][m], saved["wall_dq"][m], saved["wall_acc"][m]
-        restore_lists(mech, saved)
+        mech.restore_lists(saved)
         if self.thermal is not None:
             th = self.thermal
             th.T = np.array(saved["thermal_T"], dtype=float)
