@@ -1,13 +1,15 @@
 """Moving particles across MPI ranks (dem.engines.verlet.ranks), launched with mpiexec -n 1 and -n 2 on
 tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserve momentum (periodic box), follow
 the serial elastic collisions (energy and all) to the bit, carry the heat of the contacts as the serial run does
-(conserving it), resume from their checkpoints to the bit, lose and duplicate no particle through migration, move
+(conserving it), resume from their checkpoints to the bit,
+write a piece of every snapshot per rank (PVTU), lose and duplicate no particle through migration, move
 stress walls as the serial run to round-off, and write the run's folder from rank 0. Skipped where mpi4py or
 mpiexec is missing."""
 
 import json
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -124,6 +126,11 @@ def test_two_ranks_interrupted_and_resumed_end_as_the_uninterrupted_run(tmp_path
         assert np.array_equal(resumed[key], whole[key], equal_nan=True), key
     assert ((tmp_path / "part" / "timeseries.csv").read_text()
             == (tmp_path / "whole" / "timeseries.csv").read_text())
+    for kind in ("particles", "contacts"):
+        assert ((tmp_path / "part" / f"{kind}.pvd").read_text()
+                == (tmp_path / "whole" / f"{kind}.pvd").read_text())
+        assert (sorted(p.name for p in (tmp_path / "part").glob(f"{kind}_*"))
+                == sorted(p.name for p in (tmp_path / "whole").glob(f"{kind}_*")))
 
 
 def test_two_ranks_with_stress_walls_write_the_gathered_run_folder(tmp_path):
@@ -136,8 +143,18 @@ def test_two_ranks_with_stress_walls_write_the_gathered_run_folder(tmp_path):
     np.testing.assert_allclose(two["summary_values"], serial["summary_values"], rtol=1e-9, atol=1e-15)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["particles"] == 3 and summary["engine"] == "verlet"
-    assert ".vtu" in (out / "particles.pvd").read_text()
     assert (out / "timeseries.csv").read_text().count("\n") > 2
+    # each rank its piece of every snapshot, the .pvd listing the .pvtu files that name them: one data set
+    listed = re.findall(r'file="([^"]+)"', (out / "particles.pvd").read_text())
+    assert listed and all(name.endswith(".pvtu") for name in listed)
+    assert sorted(p.name for p in out.glob(listed[-1].replace(".pvtu", "_*.vtu"))) == [
+        listed[-1].replace(".pvtu", f"_{r}.vtu") for r in (0, 1)]
+    pyvista = pytest.importorskip("pyvista")
+    mesh = pyvista.read(out / listed[-1])
+    order = np.argsort(mesh.point_data["id"])
+    assert np.array_equal(np.asarray(mesh.points)[order], two["x"])  # every particle once, where it ended
+    contacts = pyvista.read(out / listed[-1].replace("particles", "contacts"))
+    assert contacts.n_cells == summary["contacts"]  # every contact once
 
 
 def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):

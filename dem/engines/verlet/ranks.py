@@ -37,10 +37,12 @@ every rank (one allgather of the owned values per thermal step: n floats per ran
 nothing thermal with it. The effective conductivity of the contact network (a further steady solve at each output)
 is not computed on several ranks.
 
-Outputs are gathered on rank 0 in global order (:meth:`RankMechanics.gathered`), which writes the run folder as a
-serial run does (not as PVTU pieces). So are the checkpoints, with the slabs and the lists as the ranks built them
-at their last rebuild (the positions they were built at, the particle-wall lists): a resumed run
-(:meth:`RankMechanics.restore_lists`) takes again on every rank the particles, ghosts and lists it held then, and
+The rows of ``timeseries.csv``, the summary, the plots and the checkpoints come from the sample gathered on rank 0 in
+global order (:meth:`RankMechanics.gathered`); on several ranks each rank writes its piece of every snapshot (the
+particles it owns, the contacts whose lower-id partner it owns) and rank 0 the ``.pvtu`` files that name them, listed
+in the ``.pvd`` collections (:class:`dem.output.pieces.PieceWriter`). The checkpoints carry the slabs and the lists
+as the ranks built them at their last rebuild (the positions they were built at, the particle-wall lists): a resumed
+run (:meth:`RankMechanics.restore_lists`) takes again on every rank the particles, ghosts and lists it held then, and
 goes on as the uninterrupted run does, on as many ranks as wrote the checkpoint (:func:`refuse_unsupported`). The
 ``staggered`` engine does not run under ``mpiexec``.
 """
@@ -443,6 +445,36 @@ class RankVerletEngine(VerletEngine):
         if size > 1:
             self.thermal_class = RankContactThermal
         super().__init__(scene, restart)
+        self.ranks_mechanics = self.mechanics  # this rank's particles (self.mechanics: the gathered sample at times)
+
+    # the snapshots' pieces on several ranks (dem.output.pieces): the particles this rank owns, the contacts
+    # whose lower-id partner it owns (each contact once)
+    def positions(self) -> np.ndarray:
+        m = self.ranks_mechanics
+        return super().positions() if m.size == 1 else m.state.x[m.owned]
+
+    def particle_fields(self) -> dict:
+        m = self.ranks_mechanics
+        if m.size == 1:
+            return super().particle_fields()
+        shown, self.mechanics = self.mechanics, m
+        try:
+            fields = {**super().particle_fields(), "id": self.scene.particles.id[m.gid]}
+        finally:
+            self.mechanics = shown
+        return {k: v[m.owned] for k, v in fields.items()}
+
+    def links(self):
+        m = self.ranks_mechanics
+        if m.size == 1:
+            return super().links()
+        shown, self.mechanics = self.mechanics, m
+        try:
+            points, lines, fields = super().links()
+        finally:
+            self.mechanics = shown
+        once = m.owned[lines[:, 0]]
+        return points, lines[once], {k: v[once] for k, v in fields.items()}
 
     def effective_conductivity(self) -> float | None:
         """As :meth:`~dem.engines.verlet.engine.VerletEngine.effective_conductivity` on one rank; None on more
@@ -469,12 +501,13 @@ class RankVerletEngine(VerletEngine):
 
         def observed():
             view = mech.gathered()
-            if view is not None:
-                self.mechanics = view
-                try:
-                    observe()
-                finally:
-                    self.mechanics = mech
+            if view is None:  # another rank: its pieces of the snapshots (its writer's rows are rank 0's)
+                return observe()
+            self.mechanics = view
+            try:
+                observe()
+            finally:
+                self.mechanics = mech
 
         super().run(observed if observe is not None else None, progress,
                     checkpointed if gathered_checkpoints else checkpoint)
