@@ -80,12 +80,12 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
         raise ValueError("--resume and --overwrite need --out (the folder of the run)")
     if launched() and scene.engine == "static":  # under MPI a static packing's network is solved on PETSc
         return _run_distributed(scene, out, progress, resume, overwrite)
-    comm = world() if launched() else None  # under MPI moving particles are shared by the ranks, rank 0 writes
+    comm = world() if launched() else None  # under MPI moving particles are shared by the ranks (their pieces)
     cls = engine_class(scene.engine)
     if comm is not None:
         from dem.engines.verlet.ranks import RankVerletEngine, refuse_unsupported
 
-        refuse_unsupported(scene, comm.Get_size(), resume)
+        refuse_unsupported(scene, comm.Get_size())
         cls = RankVerletEngine
     root = comm is None or comm.Get_rank() == 0
     if out is not None:
@@ -95,14 +95,19 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     restart = run_folder.load(out, scene, scene.engine) if resume else None
     engine = cls(scene, restart)
     writer = None
-    if out is not None and root:
-        writer = RunWriter(out, scene, engine, resume_step=engine.steps if resume else None)
+    resume_step = engine.steps if resume else None
+    if out is not None and comm is not None and comm.Get_size() > 1:  # a piece of every snapshot per rank
+        from dem.output.pieces import PieceWriter
+
+        writer = PieceWriter(out, scene, engine, comm.Get_rank(), comm.Get_size(), resume_step)
+    elif out is not None and root:
+        writer = RunWriter(out, scene, engine, resume_step=resume_step)
         if scene.motion is not None and scene.motion.frames:
             from dem.output.frames import WithFrames
 
             writer = WithFrames(writer, scene, out)
     checkpointer = run_folder.Checkpointer(out, scene, scene.engine, scene.output.checkpoint_every) \
-        if writer is not None and (scene.solver.mode == "transient") else None
+        if writer is not None and root and (scene.solver.mode == "transient") else None
     bar = _progress_bar(scene, engine, progress and root)
 
     def advanced(t):
@@ -122,9 +127,9 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
         summary["seconds"] = time.perf_counter() - start
         if writer is not None:
             summary["state"] = "state.npz"
-            writer.finish(_with_state(summary, engine, out))
+            writer.finish(_with_state(summary, engine, out) if root else summary)
     except KeyboardInterrupt:  # also while the run's last files are written: the folder says it was interrupted
-        if writer is not None:
+        if writer is not None and root:
             if checkpointer is not None:
                 checkpointer.last()  # the last completed step, to resume from whatever the periodic ones were
             writer.interrupted({"scene": scene.name, "mode": scene.solver.mode, "interrupted": True,

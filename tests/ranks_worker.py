@@ -35,6 +35,11 @@ CASES = {
     # elastic and frictionless (Hertz, e = 1): the energy of the collisions comes back
     "elastic": {**GAS, "contact": ELASTIC},
 }
+HEAT = {**GAS, "scene": {"physics": ["mechanical", "thermal"]},  # the elastic gas with heat through its contacts,
+        "contact": ELASTIC,  # insulated (a law whose forces do not depend on the temperature: the serial motion)
+        "material": {"density": 7800.0, "conductivity": 40.0, "specific_heat": 450.0},
+        "generator": {**GAS["generator"], "n": 50, "radius": 6e-4, "speed": 0.2},
+        "solver": {"mode": "transient", "t_end": 0.004, "thermal_interval": 1e-4}}
 CHUNK = 100  # steps between the samples of a trace
 
 
@@ -93,11 +98,64 @@ def pressed(relative: float = 0.0):
     return parse_scene(doc)
 
 
-def run_scene(scene, out=None) -> dict:
+def hot_and_cold():
+    """:data:`HEAT`, the particles' temperatures 20 to 100 (by id): heat flows wherever two of them touch."""
+    import dataclasses
+
+    from dem import parse_scene
+
+    scene = parse_scene(copy.deepcopy(HEAT))
+    p = scene.particles
+    T = 20.0 + 80.0 * (np.arange(p.n) * 37 % p.n) / p.n
+    return dataclasses.replace(scene, particles=dataclasses.replace(p, temperature=T))
+
+
+def short_compaction():
+    """:data:`COMPACTION` to 0.01 s with an output every 1 ms (an interval, a checkpoint), in the first 10 % of the
+    press: walls moving, particles crossing the slabs."""
+    from dem import parse_scene
+
+    doc = copy.deepcopy(COMPACTION)
+    doc["solver"]["t_end"] = 0.01
+    doc["output"] = {"interval": 1e-3}
+    return parse_scene(doc)
+
+
+RESUMED = {"compaction": short_compaction, "heat": hot_and_cold}  # the runs interrupted and resumed
+
+
+def interrupted_and_resumed(scene, stop: float, out) -> dict:
+    """``scene`` through the driver into ``out``, interrupted (KeyboardInterrupt on every rank, as Ctrl-C) after the
+    interval that passes ``stop`` s, then resumed from its folder: the resumed run's :func:`run_scene`."""
+    from dem.engines.verlet.ranks import RankVerletEngine
+
+    original = RankVerletEngine.run
+
+    def stopped(self, observe=None, progress=None, checkpoint=None):
+        def advanced(t):
+            if progress is not None:
+                progress(t)
+            if t >= stop:
+                raise KeyboardInterrupt
+
+        original(self, observe, advanced, checkpoint)
+
+    RankVerletEngine.run = stopped
+    try:
+        run_scene(scene, out)
+        raise AssertionError(f"the run was not interrupted at t = {stop} s")
+    except KeyboardInterrupt:
+        pass
+    finally:
+        RankVerletEngine.run = original
+    return run_scene(scene, out, resume=True)
+
+
+def run_scene(scene, out=None, resume: bool = False) -> dict:
     """``scene`` through the driver: the final particles and the summary's numbers."""
     from dem import run
 
-    result = run(scene, out=out)
+    result = run(scene, out=out, resume=resume)
     s = result.engine.mechanics.state
     numbers = {k: v for k, v in result.summary.items() if isinstance(v, (int, float)) and k != "seconds"}
     return {"x": s.x, "v": s.v, "w": s.w, "f": s.f, "T": s.T, "summary_keys": np.array(list(numbers)),
@@ -114,6 +172,12 @@ if __name__ == "__main__":
         result = run_builtin(sys.argv[2], float(sys.argv[3]), sys.argv[4])
     elif sys.argv[1] == "compaction":  # compaction RESULT
         result = run_scene(pressed())
+    elif sys.argv[1] == "heat":  # heat RESULT
+        result = run_scene(hot_and_cold())
+    elif sys.argv[1] == "whole":  # whole CASE FOLDER RESULT
+        result = run_scene(RESUMED[sys.argv[2]](), sys.argv[3])
+    elif sys.argv[1] == "resumed":  # resumed CASE STOP FOLDER RESULT
+        result = interrupted_and_resumed(RESUMED[sys.argv[2]](), float(sys.argv[3]), sys.argv[4])
     else:  # CASE RESULT
         result = trace(RankVerletEngine, sys.argv[1], comm)
     if comm.Get_rank() == 0:

@@ -1,12 +1,15 @@
 """Moving particles across MPI ranks (dem.engines.verlet.ranks), launched with mpiexec -n 1 and -n 2 on
 tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserve momentum (periodic box), follow
-the serial elastic collisions (energy and all) to the bit, lose and duplicate no particle through migration, move
+the serial elastic collisions (energy and all) to the bit, carry the heat of the contacts as the serial run does
+(conserving it), resume from their checkpoints to the bit,
+write a piece of every snapshot per rank (PVTU), lose and duplicate no particle through migration, move
 stress walls as the serial run to round-off, and write the run's folder from rank 0. Skipped where mpi4py or
 mpiexec is missing."""
 
 import json
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -41,13 +44,13 @@ def _mpi_works() -> bool:
 pytestmark = pytest.mark.skipif(not _mpi_works(), reason="mpi4py or a working mpiexec is missing")
 
 
-def ranks(n: int, *args, timeout: float = 900) -> subprocess.CompletedProcess:
+def ranks(n: int, *args, timeout: float = 900, env=None) -> subprocess.CompletedProcess:
     return subprocess.run(["mpiexec", "-n", str(n), sys.executable, str(HERE / "ranks_worker.py"), *map(str, args)],
-                          env=ENV, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
+                          env={**ENV, **(env or {})}, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
 
 
-def launched(n: int, *args) -> dict:
-    done = ranks(n, *args)
+def launched(n: int, *args, env=None) -> dict:
+    done = ranks(n, *args, env=env)
     assert done.returncode == 0, done.stderr[-3000:]
     with np.load(args[-1]) as data:
         return {k: data[k] for k in data.files}
@@ -89,6 +92,47 @@ def test_two_ranks_follow_the_serial_elastic_collisions_to_the_bit(tmp_path):
         assert np.array_equal(two[key], serial[key]), key
 
 
+def test_two_ranks_carry_the_heat_of_the_contacts(tmp_path):
+    """An insulated periodic gas whose particles start at 20-100 C: on two ranks each thermal step is solved on
+    PETSc (dem.engines.verlet.ranks.RankContactThermal). The mechanics of a periodic run is the serial one, so are
+    the contacts; the temperatures equal the serial run's to CG's tolerance with the default AMG, to round-off with
+    a direct solver, and the heat the particles hold stays what it was."""
+    serial = ranks_worker.run_scene(ranks_worker.hot_and_cold())
+    scene = ranks_worker.hot_and_cold()
+    p = scene.particles
+    heat0 = float(p.capacity @ p.temperature)
+    spread = float(np.ptp(p.temperature))
+    assert np.ptp(serial["T"]) < spread * (1 - 1e-4)  # heat flowed: the extremes moved in
+    for env, tolerance in (({}, 1e-8), ({"PETSC_OPTIONS": "-pc_type lu -pc_factor_mat_solver_type mumps"}, 1e-13)):
+        two = launched(2, "heat", tmp_path / "two.npz", env=env)
+        assert np.max(np.abs(two["T"] - serial["T"])) <= tolerance * spread, env
+        np.testing.assert_allclose(two["x"], serial["x"], rtol=0, atol=1e-15)
+        assert abs(float(p.capacity @ two["T"]) - heat0) <= 1e-12 * heat0  # insulated: total heat conserved
+        keys = list(two["summary_keys"])
+        assert two["summary_values"][keys.index("energy_error")] < 1e-12
+        assert keys == list(serial["summary_keys"])
+
+
+@pytest.mark.parametrize("case, stop", [("compaction", 0.0045), ("heat", 0.002)])
+def test_two_ranks_interrupted_and_resumed_end_as_the_uninterrupted_run(tmp_path, case, stop):
+    """Stress walls pressing 100 disks (particles migrating, hundreds of rebuilds after the checkpoint) and the gas
+    with heat on PETSc: each rank takes again the particles, ghosts and lists it held at the last rebuild, so the
+    resumed run is the uninterrupted one to the bit, its folder too."""
+    whole = launched(2, "whole", case, tmp_path / "whole", tmp_path / "whole.npz")
+    resumed = launched(2, "resumed", case, stop, tmp_path / "part", tmp_path / "resumed.npz")
+    summary = json.loads((tmp_path / "part" / "summary.json").read_text())
+    assert 0 < summary["resumed_from"]["steps"] < summary["steps"]
+    for key in ("x", "v", "w", "f", "T", "summary_values"):
+        assert np.array_equal(resumed[key], whole[key], equal_nan=True), key
+    assert ((tmp_path / "part" / "timeseries.csv").read_text()
+            == (tmp_path / "whole" / "timeseries.csv").read_text())
+    for kind in ("particles", "contacts"):
+        assert ((tmp_path / "part" / f"{kind}.pvd").read_text()
+                == (tmp_path / "whole" / f"{kind}.pvd").read_text())
+        assert (sorted(p.name for p in (tmp_path / "part").glob(f"{kind}_*"))
+                == sorted(p.name for p in (tmp_path / "whole").glob(f"{kind}_*")))
+
+
 def test_two_ranks_with_stress_walls_write_the_gathered_run_folder(tmp_path):
     out = tmp_path / "two"
     two = launched(2, "scene", "luding-three-particles", 0.002, out, tmp_path / "two.npz")
@@ -99,22 +143,33 @@ def test_two_ranks_with_stress_walls_write_the_gathered_run_folder(tmp_path):
     np.testing.assert_allclose(two["summary_values"], serial["summary_values"], rtol=1e-9, atol=1e-15)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["particles"] == 3 and summary["engine"] == "verlet"
-    assert ".vtu" in (out / "particles.pvd").read_text()
     assert (out / "timeseries.csv").read_text().count("\n") > 2
+    # each rank its piece of every snapshot, the .pvd listing the .pvtu files that name them: one data set
+    listed = re.findall(r'file="([^"]+)"', (out / "particles.pvd").read_text())
+    assert listed and all(name.endswith(".pvtu") for name in listed)
+    assert sorted(p.name for p in out.glob(listed[-1].replace(".pvtu", "_*.vtu"))) == [
+        listed[-1].replace(".pvtu", f"_{r}.vtu") for r in (0, 1)]
+    pyvista = pytest.importorskip("pyvista")
+    mesh = pyvista.read(out / listed[-1])
+    order = np.argsort(mesh.point_data["id"])
+    assert np.array_equal(np.asarray(mesh.points)[order], two["x"])  # every particle once, where it ended
+    contacts = pyvista.read(out / listed[-1].replace("particles", "contacts"))
+    assert contacts.n_cells == summary["contacts"]  # every contact once
 
 
 def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):
     from dem.engines.verlet.ranks import refuse_unsupported
 
-    scene = ranks_worker.builtin("hot-wall-sintering", 0.001)
-    with pytest.raises(ValueError, match=r"heat on moving contacts runs on one rank only"):
-        refuse_unsupported(scene, 2, resume=False)
-    with pytest.raises(ValueError, match=r"--resume: a run on 2 ranks"):
-        refuse_unsupported(ranks_worker.builtin("luding-three-particles", 0.001), 2, resume=True)
-    refuse_unsupported(scene, 1, resume=False)  # heat on one rank: the serial run
+    three = ranks_worker.builtin("luding-three-particles", 0.001)
+    with pytest.raises(ValueError, match=r"--resume: the checkpoint was written by 1 rank\(s\), this run has 2; "
+                                         r"resume without mpiexec or with mpiexec -n 1"):
+        refuse_unsupported(three, 2, {"t": 0.0})
+    with pytest.raises(ValueError, match=r"written by 2 rank\(s\), this run has 1; resume with mpiexec -n 2"):
+        refuse_unsupported(three, 1, {"ranks": 2})
+    refuse_unsupported(three, 2, {"ranks": 2})
     staggered = ranks_worker.builtin("zohdi-compaction", 0.01)
     with pytest.raises(ValueError, match=r"engine = 'staggered': under mpiexec run static packings and the verlet engine"):
-        refuse_unsupported(staggered, 1, resume=False)
+        refuse_unsupported(staggered, 1)
 
 
 @pytest.mark.slow

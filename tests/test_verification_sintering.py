@@ -89,10 +89,13 @@ def test_isolating_variants_start_where_they_should():
     assert sr.Task(sr.PREPARE, 100, 10.0).times.t_heat == 0.2
     for grid in (sr.QUICK, sr.FULL):
         tasks = grid.isolating_tasks()
-        assert tasks and len(set(tasks)) == len(tasks) and all(t.variant in sr.VARIANTS for t in tasks)
+        assert tasks and len(set(tasks)) == len(tasks) and all(t.variant in sr.VARIANTS or t.seed in sr.PREP_SEEDS
+                                                                for t in tasks)
     assert TINY.isolating_tasks() == []
-    quick = set(sr.QUICK.isolating_tasks())
-    assert held in quick and sr.Task(sr.SCHEDULE, 3, 100.0, 1.0, 1, "walls-sinter") in quick
+    quick, full = set(sr.QUICK.isolating_tasks()), set(sr.FULL.isolating_tasks())
+    assert {t.kind for t in quick} == {sr.PREPARE} and quick < full  # --quick: the cheap preparations alone
+    assert sr.Task(sr.COOL, 300, 100.0, 1.0, variant="held") in full
+    assert sr.Task(sr.SCHEDULE, 3, 100.0, 1.0, 1, "walls-sinter") in full
 
 
 def test_scene_docs_of_the_variants(tmp_path, monkeypatch):

@@ -110,11 +110,11 @@ def contact_cooling(force: float, material=LUDING_TABLE1, radius: float = 1.0e-3
 # ------------------------------------------------------------------------------------------------ the tables
 
 
-def _densification(st: Study, n, p, variant="") -> tuple[float, float, float, float]:
+def _densification(st: Study, n, p, variant="", seed=1) -> tuple[float, float, float, float]:
     """``(nu(t_heat), rise in the first 10 ms after t_heat, nu(t_f), nu(t_f)/nu(t_heat) - 1)`` of a chain."""
-    prep = st.res(sr.PREPARE, n, p, variant=variant)["volume_fraction"]
-    cool = st.res(sr.COOL, n, p, st.t_max, variant=variant)["volume_fraction"]
-    s = st.series(st.task(sr.SINTER, n, p, st.t_max, variant=variant))
+    prep = st.res(sr.PREPARE, n, p, seed=seed, variant=variant)["volume_fraction"]
+    cool = st.res(sr.COOL, n, p, st.t_max, seed, variant)["volume_fraction"]
+    s = st.series(st.task(sr.SINTER, n, p, st.t_max, seed, variant))
     return prep, float(at(s, 0.01)["volume_fraction"] - s["volume_fraction"][0]), cool, cool / prep - 1.0
 
 
@@ -126,22 +126,26 @@ PREP_LABELS = {"": "protocol: friction μ = 0.5 on particles and walls", "fricti
 
 
 def preparation_table(st: Study) -> tuple[str, dict]:
+    """ν(t_heat) of every preparation run (the protocol's other placements, :data:`sintering_runs.PREP_SEEDS`,
+    as rows of their own), and the densification of those sintered for the longest t_s and cooled."""
     rows, summary = [], {}
+    runs = [(variant, label, 1) for variant, label in PREP_LABELS.items()]
+    runs += [("", f"protocol, placement (seed) {seed}", seed) for seed in sr.PREP_SEEDS]
     for n in st.grid.n:
         for p in st.grid.p:
-            for variant, label in PREP_LABELS.items():
+            for variant, label, seed in runs:
+                key = f"n{n}-p{p:g}-{variant or 'protocol'}" + (f"-seed{seed}" if seed != 1 else "")
                 try:
-                    nu = st.res(sr.PREPARE, n, p, variant=variant)["volume_fraction"]
+                    nu = st.res(sr.PREPARE, n, p, seed=seed, variant=variant)["volume_fraction"]
                 except Missing:
                     continue
                 try:
-                    _, jump, end, dens = _densification(st, n, p, variant)
+                    _, jump, end, dens = _densification(st, n, p, variant, seed)
                     cells = [f"{jump:+.4f}", f"{end:.4f}", pct(dens)]
-                    summary[f"n{n}-p{p:g}-{variant or 'protocol'}"] = {"nu_heat": nu, "nu_f": end,
-                                                                         "densification": dens}
+                    summary[key] = {"nu_heat": nu, "nu_f": end, "densification": dens}
                 except Missing:
                     cells = ["—", "—", "—"]
-                    summary[f"n{n}-p{p:g}-{variant or 'protocol'}"] = {"nu_heat": nu}
+                    summary[key] = {"nu_heat": nu}
                 rows.append([n, f"{p:g}", label, f"{nu:.4f}"] + cells)
     if not rows:
         raise Missing("preparation runs")

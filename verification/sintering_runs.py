@@ -69,6 +69,7 @@ class Variant:
     stage_only: bool = False
 
 
+PREP_SEEDS = (2, 3)  # other random placements of the protocol's preparation: the spread of nu(t_heat) of one sample
 FRICTIONLESS = {"prep_mu": 0.0, "prep_mu_wall": 0.0}
 VARIANTS = {v.label: v for v in (
     Variant("frictionless", FRICTIONLESS),                                   # the paper's text (Sec. 4)
@@ -155,33 +156,33 @@ class Grid:
     isolation: str = ""
 
     def isolating_tasks(self) -> list[Task]:
-        """The runs that isolate the causes of the differences from the paper (:data:`VARIANTS`): the paper's
-        frictionless preparation through sintering and cool-down, the three-particle control with walls that sinter,
-        the cool-down of the longest-sintered sample with the box held and without thermal contraction, and the
-        compression test of the shortest-sintered sample at p = 100 carried to 15 % strain (``"quick"``: N max,
-        p = 10 for the preparation, p = 100 for the cool-down, the first seed); ``"full"``
-        adds every other preparation (initial speeds, compression rate, cohesion, wall friction) for every N at
-        p = 10, the densification of the frictionless one for every N and p and of those with friction on the
-        particles or on the walls only (N min, p = 10), the control prepared for 0.2 s only or with wall friction,
-        every seed and p."""
+        """The runs that isolate the causes of the differences from the paper (:data:`VARIANTS`). ``"quick"``: the
+        preparations alone (N max, p = 10: the paper's frictionless one, and frictionless particles against walls
+        with friction), each a fraction of the cost of a sintered chain. ``"full"`` adds the paper's frictionless
+        preparation through sintering and cool-down for every N and p, every other preparation (initial speeds,
+        compression rate, cohesion, wall friction) for every N at p = 10 and the densification of those with
+        friction on the particles or on the walls only (N min, p = 10), the three-particle control with walls that
+        sinter, prepared for 0.2 s only or with wall friction (every seed and p), the cool-down of the
+        longest-sintered sample with the box held and without thermal contraction (N max, both p), and the
+        compression test of the shortest-sintered sample at p = 100 carried on to 15 % strain."""
         if not self.isolation:
             return []
-        n, t_max, full = max(self.n), max(self.t_s), self.isolation == "full"
-        out = [Task(COOL, n, 10.0, t_max, variant="frictionless")]
-        seeds = self.three_seeds if full else self.three_seeds[:1]
-        out += [Task(SCHEDULE, 3, p, t_max, seed, "walls-sinter") for p in self.p for seed in seeds]
-        out += [Task(COOL, n, 100.0, t_max, variant=v) for v in ("held", "cool-no-expansion", "held-no-expansion")]
-        out.append(Task(COMPRESS, n, 100.0, min(self.t_s), variant="long"))
-        if full:
+        n, t_max = max(self.n), max(self.t_s)
+        out = [Task(PREPARE, n, 10.0, variant=v) for v in ("frictionless", "frictionless-wall-friction")]
+        out += [Task(PREPARE, n, 10.0, seed=seed) for seed in PREP_SEEDS]
+        if self.isolation == "full":
             preps = ("frictionless", "frictionless-fast", "frictionless-slow", "frictionless-cohesive",
                      "frictionless-wall-friction", "no-wall-friction")
             out += [Task(PREPARE, m, 10.0, variant=v) for m in self.n for v in preps]
+            out += [Task(PREPARE, m, p, seed=seed) for m in self.n for p in self.p for seed in PREP_SEEDS]
             out += [Task(COOL, m, p, t_max, variant="frictionless") for m in self.n for p in self.p]
             out += [Task(COOL, min(self.n), 10.0, t_max, variant=v)
                     for v in ("frictionless-wall-friction", "no-wall-friction")]
-            out += [Task(SCHEDULE, 3, p, t_max, seed, v) for p in self.p for seed in seeds
-                    for v in ("short-prep", "control-wall-friction")]
-            out += [Task(COOL, n, 10.0, t_max, variant=v) for v in ("held", "cool-no-expansion", "held-no-expansion")]
+            out += [Task(SCHEDULE, 3, p, t_max, seed, v) for p in self.p for seed in self.three_seeds
+                    for v in ("walls-sinter", "short-prep", "control-wall-friction")]
+            out += [Task(COOL, n, p, t_max, variant=v) for p in self.p
+                    for v in ("held", "cool-no-expansion", "held-no-expansion")]
+            out.append(Task(COMPRESS, n, 100.0, min(self.t_s), variant="long"))
         return list(dict.fromkeys(out))
 
     def tasks(self) -> list[Task]:

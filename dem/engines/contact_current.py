@@ -22,7 +22,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from dem.network.current import Electrodes, area_weighted_current, kirchhoff, zohdi_joule
+from dem.network.current import (Electrodes, area_weighted_current, kirchhoff, refuse_floating, require_paths,
+                                 zohdi_joule)
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.geometry.particles import Particles
 from dem.engines.staggered.heat import contact_bonds
@@ -77,15 +78,7 @@ class ContactCurrent:
             G, G_w, share = bond_conductances(self.spec, now, b, self.sigma, shares=True)
             self.flow = kirchhoff(n, b.i, b.j, G, share, b.wall_particle, b.wall_index, G_w, self.electrodes,
                                   self.linear, previous=None if self.flow is None else self.flow.solver)
-            driven = [name for name in self.flow.no_path
-                      if self.electrodes.current[self.electrodes.names.index(name)] != 0.0]
-            if driven:
-                k = self.electrodes.names.index(driven[0])
-                touches = "only a group that reaches none" if np.any(b.wall_index == k) else "no particle"
-                raise ValueError(f"walls.{driven[0]}.current = {self.electrodes.current[k]:g} A at t = {t:.6g} s: no "
-                                 f"path through the particles to an electrode at a fixed potential (the wall touches "
-                                 f"{touches}); a fixed current needs a closed circuit -- give the wall a potential "
-                                 f"(an open circuit then carries nothing) or start it in contact")
+            require_paths(self.flow, self.electrodes, b.wall_index, f" at t = {t:.6g} s")
             self._check_floating(self.flow.floating, t)
             self.J = self.flow.potential
             joule = self.flow.joule_particles
@@ -96,11 +89,8 @@ class ContactCurrent:
         return self.heating
 
     def _check_floating(self, floating: np.ndarray, t: float) -> None:
-        if self.floating == "error" and len(floating):
-            shown = ", ".join(str(int(k)) for k in floating[:10]) + (", ..." if len(floating) > 10 else "")
-            raise ValueError(f"[electrical] floating = \"error\": at t = {t:.6g} s {len(floating)} particle(s) touch "
-                             f"no electrode through their contacts (floating: their potential is undetermined and "
-                             f"they carry no current): {shown}")
+        if self.floating == "error":
+            refuse_floating(floating, f"at t = {t:.6g} s ")
 
     def electrode_currents(self) -> dict:
         """Current into the packing (A) and potential (V) of each electrode (Kirchhoff), by name."""

@@ -60,11 +60,17 @@ class ContactThermalModel:
         return bonds_and_conductances(self._particles_now(mechanics, mechanics.state.radius),
                                       self._walls_now(mechanics), self.spec, pairs=(i, j), box=self.box)
 
+    def local(self, mechanics, values: np.ndarray) -> np.ndarray:
+        """``values`` (per particle of the scene) for the particles ``mechanics`` holds: all of them, in order
+        (a rank's model holds some, :class:`dem.engines.verlet.ranks.RankContactThermal`)."""
+        return values
+
     def _particles_now(self, mechanics, radius) -> Particles:
         """The particles at their current positions with ``radius``: the current radii for the contact geometry,
         the initial ones (the mass) for the capacities and the exposed surface."""
         p = self.particles
-        return Particles(mechanics.state.x, radius, self.T, p.material, p.fixed, p.heat, p.materials)
+        return Particles(mechanics.state.x, radius, *(self.local(mechanics, a) for a in (self.T, p.material, p.fixed,
+                                                                                       p.heat)), p.materials)
 
     def _walls_now(self, mechanics) -> list:
         return [self.walls[k].at(mechanics.w.q[k]) for k in self.thermal_walls]
@@ -77,8 +83,8 @@ class ContactThermalModel:
             self.refreshes += 1
         else:
             wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
-            self.net = Network(self._particles_now(mechanics, self.particles.radius), bonds, K_pairs, K_walls,
-                               wall_T, self.sources, self.box)
+            self.net = Network(self._particles_now(mechanics, self.local(mechanics, self.particles.radius)), bonds,
+                               K_pairs, K_walls, wall_T, self.sources, self.box)
             self.assemblies += 1
         T_F, heat = theta_step(self.net, self.T[self.free], dt, self.integrator, self.linear)
         for k, v in heat.items():

@@ -1,14 +1,23 @@
 """The engine of a static packing: the pipe network of Rojek 2022 (eqs. 1-9) on bonds found once from the scene's
 geometry, solved steady or integrated in time (:mod:`dem.network.heat`). It never moves a particle and allocates
-no mechanical state; a scene whose physics is only ``"thermal"`` runs here.
+no mechanical state; a scene whose physics is ``"thermal"``, or ``"thermal"`` and ``"electrical"``, runs here.
+
+With ``"electrical"`` physics a current flows between the electrodes (walls with a potential or a current) through
+the same bonds (Kirchhoff's laws, :func:`dem.network.current.kirchhoff`: each contact's conductance the scene's law
+with the electrical conductivity for kappa). Nothing moves and the conductivities do not depend on the temperature,
+so it is solved once, before the heat: the absorbed part of its Joule heat is a constant source in every particle.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from dem import memory
-from dem.network.heat import Checkpoint, boundary_heat_flow, build_network, integrate, periodic_heat_flow, steady
+from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
+from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
+                              periodic_heat_flow, steady)
 from dem.scene.state_file import box_arrays
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
@@ -50,14 +59,35 @@ class StaticEngine:
         memory.check(scene.particles.n, "particles")  # before the bond search: a refused run costs nothing
         if scene.solver.mode == "transient":
             self._check_work()
-        self.network = build_network(scene.particles, scene.walls, scene.conductance, scene.sources, box=scene.box)
-        self.bonds, self.K_pairs, self.K_walls = self.network.bonds, self.network.K_pairs, self.network.K_walls
+        particles, walls = scene.particles, scene.walls
+        bonds, K_pairs, K_walls = bonds_and_conductances(particles, walls, scene.conductance, box=scene.box)
+        self.potential, self.circuit = None, None
+        if scene.electrical is not None:
+            particles = self._joule_heated(particles, bonds)
+        wall_temperature = np.array([w.temperature for w in walls], dtype=float)
+        self.network = Network(particles, bonds, K_pairs, K_walls, wall_temperature, scene.sources, scene.box)
+        self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
         self.restart = Checkpoint.from_arrays(restart) if restart is not None else None
         self.t_start = float(scene.start_time)
         self.T = scene.particles.temperature.astype(float)
         self.t, self.steps = (self.restart.t, self.restart.steps) if self.restart is not None else (self.t_start, 0)
         self.flows: dict = {}
         self.details: dict = {}
+
+    def _joule_heated(self, particles, bonds):
+        """The particles with the absorbed Joule heat of the current (module docstring) added to their heat sources;
+        keeps the potentials and what the summary says of the circuit."""
+        e = self.scene.electrical
+        net = electrode_bonds(particles, bonds, self.scene.walls, self.scene.conductance, e.electrodes, self.scene.box)
+        flow = kirchhoff(particles.n, bonds.i, bonds.j, net.G, net.share, net.plane_node, net.plane_index, net.G_plane,
+                         e.electrodes, self.scene.solver.linear)
+        require_paths(flow, e.electrodes, net.plane_index)
+        if e.floating == "error":
+            refuse_floating(flow.floating)
+        self.potential = flow.potential
+        self.circuit = circuit(e.electrodes, flow.electrode_potential, flow.electrode_current, flow.joule_heat,
+                               flow.electrode_power)
+        return replace(particles, heat=particles.heat + e.absorption * flow.joule_particles)
 
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """Solve (steady) or integrate (transient) to ``[solver] t_end``; ``observe()`` after every step (and at the
@@ -160,8 +190,11 @@ class StaticEngine:
 
     def particle_fields(self) -> dict:
         p = self.scene.particles
-        return {"id": p.id, "radius": p.radius, "temperature": self.T, "fixed": p.fixed.astype(np.int8),
-                "material": p.material.astype(np.int32)}
+        fields = {"id": p.id, "radius": p.radius, "temperature": self.T, "fixed": p.fixed.astype(np.int8),
+                  "material": p.material.astype(np.int32)}
+        if self.potential is not None:
+            fields["potential"] = self.potential
+        return fields
 
     def links(self):
         """The bonds as lines: a pair bond joins its particles, a wall bond joins the particle to its foot point on
@@ -207,6 +240,8 @@ class StaticEngine:
             out["effective_conductivity"] = k_eff
         out.update(T_mean=float(self.T.mean()), T_min=float(self.T.min()), T_max=float(self.T.max()))
         out.update(d)
+        if self.circuit is not None:
+            out["electrical"] = self.circuit
         return out
 
     def state(self) -> dict:

@@ -32,7 +32,7 @@ exactly the bonds of an explicit larger block.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -91,6 +91,14 @@ class Bonds:
     @property
     def n_walls(self) -> int:
         return len(self.wall_particle)
+
+    def subset(self, pairs: np.ndarray, walls: np.ndarray) -> "Bonds":
+        """The pair bonds at ``pairs`` and the wall bonds at ``walls`` (masks or indices), in their order."""
+        return replace(self, i=self.i[pairs], j=self.j[pairs], h=self.h[pairs], d=self.d[pairs], a=self.a[pairs],
+                       l_i=self.l_i[pairs], l_j=self.l_j[pairs],
+                       shift=None if self.shift is None else self.shift[pairs],
+                       wall_particle=self.wall_particle[walls], wall_index=self.wall_index[walls],
+                       wall_h=self.wall_h[walls], wall_a=self.wall_a[walls], wall_l=self.wall_l[walls])
 
 
 def candidate_pairs(position: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

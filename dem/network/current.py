@@ -35,12 +35,13 @@ undetermined; they are reported as floating).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from dem.laws.conductance import bond_conductances
 from dem.network.laplacian import BoundedLaplacian, solve_anchored
 
 SCHEMES = ("kirchhoff", "zohdi")
@@ -165,15 +166,9 @@ def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrod
     potential[held] = V[lone[held]]
     electrode_potential = np.where(electrodes.fixed_potential | on_electrodes, V, np.nan)
     x = np.nan_to_num(potential)  # floating particles carry nothing: their contacts join equal (zero) values
-    pair_current = G * (x[i] - x[j])
-    live = on_particles[plane_node]
-    wall_current = np.where(live, G_plane * (V[plane_index] - x[plane_node]), 0.0)
+    c = contact_currents(n, i, j, G, share, plane_node, plane_index, G_plane, x, V, on_particles[plane_node])
+    pair_current, wall_current, heat_pairs, heat_walls, joule_particles = c
     electrode_current = np.bincount(plane_index, wall_current, n_e)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        heat_pairs = np.where(G > 0, pair_current**2 / G, 0.0)
-        heat_walls = np.where(G_plane > 0, wall_current**2 / G_plane, 0.0)
-    joule_particles = (np.bincount(i, share * heat_pairs, n) + np.bincount(j, (1.0 - share) * heat_pairs, n)
-                       + np.bincount(plane_node, heat_walls, n))
     balance = (np.bincount(plane_node, wall_current, n) - np.bincount(i, pair_current, n)
                + np.bincount(j, pair_current, n))
     # relative to the largest contact current, or (when almost none flows) to the largest G |V|
@@ -183,6 +178,89 @@ def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrod
     power = float(np.nansum(np.where(np.isfinite(electrode_potential), electrode_potential, 0.0) * electrode_current))
     return CurrentFlow(potential, pair_current, wall_current, electrode_potential, electrode_current, joule_particles,
                        float(heat_pairs.sum() + heat_walls.sum()), power, floating, no_path, residual, solver)
+
+
+@dataclass
+class ElectrodeBonds:
+    """The current's network on the bonds of a packing: per pair bond its conductance ``G`` (S) and ``share`` (the
+    fraction of its resistance on the side of i); the wall bonds to an electrode, ``(plane_node, plane_index)`` (the
+    particle, the electrode's position in :class:`Electrodes`) of conductance ``G_plane`` (S), and ``on_electrode``
+    (which of the bonds' wall bonds they are: a wall that is no electrode carries no current)."""
+
+    G: np.ndarray
+    share: np.ndarray
+    plane_node: np.ndarray
+    plane_index: np.ndarray
+    G_plane: np.ndarray
+    on_electrode: np.ndarray
+
+
+def electrode_bonds(particles, bonds, walls, spec, electrodes: Electrodes, box=None) -> ElectrodeBonds:
+    """The electrical conductances of ``bonds`` (:func:`dem.laws.conductance.bond_conductances` with the particles'
+    electrical conductivity for kappa, without the interface conductance) and their wall bonds to the electrodes
+    among ``walls``."""
+    G, G_walls, share = bond_conductances(replace(spec, contact_conductance=None), particles, bonds,
+                                          particles.electrical_conductivity, shares=True, box=box, walls=tuple(walls))
+    electrode_of_wall = np.full(len(walls), -1, dtype=np.int64)
+    electrode_of_wall[list(electrodes.walls)] = np.arange(len(electrodes))
+    electrode = electrode_of_wall[bonds.wall_index]
+    on = electrode >= 0
+    return ElectrodeBonds(G, share, bonds.wall_particle[on], electrode[on], G_walls[on], on)
+
+
+def circuit(electrodes: Electrodes, electrode_potential, electrode_current, joule_heat: float,
+            electrode_power: float) -> dict:
+    """What the summary says of a current: each electrode's potential (V) and current into the packing (A), the
+    ``total_current`` that enters (A, the sum of the positive ones), the Joule heat of all contacts and the power the
+    electrodes deliver (W; equal, Tellegen's theorem), and between two electrodes the ``resistance`` (Ohm) of the
+    packing, their potential difference over the current."""
+    current = np.asarray(electrode_current, dtype=float)
+    total = float(current[current > 0].sum())
+    out = {"electrodes": {name: {"potential": float(v), "current": float(i)} for name, v, i in
+                          zip(electrodes.names, electrode_potential, current)},
+           "total_current": total, "joule_heat": float(joule_heat), "electrode_power": float(electrode_power)}
+    if len(electrodes) == 2 and total > 0:
+        out["resistance"] = float(abs(electrode_potential[0] - electrode_potential[1]) / total)
+    return out
+
+
+def require_paths(flow: CurrentFlow, electrodes: Electrodes, plane_index, when: str = "") -> None:
+    """A ``ValueError`` if an electrode driving a non-zero current has no path to one at a fixed potential
+    (``plane_index``: the electrode of each wall bond; ``when``: e.g. the time, for the message)."""
+    driven = [name for name in flow.no_path if electrodes.current[electrodes.names.index(name)] != 0.0]
+    if driven:
+        k = electrodes.names.index(driven[0])
+        touches = "only a group that reaches none" if np.any(np.asarray(plane_index) == k) else "no particle"
+        raise ValueError(f"walls.{driven[0]}.current = {electrodes.current[k]:g} A{when}: no path through the "
+                         f"particles to an electrode at a fixed potential (the wall touches {touches}); a fixed "
+                         f"current needs a closed circuit -- give the wall a potential (an open circuit then carries "
+                         f"nothing) or start it in contact")
+
+
+def refuse_floating(floating: np.ndarray, when: str = "") -> None:
+    """The ``ValueError`` of ``[electrical] floating = "error"`` if any particle is ``floating`` (indices; ``when``:
+    e.g. ``"at t = 1 s "``)."""
+    if len(floating):
+        shown = ", ".join(str(int(k)) for k in floating[:10]) + (", ..." if len(floating) > 10 else "")
+        raise ValueError(f"[electrical] floating = \"error\": {when}{len(floating)} particle(s) touch no electrode "
+                         f"through their contacts (floating: their potential is undetermined and they carry no "
+                         f"current): {shown}")
+
+
+def contact_currents(n: int, i, j, G, share, plane_node, plane_index, G_plane, x, V, live):
+    """The currents at the potentials ``x`` (per particle) with the electrodes at ``V``: ``(pair_current`` A from i
+    to j, ``wall_current`` A from each electrode into its particle (0 where ``live`` is False), the Joule heat
+    ``I^2/G`` of each pair and wall contact, and the Joule heat made in each particle``)``: a pair contact's shared
+    by its particles in proportion to the resistances of their halves (``share``: i's), a wall contact's in its
+    particle (module docstring)."""
+    pair_current = G * (x[i] - x[j])
+    wall_current = np.where(live, G_plane * (V[plane_index] - x[plane_node]), 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        heat_pairs = np.where(G > 0, pair_current**2 / G, 0.0)
+        heat_walls = np.where(G_plane > 0, wall_current**2 / G_plane, 0.0)
+    joule_particles = (np.bincount(i, share * heat_pairs, n) + np.bincount(j, (1.0 - share) * heat_pairs, n)
+                       + np.bincount(plane_node, heat_walls, n))
+    return pair_current, wall_current, heat_pairs, heat_walls, joule_particles
 
 
 def wall_values(n: int, plane_node, plane_index, values) -> tuple[np.ndarray, np.ndarray]:

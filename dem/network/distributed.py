@@ -209,7 +209,10 @@ class DistributedNetwork:
             solver = self.solver(A, row, n_global, rtol)
             solver_name = solver.name
             take = self.own_free & unknown
-            T_F[take] = solver.solve(net.rhs(sinks)[take], T_F[take])
+            try:
+                T_F[take] = solver.solve(net.rhs(sinks)[take], T_F[take])
+            finally:
+                solver.destroy()
             self.linear_iterations += solver.iterations
         if len(gauged_labels):
             cap = self.group_sums(gauged_labels, G.label, net.C)
@@ -246,45 +249,49 @@ class DistributedNetwork:
         energy0 = self.total(float(net.C[own] @ T[own]))
         if observer is not None:
             observer(0, 0.0, T, self.flows(T, sinks))
-        t = 0.0
-        for step in range(1, n_steps + 1):
-            last = step == n_steps
-            h = t_end - (step - 1) * dt if last else dt
-            if abs(h - dt) <= 1e-9 * dt:
-                h = dt
-            if h not in solvers:
-                M = (A * theta + sp.diags(net.C / h)).tocsr()
-                solvers[h] = (M, self.solver(M, row, n_global, rtol_linear))
-            M, solver = solvers[h]
-            rhs = net.C / h * T + r
-            if theta < 1.0:
-                rhs -= (1.0 - theta) * (A @ T)
-            T_new = T.copy()
-            T_new[own] = solver.solve(rhs[own], T[own])
-            T_new = self.halo_filled(T_new)[net.free]
-            # a uniform shift of the order of the solver's tolerance makes the residuals sum to zero (the heat
-            # balance of the step to round-off), as in the serial stepper
-            residual, weight = self.total(np.array([float(np.sum((rhs - M @ T_new)[own])),
-                                                    float(M[own].sum())]))
-            T_new += residual / weight
-            dt_min, dt_max = min(dt_min, h), max(dt_max, h)
-            T_theta = theta * T_new + (1.0 - theta) * T
-            flows = self.flows(T_theta, sinks)
-            for k, v in flows.items():
-                heat_in[k] += h * v
-            abs_in += h * self.flow_magnitude(T_theta, sinks)
-            T = T_new
-            t = t_end if last else step * dt
-            if not self.total(int(np.all(np.isfinite(T[own])))) == self.size:
-                raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {step})")
-            if bounded:
-                top = mpi.maximum(self.comm, float(T[own].max(initial=-np.inf)))
-                bottom = mpi.minimum(self.comm, float(T[own].min(initial=np.inf)))
-                violation = max(violation, top - hi, lo - bottom)
-            if observer is not None:
-                observer(step, t, T, flows)
-            if progress is not None:
-                progress(t)
+        try:  # the PETSc solvers freed however the steps end (PetscSolver.destroy)
+            t = 0.0
+            for step in range(1, n_steps + 1):
+                last = step == n_steps
+                h = t_end - (step - 1) * dt if last else dt
+                if abs(h - dt) <= 1e-9 * dt:
+                    h = dt
+                if h not in solvers:
+                    M = (A * theta + sp.diags(net.C / h)).tocsr()
+                    solvers[h] = (M, self.solver(M, row, n_global, rtol_linear))
+                M, solver = solvers[h]
+                rhs = net.C / h * T + r
+                if theta < 1.0:
+                    rhs -= (1.0 - theta) * (A @ T)
+                T_new = T.copy()
+                T_new[own] = solver.solve(rhs[own], T[own])
+                T_new = self.halo_filled(T_new)[net.free]
+                # a uniform shift of the order of the solver's tolerance makes the residuals sum to zero (the heat
+                # balance of the step to round-off), as in the serial stepper
+                residual, weight = self.total(np.array([float(np.sum((rhs - M @ T_new)[own])),
+                                                        float(M[own].sum())]))
+                T_new += residual / weight
+                dt_min, dt_max = min(dt_min, h), max(dt_max, h)
+                T_theta = theta * T_new + (1.0 - theta) * T
+                flows = self.flows(T_theta, sinks)
+                for k, v in flows.items():
+                    heat_in[k] += h * v
+                abs_in += h * self.flow_magnitude(T_theta, sinks)
+                T = T_new
+                t = t_end if last else step * dt
+                if not self.total(int(np.all(np.isfinite(T[own])))) == self.size:
+                    raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {step})")
+                if bounded:
+                    top = mpi.maximum(self.comm, float(T[own].max(initial=-np.inf)))
+                    bottom = mpi.minimum(self.comm, float(T[own].min(initial=np.inf)))
+                    violation = max(violation, top - hi, lo - bottom)
+                if observer is not None:
+                    observer(step, t, T, flows)
+                if progress is not None:
+                    progress(t)
+        finally:
+            for _, solver in solvers.values():
+                solver.destroy()
         self.linear_iterations = sum(s.iterations for _, s in solvers.values())
         energy = self.total(float(net.C[own] @ T[own]))
         scale = self.total(float(net.C[own].sum())) * (hi - lo) + abs_in

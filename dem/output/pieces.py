@@ -2,8 +2,10 @@
 
 A snapshot is one ``.vtu`` piece per rank (``particles_NNNNNNNNN_R.vtu``: the particles rank R owns; likewise the
 bonds) and a parallel VTK file ``particles_NNNNNNNNN.pvtu`` that names the pieces; the ``.pvd`` collections list the
-``.pvtu`` files, so ParaView opens all ranks' particles as one data set. ``timeseries.csv`` and ``summary.json`` are
-rank 0's (the engine reduces their numbers over the ranks); no plots (they need every particle in one process).
+``.pvtu`` files, so ParaView opens all ranks' particles as one data set. ``timeseries.csv``, ``profiles.csv``,
+``summary.json`` and the plots are rank 0's (the engine reduces or gathers their numbers there; an engine whose plots
+need every particle in one process makes none). A resumed run goes on with the files as the serial writer does:
+rank 0 drops the rows and files written after the checkpoint, every rank takes up the snapshot times.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from __future__ import annotations
 import meshio
 import numpy as np
 
-from dem.output.writer import DIGITS, RunWriter, write_pvd, write_summary, write_vtu
+from dem.output.writer import DIGITS, RunWriter, listed_snapshots, write_pvd, write_summary, write_vtu
 
 VTK_TYPES = {np.dtype(k): v for k, v in (("float32", "Float32"), ("float64", "Float64"), ("int8", "Int8"),
                                           ("int16", "Int16"), ("int32", "Int32"), ("int64", "Int64"),
@@ -46,9 +48,12 @@ def write_pvtu(path, pieces: list[str], point_fields: dict, cell_fields: dict) -
 class PieceWriter(RunWriter):
     """:class:`~dem.output.writer.RunWriter` on rank ``rank`` of ``ranks`` (module docstring)."""
 
-    def __init__(self, out_dir, scene, engine, rank: int, ranks: int):
+    def __init__(self, out_dir, scene, engine, rank: int, ranks: int, resume_step: int | None = None):
         self.rank, self.ranks = rank, ranks
-        super().__init__(out_dir, scene, engine)
+        super().__init__(out_dir, scene, engine, resume_step if rank == 0 else None)
+        if resume_step is not None and rank > 0:  # rank 0 rewrites the files; the others only take up the clock
+            self.snapshots = [(t, s) for t, s in listed_snapshots(self.out, self.kinds[0]) if s <= resume_step]
+            self._resumed_clock()
 
     def _row(self, row: dict) -> None:
         if self.rank == 0:
@@ -59,6 +64,8 @@ class PieceWriter(RunWriter):
         step, t = e.steps, e.t
         if self.snapshots and self.snapshots[-1][1] == step:
             return
+        if self.rank == 0:
+            self._profile(t)
         if self.scene.output.vtu:
             x = e.positions()
             fields = e.particle_fields()
@@ -84,14 +91,18 @@ class PieceWriter(RunWriter):
                 write_pvd(self.out / f"{kind}.pvd",
                           [(t, f"{kind}_{s:0{DIGITS}d}.pvtu") for t, s in self.snapshots])
 
-    def finish(self, summary: dict, plots: bool = False) -> dict:
-        """The last row and snapshot (all ranks), then ``summary.json`` (rank 0)."""
-        if self.last is not None and self.last["step"] % self.scene.output.every:
+    def finish(self, summary: dict, plots: bool = True) -> dict:
+        """The last row and snapshot (all ranks), then ``summary.json`` and the plots (rank 0)."""
+        if self.last is not None and not self.by_time and self.last["step"] % self.scene.output.every:
             self._guarded("timeseries.csv", lambda: self._row(self.last))
         if self.csv is not None:
             self.csv.close()
-        if self.last is not None:
+        if self.last is not None or self.by_time:
             self._guarded("snapshot", self.snapshot)
         if self.rank == 0:
             write_summary(self.out / "summary.json", self._with_errors(summary))
+            written = self._guarded("plots", lambda: self.engine.plots(self.out, summary)) if plots else None
+            if written:
+                summary["plots"] = written
+                write_summary(self.out / "summary.json", self._with_errors(summary))
         return summary

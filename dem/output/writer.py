@@ -43,19 +43,30 @@ def resumed_csv(path: pathlib.Path, keep) -> "io.TextIOBase":
     return path.open("a")
 
 
+def snapshot_files(out: pathlib.Path, kind: str):
+    """``(step, path)`` of every snapshot file of ``kind`` in ``out``: ``kind_STEP.vtu``, and in parallel the
+    pieces ``kind_STEP_RANK.vtu`` and ``kind_STEP.pvtu`` (:mod:`dem.output.pieces`)."""
+    for f in out.glob(f"{kind}_*vtu"):
+        yield int(f.name.split("_")[1].split(".")[0]), f
+
+
+def listed_snapshots(out: pathlib.Path, kind: str) -> list[tuple[float, int]]:
+    """The ``(t, step)`` of the snapshots ``out/<kind>.pvd`` lists (VTU or PVTU files)."""
+    pvd = out / f"{kind}.pvd"
+    if not pvd.exists():
+        return []
+    return [(float(t), int(step)) for t, step in
+            re.findall(r'timestep="([^"]+)"[^>]*file="[a-z]+_(\d+)\.p?vtu"', pvd.read_text())]
+
+
 def resumed_snapshots(out: pathlib.Path, kinds, last_step: int) -> list[tuple[float, int]]:
     """The ``(t, step)`` of the snapshots listed in ``out/<kind>.pvd`` up to ``last_step``; the files of later ones
     (written after the checkpoint a run resumes from) are deleted."""
-    listed = []
-    pvd = out / f"{kinds[0]}.pvd"
-    if pvd.exists():
-        listed = [(float(t), int(step)) for t, step in
-                  re.findall(r'timestep="([^"]+)"[^>]*file="[a-z]+_(\d+)\.vtu"', pvd.read_text())]
     for kind in kinds:
-        for f in out.glob(f"{kind}_*.vtu"):
-            if int(f.stem.split("_")[-1]) > last_step:
+        for step, f in snapshot_files(out, kind):
+            if step > last_step:
                 f.unlink()
-    return [(t, step) for t, step in listed if step <= last_step]
+    return [(t, step) for t, step in listed_snapshots(out, kinds[0]) if step <= last_step]
 
 
 def write_vtu(path: pathlib.Path, mesh) -> None:
@@ -123,12 +134,19 @@ class RunWriter:
                 self.columns = fh.readline().strip().split(",")
             self.csv = resumed_csv(path, lambda row: int(row["step"]) <= resume_step)
             self.snapshots = resumed_snapshots(self.out, self.kinds, resume_step)
-            t_last = max((t for t, _ in self.snapshots), default=engine.t)
+            t_last = self._resumed_clock()
             if (self.out / "profiles.csv").exists():
                 resumed_csv(self.out / "profiles.csv", lambda row: float(row["t"]) <= t_last).close()
-            interval = getattr(scene.motion, "vtu_interval", 0.0)
-            while interval > 0 and self.next_vtu <= t_last + 1e-12 * scene.solver.t_end:
-                self.next_vtu += interval  # as the run advanced it: the same sums, the same snapshot times
+
+    def _resumed_clock(self) -> float:
+        """The time of the last snapshot kept on resuming; the next snapshot's time advanced past it, as the
+        interrupted run advanced it (the same sums, the same snapshot times)."""
+        t_last = max((t for t, _ in self.snapshots), default=self.engine.t)
+        interval = getattr(self.scene.motion, "vtu_interval", 0.0)
+        self.next_vtu = self.engine.t_start
+        while interval > 0 and self.next_vtu <= t_last + 1e-12 * self.scene.solver.t_end:
+            self.next_vtu += interval
+        return t_last
 
     # ------------------------------------------------------------------------------------------------ rows
     def observe(self) -> None:
@@ -173,14 +191,7 @@ class RunWriter:
         step, t = e.steps, e.t
         if self.snapshots and self.snapshots[-1][1] == step:
             return
-        profile = e.profile()
-        if profile is not None:
-            new = not (self.out / "profiles.csv").exists()
-            with (self.out / "profiles.csv").open("a") as fh:
-                if new:
-                    fh.write("t,distance,solid_fraction,neck_over_radius\n")
-                for d, phi, a in zip(profile["distance"], profile["solid_fraction"], profile["neck_over_radius"]):
-                    fh.write(f"{t:.12g},{d:.12g},{phi:.12g},{'' if a is None else f'{a:.12g}'}\n")
+        self._profile(t)
         if not self.scene.output.vtu:
             self.snapshots.append((t, step))
             return
@@ -193,6 +204,17 @@ class RunWriter:
             cell_data={k: [v] for k, v in fields.items()}))
         self.snapshots.append((t, step))
         self._write_pvd()
+
+    def _profile(self, t: float) -> None:
+        """The engine's profiles now, a block of rows of ``profiles.csv``."""
+        profile = self.engine.profile()
+        if profile is not None:
+            new = not (self.out / "profiles.csv").exists()
+            with (self.out / "profiles.csv").open("a") as fh:
+                if new:
+                    fh.write("t,distance,solid_fraction,neck_over_radius\n")
+                for d, phi, a in zip(profile["distance"], profile["solid_fraction"], profile["neck_over_radius"]):
+                    fh.write(f"{t:.12g},{d:.12g},{phi:.12g},{'' if a is None else f'{a:.12g}'}\n")
 
     def _write_pvd(self) -> None:
         for kind in self.kinds:
@@ -244,8 +266,8 @@ class RunWriter:
         for f in self.out.glob("*.vtu.part"):
             f.unlink()
         for kind in self.kinds:
-            for f in self.out.glob(f"{kind}_*.vtu"):
-                if int(f.stem.split("_")[-1]) not in steps:
+            for step, f in snapshot_files(self.out, kind):
+                if step not in steps:
                     f.unlink()
         if self.scene.output.vtu:
             self._write_pvd()

@@ -158,16 +158,17 @@ PHYSICS = ("thermal", "mechanical", "electrical")  # the submodels a scene can n
 
 
 def check_physics(names) -> None:
-    """Every name a submodel that exists (``PHYSICS``); ``electrical`` runs with moving particles."""
+    """Every name a submodel that exists (``PHYSICS``); ``electrical`` runs with moving particles, or with
+    ``thermal`` on a static packing (its Joule heat is all it does there)."""
     for name in names:
         if name not in PHYSICS:
             raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(PHYSICS)})")
     if not names:
         raise ValueError(f"[scene] physics: names no submodel (available: {', '.join(PHYSICS)})")
-    if "electrical" in names and "mechanical" not in names:
-        raise ValueError("[scene] physics: \"electrical\" runs with moving particles: [\"mechanical\", \"thermal\", "
-                         "\"electrical\"] with [contact] law = \"zohdi\" (the current on a static packing: "
-                         "dem.network.current.kirchhoff)")
+    if "electrical" in names and "mechanical" not in names and "thermal" not in names:
+        raise ValueError("[scene] physics: \"electrical\" on a static packing heats it and runs with \"thermal\": "
+                         "[\"thermal\", \"electrical\"] (or [\"mechanical\", \"thermal\", \"electrical\"] "
+                         "with [contact] law = \"zohdi\" for particles that move)")
 
 
 def _is_number(v) -> bool:

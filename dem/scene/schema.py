@@ -19,8 +19,9 @@ STATIC = ("static",)
 VERLET = ("verlet",)
 STAGGERED = ("staggered",)
 STATIC_VERLET = ("static", "verlet")
+STATIC_STAGGERED = ("static", "staggered")
 ENGINE_WORDS = {ALL: "all", MOVING: "moving", STATIC: "static", VERLET: "verlet", STAGGERED: "staggered",
-                STATIC_VERLET: "static, verlet"}
+                STATIC_VERLET: "static, verlet", STATIC_STAGGERED: "static, staggered"}
 ARRAYS = ("materials", "walls", "phases")  # tables given as arrays of tables ([[walls]])
 LAW_TABLES = ("contact", "phases")  # tables whose keys (beyond those listed) are the contact law's material fields
 
@@ -41,7 +42,7 @@ ROWS = (
     Row("scene", ("description",), ALL, "string", "listed by `python -m dem scenes`"),
     Row("scene", ("physics",), ALL, 'list, `["thermal"]`',
         'submodels: `"thermal"`, `"mechanical"` (particles that move), `"electrical"` (the current and its Joule heat, '
-        'with `[contact] law = "zohdi"`)'),
+        'with `"thermal"`: on a static packing, or on moving ones with `[contact] law = "zohdi"`)'),
     Row("scene", ("temperature_unit",), ALL, '`"C"`; `"K"` with `[contact] law = "zohdi"`; radiation.unit where given',
         'the unit of the scene\'s temperatures, `"C"` or `"K"`: the plots\' axes say it (the laws take the '
         'temperatures as given)'),
@@ -50,7 +51,7 @@ ROWS = (
     Row("material", ("conductivity", "density", "specific_heat"), ALL, "numbers > 0",
         "κ W/(m K), ρ kg/m³, c J/(kg K); capacity C_i = ρ(4/3)πr_i³ c (Rojek 2022, eq. 1); thermal physics needs κ "
         "and c, moving particles ρ"),
-    Row("material", ("electrical_conductivity",), STAGGERED, 'number > 0, required with "electrical"',
+    Row("material", ("electrical_conductivity",), STATIC_STAGGERED, 'number > 0, required with "electrical"',
         "σ S/m: a contact's electrical conductance is the conductance law with σ for κ"),
     Row("material", ("name",), ALL, "string", "what particles call it by"),
     Row("materials", ("name", "conductivity", "density", "specific_heat", "electrical_conductivity"), ALL,
@@ -105,7 +106,7 @@ ROWS = (
     Row("walls", ("velocity",), MOVING, "m/s, inward", "of a strain wall"),
     Row("walls", ("amplitude", "frequency"), MOVING, "m, Hz", "of a vibrating wall, q(t) = q0 + A sin(2πf(t - t_0)) "
         "from the run's start t_0"),
-    Row("walls", ("potential", "current"), STAGGERED, "V or A", 'an electrode ("electrical" physics): a fixed '
+    Row("walls", ("potential", "current"), STATIC_STAGGERED, "V or A", 'an electrode ("electrical" physics): a fixed '
         "potential, or a current into the packing"),
     Row("periodic", ("lengths",), ALL,
         "[Lx, Ly, Lz] m, required (default: the box of a `[particles] file` or a `[start] state`)",
@@ -197,9 +198,11 @@ ROWS = (
         "a prescribed temperature schedule (Luding 2005, Fig. 7) and its t0 per segment"),
     Row("phases", ("start",), MOVING, "s, required", "from this time on"),
     Row("phases", ("wall_velocity",), MOVING, "{name = m/s}", "strain walls' new speeds"),
-    Row("electrical", ("scheme", "absorption", "floating", "tolerance", "sweeps"), STAGGERED,
-        '`"kirchhoff"`, 1, `"allow"`, 1e-8, 10 000',
-        "the current (Zohdi 2014, eqs. 35, 38-44): Kirchhoff or the paper's iteration"),
+    Row("electrical", ("scheme", "absorption", "floating"), STATIC_STAGGERED, '`"kirchhoff"`, 1, `"allow"`',
+        "the current (Zohdi 2014, eqs. 35, 38-44): Kirchhoff or the paper's iteration (moving particles only), the "
+        "fraction of the Joule heat the particles take, whether groups touching no electrode stop the run"),
+    Row("electrical", ("tolerance", "sweeps"), STAGGERED, "1e-8, 10 000", "the paper's iteration: its tolerance "
+        "(the largest change per sweep relative to the largest wall value) and its sweeps at most"),
 )
 TABLES = tuple(dict.fromkeys(row.table for row in ROWS))
 

@@ -153,6 +153,9 @@ def parse_electrical(doc: dict, walls, physics) -> ElectricalSpec | None:
     if not isinstance(table, dict):
         raise ValueError("[electrical]: must be a table")
     scheme = check_scheme(table.get("scheme", "kirchhoff"))
+    if scheme == "zohdi" and "mechanical" not in physics:
+        raise ValueError("[electrical] scheme = \"zohdi\": the paper's iteration runs with moving particles; a "
+                         "static packing takes scheme = \"kirchhoff\"")
     absorption = check_absorption(table.get("absorption", 1.0))
     tolerance = _number(table, "electrical", "tolerance", 1e-8)
     if tolerance <= 0:

@@ -8,9 +8,17 @@ with an owned particle (:mod:`dem.network.distributed`: its rows are the serial 
 the effective conductivity are reduced over the ranks; the snapshots are one piece per rank
 (:class:`dem.output.pieces.PieceWriter`).
 
+A current between electrodes (``"electrical"`` physics, :mod:`dem.engines.static`) is solved before the heat on the
+same ranks and the same code path: its network is a :class:`dem.network.heat.Network` of the same bonds with the
+electrical conductances, the electrodes as its walls at their potentials and nothing fixed, solved by
+:meth:`dem.network.distributed.DistributedNetwork.steady` (groups touching no electrode float at potential 0, as the
+serial solve leaves them: they carry nothing). Each rank then has the potentials of its particles and their halo,
+hence the current and Joule heat of every contact of its own particles (:func:`dem.network.current.contact_currents`);
+the electrodes' currents and the Joule heat are summed over the ranks.
+
 What it does not do, refused up front with the reason: moving particles (another engine's), radiation (a Newton
 iteration), explicit steps and ``dt = "auto"`` (fixed implicit or Crank-Nicolson steps only), the ``clip`` and
-``drop`` bond policies, ``--resume``.
+``drop`` bond policies, an electrode driving a fixed current (a superposition of solves), ``--resume``.
 """
 
 from __future__ import annotations
@@ -21,9 +29,9 @@ import numpy as np
 
 from dem import memory
 from dem.engines.static import CSV_FLOWS, StaticEngine, effective_conductivity
-from dem.geometry.bonds import Bonds
 from dem.geometry.partition import bisection, halo
 from dem.network import comm as mpi
+from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
 from dem.network.distributed import DistributedNetwork
 from dem.network.heat import Network, bonds_and_conductances
 
@@ -41,17 +49,14 @@ def unsupported(scene, resume: bool = False) -> str | None:
     if s.mode == "transient" and (s.integrator == "explicit" or s.dt == "auto"):
         return (f"[solver] integrator = {s.integrator!r}, dt = {s.dt!r}: under MPI transient runs take fixed "
                 f"implicit or crank-nicolson steps (a number for dt); run it without mpiexec")
+    if scene.electrical is not None and not np.all(scene.electrical.electrodes.fixed_potential):
+        e = scene.electrical.electrodes
+        name = e.names[int(np.flatnonzero(~e.fixed_potential)[0])]
+        return (f"walls.{name}.current: an electrode driving a fixed current does not run under MPI (its potential "
+                f"needs a superposition of solves); give it a potential, or run without mpiexec")
     if resume:
         return "--resume does not run under MPI; run the scene again"
     return None
-
-
-def _kept(bonds: Bonds, pairs: np.ndarray, walls: np.ndarray) -> Bonds:
-    """The bonds of ``bonds`` at the positions ``pairs`` and wall bonds at ``walls`` (masks)."""
-    return replace(bonds, i=bonds.i[pairs], j=bonds.j[pairs], h=bonds.h[pairs], d=bonds.d[pairs], a=bonds.a[pairs],
-                   l_i=bonds.l_i[pairs], l_j=bonds.l_j[pairs], shift=None if bonds.shift is None else
-                   bonds.shift[pairs], wall_particle=bonds.wall_particle[walls], wall_index=bonds.wall_index[walls],
-                   wall_h=bonds.wall_h[walls], wall_a=bonds.wall_a[walls], wall_l=bonds.wall_l[walls])
 
 
 class DistributedStaticEngine(StaticEngine):
@@ -72,7 +77,14 @@ class DistributedStaticEngine(StaticEngine):
         self.t, self.steps = self.t_start, 0
         self.flows, self.details, self.restart = {}, {}, None
         owner = mpi.agree(self.comm, lambda: self._build(scene, rank))  # no collective call inside: a bond out of
-        self.part = DistributedNetwork(self.comm, self.network, self.held, owner)  # range stops every rank alike
+        particles = self.scene.particles                                  # range stops every rank alike
+        self.potential, self.circuit = None, None
+        if scene.electrical is not None:
+            particles = mpi.agree(self.comm, lambda: self._joule_heated(particles, owner))
+        wall_temperature = np.array([w.temperature for w in scene.walls], dtype=float)
+        self.network = Network(particles, self.bonds, self.K_pairs, self.K_walls, wall_temperature, scene.sources,
+                               scene.box)
+        self.part = DistributedNetwork(self.comm, self.network, self.held, owner)
 
     def _build(self, scene, rank: int) -> np.ndarray:
         """This rank's particles, bonds and network (no communication); returns the owner of each held particle."""
@@ -97,12 +109,36 @@ class DistributedStaticEngine(StaticEngine):
             raise ValueError(f"rank {rank} of {self.ranks}, its {len(held)} particles numbered from 0 in the "
                              f"scene's order: {exc}") from None
         pairs, walls = mine[bonds.i] | mine[bonds.j], mine[bonds.wall_particle]
-        self.bonds, self.K_pairs, self.K_walls = _kept(bonds, pairs, walls), K_pairs[pairs], K_walls[walls]
-        wall_temperature = np.array([w.temperature for w in scene.walls], dtype=float)
-        self.network = Network(local, self.bonds, self.K_pairs, self.K_walls, wall_temperature, scene.sources, box)
+        self.bonds, self.K_pairs, self.K_walls = bonds.subset(pairs, walls), K_pairs[pairs], K_walls[walls]
         self.held, self.mine = held, mine
         self.T = local.temperature.astype(float)
         return owner[held]
+
+    def _joule_heated(self, particles, owner: np.ndarray):
+        """The held particles with the absorbed Joule heat of the current added to their heat sources (module
+        docstring: valid for the owned ones, whose contacts are all here); keeps the potentials of the held particles
+        and the circuit's summary, reduced over the ranks."""
+        e, b = self.full_scene.electrical, self.bonds
+        wires = electrode_bonds(particles, b, self.scene.walls, self.scene.conductance, e.electrodes, self.scene.box)
+        neutral = replace(particles, temperature=np.zeros(particles.n), fixed=np.zeros(particles.n, dtype=bool),
+                          heat=np.zeros(particles.n))
+        through = replace(b.subset(slice(None), wires.on_electrode), wall_index=wires.plane_index)
+        network = Network(neutral, through, wires.G, wires.G_plane, e.electrodes.potential)
+        part = DistributedNetwork(self.comm, network, self.held, owner)
+        x, _, _, n_float, _ = part.steady("mean")
+        if e.floating == "error" and n_float:
+            G = part.groups(network.fixed_diag + network.wall_diag)
+            lost = G.member(G.floating) & part.own_free
+            refuse_floating(np.sort(np.concatenate(self.comm.allgather(self.held[lost]))))
+        V = e.electrodes.potential
+        pair_current, wall_current, heat_pairs, heat_walls, self.joule = contact_currents(
+            particles.n, b.i, b.j, wires.G, wires.share, wires.plane_node, wires.plane_index, wires.G_plane, x, V,
+            np.ones(len(wires.plane_node), dtype=bool))
+        current = part.total(np.bincount(wires.plane_index, wall_current, len(V)))
+        heat = part.total(float(heat_pairs[self.mine[b.i]].sum() + heat_walls.sum()))
+        self.potential = x
+        self.circuit = circuit(e.electrodes, V, current, heat, float(V @ current))
+        return replace(particles, heat=particles.heat + e.absorption * self.joule)
 
     # ------------------------------------------------------------------------------------------------ run
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
@@ -207,6 +243,8 @@ class DistributedStaticEngine(StaticEngine):
                    T_min=mpi.minimum(self.comm, float(own.min(initial=np.inf))),
                    T_max=mpi.maximum(self.comm, float(own.max(initial=-np.inf))))
         out.update(d)
+        if self.circuit is not None:
+            out["electrical"] = self.circuit
         return out
 
     def gathered_temperatures(self) -> np.ndarray:

@@ -28,7 +28,7 @@ from dataclasses import replace
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.motion import MotionState
-from dem.geometry.neighbours import list_arrays, restore_lists
+from dem.geometry.neighbours import list_arrays
 from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
 from dem.scene.state_file import moving_arrays, normalised
@@ -43,6 +43,7 @@ class VerletEngine:
     name = "verlet"
     link_kind = "contacts"
     mechanics_class = MechanicalModel  # the particles of one process (the ranks engine sets its own)
+    thermal_class = ContactThermalModel  # their heat (the ranks engine's on several ranks: its own)
 
     def __init__(self, scene, restart: dict | None = None):
         """``restart``: a checkpoint of this scene's run (:meth:`checkpoint` as loaded by
@@ -68,7 +69,7 @@ class VerletEngine:
                                               relaxation_time=m.relaxation_time, history=saved)
         self.thermal = None
         if "thermal" in scene.physics:
-            self.thermal = ContactThermalModel(p, m.walls, scene.conductance, scene.sources, m.thermal_integrator,
+            self.thermal = self.thermal_class(p, m.walls, scene.conductance, scene.sources, m.thermal_integrator,
                                                scene.solver.linear, scene.box)
         self.schedule = m.schedule
         self.steps_start = 0
@@ -109,7 +110,7 @@ class VerletEngine:
         for k, wall in enumerate(mech.walls):
             m = names.index(wall.name)
             mech.w.q[k], mech.w.dq[k], mech.w.acc[k] = saved["wall_q"][m], saved["wall_dq"][m], saved["wall_acc"][m]
-        restore_lists(mech, saved)
+        mech.restore_lists(saved)
         if self.thermal is not None:
             th = self.thermal
             th.T = np.array(saved["thermal_T"], dtype=float)
@@ -135,7 +136,8 @@ class VerletEngine:
             return (np.array([self.schedule.at(t)]), np.array([self.schedule.rate(middle)]),
                     self.schedule.relaxation(middle))
         if self.thermal is not None:  # the network's temperatures, extrapolated with its last rate (cooling is
-            T, rate = self.thermal.T, self.thermal.rate  # then seen as cooling: k1(T, t) freezes, Sec. 3.4)
+            th = self.thermal            # then seen as cooling: k1(T, t) freezes, Sec. 3.4)
+            T, rate = th.local(mech, th.T), th.local(mech, th.rate)
         else:
             T, rate = mech.state.T, np.zeros(len(mech.state.T))
         if np.all(T == T[0]) and np.all(rate == rate[0]):
@@ -193,7 +195,7 @@ class VerletEngine:
             mech.advance(steps, T0, rate, t0)
             if self.thermal is not None:
                 self.thermal.step(mech, steps * mech.dt)
-                mech.state.T[:] = self.thermal.T  # the next interval starts from these
+                mech.state.T[:] = self.thermal.local(mech, self.thermal.T)  # the next interval starts from these
             if observe is not None and (end % out_every == 0 or end == n_end):
                 observe()
             if progress is not None:

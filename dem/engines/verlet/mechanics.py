@@ -29,7 +29,7 @@ from dem.engines import compiled
 from dem.engines.contact_forces import LOAD_COLUMNS, incident_pairs
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
 from dem.geometry.motion import MotionState
-from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
+from dem.geometry.neighbours import carry_history, restore_lists, verlet_pairs, wall_pairs
 from dem.geometry.periodic import PeriodicBox
 from dem.geometry.walls import WallArrays
 from dem.laws.contact import law_module
@@ -135,6 +135,10 @@ class MechanicalModel:
                 np.zeros((0, LOAD_COLUMNS))
         self.x_ref = s.x.copy()
         self.walls_moved()
+
+    def restore_lists(self, saved: dict) -> None:
+        """The Verlet lists of a checkpoint (:func:`dem.geometry.neighbours.restore_lists`)."""
+        restore_lists(self, saved)
 
     def walls_moved(self):
         """The walls were set elsewhere (a resumed run): their Verlet list follows."""

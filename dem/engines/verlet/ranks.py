@@ -25,10 +25,26 @@ in the serial order (its local pairs are sorted by global id), so a periodic run
 with walls only the walls' loads differ, at round-off (the ranks' partial sums are added in another order), and a
 stress wall's motion carries that difference into the packing.
 
-Outputs are gathered on rank 0 in global order (:meth:`RankMechanics.gathered`), which writes the run folder as a
-serial run does (not as PVTU pieces). Heat on moving contacts, resuming and checkpoints run on one rank only
-(:func:`refuse_unsupported` refuses them on more, where no checkpoint is written); the ``staggered`` and ``static``
-engines do not run under ``mpiexec``.
+Heat on moving contacts (:class:`RankContactThermal`): on one rank the serial network
+(:class:`dem.engines.contact_heat.ContactThermalModel`, bit for bit); on more, each thermal step is one implicit
+(or Crank-Nicolson) step of the network of every rank's contacts with an owned partner and of its owned particles'
+wall contacts, solved on PETSc across the ranks (:meth:`dem.network.distributed.DistributedNetwork.integrate`, the
+static engine's path), the ghosts being its halo. An owned particle has all its contacts on its rank (the list holds
+every pair with an owned partner), so its row is the serial row; the solution equals the serial step's to the
+linear solver's tolerance (to round-off with a direct solver in ``PETSC_OPTIONS``), and the step's heat balance holds
+to round-off as in the serial step. The temperatures (and their rates) are kept for every particle of the scene on
+every rank (one allgather of the owned values per thermal step: n floats per rank), so a migrating particle takes
+nothing thermal with it. The effective conductivity of the contact network (a further steady solve at each output)
+is not computed on several ranks.
+
+The rows of ``timeseries.csv``, the summary, the plots and the checkpoints come from the sample gathered on rank 0 in
+global order (:meth:`RankMechanics.gathered`); on several ranks each rank writes its piece of every snapshot (the
+particles it owns, the contacts whose lower-id partner it owns) and rank 0 the ``.pvtu`` files that name them, listed
+in the ``.pvd`` collections (:class:`dem.output.pieces.PieceWriter`). The checkpoints carry the slabs and the lists
+as the ranks built them at their last rebuild (the positions they were built at, the particle-wall lists): a resumed
+run (:meth:`RankMechanics.restore_lists`) takes again on every rank the particles, ghosts and lists it held then, and
+goes on as the uninterrupted run does, on as many ranks as wrote the checkpoint (:func:`refuse_unsupported`). The
+``staggered`` engine does not run under ``mpiexec``.
 """
 
 from __future__ import annotations
@@ -37,7 +53,11 @@ import os
 
 import numpy as np
 
+from dem.network import comm as mpi
 from dem.network.comm import world
+from dem.network.distributed import DistributedNetwork
+from dem.network.heat import Network
+from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.decomposition import Slabs
 from dem.engines.verlet.engine import VerletEngine
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
@@ -47,16 +67,17 @@ from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
 from sinterheat import threads
 
 
-def refuse_unsupported(scene, ranks: int, resume: bool) -> None:
-    """A ``ValueError`` naming what a run on ``ranks`` ranks cannot do with ``scene``."""
+def refuse_unsupported(scene, ranks: int, restart: dict | None = None) -> None:
+    """A ``ValueError`` naming what a run on ``ranks`` ranks cannot do with ``scene`` (``restart``: the checkpoint
+    it would resume from, which the same number of ranks must have written)."""
     if scene.engine != "verlet":
         raise ValueError(f"[solver] engine = {scene.engine!r}: under mpiexec run static packings and the verlet "
                          f"engine (particles that move), not this one; run this scene without mpiexec")
-    if ranks > 1 and "thermal" in scene.physics:
-        raise ValueError(f"physics = {list(scene.physics)}: heat on moving contacts runs on one rank only; run with "
-                         f"mpiexec -n 1 or without mpiexec")
-    if ranks > 1 and resume:
-        raise ValueError(f"--resume: a run on {ranks} ranks keeps no checkpoints; run without --resume")
+    written = 1 if restart is None or "ranks" not in restart else int(restart["ranks"])
+    if restart is not None and written != ranks:
+        how = f"with mpiexec -n {written}" if written > 1 else "without mpiexec or with mpiexec -n 1"
+        raise ValueError(f"--resume: the checkpoint was written by {written} rank(s), this run has {ranks}; resume "
+                         f"{how}")
 
 
 def _gather_rows(parts: list) -> np.ndarray:
@@ -79,7 +100,9 @@ class RankMechanics(MechanicalModel):
         self.gid = np.arange(state.n)
         self.owned = np.ones(state.n, dtype=bool)
         self.n_global = state.n
-        self.slabs = self._slabs(state, box)
+        self.slabs = self._slabs(state, box) if history is None or "rank_cuts" not in history else \
+            Slabs(int(history["rank_axis"]), np.array(history["rank_cuts"], dtype=float),
+                  float(history["rank_period"]), float(history["rank_origin"]))
         self.send_idx, self.recv_idx = {}, {}
         self.migrated = 0  # particles this rank took over from others at rebuilds
         super().__init__(state, walls, material, dt, skin, gravity, box, relaxation_time, history)
@@ -207,6 +230,46 @@ class RankMechanics(MechanicalModel):
                           "w_hist": np.asarray(saved["w_hist"])[self.gid]})
         self._refresh_ghosts()
 
+    def restore_lists(self, saved: dict) -> None:
+        """A checkpoint of several ranks (:meth:`slab_arrays`, the lists gathered by :meth:`gathered`): every rank
+        takes again the particles, ghosts and lists it held at the last rebuild -- its slab's particles at the
+        positions the lists were built at, the pairs of the gathered list with a partner it owns -- then the
+        particles' state as it is now, so that the run goes on as the uninterrupted one does (one rank: the serial
+        model's restore)."""
+        if self.size == 1:
+            return super().restore_lists(saved)
+        n, s = self.n_global, self.state
+
+        def column(key):
+            return np.array(saved[key], dtype=float)
+
+        s.x, s.v, s.w, s.f, s.tau = column("list_x_ref"), column("v"), column("w"), column("f"), column("tau")
+        s.mass, s.inertia, s.radius, s.radius_ref, s.T = (column(k) for k in ("mass", "inertia", "radius",
+                                                                                "radius_ref", "T"))
+        self.particle_state, self.w_hist = column("particle_state"), column("w_hist")
+        self.w_fn, self.w_ft = np.zeros((n,) + self.w_fn.shape[1:]), np.zeros((n,) + self.w_ft.shape[1:])
+        self.gid, self.owned = np.arange(n), np.ones(n, dtype=bool)
+        self._build_list(first=True)  # ownership and ghosts as at the last rebuild
+        local = np.full(n, -1, dtype=np.int64)
+        local[self.gid] = np.arange(len(self.gid))
+        i, j = local[np.asarray(saved["pi"])], local[np.asarray(saved["pj"])]
+        mine = (i >= 0) & (j >= 0)
+        mine[mine] = self.owned[i[mine]] | self.owned[j[mine]]
+        self._listed(i[mine], j[mine])
+        self.p_hist = np.array(saved["p_hist"], dtype=float)[mine]
+        self.p_fn, self.p_ft = np.zeros(len(self.pi)), np.zeros((len(self.pi), 3))
+        s.x[:] = np.asarray(saved["x"], dtype=float)[self.gid]
+        k = local[np.asarray(saved["wall_list_k"], dtype=np.int64)]
+        keep = (k >= 0) & self.owned[np.maximum(k, 0)]
+        self.wk, self.wm = k[keep], np.asarray(saved["wall_list_m"], dtype=np.int64)[keep]
+        self.wq_ref = np.array(saved["wall_list_q_ref"], dtype=float)
+
+    def slab_arrays(self) -> dict:
+        """The slabs and the rank count, for a checkpoint (a resumed run keeps its particles where they were)."""
+        sl = self.slabs
+        return {"rank_axis": np.array(sl.axis), "rank_cuts": sl.cuts, "rank_period": np.array(sl.period),
+                "rank_origin": np.array(sl.origin), "ranks": np.array(self.size)}
+
     # ------------------------------------------------------------------------------------------- exchanges
     def _refresh_ghosts(self) -> None:
         """The ghosts' moving columns from their owners (:meth:`_moving`)."""
@@ -288,15 +351,20 @@ class RankMechanics(MechanicalModel):
         """The whole sample as one serial model, in global order (its particles, the pairs each counted once, by
         the rank owning their lower-id partner), on rank 0 (or on every rank with ``everyone``); None elsewhere."""
         own = np.flatnonzero(self.owned)
-        rows = np.column_stack([self._pack(self._arrays(), own), self.gid[own]])
+        rows = np.column_stack([self._pack(self._arrays(), own), self.x_ref[own], self.gid[own]])
         mine = self.owned[self.pi]
         pairs = np.column_stack([self.gid[self.pi[mine]], self.gid[self.pj[mine]], self.p_hist[mine],
                                  self.p_fn[mine], self.p_ft[mine]])
-        parts = self.comm.allgather((rows, pairs)) if everyone else self.comm.gather((rows, pairs), root=0)
+        wall_list = np.column_stack([self.gid[self.wk], self.wm])
+        parts = self.comm.allgather((rows, pairs, wall_list)) if everyone else \
+            self.comm.gather((rows, pairs, wall_list), root=0)
         if parts is None:
             return None
         rows = _gather_rows([p[0] for p in parts])
         rows = rows[np.argsort(rows[:, -1], kind="stable")]
+        x_ref, rows = rows[:, -4:-1], np.column_stack([rows[:, :-4], rows[:, -1]])
+        wall_list = _gather_rows([p[2] for p in parts])
+        wall_list = wall_list[np.lexsort((wall_list[:, 1], wall_list[:, 0]))]
         pairs = _gather_rows([p[1] for p in parts])
         pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
         view = MechanicalModel.__new__(MechanicalModel)
@@ -310,8 +378,8 @@ class RankMechanics(MechanicalModel):
         view.pi, view.pj = pairs[:, 0].astype(np.int64), pairs[:, 1].astype(np.int64)
         view.p_hist, view.p_fn = pairs[:, 2:2 + n_hist], pairs[:, 2 + n_hist]
         view.p_ft = np.ascontiguousarray(pairs[:, 3 + n_hist:])
-        view.x_ref = x.copy()
-        view.wk, view.wm = wall_pairs(x, radius, self.w.normal, self.w.q, self.skin)
+        view.x_ref = np.ascontiguousarray(x_ref)  # the positions the lists were built at, and the walls' list
+        view.wk, view.wm = (np.ascontiguousarray(wall_list[:, c], dtype=np.int64) for c in (0, 1))
         return view
 
 
@@ -327,6 +395,39 @@ def _sum():
     return MPI.SUM
 
 
+class RankContactThermal(ContactThermalModel):
+    """The heat of the contacts on several ranks (module docstring): ``T`` and ``rate`` over every particle of the
+    scene on every rank, each thermal step solved on PETSc by all ranks together."""
+
+    def local(self, mechanics, values: np.ndarray) -> np.ndarray:
+        return values[mechanics.gid]
+
+    def step(self, mechanics, dt: float) -> None:
+        """Advance the temperatures by ``dt`` on the network of the contacts the ranks hold now."""
+        comm = mechanics.comm
+        bonds, K_pairs, K_walls = self.bonds(mechanics)
+        walls = mechanics.owned[bonds.wall_particle]  # a ghost's wall contacts are its owner's
+        bonds, K_walls = bonds.subset(slice(None), walls), K_walls[walls]
+        wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
+        self.net = Network(self._particles_now(mechanics, self.local(mechanics, self.particles.radius)), bonds,
+                           K_pairs, K_walls, wall_T, self.sources, self.box)
+        owner = np.full(len(mechanics.gid), mechanics.rank)
+        for rank, ghosts in mechanics.recv_idx.items():
+            owner[ghosts] = rank
+        part = DistributedNetwork(comm, self.net, mechanics.gid, owner)
+        res = mpi.agree(comm, lambda: part.integrate(self.integrator, dt, dt))
+        self.assemblies += 1
+        for k, v in res["heat_in"].items():
+            self.heat_in[k] = self.heat_in.get(k, 0.0) + v
+        T_local = self.net.full(res["T_F"])
+        T = self.T.copy()
+        own = mechanics.owned
+        for index, values in comm.allgather((mechanics.gid[own], T_local[own])):
+            T[index] = values
+        self.rate = (T - self.T) / dt
+        self.T = T
+
+
 class RankVerletEngine(VerletEngine):
     """The verlet engine with its particles spread over the MPI ranks (module docstring). Outputs come from the
     sample gathered on rank 0 at every output time; after the run every rank holds the gathered sample, so the
@@ -338,26 +439,76 @@ class RankVerletEngine(VerletEngine):
         """As :class:`VerletEngine`; unless told (``SINTERHEAT_THREADS``, ``--threads``), each rank's contact loop
         takes its share of the cores, not all of them."""
         size = world().Get_size()
-        refuse_unsupported(scene, size, restart is not None)
+        refuse_unsupported(scene, size, restart)
         if not os.environ.get(threads.ENVIRONMENT):
             threads.use(max(1, threads.cores() // size))
+        if size > 1:
+            self.thermal_class = RankContactThermal
         super().__init__(scene, restart)
+        self.ranks_mechanics = self.mechanics  # this rank's particles (self.mechanics: the gathered sample at times)
+
+    # the snapshots' pieces on several ranks (dem.output.pieces): the particles this rank owns, the contacts
+    # whose lower-id partner it owns (each contact once)
+    def positions(self) -> np.ndarray:
+        m = self.ranks_mechanics
+        return super().positions() if m.size == 1 else m.state.x[m.owned]
+
+    def particle_fields(self) -> dict:
+        m = self.ranks_mechanics
+        if m.size == 1:
+            return super().particle_fields()
+        shown, self.mechanics = self.mechanics, m
+        try:
+            fields = {**super().particle_fields(), "id": self.scene.particles.id[m.gid]}
+        finally:
+            self.mechanics = shown
+        return {k: v[m.owned] for k, v in fields.items()}
+
+    def links(self):
+        m = self.ranks_mechanics
+        if m.size == 1:
+            return super().links()
+        shown, self.mechanics = self.mechanics, m
+        try:
+            points, lines, fields = super().links()
+        finally:
+            self.mechanics = shown
+        once = m.owned[lines[:, 0]]
+        return points, lines[once], {k: v[once] for k, v in fields.items()}
+
+    def effective_conductivity(self) -> float | None:
+        """As :meth:`~dem.engines.verlet.engine.VerletEngine.effective_conductivity` on one rank; None on more
+        (module docstring)."""
+        return super().effective_conductivity() if self.mechanics.size == 1 else None
 
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """As :meth:`~dem.engines.verlet.engine.VerletEngine.run`;
         ``observe`` sees the gathered sample (every rank calls it, rank 0 with its
-        writer, the others with a callable that writes nothing); checkpoints on one rank only."""
+        writer, the others with a callable that writes nothing); on several ranks every rank gathers each checkpoint
+        (rank 0 has the ``checkpoint`` that keeps it), with the slabs (:meth:`RankMechanics.slab_arrays`)."""
         mech = self.mechanics
+        gathered_checkpoints = mech.size > 1 and mech.comm.allreduce(int(checkpoint is not None), op=_max())
 
-        def observed():
+        def checkpointed(make, final: bool = False) -> None:
             view = mech.gathered()
             if view is not None:
                 self.mechanics = view
                 try:
-                    observe()
+                    data = {**make(), **mech.slab_arrays()}
                 finally:
                     self.mechanics = mech
+                checkpoint(lambda: data, final)
+
+        def observed():
+            view = mech.gathered()
+            if view is None:  # another rank: its pieces of the snapshots (its writer's rows are rank 0's)
+                return observe()
+            self.mechanics = view
+            try:
+                observe()
+            finally:
+                self.mechanics = mech
 
         super().run(observed if observe is not None else None, progress,
-                    checkpoint if mech.size == 1 else None)
+                    checkpointed if gathered_checkpoints else checkpoint)
         self.mechanics = mech.gathered(everyone=True)
