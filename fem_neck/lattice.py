@@ -31,7 +31,8 @@ face mapped onto its sphere, cylinder, plane or their intersection curve), so th
 Both converge at one rate, so ``error_estimate = (upper - lower) / upper`` bounds the error of the reported value
 (the upper) and is 2-3 times it (the two errors are about equal, measured on the lattice cells). The bounds hold up
 to the quadrature of the curved elements (degree ``2 p``: ~5e-8 relative, measured against ``2 p + 4``) and the
-solvers' residuals (1e-10). The mesh is graded toward every neck circle, where the temperature is singular
+flux solver's residual (1e-10; the upper bound's CG stops when its energy has settled to 1e-9, and the energy of
+any iterate is an upper bound). The mesh is graded toward every neck circle, where the temperature is singular
 (``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined until the estimate
 meets ``rtol``, and the memory of each solve is estimated before it starts (:func:`effective_conductivity`).
 """
@@ -59,12 +60,20 @@ COORDINATION = {"sc": 6, "bcc": 8, "fcc": 12}
 # smallest neck meshed: below it the neck is thinner than 1.3e-3 r and the mesh of its disk explodes; the network is
 # exact in the limit of small necks (independent constrictions), which the FE shows from here up
 MIN_NECK_RATIO = 0.05
-# the meshes: element size at the neck circles over the neck radius (of the first mesh at rtol = 1e-3, and the
-# range of first meshes), far size over the particle radius, growth of the size per unit distance from the circles
-SIZE_NECK0, FIRST_SIZES, SIZE_FAR, GRADING = 0.05, (0.01, 0.3), 0.5, 0.8
+# the meshes: element size at the neck circles over the neck radius (the range of first meshes), far size over the
+# particle radius, growth of the size per unit distance from the circles
+FIRST_SIZES, SIZE_FAR, GRADING = (0.005, 0.3), 0.5, 0.8
 # measured on the lattice cells: the gap falls like size_neck^GAP_ORDER, the tetrahedra grow like
 # size_neck^-ELEMENT_ORDER (:func:`effective_conductivity`)
 GAP_ORDER, ELEMENT_ORDER = 1.25, 1.0
+# the first mesh (:func:`first_neck_size`), by order p: (size0, rtol0, neck_order, margin): at neck size size0 the
+# bounds of a cell whose smallest neck has a/r = NECK0 are about rtol0 apart; larger necks need a coarser mesh, the
+# gap falling like (a/r)^-neck_order, used only over NECK_RANGE (not extrapolated to necks smaller than measured);
+# the first mesh aims at margin rtol. p = 4: the cubic lattices at h/r = 0.02 (a/r = 0.2) are 0.9-1.1e-4 apart at
+# size 0.01, at h/r = 0.08 (a/r = 0.39) 3.3-4.4e-5. p = 3: no dependence on the neck measured (a random packing
+# with a/r >= 0.25 was 2.2e-3 apart at size 0.087, the size this rule gives for 2e-3).
+FIRST_MESH = {3: (0.05, 1e-3, 0.0, 1.0), 4: (0.01, 1e-4, 1.3, 0.75)}
+NECK0, NECK_RANGE = 0.2, (0.2, 0.5)
 # peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured)
 BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 70e3}
 _TOL = 1e-9  # geometric tolerance in units of the largest radius
@@ -496,14 +505,42 @@ def available_memory() -> float:
     return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
 
 
+def smallest_neck_ratio(cell: PeriodicCell) -> float:
+    """The smallest ``a / r`` of the cell's bonds (``r`` the smaller radius of the pair)."""
+    i, j, s = cell.bonds()
+    d = np.linalg.norm(cell.centres[j] + s * cell.period - cell.centres[i], axis=1)
+    r_i, r_j = cell.radii[i], cell.radii[j]
+    return float(np.min(neck_geometry(r_i, r_j, r_i + r_j - d).a / np.minimum(r_i, r_j)))
+
+
+def _neck_factor(neck_ratio: float, order: int) -> float:
+    """How much coarser than at ``NECK0`` a mesh may be for the same gap when the smallest neck is ``neck_ratio``."""
+    neck_order = FIRST_MESH[order][2]
+    return (float(np.clip(neck_ratio, *NECK_RANGE)) / NECK0) ** (neck_order / GAP_ORDER)
+
+
+def first_neck_size(rtol: float, neck_ratio: float, order: int) -> float:
+    """Neck size of the first mesh at ``order`` of a cell whose smallest neck has ``a / r = neck_ratio``: the size
+    whose gap is predicted at ``margin rtol`` (``FIRST_MESH``: ``rtol0`` at ``size0`` for ``a / r = NECK0``, the gap
+    falling like ``size^GAP_ORDER`` and like ``(a / r)^-neck_order``), within ``FIRST_SIZES``."""
+    size0, rtol0, _, margin = FIRST_MESH[order]
+    size = size0 * (margin * rtol / rtol0) ** (1.0 / GAP_ORDER) * _neck_factor(neck_ratio, order)
+    return float(np.clip(size, *FIRST_SIZES))
+
+
+def first_rtol(size: float, neck_ratio: float, order: int) -> float:
+    """The ``rtol`` whose first mesh at ``order`` (:func:`first_neck_size`) has neck size ``size``."""
+    size0, rtol0, _, margin = FIRST_MESH[order]
+    return rtol0 * (size / (size0 * _neck_factor(neck_ratio, order))) ** GAP_ORDER / margin
+
+
 def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | None = None,
                            max_memory: float | None = None, max_meshes: int = 4, workers: int = 2,
                            progress=None) -> CellResult:
     """``k_eff / kappa`` along z of the periodic ``cell`` with two-sided bounds (module docstring).
 
-    The first mesh has neck size ``SIZE_NECK0`` scaled to ``rtol`` (within ``FIRST_SIZES``); while the
-    bounds are more than ``rtol`` apart it predicts the
-    neck size that meets ``rtol`` (the gap falls like ``size_neck^GAP_ORDER``, the tetrahedra grow like
+    The first mesh has the neck size :func:`first_neck_size` (from ``rtol`` and the cell's smallest neck); while
+    the bounds are more than ``rtol`` apart it predicts the neck size that meets ``rtol`` (the gap falls like ``size_neck^GAP_ORDER``, the tetrahedra grow like
     ``size_neck^-ELEMENT_ORDER``) and solves there, at most ``max_meshes`` meshes. Before each mesh the memory of
     its solve is estimated (:func:`memory_estimate`); one that would not fit in ``max_memory`` bytes (default: what
     the machine has available) is refused with a ``ValueError`` naming the estimate and the ``rtol`` that would fit.
@@ -516,7 +553,8 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
         raise ValueError(f"order = {order!r}: must be one of {', '.join(map(str, BYTES_PER_ELEMENT))}")
     budget = available_memory() if max_memory is None else float(max_memory)
     t0 = time.perf_counter()
-    size = float(np.clip(SIZE_NECK0 * (rtol / 1e-3) ** (1.0 / GAP_ORDER), *FIRST_SIZES))
+    neck = smallest_neck_ratio(cell)
+    size = first_neck_size(rtol, neck, order)
     history = []
     for _ in range(max_meshes):
         if progress is not None:
@@ -526,7 +564,7 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
         if need > budget:
             # the first mesh's neck size that fits, and the rtol that starts there (tetrahedra ~ 1 / size)
             fit = size * len(cm.curved.tets) * BYTES_PER_ELEMENT[order] / max(budget - BASE_BYTES, 1.0)
-            reach = 1e-3 * (fit / SIZE_NECK0) ** GAP_ORDER
+            reach = first_rtol(fit, neck, order)
             raise ValueError(f"{cell.name}: the mesh of neck size {size:.3g} a has {len(cm.curved.tets)} tetrahedra "
                              f"and needs ~{need / 1e9:.1f} GB, more than the {budget / 1e9:.1f} GB available; "
                              f"rtol = {reach:.1e} would fit")

@@ -3,7 +3,8 @@
 The temperature is held at 1 on the hot faces and 0 on the cold ones; every other boundary is insulated. The
 discrete energy ``u^T A u`` of *any* admissible ``u`` is at least the exact conductance ``K`` (Dirichlet's principle),
 and the elements of :mod:`fem_neck.curved` fill the exact solid, so ``u^T A u >= K`` holds for the computed ``u``
-whatever the solver's residual (which only makes the bound less sharp). The ``(p - 1)(p - 2)(p - 3) / 6`` interior
+whatever the solver's residual (which only makes the bound less sharp): CG stops once the energy has settled to
+``ENERGY_RTOL``. The ``(p - 1)(p - 2)(p - 3) / 6`` interior
 nodes of every element are condensed (Schur complement, batched); the skeleton system is solved by conjugate
 gradients preconditioned by :func:`fem_neck.pcg.two_level` (the piecewise-linear hats as coarse space).
 """
@@ -18,6 +19,8 @@ from fem_neck.curved import CurvedMesh
 from fem_neck.simplex import Lagrange, lagrange, tet_quadrature
 
 CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arrays)
+# CG stops when the energy has settled to this (relative): the bound is an upper one whatever the solver's error
+ENERGY_RTOL = 1e-9
 
 
 def quadrature_degree(p: int) -> int:
@@ -116,11 +119,11 @@ class Solution:
     residual: float
 
 
-def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, rtol: float = 1e-10,
+def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: float = ENERGY_RTOL,
           degree: int | None = None) -> Solution:
     """The conforming ``P_p`` solution with ``u = 1`` on the ``hot`` faces and 0 on the ``cold`` ones (indices into
     ``mesh.faces``; quadrature of ``degree`` on curved elements, default :func:`quadrature_degree`); see the module
-    docstring."""
+    docstring. CG stops when the energy has settled to ``etol`` (:func:`fem_neck.pcg.solve`)."""
     from fem_neck import pcg
 
     basis = lagrange(p)
@@ -141,7 +144,7 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, rtol: flo
         system.add(K, elements)
     A = system.matrix()
     P = hat_prolongation(mesh, basis, num)[system.free]
-    x, iterations, residual = pcg.solve(A, system.b, pcg.two_level(A, P), rtol=rtol)
+    x, iterations, residual = pcg.solve(A, system.b, pcg.two_level(A, P), energy=(system.constant, etol))
     u = values.copy()
     u[system.free] = x
     return Solution(system.energy(A, x), u, num.n + basis.n_interior * len(mesh.tets), num.n, iterations, residual)

@@ -101,6 +101,19 @@ def test_finer_quadrature_moves_the_bounds_by_less_than_1e7():
     assert up[0] == pytest.approx(up[1], rel=1e-7)
 
 
+def test_primal_cg_stops_when_the_energy_has_settled():
+    # the upper bound's CG stops on its energy (an upper bound whatever the iterate): within the tolerance of the
+    # energy solved to round-off, above it, in fewer iterations
+    from fem_neck import primal
+
+    cm = lattice.build_cell_mesh(_chain_cell(0.08), **COARSE)
+    loose = primal.solve(cm.curved, 3, cm.hot, cm.cold)
+    tight = primal.solve(cm.curved, 3, cm.hot, cm.cold, etol=1e-15)
+    assert loose.energy == pytest.approx(tight.energy, rel=10 * primal.ENERGY_RTOL)
+    assert loose.energy >= tight.energy * (1.0 - 1e-12)  # CG lowers the energy (up to its round-off)
+    assert loose.iterations < tight.iterations
+
+
 def test_effective_conductivity_refines_to_its_tolerance():
     res = lattice.effective_conductivity(_chain_cell(0.02), rtol=1e-3, workers=1)
     assert len(res.levels) >= 2 and res.levels[0]["gap"] > 1e-3  # the first mesh was too coarse
@@ -108,6 +121,20 @@ def test_effective_conductivity_refines_to_its_tolerance():
     assert res.k_lower_over_kappa <= _chain_reference(0.02) <= res.k_eff_over_kappa == res.k_upper_over_kappa
     assert res.phi == pytest.approx(4 / 3 * math.pi / (16 * 1.98), rel=1e-12)
     assert res.k_eff_over_kappa < res.phi  # Wiener: no microstructure beats the parallel bound
+
+
+def test_first_mesh_is_coarser_for_larger_necks_and_looser_tolerances():
+    # the smallest neck of a lattice is its pair neck; of a random packing, its smallest bond's
+    assert lattice.smallest_neck_ratio(lattice.lattice_cell("bcc", 0.08)) == pytest.approx(neck_radius(1, 1, 0.08))
+    small, large = (lattice.first_neck_size(1e-4, x, 4) for x in (0.2, 0.4))
+    assert large / small == pytest.approx(2.0 ** (lattice.FIRST_MESH[4][2] / lattice.GAP_ORDER), rel=1e-12)
+    # not extrapolated below the smallest neck measured: a smaller neck gets the a/r = 0.2 mesh
+    assert lattice.first_neck_size(1e-4, 0.1, 4) == small
+    assert lattice.first_neck_size(2e-4, 0.2, 4) / small == pytest.approx(2.0 ** (1 / lattice.GAP_ORDER), rel=1e-12)
+    # p = 3: no dependence on the neck measured
+    assert lattice.first_neck_size(1e-3, 0.2, 3) == lattice.first_neck_size(1e-3, 0.4, 3)
+    # first_rtol inverts it (what the refusal names)
+    assert lattice.first_rtol(lattice.first_neck_size(1e-4, 0.3, 4), 0.3, 4) == pytest.approx(1e-4, rel=1e-12)
 
 
 def test_a_run_that_would_not_fit_is_refused_with_the_rtol_that_would():
@@ -126,6 +153,7 @@ def test_lattices_to_1e4_bracket_the_reference_with_a_sharp_estimate(case):
     res = lattice.effective_conductivity(lattice.lattice_cell(kind, h), rtol=1e-4)
     ref = REFERENCES[case]
     assert res.converged and res.error_estimate <= 1e-4
+    assert len(res.levels) == 1  # the first mesh, sized from rtol and the neck, meets rtol: no mesh is wasted
     assert res.k_lower_over_kappa < ref < res.k_upper_over_kappa
     assert (res.k_upper_over_kappa - res.k_lower_over_kappa) / (res.k_upper_over_kappa - ref) < 3.0
     assert res.k_eff_over_kappa < res.phi

@@ -24,8 +24,8 @@ def register(subparsers) -> None:
     size.add_argument("--h-over-r", type=float, metavar="X", help="overlap of neighbours over the radius")
     size.add_argument("--a-over-r", type=float, metavar="X", help="neck radius over the particle radius")
     p.add_argument("--rtol", type=float, default=1e-4,
-                   help="relative gap of the bounds to reach (default 1e-4: 0.5-3 min and 1-3 GB for the cubic "
-                   "lattices on a busy 2-core machine; 1e-3 a few seconds)")
+                   help="relative gap of the bounds to reach (default 1e-4: 10-60 s of CPU and 1-3 GB for the cubic "
+                   "lattices; 1e-3 a few seconds)")
     p.add_argument("--max-memory", type=float, metavar="GB",
                    help="memory the solve may use (default: what the machine has available)")
     add_output_options(p)
