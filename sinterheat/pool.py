@@ -232,6 +232,13 @@ class DaskPool:
         self._submitted.clear()
 
 
+def bar_switch(progress: bool) -> dict:
+    """The ``tqdm`` keywords of a study's bar: off when ``progress`` is false or ``TQDM_DISABLE`` is set (the
+    command-line tools set it for ``--no-progress``). The variable is read here, when the bar is made: tqdm reads it
+    once, when it is imported, which may be before the tool sets it."""
+    return {"disable": True} if not progress or os.environ.get("TQDM_DISABLE") else {}
+
+
 def run_jobs(jobs, workers: int | None = None, *, start: str = "fork", desc: str = "", unit: str = "job",
              progress: bool = True, done: int = 0, meanwhile=None):
     """Run ``func(*args)`` for every ``(func, args)`` of ``jobs`` on :func:`pool` (one job: in this process unless
@@ -250,7 +257,7 @@ def run_jobs(jobs, workers: int | None = None, *, start: str = "fork", desc: str
     here.update(step=f"{label}{done} of {total} {unit}s done")
     if not jobs:
         return
-    with tqdm(total=total, initial=done, desc=desc, unit=unit, file=sys.stderr, disable=not progress) as bar, \
+    with tqdm(total=total, initial=done, desc=desc, unit=unit, file=sys.stderr, **bar_switch(progress)) as bar, \
             pool(min(workers or os.cpu_count() or 1, len(jobs)), start=start) as jobs_pool:
         running = [jobs_pool.submit(func, *args) for func, args in jobs]
         if meanwhile is not None:

@@ -53,6 +53,14 @@ def test_local_jobs_come_back_complete_and_an_error_is_raised(workers):
         list(P.run_jobs([(_failing, (k,)) for k in range(5)], workers, progress=False))
 
 
+@pytest.mark.parametrize("environment, progress, shown", [("", True, True), ("1", True, False), ("", False, False)])
+def test_the_bar_follows_no_progress_of_the_command_line(monkeypatch, capsys, environment, progress, shown):
+    """--no-progress sets TQDM_DISABLE; a sweep's own bar (progress left at its default) must then stay silent."""
+    monkeypatch.setenv("TQDM_DISABLE", environment)
+    assert sorted(P.run_jobs([(abs, (-k,)) for k in range(3)], 1, desc="sweep", progress=progress)) == [0, 1, 2]
+    assert ("sweep" in capsys.readouterr().err) == shown
+
+
 def test_one_worker_runs_each_job_when_its_result_is_taken():
     ran = []
     jobs = [(ran.append, (k,)) for k in range(3)]

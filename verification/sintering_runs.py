@@ -413,14 +413,14 @@ def run_tasks(tasks, root, workers: int = 2, progress: bool = True) -> dict:
     result}``; a failed task's result holds ``error`` and its dependents are not run."""
     from tqdm import tqdm
 
-    from sinterheat.pool import pool
+    from sinterheat.pool import bar_switch, pool
 
     root = pathlib.Path(root).resolve()  # the same path on every worker
     everything = with_parents(tasks)
     results = {t: r for t in everything if (r := load_result(root, t)) is not None}
     pending = [t for t in everything if t not in results]
     bar = tqdm(total=len(everything), initial=len(results), desc="sintering runs", unit="run", file=sys.stderr,
-               disable=not progress)
+               **bar_switch(progress))
     running = {}
     with pool(workers, start="spawn") as runs:
         while pending or running:
