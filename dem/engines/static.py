@@ -226,19 +226,24 @@ class StaticEngine:
 
         return thermal_plots(out, self.scene, self.T)
 
+    def _over_the_packing(self) -> tuple:
+        """``(scene, pair bonds, (T_mean, T_min, T_max))`` of the whole packing, for the summary (the distributed
+        engine sums and reduces its ranks' parts)."""
+        return self.scene, self.bonds.n_pairs, (float(self.T.mean()), float(self.T.min()), float(self.T.max()))
+
     def summary(self) -> dict:
         """What the run found (the driver adds the scene's name, times and the state file)."""
-        p = self.scene.particles
+        scene, bonds, (T_mean, T_min, T_max) = self._over_the_packing()
         d = dict(self.details)
-        out = {"mode": self.scene.solver.mode, "t": self.t, "steps": self.steps, "particles": p.n,
-               "bonds": self.bonds.n_pairs, "energy_error": d.pop("energy_error", None), "static": True}
+        out = {"mode": self.scene.solver.mode, "t": self.t, "steps": self.steps, "particles": scene.particles.n,
+               "bonds": bonds, "energy_error": d.pop("energy_error", None), "static": True}
         for key in ("boundary_heat_flow", "periodic_heat_flow"):
             if key in d:
                 out[key] = d.pop(key)
-        k_eff = effective_conductivity(self.scene, out)
+        k_eff = effective_conductivity(scene, out)
         if k_eff is not None:
             out["effective_conductivity"] = k_eff
-        out.update(T_mean=float(self.T.mean()), T_min=float(self.T.min()), T_max=float(self.T.max()))
+        out.update(T_mean=T_mean, T_min=T_min, T_max=T_max)
         out.update(d)
         if self.circuit is not None:
             out["electrical"] = self.circuit

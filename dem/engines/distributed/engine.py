@@ -28,7 +28,7 @@ from dataclasses import replace
 import numpy as np
 
 from dem import memory
-from dem.engines.static import CSV_FLOWS, StaticEngine, effective_conductivity
+from dem.engines.static import CSV_FLOWS, StaticEngine
 from dem.geometry.partition import bisection, halo
 from dem.network import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
@@ -226,26 +226,14 @@ class DistributedStaticEngine(StaticEngine):
     def plots(self, out, summary: dict) -> list[str]:
         return []  # the plots need every particle on one rank
 
-    def summary(self) -> dict:
-        d = dict(self.details)
+    def _over_the_packing(self) -> tuple:
+        """The whole scene, the pair bonds of the owned particles summed over the ranks, the temperatures' mean,
+        smallest and largest over every rank's owned particles."""
         own = self.T[self.mine]
-        n = self.full_scene.particles.n
-        out = {"mode": self.scene.solver.mode, "t": self.t, "steps": self.steps, "particles": n,
-               "bonds": self.part.total(int(np.sum(self.mine[self.bonds.i]))),
-               "energy_error": d.pop("energy_error", None), "static": True}
-        for key in ("boundary_heat_flow", "periodic_heat_flow"):
-            if key in d:
-                out[key] = d.pop(key)
-        k_eff = effective_conductivity(self.full_scene, out)
-        if k_eff is not None:
-            out["effective_conductivity"] = k_eff
-        out.update(T_mean=float(self.part.total(float(own.sum())) / n),
-                   T_min=mpi.minimum(self.comm, float(own.min(initial=np.inf))),
-                   T_max=mpi.maximum(self.comm, float(own.max(initial=-np.inf))))
-        out.update(d)
-        if self.circuit is not None:
-            out["electrical"] = self.circuit
-        return out
+        bonds = self.part.total(int(np.sum(self.mine[self.bonds.i])))
+        T_mean = float(self.part.total(float(own.sum())) / self.full_scene.particles.n)
+        return self.full_scene, bonds, (T_mean, mpi.minimum(self.comm, float(own.min(initial=np.inf))),
+                                        mpi.maximum(self.comm, float(own.max(initial=-np.inf))))
 
     def gathered_temperatures(self) -> np.ndarray:
         """The final temperatures of all particles in the scene's order, on every rank (for small scenes: the
