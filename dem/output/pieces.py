@@ -13,7 +13,7 @@ from __future__ import annotations
 import meshio
 import numpy as np
 
-from dem.output.writer import DIGITS, RunWriter, listed_snapshots, write_pvd, write_summary, write_vtu
+from dem.output.writer import DIGITS, RunWriter, listed_snapshots, write_pvd, write_vtu
 
 VTK_TYPES = {np.dtype(k): v for k, v in (("float32", "Float32"), ("float64", "Float64"), ("int8", "Int8"),
                                           ("int16", "Int16"), ("int32", "Int32"), ("int64", "Int64"),
@@ -90,19 +90,3 @@ class PieceWriter(RunWriter):
             for kind in self.kinds:
                 write_pvd(self.out / f"{kind}.pvd",
                           [(t, f"{kind}_{s:0{DIGITS}d}.pvtu") for t, s in self.snapshots])
-
-    def finish(self, summary: dict, plots: bool = True) -> dict:
-        """The last row and snapshot (all ranks), then ``summary.json`` and the plots (rank 0)."""
-        if self.last is not None and not self.by_time and self.last["step"] % self.scene.output.every:
-            self._guarded("timeseries.csv", lambda: self._row(self.last))
-        if self.csv is not None:
-            self.csv.close()
-        if self.last is not None or self.by_time:
-            self._guarded("snapshot", self.snapshot)
-        if self.rank == 0:
-            write_summary(self.out / "summary.json", self._with_errors(summary))
-            written = self._guarded("plots", lambda: self.engine.plots(self.out, summary)) if plots else None
-            if written:
-                summary["plots"] = written
-                write_summary(self.out / "summary.json", self._with_errors(summary))
-        return summary

@@ -108,6 +108,8 @@ class RunWriter:
     """The files of one run (module docstring), fed by the engine: :meth:`observe` after every step or output time,
     :meth:`finish` at the end, :meth:`interrupted` after Ctrl-C."""
 
+    rank = 0  # a run shared out among MPI ranks (dem.output.pieces): the summary and the plots are rank 0's
+
     def __init__(self, out_dir, scene, engine, resume_step: int | None = None):
         """``resume_step``: go on with the files of a run resumed from the checkpoint at that step."""
         self.out = pathlib.Path(out_dir)
@@ -240,6 +242,8 @@ class RunWriter:
             self._guarded("snapshot", self.snapshot)
         if self.snapshots:
             self._guarded("pvd", self._write_pvd)
+        if self.rank != 0:
+            return summary
         write_summary(self.out / "summary.json", self._with_errors(summary))  # first: a plot may read it
         if plots:
             written = self._guarded("plots", lambda: self.engine.plots(self.out, summary))
