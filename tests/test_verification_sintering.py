@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from verification import sintering as S
+from verification import sintering_causes as cooling
 from verification import sintering_runs as sr
 from verification import sintering_statements as T
 from verification import sintering_study as Y
@@ -65,6 +66,12 @@ def test_tiny_grid_runs_resumes_and_fills_the_contract(tmp_path, monkeypatch):
     assert again["summary"]["statements"] == statements
     vib = json.loads((tmp_path / sr.Task(sr.VIBRATE, 12, 10.0, 1e-4).folder / "result.json").read_text())
     assert vib["volume_fraction"] is None and vib["fragments"] >= 1 and np.isfinite(vib["seconds"])
+    cool = sr.Task(sr.COOL, 12, 100.0, 2e-3)
+    st = Y.Study(tmp_path, TINY, {t: sr.load_result(tmp_path, t) for t in (cool, cool.parent)})
+    c = cooling.cool_down(st.series(cool), 0.0)
+    assert c["particles"] == pytest.approx((0.996 / 1.002) ** 2 - 1.0, rel=1e-9)  # eq. 9: a(80 °C)/a(140 °C)
+    hot, cold = st.res(sr.SINTER, 12, 100.0, 2e-3), st.res(sr.COOL, 12, 100.0, 2e-3)
+    assert cold["mass_fraction"] * (1.0 + c["box"]) == pytest.approx(hot["mass_fraction"], rel=1e-12)  # M conserved
 
 
 def test_rattlers_are_peeled_off_until_every_particle_has_two_contacts():
@@ -115,6 +122,16 @@ def test_scene_docs_of_the_variants(tmp_path, monkeypatch):
     held = sp.cooling_doc("s.npz", 100.0, walls_held=True)
     assert all("motion" not in w for w in held["walls"]) and len(held["walls"]) == 4
     assert held["solver"]["t_end"] == pytest.approx(1.5) and held["temperature"]["time"][0] == 1.3
+
+
+def test_the_cool_down_splits_into_the_box_and_the_particles_area():
+    side = np.array([30e-3, 29.97e-3, 29.94e-3])  # the box shrinks by 1 - 0.998^2 from the first row to the last
+    s = {"t": np.array([0.0, 0.1, 0.2]), "q_left": np.zeros(3), "q_bottom": np.zeros(3), "q_right": -side,
+         "q_top": -side, "volume_fraction": np.array([0.90, 0.91, 0.92]), "wall_top": np.array([0.0, 99.0, 101.0])}
+    c = cooling.cool_down(s, 0.0)
+    assert c["box"] == pytest.approx(0.998**2 - 1.0, rel=1e-12)
+    assert c["particles"] == pytest.approx(0.998**2 * 0.92 / 0.90 - 1.0, rel=1e-12)  # solid area = nu times box
+    assert (c["nu_cool"], c["nu_f"], c["top_min"], c["top_max"]) == (0.90, 0.92, 99.0, 101.0)  # no load in row 0
 
 
 def test_frozen_radii_keep_each_particle_its_size(tmp_path):

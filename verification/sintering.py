@@ -59,13 +59,13 @@ def fig_schedule(st: Study, out: pathlib.Path) -> list[pathlib.Path]:
             continue
         ax[0, 0].plot(h100["t"], h100["T_mean"], color=c, label=f"t_s = {t_s:g} s")
         ax[1, 0].plot(h100["t"], h100["k1_factor"], color=c)
-        ax[2, 0].plot(h100["t"], h100["volume_fraction"], color=c)
-        ax[3, 0].plot(h10["t"], h10["volume_fraction"], color=c)
+        ax[2, 0].plot(h100["t"], h100["mass_fraction"], color=c)
+        ax[3, 0].plot(h10["t"], h10["mass_fraction"], color=c)
     ax[0, 0].set_ylabel("T (°C)")
     ax[1, 0].set_ylabel("k1(T, t) / k1")
     ax[1, 0].set_yscale("log")
-    ax[2, 0].set_ylabel("ν (p = 100)")
-    ax[3, 0].set_ylabel("ν (p = 10)")
+    ax[2, 0].set_ylabel("ν = M/(ρ_p V) (p = 100)")
+    ax[3, 0].set_ylabel("ν = M/(ρ_p V) (p = 10)")
     ax[2, 0].set_ylim(0.78, 0.95)  # the loose start (0.3) is off the scale, as in the paper
     ax[3, 0].set_ylim(0.78, 0.86)
     ax[2, 0].axhline(0.92, color="k", ls=":", lw=0.8)
@@ -119,8 +119,8 @@ def fig_density_ts(st: Study, out: pathlib.Path) -> list[pathlib.Path]:
     for n in st.grid.n:
         for p, m in zip(st.grid.p, ("o", "s")):
             try:
-                a = [st.res(sr.SINTER, n, p, t)["volume_fraction"] for t in st.grid.t_s]
-                b = [st.res(sr.COOL, n, p, t)["volume_fraction"] for t in st.grid.t_s]
+                a = [st.res(sr.SINTER, n, p, t)["mass_fraction"] for t in st.grid.t_s]
+                b = [st.res(sr.COOL, n, p, t)["mass_fraction"] for t in st.grid.t_s]
             except Missing:
                 continue
             ls = "-" if n == st.n_max else "--"
@@ -132,7 +132,7 @@ def fig_density_ts(st: Study, out: pathlib.Path) -> list[pathlib.Path]:
     ax[0, 1].set_title("ν after cool-down (t_f); dotted: paper 0.94", fontsize=8)
     for a in ax[0]:
         a.set_xlabel("t_s (s)")
-        a.set_ylabel("ν")
+        a.set_ylabel("ν = M/(ρ_p V)")
         a.legend(fontsize=7)
     return [save_figure(fig, out / "density_vs_ts.png", dpi=DPI)]
 
@@ -289,8 +289,8 @@ def _grid_table(st: Study) -> str:
                     prep = st.res(sr.PREPARE, n, p)
                 except Missing:
                     continue
-                rows.append([n, f"{p:g}", f"{t_s:g}", f"{prep['volume_fraction']:.4f}", f"{a['volume_fraction']:.4f}",
-                             f"{b['volume_fraction']:.4f}", pct(b['volume_fraction'] / prep['volume_fraction'] - 1),
+                rows.append([n, f"{p:g}", f"{t_s:g}", f"{prep['mass_fraction']:.4f}", f"{a['mass_fraction']:.4f}",
+                             f"{b['mass_fraction']:.4f}", pct(b['mass_fraction'] / prep['mass_fraction'] - 1),
                              f"{a['coordination']:.2f}", f"{a['k1_factor']:.3g}", f"{c['failure_stress']:.0f}",
                              f"{c['failure_strain']:.4f}", f"{c['stiffness']:.3g}",
                              f"{v['largest_fragment']}/{v['fragments']}"])

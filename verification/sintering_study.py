@@ -12,6 +12,7 @@ import pathlib
 
 import numpy as np
 
+from dem.laws.contact.luding import LUDING_TABLE1, radius_at
 from verification.sinter_protocol import T_PREPARE, Times
 from verification import sintering_runs as sr
 
@@ -65,7 +66,10 @@ class Study:
 
     def history(self, n, p, t_s) -> dict:
         """The time series of preparation, sintering and cooling joined on the time axis of Fig. 7 (a continued
-        stage's first row, which repeats the previous stage's last, is dropped)."""
+        stage's first row, which repeats the previous stage's last, is dropped), with the material density
+        ``mass_fraction`` = M/(rho_p(80 °C) V): the solid fraction times (a(80 °C)/a(T))^2 of eq. 9 (Table 1's
+        material, one temperature for every particle, as the protocol's schedule gives it)."""
+        mat = LUDING_TABLE1
         times = Times(t_s=t_s)
         parts = [(self.series(self.task(sr.PREPARE, n, p)), 0.0, 0),
                  (self.series(self.task(sr.SINTER, n, p, t_s)), times.t_heat, 1),
@@ -73,8 +77,8 @@ class Study:
         keys = [k for k in parts[0][0] if all(k in s for s, _, _ in parts)]
         out = {k: np.concatenate([s[k][skip:] + (offset if k == "t" else 0.0) for s, offset, skip in parts])
                for k in keys}
-        scale = 1.0 - 1e-4 * (120.0 - out["T_mean"])  # eq. 9 with Table 1's delta a_T
-        out["mass_fraction"] = out["volume_fraction"] * ((1.0 - 1e-4 * (120.0 - T_PREPARE)) / scale) ** 2
+        cold, hot = (radius_at(1.0, T, mat.T_melt, mat.expansion) for T in (T_PREPARE, out["T_mean"]))
+        out["mass_fraction"] = out["volume_fraction"] * (cold / hot) ** 2
         return out
 
     def compression(self, n, p, t_s, variant: str = "") -> dict:
