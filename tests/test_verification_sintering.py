@@ -124,6 +124,20 @@ def test_scene_docs_of_the_variants(tmp_path, monkeypatch):
     assert held["solver"]["t_end"] == pytest.approx(1.5) and held["temperature"]["time"][0] == 1.3
 
 
+def test_the_density_statements_read_the_material_density():
+    """Sec. 4.1.4's 0.92 after sintering and 0.94 after cool-down are one measure, M/(rho_p V): hot, the solid
+    fraction at the current radii is larger by (a(140 °C)/a(80 °C))^2 and would pass where the material density fails."""
+    hot = {"volume_fraction": 0.9151, "mass_fraction": 0.9151 * (0.996 / 1.002) ** 2}
+    cold = {"volume_fraction": 0.9300, "mass_fraction": 0.9300}
+    grid = sr.Grid(n=(300,), p=(100.0,), t_s=(1.0,), three_seeds=(1,), no_expansion=False, n3d=12)
+    st = Y.Study(pathlib.Path("nowhere"), grid, {sr.Task(sr.SINTER, 300, 100.0, 1.0): hot,
+                                                 sr.Task(sr.COOL, 300, 100.0, 1.0): cold})
+    after_sintering, after_cooling, rise = T._nu_after_sintering(st), T._nu_after_cooling(st), T._cooling_increase(st)
+    assert not after_sintering.holds and after_sintering.ours.startswith("0.9042 ")
+    assert after_cooling.holds and after_cooling.ours == "0.9300"
+    assert rise.holds and rise.ours.startswith("+0.0258 ")
+
+
 def test_the_cool_down_splits_into_the_box_and_the_particles_area():
     side = np.array([30e-3, 29.97e-3, 29.94e-3])  # the box shrinks by 1 - 0.998^2 from the first row to the last
     s = {"t": np.array([0.0, 0.1, 0.2]), "q_left": np.zeros(3), "q_bottom": np.zeros(3), "q_right": -side,
