@@ -617,9 +617,9 @@ PROTOCOL_TEXT = """\
 fraction 0.3) with speeds of 0.01 m/s in a square box whose left and bottom walls are fixed and whose right and top
 walls are stress-controlled at p (eq. 1, m_w = 0.01 kg, γ_w = 0.2 kg/s). *Preparation* at 80 °C with Table 1's
 μ = 0.5 on particles and walls, for 0.2 s; at t_heat the wall friction off (μ_w = 0 as in Table 1), *heating* to
-140 °C in 0.1 s, *sintering* for t_s with t0 = 0.1 s, *cooling* to 80 °C in 0.1 s and *relaxation* for 0.1 s (Sec. 4.1, t0 = 10³ s
-outside sintering). The state after sintering (t_cool) and after relaxation (t_f) are saved; the cooled one starts
-both tests. *Compression* (Sec. 4.4): right wall at σ_xx = p, top wall moving in at ε̇_zz = 1/s to ε_zz = 0.06, so
+140 °C in 0.1 s, *sintering* for t_s with t0 = 0.1 s, *cooling* to 80 °C in 0.1 s and *relaxation* for 0.1 s
+(Sec. 4.1, t0 = 10³ s outside sintering). The state after sintering (t_cool) and after relaxation (t_f) are saved;
+the cooled one starts both tests. *Compression* (Sec. 4.4): right wall at σ_xx = p, top wall moving in at ε̇_zz = 1/s to ε_zz = 0.06, so
 that the times of Fig. 20 are strains. *Vibration* (Figs. 21-22): the box walls removed, the sample on a floor
 vibrating at 100 Hz with 0.2 mm amplitude for 0.1 s in gravity. ν is the *material density* M/(ρ_p V): the
 sample's mass over ρ_p at 80 °C times the walls' box (Fig. 9's "material density"; the mass is conserved, eq. 8); the

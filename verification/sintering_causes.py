@@ -25,7 +25,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from dem.laws.contact.luding import LUDING_TABLE1
-from verification.sinter_protocol import T0_SINTER, T_PREPARE, T_SINTER, Times
+from verification.sinter_protocol import T0_SINTER, T_PREPARE, T_SINTER
 from verification import sintering_runs as sr
 from verification.report import md_table
 from verification.sintering_statements import pct
@@ -337,11 +337,11 @@ def section(st: Study) -> tuple[str, dict]:
         "k1(T, t) like the pair contacts. A run whose contacts changed after t_heat rearranged: it is no control.",
         "", three, "",
         "**2. Cool-down.** The longest-sintered sample cooled from 140 to 80 °C four ways from the same state "
-        f"(N = {st.n_max}), the same sample prepared, sintered and cooled with the expansion Sec. 3.2's text describes "
-        "(\"one per-cent\" between 80 and 120 °C: δa_T = 2.5e-4 /K, against Table 1's 1e-4 /K), and the paper's "
-        "control run with δa_T = 0 through the whole schedule. The density at "
-        "both ends of the cool-down counted two ways, the box's and the particles' change of area over it, and the "
-        "stress on the top wall while cooling: where the box shrinks with the particles, the solid fraction at the "
+        f"(N = {st.n_max}), the same sample prepared, sintered and cooled with the expansion Sec. 3.2's text "
+        "describes (\"one per-cent\" between 80 and 120 °C: δa_T = 2.5e-4 /K, against Table 1's 1e-4 /K), and the "
+        "paper's control run with δa_T = 0 through the whole schedule. The density at both ends of the cool-down "
+        "counted two ways, the box's and the particles' change of area over it, and the stress on the top wall while "
+        "cooling: where the box shrinks with the particles, the solid fraction at the "
         "current radii stays and the material density M/(ρ_p V) rises by the particles' contraction (eq. 9: 2 δa_T "
         "60 K = 1.2 % of the area).",
         "", cool_nu, "",
@@ -364,5 +364,5 @@ def section(st: Study) -> tuple[str, dict]:
         "(the largest σ_zz before it first falls below half of it).",
         "", fail,
     ]
-    return "\n".join(md), {"preparation": prep_s, "three_particles": three_s, "cooling": cool_s, "cooling_density": cool_nu_s,
-                           "contact": contact_s, "coordination": coord_s, "failure": fail_s}
+    return "\n".join(md), {"preparation": prep_s, "three_particles": three_s, "cooling_density": cool_nu_s,
+                           "cooling": cool_s, "contact": contact_s, "coordination": coord_s, "failure": fail_s}
