@@ -146,6 +146,60 @@ def test_a_run_that_would_not_fit_is_refused_with_the_rtol_that_would():
         lattice.effective_conductivity(_chain_cell(0.2), rtol=1e-3, max_memory=0.1e9, workers=1)
 
 
+@pytest.mark.parametrize("cell, size_neck", [(_chain_cell(0.02), 0.03), (lattice.lattice_cell("sc", 0.08), 0.1),
+                                             (lattice.lattice_cell("bcc", 0.02), 0.03),
+                                             (lattice.lattice_cell("fcc", 0.08), 0.3)])
+def test_tetrahedra_predicted_before_meshing_on_the_safe_side(cell, size_neck):
+    # the prediction (from the cell and the sizes alone) is at least the mesh's tetrahedra, and not wildly more
+    predicted = lattice.predicted_tetrahedra(lattice.neck_circles(cell), size_neck)
+    meshed = len(lattice.build_cell_mesh(cell, **lattice.mesh_sizes(size_neck)).curved.tets)
+    assert meshed <= predicted < 2.0 * meshed
+
+
+def _no_meshing(*args, **kwargs):
+    raise AssertionError("a mesh was made")
+
+
+def test_a_first_mesh_that_would_not_fit_is_refused_before_meshing(monkeypatch):
+    # BCC h/r = 0.02 at 1e-5: the first mesh is predicted from the cell and refused before gmsh is called, naming
+    # the estimate and an rtol whose first mesh is predicted to fit
+    monkeypatch.setattr(lattice, "build_cell_mesh", _no_meshing)
+    cell = lattice.lattice_cell("bcc", 0.02)
+    with pytest.raises(ValueError, match=r"bcc: the first mesh \(neck size 0.00\d+ a, ~\d+ tetrahedra\) needs "
+                                         r"~\d+\.\d GB, more than the 1.0 GB available; rtol = \d\.\de-\d\d would fit"):
+        lattice.effective_conductivity(cell, rtol=1e-5, max_memory=1e9)
+    with pytest.raises(ValueError) as info:
+        lattice.effective_conductivity(cell, rtol=1e-5, max_memory=1e9)
+    fit = float(str(info.value).split("rtol = ")[-1].split()[0])
+    assert 1e-5 < fit < 1e-3
+    with pytest.raises(AssertionError, match="a mesh was made"):  # at that rtol the first mesh is let through
+        lattice.effective_conductivity(cell, rtol=fit * 1.05, max_memory=1e9)
+    circles = lattice.neck_circles(cell)
+    first = lattice.first_neck_size(fit * 1.05, lattice.smallest_neck_ratio(cell), 4)
+    assert lattice.memory_estimate(lattice.predicted_tetrahedra(circles, first), 4) <= 1e9
+    with pytest.raises(ValueError, match=r"0.4 GB available; no rtol fits: even neck size 0.3 a needs ~0\.\d GB"):
+        lattice.effective_conductivity(cell, rtol=1e-3, max_memory=0.4e9)
+
+
+def test_a_finer_mesh_that_would_not_fit_is_refused_before_meshing(monkeypatch):
+    # the chain at h/r = 0.02 needs a second mesh for 1e-3; with memory for the first only, that one is refused
+    cell = _chain_cell(0.02)
+    first = lattice.first_neck_size(1e-3, lattice.smallest_neck_ratio(cell), 3)
+    budget = lattice.memory_estimate(1.05 * lattice.predicted_tetrahedra(lattice.neck_circles(cell), first), 3)
+    build, meshes = lattice.build_cell_mesh, []
+
+    def counting(cell, **sizes):
+        meshes.append(sizes["size_neck"])
+        return build(cell, **sizes)
+
+    monkeypatch.setattr(lattice, "build_cell_mesh", counting)
+    with pytest.raises(ValueError, match=r"chain: rtol = 0.001 needs a finer mesh than the \d+ tetrahedra whose bounds "
+                                         r"are \d\.\d\de-03 apart; that mesh \(neck size [\d.]+ a, ~\d+ tetrahedra\) "
+                                         r"needs ~0.5 GB, more than the 0.5 GB available; rtol = \d\.\de-03 would fit"):
+        lattice.effective_conductivity(cell, rtol=1e-3, max_memory=budget, workers=1)
+    assert meshes == [first]
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("case", sorted(REFERENCES))
 def test_lattices_to_1e4_bracket_the_reference_with_a_sharp_estimate(case):
@@ -207,17 +261,20 @@ def test_small_necks_and_asymmetric_cells_are_refused():
     (["--kind", "sc", "--h-over-r", "0.08", "--rtol", "0"], "rtol = 0"),
     (["--kind", "sc", "--h-over-r", "0.08", "--max-memory", "0"], "max_memory = 0"),
     (["--kind", "sc", "--h-over-r", "0.08", "--rtol", "1e-6", "--max-memory", "0.8"], "would fit"),
+    (["--kind", "bcc", "--h-over-r", "0.02", "--rtol", "1e-5", "--max-memory", "1"], "GB, more than the 1.0 GB"),
     (["--kind", "hcp", "--h-over-r", "0.08"], "invalid choice"),
 ])
-def test_lattice_cli_refuses_bad_input_in_one_line(capsys, argv, match):
+def test_lattice_cli_refuses_bad_input_in_one_line(capsys, monkeypatch, argv, match):
+    # every refusal comes before any mesh is made
     from fem_neck.cli import main
 
+    monkeypatch.setattr(lattice, "build_cell_mesh", _no_meshing)
     try:
         rc = main(["lattice", *argv])
     except SystemExit as exc:  # argparse's own refusals
         rc = exc.code
     err = capsys.readouterr().err
-    assert rc == 2 and len(err.strip().splitlines()) == 1 and match in err
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and match in err and "Traceback" not in err
 
 
 def test_lattice_cli_json_and_files(capsys, tmp_path):
