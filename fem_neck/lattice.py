@@ -68,13 +68,15 @@ FIRST_SIZES, SIZE_FAR, GRADING = (0.005, 0.3), 0.5, 0.8
 # (:func:`effective_conductivity`)
 GAP_ORDER, REFINE_MARGIN = 1.25, 0.7
 # the first mesh (:func:`first_neck_size`), by order p: (size0, rtol0, neck_order, margin): at neck size size0 the
-# bounds of a cell whose smallest neck has a/r = NECK0 are about rtol0 apart; larger necks need a coarser mesh, the
+# bounds of a cell whose necks have the mean a/r = NECK0 are about rtol0 apart; larger necks need a coarser mesh, the
 # gap falling like (a/r)^-neck_order, used only over NECK_RANGE (not extrapolated to necks smaller than measured);
 # the first mesh aims at margin rtol. p = 4: the cubic lattices at h/r = 0.02 (a/r = 0.2) are 0.9-1.1e-4 apart at
-# size 0.01, at h/r = 0.08 (a/r = 0.39) 3.3-4.4e-5. p = 3: no dependence on the neck measured (a random packing
-# with a/r >= 0.25 was 2.2e-3 apart at size 0.087, the size this rule gives for 2e-3).
-FIRST_MESH = {3: (0.05, 1e-3, 0.0, 1.0), 4: (0.01, 1e-4, 1.3, 0.75)}
+# size 0.01, at h/r = 0.08 (a/r = 0.39) 3.3-4.4e-5. p = 3: the cubic lattices at a/r = 0.2 are 1.47-1.68e-3 apart
+# at size 0.05 and 4.7-5.7e-4 at 0.0191, at a/r = 0.39 0.70-0.79e-3 and 2.2-2.4e-4; two random packings (mean a/r
+# 0.32 and 0.37) were 2.5e-3 and 2.2e-3 apart at 0.087, 1.08 and 1.13 times this rule's gap (inside the margin).
+FIRST_MESH = {3: (0.05, 1.9e-3, 1.1, 0.75), 4: (0.01, 1e-4, 1.3, 0.75)}
 NECK0, NECK_RANGE = 0.2, (0.2, 0.5)
+P3_FROM = 3e-4  # the rtol from which the upper bound is P_3 by default (below, P_4)
 # the tetrahedra of a mesh predicted before meshing (:func:`predicted_tetrahedra`): the constants fitted to meshes
 # of the six cubic cells, two chains and the random packings at neck sizes 0.005-0.3, and the margin that puts every
 # one of them on the safe side
@@ -594,22 +596,22 @@ def available_memory() -> float:
     return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
 
 
-def smallest_neck_ratio(cell: PeriodicCell) -> float:
-    """The smallest ``a / r`` of the cell's bonds (``r`` the smaller radius of the pair)."""
+def mean_neck_ratio(cell: PeriodicCell) -> float:
+    """The mean ``a / r`` of the cell's bonds (``r`` the smaller radius of the pair)."""
     i, j, s = cell.bonds()
     d = np.linalg.norm(cell.centres[j] + s * cell.period - cell.centres[i], axis=1)
     r_i, r_j = cell.radii[i], cell.radii[j]
-    return float(np.min(neck_geometry(r_i, r_j, r_i + r_j - d).a / np.minimum(r_i, r_j)))
+    return float(np.mean(neck_geometry(r_i, r_j, r_i + r_j - d).a / np.minimum(r_i, r_j)))
 
 
 def _neck_factor(neck_ratio: float, order: int) -> float:
-    """How much coarser than at ``NECK0`` a mesh may be for the same gap when the smallest neck is ``neck_ratio``."""
+    """How much coarser than at ``NECK0`` a mesh may be for the same gap when the mean neck is ``neck_ratio``."""
     neck_order = FIRST_MESH[order][2]
     return (float(np.clip(neck_ratio, *NECK_RANGE)) / NECK0) ** (neck_order / GAP_ORDER)
 
 
 def first_neck_size(rtol: float, neck_ratio: float, order: int) -> float:
-    """Neck size of the first mesh at ``order`` of a cell whose smallest neck has ``a / r = neck_ratio``: the size
+    """Neck size of the first mesh at ``order`` of a cell whose mean neck has ``a / r = neck_ratio``: the size
     whose gap is predicted at ``margin rtol`` (``FIRST_MESH``: ``rtol0`` at ``size0`` for ``a / r = NECK0``, the gap
     falling like ``size^GAP_ORDER`` and like ``(a / r)^-neck_order``), within ``FIRST_SIZES``."""
     size0, rtol0, _, margin = FIRST_MESH[order]
@@ -659,6 +661,11 @@ def _check_fits(cell: PeriodicCell, circles: NeckCircles, size: float, calibrati
                      f"~{need / 1e9:.1f} GB, more than the {budget / 1e9:.1f} GB available; {tail}")
 
 
+def default_order(rtol: float) -> int:
+    """The order of the upper bound for ``rtol`` unless one is given: 3 from ``P3_FROM`` up, else 4."""
+    return 3 if rtol >= P3_FROM else 4
+
+
 def _refined_rtol(gap: float, size: float, new: float) -> float:
     """The ``rtol`` whose refinement from a mesh of neck size ``size`` with the bounds ``gap`` apart goes to the
     neck size ``new`` (the inverse of the refinement rule of :func:`effective_conductivity`)."""
@@ -670,27 +677,36 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
                            progress=None) -> CellResult:
     """``k_eff / kappa`` along z of the periodic ``cell`` with two-sided bounds (module docstring).
 
-    The first mesh has the neck size :func:`first_neck_size` (from ``rtol`` and the cell's smallest neck); while
+    The first mesh has the neck size :func:`first_neck_size` (from ``rtol`` and the cell's mean neck); while
     the bounds are more than ``rtol`` apart it predicts the neck size that meets ``rtol`` (the gap falls like
     ``size_neck^GAP_ORDER``) and solves there, at most ``max_meshes`` meshes. Before each mesh is made, its
     tetrahedra are predicted (:func:`predicted_tetrahedra`, on the safe side; from the second mesh on scaled up
     if a mesh had more) and the memory of its solve estimated (:func:`memory_estimate`): one that would not fit in
     ``max_memory`` bytes (default: what the machine has available) is refused with a ``ValueError`` naming the
-    estimate and the ``rtol`` that would fit. ``order``: of the upper bound (default 3 for ``rtol >= 3e-4``, else
-    4). ``progress(text)`` reports each mesh.
+    estimate and the ``rtol`` that would fit. ``order``: of the upper bound (default
+    :func:`default_order`). ``progress(text)`` reports each mesh.
     """
     check_positive("rtol", rtol)
     check_cell(cell)
-    order = order or (3 if rtol >= 3e-4 else 4)
+    explicit = order is not None
+    order = order or default_order(rtol)
     if order not in BYTES_PER_ELEMENT:
         raise ValueError(f"order = {order!r}: must be one of {', '.join(map(str, BYTES_PER_ELEMENT))}")
     budget = available_memory() if max_memory is None else float(max_memory)
     t0 = time.perf_counter()
-    neck = smallest_neck_ratio(cell)
+    neck = mean_neck_ratio(cell)
     circles = neck_circles(cell)
     size = first_neck_size(rtol, neck, order)
     calibration = 1.0  # tetrahedra meshed over predicted, where a mesh had more than predicted
-    what, rtol_at = "the first mesh", functools.partial(first_rtol, neck_ratio=neck, order=order)
+
+    def first_fit(fit: float) -> float:
+        """The rtol whose first mesh is the finest that fits, at the order that rtol gets (unless one was given)."""
+        reach = first_rtol(fit, neck, order)
+        if not explicit and default_order(reach) != order:  # p = 4 does not fit, p = 3 from P3_FROM does
+            reach = max(first_rtol(_size_that_fits(circles, calibration, 3, budget), neck, 3), P3_FROM)
+        return reach
+
+    what, rtol_at = "the first mesh", first_fit
     history = []
     for _ in range(max_meshes):
         _check_fits(cell, circles, size, calibration, order, budget, what, rtol_at)
