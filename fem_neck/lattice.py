@@ -34,11 +34,12 @@ to the quadrature of the curved elements (degree ``2 p``: ~5e-8 relative, measur
 flux solver's residual (1e-10; the upper bound's CG stops when its energy has settled to 1e-9, and the energy of
 any iterate is an upper bound). The mesh is graded toward every neck circle, where the temperature is singular
 (``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined until the estimate
-meets ``rtol``, and the memory of each solve is estimated before it starts (:func:`effective_conductivity`).
+meets ``rtol``, and the memory of each solve is estimated before its mesh is made (:func:`effective_conductivity`).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import time
@@ -63,17 +64,23 @@ MIN_NECK_RATIO = 0.05
 # the meshes: element size at the neck circles over the neck radius (the range of first meshes), far size over the
 # particle radius, growth of the size per unit distance from the circles
 FIRST_SIZES, SIZE_FAR, GRADING = (0.005, 0.3), 0.5, 0.8
-# measured on the lattice cells: the gap falls like size_neck^GAP_ORDER, the tetrahedra grow like
-# size_neck^-ELEMENT_ORDER (:func:`effective_conductivity`)
-GAP_ORDER, ELEMENT_ORDER = 1.25, 1.0
+# measured on the lattice cells: the gap falls like size_neck^GAP_ORDER; a refined mesh aims at REFINE_MARGIN rtol
+# (:func:`effective_conductivity`)
+GAP_ORDER, REFINE_MARGIN = 1.25, 0.7
 # the first mesh (:func:`first_neck_size`), by order p: (size0, rtol0, neck_order, margin): at neck size size0 the
-# bounds of a cell whose smallest neck has a/r = NECK0 are about rtol0 apart; larger necks need a coarser mesh, the
+# bounds of a cell whose necks have the mean a/r = NECK0 are about rtol0 apart; larger necks need a coarser mesh, the
 # gap falling like (a/r)^-neck_order, used only over NECK_RANGE (not extrapolated to necks smaller than measured);
 # the first mesh aims at margin rtol. p = 4: the cubic lattices at h/r = 0.02 (a/r = 0.2) are 0.9-1.1e-4 apart at
-# size 0.01, at h/r = 0.08 (a/r = 0.39) 3.3-4.4e-5. p = 3: no dependence on the neck measured (a random packing
-# with a/r >= 0.25 was 2.2e-3 apart at size 0.087, the size this rule gives for 2e-3).
-FIRST_MESH = {3: (0.05, 1e-3, 0.0, 1.0), 4: (0.01, 1e-4, 1.3, 0.75)}
+# size 0.01, at h/r = 0.08 (a/r = 0.39) 3.3-4.4e-5. p = 3: the cubic lattices at a/r = 0.2 are 1.47-1.68e-3 apart
+# at size 0.05 and 4.7-5.7e-4 at 0.0191, at a/r = 0.39 0.70-0.79e-3 and 2.2-2.4e-4; two random packings (mean a/r
+# 0.32 and 0.37) were 2.5e-3 and 2.2e-3 apart at 0.087, 1.08 and 1.13 times this rule's gap (inside the margin).
+FIRST_MESH = {3: (0.05, 1.9e-3, 1.1, 0.75), 4: (0.01, 1e-4, 1.3, 0.75)}
 NECK0, NECK_RANGE = 0.2, (0.2, 0.5)
+P3_FROM = 3e-4  # the rtol from which the upper bound is P_3 by default (below, P_4)
+# the tetrahedra of a mesh predicted before meshing (:func:`predicted_tetrahedra`): the constants fitted to meshes
+# of the six cubic cells, two chains and the random packings at neck sizes 0.005-0.3, and the margin that puts every
+# one of them on the safe side
+TETRAHEDRA_PER_CIRCLE, TETRAHEDRA_PER_VOLUME, PREDICTION_MARGIN = 315.0, 27.3, 1.3
 # peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured)
 BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 70e3}
 _TOL = 1e-9  # geometric tolerance in units of the largest radius
@@ -298,6 +305,98 @@ def _reaches(halfspaces: list, points: np.ndarray, radius: np.ndarray) -> np.nda
     return keep
 
 
+@dataclass(frozen=True)
+class CellFrame:
+    """What the mesh of a cell is built from, before any meshing: the cell ``scaled`` to its largest radius
+    ``unit``, the half period ``box``, the particle images that reach the computational cell with their bonds
+    (``local``, :func:`local_cluster`), the bonds' necks ``geo`` and unit directions ``e``, the cell's
+    ``halfspaces`` (:func:`_domain`), which mirror ``diagonal``/``anti`` symmetry it uses, the ``fraction`` of the
+    box it is and the exact ``solid_volume`` in it."""
+
+    scaled: PeriodicCell
+    unit: float
+    box: np.ndarray
+    local: object
+    geo: object
+    e: np.ndarray
+    halfspaces: list
+    diagonal: bool
+    anti: bool
+    fraction: float
+    solid_volume: float
+
+
+def _cell_frame(cell: PeriodicCell, method: str = "newton") -> CellFrame:
+    """The :class:`CellFrame` of ``cell``; ``ValueError`` unless it is mirror-symmetric (module docstring)."""
+    mirror, diagonal, anti = mirror_symmetry(cell)
+    if not mirror:
+        raise ValueError(f"{cell.name}: the packing is not mirror-symmetric about x = 0, y = 0 and z = 0 (modulo the "
+                         "period); this FE solves the mirror cell [0, P/2]^3 and needs those mirror planes")
+    unit = float(cell.radii.max())
+    scaled = PeriodicCell(cell.centres / unit, cell.radii / unit, cell.period / unit, cell.name)
+    box = scaled.period / 2.0
+    local = local_cluster(scaled, box)
+    fraction = 0.25 if anti else 0.5 if diagonal else 1.0
+    return CellFrame(scaled, unit, box, local, local.necks(method), local.directions(), _domain(box, diagonal, anti),
+                     diagonal, anti, fraction, float(scaled.phi * np.prod(box) * fraction))
+
+
+@dataclass(frozen=True)
+class NeckCircles:
+    """The neck circles on the boundary of a cell's solid, for predicting its mesh before meshing
+    (:func:`predicted_tetrahedra`): per circle its radius ``a``, its neck's length ``h_n`` and smaller particle
+    radius ``r_min``, and the ``fraction`` of it inside the computational cell; the solid volume there. Lengths in
+    units of the largest radius."""
+
+    a: np.ndarray
+    h_n: np.ndarray
+    r_min: np.ndarray
+    fraction: np.ndarray
+    solid_volume: float
+
+
+def neck_circles(cell: PeriodicCell, samples: int = 360) -> NeckCircles:
+    """The :class:`NeckCircles` of ``cell``: each bond's two circles sampled at ``samples`` points, the fraction
+    of them inside the computational cell and inside no other particle (there the circle is not on the boundary)."""
+    frame = _cell_frame(cell)
+    local, geo, e = frame.local, frame.geo, frame.e
+    c, r = local.centres, local.radii
+    bi, bj = local.bonds.T
+    helper = np.where(np.abs(e[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    u = np.cross(e, helper)
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    v = np.cross(e, u)
+    angle = np.linspace(0.0, 2.0 * np.pi, samples, endpoint=False)
+    ring = np.cos(angle)[None, :, None] * u[:, None, :] + np.sin(angle)[None, :, None] * v[:, None, :]
+    fractions = []
+    for z in (geo.z_i, geo.z_i + geo.h_n):
+        points = (c[bi] + z[:, None] * e)[:, None, :] + geo.a[:, None, None] * ring  # (bonds, samples, 3)
+        inside = np.ones(points.shape[:2], dtype=bool)
+        for n, d in frame.halfspaces:
+            inside &= points @ n <= d
+        for k in range(len(r)):
+            covered = np.linalg.norm(points - c[k], axis=2) < r[k] * (1.0 - 1e-9)
+            inside &= ~(covered & ((bi != k) & (bj != k))[:, None])
+        fractions.append(inside.mean(axis=1))
+    a, h_n, r_min = (np.tile(np.asarray(x, dtype=float), 2) for x in (geo.a, geo.h_n, np.minimum(r[bi], r[bj])))
+    return NeckCircles(a, h_n, r_min, np.concatenate(fractions), frame.solid_volume)
+
+
+def predicted_tetrahedra(circles: NeckCircles, size_neck: float) -> float:
+    """Tetrahedra of the mesh of neck size ``size_neck`` (:func:`mesh_sizes`), predicted before meshing, on the
+    safe side. A mesh of local size ``h(x)`` has about ``int dV / h^3`` tetrahedra up to a constant. Around a neck
+    circle of radius ``a`` the size is ``s + GRADING rho`` at the distance ``rho`` (``s = min(size_neck a, h_n)``,
+    :func:`fem_neck.cluster.neck_size_fields`) up to ``U = SIZE_FAR r_min``, so the circle adds
+    ``a (1 / (2 s) - 1 / U + s / (2 U^2))`` times a constant (the solid's angle around it over ``GRADING^2``);
+    the rest of the solid adds its volume over ``SIZE_FAR^3``. The two constants are measured
+    (``TETRAHEDRA_PER_CIRCLE``, ``TETRAHEDRA_PER_VOLUME``), times ``PREDICTION_MARGIN``."""
+    s = np.minimum(size_neck * circles.a, circles.h_n)
+    far = SIZE_FAR * circles.r_min
+    near = np.where(s < far, circles.a * (0.5 / s - 1.0 / far + 0.5 * s / far**2), 0.0)
+    per_circle = TETRAHEDRA_PER_CIRCLE * float(np.sum(circles.fraction * near))
+    return PREDICTION_MARGIN * (per_circle + TETRAHEDRA_PER_VOLUME * circles.solid_volume / SIZE_FAR**3)
+
+
 def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, grading: float,
                     curvature: int = 12, neck_cells: float = 1.0, method: str = "newton") -> CellMesh:
     """Mesh the computational cell (module docstring): the union of the spheres and necks that reach it, cut to the
@@ -308,17 +407,10 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, gradi
     from fem_neck.cluster import mesh_tetrahedra, neck_size_fields, tetrahedra
     from fem_neck.shapes import gmsh_session
 
-    mirror, diagonal, anti = mirror_symmetry(cell)
-    if not mirror:
-        raise ValueError(f"{cell.name}: the packing is not mirror-symmetric about x = 0, y = 0 and z = 0 (modulo the "
-                         "period); this FE solves the mirror cell [0, P/2]^3 and needs those mirror planes")
-    unit = float(cell.radii.max())
-    scaled = PeriodicCell(cell.centres / unit, cell.radii / unit, cell.period / unit, cell.name)
-    box = scaled.period / 2.0
-    local = local_cluster(scaled, box)
-    geo = local.necks(method)
-    e = local.directions()
-    halfspaces = _domain(box, diagonal, anti)
+    frame = _cell_frame(cell, method)
+    scaled, unit, box, local, geo, e, halfspaces = (frame.scaled, frame.unit, frame.box, frame.local, frame.geo,
+                                                    frame.e, frame.halfspaces)
+    diagonal, anti = frame.diagonal, frame.anti
     bi, bj = local.bonds.T
     start = local.centres[bi] + (0.75 * geo.z_i)[:, None] * e
     end = start + (geo.h_n + 0.25 * (geo.z_i + geo.z_j))[:, None] * e
@@ -374,9 +466,8 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, gradi
     fz = mesh.points[mesh.faces[mesh.boundary_faces], 2]
     hot = mesh.boundary_faces[np.all(np.abs(fz) < tol, axis=1)]
     cold = mesh.boundary_faces[np.all(np.abs(fz - box[2]) < tol, axis=1)]
-    fraction = 0.25 if anti else 0.5 if diagonal else 1.0
-    area = box[0] * box[1] * fraction
-    return CellMesh(mesh, hot, cold, float(box[2]), float(area), fraction, float(scaled.phi * area * box[2]),
+    area = box[0] * box[1] * frame.fraction
+    return CellMesh(mesh, hot, cold, float(box[2]), float(area), frame.fraction, frame.solid_volume,
                     float(volume_cad), unit, np.asarray(geo.a))
 
 
@@ -505,22 +596,22 @@ def available_memory() -> float:
     return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
 
 
-def smallest_neck_ratio(cell: PeriodicCell) -> float:
-    """The smallest ``a / r`` of the cell's bonds (``r`` the smaller radius of the pair)."""
+def mean_neck_ratio(cell: PeriodicCell) -> float:
+    """The mean ``a / r`` of the cell's bonds (``r`` the smaller radius of the pair)."""
     i, j, s = cell.bonds()
     d = np.linalg.norm(cell.centres[j] + s * cell.period - cell.centres[i], axis=1)
     r_i, r_j = cell.radii[i], cell.radii[j]
-    return float(np.min(neck_geometry(r_i, r_j, r_i + r_j - d).a / np.minimum(r_i, r_j)))
+    return float(np.mean(neck_geometry(r_i, r_j, r_i + r_j - d).a / np.minimum(r_i, r_j)))
 
 
 def _neck_factor(neck_ratio: float, order: int) -> float:
-    """How much coarser than at ``NECK0`` a mesh may be for the same gap when the smallest neck is ``neck_ratio``."""
+    """How much coarser than at ``NECK0`` a mesh may be for the same gap when the mean neck is ``neck_ratio``."""
     neck_order = FIRST_MESH[order][2]
     return (float(np.clip(neck_ratio, *NECK_RANGE)) / NECK0) ** (neck_order / GAP_ORDER)
 
 
 def first_neck_size(rtol: float, neck_ratio: float, order: int) -> float:
-    """Neck size of the first mesh at ``order`` of a cell whose smallest neck has ``a / r = neck_ratio``: the size
+    """Neck size of the first mesh at ``order`` of a cell whose mean neck has ``a / r = neck_ratio``: the size
     whose gap is predicted at ``margin rtol`` (``FIRST_MESH``: ``rtol0`` at ``size0`` for ``a / r = NECK0``, the gap
     falling like ``size^GAP_ORDER`` and like ``(a / r)^-neck_order``), within ``FIRST_SIZES``."""
     size0, rtol0, _, margin = FIRST_MESH[order]
@@ -534,55 +625,106 @@ def first_rtol(size: float, neck_ratio: float, order: int) -> float:
     return rtol0 * (size / (size0 * _neck_factor(neck_ratio, order))) ** GAP_ORDER / margin
 
 
+def _size_that_fits(circles: NeckCircles, calibration: float, order: int, budget: float) -> float | None:
+    """The finest neck size (down to a fiftieth of ``FIRST_SIZES``' finest) whose solve fits in ``budget`` bytes
+    (``calibration`` times its :func:`predicted_tetrahedra`), or ``None`` if not even the coarsest does."""
+    def fits(size):
+        return memory_estimate(calibration * predicted_tetrahedra(circles, size), order) <= budget
+
+    lo, hi = FIRST_SIZES[0] / 50.0, FIRST_SIZES[1]
+    if not fits(hi):
+        return None
+    if fits(lo):
+        return lo
+    for _ in range(60):  # bisection in log size: the predicted tetrahedra fall as the size grows
+        mid = math.sqrt(lo * hi)
+        lo, hi = (lo, mid) if fits(mid) else (mid, hi)
+    return hi
+
+
+def _check_fits(cell: PeriodicCell, circles: NeckCircles, size: float, calibration: float, order: int,
+                budget: float, what: str, rtol_at) -> None:
+    """``ValueError`` unless the solve on the mesh of neck size ``size`` (``calibration`` times its
+    :func:`predicted_tetrahedra`) fits in ``budget`` bytes, naming ``what`` it is, the estimate and the rtol that
+    would fit (``rtol_at(size)`` of the finest size that fits)."""
+    elements = calibration * predicted_tetrahedra(circles, size)
+    need = memory_estimate(elements, order)
+    if need <= budget:
+        return
+    fit = _size_that_fits(circles, calibration, order, budget)
+    if fit is None:
+        coarsest = memory_estimate(calibration * predicted_tetrahedra(circles, FIRST_SIZES[1]), order)
+        tail = f"no rtol fits: even neck size {FIRST_SIZES[1]:g} a needs ~{coarsest / 1e9:.1f} GB"
+    else:
+        tail = f"rtol = {rtol_at(fit):.1e} would fit"
+    raise ValueError(f"{cell.name}: {what} (neck size {size:.3g} a, ~{elements:.0f} tetrahedra) needs "
+                     f"~{need / 1e9:.1f} GB, more than the {budget / 1e9:.1f} GB available; {tail}")
+
+
+def default_order(rtol: float) -> int:
+    """The order of the upper bound for ``rtol`` unless one is given: 3 from ``P3_FROM`` up, else 4."""
+    return 3 if rtol >= P3_FROM else 4
+
+
+def _refined_rtol(gap: float, size: float, new: float) -> float:
+    """The ``rtol`` whose refinement from a mesh of neck size ``size`` with the bounds ``gap`` apart goes to the
+    neck size ``new`` (the inverse of the refinement rule of :func:`effective_conductivity`)."""
+    return gap * (new / size) ** GAP_ORDER / REFINE_MARGIN
+
+
 def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | None = None,
                            max_memory: float | None = None, max_meshes: int = 4, workers: int = 2,
                            progress=None) -> CellResult:
     """``k_eff / kappa`` along z of the periodic ``cell`` with two-sided bounds (module docstring).
 
-    The first mesh has the neck size :func:`first_neck_size` (from ``rtol`` and the cell's smallest neck); while
-    the bounds are more than ``rtol`` apart it predicts the neck size that meets ``rtol`` (the gap falls like ``size_neck^GAP_ORDER``, the tetrahedra grow like
-    ``size_neck^-ELEMENT_ORDER``) and solves there, at most ``max_meshes`` meshes. Before each mesh the memory of
-    its solve is estimated (:func:`memory_estimate`); one that would not fit in ``max_memory`` bytes (default: what
-    the machine has available) is refused with a ``ValueError`` naming the estimate and the ``rtol`` that would fit.
-    ``order``: of the upper bound (default 3 for ``rtol >= 3e-4``, else 4). ``progress(text)`` reports each mesh.
+    The first mesh has the neck size :func:`first_neck_size` (from ``rtol`` and the cell's mean neck); while
+    the bounds are more than ``rtol`` apart it predicts the neck size that meets ``rtol`` (the gap falls like
+    ``size_neck^GAP_ORDER``) and solves there, at most ``max_meshes`` meshes. Before each mesh is made, its
+    tetrahedra are predicted (:func:`predicted_tetrahedra`, on the safe side; from the second mesh on scaled up
+    if a mesh had more) and the memory of its solve estimated (:func:`memory_estimate`): one that would not fit in
+    ``max_memory`` bytes (default: what the machine has available) is refused with a ``ValueError`` naming the
+    estimate and the ``rtol`` that would fit. ``order``: of the upper bound (default
+    :func:`default_order`). ``progress(text)`` reports each mesh.
     """
     check_positive("rtol", rtol)
     check_cell(cell)
-    order = order or (3 if rtol >= 3e-4 else 4)
+    explicit = order is not None
+    order = order or default_order(rtol)
     if order not in BYTES_PER_ELEMENT:
         raise ValueError(f"order = {order!r}: must be one of {', '.join(map(str, BYTES_PER_ELEMENT))}")
     budget = available_memory() if max_memory is None else float(max_memory)
     t0 = time.perf_counter()
-    neck = smallest_neck_ratio(cell)
+    neck = mean_neck_ratio(cell)
+    circles = neck_circles(cell)
     size = first_neck_size(rtol, neck, order)
+    calibration = 1.0  # tetrahedra meshed over predicted, where a mesh had more than predicted
+
+    def first_fit(fit: float) -> float:
+        """The rtol whose first mesh is the finest that fits, at the order that rtol gets (unless one was given)."""
+        reach = first_rtol(fit, neck, order)
+        if not explicit and default_order(reach) != order:  # p = 4 does not fit, p = 3 from P3_FROM does
+            reach = max(first_rtol(_size_that_fits(circles, calibration, 3, budget), neck, 3), P3_FROM)
+        return reach
+
+    what, rtol_at = "the first mesh", first_fit
     history = []
     for _ in range(max_meshes):
+        _check_fits(cell, circles, size, calibration, order, budget, what, rtol_at)
         if progress is not None:
             progress(f"neck size {size:.3g} a")
         cm = build_cell_mesh(cell, **mesh_sizes(size))
-        need = memory_estimate(len(cm.curved.tets), order)
-        if need > budget:
-            # the first mesh's neck size that fits, and the rtol that starts there (tetrahedra ~ 1 / size)
-            fit = size * len(cm.curved.tets) * BYTES_PER_ELEMENT[order] / max(budget - BASE_BYTES, 1.0)
-            reach = first_rtol(fit, neck, order)
-            raise ValueError(f"{cell.name}: the mesh of neck size {size:.3g} a has {len(cm.curved.tets)} tetrahedra "
-                             f"and needs ~{need / 1e9:.1f} GB, more than the {budget / 1e9:.1f} GB available; "
-                             f"rtol = {reach:.1e} would fit")
+        calibration = max(calibration, len(cm.curved.tets) / predicted_tetrahedra(circles, size))
+        _check_fits(cell, circles, size, calibration, order, budget, what, rtol_at)
         b = solve_bounds(cm, order, workers)
         history.append({"size_neck": size, "elements": b.elements, "k_upper": b.upper, "k_lower": b.lower,
                         "gap": b.gap, "seconds": time.perf_counter() - t0})
         if b.gap <= rtol:
             break
-        # the neck size that meets rtol with a 30 % margin, at least 1.5x finer, at most 8x
-        new = size * min(max((0.7 * rtol / b.gap) ** (1.0 / GAP_ORDER), 1.0 / 8.0), 1.0 / 1.5)
-        elements = b.elements * (size / new) ** ELEMENT_ORDER
-        need = memory_estimate(elements, order)
-        if need > budget:
-            fit = size * ((budget - BASE_BYTES) / BYTES_PER_ELEMENT[order] / b.elements) ** (-1.0 / ELEMENT_ORDER)
-            reach = b.gap * (fit / size) ** GAP_ORDER / 0.7
-            raise ValueError(f"{cell.name}: rtol = {rtol:g} needs ~{elements:.3g} tetrahedra and ~{need / 1e9:.1f} GB "
-                             f"(the bounds are {b.gap:.2e} apart on {b.elements}), more than the {budget / 1e9:.1f} GB "
-                             f"available; rtol = {reach:.1e} would fit")
+        # the neck size that meets REFINE_MARGIN rtol, at least 1.5x finer, at most 8x
+        new = size * min(max((REFINE_MARGIN * rtol / b.gap) ** (1.0 / GAP_ORDER), 1.0 / 8.0), 1.0 / 1.5)
+        what = (f"rtol = {rtol:g} needs a finer mesh than the {b.elements} tetrahedra whose bounds are {b.gap:.2e} "
+                f"apart; that mesh")
+        rtol_at = functools.partial(_refined_rtol, b.gap, size)
         size = new
     return CellResult(k_eff_over_kappa=b.upper, k_lower_over_kappa=b.lower, k_upper_over_kappa=b.upper,
                       error_estimate=b.gap, converged=bool(b.gap <= rtol), phi=cell.phi, order=order, dofs=b.dofs_upper,

@@ -114,7 +114,14 @@ def test_primal_cg_stops_when_the_energy_has_settled():
     assert loose.iterations < tight.iterations
 
 
-def test_effective_conductivity_refines_to_its_tolerance():
+def _coarse_first_mesh(monkeypatch):
+    """A first-mesh rule for p = 3 that believes the bounds 5x closer than they are: the first mesh is too coarse."""
+    size0, rtol0, neck_order, margin = lattice.FIRST_MESH[3]
+    monkeypatch.setitem(lattice.FIRST_MESH, 3, (size0, rtol0 / 5.0, neck_order, margin))
+
+
+def test_effective_conductivity_refines_to_its_tolerance(monkeypatch):
+    _coarse_first_mesh(monkeypatch)
     res = lattice.effective_conductivity(_chain_cell(0.02), rtol=1e-3, workers=1)
     assert len(res.levels) >= 2 and res.levels[0]["gap"] > 1e-3  # the first mesh was too coarse
     assert res.converged and res.error_estimate <= 1e-3
@@ -124,15 +131,16 @@ def test_effective_conductivity_refines_to_its_tolerance():
 
 
 def test_first_mesh_is_coarser_for_larger_necks_and_looser_tolerances():
-    # the smallest neck of a lattice is its pair neck; of a random packing, its smallest bond's
-    assert lattice.smallest_neck_ratio(lattice.lattice_cell("bcc", 0.08)) == pytest.approx(neck_radius(1, 1, 0.08))
+    # the mean neck of a lattice is its pair neck
+    assert lattice.mean_neck_ratio(lattice.lattice_cell("bcc", 0.08)) == pytest.approx(neck_radius(1, 1, 0.08))
     small, large = (lattice.first_neck_size(1e-4, x, 4) for x in (0.2, 0.4))
     assert large / small == pytest.approx(2.0 ** (lattice.FIRST_MESH[4][2] / lattice.GAP_ORDER), rel=1e-12)
     # not extrapolated below the smallest neck measured: a smaller neck gets the a/r = 0.2 mesh
     assert lattice.first_neck_size(1e-4, 0.1, 4) == small
     assert lattice.first_neck_size(2e-4, 0.2, 4) / small == pytest.approx(2.0 ** (1 / lattice.GAP_ORDER), rel=1e-12)
-    # p = 3: no dependence on the neck measured
-    assert lattice.first_neck_size(1e-3, 0.2, 3) == lattice.first_neck_size(1e-3, 0.4, 3)
+    # p = 3: its own dependence on the neck
+    assert (lattice.first_neck_size(1e-3, 0.4, 3) / lattice.first_neck_size(1e-3, 0.2, 3)
+            == pytest.approx(2.0 ** (lattice.FIRST_MESH[3][2] / lattice.GAP_ORDER), rel=1e-12))
     # first_rtol inverts it (what the refusal names)
     assert lattice.first_rtol(lattice.first_neck_size(1e-4, 0.3, 4), 0.3, 4) == pytest.approx(1e-4, rel=1e-12)
 
@@ -144,6 +152,65 @@ def test_a_run_that_would_not_fit_is_refused_with_the_rtol_that_would():
     assert 1e-6 < fit < 1e-2
     with pytest.raises(ValueError, match="more than the 0.1 GB available"):
         lattice.effective_conductivity(_chain_cell(0.2), rtol=1e-3, max_memory=0.1e9, workers=1)
+
+
+@pytest.mark.parametrize("cell, size_neck", [(_chain_cell(0.02), 0.03), (lattice.lattice_cell("sc", 0.08), 0.1),
+                                             (lattice.lattice_cell("bcc", 0.02), 0.03),
+                                             (lattice.lattice_cell("fcc", 0.08), 0.3)])
+def test_tetrahedra_predicted_before_meshing_on_the_safe_side(cell, size_neck):
+    # the prediction (from the cell and the sizes alone) is at least the mesh's tetrahedra, and not wildly more
+    predicted = lattice.predicted_tetrahedra(lattice.neck_circles(cell), size_neck)
+    meshed = len(lattice.build_cell_mesh(cell, **lattice.mesh_sizes(size_neck)).curved.tets)
+    assert meshed <= predicted < 2.0 * meshed
+
+
+def _no_meshing(*args, **kwargs):
+    raise AssertionError("a mesh was made")
+
+
+def test_a_first_mesh_that_would_not_fit_is_refused_before_meshing(monkeypatch):
+    # BCC h/r = 0.02 at 1e-5: the first mesh is predicted from the cell and refused before gmsh is called, naming
+    # the estimate and an rtol whose first mesh is predicted to fit
+    monkeypatch.setattr(lattice, "build_cell_mesh", _no_meshing)
+    cell = lattice.lattice_cell("bcc", 0.02)
+    with pytest.raises(ValueError, match=r"bcc: the first mesh \(neck size 0.00\d+ a, ~\d+ tetrahedra\) needs "
+                                         r"~\d+\.\d GB, more than the 1.0 GB available; rtol = \d\.\de-\d\d would fit"):
+        lattice.effective_conductivity(cell, rtol=1e-5, max_memory=1e9)
+    with pytest.raises(ValueError) as info:
+        lattice.effective_conductivity(cell, rtol=1e-5, max_memory=1e9)
+    fit = float(str(info.value).split("rtol = ")[-1].split()[0])
+    assert 1e-5 < fit < 1e-3
+    with pytest.raises(AssertionError, match="a mesh was made"):  # at that rtol the first mesh is let through
+        lattice.effective_conductivity(cell, rtol=fit * 1.05, max_memory=1e9)
+    # at p = 4 (given) the rtol that fits is p = 4's
+    with pytest.raises(ValueError) as info:
+        lattice.effective_conductivity(cell, rtol=1e-5, order=4, max_memory=1e9)
+    fit = float(str(info.value).split("rtol = ")[-1].split()[0])
+    with pytest.raises(AssertionError, match="a mesh was made"):
+        lattice.effective_conductivity(cell, rtol=fit * 1.05, order=4, max_memory=1e9)
+    with pytest.raises(ValueError, match=r"0.4 GB available; no rtol fits: even neck size 0.3 a needs ~0\.\d GB"):
+        lattice.effective_conductivity(cell, rtol=1e-3, max_memory=0.4e9)
+
+
+def test_a_finer_mesh_that_would_not_fit_is_refused_before_meshing(monkeypatch):
+    # the chain at h/r = 0.02 needs a second mesh for 1e-3 (from a first mesh too coarse); with memory for the first
+    # only, that one is refused
+    _coarse_first_mesh(monkeypatch)
+    cell = _chain_cell(0.02)
+    first = lattice.first_neck_size(1e-3, lattice.mean_neck_ratio(cell), 3)
+    budget = lattice.memory_estimate(1.05 * lattice.predicted_tetrahedra(lattice.neck_circles(cell), first), 3)
+    build, meshes = lattice.build_cell_mesh, []
+
+    def counting(cell, **sizes):
+        meshes.append(sizes["size_neck"])
+        return build(cell, **sizes)
+
+    monkeypatch.setattr(lattice, "build_cell_mesh", counting)
+    with pytest.raises(ValueError, match=r"chain: rtol = 0.001 needs a finer mesh than the \d+ tetrahedra whose bounds "
+                                         r"are \d\.\d\de-03 apart; that mesh \(neck size [\d.]+ a, ~\d+ tetrahedra\) "
+                                         r"needs ~0.5 GB, more than the 0.5 GB available; rtol = \d\.\de-03 would fit"):
+        lattice.effective_conductivity(cell, rtol=1e-3, max_memory=budget, workers=1)
+    assert meshes == [first]
 
 
 @pytest.mark.slow
@@ -207,17 +274,20 @@ def test_small_necks_and_asymmetric_cells_are_refused():
     (["--kind", "sc", "--h-over-r", "0.08", "--rtol", "0"], "rtol = 0"),
     (["--kind", "sc", "--h-over-r", "0.08", "--max-memory", "0"], "max_memory = 0"),
     (["--kind", "sc", "--h-over-r", "0.08", "--rtol", "1e-6", "--max-memory", "0.8"], "would fit"),
+    (["--kind", "bcc", "--h-over-r", "0.02", "--rtol", "1e-5", "--max-memory", "1"], "GB, more than the 1.0 GB"),
     (["--kind", "hcp", "--h-over-r", "0.08"], "invalid choice"),
 ])
-def test_lattice_cli_refuses_bad_input_in_one_line(capsys, argv, match):
+def test_lattice_cli_refuses_bad_input_in_one_line(capsys, monkeypatch, argv, match):
+    # every refusal comes before any mesh is made
     from fem_neck.cli import main
 
+    monkeypatch.setattr(lattice, "build_cell_mesh", _no_meshing)
     try:
         rc = main(["lattice", *argv])
     except SystemExit as exc:  # argparse's own refusals
         rc = exc.code
     err = capsys.readouterr().err
-    assert rc == 2 and len(err.strip().splitlines()) == 1 and match in err
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and match in err and "Traceback" not in err
 
 
 def test_lattice_cli_json_and_files(capsys, tmp_path):

@@ -14,8 +14,9 @@ def register(subparsers) -> None:
         "gradient along z. The FE solves a sixteenth of the cubic cell bounded by mirror planes (the planes normal "
         "to z isothermal, the others insulated) on tetrahedra that fill the exact solid: conforming P_p elements give "
         "an upper bound, a divergence-free Raviart-Thomas flux of degree p - 1 a lower bound; the mesh is refined "
-        "toward the neck circles until they are --rtol apart. The memory of each mesh is estimated before it is "
-        "solved, and a run that would not fit is refused with the rtol that would. "
+        "toward the neck circles until they are --rtol apart. The tetrahedra of each mesh are predicted from the "
+        "cell's neck circles and the memory of its solve estimated before the mesh is made, and a run that would not "
+        "fit is refused up front with the estimate and the rtol that would. "
         "Prints k_eff/kappa (the upper bound, the more accurate), its bounds, error_estimate = (upper - lower) / "
         "upper, the solid fraction phi (phi kappa is the Wiener upper bound of k_eff) and the pipe network's k_eff "
         "with the full-range fit law beside it.")
