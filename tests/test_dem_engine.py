@@ -132,6 +132,32 @@ def test_rebuilds_carry_the_contact_history():
     assert np.allclose(out[0][0], out[1][0], rtol=0, atol=1e-15)
 
 
+@pytest.mark.parametrize("rate", [0.0, 4096.0])
+def test_a_long_call_keeps_the_pairs_constants_only_while_the_radii_stay(rate):
+    """One call of many steps against one call per step (each computes the pairs' constants afresh): the same run to
+    the bit. At rate 0 the radii stay (the constants are read after the first step) and a listed pair closes after
+    that step; at 4096 K/s (2^-10 K per 2^-22 s step: the same temperatures either way) they change every step."""
+    x = [[0, 0, 0], [1.9999e-3, 0, 0], [4.0009e-3, 0, 0]]  # two touch, the third is 1 um off and coming
+    v = [[0, 0, 0], [0, 0, 0], [-0.02, 0, 0]]
+    out = []
+    for calls in ("one", "each step"):
+        doc = scene_doc(x, [1e-3] * 3, v, TABLE1, temperature=115.0)
+        doc["solver"].update(dt=2.0**-22, skin=2e-4)
+        mech = VerletEngine(parse_scene(doc)).mechanics
+        assert len(mech.pi) == 2 and len(mech.contacts()[0]) == 1
+        T0, T_rate = np.array([115.0]), np.array([rate])
+        if calls == "one":
+            mech.advance(400, T0, T_rate)
+        else:
+            for k in range(400):
+                mech.advance(1, T0 + rate * k * mech.dt, T_rate)
+        out.append((mech.state.x.copy(), mech.state.radius.copy(), mech.p_hist.copy(), mech.state.v[2, 0]))
+    assert out[0][3] > -0.019  # the third particle hit the second
+    assert (out[0][1][0] != 1e-3) == (rate > 0)  # the radii changed with the temperature
+    for a, b in zip(out[0][:3], out[1][:3]):
+        assert np.array_equal(a, b)
+
+
 def test_stress_wall_balances_its_pressure():
     doc = scene_doc([[1e-3, 0, 1e-3], [3.1e-3, 0, 1e-3]], [1e-3, 1e-3], contact=TABLE1, t_end=0.05,
                     walls=[{"name": "left", "point": [0, 0, 0], "normal": [1, 0, 0]},

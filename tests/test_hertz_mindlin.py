@@ -95,7 +95,7 @@ def _pair(params, delta, vn=0.0, vr=(0.0, 0.0, 0.0), r1=1e-3, r2=2e-3, xi=(0.0, 
     hist_in = np.array([xi], dtype=float)
     hist = np.zeros_like(hist_in)
     out = hm.pair_force(0, 0, 1, hist_in, hist, state, np.zeros(2), delta, r1 + r2 - delta, n,
-                        tuple(vr), vn, r1, r2, False, dt, params)
+                        tuple(vr), vn, r1, r2, False, dt, params, ())
     return out, hist[0]
 
 

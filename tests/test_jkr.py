@@ -52,7 +52,7 @@ def _force_at(params, delta, r1=R, r2=2 * R, vn=0.0, hist=None, vr=(0.0, 0.0, 0.
     hist_in = np.zeros((1, 4)) if hist is None else np.array([hist], dtype=float)
     out_hist = np.zeros_like(hist_in)
     out = jkr.pair_force(0, 0, 1, hist_in, out_hist, state, np.zeros(2), delta, r1 + r2 - delta, (1.0, 0.0, 0.0),
-                         vr, vn, r1, r2, False, 1e-7, params)
+                         vr, vn, r1, r2, False, 1e-7, params, ())
     return out, out_hist[0]
 
 

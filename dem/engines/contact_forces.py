@@ -43,6 +43,7 @@ FINITE_MATH = {"nnan", "ninf", "nsz"}
 N_PARAMS = law.N_PARAMS
 THREADED = False  # True in the copies for more than one thread (dem.engines.compiled)
 LOAD_COLUMNS = 9  # a pair's row of the threaded loop's buffer: g = f_n n + f_t (3), n x f_t (3), l_i, l_j, closed
+KEEPS_PAIR_CONSTANTS = len(law.PAIR_CONSTANTS) > 0  # the law's pair_constants are kept per pair, in (M, 2)
 
 
 @njit(cache=True)
@@ -67,8 +68,8 @@ def incident_pairs(pi, pj, n):
 
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, parallel=THREADED)
 def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft,
-           wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True, start=None,
-           pairs=None, load=None):
+           p_const, fresh, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True,
+           start=None, pairs=None, load=None):
     """Forces and torques of the current state (gravity, the law's drag, pairs, the listed particle-wall pairs
     ``(wk, wm)``); the normal forces on the walls go into ``wforce``. Returns the index into the wall list of the
     first particle whose centre lies behind its wall, else -1.
@@ -76,8 +77,11 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
     Each contact's history is read from ``p_hist_in``/``w_hist_in`` and written to ``p_hist``/``w_hist``: the same
     arrays for a step that is taken (velocity Verlet), others for an iterate that may be discarded (the implicit
     scheme). With ``record`` the contact forces are kept (``p_fn``, ``p_ft``, ``w_fn``, ``w_ft``: outputs only, so
-    a time loop records them on the last step of a call). ``spin_axes`` (:attr:`dem.geometry.motion.MotionState.spin_axes`):
-    ``(1,)`` for 2D disks in the x-z plane, whose pair terms along y vanish.
+    a time loop records them on the last step of a call). ``p_const`` (M, 2) holds the listed pairs' numbers that
+    depend on their radii alone (``law.pair_constants``, where the law keeps any): ``fresh`` computes them (and keeps
+    them there when it has rows), else they are read from there; a time loop passes ``fresh`` where the radii or the
+    list changed. ``spin_axes`` (:attr:`dem.geometry.motion.MotionState.spin_axes`): ``(1,)`` for 2D disks in the x-z
+    plane, whose pair terms along y vanish.
 
     The law's kernels are inlined right here, scalars and 3-tuples in and out, with the material as a tuple: an
     array argument costs an atomic reference count per call (a quarter of the loop). The length of ``spin_axes`` is
@@ -110,6 +114,12 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         dy = 0.0 if planar else min_image(x[i, 1] - x[j, 1], box[1])
         dz = min_image(x[i, 2] - x[j, 2], box[2])
         ri, rj = radius[i], radius[j]
+        if KEEPS_PAIR_CONSTANTS and not fresh:  # (read here, not by the law: an array passed to a kernel costs)
+            const = (p_const[c, 0], p_const[c, 1])
+        else:  # every listed pair's: it may close later
+            const = law.pair_constants(ri, rj, params)
+            if KEEPS_PAIR_CONSTANTS and p_const.shape[0]:
+                p_const[c, 0], p_const[c, 1] = const
         d2 = dx * dx + dy * dy + dz * dz
         cut = ri + rj + law.reach(c, p_hist_in, ri, rj, params)
         if d2 >= cut * cut or d2 == 0.0:
@@ -133,7 +143,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
         vn = vr0 * n0 + vr1 * n1 + vr2 * n2
         f_n, ft0, ft1, ft2 = law.pair_force(c, i, j, p_hist_in, p_hist, state, T, delta, d, (n0, n1, n2),
-                                            (vr0, vr1, vr2), vn, ri, rj, planar, dt, params)
+                                            (vr0, vr1, vr2), vn, ri, rj, planar, dt, params, const)
         if record:
             p_fn[c] = f_n
             p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2

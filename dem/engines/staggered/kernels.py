@@ -16,6 +16,8 @@ from numba import njit
 from dem.engines.contact_forces import forces
 from dem.geometry.neighbours import min_image
 
+NO_PAIR_CONSTANTS = np.empty((0, 0))  # the pairs' numbers of the radii are computed at every force evaluation
+
 
 @njit(cache=True, error_model="numpy")
 def iterate(dt, phi, x_L, v_L, f_L, x_prev, v_prev, T, mass, radius, gravity, pi, pj, p_hist_in, p_hist, p_fn,
@@ -32,7 +34,8 @@ def iterate(dt, phi, x_L, v_L, f_L, x_prev, v_prev, T, mass, radius, gravity, pi
     any particle from ``x_ref`` (where the Verlet list was built) and a NaN flag. Returns the escaped wall pair index
     of :func:`~dem.engines.contact_forces.forces` (-1 if none)."""
     escaped = forces(x_prev, v_prev, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in,
-                     p_hist, p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt)
+                     p_hist, p_fn, p_ft, NO_PAIR_CONSTANTS, True, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn,
+                     w_ft, params, dt)
     change, motion, reach, finite = 0.0, 0.0, 0.0, 1.0
     for k in range(x_L.shape[0]):
         h = dt / mass[k]

@@ -24,6 +24,7 @@ import math
 import numpy as np
 
 from dem.engines import compiled
+from dem.engines.staggered.kernels import NO_PAIR_CONSTANTS
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, max_displacement, restore_lists, verlet_pairs, wall_pairs
 from dem.geometry.periodic import PeriodicBox
@@ -130,7 +131,7 @@ class StaggeredMechanics:
         w, s = self.w, self.state
         escaped = self._forces(x, v, self._spin, out, self._torque, (0, 1, 2), s.mass, s.radius, self.particle_state, T,
                                self.gravity, self.box, self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn,
-                               self.p_ft, w.normal, w.q, w.dq, self.wforce, self.wk, self.wm, self.w_hist,
+                               self.p_ft, NO_PAIR_CONSTANTS, True, w.normal, w.q, w.dq, self.wforce, self.wk, self.wm, self.w_hist,
                                self._w_hist_iter, self.w_fn, self.w_ft, self.params, 0.0)
         self._check_escape(escaped, x)
 

@@ -50,15 +50,19 @@ def wall_acceleration(m, wq, wdq, wmode, wpress, wmass, wdamp, wspan, wforce):
 
 
 @njit(cache=True, error_model="numpy", parallel=THREADED)
-def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spin_axes, radius, radius_ref, T0, T_rate,
-            T, state, uniform_T, t0, gravity, box, pi, pj, p_hist, p_fn, p_ft, start, pairs, load,
+def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_mass, inv_inertia, axes, spin_axes, radius,
+            radius_ref, T0, T_rate, T, state, uniform_T, t0, gravity, box, pi, pj, p_hist, p_fn, p_ft, p_const, start,
+            pairs, load,
             wn, wq, wdq, wacc, wmode, wpress, wmass, wdamp, wq0, wamp, wfreq, wspan, wforce, wk, wm, wq_ref,
             w_hist, w_fn, w_ft, params, x_ref, skin, info):
     """Up to ``n_steps`` velocity-Verlet steps (module docstring) from global step ``step0`` (t = step0 dt) of an
     interval that began at step ``first`` with temperatures ``T0`` (``T0 + T_rate (t - first dt)`` after it): times
     come from step counts, so where a run is split into calls (rebuilds, a resume) never changes its arithmetic.
     ``f``/``tau``/``wacc`` must hold the forces of the current state on entry. Returns ``(steps done, status)``;
-    ``info`` receives the particle (and wall) index of a non-finite or escaped particle (the first such). ``start``,
+    ``info`` receives the particle (and wall) index of a non-finite or escaped particle (the first such).
+    ``inv_mass``, ``inv_inertia``: ``1/mass`` and ``1/inertia``. ``p_const``: room for the pairs' numbers of the radii
+    alone (:func:`dem.engines.contact_forces.forces`), computed at the first step and at any step whose radii
+    changed, read at the others. ``start``,
     ``pairs``, ``load``: the pairs by particle and the buffer of the threaded force pass (used where
     ``THREADED``)."""
     n = x.shape[0]
@@ -69,7 +73,7 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
         t = (step0 + s) * dt
         bad = n
         for k in prange(n):
-            im, ii = 1.0 / mass[k], 1.0 / inertia[k]
+            im, ii = inv_mass[k], inv_inertia[k]
             v[k, 0] += h * f[k, 0] * im
             x[k, 0] += dt * v[k, 0]
             moved = abs(x[k, 0])
@@ -107,14 +111,15 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, axes, spi
                 phase = 2.0 * math.pi * wfreq[m] * (t + dt)
                 wq[m] = wq0[m] + wamp[m] * math.sin(phase)
                 wdq[m] = 2.0 * math.pi * wfreq[m] * wamp[m] * math.cos(phase)
-        law.update_particles((step0 + s + 1 - first) * dt, T0, T_rate, T, radius, radius_ref, state, uniform_T,
-                             params, t0, dt)
+        resized = law.update_particles((step0 + s + 1 - first) * dt, T0, T_rate, T, radius, radius_ref, state,
+                                       uniform_T, params, t0, dt)
+        fresh = s == 0 or resized
         escaped = forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist,
-                         p_fn, p_ft, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params, dt,
-                         s == n_steps - 1, start, pairs, load)
+                         p_fn, p_ft, p_const, fresh, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params,
+                         dt, s == n_steps - 1, start, pairs, load)
         worst = 0.0
         for k in prange(n):
-            im, ii = 1.0 / mass[k], 1.0 / inertia[k]
+            im, ii = inv_mass[k], inv_inertia[k]
             v[k, 0] += h * f[k, 0] * im
             d = min_image(x[k, 0] + dt * v[k, 0] - x_ref[k, 0], box[0])
             d2 = d * d

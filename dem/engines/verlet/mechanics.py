@@ -127,6 +127,7 @@ class MechanicalModel:
         """The pairs ``(i, j)`` as the list (with the threads' view of it), built at the positions of now."""
         s = self.state
         self.pi, self.pj = i, j
+        self.p_const = np.empty((len(i), 2 if self.law.PAIR_CONSTANTS else 0))  # filled at each call's first step
         if self.threaded:
             self.pair_start, self.pair_order = incident_pairs(i, j, s.n)
             self.pair_load = np.empty((len(i), LOAD_COLUMNS))
@@ -150,7 +151,7 @@ class MechanicalModel:
         s, w = self.state, self.w
         self._forces(s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, self.particle_state, s.T,
                      self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_hist, self.p_fn, self.p_ft,
-                     w.normal, w.q, w.dq, w.force, self.wk, self.wm, self.w_hist, self.w_hist, self.w_fn, self.w_ft,
+                     self.p_const, True, w.normal, w.q, w.dq, w.force, self.wk, self.wm, self.w_hist, self.w_hist, self.w_fn, self.w_ft,
                      self.params, 0.0)
         for m in range(len(self.walls)):
             w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
@@ -171,14 +172,15 @@ class MechanicalModel:
         """``n_steps`` steps with temperatures ``T0 + T_rate (t - t_now)`` (uniform when both have one entry)."""
         s, w = self.state, self.w
         T0, T_rate, uniform, t0 = self._temperature_arguments(T0, T_rate, relaxation_time)
+        inv_mass, inv_inertia = 1.0 / s.mass, 1.0 / s.inertia
         first = self.steps
         done = 0
         while done < n_steps:
             steps, status = self._advance(
-                n_steps - done, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia,
-                s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.particle_state,
+                n_steps - done, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia, inv_mass,
+                inv_inertia, s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.particle_state,
                 uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_fn, self.p_ft,
-                self.pair_start, self.pair_order, self.pair_load,
+                self.p_const, self.pair_start, self.pair_order, self.pair_load,
                 w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
                 w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_hist, self.w_fn, self.w_ft, self.params,
                 self.x_ref, self.skin, self._info)

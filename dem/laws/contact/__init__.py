@@ -16,9 +16,13 @@ A contact law module defines (SI units; forces on particle i, the unit normal ``
   largest a velocity-Verlet step may take; ``largest_reach(material, radius)`` -- the farthest beyond touching any
   contact of these particles acts (the neighbour lists' skin must exceed it; 0 for a law without forces at a
   distance);
-* ``pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params) -> (f_n, f_t0,
-  f_t1, f_t2)`` -- the force on i of pair ``c`` at overlap ``delta`` (centre distance ``d``) with relative surface velocity ``vr`` (normal part
-  ``vn``), reading the pair's history from row ``c`` of ``hist_in`` and writing it to row ``c`` of ``hist``;
+* ``pair_constants(ri, rj, params)`` -- two numbers of a pair that depend on its radii alone, which the loops keep
+  per pair and compute again only when the radii or the list changed, where ``PAIR_CONSTANTS`` names them (a law
+  that keeps none has ``PAIR_CONSTANTS = ()`` and returns two zeros);
+* ``pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params, const) -> (f_n,
+  f_t0, f_t1, f_t2)`` -- the force on i of pair ``c`` at overlap ``delta`` (centre distance ``d``) with relative
+  surface velocity ``vr`` (normal part ``vn``) and the pair's ``pair_constants`` ``const``, reading the pair's
+  history from row ``c`` of ``hist_in`` and writing it to row ``c`` of ``hist``;
   ``forget_pair(c, hist_in, hist)`` -- the pair opened (returns whether it had a history); ``reach(c, hist, ri, rj,
   params)`` -- how far beyond touching the pair still acts (0 for a law without forces at a distance);
 * ``wall_force(k, m, hist_in, hist, state, T, delta, dist, n, vr, vn, rk, dt, params)``, ``forget_wall(k, m, hist_in,
@@ -26,6 +30,7 @@ A contact law module defines (SI units; forces on particle i, the unit normal ``
   ``[k, m]``);
 * ``update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt)`` -- before the
   forces of every step: the temperatures ``T0 + T_rate elapsed`` and what the law makes of them (radii, state);
+  returns whether a radius changed;
   ``drag(k, radius, params)`` -- the drag coefficient of particle k (kg/s) where ``DRAG``.
 """
 

@@ -206,6 +206,7 @@ Material = HertzMindlinMaterial
 PAIR_HISTORY = ("xi_x", "xi_y", "xi_z")  # the tangential spring
 WALL_HISTORY = PAIR_HISTORY
 PARTICLE_STATE = ("mass",)  # each particle's mass (kg): the damping needs m*
+PAIR_CONSTANTS = ()  # (pair_constants)
 SPINS = True
 SCHEMA_ROWS = (  # the scene keys of the material (dem.scene.schema): keys, type and unit, meaning
     (("youngs_modulus", "poisson_ratio"), "Pa, -; required, E > 0, -1 < ν < 0.5",
@@ -236,7 +237,7 @@ def largest_reach(material, radius: np.ndarray) -> float:
 
 
 @njit(**IN_LOOP)
-def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params):
+def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params, const):
     """Force on particle i of the pair ``c`` = (i, j) at overlap ``delta`` (module docstring); the spring is read
     from row ``c`` of ``hist_in`` and written to row ``c`` of ``hist``. ``planar``: 2D disks in the x-z plane."""
     mi, mj = state[i, 0], state[j, 0]
@@ -247,6 +248,12 @@ def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, pl
                            params[P_XT] * eta, params[P_MU] * max(f_n, 0.0), dt)
     hist[c, 0], hist[c, 1], hist[c, 2] = xi
     return f_n, ft[0], ft[1], ft[2]
+
+
+@njit(**IN_LOOP)
+def pair_constants(ri, rj, params):
+    """No numbers of the radii alone are kept per pair (``PAIR_CONSTANTS`` is empty): two zeros."""
+    return 0.0, 0.0
 
 
 @njit(**IN_LOOP)
@@ -292,10 +299,12 @@ def wall_reach(k, m, hist, rk, params):
 
 @njit(**JIT)
 def update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt):
-    """The temperatures ``T0 + T_rate elapsed``; the law does not depend on them."""
+    """The temperatures ``T0 + T_rate elapsed``; the law does not depend on them. Returns that no radius
+    changed."""
     n = T.shape[0]
     for k in range(n):
         T[k] = T0[0] + T_rate[0] * elapsed if uniform else T0[k] + T_rate[k] * elapsed
+    return False
 
 
 @njit(**IN_LOOP)

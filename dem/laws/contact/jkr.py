@@ -126,6 +126,7 @@ Material = JKRMaterial
 PAIR_HISTORY = ("xi_x", "xi_y", "xi_z", "pulloff")  # the tangential spring; the pull-off distance, 0 before contact
 WALL_HISTORY = PAIR_HISTORY
 PARTICLE_STATE = hm.PARTICLE_STATE  # each particle's mass: the damping needs m*
+PAIR_CONSTANTS = hm.PAIR_CONSTANTS
 SPINS = True
 _JKR_ROWS = {  # where the meaning of a Hertz-Mindlin key differs with adhesion
     ("restitution",): ("0 < e ≤ 1, required", "the coefficient of restitution of a head-on collision whose adhesion "
@@ -142,6 +143,7 @@ DRAG = False
 initial_state = hm.initial_state
 reference_radius = hm.reference_radius
 update_particles = hm.update_particles
+pair_constants = hm.pair_constants
 drag = hm.drag
 
 
@@ -161,7 +163,7 @@ def _contact(xi, pulloff, delta, vn, n, vr, r_eff, m_eff, mu, dt, params):
 
 
 @njit(**IN_LOOP)
-def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params):
+def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params, const):
     """Force on particle i of the pair ``c`` = (i, j) at overlap ``delta`` (negative beyond touching, down to the
     break); spring and pull-off distance in row ``c`` of ``hist_in``/``hist``."""
     mi, mj = state[i, 0], state[j, 0]

@@ -282,11 +282,20 @@ def f_min(delta_max, k1_factor_now, delta_fluid, params):
 
 @njit(**IN_LOOP)
 def normal_force(delta, delta_dot, k1_factor_now, delta_max, k1_factor_last, delta_fluid, params):
+    """Normal force on particle i and the new history (Luding 2005, eqs. 4, 5, 7, 13, 15; Figs. 2, 3, 5):
+    :func:`normal_force_of` with the contact's ``1/(k2 delta_fluid)`` computed here."""
+    return normal_force_of(delta, delta_dot, k1_factor_now, delta_max, k1_factor_last, delta_fluid,
+                           1.0 / (params[P_K2] * delta_fluid), params)
+
+
+@njit(**IN_LOOP)
+def normal_force_of(delta, delta_dot, k1_factor_now, delta_max, k1_factor_last, delta_fluid, inv_c, params):
     """Normal force on particle i and the new history (Luding 2005, eqs. 4, 5, 7, 13, 15; Figs. 2, 3, 5).
 
     Arguments: overlap ``delta`` (m), its rate ``delta_dot`` (m/s, > 0 approaching), the factor ``k1(T, t)/k1``
     now and at the contact's previous step, the history ``delta_max`` (0 for a new contact), ``delta_fluid`` of
-    the contact, ``params`` (:meth:`LudingMaterial.params`).
+    the contact and ``inv_c = 1/(k2 delta_fluid)`` (a pair's :func:`pair_constants`), ``params``
+    (:meth:`LudingMaterial.params`).
 
     Returns ``(f_n, delta_max_new, f_min, k2_now, kc_now, delta_0)``: f_n > 0 repulsive, including the viscous
     ``gamma_0 delta_dot`` (eq. 5); f_min of eq. (15), k2(delta_max) of eq. (7), kc(T, t, delta_max) of eq. (13) and
@@ -307,7 +316,7 @@ def normal_force(delta, delta_dot, k1_factor_now, delta_max, k1_factor_last, del
       ``delta (1 + kc/k2)`` (kc/k2 = k1(T, t) kc/(k1 k2) by eq. 13, whatever delta_max), delta_max to the matching
       root, so that reloading departs into the cone on that new k2 line.
     """
-    # Written with two divisions per call (this runs for every contact at every step): with c = k2 delta_fluid,
+    # Written with one division per call (this runs for every contact at every step): with c = k2 delta_fluid,
     # k2(x) = k1 + (k2 - k1)^2 x / c below the fluid limit (k2 - k1) x < c, 1/k2 = delta_fluid / c, and the
     # comparisons of force-free overlaps with delta_fluid multiplied out by k2(x) > 0.
     k1 = params[P_K1]
@@ -316,7 +325,6 @@ def normal_force(delta, delta_dot, k1_factor_now, delta_max, k1_factor_last, del
     s = k1_factor_now
     dm = delta_max
     dk = k2 - k1
-    inv_c = 1.0 / (k2 * delta_fluid)
     kc_over_k2 = kc * delta_fluid * inv_c
     if delta > 0.0:
         if s > k1_factor_last:  # cooling: delta_0 kept
@@ -429,6 +437,7 @@ Material = LudingMaterial
 PAIR_HISTORY = ("delta_max", "k1_last", "xi_x", "xi_y", "xi_z")
 WALL_HISTORY = PAIR_HISTORY
 PARTICLE_STATE = ("k1_factor",)  # k1(T, t)/k1 of each particle's material (eqs. 10-12)
+PAIR_CONSTANTS = ("delta_fluid", "inv_k2_delta_fluid")  # of the radii only (pair_constants)
 SPINS = True  # the tangential forces act at the contact point: torques
 SCHEMA_ROWS = (  # the scene keys of the material (dem.scene.schema): keys, type and unit, meaning
     (("k1", "k2", "kc"), "N/m, required", "loading, largest un/reloading and cohesion stiffness (cold limit), "
@@ -487,14 +496,16 @@ def time_steps(material: LudingMaterial, mass: np.ndarray, inertia: np.ndarray, 
 
 
 @njit(**IN_LOOP)
-def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params):
+def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params, const):
     """Force on particle i of the closed pair ``c`` = (i, j): ``(f_n, f_t0, f_t1, f_t2)`` (normal eqs. 3-13,
-    tangential eqs. 14-24) from the overlap ``delta`` (centre distance ``d``), the unit normal ``n`` (j to i), the relative surface velocity
-    ``vr`` and its normal part ``vn``; the pair's history is read from row ``c`` of ``hist_in`` and written to row
-    ``c`` of ``hist`` (``PAIR_HISTORY``). ``planar``: 2D disks in the x-z plane (no y terms)."""
+    tangential eqs. 14-24) from the overlap ``delta`` (centre distance ``d``), the unit normal ``n`` (j to i), the
+    relative surface velocity ``vr`` and its normal part ``vn``; the pair's history is read from row ``c`` of
+    ``hist_in`` and written to row ``c`` of ``hist`` (``PAIR_HISTORY``); ``const``, its :func:`pair_constants`.
+    ``planar``: 2D disks in the x-z plane (no y terms)."""
     k1c = 0.5 * (state[i, 0] + state[j, 0])
-    f_n, dmax, f_min_now, k2_now, kc_now, d0 = normal_force(delta, -vn, k1c, hist_in[c, 0], hist_in[c, 1],
-                                                          params[P_FLUID_OVERLAP] * 2.0 * ri * rj / (ri + rj), params)
+    delta_fluid, inv_c = const
+    f_n, dmax, f_min_now, k2_now, kc_now, d0 = normal_force_of(delta, -vn, k1c, hist_in[c, 0], hist_in[c, 1],
+                                                             delta_fluid, inv_c, params)
     n0, n1, n2 = n
     xi_y = 0.0 if planar else hist_in[c, 3]
     ft, xi, sliding, f_n = tangential_force((hist_in[c, 2], xi_y, hist_in[c, 4]), n,
@@ -504,6 +515,15 @@ def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, pl
     hist[c, 1] = k1c
     hist[c, 2], hist[c, 3], hist[c, 4] = xi
     return f_n, ft[0], ft[1], ft[2]
+
+
+@njit(**IN_LOOP)
+def pair_constants(ri, rj, params):
+    """The pair's ``delta_fluid`` (Sec. 3.1.3, :func:`pair_delta_fluid`) and ``1/(k2 delta_fluid)``
+    (``PAIR_CONSTANTS``): numbers of the radii alone, which the loops keep per pair while the radii stay (two
+    divisions fewer per contact and step)."""
+    delta_fluid = params[P_FLUID_OVERLAP] * 2.0 * ri * rj / (ri + rj)
+    return delta_fluid, 1.0 / (params[P_K2] * delta_fluid)
 
 
 @njit(**IN_LOOP)
@@ -560,9 +580,10 @@ def wall_reach(k, m, hist, rk, params):
 @njit(**JIT)
 def update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt):
     """Before the forces of a step: the temperatures ``T0 + T_rate elapsed`` (uniform: one value), the radii (eq. 9)
-    and the stiffness factors relaxed over the step (eqs. 10-12)."""
+    and the stiffness factors relaxed over the step (eqs. 10-12). Returns whether a radius changed."""
     T_melt, T_var, expansion = params[P_T_MELT], params[P_T_VAR], params[P_EXPANSION]
     n = T.shape[0]
+    changed = False
     if uniform:
         Tu = T0[0] + T_rate[0] * elapsed
         target = k1_factor(Tu, T_melt, T_var)
@@ -572,13 +593,18 @@ def update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform,
         new = relax_k1(old, target, dt, t0, cooling)  # the factors of a uniform temperature are all equal
         for k in range(n):
             T[k] = Tu
-            radius[k] = radius_ref[k] * scale
+            a = radius_ref[k] * scale
+            changed |= a != radius[k]
+            radius[k] = a
             state[k, 0] = new if state[k, 0] == old else relax_k1(state[k, 0], target, dt, t0, cooling)
     else:
         for k in range(n):
             T[k] = T0[k] + T_rate[k] * elapsed
-            radius[k] = radius_at(radius_ref[k], T[k], T_melt, expansion)
+            a = radius_at(radius_ref[k], T[k], T_melt, expansion)
+            changed |= a != radius[k]
+            radius[k] = a
             state[k, 0] = relax_k1(state[k, 0], k1_factor(T[k], T_melt, T_var), dt, t0, T_rate[k] < 0.0)
+    return changed
 
 
 @njit(**IN_LOOP)

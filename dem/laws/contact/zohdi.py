@@ -124,6 +124,7 @@ Material = ZohdiMaterial
 PAIR_HISTORY = ("bonded",)  # 1: the bond of eq. 19 acts (activated by an accepted step that reached E*)
 WALL_HISTORY = ()
 PARTICLE_STATE = ()
+PAIR_CONSTANTS = ()  # (pair_constants)
 SPINS = False  # the particles do not rotate (Sec. 2)
 SCHEMA_ROWS = (  # the scene keys of the material (dem.scene.schema): keys, type and unit, meaning
     (("K_p", "p_p", "K_p_lim"), "N/m², -, N/m²; required", "particle contact force K_p |E|^p_p A (eqs. 2-12), softened "
@@ -179,7 +180,7 @@ def lens_area(ri, rj, d):
 
 
 @njit(**IN_LOOP)
-def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params):
+def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params, const):
     """Force on particle i of the pair ``c`` = (i, j) at centre distance ``d``: the contact force on the lens area
     (eqs. 2-12) softened by the pair's mean temperature (Sec. 7), less the bond's pull where the pair is bonded
     (eq. 19, ``hist_in[c, 0]``), and the friction ``mu_d |F_con|`` against the relative velocity ``-vr`` (eqs. 5-6,
@@ -197,6 +198,12 @@ def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, pl
     scale = params[Z_MU] * f_con / math.sqrt(u0 * u0 + u1 * u1 + u2 * u2 + params[Z_V_SLIP] ** 2)
     hist[c, 0] = 1.0 if bond or strain >= params[Z_E_STAR] else 0.0
     return f_n, scale * u0, scale * u1, scale * u2
+
+
+@njit(**IN_LOOP)
+def pair_constants(ri, rj, params):
+    """No numbers of the radii alone are kept per pair (``PAIR_CONSTANTS`` is empty): two zeros."""
+    return 0.0, 0.0
 
 
 @njit(**IN_LOOP)
@@ -241,10 +248,11 @@ def wall_reach(k, m, hist, rk, params):
 
 @njit(**JIT)
 def update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt):
-    """The temperatures ``T0 + T_rate elapsed``; the radii do not change."""
+    """The temperatures ``T0 + T_rate elapsed``; the radii do not change (returns False)."""
     n = T.shape[0]
     for k in range(n):
         T[k] = T0[0] + T_rate[0] * elapsed if uniform else T0[k] + T_rate[k] * elapsed
+    return False
 
 
 @njit(**IN_LOOP)
