@@ -311,7 +311,7 @@ class CellFrame:
     """What the mesh of a cell is built from, before any meshing: the cell ``scaled`` to its largest radius
     ``unit``, the half period ``box``, the particle images that reach the computational cell with their bonds
     (``local``, :func:`local_cluster`), the bonds' necks ``geo`` and unit directions ``e``, the cell's
-    ``halfspaces`` (:func:`_domain`), which mirror ``diagonal``/``anti`` symmetry it uses, the ``fraction`` of the
+    ``halfspaces`` (``_domain``), which mirror ``diagonal``/``anti`` symmetry it uses, the ``fraction`` of the
     box it is and the exact ``solid_volume`` in it."""
 
     scaled: PeriodicCell
