@@ -691,8 +691,9 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
     check_cell(cell)
     explicit = order is not None
     order = order or default_order(rtol)
-    if order not in BYTES_PER_ELEMENT:
-        raise ValueError(f"order = {order!r}: must be one of {', '.join(map(str, BYTES_PER_ELEMENT))}")
+    if order not in FIRST_MESH:  # (solve_bounds takes p = 2 too; its first mesh is not measured)
+        raise ValueError(f"order = {order!r}: must be one of {', '.join(map(str, FIRST_MESH))} (the orders whose "
+                         f"first mesh is sized from measurements)")
     budget = available_memory() if max_memory is None else float(max_memory)
     t0 = time.perf_counter()
     neck = mean_neck_ratio(cell)

@@ -25,6 +25,12 @@ def _chain_reference(h_over_r):
     return pair_conductance(1.0, 1.0, h_over_r, kappa=1.0, rtol=1e-8).K * (2.0 - h_over_r) / 16.0
 
 
+@pytest.mark.parametrize("order", [1, 2, 5])
+def test_an_order_without_a_measured_first_mesh_is_refused_by_name(order):
+    with pytest.raises(ValueError, match=rf"order = {order}: must be one of 3, 4 \(the orders whose first mesh"):
+        lattice.effective_conductivity(_chain_cell(0.08), rtol=1e-3, order=order)
+
+
 @pytest.mark.parametrize("order", [2, 3])
 def test_chain_cell_bounds_bracket_the_axisymmetric_pair(order):
     # The chain's mirror cell is a quarter of a semisphere with its half neck: both bounds must bracket the
