@@ -24,7 +24,7 @@ from dem.laws.contact.luding import LUDING_TABLE1
 from verification.sinter_protocol import Times
 from verification import sintering_runs as sr
 from verification.report import md_table, save_figure
-from verification.sintering_causes import contact_cooling, cool_down, section as causes_section
+from verification.sintering_causes import box_area, contact_cooling, cool_down, section as causes_section
 from verification.sintering_statements import pct, statements, statements_table
 from verification.sintering_study import Missing, Study, at, bulk_coordination, read_csv
 
@@ -367,7 +367,7 @@ def _control_creep(st: Study, s_end: float) -> str:
     overlap = r[i] + r[j] - np.linalg.norm(x[i] - x[j], axis=1)
     creep = a["snap0_fn"] / (LUDING_TABLE1.k1 * s_end)
     start, end = at(s, task.times.t_heat), at(s, s["t"][-1])
-    area = [(row["q_right"] + row["q_left"]) * (row["q_top"] + row["q_bottom"]) for row in (start, end)]
+    area = [box_area(row) for row in (start, end)]
     return (f"In the first placement the pair contacts end with overlaps of "
             f"{', '.join(f'{1e6 * v:.1f}' for v in overlap)} µm where f/(k1 s) of their forces gives "
             f"{', '.join(f'{1e6 * v:.1f}' for v in creep)} µm, and the box loses {pct(1.0 - area[1] / area[0])} of its "

@@ -187,7 +187,7 @@ COOL_LABELS = {"": "protocol: walls follow p, δa_T = 1e-4 /K", "cool-no-expansi
                "expansion-text": "walls follow p, δa_T = 2.5e-4 /K through the whole protocol (Sec. 3.2's text)"}
 
 
-def _box_area(row: dict) -> float:
+def box_area(row: dict) -> float:
     """Area (m^2) of the box of Fig. 1 in one row of a time series (the right and top walls' offsets are -x, -z)."""
     return (row["q_right"] + row["q_left"]) * (row["q_top"] + row["q_bottom"])
 
@@ -198,7 +198,7 @@ def cool_down(s: dict, t_cool: float) -> dict:
     box), and the least and largest stress on the top wall in between (N/m). The material density M/(rho_p V)
     changes as the inverse of the box."""
     start, end = at(s, t_cool), at(s, s["t"][-1])
-    box = _box_area(end) / _box_area(start)
+    box = box_area(end) / box_area(start)
     during = s["t"] > start["t"]  # a stage's first row is its saved state's, with no wall load yet
     return {"nu_cool": float(start["volume_fraction"]), "nu_f": float(end["volume_fraction"]), "box": box - 1.0,
             "particles": box * end["volume_fraction"] / start["volume_fraction"] - 1.0,
