@@ -18,14 +18,14 @@ adhesive law holds a contact beyond touching until it breaks); the laws whose pa
 
 Latency: a pair's geometry (a square root, then divisions) and its law form one long chain of dependent
 operations, and the processor overlaps two pairs only as far as its window of instructions reaches. So the
-one-thread loop begins the next pair's geometry (:func:`pair_geometry`) before the law of this one: the same
+loop begins the next pair's geometry (:func:`pair_geometry`) before the law of this one: the same
 operations on the same numbers (the results do not change), but the next square root and divisions run while this
 pair's law is computed. (For an open pair that geometry is not needed: a few operations spent to keep the chain
 short for the closed ones, most of a dense packing's list.)
 
 Threads: in the copies of this module for more than one thread (:mod:`dem.engines.compiled`) ``THREADED`` is
 true and the loop runs on all of numba's threads in conflict-free passes: every pair's force and torque arms into a
-row of its own (``load``), then every particle sums the rows of its pairs (:func:`incident_pairs`) in the order of
+row of its own (``load``; the pairs in blocks of consecutive ones, a few per thread), then every particle sums the rows of its pairs (:func:`incident_pairs`) in the order of
 the list. That is the order in which the one-thread loop adds them into each particle, so the results are the same
 to the bit on any number of threads. The flag is a compile-time constant: the one-thread loop carries nothing of
 the threaded one.
@@ -36,7 +36,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import get_num_threads, njit, prange
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from dem.geometry.neighbours import min_image
@@ -49,6 +49,7 @@ from dem.laws.contact import luding as law
 FINITE_MATH = {"nnan", "ninf", "nsz"}
 N_PARAMS = law.N_PARAMS
 THREADED = False  # True in the copies for more than one thread (dem.engines.compiled)
+CHUNKS_PER_THREAD = 8  # the threaded pair loop's blocks of consecutive pairs per thread (for an even load)
 LOAD_COLUMNS = 9  # a pair's row of the threaded loop's buffer: g = f_n n + f_t (3), n x f_t (3), l_i, l_j, closed
 KEEPS_PAIR_CONSTANTS = len(law.PAIR_CONSTANTS) > 0  # the law's pair_constants are kept per pair, in (M, 2)
 
@@ -130,67 +131,69 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         tau[k, 1] = 0.0
         tau[k, 2] = 0.0
     n_pairs = pi.shape[0]
-    ahead = pair_geometry(0, x, pi, pj, box, planar) if n_pairs > 0 and not THREADED else (0.0, 0.0, 0.0, 0.0, 0.0)
-    for c in prange(n_pairs):
-        i, j = np.uint64(pi[c]), np.uint64(pj[c])  # unsigned: no wrap-around of negative indices
-        if THREADED:
-            d2, d, n0, n1, n2 = pair_geometry(c, x, pi, pj, box, planar)
-        else:  # the next pair's geometry is begun before this pair's law (module docstring)
+    n_blocks = min(CHUNKS_PER_THREAD * get_num_threads(), n_pairs) if THREADED else 1
+    for b in prange(n_blocks):  # one block on one thread; on more, blocks of consecutive pairs
+        first, stop = b * n_pairs // n_blocks, (b + 1) * n_pairs // n_blocks
+        ahead = (0.0, 0.0, 0.0, 0.0, 0.0)  # the next pair's geometry, begun before this pair's law (module docstring)
+        if first < stop:
+            ahead = pair_geometry(first, x, pi, pj, box, planar)
+        for c in range(first, stop):
+            i, j = np.uint64(pi[c]), np.uint64(pj[c])  # unsigned: no wrap-around of negative indices
             d2, d, n0, n1, n2 = ahead
-            if c + 1 < n_pairs:
+            if c + 1 < stop:
                 ahead = pair_geometry(c + 1, x, pi, pj, box, planar)
-        ri, rj = radius[i], radius[j]
-        if KEEPS_PAIR_CONSTANTS and not fresh:  # (read here, not by the law: an array passed to a kernel costs)
-            const = (p_const[c, 0], p_const[c, 1])
-        else:  # every listed pair's: it may close later
-            const = law.pair_constants(ri, rj, params)
-            if KEEPS_PAIR_CONSTANTS and p_const.shape[0]:
-                p_const[c, 0], p_const[c, 1] = const
-        cut = ri + rj + law.reach(c, p_hist_in, ri, rj, params)
-        if d2 >= cut * cut or d2 == 0.0:
-            law.forget_pair(c, p_hist_in, p_hist)  # the contact opened: it forgets its history
+            ri, rj = radius[i], radius[j]
+            if KEEPS_PAIR_CONSTANTS and not fresh:  # (read here, not by the law: an array passed to a kernel costs)
+                const = (p_const[c, 0], p_const[c, 1])
+            else:  # every listed pair's: it may close later
+                const = law.pair_constants(ri, rj, params)
+                if KEEPS_PAIR_CONSTANTS and p_const.shape[0]:
+                    p_const[c, 0], p_const[c, 1] = const
+            cut = ri + rj + law.reach(c, p_hist_in, ri, rj, params)
+            if d2 >= cut * cut or d2 == 0.0:
+                law.forget_pair(c, p_hist_in, p_hist)  # the contact opened: it forgets its history
+                if record:
+                    p_fn[c] = 0.0
+                    p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = 0.0, 0.0, 0.0
+                if THREADED:
+                    load[c, 8] = 0.0  # open: no load
+                continue
+            delta = ri + rj - d
+            li, lj = ri - 0.5 * delta, rj - 0.5 * delta  # lever arms to the middle of the overlap: li + lj = d
+            # v_ij = v_i - v_j + l_i n x w_i + l_j n x w_j  (Luding 2005, eq. 18)
+            c0 = 0.0 if planar else li * w[i, 0] + lj * w[j, 0]
+            c1 = li * w[i, 1] + lj * w[j, 1]
+            c2 = 0.0 if planar else li * w[i, 2] + lj * w[j, 2]
+            vr0 = v[i, 0] - v[j, 0] + n1 * c2 - n2 * c1
+            vr1 = 0.0 if planar else v[i, 1] - v[j, 1] + n2 * c0 - n0 * c2
+            vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
+            vn = vr0 * n0 + vr1 * n1 + vr2 * n2
+            f_n, ft0, ft1, ft2 = law.pair_force(c, i, j, p_hist_in, p_hist, state, T, delta, d, (n0, n1, n2),
+                                                (vr0, vr1, vr2), vn, ri, rj, planar, dt, params, const)
             if record:
-                p_fn[c] = 0.0
-                p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = 0.0, 0.0, 0.0
-            if THREADED:
-                load[c, 8] = 0.0  # open: no load
-            continue
-        delta = ri + rj - d
-        li, lj = ri - 0.5 * delta, rj - 0.5 * delta  # lever arms to the middle of the overlap: li + lj = d
-        # v_ij = v_i - v_j + l_i n x w_i + l_j n x w_j  (Luding 2005, eq. 18)
-        c0 = 0.0 if planar else li * w[i, 0] + lj * w[j, 0]
-        c1 = li * w[i, 1] + lj * w[j, 1]
-        c2 = 0.0 if planar else li * w[i, 2] + lj * w[j, 2]
-        vr0 = v[i, 0] - v[j, 0] + n1 * c2 - n2 * c1
-        vr1 = 0.0 if planar else v[i, 1] - v[j, 1] + n2 * c0 - n0 * c2
-        vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
-        vn = vr0 * n0 + vr1 * n1 + vr2 * n2
-        f_n, ft0, ft1, ft2 = law.pair_force(c, i, j, p_hist_in, p_hist, state, T, delta, d, (n0, n1, n2),
-                                            (vr0, vr1, vr2), vn, ri, rj, planar, dt, params, const)
-        if record:
-            p_fn[c] = f_n
-            p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
-        g0, g1, g2 = f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2
-        # torques -l n x f_t on both (the lever arms -l_i n and +l_j n, the forces f_t and -f_t)
-        m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
-        if THREADED:  # into the pair's row; its particles add it below
-            load[c, 0], load[c, 1], load[c, 2], load[c, 3], load[c, 4], load[c, 5] = g0, g1, g2, m0, m1, m2
-            load[c, 6], load[c, 7], load[c, 8] = li, lj, 1.0
-            continue
-        f[i, 0] += g0
-        f[i, 1] += g1
-        f[i, 2] += g2
-        f[j, 0] -= g0
-        f[j, 1] -= g1
-        f[j, 2] -= g2
-        if law.SPINS:
-            tau[i, 1] -= li * m1
-            tau[j, 1] -= lj * m1
-            if not planar:
-                tau[i, 0] -= li * m0
-                tau[i, 2] -= li * m2
-                tau[j, 0] -= lj * m0
-                tau[j, 2] -= lj * m2
+                p_fn[c] = f_n
+                p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
+            g0, g1, g2 = f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2
+            # torques -l n x f_t on both (the lever arms -l_i n and +l_j n, the forces f_t and -f_t)
+            m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
+            if THREADED:  # into the pair's row; its particles add it below
+                load[c, 0], load[c, 1], load[c, 2], load[c, 3], load[c, 4], load[c, 5] = g0, g1, g2, m0, m1, m2
+                load[c, 6], load[c, 7], load[c, 8] = li, lj, 1.0
+                continue
+            f[i, 0] += g0
+            f[i, 1] += g1
+            f[i, 2] += g2
+            f[j, 0] -= g0
+            f[j, 1] -= g1
+            f[j, 2] -= g2
+            if law.SPINS:
+                tau[i, 1] -= li * m1
+                tau[j, 1] -= lj * m1
+                if not planar:
+                    tau[i, 0] -= li * m0
+                    tau[i, 2] -= li * m2
+                    tau[j, 0] -= lj * m0
+                    tau[j, 2] -= lj * m2
     if THREADED:
         for k in prange(n):  # each particle its pairs' rows, in the order of the list (as the loop above adds them)
             for e in range(start[k], start[k + 1]):
