@@ -419,7 +419,7 @@ def discussion(st: Study) -> str:
             text += (f" The placements differ at the walls, not inside: more than {1e3 * INTERIOR_MARGIN:g} mm "
                      f"(the largest diameter) from every wall their solid fraction is "
                      f"{', '.join(f'{v:.3f}' for v in inner)}.")
-        except Missing:
+        except (Missing, ValueError):  # ValueError: a box smaller than two margins
             pass
         return text
 
@@ -474,6 +474,8 @@ def discussion(st: Study) -> str:
         try:
             ratio = {t: st.three(100.0, seeds=(1,), t_s=t)[0] / st.three(10.0, seeds=(1,), t_s=t)[0]
                      for t in st.grid.t_s if t >= 0.01}
+            if not ratio:
+                raise Missing("three-particle controls sintered for 0.01 s or longer")
             short = min(ratio)
             text += (f" The law's creep f/(k1 s) is proportional to the contact force: the first placement densifies "
                      f"{' and '.join(f'{r:.1f}' for r in ratio.values())} times more at p = 100 than at p = 10 "

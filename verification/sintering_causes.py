@@ -161,9 +161,13 @@ def preparation_table(st: Study) -> tuple[str, dict]:
                 try:
                     nu = st.res(sr.PREPARE, n, p, seed=seed, variant=variant)["volume_fraction"]
                     half = at(st.series(task), 0.5 * task.times.t_heat)["volume_fraction"]
-                    inner = interior_fraction(st.state(task))
+                    saved = st.state(task)
                 except Missing:
                     continue
+                try:
+                    inner = interior_fraction(saved)
+                except ValueError:  # a box smaller than two margins: no interior
+                    inner = math.nan
                 try:
                     _, jump, end, dens = _densification(st, n, p, variant, seed)
                     cells = [f"{jump:+.4f}", f"{end:.4f}", pct(dens)]
@@ -171,7 +175,8 @@ def preparation_table(st: Study) -> tuple[str, dict]:
                 except Missing:
                     cells = ["—", "—", "—"]
                     summary[key] = {"nu_heat": nu, "nu_interior": inner}
-                rows.append([n, f"{p:g}", label, f"{half:.4f}", f"{nu:.4f}", f"{inner:.4f}"] + cells)
+                rows.append([n, f"{p:g}", label, f"{half:.4f}", f"{nu:.4f}",
+                             "—" if math.isnan(inner) else f"{inner:.4f}"] + cells)
     if not rows:
         raise Missing("preparation runs")
     return md_table(["N", "p (N/m)", "preparation", "ν(t_heat / 2)", "ν(t_heat)",
