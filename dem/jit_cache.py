@@ -9,8 +9,10 @@ constants can reach compiled code: the modules that import numba and, transitive
 import (:func:`compiled_sources`, found by reading the import statements, not listed by hand). Any edit to any of them
 starts a fresh cache; an unchanged installation reuses its compiled kernels across runs.
 
-:func:`configure` sets ``NUMBA_CACHE_DIR`` before numba is first imported (``import dem`` calls it); a cache folder
-the user chose (``NUMBA_CACHE_DIR`` set already) is left alone.
+:func:`configure` (``import dem`` calls it) points numba there, whether or not numba is imported already (numba
+reads the folder when a function is decorated, and every kernel of this package is decorated after the call;
+without it, a script that imports numba before ``dem`` would run kernels compiled from older sources). A folder the
+user chose with ``NUMBA_CACHE_DIR`` stays the root: the digest's folder is made inside it.
 """
 
 from __future__ import annotations
@@ -148,17 +150,25 @@ def remembered_digest(package: pathlib.Path = PACKAGE) -> str:
 
 
 def configure() -> None:
-    """Point numba's cache at ``__pycache__/numba-<digest>`` of this package (or of the temp folder when the
-    package is read-only), unless the user set ``NUMBA_CACHE_DIR`` or numba is imported already."""
-    if "NUMBA_CACHE_DIR" in os.environ or "numba" in sys.modules:
-        return
+    """Point numba's cache at ``numba-<digest>``: in ``__pycache__`` of this package (of the temp folder when the
+    package is read-only), or inside the folder the user set in ``NUMBA_CACHE_DIR`` (module docstring)."""
     key = remembered_digest()
-    folder = PACKAGE / "__pycache__" / f"numba-{key}"
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        probe = folder / ".writable"
-        probe.touch()
-    except OSError:
-        folder = pathlib.Path(tempfile.gettempdir()) / "sinterheat-numba" / key
-        folder.mkdir(parents=True, exist_ok=True)
+    name = f"numba-{key}"
+    chosen = os.environ.get("NUMBA_CACHE_DIR")
+    if chosen and pathlib.Path(chosen).name == name:  # set by this function already (a parent process)
+        folder = pathlib.Path(chosen)
+    elif chosen:
+        folder = pathlib.Path(chosen) / name
+    else:
+        folder = PACKAGE / "__pycache__" / name
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            probe = folder / ".writable"
+            probe.touch()
+        except OSError:
+            folder = pathlib.Path(tempfile.gettempdir()) / "sinterheat-numba" / key
+    folder.mkdir(parents=True, exist_ok=True)
     os.environ["NUMBA_CACHE_DIR"] = str(folder)
+    if "numba" in sys.modules:  # imported before this package: its configuration has read the environment already
+        from numba.core import config
+        config.CACHE_DIR = str(folder)

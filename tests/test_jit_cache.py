@@ -86,11 +86,19 @@ def test_the_remembered_key_follows_an_edit(copy):
     assert jit_cache.remembered_digest(copy) == jit_cache.digest(copy) != first
 
 
-def test_import_sets_the_cache_folder_unless_the_user_did():
-    code = "import os, dem; print(os.environ['NUMBA_CACHE_DIR'])"
+def test_import_points_numba_at_the_digests_folder(tmp_path):
+    """Also where numba was imported first (numba's own cache, keyed by each file alone, would otherwise serve
+    kernels compiled from older sources of the modules they call), and inside a folder the user chose."""
+    folder = f"numba-{jit_cache.digest()}"
+    code = "import os, numba, dem; from numba.core import config; print(os.environ['NUMBA_CACHE_DIR'], config.CACHE_DIR)"
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    for first in ("import dem, numba", "import numba, dem"):
+        out = subprocess.run([sys.executable, "-c", code.replace("import os, numba, dem", f"import os; {first}")],
+                             capture_output=True, text=True, env=env, check=True).stdout.split()
+        assert [pathlib.Path(o).name for o in out] == [folder, folder], first
+    env["NUMBA_CACHE_DIR"] = str(tmp_path)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
-    assert jit_cache.digest() in out
-    env["NUMBA_CACHE_DIR"] = "/tmp/mine"
+    assert out.split() == [str(tmp_path / folder)] * 2
+    env["NUMBA_CACHE_DIR"] = str(tmp_path / folder)  # a child process of a configured one: the same folder
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
-    assert out.strip() == "/tmp/mine"
+    assert out.split() == [str(tmp_path / folder)] * 2

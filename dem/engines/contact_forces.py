@@ -16,6 +16,13 @@ than the law's ``reach``, a particle-wall pair while closer than its ``wall_reac
 adhesive law holds a contact beyond touching until it breaks); the laws whose particles do not rotate
 (``law.SPINS`` false) get no torques.
 
+Latency: a pair's geometry (a square root, then divisions) and its law form one long chain of dependent
+operations, and the processor overlaps two pairs only as far as its window of instructions reaches. So the
+one-thread loop begins the next pair's geometry (:func:`pair_geometry`) before the law of this one: the same
+operations on the same numbers (the results do not change), but the next square root and divisions run while this
+pair's law is computed. (For an open pair that geometry is not needed: a few operations spent to keep the chain
+short for the closed ones, most of a dense packing's list.)
+
 Threads: in the copies of this module for more than one thread (:mod:`dem.engines.compiled`) ``THREADED`` is
 true and the loop runs on all of numba's threads in conflict-free passes: every pair's force and torque arms into a
 row of its own (``load``), then every particle sums the rows of its pairs (:func:`incident_pairs`) in the order of
@@ -66,6 +73,20 @@ def incident_pairs(pi, pj, n):
     return start, pairs
 
 
+@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="always")
+def pair_geometry(c, x, pi, pj, box, planar):
+    """The listed pair ``c`` = (i, j): ``(d2, d, n0, n1, n2)``, the squared distance of the centres (minimum image),
+    the distance and the unit normal from j to i (0 where the centres coincide)."""
+    i, j = np.uint64(pi[c]), np.uint64(pj[c])
+    dx = min_image(x[i, 0] - x[j, 0], box[0])
+    dy = 0.0 if planar else min_image(x[i, 1] - x[j, 1], box[1])
+    dz = min_image(x[i, 2] - x[j, 2], box[2])
+    d2 = dx * dx + dy * dy + dz * dz
+    d = math.sqrt(d2)
+    q = d if d2 > 0.0 else 1.0
+    return d2, d, dx / q, dy / q, dz / q
+
+
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, parallel=THREADED)
 def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft,
            p_const, fresh, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True,
@@ -108,11 +129,16 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         tau[k, 0] = 0.0
         tau[k, 1] = 0.0
         tau[k, 2] = 0.0
-    for c in prange(pi.shape[0]):
+    n_pairs = pi.shape[0]
+    ahead = pair_geometry(0, x, pi, pj, box, planar) if n_pairs > 0 and not THREADED else (0.0, 0.0, 0.0, 0.0, 0.0)
+    for c in prange(n_pairs):
         i, j = np.uint64(pi[c]), np.uint64(pj[c])  # unsigned: no wrap-around of negative indices
-        dx = min_image(x[i, 0] - x[j, 0], box[0])
-        dy = 0.0 if planar else min_image(x[i, 1] - x[j, 1], box[1])
-        dz = min_image(x[i, 2] - x[j, 2], box[2])
+        if THREADED:
+            d2, d, n0, n1, n2 = pair_geometry(c, x, pi, pj, box, planar)
+        else:  # the next pair's geometry is begun before this pair's law (module docstring)
+            d2, d, n0, n1, n2 = ahead
+            if c + 1 < n_pairs:
+                ahead = pair_geometry(c + 1, x, pi, pj, box, planar)
         ri, rj = radius[i], radius[j]
         if KEEPS_PAIR_CONSTANTS and not fresh:  # (read here, not by the law: an array passed to a kernel costs)
             const = (p_const[c, 0], p_const[c, 1])
@@ -120,7 +146,6 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
             const = law.pair_constants(ri, rj, params)
             if KEEPS_PAIR_CONSTANTS and p_const.shape[0]:
                 p_const[c, 0], p_const[c, 1] = const
-        d2 = dx * dx + dy * dy + dz * dz
         cut = ri + rj + law.reach(c, p_hist_in, ri, rj, params)
         if d2 >= cut * cut or d2 == 0.0:
             law.forget_pair(c, p_hist_in, p_hist)  # the contact opened: it forgets its history
@@ -130,8 +155,6 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
             if THREADED:
                 load[c, 8] = 0.0  # open: no load
             continue
-        d = math.sqrt(d2)
-        n0, n1, n2 = dx / d, dy / d, dz / d
         delta = ri + rj - d
         li, lj = ri - 0.5 * delta, rj - 0.5 * delta  # lever arms to the middle of the overlap: li + lj = d
         # v_ij = v_i - v_j + l_i n x w_i + l_j n x w_j  (Luding 2005, eq. 18)
