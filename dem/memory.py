@@ -15,6 +15,7 @@ import pathlib
 
 BYTES_PER_PARTICLE = 1.5e3
 BASE_BYTES = 0.2e9  # the interpreter, numpy, scipy and the compiled kernels
+SMALL_BYTES = 64e6  # a run whose particles need less than this is never refused: the machine is not asked
 
 
 def available_bytes() -> float | None:
@@ -45,6 +46,8 @@ def available_bytes() -> float | None:
 def check(n: int, name: str) -> None:
     """Refuse ``n`` particles (named ``name`` in the message, e.g. ``"[generator] n"``) when a run of them would need
     more memory than is available (module docstring)."""
+    if BYTES_PER_PARTICLE * n < SMALL_BYTES:  # (the interpreter that asks holds its base already)
+        return
     need = BASE_BYTES + BYTES_PER_PARTICLE * n
     have = available_bytes()
     if have is not None and need > have:

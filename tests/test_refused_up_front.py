@@ -1,6 +1,7 @@
 """Inputs refused before they cost: the ``box`` generator asked for more particles than fit, a run larger than the
 machine's memory, a particle that starts behind a wall -- one line, exit code 2, no traceback, no large allocation."""
 
+import math
 import pathlib
 import re
 import tracemalloc
@@ -98,6 +99,16 @@ def test_generated_run_beyond_the_machines_memory_is_refused(monkeypatch):
     assert "[generator] n: a run of 2000000 particles needs about 2.98 GiB" in str(error)
     assert f"0.931 GiB are available on this machine: use at most about {limit} particles" in str(error)
     assert peak < 1e6
+
+
+def test_a_small_run_does_not_ask_the_machine(monkeypatch):
+    def asked():
+        raise AssertionError("available_bytes read")
+    monkeypatch.setattr(memory, "available_bytes", asked)
+    first_asked = math.ceil(memory.SMALL_BYTES / memory.BYTES_PER_PARTICLE)
+    memory.check(first_asked - 1, "particles")  # not refused, /proc/meminfo not read
+    with pytest.raises(AssertionError, match="available_bytes read"):
+        memory.check(first_asked, "particles")
 
 
 @pytest.mark.parametrize("n", [50_000, 2_000_000])
