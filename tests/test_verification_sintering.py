@@ -97,12 +97,16 @@ def test_isolating_variants_start_where_they_should():
     for grid in (sr.QUICK, sr.FULL):
         tasks = grid.isolating_tasks()
         assert tasks and len(set(tasks)) == len(tasks) and all(t.variant in sr.VARIANTS or t.seed in sr.PREP_SEEDS
-                                                                for t in tasks)
+                                                                or t.n == 3 for t in tasks)
     assert TINY.isolating_tasks() == []
     quick, full = set(sr.QUICK.isolating_tasks()), set(sr.FULL.isolating_tasks())
-    assert {t.kind for t in quick} == {sr.PREPARE} and quick < full  # --quick: the cheap preparations alone
+    assert {t.kind for t in quick} == {sr.PREPARE, sr.SCHEDULE} and quick < full  # --quick: the cheap ones alone
+    assert all(t.n == 3 for t in quick if t.kind == sr.SCHEDULE)
     assert sr.Task(sr.COOL, 300, 100.0, 1.0, variant="held") in full
     assert sr.Task(sr.SCHEDULE, 3, 100.0, 1.0, 1, "walls-sinter") in full
+    for grid in (sr.QUICK, sr.FULL):  # the densification statements read every placement of N max
+        assert {sr.Task(sr.COOL, max(grid.n), p, max(grid.t_s), seed) for p in grid.p for seed in sr.PLACEMENTS} \
+            <= set(sr.with_parents(grid.tasks()))
 
 
 def test_scene_docs_of_the_variants(tmp_path, monkeypatch):
@@ -118,6 +122,10 @@ def test_scene_docs_of_the_variants(tmp_path, monkeypatch):
     control = sr.scene_doc(sr.Task(sr.SCHEDULE, 3, 100.0, 1.0, 1, "walls-sinter"), tmp_path)
     assert control["contact"]["wall_sintering"] is True and control["temperature"]["time"][1] == 0.5
     assert control["phases"][0] == {"start": 0.0, "mu": 0.5, "mu_wall": 0.0}
+    assert max(control["temperature"]["value"]) == 140.0
+    cold = sr.scene_doc(sr.Task(sr.SCHEDULE, 3, 10.0, 1.0, 1, "no-heating"), tmp_path)
+    assert set(cold["temperature"]["value"]) == {80.0}  # kept at the preparation's temperature
+    assert cold["temperature"]["time"] == control["temperature"]["time"]  # on the same schedule otherwise
     monkeypatch.setattr(sp.state_file, "load", lambda path: {"t": 1.3})  # a sintered state's clock
     held = sp.cooling_doc("s.npz", 100.0, walls_held=True)
     assert all("motion" not in w for w in held["walls"]) and len(held["walls"]) == 4
@@ -136,6 +144,38 @@ def test_the_density_statements_read_the_material_density():
     assert not after_sintering.holds and after_sintering.ours.startswith("0.9042 ")
     assert after_cooling.holds and after_cooling.ours == "0.9300"
     assert rise.holds and rise.ours.startswith("+0.0258 ")
+
+
+def test_the_densification_statements_read_the_mean_over_the_placements():
+    """One sample of N = 100 at p = 10 densifies by 3-8 % with its wall layer: the statement reads the mean of the
+    placements, and says each."""
+    grid = sr.Grid(n=(100,), p=(10.0, 100.0), t_s=(1.0,), three_seeds=(1,), no_expansion=False, n3d=12)
+    nu = {10.0: ([0.76, 0.78, 0.78], [0.82, 0.82, 0.80]), 100.0: ([0.775, 0.776, 0.774], [0.898, 0.899, 0.900])}
+    results = {}
+    for p, (start, end) in nu.items():
+        for seed, a, b in zip(sr.PLACEMENTS, start, end):
+            results[sr.Task(sr.PREPARE, 100, p, seed=seed)] = {"volume_fraction": a}
+            results[sr.Task(sr.COOL, 100, p, 1.0, seed)] = {"volume_fraction": b}
+    st = Y.Study(pathlib.Path("nowhere"), grid, results)
+    assert st.densification(10.0) == pytest.approx([0.82 / 0.76 - 1, 0.82 / 0.78 - 1, 0.80 / 0.78 - 1], rel=1e-12)
+    low, high = T._densification(st)
+    mean = np.mean([0.82 / 0.76, 0.82 / 0.78, 0.80 / 0.78]) - 1.0  # 5.3 %: holds, where the first alone (7.9 %) fails
+    assert low.holds and low.ours.startswith(f"{100 * mean:.2f} % (mean of the placements 7.89 %, 5.13 %, 2.56 %")
+    assert high.holds
+    del results[sr.Task(sr.COOL, 100, 10.0, 1.0, 3)]
+    with pytest.raises(Y.Missing):  # a placement missing: no statement from the others
+        T._densification(Y.Study(pathlib.Path("nowhere"), grid, results))
+
+
+def test_the_interior_fraction_leaves_the_wall_layer_out():
+    """A disk of radius 1 mm in the middle of a 10 mm box: pi r^2 over the 4 mm x 4 mm interior 3 mm from the walls;
+    one touching a wall adds nothing; a margin that leaves no interior is refused by name."""
+    saved = {"x": np.array([[5e-3, 0.0, 5e-3], [1e-3, 0.0, 5e-3]]), "radius": np.array([1e-3, 1e-3]),
+             "wall_names": ["left", "bottom", "right", "top"], "wall_q": np.array([0.0, 0.0, -10e-3, -10e-3])}
+    assert cooling.interior_fraction(saved, 3e-3, spacing=1e-5) == pytest.approx(np.pi * 1e-6 / 16e-6, rel=2e-3)
+    assert cooling.interior_fraction(saved, 0.0, spacing=1e-5) == pytest.approx(2 * np.pi * 1e-6 / 1e-4, rel=2e-3)
+    with pytest.raises(ValueError, match="margin = 0.006"):
+        cooling.interior_fraction(saved, 6e-3)
 
 
 def test_the_cool_down_splits_into_the_box_and_the_particles_area():

@@ -24,7 +24,8 @@ from dem.laws.contact.luding import LUDING_TABLE1
 from verification.sinter_protocol import Times
 from verification import sintering_runs as sr
 from verification.report import md_table, save_figure
-from verification.sintering_causes import box_area, contact_cooling, cool_down, section as causes_section
+from verification.sintering_causes import (INTERIOR_MARGIN, box_area, contact_cooling, cool_down, interior_fraction,
+                                           section as causes_section)
 from verification.sintering_statements import pct, statements, statements_table
 from verification.sintering_study import Missing, Study, at, bulk_coordination, read_csv
 
@@ -389,7 +390,7 @@ def discussion(st: Study) -> str:
 
     def densification():
         prep = {p: st.res(sr.PREPARE, n, p)["volume_fraction"] for p in (10.0, 100.0)}
-        dens = {p: st.res(sr.COOL, n, p, st.t_max)["volume_fraction"] / prep[p] - 1.0 for p in (10.0, 100.0)}
+        dens = {p: st.densification(p) for p in (10.0, 100.0)}
         s = st.series(st.task(sr.SINTER, n, 10.0, st.t_max))
         jump = at(s, 0.01)["volume_fraction"] - s["volume_fraction"][0]
         text = (f"*Densification and the preparation.* The paper's text prepares with frictionless particles, yet "
@@ -397,8 +398,8 @@ def discussion(st: Study) -> str:
                 f"and sintering densifies by 5 % (p = 10) and 16 % (p = 100). With Table 1's μ = 0.5 on particles and "
                 f"walls while preparing (the protocol; the paper gives the preparation's wall friction no value) "
                 f"ν(t_heat) = {prep[10.0]:.3f} and {prep[100.0]:.3f} (N = {n}), releasing the wall friction adds "
-                f"{jump:+.4f} within 10 ms (p = 10), and the densification is {pct(dens[10.0])} and "
-                f"{pct(dens[100.0])}.")
+                f"{jump:+.4f} within 10 ms (p = 10), and the densification is {pct(dens[10.0][0])} and "
+                f"{pct(dens[100.0][0])}.")
         try:
             fr = st.res(sr.PREPARE, n, 10.0, variant="frictionless")["volume_fraction"]
             fd = st.res(sr.COOL, n, 10.0, st.t_max, variant="frictionless")["volume_fraction"] / fr - 1.0
@@ -407,13 +408,18 @@ def discussion(st: Study) -> str:
                      f"frictionless preparation, for N = 300 too).")
         except Missing:
             pass
+        other = [st.res(sr.PREPARE, n, 10.0, seed=seed)["volume_fraction"] for seed in sr.PREP_SEEDS]
+        text += (f" One sample of N = {n} is a noisy measure: the same preparation from other random placements "
+                 f"ends at ν(t_heat) = {', '.join(f'{v:.3f}' for v in other)} (p = 10, seeds "
+                 f"{', '.join(str(seed) for seed in sr.PREP_SEEDS)}) against {prep[10.0]:.3f} and densifies by "
+                 f"{', '.join(pct(v) for v in dens[10.0][1:])}, while at p = 100 the three densify alike "
+                 f"({', '.join(pct(v) for v in dens[100.0])}); the statements read the mean over the placements.")
         try:
-            other = [st.res(sr.PREPARE, n, 10.0, seed=seed)["volume_fraction"] for seed in sr.PREP_SEEDS]
-            text += (f" One sample of N = {n} is a noisy measure: the same preparation from other random placements "
-                     f"ends at ν(t_heat) = {', '.join(f'{v:.3f}' for v in other)} (p = 10, seeds "
-                     f"{', '.join(str(seed) for seed in sr.PREP_SEEDS)}) against {prep[10.0]:.3f}, and the "
-                     f"densification ν(t_f)/ν(t_heat) − 1 moves with the start; the paper's Fig. 9 is of N = 300.")
-        except Missing:
+            inner = [interior_fraction(st.state(st.task(sr.PREPARE, n, 10.0, seed=seed))) for seed in sr.PLACEMENTS]
+            text += (f" The placements differ at the walls, not inside: more than {1e3 * INTERIOR_MARGIN:g} mm "
+                     f"(the largest diameter) from every wall their solid fraction is "
+                     f"{', '.join(f'{v:.3f}' for v in inner)}.")
+        except (Missing, ValueError):  # ValueError: a box smaller than two margins
             pass
         return text
 
@@ -463,6 +469,20 @@ def discussion(st: Study) -> str:
             w = {p: st.three(p, "walls-sinter", st.grid.three_seeds[:1]) for p in (10.0, 100.0)}
             text += (f" With walls that sinter like pairs the same placement densifies by {pct(w[10.0][0])} and "
                      f"{pct(w[100.0][0])}: the box then shrinks at its wall contacts as much as between the disks.")
+        except Missing:
+            pass
+        try:
+            ratio = {t: st.three(100.0, seeds=(1,), t_s=t)[0] / st.three(10.0, seeds=(1,), t_s=t)[0]
+                     for t in st.grid.t_s if t >= 0.01}
+            if not ratio:
+                raise Missing("three-particle controls sintered for 0.01 s or longer")
+            short = min(ratio)
+            text += (f" The law's creep f/(k1 s) is proportional to the contact force: the first placement densifies "
+                     f"{' and '.join(f'{r:.1f}' for r in ratio.values())} times more at p = 100 than at p = 10 "
+                     f"(t_s = {' and '.join(f'{t:g}' for t in ratio)} s), where the paper's two estimates differ by "
+                     f"a factor of 40; sintered for t_s = {short:g} s instead, p = 10 gives "
+                     f"{pct(st.three(10.0, seeds=(1,), t_s=short)[0])} but p = 100 only "
+                     f"{pct(st.three(100.0, seeds=(1,), t_s=short)[0])}: no sintering time gives both.")
         except Missing:
             pass
         return text + (f" At p = 10 the law itself creeps a loaded contact to f/(k1 s), s = k1(140 °C, t_s)/k1 = "

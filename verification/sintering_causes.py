@@ -25,7 +25,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from dem.laws.contact.luding import LUDING_TABLE1
-from verification.sinter_protocol import T0_SINTER, T_PREPARE, T_SINTER
+from verification.sinter_protocol import MEAN_RADIUS, RADIUS_SPREAD, T0_SINTER, T_PREPARE, T_SINTER
 from verification import sintering_runs as sr
 from verification.report import md_table
 from verification.sintering_statements import pct
@@ -108,6 +108,26 @@ def contact_cooling(force: float, material=LUDING_TABLE1, radius: float = 1.0e-3
 
 
 # ------------------------------------------------------------------------------------------------ the tables
+INTERIOR_MARGIN = 2.0 * MEAN_RADIUS * (1.0 + RADIUS_SPREAD)  # m: the largest diameter of Table 1's disks
+
+
+def interior_fraction(saved: dict, margin: float = INTERIOR_MARGIN, spacing: float = 2.0e-5) -> float:
+    """Solid fraction of a saved 2D state (:func:`dem.scene.state_file.load`) of the box of Fig. 1 in its interior,
+    the part more than ``margin`` (m) from every wall: the share of the points of a square grid of ``spacing`` (m)
+    there that lie inside a disk (the wall layer, where a wall orders or props the particles, left out)."""
+    names, q = list(saved["wall_names"]), saved["wall_q"]
+    lo = np.array([q[names.index("left")], q[names.index("bottom")]]) + margin  # q = n . point: -x, -z for right, top
+    hi = -np.array([q[names.index("right")], q[names.index("top")]]) - margin
+    if np.any(hi - lo < spacing):
+        raise ValueError(f"margin = {margin!r}: leaves no interior in a box of {hi - lo + 2 * margin} m")
+    xs, zs = (np.arange(a + 0.5 * spacing, b, spacing) for a, b in zip(lo, hi))
+    inside = np.zeros((len(xs), len(zs)), dtype=bool)
+    for (cx, cz), r in zip(saved["x"][:, [0, 2]], saved["radius"]):
+        ix = slice(np.searchsorted(xs, cx - r), np.searchsorted(xs, cx + r))
+        iz = slice(np.searchsorted(zs, cz - r), np.searchsorted(zs, cz + r))
+        inside[ix, iz] |= (xs[ix, None] - cx) ** 2 + (zs[None, iz] - cz) ** 2 < r * r
+    return float(np.mean(inside))
+
 
 
 def _densification(st: Study, n, p, variant="", seed=1) -> tuple[float, float, float, float]:
@@ -122,12 +142,14 @@ PREP_LABELS = {"": "protocol: friction μ = 0.5 on particles and walls", "fricti
                "text)", "frictionless-fast": "frictionless, speeds 1 m/s", "frictionless-slow": "frictionless, "
                "walls 10× slower (γ_w = 2 kg/s)", "frictionless-cohesive": "frictionless with cohesion (no "
                "brittle sliding)", "frictionless-wall-friction": "frictionless particles, walls μ_w = 0.5",
-               "no-wall-friction": "particles μ = 0.5, walls frictionless"}
+               "no-wall-friction": "particles μ = 0.5, walls frictionless", "slow": "protocol, walls 10× slower "
+               "(γ_w = 2 kg/s)"}
 
 
 def preparation_table(st: Study) -> tuple[str, dict]:
     """ν(t_heat) of every preparation run (the protocol's other placements, :data:`sintering_runs.PREP_SEEDS`,
-    as rows of their own), and the densification of those sintered for the longest t_s and cooled."""
+    as rows of their own), ν half way through it (has it settled?), ν of its interior (:func:`interior_fraction`),
+    and the densification of those sintered for the longest t_s and cooled."""
     rows, summary = [], {}
     runs = [(variant, label, 1) for variant, label in PREP_LABELS.items()]
     runs += [("", f"protocol, placement (seed) {seed}", seed) for seed in sr.PREP_SEEDS]
@@ -135,29 +157,41 @@ def preparation_table(st: Study) -> tuple[str, dict]:
         for p in st.grid.p:
             for variant, label, seed in runs:
                 key = f"n{n}-p{p:g}-{variant or 'protocol'}" + (f"-seed{seed}" if seed != 1 else "")
+                task = st.task(sr.PREPARE, n, p, seed=seed, variant=variant)
                 try:
                     nu = st.res(sr.PREPARE, n, p, seed=seed, variant=variant)["volume_fraction"]
+                    half = at(st.series(task), 0.5 * task.times.t_heat)["volume_fraction"]
+                    saved = st.state(task)
                 except Missing:
                     continue
                 try:
+                    inner = interior_fraction(saved)
+                except ValueError:  # a box smaller than two margins: no interior
+                    inner = math.nan
+                try:
                     _, jump, end, dens = _densification(st, n, p, variant, seed)
                     cells = [f"{jump:+.4f}", f"{end:.4f}", pct(dens)]
-                    summary[key] = {"nu_heat": nu, "nu_f": end, "densification": dens}
+                    summary[key] = {"nu_heat": nu, "nu_interior": inner, "nu_f": end, "densification": dens}
                 except Missing:
                     cells = ["—", "—", "—"]
-                    summary[key] = {"nu_heat": nu}
-                rows.append([n, f"{p:g}", label, f"{nu:.4f}"] + cells)
+                    summary[key] = {"nu_heat": nu, "nu_interior": inner}
+                rows.append([n, f"{p:g}", label, f"{half:.4f}", f"{nu:.4f}",
+                             "—" if math.isnan(inner) else f"{inner:.4f}"] + cells)
     if not rows:
         raise Missing("preparation runs")
-    return md_table(["N", "p (N/m)", "preparation", "ν(t_heat)", "ν in the first 10 ms after t_heat",
-                     f"ν(t_f), t_s = {st.t_max:g}", "densification"], rows), summary
+    return md_table(["N", "p (N/m)", "preparation", "ν(t_heat / 2)", "ν(t_heat)",
+                     f"ν(t_heat) more than {1e3 * INTERIOR_MARGIN:g} mm from every wall",
+                     "ν in the first 10 ms after t_heat", f"ν(t_f), t_s = {st.t_max:g}", "densification"],
+                    rows), summary
 
 
 def three_table(st: Study) -> tuple[str, dict]:
     rows, summary = [], {}
     labels = {"": "protocol: walls keep the cold law, no wall friction while preparing, t_heat = 0.5 s",
               "walls-sinter": "walls sinter like pairs", "short-prep": "prepared for 0.2 s only",
-              "control-wall-friction": "wall friction μ_w = 0.5 while preparing (as the large samples)"}
+              "control-wall-friction": "wall friction μ_w = 0.5 while preparing (as the large samples)",
+              "no-heating": "kept at 80 °C throughout (the drift of the prepared disks)",
+              "no-expansion": "δa_T = 0 (no thermal expansion, eq. 9)"}
     for p in st.grid.p:
         for variant, label in labels.items():
             got = []
@@ -180,6 +214,39 @@ def three_table(st: Study) -> tuple[str, dict]:
         raise Missing("three-particle runs")
     return md_table(["p (N/m)", "control", "t_heat (s)", "densification (mean)", "per seed",
                      "runs whose contacts changed after t_heat"], rows), summary
+
+
+def three_ts_table(st: Study) -> tuple[str, dict]:
+    """The three-particle control of the first placement sintered for every t_s: the stiffness factor s = k1(T,
+    t)/k1 at t_cool (eqs. 10-12), the densification at each p and their ratio, and the pair contacts' overlaps at
+    t_f against the creep f/(k1 s) of their forces (eq. 4 on the loading line k1(T, t); their sums): a law whose
+    creep is linear in the force densifies the same three disks p_max/p_min times more at p_max."""
+    rows, summary = [], {}
+    lo, hi = min(st.grid.p), max(st.grid.p)
+    for t_s in st.grid.t_s:
+        got = {}
+        for p in (lo, hi):
+            task = st.task(sr.SCHEDULE, 3, p, t_s)
+            try:
+                s, a = st.series(task), st.arrays(task)
+            except Missing:
+                continue
+            factor = float(at(s, task.times.t_cool)["k1_factor"])
+            x, r, i, j = a["snap0_x"], a["snap0_radius"], a["snap0_i"], a["snap0_j"]
+            overlap = float(np.sum(r[i] + r[j] - np.linalg.norm(x[i] - x[j], axis=1)))
+            creep = float(np.sum(a["snap0_fn"]) / (LUDING_TABLE1.k1 * factor))
+            got[p] = {"k1_factor": factor, "densification": st.three(p, seeds=(1,), t_s=t_s)[0],
+                      "overlap": overlap, "creep": creep}
+        if len(got) < 2:
+            continue
+        d_lo, d_hi = got[lo]["densification"], got[hi]["densification"]
+        rows.append([f"{t_s:g}", f"{got[lo]['k1_factor']:.4f}", pct(d_lo), pct(d_hi), f"{d_hi / d_lo:.1f}",
+                     f"{1e6 * got[lo]['overlap']:.2f}", f"{1e6 * got[lo]['creep']:.2f}"])
+        summary[f"ts{t_s:g}"] = got
+    if not rows:
+        raise Missing("three-particle runs for every t_s")
+    return md_table(["t_s (s)", "s = k1(T, t)/k1 at t_cool", f"densification p = {lo:g}", f"p = {hi:g}", "ratio",
+                     f"Σ pair overlaps at t_f, p = {lo:g} (µm)", "Σ f/(k1 s) (µm)"], rows), summary
 
 
 COOL_LABELS = {"": "protocol: walls follow p, δa_T = 1e-4 /K", "cool-no-expansion": "walls follow p, δa_T = 0",
@@ -322,6 +389,7 @@ def section(st: Study) -> tuple[str, dict]:
     """The subsection of the isolating runs: a table per mechanism with what it shows; the summary entries."""
     prep, prep_s = _part(preparation_table, st)
     three, three_s = _part(three_table, st)
+    three_ts, three_ts_s = _part(three_ts_table, st)
     cool_nu, cool_nu_s = _part(cooling_density_table, st)
     cool, cool_s = _part(cooling_table, st)
     contact, contact_s = _part(contact_table)
@@ -329,13 +397,22 @@ def section(st: Study) -> tuple[str, dict]:
     fail, fail_s = _part(failure_table, st)
     md = [
         "**1. Preparation and densification.** Each preparation runs to t_heat = 0.2 s at 80 °C; the protocol's "
-        "and the frictionless one then sinter for the longest t_s and cool down. ν in the first 10 ms after t_heat "
-        "is the immediate effect of switching the wall friction off (and the particle friction on).",
+        "and the frictionless one then sinter for the longest t_s and cool down. ν half way through the "
+        "preparation against ν(t_heat): has the packing settled? ν of the interior, more than the largest diameter "
+        f"({1e3 * INTERIOR_MARGIN:g} mm) from every wall: is a loose sample loose inside or at its walls? ν in the "
+        "first 10 ms after t_heat is the immediate effect of switching the wall friction off (and the particle "
+        "friction on).",
         "", prep, "",
         "**Three-particle control (Sec. 4.1.3).** Three disks through the whole schedule; the wall contacts either "
         "keep the cold law of the wall material (k1(T, t) = k1: no softening, no creep) or soften with the particle's "
-        "k1(T, t) like the pair contacts. A run whose contacts changed after t_heat rearranged: it is no control.",
+        "k1(T, t) like the pair contacts. A run whose contacts changed after t_heat rearranged: it is no control. "
+        "Kept at 80 °C, the prepared disks do not move (their drift is the baseline); without thermal expansion the "
+        "densification is the same, since t_heat and t_f are both at 80 °C and the radii of eq. 9 return.",
         "", three, "",
+        "*The control against t_s* (first placement): the densification is the pair contacts' creep under the "
+        "wall's load, the overlap growing to f/(k1 s) on the loading line of eq. 4 as k1(T, t) = s k1 relaxes "
+        "(eqs. 10-12); the wall contacts keep the cold law and the elastic overlap f/k2 stays below a micrometre.",
+        "", three_ts, "",
         "**2. Cool-down.** The longest-sintered sample cooled from 140 to 80 °C four ways from the same state "
         f"(N = {st.n_max}), the same sample prepared, sintered and cooled with the expansion Sec. 3.2's text "
         "describes (\"one per-cent\" between 80 and 120 °C: δa_T = 2.5e-4 /K, against Table 1's 1e-4 /K), and the "
@@ -364,5 +441,6 @@ def section(st: Study) -> tuple[str, dict]:
         "(the largest σ_zz before it first falls below half of it).",
         "", fail,
     ]
-    return "\n".join(md), {"preparation": prep_s, "three_particles": three_s, "cooling_density": cool_nu_s,
+    return "\n".join(md), {"preparation": prep_s, "three_particles": three_s, "three_particles_ts": three_ts_s,
+                           "cooling_density": cool_nu_s,
                            "cooling": cool_s, "contact": contact_s, "coordination": coord_s, "failure": fail_s}

@@ -56,8 +56,10 @@ CONDUCTIVITY3D, SPECIFIC_HEAT3D = 20.0, 10.0
 class Variant:
     """A change of the protocol (:mod:`verification.sinter_protocol`) that isolates one cause: ``prep`` keyword arguments of
     the preparation, ``material`` fields changed in every stage (``prep_material``: in the preparation only),
-    ``walls_held`` in the cool-down, ``t_heat`` of the three-particle control, ``strain`` of the compression test;
-    ``stage_only``: the variant changes its own stage alone and starts from the protocol's state."""
+    ``walls_held`` in the cool-down, ``t_heat`` of the three-particle control, ``heated``: false keeps a schedule
+    at the preparation's 80 °C throughout (the three-particle control without heating), ``strain`` of the
+    compression test; ``stage_only``: the variant changes its own stage alone and starts from the protocol's
+    state."""
 
     label: str
     prep: dict = field(default_factory=dict)
@@ -65,11 +67,13 @@ class Variant:
     prep_material: dict = field(default_factory=dict)
     walls_held: bool = False
     t_heat: float | None = None
+    heated: bool = True
     strain: float | None = None
     stage_only: bool = False
 
 
 PREP_SEEDS = (2, 3)  # other random placements of the protocol's preparation: the spread of nu(t_heat) of one sample
+PLACEMENTS = (1,) + PREP_SEEDS  # the placements whose mean densification the statements read (N max, t_s max)
 FRICTIONLESS = {"prep_mu": 0.0, "prep_mu_wall": 0.0}
 VARIANTS = {v.label: v for v in (
     Variant("frictionless", FRICTIONLESS),                                   # the paper's text (Sec. 4)
@@ -78,9 +82,11 @@ VARIANTS = {v.label: v for v in (
     Variant("frictionless-cohesive", FRICTIONLESS, prep_material={"brittle_sliding": False}),  # Table 1's cohesion
     Variant("frictionless-wall-friction", {**FRICTIONLESS, "prep_mu_wall": LUDING_TABLE1.mu}),
     Variant("no-wall-friction", {"prep_mu_wall": 0.0}),                      # particles frictional, walls not
+    Variant("slow", {"wall_damping": 10 * WALL_DAMPING}),                    # the protocol, walls 10x slower
     Variant("walls-sinter", material={"wall_sintering": True}),              # wall contacts soften like pairs
     Variant("short-prep", t_heat=0.2),                                       # the control prepared for 0.2 s only
     Variant("control-wall-friction", {"prep_mu_wall": LUDING_TABLE1.mu}),    # the control with the walls' friction
+    Variant("no-heating", heated=False),                                     # the control kept at 80 °C
     Variant("no-expansion", material={"expansion": 0.0}),                    # delta a_T = 0 (Sec. 4.1.3)
     Variant("expansion-text", material={"expansion": 2.5e-4}),  # Sec. 3.2's "one per-cent" from 80 to 120 °C
     Variant("held", walls_held=True, stage_only=True),                        # cool-down, the box held
@@ -158,12 +164,15 @@ class Grid:
 
     def isolating_tasks(self) -> list[Task]:
         """The runs that isolate the causes of the differences from the paper (:data:`VARIANTS`). ``"quick"``: the
-        preparations alone (N max, p = 10: the paper's frictionless one, and frictionless particles against walls
-        with friction), each a fraction of the cost of a sintered chain. ``"full"`` adds the paper's frictionless
-        preparation through sintering and cool-down for every N and p, every other preparation (initial speeds,
-        compression rate, cohesion, wall friction) for every N at p = 10 and the densification of those with
-        friction on the particles or on the walls only (N min, p = 10), the three-particle control with walls that
-        sinter, prepared for 0.2 s only or with wall friction (every seed and p), the cool-down of the
+        cheap ones, each a fraction of the cost of a sintered chain: the preparations alone (N max, p = 10: the
+        paper's frictionless one, frictionless particles against walls with friction, frictional particles against
+        frictionless walls, the protocol's with walls 10x slower) and the three-particle control of the first
+        placement kept at 80 °C and without thermal expansion (p = 10) and sintered for every t_s (both p).
+        ``"full"`` adds the paper's frictionless preparation through sintering and cool-down for every N and p,
+        every other preparation (initial speeds, compression rate, cohesion, wall friction) for every N at p = 10
+        and the densification of those with friction on the particles or on the walls only and of the slower one
+        (N min, p = 10), the three-particle control with walls that sinter, prepared for 0.2 s only, with wall
+        friction, kept at 80 °C or without thermal expansion (every seed and p), the cool-down of the
         longest-sintered sample with the box held and without thermal contraction (N max, both p), and the
         compression test of the shortest-sintered sample at p = 100 carried on to 15 % strain, and the longest
         sintering of N max at p = 100 with the thermal expansion Sec. 3.2's text describes ("one per-cent" from 80 to
@@ -171,18 +180,20 @@ class Grid:
         if not self.isolation:
             return []
         n, t_max = max(self.n), max(self.t_s)
-        out = [Task(PREPARE, n, 10.0, variant=v) for v in ("frictionless", "frictionless-wall-friction")]
-        out += [Task(PREPARE, n, 10.0, seed=seed) for seed in PREP_SEEDS]
+        out = [Task(PREPARE, n, 10.0, variant=v)
+               for v in ("frictionless", "frictionless-wall-friction", "no-wall-friction", "slow")]
+        out += [Task(SCHEDULE, 3, 10.0, t_max, 1, v) for v in ("no-heating", "no-expansion")]
+        out += [Task(SCHEDULE, 3, p, t_s, 1) for p in self.p for t_s in self.t_s]
         if self.isolation == "full":
             preps = ("frictionless", "frictionless-fast", "frictionless-slow", "frictionless-cohesive",
-                     "frictionless-wall-friction", "no-wall-friction")
+                     "frictionless-wall-friction", "no-wall-friction", "slow")
             out += [Task(PREPARE, m, 10.0, variant=v) for m in self.n for v in preps]
             out += [Task(PREPARE, m, p, seed=seed) for m in self.n for p in self.p for seed in PREP_SEEDS]
             out += [Task(COOL, m, p, t_max, variant="frictionless") for m in self.n for p in self.p]
             out += [Task(COOL, min(self.n), 10.0, t_max, variant=v)
-                    for v in ("frictionless-wall-friction", "no-wall-friction")]
+                    for v in ("frictionless-wall-friction", "no-wall-friction", "slow")]
             out += [Task(SCHEDULE, 3, p, t_max, seed, v) for p in self.p for seed in self.three_seeds
-                    for v in ("walls-sinter", "short-prep", "control-wall-friction")]
+                    for v in ("walls-sinter", "short-prep", "control-wall-friction", "no-heating", "no-expansion")]
             out += [Task(COOL, n, p, t_max, variant=v) for p in self.p
                     for v in ("held", "cool-no-expansion", "held-no-expansion")]
             out.append(Task(COOL, n, 100.0, t_max, variant="expansion-text"))
@@ -196,11 +207,12 @@ class Grid:
                 for t_s in self.t_s:
                     out += [Task(COMPRESS, n, p, t_s), Task(VIBRATE, n, p, t_s)]
         t_max = max(self.t_s)
+        out += [Task(COOL, max(self.n), p, t_max, seed) for p in self.p for seed in PREP_SEEDS]
         out += [Task(SCHEDULE, 3, p, t_max, seed) for p in self.p for seed in self.three_seeds]
         if self.no_expansion:
             out += [Task(SCHEDULE, min(self.n), p, t_max, variant="no-expansion") for p in self.p]
         out.append(Task(SINTER3D, self.n3d, P3D))
-        return out + self.isolating_tasks()
+        return list(dict.fromkeys(out + self.isolating_tasks()))
 
 
 FULL = Grid(n=(100, 300), p=(10.0, 100.0), t_s=(1e-4, 1e-3, 0.01, 0.02, 0.05, 0.1, 0.5, 1.0),
@@ -281,8 +293,11 @@ def scene_doc(task: Task, root: pathlib.Path) -> dict:
         if variant and variant.prep_material:
             raise ValueError(f"variant {task.variant!r}: a preparation-only material needs separate stages")
         if task.n == 3:
-            return sp.control_doc(task.p, task.t_s, seed=task.seed, t_heat=task.times.t_heat,
-                                  material=_material(task, SINTER), **prep)
+            doc = sp.control_doc(task.p, task.t_s, seed=task.seed, t_heat=task.times.t_heat,
+                                 material=_material(task, SINTER), **prep)
+            if variant and not variant.heated:
+                doc["temperature"]["value"] = [sp.T_PREPARE for _ in doc["temperature"]["value"]]
+            return doc
         return sp.schedule_doc(task.n, task.p, task.t_s, seed=task.seed, material=_material(task, SINTER), **prep)
     if task.kind == PREPARE3D:
         return sp.preparation_doc(task.n, task.p, seed=task.seed, material=material, dimension=3, spread=SPREAD3D)

@@ -61,6 +61,13 @@ class Study:
         with np.load(self.root / task.folder / "analysis.npz") as f:
             return {k: f[k] for k in f.files}
 
+    def state(self, task: sr.Task) -> dict:
+        """The state saved at the end of ``task`` (:func:`dem.scene.state_file.load`)."""
+        from dem.scene import state_file
+
+        self.res(task.kind, task.n, task.p, task.t_s, task.seed, task.variant)
+        return state_file.load(self.root / task.folder / "state.npz")
+
     def contacts(self, kind, n, p, t_s) -> dict:
         return self.arrays(self.task(kind, n, p, t_s))
 
@@ -99,11 +106,18 @@ class Study:
                 "failure_stress": float(szz[k]), "failure_strain": float(eps[k]), "stiffness": stiffness,
                 "kinetic_over_work": float(np.max(s["kinetic_energy"][:k + 1]) / work[k]) if work[k] > 0 else math.nan}
 
-    def three(self, p, variant: str = "", seeds=None) -> list[float]:
-        """Densification nu(t_f)/nu(t_heat) - 1 of the three-particle controls (one per seed)."""
+    def densification(self, p) -> list[float]:
+        """Densification nu(t_f)/nu(t_heat) - 1 of the protocol's placements :data:`sintering_runs.PLACEMENTS`
+        (N max, t_s max), one per placement."""
+        return [self.res(sr.COOL, self.n_max, p, self.t_max, seed)["volume_fraction"]
+                / self.res(sr.PREPARE, self.n_max, p, seed=seed)["volume_fraction"] - 1.0 for seed in sr.PLACEMENTS]
+
+    def three(self, p, variant: str = "", seeds=None, t_s=None) -> list[float]:
+        """Densification nu(t_f)/nu(t_heat) - 1 of the three-particle controls (one per seed), sintered for ``t_s``
+        (default the longest)."""
         out = []
         for seed in self.grid.three_seeds if seeds is None else seeds:
-            task = self.task(sr.SCHEDULE, 3, p, self.t_max, seed, variant)
+            task = self.task(sr.SCHEDULE, 3, p, self.t_max if t_s is None else t_s, seed, variant)
             s = self.series(task)
             out.append(float(s["volume_fraction"][-1] / at(s, task.times.t_heat)["volume_fraction"] - 1.0))
         return out
