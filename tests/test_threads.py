@@ -17,9 +17,11 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 # In a fresh process (numba's thread pool is sized when it starts): each scene's first steps on 1, 2 and 3 threads
 # (3 beyond this machine's 2 cores: the pool is made larger), the threaded copy bound for any size. The state after
-# the steps, as lists of the bytes' hex digests.
+# the steps, as lists of the bytes' hex digests. A compiled loop that numba cannot cache (it would be compiled again
+# in every process: a minute for the threaded copies) fails the run.
 SAME_BITS = """
-import hashlib, json, sys
+import hashlib, json, sys, warnings
+warnings.filterwarnings("error", message="Cannot cache compiled function")
 import numpy as np
 from sinterheat import threads
 import dem.engines.verlet.mechanics as mechanics

@@ -25,10 +25,10 @@ short for the closed ones, most of a dense packing's list.)
 
 Threads: in the copies of this module for more than one thread (:mod:`dem.engines.compiled`) ``THREADED`` is
 true and the loop runs on all of numba's threads in conflict-free passes: every pair's force and torque arms into a
-row of its own (``load``; the pairs in blocks of consecutive ones, a few per thread), then every particle sums the rows of its pairs (:func:`incident_pairs`) in the order of
-the list. That is the order in which the one-thread loop adds them into each particle, so the results are the same
-to the bit on any number of threads. The flag is a compile-time constant: the one-thread loop carries nothing of
-the threaded one.
+row of its own (``load``; the pairs in ``PAIR_BLOCKS`` blocks of consecutive ones), then every particle sums the
+rows of its pairs (:func:`incident_pairs`) in the order of the list. That is the order in which the one-thread loop
+adds them into each particle, so the results are the same to the bit on any number of threads. The flag is a
+compile-time constant: the one-thread loop carries nothing of the threaded one.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import get_num_threads, njit, prange
+from numba import njit, prange
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from dem.geometry.neighbours import min_image
@@ -49,7 +49,8 @@ from dem.laws.contact import luding as law
 FINITE_MATH = {"nnan", "ninf", "nsz"}
 N_PARAMS = law.N_PARAMS
 THREADED = False  # True in the copies for more than one thread (dem.engines.compiled)
-CHUNKS_PER_THREAD = 8  # the threaded pair loop's blocks of consecutive pairs per thread (for an even load)
+PAIR_BLOCKS = 256  # the threaded pair loop's blocks of consecutive pairs (many per thread: an even load; a constant,
+# not numba's thread count, which compiled code can read only through a pointer that cannot be cached)
 LOAD_COLUMNS = 9  # a pair's row of the threaded loop's buffer: g = f_n n + f_t (3), n x f_t (3), l_i, l_j, closed
 KEEPS_PAIR_CONSTANTS = len(law.PAIR_CONSTANTS) > 0  # the law's pair_constants are kept per pair, in (M, 2)
 
@@ -131,7 +132,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         tau[k, 1] = 0.0
         tau[k, 2] = 0.0
     n_pairs = pi.shape[0]
-    n_blocks = min(CHUNKS_PER_THREAD * get_num_threads(), n_pairs) if THREADED else 1
+    n_blocks = min(PAIR_BLOCKS, n_pairs) if THREADED else 1
     for b in prange(n_blocks):  # one block on one thread; on more, blocks of consecutive pairs
         first, stop = b * n_pairs // n_blocks, (b + 1) * n_pairs // n_blocks
         ahead = (0.0, 0.0, 0.0, 0.0, 0.0)  # the next pair's geometry, begun before this pair's law (module docstring)
