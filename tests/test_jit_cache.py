@@ -90,7 +90,8 @@ def test_import_points_numba_at_the_digests_folder(tmp_path):
     """Also where numba was imported first (numba's own cache, keyed by each file alone, would otherwise serve
     kernels compiled from older sources of the modules they call), and inside a folder the user chose."""
     folder = f"numba-{jit_cache.digest()}"
-    code = "import os, numba, dem; from numba.core import config; print(os.environ['NUMBA_CACHE_DIR'], config.CACHE_DIR)"
+    code = ("import os, numba, dem; from numba.core import config; "
+            "print(os.environ['NUMBA_CACHE_DIR'], config.CACHE_DIR)")
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     for first in ("import dem, numba", "import numba, dem"):
         out = subprocess.run([sys.executable, "-c", code.replace("import os, numba, dem", f"import os; {first}")],
