@@ -130,12 +130,12 @@ def interior_fraction(saved: dict, margin: float = INTERIOR_MARGIN, spacing: flo
 
 
 
-def _densification(st: Study, n, p, variant="", seed=1) -> tuple[float, float, float, float]:
-    """``(nu(t_heat), rise in the first 10 ms after t_heat, nu(t_f), nu(t_f)/nu(t_heat) - 1)`` of a chain."""
-    prep = st.res(sr.PREPARE, n, p, seed=seed, variant=variant)["volume_fraction"]
+def _densification(st: Study, n, p, variant="", seed=1) -> tuple[float, float, float]:
+    """``(rise in the first 10 ms after t_heat, nu(t_f), nu(t_f)/nu(t_heat) - 1)`` of a chain."""
+    dens = st.chain_densification(n, p, seed, variant)
     cool = st.res(sr.COOL, n, p, st.t_max, seed, variant)["volume_fraction"]
     s = st.series(st.task(sr.SINTER, n, p, st.t_max, seed, variant))
-    return prep, float(at(s, 0.01)["volume_fraction"] - s["volume_fraction"][0]), cool, cool / prep - 1.0
+    return float(at(s, 0.01)["volume_fraction"] - s["volume_fraction"][0]), cool, dens
 
 
 PREP_LABELS = {"": "protocol: friction μ = 0.5 on particles and walls", "frictionless": "frictionless (the paper's "
@@ -169,7 +169,7 @@ def preparation_table(st: Study) -> tuple[str, dict]:
                 except ValueError:  # a box smaller than two margins: no interior
                     inner = math.nan
                 try:
-                    _, jump, end, dens = _densification(st, n, p, variant, seed)
+                    jump, end, dens = _densification(st, n, p, variant, seed)
                     cells = [f"{jump:+.4f}", f"{end:.4f}", pct(dens)]
                     summary[key] = {"nu_heat": nu, "nu_interior": inner, "nu_f": end, "densification": dens}
                 except Missing:

@@ -106,11 +106,15 @@ class Study:
                 "failure_stress": float(szz[k]), "failure_strain": float(eps[k]), "stiffness": stiffness,
                 "kinetic_over_work": float(np.max(s["kinetic_energy"][:k + 1]) / work[k]) if work[k] > 0 else math.nan}
 
+    def chain_densification(self, n, p, seed=1, variant: str = "") -> float:
+        """Densification nu(t_f)/nu(t_heat) - 1 of one sample prepared, sintered for the longest t_s and cooled."""
+        return (self.res(sr.COOL, n, p, self.t_max, seed, variant)["volume_fraction"]
+                / self.res(sr.PREPARE, n, p, seed=seed, variant=variant)["volume_fraction"] - 1.0)
+
     def densification(self, p) -> list[float]:
-        """Densification nu(t_f)/nu(t_heat) - 1 of the protocol's placements :data:`sintering_runs.PLACEMENTS`
-        (N max, t_s max), one per placement."""
-        return [self.res(sr.COOL, self.n_max, p, self.t_max, seed)["volume_fraction"]
-                / self.res(sr.PREPARE, self.n_max, p, seed=seed)["volume_fraction"] - 1.0 for seed in sr.PLACEMENTS]
+        """:meth:`chain_densification` of the protocol's placements :data:`sintering_runs.PLACEMENTS` (N max),
+        one per placement."""
+        return [self.chain_densification(self.n_max, p, seed) for seed in sr.PLACEMENTS]
 
     def three(self, p, variant: str = "", seeds=None, t_s=None) -> list[float]:
         """Densification nu(t_f)/nu(t_heat) - 1 of the three-particle controls (one per seed), sintered for ``t_s``
