@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fem_neck import signal_guard
 from fem_neck.geometry import cap_height, check_positive, neck_geometry
 
 # Defaults of the size field (lengths relative to the corner or neck scale, see module docstring).
@@ -75,14 +76,16 @@ def gmsh_session():
 
     if gmsh.isInitialized():
         raise RuntimeError("gmsh is already initialised in this process; meshes must be built one at a time")
-    gmsh.initialize(readConfigFiles=False, interruptible=False)
+    with signal_guard.kept():  # gmsh resets the process's signal handlers (faulthandler's among them)
+        gmsh.initialize(readConfigFiles=False, interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.NumThreads", 1)
         gmsh.option.setNumber("Mesh.MaxNumThreads2D", 1)
         yield gmsh
     finally:
-        gmsh.finalize()
+        with signal_guard.kept():
+            gmsh.finalize()
 
 
 @dataclass(frozen=True)
