@@ -18,7 +18,7 @@ import sys
 STANDARD = tuple(s for s in range(1, 32) if s not in (signal.SIGKILL, signal.SIGSTOP))
 
 
-class _SigAction(ctypes.Structure):
+class SigAction(ctypes.Structure):
     """glibc's ``struct sigaction`` (x86-64 and aarch64): handler, 1024-bit mask, flags, restorer."""
     _fields_ = [("handler", ctypes.c_void_p), ("mask", ctypes.c_ulong * 16), ("flags", ctypes.c_int),
                 ("restorer", ctypes.c_void_p)]
@@ -28,20 +28,20 @@ def _libc():
     return ctypes.CDLL(None, use_errno=True) if sys.platform == "linux" else None
 
 
-def handlers() -> dict[int, _SigAction]:
+def handlers() -> dict[int, SigAction]:
     """The handler of every standard signal, as the C library holds it (empty where not on Linux)."""
     libc = _libc()
     if libc is None:
         return {}
     saved = {}
     for number in STANDARD:
-        action = _SigAction()
+        action = SigAction()
         if libc.sigaction(number, None, ctypes.byref(action)) == 0:
             saved[number] = action
     return saved
 
 
-def restore(saved: dict[int, _SigAction]) -> None:
+def restore(saved: dict[int, SigAction]) -> None:
     """Put back the handlers :func:`handlers` returned."""
     libc = _libc()
     for number, action in saved.items():
