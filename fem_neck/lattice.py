@@ -30,9 +30,9 @@ face mapped onto its sphere, cylinder, plane or their intersection curve), so th
 
 Both converge at one rate, so ``error_estimate = (upper - lower) / upper`` bounds the error of the reported value
 (the upper) and is 2-3 times it (the two errors are about equal, measured on the lattice cells). The bounds hold up
-to the quadrature of the curved elements (degree ``2 p``: ~5e-8 relative, measured against ``2 p + 4``) and the
-flux solver's residual (1e-10; the upper bound's CG stops when its energy has settled to 1e-9, and the energy of
-any iterate is an upper bound). The mesh is graded toward every neck circle, where the temperature is singular
+to the quadrature of the curved elements (degree ``2 p``: ~5e-8 relative, measured against ``2 p + 4``) and
+round-off, whatever the solvers' residuals: both CGs stop when their energy has settled to 1e-9; the energy of any
+iterate is an upper bound, and the flux of any iterate is made exactly admissible (:func:`fem_neck.dual.equilibrate`). The mesh is graded toward every neck circle, where the temperature is singular
 (``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined until the estimate
 meets ``rtol``, and the memory of each solve is estimated before its mesh is made (:func:`effective_conductivity`).
 """
@@ -491,7 +491,7 @@ def _conducting(points: np.ndarray, tets: np.ndarray, height: float, tol: float)
 @dataclass(frozen=True)
 class Bounds:
     """Both bounds of one mesh, as ``k / kappa`` of the cell: ``upper`` (P_p energy) and ``lower`` (RT_(p-1) flux),
-    the flux's largest normal-flux jump relative to its mean flux per hot face (admissibility, ~solver tolerance),
+    the flux's largest normal-flux jump relative to its mean flux per hot face (admissibility, round-off),
     unknowns of both solves, tetrahedra, the mapped mesh's volume over the exact one minus 1, seconds."""
 
     upper: float

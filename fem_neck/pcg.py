@@ -73,9 +73,8 @@ def entries(A, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
 class Assembly:
     """The system of the free unknowns, assembled chunk by chunk from element matrices on the global dofs ``l2g (E,
     n)``, the dofs marked ``fixed`` held at ``values``. Only the free block is stored (COO with 32-bit indices,
-    allocated once, then CSR); the element matrices of a chunk can be dropped after :meth:`add`, except those of
-    elements with a fixed dof, kept for :meth:`boundary_rows`. ``A_ff x = b`` gives the free values; :meth:`energy`
-    is ``u^T A u`` of the full vector exactly, whatever ``x``."""
+    allocated once, then CSR); the element matrices of a chunk can be dropped after :meth:`add`. ``A_ff x = b`` gives
+    the free values; :meth:`energy` is ``u^T A u`` of the full vector exactly, whatever ``x``."""
 
     def __init__(self, l2g: np.ndarray, fixed: np.ndarray, values: np.ndarray):
         self.free = np.flatnonzero(~fixed)
@@ -90,8 +89,6 @@ class Assembly:
         self.data = np.empty(self.offset[-1])
         self.b = np.zeros(len(self.free))
         self.constant = 0.0
-        self.touching = np.flatnonzero(np.any(fixed[l2g], axis=1))            # elements with a fixed dof
-        self.kept = {}
 
     def add(self, K: np.ndarray, elements: np.ndarray) -> None:
         loc = self.loc[elements]
@@ -105,8 +102,6 @@ class Assembly:
         self.rows[span] = np.broadcast_to(loc[:, :, None], K.shape)[pair]
         self.cols[span] = np.broadcast_to(loc[:, None, :], K.shape)[pair]
         self.data[span] = K[pair]
-        for k in np.flatnonzero(np.isin(elements, self.touching)):
-            self.kept[int(elements[k])] = K[k].copy()
 
     def matrix(self):
         """``A_ff`` (CSR); frees the COO arrays."""
@@ -120,15 +115,6 @@ class Assembly:
         """``u^T A u`` of ``u`` = ``x`` on the free dofs, the fixed values elsewhere: ``x A_ff x - 2 x b + u_d A_dd
         u_d`` (``A_fd u_d = -b``)."""
         return float(x @ (A @ x) - 2.0 * (x @ self.b) + self.constant)
-
-    def boundary_rows(self, u: np.ndarray) -> np.ndarray:
-        """``(A u)`` at the fixed dofs (zero elsewhere), from the kept element matrices."""
-        out = np.zeros(len(self.fixed))
-        for e, K in self.kept.items():
-            dofs = self.l2g[e]
-            np.add.at(out, dofs, K @ u[dofs])
-        out[~self.fixed] = 0.0
-        return out
 
 
 def two_level(A, P, blocks: np.ndarray | None = None) -> TwoLevel:
