@@ -27,13 +27,14 @@ upper bound (both errors ``O(h^2p)`` in the energy).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from fem_neck.curved import CurvedMesh
-from fem_neck.primal import ENERGY_RTOL, quadrature_degree, symmetric_products
-from fem_neck.simplex import RaviartThomas, raviart_thomas, tet_quadrature
+from fem_neck.primal import ENERGY_RTOL, numbering, quadrature_degree, symmetric_products
+from fem_neck.simplex import RaviartThomas, face_points, lagrange, raviart_thomas, tet_quadrature, triangle_quadrature
 
 CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arrays)
 
@@ -67,6 +68,27 @@ class Solution:
     iterations: int
     residual: float
     flux_defect: float
+
+
+def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.ndarray:
+    """Face multipliers ``(n_faces n_f,)`` of the ``P_p`` temperature ``u`` (skeleton values in the numbering of
+    :func:`fem_neck.primal.numbering`): its trace on every face projected onto ``P_k`` in the face basis (on the
+    unit triangle of the face's own coordinates, from its first element) -- close to the face system's solution,
+    from which its CG starts."""
+    basis, rt = lagrange(p), raviart_thomas(k)
+    skeleton = numbering(mesh, basis).l2g
+    nf = rt.n_face
+    st, w = triangle_quadrature(p + k)
+    weighted = 2.0 * w[:, None] * rt.face_basis(st)                      # the face basis is orthonormal for 2 int
+    faces = mesh.t2f.ravel()
+    first = np.zeros(len(faces), dtype=bool)
+    first[np.unique(faces, return_index=True)[1]] = True
+    out = np.zeros((len(mesh.faces), nf))
+    for face in range(4):
+        elements = np.flatnonzero(first.reshape(-1, 4)[:, face])
+        values = basis.values(face_points(face, st))[:, :skeleton.shape[1]]  # interior nodes vanish on the faces
+        out[mesh.t2f[elements, face]] = u[skeleton[elements]] @ (weighted.T @ values).T
+    return out.ravel()
 
 
 def equilibrate(mesh: CurvedMesh, H_K: np.ndarray, lam: np.ndarray, fixed_face: np.ndarray) -> np.ndarray:
@@ -107,10 +129,11 @@ def equilibrate(mesh: CurvedMesh, H_K: np.ndarray, lam: np.ndarray, fixed_face: 
 
 
 def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: float = ENERGY_RTOL,
-          degree: int | None = None) -> Solution:
+          degree: int | None = None, start: Callable[[], np.ndarray] | None = None) -> Solution:
     """The equilibrated hybridised ``RT_k`` flux with temperature 1 on the ``hot`` faces and 0 on the ``cold`` ones
     (indices into ``mesh.faces``; quadrature of ``degree`` on curved elements); see the module docstring. CG stops
-    when the face system's energy has settled to ``etol`` (:func:`fem_neck.pcg.solve`)."""
+    when the face system's energy has settled to ``etol`` (:func:`fem_neck.pcg.solve`), starting from zero or from
+    the face multipliers ``start()`` returns once the system is assembled (:func:`trace_multipliers`)."""
     import scipy.sparse as sp
 
     from fem_neck import pcg
@@ -128,8 +151,8 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     lam[hot * nf] = constant
     system = pcg.Assembly(l2g, fixed, lam)
     H_K = np.empty((E, 4 * nf, 4 * nf))
-    for start in range(0, E, CHUNK):
-        elements = np.arange(start, min(start + CHUNK, E))
+    for begin in range(0, E, CHUNK):
+        elements = np.arange(begin, min(begin + CHUNK, E))
         A = mass_matrices(mesh, rt, degree or quadrature_degree(k + 1), elements)
         H_K[elements] = np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape)))
         system.add(H_K[elements], elements)
@@ -138,8 +161,10 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     coarse = sp.csr_matrix((np.ones(len(free_faces)), (np.arange(len(free_faces)) * nf, np.arange(len(free_faces)))),
                            shape=(len(system.free), len(free_faces)))
     blocks = np.arange(len(system.free)).reshape(-1, nf)
-    x, iterations, residual = pcg.solve(H, system.b, pcg.two_level(H, coarse, blocks),
-                                        energy=(system.constant, etol))
+    precondition = pcg.two_level(H, coarse, blocks)
+    x0 = None if start is None else start()[system.free]
+    energy0 = system.constant if x0 is None else system.energy(H, x0)
+    x, iterations, residual = pcg.solve(H, system.b, precondition, x0=x0, energy=(energy0, etol))
     lam[system.free] = x
     lam_K = equilibrate(mesh, H_K, lam, fixed_face)
     outward = np.matmul(H_K, lam_K[:, :, None]).reshape(E * 4, nf)

@@ -508,16 +508,34 @@ class Bounds:
         return (self.upper - self.lower) / self.upper
 
 
-def _dual(mesh, order: int, hot, cold):
+def _dual(mesh, order: int, hot, cold, temperature):
+    """The lower bound, its CG started from the trace of the upper bound's temperature (``temperature()``, called
+    once the face system is assembled)."""
     from fem_neck import dual
 
+    def start():
+        return dual.trace_multipliers(mesh, order, temperature(), order - 1)
+
     with one_blas_thread():  # the dense work is many small products (see fem_neck.spectral.conductance)
-        return dual.solve(mesh, order - 1, hot, cold)
+        return dual.solve(mesh, order - 1, hot, cold, start=start)
+
+
+_TEMPERATURES = None  # in the lower bound's process: the queue on which the upper bound's temperature arrives
+
+
+def _receive_temperatures(queue) -> None:
+    global _TEMPERATURES
+    _TEMPERATURES = queue
+
+
+def _dual_receiving(mesh, order: int, hot, cold):
+    return _dual(mesh, order, hot, cold, _TEMPERATURES.get)
 
 
 def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
     """Upper and lower bound of the cell's ``k / kappa`` on the mesh ``cm`` (module docstring), the two solves in
-    parallel processes when ``workers >= 2``."""
+    parallel processes when ``workers >= 2`` (the lower bound assembles its system while the upper bound solves,
+    then starts its CG from the upper bound's temperature)."""
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
 
@@ -526,15 +544,19 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
     t0 = time.perf_counter()
     mesh = cm.curved
     if workers >= 2:
-        with ProcessPoolExecutor(1, mp_context=get_context("fork")) as pool:
-            future = pool.submit(_dual, mesh, order, cm.hot, cm.cold)
+        context = get_context("fork")
+        queue = context.SimpleQueue()
+        with ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures,
+                                 initargs=(queue,)) as pool:
+            future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold)
             with one_blas_thread():
                 up = primal.solve(mesh, order, cm.hot, cm.cold)
+            queue.put(up.u)
             low = future.result()
     else:
         with one_blas_thread():
             up = primal.solve(mesh, order, cm.hot, cm.cold)
-        low = _dual(mesh, order, cm.hot, cm.cold)
+        low = _dual(mesh, order, cm.hot, cm.cold, lambda: up.u)
     scale = cm.height / cm.area
     with one_blas_thread():
         volume = primal.volume(mesh)

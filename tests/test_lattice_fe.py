@@ -123,6 +123,17 @@ def test_the_lower_bound_is_admissible_whatever_the_face_solvers_iterate():
     assert settled.lower * scale < REFERENCES[("sc", 0.08)]
 
 
+def test_the_lower_bounds_cg_started_from_the_upper_bounds_temperature_takes_fewer_steps_to_the_same_bound():
+    from fem_neck import dual, primal
+
+    cm = lattice.build_cell_mesh(lattice.lattice_cell("bcc", 0.08), **COARSE)
+    up = primal.solve(cm.curved, 3, cm.hot, cm.cold)
+    cold = dual.solve(cm.curved, 2, cm.hot, cm.cold)
+    warm = dual.solve(cm.curved, 2, cm.hot, cm.cold, start=lambda: dual.trace_multipliers(cm.curved, 3, up.u, 2))
+    assert warm.iterations < 0.75 * cold.iterations
+    assert warm.lower == pytest.approx(cold.lower, rel=1e-9)
+
+
 def test_primal_cg_stops_when_the_energy_has_settled():
     # the upper bound's CG stops on its energy (an upper bound whatever the iterate): within the tolerance of the
     # energy solved to round-off, above it, in fewer iterations
