@@ -124,8 +124,10 @@ def equilibrate(mesh: CurvedMesh, H_K: np.ndarray, lam: np.ndarray, fixed_face: 
     change = (sign[:, None] * flux[faces] - outward).reshape(E, n)
     null = np.zeros(n)
     null[::nf] = 1.0
-    mu = np.linalg.solve(H_K + np.outer(null, null), change[:, :, None])[:, :, 0]
-    return lam_K + mu
+    for begin in range(0, E, CHUNK):
+        chunk = slice(begin, begin + CHUNK)
+        lam_K[chunk] += np.linalg.solve(H_K[chunk] + np.outer(null, null), change[chunk, :, None])[:, :, 0]
+    return lam_K
 
 
 def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: float = ENERGY_RTOL,
@@ -166,6 +168,7 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     energy0 = system.constant if x0 is None else system.energy(H, x0)
     x, iterations, residual = pcg.solve(H, system.b, precondition, x0=x0, energy=(energy0, etol))
     lam[system.free] = x
+    del H, precondition                                                     # (memory for the equilibration)
     lam_K = equilibrate(mesh, H_K, lam, fixed_face)
     outward = np.matmul(H_K, lam_K[:, :, None]).reshape(E * 4, nf)
     energy = float(np.einsum("ea,ea->", lam_K, outward.reshape(E, -1)))    # = sum alpha^T A alpha
