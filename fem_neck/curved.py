@@ -324,13 +324,14 @@ def _edge_term(kind, c, e, r, n, d, vi, vj, li, lj, x, dX, i, j, chord, pbuf, jb
     for a in range(3):
         chord[a] = vi[a] + t * (vj[a] - vi[a])
     _project(kind, c, e, r, n, d, chord, pbuf, jbuf)
+    weight, slope, curve = s**BLEND, BLEND * s ** (BLEND - 1), s ** (BLEND - 2)
     for a in range(3):
         off = pbuf[a] - chord[a]
         dd = (jbuf[a, 0] * (vj[0] - vi[0]) + jbuf[a, 1] * (vj[1] - vi[1]) + jbuf[a, 2] * (vj[2] - vi[2])
               - (vj[a] - vi[a]))
-        x[a] += s**BLEND * off
-        dX[a, i] += BLEND * s ** (BLEND - 1) * off - s ** (BLEND - 2) * lj * dd
-        dX[a, j] += BLEND * s ** (BLEND - 1) * off + s ** (BLEND - 2) * li * dd
+        x[a] += weight * off
+        dX[a, i] += slope * off - curve * lj * dd
+        dX[a, j] += slope * off + curve * li * dd
 
 
 @njit(cache=True)
@@ -390,12 +391,13 @@ def _map_kernel(points, tets, edge_row, face_row, kind, pc, pe, pr, pn, pd, elem
                 for k in range(3):
                     for m in range(3):
                         dD[k, m] = jbuf[k, 0] * dy[0, m] + jbuf[k, 1] * dy[1, m] + jbuf[k, 2] * dy[2, m] - dy[k, m]
+                weight, slope = s**BLEND, s ** (BLEND - 1)
                 for k in range(3):
                     D = pbuf[k] - y[k]
                     mean = dD[k, 0] * mu[0] + dD[k, 1] * mu[1] + dD[k, 2] * mu[2]
-                    x[k] += s**BLEND * D
+                    x[k] += weight * D
                     for m in range(3):
-                        dX[k, f[m]] += s ** (BLEND - 1) * (BLEND * D + dD[k, m] - mean)
+                        dX[k, f[m]] += slope * (BLEND * D + dD[k, m] - mean)
             for k in range(3):
                 X[a, q, k] = x[k]
                 for m in range(3):
