@@ -70,6 +70,37 @@ class Solution:
     flux_defect: float
 
 
+class SymmetricStack:
+    """Symmetric matrices ``(E, n, n)`` kept as their upper triangles (half the memory); ``stack[rows] = M`` keeps
+    the upper triangles of ``M``, ``stack[rows]`` gives the symmetric matrices."""
+
+    def __init__(self, count: int, n: int):
+        self.n = n
+        self.upper = np.triu_indices(n)
+        self.packed = np.empty((count, len(self.upper[0])))
+
+    def __len__(self) -> int:
+        return len(self.packed)
+
+    def __setitem__(self, rows, matrices: np.ndarray) -> None:
+        self.packed[rows] = matrices[:, self.upper[0], self.upper[1]]
+
+    def __getitem__(self, rows) -> np.ndarray:
+        packed = self.packed[rows]
+        out = np.empty((len(packed), self.n, self.n))
+        out[:, self.upper[0], self.upper[1]] = packed
+        out[:, self.upper[1], self.upper[0]] = packed
+        return out
+
+    def times(self, x: np.ndarray) -> np.ndarray:
+        """``M_e x_e`` for every matrix, ``x (E, n)``."""
+        out = np.empty_like(x)
+        for begin in range(0, len(self), CHUNK):
+            chunk = slice(begin, begin + CHUNK)
+            out[chunk] = np.matmul(self[chunk], x[chunk, :, None])[:, :, 0]
+        return out
+
+
 def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.ndarray:
     """Face multipliers ``(n_faces n_f,)`` of the ``P_p`` temperature ``u`` (skeleton values in the numbering of
     :func:`fem_neck.primal.numbering`): its trace on every face projected onto ``P_k`` in the face basis (on the
@@ -91,19 +122,19 @@ def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.nda
     return out.ravel()
 
 
-def equilibrate(mesh: CurvedMesh, H_K: np.ndarray, lam: np.ndarray, fixed_face: np.ndarray) -> np.ndarray:
+def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_face: np.ndarray) -> np.ndarray:
     """Element multipliers ``(E, 4 n_f)`` whose element fluxes ``A_K^-1 T^T lambda_K`` form an admissible flux:
     one normal flux on every face, none on the insulated ones (the module docstring), from the element matrices
-    ``H_K (E, 4 n_f, 4 n_f)``, any face multipliers ``lam (n_faces n_f,)`` and the faces held at a temperature
+    ``H_K`` (``4 n_f`` square), any face multipliers ``lam (n_faces n_f,)`` and the faces held at a temperature
     (``fixed_face``, whose flux is free)."""
     import scipy.sparse as sp
     from scipy.sparse.linalg import spsolve
 
-    E, n = H_K.shape[:2]
+    E, n = len(H_K), H_K.n
     nf = n // 4
     faces = mesh.t2f.ravel()
     lam_K = lam.reshape(-1, nf)[mesh.t2f].reshape(E, n)
-    outward = np.matmul(H_K, lam_K[:, :, None]).reshape(E * 4, nf)
+    outward = H_K.times(lam_K).reshape(E * 4, nf)
     # each face's flux along the normal out of its first element: the mean of its sides
     sides = np.bincount(faces, minlength=len(mesh.faces))
     first = np.zeros(len(faces), dtype=bool)
@@ -152,12 +183,12 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     lam = np.zeros(len(mesh.faces) * nf)
     lam[hot * nf] = constant
     system = pcg.Assembly(l2g, fixed, lam)
-    H_K = np.empty((E, 4 * nf, 4 * nf))
+    H_K = SymmetricStack(E, 4 * nf)
     for begin in range(0, E, CHUNK):
         elements = np.arange(begin, min(begin + CHUNK, E))
         A = mass_matrices(mesh, rt, degree or quadrature_degree(k + 1), elements)
         H_K[elements] = np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape)))
-        system.add(H_K[elements], elements)
+        system.add(H_K[elements], elements)                                # (made exactly symmetric)
     H = system.matrix()
     free_faces = np.flatnonzero(~fixed_face)
     coarse = sp.csr_matrix((np.ones(len(free_faces)), (np.arange(len(free_faces)) * nf, np.arange(len(free_faces)))),
@@ -170,7 +201,7 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     lam[system.free] = x
     del H, precondition                                                     # (memory for the equilibration)
     lam_K = equilibrate(mesh, H_K, lam, fixed_face)
-    outward = np.matmul(H_K, lam_K[:, :, None]).reshape(E * 4, nf)
+    outward = H_K.times(lam_K).reshape(E * 4, nf)
     energy = float(np.einsum("ea,ea->", lam_K, outward.reshape(E, -1)))    # = sum alpha^T A alpha
     jumps = np.zeros((len(mesh.faces), nf))                                 # outward moments summed per face
     np.add.at(jumps, mesh.t2f.ravel(), outward)

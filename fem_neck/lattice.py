@@ -83,8 +83,8 @@ P3_FROM = 3e-4  # the rtol from which the upper bound is P_3 by default (below, 
 # of the dense-packing study) were predicted 1.04-1.77 times their tetrahedra
 TETRAHEDRA_PER_CIRCLE, TETRAHEDRA_PER_VOLUME, PREDICTION_MARGIN = 315.0, 27.3, 1.3
 # peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured by
-# peak_memory: p = 4 93-96 kB per tetrahedron beyond the base on BCC and FCC h/r = 0.02, p = 3 31 kB on FCC 0.02)
-BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 100e3}
+# peak_memory: p = 4 104-106 kB per tetrahedron beyond the base on BCC and FCC h/r = 0.02, p = 3 31 kB on FCC 0.02)
+BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 110e3}
 _TOL = 1e-9  # geometric tolerance in units of the largest radius
 
 
@@ -536,14 +536,17 @@ def _dual_receiving(mesh, order: int, hot, cold):
 def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
     """Upper and lower bound of the cell's ``k / kappa`` on the mesh ``cm`` (module docstring), the two solves in
     parallel processes when ``workers >= 2`` (the lower bound assembles its system while the upper bound solves,
-    then starts its CG from the upper bound's temperature)."""
+    then starts its CG from the upper bound's temperature). Both integrate the curved elements at the same points,
+    where the elements are mapped once."""
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
 
     from fem_neck import primal
+    from fem_neck.simplex import tet_quadrature
 
     t0 = time.perf_counter()
     mesh = cm.curved
+    mesh.keep_jacobians(tet_quadrature(primal.quadrature_degree(order))[0])   # = dual's quadrature_degree(order)
     if workers >= 2:
         context = get_context("fork")
         queue = context.SimpleQueue()
@@ -558,6 +561,7 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
         with one_blas_thread():
             up = primal.solve(mesh, order, cm.hot, cm.cold)
         low = _dual(mesh, order, cm.hot, cm.cold, lambda: up.u)
+    mesh.keep_jacobians(None)
     scale = cm.height / cm.area
     with one_blas_thread():
         volume = primal.volume(mesh)
