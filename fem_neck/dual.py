@@ -78,6 +78,10 @@ class SymmetricStack:
         self.n = n
         self.upper = np.triu_indices(n)
         self.packed = np.empty((count, len(self.upper[0])))
+        position = np.empty((n, n), dtype=np.int64)
+        position[self.upper] = np.arange(len(self.upper[0]))
+        position.T[self.upper] = np.arange(len(self.upper[0]))
+        self.gather = position.ravel()                                       # entry (i, j) -> its packed place
 
     def __len__(self) -> int:
         return len(self.packed)
@@ -86,11 +90,7 @@ class SymmetricStack:
         self.packed[rows] = matrices[:, self.upper[0], self.upper[1]]
 
     def __getitem__(self, rows) -> np.ndarray:
-        packed = self.packed[rows]
-        out = np.empty((len(packed), self.n, self.n))
-        out[:, self.upper[0], self.upper[1]] = packed
-        out[:, self.upper[1], self.upper[0]] = packed
-        return out
+        return np.take(self.packed[rows], self.gather, axis=1).reshape(-1, self.n, self.n)
 
     def times(self, x: np.ndarray) -> np.ndarray:
         """``M_e x_e`` for every matrix, ``x (E, n)``."""
@@ -99,6 +99,18 @@ class SymmetricStack:
             chunk = slice(begin, begin + CHUNK)
             out[chunk] = np.matmul(self[chunk], x[chunk, :, None])[:, :, 0]
         return out
+
+
+def face_blocks(mesh: CurvedMesh, H_K: SymmetricStack) -> np.ndarray:
+    """The diagonal blocks ``(n_faces, n_f, n_f)`` of the face system ``sum_K H_K``: each face's block summed over
+    its elements."""
+    nf = H_K.n // 4
+    out = np.zeros((len(mesh.faces), nf, nf))
+    for begin in range(0, len(H_K), CHUNK):
+        chunk = slice(begin, begin + CHUNK)
+        M = H_K[chunk].reshape(-1, 4, nf, 4, nf)
+        np.add.at(out, mesh.t2f[chunk].T, M[:, np.arange(4), :, np.arange(4), :])   # (4, elements, nf, nf)
+    return out
 
 
 def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.ndarray:
@@ -193,8 +205,8 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     free_faces = np.flatnonzero(~fixed_face)
     coarse = sp.csr_matrix((np.ones(len(free_faces)), (np.arange(len(free_faces)) * nf, np.arange(len(free_faces)))),
                            shape=(len(system.free), len(free_faces)))
-    blocks = np.arange(len(system.free)).reshape(-1, nf)
-    precondition = pcg.two_level(H, coarse, blocks)
+    blocks = np.arange(len(system.free)).reshape(-1, nf)                  # the free faces' moments
+    precondition = pcg.two_level(H, coarse, blocks, face_blocks(mesh, H_K)[free_faces])
     x0 = None if start is None else start()[system.free]
     energy0 = system.constant if x0 is None else system.energy(H, x0)
     x, iterations, residual = pcg.solve(H, system.b, precondition, x0=x0, energy=(energy0, etol))

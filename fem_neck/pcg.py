@@ -3,8 +3,7 @@ Schwarz preconditioner (memory linear in the unknowns).
 
 ``M^-1 r = P (P^T A P)^-1 P^T r + D^-1 r``: a coarse space ``P`` (for high-order elements the piecewise-linear hats,
 for the hybridised fluxes the face means), whose Galerkin matrix gets one smoothed-aggregation AMG V-cycle (pyamg),
-plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (``blocks``: one row of dof indices per
-group, -1 padded; the moments of one face). The coarse space removes the low-frequency error, the local part the
+plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face). The coarse space removes the low-frequency error, the local part the
 high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994 for the p-version).
 """
 
@@ -16,58 +15,38 @@ ENERGY_WINDOW = 10  # steps whose energy drops bound the error left (:func:`solv
 
 
 class TwoLevel:
-    """The preconditioner of the module docstring, as a callable ``r -> M^-1 r``."""
+    """The preconditioner of the module docstring, as a callable ``r -> M^-1 r``: the local part ``D^-1`` is point
+    Jacobi, or block Jacobi on the groups of unknowns ``blocks (B, n)`` (one row of dof indices per group; the
+    moments of one face) whose diagonal blocks of ``A`` are ``block_matrices (B, n, n)`` (point Jacobi on the
+    unknowns of no group), kept as one sparse matrix."""
 
-    def __init__(self, A, P, blocks: np.ndarray | None = None):
+    def __init__(self, A, P, blocks: np.ndarray | None = None, block_matrices: np.ndarray | None = None):
         import pyamg
+        import scipy.sparse as sp
 
         self.P = P.tocsr()
         self.PT = self.P.T.tocsr()
         coarse = (self.PT @ A @ self.P).tocsr()
         self.amg = pyamg.smoothed_aggregation_solver(coarse, symmetry="symmetric", max_coarse=500).aspreconditioner(
             cycle="V")
-        if blocks is None:
-            self.blocks = None
-            self.inv_diag = 1.0 / A.diagonal()
-        else:
-            self.blocks = blocks
-            mask = blocks >= 0
-            idx = np.where(mask, blocks, 0)
-            sub = np.where(mask[:, :, None] & mask[:, None, :], entries(A, idx[:, :, None], idx[:, None, :]), 0.0)
-            n = blocks.shape[1]
-            sub[:, np.arange(n), np.arange(n)] += ~mask                # identity on padding
-            self.inverses = np.linalg.inv(sub)
-            self.mask = mask
-            self.idx = idx
-            self.covered = blocks[mask]
-            if len(np.unique(self.covered)) != len(self.covered):
+        rest = np.ones(A.shape[0], dtype=bool)
+        rows, cols, values = [], [], []
+        if blocks is not None:
+            if len(np.unique(blocks)) != blocks.size:
                 raise ValueError("blocks: a dof belongs to two blocks")
-            covered = np.zeros(A.shape[0], dtype=bool)
-            covered[self.covered] = True
-            self.rest = np.flatnonzero(~covered)
-            self.inv_diag_rest = 1.0 / A.diagonal()[self.rest]
+            rest[blocks] = False
+            rows.append(np.broadcast_to(blocks[:, :, None], block_matrices.shape).ravel())
+            cols.append(np.broadcast_to(blocks[:, None, :], block_matrices.shape).ravel())
+            values.append(np.linalg.inv(block_matrices).ravel())
+        rest = np.flatnonzero(rest)
+        rows.append(rest)
+        cols.append(rest)
+        values.append(1.0 / A.diagonal()[rest])
+        self.local = sp.csr_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
+                                   shape=A.shape)
 
     def __call__(self, r: np.ndarray) -> np.ndarray:
-        z = self.P @ self.amg(self.PT @ r)
-        if self.blocks is None:
-            return z + self.inv_diag * r
-        local = np.where(self.mask, r[self.idx], 0.0)
-        corr = np.matmul(self.inverses, local[:, :, None])[:, :, 0]
-        z[self.covered] += corr[self.mask]  # the blocks do not overlap
-        z[self.rest] += self.inv_diag_rest * r[self.rest]
-        return z
-
-
-def entries(A, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """``A[rows, cols]`` elementwise for broadcast index arrays (zeros where ``A`` has no entry)."""
-    A = A.tocsr()
-    A.sort_indices()
-    n = A.shape[1]
-    keys = np.repeat(np.arange(A.shape[0], dtype=np.int64), np.diff(A.indptr)) * n + A.indices
-    rows, cols = np.broadcast_arrays(rows, cols)
-    want = rows.astype(np.int64) * n + cols
-    pos = np.minimum(np.searchsorted(keys, want), len(keys) - 1)
-    return np.where(keys[pos] == want, A.data[pos], 0.0)
+        return self.P @ self.amg(self.PT @ r) + self.local @ r
 
 
 class Assembly:
@@ -117,8 +96,8 @@ class Assembly:
         return float(x @ (A @ x) - 2.0 * (x @ self.b) + self.constant)
 
 
-def two_level(A, P, blocks: np.ndarray | None = None) -> TwoLevel:
-    return TwoLevel(A, P, blocks)
+def two_level(A, P, blocks: np.ndarray | None = None, block_matrices: np.ndarray | None = None) -> TwoLevel:
+    return TwoLevel(A, P, blocks, block_matrices)
 
 
 def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 5000,
