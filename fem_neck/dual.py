@@ -113,6 +113,66 @@ def face_blocks(mesh: CurvedMesh, H_K: SymmetricStack) -> np.ndarray:
     return out
 
 
+@dataclass
+class FaceSystem:
+    """The face system on the free faces' moments (:func:`face_system`): ``matrix`` (block sparse, one ``n_f``
+    square block per pair of faces of an element), ``b = -H_fd lambda_d``, ``constant = lambda_d^T H_dd lambda_d``
+    (``d``: the faces held at a temperature), the free dofs and the free faces' diagonal blocks."""
+
+    matrix: object
+    b: np.ndarray
+    constant: float
+    free: np.ndarray
+    diagonal: np.ndarray
+
+    def energy(self, x: np.ndarray) -> float:
+        """``lambda^T H lambda`` of ``lambda`` = ``x`` on the free dofs, the held values elsewhere."""
+        return float(x @ (self.matrix @ x) - 2.0 * (x @ self.b) + self.constant)
+
+
+def face_system(mesh: CurvedMesh, H_K: SymmetricStack, fixed_face: np.ndarray, lam: np.ndarray) -> FaceSystem:
+    """``sum_K H_K`` on the free faces as a block sparse matrix: two faces of one element share only that element,
+    so a block off the diagonal is one element's, and a diagonal block the sum of :func:`face_blocks`; the held
+    faces' multipliers ``lam`` go to the right-hand side."""
+    import scipy.sparse as sp
+
+    nf, E = H_K.n // 4, len(H_K)
+    free_faces = np.flatnonzero(~fixed_face)
+    n_free = len(free_faces)
+    index = np.full(len(mesh.faces), -1, dtype=np.int64)
+    index[free_faces] = np.arange(n_free)
+    local_row, local_col = np.nonzero(~np.eye(4, dtype=bool))              # the 12 pairs of distinct faces
+    rows, cols = index[mesh.t2f[:, local_row]], index[mesh.t2f[:, local_col]]
+    off = (rows >= 0) & (cols >= 0)
+    keys = np.concatenate([np.arange(n_free) * (n_free + 1), (rows * n_free + cols)[off]])
+    order = np.argsort(keys)
+    place = np.empty_like(order)
+    place[order] = np.arange(len(order))
+    off_place = np.full(off.shape, -1, dtype=np.int64)
+    off_place[off] = place[n_free:]
+    diagonal = face_blocks(mesh, H_K)[free_faces]
+    data = np.empty((len(keys), nf, nf))
+    data[place[:n_free]] = diagonal
+    b = np.zeros((n_free, nf))
+    constant = 0.0
+    touching = np.any(fixed_face[mesh.t2f], axis=1)
+    for begin in range(0, E, CHUNK):
+        chunk = slice(begin, begin + CHUNK)
+        M = H_K[chunk]
+        blocks = np.moveaxis(M.reshape(-1, 4, nf, 4, nf)[:, local_row, :, local_col, :], 0, 1)
+        data[off_place[chunk][off[chunk]]] = blocks[off[chunk]]
+        near = np.flatnonzero(touching[chunk])                              # elements with a held face
+        faces = mesh.t2f[chunk][near]
+        known = np.where(fixed_face[faces][:, :, None], lam.reshape(-1, nf)[faces], 0.0).reshape(len(near), 4 * nf)
+        load = -np.matmul(M[near], known[:, :, None]).reshape(len(near), 4, nf)
+        np.add.at(b, index[faces][index[faces] >= 0], load[index[faces] >= 0])
+        constant -= float(np.sum(known * load.reshape(len(near), 4 * nf)))
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(keys // n_free, minlength=n_free))])
+    matrix = sp.bsr_matrix((data, keys[order] % n_free, indptr), shape=(n_free * nf, n_free * nf))
+    free = (free_faces[:, None] * nf + np.arange(nf)).ravel()
+    return FaceSystem(matrix, b.ravel(), constant, free, diagonal)
+
+
 def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.ndarray:
     """Face multipliers ``(n_faces n_f,)`` of the ``P_p`` temperature ``u`` (skeleton values in the numbering of
     :func:`fem_neck.primal.numbering`): its trace on every face projected onto ``P_k`` in the face basis (on the
@@ -187,31 +247,28 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     nf = rt.n_face
     T = rt.traces                                                           # (4 nf, m)
     E = len(mesh.tets)
-    l2g = (mesh.t2f[:, :, None] * nf + np.arange(nf)).reshape(E, -1)
     constant = 1.0 / rt.face_basis(np.zeros((1, 2)))[0, 0]                # coefficient of the function 1
     fixed_face = np.zeros(len(mesh.faces), dtype=bool)
     fixed_face[hot] = fixed_face[cold] = True
-    fixed = np.repeat(fixed_face, nf)
     lam = np.zeros(len(mesh.faces) * nf)
     lam[hot * nf] = constant
-    system = pcg.Assembly(l2g, fixed, lam)
-    H_K = SymmetricStack(E, 4 * nf)
+    H_K = SymmetricStack(E, 4 * nf)                                         # (made exactly symmetric)
     for begin in range(0, E, CHUNK):
         elements = np.arange(begin, min(begin + CHUNK, E))
         A = mass_matrices(mesh, rt, degree or quadrature_degree(k + 1), elements)
         H_K[elements] = np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape)))
-        system.add(H_K[elements], elements)                                # (made exactly symmetric)
-    H = system.matrix()
-    free_faces = np.flatnonzero(~fixed_face)
-    coarse = sp.csr_matrix((np.ones(len(free_faces)), (np.arange(len(free_faces)) * nf, np.arange(len(free_faces)))),
-                           shape=(len(system.free), len(free_faces)))
-    blocks = np.arange(len(system.free)).reshape(-1, nf)                  # the free faces' moments
-    precondition = pcg.two_level(H, coarse, blocks, face_blocks(mesh, H_K)[free_faces])
+    system = face_system(mesh, H_K, fixed_face, lam)
+    H = system.matrix
+    n_free = len(system.diagonal)
+    coarse = sp.csr_matrix((np.ones(n_free), (np.arange(n_free) * nf, np.arange(n_free))), shape=(n_free * nf, n_free))
+    blocks = np.arange(n_free * nf).reshape(-1, nf)                         # the free faces' moments
+    precondition = pcg.two_level(H, coarse, blocks, system.diagonal)
     x0 = None if start is None else start()[system.free]
-    energy0 = system.constant if x0 is None else system.energy(H, x0)
+    energy0 = system.constant if x0 is None else system.energy(x0)
     x, iterations, residual = pcg.solve(H, system.b, precondition, x0=x0, energy=(energy0, etol))
     lam[system.free] = x
-    del H, precondition                                                     # (memory for the equilibration)
+    dofs = len(system.free)
+    del H, precondition, system                                             # (memory for the equilibration)
     lam_K = equilibrate(mesh, H_K, lam, fixed_face)
     outward = H_K.times(lam_K).reshape(E * 4, nf)
     energy = float(np.einsum("ea,ea->", lam_K, outward.reshape(E, -1)))    # = sum alpha^T A alpha
@@ -220,4 +277,4 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     heat = float(np.sum(jumps[hot, 0])) * constant                          # a hot face has one side
     jumps[fixed_face] = 0.0
     defect = float(np.abs(jumps).max() * constant / (abs(heat) / max(len(hot), 1)))
-    return Solution(heat**2 / energy, heat, energy, len(system.free), iterations, residual, defect)
+    return Solution(heat**2 / energy, heat, energy, dofs, iterations, residual, defect)

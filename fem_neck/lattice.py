@@ -32,9 +32,11 @@ Both converge at one rate, so ``error_estimate = (upper - lower) / upper`` bound
 (the upper) and is 2-3 times it (the two errors are about equal, measured on the lattice cells). The bounds hold up
 to the quadrature of the curved elements (degree ``2 p``: ~5e-8 relative, measured against ``2 p + 4``) and
 round-off, whatever the solvers' residuals: both CGs stop when their energy has settled to 1e-9; the energy of any
-iterate is an upper bound, and the flux of any iterate is made exactly admissible (:func:`fem_neck.dual.equilibrate`). The mesh is graded toward every neck circle, where the temperature is singular
-(``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined until the estimate
-meets ``rtol``, and the memory of each solve is estimated before its mesh is made (:func:`effective_conductivity`).
+iterate is an upper bound, and the flux of any iterate is made exactly admissible
+(:func:`fem_neck.dual.equilibrate`). The mesh is graded toward every neck circle, where the temperature is
+singular (``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined until the
+estimate meets ``rtol``, and the memory of each solve is estimated before its mesh is made
+(:func:`effective_conductivity`).
 """
 
 from __future__ import annotations

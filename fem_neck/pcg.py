@@ -3,8 +3,9 @@ Schwarz preconditioner (memory linear in the unknowns).
 
 ``M^-1 r = P (P^T A P)^-1 P^T r + D^-1 r``: a coarse space ``P`` (for high-order elements the piecewise-linear hats,
 for the hybridised fluxes the face means), whose Galerkin matrix gets one smoothed-aggregation AMG V-cycle (pyamg),
-plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face). The coarse space removes the low-frequency error, the local part the
-high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994 for the p-version).
+plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face). The coarse space
+removes the low-frequency error, the local part the high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994
+for the p-version).
 """
 
 from __future__ import annotations
