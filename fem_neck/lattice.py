@@ -551,7 +551,8 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
     mesh.keep_jacobians(tet_quadrature(primal.quadrature_degree(order))[0])   # = dual's quadrature_degree(order)
     if workers >= 2:
         context = get_context("fork")
-        queue = context.SimpleQueue()
+        queue = context.Queue()      # put does not wait for the reader (which may have failed before reading)
+        queue.cancel_join_thread()   # nor does the exit, if it never read
         with ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures,
                                  initargs=(queue,)) as pool:
             future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold)

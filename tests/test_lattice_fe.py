@@ -134,6 +134,32 @@ def test_the_lower_bounds_cg_started_from_the_upper_bounds_temperature_takes_few
     assert warm.lower == pytest.approx(cold.lower, rel=1e-9)
 
 
+def test_a_lower_bound_that_fails_before_it_reads_the_temperature_is_reported_not_waited_for(monkeypatch):
+    # the upper bound hands its temperature (here > 64 kB, more than a pipe holds) to the lower bound's process
+    # after solving; had that process failed first, a blocking hand-over would wait for ever (the alarm fails it)
+    import signal
+
+    from fem_neck import dual
+
+    def broken(*args, **kwargs):
+        raise ValueError("the face system failed")
+
+    cm = lattice.build_cell_mesh(lattice.lattice_cell("bcc", 0.08), **lattice.mesh_sizes(0.05))
+    monkeypatch.setattr(dual, "face_system", broken)  # (the forked process has it too)
+
+    def waited(signum, frame):
+        raise TimeoutError("solve_bounds waited for the failed lower bound")
+
+    previous = signal.signal(signal.SIGALRM, waited)
+    signal.alarm(60)
+    try:
+        with pytest.raises(ValueError, match="the face system failed"):
+            lattice.solve_bounds(cm, 4, workers=2)
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 def test_primal_cg_stops_when_the_energy_has_settled():
     # the upper bound's CG stops on its energy (an upper bound whatever the iterate): within the tolerance of the
     # energy solved to round-off, above it, in fewer iterations
