@@ -26,9 +26,7 @@ import importlib.util
 import os
 import pathlib
 import sys
-import tempfile
 
-from dem import jit_cache
 from dem.laws.contact import law_module_name
 
 TEMPLATES = ("dem.engines.contact_forces", "dem.engines.verlet.loop", "dem.engines.staggered.kernels")
@@ -42,8 +40,11 @@ def _copy_name(law: str, template: str, threaded: bool) -> str:
 
 
 def _folder(law: str, threaded: bool) -> pathlib.Path:
-    base = pathlib.Path(os.environ.get("NUMBA_CACHE_DIR") or pathlib.Path(tempfile.gettempdir()) / "sinterheat-numba")
-    return base / f"specialised-{jit_cache.remembered_digest()}" / (f"{law}-threaded" if threaded else law)
+    """Where the copies for ``law`` live: in numba's cache folder, which :func:`dem.jit_cache.configure` named by
+    the digest of the sources."""
+    from numba.core import config
+
+    return pathlib.Path(config.CACHE_DIR) / "specialised" / (f"{law}-threaded" if threaded else law)
 
 
 def module(law: str, template: str, threaded: bool = False):
