@@ -22,7 +22,7 @@ projections), in compiled kernels.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit
@@ -180,6 +180,7 @@ class CurvedMesh:
     projectors: Projectors
     edge_projector: np.ndarray
     face_projector: np.ndarray
+    kept: tuple | None = field(default=None, repr=False)  # (xi, J of every curved element): keep_jacobians
 
     @property
     def is_curved(self) -> np.ndarray:
@@ -203,12 +204,25 @@ class CurvedMesh:
                            np.ascontiguousarray(xi, dtype=float))
 
 
+    def keep_jacobians(self, xi: np.ndarray | None) -> None:
+        """Map every curved element at the reference points ``xi`` once and keep the Jacobians, which :meth:`metric`
+        then reads at these points instead of mapping again (the two bounds integrate at the same points); ``None``
+        drops them."""
+        self.kept = None if xi is None else (np.array(xi), self.map(self.curved, xi)[1])
+
+    def jacobians(self, elements: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        """``J (E, Q, 3, 3)`` of the curved ``elements`` at ``xi``: the kept ones (:meth:`keep_jacobians`) or
+        mapped."""
+        if self.kept is not None and np.array_equal(self.kept[0], xi):
+            return self.kept[1][np.searchsorted(self.curved, elements)]
+        return self.map(elements, xi)[1]
+
     def metric(self, elements: np.ndarray, xi: np.ndarray, w: np.ndarray, inverse: bool) -> np.ndarray:
         """The quadrature-weighted metric of ``elements`` at ``xi`` as six symmetric entries ``(E, Q, 6)`` (order
         ``00, 11, 22, 01, 02, 12``, off-diagonal ones doubled): ``w |det J| J^-1 J^-T`` (``inverse``, for gradients)
         or ``w J^T J / |det J|`` (for Piola-mapped fluxes). ``ValueError`` if an element folds (``det J`` changes
         sign)."""
-        _, J = self.map(elements, xi)
+        J = self.jacobians(elements, xi)
         G, folded = _metric_kernel(J, np.ascontiguousarray(w, dtype=float), inverse)
         if folded:
             raise ValueError("a curved element folds (its Jacobian changes sign): the mesh is too coarse for the "
@@ -324,13 +338,14 @@ def _edge_term(kind, c, e, r, n, d, vi, vj, li, lj, x, dX, i, j, chord, pbuf, jb
     for a in range(3):
         chord[a] = vi[a] + t * (vj[a] - vi[a])
     _project(kind, c, e, r, n, d, chord, pbuf, jbuf)
+    weight, slope, curve = s**BLEND, BLEND * s ** (BLEND - 1), s ** (BLEND - 2)
     for a in range(3):
         off = pbuf[a] - chord[a]
         dd = (jbuf[a, 0] * (vj[0] - vi[0]) + jbuf[a, 1] * (vj[1] - vi[1]) + jbuf[a, 2] * (vj[2] - vi[2])
               - (vj[a] - vi[a]))
-        x[a] += s**BLEND * off
-        dX[a, i] += BLEND * s ** (BLEND - 1) * off - s ** (BLEND - 2) * lj * dd
-        dX[a, j] += BLEND * s ** (BLEND - 1) * off + s ** (BLEND - 2) * li * dd
+        x[a] += weight * off
+        dX[a, i] += slope * off - curve * lj * dd
+        dX[a, j] += slope * off + curve * li * dd
 
 
 @njit(cache=True)
@@ -390,12 +405,13 @@ def _map_kernel(points, tets, edge_row, face_row, kind, pc, pe, pr, pn, pd, elem
                 for k in range(3):
                     for m in range(3):
                         dD[k, m] = jbuf[k, 0] * dy[0, m] + jbuf[k, 1] * dy[1, m] + jbuf[k, 2] * dy[2, m] - dy[k, m]
+                weight, slope = s**BLEND, s ** (BLEND - 1)
                 for k in range(3):
                     D = pbuf[k] - y[k]
                     mean = dD[k, 0] * mu[0] + dD[k, 1] * mu[1] + dD[k, 2] * mu[2]
-                    x[k] += s**BLEND * D
+                    x[k] += weight * D
                     for m in range(3):
-                        dX[k, f[m]] += s ** (BLEND - 1) * (BLEND * D + dD[k, m] - mean)
+                        dX[k, f[m]] += slope * (BLEND * D + dD[k, m] - mean)
             for k in range(3):
                 X[a, q, k] = x[k]
                 for m in range(3):

@@ -1,27 +1,40 @@
 """The lower bound: a divergence-free heat flux on the exactly curved mesh (Thomson's principle), from the hybridised
-mixed method with Raviart-Thomas elements of degree ``k`` (Arnold & Brezzi 1985).
+mixed method with Raviart-Thomas elements of degree ``k`` (Arnold & Brezzi 1985), made exactly admissible whatever
+the face solver's residual.
 
 On every element the flux is a divergence-free field of ``RT_k`` mapped by Piola (:mod:`fem_neck.simplex`); its
 normal traces are tied together by a multiplier ``lambda`` in ``P_k`` on every face (the temperature trace), which is
 1 on the hot faces, 0 on the cold ones and unknown elsewhere. Eliminating the element fluxes leaves the symmetric
-positive definite face system ``H lambda = 0``, with ``H = sum_K T A_K^-1 T^T`` (``A_K`` the element's flux mass,
-``T`` the reference trace moments). Its solution's flux ``q`` has, exactly, zero divergence in every element, the
-same normal flux on both sides of every interior face (moments in ``P_k`` of a ``P_k`` trace) and none on the
-insulated faces: admissible in the complementary principle on the exact solid, so ``K >= P^2 / E*`` with ``P`` the
-heat it carries through the hot face and ``E* = int |q|^2``. The normal-flux continuity holds to the face system's
-residual; the largest jump is reported (``flux_defect``). Degree ``k = p - 1`` converges at the rate of the
-``P_p`` upper bound (both errors ``O(h^2p)`` in the energy).
+positive definite face system ``H lambda = 0``, with ``H = sum_K H_K``, ``H_K = T A_K^-1 T^T`` (``A_K`` the element's
+flux mass, ``T`` the reference trace moments); the element flux of ``lambda`` is ``A_K^-1 T^T lambda_K`` and its
+outward trace moments ``H_K lambda_K``. The face system is minimised by conjugate gradients until its energy
+``lambda^T H lambda`` has settled (as the upper bound's, :data:`fem_neck.primal.ENERGY_RTOL`), so the element fluxes
+of the iterate still jump across the faces by the residual.
+
+Equilibration (:func:`equilibrate`): every face gets one flux -- the mean of its two sides' traces, zero on the
+insulated faces -- whose face means are then corrected (the correction of least norm, a sparse direct solve on the
+element graph) so that the net flux out of every element vanishes; the element then takes the divergence-free field
+of least energy with exactly these traces (``lambda_K + mu_K`` with ``H_K mu_K`` the change of its traces; the
+traces of divergence-free ``RT_k`` fields are all of ``P_k`` per face with zero net flux). The result is divergence
+free in every element with one normal flux on every face and none on the insulated ones, to round-off whatever the
+iterate: admissible in the complementary principle on the exact solid, so ``K >= P^2 / E*`` with ``P`` the heat it
+carries through the hot faces and ``E* = int |q|^2`` (the largest normal-flux jump left is reported,
+``flux_defect``). The correction is of the size of the solver's error, which the bound feels only to second order
+(it is the maximum of ``P^2 / E*``); making an iterate's flux admissible to decouple the guarantee from the
+algebraic error follows Jiranek, Strakos & Vohralik 2010. Degree ``k = p - 1`` converges at the rate of the ``P_p``
+upper bound (both errors ``O(h^2p)`` in the energy).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from fem_neck.curved import CurvedMesh
-from fem_neck.primal import quadrature_degree, symmetric_products
-from fem_neck.simplex import RaviartThomas, raviart_thomas, tet_quadrature
+from fem_neck.primal import ENERGY_RTOL, numbering, quadrature_degree, symmetric_products
+from fem_neck.simplex import RaviartThomas, face_points, lagrange, raviart_thomas, tet_quadrature, triangle_quadrature
 
 CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arrays)
 
@@ -44,8 +57,9 @@ def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np
 @dataclass
 class Solution:
     """``lower = P^2 / E*`` (the lower bound of the conductance for a unit temperature difference, kappa = 1), the
-    heat flow ``P`` through the hot faces, ``E*``, face dofs, CG iterations, the relative residual and the largest
-    normal-flux jump across a face relative to the mean flux per hot face."""
+    heat flow ``P`` through the hot faces, ``E*``, face dofs, CG iterations, the relative residual of the face
+    system and the largest normal-flux jump across a face of the equilibrated flux relative to the mean flux per
+    hot face (round-off)."""
 
     lower: float
     heat_flow: float
@@ -56,12 +70,175 @@ class Solution:
     flux_defect: float
 
 
-def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, rtol: float = 1e-10,
-          degree: int | None = None) -> Solution:
-    """The hybridised ``RT_k`` flux with temperature 1 on the ``hot`` faces and 0 on the ``cold`` ones (indices
-    into ``mesh.faces``; quadrature of ``degree`` on curved elements); see the module docstring. The element fluxes
-    are eliminated chunk by chunk (``H_K = T A_K^-1 T^T``); the net flux moments of the faces are the face system's
-    ``-H lambda``: its residual on the free faces (the normal-flux jumps) and the heat flow on the hot ones."""
+class SymmetricStack:
+    """Symmetric matrices ``(E, n, n)`` kept as their upper triangles (half the memory); ``stack[rows] = M`` keeps
+    the upper triangles of ``M``, ``stack[rows]`` gives the symmetric matrices."""
+
+    def __init__(self, count: int, n: int):
+        self.n = n
+        self.upper = np.triu_indices(n)
+        self.packed = np.empty((count, len(self.upper[0])))
+        position = np.empty((n, n), dtype=np.int64)
+        position[self.upper] = np.arange(len(self.upper[0]))
+        position.T[self.upper] = np.arange(len(self.upper[0]))
+        self.gather = position.ravel()                                       # entry (i, j) -> its packed place
+
+    def __len__(self) -> int:
+        return len(self.packed)
+
+    def __setitem__(self, rows, matrices: np.ndarray) -> None:
+        self.packed[rows] = matrices[:, self.upper[0], self.upper[1]]
+
+    def __getitem__(self, rows) -> np.ndarray:
+        return np.take(self.packed[rows], self.gather, axis=1).reshape(-1, self.n, self.n)
+
+    def times(self, x: np.ndarray) -> np.ndarray:
+        """``M_e x_e`` for every matrix, ``x (E, n)``."""
+        out = np.empty_like(x)
+        for begin in range(0, len(self), CHUNK):
+            chunk = slice(begin, begin + CHUNK)
+            out[chunk] = np.matmul(self[chunk], x[chunk, :, None])[:, :, 0]
+        return out
+
+
+def face_blocks(mesh: CurvedMesh, H_K: SymmetricStack) -> np.ndarray:
+    """The diagonal blocks ``(n_faces, n_f, n_f)`` of the face system ``sum_K H_K``: each face's block summed over
+    its elements."""
+    nf = H_K.n // 4
+    out = np.zeros((len(mesh.faces), nf, nf))
+    for begin in range(0, len(H_K), CHUNK):
+        chunk = slice(begin, begin + CHUNK)
+        M = H_K[chunk].reshape(-1, 4, nf, 4, nf)
+        np.add.at(out, mesh.t2f[chunk].T, M[:, np.arange(4), :, np.arange(4), :])   # (4, elements, nf, nf)
+    return out
+
+
+@dataclass
+class FaceSystem:
+    """The face system on the free faces' moments (:func:`face_system`): ``matrix`` (block sparse, one ``n_f``
+    square block per pair of faces of an element), ``b = -H_fd lambda_d``, ``constant = lambda_d^T H_dd lambda_d``
+    (``d``: the faces held at a temperature), the free dofs and the free faces' diagonal blocks."""
+
+    matrix: object
+    b: np.ndarray
+    constant: float
+    free: np.ndarray
+    diagonal: np.ndarray
+
+    def energy(self, x: np.ndarray) -> float:
+        """``lambda^T H lambda`` of ``lambda`` = ``x`` on the free dofs, the held values elsewhere."""
+        return float(x @ (self.matrix @ x) - 2.0 * (x @ self.b) + self.constant)
+
+
+def face_system(mesh: CurvedMesh, H_K: SymmetricStack, fixed_face: np.ndarray, lam: np.ndarray) -> FaceSystem:
+    """``sum_K H_K`` on the free faces as a block sparse matrix: two faces of one element share only that element,
+    so a block off the diagonal is one element's, and a diagonal block the sum of :func:`face_blocks`; the held
+    faces' multipliers ``lam`` go to the right-hand side."""
+    import scipy.sparse as sp
+
+    nf, E = H_K.n // 4, len(H_K)
+    free_faces = np.flatnonzero(~fixed_face)
+    n_free = len(free_faces)
+    index = np.full(len(mesh.faces), -1, dtype=np.int64)
+    index[free_faces] = np.arange(n_free)
+    local_row, local_col = np.nonzero(~np.eye(4, dtype=bool))              # the 12 pairs of distinct faces
+    rows, cols = index[mesh.t2f[:, local_row]], index[mesh.t2f[:, local_col]]
+    off = (rows >= 0) & (cols >= 0)
+    keys = np.concatenate([np.arange(n_free) * (n_free + 1), (rows * n_free + cols)[off]])
+    order = np.argsort(keys)
+    place = np.empty_like(order)
+    place[order] = np.arange(len(order))
+    off_place = np.full(off.shape, -1, dtype=np.int64)
+    off_place[off] = place[n_free:]
+    diagonal = face_blocks(mesh, H_K)[free_faces]
+    data = np.empty((len(keys), nf, nf))
+    data[place[:n_free]] = diagonal
+    b = np.zeros((n_free, nf))
+    constant = 0.0
+    touching = np.any(fixed_face[mesh.t2f], axis=1)
+    for begin in range(0, E, CHUNK):
+        chunk = slice(begin, begin + CHUNK)
+        M = H_K[chunk]
+        blocks = np.moveaxis(M.reshape(-1, 4, nf, 4, nf)[:, local_row, :, local_col, :], 0, 1)
+        data[off_place[chunk][off[chunk]]] = blocks[off[chunk]]
+        near = np.flatnonzero(touching[chunk])                              # elements with a held face
+        faces = mesh.t2f[chunk][near]
+        known = np.where(fixed_face[faces][:, :, None], lam.reshape(-1, nf)[faces], 0.0).reshape(len(near), 4 * nf)
+        load = -np.matmul(M[near], known[:, :, None]).reshape(len(near), 4, nf)
+        np.add.at(b, index[faces][index[faces] >= 0], load[index[faces] >= 0])
+        constant -= float(np.sum(known * load.reshape(len(near), 4 * nf)))
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(keys // n_free, minlength=n_free))])
+    matrix = sp.bsr_matrix((data, keys[order] % n_free, indptr), shape=(n_free * nf, n_free * nf))
+    free = (free_faces[:, None] * nf + np.arange(nf)).ravel()
+    return FaceSystem(matrix, b.ravel(), constant, free, diagonal)
+
+
+def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.ndarray:
+    """Face multipliers ``(n_faces n_f,)`` of the ``P_p`` temperature ``u`` (skeleton values in the numbering of
+    :func:`fem_neck.primal.numbering`): its trace on every face projected onto ``P_k`` in the face basis (on the
+    unit triangle of the face's own coordinates, from its first element) -- close to the face system's solution,
+    from which its CG starts."""
+    basis, rt = lagrange(p), raviart_thomas(k)
+    skeleton = numbering(mesh, basis).l2g
+    nf = rt.n_face
+    st, w = triangle_quadrature(p + k)
+    weighted = 2.0 * w[:, None] * rt.face_basis(st)                      # the face basis is orthonormal for 2 int
+    faces = mesh.t2f.ravel()
+    first = np.zeros(len(faces), dtype=bool)
+    first[np.unique(faces, return_index=True)[1]] = True
+    out = np.zeros((len(mesh.faces), nf))
+    for face in range(4):
+        elements = np.flatnonzero(first.reshape(-1, 4)[:, face])
+        values = basis.values(face_points(face, st))[:, :skeleton.shape[1]]  # interior nodes vanish on the faces
+        out[mesh.t2f[elements, face]] = u[skeleton[elements]] @ (weighted.T @ values).T
+    return out.ravel()
+
+
+def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_face: np.ndarray) -> np.ndarray:
+    """Element multipliers ``(E, 4 n_f)`` whose element fluxes ``A_K^-1 T^T lambda_K`` form an admissible flux:
+    one normal flux on every face, none on the insulated ones (the module docstring), from the element matrices
+    ``H_K`` (``4 n_f`` square), any face multipliers ``lam (n_faces n_f,)`` and the faces held at a temperature
+    (``fixed_face``, whose flux is free)."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import spsolve
+
+    E, n = len(H_K), H_K.n
+    nf = n // 4
+    faces = mesh.t2f.ravel()
+    lam_K = lam.reshape(-1, nf)[mesh.t2f].reshape(E, n)
+    outward = H_K.times(lam_K).reshape(E * 4, nf)
+    # each face's flux along the normal out of its first element: the mean of its sides
+    sides = np.bincount(faces, minlength=len(mesh.faces))
+    first = np.zeros(len(faces), dtype=bool)
+    first[np.unique(faces, return_index=True)[1]] = True
+    sign = np.where(first, 1.0, -1.0)
+    flux = np.zeros((len(mesh.faces), nf))
+    np.add.at(flux, faces, sign[:, None] * outward)
+    flux /= sides[:, None]
+    insulated = (sides == 1) & ~fixed_face
+    flux[insulated] = 0.0
+    # the face means' correction of least norm that leaves no element a net flux: B c = -(B flux_0), c = B^T y
+    live = ~insulated[faces]
+    B = sp.csr_matrix((sign[live], (np.repeat(np.arange(E), 4)[live], faces[live])), shape=(E, len(mesh.faces)))
+    net = (sign * flux[faces, 0]).reshape(E, 4).sum(axis=1)
+    flux[:, 0] += B.T @ spsolve((B @ B.T).tocsc(), -net)
+    # each element's divergence-free field of least energy with these traces: H_K mu = change of the traces (the
+    # constant multiplier, H_K's null space, added to make the system regular; the change is orthogonal to it)
+    change = (sign[:, None] * flux[faces] - outward).reshape(E, n)
+    null = np.zeros(n)
+    null[::nf] = 1.0
+    for begin in range(0, E, CHUNK):
+        chunk = slice(begin, begin + CHUNK)
+        lam_K[chunk] += np.linalg.solve(H_K[chunk] + np.outer(null, null), change[chunk, :, None])[:, :, 0]
+    return lam_K
+
+
+def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: float = ENERGY_RTOL,
+          degree: int | None = None, start: Callable[[], np.ndarray] | None = None) -> Solution:
+    """The equilibrated hybridised ``RT_k`` flux with temperature 1 on the ``hot`` faces and 0 on the ``cold`` ones
+    (indices into ``mesh.faces``; quadrature of ``degree`` on curved elements); see the module docstring. CG stops
+    when the face system's energy has settled to ``etol`` (:func:`fem_neck.pcg.solve`), starting from zero or from
+    the face multipliers ``start()`` returns once the system is assembled (:func:`trace_multipliers`)."""
     import scipy.sparse as sp
 
     from fem_neck import pcg
@@ -69,27 +246,35 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, rtol: flo
     rt = raviart_thomas(k)
     nf = rt.n_face
     T = rt.traces                                                           # (4 nf, m)
-    l2g = (mesh.t2f[:, :, None] * nf + np.arange(nf)).reshape(len(mesh.tets), -1)
+    E = len(mesh.tets)
     constant = 1.0 / rt.face_basis(np.zeros((1, 2)))[0, 0]                # coefficient of the function 1
     fixed_face = np.zeros(len(mesh.faces), dtype=bool)
     fixed_face[hot] = fixed_face[cold] = True
-    fixed = np.repeat(fixed_face, nf)
     lam = np.zeros(len(mesh.faces) * nf)
     lam[hot * nf] = constant
-    system = pcg.Assembly(l2g, fixed, lam)
-    for start in range(0, len(mesh.tets), CHUNK):
-        elements = np.arange(start, min(start + CHUNK, len(mesh.tets)))
+    H_K = SymmetricStack(E, 4 * nf)                                         # (made exactly symmetric)
+    for begin in range(0, E, CHUNK):
+        elements = np.arange(begin, min(begin + CHUNK, E))
         A = mass_matrices(mesh, rt, degree or quadrature_degree(k + 1), elements)
-        system.add(np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape))), elements)
-    H = system.matrix()
-    free_faces = np.flatnonzero(~fixed_face)
-    coarse = sp.csr_matrix((np.ones(len(free_faces)), (np.arange(len(free_faces)) * nf, np.arange(len(free_faces)))),
-                           shape=(len(system.free), len(free_faces)))
-    blocks = np.arange(len(system.free)).reshape(-1, nf)
-    x, iterations, residual = pcg.solve(H, system.b, pcg.two_level(H, coarse, blocks), rtol=rtol)
+        H_K[elements] = np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape)))
+    system = face_system(mesh, H_K, fixed_face, lam)
+    H = system.matrix
+    n_free = len(system.diagonal)
+    coarse = sp.csr_matrix((np.ones(n_free), (np.arange(n_free) * nf, np.arange(n_free))), shape=(n_free * nf, n_free))
+    blocks = np.arange(n_free * nf).reshape(-1, nf)                         # the free faces' moments
+    precondition = pcg.two_level(H, coarse, blocks, system.diagonal)
+    x0 = None if start is None else start()[system.free]
+    energy0 = system.constant if x0 is None else system.energy(x0)
+    x, iterations, residual = pcg.solve(H, system.b, precondition, x0=x0, energy=(energy0, etol))
     lam[system.free] = x
-    energy = system.energy(H, x)                                            # = sum alpha^T A alpha
-    heat = float(np.sum(system.boundary_rows(lam)[hot * nf])) * constant    # into the solid at the hot faces
-    jumps = np.abs(H @ x - system.b) * constant
-    defect = float(jumps.max() / (abs(heat) / max(len(hot), 1))) if len(jumps) else 0.0
-    return Solution(heat**2 / energy, heat, energy, len(system.free), iterations, residual, defect)
+    dofs = len(system.free)
+    del H, precondition, system                                             # (memory for the equilibration)
+    lam_K = equilibrate(mesh, H_K, lam, fixed_face)
+    outward = H_K.times(lam_K).reshape(E * 4, nf)
+    energy = float(np.einsum("ea,ea->", lam_K, outward.reshape(E, -1)))    # = sum alpha^T A alpha
+    jumps = np.zeros((len(mesh.faces), nf))                                 # outward moments summed per face
+    np.add.at(jumps, mesh.t2f.ravel(), outward)
+    heat = float(np.sum(jumps[hot, 0])) * constant                          # a hot face has one side
+    jumps[fixed_face] = 0.0
+    defect = float(np.abs(jumps).max() * constant / (abs(heat) / max(len(hot), 1)))
+    return Solution(heat**2 / energy, heat, energy, dofs, iterations, residual, defect)

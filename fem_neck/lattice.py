@@ -30,11 +30,13 @@ face mapped onto its sphere, cylinder, plane or their intersection curve), so th
 
 Both converge at one rate, so ``error_estimate = (upper - lower) / upper`` bounds the error of the reported value
 (the upper) and is 2-3 times it (the two errors are about equal, measured on the lattice cells). The bounds hold up
-to the quadrature of the curved elements (degree ``2 p``: ~5e-8 relative, measured against ``2 p + 4``) and the
-flux solver's residual (1e-10; the upper bound's CG stops when its energy has settled to 1e-9, and the energy of
-any iterate is an upper bound). The mesh is graded toward every neck circle, where the temperature is singular
-(``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined until the estimate
-meets ``rtol``, and the memory of each solve is estimated before its mesh is made (:func:`effective_conductivity`).
+to the quadrature of the curved elements (degree ``2 p``: ~5e-8 relative, measured against ``2 p + 4``) and
+round-off, whatever the solvers' residuals: both CGs stop when their energy has settled to 1e-9; the energy of any
+iterate is an upper bound, and the flux of any iterate is made exactly admissible
+(:func:`fem_neck.dual.equilibrate`). The mesh is graded toward every neck circle, where the temperature is
+singular (``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined until the
+estimate meets ``rtol``, and the memory of each solve is estimated before its mesh is made
+(:func:`effective_conductivity`).
 """
 
 from __future__ import annotations
@@ -82,8 +84,9 @@ P3_FROM = 3e-4  # the rtol from which the upper bound is P_3 by default (below, 
 # that puts every measured mesh on the safe side: 64 of them (also the other random packings and the first meshes
 # of the dense-packing study) were predicted 1.04-1.77 times their tetrahedra
 TETRAHEDRA_PER_CIRCLE, TETRAHEDRA_PER_VOLUME, PREDICTION_MARGIN = 315.0, 27.3, 1.3
-# peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured)
-BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 70e3}
+# peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured by
+# peak_memory: p = 4 91 kB per tetrahedron beyond the base on BCC and FCC h/r = 0.02, p = 3 31 kB on FCC 0.02)
+BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 100e3}
 _TOL = 1e-9  # geometric tolerance in units of the largest radius
 
 
@@ -491,7 +494,7 @@ def _conducting(points: np.ndarray, tets: np.ndarray, height: float, tol: float)
 @dataclass(frozen=True)
 class Bounds:
     """Both bounds of one mesh, as ``k / kappa`` of the cell: ``upper`` (P_p energy) and ``lower`` (RT_(p-1) flux),
-    the flux's largest normal-flux jump relative to its mean flux per hot face (admissibility, ~solver tolerance),
+    the flux's largest normal-flux jump relative to its mean flux per hot face (admissibility, round-off),
     unknowns of both solves, tetrahedra, the mapped mesh's volume over the exact one minus 1, seconds."""
 
     upper: float
@@ -508,33 +511,60 @@ class Bounds:
         return (self.upper - self.lower) / self.upper
 
 
-def _dual(mesh, order: int, hot, cold):
+def _dual(mesh, order: int, hot, cold, temperature):
+    """The lower bound, its CG started from the trace of the upper bound's temperature (``temperature()``, called
+    once the face system is assembled)."""
     from fem_neck import dual
 
+    def start():
+        return dual.trace_multipliers(mesh, order, temperature(), order - 1)
+
     with one_blas_thread():  # the dense work is many small products (see fem_neck.spectral.conductance)
-        return dual.solve(mesh, order - 1, hot, cold)
+        return dual.solve(mesh, order - 1, hot, cold, start=start)
+
+
+_TEMPERATURES = None  # in the lower bound's process: the queue on which the upper bound's temperature arrives
+
+
+def _receive_temperatures(queue) -> None:
+    global _TEMPERATURES
+    _TEMPERATURES = queue
+
+
+def _dual_receiving(mesh, order: int, hot, cold):
+    return _dual(mesh, order, hot, cold, _TEMPERATURES.get)
 
 
 def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
     """Upper and lower bound of the cell's ``k / kappa`` on the mesh ``cm`` (module docstring), the two solves in
-    parallel processes when ``workers >= 2``."""
+    parallel processes when ``workers >= 2`` (the lower bound assembles its system while the upper bound solves,
+    then starts its CG from the upper bound's temperature). Both integrate the curved elements at the same points,
+    where the elements are mapped once."""
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
 
     from fem_neck import primal
+    from fem_neck.simplex import tet_quadrature
 
     t0 = time.perf_counter()
     mesh = cm.curved
+    mesh.keep_jacobians(tet_quadrature(primal.quadrature_degree(order))[0])   # = dual's quadrature_degree(order)
     if workers >= 2:
-        with ProcessPoolExecutor(1, mp_context=get_context("fork")) as pool:
-            future = pool.submit(_dual, mesh, order, cm.hot, cm.cold)
+        context = get_context("fork")
+        queue = context.Queue()      # put does not wait for the reader (which may have failed before reading)
+        queue.cancel_join_thread()   # nor does the exit, if it never read
+        with ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures,
+                                 initargs=(queue,)) as pool:
+            future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold)
             with one_blas_thread():
                 up = primal.solve(mesh, order, cm.hot, cm.cold)
+            queue.put(up.u)
             low = future.result()
     else:
         with one_blas_thread():
             up = primal.solve(mesh, order, cm.hot, cm.cold)
-        low = _dual(mesh, order, cm.hot, cm.cold)
+        low = _dual(mesh, order, cm.hot, cm.cold, lambda: up.u)
+    mesh.keep_jacobians(None)
     scale = cm.height / cm.area
     with one_blas_thread():
         volume = primal.volume(mesh)

@@ -3,9 +3,9 @@ Schwarz preconditioner (memory linear in the unknowns).
 
 ``M^-1 r = P (P^T A P)^-1 P^T r + D^-1 r``: a coarse space ``P`` (for high-order elements the piecewise-linear hats,
 for the hybridised fluxes the face means), whose Galerkin matrix gets one smoothed-aggregation AMG V-cycle (pyamg),
-plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (``blocks``: one row of dof indices per
-group, -1 padded; the moments of one face). The coarse space removes the low-frequency error, the local part the
-high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994 for the p-version).
+plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face). The coarse space
+removes the low-frequency error, the local part the high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994
+for the p-version).
 """
 
 from __future__ import annotations
@@ -16,66 +16,45 @@ ENERGY_WINDOW = 10  # steps whose energy drops bound the error left (:func:`solv
 
 
 class TwoLevel:
-    """The preconditioner of the module docstring, as a callable ``r -> M^-1 r``."""
+    """The preconditioner of the module docstring, as a callable ``r -> M^-1 r``: the local part ``D^-1`` is point
+    Jacobi, or block Jacobi on the groups of unknowns ``blocks (B, n)`` (one row of dof indices per group; the
+    moments of one face) whose diagonal blocks of ``A`` are ``block_matrices (B, n, n)`` (point Jacobi on the
+    unknowns of no group), kept as one sparse matrix."""
 
-    def __init__(self, A, P, blocks: np.ndarray | None = None):
+    def __init__(self, A, P, blocks: np.ndarray | None = None, block_matrices: np.ndarray | None = None):
         import pyamg
+        import scipy.sparse as sp
 
         self.P = P.tocsr()
         self.PT = self.P.T.tocsr()
         coarse = (self.PT @ A @ self.P).tocsr()
         self.amg = pyamg.smoothed_aggregation_solver(coarse, symmetry="symmetric", max_coarse=500).aspreconditioner(
             cycle="V")
-        if blocks is None:
-            self.blocks = None
-            self.inv_diag = 1.0 / A.diagonal()
-        else:
-            self.blocks = blocks
-            mask = blocks >= 0
-            idx = np.where(mask, blocks, 0)
-            sub = np.where(mask[:, :, None] & mask[:, None, :], entries(A, idx[:, :, None], idx[:, None, :]), 0.0)
-            n = blocks.shape[1]
-            sub[:, np.arange(n), np.arange(n)] += ~mask                # identity on padding
-            self.inverses = np.linalg.inv(sub)
-            self.mask = mask
-            self.idx = idx
-            self.covered = blocks[mask]
-            if len(np.unique(self.covered)) != len(self.covered):
+        rest = np.ones(A.shape[0], dtype=bool)
+        rows, cols, values = [], [], []
+        if blocks is not None:
+            if len(np.unique(blocks)) != blocks.size:
                 raise ValueError("blocks: a dof belongs to two blocks")
-            covered = np.zeros(A.shape[0], dtype=bool)
-            covered[self.covered] = True
-            self.rest = np.flatnonzero(~covered)
-            self.inv_diag_rest = 1.0 / A.diagonal()[self.rest]
+            rest[blocks] = False
+            rows.append(np.broadcast_to(blocks[:, :, None], block_matrices.shape).ravel())
+            cols.append(np.broadcast_to(blocks[:, None, :], block_matrices.shape).ravel())
+            values.append(np.linalg.inv(block_matrices).ravel())
+        rest = np.flatnonzero(rest)
+        rows.append(rest)
+        cols.append(rest)
+        values.append(1.0 / A.diagonal()[rest])
+        self.local = sp.csr_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
+                                   shape=A.shape)
 
     def __call__(self, r: np.ndarray) -> np.ndarray:
-        z = self.P @ self.amg(self.PT @ r)
-        if self.blocks is None:
-            return z + self.inv_diag * r
-        local = np.where(self.mask, r[self.idx], 0.0)
-        corr = np.matmul(self.inverses, local[:, :, None])[:, :, 0]
-        z[self.covered] += corr[self.mask]  # the blocks do not overlap
-        z[self.rest] += self.inv_diag_rest * r[self.rest]
-        return z
-
-
-def entries(A, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """``A[rows, cols]`` elementwise for broadcast index arrays (zeros where ``A`` has no entry)."""
-    A = A.tocsr()
-    A.sort_indices()
-    n = A.shape[1]
-    keys = np.repeat(np.arange(A.shape[0], dtype=np.int64), np.diff(A.indptr)) * n + A.indices
-    rows, cols = np.broadcast_arrays(rows, cols)
-    want = rows.astype(np.int64) * n + cols
-    pos = np.minimum(np.searchsorted(keys, want), len(keys) - 1)
-    return np.where(keys[pos] == want, A.data[pos], 0.0)
+        return self.P @ self.amg(self.PT @ r) + self.local @ r
 
 
 class Assembly:
     """The system of the free unknowns, assembled chunk by chunk from element matrices on the global dofs ``l2g (E,
     n)``, the dofs marked ``fixed`` held at ``values``. Only the free block is stored (COO with 32-bit indices,
-    allocated once, then CSR); the element matrices of a chunk can be dropped after :meth:`add`, except those of
-    elements with a fixed dof, kept for :meth:`boundary_rows`. ``A_ff x = b`` gives the free values; :meth:`energy`
-    is ``u^T A u`` of the full vector exactly, whatever ``x``."""
+    allocated once, then CSR); the element matrices of a chunk can be dropped after :meth:`add`. ``A_ff x = b`` gives
+    the free values; :meth:`energy` is ``u^T A u`` of the full vector exactly, whatever ``x``."""
 
     def __init__(self, l2g: np.ndarray, fixed: np.ndarray, values: np.ndarray):
         self.free = np.flatnonzero(~fixed)
@@ -90,8 +69,6 @@ class Assembly:
         self.data = np.empty(self.offset[-1])
         self.b = np.zeros(len(self.free))
         self.constant = 0.0
-        self.touching = np.flatnonzero(np.any(fixed[l2g], axis=1))            # elements with a fixed dof
-        self.kept = {}
 
     def add(self, K: np.ndarray, elements: np.ndarray) -> None:
         loc = self.loc[elements]
@@ -105,8 +82,6 @@ class Assembly:
         self.rows[span] = np.broadcast_to(loc[:, :, None], K.shape)[pair]
         self.cols[span] = np.broadcast_to(loc[:, None, :], K.shape)[pair]
         self.data[span] = K[pair]
-        for k in np.flatnonzero(np.isin(elements, self.touching)):
-            self.kept[int(elements[k])] = K[k].copy()
 
     def matrix(self):
         """``A_ff`` (CSR); frees the COO arrays."""
@@ -121,18 +96,9 @@ class Assembly:
         u_d`` (``A_fd u_d = -b``)."""
         return float(x @ (A @ x) - 2.0 * (x @ self.b) + self.constant)
 
-    def boundary_rows(self, u: np.ndarray) -> np.ndarray:
-        """``(A u)`` at the fixed dofs (zero elsewhere), from the kept element matrices."""
-        out = np.zeros(len(self.fixed))
-        for e, K in self.kept.items():
-            dofs = self.l2g[e]
-            np.add.at(out, dofs, K @ u[dofs])
-        out[~self.fixed] = 0.0
-        return out
 
-
-def two_level(A, P, blocks: np.ndarray | None = None) -> TwoLevel:
-    return TwoLevel(A, P, blocks)
+def two_level(A, P, blocks: np.ndarray | None = None, block_matrices: np.ndarray | None = None) -> TwoLevel:
+    return TwoLevel(A, P, blocks, block_matrices)
 
 
 def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 5000,
