@@ -8,7 +8,7 @@ normal traces are tied together by a multiplier ``lambda`` in ``P_k`` on every f
 positive definite face system ``H lambda = 0``, with ``H = sum_K H_K``, ``H_K = T A_K^-1 T^T`` (``A_K`` the element's
 flux mass, ``T`` the reference trace moments); the element flux of ``lambda`` is ``A_K^-1 T^T lambda_K`` and its
 outward trace moments ``H_K lambda_K``. The face system is minimised by conjugate gradients until its energy
-``lambda^T H lambda`` has settled (as the upper bound's, :data:`fem_neck.primal.ENERGY_RTOL`), so the element fluxes
+``lambda^T H lambda`` has settled (as the upper bound's, ``fem_neck.primal.ENERGY_RTOL``), so the element fluxes
 of the iterate still jump across the faces by the residual.
 
 Equilibration (:func:`equilibrate`): every face gets one flux -- the mean of its two sides' traces, zero on the
