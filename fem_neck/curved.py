@@ -190,6 +190,17 @@ class CurvedMesh:
     def curved(self) -> np.ndarray:
         return np.flatnonzero(self.is_curved)
 
+    def face_sides(self) -> np.ndarray:
+        """The elements each face belongs to: 1 on the boundary of the mesh, 2 inside."""
+        return np.bincount(self.t2f.ravel(), minlength=len(self.faces))
+
+    def first_sides(self) -> np.ndarray:
+        """``(E, 4)`` mask of the element sides that are their face's first (the element of lowest index): the
+        element a face's one normal points out of."""
+        first = np.zeros(self.t2f.size, dtype=bool)
+        first[np.unique(self.t2f.ravel(), return_index=True)[1]] = True
+        return first.reshape(self.t2f.shape)
+
     def affine_jacobians(self, elements: np.ndarray | None = None) -> np.ndarray:
         """``J (E, 3, 3)`` of the straight ``elements`` (default all; columns ``v_i - v_0``)."""
         v = self.points[self.tets if elements is None else self.tets[elements]]

@@ -183,12 +183,10 @@ def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.nda
     nf = rt.n_face
     st, w = triangle_quadrature(p + k)
     weighted = 2.0 * w[:, None] * rt.face_basis(st)                      # the face basis is orthonormal for 2 int
-    faces = mesh.t2f.ravel()
-    first = np.zeros(len(faces), dtype=bool)
-    first[np.unique(faces, return_index=True)[1]] = True
+    first = mesh.first_sides()
     out = np.zeros((len(mesh.faces), nf))
     for face in range(4):
-        elements = np.flatnonzero(first.reshape(-1, 4)[:, face])
+        elements = np.flatnonzero(first[:, face])
         values = basis.values(face_points(face, st))[:, :skeleton.shape[1]]  # interior nodes vanish on the faces
         out[mesh.t2f[elements, face]] = u[skeleton[elements]] @ (weighted.T @ values).T
     return out.ravel()
@@ -208,10 +206,8 @@ def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_fa
     lam_K = lam.reshape(-1, nf)[mesh.t2f].reshape(E, n)
     outward = H_K.times(lam_K).reshape(E * 4, nf)
     # each face's flux along the normal out of its first element: the mean of its sides
-    sides = np.bincount(faces, minlength=len(mesh.faces))
-    first = np.zeros(len(faces), dtype=bool)
-    first[np.unique(faces, return_index=True)[1]] = True
-    sign = np.where(first, 1.0, -1.0)
+    sides = mesh.face_sides()
+    sign = np.where(mesh.first_sides().ravel(), 1.0, -1.0)
     flux = np.zeros((len(mesh.faces), nf))
     np.add.at(flux, faces, sign[:, None] * outward)
     flux /= sides[:, None]

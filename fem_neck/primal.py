@@ -63,7 +63,7 @@ def volume(mesh: CurvedMesh, degree: int = 10) -> float:
     """Volume of the mapped mesh (a check of the geometry against the exact solid): ``1/3 int x . n dS`` over its
     boundary faces (the divergence theorem), each face mapped with its element and integrated by the triangle rule of
     ``degree`` (exact on the straight ones)."""
-    sides = np.bincount(mesh.t2f.ravel(), minlength=len(mesh.faces))
+    sides = mesh.face_sides()
     st, w = triangle_quadrature(degree)
     total = 0.0
     for face in range(4):
