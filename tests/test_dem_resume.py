@@ -191,3 +191,25 @@ def test_overwrite_clears_and_resume_needs_a_checkpoint(tmp_path):
     other.write_text(THERMAL.replace("t_end = 0.01", "t_end = 0.002"))
     with pytest.raises(ValueError, match="another scene"):
         run(load_scene(other), out=tmp_path / "out", resume=True)
+
+
+def test_a_restored_list_brings_the_arrays_sized_by_it(tmp_path):
+    """A checkpoint's Verlet list is rarely as long as the one the resumed model built at its start; the arrays the
+    loop indexes by pair (the pairs' constants, the threads' rows) must follow it. They did not: the loop wrote past
+    their end (the segmentation faults of the resume test in CI)."""
+    from dem.engines.verlet.engine import VerletEngine
+    from dem.geometry.neighbours import list_arrays, verlet_pairs
+
+    scene = tmp_path / "scene.toml"
+    scene.write_text(MOVING)
+    mech = VerletEngine(load_scene(scene)).mechanics
+    s = mech.state
+    longer = verlet_pairs(s.x, s.radius, 4.0 * mech.skin, mech.box)
+    assert len(longer[0]) > len(mech.pi)
+    saved = {**list_arrays(mech), "x": s.x.copy(), "pi": longer[0], "pj": longer[1],
+             "p_hist": np.zeros((len(longer[0]), mech.p_hist.shape[1]))}
+    mech.restore_lists(saved)
+    assert len(mech.pi) == len(longer[0])
+    assert mech.p_const.shape[0] == len(mech.pi) and mech.p_const.shape[1] == 2  # Luding keeps two per pair
+    if mech.threaded:
+        assert mech.pair_load.shape[0] == len(mech.pi) and mech.pair_start[-1] == 2 * len(mech.pi)

@@ -138,8 +138,10 @@ class MechanicalModel:
         self.walls_moved()
 
     def restore_lists(self, saved: dict) -> None:
-        """The Verlet lists of a checkpoint (:func:`dem.geometry.neighbours.restore_lists`)."""
+        """The Verlet lists of a checkpoint (:func:`dem.geometry.neighbours.restore_lists`), with the arrays the loop
+        indexes by pair (:meth:`_listed`) sized by them."""
         restore_lists(self, saved)
+        self._listed(self.pi, self.pj)
 
     def walls_moved(self):
         """The walls were set elsewhere (a resumed run): their Verlet list follows."""
