@@ -125,23 +125,27 @@ class MechanicalModel:
 
     def _listed(self, i: np.ndarray, j: np.ndarray):
         """The pairs ``(i, j)`` as the list (with the threads' view of it), built at the positions of now."""
-        s = self.state
         self.pi, self.pj = i, j
+        self._pair_arrays()
+        self.x_ref = self.state.x.copy()
+        self.walls_moved()
+
+    def _pair_arrays(self):
+        """The arrays the loop indexes by listed pair: the pairs' constants and the threads' view of the list."""
+        i, j = self.pi, self.pj
         self.p_const = np.empty((len(i), 2 if self.law.PAIR_CONSTANTS else 0))  # filled at each call's first step
         if self.threaded:
-            self.pair_start, self.pair_order = incident_pairs(i, j, s.n)
+            self.pair_start, self.pair_order = incident_pairs(i, j, self.state.n)
             self.pair_load = np.empty((len(i), LOAD_COLUMNS))
         else:  # the one-thread loop reads none of them
             self.pair_start, self.pair_order, self.pair_load = np.zeros(1, np.int64), np.zeros(0, np.int64), \
                 np.zeros((0, LOAD_COLUMNS))
-        self.x_ref = s.x.copy()
-        self.walls_moved()
 
     def restore_lists(self, saved: dict) -> None:
         """The Verlet lists of a checkpoint (:func:`dem.geometry.neighbours.restore_lists`), with the arrays the loop
-        indexes by pair (:meth:`_listed`) sized by them."""
+        indexes by pair (:meth:`_pair_arrays`) sized by them."""
         restore_lists(self, saved)
-        self._listed(self.pi, self.pj)
+        self._pair_arrays()
 
     def walls_moved(self):
         """The walls were set elsewhere (a resumed run): their Verlet list follows."""
