@@ -143,7 +143,7 @@ class MechanicalModel:
 
     def restore_lists(self, saved: dict) -> None:
         """The Verlet lists of a checkpoint (:func:`dem.geometry.neighbours.restore_lists`), with the arrays the loop
-        indexes by pair (:meth:`_pair_arrays`) sized by them."""
+        indexes by pair (``_pair_arrays``) sized by them."""
         restore_lists(self, saved)
         self._pair_arrays()
 
