@@ -189,10 +189,19 @@ def test_the_cool_down_splits_into_the_box_and_the_particles_area():
 
 
 def test_frozen_radii_keep_each_particle_its_size(tmp_path):
+    from dataclasses import replace
+
+    from dem.laws.contact.luding import LUDING_TABLE1, radius_at
+
     state = tmp_path / "state.npz"
-    np.savez(state, radius=np.array([1.002e-3, 0.5e-3]), radius_ref=np.array([1e-3, 0.499e-3]), x=np.zeros((2, 3)))
-    out = np.load(sr._frozen_radii(state, tmp_path / "frozen" / "start.npz"))
+    radius, T = np.array([1.002e-3, 0.5e-3]), np.array([140.0, 140.0])
+    np.savez(state, radius=radius, radius_ref=np.array([1e-3, 0.499e-3]), T=T, x=np.zeros((2, 3)))
+    out = np.load(sr._frozen_radii(state, tmp_path / "frozen" / "start.npz", replace(LUDING_TABLE1, expansion=0.0)))
     assert np.array_equal(out["radius_ref"], out["radius"]) and np.array_equal(out["x"], np.zeros((2, 3)))
+    five = replace(LUDING_TABLE1, expansion=5e-4)  # eq. 9 with the new delta a_T gives the saved radii back at 140 °C
+    out = np.load(sr._frozen_radii(state, tmp_path / "five" / "start.npz", five))
+    assert radius_at(out["radius_ref"], T, five.T_melt, five.expansion) == pytest.approx(radius, rel=1e-14)
+    assert radius_at(out["radius_ref"], 80.0, five.T_melt, five.expansion) == pytest.approx(radius * 0.98 / 1.01)
 
 
 def test_a_contact_cooled_with_its_centres_held_goes_into_tension_as_eqs_9_10_13_predict():

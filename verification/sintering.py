@@ -496,7 +496,8 @@ def discussion(st: Study) -> str:
 
     def forces():
         rows = {}
-        for variant in ("", "held", "cool-no-expansion", "held-no-expansion"):
+        for variant in ("", "held", "cool-no-expansion", "held-no-expansion", "cool-expansion-x3",
+                        "cool-expansion-x5"):
             try:
                 fn = st.arrays(st.task(sr.COOL, n, 100.0, st.t_max, variant=variant))["fn"]
             except Missing:
@@ -515,6 +516,11 @@ def discussion(st: Study) -> str:
                      f"{rows['held'][0]:.2f} ({100 * rows['held'][1]:.0f} % attract), but only with thermal "
                      f"contraction (held, δa_T = 0: {rows['held-no-expansion'][0]:.2f}); with walls that follow p, "
                      f"δa_T = 0 changes nothing ({rows['cool-no-expansion'][0]:.2f}).")
+        if {"cool-expansion-x3", "cool-expansion-x5"} <= set(rows):
+            text += (f" Nor does more contraction under those walls: three and five times Table 1's δa_T while "
+                     f"cooling give {rows['cool-expansion-x3'][0]:.2f} and {rows['cool-expansion-x5'][0]:.2f} "
+                     f"({100 * rows['cool-expansion-x3'][1]:.0f} and {100 * rows['cool-expansion-x5'][1]:.0f} % "
+                     f"attract): the box follows the particles.")
         c = contact_cooling(0.2)
         return text + (f" One contact sintered under 0.2 N and cooled with its centres held ends at {c['held']:.2f} N "
                        f"(eqs. 9, 10, 13, Fig. 5: its overlap falls by {1e6 * c['shrink']:.0f} µm, its elastic part "

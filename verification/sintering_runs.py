@@ -91,6 +91,8 @@ VARIANTS = {v.label: v for v in (
     Variant("expansion-text", material={"expansion": 2.5e-4}),  # Sec. 3.2's "one per-cent" from 80 to 120 °C
     Variant("held", walls_held=True, stage_only=True),                        # cool-down, the box held
     Variant("cool-no-expansion", material={"expansion": 0.0}, stage_only=True),
+    Variant("cool-expansion-x3", material={"expansion": 3e-4}, stage_only=True),
+    Variant("cool-expansion-x5", material={"expansion": 5e-4}, stage_only=True),
     Variant("held-no-expansion", material={"expansion": 0.0}, walls_held=True, stage_only=True),
     Variant("long", strain=0.15, stage_only=True),                             # the compression test to 15 %
 )}
@@ -163,20 +165,20 @@ class Grid:
     isolation: str = ""
 
     def isolating_tasks(self) -> list[Task]:
-        """The runs that isolate the causes of the differences from the paper (:data:`VARIANTS`). ``"quick"``: the
-        cheap ones, each a fraction of the cost of a sintered chain: the preparations alone (N max, p = 10: the
-        paper's frictionless one, frictionless particles against walls with friction, frictional particles against
-        frictionless walls, the protocol's with walls 10x slower) and the three-particle control of the first
-        placement kept at 80 °C and without thermal expansion (p = 10) and sintered for every t_s (both p).
-        ``"full"`` adds the paper's frictionless preparation through sintering and cool-down for every N and p,
-        every other preparation (initial speeds, compression rate, cohesion, wall friction) for every N at p = 10
-        and the densification of those with friction on the particles or on the walls only and of the slower one
-        (N min, p = 10), the three-particle control with walls that sinter, prepared for 0.2 s only, with wall
-        friction, kept at 80 °C or without thermal expansion (every seed and p), the cool-down of the
-        longest-sintered sample with the box held and without thermal contraction (N max, both p), and the
-        compression test of the shortest-sintered sample at p = 100 carried on to 15 % strain, and the longest
-        sintering of N max at p = 100 with the thermal expansion Sec. 3.2's text describes ("one per-cent" from 80 to
-        120 °C, δa_T = 2.5e-4 /K, against Table 1's 1e-4 /K)."""
+        """The runs that isolate the causes of the differences from the paper (:data:`VARIANTS`). ``"quick"``: the cheap
+        ones, each a fraction of the cost of a sintered chain: the preparations alone (N max, p = 10: the paper's
+        frictionless one, frictionless particles against walls with friction, frictional particles against frictionless
+        walls, the protocol's with walls 10x slower) and the three-particle control of the first placement kept at 80 °C
+        and without thermal expansion (p = 10) and sintered for every t_s (both p). ``"full"`` adds the paper's
+        frictionless preparation through sintering and cool-down for every N and p, every other preparation (initial
+        speeds, compression rate, cohesion, wall friction) for every N at p = 10 and the densification of those with
+        friction on the particles or on the walls only and of the slower one (N min, p = 10; the one with frictionless
+        walls also at p = 100), the three-particle control with walls that sinter, prepared for 0.2 s only, with wall
+        friction, kept at 80 °C or without thermal expansion (every seed and p), the cool-down of the longest-sintered
+        sample with the box held, without thermal contraction and with three and five times it (N max, both p), and the
+        compression test of the shortest-sintered sample at p = 100 carried on to 15 % strain, and the longest sintering
+        of N max at p = 100 with the thermal expansion Sec. 3.2's text describes ("one per-cent" from 80 to 120 °C, δa_T
+        = 2.5e-4 /K, against Table 1's 1e-4 /K)."""
         if not self.isolation:
             return []
         n, t_max = max(self.n), max(self.t_s)
@@ -192,10 +194,12 @@ class Grid:
             out += [Task(COOL, m, p, t_max, variant="frictionless") for m in self.n for p in self.p]
             out += [Task(COOL, min(self.n), 10.0, t_max, variant=v)
                     for v in ("frictionless-wall-friction", "no-wall-friction", "slow")]
+            out.append(Task(COOL, min(self.n), 100.0, t_max, variant="no-wall-friction"))
             out += [Task(SCHEDULE, 3, p, t_max, seed, v) for p in self.p for seed in self.three_seeds
                     for v in ("walls-sinter", "short-prep", "control-wall-friction", "no-heating", "no-expansion")]
             out += [Task(COOL, n, p, t_max, variant=v) for p in self.p
-                    for v in ("held", "cool-no-expansion", "held-no-expansion")]
+                    for v in ("held", "cool-no-expansion", "held-no-expansion", "cool-expansion-x3",
+                              "cool-expansion-x5")]
             out.append(Task(COOL, n, 100.0, t_max, variant="expansion-text"))
             out.append(Task(COMPRESS, n, 100.0, min(self.t_s), variant="long"))
         return list(dict.fromkeys(out))
@@ -248,13 +252,13 @@ def _material(task: Task, kind: str | None = None):
     return replace(LUDING_TABLE1, **changes)
 
 
-def _frozen_radii(state: pathlib.Path, out: pathlib.Path) -> str:
-    """``state`` with the reference radii set to the radii it holds, written to ``out``: a run with delta a_T = 0
-    from a state saved with thermal expansion keeps each particle's size (eq. 9 would otherwise jump it to
-    a(T_melt))."""
+def _frozen_radii(state: pathlib.Path, out: pathlib.Path, material) -> str:
+    """``state`` with the reference radii a(T_melt) of eq. 9 recomputed for ``material``'s delta a_T from the radii
+    and temperatures it holds, written to ``out``: a run with another delta a_T from a state saved with Table 1's
+    keeps each particle's size at the start (eq. 9 would otherwise jump it)."""
     with np.load(state) as f:
         data = {k: f[k] for k in f.files}
-    data["radius_ref"] = data["radius"].copy()
+    data["radius_ref"] = data["radius"] / (1.0 - material.expansion * (material.T_melt - data["T"]))
     out.parent.mkdir(parents=True, exist_ok=True)
     np.savez(out, **data)
     return str(out)
@@ -270,7 +274,7 @@ def scene_doc(task: Task, root: pathlib.Path) -> dict:
     prep = dict(variant.prep) if variant else {}
     parent = None if task.parent is None else str(root / task.parent.folder / "state.npz")
     if task.kind == COOL and variant and variant.stage_only and "expansion" in variant.material:
-        parent = _frozen_radii(pathlib.Path(parent), root / task.folder / "start.npz")
+        parent = _frozen_radii(pathlib.Path(parent), root / task.folder / "start.npz", material)
     if task.kind == PREPARE:
         damping = prep.pop("wall_damping", WALL_DAMPING)
         doc = sp.preparation_doc(task.n, task.p, seed=task.seed, material=material, **prep)
