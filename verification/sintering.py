@@ -437,6 +437,22 @@ def discussion(st: Study) -> str:
                 f"counted with the current radii stays ({a['volume_fraction']:.4f} to {b['volume_fraction']:.4f}). "
                 f"The paper's \"almost 0.92\" to \"almost 0.94\" is about 2 %, more than eq. 9 gives for 60 K "
                 f"with Table 1's δa_T = 1e-4 /K.")
+        ends = []
+        for variant, label in (("frictionless", "frictionless"), ("no-wall-friction", "with frictionless walls")):
+            for m in st.grid.n:
+                try:
+                    ends.append((label, m, st.res(sr.PREPARE, m, 100.0, variant=variant)["mass_fraction"],
+                                 st.res(sr.SINTER, m, 100.0, st.t_max, variant=variant)["mass_fraction"],
+                                 st.res(sr.COOL, m, 100.0, st.t_max, variant=variant)["mass_fraction"]))
+                except Missing:
+                    pass
+        if ends:
+            text += (" Nor does the preparation set the end: prepared "
+                     + "; ".join(f"{label} (N = {m}) the sample starts at {v0:.4f} and ends at {v1:.4f} after "
+                                 f"sintering and {v2:.4f} after cool-down" for label, m, v0, v1, v2 in ends)
+                     + f", against the protocol's {st.res(sr.PREPARE, n, 100.0)['mass_fraction']:.4f}, "
+                     f"{a['mass_fraction']:.4f} and {b['mass_fraction']:.4f} (p = 100, N = {n}): a denser start "
+                     f"leaves less to densify.")
         try:
             e = cool_down(st.series(st.task(sr.COOL, n, 100.0, st.t_max, variant="expansion-text")), 0.0)
             r = st.res(sr.COOL, n, 100.0, st.t_max, variant="expansion-text")
