@@ -77,11 +77,15 @@ def statements(st: Study) -> tuple[list[Statement], list[str]]:
 
 
 def _prep_density(st: Study):
-    """Sec. 4.1.2: the preparation gives nu ~ 0.8."""
-    rows = [(n, p, st.res(sr.PREPARE, n, p)["volume_fraction"]) for n in st.grid.n for p in st.grid.p]
+    """Sec. 4.1.2: the preparation gives nu ~ 0.8 (the mean over the grid's random placements of each N and p)."""
+    rows = [(n, p, [st.res(sr.PREPARE, n, p, seed=seed)["volume_fraction"] for seed in sr.PLACEMENTS])
+            for n in st.grid.n for p in st.grid.p]
     return Statement("Sec. 4.1.2, Fig. 9", "The initial preparation leads to a rather low density", "ν ≈ 0.8",
-                     ", ".join(f"{v:.3f} (N={n}, p={p:g})" for n, p, v in rows),
-                     all(_within(v, 0.8, 0.03) for _, _, v in rows), "±0.03")
+                     "; ".join(f"{np.mean(v):.3f} (N={n}, p={p:g}; placements {', '.join(f'{x:.3f}' for x in v)})"
+                               for n, p, v in rows),
+                     all(_within(float(np.mean(v)), 0.8, 0.03) for _, _, v in rows), "±0.03",
+                     "the mean over the random placements the grid prepares, as the densification statements read: "
+                     "one sample of N = 100 moves with its loose wall layer (the preparation runs)")
 
 
 def _density_rises_with_ts(st: Study):
