@@ -55,6 +55,16 @@ def test_a_collision_across_a_face_is_the_collision_in_the_middle():
     np.testing.assert_allclose(v_across, v_middle, rtol=1e-9, atol=1e-12)
 
 
+def test_a_contact_across_a_face_is_drawn_to_the_image_not_across_the_box():
+    engine = VerletEngine(parse_scene(pair(0.3e-3, L - 0.6e-3)))  # touching through the x faces: 0.9 mm < 2 R
+    points, lines, fields = engine.links()
+    assert len(lines) == 1 and len(points) == 3  # the two particles and the image of the partner
+    np.testing.assert_allclose(points[lines[0, 1]], [-0.6e-3, 3e-3, 3e-3], atol=1e-15)
+    assert np.linalg.norm(points[lines[0, 1]] - points[lines[0, 0]]) == pytest.approx(0.9e-3)
+    middle = VerletEngine(parse_scene(pair(3.3e-3, 2.4e-3)))
+    assert len(middle.links()[0]) == 2 and middle.links()[1].tolist() == [[0, 1]]  # no image where none crosses
+
+
 def test_heat_crosses_a_face_as_it_crosses_the_middle():
     touching = 0.9e-3  # centre distance (m): overlap 0.1 mm
     across = run(parse_scene(pair(0.2e-3, L - touching + 0.2e-3, thermal=True)))

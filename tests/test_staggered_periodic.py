@@ -86,6 +86,9 @@ def test_a_pair_across_a_face_is_the_pair_in_the_middle(v):
     assert a.current.joule_heat == pytest.approx(b.current.joule_heat, rel=1e-9)
     assert a.summary()["contacts"] == b.summary()["contacts"] == 1
     assert np.linalg.norm(b.mechanics.f[1]) > 1.0 and b.current.joule_heat > 0.0  # they touch
+    for engine in (a, b):  # the contact is drawn as long as it is, to the partner's image across the face
+        points, lines, _ = engine.links()
+        assert np.linalg.norm(points[lines[0, 1]] - points[lines[0, 0]]) == pytest.approx(0.1 * 2**0.5, rel=1e-12)
     a.run()
     b.run()
     sa, sb = a.mechanics.state, b.mechanics.state

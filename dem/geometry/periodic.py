@@ -148,3 +148,17 @@ def canonical_bonds(i: np.ndarray, j: np.ndarray, shift: np.ndarray) -> tuple:
     same = (i[1:] == i[:-1]) & (j[1:] == j[:-1]) & np.all(shift[1:] == shift[:-1], axis=1)
     keep = np.r_[True, ~same]
     return i[keep], j[keep], shift[keep]
+
+
+def pair_lines(position: np.ndarray, i: np.ndarray, j: np.ndarray, box: PeriodicBox | None) -> tuple:
+    """Lines for drawing the pairs ``(i, j)`` of ``position`` (N, 3): ``(points, lines)``. In a periodic ``box`` a
+    pair whose minimum image crosses a face joins ``i`` to the image of ``j`` beside it, appended to the points (a
+    line between the two originals would cross the box)."""
+    lines = np.column_stack([i, j]).astype(np.int64)
+    if box is None:
+        return position, lines
+    raw = position[j] - position[i]
+    near = box.minimum_image(raw)
+    crossing = np.flatnonzero(np.any(near != raw, axis=1))
+    lines[crossing, 1] = len(position) + np.arange(len(crossing))
+    return np.vstack([position, position[i[crossing]] + near[crossing]]), lines

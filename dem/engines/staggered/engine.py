@@ -32,6 +32,7 @@ import numpy as np
 
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import list_arrays
+from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
 from dem.engines.contact_current import ContactCurrent
 from dem.engines.staggered.heat import LumpedHeat
@@ -385,8 +386,8 @@ class StaggeredEngine:
         """The touching pairs as lines between the particles: normal force (N, > 0 repulsive), contact area (m^2),
         bonded."""
         i, j, fn, area, bond = self.mechanics.contacts()
-        return self.mechanics.state.x, np.column_stack([i, j]), {"normal_force": fn, "area": area,
-                                                                  "bonded": bond.astype(np.int8)}
+        points, lines = pair_lines(self.mechanics.state.x, i, j, self.mechanics.periodic_box)
+        return points, lines, {"normal_force": fn, "area": area, "bonded": bond.astype(np.int8)}
 
     def particle_fields(self) -> dict:
         s = self.mechanics.state

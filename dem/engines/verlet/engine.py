@@ -29,6 +29,7 @@ from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import list_arrays
+from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
 from dem.scene.state_file import moving_arrays, normalised
@@ -386,11 +387,11 @@ class VerletEngine:
         return self.mechanics.state.T.copy()
 
     def links(self):
-        """The closed pair contacts as lines between the particles: normal force (> 0 repulsive), tangential force
-        magnitude, overlap."""
+        """The closed pair contacts as lines between the particles (to the partner's image across a periodic face):
+        normal force (> 0 repulsive), tangential force magnitude, overlap."""
         i, j, overlap, fn, ft = self.mechanics.contacts()
-        return self.mechanics.state.x, np.column_stack([i, j]), {
-            "normal_force": fn, "tangential_force": np.linalg.norm(ft, axis=1), "overlap": overlap}
+        points, lines = pair_lines(self.mechanics.state.x, i, j, self.mechanics.periodic_box)
+        return points, lines, {"normal_force": fn, "tangential_force": np.linalg.norm(ft, axis=1), "overlap": overlap}
 
     def plots(self, out, summary: dict) -> list[str]:
         from dem.output.plots import motion_plots
