@@ -5,7 +5,8 @@ The sweeps of the CLIs -- ``python -m fem_neck fit`` and ``unequal``, ``python -
 :func:`pool`:
 
 * by default, worker processes of this machine (``concurrent.futures``: started in a fraction of a second), or this
-  process itself when one worker (or one job) is asked for;
+  process itself when one worker (or one job) is asked for; forked, unless numba's threads in this process are GNU
+  OpenMP's (:func:`sinterheat.threads.openmp_started`), which a forked child cannot use: then spawned;
 * inside :func:`use_dask` -- what the CLIs' ``--scheduler`` does -- a ``dask.distributed`` cluster: ``"local"``
   starts a ``LocalCluster`` of one-thread worker processes on this machine (several seconds), any other value is the
   address of a running scheduler (``tcp://host:8786``, e.g. one that dask-jobqueue started on SLURM). Dask is an
@@ -43,6 +44,7 @@ import uuid
 from concurrent import futures as cf
 
 from sinterheat.interrupt import ignore_interrupts, shielded, stop_pool, where
+from sinterheat.threads import openmp_started
 
 INSTALL = "pip install '.[dask]' (in the repository; or pip install 'dask[distributed]')"  #: how to get Dask
 LOCAL = "local"  #: the ``--scheduler`` value that starts a LocalCluster on this machine
@@ -166,6 +168,8 @@ class ProcessPool:
 
     def __init__(self, workers: int, start: str):
         method = start if start in multiprocessing.get_all_start_methods() else "spawn"
+        if method == "fork" and openmp_started():  # a forked worker's first parallel loop would end it
+            method = "spawn"
         self.slots = workers
         self._executor = cf.ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method),
                                                 initializer=ignore_interrupts)

@@ -6,18 +6,27 @@ core this process may run on.
 inside the loop: :mod:`dem.engines.compiled`); :func:`use` sets the number for the rest of the process: numba's
 threads, the BLAS libraries already loaded (threadpoolctl) and, through ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS``
 and ``MKL_NUM_THREADS``, those loaded later and child processes (which also inherit ``SINTERHEAT_THREADS``).
-:func:`one_blas_thread` pins BLAS to one thread for a block of work. numba's threading layer is ``workqueue`` (numba's own, present everywhere; it needs neither TBB nor OpenMP, and its
-idle threads sleep) unless ``NUMBA_THREADING_LAYER`` names another.
+:func:`one_blas_thread` pins BLAS to one thread for a block of work.
+
+numba's threading layer: GNU OpenMP (``omp``) where numba finds it, else its own ``workqueue``, unless
+``NUMBA_THREADING_LAYER`` names one. OpenMP starts a parallel loop in about a microsecond, the workqueue in about a
+tenth of a millisecond, and a step of the velocity-Verlet loop starts one (:mod:`dem.engines.verlet.loop`). GNU
+OpenMP cannot be used again in a child forked from a process that used it (numba terminates that child), so once it
+runs, the local pools spawn their workers instead of forking them (:func:`openmp_started`,
+:class:`sinterheat.pool.ProcessPool`).
 """
 
 from __future__ import annotations
 
 import functools
 import os
+import sys
 
 ENVIRONMENT = "SINTERHEAT_THREADS"
 BLAS_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
-THREADING_LAYER = "workqueue"
+# numba's threading layers, the first one found (module docstring); numba wants all three named, and TBB after the
+# workqueue, which every numba has, is never reached
+THREADING_LAYERS = ["omp", "workqueue", "tbb"]
 
 _chosen: int | None = None  # set by use()
 
@@ -85,6 +94,19 @@ def bind_numba() -> int:
         import numba
 
         if "NUMBA_THREADING_LAYER" not in os.environ:
-            numba.config.THREADING_LAYER = THREADING_LAYER
+            numba.config.THREADING_LAYER = "default"
+            numba.config.THREADING_LAYER_PRIORITY = list(THREADING_LAYERS)
         numba.set_num_threads(number)
     return number
+
+
+def openmp_started() -> bool:
+    """Whether numba's threads in this process are GNU OpenMP's (started by :func:`bind_numba` or a parallel loop):
+    a child forked from it would be terminated at its own first parallel loop."""
+    numba = sys.modules.get("numba")
+    if numba is None:
+        return False
+    try:
+        return numba.threading_layer() == "omp"
+    except ValueError:  # no parallel loop has run yet: no layer chosen
+        return False

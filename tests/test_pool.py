@@ -61,6 +61,42 @@ def test_the_bar_follows_no_progress_of_the_command_line(monkeypatch, capsys, en
     assert ("sweep" in capsys.readouterr().err) == shown
 
 
+def test_a_process_whose_numba_threads_are_openmp_spawns_its_workers(monkeypatch):
+    # a child forked from a process that ran GNU OpenMP threads is terminated at its own first parallel loop
+    monkeypatch.setattr(P, "openmp_started", lambda: True)
+    with P.pool(2) as spawned:
+        assert spawned._executor._mp_context.get_start_method() == "spawn"
+        assert [f.result() for f in [spawned.submit(_failing, 2)]] == [4]
+    monkeypatch.setattr(P, "openmp_started", lambda: False)
+    with P.pool(2) as forked:
+        assert forked._executor._mp_context.get_start_method() == "fork"
+
+
+OPENMP_STARTED = """
+import numba, numpy as np
+from sinterheat import threads
+threads.use(2)
+before = threads.openmp_started()
+threads.bind_numba()
+@numba.njit(parallel=True)
+def twice(a):
+    for k in numba.prange(len(a)):
+        a[k] *= 2.0
+twice(np.ones(8))
+print(before, threads.openmp_started(), numba.threading_layer())
+"""
+
+
+@pytest.mark.skipif(os.cpu_count() < 2, reason="needs two cores")
+def test_openmp_is_seen_once_numba_has_started_its_threads():
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_THREADING_LAYER"}
+    proc = subprocess.run([sys.executable, "-c", OPENMP_STARTED], capture_output=True, text=True, timeout=300,
+                          env={**env, "PYTHONPATH": str(ROOT)})
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    before, after, layer = proc.stdout.split()
+    assert before == "False" and after == str(layer == "omp") and layer in ("omp", "workqueue")
+
+
 def test_one_worker_runs_each_job_when_its_result_is_taken():
     ran = []
     jobs = [(ran.append, (k,)) for k in range(3)]

@@ -1,5 +1,6 @@
 """Threads: the velocity-Verlet loop gives the same bits on 1, 2 and 3 threads (its threaded copy sums each
-particle's pair forces in the order of the list, as the one-thread loop does), ``--threads`` is checked, the
+particle's pair forces in the order of the list, as the one-thread loop does: the pairs in its own block directly, the
+others from their rows), ``--threads`` is checked, the
 environment variable ``SINTERHEAT_THREADS`` is honoured, ``--quiet`` draws no progress bar."""
 
 import json
@@ -64,19 +65,28 @@ def test_one_two_and_three_threads_give_the_same_bits():
         assert one == {**two, "threaded": False} == {**three, "threaded": False}, name
 
 
-def test_pairs_by_particle_in_the_order_of_the_list():
-    from dem.engines.contact_forces import incident_pairs
+@pytest.mark.parametrize("n_blocks", [1, 2, 3, 7, 1000])
+def test_each_particle_belongs_to_the_block_of_its_first_pair_and_lists_the_others_in_order(n_blocks):
+    from dem.engines.contact_forces import pair_blocks, split_incidences
 
     rng = np.random.default_rng(1)
-    n = 50
-    i = rng.integers(0, n, 400)
-    j = (i + rng.integers(1, n, 400)) % n
-    start, pairs = incident_pairs(i, j, n)
-    for k in range(n):
-        mine = pairs[start[k]:start[k + 1]]
-        as_i, as_j = mine[mine >= 0], ~mine[mine < 0]
-        assert np.array_equal(as_i, np.flatnonzero(i == k)) and np.array_equal(as_j, np.flatnonzero(j == k))
-        assert np.all(np.diff(np.where(mine >= 0, mine, ~mine)) > 0)  # one ascending sequence of pairs
+    n, m = 50, 400
+    i = rng.integers(0, n - 1, m)  # particle n - 1 in no pair
+    j = (i + rng.integers(1, n - 1, m)) % (n - 1)
+    owner, start, pairs = split_incidences(i, j, n, n_blocks)
+    blocks = pair_blocks(m, n_blocks)
+    block = np.repeat(np.arange(blocks), np.diff([b * m // blocks for b in range(blocks + 1)]))
+    assert owner[n - 1] == -1 and start[n] - start[n - 1] == 0
+    for k in range(n - 1):
+        mine = np.flatnonzero((i == k) | (j == k))  # k's pairs in the order of the list
+        assert owner[k] == block[mine[0]]
+        listed = pairs[start[k]:start[k + 1]]
+        later = mine[block[mine] != owner[k]]
+        assert np.array_equal(np.where(listed >= 0, listed, ~listed), later)  # the others, in order
+        assert np.array_equal(listed >= 0, i[later] == k)  # c where k is the pair's i, ~c where its j
+        assert np.all(block[later] > owner[k])  # a particle's own block comes first in the list
+    if blocks == 1:
+        assert len(pairs) == 0
 
 
 @pytest.mark.parametrize("value", ["0", str(threads.cores() + 1), "two", "-1"])

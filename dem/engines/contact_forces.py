@@ -24,11 +24,15 @@ pair's law is computed. (For an open pair that geometry is not needed: a few ope
 short for the closed ones, most of a dense packing's list.)
 
 Threads: in the copies of this module for more than one thread (:mod:`dem.engines.compiled`) ``THREADED`` is
-true and the loop runs on all of numba's threads in conflict-free passes: every pair's force and torque arms into a
-row of its own (``load``; the pairs in ``PAIR_BLOCKS`` blocks of consecutive ones), then every particle sums the
-rows of its pairs (:func:`incident_pairs`) in the order of the list. That is the order in which the one-thread loop
-adds them into each particle, so the results are the same to the bit on any number of threads. The flag is a
-compile-time constant: the one-thread loop carries nothing of the threaded one.
+true and the pairs are cut into one block of consecutive pairs per thread. A particle belongs to the block of its
+first pair in the list (:func:`split_incidences`): that block's thread adds the particle's pairs in it straight into
+its force and torque, as the one-thread loop does, and no other thread writes them. A pair whose particle belongs to
+an earlier block writes its force and torque arms into a row of its own (``load``) instead, and after the blocks
+every particle adds those rows, in the order of the list (on one thread: they are few, and a parallel loop costs
+more to start than they take). Each particle's sum thus runs in the order of the list,
+the order in which the one-thread loop adds its pairs, so the results are the same to the bit on any number of
+threads; only the pairs at the blocks' seams are written twice. The flag is a compile-time constant: the one-thread
+loop carries nothing of the threaded one.
 """
 
 from __future__ import annotations
@@ -49,30 +53,49 @@ from dem.laws.contact import luding as law
 FINITE_MATH = {"nnan", "ninf", "nsz"}
 N_PARAMS = law.N_PARAMS
 THREADED = False  # True in the copies for more than one thread (dem.engines.compiled)
-PAIR_BLOCKS = 256  # the threaded pair loop's blocks of consecutive pairs (many per thread: an even load; a constant,
-# not numba's thread count, which compiled code can read only through a pointer that cannot be cached)
 LOAD_COLUMNS = 9  # a pair's row of the threaded loop's buffer: g = f_n n + f_t (3), n x f_t (3), l_i, l_j, closed
 KEEPS_PAIR_CONSTANTS = len(law.PAIR_CONSTANTS) > 0  # the law's pair_constants are kept per pair, in (M, 2)
 
 
 @njit(cache=True)
-def incident_pairs(pi, pj, n):
-    """Each particle's pairs in the order of the list, as ``(start, pairs)``: particle k's are
-    ``pairs[start[k]:start[k + 1]]``, ``c`` where k is the pair's i, ``~c`` (= -1 - c) where it is its j."""
+def pair_blocks(n_pairs, n_blocks):
+    """How many blocks of consecutive pairs the threaded loop cuts ``n_pairs`` into for ``n_blocks`` threads: block
+    ``b`` holds the pairs ``b n_pairs // blocks`` up to ``(b + 1) n_pairs // blocks``."""
+    return max(1, min(n_blocks, n_pairs))
+
+
+@njit(cache=True)
+def split_incidences(pi, pj, n, n_blocks):
+    """The threaded loop's view of the list for ``n_blocks`` threads (module docstring): ``(owner, start, pairs)``,
+    the block of each particle's first pair (-1 for a particle in none), and each particle's pairs outside that
+    block in the order of the list: particle k's are ``pairs[start[k]:start[k + 1]]``, ``c`` where k is the pair's
+    i, ``~c`` (= -1 - c) where it is its j."""
+    m = pi.shape[0]
+    blocks = pair_blocks(m, n_blocks)
+    owner = np.full(n, -1, dtype=np.int64)
+    block = np.empty(m, dtype=np.int64)
+    for b in range(blocks):
+        for c in range(b * m // blocks, (b + 1) * m // blocks):
+            block[c] = b
     start = np.zeros(n + 1, dtype=np.int64)
-    for c in range(pi.shape[0]):
-        start[pi[c] + 1] += 1
-        start[pj[c] + 1] += 1
+    for c in range(m):
+        for k in (pi[c], pj[c]):
+            if owner[k] < 0:
+                owner[k] = block[c]
+            elif block[c] != owner[k]:
+                start[k + 1] += 1
     for k in range(n):
         start[k + 1] += start[k]
     fill = start[:-1].copy()
-    pairs = np.empty(2 * pi.shape[0], dtype=np.int64)
-    for c in range(pi.shape[0]):
-        pairs[fill[pi[c]]] = c
-        fill[pi[c]] += 1
-        pairs[fill[pj[c]]] = ~c
-        fill[pj[c]] += 1
-    return start, pairs
+    pairs = np.empty(start[n], dtype=np.int64)
+    for c in range(m):
+        if block[c] != owner[pi[c]]:
+            pairs[fill[pi[c]]] = c
+            fill[pi[c]] += 1
+        if block[c] != owner[pj[c]]:
+            pairs[fill[pj[c]]] = ~c
+            fill[pj[c]] += 1
+    return owner, start, pairs
 
 
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="always")
@@ -92,7 +115,7 @@ def pair_geometry(c, x, pi, pj, box, planar):
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, parallel=THREADED)
 def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft,
            p_const, fresh, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True,
-           start=None, pairs=None, load=None):
+           start=None, pairs=None, load=None, owner=None, n_blocks=1):
     """Forces and torques of the current state (gravity, the law's drag, pairs, the listed particle-wall pairs
     ``(wk, wm)``); the normal forces on the walls go into ``wforce``. Returns the index into the wall list of the
     first particle whose centre lies behind its wall, else -1.
@@ -111,14 +134,14 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
     part of its type, so 2D and 3D get code of their own, the 2D one without the terms that vanish (a fifth
     faster).
 
-    Where ``THREADED`` (module docstring), ``start`` and ``pairs`` are the pairs by particle
-    (:func:`incident_pairs`) and ``load`` a ``(len(pi), LOAD_COLUMNS)`` buffer; the walls stay on one thread (a few
-    particles: the surface's)."""
+    Where ``THREADED`` (module docstring), ``owner``, ``start`` and ``pairs`` are :func:`split_incidences` of the
+    list for ``n_blocks`` threads and ``load`` a ``(len(pi), LOAD_COLUMNS)`` buffer; the walls stay on one thread (a
+    few particles: the surface's)."""
     planar = len(spin_axes) == 1
     escaped = -1
     n = x.shape[0]
     params = to_fixed_tuple(params, N_PARAMS)
-    for k in prange(n):
+    for k in range(n):
         if law.DRAG:
             drag = law.drag(k, radius, params)
             f[k, 0] = mass[k] * gravity[0] - drag * v[k, 0]
@@ -132,9 +155,9 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         tau[k, 1] = 0.0
         tau[k, 2] = 0.0
     n_pairs = pi.shape[0]
-    n_blocks = min(PAIR_BLOCKS, n_pairs) if THREADED else 1
-    for b in prange(n_blocks):  # one block on one thread; on more, blocks of consecutive pairs
-        first, stop = b * n_pairs // n_blocks, (b + 1) * n_pairs // n_blocks
+    blocks = pair_blocks(n_pairs, n_blocks) if THREADED else 1
+    for b in prange(blocks):  # one block on one thread; on more, a block of consecutive pairs per thread
+        first, stop = b * n_pairs // blocks, (b + 1) * n_pairs // blocks
         ahead = (0.0, 0.0, 0.0, 0.0, 0.0)  # the next pair's geometry, begun before this pair's law (module docstring)
         if first < stop:
             ahead = pair_geometry(first, x, pi, pj, box, planar)
@@ -177,26 +200,32 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
             g0, g1, g2 = f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2
             # torques -l n x f_t on both (the lever arms -l_i n and +l_j n, the forces f_t and -f_t)
             m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
-            if THREADED:  # into the pair's row; its particles add it below
-                load[c, 0], load[c, 1], load[c, 2], load[c, 3], load[c, 4], load[c, 5] = g0, g1, g2, m0, m1, m2
-                load[c, 6], load[c, 7], load[c, 8] = li, lj, 1.0
-                continue
-            f[i, 0] += g0
-            f[i, 1] += g1
-            f[i, 2] += g2
-            f[j, 0] -= g0
-            f[j, 1] -= g1
-            f[j, 2] -= g2
-            if law.SPINS:
-                tau[i, 1] -= li * m1
-                tau[j, 1] -= lj * m1
-                if not planar:
-                    tau[i, 0] -= li * m0
-                    tau[i, 2] -= li * m2
-                    tau[j, 0] -= lj * m0
-                    tau[j, 2] -= lj * m2
+            add_i, add_j = True, True
+            if THREADED:  # this block's particles here; for a particle of an earlier block, into the pair's row
+                add_i, add_j = owner[i] == b, owner[j] == b
+                if not (add_i and add_j):
+                    load[c, 0], load[c, 1], load[c, 2], load[c, 3], load[c, 4], load[c, 5] = g0, g1, g2, m0, m1, m2
+                    load[c, 6], load[c, 7], load[c, 8] = li, lj, 1.0
+            if add_i:
+                f[i, 0] += g0
+                f[i, 1] += g1
+                f[i, 2] += g2
+                if law.SPINS:
+                    tau[i, 1] -= li * m1
+                    if not planar:
+                        tau[i, 0] -= li * m0
+                        tau[i, 2] -= li * m2
+            if add_j:
+                f[j, 0] -= g0
+                f[j, 1] -= g1
+                f[j, 2] -= g2
+                if law.SPINS:
+                    tau[j, 1] -= lj * m1
+                    if not planar:
+                        tau[j, 0] -= lj * m0
+                        tau[j, 2] -= lj * m2
     if THREADED:
-        for k in prange(n):  # each particle its pairs' rows, in the order of the list (as the loop above adds them)
+        for k in range(n):  # each particle the rows of its pairs in later blocks, in the order of the list
             for e in range(start[k], start[k + 1]):
                 c = pairs[e]
                 arm = 6 if c >= 0 else 7

@@ -17,23 +17,23 @@ step:
 4. second half kick (velocities at the end of the step); stress-controlled walls from eq. 1.
 
 Like :mod:`dem.engines.contact_forces`, this module is written against the contact law imported as ``law`` and
-copied for every other law by :mod:`dem.engines.compiled`; in the copies for more than one thread ``THREADED``
-is true: the loops over particles and the force pass run on all of numba's threads, with the same results to the
-bit (:mod:`dem.engines.contact_forces`).
+copied for every other law by :mod:`dem.engines.compiled`; its copies for more than one thread call the threaded
+force pass, which runs on all of numba's threads with the same results to the bit (:mod:`dem.engines.contact_forces`).
+The kicks and the drift stay on one thread: they take a few ns per particle, less than numba's threads take to start
+a parallel loop (its ``workqueue`` layer: of the order of 0.1 ms per loop), so a step starts one parallel loop only.
 """
 
 from __future__ import annotations
 
 import math
 
-from numba import njit, prange
+from numba import njit
 
 from dem.engines.contact_forces import forces
 from dem.geometry.neighbours import min_image
 from dem.laws.contact import luding as law
 
 DONE, REBUILD, NONFINITE, ESCAPED = 0, 1, 2, 3  # how a call of advance() ended
-THREADED = False  # True in the copies for more than one thread (dem.engines.compiled)
 
 
 @njit(cache=True, error_model="numpy")
@@ -49,10 +49,10 @@ def wall_acceleration(m, wq, wdq, wmode, wpress, wmass, wdamp, wspan, wforce):
     return (wpress[m] * extent - wforce[m] - wdamp[m] * wdq[m]) / wmass[m]
 
 
-@njit(cache=True, error_model="numpy", parallel=THREADED)
+@njit(cache=True, error_model="numpy")
 def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_mass, inv_inertia, axes, spin_axes, radius,
             radius_ref, T0, T_rate, T, state, uniform_T, t0, gravity, box, pi, pj, p_hist, p_fn, p_ft, p_const, start,
-            pairs, load,
+            pairs, load, owner, n_blocks,
             wn, wq, wdq, wacc, wmode, wpress, wmass, wdamp, wq0, wamp, wfreq, wspan, wforce, wk, wm, wq_ref,
             w_hist, w_fn, w_ft, params, x_ref, skin, info):
     """Up to ``n_steps`` velocity-Verlet steps (module docstring) from global step ``step0`` (t = step0 dt) of an
@@ -63,16 +63,15 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_mass,
     ``inv_mass``, ``inv_inertia``: ``1/mass`` and ``1/inertia``. ``p_const``: room for the pairs' numbers of the radii
     alone (:func:`dem.engines.contact_forces.forces`), computed at the first step and at any step whose radii
     changed, read at the others. ``start``,
-    ``pairs``, ``load``: the pairs by particle and the buffer of the threaded force pass (used where
-    ``THREADED``)."""
+    ``pairs``, ``load``, ``owner``, ``n_blocks``: the threaded force pass's view of the list and its buffer (read by
+    the threaded copies; :func:`dem.engines.contact_forces.forces`)."""
     n = x.shape[0]
     n_w = wn.shape[0]
     h = 0.5 * dt
     planar = len(spin_axes) == 1  # 2D disks in the x-z plane: axes (0, 2), spin about y
     for s in range(n_steps):
         t = (step0 + s) * dt
-        bad = n
-        for k in prange(n):
+        for k in range(n):
             im, ii = inv_mass[k], inv_inertia[k]
             v[k, 0] += h * f[k, 0] * im
             x[k, 0] += dt * v[k, 0]
@@ -93,14 +92,8 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_mass,
                 w[k, 2] += h * tau[k, 2] * ii
                 moved += abs(w[k, 2])
             if not moved < math.inf:  # NaN or inf: name the particle before its neighbours are contaminated
-                if THREADED:  # (a parallel loop cannot return: the first such particle, after it)
-                    bad = min(bad, k)
-                else:
-                    info[0] = k
-                    return s + 1, 2
-        if THREADED and bad < n:
-            info[0] = bad
-            return s + 1, 2
+                info[0] = k
+                return s + 1, 2
         for m in range(n_w):
             if wmode[m] == 1:
                 wdq[m] += h * wacc[m]
@@ -116,9 +109,9 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_mass,
         fresh = s == 0 or resized
         escaped = forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist,
                          p_fn, p_ft, p_const, fresh, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params,
-                         dt, s == n_steps - 1, start, pairs, load)
+                         dt, s == n_steps - 1, start, pairs, load, owner, n_blocks)
         worst = 0.0
-        for k in prange(n):
+        for k in range(n):
             im, ii = inv_mass[k], inv_inertia[k]
             v[k, 0] += h * f[k, 0] * im
             d = min_image(x[k, 0] + dt * v[k, 0] - x_ref[k, 0], box[0])
@@ -136,15 +129,9 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_mass,
             if not planar:
                 w[k, 2] += h * tau[k, 2] * ii
             if not (d2 < math.inf):  # NaN or inf
-                if THREADED:
-                    bad = min(bad, k)
-                else:
-                    info[0] = k
-                    return s + 1, 2
+                info[0] = k
+                return s + 1, 2
             worst = max(worst, d2)
-        if THREADED and bad < n:
-            info[0] = bad
-            return s + 1, 2
         wall_moved = 0.0
         for m in range(n_w):
             if wmode[m] == 1:

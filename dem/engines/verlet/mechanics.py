@@ -8,8 +8,8 @@ with a one-line message naming the step and the particle.
 
 Threads: with more than one (:func:`sinterheat.threads.count`) and at least ``THREADED_MIN_PARTICLES``
 particles the model binds the threaded copy of the loop (:mod:`dem.engines.compiled`), which needs each particle's
-pairs in the order of the list (:func:`dem.engines.contact_forces.incident_pairs`, made at every rebuild); its
-results are those of one thread to the bit. Below that size a step is too short to share: the threads would cost
+pairs outside the block of its first one (:func:`dem.engines.contact_forces.split_incidences`, made at every
+rebuild); its results are those of one thread to the bit. Below that size a step is too short to share: the threads would cost
 more than they save.
 
 History: per pair in the list the numbers the law carries (``law.PAIR_HISTORY``; Luding 2005: the largest overlap,
@@ -26,7 +26,7 @@ import numpy as np
 from sinterheat import threads
 
 from dem.engines import compiled
-from dem.engines.contact_forces import LOAD_COLUMNS, incident_pairs
+from dem.engines.contact_forces import LOAD_COLUMNS, split_incidences
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, restore_lists, verlet_pairs, wall_pairs
@@ -58,7 +58,8 @@ class MechanicalModel:
         self.walls = tuple(walls)
         self.law = law_module(material.law)
         self._forces = compiled.module(material.law, "dem.engines.contact_forces").forces
-        self.threaded = threads.bind_numba() > 1 and state.n >= THREADED_MIN_PARTICLES
+        self.n_threads = threads.bind_numba()
+        self.threaded = self.n_threads > 1 and state.n >= THREADED_MIN_PARTICLES
         self._advance = compiled.module(material.law, "dem.engines.verlet.loop", self.threaded).advance
         self.params = np.ascontiguousarray(material.params(), dtype=float)
         self.dt = float(dt)
@@ -135,11 +136,11 @@ class MechanicalModel:
         i, j = self.pi, self.pj
         self.p_const = np.empty((len(i), 2 if self.law.PAIR_CONSTANTS else 0))  # filled at each call's first step
         if self.threaded:
-            self.pair_start, self.pair_order = incident_pairs(i, j, self.state.n)
+            self.pair_owner, self.pair_start, self.pair_order = split_incidences(i, j, self.state.n, self.n_threads)
             self.pair_load = np.empty((len(i), LOAD_COLUMNS))
         else:  # the one-thread loop reads none of them
-            self.pair_start, self.pair_order, self.pair_load = np.zeros(1, np.int64), np.zeros(0, np.int64), \
-                np.zeros((0, LOAD_COLUMNS))
+            self.pair_owner, self.pair_start, self.pair_order, self.pair_load = np.zeros(0, np.int64), \
+                np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros((0, LOAD_COLUMNS))
 
     def restore_lists(self, saved: dict) -> None:
         """The Verlet lists of a checkpoint (:func:`dem.geometry.neighbours.restore_lists`), with the arrays the loop
@@ -186,7 +187,7 @@ class MechanicalModel:
                 n_steps - done, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia, inv_mass,
                 inv_inertia, s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.particle_state,
                 uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_fn, self.p_ft,
-                self.p_const, self.pair_start, self.pair_order, self.pair_load,
+                self.p_const, self.pair_start, self.pair_order, self.pair_load, self.pair_owner, self.n_threads,
                 w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
                 w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_hist, self.w_fn, self.w_ft, self.params,
                 self.x_ref, self.skin, self._info)

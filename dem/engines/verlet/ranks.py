@@ -308,7 +308,8 @@ class RankMechanics(MechanicalModel):
                 1, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia, 1.0 / s.mass,
                 1.0 / s.inertia, s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.particle_state,
                 uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_fn, self.p_ft,
-                self.p_const, self.pair_start, self.pair_order, self.pair_load, w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
+                self.p_const, self.pair_start, self.pair_order, self.pair_load, self.pair_owner, self.n_threads,
+                w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
                 w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_hist, self.w_fn, self.w_ft, self.params,
                 self.x_ref, self.skin, self._info)
             self.steps += 1
