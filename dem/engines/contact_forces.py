@@ -23,16 +23,15 @@ operations on the same numbers (the results do not change), but the next square 
 pair's law is computed. (For an open pair that geometry is not needed: a few operations spent to keep the chain
 short for the closed ones, most of a dense packing's list.)
 
-Threads: in the copies of this module for more than one thread (:mod:`dem.engines.compiled`) ``THREADED`` is
-true and the pairs are cut into one block of consecutive pairs per thread. A particle belongs to the block of its
-first pair in the list (:func:`split_incidences`): that block's thread adds the particle's pairs in it straight into
-its force and torque, as the one-thread loop does, and no other thread writes them. A pair whose particle belongs to
-an earlier block writes its force and torque arms into a row of its own (``load``) instead, and after the blocks
-every particle adds those rows, in the order of the list (on one thread: they are few, and a parallel loop costs
-more to start than they take). Each particle's sum thus runs in the order of the list,
-the order in which the one-thread loop adds its pairs, so the results are the same to the bit on any number of
-threads; only the pairs at the blocks' seams are written twice. The flag is a compile-time constant: the one-thread
-loop carries nothing of the threaded one.
+Threads: in the copies of this module for more than one thread (:mod:`dem.engines.compiled`) ``THREADED`` is true and
+the pairs are cut into one block of consecutive pairs per thread. A particle belongs to the block of its first pair in
+the list (:func:`split_incidences`): that block's thread adds the particle's pairs in it straight into its force and
+torque, as the one-thread loop does, and no other thread writes them. A pair whose particle belongs to an earlier block
+writes its force and torque arms into a row of its own (``load``) instead, and after the blocks every particle adds
+those rows, in the order of the list (on one thread: they are few, and a parallel loop costs more to start than they
+take). Each particle's sum thus runs in the order of the list, the order in which the one-thread loop adds its pairs, so
+the results are the same to the bit on any number of threads; only the pairs at the blocks' seams are written twice. The
+flag is a compile-time constant: the one-thread loop carries nothing of the threaded one.
 """
 
 from __future__ import annotations

@@ -19,8 +19,9 @@ step:
 Like :mod:`dem.engines.contact_forces`, this module is written against the contact law imported as ``law`` and
 copied for every other law by :mod:`dem.engines.compiled`; its copies for more than one thread call the threaded
 force pass, which runs on all of numba's threads with the same results to the bit (:mod:`dem.engines.contact_forces`).
-The kicks and the drift stay on one thread: they take a few ns per particle, less than numba's threads take to start
-a parallel loop (its ``workqueue`` layer: of the order of 0.1 ms per loop), so a step starts one parallel loop only.
+The kicks and the drift stay on one thread: they take a few ns per particle, less than numba's threads may take to
+start a parallel loop (about 1 us on GNU OpenMP, 0.1 ms on numba's ``workqueue``: :mod:`sinterheat.threads`), so a
+step starts one parallel loop only.
 """
 
 from __future__ import annotations

@@ -6,11 +6,11 @@ the list (when some particle has moved more than half the skin), at the times th
 update, a change of schedule), or to stop a run that went wrong (a non-finite position, a particle through a wall)
 with a one-line message naming the step and the particle.
 
-Threads: with more than one (:func:`sinterheat.threads.count`) and at least ``THREADED_MIN_PARTICLES``
-particles the model binds the threaded copy of the loop (:mod:`dem.engines.compiled`), which needs each particle's
-pairs outside the block of its first one (:func:`dem.engines.contact_forces.split_incidences`, made at every
-rebuild); its results are those of one thread to the bit. Below that size a step is too short to share: the threads would cost
-more than they save.
+Threads: with more than one (:func:`sinterheat.threads.count`) and at least ``THREADED_MIN_PARTICLES`` particles the
+model binds the threaded copy of the loop (:mod:`dem.engines.compiled`), which needs each particle's pairs outside the
+block of its first one (:func:`dem.engines.contact_forces.split_incidences`, made at every rebuild); its results are
+those of one thread to the bit. Below that size a step is too short to share: the threads would cost more than they
+save.
 
 History: per pair in the list the numbers the law carries (``law.PAIR_HISTORY``; Luding 2005: the largest overlap,
 the stiffness factor the contact saw at its last step and the tangential spring), the same per particle-wall pair
