@@ -549,22 +549,24 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
     t0 = time.perf_counter()
     mesh = cm.curved
     mesh.keep_jacobians(tet_quadrature(primal.quadrature_degree(order))[0])   # = dual's quadrature_degree(order)
-    if workers >= 2:
-        context = get_context("fork")
-        queue = context.Queue()      # put does not wait for the reader (which may have failed before reading)
-        queue.cancel_join_thread()   # nor does the exit, if it never read
-        with ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures,
-                                 initargs=(queue,)) as pool:
-            future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold)
+    try:
+        if workers >= 2:
+            context = get_context("fork")
+            queue = context.Queue()      # put does not wait for the reader (which may have failed before reading)
+            queue.cancel_join_thread()   # nor does the exit, if it never read
+            with ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures,
+                                     initargs=(queue,)) as pool:
+                future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold)
+                with one_blas_thread():
+                    up = primal.solve(mesh, order, cm.hot, cm.cold)
+                queue.put(up.u)
+                low = future.result()
+        else:
             with one_blas_thread():
                 up = primal.solve(mesh, order, cm.hot, cm.cold)
-            queue.put(up.u)
-            low = future.result()
-    else:
-        with one_blas_thread():
-            up = primal.solve(mesh, order, cm.hot, cm.cold)
-        low = _dual(mesh, order, cm.hot, cm.cold, lambda: up.u)
-    mesh.keep_jacobians(None)
+            low = _dual(mesh, order, cm.hot, cm.cold, lambda: up.u)
+    finally:  # the kept Jacobians (a few hundred MB on a fine mesh) go with the solves, also when one fails
+        mesh.keep_jacobians(None)
     scale = cm.height / cm.area
     with one_blas_thread():
         volume = primal.volume(mesh)
