@@ -211,5 +211,7 @@ def test_a_restored_list_brings_the_arrays_sized_by_it(tmp_path):
     mech.restore_lists(saved)
     assert len(mech.pi) == len(longer[0])
     assert mech.p_const.shape[0] == len(mech.pi) and mech.p_const.shape[1] == 2  # Luding keeps two per pair
-    if mech.threaded:
-        assert mech.pair_load.shape[0] == len(mech.pi) and mech.pair_start[-1] == 2 * len(mech.pi)
+    if mech.threaded:  # the rows by pair, the owning block by particle, the pairs outside it indexing the list
+        assert mech.pair_load.shape[0] == len(mech.pi) and mech.pair_owner.shape == (s.n,)
+        assert mech.pair_start[-1] == len(mech.pair_order) and np.all(np.where(
+            mech.pair_order >= 0, mech.pair_order, ~mech.pair_order) < len(mech.pi))
