@@ -214,7 +214,6 @@ class CurvedMesh:
                            pr.r, pr.n, pr.d, np.ascontiguousarray(elements, dtype=np.int64),
                            np.ascontiguousarray(xi, dtype=float))
 
-
     def keep_jacobians(self, xi: np.ndarray | None) -> None:
         """Map every curved element at the reference points ``xi`` once and keep the Jacobians, which :meth:`metric`
         then reads at these points instead of mapping again (the two bounds integrate at the same points); ``None``

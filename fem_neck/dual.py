@@ -165,7 +165,8 @@ def face_system(mesh: CurvedMesh, H_K: SymmetricStack, fixed_face: np.ndarray, l
         faces = mesh.t2f[chunk][near]
         known = np.where(fixed_face[faces][:, :, None], lam.reshape(-1, nf)[faces], 0.0).reshape(len(near), 4 * nf)
         load = -np.matmul(M[near], known[:, :, None]).reshape(len(near), 4, nf)
-        np.add.at(b, index[faces][index[faces] >= 0], load[index[faces] >= 0])
+        at = index[faces]                                                   # -1 on the held faces
+        np.add.at(b, at[at >= 0], load[at >= 0])
         constant -= float(np.sum(known * load.reshape(len(near), 4 * nf)))
     indptr = np.concatenate([[0], np.cumsum(np.bincount(keys // n_free, minlength=n_free))])
     matrix = sp.bsr_matrix((data, keys[order] % n_free, indptr), shape=(n_free * nf, n_free * nf))
