@@ -31,9 +31,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from fem_neck.curved import CurvedMesh
-from fem_neck.primal import ENERGY_RTOL, numbering, quadrature_degree, symmetric_products
+from fem_neck.primal import ENERGY_RTOL, numbering, quadrature_degree, symmetric_gather, symmetric_products
 from fem_neck.simplex import RaviartThomas, face_points, lagrange, raviart_thomas, tet_quadrature, triangle_quadrature
 
 CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arrays)
@@ -48,9 +49,9 @@ def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np
     curved = np.flatnonzero(mesh.is_curved[elements])
     if len(curved):
         xi, w = tet_quadrature(degree)
-        products = symmetric_products(rt.values(xi))                          # (6 Q, m m)
+        products = symmetric_products(rt.values(xi))                          # (6 Q, m (m + 1) / 2)
         G = mesh.metric(elements[curved], xi, w, inverse=False).reshape(len(curved), -1)
-        A[curved] = (G @ products).reshape(len(curved), rt.m, rt.m)
+        A[curved] = np.take(G @ products, symmetric_gather(rt.m), axis=1).reshape(len(curved), rt.m, rt.m)
     return A
 
 
@@ -78,10 +79,7 @@ class SymmetricStack:
         self.n = n
         self.upper = np.triu_indices(n)
         self.packed = np.empty((count, len(self.upper[0])))
-        position = np.empty((n, n), dtype=np.int64)
-        position[self.upper] = np.arange(len(self.upper[0]))
-        position.T[self.upper] = np.arange(len(self.upper[0]))
-        self.gather = position.ravel()                                       # entry (i, j) -> its packed place
+        self.gather = symmetric_gather(n)                                    # entry (i, j) -> its packed place
 
     def __len__(self) -> int:
         return len(self.packed)
@@ -99,18 +97,6 @@ class SymmetricStack:
             chunk = slice(begin, begin + CHUNK)
             out[chunk] = np.matmul(self[chunk], x[chunk, :, None])[:, :, 0]
         return out
-
-
-def face_blocks(mesh: CurvedMesh, H_K: SymmetricStack) -> np.ndarray:
-    """The diagonal blocks ``(n_faces, n_f, n_f)`` of the face system ``sum_K H_K``: each face's block summed over
-    its elements."""
-    nf = H_K.n // 4
-    out = np.zeros((len(mesh.faces), nf, nf))
-    for begin in range(0, len(H_K), CHUNK):
-        chunk = slice(begin, begin + CHUNK)
-        M = H_K[chunk].reshape(-1, 4, nf, 4, nf)
-        np.add.at(out, mesh.t2f[chunk].T, M[:, np.arange(4), :, np.arange(4), :])   # (4, elements, nf, nf)
-    return out
 
 
 @dataclass
@@ -132,7 +118,7 @@ class FaceSystem:
 
 def face_system(mesh: CurvedMesh, H_K: SymmetricStack, fixed_face: np.ndarray, lam: np.ndarray) -> FaceSystem:
     """``sum_K H_K`` on the free faces as a block sparse matrix: two faces of one element share only that element,
-    so a block off the diagonal is one element's, and a diagonal block the sum of :func:`face_blocks`; the held
+    so a block off the diagonal is one element's, and a diagonal block the sum over the face's elements; the held
     faces' multipliers ``lam`` go to the right-hand side."""
     import scipy.sparse as sp
 
@@ -141,37 +127,52 @@ def face_system(mesh: CurvedMesh, H_K: SymmetricStack, fixed_face: np.ndarray, l
     n_free = len(free_faces)
     index = np.full(len(mesh.faces), -1, dtype=np.int64)
     index[free_faces] = np.arange(n_free)
+    local = index[mesh.t2f]                                                 # (E, 4), -1 on the held faces
     local_row, local_col = np.nonzero(~np.eye(4, dtype=bool))              # the 12 pairs of distinct faces
-    rows, cols = index[mesh.t2f[:, local_row]], index[mesh.t2f[:, local_col]]
+    rows, cols = local[:, local_row], local[:, local_col]
     off = (rows >= 0) & (cols >= 0)
     keys = np.concatenate([np.arange(n_free) * (n_free + 1), (rows * n_free + cols)[off]])
     order = np.argsort(keys)
     place = np.empty_like(order)
     place[order] = np.arange(len(order))
-    off_place = np.full(off.shape, -1, dtype=np.int64)
-    off_place[off] = place[n_free:]
-    diagonal = face_blocks(mesh, H_K)[free_faces]
-    data = np.empty((len(keys), nf, nf))
-    data[place[:n_free]] = diagonal
+    block = np.full((E, 4, 4), -1, dtype=np.int64)                          # each element block's place in data
+    pairs = np.full(off.shape, -1, dtype=np.int64)
+    pairs[off] = place[n_free:]
+    block[:, local_row, local_col] = pairs
+    diagonal = np.arange(4)
+    block[:, diagonal, diagonal] = np.where(local >= 0, place[np.maximum(local, 0)], -1)
+    data = np.zeros((len(keys), nf, nf))
+    _add_blocks(data, H_K.packed, H_K.gather.reshape(H_K.n, H_K.n), block)
     b = np.zeros((n_free, nf))
     constant = 0.0
-    touching = np.any(fixed_face[mesh.t2f], axis=1)
-    for begin in range(0, E, CHUNK):
-        chunk = slice(begin, begin + CHUNK)
-        M = H_K[chunk]
-        blocks = np.moveaxis(M.reshape(-1, 4, nf, 4, nf)[:, local_row, :, local_col, :], 0, 1)
-        data[off_place[chunk][off[chunk]]] = blocks[off[chunk]]
-        near = np.flatnonzero(touching[chunk])                              # elements with a held face
-        faces = mesh.t2f[chunk][near]
-        known = np.where(fixed_face[faces][:, :, None], lam.reshape(-1, nf)[faces], 0.0).reshape(len(near), 4 * nf)
-        load = -np.matmul(M[near], known[:, :, None]).reshape(len(near), 4, nf)
-        at = index[faces]                                                   # -1 on the held faces
+    near = np.flatnonzero(np.any(fixed_face[mesh.t2f], axis=1))              # elements with a held face
+    for begin in range(0, len(near), CHUNK):
+        chunk = near[begin:begin + CHUNK]
+        faces = mesh.t2f[chunk]
+        known = np.where(fixed_face[faces][:, :, None], lam.reshape(-1, nf)[faces], 0.0).reshape(len(chunk), 4 * nf)
+        load = -np.matmul(H_K[chunk], known[:, :, None]).reshape(len(chunk), 4, nf)
+        at = local[chunk]
         np.add.at(b, at[at >= 0], load[at >= 0])
-        constant -= float(np.sum(known * load.reshape(len(near), 4 * nf)))
+        constant -= float(np.sum(known * load.reshape(len(chunk), 4 * nf)))
     indptr = np.concatenate([[0], np.cumsum(np.bincount(keys // n_free, minlength=n_free))])
     matrix = sp.bsr_matrix((data, keys[order] % n_free, indptr), shape=(n_free * nf, n_free * nf))
     free = (free_faces[:, None] * nf + np.arange(nf)).ravel()
-    return FaceSystem(matrix, b.ravel(), constant, free, diagonal)
+    return FaceSystem(matrix, b.ravel(), constant, free, data[place[:n_free]])
+
+
+@njit(cache=True)
+def _add_blocks(data, packed, position, block):
+    """Adds block ``(l, m)`` of every element's symmetric matrix (``packed`` upper triangles, ``position`` of entry
+    ``(i, j)`` among them) into ``data[block[e, l, m]]`` where that is not -1."""
+    nf = data.shape[1]
+    for e in range(block.shape[0]):
+        for l in range(4):
+            for m in range(4):
+                k = block[e, l, m]
+                if k >= 0:
+                    for i in range(nf):
+                        for j in range(nf):
+                            data[k, i, j] += packed[e, position[l * nf + i, m * nf + j]]
 
 
 def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.ndarray:
@@ -257,9 +258,11 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     system = face_system(mesh, H_K, fixed_face, lam)
     H = system.matrix
     n_free = len(system.diagonal)
-    coarse = sp.csr_matrix((np.ones(n_free), (np.arange(n_free) * nf, np.arange(n_free))), shape=(n_free * nf, n_free))
-    blocks = np.arange(n_free * nf).reshape(-1, nf)                         # the free faces' moments
-    precondition = pcg.two_level(H, coarse, blocks, system.diagonal)
+    # the coarse space: the face means (the first moment of each free face); its Galerkin matrix P^T H P is the
+    # (0, 0) entry of every block
+    P = sp.csr_matrix((np.ones(n_free), (np.arange(n_free) * nf, np.arange(n_free))), shape=(n_free * nf, n_free))
+    coarse = sp.csr_matrix((H.data[:, 0, 0], H.indices, H.indptr), shape=(n_free, n_free))
+    precondition = pcg.two_level(H, P, coarse, system.diagonal)
     x0 = None if start is None else start()[system.free]
     energy0 = system.constant if x0 is None else system.energy(x0)
     x, iterations, residual = pcg.solve(H, system.b, precondition, x0=x0, energy=(energy0, etol))

@@ -11,40 +11,35 @@ for the p-version).
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 ENERGY_WINDOW = 10  # steps whose energy drops bound the error left (:func:`solve`)
 
 
 class TwoLevel:
-    """The preconditioner of the module docstring, as a callable ``r -> M^-1 r``: the local part ``D^-1`` is point
-    Jacobi, or block Jacobi on the groups of unknowns ``blocks (B, n)`` (one row of dof indices per group; the
-    moments of one face) whose diagonal blocks of ``A`` are ``block_matrices (B, n, n)`` (point Jacobi on the
-    unknowns of no group), kept as one sparse matrix."""
+    """The preconditioner of the module docstring, as a callable ``r -> M^-1 r``. The coarse matrix ``P^T A P`` is
+    computed unless given (``coarse``, CSR); the local part ``D^-1`` is point Jacobi, or block Jacobi on consecutive
+    groups of unknowns whose diagonal blocks of ``A`` are ``block_matrices (B, n, n)`` (``B n`` = all unknowns;
+    the moments of one face), kept as one block sparse matrix."""
 
-    def __init__(self, A, P, blocks: np.ndarray | None = None, block_matrices: np.ndarray | None = None):
-        import pyamg
+    def __init__(self, A, P, coarse=None, block_matrices: np.ndarray | None = None):
         import scipy.sparse as sp
+
+        from sinterheat import amg
 
         self.P = P.tocsr()
         self.PT = self.P.T.tocsr()
-        coarse = (self.PT @ A @ self.P).tocsr()
-        self.amg = pyamg.smoothed_aggregation_solver(coarse, symmetry="symmetric", max_coarse=500).aspreconditioner(
-            cycle="V")
-        rest = np.ones(A.shape[0], dtype=bool)
-        rows, cols, values = [], [], []
-        if blocks is not None:
-            if len(np.unique(blocks)) != blocks.size:
-                raise ValueError("blocks: a dof belongs to two blocks")
-            rest[blocks] = False
-            rows.append(np.broadcast_to(blocks[:, :, None], block_matrices.shape).ravel())
-            cols.append(np.broadcast_to(blocks[:, None, :], block_matrices.shape).ravel())
-            values.append(np.linalg.inv(block_matrices).ravel())
-        rest = np.flatnonzero(rest)
-        rows.append(rest)
-        cols.append(rest)
-        values.append(1.0 / A.diagonal()[rest])
-        self.local = sp.csr_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
-                                   shape=A.shape)
+        if coarse is None:
+            coarse = (self.PT @ A @ self.P).tocsr()
+        self.amg = amg.hierarchy(coarse, symmetry="symmetric", max_coarse=500).aspreconditioner(cycle="V")
+        if block_matrices is None:
+            self.local = sp.diags(1.0 / A.diagonal(), format="csr")
+        else:
+            count, n = len(block_matrices), block_matrices.shape[1]
+            if count * n != A.shape[0]:
+                raise ValueError(f"block_matrices: {count} blocks of {n} unknowns for {A.shape[0]} unknowns")
+            self.local = sp.bsr_matrix((np.linalg.inv(block_matrices), np.arange(count), np.arange(count + 1)),
+                                       shape=A.shape)
 
     def __call__(self, r: np.ndarray) -> np.ndarray:
         return self.P @ self.amg(self.PT @ r) + self.local @ r
@@ -52,43 +47,50 @@ class TwoLevel:
 
 class Assembly:
     """The system of the free unknowns, assembled chunk by chunk from element matrices on the global dofs ``l2g (E,
-    n)``, the dofs marked ``fixed`` held at ``values``. Only the free block is stored (COO with 32-bit indices,
-    allocated once, then CSR); the element matrices of a chunk can be dropped after :meth:`add`. ``A_ff x = b`` gives
-    the free values; :meth:`energy` is ``u^T A u`` of the full vector exactly, whatever ``x``."""
+    n)``, the dofs marked ``fixed`` held at ``values``. Only the free block is stored, as CSR whose pattern (sorted
+    column indices, no duplicates) and every element entry's place in it are computed once from ``l2g``
+    (``_pattern``); :meth:`add` adds a chunk's element matrices into those places, which can then be dropped.
+    The free dofs ``free`` are numbered in the order the elements first use them, so that an element's rows lie
+    near each other in memory (the pattern and the additions take half the time of the global dofs' order).
+    ``A_ff x = b`` gives the free values; :meth:`energy` is ``u^T A u`` of the full vector exactly, whatever ``x``."""
 
     def __init__(self, l2g: np.ndarray, fixed: np.ndarray, values: np.ndarray):
-        self.free = np.flatnonzero(~fixed)
-        index = np.full(len(fixed), -1, dtype=np.int32)
-        index[self.free] = np.arange(len(self.free), dtype=np.int32)
+        dofs, first = np.unique(l2g, return_index=True)
+        first_use = np.full(len(fixed), l2g.size)
+        first_use[dofs] = first
+        free = np.flatnonzero(~fixed)
+        self.free = free[np.argsort(first_use[free], kind="stable")]            # in the order the elements use them
+        n = l2g.shape[1]
+        index_type = np.int32 if len(l2g) * n * n < 2**31 else np.int64
+        index = np.full(len(fixed), -1, dtype=index_type)
+        index[self.free] = np.arange(len(self.free), dtype=index_type)
         self.l2g, self.fixed, self.values = l2g, fixed, values
-        self.loc = index[l2g]                                                  # (E, n), -1 on fixed dofs
-        count = np.sum(self.loc >= 0, axis=1) ** 2
-        self.offset = np.concatenate([[0], np.cumsum(count)])
-        self.rows = np.empty(self.offset[-1], dtype=np.int32)
-        self.cols = np.empty(self.offset[-1], dtype=np.int32)
-        self.data = np.empty(self.offset[-1])
+        loc = np.ascontiguousarray(index[l2g])                                 # (E, n), -1 on fixed dofs
+        self.indptr = np.zeros(len(self.free) + 1, dtype=index_type)
+        self.place = np.empty((len(l2g), n, n), dtype=index_type)
+        self.indices = _pattern(loc, self.indptr, self.place)
+        self.loc = loc
+        self.data = np.zeros(len(self.indices))
         self.b = np.zeros(len(self.free))
         self.constant = 0.0
 
     def add(self, K: np.ndarray, elements: np.ndarray) -> None:
-        loc = self.loc[elements]
+        """Add the element matrices ``K (len(elements), n, n)`` of consecutive ``elements``."""
         known = np.where(self.fixed[self.l2g[elements]], self.values[self.l2g[elements]], 0.0)
         load = -np.matmul(K, known[:, :, None])[:, :, 0]
+        loc = self.loc[elements]
         on = loc >= 0
         self.b += np.bincount(loc[on], load[on], minlength=len(self.free))
         self.constant -= float(np.sum(known * load))
-        pair = on[:, :, None] & on[:, None, :]
-        span = slice(self.offset[elements[0]], self.offset[elements[-1] + 1])
-        self.rows[span] = np.broadcast_to(loc[:, :, None], K.shape)[pair]
-        self.cols[span] = np.broadcast_to(loc[:, None, :], K.shape)[pair]
-        self.data[span] = K[pair]
+        _scatter(self.data, self.place[elements[0]:elements[-1] + 1], np.ascontiguousarray(K))
 
     def matrix(self):
-        """``A_ff`` (CSR); frees the COO arrays."""
+        """``A_ff`` (CSR); frees the element places."""
         import scipy.sparse as sp
 
-        A = sp.csr_matrix((self.data, (self.rows, self.cols)), shape=(len(self.free), len(self.free)))
-        del self.rows, self.cols, self.data
+        A = sp.csr_matrix((self.data, self.indices, self.indptr), shape=(len(self.free), len(self.free)))
+        A.has_sorted_indices = True
+        del self.place
         return A
 
     def energy(self, A, x: np.ndarray) -> float:
@@ -97,8 +99,82 @@ class Assembly:
         return float(x @ (A @ x) - 2.0 * (x @ self.b) + self.constant)
 
 
-def two_level(A, P, blocks: np.ndarray | None = None, block_matrices: np.ndarray | None = None) -> TwoLevel:
-    return TwoLevel(A, P, blocks, block_matrices)
+@njit(cache=True)
+def _pattern(loc, indptr, place):
+    """The CSR pattern of the free block of an assembly on the element dofs ``loc (E, n)`` (-1 on fixed dofs): fills
+    ``indptr`` (free dofs + 1) and ``place (E, n, n)`` (the index in the CSR arrays of each element entry, -1 where
+    either dof is fixed) and returns the column indices, sorted within each row. Row by row, through the elements of
+    each dof: O(entries of the element matrices)."""
+    E, n = loc.shape
+    rows = len(indptr) - 1
+    first = np.zeros(rows + 1, dtype=np.int64)                   # the dof's (element, local) incidences
+    for e in range(E):
+        for a in range(n):
+            if loc[e, a] >= 0:
+                first[loc[e, a] + 1] += 1
+    for r in range(rows):
+        first[r + 1] += first[r]
+    incidence = np.empty(first[rows], dtype=np.int64)
+    filled = first[:-1].copy()
+    for e in range(E):
+        for a in range(n):
+            r = loc[e, a]
+            if r >= 0:
+                incidence[filled[r]] = e * n + a
+                filled[r] += 1
+    seen = np.full(rows, -1, dtype=np.int64)
+    for r in range(rows):                                        # row lengths
+        count = 0
+        for s in range(first[r], first[r + 1]):
+            e = incidence[s] // n
+            for b in range(n):
+                c = loc[e, b]
+                if c >= 0 and seen[c] != r:
+                    seen[c] = r
+                    count += 1
+        indptr[r + 1] = indptr[r] + count
+    indices = np.empty(indptr[rows], dtype=loc.dtype)
+    column = np.empty(rows, dtype=loc.dtype)                     # a column's place within the current row
+    seen[:] = -1
+    for r in range(rows):
+        k = indptr[r]
+        for s in range(first[r], first[r + 1]):
+            e = incidence[s] // n
+            for b in range(n):
+                c = loc[e, b]
+                if c >= 0 and seen[c] != r:
+                    seen[c] = r
+                    indices[k] = c
+                    k += 1
+        indices[indptr[r]:k] = np.sort(indices[indptr[r]:k])
+        for k in range(indptr[r], indptr[r + 1]):
+            column[indices[k]] = k
+        for s in range(first[r], first[r + 1]):
+            e, a = incidence[s] // n, incidence[s] % n
+            for b in range(n):
+                c = loc[e, b]
+                place[e, a, b] = column[c] if c >= 0 else -1
+    for e in range(E):                                           # the rows of fixed dofs
+        for a in range(n):
+            if loc[e, a] < 0:
+                place[e, a, :] = -1
+    return indices
+
+
+@njit(cache=True)
+def _scatter(data, place, K):
+    """``data[place] += K`` over the entries whose place is not -1, element after element."""
+    E, n = K.shape[0], K.shape[1]
+    for e in range(E):
+        for a in range(n):
+            for b in range(n):
+                k = place[e, a, b]
+                if k >= 0:
+                    data[k] += K[e, a, b]
+
+
+def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None) -> TwoLevel:
+    return TwoLevel(A, P, coarse, block_matrices)
 
 
 def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 5000,

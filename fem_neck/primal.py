@@ -41,9 +41,9 @@ def stiffness_matrices(mesh: CurvedMesh, basis: Lagrange, degree: int | None = N
     curved = np.flatnonzero(mesh.is_curved[elements])
     if len(curved):
         xi, w = tet_quadrature(degree or quadrature_degree(basis.p))
-        products = symmetric_products(basis.gradients(xi))                     # (6 Q, n n)
+        products = symmetric_products(basis.gradients(xi))                     # (6 Q, n (n + 1) / 2)
         G = mesh.metric(elements[curved], xi, w, inverse=True).reshape(len(curved), -1)
-        K[curved] = (G @ products).reshape(len(curved), basis.n, basis.n)
+        K[curved] = np.take(G @ products, symmetric_gather(basis.n), axis=1).reshape(len(curved), basis.n, basis.n)
     return K
 
 
@@ -51,12 +51,22 @@ UPPER = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
 
 def symmetric_products(g: np.ndarray) -> np.ndarray:
-    """``g_i g_j^T`` of reference fields ``g (Q, 3, n)`` for the six ``(i, j)`` of ``UPPER``, as ``(Q 6, n n)``
-    (symmetrised for ``i != j``), so that ``sum_q g^T G_q g`` is one matrix product with the entries of
-    :meth:`fem_neck.curved.CurvedMesh.metric`."""
-    out = np.stack([0.5 * (np.einsum("qa,qb->qab", g[:, i], g[:, j]) + np.einsum("qa,qb->qab", g[:, j], g[:, i]))
-                    for i, j in UPPER], axis=1)
+    """``g_i g_j^T`` of reference fields ``g (Q, 3, n)`` for the six ``(i, j)`` of ``UPPER`` (symmetrised for ``i !=
+    j``), each kept as its entries on and above the diagonal in the order of ``numpy.triu_indices(n)``: ``(Q 6, n (n
+    + 1) / 2)``, so that ``sum_q g^T G_q g`` is one matrix product with the entries of
+    :meth:`fem_neck.curved.CurvedMesh.metric`, packed like this (:func:`symmetric_gather` unpacks it)."""
+    a, b = np.triu_indices(g.shape[2])
+    out = np.stack([0.5 * (g[:, i, a] * g[:, j, b] + g[:, j, a] * g[:, i, b]) for i, j in UPPER], axis=1)
     return out.reshape(g.shape[0] * 6, -1)
+
+
+def symmetric_gather(n: int) -> np.ndarray:
+    """``(n n,)``: where entry ``(a, b)`` of a symmetric ``n`` square matrix is among its packed entries on and above
+    the diagonal (the order of ``numpy.triu_indices(n)``)."""
+    upper = np.triu_indices(n)
+    position = np.empty((n, n), dtype=np.int64)
+    position[upper] = position.T[upper] = np.arange(len(upper[0]))
+    return position.ravel()
 
 
 def volume(mesh: CurvedMesh, degree: int = 10) -> float:

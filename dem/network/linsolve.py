@@ -173,23 +173,12 @@ class AMGSolver(PCGSolver):
         if self.hierarchy_of is not None:
             self.hierarchy = self.hierarchy_of.hierarchy
             return self.hierarchy_of.precondition
-        import pyamg
         from pyamg.relaxation.smoothing import change_smoothers
 
-        # pyamg estimates the spectral radius behind the coarse levels' weights by Arnoldi from a random vector of
-        # numpy's global generator: seeded here (and the caller's generator state restored), so that a solve is
-        # the same on every run, to the bit
-        state = np.random.get_state()
-        np.random.seed(AMG_SEED)
-        try:
-            with one_blas_thread():
-                self.hierarchy = pyamg.smoothed_aggregation_solver(self.A, **AMG_OPTIONS)
-        finally:
-            np.random.set_state(state)
-        for level in self.hierarchy.levels:
-            level.A = level.A.tocsr()
-            if hasattr(level, "P"):
-                level.P, level.R = level.P.tocsr(), level.R.tocsr()
+        from sinterheat import amg
+
+        with one_blas_thread():
+            self.hierarchy = amg.hierarchy(self.A, AMG_SEED, **AMG_OPTIONS)   # seeded, on CSR
         change_smoothers(self.hierarchy, AMG_SMOOTHER, AMG_SMOOTHER)
         return self.hierarchy.aspreconditioner(cycle="V")
 

@@ -1,0 +1,131 @@
+"""The sparse systems of the periodic-cell FE (fem_neck.pcg, fem_neck.dual, fem_neck.primal) against the plain
+sums they replace: a dense or COO sum of the element matrices, the Galerkin product of the coarse space."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from fem_neck import dual, lattice, pcg, primal
+from fem_neck.simplex import lagrange, raviart_thomas, tet_quadrature
+
+
+def _random_elements(seed, elements=300, n=10, dofs=500):
+    rng = np.random.default_rng(seed)
+    l2g = np.array([rng.choice(dofs, n, replace=False) for _ in range(elements)])
+    fixed = rng.random(dofs) < 0.2
+    values = np.where(fixed, rng.random(dofs), 0.0)
+    K = rng.standard_normal((elements, n, n))
+    return l2g, fixed, values, K + np.swapaxes(K, 1, 2)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs(seed):
+    l2g, fixed, values, K = _random_elements(seed)
+    system = pcg.Assembly(l2g, fixed, values)
+    for start in range(0, len(l2g), 64):  # in chunks, as the solvers add them
+        elements = np.arange(start, min(start + 64, len(l2g)))
+        system.add(K[elements], elements)
+    A = system.matrix()
+    n = l2g.shape[1]
+    full = sp.csr_matrix((K.ravel(), (np.repeat(l2g, n, axis=1).ravel(), np.tile(l2g, (1, n)).ravel())),
+                         shape=(len(fixed),) * 2).toarray()
+    free = system.free
+    assert sorted(free) == list(np.flatnonzero(~fixed))
+    assert A.has_canonical_format and np.all(np.diff(A.indices[A.indptr[0]:A.indptr[1]]) > 0)
+    np.testing.assert_allclose(A.toarray(), full[np.ix_(free, free)], atol=1e-13)
+    np.testing.assert_allclose(system.b, -full[np.ix_(free, np.flatnonzero(fixed))] @ values[fixed], atol=1e-12)
+    u = values.copy()
+    x = np.random.default_rng(seed + 10).random(len(free))
+    u[free] = x
+    assert system.energy(A, x) == pytest.approx(u @ full @ u, rel=1e-12)
+
+
+def test_packed_symmetric_products_are_the_full_ones():
+    g = np.random.default_rng(2).standard_normal((7, 3, 5))
+    packed = primal.symmetric_products(g)
+    full = np.stack([0.5 * (np.einsum("qa,qb->qab", g[:, i], g[:, j]) + np.einsum("qa,qb->qab", g[:, j], g[:, i]))
+                     for i, j in primal.UPPER], axis=1).reshape(7 * 6, 25)
+    np.testing.assert_array_equal(packed[:, primal.symmetric_gather(5)], full)
+
+
+@pytest.fixture(scope="module")
+def cell_mesh():
+    cm = lattice.build_cell_mesh(lattice.lattice_cell("bcc", 0.08), **lattice.mesh_sizes(0.1))
+    cm.curved.keep_jacobians(tet_quadrature(primal.quadrature_degree(3))[0])
+    yield cm
+    cm.curved.keep_jacobians(None)
+
+
+def _element_matrices(mesh, k):
+    """``H_K`` of every element, as :func:`fem_neck.dual.solve` makes them."""
+    rt = raviart_thomas(k)
+    A = dual.mass_matrices(mesh, rt, primal.quadrature_degree(k + 1), np.arange(len(mesh.tets)))
+    H = np.matmul(rt.traces, np.linalg.solve(A, np.broadcast_to(rt.traces.T, (len(A),) + rt.traces.T.shape)))
+    stack = dual.SymmetricStack(len(H), H.shape[1])
+    stack[np.arange(len(H))] = H
+    return stack, rt.n_face
+
+
+def test_face_system_is_the_sum_of_the_element_matrices_on_the_free_faces(cell_mesh):
+    mesh = cell_mesh.curved
+    H_K, nf = _element_matrices(mesh, 1)
+    fixed = np.zeros(len(mesh.faces), dtype=bool)
+    fixed[cell_mesh.hot] = fixed[cell_mesh.cold] = True
+    lam = np.zeros(len(mesh.faces) * nf)
+    lam[cell_mesh.hot * nf] = 1.0
+    system = dual.face_system(mesh, H_K, fixed, lam)
+    face_dofs = (mesh.t2f[:, :, None] * nf + np.arange(nf)).reshape(len(mesh.tets), -1)
+    n = 4 * nf
+    full = sp.csr_matrix((H_K[np.arange(len(H_K))].ravel(), (np.repeat(face_dofs, n, axis=1).ravel(),
+                                                             np.tile(face_dofs, (1, n)).ravel())),
+                         shape=(len(lam),) * 2)
+    held = np.setdiff1d(np.arange(len(lam)), system.free)
+    free = system.free
+    difference = system.matrix.tocsr() - full[free][:, free]
+    assert abs(difference).max() <= 1e-12 * abs(full).max()
+    np.testing.assert_allclose(system.b, -(full[free][:, held] @ lam[held]), atol=1e-12)
+    assert system.constant == pytest.approx(lam[held] @ (full[held][:, held] @ lam[held]), rel=1e-12)
+    blocks = system.diagonal.reshape(-1, nf, nf)
+    for face in range(0, len(blocks), 97):
+        rows = free[face * nf:(face + 1) * nf]
+        np.testing.assert_allclose(blocks[face], full[rows][:, rows].toarray(), atol=1e-12)
+
+
+def test_the_given_coarse_matrix_of_the_face_means_is_the_galerkin_product(cell_mesh):
+    # the lower bound hands pcg.two_level the (0, 0) entries of the face system's blocks as P^T H P
+    mesh = cell_mesh.curved
+    H_K, nf = _element_matrices(mesh, 2)
+    fixed = np.zeros(len(mesh.faces), dtype=bool)
+    fixed[cell_mesh.hot] = fixed[cell_mesh.cold] = True
+    system = dual.face_system(mesh, H_K, fixed, np.zeros(len(mesh.faces) * nf))
+    H = system.matrix
+    n_free = H.shape[0] // nf
+    P = sp.csr_matrix((np.ones(n_free), (np.arange(n_free) * nf, np.arange(n_free))), shape=(H.shape[0], n_free))
+    coarse = sp.csr_matrix((H.data[:, 0, 0], H.indices, H.indptr), shape=(n_free, n_free))
+    assert abs(coarse - (P.T @ H @ P)).max() == 0.0
+    r = np.random.default_rng(3).random(H.shape[0])
+    given = pcg.two_level(H, P, coarse, system.diagonal)(r)
+    computed = pcg.two_level(H, P, None, system.diagonal)(r)
+    np.testing.assert_allclose(given, computed, rtol=1e-12)
+
+
+def test_block_jacobi_needs_blocks_that_cover_the_unknowns():
+    A = sp.identity(10, format="csr")
+    with pytest.raises(ValueError, match="block_matrices: 3 blocks of 3 unknowns for 10 unknowns"):
+        pcg.two_level(A, sp.identity(10, format="csr"), None, np.ones((3, 3, 3)))
+
+
+def test_upper_bound_matrix_is_the_conforming_stiffness(cell_mesh):
+    # the P_2 system on the free skeleton dofs (no interior nodes at p = 2) against a COO sum of the same elements
+    mesh, basis = cell_mesh.curved, lagrange(2)
+    num = primal.numbering(mesh, basis)
+    K = primal.stiffness_matrices(mesh, basis)
+    fixed = np.zeros(num.n, dtype=bool)
+    fixed[primal.face_dofs(mesh, basis, cell_mesh.hot)] = True
+    system = pcg.Assembly(num.l2g, fixed, fixed.astype(float))
+    system.add(K, np.arange(len(K)))
+    n = basis.n
+    full = sp.csr_matrix((K.ravel(), (np.repeat(num.l2g, n, axis=1).ravel(), np.tile(num.l2g, (1, n)).ravel())),
+                         shape=(num.n, num.n))
+    free = system.free
+    assert abs(system.matrix() - full[free][:, free]).max() <= 1e-12 * abs(full).max()
