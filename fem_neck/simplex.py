@@ -1,7 +1,8 @@
 """Polynomial spaces on the reference tetrahedron ``{xi >= 0, xi_1 + xi_2 + xi_3 <= 1}`` for the periodic-cell FE.
 
-* quadrature: Stroud's conical product of Gauss-Jacobi rules (exact for degree ``2 n - 1`` with ``n`` points per
-  direction), on the tetrahedron and on a face;
+* quadrature: on the tetrahedron the fully symmetric rule of Witherden & Vincent (2015) where one is stored for the
+  degree (``SYMMETRIC_RULES``), else, and on a face, Stroud's conical product of Gauss-Jacobi rules (exact for
+  degree ``2 n - 1`` with ``n`` points per direction);
 * :class:`Lagrange`: the nodal basis of ``P_p`` on the equispaced lattice ``alpha / p`` (``|alpha| = p``), nodes
   ordered vertices, edges, faces, interior. With the vertices of every element in ascending global order, a node on
   a shared edge or face has the same barycentric multi-index in both elements, so the global numbering needs no
@@ -38,10 +39,45 @@ def _gauss_jacobi(n: int, alpha: float) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (s + 1.0), w / 2.0 ** (alpha + 1.0)
 
 
+# Fully symmetric rules on the tetrahedron, all points inside, all weights positive (Witherden & Vincent 2015,
+# Comput. Math. Appl. 69, 1232-1241), as orbit generators in barycentric coordinates with each point's weight on the
+# reference tetrahedron (volume 1/6): (a, a, a, 1 - 3a), (a, a, 1/2 - a, 1/2 - a) and (a, a, b, 1 - 2a - b)
+SYMMETRIC_RULES = {
+    6: {"s31": ((0.04067395853461135312, 0.0016795351758867738247),
+                (0.32233789014227551034, 0.0092261969239424536825),
+                (0.21460287125915202929, 0.0066537917096945820166)),
+        "s211": ((0.06366100187501752530, 0.60300566479164914137, 0.0080357142857142857143),)},
+    8: {"s31": ((0.10795272496221084848, 0.0044044418180681385674),
+                (0.18510948778258657028, 0.0086719579272897554525),
+                (0.04231654368476728162, 0.0012542093589233666301),
+                (0.31418170912403899536, 0.0069606304761558162845)),
+        "s22": ((0.43559132858383020523, 0.0060468217102181371669),),
+        "s211": ((0.02143393012713057484, 0.71746406342630832329, 0.0011928171484740721917),
+                 (0.20413933387602912043, 0.58379737830214440593, 0.0025755810251600558023))},
+}
+
+
+def _symmetric_rule(orbits: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Points ``(Q, 3)`` and weights of a rule of ``SYMMETRIC_RULES``: every distinct permutation of each orbit's
+    barycentric generator."""
+    generators = ([((a, a, a, 1.0 - 3.0 * a), w) for a, w in orbits.get("s31", ())]
+                  + [((a, a, 0.5 - a, 0.5 - a), w) for a, w in orbits.get("s22", ())]
+                  + [((a, a, b, 1.0 - 2.0 * a - b), w) for a, b, w in orbits.get("s211", ())])
+    points, weights = [], []
+    for generator, w in generators:
+        for lam in sorted(set(itertools.permutations(generator))):
+            points.append(lam[1:])
+            weights.append(w)
+    return np.array(points), np.array(weights)
+
+
 @functools.lru_cache(maxsize=None)
 def tet_quadrature(degree: int) -> tuple[np.ndarray, np.ndarray]:
     """Points ``(Q, 3)`` and weights ``(Q,)`` exact for polynomials of ``degree`` on the reference tetrahedron
-    (weights sum to its volume 1/6)."""
+    (weights sum to its volume 1/6): the symmetric rule of ``SYMMETRIC_RULES`` for that degree (degree 6: 24 points
+    against the conical product's 64; degree 8: 46 against 125), else Stroud's conical product."""
+    if degree in SYMMETRIC_RULES:
+        return _symmetric_rule(SYMMETRIC_RULES[degree])
     n = max(1, (degree + 2) // 2)
     (a, wa), (b, wb), (c, wc) = _gauss_jacobi(n, 2.0), _gauss_jacobi(n, 1.0), _gauss_jacobi(n, 0.0)
     A, B, C = (g.ravel() for g in np.meshgrid(a, b, c, indexing="ij"))
