@@ -123,32 +123,26 @@ def _pattern(loc, indptr, place):
                 incidence[filled[r]] = e * n + a
                 filled[r] += 1
     seen = np.full(rows, -1, dtype=np.int64)
-    for r in range(rows):                                        # row lengths
-        count = 0
-        for s in range(first[r], first[r + 1]):
-            e = incidence[s] // n
-            for b in range(n):
-                c = loc[e, b]
-                if c >= 0 and seen[c] != r:
-                    seen[c] = r
-                    count += 1
-        indptr[r + 1] = indptr[r] + count
-    indices = np.empty(indptr[rows], dtype=loc.dtype)
+    indices = np.empty(max(len(incidence) * (n // 4 + 1), 1), dtype=loc.dtype)  # doubled when short
     column = np.empty(rows, dtype=loc.dtype)                     # a column's place within the current row
-    seen[:] = -1
+    k = 0
     for r in range(rows):
-        k = indptr[r]
-        for s in range(first[r], first[r + 1]):
+        for s in range(first[r], first[r + 1]):                  # the distinct columns of row r
             e = incidence[s] // n
             for b in range(n):
                 c = loc[e, b]
                 if c >= 0 and seen[c] != r:
                     seen[c] = r
+                    if k == len(indices):
+                        grown = np.empty(2 * len(indices), dtype=loc.dtype)
+                        grown[:k] = indices
+                        indices = grown
                     indices[k] = c
                     k += 1
+        indptr[r + 1] = k
         indices[indptr[r]:k] = np.sort(indices[indptr[r]:k])
-        for k in range(indptr[r], indptr[r + 1]):
-            column[indices[k]] = k
+        for j in range(indptr[r], k):
+            column[indices[j]] = j
         for s in range(first[r], first[r + 1]):
             e, a = incidence[s] // n, incidence[s] % n
             for b in range(n):
@@ -158,7 +152,7 @@ def _pattern(loc, indptr, place):
         for a in range(n):
             if loc[e, a] < 0:
                 place[e, a, :] = -1
-    return indices
+    return indices[:k].copy()
 
 
 @njit(cache=True)
