@@ -99,10 +99,74 @@ class SymmetricStack:
         return out
 
 
+class SymmetricBlocks:
+    """A symmetric matrix of ``n_f`` square blocks kept as its blocks on and above the diagonal, in block compressed
+    rows (``data (K, n_f, n_f)``, ``indices``, ``indptr``): ``@`` multiplies by the whole matrix, each stored block off
+    the diagonal acting also as its transpose below it (half the memory, and half the memory traffic of a product,
+    of the full block sparse matrix)."""
+
+    def __init__(self, data: np.ndarray, indices: np.ndarray, indptr: np.ndarray):
+        self.data, self.indices, self.indptr = data, indices, indptr
+        n = (len(indptr) - 1) * data.shape[1]
+        self.shape = (n, n)
+
+    def __matmul__(self, x: np.ndarray) -> np.ndarray:
+        nf = self.data.shape[1]
+        y = np.zeros(len(x))
+        _symmetric_block_product(self.data, self.indices, self.indptr, np.ascontiguousarray(x).reshape(-1, nf),
+                                 y.reshape(-1, nf))
+        return y
+
+    def entries(self, a: int, b: int):
+        """Entry ``(a, b)`` of every block as a symmetric CSR matrix of the block rows (both triangles); the first
+        moments' ``(0, 0)`` is the Galerkin matrix of the face means."""
+        import scipy.sparse as sp
+
+        rows = np.repeat(np.arange(len(self.indptr) - 1), np.diff(self.indptr))
+        cols, upper, lower = self.indices, self.data[:, a, b], self.data[:, b, a]
+        off = rows != cols
+        n = len(self.indptr) - 1
+        return sp.csr_matrix((np.concatenate([upper, lower[off]]),
+                              (np.concatenate([rows, cols[off]]), np.concatenate([cols, rows[off]]))), shape=(n, n))
+
+    def tocsr(self):
+        """The whole matrix as CSR (for checks: twice the memory)."""
+        import scipy.sparse as sp
+
+        rows = np.repeat(np.arange(len(self.indptr) - 1), np.diff(self.indptr))
+        off = sp.bsr_matrix((np.where((rows != self.indices)[:, None, None], self.data, 0.0), self.indices,
+                             self.indptr), shape=self.shape)
+        diagonal = sp.bsr_matrix((np.where((rows == self.indices)[:, None, None], self.data, 0.0), self.indices,
+                                  self.indptr), shape=self.shape)
+        return (diagonal + off + off.T).tocsr()
+
+
+@njit(cache=True, fastmath=True)
+def _symmetric_block_product(data, indices, indptr, x, y):
+    """``y += H x`` for the symmetric block matrix of :class:`SymmetricBlocks` (``x``, ``y`` as ``(rows, n_f)``):
+    each stored block read once, for its own product and its transpose's."""
+    nf = data.shape[1]
+    below = np.empty(nf)
+    for i in range(len(indptr) - 1):
+        for k in range(indptr[i], indptr[i + 1]):
+            j = indices[k]
+            below[:] = 0.0
+            for a in range(nf):
+                s = 0.0
+                xa = x[i, a]
+                for b in range(nf):
+                    s += data[k, a, b] * x[j, b]
+                    below[b] += data[k, a, b] * xa
+                y[i, a] += s
+            if j != i:
+                for b in range(nf):
+                    y[j, b] += below[b]
+
+
 @dataclass
 class FaceSystem:
-    """The face system on the free faces' moments (:func:`face_system`): ``matrix`` (block sparse, one ``n_f``
-    square block per pair of faces of an element), ``b = -H_fd lambda_d``, ``constant = lambda_d^T H_dd lambda_d``
+    """The face system on the free faces' moments (:func:`face_system`): ``matrix`` (:class:`SymmetricBlocks`, one
+    ``n_f`` square block per pair of faces of an element), ``b = -H_fd lambda_d``, ``constant = lambda_d^T H_dd lambda_d``
     (``d``: the faces held at a temperature), the free dofs and the free faces' diagonal blocks."""
 
     matrix: object
@@ -117,11 +181,9 @@ class FaceSystem:
 
 
 def face_system(mesh: CurvedMesh, H_K: SymmetricStack, fixed_face: np.ndarray, lam: np.ndarray) -> FaceSystem:
-    """``sum_K H_K`` on the free faces as a block sparse matrix: two faces of one element share only that element,
-    so a block off the diagonal is one element's, and a diagonal block the sum over the face's elements; the held
-    faces' multipliers ``lam`` go to the right-hand side."""
-    import scipy.sparse as sp
-
+    """``sum_K H_K`` on the free faces as a symmetric block matrix (:class:`SymmetricBlocks`): two faces of one
+    element share only that element, so a block off the diagonal is one element's, and a diagonal block the sum over
+    the face's elements; the held faces' multipliers ``lam`` go to the right-hand side."""
     nf, E = H_K.n // 4, len(H_K)
     free_faces = np.flatnonzero(~fixed_face)
     n_free = len(free_faces)
@@ -130,7 +192,7 @@ def face_system(mesh: CurvedMesh, H_K: SymmetricStack, fixed_face: np.ndarray, l
     local = index[mesh.t2f]                                                 # (E, 4), -1 on the held faces
     local_row, local_col = np.nonzero(~np.eye(4, dtype=bool))              # the 12 pairs of distinct faces
     rows, cols = local[:, local_row], local[:, local_col]
-    off = (rows >= 0) & (cols >= 0)
+    off = (rows >= 0) & (cols >= 0) & (rows < cols)                         # the blocks above the diagonal
     keys = np.concatenate([np.arange(n_free) * (n_free + 1), (rows * n_free + cols)[off]])
     order = np.argsort(keys)
     place = np.empty_like(order)
@@ -155,7 +217,7 @@ def face_system(mesh: CurvedMesh, H_K: SymmetricStack, fixed_face: np.ndarray, l
         np.add.at(b, at[at >= 0], load[at >= 0])
         constant -= float(np.sum(known * load.reshape(len(chunk), 4 * nf)))
     indptr = np.concatenate([[0], np.cumsum(np.bincount(keys // n_free, minlength=n_free))])
-    matrix = sp.bsr_matrix((data, keys[order] % n_free, indptr), shape=(n_free * nf, n_free * nf))
+    matrix = SymmetricBlocks(data, keys[order] % n_free, indptr)
     free = (free_faces[:, None] * nf + np.arange(nf)).ravel()
     return FaceSystem(matrix, b.ravel(), constant, free, data[place[:n_free]])
 
@@ -261,7 +323,7 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     # the coarse space: the face means (the first moment of each free face); its Galerkin matrix P^T H P is the
     # (0, 0) entry of every block
     P = sp.csr_matrix((np.ones(n_free), (np.arange(n_free) * nf, np.arange(n_free))), shape=(n_free * nf, n_free))
-    coarse = sp.csr_matrix((H.data[:, 0, 0], H.indices, H.indptr), shape=(n_free, n_free))
+    coarse = H.entries(0, 0)
     precondition = pcg.two_level(H, P, coarse, system.diagonal)
     x0 = None if start is None else start()[system.free]
     energy0 = system.constant if x0 is None else system.energy(x0)

@@ -41,6 +41,7 @@ estimate meets ``rtol``, and the memory of each solve is estimated before its me
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 import os
@@ -554,22 +555,20 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2) -> Bounds:
             context = get_context("fork")
             queue = context.Queue()      # put does not wait for the reader (which may have failed before reading)
             queue.cancel_join_thread()   # nor does the exit, if it never read
-            with ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures,
-                                     initargs=(queue,)) as pool:
-                future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold)
-                with one_blas_thread():
-                    up = primal.solve(mesh, order, cm.hot, cm.cold)
-                queue.put(up.u)
-                low = future.result()
+            pool = ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures, initargs=(queue,))
         else:
+            pool = contextlib.nullcontext()
+        with pool:
+            future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold) if workers >= 2 else None
             with one_blas_thread():
                 up = primal.solve(mesh, order, cm.hot, cm.cold)
-            low = _dual(mesh, order, cm.hot, cm.cold, lambda: up.u)
+                if future is not None:
+                    queue.put(up.u)
+                volume = primal.volume(mesh)  # (while the lower bound finishes in its process)
+            low = future.result() if future is not None else _dual(mesh, order, cm.hot, cm.cold, lambda: up.u)
     finally:  # the kept Jacobians (a few hundred MB on a fine mesh) go with the solves, also when one fails
         mesh.keep_jacobians(None)
     scale = cm.height / cm.area
-    with one_blas_thread():
-        volume = primal.volume(mesh)
     return Bounds(float(up.energy * scale), float(low.lower * scale), float(low.flux_defect), int(up.dofs),
                   int(low.dofs), len(mesh.tets), float(volume / cm.volume_exact - 1.0), time.perf_counter() - t0)
 
