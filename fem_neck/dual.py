@@ -166,8 +166,8 @@ def _symmetric_block_product(data, indices, indptr, x, y):
 @dataclass
 class FaceSystem:
     """The face system on the free faces' moments (:func:`face_system`): ``matrix`` (:class:`SymmetricBlocks`, one
-    ``n_f`` square block per pair of faces of an element), ``b = -H_fd lambda_d``, ``constant = lambda_d^T H_dd lambda_d``
-    (``d``: the faces held at a temperature), the free dofs and the free faces' diagonal blocks."""
+    ``n_f`` square block per pair of faces of an element), ``b = -H_fd lambda_d``, ``constant = lambda_d^T H_dd
+    lambda_d`` (``d``: the faces held at a temperature), the free dofs and the free faces' diagonal blocks."""
 
     matrix: object
     b: np.ndarray

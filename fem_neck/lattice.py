@@ -30,12 +30,12 @@ face mapped onto its sphere, cylinder, plane or their intersection curve), so th
 
 Both converge at one rate, so ``error_estimate = (upper - lower) / upper`` bounds the error of the reported value
 (the upper) and is 2-3 times it (the two errors are about equal, measured on the lattice cells). The bounds hold up
-to the quadrature of the curved elements (degree ``2 p``: 2-3e-9 relative at p = 4, measured against ``2 p + 4``) and
-round-off, whatever the solvers' residuals: both CGs stop when their energy has settled to ``ALGEBRAIC_SHARE rtol``
-(1e-7 at the default ``rtol``); the energy of any iterate is an upper bound, and the flux of any iterate is made
-exactly admissible (:func:`fem_neck.dual.equilibrate`). The mesh is graded toward every neck circle, where the temperature is
-singular (``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined until the
-estimate meets ``rtol``, and the memory of each solve is estimated before its mesh is made
+to the quadrature of the curved elements (degree ``2 p``: 2-3e-9 relative at p = 4, measured against ``2 p + 4``)
+and round-off, whatever the solvers' residuals: both CGs stop when their energy has settled to ``ALGEBRAIC_SHARE
+rtol`` (1e-7 at the default ``rtol``); the energy of any iterate is an upper bound, and the flux of any iterate is
+made exactly admissible (:func:`fem_neck.dual.equilibrate`). The mesh is graded toward every neck circle, where the
+temperature is singular (``size_neck a`` at the circles, growing by ``GRADING`` per unit distance); it is refined
+until the estimate meets ``rtol``, and the memory of each solve is estimated before its mesh is made
 (:func:`effective_conductivity`).
 """
 
