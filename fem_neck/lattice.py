@@ -89,8 +89,10 @@ P3_FROM = 3e-4  # the rtol from which the upper bound is P_3 by default (below, 
 # of the dense-packing study) were predicted 1.04-1.77 times their tetrahedra
 TETRAHEDRA_PER_CIRCLE, TETRAHEDRA_PER_VOLUME, PREDICTION_MARGIN = 315.0, 27.3, 1.3
 # peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured by
-# peak_memory: p = 4 91 kB per tetrahedron beyond the base on BCC and FCC h/r = 0.02, p = 3 31 kB on FCC 0.02)
-BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 40e3, 4: 100e3}
+# peak_memory, whole runs: p = 4 at most 41 kB per tetrahedron beyond the base on the six cells of SC, BCC, FCC at
+# h/r = 0.02 and 0.08; p = 3 at most 18 kB, on the largest random packing of the dense-packing study, 106 027
+# tetrahedra; about 1.4 times that here)
+BASE_BYTES, BYTES_PER_ELEMENT = 0.5e9, {2: 20e3, 3: 25e3, 4: 60e3}
 _TOL = 1e-9  # geometric tolerance in units of the largest radius
 
 
