@@ -23,12 +23,13 @@ How it holds. The first SIGINT raises ``KeyboardInterrupt`` and any further one 
 cut short. C code may turn the interrupt into another error (numpy's import raises ``ImportError`` when it lands
 there) or swallow it (in a weakref callback it is only "ignored"; in an extension module's import it can end as a
 caught ``ImportError``): any error after a SIGINT counts as the interrupt, and a swallowed one is raised again at
-the next :meth:`Where.update` or when the command returns (the unraisable hook keeps it off stderr). tqdm bars still open are
-closed before the line is written, so it starts a line of its own. Workers of a process pool ignore SIGINT
-(:func:`ignore_interrupts` as the pool's initializer, forked inside :func:`shielded` so that no fork races the
-signal); the parent stops them (:func:`stop_pool`). :func:`exit_process` then leaves with code 130 (Python's own
-exit would report a kill by SIGINT once the interrupt has passed through some C-level imports). Before the CLI's
-``main`` runs (interpreter start-up, a few tens of ms) Python's default handler is still in place.
+the next :meth:`Where.update` or when the command returns (the unraisable hook keeps it off stderr). tqdm bars still
+open are closed before the line is written, so it starts a line of its own. Workers of a process pool ignore SIGINT
+(:func:`ignore_interrupts` as the pool's initializer, started inside :func:`shielded`, which holds a Ctrl-C back
+until the pool knows every worker it started); the parent stops them (:func:`stop_pool`). :func:`exit_process` then
+leaves with code 130 (Python's own exit would report a kill by SIGINT once the interrupt has passed through some
+C-level imports). Before the CLI's ``main`` runs (interpreter start-up, a few tens of ms) Python's default handler
+is still in place.
 """
 
 from __future__ import annotations
@@ -174,16 +175,31 @@ def ignore_interrupts() -> None:
 
 @contextlib.contextmanager
 def shielded():
-    """Hold back SIGINT while worker processes are being started: a fork inherits the blocked signal, so a worker
-    cannot be interrupted before :func:`ignore_interrupts` runs; a Ctrl-C meanwhile reaches this process on exit."""
-    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+    """Hold back SIGINT while worker processes are being started; a Ctrl-C meanwhile is raised on leaving the block.
+
+    A worker forked here but interrupted before its pool has recorded it would never be stopped: it would outlive
+    the run, holding the run's stdout and stderr. Two holds: SIGINT is blocked in this thread, so that a fork
+    inherits it blocked and a worker cannot be interrupted before :func:`ignore_interrupts` runs; and the Python
+    handler is swapped for one that only records the signal, because the kernel gives a SIGINT sent to the process
+    to any thread that does not block it (tqdm's monitor, BLAS threads), and its C handler then has this thread run
+    the Python handler all the same."""
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    held = []
+    previous = signal.getsignal(signal.SIGINT)
+    if previous is not None:  # None: a handler not installed from Python, left as it is
+        signal.signal(signal.SIGINT, lambda signum, frame: held.append(signum))
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if hasattr(signal, "pthread_sigmask") else None
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        if old is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)  # a SIGINT held on this thread is recorded now
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+        if held:
+            signal.raise_signal(signal.SIGINT)
 
 
 def stop_pool(pool) -> None:

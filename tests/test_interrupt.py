@@ -165,6 +165,31 @@ def test_an_interrupt_swallowed_in_a_destructor_ends_the_run_at_the_next_update(
                                        "no results written\n")
 
 
+def test_shielded_holds_back_a_ctrl_c_that_another_thread_receives():
+    # the kernel gives a SIGINT sent to the process to a thread that does not block it (here a waiting thread, in a
+    # CLI tqdm's monitor or BLAS threads), and the main thread then runs the Python handler: inside the block that
+    # would interrupt a pool between forking a worker and recording it, and the worker would outlive the run
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait)
+    other.start()
+    here, reached = interrupt.Where("python -m fem_neck fit"), []
+    before = signal.getsignal(signal.SIGINT)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            with interrupt.interruptible(here):
+                with interrupt.shielded():
+                    os.kill(os.getpid(), signal.SIGINT)
+                    for _ in range(50):
+                        time.sleep(0.002)  # a call: where the handler would raise
+                    reached.append("end of the block")
+                reached.append("after the block")
+    finally:
+        stop.set()
+        other.join()
+        signal.signal(signal.SIGINT, before)
+    assert reached == ["end of the block"] and here.signalled
+
+
 def test_where_message():
     here = interrupt.Where("python -m dem run")
     assert here.message() == "python -m dem run: interrupted at start-up; no results written"
