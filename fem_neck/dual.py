@@ -117,12 +117,16 @@ class SymmetricBlocks:
                                  y.reshape(-1, nf))
         return y
 
+    def block_rows(self) -> np.ndarray:
+        """The block row of every stored block (``indices`` holds their block columns)."""
+        return np.repeat(np.arange(len(self.indptr) - 1), np.diff(self.indptr))
+
     def entries(self, a: int, b: int):
         """Entry ``(a, b)`` of every block as a symmetric CSR matrix of the block rows (both triangles); the first
         moments' ``(0, 0)`` is the Galerkin matrix of the face means."""
         import scipy.sparse as sp
 
-        rows = np.repeat(np.arange(len(self.indptr) - 1), np.diff(self.indptr))
+        rows = self.block_rows()
         cols, upper, lower = self.indices, self.data[:, a, b], self.data[:, b, a]
         off = rows != cols
         n = len(self.indptr) - 1
@@ -133,7 +137,7 @@ class SymmetricBlocks:
         """The whole matrix as CSR (for checks: twice the memory)."""
         import scipy.sparse as sp
 
-        rows = np.repeat(np.arange(len(self.indptr) - 1), np.diff(self.indptr))
+        rows = self.block_rows()
         off = sp.bsr_matrix((np.where((rows != self.indices)[:, None, None], self.data, 0.0), self.indices,
                              self.indptr), shape=self.shape)
         diagonal = sp.bsr_matrix((np.where((rows == self.indices)[:, None, None], self.data, 0.0), self.indices,

@@ -98,6 +98,21 @@ def split_incidences(pi, pj, n, n_blocks):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="always")
+def add_pair_share(f, tau, k, sign, g0, g1, g2, arm, m0, m1, m2, planar):
+    """Particle ``k``'s share of a pair's force and torque: ``sign g`` into its force (``sign`` +1 for the pair's i,
+    -1 for its j) and ``-arm (n x f_t)`` into its torque, ``arm`` its lever ``l_i`` or ``l_j`` (module docstring).
+    (``x - g`` and ``x + (-1) g`` are the same number.)"""
+    f[k, 0] += sign * g0
+    f[k, 1] += sign * g1
+    f[k, 2] += sign * g2
+    if law.SPINS:
+        tau[k, 1] -= arm * m1
+        if not planar:
+            tau[k, 0] -= arm * m0
+            tau[k, 2] -= arm * m2
+
+
+@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="always")
 def pair_geometry(c, x, pi, pj, box, planar):
     """The listed pair ``c`` = (i, j): ``(d2, d, n0, n1, n2)``, the squared distance of the centres (minimum image),
     the distance and the unit normal from j to i (0 where the centres coincide)."""
@@ -206,44 +221,19 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
                     load[c, 0], load[c, 1], load[c, 2], load[c, 3], load[c, 4], load[c, 5] = g0, g1, g2, m0, m1, m2
                     load[c, 6], load[c, 7], load[c, 8] = li, lj, 1.0
             if add_i:
-                f[i, 0] += g0
-                f[i, 1] += g1
-                f[i, 2] += g2
-                if law.SPINS:
-                    tau[i, 1] -= li * m1
-                    if not planar:
-                        tau[i, 0] -= li * m0
-                        tau[i, 2] -= li * m2
+                add_pair_share(f, tau, i, 1.0, g0, g1, g2, li, m0, m1, m2, planar)
             if add_j:
-                f[j, 0] -= g0
-                f[j, 1] -= g1
-                f[j, 2] -= g2
-                if law.SPINS:
-                    tau[j, 1] -= lj * m1
-                    if not planar:
-                        tau[j, 0] -= lj * m0
-                        tau[j, 2] -= lj * m2
+                add_pair_share(f, tau, j, -1.0, g0, g1, g2, lj, m0, m1, m2, planar)
     if THREADED:
         for k in range(n):  # each particle the rows of its pairs in later blocks, in the order of the list
             for e in range(start[k], start[k + 1]):
                 c = pairs[e]
-                arm = 6 if c >= 0 else 7
+                sign, arm = (1.0, 6) if c >= 0 else (-1.0, 7)
                 c = c if c >= 0 else ~c
                 if load[c, 8] == 0.0:
                     continue
-                if arm == 6:
-                    f[k, 0] += load[c, 0]
-                    f[k, 1] += load[c, 1]
-                    f[k, 2] += load[c, 2]
-                else:
-                    f[k, 0] -= load[c, 0]
-                    f[k, 1] -= load[c, 1]
-                    f[k, 2] -= load[c, 2]
-                if law.SPINS:
-                    tau[k, 1] -= load[c, arm] * load[c, 4]
-                    if not planar:
-                        tau[k, 0] -= load[c, arm] * load[c, 3]
-                        tau[k, 2] -= load[c, arm] * load[c, 5]
+                add_pair_share(f, tau, k, sign, load[c, 0], load[c, 1], load[c, 2], load[c, arm], load[c, 3],
+                               load[c, 4], load[c, 5], planar)
     n_w = wn.shape[0]
     for m in range(n_w):
         wforce[m] = 0.0
