@@ -107,6 +107,9 @@ def test_isolating_variants_start_where_they_should():
     for grid in (sr.QUICK, sr.FULL):  # the densification statements read every placement of N max
         assert {sr.Task(sr.COOL, max(grid.n), p, max(grid.t_s), seed) for p in grid.p for seed in sr.PLACEMENTS} \
             <= set(sr.with_parents(grid.tasks()))
+        # and the failure statements every placement's compression test, for every N, p and t_s
+        assert {sr.Task(sr.COMPRESS, n, p, t, seed) for n in grid.n for p in grid.p for t in grid.t_s
+                for seed in sr.PLACEMENTS} <= set(grid.tasks())
 
 
 def test_scene_docs_of_the_variants(tmp_path, monkeypatch):
@@ -165,6 +168,29 @@ def test_the_densification_statements_read_the_mean_over_the_placements():
     del results[sr.Task(sr.COOL, 100, 10.0, 1.0, 3)]
     with pytest.raises(Y.Missing):  # a placement missing: no statement from the others
         T._densification(Y.Study(pathlib.Path("nowhere"), grid, results))
+
+
+def test_the_failure_statements_read_the_mean_over_the_placements():
+    """The failure strain of barely sintered samples differs more between placements than between t_s: the
+    statements read the mean of the placements (here the quick grid's numbers, rounded)."""
+    grid = sr.Grid(n=(100,), p=(10.0, 100.0), t_s=(1e-4, 0.01, 1.0), three_seeds=(1,), no_expansion=False, n3d=12)
+    strain = {10.0: {1e-4: [0.0015, 0.0016, 0.0018], 0.01: [0.0014, 0.0019, 0.0017], 1.0: [0.0069, 0.0051, 0.0057]},
+              100.0: {1e-4: [0.009, 0.023, 0.023], 0.01: [0.016, 0.014, 0.010], 1.0: [0.036, 0.057, 0.039]}}
+    st = Y.Study(pathlib.Path("nowhere"), grid, {})
+
+    def compression(n, p, t_s, variant="", seed=1):
+        e = strain[p][t_s][sr.PLACEMENTS.index(seed)]
+        return {"failure_strain": e, "failure_stress": 1e5 * e}
+
+    st.compression = compression
+    assert st.placement_failures(100, 100.0, 1e-4, "failure_strain") == [0.009, 0.023, 0.023]
+    stress_t, stress_p, strain_t, strain_p = T._failure_grows(st)
+    # p = 10: the first placement alone falls from t_s = 1e-4 to 0.01 (rank correlation 0.5), the mean rises
+    assert "N=100, p=10: 0.00163 → 0.0059 (rank corr. 1.00)" in strain_t.ours
+    # p = 100: the mean falls from 0.0183 to 0.0133 between t_s = 1e-4 and 0.01
+    assert "N=100, p=100: 0.0183 → 0.044 (rank corr. 0.50)" in strain_t.ours and not strain_t.holds
+    assert strain_p.holds and strain_p.ours == "larger at p = 100 in 3 of 3 (N, t_s)"
+    assert stress_p.holds and not stress_t.holds  # the stress here is the strain scaled: the same order
 
 
 def test_the_interior_fraction_leaves_the_wall_layer_out():

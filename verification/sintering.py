@@ -579,6 +579,13 @@ def discussion(st: Study) -> str:
                      f"cannot order with t_s")
         except Missing:
             pass
+        try:
+            spread = {p: st.placement_failures(n, p, st.t_min, "failure_strain") for p in st.grid.p}
+            text += (f". Between placements ε_f at t_s = {st.t_min:g} (N = {n}) spreads over "
+                     + ", ".join(f"{min(v):.4f}-{max(v):.4f} at p = {p:g}" for p, v in spread.items())
+                     + ", so the statements read the mean of the placements (the isolating runs' table)")
+        except Missing:
+            pass
         return text + (f". The strain rate (1/s) is not in the paper; at it the kinetic energy before failure stays "
                        f"below {100 * ratio:.1f} % of the work done by the top wall (longest t_s).")
 

@@ -73,7 +73,8 @@ class Variant:
 
 
 PREP_SEEDS = (2, 3)  # other random placements of the protocol's preparation: the spread of nu(t_heat) of one sample
-PLACEMENTS = (1,) + PREP_SEEDS  # the placements whose mean densification the statements read (N max, t_s max)
+PLACEMENTS = (1,) + PREP_SEEDS  # the placements whose mean the statements read: densification (N max, t_s max),
+#                                  failure in the compression test (every N, p and t_s)
 FRICTIONLESS = {"prep_mu": 0.0, "prep_mu_wall": 0.0}
 VARIANTS = {v.label: v for v in (
     Variant("frictionless", FRICTIONLESS),                                   # the paper's text (Sec. 4)
@@ -212,6 +213,8 @@ class Grid:
                     out += [Task(COMPRESS, n, p, t_s), Task(VIBRATE, n, p, t_s)]
         t_max = max(self.t_s)
         out += [Task(COOL, max(self.n), p, t_max, seed) for p in self.p for seed in PREP_SEEDS]
+        out += [Task(COMPRESS, n, p, t_s, seed) for n in self.n for p in self.p for t_s in self.t_s
+                for seed in PREP_SEEDS]
         out += [Task(SCHEDULE, 3, p, t_max, seed) for p in self.p for seed in self.three_seeds]
         if self.no_expansion:
             out += [Task(SCHEDULE, min(self.n), p, t_max, variant="no-expansion") for p in self.p]

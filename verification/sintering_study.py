@@ -88,11 +88,11 @@ class Study:
         out["mass_fraction"] = out["volume_fraction"] * (cold / hot) ** 2
         return out
 
-    def compression(self, n, p, t_s, variant: str = "") -> dict:
+    def compression(self, n, p, t_s, variant: str = "", seed: int = 1) -> dict:
         """eps_zz = 1 - z/z0, sigma_zz (top wall), sigma_xx (right wall), nu; the failure (:func:`failure`) and the
         stiffness, the slope of sigma_zz against eps_zz while the stress rises from p to half way to failure."""
-        s = self.series(self.task(sr.COMPRESS, n, p, t_s, variant=variant))
-        before = self.res(sr.COOL, n, p, t_s)
+        s = self.series(self.task(sr.COMPRESS, n, p, t_s, seed, variant))
+        before = self.res(sr.COOL, n, p, t_s, seed)
         z = -s["q_top"]
         eps = 1.0 - z / z[0]
         szz, sxx = s["wall_top"].copy(), s["wall_right"].copy()
@@ -105,6 +105,11 @@ class Study:
         return {"eps": eps, "szz": szz, "sxx": sxx, "nu": s["volume_fraction"], "t": s["t"],
                 "failure_stress": float(szz[k]), "failure_strain": float(eps[k]), "stiffness": stiffness,
                 "kinetic_over_work": float(np.max(s["kinetic_energy"][:k + 1]) / work[k]) if work[k] > 0 else math.nan}
+
+    def placement_failures(self, n, p, t_s, key: str) -> list[float]:
+        """``key`` (``"failure_stress"`` or ``"failure_strain"``) of :meth:`compression` for each of the protocol's
+        placements :data:`sintering_runs.PLACEMENTS`, one per placement."""
+        return [self.compression(n, p, t_s, seed=seed)[key] for seed in sr.PLACEMENTS]
 
     def chain_densification(self, n, p, seed=1, variant: str = "") -> float:
         """Densification nu(t_f)/nu(t_heat) - 1 of one sample prepared, sintered for the longest t_s and cooled."""
