@@ -193,6 +193,20 @@ def test_the_failure_statements_read_the_mean_over_the_placements():
     assert stress_p.holds and not stress_t.holds  # the stress here is the strain scaled: the same order
 
 
+def test_the_coordination_table_lists_every_preparation_and_placement_the_grid_sintered():
+    grid = sr.Grid(n=(100,), p=(10.0,), t_s=(1.0,), three_seeds=(1,), no_expansion=False, n3d=12)
+    done = {sr.Task(sr.SINTER, 100, 10.0, 1.0): {}, sr.Task(sr.SINTER, 100, 10.0, 1.0, 3): {},
+            sr.Task(sr.SINTER, 100, 10.0, 1.0, variant="frictionless"): {},
+            sr.Task(sr.SINTER, 100, 10.0, 1.0, 2): {"error": "failed"}}
+    st = Y.Study(pathlib.Path("nowhere"), grid, done)
+    listed = cooling.sintered_preparations(st, 100, 10.0)
+    assert [task for _, task in listed] == [sr.Task(sr.SINTER, 100, 10.0, 1.0),
+                                            sr.Task(sr.SINTER, 100, 10.0, 1.0, variant="frictionless"),
+                                            sr.Task(sr.SINTER, 100, 10.0, 1.0, 3)]  # the failed placement left out
+    assert listed[1][0] == cooling.PREP_LABELS["frictionless"] and listed[2][0] == "protocol, placement (seed) 3"
+    assert cooling.sintered_preparations(st, 100, 100.0) == []
+
+
 def test_the_interior_fraction_leaves_the_wall_layer_out():
     """A disk of radius 1 mm in the middle of a 10 mm box: pi r^2 over the 4 mm x 4 mm interior 3 mm from the walls;
     one touching a wall adds nothing; a margin that leaves no interior is refused by name."""

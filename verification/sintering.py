@@ -25,7 +25,7 @@ from verification.sinter_protocol import Times
 from verification import sintering_runs as sr
 from verification.report import md_table, save_figure
 from verification.sintering_causes import (INTERIOR_MARGIN, box_area, contact_cooling, cool_down, interior_fraction,
-                                           section as causes_section)
+                                           section as causes_section, sintered_preparations)
 from verification.sintering_statements import pct, statements, statements_table
 from verification.sintering_study import Missing, Study, at, bulk_coordination, read_csv
 
@@ -561,7 +561,16 @@ def discussion(st: Study) -> str:
                 "paper also names as the reason for a smaller C: the particles touching no wall have C = "
                 + ", ".join(f"{bulk[(m, p)]:.2f}" for m in st.grid.n for p in st.grid.p)
                 + " (the isolating runs' table). The order (p = 100 above p = 10, N = 300 above N = 100) is the "
-                "paper's.")
+                "paper's." + _spread())
+
+    def _spread() -> str:
+        found = {(m, p): [st.results[task]["coordination"] for _, task in sintered_preparations(st, m, p)]
+                 for m in st.grid.n for p in st.grid.p}
+        if all(len(v) < 2 for v in found.values()):
+            return ""
+        return (" Every preparation and placement the grid sintered gives C = "
+                + ", ".join(f"{min(v):.2f}-{max(v):.2f} for N = {m}, p = {p:g} ({len(v)} samples)"
+                            for (m, p), v in found.items() if len(v) > 1) + ".")
 
     def failure():
         ratio = max(st.compression(m, p, st.t_max)["kinetic_over_work"] for m in st.grid.n for p in st.grid.p)

@@ -146,17 +146,33 @@ PREP_LABELS = {"": "protocol: friction μ = 0.5 on particles and walls", "fricti
                "(γ_w = 2 kg/s)"}
 
 
+def preparations() -> list[tuple[str, str, int]]:
+    """``(variant, label, seed)`` of every preparation: the protocol's, each of :data:`PREP_LABELS`, and the
+    protocol's other placements (:data:`sintering_runs.PREP_SEEDS`)."""
+    return ([(variant, label, 1) for variant, label in PREP_LABELS.items()]
+            + [("", f"protocol, placement (seed) {seed}", seed) for seed in sr.PREP_SEEDS])
+
+
+def sintered_preparations(st: Study, n, p) -> list[tuple[str, sr.Task]]:
+    """``(label, task)`` of the longest sintering of each preparation and placement (:func:`preparations`) that the
+    grid ran for ``n`` particles at ``p``."""
+    tasks = [(label, st.task(sr.SINTER, n, p, st.t_max, seed, variant)) for variant, label, seed in preparations()]
+    return [(label, task) for label, task in tasks if "error" not in st.results.get(task, {"error": "not run"})]
+
+
+def _run_key(n, p, variant: str, seed: int) -> str:
+    return f"n{n}-p{p:g}-{variant or 'protocol'}" + (f"-seed{seed}" if seed != 1 else "")
+
+
 def preparation_table(st: Study) -> tuple[str, dict]:
     """ν(t_heat) of every preparation run (the protocol's other placements, :data:`sintering_runs.PREP_SEEDS`,
     as rows of their own), ν half way through it (has it settled?), ν of its interior (:func:`interior_fraction`),
     and the densification of those sintered for the longest t_s and cooled."""
     rows, summary = [], {}
-    runs = [(variant, label, 1) for variant, label in PREP_LABELS.items()]
-    runs += [("", f"protocol, placement (seed) {seed}", seed) for seed in sr.PREP_SEEDS]
     for n in st.grid.n:
         for p in st.grid.p:
-            for variant, label, seed in runs:
-                key = f"n{n}-p{p:g}-{variant or 'protocol'}" + (f"-seed{seed}" if seed != 1 else "")
+            for variant, label, seed in preparations():
+                key = _run_key(n, p, variant, seed)
                 task = st.task(sr.PREPARE, n, p, seed=seed, variant=variant)
                 try:
                     nu = st.res(sr.PREPARE, n, p, seed=seed, variant=variant)["volume_fraction"]
@@ -339,24 +355,23 @@ def contact_table() -> tuple[str, dict]:
 
 
 def coordination_table(st: Study) -> tuple[str, dict]:
+    """C after the longest sintering of every preparation and placement the grid sintered (:func:`_preparations`):
+    pair contacts only, with the wall contacts, and of the particles touching no wall."""
     rows, summary = [], {}
     for n in st.grid.n:
         for p in st.grid.p:
-            task = st.task(sr.SINTER, n, p, st.t_max)
-            try:
-                a = st.arrays(task)
-            except Missing:
-                continue
-            s = json.loads((st.root / task.folder / "summary.json").read_text())
-            c, cw = 2.0 * s["contacts"] / n, (2.0 * s["contacts"] + s["wall_contacts"]) / n
-            bulk, inside = bulk_coordination(a)
             paper = 4.0 if p == 10.0 else {100: 4.5, 300: 4.8}.get(n)
-            rows.append([n, f"{p:g}", "—" if paper is None else f"{paper:g}", f"{c:.2f}", s["wall_contacts"],
-                         f"{cw:.2f}", f"{bulk:.2f} ({inside})"])
-            summary[f"n{n}-p{p:g}"] = {"pairs_only": c, "with_walls": cw, "bulk": bulk}
+            for label, task in sintered_preparations(st, n, p):
+                a = st.arrays(task)
+                s = json.loads((st.root / task.folder / "summary.json").read_text())
+                c, cw = 2.0 * s["contacts"] / n, (2.0 * s["contacts"] + s["wall_contacts"]) / n
+                bulk, inside = bulk_coordination(a)
+                rows.append([n, f"{p:g}", "—" if paper is None else f"{paper:g}", label, f"{c:.2f}",
+                             s["wall_contacts"], f"{cw:.2f}", f"{bulk:.2f} ({inside})"])
+                summary[_run_key(n, p, task.variant, task.seed)] = {"pairs_only": c, "with_walls": cw, "bulk": bulk}
     if not rows:
         raise Missing("sintered runs")
-    return md_table(["N", "p (N/m)", "paper", "C = 2 M/N (pairs)", "wall contacts M_w",
+    return md_table(["N", "p (N/m)", "paper", "preparation", "C = 2 M/N (pairs)", "wall contacts M_w",
                      "(2 M + M_w)/N", "C of the particles touching no wall (how many)"], rows), summary
 
 
@@ -452,8 +467,9 @@ def section(st: Study) -> tuple[str, dict]:
         "(eq. 13); 0 where the overlap is gone.",
         "", contact, "",
         "**3. Coordination number.** C counts the pair contacts per particle (every particle, no wall contacts), after "
-        "the longest sintering; beside it the count with each wall contact added once, and C of the particles that "
-        "touch no wall.",
+        "the longest sintering of every preparation and placement sintered; beside it the count with each wall "
+        "contact added once, and C of the particles that touch no wall. Does another preparation or placement "
+        "reach the paper's C?",
         "", coord, "",
         f"*Failure against the placement.* Each of the {len(sr.PLACEMENTS)} random placements of every N and p "
         "prepared, sintered for each t_s, cooled and compressed (ε̇_zz = 1/s): the failure strain and stress of "
