@@ -71,3 +71,22 @@ def test_components_ignore_zero_edges_on_random_graphs():
         h = BoundedLaplacian(n, i[live], j[live], K[live], fixed, pn, pw, Kp, 3)
         for a, b in zip(g.components(), h.components()):
             assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("with_fixed", [False, True])
+def test_refreshed_matrices_are_those_assembled_afresh_also_with_an_edge_listed_twice(with_fixed):
+    """The matrices rewritten in place after :meth:`refresh` equal a fresh assembly: on distinct edges to the bit,
+    and where an edge is listed twice or a node has a loop (two entries in one place of the Laplacian)."""
+    rng = np.random.default_rng(11)
+    fixed = np.array([False, False, False, False, True]) if with_fixed else None
+    none = np.zeros(0, dtype=np.int64)
+    for i, j in ((np.array([0, 1, 2, 3]), np.array([1, 2, 3, 4])),          # a chain: distinct edges
+                 (np.array([0, 0, 1, 2, 3]), np.array([1, 1, 2, 2, 4]))):   # 0-1 twice, a loop at 2
+        g = BoundedLaplacian(5, i, j, rng.uniform(1.0, 2.0, len(i)), fixed, none, none, np.zeros(0), 0)
+        g.L  # assembled once; refreshed from then on
+        for _ in range(2):
+            K = rng.uniform(1.0, 2.0, len(i))
+            g.refresh(i, j, K, none, none, np.zeros(0))
+            fresh = BoundedLaplacian(5, i, j, K, fixed, none, none, np.zeros(0), 0)
+            for name in ("L", "L_FF", "L_FD"):
+                assert np.array_equal(getattr(g, name).toarray(), getattr(fresh, name).toarray()), name

@@ -60,7 +60,8 @@ class BoundedLaplacian:
         self.fixed = np.flatnonzero(fixed)
         self._set(i, j, K, plane_node, plane_index, K_plane)
         self._matrices = None  # (L, L_FF, L_FD), assembled when first asked for (the flux needs none)
-        self._slots = None  # where each Laplacian entry sits in L, L_FF, L_FD: built by the first rewrite
+        self._slots = None  # where each place of the Laplacian sits in L, L_FF, L_FD: built by the first rewrite
+        self._place_of = None  # the place of each Laplacian entry (edges both ways, then the diagonal)
         self._stale = False  # the conductances changed since the matrices were written
 
     def _set(self, i, j, K, plane_node, plane_index, K_plane):
@@ -84,10 +85,12 @@ class BoundedLaplacian:
         elif self._stale:
             n = self.n
             if self._slots is None:
-                # an index matrix with the Laplacian's sparsity: entry k of (rows, cols) stored as k + 1
+                # the distinct places (row, col) of the entries (an edge listed twice, or a loop on the diagonal,
+                # puts two entries in one place); an index matrix with the Laplacian's sparsity holds place p as p + 1
                 rows = np.concatenate([self.i, self.j, np.arange(n)])
                 cols = np.concatenate([self.j, self.i, np.arange(n)])
-                index = sp.csr_matrix((np.arange(1.0, len(rows) + 1.0), (rows, cols)), shape=(n, n))
+                places, self._place_of = np.unique(rows * n + cols, return_inverse=True)
+                index = sp.csr_matrix((np.arange(1.0, len(places) + 1.0), (places // n, places % n)), shape=(n, n))
                 if len(self.fixed):
                     part = index[self.free]
                     parts = (index, part[:, self.free].tocsr(), part[:, self.fixed].tocsr())
@@ -97,7 +100,7 @@ class BoundedLaplacian:
                 L = parts[0].copy()
                 self._matrices = (L, L if not len(self.fixed) else parts[1].copy(), parts[2].copy())
             diag = np.bincount(self.i, self.K, n) + np.bincount(self.j, self.K, n)
-            values = np.concatenate([-self.K, -self.K, diag])
+            values = np.bincount(self._place_of, np.concatenate([-self.K, -self.K, diag]))  # summed per place
             for matrix, slots in zip(self._matrices, self._slots):
                 matrix.data[:] = values[slots]
         self._stale = False
