@@ -24,6 +24,7 @@ import os
 import pathlib
 import sys
 import tempfile
+import warnings
 
 PACKAGE = pathlib.Path(__file__).resolve().parent
 PROJECT_PACKAGES = ("dem", "fem_neck", "sinterheat")  # the top-level packages of this project, beside dem
@@ -149,9 +150,20 @@ def remembered_digest(package: pathlib.Path = PACKAGE) -> str:
     return key
 
 
+def _writable(folder: pathlib.Path) -> bool:
+    """Whether ``folder`` exists or can be made, and a file can be written in it."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / ".writable").touch()
+    except OSError:
+        return False
+    return True
+
+
 def configure() -> None:
-    """Point numba's cache at ``numba-<digest>``: in ``__pycache__`` of this package (of the temp folder when the
-    package is read-only), or inside the folder the user set in ``NUMBA_CACHE_DIR`` (module docstring)."""
+    """Point numba's cache at ``numba-<digest>``: in ``__pycache__`` of this package, or inside the folder the user
+    set in ``NUMBA_CACHE_DIR`` (module docstring); where that cannot be written, in the temp folder (a user's folder
+    that cannot be written is named in a warning)."""
     key = remembered_digest()
     name = f"numba-{key}"
     chosen = os.environ.get("NUMBA_CACHE_DIR")
@@ -161,13 +173,13 @@ def configure() -> None:
         folder = pathlib.Path(chosen) / name
     else:
         folder = PACKAGE / "__pycache__" / name
-        try:
-            folder.mkdir(parents=True, exist_ok=True)
-            probe = folder / ".writable"
-            probe.touch()
-        except OSError:
-            folder = pathlib.Path(tempfile.gettempdir()) / "sinterheat-numba" / key
-    folder.mkdir(parents=True, exist_ok=True)
+    if not _writable(folder):
+        fallback = pathlib.Path(tempfile.gettempdir()) / "sinterheat-numba" / name  # a child process finds it by name
+        if chosen:
+            warnings.warn(f"NUMBA_CACHE_DIR = {chosen!r}: cannot write {folder}; the compiled kernels are cached in "
+                          f"{fallback} instead", stacklevel=2)
+        folder = fallback
+        folder.mkdir(parents=True, exist_ok=True)
     os.environ["NUMBA_CACHE_DIR"] = str(folder)
     if "numba" in sys.modules:  # imported before this package: its configuration has read the environment already
         from numba.core import config

@@ -8,6 +8,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 
 import pytest
 
@@ -103,3 +104,18 @@ def test_import_points_numba_at_the_digests_folder(tmp_path):
     env["NUMBA_CACHE_DIR"] = str(tmp_path / folder)  # a child process of a configured one: the same folder
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
     assert out.split() == [str(tmp_path / folder)] * 2
+
+
+def test_a_folder_the_user_chose_that_cannot_be_written_is_named_and_left(tmp_path):
+    """NUMBA_CACHE_DIR below a file: the run goes on with the kernels cached in the temp folder, a warning names the
+    variable, and a child process finds the same folder."""
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    folder = pathlib.Path(tempfile.gettempdir()) / "sinterheat-numba" / f"numba-{jit_cache.digest()}"
+    code = ("import os, subprocess, sys, dem; from numba.core import config; print(config.CACHE_DIR); "
+            "print(subprocess.run([sys.executable, '-c', 'import dem, os; print(os.environ[\"NUMBA_CACHE_DIR\"])'], "
+            "capture_output=True, text=True, check=True).stdout.strip())")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(blocker / "cache")}
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
+    assert run.stdout.split() == [str(folder)] * 2
+    assert f"NUMBA_CACHE_DIR = '{blocker / 'cache'}': cannot write" in run.stderr and "Traceback" not in run.stderr
