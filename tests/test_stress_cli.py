@@ -94,6 +94,13 @@ def test_out_is_an_existing_file(tmp_path: pathlib.Path, argv):
     check(argv + ["--out", str(afile), "--json"], "error")
 
 
+def test_out_that_cannot_be_created_is_named(tmp_path: pathlib.Path):
+    afile = tmp_path / "afile"
+    afile.write_text("")
+    outcome = check(["dem", "run", "pair", "--out", str(afile / "run"), "--json"], "error")
+    assert f"--out {afile / 'run'}: cannot be created" in outcome, outcome
+
+
 # -------------------------------------------------------------------------------------------------- python -m fem_neck
 FEM_NECK = [
     ("neck: NaN radius", ["neck", "--ri", "nan", "--rj", "1e-3", "--h", "1e-5", "--json"], "error"),

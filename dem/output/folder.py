@@ -59,7 +59,10 @@ def prepare(out, resume: bool = False, overwrite: bool = False) -> pathlib.Path:
                          f"checkpoint, --overwrite clears it first")
     for f in found:
         f.unlink()
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(f"--out {out}: cannot be created ({exc.strerror})") from None
     return out
 
 
