@@ -172,7 +172,8 @@ def main(argv=None, *, prog: str, description=None, modules, package: str) -> in
 
 
 def _main(argv, here, prog, description, modules, package) -> int:
-    named = next((a for a in (sys.argv[1:] if argv is None else argv) if a in modules), None)
+    given = sys.argv[1:] if argv is None else list(argv)
+    named = next((a for a in given if a in modules), None)
     if named is not None:  # the command's name, for an interrupt that comes before parsing ends
         here.command = f"{prog} {named}"
     parser = build_parser(prog, description or __doc__.splitlines()[0], modules, package)
@@ -188,7 +189,7 @@ def _main(argv, here, prog, description, modules, package) -> int:
         except (ValueError, OSError) as exc:  # bad input, or an output path that cannot be written
             if here.signalled:  # not bad input: an interrupt that C code turned into this error
                 raise
-            sys.stderr.write(f"{prog} {args.command}: error: {_one_line(exc)}\n")
+            sys.stderr.write(f"{prog} {args.command}: error: {_error_text(exc, args, given)}\n")
             return 2
     if here.signalled:  # the command finished, but the user asked it to stop: no result is printed
         raise KeyboardInterrupt
@@ -206,6 +207,18 @@ def _cluster(args):
     from sinterheat.pool import use_dask
 
     return use_dask(scheduler, getattr(args, "workers", None))
+
+
+def _error_text(exc: Exception, args, argv) -> str:
+    """The error's one line; a file-system error on a path the user gave names it (``--out DIR: Not a directory``
+    for an option, the path alone for a positional argument), as the arguments' own checks do."""
+    path = getattr(exc, "filename", None) if isinstance(exc, OSError) else None
+    if path is not None and exc.strerror:
+        for dest, value in vars(args).items():
+            if isinstance(value, (str, os.PathLike)) and str(value) and str(path).startswith(str(value)):
+                option = f"--{dest.replace('_', '-')}"
+                return f"{option + ' ' if option in argv else ''}{value}: {exc.strerror}"
+    return _one_line(exc)
 
 
 def _one_line(message) -> str:

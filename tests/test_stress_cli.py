@@ -99,6 +99,11 @@ def test_out_that_cannot_be_created_is_named(tmp_path: pathlib.Path):
     afile.write_text("")
     outcome = check(["dem", "run", "pair", "--out", str(afile / "run"), "--json"], "error")
     assert f"--out {afile / 'run'}: cannot be created" in outcome, outcome
+    # where a command meets the file system's error itself, the one line names the option or the path given
+    outcome = check(["fem_neck", "semisphere", "--h-over-r", "0.2", "--out", str(afile / "x"), "--json"], "error")
+    assert f"--out {afile / 'x'}: Not a directory" in outcome, outcome
+    outcome = check(["dem", "convert", "pair", str(afile / "x.csv")], "error")
+    assert f": error: {afile / 'x.csv'}: Not a directory" in outcome, outcome
 
 
 # -------------------------------------------------------------------------------------------------- python -m fem_neck
