@@ -214,8 +214,11 @@ def _error_text(exc: Exception, args, argv) -> str:
     for an option, the path alone for a positional argument), as the arguments' own checks do."""
     path = getattr(exc, "filename", None) if isinstance(exc, OSError) else None
     if path is not None and exc.strerror:
+        path = str(path)
         for dest, value in vars(args).items():
-            if isinstance(value, (str, os.PathLike)) and str(value) and str(path).startswith(str(value)):
+            given = str(value) if isinstance(value, (str, os.PathLike)) else ""
+            # the path itself, a file in it, or its temporary (.part)
+            if given and path.startswith(given) and path[len(given):len(given) + 1] in ("", os.sep, "."):
                 option = f"--{dest.replace('_', '-')}"
                 return f"{option + ' ' if option in argv else ''}{value}: {exc.strerror}"
     return _one_line(exc)
