@@ -172,9 +172,8 @@ class Grid:
         walls, the protocol's with walls 10x slower) and the three-particle control of the first placement kept at 80 °C
         and without thermal expansion (p = 10) and sintered for every t_s (both p). ``"full"`` adds the paper's
         frictionless preparation through sintering and cool-down for every N and p, every other preparation (initial
-        speeds, compression rate, cohesion, wall friction) for every N at p = 10 and the densification of those with
-        friction on the particles or on the walls only and of the slower one (N min, p = 10; the one with frictionless
-        walls also at p = 100), the three-particle control with walls that sinter, prepared for 0.2 s only, with wall
+        speeds, compression rate, cohesion, wall friction) for every N at p = 10 and the densification that follows from
+        each (N min, p = 10; the one with frictionless walls also at p = 100), the three-particle control with walls that sinter, prepared for 0.2 s only, with wall
         friction, kept at 80 °C or without thermal expansion (every seed and p), the cool-down of the longest-sintered
         sample with the box held, without thermal contraction and with three and five times it (N max, both p), and the
         compression test of the shortest-sintered sample at p = 100 carried on to 15 % strain, and the longest sintering
@@ -193,8 +192,7 @@ class Grid:
             out += [Task(PREPARE, m, 10.0, variant=v) for m in self.n for v in preps]
             out += [Task(PREPARE, m, p, seed=seed) for m in self.n for p in self.p for seed in PREP_SEEDS]
             out += [Task(COOL, m, p, t_max, variant="frictionless") for m in self.n for p in self.p]
-            out += [Task(COOL, min(self.n), 10.0, t_max, variant=v)
-                    for v in ("frictionless-wall-friction", "no-wall-friction", "slow")]
+            out += [Task(COOL, min(self.n), 10.0, t_max, variant=v) for v in preps if v != "frictionless"]
             out.append(Task(COOL, min(self.n), 100.0, t_max, variant="no-wall-friction"))
             out += [Task(SCHEDULE, 3, p, t_max, seed, v) for p in self.p for seed in self.three_seeds
                     for v in ("walls-sinter", "short-prep", "control-wall-friction", "no-heating", "no-expansion")]
