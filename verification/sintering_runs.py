@@ -173,12 +173,12 @@ class Grid:
         and without thermal expansion (p = 10) and sintered for every t_s (both p). ``"full"`` adds the paper's
         frictionless preparation through sintering and cool-down for every N and p, every other preparation (initial
         speeds, compression rate, cohesion, wall friction) for every N at p = 10 and the densification that follows from
-        each (N min, p = 10; the one with frictionless walls also at p = 100), the three-particle control with walls that sinter, prepared for 0.2 s only, with wall
-        friction, kept at 80 °C or without thermal expansion (every seed and p), the cool-down of the longest-sintered
-        sample with the box held, without thermal contraction and with three and five times it (N max, both p), and the
-        compression test of the shortest-sintered sample at p = 100 carried on to 15 % strain, and the longest sintering
-        of N max at p = 100 with the thermal expansion Sec. 3.2's text describes ("one per-cent" from 80 to 120 °C, δa_T
-        = 2.5e-4 /K, against Table 1's 1e-4 /K)."""
+        each (N min, p = 10; the one with frictionless walls also at p = 100), the three-particle control with walls
+        that sinter, prepared for 0.2 s only, with wall friction, kept at 80 °C or without thermal expansion (every seed
+        and p), the cool-down of the longest-sintered sample with the box held, without thermal contraction and with
+        three and five times it (N max, both p), and the compression test of the shortest-sintered sample at p = 100
+        carried on to 15 % strain, and the longest sintering of N max at p = 100 with the thermal expansion Sec. 3.2's
+        text describes ("one per-cent" from 80 to 120 °C, δa_T = 2.5e-4 /K, against Table 1's 1e-4 /K)."""
         if not self.isolation:
             return []
         n, t_max = max(self.n), max(self.t_s)
