@@ -26,7 +26,8 @@ run at once (``None``: as many as are submitted; a Dask scheduler starts the wai
 first, a local pool the one submitted first).
 
 Ctrl-C. Local workers ignore SIGINT (:func:`sinterheat.interrupt.ignore_interrupts`, started under
-:func:`sinterheat.interrupt.shielded`, as are a ``LocalCluster``'s); the parent stops the pool. On Dask the jobs not
+:func:`sinterheat.interrupt.shielded`, as are a ``LocalCluster``'s); the parent stops the pool. A local worker also
+ends when its parent does, however the parent ended (a SIGKILL, the OOM killer). On Dask the jobs not
 started are cancelled and a ``LocalCluster`` started here is closed; a job already running on a remote cluster runs
 to its end there (Dask does not stop a running task), so its files may still land after the command has left.
 """
@@ -172,7 +173,7 @@ class ProcessPool:
             method = "spawn"
         self.slots = workers
         self._executor = cf.ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method),
-                                                initializer=ignore_interrupts)
+                                                initializer=_worker_start)
 
     def submit(self, func, *args, priority: float = 0.0) -> cf.Future:
         with shielded():  # a worker started here cannot catch the Ctrl-C meant for this process
@@ -189,6 +190,21 @@ class ProcessPool:
             self._executor.shutdown()
         else:
             stop_pool(self._executor)
+
+
+def _worker_start() -> None:
+    """Initializer of the local workers: they ignore SIGINT (:func:`sinterheat.interrupt.ignore_interrupts`) and
+    end with their parent. A parent killed outright (SIGKILL, the OOM killer) cannot stop its pool, and its workers
+    would wait on the job queue for ever, holding their memory: a thread of each waits for the parent to end."""
+    ignore_interrupts()
+    parent = multiprocessing.parent_process()
+    if parent is not None:
+        threading.Thread(target=_exit_with, args=(parent,), name="sinterheat-parent", daemon=True).start()
+
+
+def _exit_with(parent) -> None:
+    parent.join()  # returns once the parent process has ended
+    os._exit(1)
 
 
 _ONE_AT_A_TIME = threading.Lock()

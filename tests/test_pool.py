@@ -61,6 +61,44 @@ def test_the_bar_follows_no_progress_of_the_command_line(monkeypatch, capsys, en
     assert ("sweep" in capsys.readouterr().err) == shown
 
 
+def _gone(pid: int) -> bool:
+    """The process has ended (no longer listed, or a zombie waiting to be reaped)."""
+    try:
+        return pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z"
+    except OSError:
+        return True
+
+
+ORPHANS = """
+import os, sys, time
+from sinterheat.pool import pool
+with pool(2, start=sys.argv[1]) as jobs:
+    pids = {jobs.submit(os.getpid).result() for _ in range(20)}
+    waiting = [jobs.submit(time.sleep, 120) for _ in range(2)]
+    print(*sorted(pids), flush=True)
+    time.sleep(120)
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+@pytest.mark.parametrize("start", ["fork", "spawn"])
+def test_workers_end_with_a_parent_killed_outright(start):
+    # a SIGKILL (the OOM killer) gives the parent no chance to stop its pool: the workers must not wait for ever
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    parent = subprocess.Popen([sys.executable, "-c", ORPHANS, start], stdout=subprocess.PIPE, text=True, env=env,
+                              stderr=subprocess.DEVNULL)  # a killed spawner's resource tracker reports its semaphores
+    try:
+        pids = [int(x) for x in parent.stdout.readline().split()]
+        assert pids and all(not _gone(pid) for pid in pids)
+    finally:
+        parent.kill()
+        parent.wait()
+    deadline = time.perf_counter() + 20.0
+    while time.perf_counter() < deadline and not all(_gone(pid) for pid in pids):
+        time.sleep(0.05)
+    assert all(_gone(pid) for pid in pids), [pid for pid in pids if not _gone(pid)]
+
+
 def test_a_process_whose_numba_threads_are_openmp_spawns_its_workers(monkeypatch):
     # a child forked from a process that ran GNU OpenMP threads is terminated at its own first parallel loop
     monkeypatch.setattr(P, "openmp_started", lambda: True)
