@@ -533,8 +533,14 @@ _TEMPERATURES = None  # in the lower bound's process: the queue on which the upp
 
 
 def _receive_temperatures(queue) -> None:
+    """Initializer of the lower bound's process: the queue of the upper bound's temperature; the process ends with
+    its parent (:func:`sinterheat.pool.end_with_parent`: killed outright, the parent would leave it waiting on the
+    queue for ever, holding the mesh)."""
+    from sinterheat.pool import end_with_parent
+
     global _TEMPERATURES
     _TEMPERATURES = queue
+    end_with_parent()
 
 
 def _dual_receiving(mesh, order: int, hot, cold, etol: float):

@@ -192,14 +192,20 @@ class ProcessPool:
             stop_pool(self._executor)
 
 
-def _worker_start() -> None:
-    """Initializer of the local workers: they ignore SIGINT (:func:`sinterheat.interrupt.ignore_interrupts`) and
-    end with their parent. A parent killed outright (SIGKILL, the OOM killer) cannot stop its pool, and its workers
-    would wait on the job queue for ever, holding their memory: a thread of each waits for the parent to end."""
-    ignore_interrupts()
+def end_with_parent() -> None:
+    """In a worker process: end it when its parent ends, however the parent ended. A parent killed outright
+    (SIGKILL, the OOM killer) cannot stop its workers, which would wait for their next job for ever, holding their
+    memory: a thread waits for the parent to end. Outside a child of ``multiprocessing`` it does nothing."""
     parent = multiprocessing.parent_process()
     if parent is not None:
         threading.Thread(target=_exit_with, args=(parent,), name="sinterheat-parent", daemon=True).start()
+
+
+def _worker_start() -> None:
+    """Initializer of the local workers: they ignore SIGINT (:func:`sinterheat.interrupt.ignore_interrupts`) and
+    end with their parent (:func:`end_with_parent`)."""
+    ignore_interrupts()
+    end_with_parent()
 
 
 def _exit_with(parent) -> None:

@@ -69,7 +69,7 @@ def _gone(pid: int) -> bool:
         return True
 
 
-ORPHANS = """
+ORPHANS = {"pool": """
 import os, sys, time
 from sinterheat.pool import pool
 with pool(2, start=sys.argv[1]) as jobs:
@@ -77,16 +77,28 @@ with pool(2, start=sys.argv[1]) as jobs:
     waiting = [jobs.submit(time.sleep, 120) for _ in range(2)]
     print(*sorted(pids), flush=True)
     time.sleep(120)
-"""
+""", "lattice": """
+import os, sys, time
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
+from fem_neck import lattice
+context = get_context(sys.argv[1])
+queue = context.Queue()  # the lower bound's process, as fem_neck.lattice.solve_bounds starts it
+with ProcessPoolExecutor(1, mp_context=context, initializer=lattice._receive_temperatures, initargs=(queue,)) as one:
+    pid = one.submit(os.getpid).result()
+    waiting = one.submit(time.sleep, 120)
+    print(pid, flush=True)
+    time.sleep(120)
+"""}
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
-@pytest.mark.parametrize("start", ["fork", "spawn"])
-def test_workers_end_with_a_parent_killed_outright(start):
+@pytest.mark.parametrize("script, start", [("pool", "fork"), ("pool", "spawn"), ("lattice", "fork")])
+def test_workers_end_with_a_parent_killed_outright(script, start):
     # a SIGKILL (the OOM killer) gives the parent no chance to stop its pool: the workers must not wait for ever
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    parent = subprocess.Popen([sys.executable, "-c", ORPHANS, start], stdout=subprocess.PIPE, text=True, env=env,
-                              stderr=subprocess.DEVNULL)  # a killed spawner's resource tracker reports its semaphores
+    parent = subprocess.Popen([sys.executable, "-c", ORPHANS[script], start], stdout=subprocess.PIPE, text=True,
+                              env=env, stderr=subprocess.DEVNULL)  # a killed spawner's resource tracker reports
     try:
         pids = [int(x) for x in parent.stdout.readline().split()]
         assert pids and all(not _gone(pid) for pid in pids)
