@@ -24,7 +24,8 @@ keep full relative precision. Large arrays are solved in blocks of cache size (`
 stopping as soon as its own bonds have converged.
 
 The model's range: a solution exists for ``0 < h <= max_overlap(r_i, r_j)``, where ``a`` reaches the smaller radius
-(``2r/3`` for equal spheres, Section 4.2).
+(``2r/3`` for equal spheres, Section 4.2). Once two necks of one particle meet, no pair-neck model has an answer; the
+union of the spheres (:mod:`fem_neck.geometry.union`) has one at every density.
 """
 
 from __future__ import annotations
