@@ -141,15 +141,31 @@ def cut_spheres(radius, i, j, vectors) -> CutSpheres:
     return CutSpheres(out[0], out[1], out[2].astype(bool), out[3][:m], out[3][m:])
 
 
-def necks_meet(radius, i, j, vectors, angle_i, angle_j) -> np.ndarray:
-    """Whether two necks of each particle meet (bool per particle): bond ``b`` joins ``i[b]`` and ``j[b]`` along
-    ``vectors[b]`` (``x_j - x_i``) and is seen from the two centres in cones of half-angles ``angle_i[b]``,
-    ``angle_j[b]`` (rad, :func:`angular_radius`); two necks of one particle meet when the angle between their
-    directions is at most the sum of their half-angles. Works for any neck reading."""
-    radius = np.asarray(radius, dtype=float).reshape(-1)
-    f = np.ascontiguousarray
-    return _necks_meet(len(radius), f(i, dtype=np.int64), f(j, dtype=np.int64), f(vectors, dtype=float).reshape(-1, 3),
-                       f(angle_i, dtype=float), f(angle_j, dtype=float)).astype(bool)
+def necks_meet(n: int, particle, direction, angle) -> np.ndarray:
+    """Whether two necks of each of ``n`` particles meet (bool per particle), for any neck reading.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    particle : int array (e,)
+        The particle of each neck end (a pair bond has two ends, a wall bond one).
+    direction : array (e, 3)
+        The direction from that particle's centre toward the neck (any length but zero).
+    angle : array (e,)
+        Half-angle (rad) of the cone in which the neck is seen from the centre (:func:`angular_radius`).
+
+    Two necks of one particle meet when the angle between their directions is at most the sum of their half-angles.
+    """
+    particle = np.ascontiguousarray(particle, dtype=np.int64).reshape(-1)
+    direction = np.ascontiguousarray(direction, dtype=float).reshape(-1, 3)
+    angle = np.ascontiguousarray(angle, dtype=float).reshape(-1)
+    if not (len(particle) == len(direction) == len(angle)):
+        raise ValueError(f"particle, direction and angle: {len(particle)}, {len(direction)} and {len(angle)} "
+                         f"entries, must be as many")
+    if len(particle) and (particle.min() < 0 or particle.max() >= n):
+        raise ValueError(f"particle: indices must lie in 0..{n - 1}")
+    return _necks_meet(int(n), particle, direction, angle).astype(bool)
 
 
 @njit(cache=True)
@@ -182,24 +198,29 @@ def _end_normal(e, m, vectors, normal):
 
 
 @njit(cache=True)
-def _necks_meet(n, i, j, vectors, angle_i, angle_j):
-    m = len(i)
-    offsets, ends = _group_ends(n, i, j)
+def _necks_meet(n, particle, direction, angle):
+    e = len(particle)
+    counts = np.zeros(n + 1, dtype=np.int64)
+    for x in range(e):
+        counts[particle[x] + 1] += 1
+    offsets = np.cumsum(counts)
+    fill = offsets[:-1].copy()
+    ends = np.empty(e, dtype=np.int64)
+    for x in range(e):
+        ends[fill[particle[x]]] = x
+        fill[particle[x]] += 1
     out = np.zeros(n, dtype=np.uint8)
-    nb = np.empty(3)
-    nc = np.empty(3)
     for k in range(n):
         lo, hi = offsets[k], offsets[k + 1]
         for x in range(lo, hi):
-            eb = ends[x]
-            _end_normal(eb, m, vectors, nb)
-            tb = angle_i[eb] if eb < m else angle_j[eb - m]
+            b = ends[x]
+            nb = math.sqrt(direction[b, 0] ** 2 + direction[b, 1] ** 2 + direction[b, 2] ** 2)
             for y in range(x + 1, hi):
-                ec = ends[y]
-                _end_normal(ec, m, vectors, nc)
-                tc = angle_i[ec] if ec < m else angle_j[ec - m]
-                cos_g = min(max(nb[0] * nc[0] + nb[1] * nc[1] + nb[2] * nc[2], -1.0), 1.0)
-                if math.acos(cos_g) <= tb + tc:
+                c = ends[y]
+                nc = math.sqrt(direction[c, 0] ** 2 + direction[c, 1] ** 2 + direction[c, 2] ** 2)
+                cos_g = (direction[b, 0] * direction[c, 0] + direction[b, 1] * direction[c, 1]
+                         + direction[b, 2] * direction[c, 2]) / (nb * nc)
+                if math.acos(min(max(cos_g, -1.0), 1.0)) <= angle[b] + angle[c]:
                     out[k] = 1
                     break
             if out[k]:
