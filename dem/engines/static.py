@@ -15,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from dem import memory
+from dem.geometry.necks import meeting_in, neck_account
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
 from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
                               periodic_heat_flow, steady)
@@ -67,6 +68,7 @@ class StaticEngine:
         wall_temperature = np.array([w.temperature for w in walls], dtype=float)
         self.network = Network(particles, bonds, K_pairs, K_walls, wall_temperature, scene.sources, scene.box)
         self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
+        self.meeting = meeting_in(particles, walls, bonds, scene.box)
         self.restart = Checkpoint.from_arrays(restart) if restart is not None else None
         self.t_start = float(scene.start_time)
         self.T = scene.particles.temperature.astype(float)
@@ -142,7 +144,9 @@ class StaticEngine:
         s = self.scene.solver
         out = {"law": self.scene.conductance.law, "contact": self.bonds.contact,
                "bonds_clipped": self.bonds.clipped, "bonds_dropped": self.bonds.dropped,
-               "wall_bonds": self.bonds.n_walls}
+               "wall_bonds": self.bonds.n_walls,
+               **neck_account(np.count_nonzero(self.meeting), self.scene.particles.n, self.bonds.contact,
+                              self.bonds.n_pairs + self.bonds.n_walls, self.scene.conductance.law)}
         observer = self._observed(observe)
         t0 = self.t_start
         if s.mode == "steady":
@@ -191,7 +195,7 @@ class StaticEngine:
     def particle_fields(self) -> dict:
         p = self.scene.particles
         fields = {"id": p.id, "radius": p.radius, "temperature": self.T, "fixed": p.fixed.astype(np.int8),
-                  "material": p.material.astype(np.int32)}
+                  "material": p.material.astype(np.int32), "necks_meeting": self.meeting.astype(np.int8)}
         if self.potential is not None:
             fields["potential"] = self.potential
         return fields

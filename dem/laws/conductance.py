@@ -51,7 +51,7 @@ DESCRIPTIONS = {
                    "function; exact for pairs and chains, never above the Wiener bound)",
     "zohdi": "kappa pi a^2 / |x_i - x_j| with the lens contact circle (Zohdi 2014, eqs. 11-12, 33)",
 }
-NECK_MODELS = ("newton", "first", "coble")
+NECK_MODELS = ("newton", "first", "coble", "union")
 LINEAR_SLOPES = {"rojek": fem_law.ROJEK.slope, "argento-bouvard": fem_law.ARGENTO_BOUVARD.slope}
 
 

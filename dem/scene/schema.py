@@ -135,7 +135,9 @@ ROWS = (
     Row("conductance", ("unequal",), ALL, "true", "fit and shared-body laws: multiply the series of halves by the FE "
         "correction for unequal radii (`fem_neck.law.unequal_factor`)"),
     Row("conductance", ("neck",), ALL, '`"newton"`', '`"newton"` (Rojek 2022, eqs. 27-33), `"first"` (eq. 34), '
-        '`"coble"` (eqs. 11-12)'),
+        '`"coble"` (eqs. 11-12): pair necks, no answer once two necks of a particle meet; `"union"`: the circle '
+        'where two spheres meet, the packing read as the union of its spheres (`fem_neck.geometry.union`), defined '
+        'at every density'),
     Row("conductance", ("contact_conductance",), ALL, "W/K, none", "K_c of the interface in series (eq. 8)"),
     Row("conductance", ("out_of_range",), ALL, '`"error"`', 'bonds beyond the contact model\'s range (h > '
         'max_overlap; wall overlap > r/3): `"error"` reports their count and the first pair, `"clip"` sets a to the '

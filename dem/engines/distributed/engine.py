@@ -29,6 +29,7 @@ import numpy as np
 
 from dem import memory
 from dem.engines.static import CSV_FLOWS, StaticEngine
+from dem.geometry.necks import meeting_in, neck_account
 from dem.geometry.partition import bisection, halo
 from dem.network import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
@@ -111,6 +112,7 @@ class DistributedStaticEngine(StaticEngine):
         pairs, walls = mine[bonds.i] | mine[bonds.j], mine[bonds.wall_particle]
         self.bonds, self.K_pairs, self.K_walls = bonds.subset(pairs, walls), K_pairs[pairs], K_walls[walls]
         self.held, self.mine = held, mine
+        self.meeting = meeting_in(local, scene.walls, self.bonds, box)  # right for the owned: all their bonds are here
         self.T = local.temperature.astype(float)
         return owner[held]
 
@@ -147,6 +149,11 @@ class DistributedStaticEngine(StaticEngine):
         s = self.scene.solver
         out = {"law": self.scene.conductance.law, "contact": self.bonds.contact, "bonds_clipped": 0,
                "bonds_dropped": 0, "wall_bonds": self.part.total(int(self.bonds.n_walls)), "ranks": self.ranks}
+        b = self.bonds
+        out.update(neck_account(self.part.total(int(np.count_nonzero(self.meeting[self.mine]))),
+                                self.full_scene.particles.n, b.contact,
+                                self.part.total(int(np.count_nonzero(self.mine[b.i]) + b.n_walls)),
+                                self.full_scene.conductance.law))
         observer = self._observed(observe)
         if s.mode == "steady":
             T_F, flows, err, n_float, solver = mpi.agree(

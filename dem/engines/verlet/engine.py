@@ -27,7 +27,9 @@ from dataclasses import replace
 
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
+from dem.geometry.bonds import find_bonds
 from dem.geometry.motion import MotionState
+from dem.geometry.necks import meeting_in, neck_account
 from dem.geometry.neighbours import list_arrays
 from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
@@ -350,7 +352,22 @@ class VerletEngine:
             th = self.thermal
             out.update(energy_error=th.energy_error(), heat_in={k: float(v) for k, v in th.heat_in.items()},
                        network_assemblies=th.assemblies, network_refreshes=th.refreshes, law=self.scene.conductance.law)
+            meeting, bonds = self.necks()
+            out.update(neck_account(np.count_nonzero(meeting), s.n, bonds.contact, bonds.n_pairs + bonds.n_walls,
+                                    self.scene.conductance.law))
         return out
+
+    def necks(self):
+        """``(meeting, bonds)``: the thermal bonds of the contacts now, under the scene's neck reading, and whether
+        two necks of each particle meet (:mod:`dem.geometry.necks`); from the whole sample (on several ranks, the
+        one gathered on rank 0)."""
+        mech, th = self.mechanics, self.thermal
+        s = mech.state
+        particles = replace(self.scene.particles, position=s.x, radius=s.radius)
+        walls = [mech.walls[k].at(mech.w.q[k]) for k in th.thermal_walls]
+        i, j = mech.contacts()[:2]
+        bonds = find_bonds(particles, walls, self.scene.conductance.contact, "clip", pairs=(i, j), box=th.box)
+        return meeting_in(particles, walls, bonds, th.box), bonds
 
     def particle_fields(self) -> dict:
         """Per-particle fields for snapshots: velocity, angular velocity, force, temperature, stiffness factor, and
@@ -378,7 +395,8 @@ class VerletEngine:
         return {"id": self.scene.particles.id, "radius": s.radius, "velocity": s.v, "angular_velocity": s.w,
                 "force": s.f, "temperature": s.T,
                 **{name: mech.particle_column(name) for name in mech.law.PARTICLE_STATE},
-                "stress": sigma.reshape(-1, 9), "mean_stress": mean}
+                "stress": sigma.reshape(-1, 9), "mean_stress": mean,
+                **({"necks_meeting": self.necks()[0].astype(np.int8)} if self.thermal is not None else {})}
 
     def positions(self) -> np.ndarray:
         return self.mechanics.state.x
