@@ -51,6 +51,16 @@ A_LOG = 5.0 / (4.0 * np.pi)  #: the x ln(1/x) coefficient of P(x) (module docstr
 DEFAULT_FIT = pathlib.Path(__file__).with_name("data") / "fit.json"
 
 
+NECKS = ("cylinder", "union")  #: the half bodies a law is for: Rojek's volume-conserving neck cylinder, the union
+
+
+def check_neck(neck) -> str:
+    """``neck`` if it names a half body of :data:`NECKS`, else ``ValueError``."""
+    if neck not in NECKS:
+        raise ValueError(f"neck = {neck!r}: must be one of {', '.join(NECKS)}")
+    return neck
+
+
 def check_neck_ratio(a_over_r, name: str = "a_over_r") -> np.ndarray:
     """``a/r`` as a float array, raising ``ValueError`` unless every entry is finite and in ``[0, 1]``."""
     x = np.asarray(a_over_r, dtype=float)
