@@ -16,7 +16,8 @@ graded mesh, so the curved sphere surface is followed; ``curved=False`` keeps st
 
 Public API (all plain functions of numbers, safe to call from a process pool; gmsh is opened and closed per mesh):
 
-* :func:`semisphere_conductance` -- the semisphere with a neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Section 5);
+* :func:`semisphere_conductance` -- the semisphere with a neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Section 5),
+  or the half body of the union of spheres (no neck cylinder);
 * :func:`pair_conductance` -- two spheres ``r_i``, ``r_j`` with overlap ``h`` (Section 6);
 * :func:`chain_conductance` -- a collinear chain;
 * :func:`solve_profile` -- one solve on a given mesh and order (for convergence studies).
@@ -197,13 +198,14 @@ METHODS = ("hp", "gmsh")
 
 
 def semisphere_conductance(a_over_r: float, rtol: float = 1e-4, order: int | None = None,
-                           method: str = "hp") -> Result:
+                           method: str = "hp", neck: str = "cylinder") -> Result:
     """Conductance of the semisphere with a cylindrical neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Sec. 5, Fig. 12).
 
     ``a_over_r`` in [1e-4, 1): neck radius over sphere radius (from an overlap: ``fem_neck.geometry.
-    equal_neck_radius``; the inverse is ``overlap_for_neck``). The half-neck height is ``h_n/2`` of the
-    volume-conserving neck (eqs. 19-20). ``K_over_Kcyl = K / pi`` (eqs. 38-39). ``rtol``: relative tolerance of
-    ``K`` (default 1e-4).
+    equal_neck_radius``; the inverse is ``overlap_for_neck``). ``neck``: ``"cylinder"`` (default) -- the half-neck
+    height is ``h_n/2`` of the volume-conserving neck (eqs. 19-20); ``"union"`` -- the half body of the union of
+    spheres, no neck cylinder: ``T = 1`` on the disk of radius ``a`` at the cap base ``z_i = sqrt(1 - a^2)``.
+    ``K_over_Kcyl = K / pi`` (eqs. 38-39). ``rtol``: relative tolerance of ``K`` (default 1e-4).
 
     ``method``: ``"hp"`` (default) -- curved spectral elements on a geometric quadrilateral mesh with the exact
     sphere (:mod:`fem_neck.hpmesh`, :mod:`fem_neck.spectral`): the order is raised on one mesh until two
@@ -212,16 +214,17 @@ def semisphere_conductance(a_over_r: float, rtol: float = 1e-4, order: int | Non
     ``p - 1`` and ``p`` agree; ``order`` 2, 3 or 4); an independent discretisation for cross-checks.
     """
     a_over_r = float(a_over_r)
-    shapes.semisphere_profile(a_over_r)  # validates before any meshing
+    shapes.semisphere_profile(a_over_r, neck=neck)  # validates before any meshing
     if method == "gmsh":
-        return _to_tolerance(lambda g: shapes.semisphere_mesh(a_over_r, grading=g), 1.0, 1.0, 1.0, rtol, order,
-                             [a_over_r])
+        return _to_tolerance(lambda g: shapes.semisphere_mesh(a_over_r, grading=g, neck=neck), 1.0, 1.0, 1.0, rtol,
+                             order, [a_over_r])
     if method != "hp":
         raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
     rtol = accuracy.check_rtol(rtol)
     order = accuracy.check_hp_order(order, rtol)
     start = time.perf_counter()
-    mesh, shape = hpmesh.semisphere_quad_mesh(a_over_r, accuracy.hp_corner_levels(a_over_r, rtol))
+    levels = accuracy.hp_corner_levels(a_over_r, rtol, neck=neck)
+    mesh, shape = hpmesh.semisphere_quad_mesh(a_over_r, levels, neck=neck)
     return _hp_to_tolerance(mesh, hpmesh.end_disks(mesh, shape), rtol, order, start, 1.0, 1.0, 1.0, [a_over_r])
 
 
