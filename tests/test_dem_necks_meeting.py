@@ -49,3 +49,24 @@ def test_the_plain_lens_law_reports_the_count_without_a_verdict():
     s = run(lattice("fcc", 1.6, law="zohdi")).summary
     assert s["particles_necks_meeting"] == s["particles"]
     assert "law_in_verified_range" not in s and "warnings" not in s
+
+
+def test_union_necks_take_the_union_half_body_law_and_refuse_the_cylinders():
+    """With neck = "union" the fit laws read the union's half body (fem_neck/data/fit_union.json): a pair's bond is
+    its two halves in series, each kappa pi r f_u(a/r); a fit file of the neck cylinder is refused, naming it."""
+    from fem_neck import law as fem_law
+    from fem_neck.geometry.union import lens
+
+    r_i, r_j, d, kappa = 1e-3, 0.8e-3, 1.6e-3, 394.0
+    x = np.array([[0.0, 0.0, 0.0], [d, 0.0, 0.0]])
+    for name in ("fit", "shared-body"):
+        scene = make_scene(x, [r_i, r_j], [1.0, 0.0], fixed=[True, True], mode="steady",
+                           conductance=ConductanceSpec(law=name, neck="union"))
+        K = run(scene).engine.K_pairs
+        a = float(lens(r_i, r_j, d).a)
+        union = fem_law.ConductanceLaw.default(neck="union")
+        halves = [kappa * np.pi * r * union.k_over_kcyl(a / r) for r in (r_i, r_j)]
+        assert K[0] == pytest.approx(1.0 / (1.0 / halves[0] + 1.0 / halves[1]), rel=1e-13), name
+    with pytest.raises(ValueError, match=r"fit file = .*fit\.json'?: fitted for neck = 'cylinder', cannot be used "
+                                         r"for neck = 'union'"):
+        ConductanceSpec(law="fit", neck="union", fit_file=str(fem_law.DEFAULT_FIT))
