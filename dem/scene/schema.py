@@ -59,7 +59,9 @@ ROWS = (
     Row("particles", ("position",), ALL, "list of [x, y, z] m, required", "particle centres"),
     Row("particles", ("radius",), ALL, "list, m, > 0, required", ""),
     Row("particles", ("temperature",), ALL, "list, required", "initial temperature (K or °C)"),
-    Row("particles", ("fixed",), ALL, "list of bool, all false", "held at the initial temperature (a boundary)"),
+    Row("particles", ("fixed",), ALL, "list of bool, all false",
+        "held at the initial temperature (a boundary); a steady run with two ends at different temperatures (held "
+        "groups or walls with a temperature) reports `effective_conductivity` = Q L / (A ΔT) and its `specimen`"),
     Row("particles", ("material",), ALL, "name, index or list of them, 0", "index/name into `[[materials]]`"),
     Row("particles", ("heat",), ALL, "list, W, 0", "internal heat generation Q_i^int (Rojek 2022, eq. 3)"),
     Row("particles", ("file",), ALL, "path, instead of `position` and `radius`",
