@@ -30,6 +30,7 @@ from dem.network.linsolve import BACKENDS
 from dem.output.plots import TEMPERATURE_UNITS
 from dem.scene.motion import MotionSpec, parse_motion
 from dem.scene.schema import ENGINE_NAMES, TABLES, check
+from dem.scene.groups import apply_groups
 from dem.scene.specimen import Specimen, find_specimen, held_name
 
 SCENE_DIR = pathlib.Path(__file__).with_name("builtin")
@@ -129,7 +130,7 @@ class Scene:
     engine: str = "static"  # the engine that runs it (dem.engines)
     start: dict | None = None  # the saved state it starts from (dem.scene.state_file.load), else None
     temperature_unit: str = "C"  # the unit of its temperatures, "C" or "K" (:func:`temperature_unit`)
-    groups: dict = field(default_factory=dict)  # named groups that hold their particles, {name: indices}
+    groups: dict = field(default_factory=dict)  # the [[groups]] that hold their particles, {name: indices}
 
     def __post_init__(self):
         walls = self.motion.walls if self.motion is not None else self.walls
@@ -457,6 +458,8 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     elif box is not None and not box.any_periodic:
         box = None  # a packing file's box that is not periodic (or that cannot say): only [periodic] uses it
     groups = {}
+    if "groups" in doc:
+        particles, groups = apply_groups(doc["groups"], particles)
     walls = walls + _walls(doc, start, static=not moving)
     if box is not None and moving:
         _check_walls_across(walls, box)

@@ -22,7 +22,7 @@ STATIC_VERLET = ("static", "verlet")
 STATIC_STAGGERED = ("static", "staggered")
 ENGINE_WORDS = {ALL: "all", MOVING: "moving", STATIC: "static", VERLET: "verlet", STAGGERED: "staggered",
                 STATIC_VERLET: "static, verlet", STATIC_STAGGERED: "static, staggered"}
-ARRAYS = ("materials", "walls", "phases")  # tables given as arrays of tables ([[walls]])
+ARRAYS = ("materials", "walls", "phases", "groups")  # tables given as arrays of tables ([[walls]])
 LAW_TABLES = ("contact", "phases")  # tables whose keys (beyond those listed) are the contact law's material fields
 
 
@@ -71,6 +71,24 @@ ROWS = (
         "the file's format, metres per length unit, a dump's snapshot"),
     Row("particles", ("velocity",), MOVING, "list of [vx, vy, vz] m/s, 0", "initial velocities"),
     Row("particles", ("angular_velocity",), VERLET, "list of 3-vectors, 1/s, 0", "initial angular velocities"),
+    Row("groups", ("name",), ALL, "string, required, unique",
+        "a named group of particles (`dem.scene.groups`), as LAMMPS's `region` and `group`; its selectors "
+        "(`region`, `ids`, `types`, `layer`) all choose its particles, which must be at least one"),
+    Row("groups", ("region",), ALL, '`"slab"`, `"box"`, `"sphere"`, `"cylinder"`',
+        "the particles whose centres lie in it: slab `axis`, `lo` and/or `hi` (m along it); box `lo`, `hi` (corners "
+        "[x, y, z] m); sphere `center`, `radius`; cylinder `axis`, `center` (a point of its axis), `radius`, "
+        "optional `lo`, `hi` along the axis"),
+    Row("groups", ("axis", "lo", "hi", "center", "radius"), ALL, '`"x"`/`"y"`/`"z"`, m or [x, y, z] m, m',
+        "the region's (and the layer's `axis`, default z)"),
+    Row("groups", ("ids",), ALL, "list of ids and [first, last] ranges", "by particle id (LAMMPS `group id 1:100`)"),
+    Row("groups", ("types",), ALL, "list of LAMMPS types (from 1) or material names",
+        "by type: type k is material k − 1"),
+    Row("groups", ("layer", "thickness"), ALL, '`"top"` or `"bottom"`, m',
+        "the particles whose centres lie within `thickness` of the highest (lowest) centre along `axis`"),
+    Row("groups", ("temperature", "fixed", "material", "heat"), ALL, "K or °C, bool, name or index, W",
+        "given to the group's particles over `[particles]`' lists (groups in order, a later one over an earlier "
+        "one): the initial temperature, held at it (a held group is an end of `effective_conductivity` and has its "
+        "total in `boundary_heat_flow`), the material, the internal heat per particle"),
     Row("generator", ("kind",), ALL, '`"chain"`, `"lattice"`, `"random"`, `"box"`',
         'instead of `[particles]`; `"box"`: random sequential addition in a box (moving particles)'),
     Row("generator", ("structure",), ALL, '`"sc"`', 'lattice: `"sc"`, `"bcc"` or `"fcc"` (1, 2 or 4 spheres per '
