@@ -31,7 +31,7 @@ read from LAMMPS files are sorted by id (LAMMPS writes them in the order of its 
 order. A bad file raises ``ValueError`` with one line naming the file, the line and the column.
 
 The other way: :func:`write_lammps_data` writes a packing (read here, from a scene's particles, or from a saved
-moving state, :func:`packing_from_state`) as a LAMMPS data file of ``atom_style sphere`` that ``read_data`` reads;
+state, :func:`packing_from_state`) as a LAMMPS data file of ``atom_style sphere`` that ``read_data`` reads;
 :func:`write_csv` and :func:`write_vtu` write the two other formats.
 """
 
@@ -769,17 +769,26 @@ def packing_from_particles(particles, box=None) -> Packing:
 
 
 def packing_from_state(state: dict) -> Packing:
-    """A :class:`Packing` of a saved moving state (:func:`dem.scene.state_file.load`): positions, radii, temperatures,
-    velocities and angular velocities; the density is the one that gives each particle its saved mass as a sphere
-    (``m / (4/3 pi r^3)``, also what LAMMPS computes the mass from). 3D states only: a 2D state's disks lie in the
-    x-z plane with a height, which LAMMPS's 2D spheres (x-y plane) do not have."""
-    if int(state["dimension"]) != 3:
+    """A :class:`Packing` of a saved state (:func:`dem.scene.state_file.load`) in its periodic box, if it has one:
+    positions, radii, temperatures, ids; of a moving state also velocities, angular velocities and the density that
+    gives each particle its saved mass as a sphere (``m / (4/3 pi r^3)``, also what LAMMPS computes the mass from),
+    of a static one its materials (no density: the scene's materials have them). 3D states only: a 2D state's disks
+    lie in the x-z plane with a height, which LAMMPS's 2D spheres (x-y plane) do not have."""
+    from dem.scene.state_file import saved_box
+
+    if state["moving"] and int(state["dimension"]) != 3:
         raise ValueError("state: a 2D state (disks in the x-z plane): only 3D states can be written as packings")
     radius = np.asarray(state["radius"], dtype=float)
     ids = state["id"] if "id" in state else np.arange(len(radius), dtype=np.int64)
+    box = saved_box(state)
+    lo = hi = periodic = None
+    if box is not None:
+        lo, hi, periodic = box.origin, box.origin + box.lengths, tuple(box.periodic)
+    moving = {"density": state["mass"] / (SPHERE_VOLUME * radius**3), "velocity": np.asarray(state["v"], dtype=float),
+              "angular_velocity": np.asarray(state["w"], dtype=float)} if state["moving"] else \
+        {"material": np.asarray(state["material"], dtype=np.int64) if "material" in state else None}
     return Packing(np.asarray(ids, dtype=np.int64), np.asarray(state["x"], dtype=float), radius,
-                   np.asarray(state["T"], dtype=float), density=state["mass"] / (SPHERE_VOLUME * radius**3),
-                   velocity=np.asarray(state["v"], dtype=float), angular_velocity=np.asarray(state["w"], dtype=float))
+                   np.asarray(state["T"], dtype=float), box_lo=lo, box_hi=hi, periodic=periodic, **moving)
 
 
 def lammps_ids(ids: np.ndarray) -> np.ndarray:
@@ -795,8 +804,10 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
     velocities, ``Velocities`` (``id vx vy vz wx wy wz``). Ids from :func:`lammps_ids`; type = material index + 1
     (names: their order of appearance); ``density`` kg/m^3 (one number or per particle) where the packing has none.
     The box is the packing's, or the particles' bounding box grown by ``pad`` (m) beyond the largest radius; the
-    periodicity is not part of a data file: the input script's ``boundary`` command sets it. Numbers are written
-    to round-trip (the shortest digits that read back to the same double)."""
+    periodicity is not part of a data file: the input script's ``boundary`` command sets it. A centre outside the
+    packing's box (``lo <= x < hi``, LAMMPS's rule) is wrapped into it along a periodic axis, its image flag counting
+    the periods (:func:`wrapped`), and refused along any other. Numbers are written to round-trip (the shortest
+    digits that read back to the same double)."""
     path = pathlib.Path(path)
     n = packing.n
     if packing.density is not None:
@@ -810,12 +821,13 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
         raise ValueError(f"density[{k}] = {rho[k]!r}: must be a finite number > 0 (kg/m^3)")
     types = _types(packing.material, n)
     x, r = packing.position, packing.radius
-    if packing.box_lo is not None:
-        lo, hi = packing.box_lo, packing.box_hi
-    else:
-        lo, hi = (x - r[:, None]).min(axis=0) - pad, (x + r[:, None]).max(axis=0) + pad
     image = packing.image if packing.image is not None else np.zeros((n, 3), dtype=np.int64)
     ids = lammps_ids(packing.id)
+    if packing.box_lo is not None:
+        lo, hi = packing.box_lo, packing.box_hi
+        x, image = wrapped(packing, path.name)
+    else:
+        lo, hi = (x - r[:, None]).min(axis=0) - pad, (x + r[:, None]).max(axis=0) + pad
     lo, hi = (np.asarray(b, dtype=float).tolist() for b in (lo, hi))
     head = [f"LAMMPS data file of {n} spheres written by sinterheat (dem.scene.packing_files), units = si", "",
             f"{n} atoms", f"{int(types.max())} atom types", ""]
@@ -827,6 +839,35 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
         parts += ["\nVelocities\n\n", _rows_text([ids, *packing.velocity.T, *w.T], " ")]
     _write_text(path, parts)
     return path
+
+
+def wrapped(packing: Packing, what: str = "packing") -> tuple[np.ndarray, np.ndarray]:
+    """The centres of ``packing`` in its box, ``lo <= x < hi`` (LAMMPS's rule), and their image flags: along a
+    periodic axis a centre outside is moved by whole periods and its flag counts them (``x + image L`` is kept);
+    along any other (or where the packing cannot say which axes are periodic) a centre outside is refused with
+    ``ValueError`` naming the particle and ``what`` (LAMMPS would lose it: "Did not assign all atoms correctly")."""
+    x = np.array(packing.position, dtype=float)
+    image = (np.zeros((packing.n, 3), dtype=np.int64) if packing.image is None
+             else np.array(packing.image, dtype=np.int64))
+    lo, hi = np.asarray(packing.box_lo, dtype=float), np.asarray(packing.box_hi, dtype=float)
+    periodic = packing.periodic if packing.periodic is not None else (False, False, False)
+    for a in range(3):
+        length = hi[a] - lo[a]
+        if periodic[a]:
+            k = np.floor((x[:, a] - lo[a]) / length)
+            x[:, a] -= k * length
+            x[:, a] = np.where(x[:, a] >= hi[a], lo[a], np.maximum(x[:, a], lo[a]))  # round-off at the faces
+            image[:, a] += k.astype(np.int64)
+            continue
+        outside = np.flatnonzero((x[:, a] < lo[a]) | (x[:, a] >= hi[a]))
+        if outside.size:
+            m = int(outside[0])
+            unknown = " (which axes are periodic is not known: give them, e.g. --periodic xy)" \
+                if packing.periodic is None else ""
+            raise ValueError(f"{what}: particle id {packing.id[m]} has {AXES[a]} = {float(x[m, a])!r} m, outside the "
+                             f"box [{float(lo[a])!r}, {float(hi[a])!r}) along {AXES[a]}, which is not periodic{unknown}; "
+                             f"{outside.size} particle(s) lie outside it (LAMMPS would lose them)")
+    return x, image
 
 
 def _rows_text(columns, sep: str, chunk: int = 100_000):
