@@ -19,7 +19,7 @@ def packing(periodic=(True, True, False)) -> Packing:
     """Three spheres in the box [0, L) x [0, L) x [0, 2L): the second 0.3 L beyond the +x face, the third 1.2 L
     before the -y face (two periods back along y)."""
     x = np.array([[0.5, 0.5, 0.5], [1.3, 0.5, 0.5], [0.5, -1.2, 1.0]]) * L
-    return Packing(np.array([4, 9, 11]), x, np.full(3, 0.1 * L), material=np.array([0, 1, 0]),
+    return Packing(np.array([4, 9, 11]), x, np.full(3, 0.05 * L), material=np.array([0, 1, 0]),
                    density=np.full(3, 8960.0), box_lo=np.zeros(3), box_hi=np.array([L, L, 2 * L]),
                    periodic=periodic)
 
