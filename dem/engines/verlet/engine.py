@@ -240,12 +240,13 @@ class VerletEngine:
         return ("N", "N/m", "Pa")[self._wall_extents()[1]]
 
     def _wall_extents(self) -> tuple[list, int]:
-        """Per wall the length (one box axis along it) or area (two) its load is divided by, and that number of
-        axes; all 1 and 0 axes when the walls span different numbers of axes (N/m beside Pa would share no axis)."""
+        """Per wall the length (one box axis along it) or area (two) its load is divided by -- between the walls
+        facing each other along an axis, or the periodic box's period --, and that number of axes; all 1 and 0 axes when the walls span different numbers of axes (N/m beside Pa would share no axis)."""
         mech = self.mechanics
         extents, spanned = [], set()
-        for k in range(len(mech.walls)):
-            lo_hi, extent, axes = mech.w.span[k], 1.0, 0
+        for k, wall in enumerate(mech.walls):
+            extent, axes = mech.w.periodic_extent(wall, mech.state.dimension, mech.box)  # the box's periods
+            lo_hi = mech.w.span[k]
             for a in range(2):
                 if lo_hi[2 * a] >= 0:
                     extent *= mech.w.extent(lo_hi[2 * a], lo_hi[2 * a + 1])
