@@ -122,7 +122,8 @@ ROWS = (
     Row("walls", ("motion",), MOVING, '`"fixed"`', '`"stress"` (Luding 2005, eq. 1; velocity Verlet), `"strain"` '
         '(constant `velocity`), `"vibrate"` (`amplitude`, `frequency`)'),
     Row("walls", ("pressure", "mass", "damping"), VERLET, "N/m (2D) or Pa (3D), kg, kg/s",
-        "of a stress wall: the pressure times the box's extent pushes it in (eq. 1)"),
+        "of a stress wall: the pressure times the box's extent pushes it in (eq. 1); the extent is between the walls "
+        "facing each other, or the period of a box periodic along that axis"),
     Row("walls", ("velocity",), MOVING, "m/s, inward", "of a strain wall"),
     Row("walls", ("amplitude", "frequency"), MOVING, "m, Hz", "of a vibrating wall, q(t) = q0 + A sin(2πf(t - t_0)) "
         "from the run's start t_0"),
