@@ -52,6 +52,12 @@ DESCRIPTIONS = {
     "zohdi": "kappa pi a^2 / |x_i - x_j| with the lens contact circle (Zohdi 2014, eqs. 11-12, 33)",
 }
 NECK_MODELS = ("newton", "first", "coble", "union")
+
+
+def law_keys(law: str) -> tuple:
+    """The ``[conductance]`` keys the law ``law`` reads besides ``law`` (:class:`ConductanceSpec`)."""
+    own = ("slope",) if law in ("rojek", "argento-bouvard") else ("fit_file", "unequal") if law in FIT_LAWS else ()
+    return own + (() if law == "zohdi" else ("neck",)) + ("contact_conductance", "out_of_range")
 LINEAR_SLOPES = {"rojek": fem_law.ROJEK.slope, "argento-bouvard": fem_law.ARGENTO_BOUVARD.slope}
 
 

@@ -102,8 +102,9 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
     * ``temperature.png`` -- mean, min and max temperature against time (transient);
     * ``heat_flow.png`` -- heat flow into the particles through fixed particles, walls, convection, radiation and
       internal sources against time (transient; the boundaries the scene has);
-    * ``profile.png`` -- the temperature of every particle against its height along the heat-flow axis (z) with
-      the mean of slabs, and the effective conductivity when the run reports one (scenes with a hot and a cold end).
+    * ``profile.png`` -- the temperature of every particle against its place along the heat-flow axis (the
+      specimen's, :mod:`dem.scene.specimen`) with the mean of slabs, and the effective conductivity when the run
+      reports one (scenes with a hot and a cold end).
     """
     import matplotlib
 
@@ -137,7 +138,8 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
             plt.close(fig)
             written.append("heat_flow.png")
     if scene.specimen is not None:
-        z = scene.particles.position[:, 2]
+        axis = scene.specimen.axis
+        z = scene.particles.position[:, axis]
         fig, ax = plt.subplots(figsize=(7, 4))
         ax.plot(z * 1e3, T, ".", ms=2, alpha=0.4, label="particles")
         edges = np.linspace(z.min(), z.max(), 21)
@@ -146,7 +148,7 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
         with np.errstate(invalid="ignore"):
             mean = np.bincount(slab, T, 20) / count
         ax.plot(0.5 * (edges[1:] + edges[:-1]) * 1e3, mean, "o-", label="slab mean")
-        ax.set_xlabel("z (mm), along the heat flow")
+        ax.set_xlabel(f"{'xyz'[axis]} (mm), along the heat flow")
         ax.set_ylabel(temperature_label(scene.temperature_unit))
         summary = out / "summary.json"
         title = ""

@@ -28,7 +28,7 @@ from dataclasses import replace
 import numpy as np
 
 from dem import memory
-from dem.engines.static import CSV_FLOWS, StaticEngine
+from dem.engines.static import CSV_FLOWS, StaticEngine, boundary_summary
 from dem.geometry.necks import meeting_in, neck_account
 from dem.geometry.partition import bisection, halo
 from dem.network import comm as mpi
@@ -189,12 +189,7 @@ class DistributedStaticEngine(StaticEngine):
         mine = net.fixed[self.mine[net.fixed]]
         fixed = {int(k): float(v) for part in self.comm.allgather(
             dict(zip(self.part.held[mine].tolist(), into[mine].tolist()))) for k, v in part.items()}
-        out = {"walls": {w.name: float(q) for w, q in zip(self.scene.walls, walls)},
-               "fixed_total": float(sum(fixed[k] for k in sorted(fixed)))}
-        if len(fixed) <= 1000:
-            ids = self.full_scene.particles.id
-            out["particles"] = {str(ids[k]): fixed[k] for k in sorted(fixed)}
-        return out
+        return boundary_summary(self.full_scene, walls, fixed)
 
     def _periodic(self, T: np.ndarray) -> np.ndarray:
         """Heat flow across the period along x, y, z (:func:`dem.network.heat.periodic_heat_flow`) over the
