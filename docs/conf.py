@@ -51,6 +51,10 @@ autodoc_default_options = {"undoc-members": True, "member-order": "bysource"}  #
 autodoc_typehints = "description"
 autodoc_typehints_format = "short"
 autodoc_preserve_defaults = True
+# viewcode: a source page's links to the reference use the module the object is documented in, not the first module
+# that named it (following imports sent the classes of dem.engines.contact_heat to anchors under
+# dem.engines.verlet.engine, which imports them)
+viewcode_follow_imported_members = False
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 
