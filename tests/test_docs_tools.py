@@ -8,6 +8,7 @@ sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 
 import api_check  # noqa: E402
 import gallery_order  # noqa: E402
+import site_check  # noqa: E402
 
 
 def test_public_objects_are_the_functions_and_classes_each_module_defines():
@@ -38,3 +39,59 @@ def test_every_module_with_public_objects_has_its_automodule():
         assert modules - placed == set(), package
     assert {"dem.scene.schema.display_rows", "dem.driver.run", "dem.laws.contact.jkr.JKRMaterial"} <= set(
         api_check.public_objects("dem"))
+
+
+def test_site_check_finds_remote_loads_missing_files_and_missing_anchors(tmp_path):
+    """A page that loads MathJax from a CDN, a stylesheet from another host and a missing local script, and links to
+    an anchor its target lacks, is reported line by line; what a reader follows (an external link) and what is
+    there is not."""
+    (tmp_path / "_static").mkdir()
+    (tmp_path / "_static" / "here.js").write_text("")
+    (tmp_path / "guide").mkdir()
+    (tmp_path / "guide" / "other.html").write_text('<h1 id="there">x</h1><a name="old">y</a>')
+    (tmp_path / "index.html").write_text(
+        '<script defer src="https://cdn.example.org/npm/mathjax@4/tex-mml-chtml.js"></script>'
+        '<link rel="stylesheet" href="//fonts.example.org/a.css"><link rel="next" href="guide/other.html">'
+        '<script src="_static/here.js"></script><script src="_static/gone.js"></script>'
+        '<img src="data:image/png;base64,AAAA"><span id="self"></span>'
+        '<a href="https://example.org/paper">paper</a><a href="mailto:a@b.c">mail</a><a href="#self">up</a>'
+        '<a href="guide/other.html#there">ok</a><a href="guide/other.html#old">ok</a>'
+        '<a href="guide/other.html#missing">bad</a><a href="#nowhere">bad</a><a href="gone.html">bad</a>')
+    assert site_check.problems(tmp_path) == [
+        "index.html: loads https://cdn.example.org/npm/mathjax@4/tex-mml-chtml.js from another host (the site must "
+        "read offline)",
+        "index.html: loads //fonts.example.org/a.css from another host (the site must read offline)",
+        "index.html: loads _static/gone.js, which the build does not have",
+        "index.html: links to guide/other.html#missing, but guide/other.html has no anchor 'missing'",
+        "index.html: links to #nowhere, but index.html has no anchor 'nowhere'",
+        "index.html: links to gone.html, which the build does not have",
+    ]
+    (tmp_path / "guide" / "back.html").write_text('<a href="../index.html#self">up</a><a href="../../x.html">out</a>')
+    assert site_check.problems(tmp_path)[0] == "guide/back.html: ../../x.html points outside the site"  # page order
+
+
+def test_maths_is_served_by_the_site_itself():
+    """conf.py draws the equations with a MathJax the build copies into ``_static`` (the docs extra installs it),
+    never one from a CDN: a page that still loaded a remote MathJax would also fail the build (site_check)."""
+    import importlib.util
+    import runpy
+    import tomllib
+
+    conf = runpy.run_path(str(ROOT / "docs" / "conf.py"))
+    assert {"sphinx.ext.mathjax", "sphinx-mathjax-offline", "site_check"} <= set(conf["extensions"])
+    assert not site_check.is_remote(conf.get("mathjax_path", "")) and "mathjax3_config" not in conf
+    extra = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]["docs"]
+    assert any(req.startswith("sphinx-mathjax-offline") for req in extra)
+    spec = importlib.util.find_spec("sphinx-mathjax-offline")
+    if spec is not None:  # with the docs extra installed: the script it makes the pages load is in the package
+        class App:  # what the extension's setup touches
+            config = type("Config", (), {})()
+
+            def connect(self, *args):
+                pass
+
+        app = App()
+        importlib.import_module("sphinx-mathjax-offline").setup(app)
+        assert not site_check.is_remote(app.config.mathjax_path)
+        assert (pathlib.Path(spec.origin).parent / "static" / "mathjax" / app.config.mathjax_path.split("/", 1)[1]
+                ).is_file()
