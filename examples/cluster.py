@@ -41,7 +41,7 @@ middle_T = solution.particle_T[1]  # the L is symmetric: the middle particle's m
 dem = run(make_scene(data["centres"], data["radii"], [1.0, 0.0, 0.0], fixed=[True, False, True], law="fit",
                      mode="steady"))
 K_dem = -dem.summary["boundary_heat_flow"]["particles"]["0"] / 1.0  # W/K: heat out of the hot terminal / dT
-print(f"{path}: 3D FE K = {K_cluster:.5f} W/K ({solution.dofs} dofs, middle particle at {middle_T:.4f}); "
+print(f"{path.name}: 3D FE K = {K_cluster:.5f} W/K ({solution.dofs} dofs, middle particle at {middle_T:.4f}); "
       f"DEM pipe network (fit law) {K_dem:.5f} W/K ({K_dem / K_cluster - 1:+.2%})")
 
 # %%

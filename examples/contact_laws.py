@@ -48,7 +48,8 @@ for v, e_hm, e_sticky, together in zip(speeds, e_hertz_mindlin, e_jkr, stuck):
 fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
 ax.axhline(silica["restitution"], color="k", lw=1, label="the material's restitution e")
 ax.plot(speeds, e_hertz_mindlin, "o", label='law = "hertz_mindlin"')
-ax.plot(speeds, [0.0 if together else e for e, together in zip(e_jkr, stuck)], "s-", label='law = "jkr" (w = 0.1 J/m²)')
+e_jkr_or_stuck = [0.0 if together else e for e, together in zip(e_jkr, stuck)]
+ax.plot(speeds, e_jkr_or_stuck, "s-", label='law = "jkr" (w = 0.1 J/m²)')
 ax.set_xscale("log")
 ax.set_xlabel("impact speed, relative (m/s)")
 ax.set_ylabel("coefficient of restitution (-)")

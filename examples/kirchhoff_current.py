@@ -10,6 +10,7 @@ its Joule heat is made. The current in equals the current out, and the Joule hea
 electrodes deliver.
 """
 
+import matplotlib.pyplot as plt
 import numpy as np
 
 from dem import Material, Particles
@@ -31,3 +32,25 @@ flow = kirchhoff(p.n, bonds.i, bonds.j, G, share, bonds.wall_particle, bonds.wal
                  Electrodes(("top", "bottom"), (0, 1), np.array([1e-3, 0.0]), np.full(2, np.nan)))
 print(f"current into the electrodes {flow.electrode_current} A, Joule heat {flow.joule_heat:.4f} W, "
       f"electrode power {flow.electrode_power:.4f} W")
+
+# %%
+# Each particle's potential against its height, and the current through horizontal planes at every height between
+# the particles that touch the electrodes: the contacts that cross a plane carry the whole electrode current down
+# through it (Kirchhoff's current law summed over the particles above the plane), whatever the packing's disorder.
+z = p.position[:, 2]
+touching = {e: z[bonds.wall_particle[bonds.wall_index == e]] for e in (0, 1)}  # heights of each electrode's particles
+planes = np.linspace(touching[1].max(), touching[0].min(), 41)[1:-1]       # m, crossed by particle contacts alone
+z_i, z_j = z[bonds.i][:, None], z[bonds.j][:, None]
+downward = np.where((z_i > planes) & (z_j < planes), 1.0, 0.0) - np.where((z_i < planes) & (z_j > planes), 1.0, 0.0)
+plane_current = flow.pair_current @ downward                                # A down through each plane
+fig, (left, right) = plt.subplots(1, 2, figsize=(7.2, 4.0), sharey=True, layout="constrained")
+left.plot(flow.potential * 1e3, z * 1e3, ".", ms=2, alpha=0.5)
+left.set_xlabel("particle potential (mV)")
+left.set_ylabel("height z (mm)")
+right.plot(plane_current, planes * 1e3, "o-", ms=3)
+right.axvline(flow.electrode_current[0], color="k", lw=1, ls="--", label="into the top electrode")
+right.set_xlabel("current down through the plane (A)")
+right.set_xlim(0.0, 1.2 * flow.electrode_current[0])
+right.legend(loc="lower left")
+fig.suptitle(f"{p.n} copper particles, 1 mV between the electrodes")
+plt.show()

@@ -5,8 +5,9 @@ Particles that move: a packing poured and settled
 40 spheres dropped into a 4 mm × 4 mm box fall under gravity, collide and come to rest on the floor (velocity Verlet
 with the Luding 2005 contact law: elastic-plastic normal force with viscous damping, Coulomb friction between the
 particles, frictionless walls). At rest the floor carries the packing's whole weight (with wall friction the side
-walls would take a part of it, as in Janssen's silo), and the kinetic energy has died away; the run's folder (here a temporary one)
-holds the time series ``timeseries.csv`` that shows the way there, VTU snapshots for ParaView and ``state.npz``.
+walls would take a part of it, as in Janssen's silo), and the kinetic energy has died away; the run's folder (here a
+temporary one) holds the time series ``timeseries.csv`` that shows the way there, VTU snapshots for ParaView and
+``state.npz``.
 
 The scene is the dict form of a TOML scene file (``python -m dem run FILE.toml`` reads the same keys).
 """
