@@ -27,6 +27,19 @@ def test_gallery_order_lists_the_fe_examples_first_and_puts_unlisted_ones_last()
     assert set(gallery_order.ORDER) == {p.name for p in (ROOT / "examples").glob("*.py")}  # every example placed
 
 
+def test_examples_fit_the_line_length():
+    """Every line of every example within the project's 120 characters (the gallery shows them as code)."""
+    long = [f"{p.name}:{n}" for p in sorted((ROOT / "examples").glob("*.py"))
+            for n, line in enumerate(p.read_text().splitlines(), 1) if len(line) > 120]
+    assert long == []
+
+
+def test_getting_started_lists_every_example():
+    page = (ROOT / "docs" / "getting-started.md").read_text()
+    missing = {p.stem for p in (ROOT / "examples").glob("*.py") if f"<sphx_glr_gallery_{p.stem}.py>`" not in page}
+    assert missing == set()
+
+
 def test_every_module_with_public_objects_has_its_automodule():
     """What api_check finds in a build, found without one: every module of a documented package that defines a public
     function or class is named by an ``automodule`` directive of docs/reference/ (dem's modules included)."""
