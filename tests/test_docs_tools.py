@@ -108,3 +108,26 @@ def test_maths_is_served_by_the_site_itself():
         assert not site_check.is_remote(app.config.mathjax_path)
         assert (pathlib.Path(spec.origin).parent / "static" / "mathjax" / app.config.mathjax_path.split("/", 1)[1]
                 ).is_file()
+
+
+def test_install_page_shows_the_readme_mpi_command():
+    """The install page's MPI block is the README's, which CI runs (so the page cannot drift from what works)."""
+    def block_after(text):
+        return text.split("<!-- mpi-command -->\n```bash\n", 1)[1].split("```", 1)[0]
+
+    readme, page = (ROOT / "README.md").read_text(), (ROOT / "docs" / "install.md").read_text()
+    assert block_after(page) == block_after(readme)
+
+
+def test_citation_file_names_this_version_and_the_three_papers():
+    import tomllib
+
+    import yaml
+
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    assert cff["cff-version"] == "1.2.0" and cff["authors"] and cff["type"] == "software"
+    assert cff["version"] == tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    physics = " ".join((ROOT / "docs" / "physics" / "index.md").read_text().split())  # where the pages cite them
+    assert [(ref["authors"][0]["family-names"], ref["year"]) for ref in cff["references"]] == [
+        ("Rojek", 2022), ("Luding", 2005), ("Zohdi", 2014)]
+    assert all(ref["title"] in physics for ref in cff["references"])
