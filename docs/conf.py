@@ -86,5 +86,6 @@ html_theme = "furo"
 html_title = "sinterheat"
 html_static_path = ["_static"]
 html_css_files = ["maths.css"]  # display equations without a spurious scroll bar (the file says why)
+html_favicon = "_static/favicon.svg"  # two sintered spheres
 copybutton_prompt_text = "$ "
 copybutton_only_copy_prompt_lines = False
