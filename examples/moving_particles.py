@@ -23,7 +23,7 @@ from dem import parse_scene, run
 scene = parse_scene({
     "scene": {"name": "pour", "physics": ["mechanical"]},
     "material": {"density": 1000.0},  # kg/m^3
-    "contact": {"law": "luding", "k1": 1.0e4, "k2": 2.0e4, "kc": 0.0, "kt_ratio": 0.2, "gamma_n": 0.02,
+    "contact": {"law": "luding", "k1": 1.0e3, "k2": 2.0e3, "kc": 0.0, "kt_ratio": 0.2, "gamma_n": 0.02,
                 "gamma_t": 0.005, "mu": 0.5, "mu_wall": 0.0, "T_melt": 1000.0, "T_var": 10.0, "expansion": 0.0,
                 "fluid_overlap": 0.2, "t0": 1.0, "brittle_sliding": True},  # N/m, kg/s, degC, s
     "generator": {"kind": "box", "n": 40, "radius": 0.5e-3, "radius_spread": 0.2, "seed": 1, "temperature": 20.0,
