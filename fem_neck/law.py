@@ -373,7 +373,7 @@ def unequal_factor(r_i, r_j, a, c: float = UNEQUAL_C):
     a : float or array_like
         Neck radius, m, in ``[0, min(r_i, r_j)]``.
     c : float
-        The fitted coefficient (dimensionless), default :data:`UNEQUAL_C`.
+        The fitted coefficient (dimensionless), default ``UNEQUAL_C`` = 0.0054.
 
     Returns
     -------
