@@ -20,19 +20,24 @@ import numpy as np
 
 from dem import parse_scene, run
 
+L = 4.0e-3  # m, the box's width
 scene = parse_scene({
     "scene": {"name": "pour", "physics": ["mechanical"]},
     "material": {"density": 1000.0},  # kg/m^3
-    "contact": {"law": "luding", "k1": 1.0e3, "k2": 2.0e3, "kc": 0.0, "kt_ratio": 0.2, "gamma_n": 0.02,
-                "gamma_t": 0.005, "mu": 0.5, "mu_wall": 0.0, "T_melt": 1000.0, "T_var": 10.0, "expansion": 0.0,
-                "fluid_overlap": 0.2, "t0": 1.0, "brittle_sliding": True},  # N/m, kg/s, degC, s
-    "generator": {"kind": "box", "n": 40, "radius": 0.5e-3, "radius_spread": 0.2, "seed": 1, "temperature": 20.0,
-                  "box": [[0.0, 0.0, 2.0e-3], [4.0e-3, 4.0e-3, 12.0e-3]]},
-    "walls": [{"name": "floor", "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
-              {"name": "x-", "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]},
-              {"name": "x+", "point": [4.0e-3, 0.0, 0.0], "normal": [-1.0, 0.0, 0.0]},
-              {"name": "y-", "point": [0.0, 0.0, 0.0], "normal": [0.0, 1.0, 0.0]},
-              {"name": "y+", "point": [0.0, 4.0e-3, 0.0], "normal": [0.0, -1.0, 0.0]}],
+    # N/m, kg/s, degC, s
+    "contact": {"law": "luding", "k1": 1.0e3, "k2": 2.0e3, "kc": 0.0,
+                "kt_ratio": 0.2, "gamma_n": 0.02, "gamma_t": 0.005,
+                "mu": 0.5, "mu_wall": 0.0, "T_melt": 1000.0, "T_var": 10.0,
+                "expansion": 0.0, "fluid_overlap": 0.2, "t0": 1.0,
+                "brittle_sliding": True},
+    "generator": {"kind": "box", "n": 40, "radius": 0.5e-3,
+                  "radius_spread": 0.2, "seed": 1, "temperature": 20.0,
+                  "box": [[0.0, 0.0, 2.0e-3], [L, L, 12.0e-3]]},
+    "walls": [{"name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]},
+              {"name": "x-", "point": [0, 0, 0], "normal": [1, 0, 0]},
+              {"name": "x+", "point": [L, 0, 0], "normal": [-1, 0, 0]},
+              {"name": "y-", "point": [0, 0, 0], "normal": [0, 1, 0]},
+              {"name": "y+", "point": [0, L, 0], "normal": [0, -1, 0]}],
     "gravity": {"acceleration": [0.0, 0.0, -9.81]},  # m/s^2
     "solver": {"mode": "transient", "t_end": 0.3},
 })
@@ -40,10 +45,13 @@ folder = Path(tempfile.mkdtemp(prefix="moving_particles_"))
 result = run(scene, folder)
 mechanics = result.engine.mechanics
 weight = float(np.sum(mechanics.state.mass)) * 9.81  # N
-floor = mechanics.w.force[[w.name for w in mechanics.walls].index("floor")]  # N, on the floor
-kinetic = 0.5 * float(np.sum(mechanics.state.mass * np.sum(mechanics.state.v ** 2, axis=1)))  # J
-print(f"{result.summary['particles']} particles at rest after {result.summary['t']:.2f} s: the floor carries "
-      f"{floor * 1e3:.4f} mN of their {weight * 1e3:.4f} mN weight, kinetic energy {kinetic:.2e} J")
+names = [w.name for w in mechanics.walls]
+floor = mechanics.w.force[names.index("floor")]  # N, on the floor
+speed2 = np.sum(mechanics.state.v ** 2, axis=1)  # m^2/s^2
+kinetic = 0.5 * float(np.sum(mechanics.state.mass * speed2))  # J
+print(f"{result.summary['particles']} particles at rest after "
+      f"{result.summary['t']:.2f} s: the floor carries {floor * 1e3:.4f} mN "
+      f"of their {weight * 1e3:.4f} mN weight, kinetic energy {kinetic:.2e} J")
 
 # %%
 # The kinetic energy of the particles as they fall, collide and settle.
