@@ -1,7 +1,10 @@
-"""The documentation's own machinery (``docs/_ext``), without building the site (CI builds it after the tests)."""
+"""The documentation's own machinery (``docs/_ext``), without building the site (CI builds it after the tests; one test
+builds a one-page site of its own, where Sphinx is installed)."""
 
 import pathlib
 import sys
+
+import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "docs" / "_ext"))
@@ -93,6 +96,23 @@ def test_site_check_finds_remote_loads_missing_files_and_missing_anchors(tmp_pat
     ]
     (tmp_path / "guide" / "back.html").write_text('<a href="../index.html#self">up</a><a href="../../x.html">out</a>')
     assert site_check.problems(tmp_path)[0] == "guide/back.html: ../../x.html points outside the site"  # page order
+
+
+def test_a_build_with_a_cdn_script_fails(tmp_path):
+    """site_check is wired into the build: a page that loads a script from another host fails ``sphinx -W`` (and the
+    same page without it builds). Needs Sphinx (the docs extra); the tests' own environment may lack it."""
+    sphinx_cmd = pytest.importorskip("sphinx.cmd.build")
+    (tmp_path / "conf.py").write_text(f"import sys\nsys.path.insert(0, {str(ROOT / 'docs' / '_ext')!r})\n"
+                                      "extensions = ['site_check']\n")
+    page = "Title\n=====\n\n.. raw:: html\n\n   <script src=\"https://cdn.example.org/x.js\"></script>\n"
+    (tmp_path / "index.rst").write_text(page)
+    args = ["-W", "-q", "-b", "html", str(tmp_path), str(tmp_path / "_build")]
+    assert sphinx_cmd.build_main(args) != 0
+    (tmp_path / "index.rst").write_text(page.replace("https://cdn.example.org/x.js", "_static/x.js"))
+    (tmp_path / "_static").mkdir()
+    (tmp_path / "_static" / "x.js").write_text("")
+    (tmp_path / "conf.py").write_text((tmp_path / "conf.py").read_text() + "html_static_path = ['_static']\n")
+    assert sphinx_cmd.build_main(args + ["-E"]) == 0
 
 
 def test_maths_is_served_by_the_site_itself():
