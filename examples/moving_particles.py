@@ -5,9 +5,9 @@ Particles that move: a packing poured and settled
 40 spheres dropped into a 4 mm × 4 mm box fall under gravity, collide and come to rest on the floor (velocity Verlet
 with the Luding 2005 contact law: elastic-plastic normal force with viscous damping, Coulomb friction between the
 particles, frictionless walls). At rest the floor carries the packing's whole weight (with wall friction the side
-walls would take a part of it, as in Janssen's silo), and the kinetic energy has died away; the run's folder (here a
-temporary one) holds the time series ``timeseries.csv`` that shows the way there, VTU snapshots for ParaView and
-``state.npz``.
+walls would take a part of it, as in Janssen's silo), and the particles have stopped moving (a few keep a slow spin in
+place); the run's folder (here a temporary one) holds the time series ``timeseries.csv`` that shows the way there, VTU
+snapshots for ParaView and ``state.npz``.
 
 The scene is the dict form of a TOML scene file (``python -m dem run FILE.toml`` reads the same keys).
 """
@@ -48,17 +48,20 @@ weight = float(np.sum(mechanics.state.mass)) * 9.81  # N
 names = [w.name for w in mechanics.walls]
 floor = mechanics.w.force[names.index("floor")]  # N, on the floor
 speed2 = np.sum(mechanics.state.v ** 2, axis=1)  # m^2/s^2
-kinetic = 0.5 * float(np.sum(mechanics.state.mass * speed2))  # J
+kinetic = 0.5 * float(np.sum(mechanics.state.mass * speed2))  # J, translation
 print(f"{result.summary['particles']} particles at rest after "
       f"{result.summary['t']:.2f} s: the floor carries {floor * 1e3:.4f} mN "
-      f"of their {weight * 1e3:.4f} mN weight, kinetic energy {kinetic:.2e} J")
+      f"of their {weight * 1e3:.4f} mN weight, "
+      f"translational kinetic energy {kinetic:.2e} J")
 
 # %%
-# The kinetic energy of the particles as they fall, collide and settle.
+# The kinetic energy of the particles, translational and rotational, as they
+# fall, collide and settle. What stays after 0.15 s is rotational: a few
+# spheres keep spinning in place (the walls are frictionless).
 series = np.genfromtxt(folder / "timeseries.csv", delimiter=",", names=True)
 fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
 ax.semilogy(series["t"], np.maximum(series["kinetic_energy"], 1e-30))
 ax.set_xlabel("time t (s)")
-ax.set_ylabel("kinetic energy (J)")
+ax.set_ylabel("kinetic energy, with rotation (J)")
 ax.set_title("40 spheres poured into a box")
 plt.show()
