@@ -87,7 +87,25 @@ def check_neck(neck) -> str:
 
 
 def check_neck_ratio(a_over_r, name: str = "a_over_r") -> np.ndarray:
-    """``a/r`` as a float array, raising ``ValueError`` unless every entry is finite and in ``[0, 1]``."""
+    """``a/r`` as a float array, raising ``ValueError`` unless every entry is finite and in ``[0, 1]``.
+
+    Parameters
+    ----------
+    a_over_r : float or array_like
+        Neck radius over particle radius, ``x = a/r`` (dimensionless), any shape.
+    name : str
+        The name the error message gives the value (``"a/r_min"``, say).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``a_over_r`` as floats, same shape.
+
+    Raises
+    ------
+    ValueError
+        An entry is not finite or lies outside ``[0, 1]`` (the message names the first one).
+    """
     x = np.asarray(a_over_r, dtype=float)
     bad = ~np.isfinite(x) | (x < 0.0) | (x > 1.0)
     if np.any(bad):
@@ -105,6 +123,16 @@ def neck_resistance(a_over_r):
 
     The half neck is a cylinder of radius ``a = x r`` and length ``h_n/2``; ``lambda = h_n / (2 r x^2)``, finite at
     x -> 0 (1/4) and 2/3 at x = 1.
+
+    Parameters
+    ----------
+    a_over_r : float or array_like
+        Neck radius over particle radius, ``x = a/r`` in ``[0, 1]`` (dimensionless).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``lambda(x)`` (dimensionless: the resistance times ``kappa pi r``), a float for a scalar input.
     """
     x = check_neck_ratio(a_over_r)
     s = np.sqrt(1.0 - x * x)
@@ -121,12 +149,32 @@ def half_neck_resistance(a_over_r, neck: str = "cylinder"):
 
 @dataclass(frozen=True)
 class LinearLaw:
-    """``K/K_cyl = slope * a/r`` (Rojek 2022, eq. 40; Argento & Bouvard 1996 via eqs. 41-42)."""
+    """``K/K_cyl = slope * a/r`` (Rojek 2022, eq. 40; Argento & Bouvard 1996 via eqs. 41-42).
+
+    Parameters
+    ----------
+    slope : float
+        The constant ``c`` of ``K/K_cyl = c a/r`` (dimensionless): 1.064 for Rojek 2022's eq. 40.
+    name : str
+        Where the law comes from, for reports and plots.
+    """
 
     slope: float
     name: str = "linear"
 
     def k_over_kcyl(self, a_over_r):
+        """``K/K_cyl = slope x``: the half-pair conductance over ``K_cyl = kappa pi r`` (eq. 40).
+
+        Parameters
+        ----------
+        a_over_r : float or array_like
+            Neck radius over particle radius, ``x = a/r`` in ``[0, 1]`` (dimensionless).
+
+        Returns
+        -------
+        float or numpy.ndarray
+            ``K/K_cyl`` (dimensionless), a float for a scalar input.
+        """
         return _out(self.slope * check_neck_ratio(a_over_r))
 
 
@@ -138,10 +186,29 @@ ARGENTO_BOUVARD = LinearLaw(1.0 / 0.899, "Argento & Bouvard 1996, eq. (42)")  #:
 class ConductanceLaw:
     """The full-range law ``f(x) = K/K_cyl`` (module docstring), valid on ``0 <= a/r <= 1``.
 
-    ``fit_range`` is the a/r interval of the FE points it was fitted to and ``max_rel_residual`` its largest
-    relative misfit there; outside the fit range the law follows its exact limits (x -> 0 and x = 1). ``neck`` is
-    the half body it is for (:data:`NECKS`): ``"cylinder"`` (with the half neck's ``lambda(x)``) or ``"union"``
-    (without; ``f -> inf`` as x -> 1).
+    Outside the fit range the law follows its exact limits (x -> 0 and x = 1).
+
+    Parameters
+    ----------
+    A : float
+        Coefficient of ``x ln(1/x)`` in ``P(x)`` (dimensionless); the fit keeps the derived :data:`A_LOG`.
+    B : float
+        Coefficient of ``x`` in ``P(x)`` (dimensionless, fitted).
+    C : float
+        Coefficient of ``x^2`` in ``P(x)`` (dimensionless, fitted).
+    E : float
+        Coefficient of ``x^3`` in ``P(x)`` (dimensionless, fitted).
+    fit_range : tuple of float
+        The ``(low, high)`` a/r interval of the FE points the law was fitted to (dimensionless).
+    max_rel_residual : float
+        The largest relative misfit to those FE points (dimensionless; NaN when unknown).
+    name : str
+        A label for reports and plots.
+    source : str
+        The fit.json it was read from ("" when made in memory); not compared between laws.
+    neck : str
+        The half body the law is for (:data:`NECKS`): ``"cylinder"`` (with the half neck's ``lambda(x)``) or
+        ``"union"`` (without; ``f -> inf`` as x -> 1).
     """
 
     A: float
@@ -159,6 +226,7 @@ class ConductanceLaw:
 
     @property
     def parameters(self) -> dict:
+        """``{"A": ..., "B": ..., "C": ..., "E": ...}``: the coefficients of ``P(x)``."""
         return {p: getattr(self, p) for p in PARAMETERS}
 
     @property
@@ -167,7 +235,18 @@ class ConductanceLaw:
         return FORMS[self.neck]
 
     def segment_correction(self, a_over_r):
-        """``P(x)``: sphere-segment resistance over the half-space disk value ``1/(4 kappa a)``; P(0)=1, P(1)=0."""
+        """``P(x)``: sphere-segment resistance over the half-space disk value ``1/(4 kappa a)``; P(0)=1, P(1)=0.
+
+        Parameters
+        ----------
+        a_over_r : float or array_like
+            Neck radius over particle radius, ``x = a/r`` in ``[0, 1]`` (dimensionless).
+
+        Returns
+        -------
+        float or numpy.ndarray
+            ``P(x)`` (dimensionless), a float for a scalar input.
+        """
         x = check_neck_ratio(a_over_r)
         s = np.sqrt(1.0 - x * x)
         x_log = -x * np.log(np.where(x > 0.0, x, 1.0))
@@ -177,7 +256,18 @@ class ConductanceLaw:
 
     def k_over_kcyl(self, a_over_r):
         """``K/K_cyl = x / (x lambda(x) + (pi/4) P(x))``; vectorised, 0 at x = 0; at x = 1 3/2 (cylinder) or inf
-        (union: the half body's thickness, and its resistance, vanish)."""
+        (union: the half body's thickness, and its resistance, vanish).
+
+        Parameters
+        ----------
+        a_over_r : float or array_like
+            Neck radius over particle radius, ``x = a/r`` in ``[0, 1]`` (dimensionless).
+
+        Returns
+        -------
+        float or numpy.ndarray
+            ``K/K_cyl``, the half-pair conductance over ``kappa pi r`` (dimensionless), a float for a scalar input.
+        """
         x = check_neck_ratio(a_over_r)
         with np.errstate(divide="ignore"):
             return _out(x / (x * half_neck_resistance(x, self.neck) + 0.25 * np.pi * self.segment_correction(x)))
@@ -192,7 +282,18 @@ class ConductanceLaw:
         return self
 
     def table(self, n: int = 200) -> list:
-        """``n`` rows ``[a_over_r, K_over_Kcyl]``, log-spaced below 0.01 and uniform above, over the fit range."""
+        """``n`` rows ``[a_over_r, K_over_Kcyl]``, log-spaced below 0.01 and uniform above, over the fit range.
+
+        Parameters
+        ----------
+        n : int
+            Number of rows (a fifth of them, at least 2, below a/r = 0.01).
+
+        Returns
+        -------
+        list of list of float
+            ``[a/r, K/K_cyl]`` pairs (both dimensionless), a/r increasing.
+        """
         lo, hi = self.fit_range
         n_log = max(2, n // 5)
         x = np.concatenate([np.geomspace(lo, min(0.01, hi), n_log, endpoint=False),
@@ -200,13 +301,41 @@ class ConductanceLaw:
         return [[float(a), float(k)] for a, k in zip(x, np.atleast_1d(self.k_over_kcyl(x)))]
 
     def to_dict(self) -> dict:
-        """The ``law`` entry of fit.json (without the table, which the fit adds)."""
+        """The ``law`` entry of fit.json (without the table, which the fit adds).
+
+        Returns
+        -------
+        dict
+            ``form`` (the formula as text), ``parameters`` (:attr:`parameters`), ``range`` (:attr:`fit_range`) and
+            ``max_rel_residual``.
+        """
         return {"form": self.form, "parameters": self.parameters, "range": list(self.fit_range),
                 "max_rel_residual": self.max_rel_residual}
 
     @classmethod
     def from_dict(cls, law: dict, source: str = "", neck: str = "cylinder") -> "ConductanceLaw":
-        """The law of a fit.json's ``law`` entry, for the half body ``neck`` (which the file records beside it)."""
+        """The law of a fit.json ``law`` entry (:meth:`to_dict`'s form), for the half body ``neck`` (which the file
+        records beside it).
+
+        Parameters
+        ----------
+        law : dict
+            ``parameters`` with ``A``, ``B``, ``C`` and ``E``; optional ``range`` (default ``(0.001, 0.97)``) and
+            ``max_rel_residual`` (default NaN).
+        source : str
+            Where the entry was read from, kept as :attr:`source`.
+        neck : str
+            The half body the entry was fitted for (:data:`NECKS`).
+
+        Returns
+        -------
+        ConductanceLaw
+
+        Raises
+        ------
+        ValueError
+            ``parameters`` or one of its four coefficients is missing or not a number.
+        """
         try:
             params = {p: float(law["parameters"][p]) for p in PARAMETERS}
         except (KeyError, TypeError) as exc:
@@ -218,7 +347,24 @@ class ConductanceLaw:
     @classmethod
     def from_json(cls, path) -> "ConductanceLaw":
         """The law in a fit.json written by ``python -m fem_neck fit`` (its ``law`` entry, for the file's ``neck``;
-        a file without one was fitted before the union existed, to the neck cylinder)."""
+        a file without one was fitted before the union existed, to the neck cylinder).
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The fit.json file.
+
+        Returns
+        -------
+        ConductanceLaw
+            With :attr:`source` the path.
+
+        Raises
+        ------
+        ValueError
+            The file cannot be read, is not JSON, has no ``law`` entry, its entry is incomplete or its ``neck`` is
+            unknown (the message names the file).
+        """
         path = pathlib.Path(path)
         try:
             data = json.loads(path.read_text())
@@ -253,7 +399,28 @@ def _positive(name, value):
 def half_conductance(kappa, r, a, law=None):
     """``K_i = kappa pi r f(a/r)`` in W/K: one particle's half of a sintered pair (Rojek 2022, eq. 43 for f linear).
 
-    ``law`` defaults to :meth:`ConductanceLaw.default`. Vectorised over kappa, r and a (``0 <= a <= r``).
+    Vectorised: the arguments broadcast against each other.
+
+    Parameters
+    ----------
+    kappa : float or array_like
+        Thermal conductivity of the particle's material, W/(m K), finite and > 0.
+    r : float or array_like
+        Particle radius, m, finite and > 0.
+    a : float or array_like
+        Neck radius, m, in ``[0, r]``.
+    law : LinearLaw or ConductanceLaw, optional
+        ``f(a/r) = K/K_cyl``; default :meth:`ConductanceLaw.default`.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``K_i`` in W/K, a float for scalar inputs.
+
+    Raises
+    ------
+    ValueError
+        ``kappa`` or ``r`` not finite and positive, or ``a/r`` outside ``[0, 1]``.
     """
     law = ConductanceLaw.default() if law is None else law
     kappa, r = _positive("kappa", kappa), _positive("r", r)
@@ -272,6 +439,25 @@ def unequal_factor(r_i, r_j, a, c: float = UNEQUAL_C):
     The halves of :func:`pair_conductance` are solved with an isothermal neck cross-section; in an unequal pair that
     plane is not isothermal, and freeing it lowers K (Dirichlet's principle: the series of halves is an upper
     bound). ``c`` is fitted over 1 <= r_max/r_min <= 10 (``python -m fem_neck unequal``); 1 for equal radii.
+
+    Parameters
+    ----------
+    r_i, r_j : float or array_like
+        The two particle radii, m, finite and > 0.
+    a : float or array_like
+        Neck radius, m, in ``[0, min(r_i, r_j)]``.
+    c : float
+        The fitted coefficient (dimensionless), default ``UNEQUAL_C`` = 0.0054.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The factor (dimensionless, at most 1) that multiplies the series of halves; a float for scalar inputs.
+
+    Raises
+    ------
+    ValueError
+        A radius not finite and positive, or ``a/r_min`` outside ``[0, 1]``.
     """
     r_i, r_j = _positive("r_i", r_i), _positive("r_j", r_j)
     r_min, r_max = np.minimum(r_i, r_j), np.maximum(r_i, r_j)
@@ -286,6 +472,29 @@ def pair_conductance(kappa, r_i, r_j, a, law=None, unequal: bool = True):
     exactly into the two equal-pair half necks, ``h_n = h_n(r_i, r_i)/2 + h_n(r_j, r_j)/2``). With the linear law
     both halves equal ``c kappa pi a`` (eqs. 43-45). With the full-range law and ``unequal`` (default) the series is
     multiplied by :func:`unequal_factor`; the linear laws are the papers' models and are never corrected.
+
+    Parameters
+    ----------
+    kappa : float or array_like
+        Thermal conductivity of the particles' material, W/(m K), finite and > 0.
+    r_i, r_j : float or array_like
+        The two particle radii, m, finite and > 0.
+    a : float or array_like
+        Neck radius, m, in ``[0, min(r_i, r_j)]``.
+    law : LinearLaw or ConductanceLaw, optional
+        ``f(a/r) = K/K_cyl`` of each half; default :meth:`ConductanceLaw.default`.
+    unequal : bool
+        Multiply the full-range law's series by :func:`unequal_factor` (ignored for a :class:`LinearLaw`).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``K_ij`` in W/K (0 where both halves are 0), a float for scalar inputs.
+
+    Raises
+    ------
+    ValueError
+        ``kappa`` or a radius not finite and positive, or a neck wider than its particle.
     """
     law = ConductanceLaw.default() if law is None else law
     k_i = np.asarray(half_conductance(kappa, r_i, a, law))
