@@ -49,18 +49,52 @@ def necks_meeting(radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, wall_no
 
 
 def meeting_in(particles, walls, bonds: Bonds, box=None) -> np.ndarray:
-    """:func:`necks_meeting` of ``bonds`` found among ``particles`` (:class:`dem.geometry.particles.Particles`) and
-    the bonded ``walls`` (``bonds.wall_index`` indexes them), in the periodic ``box`` if any."""
+    """:func:`necks_meeting` of bonds found among particles and walls.
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The particles (positions and radii, m) the bonds join.
+    walls : sequence of dem.geometry.walls.Wall
+        The walls ``bonds.wall_index`` indexes (their normals point into the packing).
+    bonds : Bonds
+        The pair and wall bonds, with their neck radii and reading.
+    box : dem.geometry.periodic.PeriodicBox, optional
+        The periodic box the bonds' image shifts refer to.
+
+    Returns
+    -------
+    numpy.ndarray
+        Per particle, whether two of its necks meet (bool).
+    """
     normals = np.array([walls[k].normal for k in bonds.wall_index], dtype=float).reshape(-1, 3)
     return necks_meeting(particles.radius, bonds, bonds.vectors(particles.position, box), normals)
 
 
 def neck_account(count: int, n: int, reading: str, bonds: int, law: str) -> dict:
-    """The summary's account of the necks of ``n`` particles joined by ``bonds`` bonds (pair and wall) read by
-    ``reading``: the reading every bond used (``neck_readings``: bonds per reading), how many particles carry necks
-    that meet (``particles_necks_meeting``: ``count``), and, for the laws verified against FE
-    (all but ``zohdi``), whether the run stayed where ``law`` is verified (``law_in_verified_range``: the necks of
-    every particle apart) with a one-line ``warnings`` entry where not."""
+    """The summary's account of the necks: the reading every bond used (``neck_readings``: bonds per reading), how
+    many particles carry necks that meet (``particles_necks_meeting``), and, for the laws verified against FE (all but
+    ``zohdi``), whether the run stayed where the law is verified (``law_in_verified_range``: the necks of every
+    particle apart) with a one-line ``warnings`` entry where not.
+
+    Parameters
+    ----------
+    count : int
+        Particles that carry necks that meet.
+    n : int
+        Particles in the run.
+    reading : str
+        The neck reading of the bonds (:data:`dem.geometry.bonds.CONTACT_MODELS`).
+    bonds : int
+        Pair and wall bonds.
+    law : str
+        The conductance law (:data:`dem.laws.conductance.LAWS`).
+
+    Returns
+    -------
+    dict
+        The summary's entries.
+    """
     count = int(count)
     out = {"neck_readings": {reading: int(bonds)}, "particles_necks_meeting": count}
     if reading not in PAIR_READINGS and reading != "union":

@@ -262,8 +262,35 @@ def neck_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, 
     """The factors ``(s_i, s_j, s_wall)`` of every pair bond's two halves and every wall bond's half (module
     docstring) from the particles' necks: the pair bonds (``vectors`` from ``i`` to the partner, neck radii
     ``bonds.a``, half conductances ``k_i``, ``k_j`` in W/K) and the wall bonds (unit ``wall_normals`` pointing into
-    the packing, ``bonds.wall_a``, half conductances ``k_wall``). ``volume`` (m^3 per particle; default the sphere's,
-    which the volume-conserving neck keeps): the solid each particle holds, whose Wiener bound caps its factors."""
+    the packing, ``bonds.wall_a``, half conductances ``k_wall``).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    radius : numpy.ndarray
+        Particle radii, m.
+    bonds : Bonds
+        The pair and wall bonds with their neck radii (m) and centre-to-contact distances (m).
+    vectors : numpy.ndarray
+        ``x_j - x_i`` of every pair bond (m, 3), m.
+    k_i, k_j : numpy.ndarray
+        Half conductances of every pair bond on the side of ``i`` and of ``j``, W/K.
+    k_wall : numpy.ndarray
+        Half conductance of every wall bond, W/K.
+    conductivity : numpy.ndarray
+        Per particle, its material's conductivity, W/(m K).
+    wall_normals : numpy.ndarray
+        Unit normal of every wall bond's wall (pointing into the packing).
+    volume : numpy.ndarray, optional
+        Per particle, the solid it holds, m^3 (default: its sphere's, which the volume-conserving neck keeps; under
+        the union of spheres its cut sphere's), whose Wiener bound caps its factors.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        The factors of the pair bonds' halves on ``i`` and on ``j`` and of the wall bonds' halves (dimensionless).
+    """
     f = np.ascontiguousarray
     sphere = 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=float) ** 3
     share = np.ones(n) if volume is None else np.asarray(volume, dtype=float) / sphere

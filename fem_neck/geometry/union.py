@@ -47,8 +47,16 @@ from fem_neck.geometry import check_positive
 
 @dataclass(frozen=True)
 class Lens:
-    """The neck of two overlapping spheres in the union: circle radius ``a`` and the distances ``l_i``, ``l_j`` (m)
-    from each centre to the radical plane that holds the circle (``l_i + l_j = d``)."""
+    """The neck of two overlapping spheres in the union (:func:`lens`).
+
+    Parameters
+    ----------
+    a : numpy.ndarray or float
+        Radius of the circle where the two spheres meet, m.
+    l_i, l_j : numpy.ndarray or float
+        Distances from centre ``i`` and from centre ``j`` to the radical plane that holds the circle, m
+        (``l_i + l_j = d``).
+    """
 
     a: np.ndarray
     l_i: np.ndarray
@@ -56,9 +64,25 @@ class Lens:
 
 
 def lens(r_i, r_j, d) -> Lens:
-    """The neck circle of two spheres of radii ``r_i``, ``r_j`` (m) whose centres are ``d`` (m) apart (module
-    docstring); arrays broadcast. ``ValueError`` unless ``|r_i - r_j| < d < r_i + r_j`` (the spheres overlap and
-    neither holds the other)."""
+    """The neck circle of two overlapping spheres (module docstring); arrays broadcast.
+
+    Parameters
+    ----------
+    r_i, r_j : float or array_like
+        Radii of the two spheres, m.
+    d : float or array_like
+        Distance between their centres, m.
+
+    Returns
+    -------
+    Lens
+        The circle's radius and the centres' distances from its plane.
+
+    Raises
+    ------
+    ValueError
+        Unless ``|r_i - r_j| < d < r_i + r_j`` (the spheres overlap and neither holds the other).
+    """
     r_i = check_positive("r_i", r_i)
     r_j = check_positive("r_j", r_j)
     d = check_positive("d", d)
@@ -75,18 +99,41 @@ def lens(r_i, r_j, d) -> Lens:
 
 
 def angular_radius(a, l):
-    """Half-angle (rad) of the cone in which a neck of radius ``a`` whose plane lies ``l`` from the centre is seen
-    from the centre: ``atan2(a, l)``. For a pair neck (:mod:`fem_neck.geometry`) the circle on the sphere lies at
-    ``l = sqrt(r^2 - a^2)``, so the angle is ``arcsin(a / r)``."""
+    """Half-angle of the cone in which a neck is seen from its particle's centre: ``atan2(a, l)``. For a pair neck
+    (:mod:`fem_neck.geometry`) the circle on the sphere lies at ``l = sqrt(r^2 - a^2)``, so the angle is
+    ``arcsin(a / r)``.
+
+    Parameters
+    ----------
+    a : float or array_like
+        Neck (circle) radius, m.
+    l : float or array_like
+        Distance from the centre to the circle's plane, m.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The half-angle, rad.
+    """
     return np.arctan2(a, l)
 
 
 @dataclass(frozen=True)
 class CutSpheres:
-    """The cut spheres of a packing (:func:`cut_spheres`): per particle its ``volume`` (m^3), the area
-    ``free_area`` (m^2) of its spherical surface left and ``meeting`` (whether two of its necks meet); per bond the
-    areas ``face_i``, ``face_j`` (m^2) of the flat faces the neck leaves on particle ``i`` and on ``j`` (equal: the
-    face is one piece of the radical plane)."""
+    """The cut spheres of a packing (:func:`cut_spheres`).
+
+    Parameters
+    ----------
+    volume : numpy.ndarray
+        Per particle, the volume of its sphere cut by the radical planes of its necks, m^3.
+    free_area : numpy.ndarray
+        Per particle, the area of its spherical surface left, m^2.
+    meeting : numpy.ndarray
+        Per particle, whether two of its necks meet (bool).
+    face_i, face_j : numpy.ndarray
+        Per bond, the area of the flat face the neck leaves on particle ``i`` and on ``j``, m^2 (equal: the face is
+        one piece of the radical plane).
+    """
 
     volume: np.ndarray
     free_area: np.ndarray
