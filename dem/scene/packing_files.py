@@ -48,6 +48,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from dem.output.atomic import write_aside
+
 FORMATS = ("csv", "lammps-data", "lammps-dump", "vtk")
 AXES = "xyz"
 # LAMMPS unit styles a granular packing can be in: metres and kg/m^3 per unit of length and of density
@@ -893,8 +895,8 @@ def write_vtu(path, packing: Packing) -> pathlib.Path:
 def _write_text(path: pathlib.Path, parts) -> None:
     """Write the strings (or iterables of strings) ``parts`` to ``path``: aside, then renamed, so that a file on disk
     is always whole."""
-    tmp = path.with_name(path.name + ".part")
-    with tmp.open("w") as fh:
+    def write(fh):
         for part in parts:
             fh.writelines([part] if isinstance(part, str) else part)
-    tmp.replace(path)
+
+    write_aside(path, write)

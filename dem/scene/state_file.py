@@ -27,6 +27,7 @@ import pathlib
 import numpy as np
 
 from dem.geometry.periodic import PeriodicBox
+from dem.output.atomic import write_aside
 
 FORMAT = "dem-state-2"
 FORMAT_1 = "dem-moving-state-1"  # the Luding law's histories as separate arrays (read and converted)
@@ -78,11 +79,7 @@ def save(data: dict, path) -> pathlib.Path:
     interrupted save never leaves half a state."""
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".part")
-    with tmp.open("wb") as fh:
-        np.savez(fh, format=np.array(FORMAT), **data)
-    tmp.replace(path)
-    return path
+    return write_aside(path, lambda fh: np.savez(fh, format=np.array(FORMAT), **data), "wb")
 
 
 def load(path) -> dict:
