@@ -5,7 +5,8 @@ Ctrl-C into a traceback -- and importing numpy, scipy and the package itself tak
 several on a busy machine. :func:`run_main` installs a handler that only raises ``KeyboardInterrupt`` before it
 imports anything else (``signal`` is built in), imports the command's module and runs its ``main``; an interrupt
 before ``main`` has taken over ends with the one line ``<prog> <command>: interrupted at start-up; no results
-written`` and exit code 130, as one after it does.
+written`` and exit code 130, as one after it does; SIGTERM and SIGHUP likewise (``interrupted by SIGTERM``, exit code
+128 + the signal).
 """
 
 import importlib
@@ -13,24 +14,29 @@ import os
 import signal
 import sys
 
-EXIT_CODE = 130  # 128 + SIGINT, as sinterheat.interrupt.EXIT_CODE
+_arrived = [signal.SIGINT]  # the signal that interrupted the start-up
 
 
 def _raise(signum, frame):
+    _arrived[0] = signum
     raise KeyboardInterrupt
 
 
 def run_main(prog: str, module: str, **kwargs):
-    """``sys.exit(main(**kwargs))`` of ``module`` (a dotted name) for ``python -m <package>``, Ctrl-C held to one line
-    from here on (module docstring)."""
-    signal.signal(signal.SIGINT, _raise)
+    """``sys.exit(main(**kwargs))`` of ``module`` (a dotted name) for ``python -m <package>``, Ctrl-C (and SIGTERM,
+    SIGHUP: :data:`sinterheat.interrupt.SIGNALS`) held to one line from here on (module docstring)."""
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        signum = getattr(signal, name, None)
+        if signum is not None and (name == "SIGINT" or signal.getsignal(signum) is not signal.SIG_IGN):
+            signal.signal(signum, _raise)
     try:
         main = importlib.import_module(module).main
         from sinterheat.interrupt import exit_process
     except KeyboardInterrupt:
         command = next((a for a in sys.argv[1:] if not a.startswith("-")), None)
-        sys.stderr.write(f"{prog}{'' if command is None else ' ' + command}: interrupted at start-up; "
+        by = "" if _arrived[0] == signal.SIGINT else f" by {signal.Signals(_arrived[0]).name}"
+        sys.stderr.write(f"{prog}{'' if command is None else ' ' + command}: interrupted{by} at start-up; "
                          f"no results written\n")
         sys.stderr.flush()
-        os._exit(EXIT_CODE)
+        os._exit(128 + int(_arrived[0]))
     exit_process(main(**kwargs))
