@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-from dem.output.atomic import write_aside
+from dem.output.atomic import read_npz, write_aside
 
 CHECKPOINT = "checkpoint.npz"
 LOCK = "run.lock"  # the run writing the folder: {"pid", "host"}
@@ -153,8 +153,7 @@ def load(out, scene, kind: str) -> dict:
     """The checkpoint of the run in ``out`` as a dict of arrays, refused if another scene (or kind) wrote it or the
     run is finished (:func:`finished`)."""
     path = pathlib.Path(out) / CHECKPOINT
-    with np.load(path, allow_pickle=False) as f:
-        data = {k: f[k] for k in f.files}
+    data = read_npz(path, "--resume: the checkpoint")
     if str(data.get("kind")) != kind or str(data.get("scene_digest")) != scene_digest(scene):
         raise ValueError(f"--resume: {path} was written by another scene (or another kind of run); resume it with "
                          f"the scene that started it, or use --overwrite")

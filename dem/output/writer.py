@@ -28,7 +28,7 @@ import re
 import meshio
 import numpy as np
 
-from dem.output.atomic import write_aside
+from dem.output.atomic import read_npz, write_aside
 
 MAX_SNAPSHOTS = 1000  # VTU snapshots per run (each is two files): more is refused up front (fixed dt) or thinned (auto)
 DIGITS = 9  # of the step in a snapshot's file name
@@ -97,8 +97,11 @@ def checkpoint_reached(out: pathlib.Path) -> dict | None:
     path = out / "checkpoint.npz"
     if not path.exists():
         return None
-    with np.load(path, allow_pickle=False) as f:
-        return {"t": float(f["t"]), "steps": int(f["steps"])}
+    try:
+        data = read_npz(path, "checkpoint")
+        return {"t": float(data["t"]), "steps": int(data["steps"])}
+    except (ValueError, KeyError):  # not one of ours: nothing to resume from
+        return None
 
 
 def write_summary(path, summary: dict) -> None:
