@@ -115,3 +115,29 @@ def test_a_checkpoint_that_cannot_be_written_is_one_line(tmp_path, capsys, monke
     assert code == 2 and len(err) == 1, err
     assert str(out / "checkpoint.npz") in err[0] and "No space left" in err[0]
     assert not list(out.glob("*.part")) and not (out / folder.LOCK).exists()
+
+
+@pytest.mark.slow
+def test_two_runs_into_one_folder_one_refused_the_folder_whole(tmp_path):
+    """The issue's case end to end: a run writing its folder, a second started into it (a process of its own)."""
+    from test_dem_resume import THERMAL
+    from test_signals import start
+
+    scene = tmp_path / "scene.toml"
+    scene.write_text(THERMAL)
+    out = tmp_path / "run"
+    first = start(["dem", "run", str(scene), "--out", str(out), "--quiet", "--json"], tmp_path)
+    rows = out / "timeseries.csv"
+    while first.poll() is None and not (rows.exists() and rows.read_text().count("\n") > 5):
+        pass
+    second = start(["dem", "run", str(scene), "--out", str(out), "--overwrite", "--quiet"], tmp_path)
+    _, err = second.communicate(timeout=120)
+    stdout, first_err = first.communicate(timeout=300)
+    assert first.returncode == 0, first_err
+    assert second.returncode == 2 and err.count("\n") == 1, err
+    assert f"another run is writing it (pid {first.pid} " in err, err
+    summary = json.loads((out / "summary.json").read_text())
+    text = rows.read_text()
+    assert "\x00" not in text and len(text.splitlines()) == summary["steps"] + 2  # header, steps 0 ... n
+    assert summary == {**json.loads(stdout), **{k: summary[k] for k in ("seconds", "plots", "state")
+                                                 if k in summary}}

@@ -46,7 +46,8 @@ def one_line(err: str) -> str:
     return lines[0]
 
 
-@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP], ids=["SIGTERM", "SIGHUP"])
+@pytest.mark.parametrize("signum", [signal.SIGTERM, pytest.param(signal.SIGHUP, marks=pytest.mark.slow)],
+                         ids=["SIGTERM", "SIGHUP"])
 def test_signal_before_the_first_checkpoint_then_resume(tmp_path, signum):
     scene = tmp_path / "scene.toml"
     scene.write_text(NO_PERIODIC)
