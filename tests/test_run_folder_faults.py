@@ -141,3 +141,38 @@ def test_two_runs_into_one_folder_one_refused_the_folder_whole(tmp_path):
     assert "\x00" not in text and len(text.splitlines()) == summary["steps"] + 2  # header, steps 0 ... n
     assert summary == {**json.loads(stdout), **{k: summary[k] for k in ("seconds", "plots", "state")
                                                  if k in summary}}
+
+
+@pytest.mark.slow
+def test_interrupted_sintering_run_resumed_keeps_every_profile_block(tmp_path):
+    """The issue's case end to end: hot-wall-sintering (t_end 0.08 s, a snapshot every 0.02 s) interrupted after
+    its block at t = 0.0425 (written 0.0424999633209, the exact time rounded up) and resumed: profiles.csv is the
+    uninterrupted run's, all 41 lines (it had 33)."""
+    import signal
+    import time
+
+    from dem import load_scene
+    from test_signals import start
+
+    text = (pathlib.Path(__file__).resolve().parents[1] / "dem" / "scene" / "builtin" / "hot-wall-sintering.toml")
+    text = text.read_text().replace("\nt_end = 0.15", "\nt_end = 0.08").replace("vtu_interval = 0.025",
+                                                                               "vtu_interval = 0.02")
+    scene = tmp_path / "scene.toml"
+    scene.write_text(text + "checkpoint_every = 0.5\n")  # the [output] table is the file's last
+    whole = run(load_scene(scene), out=tmp_path / "whole")
+    part = tmp_path / "part"
+    proc = start(["dem", "run", str(scene), "--out", str(part), "--quiet"], tmp_path)
+    profiles = part / "profiles.csv"
+    while proc.poll() is None and not (profiles.exists() and profiles.read_text().count("\n") >= 25):
+        time.sleep(0.05)
+    time.sleep(1.0)  # a checkpoint after the block
+    proc.send_signal(signal.SIGINT)
+    proc.communicate(timeout=120)
+    if proc.returncode == 0:
+        pytest.skip("the run finished before the interrupt reached it")
+    assert proc.returncode == 130
+    resumed = run(load_scene(scene), out=part, resume=True)
+    assert resumed.summary["resumed_from"]["t"] > 0.0425
+    assert np.array_equal(resumed.T, whole.T)
+    assert profiles.read_text() == (tmp_path / "whole" / "profiles.csv").read_text()
+    assert len(profiles.read_text().splitlines()) == 41
