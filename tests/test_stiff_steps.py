@@ -49,6 +49,9 @@ def test_capacities_lost_to_round_off_are_refused(tmp_path, capsys):
     bond's conductance. It ended at T = [83.5, -16.5] with energy_error 0.165 and exit 0."""
     refuse_scene(tmp_path, pair_toml(k="1.0e10", rho="1.0e-10", cp="1.0e-10"), capsys, "solver.dt = 0.001 s",
                  "energy_error", "wrong")
+    # dt = "auto" (the default): its smallest step, t_end / 2^40, is still ~1e22 time constants
+    refuse_scene(tmp_path, pair_toml(k="1.0e10", rho="1.0e-10", cp="1.0e-10", dt='"auto"'), capsys,
+                 "solver.dt = 'auto'", "wrong", "density and specific heat")
 
 
 def test_oscillating_steps_are_refused_where_nothing_damps_them():

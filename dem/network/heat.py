@@ -729,6 +729,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
                 raise ValueError(_wrong(f"at t = {t:.6g} s the temperatures left the prescribed range [{lo:g}, "
                                         f"{hi:g}] by {violation:.4g} (max_principle_violation, more than "
                                         f"{MAX_PRINCIPLE_TOLERANCE:g} of the range)", integrator, dt,
+                                        ROUND_OFF_HINT if auto else
                                         "the step is too large for the network's fastest time constant: use a "
                                         "smaller dt, dt = \"auto\" or integrator = \"implicit\""))
         if observer is not None:
@@ -761,6 +762,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     if not err <= ENERGY_TOLERANCE:
         raise ValueError(_wrong(f"the heat balance is off by energy_error = {err:.3g} (more than "
                                 f"{ENERGY_TOLERANCE:g})", integrator, dt,
+                                ROUND_OFF_HINT if auto else
                                 "the capacities are lost to round-off next to the conductances at this step: "
                                 "use a smaller dt (or mode = \"steady\")"))
     heat_in = {k: float(v) for k, v in heat_in.items()}
@@ -768,6 +770,11 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     return TransientResult(net.full(T), t, steps, rejected, err, heat_in, limit, dt_min, dt_max, stepper.backend,
                            factorizations, violation if bounded else None,
                            min(steps, STARTUP_STEPS) if startup is not None else 0)
+
+
+ROUND_OFF_HINT = ("even the smallest step dt = \"auto\" takes is far above the network's fastest time constant "
+                  "C/K, so the capacities are lost to round-off next to the conductances: check the materials' "
+                  "density and specific heat against the conductivity, or use mode = \"steady\"")
 
 
 def _wrong(what: str, integrator: str, dt, hint: str) -> str:

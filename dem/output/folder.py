@@ -80,7 +80,8 @@ def lock(out: pathlib.Path) -> None:
             held = _holder(path)
             if held is not None and held.get("pid") != os.getpid():
                 raise ValueError(f"--out {out}: another run is writing it (pid {held['pid']} on {held['host']}, "
-                                 f"{LOCK}); wait for it to end, or use another folder") from None
+                                 f"{LOCK}); wait for it to end, or use another folder (no such run: delete "
+                                 f"{path})") from None
             path.unlink(missing_ok=True)  # stale: its run was killed (or it is this process's own)
             continue
         with os.fdopen(fd, "w") as fh:
