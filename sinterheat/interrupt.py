@@ -47,8 +47,8 @@ import threading
 from dataclasses import dataclass, field
 
 EXIT_CODE = 130  #: 128 + SIGINT
-#: the signals handled as Ctrl-C: SIGTERM is what a batch scheduler sends at a time limit (and ``kill``), SIGHUP what a
-#: closed terminal or a lost ssh session sends; each ends a run with its one line and exit code 128 + the signal
+#: The signals handled as Ctrl-C is. SIGTERM is what a batch scheduler sends at a time limit (and ``kill``), SIGHUP
+#: what a closed terminal or a lost ssh session sends; each ends a run with its one line and exit code 128 + signal.
 SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
 EXIT_CODES = frozenset(128 + int(signum) for signum in SIGNALS)
 _current: contextvars.ContextVar[Where | None] = contextvars.ContextVar("sinterheat_where", default=None)
@@ -96,7 +96,8 @@ class Where:
 
     @property
     def exit_code(self) -> int:
-        """128 + the signal: 130 for Ctrl-C, 143 for SIGTERM, 129 for SIGHUP (what a shell reports for each)."""
+        """The exit code of the interrupted run, 128 + the signal (130 for Ctrl-C, 143 for SIGTERM, 129 for SIGHUP,
+        what a shell reports for each)."""
         return 128 + int(self.signum)
 
 

@@ -24,7 +24,7 @@ def write_aside(path, write, mode: str | None = "w") -> pathlib.Path:
 
     Parameters
     ----------
-    path : str or os.PathLike
+    path : str or pathlib.Path
         The file to write.
     write : callable
         Called once with the open temporary file (or its path).
@@ -59,7 +59,7 @@ def read_npz(path, what: str) -> dict:
 
     Parameters
     ----------
-    path : str or os.PathLike
+    path : str or pathlib.Path
         The file.
     what : str
         How the message names the file, e.g. ``"[start] state"`` or ``"--resume"``.

@@ -47,7 +47,7 @@ def resumed_csv(path: pathlib.Path, keep) -> "io.TextIOBase":
 
 def resumed_profiles(path: pathlib.Path, t_last: float) -> None:
     """``profiles.csv`` cut after the block of the snapshot at ``t_last`` (the last one a resumed run keeps). A block's
-    time is written rounded (:func:`_cell`), so it is compared with ``t_last`` rounded the same way: the block at
+    time is written rounded (``_cell``: 12 digits), so it is compared with ``t_last`` rounded the same way: the block at
     exactly ``t_last`` stays even where its rounded time lies above ``t_last``, and every later one goes."""
     limit = float(_cell(t_last))
     resumed_csv(path, lambda row: float(row["t"]) <= limit).close()
