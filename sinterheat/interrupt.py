@@ -250,6 +250,9 @@ def exit_process(code: int):
     """``sys.exit(code)`` for a CLI's ``__main__``; after an interrupt (:data:`EXIT_CODE`) stdout and stderr are
     flushed and the process leaves at once with that code (``os._exit``): the run has unwound, and Python's own
     exit would report a kill by SIGINT instead once the interrupt has passed through some C-level imports."""
+    if threading.current_thread() is threading.main_thread():  # the command is over: a late signal ends the process
+        for signum in handled():  # as the system's default does (no start-up line, no KeyboardInterrupt traceback)
+            signal.signal(signum, signal.SIG_DFL)
     if code in EXIT_CODES:
         for stream in (sys.stdout, sys.stderr):
             with contextlib.suppress(Exception):
