@@ -32,8 +32,9 @@ open are closed before the line is written, so it starts a line of its own. Work
 (:func:`ignore_interrupts` as the pool's initializer, started inside :func:`shielded`, which holds a Ctrl-C back
 until the pool knows every worker it started); the parent stops them (:func:`stop_pool`). :func:`exit_process` then
 leaves with code 130 (Python's own exit would report a kill by SIGINT once the interrupt has passed through some
-C-level imports). Before the CLI's ``main`` runs (interpreter start-up, a few tens of ms) Python's default handler
-is still in place.
+C-level imports). Before the CLI's ``main`` runs, :mod:`sinterheat.startup` holds the signals to one line (from the
+package's first statement on); only during the interpreter's own start-up, a few tens of ms, are the system's
+defaults in place.
 """
 
 from __future__ import annotations
