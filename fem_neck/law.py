@@ -367,15 +367,21 @@ class ConductanceLaw:
         """
         path = pathlib.Path(path)
         try:
-            data = json.loads(path.read_text())
+            data = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, json.JSONDecodeError) as exc:
             raise ValueError(f"fit file = {str(path)!r}: cannot be read as JSON ({exc})") from exc
+        except UnicodeDecodeError as exc:  # binary garbage: a ValueError of its own that names no file
+            raise ValueError(f"fit file = {str(path)!r}: cannot be read as JSON (not UTF-8 text: byte "
+                             f"{exc.start})") from None
         if not isinstance(data, dict) or "law" not in data:
             raise ValueError(f"fit file = {str(path)!r}: must be a JSON object with a 'law' entry")
         neck = data.get("neck", "cylinder")
         if neck not in NECKS:
             raise ValueError(f"fit file = {str(path)!r}: neck = {neck!r} must be one of {', '.join(NECKS)}")
-        return cls.from_dict(data["law"], source=str(path), neck=neck)
+        try:
+            return cls.from_dict(data["law"], source=str(path), neck=neck)
+        except ValueError as exc:
+            raise ValueError(f"fit file = {str(path)!r}: {exc}") from None
 
     @classmethod
     def default(cls, neck: str = "cylinder") -> "ConductanceLaw":

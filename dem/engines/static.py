@@ -177,6 +177,8 @@ class StaticEngine:
                        integrator=s.integrator, dt=s.dt, dt_min=res.dt_min, dt_max=res.dt_max,
                        rejected_steps=res.rejected, stable_limit=res.stable_limit, linear_solver=res.solver,
                        factorizations=res.factorizations, max_principle_violation=res.max_principle_violation)
+            if res.startup_steps:  # a stiff Crank-Nicolson run: say that its first steps were implicit Euler
+                out["startup_steps"] = res.startup_steps
         self.details = out
 
     def _boundary(self, T: np.ndarray) -> dict:

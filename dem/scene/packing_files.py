@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import csv
 import io
+import logging
 import math
 import mmap
 import pathlib
@@ -50,6 +51,8 @@ import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+
+from dem.output.atomic import write_aside
 
 FORMATS = ("csv", "lammps-data", "lammps-dump", "vtk")
 AXES = "xyz"
@@ -686,20 +689,38 @@ VTK_FIELDS = {"radius": ("radius", "radii"), "diameter": ("diameter", "diameters
                                                                                "angvelvec")}
 
 
+class _KeptLog(logging.Handler):
+    """A logging handler that keeps the messages it is given (a VTK reader's errors, for the one-line refusal)."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record):
+        self.messages.append(record.getMessage())
+
+
 def _read_vtk(path: pathlib.Path, length_unit: float, _timestep=None) -> Packing:
     import pyvista as pv
     from vtkmodules.vtkCommonCore import vtkLogger
 
     vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)  # a bad file: our one line, not VTK's log
-    with warnings.catch_warnings(record=True) as caught:  # pyvista reports a reader's error as a warning
-        warnings.simplefilter("always")
-        try:
-            mesh = pv.read(str(path))
-        except Exception as exc:  # VTK's readers raise many kinds; the file is what is wrong
-            raise ValueError(f"{path}: cannot be read as VTK ({' '.join(str(exc).split())})") from None
+    logged = _KeptLog()  # pyvista passes some reader errors to the logging module (an "ERROR:root:" line)
+    root = logging.getLogger()
+    root.addHandler(logged)
+    try:
+        with warnings.catch_warnings(record=True) as caught:  # pyvista reports a reader's error as a warning
+            warnings.simplefilter("always")
+            try:
+                mesh = pv.read(str(path))
+            except Exception as exc:  # VTK's readers raise many kinds; the file is what is wrong
+                raise ValueError(f"{path}: cannot be read as VTK ({' '.join(str(exc).split())})") from None
+    finally:
+        root.removeHandler(logged)
     if mesh is None or not hasattr(mesh, "point_data") or mesh.n_points == 0:
-        if caught:
-            raise ValueError(f"{path}: cannot be read as VTK ({' '.join(str(caught[0].message).split())})")
+        if caught or logged.messages:
+            why = str(caught[0].message) if caught else logged.messages[0]
+            raise ValueError(f"{path}: cannot be read as VTK ({' '.join(why.split())})")
         raise ValueError(f"{path}: holds no points (a VTK point set: the particle centres, with a radius or diameter "
                          "point field)")
     fields = {name.lower(): name for name in mesh.point_data.keys()}
@@ -1009,8 +1030,8 @@ def write_vtu(path, packing: Packing) -> pathlib.Path:
 def _write_text(path: pathlib.Path, parts) -> None:
     """Write the strings (or iterables of strings) ``parts`` to ``path``: aside, then renamed, so that a file on disk
     is always whole."""
-    tmp = path.with_name(path.name + ".part")
-    with tmp.open("w") as fh:
+    def write(fh):
         for part in parts:
             fh.writelines([part] if isinstance(part, str) else part)
-    tmp.replace(path)
+
+    write_aside(path, write)
