@@ -23,6 +23,17 @@ LINE = re.compile(r"^python -m (fem_neck|dem|verification) [\w-]+: interrupted a
 FIT = ["fem_neck", "fit", "--points", "200", "--rtol", "1e-8", "--out", "fit", "--json"]  # ~1 min of work
 
 
+@pytest.fixture(autouse=True)
+def _handlers_restored():
+    """Every signal a run handles (SIGINT, SIGTERM, SIGHUP) has its handler back after each test: an interrupted
+    command ignores them all until it exits, and a SIGTERM left ignored in this process would be inherited by every
+    process a later test starts."""
+    before = {signum: signal.getsignal(signum) for signum in interrupt.SIGNALS}
+    yield
+    for signum, handler in before.items():
+        signal.signal(signum, handler)
+
+
 def _start(args, cwd):
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     return subprocess.Popen([sys.executable, "-m", *args], cwd=cwd, env=env, stdout=subprocess.PIPE,
