@@ -98,17 +98,27 @@ ALGEBRAIC_SHARE = 1e-3
 FIRST_MESH = {3: (0.05, 1.9e-3, 1.1, 0.75), 4: (0.01, 1e-4, 1.3, 0.75)}
 NECK0, NECK_RANGE = 0.2, (0.2, 0.5)
 P3_FROM = 3e-4  # the rtol from which the upper bound is P_3 by default (below, P_4)
-# the union reading's first mesh, gap order and neck range (as FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE): its circles
-# are sharper edges (interior angle pi + 2 arccos(a/r)), so its gap falls more slowly, measured on its own cells
-UNION_FIRST_MESH = {3: (0.01, 1.71e-3, 1.0, 0.75), 4: (0.01, 7.0e-4, 1.0, 0.75)}
-UNION_GAP_ORDER = 0.95
-UNION_NECK0, UNION_NECK_RANGE = 0.141, (0.141, 0.6)
+# the union reading's first mesh, gap order, neck range and first sizes (as FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE,
+# FIRST_SIZES): its circles are sharper edges (interior angle pi + 2 arccos(a/r)), so its gap falls more slowly with
+# the neck size, measured on its own cells (SC, BCC, FCC; the mean a/r over all bonds, second neighbours included).
+# p = 3: at h/r = 0.02 (a/r = 0.141) 1.17-1.49e-2 apart at size 0.1, 5.4-6.4e-3 at 0.04, 1.28-1.71e-3 at 0.01
+# (gap order 0.94-1.05); SC 0.3, BCC 0.2, FCC 0.2 (a/r 0.53, 0.44, 0.44) 1.2-2.3e-3 at 0.04; SC 0.6, BCC 0.32,
+# FCC 0.3 (phi 0.97-0.976) 0.76-2.4e-3 at 0.1. p = 4: at a/r = 0.141 2.3-2.8e-3 at 0.03, 0.70-0.92e-3 at 0.01
+# (order 0.99-1.06); the larger necks 0.5-1.0e-3 at 0.03, the dense cells 1.0-4.1e-4. The gap falls like
+# (a/r)^-0.85 or faster between a/r 0.141 and 0.53 (the smallest exponent measured).
+UNION_FIRST_MESH = {3: (0.01, 1.71e-3, 0.85, 0.75), 4: (0.01, 9.2e-4, 0.85, 0.75)}
+UNION_GAP_ORDER = 0.94
+UNION_NECK0, UNION_NECK_RANGE = 0.141, (0.141, 0.53)
+UNION_FIRST_SIZES = (0.001, 0.3)
 # the tetrahedra of a mesh predicted before meshing (:func:`predicted_tetrahedra`): the constants fitted to 42 meshes
 # (the six cubic cells and two chains at neck sizes 0.005-0.3, a random packing at 0.087 and 0.03), and the margin
 # that puts every measured mesh on the safe side: 64 of them (also the other random packings and the first meshes
 # of the dense-packing study) were predicted 1.04-1.77 times their tetrahedra
 TETRAHEDRA_PER_CIRCLE, TETRAHEDRA_PER_VOLUME, PREDICTION_MARGIN = 315.0, 27.3, 1.3
-UNION_TETRAHEDRA_PER_CIRCLE, UNION_TETRAHEDRA_PER_VOLUME = 315.0, 27.3
+# the union's, fitted to 27 meshes of the three cubic cells (h/r 0.02-0.6, neck sizes 0.01-0.1): with
+# PREDICTION_MARGIN 1.05-2.62 times their tetrahedra; their memory (p = 3 at most 18 kB per tetrahedron beyond the
+# base, p = 4 52 kB, FCC h/r = 0.02 at 0.01, 17 995 tetrahedra) lies within BYTES_PER_ELEMENT
+UNION_TETRAHEDRA_PER_CIRCLE, UNION_TETRAHEDRA_PER_VOLUME = 353.0, 57.7
 # peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured by
 # peak_memory, whole runs: p = 4 at most 41 kB per tetrahedron beyond the base on the six cells of SC, BCC, FCC at
 # h/r = 0.02 and 0.08; p = 3 at most 18 kB, on the largest random packing of the dense-packing study, 106 027
@@ -759,15 +769,16 @@ def mean_neck_ratio(cell: PeriodicCell) -> float:
 
 
 def _rule(neck: str) -> tuple:
-    """``(FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE)`` of the reading ``neck`` (the union's: ``UNION_*``)."""
+    """``(FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE, FIRST_SIZES)`` of the reading ``neck`` (the union's:
+    ``UNION_*``)."""
     if neck == "union":
-        return UNION_FIRST_MESH, UNION_GAP_ORDER, UNION_NECK0, UNION_NECK_RANGE
-    return FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE
+        return UNION_FIRST_MESH, UNION_GAP_ORDER, UNION_NECK0, UNION_NECK_RANGE, UNION_FIRST_SIZES
+    return FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE, FIRST_SIZES
 
 
 def _neck_factor(neck_ratio: float, order: int, neck: str = "newton") -> float:
     """How much coarser than at ``NECK0`` a mesh may be for the same gap when the mean neck is ``neck_ratio``."""
-    first_mesh, gap_order, neck0, neck_range = _rule(neck)
+    first_mesh, gap_order, neck0, neck_range, _ = _rule(neck)
     neck_order = first_mesh[order][2]
     return (float(np.clip(neck_ratio, *neck_range)) / neck0) ** (neck_order / gap_order)
 
@@ -777,26 +788,28 @@ def first_neck_size(rtol: float, neck_ratio: float, order: int, neck: str = "new
     ``neck``: the size whose gap is predicted at ``margin rtol`` (``FIRST_MESH``: ``rtol0`` at ``size0`` for ``a / r
     = NECK0``, the gap falling like ``size^GAP_ORDER`` and like ``(a / r)^-neck_order``; the union's ``UNION_*``),
     within ``FIRST_SIZES``."""
-    first_mesh, gap_order, _, _ = _rule(neck)
+    first_mesh, gap_order, _, _, first_sizes = _rule(neck)
     size0, rtol0, _, margin = first_mesh[order]
     size = size0 * (margin * rtol / rtol0) ** (1.0 / gap_order) * _neck_factor(neck_ratio, order, neck)
-    return float(np.clip(size, *FIRST_SIZES))
+    return float(np.clip(size, *first_sizes))
 
 
 def first_rtol(size: float, neck_ratio: float, order: int, neck: str = "newton") -> float:
     """The ``rtol`` whose first mesh at ``order`` (:func:`first_neck_size`) has neck size ``size``."""
-    first_mesh, gap_order, _, _ = _rule(neck)
+    first_mesh, gap_order, _, _, _ = _rule(neck)
     size0, rtol0, _, margin = first_mesh[order]
     return rtol0 * (size / (size0 * _neck_factor(neck_ratio, order, neck))) ** gap_order / margin
 
 
 def _size_that_fits(circles: NeckCircles, calibration: float, order: int, budget: float) -> float | None:
-    """The finest neck size (down to a fiftieth of ``FIRST_SIZES``' finest) whose solve fits in ``budget`` bytes
-    (``calibration`` times its :func:`predicted_tetrahedra`), or ``None`` if not even the coarsest does."""
+    """The finest neck size (down to a fiftieth of the reading's ``FIRST_SIZES``' finest) whose solve fits in
+    ``budget`` bytes (``calibration`` times its :func:`predicted_tetrahedra`), or ``None`` if not even the coarsest
+    does."""
     def fits(size):
         return memory_estimate(calibration * predicted_tetrahedra(circles, size), order) <= budget
 
-    lo, hi = FIRST_SIZES[0] / 50.0, FIRST_SIZES[1]
+    first_sizes = _rule(circles.neck)[4]
+    lo, hi = first_sizes[0] / 50.0, first_sizes[1]
     if not fits(hi):
         return None
     if fits(lo):
@@ -818,8 +831,9 @@ def _check_fits(cell: PeriodicCell, circles: NeckCircles, size: float, calibrati
         return
     fit = _size_that_fits(circles, calibration, order, budget)
     if fit is None:
-        coarsest = memory_estimate(calibration * predicted_tetrahedra(circles, FIRST_SIZES[1]), order)
-        tail = f"no rtol fits: even neck size {FIRST_SIZES[1]:g} a needs ~{coarsest / 1e9:.1f} GB"
+        coarsest = _rule(circles.neck)[4][1]
+        need = memory_estimate(calibration * predicted_tetrahedra(circles, coarsest), order)
+        tail = f"no rtol fits: even neck size {coarsest:g} a needs ~{need / 1e9:.1f} GB"
     else:
         tail = f"rtol = {rtol_at(fit):.1e} would fit"
     raise ValueError(f"{cell.name}: {what} (neck size {size:.3g} a, ~{elements:.0f} tetrahedra) needs "
