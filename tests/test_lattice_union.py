@@ -85,6 +85,49 @@ def test_union_bounds_bracket_and_close_as_the_mesh_is_refined():
     assert min(b.upper for b in runs) < 2.0 * cell.phi / (3.0 - cell.phi) < cell.phi
 
 
+def _union_chain(h_over_r):
+    """An infinite straight chain along z read as the union (neighbours in x and y far apart): each sphere is cut by
+    the planes z = +-(1 - h/2), a body of revolution."""
+    return lattice.PeriodicCell([[0.0, 0.0, 0.0]], [1.0], [4.0, 4.0, 2.0 - h_over_r], name="chain", neck="union")
+
+
+def _union_chain_reference(h_over_r):
+    """k_eff / kappa of the union chain from an independent solver: the axisymmetric FE (fem_neck.conduction, gmsh
+    triangles graded toward the circle, isoparametric P4; P3 and grading 0.15 agree to 1e-8) of the half body, the
+    unit sphere from its equator to the plane z = l = 1 - h/2; per period the chain is two half bodies in series,
+    k_eff = (K_half / 2) d / (P_x P_y)."""
+    from fem_neck import conduction, shapes
+
+    l = 1.0 - h_over_r / 2.0
+    a = math.sqrt((1.0 - l) * (1.0 + l))
+    profile = shapes.profile_mesh((1.0, 0.0), [("arc", (a, l), 0.0, 1.0, "sphere0")], [[a, l]],
+                                  sizes=shapes.SizeField(grading=0.3))
+    return conduction.solve_profile(profile, 4).K / 2.0 * (2.0 - h_over_r) / 16.0
+
+
+@pytest.mark.parametrize("h", [0.1, 0.3])
+def test_union_chain_bounds_bracket_the_axisymmetric_truncated_sphere(h):
+    # the mirror cell holds an eighth of the sphere cut by the cold plane at its circle: both bounds bracket the
+    # independent axisymmetric value, their gap is 1.8-1.9 times the upper bound's error (measured), and the
+    # exact volume is the sphere less its two caps
+    cell = _union_chain(h)
+    assert cell.phi == pytest.approx((4 / 3 * math.pi - 2 * math.pi * (h / 2) ** 2 * (3 - h / 2) / 3) / (16 * (2 - h)),
+                                     rel=1e-13)
+    b = lattice.solve_bounds(lattice.build_cell_mesh(cell, **lattice.mesh_sizes(0.1)), 3, workers=1)
+    ref = _union_chain_reference(h)
+    assert b.lower < ref < b.upper
+    assert 1.0 < (b.upper - b.lower) / (b.upper - ref) < 3.0
+    assert b.gap < 1e-2
+
+
+@pytest.mark.slow
+def test_union_chain_to_1e4_brackets_the_axisymmetric_truncated_sphere():
+    res = lattice.effective_conductivity(_union_chain(0.3), rtol=1e-4)
+    ref = _union_chain_reference(0.3)
+    assert res.converged and res.k_lower_over_kappa < ref < res.k_upper_over_kappa
+    assert (res.k_upper_over_kappa - res.k_lower_over_kappa) / (res.k_upper_over_kappa - ref) < 3.0
+
+
 def test_union_first_mesh_and_prediction_use_the_unions_own_rule():
     cell = lattice.lattice_cell("fcc", 0.1, neck="union")
     neck = lattice.mean_neck_ratio(cell)
