@@ -100,15 +100,17 @@ NECK0, NECK_RANGE = 0.2, (0.2, 0.5)
 P3_FROM = 3e-4  # the rtol from which the upper bound is P_3 by default (below, P_4)
 # the union reading's first mesh, gap order, neck range and first sizes (as FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE,
 # FIRST_SIZES): its circles are sharper edges (interior angle pi + 2 arccos(a/r)), so its gap falls more slowly with
-# the neck size, measured on its own cells (SC, BCC, FCC; the mean a/r over all bonds, second neighbours included).
-# p = 3: at h/r = 0.02 (a/r = 0.141) 1.17-1.49e-2 apart at size 0.1, 5.4-6.4e-3 at 0.04, 1.28-1.71e-3 at 0.01
-# (gap order 0.94-1.05); SC 0.3, BCC 0.2, FCC 0.2 (a/r 0.53, 0.44, 0.44) 1.2-2.3e-3 at 0.04; SC 0.6, BCC 0.32,
-# FCC 0.3 (phi 0.97-0.976) 0.76-2.4e-3 at 0.1. p = 4: at a/r = 0.141 2.3-2.8e-3 at 0.03, 0.70-0.92e-3 at 0.01
-# (order 0.99-1.06); the larger necks 0.5-1.0e-3 at 0.03, the dense cells 1.0-4.1e-4. The gap falls like
-# (a/r)^-0.85 or faster between a/r 0.141 and 0.53 (the smallest exponent measured).
-UNION_FIRST_MESH = {3: (0.01, 1.71e-3, 0.85, 0.75), 4: (0.01, 9.2e-4, 0.85, 0.75)}
+# the neck size, and it falls with the pore fraction 1 - phi as well (a cell near closure is nearly uniform), like
+# ((1 - phi) / UNION_PORE0)^UNION_PORE_ORDER over UNION_PORE_RANGE. Measured on its own cells (SC, BCC, FCC at h/r
+# 0.02, 0.2-0.3, 0.3-0.6 and near closure; a/r the mean over all bonds, second neighbours included): per cell the
+# gap falls like size^0.83-1.06 (p = 3, BCC h/r = 0.02: 1.49e-2, 6.45e-3, 1.71e-3, 8.25e-4 at 0.1, 0.04, 0.01,
+# 0.0042); fitted at gap order 0.94 to the 37 solves at neck sizes 0.0015-0.04, like (a/r)^-0.747 and
+# (1 - phi)^0.692, rtol0 the largest measured (BCC h/r = 0.32, 2.0 and 2.7 times the fit at p = 3 and 4; SC 0.2-0.8
+# times it, so SC gets a mesh finer than it needs).
+UNION_FIRST_MESH = {3: (0.01, 2.97e-3, 0.747, 0.75), 4: (0.01, 1.87e-3, 0.747, 0.75)}
 UNION_GAP_ORDER = 0.94
-UNION_NECK0, UNION_NECK_RANGE = 0.141, (0.141, 0.53)
+UNION_NECK0, UNION_NECK_RANGE = 0.141, (0.141, 0.70)
+UNION_PORE0, UNION_PORE_ORDER, UNION_PORE_RANGE = 0.3, 0.692, (2e-5, 0.46)
 UNION_FIRST_SIZES = (0.001, 0.3)
 # the tetrahedra of a mesh predicted before meshing (:func:`predicted_tetrahedra`): the constants fitted to 42 meshes
 # (the six cubic cells and two chains at neck sizes 0.005-0.3, a random packing at 0.087 and 0.03), and the margin
@@ -776,29 +778,34 @@ def _rule(neck: str) -> tuple:
     return FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE, FIRST_SIZES
 
 
-def _neck_factor(neck_ratio: float, order: int, neck: str = "newton") -> float:
-    """How much coarser than at ``NECK0`` a mesh may be for the same gap when the mean neck is ``neck_ratio``."""
+def _neck_factor(neck_ratio: float, order: int, neck: str = "newton", pore: float = UNION_PORE0) -> float:
+    """How much coarser than at ``NECK0`` a mesh may be for the same gap when the mean neck is ``neck_ratio`` (and,
+    read as the union, the pore fraction ``pore`` rather than ``UNION_PORE0``)."""
     first_mesh, gap_order, neck0, neck_range, _ = _rule(neck)
     neck_order = first_mesh[order][2]
-    return (float(np.clip(neck_ratio, *neck_range)) / neck0) ** (neck_order / gap_order)
+    factor = (float(np.clip(neck_ratio, *neck_range)) / neck0) ** (neck_order / gap_order)
+    if neck == "union":
+        factor *= (float(np.clip(pore, *UNION_PORE_RANGE)) / UNION_PORE0) ** (-UNION_PORE_ORDER / gap_order)
+    return factor
 
 
-def first_neck_size(rtol: float, neck_ratio: float, order: int, neck: str = "newton") -> float:
+def first_neck_size(rtol: float, neck_ratio: float, order: int, neck: str = "newton",
+                    pore: float = UNION_PORE0) -> float:
     """Neck size of the first mesh at ``order`` of a cell whose mean neck has ``a / r = neck_ratio``, read as
     ``neck``: the size whose gap is predicted at ``margin rtol`` (``FIRST_MESH``: ``rtol0`` at ``size0`` for ``a / r
-    = NECK0``, the gap falling like ``size^GAP_ORDER`` and like ``(a / r)^-neck_order``; the union's ``UNION_*``),
-    within ``FIRST_SIZES``."""
+    = NECK0``, the gap falling like ``size^GAP_ORDER`` and like ``(a / r)^-neck_order``; the union's ``UNION_*``,
+    with its pore fraction ``pore = 1 - phi``), within ``FIRST_SIZES``."""
     first_mesh, gap_order, _, _, first_sizes = _rule(neck)
     size0, rtol0, _, margin = first_mesh[order]
-    size = size0 * (margin * rtol / rtol0) ** (1.0 / gap_order) * _neck_factor(neck_ratio, order, neck)
+    size = size0 * (margin * rtol / rtol0) ** (1.0 / gap_order) * _neck_factor(neck_ratio, order, neck, pore)
     return float(np.clip(size, *first_sizes))
 
 
-def first_rtol(size: float, neck_ratio: float, order: int, neck: str = "newton") -> float:
+def first_rtol(size: float, neck_ratio: float, order: int, neck: str = "newton", pore: float = UNION_PORE0) -> float:
     """The ``rtol`` whose first mesh at ``order`` (:func:`first_neck_size`) has neck size ``size``."""
     first_mesh, gap_order, _, _, _ = _rule(neck)
     size0, rtol0, _, margin = first_mesh[order]
-    return rtol0 * (size / (size0 * _neck_factor(neck_ratio, order, neck))) ** gap_order / margin
+    return rtol0 * (size / (size0 * _neck_factor(neck_ratio, order, neck, pore))) ** gap_order / margin
 
 
 def _size_that_fits(circles: NeckCircles, calibration: float, order: int, budget: float) -> float | None:
@@ -876,15 +883,17 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
     t0 = time.perf_counter()
     neck = mean_neck_ratio(cell)
     circles = neck_circles(cell)
-    size = first_neck_size(rtol, neck, order, cell.neck)
+    pore = 1.0 - cell.phi
+    size = first_neck_size(rtol, neck, order, cell.neck, pore)
     gap_order = _rule(cell.neck)[1]
     calibration = 1.0  # tetrahedra meshed over predicted, where a mesh had more than predicted
 
     def first_fit(fit: float) -> float:
         """The rtol whose first mesh is the finest that fits, at the order that rtol gets (unless one was given)."""
-        reach = first_rtol(fit, neck, order, cell.neck)
+        reach = first_rtol(fit, neck, order, cell.neck, pore)
         if not explicit and default_order(reach) != order:  # p = 4 does not fit, p = 3 from P3_FROM does
-            reach = max(first_rtol(_size_that_fits(circles, calibration, 3, budget), neck, 3, cell.neck), P3_FROM)
+            reach = max(first_rtol(_size_that_fits(circles, calibration, 3, budget), neck, 3, cell.neck, pore),
+                        P3_FROM)
         return reach
 
     what, rtol_at = "the first mesh", first_fit

@@ -135,6 +135,10 @@ def test_union_first_mesh_and_prediction_use_the_unions_own_rule():
     union, pair = lattice.first_neck_size(1e-3, neck, 3, "union"), lattice.first_neck_size(1e-3, neck, 3)
     assert union < pair  # the sharper edge needs a finer mesh for the same gap
     assert lattice.first_rtol(union, neck, 3, "union") == pytest.approx(1e-3, rel=1e-12)
+    # a denser cell (less pore) is closer to uniform: a coarser mesh gives the same gap
+    dense = lattice.first_neck_size(1e-3, neck, 3, "union", pore=0.03)
+    assert dense / union == pytest.approx(10.0 ** (lattice.UNION_PORE_ORDER / lattice.UNION_GAP_ORDER), rel=1e-12)
+    assert lattice.first_rtol(dense, neck, 3, "union", pore=0.03) == pytest.approx(1e-3, rel=1e-12)
     circles = lattice.neck_circles(cell)
     assert circles.neck == "union" and len(circles.a) == len(lattice.local_cluster(
         lattice.PeriodicCell(cell.centres, cell.radii, cell.period), cell.period / 2).bonds)
