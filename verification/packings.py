@@ -17,6 +17,10 @@ positions (the energy of the whole period, its gradient gathered from the 8 imag
 The result is checked (:func:`fem_neck.lattice.check_cell`, the neck sizes and the angular margin between neck
 circles on one sphere) and redrawn from the next attempt until it passes. In a period only a few diameters wide
 the mirror planes act like walls, so these packings jam loose (packing fraction ~0.4, coordination ~4-5).
+
+:func:`union_packing` reads the packing as the union of its spheres (``neck = "union"``, defined at every density):
+step 2 shrinks the jammed packing until the union is as dense as asked, step 3 keeps every neck at least
+``min_neck`` wide, and the necks of one particle may meet.
 """
 
 from __future__ import annotations
