@@ -119,8 +119,9 @@ UNION_FIRST_SIZES = (0.001, 0.3)
 # of the dense-packing study) were predicted 1.04-1.77 times their tetrahedra
 TETRAHEDRA_PER_CIRCLE, TETRAHEDRA_PER_VOLUME, PREDICTION_MARGIN = 315.0, 27.3, 1.3
 # the union's, fitted to 27 meshes of the three cubic cells (h/r 0.02-0.6, neck sizes 0.01-0.1): with
-# PREDICTION_MARGIN 1.05-2.62 times their tetrahedra; their memory (p = 3 at most 18 kB per tetrahedron beyond the
-# base, p = 4 52 kB, FCC h/r = 0.02 at 0.01, 17 995 tetrahedra) lies within BYTES_PER_ELEMENT
+# PREDICTION_MARGIN 1.05-2.62 times their tetrahedra (random union packings of 32-80 spheres: 1.9-3.3 times); their
+# memory (p = 3 at most 18 kB per tetrahedron beyond the base, also on random packings of up to 109 127 tetrahedra;
+# p = 4 at most 52 kB, FCC h/r = 0.02 at 0.01, 17 995 tetrahedra) lies within BYTES_PER_ELEMENT
 UNION_TETRAHEDRA_PER_CIRCLE, UNION_TETRAHEDRA_PER_VOLUME = 353.0, 57.7
 # peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured by
 # peak_memory, whole runs: p = 4 at most 41 kB per tetrahedron beyond the base on the six cells of SC, BCC, FCC at
@@ -440,9 +441,9 @@ def _cell_frame(cell: PeriodicCell, method: str = "newton") -> CellFrame:
 @dataclass(frozen=True)
 class UnionNecks:
     """The necks of the union reading, per bond of a :class:`fem_neck.cluster.Cluster`: the circle where the two
-    spheres meet, of radius ``a``, in the bond's radical plane at the distance ``z_i`` from centre ``i`` along the bond
-    (:func:`fem_neck.geometry.union.lens`); ``h_n = 0``: a neck without length (the fields the meshing reads of a pair neck's
-    :class:`fem_neck.geometry.NeckGeometry`)."""
+    spheres meet, of radius ``a``, in the bond's radical plane at the distance ``z_i`` from centre ``i`` along the
+    bond (:func:`fem_neck.geometry.union.lens`); ``h_n = 0``: a neck without length (the fields the meshing reads of
+    a pair neck's :class:`fem_neck.geometry.NeckGeometry`)."""
 
     a: np.ndarray
     z_i: np.ndarray
