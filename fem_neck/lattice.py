@@ -59,6 +59,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fem_neck.curved import FoldedMesh
 from fem_neck.geometry import check_positive, max_overlap, neck_geometry, overlap_for_neck
 from fem_neck.geometry.union import cut_spheres, lens
 from sinterheat.threads import one_blas_thread
@@ -871,8 +872,9 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
     tetrahedra are predicted (:func:`predicted_tetrahedra`, on the safe side; from the second mesh on scaled up
     if a mesh had more) and the memory of its solve estimated (:func:`memory_estimate`): one that would not fit in
     ``max_memory`` bytes (default: what the machine has available) is refused with a ``ValueError`` naming the
-    estimate and the ``rtol`` that would fit. ``order``: of the upper bound (default
-    :func:`default_order`). ``progress(text)`` reports each mesh.
+    estimate and the ``rtol`` that would fit. A mesh too coarse for the curvature of its surfaces (a curved element
+    folds, :class:`fem_neck.curved.FoldedMesh`) is followed by one twice as fine. ``order``: of the upper bound
+    (default :func:`default_order`). ``progress(text)`` reports each mesh.
     """
     check_positive("rtol", rtol)
     check_cell(cell)
@@ -900,14 +902,21 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
 
     what, rtol_at = "the first mesh", first_fit
     history = []
-    for _ in range(max_meshes):
+    for level in range(max_meshes):
         _check_fits(cell, circles, size, calibration, order, budget, what, rtol_at)
         if progress is not None:
             progress(f"neck size {size:.3g} a")
         cm = build_cell_mesh(cell, **mesh_sizes(size))
         calibration = max(calibration, len(cm.curved.tets) / predicted_tetrahedra(circles, size))
         _check_fits(cell, circles, size, calibration, order, budget, what, rtol_at)
-        b = solve_bounds(cm, order, workers, ALGEBRAIC_SHARE * rtol)
+        try:
+            b = solve_bounds(cm, order, workers, ALGEBRAIC_SHARE * rtol)
+        except FoldedMesh:  # too coarse for the curvature of its surfaces (seen on random union packings)
+            if level == max_meshes - 1:
+                raise
+            what = f"the mesh of neck size {size:.3g} a folds a curved element; the mesh twice as fine"
+            size /= 2.0
+            continue
         history.append({"size_neck": size, "elements": b.elements, "k_upper": b.upper, "k_lower": b.lower,
                         "gap": b.gap, "seconds": time.perf_counter() - t0})
         if b.gap <= rtol:

@@ -158,6 +158,31 @@ def test_union_run_to_a_loose_tolerance_and_its_refusals():
         lattice.check_cell(inside)
 
 
+def test_a_mesh_whose_curved_element_folds_is_followed_by_one_twice_as_fine(monkeypatch):
+    # (a random union packing of 80 spheres folds at neck size 0.1, too coarse for its small patches of sphere)
+    from fem_neck.curved import FoldedMesh
+
+    solve, sizes = lattice.solve_bounds, []
+
+    def folding_once(cm, *args):
+        sizes.append(cm.curved.tets.shape[0])
+        if len(sizes) == 1:
+            raise FoldedMesh("a curved element folds")
+        return solve(cm, *args)
+
+    monkeypatch.setattr(lattice, "solve_bounds", folding_once)
+    levels = []
+    res = lattice.effective_conductivity(lattice.lattice_cell("sc", 0.3, neck="union"), rtol=1e-2, workers=1,
+                                         progress=levels.append)
+    assert res.converged and len(sizes) == 2 and sizes[1] > sizes[0] and len(res.levels) == 1
+    first, second = (float(text.split()[2]) for text in levels)
+    assert second == pytest.approx(first / 2, rel=1e-2)
+    sizes.clear()
+    with pytest.raises(FoldedMesh):  # on the last mesh allowed: reported
+        lattice.effective_conductivity(lattice.lattice_cell("sc", 0.3, neck="union"), rtol=1e-2, workers=1,
+                                       max_meshes=1)
+
+
 @pytest.mark.parametrize("argv, match", [
     (["--kind", "sc", "--neck", "union", "--h-over-r", "0.85"], "valid range 0.02 <= h/r < 0.845299"),
     (["--kind", "fcc", "--neck", "union", "--h-over-r", "0.01"], "valid range 0.02 <= h/r < 0.585786"),
