@@ -10,7 +10,14 @@ Python use::
 ``dem`` needs no gmsh or FE code: it imports only :mod:`fem_neck.geometry` and :mod:`fem_neck.law`.
 """
 
-from dem import jit_cache
+import sys
+
+if sys.argv[:1] == ["-m"]:  # imported by `python -m dem`, before its __main__: Ctrl-C held to one line from here on
+    from sinterheat.startup import hold
+
+    hold("python -m dem")
+
+from dem import jit_cache  # noqa: E402
 
 jit_cache.configure()  # before numba is imported: compiled kernels cached per version of their source
 

@@ -90,6 +90,15 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     root = comm is None or comm.Get_rank() == 0
     if out is not None:
         out = on_root(comm, lambda: run_folder.prepare(out, resume, overwrite))
+    try:
+        return _run_held(scene, out, progress, resume, comm, cls, root)
+    finally:  # the folder is free again however the run ended
+        if out is not None and root:
+            run_folder.unlock(out)
+
+
+def _run_held(scene: Scene, out, progress: bool, resume: bool, comm, cls, root: bool) -> RunResult:
+    """:func:`run` once its folder (if any) is prepared and held."""
     start = time.perf_counter()
     here = _position(scene, out, progress and root)
     restart = run_folder.load(out, scene, scene.engine) if resume else None
@@ -177,27 +186,31 @@ def _run_distributed(scene: Scene, out, progress: bool, resume: bool, overwrite:
     if out is not None:
         out = mpi.agree(comm, lambda: run_folder.prepare(out, False, overwrite) if rank == 0 else None)
         out = comm.bcast(out)
-    engine = DistributedStaticEngine(scene)
-    writer = None
-    if out is not None:
-        from dem.output.pieces import PieceWriter
+    try:
+        engine = DistributedStaticEngine(scene)
+        writer = None
+        if out is not None:
+            from dem.output.pieces import PieceWriter
 
-        writer = PieceWriter(out, scene, engine, rank, comm.Get_size())
-    bar = _progress_bar(scene, engine, progress and rank == 0)
+            writer = PieceWriter(out, scene, engine, rank, comm.Get_size())
+        bar = _progress_bar(scene, engine, progress and rank == 0)
 
-    def advanced(t):
-        if bar is not None:
-            bar.update(min(t - engine.t_start, bar.total) - bar.n)
+        def advanced(t):
+            if bar is not None:
+                bar.update(min(t - engine.t_start, bar.total) - bar.n)
 
-    _advance(engine, scene, bar, writer.observe if writer is not None else None, advanced, None)
-    summary = _summary(scene, engine, None)
-    summary.pop("T", None)
-    if scene.particles.n <= T_LIST_MAX:
-        summary["T"] = engine.gathered_temperatures().tolist()
-    summary["seconds"] = mpi.maximum(comm, time.perf_counter() - start)
-    if writer is not None:
-        writer.finish(summary)
-    return RunResult(summary, engine.temperatures(), engine)
+        _advance(engine, scene, bar, writer.observe if writer is not None else None, advanced, None)
+        summary = _summary(scene, engine, None)
+        summary.pop("T", None)
+        if scene.particles.n <= T_LIST_MAX:
+            summary["T"] = engine.gathered_temperatures().tolist()
+        summary["seconds"] = mpi.maximum(comm, time.perf_counter() - start)
+        if writer is not None:
+            writer.finish(summary)
+        return RunResult(summary, engine.temperatures(), engine)
+    finally:  # rank 0 holds the folder
+        if out is not None and rank == 0:
+            run_folder.unlock(out)
 
 
 def _summary(scene: Scene, engine, restart) -> dict:

@@ -4,7 +4,12 @@ Build (offline, warnings as errors): ``python -m sphinx -W -b html docs docs/_bu
 The pages are Markdown (MyST), so ``tests/test_console_blocks.py`` runs their console blocks as it runs the README's;
 the gallery is built by running every script of ``examples/`` (sphinx-gallery); the API reference is autodoc
 (napoleon) over the packages in ``api_packages``, and ``_ext/api_check.py`` fails the build when one of their public
-functions or classes is missing from it.
+functions or classes is missing from it. The site reads offline: MathJax is served from the build's ``_static``
+(sphinx-mathjax-offline, in the docs extra), and ``_ext/site_check.py`` fails the build when a page loads anything
+from another host or links to a page or anchor that does not exist.
+
+A build of the pages alone, without running the examples: ``python -m sphinx -D plot_gallery=0 -b html docs
+docs/_build`` (the gallery's pages then show the code without its output or figures).
 """
 
 import logging
@@ -12,7 +17,7 @@ import pathlib
 import sys
 
 DOCS = pathlib.Path(__file__).resolve().parent
-sys.path.insert(0, str(DOCS / "_ext"))  # the local extensions (api_check, gallery_order, scene_schema)
+sys.path.insert(0, str(DOCS / "_ext"))  # the local extensions (api_check, gallery_order, scene_schema, site_check)
 logging.getLogger("skfem").setLevel(logging.WARNING)  # its INFO lines (each assembly) would flood the build log
 
 project = "sinterheat"
@@ -24,15 +29,19 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # MathJax 3 copied into _static/mathjax and loaded from there, not from a CDN
     "sphinx.ext.viewcode",
     "sphinx_gallery.gen_gallery",
     "sphinx_copybutton",
     "api_check",
     "scene_schema",
+    "site_check",
 ]
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "gallery/*.ipynb", "gallery/*.py"]
+# sphinx-gallery's run-time tables (sg_execution_times.rst, read them as text) load jQuery from a CDN: not pages
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "gallery/*.ipynb", "gallery/*.py", "sg_execution_times.rst",
+                    "gallery/sg_execution_times.rst"]
 
 # MyST: $...$ and $$...$$ maths, heading anchors for [text](page.md#heading) links
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
@@ -51,6 +60,10 @@ autodoc_default_options = {"undoc-members": True, "member-order": "bysource"}  #
 autodoc_typehints = "description"
 autodoc_typehints_format = "short"
 autodoc_preserve_defaults = True
+# viewcode: a source page's links to the reference use the module the object is documented in, not the first module
+# that named it (following imports sent the classes of dem.engines.contact_heat to anchors under
+# dem.engines.verlet.engine, which imports them)
+viewcode_follow_imported_members = False
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 
@@ -71,6 +84,8 @@ sphinx_gallery_conf = {
 
 html_theme = "furo"
 html_title = "sinterheat"
-html_static_path = []
+html_static_path = ["_static"]
+html_css_files = ["maths.css"]  # display equations without a spurious scroll bar (the file says why)
+html_favicon = "_static/favicon.svg"  # two sintered spheres
 copybutton_prompt_text = "$ "
 copybutton_only_copy_prompt_lines = False

@@ -18,10 +18,13 @@ import numpy as np
 
 from dem import make_scene, run
 
-position = [[0.0, 0.0, 0.0], [0.0, 0.0, 3.94e-3]]  # m: r = 1 and 3 mm, overlap 0.06 mm
+# m: r = 1 and 3 mm, overlap 0.06 mm
+position = [[0.0, 0.0, 0.0], [0.0, 0.0, 3.94e-3]]
 radius = [1.0e-3, 3.0e-3]
-out = pathlib.Path(tempfile.mkdtemp()) / "transient_pair"  # summary.json, timeseries.csv, VTU, plots
-result = run(make_scene(position, radius, [100.0, 0.0], law="rojek", mode="transient", integrator="crank-nicolson",
+# the run's folder: summary.json, timeseries.csv, VTU, plots
+out = pathlib.Path(tempfile.mkdtemp()) / "transient_pair"
+result = run(make_scene(position, radius, [100.0, 0.0], law="rojek",
+                        mode="transient", integrator="crank-nicolson",
                         dt="auto", rtol=1e-4, t_end=0.1), out=out)
 T_i, T_j = result.T
 
@@ -30,19 +33,25 @@ C = result.thermal.network.particles.capacity  # J/K, rho 4/3 pi r^3 c
 rate = K * (1.0 / C[0] + 1.0 / C[1])
 exact = 100.0 * np.exp(-rate * 0.1)
 difference_error = abs((T_i - T_j) - exact) / 100.0
-print(f"t = 0.1 s: T = {T_i:.5f}, {T_j:.5f} C; T_i - T_j = {T_i - T_j:.5f} (closed form {exact:.5f}), "
-      f"{result.summary['steps']} steps, energy error {result.summary['energy_error']:.0e}")
+print(f"t = 0.1 s: T = {T_i:.5f}, {T_j:.5f} C; "
+      f"T_i - T_j = {T_i - T_j:.5f} (closed form {exact:.5f}), "
+      f"{result.summary['steps']} steps, "
+      f"energy error {result.summary['energy_error']:.0e}")
 
 # %%
 # Every step of the run against the closed form (the small particle is the hotter one: T_max).
 steps = np.genfromtxt(out / "timeseries.csv", delimiter=",", names=True)
 t = np.linspace(0.0, 0.1, 400)
-mean = (C[0] * 100.0) / (C[0] + C[1])  # the capacity-weighted mean temperature, conserved
+# the capacity-weighted mean temperature, conserved
+mean = (C[0] * 100.0) / (C[0] + C[1])
+decay = 100.0 * np.exp(-rate * t) / (C[0] + C[1])
 fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
-ax.plot(t * 1e3, mean + C[1] / (C[0] + C[1]) * 100.0 * np.exp(-rate * t), "k-", lw=1, label="closed form")
-ax.plot(t * 1e3, mean - C[0] / (C[0] + C[1]) * 100.0 * np.exp(-rate * t), "k-", lw=1)
-ax.plot(steps["t"] * 1e3, steps["T_max"], "o", ms=4, label="r = 1 mm (Crank-Nicolson steps)")
-ax.plot(steps["t"] * 1e3, steps["T_min"], "s", ms=4, label="r = 3 mm (Crank-Nicolson steps)")
+ax.plot(t * 1e3, mean + C[1] * decay, "k-", lw=1, label="closed form")
+ax.plot(t * 1e3, mean - C[0] * decay, "k-", lw=1)
+ax.plot(steps["t"] * 1e3, steps["T_max"], "o", ms=4,
+        label="r = 1 mm (Crank-Nicolson steps)")
+ax.plot(steps["t"] * 1e3, steps["T_min"], "s", ms=4,
+        label="r = 3 mm (Crank-Nicolson steps)")
 ax.set_xlabel("time t (ms)")
 ax.set_ylabel("particle temperature T (°C)")
 ax.set_title(f"{result.summary['steps']} error-controlled steps, rtol = 1e-4")

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fem_neck.hpmesh import SIGMA
+from fem_neck.law import check_neck
 
 # Conservative exponent of the order p-1 error in the grading factor (observed on the reference semispheres:
 # P1 ~2, P2 3-4, P3 4.5-6), and the grading that meets the reference tolerance in one round.
@@ -139,19 +140,33 @@ def check_hp_order(order, rtol: float) -> int:
     return int(order)
 
 
-def hp_corner_levels(a_over_r: float, rtol: float, sigma: float = SIGMA) -> int:
-    """Geometric refinement levels toward the corner: the corner cell's error ``~ 1e-7 * sigma^(2 lambda (L - 2))``
-    (measured at L = 2) pushed 100x below ``rtol``."""
-    lam = corner_exponent(a_over_r)
-    decades = max(0.0, np.log10(1e-7 / (0.01 * rtol)))
+# The corner cell's relative error at L = 2 levels (measured, largest at the smallest necks): 1e-7 at the re-entrant
+# corner of the neck cylinder; 3e-5 where the union's isothermal disk meets the sphere (2.8e-5 at a/r = 1e-3, 8e-6
+# at 0.3), whose exponent is lower. Each further level divides it by sigma^(-2 lambda) (measured: 5.9 per level for
+# the union's small necks, lambda = 1/2).
+HP_CORNER_ERROR = {"cylinder": 1e-7, "union": 3e-5}
+
+
+def hp_corner_levels(a_over_r: float, rtol: float, sigma: float = SIGMA, neck: str = "cylinder") -> int:
+    """Geometric refinement levels toward the corner: the corner cell's error ``~ c * sigma^(2 lambda (L - 2))``
+    (``c`` = :data:`HP_CORNER_ERROR` of the ``neck``, measured at L = 2) pushed 100x below ``rtol``."""
+    lam = corner_exponent(a_over_r, neck)
+    decades = max(0.0, np.log10(HP_CORNER_ERROR[neck] / (0.01 * rtol)))
     return int(2 + np.ceil(decades / (-2.0 * lam * np.log10(sigma))))
 
 
-def corner_exponent(a_over_r):
-    """Singular exponent ``lambda = pi / (pi + arccos(a/r))`` of the re-entrant corner where a cylindrical neck of
-    radius ``a`` meets a sphere of radius ``r`` (interior angle ``pi + arccos(a/r)``, both faces insulated): the
-    temperature near it varies like ``rho^lambda``, 2/3 for a vanishing neck, 1 (no singularity) at ``a = r``."""
-    return np.pi / (np.pi + np.arccos(np.clip(a_over_r, 0.0, 1.0)))
+def corner_exponent(a_over_r, neck: str = "cylinder"):
+    """Singular exponent ``lambda`` of the temperature at the neck's rim, which varies like ``rho^lambda`` there.
+
+    ``neck = "cylinder"``: the re-entrant corner where a cylindrical neck of radius ``a`` meets a sphere of radius
+    ``r`` (interior angle ``pi + arccos(a/r)``, both faces insulated), ``lambda = pi / (pi + arccos(a/r))``: 2/3 for
+    a vanishing neck, 1 (no singularity) at ``a = r``. ``neck = "union"``: the corner where the isothermal neck disk
+    meets the insulated sphere (interior angle ``omega = pi/2 + arccos(a/r)``, mixed Dirichlet/Neumann, so
+    ``lambda = pi / (2 omega) = pi / (pi + 2 arccos(a/r))``): 1/2 for a vanishing neck (the rim of a disk on a
+    half-space), 1 at ``a = r``.
+    """
+    angle = np.arccos(np.clip(a_over_r, 0.0, 1.0))
+    return np.pi / (np.pi + (2.0 if check_neck(neck) == "union" else 1.0) * angle)
 
 
 MESH_RATIO = 1.6  #: sizes shrink by this factor per level of a mesh sequence

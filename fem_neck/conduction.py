@@ -16,7 +16,8 @@ graded mesh, so the curved sphere surface is followed; ``curved=False`` keeps st
 
 Public API (all plain functions of numbers, safe to call from a process pool; gmsh is opened and closed per mesh):
 
-* :func:`semisphere_conductance` -- the semisphere with a neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Section 5);
+* :func:`semisphere_conductance` -- the semisphere with a neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Section 5),
+  or the half body of the union of spheres (no neck cylinder);
 * :func:`pair_conductance` -- two spheres ``r_i``, ``r_j`` with overlap ``h`` (Section 6);
 * :func:`chain_conductance` -- a collinear chain;
 * :func:`solve_profile` -- one solve on a given mesh and order (for convergence studies).
@@ -37,7 +38,28 @@ from fem_neck.geometry import check_positive, neck_geometry
 @dataclass
 class Solution:
     """One FE solve on one mesh (length-normalised body, ``kappa = 1``): the conductance ``K = K_reaction +
-    geometry_correction``, the basis and the temperature ``u`` (``T = 0`` on ``bottom``, ``1`` on ``top``)."""
+    geometry_correction``, the basis and the temperature ``u`` (``T = 0`` on ``bottom``, ``1`` on ``top``).
+
+    Parameters
+    ----------
+    K : float
+        Conductance of the normalised body (lengths over the length scale, ``kappa = 1``): ``K_reaction +
+        geometry_correction``; times ``kappa`` and the length scale it is in W/K.
+    K_reaction : float
+        ``2 pi`` times the reaction at the ``top`` dofs (normalised, as ``K``).
+    geometry_correction : float
+        The Hadamard correction of :func:`geometry_correction` (normalised, as ``K``).
+    dofs : int
+        Number of unknowns of the solve.
+    order : int
+        Lagrange element order, 1 to 4.
+    basis : skfem.Basis
+        The FE basis on the (curved) mesh.
+    u : numpy.ndarray
+        Temperature at the dofs of ``basis`` (dimensionless: 0 on ``bottom``, 1 on ``top``).
+    matrix : scipy.sparse.csr_matrix
+        The assembled axisymmetric stiffness matrix (before the temperatures were fixed).
+    """
 
     K: float
     K_reaction: float
@@ -53,14 +75,44 @@ class Solution:
 class Result:
     """A conductance solved to a tolerance.
 
-    K: conductance in W/K for the given ``kappa`` and lengths. K_over_Kcyl: ``K / (kappa pi r)`` with ``r`` the
-    sphere radius (semisphere) or the smallest radius (pair, chain) -- the normalisation of Rojek 2022, eqs. 38-39.
-    error_estimate: relative error estimate of ``K`` (see :mod:`fem_neck.accuracy`); converged: whether it met
-    the tolerance. dofs: unknowns of the reported solve; seconds: wall time of meshing and all solves; h_min:
-    shortest mesh edge (in the input length unit); grading: final size-per-corner-distance factor; order: element
-    order of the reported solve; rounds: meshes tried. necks: neck radius per bond (input length unit).
-    solution, profile, length_scale, kappa: what :mod:`fem_neck.render` needs (dropped when pickled, so results
-    travel cheaply between processes).
+    ``solution`` and ``profile`` are what :mod:`fem_neck.render` needs; they are dropped when the result is pickled,
+    so results travel cheaply between processes.
+
+    Parameters
+    ----------
+    K : float
+        Conductance in W/K for the given ``kappa`` and lengths.
+    K_over_Kcyl : float
+        ``K / (kappa pi r)`` (dimensionless) with ``r`` the sphere radius (semisphere) or the smallest radius (pair,
+        chain): the normalisation of Rojek 2022, eqs. 38-39.
+    error_estimate : float
+        Relative error estimate of ``K`` (dimensionless; :mod:`fem_neck.accuracy`).
+    converged : bool
+        Whether the estimate met the tolerance asked for.
+    dofs : int
+        Unknowns of the reported solve.
+    seconds : float
+        Wall time of the meshing and all solves, s.
+    h_min : float
+        Shortest mesh edge, in the unit of the input lengths (m for pairs and chains; units of r for the
+        semisphere).
+    grading : float
+        Final mesh size per distance from the neck corner (dimensionless; the hp path's geometric ratio).
+    order : int
+        Element order of the reported solve.
+    rounds : int
+        Meshes (gmsh path) or orders (hp path) tried.
+    necks : list of float
+        Neck radius of each bond, in the unit of the input lengths.
+    kappa : float
+        Thermal conductivity the conductance is for, W/(m K).
+    length_scale : float
+        The length the body was normalised by before meshing, in the unit of the input lengths.
+    solution : Solution or None
+        The reported solve (None after unpickling).
+    profile : object
+        The meshed profile (:class:`fem_neck.shapes.ProfileMesh`, or the hp quadrilateral mesh); None after
+        unpickling.
     """
 
     K: float
@@ -103,9 +155,32 @@ def _axisymmetric_laplace():
 def solve_profile(profile: shapes.ProfileMesh, order: int = 2, curved: bool = True, mesh=None) -> Solution:
     """Solve ``div(x grad T) = 0`` with ``T = 0`` on ``bottom``, ``1`` on ``top``; ``K = 2 pi (reaction)``, kappa = 1.
 
-    ``curved`` uses the isoparametric quadratic mesh (:func:`fem_neck.shapes.curved_mesh`; pass it as ``mesh`` to
-    reuse it across orders); P1 is always affine. The SPD system is factorised by SuperLU in symmetric mode with a
-    minimum-degree ordering of ``A + A^T`` (3x faster than its default column ordering here).
+    The SPD system is factorised by SuperLU in symmetric mode with a minimum-degree ordering of ``A + A^T`` (3x
+    faster than its default column ordering here).
+
+    Parameters
+    ----------
+    profile : fem_neck.shapes.ProfileMesh
+        The meshed meridian profile (lengths normalised), with its ``top`` and ``bottom`` boundaries and its arcs.
+    order : int
+        Lagrange element order, 1 to 4.
+    curved : bool
+        Solve on the isoparametric quadratic mesh (:func:`fem_neck.shapes.curved_mesh`) that follows the spheres;
+        False keeps straight sides (studies only). P1 is always affine.
+    mesh : skfem.MeshTri2, optional
+        The curved mesh of ``profile``, made once and passed to reuse it across orders.
+
+    Returns
+    -------
+    Solution
+        The conductance of the normalised body (``kappa = 1``), its basis and temperatures.
+
+    Raises
+    ------
+    ValueError
+        ``order`` not 1 to 4.
+    RuntimeError
+        The FE basis failed on a degenerate (round-off flat) element.
     """
     import skfem
     from scipy.sparse.linalg import splu
@@ -143,6 +218,22 @@ def geometry_correction(profile: shapes.ProfileMesh, basis, u, points: int = 8) 
     Gauss points along the edge (taken in the reference triangle, so no point inversion is needed); ``kappa = 1``,
     ``Delta T = 1``, ``dS = 2 pi x ds``. It removes the ``O(h^4)`` geometric error of quadratic boundaries to
     second order (measured: P4 from -3e-6 to 1e-8 on the reference semisphere).
+
+    Parameters
+    ----------
+    profile : fem_neck.shapes.ProfileMesh
+        The meshed profile: its straight mesh and its arcs (centre height and radius of each sphere's boundary).
+    basis : skfem.Basis
+        The basis ``u`` lives on (straight or curved mesh of ``profile``).
+    u : numpy.ndarray
+        Temperature at the dofs of ``basis`` (0 on ``bottom``, 1 on ``top``).
+    points : int
+        Gauss points per boundary edge.
+
+    Returns
+    -------
+    float
+        ``dK`` for the normalised body (``kappa = 1``, lengths normalised), to add to the reaction conductance.
     """
     import skfem
 
@@ -197,31 +288,53 @@ METHODS = ("hp", "gmsh")
 
 
 def semisphere_conductance(a_over_r: float, rtol: float = 1e-4, order: int | None = None,
-                           method: str = "hp") -> Result:
+                           method: str = "hp", neck: str = "cylinder") -> Result:
     """Conductance of the semisphere with a cylindrical neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Sec. 5, Fig. 12).
 
-    ``a_over_r`` in [1e-4, 1): neck radius over sphere radius (from an overlap: ``fem_neck.geometry.
-    equal_neck_radius``; the inverse is ``overlap_for_neck``). The half-neck height is ``h_n/2`` of the
-    volume-conserving neck (eqs. 19-20). ``K_over_Kcyl = K / pi`` (eqs. 38-39). ``rtol``: relative tolerance of
-    ``K`` (default 1e-4).
+    ``neck = "cylinder"`` (default): the half-neck height is ``h_n/2`` of the volume-conserving neck (eqs. 19-20);
+    ``neck = "union"``: the half body of the union of spheres, no neck cylinder, ``T = 1`` on the disk of radius ``a``
+    at the cap base ``z_i = sqrt(1 - a^2)``. ``K_over_Kcyl = K / pi`` (eqs. 38-39).
 
-    ``method``: ``"hp"`` (default) -- curved spectral elements on a geometric quadrilateral mesh with the exact
-    sphere (:mod:`fem_neck.hpmesh`, :mod:`fem_neck.spectral`): the order is raised on one mesh until two
-    consecutive orders agree to ``rtol``; ``order`` is then the first order tried (2 to 11, default from ``rtol``).
-    ``"gmsh"`` -- the triangle path shared with pairs and chains (graded gmsh mesh, P2-P4, regraded until orders
-    ``p - 1`` and ``p`` agree; ``order`` 2, 3 or 4); an independent discretisation for cross-checks.
+    Parameters
+    ----------
+    a_over_r : float
+        Neck radius over sphere radius (dimensionless), in ``[1e-4, 1)``; from an overlap:
+        ``fem_neck.geometry.equal_neck_radius`` (the inverse is ``overlap_for_neck``).
+    rtol : float
+        Relative tolerance of ``K`` (dimensionless).
+    order : int, optional
+        The first element order tried: 2 to 11 for ``"hp"``, 2, 3 or 4 for ``"gmsh"``; default from ``rtol``.
+    method : str
+        ``"hp"`` -- curved spectral elements on a geometric quadrilateral mesh with the exact sphere
+        (:mod:`fem_neck.hpmesh`, :mod:`fem_neck.spectral`), the order raised on one mesh until two consecutive
+        orders agree to ``rtol``; ``"gmsh"`` -- the triangle path shared with pairs and chains (graded gmsh mesh,
+        P2-P4, regraded until orders ``p - 1`` and ``p`` agree), an independent discretisation for cross-checks.
+    neck : str
+        The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"``, Rojek's volume-conserving neck, or ``"union"``,
+        the union of spheres (no neck cylinder).
+
+    Returns
+    -------
+    Result
+        ``K`` for ``r = 1`` and ``kappa = 1`` (times ``kappa r`` it is in W/K), with its error estimate.
+
+    Raises
+    ------
+    ValueError
+        ``a_over_r``, ``rtol``, ``order``, ``method`` or ``neck`` out of range (the message names it).
     """
     a_over_r = float(a_over_r)
-    shapes.semisphere_profile(a_over_r)  # validates before any meshing
+    shapes.semisphere_profile(a_over_r, neck=neck)  # validates before any meshing
     if method == "gmsh":
-        return _to_tolerance(lambda g: shapes.semisphere_mesh(a_over_r, grading=g), 1.0, 1.0, 1.0, rtol, order,
-                             [a_over_r])
+        return _to_tolerance(lambda g: shapes.semisphere_mesh(a_over_r, grading=g, neck=neck), 1.0, 1.0, 1.0, rtol,
+                             order, [a_over_r])
     if method != "hp":
         raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
     rtol = accuracy.check_rtol(rtol)
     order = accuracy.check_hp_order(order, rtol)
     start = time.perf_counter()
-    mesh, shape = hpmesh.semisphere_quad_mesh(a_over_r, accuracy.hp_corner_levels(a_over_r, rtol))
+    levels = accuracy.hp_corner_levels(a_over_r, rtol, neck=neck)
+    mesh, shape = hpmesh.semisphere_quad_mesh(a_over_r, levels, neck=neck)
     return _hp_to_tolerance(mesh, hpmesh.end_disks(mesh, shape), rtol, order, start, 1.0, 1.0, 1.0, [a_over_r])
 
 
@@ -252,8 +365,31 @@ def _hp_to_tolerance(mesh, fixed: dict, rtol: float, p: int, start: float, kappa
 def chain_conductance(radii, overlaps, kappa: float, rtol: float = 1e-4, order: int | None = None) -> Result:
     """Conductance (W/K) between the outer equatorial planes of a collinear chain of sintered spheres.
 
-    ``radii``: N sphere radii (m); ``overlaps``: N-1 overlaps ``h = r_k + r_(k+1) - d`` (m), each neck from the
-    volume-conserving model (Rojek 2022, eqs. 21-33); ``kappa`` in W/(m K). ``K_over_Kcyl`` uses the smallest radius.
+    Each neck is the volume-conserving model's (Rojek 2022, eqs. 21-33); the graded gmsh path, orders ``p - 1`` and
+    ``p`` compared.
+
+    Parameters
+    ----------
+    radii : array_like
+        The N sphere radii along the chain, m, each > 0 (neighbours at most 1e6 apart).
+    overlaps : array_like
+        The N - 1 overlaps ``h = r_k + r_(k+1) - d`` of neighbouring spheres, m.
+    kappa : float
+        Thermal conductivity, W/(m K), > 0.
+    rtol : float
+        Relative tolerance of ``K`` (dimensionless).
+    order : int, optional
+        Element order 2, 3 or 4; default from ``rtol``.
+
+    Returns
+    -------
+    Result
+        ``K`` in W/K; ``K_over_Kcyl`` uses the smallest radius.
+
+    Raises
+    ------
+    ValueError
+        A radius, overlap (named by its bond), ``kappa``, ``rtol`` or ``order`` out of range.
     """
     kappa = float(check_positive("kappa", kappa))
     radii = np.atleast_1d(check_positive("radii", radii)).astype(float)
@@ -268,11 +404,36 @@ def pair_conductance(r_i: float, r_j: float, h: float, kappa: float, rtol: float
                      order: int | None = None, method: str = "auto") -> Result:
     """Conductance (W/K) of two sintered spheres between their outer equatorial planes (Rojek 2022, Sec. 6).
 
-    ``method``: ``"hp"`` -- the two halves of :func:`fem_neck.hpmesh.pair_quad_mesh`, order raised until two orders
-    agree (necks ``1e-4 <= a / r_min < 1``); ``"gmsh"`` -- the chain of two, :func:`chain_conductance` ``([r_i,
-    r_j], [h], kappa)``; ``"auto"`` (default) -- hp (the gmsh path only to refuse too thin a neck). At the model's
-    limit ``h = max_overlap`` (``a = r_min``, the smaller sphere's surface vanishes) both refuse.
-    ``K_over_Kcyl`` uses the smaller radius.
+    At the model's limit ``h = max_overlap`` (``a = r_min``, the smaller sphere's surface vanishes) both methods
+    refuse.
+
+    Parameters
+    ----------
+    r_i, r_j : float
+        The two sphere radii, m, > 0 and at most 1e6 apart.
+    h : float
+        Overlap ``r_i + r_j - d`` of the spheres whose centres are ``d`` apart, m (the neck from the
+        volume-conserving model, Rojek 2022, eqs. 21-33).
+    kappa : float
+        Thermal conductivity, W/(m K), > 0.
+    rtol : float
+        Relative tolerance of ``K`` (dimensionless).
+    order : int, optional
+        The first element order tried (hp: 2 to 11; gmsh: 2, 3 or 4); default from ``rtol``.
+    method : str
+        ``"hp"`` -- the two halves of :func:`fem_neck.hpmesh.pair_quad_mesh`, order raised until two orders agree
+        (necks ``1e-4 <= a / r_min < 1``); ``"gmsh"`` -- the chain of two, :func:`chain_conductance`
+        ``([r_i, r_j], [h], kappa)``; ``"auto"`` -- hp (the gmsh path only to refuse too thin a neck).
+
+    Returns
+    -------
+    Result
+        ``K`` in W/K; ``K_over_Kcyl`` uses the smaller radius.
+
+    Raises
+    ------
+    ValueError
+        A radius, ``h``, ``kappa``, ``rtol``, ``order`` or ``method`` out of range (the message names it).
     """
     geo = neck_geometry(check_positive("r_i", r_i), check_positive("r_j", r_j), h)  # names the bad argument
     kappa = float(check_positive("kappa", kappa))

@@ -14,9 +14,12 @@
 * :func:`run_fit` -- all of it, writing ``fit.json`` (read by the DEM), ``fit.csv`` and ``fit.png`` (the Fig. 16
   analogue) into one folder.
 
+Every step takes ``neck``: ``"cylinder"`` (default) sweeps and fits the semisphere with Rojek's neck cylinder,
+``"union"`` the half body of the union of spheres (no cylinder; A = 1/pi), and fit.json records which.
+
 The FE solver is named by ``"module:function"`` (default :data:`SOLVER`, ``semisphere_conductance(a_over_r,
-rtol, method=...)`` returning an object with ``K_over_Kcyl``, ``error_estimate`` and ``dofs``), so worker processes
-import it; ``method`` (default :data:`METHOD`) is passed to it.
+rtol, method=..., neck=...)`` returning an object with ``K_over_Kcyl``, ``error_estimate`` and ``dofs``), so worker
+processes import it; ``method`` (default :data:`METHOD`) and ``neck`` are passed to it.
 """
 
 from __future__ import annotations
@@ -32,7 +35,8 @@ import numpy as np
 
 from sinterheat.interrupt import where
 from sinterheat.pool import run_jobs
-from fem_neck.law import A_LOG, ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, neck_resistance
+from fem_neck.law import (A_LOG, A_LOG_UNION, ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, check_neck,
+                          half_neck_resistance)
 
 SOLVER = "fem_neck.conduction:semisphere_conductance"  #: the FE solver of a sweep point
 METHOD = "hp"  #: the discretisation passed to it
@@ -40,12 +44,14 @@ X_MAX = 0.97  # the sweep's largest a/r
 X_SMALL = (0.001, 0.02)  # the log-spaced small-neck block
 LINEAR_RANGE = 0.7  # Rojek 2022, Section 5: "up to nearly a/r = 0.7 ... linear"
 PAPER_H_OVER_R = (0.02, 0.08, 0.2, 0.4)  # the four cases of Rojek 2022, Figs. 13-14
-CSV_FIELDS = ("a_over_r", "K_over_Kcyl", "error_estimate", "dofs", "seconds", "rtol", "uniform", "solver", "method")
+CSV_FIELDS = ("a_over_r", "K_over_Kcyl", "error_estimate", "dofs", "seconds", "rtol", "uniform", "solver", "method",
+              "neck")
 
 
 @dataclass(frozen=True)
 class FitPoint:
-    """One FE solve of the semisphere with a neck: K/K_cyl at a/r to the tolerance ``rtol``."""
+    """One FE solve of the semisphere with a neck (or the union's half body): K/K_cyl at a/r to the tolerance
+    ``rtol``."""
 
     a_over_r: float
     K_over_Kcyl: float
@@ -56,6 +62,7 @@ class FitPoint:
     uniform: bool  # part of the uniform-in-a/r sampling used by the linear fit
     solver: str = SOLVER  # "module:function" that solved it
     method: str = METHOD  # the method passed to the solver
+    neck: str = "cylinder"  # the half body solved (fem_neck.law.NECKS)
 
 
 def sweep_points(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -80,19 +87,20 @@ def _key(x: float) -> str:
     return f"{x:.12g}"
 
 
-def _solve_point(solver: str, method: str, a_over_r: float, rtol: float) -> dict:
+def _solve_point(solver: str, method: str, neck: str, a_over_r: float, rtol: float) -> dict:
     """Worker: import the solver by name and solve one point (runs in a child process)."""
     module, func = solver.split(":")
     t0 = time.perf_counter()
-    res = getattr(importlib.import_module(module), func)(a_over_r, rtol=rtol, method=method)
+    res = getattr(importlib.import_module(module), func)(a_over_r, rtol=rtol, method=method, neck=neck)
     return {"a_over_r": a_over_r, "K_over_Kcyl": float(res.K_over_Kcyl),
             "error_estimate": float(res.error_estimate), "dofs": int(res.dofs),
-            "seconds": time.perf_counter() - t0, "rtol": rtol, "solver": solver, "method": method}
+            "seconds": time.perf_counter() - t0, "rtol": rtol, "solver": solver, "method": method, "neck": neck}
 
 
 def read_points(path) -> dict:
     """Points already in a ``fit.csv``, keyed by a/r (a CSV without solver and method columns -- written before
-    they were recorded -- gives points of unknown provenance: empty ``solver`` and ``method``)."""
+    they were recorded -- gives points of unknown provenance: empty ``solver`` and ``method``; one without a neck
+    column was written before the union existed: ``neck = "cylinder"``)."""
     path = pathlib.Path(path)
     if not path.exists():
         return {}
@@ -103,18 +111,19 @@ def read_points(path) -> dict:
                 p = FitPoint(float(row["a_over_r"]), float(row["K_over_Kcyl"]), float(row["error_estimate"]),
                              int(row["dofs"]), float(row["seconds"]), float(row["rtol"]),
                              row["uniform"] in ("1", "True", "true"), row.get("solver") or "",
-                             row.get("method") or "")
+                             row.get("method") or "", row.get("neck") or "cylinder")
             except (KeyError, ValueError, TypeError):
                 continue  # a half-written last line of an interrupted run
             out[_key(p.a_over_r)] = p
     return out
 
 
-def reusable_points(path, rtol: float, solver: str = SOLVER, method: str = METHOD) -> tuple[dict, int]:
-    """The points of a ``fit.csv`` computed by ``solver`` with ``method`` to exactly ``rtol`` (keyed by a/r), and
-    how many other points the file holds (other solver, method or tolerance: they are not reused)."""
+def reusable_points(path, rtol: float, solver: str = SOLVER, method: str = METHOD,
+                    neck: str = "cylinder") -> tuple[dict, int]:
+    """The points of a ``fit.csv`` computed by ``solver`` with ``method`` for ``neck`` to exactly ``rtol`` (keyed by
+    a/r), and how many other points the file holds (other solver, method, neck or tolerance: they are not reused)."""
     points = read_points(path)
-    same = {k: p for k, p in points.items() if (p.solver, p.method, p.rtol) == (solver, method, rtol)}
+    same = {k: p for k, p in points.items() if (p.solver, p.method, p.neck, p.rtol) == (solver, method, neck, rtol)}
     return same, len(points) - len(same)
 
 
@@ -134,9 +143,9 @@ def _append(path: pathlib.Path, point: FitPoint) -> None:
 
 def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int | None = None,
           solver: str = SOLVER, method: str = METHOD, progress: bool = True, reuse=None,
-          meanwhile=None) -> list[FitPoint]:
-    """Solve the semisphere at every a/r to ``rtol`` on ``workers`` processes (default: all cores), or on the Dask
-    cluster of :func:`sinterheat.pool.use_dask`.
+          meanwhile=None, neck: str = "cylinder") -> list[FitPoint]:
+    """Solve the semisphere (``neck = "cylinder"``) or the union's half body (``"union"``) at every a/r to ``rtol``
+    on ``workers`` processes (default: all cores), or on the Dask cluster of :func:`sinterheat.pool.use_dask`.
 
     ``reuse``: points solved before, keyed by a/r (:func:`reusable_points`); those at the sweep's a/r are kept
     instead of solved. With ``csv_path`` the CSV is rewritten with the kept points and each new point is appended
@@ -145,6 +154,7 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
     """
     if not (isinstance(rtol, float) and 0.0 < rtol < 0.1):
         raise ValueError(f"rtol = {rtol!r}: must be a float in (0, 0.1)")
+    check_neck(neck)
     x = np.asarray(a_over_r, dtype=float)
     uniform = np.asarray(uniform, dtype=bool)
     csv_path = pathlib.Path(csv_path) if csv_path is not None else None
@@ -161,7 +171,7 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
             here.update(out=csv_path.parent)
     if todo:
         importlib.import_module(solver.split(":")[0])  # fail early in the parent, and let fork start warm
-    jobs = [(_solve_point, (solver, method, xi, rtol)) for xi, _ in todo]
+    jobs = [(_solve_point, (solver, method, neck, xi, rtol)) for xi, _ in todo]
     uniform_of = {_key(xi): ui for xi, ui in todo}
     for res in run_jobs(jobs, workers, desc="fit sweep", unit="solve", progress=progress, done=len(points),
                         meanwhile=meanwhile):
@@ -191,24 +201,28 @@ def _law_basis(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return p0, F
 
 
-def fit_law(a_over_r, k_over_kcyl, A: float = A_LOG) -> ConductanceLaw:
-    """Fit B, C, E of the full-range law (A fixed, default the derived 5/(4 pi)) to FE points, 0 < a/r < 1.
+def fit_law(a_over_r, k_over_kcyl, A: float | None = None, neck: str = "cylinder") -> ConductanceLaw:
+    """Fit B, C, E of the full-range law for ``neck`` (A fixed, default the derived :data:`fem_neck.law.A_LOG` =
+    5/(4 pi) for the neck cylinder, :data:`fem_neck.law.A_LOG_UNION` = 1/pi for the union) to FE points,
+    0 < a/r < 1.
 
     Least squares on the relative residual: ``1/f - lambda = pi/(4x) P`` is linear in the parameters; Gauss-Newton
     on the exact relative residual ``f_law/f_FE - 1`` from that linear start converges in a few steps.
     """
+    A = (A_LOG if check_neck(neck) == "cylinder" else A_LOG_UNION) if A is None else A
     x = np.asarray(a_over_r, dtype=float)
     f = np.asarray(k_over_kcyl, dtype=float)
     if x.size < len(PARAMETERS):
         raise ValueError(f"points = {x.size}: the law needs at least {len(PARAMETERS)} FE points")
+    lam = np.asarray(half_neck_resistance(x, neck))
     p0, F = _law_basis(x)
     p0, F = p0 + A * F[:, 0], F[:, 1:]
-    p_data = (1.0 / f - np.asarray(neck_resistance(x))) * 4.0 * x / np.pi
+    p_data = (1.0 / f - lam) * 4.0 * x / np.pi
     weight = f * np.pi / (4.0 * x)  # d(rel. residual)/dP to first order
     params, *_ = np.linalg.lstsq(F * weight[:, None], (p_data - p0) * weight, rcond=None)
     for _ in range(8):
         p = p0 + F @ params
-        f_law = x / (x * neck_resistance(x) + 0.25 * np.pi * p)
+        f_law = x / (x * lam + 0.25 * np.pi * p)
         r = f_law / f - 1.0
         jac = -(f_law**2 / f * np.pi / (4.0 * x))[:, None] * F
         step, *_ = np.linalg.lstsq(jac, -r, rcond=None)
@@ -216,26 +230,34 @@ def fit_law(a_over_r, k_over_kcyl, A: float = A_LOG) -> ConductanceLaw:
         if np.max(np.abs(step)) < 1e-13:
             break
     fit_range = (round(float(x.min()), 12), round(float(x.max()), 12))
-    law = ConductanceLaw(A, *map(float, params), fit_range=fit_range)
+    law = ConductanceLaw(A, *map(float, params), fit_range=fit_range, neck=neck)
     resid = np.asarray(law.k_over_kcyl(x)) / f - 1.0
-    return ConductanceLaw(A, *map(float, params), fit_range=fit_range, max_rel_residual=float(np.abs(resid).max()))
+    return ConductanceLaw(A, *map(float, params), fit_range=fit_range, max_rel_residual=float(np.abs(resid).max()),
+                          neck=neck)
 
 
 def slope_sensitivity(law: ConductanceLaw) -> dict:
     """The least-squares slope c of eq. (40) under other samplings, evaluated on the (FE-fitted) law.
 
     Keys: continuous uniform a/r on (0, 0.6], (0, 0.7], (0, 0.8]; uniform in h/r for a/r <= 0.7; the paper's four
-    h/r of Figs. 13-14 (their a/r reach 0.83).
+    h/r of Figs. 13-14 (their a/r reach 0.83). The overlap h of two equal spheres gives a/r through the law's neck:
+    the volume-conserving neck (eqs. 18-20) for ``law.neck = "cylinder"``, the circle where the spheres meet,
+    ``a = sqrt(h (r - h/4))``, for the union.
     """
     from fem_neck.geometry import neck_radius, overlap_for_neck
+    from fem_neck.geometry.union import lens
 
     def cont(x):
         return linear_slope(x, law.k_over_kcyl(x), x_max=1.0)
 
+    def a_over_r(h):
+        return np.asarray(neck_radius(1.0, 1.0, h) if law.neck == "cylinder" else lens(1.0, 1.0, 2.0 - h).a)
+
     dense = lambda hi: np.linspace(hi / 4000, hi, 4000)  # noqa: E731 - midpoint-free uniform grid
-    h_max = overlap_for_neck(1.0, 1.0, LINEAR_RANGE)
-    x_h = np.asarray(neck_radius(1.0, 1.0, np.linspace(h_max / 4000, h_max, 4000)))
-    x_paper = np.asarray(neck_radius(1.0, 1.0, np.array(PAPER_H_OVER_R)))
+    h_max = (overlap_for_neck(1.0, 1.0, LINEAR_RANGE) if law.neck == "cylinder"
+             else 2.0 * LINEAR_RANGE**2 / (1.0 + np.sqrt(1.0 - LINEAR_RANGE**2)))  # a = 0.7: h = 2 (1 - sqrt(1 - a^2))
+    x_h = a_over_r(np.linspace(h_max / 4000, h_max, 4000))
+    x_paper = a_over_r(np.array(PAPER_H_OVER_R))
     return {
         "uniform_a_over_r_to_0.6": cont(dense(0.6)),
         "uniform_a_over_r_to_0.7": cont(dense(0.7)),
@@ -267,7 +289,7 @@ def plot(points: list[FitPoint], slope: float, law: ConductanceLaw, path) -> Non
     ax.plot(xs, ARGENTO_BOUVARD.slope * xs, "-.", color="C3",
             label=f"Argento-Bouvard eq. 42, c = {ARGENTO_BOUVARD.slope:.3f}")
     ax.plot(xs[:120], 4 / np.pi * xs[:120], lw=0.8, color="grey", label="constriction limit (4/pi) a/r")
-    ax.set(xlabel="a/r", ylabel="K / K_cyl", xlim=(0, 1), ylim=(0, 1.6))
+    ax.set(xlabel="a/r", ylabel="K / K_cyl", xlim=(0, 1), ylim=(0, max(1.6, 1.1 * f.max())))  # union: f -> inf
     ax.legend(fontsize=8)
     axr.axhspan(-0.5, 0.5, color="C0", alpha=0.10, label="+-0.5 % target")
     axr.plot(x, 100 * (np.asarray(law.k_over_kcyl(x)) / f - 1.0), "o-", ms=3, lw=0.8, color="C0",
@@ -291,27 +313,30 @@ def import_plotting() -> None:
 
 def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | None = None,
             solver: str = SOLVER, method: str = METHOD, progress: bool = True, plot_png: bool = True,
-            fresh: bool = False) -> dict:
+            fresh: bool = False, neck: str = "cylinder") -> dict:
     """Sweep, fit and (with ``out``) write fit.json, fit.csv and fit.png; returns the content of fit.json.
 
-    Points of an existing ``out/fit.csv`` solved by the same ``solver`` and ``method`` to the same ``rtol`` are
-    reused unless ``fresh``; ``reused`` in the result says how many (``points``, ``of``, and ``not_matching``: the
-    file's points from other settings, recomputed).
+    ``neck``: the half body swept and fitted, ``"cylinder"`` (the semisphere with Rojek's neck, default) or
+    ``"union"`` (the union of spheres); fit.json records it as ``neck``, which
+    :meth:`fem_neck.law.ConductanceLaw.from_json` reads. Points of an existing ``out/fit.csv`` solved by the same
+    ``solver``, ``method`` and ``neck`` to the same ``rtol`` are reused unless ``fresh``; ``reused`` in the result
+    says how many (``points``, ``of``, and ``not_matching``: the file's points from other settings, recomputed).
     """
     t0 = time.perf_counter()
+    check_neck(neck)
     x, uniform = sweep_points(n_points)
     out = pathlib.Path(out) if out is not None else None
     csv_path = out / "fit.csv" if out is not None else None
-    reuse, other = reusable_points(csv_path, rtol, solver, method) if csv_path and not fresh else ({}, 0)
+    reuse, other = reusable_points(csv_path, rtol, solver, method, neck) if csv_path and not fresh else ({}, 0)
     points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, method=method,
                    progress=progress, reuse=reuse,
-                   meanwhile=import_plotting if out is not None and plot_png else None)
+                   meanwhile=import_plotting if out is not None and plot_png else None, neck=neck)
     reused = sum(_key(xi) in reuse for xi in x)
     xa = np.array([p.a_over_r for p in points])
     fa = np.array([p.K_over_Kcyl for p in points])
     um = np.array([p.uniform for p in points])
     slope = linear_slope(xa[um], fa[um])
-    law = fit_law(xa, fa)
+    law = fit_law(xa, fa, neck=neck)
     result = {
         "slope": slope,
         "sampling": f"least squares through the origin on the {int(np.sum(um & (xa <= LINEAR_RANGE)))} FE points "
@@ -325,6 +350,7 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
         "paper": {"rojek_eq40": ROJEK.slope, "argento_bouvard_eq42": ARGENTO_BOUVARD.slope},
         "solver": solver,
         "method": method,
+        "neck": neck,
         "reused": {"points": reused, "of": len(x), "not_matching": other},
         "cpu_seconds": float(sum(p.seconds for p in points)),
         "seconds": time.perf_counter() - t0,

@@ -2,14 +2,16 @@
 
 The body (sphere radius 1, neck radius ``a``, meridian half-plane, ``x`` radial) is the sphere cut at its equator
 ``z = 0`` and at the cap base ``z_i = sqrt(1 - a^2)``, plus the half neck ``[0, a] x [z_i, z_i + t]`` with
-``t = h_n / 2`` (eqs. 19-20). The temperature is singular at the re-entrant corner ``C = (a, z_i)``; an hp method
+``t = h_n / 2`` (eqs. 19-20) -- or, for the *union* of spheres, no neck cylinder at all (``t = 0``: the end disk is
+the cap base itself, the circle where two spheres meet). The temperature is singular at the corner ``C = (a, z_i)``
+(re-entrant with the cylinder; with the union, where the isothermal disk meets the insulated sphere); an hp method
 converges exponentially when the elements shrink geometrically toward ``C`` while the order is raised
 (Babuska-Guo). The mesh is built from three families of quadrilaterals, all from closed-form points (no mesher):
 
 * **corner cells** -- three cells meet at ``C``: the neck square ``[a - R, a] x [z_i, z_i + R]``, the square below
-  it, and the wedge between the line ``x = a`` and the sphere. Each is refined ``levels`` times by the pattern
-  "corner cell -> corner cell scaled by ``sigma`` + two trapezoids" (far edges untouched, so the mesh stays
-  conforming);
+  it, and the wedge between the line ``x = a`` and the sphere (the union has no neck square: two cells). Each is
+  refined ``levels`` times by the pattern "corner cell -> corner cell scaled by ``sigma`` + two trapezoids" (far
+  edges untouched, so the mesh stays conforming);
 * **rings** around ``C`` (geometric radii from ``R`` to ``a``) and, for small necks, rings around the axis point
   ``P = (0, z_i)`` (from ``3.5 a`` to ``0.6 z_i``), so every scale from the neck height ``t ~ a^2 / 4`` to the
   sphere radius is covered by elements of its own size;
@@ -18,8 +20,9 @@ converges exponentially when the elements shrink geometrically toward ``C`` whil
 The neck above the cap base is a tensor grid whose columns end at ``x = a - rho`` for the ring radii ``rho``. Two
 layouts of the body below share the corner cells: *small neck* (``a <= 0.6``, ``R = t``: square and wedge rings to
 the axis, then rings around ``P`` and spokes to the equator) and *large neck* (``a > 0.6``, ``R = min(t, z_i / 2)``:
-two rows of the neck's columns, then the wedge down to the equator). A pair (:func:`pair_quad_mesh`) is two such
-half bodies, each in its own sphere radius, glued at the neck's mid-plane.
+two rows of the neck's columns, then the wedge down to the equator); the union takes ``R = min(a / 4, z_i / 2)``.
+A pair (:func:`pair_quad_mesh`) is two such half bodies, each in its own sphere radius, glued at the neck's
+mid-plane.
 
 Coordinates are ``(x, z - z_i)``: relative to the corner's height, so elements of size 1e-15 next to ``C`` keep full
 precision even at ``a = 1e-4`` (where ``t = 2.5e-9``); points on the sphere are given by their angle offset
@@ -34,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fem_neck.geometry import cap_height, neck_geometry
+from fem_neck.law import check_neck
 from fem_neck.spectral import QuadMesh
 
 SIGMA = 0.17            # geometric factor of the corner refinement (hp optimum ~0.15-0.2)
@@ -46,8 +50,8 @@ LONGEST_ARC = 0.6       # radians of sphere in one far cell before it is split
 
 @dataclass(frozen=True)
 class SemisphereShape:
-    """Dimensions of the body (sphere radius 1): neck radius ``a``, cap base ``z_i``, half-neck height ``t``, the
-    corner's polar angle ``phi_c``. Exact volume for checks: :meth:`volume`."""
+    """Dimensions of the body (sphere radius 1): neck radius ``a``, cap base ``z_i``, half-neck height ``t`` (0 for
+    the union), the corner's polar angle ``phi_c``. Exact volume for checks: :meth:`volume`."""
 
     a: float
     z_i: float
@@ -55,10 +59,13 @@ class SemisphereShape:
     phi_c: float
 
     @classmethod
-    def from_neck(cls, a: float) -> "SemisphereShape":
+    def from_neck(cls, a: float, neck: str = "cylinder") -> "SemisphereShape":
+        """The body of neck radius ``a``: ``neck = "cylinder"`` (the volume-conserving half neck, eqs. 19-20) or
+        ``"union"`` (no neck cylinder)."""
         h_c = float(cap_height(1.0, a))
-        return cls(a=a, z_i=math.sqrt((1.0 - a) * (1.0 + a)), t=h_c * (3.0 - h_c) / (3.0 * (2.0 - h_c)),
-                   phi_c=math.atan2(math.sqrt((1.0 - a) * (1.0 + a)), a))
+        t = h_c * (3.0 - h_c) / (3.0 * (2.0 - h_c)) if check_neck(neck) == "cylinder" else 0.0
+        z_i = math.sqrt((1.0 - a) * (1.0 + a))
+        return cls(a=a, z_i=z_i, t=t, phi_c=math.atan2(z_i, a))
 
     def volume(self) -> float:
         """Volume of revolution: the sphere between ``z = 0`` and ``z_i`` plus the neck cylinder."""
@@ -180,10 +187,11 @@ def _chord_delta(rho: float) -> float:
     return 2.0 * math.asin(0.5 * rho)
 
 
-def semisphere_quad_mesh(a: float, levels: int, sigma: float = SIGMA) -> tuple[QuadMesh, SemisphereShape]:
+def semisphere_quad_mesh(a: float, levels: int, sigma: float = SIGMA,
+                         neck: str = "cylinder") -> tuple[QuadMesh, SemisphereShape]:
     """The geometric quadrilateral mesh of the semisphere with neck radius ``a`` (``1e-4 <= a < 1``, sphere radius
-    1) refined ``levels`` times toward the corner; see the module docstring."""
-    shape = SemisphereShape.from_neck(a)
+    1) refined ``levels`` times toward the corner; ``neck``: ``"cylinder"`` or ``"union"`` (module docstring)."""
+    shape = SemisphereShape.from_neck(a, neck)
     return half_body(shape, corner_radius(shape), levels, sigma), shape
 
 
@@ -195,7 +203,10 @@ def end_disks(mesh: QuadMesh, shape: SemisphereShape) -> dict:
 
 
 def corner_radius(shape: SemisphereShape) -> float:
-    """Radius ``R`` of the corner cells: the neck height ``t`` for small necks, at most half of ``z_i`` otherwise."""
+    """Radius ``R`` of the corner cells: the neck height ``t`` for small necks, at most half of ``z_i`` otherwise;
+    without a neck cylinder (``t = 0``) a quarter of the neck radius, at most half of ``z_i`` (one ring to ``a``)."""
+    if shape.t == 0.0:
+        return min(shape.a / RING_RATIO, 0.5 * shape.z_i)
     return shape.t if shape.a <= SMALL_NECK_MAX else min(shape.t, 0.5 * shape.z_i)
 
 
@@ -203,14 +214,15 @@ def half_body(shape: SemisphereShape, R: float, levels: int, sigma: float = SIGM
     """One sphere from its equator to the plane ``t`` above its cap base (the neck's end disk), corner cells of
     radius ``R <= t``. The neck cylinder is a tensor grid whose columns end at ``x = a - rho`` for the ring radii
     ``rho`` from ``R`` to ``a`` -- so two halves with the same ``a``, ``t`` and ``R`` share their end disk's nodes
-    (:func:`pair_quad_mesh`)."""
-    if R >= shape.t * (1.0 - 1e-9):  # a corner radius computed in another sphere's units may miss t by round-off
+    (:func:`pair_quad_mesh`). With ``t = 0`` (the union) the end disk is the cap base and ``0 < R < a``."""
+    if shape.t > 0.0 and R >= shape.t * (1.0 - 1e-9):  # a corner radius in another sphere's units may miss t
         R = shape.t
     b = _Builder(shape)
     corner = b.sphere(0.0)
     down, mid, on_sphere = _corner_cells(b, shape, corner, R, levels, sigma)
     radii = _radii(R, shape.a)
-    _neck_block(b, shape, R, radii)
+    if shape.t > 0.0:
+        _neck_block(b, shape, R, radii)
     if shape.a <= SMALL_NECK_MAX:
         _small_neck_body(b, shape, radii)
     else:
@@ -219,14 +231,16 @@ def half_body(shape: SemisphereShape, R: float, levels: int, sigma: float = SIGM
 
 
 def _corner_cells(b: _Builder, shape: SemisphereShape, corner: int, R: float, levels: int, sigma: float):
-    """The three refined corner cells of radius ``R``; returns the ids of their outer vertices."""
+    """The refined corner cells of radius ``R`` (three; two without a neck cylinder); returns the ids of their
+    outer vertices."""
     a = shape.a
-    up, up_left = b.vertex(a, R), b.vertex(a - R, R)
+    up = (b.vertex(a, R), b.vertex(a - R, R)) if shape.t > 0.0 else None
     left, low_left, down = b.vertex(a - R, 0.0), b.vertex(a - R, -R), b.vertex(a, -R)
     s_delta = _chord_delta(R)
     on_sphere = b.sphere(s_delta)
     mid = _bulge_mid(b, shape, R, s_delta)
-    b.corner_cell(corner, up, up_left, left, levels, sigma)
+    if up is not None:
+        b.corner_cell(corner, *up, left, levels, sigma)
     b.corner_cell(corner, left, low_left, down, levels, sigma)
     b.corner_cell(corner, down, mid, on_sphere, levels, sigma)
     return down, mid, on_sphere

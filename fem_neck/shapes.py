@@ -5,7 +5,8 @@ Every body here is a solid of revolution about the z axis, so it is meshed in it
 
 * :func:`semisphere_mesh` -- the semisphere with a cylindrical neck of Rojek 2022, Section 5, Fig. 12: the sphere
   of radius ``r`` from its equatorial plane ``z = 0`` to the cap base ``z_i = sqrt(r^2 - a^2)``, then the half neck,
-  a cylinder of radius ``a`` and height ``h_n / 2`` (eqs. 19-20);
+  a cylinder of radius ``a`` and height ``h_n / 2`` (eqs. 19-20); with ``neck = "union"`` the half body of the
+  union of spheres, the sphere up to the cap base alone (no neck cylinder);
 * :func:`chain_mesh` -- a collinear chain of spheres with arbitrary radii and overlaps, the end particles cut at
   their outer equatorial planes (the unequal pair of Section 6, Figs. 8 and 17, is the chain of two).
 
@@ -34,6 +35,7 @@ import numpy as np
 
 from fem_neck import signal_guard
 from fem_neck.geometry import cap_height, check_positive, neck_geometry
+from fem_neck.law import check_neck
 
 # Defaults of the size field (lengths relative to the corner or neck scale, see module docstring).
 DEFAULT_GRADING = 0.3
@@ -138,12 +140,15 @@ def _check_arc(k, r, z_lo, z_hi):
         raise ValueError(f"sphere {k} (radius {r:.6g}) is consumed by its necks: nothing of its surface remains")
 
 
-def semisphere_profile(a_over_r: float, r: float = 1.0):
+def semisphere_profile(a_over_r: float, r: float = 1.0, neck: str = "cylinder"):
     """Outer boundary, corners and neck height of the semisphere with a neck (Rojek 2022, Fig. 12, eqs. 19-20).
 
-    ``h_n / 2 = h_c - h/2`` with ``h = 2 phi(h_c)`` (volume conservation) simplifies to
-    ``h_c (3r - h_c) / (3 (2r - h_c))``, free of cancellation for small necks.
+    ``neck = "cylinder"`` (default): ``h_n / 2 = h_c - h/2`` with ``h = 2 phi(h_c)`` (volume conservation)
+    simplifies to ``h_c (3r - h_c) / (3 (2r - h_c))``, free of cancellation for small necks. ``neck = "union"``: the
+    half body of the union of spheres, the sphere up to its cap base, whose disk of radius ``a`` is the end disk
+    (no neck cylinder; the corner is where that disk meets the sphere).
     """
+    check_neck(neck)
     r = float(check_positive("r", r))
     a = float(check_positive("a_over_r", a_over_r, upper=1.0, upper_name="the neck reaches the sphere radius")) * r
     if not MIN_NECK_RATIO * r <= a < r * (1.0 - 1e-9):
@@ -151,6 +156,8 @@ def semisphere_profile(a_over_r: float, r: float = 1.0):
                          "cannot be meshed; at 1 the sphere surface vanishes)")
     h_c = float(cap_height(r, a))
     z_i = math.sqrt((r - a) * (r + a))
+    if neck == "union":
+        return (r, 0.0), [("arc", (a, z_i), 0.0, r, "sphere0")], np.array([[a, z_i]]), []
     half_neck = h_c * (3.0 * r - h_c) / (3.0 * (2.0 * r - h_c))
     segments = [
         ("arc", (a, z_i), 0.0, r, "sphere0"),
@@ -385,12 +392,13 @@ def curved_mesh(profile: ProfileMesh):
 
 
 def semisphere_mesh(a_over_r: float, r: float = 1.0, grading: float = DEFAULT_GRADING,
-                    sizes: SizeField | None = None) -> ProfileMesh:
+                    sizes: SizeField | None = None, neck: str = "cylinder") -> ProfileMesh:
     """Graded mesh of the semisphere with a neck (Rojek 2022, Fig. 12); see :func:`semisphere_profile`.
 
-    ``bottom`` is the equatorial disk (``z = 0``), ``top`` the neck's end disk (``z = z_i + h_n/2``).
+    ``bottom`` is the equatorial disk (``z = 0``), ``top`` the neck's end disk (``z = z_i + h_n/2``; ``z_i`` for
+    ``neck = "union"``).
     """
-    start, segments, corners, necks = semisphere_profile(a_over_r, r)
+    start, segments, corners, necks = semisphere_profile(a_over_r, r, neck)
     return profile_mesh(start, segments, corners, necks, sizes or SizeField(grading=grading))
 
 

@@ -145,6 +145,8 @@ def finite_or_none(value):
 
 def _write_result(result: dict, as_json: bool) -> None:
     result = finite_or_none(result)
+    for warning in result.get("warnings", ()):  # what a run says of its own standing: on stderr too
+        print(f"warning: {warning}", file=sys.stderr)
     if as_json:
         json.dump(result, sys.stdout)
         sys.stdout.write("\n")

@@ -8,6 +8,10 @@ never a traceback::
 
     python -m fem_neck fit: interrupted at fit, fit sweep: 12 of 40 solves done; partial results in results/fit
 
+SIGTERM (a batch scheduler's time limit, ``kill``) and SIGHUP (a closed terminal) are handled the same way: the run
+keeps what it has (a ``dem run`` its last checkpoint, resumable) and ends with the line ``... interrupted by SIGTERM
+at ...`` and exit code 128 + the signal (143, 129); a SIGHUP that ``nohup`` ignores stays ignored.
+
 Long work says where it is by updating the current run's :class:`Where` (outside a CLI run :func:`where` returns a
 throw-away one, so library code can always call it)::
 
@@ -28,8 +32,9 @@ open are closed before the line is written, so it starts a line of its own. Work
 (:func:`ignore_interrupts` as the pool's initializer, started inside :func:`shielded`, which holds a Ctrl-C back
 until the pool knows every worker it started); the parent stops them (:func:`stop_pool`). :func:`exit_process` then
 leaves with code 130 (Python's own exit would report a kill by SIGINT once the interrupt has passed through some
-C-level imports). Before the CLI's ``main`` runs (interpreter start-up, a few tens of ms) Python's default handler
-is still in place.
+C-level imports). Before the CLI's ``main`` runs, :mod:`sinterheat.startup` holds the signals to one line (from the
+package's first statement on); only during the interpreter's own start-up, a few tens of ms, are the system's
+defaults in place.
 """
 
 from __future__ import annotations
@@ -43,6 +48,10 @@ import threading
 from dataclasses import dataclass, field
 
 EXIT_CODE = 130  #: 128 + SIGINT
+#: The signals handled as Ctrl-C is. SIGTERM is what a batch scheduler sends at a time limit (and ``kill``), SIGHUP
+#: what a closed terminal or a lost ssh session sends; each ends a run with its one line and exit code 128 + signal.
+SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
+EXIT_CODES = frozenset(128 + int(signum) for signum in SIGNALS)
 _current: contextvars.ContextVar[Where | None] = contextvars.ContextVar("sinterheat_where", default=None)
 
 
@@ -57,6 +66,7 @@ class Where:
     t: float | None = None
     out: str | None = None
     signalled: bool = field(default=False, repr=False)  # a SIGINT has arrived (set by the handler)
+    signum: int = field(default=signal.SIGINT, repr=False)  # the signal that arrived (SIGINT, SIGTERM or SIGHUP)
 
     _FIELDS = ("stage", "step", "t", "out")
 
@@ -82,7 +92,14 @@ class Where:
         if self.t is not None:
             at.append(f"t = {self.t:.6g} s")
         results = f"partial results in {self.out}" if self.out else "no results written"
-        return f"{self.command}: interrupted at {', '.join(at) or 'start-up'}; {results}"
+        by = "" if self.signum == signal.SIGINT else f" by {signal.Signals(self.signum).name}"
+        return f"{self.command}: interrupted{by} at {', '.join(at) or 'start-up'}; {results}"
+
+    @property
+    def exit_code(self) -> int:
+        """The exit code of the interrupted run, 128 + the signal (130 for Ctrl-C, 143 for SIGTERM, 129 for SIGHUP,
+        what a shell reports for each)."""
+        return 128 + int(self.signum)
 
 
 def where() -> Where:
@@ -90,12 +107,19 @@ def where() -> Where:
     return _current.get() or Where()
 
 
+def handled() -> list[int]:
+    """The :data:`SIGNALS` a run handles here: all but SIGTERM or SIGHUP where they are ignored already (``nohup``
+    ignores SIGHUP so that the run outlives its terminal: it does)."""
+    return [signum for signum in SIGNALS if signum == signal.SIGINT or signal.getsignal(signum) is not signal.SIG_IGN]
+
+
 def _raise_once(signum, frame):
     state = _current.get()
     if state is not None:
         if state.signalled:
-            return  # a second Ctrl-C must not cut the clean-up short
+            return  # a second Ctrl-C (or SIGTERM) must not cut the clean-up short
         state.signalled = True
+        state.signum = signum
     raise KeyboardInterrupt
 
 
@@ -116,15 +140,17 @@ def interruptible(state: Where):
     the process is on its way out, and a further Ctrl-C during its exit stays ignored)."""
     token = _current.set(state)
     main_thread = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGINT, _raise_once) if main_thread else None
+    previous = {signum: signal.signal(signum, _raise_once) for signum in handled()} if main_thread else {}
     hook, sys.unraisablehook = sys.unraisablehook, _unraisable(sys.unraisablehook)
     try:
         yield state
     finally:
         sys.unraisablehook = hook
         _current.reset(token)
-        if previous is not None and not state.signalled:
-            signal.signal(signal.SIGINT, previous)
+        if not state.signalled:
+            for signum, handler in previous.items():
+                if handler is not None:
+                    signal.signal(signum, handler)
 
 
 def run_command(state: Where, func, *args) -> int:
@@ -146,9 +172,10 @@ def run_command(state: Where, func, *args) -> int:
 
 def interrupted(state: Where) -> int:
     """After a ``KeyboardInterrupt``: finalize gmsh if a session is open, close open tqdm bars, write the one line
-    on stderr; returns :data:`EXIT_CODE`."""
+    on stderr; returns the exit code, 128 + the signal (:data:`EXIT_CODE` for Ctrl-C)."""
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        for signum in SIGNALS:
+            signal.signal(signum, signal.SIG_IGN)
     gmsh = sys.modules.get("gmsh")
     if gmsh is not None:
         with contextlib.suppress(Exception):
@@ -162,15 +189,18 @@ def interrupted(state: Where) -> int:
     with contextlib.suppress(OSError, ValueError):
         sys.stderr.write(state.message() + "\n")
         sys.stderr.flush()
-    return EXIT_CODE
+    return state.exit_code
 
 
 def ignore_interrupts() -> None:
-    """Initializer of pool workers: ignore SIGINT (a terminal's Ctrl-C reaches the whole process group; the parent
-    handles it and stops the pool) and undo the block :func:`shielded` handed down."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    """Initializer of pool workers: ignore SIGINT and SIGHUP (a terminal's Ctrl-C or hang-up reaches the whole
+    process group; the parent handles it and stops the pool), die of SIGTERM as a process does by default (it is how
+    :func:`stop_pool` ends them; a forked worker would otherwise inherit the parent's handler), and undo the block
+    :func:`shielded` handed down."""
+    for signum in SIGNALS:
+        signal.signal(signum, signal.SIG_DFL if signum == getattr(signal, "SIGTERM", None) else signal.SIG_IGN)
     if hasattr(signal, "pthread_sigmask"):
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
 
 
 @contextlib.contextmanager
@@ -187,19 +217,21 @@ def shielded():
         yield
         return
     held = []
-    previous = signal.getsignal(signal.SIGINT)
-    if previous is not None:  # None: a handler not installed from Python, left as it is
-        signal.signal(signal.SIGINT, lambda signum, frame: held.append(signum))
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if hasattr(signal, "pthread_sigmask") else None
+    previous = {signum: signal.getsignal(signum) for signum in SIGNALS}
+    for signum, handler in previous.items():
+        if handler is not None:  # None: a handler not installed from Python, left as it is
+            signal.signal(signum, lambda signum, frame: held.append(signum))
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, set(SIGNALS)) if hasattr(signal, "pthread_sigmask") else None
     try:
         yield
     finally:
         if old is not None:
-            signal.pthread_sigmask(signal.SIG_SETMASK, old)  # a SIGINT held on this thread is recorded now
-        if previous is not None:
-            signal.signal(signal.SIGINT, previous)
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)  # a signal held on this thread is recorded now
+        for signum, handler in previous.items():
+            if handler is not None:
+                signal.signal(signum, handler)
         if held:
-            signal.raise_signal(signal.SIGINT)
+            signal.raise_signal(held[0])
 
 
 def stop_pool(pool) -> None:
@@ -219,7 +251,10 @@ def exit_process(code: int):
     """``sys.exit(code)`` for a CLI's ``__main__``; after an interrupt (:data:`EXIT_CODE`) stdout and stderr are
     flushed and the process leaves at once with that code (``os._exit``): the run has unwound, and Python's own
     exit would report a kill by SIGINT instead once the interrupt has passed through some C-level imports."""
-    if code == EXIT_CODE:
+    if threading.current_thread() is threading.main_thread():  # the command is over: a late signal ends the process
+        for signum in handled():  # as the system's default does (no start-up line, no KeyboardInterrupt traceback)
+            signal.signal(signum, signal.SIG_DFL)
+    if code in EXIT_CODES:
         for stream in (sys.stdout, sys.stderr):
             with contextlib.suppress(Exception):
                 stream.flush()

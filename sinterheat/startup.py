@@ -1,36 +1,48 @@
-"""The first thing a CLI's ``__main__`` does: hold Ctrl-C to one line from the first statement on.
+"""The first thing a CLI does: hold Ctrl-C to one line from the first statement on.
 
 Until a command's ``main`` installs the handler of :mod:`sinterheat.interrupt`, Python's default handler would turn a
 Ctrl-C into a traceback -- and importing numpy, scipy and the package itself takes from a tenth of a second to
-several on a busy machine. :func:`run_main` installs a handler that only raises ``KeyboardInterrupt`` before it
-imports anything else (``signal`` is built in), imports the command's module and runs its ``main``; an interrupt
-before ``main`` has taken over ends with the one line ``<prog> <command>: interrupted at start-up; no results
-written`` and exit code 130, as one after it does.
+several on a busy machine. ``python -m dem`` imports the package ``dem`` (and so numpy and scipy) before its
+``__main__`` runs, so the package calls :func:`hold` as its first statement when it is imported for ``-m``;
+:func:`run_main` calls it again, imports the command's module and runs its ``main``. A signal before ``main`` has
+taken over ends the process at once (nothing is written yet, nothing needs cleaning up) with the one line ``<prog>
+<command>: interrupted at start-up; no results written`` and exit code 130, as one after it does; SIGTERM and SIGHUP
+likewise (``interrupted by SIGTERM``, exit code 128 + the signal; a SIGHUP that ``nohup`` ignores stays ignored).
 """
 
+import functools
 import importlib
 import os
 import signal
 import sys
 
-EXIT_CODE = 130  # 128 + SIGINT, as sinterheat.interrupt.EXIT_CODE
+
+def _leave(prog: str, signum, frame):
+    """The start-up handler: the one line, and out."""
+    command = next((a for a in sys.argv[1:] if not a.startswith("-")), None)
+    by = "" if signum == signal.SIGINT else f" by {signal.Signals(signum).name}"
+    try:
+        sys.stderr.write(f"{prog}{'' if command is None else ' ' + command}: interrupted{by} at start-up; "
+                         f"no results written\n")
+        sys.stderr.flush()
+    finally:
+        os._exit(128 + int(signum))
 
 
-def _raise(signum, frame):
-    raise KeyboardInterrupt
+def hold(prog: str) -> None:
+    """Install the start-up handler (module docstring) for SIGINT, SIGTERM and SIGHUP; ``prog`` names the command
+    in its line, e.g. ``"python -m dem"``."""
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        signum = getattr(signal, name, None)
+        if signum is not None and (name == "SIGINT" or signal.getsignal(signum) is not signal.SIG_IGN):
+            signal.signal(signum, functools.partial(_leave, prog))
 
 
 def run_main(prog: str, module: str, **kwargs):
-    """``sys.exit(main(**kwargs))`` of ``module`` (a dotted name) for ``python -m <package>``, Ctrl-C held to one line
-    from here on (module docstring)."""
-    signal.signal(signal.SIGINT, _raise)
-    try:
-        main = importlib.import_module(module).main
-        from sinterheat.interrupt import exit_process
-    except KeyboardInterrupt:
-        command = next((a for a in sys.argv[1:] if not a.startswith("-")), None)
-        sys.stderr.write(f"{prog}{'' if command is None else ' ' + command}: interrupted at start-up; "
-                         f"no results written\n")
-        sys.stderr.flush()
-        os._exit(EXIT_CODE)
+    """``sys.exit(main(**kwargs))`` of ``module`` (a dotted name) for ``python -m <package>``, Ctrl-C (and SIGTERM,
+    SIGHUP) held to one line from here on (module docstring)."""
+    hold(prog)
+    main = importlib.import_module(module).main
+    from sinterheat.interrupt import exit_process
+
     exit_process(main(**kwargs))

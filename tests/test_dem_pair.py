@@ -76,8 +76,12 @@ def test_stable_limit_is_the_pair_eigenvalue_and_larger_dt_refused():
     assert stable_limit(net) == pytest.approx(limit, rel=1e-10)
     with pytest.raises(ValueError, match="stability limit"):
         integrate(net, "explicit", 1.01 * limit, 1.0)
-    res = integrate(net, "explicit", 0.99 * limit, 2.0)  # stable (oscillating) below the limit
-    assert abs(res.T[0] - res.T[1]) < 100.0
+    # stable below the limit, but oscillating far outside the initial range: refused as a wrong answer
+    seen = []
+    with pytest.raises(ValueError, match="max_principle_violation"):
+        integrate(net, "explicit", 0.99 * limit, 2.0, observer=lambda step, t, T, flows: seen.append(T[0] - T[1]))
+    assert len(seen) == 1 and abs(seen[0]) == 100.0  # refused at the first step, where the overshoot appears
+    assert integrate(net, "explicit", 0.49 * limit, 2.0).max_principle_violation == 0.0  # not oscillating
 
 
 def test_run_summary_of_the_pair_scene(tmp_path):

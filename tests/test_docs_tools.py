@@ -1,13 +1,18 @@
-"""The documentation's own machinery (``docs/_ext``), without building the site (CI builds it after the tests)."""
+"""The documentation's own machinery (``docs/_ext``), without building the site (CI builds it after the tests; one test
+builds a one-page site of its own, where Sphinx is installed)."""
 
 import pathlib
 import sys
+
+import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 
 import api_check  # noqa: E402
+import docstring_check  # noqa: E402
 import gallery_order  # noqa: E402
+import site_check  # noqa: E402
 
 
 def test_public_objects_are_the_functions_and_classes_each_module_defines():
@@ -26,6 +31,30 @@ def test_gallery_order_lists_the_fe_examples_first_and_puts_unlisted_ones_last()
     assert set(gallery_order.ORDER) == {p.name for p in (ROOT / "examples").glob("*.py")}  # every example placed
 
 
+def test_examples_fit_the_line_length():
+    """Every line of every example within the project's 120 characters, and the code the gallery shows in its code
+    column (all but the docstring and the text cells, ``# %%`` and the comment lines under it) within 79, so that
+    none runs off the page."""
+    import ast
+
+    long = []
+    for path in sorted((ROOT / "examples").glob("*.py")):
+        lines = path.read_text().splitlines()
+        docstring_end = ast.parse(path.read_text()).body[0].end_lineno
+        text_cell = False
+        for n, line in enumerate(lines, 1):
+            text_cell = line.startswith("# %%") or (text_cell and line.startswith("#"))
+            if len(line) > 120 or (n > docstring_end and not text_cell and len(line) > 79):
+                long.append(f"{path.name}:{n}")
+    assert long == []
+
+
+def test_getting_started_lists_every_example():
+    page = (ROOT / "docs" / "getting-started.md").read_text()
+    missing = {p.stem for p in (ROOT / "examples").glob("*.py") if f"<sphx_glr_gallery_{p.stem}.py>`" not in page}
+    assert missing == set()
+
+
 def test_every_module_with_public_objects_has_its_automodule():
     """What api_check finds in a build, found without one: every module of a documented package that defines a public
     function or class is named by an ``automodule`` directive of docs/reference/ (dem's modules included)."""
@@ -38,3 +67,134 @@ def test_every_module_with_public_objects_has_its_automodule():
         assert modules - placed == set(), package
     assert {"dem.scene.schema.display_rows", "dem.driver.run", "dem.laws.contact.jkr.JKRMaterial"} <= set(
         api_check.public_objects("dem"))
+
+
+def test_site_check_finds_remote_loads_missing_files_and_missing_anchors(tmp_path):
+    """A page that loads MathJax from a CDN, a stylesheet from another host and a missing local script, and links to
+    an anchor its target lacks, is reported line by line; what a reader follows (an external link) and what is
+    there is not."""
+    (tmp_path / "_static").mkdir()
+    (tmp_path / "_static" / "here.js").write_text("")
+    (tmp_path / "guide").mkdir()
+    (tmp_path / "guide" / "other.html").write_text('<h1 id="there">x</h1><a name="old">y</a>')
+    (tmp_path / "index.html").write_text(
+        '<script defer src="https://cdn.example.org/npm/mathjax@4/tex-mml-chtml.js"></script>'
+        '<link rel="stylesheet" href="//fonts.example.org/a.css"><link rel="next" href="guide/other.html">'
+        '<script src="_static/here.js"></script><script src="_static/gone.js"></script>'
+        '<img src="data:image/png;base64,AAAA"><span id="self"></span>'
+        '<a href="https://example.org/paper">paper</a><a href="mailto:a@b.c">mail</a><a href="#self">up</a>'
+        '<a href="guide/other.html#there">ok</a><a href="guide/other.html#old">ok</a>'
+        '<a href="guide/other.html#missing">bad</a><a href="#nowhere">bad</a><a href="gone.html">bad</a>')
+    assert site_check.problems(tmp_path) == [
+        "index.html: loads https://cdn.example.org/npm/mathjax@4/tex-mml-chtml.js from another host (the site must "
+        "read offline)",
+        "index.html: loads //fonts.example.org/a.css from another host (the site must read offline)",
+        "index.html: loads _static/gone.js, which the build does not have",
+        "index.html: links to guide/other.html#missing, but guide/other.html has no anchor 'missing'",
+        "index.html: links to #nowhere, but index.html has no anchor 'nowhere'",
+        "index.html: links to gone.html, which the build does not have",
+    ]
+    (tmp_path / "guide" / "back.html").write_text('<a href="../index.html#self">up</a><a href="../../x.html">out</a>')
+    assert site_check.problems(tmp_path)[0] == "guide/back.html: ../../x.html points outside the site"  # page order
+
+
+def test_a_build_with_a_cdn_script_fails(tmp_path):
+    """site_check is wired into the build: a page that loads a script from another host fails ``sphinx -W`` (and the
+    same page without it builds). Needs Sphinx (the docs extra); the tests' own environment may lack it."""
+    sphinx_cmd = pytest.importorskip("sphinx.cmd.build")
+    (tmp_path / "conf.py").write_text(f"import sys\nsys.path.insert(0, {str(ROOT / 'docs' / '_ext')!r})\n"
+                                      "extensions = ['site_check']\n")
+    page = "Title\n=====\n\n.. raw:: html\n\n   <script src=\"https://cdn.example.org/x.js\"></script>\n"
+    (tmp_path / "index.rst").write_text(page)
+    args = ["-W", "-q", "-b", "html", str(tmp_path), str(tmp_path / "_build")]
+    assert sphinx_cmd.build_main(args) != 0
+    (tmp_path / "index.rst").write_text(page.replace("https://cdn.example.org/x.js", "_static/x.js"))
+    (tmp_path / "_static").mkdir()
+    (tmp_path / "_static" / "x.js").write_text("")
+    (tmp_path / "conf.py").write_text((tmp_path / "conf.py").read_text() + "html_static_path = ['_static']\n")
+    assert sphinx_cmd.build_main(args + ["-E"]) == 0
+
+
+def test_maths_is_served_by_the_site_itself():
+    """conf.py draws the equations with a MathJax the build copies into ``_static`` (the docs extra installs it),
+    never one from a CDN: a page that still loaded a remote MathJax would also fail the build (site_check)."""
+    import importlib.util
+    import runpy
+    import tomllib
+
+    conf = runpy.run_path(str(ROOT / "docs" / "conf.py"))
+    assert {"sphinx.ext.mathjax", "sphinx-mathjax-offline", "site_check"} <= set(conf["extensions"])
+    assert not site_check.is_remote(conf.get("mathjax_path", "")) and "mathjax3_config" not in conf
+    extra = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]["docs"]
+    assert any(req.startswith("sphinx-mathjax-offline") for req in extra)
+    spec = importlib.util.find_spec("sphinx-mathjax-offline")
+    if spec is not None:  # with the docs extra installed: the script it makes the pages load is in the package
+        class App:  # what the extension's setup touches
+            config = type("Config", (), {})()
+
+            def connect(self, *args):
+                pass
+
+        app = App()
+        importlib.import_module("sphinx-mathjax-offline").setup(app)
+        assert not site_check.is_remote(app.config.mathjax_path)
+        assert (pathlib.Path(spec.origin).parent / "static" / "mathjax" / app.config.mathjax_path.split("/", 1)[1]
+                ).is_file()
+
+
+def test_install_page_shows_the_readme_mpi_command():
+    """The install page's MPI block is the README's, which CI runs (so the page cannot drift from what works)."""
+    def block_after(text):
+        return text.split("<!-- mpi-command -->\n```bash\n", 1)[1].split("```", 1)[0]
+
+    readme, page = (ROOT / "README.md").read_text(), (ROOT / "docs" / "install.md").read_text()
+    assert block_after(page) == block_after(readme)
+
+
+def test_citation_file_names_this_version_and_the_three_papers():
+    import tomllib
+
+    import yaml
+
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    assert cff["cff-version"] == "1.2.0" and cff["authors"] and cff["type"] == "software"
+    assert cff["version"] == tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    physics = " ".join((ROOT / "docs" / "physics" / "index.md").read_text().split())  # where the pages cite them
+    assert [(ref["authors"][0]["family-names"], ref["year"]) for ref in cff["references"]] == [
+        ("Rojek", 2022), ("Luding", 2005), ("Zohdi", 2014)]
+    assert all(ref["title"] in physics for ref in cff["references"])
+
+
+def test_described_reads_numpy_parameter_sections():
+    doc = """Summary.
+
+Parameters
+----------
+r_i, r_j : float
+    The radii, m.
+kappa : float
+h
+    Overlap, m.
+*args
+    More.
+
+Returns
+-------
+K : float
+    Conductance, W/K.
+"""
+    assert docstring_check.described(doc) == {"r_i", "r_j", "h", "args"}  # kappa has no description; K is returned
+    assert docstring_check.described("Fields\n\nK: conductance.") == set()  # prose is not a Parameters section
+
+
+# The ratchet: public parameters (of functions, classes and the public methods they define) that no docstring
+# describes, per package. The count may fall, never rise: a new public parameter comes with its description (numpy
+# style, "Parameters" section: meaning and unit), and whoever documents more lowers the number here.
+UNDESCRIBED = {"fem_neck": 682, "dem": 1251, "sinterheat": 73}
+
+
+def test_undescribed_public_parameters_do_not_grow():
+    counts = {package: len(docstring_check.undescribed(package)) for package in UNDESCRIBED}
+    assert all(counts[p] <= UNDESCRIBED[p] for p in UNDESCRIBED), (counts, UNDESCRIBED)
+    assert [name for name in docstring_check.undescribed("fem_neck")
+            if name.startswith(("fem_neck.law.", "fem_neck.conduction."))] == []  # described in full

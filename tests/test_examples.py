@@ -84,6 +84,8 @@ def test_kirchhoff_current():
     assert flow.electrode_current[0] == pytest.approx(-flow.electrode_current[1], rel=1e-12)  # charge conserved
     assert flow.joule_heat == pytest.approx(flow.electrode_power, rel=1e-9)  # energy conserved
     assert flow.electrode_current[0] == pytest.approx(133.8, abs=0.05)  # the numbers of the guide's electrical page
+    # the figure: every horizontal plane between the electrodes' particles carries the whole current down
+    assert len(ns["planes"]) == 39 and ns["plane_current"] == pytest.approx(flow.electrode_current[0], rel=1e-9)
 
 
 def test_the_guide_current_snippet_runs_as_printed():

@@ -119,8 +119,9 @@ def test_pair_necks_meet_where_the_lattice_pair_model_ends(kind):
         i, j, s = cell.bonds()
         vectors = cell.centres[j] + s * cell.period - cell.centres[i]
         a = neck_radius(1.0, 1.0, h)
-        angle = np.full(len(i), float(angular_radius(a, math.sqrt(1 - a * a))))
-        assert necks_meet(cell.radii, i, j, vectors, angle, angle).tolist() == [meet] * cell.n
+        angle = np.full(2 * len(i), float(angular_radius(a, math.sqrt(1 - a * a))))
+        got = necks_meet(cell.n, np.concatenate([i, j]), np.vstack([vectors, -vectors]), angle)
+        assert got.tolist() == [meet] * cell.n
 
 
 def test_union_necks_meet_from_the_lattice_angle():

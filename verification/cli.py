@@ -6,6 +6,9 @@ Commands (each writes ``report.md``, ``summary.json`` and ``run.json`` plus PNG 
 * ``dem-vs-fe``  -- DEM pipe network against FE: collinear chains, 3D clusters, transient pair, periodic lattices
   and random packings (sections ``chains``, ``clusters``, ``transient``, ``lattices``);
 * ``lattices``   -- only the periodic packings (section ``lattices``: FE results are cached in its folder);
+* ``densification`` -- k_eff against the solid fraction of the union of spheres up to phi ~0.97: lattices and random
+  packings (FE beside DEM), a Luding-sintered compact, the Wiener and Hashin-Shtrikman bounds, Koh & Fortini
+  (section ``densification``);
 * ``all``        -- ``paper`` and ``dem-vs-fe``.
 
 Run time against error is ``python -m benchmarks``; the stress cases are tests (``python -m pytest -m stress``).
@@ -35,6 +38,8 @@ COMMANDS = {
     "lattices": (("lattices",), "DEM pipe network against FE of periodic SC, BCC, FCC lattices and random packings"),
     "all": (("paper", "chains", "clusters", "transient", "lattices"), "paper and dem-vs-fe"),
     "sintering": (("sintering",), "Luding 2005 Sec. 4 reproduced: sintering, compression and vibration tests"),
+    "densification": (("densification",), "k_eff through densification: union-of-spheres lattices, random packings "
+                      "and a sintered compact, FE beside DEM, with the bounds and Koh & Fortini"),
 }
 
 

@@ -118,9 +118,9 @@ def fe_pair_conductance(r_i: float, r_j: float, h: float) -> float:
     return float(pair_conductance(r_i, r_j, h, kappa=1.0, rtol=1e-8).K)
 
 
-def dem_periodic(cell: lattice.PeriodicCell, law: str) -> float:
+def dem_periodic(cell: lattice.PeriodicCell, law: str, neck: str = "newton") -> float:
     """The DEM's ``k_eff / kappa`` of the periodic packing along z (drop of 1 K per period), for a conductance law
-    or :data:`NETWORK_ONLY`."""
+    or :data:`NETWORK_ONLY`, with the neck reading ``neck`` (``conductance.neck``)."""
     from dem.geometry.bonds import find_bonds
     from dem.laws.conductance import ConductanceSpec, bond_conductances
     from dem.geometry.particles import Material, Particles
@@ -130,7 +130,7 @@ def dem_periodic(cell: lattice.PeriodicCell, law: str) -> float:
     box = PeriodicBox(cell.period, drop=[0.0, 0.0, 1.0])
     unit = Material(1.0, 1.0, 1.0, "unit")
     particles = Particles.from_arrays(cell.centres, cell.radii, np.zeros(cell.n), materials=(unit,))
-    spec = ConductanceSpec(law="rojek" if law == NETWORK_ONLY else law)
+    spec = ConductanceSpec(law="rojek" if law == NETWORK_ONLY else law, neck=neck)
     bonds = find_bonds(particles, contact=spec.contact, box=box)
     if law == NETWORK_ONLY:
         K = np.array([fe_pair_conductance(*sorted((float(cell.radii[i]), float(cell.radii[j]))), float(h))

@@ -5,7 +5,7 @@ Usage::
 
     python -m dem run SCENE [--out DIR] [--json]     SCENE: a TOML file or a built-in name
     python -m dem scenes [--json]
-    python -m dem laws [--json]                      the conductance laws a scene can select
+    python -m dem laws [--json]                      the conductance and contact laws a scene can select
     python -m dem contact SCENE --history FILE.csv [--no-damping] [--out DIR] [--json]
     python -m dem convert IN OUT [--format F] [--length-unit U] [--json]   IN: a packing file, state.npz or scene;
                                                                           OUT: a LAMMPS data file, CSV or VTU

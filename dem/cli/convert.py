@@ -3,11 +3,14 @@
 
 IN is a packing file (CSV, LAMMPS data file or dump, VTK point set: :func:`dem.scene.packing_files.read_packing`, the
 format from the name or ``--format``), a saved moving state (``state.npz``: positions, radii, temperatures,
-velocities, and densities from the saved masses) or a scene (a TOML file or a built-in name: its particles,
+velocities, and densities from the saved masses; a static run's state: positions, radii, temperatures, materials) or a scene (a TOML file or a built-in name: its particles,
 generated ones included, with its materials' densities and its periodic box). OUT is written by its name: a LAMMPS
 data file of ``atom_style sphere`` (``.data``, ``.lmp``, ``data.*``; ``read_data`` reads it, ``units si``; LAMMPS
 numbers atoms from 1, so ids 0..N-1 become 1..N), ``.csv`` or ``.vtu``. A data file does not say which axes are
-periodic: the input script's ``boundary`` command does (the summary lists the periodic axes IN records).
+periodic: the input script's ``boundary`` command does (the summary lists the periodic axes IN records). The box is
+IN's (a state's or a scene's periodic box, a file's box); a centre outside it is wrapped into it along a periodic axis
+(its image flag counting the periods) and refused along any other. ``--periodic`` is for packing files only (a state
+or a scene says which of its axes are periodic).
 """
 
 from __future__ import annotations
@@ -41,7 +44,12 @@ def read_input(args):
     from dem.scene import packing_files, state_file
 
     source = pathlib.Path(args.input)
-    if source.suffix.lower() == ".npz":
+    is_state = source.suffix.lower() == ".npz"
+    if (is_state or source.suffix.lower() == ".toml" or (not source.exists() and not source.suffix)) and \
+            args.periodic is not None:
+        raise ValueError(f"--periodic = {args.periodic!r}: only for a packing file; a saved state or a scene "
+                         f"keeps its own periodic box")
+    if is_state:
         return packing_files.packing_from_state(state_file.load(source)), "state"
     if source.suffix.lower() == ".toml" or (not source.exists() and not source.suffix):
         from dem.scene import load_scene

@@ -1,13 +1,23 @@
-"""``python -m dem laws [--json]``: list the selectable conductance laws (``[conductance] law``), one line each."""
+"""``python -m dem laws [--json]``: list the laws a scene can name, one line each with the keys it reads: the
+conductance laws (``[conductance] law``: every static and moving run's bonds) and the contact laws of particles that
+move (``[contact] law``, :data:`dem.laws.contact.CONTACT_LAWS`: their material's keys, SI units)."""
 
 
 def register(sub):
-    parser = sub.add_parser("laws", help="list the conductance laws", description=__doc__)
+    parser = sub.add_parser("laws", help="list the conductance and contact laws with their keys",
+                            description=__doc__)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout, nothing else")
     parser.set_defaults(run=run)
 
 
 def run(args) -> dict:
-    from dem.laws.conductance import DESCRIPTIONS, LAWS
+    from dataclasses import fields
 
-    return {name: DESCRIPTIONS[name] for name in LAWS}
+    from dem.laws import contact
+    from dem.laws.conductance import DESCRIPTIONS, LAWS, law_keys
+
+    out = {name: f"[conductance] {DESCRIPTIONS[name]}; keys: {', '.join(law_keys(name))}" for name in LAWS}
+    for name in contact.CONTACT_LAWS:
+        keys = ", ".join(f.name for f in fields(contact.law_module(name).Material))
+        out[name if name not in out else f"{name} (contact)"] = f"[contact] {contact.DESCRIPTIONS[name]}; keys: {keys}"
+    return out

@@ -92,6 +92,32 @@ class ContactThermalModel:
         self.rate[self.free] = (T_F - self.T[self.free]) / dt
         self.T[self.free] = T_F
 
+    def contact_heat(self, mechanics, i: np.ndarray, j: np.ndarray) -> tuple[dict, np.ndarray]:
+        """The heat of the contacts ``(i, j)`` of ``mechanics`` now, for the snapshots: per contact its
+        ``neck_radius`` (m), ``conductance`` (W/K) and ``heat_flow`` (W, from i to j), all 0 for a contact without
+        a bond (``conductance.out_of_range = "drop"``); and the heat flow (W) into each particle through its
+        contacts and walls."""
+        bonds, K_pairs, K_walls = self.bonds(mechanics)
+        T = self.local(mechanics, self.T)
+        n = len(T)
+        jump = bonds.shifts @ self.box.drop if self.box is not None else 0.0
+        q = K_pairs * (T[bonds.i] - T[bonds.j] + jump)
+        wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
+        q_walls = K_walls * (T[bonds.wall_particle] - wall_T[bonds.wall_index])
+        into = np.bincount(bonds.j, q, n) - np.bincount(bonds.i, q, n) - np.bincount(bonds.wall_particle, q_walls, n)
+        fields = {name: np.zeros(len(i)) for name in ("neck_radius", "conductance", "heat_flow")}
+        if not bonds.n_pairs:
+            return fields, into
+        key = np.minimum(bonds.i, bonds.j) * n + np.maximum(bonds.i, bonds.j)
+        order = np.argsort(key, kind="stable")
+        wanted = np.minimum(i, j) * n + np.maximum(i, j)
+        at = order[np.clip(np.searchsorted(key[order], wanted), 0, len(key) - 1)]
+        found = key[at] == wanted
+        sign = np.where(bonds.i[at] == i, 1.0, -1.0)  # the bond's direction against the contact's
+        for name, values in (("neck_radius", bonds.a[at]), ("conductance", K_pairs[at]), ("heat_flow", sign * q[at])):
+            fields[name][found] = values[found]
+        return fields, into
+
     def energy_error(self) -> float:
         """``|sum C (T - T0) - heat in| / scale`` (relative; the scale is the capacity times the temperature range
         plus the heat exchanged)."""

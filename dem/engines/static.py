@@ -15,9 +15,11 @@ from dataclasses import replace
 import numpy as np
 
 from dem import memory
+from dem.geometry.necks import meeting_in, neck_account
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
 from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
                               periodic_heat_flow, steady)
+from dem.scene.specimen import group_flows, held_groups
 from dem.scene.state_file import box_arrays
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
@@ -26,24 +28,33 @@ CSV_FLOWS = ("fixed", "walls", "convection", "radiation", "internal")  # the hea
 
 
 def effective_conductivity(scene, summary: dict) -> float | None:
-    """``k_eff = Q L / (A dT)`` (steady): of a generated specimen between hot and cold ends, or along the one axis
-    of a periodic box with a temperature drop per period (``Q`` the heat flow across the period)."""
+    """``k_eff = Q L / (A dT)`` (steady): between the two ends of the scene's specimen (:mod:`dem.scene.specimen`:
+    walls or held groups, ``Q`` the heat leaving the hot end), or along the one axis of a periodic box with a
+    temperature drop per period (``Q`` the heat flow across the period)."""
     box, sp = scene.box, scene.specimen
     if box is not None and "periodic_heat_flow" in summary:
         axes = np.flatnonzero(box.drop)
-        if len(axes) != 1:
-            return None
-        k = int(axes[0])
-        return summary["periodic_heat_flow"][k] * box.lengths[k] / (box.cross_section(k) * box.drop[k])
-    if sp is None or sp.hot == sp.cold or "boundary_heat_flow" not in summary:
+        if len(axes) == 1:
+            k = int(axes[0])
+            return summary["periodic_heat_flow"][k] * box.lengths[k] / (box.cross_section(k) * box.drop[k])
+    if sp is None or sp.periodic or sp.hot == sp.cold or "boundary_heat_flow" not in summary:
         return None
-    boundary = summary["boundary_heat_flow"]
-    if sp.hot_particles:
-        ids = scene.particles.id
-        q = -sum(boundary.get("particles", {}).get(str(ids[k]), 0.0) for k in sp.hot_particles)
-    else:
-        q = -boundary["walls"][sp.hot_wall]
+    kind, name = sp.hot_end
+    q = -summary["boundary_heat_flow"]["walls" if kind == "wall" else "groups"][name]
     return q * sp.length / (sp.area * (sp.hot - sp.cold))
+
+
+def boundary_summary(scene, walls, into: dict) -> dict:
+    """The summary's ``boundary_heat_flow``: W into each wall (``walls``, in the scene's order) by name, into each
+    held group (:func:`dem.scene.specimen.held_groups`) by name, into all held particles, and (up to 1000 of them)
+    into each held particle by id (``into``: ``{index: W}``)."""
+    groups = held_groups(scene.particles, scene.groups)
+    out = {"walls": {w.name: float(q) for w, q in zip(scene.walls, walls)}, "groups": group_flows(groups, into),
+           "fixed_total": float(sum(into[k] for k in sorted(into)))}
+    if len(into) <= 1000:  # by particle id (the index unless a packing file gave ids)
+        ids = scene.particles.id
+        out["particles"] = {str(ids[k]): into[k] for k in sorted(into)}
+    return out
 
 
 class StaticEngine:
@@ -67,6 +78,7 @@ class StaticEngine:
         wall_temperature = np.array([w.temperature for w in walls], dtype=float)
         self.network = Network(particles, bonds, K_pairs, K_walls, wall_temperature, scene.sources, scene.box)
         self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
+        self.meeting = meeting_in(particles, walls, bonds, scene.box)
         self.restart = Checkpoint.from_arrays(restart) if restart is not None else None
         self.t_start = float(scene.start_time)
         self.T = scene.particles.temperature.astype(float)
@@ -142,7 +154,9 @@ class StaticEngine:
         s = self.scene.solver
         out = {"law": self.scene.conductance.law, "contact": self.bonds.contact,
                "bonds_clipped": self.bonds.clipped, "bonds_dropped": self.bonds.dropped,
-               "wall_bonds": self.bonds.n_walls}
+               "wall_bonds": self.bonds.n_walls,
+               **neck_account(np.count_nonzero(self.meeting), self.scene.particles.n, self.bonds.contact,
+                              self.bonds.n_pairs + self.bonds.n_walls, self.scene.conductance.law)}
         observer = self._observed(observe)
         t0 = self.t_start
         if s.mode == "steady":
@@ -163,16 +177,13 @@ class StaticEngine:
                        integrator=s.integrator, dt=s.dt, dt_min=res.dt_min, dt_max=res.dt_max,
                        rejected_steps=res.rejected, stable_limit=res.stable_limit, linear_solver=res.solver,
                        factorizations=res.factorizations, max_principle_violation=res.max_principle_violation)
+            if res.startup_steps:  # a stiff Crank-Nicolson run: say that its first steps were implicit Euler
+                out["startup_steps"] = res.startup_steps
         self.details = out
 
     def _boundary(self, T: np.ndarray) -> dict:
         flows = boundary_heat_flow(self.network, T)
-        out = {"walls": {w.name: float(q) for w, q in zip(self.scene.walls, flows["walls"])},
-               "fixed_total": float(sum(flows["particles"].values()))}
-        if len(flows["particles"]) <= 1000:  # by particle id (the index unless a packing file gave ids)
-            ids = self.scene.particles.id
-            out["particles"] = {str(ids[k]): v for k, v in flows["particles"].items()}
-        return out
+        return boundary_summary(self.scene, flows["walls"], flows["particles"])
 
     # -------------------------------------------------------------------------------------------- outputs
     def record(self) -> dict:
@@ -191,7 +202,7 @@ class StaticEngine:
     def particle_fields(self) -> dict:
         p = self.scene.particles
         fields = {"id": p.id, "radius": p.radius, "temperature": self.T, "fixed": p.fixed.astype(np.int8),
-                  "material": p.material.astype(np.int32)}
+                  "material": p.material.astype(np.int32), "necks_meeting": self.meeting.astype(np.int8)}
         if self.potential is not None:
             fields["potential"] = self.potential
         return fields
@@ -243,6 +254,8 @@ class StaticEngine:
         k_eff = effective_conductivity(scene, out)
         if k_eff is not None:
             out["effective_conductivity"] = k_eff
+            if scene.specimen is not None and not scene.specimen.periodic:
+                out["specimen"] = scene.specimen.describe()
         out.update(T_mean=T_mean, T_min=T_min, T_max=T_max)
         out.update(d)
         if self.circuit is not None:

@@ -11,6 +11,8 @@ The contact radius ``a`` of a bond is given by the *contact geometry* that the c
   ``0 < h <= max_overlap(r_i, r_j)``.
 * ``"lens"`` -- the intersection circle of the two spheres (Zohdi 2014, eqs. 7-12): ``a^2 = r_i^2 - L_i^2`` with
   ``L_i = (d - (r_j^2 - r_i^2)/d)/2``. Its range is ``L_i, L_j >= 0``.
+* ``"union"`` -- the same circle read as a neck of the union of the spheres (:mod:`fem_neck.geometry.union`: each
+  sphere cut by its radical planes, Arzt 1982), defined at every density; the range is the lens'.
 
 A particle touching a wall (plane) is bonded to the wall. With a neck model the contact is the mirror image: a
 sphere sintered to its mirror image across the plane, whose symmetry plane is the isothermal wall, so the wall bond
@@ -42,7 +44,8 @@ from fem_neck.geometry import max_overlap, neck_radius
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox, canonical_bonds
 
-CONTACT_MODELS = ("newton", "first", "coble", "lens")
+CONTACT_MODELS = ("newton", "first", "coble", "lens", "union")
+LENS_GEOMETRY = ("lens", "union")  # the contact models whose circle is where the two spheres meet
 OUT_OF_RANGE = ("error", "clip", "drop")
 
 
@@ -187,7 +190,7 @@ def _pair_contacts(p: Particles, i, j, vec, contact, policy):
     d = np.linalg.norm(vec, axis=1)
     h = r_i + r_j - d
     l_i, l_j = _lens_planes(r_i, r_j, d)
-    if contact == "lens":
+    if contact in LENS_GEOMETRY:
         bad = (l_i < 0) | (l_j < 0)
         limit = "the lens needs both centres outside the other sphere's cap: d^2 >= |r_j^2 - r_i^2|"
     else:
@@ -207,7 +210,7 @@ def _pair_contacts(p: Particles, i, j, vec, contact, policy):
         dropped = count
     elif count:
         clipped = count
-    if contact == "lens":
+    if contact in LENS_GEOMETRY:
         small_i = r_i <= r_j
         if clipped:  # the smaller sphere's centre on the radical plane: a is its radius, the larger's pipe is d
             coincident = np.flatnonzero(bad & (d == 0.0))
@@ -241,7 +244,7 @@ def _wall_contacts(p: Particles, walls, contact, policy):
     delta = np.concatenate(hs) if hs else np.zeros(0)
     dist = np.concatenate(dists) if dists else np.zeros(0)
     r = p.radius[k_p]
-    if contact == "lens":
+    if contact in LENS_GEOMETRY:
         bad = dist < 0
         limit = "the centre must stay on the packing's side of the wall"
     else:
@@ -260,13 +263,13 @@ def _wall_contacts(p: Particles, walls, contact, policy):
         dropped = count
     elif count:
         clipped = count
-        if contact == "lens":  # centre on or behind the plane: the pipe has no length, the conductance no bound
+        if contact in LENS_GEOMETRY:  # centre on or behind the plane: the pipe has no length, the conductance no bound
             k = int(np.flatnonzero(bad)[0])
             raise ValueError(f"particle {k_p[k]} has its centre on or behind wall {walls[k_w[k]].name!r} (distance "
                              f"{dist[k]:.6g} m): the lens law's conductance kappa pi a^2 / L is infinite at L = 0; "
                              f"move the wall or set conductance.out_of_range = \"drop\"")
         delta = np.minimum(delta, r / 3.0)
-    if contact == "lens":
+    if contact in LENS_GEOMETRY:
         a = np.sqrt(np.maximum(r**2 - dist**2, 0.0))
     else:
         a = np.asarray(neck_radius(r, r, 2.0 * delta, method=contact)) if len(r) else np.zeros(0)

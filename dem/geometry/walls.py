@@ -11,7 +11,8 @@ only, so its state is the offset ``q`` and the normal velocity ``dq/dt`` (positi
   it, and the damping ``gamma_w`` (kg/s) calms it. In 2D (disks of height h) ``p`` is a force per length (N/m, as in
   the paper) and ``L`` the distance between the two walls perpendicular to the wall in the x-z plane; in 3D ``p`` is
   a stress (Pa) and ``L`` the area between the four perpendicular walls. Stress walls therefore need an axis-aligned
-  box: a wall facing each way along every perpendicular in-plane axis.
+  box: a wall facing each way along every perpendicular in-plane axis, or a periodic box along it (whose period is
+  the extent there: a stress wall presses a bed in a box periodic across it).
 * ``"strain"`` -- moves in at the constant ``velocity`` (m/s); a compression at strain rate ``e`` of a box of
   initial height ``z0`` is ``velocity = e z0`` (Luding 2005, Sec. 4.4: ``eps_zz = 1 - z/z0``).
 * ``"vibrate"`` -- ``q(t) = q0 + A sin(2 pi f t)``: a vibrating base (Luding 2005, Figs. 21-22).
@@ -144,7 +145,7 @@ class WallArrays:
     dq: np.ndarray         # (W,) normal velocities (inward positive)
     acc: np.ndarray        # (W,) accelerations of stress walls
     mode: np.ndarray       # (W,) int, MOTIONS
-    pressure: np.ndarray
+    pressure: np.ndarray   # (W,) of a stress wall, times the box's periods along its periodic in-plane axes
     mass: np.ndarray
     damping: np.ndarray
     q0: np.ndarray
@@ -154,7 +155,11 @@ class WallArrays:
     force: np.ndarray      # (W,) normal force the particles exert on each wall (N, pushing outward > 0)
 
     @classmethod
-    def build(cls, walls, dimension: int) -> "WallArrays":
+    def build(cls, walls, dimension: int, periods=None) -> "WallArrays":
+        """The arrays of ``walls`` (``dimension`` 2 or 3); ``periods`` (3,) m: the periodic box's lengths, 0 along
+        its non-periodic axes (None: no periodic box). Along a periodic in-plane axis a stress wall's extent is the
+        period, folded into its ``pressure`` (the kernels multiply that by the extent between the walls)."""
+        periods = np.zeros(3) if periods is None else np.asarray(periods, dtype=float)
         n_w = len(walls)
         normal = np.array([w.normal for w in walls], dtype=float).reshape(n_w, 3)
         q = np.array([w.offset for w in walls], dtype=float)
@@ -170,19 +175,30 @@ class WallArrays:
         for k, wall in enumerate(walls):
             axis = axis_of(wall.normal)
             perpendicular = [a for a in range(3) if a != axis and not (dimension == 2 and a == 1)]
+            bounded = [a for a in perpendicular if periods[a] == 0.0]  # by walls; the others by the box's period
             if wall.motion == "stress":  # a stress wall needs its extent; the others report a force then
                 if axis is None:
                     raise ValueError(f"walls.{wall.name}: a stress-controlled wall must be axis-aligned (normal "
                                      f"along x, y or z)")
-                missing = [a for a in perpendicular if a not in box]
+                missing = [a for a in bounded if a not in box]
                 if missing:
                     raise ValueError(f"walls.{wall.name}: a stress-controlled wall needs one wall facing each way "
-                                     f"along the {'xyz'[missing[0]]} axis (the box that gives its "
-                                     f"{'length' if dimension == 2 else 'area'})")
-            if axis is not None and all(a in box for a in perpendicular):
-                pairs = [m for a in perpendicular for m in box[a]]
+                                     f"along the {'xyz'[missing[0]]} axis, or a periodic {'xyz'[missing[0]]} axis "
+                                     f"(the box that gives its {'length' if dimension == 2 else 'area'})")
+            if axis is not None and all(a in box for a in bounded):
+                pairs = [m for a in bounded for m in box[a]]
                 arrays.span[k] = pairs + [-1] * (4 - len(pairs))
+                arrays.pressure[k] *= float(np.prod([periods[a] for a in perpendicular if a not in bounded]))
         return arrays
+
+    @staticmethod
+    def periodic_extent(wall, dimension: int, periods) -> tuple[float, int]:
+        """The product of the periods along ``wall``'s periodic in-plane axes (m or m^2; 1 for none) and their
+        count."""
+        axis = axis_of(wall.normal)
+        periods = np.zeros(3) if periods is None else np.asarray(periods, dtype=float)
+        along = [periods[a] for a in range(3) if a != axis and not (dimension == 2 and a == 1) and periods[a] > 0]
+        return float(np.prod(along)), len(along)
 
     def extent(self, lo: int, hi: int) -> float:
         """Distance between two opposite axis-aligned walls."""

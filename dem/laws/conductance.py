@@ -51,7 +51,13 @@ DESCRIPTIONS = {
                    "function; exact for pairs and chains, never above the Wiener bound)",
     "zohdi": "kappa pi a^2 / |x_i - x_j| with the lens contact circle (Zohdi 2014, eqs. 11-12, 33)",
 }
-NECK_MODELS = ("newton", "first", "coble")
+NECK_MODELS = ("newton", "first", "coble", "union")
+
+
+def law_keys(law: str) -> tuple:
+    """The ``[conductance]`` keys the law ``law`` reads besides ``law`` (:class:`ConductanceSpec`)."""
+    own = ("slope",) if law in ("rojek", "argento-bouvard") else ("fit_file", "unequal") if law in FIT_LAWS else ()
+    return own + (() if law == "zohdi" else ("neck",)) + ("contact_conductance", "out_of_range")
 LINEAR_SLOPES = {"rojek": fem_law.ROJEK.slope, "argento-bouvard": fem_law.ARGENTO_BOUVARD.slope}
 
 
@@ -88,18 +94,26 @@ class ConductanceSpec:
         if kc is not None and (not np.isfinite(kc) or kc <= 0):
             raise ValueError(f"conductance.contact_conductance = {kc!r}: must be finite and > 0 (W/K)")
         if self.law in FIT_LAWS:
-            fit_law(self.fit_file)  # a missing or malformed fit file is reported when the scene is read
+            self.fitted()  # a missing or malformed fit file, or one of the other half body, is reported when read
 
     @property
     def contact(self) -> str:
         """The contact geometry the law needs (:mod:`dem.geometry.bonds`)."""
         return "lens" if self.law == "zohdi" else self.neck
 
+    def fitted(self):
+        """The full-range law of the fit laws (:class:`fem_neck.law.ConductanceLaw`) for this neck reading: the
+        union of spheres' half body (no neck cylinder) for ``neck = "union"``, the neck cylinder's otherwise;
+        ``fit_file`` (default: the fit shipped for that half body) must have been fitted for it."""
+        half_body = "union" if self.neck == "union" else "cylinder"
+        return fit_law(self.fit_file, half_body).require_neck(half_body)
+
 
 @functools.lru_cache(maxsize=8)
-def fit_law(path: str | None):
-    """The full-range law of a fit.json (:class:`fem_neck.law.ConductanceLaw`), read once per path."""
-    return fem_law.ConductanceLaw.default() if path is None else fem_law.ConductanceLaw.from_json(path)
+def fit_law(path: str | None, neck: str = "cylinder"):
+    """The full-range law of a fit.json (:class:`fem_neck.law.ConductanceLaw`), read once per path; without a path
+    the one shipped for the half body ``neck`` (``"cylinder"`` or ``"union"``)."""
+    return fem_law.ConductanceLaw.default(neck) if path is None else fem_law.ConductanceLaw.from_json(path)
 
 
 def half_conductance(spec: ConductanceSpec, kappa, r, a, length):
@@ -108,7 +122,7 @@ def half_conductance(spec: ConductanceSpec, kappa, r, a, length):
     if spec.law in LINEAR_SLOPES:
         return (spec.slope or LINEAR_SLOPES[spec.law]) * kappa * np.pi * a          # eqs. (43), (42)
     if spec.law in FIT_LAWS:
-        return kappa * np.pi * r * np.asarray(fit_law(spec.fit_file).k_over_kcyl(np.minimum(a / r, 1.0)))
+        return kappa * np.pi * r * np.asarray(spec.fitted().k_over_kcyl(np.minimum(a / r, 1.0)))
     with np.errstate(divide="ignore"):
         return kappa * np.pi * a * a / length                                         # Zohdi 2014, eq. (33)
 
@@ -144,11 +158,16 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
         if bonds.n_walls and not len(walls):
             raise ValueError("conductance.law = \"shared-body\": the wall bonds' walls are needed (their normals)")
         normals = np.array([w.normal for w in walls])[bonds.wall_index] if bonds.n_walls else np.zeros((0, 3))
-        s_i, s_j, s_w = neck_factors(particles.n, r, bonds, bonds.vectors(particles.position, box), k_i, k_j, k_w,
-                                     kappa, normals)
+        vectors = bonds.vectors(particles.position, box)
+        volume = None
+        if spec.neck == "union":  # each particle keeps its cut sphere (fem_neck.geometry.union), not its sphere
+            from fem_neck.geometry.union import cut_spheres
+
+            volume = cut_spheres(r, bonds.i, bonds.j, vectors).volume
+        s_i, s_j, s_w = neck_factors(particles.n, r, bonds, vectors, k_i, k_j, k_w, kappa, normals, volume)
         k_i, k_j, k_w = s_i * k_i, s_j * k_j, s_w * k_w
     k_pair = series(k_i, k_j)
-    if spec.law in FIT_LAWS and spec.unequal and bonds.n_pairs:
+    if spec.law in FIT_LAWS and spec.unequal and spec.neck != "union" and bonds.n_pairs:  # fitted to neck cylinders
         k_pair = k_pair * fem_law.unequal_factor(r[bonds.i], r[bonds.j], bonds.a)
     k_pair, k_wall = series(k_pair, kc), series(k_w, kc)
     _check_finite(spec, k_pair, bonds.a, lambda k: f"bond ({bonds.i[k]}, {bonds.j[k]})")

@@ -50,7 +50,8 @@ for bit.
 ``sum_b s_b K_b l_b^2 (n_b . g)^2`` (the halves of a bond in series, Cauchy-Schwarz), and the Wiener bound ``phi
 kappa`` is the same field's energy in the solid, ``kappa V_k |g|^2`` per particle. So a particle's factors are
 scaled down together wherever ``lambda_max(sum_b s_b K_b l_b^2 n_b n_b^T)`` exceeds ``kappa V_k`` (``V_k = 4/3 pi
-r^3``, the volume each particle keeps under the volume-conserving neck): a periodic network then never conducts
+r^3``, the volume each particle keeps under the volume-conserving neck; under the union of spheres its cut sphere's,
+:func:`fem_neck.geometry.union.cut_spheres`): a periodic network then never conducts
 more than ``phi kappa``. The cap binds only where the necks overlap (beyond the pair model); it is applied to
 particles with non-collinear necks.
 
@@ -136,7 +137,7 @@ def _own_flux(x, N, z, flux):
 
 @numba.njit(cache=True, parallel=True)
 def _factors(n_particles, i, j, vec, a, l_i, l_j, k_i, k_j, wall_particle, wall_normal, wall_a, wall_l, k_wall,
-             radius, kappa):
+             radius, kappa, share):
     """The factor of every neck end (module docstring): end ``e < m`` is bond ``e``'s half on particle ``i``,
     ``m <= e < 2m`` its half on ``j``, and the rest the wall bonds' halves. Bonds: ``vec`` (m, 3) from ``i`` to the
     partner, neck radius ``a``, centre-to-contact distances ``l_i``, ``l_j``, half conductances ``k_i``, ``k_j``;
@@ -160,13 +161,13 @@ def _factors(n_particles, i, j, vec, a, l_i, l_j, k_i, k_j, wall_particle, wall_
     chunk = 4096
     for block in numba.prange((n_particles + chunk - 1) // chunk):
         _block_factors(block * chunk, min((block + 1) * chunk, n_particles), offsets, ends, m, vec, a, l_i, l_j,
-                       k_i, k_j, wall_normal, wall_a, wall_l, k_wall, radius, kappa, z_max, out)
+                       k_i, k_j, wall_normal, wall_a, wall_l, k_wall, radius, kappa, share, z_max, out)
     return out
 
 
 @numba.njit(cache=True)
 def _block_factors(first, last, offsets, ends, m, vec, a, l_i, l_j, k_i, k_j, wall_normal, wall_a, wall_l, k_wall,
-                   radius, kappa, z_max, out):
+                   radius, kappa, share, z_max, out):
     """:func:`_factors` for the particles ``first:last``, with work arrays of their own."""
     normal = np.empty((z_max, 3))
     base = np.empty(z_max)
@@ -246,7 +247,7 @@ def _block_factors(first, last, offsets, ends, m, vec, a, l_i, l_j, k_i, k_j, wa
             for p in range(3):
                 for c in range(3):
                     M[p, c] += w * normal[b, p] * normal[b, c]
-        limit = 4.0 / 3.0 * np.pi
+        limit = 4.0 / 3.0 * np.pi * share[k]
         shrink = 1.0
         if M[0, 0] + M[1, 1] + M[2, 2] > limit:
             lam = np.linalg.eigvalsh(M)[2]
@@ -257,17 +258,47 @@ def _block_factors(first, last, offsets, ends, m, vec, a, l_i, l_j, k_i, k_j, wa
 
 
 def neck_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray, k_j: np.ndarray,
-                 k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray):
+                 k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray, volume=None):
     """The factors ``(s_i, s_j, s_wall)`` of every pair bond's two halves and every wall bond's half (module
     docstring) from the particles' necks: the pair bonds (``vectors`` from ``i`` to the partner, neck radii
     ``bonds.a``, half conductances ``k_i``, ``k_j`` in W/K) and the wall bonds (unit ``wall_normals`` pointing into
-    the packing, ``bonds.wall_a``, half conductances ``k_wall``)."""
+    the packing, ``bonds.wall_a``, half conductances ``k_wall``).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    radius : numpy.ndarray
+        Particle radii, m.
+    bonds : Bonds
+        The pair and wall bonds with their neck radii (m) and centre-to-contact distances (m).
+    vectors : numpy.ndarray
+        ``x_j - x_i`` of every pair bond (m, 3), m.
+    k_i, k_j : numpy.ndarray
+        Half conductances of every pair bond on the side of ``i`` and of ``j``, W/K.
+    k_wall : numpy.ndarray
+        Half conductance of every wall bond, W/K.
+    conductivity : numpy.ndarray
+        Per particle, its material's conductivity, W/(m K).
+    wall_normals : numpy.ndarray
+        Unit normal of every wall bond's wall (pointing into the packing).
+    volume : numpy.ndarray, optional
+        Per particle, the solid it holds, m^3 (default: its sphere's, which the volume-conserving neck keeps; under
+        the union of spheres its cut sphere's), whose Wiener bound caps its factors.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        The factors of the pair bonds' halves on ``i`` and on ``j`` and of the wall bonds' halves (dimensionless).
+    """
     f = np.ascontiguousarray
+    sphere = 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=float) ** 3
+    share = np.ones(n) if volume is None else np.asarray(volume, dtype=float) / sphere
     out = _factors(n, f(bonds.i, dtype=np.int64), f(bonds.j, dtype=np.int64), f(vectors, dtype=float),
                    f(bonds.a, dtype=float), f(bonds.l_i, dtype=float), f(bonds.l_j, dtype=float), f(k_i, dtype=float),
                    f(k_j, dtype=float), f(bonds.wall_particle, dtype=np.int64),
                    f(np.reshape(wall_normals, (-1, 3)), dtype=float), f(bonds.wall_a, dtype=float),
                    f(bonds.wall_l, dtype=float), f(k_wall, dtype=float), f(radius, dtype=float),
-                   f(conductivity, dtype=float))
+                   f(conductivity, dtype=float), f(share, dtype=float))
     m = bonds.n_pairs
     return out[:m], out[m:2 * m], out[2 * m:]

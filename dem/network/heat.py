@@ -23,6 +23,16 @@ matrix; it is SPD when every connected group of free particles reaches a fixed p
   grid of [0, t_end], so the few step sizes used are factorised once each and the run ends exactly on t_end;
   explicit steps stay below 0.9 of the stable limit.
 
+  Stiff steps: Crank-Nicolson's amplification factor ``(1 - z/2)/(1 + z/2)``, ``z = lambda dt``, turns negative
+  for ``dt > 2/lambda`` and tends to -1 for ``z >> 1``: a fixed step far above the stiffest time constant keeps
+  the initial temperature difference alternating for ever (a pair stays at 100 and 0 C). Such a run (fixed ``dt``
+  above the stable limit ``2/lambda_max``) starts with ``STARTUP_STEPS`` implicit Euler steps (Rannacher's
+  start-up; amplification ``1/(1 + z)``, L-stable), which damp the stiff part of the initial data; the finite
+  number of first-order steps keeps the run second order, and a step within the stable limit runs plain
+  Crank-Nicolson as before. Whatever the integrator, a run whose ``max_principle_violation`` exceeds
+  ``MAX_PRINCIPLE_TOLERANCE`` of the scene's temperature range, or whose ``energy_error`` exceeds
+  ``ENERGY_TOLERANCE``, is refused with a message naming ``dt``: its temperatures are wrong.
+
   ``python -m benchmarks dem`` measures steps, error and time of each integrator, fixed and ``"auto"`` at rtol
   1e-2 ... 1e-4, on the decay of a 2048-particle packing between plates (section "DEM transient: error against
   time"). The dyadic grid rounds every step down to a power of 2: it costs some more steps for the same error, but
@@ -68,6 +78,10 @@ AUTO_LEVELS = 40  # implicit dt = "auto": steps t_end / 2^k, k <= AUTO_LEVELS
 AUTO_CONDITION = 1e8  # dt = "auto": steps at most this x min(C_i / A_ii), the fastest time constant (conditioning)
 AUTO_PROJECTION = 10.0  # dt = "auto": refuse once the current step projects this many x max_steps (after 100)
 AUTO_MIN_STEP = 2.0**-AUTO_LEVELS  # dt = "auto": steps this small (x t_end) are accepted whatever their error
+STARTUP_STEPS = 2  # fixed-step Crank-Nicolson above the stable limit: this many implicit Euler steps first
+MAX_PRINCIPLE_TOLERANCE = 0.01  # max_principle_violation allowed, x the scene's temperature range
+ROUND_OFF = math.sqrt(np.finfo(float).eps)  # ... and never below this x the largest prescribed |temperature|
+ENERGY_TOLERANCE = 1e-6  # energy_error allowed at the end of a transient run
 
 
 @dataclass
@@ -398,6 +412,7 @@ class TransientResult:
     solver: str
     factorizations: int
     max_principle_violation: float | None = None
+    startup_steps: int = 0  # implicit Euler steps that started a stiff Crank-Nicolson run (module docstring)
 
 
 class _Stepper:
@@ -590,6 +605,10 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     stepper = _Stepper(net, theta, linear, rtol_linear)
     T = net.particles.temperature[net.free].astype(float)
     limit = None
+    startup = None  # fixed-step Crank-Nicolson above the stable limit: implicit Euler start-up (module docstring)
+    if theta == 0.5 and not isinstance(dt, str) and np.isfinite(dt) and dt > 0 \
+            and float(dt) > stable_limit(net, net.sinks(T)):
+        startup = _Stepper(net, 1.0, linear, rtol_linear)
     if theta < 0.5:
         # radiation: the stiffest linearisation within the prescribed temperatures (maximum principle)
         t_hot = np.full(net.n_free, net.temperature_bounds()[1])
@@ -684,7 +703,8 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
                 dt_want = h * min(factor, AUTO_SAFETY)
                 continue
         else:
-            T_new, T_theta, sinks = stepper.step(T, h)
+            first = startup is not None and steps < STARTUP_STEPS
+            T_new, T_theta, sinks = (startup if first else stepper).step(T, h)
             parts = [(h, T_theta, sinks)]
         flows = {}
         for h_part, T_theta, sinks in parts:
@@ -705,6 +725,13 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
             raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {steps})")
         if bounded and len(T):
             violation = max(violation, float(T.max()) - hi, lo - float(T.min()))
+            if violation > max(MAX_PRINCIPLE_TOLERANCE * (hi - lo), ROUND_OFF * max(abs(lo), abs(hi))):
+                raise ValueError(_wrong(f"at t = {t:.6g} s the temperatures left the prescribed range [{lo:g}, "
+                                        f"{hi:g}] by {violation:.4g} (max_principle_violation, more than "
+                                        f"{MAX_PRINCIPLE_TOLERANCE:g} of the range)", integrator, dt,
+                                        ROUND_OFF_HINT if auto else
+                                        "the step is too large for the network's fastest time constant: use a "
+                                        "smaller dt, dt = \"auto\" or integrator = \"implicit\""))
         if observer is not None:
             observer(steps, t, T, flows)
         if progress is not None:
@@ -732,6 +759,25 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     energy = float(net.C @ T)
     scale_e = float(net.C.sum()) * net.temperature_range() + abs_in
     err = abs(energy - energy0 - sum(heat_in.values())) / scale_e if scale_e > 0 else 0.0
+    if not err <= ENERGY_TOLERANCE:
+        raise ValueError(_wrong(f"the heat balance is off by energy_error = {err:.3g} (more than "
+                                f"{ENERGY_TOLERANCE:g})", integrator, dt,
+                                ROUND_OFF_HINT if auto else
+                                "the capacities are lost to round-off next to the conductances at this step: "
+                                "use a smaller dt (or mode = \"steady\")"))
     heat_in = {k: float(v) for k, v in heat_in.items()}
+    factorizations = stepper.factorizations + (startup.factorizations if startup is not None else 0)
     return TransientResult(net.full(T), t, steps, rejected, err, heat_in, limit, dt_min, dt_max, stepper.backend,
-                           stepper.factorizations, violation if bounded else None)
+                           factorizations, violation if bounded else None,
+                           min(steps, STARTUP_STEPS) if startup is not None else 0)
+
+
+ROUND_OFF_HINT = ("even the smallest step dt = \"auto\" takes is far above the network's fastest time constant "
+                  "C/K, so the capacities are lost to round-off next to the conductances: check the materials' "
+                  "density and specific heat against the conductivity, or use mode = \"steady\"")
+
+
+def _wrong(what: str, integrator: str, dt, hint: str) -> str:
+    """The one-line refusal of a transient run whose temperatures came out wrong (module docstring)."""
+    step = f"{dt:.6g} s" if not isinstance(dt, str) else f"{dt!r}"
+    return f"solver.dt = {step} ({integrator}): {what}, so the temperatures are wrong; {hint}"

@@ -3,6 +3,12 @@
 * A folder that already holds a run (``RUN_FILES``) is refused unless the run is resumed (``resume``: go on
   from its last checkpoint) or cleared first (``overwrite``: the run's own files are deleted, nothing else). So two
   runs never mix their rows and snapshots.
+* A run holds its folder while it writes it: ``run.lock`` names its process (pid and host), taken before any file
+  is touched and removed when the run ends however it ends. A second run into the folder (``--resume`` and
+  ``--overwrite`` too) is refused naming the holder; a lock whose process is gone (a run killed outright) is stale
+  and taken over.
+* ``--resume`` of a finished run (a ``summary.json`` not marked ``interrupted`` or ``stopped``) is refused: there
+  is nothing to go on with, and the folder is left as it is.
 * While a transient run goes, :class:`Checkpointer` keeps the state between two steps (or intervals) and writes it
   to ``checkpoint.npz`` every ``[output] checkpoint_every`` seconds of wall time (default 5), at the end and after
   Ctrl-C, written aside and renamed, so a checkpoint on disk is always whole; an interrupted run resumes from the
@@ -12,12 +18,18 @@
 from __future__ import annotations
 
 import hashlib
+import json
+import os
 import pathlib
+import socket
 import time
 
 import numpy as np
 
+from dem.output.atomic import read_npz, write_aside
+
 CHECKPOINT = "checkpoint.npz"
+LOCK = "run.lock"  # the run writing the folder: {"pid", "host"}
 RUN_FILES = ("summary.json", "timeseries.csv", "profiles.csv", CHECKPOINT, "state.npz", "*.pvd", "*.vtu", "*.pvtu",
              "*.png")
 
@@ -37,6 +49,69 @@ def scene_digest(scene) -> str:
     return h.hexdigest()
 
 
+def _holder(path: pathlib.Path) -> dict | None:
+    """``{"pid", "host"}`` of the run named by the lock file at ``path`` while that process lives (on this host:
+    on another one it cannot be checked, so it counts as alive), None for a missing, unreadable or stale lock."""
+    try:
+        held = json.loads(path.read_text())
+        pid, host = int(held["pid"]), str(held["host"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if host != socket.gethostname():
+        return held
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return None
+    except PermissionError:  # alive, another user's
+        pass
+    return held
+
+
+def lock(out: pathlib.Path) -> None:
+    """Take the folder ``out`` for this process (module docstring): ``ValueError`` naming the holder when another
+    live run has it; a stale lock is replaced."""
+    path = out / LOCK
+    me = json.dumps({"pid": os.getpid(), "host": socket.gethostname()})
+    for _ in range(2):
+        try:
+            fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        except FileExistsError:
+            held = _holder(path)
+            if held is not None and held.get("pid") != os.getpid():
+                raise ValueError(f"--out {out}: another run is writing it (pid {held['pid']} on {held['host']}, "
+                                 f"{LOCK}); wait for it to end, or use another folder (no such run: delete "
+                                 f"{path})") from None
+            path.unlink(missing_ok=True)  # stale: its run was killed (or it is this process's own)
+            continue
+        with os.fdopen(fd, "w") as fh:
+            fh.write(me)
+        return
+    raise ValueError(f"--out {out}: {LOCK} could not be taken (another run took it at the same moment)")
+
+
+def unlock(out) -> None:
+    """Release the folder ``out`` if this process holds it."""
+    path = pathlib.Path(out) / LOCK
+    try:
+        held = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return
+    if held.get("pid") == os.getpid() and held.get("host") == socket.gethostname():
+        path.unlink(missing_ok=True)
+
+
+def finished(out: pathlib.Path) -> dict | None:
+    """The summary of the finished run in ``out`` (not marked ``interrupted`` or ``stopped``), or None."""
+    try:
+        summary = json.loads((out / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(summary, dict) or summary.get("interrupted") or "stopped" in summary:
+        return None
+    return summary
+
+
 def run_files(out: pathlib.Path) -> list[pathlib.Path]:
     return sorted({f for pattern in RUN_FILES for f in out.glob(pattern)})
 
@@ -49,31 +124,44 @@ def prepare(out, resume: bool = False, overwrite: bool = False) -> pathlib.Path:
         raise ValueError("--resume and --overwrite: give one of them")
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {out}: exists and is not a folder")
-    found = run_files(out) if out.exists() else []
-    if resume:
-        if not (out / CHECKPOINT).exists():
-            raise ValueError(f"--resume: {out} holds no checkpoint ({CHECKPOINT}) to go on from")
-        return out
-    if found and not overwrite:
-        raise ValueError(f"--out {out}: holds a run already ({found[0].name}, ...); --resume goes on from its last "
-                         f"checkpoint, --overwrite clears it first")
-    for f in found:
-        f.unlink()
+    held = out.exists()
+    if held:  # first of all: a folder another run is writing is refused whatever was asked
+        lock(out)
     try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ValueError(f"--out {out}: cannot be created ({exc.strerror})") from None
+        found = run_files(out) if out.exists() else []
+        if resume:
+            if not (out / CHECKPOINT).exists():
+                raise ValueError(f"--resume: {out} holds no checkpoint ({CHECKPOINT}) to go on from")
+        elif found and not overwrite:
+            raise ValueError(f"--out {out}: holds a run already ({found[0].name}, ...); --resume goes on from its "
+                             f"last checkpoint, --overwrite clears it first")
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ValueError(f"--out {out}: cannot be created ({exc.strerror})") from None
+        if not held:
+            lock(out)
+        if not resume:
+            for f in run_files(out):
+                f.unlink()
+    except BaseException:
+        unlock(out)
+        raise
     return out
 
 
 def load(out, scene, kind: str) -> dict:
-    """The checkpoint of the run in ``out`` as a dict of arrays, refused if another scene (or kind) wrote it."""
+    """The checkpoint of the run in ``out`` as a dict of arrays, refused if another scene (or kind) wrote it or the
+    run is finished (:func:`finished`)."""
     path = pathlib.Path(out) / CHECKPOINT
-    with np.load(path, allow_pickle=False) as f:
-        data = {k: f[k] for k in f.files}
+    data = read_npz(path, "--resume: the checkpoint")
     if str(data.get("kind")) != kind or str(data.get("scene_digest")) != scene_digest(scene):
         raise ValueError(f"--resume: {path} was written by another scene (or another kind of run); resume it with "
                          f"the scene that started it, or use --overwrite")
+    done = finished(pathlib.Path(out))
+    if done is not None:
+        raise ValueError(f"--resume: {out} holds a finished run (summary.json, t = {done.get('t')}, steps = "
+                         f"{done.get('steps')}); nothing to go on with; --overwrite runs it again")
     return data
 
 
@@ -105,9 +193,6 @@ class Checkpointer:
             self._write()
 
     def _write(self) -> None:
-        tmp = self.path.with_name(self.path.name + ".part")
-        with tmp.open("wb") as fh:
-            np.savez(fh, **self.header, **self.latest)
-        tmp.replace(self.path)
+        write_aside(self.path, lambda fh: np.savez(fh, **self.header, **self.latest), "wb")
         self.written_at = time.monotonic()
         self.written = True

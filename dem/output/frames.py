@@ -14,6 +14,8 @@ import pathlib
 
 import numpy as np
 
+from dem.output.atomic import read_npz, write_aside
+
 WINDOW = (900, 700)
 
 
@@ -93,13 +95,14 @@ class FrameWriter:
         fraction = sim.record().get("volume_fraction")
         title = f"t = {t:.3f} s" + (f",  volume fraction {fraction:.3f}" if fraction is not None else "")
         plates = sim.plates()
-        np.savez(self._data(self.next), x=s.x, radius=s.radius, T=s.T, title=np.array(title),
-                 plates=np.array([np.concatenate([c, n, size]) for c, n, size in plates]).reshape(-1, 8))
+        arrays = dict(x=s.x, radius=s.radius, T=s.T, title=np.array(title),
+                      plates=np.array([np.concatenate([c, n, size]) for c, n, size in plates]).reshape(-1, 8))
+        write_aside(self._data(self.next), lambda fh: np.savez(fh, **arrays), "wb")  # whole, for a resumed run
         self.next += 1
 
     def render(self) -> list[str]:
         """Draw every saved frame as ``frame_KK.png`` with one colour range (class docstring); returns the names."""
-        frames = [(k, np.load(self._data(k))) for k in range(len(self.times)) if self._data(k).exists()]
+        frames = [(k, read_npz(self._data(k), "frame")) for k in range(len(self.times)) if self._data(k).exists()]
         hottest = max((float(np.max(f["T"])) for _, f in frames), default=self.T_high)
         clim = (self.T_low, max(self.T_high, hottest))
         self.written = []

@@ -13,6 +13,7 @@ from __future__ import annotations
 import meshio
 import numpy as np
 
+from dem.output.atomic import write_aside
 from dem.output.writer import DIGITS, RunWriter, listed_snapshots, write_pvd, write_vtu
 
 VTK_TYPES = {np.dtype(k): v for k, v in (("float32", "Float32"), ("float64", "Float64"), ("int8", "Int8"),
@@ -40,9 +41,7 @@ def write_pvtu(path, pieces: list[str], point_fields: dict, cell_fields: dict) -
             + '    <PPoints>\n      <PDataArray type="Float64" NumberOfComponents="3"/>\n    </PPoints>\n'
             + "".join(f'    <Piece Source="{p}"/>\n' for p in pieces)
             + "  </PUnstructuredGrid>\n</VTKFile>\n")
-    tmp = path.with_name(path.name + ".part")
-    tmp.write_text(text)
-    tmp.replace(path)
+    write_aside(path, lambda fh: fh.write(text))
 
 
 class PieceWriter(RunWriter):

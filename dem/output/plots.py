@@ -15,6 +15,13 @@ import pathlib
 
 import numpy as np
 
+from dem.output.atomic import write_aside
+
+
+def _save(fig, path: pathlib.Path) -> None:
+    """``fig`` as a PNG at ``path``, written aside and renamed (:mod:`dem.output.atomic`)."""
+    write_aside(path, lambda fh: fig.savefig(fh, format="png", dpi=120), "wb")
+
 
 def _read_csv(path: pathlib.Path) -> dict:
     with path.open() as fh:
@@ -69,7 +76,7 @@ def motion_plots(out_dir, temperature_unit: str, wall_unit: str) -> list[str]:
             ax.set_ylabel(label, fontsize=8)
         axes[-1, 0].set_xlabel("t (s)")
         fig.tight_layout()
-        fig.savefig(out / "timeseries.png", dpi=120)
+        _save(fig, out / "timeseries.png")
         plt.close(fig)
         written.append("timeseries.png")
     if data and "joule_heat" in data and "volume_fraction" in data and "T_mean" in data:
@@ -90,7 +97,7 @@ def motion_plots(out_dir, temperature_unit: str, wall_unit: str) -> list[str]:
             a2.set_ylabel("neck radius a / r (mean over contacts)")
             a2.legend(fontsize=7)
             fig.tight_layout()
-            fig.savefig(out / "profiles.png", dpi=120)
+            _save(fig, out / "profiles.png")
             plt.close(fig)
             written.append("profiles.png")
     return written
@@ -102,8 +109,9 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
     * ``temperature.png`` -- mean, min and max temperature against time (transient);
     * ``heat_flow.png`` -- heat flow into the particles through fixed particles, walls, convection, radiation and
       internal sources against time (transient; the boundaries the scene has);
-    * ``profile.png`` -- the temperature of every particle against its height along the heat-flow axis (z) with
-      the mean of slabs, and the effective conductivity when the run reports one (scenes with a hot and a cold end).
+    * ``profile.png`` -- the temperature of every particle against its place along the heat-flow axis (the
+      specimen's, :mod:`dem.scene.specimen`) with the mean of slabs, and the effective conductivity when the run
+      reports one (scenes with a hot and a cold end).
     """
     import matplotlib
 
@@ -121,7 +129,7 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
         ax.set_ylabel(temperature_label(scene.temperature_unit))
         ax.legend()
         fig.tight_layout()
-        fig.savefig(out / "temperature.png", dpi=120)
+        _save(fig, out / "temperature.png")
         plt.close(fig)
         written.append("temperature.png")
         flows = [k for k in data if k.startswith("Q_") and any(abs(v) > 0 for v in data[k])]
@@ -133,11 +141,12 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
             ax.set_ylabel("heat flow into the particles (W)")
             ax.legend()
             fig.tight_layout()
-            fig.savefig(out / "heat_flow.png", dpi=120)
+            _save(fig, out / "heat_flow.png")
             plt.close(fig)
             written.append("heat_flow.png")
     if scene.specimen is not None:
-        z = scene.particles.position[:, 2]
+        axis = scene.specimen.axis
+        z = scene.particles.position[:, axis]
         fig, ax = plt.subplots(figsize=(7, 4))
         ax.plot(z * 1e3, T, ".", ms=2, alpha=0.4, label="particles")
         edges = np.linspace(z.min(), z.max(), 21)
@@ -146,7 +155,7 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
         with np.errstate(invalid="ignore"):
             mean = np.bincount(slab, T, 20) / count
         ax.plot(0.5 * (edges[1:] + edges[:-1]) * 1e3, mean, "o-", label="slab mean")
-        ax.set_xlabel("z (mm), along the heat flow")
+        ax.set_xlabel(f"{'xyz'[axis]} (mm), along the heat flow")
         ax.set_ylabel(temperature_label(scene.temperature_unit))
         summary = out / "summary.json"
         title = ""
@@ -158,7 +167,7 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
         ax.set_title(title)
         ax.legend()
         fig.tight_layout()
-        fig.savefig(out / "profile.png", dpi=120)
+        _save(fig, out / "profile.png")
         plt.close(fig)
         written.append("profile.png")
     return written
@@ -180,6 +189,6 @@ def _fraction_temperature(plt, out: pathlib.Path, data: dict, temperature_unit: 
                     label="current flowing")
     ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "fraction_temperature.png", dpi=120)
+    _save(fig, out / "fraction_temperature.png")
     plt.close(fig)
     return "fraction_temperature.png"

@@ -28,6 +28,8 @@ import re
 import meshio
 import numpy as np
 
+from dem.output.atomic import read_npz, write_aside
+
 MAX_SNAPSHOTS = 1000  # VTU snapshots per run (each is two files): more is refused up front (fixed dt) or thinned (auto)
 DIGITS = 9  # of the step in a snapshot's file name
 
@@ -39,8 +41,16 @@ def resumed_csv(path: pathlib.Path, keep) -> "io.TextIOBase":
         lines = fh.read().splitlines()
     header = lines[0].split(",") if lines else []
     kept = lines[:1] + [line for line in lines[1:] if keep(dict(zip(header, line.split(","))))]
-    path.write_text("".join(line + "\n" for line in kept))
+    write_aside(path, lambda fh: fh.write("".join(line + "\n" for line in kept)))
     return path.open("a")
+
+
+def resumed_profiles(path: pathlib.Path, t_last: float) -> None:
+    """``profiles.csv`` cut after the block of the snapshot at ``t_last`` (the last one a resumed run keeps). A block's
+    time is written rounded (``_cell``: 12 digits), so it is compared with ``t_last`` rounded the same way: the block at
+    exactly ``t_last`` stays even where its rounded time lies above ``t_last``, and every later one goes."""
+    limit = float(_cell(t_last))
+    resumed_csv(path, lambda row: float(row["t"]) <= limit).close()
 
 
 def snapshot_files(out: pathlib.Path, kind: str):
@@ -71,16 +81,15 @@ def resumed_snapshots(out: pathlib.Path, kinds, last_step: int) -> list[tuple[fl
 
 def write_vtu(path: pathlib.Path, mesh) -> None:
     """``mesh`` to ``path``, written aside and renamed: a VTU file on disk is always whole."""
-    tmp = path.with_name(path.name + ".part")
-    meshio.write(tmp, mesh, file_format="vtu")
-    tmp.replace(path)
+    write_aside(path, lambda tmp: meshio.write(tmp, mesh, file_format="vtu"), None)
 
 
 def write_pvd(path: pathlib.Path, entries: list[tuple[float, str]]) -> None:
     """A ParaView collection of ``(time, file)`` entries."""
     rows = "\n".join(f'    <DataSet timestep="{t:.17g}" group="" part="0" file="{f}"/>' for t, f in entries)
-    path.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
-                    f"  <Collection>\n{rows}\n  </Collection>\n</VTKFile>\n")
+    write_aside(path, lambda fh: fh.write('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" '
+                                          f'byte_order="LittleEndian">\n  <Collection>\n{rows}\n  </Collection>\n'
+                                          "</VTKFile>\n"))
 
 
 def checkpoint_reached(out: pathlib.Path) -> dict | None:
@@ -88,16 +97,16 @@ def checkpoint_reached(out: pathlib.Path) -> dict | None:
     path = out / "checkpoint.npz"
     if not path.exists():
         return None
-    with np.load(path, allow_pickle=False) as f:
-        return {"t": float(f["t"]), "steps": int(f["steps"])}
+    try:
+        data = read_npz(path, "checkpoint")
+        return {"t": float(data["t"]), "steps": int(data["steps"])}
+    except (ValueError, KeyError):  # not one of ours: nothing to resume from
+        return None
 
 
 def write_summary(path, summary: dict) -> None:
     """``summary`` as JSON, written aside and renamed."""
-    path = pathlib.Path(path)
-    tmp = path.with_name(path.name + ".part")
-    tmp.write_text(json.dumps(summary, indent=2) + "\n")
-    tmp.replace(path)
+    write_aside(path, lambda fh: fh.write(json.dumps(summary, indent=2) + "\n"))
 
 
 def _cell(value) -> str:
@@ -138,7 +147,7 @@ class RunWriter:
             self.snapshots = resumed_snapshots(self.out, self.kinds, resume_step)
             t_last = self._resumed_clock()
             if (self.out / "profiles.csv").exists():
-                resumed_csv(self.out / "profiles.csv", lambda row: float(row["t"]) <= t_last).close()
+                resumed_profiles(self.out / "profiles.csv", t_last)
 
     def _resumed_clock(self) -> float:
         """The time of the last snapshot kept on resuming; the next snapshot's time advanced past it, as the
@@ -216,7 +225,7 @@ class RunWriter:
                 if new:
                     fh.write("t,distance,solid_fraction,neck_over_radius\n")
                 for d, phi, a in zip(profile["distance"], profile["solid_fraction"], profile["neck_over_radius"]):
-                    fh.write(f"{t:.12g},{d:.12g},{phi:.12g},{'' if a is None else f'{a:.12g}'}\n")
+                    fh.write(f"{_cell(t)},{_cell(d)},{_cell(phi)},{_cell(a)}\n")
 
     def _write_pvd(self) -> None:
         for kind in self.kinds:

@@ -28,10 +28,13 @@ The format comes from the file's name (``.csv``; ``.data``, ``.lmp`` or a name `
 ``length_unit`` (0.001 for a file in mm, 1e-6 in um; densities stay kg/m^3); a LAMMPS file that records its unit
 style (the title line ``units = cgs`` of ``write_data``, ``ITEM: UNITS`` of a dump) is converted from it. Particles
 read from LAMMPS files are sorted by id (LAMMPS writes them in the order of its processors); other files keep their
-order. A bad file raises ``ValueError`` with one line naming the file, the line and the column.
+order. A bad file raises ``ValueError`` with one line naming the file, the line and the column. A file that reads
+but looks wrong gets a ``UserWarning``: positions of at most 6 significant digits with pairs within that rounding of
+touching (:func:`printed_precision`), a median radius beyond :data:`RADIUS_PLAUSIBLE` (another length unit than the
+file says).
 
 The other way: :func:`write_lammps_data` writes a packing (read here, from a scene's particles, or from a saved
-moving state, :func:`packing_from_state`) as a LAMMPS data file of ``atom_style sphere`` that ``read_data`` reads;
+state, :func:`packing_from_state`) as a LAMMPS data file of ``atom_style sphere`` that ``read_data`` reads;
 :func:`write_csv` and :func:`write_vtu` write the two other formats.
 """
 
@@ -39,6 +42,7 @@ from __future__ import annotations
 
 import csv
 import io
+import logging
 import math
 import mmap
 import pathlib
@@ -47,6 +51,8 @@ import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+
+from dem.output.atomic import write_aside
 
 FORMATS = ("csv", "lammps-data", "lammps-dump", "vtk")
 AXES = "xyz"
@@ -156,7 +162,10 @@ def read_packing(path, format: str | None = None, length_unit: float = 1.0, time
         raise ValueError(f"{path}: cannot be read as text ({exc.reason} at byte {exc.start})") from None
     if axes is not None:
         packing = replace(packing, periodic=axes)
-    return _checked(packing, path, fmt)
+    packing = _checked(packing, path, fmt)
+    _warn_unit(packing, length_unit)
+    _warn_precision(packing)
+    return packing
 
 
 def _axes(periodic) -> tuple:
@@ -203,6 +212,57 @@ def _checked(p: Packing, path, fmt: str) -> Packing:
         a = int(np.flatnonzero(p.box_hi <= p.box_lo)[0])
         raise ValueError(f"{path}: box {AXES[a]}lo = {p.box_lo[a]:.9g} >= {AXES[a]}hi = {p.box_hi[a]:.9g}")
     return replace(p, source=str(path), format=fmt)
+
+
+RADIUS_PLAUSIBLE = (1e-8, 0.05)  # m: the median radius of a powder or a granular bed (10 nm to 5 cm)
+PRINTED_DIGITS = 6  # LAMMPS's default float format in dumps (%g)
+
+
+def _warn_unit(p: Packing, length_unit: float) -> None:
+    """Warn when the particles' median radius (m) lies outside :data:`RADIUS_PLAUSIBLE`: the file is likely in
+    another length unit than it says (or than ``length_unit``)."""
+    r = float(np.median(p.radius))
+    if RADIUS_PLAUSIBLE[0] <= r <= RADIUS_PLAUSIBLE[1]:
+        return
+    said = (f"LAMMPS units {p.units}" if p.units is not None else
+            f"length_unit = {length_unit:g}" + (" and no LAMMPS units line" if p.format.startswith("lammps") else ""))
+    hint = ("in mm (length_unit = 1e-3) or um (1e-6)" if r > RADIUS_PLAUSIBLE[1] else
+            "in metres read with a length_unit for mm or um")
+    warnings.warn(f"{p.source}: the median radius is {r:.3g} m (read with {said}): grains are "
+                  f"{RADIUS_PLAUSIBLE[0]:g} to {RADIUS_PLAUSIBLE[1]:g} m; is the file {hint}?", stacklevel=3)
+
+
+def printed_precision(x: np.ndarray, digits: int = PRINTED_DIGITS) -> float | None:
+    """The largest rounding error (m) of coordinates ``x`` that carry at most ``digits`` significant digits (each
+    equal to itself rounded to them), or None where one carries more."""
+    x = np.asarray(x, dtype=float).ravel()
+    x = x[x != 0.0]
+    if not len(x):
+        return None
+    step = 10.0 ** (np.floor(np.log10(np.abs(x))) - (digits - 1))
+    if not np.allclose(np.round(x / step) * step, x, rtol=1e-12, atol=0.0):
+        return None
+    return float(0.5 * step.max())
+
+
+def _warn_precision(p: Packing) -> None:
+    """Warn when the positions carry at most :data:`PRINTED_DIGITS` significant digits and contacts sit within that
+    rounding (their gap or overlap below it): those contacts may be gained or lost by the rounding."""
+    error = printed_precision(p.position)
+    if error is None or p.n < 2:
+        return
+    from scipy.spatial import cKDTree
+
+    tolerance = 2.0 * math.sqrt(3.0) * error  # the distance of two rounded centres is off by at most this
+    i, j = cKDTree(p.position).query_pairs(2.0 * float(p.radius.max()) + tolerance, output_type="ndarray").T
+    gap = np.linalg.norm(p.position[i] - p.position[j], axis=1) - (p.radius[i] + p.radius[j])
+    near = int(np.count_nonzero(np.abs(gap) <= tolerance))
+    if near:
+        warnings.warn(f"{p.source}: the positions carry {PRINTED_DIGITS} significant digits (rounded by up to "
+                      f"{error:.3g} m) and {near} pair(s) within {tolerance:.3g} m of touching "
+                      f"({int(np.count_nonzero(gap < 0))} contacts in all), so the rounding may make or break "
+                      "contacts; write the file with full precision (LAMMPS: dump_modify format float %.17g)",
+                      stacklevel=3)
 
 
 # A table of numbers is parsed at C speed (np.loadtxt); only a table that fails is read again, line by line, to name
@@ -404,6 +464,7 @@ def _read_data(path: pathlib.Path, length_unit: float, _timestep=None) -> Packin
     if len(atoms) != n_atoms:
         raise FileError(path, f"the Atoms section has {len(atoms)} lines but the header says {n_atoms} atoms", start)
     ids = _integers(path, atoms[:, 0], body, first, 1, "id")
+    _unique_ids(path, ids, body, first)
     diameter = atoms[:, 2]
     _check_rows(path, diameter <= 0, body, first, 3, "diameter",  # diameter 0: a LAMMPS point particle
                 lambda row: f"diameter = {float(diameter[row])!r}: must be > 0 (a sphere)")
@@ -424,6 +485,17 @@ def _read_data(path: pathlib.Path, length_unit: float, _timestep=None) -> Packin
         out.update(velocity=velocity, angular_velocity=omega)
     packing = Packing(ids, atoms[:, 4:7], 0.5 * diameter, box_lo=lo, box_hi=hi, units=units, **out)
     return _sorted(_scaled(packing, length), np.argsort(ids, kind="stable"))
+
+
+def _unique_ids(path, ids: np.ndarray, body: str, first: int) -> None:
+    """Refuse an id given to two atoms of a section, naming both lines (before any other section is matched to
+    the atoms)."""
+    order = np.argsort(ids, kind="stable")
+    same = np.flatnonzero(ids[order][1:] == ids[order][:-1])
+    if same.size:
+        a, b = order[same[0]], order[same[0] + 1]
+        raise FileError(path, f"id {ids[a]} is given to two atoms (lines {_row_line(body, first, a)} and "
+                        f"{_row_line(body, first, b)}); ids must be unique", _row_line(body, first, b))
 
 
 def _data_header(path, header: str) -> tuple[int, np.ndarray, np.ndarray]:
@@ -617,20 +689,38 @@ VTK_FIELDS = {"radius": ("radius", "radii"), "diameter": ("diameter", "diameters
                                                                                "angvelvec")}
 
 
+class _KeptLog(logging.Handler):
+    """A logging handler that keeps the messages it is given (a VTK reader's errors, for the one-line refusal)."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record):
+        self.messages.append(record.getMessage())
+
+
 def _read_vtk(path: pathlib.Path, length_unit: float, _timestep=None) -> Packing:
     import pyvista as pv
     from vtkmodules.vtkCommonCore import vtkLogger
 
     vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)  # a bad file: our one line, not VTK's log
-    with warnings.catch_warnings(record=True) as caught:  # pyvista reports a reader's error as a warning
-        warnings.simplefilter("always")
-        try:
-            mesh = pv.read(str(path))
-        except Exception as exc:  # VTK's readers raise many kinds; the file is what is wrong
-            raise ValueError(f"{path}: cannot be read as VTK ({' '.join(str(exc).split())})") from None
+    logged = _KeptLog()  # pyvista passes some reader errors to the logging module (an "ERROR:root:" line)
+    root = logging.getLogger()
+    root.addHandler(logged)
+    try:
+        with warnings.catch_warnings(record=True) as caught:  # pyvista reports a reader's error as a warning
+            warnings.simplefilter("always")
+            try:
+                mesh = pv.read(str(path))
+            except Exception as exc:  # VTK's readers raise many kinds; the file is what is wrong
+                raise ValueError(f"{path}: cannot be read as VTK ({' '.join(str(exc).split())})") from None
+    finally:
+        root.removeHandler(logged)
     if mesh is None or not hasattr(mesh, "point_data") or mesh.n_points == 0:
-        if caught:
-            raise ValueError(f"{path}: cannot be read as VTK ({' '.join(str(caught[0].message).split())})")
+        if caught or logged.messages:
+            why = str(caught[0].message) if caught else logged.messages[0]
+            raise ValueError(f"{path}: cannot be read as VTK ({' '.join(why.split())})")
         raise ValueError(f"{path}: holds no points (a VTK point set: the particle centres, with a radius or diameter "
                          "point field)")
     fields = {name.lower(): name for name in mesh.point_data.keys()}
@@ -749,9 +839,15 @@ def scene_particles(table: dict, materials, base_dir=None):
         if off.size:
             k = int(off[0])
             m = particles.materials[particles.material[k]]
+            if packing.units is None and abs(m.density / packing.density[k] / 1e3 - 1.0) <= DENSITY_RTOL:
+                advice = (f"{packing.density[k]:.6g} is the material's density in g/cm^3, as a LAMMPS file in "
+                          "units micro or cgs writes it: give the file its units line (`units = micro` or `units = cgs` in its first line, as write_data "
+                          "writes it), which converts its lengths too")
+            else:
+                advice = ("give the material that density (with [[materials]] for several: LAMMPS type k is material "
+                          "k - 1)")
             raise ValueError(f"[particles] file {name!r}: particle id {packing.id[k]} has density "
-                             f"{packing.density[k]:.6g} kg/m^3 but its material {m.name!r} {m.density:.6g}; give the "
-                             "material that density (with [[materials]] for several: LAMMPS type k is material k - 1)")
+                             f"{packing.density[k]:.6g} kg/m^3 but its material {m.name!r} {m.density:.6g}; {advice}")
     box = packing.periodic_box() if packing.box_lo is not None else None
     return particles, box
 
@@ -769,17 +865,26 @@ def packing_from_particles(particles, box=None) -> Packing:
 
 
 def packing_from_state(state: dict) -> Packing:
-    """A :class:`Packing` of a saved moving state (:func:`dem.scene.state_file.load`): positions, radii, temperatures,
-    velocities and angular velocities; the density is the one that gives each particle its saved mass as a sphere
-    (``m / (4/3 pi r^3)``, also what LAMMPS computes the mass from). 3D states only: a 2D state's disks lie in the
-    x-z plane with a height, which LAMMPS's 2D spheres (x-y plane) do not have."""
-    if int(state["dimension"]) != 3:
+    """A :class:`Packing` of a saved state (:func:`dem.scene.state_file.load`) in its periodic box, if it has one:
+    positions, radii, temperatures, ids; of a moving state also velocities, angular velocities and the density that
+    gives each particle its saved mass as a sphere (``m / (4/3 pi r^3)``, also what LAMMPS computes the mass from),
+    of a static one its materials (no density: the scene's materials have them). 3D states only: a 2D state's disks
+    lie in the x-z plane with a height, which LAMMPS's 2D spheres (x-y plane) do not have."""
+    from dem.scene.state_file import saved_box
+
+    if state["moving"] and int(state["dimension"]) != 3:
         raise ValueError("state: a 2D state (disks in the x-z plane): only 3D states can be written as packings")
     radius = np.asarray(state["radius"], dtype=float)
     ids = state["id"] if "id" in state else np.arange(len(radius), dtype=np.int64)
+    box = saved_box(state)
+    lo = hi = periodic = None
+    if box is not None:
+        lo, hi, periodic = box.origin, box.origin + box.lengths, tuple(box.periodic)
+    moving = {"density": state["mass"] / (SPHERE_VOLUME * radius**3), "velocity": np.asarray(state["v"], dtype=float),
+              "angular_velocity": np.asarray(state["w"], dtype=float)} if state["moving"] else \
+        {"material": np.asarray(state["material"], dtype=np.int64) if "material" in state else None}
     return Packing(np.asarray(ids, dtype=np.int64), np.asarray(state["x"], dtype=float), radius,
-                   np.asarray(state["T"], dtype=float), density=state["mass"] / (SPHERE_VOLUME * radius**3),
-                   velocity=np.asarray(state["v"], dtype=float), angular_velocity=np.asarray(state["w"], dtype=float))
+                   np.asarray(state["T"], dtype=float), box_lo=lo, box_hi=hi, periodic=periodic, **moving)
 
 
 def lammps_ids(ids: np.ndarray) -> np.ndarray:
@@ -795,8 +900,10 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
     velocities, ``Velocities`` (``id vx vy vz wx wy wz``). Ids from :func:`lammps_ids`; type = material index + 1
     (names: their order of appearance); ``density`` kg/m^3 (one number or per particle) where the packing has none.
     The box is the packing's, or the particles' bounding box grown by ``pad`` (m) beyond the largest radius; the
-    periodicity is not part of a data file: the input script's ``boundary`` command sets it. Numbers are written
-    to round-trip (the shortest digits that read back to the same double)."""
+    periodicity is not part of a data file: the input script's ``boundary`` command sets it. A centre outside the
+    packing's box (``lo <= x < hi``, LAMMPS's rule) is wrapped into it along a periodic axis, its image flag counting
+    the periods (:func:`wrapped`), and refused along any other. Numbers are written to round-trip (the shortest
+    digits that read back to the same double)."""
     path = pathlib.Path(path)
     n = packing.n
     if packing.density is not None:
@@ -810,12 +917,13 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
         raise ValueError(f"density[{k}] = {rho[k]!r}: must be a finite number > 0 (kg/m^3)")
     types = _types(packing.material, n)
     x, r = packing.position, packing.radius
-    if packing.box_lo is not None:
-        lo, hi = packing.box_lo, packing.box_hi
-    else:
-        lo, hi = (x - r[:, None]).min(axis=0) - pad, (x + r[:, None]).max(axis=0) + pad
     image = packing.image if packing.image is not None else np.zeros((n, 3), dtype=np.int64)
     ids = lammps_ids(packing.id)
+    if packing.box_lo is not None:
+        lo, hi = packing.box_lo, packing.box_hi
+        x, image = wrapped(packing, path.name)
+    else:
+        lo, hi = (x - r[:, None]).min(axis=0) - pad, (x + r[:, None]).max(axis=0) + pad
     lo, hi = (np.asarray(b, dtype=float).tolist() for b in (lo, hi))
     head = [f"LAMMPS data file of {n} spheres written by sinterheat (dem.scene.packing_files), units = si", "",
             f"{n} atoms", f"{int(types.max())} atom types", ""]
@@ -827,6 +935,35 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
         parts += ["\nVelocities\n\n", _rows_text([ids, *packing.velocity.T, *w.T], " ")]
     _write_text(path, parts)
     return path
+
+
+def wrapped(packing: Packing, what: str = "packing") -> tuple[np.ndarray, np.ndarray]:
+    """The centres of ``packing`` in its box, ``lo <= x < hi`` (LAMMPS's rule), and their image flags: along a
+    periodic axis a centre outside is moved by whole periods and its flag counts them (``x + image L`` is kept);
+    along any other (or where the packing cannot say which axes are periodic) a centre outside is refused with
+    ``ValueError`` naming the particle and ``what`` (LAMMPS would lose it: "Did not assign all atoms correctly")."""
+    x = np.array(packing.position, dtype=float)
+    image = (np.zeros((packing.n, 3), dtype=np.int64) if packing.image is None
+             else np.array(packing.image, dtype=np.int64))
+    lo, hi = np.asarray(packing.box_lo, dtype=float), np.asarray(packing.box_hi, dtype=float)
+    periodic = packing.periodic if packing.periodic is not None else (False, False, False)
+    for a in range(3):
+        length = hi[a] - lo[a]
+        if periodic[a]:
+            k = np.floor((x[:, a] - lo[a]) / length)
+            x[:, a] -= k * length
+            x[:, a] = np.where(x[:, a] >= hi[a], lo[a], np.maximum(x[:, a], lo[a]))  # round-off at the faces
+            image[:, a] += k.astype(np.int64)
+            continue
+        outside = np.flatnonzero((x[:, a] < lo[a]) | (x[:, a] >= hi[a]))
+        if outside.size:
+            m = int(outside[0])
+            unknown = " (which axes are periodic is not known: give them, e.g. --periodic xy)" \
+                if packing.periodic is None else ""
+            raise ValueError(f"{what}: particle id {packing.id[m]} has {AXES[a]} = {float(x[m, a])!r} m, outside the "
+                             f"box [{float(lo[a])!r}, {float(hi[a])!r}) along {AXES[a]}, which is not periodic{unknown}; "
+                             f"{outside.size} particle(s) lie outside it (LAMMPS would lose them)")
+    return x, image
 
 
 def _rows_text(columns, sep: str, chunk: int = 100_000):
@@ -893,8 +1030,8 @@ def write_vtu(path, packing: Packing) -> pathlib.Path:
 def _write_text(path: pathlib.Path, parts) -> None:
     """Write the strings (or iterables of strings) ``parts`` to ``path``: aside, then renamed, so that a file on disk
     is always whole."""
-    tmp = path.with_name(path.name + ".part")
-    with tmp.open("w") as fh:
+    def write(fh):
         for part in parts:
             fh.writelines([part] if isinstance(part, str) else part)
-    tmp.replace(path)
+
+    write_aside(path, write)

@@ -24,12 +24,14 @@ from dem.scene.zohdi import ElectricalSpec, parse_electrical
 from dem.geometry.particles import COPPER, Material, Particles, material_indices
 from dem.geometry.periodic import AXES, PeriodicBox
 from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources
-from dem.geometry.walls import Wall, axis_of, box_axes, check_inside, extent
+from dem.geometry.walls import Wall, check_inside
 from dem.network.heat import INTEGRATORS
 from dem.network.linsolve import BACKENDS
 from dem.output.plots import TEMPERATURE_UNITS
 from dem.scene.motion import MotionSpec, parse_motion
 from dem.scene.schema import ENGINE_NAMES, TABLES, check
+from dem.scene.groups import apply_groups
+from dem.scene.specimen import Specimen, find_specimen, held_name
 
 SCENE_DIR = pathlib.Path(__file__).with_name("builtin")
 MODES = ("transient", "steady")
@@ -107,21 +109,6 @@ class OutputSpec:
 
 
 @dataclass(frozen=True)
-class Specimen:
-    """For generated scenes with hot/cold ends: length L (m) and cross-section A (m^2) for ``k_eff = Q L/(A dT)``,
-    and where the heat enters: the wall named ``hot``, the fixed particles ``hot_particles``, or (``periodic``) the
-    period's face normal to z, across which the temperature drops by ``hot - cold``."""
-
-    length: float
-    area: float
-    hot: float
-    cold: float
-    hot_particles: tuple = ()
-    periodic: bool = False
-    hot_wall: str = "hot"  # the name of the wall the heat enters through
-
-
-@dataclass(frozen=True)
 class Scene:
     """One DEM run: particles (+ walls), conductance law, ambient sources, solver, outputs, the physics to run;
     ``contact`` the Luding 2005 material of a ``[contact]`` table, or None."""
@@ -143,6 +130,7 @@ class Scene:
     engine: str = "static"  # the engine that runs it (dem.engines)
     start: dict | None = None  # the saved state it starts from (dem.scene.state_file.load), else None
     temperature_unit: str = "C"  # the unit of its temperatures, "C" or "K" (:func:`temperature_unit`)
+    groups: dict = field(default_factory=dict)  # the [[groups]] that hold their particles, {name: indices}
 
     def __post_init__(self):
         walls = self.motion.walls if self.motion is not None else self.walls
@@ -188,8 +176,10 @@ def make_scene(position, radius, temperature, *, materials=(COPPER,), material=N
     Keyword ``solver_options`` are :class:`SolverSpec` fields (``mode``, ``integrator``, ``dt``, ...).
     """
     particles = Particles.from_arrays(position, radius, temperature, materials, material, fixed, heat)
-    return Scene(particles, tuple(walls), conductance or ConductanceSpec(law=law), sources or Sources(),
-                 solver or SolverSpec(**solver_options), output or OutputSpec(), name=name, box=box)
+    walls = tuple(walls)
+    return Scene(particles, walls, conductance or ConductanceSpec(law=law), sources or Sources(),
+                 solver or SolverSpec(**solver_options), output or OutputSpec(), name=name,
+                 specimen=find_specimen(particles, walls, box), box=box)
 
 
 # --------------------------------------------------------------------------------------------------- TOML
@@ -294,7 +284,7 @@ def _generated_particles(t: dict, materials, dimension: int = 3):
         fixed[layout.bottom] = fixed[layout.top] = True
         temperature[layout.bottom], temperature[layout.top] = hot, cold
         length = float(np.mean(layout.position[layout.top, 2]) - np.mean(layout.position[layout.bottom, 2]))
-        specimen = Specimen(length, layout.area, hot, cold, tuple(int(k) for k in layout.bottom))
+        specimen = Specimen(length, layout.area, hot, cold, ("group", held_name(hot)), ("group", held_name(cold)))
     elif boundary == "plates":
         # plane walls touching the end layers with overlap delta = overlap * r / 2: the mirror pair's neck equals
         # that of a pair with the generator's relative overlap
@@ -361,32 +351,12 @@ def _walls(doc, start: dict | None, static: bool) -> tuple:
     return tuple(out)
 
 
-def _specimen_between(walls, start: dict, particles) -> Specimen | None:
-    """The specimen of a static scene started from a saved state (its effective conductivity, ``k_eff = Q L / (A
-    dT)``): between the only two walls that carry a temperature, facing each other along an axis; its cross-section
-    from the saved state's walls along the other axes, else from the particles' extent along them."""
-    heated = [w for w in walls if w.temperature is not None]
-    if len(heated) != 2 or heated[0].temperature == heated[1].temperature:
-        return None
-    hot, cold = sorted(heated, key=lambda w: -w.temperature)
-    axis = axis_of(hot.normal)
-    if axis is None or not np.allclose(hot.normal, -cold.normal, atol=1e-12):
-        return None
-    length = -(hot.offset + cold.offset)
-    saved = [Wall(name, normal * q, normal) for name, normal, q in
-             zip(start["wall_names"], start["wall_normal"], start["wall_q"])] \
-        if start["moving"] and np.any(start["wall_normal"]) else []
-    box = box_axes(saved)
-    area = 1.0
-    for a in range(3):
-        if a == axis:
-            continue
-        if a in box:
-            area *= extent(np.array([w.offset for w in saved]), *box[a])
-        else:
-            x, r = particles.position[:, a], particles.radius
-            area *= float(np.max(x + r) - np.min(x - r))
-    return Specimen(length, area, hot.temperature, cold.temperature, hot_wall=hot.name)
+def _saved_walls(start: dict | None) -> list:
+    """The walls of a saved moving state, where they stood (they bound a static scene's cross-section)."""
+    if start is None or not start["moving"] or not np.any(start["wall_normal"]):
+        return []
+    return [Wall(name, normal * q, normal) for name, normal, q in
+            zip(start["wall_names"], start["wall_normal"], start["wall_q"])]
 
 
 def _spec(cls, table, section, numeric=(), integer=(), words=()):
@@ -487,11 +457,14 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         box = _periodic_box(doc["periodic"], box)
     elif box is not None and not box.any_periodic:
         box = None  # a packing file's box that is not periodic (or that cannot say): only [periodic] uses it
+    groups = {}
+    if "groups" in doc:
+        particles, groups = apply_groups(doc["groups"], particles)
     walls = walls + _walls(doc, start, static=not moving)
     if box is not None and moving:
         _check_walls_across(walls, box)
-    if not moving and specimen is None and start is not None:
-        specimen = _specimen_between(walls, start, particles)
+    if not moving and specimen is None:
+        specimen = find_specimen(particles, walls, box, groups, bounds=_saved_walls(start))
     cond = dict(doc.get("conductance", {}))
     if "fit_file" in cond and not isinstance(cond["fit_file"], str):
         raise ValueError(f"[conductance] fit_file = {cond['fit_file']!r}: must be a path (string)")
@@ -516,7 +489,7 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     return Scene(particles, () if moving else walls, conductance, Sources(conv, rad), solver, output,
                  tuple(physics), str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact,
                  motion, electrical, box, engine, start,
-                 temperature_unit(meta, rad, zohdi=law is not None and law.NAME == "zohdi"))
+                 temperature_unit(meta, rad, zohdi=law is not None and law.NAME == "zohdi"), groups)
 
 
 

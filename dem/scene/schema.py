@@ -22,7 +22,7 @@ STATIC_VERLET = ("static", "verlet")
 STATIC_STAGGERED = ("static", "staggered")
 ENGINE_WORDS = {ALL: "all", MOVING: "moving", STATIC: "static", VERLET: "verlet", STAGGERED: "staggered",
                 STATIC_VERLET: "static, verlet", STATIC_STAGGERED: "static, staggered"}
-ARRAYS = ("materials", "walls", "phases")  # tables given as arrays of tables ([[walls]])
+ARRAYS = ("materials", "walls", "phases", "groups")  # tables given as arrays of tables ([[walls]])
 LAW_TABLES = ("contact", "phases")  # tables whose keys (beyond those listed) are the contact law's material fields
 
 
@@ -59,7 +59,9 @@ ROWS = (
     Row("particles", ("position",), ALL, "list of [x, y, z] m, required", "particle centres"),
     Row("particles", ("radius",), ALL, "list, m, > 0, required", ""),
     Row("particles", ("temperature",), ALL, "list, required", "initial temperature (K or °C)"),
-    Row("particles", ("fixed",), ALL, "list of bool, all false", "held at the initial temperature (a boundary)"),
+    Row("particles", ("fixed",), ALL, "list of bool, all false",
+        "held at the initial temperature (a boundary); a steady run with two ends at different temperatures (held "
+        "groups or walls with a temperature) reports `effective_conductivity` = Q L / (A ΔT) and its `specimen`"),
     Row("particles", ("material",), ALL, "name, index or list of them, 0", "index/name into `[[materials]]`"),
     Row("particles", ("heat",), ALL, "list, W, 0", "internal heat generation Q_i^int (Rojek 2022, eq. 3)"),
     Row("particles", ("file",), ALL, "path, instead of `position` and `radius`",
@@ -69,6 +71,24 @@ ROWS = (
         "the file's format, metres per length unit, a dump's snapshot"),
     Row("particles", ("velocity",), MOVING, "list of [vx, vy, vz] m/s, 0", "initial velocities"),
     Row("particles", ("angular_velocity",), VERLET, "list of 3-vectors, 1/s, 0", "initial angular velocities"),
+    Row("groups", ("name",), ALL, "string, required, unique",
+        "a named group of particles (`dem.scene.groups`), as LAMMPS's `region` and `group`; its selectors "
+        "(`region`, `ids`, `types`, `layer`) all choose its particles, which must be at least one"),
+    Row("groups", ("region",), ALL, '`"slab"`, `"box"`, `"sphere"`, `"cylinder"`',
+        "the particles whose centres lie in it: slab `axis`, `lo` and/or `hi` (m along it); box `lo`, `hi` (corners "
+        "[x, y, z] m); sphere `center`, `radius`; cylinder `axis`, `center` (a point of its axis), `radius`, "
+        "optional `lo`, `hi` along the axis"),
+    Row("groups", ("axis", "lo", "hi", "center", "radius"), ALL, '`"x"`/`"y"`/`"z"`, m or [x, y, z] m, m',
+        "the region's (and the layer's `axis`, default z)"),
+    Row("groups", ("ids",), ALL, "list of ids and [first, last] ranges", "by particle id (LAMMPS `group id 1:100`)"),
+    Row("groups", ("types",), ALL, "list of LAMMPS types (from 1) or material names",
+        "by type: type k is material k − 1"),
+    Row("groups", ("layer", "thickness"), ALL, '`"top"` or `"bottom"`, m',
+        "the particles whose centres lie within `thickness` of the highest (lowest) centre along `axis`"),
+    Row("groups", ("temperature", "fixed", "material", "heat"), ALL, "K or °C, bool, name or index, W",
+        "given to the group's particles over `[particles]`' lists (groups in order, a later one over an earlier "
+        "one): the initial temperature, held at it (a held group is an end of `effective_conductivity` and has its "
+        "total in `boundary_heat_flow`), the material, the internal heat per particle"),
     Row("generator", ("kind",), ALL, '`"chain"`, `"lattice"`, `"random"`, `"box"`',
         'instead of `[particles]`; `"box"`: random sequential addition in a box (moving particles)'),
     Row("generator", ("structure",), ALL, '`"sc"`', 'lattice: `"sc"`, `"bcc"` or `"fcc"` (1, 2 or 4 spheres per '
@@ -102,7 +122,8 @@ ROWS = (
     Row("walls", ("motion",), MOVING, '`"fixed"`', '`"stress"` (Luding 2005, eq. 1; velocity Verlet), `"strain"` '
         '(constant `velocity`), `"vibrate"` (`amplitude`, `frequency`)'),
     Row("walls", ("pressure", "mass", "damping"), VERLET, "N/m (2D) or Pa (3D), kg, kg/s",
-        "of a stress wall: the pressure times the box's extent pushes it in (eq. 1)"),
+        "of a stress wall: the pressure times the box's extent pushes it in (eq. 1); the extent is between the walls "
+        "facing each other, or the period of a box periodic along that axis"),
     Row("walls", ("velocity",), MOVING, "m/s, inward", "of a strain wall"),
     Row("walls", ("amplitude", "frequency"), MOVING, "m, Hz", "of a vibrating wall, q(t) = q0 + A sin(2πf(t - t_0)) "
         "from the run's start t_0"),
@@ -135,7 +156,9 @@ ROWS = (
     Row("conductance", ("unequal",), ALL, "true", "fit and shared-body laws: multiply the series of halves by the FE "
         "correction for unequal radii (`fem_neck.law.unequal_factor`)"),
     Row("conductance", ("neck",), ALL, '`"newton"`', '`"newton"` (Rojek 2022, eqs. 27-33), `"first"` (eq. 34), '
-        '`"coble"` (eqs. 11-12)'),
+        '`"coble"` (eqs. 11-12): pair necks, no answer once two necks of a particle meet; `"union"`: the circle '
+        'where two spheres meet, the packing read as the union of its spheres (`fem_neck.geometry.union`), defined '
+        'at every density'),
     Row("conductance", ("contact_conductance",), ALL, "W/K, none", "K_c of the interface in series (eq. 8)"),
     Row("conductance", ("out_of_range",), ALL, '`"error"`', 'bonds beyond the contact model\'s range (h > '
         'max_overlap; wall overlap > r/3): `"error"` reports their count and the first pair, `"clip"` sets a to the '

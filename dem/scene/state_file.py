@@ -27,6 +27,7 @@ import pathlib
 import numpy as np
 
 from dem.geometry.periodic import PeriodicBox
+from dem.output.atomic import read_npz, write_aside
 
 FORMAT = "dem-state-2"
 FORMAT_1 = "dem-moving-state-1"  # the Luding law's histories as separate arrays (read and converted)
@@ -78,11 +79,7 @@ def save(data: dict, path) -> pathlib.Path:
     interrupted save never leaves half a state."""
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".part")
-    with tmp.open("wb") as fh:
-        np.savez(fh, format=np.array(FORMAT), **data)
-    tmp.replace(path)
-    return path
+    return write_aside(path, lambda fh: np.savez(fh, format=np.array(FORMAT), **data), "wb")
 
 
 def load(path) -> dict:
@@ -90,11 +87,7 @@ def load(path) -> dict:
     whether it has the velocities and histories of particles that move); ``ValueError`` naming the file when it is
     not one."""
     path = pathlib.Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as f:
-            data = {k: f[k] for k in f.files}
-    except (OSError, ValueError) as exc:
-        raise ValueError(f"[start] state = {str(path)!r}: cannot be read as a saved state ({exc})") from None
+    data = read_npz(path, "[start] state")
     if str(data.get("format", "")) == FORMAT_1:
         data = _from_format_1(data)
     if str(data.get("format", "")) != FORMAT:

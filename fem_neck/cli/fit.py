@@ -4,12 +4,16 @@ Writes fit.json (the file the DEM's ``fit`` law reads), fit.csv (written point b
 --out resumes an interrupted sweep) and fit.png (the Fig. 16 analogue) into --out (default: results/fit). Points of
 an existing fit.csv are reused only when they were solved by the same solver and method to the same --rtol; the run
 says how many on stderr ("reused 38 of 40 points from fit.csv; --fresh recomputes"), and --fresh recomputes all.
+--neck union sweeps and fits the half body of the union of spheres instead (no neck cylinder; default --out
+results/fit-union); its fit.json records the neck, and a law read from it refuses the other neck
+(fem_neck.law.ConductanceLaw.require_neck).
 """
 
 from __future__ import annotations
 
 import sys
 
+from fem_neck.law import NECKS
 from sinterheat.cli import add_output_options, add_scheduler_option, add_workers_option
 
 
@@ -22,10 +26,13 @@ def register(subparsers) -> None:
                         "(0, 0.97])")
     p.add_argument("--rtol", type=float, default=1e-4, help="relative tolerance of each FE point (default 1e-4)")
     p.add_argument("--fresh", action="store_true", help="recompute every point (ignore an existing fit.csv)")
+    p.add_argument("--neck", choices=NECKS, default="cylinder",
+                   help="the half body: cylinder (Rojek's volume-conserving neck, default) or union (the union of "
+                        "spheres, no neck cylinder)")
     add_workers_option(p)
     add_scheduler_option(p)
     add_output_options(p)
-    p.set_defaults(run=run, out="results/fit")
+    p.set_defaults(run=run)
 
 
 MAX_POINTS = 200  # one point takes ~0.5 s of one core: 200 points are ~1 min on 2 cores
@@ -38,13 +45,15 @@ def run(args) -> dict:
         raise ValueError(f"points = {args.points}: valid range 4 <= points <= {MAX_POINTS} (each point is an FE solve "
                          f"of ~0.5 s; the fit's slope is converged well before)")
 
-    result = run_fit(args.points, args.rtol, args.out, workers=args.workers, fresh=args.fresh)
+    if args.out is None:
+        args.out = "results/fit" if args.neck == "cylinder" else f"results/fit-{args.neck}"
+    result = run_fit(args.points, args.rtol, args.out, workers=args.workers, fresh=args.fresh, neck=args.neck)
     reused = result["reused"]
     if reused["points"]:
         sys.stderr.write(f"reused {reused['points']} of {reused['of']} points from fit.csv; --fresh recomputes\n")
     if reused["not_matching"]:
-        sys.stderr.write(f"fit.csv: {reused['not_matching']} points from another solver, method or tolerance were "
-                         f"not reused (this run: {result['method']}, rtol {args.rtol:g})\n")
+        sys.stderr.write(f"fit.csv: {reused['not_matching']} points from another solver, method, neck or tolerance "
+                         f"were not reused (this run: {result['method']}, {args.neck}, rtol {args.rtol:g})\n")
     return {"slope": result["slope"], "sampling": result["sampling"], "points": result["points"],
             "law": result["law"], "slope_sensitivity": result["slope_sensitivity"],
             "unconverged": result["unconverged"], "reused": reused, "seconds": result["seconds"],

@@ -28,7 +28,8 @@ from dataclasses import replace
 import numpy as np
 
 from dem import memory
-from dem.engines.static import CSV_FLOWS, StaticEngine
+from dem.engines.static import CSV_FLOWS, StaticEngine, boundary_summary
+from dem.geometry.necks import meeting_in, neck_account
 from dem.geometry.partition import bisection, halo
 from dem.network import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
@@ -111,6 +112,7 @@ class DistributedStaticEngine(StaticEngine):
         pairs, walls = mine[bonds.i] | mine[bonds.j], mine[bonds.wall_particle]
         self.bonds, self.K_pairs, self.K_walls = bonds.subset(pairs, walls), K_pairs[pairs], K_walls[walls]
         self.held, self.mine = held, mine
+        self.meeting = meeting_in(local, scene.walls, self.bonds, box)  # right for the owned: all their bonds are here
         self.T = local.temperature.astype(float)
         return owner[held]
 
@@ -147,6 +149,11 @@ class DistributedStaticEngine(StaticEngine):
         s = self.scene.solver
         out = {"law": self.scene.conductance.law, "contact": self.bonds.contact, "bonds_clipped": 0,
                "bonds_dropped": 0, "wall_bonds": self.part.total(int(self.bonds.n_walls)), "ranks": self.ranks}
+        b = self.bonds
+        out.update(neck_account(self.part.total(int(np.count_nonzero(self.meeting[self.mine]))),
+                                self.full_scene.particles.n, b.contact,
+                                self.part.total(int(np.count_nonzero(self.mine[b.i]) + b.n_walls)),
+                                self.full_scene.conductance.law))
         observer = self._observed(observe)
         if s.mode == "steady":
             T_F, flows, err, n_float, solver = mpi.agree(
@@ -182,12 +189,7 @@ class DistributedStaticEngine(StaticEngine):
         mine = net.fixed[self.mine[net.fixed]]
         fixed = {int(k): float(v) for part in self.comm.allgather(
             dict(zip(self.part.held[mine].tolist(), into[mine].tolist()))) for k, v in part.items()}
-        out = {"walls": {w.name: float(q) for w, q in zip(self.scene.walls, walls)},
-               "fixed_total": float(sum(fixed[k] for k in sorted(fixed)))}
-        if len(fixed) <= 1000:
-            ids = self.full_scene.particles.id
-            out["particles"] = {str(ids[k]): fixed[k] for k in sorted(fixed)}
-        return out
+        return boundary_summary(self.full_scene, walls, fixed)
 
     def _periodic(self, T: np.ndarray) -> np.ndarray:
         """Heat flow across the period along x, y, z (:func:`dem.network.heat.periodic_heat_flow`) over the

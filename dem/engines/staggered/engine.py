@@ -35,7 +35,8 @@ from dem.geometry.neighbours import list_arrays
 from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
 from dem.engines.contact_current import ContactCurrent
-from dem.engines.staggered.heat import LumpedHeat
+from dem.engines.staggered.heat import LumpedHeat, contact_bonds
+from dem.geometry.necks import meeting_in, neck_account
 from dem.engines.staggered.mechanics import StaggeredMechanics
 from dem.scene.state_file import moving_arrays, normalised
 
@@ -360,6 +361,9 @@ class StaggeredEngine:
         if self.thermal is not None:
             out.update(energy_error=self.thermal.energy_error(),
                        heat_in={k: float(v) for k, v in self.thermal.heat_in.items()}, law=self.scene.conductance.law)
+            meeting, bonds = self.necks()
+            out.update(neck_account(np.count_nonzero(meeting), mech.state.n, bonds.contact,
+                                    bonds.n_pairs + bonds.n_walls, self.scene.conductance.law))
         if self.current is not None:
             c = self.current
             out.update(scheme=c.scheme, current_refreshes=c.refreshes, joule_energy=c.joule_energy,
@@ -389,10 +393,21 @@ class StaggeredEngine:
         points, lines = pair_lines(self.mechanics.state.x, i, j, self.mechanics.periodic_box)
         return points, lines, {"normal_force": fn, "area": area, "bonded": bond.astype(np.int8)}
 
+    def necks(self):
+        """``(meeting, bonds)``: the lens bonds of the touching pairs now (those out of the lens' range left out) and
+        whether two necks of each particle meet (:mod:`dem.geometry.necks`)."""
+        mech, th = self.mechanics, self.thermal
+        s = mech.state
+        now, bonds = contact_bonds(self.scene.particles, mech, s.x, s.T, th.thermal_walls, "lens", "drop")
+        walls = [mech.walls[k].at(float(mech.w.q[k])) for k in th.thermal_walls]
+        return meeting_in(now, walls, bonds, mech.periodic_box), bonds
+
     def particle_fields(self) -> dict:
         s = self.mechanics.state
         out = {"id": self.scene.particles.id, "radius": s.radius, "velocity": s.v, "force": self.mechanics.f,
                "temperature": s.T}
+        if self.thermal is not None:
+            out["necks_meeting"] = self.necks()[0].astype(np.int8)
         if self.current is not None:
             out["heating"] = self.current.heating
             out["current" if self.current.scheme == "zohdi" else "potential"] = np.nan_to_num(self.current.J)

@@ -57,7 +57,7 @@ class StaggeredMechanics:
         self.skin = float(skin)
         self.periodic_box = box
         self.box = box.kernel_lengths if box is not None else np.zeros(3)  # 0: not periodic
-        self.w = WallArrays.build(self.walls, 3)
+        self.w = WallArrays.build(self.walls, 3, self.box)
         n = state.n
         self.f = np.zeros((n, 3))          # forces at the start of the step, F^L
         self._f_iter = np.zeros((n, 3))    # forces of the current iteration, F^(K-1)

@@ -27,7 +27,9 @@ from dataclasses import replace
 
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
+from dem.geometry.bonds import find_bonds
 from dem.geometry.motion import MotionState
+from dem.geometry.necks import meeting_in, neck_account
 from dem.geometry.neighbours import list_arrays
 from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
@@ -240,12 +242,13 @@ class VerletEngine:
         return ("N", "N/m", "Pa")[self._wall_extents()[1]]
 
     def _wall_extents(self) -> tuple[list, int]:
-        """Per wall the length (one box axis along it) or area (two) its load is divided by, and that number of
-        axes; all 1 and 0 axes when the walls span different numbers of axes (N/m beside Pa would share no axis)."""
+        """Per wall the length (one box axis along it) or area (two) its load is divided by -- between the walls
+        facing each other along an axis, or the periodic box's period --, and that number of axes; all 1 and 0 axes when the walls span different numbers of axes (N/m beside Pa would share no axis)."""
         mech = self.mechanics
         extents, spanned = [], set()
-        for k in range(len(mech.walls)):
-            lo_hi, extent, axes = mech.w.span[k], 1.0, 0
+        for k, wall in enumerate(mech.walls):
+            extent, axes = mech.w.periodic_extent(wall, mech.state.dimension, mech.box)  # the box's periods
+            lo_hi = mech.w.span[k]
             for a in range(2):
                 if lo_hi[2 * a] >= 0:
                     extent *= mech.w.extent(lo_hi[2 * a], lo_hi[2 * a + 1])
@@ -305,10 +308,7 @@ class VerletEngine:
         slab = np.clip(np.searchsorted(edges, dist) - 1, 0, bins - 1)
         density = np.bincount(slab, v, bins) / (area * np.diff(edges))
         i, j, overlap = mech.contacts()[:3]
-        r_min = np.minimum(s.radius[i], s.radius[j])
-        # within the neck model's range (the neck reaches the smaller radius), for the profile
-        h = np.minimum(overlap, 0.999 * max_overlap(s.radius[i], s.radius[j]))
-        neck = np.asarray(neck_radius(s.radius[i], s.radius[j], h)) / r_min if len(i) else np.zeros(0)
+        neck = self._necks(s.radius[i], s.radius[j], overlap) / np.minimum(s.radius[i], s.radius[j])
         mid = np.clip(np.searchsorted(edges, 0.5 * (dist[i] + dist[j])) - 1, 0, bins - 1)
         count = np.bincount(mid, minlength=bins)
         with np.errstate(invalid="ignore"):
@@ -350,11 +350,26 @@ class VerletEngine:
             th = self.thermal
             out.update(energy_error=th.energy_error(), heat_in={k: float(v) for k, v in th.heat_in.items()},
                        network_assemblies=th.assemblies, network_refreshes=th.refreshes, law=self.scene.conductance.law)
+            meeting, bonds = self.necks()
+            out.update(neck_account(np.count_nonzero(meeting), s.n, bonds.contact, bonds.n_pairs + bonds.n_walls,
+                                    self.scene.conductance.law))
         return out
 
+    def necks(self):
+        """``(meeting, bonds)``: the thermal bonds of the contacts now, under the scene's neck reading, and whether
+        two necks of each particle meet (:mod:`dem.geometry.necks`); from the whole sample (on several ranks, the
+        one gathered on rank 0)."""
+        mech, th = self.mechanics, self.thermal
+        s = mech.state
+        particles = replace(self.scene.particles, position=s.x, radius=s.radius)
+        walls = [mech.walls[k].at(mech.w.q[k]) for k in th.thermal_walls]
+        i, j = mech.contacts()[:2]
+        bonds = find_bonds(particles, walls, self.scene.conductance.contact, "clip", pairs=(i, j), box=th.box)
+        return meeting_in(particles, walls, bonds, th.box), bonds
+
     def particle_fields(self) -> dict:
-        """Per-particle fields for snapshots: velocity, angular velocity, force, temperature, stiffness factor, and
-        the particle stress ``sigma_i = (1/V_i) sum_c l_c (x) f_c`` (l_c from the centre to contact c, f_c the force
+        """Per-particle fields for snapshots: velocity, angular velocity, force, temperature, stiffness factor, with
+        thermal physics the heat flow (W) into the particle through its contacts and walls, and the particle stress ``sigma_i = (1/V_i) sum_c l_c (x) f_c`` (l_c from the centre to contact c, f_c the force
         on i there) with its mean ``tr(sigma)/dim`` (positive in compression)."""
         mech = self.mechanics
         s = mech.state
@@ -375,10 +390,14 @@ class VerletEngine:
         # sign: compression positive (the lever arm points against the compressive force)
         sigma = -sigma
         mean = np.trace(sigma, axis1=1, axis2=2) / s.dimension
-        return {"id": self.scene.particles.id, "radius": s.radius, "velocity": s.v, "angular_velocity": s.w,
-                "force": s.f, "temperature": s.T,
-                **{name: mech.particle_column(name) for name in mech.law.PARTICLE_STATE},
-                "stress": sigma.reshape(-1, 9), "mean_stress": mean}
+        fields = {"id": self.scene.particles.id, "radius": s.radius, "velocity": s.v, "angular_velocity": s.w,
+                  "force": s.f, "temperature": s.T,
+                  **{name: mech.particle_column(name) for name in mech.law.PARTICLE_STATE},
+                  "stress": sigma.reshape(-1, 9), "mean_stress": mean}
+        if self.thermal is not None:
+            fields["heat_flow"] = self.thermal.contact_heat(mech, i, j)[1]
+            fields["necks_meeting"] = self.necks()[0].astype(np.int8)
+        return fields
 
     def positions(self) -> np.ndarray:
         return self.mechanics.state.x
@@ -388,10 +407,27 @@ class VerletEngine:
 
     def links(self):
         """The closed pair contacts as lines between the particles (to the partner's image across a periodic face):
-        normal force (> 0 repulsive), tangential force magnitude, overlap."""
+        normal force (> 0 repulsive), tangential force magnitude, overlap, neck radius (m); with thermal physics
+        each contact's conductance (W/K) and heat flow (W, from the first particle to the second), its neck that of
+        its bond (:meth:`dem.engines.contact_heat.ContactThermalModel.contact_heat`), else the volume-conserving
+        neck of its overlap (Rojek 2022, eqs. 27-33)."""
         i, j, overlap, fn, ft = self.mechanics.contacts()
         points, lines = pair_lines(self.mechanics.state.x, i, j, self.mechanics.periodic_box)
-        return points, lines, {"normal_force": fn, "tangential_force": np.linalg.norm(ft, axis=1), "overlap": overlap}
+        fields = {"normal_force": fn, "tangential_force": np.linalg.norm(ft, axis=1), "overlap": overlap}
+        if self.thermal is not None:
+            fields.update(self.thermal.contact_heat(self.mechanics, i, j)[0])
+        else:
+            r = self.mechanics.state.radius
+            fields["neck_radius"] = self._necks(r[i], r[j], overlap)
+        return points, lines, fields
+
+    @staticmethod
+    def _necks(ri: np.ndarray, rj: np.ndarray, overlap: np.ndarray) -> np.ndarray:
+        """The volume-conserving neck radius (m) of each contact, its overlap within the neck model's range (the
+        neck reaches the smaller radius)."""
+        if not len(ri):
+            return np.zeros(0)
+        return np.asarray(neck_radius(ri, rj, np.minimum(overlap, 0.999 * max_overlap(ri, rj))), dtype=float)
 
     def plots(self, out, summary: dict) -> list[str]:
         from dem.output.plots import motion_plots

@@ -72,7 +72,7 @@ class MechanicalModel:
         self.periodic_box = box
         self.box = box.kernel_lengths if box is not None else np.zeros(3)  # 0: not periodic
         self.relaxation_time = float(relaxation_time)
-        self.w = WallArrays.build(self.walls, state.dimension)
+        self.w = WallArrays.build(self.walls, state.dimension, self.box)
         n, n_w = state.n, len(self.walls)
         self.particle_state = self.law.initial_state(material, state.T, state.mass)  # each particle's state at the start
         self.w_hist = np.zeros((n, n_w, len(self.law.WALL_HISTORY)))

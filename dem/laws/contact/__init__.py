@@ -47,6 +47,17 @@ CONTACT_LAWS = {
 }
 
 
+#: One line on each contact law, for ``python -m dem laws``.
+DESCRIPTIONS = {
+    "luding": "sintering: hysteretic normal law with cohesion, temperature-dependent stiffness, friction "
+              "(Luding, Manetsberger & Mueller 2005)",
+    "zohdi": "power law on the contact area, bonds, thermal softening; staggered engine (Zohdi 2014)",
+    "hertz_mindlin": "elastic spheres: Hertz normal force with Tsuji's damping (restitution e), Mindlin tangential "
+                     "stiffness, Coulomb friction",
+    "jkr": "Johnson-Kendall-Roberts 1971 adhesion, with Hertz-Mindlin's damping and friction",
+}
+
+
 def law_module_name(name) -> str:
     """The module of the contact law ``name``; ``ValueError`` naming the laws for an unknown one."""
     if not isinstance(name, str) or name not in CONTACT_LAWS:
