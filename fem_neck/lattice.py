@@ -134,9 +134,22 @@ _TOL = 1e-9  # geometric tolerance in units of the largest radius
 
 @dataclass(frozen=True)
 class PeriodicCell:
-    """One period of a packing: ``centres`` (n, 3) wrapped into ``[0, period)``, ``radii`` (n,), ``period`` (3,).
+    """One period of a packing. Every pair of particle images closer than the sum of their radii is bonded (Rojek
+    2022, eq. 21).
 
-    Every pair of particle images closer than the sum of their radii is bonded (Rojek 2022, eq. 21).
+    Attributes
+    ----------
+    centres : numpy.ndarray (n, 3)
+        Particle centres, m, wrapped into ``[0, period)``.
+    radii : numpy.ndarray (n,)
+        Particle radii, m.
+    period : numpy.ndarray (3,)
+        Edges of the period box, m.
+    name : str
+        Name of the cell in messages.
+    neck : str
+        How bonds are read (``NECKS``): ``"newton"``, the volume-conserving pair necks (Rojek 2022, eqs. 21-33);
+        ``"union"``, the union of the spheres (module docstring).
     """
 
     centres: np.ndarray
@@ -208,9 +221,20 @@ class PeriodicCell:
 
 
 def lattice_cell(kind: str, h_over_r: float, radius: float = 1.0, neck: str = "newton") -> PeriodicCell:
-    """The cubic cell of a simple cubic, body-centred or face-centred cubic lattice of equal spheres of ``radius``
-    (m) whose nearest neighbours overlap by ``h = h_over_r * radius`` (neighbour distance ``2r - h``), its bonds read
-    as ``neck`` (``NECKS``; the valid ``h_over_r`` of each: :func:`check_h_over_r`)."""
+    """The cubic cell of a simple cubic, body-centred or face-centred cubic lattice of equal spheres.
+
+    Parameters
+    ----------
+    kind : str
+        ``"sc"``, ``"bcc"`` or ``"fcc"``.
+    h_over_r : float
+        Overlap of nearest neighbours over the radius (neighbour distance ``2r - h``); the valid range of each
+        reading: :func:`check_h_over_r`.
+    radius : float
+        Particle radius, m.
+    neck : str
+        How bonds are read (``NECKS``, :class:`PeriodicCell`).
+    """
     if kind not in KINDS:
         raise ValueError(f"kind = {kind!r}: must be one of {', '.join(KINDS)}")
     if neck not in NECKS:
@@ -235,20 +259,42 @@ def max_h_over_r(kind: str) -> float:
 def union_max_h_over_r(kind: str) -> float:
     """``h/r`` at which the union of the lattice's spheres fills space: the neighbour distance at which the radius
     is the lattice's covering radius (SC: the cube's half diagonal, ``d = 2r / sqrt(3)``, h/r = 0.8453; BCC: ``sqrt(5)
-    / 4`` of the cube edge, ``d = 2 sqrt(3 / 5) r``, 0.4508; FCC: half the cube edge, ``d = sqrt(2) r``, 0.5858)."""
+    / 4`` of the cube edge, ``d = 2 sqrt(3 / 5) r``, 0.4508; FCC: half the cube edge, ``d = sqrt(2) r``, 0.5858).
+
+    Parameters
+    ----------
+    kind : str
+        ``"sc"``, ``"bcc"`` or ``"fcc"``.
+    """
     covering = {"sc": math.sqrt(3.0) / 2.0, "bcc": math.sqrt(5.0) / 4.0, "fcc": 0.5}[kind]  # over the cube edge
     return 2.0 - 1.0 / (covering * EDGE_OVER_SPACING[kind])
 
 
 def union_neck_ratio(h_over_r: float) -> float:
-    """``a/r`` of the circle where two equal spheres that overlap by ``h_over_r`` meet: ``a^2 = r h - h^2 / 4``
-    (:func:`fem_neck.geometry.union.lens` at ``d = 2r - h``)."""
+    """``a/r`` of the circle where two equal spheres meet: ``a^2 = r h - h^2 / 4`` (:func:`fem_neck.geometry.union.lens`
+    at ``d = 2r - h``).
+
+    Parameters
+    ----------
+    h_over_r : float
+        Their overlap over the radius, ``0 < h/r < 2``.
+    """
     return float(lens(1.0, 1.0, 2.0 - h_over_r).a)
 
 
 def check_h_over_r(kind: str, h_over_r: float, neck: str = "newton") -> float:
     """``h_over_r`` if the lattice's necks exist (and are not too small to mesh) and, read as pair necks, stay apart,
-    or, read as the union of the spheres, leave pores open (:func:`union_max_h_over_r`); else ValueError."""
+    or, read as the union of the spheres, leave pores open (:func:`union_max_h_over_r`); else ValueError.
+
+    Parameters
+    ----------
+    kind : str
+        ``"sc"``, ``"bcc"`` or ``"fcc"``.
+    h_over_r : float
+        Overlap of nearest neighbours over the radius.
+    neck : str
+        How bonds are read (``NECKS``).
+    """
     if neck == "union":
         low, high = UNION_MIN_H_OVER_R, union_max_h_over_r(kind)
         if not (isinstance(h_over_r, (int, float)) and low <= h_over_r < high):
@@ -441,10 +487,19 @@ def _cell_frame(cell: PeriodicCell, method: str = "newton") -> CellFrame:
 
 @dataclass(frozen=True)
 class UnionNecks:
-    """The necks of the union reading, per bond of a :class:`fem_neck.cluster.Cluster`: the circle where the two
-    spheres meet, of radius ``a``, in the bond's radical plane at the distance ``z_i`` from centre ``i`` along the
-    bond (:func:`fem_neck.geometry.union.lens`); ``h_n = 0``: a neck without length (the fields the meshing reads of
-    a pair neck's :class:`fem_neck.geometry.NeckGeometry`)."""
+    """The necks of the union reading, per bond of a :class:`fem_neck.cluster.Cluster` (the fields the meshing
+    reads of a pair neck's :class:`fem_neck.geometry.NeckGeometry`).
+
+    Attributes
+    ----------
+    a : numpy.ndarray
+        Radius of the circle where the two spheres meet (:func:`fem_neck.geometry.union.lens`), in the cluster's
+        length unit.
+    z_i : numpy.ndarray
+        Distance from centre ``i`` along the bond to the bond's radical plane, which holds the circle.
+    h_n : numpy.ndarray
+        Zeros: a neck without length.
+    """
 
     a: np.ndarray
     z_i: np.ndarray
@@ -452,7 +507,13 @@ class UnionNecks:
 
 
 def union_necks(local) -> UnionNecks:
-    """The :class:`UnionNecks` of the bonds of the cluster ``local``."""
+    """The :class:`UnionNecks` of the bonds of a cluster.
+
+    Parameters
+    ----------
+    local : fem_neck.cluster.Cluster
+        Spheres and their bonds (overlapping pairs).
+    """
     i, j = local.bonds.T
     neck = lens(local.radii[i], local.radii[j], np.linalg.norm(local.centres[j] - local.centres[i], axis=1))
     return UnionNecks(neck.a, neck.l_i, np.zeros_like(neck.a))
@@ -461,9 +522,23 @@ def union_necks(local) -> UnionNecks:
 @dataclass(frozen=True)
 class NeckCircles:
     """The neck circles on the boundary of a cell's solid, for predicting its mesh before meshing
-    (:func:`predicted_tetrahedra`): per circle its radius ``a``, its neck's length ``h_n`` and smaller particle
-    radius ``r_min``, and the ``fraction`` of it inside the computational cell; the solid volume there. Lengths in
-    units of the largest radius."""
+    (:func:`predicted_tetrahedra`). Lengths in units of the largest radius.
+
+    Attributes
+    ----------
+    a : numpy.ndarray
+        Radius of each circle.
+    h_n : numpy.ndarray
+        Length of its neck (``inf`` for the union's circles, which no neck length limits).
+    r_min : numpy.ndarray
+        The smaller radius of its pair.
+    fraction : numpy.ndarray
+        The fraction of the circle inside the computational cell and on the solid's boundary.
+    solid_volume : float
+        Volume of the solid in the computational cell.
+    neck : str
+        The cell's reading (``NECKS``): which constants predict its mesh.
+    """
 
     a: np.ndarray
     h_n: np.ndarray
@@ -765,7 +840,13 @@ def available_memory() -> float:
 
 def mean_neck_ratio(cell: PeriodicCell) -> float:
     """The mean ``a / r`` of the cell's bonds (``r`` the smaller radius of the pair; ``a`` the neck's radius, or the
-    radius of the circle where the spheres meet, read as their union)."""
+    radius of the circle where the spheres meet, read as their union).
+
+    Parameters
+    ----------
+    cell : PeriodicCell
+        The packing.
+    """
     i, j, s = cell.bonds()
     d = np.linalg.norm(cell.centres[j] + s * cell.period - cell.centres[i], axis=1)
     r_i, r_j = cell.radii[i], cell.radii[j]
@@ -794,10 +875,23 @@ def _neck_factor(neck_ratio: float, order: int, neck: str = "newton", pore: floa
 
 def first_neck_size(rtol: float, neck_ratio: float, order: int, neck: str = "newton",
                     pore: float = UNION_PORE0) -> float:
-    """Neck size of the first mesh at ``order`` of a cell whose mean neck has ``a / r = neck_ratio``, read as
-    ``neck``: the size whose gap is predicted at ``margin rtol`` (``FIRST_MESH``: ``rtol0`` at ``size0`` for ``a / r
-    = NECK0``, the gap falling like ``size^GAP_ORDER`` and like ``(a / r)^-neck_order``; the union's ``UNION_*``,
-    with its pore fraction ``pore = 1 - phi``), within ``FIRST_SIZES``."""
+    """Neck size of the first mesh of a cell: the size whose gap is predicted at ``margin rtol`` (``FIRST_MESH``:
+    ``rtol0`` at ``size0`` for ``a / r = NECK0``, the gap falling like ``size^GAP_ORDER`` and like ``(a /
+    r)^-neck_order``; the union's ``UNION_*``, its gap also falling with the pore fraction), within ``FIRST_SIZES``.
+
+    Parameters
+    ----------
+    rtol : float
+        Relative gap of the bounds asked for.
+    neck_ratio : float
+        The cell's mean ``a / r`` (:func:`mean_neck_ratio`).
+    order : int
+        Order of the upper bound (3 or 4).
+    neck : str
+        The cell's reading (``NECKS``).
+    pore : float
+        The cell's pore fraction ``1 - phi`` (read as the union only).
+    """
     first_mesh, gap_order, _, _, first_sizes = _rule(neck)
     size0, rtol0, _, margin = first_mesh[order]
     size = size0 * (margin * rtol / rtol0) ** (1.0 / gap_order) * _neck_factor(neck_ratio, order, neck, pore)
@@ -805,7 +899,15 @@ def first_neck_size(rtol: float, neck_ratio: float, order: int, neck: str = "new
 
 
 def first_rtol(size: float, neck_ratio: float, order: int, neck: str = "newton", pore: float = UNION_PORE0) -> float:
-    """The ``rtol`` whose first mesh at ``order`` (:func:`first_neck_size`) has neck size ``size``."""
+    """The ``rtol`` whose first mesh (:func:`first_neck_size`) has the neck size ``size``.
+
+    Parameters
+    ----------
+    size : float
+        Element size at the neck circles over their radius.
+    neck_ratio, order, neck, pore
+        As for :func:`first_neck_size`.
+    """
     first_mesh, gap_order, _, _, _ = _rule(neck)
     size0, rtol0, _, margin = first_mesh[order]
     return rtol0 * (size / (size0 * _neck_factor(neck_ratio, order, neck, pore))) ** gap_order / margin
@@ -873,8 +975,24 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
     if a mesh had more) and the memory of its solve estimated (:func:`memory_estimate`): one that would not fit in
     ``max_memory`` bytes (default: what the machine has available) is refused with a ``ValueError`` naming the
     estimate and the ``rtol`` that would fit. A mesh too coarse for the curvature of its surfaces (a curved element
-    folds, :class:`fem_neck.curved.FoldedMesh`) is followed by one twice as fine. ``order``: of the upper bound
-    (default :func:`default_order`). ``progress(text)`` reports each mesh.
+    folds, :class:`fem_neck.curved.FoldedMesh`) is followed by one twice as fine.
+
+    Parameters
+    ----------
+    cell : PeriodicCell
+        The packing, mirror-symmetric about x = 0, y = 0 and z = 0; its bonds read as ``cell.neck``.
+    rtol : float
+        Relative gap ``(upper - lower) / upper`` of the bounds to reach.
+    order : int, optional
+        Order of the upper bound, 3 or 4 (default :func:`default_order`).
+    max_memory : float, optional
+        Bytes the solves may use (default: what the machine has available).
+    max_meshes : int
+        Most meshes solved.
+    workers : int
+        2: the two bounds in parallel processes; 1: one after the other.
+    progress : callable, optional
+        ``progress(text)`` reports each mesh.
     """
     check_positive("rtol", rtol)
     check_cell(cell)
