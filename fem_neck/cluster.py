@@ -191,7 +191,9 @@ def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, si
     radius at a distance ``2 a`` (Distance + Threshold fields), or, with ``grading``, growing by ``grading`` per unit
     distance (the same relative grading around small and large necks). The circles are the curves all of whose sample points
     lie at distance ``a`` from the bond axis and at the neck's ends (possibly split into arcs at seams or cut by
-    planes). ``every_bond``: each bond must have its two circles on the boundary (else ``RuntimeError``); otherwise
+    planes); a neck without length (``h_n = 0``: the circle where two spheres of a union meet,
+    :class:`fem_neck.lattice.UnionNecks`) has one circle, and ``size_neck a`` there. ``every_bond``: each bond must
+    have its two circles on the boundary (else ``RuntimeError``); otherwise
     bonds without any are skipped (a neck cut away by a cell face). Returns the Threshold field tags.
     """
     c, r = cluster.centres, cluster.radii
@@ -210,7 +212,7 @@ def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, si
             axial = rel @ e[b]
             radial = np.linalg.norm(rel - axial[:, None] * e[b], axis=1)
             on_radius = np.all(np.abs(radial - geo.a[b]) < 10 * tol)
-            for z in (geo.z_i[b], geo.z_i[b] + geo.h_n[b]):
+            for z in (geo.z_i[b], geo.z_i[b] + geo.h_n[b]) if geo.h_n[b] > 0 else (geo.z_i[b],):
                 if on_radius and np.all(np.abs(axial - z) < 10 * tol):
                     found.append(tag)
         if len(found) < 2 and every_bond:
@@ -221,7 +223,7 @@ def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, si
         gmsh.model.mesh.field.setNumbers(dist, "CurvesList", found)
         gmsh.model.mesh.field.setNumber(dist, "Sampling", 200)
         thr = gmsh.model.mesh.field.add("Threshold")
-        size_min = min(size_neck * geo.a[b], geo.h_n[b] / neck_cells)
+        size_min = min(size_neck * geo.a[b], geo.h_n[b] / neck_cells) if geo.h_n[b] > 0 else size_neck * geo.a[b]
         size_max = size_far * min(r[bi[b]], r[bj[b]])
         gmsh.model.mesh.field.setNumber(thr, "InField", dist)
         gmsh.model.mesh.field.setNumber(thr, "SizeMin", size_min)

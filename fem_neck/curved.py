@@ -35,6 +35,10 @@ BLEND = 3  # power of the blending weights (module docstring)
 P_SPHERE, P_CYLINDER, P_CIRCLE, P_ELLIPSE = 0, 1, 2, 3
 
 
+class FoldedMesh(ValueError):
+    """A curved element folds (its Jacobian changes sign): the mesh is too coarse for the curvature of its surfaces."""
+
+
 @dataclass(frozen=True)
 class Surface:
     """An analytic surface: a sphere (``centre``, ``radius``), a cylinder (a point ``centre`` on its axis, unit
@@ -230,12 +234,12 @@ class CurvedMesh:
     def metric(self, elements: np.ndarray, xi: np.ndarray, w: np.ndarray, inverse: bool) -> np.ndarray:
         """The quadrature-weighted metric of ``elements`` at ``xi`` as six symmetric entries ``(E, Q, 6)`` (order
         ``00, 11, 22, 01, 02, 12``, off-diagonal ones doubled): ``w |det J| J^-1 J^-T`` (``inverse``, for gradients)
-        or ``w J^T J / |det J|`` (for Piola-mapped fluxes). ``ValueError`` if an element folds (``det J`` changes
+        or ``w J^T J / |det J|`` (for Piola-mapped fluxes). :class:`FoldedMesh` if an element folds (``det J`` changes
         sign)."""
         J = self.jacobians(elements, xi)
         G, folded = _metric_kernel(J, np.ascontiguousarray(w, dtype=float), inverse)
         if folded:
-            raise ValueError("a curved element folds (its Jacobian changes sign): the mesh is too coarse for the "
+            raise FoldedMesh("a curved element folds (its Jacobian changes sign): the mesh is too coarse for the "
                              "curvature of the surfaces")
         return G
 

@@ -9,6 +9,15 @@ stay apart: :func:`check_cell` refuses a cell where two neck circles on one sphe
 ``a/r = sin(theta/2)``, theta the smallest angle between bonds: SC 90 deg, BCC 70.5 deg, FCC 60 deg; see
 :func:`max_h_over_r`).
 
+The union reading (``neck = "union"``). The solid is the union of the spheres: Arzt's (1982) truncated spheres, each
+cut by its radical planes (:mod:`fem_neck.geometry.union`), no cylinders. A neck is the circle where two spheres meet
+(:class:`UnionNecks`), second neighbours that overlap are necks too, and the necks of one particle may meet; the
+model holds up to the overlap at which the spheres fill space (:func:`union_max_h_over_r`), and ``phi`` is the exact
+volume of the cut spheres over the period. Its circles are re-entrant edges of interior angle ``pi + 2 arccos(a/r)``
+(equal spheres), sharper than a pair neck's, so its first mesh, gap order and mesh prediction are measured on its own
+cells (``UNION_*``). Below ``UNION_MIN_H_OVER_R`` the gap between two spheres at their circle is too thin a wedge to
+mesh.
+
 The computational cell. A macroscopic gradient along z through a packing that is mirror-symmetric about the planes
 ``x = 0``, ``y = 0``, ``z = 0`` (hence also about ``x = P_x/2`` etc.) leaves the planes ``z = 0`` and ``z = P_z/2``
 isothermal (the temperature fluctuation is odd under the z mirror) and the planes normal to x and y insulated (it
@@ -50,10 +59,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fem_neck.curved import FoldedMesh
 from fem_neck.geometry import check_positive, max_overlap, neck_geometry, overlap_for_neck
+from fem_neck.geometry.union import cut_spheres, lens
 from sinterheat.threads import one_blas_thread
 
 KINDS = ("sc", "bcc", "fcc")
+# the readings of a bond: "newton", the volume-conserving pair neck (Rojek 2022, eqs. 21-33); "union", the union of the
+# spheres (module docstring)
+NECKS = ("newton", "union")
 # particle sites of the cubic cell (units of the cell edge) and the cell edge in units of the neighbour distance
 BASIS = {"sc": [[0.0, 0.0, 0.0]],
          "bcc": [[0.0, 0.0, 0.0], [0.5, 0.5, 0.5]],
@@ -64,6 +78,8 @@ COORDINATION = {"sc": 6, "bcc": 8, "fcc": 12}
 # smallest neck meshed: below it the neck is thinner than 1.3e-3 r and the mesh of its disk explodes; the network is
 # exact in the limit of small necks (independent constrictions), which the FE shows from here up
 MIN_NECK_RATIO = 0.05
+# the smallest overlap of nearest neighbours whose union the mesher takes (module docstring)
+UNION_MIN_H_OVER_R = 0.02
 # the meshes: element size at the neck circles over the neck radius (the range of first meshes), far size over the
 # particle radius, growth of the size per unit distance from the circles
 FIRST_SIZES, SIZE_FAR, GRADING = (0.005, 0.3), 0.5, 0.8
@@ -83,11 +99,31 @@ ALGEBRAIC_SHARE = 1e-3
 FIRST_MESH = {3: (0.05, 1.9e-3, 1.1, 0.75), 4: (0.01, 1e-4, 1.3, 0.75)}
 NECK0, NECK_RANGE = 0.2, (0.2, 0.5)
 P3_FROM = 3e-4  # the rtol from which the upper bound is P_3 by default (below, P_4)
+# the union reading's first mesh, gap order, neck range and first sizes (as FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE,
+# FIRST_SIZES): its circles are sharper edges (interior angle pi + 2 arccos(a/r)), so its gap falls more slowly with
+# the neck size, and it falls with the pore fraction 1 - phi as well (a cell near closure is nearly uniform), like
+# ((1 - phi) / UNION_PORE0)^UNION_PORE_ORDER over UNION_PORE_RANGE. Measured on its own cells (SC, BCC, FCC at h/r
+# 0.02, 0.2-0.3, 0.3-0.6 and near closure; a/r the mean over all bonds, second neighbours included): per cell the
+# gap falls like size^0.83-1.06 (p = 3, BCC h/r = 0.02: 1.49e-2, 6.45e-3, 1.71e-3, 8.25e-4 at 0.1, 0.04, 0.01,
+# 0.0042); fitted at gap order 0.94 to the 37 solves at neck sizes 0.0015-0.04, like (a/r)^-0.747 and
+# (1 - phi)^0.692. The cells scatter about the fit by 0.2-2.7 (SC 0.2-0.9, FCC 0.7-1.9, BCC 1.1-2.7; random
+# packings of phi 0.6 0.3-0.35), so rtol0 is the fit, not the largest: a cell inside 1 / margin of it meets rtol on
+# its first mesh, a BCC cell may need a second, and the first mesh's memory is not predicted for the worst cell.
+UNION_FIRST_MESH = {3: (0.01, 1.52e-3, 0.747, 0.75), 4: (0.01, 7.03e-4, 0.747, 0.75)}
+UNION_GAP_ORDER = 0.94
+UNION_NECK0, UNION_NECK_RANGE = 0.141, (0.141, 0.70)
+UNION_PORE0, UNION_PORE_ORDER, UNION_PORE_RANGE = 0.3, 0.692, (2e-5, 0.46)
+UNION_FIRST_SIZES = (0.001, 0.3)
 # the tetrahedra of a mesh predicted before meshing (:func:`predicted_tetrahedra`): the constants fitted to 42 meshes
 # (the six cubic cells and two chains at neck sizes 0.005-0.3, a random packing at 0.087 and 0.03), and the margin
 # that puts every measured mesh on the safe side: 64 of them (also the other random packings and the first meshes
 # of the dense-packing study) were predicted 1.04-1.77 times their tetrahedra
 TETRAHEDRA_PER_CIRCLE, TETRAHEDRA_PER_VOLUME, PREDICTION_MARGIN = 315.0, 27.3, 1.3
+# the union's, fitted to 27 meshes of the three cubic cells (h/r 0.02-0.6, neck sizes 0.01-0.1): with
+# PREDICTION_MARGIN 1.05-2.62 times their tetrahedra (random union packings of 32-80 spheres: 1.9-3.3 times); their
+# memory (p = 3 at most 18 kB per tetrahedron beyond the base, also on random packings of up to 109 127 tetrahedra;
+# p = 4 at most 52 kB, FCC h/r = 0.02 at 0.01, 17 995 tetrahedra) lies within BYTES_PER_ELEMENT
+UNION_TETRAHEDRA_PER_CIRCLE, UNION_TETRAHEDRA_PER_VOLUME = 353.0, 57.7
 # peak memory of solve_bounds (both processes): BASE_BYTES + BYTES_PER_ELEMENT[order] * tetrahedra (measured by
 # peak_memory, whole runs: p = 4 at most 41 kB per tetrahedron beyond the base on the six cells of SC, BCC, FCC at
 # h/r = 0.02 and 0.08; p = 3 at most 18 kB, on the largest random packing of the dense-packing study, 106 027
@@ -98,17 +134,33 @@ _TOL = 1e-9  # geometric tolerance in units of the largest radius
 
 @dataclass(frozen=True)
 class PeriodicCell:
-    """One period of a packing: ``centres`` (n, 3) wrapped into ``[0, period)``, ``radii`` (n,), ``period`` (3,).
+    """One period of a packing. Every pair of particle images closer than the sum of their radii is bonded (Rojek
+    2022, eq. 21).
 
-    Every pair of particle images closer than the sum of their radii is bonded (Rojek 2022, eq. 21).
+    Attributes
+    ----------
+    centres : numpy.ndarray (n, 3)
+        Particle centres, m, wrapped into ``[0, period)``.
+    radii : numpy.ndarray (n,)
+        Particle radii, m.
+    period : numpy.ndarray (3,)
+        Edges of the period box, m.
+    name : str
+        Name of the cell in messages.
+    neck : str
+        How bonds are read (``NECKS``): ``"newton"``, the volume-conserving pair necks (Rojek 2022, eqs. 21-33);
+        ``"union"``, the union of the spheres (module docstring).
     """
 
     centres: np.ndarray
     radii: np.ndarray
     period: np.ndarray
     name: str = "cell"
+    neck: str = "newton"
 
     def __post_init__(self):
+        if self.neck not in NECKS:
+            raise ValueError(f"neck = {self.neck!r}: must be one of {', '.join(NECKS)}")
         period = check_positive("period", np.asarray(self.period, dtype=float).reshape(-1))
         if period.shape != (3,):
             raise ValueError(f"period = {self.period!r}: must be three lengths")
@@ -128,7 +180,13 @@ class PeriodicCell:
 
     @property
     def phi(self) -> float:
-        """Solid volume fraction ``sum 4/3 pi r^3 / |period|`` (exact: the necks conserve each particle's volume)."""
+        """Solid volume fraction ``sum 4/3 pi r^3 / |period|`` (exact: the necks conserve each particle's volume);
+        read as the union of the spheres, the sum of the volumes of the spheres cut by their radical planes over
+        ``|period|`` (:func:`fem_neck.geometry.union.cut_spheres`, exact)."""
+        if self.neck == "union":
+            i, j, s = self.bonds()
+            vectors = self.centres[j] + s * self.period - self.centres[i]
+            return float(np.sum(cut_spheres(self.radii, i, j, vectors).volume) / np.prod(self.period))
         return float(np.sum(4.0 / 3.0 * np.pi * self.radii**3) / np.prod(self.period))
 
     def images(self, lo, hi) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -162,16 +220,30 @@ class PeriodicCell:
         return arr[:, 0], arr[:, 1], arr[:, 2:]
 
 
-def lattice_cell(kind: str, h_over_r: float, radius: float = 1.0) -> PeriodicCell:
-    """The cubic cell of a simple cubic, body-centred or face-centred cubic lattice of equal spheres of ``radius``
-    whose nearest neighbours overlap by ``h = h_over_r * radius`` (neighbour distance ``2r - h``)."""
+def lattice_cell(kind: str, h_over_r: float, radius: float = 1.0, neck: str = "newton") -> PeriodicCell:
+    """The cubic cell of a simple cubic, body-centred or face-centred cubic lattice of equal spheres.
+
+    Parameters
+    ----------
+    kind : str
+        ``"sc"``, ``"bcc"`` or ``"fcc"``.
+    h_over_r : float
+        Overlap of nearest neighbours over the radius (neighbour distance ``2r - h``); the valid range of each
+        reading: :func:`check_h_over_r`.
+    radius : float
+        Particle radius, m.
+    neck : str
+        How bonds are read (``NECKS``, :class:`PeriodicCell`).
+    """
     if kind not in KINDS:
         raise ValueError(f"kind = {kind!r}: must be one of {', '.join(KINDS)}")
+    if neck not in NECKS:
+        raise ValueError(f"neck = {neck!r}: must be one of {', '.join(NECKS)}")
     check_positive("radius", radius)
-    check_h_over_r(kind, h_over_r)
+    check_h_over_r(kind, h_over_r, neck)
     edge = EDGE_OVER_SPACING[kind] * (2.0 - h_over_r) * radius
     basis = np.asarray(BASIS[kind]) * edge
-    return PeriodicCell(basis, np.full(len(basis), float(radius)), np.full(3, edge), name=kind)
+    return PeriodicCell(basis, np.full(len(basis), float(radius)), np.full(3, edge), name=kind, neck=neck)
 
 
 def max_neck_ratio(kind: str) -> float:
@@ -184,8 +256,52 @@ def max_h_over_r(kind: str) -> float:
     return overlap_for_neck(1.0, 1.0, max_neck_ratio(kind))
 
 
-def check_h_over_r(kind: str, h_over_r: float) -> float:
-    """``h_over_r`` if the lattice's necks exist and stay apart (and are not too small to mesh), else ValueError."""
+def union_max_h_over_r(kind: str) -> float:
+    """``h/r`` at which the union of the lattice's spheres fills space: the neighbour distance at which the radius
+    is the lattice's covering radius (SC: the cube's half diagonal, ``d = 2r / sqrt(3)``, h/r = 0.8453; BCC: ``sqrt(5)
+    / 4`` of the cube edge, ``d = 2 sqrt(3 / 5) r``, 0.4508; FCC: half the cube edge, ``d = sqrt(2) r``, 0.5858).
+
+    Parameters
+    ----------
+    kind : str
+        ``"sc"``, ``"bcc"`` or ``"fcc"``.
+    """
+    covering = {"sc": math.sqrt(3.0) / 2.0, "bcc": math.sqrt(5.0) / 4.0, "fcc": 0.5}[kind]  # over the cube edge
+    return 2.0 - 1.0 / (covering * EDGE_OVER_SPACING[kind])
+
+
+def union_neck_ratio(h_over_r: float) -> float:
+    """``a/r`` of the circle where two equal spheres meet: ``a^2 = r h - h^2 / 4`` (:func:`fem_neck.geometry.union.lens`
+    at ``d = 2r - h``).
+
+    Parameters
+    ----------
+    h_over_r : float
+        Their overlap over the radius, ``0 < h/r < 2``.
+    """
+    return float(lens(1.0, 1.0, 2.0 - h_over_r).a)
+
+
+def check_h_over_r(kind: str, h_over_r: float, neck: str = "newton") -> float:
+    """``h_over_r`` if the lattice's necks exist (and are not too small to mesh) and, read as pair necks, stay apart,
+    or, read as the union of the spheres, leave pores open (:func:`union_max_h_over_r`); else ValueError.
+
+    Parameters
+    ----------
+    kind : str
+        ``"sc"``, ``"bcc"`` or ``"fcc"``.
+    h_over_r : float
+        Overlap of nearest neighbours over the radius.
+    neck : str
+        How bonds are read (``NECKS``).
+    """
+    if neck == "union":
+        low, high = UNION_MIN_H_OVER_R, union_max_h_over_r(kind)
+        if not (isinstance(h_over_r, (int, float)) and low <= h_over_r < high):
+            raise ValueError(f"h_over_r = {h_over_r!r}: valid range {low:.6g} <= h/r < {high:.6g} for the union "
+                             f"of the {kind} lattice's spheres (from h/r = {high:.6g} they fill space; below "
+                             f"{low:.6g} the gap between the spheres at their circles is too thin to mesh)")
+        return float(h_over_r)
     low = overlap_for_neck(1.0, 1.0, MIN_NECK_RATIO)
     high = max_h_over_r(kind)
     if not (isinstance(h_over_r, (int, float)) and low <= h_over_r < high):
@@ -198,8 +314,9 @@ def check_h_over_r(kind: str, h_over_r: float) -> float:
 
 
 def check_cell(cell: PeriodicCell, method: str = "newton") -> None:
-    """Raise ``ValueError`` unless every bond's overlap lies in the neck model's range and no two necks of one
-    particle touch (their circles, of angular radius ``arcsin(a/r)``, must stay apart on the sphere)."""
+    """Raise ``ValueError`` unless some particles overlap and, read as pair necks, every bond's overlap lies in the
+    neck model's range and no two necks of one particle touch (their circles, of angular radius ``arcsin(a/r)``,
+    must stay apart on the sphere), or, read as the union of the spheres, no sphere lies inside another."""
     i, j, s = cell.bonds()
     if not len(i):
         raise ValueError(f"{cell.name}: no two particles overlap, so nothing conducts")
@@ -207,6 +324,14 @@ def check_cell(cell: PeriodicCell, method: str = "newton") -> None:
     d = np.linalg.norm(e, axis=1)
     e = e / d[:, None]
     r_i, r_j = cell.radii[i], cell.radii[j]
+    if cell.neck == "union":
+        inside = np.flatnonzero(d <= np.abs(r_i - r_j))
+        if inside.size:
+            b = int(inside[0])
+            raise ValueError(f"{cell.name}: particle {i[b] if r_i[b] < r_j[b] else j[b]} lies inside particle "
+                             f"{j[b] if r_i[b] < r_j[b] else i[b]} (centres {d[b]:.6g} apart, radii {r_i[b]:.6g} and "
+                             f"{r_j[b]:.6g}): it is no particle of the union")
+        return
     h = r_i + r_j - d
     limit = max_overlap(r_i, r_j)
     bad = np.flatnonzero(h > limit)
@@ -303,6 +428,14 @@ def _domain(box: np.ndarray, diagonal: bool, anti: bool) -> list:
     return [(np.asarray(n) / np.linalg.norm(n), d / np.linalg.norm(n)) for n, d in planes]
 
 
+def _inside(halfspaces: list, points: np.ndarray, tol: float) -> np.ndarray:
+    """Whether the ``points`` lie in the cell (to ``tol``)."""
+    keep = np.ones(len(points), dtype=bool)
+    for n, d in halfspaces:
+        keep &= points @ n - d <= tol
+    return keep
+
+
 def _reaches(halfspaces: list, points: np.ndarray, radius: np.ndarray) -> np.ndarray:
     """Whether the balls (or, with ``points (k, 2, 3)``, capsules) of ``radius`` can meet the cell: no half-space
     leaves them wholly outside (a necessary condition; enough to leave out the far images)."""
@@ -343,26 +476,76 @@ def _cell_frame(cell: PeriodicCell, method: str = "newton") -> CellFrame:
         raise ValueError(f"{cell.name}: the packing is not mirror-symmetric about x = 0, y = 0 and z = 0 (modulo the "
                          "period); this FE solves the mirror cell [0, P/2]^3 and needs those mirror planes")
     unit = float(cell.radii.max())
-    scaled = PeriodicCell(cell.centres / unit, cell.radii / unit, cell.period / unit, cell.name)
+    scaled = PeriodicCell(cell.centres / unit, cell.radii / unit, cell.period / unit, cell.name, cell.neck)
     box = scaled.period / 2.0
     local = local_cluster(scaled, box)
     fraction = 0.25 if anti else 0.5 if diagonal else 1.0
-    return CellFrame(scaled, unit, box, local, local.necks(method), local.directions(), _domain(box, diagonal, anti),
+    geo = union_necks(local) if cell.neck == "union" else local.necks(method)
+    return CellFrame(scaled, unit, box, local, geo, local.directions(), _domain(box, diagonal, anti),
                      diagonal, anti, fraction, float(scaled.phi * np.prod(box) * fraction))
+
+
+@dataclass(frozen=True)
+class UnionNecks:
+    """The necks of the union reading, per bond of a :class:`fem_neck.cluster.Cluster` (the fields the meshing
+    reads of a pair neck's :class:`fem_neck.geometry.NeckGeometry`).
+
+    Attributes
+    ----------
+    a : numpy.ndarray
+        Radius of the circle where the two spheres meet (:func:`fem_neck.geometry.union.lens`), in the cluster's
+        length unit.
+    z_i : numpy.ndarray
+        Distance from centre ``i`` along the bond to the bond's radical plane, which holds the circle.
+    h_n : numpy.ndarray
+        Zeros: a neck without length.
+    """
+
+    a: np.ndarray
+    z_i: np.ndarray
+    h_n: np.ndarray
+
+
+def union_necks(local) -> UnionNecks:
+    """The :class:`UnionNecks` of the bonds of a cluster.
+
+    Parameters
+    ----------
+    local : fem_neck.cluster.Cluster
+        Spheres and their bonds (overlapping pairs).
+    """
+    i, j = local.bonds.T
+    neck = lens(local.radii[i], local.radii[j], np.linalg.norm(local.centres[j] - local.centres[i], axis=1))
+    return UnionNecks(neck.a, neck.l_i, np.zeros_like(neck.a))
 
 
 @dataclass(frozen=True)
 class NeckCircles:
     """The neck circles on the boundary of a cell's solid, for predicting its mesh before meshing
-    (:func:`predicted_tetrahedra`): per circle its radius ``a``, its neck's length ``h_n`` and smaller particle
-    radius ``r_min``, and the ``fraction`` of it inside the computational cell; the solid volume there. Lengths in
-    units of the largest radius."""
+    (:func:`predicted_tetrahedra`). Lengths in units of the largest radius.
+
+    Attributes
+    ----------
+    a : numpy.ndarray
+        Radius of each circle.
+    h_n : numpy.ndarray
+        Length of its neck (``inf`` for the union's circles, which no neck length limits).
+    r_min : numpy.ndarray
+        The smaller radius of its pair.
+    fraction : numpy.ndarray
+        The fraction of the circle inside the computational cell and on the solid's boundary.
+    solid_volume : float
+        Volume of the solid in the computational cell.
+    neck : str
+        The cell's reading (``NECKS``): which constants predict its mesh.
+    """
 
     a: np.ndarray
     h_n: np.ndarray
     r_min: np.ndarray
     fraction: np.ndarray
     solid_volume: float
+    neck: str = "newton"
 
 
 def neck_circles(cell: PeriodicCell, samples: int = 360) -> NeckCircles:
@@ -372,6 +555,8 @@ def neck_circles(cell: PeriodicCell, samples: int = 360) -> NeckCircles:
     local, geo, e = frame.local, frame.geo, frame.e
     c, r = local.centres, local.radii
     bi, bj = local.bonds.T
+    union = cell.neck == "union"
+    slack = _TOL if union else 0.0  # a union's circle may lie on a mirror plane, a face of the cell
     helper = np.where(np.abs(e[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
     u = np.cross(e, helper)
     u /= np.linalg.norm(u, axis=1)[:, None]
@@ -379,17 +564,19 @@ def neck_circles(cell: PeriodicCell, samples: int = 360) -> NeckCircles:
     angle = np.linspace(0.0, 2.0 * np.pi, samples, endpoint=False)
     ring = np.cos(angle)[None, :, None] * u[:, None, :] + np.sin(angle)[None, :, None] * v[:, None, :]
     fractions = []
-    for z in (geo.z_i, geo.z_i + geo.h_n):
+    ends = (geo.z_i,) if union else (geo.z_i, geo.z_i + geo.h_n)
+    for z in ends:
         points = (c[bi] + z[:, None] * e)[:, None, :] + geo.a[:, None, None] * ring  # (bonds, samples, 3)
         inside = np.ones(points.shape[:2], dtype=bool)
         for n, d in frame.halfspaces:
-            inside &= points @ n <= d
+            inside &= points @ n <= d + slack
         for k in range(len(r)):
             covered = np.linalg.norm(points - c[k], axis=2) < r[k] * (1.0 - 1e-9)
             inside &= ~(covered & ((bi != k) & (bj != k))[:, None])
         fractions.append(inside.mean(axis=1))
-    a, h_n, r_min = (np.tile(np.asarray(x, dtype=float), 2) for x in (geo.a, geo.h_n, np.minimum(r[bi], r[bj])))
-    return NeckCircles(a, h_n, r_min, np.concatenate(fractions), frame.solid_volume)
+    h_n = np.full(len(bi), np.inf) if union else geo.h_n  # a union's circle: no neck length limits its size
+    a, h_n, r_min = (np.tile(np.asarray(x, dtype=float), len(ends)) for x in (geo.a, h_n, np.minimum(r[bi], r[bj])))
+    return NeckCircles(a, h_n, r_min, np.concatenate(fractions), frame.solid_volume, cell.neck)
 
 
 def predicted_tetrahedra(circles: NeckCircles, size_neck: float) -> float:
@@ -403,8 +590,10 @@ def predicted_tetrahedra(circles: NeckCircles, size_neck: float) -> float:
     s = np.minimum(size_neck * circles.a, circles.h_n)
     far = SIZE_FAR * circles.r_min
     near = np.where(s < far, circles.a * (0.5 / s - 1.0 / far + 0.5 * s / far**2), 0.0)
-    per_circle = TETRAHEDRA_PER_CIRCLE * float(np.sum(circles.fraction * near))
-    return PREDICTION_MARGIN * (per_circle + TETRAHEDRA_PER_VOLUME * circles.solid_volume / SIZE_FAR**3)
+    per_circle, per_volume = ((UNION_TETRAHEDRA_PER_CIRCLE, UNION_TETRAHEDRA_PER_VOLUME) if circles.neck == "union"
+                              else (TETRAHEDRA_PER_CIRCLE, TETRAHEDRA_PER_VOLUME))
+    return PREDICTION_MARGIN * (per_circle * float(np.sum(circles.fraction * near))
+                                + per_volume * circles.solid_volume / SIZE_FAR**3)
 
 
 def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, grading: float,
@@ -422,14 +611,22 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, gradi
                                                     frame.e, frame.halfspaces)
     diagonal, anti = frame.diagonal, frame.anti
     bi, bj = local.bonds.T
-    start = local.centres[bi] + (0.75 * geo.z_i)[:, None] * e
-    end = start + (geo.h_n + 0.25 * (geo.z_i + geo.z_j))[:, None] * e
-    use_sphere = _reaches(halfspaces, local.centres, local.radii)
-    use_neck = _reaches(halfspaces, np.stack([start, end], axis=1), geo.a)
-    surfaces = [curved.sphere(c, r) for c, r in zip(local.centres, local.radii)]
-    surfaces += [curved.cylinder(c, d, a) for c, d, a in zip(local.centres[bi], e, geo.a)]
-    surfaces += [curved.plane(n, d) for n, d in halfspaces]
     tol = 1e-6
+    if scaled.neck == "union":
+        # the spheres centred in the cell: every other one is covered there by its mirror image (the cell is bounded
+        # by mirror planes of the packing, and a ball reflected across one of them covers the ball's part on the
+        # cell's side), so no sphere meets a cell face in a circle of its own
+        use_sphere = _inside(halfspaces, local.centres, tol)
+        use_neck = np.zeros(len(bi), dtype=bool)
+        surfaces = [curved.sphere(c, r) for c, r in zip(local.centres[use_sphere], local.radii[use_sphere])]
+    else:
+        start = local.centres[bi] + (0.75 * geo.z_i)[:, None] * e
+        end = start + (geo.h_n + 0.25 * (geo.z_i + geo.z_j))[:, None] * e
+        use_sphere = _reaches(halfspaces, local.centres, local.radii)
+        use_neck = _reaches(halfspaces, np.stack([start, end], axis=1), geo.a)
+        surfaces = [curved.sphere(c, r) for c, r in zip(local.centres, local.radii)]
+        surfaces += [curved.cylinder(c, d, a) for c, d, a in zip(local.centres[bi], e, geo.a)]
+    surfaces += [curved.plane(n, d) for n, d in halfspaces]
     surfaces = curved.distinct(surfaces, tol)
     with gmsh_session() as gmsh:
         occ = gmsh.model.occ
@@ -642,41 +839,89 @@ def available_memory() -> float:
 
 
 def mean_neck_ratio(cell: PeriodicCell) -> float:
-    """The mean ``a / r`` of the cell's bonds (``r`` the smaller radius of the pair)."""
+    """The mean ``a / r`` of the cell's bonds (``r`` the smaller radius of the pair; ``a`` the neck's radius, or the
+    radius of the circle where the spheres meet, read as their union).
+
+    Parameters
+    ----------
+    cell : PeriodicCell
+        The packing.
+    """
     i, j, s = cell.bonds()
     d = np.linalg.norm(cell.centres[j] + s * cell.period - cell.centres[i], axis=1)
     r_i, r_j = cell.radii[i], cell.radii[j]
-    return float(np.mean(neck_geometry(r_i, r_j, r_i + r_j - d).a / np.minimum(r_i, r_j)))
+    a = lens(r_i, r_j, d).a if cell.neck == "union" else neck_geometry(r_i, r_j, r_i + r_j - d).a
+    return float(np.mean(a / np.minimum(r_i, r_j)))
 
 
-def _neck_factor(neck_ratio: float, order: int) -> float:
-    """How much coarser than at ``NECK0`` a mesh may be for the same gap when the mean neck is ``neck_ratio``."""
-    neck_order = FIRST_MESH[order][2]
-    return (float(np.clip(neck_ratio, *NECK_RANGE)) / NECK0) ** (neck_order / GAP_ORDER)
+def _rule(neck: str) -> tuple:
+    """``(FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE, FIRST_SIZES)`` of the reading ``neck`` (the union's:
+    ``UNION_*``)."""
+    if neck == "union":
+        return UNION_FIRST_MESH, UNION_GAP_ORDER, UNION_NECK0, UNION_NECK_RANGE, UNION_FIRST_SIZES
+    return FIRST_MESH, GAP_ORDER, NECK0, NECK_RANGE, FIRST_SIZES
 
 
-def first_neck_size(rtol: float, neck_ratio: float, order: int) -> float:
-    """Neck size of the first mesh at ``order`` of a cell whose mean neck has ``a / r = neck_ratio``: the size
-    whose gap is predicted at ``margin rtol`` (``FIRST_MESH``: ``rtol0`` at ``size0`` for ``a / r = NECK0``, the gap
-    falling like ``size^GAP_ORDER`` and like ``(a / r)^-neck_order``), within ``FIRST_SIZES``."""
-    size0, rtol0, _, margin = FIRST_MESH[order]
-    size = size0 * (margin * rtol / rtol0) ** (1.0 / GAP_ORDER) * _neck_factor(neck_ratio, order)
-    return float(np.clip(size, *FIRST_SIZES))
+def _neck_factor(neck_ratio: float, order: int, neck: str = "newton", pore: float = UNION_PORE0) -> float:
+    """How much coarser than at ``NECK0`` a mesh may be for the same gap when the mean neck is ``neck_ratio`` (and,
+    read as the union, the pore fraction ``pore`` rather than ``UNION_PORE0``)."""
+    first_mesh, gap_order, neck0, neck_range, _ = _rule(neck)
+    neck_order = first_mesh[order][2]
+    factor = (float(np.clip(neck_ratio, *neck_range)) / neck0) ** (neck_order / gap_order)
+    if neck == "union":
+        factor *= (float(np.clip(pore, *UNION_PORE_RANGE)) / UNION_PORE0) ** (-UNION_PORE_ORDER / gap_order)
+    return factor
 
 
-def first_rtol(size: float, neck_ratio: float, order: int) -> float:
-    """The ``rtol`` whose first mesh at ``order`` (:func:`first_neck_size`) has neck size ``size``."""
-    size0, rtol0, _, margin = FIRST_MESH[order]
-    return rtol0 * (size / (size0 * _neck_factor(neck_ratio, order))) ** GAP_ORDER / margin
+def first_neck_size(rtol: float, neck_ratio: float, order: int, neck: str = "newton",
+                    pore: float = UNION_PORE0) -> float:
+    """Neck size of the first mesh of a cell: the size whose gap is predicted at ``margin rtol`` (``FIRST_MESH``:
+    ``rtol0`` at ``size0`` for ``a / r = NECK0``, the gap falling like ``size^GAP_ORDER`` and like ``(a /
+    r)^-neck_order``; the union's ``UNION_*``, its gap also falling with the pore fraction), within ``FIRST_SIZES``.
+
+    Parameters
+    ----------
+    rtol : float
+        Relative gap of the bounds asked for.
+    neck_ratio : float
+        The cell's mean ``a / r`` (:func:`mean_neck_ratio`).
+    order : int
+        Order of the upper bound (3 or 4).
+    neck : str
+        The cell's reading (``NECKS``).
+    pore : float
+        The cell's pore fraction ``1 - phi`` (read as the union only).
+    """
+    first_mesh, gap_order, _, _, first_sizes = _rule(neck)
+    size0, rtol0, _, margin = first_mesh[order]
+    size = size0 * (margin * rtol / rtol0) ** (1.0 / gap_order) * _neck_factor(neck_ratio, order, neck, pore)
+    return float(np.clip(size, *first_sizes))
+
+
+def first_rtol(size: float, neck_ratio: float, order: int, neck: str = "newton", pore: float = UNION_PORE0) -> float:
+    """The ``rtol`` whose first mesh (:func:`first_neck_size`) has the neck size ``size``.
+
+    Parameters
+    ----------
+    size : float
+        Element size at the neck circles over their radius.
+    neck_ratio, order, neck, pore
+        As for :func:`first_neck_size`.
+    """
+    first_mesh, gap_order, _, _, _ = _rule(neck)
+    size0, rtol0, _, margin = first_mesh[order]
+    return rtol0 * (size / (size0 * _neck_factor(neck_ratio, order, neck, pore))) ** gap_order / margin
 
 
 def _size_that_fits(circles: NeckCircles, calibration: float, order: int, budget: float) -> float | None:
-    """The finest neck size (down to a fiftieth of ``FIRST_SIZES``' finest) whose solve fits in ``budget`` bytes
-    (``calibration`` times its :func:`predicted_tetrahedra`), or ``None`` if not even the coarsest does."""
+    """The finest neck size (down to a fiftieth of the reading's ``FIRST_SIZES``' finest) whose solve fits in
+    ``budget`` bytes (``calibration`` times its :func:`predicted_tetrahedra`), or ``None`` if not even the coarsest
+    does."""
     def fits(size):
         return memory_estimate(calibration * predicted_tetrahedra(circles, size), order) <= budget
 
-    lo, hi = FIRST_SIZES[0] / 50.0, FIRST_SIZES[1]
+    first_sizes = _rule(circles.neck)[4]
+    lo, hi = first_sizes[0] / 50.0, first_sizes[1]
     if not fits(hi):
         return None
     if fits(lo):
@@ -698,8 +943,9 @@ def _check_fits(cell: PeriodicCell, circles: NeckCircles, size: float, calibrati
         return
     fit = _size_that_fits(circles, calibration, order, budget)
     if fit is None:
-        coarsest = memory_estimate(calibration * predicted_tetrahedra(circles, FIRST_SIZES[1]), order)
-        tail = f"no rtol fits: even neck size {FIRST_SIZES[1]:g} a needs ~{coarsest / 1e9:.1f} GB"
+        coarsest = _rule(circles.neck)[4][1]
+        need = memory_estimate(calibration * predicted_tetrahedra(circles, coarsest), order)
+        tail = f"no rtol fits: even neck size {coarsest:g} a needs ~{need / 1e9:.1f} GB"
     else:
         tail = f"rtol = {rtol_at(fit):.1e} would fit"
     raise ValueError(f"{cell.name}: {what} (neck size {size:.3g} a, ~{elements:.0f} tetrahedra) needs "
@@ -711,10 +957,10 @@ def default_order(rtol: float) -> int:
     return 3 if rtol >= P3_FROM else 4
 
 
-def _refined_rtol(gap: float, size: float, new: float) -> float:
+def _refined_rtol(gap: float, size: float, new: float, neck: str = "newton") -> float:
     """The ``rtol`` whose refinement from a mesh of neck size ``size`` with the bounds ``gap`` apart goes to the
     neck size ``new`` (the inverse of the refinement rule of :func:`effective_conductivity`)."""
-    return gap * (new / size) ** GAP_ORDER / REFINE_MARGIN
+    return gap * (new / size) ** _rule(neck)[1] / REFINE_MARGIN
 
 
 def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | None = None,
@@ -728,8 +974,25 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
     tetrahedra are predicted (:func:`predicted_tetrahedra`, on the safe side; from the second mesh on scaled up
     if a mesh had more) and the memory of its solve estimated (:func:`memory_estimate`): one that would not fit in
     ``max_memory`` bytes (default: what the machine has available) is refused with a ``ValueError`` naming the
-    estimate and the ``rtol`` that would fit. ``order``: of the upper bound (default
-    :func:`default_order`). ``progress(text)`` reports each mesh.
+    estimate and the ``rtol`` that would fit. A mesh too coarse for the curvature of its surfaces (a curved element
+    folds, :class:`fem_neck.curved.FoldedMesh`) is followed by one twice as fine.
+
+    Parameters
+    ----------
+    cell : PeriodicCell
+        The packing, mirror-symmetric about x = 0, y = 0 and z = 0; its bonds read as ``cell.neck``.
+    rtol : float
+        Relative gap ``(upper - lower) / upper`` of the bounds to reach.
+    order : int, optional
+        Order of the upper bound, 3 or 4 (default :func:`default_order`).
+    max_memory : float, optional
+        Bytes the solves may use (default: what the machine has available).
+    max_meshes : int
+        Most meshes solved.
+    workers : int
+        2: the two bounds in parallel processes; 1: one after the other.
+    progress : callable, optional
+        ``progress(text)`` reports each mesh.
     """
     check_positive("rtol", rtol)
     check_cell(cell)
@@ -742,35 +1005,45 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
     t0 = time.perf_counter()
     neck = mean_neck_ratio(cell)
     circles = neck_circles(cell)
-    size = first_neck_size(rtol, neck, order)
+    pore = 1.0 - cell.phi
+    size = first_neck_size(rtol, neck, order, cell.neck, pore)
+    gap_order = _rule(cell.neck)[1]
     calibration = 1.0  # tetrahedra meshed over predicted, where a mesh had more than predicted
 
     def first_fit(fit: float) -> float:
         """The rtol whose first mesh is the finest that fits, at the order that rtol gets (unless one was given)."""
-        reach = first_rtol(fit, neck, order)
+        reach = first_rtol(fit, neck, order, cell.neck, pore)
         if not explicit and default_order(reach) != order:  # p = 4 does not fit, p = 3 from P3_FROM does
-            reach = max(first_rtol(_size_that_fits(circles, calibration, 3, budget), neck, 3), P3_FROM)
+            reach = max(first_rtol(_size_that_fits(circles, calibration, 3, budget), neck, 3, cell.neck, pore),
+                        P3_FROM)
         return reach
 
     what, rtol_at = "the first mesh", first_fit
     history = []
-    for _ in range(max_meshes):
+    for level in range(max_meshes):
         _check_fits(cell, circles, size, calibration, order, budget, what, rtol_at)
         if progress is not None:
             progress(f"neck size {size:.3g} a")
         cm = build_cell_mesh(cell, **mesh_sizes(size))
         calibration = max(calibration, len(cm.curved.tets) / predicted_tetrahedra(circles, size))
         _check_fits(cell, circles, size, calibration, order, budget, what, rtol_at)
-        b = solve_bounds(cm, order, workers, ALGEBRAIC_SHARE * rtol)
+        try:
+            b = solve_bounds(cm, order, workers, ALGEBRAIC_SHARE * rtol)
+        except FoldedMesh:  # too coarse for the curvature of its surfaces (seen on random union packings)
+            if level == max_meshes - 1:
+                raise
+            what = f"the mesh of neck size {size:.3g} a folds a curved element; the mesh twice as fine"
+            size /= 2.0
+            continue
         history.append({"size_neck": size, "elements": b.elements, "k_upper": b.upper, "k_lower": b.lower,
                         "gap": b.gap, "seconds": time.perf_counter() - t0})
         if b.gap <= rtol:
             break
         # the neck size that meets REFINE_MARGIN rtol, at least 1.5x finer, at most 8x
-        new = size * min(max((REFINE_MARGIN * rtol / b.gap) ** (1.0 / GAP_ORDER), 1.0 / 8.0), 1.0 / 1.5)
+        new = size * min(max((REFINE_MARGIN * rtol / b.gap) ** (1.0 / gap_order), 1.0 / 8.0), 1.0 / 1.5)
         what = (f"rtol = {rtol:g} needs a finer mesh than the {b.elements} tetrahedra whose bounds are {b.gap:.2e} "
                 f"apart; that mesh")
-        rtol_at = functools.partial(_refined_rtol, b.gap, size)
+        rtol_at = functools.partial(_refined_rtol, b.gap, size, neck=cell.neck)
         size = new
     return CellResult(k_eff_over_kappa=b.upper, k_lower_over_kappa=b.lower, k_upper_over_kappa=b.upper,
                       error_estimate=b.gap, converged=bool(b.gap <= rtol), phi=cell.phi, order=order, dofs=b.dofs_upper,

@@ -40,3 +40,19 @@ def test_mirror_packing_is_a_valid_symmetric_cell():
     check_cell(cell)
     i, j, _ = cell.bonds()
     assert np.bincount(np.concatenate([i, j]), minlength=cell.n).min() >= 1
+
+
+@pytest.mark.slow
+def test_union_packing_is_a_valid_symmetric_union_and_its_bounds_close_to_0_2_percent():
+    from fem_neck import lattice
+    from fem_neck.geometry.union import lens
+
+    cell = packings.union_packing(3, 0.8, seed=0)
+    assert cell.n == 24 and cell.neck == "union" and mirror_symmetry(cell)[0]
+    assert abs(cell.phi - 0.8) < 0.02
+    i, j, s = cell.bonds()
+    d = np.linalg.norm(cell.centres[j] + s * cell.period - cell.centres[i], axis=1)
+    assert np.all(lens(cell.radii[i], cell.radii[j], d).a >= 0.99 * 0.2 * np.minimum(cell.radii[i], cell.radii[j]))
+    res = lattice.effective_conductivity(cell, rtol=2e-3)
+    assert res.converged and res.error_estimate <= 2e-3
+    assert res.k_lower_over_kappa <= res.k_eff_over_kappa < res.phi  # Wiener (a random cell need not be isotropic)

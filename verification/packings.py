@@ -17,6 +17,10 @@ positions (the energy of the whole period, its gradient gathered from the 8 imag
 The result is checked (:func:`fem_neck.lattice.check_cell`, the neck sizes and the angular margin between neck
 circles on one sphere) and redrawn from the next attempt until it passes. In a period only a few diameters wide
 the mirror planes act like walls, so these packings jam loose (packing fraction ~0.4, coordination ~4-5).
+
+:func:`union_packing` reads the packing as the union of its spheres (``neck = "union"``, defined at every density):
+step 2 shrinks the jammed packing until the union is as dense as asked, step 3 keeps every neck at least
+``min_neck`` wide, and the necks of one particle may meet.
 """
 
 from __future__ import annotations
@@ -102,6 +106,29 @@ def _relax(x, radius8, period, bonds, overlap, gap):
     return res.x[:-1].reshape(n, 3) * scale, period * scale, float(res.fun)
 
 
+_NONE = (np.zeros(0, int), np.zeros(0, int), np.zeros((0, 3), int))  # no bonds
+
+
+def _jammed(n: int, spread: float, rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Step 1 (module docstring): ``n`` base spheres of mean radius 1, radii uniform within ``+-spread``, jammed in
+    the mirror cell; ``(base positions, radii of the 8 n images, period)``."""
+    r = 1.0 + spread * rng.uniform(-1.0, 1.0, n)
+    r8 = np.tile(r, 8)
+    volume = 8.0 * np.sum(4.0 / 3.0 * np.pi * r**3)
+    side = (volume / 0.3) ** (1.0 / 3.0)
+    x = rng.uniform(0.05, 0.45, (n, 3)) * side
+    lo, hi = 0.3, 0.7  # bisection on the packing fraction
+    for _ in range(16):
+        phi = 0.5 * (lo + hi)
+        new_side = (volume / phi) ** (1.0 / 3.0)
+        y, _, energy = _relax(x * new_side / side, r8, np.full(3, new_side), _NONE, (0.0, 0.0), 0.0)
+        if energy > 1e-12 * n:
+            hi = phi
+        else:
+            lo, x, side = phi, y, new_side
+    return x, r8, np.full(3, side)
+
+
 def mirror_packing(n: int, overlap: float = 0.07, spread: float = 0.15, seed: int = 0, min_neck: float = 0.15,
                    max_neck: float = 0.6, min_margin_deg: float = 5.0, max_tries: int = 20) -> PeriodicCell:
     """A random sintered packing of ``8 n`` spheres (mean radius 1, radii uniform within ``+-spread``) in a cubic
@@ -111,24 +138,8 @@ def mirror_packing(n: int, overlap: float = 0.07, spread: float = 0.15, seed: in
 
     from fem_neck.geometry import overlap_for_neck
 
-    none = (np.zeros(0, int), np.zeros(0, int), np.zeros((0, 3), int))
     for attempt in range(max_tries):
-        rng = np.random.default_rng([seed, attempt])
-        r = 1.0 + spread * rng.uniform(-1.0, 1.0, n)
-        r8 = np.tile(r, 8)
-        volume = 8.0 * np.sum(4.0 / 3.0 * np.pi * r**3)
-        side = (volume / 0.3) ** (1.0 / 3.0)
-        x = rng.uniform(0.05, 0.45, (n, 3)) * side
-        lo, hi = 0.3, 0.7  # 1. jamming: bisection on the packing fraction
-        for _ in range(16):
-            phi = 0.5 * (lo + hi)
-            new_side = (volume / phi) ** (1.0 / 3.0)
-            y, _, energy = _relax(x * new_side / side, r8, np.full(3, new_side), none, (0.0, 0.0), 0.0)
-            if energy > 1e-12 * n:
-                hi = phi
-            else:
-                lo, x, side = phi, y, new_side
-        period = np.full(3, side)
+        x, r8, period = _jammed(n, spread, np.random.default_rng([seed, attempt]))
         p, q, _, d = _pairs(_images(x, period), r8, period)
         r_min = np.minimum(r8[p], r8[q])
 
@@ -150,6 +161,68 @@ def mirror_packing(n: int, overlap: float = 0.07, spread: float = 0.15, seed: in
         if _acceptable(cell, min_neck, np.radians(min_margin_deg)):
             return cell
     raise RuntimeError(f"mirror packing n={n} seed={seed}: no acceptable packing in {max_tries} tries")
+
+
+def union_packing(n: int, phi: float, spread: float = 0.15, seed: int = 0, min_neck: float = 0.2,
+                  max_tries: int = 20) -> PeriodicCell:
+    """A random packing of ``8 n`` overlapping spheres (mean radius 1, radii uniform within ``+-spread``) in a cubic
+    period, mirror-symmetric about the planes through the origin, read as the union of its spheres
+    (``neck = "union"``) and about ``phi`` dense.
+
+    ``phi`` (0 < phi < 1): the union's solid fraction aimed at (exact volumes of the cut spheres,
+    :func:`fem_neck.geometry.union.cut_spheres`); ``min_neck``: the smallest ``a / r`` of a neck (``r`` the smaller
+    radius), below which the gap between two spheres at their circle is too thin to mesh. After jamming (step 1 of
+    the module docstring) positions and period shrink by one factor until the union is ``phi`` dense, then the
+    overlapping pairs are pulled to necks of at least ``min_neck`` and every other pair pushed apart (step 3), twice,
+    each time from the factor that gives ``phi``: the cell's ``phi`` lies within a few per cent of the one asked for.
+    """
+    from scipy.optimize import brentq
+
+    if not 0.0 < phi < 1.0:
+        raise ValueError(f"phi = {phi!r}: valid range 0 < phi < 1")
+    overlap = (2.0 - 2.0 * np.sqrt(1.0 - min_neck**2), 1.0)  # h / r_min: the neck of equal spheres, at most r_min
+    name = f"union packing n={8 * n} seed={seed}"
+    for attempt in range(max_tries):
+        x, r8, period = _jammed(n, spread, np.random.default_rng([seed, attempt]))
+
+        def fraction(lam):
+            return PeriodicCell(_images(x * lam, period * lam), r8, period * lam, neck="union").phi - phi
+
+        try:
+            for _ in range(2):
+                lam = brentq(fraction, 0.5, 1.0, xtol=1e-6)
+                x, period = x * lam, period * lam
+                bonds = _bond_list(x, r8, period, 1.0)
+                for _ in range(20):
+                    x, period, energy = _relax(x, r8, period, bonds, overlap, 1e-3)
+                    new = _bond_list(x, r8, period, 1.0)
+                    if energy < 1e-20 and len(new[0]) == len(bonds[0]):
+                        break
+                    bonds = new
+            cell = PeriodicCell(_images(x, period), r8, period, name=name, neck="union")
+        except ValueError:  # a sphere inside another, or a centre beyond a radical plane, on the way
+            continue
+        if _acceptable_union(cell, min_neck):
+            return cell
+    raise RuntimeError(f"{name}: no acceptable packing in {max_tries} tries")
+
+
+def _acceptable_union(cell: PeriodicCell, min_neck: float) -> bool:
+    """The cell is a valid union (no sphere inside another, every centre inside its cut sphere), every sphere
+    bonded, every neck at least ``min_neck`` of the smaller radius."""
+    from fem_neck.geometry.union import lens
+
+    try:
+        check_cell(cell)
+        cell.phi
+    except ValueError:
+        return False
+    i, j, s = cell.bonds()
+    if np.bincount(np.concatenate([i, j]), minlength=cell.n).min() < 1:
+        return False
+    d = np.linalg.norm(cell.centres[j] + s * cell.period - cell.centres[i], axis=1)
+    return bool(np.all(lens(cell.radii[i], cell.radii[j], d).a >= 0.99 * min_neck * np.minimum(cell.radii[i],
+                                                                                              cell.radii[j])))
 
 
 def _acceptable(cell: PeriodicCell, min_neck: float, margin: float) -> bool:

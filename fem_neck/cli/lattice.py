@@ -21,9 +21,16 @@ def register(subparsers) -> None:
         "upper, the solid fraction phi (phi kappa is the Wiener upper bound of k_eff) and the pipe network's k_eff "
         "with the full-range fit law beside it.")
     p.add_argument("--kind", choices=("sc", "bcc", "fcc"), required=True, help="lattice")
+    p.add_argument("--neck", choices=("newton", "union"), default="newton",
+                   help="the solid: 'newton' (default), the spheres joined by the volume-conserving pair necks; "
+                   "'union', the union of the spheres (Arzt's truncated spheres, each cut by its radical planes: "
+                   "defined also where the necks of a particle meet, up to the overlap at which the spheres fill "
+                   "space; second neighbours that overlap are necks too)")
     size = p.add_mutually_exclusive_group(required=True)
-    size.add_argument("--h-over-r", type=float, metavar="X", help="overlap of neighbours over the radius")
-    size.add_argument("--a-over-r", type=float, metavar="X", help="neck radius over the particle radius")
+    size.add_argument("--h-over-r", type=float, metavar="X", help="overlap of neighbours over the radius (the "
+                      "neighbour distance is 2r - h)")
+    size.add_argument("--a-over-r", type=float, metavar="X", help="neck radius over the particle radius (with "
+                      "--neck union: the radius of the circle where neighbours meet)")
     p.add_argument("--rtol", type=float, default=1e-4,
                    help="relative gap of the bounds to reach (default 1e-4: 10-60 s of CPU and 1-3 GB for the cubic "
                    "lattices; 1e-3 a few seconds)")
@@ -47,30 +54,41 @@ def run(args) -> dict:
         raise ValueError(f"rtol = {args.rtol!r}: valid range 1e-6 <= rtol < 0.1")
     if args.max_memory is not None and not (0.1 <= args.max_memory < 1e6):
         raise ValueError(f"max_memory = {args.max_memory!r}: valid range 0.1 <= max_memory < 1e6 (GB)")
+    union = args.neck == "union"
     if args.a_over_r is not None:
         x = args.a_over_r
-        limit = lattice.max_neck_ratio(args.kind)
-        if not (lattice.MIN_NECK_RATIO <= x < limit):
-            raise ValueError(f"a_over_r = {x!r}: valid range {lattice.MIN_NECK_RATIO} <= a/r < {limit:.6g} for "
-                             f"{args.kind} (there the necks of one particle touch)")
-        h = overlap_for_neck(1.0, 1.0, x)
+        if union:
+            low, limit = (lattice.union_neck_ratio(h) for h in (lattice.UNION_MIN_H_OVER_R,
+                                                                 lattice.union_max_h_over_r(args.kind)))
+            if not (low <= x < limit):
+                raise ValueError(f"a_over_r = {x!r}: valid range {low:.6g} <= a/r < {limit:.6g} for the union of "
+                                 f"the {args.kind} lattice's spheres (there they fill space)")
+            h = 2.0 - 2.0 * math.sqrt(1.0 - x * x)  # the circle of two unit spheres 2 - h apart: a^2 = h - h^2 / 4
+        else:
+            limit = lattice.max_neck_ratio(args.kind)
+            if not (lattice.MIN_NECK_RATIO <= x < limit):
+                raise ValueError(f"a_over_r = {x!r}: valid range {lattice.MIN_NECK_RATIO} <= a/r < {limit:.6g} for "
+                                 f"{args.kind} (there the necks of one particle touch)")
+            h = overlap_for_neck(1.0, 1.0, x)
     else:
         h = args.h_over_r
         if not math.isfinite(h):
             raise ValueError(f"h_over_r = {h!r}: must be finite")
-    cell = lattice.lattice_cell(args.kind, h)
+    cell = lattice.lattice_cell(args.kind, h, neck=args.neck)
     with tqdm(desc=f"lattice {args.kind}", unit="mesh", leave=False, delay=2.0) as bar:
         res = lattice.effective_conductivity(cell, rtol=args.rtol,
                                              max_memory=None if args.max_memory is None else args.max_memory * 1e9,
                                              progress=lambda text: (bar.set_postfix_str(text, refresh=False), bar.update(1)))
-    network = lattice.network_conductivity(cell, lambda r_i, r_j, a: pair_conductance(1.0, r_i, r_j, a))
-    out = {"kind": args.kind, "h_over_r": h, "a_over_r": neck_radius(1.0, 1.0, h),
+    out = {"kind": args.kind, **({"neck": "union"} if union else {}), "h_over_r": h,
+           "a_over_r": lattice.union_neck_ratio(h) if union else neck_radius(1.0, 1.0, h),
            "coordination": lattice.COORDINATION[args.kind], "k_eff_over_kappa": res.k_eff_over_kappa,
            "k_lower_over_kappa": res.k_lower_over_kappa, "k_upper_over_kappa": res.k_upper_over_kappa,
-           "error_estimate": res.error_estimate, "converged": res.converged, "phi": res.phi,
-           "k_network_fit_over_kappa": network, "network_rel_error": network / res.k_eff_over_kappa - 1.0,
-           "order": res.order, "dofs": res.dofs, "elements": res.elements, "meshes": len(res.levels),
-           "volume_error": res.volume_error, "memory_estimate_gb": res.memory_estimate / 1e9, "seconds": res.seconds}
+           "error_estimate": res.error_estimate, "converged": res.converged, "phi": res.phi}
+    if not union:  # (the network laws read pair necks)
+        network = lattice.network_conductivity(cell, lambda r_i, r_j, a: pair_conductance(1.0, r_i, r_j, a))
+        out.update({"k_network_fit_over_kappa": network, "network_rel_error": network / res.k_eff_over_kappa - 1.0})
+    out.update({"order": res.order, "dofs": res.dofs, "elements": res.elements, "meshes": len(res.levels),
+           "volume_error": res.volume_error, "memory_estimate_gb": res.memory_estimate / 1e9, "seconds": res.seconds})
     if args.out:
         path = pathlib.Path(args.out)
         path.mkdir(parents=True, exist_ok=True)
