@@ -14,6 +14,10 @@ import os
 import pathlib
 
 BYTES_PER_PARTICLE = 1.5e3
+# a steady solve of the benchmarks' 10^6-particle random packing takes 10.5 s on a quiet 2-core machine (bonds,
+# conductances, network, AMG-CG; python -m benchmarks dem): about 1e-5 s per particle
+SECONDS_PER_PARTICLE = 1.05e-5
+ANNOUNCE_FROM = 1_000_000  # runs of this many particles or more say what they will take before they start
 BASE_BYTES = 0.2e9  # the interpreter, numpy, scipy and the compiled kernels
 SMALL_BYTES = 64e6  # a run whose particles need less than this is never refused: the machine is not asked
 
@@ -55,3 +59,25 @@ def check(n: int, name: str) -> None:
                          f"{BYTES_PER_PARTICLE / 1e3:.3g} kB per particle at the peak of a steady solve), and "
                          f"{max(have, 0.0) / 2**30:.3g} GiB are available on this machine: use at most about "
                          f"{max(int((have - BASE_BYTES) / BYTES_PER_PARTICLE), 0)} particles")
+
+
+def estimate(n: int) -> str | None:
+    """What a run of ``n`` particles will take, said before it starts where it is large (``n >= ANNOUNCE_FROM``):
+    the memory at the peak of a steady solve and its time on 2 cores (module docstring); None for smaller runs.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+
+    Returns
+    -------
+    str or None
+        One line, or None below :data:`ANNOUNCE_FROM` particles.
+    """
+    if n < ANNOUNCE_FROM:
+        return None
+    need = BASE_BYTES + BYTES_PER_PARTICLE * n
+    return (f"{n} particles: about {need / 2**30:.3g} GiB at the peak of a steady solve and about "
+            f"{SECONDS_PER_PARTICLE * n:.3g} s for it on 2 cores (a transient or moving run takes longer)")
+

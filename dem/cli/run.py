@@ -33,7 +33,7 @@ def register(sub):
 def run(args) -> dict:
     from dem.scene import load_scene
     from dem.driver import run as run_scene
-    from dem.memory import available_bytes
+    from dem.memory import available_bytes, estimate
     from dem.network.comm import launched, launcher_rank
 
     if launched() and launcher_rank() > 0:  # one summary, one error line: rank 0's
@@ -43,6 +43,9 @@ def run(args) -> dict:
         os.environ["TQDM_DISABLE"] = "1"
     try:
         scene = load_scene(args.scene)
+        big = estimate(scene.particles.n)
+        if big is not None:  # said before it starts, as the memory is checked before it starts
+            print(f"python -m dem run: {big}", file=sys.stderr, flush=True)
         summary = run_scene(scene, args.out, progress=True, resume=args.resume, overwrite=args.overwrite).summary
     except MemoryError:  # beyond the estimate checked up front (dem.memory): say so in one line all the same
         raise ValueError(f"scene = {args.scene!r}: ran out of memory (the machine had "
