@@ -7,6 +7,7 @@ import sys
 import time
 
 import matplotlib.image
+import numpy as np
 import pytest
 
 from test_verification_report import assert_report_links_resolve
@@ -78,3 +79,24 @@ def test_all_quick_under_three_minutes(tmp_path):
     summary, _ = _check_run(out, proc, ["paper", "chains", "clusters", "transient", "lattices"])
     assert any(k.startswith("chains.") for k in summary)
     assert seconds < 180.0, seconds
+
+
+def test_densification_bounds_and_correlation_are_their_closed_forms():
+    from verification import densification
+
+    phi = np.array([0.6, 0.9, 1.0])
+    assert np.allclose(densification.hashin_shtrikman(phi), 2 * phi / (3 - phi), rtol=0, atol=0)
+    assert densification.hashin_shtrikman(1.0) == 1.0 and densification.koh_fortini(1.0) == 1.0
+    assert densification.koh_fortini(0.9) == pytest.approx(0.9 / 1.11, rel=1e-15)  # e = 0.1: 0.9 / (1 + 0.11)
+
+
+@pytest.mark.slow
+def test_densification_quick(tmp_path):
+    """One union cell per lattice: the FE below both bounds, the laws on union necks beside it, the figure opens."""
+    out = tmp_path / "res"
+    proc = _run("densification", "--quick", "--json", "--no-progress", "--out", str(out))
+    summary, md = _check_run(out, proc, ["densification"])
+    assert summary["densification FE above the HS bound"] == 0
+    rows = [v for k, v in summary.items() if isinstance(v, dict) and "rel_err_fit" in v]
+    assert len(rows) == 3 and all(r["fe_error_estimate"] < 1e-2 for r in rows)
+    assert all(abs(r["rel_err_shared-body"]) < 0.03 for r in rows)

@@ -36,8 +36,8 @@ LAWS = ("argento-bouvard", "fit", "shared-body")
 OVERLAPS = {"sc": (0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6), "bcc": (0.05, 0.1, 0.2, 0.3, 0.35),
             "fcc": (0.05, 0.1, 0.2, 0.3)}
 QUICK_OVERLAPS = {"sc": (0.3,), "bcc": (0.2,), "fcc": (0.1,)}
-RANDOM = ((1, 0.6), (2, 0.75), (3, 0.9))  # (seed, phi aimed at) of the union mirror packings
-RANDOM_SPHERES = 3  # union_packing(n): 8 n spheres per period
+RANDOM = ((1, 0.6), (2, 0.8), (3, 0.95))  # (seed, phi aimed at) of the union mirror packings
+RANDOM_SPHERES = 4  # union_packing(n): 8 n spheres per period
 RTOL, QUICK_RTOL, RANDOM_RTOL = 1e-3, 1e-2, 2e-3
 COMPACT = "hot-wall-sintering"
 
