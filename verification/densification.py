@@ -161,6 +161,7 @@ def _figure(rows: list, compact: dict | None, out_dir: pathlib.Path) -> list:
     ax1.legend(fontsize=7, loc="upper left")
     ax1.set_title("k_eff through densification (union of spheres)")
     ax2.axhline(0.0, color="grey", lw=0.8)
+    ax2.set_yscale("symlog", linthresh=1.0)
     for y in (-1.0, 1.0):
         ax2.axhline(y, color="grey", lw=0.6, ls="--")
     ax2.set_xlabel("solid fraction phi")
