@@ -1002,7 +1002,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     resume : Checkpoint or None
         The checkpoint to go on from; None: start at t = 0.
     checkpoint : callable or None
-        ``checkpoint(make)`` or ``checkpoint(make, final)``; None: not called.
+        ``checkpoint(make)`` after every accepted step, ``checkpoint(make, final=True)`` at the end; None: not called.
 
     Returns
     -------
