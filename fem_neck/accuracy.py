@@ -99,7 +99,7 @@ def check_order(order, rtol: float) -> int:
     Parameters
     ----------
     order : int or None
-        The order asked for, one of :data:`ORDERS`; None: the default for ``rtol``.
+        The order asked for, one of ``ORDERS``; None: the default for ``rtol``.
     rtol : float
         Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
 
@@ -111,7 +111,7 @@ def check_order(order, rtol: float) -> int:
     Raises
     ------
     ValueError
-        ``order`` is not one of :data:`ORDERS`.
+        ``order`` is not one of ``ORDERS``.
     """
     if order is None:
         return default_order(rtol)
@@ -129,7 +129,7 @@ def initial_grading(rtol: float, order: int) -> float:
     rtol : float
         Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
     order : int
-        The order of the reported solve, one of :data:`ORDERS`.
+        The order of the reported solve, one of ``ORDERS``.
 
     Returns
     -------
@@ -171,12 +171,12 @@ def next_grading(grading: float, rtol: float, estimate: float, order: int) -> fl
     estimate : float
         The last round's error estimate (relative, > 0).
     order : int
-        The order of the reported solve, one of :data:`ORDERS`.
+        The order of the reported solve, one of ``ORDERS``.
 
     Returns
     -------
     float
-        The next grading factor, not below :data:`FINEST_GRADING`.
+        The next grading factor, not below ``FINEST_GRADING``.
     """
     factor = (0.7 * rtol / estimate) ** (1.0 / RATE[order])
     return float(max(FINEST_GRADING, grading * min(0.85, max(1.0 / 3.0, factor))))
@@ -196,7 +196,7 @@ def solve_to_tolerance(solve_pair, rtol: float, order: int):
     rtol : float
         Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
     order : int
-        The order ``p`` of the reported solve, one of :data:`ORDERS`.
+        The order ``p`` of the reported solve, one of ``ORDERS``.
 
     Returns
     -------

@@ -399,7 +399,7 @@ def slope_sensitivity(law: ConductanceLaw) -> dict:
 
     Returns
     -------
-    dict of str to float
+    dict
         The slope c (dimensionless) under each sampling.
     """
     from fem_neck.geometry import neck_radius, overlap_for_neck

@@ -243,7 +243,7 @@ def semisphere_quad_mesh(a: float, levels: int, sigma: float = SIGMA,
     levels : int
         Number of geometric refinements of the corner cells toward the corner ``C`` (>= 0).
     sigma : float
-        The geometric factor of each refinement, in ``(0, 1)`` (:data:`SIGMA` by default).
+        The geometric factor of each refinement, in ``(0, 1)`` (``SIGMA`` by default).
     neck : str
         The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (with the volume-conserving half neck) or
         ``"union"`` (no neck cylinder).
@@ -311,7 +311,7 @@ def half_body(shape: SemisphereShape, R: float, levels: int, sigma: float = SIGM
     levels : int
         Number of geometric refinements of the corner cells toward the corner ``C`` (>= 0).
     sigma : float
-        The geometric factor of each refinement, in ``(0, 1)`` (:data:`SIGMA` by default).
+        The geometric factor of each refinement, in ``(0, 1)`` (``SIGMA`` by default).
 
     Returns
     -------
@@ -441,7 +441,7 @@ def pair_quad_mesh(r_i: float, r_j: float, h: float, levels: int, sigma: float =
     levels : int
         Number of geometric refinements of the corner cells toward the corner ``C`` (>= 0).
     sigma : float
-        The geometric factor of each refinement, in ``(0, 1)`` (:data:`SIGMA` by default).
+        The geometric factor of each refinement, in ``(0, 1)`` (``SIGMA`` by default).
 
     Returns
     -------

@@ -62,7 +62,7 @@ def module(law: str, template: str, threaded: bool = False):
 
     Returns
     -------
-    module
+    object
         The compiled module.
 
     Raises

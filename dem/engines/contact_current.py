@@ -51,7 +51,7 @@ class ContactCurrent:
     sweeps : int
         Zohdi's iteration: the most sweeps per refresh.
     linear : str
-        Kirchhoff's linear solver (:data:`dem.network.linsolve.BACKENDS`, or ``"auto"``).
+        Kirchhoff's linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
     floating : str
         ``"allow"`` or ``"error"`` (particles touching no electrode stop the run).
     """

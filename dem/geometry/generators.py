@@ -245,7 +245,7 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
         Relative spread of the radii, in ``[0, 1)``: half-width for ``"uniform"``, standard deviation over the
         mean for ``"lognormal"``.
     distribution : str
-        The radius distribution, one of :data:`DISTRIBUTIONS`.
+        The radius distribution, one of ``DISTRIBUTIONS``.
     jitter : float
         Half-width of the uniform position noise over the neighbour distance, in ``[0, 0.25)``.
     periodic : bool

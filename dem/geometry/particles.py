@@ -74,7 +74,7 @@ def check_vector(name: str, value) -> np.ndarray:
     Raises
     ------
     ValueError
-        ``value`` is not a finite 3-vector, or a component exceeds :data:`POSITION_MAX`.
+        ``value`` is not a finite 3-vector, or a component exceeds ``POSITION_MAX``.
     """
     try:
         v = np.asarray(value, dtype=float)
@@ -129,7 +129,7 @@ def check_temperature(name: str, value) -> float:
     Raises
     ------
     ValueError
-        ``value`` is not a finite number, or its magnitude exceeds :data:`TEMPERATURE_MAX`.
+        ``value`` is not a finite number, or its magnitude exceeds ``TEMPERATURE_MAX``.
     """
     if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
         raise ValueError(f"{name} = {value!r}: must be a finite number")
@@ -224,7 +224,7 @@ class Material:
     Raises
     ------
     ValueError
-        A property given is not a finite number > 0 within :data:`PROPERTY_RANGE`, or the density is missing.
+        A property given is not a finite number > 0 within ``PROPERTY_RANGE``, or the density is missing.
     """
 
     conductivity: float | None
@@ -297,11 +297,11 @@ class Particles:
         Parameters
         ----------
         position : array_like
-            (N, 3) centres (m), N >= 1, each component within :data:`POSITION_MAX`.
+            (N, 3) centres (m), N >= 1, each component within ``POSITION_MAX``.
         radius : array_like
-            (N,) radii (m), within :data:`RADIUS_RANGE`.
+            (N,) radii (m), within ``RADIUS_RANGE``.
         temperature : array_like
-            (N,) temperatures (the scene's unit, K or degC), within :data:`TEMPERATURE_MAX`.
+            (N,) temperatures (the scene's unit, K or degC), within ``TEMPERATURE_MAX``.
         materials : Material or sequence of Material
             The materials (at least one).
         material : array_like or None

@@ -210,7 +210,7 @@ def box_axes(walls) -> dict[int, tuple[int, int]]:
 
     Returns
     -------
-    dict of int to tuple of (int, int)
+    dict
         ``{axis: (lo, hi)}``, indices into ``walls``.
     """
     out = {}
@@ -257,7 +257,7 @@ class WallArrays:
     acc : numpy.ndarray
         (W,) normal accelerations of stress walls (m/s^2).
     mode : numpy.ndarray
-        (W,) int, each wall's motion as its code in :data:`MOTIONS`.
+        (W,) int, each wall's motion as its code in ``MOTIONS``.
     pressure : numpy.ndarray
         (W,) a stress wall's pressure (N/m in 2D, Pa in 3D) times the product of the box's periods (m) along its
         periodic in-plane axes.

@@ -60,7 +60,7 @@ def law_keys(law: str) -> tuple:
     Parameters
     ----------
     law : str
-        A law of :data:`LAWS`.
+        A law of ``LAWS``.
 
     Returns
     -------
@@ -81,7 +81,7 @@ class ConductanceSpec:
     Parameters
     ----------
     law : str
-        The law, one of :data:`LAWS` (module docstring).
+        The law, one of ``LAWS`` (module docstring).
     slope : float or None
         The coefficient c of ``K_i = c kappa_i pi a`` (dimensionless, > 0), for ``"rojek"`` and
         ``"argento-bouvard"`` only; None: the law's own (1.064, 1.112).
@@ -89,7 +89,7 @@ class ConductanceSpec:
         Path of a fit.json written by ``python -m fem_neck fit``, for ``"fit"`` and ``"shared-body"`` only; None:
         the fit shipped for the half body.
     neck : str
-        The neck model giving the contact radius from the overlap, one of :data:`NECK_MODELS` (``"newton"``,
+        The neck model giving the contact radius from the overlap, one of ``NECK_MODELS`` (``"newton"``,
         ``"first"``, ``"coble"``: :func:`fem_neck.geometry.neck_radius`; ``"union"``: the circle where the two
         spheres meet).
     contact_conductance : float or None
@@ -97,7 +97,7 @@ class ConductanceSpec:
         interface resistance.
     out_of_range : str
         What a bond whose overlap lies beyond the neck model's range does, one of
-        :data:`dem.geometry.bonds.OUT_OF_RANGE`: ``"error"``, ``"clip"`` or ``"drop"``.
+        ``dem.geometry.bonds.OUT_OF_RANGE``: ``"error"``, ``"clip"`` or ``"drop"``.
     unequal : bool
         Whether the fit laws multiply a pair of unequal radii by :func:`fem_neck.law.unequal_factor`.
 

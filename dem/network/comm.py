@@ -54,8 +54,8 @@ def agree(comm, action):
 
     Parameters
     ----------
-    comm : mpi4py.MPI.Comm
-        The communicator.
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
     action : callable
         Called without arguments on every rank.
 
@@ -87,8 +87,8 @@ def on_root(comm, action):
 
     Parameters
     ----------
-    comm : mpi4py.MPI.Comm or None
-        The communicator; None: no MPI.
+    comm : object or None
+        The MPI communicator (an ``mpi4py.MPI.Comm``); None: no MPI.
     action : callable
         Called without arguments on rank 0.
 
@@ -121,8 +121,8 @@ def total(comm, value):
 
     Parameters
     ----------
-    comm : mpi4py.MPI.Comm
-        The communicator.
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
     value : float or array_like
         This rank's part (any unit).
 
@@ -145,8 +145,8 @@ def maximum(comm, value: float) -> float:
 
     Parameters
     ----------
-    comm : mpi4py.MPI.Comm
-        The communicator.
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
     value : float
         This rank's value.
 
@@ -165,8 +165,8 @@ def minimum(comm, value: float) -> float:
 
     Parameters
     ----------
-    comm : mpi4py.MPI.Comm
-        The communicator.
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
     value : float
         This rank's value.
 
@@ -189,8 +189,8 @@ class HaloExchange:
 
     Parameters
     ----------
-    comm : mpi4py.MPI.Comm
-        The communicator.
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
     held : numpy.ndarray
         Global indices of the particles this rank holds, sorted.
     owner : numpy.ndarray

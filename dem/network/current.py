@@ -184,7 +184,7 @@ def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrod
     electrodes : Electrodes
         The electrodes.
     linear : str
-        The linear solver (:data:`dem.network.linsolve.BACKENDS`, or ``"auto"``).
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
     previous : object or None
         The ``solver`` of an earlier :class:`CurrentFlow` to reuse; None: a new one.
 
@@ -585,7 +585,7 @@ def zohdi_joule(J, volume, sigma, absorption: float) -> np.ndarray:
 
 
 def check_scheme(scheme: str) -> str:
-    """``scheme`` if it is one of :data:`SCHEMES`.
+    """``scheme`` if it is one of ``SCHEMES``.
 
     Parameters
     ----------
@@ -600,7 +600,7 @@ def check_scheme(scheme: str) -> str:
     Raises
     ------
     ValueError
-        ``scheme`` is not one of :data:`SCHEMES`.
+        ``scheme`` is not one of ``SCHEMES``.
     """
     if scheme not in SCHEMES:
         raise ValueError(f"[electrical] scheme = {scheme!r}: must be one of {', '.join(SCHEMES)}")

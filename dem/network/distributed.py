@@ -75,8 +75,8 @@ class DistributedNetwork:
 
     Parameters
     ----------
-    comm : mpi4py.MPI.Comm
-        The communicator.
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
     net : dem.network.heat.Network
         The network of the particles this rank holds.
     held : numpy.ndarray
@@ -405,7 +405,7 @@ class DistributedNetwork:
         Parameters
         ----------
         integrator : str
-            ``"implicit"`` or ``"crank-nicolson"`` (:data:`dem.network.heat.INTEGRATORS`).
+            ``"implicit"`` or ``"crank-nicolson"`` (``dem.network.heat.INTEGRATORS``).
         dt : float
             The step (s).
         t_end : float

@@ -523,7 +523,7 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
     floating : str
         ``"error"`` or ``"mean"`` (above).
     linear : str
-        The linear solver (:data:`dem.network.linsolve.BACKENDS`, or ``"auto"``).
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
     max_newton : int
         The most Newton iterations on radiation.
     rtol : float
@@ -818,7 +818,7 @@ def theta_step(net: Network, T_F: np.ndarray, dt: float, integrator: str = "impl
     integrator : str
         ``"explicit"``, ``"implicit"`` or ``"crank-nicolson"``.
     linear : str
-        The linear solver (:data:`dem.network.linsolve.BACKENDS`, or ``"auto"``).
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
     rtol_linear : float
         The relative residual of iterative linear solves.
 
@@ -990,7 +990,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     rtol : float
         The global error wanted with ``dt = "auto"``, relative to the temperature range.
     linear : str
-        The linear solver (:data:`dem.network.linsolve.BACKENDS`, or ``"auto"``).
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
     max_steps : int
         The most steps.
     observer : callable or None

@@ -249,7 +249,7 @@ class BoundedLaplacian:
         Parameters
         ----------
         x_fixed : array_like
-            The fixed nodes' values (K or V), in the order of :attr:`fixed`.
+            The fixed nodes' values (K or V), in the order of ``fixed``.
         x_planes : array_like
             The planes' values (K for heat, V for current).
 
@@ -325,9 +325,9 @@ class BoundedLaplacian:
         Parameters
         ----------
         x_free : array_like
-            The free nodes' values, in the order of :attr:`free`.
+            The free nodes' values, in the order of ``free``.
         x_fixed : array_like
-            The fixed nodes' values, in the order of :attr:`fixed`.
+            The fixed nodes' values, in the order of ``fixed``.
 
         Returns
         -------
@@ -356,7 +356,7 @@ def solve_anchored(system: BoundedLaplacian, rhs: np.ndarray, subset: np.ndarray
     subset : numpy.ndarray or None
         Positions in ``system.free`` to solve on; None: all.
     linear : str
-        The linear solver (:data:`dem.network.linsolve.BACKENDS`, or ``"auto"``).
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
     rtol : float
         Relative residual tolerance of an iterative solver.
     solver : object or None

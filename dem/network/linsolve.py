@@ -374,7 +374,7 @@ def make_solver(A: sp.spmatrix, backend: str = "auto", laplacian_diagonal: np.nd
     A : scipy.sparse.spmatrix
         The symmetric positive definite matrix (e.g. W/K).
     backend : str
-        ``"auto"`` or one of :data:`BACKENDS`.
+        ``"auto"`` or one of ``BACKENDS``.
     laplacian_diagonal : numpy.ndarray or None
         The Laplacian's part of the diagonal, for ``"auto"``; None: the whole diagonal.
     rtol : float

@@ -49,8 +49,8 @@ def matrix(comm, rows, n_global: int):
 
     Parameters
     ----------
-    comm : mpi4py.MPI.Comm
-        The communicator.
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
     rows : scipy.sparse.csr_matrix
         This rank's rows, columns numbered globally and sorted.
     n_global : int
@@ -58,8 +58,8 @@ def matrix(comm, rows, n_global: int):
 
     Returns
     -------
-    petsc4py.PETSc.Mat
-        The assembled matrix.
+    object
+        The assembled matrix (a ``petsc4py.PETSc.Mat``).
 
     Raises
     ------
@@ -97,7 +97,7 @@ class PetscSolver:
 
     Parameters
     ----------
-    A : petsc4py.PETSc.Mat
+    A : object
         The distributed symmetric positive definite matrix (:func:`matrix`).
     rtol : float
         The relative unpreconditioned residual at which CG stops.

@@ -102,11 +102,11 @@ class Packing:
     source : str
         The file read (its path as given).
     format : str
-        The file's format, one of :data:`FORMATS`.
+        The file's format, one of ``FORMATS``.
     timestep : int or None
         The timestep of a dump's snapshot; None for other files.
     units : str or None
-        The LAMMPS unit style the file records (converted from to SI), a key of :data:`LAMMPS_UNITS`; None where
+        The LAMMPS unit style the file records (converted from to SI), a key of ``LAMMPS_UNITS``; None where
         it records none.
     ignored : tuple
         The names of the columns or fields that were not read.
@@ -204,7 +204,7 @@ def format_of(path) -> str:
     Returns
     -------
     str
-        One of :data:`FORMATS`.
+        One of ``FORMATS``.
 
     Raises
     ------
@@ -237,7 +237,7 @@ def read_packing(path, format: str | None = None, length_unit: float = 1.0, time
     path : str or pathlib.Path
         The packing file.
     format : str or None
-        One of :data:`FORMATS`; None: from the file's name (:func:`format_of`).
+        One of ``FORMATS``; None: from the file's name (:func:`format_of`).
     length_unit : float
         Metres per length unit of the file, > 0 (0.001 for mm, 1e-6 for um).
     timestep : int or None
@@ -353,7 +353,7 @@ def printed_precision(x: np.ndarray, digits: int = PRINTED_DIGITS) -> float | No
     x : numpy.ndarray
         Coordinates (m), any shape; zeros carry no digits and are skipped.
     digits : int
-        Number of significant digits, >= 1 (:data:`PRINTED_DIGITS`, LAMMPS's ``%g``, by default).
+        Number of significant digits, >= 1 (``PRINTED_DIGITS``, LAMMPS's ``%g``, by default).
 
     Returns
     -------

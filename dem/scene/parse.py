@@ -56,7 +56,7 @@ class SolverSpec:
     mode : str
         ``"steady"`` (the steady temperatures) or ``"transient"`` (integrate in time to ``t_end``).
     integrator : str
-        The transient time stepper, one of :data:`dem.network.heat.INTEGRATORS`.
+        The transient time stepper, one of ``dem.network.heat.INTEGRATORS``.
     dt : float or str
         The time step (s, > 0), or ``"auto"`` (adaptive, to ``rtol``).
     t_end : float or None
@@ -64,7 +64,7 @@ class SolverSpec:
     rtol : float
         Relative tolerance of the adaptive step ``dt = "auto"``, in ``[RTOL_MIN, 1)``.
     linear : str
-        The linear solver: ``"auto"`` or one of :data:`dem.network.linsolve.BACKENDS`.
+        The linear solver: ``"auto"`` or one of ``dem.network.linsolve.BACKENDS``.
     floating : str
         What a steady solve does with a group of particles without a fixed temperature: ``"error"`` (refuse) or
         ``"mean"`` (keep its capacity-weighted mean initial temperature), :func:`dem.network.heat.steady`.
@@ -171,7 +171,7 @@ class Scene:
     output : OutputSpec
         What the run folder gets, and how often.
     physics : tuple of str
-        The submodels to run, from :data:`PHYSICS`.
+        The submodels to run, from ``PHYSICS``.
     name : str
         The scene's name (the file's stem, or a built-in's name).
     description : str
@@ -293,7 +293,7 @@ def make_scene(position, radius, temperature, *, materials=(COPPER,), material=N
     walls : sequence of dem.geometry.walls.Wall
         The walls.
     law : str
-        The conductance law (:data:`dem.laws.conductance.LAWS`), read only where ``conductance`` is None.
+        The conductance law (``dem.laws.conductance.LAWS``), read only where ``conductance`` is None.
     conductance : dem.laws.conductance.ConductanceSpec or None
         The law and its options; None: ``ConductanceSpec(law=law)``.
     sources : dem.laws.ambient.Sources or None

@@ -101,7 +101,7 @@ def held_groups(particles, named: dict | None = None) -> dict[str, np.ndarray]:
 
     Returns
     -------
-    dict of str to numpy.ndarray
+    dict
         ``{name: indices}`` of every held group, named groups first.
     """
     fixed = np.asarray(particles.fixed, dtype=bool)
@@ -130,7 +130,7 @@ def group_flows(groups: dict, into: dict) -> dict[str, float]:
 
     Returns
     -------
-    dict of str to float
+    dict
         ``{name: W}``, the total heat flow into each group (W).
     """
     return {name: float(sum(into[int(k)] for k in idx)) for name, idx in groups.items()}

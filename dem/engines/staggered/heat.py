@@ -55,7 +55,7 @@ def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_
     wall_ids : sequence of int
         Indices of the walls whose contacts are wanted.
     contact : str
-        The contact geometry (:data:`dem.geometry.bonds.CONTACT_MODELS`).
+        The contact geometry (``dem.geometry.bonds.CONTACT_MODELS``).
     out_of_range : str
         The policy for contacts beyond the geometry's range: ``"error"``, ``"clip"`` or ``"drop"``.
 

@@ -131,8 +131,8 @@ class RankMechanics(MechanicalModel):
             The material's relaxation time (s; Luding 2005's ``t0``).
         history : dict or None
             A saved state to start the particle state and contact histories from; None: none.
-        comm : mpi4py.MPI.Comm or None
-            The communicator; None: MPI's world.
+        comm : object or None
+            The MPI communicator (an ``mpi4py.MPI.Comm``); None: MPI's world.
         """
         self.comm = world() if comm is None else comm
         self.rank, self.size = self.comm.Get_rank(), self.comm.Get_size()

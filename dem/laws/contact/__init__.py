@@ -91,7 +91,7 @@ def law_module(name):
 
     Returns
     -------
-    module
+    object
         The law's module.
 
     Raises
