@@ -92,7 +92,18 @@ def _sources(package: pathlib.Path) -> list[pathlib.Path]:
 
 def compiled_sources(package: pathlib.Path = PACKAGE) -> list[pathlib.Path]:
     """Every module whose code or constants can reach compiled code: the modules of ``package`` that import numba,
-    and every project module they import, transitively (module docstring)."""
+    and every project module they import, transitively (module docstring).
+
+    Parameters
+    ----------
+    package : pathlib.Path
+        The package's folder (``dem/`` by default).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The source files, sorted.
+    """
     root = package.parent
     seeds = []
     for path in _sources(package):
@@ -108,7 +119,18 @@ def compiled_sources(package: pathlib.Path = PACKAGE) -> list[pathlib.Path]:
 
 
 def digest(package: pathlib.Path = PACKAGE) -> str:
-    """A short hash of the source of :func:`compiled_sources`."""
+    """A short hash of the source of :func:`compiled_sources`.
+
+    Parameters
+    ----------
+    package : pathlib.Path
+        The package's folder (``dem/`` by default).
+
+    Returns
+    -------
+    str
+        The hash, hexadecimal.
+    """
     h = hashlib.sha1()
     root = package.parent
     for path in compiled_sources(package):
@@ -130,7 +152,18 @@ def _stamp(package: pathlib.Path) -> str:
 def remembered_digest(package: pathlib.Path = PACKAGE) -> str:
     """:func:`digest`, remembered in ``__pycache__/jit_digest.json`` for as long as no source file of the project
     changed its size or modification time (as Python's own ``.pyc`` files are): reading the imports of the compiled
-    modules takes a tenth of a second, a look at the files' times a millisecond."""
+    modules takes a tenth of a second, a look at the files' times a millisecond.
+
+    Parameters
+    ----------
+    package : pathlib.Path
+        The package's folder (``dem/`` by default).
+
+    Returns
+    -------
+    str
+        The hash of :func:`digest`.
+    """
     memo = package / "__pycache__" / "jit_digest.json"
     stamp = _stamp(package)
     try:

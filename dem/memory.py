@@ -49,7 +49,20 @@ def available_bytes() -> float | None:
 
 def check(n: int, name: str) -> None:
     """Refuse ``n`` particles (named ``name`` in the message, e.g. ``"[generator] n"``) when a run of them would need
-    more memory than is available (module docstring)."""
+    more memory than is available (module docstring).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    name : str
+        What the message calls the count (``"[generator] n"``, say).
+
+    Raises
+    ------
+    ValueError
+        A run of ``n`` particles needs more memory than the machine has available.
+    """
     if BYTES_PER_PARTICLE * n < SMALL_BYTES:  # (the interpreter that asks holds its base already)
         return
     need = BASE_BYTES + BYTES_PER_PARTICLE * n

@@ -52,7 +52,23 @@ FINEST_GRADING = 0.02
 
 
 def check_rtol(rtol) -> float:
-    """Validate a relative tolerance: finite, ``1e-9 <= rtol < 1``."""
+    """Validate a relative tolerance: finite, ``1e-9 <= rtol < 1``.
+
+    Parameters
+    ----------
+    rtol : float
+        The relative tolerance (dimensionless).
+
+    Returns
+    -------
+    float
+        ``rtol`` as a float.
+
+    Raises
+    ------
+    ValueError
+        ``rtol`` is not finite or lies outside ``[1e-9, 1)``.
+    """
     value = float(rtol)
     if not (np.isfinite(value) and 1e-9 <= value < 1.0):
         raise ValueError(f"rtol = {rtol!r}: valid range 1e-9 <= rtol < 1")
@@ -61,11 +77,42 @@ def check_rtol(rtol) -> float:
 
 def default_order(rtol: float) -> int:
     """The fastest order pair for a tolerance (measured on the reference semispheres): P2/P3 down to 3e-5, then
-    P3/P4, whose estimator (the P3 solve) reaches 1e-6 on meshes ~5x smaller than P2 needs."""
+    P3/P4, whose estimator (the P3 solve) reaches 1e-6 on meshes ~5x smaller than P2 needs.
+
+    Parameters
+    ----------
+    rtol : float
+        Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
+
+    Returns
+    -------
+    int
+        The order ``p`` of the reported solve: 3 or 4.
+    """
     return 3 if rtol >= 3e-5 else 4
 
 
 def check_order(order, rtol: float) -> int:
+    """The order ``p`` of the reported solve of the order pair ``p - 1``, ``p``: ``order``, or the default for
+    ``rtol`` (:func:`default_order`).
+
+    Parameters
+    ----------
+    order : int or None
+        The order asked for, one of ``ORDERS``; None: the default for ``rtol``.
+    rtol : float
+        Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
+
+    Returns
+    -------
+    int
+        The order.
+
+    Raises
+    ------
+    ValueError
+        ``order`` is not one of ``ORDERS``.
+    """
     if order is None:
         return default_order(rtol)
     if order not in ORDERS:
@@ -75,17 +122,62 @@ def check_order(order, rtol: float) -> int:
 
 
 def initial_grading(rtol: float, order: int) -> float:
-    """Starting grading factor, calibrated so the default tolerance is met in one round for the reference cases."""
+    """Starting grading factor, calibrated so the default tolerance is met in one round for the reference cases.
+
+    Parameters
+    ----------
+    rtol : float
+        Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
+    order : int
+        The order of the reported solve, one of ``ORDERS``.
+
+    Returns
+    -------
+    float
+        The grading factor (element size per distance to the nearest re-entrant corner, dimensionless), within
+        ``[FINEST_GRADING, COARSEST_GRADING]``.
+    """
     base, tol = REFERENCE_GRADING[order]
     return float(np.clip(base * (rtol / tol) ** (1.0 / RATE[order]), FINEST_GRADING, COARSEST_GRADING))
 
 
 def relative_difference(k_high: float, k_low: float) -> float:
+    """The order-difference error estimate ``|K_p - K_(p-1)| / |K_p|`` (module docstring).
+
+    Parameters
+    ----------
+    k_high : float
+        The order-``p`` value (any unit, nonzero).
+    k_low : float
+        The order-``p - 1`` value (same unit).
+
+    Returns
+    -------
+    float
+        The relative difference (dimensionless).
+    """
     return abs(k_high - k_low) / abs(k_high)
 
 
 def next_grading(grading: float, rtol: float, estimate: float, order: int) -> float:
-    """Shrink the grading so that ``estimate * (new/old)^RATE`` lands at ~0.7 rtol; at least 15 %, at most 3x."""
+    """Shrink the grading so that ``estimate * (new/old)^RATE`` lands at ~0.7 rtol; at least 15 %, at most 3x.
+
+    Parameters
+    ----------
+    grading : float
+        The grading factor of the last round (dimensionless).
+    rtol : float
+        Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
+    estimate : float
+        The last round's error estimate (relative, > 0).
+    order : int
+        The order of the reported solve, one of ``ORDERS``.
+
+    Returns
+    -------
+    float
+        The next grading factor, not below ``FINEST_GRADING``.
+    """
     factor = (0.7 * rtol / estimate) ** (1.0 / RATE[order])
     return float(max(FINEST_GRADING, grading * min(0.85, max(1.0 / 3.0, factor))))
 
@@ -95,6 +187,26 @@ def solve_to_tolerance(solve_pair, rtol: float, order: int):
     ``rtol``. Returns ``(K_p, estimate, grading, payload, rounds, converged)``; when refining stops paying (the
     finest grading, an estimate that no longer halves, or a mesh too fine for double precision -- tiny necks at
     rtol < 1e-6) the best round so far is returned with ``converged = False`` and its honest estimate.
+
+    Parameters
+    ----------
+    solve_pair : callable
+        ``solve_pair(grading, order) -> (K_p, K_(p-1), payload)``: the value at orders ``p`` and ``p - 1`` on the
+        mesh of that grading, and anything the caller wants back; a ``RuntimeError`` ends the refinement.
+    rtol : float
+        Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
+    order : int
+        The order ``p`` of the reported solve, one of ``ORDERS``.
+
+    Returns
+    -------
+    tuple
+        ``(K_p, estimate, grading, payload, rounds, converged)`` of the best round.
+
+    Raises
+    ------
+    RuntimeError
+        The first round's ``solve_pair`` raised it.
     """
     grading = initial_grading(rtol, order)
     best = None
@@ -127,11 +239,41 @@ HP_MAX_ORDER = 11
 
 def hp_start_order(rtol: float) -> int:
     """First reported order: the one whose difference to ``p - 1`` typically meets ``rtol`` (about 1.2 decades per
-    order at a/r = 0.39: p = 4 for 1e-4, 6 for 1e-6)."""
+    order at a/r = 0.39: p = 4 for 1e-4, 6 for 1e-6).
+
+    Parameters
+    ----------
+    rtol : float
+        Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
+
+    Returns
+    -------
+    int
+        The order, in ``[2, HP_MAX_ORDER]``.
+    """
     return int(np.clip(np.ceil((np.log10(1.0 / rtol) + 0.3) / 1.2), 2, HP_MAX_ORDER))
 
 
 def check_hp_order(order, rtol: float) -> int:
+    """The first order the hp path reports: ``order``, or the default for ``rtol`` (:func:`hp_start_order`).
+
+    Parameters
+    ----------
+    order : int or None
+        The order asked for, ``2 <= order <= HP_MAX_ORDER``; None: the default for ``rtol``.
+    rtol : float
+        Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
+
+    Returns
+    -------
+    int
+        The order.
+
+    Raises
+    ------
+    ValueError
+        ``order`` is not an integer in ``[2, HP_MAX_ORDER]``.
+    """
     if order is None:
         return hp_start_order(rtol)
     if not (isinstance(order, (int, np.integer)) and 2 <= order <= HP_MAX_ORDER):
@@ -149,7 +291,29 @@ HP_CORNER_ERROR = {"cylinder": 1e-7, "union": 3e-5}
 
 def hp_corner_levels(a_over_r: float, rtol: float, sigma: float = SIGMA, neck: str = "cylinder") -> int:
     """Geometric refinement levels toward the corner: the corner cell's error ``~ c * sigma^(2 lambda (L - 2))``
-    (``c`` = :data:`HP_CORNER_ERROR` of the ``neck``, measured at L = 2) pushed 100x below ``rtol``."""
+    (``c`` = :data:`HP_CORNER_ERROR` of the ``neck``, measured at L = 2) pushed 100x below ``rtol``.
+
+    Parameters
+    ----------
+    a_over_r : float
+        Neck radius over particle radius, ``a/r`` in ``[0, 1]`` (dimensionless).
+    rtol : float
+        Relative tolerance of the conductance, ``1e-9 <= rtol < 1``.
+    sigma : float
+        The geometric grading ratio of the corner refinement, in ``(0, 1)`` (each level's cell over the last's).
+    neck : str
+        The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` or ``"union"``.
+
+    Returns
+    -------
+    int
+        The number of refinement levels, >= 2.
+
+    Raises
+    ------
+    ValueError
+        ``neck`` is not one of :data:`fem_neck.law.NECKS`.
+    """
     lam = corner_exponent(a_over_r, neck)
     decades = max(0.0, np.log10(HP_CORNER_ERROR[neck] / (0.01 * rtol)))
     return int(2 + np.ceil(decades / (-2.0 * lam * np.log10(sigma))))
@@ -164,6 +328,23 @@ def corner_exponent(a_over_r, neck: str = "cylinder"):
     meets the insulated sphere (interior angle ``omega = pi/2 + arccos(a/r)``, mixed Dirichlet/Neumann, so
     ``lambda = pi / (2 omega) = pi / (pi + 2 arccos(a/r))``): 1/2 for a vanishing neck (the rim of a disk on a
     half-space), 1 at ``a = r``.
+
+    Parameters
+    ----------
+    a_over_r : float or array_like
+        Neck radius over particle radius, ``a/r`` (dimensionless; clipped to ``[0, 1]``).
+    neck : str
+        The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` or ``"union"``.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``lambda`` (dimensionless), in ``[2/3, 1]`` for the cylinder and ``[1/2, 1]`` for the union.
+
+    Raises
+    ------
+    ValueError
+        ``neck`` is not one of :data:`fem_neck.law.NECKS`.
     """
     angle = np.arccos(np.clip(a_over_r, 0.0, 1.0))
     return np.pi / (np.pi + (2.0 if check_neck(neck) == "union" else 1.0) * angle)
@@ -177,11 +358,26 @@ SAFETY = 1.25  #: on the extrapolated error of a mesh sequence (Roache's factor 
 class SequenceEstimate:
     """The error of the finest value of a mesh sequence (:func:`mesh_sequence_estimate`).
 
-    ``error``: absolute error estimate of the finest value; ``relative``: ``error / |value|``; ``rate``: the error
-    ratio per level used; ``observed_rate`` and ``observed_order`` (``log(observed_rate) / log(ratio)``): from
-    three levels, ``None`` with two or when the sequence does not contract; ``corner_order``: ``2 lambda``;
-    ``monotone``: the sequence contracts. ``amplification = SAFETY / (rate - 1)`` turns the last change of any other
+    ``relative``: ``error / |value|``. ``amplification = SAFETY / (rate - 1)`` turns the last change of any other
     quantity solved on the same meshes (e.g. particle temperatures) into its error estimate.
+
+    Parameters
+    ----------
+    value : float
+        The finest value of the sequence (the unit of the values, e.g. W/K).
+    error : float
+        Absolute error estimate of ``value`` (same unit).
+    rate : float
+        The error ratio per level used (dimensionless, > 1).
+    observed_rate : float or None
+        The ratio of the last two changes, from three levels; None with two, or when the sequence does not contract.
+    observed_order : float or None
+        ``log(observed_rate) / log(ratio)``, the observed convergence order in the mesh size; None where there is no
+        observed rate.
+    corner_order : float
+        ``2 lambda``, the order the re-entrant corner allows.
+    monotone : bool
+        Whether the sequence contracts (its changes shrink without changing sign).
     """
 
     value: float
@@ -202,7 +398,25 @@ class SequenceEstimate:
 
 
 def mesh_levels(levels: int, ratio: float = MESH_RATIO) -> list[float]:
-    """Size factors of a mesh sequence, coarsest first, the finest 1: ``ratio^(levels-1), ..., ratio, 1``."""
+    """Size factors of a mesh sequence, coarsest first, the finest 1: ``ratio^(levels-1), ..., ratio, 1``.
+
+    Parameters
+    ----------
+    levels : int
+        Number of meshes: 1, 2 or 3.
+    ratio : float
+        The factor (> 1) by which every element size shrinks per level.
+
+    Returns
+    -------
+    list of float
+        The factors multiplying the finest mesh's sizes.
+
+    Raises
+    ------
+    ValueError
+        ``levels`` is not 1, 2 or 3.
+    """
     if levels not in (1, 2, 3):
         raise ValueError(f"levels = {levels!r}: must be 1, 2 or 3")
     return [ratio ** k for k in range(levels - 1, -1, -1)]
@@ -213,6 +427,25 @@ def mesh_sequence_estimate(values, exponent: float, ratio: float = MESH_RATIO) -
 
     ``exponent``: the smallest corner exponent ``lambda`` of the body (:func:`corner_exponent`; 1 if it has no
     re-entrant corner). See the module docstring for the formula and why it bounds the error.
+
+    Parameters
+    ----------
+    values : sequence of float
+        The 2 or 3 values, coarsest mesh first (any unit, e.g. W/K).
+    exponent : float
+        The smallest corner exponent ``lambda`` of the body, ``0.5 <= lambda <= 1``.
+    ratio : float
+        The factor (> 1) by which every element size shrinks per level.
+
+    Returns
+    -------
+    SequenceEstimate
+        The finest value and its error estimate.
+
+    Raises
+    ------
+    ValueError
+        Not 2 or 3 values, or ``exponent`` outside ``[0.5, 1]``.
     """
     v = [float(x) for x in values]
     if len(v) not in (2, 3):

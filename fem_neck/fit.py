@@ -51,7 +51,31 @@ CSV_FIELDS = ("a_over_r", "K_over_Kcyl", "error_estimate", "dofs", "seconds", "r
 @dataclass(frozen=True)
 class FitPoint:
     """One FE solve of the semisphere with a neck (or the union's half body): K/K_cyl at a/r to the tolerance
-    ``rtol``."""
+    ``rtol``.
+
+    Parameters
+    ----------
+    a_over_r : float
+        Neck radius over particle radius, ``a/r`` (dimensionless).
+    K_over_Kcyl : float
+        The half body's conductance over ``K_cyl = kappa pi r`` (dimensionless).
+    error_estimate : float
+        The solver's relative error estimate of ``K_over_Kcyl``.
+    dofs : int
+        Degrees of freedom of the (finest) solve.
+    seconds : float
+        Wall time of the solve (s).
+    rtol : float
+        The relative tolerance it was solved to.
+    uniform : bool
+        Whether the point is part of the uniform-in-a/r sampling used by the linear fit.
+    solver : str
+        The ``"module:function"`` that solved it (empty: unknown, from an old CSV).
+    method : str
+        The method passed to the solver (empty: unknown).
+    neck : str
+        The half body solved (:data:`fem_neck.law.NECKS`).
+    """
 
     a_over_r: float
     K_over_Kcyl: float
@@ -70,6 +94,21 @@ def sweep_points(n: int) -> tuple[np.ndarray, np.ndarray]:
 
     ``n // 8`` points log-spaced on [0.001, 0.02) (the constriction end, where the linear law fails) and
     ``m = n - n // 8`` uniform points ``0.97 k / m``, k = 1..m.
+
+    Parameters
+    ----------
+    n : int
+        Number of points, >= 4.
+
+    Returns
+    -------
+    tuple of (numpy.ndarray, numpy.ndarray)
+        The a/r (dimensionless, ascending) and a bool mask of the uniform ones.
+
+    Raises
+    ------
+    ValueError
+        ``n`` is not an integer >= 4.
     """
     if not isinstance(n, (int, np.integer)) or n < 4:
         raise ValueError(f"points = {n!r}: must be an integer >= 4")
@@ -100,7 +139,18 @@ def _solve_point(solver: str, method: str, neck: str, a_over_r: float, rtol: flo
 def read_points(path) -> dict:
     """Points already in a ``fit.csv``, keyed by a/r (a CSV without solver and method columns -- written before
     they were recorded -- gives points of unknown provenance: empty ``solver`` and ``method``; one without a neck
-    column was written before the union existed: ``neck = "cylinder"``)."""
+    column was written before the union existed: ``neck = "cylinder"``).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``fit.csv``; a missing file holds no points.
+
+    Returns
+    -------
+    dict
+        ``{a/r as text: FitPoint}``; unreadable rows (a half-written last line) are skipped.
+    """
     path = pathlib.Path(path)
     if not path.exists():
         return {}
@@ -121,7 +171,27 @@ def read_points(path) -> dict:
 def reusable_points(path, rtol: float, solver: str = SOLVER, method: str = METHOD,
                     neck: str = "cylinder") -> tuple[dict, int]:
     """The points of a ``fit.csv`` computed by ``solver`` with ``method`` for ``neck`` to exactly ``rtol`` (keyed by
-    a/r), and how many other points the file holds (other solver, method, neck or tolerance: they are not reused)."""
+    a/r), and how many other points the file holds (other solver, method, neck or tolerance: they are not reused).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``fit.csv``.
+    rtol : float
+        The tolerance the points must have been solved to.
+    solver : str
+        The FE solver as ``"module:function"`` (module docstring).
+    method : str
+        The discretisation passed to the solver (``"hp"``, say).
+    neck : str
+        The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (the semisphere with Rojek's neck cylinder) or
+        ``"union"`` (the union of spheres).
+
+    Returns
+    -------
+    tuple of (dict, int)
+        ``{a/r as text: FitPoint}`` of the matching points, and the number of the others.
+    """
     points = read_points(path)
     same = {k: p for k, p in points.items() if (p.solver, p.method, p.neck, p.rtol) == (solver, method, neck, rtol)}
     return same, len(points) - len(same)
@@ -151,6 +221,42 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
     instead of solved. With ``csv_path`` the CSV is rewritten with the kept points and each new point is appended
     as soon as it is solved, so an interrupted sweep loses nothing. ``meanwhile``: see
     :func:`sinterheat.pool.run_jobs`. Returns the points sorted by a/r.
+
+    Parameters
+    ----------
+    a_over_r : array_like
+        The a/r to solve (dimensionless).
+    uniform : array_like
+        Bool per point: part of the uniform sampling of the linear fit.
+    rtol : float
+        Relative tolerance of every solve, in ``(0, 0.1)``.
+    csv_path : str or pathlib.Path or None
+        The CSV to (re)write as points arrive; None: none.
+    workers : int or None
+        Number of worker processes; None: all cores.
+    solver : str
+        The FE solver as ``"module:function"`` (module docstring).
+    method : str
+        The discretisation passed to the solver (``"hp"``, say).
+    progress : bool
+        Whether to show a progress bar on stderr.
+    reuse : dict or None
+        Points solved before, ``{a/r as text: FitPoint}`` (:func:`reusable_points`); None: none.
+    meanwhile : callable or None
+        Run in a thread once the jobs are submitted; None: nothing.
+    neck : str
+        The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (the semisphere with Rojek's neck cylinder) or
+        ``"union"`` (the union of spheres).
+
+    Returns
+    -------
+    list of FitPoint
+        The points, sorted by a/r.
+
+    Raises
+    ------
+    ValueError
+        ``rtol`` is not a float in ``(0, 0.1)`` or ``neck`` is not one of :data:`fem_neck.law.NECKS`.
     """
     if not (isinstance(rtol, float) and 0.0 < rtol < 0.1):
         raise ValueError(f"rtol = {rtol!r}: must be a float in (0, 0.1)")
@@ -184,7 +290,27 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
 
 
 def linear_slope(a_over_r, k_over_kcyl, x_max: float = LINEAR_RANGE) -> float:
-    """Least-squares slope through the origin, ``c = sum(x f) / sum(x^2)`` over ``a/r <= x_max`` (eq. 40)."""
+    """Least-squares slope through the origin, ``c = sum(x f) / sum(x^2)`` over ``a/r <= x_max`` (eq. 40).
+
+    Parameters
+    ----------
+    a_over_r : array_like
+        The points' a/r (dimensionless).
+    k_over_kcyl : array_like
+        The points' K/K_cyl (dimensionless).
+    x_max : float
+        The largest a/r used (Rojek 2022's 0.7 by default).
+
+    Returns
+    -------
+    float
+        The slope c of ``K/K_cyl = c a/r`` (dimensionless).
+
+    Raises
+    ------
+    ValueError
+        No point has ``a/r <= x_max``.
+    """
     x = np.asarray(a_over_r, dtype=float)
     f = np.asarray(k_over_kcyl, dtype=float)
     m = x <= x_max
@@ -208,6 +334,28 @@ def fit_law(a_over_r, k_over_kcyl, A: float | None = None, neck: str = "cylinder
 
     Least squares on the relative residual: ``1/f - lambda = pi/(4x) P`` is linear in the parameters; Gauss-Newton
     on the exact relative residual ``f_law/f_FE - 1`` from that linear start converges in a few steps.
+
+    Parameters
+    ----------
+    a_over_r : array_like
+        The FE points' a/r, in ``(0, 1)`` (dimensionless).
+    k_over_kcyl : array_like
+        The FE points' K/K_cyl (dimensionless, > 0).
+    A : float or None
+        The fixed ``x ln(1/x)`` coefficient; None: the derived one for ``neck``.
+    neck : str
+        The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (the semisphere with Rojek's neck cylinder) or
+        ``"union"`` (the union of spheres).
+
+    Returns
+    -------
+    fem_neck.law.ConductanceLaw
+        The fitted law, with its fit range and largest relative residual.
+
+    Raises
+    ------
+    ValueError
+        Fewer points than the law has parameters, or ``neck`` is not one of :data:`fem_neck.law.NECKS`.
     """
     A = (A_LOG if check_neck(neck) == "cylinder" else A_LOG_UNION) if A is None else A
     x = np.asarray(a_over_r, dtype=float)
@@ -243,6 +391,16 @@ def slope_sensitivity(law: ConductanceLaw) -> dict:
     h/r of Figs. 13-14 (their a/r reach 0.83). The overlap h of two equal spheres gives a/r through the law's neck:
     the volume-conserving neck (eqs. 18-20) for ``law.neck = "cylinder"``, the circle where the spheres meet,
     ``a = sqrt(h (r - h/4))``, for the union.
+
+    Parameters
+    ----------
+    law : fem_neck.law.ConductanceLaw
+        The full-range law the samplings are evaluated on.
+
+    Returns
+    -------
+    dict
+        The slope c (dimensionless) under each sampling.
     """
     from fem_neck.geometry import neck_radius, overlap_for_neck
     from fem_neck.geometry.union import lens
@@ -271,7 +429,19 @@ def plot(points: list[FitPoint], slope: float, law: ConductanceLaw, path) -> Non
     """The Fig. 16 analogue: FE points, the linear fits and the law; below, relative deviations from FE.
 
     Drawn on a bare Agg figure with fixed margins (no pyplot, no layout engine: they cost more than the 40 solves of
-    the sweep)."""
+    the sweep).
+
+    Parameters
+    ----------
+    points : list of FitPoint
+        The FE points.
+    slope : float
+        The fitted linear slope c (dimensionless).
+    law : fem_neck.law.ConductanceLaw
+        The fitted full-range law.
+    path : str or pathlib.Path
+        The PNG file to write.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -321,6 +491,40 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
     :meth:`fem_neck.law.ConductanceLaw.from_json` reads. Points of an existing ``out/fit.csv`` solved by the same
     ``solver``, ``method`` and ``neck`` to the same ``rtol`` are reused unless ``fresh``; ``reused`` in the result
     says how many (``points``, ``of``, and ``not_matching``: the file's points from other settings, recomputed).
+
+    Parameters
+    ----------
+    n_points : int
+        Number of sweep points, >= 4 (:func:`sweep_points`).
+    rtol : float
+        Relative tolerance of every solve, in ``(0, 0.1)``.
+    out : str or pathlib.Path or None
+        The folder for fit.json, fit.csv and fit.png; None: nothing written.
+    workers : int or None
+        Number of worker processes; None: all cores.
+    solver : str
+        The FE solver as ``"module:function"`` (module docstring).
+    method : str
+        The discretisation passed to the solver (``"hp"``, say).
+    progress : bool
+        Whether to show a progress bar on stderr.
+    plot_png : bool
+        Whether to draw fit.png (with ``out``).
+    fresh : bool
+        Whether to recompute every point instead of reusing those of ``out/fit.csv``.
+    neck : str
+        The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (the semisphere with Rojek's neck cylinder) or
+        ``"union"`` (the union of spheres).
+
+    Returns
+    -------
+    dict
+        The content of fit.json: the slope, the law, the points and their provenance.
+
+    Raises
+    ------
+    ValueError
+        A bad ``n_points``, ``rtol`` or ``neck``.
     """
     t0 = time.perf_counter()
     check_neck(neck)

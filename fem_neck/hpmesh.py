@@ -51,7 +51,20 @@ LONGEST_ARC = 0.6       # radians of sphere in one far cell before it is split
 @dataclass(frozen=True)
 class SemisphereShape:
     """Dimensions of the body (sphere radius 1): neck radius ``a``, cap base ``z_i``, half-neck height ``t`` (0 for
-    the union), the corner's polar angle ``phi_c``. Exact volume for checks: :meth:`volume`."""
+    the union), the corner's polar angle ``phi_c``. Exact volume for checks: :meth:`volume`.
+
+    Parameters
+    ----------
+    a : float
+        Neck radius, in units of the sphere radius.
+    z_i : float
+        Height of the cap base above the equator, ``sqrt(1 - a^2)``, in units of the sphere radius.
+    t : float
+        Height of the half neck above the cap base, ``h_n / 2`` (eqs. 19-20), in units of the sphere radius; 0 for
+        the union.
+    phi_c : float
+        Polar angle of the corner ``C`` from the equatorial plane, ``atan2(z_i, a)`` (rad).
+    """
 
     a: float
     z_i: float
@@ -61,7 +74,26 @@ class SemisphereShape:
     @classmethod
     def from_neck(cls, a: float, neck: str = "cylinder") -> "SemisphereShape":
         """The body of neck radius ``a``: ``neck = "cylinder"`` (the volume-conserving half neck, eqs. 19-20) or
-        ``"union"`` (no neck cylinder)."""
+        ``"union"`` (no neck cylinder).
+
+        Parameters
+        ----------
+        a : float
+            Neck radius, in units of the sphere radius, in ``[0, 1)``.
+        neck : str
+            The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (with the volume-conserving half neck) or
+            ``"union"`` (no neck cylinder).
+
+        Returns
+        -------
+        SemisphereShape
+            The body's dimensions.
+
+        Raises
+        ------
+        ValueError
+            ``neck`` is not one of :data:`fem_neck.law.NECKS`.
+        """
         h_c = float(cap_height(1.0, a))
         t = h_c * (3.0 - h_c) / (3.0 * (2.0 - h_c)) if check_neck(neck) == "cylinder" else 0.0
         z_i = math.sqrt((1.0 - a) * (1.0 + a))
@@ -73,7 +105,19 @@ class SemisphereShape:
 
     def sphere_point(self, delta):
         """Points on the sphere at angle offset ``delta`` (toward the equator) from ``C``, in ``(x, z - z_i)``, and
-        their ``delta``-derivatives; ``S - C = 2 sin(delta/2) (sin(phi_c - delta/2), -cos(phi_c - delta/2))``."""
+        their ``delta``-derivatives; ``S - C = 2 sin(delta/2) (sin(phi_c - delta/2), -cos(phi_c - delta/2))``.
+
+        Parameters
+        ----------
+        delta : float or array_like
+            Angle offsets from ``C`` along the sphere toward the equator (rad), any shape.
+
+        Returns
+        -------
+        tuple of (numpy.ndarray, numpy.ndarray)
+            The points ``(x, z - z_i)`` and their derivatives with respect to ``delta``, shape ``delta.shape + (2,)``
+            each (units of the sphere radius).
+        """
         delta = np.asarray(delta, dtype=float)
         half = np.sin(0.5 * delta)
         mid = self.phi_c - 0.5 * delta
@@ -190,21 +234,63 @@ def _chord_delta(rho: float) -> float:
 def semisphere_quad_mesh(a: float, levels: int, sigma: float = SIGMA,
                          neck: str = "cylinder") -> tuple[QuadMesh, SemisphereShape]:
     """The geometric quadrilateral mesh of the semisphere with neck radius ``a`` (``1e-4 <= a < 1``, sphere radius
-    1) refined ``levels`` times toward the corner; ``neck``: ``"cylinder"`` or ``"union"`` (module docstring)."""
+    1) refined ``levels`` times toward the corner; ``neck``: ``"cylinder"`` or ``"union"`` (module docstring).
+
+    Parameters
+    ----------
+    a : float
+        Neck radius over sphere radius, ``1e-4 <= a < 1``.
+    levels : int
+        Number of geometric refinements of the corner cells toward the corner ``C`` (>= 0).
+    sigma : float
+        The geometric factor of each refinement, in ``(0, 1)`` (``SIGMA`` by default).
+    neck : str
+        The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (with the volume-conserving half neck) or
+        ``"union"`` (no neck cylinder).
+
+    Returns
+    -------
+    tuple of (fem_neck.spectral.QuadMesh, SemisphereShape)
+        The mesh (coordinates ``(x, z - z_i)``, units of the sphere radius) and the body's dimensions.
+    """
     shape = SemisphereShape.from_neck(a, neck)
     return half_body(shape, corner_radius(shape), levels, sigma), shape
 
 
 def end_disks(mesh: QuadMesh, shape: SemisphereShape) -> dict:
     """The fixed temperatures of the semisphere, as :func:`fem_neck.spectral.conductance` takes them: ``T = 0`` on
-    the equatorial disk, ``1`` on the neck's end disk (vertex masks; both planes are built exactly)."""
+    the equatorial disk, ``1`` on the neck's end disk (vertex masks; both planes are built exactly).
+
+    Parameters
+    ----------
+    mesh : fem_neck.spectral.QuadMesh
+        A mesh of :func:`half_body` or :func:`semisphere_quad_mesh`.
+    shape : SemisphereShape
+        The body it meshes.
+
+    Returns
+    -------
+    dict
+        ``{0.0: mask, 1.0: mask}``: bool vertex masks of the equatorial disk and the end disk.
+    """
     z = mesh.points[:, 1]
     return {0.0: z == -shape.z_i, 1.0: z == shape.t}
 
 
 def corner_radius(shape: SemisphereShape) -> float:
     """Radius ``R`` of the corner cells: the neck height ``t`` for small necks, at most half of ``z_i`` otherwise;
-    without a neck cylinder (``t = 0``) a quarter of the neck radius, at most half of ``z_i`` (one ring to ``a``)."""
+    without a neck cylinder (``t = 0``) a quarter of the neck radius, at most half of ``z_i`` (one ring to ``a``).
+
+    Parameters
+    ----------
+    shape : SemisphereShape
+        The body.
+
+    Returns
+    -------
+    float
+        ``R``, in units of the sphere radius.
+    """
     if shape.t == 0.0:
         return min(shape.a / RING_RATIO, 0.5 * shape.z_i)
     return shape.t if shape.a <= SMALL_NECK_MAX else min(shape.t, 0.5 * shape.z_i)
@@ -214,7 +300,24 @@ def half_body(shape: SemisphereShape, R: float, levels: int, sigma: float = SIGM
     """One sphere from its equator to the plane ``t`` above its cap base (the neck's end disk), corner cells of
     radius ``R <= t``. The neck cylinder is a tensor grid whose columns end at ``x = a - rho`` for the ring radii
     ``rho`` from ``R`` to ``a`` -- so two halves with the same ``a``, ``t`` and ``R`` share their end disk's nodes
-    (:func:`pair_quad_mesh`). With ``t = 0`` (the union) the end disk is the cap base and ``0 < R < a``."""
+    (:func:`pair_quad_mesh`). With ``t = 0`` (the union) the end disk is the cap base and ``0 < R < a``.
+
+    Parameters
+    ----------
+    shape : SemisphereShape
+        The body (units of its sphere radius).
+    R : float
+        Radius of the corner cells (units of the sphere radius), ``<= t`` (``< a`` for the union).
+    levels : int
+        Number of geometric refinements of the corner cells toward the corner ``C`` (>= 0).
+    sigma : float
+        The geometric factor of each refinement, in ``(0, 1)`` (``SIGMA`` by default).
+
+    Returns
+    -------
+    fem_neck.spectral.QuadMesh
+        The mesh, in coordinates ``(x, z - z_i)``.
+    """
     if shape.t > 0.0 and R >= shape.t * (1.0 - 1e-9):  # a corner radius in another sphere's units may miss t
         R = shape.t
     b = _Builder(shape)
@@ -324,7 +427,33 @@ def pair_quad_mesh(r_i: float, r_j: float, h: float, levels: int, sigma: float =
     from the mid-plane. The corner radius is the smaller of the two halves' own (:func:`corner_radius`), so the
     neck's columns, which depend on ``a``, ``t`` and ``R`` alone, are the same in both; ``mesh.origin`` puts absolute
     ``z`` at sphere ``i``'s centre, as on the gmsh path. Returns ``(mesh, s, bottom vertex mask, top vertex mask,
-    a)``."""
+    a)``.
+
+    Parameters
+    ----------
+    r_i : float
+        Radius of the lower sphere (any length unit, e.g. m).
+    r_j : float
+        Radius of the upper sphere (same unit).
+    h : float
+        Overlap of the two spheres (same unit), which gives the volume-conserving neck
+        (:func:`fem_neck.geometry.neck_geometry`).
+    levels : int
+        Number of geometric refinements of the corner cells toward the corner ``C`` (>= 0).
+    sigma : float
+        The geometric factor of each refinement, in ``(0, 1)`` (``SIGMA`` by default).
+
+    Returns
+    -------
+    tuple
+        ``(mesh, s, bottom, top, a)``: the mesh in units of ``s = min(r_i, r_j)``, ``s``, the bool vertex masks
+        of sphere i's and sphere j's equatorial disks, and the neck radius (unit of the radii).
+
+    Raises
+    ------
+    RuntimeError
+        The two halves do not share the neck's mid-plane nodes.
+    """
     geo = neck_geometry(r_i, r_j, h)
     a, t = float(geo.a), 0.5 * float(geo.h_n)
     s = min(r_i, r_j)

@@ -80,7 +80,24 @@ NECKS = ("cylinder", "union")  #: the half bodies a law is for: Rojek's volume-c
 
 
 def check_neck(neck) -> str:
-    """``neck`` if it names a half body of :data:`NECKS`, else ``ValueError``."""
+    """``neck`` if it names a half body of :data:`NECKS`, else ``ValueError``.
+
+    Parameters
+    ----------
+    neck : str
+        The half body a law is for: ``"cylinder"`` (Rojek's volume-conserving neck cylinder) or ``"union"`` (the
+        union of spheres).
+
+    Returns
+    -------
+    str
+        ``neck``, unchanged.
+
+    Raises
+    ------
+    ValueError
+        ``neck`` is not one of :data:`NECKS`.
+    """
     if neck not in NECKS:
         raise ValueError(f"neck = {neck!r}: must be one of {', '.join(NECKS)}")
     return neck
@@ -142,7 +159,25 @@ def neck_resistance(a_over_r):
 
 def half_neck_resistance(a_over_r, neck: str = "cylinder"):
     """The neck's part of the half body's resistance in units of ``1/(kappa pi r)``: ``lambda(x)`` of the half neck
-    cylinder (:func:`neck_resistance`) for ``neck = "cylinder"``, 0 for the union (it has no neck cylinder)."""
+    cylinder (:func:`neck_resistance`) for ``neck = "cylinder"``, 0 for the union (it has no neck cylinder).
+
+    Parameters
+    ----------
+    a_over_r : float or array_like
+        Neck radius over particle radius, ``x = a/r`` in ``[0, 1]`` (dimensionless).
+    neck : str
+        The half body (:data:`NECKS`): ``"cylinder"`` or ``"union"``.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The half neck's resistance times ``kappa pi r`` (dimensionless), a float for a scalar input.
+
+    Raises
+    ------
+    ValueError
+        ``a_over_r`` has an entry outside ``[0, 1]`` or not finite, or ``neck`` is not one of :data:`NECKS`.
+    """
     x = check_neck_ratio(a_over_r)
     return neck_resistance(x) if check_neck(neck) == "cylinder" else _out(np.zeros_like(x))
 
@@ -274,7 +309,23 @@ class ConductanceLaw:
 
     def require_neck(self, neck: str) -> "ConductanceLaw":
         """This law if it was fitted for ``neck``; ``ValueError`` naming its fit file otherwise (a law of the
-        neck-cylinder half body used for union necks, or the reverse)."""
+        neck-cylinder half body used for union necks, or the reverse).
+
+        Parameters
+        ----------
+        neck : str
+            The half body the caller will use the law for (:data:`NECKS`): ``"cylinder"`` or ``"union"``.
+
+        Returns
+        -------
+        ConductanceLaw
+            This law, unchanged.
+
+        Raises
+        ------
+        ValueError
+            ``neck`` is not one of :data:`NECKS`, or the law was fitted for the other half body.
+        """
         if check_neck(neck) != self.neck:
             where = f"fit file = {self.source!r}" if self.source else "law"
             raise ValueError(f"{where}: fitted for neck = {self.neck!r}, cannot be used for neck = {neck!r} (fit one "
@@ -386,7 +437,23 @@ class ConductanceLaw:
     @classmethod
     def default(cls, neck: str = "cylinder") -> "ConductanceLaw":
         """The fit shipped with the package for ``neck``, read once: ``fem_neck/data/fit.json`` (the neck cylinder,
-        default) or ``fem_neck/data/fit_union.json`` (the union of spheres)."""
+        default) or ``fem_neck/data/fit_union.json`` (the union of spheres).
+
+        Parameters
+        ----------
+        neck : str
+            The half body (:data:`NECKS`): ``"cylinder"`` (default) or ``"union"``.
+
+        Returns
+        -------
+        ConductanceLaw
+            The shipped law fitted for ``neck``.
+
+        Raises
+        ------
+        ValueError
+            ``neck`` is not one of :data:`NECKS`, or the shipped file cannot be read or was fitted for another neck.
+        """
         return _default_law(check_neck(neck))
 
 

@@ -53,6 +53,24 @@ class SizeField:
     corner and ``h_min = h_min_fraction * a``; ``uniform`` replaces it by one constant size (for convergence studies
     only: it leaves the corner singularity unresolved). Inside a neck thinner than ``grading * a`` the size is at most
     the neck height over ``neck_cells_per_height`` (0.25: four heights).
+
+    Parameters
+    ----------
+    grading : float
+        Growth of the element size per distance to the nearest corner, ``0 < grading <= 1`` (dimensionless).
+    h_min_fraction : float
+        The innermost size ``h_min`` over the neck radius ``a`` (dimensionless).
+    neck_cells_per_height : float
+        Cells per neck height inside a thin neck: the size there is at most the height over this (0.25: four
+        heights).
+    uniform : float or None
+        One constant element size (the body's length unit, e.g. the sphere radius 1) instead of the graded law;
+        None: graded.
+
+    Raises
+    ------
+    ValueError
+        ``grading`` outside ``(0, 1]`` or ``uniform`` not finite and > 0.
     """
 
     grading: float = DEFAULT_GRADING
@@ -100,6 +118,21 @@ class ProfileMesh:
     corners: ``(m, 2)`` array of the re-entrant corner points ``(a, z)``.
     volume: exact volume of the body of revolution (for conservation checks).
     h_min: shortest mesh edge; z_top: axial position of the ``top`` disk.
+
+    Parameters
+    ----------
+    mesh : skfem.MeshTri1
+        The triangle mesh of the meridian half-plane, ``(x, z)``, with the named boundaries of the module docstring.
+    arcs : dict
+        ``{boundary name: (z_centre, radius)}`` of every spherical surface (the body's length unit).
+    corners : numpy.ndarray
+        ``(m, 2)`` the re-entrant corner points ``(a, z)``.
+    volume : float
+        Exact volume of the body of revolution (length unit cubed).
+    h_min : float
+        Shortest mesh edge (length unit).
+    z_top : float
+        Axial position of the ``top`` disk (length unit).
     """
 
     mesh: object
@@ -147,6 +180,28 @@ def semisphere_profile(a_over_r: float, r: float = 1.0, neck: str = "cylinder"):
     simplifies to ``h_c (3r - h_c) / (3 (2r - h_c))``, free of cancellation for small necks. ``neck = "union"``: the
     half body of the union of spheres, the sphere up to its cap base, whose disk of radius ``a`` is the end disk
     (no neck cylinder; the corner is where that disk meets the sphere).
+
+    Parameters
+    ----------
+    a_over_r : float
+        Neck radius over sphere radius, ``MIN_NECK_RATIO <= a_over_r < 1``.
+    r : float
+        Sphere radius (any length unit, e.g. m; > 0).
+    neck : str
+        The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (with Rojek's half neck) or ``"union"`` (the
+        sphere up to its cap base).
+
+    Returns
+    -------
+    tuple
+        ``(start, segments, corners, necks)``: the bottom rim ``(r, 0)``, the outer segments (a segment is
+        ``("arc", end, z_centre, radius, name)`` or ``("line", end, name)``), the ``(1, 2)`` corner array and the
+        necks as ``(a, z_low, z_high)`` (none for the union); lengths in the unit of ``r``.
+
+    Raises
+    ------
+    ValueError
+        ``a_over_r`` or ``r`` out of range, or ``neck`` not one of :data:`fem_neck.law.NECKS`.
     """
     check_neck(neck)
     r = float(check_positive("r", r))
@@ -170,8 +225,26 @@ def chain_profile(radii, overlaps):
     """Outer boundary of a collinear chain of spheres (centres on the z axis, the first at ``z = 0``).
 
     Neck k joins spheres k and k+1: radius ``a_k`` and length ``h_n`` from the volume-conserving model (Rojek 2022,
-    eqs. 21-33). The end spheres are cut at their outer equatorial planes. Returns the start point, the segments,
-    the corner points, the necks as ``(a, z_low, z_high)`` and the neck radii.
+    eqs. 21-33). The end spheres are cut at their outer equatorial planes.
+
+    Parameters
+    ----------
+    radii : array_like
+        The spheres' radii (any length unit, e.g. m; > 0), at least 2, neighbours within :data:`MAX_RADIUS_RATIO`.
+    overlaps : array_like
+        The overlap ``h`` of each neighbouring pair (same unit), one per bond.
+
+    Returns
+    -------
+    tuple
+        ``(start, segments, corners, necks)``: the bottom rim, the outer segments, the ``(m, 2)`` corner points
+        and the necks as ``(a, z_low, z_high)``; lengths in the unit of the radii.
+
+    Raises
+    ------
+    ValueError
+        Bad radii or overlaps: fewer than 2 spheres, a radius ratio out of range, a neck too thin to mesh or
+        without length, a sphere consumed by its necks.
     """
     radii = np.atleast_1d(check_positive("radii", radii)).astype(float)
     overlaps = np.atleast_1d(np.asarray(overlaps, dtype=float))
@@ -208,7 +281,20 @@ def chain_profile(radii, overlaps):
 
 
 def check_radius_ratio(radii, names=None) -> None:
-    """Neighbouring radii at most :data:`MAX_RADIUS_RATIO` apart (``ValueError`` naming the pair otherwise)."""
+    """Neighbouring radii at most :data:`MAX_RADIUS_RATIO` apart (``ValueError`` naming the pair otherwise).
+
+    Parameters
+    ----------
+    radii : sequence of float
+        The radii in chain order (any length unit).
+    names : tuple of (str, str) or None
+        The names the message gives the pair (a two-sphere call); None: ``radii[k]`` and ``radii[k + 1]``.
+
+    Raises
+    ------
+    ValueError
+        A neighbouring ratio lies outside ``[1/MAX_RADIUS_RATIO, MAX_RADIUS_RATIO]``.
+    """
     for k in range(len(radii) - 1):
         r_i, r_j = float(radii[k]), float(radii[k + 1])
         if not (1.0 / MAX_RADIUS_RATIO <= r_j / r_i <= MAX_RADIUS_RATIO):
@@ -362,6 +448,24 @@ def profile_mesh(start, segments, corners, necks=(), sizes: SizeField | None = N
     ``("line", end, name)`` or ``("arc", end, z_centre, radius, name)``, counter-clockwise, ending at the top rim),
     then the ``top`` line back to the axis and the ``axis``. ``corners`` ((m, 2), each a segment end point) are
     where the size is graded; ``necks`` are ``(a, z_low, z_high)`` cylinders kept isotropic when thin.
+
+    Parameters
+    ----------
+    start : tuple of float
+        The bottom rim ``(x, z)``, where the first segment starts.
+    segments : list of tuple
+        The outer boundary, counter-clockwise from ``start`` to the top rim.
+    corners : array_like
+        ``(m, 2)`` the re-entrant corner points.
+    necks : sequence of tuple
+        The neck cylinders ``(a, z_low, z_high)``.
+    sizes : SizeField or None
+        The element-size law; None: ``SizeField()``.
+
+    Returns
+    -------
+    ProfileMesh
+        The mesh with its arcs, corners, exact volume, shortest edge and top height.
     """
     sizes = sizes or SizeField()
     corners = np.atleast_2d(np.asarray(corners, dtype=float))
@@ -378,6 +482,16 @@ def curved_mesh(profile: ProfileMesh):
 
     Straight-sided triangles inscribe the sphere and lose an ``O(h^2)`` sliver of volume per edge; the quadratic
     boundary cuts that to ``O(h^4)``. Named boundaries carry over (same facets).
+
+    Parameters
+    ----------
+    profile : ProfileMesh
+        The linear mesh and its arcs.
+
+    Returns
+    -------
+    skfem.MeshTri2
+        The quadratic mesh.
     """
     import skfem
 
@@ -397,12 +511,48 @@ def semisphere_mesh(a_over_r: float, r: float = 1.0, grading: float = DEFAULT_GR
 
     ``bottom`` is the equatorial disk (``z = 0``), ``top`` the neck's end disk (``z = z_i + h_n/2``; ``z_i`` for
     ``neck = "union"``).
+
+    Parameters
+    ----------
+    a_over_r : float
+        Neck radius over sphere radius, ``MIN_NECK_RATIO <= a_over_r < 1``.
+    r : float
+        Sphere radius (any length unit, e.g. m; > 0).
+    grading : float
+        The size field's grading (:class:`SizeField`), read where ``sizes`` is None.
+    sizes : SizeField or None
+        The element-size law; None: ``SizeField(grading=grading)``.
+    neck : str
+        The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (with Rojek's half neck) or ``"union"`` (the
+        sphere up to its cap base).
+
+    Returns
+    -------
+    ProfileMesh
+        The graded mesh.
     """
     start, segments, corners, necks = semisphere_profile(a_over_r, r, neck)
     return profile_mesh(start, segments, corners, necks, sizes or SizeField(grading=grading))
 
 
 def chain_mesh(radii, overlaps, grading: float = DEFAULT_GRADING, sizes: SizeField | None = None) -> ProfileMesh:
-    """Graded mesh of a collinear chain (``bottom``: equator of the first sphere, ``top``: of the last)."""
+    """Graded mesh of a collinear chain (``bottom``: equator of the first sphere, ``top``: of the last).
+
+    Parameters
+    ----------
+    radii : array_like
+        The spheres' radii (any length unit; > 0), at least 2 (:func:`chain_profile`).
+    overlaps : array_like
+        The overlap of each neighbouring pair (same unit).
+    grading : float
+        The size field's grading (:class:`SizeField`), read where ``sizes`` is None.
+    sizes : SizeField or None
+        The element-size law; None: ``SizeField(grading=grading)``.
+
+    Returns
+    -------
+    ProfileMesh
+        The graded mesh.
+    """
     start, segments, corners, necks = chain_profile(radii, overlaps)
     return profile_mesh(start, segments, corners, necks, sizes or SizeField(grading=grading))

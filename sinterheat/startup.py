@@ -31,7 +31,13 @@ def _leave(prog: str, signum, frame):
 
 def hold(prog: str) -> None:
     """Install the start-up handler (module docstring) for SIGINT, SIGTERM and SIGHUP; ``prog`` names the command
-    in its line, e.g. ``"python -m dem"``."""
+    in its line, e.g. ``"python -m dem"``.
+
+    Parameters
+    ----------
+    prog : str
+        The command as the user typed it, which starts the one line a signal writes (``"python -m dem"``, say).
+    """
     for name in ("SIGINT", "SIGTERM", "SIGHUP"):
         signum = getattr(signal, name, None)
         if signum is not None and (name == "SIGINT" or signal.getsignal(signum) is not signal.SIG_IGN):
@@ -40,7 +46,17 @@ def hold(prog: str) -> None:
 
 def run_main(prog: str, module: str, **kwargs):
     """``sys.exit(main(**kwargs))`` of ``module`` (a dotted name) for ``python -m <package>``, Ctrl-C (and SIGTERM,
-    SIGHUP) held to one line from here on (module docstring)."""
+    SIGHUP) held to one line from here on (module docstring).
+
+    Parameters
+    ----------
+    prog : str
+        The command as the user typed it (``"python -m dem"``, say), for the start-up line (:func:`hold`).
+    module : str
+        Dotted name of the module whose ``main`` runs the command (``"dem.cli"``, say).
+    **kwargs
+        Keyword arguments passed on to that ``main``.
+    """
     hold(prog)
     main = importlib.import_module(module).main
     from sinterheat.interrupt import exit_process

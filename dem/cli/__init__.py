@@ -20,5 +20,17 @@ COMMANDS = ("run", "scenes", "contact", "laws", "convert")
 
 
 def main(argv=None) -> int:
+    """``python -m dem``: parse the command line, run the command, print its result.
+
+    Parameters
+    ----------
+    argv : list of str or None
+        The arguments after the program name; None: ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit code: 0, 2 for bad input (a one-line error), 128 + the signal when interrupted.
+    """
     return cli.main(argv, prog="python -m dem", description=" ".join(__doc__.split("\n\n")[0].split()),
                     modules=COMMANDS, package="dem.cli")

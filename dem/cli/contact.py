@@ -34,6 +34,13 @@ OUTPUTS = ("force", "delta_max", "delta_0", "k1", "k2", "kc", "f_min")
 
 
 def register(sub):
+    """Add the ``contact`` command (module docstring) to the subcommands of ``python -m dem``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``python -m dem`` parser.
+    """
     parser = sub.add_parser("contact", help="drive one Luding 2005 contact through an overlap/temperature history",
                             description=__doc__)
     parser.add_argument("scene", help="a scene with a [contact] table (TOML file or built-in name, e.g. luding-table1)")
@@ -46,7 +53,23 @@ def register(sub):
 
 def read_history(path) -> dict:
     """Columns ``t``, ``overlap``, ``T`` of a CSV as float arrays; ``ValueError`` naming the file, row and column
-    of anything missing, non-numeric, non-finite, or a ``t`` that does not increase."""
+    of anything missing, non-numeric, non-finite, or a ``t`` that does not increase.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The history CSV.
+
+    Returns
+    -------
+    dict
+        ``{"t": s, "overlap": m, "T": the scene's temperature unit}``, float arrays.
+
+    Raises
+    ------
+    ValueError
+        The file cannot be read, or a value is missing, not a finite number, or a time does not increase.
+    """
     name = pathlib.Path(path).name
     if not pathlib.Path(path).is_file():
         raise ValueError(f"history = {str(path)!r}: no such file")
@@ -85,7 +108,22 @@ def read_history(path) -> dict:
 
 def check_overlaps(path, overlap, radius: float) -> None:
     """Refuse an overlap of the pair of radius ``radius`` at or beyond the pair's size ``2 radius`` (the centres meet
-    there), naming the file and the row."""
+    there), naming the file and the row.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The history CSV (named in the message).
+    overlap : array_like
+        The overlaps of its rows (m).
+    radius : float
+        The pair's particle radius a (m).
+
+    Raises
+    ------
+    ValueError
+        An overlap is ``>= 2 a``.
+    """
     beyond = np.flatnonzero(np.asarray(overlap) >= 2.0 * radius)
     if beyond.size:
         k = int(beyond[0])
@@ -96,7 +134,29 @@ def check_overlaps(path, overlap, radius: float) -> None:
 
 def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> dict:
     """One pair contact of two equal particles of radius ``radius`` through the history (see the module
-    docstring); returns the per-row arrays named in ``OUTPUTS``."""
+    docstring); returns the per-row arrays named in ``OUTPUTS``.
+
+    Parameters
+    ----------
+    material : dem.laws.contact.luding.LudingMaterial
+        The contact material.
+    radius : float
+        The particles' radius a (m).
+    t : numpy.ndarray
+        The rows' times (s), increasing.
+    overlap : numpy.ndarray
+        The rows' overlaps (m); <= 0 opens the contact.
+    T : numpy.ndarray
+        The rows' temperatures (the unit of ``T_melt``).
+    damping : bool
+        Whether the viscous force ``gamma_0 delta_dot`` (eq. 5) is included.
+
+    Returns
+    -------
+    dict
+        ``{name: (rows,) array}`` for the names of ``OUTPUTS``: force (N), delta_max, delta_0 (m), k1, k2, kc
+        (N/m), f_min (N).
+    """
     from dem.laws.contact import luding as law
 
     params = material.params()
@@ -120,6 +180,23 @@ def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> 
 
 
 def run(args) -> dict:
+    """Drive the pair through the history (module docstring); print the table unless ``--json``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line: ``scene``, ``history``, ``no_damping``, ``json`` and ``out``.
+
+    Returns
+    -------
+    dict
+        The pair, and with ``--json`` every row's inputs and outputs; with ``--out`` the files written.
+
+    Raises
+    ------
+    ValueError
+        A bad scene, history or overlap.
+    """
     from dem.laws.contact.luding import pair_delta_fluid
     from dem.scene.parse import load_scene, luding_material_from_scene
 
@@ -151,6 +228,17 @@ def run(args) -> dict:
 
 
 def write_csv(path: pathlib.Path, history: dict, rows: dict) -> None:
+    """Write the rows' inputs and outputs as ``contact.csv``, numbers that read back to the same doubles.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file to write.
+    history : dict
+        The history's columns ``t`` (s), ``overlap`` (m), ``T`` (:func:`read_history`).
+    rows : dict
+        The per-row outputs of :func:`drive_pair`.
+    """
     with open(path, "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(COLUMNS + OUTPUTS)
@@ -159,6 +247,15 @@ def write_csv(path: pathlib.Path, history: dict, rows: dict) -> None:
 
 
 def print_table(history: dict, rows: dict) -> None:
+    """Print the rows' inputs and outputs as a table on stdout.
+
+    Parameters
+    ----------
+    history : dict
+        The history's columns ``t`` (s), ``overlap`` (m), ``T`` (:func:`read_history`).
+    rows : dict
+        The per-row outputs of :func:`drive_pair`.
+    """
     names = COLUMNS + OUTPUTS
     print("  ".join(f"{name:>12}" for name in names))
     for k in range(len(history["t"])):
@@ -169,7 +266,23 @@ def print_table(history: dict, rows: dict) -> None:
 def plot(path: pathlib.Path, material, radius: float, history: dict, rows: dict, temperature_unit: str) -> None:
     """Left: force against overlap in the style of Luding 2005, Figs. 2, 3 and 5 -- the cold k1 line, the k1(T, t)
     and -kc(T, t, delta_max) lines of the last row and the path through the rows. Right: the temperature history
-    (in the scene's ``temperature_unit``) and the stiffness factor k1(T, t)/k1 it drives (eqs. 10, 12)."""
+    (in the scene's ``temperature_unit``) and the stiffness factor k1(T, t)/k1 it drives (eqs. 10, 12).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The PNG file to write.
+    material : dem.laws.contact.luding.LudingMaterial
+        The contact material.
+    radius : float
+        The particles' radius a (m).
+    history : dict
+        The history's columns ``t`` (s), ``overlap`` (m), ``T`` (:func:`read_history`).
+    rows : dict
+        The per-row outputs of :func:`drive_pair`.
+    temperature_unit : str
+        The scene's temperature unit, ``"C"`` or ``"K"``, for the axis label.
+    """
     from matplotlib.figure import Figure
 
     from dem.laws.contact import luding as law

@@ -21,6 +21,13 @@ OUTPUTS = {"lammps-data": "LAMMPS data file (atom_style sphere)", "csv": "CSV", 
 
 
 def register(sub):
+    """Add the ``convert`` command (module docstring) to the subcommands of ``python -m dem``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``python -m dem`` parser.
+    """
     parser = sub.add_parser("convert", help="write a packing, a saved state or a scene's particles as a LAMMPS "
                             "data file, CSV or VTU", description=__doc__)
     parser.add_argument("input", metavar="IN", help="packing file, state.npz, or scene (TOML file or built-in name)")
@@ -40,7 +47,23 @@ def register(sub):
 
 
 def read_input(args):
-    """The :class:`dem.scene.packing_files.Packing` of IN and what it was (``packing``, ``state`` or ``scene``)."""
+    """The :class:`dem.scene.packing_files.Packing` of IN and what it was (``packing``, ``state`` or ``scene``).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line: ``input``, ``format``, ``length_unit``, ``timestep``, ``periodic``.
+
+    Returns
+    -------
+    tuple of (dem.scene.packing_files.Packing, str)
+        The packing and its kind.
+
+    Raises
+    ------
+    ValueError
+        A bad input, or ``--periodic`` for a state or a scene.
+    """
     from dem.scene import packing_files, state_file
 
     source = pathlib.Path(args.input)
@@ -60,6 +83,23 @@ def read_input(args):
 
 
 def run(args) -> dict:
+    """Write IN as OUT (module docstring).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    dict
+        What was read and written: kinds, formats, particle count, id range, box and periodic axes.
+
+    Raises
+    ------
+    ValueError
+        A bad OUT name, ``--density``, or input.
+    """
     from dem.scene import packing_files
 
     target = pathlib.Path(args.output)

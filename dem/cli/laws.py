@@ -4,6 +4,13 @@ move (``[contact] law``, :data:`dem.laws.contact.CONTACT_LAWS`: their material's
 
 
 def register(sub):
+    """Add the ``laws`` command (module docstring) to the subcommands of ``python -m dem``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``python -m dem`` parser.
+    """
     parser = sub.add_parser("laws", help="list the conductance and contact laws with their keys",
                             description=__doc__)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout, nothing else")
@@ -11,6 +18,18 @@ def register(sub):
 
 
 def run(args) -> dict:
+    """The laws, one line each (module docstring).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+
+    Returns
+    -------
+    dict
+        ``{law: "[table] description; keys: ..."}``.
+    """
     from dataclasses import fields
 
     from dem.laws import contact

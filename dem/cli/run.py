@@ -20,6 +20,13 @@ from sinterheat.cli import add_output_options, add_quiet_option, add_threads_opt
 
 
 def register(sub):
+    """Add the ``run`` command (module docstring) to the subcommands of ``python -m dem``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subparsers of the ``python -m dem`` parser.
+    """
     parser = sub.add_parser("run", help="run a scene (TOML file or built-in name)", description=__doc__)
     parser.add_argument("scene", help="path to a scene TOML file, or a built-in name (see `python -m dem scenes`)")
     add_output_options(parser)
@@ -31,6 +38,23 @@ def register(sub):
 
 
 def run(args) -> dict:
+    """Run the scene ``args.scene`` (module docstring) and return its summary.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line: ``scene``, ``out``, ``resume``, ``overwrite``, ``quiet`` and ``json``.
+
+    Returns
+    -------
+    dict
+        The run's summary: in full with ``--json``, else as the console shows it (:func:`console`).
+
+    Raises
+    ------
+    ValueError
+        A bad scene or run folder, or the run ran out of memory (one line, which the CLI prints).
+    """
     from dem.scene import load_scene
     from dem.driver import run as run_scene
     from dem.memory import available_bytes, estimate
@@ -55,7 +79,18 @@ def run(args) -> dict:
 
 def console(summary: dict) -> dict:
     """The summary as the console shows it: the heat flow into the held particles as a total per group, not one
-    number per particle (``--json`` and ``summary.json`` have them all)."""
+    number per particle (``--json`` and ``summary.json`` have them all).
+
+    Parameters
+    ----------
+    summary : dict
+        The run's summary (:meth:`dem.engines.static.StaticEngine.summary` and the driver's additions).
+
+    Returns
+    -------
+    dict
+        ``summary`` without ``boundary_heat_flow["particles"]`` (unchanged where there is none).
+    """
     flows = summary.get("boundary_heat_flow")
     if not isinstance(flows, dict) or "particles" not in flows:
         return summary

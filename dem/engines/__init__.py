@@ -38,7 +38,23 @@ ENGINES = {
 
 
 def engine_class(name: str):
-    """The engine registered as ``name`` (:data:`ENGINES`), imported only now: a scene loads the code it runs."""
+    """The engine registered as ``name`` (:data:`ENGINES`), imported only now: a scene loads the code it runs.
+
+    Parameters
+    ----------
+    name : str
+        The engine's name, a key of :data:`ENGINES`.
+
+    Returns
+    -------
+    type
+        The engine's class.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is not a registered engine.
+    """
     if name not in ENGINES:
         raise ValueError(f"[solver] engine = {name!r}: must be one of {', '.join(ENGINES)}")
     module, cls = ENGINES[name].split(":")

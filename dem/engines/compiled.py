@@ -49,7 +49,29 @@ def _folder(law: str, threaded: bool) -> pathlib.Path:
 
 def module(law: str, template: str, threaded: bool = False):
     """The module ``template`` (one of ``TEMPLATES``) compiled for the contact law named ``law``; ``threaded``:
-    its copy for more than one thread (module docstring)."""
+    its copy for more than one thread (module docstring).
+
+    Parameters
+    ----------
+    law : str
+        The contact law (:data:`dem.laws.contact.CONTACT_LAWS`).
+    template : str
+        The dotted name of the template module, one of ``TEMPLATES``.
+    threaded : bool
+        Whether the copy for more than one thread is wanted.
+
+    Returns
+    -------
+    object
+        The compiled module.
+
+    Raises
+    ------
+    ValueError
+        ``law`` is not a known contact law.
+    RuntimeError
+        The template imports its contact law more than once.
+    """
     law_path = law_module_name(law)
     if law_path == TEMPLATE_LAW and not threaded:
         return importlib.import_module(template)

@@ -30,7 +30,31 @@ from dem.engines.staggered.heat import contact_bonds
 
 
 class ContactCurrent:
-    """The current of the configuration last refreshed and its heating (module docstring)."""
+    """The current of the configuration last refreshed and its heating (module docstring).
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The scene's particles: their electrical conductivity (S/m) and volumes (m^3).
+    walls : sequence of dem.geometry.walls.Wall
+        The scene's walls.
+    electrodes : dem.network.current.Electrodes
+        The electrified walls, at a potential (V) or a current (A; Zohdi's scheme: ``J_ext``).
+    spec : dem.laws.conductance.ConductanceSpec
+        The conductance law, used with sigma for kappa (its interface conductance left out).
+    scheme : str
+        ``"kirchhoff"`` or ``"zohdi"``.
+    absorption : float
+        The absorbed fraction a of the Joule heat, in ``[0, 1]`` (eq. 35).
+    tolerance : float
+        Zohdi's iteration: the largest change per sweep, relative to the largest ``|J_ext|``, at which it stops.
+    sweeps : int
+        Zohdi's iteration: the most sweeps per refresh.
+    linear : str
+        Kirchhoff's linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
+    floating : str
+        ``"allow"`` or ``"error"`` (particles touching no electrode stop the run).
+    """
 
     name = "electrical"
 
@@ -53,14 +77,38 @@ class ContactCurrent:
         self.peak_power = 0.0
 
     def book(self, dt: float) -> None:
-        """Add a step of ``dt`` at the current held during it to the energies delivered."""
+        """Add a step of ``dt`` at the current held during it to the energies delivered.
+
+        Parameters
+        ----------
+        dt : float
+            The step (s).
+        """
         self.joule_energy += dt * self.joule_heat
         self.electrode_energy += dt * (self.electrode_power or 0.0)
         self.peak_power = max(self.peak_power, self.joule_heat)
 
     def refresh(self, mech, t: float = 0.0) -> np.ndarray:
         """The current at the state of the mechanics ``mech`` (at time ``t``, for messages): updates
-        ``heating``."""
+        ``heating``.
+
+        Parameters
+        ----------
+        mech : dem.engines.staggered.mechanics.StaggeredMechanics
+            The mechanics: positions (m), temperatures and walls now.
+        t : float
+            The time (s), for messages.
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) the heating of each particle (W).
+
+        Raises
+        ------
+        ValueError
+            A fixed-current electrode has no path, or floating particles with ``floating = "error"``.
+        """
         lens = self.scheme == "zohdi"
         now, b = contact_bonds(self.particles, mech, mech.state.x, mech.state.T, self.electrodes.walls,
                                "lens" if lens else self.spec.contact, self.spec.out_of_range)

@@ -31,7 +31,31 @@ from dem.network.heat import Network, bonds_and_conductances, theta_step
 
 
 class ContactThermalModel:
-    """The thermal network on the current contacts (module docstring)."""
+    """The thermal network on the current contacts (module docstring).
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The scene's particles at the start: their temperatures (the scene's unit, K or degC) are the initial ones,
+        their masses give the capacities, and their materials, ``fixed`` flags and heat sources (W) hold throughout.
+    walls : sequence of dem.geometry.walls.Wall
+        The scene's walls; those with a temperature are isothermal planes bonded to the particles touching them.
+    spec : dem.laws.conductance.ConductanceSpec
+        The scene's contact geometry and conductance law.
+    sources : dem.laws.ambient.Sources
+        The heat exchanged with the surroundings (convection, radiation), if any.
+    integrator : str
+        The network's implicit step: ``"implicit"`` (backward Euler) or ``"crank-nicolson"``.
+    linear : str
+        The linear solver of each step (:func:`dem.network.heat.theta_step`), ``"auto"`` by default.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box (bonds across its faces, its temperature drop per period); None without one.
+
+    Raises
+    ------
+    ValueError
+        ``integrator`` is neither ``"implicit"`` nor ``"crank-nicolson"``.
+    """
 
     name = "thermal"
 
@@ -55,14 +79,39 @@ class ContactThermalModel:
         self.assemblies = self.refreshes = 0
 
     def bonds(self, mechanics):
-        """Bonds and conductances ``(bonds, K_pairs, K_walls)`` of the contacts of ``mechanics`` now."""
+        """Bonds and conductances ``(bonds, K_pairs, K_walls)`` of the contacts of ``mechanics`` now.
+
+        Parameters
+        ----------
+        mechanics : dem.engines.verlet.mechanics.MechanicalModel
+            The mechanical submodel: its current contacts, positions (m), radii (m) and wall offsets (m).
+
+        Returns
+        -------
+        tuple
+            The bonds (:func:`dem.network.heat.bonds_and_conductances`), the pair conductances (W/K) and the
+            wall conductances (W/K).
+        """
         i, j = mechanics.contacts()[:2]
         return bonds_and_conductances(self._particles_now(mechanics, mechanics.state.radius),
                                       self._walls_now(mechanics), self.spec, pairs=(i, j), box=self.box)
 
     def local(self, mechanics, values: np.ndarray) -> np.ndarray:
         """``values`` (per particle of the scene) for the particles ``mechanics`` holds: all of them, in order
-        (a rank's model holds some, :class:`dem.engines.verlet.ranks.RankContactThermal`)."""
+        (a rank's model holds some, :class:`dem.engines.verlet.ranks.RankContactThermal`).
+
+        Parameters
+        ----------
+        mechanics : dem.engines.verlet.mechanics.MechanicalModel
+            The mechanical submodel whose particles are wanted.
+        values : numpy.ndarray
+            One value per particle of the scene, any unit.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``values`` itself (this model holds every particle).
+        """
         return values
 
     def _particles_now(self, mechanics, radius) -> Particles:
@@ -76,7 +125,15 @@ class ContactThermalModel:
         return [self.walls[k].at(mechanics.w.q[k]) for k in self.thermal_walls]
 
     def step(self, mechanics, dt: float) -> None:
-        """Advance the temperatures by ``dt`` on the network of the contacts of ``mechanics`` now."""
+        """Advance the temperatures by ``dt`` on the network of the contacts of ``mechanics`` now.
+
+        Parameters
+        ----------
+        mechanics : dem.engines.verlet.mechanics.MechanicalModel
+            The mechanical submodel at the end of the interval: its contacts give the network.
+        dt : float
+            The step (s), > 0.
+        """
         bonds, K_pairs, K_walls = self.bonds(mechanics)
         if self.net is not None and self.net.graph.same_edges(bonds.i, bonds.j, bonds.wall_particle, bonds.wall_index):
             self.net.refresh(bonds, K_pairs, K_walls)
@@ -96,7 +153,21 @@ class ContactThermalModel:
         """The heat of the contacts ``(i, j)`` of ``mechanics`` now, for the snapshots: per contact its
         ``neck_radius`` (m), ``conductance`` (W/K) and ``heat_flow`` (W, from i to j), all 0 for a contact without
         a bond (``conductance.out_of_range = "drop"``); and the heat flow (W) into each particle through its
-        contacts and walls."""
+        contacts and walls.
+
+        Parameters
+        ----------
+        mechanics : dem.engines.verlet.mechanics.MechanicalModel
+            The mechanical submodel now: its contacts give the bonds.
+        i, j : numpy.ndarray
+            The contacts' particle indices, shape (M,) each; the heat flow is counted from ``i`` to ``j``.
+
+        Returns
+        -------
+        tuple of (dict, numpy.ndarray)
+            ``{"neck_radius": m, "conductance": W/K, "heat_flow": W}``, arrays of shape (M,), and the heat flow into
+            each particle (W), shape (N,).
+        """
         bonds, K_pairs, K_walls = self.bonds(mechanics)
         T = self.local(mechanics, self.T)
         n = len(T)

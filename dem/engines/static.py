@@ -30,7 +30,21 @@ CSV_FLOWS = ("fixed", "walls", "convection", "radiation", "internal")  # the hea
 def effective_conductivity(scene, summary: dict) -> float | None:
     """``k_eff = Q L / (A dT)`` (steady): between the two ends of the scene's specimen (:mod:`dem.scene.specimen`:
     walls or held groups, ``Q`` the heat leaving the hot end), or along the one axis of a periodic box with a
-    temperature drop per period (``Q`` the heat flow across the period)."""
+    temperature drop per period (``Q`` the heat flow across the period).
+
+    Parameters
+    ----------
+    scene : dem.scene.parse.Scene
+        The scene: its specimen (:mod:`dem.scene.specimen`) and periodic box.
+    summary : dict
+        The run's summary: its ``boundary_heat_flow`` (W) or ``periodic_heat_flow`` (W per axis).
+
+    Returns
+    -------
+    float or None
+        ``k_eff`` (W/(m K)), or None where the scene has no specimen, its ends are at one temperature or the
+        summary lacks the heat flow.
+    """
     box, sp = scene.box, scene.specimen
     if box is not None and "periodic_heat_flow" in summary:
         axes = np.flatnonzero(box.drop)
@@ -47,7 +61,23 @@ def effective_conductivity(scene, summary: dict) -> float | None:
 def boundary_summary(scene, walls, into: dict) -> dict:
     """The summary's ``boundary_heat_flow``: W into each wall (``walls``, in the scene's order) by name, into each
     held group (:func:`dem.scene.specimen.held_groups`) by name, into all held particles, and (up to 1000 of them)
-    into each held particle by id (``into``: ``{index: W}``)."""
+    into each held particle by id (``into``: ``{index: W}``).
+
+    Parameters
+    ----------
+    scene : dem.scene.parse.Scene
+        The scene: its walls, particles and named groups.
+    walls : sequence of float
+        The heat flow into each wall of ``scene.walls``, in its order (W).
+    into : dict
+        The heat flow into each held particle, ``{index: W}``.
+
+    Returns
+    -------
+    dict
+        ``{"walls": {name: W}, "groups": {name: W}, "fixed_total": W}``, and ``"particles": {id: W}`` for up to
+        1000 held particles.
+    """
     groups = held_groups(scene.particles, scene.groups)
     out = {"walls": {w.name: float(q) for w, q in zip(scene.walls, walls)}, "groups": group_flows(groups, into),
            "fixed_total": float(sum(into[k] for k in sorted(into)))}
@@ -59,7 +89,21 @@ def boundary_summary(scene, walls, into: dict) -> dict:
 
 class StaticEngine:
     """The thermal network of a static packing (module docstring), as the driver asks of an engine
-    (:mod:`dem.engines`)."""
+    (:mod:`dem.engines`).
+
+    Parameters
+    ----------
+    scene : dem.scene.parse.Scene
+        The scene to solve (steady) or integrate (transient).
+    restart : dict or None
+        The checkpoint of this scene's transient run (:func:`dem.output.folder.load`) to go on from; None: start
+        at the scene's start.
+
+    Raises
+    ------
+    ValueError
+        The scene needs more memory than is available, or a fixed-step transient run exceeds the work limit.
+    """
 
     name = "static"
     link_kind = "bonds"
@@ -104,7 +148,23 @@ class StaticEngine:
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """Solve (steady) or integrate (transient) to ``[solver] t_end``; ``observe()`` after every step (and at the
         start), ``progress(t)`` with the simulated time, ``checkpoint(make, final)`` after every step and at the end
-        (:func:`dem.network.heat.integrate`)."""
+        (:func:`dem.network.heat.integrate`).
+
+        Parameters
+        ----------
+        observe : callable or None
+            Called without arguments after every step and at the start (the snapshots); None: not called.
+        progress : callable or None
+            Called with the simulated time (s) as the run advances; None: not called.
+        checkpoint : callable or None
+            Called as ``checkpoint(make, final)`` after every step and at the end; None: not called.
+
+        Raises
+        ------
+        ValueError
+            A factorisation failed (exactly singular); the message says why from the scene's capacities and
+            conductances.
+        """
         try:
             self._run(observe, progress, checkpoint)
         except RuntimeError as exc:  # e.g. SuperLU "Factor is exactly singular": explain it as a property of the scene
@@ -233,6 +293,20 @@ class StaticEngine:
         return None
 
     def plots(self, out, summary: dict) -> list[str]:
+        """Write the run folder's plots (:func:`dem.output.plots.thermal_plots`).
+
+        Parameters
+        ----------
+        out : str or pathlib.Path
+            The run folder.
+        summary : dict
+            The run's summary (unused here: the plots read the folder and the engine's temperatures).
+
+        Returns
+        -------
+        list of str
+            The names of the files written.
+        """
         from dem.output.plots import thermal_plots
 
         return thermal_plots(out, self.scene, self.T)

@@ -25,7 +25,18 @@ DIRECTIONS = 96  # surface points per particle: the fraction is resolved to abou
 
 
 def fibonacci_directions(n: int) -> np.ndarray:
-    """``n`` unit vectors spread evenly over the sphere (equal-area Fibonacci lattice)."""
+    """``n`` unit vectors spread evenly over the sphere (equal-area Fibonacci lattice).
+
+    Parameters
+    ----------
+    n : int
+        Number of directions.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 3) unit vectors.
+    """
     k = np.arange(n) + 0.5
     z = 1.0 - 2.0 * k / n
     phi = np.pi * (1.0 + 5.0**0.5) * k
@@ -111,7 +122,22 @@ def _exposed(x, radius, directions, lo, size, ncell, members, start, count):
 
 
 def exposed_fraction(position: np.ndarray, radius: np.ndarray, directions: int = DIRECTIONS) -> np.ndarray:
-    """The exposed fraction of every particle's surface (module docstring), in [0, 1]."""
+    """The exposed fraction of every particle's surface (module docstring), in [0, 1].
+
+    Parameters
+    ----------
+    position : numpy.ndarray
+        (N, 3) particle centres (m).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    directions : int
+        Number of directions sampled over each surface (:func:`fibonacci_directions`).
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) the exposed fractions.
+    """
     x = np.ascontiguousarray(position, dtype=float)
     r = np.ascontiguousarray(radius, dtype=float)
     if len(r) == 0:

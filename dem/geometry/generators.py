@@ -48,7 +48,31 @@ def _check_count(n: int, name: str):
 class Layout:
     """Generated geometry: ``position`` (N,3), ``radius`` (N,), ``bottom``/``top`` layer indices, the z of the
     lowest/highest particle surfaces, the cross-section ``area`` (m^2) normal to z; ``period`` (3,) and ``origin``
-    (3,) of the box that tiles space with the block (None where it does not), initial ``velocity`` (N,3) or None."""
+    (3,) of the box that tiles space with the block (None where it does not), initial ``velocity`` (N,3) or None.
+
+    Parameters
+    ----------
+    position : numpy.ndarray
+        (N, 3) centres (m).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    bottom : numpy.ndarray
+        Indices of the bottom layer (lowest along z).
+    top : numpy.ndarray
+        Indices of the top layer.
+    z_low : float
+        z of the lowest particle surface (m).
+    z_high : float
+        z of the highest particle surface (m).
+    area : float
+        The cross-section normal to z (m^2).
+    period : numpy.ndarray or None
+        (3,) the box that tiles space with the block (m); None where it does not.
+    origin : numpy.ndarray or None
+        (3,) that box's lower corner (m); None with no period.
+    velocity : numpy.ndarray or None
+        (N, 3) initial velocities (m/s); None: at rest.
+    """
 
     position: np.ndarray
     radius: np.ndarray
@@ -85,7 +109,27 @@ def _overlap(value, count, name="overlap"):
 
 
 def chain(n: int, radius, overlap) -> Layout:
-    """``n`` collinear particles along z; ``radius`` scalar or per particle, ``overlap`` scalar or per bond."""
+    """``n`` collinear particles along z; ``radius`` scalar or per particle, ``overlap`` scalar or per bond.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles, >= 1.
+    radius : float or sequence of float
+        Radius (m), one for all or one per particle, > 0.
+    overlap : float or sequence of float
+        Relative overlap ``h / min(r_i, r_j)``, one for all or one per bond, within the neck model's range.
+
+    Returns
+    -------
+    Layout
+        The chain, the first particle's centre at the origin.
+
+    Raises
+    ------
+    ValueError
+        A bad ``n``, radius or overlap (the message names it).
+    """
     if not isinstance(n, int) or isinstance(n, bool) or n < 1:
         raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
     _check_count(n, "n")
@@ -119,7 +163,29 @@ CELL_EDGE = {"sc": 1.0, "bcc": 2.0 / np.sqrt(3.0), "fcc": np.sqrt(2.0)}
 def lattice(shape, radius, overlap, structure: str = "sc") -> Layout:
     """A block of ``shape = [nx, ny, nz]`` cubic cells of equal spheres: simple cubic (one sphere per cell, so the
     block is nx x ny x nz spheres), body-centred (two) or face-centred cubic (four), nearest neighbours ``2r - h``
-    apart (``h = overlap * r``). Its ``period`` is the block's size: shape times the cell edge."""
+    apart (``h = overlap * r``). Its ``period`` is the block's size: shape times the cell edge.
+
+    Parameters
+    ----------
+    shape : sequence of int
+        ``[nx, ny, nz]``, the number of cubic cells along each axis (>= 1).
+    radius : float
+        The spheres' radius (m), > 0.
+    overlap : float
+        Relative overlap ``h / r`` of nearest neighbours.
+    structure : str
+        ``"sc"``, ``"bcc"`` or ``"fcc"``.
+
+    Returns
+    -------
+    Layout
+        The block, with its ``period`` and ``origin``.
+
+    Raises
+    ------
+    ValueError
+        A bad shape, radius, overlap or structure (the message names it).
+    """
     if structure not in STRUCTURES:
         raise ValueError(f"[generator] structure = {structure!r}: must be one of {', '.join(STRUCTURES)}")
     if (not isinstance(shape, (list, tuple)) or len(shape) != 3
@@ -163,7 +229,38 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
     ``h / min(r_i, r_j)`` over bonded pairs, ``jitter`` the half-width of the position noise over the neighbour
     distance. ``periodic``: the block tiles space with its ``period`` (complete FCC cells along z as well, so the
     layer count is even; at least 2 x 2 x 2 cells, n >= 32), the overlaps across its faces count in the mean, and
-    the positions are wrapped into the period box."""
+    the positions are wrapped into the period box.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles asked for, >= 1 (rounded up to complete layers).
+    radius : float
+        Mean radius (m), > 0, before the common scaling that meets ``overlap``.
+    overlap : float
+        Target mean relative overlap ``h / min(r_i, r_j)`` of the bonded pairs, < 2/3.
+    seed : int
+        Seed of the random generator, >= 0.
+    radius_spread : float
+        Relative spread of the radii, in ``[0, 1)``: half-width for ``"uniform"``, standard deviation over the
+        mean for ``"lognormal"``.
+    distribution : str
+        The radius distribution, one of ``DISTRIBUTIONS``.
+    jitter : float
+        Half-width of the uniform position noise over the neighbour distance, in ``[0, 0.25)``.
+    periodic : bool
+        Whether the block tiles space with its ``period``.
+
+    Returns
+    -------
+    Layout
+        The packing.
+
+    Raises
+    ------
+    ValueError
+        A parameter out of its range, or more particles than one machine holds.
+    """
     if not isinstance(n, int) or isinstance(n, bool) or n < 1:
         raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
     _check_count(n, "n")
@@ -245,7 +342,24 @@ def box_capacity(radius: float, spread: float, box, dimension: int = 3) -> int:
     """About how many particles :func:`random_box` can place at most in ``box``: the box's volume (area of the x-z
     face for 2D disks) filled to the jamming fraction of random sequential addition (``RSA_JAMMING``), over
     the particles' mean volume (area). An upper estimate: the box's faces and a finite number of attempts leave
-    it emptier (about 0.30 for the spheres of ``hot-wall-sintering``)."""
+    it emptier (about 0.30 for the spheres of ``hot-wall-sintering``).
+
+    Parameters
+    ----------
+    radius : float
+        Mean radius (m).
+    spread : float
+        Relative half-width of the uniform radius distribution, in ``[0, 1)``.
+    box : sequence
+        ``[[x, y, z]_lo, [x, y, z]_hi]``, the box's corners (m).
+    dimension : int
+        3 (spheres) or 2 (disks in the x-z plane).
+
+    Returns
+    -------
+    int
+        The estimated largest number of particles.
+    """
     b = np.asarray(box, dtype=float)
     span = (b[1] - b[0])[[0, 2] if dimension == 2 else [0, 1, 2]]
     return int(RSA_JAMMING[dimension] * float(np.prod(span)) / _mean_size(radius, spread, dimension))
@@ -257,7 +371,35 @@ def random_box(n: int, radius, box, radius_spread: float = 0.0, seed: int = 0, s
     [x, y, z]_hi]`` without overlapping each other or the box faces (random sequential addition, Zohdi 2014,
     Sec. 7; Luding 2005, Sec. 4: "randomly placed in a box with random initial velocity"). Radii uniform in
     ``radius (1 +- radius_spread)`` (Luding's w0); velocities of magnitude ``speed`` in random directions (in the
-    x-z plane for 2D disks, which keep ``y = 0``). Refused when the box is too full for the particles to fit."""
+    x-z plane for 2D disks, which keep ``y = 0``). Refused when the box is too full for the particles to fit.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles, >= 1.
+    radius : float
+        Mean radius (m), > 0.
+    box : sequence
+        ``[[x, y, z]_lo, [x, y, z]_hi]``, the box's corners (m).
+    radius_spread : float
+        Relative half-width of the uniform radius distribution, in ``[0, 1)``.
+    seed : int
+        Seed of the random generator, >= 0.
+    speed : float
+        Magnitude of each particle's initial velocity (m/s), >= 0.
+    dimension : int
+        3 (spheres) or 2 (disks in the x-z plane).
+
+    Returns
+    -------
+    Layout
+        The particles with their velocities.
+
+    Raises
+    ------
+    ValueError
+        A parameter out of its range, or a box too full for the particles.
+    """
     if not isinstance(n, int) or isinstance(n, bool) or n < 1:
         raise ValueError(f"[generator] n = {n!r}: must be an integer >= 1")
     _check_count(n, "n")

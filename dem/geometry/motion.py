@@ -22,7 +22,24 @@ DIMENSIONS = (2, 3)
 
 
 def particle_mass(dimension: int, density, radius, height: float | None = None) -> np.ndarray:
-    """``rho (4/3) pi a^3`` (spheres) or ``rho pi a^2 h`` (disks of height h), kg."""
+    """``rho (4/3) pi a^3`` (spheres) or ``rho pi a^2 h`` (disks of height h), kg.
+
+    Parameters
+    ----------
+    dimension : int
+        3 (spheres) or 2 (disks in the x-z plane).
+    density : float or array_like
+        Density rho (kg/m^3), scalar or one per particle.
+    radius : float or array_like
+        Radii a (m).
+    height : float or None
+        Height h of the disks (m), read in 2D only.
+
+    Returns
+    -------
+    numpy.ndarray
+        The masses (kg).
+    """
     radius = np.asarray(radius, dtype=float)
     if dimension == 3:
         return density * 4.0 / 3.0 * np.pi * radius**3
@@ -30,7 +47,22 @@ def particle_mass(dimension: int, density, radius, height: float | None = None) 
 
 
 def moment_of_inertia(dimension: int, mass, radius) -> np.ndarray:
-    """``(2/5) m a^2`` (sphere) or ``m a^2 / 2`` (disk about its axis), kg m^2."""
+    """``(2/5) m a^2`` (sphere) or ``m a^2 / 2`` (disk about its axis), kg m^2.
+
+    Parameters
+    ----------
+    dimension : int
+        3 (spheres) or 2 (disks in the x-z plane).
+    mass : float or array_like
+        Masses m (kg).
+    radius : float or array_like
+        Radii a (m).
+
+    Returns
+    -------
+    numpy.ndarray
+        The moments of inertia (kg m^2).
+    """
     return (0.4 if dimension == 3 else 0.5) * np.asarray(mass) * np.asarray(radius) ** 2
 
 
@@ -42,7 +74,35 @@ def _mask(axes: tuple[int, ...]) -> np.ndarray:
 
 @dataclass
 class MotionState:
-    """Arrays of N particles (C-contiguous float64, ``(N, 3)`` vectors); mutated in place by the integrator."""
+    """Arrays of N particles (C-contiguous float64, ``(N, 3)`` vectors); mutated in place by the integrator.
+
+    Parameters
+    ----------
+    dimension : int
+        3 (spheres) or 2 (disks in the x-z plane).
+    height : float or None
+        Height of the 2D disks (m); None in 3D.
+    x : numpy.ndarray
+        (N, 3) positions (m).
+    v : numpy.ndarray
+        (N, 3) velocities (m/s).
+    w : numpy.ndarray
+        (N, 3) angular velocities (rad/s).
+    f : numpy.ndarray
+        (N, 3) forces (N).
+    tau : numpy.ndarray
+        (N, 3) torques (N m).
+    mass : numpy.ndarray
+        (N,) masses (kg), constant.
+    inertia : numpy.ndarray
+        (N,) moments of inertia (kg m^2).
+    radius : numpy.ndarray
+        (N,) current radii (m), which follow the temperature by thermal expansion.
+    radius_ref : numpy.ndarray
+        (N,) radii at the reference (melting) temperature (m).
+    T : numpy.ndarray
+        (N,) temperatures (the scene's unit, K or degC).
+    """
 
     dimension: int
     height: float | None
@@ -61,7 +121,39 @@ class MotionState:
     def create(cls, dimension, position, radius, density, temperature, velocity=None, angular_velocity=None,
                height=None, radius_ref=None) -> "MotionState":
         """A state at rest unless ``velocity``/``angular_velocity`` are given; ``density`` kg/m^3 (scalar or per
-        particle); 2D disks need ``height`` (m) and positions with ``y = 0``."""
+        particle); 2D disks need ``height`` (m) and positions with ``y = 0``.
+
+        Parameters
+        ----------
+        dimension : int
+            3 (spheres) or 2 (disks in the x-z plane).
+        position : array_like
+            (N, 3) positions (m); ``y = 0`` in 2D.
+        radius : array_like
+            (N,) radii (m).
+        density : float or array_like
+            Density (kg/m^3), scalar or one per particle.
+        temperature : array_like
+            (N,) temperatures (the scene's unit, K or degC).
+        velocity : array_like or None
+            (N, 3) velocities (m/s); None: at rest.
+        angular_velocity : array_like or None
+            (N, 3) angular velocities (rad/s); None: at rest.
+        height : float or None
+            Height of the 2D disks (m, > 0); read in 2D only.
+        radius_ref : array_like or None
+            (N,) radii at the reference temperature (m); None: ``radius``.
+
+        Returns
+        -------
+        MotionState
+            The state, with velocities restricted to the particles' degrees of freedom.
+
+        Raises
+        ------
+        ValueError
+            A bad ``dimension``, or in 2D a missing or bad ``height`` or a position off the x-z plane.
+        """
         if dimension not in DIMENSIONS:
             raise ValueError(f"[scene] dimension = {dimension!r}: must be 2 (disks) or 3 (spheres)")
         x = np.ascontiguousarray(position, dtype=float).copy()

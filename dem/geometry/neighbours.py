@@ -146,7 +146,26 @@ def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray
                  capacity: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j + skin`` (minimum image on periodic axes), sorted by
     ``(i, j)``. ``capacity``: the number of pairs expected (a rebuild passes its last list's length with some
-    room): one pass over the cells when they fit, else a second one."""
+    room): one pass over the cells when they fit, else a second one.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        (N, 3) particle centres (m).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    skin : float
+        The list's skin (m), >= 0.
+    box : numpy.ndarray
+        (3,) the periodic box's lengths, 0 along non-periodic axes (m).
+    capacity : int
+        The number of pairs expected.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(i, j)``, int, sorted by ``(i, j)``.
+    """
     if len(radius) < 2:
         empty = np.zeros(0, dtype=np.int64)
         return empty, empty
@@ -188,7 +207,22 @@ def _rows_in(old_i, old_j, new_i, new_j):
 
 def carry_history(old_i, old_j, new_i, new_j, *columns):
     """History rows of the pairs ``(new_i, new_j)`` taken from the rows of the same pairs in ``(old_i, old_j)``
-    (both sorted by ``(i, j)``); pairs new to the list start from zeros. Returns the new columns."""
+    (both sorted by ``(i, j)``); pairs new to the list start from zeros. Returns the new columns.
+
+    Parameters
+    ----------
+    old_i, old_j : numpy.ndarray
+        The old list's pairs, sorted by ``(i, j)``.
+    new_i, new_j : numpy.ndarray
+        The new list's pairs, sorted by ``(i, j)``.
+    *columns : numpy.ndarray
+        History arrays with one row per old pair (any unit and trailing shape).
+
+    Returns
+    -------
+    list of numpy.ndarray
+        The same columns with one row per new pair.
+    """
     rows = _rows_in(old_i, old_j, new_i, new_j)
     found = rows >= 0
     out = []
@@ -202,7 +236,26 @@ def carry_history(old_i, old_j, new_i, new_j, *columns):
 def wall_pairs(x: np.ndarray, radius: np.ndarray, normal: np.ndarray, offset: np.ndarray,
                skin: float) -> tuple[np.ndarray, np.ndarray]:
     """Particle-wall pairs ``(k, m)`` with particle k closer than ``r_k + skin`` to the plane ``n_m . x = q_m`` (or
-    behind it): the Verlet list of the walls."""
+    behind it): the Verlet list of the walls.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        (N, 3) particle centres (m).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    normal : numpy.ndarray
+        (W, 3) the walls' unit normals, into the packing.
+    offset : numpy.ndarray
+        (W,) the walls' offsets ``q`` (m).
+    skin : float
+        The list's skin (m).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(k, m)``, int: the particle and the wall of each pair.
+    """
     if len(offset) == 0:
         empty = np.zeros(0, dtype=np.int64)
         return empty, empty
@@ -214,7 +267,18 @@ def wall_pairs(x: np.ndarray, radius: np.ndarray, normal: np.ndarray, offset: np
 def list_arrays(mech) -> dict:
     """The Verlet lists of ``mech`` (its pairs ``pi, pj``, particle-wall pairs ``wk, wm`` and the positions
     ``x_ref`` and wall offsets ``wq_ref`` they were built at), for a checkpoint: a resumed run rebuilds its lists at
-    the steps the uninterrupted run does."""
+    the steps the uninterrupted run does.
+
+    Parameters
+    ----------
+    mech : dem.engines.verlet.mechanics.MechanicalModel
+        The mechanical model of particles that move.
+
+    Returns
+    -------
+    dict
+        The lists' arrays, named as a checkpoint holds them.
+    """
     return {"pi": mech.pi, "pj": mech.pj, "list_x_ref": mech.x_ref, "wall_list_k": mech.wk, "wall_list_m": mech.wm,
             "wall_list_q_ref": mech.wq_ref}
 
@@ -222,7 +286,15 @@ def list_arrays(mech) -> dict:
 def restore_lists(mech, saved: dict) -> None:
     """The Verlet lists of a checkpoint (:func:`list_arrays`) back into ``mech``, with the saved pair histories and
     the positions they go with (in a periodic box the list built before may have wrapped particles the uninterrupted
-    run wraps only at its next rebuild)."""
+    run wraps only at its next rebuild).
+
+    Parameters
+    ----------
+    mech : dem.engines.verlet.mechanics.MechanicalModel
+        The mechanical model of particles that move.
+    saved : dict
+        The checkpoint's arrays (:func:`list_arrays`, with ``x`` and ``p_hist``).
+    """
     mech.state.x[:] = saved["x"]
     mech.pi, mech.pj = (np.array(saved[k], dtype=np.int64) for k in ("pi", "pj"))
     mech.p_hist = np.array(saved["p_hist"], dtype=float)

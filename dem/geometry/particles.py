@@ -22,7 +22,31 @@ PROPERTY_RANGE = (1e-10, 1e10)         # conductivity W/(m K), density kg/m^3, s
 
 def check_range(name: str, arr: np.ndarray, low: float | None, high: float, what: str = "") -> np.ndarray:
     """Raise ``ValueError`` naming the first entry outside ``[low, high]`` (``|value| <= high`` when ``low`` is
-    None) and the valid range."""
+    None) and the valid range.
+
+    Parameters
+    ----------
+    name : str
+        The array's name in the error message (``"particles.radius"``, say).
+    arr : numpy.ndarray
+        The values, any shape (any unit).
+    low : float or None
+        The smallest valid value; None: ``|value| <= high`` instead.
+    high : float
+        The largest valid value (or magnitude, where ``low`` is None).
+    what : str
+        Text after the range in the message (its unit, e.g. ``" m"``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``arr``, unchanged.
+
+    Raises
+    ------
+    ValueError
+        An entry lies outside the range.
+    """
     bad = (np.abs(arr) > high) if low is None else ((arr < low) | (arr > high))
     if np.any(bad):
         k = int(np.flatnonzero(bad)[0])
@@ -33,7 +57,25 @@ def check_range(name: str, arr: np.ndarray, low: float | None, high: float, what
 
 
 def check_vector(name: str, value) -> np.ndarray:
-    """``value`` as a finite 3-vector of at most POSITION_MAX per component, else ``ValueError`` naming it."""
+    """``value`` as a finite 3-vector of at most POSITION_MAX per component, else ``ValueError`` naming it.
+
+    Parameters
+    ----------
+    name : str
+        The vector's name in the error message (``"particles.radius"``, say).
+    value : array_like
+        The vector [x, y, z] (m).
+
+    Returns
+    -------
+    numpy.ndarray
+        (3,) floats.
+
+    Raises
+    ------
+    ValueError
+        ``value`` is not a finite 3-vector, or a component exceeds ``POSITION_MAX``.
+    """
     try:
         v = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -44,7 +86,25 @@ def check_vector(name: str, value) -> np.ndarray:
 
 
 def check_unit_vector(name: str, value) -> np.ndarray:
-    """``value`` as a unit 3-vector (a finite, non-zero 3-vector, normalised), else ``ValueError`` naming it."""
+    """``value`` as a unit 3-vector (a finite, non-zero 3-vector, normalised), else ``ValueError`` naming it.
+
+    Parameters
+    ----------
+    name : str
+        The vector's name in the error message (``"particles.radius"``, say).
+    value : array_like
+        The direction [x, y, z] (any length).
+
+    Returns
+    -------
+    numpy.ndarray
+        (3,) the unit vector.
+
+    Raises
+    ------
+    ValueError
+        ``value`` is not a finite, non-zero 3-vector.
+    """
     v = check_vector(name, value)
     if np.linalg.norm(v) == 0.0:
         raise ValueError(f"{name} = {value!r}: must be a finite non-zero 3-vector")
@@ -52,14 +112,54 @@ def check_unit_vector(name: str, value) -> np.ndarray:
 
 
 def check_temperature(name: str, value) -> float:
-    """``value`` as a finite temperature within ``TEMPERATURE_MAX``, else ``ValueError`` naming it."""
+    """``value`` as a finite temperature within ``TEMPERATURE_MAX``, else ``ValueError`` naming it.
+
+    Parameters
+    ----------
+    name : str
+        The temperature's name in the error message (``"particles.radius"``, say).
+    value : float
+        The temperature (the scene's unit, K or degC).
+
+    Returns
+    -------
+    float
+        ``value`` as a float.
+
+    Raises
+    ------
+    ValueError
+        ``value`` is not a finite number, or its magnitude exceeds ``TEMPERATURE_MAX``.
+    """
     if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
         raise ValueError(f"{name} = {value!r}: must be a finite number")
     return float(check_range(name, np.float64(value), None, TEMPERATURE_MAX))
 
 
 def finite_array(name: str, value, shape_tail=(), dtype=float) -> np.ndarray:
-    """``value`` as an array of rank ``1 + len(shape_tail)`` with the given trailing shape and finite entries."""
+    """``value`` as an array of rank ``1 + len(shape_tail)`` with the given trailing shape and finite entries.
+
+    Parameters
+    ----------
+    name : str
+        The array's name in the error message (``"particles.radius"``, say).
+    value : array_like
+        The values (any unit).
+    shape_tail : tuple of int
+        The shape after the first axis (``(3,)`` for a list of 3-vectors; ``()`` for a list of numbers).
+    dtype : type
+        The array's dtype.
+
+    Returns
+    -------
+    numpy.ndarray
+        The array.
+
+    Raises
+    ------
+    ValueError
+        ``value`` is not numeric, has another shape, or has an entry that is not finite.
+    """
     try:
         arr = np.asarray(value, dtype=dtype)
     except (TypeError, ValueError) as exc:
@@ -75,7 +175,27 @@ def finite_array(name: str, value, shape_tail=(), dtype=float) -> np.ndarray:
 
 
 def check_positive_entries(name: str, arr: np.ndarray, allow_zero: bool = False) -> np.ndarray:
-    """Raise ``ValueError`` naming the first entry that is not ``> 0`` (or ``>= 0``)."""
+    """Raise ``ValueError`` naming the first entry that is not ``> 0`` (or ``>= 0``).
+
+    Parameters
+    ----------
+    name : str
+        The array's name in the error message (``"particles.radius"``, say).
+    arr : numpy.ndarray
+        The values (any unit).
+    allow_zero : bool
+        Whether 0 is valid.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``arr``, unchanged.
+
+    Raises
+    ------
+    ValueError
+        An entry is not ``> 0`` (``>= 0`` with ``allow_zero``).
+    """
     bad = arr < 0.0 if allow_zero else arr <= 0.0
     if np.any(bad):
         k = int(np.flatnonzero(bad)[0])
@@ -86,7 +206,26 @@ def check_positive_entries(name: str, arr: np.ndarray, allow_zero: bool = False)
 @dataclass(frozen=True)
 class Material:
     """Thermal properties of one material (SI units): conductivity kappa W/(m K), density kg/m^3, c J/(kg K); the
-    electrical conductivity sigma S/m for electrical physics."""
+    electrical conductivity sigma S/m for electrical physics.
+
+    Parameters
+    ----------
+    conductivity : float or None
+        Thermal conductivity kappa (W/(m K)); None for a scene without thermal physics.
+    density : float
+        Density rho (kg/m^3).
+    specific_heat : float or None
+        Specific heat c (J/(kg K)); None for a scene without thermal physics.
+    name : str
+        The material's name (in messages and ``[[groups]] material``).
+    electrical_conductivity : float or None
+        Electrical conductivity sigma (S/m), for electrical physics; None: none.
+
+    Raises
+    ------
+    ValueError
+        A property given is not a finite number > 0 within ``PROPERTY_RANGE``, or the density is missing.
+    """
 
     conductivity: float | None
     density: float
@@ -115,6 +254,25 @@ class Particles:
     to the outputs.
 
     Build with :meth:`from_arrays`, which validates every array and names the first bad entry.
+
+    Parameters
+    ----------
+    position : numpy.ndarray
+        (N, 3) centres (m).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    temperature : numpy.ndarray
+        (N,) temperatures (the scene's unit, K or degC).
+    material : numpy.ndarray
+        (N,) int, each particle's index into ``materials``.
+    fixed : numpy.ndarray
+        (N,) bool, True for a particle held at its initial temperature.
+    heat : numpy.ndarray
+        (N,) internal heat source of each particle (W, eq. 3).
+    materials : tuple of Material
+        The materials.
+    id : numpy.ndarray or None
+        (N,) int, the particles' ids; None: 0..N-1.
     """
 
     position: np.ndarray
@@ -134,7 +292,40 @@ class Particles:
     def from_arrays(cls, position, radius, temperature, materials=(COPPER,), material=None, fixed=None,
                     heat=None, prefix: str = "particles", id=None) -> "Particles":
         """Validated particle state; ``material`` defaults to 0, ``fixed`` to False, ``heat`` to 0 W, ``id`` to
-        0..N-1."""
+        0..N-1.
+
+        Parameters
+        ----------
+        position : array_like
+            (N, 3) centres (m), N >= 1, each component within ``POSITION_MAX``.
+        radius : array_like
+            (N,) radii (m), within ``RADIUS_RANGE``.
+        temperature : array_like
+            (N,) temperatures (the scene's unit, K or degC), within ``TEMPERATURE_MAX``.
+        materials : Material or sequence of Material
+            The materials (at least one).
+        material : array_like or None
+            (N,) int, each particle's index into ``materials``; None: all 0.
+        fixed : array_like or None
+            (N,) bool, True for a particle held at its temperature; None: none held.
+        heat : array_like or None
+            (N,) internal heat source of each particle (W); None: none.
+        prefix : str
+            The table the arrays come from, in error messages (``"[particles]"``, say).
+        id : array_like or None
+            (N,) int, unique ids >= 0; None: 0..N-1.
+
+        Returns
+        -------
+        Particles
+            The validated particles.
+
+        Raises
+        ------
+        ValueError
+            An array has a bad shape, length or entry (the first is named), or a heat capacity is not finite and
+            positive.
+        """
         sep = " " if prefix.startswith("[") else "."
         if isinstance(materials, Material):
             materials = (materials,)
@@ -210,14 +401,47 @@ class Particles:
         return self.mass * self._property("specific_heat")
 
     def permuted(self, order: np.ndarray) -> "Particles":
-        """The same particles in the order ``order`` (used to test independence from ordering)."""
+        """The same particles in the order ``order`` (used to test independence from ordering).
+
+        Parameters
+        ----------
+        order : numpy.ndarray
+            (N,) int, a permutation of 0..N-1.
+
+        Returns
+        -------
+        Particles
+            The particles, ``k``-th the ``order[k]``-th of these.
+        """
         return Particles(self.position[order], self.radius[order], self.temperature[order], self.material[order],
                          self.fixed[order], self.heat[order], self.materials, self.id[order])
 
 
 def material_indices(name: str, value, materials, n: int) -> list | None:
     """The indices into ``materials`` of ``value``: a material's name or index, or a list (or array) of them for
-    ``n`` particles; None stays None (material 0). Indices are range-checked by :meth:`Particles.from_arrays`."""
+    ``n`` particles; None stays None (material 0). Indices are range-checked by :meth:`Particles.from_arrays`.
+
+    Parameters
+    ----------
+    name : str
+        The key's name in error messages (``"[particles] material"``, say).
+    value : str or int or list or numpy.ndarray or None
+        A material's name or index, or one per particle.
+    materials : sequence of Material
+        The materials the names refer to.
+    n : int
+        The number of particles a single name or index is given to.
+
+    Returns
+    -------
+    list of int or None
+        The indices, or None where ``value`` is None.
+
+    Raises
+    ------
+    ValueError
+        An unknown name, or an entry that is neither a name nor an integer.
+    """
     if value is None:
         return None
     names = [m.name for m in materials]

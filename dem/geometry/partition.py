@@ -19,7 +19,22 @@ import numpy as np
 
 def bisection(position: np.ndarray, parts: int, lengths: np.ndarray | None = None) -> np.ndarray:
     """The rank (0 ... ``parts - 1``) of every particle: recursive coordinate bisection (module docstring).
-    ``lengths``: the extent of each axis where it is known (a periodic box), else the particles' span."""
+    ``lengths``: the extent of each axis where it is known (a periodic box), else the particles' span.
+
+    Parameters
+    ----------
+    position : numpy.ndarray
+        (N, 3) particle centres (m).
+    parts : int
+        Number of ranks, >= 1.
+    lengths : numpy.ndarray or None
+        (3,) the box's lengths (m); None: the particles' span.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) int, the rank of each particle.
+    """
     if parts < 1:
         raise ValueError(f"parts = {parts}: must be >= 1")
     owner = np.zeros(len(position), dtype=np.int64)
@@ -43,7 +58,28 @@ def _split(position, members, first, parts, owner, lengths):
 
 def halo(position: np.ndarray, owner: np.ndarray, rank: int, reach: float, lengths=None, periodic=None) -> np.ndarray:
     """Indices of the particles that ``rank`` does not own within ``reach`` (per axis) of the bounding box of those it
-    owns (module docstring); ``lengths`` and ``periodic`` (3,): the box, whose periodic axes wrap."""
+    owns (module docstring); ``lengths`` and ``periodic`` (3,): the box, whose periodic axes wrap.
+
+    Parameters
+    ----------
+    position : numpy.ndarray
+        (N, 3) particle centres (m).
+    owner : numpy.ndarray
+        (N,) int, the rank of each particle (:func:`bisection`).
+    rank : int
+        The rank whose halo is wanted.
+    reach : float
+        How far beyond its particles' bounding box the halo reaches (m).
+    lengths : array_like or None
+        (3,) the box's lengths (m), read along periodic axes; None without a box.
+    periodic : array_like or None
+        (3,) bool, the box's periodic axes; None: none.
+
+    Returns
+    -------
+    numpy.ndarray
+        Indices of the halo particles.
+    """
     mine = owner == rank
     if not np.any(mine):
         return np.zeros(0, dtype=np.int64)

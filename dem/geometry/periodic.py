@@ -26,7 +26,25 @@ AXES = "xyz"
 @dataclass(frozen=True)
 class PeriodicBox:
     """``lengths`` (3,) m of the box from ``origin`` (3,); ``periodic`` (3,) bool; ``drop`` (3,) the temperature
-    drop per period along each periodic axis (K or degC), zero by default."""
+    drop per period along each periodic axis (K or degC), zero by default.
+
+    Parameters
+    ----------
+    lengths : array_like
+        (3,) the box's lengths along x, y, z (m), finite and > 0.
+    periodic : tuple of bool
+        Which of x, y, z are periodic.
+    origin : array_like or None
+        (3,) the box's lower corner (m); None: the origin.
+    drop : array_like or None
+        (3,) the temperature drop per period along each axis (K or degC), nonzero only along periodic axes;
+        None: zero.
+
+    Raises
+    ------
+    ValueError
+        A field has a bad shape or value, or a drop is given along a non-periodic axis.
+    """
 
     lengths: np.ndarray
     periodic: tuple = (True, True, True)
@@ -69,7 +87,18 @@ class PeriodicBox:
         return np.where(self.mask, self.lengths, 0.0)
 
     def wrap(self, x: np.ndarray) -> np.ndarray:
-        """Positions moved into ``[origin, origin + lengths)`` along the periodic axes."""
+        """Positions moved into ``[origin, origin + lengths)`` along the periodic axes.
+
+        Parameters
+        ----------
+        x : array_like
+            (N, 3) or (3,) positions (m).
+
+        Returns
+        -------
+        numpy.ndarray
+            The wrapped positions (m), same shape; the non-periodic components unchanged.
+        """
         x = np.asarray(x, dtype=float)
         offset = np.mod(x - self.origin, self.lengths)
         offset = np.where(offset >= self.lengths, 0.0, offset)  # mod of a tiny negative number rounds up to L
@@ -78,7 +107,18 @@ class PeriodicBox:
     def wrap_outside(self, x: np.ndarray) -> np.ndarray:
         """Moves the positions ``x`` (N, 3) that have left the box along a periodic axis back into it, in place (the
         others keep their bits, so a resumed run wraps as the uninterrupted one did); returns the displacement each
-        got (a multiple of the lengths; zero for the others)."""
+        got (a multiple of the lengths; zero for the others).
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            (N, 3) positions (m), changed in place.
+
+        Returns
+        -------
+        numpy.ndarray
+            (N, 3) the displacement each position got (m).
+        """
         outside = self.mask & ((x < self.origin) | (x >= self.origin + self.lengths))
         if not outside.any():
             return np.zeros_like(x)
@@ -88,12 +128,38 @@ class PeriodicBox:
         return moved
 
     def minimum_image(self, dx: np.ndarray) -> np.ndarray:
-        """The shortest image of each displacement ``dx`` (N, 3) along the periodic axes."""
+        """The shortest image of each displacement ``dx`` (N, 3) along the periodic axes.
+
+        Parameters
+        ----------
+        dx : array_like
+            (N, 3) displacements (m).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N, 3) the shortest images (m).
+        """
         dx = np.asarray(dx, dtype=float)
         return np.where(self.mask, dx - self.lengths * np.round(dx / self.lengths), dx)
 
     def bond_vectors(self, position: np.ndarray, i: np.ndarray, j: np.ndarray, shift: np.ndarray) -> np.ndarray:
-        """``x_j + shift L - x_i`` for bonds from ``i`` to the image ``shift`` of ``j``."""
+        """``x_j + shift L - x_i`` for bonds from ``i`` to the image ``shift`` of ``j``.
+
+        Parameters
+        ----------
+        position : numpy.ndarray
+            (N, 3) particle centres (m).
+        i, j : numpy.ndarray
+            (B,) int, the bonds' particle indices.
+        shift : numpy.ndarray
+            (B, 3) int, the image of ``j`` each bond joins (periods along x, y, z).
+
+        Returns
+        -------
+        numpy.ndarray
+            (B, 3) the bond vectors (m).
+        """
         return position[j] + shift * self.lengths - position[i]
 
     def images(self, position: np.ndarray, cutoff: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -101,6 +167,18 @@ class PeriodicBox:
 
         ``points = wrap(x_owner) + shift L``; the originals come first (shift 0). Along each periodic axis, images
         are added axis by axis (so edges and corners get theirs), ``ceil(cutoff / L)`` periods deep.
+
+        Parameters
+        ----------
+        position : numpy.ndarray
+            (N, 3) particle centres (m).
+        cutoff : float
+            How far beyond the box's periodic faces images are kept (m).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            ``points`` (M, 3) m, ``owner`` (M,) the particle each point is an image of, ``shift`` (M, 3) int.
         """
         x = self.wrap(position)
         owner = np.arange(len(x))
@@ -124,14 +202,38 @@ class PeriodicBox:
         return x, owner, shift
 
     def cross_section(self, axis: int = 2) -> float:
-        """Area of the box normal to ``axis`` (m^2)."""
+        """Area of the box normal to ``axis`` (m^2).
+
+        Parameters
+        ----------
+        axis : int
+            0, 1 or 2 (x, y, z).
+
+        Returns
+        -------
+        float
+            The product of the two other lengths (m^2).
+        """
         others = [k for k in range(3) if k != axis]
         return float(self.lengths[others[0]] * self.lengths[others[1]])
 
 
 def canonical_bonds(i: np.ndarray, j: np.ndarray, shift: np.ndarray) -> tuple:
     """Each bond once, sorted: ``(i, j, shift)`` and ``(j, i, -shift)`` are the same bond; keep ``i < j``, or
-    ``i == j`` with the first nonzero shift component positive. A bond with ``i == j`` and zero shift is dropped."""
+    ``i == j`` with the first nonzero shift component positive. A bond with ``i == j`` and zero shift is dropped.
+
+    Parameters
+    ----------
+    i, j : array_like
+        (B,) int, the bonds' particle indices.
+    shift : array_like
+        (B, 3) int, the image of ``j`` each bond joins.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(i, j, shift)`` of the distinct bonds, sorted by ``i``, ``j``, then shift.
+    """
     i, j, shift = np.asarray(i, np.int64), np.asarray(j, np.int64), np.asarray(shift, np.int64).reshape(-1, 3)
     first = np.zeros(len(i), dtype=np.int64)
     for k in (2, 1, 0):  # the first nonzero component, found last to first
@@ -153,7 +255,23 @@ def canonical_bonds(i: np.ndarray, j: np.ndarray, shift: np.ndarray) -> tuple:
 def pair_lines(position: np.ndarray, i: np.ndarray, j: np.ndarray, box: PeriodicBox | None) -> tuple:
     """Lines for drawing the pairs ``(i, j)`` of ``position`` (N, 3): ``(points, lines)``. In a periodic ``box`` a
     pair whose minimum image crosses a face joins ``i`` to the image of ``j`` beside it, appended to the points (a
-    line between the two originals would cross the box)."""
+    line between the two originals would cross the box).
+
+    Parameters
+    ----------
+    position : numpy.ndarray
+        (N, 3) particle centres (m).
+    i, j : numpy.ndarray
+        (P,) int, the pairs' particle indices.
+    box : PeriodicBox or None
+        The periodic box; None: lines between the originals.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``points`` (N + C, 3) m (the centres, then the C images appended) and ``lines`` (P, 2) int indices into
+        them.
+    """
     lines = np.column_stack([i, j]).astype(np.int64)
     if box is None:
         return position, lines

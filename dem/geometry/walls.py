@@ -45,7 +45,39 @@ def _nonnegative(name: str, value, positive: bool = False) -> float:
 class Wall:
     """One plane wall (module docstring). ``temperature`` (optional): an isothermal plane; ``motion`` and its
     parameters: ``pressure`` N/m (2D) or Pa (3D), ``mass`` kg, ``damping`` kg/s, ``velocity`` m/s, ``amplitude`` m,
-    ``frequency`` Hz."""
+    ``frequency`` Hz.
+
+    Parameters
+    ----------
+    name : str
+        The wall's name in the scene (error messages say ``walls.<name>``).
+    point : array_like
+        A point of the plane, [x, y, z] (m).
+    normal : array_like
+        Unit normal [x, y, z] pointing into the packing (dimensionless).
+    temperature : float or None
+        Temperature of an isothermal wall (the scene's unit, K or degC); None: the wall exchanges no heat.
+    motion : str
+        How the wall moves along its normal: ``"fixed"``, ``"stress"``, ``"strain"`` or ``"vibrate"`` (module
+        docstring).
+    pressure : float
+        External pressure of a stress wall, ``p >= 0``: N/m in 2D, Pa in 3D.
+    mass : float
+        Mass ``m_w > 0`` of a stress wall (kg).
+    damping : float
+        Damping ``gamma_w >= 0`` of a stress wall (kg/s).
+    velocity : float
+        Constant normal velocity of a strain wall, positive into the packing (m/s).
+    amplitude : float
+        Amplitude ``A >= 0`` of a vibrating wall (m).
+    frequency : float
+        Frequency ``f >= 0`` of a vibrating wall (Hz).
+
+    Raises
+    ------
+    ValueError
+        A parameter is malformed or out of its range; the message names it (``walls.<name>.<parameter>``).
+    """
 
     name: str
     point: np.ndarray
@@ -84,11 +116,33 @@ class Wall:
         return float(self.normal @ self.point)
 
     def distance(self, position: np.ndarray) -> np.ndarray:
-        """Signed distance of each point from the plane, ``n . x - q`` (positive on the packing's side)."""
+        """Signed distance of each point from the plane, ``n . x - q`` (positive on the packing's side).
+
+        Parameters
+        ----------
+        position : numpy.ndarray
+            Points, shape (N, 3) or (3,) (m).
+
+        Returns
+        -------
+        numpy.ndarray
+            The signed distances (m), shape (N,) or scalar.
+        """
         return position @ self.normal - self.offset
 
     def at(self, offset: float) -> "Wall":
-        """The same wall moved along its normal to the plane ``n . x = offset``."""
+        """The same wall moved along its normal to the plane ``n . x = offset``.
+
+        Parameters
+        ----------
+        offset : float
+            The new offset ``q`` of the plane (m).
+
+        Returns
+        -------
+        Wall
+            A copy through the point ``offset * normal``.
+        """
         return replace(self, point=self.normal * offset)
 
 
@@ -96,7 +150,22 @@ def check_inside(walls, position: np.ndarray, ids: np.ndarray | None = None) -> 
     """Refuse a particle whose centre starts behind a wall (``n . x < q``: outside the box the walls enclose),
     naming the particle, the wall and how far behind it lies. Such a particle would be bonded to that wall with an
     overlap beyond its radius (a static network), or be reported as leaving the box at the first step (moving
-    particles)."""
+    particles).
+
+    Parameters
+    ----------
+    walls : sequence of Wall
+        The walls.
+    position : numpy.ndarray
+        Particle centres, shape (N, 3) (m).
+    ids : numpy.ndarray or None
+        The particles' ids, shape (N,), named in the message where they differ from the index; None: indices only.
+
+    Raises
+    ------
+    ValueError
+        A centre lies behind a wall (``n . x < q``); the message names the particle, the wall and the depth (m).
+    """
     if not walls or len(position) == 0:
         return
     normal = np.array([w.normal for w in walls])
@@ -114,14 +183,36 @@ def check_inside(walls, position: np.ndarray, ids: np.ndarray | None = None) -> 
 
 
 def axis_of(normal: np.ndarray) -> int | None:
-    """The axis an axis-aligned normal points along, else None."""
+    """The axis an axis-aligned normal points along, else None.
+
+    Parameters
+    ----------
+    normal : numpy.ndarray
+        A unit normal [x, y, z] (dimensionless).
+
+    Returns
+    -------
+    int or None
+        0, 1 or 2 (x, y, z) where the normal lies along that axis (within 1e-12), else None.
+    """
     k = int(np.argmax(np.abs(normal)))
     return k if abs(abs(normal[k]) - 1.0) < 1e-12 else None
 
 
 def box_axes(walls) -> dict[int, tuple[int, int]]:
     """``{axis: (lo, hi)}``: along each axis the index of the one wall facing +axis (``lo``) and of the one facing
-    -axis (``hi``), for the axes that have exactly one of each."""
+    -axis (``hi``), for the axes that have exactly one of each.
+
+    Parameters
+    ----------
+    walls : sequence of Wall
+        The walls.
+
+    Returns
+    -------
+    dict
+        ``{axis: (lo, hi)}``, indices into ``walls``.
+    """
     out = {}
     for a in range(3):
         lo = [m for m, w in enumerate(walls) if axis_of(w.normal) == a and w.normal[a] > 0]
@@ -132,13 +223,60 @@ def box_axes(walls) -> dict[int, tuple[int, int]]:
 
 
 def extent(q: np.ndarray, lo: int, hi: int) -> float:
-    """Distance between two opposite axis-aligned walls at offsets ``q``."""
+    """Distance between two opposite axis-aligned walls at offsets ``q``.
+
+    Parameters
+    ----------
+    q : numpy.ndarray
+        The walls' offsets ``q`` of their planes ``n . x = q`` (m).
+    lo : int
+        Index of the wall facing +axis.
+    hi : int
+        Index of the wall facing -axis.
+
+    Returns
+    -------
+    float
+        ``-(q[lo] + q[hi])``, the distance between their planes (m).
+    """
     return float(-(q[lo] + q[hi]))
 
 
 @dataclass
 class WallArrays:
-    """The walls' state and parameters as arrays for the compiled loops (mutated in place)."""
+    """The walls' state and parameters as arrays for the compiled loops (mutated in place); W walls.
+
+    Parameters
+    ----------
+    normal : numpy.ndarray
+        (W, 3) unit normals pointing into the packing.
+    q : numpy.ndarray
+        (W,) offsets of the planes ``n . x = q`` (m).
+    dq : numpy.ndarray
+        (W,) normal velocities, positive into the packing (m/s).
+    acc : numpy.ndarray
+        (W,) normal accelerations of stress walls (m/s^2).
+    mode : numpy.ndarray
+        (W,) int, each wall's motion as its code in ``MOTIONS``.
+    pressure : numpy.ndarray
+        (W,) a stress wall's pressure (N/m in 2D, Pa in 3D) times the product of the box's periods (m) along its
+        periodic in-plane axes.
+    mass : numpy.ndarray
+        (W,) stress-wall masses (kg).
+    damping : numpy.ndarray
+        (W,) stress-wall damping coefficients (kg/s).
+    q0 : numpy.ndarray
+        (W,) the offsets at the start, about which vibrating walls oscillate (m).
+    amplitude : numpy.ndarray
+        (W,) vibration amplitudes (m).
+    frequency : numpy.ndarray
+        (W,) vibration frequencies (Hz).
+    span : numpy.ndarray
+        (W, 4) int: the (lo, hi) indices of the walls bounding each of the wall's (up to two) perpendicular axes,
+        -1 where none.
+    force : numpy.ndarray
+        (W,) normal force the particles exert on each wall, pushing outward positive (N).
+    """
 
     normal: np.ndarray     # (W, 3)
     q: np.ndarray          # (W,) offsets n . x = q
@@ -158,7 +296,27 @@ class WallArrays:
     def build(cls, walls, dimension: int, periods=None) -> "WallArrays":
         """The arrays of ``walls`` (``dimension`` 2 or 3); ``periods`` (3,) m: the periodic box's lengths, 0 along
         its non-periodic axes (None: no periodic box). Along a periodic in-plane axis a stress wall's extent is the
-        period, folded into its ``pressure`` (the kernels multiply that by the extent between the walls)."""
+        period, folded into its ``pressure`` (the kernels multiply that by the extent between the walls).
+
+        Parameters
+        ----------
+        walls : sequence of Wall
+            The walls.
+        dimension : int
+            2 (disks in the x-z plane) or 3.
+        periods : array_like or None
+            (3,) the periodic box's lengths (m), 0 along its non-periodic axes; None: no periodic box.
+
+        Returns
+        -------
+        WallArrays
+            The arrays, walls at rest except strain and vibrating ones.
+
+        Raises
+        ------
+        ValueError
+            A stress wall is not axis-aligned or lacks the box (walls or periods) that gives its extent.
+        """
         periods = np.zeros(3) if periods is None else np.asarray(periods, dtype=float)
         n_w = len(walls)
         normal = np.array([w.normal for w in walls], dtype=float).reshape(n_w, 3)
@@ -194,12 +352,40 @@ class WallArrays:
     @staticmethod
     def periodic_extent(wall, dimension: int, periods) -> tuple[float, int]:
         """The product of the periods along ``wall``'s periodic in-plane axes (m or m^2; 1 for none) and their
-        count."""
+        count.
+
+        Parameters
+        ----------
+        wall : Wall
+            The wall.
+        dimension : int
+            2 (disks in the x-z plane: y is not in-plane) or 3.
+        periods : array_like or None
+            (3,) the periodic box's lengths (m), 0 along its non-periodic axes; None: no periodic box.
+
+        Returns
+        -------
+        tuple of (float, int)
+            The product of the periods (m along one axis, m^2 along two; 1.0 for none) and how many there are.
+        """
         axis = axis_of(wall.normal)
         periods = np.zeros(3) if periods is None else np.asarray(periods, dtype=float)
         along = [periods[a] for a in range(3) if a != axis and not (dimension == 2 and a == 1) and periods[a] > 0]
         return float(np.prod(along)), len(along)
 
     def extent(self, lo: int, hi: int) -> float:
-        """Distance between two opposite axis-aligned walls."""
+        """Distance between two opposite axis-aligned walls.
+
+        Parameters
+        ----------
+        lo : int
+            Index of the wall facing +axis.
+        hi : int
+            Index of the wall facing -axis.
+
+        Returns
+        -------
+        float
+            The distance between their planes at their current offsets (m).
+        """
         return extent(self.q, lo, hi)

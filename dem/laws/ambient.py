@@ -48,7 +48,23 @@ def _area(name: str, fraction, radius: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class Convection:
     """``Q_i^conv = h A_i (T_inf - T_i)`` with ``A_i = area_fraction * 4 pi r_i^2``: by default the exposed part of
-    each surface (``"exposed"``, :mod:`dem.geometry.exposure`); ``area_fraction = 1`` opts in to the whole surface."""
+    each surface (``"exposed"``, :mod:`dem.geometry.exposure`); ``area_fraction = 1`` opts in to the whole surface.
+
+    Parameters
+    ----------
+    h : float
+        Heat transfer coefficient (W/(m^2 K)), in ``[0, HEAT_TRANSFER_MAX]``.
+    T_inf : float
+        Ambient temperature (the scene's unit, K or degC).
+    area_fraction : str or float or array_like
+        The fraction of each particle's surface ``4 pi r^2`` exposed, in ``[0, 1]`` (a number or one per particle),
+        or ``"exposed"`` (computed from the packing, :meth:`Sources.resolved`).
+
+    Raises
+    ------
+    ValueError
+        A field is out of its range; the message names it (``convection.<field>``).
+    """
 
     h: float
     T_inf: float
@@ -61,14 +77,48 @@ class Convection:
         check_temperature("convection.T_inf", self.T_inf)
 
     def coefficient(self, radius: np.ndarray) -> np.ndarray:
-        """``h A_i`` in W/K."""
+        """``h A_i`` in W/K.
+
+        Parameters
+        ----------
+        radius : numpy.ndarray
+            (N,) particle radii (m).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) ``h A_i`` (W/K).
+
+        Raises
+        ------
+        ValueError
+            The area fraction is still ``"exposed"`` (not resolved) or out of ``[0, 1]``.
+        """
         return self.h * _area("convection", self.area_fraction, radius)
 
 
 @dataclass(frozen=True)
 class Radiation:
     """``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)``; temperatures in ``unit`` ("K" or "C", required), T^4 in
-    kelvin."""
+    kelvin.
+
+    Parameters
+    ----------
+    emissivity : float
+        Emissivity eps of the particles' surfaces, in ``[0, 1]``.
+    T_inf : float
+        Ambient temperature (in ``unit``), between absolute zero and ``RADIATION_T_MAX``.
+    area_fraction : str or float or array_like
+        The fraction of each particle's surface ``4 pi r^2`` exposed, in ``[0, 1]`` (a number or one per particle),
+        or ``"exposed"`` (computed from the packing, :meth:`Sources.resolved`).
+    unit : str
+        The unit of the scene's temperatures, ``"K"`` or ``"C"`` (required).
+
+    Raises
+    ------
+    ValueError
+        A field is missing or out of its range; the message names it (``radiation.<field>``).
+    """
 
     emissivity: float
     T_inf: float
@@ -90,10 +140,38 @@ class Radiation:
                              f"{self.unit} (absolute zero to {RADIATION_T_MAX:g} K)")
 
     def kelvin(self, T):
+        """Temperatures in kelvin.
+
+        Parameters
+        ----------
+        T : float or array_like
+            Temperatures in :attr:`unit`.
+
+        Returns
+        -------
+        numpy.ndarray
+            The same temperatures in K.
+        """
         return np.asarray(T, dtype=float) + KELVIN_OFFSET[self.unit]
 
     def coefficient(self, radius: np.ndarray) -> np.ndarray:
-        """``eps sigma A_i`` in W/K^4."""
+        """``eps sigma A_i`` in W/K^4.
+
+        Parameters
+        ----------
+        radius : numpy.ndarray
+            (N,) particle radii (m).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) ``eps sigma A_i`` (W/K^4).
+
+        Raises
+        ------
+        ValueError
+            The area fraction is still ``"exposed"`` (not resolved) or out of ``[0, 1]``.
+        """
         return self.emissivity * STEFAN_BOLTZMANN * _area("radiation", self.area_fraction, radius)
 
 
@@ -105,14 +183,37 @@ def _check_fraction(name: str, fraction) -> None:
 
 @dataclass(frozen=True)
 class Sources:
-    """The ambient exchanges of a scene; ``None`` means the term is absent (and never evaluated)."""
+    """The ambient exchanges of a scene; ``None`` means the term is absent (and never evaluated).
+
+    Parameters
+    ----------
+    convection : Convection or None
+        Convection to an ambient; None: none.
+    radiation : Radiation or None
+        Radiation to an ambient; None: none.
+    """
 
     convection: Convection | None = None
     radiation: Radiation | None = None
 
     def resolved(self, position: np.ndarray, radius: np.ndarray, keep: np.ndarray) -> "Sources":
         """The same exchanges with every ``"exposed"`` area fraction replaced by the fractions of the particles
-        ``keep`` (indices) computed from the packing (:func:`dem.geometry.exposure.exposed_fraction`, once for both)."""
+        ``keep`` (indices) computed from the packing (:func:`dem.geometry.exposure.exposed_fraction`, once for both).
+
+        Parameters
+        ----------
+        position : numpy.ndarray
+            (N, 3) centres of the whole packing (m).
+        radius : numpy.ndarray
+            (N,) radii of the whole packing (m).
+        keep : numpy.ndarray
+            Indices of the particles the exchanges apply to (the free ones, say).
+
+        Returns
+        -------
+        Sources
+            The exchanges with numeric area fractions (itself where none was ``"exposed"``).
+        """
         if not any(s is not None and isinstance(s.area_fraction, str) for s in (self.convection, self.radiation)):
             return self
         from dem.geometry.exposure import exposed_fraction
@@ -134,6 +235,21 @@ def linear_sink_terms(sources: Sources, radius: np.ndarray, T_lin: np.ndarray | 
     Convection is linear: ``g = h A``, ``b = h A T_inf``. Radiation is linearised about ``T_lin`` (a Newton step
     of ``T^4``): ``T^4 ~ 4 T0^3 T - 3 T0^4`` in kelvin, so ``g = 4 eps sigma A T0^3 >= 0`` keeps the system
     matrix symmetric positive definite and the implicit integrators unconditionally stable.
+
+    Parameters
+    ----------
+    sources : Sources
+        The exchanges, with resolved area fractions.
+    radius : numpy.ndarray
+        (N,) particle radii (m).
+    T_lin : numpy.ndarray or None
+        (N,) the temperatures radiation is linearised about (the scene's unit); read only with radiation.
+
+    Returns
+    -------
+    dict
+        ``{name: (g, b)}``: ``g`` (N,) in W/K and ``b`` (N,) in W, for ``"convection"`` and ``"radiation"`` where
+        present.
     """
     terms = {}
     if sources.convection is not None:

@@ -55,7 +55,19 @@ NECK_MODELS = ("newton", "first", "coble", "union")
 
 
 def law_keys(law: str) -> tuple:
-    """The ``[conductance]`` keys the law ``law`` reads besides ``law`` (:class:`ConductanceSpec`)."""
+    """The ``[conductance]`` keys the law ``law`` reads besides ``law`` (:class:`ConductanceSpec`).
+
+    Parameters
+    ----------
+    law : str
+        A law of ``LAWS``.
+
+    Returns
+    -------
+    tuple of str
+        The keys, the law's own first (``slope``; ``fit_file``, ``unequal``), then ``neck`` (all but
+        ``"zohdi"``), ``contact_conductance`` and ``out_of_range``.
+    """
     own = ("slope",) if law in ("rojek", "argento-bouvard") else ("fit_file", "unequal") if law in FIT_LAWS else ()
     return own + (() if law == "zohdi" else ("neck",)) + ("contact_conductance", "out_of_range")
 LINEAR_SLOPES = {"rojek": fem_law.ROJEK.slope, "argento-bouvard": fem_law.ARGENTO_BOUVARD.slope}
@@ -64,7 +76,37 @@ LINEAR_SLOPES = {"rojek": fem_law.ROJEK.slope, "argento-bouvard": fem_law.ARGENT
 @dataclass(frozen=True)
 class ConductanceSpec:
     """Which law, and its options: ``slope`` (linear laws), ``fit_file`` (fit), ``neck`` model for the neck laws,
-    ``contact_conductance`` K_c in W/K (eq. 8; None = no interface resistance), ``out_of_range`` bond policy."""
+    ``contact_conductance`` K_c in W/K (eq. 8; None = no interface resistance), ``out_of_range`` bond policy.
+
+    Parameters
+    ----------
+    law : str
+        The law, one of ``LAWS`` (module docstring).
+    slope : float or None
+        The coefficient c of ``K_i = c kappa_i pi a`` (dimensionless, > 0), for ``"rojek"`` and
+        ``"argento-bouvard"`` only; None: the law's own (1.064, 1.112).
+    fit_file : str or None
+        Path of a fit.json written by ``python -m fem_neck fit``, for ``"fit"`` and ``"shared-body"`` only; None:
+        the fit shipped for the half body.
+    neck : str
+        The neck model giving the contact radius from the overlap, one of ``NECK_MODELS`` (``"newton"``,
+        ``"first"``, ``"coble"``: :func:`fem_neck.geometry.neck_radius`; ``"union"``: the circle where the two
+        spheres meet).
+    contact_conductance : float or None
+        Interface conductance K_c in series with each bond (W/K, finite and > 0; Rojek 2022, eq. 8); None: no
+        interface resistance.
+    out_of_range : str
+        What a bond whose overlap lies beyond the neck model's range does, one of
+        ``dem.geometry.bonds.OUT_OF_RANGE``: ``"error"``, ``"clip"`` or ``"drop"``.
+    unequal : bool
+        Whether the fit laws multiply a pair of unequal radii by :func:`fem_neck.law.unequal_factor`.
+
+    Raises
+    ------
+    ValueError
+        An option is out of its range or given to a law that does not read it; a fit file that cannot be read
+        or was fitted for the other half body.
+    """
 
     law: str = "rojek"
     slope: float | None = None
@@ -112,12 +154,51 @@ class ConductanceSpec:
 @functools.lru_cache(maxsize=8)
 def fit_law(path: str | None, neck: str = "cylinder"):
     """The full-range law of a fit.json (:class:`fem_neck.law.ConductanceLaw`), read once per path; without a path
-    the one shipped for the half body ``neck`` (``"cylinder"`` or ``"union"``)."""
+    the one shipped for the half body ``neck`` (``"cylinder"`` or ``"union"``).
+
+    Parameters
+    ----------
+    path : str or None
+        Path of a fit.json written by ``python -m fem_neck fit``; None: the shipped fit.
+    neck : str
+        The half body of the shipped fit (:data:`fem_neck.law.NECKS`), read only where ``path`` is None.
+
+    Returns
+    -------
+    fem_neck.law.ConductanceLaw
+        The law.
+
+    Raises
+    ------
+    ValueError
+        The file cannot be read or is malformed.
+    """
     return fem_law.ConductanceLaw.default(neck) if path is None else fem_law.ConductanceLaw.from_json(path)
 
 
 def half_conductance(spec: ConductanceSpec, kappa, r, a, length):
-    """One particle's half of a contact in W/K (module docstring); ``length`` is the centre-to-contact distance."""
+    """One particle's half of a contact in W/K (module docstring); ``length`` is the centre-to-contact distance.
+
+    Vectorised: the arrays broadcast against each other.
+
+    Parameters
+    ----------
+    spec : ConductanceSpec
+        The law and its options.
+    kappa : float or array_like
+        The particle's thermal conductivity (W/(m K)), or electrical conductivity (S/m) for a conductance in S.
+    r : float or array_like
+        The particle's radius (m).
+    a : float or array_like
+        The contact (neck) radius (m).
+    length : float or array_like
+        Distance from the particle's centre to the contact plane (m), read by ``"zohdi"`` only.
+
+    Returns
+    -------
+    numpy.ndarray
+        The half conductance ``K_i`` (W/K; S with an electrical conductivity).
+    """
     kappa, r, a, length = (np.asarray(x, dtype=float) for x in (kappa, r, a, length))
     if spec.law in LINEAR_SLOPES:
         return (spec.slope or LINEAR_SLOPES[spec.law]) * kappa * np.pi * a          # eqs. (43), (42)
@@ -128,7 +209,18 @@ def half_conductance(spec: ConductanceSpec, kappa, r, a, length):
 
 
 def series(*halves):
-    """Conductances in series, ``1 / sum(1/K)`` (Rojek 2022, eqs. 5-9); an infinite half adds no resistance."""
+    """Conductances in series, ``1 / sum(1/K)`` (Rojek 2022, eqs. 5-9); an infinite half adds no resistance.
+
+    Parameters
+    ----------
+    *halves : float or array_like or None
+        The conductances (W/K), broadcast against each other; a None is left out (no such part).
+
+    Returns
+    -------
+    numpy.ndarray
+        The series conductance (W/K).
+    """
     with np.errstate(divide="ignore"):
         resistance = sum(1.0 / np.asarray(k, dtype=float) for k in halves if k is not None)
     return 1.0 / resistance
@@ -144,6 +236,36 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     particle i, ``R_i / (R_i + R_j)`` (where that part of the bond's Joule heat is made). ``box``: the periodic box
     the bonds' image shifts refer to (:mod:`dem.geometry.periodic`); ``walls``: the walls of the wall bonds, whose normals
     the ``shared-body`` law needs.
+
+    Parameters
+    ----------
+    spec : ConductanceSpec
+        The law and its options.
+    particles : dem.geometry.particles.Particles
+        The particles: radii (m), positions (m), materials' conductivities (W/(m K)).
+    bonds : dem.geometry.bonds.Bonds
+        The pair and wall bonds, with their contact radii (m) and centre-to-contact distances (m).
+    conductivity : array_like or None
+        (N,) a conductivity per particle in place of the materials' kappa (W/(m K), or S/m for electrical
+        conductances in S); None: the materials'.
+    shares : bool
+        Whether to return each pair bond's share of its resistance on the side of particle i as well.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box the bonds' image shifts refer to; None without one.
+    walls : sequence of dem.geometry.walls.Wall
+        The walls of the wall bonds (indexed by ``bonds.wall_index``), needed by ``"shared-body"``.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(K_pairs, K_walls)`` (W/K, or S), and with ``shares`` the share ``R_i / (R_i + R_j)`` per pair bond
+        (dimensionless).
+
+    Raises
+    ------
+    ValueError
+        ``"shared-body"`` has wall bonds but no walls, or a conductance is not finite and >= 0 (the law and the
+        bond are named).
     """
     kappa = particles.conductivity if conductivity is None else np.asarray(conductivity, dtype=float)
     r = particles.radius

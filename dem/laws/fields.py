@@ -11,7 +11,26 @@ import numpy as np
 
 def check_fields(material, section: str, positive: dict, nonnegative: dict, flags=()) -> None:
     """Raise for the first field of the dataclass ``material`` that is not a finite number (or a bool, for the names
-    in ``flags``), or breaks its sign: ``positive``/``nonnegative`` map field names to their units."""
+    in ``flags``), or breaks its sign: ``positive``/``nonnegative`` map field names to their units.
+
+    Parameters
+    ----------
+    material : object
+        A contact-law material (a dataclass instance).
+    section : str
+        The table its fields are named under in the message (``"contact"``).
+    positive : dict
+        ``{field name: unit}`` of the fields that must be > 0 (the unit, or ``""``, follows the rule in the message).
+    nonnegative : dict
+        ``{field name: unit}`` of the fields that must be >= 0.
+    flags : sequence of str
+        The fields that must be booleans.
+
+    Raises
+    ------
+    ValueError
+        The first field that breaks its rule, named as ``<section>.<field>``.
+    """
     for f in fields(material):
         value = getattr(material, f.name)
         if f.name in flags:
@@ -29,7 +48,27 @@ def check_fields(material, section: str, positive: dict, nonnegative: dict, flag
 
 def material_from_table(cls, law: str, values: dict):
     """The material ``cls`` of the contact law ``law`` from a scene's ``[contact]`` values (without ``law``): every
-    field without a default required, no other; a bad value is reported as ``[contact] name = value: rule``."""
+    field without a default required, no other; a bad value is reported as ``[contact] name = value: rule``.
+
+    Parameters
+    ----------
+    cls : type
+        The law's material dataclass.
+    law : str
+        The law's name, in messages.
+    values : dict
+        The ``[contact]`` table without ``law`` (SI units).
+
+    Returns
+    -------
+    object
+        The material.
+
+    Raises
+    ------
+    ValueError
+        An unknown or missing key, or a bad value.
+    """
     names = [f.name for f in fields(cls)]
     extra = sorted(set(values) - set(names))
     if extra:

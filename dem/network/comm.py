@@ -50,7 +50,25 @@ def world():
 
 def agree(comm, action):
     """Run ``action()`` on every rank; if it raises a ValueError on any rank, raise it on all of them (with the first
-    failing rank's message), so that no rank waits in a collective call for one that stopped."""
+    failing rank's message), so that no rank waits in a collective call for one that stopped.
+
+    Parameters
+    ----------
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
+    action : callable
+        Called without arguments on every rank.
+
+    Returns
+    -------
+    object
+        This rank's result of ``action()``.
+
+    Raises
+    ------
+    ValueError
+        ``action`` raised one on some rank.
+    """
     message = None
     try:
         result = action()
@@ -65,7 +83,25 @@ def agree(comm, action):
 
 def on_root(comm, action):
     """``action()`` on rank 0 only, its result (or its ``ValueError``) on every rank of ``comm`` (None: no MPI, the
-    action runs here)."""
+    action runs here).
+
+    Parameters
+    ----------
+    comm : object or None
+        The MPI communicator (an ``mpi4py.MPI.Comm``); None: no MPI.
+    action : callable
+        Called without arguments on rank 0.
+
+    Returns
+    -------
+    object
+        Rank 0's result, on every rank.
+
+    Raises
+    ------
+    ValueError
+        ``action`` raised one on rank 0.
+    """
     if comm is None:
         return action()
     error = result = None
@@ -81,7 +117,20 @@ def on_root(comm, action):
 
 
 def total(comm, value):
-    """Sum over ranks of a number or an array."""
+    """Sum over ranks of a number or an array.
+
+    Parameters
+    ----------
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
+    value : float or array_like
+        This rank's part (any unit).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The sum, on every rank.
+    """
     from mpi4py import MPI
 
     if np.isscalar(value):
@@ -92,12 +141,40 @@ def total(comm, value):
 
 
 def maximum(comm, value: float) -> float:
+    """Largest value over ranks.
+
+    Parameters
+    ----------
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
+    value : float
+        This rank's value.
+
+    Returns
+    -------
+    float
+        The maximum, on every rank.
+    """
     from mpi4py import MPI
 
     return comm.allreduce(value, op=MPI.MAX)
 
 
 def minimum(comm, value: float) -> float:
+    """Smallest value over ranks.
+
+    Parameters
+    ----------
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
+    value : float
+        This rank's value.
+
+    Returns
+    -------
+    float
+        The minimum, on every rank.
+    """
     from mpi4py import MPI
 
     return comm.allreduce(value, op=MPI.MIN)
@@ -109,6 +186,15 @@ class HaloExchange:
     ``held`` the global indices of the particles this rank holds (sorted), ``owner`` the rank owning each of them.
     Built once (which entries each rank sends where); :meth:`fill` then copies the owners' values into the halo
     entries of an array over the held particles.
+
+    Parameters
+    ----------
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
+    held : numpy.ndarray
+        Global indices of the particles this rank holds, sorted.
+    owner : numpy.ndarray
+        The rank owning each held particle.
     """
 
     def __init__(self, comm, held: np.ndarray, owner: np.ndarray):
@@ -126,7 +212,18 @@ class HaloExchange:
         self.send_from = np.searchsorted(held, wanted)
 
     def fill(self, values: np.ndarray) -> np.ndarray:
-        """``values`` (over the held particles, owned entries valid) with the halo entries set from their owners."""
+        """``values`` (over the held particles, owned entries valid) with the halo entries set from their owners.
+
+        Parameters
+        ----------
+        values : numpy.ndarray
+            One value per held particle (any unit), changed in place.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``values``.
+        """
         sent = np.ascontiguousarray(values[self.send_from], dtype=float)
         received = np.empty(len(self.receive_at), dtype=float)
         self.comm.Alltoallv([sent, (self.send_counts, None)], [received, (self.receive_counts, None)])

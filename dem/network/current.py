@@ -50,7 +50,19 @@ SCHEMES = ("kirchhoff", "zohdi")
 @dataclass(frozen=True)
 class Electrodes:
     """The electrified walls: ``names``, and per electrode either a ``potential`` (V) or a ``current`` (A, into the
-    packing; Zohdi's scheme: the wall's ``J_ext``), the other NaN. ``walls``: their indices in the scene's walls."""
+    packing; Zohdi's scheme: the wall's ``J_ext``), the other NaN. ``walls``: their indices in the scene's walls.
+
+    Parameters
+    ----------
+    names : tuple of str
+        The electrified walls' names.
+    walls : tuple of int
+        Their indices in the scene's walls.
+    potential : numpy.ndarray
+        (E,) each electrode's potential (V), NaN for one that drives a current.
+    current : numpy.ndarray
+        (E,) each electrode's current into the packing (A; Zohdi's scheme: ``J_ext``), NaN for one at a potential.
+    """
 
     names: tuple
     walls: tuple
@@ -78,6 +90,33 @@ class CurrentFlow:
     particle relative to the largest contact current (or, when almost none flows, to 1e-12 of the largest electrode
     conductance times the largest electrode potential). ``solver``: the linear solver of the particles' matrix, for
     the next refresh to reuse (``kirchhoff(previous=...)``; None when no particle has a path).
+
+    Parameters
+    ----------
+    potential : numpy.ndarray
+        (N,) particle potentials (V), NaN on floating particles.
+    pair_current : numpy.ndarray
+        (M,) current of each pair contact from i to j (A).
+    wall_current : numpy.ndarray
+        (B,) current from each electrode into the particle of its contact (A).
+    electrode_potential : numpy.ndarray
+        (E,) electrode potentials (V); NaN for an electrode with no path.
+    electrode_current : numpy.ndarray
+        (E,) current of each electrode into the packing (A).
+    joule_particles : numpy.ndarray
+        (N,) Joule heat made in each particle (W).
+    joule_heat : float
+        Joule heat of all contacts (W).
+    electrode_power : float
+        Power the electrodes deliver, ``sum V_e I_e`` (W).
+    floating : numpy.ndarray
+        Indices of the particles in groups that touch no electrode with a path.
+    no_path : tuple of str
+        Names of the fixed-current electrodes that reach no electrode at a fixed potential.
+    residual : float
+        The largest current imbalance at a particle, relative (dimensionless).
+    solver : object
+        The particles' linear solver, for the next refresh; None when no particle has a path.
     """
 
     potential: np.ndarray
@@ -124,7 +163,41 @@ def kirchhoff(n: int, i, j, G, share, plane_node, plane_index, G_plane, electrod
     the fraction of each contact's resistance on the side of i) and to the electrodes by ``(plane_node,
     plane_index)`` of conductance ``G_plane`` (module docstring). At least one electrode must be at a fixed
     potential (the reference). ``previous``: the ``solver`` of an earlier solution of (about) the same network, whose
-    AMG hierarchy then serves again (:func:`dem.network.linsolve.make_solver`)."""
+    AMG hierarchy then serves again (:func:`dem.network.linsolve.make_solver`).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    i, j : array_like
+        (M,) int, the particles of each pair contact.
+    G : array_like
+        (M,) the pair contacts' conductances (S).
+    share : array_like
+        (M,) the fraction of each pair contact's resistance on the side of i.
+    plane_node : array_like
+        (B,) int, the particle of each electrode contact.
+    plane_index : array_like
+        (B,) int, the electrode (its position in :class:`Electrodes`) of each electrode contact.
+    G_plane : array_like
+        (B,) the electrode contacts' conductances (S).
+    electrodes : Electrodes
+        The electrodes.
+    linear : str
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
+    previous : object or None
+        The ``solver`` of an earlier :class:`CurrentFlow` to reuse; None: a new one.
+
+    Returns
+    -------
+    CurrentFlow
+        The potentials, currents and Joule heat.
+
+    Raises
+    ------
+    ValueError
+        No electrode is at a fixed potential.
+    """
     i, j = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64)
     plane_node, plane_index = np.asarray(plane_node, dtype=np.int64), np.asarray(plane_index, dtype=np.int64)
     G, G_plane, share = (np.asarray(x, dtype=float) for x in (G, G_plane, share))
@@ -185,7 +258,23 @@ class ElectrodeBonds:
     """The current's network on the bonds of a packing: per pair bond its conductance ``G`` (S) and ``share`` (the
     fraction of its resistance on the side of i); the wall bonds to an electrode, ``(plane_node, plane_index)`` (the
     particle, the electrode's position in :class:`Electrodes`) of conductance ``G_plane`` (S), and ``on_electrode``
-    (which of the bonds' wall bonds they are: a wall that is no electrode carries no current)."""
+    (which of the bonds' wall bonds they are: a wall that is no electrode carries no current).
+
+    Parameters
+    ----------
+    G : numpy.ndarray
+        (M,) pair bond conductances (S).
+    share : numpy.ndarray
+        (M,) the fraction of each pair bond's resistance on the side of i.
+    plane_node : array_like
+        (B,) int, the particle of each electrode contact.
+    plane_index : array_like
+        (B,) int, the electrode (its position in :class:`Electrodes`) of each electrode contact.
+    G_plane : array_like
+        (B,) the electrode contacts' conductances (S).
+    on_electrode : numpy.ndarray
+        Bool per wall bond of the packing: True for those to an electrode.
+    """
 
     G: np.ndarray
     share: np.ndarray
@@ -198,7 +287,28 @@ class ElectrodeBonds:
 def electrode_bonds(particles, bonds, walls, spec, electrodes: Electrodes, box=None) -> ElectrodeBonds:
     """The electrical conductances of ``bonds`` (:func:`dem.laws.conductance.bond_conductances` with the particles'
     electrical conductivity for kappa, without the interface conductance) and their wall bonds to the electrodes
-    among ``walls``."""
+    among ``walls``.
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The particles, with their materials' electrical conductivity (S/m).
+    bonds : dem.geometry.bonds.Bonds
+        The pair and wall bonds.
+    walls : sequence of dem.geometry.walls.Wall
+        The scene's walls (the bonds' wall indices refer to them).
+    spec : dem.laws.conductance.ConductanceSpec
+        The conductance law (its interface conductance is left out).
+    electrodes : Electrodes
+        The electrodes.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box of the bonds; None without one.
+
+    Returns
+    -------
+    ElectrodeBonds
+        The network of the current.
+    """
     G, G_walls, share = bond_conductances(replace(spec, contact_conductance=None), particles, bonds,
                                           particles.electrical_conductivity, shares=True, box=box, walls=tuple(walls))
     electrode_of_wall = np.full(len(walls), -1, dtype=np.int64)
@@ -213,7 +323,26 @@ def circuit(electrodes: Electrodes, electrode_potential, electrode_current, joul
     """What the summary says of a current: each electrode's potential (V) and current into the packing (A), the
     ``total_current`` that enters (A, the sum of the positive ones), the Joule heat of all contacts and the power the
     electrodes deliver (W; equal, Tellegen's theorem), and between two electrodes the ``resistance`` (Ohm) of the
-    packing, their potential difference over the current."""
+    packing, their potential difference over the current.
+
+    Parameters
+    ----------
+    electrodes : Electrodes
+        The electrodes.
+    electrode_potential : array_like
+        (E,) electrode potentials (V).
+    electrode_current : array_like
+        (E,) electrode currents into the packing (A).
+    joule_heat : float
+        Joule heat of all contacts (W).
+    electrode_power : float
+        Power the electrodes deliver (W).
+
+    Returns
+    -------
+    dict
+        The summary's ``circuit`` entry.
+    """
     current = np.asarray(electrode_current, dtype=float)
     total = float(current[current > 0].sum())
     out = {"electrodes": {name: {"potential": float(v), "current": float(i)} for name, v, i in
@@ -226,7 +355,24 @@ def circuit(electrodes: Electrodes, electrode_potential, electrode_current, joul
 
 def require_paths(flow: CurrentFlow, electrodes: Electrodes, plane_index, when: str = "") -> None:
     """A ``ValueError`` if an electrode driving a non-zero current has no path to one at a fixed potential
-    (``plane_index``: the electrode of each wall bond; ``when``: e.g. the time, for the message)."""
+    (``plane_index``: the electrode of each wall bond; ``when``: e.g. the time, for the message).
+
+    Parameters
+    ----------
+    flow : CurrentFlow
+        The solution.
+    electrodes : Electrodes
+        The electrodes.
+    plane_index : array_like
+        (B,) int, the electrode of each electrode contact.
+    when : str
+        Text placed after the current in the message (``" at t = 1 s"``, say).
+
+    Raises
+    ------
+    ValueError
+        An electrode driving a non-zero current has no path to one at a fixed potential.
+    """
     driven = [name for name in flow.no_path if electrodes.current[electrodes.names.index(name)] != 0.0]
     if driven:
         k = electrodes.names.index(driven[0])
@@ -239,7 +385,20 @@ def require_paths(flow: CurrentFlow, electrodes: Electrodes, plane_index, when: 
 
 def refuse_floating(floating: np.ndarray, when: str = "") -> None:
     """The ``ValueError`` of ``[electrical] floating = "error"`` if any particle is ``floating`` (indices; ``when``:
-    e.g. ``"at t = 1 s "``)."""
+    e.g. ``"at t = 1 s "``).
+
+    Parameters
+    ----------
+    floating : numpy.ndarray
+        Indices of the floating particles.
+    when : str
+        Text placed before the count in the message (``"at t = 1 s "``, say).
+
+    Raises
+    ------
+    ValueError
+        ``floating`` is not empty (the message lists up to ten of them).
+    """
     if len(floating):
         shown = ", ".join(str(int(k)) for k in floating[:10]) + (", ..." if len(floating) > 10 else "")
         raise ValueError(f"[electrical] floating = \"error\": {when}{len(floating)} particle(s) touch no electrode "
@@ -252,7 +411,36 @@ def contact_currents(n: int, i, j, G, share, plane_node, plane_index, G_plane, x
     to j, ``wall_current`` A from each electrode into its particle (0 where ``live`` is False), the Joule heat
     ``I^2/G`` of each pair and wall contact, and the Joule heat made in each particle``)``: a pair contact's shared
     by its particles in proportion to the resistances of their halves (``share``: i's), a wall contact's in its
-    particle (module docstring)."""
+    particle (module docstring).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    i, j : array_like
+        (M,) int, the particles of each pair contact.
+    G : array_like
+        (M,) the pair contacts' conductances (S).
+    share : array_like
+        (M,) the fraction of each pair contact's resistance on the side of i.
+    plane_node : array_like
+        (B,) int, the particle of each electrode contact.
+    plane_index : array_like
+        (B,) int, the electrode (its position in :class:`Electrodes`) of each electrode contact.
+    G_plane : array_like
+        (B,) the electrode contacts' conductances (S).
+    x : numpy.ndarray
+        (N,) particle potentials (V).
+    V : numpy.ndarray
+        (E,) electrode potentials (V).
+    live : numpy.ndarray
+        (B,) bool, whether each electrode contact carries current.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(pair_current, wall_current, heat_pairs, heat_walls, joule_particles)``: A, A, W, W, W.
+    """
     pair_current = G * (x[i] - x[j])
     wall_current = np.where(live, G_plane * (V[plane_index] - x[plane_node]), 0.0)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -265,7 +453,24 @@ def contact_currents(n: int, i, j, G, share, plane_node, plane_index, G_plane, x
 
 def wall_values(n: int, plane_node, plane_index, values) -> tuple[np.ndarray, np.ndarray]:
     """``(touching, value)``: which particles touch an electrified wall and the wall's value each takes (the mean
-    of the walls' values when it touches several; Zohdi 2014, Remark 2)."""
+    of the walls' values when it touches several; Zohdi 2014, Remark 2).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    plane_node : array_like
+        (B,) int, the particle of each electrode contact.
+    plane_index : array_like
+        (B,) int, the electrode (its position in :class:`Electrodes`) of each electrode contact.
+    values : array_like
+        (E,) each electrode's value.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``touching`` (N,) bool and ``value`` (N,), 0 where not touching.
+    """
     plane_node = np.asarray(plane_node, dtype=np.int64)
     count = np.bincount(plane_node, minlength=n)
     total = np.bincount(plane_node, np.asarray(values, dtype=float)[plane_index], n)
@@ -277,7 +482,21 @@ def wall_values(n: int, plane_node, plane_index, values) -> tuple[np.ndarray, np
 class AreaWeightedCurrent:
     """Zohdi's scheme: ``J`` (N,) per particle, the Gauss-Seidel ``sweeps`` taken, the last sweep's largest
     ``change`` (relative to the largest wall value), whether it reached the tolerance, and the ``floating``
-    particles."""
+    particles.
+
+    Parameters
+    ----------
+    J : numpy.ndarray
+        (N,) Zohdi's current per particle (the unit of ``J_ext``).
+    sweeps : int
+        Gauss-Seidel sweeps taken.
+    change : float
+        The last sweep's largest change, relative to the largest ``|J_ext|``.
+    converged : bool
+        Whether that change met the tolerance.
+    floating : numpy.ndarray
+        Indices of the particles in groups that touch no electrified wall (they carry no current).
+    """
 
     J: np.ndarray
     sweeps: int
@@ -291,7 +510,34 @@ def area_weighted_current(n: int, i, j, area, plane_node, plane_index, J_ext, J0
     """The current of Zohdi 2014, eqs. (42)-(43) with Remark 2 (module docstring): particles touching an electrified
     wall take its value ``J_ext`` (per electrode), the others the area-weighted mean of their neighbours, by
     Gauss-Seidel sweeps from ``J0`` (the previous solution: a warm start; zeros when None) until no value changes by
-    more than ``tol`` times the largest ``|J_ext|``. Groups that touch no electrified wall carry no current."""
+    more than ``tol`` times the largest ``|J_ext|``. Groups that touch no electrified wall carry no current.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    i, j : array_like
+        (M,) int, the particles of each pair contact.
+    area : array_like
+        (M,) contact areas ``A_ij`` of the pair contacts (m^2), the weights of eq. (43).
+    plane_node : array_like
+        (B,) int, the particle of each electrode contact.
+    plane_index : array_like
+        (B,) int, the electrode (its position in :class:`Electrodes`) of each electrode contact.
+    J_ext : array_like
+        (E,) each electrode's value ``J_ext``.
+    J0 : array_like or None
+        (N,) the previous solution, a warm start; None: zeros.
+    tol : float
+        The largest change per sweep at which the sweeps stop, relative to the largest ``|J_ext|``.
+    max_sweeps : int
+        The most sweeps.
+
+    Returns
+    -------
+    AreaWeightedCurrent
+        The solution.
+    """
     from dem.network.gauss_seidel import gauss_seidel  # compiled: loaded by the schemes that sweep
 
     i, j = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64)
@@ -317,17 +563,68 @@ def area_weighted_current(n: int, i, j, area, plane_node, plane_index, J_ext, J0
 
 
 def zohdi_joule(J, volume, sigma, absorption: float) -> np.ndarray:
-    """``H_i = a J_i^2 V_i / sigma_i`` (Zohdi 2014, eq. 35), W."""
+    """``H_i = a J_i^2 V_i / sigma_i`` (Zohdi 2014, eq. 35), W.
+
+    Parameters
+    ----------
+    J : array_like
+        (N,) Zohdi's current per particle.
+    volume : array_like
+        (N,) particle volumes (m^3).
+    sigma : array_like
+        (N,) electrical conductivities (S/m).
+    absorption : float
+        The absorbed fraction a, in ``[0, 1]``.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) the Joule heat of each particle (W, with J in A/m^2).
+    """
     return absorption * np.asarray(J) ** 2 * np.asarray(volume) / np.asarray(sigma)
 
 
 def check_scheme(scheme: str) -> str:
+    """``scheme`` if it is one of ``SCHEMES``.
+
+    Parameters
+    ----------
+    scheme : str
+        ``"kirchhoff"`` or ``"zohdi"``.
+
+    Returns
+    -------
+    str
+        ``scheme``.
+
+    Raises
+    ------
+    ValueError
+        ``scheme`` is not one of ``SCHEMES``.
+    """
     if scheme not in SCHEMES:
         raise ValueError(f"[electrical] scheme = {scheme!r}: must be one of {', '.join(SCHEMES)}")
     return scheme
 
 
 def check_absorption(a) -> float:
+    """``a`` as a float if it is a number in ``[0, 1]``.
+
+    Parameters
+    ----------
+    a : float
+        The absorbed fraction of eq. (35).
+
+    Returns
+    -------
+    float
+        ``a``.
+
+    Raises
+    ------
+    ValueError
+        ``a`` is not a finite number in ``[0, 1]``.
+    """
     if not isinstance(a, (int, float)) or isinstance(a, bool) or not math.isfinite(a) or not 0.0 <= a <= 1.0:
         raise ValueError(f"[electrical] absorption = {a!r}: must be in [0, 1] (Zohdi 2014, eq. 35)")
     return float(a)

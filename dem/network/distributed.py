@@ -33,7 +33,19 @@ from dem.network.petsc import PetscSolver, matrix
 class Groups:
     """The groups of free particles over all ranks: ``label`` per local free particle (the smallest particle index
     of its group), and the labels of the groups that are ``anchored``, ``jumping`` (a periodic temperature jump)
-    and ``floating`` (neither), each sorted."""
+    and ``floating`` (neither), each sorted.
+
+    Parameters
+    ----------
+    label : numpy.ndarray
+        Per local free particle, its group's label (the smallest global particle index in it).
+    anchored : numpy.ndarray
+        Labels of the groups joined to a fixed temperature, a wall or an ambient.
+    jumping : numpy.ndarray
+        Labels of the groups with a periodic temperature jump that are not anchored.
+    floating : numpy.ndarray
+        Labels of the other groups.
+    """
 
     label: np.ndarray
     anchored: np.ndarray
@@ -41,14 +53,37 @@ class Groups:
     floating: np.ndarray
 
     def member(self, labels: np.ndarray) -> np.ndarray:
-        """Mask over the local free particles: in one of the groups ``labels``."""
+        """Mask over the local free particles: in one of the groups ``labels``.
+
+        Parameters
+        ----------
+        labels : numpy.ndarray
+            Group labels.
+
+        Returns
+        -------
+        numpy.ndarray
+            Bool per local free particle.
+        """
         return np.isin(self.label, labels)
 
 
 class DistributedNetwork:
     """This rank's part of the network (module docstring). ``net``: the
     :class:`~dem.network.heat.Network` of the held particles,
-    ``held`` their global indices (sorted), ``owner`` the rank owning each of them."""
+    ``held`` their global indices (sorted), ``owner`` the rank owning each of them.
+
+    Parameters
+    ----------
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
+    net : dem.network.heat.Network
+        The network of the particles this rank holds.
+    held : numpy.ndarray
+        Global indices of the held particles, sorted.
+    owner : numpy.ndarray
+        The rank owning each held particle.
+    """
 
     def __init__(self, comm, net: Network, held: np.ndarray, owner: np.ndarray):
         self.comm, self.net, self.held = comm, net, held
@@ -60,27 +95,88 @@ class DistributedNetwork:
 
     # ------------------------------------------------------------------------------------------- reductions
     def total(self, value):
+        """Sum over ranks (:func:`dem.network.comm.total`).
+
+        Parameters
+        ----------
+        value : float or array_like
+            This rank's part.
+
+        Returns
+        -------
+        float or numpy.ndarray
+            The sum.
+        """
         return mpi.total(self.comm, value)
 
     def halo_filled(self, T_F: np.ndarray) -> np.ndarray:
-        """All held temperatures (fixed ones too) from the owned entries of ``T_F`` (over the local free ones)."""
+        """All held temperatures (fixed ones too) from the owned entries of ``T_F`` (over the local free ones).
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the local free particles (owned entries valid; K or degC).
+
+        Returns
+        -------
+        numpy.ndarray
+            Temperatures of all held particles, the halo's from their owners.
+        """
         return self.exchange.fill(self.net.full(T_F))
 
     def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
         """Heat flow (W) into all free particles through each boundary
-        (:meth:`~dem.network.heat.Network.flows` over the ranks)."""
+        (:meth:`~dem.network.heat.Network.flows` over the ranks).
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the local free particles (owned entries valid; K or degC).
+        sinks : dict
+            The ambient terms ``{name: (g, b)}`` (:meth:`dem.network.heat.Network.sinks`): W/K and W per particle.
+
+        Returns
+        -------
+        dict
+            ``{boundary: W}``, summed over the ranks.
+        """
         part = self.net.flows(T_F, sinks, self.own_free)
         sums = self.total(np.array(list(part.values())))
         return dict(zip(part, map(float, sums)))
 
     def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
+        """The scale of the heat flows over the ranks: the net flow, at least sqrt(eps) times the gross one (W).
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the local free particles (owned entries valid; K or degC).
+        sinks : dict
+            The ambient terms ``{name: (g, b)}`` (:meth:`dem.network.heat.Network.sinks`): W/K and W per particle.
+
+        Returns
+        -------
+        float
+            The scale (W).
+        """
         net, gross = self.total(np.array(self.net.flow_sums(T_F, sinks, self.own_free)))
         return float(max(net, np.sqrt(np.finfo(float).eps) * gross))
 
     # ------------------------------------------------------------------------------------------ numbering
     def numbering(self, unknown: np.ndarray) -> tuple[np.ndarray, int]:
         """Global row of every local free particle in ``unknown`` (a mask over them; -1 elsewhere), rank after rank,
-        and the global count. The halo's rows come from their owners."""
+        and the global count. The halo's rows come from their owners.
+
+        Parameters
+        ----------
+        unknown : numpy.ndarray
+            Bool per local free particle: an unknown of the system.
+
+        Returns
+        -------
+        tuple of (numpy.ndarray, int)
+            The global rows and the global count.
+        """
         mine = unknown & self.own_free
         count = int(mine.sum())
         offset = self.comm.exscan(count) or 0  # None on rank 0
@@ -94,7 +190,20 @@ class DistributedNetwork:
 
     def rows(self, M: sp.csr_matrix, row: np.ndarray) -> sp.csr_matrix:
         """The owned rows of ``M`` (over the local free particles) among the unknowns numbered ``row``, with their
-        columns numbered globally (sorted)."""
+        columns numbered globally (sorted).
+
+        Parameters
+        ----------
+        M : scipy.sparse.csr_matrix
+            The system matrix over the local free particles (W/K).
+        row : numpy.ndarray
+            The global row of each local free particle, -1 where it is no unknown (:meth:`numbering`).
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix
+            This rank's rows, columns numbered globally.
+        """
         take = np.flatnonzero(self.own_free & (row >= 0))
         cols = np.flatnonzero(row >= 0)
         local = M[take][:, cols].tocsr()
@@ -104,13 +213,41 @@ class DistributedNetwork:
         return out
 
     def solver(self, M: sp.csr_matrix, row: np.ndarray, n_global: int, rtol: float) -> PetscSolver:
-        """CG + AMG on the unknowns numbered ``row`` of the system ``M`` (over the local free particles)."""
+        """CG + AMG on the unknowns numbered ``row`` of the system ``M`` (over the local free particles).
+
+        Parameters
+        ----------
+        M : scipy.sparse.csr_matrix
+            The system matrix over the local free particles (W/K).
+        row : numpy.ndarray
+            The global row of each local free particle, -1 where it is no unknown (:meth:`numbering`).
+        n_global : int
+            The global count of unknowns.
+        rtol : float
+            The relative residual at which CG stops.
+
+        Returns
+        -------
+        dem.network.petsc.PetscSolver
+            The solver.
+        """
         return PetscSolver(matrix(self.comm, self.rows(M, row), n_global), rtol)
 
     # --------------------------------------------------------------------------------------------- groups
     def groups(self, anchor: np.ndarray) -> Groups:
         """The groups over all ranks (module docstring); ``anchor`` (per local free particle) > 0 where a particle
-        is joined to a fixed one, a wall or an ambient."""
+        is joined to a fixed one, a wall or an ambient.
+
+        Parameters
+        ----------
+        anchor : numpy.ndarray
+            Per local free particle, its conductance to fixed particles, walls and ambients (W/K).
+
+        Returns
+        -------
+        Groups
+            The groups.
+        """
         net, n_free = self.net, len(self.net.free)
         g = net.graph
         where = np.full(net.particles.n, -1, dtype=np.int64)
@@ -151,7 +288,22 @@ class DistributedNetwork:
 
     def group_sums(self, labels: np.ndarray, group: np.ndarray, values: np.ndarray) -> np.ndarray:
         """Per group of ``labels`` (sorted): the sum of ``values`` over its owned members (``group`` per local free
-        particle, the groups' labels)."""
+        particle, the groups' labels).
+
+        Parameters
+        ----------
+        labels : numpy.ndarray
+            The groups' labels, sorted.
+        group : numpy.ndarray
+            The group label of each local free particle.
+        values : numpy.ndarray
+            One value per local free particle (any unit).
+
+        Returns
+        -------
+        numpy.ndarray
+            The sums per group, over the ranks.
+        """
         inside = self.own_free & np.isin(group, labels)
         where = np.searchsorted(labels, group[inside])
         return self.total(np.bincount(where, values[inside], len(labels)))
@@ -160,7 +312,25 @@ class DistributedNetwork:
     def steady(self, floating: str = "error", rtol: float = 1e-10):
         """Steady temperatures of the free particles (this rank's entries: over the local free ones, owned ones
         valid): :func:`dem.network.heat.steady` over the ranks, without radiation. Returns ``(T_F, flows,
-        energy_error, floating groups, solver name)``."""
+        energy_error, floating groups, solver name)``.
+
+        Parameters
+        ----------
+        floating : str
+            ``"error"`` (refuse a floating group) or ``"mean"`` (keep it at its capacity-weighted mean).
+        rtol : float
+            The relative residual of the linear solves.
+
+        Returns
+        -------
+        tuple
+            ``(T_F, flows, energy_error, floating groups, solver name)``.
+
+        Raises
+        ------
+        ValueError
+            A floating group with ``floating = "error"``, or one whose sources do not sum to zero.
+        """
         net = self.net
         T_F = net.particles.temperature[net.free].astype(float)
         sinks = net.sinks(T_F)
@@ -230,7 +400,33 @@ class DistributedNetwork:
                   progress=None):
         """Theta-method steps of fixed size ``dt`` to ``t_end`` (:func:`dem.network.heat.integrate` with a fixed
         step, over the ranks; ``integrator`` implicit or crank-nicolson). ``observer(step, t, T_F, flows)`` after
-        every step and at the start. Returns a dict of what the serial integrator reports."""
+        every step and at the start. Returns a dict of what the serial integrator reports.
+
+        Parameters
+        ----------
+        integrator : str
+            ``"implicit"`` or ``"crank-nicolson"`` (``dem.network.heat.INTEGRATORS``).
+        dt : float
+            The step (s).
+        t_end : float
+            The time to integrate to (s).
+        rtol_linear : float
+            The relative residual of the linear solves.
+        observer : callable or None
+            ``observer(step, t, T_F, flows)``; None: not called.
+        progress : callable or None
+            ``progress(t)`` with the simulated time (s) after every step; None: not called.
+
+        Returns
+        -------
+        dict
+            ``T_F``, ``t``, ``steps``, ``energy_error``, ``heat_in`` and the rest the serial integrator reports.
+
+        Raises
+        ------
+        ValueError
+            The temperatures became non-finite.
+        """
         net, theta = self.net, INTEGRATORS[integrator]
         T = net.particles.temperature[net.free].astype(float)
         sinks = net.sinks(T)

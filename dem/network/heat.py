@@ -88,7 +88,25 @@ ENERGY_TOLERANCE = 1e-6  # energy_error allowed at the end of a transient run
 class Network:
     """The linear(ised) heat balance of the free particles (module docstring), assembled once: the generic
     :class:`dem.network.laplacian.BoundedLaplacian` (the same solve serves the electrical current) with the particles'
-    capacities, sources and fixed temperatures."""
+    capacities, sources and fixed temperatures.
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The particles: capacities (J/K), heat sources (W), fixed flags and temperatures (K or degC).
+    bonds : dem.geometry.bonds.Bonds
+        The pair and wall bonds.
+    K_pairs : numpy.ndarray
+        The pair bonds' conductances (W/K).
+    K_walls : numpy.ndarray
+        The wall bonds' conductances (W/K).
+    wall_temperature : numpy.ndarray
+        Each wall's temperature (K or degC), in the order of the walls the bonds index.
+    sources : dem.laws.ambient.Sources
+        The exchanges with the surroundings.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box, whose temperature drop per period drives the network; None: none.
+    """
 
     particles: Particles
     bonds: Bonds
@@ -135,7 +153,22 @@ class Network:
 
     def refresh(self, bonds: Bonds, K_pairs: np.ndarray, K_walls: np.ndarray) -> None:
         """New conductances (and bond geometry) on the same bonds, in the same order: the matrices keep their
-        sparsity and only their entries are rewritten (no re-assembly, no new sparsity analysis)."""
+        sparsity and only their entries are rewritten (no re-assembly, no new sparsity analysis).
+
+        Parameters
+        ----------
+        bonds : dem.geometry.bonds.Bonds
+            The same bonds, in the same order, with their geometry now.
+        K_pairs : numpy.ndarray
+            The pair bonds' conductances (W/K).
+        K_walls : numpy.ndarray
+            The wall bonds' conductances (W/K).
+
+        Raises
+        ------
+        ValueError
+            The bonds are not those of the network.
+        """
         if not self.graph.same_edges(bonds.i, bonds.j, bonds.wall_particle, bonds.wall_index):
             raise ValueError("Network.refresh: the bonds changed; build a new Network")
         self.graph.refresh(bonds.i, bonds.j, K_pairs, bonds.wall_particle, bonds.wall_index, K_walls)
@@ -152,18 +185,68 @@ class Network:
         return ("fixed", "walls", "internal", *self.sources.names) + (("periodic",) if self.periodic else ())
 
     def sinks(self, T_F: np.ndarray) -> dict:
+        """The ambient exchange of the free particles as ``Q = b - g T`` (:func:`dem.laws.ambient.linear_sink_terms`).
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the free particles (K or degC).
+
+        Returns
+        -------
+        dict
+            ``{name: (g, b)}``: W/K and W per free particle.
+        """
         return linear_sink_terms(self.sources, self.radius, T_F)
 
     def matrix(self, sinks: dict) -> sp.csr_matrix:
-        """The system matrix ``A = L_FF + diag(K_wall + g)``, CSR."""
+        """The system matrix ``A = L_FF + diag(K_wall + g)``, CSR.
+
+        Parameters
+        ----------
+        sinks : dict
+            The ambient terms ``{name: (g, b)}`` (:meth:`sinks`): W/K and W per free particle.
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix
+            ``A`` (W/K).
+        """
         return self.graph.matrix(sum((g for g, _ in sinks.values()), np.zeros(self.n_free)))
 
     def rhs(self, sinks: dict) -> np.ndarray:
+        """The right-hand side ``r`` of the module docstring.
+
+        Parameters
+        ----------
+        sinks : dict
+            The ambient terms ``{name: (g, b)}`` (:meth:`sinks`): W/K and W per free particle.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``r`` per free particle (W).
+        """
         return self.r_const + sum((b for _, b in sinks.values()), np.zeros(self.n_free))
 
     def flows(self, T_F: np.ndarray, sinks: dict, rows=None) -> dict:
         """Heat flow into the free particles (W) through each boundary at temperatures ``T_F``; ``rows``: into
-        those free particles only (a mask over them: a rank's own in a distributed run)."""
+        those free particles only (a mask over them: a rank's own in a distributed run).
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the free particles (K or degC).
+        sinks : dict
+            The ambient terms ``{name: (g, b)}`` (:meth:`sinks`): W/K and W per free particle.
+        rows : numpy.ndarray or None
+            A mask over the free particles to sum over; None: all.
+
+        Returns
+        -------
+        dict
+            ``{boundary: W}`` for :attr:`flow_names`.
+        """
         s = slice(None) if rows is None else rows
         out = {"fixed": float(self.fixed_rhs[s].sum() - self.fixed_diag[s] @ T_F[s]),
                "walls": float(self.wall_rhs[s].sum() - self.wall_diag[s] @ T_F[s]),
@@ -181,13 +264,40 @@ class Network:
         Each flow is a difference of terms ``K T``. Where (almost) no heat flows, the flows are the round-off of
         those terms and a balance relative to them means nothing, so the scale is never taken below
         ``sqrt(eps) sum |K T|``: temperature differences below ~1e-8 of the temperatures count as no flow.
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the free particles (K or degC).
+        sinks : dict
+            The ambient terms ``{name: (g, b)}`` (:meth:`sinks`): W/K and W per free particle.
+
+        Returns
+        -------
+        float
+            The scale (W).
         """
         net, gross = self.flow_sums(T_F, sinks)
         return float(max(net, np.sqrt(np.finfo(float).eps) * gross))
 
     def flow_sums(self, T_F: np.ndarray, sinks: dict, rows=None) -> tuple[float, float]:
         """``(sum |flow|, sum |K T|)`` over the boundaries of the free particles (or of ``rows``, as in
-        :meth:`flows`): the two sums behind :meth:`flow_magnitude`."""
+        :meth:`flows`): the two sums behind :meth:`flow_magnitude`.
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the free particles (K or degC).
+        sinks : dict
+            The ambient terms ``{name: (g, b)}`` (:meth:`sinks`): W/K and W per free particle.
+        rows : numpy.ndarray or None
+            A mask over the free particles to sum over; None: all.
+
+        Returns
+        -------
+        tuple of (float, float)
+            The two sums (W).
+        """
         s = slice(None) if rows is None else rows
         pairs = [(self.fixed_diag, self.fixed_rhs), (self.wall_diag, self.wall_rhs), *sinks.values()]  # (g, b)
         net = gross = float(np.abs(self.heat[s]).sum() + np.abs(self.periodic_rhs[s]).sum())
@@ -197,6 +307,18 @@ class Network:
         return net, gross
 
     def full(self, T_F: np.ndarray) -> np.ndarray:
+        """All particles' temperatures: ``T_F`` on the free ones, the fixed ones' own.
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the free particles (K or degC).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) temperatures (K or degC).
+        """
         T = self.particles.temperature.copy()
         T[self.free] = T_F
         return T
@@ -225,6 +347,33 @@ def build_network(particles: Particles, walls=(), spec=None, sources: Sources | 
     instead of searching for overlaps. ``bonds`` already found (e.g. to time the search apart) skip the search. To
     impose other pair conductances, replace them: ``dataclasses.replace(net, K_pairs=K)``. ``box``: a periodic box
     (:mod:`dem.geometry.periodic`), whose faces bonds cross and whose temperature drop per period drives the network.
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The particles (positions and radii in m, temperatures, materials).
+    walls : sequence of dem.geometry.walls.Wall
+        The walls; those with a temperature are bonded to the particles touching them.
+    spec : dem.laws.conductance.ConductanceSpec or None
+        The contact geometry and conductance law; None: the ``rojek`` law.
+    sources : dem.laws.ambient.Sources or None
+        The exchanges with the surroundings; None: none.
+    pairs : tuple of numpy.ndarray or None
+        ``(i, j)`` pair bonds to use instead of searching for overlaps; None: search.
+    bonds : dem.geometry.bonds.Bonds or None
+        Bonds already found (the search is skipped); None: find them.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box; None: none.
+
+    Returns
+    -------
+    Network
+        The assembled network.
+
+    Raises
+    ------
+    ValueError
+        A bond beyond the contact model's range (with ``out_of_range = "error"``) or a conductance that is not finite.
     """
     spec = ConductanceSpec() if spec is None else spec
     walls = tuple(walls)
@@ -237,14 +386,53 @@ def build_network(particles: Particles, walls=(), spec=None, sources: Sources | 
 def bonds_and_conductances(particles: Particles, walls, spec, *, pairs=None, bonds: Bonds | None = None,
                            box: PeriodicBox | None = None) -> tuple[Bonds, np.ndarray, np.ndarray]:
     """The bonds of ``particles`` (and ``walls``) and their pair and wall conductances: the first half of
-    :func:`build_network`, for a network whose bonds change while its particles stay (:mod:`dem.engines.contact_heat`)."""
+    :func:`build_network`, for a network whose bonds change while its particles stay (:mod:`dem.engines.contact_heat`).
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The particles (positions and radii in m, temperatures, materials).
+    walls : sequence of dem.geometry.walls.Wall
+        The walls; those with a temperature are bonded to the particles touching them.
+    spec : dem.laws.conductance.ConductanceSpec
+        The contact geometry and conductance law.
+    pairs : tuple of numpy.ndarray or None
+        ``(i, j)`` pair bonds to use instead of searching for overlaps; None: search.
+    bonds : dem.geometry.bonds.Bonds or None
+        Bonds already found (the search is skipped); None: find them.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box; None: none.
+
+    Returns
+    -------
+    tuple
+        ``(bonds, K_pairs, K_walls)``: the bonds and their conductances (W/K).
+
+    Raises
+    ------
+    ValueError
+        A bond beyond the contact model's range (with ``out_of_range = "error"``) or a conductance that is not finite.
+    """
     if bonds is None:
         bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, pairs=pairs, box=box)
     return (bonds, *bond_conductances(spec, particles, bonds, box=box, walls=tuple(walls)))
 
 
 def boundary_heat_flow(net: Network, T: np.ndarray) -> dict:
-    """W into each fixed particle (from its bonds and walls) and into each wall, at full temperatures ``T``."""
+    """W into each fixed particle (from its bonds and walls) and into each wall, at full temperatures ``T``.
+
+    Parameters
+    ----------
+    net : Network
+        The network.
+    T : numpy.ndarray
+        (N,) the temperatures of all particles (K or degC).
+
+    Returns
+    -------
+    dict
+        ``{"particles": {index: W}, "walls": (W,) array of W}``.
+    """
     p, b = net.particles, net.bonds
     into_fixed = -(net.L @ T) + net.jump_rhs
     to_wall = net.K_walls * (T[b.wall_particle] - net.wall_temperature[b.wall_index])
@@ -257,7 +445,20 @@ def boundary_heat_flow(net: Network, T: np.ndarray) -> dict:
 def periodic_heat_flow(net: Network, T: np.ndarray) -> np.ndarray:
     """Heat flow (W) across the period along x, y and z at full temperatures ``T``: every bond's flow from ``i``
     to the image ``shift`` of ``j``, ``K (T_i - T_j + g)``, times ``shift`` (a bond spanning ``s`` periods crosses
-    ``s`` of the period's planes). In a steady state it is the flow through any plane normal to that axis."""
+    ``s`` of the period's planes). In a steady state it is the flow through any plane normal to that axis.
+
+    Parameters
+    ----------
+    net : Network
+        The network.
+    T : numpy.ndarray
+        (N,) the temperatures of all particles (K or degC).
+
+    Returns
+    -------
+    numpy.ndarray
+        (3,) the heat flow along x, y, z (W).
+    """
     b = net.bonds
     q = net.K_pairs * (T[b.i] - T[b.j] + net.jump)
     return q @ b.shifts
@@ -265,6 +466,24 @@ def periodic_heat_flow(net: Network, T: np.ndarray) -> np.ndarray:
 # -------------------------------------------------------------------------------------------------- steady
 @dataclass
 class SteadyResult:
+    """What :func:`steady` found.
+
+    Parameters
+    ----------
+    T : numpy.ndarray
+        (N,) the steady temperatures of all particles (K or degC).
+    flows : dict
+        Heat flow into the free particles through each boundary (W).
+    energy_error : float
+        The relative mismatch of the heat balance.
+    iterations : int
+        Newton iterations (1 without radiation).
+    solver : str
+        The linear solver that ran.
+    floating : int
+        Number of floating groups held at their mean temperature.
+    """
+
     T: np.ndarray
     flows: dict
     energy_error: float
@@ -296,6 +515,30 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
     constant, fixed by keeping its capacity-weighted mean temperature at the initial one. Otherwise
     ``floating = "error"`` explains and refuses; ``"mean"`` keeps such a group at the capacity-weighted mean of its
     initial temperatures (the long-time limit of the transient), provided its internal sources sum to zero.
+
+    Parameters
+    ----------
+    net : Network
+        The network.
+    floating : str
+        ``"error"`` or ``"mean"`` (above).
+    linear : str
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
+    max_newton : int
+        The most Newton iterations on radiation.
+    rtol : float
+        The relative residual of iterative linear solves.
+
+    Returns
+    -------
+    SteadyResult
+        The temperatures and heat flows.
+
+    Raises
+    ------
+    ValueError
+        A floating group with ``floating = "error"`` or with a net source, a bad ``floating``, or a Newton iteration
+        that did not converge.
     """
     T_F = net.particles.temperature[net.free].astype(float)
     n_comp, label, anchored, jumping = _components(net)
@@ -380,6 +623,18 @@ def stable_limit(net: Network, sinks: dict | None = None) -> float:
 
     ``lambda_max`` from Lanczos on the symmetric ``C^-1/2 A C^-1/2`` (dense for small systems); where Lanczos
     fails the Gershgorin bound ``lambda_max <= max_i 2 A_ii / C_i`` gives a safe (smaller) limit.
+
+    Parameters
+    ----------
+    net : Network
+        The network.
+    sinks : dict or None
+        The ambient terms to linearise with; None: at the initial temperatures.
+
+    Returns
+    -------
+    float
+        The limit (s).
     """
     sinks = net.sinks(net.particles.temperature[net.free]) if sinks is None else sinks
     A = net.matrix(sinks)
@@ -400,6 +655,38 @@ def stable_limit(net: Network, sinks: dict | None = None) -> float:
 
 @dataclass
 class TransientResult:
+    """What :func:`integrate` found.
+
+    Parameters
+    ----------
+    T : numpy.ndarray
+        (N,) the temperatures of all particles at the end (K or degC).
+    t : float
+        The time reached (s).
+    steps : int
+        Accepted steps.
+    rejected : int
+        Rejected steps (``dt = "auto"``).
+    energy_error : float
+        The relative mismatch of the heat balance.
+    heat_in : dict
+        Energy that entered the free particles through each boundary (J).
+    stable_limit : float or None
+        The explicit stability limit (s), where it was computed.
+    dt_min : float
+        The smallest step taken (s).
+    dt_max : float
+        The largest step taken (s).
+    solver : str
+        The linear solver that ran.
+    factorizations : int
+        Number of system solvers built.
+    max_principle_violation : float or None
+        The largest excursion beyond the prescribed temperatures (K); None with internal sources.
+    startup_steps : int
+        Implicit Euler steps that started a stiff Crank-Nicolson run.
+    """
+
     T: np.ndarray
     t: float
     steps: int
@@ -518,12 +805,51 @@ def theta_step(net: Network, T_F: np.ndarray, dt: float, integrator: str = "impl
     """One theta-method step of size ``dt`` from the free temperatures ``T_F`` on ``net`` (a network whose
     conductances change between steps, e.g. necks that grow): ``(T_new, heat)`` with ``heat`` the energy (J) that
     entered the free particles through each boundary during the step, integrated with the step's own weighting so
-    that ``C . (T_new - T_F)`` equals its sum to round-off."""
+    that ``C . (T_new - T_F)`` equals its sum to round-off.
+
+    Parameters
+    ----------
+    net : Network
+        The network.
+    T_F : numpy.ndarray
+        Temperatures of the free particles (K or degC).
+    dt : float
+        The step (s).
+    integrator : str
+        ``"explicit"``, ``"implicit"`` or ``"crank-nicolson"``.
+    linear : str
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
+    rtol_linear : float
+        The relative residual of iterative linear solves.
+
+    Returns
+    -------
+    tuple of (numpy.ndarray, dict)
+        The free temperatures after the step, and ``{boundary: J}``.
+    """
     T_new, T_theta, sinks = _Stepper(net, INTEGRATORS[integrator], linear, rtol_linear).step(T_F, dt)
     return T_new, {k: dt * v for k, v in net.flows(T_theta, sinks).items()}
 
 
 def check_step_count(t_end: float, dt: float, max_steps: int, what: str):
+    """Refuse a fixed-step run of more than ``max_steps`` steps up front.
+
+    Parameters
+    ----------
+    t_end : float
+        The run's end (s).
+    dt : float
+        The step (s).
+    max_steps : int
+        The most steps allowed.
+    what : str
+        What the message names first (``"solver.dt = 1e-3 s"``, say).
+
+    Raises
+    ------
+    ValueError
+        ``t_end / dt > max_steps``.
+    """
     steps = t_end / dt
     if steps > max_steps:
         raise ValueError(f"{what}: t_end / dt = {steps:.3g} steps exceeds solver.max_steps = {max_steps}; "
@@ -536,6 +862,18 @@ def step_tolerance(rtol: float, order: int) -> float:
     An order-q method whose steps each make a local error ``tau`` ends ``~ c tau^(q/(q+1))`` off (the steps shrink
     with ``tau^(1/(q+1))``), so ``tau = min(rtol, k_q rtol^((q+1)/q))``; ``k_q`` (``AUTO_LOCAL``) is calibrated
     on the decay of a pair and of a packing between plates (global errors 0.1-1 x rtol for rtol 1e-2 ... 1e-4).
+
+    Parameters
+    ----------
+    rtol : float
+        The global error wanted, relative to the temperature range.
+    order : int
+        The method's order q: 1 or 2.
+
+    Returns
+    -------
+    float
+        ``tau``, relative to the temperature range.
     """
     return min(rtol, AUTO_LOCAL[order] * rtol ** ((order + 1) / order))
 
@@ -551,7 +889,37 @@ def _controller_factor(err: float, tol: float, order: int) -> float:
 @dataclass
 class Checkpoint:
     """Where :func:`integrate` stands after an accepted step: everything its loop carries, so that a run resumed
-    from it ends bit for bit where the uninterrupted run ends (the linear solvers' warm starts included)."""
+    from it ends bit for bit where the uninterrupted run ends (the linear solvers' warm starts included).
+
+    Parameters
+    ----------
+    T : numpy.ndarray
+        The free particles' temperatures (K or degC).
+    t : float
+        The time (s).
+    steps : int
+        Accepted steps so far.
+    rejected : int
+        Rejected steps so far.
+    units : int
+        The time on the dyadic grid, ``t = t_end * units / 2^AUTO_LEVELS`` (implicit ``dt = "auto"``).
+    dt_want : float
+        The step the controller asks for next (s).
+    heat_in : dict
+        Energy that entered through each boundary so far (J).
+    abs_in : float
+        The sum of the absolute heat exchanged so far (J), the energy balance's scale.
+    dt_min : float
+        The smallest step so far (s).
+    dt_max : float
+        The largest step so far (s).
+    violation : float
+        The largest excursion beyond the prescribed temperatures so far (K).
+    energy0 : float
+        ``sum C T`` at the start (J).
+    history : list
+        The stepper's ``(T, dt)`` of the last accepted steps (its warm starts).
+    """
 
     T: np.ndarray
     t: float
@@ -580,6 +948,18 @@ class Checkpoint:
 
     @classmethod
     def from_arrays(cls, data: dict) -> "Checkpoint":
+        """The checkpoint of :meth:`arrays`.
+
+        Parameters
+        ----------
+        data : dict
+            The arrays, as loaded from the ``.npz``.
+
+        Returns
+        -------
+        Checkpoint
+            The checkpoint.
+        """
         history = [(data["history_T"][k], float(data["history_dt"][k])) for k in range(len(data["history_dt"]))]
         heat = {str(k): float(v) for k, v in zip(data["heat_keys"], data["heat_values"])}
         return cls(np.array(data["T"], dtype=float), float(data["t"]), int(data["steps"]), int(data["rejected"]),
@@ -596,6 +976,44 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     ``progress(t)`` reports the simulated time. ``checkpoint(make)`` is called after every accepted step and at the
     end with ``make()`` building the :class:`Checkpoint` (the caller decides how often to build and keep one);
     ``resume`` starts from such a checkpoint instead of t = 0.
+
+    Parameters
+    ----------
+    net : Network
+        The network.
+    integrator : str
+        ``"explicit"``, ``"implicit"`` or ``"crank-nicolson"``.
+    dt : float or str
+        The step (s), or ``"auto"`` (error-controlled).
+    t_end : float
+        The time to integrate to (s), > 0.
+    rtol : float
+        The global error wanted with ``dt = "auto"``, relative to the temperature range.
+    linear : str
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
+    max_steps : int
+        The most steps.
+    observer : callable or None
+        ``observer(step, t, T_F, flows)``; None: not called.
+    progress : callable or None
+        ``progress(t)`` with the simulated time (s); None: not called.
+    rtol_linear : float
+        The relative residual of iterative linear solves.
+    resume : Checkpoint or None
+        The checkpoint to go on from; None: start at t = 0.
+    checkpoint : callable or None
+        ``checkpoint(make)`` after every accepted step, ``checkpoint(make, final=True)`` at the end; None: not called.
+
+    Returns
+    -------
+    TransientResult
+        The temperatures at ``t_end`` and the run's account.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, a step above the explicit stability limit, too many steps, or temperatures that came out
+        wrong (a heat balance or maximum-principle violation beyond its tolerance).
     """
     if integrator not in INTEGRATORS:
         raise ValueError(f"solver.integrator = {integrator!r}: must be one of {', '.join(INTEGRATORS)}")

@@ -35,7 +35,22 @@ from dem.network.linsolve import make_solver
 
 
 def laplacian(n: int, i: np.ndarray, j: np.ndarray, K: np.ndarray) -> sp.csr_matrix:
-    """Weighted graph Laplacian ``L_ii = sum_j K_ij``, ``L_ij = -K_ij`` (symmetric, rows sum to zero)."""
+    """Weighted graph Laplacian ``L_ii = sum_j K_ij``, ``L_ij = -K_ij`` (symmetric, rows sum to zero).
+
+    Parameters
+    ----------
+    n : int
+        Number of nodes.
+    i, j : array_like
+        (M,) int, the edges' nodes.
+    K : array_like
+        (M,) edge conductances (W/K for heat, S for current).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix
+        The (n, n) Laplacian (the unit of ``K``).
+    """
     diag = np.bincount(i, K, n) + np.bincount(j, K, n)
     rows = np.concatenate([i, j, np.arange(n)])
     cols = np.concatenate([j, i, np.arange(n)])
@@ -51,6 +66,25 @@ class BoundedLaplacian:
     Attributes: ``free``, ``fixed`` (node indices), ``L`` (all nodes), ``L_FF``, ``L_FD`` (CSR), ``plane_diag``
     (per free node: the sum of its plane conductances), ``fixed_diag`` (per free node: the sum of its conductances to
     fixed nodes); the matrices and sums are made when first asked for (:meth:`flux` needs none of them).
+
+    Parameters
+    ----------
+    n : int
+        Number of nodes.
+    i, j : array_like
+        (M,) int, the edges' nodes.
+    K : array_like
+        (M,) edge conductances (W/K for heat, S for current).
+    fixed : array_like or None
+        (n,) bool, the nodes at prescribed values; None: none.
+    plane_node : array_like
+        (B,) int, the node of each plane bond.
+    plane_index : array_like
+        (B,) int, the plane of each plane bond.
+    K_plane : array_like
+        (B,) plane bond conductances (same unit).
+    n_planes : int
+        Number of planes.
     """
 
     def __init__(self, n: int, i, j, K, fixed, plane_node, plane_index, K_plane, n_planes: int):
@@ -122,14 +156,48 @@ class BoundedLaplacian:
                           doc="The sum of each free node's conductances to fixed nodes.")
 
     def same_edges(self, i, j, plane_node, plane_index) -> bool:
-        """Whether these edges and plane bonds are those of the assembled matrices (same order)."""
+        """Whether these edges and plane bonds are those of the assembled matrices (same order).
+
+        Parameters
+        ----------
+        i, j : array_like
+            (M,) int, the edges' nodes.
+        plane_node : array_like
+            (B,) int, the node of each plane bond.
+        plane_index : array_like
+            (B,) int, the plane of each plane bond.
+
+        Returns
+        -------
+        bool
+            True where all four arrays equal the assembled ones.
+        """
         return all(a is b or np.array_equal(a, b) for a, b in ((i, self.i), (j, self.j),
                                                                (plane_node, self.plane_node),
                                                                (plane_index, self.plane_index)))
 
     def refresh(self, i, j, K, plane_node, plane_index, K_plane) -> None:
         """New conductances on the same edges and plane bonds, in the same order: the matrices keep their sparsity
-        and only their entries are rewritten (no re-assembly, no new sparsity analysis), when next asked for."""
+        and only their entries are rewritten (no re-assembly, no new sparsity analysis), when next asked for.
+
+        Parameters
+        ----------
+        i, j : array_like
+            (M,) int, the edges' nodes.
+        K : array_like
+            (M,) edge conductances (W/K for heat, S for current).
+        plane_node : array_like
+            (B,) int, the node of each plane bond.
+        plane_index : array_like
+            (B,) int, the plane of each plane bond.
+        K_plane : array_like
+            (B,) plane bond conductances (same unit).
+
+        Raises
+        ------
+        ValueError
+            The edges or plane bonds are not the assembled ones.
+        """
         if not self.same_edges(i, j, plane_node, plane_index):
             raise ValueError("BoundedLaplacian.refresh: the edges changed; build a new one")
         self._set(i, j, K, plane_node, plane_index, K_plane)
@@ -141,19 +209,55 @@ class BoundedLaplacian:
         return self.L_FF.diagonal()
 
     def matrix(self, extra_diag=None) -> sp.csr_matrix:
-        """``A = L_FF + diag(plane conductances + extra_diag)``, CSR."""
+        """``A = L_FF + diag(plane conductances + extra_diag)``, CSR.
+
+        Parameters
+        ----------
+        extra_diag : array_like or None
+            Per free node, more on the diagonal (e.g. ``C/dt`` or an ambient's conductance; the unit of ``K``);
+            None: nothing.
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix
+            ``A`` on the free nodes.
+        """
         extra = self.plane_diag if extra_diag is None else self.plane_diag + extra_diag
         return (self.L_FF + sp.diags(extra)).tocsr()
 
     def plane_rhs(self, x_planes) -> np.ndarray:
-        """``sum_w K_kw x_w`` per free node: what the planes at values ``x_planes`` drive into it."""
+        """``sum_w K_kw x_w`` per free node: what the planes at values ``x_planes`` drive into it.
+
+        Parameters
+        ----------
+        x_planes : array_like
+            The planes' values (K for heat, V for current).
+
+        Returns
+        -------
+        numpy.ndarray
+            Per free node (W for heat, A for current).
+        """
         x_planes = np.asarray(x_planes, dtype=float)
         if not len(self.plane_node):
             return np.zeros(len(self.free))
         return np.bincount(self.plane_node, self.K_plane * x_planes[self.plane_index], self.n)[self.free]
 
     def boundary_rhs(self, x_fixed, x_planes) -> np.ndarray:
-        """``b = -L_FD x_D + sum_w K_kw x_w`` per free node."""
+        """``b = -L_FD x_D + sum_w K_kw x_w`` per free node.
+
+        Parameters
+        ----------
+        x_fixed : array_like
+            The fixed nodes' values (K or V), in the order of ``fixed``.
+        x_planes : array_like
+            The planes' values (K for heat, V for current).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``b`` per free node (W for heat, A for current).
+        """
         b = self.plane_rhs(x_planes)
         if len(self.fixed):
             b = b - self.L_FD @ np.asarray(x_fixed, dtype=float)
@@ -162,7 +266,18 @@ class BoundedLaplacian:
     def components(self, anchor_extra=None):
         """Connected groups of free nodes: ``(count, label per free node, anchored per group)``; a group is
         anchored when one of its nodes is joined to a fixed node, a plane or (``anchor_extra > 0``) an ambient.
-        Only edges with ``K > 0`` join nodes (an edge with ``K = 0``, an open contact, is none)."""
+        Only edges with ``K > 0`` join nodes (an edge with ``K = 0``, an open contact, is none).
+
+        Parameters
+        ----------
+        anchor_extra : array_like or None
+            Per free node, a conductance to an ambient (> 0 anchors its group); None: none.
+
+        Returns
+        -------
+        tuple
+            ``(count, label, anchored)``: the number of groups, each free node's group, and a bool per group.
+        """
         where = np.full(self.n, -1, dtype=np.int64)
         where[self.free] = np.arange(len(self.free))
         a, b = where[self.i], where[self.j]
@@ -181,7 +296,22 @@ class BoundedLaplacian:
         """Net flow into every node (fixed ones too) at node values ``x`` (all nodes) with the planes at
         ``x_planes``: ``-(L x)_k + sum_w K_kw (x_w - x_k)`` (W for heat: the conducted heat ``Q_k``). Summed edge by
         edge in the order of the edges, then the plane bonds (:func:`dem.network.flux.edge_flux`), from the conductances as they
-        are (right after :meth:`refresh`, without the matrices). ``out``: an array of ``n`` to write into."""
+        are (right after :meth:`refresh`, without the matrices). ``out``: an array of ``n`` to write into.
+
+        Parameters
+        ----------
+        x : array_like
+            (n,) the values of all nodes (K or V).
+        x_planes : array_like
+            The planes' values (K for heat, V for current).
+        out : numpy.ndarray or None
+            (n,) an array to write into; None: a new one.
+
+        Returns
+        -------
+        numpy.ndarray
+            (n,) the net flow into each node (W for heat, A for current).
+        """
         from dem.network.flux import edge_flux  # compiled: imported by the moving engines only (a static run loads no numba)
 
         out = np.empty(self.n) if out is None else out
@@ -190,7 +320,20 @@ class BoundedLaplacian:
         return out
 
     def full(self, x_free, x_fixed) -> np.ndarray:
-        """Values on all nodes from those of the free and the fixed nodes."""
+        """Values on all nodes from those of the free and the fixed nodes.
+
+        Parameters
+        ----------
+        x_free : array_like
+            The free nodes' values, in the order of ``free``.
+        x_fixed : array_like
+            The fixed nodes' values, in the order of ``fixed``.
+
+        Returns
+        -------
+        numpy.ndarray
+            (n,) the values of all nodes.
+        """
         x = np.empty(self.n)
         x[self.free] = x_free
         x[self.fixed] = x_fixed
@@ -202,7 +345,30 @@ def solve_anchored(system: BoundedLaplacian, rhs: np.ndarray, subset: np.ndarray
     """Solve ``A x = rhs`` on the free nodes listed by ``subset`` (positions in ``system.free``; all when None),
     e.g. the anchored groups, where ``A`` is definite. Returns ``(x on the subset, solver)``; pass the solver back
     to reuse its factorisation for another right-hand side of the same matrix, or as ``previous`` for a matrix
-    that changed a little (its AMG hierarchy serves again, :func:`dem.network.linsolve.make_solver`)."""
+    that changed a little (its AMG hierarchy serves again, :func:`dem.network.linsolve.make_solver`).
+
+    Parameters
+    ----------
+    system : BoundedLaplacian
+        The network.
+    rhs : numpy.ndarray
+        The right-hand side per free node (W for heat, A for current).
+    subset : numpy.ndarray or None
+        Positions in ``system.free`` to solve on; None: all.
+    linear : str
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
+    rtol : float
+        Relative residual tolerance of an iterative solver.
+    solver : object or None
+        A solver of this very matrix to reuse; None: make one.
+    previous : object or None
+        A solver of a matrix that changed a little, whose AMG hierarchy serves again; None: none.
+
+    Returns
+    -------
+    tuple
+        ``(x, solver)``: the values on the subset (K or V) and the solver used.
+    """
     if subset is not None and len(subset) == 0:
         return np.zeros(0), solver
     if solver is None:

@@ -62,7 +62,15 @@ class SolverError(ValueError):
 
 
 class DirectSolver:
-    """Sparse LU, factorised once."""
+    """Sparse LU, factorised once.
+
+    Parameters
+    ----------
+    A : scipy.sparse.spmatrix
+        The symmetric positive definite matrix (e.g. W/K).
+    rtol : float
+        Not read (an exact solve); taken so that every backend is made alike.
+    """
 
     name = "direct"
 
@@ -72,6 +80,20 @@ class DirectSolver:
         self.iterations = 0
 
     def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
+        """The solution by the factorisation.
+
+        Parameters
+        ----------
+        b : numpy.ndarray
+            The right-hand side (e.g. W).
+        x0 : numpy.ndarray or None
+            A start (warm start of an iterative solver; not read by a direct one); None: zero.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``x`` with ``A x = b`` (e.g. K).
+        """
         return self.lu.solve(b)
 
 
@@ -81,7 +103,17 @@ def _dot(a: np.ndarray, b: np.ndarray) -> float:
 
 
 class PCGSolver:
-    """Preconditioned conjugate gradients to ``|r| <= rtol |b|``, warm-started from ``x0``."""
+    """Preconditioned conjugate gradients to ``|r| <= rtol |b|``, warm-started from ``x0``.
+
+    Parameters
+    ----------
+    A : scipy.sparse.spmatrix
+        The symmetric positive definite matrix (e.g. W/K).
+    rtol : float
+        The relative residual at which the iteration stops.
+    max_iterations : int or None
+        The most iterations per solve; None: ``max(1000, 10 sqrt(N))``.
+    """
 
     name = "cg"
 
@@ -97,6 +129,25 @@ class PCGSolver:
         return lambda r: inv_diag * r
 
     def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
+        """CG to ``|r| <= rtol |b|``.
+
+        Parameters
+        ----------
+        b : numpy.ndarray
+            The right-hand side (e.g. W).
+        x0 : numpy.ndarray or None
+            A start (warm start of an iterative solver; not read by a direct one); None: zero.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``x`` with ``A x = b`` (e.g. K).
+
+        Raises
+        ------
+        SolverError
+            The iteration did not reach ``rtol`` within its iterations.
+        """
         A, M = self.A, self.precondition
         x = np.zeros_like(b) if x0 is None else np.array(x0, dtype=float)
         r = b - A @ x
@@ -151,6 +202,17 @@ class AMGSolver(PCGSolver):
     smoothing is a symmetric positive definite operator, a valid CG preconditioner for any SPD matrix, and CG
     stops on this matrix's own residual: the criterion is the same as with a fresh hierarchy, only the iterations
     may grow (:meth:`solve` bounds them).
+
+    Parameters
+    ----------
+    A : scipy.sparse.spmatrix
+        The symmetric positive definite matrix (e.g. W/K).
+    rtol : float
+        The relative residual at which CG stops.
+    max_iterations : int or None
+        The most iterations per solve; None: ``max(1000, 10 sqrt(N))``.
+    hierarchy_of : AMGSolver or None
+        The solver of an earlier matrix of the same size whose hierarchy preconditions this one; None: build one.
     """
 
     name = "amg"
@@ -185,7 +247,25 @@ class AMGSolver(PCGSolver):
     def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
         """CG to the criterion. A reused hierarchy (``hierarchy_of``) that needs more than ``AMG_REUSE_GROWTH``
         times the most iterations a solve on its own matrix took (plus one) is dropped there and a fresh one built
-        for this matrix, which then solves from ``x0`` again."""
+        for this matrix, which then solves from ``x0`` again.
+
+        Parameters
+        ----------
+        b : numpy.ndarray
+            The right-hand side (e.g. W).
+        x0 : numpy.ndarray or None
+            A start (warm start of an iterative solver; not read by a direct one); None: zero.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``x`` with ``A x = b`` (e.g. K).
+
+        Raises
+        ------
+        SolverError
+            The iteration did not reach ``rtol`` within its iterations.
+        """
         with one_blas_thread():
             if not self.reused:
                 return self._own_solve(b, x0)
@@ -214,13 +294,42 @@ BACKENDS = {"direct": DirectSolver, "cg": PCGSolver, "amg": AMGSolver}
 
 class AutoCGSolver(PCGSolver):
     """Jacobi-CG as picked by ``"auto"``; should it not converge (the unscaled residual target out of reach in
-    floating point), the matrix goes to ``fallback`` for good."""
+    floating point), the matrix goes to ``fallback`` for good.
+
+    Parameters
+    ----------
+    A : scipy.sparse.spmatrix
+        The symmetric positive definite matrix (e.g. W/K).
+    rtol : float
+        The relative residual at which CG stops.
+    fallback : str
+        The backend taken should CG fail: ``"direct"`` or ``"amg"``.
+    """
 
     def __init__(self, A: sp.spmatrix, rtol: float = 1e-12, fallback: str = "amg"):
         super().__init__(A, rtol)
         self.fallback_name, self.fallback = fallback, None
 
     def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
+        """Jacobi-CG, or the fallback once CG has failed.
+
+        Parameters
+        ----------
+        b : numpy.ndarray
+            The right-hand side (e.g. W).
+        x0 : numpy.ndarray or None
+            A start (warm start of an iterative solver; not read by a direct one); None: zero.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``x`` with ``A x = b`` (e.g. K).
+
+        Raises
+        ------
+        SolverError
+            The fallback failed as well (an iterative one).
+        """
         if self.fallback is None:
             try:
                 return super().solve(b, x0)
@@ -231,7 +340,20 @@ class AutoCGSolver(PCGSolver):
 
 
 def choose_backend(A: sp.spmatrix, laplacian_diagonal: np.ndarray) -> str:
-    """The ``"auto"`` rule of the module docstring."""
+    """The ``"auto"`` rule of the module docstring.
+
+    Parameters
+    ----------
+    A : scipy.sparse.spmatrix
+        The symmetric positive definite matrix (e.g. W/K).
+    laplacian_diagonal : numpy.ndarray
+        The part of ``A``'s diagonal that the Laplacian makes (the rest is the capacity term ``C/dt`` and the like).
+
+    Returns
+    -------
+    str
+        ``"cg"``, ``"direct"`` or ``"amg"``.
+    """
     n = A.shape[0]
     extra = A.diagonal() - laplacian_diagonal
     with np.errstate(divide="ignore"):
@@ -245,7 +367,31 @@ def make_solver(A: sp.spmatrix, backend: str = "auto", laplacian_diagonal: np.nd
                 rtol: float = 1e-12, previous=None):
     """A solver for the SPD matrix ``A`` (module docstring). ``previous``: the solver of an earlier matrix of the same
     size that changed little since (a refreshed network, the next Newton or time step); when both are AMG, its
-    hierarchy preconditions ``A`` (no setup; :class:`AMGSolver`, ``hierarchy_of``)."""
+    hierarchy preconditions ``A`` (no setup; :class:`AMGSolver`, ``hierarchy_of``).
+
+    Parameters
+    ----------
+    A : scipy.sparse.spmatrix
+        The symmetric positive definite matrix (e.g. W/K).
+    backend : str
+        ``"auto"`` or one of ``BACKENDS``.
+    laplacian_diagonal : numpy.ndarray or None
+        The Laplacian's part of the diagonal, for ``"auto"``; None: the whole diagonal.
+    rtol : float
+        The relative residual of the iterative backends.
+    previous : object or None
+        The solver of an earlier matrix of the same size; None: none.
+
+    Returns
+    -------
+    object
+        A solver with ``solve(b, x0=None)``.
+
+    Raises
+    ------
+    ValueError
+        ``backend`` is unknown.
+    """
     if backend == "auto":
         backend = choose_backend(A, A.diagonal() if laplacian_diagonal is None else laplacian_diagonal)
         if backend == "cg":

@@ -45,7 +45,27 @@ def petsc():
 
 def matrix(comm, rows, n_global: int):
     """The PETSc MPIAIJ matrix whose rows on this rank are ``rows`` (scipy CSR, columns numbered globally, sorted);
-    the ranks' rows follow each other in rank order."""
+    the ranks' rows follow each other in rank order.
+
+    Parameters
+    ----------
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
+    rows : scipy.sparse.csr_matrix
+        This rank's rows, columns numbered globally and sorted.
+    n_global : int
+        The matrix's global size.
+
+    Returns
+    -------
+    object
+        The assembled matrix (a ``petsc4py.PETSc.Mat``).
+
+    Raises
+    ------
+    ValueError
+        petsc4py is not importable.
+    """
     PETSc = petsc()
     n_local = rows.shape[0]
     A = PETSc.Mat().createAIJ(size=((n_local, n_global), (n_local, n_global)),
@@ -73,7 +93,17 @@ def _preconditioner(PETSc) -> tuple[str, dict]:
 class PetscSolver:
     """CG + AMG on a distributed matrix (module docstring): ``solve(b, x0)`` with ``b`` and ``x0`` this rank's
     entries; ``iterations`` sums the CG iterations of all solves, ``name`` says which preconditioner ran;
-    :meth:`destroy` when done."""
+    :meth:`destroy` when done.
+
+    Parameters
+    ----------
+    A : object
+        The distributed symmetric positive definite matrix (:func:`matrix`).
+    rtol : float
+        The relative unpreconditioned residual at which CG stops.
+    max_iterations : int
+        The most CG iterations per solve.
+    """
 
     def __init__(self, A, rtol: float = 1e-10, max_iterations: int = 10_000):
         PETSc = petsc()
@@ -104,6 +134,25 @@ class PetscSolver:
             obj.destroy()
 
     def solve(self, b: np.ndarray, x0: np.ndarray | None = None) -> np.ndarray:
+        """CG + AMG to ``|b - A x| <= rtol |b|``.
+
+        Parameters
+        ----------
+        b : numpy.ndarray
+            This rank's entries of the right-hand side (e.g. W).
+        x0 : numpy.ndarray or None
+            This rank's entries of a start; None: zero.
+
+        Returns
+        -------
+        numpy.ndarray
+            This rank's entries of ``x`` (e.g. K).
+
+        Raises
+        ------
+        ValueError
+            CG did not converge (the message gives PETSc's reason).
+        """
         PETSc = petsc()
         self._b.setArray(b)
         self.ksp.setInitialGuessNonzero(x0 is not None)

@@ -31,7 +31,31 @@ def _quiet_pyvista():
 def render(path, x, radius, T, plates, up: int, clim, title: str, unit: str = "K", sphere_resolution: int = 12) -> None:
     """Write one PNG: spheres at ``x`` of ``radius`` coloured by ``T`` (colour range ``clim``, temperatures in
     ``unit``: "K" or "C"), the ``plates`` (``(centre, normal, (size_1, size_2))``) in grey, axis ``up`` vertical,
-    ``title`` at the top, clear of the picture's edges."""
+    ``title`` at the top, clear of the picture's edges.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The PNG file to write.
+    x : array_like
+        (N, 3) particle centres (m).
+    radius : array_like
+        (N,) radii (m).
+    T : array_like
+        (N,) temperatures (in ``unit``).
+    plates : sequence of tuple
+        The walls to draw, each ``(centre (m), normal, (size_1, size_2) (m))``.
+    up : int
+        The axis drawn vertical: 0, 1 or 2.
+    clim : tuple of float
+        The colour range (in ``unit``).
+    title : str
+        The text at the top.
+    unit : str
+        The temperatures' unit, ``"K"`` or ``"C"``.
+    sphere_resolution : int
+        Facets around each sphere.
+    """
     from dem.output.plots import TEMPERATURE_UNITS
 
     pv = _quiet_pyvista()
@@ -72,7 +96,25 @@ class FrameWriter:
     particles, so that colours compare across frames."""
 
     def __init__(self, out_dir, count: int, t_end: float, up: int, T_low: float, T_high: float, unit: str = "K"):
-        """``up``: the vertical axis; ``unit``: the temperatures' ("K" or "C")."""
+        """``up``: the vertical axis; ``unit``: the temperatures' ("K" or "C").
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            The run folder (frames go to its ``frames/``).
+        count : int
+            Number of frames, evenly spaced from 0 to ``t_end``.
+        t_end : float
+            The run's end (s).
+        up : int
+            The axis drawn vertical: 0, 1 or 2.
+        T_low : float
+            The bottom of the colour range (in ``unit``).
+        T_high : float
+            The top of the colour range at least (in ``unit``).
+        unit : str
+            ``"K"`` or ``"C"``.
+        """
         self.dir = pathlib.Path(out_dir) / "frames"
         self.dir.mkdir(parents=True, exist_ok=True)
         self.times = list(np.linspace(0.0, t_end, count)) if count > 1 else [t_end]
@@ -116,7 +158,17 @@ class FrameWriter:
 
 class WithFrames:
     """A run's writer (:class:`dem.output.writer.RunWriter`) that also renders ``[output] frames`` pictures, the
-    colours from the coldest prescribed temperature (initial, walls) to the hottest prescribed or reached."""
+    colours from the coldest prescribed temperature (initial, walls) to the hottest prescribed or reached.
+
+    Parameters
+    ----------
+    writer : dem.output.writer.RunWriter
+        The run's writer.
+    scene : dem.scene.parse.Scene
+        The scene (its ``[output] frames``, walls and temperatures).
+    out_dir : str or pathlib.Path
+        The run folder.
+    """
 
     def __init__(self, writer, scene, out_dir):
         m = scene.motion
@@ -135,8 +187,30 @@ class WithFrames:
         self.frames(self.writer.engine)
 
     def finish(self, summary: dict, plots: bool = True) -> dict:
+        """Render the frames, then close the run's files (:meth:`dem.output.writer.RunWriter.finish`).
+
+        Parameters
+        ----------
+        summary : dict
+            The run's summary; gets ``frames``, the files rendered.
+        plots : bool
+            Whether to draw the run's plots.
+
+        Returns
+        -------
+        dict
+            The summary as written.
+        """
         summary["frames"] = self.frames.render()
         return self.writer.finish(summary, plots)
 
     def interrupted(self, summary: dict) -> None:
+        """Render the frames taken, then close the files of a stopped run
+        (:meth:`dem.output.writer.RunWriter.interrupted`).
+
+        Parameters
+        ----------
+        summary : dict
+            The run's summary so far.
+        """
         self.writer.interrupted({**summary, "frames": self.frames.render()})

@@ -34,7 +34,19 @@ def _arrays(tag: str, fields: dict) -> str:
 
 def write_pvtu(path, pieces: list[str], point_fields: dict, cell_fields: dict) -> None:
     """A parallel unstructured grid naming the VTU ``pieces`` (file names beside it), whose point and cell data
-    arrays are those of ``point_fields`` and ``cell_fields`` (name: an array of the right type and components)."""
+    arrays are those of ``point_fields`` and ``cell_fields`` (name: an array of the right type and components).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``.pvtu`` file to write.
+    pieces : list of str
+        The pieces' file names, relative to ``path``'s folder.
+    point_fields : dict
+        ``{name: array}`` whose dtype and components the point data declare.
+    cell_fields : dict
+        ``{name: array}`` whose dtype and components the cell data declare.
+    """
     text = ('<?xml version="1.0"?>\n<VTKFile type="PUnstructuredGrid" version="0.1" byte_order="LittleEndian">\n'
             '  <PUnstructuredGrid GhostLevel="0">\n'
             + _arrays("PPointData", point_fields) + _arrays("PCellData", cell_fields)
@@ -45,7 +57,23 @@ def write_pvtu(path, pieces: list[str], point_fields: dict, cell_fields: dict) -
 
 
 class PieceWriter(RunWriter):
-    """:class:`~dem.output.writer.RunWriter` on rank ``rank`` of ``ranks`` (module docstring)."""
+    """:class:`~dem.output.writer.RunWriter` on rank ``rank`` of ``ranks`` (module docstring).
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The run folder.
+    scene : dem.scene.parse.Scene
+        The scene.
+    engine : object
+        The engine that runs it (:mod:`dem.engines`).
+    rank : int
+        This process's rank.
+    ranks : int
+        Number of ranks.
+    resume_step : int or None
+        The step of the checkpoint a resumed run goes on from; None: a fresh run.
+    """
 
     def __init__(self, out_dir, scene, engine, rank: int, ranks: int, resume_step: int | None = None):
         self.rank, self.ranks = rank, ranks

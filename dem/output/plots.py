@@ -35,13 +35,41 @@ TEMPERATURE_UNITS = {"C": "°C", "K": "K"}  # [scene] temperature_unit: the symb
 
 
 def temperature_label(unit: str, what: str = "temperature") -> str:
-    """An axis label with the scene's temperature unit (``[scene] temperature_unit``: "C" or "K")."""
+    """An axis label with the scene's temperature unit (``[scene] temperature_unit``: "C" or "K").
+
+    Parameters
+    ----------
+    unit : str
+        ``"C"`` or ``"K"``.
+    what : str
+        The quantity named before the unit.
+
+    Returns
+    -------
+    str
+        ``"<what> (<symbol>)"``.
+    """
     return f"{what} ({TEMPERATURE_UNITS[unit]})"
 
 
 def motion_plots(out_dir, temperature_unit: str, wall_unit: str) -> list[str]:
     """Write the plots of a moving-particle run folder; returns the file names written. ``temperature_unit``: the
-    scene's ("C" or "K"); ``wall_unit``: that of the ``wall_*`` columns ("Pa", "N/m" or "N", one for all walls)."""
+    scene's ("C" or "K"); ``wall_unit``: that of the ``wall_*`` columns ("Pa", "N/m" or "N", one for all walls).
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The run folder (its ``timeseries.csv`` is read).
+    temperature_unit : str
+        ``"C"`` or ``"K"``.
+    wall_unit : str
+        The unit of the wall loads: ``"Pa"``, ``"N/m"`` or ``"N"``.
+
+    Returns
+    -------
+    list of str
+        The names of the files written.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -112,6 +140,20 @@ def thermal_plots(out_dir, scene, T) -> list[str]:
     * ``profile.png`` -- the temperature of every particle against its place along the heat-flow axis (the
       specimen's, :mod:`dem.scene.specimen`) with the mean of slabs, and the effective conductivity when the run
       reports one (scenes with a hot and a cold end).
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The run folder (its ``timeseries.csv`` is read).
+    scene : dem.scene.parse.Scene
+        The scene (particles, specimen, temperature unit).
+    T : numpy.ndarray
+        (N,) the particles' final temperatures (K or degC).
+
+    Returns
+    -------
+    list of str
+        The names of the files written.
     """
     import matplotlib
 

@@ -36,7 +36,27 @@ ACTIONS = ("temperature", "fixed", "material", "heat")
 
 def apply_groups(tables, particles: Particles) -> tuple[Particles, dict]:
     """The particles with what the ``[[groups]]`` ``tables`` give them (module docstring), and the groups that
-    hold their particles (``fixed = true``), ``{name: indices}``."""
+    hold their particles (``fixed = true``), ``{name: indices}``.
+
+    Parameters
+    ----------
+    tables : list of dict
+        The scene's ``[[groups]]`` tables, applied in order (a later group over an earlier one).
+    particles : dem.geometry.particles.Particles
+        The particles of ``[particles]``, before the groups.
+
+    Returns
+    -------
+    tuple of (dem.geometry.particles.Particles, dict)
+        The particles with each group's ``temperature``, ``fixed``, ``material`` and ``heat`` set, and the groups
+        with ``fixed = true`` as ``{name: indices}``.
+
+    Raises
+    ------
+    ValueError
+        ``tables`` is not a list, or a group has no (or a repeated) name, a bad selector or a bad value; the message
+        names the group and the key.
+    """
     if not isinstance(tables, list):
         raise ValueError("[[groups]]: must be an array of tables")
     held, names = {}, set()
@@ -58,7 +78,27 @@ def apply_groups(tables, particles: Particles) -> tuple[Particles, dict]:
 
 def select(table: dict, particles: Particles, where: str) -> np.ndarray:
     """The indices of the particles every selector of ``table`` chooses; ``ValueError`` when it has none or they
-    choose no particle."""
+    choose no particle.
+
+    Parameters
+    ----------
+    table : dict
+        One ``[[groups]]`` table; its selectors (``region``, ``ids``, ``types``, ``layer``) are read.
+    particles : dem.geometry.particles.Particles
+        The particles to choose from (positions in m, ids, materials).
+    where : str
+        The group's name in error messages (``"[groups][0] (hot)"``, say).
+
+    Returns
+    -------
+    numpy.ndarray
+        The indices (into ``particles``) of the chosen particles, ascending.
+
+    Raises
+    ------
+    ValueError
+        ``table`` has no selector, a selector is malformed, or together they choose no particle.
+    """
     given = [key for key in SELECTORS if key in table]
     if not given:
         raise ValueError(f"{where}: needs a selector ({', '.join(SELECTORS)})")

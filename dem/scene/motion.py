@@ -39,6 +39,54 @@ DEFAULT_OUTPUT_ROWS = 100     # rows of timeseries.csv when [output] interval is
 DEFAULT_THERMAL_STEPS = 1000  # mechanical steps per thermal step when [solver] thermal_interval is not given
 @dataclass(frozen=True)
 class MotionSpec:
+    """The moving part of a scene (module docstring), as :func:`parse_motion` reads it.
+
+    Parameters
+    ----------
+    dimension : int
+        3 (spheres) or 2 (disks in the x-z plane).
+    height : float or None
+        Height of the 2D disks (m); None in 3D.
+    velocity : numpy.ndarray or None
+        (N, 3) initial velocities (m/s); None: at rest.
+    angular_velocity : numpy.ndarray or None
+        (N, 3) initial angular velocities (rad/s); None: at rest.
+    walls : tuple of dem.geometry.walls.Wall
+        The walls, fixed or moving.
+    gravity : tuple of float
+        The gravitational acceleration [x, y, z] (m/s^2).
+    schedule : dem.scene.events.TemperatureSchedule or None
+        A prescribed temperature history; None: none.
+    dt : float
+        The mechanical time step (s).
+    stable_dt : float
+        The largest stable velocity-Verlet step for the stiffest contact (s).
+    skin : float
+        The neighbour list's skin (m).
+    thermal_interval : float
+        Time between the steps of a coupled thermal network (s).
+    thermal_integrator : str
+        That network's step: ``"implicit"`` or ``"crank-nicolson"``.
+    output_interval : float
+        Time between rows of ``timeseries.csv`` (s).
+    vtu_interval : float
+        Time between VTU snapshots (s).
+    phases : tuple
+        ``(start time (s), {material field: value})``, sorted by start.
+    start : dict or None
+        The saved state (:func:`dem.scene.state_file.load`) the run begins from; None: the scene's particles.
+    wall_phases : tuple
+        ``(start time (s), {wall name: inward velocity (m/s)})``, sorted by start.
+    stepping : dem.scene.zohdi.ZohdiStepping or None
+        The implicit stepping of ``law = "zohdi"``; None for other laws.
+    control : int or None
+        With ``law = "zohdi"``: the axis (0, 1, 2) the powder bed stands and is pressed along; None otherwise.
+    frames : int
+        With ``law = "zohdi"``: the number of rendered frames (PNG) over the run.
+    relaxation_time : float
+        The relaxation time of a relaxing material (s; Luding 2005, ``t0`` of eqs. 11-12), 0 without one.
+    """
+
     dimension: int
     height: float | None
     velocity: np.ndarray | None
@@ -79,7 +127,28 @@ def time_steps(contact, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarra
                height: float | None) -> tuple[float, float]:
     """``(dt, stable)`` of the contact law ``contact.law`` (its ``time_steps``): the step ``dt = "auto"`` takes, and
     the largest velocity-Verlet step that stays stable for the stiffest contact; a two-particle contact of the mean
-    radius sets the typical mass."""
+    radius sets the typical mass.
+
+    Parameters
+    ----------
+    contact : object
+        The contact law's material (:mod:`dem.laws.contact`), with its ``law`` and ``density`` (kg/m^3).
+    mass : numpy.ndarray
+        (N,) particle masses (kg).
+    inertia : numpy.ndarray
+        (N,) moments of inertia (kg m^2).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    dimension : int
+        3 (spheres) or 2 (disks).
+    height : float or None
+        Height of the 2D disks (m); None in 3D.
+
+    Returns
+    -------
+    tuple of (float, float)
+        ``(dt, stable)`` (s).
+    """
     m_mean = float(particle_mass(dimension, contact.density, np.mean(radius), height))
     return law_module(contact.law).time_steps(contact, mass, inertia, radius, m_mean)
 
@@ -87,7 +156,37 @@ def time_steps(contact, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarra
 def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, start=None, walls=()) -> MotionSpec:
     """The moving part of a scene (module docstring); ``particles``, ``solver``, the ``contact`` material and the
     ``walls`` are already parsed (the schema has checked every key); ``velocity`` comes from a generator (its random
-    ``speed``); ``start`` is a saved state."""
+    ``speed``); ``start`` is a saved state.
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed TOML document.
+    particles : dem.geometry.particles.Particles
+        The scene's particles.
+    solver : dem.scene.parse.SolverSpec
+        The scene's solver (transient, with ``t_end``).
+    physics : sequence of str
+        The scene's ``[scene] physics``.
+    contact : object
+        The contact law's material (:mod:`dem.laws.contact`).
+    velocity : numpy.ndarray or None
+        (N, 3) velocities from a generator (m/s); None: none.
+    start : dict or None
+        A saved state to begin from; None: none.
+    walls : tuple of dem.geometry.walls.Wall
+        The scene's walls.
+
+    Returns
+    -------
+    MotionSpec
+        The moving part of the scene.
+
+    Raises
+    ------
+    ValueError
+        A bad table or key (the message names it).
+    """
     meta = doc.get("scene", {})
     dimension = meta.get("dimension", 3)
     if dimension not in (2, 3) or isinstance(dimension, bool):

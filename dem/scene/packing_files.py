@@ -70,7 +70,47 @@ class Packing:
     ``box_lo``, ``box_hi`` (3,) m: the box, where the file gives one; ``periodic``: its periodic axes (3 bools), None
     where the file cannot say. ``source`` the file, ``format`` its format, ``timestep`` that of a dump's snapshot,
     ``units`` the LAMMPS unit style the file records (converted from), ``ignored`` the columns or fields that were
-    not read."""
+    not read.
+
+    Parameters
+    ----------
+    id : numpy.ndarray
+        (N,) int, the particles' ids.
+    position : numpy.ndarray
+        (N, 3) centres (m).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    temperature : numpy.ndarray or None
+        (N,) temperatures (the scene's unit, K or degC); None where the file has none.
+    fixed : numpy.ndarray or None
+        (N,) bool, True for a particle held at its temperature; None where the file has no such column.
+    material : numpy.ndarray or None
+        (N,) material indices from 0 (int) or material names (str); None where the file has none.
+    density : numpy.ndarray or None
+        (N,) densities (kg/m^3); None where the file has none.
+    velocity : numpy.ndarray or None
+        (N, 3) velocities (m/s); None where the file has none.
+    angular_velocity : numpy.ndarray or None
+        (N, 3) angular velocities (rad/s); None where the file has none.
+    image : numpy.ndarray or None
+        (N, 3) int, LAMMPS image flags: the periods by which a wrapped centre was moved; None where the file has
+        none.
+    box_lo, box_hi : numpy.ndarray or None
+        (3,) lower and upper corners of the box (m); None where the file gives no box.
+    periodic : tuple or None
+        Three bools, the box's periodic axes; None where the file cannot say.
+    source : str
+        The file read (its path as given).
+    format : str
+        The file's format, one of ``FORMATS``.
+    timestep : int or None
+        The timestep of a dump's snapshot; None for other files.
+    units : str or None
+        The LAMMPS unit style the file records (converted from to SI), a key of ``LAMMPS_UNITS``; None where
+        it records none.
+    ignored : tuple
+        The names of the columns or fields that were not read.
+    """
 
     id: np.ndarray
     position: np.ndarray
@@ -97,7 +137,25 @@ class Packing:
 
     def periodic_box(self, axes=None, drop=None):
         """The file's box as a :class:`dem.geometry.periodic.PeriodicBox`, periodic along ``axes`` (default: the file's
-        periodic axes); ``drop`` the temperature drop per period. ``ValueError`` when the file gives no box."""
+        periodic axes); ``drop`` the temperature drop per period. ``ValueError`` when the file gives no box.
+
+        Parameters
+        ----------
+        axes : sequence of bool or None
+            Three bools, the periodic axes; None: the file's (none where it cannot say).
+        drop : array_like or None
+            (3,) the temperature drop per period along each axis (K); None: zero.
+
+        Returns
+        -------
+        dem.geometry.periodic.PeriodicBox
+            The box from ``box_lo`` with lengths ``box_hi - box_lo`` (m).
+
+        Raises
+        ------
+        ValueError
+            The file gives no box.
+        """
         from dem.geometry.periodic import PeriodicBox
 
         if self.box_lo is None:
@@ -108,7 +166,21 @@ class Packing:
 
 
 class FileError(ValueError):
-    """A bad file: one line naming the file, the line and the column."""
+    """A bad file: one line naming the file, the line and the column.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+    message : str
+        What is wrong.
+    line : int or None
+        The line number in the file (from 1); None where not about one line.
+    column : int or None
+        The column number (from 1); None where not about one column.
+    name : str or None
+        The column's name, given after its number; None for none.
+    """
 
     def __init__(self, path, message: str, line: int | None = None, column: int | None = None,
                  name: str | None = None):
@@ -122,7 +194,23 @@ class FileError(ValueError):
 
 # --------------------------------------------------------------------------------------------------- reading
 def format_of(path) -> str:
-    """The format of a packing file, from its name (module docstring); ``ValueError`` when the name does not say."""
+    """The format of a packing file, from its name (module docstring); ``ValueError`` when the name does not say.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file's path (only its name is read).
+
+    Returns
+    -------
+    str
+        One of ``FORMATS``.
+
+    Raises
+    ------
+    ValueError
+        The name matches no format.
+    """
     p = pathlib.Path(path)
     name, suffix = p.name.lower(), p.suffix.lower()
     if suffix == ".csv":
@@ -142,7 +230,31 @@ def read_packing(path, format: str | None = None, length_unit: float = 1.0, time
     """The packing in the file ``path`` (module docstring). ``format``: one of ``FORMATS`` (default: from the
     name); ``length_unit``: metres per length unit of the file; ``timestep``: the snapshot of a dump (default: the
     last); ``periodic``: the periodic axes, as ``"xyz"``-letters or three bools, for files that do not record them
-    (a LAMMPS data file) or to override them."""
+    (a LAMMPS data file) or to override them.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The packing file.
+    format : str or None
+        One of ``FORMATS``; None: from the file's name (:func:`format_of`).
+    length_unit : float
+        Metres per length unit of the file, > 0 (0.001 for mm, 1e-6 for um).
+    timestep : int or None
+        The snapshot of a dump to read; None: its last.
+    periodic : str or sequence of bool or None
+        The periodic axes, as ``"xyz"`` letters (``"xy"``, say) or three bools; None: what the file records.
+
+    Returns
+    -------
+    Packing
+        The packing, in SI units.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, or a bad file (:class:`FileError`, one line naming the file, the line and the column).
+    """
     path = pathlib.Path(path)
     fmt = format_of(path) if format is None else format
     if fmt not in FORMATS:
@@ -234,7 +346,21 @@ def _warn_unit(p: Packing, length_unit: float) -> None:
 
 def printed_precision(x: np.ndarray, digits: int = PRINTED_DIGITS) -> float | None:
     """The largest rounding error (m) of coordinates ``x`` that carry at most ``digits`` significant digits (each
-    equal to itself rounded to them), or None where one carries more."""
+    equal to itself rounded to them), or None where one carries more.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Coordinates (m), any shape; zeros carry no digits and are skipped.
+    digits : int
+        Number of significant digits, >= 1 (``PRINTED_DIGITS``, LAMMPS's ``%g``, by default).
+
+    Returns
+    -------
+    float or None
+        Half the step of the last digit of the largest coordinate (m), or None where a coordinate carries more
+        digits or all are zero.
+    """
     x = np.asarray(x, dtype=float).ravel()
     x = x[x != 0.0]
     if not len(x):
@@ -793,7 +919,27 @@ def scene_particles(table: dict, materials, base_dir=None):
     and the file's box as a :class:`dem.geometry.periodic.PeriodicBox` (periodic along the axes the file says are, none where
     it cannot say), or None. ``temperature`` (a number or a list), ``fixed``, ``material`` (a name or index, or a
     list of them) and ``heat`` come from the table where given, else from the file; a density the file gives must be
-    its material's."""
+    its material's.
+
+    Parameters
+    ----------
+    table : dict
+        The scene's ``[particles]`` table, with its ``file`` key.
+    materials : sequence of dem.geometry.particles.Material
+        The scene's materials.
+    base_dir : str or pathlib.Path or None
+        The scene's folder, against which a relative ``file`` is read; None: the working directory.
+
+    Returns
+    -------
+    tuple of (dem.geometry.particles.Particles, dem.geometry.periodic.PeriodicBox or None)
+        The particles and the file's box.
+
+    Raises
+    ------
+    ValueError
+        A bad key of the table, a bad file, or a density of the file that is not its material's.
+    """
     from dem.geometry.particles import Particles, material_indices
 
     name = table["file"]
@@ -855,7 +1001,21 @@ def scene_particles(table: dict, materials, base_dir=None):
 # --------------------------------------------------------------------------------------------------- writing
 def packing_from_particles(particles, box=None) -> Packing:
     """A :class:`Packing` of a scene's :class:`dem.geometry.particles.Particles` (densities from its materials) in the
-    periodic box ``box`` (:class:`dem.geometry.periodic.PeriodicBox`) or none."""
+    periodic box ``box`` (:class:`dem.geometry.periodic.PeriodicBox`) or none.
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The scene's particles.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box; None: the packing has no box.
+
+    Returns
+    -------
+    Packing
+        The packing: ids, positions (m), radii (m), temperatures, fixed flags, material indices and densities
+        (kg/m^3).
+    """
     density = np.array([m.density for m in particles.materials], dtype=float)[particles.material]
     lo = hi = periodic = None
     if box is not None:
@@ -869,7 +1029,23 @@ def packing_from_state(state: dict) -> Packing:
     positions, radii, temperatures, ids; of a moving state also velocities, angular velocities and the density that
     gives each particle its saved mass as a sphere (``m / (4/3 pi r^3)``, also what LAMMPS computes the mass from),
     of a static one its materials (no density: the scene's materials have them). 3D states only: a 2D state's disks
-    lie in the x-z plane with a height, which LAMMPS's 2D spheres (x-y plane) do not have."""
+    lie in the x-z plane with a height, which LAMMPS's 2D spheres (x-y plane) do not have.
+
+    Parameters
+    ----------
+    state : dict
+        The saved state's arrays (:func:`dem.scene.state_file.load`).
+
+    Returns
+    -------
+    Packing
+        The packing (SI units).
+
+    Raises
+    ------
+    ValueError
+        The state is a moving 2D one.
+    """
     from dem.scene.state_file import saved_box
 
     if state["moving"] and int(state["dimension"]) != 3:
@@ -889,7 +1065,18 @@ def packing_from_state(state: dict) -> Packing:
 
 def lammps_ids(ids: np.ndarray) -> np.ndarray:
     """The atom ids a packing gets in LAMMPS, which numbers atoms from 1: its own ids where all are >= 1, else its
-    ids + 1 (this toolkit numbers particles from 0)."""
+    ids + 1 (this toolkit numbers particles from 0).
+
+    Parameters
+    ----------
+    ids : numpy.ndarray
+        (N,) int, the packing's ids (N >= 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) int, the ids shifted (where needed) so that the smallest is 1.
+    """
     ids = np.asarray(ids, dtype=np.int64)
     return ids if ids.min() >= 1 else ids + 1 - min(int(ids.min()), 0)
 
@@ -903,7 +1090,30 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
     periodicity is not part of a data file: the input script's ``boundary`` command sets it. A centre outside the
     packing's box (``lo <= x < hi``, LAMMPS's rule) is wrapped into it along a periodic axis, its image flag counting
     the periods (:func:`wrapped`), and refused along any other. Numbers are written to round-trip (the shortest
-    digits that read back to the same double)."""
+    digits that read back to the same double).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file to write (written aside, then moved into place).
+    packing : Packing
+        The packing.
+    density : float or array_like or None
+        Density (kg/m^3), one number or one per particle, for a packing without densities; None: the packing's.
+    pad : float
+        Where the packing has no box: how far (m) the box reaches beyond the particles' outermost surfaces.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    ValueError
+        The packing has no density and none is given, a density is not finite and > 0, or a centre lies outside
+        the box along a non-periodic axis.
+    """
     path = pathlib.Path(path)
     n = packing.n
     if packing.density is not None:
@@ -941,7 +1151,25 @@ def wrapped(packing: Packing, what: str = "packing") -> tuple[np.ndarray, np.nda
     """The centres of ``packing`` in its box, ``lo <= x < hi`` (LAMMPS's rule), and their image flags: along a
     periodic axis a centre outside is moved by whole periods and its flag counts them (``x + image L`` is kept);
     along any other (or where the packing cannot say which axes are periodic) a centre outside is refused with
-    ``ValueError`` naming the particle and ``what`` (LAMMPS would lose it: "Did not assign all atoms correctly")."""
+    ``ValueError`` naming the particle and ``what`` (LAMMPS would lose it: "Did not assign all atoms correctly").
+
+    Parameters
+    ----------
+    packing : Packing
+        The packing, with a box (``box_lo``, ``box_hi``).
+    what : str
+        What the error message calls the packing (a file's name, say).
+
+    Returns
+    -------
+    tuple of (numpy.ndarray, numpy.ndarray)
+        The wrapped centres, (N, 3) m, and their image flags, (N, 3) int.
+
+    Raises
+    ------
+    ValueError
+        A centre lies outside the box along an axis that is not periodic (or not known to be).
+    """
     x = np.array(packing.position, dtype=float)
     image = (np.zeros((packing.n, 3), dtype=np.int64) if packing.image is None
              else np.array(packing.image, dtype=np.int64))
@@ -992,7 +1220,20 @@ def _types(material, n: int) -> np.ndarray:
 
 def write_csv(path, packing: Packing) -> pathlib.Path:
     """Write ``packing`` as CSV (``id, x, y, z, radius`` and its optional columns), numbers that read back to the
-    same doubles."""
+    same doubles.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file to write.
+    packing : Packing
+        The packing.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
     path = pathlib.Path(path)
     columns = {"id": packing.id, "x": packing.position[:, 0], "y": packing.position[:, 1],
                "z": packing.position[:, 2], "radius": packing.radius}
@@ -1008,7 +1249,20 @@ def write_csv(path, packing: Packing) -> pathlib.Path:
 
 def write_vtu(path, packing: Packing) -> pathlib.Path:
     """Write ``packing`` as a VTU point set (vertex cells) with the point fields ``id``, ``radius`` and its
-    optional ones: what ParaView opens and :func:`read_packing` reads back."""
+    optional ones: what ParaView opens and :func:`read_packing` reads back.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file to write.
+    packing : Packing
+        The packing.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
     import meshio
 
     from dem.output.writer import write_vtu as write_whole

@@ -49,7 +49,33 @@ GENERATOR_KEYS = {
 @dataclass(frozen=True)
 class SolverSpec:
     """``mode`` steady|transient; transient: ``integrator``, ``dt`` (s or "auto"), ``t_end``, ``rtol`` (auto dt);
-    ``linear`` backend (:mod:`dem.network.linsolve`); ``floating`` steady policy; ``max_steps`` guard."""
+    ``linear`` backend (:mod:`dem.network.linsolve`); ``floating`` steady policy; ``max_steps`` guard.
+
+    Parameters
+    ----------
+    mode : str
+        ``"steady"`` (the steady temperatures) or ``"transient"`` (integrate in time to ``t_end``).
+    integrator : str
+        The transient time stepper, one of ``dem.network.heat.INTEGRATORS``.
+    dt : float or str
+        The time step (s, > 0), or ``"auto"`` (adaptive, to ``rtol``).
+    t_end : float or None
+        The time a transient run ends at (s, finite and > 0; required in transient mode).
+    rtol : float
+        Relative tolerance of the adaptive step ``dt = "auto"``, in ``[RTOL_MIN, 1)``.
+    linear : str
+        The linear solver: ``"auto"`` or one of ``dem.network.linsolve.BACKENDS``.
+    floating : str
+        What a steady solve does with a group of particles without a fixed temperature: ``"error"`` (refuse) or
+        ``"mean"`` (keep its capacity-weighted mean initial temperature), :func:`dem.network.heat.steady`.
+    max_steps : int
+        The most time steps a transient run may take (>= 1).
+
+    Raises
+    ------
+    ValueError
+        A field is out of its range; the message names it (``[solver] <key>``).
+    """
 
     mode: str = "steady"
     integrator: str = "crank-nicolson"
@@ -89,7 +115,24 @@ class SolverSpec:
 @dataclass(frozen=True)
 class OutputSpec:
     """CSV row every ``every`` steps; VTU snapshot every ``vtu_every`` steps (0: first and last only); a checkpoint
-    of a transient run every ``checkpoint_every`` seconds of wall time (:mod:`dem.output.folder`)."""
+    of a transient run every ``checkpoint_every`` seconds of wall time (:mod:`dem.output.folder`).
+
+    Parameters
+    ----------
+    every : int
+        Steps between rows of the time-series CSV (>= 1).
+    vtu_every : int
+        Steps between VTU snapshots (>= 0; 0: the first and last only).
+    vtu : bool
+        Whether to write VTU snapshots at all.
+    checkpoint_every : float
+        Wall-clock time between checkpoints of a transient run (s, > 0).
+
+    Raises
+    ------
+    ValueError
+        A field is out of its range; the message names it (``[output] <key>``).
+    """
 
     every: int = 1
     vtu_every: int = 0
@@ -111,7 +154,52 @@ class OutputSpec:
 @dataclass(frozen=True)
 class Scene:
     """One DEM run: particles (+ walls), conductance law, ambient sources, solver, outputs, the physics to run;
-    ``contact`` the Luding 2005 material of a ``[contact]`` table, or None."""
+    ``contact`` the Luding 2005 material of a ``[contact]`` table, or None.
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The particles at the start.
+    walls : tuple of dem.geometry.walls.Wall
+        The walls of a static packing (the moving walls of particles that move are ``motion.walls``).
+    conductance : dem.laws.conductance.ConductanceSpec
+        The contact geometry and conductance law.
+    sources : dem.laws.ambient.Sources
+        The exchanges with the surroundings (convection, radiation).
+    solver : SolverSpec
+        The thermal solver: steady or transient, and its options.
+    output : OutputSpec
+        What the run folder gets, and how often.
+    physics : tuple of str
+        The submodels to run, from ``PHYSICS``.
+    name : str
+        The scene's name (the file's stem, or a built-in's name).
+    description : str
+        One line saying what the scene is.
+    specimen : dem.scene.specimen.Specimen or None
+        The specimen of the effective conductivity ``k_eff = Q L / (A dT)``; None: the scene has none.
+    contact : object
+        The material of the contact law (:mod:`dem.laws.contact`), or None.
+    motion : dem.scene.motion.MotionSpec or None
+        The particles' motion (physics with ``"mechanical"``), or None for a static packing.
+    electrical : dem.scene.zohdi.ElectricalSpec or None
+        The current's scheme and electrodes (``"electrical"`` physics), or None.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box, or None.
+    engine : str
+        The engine that runs the scene (:mod:`dem.engines`), ``"static"`` by default.
+    start : dict or None
+        The saved state the run starts from (:func:`dem.scene.state_file.load`), or None.
+    temperature_unit : str
+        The unit of the scene's temperatures, ``"C"`` or ``"K"`` (:func:`temperature_unit`).
+    groups : dict
+        The ``[[groups]]`` that hold their particles, ``{name: indices}`` (:func:`dem.scene.groups.apply_groups`).
+
+    Raises
+    ------
+    ValueError
+        A particle's centre starts behind a wall (:func:`dem.geometry.walls.check_inside`).
+    """
 
     particles: Particles
     walls: tuple = ()
@@ -147,7 +235,18 @@ PHYSICS = ("thermal", "mechanical", "electrical")  # the submodels a scene can n
 
 def check_physics(names) -> None:
     """Every name a submodel that exists (``PHYSICS``); ``electrical`` runs with moving particles, or with
-    ``thermal`` on a static packing (its Joule heat is all it does there)."""
+    ``thermal`` on a static packing (its Joule heat is all it does there).
+
+    Parameters
+    ----------
+    names : sequence of str
+        The ``[scene] physics`` names.
+
+    Raises
+    ------
+    ValueError
+        A name is unknown, there is none, or ``electrical`` is named without ``thermal`` or ``mechanical``.
+    """
     for name in names:
         if name not in PHYSICS:
             raise ValueError(f"[scene] physics = {name!r}: unknown (available: {', '.join(PHYSICS)})")
@@ -174,6 +273,51 @@ def make_scene(position, radius, temperature, *, materials=(COPPER,), material=N
         make_scene(x, r, T, box=PeriodicBox(L, drop=[0, 0, 1.0]), law="fit")      # periodic, 1 K drop along z
 
     Keyword ``solver_options`` are :class:`SolverSpec` fields (``mode``, ``integrator``, ``dt``, ...).
+
+    Parameters
+    ----------
+    position : array_like
+        (N, 3) particle centres (m).
+    radius : float or array_like
+        Particle radii (m), one per particle.
+    temperature : float or array_like
+        Initial temperatures (K or degC), one per particle; the held ones keep theirs.
+    materials : sequence of dem.geometry.particles.Material
+        The materials (copper by default).
+    material : array_like or None
+        (N,) int, each particle's index into ``materials``; None: all the first.
+    fixed : array_like or None
+        (N,) bool, True for a particle held at its temperature; None: none held.
+    heat : array_like or None
+        (N,) internal heat source of each particle (W); None: none.
+    walls : sequence of dem.geometry.walls.Wall
+        The walls.
+    law : str
+        The conductance law (``dem.laws.conductance.LAWS``), read only where ``conductance`` is None.
+    conductance : dem.laws.conductance.ConductanceSpec or None
+        The law and its options; None: ``ConductanceSpec(law=law)``.
+    sources : dem.laws.ambient.Sources or None
+        Convection and radiation; None: neither.
+    solver : SolverSpec or None
+        The solver; None: ``SolverSpec(**solver_options)``.
+    output : OutputSpec or None
+        The outputs; None: the defaults.
+    name : str
+        The scene's name.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box; None: none.
+    **solver_options
+        :class:`SolverSpec` fields, read only where ``solver`` is None.
+
+    Returns
+    -------
+    Scene
+        The scene, with the specimen found between its ends (:func:`dem.scene.specimen.find_specimen`).
+
+    Raises
+    ------
+    ValueError
+        A bad array or option; the message names it.
     """
     particles = Particles.from_arrays(position, radius, temperature, materials, material, fixed, heat)
     walls = tuple(walls)
@@ -404,7 +548,28 @@ def _engine(doc: dict, physics, law) -> str:
 
 def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None) -> Scene:
     """Validate a parsed TOML document into a :class:`Scene`: every table and key against the schema of the engine
-    the scene runs on (:mod:`dem.scene.schema`), then each table into its part of the scene."""
+    the scene runs on (:mod:`dem.scene.schema`), then each table into its part of the scene.
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed TOML document (SI units).
+    source : str
+        The scene's name where ``[scene] name`` gives none (a file's stem).
+    base_dir : pathlib.Path or None
+        The scene file's folder, against which relative paths (a packing file, a saved state) are read; None:
+        the working directory.
+
+    Returns
+    -------
+    Scene
+        The scene.
+
+    Raises
+    ------
+    ValueError
+        A table or key is unknown, missing or bad; the message names the table and the key.
+    """
     if not isinstance(doc, dict):
         raise ValueError("scene: must be a table of tables")
     unknown = sorted(set(doc) - set(TABLES))
@@ -497,7 +662,27 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
 def temperature_unit(meta: dict, rad: Radiation | None, zohdi: bool) -> str:
     """``[scene] temperature_unit``: "C" or "K"; by default ``radiation.unit`` where the scene has radiation, "K"
     for scenes with Zohdi 2014's contact law (``zohdi``: its thermal softening and Joule heating work in kelvin),
-    else "C". Only labels the outputs: every law takes the scene's temperatures as they are."""
+    else "C". Only labels the outputs: every law takes the scene's temperatures as they are.
+
+    Parameters
+    ----------
+    meta : dict
+        The ``[scene]`` table.
+    rad : dem.laws.ambient.Radiation or None
+        The scene's radiation, whose ``unit`` is the default; None without radiation.
+    zohdi : bool
+        Whether the scene uses Zohdi 2014's contact law (default unit ``"K"``).
+
+    Returns
+    -------
+    str
+        ``"C"`` or ``"K"``.
+
+    Raises
+    ------
+    ValueError
+        The unit is neither, or differs from the radiation's.
+    """
     default = rad.unit if rad is not None else "K" if zohdi else "C"
     unit = meta.get("temperature_unit", default)
     if unit not in TEMPERATURE_UNITS:
@@ -521,7 +706,23 @@ def _check_walls_across(walls, box: PeriodicBox) -> None:
 def contact_material_from_scene(doc: dict):
     """The contact material of a TOML document's ``[contact]`` table: ``law`` names the contact law
     (:data:`dem.laws.contact.CONTACT_LAWS`), the other keys are its material's fields in SI units (``density``
-    defaults to that of a single ``[material]``)."""
+    defaults to that of a single ``[material]``).
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed TOML document.
+
+    Returns
+    -------
+    object
+        The contact law's material (its ``Material`` class, :mod:`dem.laws.contact`).
+
+    Raises
+    ------
+    ValueError
+        There is no ``[contact]`` table, its law is unknown, or a value is bad.
+    """
     table = doc.get("contact")
     if not isinstance(table, dict):
         raise ValueError(f"[contact]: must be a table with law = one of {', '.join(CONTACT_LAWS)}, and the material")
@@ -536,7 +737,23 @@ def contact_material_from_scene(doc: dict):
 def luding_material_from_scene(doc_or_scene):
     """The Luding 2005 contact material of a :class:`Scene` (its ``contact``) or of a TOML document (its
     ``[contact]`` table, :func:`contact_material_from_scene`). Raises ``ValueError`` when there is none or a value
-    is bad."""
+    is bad.
+
+    Parameters
+    ----------
+    doc_or_scene : Scene or dict
+        A scene, or a parsed TOML document.
+
+    Returns
+    -------
+    object
+        The Luding 2005 material (:mod:`dem.laws.contact`).
+
+    Raises
+    ------
+    ValueError
+        There is no Luding contact material, or a value is bad.
+    """
     if isinstance(doc_or_scene, Scene):
         material = doc_or_scene.contact
         if material is None or material.law != "luding":
@@ -579,7 +796,24 @@ def builtin_scenes() -> dict:
 
 
 def load_scene(name_or_path) -> Scene:
-    """Read a scene from a TOML file path or a built-in name (``python -m dem scenes`` lists them)."""
+    """Read a scene from a TOML file path or a built-in name (``python -m dem scenes`` lists them).
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path
+        A scene TOML file, or the name of a built-in scene.
+
+    Returns
+    -------
+    Scene
+        The scene.
+
+    Raises
+    ------
+    ValueError
+        No such file or built-in, a file that cannot be read or is malformed TOML, or a bad scene (the message
+        starts with the file's name).
+    """
     path = pathlib.Path(name_or_path)
     if not path.exists() and (SCENE_DIR / f"{name_or_path}.toml").exists():
         path = SCENE_DIR / f"{name_or_path}.toml"

@@ -31,7 +31,28 @@ class Specimen:
     """Length L (m) and cross-section A (m^2) for ``k_eff = Q L/(A dT)``, the hot and cold temperatures, the
     ``axis`` (0, 1, 2) along which heat flows, and the ends: ``hot_end``/``cold_end`` are ``("wall", name)`` or
     ``("group", name)`` (the held group of :func:`held_groups`). ``periodic``: instead, the period's face normal to
-    z, across which the temperature drops by ``hot - cold``."""
+    z, across which the temperature drops by ``hot - cold``.
+
+    Parameters
+    ----------
+    length : float
+        L, the distance between the two ends along ``axis`` (m).
+    area : float
+        A, the cross-section normal to ``axis`` (m^2), from :func:`cross_section`.
+    hot : float
+        Temperature of the hot end (the scene's unit, K or degC).
+    cold : float
+        Temperature of the cold end (same unit); ``hot - cold`` is the dT of ``k_eff``.
+    hot_end : tuple
+        The hot end, ``("wall", name)`` or ``("group", name)``.
+    cold_end : tuple
+        The cold end, in the same form.
+    periodic : bool
+        True where the specimen is the period itself (the temperature drops by ``hot - cold`` across it), not two
+        ends.
+    axis : int
+        The axis along which heat flows: 0, 1 or 2 (x, y, z).
+    """
 
     length: float
     area: float
@@ -52,13 +73,37 @@ class Specimen:
 
 
 def held_name(temperature: float) -> str:
-    """The name of the held particles of one temperature that no named group holds."""
+    """The name of the held particles of one temperature that no named group holds.
+
+    Parameters
+    ----------
+    temperature : float
+        The temperature the particles are held at (the scene's unit, K or degC).
+
+    Returns
+    -------
+    str
+        ``"held at T"``, with T to ten significant digits.
+    """
     return f"held at {temperature:.10g}"
 
 
 def held_groups(particles, named: dict | None = None) -> dict[str, np.ndarray]:
     """The groups of held (``fixed``) particles, ``{name: indices}``: every named group (``named``: ``{name:
-    indices}``) whose particles are all held, then the other held particles by temperature (:func:`held_name`)."""
+    indices}``) whose particles are all held, then the other held particles by temperature (:func:`held_name`).
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The scene's particles (their ``fixed`` flags and temperatures are read).
+    named : dict or None
+        The scene's named groups, ``{name: indices}`` (indices into ``particles``); None for none.
+
+    Returns
+    -------
+    dict
+        ``{name: indices}`` of every held group, named groups first.
+    """
     fixed = np.asarray(particles.fixed, dtype=bool)
     out, taken = {}, np.zeros(len(fixed), dtype=bool)
     for name, idx in (named or {}).items():
@@ -74,7 +119,20 @@ def held_groups(particles, named: dict | None = None) -> dict[str, np.ndarray]:
 
 
 def group_flows(groups: dict, into: dict) -> dict[str, float]:
-    """The heat flow (W) into each held group: the sum over its particles of ``into`` (``{index: W}``)."""
+    """The heat flow (W) into each held group: the sum over its particles of ``into`` (``{index: W}``).
+
+    Parameters
+    ----------
+    groups : dict
+        The held groups, ``{name: indices}`` (:func:`held_groups`).
+    into : dict
+        The heat flow into each held particle, ``{index: W}``; every index of ``groups`` must be a key.
+
+    Returns
+    -------
+    dict
+        ``{name: W}``, the total heat flow into each group (W).
+    """
     return {name: float(sum(into[int(k)] for k in idx)) for name, idx in groups.items()}
 
 
@@ -82,7 +140,27 @@ def find_specimen(particles, walls, box=None, named: dict | None = None, bounds=
     """The specimen between the scene's two ends (module docstring), or None where it has not exactly two ends
     at different temperatures that face each other along an axis. ``walls``: the scene's walls (those with a
     temperature are ends); ``box``: its :class:`dem.geometry.periodic.PeriodicBox` or None; ``named``: its named
-    groups ``{name: indices}``; ``bounds``: walls that only bound the cross-section (a saved state's)."""
+    groups ``{name: indices}``; ``bounds``: walls that only bound the cross-section (a saved state's).
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The scene's particles (positions in m, temperatures, ``fixed`` flags).
+    walls : sequence of dem.geometry.walls.Wall
+        The scene's walls; those with a temperature are ends.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box, whose periods give the cross-section along periodic axes; None without one.
+    named : dict or None
+        The scene's named groups, ``{name: indices}``; None for none.
+    bounds : sequence of dem.geometry.walls.Wall
+        Walls that only bound the cross-section (a saved state's), not ends.
+
+    Returns
+    -------
+    Specimen or None
+        The specimen, or None where the scene has not exactly two ends at different temperatures facing each other
+        along an axis a positive length apart.
+    """
     ends = [("wall", w.name, float(w.temperature), w) for w in walls if w.temperature is not None]
     for name, idx in held_groups(particles, named).items():
         T = np.unique(particles.temperature[idx])
@@ -123,7 +201,24 @@ def _where(end, axis: int, x: np.ndarray) -> float:
 
 def cross_section(particles, axis: int, box=None, bounds=()) -> float:
     """The area (m^2) normal to ``axis``: along each other axis the box's period, else the extent between the
-    ``bounds`` walls facing each other along it, else the particles' extent."""
+    ``bounds`` walls facing each other along it, else the particles' extent.
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The particles, whose outermost surfaces give the extent along an axis nothing else bounds (m).
+    axis : int
+        The axis the cross-section is normal to: 0, 1 or 2 (x, y, z).
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box, whose period (m) is the extent along each periodic axis; None without one.
+    bounds : sequence of dem.geometry.walls.Wall
+        Walls bounding the cross-section; two facing each other along an axis give its extent there.
+
+    Returns
+    -------
+    float
+        The cross-section's area (m^2).
+    """
     walls = list(bounds)
     pairs = box_axes(walls)
     offsets = np.array([w.offset for w in walls])

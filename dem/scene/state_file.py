@@ -40,7 +40,19 @@ COUNTERS = ("neighbour_rebuilds", "network_assemblies", "network_refreshes")
 
 def moving_arrays(engine) -> dict:
     """The state of an engine with moving particles (its ``mechanics``: state, walls, contact law, histories) as a
-    dict of arrays (module docstring)."""
+    dict of arrays (module docstring).
+
+    Parameters
+    ----------
+    engine : object
+        An engine of moving particles (:mod:`dem.engines.verlet`): its name, time, steps, scene and ``mechanics``
+        (:class:`dem.engines.verlet.mechanics.MechanicalModel`).
+
+    Returns
+    -------
+    dict
+        The state's arrays, SI units.
+    """
     mech = engine.mechanics
     s = mech.state
     data = {"engine": np.array(engine.name), "t": np.array(engine.t), "steps": np.array(engine.steps),
@@ -61,14 +73,36 @@ def moving_arrays(engine) -> dict:
 
 
 def box_arrays(box: PeriodicBox | None) -> dict:
-    """The periodic box ``box`` as arrays of a state (none without a box)."""
+    """The periodic box ``box`` as arrays of a state (none without a box).
+
+    Parameters
+    ----------
+    box : dem.geometry.periodic.PeriodicBox or None
+        The box, or None.
+
+    Returns
+    -------
+    dict
+        Its lengths (m), periodic axes and origin (m) as arrays; empty without a box.
+    """
     if box is None:
         return {}
     return {"box_lengths": box.lengths, "box_periodic": np.array(box.periodic), "box_origin": box.origin}
 
 
 def saved_box(data: dict) -> PeriodicBox | None:
-    """The periodic box of a loaded state (:func:`box_arrays`), or None."""
+    """The periodic box of a loaded state (:func:`box_arrays`), or None.
+
+    Parameters
+    ----------
+    data : dict
+        A loaded state (:func:`load`).
+
+    Returns
+    -------
+    dem.geometry.periodic.PeriodicBox or None
+        The box, or None where the state has none.
+    """
     if "box_lengths" not in data:
         return None
     return PeriodicBox(data["box_lengths"], tuple(bool(p) for p in data["box_periodic"]), data["box_origin"])
@@ -76,7 +110,20 @@ def saved_box(data: dict) -> PeriodicBox | None:
 
 def save(data: dict, path) -> pathlib.Path:
     """Write the state ``data`` (an engine's ``state()``) to ``path`` (``.npz``), written aside and renamed: an
-    interrupted save never leaves half a state."""
+    interrupted save never leaves half a state.
+
+    Parameters
+    ----------
+    data : dict
+        The state's arrays.
+    path : str or pathlib.Path
+        The ``.npz`` file to write (its folder is made).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     return write_aside(path, lambda fh: np.savez(fh, format=np.array(FORMAT), **data), "wb")
@@ -85,7 +132,23 @@ def save(data: dict, path) -> pathlib.Path:
 def load(path) -> dict:
     """The saved state at ``path`` as a dict (arrays, with its scalars and names as Python values; ``moving`` says
     whether it has the velocities and histories of particles that move); ``ValueError`` naming the file when it is
-    not one."""
+    not one.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``.npz`` file (a run's ``state.npz``).
+
+    Returns
+    -------
+    dict
+        The state (SI units).
+
+    Raises
+    ------
+    ValueError
+        The file cannot be read, is not a saved state, or is incomplete.
+    """
     path = pathlib.Path(path)
     data = read_npz(path, "[start] state")
     if str(data.get("format", "")) == FORMAT_1:
@@ -114,7 +177,18 @@ def _from_format_1(data: dict) -> dict:
 
 
 def normalised(data: dict) -> dict:
-    """The scalars and names of a loaded state (or checkpoint) as Python values."""
+    """The scalars and names of a loaded state (or checkpoint) as Python values.
+
+    Parameters
+    ----------
+    data : dict
+        The loaded arrays, changed in place.
+
+    Returns
+    -------
+    dict
+        ``data``, with ``moving`` set.
+    """
     data["engine"] = str(data["engine"])
     data["t"], data["steps"] = float(data["t"]), int(data["steps"])
     data["moving"] = "v" in data

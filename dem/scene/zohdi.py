@@ -42,7 +42,34 @@ class ZohdiStepping:
     least ``shrink`` (in [LEAST_FACTOR, 1)) and at most ``LEAST_FACTOR`` -- eq. (30) assumes the error falls as
     ``(S dt^p)^K``; where an iteration stalls instead (a force that is steep in the velocity, such as friction below
     ``v_slip``), Phi of a failed step is close to 1 and the restarts would creep -- and a floor ``dt_min`` below
-    which a step that cannot converge stops the run."""
+    which a step that cannot converge stops the run.
+
+    Parameters
+    ----------
+    dt : float
+        The first step (s), > 0.
+    dt_max : float
+        The upper bound Delta t_lim of the step (s), >= ``dt``.
+    phi : float
+        The trapezoidal weight, in ``[0, 1]`` (eqs. 22-24).
+    iterations : int
+        K_d, the target number of fixed-point iterations per step (eq. 30), >= 2.
+    tolerance : float
+        TOL, the relative change at which the fixed-point iteration stops (eqs. 47-48), > 0.
+    order : float
+        p of eq. (30), > 0.
+    growth : float
+        The largest factor by which an accepted step grows, >= 1.
+    shrink : float
+        The least factor by which a restarted step shrinks, in ``[LEAST_FACTOR, 1)``.
+    dt_min : float
+        The smallest step (s), in ``(0, dt]``: a step that cannot converge above it stops the run.
+
+    Raises
+    ------
+    ValueError
+        A field is not finite or out of its range (the message names it, ``[solver] <key>``).
+    """
 
     dt: float
     dt_max: float
@@ -86,7 +113,20 @@ class ZohdiStepping:
     def factor(self, error: float, K: int) -> float:
         """The step factor Phi_K of eq. (30) / Algorithm 1 (4c) for the relative iteration error ``error`` after
         ``K`` iterations: ``(TOL/D0)^(1/(p K_d)) / (D_K/D0)^(1/(p K))`` with ``D0 = 1`` (the first iterate's relative
-        change is 1 by construction), clipped to ``[LEAST_FACTOR, growth]``."""
+        change is 1 by construction), clipped to ``[LEAST_FACTOR, growth]``.
+
+        Parameters
+        ----------
+        error : float
+            The relative change of the last iterate (D_K, dimensionless).
+        K : int
+            The number of iterations done, >= 1.
+
+        Returns
+        -------
+        float
+            Phi_K, the factor the next step is multiplied by.
+        """
         if error <= 0.0:
             return self.growth
         p = self.order
@@ -94,7 +134,18 @@ class ZohdiStepping:
         return min(self.growth, max(LEAST_FACTOR, phi))
 
     def restart_factor(self, phi: float) -> float:
-        """The factor of a restarted step: Phi_K, but at least ``shrink`` and at most ``LEAST_FACTOR``."""
+        """The factor of a restarted step: Phi_K, but at least ``shrink`` and at most ``LEAST_FACTOR``.
+
+        Parameters
+        ----------
+        phi : float
+            Phi_K of the failed step (:meth:`factor`).
+
+        Returns
+        -------
+        float
+            The factor the restarted step is multiplied by, in ``[LEAST_FACTOR, shrink]``.
+        """
         return max(LEAST_FACTOR, min(phi, self.shrink))
 
 
@@ -103,7 +154,23 @@ STEPPING_KEYS = {f.name for f in fields(ZohdiStepping)}
 
 @dataclass(frozen=True)
 class ElectricalSpec:
-    """The ``[electrical]`` table and the electrodes of the ``[[walls]]``."""
+    """The ``[electrical]`` table and the electrodes of the ``[[walls]]``.
+
+    Parameters
+    ----------
+    scheme : str
+        How the current is solved: ``"kirchhoff"`` or ``"zohdi"`` (module docstring).
+    absorption : float
+        The fraction a of the Joule heat the particles absorb (Zohdi 2014, eq. 35), in ``[0, 1]``.
+    electrodes : dem.network.current.Electrodes
+        The electrified walls, each at a potential (V) or a current (A).
+    tolerance : float
+        Zohdi's iteration: the largest change per sweep relative to the largest wall value at which it stops, > 0.
+    sweeps : int
+        Zohdi's iteration: the most sweeps per refresh, >= 1.
+    floating : str
+        ``"allow"`` (particles touching no electrode carry no current) or ``"error"`` (stop, naming them).
+    """
 
     scheme: str
     absorption: float
@@ -123,7 +190,23 @@ def _number(table, section, key, default=None):
 
 
 def parse_stepping(table: dict) -> ZohdiStepping:
-    """The stepping parameters of ``[solver]`` (``dt`` required)."""
+    """The stepping parameters of ``[solver]`` (``dt`` required).
+
+    Parameters
+    ----------
+    table : dict
+        The ``[solver]`` table.
+
+    Returns
+    -------
+    ZohdiStepping
+        The stepping; ``dt_max`` defaults to ``dt``.
+
+    Raises
+    ------
+    ValueError
+        ``dt`` is missing or not a number, or a key is out of its range.
+    """
     if "dt" not in table:
         raise ValueError("[solver] dt: required with [contact] law = \"zohdi\" (the first step, s)")
     if isinstance(table["dt"], str):
@@ -138,7 +221,28 @@ def parse_stepping(table: dict) -> ZohdiStepping:
 
 def parse_electrical(doc: dict, walls, physics) -> ElectricalSpec | None:
     """The current's scheme and electrodes, or None without ``"electrical"`` physics (where electrode keys are
-    refused)."""
+    refused).
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed TOML document (its ``[electrical]`` table and ``[[walls]]``).
+    walls : sequence of dem.geometry.walls.Wall
+        The scene's walls, in the order of ``[[walls]]``.
+    physics : sequence of str
+        The scene's ``[scene] physics``.
+
+    Returns
+    -------
+    ElectricalSpec or None
+        The current's spec, or None without ``"electrical"`` physics.
+
+    Raises
+    ------
+    ValueError
+        A bad key, electrode keys without ``"electrical"`` physics, no electrode, or (Kirchhoff's scheme) no
+        electrode at a fixed potential.
+    """
     tables = doc.get("walls", [])
     names = [w.name for w in walls]
     marked = [(k, t) for k, t in enumerate(tables) if isinstance(t, dict) and set(t) & ELECTRODE_KEYS]
@@ -193,7 +297,43 @@ def parse_electrical(doc: dict, walls, physics) -> ElectricalSpec | None:
 
 def zohdi_motion(doc: dict, particles, solver, physics, start, walls, gravity, velocity, phases, wall_phases,
                  dimension):
-    """The :class:`~dem.scene.motion.MotionSpec` of a scene with ``[contact] law = "zohdi"``."""
+    """The :class:`~dem.scene.motion.MotionSpec` of a scene with ``[contact] law = "zohdi"``.
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed TOML document (its ``[solver]`` and ``[output]`` tables).
+    particles : dem.geometry.particles.Particles
+        The scene's particles (their mean radius sets the default skin, m).
+    solver : dem.scene.parse.SolverSpec
+        The scene's solver (its ``t_end``, s, sets the default output interval).
+    physics : sequence of str
+        The scene's ``[scene] physics`` (not read here).
+    start : dict or None
+        A saved state (not read here: the spec starts from the scene's particles).
+    walls : tuple of dem.geometry.walls.Wall
+        The scene's walls.
+    gravity : tuple of float
+        The gravitational acceleration [x, y, z] (m/s^2).
+    velocity : numpy.ndarray or None
+        (N, 3) initial velocities (m/s); None: at rest.
+    phases : tuple
+        The ``[[phases]]`` material changes (not read here: this law takes none).
+    wall_phases : tuple
+        ``(start time (s), {wall name: inward velocity (m/s)})``, sorted by start.
+    dimension : int
+        The scene's dimension; must be 3.
+
+    Returns
+    -------
+    dem.scene.motion.MotionSpec
+        The moving part of the scene.
+
+    Raises
+    ------
+    ValueError
+        ``dimension`` is not 3, or a bad ``[solver]`` or ``[output]`` key.
+    """
     from dem.scene.motion import MotionSpec, _num
 
     if dimension != 3:

@@ -40,7 +40,20 @@ HALO_MARGIN = 1.0 + 1e-9  # the halo's reach: this x one bond length (two larges
 
 
 def unsupported(scene, resume: bool = False) -> str | None:
-    """Why ``scene`` cannot run on several ranks (module docstring), or None."""
+    """Why ``scene`` cannot run on several ranks (module docstring), or None.
+
+    Parameters
+    ----------
+    scene : dem.scene.parse.Scene
+        The scene.
+    resume : bool
+        Whether the run would resume from a checkpoint.
+
+    Returns
+    -------
+    str or None
+        The one-line reason, or None where it can run.
+    """
     s = scene.solver
     if scene.sources.radiation is not None:
         return f"scene {scene.name!r}: radiation (a Newton iteration) does not run under MPI; run it without mpiexec"
@@ -68,6 +81,20 @@ class DistributedStaticEngine(StaticEngine):
     name = "static"
 
     def __init__(self, scene, restart: dict | None = None):
+        """This rank's particles of ``scene`` and their network.
+
+        Parameters
+        ----------
+        scene : dem.scene.parse.Scene
+            The scene.
+        restart : dict or None
+            A checkpoint (refused: a distributed run does not resume); None.
+
+        Raises
+        ------
+        ValueError
+            The scene cannot run on several ranks (:func:`unsupported`).
+        """
         why = unsupported(scene, restart is not None)
         if why is not None:
             raise ValueError(why)
@@ -145,7 +172,22 @@ class DistributedStaticEngine(StaticEngine):
     # ------------------------------------------------------------------------------------------------ run
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """Solve (steady) or step (transient) to ``[solver] t_end`` on all ranks together (``checkpoint`` unused:
-        a distributed run does not resume)."""
+        a distributed run does not resume).
+
+        Parameters
+        ----------
+        observe : callable or None
+            Called without arguments at the output times; None: not called.
+        progress : callable or None
+            Called with the simulated time (s); None: not called.
+        checkpoint : callable or None
+            Called as ``checkpoint(make, final)``; None: not called.
+
+        Raises
+        ------
+        ValueError
+            The network has no solution (a floating group) or the solve failed.
+        """
         s = self.scene.solver
         out = {"law": self.scene.conductance.law, "contact": self.bonds.contact, "bonds_clipped": 0,
                "bonds_dropped": 0, "wall_bonds": self.part.total(int(self.bonds.n_walls)), "ranks": self.ranks}

@@ -57,7 +57,15 @@ class StaggeredEngine:
     def __init__(self, scene, restart: dict | None = None):
         """``restart``: a checkpoint of this scene's run (:meth:`checkpoint`): the run goes on from its step, bit for
         bit. A scene that starts from a saved state goes on from its positions, velocities, temperatures, time and
-        counters."""
+        counters.
+
+        Parameters
+        ----------
+        scene : dem.scene.parse.Scene
+            The scene, with ``[contact] law = "zohdi"``.
+        restart : dict or None
+            A checkpoint of this scene's run to go on from; None: start at the scene's start.
+        """
         self.scene = scene
         m, p = scene.motion, scene.particles
         self.stepping = m.stepping
@@ -203,7 +211,22 @@ class StaggeredEngine:
 
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """Advance to ``[solver] t_end``; ``observe()`` at the start, whenever an output time is passed, and at the
-        end; ``progress(t)`` and ``checkpoint(make, final)`` after every step."""
+        end; ``progress(t)`` and ``checkpoint(make, final)`` after every step.
+
+        Parameters
+        ----------
+        observe : callable or None
+            Called without arguments at the output times; None: not called.
+        progress : callable or None
+            Called with the simulated time (s) after every step; None: not called.
+        checkpoint : callable or None
+            Called as ``checkpoint(make, final)`` after every step; None: not called.
+
+        Raises
+        ------
+        ConvergenceError
+            A step cannot converge even at ``dt_min`` (a ValueError, as is a particle leaving the box).
+        """
         t_end = self.scene.solver.t_end
         every = self.scene.motion.output_interval
         next_out = self.t_start + every
@@ -382,6 +405,20 @@ class StaggeredEngine:
         return self.mechanics.state.T.copy()
 
     def plots(self, out, summary: dict) -> list[str]:
+        """Write the run folder's plots (:func:`dem.output.plots.motion_plots`, wall loads as forces).
+
+        Parameters
+        ----------
+        out : str or pathlib.Path
+            The run folder.
+        summary : dict
+            The run's summary (not read).
+
+        Returns
+        -------
+        list of str
+            The names of the files written.
+        """
         from dem.output.plots import motion_plots
 
         return motion_plots(out, self.scene.temperature_unit, "N")  # the walls' loads: forces
@@ -416,6 +453,21 @@ class StaggeredEngine:
 
 
 def cap_volume(centre, radius, level):
-    """Volume of each sphere below the plane ``x = level`` along its axis (a spherical cap), m^3."""
+    """Volume of each sphere below the plane ``x = level`` along its axis (a spherical cap), m^3.
+
+    Parameters
+    ----------
+    centre : array_like
+        The spheres' centres' coordinates along the axis (m).
+    radius : array_like
+        Their radii (m).
+    level : float
+        The plane's coordinate along the axis (m).
+
+    Returns
+    -------
+    numpy.ndarray
+        The volumes below the plane (m^3).
+    """
     h = np.clip(level - (np.asarray(centre) - radius), 0.0, 2.0 * radius)
     return math.pi * h * h * (3.0 * radius - h) / 3.0

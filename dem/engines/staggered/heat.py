@@ -40,7 +40,35 @@ from dem.network.laplacian import BoundedLaplacian
 def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_of_range: str):
     """``(particles at x, bonds)``: the touching pairs of the Verlet list of ``mech`` at positions ``x`` and the
     particles touching the walls ``wall_ids`` (where the mechanics has them), with contact radii from the geometry
-    ``contact`` (:func:`dem.geometry.bonds.find_bonds`; in the periodic box of ``mech`` across its faces)."""
+    ``contact`` (:func:`dem.geometry.bonds.find_bonds`; in the periodic box of ``mech`` across its faces).
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The scene's particles (radii in m, materials, fixed flags, heat sources).
+    mech : dem.engines.staggered.mechanics.StaggeredMechanics
+        The mechanics: its Verlet lists, walls and periodic box.
+    x : numpy.ndarray
+        (N, 3) particle positions (m).
+    T : numpy.ndarray
+        (N,) temperatures (K).
+    wall_ids : sequence of int
+        Indices of the walls whose contacts are wanted.
+    contact : str
+        The contact geometry (``dem.geometry.bonds.CONTACT_MODELS``).
+    out_of_range : str
+        The policy for contacts beyond the geometry's range: ``"error"``, ``"clip"`` or ``"drop"``.
+
+    Returns
+    -------
+    tuple of (dem.geometry.particles.Particles, dem.geometry.bonds.Bonds)
+        The particles at ``x`` with temperatures ``T``, and the bonds.
+
+    Raises
+    ------
+    ValueError
+        A contact beyond the geometry's range with ``out_of_range = "error"``.
+    """
     closed = kernels.closed_pairs(x, particles.radius, mech.pi, mech.pj, mech.box)
     now = Particles(x, particles.radius, T, particles.material, particles.fixed, particles.heat, particles.materials)
     planes = [mech.walls[k].at(float(mech.w.q[k])) for k in wall_ids]
@@ -49,7 +77,17 @@ def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_
 
 
 class LumpedHeat:
-    """The temperatures of the particles (module docstring)."""
+    """The temperatures of the particles (module docstring).
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The scene's particles: initial temperatures (K), capacities, conductivities, fixed flags.
+    walls : sequence of dem.geometry.walls.Wall
+        The scene's walls; those with a temperature are isothermal planes.
+    spec : dem.laws.conductance.ConductanceSpec
+        The conductance law of the contacts.
+    """
 
     name = "thermal"
 
@@ -84,7 +122,22 @@ class LumpedHeat:
 
     def conductances(self, mech, x, T):
         """``(K, K_w, plane_node, plane_index)``: the conductances (W/K) of the listed pairs (0 where they do not
-        touch) and of the plane bonds, at positions ``x``."""
+        touch) and of the plane bonds, at positions ``x``.
+
+        Parameters
+        ----------
+        mech : dem.engines.staggered.mechanics.StaggeredMechanics
+            The mechanics: its Verlet lists, walls and periodic box.
+        x : numpy.ndarray
+            (N, 3) particle positions (m).
+        T : numpy.ndarray
+            (N,) temperatures (K).
+
+        Returns
+        -------
+        tuple
+            ``(K, K_w, plane_node, plane_index)``: W/K, W/K and the plane bonds' particles and walls.
+        """
         plane_node, plane_index, wall = self._plane_bonds(mech)
         K, K_w = np.empty(len(mech.pi)), np.empty(len(plane_node))
         if self.spec.law == "zohdi":
@@ -111,7 +164,22 @@ class LumpedHeat:
 
     def conduction(self, mech, x, T) -> np.ndarray:
         """``Q_i`` (W) of eq. (33) at positions ``x`` (the contacts of the Verlet list of the mechanics ``mech``,
-        the walls where it has them) and temperatures ``T``: the flux of the network (module docstring)."""
+        the walls where it has them) and temperatures ``T``: the flux of the network (module docstring).
+
+        Parameters
+        ----------
+        mech : dem.engines.staggered.mechanics.StaggeredMechanics
+            The mechanics: its Verlet lists, walls and periodic box.
+        x : numpy.ndarray
+            (N, 3) particle positions (m).
+        T : numpy.ndarray
+            (N,) temperatures (K).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) ``Q_i`` (W).
+        """
         K, K_w, plane_node, plane_index = self.conductances(mech, x, T)
         g = self.graph
         if g is not None and g.same_edges(mech.pi, mech.pj, plane_node, plane_index):
@@ -124,12 +192,37 @@ class LumpedHeat:
         return g.flux(T, self.wall_T)
 
     def start(self, mech) -> None:
-        """``Q^L`` at the state of ``mech`` (the first step)."""
+        """``Q^L`` at the state of ``mech`` (the first step).
+
+        Parameters
+        ----------
+        mech : dem.engines.staggered.mechanics.StaggeredMechanics
+            The mechanics: its Verlet lists, walls and periodic box.
+        """
         self.Q = self.conduction(mech, mech.state.x, self.T)
 
     def iterate(self, dt: float, phi: float, mech, T_prev, H) -> np.ndarray:
         """``theta^K`` of eq. (37) from the previous iterate ``T_prev`` at the positions of the latest iterate of
-        the mechanics ``mech`` with the Joule heating ``H`` (W per particle)."""
+        the mechanics ``mech`` with the Joule heating ``H`` (W per particle).
+
+        Parameters
+        ----------
+        dt : float
+            The step (s).
+        phi : float
+            The trapezoidal weight of eq. (36), in ``[0, 1]``.
+        mech : dem.engines.staggered.mechanics.StaggeredMechanics
+            The mechanics: its Verlet lists, walls and periodic box.
+        T_prev : numpy.ndarray
+            (N,) the previous iterate's temperatures (K).
+        H : numpy.ndarray
+            (N,) Joule heating of each particle (W).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) ``theta^K`` (K); the fixed particles keep theirs.
+        """
         self._Q_iter = self.conduction(mech, mech.x_iterate, T_prev)
         T = self.T + dt / self.C * (phi * self._Q_iter + (1.0 - phi) * self.Q + H)
         T[~self.free] = self.T[~self.free]
@@ -137,7 +230,21 @@ class LumpedHeat:
 
     def accept(self, dt: float, phi: float, T, mech, H) -> None:
         """The iterate ``T`` becomes the state: the heat of the step is booked (with the flows the iteration used)
-        and ``Q^L`` of the next step is taken at the accepted state."""
+        and ``Q^L`` of the next step is taken at the accepted state.
+
+        Parameters
+        ----------
+        dt : float
+            The step (s).
+        phi : float
+            The trapezoidal weight of eq. (36), in ``[0, 1]``.
+        T : numpy.ndarray
+            (N,) the accepted iterate's temperatures (K).
+        mech : dem.engines.staggered.mechanics.StaggeredMechanics
+            The mechanics: its Verlet lists, walls and periodic box.
+        H : numpy.ndarray
+            (N,) Joule heating of each particle (W).
+        """
         f = self.free
         self.heat_in["boundaries"] += dt * float(phi * self._Q_iter[f].sum() + (1.0 - phi) * self.Q[f].sum())
         self.heat_in["joule"] += dt * float(np.sum(H[f]))

@@ -42,7 +42,30 @@ class StaggeredMechanics:
         """``material``: the contact law's material (``material.law`` names the law: one whose particles do not
         rotate); ``history``: a saved state (:mod:`dem.scene.state_file`) whose walls (by name: offset and speed)
         and, for the same contact law, contact histories the model starts from; ``box``: a periodic box (module
-        docstring)."""
+        docstring).
+
+        Parameters
+        ----------
+        state : dem.geometry.motion.MotionState
+            The particles' state (SI units), advanced in place.
+        walls : sequence of dem.geometry.walls.Wall
+            The walls (fixed, strain or vibrating; no stress walls).
+        material : object
+            The contact law's material (:mod:`dem.laws.contact`).
+        gravity : array_like
+            The gravitational acceleration [x, y, z] (m/s^2).
+        skin : float
+            The Verlet list's skin (m).
+        history : dict or None
+            A saved state to start the walls and contact histories from; None: none.
+        box : dem.geometry.periodic.PeriodicBox or None
+            The periodic box; None: none.
+
+        Raises
+        ------
+        ValueError
+            A stress-controlled wall, or an unknown contact law.
+        """
         self.state = state
         self.walls = tuple(walls)
         for wall in self.walls:
@@ -117,7 +140,13 @@ class StaggeredMechanics:
 
     def resume_lists(self, saved: dict) -> None:
         """The Verlet lists of a checkpoint (a resumed run rebuilds them at the uninterrupted run's steps), with the
-        forces of the start of the step on them."""
+        forces of the start of the step on them.
+
+        Parameters
+        ----------
+        saved : dict
+            The checkpoint's arrays (:func:`dem.geometry.neighbours.list_arrays`, with ``x`` and ``p_hist``).
+        """
         restore_lists(self, saved)
         self._p_hist_iter = np.zeros_like(self.p_hist)
         s = self.state
@@ -143,7 +172,20 @@ class StaggeredMechanics:
 
     # --------------------------------------------------------------------------------------------- walls
     def wall_offsets(self, t: float, dt: float) -> np.ndarray:
-        """Where the walls are at ``t + dt`` when the step starts at ``t`` with them at ``q_start``."""
+        """Where the walls are at ``t + dt`` when the step starts at ``t`` with them at ``q_start``.
+
+        Parameters
+        ----------
+        t : float
+            The step's start (s).
+        dt : float
+            The step (s).
+
+        Returns
+        -------
+        numpy.ndarray
+            (W,) the walls' offsets (m).
+        """
         w = self.w
         q = self.q_start.copy()
         strain = w.mode == MOTIONS["strain"]
@@ -153,13 +195,29 @@ class StaggeredMechanics:
         return q
 
     def set_wall_velocity(self, name: str, velocity: float) -> None:
-        """A strain wall's inward speed from now on (a ``[[phases]]`` entry)."""
+        """A strain wall's inward speed from now on (a ``[[phases]]`` entry).
+
+        Parameters
+        ----------
+        name : str
+            The wall's name.
+        velocity : float
+            Its inward speed (m/s).
+        """
         m = [w.name for w in self.walls].index(name)
         self.w.dq[m] = velocity
 
     # ----------------------------------------------------------------------------------------------- step
     def begin(self, t: float, dt: float) -> None:
-        """Start a step of ``dt`` from the state now: walls to their end-of-step place, iterate 0 = the state."""
+        """Start a step of ``dt`` from the state now: walls to their end-of-step place, iterate 0 = the state.
+
+        Parameters
+        ----------
+        t : float
+            The step's start (s).
+        dt : float
+            The step (s).
+        """
         self.q_start = self.w.q.copy()
         self.w.q[:] = self.wall_offsets(t, dt)
         if max_displacement(self.state.x, self.x_ref, self.box) + self._wall_reach() > 0.5 * self.skin:
@@ -169,7 +227,27 @@ class StaggeredMechanics:
 
     def iterate(self, dt: float, phi: float, T: np.ndarray) -> tuple[float, float]:
         """One fixed-point iteration at the temperatures ``T`` (those of the previous iterate): the new iterate is
-        ``x_new``, ``v_new``. Returns ``(sum |r^K - r^(K-1)|, sum |r^K - r^L|)``."""
+        ``x_new``, ``v_new``. Returns ``(sum |r^K - r^(K-1)|, sum |r^K - r^L|)``.
+
+        Parameters
+        ----------
+        dt : float
+            The step (s).
+        phi : float
+            The trapezoidal weight, in ``[0, 1]`` (eqs. 22-24).
+        T : numpy.ndarray
+            (N,) temperatures (K).
+
+        Returns
+        -------
+        tuple of (float, float)
+            The change since the last iterate and the motion since the step's start (m, summed over particles).
+
+        Raises
+        ------
+        ValueError
+            A particle left the box through a wall, or a position became non-finite.
+        """
         s, w = self.state, self.w
         escaped = self._iterate(dt, phi, s.x, s.v, self.f, self.x_prev, self.v_prev, T, s.mass, s.radius,
                                 self.gravity, self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn, self.p_ft,
@@ -195,7 +273,13 @@ class StaggeredMechanics:
 
     def accept(self, T: np.ndarray) -> None:
         """The latest iterate becomes the state (with the temperatures ``T`` of the step's end); its forces become
-        F^L of the next step and the histories it made are kept (Zohdi 2014: the bonds it activated)."""
+        F^L of the next step and the histories it made are kept (Zohdi 2014: the bonds it activated).
+
+        Parameters
+        ----------
+        T : numpy.ndarray
+            (N,) temperatures (K).
+        """
         s = self.state
         s.x[:] = self.x_prev
         s.v[:] = self.v_prev
@@ -215,7 +299,18 @@ class StaggeredMechanics:
 
     # -------------------------------------------------------------------------------------------- outputs
     def pair_column(self, name: str) -> np.ndarray:
-        """The column ``name`` of the listed pairs' committed history (``law.PAIR_HISTORY``; e.g. ``"bonded"``)."""
+        """The column ``name`` of the listed pairs' committed history (``law.PAIR_HISTORY``; e.g. ``"bonded"``).
+
+        Parameters
+        ----------
+        name : str
+            A name of the law's ``PAIR_HISTORY``.
+
+        Returns
+        -------
+        numpy.ndarray
+            One value per listed pair.
+        """
         return self.p_hist[:, self.law.PAIR_HISTORY.index(name)]
 
     def contacts(self):

@@ -23,7 +23,19 @@ import numpy as np
 @dataclass(frozen=True)
 class Slabs:
     """``cuts`` (P + 1,) along ``axis``; ``period`` the box length along it (0: open axis, the outer cuts are
-    -inf and inf) and ``origin`` the box's lower face."""
+    -inf and inf) and ``origin`` the box's lower face.
+
+    Parameters
+    ----------
+    axis : int
+        The axis the slabs are cut along: 0, 1 or 2 (x, y, z).
+    cuts : numpy.ndarray
+        (P + 1,) the slabs' faces along the axis (m), ascending.
+    period : float
+        The periodic box's length along the axis (m); 0: an open axis.
+    origin : float
+        The box's lower face along the axis (m).
+    """
 
     axis: int
     cuts: np.ndarray
@@ -32,7 +44,31 @@ class Slabs:
 
     @classmethod
     def balanced(cls, coordinate: np.ndarray, ranks: int, axis: int, period: float = 0.0, origin: float = 0.0):
-        """Slabs holding nearly equal numbers of the particles at ``coordinate`` (their positions along ``axis``)."""
+        """Slabs holding nearly equal numbers of the particles at ``coordinate`` (their positions along ``axis``).
+
+        Parameters
+        ----------
+        coordinate : numpy.ndarray
+            (N,) the particles' coordinates along ``axis`` (m).
+        ranks : int
+            Number of slabs, >= 1.
+        axis : int
+            The axis: 0, 1 or 2.
+        period : float
+            The periodic box's length along the axis (m); 0: an open axis.
+        origin : float
+            The box's lower face along the axis (m).
+
+        Returns
+        -------
+        Slabs
+            The slabs.
+
+        Raises
+        ------
+        ValueError
+            ``ranks < 1``.
+        """
         if ranks < 1:
             raise ValueError(f"ranks = {ranks!r}: must be at least 1")
         u = np.sort(cls(axis, np.zeros(2), period, origin).wrapped(np.asarray(coordinate, dtype=float)))
@@ -46,18 +82,53 @@ class Slabs:
         return len(self.cuts) - 1
 
     def wrapped(self, u: np.ndarray) -> np.ndarray:
-        """Coordinates along the axis, wrapped into ``[origin, origin + period)`` on a periodic axis."""
+        """Coordinates along the axis, wrapped into ``[origin, origin + period)`` on a periodic axis.
+
+        Parameters
+        ----------
+        u : numpy.ndarray
+            Coordinates along the axis (m).
+
+        Returns
+        -------
+        numpy.ndarray
+            The wrapped coordinates (m); unchanged on an open axis.
+        """
         if self.period > 0:
             return self.origin + np.mod(u - self.origin, self.period)
         return u
 
     def owner(self, x: np.ndarray) -> np.ndarray:
-        """The rank owning each particle at positions ``x`` (N, 3)."""
+        """The rank owning each particle at positions ``x`` (N, 3).
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            (N, 3) particle centres (m).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) int, the ranks.
+        """
         u = self.wrapped(x[:, self.axis])
         return np.clip(np.searchsorted(self.cuts, u, side="right") - 1, 0, self.ranks - 1)
 
     def distance(self, x: np.ndarray, rank: int) -> np.ndarray:
-        """How far each centre lies from the slab of ``rank`` along the axis (0 inside it)."""
+        """How far each centre lies from the slab of ``rank`` along the axis (0 inside it).
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            (N, 3) particle centres (m).
+        rank : int
+            The rank, ``0 <= rank < ranks``.
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) the distances (m), the nearer image on a periodic axis.
+        """
         u = self.wrapped(x[:, self.axis])
         lo, hi = self.cuts[rank], self.cuts[rank + 1]
         images = (u - self.period, u, u + self.period) if self.period > 0 else (u,)  # both ways round the box
@@ -65,5 +136,20 @@ class Slabs:
 
     def within_halo(self, x: np.ndarray, rank: int, halo: float) -> np.ndarray:
         """Indices of the particles at ``x`` closer than ``halo`` to the slab of ``rank`` (those of another rank's
-        slab are the ghosts ``rank`` needs)."""
+        slab are the ghosts ``rank`` needs).
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            (N, 3) particle centres (m).
+        rank : int
+            The rank, ``0 <= rank < ranks``.
+        halo : float
+            The halo's width (m).
+
+        Returns
+        -------
+        numpy.ndarray
+            Indices of those particles.
+        """
         return np.flatnonzero(self.distance(x, rank) < halo)

@@ -51,7 +51,15 @@ class VerletEngine:
     def __init__(self, scene, restart: dict | None = None):
         """``restart``: a checkpoint of this scene's run (:meth:`checkpoint` as loaded by
         :func:`dem.output.folder.load`): the run goes on from its step as if it had not stopped. A scene that starts
-        from a saved state (``[start] state``) goes on from that state's time and counters."""
+        from a saved state (``[start] state``) goes on from that state's time and counters.
+
+        Parameters
+        ----------
+        scene : dem.scene.parse.Scene
+            The scene.
+        restart : dict or None
+            A checkpoint of this scene's run to go on from; None: start at the scene's start.
+        """
         self.scene = scene
         m = scene.motion
         p = scene.particles
@@ -182,7 +190,22 @@ class VerletEngine:
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """Advance to ``[solver] t_end``; ``observe()`` after each interval that ends on an output time (and at the
         start), ``progress(t)`` after every interval, ``checkpoint(make, final)`` after every interval and at the end
-        (:class:`dem.output.folder.Checkpointer`)."""
+        (:class:`dem.output.folder.Checkpointer`).
+
+        Parameters
+        ----------
+        observe : callable or None
+            Called without arguments at the output times; None: not called.
+        progress : callable or None
+            Called with the simulated time (s); None: not called.
+        checkpoint : callable or None
+            Called as ``checkpoint(make, final)``; None: not called.
+
+        Raises
+        ------
+        ValueError
+            The mechanics stopped (a non-finite state, a particle leaving the box).
+        """
         m, mech = self.scene.motion, self.mechanics
         n_end = max(1, math.ceil((self.scene.solver.t_end - mech.t_start) / mech.dt - 1e-9))
         out_every = max(1, round(m.output_interval / mech.dt))
@@ -291,7 +314,19 @@ class VerletEngine:
     def profile(self, bins: int = 8) -> dict | None:
         """Solid fraction and mean neck radius (Rojek's volume-conserving neck of each contact's overlap, a/r of
         the smaller particle) in slabs parallel to the hot wall, against the distance from it; None without a hot
-        wall and a closed box."""
+        wall and a closed box.
+
+        Parameters
+        ----------
+        bins : int
+            Number of slabs.
+
+        Returns
+        -------
+        dict or None
+            ``distance`` (m, the slabs' middles from the hot wall), ``solid_fraction`` and ``neck_over_radius`` (mean
+            a/r, None for a slab without contacts); None without a hot wall and a closed box.
+        """
         pair = self.heated_walls()
         volume = self.box_volume()
         if pair is None or volume is None:
@@ -430,6 +465,20 @@ class VerletEngine:
         return np.asarray(neck_radius(ri, rj, np.minimum(overlap, 0.999 * max_overlap(ri, rj))), dtype=float)
 
     def plots(self, out, summary: dict) -> list[str]:
+        """Write the run folder's plots (:func:`dem.output.plots.motion_plots`).
+
+        Parameters
+        ----------
+        out : str or pathlib.Path
+            The run folder.
+        summary : dict
+            The run's summary (not read).
+
+        Returns
+        -------
+        list of str
+            The names of the files written.
+        """
         from dem.output.plots import motion_plots
 
         return motion_plots(out, self.scene.temperature_unit, self.wall_load_unit())

@@ -53,7 +53,34 @@ class MechanicalModel:
         (:class:`dem.geometry.periodic.PeriodicBox`): contacts across its faces by the minimum image, the particles
         wrapped into it at every rebuild of the Verlet list; ``history``: a saved state
         (:func:`dem.scene.state_file.load`) whose particle state and contact histories (pairs, and particle-wall
-        pairs matched by wall name) the model starts from."""
+        pairs matched by wall name) the model starts from.
+
+        Parameters
+        ----------
+        state : dem.geometry.motion.MotionState
+            The particles' state (SI units), advanced in place.
+        walls : sequence of dem.geometry.walls.Wall
+            The walls.
+        material : object
+            The contact law's material (:mod:`dem.laws.contact`).
+        dt : float
+            The velocity-Verlet step (s).
+        skin : float
+            The Verlet list's skin (m), larger than the law's largest reach.
+        gravity : array_like
+            The gravitational acceleration [x, y, z] (m/s^2).
+        box : dem.geometry.periodic.PeriodicBox or None
+            The periodic box; None: none.
+        relaxation_time : float
+            The material's relaxation time (s; Luding 2005's ``t0``).
+        history : dict or None
+            A saved state to start the particle state and contact histories from; None: none.
+
+        Raises
+        ------
+        ValueError
+            The skin does not exceed the law's largest reach, a stress wall lacks its box, or an unknown law.
+        """
         self.state = state
         self.walls = tuple(walls)
         self.law = law_module(material.law)
@@ -144,7 +171,13 @@ class MechanicalModel:
 
     def restore_lists(self, saved: dict) -> None:
         """The Verlet lists of a checkpoint (:func:`dem.geometry.neighbours.restore_lists`), with the arrays the loop
-        indexes by pair (``_pair_arrays``) sized by them."""
+        indexes by pair (``_pair_arrays``) sized by them.
+
+        Parameters
+        ----------
+        saved : dict
+            The checkpoint's arrays.
+        """
         restore_lists(self, saved)
         self._pair_arrays()
 
@@ -176,7 +209,24 @@ class MechanicalModel:
                 self.relaxation_time if relaxation_time is None else relaxation_time)
 
     def advance(self, n_steps: int, T0: np.ndarray, T_rate: np.ndarray, relaxation_time: float | None = None):
-        """``n_steps`` steps with temperatures ``T0 + T_rate (t - t_now)`` (uniform when both have one entry)."""
+        """``n_steps`` steps with temperatures ``T0 + T_rate (t - t_now)`` (uniform when both have one entry).
+
+        Parameters
+        ----------
+        n_steps : int
+            Number of steps.
+        T0 : numpy.ndarray
+            Temperatures now (K or degC): one per particle, or one for all.
+        T_rate : numpy.ndarray
+            Their rates (K/s), shaped as ``T0``.
+        relaxation_time : float or None
+            The relaxation time (s); None: the model's.
+
+        Raises
+        ------
+        MechanicsError
+            A particle's position or velocity became non-finite, or a particle left the box (a ValueError).
+        """
         s, w = self.state, self.w
         T0, T_rate, uniform, t0 = self._temperature_arguments(T0, T_rate, relaxation_time)
         inv_mass, inv_inertia = 1.0 / s.mass, 1.0 / s.inertia
@@ -227,11 +277,33 @@ class MechanicalModel:
 
     def particle_column(self, name: str) -> np.ndarray:
         """The column ``name`` of the contact law's particle state (``law.PARTICLE_STATE``; e.g. the stiffness factor
-        ``"k1_factor"`` of Luding 2005), a view."""
+        ``"k1_factor"`` of Luding 2005), a view.
+
+        Parameters
+        ----------
+        name : str
+            A name of the law's ``PARTICLE_STATE``.
+
+        Returns
+        -------
+        numpy.ndarray
+            One value per particle.
+        """
         return self.particle_state[:, self.law.PARTICLE_STATE.index(name)]
 
     def pair_column(self, name: str) -> np.ndarray:
-        """The column ``name`` of the listed pairs' history (``law.PAIR_HISTORY``; e.g. ``"delta_max"``), a view."""
+        """The column ``name`` of the listed pairs' history (``law.PAIR_HISTORY``; e.g. ``"delta_max"``), a view.
+
+        Parameters
+        ----------
+        name : str
+            A name of the law's ``PAIR_HISTORY``.
+
+        Returns
+        -------
+        numpy.ndarray
+            One value per listed pair.
+        """
         return self.p_hist[:, self.law.PAIR_HISTORY.index(name)]
 
     def coordination(self) -> float:

@@ -69,7 +69,22 @@ from sinterheat import threads
 
 def refuse_unsupported(scene, ranks: int, restart: dict | None = None) -> None:
     """A ``ValueError`` naming what a run on ``ranks`` ranks cannot do with ``scene`` (``restart``: the checkpoint
-    it would resume from, which the same number of ranks must have written)."""
+    it would resume from, which the same number of ranks must have written).
+
+    Parameters
+    ----------
+    scene : dem.scene.parse.Scene
+        The scene.
+    ranks : int
+        The number of MPI ranks.
+    restart : dict or None
+        The checkpoint to resume from; None: a fresh run.
+
+    Raises
+    ------
+    ValueError
+        The scene or the checkpoint cannot run on ``ranks`` ranks.
+    """
     if scene.engine != "verlet":
         raise ValueError(f"[solver] engine = {scene.engine!r}: under mpiexec run static packings and the verlet "
                          f"engine (particles that move), not this one; run this scene without mpiexec")
@@ -94,7 +109,31 @@ class RankMechanics(MechanicalModel):
                  box=None, relaxation_time: float = 1e3, history=None, comm=None):
         """``state``: every particle of the scene (each rank reads them all and keeps its slab); ``comm``: the
         communicator (MPI's world by default); the rest as for
-        :class:`~dem.engines.verlet.mechanics.MechanicalModel`."""
+        :class:`~dem.engines.verlet.mechanics.MechanicalModel`.
+
+        Parameters
+        ----------
+        state : dem.geometry.motion.MotionState
+            Every particle of the scene (each rank keeps its slab).
+        walls : sequence of dem.geometry.walls.Wall
+            The walls.
+        material : object
+            The contact law's material (:mod:`dem.laws.contact`).
+        dt : float
+            The velocity-Verlet step (s).
+        skin : float
+            The Verlet list's skin (m), larger than the law's largest reach.
+        gravity : array_like
+            The gravitational acceleration [x, y, z] (m/s^2).
+        box : dem.geometry.periodic.PeriodicBox or None
+            The periodic box; None: none.
+        relaxation_time : float
+            The material's relaxation time (s; Luding 2005's ``t0``).
+        history : dict or None
+            A saved state to start the particle state and contact histories from; None: none.
+        comm : object or None
+            The MPI communicator (an ``mpi4py.MPI.Comm``); None: MPI's world.
+        """
         self.comm = world() if comm is None else comm
         self.rank, self.size = self.comm.Get_rank(), self.comm.Get_size()
         self.gid = np.arange(state.n)
@@ -235,7 +274,13 @@ class RankMechanics(MechanicalModel):
         takes again the particles, ghosts and lists it held at the last rebuild -- its slab's particles at the
         positions the lists were built at, the pairs of the gathered list with a partner it owns -- then the
         particles' state as it is now, so that the run goes on as the uninterrupted one does (one rank: the serial
-        model's restore)."""
+        model's restore).
+
+        Parameters
+        ----------
+        saved : dict
+            The checkpoint's arrays.
+        """
         if self.size == 1:
             return super().restore_lists(saved)
         n, s = self.n_global, self.state
@@ -297,7 +342,24 @@ class RankMechanics(MechanicalModel):
 
     def advance(self, n_steps: int, T0: np.ndarray, T_rate: np.ndarray, relaxation_time: float | None = None):
         """``n_steps`` steps, one call of the compiled loop each, with the exchanges between them (module
-        docstring)."""
+        docstring).
+
+        Parameters
+        ----------
+        n_steps : int
+            Number of steps.
+        T0 : numpy.ndarray
+            Temperatures now (K or degC): one per particle of the scene, or one for all.
+        T_rate : numpy.ndarray
+            Their rates (K/s), shaped as ``T0``.
+        relaxation_time : float or None
+            The relaxation time (s); None: the model's.
+
+        Raises
+        ------
+        MechanicsError
+            A particle's position or velocity became non-finite, or a particle left the box (a ValueError).
+        """
         s, w = self.state, self.w
         T0, T_rate, uniform, t0 = self._temperature_arguments(T0, T_rate, relaxation_time)
         first = self.steps
@@ -350,7 +412,18 @@ class RankMechanics(MechanicalModel):
     # --------------------------------------------------------------------------------------------- outputs
     def gathered(self, everyone: bool = False) -> MechanicalModel | None:
         """The whole sample as one serial model, in global order (its particles, the pairs each counted once, by
-        the rank owning their lower-id partner), on rank 0 (or on every rank with ``everyone``); None elsewhere."""
+        the rank owning their lower-id partner), on rank 0 (or on every rank with ``everyone``); None elsewhere.
+
+        Parameters
+        ----------
+        everyone : bool
+            Whether every rank gets the gathered model, not rank 0 alone.
+
+        Returns
+        -------
+        dem.engines.verlet.mechanics.MechanicalModel or None
+            The serial model of the whole sample, or None on the other ranks.
+        """
         own = np.flatnonzero(self.owned)
         rows = np.column_stack([self._pack(self._arrays(), own), self.x_ref[own], self.gid[own]])
         mine = self.owned[self.pi]
@@ -404,7 +477,15 @@ class RankContactThermal(ContactThermalModel):
         return values[mechanics.gid]
 
     def step(self, mechanics, dt: float) -> None:
-        """Advance the temperatures by ``dt`` on the network of the contacts the ranks hold now."""
+        """Advance the temperatures by ``dt`` on the network of the contacts the ranks hold now.
+
+        Parameters
+        ----------
+        mechanics : RankMechanics
+            This rank's mechanics: its contacts now.
+        dt : float
+            The step (s).
+        """
         comm = mechanics.comm
         bonds, K_pairs, K_walls = self.bonds(mechanics)
         walls = mechanics.owned[bonds.wall_particle]  # a ghost's wall contacts are its owner's
@@ -438,7 +519,20 @@ class RankVerletEngine(VerletEngine):
 
     def __init__(self, scene, restart: dict | None = None):
         """As :class:`VerletEngine`; unless told (``SINTERHEAT_THREADS``, ``--threads``), each rank's contact loop
-        takes its share of the cores, not all of them."""
+        takes its share of the cores, not all of them.
+
+        Parameters
+        ----------
+        scene : dem.scene.parse.Scene
+            The scene.
+        restart : dict or None
+            A checkpoint of this scene's run to go on from; None: start at the scene's start.
+
+        Raises
+        ------
+        ValueError
+            The scene or the checkpoint cannot run on this many ranks.
+        """
         size = world().Get_size()
         refuse_unsupported(scene, size, restart)
         if not os.environ.get(threads.ENVIRONMENT):
@@ -486,7 +580,17 @@ class RankVerletEngine(VerletEngine):
         """As :meth:`~dem.engines.verlet.engine.VerletEngine.run`;
         ``observe`` sees the gathered sample (every rank calls it, rank 0 with its
         writer, the others with a callable that writes nothing); on several ranks every rank gathers each checkpoint
-        (rank 0 has the ``checkpoint`` that keeps it), with the slabs (:meth:`RankMechanics.slab_arrays`)."""
+        (rank 0 has the ``checkpoint`` that keeps it), with the slabs (:meth:`RankMechanics.slab_arrays`).
+
+        Parameters
+        ----------
+        observe : callable or None
+            Called without arguments at the output times; None: not called.
+        progress : callable or None
+            Called with the simulated time (s); None: not called.
+        checkpoint : callable or None
+            Called as ``checkpoint(make, final)``; None: not called.
+        """
         mech = self.mechanics
         gathered_checkpoints = mech.size > 1 and mech.comm.allreduce(int(checkpoint is not None), op=_max())
 

@@ -59,12 +59,44 @@ DESCRIPTIONS = {
 
 
 def law_module_name(name) -> str:
-    """The module of the contact law ``name``; ``ValueError`` naming the laws for an unknown one."""
+    """The module of the contact law ``name``; ``ValueError`` naming the laws for an unknown one.
+
+    Parameters
+    ----------
+    name : str
+        A law of :data:`CONTACT_LAWS` (``"luding"``, say).
+
+    Returns
+    -------
+    str
+        The law's dotted module name.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is not a known law.
+    """
     if not isinstance(name, str) or name not in CONTACT_LAWS:
         raise ValueError(f"[contact] law = {name!r}: must be one of {', '.join(CONTACT_LAWS)}")
     return CONTACT_LAWS[name]
 
 
 def law_module(name):
-    """The contact law ``name`` (:data:`CONTACT_LAWS`), imported."""
+    """The contact law ``name`` (:data:`CONTACT_LAWS`), imported.
+
+    Parameters
+    ----------
+    name : str
+        A law of :data:`CONTACT_LAWS`.
+
+    Returns
+    -------
+    object
+        The law's module.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is not a known law.
+    """
     return importlib.import_module(law_module_name(name))

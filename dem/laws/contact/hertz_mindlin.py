@@ -64,7 +64,30 @@ class HertzMindlinMaterial:
     """Material of the Hertz-Mindlin contact (SI units; module docstring): ``youngs_modulus`` E and
     ``poisson_ratio`` nu of the particles (and of the walls); ``restitution``, the coefficient of restitution e of a
     head-on collision (0 < e <= 1; 1: no damping); ``tangential_damping`` eta_t/eta_n; ``mu``, ``mu_wall`` the
-    friction coefficients between particles and with a wall; ``density``."""
+    friction coefficients between particles and with a wall; ``density``.
+
+    Parameters
+    ----------
+    youngs_modulus : float
+        Young's modulus E of the particles and walls (Pa), > 0.
+    poisson_ratio : float
+        Poisson's ratio nu, in ``(-1, 0.5)``.
+    restitution : float
+        Coefficient of restitution e of a head-on collision, in ``(0, 1]`` (1: no damping).
+    tangential_damping : float
+        eta_t / eta_n, the tangential over the normal damping coefficient, >= 0.
+    mu : float
+        Particle-particle friction coefficient, >= 0.
+    mu_wall : float
+        Particle-wall friction coefficient, >= 0.
+    density : float
+        Particle density (kg/m^3), > 0.
+
+    Raises
+    ------
+    ValueError
+        A field is out of its range; the message names it (``contact.<field>``).
+    """
 
     youngs_modulus: float
     poisson_ratio: float
@@ -111,7 +134,18 @@ class HertzMindlinMaterial:
         return out
 
     def rayleigh_time(self, radius: float) -> float:
-        """``T_R = pi a sqrt(rho/G)/(0.1631 nu + 0.8766)`` of a particle of radius ``a`` (s)."""
+        """``T_R = pi a sqrt(rho/G)/(0.1631 nu + 0.8766)`` of a particle of radius ``a`` (s).
+
+        Parameters
+        ----------
+        radius : float
+            The particle's radius a (m).
+
+        Returns
+        -------
+        float
+            The Rayleigh time (s).
+        """
         return (math.pi * radius * math.sqrt(self.density / self.shear_modulus)
                 / (0.1631 * self.poisson_ratio + 0.8766))
 
@@ -119,14 +153,36 @@ class HertzMindlinMaterial:
 def damping_coefficient(restitution: float) -> float:
     """``alpha = sqrt(5) (-ln e)/sqrt(pi^2 + ln^2 e)``: the damping ``eta_n = alpha sqrt(m* k_n)`` whose head-on
     Hertz collision has the coefficient of restitution e, at every impact speed (Antypov & Elliott 2011, EPL 94,
-    50004: ``e = exp(-pi b/sqrt(1 - b^2))``, ``b = alpha/sqrt(5)``)."""
+    50004: ``e = exp(-pi b/sqrt(1 - b^2))``, ``b = alpha/sqrt(5)``).
+
+    Parameters
+    ----------
+    restitution : float
+        The coefficient of restitution e, in ``(0, 1]``.
+
+    Returns
+    -------
+    float
+        alpha (dimensionless), 0 for e = 1.
+    """
     log_e = math.log(restitution)
     return math.sqrt(5.0) * -log_e / math.sqrt(math.pi**2 + log_e**2)
 
 
 def restitution_of(alpha: float) -> float:
     """The coefficient of restitution of a head-on collision with the damping ``alpha`` (< sqrt(5)): ``exp(-pi b /
-    sqrt(1 - b^2))``, ``b = alpha/sqrt(5)`` (Antypov & Elliott 2011), the inverse of :func:`damping_coefficient`."""
+    sqrt(1 - b^2))``, ``b = alpha/sqrt(5)`` (Antypov & Elliott 2011), the inverse of :func:`damping_coefficient`.
+
+    Parameters
+    ----------
+    alpha : float
+        The damping coefficient, in ``[0, sqrt(5))`` (dimensionless).
+
+    Returns
+    -------
+    float
+        The coefficient of restitution e.
+    """
     b = alpha / math.sqrt(5.0)
     return math.exp(-math.pi * b / math.sqrt(1.0 - b * b))
 
@@ -137,7 +193,26 @@ def time_steps(material: HertzMindlinMaterial, mass: np.ndarray, inertia: np.nda
     (module docstring). Hertz's stiffness ``k = dF/d delta = 2 E* a`` grows with the overlap, so no step is stable at
     every overlap: ``stable`` is the largest velocity-Verlet step, ``2/(omega + eta_n/(2 m*))``, for the lightest
     pair at an overlap of ``STABLE_OVERLAP`` R* (beyond the small strains Hertz's law is for), with its
-    stiffest mode: normal, ``2 E* a``, or tangential with rotation, ``8 G* a (1 + m a^2/I)``."""
+    stiffest mode: normal, ``2 E* a``, or tangential with rotation, ``8 G* a (1 + m a^2/I)``.
+
+    Parameters
+    ----------
+    material : HertzMindlinMaterial
+        The contact material.
+    mass : numpy.ndarray
+        (N,) masses (kg).
+    inertia : numpy.ndarray
+        (N,) moments of inertia (kg m^2).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    m_mean : float
+        The mass of a particle of the mean radius (kg; not read by this law).
+
+    Returns
+    -------
+    tuple of (float, float)
+        The step ``dt = "auto"`` takes (at most ``stable``) and ``stable`` (s).
+    """
     order = np.argsort(mass)
     lo, hi = order[0], order[1] if len(mass) > 1 else order[0]
     m_eff = mass[lo] * mass[hi] / (mass[lo] + mass[hi]) if len(mass) > 1 else float(mass[lo])
@@ -222,17 +297,60 @@ DRAG = False
 
 
 def initial_state(material, T: np.ndarray, mass: np.ndarray) -> np.ndarray:
-    """Each particle's mass, the state the kernels read m* from."""
+    """Each particle's mass, the state the kernels read m* from.
+
+    Parameters
+    ----------
+    material : HertzMindlinMaterial
+        The contact material (not read by this hook).
+    T : numpy.ndarray
+        (N,) initial temperatures (only their count is read).
+    mass : numpy.ndarray
+        (N,) masses (kg).
+
+    Returns
+    -------
+    numpy.ndarray
+        (N, 1) the masses (kg).
+    """
     return np.array(mass, dtype=float).reshape(len(T), 1)
 
 
 def reference_radius(material, radius: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """The radii do not change with temperature."""
+    """The radii do not change with temperature.
+
+    Parameters
+    ----------
+    material : HertzMindlinMaterial
+        The contact material (not read by this hook).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    T : numpy.ndarray
+        (N,) temperatures (not read).
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) a copy of ``radius`` (m).
+    """
     return np.array(radius, dtype=float)
 
 
 def largest_reach(material, radius: np.ndarray) -> float:
-    """The law acts on overlapping particles only."""
+    """The law acts on overlapping particles only.
+
+    Parameters
+    ----------
+    material : HertzMindlinMaterial
+        The contact material (not read by this hook).
+    radius : numpy.ndarray
+        (N,) radii (m; not read).
+
+    Returns
+    -------
+    float
+        0.0: the largest gap (m) across which the law acts.
+    """
     return 0.0
 
 

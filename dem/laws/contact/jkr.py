@@ -52,7 +52,32 @@ N_PARAMS = hm.N_PARAMS + 3
 class JKRMaterial(HertzMindlinMaterial):
     """Material of the JKR contact: that of Hertz-Mindlin
     (:class:`~dem.laws.contact.hertz_mindlin.HertzMindlinMaterial`) and ``work_of_adhesion`` w > 0 (J/m^2; twice the
-    surface energy of identical surfaces). ``restitution`` is that of a collision whose adhesion is negligible."""
+    surface energy of identical surfaces). ``restitution`` is that of a collision whose adhesion is negligible.
+
+    Parameters
+    ----------
+    youngs_modulus : float
+        Young's modulus E of the particles and walls (Pa), > 0.
+    poisson_ratio : float
+        Poisson's ratio nu, in ``(-1, 0.5)``.
+    restitution : float
+        Coefficient of restitution e of a head-on collision with negligible adhesion, in ``(0, 1]``.
+    tangential_damping : float
+        eta_t / eta_n, the tangential over the normal damping coefficient, >= 0.
+    mu : float
+        Particle-particle friction coefficient, >= 0.
+    mu_wall : float
+        Particle-wall friction coefficient, >= 0.
+    density : float
+        Particle density (kg/m^3), > 0.
+    work_of_adhesion : float
+        The work of adhesion w (J/m^2), > 0.
+
+    Raises
+    ------
+    ValueError
+        A field is out of its range; the message names it (``contact.<field>``).
+    """
 
     work_of_adhesion: float
 
@@ -74,7 +99,18 @@ class JKRMaterial(HertzMindlinMaterial):
         return out
 
     def pulloff_distance(self, r_eff):
-        """How far beyond touching a contact of effective radius ``R*`` breaks, ``3/4 (pi^2 w^2 R*/E*^2)^(1/3)`` (m)."""
+        """How far beyond touching a contact of effective radius ``R*`` breaks, ``3/4 (pi^2 w^2 R*/E*^2)^(1/3)`` (m).
+
+        Parameters
+        ----------
+        r_eff : float or array_like
+            The effective radius ``R* = a_i a_j/(a_i + a_j)`` (m; a particle's radius on a wall).
+
+        Returns
+        -------
+        float or numpy.ndarray
+            ``-delta_c``, the pull-off distance (m).
+        """
         return 0.75 * np.cbrt(math.pi**2 * self.work_of_adhesion**2 * r_eff / self.effective_modulus**2)
 
 
@@ -148,7 +184,20 @@ drag = hm.drag
 
 
 def largest_reach(material: JKRMaterial, radius: np.ndarray) -> float:
-    """The pull-off distance of the largest particle on a wall (R* = its radius), the farthest any contact acts."""
+    """The pull-off distance of the largest particle on a wall (R* = its radius), the farthest any contact acts.
+
+    Parameters
+    ----------
+    material : JKRMaterial
+        The contact material.
+    radius : numpy.ndarray
+        (N,) radii (m).
+
+    Returns
+    -------
+    float
+        The largest gap across which a contact acts (m).
+    """
     return float(material.pulloff_distance(float(np.max(radius))))
 
 

@@ -70,6 +70,46 @@ class LudingMaterial:
     contact keeps no cohesion, f_n >= 0 (footnote 5); ``density`` of the particles; ``wall_sintering``: a
     particle-wall contact softens and sinters with the particle's k1(T, t) like a pair (true), or keeps the
     cold-limit k1 of a wall that does not melt (false; Luding 2005 gives the walls no law beyond mu_w).
+
+    Parameters
+    ----------
+    k1 : float
+        Plastic loading stiffness in the cold limit (N/m), > 0 and <= ``k2`` (eq. 4).
+    k2 : float
+        Largest un/reloading stiffness (N/m), > 0 (eq. 7).
+    kc : float
+        Cohesion stiffness in the cold limit (N/m), >= 0.
+    kt_ratio : float
+        alpha = k_t / k2(delta_max), the tangential stiffness ratio (eq. 23), >= 0.
+    gamma_n : float
+        Normal viscous damping gamma_0 (kg/s), >= 0 (eq. 5).
+    gamma_t : float
+        Tangential viscous damping (kg/s), >= 0 (eq. 19).
+    mu : float
+        Particle-particle friction coefficient in the cold limit, >= 0 (eq. 14).
+    mu_wall : float
+        Particle-wall friction coefficient in the cold limit, >= 0 (eq. 24).
+    T_melt : float
+        Melting temperature of k1(T) (degC or K; eq. 10).
+    T_var : float
+        Width of the melting transition of k1(T) (K), > 0 (eq. 10).
+    expansion : float
+        Thermal expansion coefficient delta a_T (1/K), >= 0 (eq. 9).
+    fluid_overlap : float
+        phi = delta_fluid / a, in ``(0, 1)`` (Sec. 3.1.3).
+    t0 : float
+        Relaxation time of k1(T, t) (s), > 0 (eqs. 11-12).
+    brittle_sliding : bool
+        Whether a sliding contact keeps no cohesion, f_n >= 0 (footnote 5).
+    density : float
+        Particle density (kg/m^3), > 0.
+    wall_sintering : bool
+        Whether a particle-wall contact softens and sinters with the particle's k1(T, t) like a pair.
+
+    Raises
+    ------
+    ValueError
+        A field is out of its range, or ``k1 > k2``; the message names it (``contact.<field>``).
     """
 
     k1: float
@@ -118,7 +158,20 @@ class LudingMaterial:
 
     def check_temperatures(self, T, name: str = "T") -> None:
         """Raise ``ValueError`` if a temperature lies at or below :attr:`lowest_temperature`, where eq. (9)
-        gives a radius <= 0 (the linear expansion law no longer holds)."""
+        gives a radius <= 0 (the linear expansion law no longer holds).
+
+        Parameters
+        ----------
+        T : array_like
+            Temperatures (degC or K, the unit of ``T_melt``).
+        name : str
+            The temperatures' name in the message.
+
+        Raises
+        ------
+        ValueError
+            A temperature lies at or below :attr:`lowest_temperature`.
+        """
         T = np.asarray(T, dtype=float)
         bad = np.flatnonzero(T <= self.lowest_temperature)
         if bad.size:
@@ -142,7 +195,27 @@ LUDING_TABLE1 = LudingMaterial(k1=1.0e5, k2=2.0e5, kc=1.0e5, kt_ratio=0.2, gamma
 def time_step(k2: float, gamma_n: float, m_min: float) -> float:
     """``t_MD = pi/(50 omega)``, ``omega = sqrt(k2/m12 - eta0^2)``, ``eta0 = gamma_0/(2 m12)`` (Luding 2005,
     eq. 6 and below) for the smallest reduced mass ``m_min = m12`` (kg) of any contact; k2 is the largest
-    stiffness. Overcritical damping (omega^2 <= 0) is refused."""
+    stiffness. Overcritical damping (omega^2 <= 0) is refused.
+
+    Parameters
+    ----------
+    k2 : float
+        The largest stiffness (N/m).
+    gamma_n : float
+        Normal viscous damping gamma_0 (kg/s).
+    m_min : float
+        The smallest reduced mass of any contact (kg), > 0.
+
+    Returns
+    -------
+    float
+        ``t_MD`` (s).
+
+    Raises
+    ------
+    ValueError
+        ``m_min`` is not finite and > 0, or the damping is overcritical.
+    """
     if not (math.isfinite(m_min) and m_min > 0):
         raise ValueError(f"m_min = {m_min!r}: must be a finite reduced mass > 0 (kg)")
     eta0 = gamma_n / (2.0 * m_min)
@@ -460,18 +533,61 @@ DRAG = False
 
 
 def initial_state(material: LudingMaterial, T: np.ndarray, mass: np.ndarray) -> np.ndarray:
-    """Each particle's stiffness factor relaxed at its initial temperature, ``k1(T)/k1`` (eq. 10)."""
+    """Each particle's stiffness factor relaxed at its initial temperature, ``k1(T)/k1`` (eq. 10).
+
+    Parameters
+    ----------
+    material : LudingMaterial
+        The contact material.
+    T : numpy.ndarray
+        (N,) initial temperatures (the unit of ``T_melt``).
+    mass : numpy.ndarray
+        (N,) masses (kg; not read by this law).
+
+    Returns
+    -------
+    numpy.ndarray
+        (N, 1) the factors (dimensionless).
+    """
     return np.array([[k1_factor(float(t), material.T_melt, material.T_var)] for t in T]).reshape(len(T), 1)
 
 
 def reference_radius(material: LudingMaterial, radius: np.ndarray, T: np.ndarray) -> np.ndarray:
     """The radii at the melting temperature that give ``radius`` at ``T`` (eq. 9): thermal expansion changes the
-    radius, not the mass."""
+    radius, not the mass.
+
+    Parameters
+    ----------
+    material : LudingMaterial
+        The contact material.
+    radius : numpy.ndarray
+        (N,) radii at ``T`` (m).
+    T : numpy.ndarray
+        (N,) temperatures (the unit of ``T_melt``).
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) radii at ``T_melt`` (m).
+    """
     return radius / np.array([radius_at(1.0, float(t), material.T_melt, material.expansion) for t in T])
 
 
 def largest_reach(material: LudingMaterial, radius: np.ndarray) -> float:
-    """The law acts on overlapping particles only."""
+    """The law acts on overlapping particles only.
+
+    Parameters
+    ----------
+    material : LudingMaterial
+        The contact material.
+    radius : numpy.ndarray
+        (N,) radii (m).
+
+    Returns
+    -------
+    float
+        0.0: the largest gap (m) across which the law acts.
+    """
     return 0.0
 
 
@@ -485,6 +601,29 @@ def time_steps(material: LudingMaterial, mass: np.ndarray, inertia: np.ndarray, 
     velocity-Verlet step that stays stable for the stiffest contact, ``2/(omega_max + eta)``: the lightest pair, with
     the normal stiffness k2 or the tangential spring acting with rotation (``alpha k2 (1 + m a^2/I)``), whichever is
     stiffer, and the viscous rate ``eta = gamma_n/(2 m12)``.
+
+    Parameters
+    ----------
+    material : LudingMaterial
+        The contact material.
+    mass : numpy.ndarray
+        (N,) masses (kg).
+    inertia : numpy.ndarray
+        (N,) moments of inertia (kg m^2).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    m_mean : float
+        The mass of a particle of the mean radius (kg).
+
+    Returns
+    -------
+    tuple of (float, float)
+        The step ``dt = "auto"`` takes, ``min(t_MD, stable)``, and ``stable`` (s).
+
+    Raises
+    ------
+    ValueError
+        The normal damping is overcritical.
     """
     order = np.argsort(mass)
     t_md = time_step(material.k2, material.gamma_n, 0.5 * m_mean)

@@ -76,6 +76,42 @@ class ZohdiMaterial:
     A_ij`` (eq. 19), activated once ``|E_ij| >= E_star`` and kept while the particles touch; sliding friction
     ``mu_d |F_con|`` against the relative velocity (eqs. 5-6; against the tangential one at a wall, eqs. 16-17),
     its direction regularised below ``v_slip``; drag ``-c_env 6 pi R v`` (eq. 20, Sec. 7); ``density``.
+
+    Parameters
+    ----------
+    K_p : float
+        K_p0, the particle-particle contact stiffness when cold (N/m^2), > 0 (eq. 2).
+    p_p : float
+        The exponent of the particle contact law, > 0 (eq. 2).
+    K_p_lim : float
+        K_p^lim, the softened floor of K_p (N/m^2), in ``[0, K_p]`` (Sec. 7).
+    K_w : float
+        K_w0, the particle-wall contact stiffness when cold (N/m^2), > 0 (eq. 13).
+    p_w : float
+        The exponent of the wall contact law, > 0 (eq. 13).
+    K_w_lim : float
+        K_w^lim, the softened floor of K_w (N/m^2), in ``[0, K_w]`` (Sec. 7).
+    theta_star : float
+        theta*, the softening temperature (K, absolute), > 0 (Sec. 7).
+    K_b : float
+        The bond stiffness (N/m^2), >= 0 (eq. 19).
+    p_b : float
+        The exponent of the bond law, > 0 (eq. 19).
+    E_star : float
+        E*, the strain magnitude that activates a bond, >= 0 (eqs. 18-19).
+    mu_d : float
+        The dynamic friction coefficient of particles and walls, >= 0 (eqs. 5, 16).
+    c_env : float
+        c_env^o of the drag ``c_env = c_env^o 6 pi R`` (kg/(m s)), >= 0 (eq. 20, Sec. 7).
+    v_slip : float
+        The regularisation speed of the friction direction (m/s), > 0.
+    density : float
+        Particle density (kg/m^3), > 0.
+
+    Raises
+    ------
+    ValueError
+        A field is out of its range, or a floor exceeds its cold stiffness; the message names it.
     """
 
     K_p: float
@@ -112,7 +148,20 @@ class ZohdiMaterial:
         return out
 
     def stiffness(self, theta, wall: bool = False):
-        """``max(K_0 (1 - theta/theta*), K_lim)`` (Sec. 7), N/m^2."""
+        """``max(K_0 (1 - theta/theta*), K_lim)`` (Sec. 7), N/m^2.
+
+        Parameters
+        ----------
+        theta : float or array_like
+            Temperatures (K, absolute); for a pair the mean of the two.
+        wall : bool
+            Whether the wall's stiffness (K_w, K_w^lim) is wanted rather than the particles' (K_p, K_p^lim).
+
+        Returns
+        -------
+        numpy.ndarray
+            The softened stiffness (N/m^2).
+        """
         k0, floor = (self.K_w, self.K_w_lim) if wall else (self.K_p, self.K_p_lim)
         return np.maximum(k0 * (1.0 - np.asarray(theta, dtype=float) / self.theta_star), floor)
 
@@ -143,23 +192,81 @@ IN_LOOP = {**JIT, "inline": "always"}
 
 
 def initial_state(material: ZohdiMaterial, T: np.ndarray, mass: np.ndarray) -> np.ndarray:
-    """No state per particle: the temperatures themselves soften the contacts."""
+    """No state per particle: the temperatures themselves soften the contacts.
+
+    Parameters
+    ----------
+    material : ZohdiMaterial
+        The contact material (not read by this hook).
+    T : numpy.ndarray
+        (N,) initial temperatures (only their count is read).
+    mass : numpy.ndarray
+        (N,) masses (kg; not read).
+
+    Returns
+    -------
+    numpy.ndarray
+        An (N, 0) array.
+    """
     return np.zeros((len(T), 0))
 
 
 def reference_radius(material: ZohdiMaterial, radius: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """The radii do not change with temperature."""
+    """The radii do not change with temperature.
+
+    Parameters
+    ----------
+    material : ZohdiMaterial
+        The contact material (not read by this hook).
+    radius : numpy.ndarray
+        (N,) radii (m).
+    T : numpy.ndarray
+        (N,) temperatures (not read).
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) a copy of ``radius`` (m).
+    """
     return np.array(radius, dtype=float)
 
 
 def largest_reach(material: ZohdiMaterial, radius: np.ndarray) -> float:
-    """The law acts on touching particles only."""
+    """The law acts on touching particles only.
+
+    Parameters
+    ----------
+    material : ZohdiMaterial
+        The contact material (not read by this hook).
+    radius : numpy.ndarray
+        (N,) radii (m; not read).
+
+    Returns
+    -------
+    float
+        0.0: the largest gap (m) across which the law acts.
+    """
     return 0.0
 
 
 def time_steps(material: ZohdiMaterial, mass, inertia, radius, m_mean: float):
     """The law is stepped by the implicit scheme of the paper (:mod:`dem.engines.staggered`), not by velocity
-    Verlet."""
+    Verlet.
+
+    Parameters
+    ----------
+    material : ZohdiMaterial
+        The contact material.
+    mass, inertia, radius : numpy.ndarray
+        (N,) masses (kg), moments of inertia (kg m^2) and radii (m), as every law's ``time_steps`` takes them.
+    m_mean : float
+        The mass of a particle of the mean radius (kg).
+
+    Raises
+    ------
+    ValueError
+        Always: this law has no velocity-Verlet step.
+    """
     raise ValueError("[contact] law = \"zohdi\": runs on the staggered implicit scheme of Zohdi 2014 (its [solver] "
                      "keys dt, dt_max, phi, iterations, tolerance), not on velocity-Verlet steps")
 
