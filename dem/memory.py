@@ -86,7 +86,7 @@ def estimate(n: int) -> str | None:
     Returns
     -------
     str or None
-        One line, or None below :data:`ANNOUNCE_FROM` particles.
+        One line, or None below ``ANNOUNCE_FROM`` particles.
     """
     if n < ANNOUNCE_FROM:
         return None

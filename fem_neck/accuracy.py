@@ -291,7 +291,7 @@ HP_CORNER_ERROR = {"cylinder": 1e-7, "union": 3e-5}
 
 def hp_corner_levels(a_over_r: float, rtol: float, sigma: float = SIGMA, neck: str = "cylinder") -> int:
     """Geometric refinement levels toward the corner: the corner cell's error ``~ c * sigma^(2 lambda (L - 2))``
-    (``c`` = :data:`HP_CORNER_ERROR` of the ``neck``, measured at L = 2) pushed 100x below ``rtol``.
+    (``c`` = ``HP_CORNER_ERROR`` of the ``neck``, measured at L = 2) pushed 100x below ``rtol``.
 
     Parameters
     ----------

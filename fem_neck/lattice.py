@@ -137,14 +137,14 @@ class PeriodicCell:
     """One period of a packing. Every pair of particle images closer than the sum of their radii is bonded (Rojek
     2022, eq. 21).
 
-    Attributes
+    Parameters
     ----------
-    centres : numpy.ndarray (n, 3)
-        Particle centres, m, wrapped into ``[0, period)``.
-    radii : numpy.ndarray (n,)
-        Particle radii, m.
-    period : numpy.ndarray (3,)
-        Edges of the period box, m.
+    centres : numpy.ndarray
+        Particle centres (n, 3), m, wrapped into ``[0, period)``.
+    radii : numpy.ndarray
+        Particle radii (n,), m.
+    period : numpy.ndarray
+        Edges of the period box (3,), m.
     name : str
         Name of the cell in messages.
     neck : str
@@ -490,7 +490,7 @@ class UnionNecks:
     """The necks of the union reading, per bond of a :class:`fem_neck.cluster.Cluster` (the fields the meshing
     reads of a pair neck's :class:`fem_neck.geometry.NeckGeometry`).
 
-    Attributes
+    Parameters
     ----------
     a : numpy.ndarray
         Radius of the circle where the two spheres meet (:func:`fem_neck.geometry.union.lens`), in the cluster's
@@ -524,7 +524,7 @@ class NeckCircles:
     """The neck circles on the boundary of a cell's solid, for predicting its mesh before meshing
     (:func:`predicted_tetrahedra`). Lengths in units of the largest radius.
 
-    Attributes
+    Parameters
     ----------
     a : numpy.ndarray
         Radius of each circle.

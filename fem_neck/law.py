@@ -71,12 +71,12 @@ FORM_UNION = "1/f = pi/(4x) * (1 + A x ln(1/x) + B x + C x^2 + E x^3 - (1 + B + 
 FORMS = {"cylinder": FORM, "union": FORM_UNION}  #: the law's form for each neck
 PARAMETERS = ("A", "B", "C", "E")
 A_LOG = 5.0 / (4.0 * np.pi)  #: the x ln(1/x) coefficient of P(x) (module docstring); the fit keeps A = A_LOG
-A_LOG_UNION = 1.0 / np.pi  #: the same for the union's half body: the ball's log alone (module docstring)
+A_LOG_UNION = 1.0 / np.pi  #: The same for the union's half body, the ball's log alone (module docstring).
 DEFAULT_FIT = pathlib.Path(__file__).with_name("data") / "fit.json"
 DEFAULT_FIT_UNION = DEFAULT_FIT.with_name("fit_union.json")
 
 
-NECKS = ("cylinder", "union")  #: the half bodies a law is for: Rojek's volume-conserving neck cylinder, the union
+NECKS = ("cylinder", "union")  #: The half bodies a law is for, Rojek's volume-conserving neck cylinder or the union
 
 
 def check_neck(neck) -> str:

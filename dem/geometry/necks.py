@@ -25,14 +25,14 @@ def necks_meeting(radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, wall_no
 
     Parameters
     ----------
-    radius : array (n,)
+    radius : numpy.ndarray
         Particle radii, m.
     bonds : Bonds
         The pair and wall bonds with their neck radii and reading (``bonds.contact``).
-    vectors : array (m, 3)
-        ``x_j - x_i`` of every pair bond, m (the image's across a periodic face).
-    wall_normals : array (w, 3)
-        The unit normal of each wall bond's wall, pointing into the packing.
+    vectors : numpy.ndarray
+        ``x_j - x_i`` of every pair bond (one row each), m (the image's across a periodic face).
+    wall_normals : numpy.ndarray
+        The unit normal of each wall bond's wall (one row each), pointing into the packing.
     """
     radius = np.asarray(radius, dtype=float)
     i, j, p = bonds.i, bonds.j, bonds.wall_particle
@@ -84,11 +84,11 @@ def neck_account(count: int, n: int, reading: str, bonds: int, law: str) -> dict
     n : int
         Particles in the run.
     reading : str
-        The neck reading of the bonds (:data:`dem.geometry.bonds.CONTACT_MODELS`).
+        The neck reading of the bonds (``dem.geometry.bonds.CONTACT_MODELS``).
     bonds : int
         Pair and wall bonds.
     law : str
-        The conductance law (:data:`dem.laws.conductance.LAWS`).
+        The conductance law (``dem.laws.conductance.LAWS``).
 
     Returns
     -------

@@ -30,7 +30,7 @@ style (the title line ``units = cgs`` of ``write_data``, ``ITEM: UNITS`` of a du
 read from LAMMPS files are sorted by id (LAMMPS writes them in the order of its processors); other files keep their
 order. A bad file raises ``ValueError`` with one line naming the file, the line and the column. A file that reads
 but looks wrong gets a ``UserWarning``: positions of at most 6 significant digits with pairs within that rounding of
-touching (:func:`printed_precision`), a median radius beyond :data:`RADIUS_PLAUSIBLE` (another length unit than the
+touching (:func:`printed_precision`), a median radius beyond ``RADIUS_PLAUSIBLE`` (another length unit than the
 file says).
 
 The other way: :func:`write_lammps_data` writes a packing (read here, from a scene's particles, or from a saved
@@ -331,7 +331,7 @@ PRINTED_DIGITS = 6  # LAMMPS's default float format in dumps (%g)
 
 
 def _warn_unit(p: Packing, length_unit: float) -> None:
-    """Warn when the particles' median radius (m) lies outside :data:`RADIUS_PLAUSIBLE`: the file is likely in
+    """Warn when the particles' median radius (m) lies outside ``RADIUS_PLAUSIBLE``: the file is likely in
     another length unit than it says (or than ``length_unit``)."""
     r = float(np.median(p.radius))
     if RADIUS_PLAUSIBLE[0] <= r <= RADIUS_PLAUSIBLE[1]:

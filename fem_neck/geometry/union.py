@@ -147,12 +147,13 @@ def cut_spheres(radius, i, j, vectors) -> CutSpheres:
 
     Parameters
     ----------
-    radius : array (n,)
+    radius : numpy.ndarray
         Particle radii, m.
-    i, j : int arrays (m,)
-        The overlapping pairs (each once; ``j`` may be a periodic image of a particle, given by ``vectors``).
-    vectors : array (m, 3)
-        ``x_j - x_i`` of every pair (m), the image's in a periodic packing.
+    i, j : numpy.ndarray
+        The overlapping pairs, integer indices (each pair once; ``j`` may be a periodic image of a particle, given by
+        ``vectors``).
+    vectors : numpy.ndarray
+        ``x_j - x_i`` of every pair (one row each), m: the image's in a periodic packing.
 
     Returns
     -------
@@ -188,20 +189,24 @@ def cut_spheres(radius, i, j, vectors) -> CutSpheres:
 
 
 def necks_meet(n: int, particle, direction, angle) -> np.ndarray:
-    """Whether two necks of each of ``n`` particles meet (bool per particle), for any neck reading.
+    """Whether two necks of each of ``n`` particles meet (bool per particle), for any neck reading: two necks of one
+    particle meet when the angle between their directions is at most the sum of their half-angles.
 
     Parameters
     ----------
     n : int
         Number of particles.
-    particle : int array (e,)
-        The particle of each neck end (a pair bond has two ends, a wall bond one).
-    direction : array (e, 3)
-        The direction from that particle's centre toward the neck (any length but zero).
-    angle : array (e,)
+    particle : numpy.ndarray
+        The particle of each neck end, integer indices (a pair bond has two ends, a wall bond one).
+    direction : numpy.ndarray
+        The direction from that particle's centre toward the neck (one row each, any length but zero).
+    angle : numpy.ndarray
         Half-angle (rad) of the cone in which the neck is seen from the centre (:func:`angular_radius`).
 
-    Two necks of one particle meet when the angle between their directions is at most the sum of their half-angles.
+    Returns
+    -------
+    numpy.ndarray
+        Per particle, whether two of its necks meet (bool).
     """
     particle = np.ascontiguousarray(particle, dtype=np.int64).reshape(-1)
     direction = np.ascontiguousarray(direction, dtype=float).reshape(-1, 3)
