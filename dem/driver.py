@@ -55,6 +55,16 @@ def _progress_bar(scene: Scene, engine, enabled: bool):
                 delay=2.0, bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s simulated" + tail)
 
 
+def _announce(scene: Scene, enabled: bool) -> None:
+    """A run of many particles says on stderr what it will take (:func:`dem.memory.estimate`), once its up-front
+    checks have passed; only where it reports its progress (the CLI's)."""
+    from dem.memory import estimate
+
+    line = estimate(scene.particles.n) if enabled else None
+    if line is not None:
+        print(f"python -m dem run: {line}", file=sys.stderr, flush=True)
+
+
 def _position(scene: Scene, out, progress: bool) -> Where:
     """The run's position for the line an interrupt prints (:func:`sinterheat.interrupt.where`) -- only for a run
     that reports its progress (the CLI's): a run inside another command (a verification section) leaves that
@@ -102,7 +112,8 @@ def _run_held(scene: Scene, out, progress: bool, resume: bool, comm, cls, root: 
     start = time.perf_counter()
     here = _position(scene, out, progress and root)
     restart = run_folder.load(out, scene, scene.engine) if resume else None
-    engine = cls(scene, restart)
+    engine = cls(scene, restart)  # the memory and the work checked and refused up front
+    _announce(scene, progress and root)
     writer = None
     resume_step = engine.steps if resume else None
     if out is not None and comm is not None and comm.Get_size() > 1:  # a piece of every snapshot per rank
@@ -188,6 +199,7 @@ def _run_distributed(scene: Scene, out, progress: bool, resume: bool, overwrite:
         out = comm.bcast(out)
     try:
         engine = DistributedStaticEngine(scene)
+        _announce(scene, progress and rank == 0)
         writer = None
         if out is not None:
             from dem.output.pieces import PieceWriter

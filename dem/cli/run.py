@@ -57,23 +57,26 @@ def run(args) -> dict:
     """
     from dem.scene import load_scene
     from dem.driver import run as run_scene
-    from dem.memory import available_bytes, estimate
+    from dem.memory import available_bytes
     from dem.network.comm import launched, launcher_rank
 
     if launched() and launcher_rank() > 0:  # one summary, one error line: rank 0's
         sys.stdout = sys.stderr = open(os.devnull, "w")
 
+    quiet = os.environ.get("TQDM_DISABLE")
     if args.quiet:  # no bar; the run keeps its position for the line an interrupt prints
         os.environ["TQDM_DISABLE"] = "1"
     try:
         scene = load_scene(args.scene)
-        big = estimate(scene.particles.n)
-        if big is not None:  # said before it starts, as the memory is checked before it starts
-            print(f"python -m dem run: {big}", file=sys.stderr, flush=True)
         summary = run_scene(scene, args.out, progress=True, resume=args.resume, overwrite=args.overwrite).summary
     except MemoryError:  # beyond the estimate checked up front (dem.memory): say so in one line all the same
         raise ValueError(f"scene = {args.scene!r}: ran out of memory (the machine had "
                          f"{(available_bytes() or 0.0) / 2**30:.3g} GiB available); use fewer particles") from None
+    finally:  # called in a process that goes on (a test, a notebook), the environment is left as it was
+        if quiet is None:
+            os.environ.pop("TQDM_DISABLE", None)
+        else:
+            os.environ["TQDM_DISABLE"] = quiet
     return summary if args.json else console(summary)
 
 
