@@ -12,7 +12,8 @@
 * :func:`fit_law` -- B, C, E of :class:`fem_neck.law.ConductanceLaw` (A = 5/(4 pi) is derived), least squares on
   relative residuals.
 * :func:`run_fit` -- all of it, writing ``fit.json`` (read by the DEM), ``fit.csv`` and ``fit.png`` (the Fig. 16
-  analogue) into one folder.
+  analogue) into one folder; the figure is drawn by a process of its own that imports matplotlib while the sweep
+  starts (this process never imports matplotlib).
 
 Every step takes ``neck``: ``"cylinder"`` (default) sweeps and fits the semisphere with Rojek's neck cylinder,
 ``"union"`` the half body of the union of spheres (no cylinder; A = 1/pi), and fit.json records which.
@@ -24,6 +25,7 @@ processes import it; ``method`` (default :data:`METHOD`) and ``neck`` are passed
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import importlib
 import json
@@ -34,7 +36,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from sinterheat.interrupt import where
-from sinterheat.pool import run_jobs
+from sinterheat.pool import ProcessPool, run_jobs
 from fem_neck.law import (A_LOG, A_LOG_UNION, ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, check_neck,
                           half_neck_resistance)
 
@@ -143,14 +145,13 @@ def _append(path: pathlib.Path, point: FitPoint) -> None:
 
 def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int | None = None,
           solver: str = SOLVER, method: str = METHOD, progress: bool = True, reuse=None,
-          meanwhile=None, neck: str = "cylinder") -> list[FitPoint]:
+          neck: str = "cylinder") -> list[FitPoint]:
     """Solve the semisphere (``neck = "cylinder"``) or the union's half body (``"union"``) at every a/r to ``rtol``
     on ``workers`` processes (default: all cores), or on the Dask cluster of :func:`sinterheat.pool.use_dask`.
 
     ``reuse``: points solved before, keyed by a/r (:func:`reusable_points`); those at the sweep's a/r are kept
     instead of solved. With ``csv_path`` the CSV is rewritten with the kept points and each new point is appended
-    as soon as it is solved, so an interrupted sweep loses nothing. ``meanwhile``: see
-    :func:`sinterheat.pool.run_jobs`. Returns the points sorted by a/r.
+    as soon as it is solved, so an interrupted sweep loses nothing. Returns the points sorted by a/r.
     """
     if not (isinstance(rtol, float) and 0.0 < rtol < 0.1):
         raise ValueError(f"rtol = {rtol!r}: must be a float in (0, 0.1)")
@@ -173,8 +174,7 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
         importlib.import_module(solver.split(":")[0])  # fail early in the parent, and let fork start warm
     jobs = [(_solve_point, (solver, method, neck, xi, rtol)) for xi, _ in todo]
     uniform_of = {_key(xi): ui for xi, ui in todo}
-    for res in run_jobs(jobs, workers, desc="fit sweep", unit="solve", progress=progress, done=len(points),
-                        meanwhile=meanwhile):
+    for res in run_jobs(jobs, workers, desc="fit sweep", unit="solve", progress=progress, done=len(points)):
         p = FitPoint(**res, uniform=uniform_of[_key(res["a_over_r"])])
         points[_key(p.a_over_r)] = p
         if csv_path is not None:
@@ -306,9 +306,23 @@ def plot(points: list[FitPoint], slope: float, law: ConductanceLaw, path) -> Non
 
 
 def import_plotting() -> None:
-    """Import what :func:`plot` needs (run in a thread while the sweep's workers solve)."""
+    """Import what :func:`plot` needs (in the process that will draw, while the sweep solves: :func:`run_fit`)."""
     import matplotlib.backends.backend_agg  # noqa: F401
     import matplotlib.figure  # noqa: F401
+
+
+@contextlib.contextmanager
+def _plotter(draw: bool):
+    """The process that draws fit.png (``None`` when ``draw`` is false): forked now, it imports matplotlib at once
+    (:func:`import_plotting`), on the other core while this process imports the solver, and takes :func:`plot`
+    once the fit is known, while this process writes fit.json and fit.csv. A plotting error is raised by the
+    ``result()`` of its job; an error here stops it at once."""
+    if not draw:
+        yield None
+        return
+    with ProcessPool(1, "fork") as plotter:
+        plotter.submit(import_plotting)
+        yield plotter
 
 
 def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | None = None,
@@ -328,43 +342,44 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
     out = pathlib.Path(out) if out is not None else None
     csv_path = out / "fit.csv" if out is not None else None
     reuse, other = reusable_points(csv_path, rtol, solver, method, neck) if csv_path and not fresh else ({}, 0)
-    points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, method=method,
-                   progress=progress, reuse=reuse,
-                   meanwhile=import_plotting if out is not None and plot_png else None, neck=neck)
-    reused = sum(_key(xi) in reuse for xi in x)
-    xa = np.array([p.a_over_r for p in points])
-    fa = np.array([p.K_over_Kcyl for p in points])
-    um = np.array([p.uniform for p in points])
-    slope = linear_slope(xa[um], fa[um])
-    law = fit_law(xa, fa, neck=neck)
-    result = {
-        "slope": slope,
-        "sampling": f"least squares through the origin on the {int(np.sum(um & (xa <= LINEAR_RANGE)))} FE points "
-                    f"uniform in a/r (0.97 k/m) with a/r <= {LINEAR_RANGE}, as Rojek 2022 Fig. 16 / eq. (40)",
-        "slope_sensitivity": slope_sensitivity(law),
-        "points": [[p.a_over_r, p.K_over_Kcyl] for p in points],
-        "error_estimates": [p.error_estimate for p in points],
-        "unconverged": [p.a_over_r for p in points if not p.error_estimate <= p.rtol],
-        "rtol": rtol,
-        "law": {**law.to_dict(), "table": law.table(200)},
-        "paper": {"rojek_eq40": ROJEK.slope, "argento_bouvard_eq42": ARGENTO_BOUVARD.slope},
-        "solver": solver,
-        "method": method,
-        "neck": neck,
-        "reused": {"points": reused, "of": len(x), "not_matching": other},
-        "cpu_seconds": float(sum(p.seconds for p in points)),
-        "seconds": time.perf_counter() - t0,
-    }
-    if out is not None:
-        (out / "fit.json").write_text(json.dumps(result, indent=1) + "\n")
-        resid = np.asarray(law.k_over_kcyl(xa)) / fa - 1.0
-        with (out / "fit.csv").open("w", newline="") as fh:  # final: sorted, with the law's residual
-            w = csv.writer(fh)
-            w.writerow(CSV_FIELDS + ("law", "law_rel_residual"))
-            for p, r in zip(points, resid):
-                w.writerow(_csv_row(p) + [repr(float(p.K_over_Kcyl * (1 + r))), repr(float(r))])
-        if plot_png:
-            plot(points, slope, law, out / "fit.png")
+    with _plotter(out is not None and plot_png) as plotter:
+        points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, method=method,
+                       progress=progress, reuse=reuse, neck=neck)
+        reused = sum(_key(xi) in reuse for xi in x)
+        xa = np.array([p.a_over_r for p in points])
+        fa = np.array([p.K_over_Kcyl for p in points])
+        um = np.array([p.uniform for p in points])
+        slope = linear_slope(xa[um], fa[um])
+        law = fit_law(xa, fa, neck=neck)
+        drawn = plotter.submit(plot, points, slope, law, out / "fit.png") if plotter is not None else None
+        result = {
+            "slope": slope,
+            "sampling": f"least squares through the origin on the {int(np.sum(um & (xa <= LINEAR_RANGE)))} FE points "
+                        f"uniform in a/r (0.97 k/m) with a/r <= {LINEAR_RANGE}, as Rojek 2022 Fig. 16 / eq. (40)",
+            "slope_sensitivity": slope_sensitivity(law),
+            "points": [[p.a_over_r, p.K_over_Kcyl] for p in points],
+            "error_estimates": [p.error_estimate for p in points],
+            "unconverged": [p.a_over_r for p in points if not p.error_estimate <= p.rtol],
+            "rtol": rtol,
+            "law": {**law.to_dict(), "table": law.table(200)},
+            "paper": {"rojek_eq40": ROJEK.slope, "argento_bouvard_eq42": ARGENTO_BOUVARD.slope},
+            "solver": solver,
+            "method": method,
+            "neck": neck,
+            "reused": {"points": reused, "of": len(x), "not_matching": other},
+            "cpu_seconds": float(sum(p.seconds for p in points)),
+            "seconds": time.perf_counter() - t0,
+        }
+        if out is not None:
+            (out / "fit.json").write_text(json.dumps(result, indent=1) + "\n")
+            resid = np.asarray(law.k_over_kcyl(xa)) / fa - 1.0
+            with (out / "fit.csv").open("w", newline="") as fh:  # final: sorted, with the law's residual
+                w = csv.writer(fh)
+                w.writerow(CSV_FIELDS + ("law", "law_rel_residual"))
+                for p, r in zip(points, resid):
+                    w.writerow(_csv_row(p) + [repr(float(p.K_over_Kcyl * (1 + r))), repr(float(r))])
+        if drawn is not None:
+            drawn.result()  # the plotter's error, if any, raised here
     return result
 
 
