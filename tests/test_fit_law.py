@@ -234,3 +234,8 @@ def test_a_figure_that_cannot_be_written_fails_the_fit(tmp_path):
     with pytest.raises(IsADirectoryError):
         fit.run_fit(4, 1e-4, out, workers=1, progress=False)
     assert (out / "fit.json").exists()  # the numbers are written before the figure is waited for
+
+
+def test_log_axis_labels_are_decades_in_superscript():
+    labels = [fit._decade_label(v) for v in (1e-3, 2e-3, 0.01, 0.5, 1.0, 10.0, 0.0)]
+    assert labels == ["10\u207b\u00b3", "", "10\u207b\u00b2", "", "10\u2070", "10\u00b9", ""]
