@@ -15,7 +15,8 @@ are timed side by side, alternating, in one run, and reported as ratios.
 
 SUBJECTS = {
     "neck": "benchmarks.neck",  # fem_neck.neck_radius against a plain numpy Newton
-    "fe": "benchmarks.fe",  # FE conductance: error against time, NGSolve, the fit, the main command's start-up
+    "fe": "benchmarks.fe",  # FE conductance: error against time, NGSolve, the periodic cells
+    "fit": "benchmarks.fit",  # the main command python -m fem_neck fit: its sweep, its whole process beside NGSolve's
     "dem": "benchmarks.dem",  # DEM solvers: transient accuracy, steady scaling, linear solvers, OpenPNM
     "mechanics": "benchmarks.mechanics",  # the moving-particle loop against LAMMPS, compile cost, thermal-only path
     "electrical": "benchmarks.electrical",  # Zohdi 2014's Section 7 example, step cost, Kirchhoff against eq. 43

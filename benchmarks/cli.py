@@ -1,7 +1,8 @@
 """``python -m benchmarks [SUBJECT ...]``: run time against error, with the targets each subject must meet.
 
 Subjects (all when none is named): ``neck`` (the neck radius against a plain numpy Newton), ``fe`` (FE conductance:
-error against time, NGSolve side by side, the fit, the main command's start-up), ``dem`` (the DEM's thermal solvers
+error against time, NGSolve side by side, the periodic cells), ``fit`` (the main command ``python -m fem_neck fit``:
+its sweep, its whole process beside NGSolve's), ``dem`` (the DEM's thermal solvers
 to 10^6 particles, OpenPNM side by side), ``mechanics`` (the moving-particle loop in ns per particle-step, 2D and 3D,
 LAMMPS side by side; numba's compile cost; the thermal-only path; the whole sintering schedule), ``electrical``
 (Zohdi 2014's Section 7 example, its step cost, the Kirchhoff solve against the paper's current iteration). Writes ``report.md``, ``summary.json`` and ``run.json`` plus CSV and PNG

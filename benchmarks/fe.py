@@ -1,5 +1,5 @@
-"""FE conductance of the semisphere (Rojek 2022, Fig. 12): error against time, NGSolve on the same problem, the fit
-sweep, and the main command's start-up beside NGSolve's.
+"""FE conductance of the semisphere (Rojek 2022, Fig. 12): error against time, NGSolve on the same problem (also the
+sweep that the main command is timed against, :mod:`benchmarks.fit`), and the periodic cells.
 
 * Error against time: P1-P4 on uniform/graded gmsh triangle meshes, the hp spectral elements (p = 2-9 on one
   geometric mesh) and both estimator-driven paths (hp, the default, and gmsh) at h/r = 0.02, 0.08, 0.4, against the
@@ -7,9 +7,6 @@ sweep, and the main command's start-up beside NGSolve's.
 * NGSolve (optional extra ``pip install .[peers]``; skipped with a note when absent): H1 order p on a netgen/OCC
   mesh curved to order p, hp-refined toward the re-entrant corner; its cheapest setting for each tolerance, and the
   headline 1e-4 solve timed side by side with ours.
-* The fit sweep (``fem_neck.fit.run_fit``, 44 points to 1e-4 on both cores).
-* Start-up: the whole process of ``python -m fem_neck fit --out DIR`` (fresh folder; imports, 40 solves, fit.json,
-  fit.csv and fit.png) against the whole process of NGSolve solving the same 40 points, alternating.
 * Periodic cells: ``python -m fem_neck lattice --rtol 1e-4`` on SC, BCC and FCC at h/r = 0.02 and 0.08 as a whole
   process (wall time, peak memory, true error against :data:`verification.lattices.REFERENCES`, the estimate over
   the true error), and NGSolve on the same cell (:func:`verification.ngsolve_cell.ngsolve_cell`) at the lowest order
@@ -39,9 +36,8 @@ SIDE_BY_SIDE_ROUNDS = 15
 # NGSolve's setting of the start-up comparison: it reaches 1e-4 at all three h/r (error 3.2e-5) and was the cheapest
 # such setting of a full study on a quiet machine; fixed, so that the comparison does not follow timing noise
 NGSOLVE_STARTUP = {"order": 3, "maxh": 0.3, "hp_levels": 2}
-STARTUP_POINTS = 40  # the main command's default sweep
-LIMITS = {"fe_seconds_to_1e-4": 0.5, "fit_seconds": 15.0, "fe_over_ngsolve": 1.0, "startup_ratio": 1.5,
-          "lattice_seconds": 60.0, "lattice_gb": 4.0, "lattice_estimate_ratio": 3.0, "lattice_over_ngsolve": 2.0}
+LIMITS = {"fe_seconds_to_1e-4": 0.5, "fe_over_ngsolve": 1.0, "lattice_seconds": 60.0, "lattice_gb": 4.0,
+          "lattice_estimate_ratio": 3.0, "lattice_over_ngsolve": 2.0}
 LATTICE_RTOL = 1e-4
 NGSOLVE_ORDERS = (3, 4, 5)  # NGSolve's orders tried for equal accuracy (hp levels = order, maxh 0.5)
 
@@ -337,75 +333,6 @@ def study_error_against_time(section, quick: bool) -> None:
     )
 
 
-# ------------------------------------------------------------------------------------------------------ the fit
-def study_fit(section, quick: bool) -> None:
-    from fem_neck.fit import run_fit
-
-    points = 12 if quick else 44
-    with tempfile.TemporaryDirectory() as tmp:  # fresh folder: run_fit resumes from an existing fit.csv
-        t0 = time.perf_counter()
-        fit = run_fit(n_points=points, rtol=1e-4, out=pathlib.Path(tmp), progress=False)
-        seconds = time.perf_counter() - t0
-    section.summary.update({"fit_seconds": seconds, "fit_points": points, "fit_cpu_seconds": fit.get("cpu_seconds")})
-    row = {"points": points, "rtol": 1e-4, "seconds": seconds, "cpu_seconds_in_solves": fit.get("cpu_seconds"),
-           "slope": fit.get("slope"), "unconverged": len(fit.get("unconverged", []))}
-    section.csv("fit", [row])
-    note = " Quick mode: 12 points, so this is not the target's figure (>= 40 points)." if quick else ""
-    section.add_text(
-        "Fit sweep",
-        f"`fem_neck.fit.run_fit(n_points={points}, rtol=1e-4)` into a fresh folder (process pool over both cores, "
-        f"including fit.json/csv/png).{note}\n\n" + records_table([row]))
-
-
-# --------------------------------------------------------------------------------------------------- start-up
-def study_startup(section, quick: bool) -> None:
-    """The main command as a user runs it, beside NGSolve solving the same points, each a whole fresh process."""
-    label = f"`python -m fem_neck fit` / NGSolve sweep of the same {STARTUP_POINTS} points, whole processes"
-    if not available("ngsolve"):
-        section.add_text("Start-up of the main command", "NGSolve is not installed (optional extra: "
-                                                         "`pip install .[peers]`); skipped.")
-        section.target(label, None, LIMITS["startup_ratio"])
-        return
-    setting = NGSOLVE_STARTUP
-    rounds = 2 if quick else 5
-    worker = (f"from benchmarks.fe import ngsolve_sweep; ngsolve_sweep({STARTUP_POINTS}, {setting['order']}, "
-              f"{setting['maxh']}, {setting['hp_levels']})")
-    with tempfile.TemporaryDirectory() as tmp:
-        runs = iter(range(10**6))
-
-        def ours():
-            out = pathlib.Path(tmp) / f"fit{next(runs)}"  # a fresh folder every time (no resume)
-            subprocess.run([sys.executable, "-m", "fem_neck", "fit", "--out", str(out)], check=True,
-                           capture_output=True)
-            return json.loads((out / "fit.json").read_text())
-
-        def theirs():
-            proc = subprocess.run([sys.executable, "-c", worker], check=True, capture_output=True, text=True)
-            return json.loads(proc.stdout.splitlines()[-1])
-
-        best, values = side_by_side({"fit": ours, "ngsolve": theirs}, rounds)
-    k_ours = [k for _, k in values["fit"]["points"]]
-    k_ng = values["ngsolve"]["K_over_Kcyl"]
-    deviation = max(abs(b / a - 1.0) for a, b in zip(k_ours, k_ng))
-    ratio = best["fit"] / best["ngsolve"]
-    section.summary.update({"startup_fit_seconds": best["fit"], "startup_ngsolve_seconds": best["ngsolve"],
-                            "startup_fit_over_ngsolve": ratio})
-    section.csv("startup", [{"command": "python -m fem_neck fit --out DIR", "seconds": best["fit"],
-                             "points": len(k_ours)},
-                            {"command": f"NGSolve sweep (order {setting['order']}, maxh {setting['maxh']}, "
-                                        f"{setting['hp_levels']} hp levels)", "seconds": best["ngsolve"],
-                             "points": len(k_ng)}])
-    section.add_text(
-        "Start-up of the main command",
-        f"Whole processes, best of {rounds} alternating rounds: `python -m fem_neck fit --out DIR` into a fresh "
-        f"folder (imports, {STARTUP_POINTS} hp solves to 1e-4 on both cores, fit.json, fit.csv, fit.png) "
-        f"**{best['fit']:.2f} s**; NGSolve solving the same {STARTUP_POINTS} a/r in one process (import, geometry, "
-        f"mesh, solve at order {setting['order']}, maxh {setting['maxh']}, {setting['hp_levels']} hp levels, which "
-        f"reaches 1e-4 at the three reference cases; no estimate, no files) **{best['ngsolve']:.2f} s**; ratio "
-        f"**{ratio:.2f}**. The two sweeps agree to {deviation:.1e} (largest relative difference over the points).")
-    section.target(label, ratio, LIMITS["startup_ratio"])
-
-
 # ------------------------------------------------------------------------------------------------- periodic cells
 def lattice_process(kind: str, h_over_r: float, rtol: float) -> dict:
     """``python -m fem_neck lattice --json`` as a fresh process: its output, wall seconds and peak memory (GB)."""
@@ -481,16 +408,12 @@ def study_lattice(section, quick: bool) -> None:
 
 
 def run(section, quick: bool) -> None:
-    section.summary.update({"fe_seconds_to_1e-4": None, "ngsolve_seconds_to_1e-4": None, "fit_seconds": None,
-                            "fe_over_ngsolve_side_by_side": None, "startup_fit_over_ngsolve": None})
+    section.summary.update({"fe_seconds_to_1e-4": None, "ngsolve_seconds_to_1e-4": None,
+                            "fe_over_ngsolve_side_by_side": None})
     study_error_against_time(section, quick)
     section.target("semisphere K to 1e-4 (warm, h/r = 0.08)", section.summary["fe_seconds_to_1e-4"],
                    LIMITS["fe_seconds_to_1e-4"], "s")
     study_ngsolve(section, quick)
     section.target("semisphere: ours / NGSolve, side by side", section.summary["fe_over_ngsolve_side_by_side"],
                    LIMITS["fe_over_ngsolve"])
-    study_fit(section, quick)
-    section.target("the full fit, >= 40 points to 1e-4, both cores", None if quick else section.summary["fit_seconds"],
-                   LIMITS["fit_seconds"], "s")
-    study_startup(section, quick)
     study_lattice(section, quick)

@@ -12,7 +12,8 @@
 * :func:`fit_law` -- B, C, E of :class:`fem_neck.law.ConductanceLaw` (A = 5/(4 pi) is derived), least squares on
   relative residuals.
 * :func:`run_fit` -- all of it, writing ``fit.json`` (read by the DEM), ``fit.csv`` and ``fit.png`` (the Fig. 16
-  analogue) into one folder.
+  analogue) into one folder; the figure is drawn by a process of its own that imports matplotlib while the sweep
+  starts (this process never imports matplotlib).
 
 Every step takes ``neck``: ``"cylinder"`` (default) sweeps and fits the semisphere with Rojek's neck cylinder,
 ``"union"`` the half body of the union of spheres (no cylinder; A = 1/pi), and fit.json records which.
@@ -24,6 +25,7 @@ processes import it; ``method`` (default :data:`METHOD`) and ``neck`` are passed
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import importlib
 import json
@@ -34,7 +36,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from sinterheat.interrupt import where
-from sinterheat.pool import run_jobs
+from sinterheat.pool import ProcessPool, run_jobs
 from fem_neck.law import (A_LOG, A_LOG_UNION, ARGENTO_BOUVARD, PARAMETERS, ROJEK, ConductanceLaw, check_neck,
                           half_neck_resistance)
 
@@ -213,14 +215,13 @@ def _append(path: pathlib.Path, point: FitPoint) -> None:
 
 def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int | None = None,
           solver: str = SOLVER, method: str = METHOD, progress: bool = True, reuse=None,
-          meanwhile=None, neck: str = "cylinder") -> list[FitPoint]:
+          neck: str = "cylinder") -> list[FitPoint]:
     """Solve the semisphere (``neck = "cylinder"``) or the union's half body (``"union"``) at every a/r to ``rtol``
     on ``workers`` processes (default: all cores), or on the Dask cluster of :func:`sinterheat.pool.use_dask`.
 
     ``reuse``: points solved before, keyed by a/r (:func:`reusable_points`); those at the sweep's a/r are kept
     instead of solved. With ``csv_path`` the CSV is rewritten with the kept points and each new point is appended
-    as soon as it is solved, so an interrupted sweep loses nothing. ``meanwhile``: see
-    :func:`sinterheat.pool.run_jobs`. Returns the points sorted by a/r.
+    as soon as it is solved, so an interrupted sweep loses nothing. Returns the points sorted by a/r.
 
     Parameters
     ----------
@@ -242,8 +243,6 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
         Whether to show a progress bar on stderr.
     reuse : dict or None
         Points solved before, ``{a/r as text: FitPoint}`` (:func:`reusable_points`); None: none.
-    meanwhile : callable or None
-        Run in a thread once the jobs are submitted; None: nothing.
     neck : str
         The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (the semisphere with Rojek's neck cylinder) or
         ``"union"`` (the union of spheres).
@@ -279,8 +278,7 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
         importlib.import_module(solver.split(":")[0])  # fail early in the parent, and let fork start warm
     jobs = [(_solve_point, (solver, method, neck, xi, rtol)) for xi, _ in todo]
     uniform_of = {_key(xi): ui for xi, ui in todo}
-    for res in run_jobs(jobs, workers, desc="fit sweep", unit="solve", progress=progress, done=len(points),
-                        meanwhile=meanwhile):
+    for res in run_jobs(jobs, workers, desc="fit sweep", unit="solve", progress=progress, done=len(points)):
         p = FitPoint(**res, uniform=uniform_of[_key(res["a_over_r"])])
         points[_key(p.a_over_r)] = p
         if csv_path is not None:
@@ -465,6 +463,7 @@ def plot(points: list[FitPoint], slope: float, law: ConductanceLaw, path) -> Non
     axr.plot(x, 100 * (np.asarray(law.k_over_kcyl(x)) / f - 1.0), "o-", ms=3, lw=0.8, color="C0",
              label="full-range law")
     axr.set(xscale="log", xlabel="a/r", ylabel="law / FE - 1 [%]", ylim=(-0.6, 0.6))
+    axr.xaxis.set_major_formatter(_decade_label)
     axl = axr.twinx()  # the linear laws miss by up to ~20 %: their own scale
     axl.plot(x, 100 * (slope * x / f - 1.0), "--", lw=0.8, color="C1", label="our linear fit (right axis)")
     axl.plot(x, 100 * (ROJEK.slope * x / f - 1.0), ":", lw=0.8, color="C2", label="Rojek eq. 40 (right axis)")
@@ -475,10 +474,36 @@ def plot(points: list[FitPoint], slope: float, law: ConductanceLaw, path) -> Non
     fig.savefig(path, dpi=130)
 
 
+_SUPERSCRIPT = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")
+
+
+def _decade_label(value: float, position=None) -> str:
+    """A log axis' tick label, ``10`` and the exponent in Unicode superscripts (as matplotlib's mathtext labels
+    look, without its parser, which costs a third of the figure): ``""`` between decades."""
+    if not value > 0:
+        return ""
+    exponent = round(float(np.log10(value)))
+    return "10" + str(exponent).translate(_SUPERSCRIPT) if np.isclose(value, 10.0**exponent) else ""
+
+
 def import_plotting() -> None:
-    """Import what :func:`plot` needs (run in a thread while the sweep's workers solve)."""
+    """Import what :func:`plot` needs (in the process that will draw, while the sweep solves: :func:`run_fit`)."""
     import matplotlib.backends.backend_agg  # noqa: F401
     import matplotlib.figure  # noqa: F401
+
+
+@contextlib.contextmanager
+def _plotter(draw: bool):
+    """The process that draws fit.png (``None`` when ``draw`` is false): forked now, it imports matplotlib at once
+    (:func:`import_plotting`), on the other core while this process imports the solver, and takes :func:`plot`
+    once the fit is known, while this process writes fit.json and fit.csv. A plotting error is raised by the
+    ``result()`` of its job; an error here stops it at once."""
+    if not draw:
+        yield None
+        return
+    with ProcessPool(1, "fork") as plotter:
+        plotter.submit(import_plotting)
+        yield plotter
 
 
 def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | None = None,
@@ -532,43 +557,44 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
     out = pathlib.Path(out) if out is not None else None
     csv_path = out / "fit.csv" if out is not None else None
     reuse, other = reusable_points(csv_path, rtol, solver, method, neck) if csv_path and not fresh else ({}, 0)
-    points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, method=method,
-                   progress=progress, reuse=reuse,
-                   meanwhile=import_plotting if out is not None and plot_png else None, neck=neck)
-    reused = sum(_key(xi) in reuse for xi in x)
-    xa = np.array([p.a_over_r for p in points])
-    fa = np.array([p.K_over_Kcyl for p in points])
-    um = np.array([p.uniform for p in points])
-    slope = linear_slope(xa[um], fa[um])
-    law = fit_law(xa, fa, neck=neck)
-    result = {
-        "slope": slope,
-        "sampling": f"least squares through the origin on the {int(np.sum(um & (xa <= LINEAR_RANGE)))} FE points "
-                    f"uniform in a/r (0.97 k/m) with a/r <= {LINEAR_RANGE}, as Rojek 2022 Fig. 16 / eq. (40)",
-        "slope_sensitivity": slope_sensitivity(law),
-        "points": [[p.a_over_r, p.K_over_Kcyl] for p in points],
-        "error_estimates": [p.error_estimate for p in points],
-        "unconverged": [p.a_over_r for p in points if not p.error_estimate <= p.rtol],
-        "rtol": rtol,
-        "law": {**law.to_dict(), "table": law.table(200)},
-        "paper": {"rojek_eq40": ROJEK.slope, "argento_bouvard_eq42": ARGENTO_BOUVARD.slope},
-        "solver": solver,
-        "method": method,
-        "neck": neck,
-        "reused": {"points": reused, "of": len(x), "not_matching": other},
-        "cpu_seconds": float(sum(p.seconds for p in points)),
-        "seconds": time.perf_counter() - t0,
-    }
-    if out is not None:
-        (out / "fit.json").write_text(json.dumps(result, indent=1) + "\n")
-        resid = np.asarray(law.k_over_kcyl(xa)) / fa - 1.0
-        with (out / "fit.csv").open("w", newline="") as fh:  # final: sorted, with the law's residual
-            w = csv.writer(fh)
-            w.writerow(CSV_FIELDS + ("law", "law_rel_residual"))
-            for p, r in zip(points, resid):
-                w.writerow(_csv_row(p) + [repr(float(p.K_over_Kcyl * (1 + r))), repr(float(r))])
-        if plot_png:
-            plot(points, slope, law, out / "fit.png")
+    with _plotter(out is not None and plot_png) as plotter:
+        points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, method=method,
+                       progress=progress, reuse=reuse, neck=neck)
+        reused = sum(_key(xi) in reuse for xi in x)
+        xa = np.array([p.a_over_r for p in points])
+        fa = np.array([p.K_over_Kcyl for p in points])
+        um = np.array([p.uniform for p in points])
+        slope = linear_slope(xa[um], fa[um])
+        law = fit_law(xa, fa, neck=neck)
+        drawn = plotter.submit(plot, points, slope, law, out / "fit.png") if plotter is not None else None
+        result = {
+            "slope": slope,
+            "sampling": f"least squares through the origin on the {int(np.sum(um & (xa <= LINEAR_RANGE)))} FE points "
+                        f"uniform in a/r (0.97 k/m) with a/r <= {LINEAR_RANGE}, as Rojek 2022 Fig. 16 / eq. (40)",
+            "slope_sensitivity": slope_sensitivity(law),
+            "points": [[p.a_over_r, p.K_over_Kcyl] for p in points],
+            "error_estimates": [p.error_estimate for p in points],
+            "unconverged": [p.a_over_r for p in points if not p.error_estimate <= p.rtol],
+            "rtol": rtol,
+            "law": {**law.to_dict(), "table": law.table(200)},
+            "paper": {"rojek_eq40": ROJEK.slope, "argento_bouvard_eq42": ARGENTO_BOUVARD.slope},
+            "solver": solver,
+            "method": method,
+            "neck": neck,
+            "reused": {"points": reused, "of": len(x), "not_matching": other},
+            "cpu_seconds": float(sum(p.seconds for p in points)),
+            "seconds": time.perf_counter() - t0,
+        }
+        if out is not None:
+            (out / "fit.json").write_text(json.dumps(result, indent=1) + "\n")
+            resid = np.asarray(law.k_over_kcyl(xa)) / fa - 1.0
+            with (out / "fit.csv").open("w", newline="") as fh:  # final: sorted, with the law's residual
+                w = csv.writer(fh)
+                w.writerow(CSV_FIELDS + ("law", "law_rel_residual"))
+                for p, r in zip(points, resid):
+                    w.writerow(_csv_row(p) + [repr(float(p.K_over_Kcyl * (1 + r))), repr(float(r))])
+        if drawn is not None:
+            drawn.result()  # the plotter's error, if any, raised here
     return result
 
 

@@ -266,14 +266,13 @@ def bar_switch(progress: bool) -> dict:
 
 
 def run_jobs(jobs, workers: int | None = None, *, start: str = "fork", desc: str = "", unit: str = "job",
-             progress: bool = True, done: int = 0, meanwhile=None):
+             progress: bool = True, done: int = 0):
     """Run ``func(*args)`` for every ``(func, args)`` of ``jobs`` on :func:`pool` (one job: in this process unless
     on Dask); yield the results as they finish.
 
     A tqdm bar on stderr counts ``done`` jobs finished earlier plus these, and so does the run's
     :func:`sinterheat.interrupt.where` (its step: ``"<desc>: k of n <unit>s done"``). On an interrupt, an error, or
-    when the caller stops iterating, the pool is stopped at once. ``meanwhile()`` runs in a thread of this process
-    once the jobs are submitted (e.g. importing what the caller needs next, while this process would only wait).
+    when the caller stops iterating, the pool is stopped at once.
     """
     from tqdm import tqdm
 
@@ -286,8 +285,6 @@ def run_jobs(jobs, workers: int | None = None, *, start: str = "fork", desc: str
     with tqdm(total=total, initial=done, desc=desc, unit=unit, file=sys.stderr, **bar_switch(progress)) as bar, \
             pool(min(workers or os.cpu_count() or 1, len(jobs)), start=start) as jobs_pool:
         running = [jobs_pool.submit(func, *args) for func, args in jobs]
-        if meanwhile is not None:
-            threading.Thread(target=meanwhile, daemon=True).start()
         while running:
             finished = jobs_pool.wait(running)
             running = [f for f in running if f not in finished]

@@ -2,6 +2,9 @@
 
 import csv
 import json
+import pathlib
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -12,6 +15,7 @@ from fem_neck.geometry import neck_geometry, overlap_for_neck
 
 from verification.cases import SEC6, SEMISPHERE
 
+ROOT = pathlib.Path(__file__).resolve().parents[1]
 REFERENCE = [(row.a_over_r, row.K_over_Kcyl) for row in SEMISPHERE]  # independent hp-FE, 12 digits
 
 
@@ -207,3 +211,31 @@ def test_unequal_pairs_against_fe(tmp_path):
     paper = res["paper_case"]  # Rojek 2022 Sec. 6: r_i = 1 mm, r_j = 3 mm, h = 0.06 mm, kappa = 394
     assert paper["a"] == pytest.approx(SEC6["a"].value, rel=2e-6)
     assert paper["K_law"] == pytest.approx(paper["K_fe"], rel=2e-3)
+
+
+def test_fit_command_draws_its_figure_without_importing_matplotlib(tmp_path):
+    """The command's own process never imports matplotlib (its import, longer than the whole sweep, runs in the
+    plotting process on the other core while this one imports the solver), and fit.png is still written."""
+    out = tmp_path / "fit"
+    script = ("import json, sys; from fem_neck.cli import main; "
+              f"code = main(['fit', '--points', '4', '--workers', '2', '--out', {str(out)!r}, '--json']); "
+              "print(json.dumps({'code': code, 'loaded': sorted(m for m in sys.modules if m.startswith("
+              "('matplotlib', 'PIL')))}))")
+    proc = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    seen = json.loads(proc.stdout.splitlines()[-1])
+    assert seen == {"code": 0, "loaded": []}, proc.stderr[-2000:]
+    assert (out / "fit.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert len(json.loads((out / "fit.json").read_text())["points"]) == 4
+
+
+def test_a_figure_that_cannot_be_written_fails_the_fit(tmp_path):
+    out = tmp_path / "fit"
+    (out / "fit.png").mkdir(parents=True)  # savefig in the plotting process fails
+    with pytest.raises(IsADirectoryError):
+        fit.run_fit(4, 1e-4, out, workers=1, progress=False)
+    assert (out / "fit.json").exists()  # the numbers are written before the figure is waited for
+
+
+def test_log_axis_labels_are_decades_in_superscript():
+    labels = [fit._decade_label(v) for v in (1e-3, 2e-3, 0.01, 0.5, 1.0, 10.0, 0.0)]
+    assert labels == ["10\u207b\u00b3", "", "10\u207b\u00b2", "", "10\u2070", "10\u00b9", ""]

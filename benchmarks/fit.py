@@ -1,0 +1,107 @@
+"""The main command, ``python -m fem_neck fit``: the sweep in this process, and the whole command as a user runs it
+beside NGSolve solving the same points.
+
+* The fit sweep (``fem_neck.fit.run_fit``, 44 points to 1e-4 on both cores, into a fresh folder).
+* The whole process of ``python -m fem_neck fit --json --out DIR`` (fresh folder; imports, 40 solves, fit.json,
+  fit.csv and fit.png), best of several rounds; with NGSolve installed (optional extra ``pip install .[peers]``),
+  alternating with the whole process of NGSolve solving the same 40 a/r (:func:`benchmarks.fe.ngsolve_sweep` at
+  :data:`benchmarks.fe.NGSOLVE_STARTUP`), and the ratio.
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+from benchmarks.fe import NGSOLVE_STARTUP
+from benchmarks.timing import available, side_by_side
+from verification.report import records_table
+
+TITLE = "The main command: python -m fem_neck fit"
+STARTUP_POINTS = 40  # the main command's default sweep
+LIMITS = {"fit_seconds": 15.0, "startup_ratio": 1.5}
+
+
+def study_fit(section, quick: bool) -> None:
+    from fem_neck.fit import run_fit
+
+    points = 12 if quick else 44
+    with tempfile.TemporaryDirectory() as tmp:  # fresh folder: run_fit resumes from an existing fit.csv
+        t0 = time.perf_counter()
+        fit = run_fit(n_points=points, rtol=1e-4, out=pathlib.Path(tmp), progress=False)
+        seconds = time.perf_counter() - t0
+    section.summary.update({"fit_seconds": seconds, "fit_points": points, "fit_cpu_seconds": fit.get("cpu_seconds")})
+    row = {"points": points, "rtol": 1e-4, "seconds": seconds, "cpu_seconds_in_solves": fit.get("cpu_seconds"),
+           "slope": fit.get("slope"), "unconverged": len(fit.get("unconverged", []))}
+    section.csv("fit", [row])
+    note = " Quick mode: 12 points, so this is not the target's figure (>= 40 points)." if quick else ""
+    section.add_text(
+        "Fit sweep",
+        f"`fem_neck.fit.run_fit(n_points={points}, rtol=1e-4)` into a fresh folder (process pool over both cores, "
+        f"including fit.json/csv/png).{note}\n\n" + records_table([row]))
+
+
+def study_startup(section, quick: bool) -> None:
+    """The main command as a user runs it, a whole fresh process each time, beside NGSolve solving the same points
+    (when installed)."""
+    label = f"`python -m fem_neck fit` / NGSolve sweep of the same {STARTUP_POINTS} points, whole processes"
+    setting = NGSOLVE_STARTUP
+    rounds = 2 if quick else 5
+    worker = (f"from benchmarks.fe import ngsolve_sweep; ngsolve_sweep({STARTUP_POINTS}, {setting['order']}, "
+              f"{setting['maxh']}, {setting['hp_levels']})")
+    with tempfile.TemporaryDirectory() as tmp:
+        runs = iter(range(10**6))
+
+        def ours():
+            out = pathlib.Path(tmp) / f"fit{next(runs)}"  # a fresh folder every time (no resume)
+            subprocess.run([sys.executable, "-m", "fem_neck", "fit", "--json", "--out", str(out)], check=True,
+                           capture_output=True)
+            return json.loads((out / "fit.json").read_text())
+
+        def theirs():
+            proc = subprocess.run([sys.executable, "-c", worker], check=True, capture_output=True, text=True)
+            return json.loads(proc.stdout.splitlines()[-1])
+
+        peers = {"fit": ours, "ngsolve": theirs} if available("ngsolve") else {"fit": ours}
+        best, values = side_by_side(peers, rounds)
+    ours_text = (f"`python -m fem_neck fit --json --out DIR` into a fresh folder (imports, {STARTUP_POINTS} hp solves "
+                 f"to 1e-4 on both cores, fit.json, fit.csv, fit.png) **{best['fit']:.2f} s**")
+    section.summary["startup_fit_seconds"] = best["fit"]
+    rows = [{"command": "python -m fem_neck fit --json --out DIR", "seconds": best["fit"],
+             "points": len(values["fit"]["points"])}]
+    if "ngsolve" not in peers:
+        section.csv("startup", rows)
+        section.add_text("Start-up of the main command",
+                         f"Whole processes, best of {rounds} rounds: {ours_text}. NGSolve is not installed (optional "
+                         "extra: `pip install .[peers]`): the side-by-side ratio is skipped.")
+        section.target(label, None, LIMITS["startup_ratio"])
+        return
+    k_ours = [k for _, k in values["fit"]["points"]]
+    k_ng = values["ngsolve"]["K_over_Kcyl"]
+    deviation = max(abs(b / a - 1.0) for a, b in zip(k_ours, k_ng))
+    ratio = best["fit"] / best["ngsolve"]
+    section.summary.update({"startup_ngsolve_seconds": best["ngsolve"], "startup_fit_over_ngsolve": ratio})
+    section.csv("startup", rows + [{"command": f"NGSolve sweep (order {setting['order']}, maxh {setting['maxh']}, "
+                                               f"{setting['hp_levels']} hp levels)", "seconds": best["ngsolve"],
+                                    "points": len(k_ng)}])
+    section.add_text(
+        "Start-up of the main command",
+        f"Whole processes, best of {rounds} alternating rounds: {ours_text}; NGSolve solving the same "
+        f"{STARTUP_POINTS} a/r in one process (import, geometry, mesh, solve at order {setting['order']}, maxh "
+        f"{setting['maxh']}, {setting['hp_levels']} hp levels, which reaches 1e-4 at the three reference cases; no "
+        f"estimate, no files) **{best['ngsolve']:.2f} s**; ratio **{ratio:.2f}**. The two sweeps agree to "
+        f"{deviation:.1e} (largest relative difference over the points).")
+    section.target(label, ratio, LIMITS["startup_ratio"])
+
+
+def run(section, quick: bool) -> None:
+    section.summary.update({"fit_seconds": None, "startup_fit_seconds": None, "startup_ngsolve_seconds": None,
+                            "startup_fit_over_ngsolve": None})
+    study_fit(section, quick)
+    section.target("the full fit, >= 40 points to 1e-4, both cores", None if quick else section.summary["fit_seconds"],
+                   LIMITS["fit_seconds"], "s")
+    study_startup(section, quick)
