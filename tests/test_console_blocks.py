@@ -32,7 +32,9 @@ RTOL, ATOL = 1e-6, 1e-12
 SLOW = ("fem_neck converge", "fem_neck lattice", "fem_neck cluster", "verification")  # commands of more than a few seconds: marked slow
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 TIMING = re.compile(r"(?<![\w.])\d+(?:\.\d+)?\s?s\b")  # "1.8 s": a wall time in a table
-PROGRESS = re.compile(r"\d+%\||it/s\]|s/it\]")  # a tqdm bar on stderr (a terminal overwrites it in place)
+# a tqdm bar on stderr (a terminal overwrites it in place): its percentage, its rate, or its elapsed-time bracket
+# ("[00:03, 3.76s/mesh" where the bar has no total)
+PROGRESS = re.compile(r"\d+%\||it/s\]|s/it\]|\[\d+:\d\d(:\d\d)?[,<]")
 
 
 def shown(output: str) -> list[str]:
@@ -84,6 +86,10 @@ def close(a: float, b: float) -> bool:
     if abs(a) < ATOL and abs(b) < ATOL:
         return True
     return math.isclose(a, b, rel_tol=RTOL, abs_tol=0.0)
+
+
+def test_a_bar_without_a_total_is_progress():
+    assert shown("lattice fcc: 1mesh [00:03,  3.76s/mesh, neck size 0.3 a]\nkind  fcc") == ["kind  fcc"]
 
 
 def test_number_extraction_ignores_timings_and_keeps_the_rest():
