@@ -25,7 +25,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from dem.network import comm as mpi
-from dem.network.heat import INTEGRATORS, Network
+from dem.network.heat import INTEGRATORS, STARTUP_STEPS, Network
 from dem.network.petsc import PetscSolver, matrix
 
 
@@ -443,6 +443,14 @@ class DistributedNetwork:
         heat_in = {k: 0.0 for k in net.flow_names}
         own = self.own_free
         energy0 = self.total(float(net.C[own] @ T[own]))
+        # Crank-Nicolson above the stable limit starts with implicit Euler steps, as the serial integrator does
+        # (dem.network.heat.integrate): taken where the step is surely above it, 2 / dt < max_i A_ii / C_i (a lower
+        # bound of lambda_max(C^-1 A), the Rayleigh quotient of a unit vector)
+        startup = 0
+        if theta < 1.0:
+            lam_low = mpi.maximum(self.comm, float(np.max(A.diagonal()[own] / net.C[own], initial=0.0)))
+            if lam_low > 0.0 and dt > 2.0 / lam_low:
+                startup = STARTUP_STEPS
         if observer is not None:
             observer(0, 0.0, T, self.flows(T, sinks))
         try:  # the PETSc solvers freed however the steps end (PetscSolver.destroy)
@@ -452,13 +460,14 @@ class DistributedNetwork:
                 h = t_end - (step - 1) * dt if last else dt
                 if abs(h - dt) <= 1e-9 * dt:
                     h = dt
-                if h not in solvers:
-                    M = (A * theta + sp.diags(net.C / h)).tocsr()
-                    solvers[h] = (M, self.solver(M, row, n_global, rtol_linear))
-                M, solver = solvers[h]
+                th = 1.0 if step <= startup else theta
+                if (h, th) not in solvers:
+                    M = (A * th + sp.diags(net.C / h)).tocsr()
+                    solvers[h, th] = (M, self.solver(M, row, n_global, rtol_linear))
+                M, solver = solvers[h, th]
                 rhs = net.C / h * T + r
-                if theta < 1.0:
-                    rhs -= (1.0 - theta) * (A @ T)
+                if th < 1.0:
+                    rhs -= (1.0 - th) * (A @ T)
                 T_new = T.copy()
                 T_new[own] = solver.solve(rhs[own], T[own])
                 T_new = self.halo_filled(T_new)[net.free]
@@ -468,7 +477,7 @@ class DistributedNetwork:
                                                         float(M[own].sum())]))
                 T_new += residual / weight
                 dt_min, dt_max = min(dt_min, h), max(dt_max, h)
-                T_theta = theta * T_new + (1.0 - theta) * T
+                T_theta = th * T_new + (1.0 - th) * T
                 flows = self.flows(T_theta, sinks)
                 for k, v in flows.items():
                     heat_in[k] += h * v
@@ -495,4 +504,4 @@ class DistributedNetwork:
         name = next(iter(solvers.values()))[1].name if solvers else "none"
         return {"T_F": T, "t": t, "steps": n_steps, "energy_error": err, "heat_in": heat_in,
                 "dt_min": dt_min, "dt_max": dt_max, "solver": name, "factorizations": len(solvers),
-                "violation": violation if bounded else None}
+                "violation": violation if bounded else None, "startup_steps": min(startup, n_steps)}

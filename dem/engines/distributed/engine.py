@@ -216,6 +216,8 @@ class DistributedStaticEngine(StaticEngine):
                        dt_min=res["dt_min"], dt_max=res["dt_max"], rejected_steps=0, stable_limit=None,
                        linear_solver=res["solver"], factorizations=res["factorizations"],
                        max_principle_violation=res["violation"])
+            if res["startup_steps"]:  # a stiff Crank-Nicolson run: its first steps were implicit Euler
+                out["startup_steps"] = res["startup_steps"]
         out["linear_iterations"] = self.part.linear_iterations
         self.details = out
 
