@@ -88,6 +88,9 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     ``progress``: a bar on stderr, and the run's position in the line an interrupt prints."""
     if out is None and (resume or overwrite):
         raise ValueError("--resume and --overwrite need --out (the folder of the run)")
+    if launched() and scene.output.lammps_dump and world().Get_size() > 1:
+        raise ValueError("[output] lammps_dump = true: not written under MPI (each rank writes its piece of a VTU "
+                         "snapshot); run on one process, or convert a state with python -m dem convert")
     if launched() and scene.engine == "static":  # under MPI a static packing's network is solved on PETSc
         return _run_distributed(scene, out, progress, resume, overwrite)
     comm = world() if launched() else None  # under MPI moving particles are shared by the ranks (their pieces)

@@ -79,3 +79,35 @@ def test_dem_convert_keeps_a_states_periodic_box(tmp_path):
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1
     assert "--periodic = 'xy': only for a packing file" in proc.stderr
+
+
+def test_a_moving_run_writes_lammps_dumps_that_read_back(tmp_path):
+    """[output] lammps_dump: beside every snapshot a LAMMPS text dump; the last one reads back (read_packing) to the
+    run's final state bit for bit: ids, centres, radii, velocities, temperatures, and its forces are there."""
+    import pathlib
+    import tomllib
+
+    builtin = pathlib.Path(__file__).resolve().parents[1] / "dem" / "scene" / "builtin"
+    text = (builtin / "hot-wall-sintering.toml").read_text().replace("t_end = 0.15\n", "t_end = 0.004\n")
+    doc = tomllib.loads(text)
+    doc.setdefault("output", {})["lammps_dump"] = True
+    result = run(parse_scene(doc), tmp_path / "run")
+    dumps = sorted((tmp_path / "run").glob("particles_*.dump"))
+    vtus = sorted((tmp_path / "run").glob("particles_*.vtu"))
+    assert len(dumps) == len(vtus) >= 2
+    last = read_packing(dumps[-1])
+    state = state_file.load(tmp_path / "run" / "state.npz")
+    assert last.timestep == result.summary["steps"]
+    assert np.array_equal(last.position, state["x"]) and np.array_equal(last.radius, state["radius"])
+    assert np.array_equal(last.temperature, state["T"]) and np.array_equal(last.velocity, state["v"])
+    assert last.id.tolist() == (np.asarray(state["id"]) + 1).tolist()  # LAMMPS numbers atoms from 1
+    header = dumps[-1].read_text().splitlines()
+    assert header[:2] == ["ITEM: UNITS", "si"]
+    assert header[10] == "ITEM: ATOMS id type radius x y z vx vy vz fx fy fz T"
+
+
+def test_lammps_dump_must_be_true_or_false():
+    with pytest.raises(ValueError, match=r"\[output\] lammps_dump = 'yes': must be true or false"):
+        parse_scene({"material": {"conductivity": 1.0, "density": 1.0, "specific_heat": 1.0},
+                     "particles": {"position": [[0, 0, 0]], "radius": [1e-3], "temperature": [0.0]},
+                     "output": {"lammps_dump": "yes"}})

@@ -6,6 +6,8 @@
   fields the engine offers (``engine.particle_fields()``);
 * ``bonds.pvd`` + ``bonds_NNNNNNNNN.vtu`` (a static packing) or ``contacts.pvd`` + ``contacts_NNNNNNNNN.vtu`` (particles
   that move) -- the links between particles as lines with their fields (``engine.links()``);
+* ``particles_NNNNNNNNN.dump`` (with ``[output] lammps_dump``) -- the same snapshots as LAMMPS text dumps
+  (:func:`dem.scene.packing_files.write_lammps_dump`), for OVITO and LAMMPS's tools;
 * ``profiles.csv`` -- profiles against the distance from a heated wall, where the engine offers them;
 * ``summary.json`` at the end (and after Ctrl-C, marked ``"interrupted": true``), and the engine's plots.
 
@@ -56,7 +58,7 @@ def resumed_profiles(path: pathlib.Path, t_last: float) -> None:
 def snapshot_files(out: pathlib.Path, kind: str):
     """``(step, path)`` of every snapshot file of ``kind`` in ``out``: ``kind_STEP.vtu``, and in parallel the
     pieces ``kind_STEP_RANK.vtu`` and ``kind_STEP.pvtu`` (:mod:`dem.output.pieces`)."""
-    for f in out.glob(f"{kind}_*vtu"):
+    for f in (*out.glob(f"{kind}_*vtu"), *out.glob(f"{kind}_*.dump")):
         yield int(f.name.split("_")[1].split(".")[0]), f
 
 
@@ -203,6 +205,8 @@ class RunWriter:
         if self.snapshots and self.snapshots[-1][1] == step:
             return
         self._profile(t)
+        if self.scene.output.lammps_dump:
+            self._dump(step)
         if not self.scene.output.vtu:
             self.snapshots.append((t, step))
             return
@@ -215,6 +219,18 @@ class RunWriter:
             cell_data={k: [v] for k, v in fields.items()}))
         self.snapshots.append((t, step))
         self._write_pvd()
+
+    def _dump(self, step: int) -> None:
+        """The particles now as a LAMMPS text dump, ``particles_STEP.dump`` (:func:`write_lammps_dump`)."""
+        from dataclasses import replace
+
+        from dem.scene.packing_files import packing_from_particles, write_lammps_dump
+
+        e = self.engine
+        fields = e.particle_fields()
+        packing = replace(packing_from_particles(self.scene.particles, self.scene.box), position=e.positions(),
+                          radius=fields["radius"], temperature=e.temperatures(), velocity=fields.get("velocity"))
+        write_lammps_dump(self.out / f"particles_{step:0{DIGITS}d}.dump", packing, step, fields.get("force"))
 
     def _profile(self, t: float) -> None:
         """The engine's profiles now, a block of rows of ``profiles.csv``."""

@@ -14,9 +14,9 @@
 * ``lammps-dump`` -- a LAMMPS or LIGGGHTS text dump (``dump custom``): the last snapshot or the one at
   ``timestep``; columns ``id``, ``type``, positions ``x y z`` (or unwrapped ``xu yu zu``, scaled ``xs ys zs``,
   scaled unwrapped ``xsu ysu zsu``; unwrapped positions are wrapped into the box along its periodic axes),
-  ``radius`` or ``diameter``, optional ``mass`` or ``density``, ``temperature`` (LIGGGHTS: ``f_Temp``), ``vx vy vz``,
-  ``omegax omegay omegaz``, ``ix iy iz``. ``ITEM: BOX BOUNDS`` gives the box and, with its ``pp``/``ff``/``ss``
-  flags, the periodic axes.
+  ``radius`` or ``diameter``, optional ``mass`` or ``density``, ``temperature`` (or ``T``; LIGGGHTS: ``f_Temp``),
+  ``vx vy vz``, ``omegax omegay omegaz``, ``ix iy iz``. ``ITEM: BOX BOUNDS`` gives the box and, with its
+  ``pp``/``ff``/``ss`` flags, the periodic axes.
 * ``vtk`` -- a VTK point set (``.vtu``, ``.vtp``, legacy ``.vtk``: what LIGGGHTS, Yade, ParaView and this toolkit's
   runs write), read by VTK itself (pyvista): the points are the centres, a point field ``radius`` (Yade: ``radii``)
   or ``diameter`` the sizes, and the fields ``id``, ``temperature``, ``fixed``, ``material`` (Yade:
@@ -35,7 +35,8 @@ file says).
 
 The other way: :func:`write_lammps_data` writes a packing (read here, from a scene's particles, or from a saved
 state, :func:`packing_from_state`) as a LAMMPS data file of ``atom_style sphere`` that ``read_data`` reads;
-:func:`write_csv` and :func:`write_vtu` write the two other formats.
+:func:`write_csv` and :func:`write_vtu` write the two other formats, :func:`write_lammps_dump` one snapshot of a
+LAMMPS text dump (a moving run's ``[output] lammps_dump``).
 """
 
 from __future__ import annotations
@@ -658,7 +659,7 @@ def _sorted(p: Packing, order: np.ndarray) -> Packing:
 
 # ------------------------------------------------------------------------------------------------ LAMMPS dump
 DUMP_POSITIONS = (("x", "y", "z"), ("xu", "yu", "zu"), ("xs", "ys", "zs"), ("xsu", "ysu", "zsu"))
-DUMP_TEMPERATURE = ("temperature", "temp", "f_temp", "f_temperature")
+DUMP_TEMPERATURE = ("temperature", "temp", "t", "f_temp", "f_temperature")
 
 
 def _read_dump(path: pathlib.Path, length_unit: float, timestep: int | None) -> Packing:
@@ -1144,6 +1145,54 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
         w = packing.angular_velocity if packing.angular_velocity is not None else np.zeros((n, 3))
         parts += ["\nVelocities\n\n", _rows_text([ids, *packing.velocity.T, *w.T], " ")]
     _write_text(path, parts)
+    return path
+
+
+def write_lammps_dump(path, packing: Packing, timestep: int, force=None) -> pathlib.Path:
+    """Write ``packing`` as one snapshot of a LAMMPS text dump (``dump custom``, ``units si``): ``ITEM: UNITS``,
+    ``TIMESTEP``, ``NUMBER OF ATOMS``, ``BOX BOUNDS`` (``pp`` along the packing's periodic axes, ``ff`` elsewhere)
+    and ``ATOMS id type radius x y z`` followed by ``vx vy vz``, ``fx fy fz`` and ``T`` where the packing has them,
+    the columns OVITO and LAMMPS's tools read. Ids from :func:`lammps_ids`, type = material index + 1; the box is the
+    packing's, or the particles' bounding box; numbers written to round-trip. :func:`read_packing` reads it back.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file to write (written aside, then moved into place).
+    packing : Packing
+        The particles: ids, centres (m), radii (m), and where present materials, velocities (m/s), temperatures.
+    timestep : int
+        The snapshot's step number (``ITEM: TIMESTEP``).
+    force : numpy.ndarray or None
+        (N, 3) forces on the particles (N); None: no force columns.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
+    path = pathlib.Path(path)
+    n = packing.n
+    x, r = packing.position, packing.radius
+    if packing.box_lo is not None:
+        lo, hi = np.asarray(packing.box_lo, dtype=float), np.asarray(packing.box_hi, dtype=float)
+    else:
+        lo, hi = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
+    periodic = packing.periodic or (False, False, False)
+    names, columns = ["id", "type", "radius", "x", "y", "z"], [lammps_ids(packing.id), _types(packing.material, n),
+                                                                r, *x.T]
+    for extra, data in (("vx vy vz", packing.velocity), ("fx fy fz", force)):
+        if data is not None:
+            names += extra.split()
+            columns += list(np.asarray(data, dtype=float).reshape(n, 3).T)
+    if packing.temperature is not None:
+        names.append("T")
+        columns.append(packing.temperature)
+    flags = " ".join("pp" if p else "ff" for p in periodic)
+    head = ["ITEM: UNITS", "si", "ITEM: TIMESTEP", str(int(timestep)), "ITEM: NUMBER OF ATOMS", str(n),
+            f"ITEM: BOX BOUNDS {flags}", *(f"{float(lo[a])!r} {float(hi[a])!r}" for a in range(3)),
+            "ITEM: ATOMS " + " ".join(names)]
+    _write_text(path, ["\n".join(head) + "\n", _rows_text(columns, " ")])
     return path
 
 

@@ -127,6 +127,9 @@ class OutputSpec:
         Whether to write VTU snapshots at all.
     checkpoint_every : float
         Wall-clock time between checkpoints of a transient run (s, > 0).
+    lammps_dump : bool
+        Whether to write, at every snapshot, a LAMMPS ``dump custom`` text file of the particles
+        (``particles_STEP.dump``: id type radius x y z, velocities, forces and T where the engine has them).
 
     Raises
     ------
@@ -138,14 +141,16 @@ class OutputSpec:
     vtu_every: int = 0
     vtu: bool = True
     checkpoint_every: float = 5.0
+    lammps_dump: bool = False
 
     def __post_init__(self):
         for key in ("every", "vtu_every"):
             v = getattr(self, key)
             if not isinstance(v, int) or isinstance(v, bool) or v < (1 if key == "every" else 0):
                 raise ValueError(f"[output] {key} = {v!r}: must be an integer >= {1 if key == 'every' else 0}")
-        if not isinstance(self.vtu, bool):
-            raise ValueError(f"[output] vtu = {self.vtu!r}: must be true or false")
+        for key in ("vtu", "lammps_dump"):
+            if not isinstance(getattr(self, key), bool):
+                raise ValueError(f"[output] {key} = {getattr(self, key)!r}: must be true or false")
         if not (isinstance(self.checkpoint_every, (int, float)) and not isinstance(self.checkpoint_every, bool)
                 and self.checkpoint_every > 0 and math.isfinite(self.checkpoint_every)):
             raise ValueError(f"[output] checkpoint_every = {self.checkpoint_every!r}: must be a number of seconds > 0")

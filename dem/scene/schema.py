@@ -210,6 +210,9 @@ ROWS = (
     Row("output", ("interval",), MOVING, "s, t_end / 100", "between rows of `timeseries.csv`"),
     Row("output", ("vtu_interval",), MOVING, "s, 0", "between VTU snapshots (0: first and last)"),
     Row("output", ("vtu",), ALL, "true", "write VTU/PVD snapshots"),
+    Row("output", ("lammps_dump",), ALL, "false", "beside every snapshot a LAMMPS `dump custom` text file "
+        "`particles_STEP.dump` (id type radius x y z, vx vy vz fx fy fz and T where the engine has them; OVITO and "
+        "LAMMPS's tools read it); not under MPI"),
     Row("output", ("checkpoint_every",), ALL, "5", "seconds of wall time between checkpoints (`--resume`)"),
     Row("output", ("fraction_axis",), STAGGERED, '`"x"`, `"y"` or `"z"`',
         "the axis the powder stands and is pressed along (Zohdi 2014, Sec. 7, Remark 1)"),
