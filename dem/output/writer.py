@@ -7,7 +7,7 @@
 * ``bonds.pvd`` + ``bonds_NNNNNNNNN.vtu`` (a static packing) or ``contacts.pvd`` + ``contacts_NNNNNNNNN.vtu`` (particles
   that move) -- the links between particles as lines with their fields (``engine.links()``);
 * ``particles_NNNNNNNNN.dump`` (with ``[output] lammps_dump``) -- the same snapshots as LAMMPS text dumps
-  (:func:`dem.scene.packing_files.write_lammps_dump`), for OVITO and LAMMPS's tools;
+  (:mod:`dem.output.lammps_dump`), for OVITO and LAMMPS's tools;
 * ``profiles.csv`` -- profiles against the distance from a heated wall, where the engine offers them;
 * ``summary.json`` at the end (and after Ctrl-C, marked ``"interrupted": true``), and the engine's plots.
 
@@ -221,16 +221,21 @@ class RunWriter:
         self._write_pvd()
 
     def _dump(self, step: int) -> None:
-        """The particles now as a LAMMPS text dump, ``particles_STEP.dump`` (:func:`write_lammps_dump`)."""
-        from dataclasses import replace
-
-        from dem.scene.packing_files import packing_from_particles, write_lammps_dump
+        """The particles now as a LAMMPS text dump, ``particles_STEP.dump`` (:func:`dem.output.lammps_dump.write_dump`):
+        types from the materials (index + 1), the box the periodic one or the particles' extent."""
+        from dem.output.lammps_dump import write_dump
 
         e = self.engine
         fields = e.particle_fields()
-        packing = replace(packing_from_particles(self.scene.particles, self.scene.box), position=e.positions(),
-                          radius=fields["radius"], temperature=e.temperatures(), velocity=fields.get("velocity"))
-        write_lammps_dump(self.out / f"particles_{step:0{DIGITS}d}.dump", packing, step, fields.get("force"))
+        x, r = e.positions(), np.asarray(fields["radius"], dtype=float)
+        box = self.scene.box
+        if box is not None:
+            lo, hi, periodic = box.origin, box.origin + box.lengths, tuple(box.periodic)
+        else:
+            lo, hi, periodic = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0), (False, False, False)
+        write_dump(self.out / f"particles_{step:0{DIGITS}d}.dump", step, fields["id"],
+                   np.asarray(self.scene.particles.material) + 1, r, x, lo, hi, periodic, fields.get("velocity"),
+                   fields.get("force"), e.temperatures())
 
     def _profile(self, t: float) -> None:
         """The engine's profiles now, a block of rows of ``profiles.csv``."""

@@ -35,8 +35,7 @@ file says).
 
 The other way: :func:`write_lammps_data` writes a packing (read here, from a scene's particles, or from a saved
 state, :func:`packing_from_state`) as a LAMMPS data file of ``atom_style sphere`` that ``read_data`` reads;
-:func:`write_csv` and :func:`write_vtu` write the two other formats, :func:`write_lammps_dump` one snapshot of a
-LAMMPS text dump (a moving run's ``[output] lammps_dump``).
+:func:`write_csv` and :func:`write_vtu` write the two other formats (a run's LAMMPS text dumps: :mod:`dem.output.lammps_dump`).
 """
 
 from __future__ import annotations
@@ -54,6 +53,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from dem.output.atomic import write_aside
+from dem.output.lammps_dump import lammps_ids, rows_text as _rows_text
 
 FORMATS = ("csv", "lammps-data", "lammps-dump", "vtk")
 AXES = "xyz"
@@ -1064,24 +1064,6 @@ def packing_from_state(state: dict) -> Packing:
                    np.asarray(state["T"], dtype=float), box_lo=lo, box_hi=hi, periodic=periodic, **moving)
 
 
-def lammps_ids(ids: np.ndarray) -> np.ndarray:
-    """The atom ids a packing gets in LAMMPS, which numbers atoms from 1: its own ids where all are >= 1, else its
-    ids + 1 (this toolkit numbers particles from 0).
-
-    Parameters
-    ----------
-    ids : numpy.ndarray
-        (N,) int, the packing's ids (N >= 1).
-
-    Returns
-    -------
-    numpy.ndarray
-        (N,) int, the ids shifted (where needed) so that the smallest is 1.
-    """
-    ids = np.asarray(ids, dtype=np.int64)
-    return ids if ids.min() >= 1 else ids + 1 - min(int(ids.min()), 0)
-
-
 def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) -> pathlib.Path:
     """Write ``packing`` as a LAMMPS data file of ``atom_style sphere`` (``units si``): the header (atoms, atom
     types, box), ``Atoms # sphere`` (``id type diameter density x y z ix iy iz``) and, where the packing has
@@ -1148,54 +1130,6 @@ def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) ->
     return path
 
 
-def write_lammps_dump(path, packing: Packing, timestep: int, force=None) -> pathlib.Path:
-    """Write ``packing`` as one snapshot of a LAMMPS text dump (``dump custom``, ``units si``): ``ITEM: UNITS``,
-    ``TIMESTEP``, ``NUMBER OF ATOMS``, ``BOX BOUNDS`` (``pp`` along the packing's periodic axes, ``ff`` elsewhere)
-    and ``ATOMS id type radius x y z`` followed by ``vx vy vz``, ``fx fy fz`` and ``T`` where the packing has them,
-    the columns OVITO and LAMMPS's tools read. Ids from :func:`lammps_ids`, type = material index + 1; the box is the
-    packing's, or the particles' bounding box; numbers written to round-trip. :func:`read_packing` reads it back.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        The file to write (written aside, then moved into place).
-    packing : Packing
-        The particles: ids, centres (m), radii (m), and where present materials, velocities (m/s), temperatures.
-    timestep : int
-        The snapshot's step number (``ITEM: TIMESTEP``).
-    force : numpy.ndarray or None
-        (N, 3) forces on the particles (N); None: no force columns.
-
-    Returns
-    -------
-    pathlib.Path
-        The file written.
-    """
-    path = pathlib.Path(path)
-    n = packing.n
-    x, r = packing.position, packing.radius
-    if packing.box_lo is not None:
-        lo, hi = np.asarray(packing.box_lo, dtype=float), np.asarray(packing.box_hi, dtype=float)
-    else:
-        lo, hi = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
-    periodic = packing.periodic or (False, False, False)
-    names, columns = ["id", "type", "radius", "x", "y", "z"], [lammps_ids(packing.id), _types(packing.material, n),
-                                                                r, *x.T]
-    for extra, data in (("vx vy vz", packing.velocity), ("fx fy fz", force)):
-        if data is not None:
-            names += extra.split()
-            columns += list(np.asarray(data, dtype=float).reshape(n, 3).T)
-    if packing.temperature is not None:
-        names.append("T")
-        columns.append(packing.temperature)
-    flags = " ".join("pp" if p else "ff" for p in periodic)
-    head = ["ITEM: UNITS", "si", "ITEM: TIMESTEP", str(int(timestep)), "ITEM: NUMBER OF ATOMS", str(n),
-            f"ITEM: BOX BOUNDS {flags}", *(f"{float(lo[a])!r} {float(hi[a])!r}" for a in range(3)),
-            "ITEM: ATOMS " + " ".join(names)]
-    _write_text(path, ["\n".join(head) + "\n", _rows_text(columns, " ")])
-    return path
-
-
 def wrapped(packing: Packing, what: str = "packing") -> tuple[np.ndarray, np.ndarray]:
     """The centres of ``packing`` in its box, ``lo <= x < hi`` (LAMMPS's rule), and their image flags: along a
     periodic axis a centre outside is moved by whole periods and its flag counts them (``x + image L`` is kept);
@@ -1241,20 +1175,6 @@ def wrapped(packing: Packing, what: str = "packing") -> tuple[np.ndarray, np.nda
                              f"box [{float(lo[a])!r}, {float(hi[a])!r}) along {AXES[a]}, which is not periodic{unknown}; "
                              f"{outside.size} particle(s) lie outside it (LAMMPS would lose them)")
     return x, image
-
-
-def _rows_text(columns, sep: str, chunk: int = 100_000):
-    """The rows of ``columns`` (arrays of one length) as lines of text, ``chunk`` rows per string yielded: floats as
-    the shortest digits that read back to the same double (``repr``), integers as they are, bools as true/false."""
-    columns = [np.asarray(c) for c in columns]
-    for start in range(0, len(columns[0]), chunk):
-        words = []
-        for column in (c[start:start + chunk] for c in columns):
-            if column.dtype.kind == "b":
-                words.append(np.where(column, "true", "false").tolist())
-            else:
-                words.append(list(map(repr if column.dtype.kind == "f" else str, column.tolist())))
-        yield "\n".join(map(sep.join, zip(*words))) + "\n"
 
 
 def _types(material, n: int) -> np.ndarray:
