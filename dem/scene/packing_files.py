@@ -1067,8 +1067,9 @@ def packing_from_state(state: dict) -> Packing:
 def write_lammps_data(path, packing: Packing, density=None, pad: float = 0.0) -> pathlib.Path:
     """Write ``packing`` as a LAMMPS data file of ``atom_style sphere`` (``units si``): the header (atoms, atom
     types, box), ``Atoms # sphere`` (``id type diameter density x y z ix iy iz``) and, where the packing has
-    velocities, ``Velocities`` (``id vx vy vz wx wy wz``). Ids from :func:`lammps_ids`; type = material index + 1
-    (names: their order of appearance); ``density`` kg/m^3 (one number or per particle) where the packing has none.
+    velocities, ``Velocities`` (``id vx vy vz wx wy wz``). Ids from :func:`dem.output.lammps_dump.lammps_ids`;
+    type = material index + 1 (names: their order of appearance); ``density`` kg/m^3 (one number or per particle)
+    where the packing has none.
     The box is the packing's, or the particles' bounding box grown by ``pad`` (m) beyond the largest radius; the
     periodicity is not part of a data file: the input script's ``boundary`` command sets it. A centre outside the
     packing's box (``lo <= x < hi``, LAMMPS's rule) is wrapped into it along a periodic axis, its image flag counting
