@@ -44,6 +44,8 @@ from dataclasses import dataclass
 import numpy as np
 from fem_neck.geometry import check_positive
 
+PAIRS_PER_BLOCK = 1 << 20  # necks_meet compares at most this many pairs of necks at once (a few tens of MB)
+
 
 @dataclass(frozen=True)
 class Lens:
@@ -216,17 +218,19 @@ def necks_meet(n: int, particle, direction, angle) -> np.ndarray:
                          f"entries, must be as many")
     if len(particle) and (particle.min() < 0 or particle.max() >= n):
         raise ValueError(f"particle: indices must lie in 0..{n - 1}")
-    unit = direction / np.linalg.norm(direction, axis=1)[:, None]
+    unit = direction / np.sqrt(np.einsum("ij,ij->i", direction, direction))[:, None]
     order = np.argsort(particle, kind="stable")
-    particle, unit, angle = particle[order], unit[order], angle[order]
+    counts = np.bincount(particle, minlength=int(n))
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])  # a particle's ends are order[first : first + count]
     out = np.zeros(int(n), dtype=bool)
-    for step in range(1, len(particle)):  # every end against the end `step` places on, while both are one particle's
-        same = np.flatnonzero(particle[step:] == particle[:-step])
-        if not len(same):
-            break
-        cos_g = np.einsum("ij,ij->i", unit[same + step], unit[same])
-        hit = np.arccos(np.clip(cos_g, -1.0, 1.0)) <= angle[same + step] + angle[same]
-        out[particle[same[hit]]] = True
+    for z in np.unique(counts[counts >= 2]):  # the particles of one neck count at once: every pair of their necks
+        b, c = np.triu_indices(int(z), 1)
+        group = np.flatnonzero(counts == z)
+        for block in np.array_split(group, -(-len(group) * len(b) // PAIRS_PER_BLOCK)):
+            ends = order[first[block][:, None] + np.arange(z)]  # (particles, z)
+            u, half = unit[ends], angle[ends]
+            cos_g = np.matmul(u, u.transpose(0, 2, 1))[:, b, c]
+            out[block] = np.any(np.arccos(np.clip(cos_g, -1.0, 1.0)) <= half[:, b] + half[:, c], axis=1)
     return out
 
 
