@@ -843,11 +843,14 @@ def engine_modules_loaded(scenes) -> tuple[list[str], float]:
 
 def direct_thermal(scene):
     """The thermal-only run as the lower-level calls :func:`dem.driver.run` makes: bonds, conductances,
-    network, then the steady solve (and the boundary heat flows it reports) or the time integration."""
+    network, the particles whose necks meet (the neck account it reports), then the steady solve (and the boundary
+    heat flows it reports) or the time integration."""
+    from dem.geometry.necks import meeting_in
     from dem.network.heat import boundary_heat_flow, build_network, integrate, steady
 
     s = scene.solver
     net = build_network(scene.particles, scene.walls, scene.conductance, scene.sources)
+    meeting_in(scene.particles, scene.walls, net.bonds, scene.box)
     if s.mode != "steady":
         return integrate(net, s.integrator, s.dt, s.t_end, s.rtol, s.linear, s.max_steps).T
     T = steady(net, s.floating, s.linear).T
