@@ -175,9 +175,8 @@ def cut_spheres(radius, i, j, vectors) -> CutSpheres:
         raise ValueError(f"i, j: particle indices must lie in 0..{n - 1}")
     d = np.linalg.norm(vectors, axis=1)
     if len(i):
-        lens(radius[i], radius[j], d)  # the range of every pair, with its message
-        l_i = 0.5 * (d + (radius[i] - radius[j]) * (radius[i] + radius[j]) / d)
-        beyond = (l_i <= 0.0) | (d - l_i <= 0.0)
+        neck = lens(radius[i], radius[j], d)  # the range of every pair, with its message
+        beyond = (neck.l_i <= 0.0) | (neck.l_j <= 0.0)
         if np.any(beyond):
             b = int(np.flatnonzero(beyond)[0])
             raise ValueError(f"pair ({i[b]}, {j[b]}): d = {d[b]:.6g} with radii {radius[i[b]]:.6g} and "
