@@ -205,14 +205,17 @@ class RunWriter:
         if self.snapshots and self.snapshots[-1][1] == step:
             return
         self._profile(t)
+        if not (self.scene.output.vtu or self.scene.output.lammps_dump):
+            self.snapshots.append((t, step))
+            return
+        x, particles = e.positions(), e.particle_fields()  # once for the VTU and the dump
         if self.scene.output.lammps_dump:
-            self._dump(step)
+            self._dump(step, x, particles)
         if not self.scene.output.vtu:
             self.snapshots.append((t, step))
             return
-        x = e.positions()
         write_vtu(self.out / f"particles_{step:0{DIGITS}d}.vtu", meshio.Mesh(
-            x, [("vertex", np.arange(len(x)).reshape(-1, 1))], point_data=e.particle_fields()))
+            x, [("vertex", np.arange(len(x)).reshape(-1, 1))], point_data=particles))
         points, lines, fields = e.links()
         write_vtu(self.out / f"{e.link_kind}_{step:0{DIGITS}d}.vtu", meshio.Mesh(
             points, [("line", np.asarray(lines, dtype=np.int64).reshape(-1, 2))],
@@ -220,14 +223,13 @@ class RunWriter:
         self.snapshots.append((t, step))
         self._write_pvd()
 
-    def _dump(self, step: int) -> None:
-        """The particles now as a LAMMPS text dump, ``particles_STEP.dump`` (:func:`dem.output.lammps_dump.write_dump`):
-        types from the materials (index + 1), the box the periodic one or the particles' extent."""
+    def _dump(self, step: int, x: np.ndarray, fields: dict) -> None:
+        """The particles at positions ``x`` with their ``fields`` (the engine's) as a LAMMPS text dump,
+        ``particles_STEP.dump`` (:func:`dem.output.lammps_dump.write_dump`): types from the materials (index + 1),
+        the box the periodic one or the particles' extent."""
         from dem.output.lammps_dump import write_dump
 
-        e = self.engine
-        fields = e.particle_fields()
-        x, r = e.positions(), np.asarray(fields["radius"], dtype=float)
+        r = np.asarray(fields["radius"], dtype=float)
         box = self.scene.box
         if box is not None:
             lo, hi, periodic = box.origin, box.origin + box.lengths, tuple(box.periodic)
@@ -235,7 +237,7 @@ class RunWriter:
             lo, hi, periodic = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0), (False, False, False)
         write_dump(self.out / f"particles_{step:0{DIGITS}d}.dump", step, fields["id"],
                    np.asarray(self.scene.particles.material) + 1, r, x, lo, hi, periodic, fields.get("velocity"),
-                   fields.get("force"), e.temperatures())
+                   fields.get("force"), self.engine.temperatures())
 
     def _profile(self, t: float) -> None:
         """The engine's profiles now, a block of rows of ``profiles.csv``."""
