@@ -1,4 +1,5 @@
-"""Runs that say where they stand: the particles whose necks meet, under every neck reading (dem.geometry.necks)."""
+"""Runs that say where they stand: the particles whose necks meet, under every neck reading (dem.geometry.necks), and
+the FE evidence of the law there (dem.laws.verified_range)."""
 
 import math
 
@@ -39,7 +40,9 @@ def test_union_reading_runs_where_the_pair_necks_have_no_answer():
     result = run(scene)
     s = result.summary
     assert s["neck_readings"] == {"union": s["bonds"]} and s["particles_necks_meeting"] == s["particles"]
-    assert "law 'rojek' is not verified against FE on union necks that meet" in s["warnings"][0]
+    assert s["warnings"] == ["law 'rojek' was not compared with FE on union necks (python -m verification "
+                             "densification compares shared-body, fit, argento-bouvard): no error bound"]
+    assert s["law_in_verified_range"] is False
     a = result.engine.bonds.a
     assert np.allclose(a, math.sqrt(1.0 - 0.8**2) * 1e-3, rtol=1e-12)
     assert result.engine.particle_fields()["necks_meeting"].tolist() == [1] * s["particles"]
@@ -70,3 +73,55 @@ def test_union_necks_take_the_union_half_body_law_and_refuse_the_cylinders():
     with pytest.raises(ValueError, match=r"fit file = .*fit\.json'?: fitted for neck = 'cylinder', cannot be used "
                                          r"for neck = 'union'"):
         ConductanceSpec(law="fit", neck="union", fit_file=str(fem_law.DEFAULT_FIT))
+
+
+@pytest.mark.parametrize("h, stands", [(0.05, "verified"), (0.3, "wide"), (0.6, "meeting")])
+def test_a_union_run_reports_the_fe_evidence_of_its_range(h, stands):
+    """SC on union necks with the shared-body law: necks of a/r 0.22 are verified (within 1 %, no warning), of 0.53
+    are wide (apart), and at h/r = 0.6 the six necks of every sphere meet (cones of 45.6 degrees, 90 degrees apart):
+    each range names its interval of EVIDENCE."""
+    from dem.laws.verified_range import EVIDENCE, percent_range
+
+    evidence = EVIDENCE["shared-body"]
+    s = run(lattice("sc", 2.0 - h, neck="union", law="shared-body")).summary
+    n = s["particles"]
+    assert (s["particles_necks_wide"], s["particles_necks_meeting"]) == {"verified": (0, 0), "wide": (n, 0),
+                                                                         "meeting": (0, n)}[stands]
+    assert s["law_in_verified_range"] is (stands == "verified")
+    interval = {"verified": (-0.01, 0.01), "wide": evidence.apart, "meeting": evidence.meeting}[stands]
+    assert s["law_error_range"] == list(interval)
+    if stands == "verified":
+        assert "warnings" not in s
+    else:
+        assert len(s["warnings"]) == 1 and f"law 'shared-body' at {percent_range(interval)} of k_eff" in s["warnings"][0]
+
+
+def test_the_account_joins_the_ranges_a_run_reached():
+    from dem.laws.verified_range import EVIDENCE, neck_account
+
+    fit = EVIDENCE["fit"]
+    s = neck_account(3, 10, "union", 40, "fit", wide=5)
+    assert (s["particles_necks_meeting"], s["particles_necks_wide"]) == (3, 5)
+    assert s["law_error_range"] == [min(fit.apart[0], fit.meeting[0]), max(fit.apart[1], fit.meeting[1])]
+    assert [w.split(":")[0] for w in s["warnings"]] == ["5 of 10 particles (50.0 %) carry a neck wider than a/r = 0 "
+                                                        "(none meeting)", "3 of 10 particles (30.0 %) carry necks that meet"]
+    pair = neck_account(3, 10, "newton", 40, "shared-body", wide=5)  # wide necks count only under the union reading
+    assert "particles_necks_wide" not in pair and "law_error_range" not in pair and len(pair["warnings"]) == 1
+
+
+def test_the_densification_study_holds_each_case_to_the_declared_evidence():
+    """verification.densification fails a case whose error lies outside the interval of the range it reached."""
+    from dem.laws.verified_range import EVIDENCE
+    from verification.densification import outside_evidence
+
+    ev = EVIDENCE["shared-body"]
+    row = {"rel": {"shared-body": 0.009}, "widest_neck": ev.verified_width, "meeting": 0}
+    assert outside_evidence(row, "shared-body") == 0.0
+    row["rel"]["shared-body"] = 0.012  # verified range: +-1 %
+    assert outside_evidence(row, "shared-body") == pytest.approx(0.002, abs=1e-15)
+    row["widest_neck"] = ev.verified_width + 0.01  # wide: the apart interval
+    assert outside_evidence(row, "shared-body") == 0.0
+    row["rel"]["shared-body"] = ev.meeting[0]
+    assert outside_evidence(row, "shared-body") == pytest.approx(ev.apart[0] - ev.meeting[0], abs=1e-15)
+    row["meeting"] = 2
+    assert outside_evidence(row, "shared-body") == 0.0

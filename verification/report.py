@@ -21,7 +21,8 @@ section is ``fail`` or ``error``.
 the two commands share.
 
 Two ways to fill a section: the verification sections are modules with ``run(out_dir, quick) -> dict`` returning
-``title``, ``markdown``, ``summary`` and ``figures`` (:func:`run_sections`); the benchmark subjects write into the
+``title``, ``markdown``, ``summary`` and ``figures``, and optionally ``targets`` (``(label, measured, limit)``
+triples, each a :meth:`Section.target`) (:func:`run_sections`); the benchmark subjects write into the
 section as they go (``section.csv``, ``section.figure``, ``section.add_text``, ``section.summary``,
 ``section.target``) inside ``with section.running():``.
 """
@@ -358,6 +359,8 @@ def run_section(name: str, out_dir: pathlib.Path, quick: bool, options: dict | N
         section.summary.update(jsonable(result["summary"]))
         section.title, section.markdown = str(result["title"]), str(result["markdown"])
         section.figures += [pathlib.Path(f) for f in result["figures"]]
+        for label, measured, limit in result.get("targets", ()):
+            section.target(label, measured, limit)
     return section
 
 

@@ -15,7 +15,8 @@ from dataclasses import replace
 import numpy as np
 
 from dem import memory
-from dem.geometry.necks import meeting_in, neck_account
+from dem.geometry.necks import meeting_in
+from dem.laws.verified_range import neck_account, wide_necks
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
 from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
                               periodic_heat_flow, steady)
@@ -216,7 +217,9 @@ class StaticEngine:
                "bonds_clipped": self.bonds.clipped, "bonds_dropped": self.bonds.dropped,
                "wall_bonds": self.bonds.n_walls,
                **neck_account(np.count_nonzero(self.meeting), self.scene.particles.n, self.bonds.contact,
-                              self.bonds.n_pairs + self.bonds.n_walls, self.scene.conductance.law)}
+                              self.bonds.n_pairs + self.bonds.n_walls, self.scene.conductance.law,
+                              np.count_nonzero(wide_necks(self.scene.particles.radius, self.bonds, self.meeting,
+                                                          self.scene.conductance.law)))}
         observer = self._observed(observe)
         t0 = self.t_start
         if s.mode == "steady":

@@ -17,9 +17,6 @@ from fem_neck.geometry.union import angular_radius, necks_meet
 
 from dem.geometry.bonds import LENS_GEOMETRY, Bonds
 
-PAIR_READINGS = ("newton", "first", "coble")  # the readings that end where necks meet
-
-
 def necks_meeting(radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, wall_normals: np.ndarray) -> np.ndarray:
     """Whether two necks of each particle meet (bool per particle).
 
@@ -71,42 +68,23 @@ def meeting_in(particles, walls, bonds: Bonds, box=None) -> np.ndarray:
     return necks_meeting(particles.radius, bonds, bonds.vectors(particles.position, box), normals)
 
 
-def neck_account(count: int, n: int, reading: str, bonds: int, law: str) -> dict:
-    """The summary's account of the necks: the reading every bond used (``neck_readings``: bonds per reading), how
-    many particles carry necks that meet (``particles_necks_meeting``), and, for the laws verified against FE (all but
-    ``zohdi``), whether the run stayed where the law is verified (``law_in_verified_range``: the necks of every
-    particle apart) with a one-line ``warnings`` entry where not.
+def widest_necks(radius: np.ndarray, bonds: Bonds) -> np.ndarray:
+    """Per particle, its widest neck over its radius, ``max a / r`` (0 without a neck).
 
     Parameters
     ----------
-    count : int
-        Particles that carry necks that meet.
-    n : int
-        Particles in the run.
-    reading : str
-        The neck reading of the bonds (``dem.geometry.bonds.CONTACT_MODELS``).
-    bonds : int
-        Pair and wall bonds.
-    law : str
-        The conductance law (``dem.laws.conductance.LAWS``).
+    radius : numpy.ndarray
+        Particle radii, m.
+    bonds : Bonds
+        The pair and wall bonds with their neck radii, m.
 
     Returns
     -------
-    dict
-        The summary's entries.
+    numpy.ndarray
+        ``max a / r`` per particle (dimensionless).
     """
-    count = int(count)
-    out = {"neck_readings": {reading: int(bonds)}, "particles_necks_meeting": count}
-    if reading not in PAIR_READINGS and reading != "union":
-        return out
-    out["law_in_verified_range"] = count == 0
-    if count:
-        where = f"{count} of {n} particles ({100.0 * count / n:.1f} %) carry necks that meet"
-        if reading in PAIR_READINGS:
-            why = (f"the pair-neck reading {reading!r} has no answer there, so law {law!r} is outside the "
-                   f"range where it is verified; conductance.neck = \"union\" reads the packing as the union of its "
-                   f"spheres, defined at every density")
-        else:
-            why = f"law {law!r} is not verified against FE on union necks that meet"
-        out["warnings"] = [f"{where}: {why}"]
-    return out
+    radius = np.asarray(radius, dtype=float)
+    widest = np.zeros(len(radius))
+    for particle, a in ((bonds.i, bonds.a), (bonds.j, bonds.a), (bonds.wall_particle, bonds.wall_a)):
+        np.maximum.at(widest, particle, np.asarray(a, dtype=float) / radius[particle])
+    return widest

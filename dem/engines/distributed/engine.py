@@ -29,7 +29,8 @@ import numpy as np
 
 from dem import memory
 from dem.engines.static import CSV_FLOWS, StaticEngine, boundary_summary
-from dem.geometry.necks import meeting_in, neck_account
+from dem.geometry.necks import meeting_in
+from dem.laws.verified_range import neck_account, wide_necks
 from dem.geometry.partition import bisection, halo
 from dem.network import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
@@ -140,6 +141,7 @@ class DistributedStaticEngine(StaticEngine):
         self.bonds, self.K_pairs, self.K_walls = bonds.subset(pairs, walls), K_pairs[pairs], K_walls[walls]
         self.held, self.mine = held, mine
         self.meeting = meeting_in(local, scene.walls, self.bonds, box)  # right for the owned: all their bonds are here
+        self.wide = wide_necks(local.radius, self.bonds, self.meeting, scene.conductance.law)
         self.T = local.temperature.astype(float)
         return owner[held]
 
@@ -195,7 +197,8 @@ class DistributedStaticEngine(StaticEngine):
         out.update(neck_account(self.part.total(int(np.count_nonzero(self.meeting[self.mine]))),
                                 self.full_scene.particles.n, b.contact,
                                 self.part.total(int(np.count_nonzero(self.mine[b.i]) + b.n_walls)),
-                                self.full_scene.conductance.law))
+                                self.full_scene.conductance.law,
+                                self.part.total(int(np.count_nonzero(self.wide[self.mine])))))
         observer = self._observed(observe)
         if s.mode == "steady":
             T_F, flows, err, n_float, solver = mpi.agree(

@@ -36,7 +36,8 @@ from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
 from dem.engines.contact_current import ContactCurrent
 from dem.engines.staggered.heat import LumpedHeat, contact_bonds
-from dem.geometry.necks import meeting_in, neck_account
+from dem.geometry.necks import meeting_in
+from dem.laws.verified_range import neck_account, wide_necks
 from dem.engines.staggered.mechanics import StaggeredMechanics
 from dem.scene.state_file import moving_arrays, normalised
 
@@ -385,8 +386,10 @@ class StaggeredEngine:
             out.update(energy_error=self.thermal.energy_error(),
                        heat_in={k: float(v) for k, v in self.thermal.heat_in.items()}, law=self.scene.conductance.law)
             meeting, bonds = self.necks()
+            law = self.scene.conductance.law
             out.update(neck_account(np.count_nonzero(meeting), mech.state.n, bonds.contact,
-                                    bonds.n_pairs + bonds.n_walls, self.scene.conductance.law))
+                                    bonds.n_pairs + bonds.n_walls, law,
+                                    np.count_nonzero(wide_necks(mech.state.radius, bonds, meeting, law))))
         if self.current is not None:
             c = self.current
             out.update(scheme=c.scheme, current_refreshes=c.refreshes, joule_energy=c.joule_energy,

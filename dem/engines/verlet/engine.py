@@ -29,11 +29,12 @@ from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.bonds import find_bonds
 from dem.geometry.motion import MotionState
-from dem.geometry.necks import meeting_in, neck_account
+from dem.geometry.necks import meeting_in
 from dem.geometry.neighbours import list_arrays
 from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
+from dem.laws.verified_range import neck_account, wide_necks
 from dem.scene.state_file import moving_arrays, normalised
 from dem.network.heat import boundary_heat_flow, steady
 from fem_neck.geometry import max_overlap, neck_radius
@@ -386,8 +387,9 @@ class VerletEngine:
             out.update(energy_error=th.energy_error(), heat_in={k: float(v) for k, v in th.heat_in.items()},
                        network_assemblies=th.assemblies, network_refreshes=th.refreshes, law=self.scene.conductance.law)
             meeting, bonds = self.necks()
-            out.update(neck_account(np.count_nonzero(meeting), s.n, bonds.contact, bonds.n_pairs + bonds.n_walls,
-                                    self.scene.conductance.law))
+            law = self.scene.conductance.law
+            out.update(neck_account(np.count_nonzero(meeting), s.n, bonds.contact, bonds.n_pairs + bonds.n_walls, law,
+                                    np.count_nonzero(wide_necks(s.radius, bonds, meeting, law))))
         return out
 
     def necks(self):

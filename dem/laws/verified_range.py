@@ -1,0 +1,174 @@
+"""Where a run stands against the FE evidence: the summary's account of the necks and of its law's verified range.
+
+**The pair-neck readings** (``newton``, ``first``, ``coble``; Rojek 2022, eqs. 10-34) have no answer once two necks of a
+particle meet: a law on them is then outside the range where it is verified, whatever its number.
+
+**The union of spheres.**
+Under ``conductance.neck = "union"`` (the union of the spheres, :mod:`fem_neck.geometry.union`) a packing is read at
+every density, but the laws were built on pair necks. ``python -m verification densification`` measures them against
+the periodic-cell FE of the union (:mod:`fem_neck.lattice`, two-sided bounds) on simple, body- and face-centred cubic
+lattices from ``phi`` 0.56 to 0.99 and on random mirror packings of overlapping spheres (radii +-15 %) at ``phi`` 0.6,
+0.8 and 0.95. Its relative errors ``k_network / k_FE - 1`` fall into three ranges of the necks, by each particle's
+widest neck ``a / r`` (``a`` the lens radius, ``r`` the particle's) and whether two of its necks meet
+(:mod:`dem.geometry.necks`):
+
+* **verified**: every neck of the particle at most ``verified_width`` wide and none meeting -- within 1 % of the FE on
+  all three lattices;
+* **wide**: a neck wider, none meeting -- the interval ``apart``;
+* **meeting**: two necks meet -- the interval ``meeting``.
+
+The intervals are the measured extremes, widened by the FE's own tolerance (1e-3 on the lattices, 2e-3 on the random
+packings); the study checks every one of its cases against them and fails if one falls outside. A law missing from
+:data:`EVIDENCE` was not compared with FE on union necks.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from dem.geometry.necks import widest_necks
+
+PAIR_READINGS = ("newton", "first", "coble")  # the readings that end where necks meet
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """The FE evidence of one law on union necks (module docstring).
+
+    Parameters
+    ----------
+    verified_width : float
+        The widest neck ``a / r`` (dimensionless) up to which the law is within 1 % of the FE where necks do not meet;
+        0 where it is not within 1 % even at the narrowest union neck compared.
+    apart : tuple of float
+        ``(low, high)``: the relative error of ``k_eff`` (dimensionless, -0.1 for -10 %) where necks are wider than
+        ``verified_width`` but do not meet.
+    meeting : tuple of float
+        ``(low, high)``: the relative error of ``k_eff`` (dimensionless) where two necks of a particle meet.
+    """
+
+    verified_width: float
+    apart: tuple[float, float]
+    meeting: tuple[float, float]
+
+
+EVIDENCE = {
+    "shared-body": Evidence(verified_width=0.3123, apart=(-0.002, 0.065), meeting=(-0.559, 0.023)),
+    "fit": Evidence(verified_width=0.0, apart=(-0.002, 0.840), meeting=(0.006, 5.47)),
+    "argento-bouvard": Evidence(verified_width=0.0, apart=(-0.119, 0.630), meeting=(-0.194, 3.99)),
+}
+
+
+def percent_range(interval: tuple[float, float]) -> str:
+    """``"-55.9 % to +2.3 %"`` for ``(-0.559, 0.023)``: a relative-error interval as the warnings print it.
+
+    Parameters
+    ----------
+    interval : tuple of float
+        ``(low, high)``, relative errors (dimensionless).
+
+    Returns
+    -------
+    str
+        The interval in per cent.
+    """
+    low, high = interval
+    return f"{100.0 * low:+.1f} % to {100.0 * high:+.1f} %"
+
+
+def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide: int = 0) -> dict:
+    """The summary's account of the necks and of where the law stands (module docstring).
+
+    Entries: the reading every bond used (``neck_readings``: bonds per reading), how many particles carry necks that
+    meet (``particles_necks_meeting``), and, for the laws verified against FE (all but ``zohdi``), whether the run
+    stayed where its law is verified (``law_in_verified_range``), with one ``warnings`` line per range it left. Under
+    the union reading, a law with FE evidence there also reports ``particles_necks_wide`` and ``law_error_range``:
+    the relative error of ``k_eff`` (``[low, high]``, dimensionless) the evidence allows over the ranges the run
+    reached.
+
+    Parameters
+    ----------
+    meeting : int
+        Particles that carry necks that meet.
+    n : int
+        Particles in the run.
+    reading : str
+        The neck reading of the bonds (``dem.geometry.bonds.CONTACT_MODELS``).
+    bonds : int
+        Pair and wall bonds.
+    law : str
+        The conductance law (``dem.laws.conductance.LAWS``).
+    wide : int
+        Particles whose necks do not meet but one of which is wider than the law's ``verified_width``
+        (:func:`dem.geometry.necks.widest_necks`); union reading only.
+
+    Returns
+    -------
+    dict
+        The summary's entries.
+    """
+    meeting, wide = int(meeting), int(wide)
+    out = {"neck_readings": {reading: int(bonds)}, "particles_necks_meeting": meeting}
+    if reading not in PAIR_READINGS and reading != "union":
+        return out
+    if reading in PAIR_READINGS:
+        out["law_in_verified_range"] = meeting == 0
+        if meeting:
+            out["warnings"] = [f"{_share(meeting, n)} carry necks that meet: the pair-neck reading {reading!r} has no "
+                               f"answer there, so law {law!r} is outside the range where it is verified; "
+                               f"conductance.neck = \"union\" reads the packing as the union of its spheres, defined at "
+                               f"every density"]
+        return out
+    evidence = EVIDENCE.get(law)
+    if evidence is None:
+        out["law_in_verified_range"] = False
+        out["warnings"] = [f"law {law!r} was not compared with FE on union necks (python -m verification "
+                           f"densification compares {', '.join(EVIDENCE)}): no error bound"]
+        return out
+    out["particles_necks_wide"] = wide
+    out["law_in_verified_range"] = meeting == 0 and wide == 0
+    reached = [interval for count, interval in ((wide, evidence.apart), (meeting, evidence.meeting)) if count]
+    out["law_error_range"] = ([min(r[0] for r in reached), max(r[1] for r in reached)] if reached
+                              else [-0.01, 0.01])
+    warnings = []
+    if wide:
+        warnings.append(f"{_share(wide, n)} carry a neck wider than a/r = {evidence.verified_width:g} (none meeting): "
+                        f"FE of the union puts law {law!r} at {percent_range(evidence.apart)} of k_eff there")
+    if meeting:
+        warnings.append(f"{_share(meeting, n)} carry necks that meet: FE of the union puts law {law!r} at "
+                        f"{percent_range(evidence.meeting)} of k_eff there")
+    if warnings:
+        out["warnings"] = warnings
+    return out
+
+
+def wide_necks(radius: np.ndarray, bonds, meeting: np.ndarray, law: str) -> np.ndarray:
+    """Per particle, whether its necks do not meet but one is wider than the law's ``verified_width`` on union necks
+    (all False under another reading or for a law without FE evidence there).
+
+    Parameters
+    ----------
+    radius : numpy.ndarray
+        Particle radii, m.
+    bonds : dem.geometry.bonds.Bonds
+        The pair and wall bonds with their neck radii (m) and reading.
+    meeting : numpy.ndarray
+        Per particle, whether two of its necks meet (bool, :func:`dem.geometry.necks.meeting_in`).
+    law : str
+        The conductance law.
+
+    Returns
+    -------
+    numpy.ndarray
+        Bool per particle.
+    """
+    evidence = EVIDENCE.get(law)
+    if bonds.contact != "union" or evidence is None:
+        return np.zeros(len(radius), dtype=bool)
+    return ~np.asarray(meeting, dtype=bool) & (widest_necks(radius, bonds) > evidence.verified_width)
+
+
+def _share(count: int, n: int) -> str:
+    return f"{count} of {n} particles ({100.0 * count / n:.1f} %)"
