@@ -281,13 +281,11 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
             raise ValueError("conductance.law = \"shared-body\": the wall bonds' walls are needed (their normals)")
         normals = np.array([w.normal for w in walls])[bonds.wall_index] if bonds.n_walls else np.zeros((0, 3))
         vectors = bonds.vectors(particles.position, box)
-        volume = None
-        if spec.neck == "union":  # each particle keeps its cut sphere (fem_neck.geometry.union), not its sphere
-            from fem_neck.geometry.union import cut_spheres
-
-            volume = cut_spheres(r, bonds.i, bonds.j, vectors).volume
-        s_i, s_j, s_w = neck_factors(particles.n, r, bonds, vectors, k_i, k_j, k_w, kappa, normals, volume)
-        k_i, k_j, k_w = s_i * k_i, s_j * k_j, s_w * k_w
+        if spec.neck == "union":
+            k_i, k_j, k_w = _shared_union_body(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w)
+        else:
+            s_i, s_j, s_w = neck_factors(particles.n, r, bonds, vectors, k_i, k_j, k_w, kappa, normals)
+            k_i, k_j, k_w = s_i * k_i, s_j * k_j, s_w * k_w
     k_pair = series(k_i, k_j)
     if spec.law in FIT_LAWS and spec.unequal and spec.neck != "union" and bonds.n_pairs:  # fitted to neck cylinders
         k_pair = k_pair * fem_law.unequal_factor(r[bonds.i], r[bonds.j], bonds.a)
@@ -300,6 +298,58 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
         share = k_j / (k_i + k_j)  # R_i / (R_i + R_j); an infinite half (a centre on the contact plane) makes none
     share = np.where(np.isfinite(share), share, np.where(np.isinf(k_i), 0.0, 1.0))
     return k_pair, k_wall, share
+
+
+def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_i, k_j, k_w):
+    """The ``shared-body`` halves under the union of spheres: each half body of the union law narrowed to the
+    particle's cut sphere (:mod:`dem.laws.cut_body`), then the factors of the necks sharing it
+    (:mod:`dem.laws.shared_body`) with the cut sphere's volume in the cap on the mean of the particle's tensor; a
+    neck inside a third sphere (its half conductance 0) carries nothing and takes no part in the factors.
+
+    Parameters
+    ----------
+    particles : Particles
+        The particles (radii, m).
+    bonds : Bonds
+        The union bonds (lens radii and radical-plane distances, m).
+    vectors : numpy.ndarray
+        ``x_j - x_i`` of every pair bond, m.
+    normals : numpy.ndarray
+        The unit normal of every wall bond's wall, into the packing.
+    kappa : numpy.ndarray
+        Per particle, its conductivity, W/(m K).
+    k_i, k_j, k_w : numpy.ndarray
+        The union law's half conductances of the pair bonds on ``i``, on ``j`` and of the wall bonds, W/K.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        The three arrays of half conductances, W/K.
+    """
+    from fem_neck.geometry.union import cut_spheres
+
+    from dem.laws.cut_body import cut_body_resistance
+    from dem.laws.shared_body import neck_factors
+
+    r = particles.radius
+    unit = vectors / np.linalg.norm(vectors, axis=1)[:, None] if bonds.n_pairs else np.zeros((0, 3))
+    particle = np.concatenate([bonds.i, bonds.j, bonds.wall_particle])
+    ends = cut_body_resistance(r, particle, np.vstack([unit, -unit, -np.reshape(normals, (-1, 3))]),
+                               np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l])) / kappa[particle]
+    m = bonds.n_pairs
+    with np.errstate(divide="ignore"):  # no extra resistance (0): an infinite conductance in series
+        k_i, k_j, k_w = (series(k, 1.0 / dR) for k, dR in ((k_i, ends[:m]), (k_j, ends[m:2 * m]),
+                                                         (k_w, ends[2 * m:])))
+    pairs, walls = (k_i > 0.0) & (k_j > 0.0), k_w > 0.0
+    live = bonds.subset(pairs, walls)
+    volume = cut_spheres(r, live.i, live.j, vectors[pairs]).volume
+    s_i, s_j, s_w = neck_factors(particles.n, r, live, vectors[pairs], k_i[pairs], k_j[pairs], k_w[walls], kappa,
+                                 np.reshape(normals, (-1, 3))[walls], volume, trace_cap=True)
+    k_i, k_j, k_w = np.where(pairs, k_i, 0.0), np.where(pairs, k_j, 0.0), k_w.copy()
+    k_i[pairs] *= s_i
+    k_j[pairs] *= s_j
+    k_w[walls] *= s_w
+    return k_i, k_j, k_w
 
 
 def _check_finite(spec: ConductanceSpec, K: np.ndarray, a: np.ndarray, name) -> None:

@@ -55,7 +55,7 @@ class Evidence:
 
 
 EVIDENCE = {
-    "shared-body": Evidence(verified_width=0.3123, apart=(-0.002, 0.065), meeting=(-0.559, 0.023)),
+    "shared-body": Evidence(verified_width=0.3123, apart=(-0.002, 0.057), meeting=(-0.037, 0.048)),
     "fit": Evidence(verified_width=0.0, apart=(-0.002, 0.840), meeting=(0.006, 5.47)),
     "argento-bouvard": Evidence(verified_width=0.0, apart=(-0.119, 0.630), meeting=(-0.194, 3.99)),
 }
