@@ -172,6 +172,24 @@ def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):
         refuse_unsupported(staggered, 1)
 
 
+
+def test_a_wrong_static_run_on_two_ranks_ends_in_one_line_and_exit_2(tmp_path):
+    """The pair of tests/mpi whose Crank-Nicolson steps throw it 1.21 K out of its range at t = 0.6 s (the serial run
+    refuses it): under mpiexec -n 2 the command prints the serial run's one line, no traceback, and every rank
+    exits 2 (it exited 0)."""
+    scene = tmp_path / "pair.toml"
+    scene.write_text("[material]\nconductivity = 394.0\ndensity = 8960.0\nspecific_heat = 385.0\n"
+                     "[particles]\nposition = [[0.0, 0.0, 0.0], [0.0, 0.0, 1.094e-2]]\nradius = [1.0e-3, 1.0e-2]\n"
+                     "temperature = [0.0, 100.0]\n"
+                     '[solver]\nmode = "transient"\nintegrator = "crank-nicolson"\ndt = 0.2\nt_end = 2.0\n')
+    done = subprocess.run(["mpiexec", "-n", "2", sys.executable, "-m", "dem", "run", str(scene), "--quiet"],
+                          env=ENV, capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert done.returncode == 2, done.stderr[-3000:]
+    ours = [line for line in done.stderr.splitlines() if line.startswith("python -m dem run")]
+    assert len(ours) == 1 and "Traceback" not in done.stderr
+    assert ours[0].startswith("python -m dem run: error: solver.dt = 0.2 s (crank-nicolson): at t = 0.6 s the "
+                              "temperatures left the prescribed range [0, 100] by 1.212 (max_principle_violation")
+
 @pytest.mark.slow
 def test_two_ranks_compact_as_the_serial_runs_do(tmp_path):
     # The packing a stress-controlled compaction reaches is chaotic: round-off (here: the two ranks add the walls'
