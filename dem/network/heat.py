@@ -665,7 +665,7 @@ def surely_stiff(dt: float, A: sp.csr_matrix, C: np.ndarray, rows=None, largest=
     dt : float
         The step (s).
     A : scipy.sparse.csr_matrix
-        The system matrix (W/K, :meth:`Network.matrix`).
+        The system matrix (W/K, :meth:`dem.network.heat.Network.matrix`).
     C : numpy.ndarray
         The capacities of its rows (J/K).
     rows : numpy.ndarray or None
