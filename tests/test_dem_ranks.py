@@ -1,7 +1,7 @@
 """Moving particles across MPI ranks (dem.engines.verlet.ranks), launched with mpiexec -n 1 and -n 2 on
 tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserve momentum (periodic box), follow
 the serial elastic collisions (energy and all) to the bit, carry the heat of the contacts as the serial run does
-(conserving it), resume from their checkpoints to the bit,
+(conserving it, stiff thermal steps too), resume from their checkpoints to the bit,
 write a piece of every snapshot per rank (PVTU), lose and duplicate no particle through migration, move
 stress walls as the serial run to round-off, and write the run's folder from rank 0. Skipped where mpi4py or
 mpiexec is missing."""
@@ -112,6 +112,22 @@ def test_two_ranks_carry_the_heat_of_the_contacts(tmp_path):
         assert two["summary_values"][keys.index("energy_error")] < 1e-12
         assert keys == list(serial["summary_keys"])
 
+
+
+def test_two_ranks_take_the_serial_runs_stiff_thermal_steps(tmp_path):
+    """The gas with a specific heat of 1e-4 J/(kg K): its contacts' time constants are ~1e-7 s, the thermal steps
+    (Crank-Nicolson asked for, the default) 1e-4 s. Every such step surely above the stable limit is an implicit
+    Euler step, on two ranks (dem.network.distributed) as in the serial run (dem.engines.contact_heat): the same
+    temperatures to CG's tolerance and the same count of such steps. The serial run took plain Crank-Nicolson steps,
+    and its temperatures kept alternating across the contacts where the ranks' had equalised."""
+    serial = ranks_worker.run_scene(ranks_worker.hot_and_cold(ranks_worker.STIFF_SPECIFIC_HEAT))
+    two = launched(2, "stiff-heat", tmp_path / "two.npz")
+    spread = 80.0
+    assert np.max(np.abs(two["T"] - serial["T"])) <= 1e-8 * spread
+    keys = list(serial["summary_keys"])
+    assert list(two["summary_keys"]) == keys
+    startup = keys.index("startup_steps")
+    assert two["summary_values"][startup] == serial["summary_values"][startup] > 0
 
 @pytest.mark.parametrize("case, stop", [("compaction", 0.0045), ("heat", 0.002)])
 def test_two_ranks_interrupted_and_resumed_end_as_the_uninterrupted_run(tmp_path, case, stop):
