@@ -198,3 +198,19 @@ def test_temperatures_out_of_range_stop_every_rank_as_the_serial_run():
     assert str(ours.value) == str(serial_error.value)
     assert "at t = 0.6 s" in str(ours.value) and "by 1.212 (max_principle_violation" in str(ours.value)
     COMM.Barrier()  # every rank got here: none waits in the integrator
+
+
+def test_crank_nicolson_steps_far_above_the_stiffest_time_constant_end_as_in_the_serial_run():
+    """The issue's pair (r = 1 and 3 mm at 100 and 0 C) in steps of 1e6 s, ~1e8 time constants: the serial run
+    ends at the capacity-weighted mean 100/28 C. On the ranks CG stopped at its first iteration (PETSc's divergence
+    test: the warm start's residual, ~K |delta T|, is far above |b| ~ C/dt |T|), and the run was refused."""
+    doc = {"material": MATERIAL,
+           "particles": {"position": [[0.0, 0.0, 0.0], [0.0, 0.0, 3.94e-3]], "radius": [1e-3, 3e-3],
+                         "temperature": [100.0, 0.0]},
+           "solver": {"mode": "transient", "integrator": "crank-nicolson", "dt": 1e6, "t_end": 1e7}}
+    scene = parse_scene(doc)
+    result = run(scene)
+    ref = serial(scene)
+    assert np.allclose(result.engine.gathered_temperatures(), 100.0 / 28.0, rtol=0, atol=1e-6)
+    assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-6
+    assert result.summary["startup_steps"] == ref.summary()["startup_steps"] == 2
