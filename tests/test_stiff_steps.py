@@ -60,6 +60,17 @@ def test_capacities_lost_to_round_off_are_refused(tmp_path, capsys):
                  "solver.dt = 'auto'", "wrong", "density and specific heat")
 
 
+@pytest.mark.parametrize("linear, needles", [
+    ("cg", ("cg broke down", "singular to round-off", "capacities")),  # p.Ap = 0: ZeroDivisionError in CG
+    ("amg", ("amg did not reach rtol",)),  # the residuals' sum over the matrix's, both 0: ZeroDivisionError
+])
+def test_capacities_lost_to_round_off_in_an_iterative_solve_are_refused(tmp_path, capsys, linear, needles):
+    """The same pair with an iterative linear solver: a ZeroDivisionError traceback (CG's p.Ap, or the uniform
+    shift that balances the residuals, divided by the matrix's sum: C/dt lost next to K in every row sum)."""
+    refuse_scene(tmp_path, pair_toml(k="1.0e10", rho="1.0e-10", cp="1.0e-10") + f'linear = "{linear}"\n', capsys,
+                 *needles)
+
+
 def test_oscillating_steps_are_refused_where_nothing_damps_them():
     """The pair resumed from a checkpoint past the start-up, still at 100 and 0 C: nothing damps the stiff mode,
     plain Crank-Nicolson alternates it (T_1 -> -92.9 C), and the maximum-principle check refuses the run in one

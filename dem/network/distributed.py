@@ -25,7 +25,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from dem.network import comm as mpi
-from dem.network.heat import (INTEGRATORS, STARTUP_STEPS, Network, refuse_energy_error,
+from dem.network.heat import (INTEGRATORS, STARTUP_STEPS, Network, balancing_shift, refuse_energy_error,
                               refuse_out_of_range, surely_stiff)
 from dem.network.petsc import PetscSolver, matrix
 
@@ -473,7 +473,7 @@ class DistributedNetwork:
                 # balance of the step to round-off), as in the serial stepper
                 residual, weight = self.total(np.array([float(np.sum((rhs - M @ T_new)[own])),
                                                         float(M[own].sum())]))
-                T_new += residual / weight
+                T_new += balancing_shift(residual, weight)
                 dt_min, dt_max = min(dt_min, h), max(dt_max, h)
                 T_theta = th * T_new + (1.0 - th) * T
                 flows = self.flows(T_theta, sinks)

@@ -806,7 +806,7 @@ class _Stepper:
         if solver.name != "direct":
             # iterative solve: a uniform shift of the order of its tolerance makes the residuals sum to zero, so
             # the heat balance of the step (and energy_error) holds to round-off
-            T_new += float(np.sum(rhs - solver.A @ T_new)) / float(solver.A.sum())
+            T_new += balancing_shift(float(np.sum(rhs - solver.A @ T_new)), float(solver.A.sum()))
         return T_new, self.theta * T_new + (1.0 - self.theta) * T, sinks
 
     def estimated_step(self, T: np.ndarray, dt: float):
@@ -830,6 +830,27 @@ class _Stepper:
         q = ORDER[self.theta]
         err = float(np.max(np.abs(T_b - T_1), initial=0.0)) / (2.0**q - 1.0)
         return T_b, [(half, th_a, s_a), (half, th_b, s_b)], err
+
+
+def balancing_shift(residual: float, weight: float) -> float:
+    """The uniform shift of an iterative solve's temperatures that makes its residuals sum to zero (the module
+    docstring's energy bookkeeping): ``residual / weight``; 0 where ``weight`` came out 0, the capacities ``C/dt``
+    lost to round-off next to the conductances in the matrix's row sums, whose run the heat balance check then
+    refuses (``energy_error``) instead of dividing by zero.
+
+    Parameters
+    ----------
+    residual : float
+        The sum of the solve's residuals ``b - M T`` (W).
+    weight : float
+        The sum of the entries of the step's matrix ``M = C/dt + theta A`` (W/K).
+
+    Returns
+    -------
+    float
+        The shift (K).
+    """
+    return residual / weight if weight > 0.0 else 0.0
 
 
 def theta_step(net: Network, T_F: np.ndarray, dt: float, integrator: str = "implicit", linear: str = "auto",
