@@ -16,7 +16,7 @@ import numpy as np
 from dem.engines import engine_class
 from dem.network.comm import launched, on_root, world
 from dem.output import folder as run_folder
-from dem.output.writer import RunWriter
+from dem.output.writer import RunWriter, write_summary
 from dem.scene import Scene
 from dem.scene import state_file
 from sinterheat.interrupt import Where, where
@@ -102,7 +102,7 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
         cls = RankVerletEngine
     root = comm is None or comm.Get_rank() == 0
     if out is not None:
-        out = on_root(comm, lambda: run_folder.prepare(out, resume, overwrite))
+        out, resume = on_root(comm, lambda: run_folder.prepare(out, resume, overwrite))
     try:
         return _run_held(scene, out, progress, resume, comm, cls, root)
     finally:  # the folder is free again however the run ended
@@ -115,7 +115,13 @@ def _run_held(scene: Scene, out, progress: bool, resume: bool, comm, cls, root: 
     start = time.perf_counter()
     here = _position(scene, out, progress and root)
     restart = run_folder.load(out, scene, scene.engine) if resume else None
-    engine = cls(scene, restart)  # the memory and the work checked and refused up front
+    try:
+        engine = cls(scene, restart)  # the memory and the work checked and refused up front
+    except KeyboardInterrupt:  # nothing written yet: a --resume starts the run again (run_folder.interrupted_at_start)
+        if out is not None and root and restart is None:
+            write_summary(out / "summary.json", {"scene": scene.name, "mode": scene.solver.mode, "interrupted": True,
+                                                 "physics": list(scene.physics), "resume_from": None})
+        raise
     _announce(scene, progress and root)
     writer = None
     resume_step = engine.steps if resume else None
@@ -198,7 +204,7 @@ def _run_distributed(scene: Scene, out, progress: bool, resume: bool, overwrite:
     rank = comm.Get_rank()
     start = time.perf_counter()
     if out is not None:
-        out = mpi.agree(comm, lambda: run_folder.prepare(out, False, overwrite) if rank == 0 else None)
+        out = mpi.agree(comm, lambda: run_folder.prepare(out, False, overwrite)[0] if rank == 0 else None)
         out = comm.bcast(out)
     try:
         engine = DistributedStaticEngine(scene)

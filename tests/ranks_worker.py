@@ -40,6 +40,7 @@ HEAT = {**GAS, "scene": {"physics": ["mechanical", "thermal"]},  # the elastic g
         "material": {"density": 7800.0, "conductivity": 40.0, "specific_heat": 450.0},
         "generator": {**GAS["generator"], "n": 50, "radius": 6e-4, "speed": 0.2},
         "solver": {"mode": "transient", "t_end": 0.004, "thermal_interval": 1e-4}}
+STIFF_SPECIFIC_HEAT = 1e-4  # J/(kg K): the contacts' time constants ~1e-7 s, far below the thermal interval
 CHUNK = 100  # steps between the samples of a trace
 
 
@@ -98,13 +99,16 @@ def pressed(relative: float = 0.0):
     return parse_scene(doc)
 
 
-def hot_and_cold():
-    """:data:`HEAT`, the particles' temperatures 20 to 100 (by id): heat flows wherever two of them touch."""
+def hot_and_cold(specific_heat: float = 450.0):
+    """:data:`HEAT`, the particles' temperatures 20 to 100 (by id): heat flows wherever two of them touch;
+    ``specific_heat`` (J/(kg K)) of the particles."""
     import dataclasses
 
     from dem import parse_scene
 
-    scene = parse_scene(copy.deepcopy(HEAT))
+    doc = copy.deepcopy(HEAT)
+    doc["material"]["specific_heat"] = specific_heat
+    scene = parse_scene(doc)
     p = scene.particles
     T = 20.0 + 80.0 * (np.arange(p.n) * 37 % p.n) / p.n
     return dataclasses.replace(scene, particles=dataclasses.replace(p, temperature=T))
@@ -174,6 +178,8 @@ if __name__ == "__main__":
         result = run_scene(pressed())
     elif sys.argv[1] == "heat":  # heat RESULT
         result = run_scene(hot_and_cold())
+    elif sys.argv[1] == "stiff-heat":  # stiff-heat RESULT
+        result = run_scene(hot_and_cold(STIFF_SPECIFIC_HEAT))
     elif sys.argv[1] == "whole":  # whole CASE FOLDER RESULT
         result = run_scene(RESUMED[sys.argv[2]](), sys.argv[3])
     elif sys.argv[1] == "resumed":  # resumed CASE STOP FOLDER RESULT

@@ -1,7 +1,7 @@
 """Moving particles across MPI ranks (dem.engines.verlet.ranks), launched with mpiexec -n 1 and -n 2 on
 tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserve momentum (periodic box), follow
 the serial elastic collisions (energy and all) to the bit, carry the heat of the contacts as the serial run does
-(conserving it), resume from their checkpoints to the bit,
+(conserving it, stiff thermal steps too), resume from their checkpoints to the bit,
 write a piece of every snapshot per rank (PVTU), lose and duplicate no particle through migration, move
 stress walls as the serial run to round-off, and write the run's folder from rank 0. Skipped where mpi4py or
 mpiexec is missing."""
@@ -113,6 +113,22 @@ def test_two_ranks_carry_the_heat_of_the_contacts(tmp_path):
         assert keys == list(serial["summary_keys"])
 
 
+
+def test_two_ranks_take_the_serial_runs_stiff_thermal_steps(tmp_path):
+    """The gas with a specific heat of 1e-4 J/(kg K): its contacts' time constants are ~1e-7 s, the thermal steps
+    (Crank-Nicolson asked for, the default) 1e-4 s. Every such step surely above the stable limit is an implicit
+    Euler step, on two ranks (dem.network.distributed) as in the serial run (dem.engines.contact_heat): the same
+    temperatures to CG's tolerance and the same count of such steps. The serial run took plain Crank-Nicolson steps,
+    and its temperatures kept alternating across the contacts where the ranks' had equalised."""
+    serial = ranks_worker.run_scene(ranks_worker.hot_and_cold(ranks_worker.STIFF_SPECIFIC_HEAT))
+    two = launched(2, "stiff-heat", tmp_path / "two.npz")
+    spread = 80.0
+    assert np.max(np.abs(two["T"] - serial["T"])) <= 1e-8 * spread
+    keys = list(serial["summary_keys"])
+    assert list(two["summary_keys"]) == keys
+    startup = keys.index("startup_steps")
+    assert two["summary_values"][startup] == serial["summary_values"][startup] > 0
+
 @pytest.mark.parametrize("case, stop", [("compaction", 0.0045), ("heat", 0.002)])
 def test_two_ranks_interrupted_and_resumed_end_as_the_uninterrupted_run(tmp_path, case, stop):
     """Stress walls pressing 100 disks (particles migrating, hundreds of rebuilds after the checkpoint) and the gas
@@ -171,6 +187,24 @@ def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):
     with pytest.raises(ValueError, match=r"engine = 'staggered': under mpiexec run static packings and the verlet engine"):
         refuse_unsupported(staggered, 1)
 
+
+
+def test_a_wrong_static_run_on_two_ranks_ends_in_one_line_and_exit_2(tmp_path):
+    """The pair of tests/mpi whose Crank-Nicolson steps throw it 1.21 K out of its range at t = 0.6 s (the serial run
+    refuses it): under mpiexec -n 2 the command prints the serial run's one line, no traceback, and every rank
+    exits 2 (it exited 0)."""
+    scene = tmp_path / "pair.toml"
+    scene.write_text("[material]\nconductivity = 394.0\ndensity = 8960.0\nspecific_heat = 385.0\n"
+                     "[particles]\nposition = [[0.0, 0.0, 0.0], [0.0, 0.0, 1.094e-2]]\nradius = [1.0e-3, 1.0e-2]\n"
+                     "temperature = [0.0, 100.0]\n"
+                     '[solver]\nmode = "transient"\nintegrator = "crank-nicolson"\ndt = 0.2\nt_end = 2.0\n')
+    done = subprocess.run(["mpiexec", "-n", "2", sys.executable, "-m", "dem", "run", str(scene), "--quiet"],
+                          env=ENV, capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert done.returncode == 2, done.stderr[-3000:]
+    ours = [line for line in done.stderr.splitlines() if line.startswith("python -m dem run")]
+    assert len(ours) == 1 and "Traceback" not in done.stderr
+    assert ours[0].startswith("python -m dem run: error: solver.dt = 0.2 s (crank-nicolson): at t = 0.6 s the "
+                              "temperatures left the prescribed range [0, 100] by 1.212 (max_principle_violation")
 
 @pytest.mark.slow
 def test_two_ranks_compact_as_the_serial_runs_do(tmp_path):

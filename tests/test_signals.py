@@ -73,6 +73,41 @@ def test_signal_before_the_first_checkpoint_then_resume(tmp_path, signum):
     assert (part / "timeseries.csv").read_text() == (tmp_path / "whole" / "timeseries.csv").read_text()
 
 
+@pytest.mark.parametrize("when", ["building", "stepping"])
+def test_a_signal_before_the_first_step_then_resume_starts_the_run(tmp_path, monkeypatch, when):
+    """A signal while the run builds its engine (SIGTERM 3 s into hot-wall-sintering: numba's kernels loading) left
+    an empty folder, or, once its first files were written, one whose summary said interrupted with no checkpoint;
+    either way --resume refused it ("holds no checkpoint"), and a scheduler's requeue with --resume failed. Now
+    --resume of such a folder runs the scene from its beginning and ends where the uninterrupted run ends."""
+    import dem.driver
+
+    scene_file = tmp_path / "scene.toml"
+    scene_file.write_text(NO_PERIODIC.replace("t_end = 0.01", "t_end = 0.001"))
+    scene = load_scene(scene_file)
+    part = tmp_path / "part"
+    built = dem.driver.engine_class(scene.engine)
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    if when == "building":
+        monkeypatch.setattr(dem.driver, "engine_class", lambda name: interrupted)
+    else:
+        monkeypatch.setattr(built, "run", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run(scene, out=part)
+    monkeypatch.undo()
+    summary = json.loads((part / "summary.json").read_text())
+    assert summary["interrupted"] is True and summary["resume_from"] is None
+    assert not (part / "run.lock").exists() and not (part / "checkpoint.npz").exists()
+    resumed = run(load_scene(scene_file), out=part, resume=True)
+    whole = run(load_scene(scene_file), out=tmp_path / "whole")
+    assert "resumed_from" not in resumed.summary and np.array_equal(resumed.T, whole.T)
+    for name in ("timeseries.csv", "particles.pvd"):
+        assert (part / name).read_text() == (tmp_path / "whole" / name).read_text(), name
+    with pytest.raises(ValueError, match="holds a finished run"):
+        run(load_scene(scene_file), out=part, resume=True)
+
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_a_signal_while_the_package_imports_is_one_line(tmp_path, signum):
     """``python -m dem`` imports the package ``dem`` (numpy, scipy, ...) before its ``__main__`` runs: a Ctrl-C

@@ -6,6 +6,9 @@ particles end at the ambient's 20 C. Plain Crank-Nicolson at a step ~1e4-1e8 tim
 kept the initial difference alternating (T = [99.9998, 7e-6] and the like) and exited 0; each case now ends within
 1e-4 of the true answer, or, where the capacities are lost to round-off next to the conductances, is refused in
 one line naming ``dt``. Steps within the stable limit still run plain Crank-Nicolson.
+
+The network coupled to moving particles takes a thermal step of many mechanical steps: far above the stiffest time
+constant, each Crank-Nicolson step surely above the stable limit is an implicit Euler step.
 """
 
 from __future__ import annotations
@@ -16,8 +19,11 @@ import numpy as np
 import pytest
 
 from dem.cli import main as dem_main
+from dem.engines.verlet.engine import VerletEngine
 from dem.network.heat import Checkpoint, integrate, stable_limit
+from dem.scene import parse_scene
 from test_cli_stress import refuse_scene, run_scene
+from test_dem_coupled import pile
 from test_dem_pair import pair_network
 
 EQUAL = 100.0 / 28.0  # capacity-weighted mean: C_1 : C_2 = 1 : 27
@@ -52,6 +58,17 @@ def test_capacities_lost_to_round_off_are_refused(tmp_path, capsys):
     # dt = "auto" (the default): its smallest step, t_end / 2^40, is still ~1e22 time constants
     refuse_scene(tmp_path, pair_toml(k="1.0e10", rho="1.0e-10", cp="1.0e-10", dt='"auto"'), capsys,
                  "solver.dt = 'auto'", "wrong", "density and specific heat")
+
+
+@pytest.mark.parametrize("linear, needles", [
+    ("cg", ("cg broke down", "singular to round-off", "capacities")),  # p.Ap = 0: ZeroDivisionError in CG
+    ("amg", ("amg did not reach rtol",)),  # the residuals' sum over the matrix's, both 0: ZeroDivisionError
+])
+def test_capacities_lost_to_round_off_in_an_iterative_solve_are_refused(tmp_path, capsys, linear, needles):
+    """The same pair with an iterative linear solver: a ZeroDivisionError traceback (CG's p.Ap, or the uniform
+    shift that balances the residuals, divided by the matrix's sum: C/dt lost next to K in every row sum)."""
+    refuse_scene(tmp_path, pair_toml(k="1.0e10", rho="1.0e-10", cp="1.0e-10") + f'linear = "{linear}"\n', capsys,
+                 *needles)
 
 
 def test_oscillating_steps_are_refused_where_nothing_damps_them():
@@ -90,3 +107,50 @@ def test_builtin_pair_prints_what_it_printed(capsys):
     s = json.loads(capsys.readouterr().out)
     assert s["T"] == pytest.approx([16.87003057, 3.078887757], rel=1e-9)
     assert "startup_steps" not in s
+
+
+def settling_columns(integrator: str, thermal_interval: float, specific_heat: float = 1e-3):
+    """The 3 x 3 spheres of tests/test_dem_coupled.py settling under gravity on an insulated floor (Hertz, no force
+    depends on the temperature): three columns of three touching spheres (neighbouring columns just touch, no
+    overlap) at 0, 100, 0 C, then 100, 0, 100 C, then 0, 100, 0 C. With a specific heat of 1e-3 J/(kg K) the
+    stiffest time constant is ~1e-7 s, so each column is at its mean long before the first thermal step of 2 ms
+    ends (z = lambda dt ~ 3e4)."""
+    doc = pile(t_end=0.02, integrator=integrator, thermal_interval=thermal_interval)
+    doc["contact"] = {"law": "hertz_mindlin", "youngs_modulus": 1.0e7, "poisson_ratio": 0.3, "restitution": 0.3,
+                      "tangential_damping": 0.0, "mu": 0.5, "mu_wall": 0.5}
+    doc["material"]["specific_heat"] = specific_heat
+    del doc["walls"][0]["temperature"]
+    doc["particles"]["temperature"] = [100.0 * (k % 2) for k in range(9)]
+    doc["output"] = {"interval": 2e-3}
+    engine = VerletEngine(parse_scene(doc))
+    engine.run()
+    return engine
+
+
+def test_stiff_crank_nicolson_on_moving_particles_ends_at_the_true_answer():
+    """Plain Crank-Nicolson in steps of 2 ms kept the columns alternating: [66.45, -32.68, 66.24] C in the first
+    (true: 33.33 C each, 100 C out of its range). Each step is now an implicit Euler step (startup_steps: every
+    thermal step of the run): every column at its mean to 1e-6 of the range, as the implicit run at 1/64 of the
+    step, and the heat balance exact."""
+    true = np.repeat([100.0 / 3.0, 200.0 / 3.0, 100.0 / 3.0], 3)
+    run = settling_columns("crank-nicolson", 2e-3)
+    assert np.max(np.abs(run.thermal.T - true)) <= 1e-6 * 100.0, run.thermal.T
+    s = run.summary()
+    assert s["network_assemblies"] == 1  # the columns stayed as they were
+    assert s["startup_steps"] == s["network_assemblies"] + s["network_refreshes"] >= 10
+    assert s["energy_error"] < 1e-12
+    reference = settling_columns("implicit", 2e-3 / 64)
+    assert np.max(np.abs(run.thermal.T - reference.thermal.T)) <= 1e-6 * 100.0
+    assert "startup_steps" not in reference.summary()
+
+
+def test_crank_nicolson_on_moving_particles_within_the_limit_stays_crank_nicolson():
+    """The same columns with a specific heat of 30 J/(kg K): the stable limit is 3.4 ms, the bound 2 / max(A_ii /
+    C_i) 5.2 ms, so the steps of 2 ms are Crank-Nicolson's. They end 0.026 K from the run at 1/32 of the step
+    (implicit Euler steps: 0.17 K)."""
+    run = settling_columns("crank-nicolson", 2e-3, specific_heat=30.0)
+    assert "startup_steps" not in run.summary()
+    fine = settling_columns("crank-nicolson", 2e-3 / 32, specific_heat=30.0).thermal.T
+    assert np.max(np.abs(run.thermal.T - fine)) <= 0.05
+    implicit = settling_columns("implicit", 2e-3, specific_heat=30.0).thermal.T
+    assert np.max(np.abs(implicit - fine)) > 0.1

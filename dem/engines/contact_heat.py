@@ -16,6 +16,17 @@ When the set of contacts has not changed, the network keeps its matrices and onl
 (:meth:`dem.network.heat.Network.refresh`); a new or lost contact re-assembles it. Each step's heat balance holds to
 round-off (:func:`dem.network.heat.theta_step`), so the energy bookkeeping stays exact through contact changes.
 
+Stiff steps: a thermal step is many mechanical steps long, and may be far above the network's stiffest time constant
+``C/K`` (small particles, conductive necks). Crank-Nicolson's amplification factor tends to -1 there, so a
+temperature difference across a contact would alternate from step to step instead of equalising (a column of
+particles at 0, 100 and 0 C stayed at 66, -33 and 66 C). Each thermal step is a new network (its contacts and their
+conductances changed), so each Crank-Nicolson step surely above the stable limit
+(:func:`dem.network.heat.surely_stiff`) is taken as the implicit Euler step that starts a stiff static run
+(:func:`dem.network.heat.integrate`, Rannacher's start-up; L-stable), and counted in ``startup_steps``. Such a step
+is first order, as the run is anyway: mechanics and heat are split sequentially over the thermal interval. A step
+within the limit is Crank-Nicolson's, as before; on several ranks each thermal step makes the same choice
+(:meth:`dem.network.distributed.DistributedNetwork.integrate`).
+
 The capacities use each particle's mass (constant: thermal expansion changes the radius, not the mass).
 """
 
@@ -27,7 +38,7 @@ from dem.laws.conductance import ConductanceSpec
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources
-from dem.network.heat import Network, bonds_and_conductances, theta_step
+from dem.network.heat import Network, bonds_and_conductances, surely_stiff, theta_step
 
 
 class ContactThermalModel:
@@ -77,6 +88,7 @@ class ContactThermalModel:
         self.heat_in: dict = {}
         self.energy0 = float(particles.capacity @ self.T)
         self.assemblies = self.refreshes = 0
+        self.startup_steps = 0  # Crank-Nicolson steps taken as implicit Euler steps (module docstring)
 
     def bonds(self, mechanics):
         """Bonds and conductances ``(bonds, K_pairs, K_walls)`` of the contacts of ``mechanics`` now.
@@ -143,7 +155,12 @@ class ContactThermalModel:
             self.net = Network(self._particles_now(mechanics, self.local(mechanics, self.particles.radius)), bonds,
                                K_pairs, K_walls, wall_T, self.sources, self.box)
             self.assemblies += 1
-        T_F, heat = theta_step(self.net, self.T[self.free], dt, self.integrator, self.linear)
+        T_F = self.T[self.free]
+        integrator = self.integrator
+        if integrator == "crank-nicolson" and surely_stiff(dt, self.net.matrix(self.net.sinks(T_F)), self.net.C):
+            integrator = "implicit"  # the start-up of a step far above the stiffest time constant (module docstring)
+            self.startup_steps += 1
+        T_F, heat = theta_step(self.net, T_F, dt, integrator, self.linear)
         for k, v in heat.items():
             self.heat_in[k] = self.heat_in.get(k, 0.0) + v
         self.rate[self.free] = (T_F - self.T[self.free]) / dt

@@ -25,7 +25,8 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from dem.network import comm as mpi
-from dem.network.heat import INTEGRATORS, STARTUP_STEPS, Network
+from dem.network.heat import (INTEGRATORS, STARTUP_STEPS, Network, balancing_shift, refuse_energy_error,
+                              refuse_out_of_range, surely_stiff)
 from dem.network.petsc import PetscSolver, matrix
 
 
@@ -425,7 +426,8 @@ class DistributedNetwork:
         Raises
         ------
         ValueError
-            The temperatures became non-finite.
+            The temperatures became non-finite, or came out wrong as the serial integrator refuses them (a
+            maximum-principle violation or a heat balance beyond its tolerance): on every rank alike.
         """
         net, theta = self.net, INTEGRATORS[integrator]
         T = net.particles.temperature[net.free].astype(float)
@@ -444,13 +446,9 @@ class DistributedNetwork:
         own = self.own_free
         energy0 = self.total(float(net.C[own] @ T[own]))
         # Crank-Nicolson above the stable limit starts with implicit Euler steps, as the serial integrator does
-        # (dem.network.heat.integrate): taken where the step is surely above it, 2 / dt < max_i A_ii / C_i (a lower
-        # bound of lambda_max(C^-1 A), the Rayleigh quotient of a unit vector)
-        startup = 0
-        if theta < 1.0:
-            lam_low = mpi.maximum(self.comm, float(np.max(A.diagonal()[own] / net.C[own], initial=0.0)))
-            if lam_low > 0.0 and dt > 2.0 / lam_low:
-                startup = STARTUP_STEPS
+        # (dem.network.heat.integrate): taken where the step is surely above it (dem.network.heat.surely_stiff)
+        stiff = theta < 1.0 and surely_stiff(dt, A, net.C, own, lambda rate: mpi.maximum(self.comm, rate))
+        startup = STARTUP_STEPS if stiff else 0
         if observer is not None:
             observer(0, 0.0, T, self.flows(T, sinks))
         try:  # the PETSc solvers freed however the steps end (PetscSolver.destroy)
@@ -475,7 +473,7 @@ class DistributedNetwork:
                 # balance of the step to round-off), as in the serial stepper
                 residual, weight = self.total(np.array([float(np.sum((rhs - M @ T_new)[own])),
                                                         float(M[own].sum())]))
-                T_new += residual / weight
+                T_new += balancing_shift(residual, weight)
                 dt_min, dt_max = min(dt_min, h), max(dt_max, h)
                 T_theta = th * T_new + (1.0 - th) * T
                 flows = self.flows(T_theta, sinks)
@@ -490,6 +488,8 @@ class DistributedNetwork:
                     top = mpi.maximum(self.comm, float(T[own].max(initial=-np.inf)))
                     bottom = mpi.minimum(self.comm, float(T[own].min(initial=np.inf)))
                     violation = max(violation, top - hi, lo - bottom)
+                    # the serial run's refusal, on every rank at the same step (mpi.agree: none left waiting)
+                    mpi.agree(self.comm, lambda: refuse_out_of_range(violation, lo, hi, t, integrator, dt))
                 if observer is not None:
                     observer(step, t, T, flows)
                 if progress is not None:
@@ -501,6 +501,7 @@ class DistributedNetwork:
         energy = self.total(float(net.C[own] @ T[own]))
         scale = self.total(float(net.C[own].sum())) * (hi - lo) + abs_in
         err = abs(energy - energy0 - sum(heat_in.values())) / scale if scale > 0 else 0.0
+        mpi.agree(self.comm, lambda: refuse_energy_error(err, integrator, dt))
         name = next(iter(solvers.values()))[1].name if solvers else "none"
         return {"T_F": T, "t": t, "steps": n_steps, "energy_error": err, "heat_in": heat_in,
                 "dt_min": dt_min, "dt_max": dt_max, "solver": name, "factorizations": len(solvers),

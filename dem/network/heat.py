@@ -653,6 +653,38 @@ def stable_limit(net: Network, sinks: dict | None = None) -> float:
     return 2.0 / lam if lam > 0 else math.inf
 
 
+def surely_stiff(dt: float, A: sp.csr_matrix, C: np.ndarray, rows=None, largest=None) -> bool:
+    """Whether the step ``dt`` is surely above the stable limit ``2 / lambda_max(C^-1 A)`` (:func:`stable_limit`)
+    without computing an eigenvalue: ``dt > 2 / max_i (A_ii / C_i)``, the largest ``A_ii / C_i`` being a lower bound
+    of ``lambda_max`` (the Rayleigh quotient of a unit vector). Where it is not, Crank-Nicolson keeps the maximum
+    principle (its explicit half ``C/dt - A/2`` has no negative entry) and no mode's amplification factor is below
+    -1/3 (``z = lambda dt <= 2 dt max_i A_ii / C_i <= 4``, Gershgorin): no start-up is needed.
+
+    Parameters
+    ----------
+    dt : float
+        The step (s).
+    A : scipy.sparse.csr_matrix
+        The system matrix (W/K, :meth:`dem.network.heat.Network.matrix`).
+    C : numpy.ndarray
+        The capacities of its rows (J/K).
+    rows : numpy.ndarray or None
+        A mask over the rows to take (a rank's own in a distributed run); None: all.
+    largest : callable or None
+        The largest of a value over the processes that share the network (a rank's over the ranks); None: this
+        process holds it all.
+
+    Returns
+    -------
+    bool
+        ``dt`` is above ``2 / max_i (A_ii / C_i)``.
+    """
+    s = slice(None) if rows is None else rows
+    rate = float(np.max(A.diagonal()[s] / C[s], initial=0.0))
+    rate = rate if largest is None else largest(rate)
+    return rate > 0.0 and dt > 2.0 / rate
+
+
 @dataclass
 class TransientResult:
     """What :func:`integrate` found.
@@ -774,7 +806,7 @@ class _Stepper:
         if solver.name != "direct":
             # iterative solve: a uniform shift of the order of its tolerance makes the residuals sum to zero, so
             # the heat balance of the step (and energy_error) holds to round-off
-            T_new += float(np.sum(rhs - solver.A @ T_new)) / float(solver.A.sum())
+            T_new += balancing_shift(float(np.sum(rhs - solver.A @ T_new)), float(solver.A.sum()))
         return T_new, self.theta * T_new + (1.0 - self.theta) * T, sinks
 
     def estimated_step(self, T: np.ndarray, dt: float):
@@ -798,6 +830,27 @@ class _Stepper:
         q = ORDER[self.theta]
         err = float(np.max(np.abs(T_b - T_1), initial=0.0)) / (2.0**q - 1.0)
         return T_b, [(half, th_a, s_a), (half, th_b, s_b)], err
+
+
+def balancing_shift(residual: float, weight: float) -> float:
+    """The uniform shift of an iterative solve's temperatures that makes its residuals sum to zero (the module
+    docstring's energy bookkeeping): ``residual / weight``; 0 where ``weight`` came out 0, the capacities ``C/dt``
+    lost to round-off next to the conductances in the matrix's row sums, whose run the heat balance check then
+    refuses (``energy_error``) instead of dividing by zero.
+
+    Parameters
+    ----------
+    residual : float
+        The sum of the solve's residuals ``b - M T`` (W).
+    weight : float
+        The sum of the entries of the step's matrix ``M = C/dt + theta A`` (W/K).
+
+    Returns
+    -------
+    float
+        The shift (K).
+    """
+    return residual / weight if weight > 0.0 else 0.0
 
 
 def theta_step(net: Network, T_F: np.ndarray, dt: float, integrator: str = "implicit", linear: str = "auto",
@@ -1143,13 +1196,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
             raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {steps})")
         if bounded and len(T):
             violation = max(violation, float(T.max()) - hi, lo - float(T.min()))
-            if violation > max(MAX_PRINCIPLE_TOLERANCE * (hi - lo), ROUND_OFF * max(abs(lo), abs(hi))):
-                raise ValueError(_wrong(f"at t = {t:.6g} s the temperatures left the prescribed range [{lo:g}, "
-                                        f"{hi:g}] by {violation:.4g} (max_principle_violation, more than "
-                                        f"{MAX_PRINCIPLE_TOLERANCE:g} of the range)", integrator, dt,
-                                        ROUND_OFF_HINT if auto else
-                                        "the step is too large for the network's fastest time constant: use a "
-                                        "smaller dt, dt = \"auto\" or integrator = \"implicit\""))
+            refuse_out_of_range(violation, lo, hi, t, integrator, dt)
         if observer is not None:
             observer(steps, t, T, flows)
         if progress is not None:
@@ -1177,12 +1224,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     energy = float(net.C @ T)
     scale_e = float(net.C.sum()) * net.temperature_range() + abs_in
     err = abs(energy - energy0 - sum(heat_in.values())) / scale_e if scale_e > 0 else 0.0
-    if not err <= ENERGY_TOLERANCE:
-        raise ValueError(_wrong(f"the heat balance is off by energy_error = {err:.3g} (more than "
-                                f"{ENERGY_TOLERANCE:g})", integrator, dt,
-                                ROUND_OFF_HINT if auto else
-                                "the capacities are lost to round-off next to the conductances at this step: "
-                                "use a smaller dt (or mode = \"steady\")"))
+    refuse_energy_error(err, integrator, dt)
     heat_in = {k: float(v) for k, v in heat_in.items()}
     factorizations = stepper.factorizations + (startup.factorizations if startup is not None else 0)
     return TransientResult(net.full(T), t, steps, rejected, err, heat_in, limit, dt_min, dt_max, stepper.backend,
@@ -1195,7 +1237,66 @@ ROUND_OFF_HINT = ("even the smallest step dt = \"auto\" takes is far above the n
                   "density and specific heat against the conductivity, or use mode = \"steady\"")
 
 
+def refuse_out_of_range(violation: float, lo: float, hi: float, t: float, integrator: str, dt) -> None:
+    """Refuse a transient run whose temperatures left the prescribed range ``[lo, hi]`` by more than
+    ``MAX_PRINCIPLE_TOLERANCE`` of it (and more than round-off of the temperatures): one line naming ``dt``
+    (module docstring). The serial and the distributed integrators both end a run here.
+
+    Parameters
+    ----------
+    violation : float
+        The largest excursion beyond ``[lo, hi]`` so far (the scene's temperature unit, K or degC).
+    lo, hi : float
+        The lowest and highest temperature the scene prescribes (K or degC).
+    t : float
+        The time reached (s).
+    integrator : str
+        ``"explicit"``, ``"implicit"`` or ``"crank-nicolson"``.
+    dt : float or str
+        The step asked for (s), or ``"auto"``.
+
+    Raises
+    ------
+    ValueError
+        ``violation`` is beyond the tolerance.
+    """
+    if violation > max(MAX_PRINCIPLE_TOLERANCE * (hi - lo), ROUND_OFF * max(abs(lo), abs(hi))):
+        raise ValueError(_wrong(f"at t = {t:.6g} s the temperatures left the prescribed range [{lo:g}, {hi:g}] by "
+                                f"{violation:.4g} (max_principle_violation, more than {MAX_PRINCIPLE_TOLERANCE:g} of "
+                                f"the range)", integrator, dt,
+                                "the step is too large for the network's fastest time constant: use a smaller dt, "
+                                "dt = \"auto\" or integrator = \"implicit\""))
+
+
+def refuse_energy_error(err: float, integrator: str, dt) -> None:
+    """Refuse a transient run whose heat balance is off by more than ``ENERGY_TOLERANCE``: one line naming ``dt``
+    (module docstring). The serial and the distributed integrators both end a run here.
+
+    Parameters
+    ----------
+    err : float
+        The run's ``energy_error`` (relative).
+    integrator : str
+        ``"explicit"``, ``"implicit"`` or ``"crank-nicolson"``.
+    dt : float or str
+        The step asked for (s), or ``"auto"``.
+
+    Raises
+    ------
+    ValueError
+        ``err`` is beyond the tolerance (or not a number).
+    """
+    if not err <= ENERGY_TOLERANCE:
+        raise ValueError(_wrong(f"the heat balance is off by energy_error = {err:.3g} (more than "
+                                f"{ENERGY_TOLERANCE:g})", integrator, dt,
+                                "the capacities are lost to round-off next to the conductances at this step: use a "
+                                "smaller dt (or mode = \"steady\")"))
+
+
 def _wrong(what: str, integrator: str, dt, hint: str) -> str:
-    """The one-line refusal of a transient run whose temperatures came out wrong (module docstring)."""
-    step = f"{dt:.6g} s" if not isinstance(dt, str) else f"{dt!r}"
-    return f"solver.dt = {step} ({integrator}): {what}, so the temperatures are wrong; {hint}"
+    """The one-line refusal of a transient run whose temperatures came out wrong (module docstring); with ``dt =
+    "auto"`` the hint is ``ROUND_OFF_HINT`` (the controller's smallest step was still too large)."""
+    auto = isinstance(dt, str)
+    step = f"{dt!r}" if auto else f"{dt:.6g} s"
+    return f"solver.dt = {step} ({integrator}): {what}, so the temperatures are wrong; " + (ROUND_OFF_HINT if auto
+                                                                                           else hint)

@@ -146,7 +146,8 @@ class PCGSolver:
         Raises
         ------
         SolverError
-            The iteration did not reach ``rtol`` within its iterations.
+            The iteration did not reach ``rtol`` within its iterations, or broke down (``A`` not positive definite
+            to round-off).
         """
         A, M = self.A, self.precondition
         x = np.zeros_like(b) if x0 is None else np.array(x0, dtype=float)
@@ -160,7 +161,12 @@ class PCGSolver:
         rz = _dot(r, z)
         for k in range(1, self.max_iterations + 1):
             q = A @ p
-            alpha = rz / _dot(p, q)
+            pq = _dot(p, q)
+            if not pq > 0.0:  # breakdown: p in the null space of A as rounded (not positive definite to round-off)
+                raise SolverError(f"{self.name} broke down at iteration {k} (p.Ap = {pq:.3g}: the matrix is singular "
+                                  f"to round-off, e.g. capacities C/dt lost next to the conductances); try a smaller "
+                                  f"dt or solver.linear = \"direct\"")
+            alpha = rz / pq
             x += alpha * p
             q *= alpha
             r -= q

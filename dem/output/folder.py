@@ -9,6 +9,9 @@
   and taken over.
 * ``--resume`` of a finished run (a ``summary.json`` not marked ``interrupted`` or ``stopped``) is refused: there
   is nothing to go on with, and the folder is left as it is.
+* ``--resume`` of a run interrupted before it completed a step (a ``summary.json`` marked ``interrupted`` with no
+  checkpoint to go on from, :func:`interrupted_at_start`: a batch scheduler's SIGTERM while the run still built its
+  engine) starts that run again from its beginning, its files cleared: it ends where the uninterrupted run ends.
 * While a transient run goes, :class:`Checkpointer` keeps the state between two steps (or intervals) and writes it
   to ``checkpoint.npz`` every ``[output] checkpoint_every`` seconds of wall time (default 5), at the end and after
   Ctrl-C, written aside and renamed, so a checkpoint on disk is always whole; an interrupted run resumes from the
@@ -112,13 +115,37 @@ def finished(out: pathlib.Path) -> dict | None:
     return summary
 
 
+def interrupted_at_start(out: pathlib.Path) -> bool:
+    """Whether the run in ``out`` was interrupted before it completed a step: its ``summary.json`` marked
+    ``interrupted``, with no checkpoint to resume from (module docstring).
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The run's folder.
+
+    Returns
+    -------
+    bool
+        A ``--resume`` of it starts the run from its beginning.
+    """
+    try:
+        summary = json.loads((out / "summary.json").read_text())
+    except (OSError, ValueError):
+        return False
+    return (isinstance(summary, dict) and summary.get("interrupted") is True and summary.get("resume_from") is None
+            and not (out / CHECKPOINT).exists())
+
+
 def run_files(out: pathlib.Path) -> list[pathlib.Path]:
     return sorted({f for pattern in RUN_FILES for f in out.glob(pattern)})
 
 
-def prepare(out, resume: bool = False, overwrite: bool = False) -> pathlib.Path:
+def prepare(out, resume: bool = False, overwrite: bool = False) -> tuple[pathlib.Path, bool]:
     """The output folder, checked: refused when it holds a run and neither ``resume`` nor ``overwrite`` is given;
-    with ``overwrite`` the old run's files are deleted first."""
+    with ``overwrite`` the old run's files are deleted first, and so are those of a run interrupted before it
+    completed a step when it is resumed (:func:`interrupted_at_start`). Returns the folder and whether the run goes
+    on from a checkpoint."""
     out = pathlib.Path(out)
     if resume and overwrite:
         raise ValueError("--resume and --overwrite: give one of them")
@@ -131,7 +158,9 @@ def prepare(out, resume: bool = False, overwrite: bool = False) -> pathlib.Path:
         found = run_files(out) if out.exists() else []
         if resume:
             if not (out / CHECKPOINT).exists():
-                raise ValueError(f"--resume: {out} holds no checkpoint ({CHECKPOINT}) to go on from")
+                if not interrupted_at_start(out):
+                    raise ValueError(f"--resume: {out} holds no checkpoint ({CHECKPOINT}) to go on from")
+                resume = False  # interrupted before its first step: it starts again
         elif found and not overwrite:
             raise ValueError(f"--out {out}: holds a run already ({found[0].name}, ...); --resume goes on from its "
                              f"last checkpoint, --overwrite clears it first")
@@ -147,7 +176,7 @@ def prepare(out, resume: bool = False, overwrite: bool = False) -> pathlib.Path:
     except BaseException:
         unlock(out)
         raise
-    return out
+    return out, resume
 
 
 def load(out, scene, kind: str) -> dict:

@@ -175,3 +175,42 @@ def test_a_bond_out_of_range_on_one_rank_stops_every_rank():
         run(scene)
     beyond = "particle pairs lie beyond the contact model's range"
     assert beyond in str(serial_error.value) and beyond in str(ours.value) and " of " in str(ours.value).split(":")[0]
+
+
+# a copper pair, r = 1 mm at 0 C and r = 10 mm at 100 C (overlap 0.06 mm), equalising at 99.9 C
+UNEQUAL_PAIR = {"material": MATERIAL,
+                "particles": {"position": [[0.0, 0.0, 0.0], [0.0, 0.0, 1.094e-2]], "radius": [1e-3, 1e-2],
+                              "temperature": [0.0, 100.0]},
+                "solver": {"mode": "transient", "integrator": "crank-nicolson", "dt": 0.2, "t_end": 2.0}}
+
+
+def test_temperatures_out_of_range_stop_every_rank_as_the_serial_run():
+    """Crank-Nicolson steps of 0.2 s, z = lambda dt = 4.19: the two implicit Euler steps of the start-up leave
+    1/(1 + z)^2 = 3.7 % of the stiff mode, and the next step (factor (1 - z/2)/(1 + z/2) = -0.35) throws the small
+    particle 1.21 K above 100 C. The serial run refuses it at t = 0.6 s; the ranks reported
+    max_principle_violation = 1.21 and ended as if nothing were wrong. Now every rank stops at the same step with
+    the serial run's message (one process refusing alone would leave the other waiting in its next reduction)."""
+    scene = parse_scene(UNEQUAL_PAIR)
+    with pytest.raises(ValueError) as serial_error:
+        serial(scene)
+    with pytest.raises(ValueError) as ours:
+        run(scene)
+    assert str(ours.value) == str(serial_error.value)
+    assert "at t = 0.6 s" in str(ours.value) and "by 1.212 (max_principle_violation" in str(ours.value)
+    COMM.Barrier()  # every rank got here: none waits in the integrator
+
+
+def test_crank_nicolson_steps_far_above_the_stiffest_time_constant_end_as_in_the_serial_run():
+    """The issue's pair (r = 1 and 3 mm at 100 and 0 C) in steps of 1e6 s, ~1e8 time constants: the serial run
+    ends at the capacity-weighted mean 100/28 C. On the ranks CG stopped at its first iteration (PETSc's divergence
+    test: the warm start's residual, ~K |delta T|, is far above |b| ~ C/dt |T|), and the run was refused."""
+    doc = {"material": MATERIAL,
+           "particles": {"position": [[0.0, 0.0, 0.0], [0.0, 0.0, 3.94e-3]], "radius": [1e-3, 3e-3],
+                         "temperature": [100.0, 0.0]},
+           "solver": {"mode": "transient", "integrator": "crank-nicolson", "dt": 1e6, "t_end": 1e7}}
+    scene = parse_scene(doc)
+    result = run(scene)
+    ref = serial(scene)
+    assert np.allclose(result.engine.gathered_temperatures(), 100.0 / 28.0, rtol=0, atol=1e-6)
+    assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-6
+    assert result.summary["startup_steps"] == ref.summary()["startup_steps"] == 2

@@ -130,6 +130,7 @@ class VerletEngine:
             th.energy0 = float(saved["thermal_energy0"])
             th.heat_in = {str(k): float(v) for k, v in zip(saved["heat_keys"], saved["heat_values"])}
             th.assemblies, th.refreshes = int(saved["network_assemblies"]), int(saved["network_refreshes"])
+            th.startup_steps = int(saved.get("thermal_startup_steps", 0))  # 0: a checkpoint from before the count
 
     @property
     def temperature_source(self) -> str:
@@ -386,6 +387,8 @@ class VerletEngine:
             th = self.thermal
             out.update(energy_error=th.energy_error(), heat_in={k: float(v) for k, v in th.heat_in.items()},
                        network_assemblies=th.assemblies, network_refreshes=th.refreshes, law=self.scene.conductance.law)
+            if th.startup_steps:  # stiff Crank-Nicolson thermal steps taken as implicit Euler
+                out["startup_steps"] = th.startup_steps
             meeting, bonds = self.necks()
             law = self.scene.conductance.law
             out.update(neck_account(np.count_nonzero(meeting), s.n, bonds.contact, bonds.n_pairs + bonds.n_walls, law,
@@ -504,5 +507,6 @@ class VerletEngine:
             th = self.thermal
             data.update(thermal_T=th.T, thermal_rate=th.rate, thermal_energy0=np.array(th.energy0),
                         heat_keys=np.array(list(th.heat_in), dtype=str),
-                        heat_values=np.array(list(th.heat_in.values()), dtype=float))
+                        heat_values=np.array(list(th.heat_in.values()), dtype=float),
+                        thermal_startup_steps=np.array(th.startup_steps))
         return data
