@@ -71,11 +71,14 @@ def meeting_in(particles, walls, bonds: Bonds, box=None) -> np.ndarray:
     return necks_meeting(particles.radius, bonds, bonds.vectors(particles.position, box), normals)
 
 
-def neck_account(count: int, n: int, reading: str, bonds: int, law: str) -> dict:
+def neck_account(count: int, n: int, reading: str, bonds: int, law: str, readings: dict | None = None,
+                 handed_over: int | None = None) -> dict:
     """The summary's account of the necks: the reading every bond used (``neck_readings``: bonds per reading), how
     many particles carry necks that meet (``particles_necks_meeting``), and, for the laws verified against FE (all but
     ``zohdi``), whether the run stayed where the law is verified (``law_in_verified_range``: the necks of every
-    particle apart) with a one-line ``warnings`` entry where not.
+    particle apart) with a one-line ``warnings`` entry where not. A run that hands particles over to the union
+    (:mod:`dem.geometry.handover`) also says how many it handed over (``particles_handed_over``); its particles whose
+    necks meet are read by the union.
 
     Parameters
     ----------
@@ -84,11 +87,15 @@ def neck_account(count: int, n: int, reading: str, bonds: int, law: str) -> dict
     n : int
         Particles in the run.
     reading : str
-        The neck reading of the bonds (``dem.geometry.bonds.CONTACT_MODELS``).
+        The neck reading of the scene (``dem.geometry.bonds.CONTACT_MODELS``).
     bonds : int
         Pair and wall bonds.
     law : str
         The conductance law (``dem.laws.conductance.LAWS``).
+    readings : dict or None
+        Bonds per reading where they differ (a hand-over); None: all ``bonds`` read ``reading``.
+    handed_over : int or None
+        Particles handed over to the union; None: the run hands none over.
 
     Returns
     -------
@@ -96,13 +103,16 @@ def neck_account(count: int, n: int, reading: str, bonds: int, law: str) -> dict
         The summary's entries.
     """
     count = int(count)
-    out = {"neck_readings": {reading: int(bonds)}, "particles_necks_meeting": count}
+    out = {"neck_readings": {reading: int(bonds)} if readings is None else {k: int(v) for k, v in readings.items()},
+           "particles_necks_meeting": count}
+    if handed_over is not None:
+        out["particles_handed_over"] = int(handed_over)
     if reading not in PAIR_READINGS and reading != "union":
         return out
     out["law_in_verified_range"] = count == 0
     if count:
         where = f"{count} of {n} particles ({100.0 * count / n:.1f} %) carry necks that meet"
-        if reading in PAIR_READINGS:
+        if reading in PAIR_READINGS and handed_over is None:
             why = (f"the pair-neck reading {reading!r} has no answer there, so law {law!r} is outside the "
                    f"range where it is verified; conductance.neck = \"union\" reads the packing as the union of its "
                    f"spheres, defined at every density")

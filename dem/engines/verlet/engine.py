@@ -28,6 +28,7 @@ from dataclasses import replace
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.bonds import find_bonds
+from dem.geometry.handover import bond_weights
 from dem.geometry.motion import MotionState
 from dem.geometry.necks import meeting_in, neck_account
 from dem.geometry.neighbours import list_arrays
@@ -129,6 +130,9 @@ class VerletEngine:
             th.energy0 = float(saved["thermal_energy0"])
             th.heat_in = {str(k): float(v) for k, v in zip(saved["heat_keys"], saved["heat_values"])}
             th.assemblies, th.refreshes = int(saved["network_assemblies"]), int(saved["network_refreshes"])
+            if "handover_steps" in saved:  # a checkpoint written before the hand-over has none
+                th.handover_steps = np.array(saved["handover_steps"], dtype=np.int64)
+                th.solid_radius = np.array(saved["solid_radius"], dtype=float)
 
     @property
     def temperature_source(self) -> str:
@@ -386,8 +390,14 @@ class VerletEngine:
             out.update(energy_error=th.energy_error(), heat_in={k: float(v) for k, v in th.heat_in.items()},
                        network_assemblies=th.assemblies, network_refreshes=th.refreshes, law=self.scene.conductance.law)
             meeting, bonds = self.necks()
+            readings = handed_over = None
+            if th.handing_over(mech):
+                union = np.concatenate(bond_weights(th.weight, bonds)) >= 0.5  # the reading of the larger weight
+                readings = {bonds.contact: int(np.count_nonzero(~union)), "union": int(np.count_nonzero(union))}
+                handed_over = np.count_nonzero(th.weight == 1.0)
+                out["particles_handing_over"] = int(np.count_nonzero((th.weight > 0.0) & (th.weight < 1.0)))
             out.update(neck_account(np.count_nonzero(meeting), s.n, bonds.contact, bonds.n_pairs + bonds.n_walls,
-                                    self.scene.conductance.law))
+                                    self.scene.conductance.law, readings, handed_over))
         return out
 
     def necks(self):
@@ -432,6 +442,9 @@ class VerletEngine:
         if self.thermal is not None:
             fields["heat_flow"] = self.thermal.contact_heat(mech, i, j)[1]
             fields["necks_meeting"] = self.necks()[0].astype(np.int8)
+            if self.thermal.handing_over(mech):
+                fields["solid_radius"] = np.where(self.thermal.weight > 0.0, self.thermal.solid_radius, s.radius)
+                fields["handed_over"] = self.thermal.weight.copy()
         return fields
 
     def positions(self) -> np.ndarray:
@@ -502,5 +515,6 @@ class VerletEngine:
             th = self.thermal
             data.update(thermal_T=th.T, thermal_rate=th.rate, thermal_energy0=np.array(th.energy0),
                         heat_keys=np.array(list(th.heat_in), dtype=str),
-                        heat_values=np.array(list(th.heat_in.values()), dtype=float))
+                        heat_values=np.array(list(th.heat_in.values()), dtype=float),
+                        handover_steps=th.handover_steps, solid_radius=th.solid_radius)
         return data
