@@ -10,6 +10,7 @@ from scipy.optimize import brentq
 
 from dem import parse_scene
 from dem.engines.contact_heat import ContactThermalModel
+from dem.engines.staggered.engine import StaggeredEngine
 from dem.engines.verlet.engine import VerletEngine
 from dem.geometry import handover
 from dem.geometry.handover import HANDOVER_STEPS, advance, solid_radii, weights
@@ -124,9 +125,9 @@ def conductance(engine, steps) -> float:
     """The steady heat flow (W) from the hot layer to the cold one per kelvin, on the contacts now with the
     hand-over steps ``steps``."""
     th, mech = engine.thermal, engine.mechanics
-    kept, th.handover_steps = th.handover_steps, steps
+    kept, th.handover.steps = th.handover.steps, steps
     bonds, K, K_walls = th.bonds(mech)
-    th.handover_steps = kept
+    th.handover.steps = kept
     net = Network(th._particles_now(mech, th.particles.radius), bonds, K, K_walls, np.zeros(0), th.sources, th.box)
     into = boundary_heat_flow(net, steady(net, floating="mean").T)["particles"]
     return -sum(q for k, q in into.items() if th.particles.temperature[k] == 100.0) / 100.0
@@ -140,13 +141,13 @@ def run_through(scene: dict):
     jumps, volumes = [], []
 
     def recorded(mech, dt):
-        before = th.handover_steps.copy()
+        before = th.handover.steps.copy()
         step(mech, dt)
-        if np.any(th.handover_steps != before):
-            jumps.append(conductance(engine, th.handover_steps) / conductance(engine, before) - 1.0)
+        if np.any(th.handover.steps != before):
+            jumps.append(conductance(engine, th.handover.steps) / conductance(engine, before) - 1.0)
             bonds = engine.necks()[1]
-            grown = th.weight > 0.0
-            cut = cut_spheres(np.where(grown, th.solid_radius, mech.state.radius), bonds.i, bonds.j,
+            grown = th.handover.weight > 0.0
+            cut = cut_spheres(np.where(grown, th.handover.solid_radius, mech.state.radius), bonds.i, bonds.j,
                               bonds.vectors(mech.state.x, th.box)).volume
             volumes.append((cut[grown].sum(), (4.0 / 3.0 * np.pi * mech.state.radius[grown] ** 3).sum()))
 
@@ -162,8 +163,8 @@ def test_a_run_through_the_handover_keeps_the_volume_and_k_eff_continuous():
     cold layers changes by at most 0.5 % across a step; the summary and the snapshots say who was handed over."""
     engine, jumps, volumes = run_through(squeezed(0.005, rate=30.0))
     th = engine.thermal
-    handed = th.handover_steps == HANDOVER_STEPS
-    assert np.count_nonzero(handed) >= 40 and np.all(handed == (th.handover_steps > 0))
+    handed = th.handover.steps == HANDOVER_STEPS
+    assert np.count_nonzero(handed) >= 40 and np.all(handed == (th.handover.steps > 0))
     assert np.max(np.abs(volumes[:, 0] / volumes[:, 1] - 1.0)) < 1e-9
     assert np.max(np.abs(jumps)) < 5e-3
     summary = engine.summary()
@@ -187,7 +188,7 @@ def test_runs_whose_necks_never_meet_are_unchanged_to_the_bit(monkeypatch):
     scene = squeezed(0.003, h_over_r=0.04, rate=5.0)
     handed = VerletEngine(parse_scene(scene))
     handed.run()
-    assert not np.any(handed.thermal.handover_steps) and "particles_handed_over" in handed.summary()
+    assert not np.any(handed.thermal.handover.steps) and "particles_handed_over" in handed.summary()
     monkeypatch.setattr(ContactThermalModel, "hands_over", False)
     plain = VerletEngine(parse_scene(scene))
     plain.run()
@@ -202,16 +203,55 @@ def test_a_resumed_run_goes_on_handing_over_bit_for_bit():
     first = VerletEngine(parse_scene(squeezed(0.003)))
     first.run()
     th = first.thermal
-    on_the_way = (th.handover_steps > 0) & (th.handover_steps < HANDOVER_STEPS)
+    on_the_way = (th.handover.steps > 0) & (th.handover.steps < HANDOVER_STEPS)
     assert np.any(on_the_way & ~first.necks()[0])
     resumed = VerletEngine(parse_scene(squeezed(0.004)), restart=first.checkpoint())
     resumed.run()
-    for name in ("T", "handover_steps", "solid_radius"):
-        assert np.array_equal(getattr(resumed.thermal, name), getattr(whole.thermal, name)), name
+    assert np.array_equal(resumed.thermal.T, whole.thermal.T)
+    for name in ("steps", "solid_radius"):
+        assert np.array_equal(getattr(resumed.thermal.handover, name), getattr(whole.thermal.handover, name)), name
     assert np.array_equal(resumed.mechanics.state.x, whole.mechanics.state.x)
     th, mech = whole.thermal, whole.mechanics
-    grown = th.handover_steps > 0
+    grown = th.handover.steps > 0
     bonds = whole.necks()[1]
-    cut = cut_spheres(np.where(grown, th.solid_radius, mech.state.radius), bonds.i, bonds.j,
+    cut = cut_spheres(np.where(grown, th.handover.solid_radius, mech.state.radius), bonds.i, bonds.j,
                       bonds.vectors(mech.state.x, th.box)).volume
     assert np.any(grown) and np.max(np.abs(cut[grown] / (4.0 / 3.0 * np.pi * mech.state.radius[grown] ** 3) - 1)) < 1e-9
+
+
+ZOHDI = {"law": "zohdi", "K_p": 1.0e3, "p_p": 1.0, "K_p_lim": 1.0e3, "K_w": 1.0e3, "p_w": 1.0, "K_w_lim": 1.0e3,
+         "theta_star": 5000.0, "K_b": 0.0, "p_b": 1.0, "E_star": 0.9, "mu_d": 0.0, "c_env": 0.0, "v_slip": 0.1}
+
+
+def squeezed_staggered(t_end: float) -> dict:
+    """The squeezed cluster with Zohdi's soft contact, on the staggered engine, fixed steps."""
+    scene = squeezed(t_end)
+    scene["contact"] = ZOHDI
+    scene["solver"] = {"mode": "transient", "t_end": t_end, "dt": 5e-5, "dt_max": 5e-5}
+    return scene
+
+
+def test_the_staggered_engine_hands_over_and_resumes_bit_for_bit():
+    """Zohdi's staggered scheme with the fit law on the volume-conserving necks: particles are handed over at its
+    accepted steps, keep their volume, and a run resumed from its checkpoint while they are on the way ends as the
+    one that did not stop."""
+    whole = StaggeredEngine(parse_scene(squeezed_staggered(0.003)))
+    whole.run()
+    first = StaggeredEngine(parse_scene(squeezed_staggered(0.002)))
+    first.run()
+    steps = first.thermal.handover.steps
+    assert np.any((steps > 0) & (steps < HANDOVER_STEPS))
+    resumed = StaggeredEngine(parse_scene(squeezed_staggered(0.003)), restart=first.checkpoint())
+    resumed.run()
+    th, mech = whole.thermal, whole.mechanics
+    assert np.array_equal(resumed.thermal.T, th.T)
+    for name in ("steps", "solid_radius"):
+        assert np.array_equal(getattr(resumed.thermal.handover, name), getattr(th.handover, name)), name
+    grown = th.handover.steps > 0
+    bonds = whole._pair_bonds()
+    cut = cut_spheres(np.where(grown, th.handover.solid_radius, mech.state.radius), bonds.i, bonds.j,
+                      bonds.vectors(mech.state.x, mech.periodic_box)).volume
+    assert np.any(grown) and np.max(np.abs(cut[grown] / (4.0 / 3.0 * np.pi * mech.state.radius[grown] ** 3) - 1)) < 1e-9
+    summary = whole.summary()
+    assert summary["particles_handed_over"] + summary["particles_handing_over"] == np.count_nonzero(grown)
+    assert np.array_equal(whole.particle_fields()["handed_over"], th.handover.weight)

@@ -27,16 +27,10 @@ last step left them.
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
-from fem_neck.geometry import max_overlap
-
-from dem.geometry.bonds import find_bonds
-from dem.geometry.handover import advance, bond_weights, solid_radii, weights
-from dem.geometry.necks import PAIR_READINGS, necks_meeting
-from dem.laws.conductance import ConductanceSpec, bond_conductances
+from dem.engines.handover import Handover
+from dem.laws.conductance import ConductanceSpec
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources
@@ -91,25 +85,17 @@ class ContactThermalModel:
         self.heat_in: dict = {}
         self.energy0 = float(particles.capacity @ self.T)
         self.assemblies = self.refreshes = 0
-        self.handover_steps = np.zeros(len(self.T), dtype=np.int64)  # per particle (dem.geometry.handover)
-        self.solid_radius = particles.radius.astype(float).copy()  # m: the last solution where the weight is > 0
+        self.handover = Handover(spec, particles.radius)
 
     def handing_over(self, mechanics) -> bool:
-        """Whether this run hands particles over to the union: a pair-neck reading in 3D (not on several ranks)."""
-        return (self.hands_over and self.spec.law != "zohdi" and self.spec.neck in PAIR_READINGS
-                and mechanics.state.dimension == 3)
-
-    @property
-    def weight(self) -> np.ndarray:
-        """Per particle its hand-over weight (:func:`dem.geometry.handover.weights`: 0 the pair reading, 1 the
-        union)."""
-        return weights(self.handover_steps)
+        """Whether this run hands particles over to the union (:meth:`dem.engines.handover.Handover.applies`; not on
+        several ranks)."""
+        return self.hands_over and Handover.applies(self.spec, mechanics.state.dimension)
 
     def bonds(self, mechanics, update: bool = False):
         """Bonds and conductances ``(bonds, K_pairs, K_walls)`` of the contacts of ``mechanics`` now.
 
-        Handing over (:meth:`handing_over`), a bond's conductance is ``(1 - w) K_pair + w K_union`` with its weight
-        ``w`` (:func:`dem.geometry.handover.bond_weights`), and its neck that of the reading with the larger weight.
+        Handing over (:meth:`handing_over`), the bonds as :meth:`dem.engines.handover.Handover.bonds` reads them.
 
         Parameters
         ----------
@@ -129,43 +115,7 @@ class ContactThermalModel:
         now, walls = self._particles_now(mechanics, mechanics.state.radius), self._walls_now(mechanics)
         if not self.handing_over(mechanics):
             return bonds_and_conductances(now, walls, self.spec, pairs=(i, j), box=self.box)
-        pair = find_bonds(now, walls, self.spec.contact, "clip", pairs=(i, j), box=self.box)
-        vectors = pair.vectors(now.position, self.box)
-        normals = np.array([w.normal for w in walls], dtype=float).reshape(-1, 3)[pair.wall_index]
-        if update:
-            self.handover_steps = advance(self.handover_steps, necks_meeting(now.radius, pair, vectors, normals))
-        if not np.any(self.handover_steps):  # nothing handed over: the pair reading alone, as without the hand-over
-            return bonds_and_conductances(now, walls, self.spec, pairs=(i, j), box=self.box,
-                                          bonds=pair if self.spec.out_of_range == "clip" else None)
-        weight = self.weight
-        w_pair, w_wall = bond_weights(weight, pair)
-        K_pair, K_wall = bond_conductances(self.spec, now, pair, box=self.box, walls=walls)
-        # bonds past the pair reading's range where it still has weight: the scene's out_of_range policy
-        past = (pair.h > max_overlap(now.radius[pair.i], now.radius[pair.j])) & (w_pair < 1.0)
-        past_wall = (pair.wall_h > now.radius[pair.wall_particle] / 3.0) & (w_wall < 1.0)
-        if self.spec.out_of_range == "error" and (np.any(past) or np.any(past_wall)):
-            find_bonds(now, walls, self.spec.contact, "error", pairs=(pair.i[past], pair.j[past]), box=self.box)
-        if self.spec.out_of_range == "drop":
-            K_pair[past], K_wall[past_wall] = 0.0, 0.0
-        solid = solid_radii(now.radius, weight > 0.0, pair.i, pair.j, vectors, pair.wall_particle, normals,
-                            pair.wall_l, start=self.solid_radius)
-        if update:
-            self.solid_radius = solid
-        grown = replace(now, radius=solid)
-        union = find_bonds(grown, walls, "union", "error", pairs=(i, j), box=self.box)
-        n = now.n  # the grown spheres may touch a wall the particle does not: the contacts' wall bonds only
-        union = union.subset(slice(None), np.isin(union.wall_index * n + union.wall_particle,
-                                                   pair.wall_index * n + pair.wall_particle))
-        K_union, K_wall_union = bond_conductances(replace(self.spec, neck="union"), grown, union, box=self.box,
-                                                  walls=walls)
-        K_pair = (1.0 - w_pair) * K_pair + w_pair * K_union
-        K_wall = (1.0 - w_wall) * K_wall + w_wall * K_wall_union
-        read = w_pair >= 0.5
-        read_wall = w_wall >= 0.5
-        bonds = replace(pair, a=np.where(read, union.a, pair.a), l_i=np.where(read, union.l_i, pair.l_i),
-                        l_j=np.where(read, union.l_j, pair.l_j), wall_a=np.where(read_wall, union.wall_a, pair.wall_a),
-                        wall_l=np.where(read_wall, union.wall_l, pair.wall_l))
-        return bonds, K_pair, K_wall
+        return self.handover.bonds(now, walls, (i, j), self.box, update)
 
     def local(self, mechanics, values: np.ndarray) -> np.ndarray:
         """``values`` (per particle of the scene) for the particles ``mechanics`` holds: all of them, in order

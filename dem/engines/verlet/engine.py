@@ -28,7 +28,6 @@ from dataclasses import replace
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.bonds import find_bonds
-from dem.geometry.handover import bond_weights
 from dem.geometry.motion import MotionState
 from dem.geometry.necks import meeting_in, neck_account
 from dem.geometry.neighbours import list_arrays
@@ -130,9 +129,7 @@ class VerletEngine:
             th.energy0 = float(saved["thermal_energy0"])
             th.heat_in = {str(k): float(v) for k, v in zip(saved["heat_keys"], saved["heat_values"])}
             th.assemblies, th.refreshes = int(saved["network_assemblies"]), int(saved["network_refreshes"])
-            if "handover_steps" in saved:  # a checkpoint written before the hand-over has none
-                th.handover_steps = np.array(saved["handover_steps"], dtype=np.int64)
-                th.solid_radius = np.array(saved["solid_radius"], dtype=float)
+            th.handover.restore(saved)
 
     @property
     def temperature_source(self) -> str:
@@ -392,10 +389,9 @@ class VerletEngine:
             meeting, bonds = self.necks()
             readings = handed_over = None
             if th.handing_over(mech):
-                union = np.concatenate(bond_weights(th.weight, bonds)) >= 0.5  # the reading of the larger weight
-                readings = {bonds.contact: int(np.count_nonzero(~union)), "union": int(np.count_nonzero(union))}
-                handed_over = np.count_nonzero(th.weight == 1.0)
-                out["particles_handing_over"] = int(np.count_nonzero((th.weight > 0.0) & (th.weight < 1.0)))
+                account = th.handover.account(bonds)
+                readings, handed_over = account["readings"], account["handed_over"]
+                out["particles_handing_over"] = account["handing_over"]
             out.update(neck_account(np.count_nonzero(meeting), s.n, bonds.contact, bonds.n_pairs + bonds.n_walls,
                                     self.scene.conductance.law, readings, handed_over))
         return out
@@ -443,8 +439,8 @@ class VerletEngine:
             fields["heat_flow"] = self.thermal.contact_heat(mech, i, j)[1]
             fields["necks_meeting"] = self.necks()[0].astype(np.int8)
             if self.thermal.handing_over(mech):
-                fields["solid_radius"] = np.where(self.thermal.weight > 0.0, self.thermal.solid_radius, s.radius)
-                fields["handed_over"] = self.thermal.weight.copy()
+                fields["solid_radius"] = self.thermal.handover.solid_radii(s.radius)
+                fields["handed_over"] = self.thermal.handover.weight
         return fields
 
     def positions(self) -> np.ndarray:
@@ -515,6 +511,5 @@ class VerletEngine:
             th = self.thermal
             data.update(thermal_T=th.T, thermal_rate=th.rate, thermal_energy0=np.array(th.energy0),
                         heat_keys=np.array(list(th.heat_in), dtype=str),
-                        heat_values=np.array(list(th.heat_in.values()), dtype=float),
-                        handover_steps=th.handover_steps, solid_radius=th.solid_radius)
+                        heat_values=np.array(list(th.heat_in.values()), dtype=float), **th.handover.state())
         return data
