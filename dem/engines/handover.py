@@ -126,6 +126,8 @@ class Handover:
             ``out_of_range = "error"``; a conductance that is not finite.
         """
         spec = self.spec
+        if not update and not np.any(self.steps):  # nothing handed over and nothing to update: the pair reading
+            return bonds_and_conductances(now, walls, spec, pairs=pairs, box=box)
         pair = find_bonds(now, walls, spec.contact, "clip", pairs=pairs, box=box)
         vectors = pair.vectors(now.position, box)
         normals = np.array([w.normal for w in walls], dtype=float).reshape(-1, 3)[pair.wall_index]
@@ -164,8 +166,8 @@ class Handover:
 
     def account(self, bonds) -> dict:
         """The summary's entries of the hand-over, for :func:`dem.geometry.necks.neck_account`: ``readings`` (bonds
-        per reading: the union where a bond's weight is at least 1/2) and ``handed_over`` (particles), and
-        ``particles_handing_over`` (on the way).
+        per reading, those with bonds: the union where a bond's weight is at least 1/2) and ``handed_over``
+        (particles), and ``handing_over`` (particles on the way).
 
         Parameters
         ----------
@@ -178,6 +180,8 @@ class Handover:
             ``{"readings": dict, "handed_over": int, "handing_over": int}``.
         """
         union = np.concatenate(bond_weights(self.weight, bonds)) >= 0.5
-        return {"readings": {bonds.contact: int(np.count_nonzero(~union)), "union": int(np.count_nonzero(union))},
+        counts = {bonds.contact: int(np.count_nonzero(~union)), "union": int(np.count_nonzero(union))}
+        readings = {k: v for k, v in counts.items() if v} or {bonds.contact: 0}
+        return {"readings": readings,
                 "handed_over": int(np.count_nonzero(self.weight == 1.0)),
                 "handing_over": int(np.count_nonzero((self.weight > 0.0) & (self.weight < 1.0)))}

@@ -35,7 +35,7 @@ from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
 from dem.scene.state_file import moving_arrays, normalised
-from dem.network.heat import boundary_heat_flow, steady
+from dem.network.heat import Network, boundary_heat_flow, bonds_and_conductances, steady
 from fem_neck.geometry import max_overlap, neck_radius
 
 
@@ -295,19 +295,40 @@ class VerletEngine:
             return None
         return tuple(walls) if a.temperature > b.temperature else tuple(reversed(walls))
 
-    def effective_conductivity(self) -> float | None:
+    def effective_conductivity(self, pair_necks: bool = False) -> float | None:
         """``k_eff = Q L / (A (T_hot - T_cold))`` of the contact network as it is now, from a steady solve between
         the hot and the cold wall (W/(m K)); None without two such walls, a closed box or a network (or with
-        ambient sources, which are not conduction). Groups of particles touching neither wall carry no heat."""
+        ambient sources, which are not conduction). Groups of particles touching neither wall carry no heat.
+
+        Parameters
+        ----------
+        pair_necks : bool
+            Whether to read every contact as a pair neck (the scene's reading, clipped to its range), as if no
+            particle had been handed over to the union (:mod:`dem.engines.handover`); False: the network as the
+            run conducts.
+
+        Returns
+        -------
+        float or None
+            k_eff (W/(m K)), or None.
+        """
         th, pair = self.thermal, self.heated_walls()
         volume = self.box_volume()
         if th is None or th.net is None or pair is None or volume is None or self.scene.sources.names:
             return None
         mech = self.mechanics
+        net = th.net
+        if pair_necks:
+            i, j = mech.contacts()[:2]
+            bonds, K_pairs, K_walls = bonds_and_conductances(
+                th._particles_now(mech, mech.state.radius), th._walls_now(mech),
+                replace(th.spec, out_of_range="clip"), pairs=(i, j), box=th.box)
+            net = Network(th._particles_now(mech, th.particles.radius), bonds, K_pairs, K_walls, net.wall_temperature,
+                          th.sources, th.box)
         hot, cold = pair
         length = -(mech.w.q[hot] + mech.w.q[cold])
-        res = steady(th.net, floating="mean", linear=self.scene.solver.linear)
-        into = boundary_heat_flow(th.net, res.T)["walls"]
+        res = steady(net, floating="mean", linear=self.scene.solver.linear)
+        into = boundary_heat_flow(net, res.T)["walls"]
         q = -into[th.thermal_walls.index(hot)]  # heat leaving the hot wall
         delta_T = mech.walls[hot].temperature - mech.walls[cold].temperature
         return float(q * length / (volume / length * delta_T))
@@ -364,6 +385,8 @@ class VerletEngine:
                "T_min": float(np.min(s.T)), "T_max": float(np.max(s.T))}
         if self.thermal is not None and self.heated_walls() is not None:
             row["effective_conductivity"] = self.effective_conductivity()
+            if self.thermal.handing_over(mech):  # beside it, the contacts all read as pair necks
+                row["effective_conductivity_pair_necks"] = self.effective_conductivity(pair_necks=True)
         for name, value in self.wall_stress().items():
             row[f"wall_{name}"] = value
         for k, wall in enumerate(mech.walls):
