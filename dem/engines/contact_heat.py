@@ -89,7 +89,18 @@ class ContactThermalModel:
 
     def handing_over(self, mechanics) -> bool:
         """Whether this run hands particles over to the union (:meth:`dem.engines.handover.Handover.applies`; not on
-        several ranks)."""
+        several ranks).
+
+        Parameters
+        ----------
+        mechanics : dem.engines.verlet.mechanics.MechanicalModel
+            The mechanical submodel (its dimension).
+
+        Returns
+        -------
+        bool
+            Whether it does.
+        """
         return self.hands_over and Handover.applies(self.spec, mechanics.state.dimension)
 
     def bonds(self, mechanics, update: bool = False):
