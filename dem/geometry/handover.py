@@ -35,7 +35,7 @@ Design choices:
     surface, so the lens circle is the smaller (twelve equal necks meeting: a/r = 0.41 against 0.50, the ``fit``
     law's half 5 % lower on the union than on the cylinder, ``rojek``'s 17 %). Handed over at once, a compact whose
     particles meet together would see its k_eff jump by that much; over ``HANDOVER_STEPS`` steps no step changes
-    a bond by more than a fiftieth of it. Runs in which no necks meet are the same as without the hand-over, to the
+    a bond by more than a hundredth of it. Runs in which no necks meet are the same as without the hand-over, to the
     bit.
 (d) The snapshots carry ``solid_radius`` and ``handed_over`` (the weight) per particle, the summary how many
     particles were handed over (``particles_handed_over``) and how many are on the way (``particles_handing_over``).
@@ -49,7 +49,7 @@ from scipy.sparse.linalg import spsolve
 
 from fem_neck.geometry.union import cut_spheres
 
-HANDOVER_STEPS = 50  # thermal steps over which a particle is handed over
+HANDOVER_STEPS = 100  # thermal steps over which a particle is handed over
 VOLUME_RTOL = 1e-12  # the solid radii keep every cut sphere's volume to this fraction
 NEWTON_ITERATIONS = 30
 
