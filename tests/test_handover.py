@@ -254,6 +254,7 @@ def squeezed_staggered(t_end: float) -> dict:
     return scene
 
 
+@pytest.mark.slow
 def test_the_staggered_engine_hands_over_and_resumes_bit_for_bit():
     """Zohdi's staggered scheme with the fit law on the volume-conserving necks: particles are handed over at its
     accepted steps, keep their volume, and a run resumed from its checkpoint while they are on the way ends as the
