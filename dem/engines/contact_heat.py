@@ -28,12 +28,19 @@ within the limit is Crank-Nicolson's, as before; on several ranks each thermal s
 (:meth:`dem.network.distributed.DistributedNetwork.integrate`).
 
 The capacities use each particle's mass (constant: thermal expansion changes the radius, not the mass).
+
+With a pair-neck reading (``newton``, ``first``, ``coble``) in 3D, a particle whose necks meet is handed over to the
+union of spheres (:mod:`dem.engines.handover`): its bonds read the lens circles of the grown solid spheres, which
+keep the particles' volumes, blended with the pair reading over the steps of the hand-over. Each thermal step
+advances the hand-overs and solves the solid radii at the configuration of its end; the snapshots read them as the
+last step left them.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from dem.engines.handover import Handover
 from dem.laws.conductance import ConductanceSpec
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
@@ -69,6 +76,7 @@ class ContactThermalModel:
     """
 
     name = "thermal"
+    hands_over = True  # a pair-neck reading hands particles whose necks meet over to the union (module docstring)
 
     def __init__(self, particles: Particles, walls, spec: ConductanceSpec, sources: Sources,
                  integrator: str = "implicit", linear: str = "auto", box: PeriodicBox | None = None):
@@ -89,14 +97,36 @@ class ContactThermalModel:
         self.energy0 = float(particles.capacity @ self.T)
         self.assemblies = self.refreshes = 0
         self.startup_steps = 0  # Crank-Nicolson steps taken as implicit Euler steps (module docstring)
+        self.handover = Handover(spec, particles.radius)
 
-    def bonds(self, mechanics):
+    def handing_over(self, mechanics) -> bool:
+        """Whether this run hands particles over to the union (:meth:`dem.engines.handover.Handover.applies`; not on
+        several ranks).
+
+        Parameters
+        ----------
+        mechanics : dem.engines.verlet.mechanics.MechanicalModel
+            The mechanical submodel (its dimension).
+
+        Returns
+        -------
+        bool
+            Whether it does.
+        """
+        return self.hands_over and Handover.applies(self.spec, mechanics.state.dimension)
+
+    def bonds(self, mechanics, update: bool = False):
         """Bonds and conductances ``(bonds, K_pairs, K_walls)`` of the contacts of ``mechanics`` now.
+
+        Handing over (:meth:`handing_over`), the bonds as :meth:`dem.engines.handover.Handover.bonds` reads them.
 
         Parameters
         ----------
         mechanics : dem.engines.verlet.mechanics.MechanicalModel
             The mechanical submodel: its current contacts, positions (m), radii (m) and wall offsets (m).
+        update : bool
+            Whether to update the hand-over weights and solid radii to this configuration first (a thermal step
+            does; a snapshot reads them as they are).
 
         Returns
         -------
@@ -105,8 +135,10 @@ class ContactThermalModel:
             wall conductances (W/K).
         """
         i, j = mechanics.contacts()[:2]
-        return bonds_and_conductances(self._particles_now(mechanics, mechanics.state.radius),
-                                      self._walls_now(mechanics), self.spec, pairs=(i, j), box=self.box)
+        now, walls = self._particles_now(mechanics, mechanics.state.radius), self._walls_now(mechanics)
+        if not self.handing_over(mechanics):
+            return bonds_and_conductances(now, walls, self.spec, pairs=(i, j), box=self.box)
+        return self.handover.bonds(now, walls, (i, j), self.box, update)
 
     def local(self, mechanics, values: np.ndarray) -> np.ndarray:
         """``values`` (per particle of the scene) for the particles ``mechanics`` holds: all of them, in order
@@ -146,7 +178,7 @@ class ContactThermalModel:
         dt : float
             The step (s), > 0.
         """
-        bonds, K_pairs, K_walls = self.bonds(mechanics)
+        bonds, K_pairs, K_walls = self.bonds(mechanics, update=True)
         if self.net is not None and self.net.graph.same_edges(bonds.i, bonds.j, bonds.wall_particle, bonds.wall_index):
             self.net.refresh(bonds, K_pairs, K_walls)
             self.refreshes += 1

@@ -17,6 +17,8 @@ from fem_neck.geometry.union import angular_radius, necks_meet
 
 from dem.geometry.bonds import LENS_GEOMETRY, Bonds
 
+PAIR_READINGS = ("newton", "first", "coble")  # the readings that end where necks meet
+
 def necks_meeting(radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, wall_normals: np.ndarray) -> np.ndarray:
     """Whether two necks of each particle meet (bool per particle).
 

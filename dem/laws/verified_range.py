@@ -28,9 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dem.geometry.necks import widest_necks
-
-PAIR_READINGS = ("newton", "first", "coble")  # the readings that end where necks meet
+from dem.geometry.necks import PAIR_READINGS, widest_necks
 
 
 @dataclass(frozen=True)
@@ -78,15 +76,17 @@ def percent_range(interval: tuple[float, float]) -> str:
     return f"{100.0 * low:+.1f} % to {100.0 * high:+.1f} %"
 
 
-def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide: int = 0) -> dict:
+def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide: int = 0,
+                 readings: dict | None = None, handed_over: int | None = None) -> dict:
     """The summary's account of the necks and of where the law stands (module docstring).
 
     Entries: the reading every bond used (``neck_readings``: bonds per reading), how many particles carry necks that
     meet (``particles_necks_meeting``), and, for the laws verified against FE (all but ``zohdi``), whether the run
     stayed where its law is verified (``law_in_verified_range``), with one ``warnings`` line per range it left. Under
-    the union reading, a law with FE evidence there also reports ``particles_necks_wide`` and ``law_error_range``:
-    the relative error of ``k_eff`` (``[low, high]``, dimensionless) the evidence allows over the ranges the run
-    reached.
+    the union reading, or in a run that hands particles whose necks meet over to it (:mod:`dem.engines.handover`,
+    ``particles_handed_over``), a law with FE evidence there also reports ``law_error_range``: the relative error of
+    ``k_eff`` (``[low, high]``, dimensionless) the evidence allows over the ranges the run reached; under the union
+    reading also ``particles_necks_wide``.
 
     Parameters
     ----------
@@ -95,14 +95,18 @@ def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide:
     n : int
         Particles in the run.
     reading : str
-        The neck reading of the bonds (``dem.geometry.bonds.CONTACT_MODELS``).
+        The neck reading of the scene (``dem.geometry.bonds.CONTACT_MODELS``).
     bonds : int
         Pair and wall bonds.
     law : str
         The conductance law (``dem.laws.conductance.LAWS``).
     wide : int
         Particles whose necks do not meet but one of which is wider than the law's ``verified_width``
-        (:func:`dem.geometry.necks.widest_necks`); union reading only.
+        (:func:`wide_necks`); union reading only.
+    readings : dict or None
+        Bonds per reading where they differ (a hand-over); None: all ``bonds`` read ``reading``.
+    handed_over : int or None
+        Particles handed over to the union; None: the run hands none over.
 
     Returns
     -------
@@ -110,24 +114,30 @@ def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide:
         The summary's entries.
     """
     meeting, wide = int(meeting), int(wide)
-    out = {"neck_readings": {reading: int(bonds)}, "particles_necks_meeting": meeting}
+    out = {"neck_readings": {reading: int(bonds)} if readings is None else {k: int(v) for k, v in readings.items()},
+           "particles_necks_meeting": meeting}
+    if handed_over is not None:
+        out["particles_handed_over"] = int(handed_over)
     if reading not in PAIR_READINGS and reading != "union":
         return out
     if reading in PAIR_READINGS:
         out["law_in_verified_range"] = meeting == 0
-        if meeting:
+        if meeting and handed_over is None:
             out["warnings"] = [f"{_share(meeting, n)} carry necks that meet: the pair-neck reading {reading!r} has no "
                                f"answer there, so law {law!r} is outside the range where it is verified; "
                                f"conductance.neck = \"union\" reads the packing as the union of its spheres, defined at "
                                f"every density"]
-        return out
+            return out
+        wide = 0  # the pair necks are verified while apart; the union reads only the handed-over particles
     evidence = EVIDENCE.get(law)
     if evidence is None:
-        out["law_in_verified_range"] = False
-        out["warnings"] = [f"law {law!r} was not compared with FE on union necks (python -m verification "
-                           f"densification compares {', '.join(EVIDENCE)}): no error bound"]
+        out["law_in_verified_range"] = False if reading == "union" else out["law_in_verified_range"]
+        if reading == "union" or meeting:
+            out["warnings"] = [f"law {law!r} was not compared with FE on union necks (python -m verification "
+                               f"densification compares {', '.join(EVIDENCE)}): no error bound"]
         return out
-    out["particles_necks_wide"] = wide
+    if reading == "union":
+        out["particles_necks_wide"] = wide
     out["law_in_verified_range"] = meeting == 0 and wide == 0
     reached = [interval for count, interval in ((wide, evidence.apart), (meeting, evidence.meeting)) if count]
     out["law_error_range"] = ([min(r[0] for r in reached), max(r[1] for r in reached)] if reached
@@ -137,7 +147,8 @@ def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide:
         warnings.append(f"{_share(wide, n)} carry a neck wider than a/r = {evidence.verified_width:g} (none meeting): "
                         f"FE of the union puts law {law!r} at {percent_range(evidence.apart)} of k_eff there")
     if meeting:
-        warnings.append(f"{_share(meeting, n)} carry necks that meet: FE of the union puts law {law!r} at "
+        read = "carry necks that meet" if reading == "union" else "carry necks that meet, read as the union"
+        warnings.append(f"{_share(meeting, n)} {read}: FE of the union puts law {law!r} at "
                         f"{percent_range(evidence.meeting)} of k_eff there")
     if warnings:
         out["warnings"] = warnings

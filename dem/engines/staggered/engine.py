@@ -35,6 +35,7 @@ from dem.geometry.neighbours import list_arrays
 from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
 from dem.engines.contact_current import ContactCurrent
+from dem.engines.handover import Handover
 from dem.engines.staggered.heat import LumpedHeat, contact_bonds
 from dem.geometry.necks import meeting_in
 from dem.laws.verified_range import neck_account, wide_necks
@@ -82,6 +83,7 @@ class StaggeredEngine:
         if self.thermal is not None and restart is not None:
             self.thermal.T, self.thermal.T0 = saved["T"].copy(), saved["thermal_T0"].copy()
             self.thermal.heat_in = {str(k): float(v) for k, v in zip(saved["heat_keys"], saved["heat_values"])}
+            self.thermal.handover.restore(saved)
         self.current = None
         if "electrical" in scene.physics:
             e = scene.electrical
@@ -263,7 +265,7 @@ class StaggeredEngine:
         if self.thermal is not None:
             th = self.thermal
             data.update(thermal_T0=th.T0, heat_keys=np.array(list(th.heat_in), dtype=str),
-                        heat_values=np.array(list(th.heat_in.values()), dtype=float))
+                        heat_values=np.array(list(th.heat_in.values()), dtype=float), **th.handover.state())
         if self.current is not None:
             c = self.current
             data.update(current_J=c.J, **{f"current_{k}": np.array(getattr(c, k)) for k in (
@@ -387,9 +389,15 @@ class StaggeredEngine:
                        heat_in={k: float(v) for k, v in self.thermal.heat_in.items()}, law=self.scene.conductance.law)
             meeting, bonds = self.necks()
             law = self.scene.conductance.law
+            readings = handed_over = None
+            if self._handing_over():
+                account = self.thermal.handover.account(self._pair_bonds())
+                readings, handed_over = account["readings"], account["handed_over"]
+                out["particles_handing_over"] = account["handing_over"]
             out.update(neck_account(np.count_nonzero(meeting), mech.state.n, bonds.contact,
                                     bonds.n_pairs + bonds.n_walls, law,
-                                    np.count_nonzero(wide_necks(mech.state.radius, bonds, meeting, law))))
+                                    np.count_nonzero(wide_necks(mech.state.radius, bonds, meeting, law)), readings,
+                                    handed_over))
         if self.current is not None:
             c = self.current
             out.update(scheme=c.scheme, current_refreshes=c.refreshes, joule_energy=c.joule_energy,
@@ -442,12 +450,25 @@ class StaggeredEngine:
         walls = [mech.walls[k].at(float(mech.w.q[k])) for k in th.thermal_walls]
         return meeting_in(now, walls, bonds, mech.periodic_box), bonds
 
+    def _handing_over(self) -> bool:
+        """Whether the thermal submodel hands particles over to the union (:mod:`dem.engines.handover`)."""
+        return self.thermal is not None and Handover.applies(self.scene.conductance, self.mechanics.state.dimension)
+
+    def _pair_bonds(self):
+        """The bonds of the touching pairs now under the scene's pair-neck reading (clipped to its range)."""
+        mech, th = self.mechanics, self.thermal
+        return contact_bonds(self.scene.particles, mech, mech.state.x, mech.state.T, th.thermal_walls,
+                             self.scene.conductance.contact, "clip")[1]
+
     def particle_fields(self) -> dict:
         s = self.mechanics.state
         out = {"id": self.scene.particles.id, "radius": s.radius, "velocity": s.v, "force": self.mechanics.f,
                "temperature": s.T}
         if self.thermal is not None:
             out["necks_meeting"] = self.necks()[0].astype(np.int8)
+            if self._handing_over():
+                out["solid_radius"] = self.thermal.handover.solid_radii(s.radius)
+                out["handed_over"] = self.thermal.handover.weight
         if self.current is not None:
             out["heating"] = self.current.heating
             out["current" if self.current.scheme == "zohdi" else "potential"] = np.nan_to_num(self.current.J)

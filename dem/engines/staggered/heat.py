@@ -6,7 +6,8 @@ The contact conductance is the scene's ``[conductance] law`` on each contact as 
 packing: ``law = "zohdi"`` is the paper's ``K_ij A_ij / |r_i - r_j|`` (eq. 33 with the lens area of eqs. 7-12;
 compiled on the Verlet list, :func:`dem.laws.lens_conductance.lens_list_conductances`), any other law is evaluated on the
 bonds of the touching pairs (:func:`dem.geometry.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`),
-``"fit"`` the FE-verified neck law.
+``"fit"`` the FE-verified neck law; with a pair-neck reading, particles whose necks meet are handed over to the union
+of spheres at each accepted step (:mod:`dem.engines.handover`).
 
 ``Q`` is the flux of the contact network (:meth:`dem.network.laplacian.BoundedLaplacian.flux`, ``-L theta`` plus the
 walls' terms) whose edges are the pairs of the mechanics' Verlet list and its particle-wall pairs with the
@@ -29,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from dem.engines.handover import Handover
 from dem.geometry.bonds import find_bonds
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.laws.lens_conductance import LENS_POLICY, lens_list_conductances
@@ -37,9 +39,36 @@ from dem.engines.staggered import kernels
 from dem.network.laplacian import BoundedLaplacian
 
 
+def contact_pairs(particles: Particles, mech, x, T, wall_ids) -> tuple:
+    """``(particles at x, walls, pairs)``: the touching pairs ``(i, j)`` of the Verlet list of ``mech`` at positions
+    ``x``, and the walls ``wall_ids`` where the mechanics has them.
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The scene's particles (radii in m, materials, fixed flags, heat sources).
+    mech : dem.engines.staggered.mechanics.StaggeredMechanics
+        The mechanics: its Verlet lists, walls and periodic box.
+    x : numpy.ndarray
+        (N, 3) particle positions (m).
+    T : numpy.ndarray
+        (N,) temperatures (K).
+    wall_ids : sequence of int
+        Indices of the walls whose contacts are wanted.
+
+    Returns
+    -------
+    tuple
+        The particles at ``x`` with temperatures ``T``, the walls (:class:`dem.geometry.walls.Wall`) and the pairs.
+    """
+    closed = kernels.closed_pairs(x, particles.radius, mech.pi, mech.pj, mech.box)
+    now = Particles(x, particles.radius, T, particles.material, particles.fixed, particles.heat, particles.materials)
+    planes = [mech.walls[k].at(float(mech.w.q[k])) for k in wall_ids]
+    return now, planes, (mech.pi[closed], mech.pj[closed])
+
+
 def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_of_range: str):
-    """``(particles at x, bonds)``: the touching pairs of the Verlet list of ``mech`` at positions ``x`` and the
-    particles touching the walls ``wall_ids`` (where the mechanics has them), with contact radii from the geometry
+    """``(particles at x, bonds)``: the bonds of :func:`contact_pairs`, with contact radii from the geometry
     ``contact`` (:func:`dem.geometry.bonds.find_bonds`; in the periodic box of ``mech`` across its faces).
 
     Parameters
@@ -69,11 +98,8 @@ def contact_bonds(particles: Particles, mech, x, T, wall_ids, contact: str, out_
     ValueError
         A contact beyond the geometry's range with ``out_of_range = "error"``.
     """
-    closed = kernels.closed_pairs(x, particles.radius, mech.pi, mech.pj, mech.box)
-    now = Particles(x, particles.radius, T, particles.material, particles.fixed, particles.heat, particles.materials)
-    planes = [mech.walls[k].at(float(mech.w.q[k])) for k in wall_ids]
-    return now, find_bonds(now, planes, contact, out_of_range, pairs=(mech.pi[closed], mech.pj[closed]),
-                           box=mech.periodic_box)
+    now, planes, pairs = contact_pairs(particles, mech, x, T, wall_ids)
+    return now, find_bonds(now, planes, contact, out_of_range, pairs=pairs, box=mech.periodic_box)
 
 
 class LumpedHeat:
@@ -109,6 +135,7 @@ class LumpedHeat:
         self.graph: BoundedLaplacian | None = None  # the network on the Verlet list (module docstring)
         self._lists = None  # the mechanics' wall list (wk, wm) the plane bonds come from
         self.assemblies = self.refreshes = 0
+        self.handover = Handover(spec, particles.radius)  # the hand-over to the union (dem.engines.handover)
 
     def _plane_bonds(self, mech):
         """The network's plane bonds: the listed particle-wall pairs of the walls with a temperature, as
@@ -120,9 +147,10 @@ class LumpedHeat:
             self._lists = (mech.wk, mech.wm)
         return self._planes
 
-    def conductances(self, mech, x, T):
+    def conductances(self, mech, x, T, update: bool = False):
         """``(K, K_w, plane_node, plane_index)``: the conductances (W/K) of the listed pairs (0 where they do not
-        touch) and of the plane bonds, at positions ``x``.
+        touch) and of the plane bonds, at positions ``x``; with a pair-neck reading through the hand-over to the
+        union (:class:`dem.engines.handover.Handover`).
 
         Parameters
         ----------
@@ -132,6 +160,8 @@ class LumpedHeat:
             (N, 3) particle positions (m).
         T : numpy.ndarray
             (N,) temperatures (K).
+        update : bool
+            Whether to advance the hand-overs at ``x`` (an accepted step does; an iterate does not).
 
         Returns
         -------
@@ -148,10 +178,14 @@ class LumpedHeat:
                 contact_bonds(self.particles, mech, x, T, self.thermal_walls, "lens", self.spec.out_of_range)
                 raise RuntimeError(f"{bad} lens contacts out of range that find_bonds accepts")
             return K, K_w, plane_node, plane_index
-        now, b = contact_bonds(self.particles, mech, x, T, self.thermal_walls, self.spec.contact,
-                               self.spec.out_of_range)
-        K_b, K_wb = bond_conductances(self.spec, now, b, walls=[self.walls[k].at(float(mech.w.q[k]))
-                                                                  for k in self.thermal_walls])
+        if Handover.applies(self.spec, mech.state.dimension):
+            now, planes, pairs = contact_pairs(self.particles, mech, x, T, self.thermal_walls)
+            b, K_b, K_wb = self.handover.bonds(now, planes, pairs, mech.periodic_box, update)
+        else:
+            now, b = contact_bonds(self.particles, mech, x, T, self.thermal_walls, self.spec.contact,
+                                   self.spec.out_of_range)
+            K_b, K_wb = bond_conductances(self.spec, now, b, walls=[self.walls[k].at(float(mech.w.q[k]))
+                                                                      for k in self.thermal_walls])
         n = self.particles.n
         K[:] = 0.0
         K[np.searchsorted(mech.pi * n + mech.pj, b.i * n + b.j)] = K_b  # the list is sorted by (i, j)
@@ -162,7 +196,7 @@ class LumpedHeat:
             K_w[order[np.searchsorted(key[order], b.wall_index * n + b.wall_particle)]] = K_wb
         return K, K_w, plane_node, plane_index
 
-    def conduction(self, mech, x, T) -> np.ndarray:
+    def conduction(self, mech, x, T, update: bool = False) -> np.ndarray:
         """``Q_i`` (W) of eq. (33) at positions ``x`` (the contacts of the Verlet list of the mechanics ``mech``,
         the walls where it has them) and temperatures ``T``: the flux of the network (module docstring).
 
@@ -174,13 +208,15 @@ class LumpedHeat:
             (N, 3) particle positions (m).
         T : numpy.ndarray
             (N,) temperatures (K).
+        update : bool
+            Whether to advance the hand-overs at ``x`` (:meth:`conductances`).
 
         Returns
         -------
         numpy.ndarray
             (N,) ``Q_i`` (W).
         """
-        K, K_w, plane_node, plane_index = self.conductances(mech, x, T)
+        K, K_w, plane_node, plane_index = self.conductances(mech, x, T, update)
         g = self.graph
         if g is not None and g.same_edges(mech.pi, mech.pj, plane_node, plane_index):
             g.refresh(mech.pi, mech.pj, K, plane_node, plane_index, K_w)
@@ -249,7 +285,7 @@ class LumpedHeat:
         self.heat_in["boundaries"] += dt * float(phi * self._Q_iter[f].sum() + (1.0 - phi) * self.Q[f].sum())
         self.heat_in["joule"] += dt * float(np.sum(H[f]))
         self.T = np.array(T, dtype=float)
-        self.Q = self.conduction(mech, mech.state.x, self.T)
+        self.Q = self.conduction(mech, mech.state.x, self.T, update=True)
 
     def energy_error(self) -> float:
         """``|sum C (theta - theta_0) - heat in| / scale`` over the free particles (relative; the scale is the

@@ -36,7 +36,7 @@ from dem.geometry.walls import box_axes
 from dem.laws.contact import law_module
 from dem.laws.verified_range import neck_account, wide_necks
 from dem.scene.state_file import moving_arrays, normalised
-from dem.network.heat import boundary_heat_flow, steady
+from dem.network.heat import Network, boundary_heat_flow, bonds_and_conductances, steady
 from fem_neck.geometry import max_overlap, neck_radius
 
 
@@ -131,6 +131,7 @@ class VerletEngine:
             th.heat_in = {str(k): float(v) for k, v in zip(saved["heat_keys"], saved["heat_values"])}
             th.assemblies, th.refreshes = int(saved["network_assemblies"]), int(saved["network_refreshes"])
             th.startup_steps = int(saved.get("thermal_startup_steps", 0))  # 0: a checkpoint from before the count
+            th.handover.restore(saved)
 
     @property
     def temperature_source(self) -> str:
@@ -296,19 +297,40 @@ class VerletEngine:
             return None
         return tuple(walls) if a.temperature > b.temperature else tuple(reversed(walls))
 
-    def effective_conductivity(self) -> float | None:
+    def effective_conductivity(self, pair_necks: bool = False) -> float | None:
         """``k_eff = Q L / (A (T_hot - T_cold))`` of the contact network as it is now, from a steady solve between
         the hot and the cold wall (W/(m K)); None without two such walls, a closed box or a network (or with
-        ambient sources, which are not conduction). Groups of particles touching neither wall carry no heat."""
+        ambient sources, which are not conduction). Groups of particles touching neither wall carry no heat.
+
+        Parameters
+        ----------
+        pair_necks : bool
+            Whether to read every contact as a pair neck (the scene's reading, clipped to its range), as if no
+            particle had been handed over to the union (:mod:`dem.engines.handover`); False: the network as the
+            run conducts.
+
+        Returns
+        -------
+        float or None
+            k_eff (W/(m K)), or None.
+        """
         th, pair = self.thermal, self.heated_walls()
         volume = self.box_volume()
         if th is None or th.net is None or pair is None or volume is None or self.scene.sources.names:
             return None
         mech = self.mechanics
+        net = th.net
+        if pair_necks:
+            i, j = mech.contacts()[:2]
+            bonds, K_pairs, K_walls = bonds_and_conductances(
+                th._particles_now(mech, mech.state.radius), th._walls_now(mech),
+                replace(th.spec, out_of_range="clip"), pairs=(i, j), box=th.box)
+            net = Network(th._particles_now(mech, th.particles.radius), bonds, K_pairs, K_walls, net.wall_temperature,
+                          th.sources, th.box)
         hot, cold = pair
         length = -(mech.w.q[hot] + mech.w.q[cold])
-        res = steady(th.net, floating="mean", linear=self.scene.solver.linear)
-        into = boundary_heat_flow(th.net, res.T)["walls"]
+        res = steady(net, floating="mean", linear=self.scene.solver.linear)
+        into = boundary_heat_flow(net, res.T)["walls"]
         q = -into[th.thermal_walls.index(hot)]  # heat leaving the hot wall
         delta_T = mech.walls[hot].temperature - mech.walls[cold].temperature
         return float(q * length / (volume / length * delta_T))
@@ -365,6 +387,8 @@ class VerletEngine:
                "T_min": float(np.min(s.T)), "T_max": float(np.max(s.T))}
         if self.thermal is not None and self.heated_walls() is not None:
             row["effective_conductivity"] = self.effective_conductivity()
+            if self.thermal.handing_over(mech):  # beside it, the contacts all read as pair necks
+                row["effective_conductivity_pair_necks"] = self.effective_conductivity(pair_necks=True)
         for name, value in self.wall_stress().items():
             row[f"wall_{name}"] = value
         for k, wall in enumerate(mech.walls):
@@ -391,8 +415,14 @@ class VerletEngine:
                 out["startup_steps"] = th.startup_steps
             meeting, bonds = self.necks()
             law = self.scene.conductance.law
+            readings = handed_over = None
+            if th.handing_over(mech):
+                account = th.handover.account(bonds)
+                readings, handed_over = account["readings"], account["handed_over"]
+                out["particles_handing_over"] = account["handing_over"]
             out.update(neck_account(np.count_nonzero(meeting), s.n, bonds.contact, bonds.n_pairs + bonds.n_walls, law,
-                                    np.count_nonzero(wide_necks(s.radius, bonds, meeting, law))))
+                                    np.count_nonzero(wide_necks(s.radius, bonds, meeting, law)), readings,
+                                    handed_over))
         return out
 
     def necks(self):
@@ -437,6 +467,9 @@ class VerletEngine:
         if self.thermal is not None:
             fields["heat_flow"] = self.thermal.contact_heat(mech, i, j)[1]
             fields["necks_meeting"] = self.necks()[0].astype(np.int8)
+            if self.thermal.handing_over(mech):
+                fields["solid_radius"] = self.thermal.handover.solid_radii(s.radius)
+                fields["handed_over"] = self.thermal.handover.weight
         return fields
 
     def positions(self) -> np.ndarray:
@@ -508,5 +541,5 @@ class VerletEngine:
             data.update(thermal_T=th.T, thermal_rate=th.rate, thermal_energy0=np.array(th.energy0),
                         heat_keys=np.array(list(th.heat_in), dtype=str),
                         heat_values=np.array(list(th.heat_in.values()), dtype=float),
-                        thermal_startup_steps=np.array(th.startup_steps))
+                        thermal_startup_steps=np.array(th.startup_steps), **th.handover.state())
         return data

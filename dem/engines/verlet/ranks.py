@@ -471,7 +471,10 @@ def _sum():
 
 class RankContactThermal(ContactThermalModel):
     """The heat of the contacts on several ranks (module docstring): ``T`` and ``rate`` over every particle of the
-    scene on every rank, each thermal step solved on PETSc by all ranks together."""
+    scene on every rank, each thermal step solved on PETSc by all ranks together. No hand-over to the union
+    (:mod:`dem.geometry.handover`): its solid radii are solved over the whole sample, which no rank holds."""
+
+    hands_over = False
 
     def local(self, mechanics, values: np.ndarray) -> np.ndarray:
         return values[mechanics.gid]
