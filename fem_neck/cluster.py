@@ -238,7 +238,7 @@ def add_neck_cylinders(occ, cluster: Cluster, geo) -> list:
 
     Parameters
     ----------
-    occ : module
+    occ : object
         ``gmsh.model.occ`` of an open gmsh session.
     cluster : Cluster
         The cluster (in the session's length unit).
@@ -270,7 +270,7 @@ def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, si
 
     Parameters
     ----------
-    gmsh : module
+    gmsh : object
         The ``gmsh`` module, in an open session with the solid built.
     cluster : Cluster
         The cluster (in the session's length unit).
@@ -341,7 +341,7 @@ def mesh_tetrahedra(gmsh, curvature: int, size_max: float) -> None:
 
     Parameters
     ----------
-    gmsh : module
+    gmsh : object
         The ``gmsh`` module, in an open session with the background size field set.
     curvature : int
         Elements per 2 pi of surface curvature.
@@ -364,7 +364,7 @@ def tetrahedra(gmsh, vol_tag: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    gmsh : module
+    gmsh : object
         The ``gmsh`` module, in an open session with the volume meshed.
     vol_tag : int
         Tag of the meshed volume.

@@ -237,7 +237,7 @@ def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 50
 
     Parameters
     ----------
-    A : scipy.sparse matrix or LinearOperator
+    A : scipy.sparse matrix or scipy.sparse.linalg.LinearOperator
         The symmetric positive definite matrix (n, n).
     b : numpy.ndarray
         Right-hand side (n,).

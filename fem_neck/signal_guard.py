@@ -46,7 +46,7 @@ def restore(saved: dict[int, SigAction]) -> None:
 
     Parameters
     ----------
-    saved : dict of int to SigAction
+    saved : dict
         Signal number to the C library's handler record, as :func:`handlers` returned it.
     """
     libc = _libc()

@@ -317,7 +317,7 @@ def conductance(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
         The quadrilateral mesh of the meridian half-plane.
     order : int
         Polynomial order ``p`` (1 to ``MAX_ORDER``).
-    fixed_vertices : dict of float to array_like of bool
+    fixed_vertices : dict
         Temperature (K) to a mask over the vertices where it is held; two entries (as in :func:`solve`).
     """
     with one_blas_thread():
@@ -336,7 +336,7 @@ def solve(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
         The quadrilateral mesh of the meridian half-plane.
     order : int
         Polynomial order ``p`` (1 to ``MAX_ORDER``).
-    fixed_vertices : dict of float to array_like of bool
+    fixed_vertices : dict
         Temperature (K) to a mask over the vertices where it is held; two entries, the difference of their keys being
         the temperature difference.
     """

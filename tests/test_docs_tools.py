@@ -190,7 +190,7 @@ K : float
 # The ratchet: public parameters (of functions, classes and the public methods they define) that no docstring
 # describes, per package. The count may fall, never rise: a new public parameter comes with its description (numpy
 # style, "Parameters" section: meaning and unit), and whoever documents more lowers the number here.
-UNDESCRIBED = {"fem_neck": 41, "dem": 98, "sinterheat": 70}
+UNDESCRIBED = {"fem_neck": 41, "dem": 0, "sinterheat": 70}
 
 
 def test_undescribed_public_parameters_do_not_grow():

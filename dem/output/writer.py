@@ -143,7 +143,7 @@ def write_pvd(path: pathlib.Path, entries: list[tuple[float, str]]) -> None:
     ----------
     path : pathlib.Path
         The ``.pvd`` file to write.
-    entries : list of tuple of (float, str)
+    entries : list of tuple
         ``(time in s, file name relative to the collection)`` of every snapshot.
     """
     rows = "\n".join(f'    <DataSet timestep="{t:.17g}" group="" part="0" file="{f}"/>' for t, f in entries)
