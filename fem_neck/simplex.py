@@ -264,6 +264,10 @@ def face_normal(face: int) -> np.ndarray:
 class RaviartThomas:
     """Divergence-free fields of ``RT_k`` on the reference tetrahedron (module docstring).
 
+    ``values(xi)`` gives the ``m`` fields at reference points ``(..., 3, m)``; ``traces (4 n_f, m)`` are the moments
+    ``int_F mu tau . n_out dS`` against the face basis ``mu`` (``n_f`` functions of ``(s, t)`` per face, orthonormal
+    on the unit triangle, the first constant); ``mass[i, j] = int tau_i tau_j^T`` (3, 3, m, m).
+
     Parameters
     ----------
     k : int
@@ -277,10 +281,6 @@ class RaviartThomas:
         Exponents ``(n_f, 2)`` of the monomials of ``P_k`` in the face coordinates ``(s, t)``.
     face_coefficients : numpy.ndarray
         ``(n_f, n_f)``: the orthonormal face basis on those monomials.
-
-    ``values(xi)`` gives the ``m`` fields at reference points ``(..., 3, m)``; ``traces (4 n_f, m)`` are the moments
-    ``int_F mu tau . n_out dS`` against the face basis ``mu`` (``n_f`` functions of ``(s, t)`` per face, orthonormal
-    on the unit triangle, the first constant); ``mass[i, j] = int tau_i tau_j^T`` (3, 3, m, m).
     """
 
     k: int

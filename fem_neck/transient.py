@@ -1,4 +1,4 @@
-"""Transient conduction in an insulated sintered pair: axisymmetric FE against the lumped-capacity pipe model.
+r"""Transient conduction in an insulated sintered pair: axisymmetric FE against the lumped-capacity pipe model.
 
 The pair of spheres ``r_i``, ``r_j`` with the volume-conserving cylindrical neck (Rojek 2022, Sections 4.3) is a
 body of revolution. In its meridian half-plane (``x`` radial >= 0, ``y`` axial, centre i at the origin, centre j at
@@ -7,17 +7,19 @@ with gmsh OCC booleans (as in :mod:`fem_neck.cluster`, the caps need no explicit
 ``y = z_split`` where each particle's share of the cylinder equals its cap's volume, so that each particle owns
 exactly ``4/3 pi r^3`` -- the DEM's mass -- and the initial field (``T_i`` on particle i, ``T_j`` on j) is sharp.
 
-The heat equation ``rho c dT/dt = div(kappa grad T)``, insulated everywhere, in axisymmetric weak form (every
-integrand weighted by the radial coordinate ``x``, design notes): mass ``M = 2 pi rho c int u v x``, stiffness
-``A = 2 pi kappa int grad u . grad v x``. Time stepping is implicit: backward Euler for the first steps (it damps
-the stiff modes of the discontinuous start; Rannacher's start-up) then Crank-Nicolson, with the step doubling in
-blocks up to a cap (:func:`time_grid`), each distinct step's matrix factorised once. Both conserve ``1^T M T``
-exactly (``A 1 = 0``), i.e. the energy ``sum_i C_i Tbar_i``.
+The heat equation :math:`\rho c \, \partial T/\partial t = \nabla \cdot (\kappa \nabla T)`, insulated everywhere,
+in axisymmetric weak form (every integrand weighted by the radial coordinate ``x``, design notes): mass
+:math:`M = 2 \pi \rho c \int u v x`, stiffness :math:`A = 2 \pi \kappa \int \nabla u \cdot \nabla v \, x`. Time
+stepping is implicit: backward Euler for the first steps (it damps the stiff modes of the discontinuous start;
+Rannacher's start-up) then Crank-Nicolson, with the step doubling in blocks up to a cap (:func:`time_grid`), each
+distinct step's matrix factorised once. Both conserve ``1^T M T`` exactly (``A 1 = 0``), i.e. the energy ``sum_i C_i
+Tbar_i``.
 
-The lumped model (Rojek 2022, eqs. 2-4): ``C_i dT_i/dt = K (T_j - T_i)``, so the particle-temperature difference
-decays as ``exp(-lambda t)`` with ``lambda = K (1/C_i + 1/C_j)``, ``C = rho c 4/3 pi r^3``. The FE difference of the
-particle *means* tends to ``exp(-lambda_1 t)`` with ``lambda_1`` the smallest non-zero eigenvalue of ``(A, M)``
-(:func:`first_decay_rate`); ``lambda_1 (1/C_i + 1/C_j)^-1`` is the conductance the lumped model would need.
+The lumped model (Rojek 2022, eqs. 2-4): :math:`C_i \, dT_i/dt = K (T_j - T_i)`, so the particle-temperature
+difference decays as :math:`e^{-\lambda t}` with :math:`\lambda = K (1/C_i + 1/C_j)`,
+:math:`C = \rho c \tfrac{4}{3} \pi r^3`. The FE difference of the particle *means* tends to
+:math:`e^{-\lambda_1 t}` with :math:`\lambda_1` the smallest non-zero eigenvalue of :math:`(A, M)`
+(:func:`first_decay_rate`); :math:`\lambda_1 (1/C_i + 1/C_j)^{-1}` is the conductance the lumped model would need.
 """
 
 from __future__ import annotations
