@@ -11,6 +11,7 @@ sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 
 import api_check  # noqa: E402
 import docstring_check  # noqa: E402
+import gallery_links  # noqa: E402
 import gallery_order  # noqa: E402
 import site_check  # noqa: E402
 
@@ -67,6 +68,23 @@ def test_every_module_with_public_objects_has_its_automodule():
         assert modules - placed == set(), package
     assert {"dem.scene.schema.display_rows", "dem.driver.run", "dem.laws.contact.jkr.JKRMaterial"} <= set(
         api_check.public_objects("dem"))
+
+
+def test_gallery_links_match_an_api_entry_by_the_object_an_example_used():
+    """An example's use of a function under its short public path (``fem_neck.neck_radius``) reaches the entry where
+    the function is defined; a name no example uses, a constant and a name that is not there get no link."""
+    from fem_neck.geometry import neck_radius
+    from fem_neck.law import pair_conductance
+
+    used = [["neck_models.py", "examples", "gallery", "intro", "Neck models"]]
+    found = gallery_links.index({"fem_neck.neck_radius": used, "fem_neck.geometry.neck_radius": used,
+                                 "fem_neck.law.pair_conductance": [], "fem_neck.law.ROJEK": used,
+                                 "fem_neck.law.no_such_law": used, "no_such_package.f": used})
+    assert found == {id(neck_radius): ["fem_neck.neck_radius", "fem_neck.geometry.neck_radius"]}
+    assert id(pair_conductance) not in found
+    assert gallery_links.lines(found[id(neck_radius)]) == [
+        "", ".. rubric:: Examples using this", "",
+        ".. minigallery:: fem_neck.geometry.neck_radius fem_neck.neck_radius", ""]
 
 
 def test_site_check_finds_remote_loads_missing_files_and_missing_anchors(tmp_path):
@@ -140,6 +158,22 @@ def test_maths_is_served_by_the_site_itself():
         assert not site_check.is_remote(app.config.mathjax_path)
         assert (pathlib.Path(spec.origin).parent / "static" / "mathjax" / app.config.mathjax_path.split("/", 1)[1]
                 ).is_file()
+
+
+def test_scipy_names_link_through_the_inventory_committed_with_the_docs():
+    """intersphinx reads SciPy's inventory from the file under docs/ (no request at build time), and the inventory
+    holds the names the docstrings use."""
+    import posixpath
+    import runpy
+
+    uri, inventory = runpy.run_path(str(ROOT / "docs" / "conf.py"))["intersphinx_mapping"]["scipy"]
+    assert uri.startswith("https://") and not site_check.is_remote(inventory)
+    assert pathlib.Path(inventory).is_file() and pathlib.Path(inventory).is_relative_to(ROOT / "docs")
+    loader = pytest.importorskip("sphinx.util.inventory").InventoryFile
+    with open(inventory, "rb") as fh:
+        names = loader.load(fh, uri, posixpath.join)["py:class"]
+    assert names["scipy.sparse.csr_matrix"].uri == uri + "reference/generated/scipy.sparse.csr_matrix.html" \
+        "#scipy.sparse.csr_matrix"
 
 
 def test_install_page_shows_the_readme_mpi_command():
