@@ -2,11 +2,12 @@
 
 Build (offline, warnings as errors): ``python -m sphinx -W -b html docs docs/_build`` after ``pip install '.[docs]'``.
 The pages are Markdown (MyST), so ``tests/test_console_blocks.py`` runs their console blocks as it runs the README's;
-the gallery is built by running every script of ``examples/`` (sphinx-gallery); the API reference is autodoc
-(napoleon) over the packages in ``api_packages``, and ``_ext/api_check.py`` fails the build when one of their public
-functions or classes is missing from it. The site reads offline: MathJax is served from the build's ``_static``
-(sphinx-mathjax-offline, in the docs extra), and ``_ext/site_check.py`` fails the build when a page loads anything
-from another host or links to a page or anchor that does not exist.
+the gallery is built by running every script of ``examples/`` (sphinx-gallery); the API reference is autodoc (napoleon)
+over the packages in ``api_packages``, and ``_ext/api_check.py`` fails the build when one of their public functions or
+classes is missing from it; an entry a gallery example uses shows that example (``_ext/gallery_links.py``). The site
+reads offline: MathJax is served from the build's ``_static`` (sphinx-mathjax-offline, in the docs extra), and
+``_ext/site_check.py`` fails the build when a page loads anything from another host or links to a page or anchor that
+does not exist.
 
 A build of the pages alone, without running the examples: ``python -m sphinx -D plot_gallery=0 -b html docs
 docs/_build`` (the gallery's pages then show the code without its output or figures).

@@ -74,13 +74,15 @@ def test_gallery_links_match_an_api_entry_by_the_object_an_example_used():
     """An example's use of a function under its short public path (``fem_neck.neck_radius``) reaches the entry where
     the function is defined; a name no example uses, a constant and a name that is not there get no link."""
     from fem_neck.geometry import neck_radius
-    from fem_neck.law import pair_conductance
+    from fem_neck.law import ConductanceLaw, pair_conductance
 
     used = [["neck_models.py", "examples", "gallery", "intro", "Neck models"]]
     found = gallery_links.index({"fem_neck.neck_radius": used, "fem_neck.geometry.neck_radius": used,
+                                 "fem_neck.law.ConductanceLaw.default": used,
                                  "fem_neck.law.pair_conductance": [], "fem_neck.law.ROJEK": used,
                                  "fem_neck.law.no_such_law": used, "no_such_package.f": used})
-    assert found == {id(neck_radius): ["fem_neck.neck_radius", "fem_neck.geometry.neck_radius"]}
+    assert found == {id(neck_radius): ["fem_neck.neck_radius", "fem_neck.geometry.neck_radius"],
+                     id(vars(ConductanceLaw)["default"].__func__): ["fem_neck.law.ConductanceLaw.default"]}
     assert id(pair_conductance) not in found
     assert gallery_links.lines(found[id(neck_radius)]) == [
         "", ".. rubric:: Examples using this", "",

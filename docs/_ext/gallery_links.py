@@ -18,9 +18,14 @@ import pathlib
 RUBRIC = "Examples using this"
 
 
+def _plain(obj):
+    """A bound (class) method's function: what autodoc documents for it."""
+    return getattr(obj, "__func__", obj)
+
+
 def resolve(name: str):
-    """The function or class that the dotted ``name`` denotes (the longest importable module, then attributes), or
-    None."""
+    """The function or class that the dotted ``name`` denotes (the longest importable module, then attributes; a
+    method as its function), or None."""
     parts = name.split(".")
     for k in range(len(parts), 0, -1):
         try:
@@ -29,6 +34,7 @@ def resolve(name: str):
             continue
         for attr in parts[k:]:
             obj = getattr(obj, attr, None)
+        obj = _plain(obj)
         return obj if inspect.isfunction(obj) or inspect.isclass(obj) else None
     return None
 
@@ -59,7 +65,7 @@ def _index(app) -> dict[int, list[str]]:
 
 def add_examples(app, what, name, obj, options, docstring):
     if what in ("function", "class", "method"):
-        keys = _index(app).get(id(obj))
+        keys = _index(app).get(id(_plain(obj)))
         if keys:
             docstring.extend(lines(keys))
 
