@@ -69,8 +69,8 @@ def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np
 
 @dataclass
 class Solution:
-    """The equilibrated flux of :func:`solve`. Heat flows and energies are for a unit temperature difference and
-    ``kappa`` = 1, in the mesh's length unit (W/K per W/(m K) for a mesh in metres).
+    """The equilibrated flux of :func:`solve`, for the unit temperature difference and ``kappa`` = 1: ``lower`` and
+    ``heat_flow`` are then ``K / kappa`` and ``P / kappa``, in the mesh's length unit (m for a mesh in metres).
 
     Parameters
     ----------

@@ -195,8 +195,8 @@ class Solution:
     Parameters
     ----------
     energy : float
-        ``u^T A u``: the upper bound of the conductance for a unit temperature difference and ``kappa`` = 1, in the
-        unit of the mesh's length (W/K per W/(m K) and per K for a mesh in metres).
+        ``u^T A u``: the upper bound of the conductance over ``kappa`` (``K / kappa``, for the unit temperature
+        difference), in the mesh's length unit (m for a mesh in metres).
     u : numpy.ndarray
         Temperature of every skeleton node (vertices, edges, faces; the interior nodes are condensed), for 1 K on
         the hot faces and 0 on the cold ones.
