@@ -338,6 +338,7 @@ class RaviartThomas:
 
     @functools.cached_property
     def traces(self) -> np.ndarray:
+        """The face moments ``int_F mu tau . n_out dS``, (4 n_f, m): face-basis function (rows) by field."""
         st, w = triangle_quadrature(2 * self.k + 2)
         mu = self.face_basis(st)                                   # (q, n_f)
         rows = []
@@ -348,6 +349,7 @@ class RaviartThomas:
 
     @functools.cached_property
     def mass(self) -> np.ndarray:
+        """``mass[i, j] = int tau_i tau_j^T`` (3, 3, m, m) on the reference tetrahedron."""
         x, w = tet_quadrature(2 * self.k + 2)
         v = self.values(x)
         return np.einsum("q,qia,qjb->ijab", w, v, v)

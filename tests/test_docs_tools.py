@@ -234,3 +234,18 @@ def test_every_public_parameter_is_described():
     geometry = [name for name in missing["fem_neck"] if name.startswith("fem_neck.geometry.")]
     assert [name for names in missing.values() for name in names if name not in geometry] == []
     assert len(geometry) <= GEOMETRY_UNDESCRIBED, geometry
+
+
+# Every public function, class, method and property has a docstring (its own, or the one of the method it overrides,
+# which autodoc shows), but in the pipe network's modules, being reworked when this check came: their count may only
+# fall.
+OWNED_ELSEWHERE = ("dem.network.",)
+OWNED_ELSEWHERE_UNDOCUMENTED = 6
+
+
+def test_every_public_object_has_a_docstring():
+    missing = [name for package in ("fem_neck", "dem", "sinterheat") for name in docstring_check.undocumented(package)]
+    elsewhere = [name for name in missing if name.startswith(OWNED_ELSEWHERE)]
+    assert [name for name in missing if name not in elsewhere] == []
+    assert len(elsewhere) <= OWNED_ELSEWHERE_UNDOCUMENTED, elsewhere
+
