@@ -395,7 +395,7 @@ class SequenceEstimate:
 
     @property
     def amplification(self) -> float:
-        """The factor from the last change to the error estimate: ``SAFETY / (rate - 1)``."""
+        """The factor ``SAFETY / (rate - 1)`` from the last change to the error estimate."""
         return SAFETY / (self.rate - 1.0)
 
 

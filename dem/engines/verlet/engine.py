@@ -134,7 +134,7 @@ class VerletEngine:
 
     @property
     def temperature_source(self) -> str:
-        """Where the particles' temperatures come from: ``schedule``, ``network`` or ``initial``."""
+        """The source of the particles' temperatures (``schedule``, ``network`` or ``initial``)."""
         if self.schedule is not None:
             return "schedule"
         return "network" if self.thermal is not None else "initial"
