@@ -26,7 +26,17 @@ T_LIST_MAX = 1000  # the summary lists the final temperatures for scenes up to t
 
 @dataclass
 class RunResult:
-    """``summary`` (JSON-ready), final temperatures ``T`` (input order) and the ``engine`` that ran."""
+    """What :func:`run` returns.
+
+    Parameters
+    ----------
+    summary : dict
+        The run's summary (JSON-ready; what ``summary.json`` holds).
+    T : numpy.ndarray
+        Final particle temperatures, in the scene's temperature unit (``[scene] temperature_unit``), in input order.
+    engine : object
+        The engine that ran (its ``name`` is the scene's engine).
+    """
 
     summary: dict
     T: np.ndarray
@@ -85,7 +95,21 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     that folder (refused if it holds a run, unless ``resume``: go on from its last checkpoint, or ``overwrite``: clear
     it first; :mod:`dem.output.folder`). Ctrl-C leaves the folder usable and resumable: the rows and snapshots written
     so far, the checkpoint of the last completed step, and ``summary.json`` marked ``"interrupted": true``.
-    ``progress``: a bar on stderr, and the run's position in the line an interrupt prints."""
+    ``progress``: a bar on stderr, and the run's position in the line an interrupt prints.
+
+    Parameters
+    ----------
+    scene : dem.scene.parse.Scene
+        The scene (:func:`dem.scene.parse.load_scene` reads one).
+    out : str or pathlib.Path, optional
+        The output folder; None writes nothing.
+    progress : bool
+        Draw a progress bar on stderr.
+    resume : bool
+        Go on from the last checkpoint of the run in ``out``.
+    overwrite : bool
+        Clear the run in ``out`` first.
+    """
     if out is None and (resume or overwrite):
         raise ValueError("--resume and --overwrite need --out (the folder of the run)")
     if launched() and scene.output.lammps_dump and world().Get_size() > 1:

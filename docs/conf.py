@@ -2,11 +2,12 @@
 
 Build (offline, warnings as errors): ``python -m sphinx -W -b html docs docs/_build`` after ``pip install '.[docs]'``.
 The pages are Markdown (MyST), so ``tests/test_console_blocks.py`` runs their console blocks as it runs the README's;
-the gallery is built by running every script of ``examples/`` (sphinx-gallery); the API reference is autodoc
-(napoleon) over the packages in ``api_packages``, and ``_ext/api_check.py`` fails the build when one of their public
-functions or classes is missing from it. The site reads offline: MathJax is served from the build's ``_static``
-(sphinx-mathjax-offline, in the docs extra), and ``_ext/site_check.py`` fails the build when a page loads anything
-from another host or links to a page or anchor that does not exist.
+the gallery is built by running every script of ``examples/`` (sphinx-gallery); the API reference is autodoc (napoleon)
+over the packages in ``api_packages``, and ``_ext/api_check.py`` fails the build when one of their public functions or
+classes is missing from it; an entry a gallery example uses shows that example (``_ext/gallery_links.py``). The site
+reads offline: MathJax is served from the build's ``_static`` (sphinx-mathjax-offline, in the docs extra), and
+``_ext/site_check.py`` fails the build when a page loads anything from another host or links to a page or anchor that
+does not exist.
 
 A build of the pages alone, without running the examples: ``python -m sphinx -D plot_gallery=0 -b html docs
 docs/_build`` (the gallery's pages then show the code without its output or figures).
@@ -17,7 +18,7 @@ import pathlib
 import sys
 
 DOCS = pathlib.Path(__file__).resolve().parent
-sys.path.insert(0, str(DOCS / "_ext"))  # the local extensions (api_check, gallery_order, scene_schema, site_check)
+sys.path.insert(0, str(DOCS / "_ext"))  # the local extensions (api_check, gallery_links, gallery_order, ...)
 logging.getLogger("skfem").setLevel(logging.WARNING)  # its INFO lines (each assembly) would flood the build log
 
 project = "sinterheat"
@@ -31,9 +32,11 @@ extensions = [
     "sphinx.ext.mathjax",
     "sphinx-mathjax-offline",  # MathJax 3 copied into _static/mathjax and loaded from there, not from a CDN
     "sphinx.ext.viewcode",
+    "sphinx.ext.intersphinx",
     "sphinx_gallery.gen_gallery",
     "sphinx_copybutton",
     "api_check",
+    "gallery_links",
     "scene_schema",
     "site_check",
 ]
@@ -48,11 +51,15 @@ myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 myst_dmath_double_inline = True
 
-# Every cross-reference must resolve (a broken one is a warning, so an error under -W). Names of other projects
-# (numpy, scipy, skfem ...) are not linked: the build is offline, without intersphinx.
+# Every cross-reference must resolve (a broken one is a warning, so an error under -W). SciPy's names link to its
+# site through the inventory committed in _intersphinx (read from the file: the build stays offline; it is the
+# inventory of SciPy 1.10.1's documentation, as Debian's python-scipy-doc ships it). NumPy publishes no inventory that
+# can be vendored here, so its names, and those of the other projects, are not linked.
+intersphinx_mapping = {"scipy": ("https://docs.scipy.org/doc/scipy/", str(DOCS / "_intersphinx" / "scipy-objects.inv"))}
 nitpicky = True
 nitpick_ignore_regex = [
-    (r"py:.*", r"(np|numpy|sp|scipy|skfem|meshio|pyvista|gmsh|argparse|pathlib|concurrent|typing|collections|io)\b.*"),
+    (r"py:.*", r"(np|numpy|sp|scipy|skfem|meshio|pyvista|gmsh|argparse|pathlib|concurrent|typing|collections|io|"
+               r"distributed)\b.*"),
     (r"py:.*", r"(optional|callable|array|array_like|array-like|ndarray|sequence|iterable|mapping|path|object)"),
 ]
 
@@ -80,6 +87,10 @@ sphinx_gallery_conf = {
     "show_signature": False,
     "only_warn_on_example_error": False,  # an example that raises fails the build
     "min_reported_time": 0,
+    # which functions and classes of these packages each example uses: "Examples using this" under their API entries
+    # (_ext/gallery_links.py)
+    "doc_module": ("fem_neck", "dem", "sinterheat"),
+    "backreferences_dir": "gen_modules/backreferences",
 }
 
 html_theme = "furo"

@@ -390,10 +390,12 @@ class SequenceEstimate:
 
     @property
     def relative(self) -> float:
+        """The error estimate over the value's magnitude (dimensionless; inf for a zero value)."""
         return self.error / abs(self.value) if self.value else math.inf
 
     @property
     def amplification(self) -> float:
+        """The factor ``SAFETY / (rate - 1)`` from the last change to the error estimate."""
         return SAFETY / (self.rate - 1.0)
 
 

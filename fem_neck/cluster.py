@@ -46,8 +46,20 @@ _EXTEND = 0.25  # neck cylinders reach delta = _EXTEND * z into each sphere (hid
 
 @dataclass(frozen=True)
 class Terminal:
-    """A particle held at temperature ``T``: ``kind`` is ``"plane"`` (one-bond particle cut at its centre plane)
-    or ``"core"`` (ball of radius ``rho * r`` at the centre removed, its surface held at ``T``)."""
+    """A particle held at a fixed temperature (module docstring).
+
+    Parameters
+    ----------
+    particle : int
+        Index of the particle in the cluster.
+    T : float
+        Its temperature, K.
+    kind : str
+        ``"plane"`` (a one-bond particle cut at its centre plane, the cut disk held at ``T``) or ``"core"`` (a ball
+        of radius ``rho r`` at the centre removed, its surface held at ``T``).
+    rho : float
+        Radius of the core ball over the particle radius (dimensionless, ``"core"`` only).
+    """
 
     particle: int
     T: float
@@ -57,7 +69,17 @@ class Terminal:
 
 @dataclass(frozen=True)
 class Cluster:
-    """Spheres ``centres`` (n, 3) and ``radii`` (n,) in metres joined by ``bonds`` (m, 2) of particle indices."""
+    """Spheres joined by sintered necks; ``ValueError`` on inconsistent shapes or indices.
+
+    Parameters
+    ----------
+    centres : array_like
+        Sphere centres ``(n, 3)``, m.
+    radii : array_like
+        Sphere radii ``(n,)``, m, each finite and > 0.
+    bonds : array_like
+        Bonded pairs ``(m, 2)`` of distinct particle indices; each pair's overlap sets its neck.
+    """
 
     centres: np.ndarray
     radii: np.ndarray
@@ -77,6 +99,7 @@ class Cluster:
 
     @property
     def n(self) -> int:
+        """Number of particles."""
         return len(self.radii)
 
     def overlaps(self) -> np.ndarray:
@@ -86,7 +109,14 @@ class Cluster:
 
     def necks(self, method: str = "newton"):
         """:class:`fem_neck.geometry.NeckGeometry` of every bond (raises ``ValueError`` outside the neck model's
-        range)."""
+        range).
+
+        Parameters
+        ----------
+        method : str
+            Neck model: ``"newton"`` (volume-conserving, default), ``"first"`` or ``"coble"``
+            (:func:`fem_neck.geometry.neck_radius`).
+        """
         i, j = self.bonds.T
         return neck_geometry(self.radii[i], self.radii[j], self.overlaps(), method=method)
 
@@ -98,7 +128,13 @@ class Cluster:
 
     def corner_exponent(self, method: str = "newton") -> float:
         """The smallest singular exponent of the re-entrant neck edges (each neck meets two spheres, each side with
-        ``lambda = pi / (pi + arccos(a / r_k))``, :func:`fem_neck.accuracy.corner_exponent`); 1 without bonds."""
+        ``lambda = pi / (pi + arccos(a / r_k))``, :func:`fem_neck.accuracy.corner_exponent`); 1 without bonds.
+
+        Parameters
+        ----------
+        method : str
+            Neck model (as in :meth:`necks`).
+        """
         from fem_neck.accuracy import corner_exponent
 
         if not len(self.bonds):
@@ -117,6 +153,15 @@ class Cluster:
         Bonded pairs must overlap within the neck model's range; unbonded spheres must stay more than ``gap``
         (m) apart; two neck circles on one sphere (angular radius ``arcsin(a/r)`` each) must stay more than
         ``angle_margin`` (radians) apart.
+
+        Parameters
+        ----------
+        method : str
+            Neck model (as in :meth:`necks`).
+        gap : float
+            Smallest distance between the surfaces of unbonded spheres, m.
+        angle_margin : float
+            Smallest angle between two neck circles on one sphere, rad.
         """
         h = self.overlaps()
         i, j = self.bonds.T
@@ -151,12 +196,29 @@ class Cluster:
 
 @dataclass
 class ClusterMesh:
-    """A tetrahedral mesh of a cluster with boundaries ``"hot"`` and ``"cold"``.
+    """A tetrahedral mesh of a cluster with boundaries ``"hot"`` and ``"cold"`` (:func:`build_cluster_mesh`).
 
-    ``particle`` gives the owning particle of every element (at its centroid) and ``cut`` marks the elements whose
-    vertices belong to different particles (those that a neck's split plane or a cap plane passes through);
-    ``volume_exact`` is the solid's exact volume and ``volume_cad`` the OCC volume of the built solid (they agree
-    to the CAD kernel's tolerance); ``method``: the neck model.
+    Parameters
+    ----------
+    cluster : Cluster
+        The cluster meshed, m.
+    terminals : tuple of Terminal
+        Its terminals.
+    mesh : skfem.MeshTet or skfem.MeshTet2
+        The mesh, m, with boundaries ``"hot"`` and ``"cold"``.
+    particle : numpy.ndarray
+        The owning particle of every element (at its centroid).
+    volume_exact : float
+        The solid's exact volume, m^3.
+    volume_cad : float
+        The OCC volume of the built solid, m^3 (equal to ``volume_exact`` to the CAD kernel's tolerance).
+    neck_a : numpy.ndarray
+        Neck radius of every bond, m.
+    cut : numpy.ndarray, optional
+        Mask of the elements whose vertices belong to different particles (those that a neck's split plane or a
+        cap plane passes through).
+    method : str
+        The neck model (:func:`fem_neck.geometry.neck_geometry`).
     """
 
     cluster: Cluster
@@ -172,7 +234,17 @@ class ClusterMesh:
 
 def add_neck_cylinders(occ, cluster: Cluster, geo) -> list:
     """One OCC cylinder per bond: the neck of radius ``a`` from ``z_i`` to ``z_i + h_n`` along the bond, extended by
-    ``_EXTEND * z`` into both spheres (hidden inside them) so that its side meets each sphere transversally."""
+    ``_EXTEND * z`` into both spheres (hidden inside them) so that its side meets each sphere transversally.
+
+    Parameters
+    ----------
+    occ : object
+        ``gmsh.model.occ`` of an open gmsh session.
+    cluster : Cluster
+        The cluster (in the session's length unit).
+    geo : fem_neck.geometry.NeckGeometry
+        Its necks (:meth:`Cluster.necks`).
+    """
     e = cluster.directions()
     c = cluster.centres
     bi = cluster.bonds[:, 0]
@@ -195,6 +267,30 @@ def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, si
     :class:`fem_neck.lattice.UnionNecks`) has one circle, and ``size_neck a`` there. ``every_bond``: each bond must
     have its two circles on the boundary (else ``RuntimeError``); otherwise
     bonds without any are skipped (a neck cut away by a cell face). Returns the Threshold field tags.
+
+    Parameters
+    ----------
+    gmsh : object
+        The ``gmsh`` module, in an open session with the solid built.
+    cluster : Cluster
+        The cluster (in the session's length unit).
+    geo : fem_neck.geometry.NeckGeometry
+        Its necks (:meth:`Cluster.necks`).
+    surfaces : sequence of int
+        Tags of the boundary surfaces searched for neck circles.
+    size_neck : float
+        Element size at a neck circle over its neck radius ``a`` (dimensionless).
+    size_far : float
+        Element size at distance ``2 a`` over the bond's smaller radius (dimensionless).
+    neck_cells : float
+        Elements along the neck length ``h_n`` at least.
+    tol : float
+        Distance within which a curve's sample points count as on a neck circle, in the session's length unit.
+    every_bond : bool
+        Require both circles of every bond on the boundary.
+    grading : float, optional
+        Growth of the size per unit distance from the circle (dimensionless); default the linear ramp to
+        ``size_far`` at ``2 a``.
     """
     c, r = cluster.centres, cluster.radii
     bi, bj = cluster.bonds.T
@@ -241,7 +337,17 @@ def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, si
 def mesh_tetrahedra(gmsh, curvature: int, size_max: float) -> None:
     """Generate the 3D mesh from the background size field: ``curvature`` elements per 2 pi of surface curvature,
     at most ``size_max``; one thread and fixed algorithms (Frontal-Delaunay surfaces, Delaunay volume), so the same
-    input gives the same mesh."""
+    input gives the same mesh.
+
+    Parameters
+    ----------
+    gmsh : object
+        The ``gmsh`` module, in an open session with the background size field set.
+    curvature : int
+        Elements per 2 pi of surface curvature.
+    size_max : float
+        Largest element size, in the session's length unit.
+    """
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", curvature)
@@ -254,7 +360,15 @@ def mesh_tetrahedra(gmsh, curvature: int, size_max: float) -> None:
 
 def tetrahedra(gmsh, vol_tag: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(points (N, 3), tets (M, 4) indices into points, index)`` of the meshed volume ``vol_tag``; ``index`` maps
-    gmsh node tags to rows of ``points``."""
+    gmsh node tags to rows of ``points``.
+
+    Parameters
+    ----------
+    gmsh : object
+        The ``gmsh`` module, in an open session with the volume meshed.
+    vol_tag : int
+        Tag of the meshed volume.
+    """
     node_tags, coords, _ = gmsh.model.mesh.getNodes()
     points = np.asarray(coords).reshape(-1, 3)
     index = np.full(int(node_tags.max()) + 1, -1, dtype=np.int64)
@@ -308,6 +422,25 @@ def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size
     :func:`curved_mesh` (exact boundary edge midpoints; use with ``order=2``). Deterministic (one thread, fixed
     algorithm). Terminals: a sequence of :class:`Terminal`; only the hottest and coldest boundaries are named
     (``"hot"``, ``"cold"``), intermediate temperatures are not supported.
+
+    Parameters
+    ----------
+    cluster : Cluster
+        The cluster, m (validated with ``method``).
+    terminals : sequence of Terminal
+        At least two, of at least two temperatures.
+    size_neck : float
+        Element size at the neck circles over the neck radius (dimensionless, > 0).
+    size_far : float
+        Element size at distance ``2 a`` over the bond's smaller radius (dimensionless, > 0).
+    curvature : int
+        gmsh's elements per 2 pi of surface curvature.
+    method : str
+        Neck model (as in :meth:`Cluster.necks`).
+    curved : bool
+        Return the quadratic mesh of :func:`curved_mesh` (for ``order=2``).
+    neck_cells : float
+        Elements along the neck length at least (> 0).
     """
     from skfem import MeshTet
 
@@ -422,6 +555,20 @@ def curved_mesh(mesh, cluster: Cluster, geo, terminals, tol: float | None = None
     midpoints are moved onto the exact surfaces -- the spheres, the neck cylinders, the core balls and the neck
     circles where sphere and cylinder meet. Straight-sided tetrahedra inscribe the spheres (volume and ``K`` too
     small); with P2 on this mesh the geometric error falls from O(h^2) to O(h^3) or better.
+
+    Parameters
+    ----------
+    mesh : skfem.MeshTet
+        The first-order mesh (in the unit of ``cluster``).
+    cluster : Cluster
+        The cluster it meshes.
+    geo : fem_neck.geometry.NeckGeometry
+        Its necks (:meth:`Cluster.necks`).
+    terminals : sequence of Terminal
+        Its terminals (their cut planes and core balls).
+    tol : float, optional
+        Distance within which a point counts as on a surface, in the mesh's length unit; default ``1e-7`` times
+        the largest radius.
     """
     from skfem import MeshTet2
 
@@ -501,6 +648,15 @@ def assign_particles(cluster: Cluster, geo, x: np.ndarray) -> np.ndarray:
     In a neck cylinder of bond ``(i, j)``, the part of length ``V_cap,i / (pi a^2)`` next to ``i`` belongs to ``i``,
     the rest to ``j``; elsewhere the point belongs to the sphere that contains it on the near side of all of that
     sphere's cap planes (its truncated sphere). Each particle thus owns the volume ``4/3 pi r^3``.
+
+    Parameters
+    ----------
+    cluster : Cluster
+        The cluster, m.
+    geo : fem_neck.geometry.NeckGeometry
+        Its necks (:meth:`Cluster.necks`).
+    x : numpy.ndarray
+        Points ``(N, 3)`` of the solid, m.
     """
     c, r = cluster.centres, cluster.radii
     bi, bj = cluster.bonds.T
@@ -528,8 +684,25 @@ def assign_particles(cluster: Cluster, geo, x: np.ndarray) -> np.ndarray:
 
 @dataclass
 class ClusterSolution:
-    """Steady 3D conduction result: ``K`` (W/K) = ``Q / (T_hot - T_cold)``; ``particle_T`` the per-particle mean
-    temperatures; ``particle_volume`` the mesh volume each particle owns; ``dofs``; ``u`` and ``basis`` the field."""
+    """Steady 3D conduction result (:func:`solve_cluster`).
+
+    Parameters
+    ----------
+    K : float
+        Conductance ``Q / (T_hot - T_cold)``, W/K.
+    Q : float
+        Heat flow through the hot terminal (the reaction at its dofs), W.
+    particle_T : numpy.ndarray
+        Mean temperature of every particle over the volume it owns, K.
+    particle_volume : numpy.ndarray
+        The mesh volume each particle owns, m^3.
+    dofs : int
+        Unknowns of the FE space.
+    u : numpy.ndarray
+        Temperature at every dof, K.
+    basis : skfem.Basis
+        The FE basis ``u`` lives on.
+    """
 
     K: float
     Q: float
@@ -547,6 +720,15 @@ def particle_means(basis, u: np.ndarray, cmesh: ClusterMesh) -> tuple[np.ndarray
     planes: the necks' split planes and the spheres' cap planes) and counts whole; an element that such a plane
     cuts is divided at its quadrature points (:func:`assign_particles`), so the shares are exact to quadrature
     instead of to whole elements (which would leave an O(h) error that no mesh sequence estimate follows).
+
+    Parameters
+    ----------
+    basis : skfem.Basis
+        The FE basis of ``u`` on ``cmesh.mesh``.
+    u : numpy.ndarray
+        Temperature at every dof, K.
+    cmesh : ClusterMesh
+        The mesh with its particle ownership.
     """
     value = np.asarray(basis.interpolate(u))
     dx = basis.dx
@@ -566,6 +748,17 @@ def solve_cluster(cmesh: ClusterMesh, kappa: float = 1.0, order: int = 2, rtol: 
 
     P1 or P2 tetrahedra; the linear system is solved by conjugate gradients with a smoothed-aggregation AMG
     preconditioner (pyamg) to relative residual ``rtol``. ``Q`` is the reaction at the hot dofs (design notes).
+
+    Parameters
+    ----------
+    cmesh : ClusterMesh
+        The meshed cluster.
+    kappa : float
+        Thermal conductivity, W/(m K), > 0.
+    order : int
+        Element order, 1 or 2.
+    rtol : float
+        Relative residual of the AMG-preconditioned CG (dimensionless).
     """
     import pyamg
     from skfem import Basis, ElementTetP1, ElementTetP2, condense
@@ -598,11 +791,26 @@ def solve_cluster(cmesh: ClusterMesh, kappa: float = 1.0, order: int = 2, rtol: 
 class ClusterResult:
     """A cluster solved on a mesh sequence (:func:`cluster_conductance`); the values are the finest level's.
 
-    ``K`` (W/K) with ``error_estimate`` (relative, :func:`fem_neck.accuracy.mesh_sequence_estimate`; ``None`` with
-    one level); ``particle_T`` with ``T_error_estimate`` (absolute, same unit as the terminal temperatures: the last
-    change of the particle means times the estimate's amplification); ``levels``: per level the size factor,
-    ``dofs``, ``K`` and seconds; ``sequence``: the :class:`fem_neck.accuracy.SequenceEstimate` (``None`` with one
-    level); ``cmesh`` and ``solution``: the finest level's mesh and field.
+    Parameters
+    ----------
+    K : float
+        Conductance, W/K.
+    error_estimate : float or None
+        Relative error estimate of ``K`` (dimensionless, :func:`fem_neck.accuracy.mesh_sequence_estimate`; None
+        with one level).
+    particle_T : numpy.ndarray
+        Mean temperature of every particle, K.
+    T_error_estimate : float or None
+        Absolute error estimate of ``particle_T``, K: the last change of the particle means times the estimate's
+        amplification (None with one level).
+    levels : list of dict
+        Per level the ``size_factor``, ``dofs``, ``K`` (W/K) and ``seconds`` (wall time, s).
+    sequence : fem_neck.accuracy.SequenceEstimate or None
+        The estimate's details (None with one level).
+    cmesh : ClusterMesh
+        The finest level's mesh.
+    solution : ClusterSolution
+        The finest level's field.
     """
 
     K: float
@@ -626,6 +834,27 @@ def cluster_conductance(cluster: Cluster, terminals, kappa: float = 1.0, size_ne
     levels refine one mesh pattern and the error falls at least at the neck edges' corner rate. The estimate is
     :func:`fem_neck.accuracy.mesh_sequence_estimate` with the cluster's smallest corner exponent. Three levels cost
     about 1.5 times the finest alone (dofs fall ~3x per level).
+
+    Parameters
+    ----------
+    cluster : Cluster
+        The cluster, m.
+    terminals : sequence of Terminal
+        At least two, of at least two temperatures.
+    kappa : float
+        Thermal conductivity, W/(m K), > 0.
+    size_neck : float
+        The finest level's element size at the neck circles over the neck radius (dimensionless).
+    size_far : float
+        The finest level's element size at distance ``2 a`` over the bond's smaller radius (dimensionless).
+    levels : int
+        Meshes of the sequence: 1, 2 or 3.
+    curvature : float, optional
+        The finest level's elements per 2 pi of surface curvature; default ``4 / size_far``.
+    neck_cells : float
+        The finest level's elements along the neck length at least.
+    method : str
+        Neck model (as in :meth:`Cluster.necks`).
     """
     import time
 
@@ -656,7 +885,17 @@ def cluster_conductance(cluster: Cluster, terminals, kappa: float = 1.0, size_ne
 
 
 def write_vtu(cmesh: ClusterMesh, sol: ClusterSolution, path) -> None:
-    """Write the temperature (vertex values) and the owning particle per element to a VTU file for ParaView."""
+    """Write the temperature (vertex values) and the owning particle per element to a VTU file for ParaView.
+
+    Parameters
+    ----------
+    cmesh : ClusterMesh
+        The mesh solved on.
+    sol : ClusterSolution
+        The solution on it.
+    path : str or pathlib.Path
+        The ``.vtu`` file to write.
+    """
     import meshio
 
     mesh = cmesh.mesh
@@ -667,7 +906,13 @@ def write_vtu(cmesh: ClusterMesh, sol: ClusterSolution, path) -> None:
 
 def load_cluster_json(data: dict) -> tuple[Cluster, list]:
     """``{"centres": [[x, y, z], ...], "radii": [...], "bonds": [[i, j], ...], "terminals": [{"particle": k,
-    "T": ..., "kind": "plane"|"core", "rho": 0.25}, ...]}`` (metres, kelvin) -> (Cluster, terminals)."""
+    "T": ..., "kind": "plane"|"core", "rho": 0.25}, ...]}`` (metres, kelvin) -> (Cluster, terminals).
+
+    Parameters
+    ----------
+    data : dict
+        The parsed JSON document (above).
+    """
     try:
         cluster = Cluster(np.asarray(data["centres"], dtype=float), np.asarray(data["radii"], dtype=float),
                           np.asarray(data["bonds"], dtype=int))

@@ -1,14 +1,19 @@
-"""Steady axisymmetric heat conduction through sintered necks (scikit-fem), and the conductances of Rojek 2022.
+r"""Steady axisymmetric heat conduction through sintered necks (scikit-fem), and the conductances of Rojek 2022.
 
 Physics. In the meridian half-plane (``x`` radial, ``y`` axial) the steady conduction equation of a body of
-revolution is ``div(kappa x grad T) = 0``; its weak form is the Laplacian weighted by the radial coordinate ``x``
-(``w.x[0]``), and every heat flow is ``2 pi`` times the meridian integral. The temperature is fixed on the two end
-disks (``T = 1`` on ``top``, ``0`` on ``bottom``), every other surface is insulated, so with ``Delta T = 1``
+revolution is :math:`\nabla \cdot (\kappa x \nabla T) = 0`; its weak form is the Laplacian weighted by the radial
+coordinate ``x`` (``w.x[0]``), and every heat flow is :math:`2 \pi` times the meridian integral. The temperature is
+fixed on the two end disks (``T = 1`` on ``top``, ``0`` on ``bottom``), every other surface is insulated, so with
+:math:`\Delta T = 1`
 
-    K = Q / Delta T = 2 pi kappa sum_{i in top} (A u)_i          (the reaction at the Dirichlet dofs)
-      = 2 pi kappa u^T A u                                       (the energy; identical to round-off),
+.. math::
 
-which converges at twice the rate of the boundary flux ``-kappa dT/dn`` (the tests cross-check both).
+    K = \frac{Q}{\Delta T} &= 2 \pi \kappa \sum_{i \in \mathrm{top}} (A u)_i
+        \quad \text{(the reaction at the Dirichlet dofs)} \\
+      &= 2 \pi \kappa \, u^T A u \quad \text{(the energy; identical to round-off)},
+
+which converges at twice the rate of the boundary flux :math:`-\kappa \, \partial T / \partial n` (the tests
+cross-check both).
 Lengths are normalised by the largest radius before meshing, and ``K`` scales back linearly with length.
 
 Accuracy: see :mod:`fem_neck.accuracy`. Elements are Lagrange P1-P4 on the isoparametric (quadratic) version of the

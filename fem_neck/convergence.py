@@ -36,13 +36,30 @@ REFERENCE_RTOL = 1e-9  # the hp solve the errors are measured against
 
 
 def aitken(k1: float, k2: float, k3: float) -> float:
-    """Limit of a sequence converging geometrically: ``k3 - (k3 - k2)^2 / ((k3 - k2) - (k2 - k1))``."""
+    """Limit of a sequence converging geometrically: ``k3 - (k3 - k2)^2 / ((k3 - k2) - (k2 - k1))``.
+
+    Parameters
+    ----------
+    k1, k2, k3 : float
+        Three successive values of the sequence, coarsest first (here ``K/K_cyl`` of the three finest graded P2 levels,
+        dimensionless). Returns ``k3`` when the second difference vanishes.
+    """
     denominator = (k3 - k2) - (k2 - k1)
     return k3 if denominator == 0.0 else k3 - (k3 - k2) ** 2 / denominator
 
 
 def observed_order(dofs, values, reference: float) -> float:
-    """Least-squares slope ``q`` of ``log|K - K_ref|`` against ``-log dofs`` (NaN from fewer than two errors)."""
+    """Least-squares slope ``q`` of ``log|K - K_ref|`` against ``-log dofs`` (NaN from fewer than two errors).
+
+    Parameters
+    ----------
+    dofs : array_like of int
+        Unknowns of each level.
+    values : array_like of float
+        The quantity at each level (here ``K/K_cyl``, dimensionless).
+    reference : float
+        The value the errors are measured against (here the hp solve to rtol 1e-9), in the unit of ``values``.
+    """
     err = np.abs(np.asarray(values) - reference)
     keep = err > 0
     if keep.sum() < 2:
@@ -51,7 +68,15 @@ def observed_order(dofs, values, reference: float) -> float:
 
 
 def error_ratio_per_order(values, reference: float) -> float:
-    """Median factor by which the error falls from one order to the next (above the round-off floor 1e-12)."""
+    """Median factor by which the error falls from one order to the next (above the round-off floor 1e-12).
+
+    Parameters
+    ----------
+    values : sequence of float
+        The quantity at successive orders, lowest first (here ``K/K_cyl`` of the hp series, dimensionless).
+    reference : float
+        The value the relative errors are measured against, in the unit of ``values`` (non-zero).
+    """
     err = np.array([abs(v - reference) / reference for v in values])
     keep = (err[:-1] > 1e-12) & (err[1:] > 1e-12)
     return float(np.median(err[:-1][keep] / err[1:][keep])) if keep.any() else float("nan")
@@ -63,7 +88,15 @@ def levels_count() -> int:
 
 
 def mesh_levels(a_over_r: float, progress=None) -> list[dict]:
-    """One row per solve of every series (module docstring); ``progress.update()`` after each, if given."""
+    """One row per solve of every series (module docstring); ``progress.update()`` after each, if given.
+
+    Parameters
+    ----------
+    a_over_r : float
+        Neck radius over sphere radius ``a/r`` of the semisphere (dimensionless, in ``(0, 1)``).
+    progress : object, optional
+        Anything with an ``update()`` method (a tqdm bar), called once after each solve.
+    """
     from fem_neck import conduction, hpmesh, shapes, spectral
     from sinterheat.interrupt import where
 
@@ -99,7 +132,19 @@ def mesh_levels(a_over_r: float, progress=None) -> list[dict]:
 
 def study(a_over_r: float, out=None, *, progress: bool = True, title: str | None = None) -> dict:
     """The whole study at ``a_over_r``: every level, the Aitken limit, observed orders, the hp error ratio and the
-    reference. With ``out``, writes ``converge.png`` and ``converge.json`` there (``plot`` names the PNG)."""
+    reference. With ``out``, writes ``converge.png`` and ``converge.json`` there (``plot`` names the PNG).
+
+    Parameters
+    ----------
+    a_over_r : float
+        Neck radius over sphere radius ``a/r`` of the semisphere (dimensionless, in ``(0, 1)``).
+    out : str or pathlib.Path, optional
+        Folder for ``converge.png`` and ``converge.json`` (created if missing); None writes nothing.
+    progress : bool
+        Show a progress bar on stderr (tqdm; off when stderr is not a terminal).
+    title : str, optional
+        Title of the plot's left panel; default ``semisphere a/r=...``.
+    """
     from tqdm import tqdm
 
     from fem_neck import conduction
@@ -136,7 +181,19 @@ def study(a_over_r: float, out=None, *, progress: bool = True, title: str | None
 
 
 def plot(levels, reference: float, path, title: str) -> None:
-    """K/K_cyl against elements across the neck, and the relative error against dofs, per series."""
+    """K/K_cyl against elements across the neck, and the relative error against dofs, per series.
+
+    Parameters
+    ----------
+    levels : list of dict
+        The rows of :func:`mesh_levels`.
+    reference : float
+        ``K/K_cyl`` the errors are measured against (dimensionless), drawn as a horizontal line.
+    path : str or pathlib.Path
+        The PNG file to write.
+    title : str
+        Title of the left panel.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 

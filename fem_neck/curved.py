@@ -41,8 +41,19 @@ class FoldedMesh(ValueError):
 
 @dataclass(frozen=True)
 class Surface:
-    """An analytic surface: a sphere (``centre``, ``radius``), a cylinder (a point ``centre`` on its axis, unit
-    ``axis``, ``radius``) or a plane (unit normal ``axis``, offset ``radius``: ``axis . x = radius``)."""
+    """An analytic surface: a sphere, a cylinder or a plane. Lengths in the mesh's unit.
+
+    Parameters
+    ----------
+    kind : str
+        ``SPHERE``, ``CYLINDER`` or ``PLANE``.
+    centre : numpy.ndarray
+        ``(3,)``: the sphere's centre, a point on the cylinder's axis (unused for a plane).
+    axis : numpy.ndarray
+        ``(3,)``: the cylinder's unit axis, the plane's unit normal (unused for a sphere).
+    radius : float
+        The sphere's or cylinder's radius; the plane's offset (``axis . x = radius``).
+    """
 
     kind: str
     centre: np.ndarray
@@ -50,7 +61,13 @@ class Surface:
     radius: float
 
     def distance(self, x: np.ndarray) -> np.ndarray:
-        """Distance of points ``(..., 3)`` from the surface."""
+        """Distance of points ``(..., 3)`` from the surface.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            Points ``(..., 3)``, in the mesh's length unit.
+        """
         if self.kind == SPHERE:
             return np.abs(np.linalg.norm(x - self.centre, axis=-1) - self.radius)
         if self.kind == CYLINDER:
@@ -62,7 +79,15 @@ class Surface:
 
 def distinct(surfaces: list, tol: float) -> list:
     """The surfaces without repeats: two collinear necks of one sphere (opposite bonds of a lattice) lie on one
-    cylinder, which must be one surface for the curves between its patches to be found."""
+    cylinder, which must be one surface for the curves between its patches to be found.
+
+    Parameters
+    ----------
+    surfaces : list of Surface
+        The surfaces, possibly with repeats.
+    tol : float
+        Largest difference of centres, axes and radii of one surface, in the mesh's length unit.
+    """
     out = []
     for s in surfaces:
         if s.kind == CYLINDER:
@@ -78,15 +103,44 @@ def distinct(surfaces: list, tol: float) -> list:
 
 
 def sphere(centre, radius) -> Surface:
+    """A sphere :class:`Surface`.
+
+    Parameters
+    ----------
+    centre : array_like
+        ``(3,)``: its centre, in the mesh's length unit.
+    radius : float
+        Its radius, in the mesh's length unit.
+    """
     return Surface(SPHERE, np.asarray(centre, dtype=float), np.zeros(3), float(radius))
 
 
 def cylinder(point, axis, radius) -> Surface:
+    """A cylinder :class:`Surface`.
+
+    Parameters
+    ----------
+    point : array_like
+        ``(3,)``: a point on its axis, in the mesh's length unit.
+    axis : array_like
+        ``(3,)``: the axis direction (any length; normalised).
+    radius : float
+        Its radius, in the mesh's length unit.
+    """
     axis = np.asarray(axis, dtype=float)
     return Surface(CYLINDER, np.asarray(point, dtype=float), axis / np.linalg.norm(axis), float(radius))
 
 
 def plane(normal, offset) -> Surface:
+    """The plane :class:`Surface` ``normal . x = offset``.
+
+    Parameters
+    ----------
+    normal : array_like
+        ``(3,)``: a normal (any length; the plane is normalised with it).
+    offset : float
+        The right-hand side, in the mesh's length unit times the length of ``normal``.
+    """
     normal = np.asarray(normal, dtype=float)
     norm = np.linalg.norm(normal)
     return Surface(PLANE, np.zeros(3), normal / norm, float(offset) / norm)
@@ -94,8 +148,23 @@ def plane(normal, offset) -> Surface:
 
 @dataclass
 class Projectors:
-    """Rows of projections onto surfaces and curves: ``kind`` (P_*), ``c`` (centre or axis point), ``e`` (axis or
-    circle normal), ``r`` (radius), ``n``, ``d`` (the cutting plane ``n . x = d`` of an ellipse)."""
+    """Rows of projections onto surfaces and curves (one row per projector; lengths in the mesh's unit).
+
+    Parameters
+    ----------
+    kind : numpy.ndarray
+        Kind of every row, one of the ``P_*`` codes (sphere, cylinder, circle, ellipse).
+    c : numpy.ndarray
+        ``(R, 3)``: centre (sphere, circle) or a point on the axis (cylinder, ellipse).
+    e : numpy.ndarray
+        ``(R, 3)``: unit axis (cylinder, ellipse) or the circle's unit normal; zero for a sphere.
+    r : numpy.ndarray
+        ``(R,)``: radius.
+    n : numpy.ndarray
+        ``(R, 3)``: unit normal of an ellipse's cutting plane ``n . x = d`` (zero otherwise).
+    d : numpy.ndarray
+        ``(R,)``: offset of that plane.
+    """
 
     kind: np.ndarray
     c: np.ndarray
@@ -106,9 +175,27 @@ class Projectors:
 
     @classmethod
     def empty(cls) -> "Projectors":
+        """No rows."""
         return cls(np.zeros(0, int), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3)), np.zeros(0))
 
     def append(self, kind, c, e, r, n=np.zeros(3), d=0.0) -> int:
+        """Add a row; return its index. Lengths in the mesh's unit.
+
+        Parameters
+        ----------
+        kind : int
+            One of the ``P_*`` codes.
+        c : array_like
+            ``(3,)``: centre or a point on the axis.
+        e : array_like
+            ``(3,)``: unit axis or circle normal.
+        r : float
+            Radius.
+        n : array_like
+            ``(3,)``: unit normal of an ellipse's cutting plane.
+        d : float
+            Offset of that plane.
+        """
         self.kind = np.append(self.kind, kind)
         self.c = np.vstack([self.c, c])
         self.e = np.vstack([self.e, e])
@@ -118,7 +205,15 @@ class Projectors:
         return len(self.kind) - 1
 
     def project(self, row: int, y: np.ndarray) -> np.ndarray:
-        """The projection of the point ``y`` by projector ``row``."""
+        """The projection of the point ``y`` by projector ``row``.
+
+        Parameters
+        ----------
+        row : int
+            The projector.
+        y : numpy.ndarray
+            The point ``(3,)``, in the mesh's length unit.
+        """
         out, jac = np.empty(3), np.empty((3, 3))
         _project(self.kind[row], self.c[row], self.e[row], self.r[row], self.n[row], self.d[row],
                  np.asarray(y, dtype=float), out, jac)
@@ -165,12 +260,38 @@ def _curve_projector(proj: Projectors, s1: Surface, s2: Surface, on: np.ndarray,
 
 @dataclass
 class CurvedMesh:
-    """A tetrahedral mesh whose boundary lies exactly on analytic surfaces (module docstring).
+    """A tetrahedral mesh whose boundary lies exactly on analytic surfaces (module docstring); :func:`build` makes
+    one. ``curved`` lists the elements with any curved edge.
 
-    ``points (N, 3)``, ``tets (M, 4)`` (vertices ascending), ``edges (NE, 2)``, ``faces (NF, 3)`` (ascending),
-    ``t2e (M, 6)`` and ``t2f (M, 4)`` (local edges ``fem_neck.simplex.EDGES``, face ``l`` opposite vertex
-    ``l``), ``boundary_faces`` with their ``face_surface`` index into ``surfaces``; ``edge_projector (M, 6)`` and
-    ``face_projector (M, 4)``: rows of ``projectors`` (-1: straight); ``curved``: elements with any curved edge."""
+    Parameters
+    ----------
+    points : numpy.ndarray
+        Vertex coordinates ``(N, 3)``, in the body's length unit.
+    tets : numpy.ndarray
+        Vertex indices ``(M, 4)`` of every tetrahedron, ascending.
+    edges : numpy.ndarray
+        Vertex pairs ``(NE, 2)`` of the edges, ascending.
+    faces : numpy.ndarray
+        Vertex triples ``(NF, 3)`` of the faces, ascending.
+    t2e : numpy.ndarray
+        ``(M, 6)``: the edge of each local edge (in the order of ``fem_neck.simplex.EDGES``).
+    t2f : numpy.ndarray
+        ``(M, 4)``: the face of each local face (face ``l`` opposite vertex ``l``).
+    boundary_faces : numpy.ndarray
+        Indices into ``faces`` of the boundary faces.
+    face_surface : numpy.ndarray
+        Index into ``surfaces`` of each boundary face.
+    surfaces : list of Surface
+        The analytic surfaces of the boundary.
+    projectors : Projectors
+        The projections onto the surfaces and the curves where they meet.
+    edge_projector : numpy.ndarray
+        ``(M, 6)``: row of ``projectors`` of each local edge (-1: straight).
+    face_projector : numpy.ndarray
+        ``(M, 4)``: row of ``projectors`` of each local face (-1: straight).
+    kept : tuple, optional
+        ``(xi, J)``: reference points and the Jacobians of every curved element there (:meth:`keep_jacobians`).
+    """
 
     points: np.ndarray
     tets: np.ndarray
@@ -188,10 +309,12 @@ class CurvedMesh:
 
     @property
     def is_curved(self) -> np.ndarray:
+        """``(M,)`` mask of the elements with any curved edge."""
         return np.any(self.edge_projector >= 0, axis=1)
 
     @property
     def curved(self) -> np.ndarray:
+        """Indices of the elements with any curved edge."""
         return np.flatnonzero(self.is_curved)
 
     def face_sides(self) -> np.ndarray:
@@ -206,13 +329,27 @@ class CurvedMesh:
         return first.reshape(self.t2f.shape)
 
     def affine_jacobians(self, elements: np.ndarray | None = None) -> np.ndarray:
-        """``J (E, 3, 3)`` of the straight ``elements`` (default all; columns ``v_i - v_0``)."""
+        """``J (E, 3, 3)`` of the straight ``elements`` (default all; columns ``v_i - v_0``).
+
+        Parameters
+        ----------
+        elements : numpy.ndarray, optional
+            Element indices; default all.
+        """
         v = self.points[self.tets if elements is None else self.tets[elements]]
         return np.transpose(v[:, 1:] - v[:, :1], (0, 2, 1))
 
     def map(self, elements: np.ndarray, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(x (E, Q, 3), J (E, Q, 3, 3))`` of ``elements (E,)`` at reference points ``xi (Q, 3)`` (compiled
-        kernel ``_map_kernel``)."""
+        kernel ``_map_kernel``).
+
+        Parameters
+        ----------
+        elements : numpy.ndarray
+            Element indices ``(E,)``.
+        xi : numpy.ndarray
+            Reference points ``(Q, 3)``.
+        """
         pr = self.projectors
         return _map_kernel(self.points, self.tets, self.edge_projector, self.face_projector, pr.kind, pr.c, pr.e,
                            pr.r, pr.n, pr.d, np.ascontiguousarray(elements, dtype=np.int64),
@@ -221,12 +358,26 @@ class CurvedMesh:
     def keep_jacobians(self, xi: np.ndarray | None) -> None:
         """Map every curved element at the reference points ``xi`` once and keep the Jacobians, which :meth:`metric`
         then reads at these points instead of mapping again (the two bounds integrate at the same points); ``None``
-        drops them."""
+        drops them.
+
+        Parameters
+        ----------
+        xi : numpy.ndarray or None
+            Reference points ``(Q, 3)``; None drops the kept Jacobians.
+        """
         self.kept = None if xi is None else (np.array(xi), self.map(self.curved, xi)[1])
 
     def jacobians(self, elements: np.ndarray, xi: np.ndarray) -> np.ndarray:
         """``J (E, Q, 3, 3)`` of the curved ``elements`` at ``xi``: the kept ones (:meth:`keep_jacobians`) or
-        mapped."""
+        mapped.
+
+        Parameters
+        ----------
+        elements : numpy.ndarray
+            Indices of curved elements ``(E,)``.
+        xi : numpy.ndarray
+            Reference points ``(Q, 3)``.
+        """
         if self.kept is not None and np.array_equal(self.kept[0], xi):
             return self.kept[1][np.searchsorted(self.curved, elements)]
         return self.map(elements, xi)[1]
@@ -235,7 +386,19 @@ class CurvedMesh:
         """The quadrature-weighted metric of ``elements`` at ``xi`` as six symmetric entries ``(E, Q, 6)`` (order
         ``00, 11, 22, 01, 02, 12``, off-diagonal ones doubled): ``w |det J| J^-1 J^-T`` (``inverse``, for gradients)
         or ``w J^T J / |det J|`` (for Piola-mapped fluxes). :class:`FoldedMesh` if an element folds (``det J`` changes
-        sign)."""
+        sign).
+
+        Parameters
+        ----------
+        elements : numpy.ndarray
+            Indices of curved elements ``(E,)``.
+        xi : numpy.ndarray
+            Reference points ``(Q, 3)``.
+        w : numpy.ndarray
+            Quadrature weights ``(Q,)``.
+        inverse : bool
+            True for ``w |det J| J^-1 J^-T`` (gradients), False for ``w J^T J / |det J|`` (fluxes).
+        """
         J = self.jacobians(elements, xi)
         G, folded = _metric_kernel(J, np.ascontiguousarray(w, dtype=float), inverse)
         if folded:
@@ -442,7 +605,23 @@ def build(points: np.ndarray, tets: np.ndarray, triangles: np.ndarray, triangle_
           surfaces: list, tol: float) -> CurvedMesh:
     """The :class:`CurvedMesh` of a first-order mesh: ``triangles (T, 3)`` are its boundary faces and
     ``triangle_surface`` the index into ``surfaces`` of each. Boundary vertices are moved onto their surface (or
-    onto the curve, where two surfaces meet; left where three meet) -- they lie there already to ``tol``."""
+    onto the curve, where two surfaces meet; left where three meet) -- they lie there already to ``tol``.
+
+    Parameters
+    ----------
+    points : numpy.ndarray
+        Vertex coordinates ``(N, 3)`` of the first-order mesh, in the body's length unit.
+    tets : numpy.ndarray
+        Vertex indices ``(M, 4)`` of its tetrahedra (any order; sorted here).
+    triangles : numpy.ndarray
+        Vertex indices ``(T, 3)`` of its boundary faces.
+    triangle_surface : numpy.ndarray
+        Index into ``surfaces`` of each boundary triangle.
+    surfaces : list of Surface
+        The analytic surfaces of the boundary.
+    tol : float
+        Distance within which the boundary vertices lie on their surfaces already, in the body's length unit.
+    """
     points = np.array(points, dtype=float)
     tets = np.sort(np.asarray(tets, dtype=np.int64), axis=1)
     M = len(tets)

@@ -42,7 +42,19 @@ CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arr
 
 def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np.ndarray) -> np.ndarray:
     """Flux mass matrices ``(E, m, m)`` of ``elements``: ``int sigma^T J^T J tau / |det J|`` on the reference element
-    (exact on straight elements, quadrature of ``degree`` on curved ones)."""
+    (exact on straight elements, quadrature of ``degree`` on curved ones).
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    rt : fem_neck.simplex.RaviartThomas
+        The reference flux space.
+    degree : int
+        Quadrature degree on the curved elements.
+    elements : numpy.ndarray
+        Indices of the elements (rows of ``mesh.tets``).
+    """
     J = mesh.affine_jacobians(elements)
     G = np.einsum("eai,eaj->eij", J, J) / np.abs(np.linalg.det(J))[:, None, None]
     A = np.einsum("eij,ijab->eab", G, rt.mass)
@@ -57,10 +69,27 @@ def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np
 
 @dataclass
 class Solution:
-    """``lower = P^2 / E*`` (the lower bound of the conductance for a unit temperature difference, kappa = 1), the
-    heat flow ``P`` through the hot faces, ``E*``, face dofs, CG iterations, the relative residual of the face
-    system and the largest normal-flux jump across a face of the equilibrated flux relative to the mean flux per
-    hot face (round-off)."""
+    """The equilibrated flux of :func:`solve`, for the unit temperature difference and ``kappa`` = 1: ``lower`` and
+    ``heat_flow`` are then ``K / kappa`` and ``P / kappa``, in the mesh's length unit (m for a mesh in metres).
+
+    Parameters
+    ----------
+    lower : float
+        ``P^2 / E*``: the lower bound of the conductance.
+    heat_flow : float
+        ``P``, the heat the flux carries through the hot faces.
+    energy : float
+        ``E* = int |q|^2`` of the equilibrated flux.
+    dofs : int
+        Unknowns of the face system (the free faces' moments).
+    iterations : int
+        CG iterations on the face system.
+    residual : float
+        Relative residual of the face system CG stopped at (dimensionless).
+    flux_defect : float
+        Largest normal-flux jump across a face of the equilibrated flux, relative to the mean flux per hot face
+        (dimensionless; round-off).
+    """
 
     lower: float
     heat_flow: float
@@ -73,7 +102,15 @@ class Solution:
 
 class SymmetricStack:
     """Symmetric matrices ``(E, n, n)`` kept as their upper triangles (half the memory); ``stack[rows] = M`` keeps
-    the upper triangles of ``M``, ``stack[rows]`` gives the symmetric matrices."""
+    the upper triangles of ``M``, ``stack[rows]`` gives the symmetric matrices.
+
+    Parameters
+    ----------
+    count : int
+        Number of matrices ``E``.
+    n : int
+        Size of each square matrix.
+    """
 
     def __init__(self, count: int, n: int):
         self.n = n
@@ -82,6 +119,7 @@ class SymmetricStack:
         self.gather = symmetric_gather(n)                                    # entry (i, j) -> its packed place
 
     def __len__(self) -> int:
+        """Number of matrices."""
         return len(self.packed)
 
     def __setitem__(self, rows, matrices: np.ndarray) -> None:
@@ -91,7 +129,13 @@ class SymmetricStack:
         return np.take(self.packed[rows], self.gather, axis=1).reshape(-1, self.n, self.n)
 
     def times(self, x: np.ndarray) -> np.ndarray:
-        """``M_e x_e`` for every matrix, ``x (E, n)``."""
+        """``M_e x_e`` for every matrix, ``x (E, n)``.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            One vector per matrix, ``(E, n)``.
+        """
         out = np.empty_like(x)
         for begin in range(0, len(self), CHUNK):
             chunk = slice(begin, begin + CHUNK)
@@ -103,7 +147,17 @@ class SymmetricBlocks:
     """A symmetric matrix of ``n_f`` square blocks kept as its blocks on and above the diagonal, in block compressed
     rows (``data (K, n_f, n_f)``, ``indices``, ``indptr``): ``@`` multiplies by the whole matrix, each stored block off
     the diagonal acting also as its transpose below it (half the memory, and half the memory traffic of a product,
-    of the full block sparse matrix)."""
+    of the full block sparse matrix).
+
+    Parameters
+    ----------
+    data : numpy.ndarray
+        The stored blocks ``(K, n_f, n_f)``, those on and above the diagonal.
+    indices : numpy.ndarray
+        Block column of every stored block, ascending within a block row.
+    indptr : numpy.ndarray
+        Start of every block row in ``data`` and ``indices``, and the end (block rows + 1).
+    """
 
     def __init__(self, data: np.ndarray, indices: np.ndarray, indptr: np.ndarray):
         self.data, self.indices, self.indptr = data, indices, indptr
@@ -123,7 +177,13 @@ class SymmetricBlocks:
 
     def entries(self, a: int, b: int):
         """Entry ``(a, b)`` of every block as a symmetric CSR matrix of the block rows (both triangles); the first
-        moments' ``(0, 0)`` is the Galerkin matrix of the face means."""
+        moments' ``(0, 0)`` is the Galerkin matrix of the face means.
+
+        Parameters
+        ----------
+        a, b : int
+            Row and column within a block (0 to ``n_f - 1``).
+        """
         import scipy.sparse as sp
 
         rows = self.block_rows()
@@ -169,9 +229,22 @@ def _symmetric_block_product(data, indices, indptr, x, y):
 
 @dataclass
 class FaceSystem:
-    """The face system on the free faces' moments (:func:`face_system`): ``matrix`` (:class:`SymmetricBlocks`, one
-    ``n_f`` square block per pair of faces of an element), ``b = -H_fd lambda_d``, ``constant = lambda_d^T H_dd
-    lambda_d`` (``d``: the faces held at a temperature), the free dofs and the free faces' diagonal blocks."""
+    """The face system on the free faces' moments (:func:`face_system`); ``d`` denotes the faces held at a
+    temperature, ``f`` the free ones.
+
+    Parameters
+    ----------
+    matrix : SymmetricBlocks
+        ``H_ff``, one ``n_f`` square block per pair of faces of an element.
+    b : numpy.ndarray
+        Right-hand side ``-H_fd lambda_d``.
+    constant : float
+        ``lambda_d^T H_dd lambda_d``.
+    free : numpy.ndarray
+        The free dofs (indices into the face multipliers ``(n_faces n_f,)``).
+    diagonal : numpy.ndarray
+        The free faces' diagonal blocks ``(n_free, n_f, n_f)`` (for block Jacobi).
+    """
 
     matrix: object
     b: np.ndarray
@@ -180,14 +253,32 @@ class FaceSystem:
     diagonal: np.ndarray
 
     def energy(self, x: np.ndarray) -> float:
-        """``lambda^T H lambda`` of ``lambda`` = ``x`` on the free dofs, the held values elsewhere."""
+        """``lambda^T H lambda`` of ``lambda`` = ``x`` on the free dofs, the held values elsewhere.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            Values of the free dofs, in the order of ``free``.
+        """
         return float(x @ (self.matrix @ x) - 2.0 * (x @ self.b) + self.constant)
 
 
 def face_system(mesh: CurvedMesh, H_K: SymmetricStack, fixed_face: np.ndarray, lam: np.ndarray) -> FaceSystem:
     """``sum_K H_K`` on the free faces as a symmetric block matrix (:class:`SymmetricBlocks`): two faces of one
     element share only that element, so a block off the diagonal is one element's, and a diagonal block the sum over
-    the face's elements; the held faces' multipliers ``lam`` go to the right-hand side."""
+    the face's elements; the held faces' multipliers ``lam`` go to the right-hand side.
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    H_K : SymmetricStack
+        The element matrices ``T A_K^-1 T^T`` (``4 n_f`` square).
+    fixed_face : numpy.ndarray
+        Boolean mask over ``mesh.faces``: True on the faces held at a temperature.
+    lam : numpy.ndarray
+        Face multipliers ``(n_faces n_f,)``; only those of the held faces are read (the temperature there, K).
+    """
     nf, E = H_K.n // 4, len(H_K)
     free_faces = np.flatnonzero(~fixed_face)
     n_free = len(free_faces)
@@ -245,7 +336,19 @@ def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.nda
     """Face multipliers ``(n_faces n_f,)`` of the ``P_p`` temperature ``u`` (skeleton values in the numbering of
     :func:`fem_neck.primal.numbering`): its trace on every face projected onto ``P_k`` in the face basis (on the
     unit triangle of the face's own coordinates, from its first element) -- close to the face system's solution,
-    from which its CG starts."""
+    from which its CG starts.
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    p : int
+        Order of the ``P_p`` temperature.
+    u : numpy.ndarray
+        Skeleton values of the temperature (:class:`fem_neck.primal.Solution` ``u``), K.
+    k : int
+        Degree of the face space ``P_k``.
+    """
     basis, rt = lagrange(p), raviart_thomas(k)
     skeleton = numbering(mesh, basis).l2g
     nf = rt.n_face
@@ -264,7 +367,19 @@ def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_fa
     """Element multipliers ``(E, 4 n_f)`` whose element fluxes ``A_K^-1 T^T lambda_K`` form an admissible flux:
     one normal flux on every face, none on the insulated ones (the module docstring), from the element matrices
     ``H_K`` (``4 n_f`` square), any face multipliers ``lam (n_faces n_f,)`` and the faces held at a temperature
-    (``fixed_face``, whose flux is free)."""
+    (``fixed_face``, whose flux is free).
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    H_K : SymmetricStack
+        The element matrices ``T A_K^-1 T^T`` (``4 n_f`` square).
+    lam : numpy.ndarray
+        Face multipliers ``(n_faces n_f,)`` (any: the CG iterate).
+    fixed_face : numpy.ndarray
+        Boolean mask over ``mesh.faces``: True on the faces held at a temperature (whose flux is free).
+    """
     import scipy.sparse as sp
     from scipy.sparse.linalg import spsolve
 
@@ -302,7 +417,23 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     """The equilibrated hybridised ``RT_k`` flux with temperature 1 on the ``hot`` faces and 0 on the ``cold`` ones
     (indices into ``mesh.faces``; quadrature of ``degree`` on curved elements); see the module docstring. CG stops
     when the face system's energy has settled to ``etol`` (:func:`fem_neck.pcg.solve`), starting from zero or from
-    the face multipliers ``start()`` returns once the system is assembled (:func:`trace_multipliers`)."""
+    the face multipliers ``start()`` returns once the system is assembled (:func:`trace_multipliers`).
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh of the solid (any length unit).
+    k : int
+        Degree of the Raviart-Thomas space (0 to 7).
+    hot, cold : numpy.ndarray
+        Indices into ``mesh.faces`` of the faces held at 1 and at 0.
+    etol : float
+        Relative energy tolerance of CG's energy stop (dimensionless).
+    degree : int, optional
+        Quadrature degree on curved elements; default ``quadrature_degree(k + 1)``.
+    start : callable, optional
+        Returns the face multipliers ``(n_faces n_f,)`` CG starts from (:func:`trace_multipliers`); zero if None.
+    """
     import scipy.sparse as sp
 
     from fem_neck import pcg

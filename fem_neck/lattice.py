@@ -176,6 +176,7 @@ class PeriodicCell:
 
     @property
     def n(self) -> int:
+        """Number of particles in the period."""
         return len(self.radii)
 
     @property
@@ -190,7 +191,13 @@ class PeriodicCell:
         return float(np.sum(4.0 / 3.0 * np.pi * self.radii**3) / np.prod(self.period))
 
     def images(self, lo, hi) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Every image ``c_k + n P`` with its centre in the box ``[lo, hi]``: ``(centres, owner k, shift n)``."""
+        """Every image ``c_k + n P`` with its centre in the box ``[lo, hi]``: ``(centres, owner k, shift n)``.
+
+        Parameters
+        ----------
+        lo, hi : array_like
+            Corners ``(3,)`` of the box, m.
+        """
         lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
         n_lo = np.floor((lo - self.period) / self.period).astype(int)
         n_hi = np.ceil(hi / self.period).astype(int)
@@ -247,12 +254,24 @@ def lattice_cell(kind: str, h_over_r: float, radius: float = 1.0, neck: str = "n
 
 
 def max_neck_ratio(kind: str) -> float:
-    """Largest ``a/r`` of a cubic lattice: the neck circles of one particle touch at ``a/r = sin(theta/2)``."""
+    """Largest ``a/r`` of a cubic lattice: the neck circles of one particle touch at ``a/r = sin(theta/2)``.
+
+    Parameters
+    ----------
+    kind : str
+        ``"sc"``, ``"bcc"`` or ``"fcc"``.
+    """
     return math.sin(BOND_ANGLE[kind] / 2.0)
 
 
 def max_h_over_r(kind: str) -> float:
-    """``h/r`` at which the necks of one particle of the lattice touch (SC 0.2761, BCC 0.1774, FCC 0.1308)."""
+    """``h/r`` at which the necks of one particle of the lattice touch (SC 0.2761, BCC 0.1774, FCC 0.1308).
+
+    Parameters
+    ----------
+    kind : str
+        ``"sc"``, ``"bcc"`` or ``"fcc"``.
+    """
     return overlap_for_neck(1.0, 1.0, max_neck_ratio(kind))
 
 
@@ -316,7 +335,15 @@ def check_h_over_r(kind: str, h_over_r: float, neck: str = "newton") -> float:
 def check_cell(cell: PeriodicCell, method: str = "newton") -> None:
     """Raise ``ValueError`` unless some particles overlap and, read as pair necks, every bond's overlap lies in the
     neck model's range and no two necks of one particle touch (their circles, of angular radius ``arcsin(a/r)``,
-    must stay apart on the sphere), or, read as the union of the spheres, no sphere lies inside another."""
+    must stay apart on the sphere), or, read as the union of the spheres, no sphere lies inside another.
+
+    Parameters
+    ----------
+    cell : PeriodicCell
+        The cell.
+    method : str
+        Neck model of the pair reading (:func:`fem_neck.geometry.neck_radius`).
+    """
     i, j, s = cell.bonds()
     if not len(i):
         raise ValueError(f"{cell.name}: no two particles overlap, so nothing conducts")
@@ -358,7 +385,13 @@ def check_cell(cell: PeriodicCell, method: str = "newton") -> None:
 def mirror_symmetry(cell: PeriodicCell) -> tuple[bool, bool, bool]:
     """``(mirror, diagonal, antidiagonal)``: whether the packing is symmetric under ``x -> -x``, ``y -> -y`` and
     ``z -> -z`` (each modulo the period); whether it is also symmetric under ``x <-> y``; and whether also under
-    ``(x, y) -> (P/2 - y, P/2 - x)`` (the face-centred cubic lattice)."""
+    ``(x, y) -> (P/2 - y, P/2 - x)`` (the face-centred cubic lattice).
+
+    Parameters
+    ----------
+    cell : PeriodicCell
+        The cell.
+    """
 
     def same(mapped) -> bool:
         mapped = np.mod(mapped, cell.period)
@@ -378,10 +411,30 @@ def mirror_symmetry(cell: PeriodicCell) -> tuple[bool, bool, bool]:
 
 @dataclass
 class CellMesh:
-    """The meshed computational cell: ``curved`` (:class:`fem_neck.curved.CurvedMesh`, exact geometry), ``hot`` and
-    ``cold`` its face indices on ``z = 0`` and ``z = height``, the cross-section ``area``, ``wedge`` (the fraction
-    of the box meshed: 1, the half ``y <= x``, or the quarter with also ``x + y <= P/2``), the exact and the CAD
-    volume of the solid in the cell and the neck radii. Lengths in units of the largest radius ``unit``."""
+    """The meshed computational cell (:func:`build_cell_mesh`). Lengths in units of the largest radius ``unit``.
+
+    Parameters
+    ----------
+    curved : fem_neck.curved.CurvedMesh
+        The mesh, exact geometry.
+    hot, cold : numpy.ndarray
+        Indices into ``curved.faces`` of its faces on ``z = 0`` and on ``z = height``.
+    height : float
+        Height of the cell, the half period along z (in units of ``unit``).
+    area : float
+        Cross-section of the cell normal to z (in units of ``unit`` squared).
+    wedge : float
+        The fraction of the half-period box meshed: 1, 1/2 (the wedge ``y <= x``) or 1/4 (with also
+        ``x + y <= P/2``).
+    volume_exact : float
+        The exact volume of the solid in the cell (in units of ``unit`` cubed).
+    volume_cad : float
+        The OCC volume of the built solid (in units of ``unit`` cubed).
+    unit : float
+        The largest particle radius, m: the length unit of the mesh.
+    neck_a : numpy.ndarray
+        Neck radius of every bond of the local cluster (in units of ``unit``).
+    """
 
     curved: object
     hot: np.ndarray
@@ -397,7 +450,15 @@ class CellMesh:
 
 def local_cluster(cell: PeriodicCell, box: np.ndarray):
     """The particle images whose spheres or necks can reach the box ``[0, box]``, with their bonds, as a
-    :class:`fem_neck.cluster.Cluster` (a neck point lies within ``sqrt(2) r_max`` of its nearer centre)."""
+    :class:`fem_neck.cluster.Cluster` (a neck point lies within ``sqrt(2) r_max`` of its nearer centre).
+
+    Parameters
+    ----------
+    cell : PeriodicCell
+        The cell.
+    box : numpy.ndarray
+        The far corner ``(3,)`` of the box, in the cell's length unit.
+    """
     from fem_neck.cluster import Cluster
 
     r_max = float(cell.radii.max())
@@ -450,11 +511,33 @@ def _reaches(halfspaces: list, points: np.ndarray, radius: np.ndarray) -> np.nda
 
 @dataclass(frozen=True)
 class CellFrame:
-    """What the mesh of a cell is built from, before any meshing: the cell ``scaled`` to its largest radius
-    ``unit``, the half period ``box``, the particle images that reach the computational cell with their bonds
-    (``local``, :func:`local_cluster`), the bonds' necks ``geo`` and unit directions ``e``, the cell's
-    ``halfspaces`` (``_domain``), which mirror ``diagonal``/``anti`` symmetry it uses, the ``fraction`` of the
-    box it is and the exact ``solid_volume`` in it."""
+    """What the mesh of a cell is built from, before any meshing. Lengths in units of ``unit``.
+
+    Parameters
+    ----------
+    scaled : PeriodicCell
+        The cell scaled to its largest radius.
+    unit : float
+        The largest particle radius, m.
+    box : numpy.ndarray
+        The half period ``(3,)``.
+    local : fem_neck.cluster.Cluster
+        The particle images that reach the computational cell, with their bonds (:func:`local_cluster`).
+    geo : fem_neck.geometry.NeckGeometry
+        The necks of those bonds.
+    e : numpy.ndarray
+        Unit directions ``(bonds, 3)`` of the bonds.
+    halfspaces : list of tuple
+        ``(n, d)`` of every half-space ``n . x <= d`` bounding the computational cell.
+    diagonal : bool
+        Whether the cell is the wedge ``y <= x`` of the box (symmetry under ``x <-> y``).
+    anti : bool
+        Whether it is also cut by ``x + y <= P/2`` (the face-centred cubic symmetry).
+    fraction : float
+        The fraction of the box the cell is (1, 1/2 or 1/4).
+    solid_volume : float
+        The exact volume of the solid in the cell.
+    """
 
     scaled: PeriodicCell
     unit: float
@@ -550,7 +633,15 @@ class NeckCircles:
 
 def neck_circles(cell: PeriodicCell, samples: int = 360) -> NeckCircles:
     """The :class:`NeckCircles` of ``cell``: each bond's two circles sampled at ``samples`` points, the fraction
-    of them inside the computational cell and inside no other particle (there the circle is not on the boundary)."""
+    of them inside the computational cell and inside no other particle (there the circle is not on the boundary).
+
+    Parameters
+    ----------
+    cell : PeriodicCell
+        The cell.
+    samples : int
+        Points per circle.
+    """
     frame = _cell_frame(cell)
     local, geo, e = frame.local, frame.geo, frame.e
     c, r = local.centres, local.radii
@@ -586,7 +677,15 @@ def predicted_tetrahedra(circles: NeckCircles, size_neck: float) -> float:
     :func:`fem_neck.cluster.neck_size_fields`) up to ``U = SIZE_FAR r_min``, so the circle adds
     ``a (1 / (2 s) - 1 / U + s / (2 U^2))`` times a constant (the solid's angle around it over ``GRADING^2``);
     the rest of the solid adds its volume over ``SIZE_FAR^3``. The two constants are measured
-    (``TETRAHEDRA_PER_CIRCLE``, ``TETRAHEDRA_PER_VOLUME``), times ``PREDICTION_MARGIN``."""
+    (``TETRAHEDRA_PER_CIRCLE``, ``TETRAHEDRA_PER_VOLUME``), times ``PREDICTION_MARGIN``.
+
+    Parameters
+    ----------
+    circles : NeckCircles
+        The cell's neck circles (:func:`neck_circles`).
+    size_neck : float
+        Element size at the neck circles over the neck radius (dimensionless).
+    """
     s = np.minimum(size_neck * circles.a, circles.h_n)
     far = SIZE_FAR * circles.r_min
     near = np.where(s < far, circles.a * (0.5 / s - 1.0 / far + 0.5 * s / far**2), 0.0)
@@ -601,7 +700,25 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, gradi
     """Mesh the computational cell (module docstring): the union of the spheres and necks that reach it, cut to the
     cell, graded toward every neck circle (``size_neck a`` at the circles, growing by ``grading`` per unit
     distance up to ``size_far r``; :func:`fem_neck.cluster.neck_size_fields`), its boundary classified onto the
-    exact spheres, cylinders and planes (:mod:`fem_neck.curved`). Lengths are scaled to the largest radius."""
+    exact spheres, cylinders and planes (:mod:`fem_neck.curved`). Lengths are scaled to the largest radius.
+
+    Parameters
+    ----------
+    cell : PeriodicCell
+        The cell (validated by :func:`check_cell`).
+    size_neck : float
+        Element size at the neck circles over the neck radius (dimensionless).
+    size_far : float
+        Largest element size over the particle radius (dimensionless).
+    grading : float
+        Growth of the element size per unit distance from a neck circle (dimensionless).
+    curvature : int
+        gmsh's elements per 2 pi of surface curvature.
+    neck_cells : float
+        Elements along a neck's length at least.
+    method : str
+        Neck model of the pair reading (:func:`fem_neck.geometry.neck_radius`).
+    """
     from fem_neck import curved
     from fem_neck.cluster import mesh_tetrahedra, neck_size_fields, tetrahedra
     from fem_neck.shapes import gmsh_session
@@ -696,9 +813,25 @@ def _conducting(points: np.ndarray, tets: np.ndarray, height: float, tol: float)
 
 @dataclass(frozen=True)
 class Bounds:
-    """Both bounds of one mesh, as ``k / kappa`` of the cell: ``upper`` (P_p energy) and ``lower`` (RT_(p-1) flux),
-    the flux's largest normal-flux jump relative to its mean flux per hot face (admissibility, round-off),
-    unknowns of both solves, tetrahedra, the mapped mesh's volume over the exact one minus 1, seconds."""
+    """Both bounds of one mesh (:func:`solve_bounds`), as ``k / kappa`` of the cell (dimensionless).
+
+    Parameters
+    ----------
+    upper : float
+        Upper bound (``P_p`` energy, :mod:`fem_neck.primal`).
+    lower : float
+        Lower bound (``RT_(p-1)`` flux, :mod:`fem_neck.dual`).
+    flux_defect : float
+        The flux's largest normal-flux jump relative to its mean flux per hot face (admissibility; round-off).
+    dofs_upper, dofs_lower : int
+        Unknowns of the two solves.
+    elements : int
+        Tetrahedra of the mesh.
+    volume_error : float
+        The mapped mesh's volume over the exact one, minus 1 (dimensionless).
+    seconds : float
+        Wall time of both solves, s.
+    """
 
     upper: float
     lower: float
@@ -711,6 +844,7 @@ class Bounds:
 
     @property
     def gap(self) -> float:
+        """``(upper - lower) / upper``: the relative error bound (dimensionless)."""
         return (self.upper - self.lower) / self.upper
 
 
@@ -749,7 +883,19 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2, etol: float | N
     parallel processes when ``workers >= 2`` (the lower bound assembles its system while the upper bound solves,
     then starts its CG from the upper bound's temperature). Both integrate the curved elements at the same points,
     where the elements are mapped once. Both CGs stop when their energy has settled to ``etol`` (default
-    ``fem_neck.primal.ENERGY_RTOL``)."""
+    ``fem_neck.primal.ENERGY_RTOL``).
+
+    Parameters
+    ----------
+    cm : CellMesh
+        The meshed cell.
+    order : int
+        Order ``p`` of the upper bound (the lower bound's flux has degree ``p - 1``).
+    workers : int
+        Processes: 2 or more runs the two bounds side by side, 1 one after the other.
+    etol : float, optional
+        Relative energy tolerance of both CGs (dimensionless).
+    """
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
 
@@ -785,9 +931,41 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2, etol: float | N
 
 @dataclass
 class CellResult:
-    """Effective conductivity of a periodic cell (module docstring): the best value ``k_eff_over_kappa`` (P_p, the
-    upper bound), its bounds, ``error_estimate = (upper - lower) / upper``, the solid fraction ``phi`` (also the
-    Wiener bound of ``k_eff / kappa``), what the last mesh cost and every mesh solved (``levels``)."""
+    """Effective conductivity of a periodic cell (module docstring, :func:`effective_conductivity`); the values are
+    the last mesh's. Conductivities are over the particles' ``kappa`` (dimensionless).
+
+    Parameters
+    ----------
+    k_eff_over_kappa : float
+        The best value: the ``P_p`` upper bound.
+    k_lower_over_kappa, k_upper_over_kappa : float
+        The two bounds.
+    error_estimate : float
+        ``(upper - lower) / upper`` (dimensionless).
+    converged : bool
+        Whether ``error_estimate`` met the tolerance asked for.
+    phi : float
+        Solid volume fraction (also the Wiener bound of ``k_eff / kappa``).
+    order : int
+        Order ``p`` of the upper bound's elements.
+    dofs : int
+        Unknowns of the upper bound's solve.
+    elements : int
+        Tetrahedra of the mesh.
+    levels : list of dict
+        Every mesh solved: ``size_neck``, ``elements``, ``k_upper``, ``k_lower``, ``gap`` and ``seconds`` (wall time
+        since the start, s).
+    seconds : float
+        Wall time of the whole computation, s.
+    volume_error : float
+        The mapped mesh's volume over the exact one, minus 1.
+    flux_defect : float
+        The lower bound's flux defect (:class:`Bounds`).
+    memory_estimate : float
+        Estimated peak memory of the last solve, bytes (:func:`memory_estimate`).
+    mesh : CellMesh, optional
+        The last mesh.
+    """
 
     k_eff_over_kappa: float
     k_lower_over_kappa: float
@@ -808,13 +986,27 @@ class CellResult:
 
 def mesh_sizes(size_neck: float) -> dict:
     """The mesh of neck size ``size_neck`` (element size at the neck circles over the neck radius): far size and
-    grading fixed (``SIZE_FAR``, ``GRADING``)."""
+    grading fixed (``SIZE_FAR``, ``GRADING``).
+
+    Parameters
+    ----------
+    size_neck : float
+        Element size at the neck circles over the neck radius (dimensionless).
+    """
     return {"size_neck": size_neck, "size_far": SIZE_FAR, "grading": GRADING}
 
 
 def memory_estimate(elements: float, order: int) -> float:
     """Peak bytes of one :func:`solve_bounds` on ``elements`` tetrahedra (both processes; measured, see
-    ``BYTES_PER_ELEMENT``)."""
+    ``BYTES_PER_ELEMENT``).
+
+    Parameters
+    ----------
+    elements : float
+        Tetrahedra of the mesh.
+    order : int
+        Order of the upper bound: 2, 3 or 4.
+    """
     return BASE_BYTES + BYTES_PER_ELEMENT[order] * elements
 
 
@@ -953,7 +1145,13 @@ def _check_fits(cell: PeriodicCell, circles: NeckCircles, size: float, calibrati
 
 
 def default_order(rtol: float) -> int:
-    """The order of the upper bound for ``rtol`` unless one is given: 3 from ``P3_FROM`` up, else 4."""
+    """The order of the upper bound for ``rtol`` unless one is given: 3 from ``P3_FROM`` up, else 4.
+
+    Parameters
+    ----------
+    rtol : float
+        The relative error asked for (dimensionless).
+    """
     return 3 if rtol >= P3_FROM else 4
 
 
@@ -1055,7 +1253,16 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
 def network_conductivity(cell: PeriodicCell, pair_conductance) -> float:
     """``k_zz / kappa`` of the pipe network on the cell's bonds when every particle's temperature follows the
     uniform gradient (exact for lattices, whose bond stars are centrosymmetric): ``sum_b K_b dz_b^2 / |period|``.
-    ``pair_conductance(r_i, r_j, a)`` gives the bond conductances for kappa = 1."""
+    ``pair_conductance(r_i, r_j, a)`` gives the bond conductances for kappa = 1.
+
+    Parameters
+    ----------
+    cell : PeriodicCell
+        The cell (pair reading).
+    pair_conductance : callable
+        ``(r_i, r_j, a) -> K`` in W/K for ``kappa`` = 1 W/(m K), vectorised (e.g. a partial of
+        :func:`fem_neck.law.pair_conductance`).
+    """
     i, j, s = cell.bonds()
     e = cell.centres[j] + s * cell.period - cell.centres[i]
     d = np.linalg.norm(e, axis=1)
@@ -1066,7 +1273,15 @@ def network_conductivity(cell: PeriodicCell, pair_conductance) -> float:
 
 
 def write_vtu(result: CellResult, path) -> None:
-    """The cell's mesh (straight tetrahedra, vertices on the exact surfaces) for ParaView (VTU)."""
+    """The cell's mesh (straight tetrahedra, vertices on the exact surfaces) for ParaView (VTU).
+
+    Parameters
+    ----------
+    result : CellResult
+        A result that kept its ``mesh``.
+    path : str or pathlib.Path
+        The ``.vtu`` file to write.
+    """
     import meshio
 
     mesh = result.mesh.curved

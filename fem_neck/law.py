@@ -1,60 +1,72 @@
-"""Conductance laws of a sintered neck: K/K_cyl as a function of a/r (numpy only; the DEM imports this module).
+r"""Conductance laws of a sintered neck: K/K_cyl as a function of a/r (numpy only; the DEM imports this module).
 
-``x = a/r`` is the neck radius over the particle radius and ``K_cyl = kappa*pi*r`` (Rojek 2022, eqs. 38-39) the
-conductance of a cylinder of radius r and length r. A *law* is any object with ``k_over_kcyl(x)``; from it
+:math:`x = a/r` is the neck radius over the particle radius and :math:`K_{cyl} = \kappa \pi r` (Rojek 2022,
+eqs. 38-39) the conductance of a cylinder of radius r and length r. A *law* is any object with ``k_over_kcyl(x)``;
+from it
 
-* :func:`half_conductance` -- the conductance of one particle's half of a sintered pair, ``K_i = kappa pi r_i
-  f(a/r_i)`` (eq. 43 when f is linear), and
-* :func:`pair_conductance` -- the thermal pipe of a pair, the two halves in series, each with its own ``a/r_i``:
-  ``K_ij = K_i K_j / (K_i + K_j)`` (Rojek 2022, eq. 9), for the full-range law times the small FE correction for
-  unequal radii :func:`unequal_factor`.
+* :func:`half_conductance` -- the conductance of one particle's half of a sintered pair, :math:`K_i = \kappa \pi
+  r_i f(a/r_i)` (eq. 43 when f is linear), and
+* :func:`pair_conductance` -- the thermal pipe of a pair, the two halves in series, each with its own
+  :math:`a/r_i`: :math:`K_{ij} = K_i K_j / (K_i + K_j)` (Rojek 2022, eq. 9), for the full-range law times the
+  small FE correction for unequal radii :func:`unequal_factor`.
 
 The laws:
 
-* :class:`LinearLaw` -- ``f(x) = c x``; :data:`ROJEK` is c = 1.064 (Rojek 2022, eq. 40), :data:`ARGENTO_BOUVARD`
+* :class:`LinearLaw` -- :math:`f(x) = c x`; :data:`ROJEK` is c = 1.064 (Rojek 2022, eq. 40), :data:`ARGENTO_BOUVARD`
   c = 1/0.899 = 1.112 (eqs. 41-42).
 * :class:`ConductanceLaw` -- the full-range law fitted to FE by ``python -m fem_neck fit`` and read from its
   ``fit.json`` (:meth:`ConductanceLaw.from_json`; :meth:`ConductanceLaw.default` is the fit shipped in
-  ``fem_neck/data/fit.json``). It splits the half body's resistance (in units of ``1/(kappa pi r)``) into the neck
-  cylinder and the sphere segment::
+  ``fem_neck/data/fit.json``). It splits the half body's resistance (in units of :math:`1/(\kappa \pi r)`) into the
+  neck cylinder and the sphere segment:
 
-      1/f(x) = lambda(x) + (pi / (4 x)) P(x)
+  .. math::
 
-  - ``lambda(x) = (h_n/2) / (r x^2)`` is the exact resistance of the half neck, a cylinder of radius a and length
-    ``h_n/2`` (eqs. 16-20): with ``s = sqrt(1 - x^2)`` and ``h_c = x^2/(1 + s)``,
-    ``lambda = (3 - h_c) / (3 (2 - h_c) (1 + s))``, from 1/4 at x -> 0 to 2/3 at x = 1.
-  - ``pi/(4x)`` is the spreading resistance ``1/(4 kappa a)`` of an isothermal disk on a half-space, and
-    ``P(x) = 1 + A x ln(1/x) + B x + C x^2 + E x^3 - (1 + B + C + E)(1 - s)`` the sphere segment's correction to it.
-    P(0) = 1: the half-conductance tends to the constriction limit ``4 kappa a`` (f -> (4/pi) x). The ``x ln(1/x)``
-    term is the next order of the small-neck expansion, with the coefficient :data:`A_LOG` = 5/(4 pi) derived, not
-    fitted: 1/pi from the sphere (the Neumann function of a ball has a logarithmic part, so a small contact on a
-    sphere of radius r adds ``ln(r/a)/(4 pi kappa r)`` to ``1/(4 kappa a)``), plus 1/(4 pi) from the thin half neck
-    (length ``l = a x/4``) carrying the isothermal disk's rim-singular flux ``q ~ (a^2 - rho^2)^(-1/2)``, which
-    adds ``(l/(4 pi kappa a^2)) ln(a/l)`` to its 1-D resistance. The FE sweep gives 0.398 +- 0.002 for this
-    coefficient between a/r = 3e-4 and 1e-2 (5/(4 pi) = 0.3979).
-    ``s = z_i / r`` is the thickness of the segment left between the equator and the cap base; it vanishes at
-    x = 1, where P(1) = 0 and the half body is a cylinder of radius r and length 2r/3, ``f(1) = 3/2`` exactly.
+      \frac{1}{f(x)} = \lambda(x) + \frac{\pi}{4 x} P(x)
+
+  - :math:`\lambda(x) = (h_n/2) / (r x^2)` is the exact resistance of the half neck, a cylinder of radius a and
+    length :math:`h_n/2` (eqs. 16-20): with :math:`s = \sqrt{1 - x^2}` and :math:`h_c = x^2/(1 + s)`,
+    :math:`\lambda = (3 - h_c) / (3 (2 - h_c) (1 + s))`, from 1/4 at x -> 0 to 2/3 at x = 1.
+  - :math:`\pi/(4x)` is the spreading resistance :math:`1/(4 \kappa a)` of an isothermal disk on a half-space, and
+
+    .. math::
+
+        P(x) = 1 + A x \ln(1/x) + B x + C x^2 + E x^3 - (1 + B + C + E)(1 - s)
+
+    the sphere segment's correction to it.
+    P(0) = 1: the half-conductance tends to the constriction limit :math:`4 \kappa a` (:math:`f \to (4/\pi) x`).
+    The :math:`x \ln(1/x)` term is the next order of the small-neck expansion, with the coefficient :data:`A_LOG` =
+    :math:`5/(4 \pi)` derived, not fitted: :math:`1/\pi` from the sphere (the Neumann function of a ball has a
+    logarithmic part, so a small contact on a sphere of radius r adds :math:`\ln(r/a)/(4 \pi \kappa r)` to
+    :math:`1/(4 \kappa a)`), plus :math:`1/(4 \pi)` from the thin half neck (length :math:`l = a x/4`) carrying the
+    isothermal disk's rim-singular flux :math:`q \sim (a^2 - \rho^2)^{-1/2}`, which adds
+    :math:`(l/(4 \pi \kappa a^2)) \ln(a/l)` to its 1-D resistance. The FE sweep gives 0.398 +- 0.002 for this
+    coefficient between a/r = 3e-4 and 1e-2 (:math:`5/(4 \pi)` = 0.3979).
+    :math:`s = z_i / r` is the thickness of the segment left between the equator and the cap base; it vanishes at
+    x = 1, where P(1) = 0 and the half body is a cylinder of radius r and length 2r/3, :math:`f(1) = 3/2` exactly.
 
 * The same law for the half body of the *union of spheres* (``ConductanceLaw(..., neck="union")``;
   :meth:`ConductanceLaw.default` ``(neck="union")`` is the fit shipped in ``fem_neck/data/fit_union.json``, written
   by ``python -m fem_neck fit --neck union``). A neck of the union is the circle where two spheres meet, in their
-  radical plane at ``l = (d^2 + r_i^2 - r_j^2) / (2 d)`` from centre i, of radius ``a = sqrt(r_i^2 - l^2)``
+  radical plane at :math:`l = (d^2 + r_i^2 - r_j^2) / (2 d)` from centre i, of radius :math:`a = \sqrt{r_i^2 - l^2}`
   (:func:`fem_neck.geometry.union.lens`); the half body is the sphere between its equatorial plane and that plane,
-  whose disk of radius a is isothermal, with no neck cylinder::
+  whose disk of radius a is isothermal, with no neck cylinder:
 
-      1/f(x) = (pi / (4 x)) P_u(x)
+  .. math::
 
-  with ``P_u`` of the form of P and its own B, C, E. P_u(0) = 1 (the constriction limit ``4 kappa a``). Its
-  ``x ln(1/x)`` coefficient is :data:`A_LOG_UNION` = 1/pi, the ball's Neumann log alone: there is no half neck to
-  carry the disk's rim-singular flux (the rim now sees the sphere at the angle ``pi/2 + arccos(x)``, a change of
-  the geometry of relative size x with a finite energy integral, which moves B, not A). The FE gives 0.3183 for this
-  coefficient between a/r = 3e-4 and 1e-2 (1/pi = 0.31831), against 0.3980 for the neck cylinder. At x -> 1 the
-  half body is a slab of thickness ``s = z_i / r``: its resistance vanishes and f -> inf; the exact limit, the 1-D
-  resistance through the cross-sections ``pi (r^2 - z^2)``, is ``1/f = atanh(s) + O(s^4)``, and the form gives
-  ``1/f -> (pi/4)(1 + B + C + E) s`` (P_u(1) = 0 from the last term). B, C, E are fitted freely, as for the cylinder:
-  holding the slope at s -> 0 exact (``1 + B + C + E = 4/pi``) costs the form a factor 5 in accuracy over the
-  sweep, so the fitted slope differs from 1 by what the fit's residual at x = 0.97 allows (see the fit file's
-  ``max_rel_residual``, and the guide for the law's error beyond the fit range).
+      \frac{1}{f(x)} = \frac{\pi}{4 x} P_u(x)
+
+  with :math:`P_u` of the form of P and its own B, C, E. :math:`P_u(0) = 1` (the constriction limit
+  :math:`4 \kappa a`). Its :math:`x \ln(1/x)` coefficient is :data:`A_LOG_UNION` = :math:`1/\pi`, the ball's
+  Neumann log alone: there is no half neck to carry the disk's rim-singular flux (the rim now sees the sphere at the
+  angle :math:`\pi/2 + \arccos(x)`, a change of the geometry of relative size x with a finite energy integral, which
+  moves B, not A). The FE gives 0.3183 for this coefficient between a/r = 3e-4 and 1e-2 (:math:`1/\pi` = 0.31831),
+  against 0.3980 for the neck cylinder. At x -> 1 the half body is a slab of thickness :math:`s = z_i / r`: its
+  resistance vanishes and :math:`f \to \infty`; the exact limit, the 1-D resistance through the cross-sections
+  :math:`\pi (r^2 - z^2)`, is :math:`1/f = \operatorname{atanh}(s) + O(s^4)`, and the form gives
+  :math:`1/f \to (\pi/4)(1 + B + C + E) s` (:math:`P_u(1) = 0` from the last term). B, C, E are fitted freely, as
+  for the cylinder: holding the slope at s -> 0 exact (:math:`1 + B + C + E = 4/\pi`) costs the form a factor 5 in
+  accuracy over the sweep, so the fitted slope differs from 1 by what the fit's residual at x = 0.97 allows (see the
+  fit file's ``max_rel_residual``, and the guide for the law's error beyond the fit range).
 """
 
 from __future__ import annotations
@@ -470,7 +482,8 @@ def _positive(name, value):
 
 
 def half_conductance(kappa, r, a, law=None):
-    """``K_i = kappa pi r f(a/r)`` in W/K: one particle's half of a sintered pair (Rojek 2022, eq. 43 for f linear).
+    r""":math:`K_i = \kappa \pi r f(a/r)` in W/K: one particle's half of a sintered pair (Rojek 2022, eq. 43 for f
+    linear).
 
     Vectorised: the arguments broadcast against each other.
 
@@ -507,7 +520,8 @@ UNEQUAL_C = 0.0054
 
 
 def unequal_factor(r_i, r_j, a, c: float = UNEQUAL_C):
-    """``1 / (1 + c (a/r_min) ln(r_max/r_min))``: the FE correction of the series of halves for unequal radii.
+    r""":math:`1 / (1 + c (a/r_{min}) \ln(r_{max}/r_{min}))`: the FE correction of the series of halves for unequal
+    radii.
 
     The halves of :func:`pair_conductance` are solved with an isothermal neck cross-section; in an unequal pair that
     plane is not isothermal, and freeing it lowers K (Dirichlet's principle: the series of halves is an upper
@@ -539,7 +553,8 @@ def unequal_factor(r_i, r_j, a, c: float = UNEQUAL_C):
 
 
 def pair_conductance(kappa, r_i, r_j, a, law=None, unequal: bool = True):
-    """``K_ij = K_i K_j / (K_i + K_j)`` with ``K_i = kappa pi r_i f(a/r_i)`` (Rojek 2022, eq. 9); vectorised.
+    r""":math:`K_{ij} = K_i K_j / (K_i + K_j)` with :math:`K_i = \kappa \pi r_i f(a/r_i)` (Rojek 2022, eq. 9);
+    vectorised.
 
     Each half takes its own ``a/r`` (its own half neck too: the neck length of the volume-conserving model splits
     exactly into the two equal-pair half necks, ``h_n = h_n(r_i, r_i)/2 + h_n(r_j, r_j)/2``). With the linear law

@@ -20,7 +20,20 @@ class TwoLevel:
     """The preconditioner of the module docstring, as a callable ``r -> M^-1 r``. The coarse matrix ``P^T A P`` is
     computed unless given (``coarse``, CSR); the local part ``D^-1`` is point Jacobi, or block Jacobi on consecutive
     groups of unknowns whose diagonal blocks of ``A`` are ``block_matrices (B, n, n)`` (``B n`` = all unknowns;
-    the moments of one face), kept as one block sparse matrix."""
+    the moments of one face), kept as one block sparse matrix.
+
+    Parameters
+    ----------
+    A : scipy.sparse matrix
+        The symmetric positive definite system matrix (n, n) of the free unknowns.
+    P : scipy.sparse matrix
+        The coarse space (n, m): column j holds coarse function j on the unknowns.
+    coarse : scipy.sparse.csr_matrix, optional
+        ``P^T A P`` (m, m) if the caller has it; computed otherwise.
+    block_matrices : numpy.ndarray, optional
+        The diagonal blocks (B, k, k) of ``A`` on consecutive groups of ``k`` unknowns (``B k = n``), inverted for the
+        block Jacobi part; None for point Jacobi.
+    """
 
     def __init__(self, A, P, coarse=None, block_matrices: np.ndarray | None = None):
         import scipy.sparse as sp
@@ -52,7 +65,18 @@ class Assembly:
     (``_pattern``); :meth:`add` adds a chunk's element matrices into those places, which can then be dropped.
     The free dofs ``free`` are numbered in the order the elements first use them, so that an element's rows lie
     near each other in memory (the pattern and the additions take half the time of the global dofs' order).
-    ``A_ff x = b`` gives the free values; :meth:`energy` is ``u^T A u`` of the full vector exactly, whatever ``x``."""
+    ``A_ff x = b`` gives the free values; :meth:`energy` is ``u^T A u`` of the full vector exactly, whatever ``x``.
+
+    Parameters
+    ----------
+    l2g : numpy.ndarray
+        Global dof of each element's local dofs, integers (E, n).
+    fixed : numpy.ndarray
+        Boolean mask over the global dofs: True where the value is prescribed (Dirichlet).
+    values : numpy.ndarray
+        Value of every global dof (only those marked ``fixed`` are read), in the unit of the unknown (K for a
+        temperature).
+    """
 
     def __init__(self, l2g: np.ndarray, fixed: np.ndarray, values: np.ndarray):
         dofs, first = np.unique(l2g, return_index=True)
@@ -75,7 +99,15 @@ class Assembly:
         self.constant = 0.0
 
     def add(self, K: np.ndarray, elements: np.ndarray) -> None:
-        """Add the element matrices ``K (len(elements), n, n)`` of consecutive ``elements``."""
+        """Add the element matrices ``K (len(elements), n, n)`` of consecutive ``elements``.
+
+        Parameters
+        ----------
+        K : numpy.ndarray
+            Element matrices (len(elements), n, n), in the unit of the system (W/K for a conductance matrix).
+        elements : numpy.ndarray
+            Indices of consecutive elements (rows of ``l2g``), ascending without gaps.
+        """
         known = np.where(self.fixed[self.l2g[elements]], self.values[self.l2g[elements]], 0.0)
         load = -np.matmul(K, known[:, :, None])[:, :, 0]
         loc = self.loc[elements]
@@ -95,7 +127,15 @@ class Assembly:
 
     def energy(self, A, x: np.ndarray) -> float:
         """``u^T A u`` of ``u`` = ``x`` on the free dofs, the fixed values elsewhere: ``x A_ff x - 2 x b + u_d A_dd
-        u_d`` (``A_fd u_d = -b``)."""
+        u_d`` (``A_fd u_d = -b``).
+
+        Parameters
+        ----------
+        A : scipy.sparse.csr_matrix
+            ``A_ff``, as :meth:`matrix` returned it.
+        x : numpy.ndarray
+            Values of the free dofs, in the order of ``free``.
+        """
         return float(x @ (A @ x) - 2.0 * (x @ self.b) + self.constant)
 
 
@@ -168,6 +208,19 @@ def _scatter(data, place, K):
 
 
 def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None) -> TwoLevel:
+    """The preconditioner :class:`TwoLevel` of ``A`` on the coarse space ``P``.
+
+    Parameters
+    ----------
+    A : scipy.sparse matrix
+        The symmetric positive definite system matrix (n, n).
+    P : scipy.sparse matrix
+        The coarse space (n, m).
+    coarse : scipy.sparse.csr_matrix, optional
+        ``P^T A P`` if the caller has it.
+    block_matrices : numpy.ndarray, optional
+        Diagonal blocks (B, k, k) of ``A`` for block Jacobi; None for point Jacobi.
+    """
     return TwoLevel(A, P, coarse, block_matrices)
 
 
@@ -180,7 +233,26 @@ def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 50
     CG lowers by ``alpha_k r_k . z_k`` in step k: when the last ``ENERGY_WINDOW`` steps together lowered it by less
     than ``etol E(x)``. The error left is then ~``etol E`` (the steps shrink geometrically), about half the
     iterations of a residual of ``etol`` -- enough for a Dirichlet energy, which bounds the exact one from above
-    whatever ``x`` (the energy error after step k is the sum of the later drops; Strakos & Tichy 2002)."""
+    whatever ``x`` (the energy error after step k is the sum of the later drops; Strakos & Tichy 2002).
+
+    Parameters
+    ----------
+    A : scipy.sparse matrix or scipy.sparse.linalg.LinearOperator
+        The symmetric positive definite matrix (n, n).
+    b : numpy.ndarray
+        Right-hand side (n,).
+    precondition : callable
+        ``r -> M^-1 r`` for a symmetric positive definite ``M`` (a :class:`TwoLevel`).
+    rtol : float
+        Relative residual ``|r| / |b|`` to reach (dimensionless; ignored when ``energy`` is given).
+    maxiter : int
+        Iterations allowed before ``RuntimeError``.
+    x0 : numpy.ndarray, optional
+        Start vector (n,); zero by default.
+    energy : tuple of float, optional
+        ``(E0, etol)``: the energy at ``x0`` (in the unit of ``b x``) and the relative energy tolerance
+        (dimensionless) of the energy stop above.
+    """
     x = np.zeros_like(b) if x0 is None else x0.copy()
     r = b - A @ x
     norm_b = float(np.linalg.norm(b)) or 1.0

@@ -25,14 +25,32 @@ ENERGY_RTOL = 1e-9
 
 def quadrature_degree(p: int) -> int:
     """Quadrature degree on curved elements: ``2 p`` (the polynomial part is ``2 p - 2``; two more for the map's
-    variation: at p = 4 the bounds move by 2-3e-9 relative against ``2 p + 4``, measured on the lattice cells)."""
+    variation: at p = 4 the bounds move by 2-3e-9 relative against ``2 p + 4``, measured on the lattice cells).
+
+    Parameters
+    ----------
+    p : int
+        Polynomial order of the elements (>= 1).
+    """
     return 2 * p
 
 
 def stiffness_matrices(mesh: CurvedMesh, basis: Lagrange, degree: int | None = None,
                        elements: np.ndarray | None = None) -> np.ndarray:
     """Element matrices ``(E, n, n)`` of ``int grad phi_a . grad phi_b`` of ``elements`` (default all): exact on
-    straight elements (a combination of the reference matrices), quadrature of ``degree`` on the curved ones."""
+    straight elements (a combination of the reference matrices), quadrature of ``degree`` on the curved ones.
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh, lengths in its own unit.
+    basis : fem_neck.simplex.Lagrange
+        The reference ``P_p`` basis.
+    degree : int, optional
+        Quadrature degree on the curved elements; default :func:`quadrature_degree`.
+    elements : numpy.ndarray, optional
+        Indices of the elements (rows of ``mesh.tets``); default all.
+    """
     elements = np.arange(len(mesh.tets)) if elements is None else elements
     J = mesh.affine_jacobians(elements)
     inv = np.linalg.inv(J)
@@ -54,7 +72,13 @@ def symmetric_products(g: np.ndarray) -> np.ndarray:
     """``g_i g_j^T`` of reference fields ``g (Q, 3, n)`` for the six ``(i, j)`` of ``UPPER`` (symmetrised for ``i !=
     j``), each kept as its entries on and above the diagonal in the order of ``numpy.triu_indices(n)``: ``(Q 6, n (n
     + 1) / 2)``, so that ``sum_q g^T G_q g`` is one matrix product with the entries of
-    :meth:`fem_neck.curved.CurvedMesh.metric`, packed like this (:func:`symmetric_gather` unpacks it)."""
+    :meth:`fem_neck.curved.CurvedMesh.metric`, packed like this (:func:`symmetric_gather` unpacks it).
+
+    Parameters
+    ----------
+    g : numpy.ndarray
+        Gradients of the ``n`` reference basis functions at ``Q`` points, ``(Q, 3, n)``.
+    """
     a, b = np.triu_indices(g.shape[2])
     out = np.stack([0.5 * (g[:, i, a] * g[:, j, b] + g[:, j, a] * g[:, i, b]) for i, j in UPPER], axis=1)
     return out.reshape(g.shape[0] * 6, -1)
@@ -62,7 +86,13 @@ def symmetric_products(g: np.ndarray) -> np.ndarray:
 
 def symmetric_gather(n: int) -> np.ndarray:
     """``(n n,)``: where entry ``(a, b)`` of a symmetric ``n`` square matrix is among its packed entries on and above
-    the diagonal (the order of ``numpy.triu_indices(n)``)."""
+    the diagonal (the order of ``numpy.triu_indices(n)``).
+
+    Parameters
+    ----------
+    n : int
+        Size of the square matrix.
+    """
     upper = np.triu_indices(n)
     position = np.empty((n, n), dtype=np.int64)
     position[upper] = position.T[upper] = np.arange(len(upper[0]))
@@ -72,7 +102,15 @@ def symmetric_gather(n: int) -> np.ndarray:
 def volume(mesh: CurvedMesh, degree: int = 10) -> float:
     """Volume of the mapped mesh (a check of the geometry against the exact solid): ``1/3 int x . n dS`` over its
     boundary faces (the divergence theorem), each face mapped with its element and integrated by the triangle rule of
-    ``degree`` (exact on the straight ones)."""
+    ``degree`` (exact on the straight ones).
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved mesh; the volume is in the cube of its length unit.
+    degree : int
+        Degree of the triangle quadrature on each boundary face.
+    """
     sides = mesh.face_sides()
     st, w = triangle_quadrature(degree)
     total = 0.0
@@ -89,14 +127,32 @@ def volume(mesh: CurvedMesh, degree: int = 10) -> float:
 
 @dataclass(frozen=True)
 class Numbering:
-    """Global dofs of the skeleton nodes (vertices, edges, faces) of every element ``(M, n_skeleton)`` in the local
-    order of :class:`fem_neck.simplex.Lagrange`, and their count."""
+    """Global dofs of the skeleton nodes (vertices, edges, faces) of every element.
+
+    Parameters
+    ----------
+    l2g : numpy.ndarray
+        Global dof of each element's skeleton nodes ``(M, n_skeleton)``, in the local order of
+        :class:`fem_neck.simplex.Lagrange`.
+    n : int
+        Number of global skeleton dofs.
+    """
 
     l2g: np.ndarray
     n: int
 
 
 def numbering(mesh: CurvedMesh, basis: Lagrange) -> Numbering:
+    """The :class:`Numbering` of the skeleton nodes: vertices first, then ``n_edge`` dofs per edge, then ``n_face``
+    per face.
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    basis : fem_neck.simplex.Lagrange
+        The reference ``P_p`` basis (its dofs per edge and per face).
+    """
     M = len(mesh.tets)
     nv, ne = len(mesh.points), len(mesh.edges)
     cols = [mesh.tets]
@@ -110,7 +166,17 @@ def numbering(mesh: CurvedMesh, basis: Lagrange) -> Numbering:
 
 
 def face_dofs(mesh: CurvedMesh, basis: Lagrange, faces: np.ndarray) -> np.ndarray:
-    """Global dofs of every node on the given faces."""
+    """Global dofs of every node on the given faces.
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    basis : fem_neck.simplex.Lagrange
+        The reference ``P_p`` basis.
+    faces : numpy.ndarray
+        Indices into ``mesh.faces``.
+    """
     nv, ne = len(mesh.points), len(mesh.edges)
     pe, pf = basis.n_edge, basis.n_face
     verts = mesh.faces[faces]
@@ -124,8 +190,25 @@ def face_dofs(mesh: CurvedMesh, basis: Lagrange, faces: np.ndarray) -> np.ndarra
 
 @dataclass
 class Solution:
-    """``energy = u^T A u`` (the upper bound of the conductance for a unit temperature difference, kappa = 1), the
-    skeleton temperature ``u``, dofs (all nodes), skeleton dofs, CG iterations and the relative residual."""
+    """The conforming solve of :func:`solve`.
+
+    Parameters
+    ----------
+    energy : float
+        ``u^T A u``: the upper bound of the conductance over ``kappa`` (``K / kappa``, for the unit temperature
+        difference), in the mesh's length unit (m for a mesh in metres).
+    u : numpy.ndarray
+        Temperature of every skeleton node (vertices, edges, faces; the interior nodes are condensed), for 1 K on
+        the hot faces and 0 on the cold ones.
+    dofs : int
+        Unknowns of the whole discretisation (all nodes, interior ones included).
+    skeleton_dofs : int
+        Unknowns of the condensed system CG solved.
+    iterations : int
+        CG iterations.
+    residual : float
+        Relative residual ``|r| / |b|`` CG stopped at (dimensionless).
+    """
 
     energy: float
     u: np.ndarray
@@ -139,7 +222,21 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
           degree: int | None = None) -> Solution:
     """The conforming ``P_p`` solution with ``u = 1`` on the ``hot`` faces and 0 on the ``cold`` ones (indices into
     ``mesh.faces``; quadrature of ``degree`` on curved elements, default :func:`quadrature_degree`); see the module
-    docstring. CG stops when the energy has settled to ``etol`` (:func:`fem_neck.pcg.solve`)."""
+    docstring. CG stops when the energy has settled to ``etol`` (:func:`fem_neck.pcg.solve`).
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh of the solid (any length unit; the energy is per unit ``kappa`` in that unit).
+    p : int
+        Polynomial order of the elements (>= 1).
+    hot, cold : numpy.ndarray
+        Indices into ``mesh.faces`` of the faces held at 1 and at 0.
+    etol : float
+        Relative energy tolerance of CG's energy stop (dimensionless).
+    degree : int, optional
+        Quadrature degree on curved elements; default :func:`quadrature_degree`.
+    """
     from fem_neck import pcg
 
     basis = lagrange(p)
@@ -168,7 +265,17 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
 
 def hat_prolongation(mesh: CurvedMesh, basis: Lagrange, num: Numbering):
     """The piecewise-linear hats in the skeleton basis, ``(n_skeleton, n_vertices)``: a hat's coefficient at a node
-    is its barycentric coordinate there."""
+    is its barycentric coordinate there.
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    basis : fem_neck.simplex.Lagrange
+        The reference ``P_p`` basis.
+    num : Numbering
+        The skeleton numbering of :func:`numbering`.
+    """
     import scipy.sparse as sp
 
     skel = basis.n - basis.n_interior

@@ -15,7 +15,17 @@ import numpy as np
 
 
 def sampled_fields(result, delta_t: float = 1.0, refine: int = 2):
-    """Refined linear sampling of the solution: ``(points (n, 2), triangles (m, 3), T (n,), q (n,))``."""
+    """Refined linear sampling of the solution: ``(points (n, 2), triangles (m, 3), T (n,), q (n,))``.
+
+    Parameters
+    ----------
+    result : fem_neck.conduction.Result
+        A result solved in this process (one that kept its ``solution`` and ``profile``).
+    delta_t : float
+        Temperature difference across the body, K: the solve's unit field is scaled by it.
+    refine : int
+        Times each element is subdivided for the sampling (the hp path: ``2 refine + 4`` points per edge).
+    """
     import skfem
 
     from fem_neck import spectral
@@ -48,7 +58,17 @@ def _mirrored(points, triangles, *fields):
 
 
 def write_vtu(result, path, delta_t: float = 1.0) -> pathlib.Path:
-    """Write ``temperature`` and ``heat_flux`` (point data) on the refined meridian mesh (x radial, y axial)."""
+    """Write ``temperature`` and ``heat_flux`` (point data) on the refined meridian mesh (x radial, y axial).
+
+    Parameters
+    ----------
+    result : fem_neck.conduction.Result
+        A result solved in this process (one that kept its ``solution`` and ``profile``).
+    path : str or pathlib.Path
+        The ``.vtu`` file to write.
+    delta_t : float
+        Temperature difference across the body, K.
+    """
     import meshio
 
     points, triangles, temperature, flux = sampled_fields(result, delta_t)
@@ -59,7 +79,19 @@ def write_vtu(result, path, delta_t: float = 1.0) -> pathlib.Path:
 
 
 def write_png(result, path, title: str = "", delta_t: float = 1.0) -> pathlib.Path:
-    """Two panels, temperature and heat-flux magnitude (log colour scale), of the mirrored axial section."""
+    """Two panels, temperature and heat-flux magnitude (log colour scale), of the mirrored axial section.
+
+    Parameters
+    ----------
+    result : fem_neck.conduction.Result
+        A result solved in this process (one that kept its ``solution`` and ``profile``).
+    path : str or pathlib.Path
+        The PNG file to write.
+    title : str
+        Text put before each panel's field name.
+    delta_t : float
+        Temperature difference across the body, K.
+    """
     import pyvista
 
     pyvista.OFF_SCREEN = True

@@ -42,7 +42,13 @@ def handlers() -> dict[int, SigAction]:
 
 
 def restore(saved: dict[int, SigAction]) -> None:
-    """Put back the handlers :func:`handlers` returned."""
+    """Put back the handlers :func:`handlers` returned.
+
+    Parameters
+    ----------
+    saved : dict
+        Signal number to the C library's handler record, as :func:`handlers` returned it.
+    """
     libc = _libc()
     for number, action in saved.items():
         libc.sigaction(number, ctypes.byref(action), None)

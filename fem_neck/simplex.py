@@ -27,7 +27,13 @@ FACES = ((1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2))  # face l is opposite verte
 
 
 def barycentric(xi: np.ndarray) -> np.ndarray:
-    """Barycentric coordinates ``(..., 4)`` of reference points ``(..., 3)``."""
+    """Barycentric coordinates ``(..., 4)`` of reference points ``(..., 3)``.
+
+    Parameters
+    ----------
+    xi : numpy.ndarray
+        Reference coordinates ``(..., 3)``.
+    """
     return np.concatenate([1.0 - xi.sum(axis=-1, keepdims=True), xi], axis=-1)
 
 
@@ -103,12 +109,28 @@ def _exponents(degree: int, dim: int, homogeneous: bool = False) -> np.ndarray:
 
 
 def monomials(x: np.ndarray, exponents: np.ndarray) -> np.ndarray:
-    """Monomials ``(..., m)`` at points ``(..., d)``."""
+    """Monomials ``(..., m)`` at points ``(..., d)``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Points ``(..., d)``.
+    exponents : numpy.ndarray
+        Integer exponents ``(m, d)``, one row per monomial.
+    """
     return np.prod(x[..., None, :] ** exponents, axis=-1)
 
 
 def monomial_gradients(x: np.ndarray, exponents: np.ndarray) -> np.ndarray:
-    """Gradients ``(..., d, m)`` of the monomials at points ``(..., d)``."""
+    """Gradients ``(..., d, m)`` of the monomials at points ``(..., d)``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Points ``(..., d)``.
+    exponents : numpy.ndarray
+        Integer exponents ``(m, d)``, one row per monomial.
+    """
     d = exponents.shape[1]
     out = []
     for k in range(d):
@@ -138,8 +160,22 @@ def _node_indices(p: int) -> list[tuple[int, ...]]:
 
 @dataclass(frozen=True)
 class Lagrange:
-    """The nodal basis of ``P_p`` on the reference tetrahedron (module docstring): ``nodes (n, 3)``, counts per
-    vertex, edge, face and interior, and the coefficients on the monomials."""
+    """The nodal basis of ``P_p`` on the reference tetrahedron (module docstring).
+
+    Parameters
+    ----------
+    p : int
+        Polynomial order (1 to 8).
+    nodes : numpy.ndarray
+        Reference coordinates ``(n, 3)`` of the nodes, ordered vertices, edges, faces, interior.
+    n_edge, n_face, n_interior : int
+        Nodes inside each edge (``p - 1``), inside each face (``(p - 1)(p - 2)/2``) and inside the element
+        (``(p - 1)(p - 2)(p - 3)/6``).
+    exponents : numpy.ndarray
+        Exponents ``(n, 3)`` of the monomials of total degree ``<= p``.
+    coefficients : numpy.ndarray
+        Coefficients ``(n, n)`` of the basis functions (columns) on the monomials (rows).
+    """
 
     p: int
     nodes: np.ndarray
@@ -151,14 +187,27 @@ class Lagrange:
 
     @property
     def n(self) -> int:
+        """Number of basis functions."""
         return len(self.nodes)
 
     def values(self, xi: np.ndarray) -> np.ndarray:
-        """Basis values ``(..., n)`` at reference points ``(..., 3)``."""
+        """Basis values ``(..., n)`` at reference points ``(..., 3)``.
+
+        Parameters
+        ----------
+        xi : numpy.ndarray
+            Reference coordinates ``(..., 3)``.
+        """
         return monomials(xi, self.exponents) @ self.coefficients
 
     def gradients(self, xi: np.ndarray) -> np.ndarray:
-        """Reference gradients ``(..., 3, n)``."""
+        """Reference gradients ``(..., 3, n)``.
+
+        Parameters
+        ----------
+        xi : numpy.ndarray
+            Reference coordinates ``(..., 3)``.
+        """
         return monomial_gradients(xi, self.exponents) @ self.coefficients
 
     @functools.cached_property
@@ -171,6 +220,7 @@ class Lagrange:
 
 @functools.lru_cache(maxsize=None)
 def lagrange(p: int) -> Lagrange:
+    """The :class:`Lagrange` basis of order ``p`` (1 to 8; ValueError otherwise), cached."""
     if not 1 <= p <= 8:
         raise ValueError(f"order = {p!r}: valid range 1 <= order <= 8")
     alpha = np.array(_node_indices(p), dtype=float)
@@ -183,13 +233,27 @@ def lagrange(p: int) -> Lagrange:
 
 def face_points(face: int, st: np.ndarray) -> np.ndarray:
     """Reference points ``(..., 3)`` of face ``face`` at its coordinates ``(s, t)``: ``v_a + s (v_b - v_a) + t (v_c
-    - v_a)`` with ``(a, b, c)`` its vertices in ascending order -- the same parametrisation from both elements."""
+    - v_a)`` with ``(a, b, c)`` its vertices in ascending order -- the same parametrisation from both elements.
+
+    Parameters
+    ----------
+    face : int
+        Face index 0 to 3 (face ``l`` is opposite vertex ``l``).
+    st : numpy.ndarray
+        Coordinates ``(..., 2)`` on the unit triangle.
+    """
     a, b, c = (VERTICES[v] for v in FACES[face])
     return a + st[..., :1] * (b - a) + st[..., 1:] * (c - a)
 
 
 def face_normal(face: int) -> np.ndarray:
-    """Outward normal of reference face ``face`` scaled by the Jacobian of its ``(s, t)`` parametrisation."""
+    """Outward normal of reference face ``face`` scaled by the Jacobian of its ``(s, t)`` parametrisation.
+
+    Parameters
+    ----------
+    face : int
+        Face index 0 to 3 (face ``l`` is opposite vertex ``l``).
+    """
     a, b, c = (VERTICES[v] for v in FACES[face])
     n = np.cross(b - a, c - a)
     inward = VERTICES[face] - a
@@ -203,6 +267,20 @@ class RaviartThomas:
     ``values(xi)`` gives the ``m`` fields at reference points ``(..., 3, m)``; ``traces (4 n_f, m)`` are the moments
     ``int_F mu tau . n_out dS`` against the face basis ``mu`` (``n_f`` functions of ``(s, t)`` per face, orthonormal
     on the unit triangle, the first constant); ``mass[i, j] = int tau_i tau_j^T`` (3, 3, m, m).
+
+    Parameters
+    ----------
+    k : int
+        Degree of the space (0 to 7).
+    exponents : numpy.ndarray
+        Exponents ``(n_k, 3)`` of the monomials of ``P_k``.
+    coefficients : numpy.ndarray
+        ``(3 n_k + n_h, m)``: the divergence-free fields as combinations of the monomial fields (``e_d`` times each
+        monomial, then ``x`` times each of the ``n_h`` homogeneous ones).
+    face_exponents : numpy.ndarray
+        Exponents ``(n_f, 2)`` of the monomials of ``P_k`` in the face coordinates ``(s, t)``.
+    face_coefficients : numpy.ndarray
+        ``(n_f, n_f)``: the orthonormal face basis on those monomials.
     """
 
     k: int
@@ -213,10 +291,12 @@ class RaviartThomas:
 
     @property
     def m(self) -> int:
+        """Number of divergence-free fields."""
         return self.coefficients.shape[1]
 
     @property
     def n_face(self) -> int:
+        """Number of face functions per face."""
         return self.face_coefficients.shape[1]
 
     def _full(self, xi: np.ndarray) -> np.ndarray:
@@ -237,13 +317,28 @@ class RaviartThomas:
         return np.flatnonzero(self.exponents.sum(axis=1) == self.k)
 
     def values(self, xi: np.ndarray) -> np.ndarray:
+        """The ``m`` fields ``(..., 3, m)`` at reference points ``xi (..., 3)``.
+
+        Parameters
+        ----------
+        xi : numpy.ndarray
+            Reference coordinates ``(..., 3)``.
+        """
         return self._full(xi) @ self.coefficients
 
     def face_basis(self, st: np.ndarray) -> np.ndarray:
+        """The face functions ``mu (..., n_f)`` at face coordinates ``st (..., 2)``.
+
+        Parameters
+        ----------
+        st : numpy.ndarray
+            Coordinates ``(..., 2)`` on the unit triangle.
+        """
         return monomials(st, self.face_exponents) @ self.face_coefficients
 
     @functools.cached_property
     def traces(self) -> np.ndarray:
+        """The face moments ``int_F mu tau . n_out dS``, (4 n_f, m): face-basis function (rows) by field."""
         st, w = triangle_quadrature(2 * self.k + 2)
         mu = self.face_basis(st)                                   # (q, n_f)
         rows = []
@@ -254,6 +349,7 @@ class RaviartThomas:
 
     @functools.cached_property
     def mass(self) -> np.ndarray:
+        """``mass[i, j] = int tau_i tau_j^T`` (3, 3, m, m) on the reference tetrahedron."""
         x, w = tet_quadrature(2 * self.k + 2)
         v = self.values(x)
         return np.einsum("q,qia,qjb->ijab", w, v, v)
@@ -270,6 +366,8 @@ def _divergence(xi: np.ndarray, exponents: np.ndarray, homogeneous: np.ndarray, 
 
 @functools.lru_cache(maxsize=None)
 def raviart_thomas(k: int) -> RaviartThomas:
+    """The :class:`RaviartThomas` space of degree ``k`` (0 to 7; ValueError otherwise), its fields orthonormal in
+    the reference mass, cached."""
     if not 0 <= k <= 7:
         raise ValueError(f"k = {k!r}: valid range 0 <= k <= 7")
     exponents = _exponents(k, 3)

@@ -35,15 +35,24 @@ MAX_ORDER = 12
 class QuadMesh:
     """Quadrilaterals with straight or circular edges.
 
-    points: ``(V, 2)`` vertex coordinates ``(x, z)`` (``x`` the radial coordinate).
-    quads: ``(E, 4)`` vertex indices, counter-clockwise.
-    arc_angles: ``(E, 4, 2)`` for edge ``k`` (from vertex ``k`` to ``k + 1``): the angle offsets ``(delta_start,
-    delta_end)`` of its ends along a circle, or NaN for a straight edge.
-    arc_circle: ``(E, 4)`` index into ``circles`` of a curved edge's circle (-1 for straight edges).
-    circles: functions ``delta (array) -> (points (..., 2), d points / d delta (..., 2))``, cancellation-free
-    in the coordinates of ``points``.
-    origin: ``(0, z0)``: absolute coordinates are ``points + origin`` (only the axial coordinate may be shifted:
-    the radial one is the weight of the axisymmetric forms).
+    Parameters
+    ----------
+    points : numpy.ndarray
+        Vertex coordinates ``(V, 2)``, ``(x, z)`` with ``x`` the radial coordinate, in the length unit of the body
+        (relative to ``origin``).
+    quads : numpy.ndarray
+        Vertex indices ``(E, 4)``, counter-clockwise.
+    arc_angles : numpy.ndarray
+        ``(E, 4, 2)``: for edge ``k`` (from vertex ``k`` to ``k + 1``) the angle offsets ``(delta_start,
+        delta_end)`` of its ends along its circle, rad, or NaN for a straight edge.
+    arc_circle : numpy.ndarray
+        ``(E, 4)``: index into ``circles`` of a curved edge's circle (-1 for straight edges).
+    circles : tuple of callable
+        Functions ``delta (array, rad) -> (points (..., 2), d points / d delta (..., 2))``, cancellation-free in
+        the coordinates of ``points``.
+    origin : tuple of float
+        ``(0, z0)``: absolute coordinates are ``points + origin`` (only the axial coordinate may be shifted: the
+        radial one is the weight of the axisymmetric forms).
     """
 
     points: np.ndarray
@@ -57,7 +66,13 @@ class QuadMesh:
 @functools.lru_cache(maxsize=None)
 def reference(order: int):
     """GLL nodes on [0, 1], Gauss points/weights on [0, 1], and the 1D Lagrange values and derivatives at the Gauss
-    points: ``(nodes, gauss, weights, values (q, p+1), derivatives (q, p+1))``, ``q = p + 2``."""
+    points: ``(nodes, gauss, weights, values (q, p+1), derivatives (q, p+1))``, ``q = p + 2``.
+
+    Parameters
+    ----------
+    order : int
+        Polynomial order ``p`` (1 to ``MAX_ORDER``).
+    """
     from numpy.polynomial import legendre
 
     coefficients = np.zeros(order + 1)
@@ -71,7 +86,15 @@ def reference(order: int):
 
 
 def lagrange(nodes: np.ndarray, x: np.ndarray):
-    """Values and derivatives ``(len(x), len(nodes))`` of the Lagrange polynomials on ``nodes`` at ``x``."""
+    """Values and derivatives ``(len(x), len(nodes))`` of the Lagrange polynomials on ``nodes`` at ``x``.
+
+    Parameters
+    ----------
+    nodes : numpy.ndarray
+        Interpolation nodes (1D).
+    x : numpy.ndarray
+        Evaluation points (1D).
+    """
     diff = x[:, None] - nodes[None, :]
     n = nodes.size
     values = np.empty((x.size, n))
@@ -116,7 +139,15 @@ def _edge_offsets(mesh: QuadMesh, k: int, s: np.ndarray):
 def geometry(mesh: QuadMesh, xi: np.ndarray, eta: np.ndarray):
     """Transfinite map at reference points ``(xi, eta)`` (1D arrays, same length m): ``X (E, m, 2)``, ``dX/dxi`` and
     ``dX/deta``. Bilinear interpolation of the vertices plus, per curved edge, its offset from the chord blended
-    linearly toward the opposite edge (Gordon-Hall)."""
+    linearly toward the opposite edge (Gordon-Hall).
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The quadrilateral mesh.
+    xi, eta : numpy.ndarray
+        Reference coordinates in ``[0, 1]`` (1D, same length).
+    """
     P = mesh.points[mesh.quads]                          # (E, 4, 2)
     xi_, eta_ = xi[None, :, None], eta[None, :, None]
     p0, p1, p2, p3 = (P[:, k, None, :] for k in range(4))
@@ -152,7 +183,15 @@ def numbering(mesh: QuadMesh, order: int):
     """Global dof of every local node ``(E, (p + 1)^2)`` (local node ``a + (p + 1) b``, ``a`` along xi), the dof
     count, the skeleton dof count and the vertex pair of every global edge ``(NE, 2)``. Vertices come first, then
     ``p - 1`` nodes per edge (ordered from its lower to its higher vertex index) -- together the skeleton -- then
-    ``(p - 1)^2`` interior nodes per element."""
+    ``(p - 1)^2`` interior nodes per element.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The quadrilateral mesh.
+    order : int
+        Polynomial order ``p``.
+    """
     p = order
     quads = mesh.quads
     n_vertices = mesh.points.shape[0]
@@ -217,7 +256,15 @@ def _element(p: int) -> _Element:
 
 def stiffness(mesh: QuadMesh, order: int):
     """Element matrices ``(E, n, n)`` of ``int x grad u . grad v`` (``x`` = first coordinate, the radius) and the
-    smallest ``det J`` at a quadrature point."""
+    smallest ``det J`` at a quadrature point.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The quadrilateral mesh.
+    order : int
+        Polynomial order ``p``.
+    """
     el = _element(order)
     X, X_xi, X_eta = geometry(mesh, el.xi, el.eta)
     det = X_xi[..., 0] * X_eta[..., 1] - X_xi[..., 1] * X_eta[..., 0]          # (E, Q)
@@ -232,9 +279,24 @@ def stiffness(mesh: QuadMesh, order: int):
 
 @dataclass
 class Solution:
-    """One solve: ``K_over_kappa = K / kappa`` for a unit temperature difference, the dof count (all nodes) and the
-    skeleton dofs actually solved for (interiors are condensed), the order, the temperature at every local node
-    ``u_local (E, (p + 1)^2)`` and the smallest Jacobian determinant."""
+    """One solve of :func:`solve`.
+
+    Parameters
+    ----------
+    K_over_kappa : float
+        ``K / kappa`` for a unit temperature difference, in the length unit of the mesh (m for a mesh in metres).
+    dofs : int
+        Unknowns of the discretisation (all nodes).
+    skeleton_dofs : int
+        Unknowns actually solved for (vertices and edge nodes; the interiors are condensed).
+    order : int
+        Polynomial order ``p`` of the elements.
+    u_local : numpy.ndarray
+        Temperature ``(E, (p + 1)^2)`` at every local node, in the unit of the fixed values (K).
+    jacobian_min : float
+        Smallest Jacobian determinant of the element maps at the quadrature points (> 0 for a valid mesh), in the
+        square of the length unit.
+    """
 
     K_over_kappa: float
     dofs: int
@@ -247,7 +309,17 @@ class Solution:
 def conductance(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
     """:func:`solve` with BLAS on one thread: the dense work here is many small products, for which a second BLAS
     thread only adds synchronisation -- on a busy 2-core machine it made the element matrices 3-6x slower and a
-    dense 300 x 300 Cholesky 5-50x slower (measured); parallel sweeps use processes instead."""
+    dense 300 x 300 Cholesky 5-50x slower (measured); parallel sweeps use processes instead.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The quadrilateral mesh of the meridian half-plane.
+    order : int
+        Polynomial order ``p`` (1 to ``MAX_ORDER``).
+    fixed_vertices : dict
+        Temperature (K) to a mask over the vertices where it is held; two entries (as in :func:`solve`).
+    """
     with one_blas_thread():
         return solve(mesh, order, fixed_vertices)
 
@@ -256,7 +328,18 @@ def solve(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
     """Solve ``div(x grad T) = 0`` with ``T`` held at ``value`` on every edge whose two vertices are in
     ``fixed_vertices[value]`` (a boolean mask over the vertices; two values), insulated elsewhere; return ``K / kappa
     = 2 pi u^T A u / (Delta T)^2``. Element interiors are condensed (Schur complement, batched) so only the skeleton
-    is factorised; the energy of the condensed system equals that of the full one."""
+    is factorised; the energy of the condensed system equals that of the full one.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The quadrilateral mesh of the meridian half-plane.
+    order : int
+        Polynomial order ``p`` (1 to ``MAX_ORDER``).
+    fixed_vertices : dict
+        Temperature (K) to a mask over the vertices where it is held; two entries, the difference of their keys being
+        the temperature difference.
+    """
     if not (isinstance(order, (int, np.integer)) and 1 <= order <= MAX_ORDER):
         raise ValueError(f"order = {order!r}: valid range 1 <= order <= {MAX_ORDER}")
     p = int(order)
@@ -310,7 +393,15 @@ def solve(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
 
 def measure(mesh: QuadMesh, order: int = 4) -> tuple[float, float]:
     """``(2 pi int x dA, min det J)``: the volume of revolution of the mesh (a check against the exact body) and its
-    smallest Jacobian determinant at the order's quadrature points (> 0 for a valid mesh)."""
+    smallest Jacobian determinant at the order's quadrature points (> 0 for a valid mesh).
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The quadrilateral mesh of the meridian half-plane.
+    order : int
+        Order whose quadrature (``p + 2`` Gauss points per direction) integrates the volume.
+    """
     el = _element(order)
     X, X_xi, X_eta = geometry(mesh, el.xi, el.eta)
     det = X_xi[..., 0] * X_eta[..., 1] - X_xi[..., 1] * X_eta[..., 0]
@@ -320,7 +411,17 @@ def measure(mesh: QuadMesh, order: int = 4) -> tuple[float, float]:
 def sample(mesh: QuadMesh, solution: Solution, points_per_edge: int = 6):
     """The solution on a uniform ``points_per_edge``-grid in every element, for pictures and VTU files:
     ``(points (n, 2), triangles (m, 3), T (n,), |grad T| (n,))`` in absolute coordinates (points per element, not
-    shared)."""
+    shared).
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The mesh ``solution`` was solved on.
+    solution : Solution
+        The solve to sample.
+    points_per_edge : int
+        Sample points along each edge of every element (>= 2).
+    """
     p = solution.order
     nodes = reference(p)[0]
     s = np.linspace(0.0, 1.0, points_per_edge)

@@ -1,4 +1,4 @@
-"""Transient conduction in an insulated sintered pair: axisymmetric FE against the lumped-capacity pipe model.
+r"""Transient conduction in an insulated sintered pair: axisymmetric FE against the lumped-capacity pipe model.
 
 The pair of spheres ``r_i``, ``r_j`` with the volume-conserving cylindrical neck (Rojek 2022, Sections 4.3) is a
 body of revolution. In its meridian half-plane (``x`` radial >= 0, ``y`` axial, centre i at the origin, centre j at
@@ -7,17 +7,19 @@ with gmsh OCC booleans (as in :mod:`fem_neck.cluster`, the caps need no explicit
 ``y = z_split`` where each particle's share of the cylinder equals its cap's volume, so that each particle owns
 exactly ``4/3 pi r^3`` -- the DEM's mass -- and the initial field (``T_i`` on particle i, ``T_j`` on j) is sharp.
 
-The heat equation ``rho c dT/dt = div(kappa grad T)``, insulated everywhere, in axisymmetric weak form (every
-integrand weighted by the radial coordinate ``x``, design notes): mass ``M = 2 pi rho c int u v x``, stiffness
-``A = 2 pi kappa int grad u . grad v x``. Time stepping is implicit: backward Euler for the first steps (it damps
-the stiff modes of the discontinuous start; Rannacher's start-up) then Crank-Nicolson, with the step doubling in
-blocks up to a cap (:func:`time_grid`), each distinct step's matrix factorised once. Both conserve ``1^T M T``
-exactly (``A 1 = 0``), i.e. the energy ``sum_i C_i Tbar_i``.
+The heat equation :math:`\rho c \, \partial T/\partial t = \nabla \cdot (\kappa \nabla T)`, insulated everywhere,
+in axisymmetric weak form (every integrand weighted by the radial coordinate ``x``, design notes): mass
+:math:`M = 2 \pi \rho c \int u v x`, stiffness :math:`A = 2 \pi \kappa \int \nabla u \cdot \nabla v \, x`. Time
+stepping is implicit: backward Euler for the first steps (it damps the stiff modes of the discontinuous start;
+Rannacher's start-up) then Crank-Nicolson, with the step doubling in blocks up to a cap (:func:`time_grid`), each
+distinct step's matrix factorised once. Both conserve ``1^T M T`` exactly (``A 1 = 0``), i.e. the energy ``sum_i C_i
+Tbar_i``.
 
-The lumped model (Rojek 2022, eqs. 2-4): ``C_i dT_i/dt = K (T_j - T_i)``, so the particle-temperature difference
-decays as ``exp(-lambda t)`` with ``lambda = K (1/C_i + 1/C_j)``, ``C = rho c 4/3 pi r^3``. The FE difference of the
-particle *means* tends to ``exp(-lambda_1 t)`` with ``lambda_1`` the smallest non-zero eigenvalue of ``(A, M)``
-(:func:`first_decay_rate`); ``lambda_1 (1/C_i + 1/C_j)^-1`` is the conductance the lumped model would need.
+The lumped model (Rojek 2022, eqs. 2-4): :math:`C_i \, dT_i/dt = K (T_j - T_i)`, so the particle-temperature
+difference decays as :math:`e^{-\lambda t}` with :math:`\lambda = K (1/C_i + 1/C_j)`,
+:math:`C = \rho c \tfrac{4}{3} \pi r^3`. The FE difference of the particle *means* tends to
+:math:`e^{-\lambda_1 t}` with :math:`\lambda_1` the smallest non-zero eigenvalue of :math:`(A, M)`
+(:func:`first_decay_rate`); :math:`\lambda_1 (1/C_i + 1/C_j)^{-1}` is the conductance the lumped model would need.
 """
 
 from __future__ import annotations
@@ -33,9 +35,21 @@ _EXTEND = 0.25  # the neck rectangle reaches this fraction of z into each disk (
 
 @dataclass
 class PairMesh:
-    """Meridian-plane mesh of the closed pair: ``mesh`` (``skfem.MeshTri1``, metres), ``particle`` (0 or 1 per
-    element), ``z_split`` (axial position of the neck split), ``volume_exact`` (``4/3 pi (r_i^3 + r_j^3)``) and the
-    :class:`fem_neck.geometry.NeckGeometry` ``geometry``."""
+    """Meridian-plane mesh of the closed pair (:func:`pair_mesh`).
+
+    Parameters
+    ----------
+    mesh : skfem.MeshTri1
+        Triangles of the meridian half-plane (``x`` radial, ``y`` axial), m.
+    particle : numpy.ndarray
+        Particle of every element, 0 (i) or 1 (j).
+    z_split : float
+        Axial position of the neck split from centre i, m (:func:`split_position`).
+    volume_exact : float
+        ``4/3 pi (r_i^3 + r_j^3)``, m^3.
+    geometry : fem_neck.geometry.NeckGeometry
+        The pair's neck geometry.
+    """
 
     mesh: object
     particle: np.ndarray
@@ -45,7 +59,15 @@ class PairMesh:
 
 
 def split_position(geo, r_i) -> float:
-    """Axial position (from centre i) where the neck is split: ``z_i + V_cap,i / (pi a^2)``."""
+    """Axial position (from centre i) where the neck is split: ``z_i + V_cap,i / (pi a^2)``.
+
+    Parameters
+    ----------
+    geo : fem_neck.geometry.NeckGeometry
+        The pair's neck geometry (m).
+    r_i : float
+        Radius of particle i, m.
+    """
     cap_i = np.pi * geo.h_ci**2 * (3.0 * r_i - geo.h_ci) / 3.0
     return float(geo.z_i + cap_i / (np.pi * geo.a**2))
 
@@ -56,6 +78,19 @@ def pair_mesh(r_i: float, r_j: float, h: float, grading: float = 0.3, size_max: 
 
     The size grows linearly with the distance ``s`` to the two neck corners, ``min(size_max r_min, size_min m +
     grading s)`` with ``m = min(a, h_n)``; single-threaded gmsh (deterministic).
+
+    Parameters
+    ----------
+    r_i, r_j : float
+        The two particle radii, m, finite and > 0.
+    h : float
+        Overlap of the two spheres, m, > 0 (the input of :func:`fem_neck.geometry.neck_geometry`).
+    grading : float
+        Growth of the element size per distance from the neck corners (dimensionless).
+    size_max : float
+        Largest element size, relative to the smaller radius (dimensionless).
+    size_min : float
+        Element size at the corners, relative to ``min(a, h_n)`` (dimensionless).
     """
     from skfem import MeshTri1
 
@@ -129,9 +164,21 @@ def _forms(basis, kappa, rho_c):
 
 @dataclass
 class TransientResult:
-    """``t`` (s), ``T_mean`` (len(t), 2) particle-mean temperatures, ``C`` (2,) the FE particle capacities (J/K,
-    ``rho c`` times each particle's mesh volume), ``energy`` ``M``-weighted total heat content per time (J, up to
-    a constant), ``dofs``."""
+    """The integration of :func:`solve_transient`.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Times, s, from 0 (len(steps) + 1).
+    T_mean : numpy.ndarray
+        Particle-mean temperatures (len(t), 2), K.
+    C : numpy.ndarray
+        FE heat capacities of the two particles (2,), J/K: ``rho c`` times each particle's mesh volume.
+    energy : numpy.ndarray
+        Total heat content ``1^T M T`` at each time, J (up to a constant; conserved).
+    dofs : int
+        Unknowns of the FE space.
+    """
 
     t: np.ndarray
     T_mean: np.ndarray
@@ -142,7 +189,19 @@ class TransientResult:
 
 def time_grid(t_end: float, dt0: float, dt_max: float, steps_per_block: int = 8) -> np.ndarray:
     """Time steps to ``t_end``: ``steps_per_block`` steps of ``dt0``, then of ``2 dt0``, ``4 dt0``, ... until the
-    step reaches ``dt_max``, then steps of ``dt_max`` (the last one shortened to land on ``t_end``)."""
+    step reaches ``dt_max``, then steps of ``dt_max`` (the last one shortened to land on ``t_end``).
+
+    Parameters
+    ----------
+    t_end : float
+        End time, s, > 0.
+    dt0 : float
+        First time step, s, > 0.
+    dt_max : float
+        Largest time step, s, > 0.
+    steps_per_block : int
+        Steps taken at each step size before it doubles.
+    """
     t_end = float(check_positive("t_end", t_end))
     dt0 = float(check_positive("dt0", dt0))
     dt_max = float(check_positive("dt_max", dt_max))
@@ -161,7 +220,27 @@ def time_grid(t_end: float, dt0: float, dt_max: float, steps_per_block: int = 8)
 def solve_transient(pm: PairMesh, kappa: float, rho: float, c: float, T_i: float, T_j: float, steps: np.ndarray,
                     order: int = 2, startup: int = 4) -> TransientResult:
     """Integrate the insulated pair from ``T_i``/``T_j`` over the time ``steps`` (array of dt): ``startup`` backward
-    Euler steps, then Crank-Nicolson; each distinct dt is factorised once (scipy splu)."""
+    Euler steps, then Crank-Nicolson; each distinct dt is factorised once (scipy splu).
+
+    Parameters
+    ----------
+    pm : PairMesh
+        The meshed pair.
+    kappa : float
+        Thermal conductivity, W/(m K), > 0.
+    rho : float
+        Density, kg/m^3, > 0.
+    c : float
+        Specific heat capacity, J/(kg K), > 0.
+    T_i, T_j : float
+        Initial temperatures of particles i and j, K.
+    steps : numpy.ndarray
+        The time steps, s, each > 0 (:func:`time_grid`).
+    order : int
+        Element order, 1 or 2.
+    startup : int
+        Backward Euler steps before Crank-Nicolson.
+    """
     import scipy.sparse.linalg as spl
     from skfem import Basis, ElementTriP1, ElementTriP2, Functional
 
@@ -203,7 +282,21 @@ def solve_transient(pm: PairMesh, kappa: float, rho: float, c: float, T_i: float
 
 def first_decay_rate(pm: PairMesh, kappa: float, rho: float, c: float, order: int = 2) -> float:
     """Smallest non-zero eigenvalue ``lambda_1`` of ``A x = lambda M x`` (1/s): the late-time decay rate of the
-    insulated pair's temperature difference."""
+    insulated pair's temperature difference.
+
+    Parameters
+    ----------
+    pm : PairMesh
+        The meshed pair.
+    kappa : float
+        Thermal conductivity, W/(m K).
+    rho : float
+        Density, kg/m^3.
+    c : float
+        Specific heat capacity, J/(kg K).
+    order : int
+        Element order, 1 or 2.
+    """
     import scipy.sparse.linalg as spl
     from skfem import Basis, ElementTriP1, ElementTriP2
 
@@ -216,7 +309,19 @@ def first_decay_rate(pm: PairMesh, kappa: float, rho: float, c: float, order: in
 
 
 def lumped_pair(t, T_i: float, T_j: float, C_i: float, C_j: float, K: float) -> np.ndarray:
-    """Closed form of the lumped pair (Rojek 2022, eqs. 2-4): temperatures (len(t), 2)."""
+    """Closed form of the lumped pair (Rojek 2022, eqs. 2-4): temperatures (len(t), 2).
+
+    Parameters
+    ----------
+    t : array_like
+        Times, s.
+    T_i, T_j : float
+        Initial temperatures of particles i and j, K.
+    C_i, C_j : float
+        Heat capacities of the particles, J/K (``rho c 4/3 pi r^3``).
+    K : float
+        Conductance of the pipe between them, W/K.
+    """
     t = np.asarray(t, dtype=float)
     T_eq = (C_i * T_i + C_j * T_j) / (C_i + C_j)
     decay = np.exp(-K * (1.0 / C_i + 1.0 / C_j) * t)

@@ -52,7 +52,26 @@ def _parse_list(name: str, values, lo: float, hi: float) -> tuple:
 
 def study(ratios=RATIOS, necks=NECKS, rtol: float = 1e-4, out=None, *, workers: int | None = None,
           progress: bool = True, paper_rtol: float = 1e-6) -> dict:
-    """Run the study (module docstring); with ``out`` write unequal.json, unequal.csv and unequal.png."""
+    """Run the study (module docstring); with ``out`` write unequal.json, unequal.csv and unequal.png.
+
+    Parameters
+    ----------
+    ratios : sequence of float
+        Radius ratios ``q = r_j/r_i`` to solve (dimensionless, each in ``[1, 100]``).
+    necks : sequence of float
+        Neck radii ``a/r_i`` to solve (dimensionless, each in ``[0.001, 0.99]``).
+    rtol : float
+        Relative error the FE solves of the grid are converged to (dimensionless, in ``(0, 0.1)``).
+    out : str or pathlib.Path, optional
+        Folder for unequal.json, unequal.csv and unequal.png (created if missing); None writes nothing.
+    workers : int, optional
+        Processes solving at once (:func:`sinterheat.pool.run_jobs`); default one per core.
+    progress : bool
+        Show a progress bar on stderr.
+    paper_rtol : float
+        Relative error the solve of the paper's case (Rojek 2022, Section 6: ``r_i`` = 1 mm, ``r_j`` = 3 mm,
+        ``h`` = 0.06 mm, ``kappa`` = 394 W/(m K)) is converged to (dimensionless).
+    """
     ratios = _parse_list("ratios", ratios, 1.0, 100.0)
     necks = _parse_list("necks", necks, 1e-3, 0.99)
     if not (isinstance(rtol, float) and 0.0 < rtol < 0.1):
@@ -116,7 +135,17 @@ def study(ratios=RATIOS, necks=NECKS, rtol: float = 1e-4, out=None, *, workers: 
 
 
 def plot(rows, ratios, path) -> None:
-    """Relative deviation from FE of the halves law (solid), corrected (dotted) and eq. 43 (inset scale)."""
+    """Relative deviation from FE of the halves law (solid), corrected (dotted) and eq. 43 (inset scale).
+
+    Parameters
+    ----------
+    rows : list of dict
+        The ``cases`` rows of :func:`study` (``r_j``, ``a`` and the ``dev_*`` deviations).
+    ratios : sequence of float
+        The radius ratios ``r_j/r_i`` to draw, one colour each.
+    path : str or pathlib.Path
+        The PNG file to write.
+    """
     import matplotlib
 
     matplotlib.use("Agg")

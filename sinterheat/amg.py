@@ -15,7 +15,17 @@ SEED = 0  # the random start vector of pyamg's spectral-radius estimates
 
 
 def hierarchy(A, seed: int = SEED, **options):
-    """``pyamg.smoothed_aggregation_solver(A, **options)`` seeded with ``seed``, every level on CSR."""
+    """``pyamg.smoothed_aggregation_solver(A, **options)`` seeded with ``seed``, every level on CSR.
+
+    Parameters
+    ----------
+    A : scipy.sparse matrix
+        The symmetric positive definite matrix (n, n).
+    seed : int
+        Seed of numpy's global generator during the setup (restored after).
+    options : object
+        Keywords of ``pyamg.smoothed_aggregation_solver`` (``symmetry``, ``max_coarse``, ...).
+    """
     import pyamg
 
     state = np.random.get_state()

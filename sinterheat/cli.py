@@ -33,6 +33,13 @@ class OneLineParser(argparse.ArgumentParser):
 
     Negative numbers in scientific notation (``--ri -1e-3``) are read as values, not as options, so that the
     command can reject them with a message about the value.
+
+    Parameters
+    ----------
+    args : object
+        Positional arguments of ``argparse.ArgumentParser``.
+    kwargs : object
+        Keyword arguments of ``argparse.ArgumentParser`` (``prog``, ``description``, ...).
     """
 
     def __init__(self, *args, **kwargs):
@@ -40,13 +47,25 @@ class OneLineParser(argparse.ArgumentParser):
         self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$", re.I)
 
     def error(self, message):
-        """Print ``PROG: error: MESSAGE`` as one line on stderr and exit with code 2 (no usage block)."""
+        """Print ``PROG: error: MESSAGE`` as one line on stderr and exit with code 2 (no usage block).
+
+        Parameters
+        ----------
+        message : str
+            argparse's message.
+        """
         sys.stderr.write(f"{self.prog}: error: {message}\n")
         raise SystemExit(2)
 
 
 def add_output_options(parser: argparse.ArgumentParser) -> None:
-    """The options every sub-command shares: ``--json`` and ``--out DIR``."""
+    """The options every sub-command shares: ``--json`` and ``--out DIR``.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        A sub-command's parser.
+    """
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout, nothing else")
     parser.add_argument("--out", metavar="DIR", default=None, help="write result files into DIR")
 
@@ -62,7 +81,13 @@ def _worker_count(text: str) -> int:
 
 
 def add_workers_option(parser: argparse.ArgumentParser) -> None:
-    """``--workers W``: processes of a parallel sweep (default: all cores), checked to be >= 1."""
+    """``--workers W``: processes of a parallel sweep (default: all cores), checked to be >= 1.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        A sub-command's parser.
+    """
     parser.add_argument("--workers", type=_worker_count, default=None, metavar="W",
                         help="processes (default: all cores)")
 
@@ -79,7 +104,13 @@ def _checked_by(module: str, check: str):
 
 
 def add_threads_option(parser: argparse.ArgumentParser) -> None:
-    """``--threads N``: the threads of the compiled loops and of BLAS, 1 to the cores (:mod:`sinterheat.threads`)."""
+    """``--threads N``: the threads of the compiled loops and of BLAS, 1 to the cores (:mod:`sinterheat.threads`).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        A sub-command's parser.
+    """
     parser.add_argument("--threads", type=_checked_by("sinterheat.threads", "check"), default=None, metavar="N",
                         help="threads of the compiled loops and BLAS, 1 to the cores (default: the environment "
                              "variable SINTERHEAT_THREADS, else every core); results are the same on any number")
@@ -87,20 +118,38 @@ def add_threads_option(parser: argparse.ArgumentParser) -> None:
 
 def use_threads(args) -> None:
     """The threads of ``--threads``, or of :func:`sinterheat.threads.count` (a bad ``SINTERHEAT_THREADS``: a
-    ``ValueError`` naming it), for the rest of the process."""
+    ``ValueError`` naming it), for the rest of the process.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed options with ``threads`` (int or None).
+    """
     from sinterheat import threads
 
     threads.use(threads.count() if args.threads is None else args.threads)
 
 
 def add_quiet_option(parser: argparse.ArgumentParser) -> None:
-    """``--quiet``: no progress bars; only the result and errors."""
+    """``--quiet``: no progress bars; only the result and errors.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        A sub-command's parser.
+    """
     parser.add_argument("--quiet", action="store_true", help="no progress bars: only the result and errors")
 
 
 def add_scheduler_option(parser: argparse.ArgumentParser) -> None:
     """``--scheduler ADDRESS``: the sweep's jobs on a Dask cluster (:func:`sinterheat.pool.use_dask`); without Dask
-    installed the option is refused with how to install it."""
+    installed the option is refused with how to install it.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        A sub-command's parser.
+    """
     parser.add_argument("--scheduler", type=_checked_by("sinterheat.pool", "check_scheduler"), default=None,
                         metavar="ADDRESS",
                         help="run the independent jobs on a Dask cluster: a scheduler's address (tcp://host:8786) or "
@@ -123,6 +172,13 @@ def print_result(result: dict, as_json: bool) -> None:
     """``--json``: one JSON object; otherwise one ``key: value`` line per entry.
 
     A reader that closes the pipe early (``| head``) ends the output quietly, as for any Unix filter.
+
+    Parameters
+    ----------
+    result : dict
+        The command's JSON-ready result.
+    as_json : bool
+        Print one JSON object instead of lines.
     """
     try:
         _write_result(result, as_json)
@@ -133,7 +189,13 @@ def print_result(result: dict, as_json: bool) -> None:
 
 def finite_or_none(value):
     """``value`` with every non-finite float (NaN, +-inf) replaced by ``None``: JSON has no NaN, and a number that
-    is not defined (e.g. an order fitted from fewer than two points) is reported as null, never as NaN."""
+    is not defined (e.g. an order fitted from fewer than two points) is reported as null, never as NaN.
+
+    Parameters
+    ----------
+    value : object
+        A number, or a dict, list or tuple of them (nested).
+    """
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, dict):
@@ -157,6 +219,20 @@ def _write_result(result: dict, as_json: bool) -> None:
 
 
 def build_parser(prog: str, description: str, modules, package: str) -> argparse.ArgumentParser:
+    """The top-level parser of ``prog`` with one sub-command per module of ``modules`` (each module's ``register`` adds
+    its parser).
+
+    Parameters
+    ----------
+    prog : str
+        The program's name (``python -m fem_neck``).
+    description : str
+        The top-level help text.
+    modules : sequence of str
+        The sub-command modules' names, relative to ``package``.
+    package : str
+        The package holding them (``fem_neck.cli``).
+    """
     parser = OneLineParser(prog=prog, description=description)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=OneLineParser)
     sub.required = True
@@ -166,7 +242,21 @@ def build_parser(prog: str, description: str, modules, package: str) -> argparse
 
 
 def main(argv=None, *, prog: str, description=None, modules, package: str) -> int:
-    """Run the sub-command named in ``argv`` among ``modules`` of ``package`` (each exposing ``register``)."""
+    """Run the sub-command named in ``argv`` among ``modules`` of ``package`` (each exposing ``register``).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The command-line arguments after the program name; default ``sys.argv[1:]``.
+    prog : str
+        The program's name (``python -m fem_neck``), which starts every error line.
+    description : str, optional
+        The top-level help text; default this module's docstring's first line.
+    modules : sequence of str
+        The sub-command modules' names, relative to ``package``.
+    package : str
+        The package holding them (``fem_neck.cli``).
+    """
     from sinterheat.interrupt import Where, run_command
 
     here = Where(prog)

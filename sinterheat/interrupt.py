@@ -57,8 +57,25 @@ _current: contextvars.ContextVar[Where | None] = contextvars.ContextVar("sinterh
 
 @dataclass
 class Where:
-    """Where a run is: ``command`` (e.g. ``"python -m fem_neck fit"``), ``stage``, ``step``, ``t`` (simulated
-    time, s) and ``out`` (folder with usable partial results, or ``None``)."""
+    """Where a run is (module docstring).
+
+    Parameters
+    ----------
+    command : str
+        The command, e.g. ``"python -m fem_neck fit"``.
+    stage : str
+        What is running.
+    step : int or str or None
+        An int is shown as "step k"; a string as it is (e.g. "12 of 40 solves done").
+    t : float or None
+        Simulated time, s.
+    out : str or None
+        The folder holding usable partial results; None: no results written yet.
+    signalled : bool
+        Whether a handled signal has arrived (set by the handler).
+    signum : int
+        The signal that arrived (SIGINT, SIGTERM or SIGHUP).
+    """
 
     command: str = ""
     stage: str = ""
@@ -75,6 +92,11 @@ class Where:
 
         After a Ctrl-C it raises ``KeyboardInterrupt`` (once the fields are set): an interrupt that C code swallowed
         surfaces at the next update.
+
+        Parameters
+        ----------
+        fields : object
+            New values by name: ``stage`` (str), ``step`` (int or str), ``t`` (simulated time, s), ``out`` (folder).
         """
         for name, value in fields.items():
             if name not in self._FIELDS:
@@ -137,7 +159,13 @@ def _unraisable(previous):
 def interruptible(state: Where):
     """Run a command's body with ``state`` as the current :class:`Where` and the SIGINT handler of this module
     (:func:`run_command` is the usual way). The previous handler is restored unless the run was interrupted (then
-    the process is on its way out, and a further Ctrl-C during its exit stays ignored)."""
+    the process is on its way out, and a further Ctrl-C during its exit stays ignored).
+
+    Parameters
+    ----------
+    state : Where
+        The run's position, updated by the command and read by the handler.
+    """
     token = _current.set(state)
     main_thread = threading.current_thread() is threading.main_thread()
     previous = {signum: signal.signal(signum, _raise_once) for signum in handled()} if main_thread else {}
@@ -159,6 +187,15 @@ def run_command(state: Where, func, *args) -> int:
 
         here = Where("python -m fem_neck fit")
         return run_command(here, body, argv, here)   # body updates here.command, here.update(...)
+
+    Parameters
+    ----------
+    state : Where
+        The run's position (its ``command`` names the line).
+    func : callable
+        The command's body, returning its exit code.
+    args : object
+        Its positional arguments.
     """
     try:
         with interruptible(state):
@@ -172,7 +209,13 @@ def run_command(state: Where, func, *args) -> int:
 
 def interrupted(state: Where) -> int:
     """After a ``KeyboardInterrupt``: finalize gmsh if a session is open, close open tqdm bars, write the one line
-    on stderr; returns the exit code, 128 + the signal (:data:`EXIT_CODE` for Ctrl-C)."""
+    on stderr; returns the exit code, 128 + the signal (:data:`EXIT_CODE` for Ctrl-C).
+
+    Parameters
+    ----------
+    state : Where
+        The interrupted run's position.
+    """
     if threading.current_thread() is threading.main_thread():
         for signum in SIGNALS:
             signal.signal(signum, signal.SIG_IGN)
@@ -236,7 +279,13 @@ def shielded():
 
 def stop_pool(pool) -> None:
     """Stop a ``concurrent.futures.ProcessPoolExecutor`` at once: cancel what has not started and terminate the
-    workers (their running jobs are abandoned)."""
+    workers (their running jobs are abandoned).
+
+    Parameters
+    ----------
+    pool : concurrent.futures.ProcessPoolExecutor
+        The executor to stop.
+    """
     processes = list((getattr(pool, "_processes", None) or {}).values())  # no public handle before Python 3.14
     pool.shutdown(wait=False, cancel_futures=True)
     for process in processes:
@@ -250,7 +299,13 @@ def stop_pool(pool) -> None:
 def exit_process(code: int):
     """``sys.exit(code)`` for a CLI's ``__main__``; after an interrupt (:data:`EXIT_CODE`) stdout and stderr are
     flushed and the process leaves at once with that code (``os._exit``): the run has unwound, and Python's own
-    exit would report a kill by SIGINT instead once the interrupt has passed through some C-level imports."""
+    exit would report a kill by SIGINT instead once the interrupt has passed through some C-level imports.
+
+    Parameters
+    ----------
+    code : int
+        The exit code.
+    """
     if threading.current_thread() is threading.main_thread():  # the command is over: a late signal ends the process
         for signum in handled():  # as the system's default does (no start-up line, no KeyboardInterrupt traceback)
             signal.signal(signum, signal.SIG_DFL)

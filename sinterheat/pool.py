@@ -63,7 +63,13 @@ def dask_available() -> bool:
 
 def check_scheduler(scheduler: str) -> str:
     """``scheduler`` if Dask is installed and the value can name one (``"local"`` or an address), else
-    ``ValueError`` saying what is wrong (and how to install Dask)."""
+    ``ValueError`` saying what is wrong (and how to install Dask).
+
+    Parameters
+    ----------
+    scheduler : str
+        ``"local"`` or a scheduler's address (``tcp://host:8786``).
+    """
     if not dask_available():
         raise ValueError(f"scheduler = {scheduler!r}: Dask is not installed; {INSTALL}")
     if not scheduler or scheduler != scheduler.strip() or " " in scheduler:
@@ -79,7 +85,15 @@ def use_dask(scheduler, workers: int | None = None):
     scheduler that cannot be reached within :data:`CONNECT_TIMEOUT` is an ``OSError``), or a
     ``distributed.Client`` of the caller's (used as it is); ``None`` changes nothing. When the block ends by an
     error or an interrupt, Dask's log lines while it closes (jobs cancelled, workers killed) are silenced: the
-    error's one line is what the user reads."""
+    error's one line is what the user reads.
+
+    Parameters
+    ----------
+    scheduler : str or distributed.Client or None
+        ``"local"``, a scheduler's address, a client, or None.
+    workers : int, optional
+        Worker processes of a ``"local"`` cluster; default all cores.
+    """
     global _client
     if scheduler is None:
         yield None
@@ -125,7 +139,15 @@ def _connect(stack: contextlib.ExitStack, scheduler: str, workers: int | None):
 def pool(workers: int | None = None, *, start: str = "fork"):
     """The pool jobs go to, as a context manager (module docstring): the Dask cluster of :func:`use_dask` if one is
     in use, else ``workers`` local processes (default: all cores), started by ``start`` (``"fork"``: warm, with what
-    this process imported; ``"spawn"``: fresh interpreters), or this process itself for one worker."""
+    this process imported; ``"spawn"``: fresh interpreters), or this process itself for one worker.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Number of local worker processes; default all cores (ignored on Dask).
+    start : str
+        Start method of local workers: ``"fork"`` or ``"spawn"``.
+    """
     if _client is not None:
         return DaskPool(_client)
     workers = workers or os.cpu_count() or 1
@@ -141,11 +163,29 @@ class InProcess:
         self._queued = {}
 
     def submit(self, func, *args, priority: float = 0.0) -> cf.Future:
+        """Queue ``func(*args)``; it runs when its future is waited for.
+
+        Parameters
+        ----------
+        func : callable
+            The job: a picklable function (for process and Dask pools).
+        args : object
+            Its positional arguments.
+        priority : float
+            Ignored (the jobs run in the order they are waited for).
+        """
         future = cf.Future()
         self._queued[future] = (func, args)
         return future
 
     def wait(self, futures) -> set:
+        """Run the first queued job of ``futures`` unless one is done already; the futures that are done.
+
+        Parameters
+        ----------
+        futures : iterable of concurrent.futures.Future
+            Futures this pool's :meth:`submit` returned.
+        """
         done = {f for f in futures if f.done()}
         if done:
             return done
@@ -165,7 +205,15 @@ class InProcess:
 
 
 class ProcessPool:
-    """``workers`` processes of this machine that ignore SIGINT; stopped at once when the block ends by an error."""
+    """``workers`` processes of this machine that ignore SIGINT; stopped at once when the block ends by an error.
+
+    Parameters
+    ----------
+    workers : int
+        Number of worker processes.
+    start : str
+        Start method: ``"fork"`` (falls back to ``"spawn"`` where fork is unsafe or missing) or ``"spawn"``.
+    """
 
     def __init__(self, workers: int, start: str):
         method = start if start in multiprocessing.get_all_start_methods() else "spawn"
@@ -176,10 +224,28 @@ class ProcessPool:
                                                 initializer=_worker_start)
 
     def submit(self, func, *args, priority: float = 0.0) -> cf.Future:
+        """Start ``func(*args)`` on a worker process; its future.
+
+        Parameters
+        ----------
+        func : callable
+            The job: a picklable function (for process and Dask pools).
+        args : object
+            Its positional arguments.
+        priority : float
+            Ignored (the executor runs jobs in the order submitted).
+        """
         with shielded():  # a worker started here cannot catch the Ctrl-C meant for this process
             return self._executor.submit(func, *args)
 
     def wait(self, futures) -> set:
+        """The futures of ``futures`` that are done, once one is.
+
+        Parameters
+        ----------
+        futures : iterable of concurrent.futures.Future
+            Futures this pool's :meth:`submit` returned.
+        """
         return cf.wait(list(futures), return_when=cf.FIRST_COMPLETED).done
 
     def __enter__(self):
@@ -224,7 +290,13 @@ def _alone(func, *args):
 
 class DaskPool:
     """Jobs on the cluster of a ``distributed.Client``; those not started are cancelled when the block ends by an
-    error (Ctrl-C included)."""
+    error (Ctrl-C included).
+
+    Parameters
+    ----------
+    client : distributed.Client
+        The connected client of the cluster.
+    """
 
     slots = None
 
@@ -233,6 +305,17 @@ class DaskPool:
         self._submitted = []
 
     def submit(self, func, *args, priority: float = 0.0):
+        """Start ``func(*args)`` on the cluster, one job at a time per worker process; its Dask future.
+
+        Parameters
+        ----------
+        func : callable
+            The job: a picklable function.
+        args : object
+            Its positional arguments.
+        priority : float
+            Dask's scheduling priority (higher runs first).
+        """
         key = f"{getattr(func, '__name__', 'job')}-{uuid.uuid4().hex}"
         future = self._client.submit(_alone, func, *args, key=key, priority=priority, pure=False)
         self._submitted.append(future)
@@ -241,7 +324,13 @@ class DaskPool:
     def wait(self, futures) -> set:
         """The futures of ``futures`` that are done, once one is. Polled here rather than waited for in
         ``distributed.wait``: a Ctrl-C that lands inside distributed's blocking call leaves its event loop a callback
-        that fails with a traceback on stderr; here it lands in ``time.sleep``."""
+        that fails with a traceback on stderr; here it lands in ``time.sleep``.
+
+        Parameters
+        ----------
+        futures : iterable of distributed.Future
+            Futures this pool's :meth:`submit` returned.
+        """
         while True:
             done = {future for future in futures if future.done()}  # the client's own state: no round trip
             if done:
@@ -261,7 +350,13 @@ class DaskPool:
 def bar_switch(progress: bool) -> dict:
     """The ``tqdm`` keywords of a study's bar: off when ``progress`` is false or ``TQDM_DISABLE`` is set (the
     command-line tools set it for ``--no-progress``). The variable is read here, when the bar is made: tqdm reads it
-    once, when it is imported, which may be before the tool sets it."""
+    once, when it is imported, which may be before the tool sets it.
+
+    Parameters
+    ----------
+    progress : bool
+        Whether the caller wants a bar.
+    """
     return {"disable": True} if not progress or os.environ.get("TQDM_DISABLE") else {}
 
 
@@ -273,6 +368,23 @@ def run_jobs(jobs, workers: int | None = None, *, start: str = "fork", desc: str
     A tqdm bar on stderr counts ``done`` jobs finished earlier plus these, and so does the run's
     :func:`sinterheat.interrupt.where` (its step: ``"<desc>: k of n <unit>s done"``). On an interrupt, an error, or
     when the caller stops iterating, the pool is stopped at once.
+
+    Parameters
+    ----------
+    jobs : list of tuple
+        ``(func, args)`` pairs: each job is ``func(*args)``.
+    workers : int, optional
+        Local worker processes; default all cores (at most one per job).
+    start : str
+        Start method of local workers: ``"fork"`` or ``"spawn"``.
+    desc : str
+        Label of the bar and of the interrupt line.
+    unit : str
+        What a job is called in the bar (``"solve"``, ...).
+    progress : bool
+        Draw the bar.
+    done : int
+        Jobs finished earlier (a resumed sweep), counted in the bar's total.
     """
     from tqdm import tqdm
 

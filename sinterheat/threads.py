@@ -40,7 +40,15 @@ def cores() -> int:
 
 
 def check(value, name: str = "threads") -> int:
-    """``value`` (an int or its text) as a thread count, 1 to :func:`cores`; else a ``ValueError`` naming ``name``."""
+    """``value`` (an int or its text) as a thread count, 1 to :func:`cores`; else a ``ValueError`` naming ``name``.
+
+    Parameters
+    ----------
+    value : int or str
+        The thread count, or its text.
+    name : str
+        The parameter's name in the error message.
+    """
     limit = cores()
     try:
         number = int(str(value).strip())
@@ -61,7 +69,13 @@ def count() -> int:
 
 
 def use(number: int) -> None:
-    """Use ``number`` threads (checked by :func:`check`) from here on: numba's loops and BLAS (module docstring)."""
+    """Use ``number`` threads (checked by :func:`check`) from here on: numba's loops and BLAS (module docstring).
+
+    Parameters
+    ----------
+    number : int or str
+        Thread count, 1 to :func:`cores`.
+    """
     global _chosen
     _chosen = check(number)
     for variable in (ENVIRONMENT, *BLAS_VARIABLES):  # the child processes (a sweep's workers) inherit them

@@ -11,6 +11,7 @@ sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 
 import api_check  # noqa: E402
 import docstring_check  # noqa: E402
+import gallery_links  # noqa: E402
 import gallery_order  # noqa: E402
 import site_check  # noqa: E402
 
@@ -67,6 +68,25 @@ def test_every_module_with_public_objects_has_its_automodule():
         assert modules - placed == set(), package
     assert {"dem.scene.schema.display_rows", "dem.driver.run", "dem.laws.contact.jkr.JKRMaterial"} <= set(
         api_check.public_objects("dem"))
+
+
+def test_gallery_links_match_an_api_entry_by_the_object_an_example_used():
+    """An example's use of a function under its short public path (``fem_neck.neck_radius``) reaches the entry where
+    the function is defined; a name no example uses, a constant and a name that is not there get no link."""
+    from fem_neck.geometry import neck_radius
+    from fem_neck.law import ConductanceLaw, pair_conductance
+
+    used = [["neck_models.py", "examples", "gallery", "intro", "Neck models"]]
+    found = gallery_links.index({"fem_neck.neck_radius": used, "fem_neck.geometry.neck_radius": used,
+                                 "fem_neck.law.ConductanceLaw.default": used,
+                                 "fem_neck.law.pair_conductance": [], "fem_neck.law.ROJEK": used,
+                                 "fem_neck.law.no_such_law": used, "no_such_package.f": used})
+    assert found == {id(neck_radius): ["fem_neck.neck_radius", "fem_neck.geometry.neck_radius"],
+                     id(vars(ConductanceLaw)["default"].__func__): ["fem_neck.law.ConductanceLaw.default"]}
+    assert id(pair_conductance) not in found
+    assert gallery_links.lines(found[id(neck_radius)]) == [
+        "", ".. rubric:: Examples using this", "",
+        ".. minigallery:: fem_neck.geometry.neck_radius fem_neck.neck_radius", ""]
 
 
 def test_site_check_finds_remote_loads_missing_files_and_missing_anchors(tmp_path):
@@ -142,6 +162,22 @@ def test_maths_is_served_by_the_site_itself():
                 ).is_file()
 
 
+def test_scipy_names_link_through_the_inventory_committed_with_the_docs():
+    """intersphinx reads SciPy's inventory from the file under docs/ (no request at build time), and the inventory
+    holds the names the docstrings use."""
+    import posixpath
+    import runpy
+
+    uri, inventory = runpy.run_path(str(ROOT / "docs" / "conf.py"))["intersphinx_mapping"]["scipy"]
+    assert uri.startswith("https://") and not site_check.is_remote(inventory)
+    assert pathlib.Path(inventory).is_file() and pathlib.Path(inventory).is_relative_to(ROOT / "docs")
+    loader = pytest.importorskip("sphinx.util.inventory").InventoryFile
+    with open(inventory, "rb") as fh:
+        names = loader.load(fh, uri, posixpath.join)["py:class"]
+    assert names["scipy.sparse.csr_matrix"].uri == uri + "reference/generated/scipy.sparse.csr_matrix.html" \
+        "#scipy.sparse.csr_matrix"
+
+
 def test_install_page_shows_the_readme_mpi_command():
     """The install page's MPI block is the README's, which CI runs (so the page cannot drift from what works)."""
     def block_after(text):
@@ -187,14 +223,29 @@ K : float
     assert docstring_check.described("Fields\n\nK: conductance.") == set()  # prose is not a Parameters section
 
 
-# The ratchet: public parameters (of functions, classes and the public methods they define) that no docstring
-# describes, per package. The count may fall, never rise: a new public parameter comes with its description (numpy
-# style, "Parameters" section: meaning and unit), and whoever documents more lowers the number here.
-UNDESCRIBED = {"fem_neck": 524, "dem": 98, "sinterheat": 70}
+# Every public parameter (of functions, classes and the public methods they define) is described in its docstring,
+# numpy style ("Parameters" section: meaning and unit): a new public parameter comes with its description. The one
+# exception is a ratchet: fem_neck.geometry's own functions, which may shrink to none but never grow.
+GEOMETRY_UNDESCRIBED = 41
 
 
-def test_undescribed_public_parameters_do_not_grow():
-    counts = {package: len(docstring_check.undescribed(package)) for package in UNDESCRIBED}
-    assert all(counts[p] <= UNDESCRIBED[p] for p in UNDESCRIBED), (counts, UNDESCRIBED)
-    assert [name for name in docstring_check.undescribed("fem_neck")
-            if name.startswith(("fem_neck.law.", "fem_neck.conduction."))] == []  # described in full
+def test_every_public_parameter_is_described():
+    missing = {package: docstring_check.undescribed(package) for package in ("fem_neck", "dem", "sinterheat")}
+    geometry = [name for name in missing["fem_neck"] if name.startswith("fem_neck.geometry.")]
+    assert [name for names in missing.values() for name in names if name not in geometry] == []
+    assert len(geometry) <= GEOMETRY_UNDESCRIBED, geometry
+
+
+# Every public function, class, method and property has a docstring (its own, or the one of the method it overrides,
+# which autodoc shows), but in the pipe network's modules, being reworked when this check came: their count may only
+# fall.
+OWNED_ELSEWHERE = ("dem.network.",)
+OWNED_ELSEWHERE_UNDOCUMENTED = 6
+
+
+def test_every_public_object_has_a_docstring():
+    missing = [name for package in ("fem_neck", "dem", "sinterheat") for name in docstring_check.undocumented(package)]
+    elsewhere = [name for name in missing if name.startswith(OWNED_ELSEWHERE)]
+    assert [name for name in missing if name not in elsewhere] == []
+    assert len(elsewhere) <= OWNED_ELSEWHERE_UNDOCUMENTED, elsewhere
+

@@ -257,12 +257,15 @@ class StaticEngine:
                 "T_max": float(T.max()), **{f"Q_{k}": float(self.flows.get(k, 0.0)) for k in CSV_FLOWS}}
 
     def positions(self) -> np.ndarray:
+        """Particle centres (n, 3), m."""
         return self.scene.particles.position
 
     def temperatures(self) -> np.ndarray:
+        """Particle temperatures (n,), in the scene's temperature unit."""
         return self.T
 
     def particle_fields(self) -> dict:
+        """The snapshot's point data by name: id, radius, temperature, fixed, material, necks_meeting."""
         p = self.scene.particles
         fields = {"id": p.id, "radius": p.radius, "temperature": self.T, "fixed": p.fixed.astype(np.int8),
                   "material": p.material.astype(np.int32), "necks_meeting": self.meeting.astype(np.int8)}
@@ -293,6 +296,7 @@ class StaticEngine:
                                "neck_radius": np.concatenate([b.a, b.wall_a])}
 
     def profile(self):
+        """None: this engine offers no profiles."""
         return None
 
     def plots(self, out, summary: dict) -> list[str]:

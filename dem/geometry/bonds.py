@@ -51,12 +51,37 @@ OUT_OF_RANGE = ("error", "clip", "drop")
 
 @dataclass(frozen=True)
 class Bonds:
-    """Pair bonds ``(i, j)`` with ``i < j`` and wall bonds ``(wall_particle, wall_index)`` as index arrays.
+    """Pair bonds ``(i, j)`` with ``i < j`` and wall bonds ``(wall_particle, wall_index)`` as index arrays
+    (:func:`find_bonds`). Per-bond arrays have one entry per pair bond (``m``) or per wall bond.
 
-    Per pair bond: overlap ``h``, centre distance ``d``, contact radius ``a``, centre-to-contact-plane distances
-    ``l_i``, ``l_j`` and, in a periodic box, the ``shift`` (m, 3) of the image of ``j`` (None: no periodic box,
-    all zero). Per wall bond: ``wall_h`` (overlap ``delta``), ``wall_a``, ``wall_l``. ``clipped`` and ``dropped``
-    count the bonds the out-of-range policy changed.
+    Parameters
+    ----------
+    i, j : numpy.ndarray
+        The two particles of every pair bond, ``i < j``.
+    h : numpy.ndarray
+        Overlap ``r_i + r_j - d`` of every pair bond, m.
+    d : numpy.ndarray
+        Centre distance of every pair bond (to the image of ``j`` in a periodic box), m.
+    a : numpy.ndarray
+        Contact (neck) radius of every pair bond, m, from the contact geometry ``contact``.
+    l_i, l_j : numpy.ndarray
+        Distances from the centres of ``i`` and ``j`` to the plane of the contact circle, m.
+    wall_particle : numpy.ndarray
+        The particle of every wall bond.
+    wall_index : numpy.ndarray
+        The wall of every wall bond (index into the scene's walls).
+    wall_h : numpy.ndarray
+        Overlap ``delta = r - L`` of every wall bond, m.
+    wall_a : numpy.ndarray
+        Contact radius of every wall bond, m.
+    wall_l : numpy.ndarray
+        Distance ``L`` of the particle's centre from the wall, m.
+    contact : str
+        The contact geometry (``CONTACT_MODELS``, module docstring).
+    clipped, dropped : int
+        Bonds the out-of-range policy clipped to the range's end, and dropped.
+    shift : numpy.ndarray, optional
+        In a periodic box, the integer image shift ``(m, 3)`` of ``j``; None without one (all zero).
     """
 
     i: np.ndarray
@@ -82,21 +107,39 @@ class Bonds:
         return np.zeros((len(self.i), 3), dtype=np.int64) if self.shift is None else self.shift
 
     def vectors(self, position: np.ndarray, box: PeriodicBox | None = None) -> np.ndarray:
-        """``x_j (+ shift L) - x_i`` of every pair bond (m, 3)."""
+        """``x_j (+ shift L) - x_i`` of every pair bond (m, 3).
+
+        Parameters
+        ----------
+        position : numpy.ndarray
+            Particle centres ``(n, 3)``, m.
+        box : dem.geometry.periodic.PeriodicBox, optional
+            The periodic box the bonds were found in; None without one.
+        """
         if box is None or self.shift is None:
             return position[self.j] - position[self.i]
         return box.bond_vectors(position, self.i, self.j, self.shift)
 
     @property
     def n_pairs(self) -> int:
+        """Number of pair bonds."""
         return len(self.i)
 
     @property
     def n_walls(self) -> int:
+        """Number of wall bonds."""
         return len(self.wall_particle)
 
     def subset(self, pairs: np.ndarray, walls: np.ndarray) -> "Bonds":
-        """The pair bonds at ``pairs`` and the wall bonds at ``walls`` (masks or indices), in their order."""
+        """The pair bonds at ``pairs`` and the wall bonds at ``walls`` (masks or indices), in their order.
+
+        Parameters
+        ----------
+        pairs : numpy.ndarray
+            Mask or indices of the pair bonds to keep.
+        walls : numpy.ndarray
+            Mask or indices of the wall bonds to keep.
+        """
         return replace(self, i=self.i[pairs], j=self.j[pairs], h=self.h[pairs], d=self.d[pairs], a=self.a[pairs],
                        l_i=self.l_i[pairs], l_j=self.l_j[pairs],
                        shift=None if self.shift is None else self.shift[pairs],
@@ -105,7 +148,15 @@ class Bonds:
 
 
 def candidate_pairs(position: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """All pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j`` (k-d trees per radius class)."""
+    """All pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j`` (k-d trees per radius class).
+
+    Parameters
+    ----------
+    position : numpy.ndarray
+        Particle centres ``(n, 3)``, m.
+    radius : numpy.ndarray
+        Particle radii ``(n,)``, m, > 0.
+    """
     n = len(radius)
     if n < 2:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
@@ -135,7 +186,17 @@ def candidate_pairs(position: np.ndarray, radius: np.ndarray) -> tuple[np.ndarra
 def periodic_pairs(position: np.ndarray, radius: np.ndarray, box: PeriodicBox) -> tuple:
     """All bonds ``(i, j, shift)`` with ``|x_j + shift L - x_i| < r_i + r_j`` in a periodic box: the overlaps among
     the particles and their images near the faces (:meth:`~dem.geometry.periodic.PeriodicBox.images`), each bond
-    once (:func:`dem.geometry.periodic.canonical_bonds`)."""
+    once (:func:`dem.geometry.periodic.canonical_bonds`).
+
+    Parameters
+    ----------
+    position : numpy.ndarray
+        Particle centres ``(n, 3)``, m.
+    radius : numpy.ndarray
+        Particle radii ``(n,)``, m, > 0.
+    box : dem.geometry.periodic.PeriodicBox
+        The periodic box.
+    """
     n = len(radius)
     points, owner, shift = box.images(position, 2.0 * float(radius.max()))
     p, q = candidate_pairs(points, radius[owner])
@@ -148,7 +209,15 @@ def periodic_pairs(position: np.ndarray, radius: np.ndarray, box: PeriodicBox) -
 
 
 def sorted_pairs(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs as ``i < j``, sorted by ``(i, j)`` (one int64 key), without duplicates."""
+    """Pairs as ``i < j``, sorted by ``(i, j)`` (one int64 key), without duplicates.
+
+    Parameters
+    ----------
+    i, j : numpy.ndarray
+        Particle indices of the pairs (either order), int64.
+    n : int
+        Number of particles (the indices are below it).
+    """
     key = np.sort(np.minimum(i, j) * n + np.maximum(i, j))
     # sort + neighbour mask rather than np.unique: same keys, 0.05 s instead of 6.5 s at 5e6 pairs (numpy 2.4)
     key = key[np.r_[True, key[1:] != key[:-1]]] if len(key) else key
@@ -156,7 +225,15 @@ def sorted_pairs(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.n
 
 
 def unique_pairs(i, j, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Canonical (``i < j``), duplicate-free pairs; self-pairs and indices outside ``[0, n)`` raise ValueError."""
+    """Canonical (``i < j``), duplicate-free pairs; self-pairs and indices outside ``[0, n)`` raise ValueError.
+
+    Parameters
+    ----------
+    i, j : array_like
+        Particle indices of the pairs (either order).
+    n : int
+        Number of particles.
+    """
     i = np.asarray(i, dtype=np.int64).ravel()
     j = np.asarray(j, dtype=np.int64).ravel()
     if len(i) != len(j):
@@ -283,6 +360,21 @@ def find_bonds(particles: Particles, walls=(), contact: str = "newton", out_of_r
     ``pairs = (i, j)`` gives the pair bonds explicitly instead of searching for overlaps (duplicates and reversed
     duplicates are removed; every listed pair must overlap; in a periodic ``box``, through its nearest image).
     With a periodic ``box`` bonds cross its faces (:func:`periodic_pairs`).
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The particles (positions and radii in m).
+    walls : sequence of dem.geometry.walls.Wall
+        The planes particles may touch.
+    contact : str
+        Contact geometry, one of ``CONTACT_MODELS`` (module docstring).
+    out_of_range : str
+        What to do with bonds beyond the model's range: ``"error"``, ``"clip"`` or ``"drop"``.
+    pairs : tuple of array_like, optional
+        ``(i, j)``: the pair bonds given explicitly; None searches for overlaps.
+    box : dem.geometry.periodic.PeriodicBox, optional
+        A periodic box whose faces bonds may cross.
     """
     if contact not in CONTACT_MODELS:
         raise ValueError(f"contact = {contact!r}: must be one of {', '.join(CONTACT_MODELS)}")

@@ -181,6 +181,7 @@ class MotionState:
 
     @property
     def n(self) -> int:
+        """Number of particles."""
         return len(self.mass)
 
     @property
@@ -209,6 +210,7 @@ class MotionState:
                      + 0.5 * self.inertia @ np.einsum("ij,ij->i", self.w, self.w))
 
     def momentum(self) -> np.ndarray:
+        """Total momentum (dimension,), kg m/s."""
         return self.mass @ self.v
 
     def solid_volume(self) -> float:

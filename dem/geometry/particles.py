@@ -367,6 +367,7 @@ class Particles:
 
     @property
     def n(self) -> int:
+        """Number of particles."""
         return len(self.radius)
 
     def _property(self, key: str, physics: str = "thermal") -> np.ndarray:
@@ -378,6 +379,7 @@ class Particles:
 
     @property
     def conductivity(self) -> np.ndarray:
+        """Thermal conductivity of each particle's material (n,), W/(m K)."""
         return self._property("conductivity")
 
     @property
@@ -387,6 +389,7 @@ class Particles:
 
     @property
     def volume(self) -> np.ndarray:
+        """Volume of each sphere (n,), m^3."""
         with np.errstate(over="ignore", under="ignore"):
             return 4.0 / 3.0 * np.pi * self.radius**3
 

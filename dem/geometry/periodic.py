@@ -74,10 +74,12 @@ class PeriodicBox:
 
     @property
     def mask(self) -> np.ndarray:
+        """Which axes are periodic (3,) bool."""
         return np.array(self.periodic)
 
     @property
     def any_periodic(self) -> bool:
+        """Whether any axis is periodic."""
         return any(self.periodic)
 
     @property

@@ -226,6 +226,7 @@ class Sources:
 
     @property
     def names(self) -> list[str]:
+        """The sources given (``convection``, ``radiation``), in that order."""
         return [k for k in ("convection", "radiation") if getattr(self, k) is not None]
 
 

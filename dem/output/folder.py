@@ -38,7 +38,13 @@ RUN_FILES = ("summary.json", "timeseries.csv", "profiles.csv", CHECKPOINT, "stat
 
 
 def scene_digest(scene) -> str:
-    """A digest of everything that decides a run's result: the particles' arrays and every specification."""
+    """A digest of everything that decides a run's result: the particles' arrays and every specification.
+
+    Parameters
+    ----------
+    scene : dem.scene.parse.Scene
+        The run's scene.
+    """
     h = hashlib.sha1()
     p = scene.particles
     for arr in (p.position, p.radius, p.temperature, p.material, p.fixed, p.heat):
@@ -73,7 +79,13 @@ def _holder(path: pathlib.Path) -> dict | None:
 
 def lock(out: pathlib.Path) -> None:
     """Take the folder ``out`` for this process (module docstring): ``ValueError`` naming the holder when another
-    live run has it; a stale lock is replaced."""
+    live run has it; a stale lock is replaced.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The output folder (existing).
+    """
     path = out / LOCK
     me = json.dumps({"pid": os.getpid(), "host": socket.gethostname()})
     for _ in range(2):
@@ -94,7 +106,13 @@ def lock(out: pathlib.Path) -> None:
 
 
 def unlock(out) -> None:
-    """Release the folder ``out`` if this process holds it."""
+    """Release the folder ``out`` if this process holds it.
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+        The output folder.
+    """
     path = pathlib.Path(out) / LOCK
     try:
         held = json.loads(path.read_text())
@@ -105,7 +123,13 @@ def unlock(out) -> None:
 
 
 def finished(out: pathlib.Path) -> dict | None:
-    """The summary of the finished run in ``out`` (not marked ``interrupted`` or ``stopped``), or None."""
+    """The summary of the finished run in ``out`` (not marked ``interrupted`` or ``stopped``), or None.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The output folder.
+    """
     try:
         summary = json.loads((out / "summary.json").read_text())
     except (OSError, ValueError):
@@ -138,14 +162,35 @@ def interrupted_at_start(out: pathlib.Path) -> bool:
 
 
 def run_files(out: pathlib.Path) -> list[pathlib.Path]:
+    """The files of a run in ``out`` (those matching ``RUN_FILES``), sorted.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The output folder.
+    """
     return sorted({f for pattern in RUN_FILES for f in out.glob(pattern)})
 
 
 def prepare(out, resume: bool = False, overwrite: bool = False) -> tuple[pathlib.Path, bool]:
     """The output folder, checked: refused when it holds a run and neither ``resume`` nor ``overwrite`` is given;
     with ``overwrite`` the old run's files are deleted first, and so are those of a run interrupted before it
-    completed a step when it is resumed (:func:`interrupted_at_start`). Returns the folder and whether the run goes
-    on from a checkpoint."""
+    completed a step when it is resumed (:func:`interrupted_at_start`).
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+        The output folder (created if missing).
+    resume : bool
+        Go on from the checkpoint of the run in ``out``.
+    overwrite : bool
+        Delete the run's files in ``out`` first.
+
+    Returns
+    -------
+    tuple
+        The folder (pathlib.Path) and whether the run goes on from a checkpoint (bool).
+    """
     out = pathlib.Path(out)
     if resume and overwrite:
         raise ValueError("--resume and --overwrite: give one of them")
@@ -181,7 +226,17 @@ def prepare(out, resume: bool = False, overwrite: bool = False) -> tuple[pathlib
 
 def load(out, scene, kind: str) -> dict:
     """The checkpoint of the run in ``out`` as a dict of arrays, refused if another scene (or kind) wrote it or the
-    run is finished (:func:`finished`)."""
+    run is finished (:func:`finished`).
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+        The output folder.
+    scene : dem.scene.parse.Scene
+        The scene resuming the run (it must be the one that wrote the checkpoint).
+    kind : str
+        The kind of run (the scene's engine), which must match the checkpoint's.
+    """
     path = pathlib.Path(out) / CHECKPOINT
     data = read_npz(path, "--resume: the checkpoint")
     if str(data.get("kind")) != kind or str(data.get("scene_digest")) != scene_digest(scene):
@@ -197,7 +252,19 @@ def load(out, scene, kind: str) -> dict:
 class Checkpointer:
     """Keeps the checkpoint of the last completed step and writes it to ``out/checkpoint.npz`` once ``every`` seconds
     have passed since the last write, at the end (``final``) and after Ctrl-C (:meth:`last`): a run interrupted at any
-    moment -- in its first seconds too -- resumes from the step it had completed."""
+    moment -- in its first seconds too -- resumes from the step it had completed.
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+        The output folder.
+    scene : dem.scene.parse.Scene
+        The run's scene (its digest goes into the checkpoint).
+    kind : str
+        The kind of run (the scene's engine).
+    every : float
+        Wall time between two writes, s.
+    """
 
     def __init__(self, out, scene, kind: str, every: float):
         self.path = pathlib.Path(out) / CHECKPOINT

@@ -180,9 +180,11 @@ class WithFrames:
 
     @property
     def last(self):
+        """The last row the writer observed."""
         return self.writer.last
 
     def observe(self) -> None:
+        """Observe the row (:meth:`dem.output.writer.RunWriter.observe`), then draw the frames due."""
         self.writer.observe()
         self.frames(self.writer.engine)
 

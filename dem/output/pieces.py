@@ -87,6 +87,7 @@ class PieceWriter(RunWriter):
             super()._row(row)
 
     def snapshot(self) -> None:
+        """Write this rank's pieces of the snapshot at the current step (rank 0 also the profile); list it."""
         e = self.engine
         step, t = e.steps, e.t
         if self.snapshots and self.snapshots[-1][1] == step:

@@ -38,7 +38,15 @@ DIGITS = 9  # of the step in a snapshot's file name
 
 def resumed_csv(path: pathlib.Path, keep) -> "io.TextIOBase":
     """``path`` opened for appending after dropping the rows (dicts) ``keep`` refuses: the rows written after the
-    checkpoint a run resumes from."""
+    checkpoint a run resumes from.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The CSV file (with a header row).
+    keep : callable
+        ``row (dict of column to text) -> bool``: whether a row stays.
+    """
     with path.open() as fh:
         lines = fh.read().splitlines()
     header = lines[0].split(",") if lines else []
@@ -50,20 +58,44 @@ def resumed_csv(path: pathlib.Path, keep) -> "io.TextIOBase":
 def resumed_profiles(path: pathlib.Path, t_last: float) -> None:
     """``profiles.csv`` cut after the block of the snapshot at ``t_last`` (the last one a resumed run keeps). A block's
     time is written rounded (``_cell``: 12 digits), so it is compared with ``t_last`` rounded the same way: the block at
-    exactly ``t_last`` stays even where its rounded time lies above ``t_last``, and every later one goes."""
+    exactly ``t_last`` stays even where its rounded time lies above ``t_last``, and every later one goes.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``profiles.csv`` file.
+    t_last : float
+        Time of the last snapshot kept, s.
+    """
     limit = float(_cell(t_last))
     resumed_csv(path, lambda row: float(row["t"]) <= limit).close()
 
 
 def snapshot_files(out: pathlib.Path, kind: str):
     """``(step, path)`` of every snapshot file of ``kind`` in ``out``: ``kind_STEP.vtu``, and in parallel the
-    pieces ``kind_STEP_RANK.vtu`` and ``kind_STEP.pvtu`` (:mod:`dem.output.pieces`)."""
+    pieces ``kind_STEP_RANK.vtu`` and ``kind_STEP.pvtu`` (:mod:`dem.output.pieces`).
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The output folder.
+    kind : str
+        The snapshot kind: ``"particles"``, ``"bonds"`` or ``"contacts"``.
+    """
     for f in (*out.glob(f"{kind}_*vtu"), *out.glob(f"{kind}_*.dump")):
         yield int(f.name.split("_")[1].split(".")[0]), f
 
 
 def listed_snapshots(out: pathlib.Path, kind: str) -> list[tuple[float, int]]:
-    """The ``(t, step)`` of the snapshots ``out/<kind>.pvd`` lists (VTU or PVTU files)."""
+    """The ``(t, step)`` of the snapshots ``out/<kind>.pvd`` lists (VTU or PVTU files).
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The output folder.
+    kind : str
+        The snapshot kind: ``"particles"``, ``"bonds"`` or ``"contacts"``.
+    """
     pvd = out / f"{kind}.pvd"
     if not pvd.exists():
         return []
@@ -73,7 +105,17 @@ def listed_snapshots(out: pathlib.Path, kind: str) -> list[tuple[float, int]]:
 
 def resumed_snapshots(out: pathlib.Path, kinds, last_step: int) -> list[tuple[float, int]]:
     """The ``(t, step)`` of the snapshots listed in ``out/<kind>.pvd`` up to ``last_step``; the files of later ones
-    (written after the checkpoint a run resumes from) are deleted."""
+    (written after the checkpoint a run resumes from) are deleted.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The output folder.
+    kinds : sequence of str
+        The snapshot kinds of the run, the first one's collection giving the list.
+    last_step : int
+        The step of the checkpoint the run resumes from.
+    """
     for kind in kinds:
         for step, f in snapshot_files(out, kind):
             if step > last_step:
@@ -82,12 +124,28 @@ def resumed_snapshots(out: pathlib.Path, kinds, last_step: int) -> list[tuple[fl
 
 
 def write_vtu(path: pathlib.Path, mesh) -> None:
-    """``mesh`` to ``path``, written aside and renamed: a VTU file on disk is always whole."""
+    """``mesh`` to ``path``, written aside and renamed: a VTU file on disk is always whole.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``.vtu`` file to write.
+    mesh : meshio.Mesh
+        What to write.
+    """
     write_aside(path, lambda tmp: meshio.write(tmp, mesh, file_format="vtu"), None)
 
 
 def write_pvd(path: pathlib.Path, entries: list[tuple[float, str]]) -> None:
-    """A ParaView collection of ``(time, file)`` entries."""
+    """A ParaView collection of ``(time, file)`` entries.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``.pvd`` file to write.
+    entries : list of tuple
+        ``(time in s, file name relative to the collection)`` of every snapshot.
+    """
     rows = "\n".join(f'    <DataSet timestep="{t:.17g}" group="" part="0" file="{f}"/>' for t, f in entries)
     write_aside(path, lambda fh: fh.write('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" '
                                           f'byte_order="LittleEndian">\n  <Collection>\n{rows}\n  </Collection>\n'
@@ -95,7 +153,13 @@ def write_pvd(path: pathlib.Path, entries: list[tuple[float, str]]) -> None:
 
 
 def checkpoint_reached(out: pathlib.Path) -> dict | None:
-    """``{"t", "steps"}`` of the checkpoint in ``out`` (where ``--resume`` goes on from), or None."""
+    """``{"t", "steps"}`` of the checkpoint in ``out`` (where ``--resume`` goes on from), or None.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The output folder.
+    """
     path = out / "checkpoint.npz"
     if not path.exists():
         return None
@@ -107,7 +171,15 @@ def checkpoint_reached(out: pathlib.Path) -> dict | None:
 
 
 def write_summary(path, summary: dict) -> None:
-    """``summary`` as JSON, written aside and renamed."""
+    """``summary`` as JSON, written aside and renamed.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The JSON file to write.
+    summary : dict
+        The JSON-ready summary.
+    """
     write_aside(path, lambda fh: fh.write(json.dumps(summary, indent=2) + "\n"))
 
 
@@ -122,7 +194,21 @@ class RunWriter:
     rank = 0  # a run shared out among MPI ranks (dem.output.pieces): the summary and the plots are rank 0's
 
     def __init__(self, out_dir, scene, engine, resume_step: int | None = None):
-        """``resume_step``: go on with the files of a run resumed from the checkpoint at that step."""
+        """Open the run's files in ``out_dir``.
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            The output folder (created if missing).
+        scene : dem.scene.parse.Scene
+            The run's scene (its ``[output]`` table says when rows and snapshots are written).
+        engine : object
+            The run's engine: ``record()``, ``particle_fields()``, ``links()``, ``link_kind``, ``t_start`` and
+            ``plots()``.
+        resume_step : int, optional
+            Go on with the files of a run resumed from the checkpoint at that step (the rows and snapshots
+            written after it are dropped); None starts afresh.
+        """
         self.out = pathlib.Path(out_dir)
         self.out.mkdir(parents=True, exist_ok=True)
         self.scene, self.engine = scene, engine
@@ -265,7 +351,15 @@ class RunWriter:
 
     def finish(self, summary: dict, plots: bool = True) -> dict:
         """Close the run's files: the last row and snapshot where they are not written yet, ``summary.json``, then
-        the plots; returns the summary as written."""
+        the plots; returns the summary as written.
+
+        Parameters
+        ----------
+        summary : dict
+            The run's summary (JSON-ready).
+        plots : bool
+            Draw the engine's plots after writing the summary.
+        """
         if self.last is not None and not self.by_time and self.last["step"] % self.scene.output.every:
             self._guarded("timeseries.csv", lambda: self._row(self.last))
         if self.csv is not None:
@@ -292,7 +386,13 @@ class RunWriter:
     def interrupted(self, summary: dict) -> None:
         """Close the files of a run stopped by Ctrl-C: ``summary.json`` marked ``"interrupted": true`` with the state
         the last row reached and where a resume starts (the last checkpoint); half-written files and the files of an
-        unfinished snapshot are deleted and every PVD collection lists exactly the snapshots on disk."""
+        unfinished snapshot are deleted and every PVD collection lists exactly the snapshots on disk.
+
+        Parameters
+        ----------
+        summary : dict
+            The run's summary so far (JSON-ready); completed here with the time and steps reached and ``resume_from``.
+        """
         if self.last is not None:
             summary.update(t=self.last["t"], steps=self.last["step"])
         summary["resume_from"] = checkpoint_reached(self.out)

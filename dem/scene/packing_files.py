@@ -134,6 +134,7 @@ class Packing:
 
     @property
     def n(self) -> int:
+        """Number of particles."""
         return len(self.radius)
 
     def periodic_box(self, axes=None, drop=None):

@@ -28,7 +28,21 @@ LAW_TABLES = ("contact", "phases")  # tables whose keys (beyond those listed) ar
 
 @dataclass(frozen=True)
 class Row:
-    """Keys of one table that share a type, a default and a meaning; ``engines`` read them."""
+    """Keys of one table that share a type, a default and a meaning (one row of the scene schema page).
+
+    Parameters
+    ----------
+    table : str
+        The TOML table (``"scene"``, ``"material"``, ...).
+    keys : tuple of str
+        The keys the row documents.
+    engines : tuple of str
+        The engines that read them (``ENGINE_NAMES``).
+    type : str
+        Their type, unit and default, as the schema page shows it (Markdown).
+    meaning : str
+        What they mean (Markdown).
+    """
 
     table: str
     keys: tuple
@@ -234,7 +248,15 @@ TABLES = tuple(dict.fromkeys(row.table for row in ROWS))
 
 
 def keys(table: str, engine: str | None = None) -> set[str]:
-    """The keys of ``table`` (those ``engine`` reads, when given)."""
+    """The keys of ``table`` (those ``engine`` reads, when given).
+
+    Parameters
+    ----------
+    table : str
+        The TOML table.
+    engine : str, optional
+        An engine (``ENGINE_NAMES``); None: the keys any engine reads.
+    """
     return {k for row in ROWS if row.table == table and (engine is None or engine in row.engines) for k in row.keys}
 
 
@@ -245,7 +267,17 @@ def _engines_reading(table: str, key: str) -> tuple:
 
 def law_keys(table: str, engine: str, law) -> set[str]:
     """The contact law's material fields a table takes (``law``: the law's module): ``[contact]`` all of them,
-    ``[[phases]]`` all but the density on velocity Verlet (the staggered scheme changes wall speeds only)."""
+    ``[[phases]]`` all but the density on velocity Verlet (the staggered scheme changes wall speeds only).
+
+    Parameters
+    ----------
+    table : str
+        The TOML table.
+    engine : str
+        The scene's engine.
+    law : object or None
+        The contact law's module (its ``Material`` dataclass lists the fields); None: no law.
+    """
     if law is None or table not in LAW_TABLES or (table == "phases" and engine != "verlet"):
         return set()
     names = {f.name for f in fields(law.Material)}
@@ -254,7 +286,17 @@ def law_keys(table: str, engine: str, law) -> set[str]:
 
 def check(doc: dict, engine: str, law=None) -> None:
     """Every table and key of the TOML document ``doc`` is one the scene's ``engine`` reads (``law``: the module of
-    its contact law, for the ``[contact]`` and ``[[phases]]`` keys); ``ValueError`` naming the first that is not."""
+    its contact law, for the ``[contact]`` and ``[[phases]]`` keys); ``ValueError`` naming the first that is not.
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed TOML document.
+    engine : str
+        The scene's engine.
+    law : object, optional
+        The module of its contact law.
+    """
     for table, value in doc.items():
         if table not in TABLES:
             raise ValueError(f"[{table}]: unknown table (allowed: {', '.join(sorted(TABLES))})")

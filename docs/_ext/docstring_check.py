@@ -85,3 +85,28 @@ def undescribed(package: str) -> list[str]:
                 missing += [f"{dotted}.{attr}({p})" for p in _parameters(function, not isinstance(member, staticmethod))
                             if p not in documented]
     return missing
+
+
+def undocumented(package: str) -> list[str]:
+    """The public functions and classes of ``package`` (:func:`api_check.public_objects`), and the public methods and
+    properties each class defines, that have no docstring: of their own, or (a method, a property) inherited from the
+    one they override, as autodoc shows it. A dataclass's generated signature is none."""
+    import importlib
+
+    missing = []
+    for dotted in api_check.public_objects(package):
+        module, _, name = dotted.rpartition(".")
+        obj = getattr(importlib.import_module(module), name)
+        own = vars(obj).get("__doc__") if inspect.isclass(obj) else obj.__doc__
+        if dataclasses.is_dataclass(obj) and (own or "").startswith(f"{obj.__name__}("):
+            own = None
+        if not (own or "").strip():
+            missing.append(dotted)
+        for attr, member in (vars(obj).items() if inspect.isclass(obj) else ()):
+            function = member.fget if isinstance(member, property) else getattr(member, "__func__", member)
+            function = getattr(function, "func", function)  # functools.cached_property
+            documented = inspect.getdoc(member if isinstance(member, property) else function)
+            if not attr.startswith("_") and inspect.isfunction(function) and not (documented or "").strip():
+                missing.append(f"{dotted}.{attr}")
+    return missing
+

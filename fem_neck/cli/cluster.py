@@ -14,7 +14,19 @@ MAX_SECONDS = 300.0
 
 def estimate_seconds(n: int, size_neck: float, size_far: float, levels: int) -> float:
     """Rough run time (s) of a cluster solve on 2 cores: per particle ~0.75 s x ((0.25/size_far)^2.2 +
-    (0.12/size_neck)^2) for the finest level; the coarser levels (sizes x1.6, x2.56) add about 35 % and 12 %."""
+    (0.12/size_neck)^2) for the finest level; the coarser levels (sizes x1.6, x2.56) add about 35 % and 12 %.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    size_neck : float
+        The finest level's element size at the neck circles over the neck radius (dimensionless).
+    size_far : float
+        The finest level's element size away from the necks over the radius (dimensionless).
+    levels : int
+        Mesh levels, 1 to 3.
+    """
     per_level = 0.75 * n * ((0.25 / size_far) ** 2.2 + (0.12 / size_neck) ** 2)
     return per_level * (1.0, 1.35, 1.5)[levels - 1]
 
@@ -23,6 +35,13 @@ TERMINAL_KEYS = {"particle", "T", "kind", "rho"}
 
 
 def register(subparsers) -> None:
+    """Add the ``cluster`` sub-command's parser (its options and ``run``) to ``subparsers``.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The sub-commands of the ``python -m fem_neck`` parser.
+    """
     p = subparsers.add_parser(
         "cluster",
         help="3D FE conductance and particle mean temperatures of a sintered cluster",
@@ -50,6 +69,15 @@ def register(subparsers) -> None:
 
 
 def run(args) -> dict:
+    """Solve the cluster of the JSON file ``args.file`` (:func:`fem_neck.cluster.cluster_conductance`); the result as a
+    JSON-ready dict (VTU and JSON files into ``--out`` if given).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``python -m fem_neck cluster`` (its ``--help`` lists them, with their units: lengths in m,
+        temperatures in K, conductivities in W/(m K)).
+    """
     import json
     import pathlib
     import time
@@ -121,7 +149,13 @@ def _index(name: str, value, n: int) -> int:
 
 
 def checked_cluster_data(data) -> dict:
-    """The cluster JSON with every entry's type, shape and range checked, naming the first bad entry."""
+    """The cluster JSON with every entry's type, shape and range checked, naming the first bad entry.
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON document (:func:`fem_neck.cluster.load_cluster_json` gives its layout).
+    """
     if not isinstance(data, dict):
         raise ValueError(f"cluster file: must be a JSON object with centres, radii, bonds, terminals; got "
                          f"{type(data).__name__}")

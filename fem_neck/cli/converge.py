@@ -9,6 +9,13 @@ from sinterheat.cli import add_output_options
 
 
 def register(subparsers) -> None:
+    """Add the ``converge`` sub-command's parser (its options and ``run``) to ``subparsers``.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The sub-commands of the ``python -m fem_neck`` parser.
+    """
     p = subparsers.add_parser(
         "converge", help="mesh convergence of the semisphere conductance (Fig. 15 analogue)",
         description=__doc__.splitlines()[0] + " P1/P2 on graded and uniform meshes, straight or curved boundary, and "
@@ -21,6 +28,14 @@ def register(subparsers) -> None:
 
 
 def run(args) -> dict:
+    """Run the convergence study (:func:`fem_neck.convergence.study`); its summary as a JSON-ready dict.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``python -m fem_neck converge`` (its ``--help`` lists them, with their units:
+        lengths in m, temperatures in K, conductivities in W/(m K)).
+    """
     from fem_neck import convergence
     from fem_neck.cli.solve import semisphere_case
 

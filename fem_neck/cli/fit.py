@@ -18,6 +18,13 @@ from sinterheat.cli import add_output_options, add_scheduler_option, add_workers
 
 
 def register(subparsers) -> None:
+    """Add the ``fit`` sub-command's parser (its options and ``run``) to ``subparsers``.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The sub-commands of the ``python -m fem_neck`` parser.
+    """
     p = subparsers.add_parser(
         "fit", help="sweep a/r, fit K/K_cyl = c a/r and the full-range law (Fig. 16 analogue)",
         description=__doc__.splitlines()[0] + " " + " ".join(__doc__.split("\n\n")[1].split()))
@@ -39,6 +46,14 @@ MAX_POINTS = 200  # one point takes ~0.5 s of one core: 200 points are ~1 min on
 
 
 def run(args) -> dict:
+    """Sweep ``a/r`` and fit the laws (:func:`fem_neck.fit.run_fit`); the fit as a JSON-ready dict.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``python -m fem_neck fit`` (its ``--help`` lists them, with their units: lengths in m,
+        temperatures in K, conductivities in W/(m K)).
+    """
     from fem_neck.fit import run_fit
 
     if args.points > MAX_POINTS:

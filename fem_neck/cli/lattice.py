@@ -7,6 +7,13 @@ from sinterheat.cli import add_output_options
 
 
 def register(subparsers) -> None:
+    """Add the ``lattice`` sub-command's parser (its options and ``run``) to ``subparsers``.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The sub-commands of the ``python -m fem_neck`` parser.
+    """
     p = subparsers.add_parser(
         "lattice", help="k_eff of an SC, BCC or FCC lattice of sintered spheres (3D FE, two-sided bounds)",
         description="Steady conduction through an infinite cubic lattice of equal spheres joined by the "
@@ -41,6 +48,14 @@ def register(subparsers) -> None:
 
 
 def run(args) -> dict:
+    """Solve the lattice cell (:func:`fem_neck.lattice.effective_conductivity`); the result as a JSON-ready dict.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``python -m fem_neck lattice`` (its ``--help`` lists them, with their units: lengths in m,
+        temperatures in K, conductivities in W/(m K)).
+    """
     import json
     import pathlib
 

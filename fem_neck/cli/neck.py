@@ -5,6 +5,13 @@ from fem_neck.geometry import METHODS, neck_geometry, neck_radius
 
 
 def register(subparsers) -> None:
+    """Add the ``neck`` sub-command's parser (its options and ``run``) to ``subparsers``.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The sub-commands of the ``python -m fem_neck`` parser.
+    """
     p = subparsers.add_parser(
         "neck",
         help="neck radius and geometry of two sintered spheres",
@@ -21,6 +28,14 @@ def register(subparsers) -> None:
 
 
 def run(args) -> dict:
+    """The neck geometry of the pair (:func:`fem_neck.geometry.neck_geometry`) as a JSON-ready dict.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``python -m fem_neck neck`` (its ``--help`` lists them, with their units: lengths in m,
+        temperatures in K, conductivities in W/(m K)).
+    """
     geo = neck_geometry(args.ri, args.rj, args.h, method=args.method)
     a_coble = neck_radius(args.ri, args.rj, args.h, method="coble")
     result = {

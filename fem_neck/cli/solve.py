@@ -18,7 +18,15 @@ MAX_CHAIN = 50  # spheres in one chain solve (40 take ~28 s and 1.4 GB on 2 core
 
 
 def model_bond_conductance(kappa: float, a):
-    """``K_ij = K_i K_j / (K_i + K_j) = 1.064 kappa pi a / 2`` (Rojek 2022, eqs. 43-45)."""
+    """``K_ij = K_i K_j / (K_i + K_j) = 1.064 kappa pi a / 2`` (Rojek 2022, eqs. 43-45).
+
+    Parameters
+    ----------
+    kappa : float
+        Thermal conductivity, W/(m K).
+    a : float or array_like
+        Neck radius, m.
+    """
     return PAPER_SLOPE * kappa * math.pi * np.asarray(a, dtype=float) / 2.0
 
 
@@ -50,6 +58,13 @@ def _add_accuracy(p, methods: tuple = ()) -> None:
 
 
 def register(subparsers) -> None:
+    """Add the ``semisphere``, ``pair`` and ``chain`` sub-commands' parsers to ``subparsers``.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The sub-commands of the ``python -m fem_neck`` parser.
+    """
     p = subparsers.add_parser(
         "semisphere", help="conductance of the semisphere with a neck (FE, Rojek 2022 Sec. 5)",
         description="Semisphere of radius r = 1 with the volume-conserving cylindrical half neck (Rojek 2022, Fig. 12; "
@@ -117,7 +132,13 @@ def _accuracy_fields(result) -> dict:
 
 
 def semisphere_case(args) -> tuple[float, float]:
-    """``(h/r, a/r)`` of the semisphere from ``--h-over-r`` or ``--a-over-r`` (eqs. 19-20 and their inverse)."""
+    """``(h/r, a/r)`` of the semisphere from ``--h-over-r`` or ``--a-over-r`` (eqs. 19-20 and their inverse).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed options with ``h_over_r`` (``h/r`` in ``(0, 2/3]``) or ``a_over_r`` (``a/r``), dimensionless.
+    """
     from fem_neck.geometry import check_positive, equal_neck_radius, overlap_for_neck
 
     if args.h_over_r is not None:
@@ -128,6 +149,14 @@ def semisphere_case(args) -> tuple[float, float]:
 
 
 def run_semisphere(args) -> dict:
+    """The semisphere's ``K/K_cyl`` (:func:`fem_neck.conduction.semisphere_conductance`) as a JSON-ready dict; files
+    into ``--out`` if given.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``python -m fem_neck semisphere`` (its ``--help`` lists them).
+    """
     from fem_neck import conduction
 
     h, a = semisphere_case(args)
@@ -147,6 +176,14 @@ def _compare(result, kappa: float, necks) -> dict:
 
 
 def run_pair(args) -> dict:
+    """The pair's conductance (:func:`fem_neck.conduction.pair_conductance`) against the paper's model, as a JSON-ready
+    dict; files into ``--out`` if given.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``python -m fem_neck pair``: radii and overlap in m, ``kappa`` in W/(m K).
+    """
     from fem_neck import conduction
 
     result = _mesh_errors_as_value_errors(
@@ -161,6 +198,14 @@ def run_pair(args) -> dict:
 
 
 def run_chain(args) -> dict:
+    """The chain's conductance (:func:`fem_neck.conduction.chain_conductance`) against the pipe model in series, as a
+    JSON-ready dict; files into ``--out`` if given.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``python -m fem_neck chain``: radii and overlaps in m, ``kappa`` in W/(m K).
+    """
     from fem_neck import conduction
 
     radii = _floats("radii", args.radii)

@@ -9,6 +9,13 @@ from sinterheat.cli import add_output_options, add_scheduler_option, add_workers
 
 
 def register(subparsers) -> None:
+    """Add the ``unequal`` sub-command's parser (its options and ``run``) to ``subparsers``.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The sub-commands of the ``python -m fem_neck`` parser.
+    """
     from fem_neck.unequal import NECKS, RATIOS
 
     p = subparsers.add_parser("unequal", help="unequal radii: FE pairs vs eq. 43 and the full-range law per half",
@@ -28,6 +35,14 @@ MAX_PAIRS = 200  # FE pair solves in one study (~1 s each of one core)
 
 
 def run(args) -> dict:
+    """Run the unequal-radii study (:func:`fem_neck.unequal.study`); its result as a JSON-ready dict.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``python -m fem_neck unequal`` (its ``--help`` lists them, with their units: lengths in m,
+        temperatures in K, conductivities in W/(m K)).
+    """
     from fem_neck.unequal import study
 
     pairs = len(args.ratios.split(",")) * len(args.necks.split(","))

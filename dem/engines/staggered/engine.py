@@ -352,6 +352,7 @@ class StaggeredEngine:
         return row
 
     def profile(self):
+        """None: this engine offers no profiles."""
         return None
 
     def plates(self) -> list:
@@ -373,6 +374,7 @@ class StaggeredEngine:
         return out
 
     def summary(self) -> dict:
+        """What the run found (JSON-ready): the last row, the step counts and sizes, the contacts."""
         mech = self.mechanics
         out = {k: v for k, v in self.record().items() if k not in ("step", "dt", "iterations")}
         dts = np.array(self.dt_taken) if self.dt_taken else np.zeros(1)
@@ -410,9 +412,11 @@ class StaggeredEngine:
         return out
 
     def positions(self) -> np.ndarray:
+        """Particle centres (n, 3), m."""
         return self.mechanics.state.x
 
     def temperatures(self) -> np.ndarray:
+        """Particle temperatures (n,), a copy, in the scene's temperature unit."""
         return self.mechanics.state.T.copy()
 
     def plots(self, out, summary: dict) -> list[str]:
@@ -461,6 +465,7 @@ class StaggeredEngine:
                              self.scene.conductance.contact, "clip")[1]
 
     def particle_fields(self) -> dict:
+        """The snapshot's point data by name: id, radius, velocity, force, temperature, and the current's."""
         s = self.mechanics.state
         out = {"id": self.scene.particles.id, "radius": s.radius, "velocity": s.v, "force": self.mechanics.f,
                "temperature": s.T}

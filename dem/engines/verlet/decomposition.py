@@ -79,6 +79,7 @@ class Slabs:
 
     @property
     def ranks(self) -> int:
+        """Number of slabs (ranks)."""
         return len(self.cuts) - 1
 
     def wrapped(self, u: np.ndarray) -> np.ndarray:

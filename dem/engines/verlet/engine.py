@@ -92,10 +92,12 @@ class VerletEngine:
 
     @property
     def t(self) -> float:
+        """Simulated time, s."""
         return self.mechanics.t
 
     @property
     def t_start(self) -> float:
+        """The time the run started at, s (0, or a saved state's)."""
         return self.mechanics.t_start
 
     @property
@@ -135,6 +137,7 @@ class VerletEngine:
 
     @property
     def temperature_source(self) -> str:
+        """The source of the particles' temperatures (``schedule``, ``network`` or ``initial``)."""
         if self.schedule is not None:
             return "schedule"
         return "network" if self.thermal is not None else "initial"
@@ -396,6 +399,7 @@ class VerletEngine:
         return row
 
     def summary(self) -> dict:
+        """What the run found (JSON-ready): the last row, the steps, contacts, momentum and thermal totals."""
         mech = self.mechanics
         s = mech.state
         out = {"mode": "transient", "static": False,
@@ -473,9 +477,11 @@ class VerletEngine:
         return fields
 
     def positions(self) -> np.ndarray:
+        """Particle centres (n, 3), m."""
         return self.mechanics.state.x
 
     def temperatures(self) -> np.ndarray:
+        """Particle temperatures (n,), a copy, in the scene's temperature unit."""
         return self.mechanics.state.T.copy()
 
     def links(self):
@@ -523,6 +529,7 @@ class VerletEngine:
 
     @property
     def dt(self) -> float:
+        """The time step, s."""
         return self.mechanics.dt
 
     def state(self) -> dict:

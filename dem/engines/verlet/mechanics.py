@@ -199,6 +199,7 @@ class MechanicalModel:
     # --------------------------------------------------------------------------------------------- advance
     @property
     def t(self) -> float:
+        """Simulated time ``t_start + steps dt``, s."""
         return self.t_start + self.steps * self.dt
 
     def _temperature_arguments(self, T0, T_rate, relaxation_time: float | None):

@@ -549,10 +549,12 @@ class RankVerletEngine(VerletEngine):
     # the snapshots' pieces on several ranks (dem.output.pieces): the particles this rank owns, the contacts
     # whose lower-id partner it owns (each contact once)
     def positions(self) -> np.ndarray:
+        """Centres (n, 3) of the particles this rank owns, m."""
         m = self.ranks_mechanics
         return super().positions() if m.size == 1 else m.state.x[m.owned]
 
     def particle_fields(self) -> dict:
+        """The snapshot's point data of the particles this rank owns."""
         m = self.ranks_mechanics
         if m.size == 1:
             return super().particle_fields()
@@ -564,6 +566,7 @@ class RankVerletEngine(VerletEngine):
         return {k: v[m.owned] for k, v in fields.items()}
 
     def links(self):
+        """``(points, lines, fields)`` of the contacts this rank owns (each contact once)."""
         m = self.ranks_mechanics
         if m.size == 1:
             return super().links()
