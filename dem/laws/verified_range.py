@@ -122,7 +122,9 @@ def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide:
         return out
     if reading in PAIR_READINGS:
         out["law_in_verified_range"] = meeting == 0
-        if meeting and handed_over is None:
+        if not meeting:
+            return out
+        if handed_over is None:
             out["warnings"] = [f"{_share(meeting, n)} carry necks that meet: the pair-neck reading {reading!r} has no "
                                f"answer there, so law {law!r} is outside the range where it is verified; "
                                f"conductance.neck = \"union\" reads the packing as the union of its spheres, defined at "
@@ -131,10 +133,9 @@ def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide:
         wide = 0  # the pair necks are verified while apart; the union reads only the handed-over particles
     evidence = EVIDENCE.get(law)
     if evidence is None:
-        out["law_in_verified_range"] = False if reading == "union" else out["law_in_verified_range"]
-        if reading == "union" or meeting:
-            out["warnings"] = [f"law {law!r} was not compared with FE on union necks (python -m verification "
-                               f"densification compares {', '.join(EVIDENCE)}): no error bound"]
+        out["law_in_verified_range"] = False
+        out["warnings"] = [f"law {law!r} was not compared with FE on union necks (python -m verification "
+                           f"densification compares {', '.join(EVIDENCE)}): no error bound"]
         return out
     if reading == "union":
         out["particles_necks_wide"] = wide
