@@ -173,7 +173,7 @@ class StaticEngine:
     def _check_work(self) -> None:
         """Refuse a fixed-step run whose particle-steps exceed ``WORK_PER_STEP_LIMIT * max_steps`` up front, with a
         time estimate (:data:`SECONDS_PER_PARTICLE_STEP`)."""
-        s, n = self.scene.solver, self.scene.particles.n
+        s, n = self.scene.solver, self.scene.particle_count
         if s.dt == "auto":
             return  # the step count is not known in advance; max_steps bounds it while running
         work = s.t_end / s.dt * n
@@ -320,7 +320,7 @@ class StaticEngine:
         """What the run found (the driver adds the scene's name, times and the state file)."""
         scene, bonds, (T_mean, T_min, T_max) = self._over_the_packing()
         d = dict(self.details)
-        out = {"mode": self.scene.solver.mode, "t": self.t, "steps": self.steps, "particles": scene.particles.n,
+        out = {"mode": self.scene.solver.mode, "t": self.t, "steps": self.steps, "particles": scene.particle_count,
                "bonds": bonds, "energy_error": d.pop("energy_error", None), "static": True}
         for key in ("boundary_heat_flow", "periodic_heat_flow"):
             if key in d:

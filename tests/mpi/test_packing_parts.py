@@ -1,0 +1,28 @@
+"""A packing in parts (:mod:`dem.scene.packing_parts`) read in part on each rank: no rank holds the whole packing
+or opens every block, and the run gives the effective conductivity, the temperatures and the bond count of the
+serial run of the same scene read whole, in the same process."""
+
+import numpy as np
+import pytest
+
+from benchmarks.distributed import parts_scene
+from dem.driver import run
+from dem.scene import load_scene
+from test_distributed_network import COMM, serial, shared_folder
+
+
+def test_a_packing_read_in_parts_gives_the_serial_run():
+    folder = shared_folder()
+    path = parts_scene(20000, folder, 20) if COMM.Get_rank() == 0 else None
+    path = COMM.bcast(path)
+    scene = load_scene(path, part=(COMM.Get_size(), COMM.Get_rank()))
+    whole = load_scene(path)
+    assert scene.part is not None and scene.particles.n < whole.particles.n == scene.particle_count
+    assert scene.part.blocks_read < 20
+    result = run(scene)
+    ref = serial(whole)
+    s, r = result.summary, ref.summary()
+    assert s["ranks"] == COMM.Get_size() and s["particles"] == r["particles"] == whole.particles.n
+    assert s["bonds"] == r["bonds"] and s["wall_bonds"] == r["wall_bonds"] > 0
+    assert s["effective_conductivity"] == pytest.approx(r["effective_conductivity"], rel=1e-8)
+    assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-8  # hot - cold = 1 K
