@@ -180,6 +180,6 @@ def run(section, quick: bool) -> None:
                  f"(:func:`benchmarks.distributed.projection`): ~{projected['iterations']} AMG iterations, setup "
                  f"{projected['setup_seconds']:.3g} s + solve {projected['solve_seconds']:.3g} s, "
                  f"~{projected['peak_rss_mib_per_rank']} MiB per rank. The packing is generated on every rank (the "
-                 f"`packing_seconds` column, not in the total): at 10^8 particles a scene must come from a file read "
-                 f"in parts.")
+                 f"`packing_seconds` column, not in the total): at 10^8 particles a scene must come from a packing "
+                 f"in parts (python -m dem convert IN NAME.parts), of which each rank reads only its part.")
     section.add_text("Steady network on 1 and 2 ranks", text)
