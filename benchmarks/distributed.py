@@ -29,11 +29,12 @@ TARGET_PARTICLES = 10**8  # the projection's size
 PER_RANK_PROJECTED = 10**6  # particles per rank in the projection (as measured on one rank)
 
 
-def parts_scene(n: int, folder, blocks: int | None = None) -> pathlib.Path:
-    """A random sintered packing of ~n copper particles between a hot and a cold wall (the ``plates`` of the
-    scenes' generator, rojek law, steady, floating = "mean"), written in parts (:mod:`dem.scene.packing_parts`) as
-    ``packing.parts`` in ``folder`` with ``blocks`` blocks (None: the default), and the scene ``packing.toml`` that
-    reads it; returns the scene's path."""
+def parts_scene(n: int, folder, blocks: int | None = None, boundary: str = "plates") -> pathlib.Path:
+    """A random sintered packing of ~n copper particles between a hot and a cold wall (``boundary`` ``"plates"``
+    of the scenes' generator) or with its bottom and top layers held hot and cold (``"fixed"``), rojek law, steady,
+    floating = "mean", written in parts (:mod:`dem.scene.packing_parts`) as ``packing.parts`` in ``folder`` with
+    ``blocks`` blocks (None: the default), and the scene ``packing.toml`` that reads it; returns the scene's
+    path."""
     from dem.scene.packing_files import packing_from_particles
     from dem.scene.packing_parts import write_parts
     from dem.scene.parse import parse_scene
@@ -42,7 +43,7 @@ def parts_scene(n: int, folder, blocks: int | None = None) -> pathlib.Path:
     material = {"conductivity": 394.0, "density": 8960.0, "specific_heat": 385.0}
     generated = parse_scene({"material": material, "generator": {
         "kind": "random", "n": int(n), "radius": PACKING["radius"], "overlap": PACKING["overlap"], "seed": 0,
-        "boundary": "plates", "hot": 1.0, "cold": 0.0}})
+        "boundary": boundary, "hot": 1.0, "cold": 0.0}})
     write_parts(folder / "packing.parts", packing_from_particles(generated.particles), blocks)
     walls = "".join(f'[[walls]]\nname = "{w.name}"\npoint = {[float(v) for v in w.point]}\n'
                     f'normal = {[float(v) for v in w.normal]}\ntemperature = {float(w.temperature)!r}\n'

@@ -80,15 +80,25 @@ def test_blocks_are_shared_by_weight():
     assert bisection(x, 4, weights=np.array([100.0, 1.0, 1.0, 1.0])).tolist() == [0, 1, 2, 3]  # a point per part
 
 
-def _scene(tmp_path, extra: str = "", walls: bool = True) -> str:
+def _scene(tmp_path, extra: str = "", ends: str = "walls") -> str:
+    """A packing in 24 blocks between hot and cold walls, or (``ends = "layers"``) with its bottom and top layers
+    held at 1 and 0 in the file, and the scene of it."""
     lay = random_packing(1200, 1e-4, 0.1, seed=5)
-    x = lay.position
-    write_parts(tmp_path / "p.parts", Packing(np.arange(len(lay.radius)), x, lay.radius), 24)
-    lo, hi = float(x[:, 2].min() - 0.5e-4), float(x[:, 2].max() + 0.5e-4)
-    text = MATERIALS + '[particles]\nfile = "p.parts"\ntemperature = 0.5\n' + extra
-    if walls:
-        text += (f'[[walls]]\nname = "hot"\npoint = [0, 0, {lo!r}]\nnormal = [0, 0, 1]\ntemperature = 1.0\n'
+    x, n = lay.position, len(lay.radius)
+    text = MATERIALS + '[particles]\nfile = "p.parts"\n'
+    if ends == "walls":
+        packing = Packing(np.arange(n), x, lay.radius)
+        lo, hi = float(x[:, 2].min() - 0.5e-4), float(x[:, 2].max() + 0.5e-4)
+        text += ('temperature = 0.5\n' + extra +
+                 f'[[walls]]\nname = "hot"\npoint = [0, 0, {lo!r}]\nnormal = [0, 0, 1]\ntemperature = 1.0\n'
                  f'[[walls]]\nname = "cold"\npoint = [0, 0, {hi!r}]\nnormal = [0, 0, -1]\ntemperature = 0.0\n')
+    else:
+        text += extra
+        fixed, T = np.zeros(n, dtype=bool), np.full(n, 0.5)
+        fixed[lay.bottom] = fixed[lay.top] = True
+        T[lay.bottom], T[lay.top] = 1.0, 0.0
+        packing = Packing(np.arange(n), x, lay.radius, temperature=T, fixed=fixed)
+    write_parts(tmp_path / "p.parts", packing, 24)
     (tmp_path / "s.toml").write_text(text + '[solver]\nmode = "steady"\nfloating = "mean"\n')
     return str(tmp_path / "s.toml")
 
@@ -96,6 +106,7 @@ def _scene(tmp_path, extra: str = "", walls: bool = True) -> str:
 def test_a_scene_read_in_part_has_the_whole_scenes_specimen(tmp_path):
     path = _scene(tmp_path, 'material = "steel"\n')
     whole = load_scene(path)
+    assert whole.specimen.hot_end == ("wall", "hot")
     for r in range(3):
         s = load_scene(path, part=(3, r))
         assert s.specimen == whole.specimen and s.particle_count == whole.particles.n
@@ -103,8 +114,20 @@ def test_a_scene_read_in_part_has_the_whole_scenes_specimen(tmp_path):
         assert np.all(s.particles.material == 1) and np.all(s.particles.temperature == 0.5)
 
 
+def test_held_layers_are_the_ends_over_the_whole_packing(tmp_path):
+    path = _scene(tmp_path, ends="layers")
+    whole = load_scene(path)
+    assert whole.specimen.hot_end == ("group", "held at 1")
+    for r in range(4):
+        s = load_scene(path, part=(4, r))
+        assert s.specimen == whole.specimen
+        assert np.array_equal(s.part.fixed_places, np.flatnonzero(whole.particles.fixed))
+        assert not np.all(np.isin(np.flatnonzero(whole.particles.fixed), s.part.held))  # not all of them held here
+        assert np.array_equal(s.particles.fixed, whole.particles.fixed[s.part.held])
+
+
 @pytest.mark.parametrize("extra, message", [
-    ("fixed = true\n", "held at their temperature (fixed)"),
+    ("fixed = true\n", "[particles] fixed: not for a packing read in parts"),
     ("length_unit = 0.001\n", "length_unit: not for a packing in parts"),
     ('[[groups]]\nname = "top"\nlayer = "top"\nthickness = 1e-4\nfixed = true\n', "[[groups]]: not on a packing read"),
 ])

@@ -78,11 +78,15 @@ def boundary_summary(scene, walls, into: dict) -> dict:
         ``{"walls": {name: W}, "groups": {name: W}, "fixed_total": W}``, and ``"particles": {id: W}`` for up to
         1000 held particles.
     """
-    groups = held_groups(scene.particles, scene.groups)
+    part = scene.part
+    if part is None or part.fixed is None:
+        groups, ids = held_groups(scene.particles, scene.groups), scene.particles.id
+    else:  # a rank's part of a packing in parts: the groups of all its fixed particles, by their places in it
+        groups = {name: part.fixed_places[k] for name, k in held_groups(part.fixed).items()}
+        ids = dict(zip(part.fixed_places.tolist(), part.fixed.id.tolist()))
     out = {"walls": {w.name: float(q) for w, q in zip(scene.walls, walls)}, "groups": group_flows(groups, into),
            "fixed_total": float(sum(into[k] for k in sorted(into)))}
     if len(into) <= 1000:  # by particle id (the index unless a packing file gave ids)
-        ids = scene.particles.id
         out["particles"] = {str(ids[k]): into[k] for k in sorted(into)}
     return out
 

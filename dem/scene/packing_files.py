@@ -933,8 +933,8 @@ def scene_particles(table: dict, materials, base_dir=None, part=None):
     it cannot say), or None. ``temperature`` (a number or a list), ``fixed``, ``material`` (a name or index, or a
     list of them) and ``heat`` come from the table where given, else from the file; a density the file gives must be
     its material's. With ``part``, a packing in parts (:mod:`dem.scene.packing_parts`) gives only the particles that
-    rank holds (a list in the table is of the whole packing, taken at their places); no particle may be held at its
-    temperature there (the specimen's ends are then walls or the period).
+    rank holds (a list in the table is of the whole packing, taken at their places), and its ``Part`` the particles
+    of the whole packing that its file holds at their temperature (``fixed`` in the table is refused there).
 
     Parameters
     ----------
@@ -1022,6 +1022,13 @@ def scene_particles(table: dict, materials, base_dir=None, part=None):
             raise ValueError(f"[particles] file {name!r}: particle id {packing.id[k]} has density "
                              f"{packing.density[k]:.6g} kg/m^3 but its material {m.name!r} {m.density:.6g}; {advice}")
     box = packing.periodic_box() if packing.box_lo is not None else None
+    if held is not None and held.fixed is not None:  # the whole packing's fixed particles, as the scene has them
+        f = held.fixed
+        T = table.get("temperature", f.temperature)
+        T = np.asarray(T, dtype=float)[held.fixed_places] if isinstance(T, list) else np.broadcast_to(T, (f.n,))
+        held = replace(held, fixed=Particles.from_arrays(f.position, f.radius, T, materials,
+                                                         fixed=np.ones(f.n, dtype=bool), prefix="[particles]",
+                                                         id=f.id))
     return particles, box, held
 
 
@@ -1033,11 +1040,11 @@ def _part_of(path, table: dict, options: dict, ranks: int, rank: int, box_of):
     extra = sorted(set(options) - {"format"})
     if extra:
         raise ValueError(f"{extra[0]}: not for a packing in parts (in metres, one snapshot)")
+    if "fixed" in table:
+        raise ValueError(f"[particles] fixed: not for a packing read in parts on several ranks (the fixed particles "
+                         f"are the file's, {path.name}/{packing_parts.HELD}); write them into it, or run on one "
+                         "process")
     index = packing_parts.read_index(path)
-    if index.fixed or table.get("fixed", False) is not False:
-        raise ValueError(f"{path}: particles held at their temperature (fixed) do not run on a packing read in parts "
-                         "on several ranks (the specimen's ends are found over the whole packing); make the ends "
-                         "walls, or run on one process")
     file_box = None
     if index.box_lo is not None:
         from dem.geometry.periodic import PeriodicBox

@@ -7,7 +7,9 @@ regions of (almost) equal counts. Each block holds its particles in the packing'
 (``index``, from 0), ids, centres (m), radii (m) and the optional per-particle arrays of a
 :class:`dem.scene.packing_files.Packing` that the packing has. The index gives, per block, its file, its count, the
 bounding box of its centres and its largest radius; for the packing, its count, its box and periodic axes, the
-extent of its particles' surfaces and their largest radius.
+extent of its particles' surfaces and their largest radius. The particles held at their temperature (``fixed``), if
+any, are also in ``held.npz`` (as a block): the ends of the specimen and the groups of ``boundary_heat_flow`` are
+found over all of them (:mod:`dem.scene.specimen`), which every rank reads.
 
 Read whole (:func:`read_whole`: what ``[particles] file`` reads on one process, and ``python -m dem convert``), a
 packing in parts is the packing it was written from, in its order, to the bit. Read in part (:func:`read_part`),
@@ -37,6 +39,7 @@ from dem.scene.packing_files import Packing
 
 SUFFIX = ".parts"
 INDEX = "index.json"
+HELD = "held.npz"  # the fixed particles of the whole packing
 KIND = "sinterheat packing in parts"
 VERSION = 1
 OPTIONAL = ("temperature", "fixed", "material", "density", "velocity", "angular_velocity", "image")
@@ -159,7 +162,7 @@ def write_parts(path, packing: Packing, blocks: int | None = None) -> pathlib.Pa
     if path.exists() and not path.is_dir():
         raise ValueError(f"OUT = {str(path)!r}: is a file, not a folder")
     if path.is_dir():
-        alien = [p.name for p in path.iterdir() if not (p.name == INDEX or p.name.startswith("block-"))]
+        alien = [p.name for p in path.iterdir() if not (p.name in (INDEX, HELD) or p.name.startswith("block-"))]
         if alien:
             raise ValueError(f"OUT = {str(path)!r}: holds {alien[0]!r}, not a packing in parts; give another name")
         for old in path.iterdir():
@@ -174,18 +177,15 @@ def write_parts(path, packing: Packing, blocks: int | None = None) -> pathlib.Pa
     entries = []
     for b in range(blocks):
         take = members[starts[b]:starts[b + 1]]
-        arrays = {"index": take, "id": packing.id[take], "position": packing.position[take],
-                  "radius": packing.radius[take]}
-        for k in fields:
-            value = np.asarray(getattr(packing, k))[take]
-            arrays[k] = value.astype(str) if value.dtype.kind == "O" else value
         name = f"block-{b:05d}.npz"
-        write_aside(path / name, lambda fh, a=arrays: np.savez(fh, **a), "wb")
+        _write_block(path / name, packing, take, fields)
         x = packing.position[take]
         entries.append({"file": name, "count": len(take), "lo": x.min(axis=0).tolist(), "hi": x.max(axis=0).tolist(),
                         "radius_max": float(packing.radius[take].max())})
     x, r = packing.position, packing.radius
     fixed = 0 if packing.fixed is None else int(np.count_nonzero(packing.fixed))
+    if fixed:
+        _write_block(path / HELD, packing, np.flatnonzero(packing.fixed), fields)
     index = {"kind": KIND, "version": VERSION, "particles": n, "fields": list(fields), "fixed": fixed,
              "extent_lo": (x - r[:, None]).min(axis=0).tolist(), "extent_hi": (x + r[:, None]).max(axis=0).tolist(),
              "box_lo": None if packing.box_lo is None else np.asarray(packing.box_lo, dtype=float).tolist(),
@@ -194,6 +194,15 @@ def write_parts(path, packing: Packing, blocks: int | None = None) -> pathlib.Pa
              "blocks": entries}
     write_aside(path / INDEX, lambda fh: json.dump(index, fh, indent=1))
     return path
+
+
+def _write_block(file, packing: Packing, take: np.ndarray, fields) -> None:
+    """The particles ``take`` (places in ``packing``, ascending) as one ``.npz`` block."""
+    arrays = {"index": take, "id": packing.id[take], "position": packing.position[take], "radius": packing.radius[take]}
+    for k in fields:
+        value = np.asarray(getattr(packing, k))[take]
+        arrays[k] = value.astype(str) if value.dtype.kind == "O" else value
+    write_aside(file, lambda fh: np.savez(fh, **arrays), "wb")
 
 
 def read_index(path) -> Index:
@@ -236,17 +245,20 @@ def read_index(path) -> Index:
         raise ValueError(f"{file}: {exc if isinstance(exc, ValueError) else f'missing or bad entry {exc}'}") from None
 
 
+def _load(file, index: Index, count: int) -> dict:
+    """The arrays of one block file, which must hold ``count`` particles."""
+    with np.load(file, allow_pickle=False) as data:
+        arrays = {k: data[k] for k in ("index", "id", "position", "radius", *index.fields)}
+    if len(arrays["index"]) != count:
+        raise ValueError(f"{file}: holds {len(arrays['index'])} particles, the index says {count}")
+    return arrays
+
+
 def _read_blocks(path, index: Index, which) -> tuple[np.ndarray, np.ndarray, dict]:
     """The places in the packing (``index`` arrays), the block of each particle and the arrays of the blocks
     ``which``, in the packing's order."""
     path = pathlib.Path(path)
-    parts = []
-    for b in which:
-        with np.load(path / index.files[b], allow_pickle=False) as data:
-            parts.append({k: data[k] for k in ("index", "id", "position", "radius", *index.fields)})
-            if len(parts[-1]["index"]) != index.count[b]:
-                raise ValueError(f"{path / index.files[b]}: holds {len(parts[-1]['index'])} particles, the index "
-                                 f"says {index.count[b]}")
+    parts = [_load(path / index.files[b], index, index.count[b]) for b in which]
     arrays = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     block = np.repeat(np.asarray(which, dtype=np.int64), index.count[np.asarray(which, dtype=np.int64)])
     order = np.argsort(arrays["index"], kind="stable")
@@ -301,6 +313,12 @@ class Part:
         (3,) the extent of the whole packing's surfaces (m), for the specimen's cross-section.
     blocks_read : int
         How many blocks the rank opened.
+    fixed_places : numpy.ndarray
+        (K,) int, the places in the packing of all its particles held at their temperature, sorted.
+    fixed : object
+        Those particles: a :class:`dem.scene.packing_files.Packing` (:func:`read_part`), or the scene's
+        :class:`dem.geometry.particles.Particles` of them (:func:`dem.scene.packing_files.scene_particles`); None
+        where there are none.
     """
 
     n: int
@@ -310,6 +328,8 @@ class Part:
     extent_lo: np.ndarray
     extent_hi: np.ndarray
     blocks_read: int
+    fixed_places: np.ndarray
+    fixed: object = None
 
 
 def block_owner(index: Index, ranks: int, lengths=None) -> np.ndarray:
@@ -356,7 +376,8 @@ def _near(lo: np.ndarray, hi: np.ndarray, region_lo: np.ndarray, region_hi: np.n
 
 def read_part(path, ranks: int, rank: int, box=None) -> tuple[Packing, Part]:
     """The particles that rank ``rank`` of ``ranks`` holds of the packing in parts ``path`` (module docstring):
-    those of its blocks and, of the other blocks, those within one bond length of its centres' bounding box.
+    those of its blocks and, of the other blocks, those within one bond length of its centres' bounding box; and
+    the packing's fixed particles (``Part.fixed``).
 
     Parameters
     ----------
@@ -394,5 +415,11 @@ def read_part(path, ranks: int, rank: int, box=None) -> tuple[Packing, Part]:
     keep = np.union1d(np.flatnonzero(rank_of == rank),
                       halo(arrays["position"], np.where(rank_of == rank, rank, -1), rank, reach,
                            None if box is None else box.lengths, None if box is None else box.mask))
-    part = Part(index.n, ranks, places[keep], rank_of[keep], index.extent_lo, index.extent_hi, len(read))
+    fixed_places, fixed = np.zeros(0, dtype=np.int64), None
+    if index.fixed:
+        held = _load(pathlib.Path(path) / HELD, index, index.fixed)
+        fixed_places = held.pop("index")
+        fixed = _packing(path, index, held)
+    part = Part(index.n, ranks, places[keep], rank_of[keep], index.extent_lo, index.extent_hi, len(read),
+                fixed_places, fixed)
     return _packing(path, index, {k: v[keep] for k, v in arrays.items()}), part
