@@ -647,8 +647,8 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         _check_walls_across(walls, box)
     if not moving and specimen is None:
         ends = particles if held is None or held.fixed is None else held.fixed  # the fixed ones of all, in parts
-        extent = None if held is None else (held.extent_lo, held.extent_hi)
-        specimen = find_specimen(ends, walls, box, groups, bounds=_saved_walls(start), extent=extent)
+        span = None if held is None else (held.extent_lo, held.extent_hi)
+        specimen = find_specimen(ends, walls, box, groups, bounds=_saved_walls(start), span=span)
     cond = dict(doc.get("conductance", {}))
     if "fit_file" in cond and not isinstance(cond["fit_file"], str):
         raise ValueError(f"[conductance] fit_file = {cond['fit_file']!r}: must be a path (string)")
