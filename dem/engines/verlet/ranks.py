@@ -475,7 +475,20 @@ class RankContactThermal(ContactThermalModel):
 
     def local(self, mechanics, values: np.ndarray) -> np.ndarray:
         """As :meth:`~dem.engines.contact_heat.ContactThermalModel.local`: a rank's particles (by their global ids),
-        or all of them in a gathered sample (:meth:`RankMechanics.gathered`)."""
+        or all of them in a gathered sample (:meth:`RankMechanics.gathered`).
+
+        Parameters
+        ----------
+        mechanics : RankMechanics or dem.engines.verlet.mechanics.MechanicalModel
+            This rank's mechanics, or the gathered sample.
+        values : numpy.ndarray
+            One value per particle of the scene, any unit.
+
+        Returns
+        -------
+        numpy.ndarray
+            The values of the particles ``mechanics`` holds, in its order.
+        """
         return values[mechanics.gid] if isinstance(mechanics, RankMechanics) else values
 
     def step(self, mechanics, dt: float) -> None:
