@@ -14,12 +14,13 @@ from __future__ import annotations
 import json
 import math
 import os
+import pathlib
 import shutil
 import subprocess
 import sys
 import time
 
-from benchmarks.dem import packing_network
+from benchmarks.dem import PACKING, packing_network
 from benchmarks.timing import available, emit, peak_rss_mib
 from verification.report import records_table
 
@@ -28,17 +29,52 @@ TARGET_PARTICLES = 10**8  # the projection's size
 PER_RANK_PROJECTED = 10**6  # particles per rank in the projection (as measured on one rank)
 
 
-def scaling_worker(n: int) -> None:
-    """One steady solve of the ~n-particle packing on the ranks of this ``mpiexec``; rank 0 prints one JSON line."""
+def parts_scene(n: int, folder, blocks: int | None = None, boundary: str = "plates") -> pathlib.Path:
+    """A random sintered packing of ~n copper particles between a hot and a cold wall (``boundary`` ``"plates"``
+    of the scenes' generator) or with its bottom and top layers held hot and cold (``"fixed"``), rojek law, steady,
+    floating = "mean", written in parts (:mod:`dem.scene.packing_parts`) as ``packing.parts`` in ``folder`` with
+    ``blocks`` blocks (None: the default), and the scene ``packing.toml`` that reads it; returns the scene's
+    path."""
+    from dem.scene.packing_files import packing_from_particles
+    from dem.scene.packing_parts import write_parts
+    from dem.scene.parse import parse_scene
+
+    folder = pathlib.Path(folder)
+    material = {"conductivity": 394.0, "density": 8960.0, "specific_heat": 385.0}
+    generated = parse_scene({"material": material, "generator": {
+        "kind": "random", "n": int(n), "radius": PACKING["radius"], "overlap": PACKING["overlap"], "seed": 0,
+        "boundary": boundary, "hot": 1.0, "cold": 0.0}})
+    write_parts(folder / "packing.parts", packing_from_particles(generated.particles), blocks)
+    walls = "".join(f'[[walls]]\nname = "{w.name}"\npoint = {[float(v) for v in w.point]}\n'
+                    f'normal = {[float(v) for v in w.normal]}\ntemperature = {float(w.temperature)!r}\n'
+                    for w in generated.walls)
+    (folder / "packing.toml").write_text(
+        "[material]\n" + "".join(f"{k} = {v!r}\n" for k, v in material.items()) +
+        '[particles]\nfile = "packing.parts"\n' + walls +
+        '[conductance]\nlaw = "rojek"\n[solver]\nmode = "steady"\nfloating = "mean"\n')
+    return folder / "packing.toml"
+
+
+def scaling_worker(n: int, scene_file: str | None = None) -> None:
+    """One steady solve of the ~n-particle packing on the ranks of this ``mpiexec``; rank 0 prints one JSON line.
+    With ``scene_file`` (:func:`parts_scene`), that scene instead, each rank reading only its part of the packing
+    (``packing_seconds``: the reading; ``held``: the particles each rank holds)."""
     from dem.engines.distributed.engine import DistributedStaticEngine
     from dem.scene.parse import make_scene
 
     load = os.getloadavg()[0]
     t0 = time.perf_counter()
-    net, _ = packing_network(n)
-    p = net.particles
-    scene = make_scene(p.position, p.radius, p.temperature, fixed=p.fixed, law="rojek", mode="steady",
-                       floating="mean", name="packing")
+    if scene_file is None:
+        net, _ = packing_network(n)
+        p = net.particles
+        scene = make_scene(p.position, p.radius, p.temperature, fixed=p.fixed, law="rojek", mode="steady",
+                           floating="mean", name="packing")
+    else:
+        from dem.network.comm import world
+        from dem.scene import load_scene
+
+        comm = world()
+        scene = load_scene(scene_file, part=(comm.Get_size(), comm.Get_rank()))
     t1 = time.perf_counter()
     engine = DistributedStaticEngine(scene)
     t2 = time.perf_counter()
@@ -46,20 +82,22 @@ def scaling_worker(n: int) -> None:
     t3 = time.perf_counter()
     comm = engine.comm
     times = comm.gather({"packing_seconds": t1 - t0, "setup_seconds": t2 - t1, "solve_seconds": t3 - t2,
-                         "peak_rss_mib": peak_rss_mib()})
+                         "peak_rss_mib": peak_rss_mib(), "held": scene.particles.n})
     s = engine.summary()  # reduced over the ranks: every rank takes part
     if comm.Get_rank() == 0:
-        emit({"particles": p.n, "ranks": engine.ranks, "bonds": s["bonds"], "solver": s["linear_solver"],
-              "iterations": s["linear_iterations"], "load_average": load,
+        emit({"particles": scene.particle_count, "ranks": engine.ranks, "bonds": s["bonds"],
+              "solver": s["linear_solver"], "iterations": s["linear_iterations"], "load_average": load,
               **{key: max(t[key] for t in times) for key in ("packing_seconds", "setup_seconds", "solve_seconds")},
               "peak_rss_mib_per_rank": [round(t["peak_rss_mib"]) for t in times],
-              "T_mean": s["T_mean"]})
+              "held_per_rank": [t["held"] for t in times], "T_mean": s["T_mean"],
+              "effective_conductivity": s.get("effective_conductivity")})
 
 
-def run_ranks(n: int, ranks: int, timeout: float) -> dict:
-    """:func:`scaling_worker` of ``n`` particles on ``ranks`` ranks in a fresh ``mpiexec``: its row, or one with
-    ``error``."""
-    code = f"from benchmarks.distributed import scaling_worker; scaling_worker({int(n)})"
+def run_ranks(n: int, ranks: int, timeout: float, scene_file=None) -> dict:
+    """:func:`scaling_worker` of ``n`` particles (or of the packing in parts of ``scene_file``) on ``ranks`` ranks in
+    a fresh ``mpiexec``: its row, or one with ``error``."""
+    file = None if scene_file is None else str(scene_file)
+    code = f"from benchmarks.distributed import scaling_worker; scaling_worker({int(n)}, {file!r})"
     env = dict(os.environ, DEM_MPI="1")
     command = ["mpiexec", "-n", str(ranks), sys.executable, "-c", code]
     try:
@@ -143,6 +181,6 @@ def run(section, quick: bool) -> None:
                  f"(:func:`benchmarks.distributed.projection`): ~{projected['iterations']} AMG iterations, setup "
                  f"{projected['setup_seconds']:.3g} s + solve {projected['solve_seconds']:.3g} s, "
                  f"~{projected['peak_rss_mib_per_rank']} MiB per rank. The packing is generated on every rank (the "
-                 f"`packing_seconds` column, not in the total): at 10^8 particles a scene must come from a file read "
-                 f"in parts.")
+                 f"`packing_seconds` column, not in the total): at 10^8 particles a scene must come from a packing "
+                 f"in parts (python -m dem convert IN NAME.parts), of which each rank reads only its part.")
     section.add_text("Steady network on 1 and 2 ranks", text)

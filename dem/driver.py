@@ -70,7 +70,7 @@ def _announce(scene: Scene, enabled: bool) -> None:
     checks have passed; only where it reports its progress (the CLI's)."""
     from dem.memory import estimate
 
-    line = estimate(scene.particles.n) if enabled else None
+    line = estimate(scene.particle_count) if enabled else None
     if line is not None:
         print(f"python -m dem run: {line}", file=sys.stderr, flush=True)
 
@@ -247,7 +247,7 @@ def _run_distributed(scene: Scene, out, progress: bool, resume: bool, overwrite:
         _advance(engine, scene, bar, writer.observe if writer is not None else None, advanced, None)
         summary = _summary(scene, engine, None)
         summary.pop("T", None)
-        if scene.particles.n <= T_LIST_MAX:
+        if scene.particle_count <= T_LIST_MAX:
             summary["T"] = engine.gathered_temperatures().tolist()
         summary["seconds"] = mpi.maximum(comm, time.perf_counter() - start)
         if writer is not None:

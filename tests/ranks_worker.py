@@ -29,6 +29,15 @@ COMPACTION = {  # 100 disks of Luding 2005's Table 1 sizes, stiffer-than-soft li
               {"name": "right", "point": [COMPACTION_SIDE, 0.0, 0.0], "normal": [-1.0, 0.0, 0.0], **STRESS_WALL},
               {"name": "top", "point": [0.0, 0.0, COMPACTION_SIDE], "normal": [0.0, 0.0, -1.0], **STRESS_WALL}],
     "solver": {"mode": "transient", "t_end": 0.1}}
+SPACING = 9.75e-4  # m, the centres' spacing of a lattice of radius 5e-4 and overlap 0.05
+KEFF = {  # heat from a hot to a cold wall through a lattice column, periodic across: an effective conductivity
+    "scene": {"physics": ["mechanical", "thermal"]},
+    "material": {"density": 7800.0, "conductivity": 40.0, "specific_heat": 450.0}, "contact": ELASTIC,
+    "generator": {"kind": "lattice", "shape": [3, 3, 10], "radius": 5e-4, "overlap": 0.05, "temperature": 60.0},
+    "periodic": {"lengths": [3 * SPACING, 3 * SPACING, 1.0], "axes": ["x", "y"]},
+    "walls": [{"name": "hot", "point": [0.0, 0.0, -SPACING / 2], "normal": [0.0, 0.0, 1.0], "temperature": 100.0},
+              {"name": "cold", "point": [0.0, 0.0, 9.5 * SPACING], "normal": [0.0, 0.0, -1.0], "temperature": 20.0}],
+    "solver": {"mode": "transient", "t_end": 0.001, "thermal_interval": 1e-4}, "output": {"interval": 5e-4}}
 CASES = {
     # frictional, damped, sintering law: momentum is what a periodic box conserves
     "gas": GAS,
@@ -169,6 +178,7 @@ def run_scene(scene, out=None, resume: bool = False) -> dict:
 if __name__ == "__main__":
     from mpi4py import MPI
 
+    from dem import parse_scene
     from dem.engines.verlet.ranks import RankVerletEngine
 
     comm = MPI.COMM_WORLD
@@ -180,6 +190,8 @@ if __name__ == "__main__":
         result = run_scene(hot_and_cold())
     elif sys.argv[1] == "stiff-heat":  # stiff-heat RESULT
         result = run_scene(hot_and_cold(STIFF_SPECIFIC_HEAT))
+    elif sys.argv[1] == "keff":  # keff FOLDER RESULT
+        result = run_scene(parse_scene(copy.deepcopy(KEFF)), sys.argv[2])
     elif sys.argv[1] == "whole":  # whole CASE FOLDER RESULT
         result = run_scene(RESUMED[sys.argv[2]](), sys.argv[3])
     elif sys.argv[1] == "resumed":  # resumed CASE STOP FOLDER RESULT

@@ -99,6 +99,7 @@ def test_linear_limit_is_the_luding_law_without_plasticity_and_cohesion():
     assert k1_factor(mechanics.T_RUN, lin.T_melt, lin.T_var) == 1.0  # no softening at the run's temperature
 
 
+@pytest.mark.slow  # the benchmark's whole quick path, every row (~2 min)
 def test_quick_path_on_tiny_sizes_writes_every_row(tmp_path):
     section = StandInSection(tmp_path / "mechanics")
     mechanics.run(section, quick=True, sizes=TINY, cache=tmp_path / "cache")

@@ -29,7 +29,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 PAGES = [README, *sorted(p for p in (ROOT / "docs").rglob("*.md") if "_build" not in p.parts)]
 RTOL, ATOL = 1e-6, 1e-12
-SLOW = ("fem_neck converge", "fem_neck lattice", "fem_neck cluster", "verification")  # commands of more than a few seconds: marked slow
+SLOW = ("fem_neck converge", "fem_neck lattice", "fem_neck cluster", "verification", "dem run fcc.toml")  # commands of more than a few seconds: marked slow
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 TIMING = re.compile(r"(?<![\w.])\d+(?:\.\d+)?\s?s\b")  # "1.8 s": a wall time in a table
 # a tqdm bar on stderr (a terminal overwrites it in place): its percentage, its rate, or its elapsed-time bracket

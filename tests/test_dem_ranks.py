@@ -3,7 +3,8 @@ tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserv
 the serial elastic collisions (energy and all) to the bit, carry the heat of the contacts as the serial run does
 (conserving it, stiff thermal steps too), resume from their checkpoints to the bit,
 write a piece of every snapshot per rank (PVTU), lose and duplicate no particle through migration, move
-stress walls as the serial run to round-off, and write the run's folder from rank 0. Skipped where mpi4py or
+stress walls as the serial run to round-off, report the serial effective conductivity, and write the run's folder
+from rank 0. Skipped where mpi4py or
 mpiexec is missing."""
 
 import json
@@ -128,6 +129,23 @@ def test_two_ranks_take_the_serial_runs_stiff_thermal_steps(tmp_path):
     assert list(two["summary_keys"]) == keys
     startup = keys.index("startup_steps")
     assert two["summary_values"][startup] == serial["summary_values"][startup] > 0
+def test_two_ranks_report_the_serial_effective_conductivity(tmp_path):
+    """Heat from a hot to a cold wall through a lattice column, periodic across: on two ranks the effective
+    conductivity is that of the gathered sample (its serial network, solved on rank 0 at each output and on every
+    rank after the run), the serial run's at every output and at the end."""
+    import csv
+
+    from dem import parse_scene
+
+    serial = ranks_worker.run_scene(parse_scene(ranks_worker.KEFF), tmp_path / "serial")
+    two = launched(2, "keff", tmp_path / "two", tmp_path / "two.npz")
+    k_serial = serial["summary_values"][list(serial["summary_keys"]).index("effective_conductivity")]
+    k_two = two["summary_values"][list(two["summary_keys"]).index("effective_conductivity")]
+    assert k_serial > 0 and k_two == pytest.approx(k_serial, rel=1e-12)
+    rows = [[r["effective_conductivity"] for r in csv.DictReader((tmp_path / name / "timeseries.csv").open())]
+            for name in ("serial", "two")]
+    assert rows[0] == rows[1] and sum(1 for k in rows[1] if k) >= 2  # every output's, as printed
+
 
 @pytest.mark.parametrize("case, stop", [("compaction", 0.0045), ("heat", 0.002)])
 def test_two_ranks_interrupted_and_resumed_end_as_the_uninterrupted_run(tmp_path, case, stop):

@@ -145,7 +145,9 @@ def listed(pvd: pathlib.Path) -> list[str]:
     return re.findall(r'file="([^"]+)"', pvd.read_text())
 
 
-@pytest.mark.parametrize("text, seed", [(THERMAL, 3), (MOVING, 4), (ZOHDI, 5)], ids=["thermal", "moving", "zohdi"])
+@pytest.mark.parametrize("text, seed", [(THERMAL, 3), pytest.param(MOVING, 4, marks=pytest.mark.slow),
+                                        pytest.param(ZOHDI, 5, marks=pytest.mark.slow)],
+                         ids=["thermal", "moving", "zohdi"])  # the thermal run is the quick check
 def test_interrupted_then_resumed_ends_as_the_uninterrupted_run(tmp_path, text, seed):
     scene = tmp_path / "scene.toml"
     scene.write_text(text)

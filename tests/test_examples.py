@@ -116,6 +116,7 @@ def test_pack_sinter_measure():
     assert ns["sinter"].summary["started_from"]["t"] == ns["t_pressed"]  # each stage from the one before
 
 
+@pytest.mark.slow  # every contact law's study (~1 min)
 def test_contact_laws():
     ns = run_example("contact_laws")
     assert all(abs(e - 0.8) < 2e-3 for e in ns["e_hertz_mindlin"])  # the material's e at every speed (dt = auto)

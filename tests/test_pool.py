@@ -222,6 +222,7 @@ def test_fit_sweep_on_dask_equals_the_local_pool(dask_client):
     assert [p.error_estimate for p in on_dask] == [p.error_estimate for p in local]
 
 
+@pytest.mark.slow  # (the fit sweep on Dask above is the quick check)
 def test_sintering_runs_on_dask_equal_the_local_pool_and_resume(dask_client, tmp_path):
     with P.use_dask(dask_client):
         on_dask = sr.run_tasks(TASKS, tmp_path / "dask", progress=False)
@@ -277,6 +278,7 @@ def test_size_sweep_keeps_the_sizes_up_to_the_first_failure(sizes_worker, reques
         assert [len(w) for w in section.written] == [1, 2, 3]
 
 
+@pytest.mark.slow  # a Dask cluster started and interrupted in a fresh process
 def test_interrupted_dask_run_is_one_line_and_exit_130(tmp_path):
     pytest.importorskip("distributed")
     args = ["fem_neck", "fit", "--points", "200", "--rtol", "1e-8", "--scheduler", "local", "--workers", "2",

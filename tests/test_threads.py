@@ -53,6 +53,7 @@ def _env(**extra):
     return {**os.environ, "PYTHONPATH": path, **extra}
 
 
+@pytest.mark.slow  # three whole runs in a fresh process (~1.5 min); the blocks' tests below are the quick check
 def test_one_two_and_three_threads_give_the_same_bits():
     proc = subprocess.run([sys.executable, "-c", SAME_BITS], env=_env(NUMBA_NUM_THREADS="3"), capture_output=True,
                           text=True, timeout=1800)

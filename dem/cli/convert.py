@@ -1,12 +1,15 @@
 """``python -m dem convert IN OUT [--format F] [--length-unit U] [--timestep N] [--periodic AXES] [--density RHO]
-[--json]``: a packing written in another format, e.g. for LAMMPS.
+[--blocks B] [--json]``: a packing written in another format, e.g. for LAMMPS, or in parts for many MPI ranks.
 
-IN is a packing file (CSV, LAMMPS data file or dump, VTK point set: :func:`dem.scene.packing_files.read_packing`, the
-format from the name or ``--format``), a saved moving state (``state.npz``: positions, radii, temperatures,
+IN is a packing file (CSV, LAMMPS data file or dump, VTK point set, a packing in parts:
+:func:`dem.scene.packing_files.read_packing`, the format from the name or ``--format``), a saved moving state
+(``state.npz``: positions, radii, temperatures,
 velocities, and densities from the saved masses; a static run's state: positions, radii, temperatures, materials) or a scene (a TOML file or a built-in name: its particles,
 generated ones included, with its materials' densities and its periodic box). OUT is written by its name: a LAMMPS
 data file of ``atom_style sphere`` (``.data``, ``.lmp``, ``data.*``; ``read_data`` reads it, ``units si``; LAMMPS
-numbers atoms from 1, so ids 0..N-1 become 1..N), ``.csv`` or ``.vtu``. A data file does not say which axes are
+numbers atoms from 1, so ids 0..N-1 become 1..N), ``.csv``, ``.vtu``, or a packing in parts, a folder ``NAME.parts``
+of ``--blocks`` blocks (:mod:`dem.scene.packing_parts`: what ``[particles] file`` reads in parts under MPI, each rank
+only its own). A data file does not say which axes are
 periodic: the input script's ``boundary`` command does (the summary lists the periodic axes IN records). The box is
 IN's (a state's or a scene's periodic box, a file's box); a centre outside it is wrapped into it along a periodic axis
 (its image flag counting the periods) and refused along any other. ``--periodic`` is for packing files only (a state
@@ -17,7 +20,8 @@ from __future__ import annotations
 
 import pathlib
 
-OUTPUTS = {"lammps-data": "LAMMPS data file (atom_style sphere)", "csv": "CSV", "vtk": "VTU"}
+OUTPUTS = {"lammps-data": "LAMMPS data file (atom_style sphere)", "csv": "CSV", "vtk": "VTU",
+           "parts": "packing in parts"}
 
 
 def register(sub):
@@ -29,10 +33,11 @@ def register(sub):
         The subparsers of the ``python -m dem`` parser.
     """
     parser = sub.add_parser("convert", help="write a packing, a saved state or a scene's particles as a LAMMPS "
-                            "data file, CSV or VTU", description=__doc__)
+                            "data file, CSV, VTU or a packing in parts", description=__doc__)
     parser.add_argument("input", metavar="IN", help="packing file, state.npz, or scene (TOML file or built-in name)")
-    parser.add_argument("output", metavar="OUT", help="file to write: .data / .lmp / data.* (LAMMPS), .csv or .vtu")
-    parser.add_argument("--format", default=None, help="format of IN: csv, lammps-data, lammps-dump or vtk "
+    parser.add_argument("output", metavar="OUT", help="file to write: .data / .lmp / data.* (LAMMPS), .csv, .vtu, "
+                        "or a folder NAME.parts (a packing in parts)")
+    parser.add_argument("--format", default=None, help="format of IN: csv, lammps-data, lammps-dump, vtk or parts "
                         "(default: from its name)")
     parser.add_argument("--length-unit", type=float, default=1.0, metavar="U",
                         help="metres per length unit of IN (0.001 for mm; default 1)")
@@ -42,6 +47,9 @@ def register(sub):
                         help="periodic axes of IN, e.g. xyz or xy (a LAMMPS data file does not record them)")
     parser.add_argument("--density", type=float, default=None, metavar="RHO",
                         help="kg/m^3 of every particle, for a LAMMPS data file when IN gives none")
+    parser.add_argument("--blocks", type=int, default=None, metavar="B",
+                        help="blocks of a packing in parts, at least the MPI ranks that will read it (default: about "
+                        "65536 particles each, at least 64 where each keeps 1000)")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout, nothing else")
     parser.set_defaults(run=run)
 
@@ -108,14 +116,22 @@ def run(args) -> dict:
     except ValueError:
         out_format = None
     if out_format not in OUTPUTS or target.suffix.lower() in (".vtk", ".vtp", ".pvtu", ".pvtp"):
-        raise ValueError(f"OUT = {args.output!r}: writes a LAMMPS data file (.data, .lmp, data.*), .csv or .vtu")
+        raise ValueError(f"OUT = {args.output!r}: writes a LAMMPS data file (.data, .lmp, data.*), .csv, .vtu or a "
+                         f"packing in parts (NAME.parts)")
     if args.density is not None and not args.density > 0:
         raise ValueError(f"--density = {args.density!r}: must be > 0 (kg/m^3)")
+    if args.blocks is not None and (out_format != "parts" or args.blocks < 1):
+        raise ValueError(f"--blocks = {args.blocks!r}: for OUT = NAME.parts only, >= 1 (and at most the particles)")
     packing, kind = read_input(args)
     if out_format == "lammps-data":
         packing_files.write_lammps_data(target, packing, args.density)
     elif out_format == "csv":
         packing_files.write_csv(target, packing)
+    elif out_format == "parts":
+        from dem.scene.packing_parts import read_index, write_parts
+
+        write_parts(target, packing, args.blocks)
+        blocks = read_index(target).blocks
     else:
         packing_files.write_vtu(target, packing)
     ids = packing_files.lammps_ids(packing.id) if out_format == "lammps-data" else packing.id
@@ -128,4 +144,6 @@ def run(args) -> dict:
                           else "".join(a for a, p in zip(packing_files.AXES, packing.periodic) if p) or "none")
     if packing.ignored:
         result["ignored"] = list(packing.ignored)
+    if out_format == "parts":
+        result["blocks"] = blocks
     return result

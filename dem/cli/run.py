@@ -10,7 +10,8 @@ bar. The console shows the heat flow into held particles as a total per group (`
 also per particle, for up to 1000 of them).
 
 Under ``mpiexec -n N`` (N > 1) a static scene runs on N ranks (:mod:`dem.engines.distributed`; PETSc options through
-``PETSC_OPTIONS``); rank 0 prints the summary and the one-line errors, the other ranks print nothing.
+``PETSC_OPTIONS``), each reading only its part of a packing in parts (``[particles] file = "NAME.parts"``,
+:mod:`dem.scene.packing_parts`); rank 0 prints the summary and the one-line errors, the other ranks print nothing.
 """
 
 import os
@@ -58,7 +59,7 @@ def run(args) -> dict:
     from dem.scene import load_scene
     from dem.driver import run as run_scene
     from dem.memory import available_bytes
-    from dem.network.comm import launched, launcher_rank
+    from dem.network.comm import launched, launcher_rank, world
 
     if launched() and launcher_rank() > 0:  # one summary, one error line: rank 0's
         sys.stdout = sys.stderr = open(os.devnull, "w")
@@ -67,7 +68,8 @@ def run(args) -> dict:
     if args.quiet:  # no bar; the run keeps its position for the line an interrupt prints
         os.environ["TQDM_DISABLE"] = "1"
     try:
-        scene = load_scene(args.scene)
+        comm = world() if launched() else None  # a packing in parts: each rank reads its own part
+        scene = load_scene(args.scene, part=None if comm is None else (comm.Get_size(), comm.Get_rank()))
         summary = run_scene(scene, args.out, progress=True, resume=args.resume, overwrite=args.overwrite).summary
     except MemoryError:  # beyond the estimate checked up front (dem.memory): say so in one line all the same
         raise ValueError(f"scene = {args.scene!r}: ran out of memory (the machine had "

@@ -168,6 +168,26 @@ class ContactThermalModel:
     def _walls_now(self, mechanics) -> list:
         return [self.walls[k].at(mechanics.w.q[k]) for k in self.thermal_walls]
 
+    def network(self, mechanics, bonds: tuple | None = None) -> Network:
+        """A new network of the contacts of ``mechanics`` now.
+
+        Parameters
+        ----------
+        mechanics : dem.engines.verlet.mechanics.MechanicalModel
+            The mechanical submodel: its contacts, positions (m), radii (m) and wall offsets (m).
+        bonds : tuple or None
+            Its ``(bonds, K_pairs, K_walls)`` where known already (:meth:`bonds`); None: found now.
+
+        Returns
+        -------
+        dem.network.heat.Network
+            The network, at the temperatures ``T``.
+        """
+        bonds, K_pairs, K_walls = self.bonds(mechanics) if bonds is None else bonds
+        wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
+        return Network(self._particles_now(mechanics, self.local(mechanics, self.particles.radius)), bonds, K_pairs,
+                       K_walls, wall_T, self.sources, self.box)
+
     def step(self, mechanics, dt: float) -> None:
         """Advance the temperatures by ``dt`` on the network of the contacts of ``mechanics`` now.
 
@@ -183,9 +203,7 @@ class ContactThermalModel:
             self.net.refresh(bonds, K_pairs, K_walls)
             self.refreshes += 1
         else:
-            wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
-            self.net = Network(self._particles_now(mechanics, self.local(mechanics, self.particles.radius)), bonds,
-                               K_pairs, K_walls, wall_T, self.sources, self.box)
+            self.net = self.network(mechanics, (bonds, K_pairs, K_walls))
             self.assemblies += 1
         T_F = self.T[self.free]
         integrator = self.integrator

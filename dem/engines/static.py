@@ -79,11 +79,15 @@ def boundary_summary(scene, walls, into: dict) -> dict:
         ``{"walls": {name: W}, "groups": {name: W}, "fixed_total": W}``, and ``"particles": {id: W}`` for up to
         1000 held particles.
     """
-    groups = held_groups(scene.particles, scene.groups)
+    part = scene.part
+    if part is None or part.fixed is None:
+        groups, ids = held_groups(scene.particles, scene.groups), scene.particles.id
+    else:  # a rank's part of a packing in parts: the groups of all its fixed particles, by their places in it
+        groups = {name: part.fixed_places[k] for name, k in held_groups(part.fixed).items()}
+        ids = dict(zip(part.fixed_places.tolist(), part.fixed.id.tolist()))
     out = {"walls": {w.name: float(q) for w, q in zip(scene.walls, walls)}, "groups": group_flows(groups, into),
            "fixed_total": float(sum(into[k] for k in sorted(into)))}
     if len(into) <= 1000:  # by particle id (the index unless a packing file gave ids)
-        ids = scene.particles.id
         out["particles"] = {str(ids[k]): into[k] for k in sorted(into)}
     return out
 
@@ -174,7 +178,7 @@ class StaticEngine:
     def _check_work(self) -> None:
         """Refuse a fixed-step run whose particle-steps exceed ``WORK_PER_STEP_LIMIT * max_steps`` up front, with a
         time estimate (:data:`SECONDS_PER_PARTICLE_STEP`)."""
-        s, n = self.scene.solver, self.scene.particles.n
+        s, n = self.scene.solver, self.scene.particle_count
         if s.dt == "auto":
             return  # the step count is not known in advance; max_steps bounds it while running
         work = s.t_end / s.dt * n
@@ -327,7 +331,7 @@ class StaticEngine:
         """What the run found (the driver adds the scene's name, times and the state file)."""
         scene, bonds, (T_mean, T_min, T_max) = self._over_the_packing()
         d = dict(self.details)
-        out = {"mode": self.scene.solver.mode, "t": self.t, "steps": self.steps, "particles": scene.particles.n,
+        out = {"mode": self.scene.solver.mode, "t": self.t, "steps": self.steps, "particles": scene.particle_count,
                "bonds": bonds, "energy_error": d.pop("energy_error", None), "static": True}
         for key in ("boundary_heat_flow", "periodic_heat_flow"):
             if key in d:

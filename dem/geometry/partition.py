@@ -10,16 +10,24 @@ not as the slabs' ever larger share.
 bond length (twice the largest radius: two spheres bond only when ``d < r_i + r_j``), every bond of an owned particle
 has its partner among the owned and the halo particles, so a bond search over those finds all of them. On periodic
 axes the distance is taken to the nearest image.
+
+A packing stored in parts (:mod:`dem.scene.packing_parts`) is shared out by its blocks, not its particles: the same
+bisection over the blocks' centres, each weighted by its particle count, so that a rank reads only its blocks and
+those within ``reach`` of them.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+HALO_MARGIN = 1.0 + 1e-9  # the halo's reach: this x one bond length (two largest radii), against round-off
 
-def bisection(position: np.ndarray, parts: int, lengths: np.ndarray | None = None) -> np.ndarray:
+
+def bisection(position: np.ndarray, parts: int, lengths: np.ndarray | None = None,
+              weights: np.ndarray | None = None) -> np.ndarray:
     """The rank (0 ... ``parts - 1``) of every particle: recursive coordinate bisection (module docstring).
-    ``lengths``: the extent of each axis where it is known (a periodic box), else the particles' span.
+    ``lengths``: the extent of each axis where it is known (a periodic box), else the particles' span; ``weights``:
+    what each point counts for (a block's particles), each cut at the weight that gives each side its share.
 
     Parameters
     ----------
@@ -29,6 +37,8 @@ def bisection(position: np.ndarray, parts: int, lengths: np.ndarray | None = Non
         Number of ranks, >= 1.
     lengths : numpy.ndarray or None
         (3,) the box's lengths (m); None: the particles' span.
+    weights : numpy.ndarray or None
+        (N,) what each point counts for, >= 0 (the particle count of a block); None: one each.
 
     Returns
     -------
@@ -38,11 +48,11 @@ def bisection(position: np.ndarray, parts: int, lengths: np.ndarray | None = Non
     if parts < 1:
         raise ValueError(f"parts = {parts}: must be >= 1")
     owner = np.zeros(len(position), dtype=np.int64)
-    _split(position, np.arange(len(position)), 0, parts, owner, lengths)
+    _split(position, np.arange(len(position)), 0, parts, owner, lengths, weights)
     return owner
 
 
-def _split(position, members, first, parts, owner, lengths):
+def _split(position, members, first, parts, owner, lengths, weights):
     if parts == 1 or len(members) == 0:
         owner[members] = first
         return
@@ -50,10 +60,16 @@ def _split(position, members, first, parts, owner, lengths):
     span = np.ptp(x, axis=0) if lengths is None else np.minimum(np.ptp(x, axis=0), lengths)
     axis = int(np.argmax(span))
     low_parts = parts // 2
-    cut = len(members) * low_parts // parts
     order = members[np.argsort(x[:, axis], kind="stable")]
-    _split(position, order[:cut], first, low_parts, owner, lengths)
-    _split(position, order[cut:], first + low_parts, parts - low_parts, owner, lengths)
+    if weights is None:
+        cut = len(members) * low_parts // parts
+    else:  # the first points up to the low side's share of the weight, each side at least one point per part
+        w = np.cumsum(weights[order])
+        cut = int(np.searchsorted(w, w[-1] * low_parts / parts, side="right"))
+        if len(members) >= parts:
+            cut = min(max(cut, low_parts), len(members) - (parts - low_parts))
+    _split(position, order[:cut], first, low_parts, owner, lengths, weights)
+    _split(position, order[cut:], first + low_parts, parts - low_parts, owner, lengths, weights)
 
 
 def halo(position: np.ndarray, owner: np.ndarray, rank: int, reach: float, lengths=None, periodic=None) -> np.ndarray:

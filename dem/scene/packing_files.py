@@ -23,15 +23,18 @@
   ``materialId``; LIGGGHTS: ``type``, from 1), ``density`` or ``mass``, ``velocity`` (Yade: ``linVelVec``; LIGGGHTS:
   ``v``) are read where present.
 
-The format comes from the file's name (``.csv``; ``.data``, ``.lmp`` or a name ``data.*``; ``.dump``,
-``.lammpstrj`` or ``dump.*``; ``.vtu``, ``.vtp``, ``.vtk``) or an explicit ``format``. Lengths are multiplied by
+* ``parts`` -- a packing in parts, a folder ``NAME.parts`` of blocks that MPI ranks read one part each
+  (:mod:`dem.scene.packing_parts`; read here whole), in SI units.
+
+The format comes from the file's name (``.csv``; ``.data``, ``.lmp`` or a name ``data.*``; ``.dump``, ``.lammpstrj``
+or ``dump.*``; ``.vtu``, ``.vtp``, ``.vtk``; ``.parts``) or an explicit ``format``. Lengths are multiplied by
 ``length_unit`` (0.001 for a file in mm, 1e-6 in um; densities stay kg/m^3); a LAMMPS file that records its unit
 style (the title line ``units = cgs`` of ``write_data``, ``ITEM: UNITS`` of a dump) is converted from it. Particles
 read from LAMMPS files are sorted by id (LAMMPS writes them in the order of its processors); other files keep their
 order. A bad file raises ``ValueError`` with one line naming the file, the line and the column. A file that reads
 but looks wrong gets a ``UserWarning``: positions of at most 6 significant digits with pairs within that rounding of
-touching (:func:`printed_precision`), a median radius beyond ``RADIUS_PLAUSIBLE`` (another length unit than the
-file says).
+touching (:func:`printed_precision`), a median radius beyond ``RADIUS_PLAUSIBLE`` (another length unit than the file
+says).
 
 The other way: :func:`write_lammps_data` writes a packing (read here, from a scene's particles, or from a saved
 state, :func:`packing_from_state`) as a LAMMPS data file of ``atom_style sphere`` that ``read_data`` reads;
@@ -55,7 +58,7 @@ import numpy as np
 from dem.output.atomic import write_aside
 from dem.output.lammps_dump import lammps_ids, rows_text as _rows_text
 
-FORMATS = ("csv", "lammps-data", "lammps-dump", "vtk")
+FORMATS = ("csv", "lammps-data", "lammps-dump", "vtk", "parts")
 AXES = "xyz"
 # LAMMPS unit styles a granular packing can be in: metres and kg/m^3 per unit of length and of density
 LAMMPS_UNITS = {"si": (1.0, 1.0), "cgs": (1e-2, 1e3), "micro": (1e-6, 1e3), "nano": (1e-9, 1e6)}
@@ -223,8 +226,10 @@ def format_of(path) -> str:
         return "lammps-dump"
     if suffix in (".vtu", ".vtp", ".vtk", ".pvtu", ".pvtp"):
         return "vtk"
+    if suffix == ".parts":
+        return "parts"
     raise ValueError(f"{path}: the format is not known from the name; give format = one of {', '.join(FORMATS)} "
-                     "(extensions: .csv; .data, .lmp, data.*; .dump, .lammpstrj, dump.*; .vtu, .vtp, .vtk)")
+                     "(extensions: .csv; .data, .lmp, data.*; .dump, .lammpstrj, dump.*; .vtu, .vtp, .vtk; .parts)")
 
 
 def read_packing(path, format: str | None = None, length_unit: float = 1.0, timestep: int | None = None,
@@ -267,13 +272,20 @@ def read_packing(path, format: str | None = None, length_unit: float = 1.0, time
     if timestep is not None and fmt != "lammps-dump":
         raise ValueError(f"timestep = {timestep!r}: only for LAMMPS dumps (format = 'lammps-dump')")
     axes = None if periodic is None else _axes(periodic)
-    if not path.is_file():
+    if fmt == "parts":  # a folder (dem.scene.packing_parts), in SI units as written
+        from dem.scene.packing_parts import read_whole
+
+        if length_unit != 1.0:
+            raise ValueError(f"length_unit = {length_unit!r}: a packing in parts is in metres (1)")
+        packing = read_whole(path)
+    elif not path.is_file():
         raise ValueError(f"{path}: no such file")
-    reader = {"csv": _read_csv, "lammps-data": _read_data, "lammps-dump": _read_dump, "vtk": _read_vtk}[fmt]
-    try:
-        packing = reader(path, float(length_unit), timestep)
-    except UnicodeDecodeError as exc:
-        raise ValueError(f"{path}: cannot be read as text ({exc.reason} at byte {exc.start})") from None
+    else:
+        reader = {"csv": _read_csv, "lammps-data": _read_data, "lammps-dump": _read_dump, "vtk": _read_vtk}[fmt]
+        try:
+            packing = reader(path, float(length_unit), timestep)
+        except UnicodeDecodeError as exc:
+            raise ValueError(f"{path}: cannot be read as text ({exc.reason} at byte {exc.start})") from None
     if axes is not None:
         packing = replace(packing, periodic=axes)
     packing = _checked(packing, path, fmt)
@@ -915,13 +927,15 @@ SCENE_KEYS = ("file", "format", "length_unit", "timestep")  # [particles] keys o
 DENSITY_RTOL = 1e-3  # a file's density against its material's: printed digits (LAMMPS dumps: 6) pass, a mix-up fails
 
 
-def scene_particles(table: dict, materials, base_dir=None):
+def scene_particles(table: dict, materials, base_dir=None, part=None):
     """``[particles] file = "..."`` of a scene: the :class:`dem.geometry.particles.Particles` of the file (``format``,
     ``length_unit``, ``timestep`` as for :func:`read_packing`; the path relative to ``base_dir``, the scene's folder)
     and the file's box as a :class:`dem.geometry.periodic.PeriodicBox` (periodic along the axes the file says are, none where
     it cannot say), or None. ``temperature`` (a number or a list), ``fixed``, ``material`` (a name or index, or a
     list of them) and ``heat`` come from the table where given, else from the file; a density the file gives must be
-    its material's.
+    its material's. With ``part``, a packing in parts (:mod:`dem.scene.packing_parts`) gives only the particles that
+    rank holds (a list in the table is of the whole packing, taken at their places), and its ``Part`` the particles
+    of the whole packing that its file holds at their temperature (``fixed`` in the table is refused there).
 
     Parameters
     ----------
@@ -931,11 +945,15 @@ def scene_particles(table: dict, materials, base_dir=None):
         The scene's materials.
     base_dir : str or pathlib.Path or None
         The scene's folder, against which a relative ``file`` is read; None: the working directory.
+    part : tuple or None
+        ``(ranks, rank, box_of)``: read a packing in parts as rank ``rank`` of ``ranks``, the scene's periodic box
+        ``box_of(file_box)`` (a callable from the file's box, or None, to the scene's); None: read the whole file.
 
     Returns
     -------
-    tuple of (dem.geometry.particles.Particles, dem.geometry.periodic.PeriodicBox or None)
-        The particles and the file's box.
+    tuple of (dem.geometry.particles.Particles, dem.geometry.periodic.PeriodicBox or None, object)
+        The particles, the file's box, and the :class:`dem.scene.packing_parts.Part` they are of (None where the
+        whole file was read).
 
     Raises
     ------
@@ -954,15 +972,23 @@ def scene_particles(table: dict, materials, base_dir=None):
     if "timestep" in options and (not isinstance(options["timestep"], int) or isinstance(options["timestep"], bool)):
         raise ValueError(f"[particles] timestep = {options['timestep']!r}: must be an integer (a dump's timestep)")
     path = pathlib.Path(base_dir) / name if base_dir is not None else pathlib.Path(name)
+    held = None
     try:
-        packing = read_packing(path, **options)
+        if part is not None and options.get("format", format_of(path) if path.suffix else None) == "parts":
+            packing, held = _part_of(path, table, options, *part)
+        else:
+            packing = read_packing(path, **options)
     except ValueError as exc:
         raise ValueError(f"[particles] file: {exc}") from None
     n = packing.n
     values = {}
-    for key in ("temperature", "fixed", "heat"):
+    for key in ("temperature", "fixed", "heat", "material"):
         value = table.get(key, getattr(packing, key, None))
-        if isinstance(value, (int, float)) and not isinstance(value, bool) and key != "fixed":
+        if held is not None and key in table and isinstance(value, list):
+            if len(value) != held.n:
+                raise ValueError(f"[particles] {key}: {len(value)} values for the {held.n} particles of {name!r}")
+            value = np.asarray(value)[held.held]
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and key not in ("fixed", "material"):
             value = np.full(n, float(value))
         elif isinstance(value, bool) and key == "fixed":
             value = np.full(n, value)
@@ -978,7 +1004,7 @@ def scene_particles(table: dict, materials, base_dir=None):
                              f"{len(materials)} material(s); give [[materials]] (LAMMPS type k is material k - 1) or "
                              "[particles] material")
     material = material_indices("[particles] material" if "material" in table else f"[particles] file {name!r}: "
-                                "material", table.get("material", packing.material), materials, n)
+                                "material", values["material"], materials, n)
     particles = Particles.from_arrays(packing.position, packing.radius, values["temperature"], materials, material,
                                       values["fixed"], values["heat"], prefix="[particles]", id=packing.id)
     if packing.density is not None:
@@ -997,7 +1023,35 @@ def scene_particles(table: dict, materials, base_dir=None):
             raise ValueError(f"[particles] file {name!r}: particle id {packing.id[k]} has density "
                              f"{packing.density[k]:.6g} kg/m^3 but its material {m.name!r} {m.density:.6g}; {advice}")
     box = packing.periodic_box() if packing.box_lo is not None else None
-    return particles, box
+    if held is not None and held.fixed is not None:  # the whole packing's fixed particles, as the scene has them
+        f = held.fixed
+        T = table.get("temperature", f.temperature)
+        T = np.asarray(T, dtype=float)[held.fixed_places] if isinstance(T, list) else np.broadcast_to(T, (f.n,))
+        held = replace(held, fixed=Particles.from_arrays(f.position, f.radius, T, materials,
+                                                         fixed=np.ones(f.n, dtype=bool), prefix="[particles]",
+                                                         id=f.id))
+    return particles, box, held
+
+
+def _part_of(path, table: dict, options: dict, ranks: int, rank: int, box_of):
+    """The packing and :class:`dem.scene.packing_parts.Part` that rank ``rank`` of ``ranks`` holds of the packing in
+    parts ``path`` (:func:`scene_particles`)."""
+    from dem.scene import packing_parts
+
+    extra = sorted(set(options) - {"format"})
+    if extra:
+        raise ValueError(f"{extra[0]}: not for a packing in parts (in metres, one snapshot)")
+    if "fixed" in table:
+        raise ValueError(f"[particles] fixed: not for a packing read in parts on several ranks (the fixed particles "
+                         f"are the file's, {path.name}/{packing_parts.HELD}); write them into it, or run on one "
+                         "process")
+    index = packing_parts.read_index(path)
+    file_box = None
+    if index.box_lo is not None:
+        from dem.geometry.periodic import PeriodicBox
+
+        file_box = PeriodicBox(index.box_hi - index.box_lo, index.periodic or (False,) * 3, index.box_lo)
+    return packing_parts.read_part(path, ranks, rank, box_of(file_box))
 
 
 # --------------------------------------------------------------------------------------------------- writing

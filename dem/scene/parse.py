@@ -199,6 +199,9 @@ class Scene:
         The unit of the scene's temperatures, ``"C"`` or ``"K"`` (:func:`temperature_unit`).
     groups : dict
         The ``[[groups]]`` that hold their particles, ``{name: indices}`` (:func:`dem.scene.groups.apply_groups`).
+    part : dem.scene.packing_parts.Part or None
+        Where ``particles`` are in the packing when they are one rank's part of a packing in parts
+        (:func:`dem.scene.packing_parts.read_part`); None: they are the whole packing.
 
     Raises
     ------
@@ -224,10 +227,16 @@ class Scene:
     start: dict | None = None  # the saved state it starts from (dem.scene.state_file.load), else None
     temperature_unit: str = "C"  # the unit of its temperatures, "C" or "K" (:func:`temperature_unit`)
     groups: dict = field(default_factory=dict)  # the [[groups]] that hold their particles, {name: indices}
+    part: object = None  # a rank's part of a packing in parts (dem.scene.packing_parts.Part), else None
 
     def __post_init__(self):
         walls = self.motion.walls if self.motion is not None else self.walls
         check_inside(walls, self.particles.position, self.particles.id)
+
+    @property
+    def particle_count(self) -> int:
+        """The number of particles in the whole packing (more than ``particles`` holds where it is a rank's part)."""
+        return self.particles.n if self.part is None else self.part.n
 
     @property
     def start_time(self) -> float:
@@ -364,10 +373,10 @@ def _materials(doc, thermal: bool = True, electrical: bool = False) -> tuple:
     return tuple(out)
 
 
-def _explicit_particles(t: dict, materials, base_dir=None):
+def _explicit_particles(t: dict, materials, base_dir=None, part=None):
     if "file" in t:  # a packing file (dem.scene.packing_files); its box, periodic or not, is returned as the box
-        particles, box = packing_files.scene_particles(t, materials, base_dir)
-        return particles, (), None, None, box
+        particles, box, held = packing_files.scene_particles(t, materials, base_dir, part)
+        return particles, (), None, None, box, held
     extra = sorted(set(t) & set(packing_files.SCENE_KEYS))
     if extra:
         raise ValueError(f"[particles] {extra[0]}: only with file = \"...\" (a packing file)")
@@ -377,7 +386,7 @@ def _explicit_particles(t: dict, materials, base_dir=None):
     n = len(t["position"]) if isinstance(t["position"], list) else 0
     material = material_indices("[particles] material", t.get("material"), materials, n)
     return Particles.from_arrays(t["position"], t["radius"], t["temperature"], materials, material, t.get("fixed"),
-                                 t.get("heat"), prefix="[particles]"), (), None, None, None
+                                 t.get("heat"), prefix="[particles]"), (), None, None, None, None
 
 
 def _generated_particles(t: dict, materials, dimension: int = 3):
@@ -551,7 +560,7 @@ def _engine(doc: dict, physics, law) -> str:
     return named
 
 
-def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None) -> Scene:
+def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None = None, part=None) -> Scene:
     """Validate a parsed TOML document into a :class:`Scene`: every table and key against the schema of the engine
     the scene runs on (:mod:`dem.scene.schema`), then each table into its part of the scene.
 
@@ -564,6 +573,10 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     base_dir : pathlib.Path or None
         The scene file's folder, against which relative paths (a packing file, a saved state) are read; None:
         the working directory.
+    part : tuple or None
+        ``(ranks, rank)``: a static scene whose ``[particles] file`` is a packing in parts
+        (:mod:`dem.scene.packing_parts`) gets only the particles rank ``rank`` of ``ranks`` holds (``Scene.part``
+        says which); None, or another scene: every particle.
 
     Returns
     -------
@@ -598,7 +611,7 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     engine = _engine(doc, physics, law)
     check(doc, engine, law)
     materials = _materials(doc, thermal="thermal" in physics, electrical="electrical" in physics)
-    start = None
+    start = held = None  # held: the part of a packing in parts that this rank holds, if it holds a part
     if "start" in doc:
         if "particles" in doc or "generator" in doc:
             raise ValueError("[start] state: the particles come from the saved state; remove [particles] or "
@@ -616,25 +629,26 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     elif ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
     elif "particles" in doc:
-        particles, walls, specimen, velocity, box = _explicit_particles(doc["particles"], materials, base_dir)
+        in_part = None if part is None or engine != "static" else (*part, lambda file_box: _scene_box(doc, file_box))
+        particles, walls, specimen, velocity, box, held = _explicit_particles(doc["particles"], materials, base_dir,
+                                                                              in_part)
     else:
         particles, walls, specimen, velocity, box = _generated_particles(doc["generator"], materials,
                                                                          meta.get("dimension", 3))
-    if "periodic" in doc:
-        if box is not None and "generator" in doc:
-            raise ValueError("[periodic]: the generator's boundary = \"periodic\" already makes the block periodic; "
-                             "give one or the other")
-        box = _periodic_box(doc["periodic"], box)
-    elif box is not None and not box.any_periodic:
-        box = None  # a packing file's box that is not periodic (or that cannot say): only [periodic] uses it
+    box = _scene_box(doc, box)
     groups = {}
     if "groups" in doc:
+        if held is not None:
+            raise ValueError("[[groups]]: not on a packing read in parts on several ranks (a group is chosen over the "
+                             "whole packing); run on one process")
         particles, groups = apply_groups(doc["groups"], particles)
     walls = walls + _walls(doc, start, static=not moving)
     if box is not None and moving:
         _check_walls_across(walls, box)
     if not moving and specimen is None:
-        specimen = find_specimen(particles, walls, box, groups, bounds=_saved_walls(start))
+        ends = particles if held is None or held.fixed is None else held.fixed  # the fixed ones of all, in parts
+        span = None if held is None else (held.extent_lo, held.extent_hi)
+        specimen = find_specimen(ends, walls, box, groups, bounds=_saved_walls(start), span=span)
     cond = dict(doc.get("conductance", {}))
     if "fit_file" in cond and not isinstance(cond["fit_file"], str):
         raise ValueError(f"[conductance] fit_file = {cond['fit_file']!r}: must be a path (string)")
@@ -659,7 +673,20 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     return Scene(particles, () if moving else walls, conductance, Sources(conv, rad), solver, output,
                  tuple(physics), str(meta.get("name", source)), str(meta.get("description", "")), specimen, contact,
                  motion, electrical, box, engine, start,
-                 temperature_unit(meta, rad, zohdi=law is not None and law.NAME == "zohdi"), groups)
+                 temperature_unit(meta, rad, zohdi=law is not None and law.NAME == "zohdi"), groups, held)
+
+
+def _scene_box(doc: dict, box: PeriodicBox | None) -> PeriodicBox | None:
+    """The scene's periodic box: ``[periodic]`` over the box of its packing file or generator (``box``), else that
+    box where it is periodic along some axis."""
+    if "periodic" in doc:
+        if box is not None and "generator" in doc:
+            raise ValueError("[periodic]: the generator's boundary = \"periodic\" already makes the block periodic; "
+                             "give one or the other")
+        return _periodic_box(doc["periodic"], box)
+    if box is not None and not box.any_periodic:
+        return None  # a packing file's box that is not periodic (or that cannot say): only [periodic] uses it
+    return box
 
 
 
@@ -800,13 +827,15 @@ def builtin_scenes() -> dict:
     return out
 
 
-def load_scene(name_or_path) -> Scene:
+def load_scene(name_or_path, part=None) -> Scene:
     """Read a scene from a TOML file path or a built-in name (``python -m dem scenes`` lists them).
 
     Parameters
     ----------
     name_or_path : str or pathlib.Path
         A scene TOML file, or the name of a built-in scene.
+    part : tuple or None
+        ``(ranks, rank)``: of a packing in parts, only what this rank holds (:func:`parse_scene`); None: all.
 
     Returns
     -------
@@ -835,6 +864,6 @@ def load_scene(name_or_path) -> Scene:
     except (OSError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path.name}: cannot be read ({exc})") from None
     try:
-        return parse_scene(doc, path.stem, path.parent)
+        return parse_scene(doc, path.stem, path.parent, part)
     except ValueError as exc:
         raise ValueError(f"{path.name}: {exc}") from None

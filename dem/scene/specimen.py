@@ -136,11 +136,12 @@ def group_flows(groups: dict, into: dict) -> dict[str, float]:
     return {name: float(sum(into[int(k)] for k in idx)) for name, idx in groups.items()}
 
 
-def find_specimen(particles, walls, box=None, named: dict | None = None, bounds=()) -> Specimen | None:
+def find_specimen(particles, walls, box=None, named: dict | None = None, bounds=(), span=None) -> Specimen | None:
     """The specimen between the scene's two ends (module docstring), or None where it has not exactly two ends
     at different temperatures that face each other along an axis. ``walls``: the scene's walls (those with a
     temperature are ends); ``box``: its :class:`dem.geometry.periodic.PeriodicBox` or None; ``named``: its named
-    groups ``{name: indices}``; ``bounds``: walls that only bound the cross-section (a saved state's).
+    groups ``{name: indices}``; ``bounds``: walls that only bound the cross-section (a saved state's); ``span``:
+    the whole packing's extent where ``particles`` are a part of it.
 
     Parameters
     ----------
@@ -154,6 +155,9 @@ def find_specimen(particles, walls, box=None, named: dict | None = None, bounds=
         The scene's named groups, ``{name: indices}``; None for none.
     bounds : sequence of dem.geometry.walls.Wall
         Walls that only bound the cross-section (a saved state's), not ends.
+    span : tuple or None
+        ``(lo, hi)``, (3,) each: the extent of the packing's surfaces (m), where ``particles`` are only a part of
+        it (:mod:`dem.scene.packing_parts`); None: that of ``particles``.
 
     Returns
     -------
@@ -175,7 +179,7 @@ def find_specimen(particles, walls, box=None, named: dict | None = None, bounds=
     length = abs(_where(hot, axis, particles.position) - _where(cold, axis, particles.position))
     if not length > 0:
         return None
-    return Specimen(length, cross_section(particles, axis, box, bounds), hot[2], cold[2], hot[:2], cold[:2],
+    return Specimen(length, cross_section(particles, axis, box, bounds, span), hot[2], cold[2], hot[:2], cold[:2],
                     axis=axis)
 
 
@@ -199,7 +203,7 @@ def _where(end, axis: int, x: np.ndarray) -> float:
     return float(end[3].point[axis]) if end[0] == "wall" else float(x[end[3], axis].mean())
 
 
-def cross_section(particles, axis: int, box=None, bounds=()) -> float:
+def cross_section(particles, axis: int, box=None, bounds=(), span=None) -> float:
     """The area (m^2) normal to ``axis``: along each other axis the box's period, else the extent between the
     ``bounds`` walls facing each other along it, else the particles' extent.
 
@@ -213,6 +217,8 @@ def cross_section(particles, axis: int, box=None, bounds=()) -> float:
         The periodic box, whose period (m) is the extent along each periodic axis; None without one.
     bounds : sequence of dem.geometry.walls.Wall
         Walls bounding the cross-section; two facing each other along an axis give its extent there.
+    span : tuple or None
+        ``(lo, hi)``, (3,) each: the extent of the particles' outermost surfaces (m); None: from ``particles``.
 
     Returns
     -------
@@ -230,6 +236,8 @@ def cross_section(particles, axis: int, box=None, bounds=()) -> float:
             area *= float(box.lengths[a])
         elif a in pairs:
             area *= extent(offsets, *pairs[a])
+        elif span is not None:
+            area *= float(span[1][a] - span[0][a])
         else:
             x, r = particles.position[:, a], particles.radius
             area *= float(np.max(x + r) - np.min(x - r))

@@ -3,10 +3,11 @@ steady or in implicit steps of a fixed size, its particles shared out in space a
 
 Every rank reads the scene, keeps the particles of its cell of a recursive coordinate bisection
 (:func:`dem.geometry.partition.bisection`) and a halo of one bond length around them
-(:func:`dem.geometry.partition.halo`), finds their bonds and conductances as the serial engine does, and keeps those
-with an owned particle (:mod:`dem.network.distributed`: its rows are the serial matrix's to the bit). The summary and
-the effective conductivity are reduced over the ranks; the snapshots are one piece per rank
-(:class:`dem.output.pieces.PieceWriter`).
+(:func:`dem.geometry.partition.halo`) -- or, from a packing in parts, reads only those
+(:func:`dem.scene.packing_parts.read_part`: the scene's ``part``) --, finds their bonds and conductances as the
+serial engine does, and keeps those with an owned particle (:mod:`dem.network.distributed`: its rows are the serial
+matrix's to the bit). The summary and the effective conductivity are reduced over the ranks; the snapshots are one
+piece per rank (:class:`dem.output.pieces.PieceWriter`).
 
 A current between electrodes (``"electrical"`` physics, :mod:`dem.engines.static`) is solved before the heat on the
 same ranks and the same code path: its network is a :class:`dem.network.heat.Network` of the same bonds with the
@@ -30,14 +31,12 @@ import numpy as np
 from dem import memory
 from dem.engines.static import CSV_FLOWS, StaticEngine, boundary_summary
 from dem.geometry.necks import meeting_in
+from dem.geometry.partition import HALO_MARGIN, bisection, halo
 from dem.laws.verified_range import neck_account, wide_necks
-from dem.geometry.partition import bisection, halo
 from dem.network import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
 from dem.network.distributed import DistributedNetwork
 from dem.network.heat import Network, bonds_and_conductances
-
-HALO_MARGIN = 1.0 + 1e-9  # the halo's reach: this x one bond length (two largest radii), against round-off
 
 
 def unsupported(scene, resume: bool = False) -> str | None:
@@ -122,16 +121,25 @@ class DistributedStaticEngine(StaticEngine):
             raise ValueError(f"{p.n} particles on {self.ranks} ranks: use at most {p.n} ranks")
         if scene.solver.mode == "transient":
             self._check_work()
-        lengths = None if box is None else np.where(box.mask, box.lengths, np.inf)
-        owner = bisection(p.position, self.ranks, lengths)
-        reach = 2.0 * float(p.radius.max()) * HALO_MARGIN
-        self.owned = np.flatnonzero(owner == rank)
-        held = np.union1d(self.owned, halo(p.position, owner, rank, reach, None if box is None else box.lengths,
-                                          None if box is None else box.mask))
+        if scene.part is not None:  # read in part: the held particles and their owners
+            if scene.part.ranks != self.ranks:
+                raise ValueError(f"the packing in parts was read for {scene.part.ranks} ranks, not these "
+                                 f"{self.ranks}")
+            held, owner_held = scene.part.held, scene.part.owner
+            self.owned = held[owner_held == rank]
+            local = p
+        else:
+            lengths = None if box is None else np.where(box.mask, box.lengths, np.inf)
+            owner = bisection(p.position, self.ranks, lengths)
+            reach = 2.0 * float(p.radius.max()) * HALO_MARGIN
+            self.owned = np.flatnonzero(owner == rank)
+            held = np.union1d(self.owned, halo(p.position, owner, rank, reach, None if box is None else box.lengths,
+                                              None if box is None else box.mask))
+            owner_held = owner[held]
+            local = p.permuted(held)
         memory.check(len(held), "particles")
-        local = p.permuted(held)
         self.scene = replace(scene, particles=local)
-        mine = owner[held] == rank
+        mine = owner_held == rank
         try:
             bonds, K_pairs, K_walls = bonds_and_conductances(local, scene.walls, scene.conductance, box=box)
         except ValueError as exc:  # its counts and indices are of this rank's particles
@@ -143,7 +151,7 @@ class DistributedStaticEngine(StaticEngine):
         self.meeting = meeting_in(local, scene.walls, self.bonds, box)  # right for the owned: all their bonds are here
         self.wide = wide_necks(local.radius, self.bonds, self.meeting, scene.conductance.law)
         self.T = local.temperature.astype(float)
-        return owner[held]
+        return owner_held
 
     def _joule_heated(self, particles, owner: np.ndarray):
         """The held particles with the absorbed Joule heat of the current added to their heat sources (module
@@ -195,7 +203,7 @@ class DistributedStaticEngine(StaticEngine):
                "bonds_dropped": 0, "wall_bonds": self.part.total(int(self.bonds.n_walls)), "ranks": self.ranks}
         b = self.bonds
         out.update(neck_account(self.part.total(int(np.count_nonzero(self.meeting[self.mine]))),
-                                self.full_scene.particles.n, b.contact,
+                                self.full_scene.particle_count, b.contact,
                                 self.part.total(int(np.count_nonzero(self.mine[b.i]) + b.n_walls)),
                                 self.full_scene.conductance.law,
                                 self.part.total(int(np.count_nonzero(self.wide[self.mine])))))
@@ -280,14 +288,14 @@ class DistributedStaticEngine(StaticEngine):
         smallest and largest over every rank's owned particles."""
         own = self.T[self.mine]
         bonds = self.part.total(int(np.sum(self.mine[self.bonds.i])))
-        T_mean = float(self.part.total(float(own.sum())) / self.full_scene.particles.n)
+        T_mean = float(self.part.total(float(own.sum())) / self.full_scene.particle_count)
         return self.full_scene, bonds, (T_mean, mpi.minimum(self.comm, float(own.min(initial=np.inf))),
                                         mpi.maximum(self.comm, float(own.max(initial=-np.inf))))
 
     def gathered_temperatures(self) -> np.ndarray:
         """The final temperatures of all particles in the scene's order, on every rank (for small scenes: the
         summary's list, tests)."""
-        T = np.empty(self.full_scene.particles.n)
+        T = np.empty(self.full_scene.particle_count)
         for index, values in self.comm.allgather((self.owned, self.T[self.mine])):
             T[index] = values
         return T

@@ -35,7 +35,8 @@ linear solver's tolerance (to round-off with a direct solver in ``PETSC_OPTIONS`
 to round-off as in the serial step. The temperatures (and their rates) are kept for every particle of the scene on
 every rank (one allgather of the owned values per thermal step: n floats per rank), so a migrating particle takes
 nothing thermal with it. The effective conductivity of the contact network (a further steady solve at each output)
-is not computed on several ranks.
+is that of the gathered sample (below): the serial network of its contacts, solved on rank 0 at an output time and on
+every rank after the run.
 
 The rows of ``timeseries.csv``, the summary, the plots and the checkpoints come from the sample gathered on rank 0 in
 global order (:meth:`RankMechanics.gathered`); on several ranks each rank writes its piece of every snapshot (the
@@ -56,7 +57,6 @@ import numpy as np
 from dem.network import comm as mpi
 from dem.network.comm import world
 from dem.network.distributed import DistributedNetwork
-from dem.network.heat import Network
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.decomposition import Slabs
 from dem.engines.verlet.engine import VerletEngine
@@ -477,7 +477,22 @@ class RankContactThermal(ContactThermalModel):
     hands_over = False
 
     def local(self, mechanics, values: np.ndarray) -> np.ndarray:
-        return values[mechanics.gid]
+        """As :meth:`~dem.engines.contact_heat.ContactThermalModel.local`: a rank's particles (by their global ids),
+        or all of them in a gathered sample (:meth:`RankMechanics.gathered`).
+
+        Parameters
+        ----------
+        mechanics : RankMechanics or dem.engines.verlet.mechanics.MechanicalModel
+            This rank's mechanics, or the gathered sample.
+        values : numpy.ndarray
+            One value per particle of the scene, any unit.
+
+        Returns
+        -------
+        numpy.ndarray
+            The values of the particles ``mechanics`` holds, in its order.
+        """
+        return values[mechanics.gid] if isinstance(mechanics, RankMechanics) else values
 
     def step(self, mechanics, dt: float) -> None:
         """Advance the temperatures by ``dt`` on the network of the contacts the ranks hold now.
@@ -492,10 +507,7 @@ class RankContactThermal(ContactThermalModel):
         comm = mechanics.comm
         bonds, K_pairs, K_walls = self.bonds(mechanics)
         walls = mechanics.owned[bonds.wall_particle]  # a ghost's wall contacts are its owner's
-        bonds, K_walls = bonds.subset(slice(None), walls), K_walls[walls]
-        wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
-        self.net = Network(self._particles_now(mechanics, self.local(mechanics, self.particles.radius)), bonds,
-                           K_pairs, K_walls, wall_T, self.sources, self.box)
+        self.net = self.network(mechanics, (bonds.subset(slice(None), walls), K_pairs, K_walls[walls]))
         owner = np.full(len(mechanics.gid), mechanics.rank)
         for rank, ghosts in mechanics.recv_idx.items():
             owner[ghosts] = rank
@@ -579,9 +591,20 @@ class RankVerletEngine(VerletEngine):
         return points, lines[once], {k: v[once] for k, v in fields.items()}
 
     def effective_conductivity(self) -> float | None:
-        """As :meth:`~dem.engines.verlet.engine.VerletEngine.effective_conductivity` on one rank; None on more
-        (module docstring)."""
-        return super().effective_conductivity() if self.mechanics.size == 1 else None
+        """As :meth:`~dem.engines.verlet.engine.VerletEngine.effective_conductivity` on one rank; on more, of the
+        gathered sample (rank 0's at an output time, every rank's after the run: the serial network of its contacts
+        now), None on a rank that holds its slab only (module docstring)."""
+        m = self.ranks_mechanics
+        if m.size == 1:
+            return super().effective_conductivity()
+        th = self.thermal
+        if self.mechanics is m or th is None or th.net is None:
+            return None
+        slab_network, th.net = th.net, th.network(self.mechanics)
+        try:
+            return super().effective_conductivity()
+        finally:
+            th.net = slab_network
 
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """As :meth:`~dem.engines.verlet.engine.VerletEngine.run`;
