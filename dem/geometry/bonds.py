@@ -1,8 +1,10 @@
 """Bonds from geometry: overlapping particle pairs and particle-wall contacts, with their neck radii.
 
 Two spheres are bonded when they overlap, ``h = r_i + r_j - d > 0`` (Rojek 2022, eq. 21/44). Candidate pairs come
-from k-d trees (``scipy.spatial.cKDTree``); particles are grouped in radius classes (a factor 2 apart) so that a
-polydisperse packing never searches with twice the largest radius among its small particles.
+from cubic cells of the largest diameter searched on numba's threads when no radius is twice the smallest (the
+neighbour list's binning, :func:`dem.geometry.neighbours.verlet_pairs`), else from k-d trees
+(``scipy.spatial.cKDTree``), the particles grouped in radius classes (a factor 2 apart) so that a polydisperse
+packing never searches with twice the largest radius among its small particles.
 
 The contact radius ``a`` of a bond is given by the *contact geometry* that the conductance law asks for:
 
@@ -41,12 +43,14 @@ from scipy.spatial import cKDTree
 
 from fem_neck.geometry import max_overlap, neck_radius
 
+from dem.geometry.neighbours import verlet_pairs
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox, canonical_bonds
 
 CONTACT_MODELS = ("newton", "first", "coble", "lens", "union")
 LENS_GEOMETRY = ("lens", "union")  # the contact models whose circle is where the two spheres meet
 OUT_OF_RANGE = ("error", "clip", "drop")
+PAIRS_EXPECTED = 8  # room for pairs per particle in a one-class search (a dense random packing has 5.5)
 
 
 @dataclass(frozen=True)
@@ -105,11 +109,15 @@ class Bonds:
 
 
 def candidate_pairs(position: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """All pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j`` (k-d trees per radius class)."""
+    """All pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j``, sorted by ``(i, j)``: a packing in one radius class
+    (no radius twice the smallest) by cell binning on numba's threads (:func:`dem.geometry.neighbours.verlet_pairs`
+    with no skin), a wider one by k-d trees per radius class."""
     n = len(radius)
     if n < 2:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
     level = np.floor(np.log2(radius / radius.min())).astype(np.int64)
+    if not level.any():
+        return verlet_pairs(position, radius, 0.0, np.zeros(3), PAIRS_EXPECTED * n)
     classes = [np.flatnonzero(level == k) for k in np.unique(level)]
     trees = [cKDTree(position[idx]) for idx in classes]
     r_max = [radius[idx].max() for idx in classes]
