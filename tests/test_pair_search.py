@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from dem.geometry import neighbours
+from dem.geometry import bonds, neighbours
 from dem.geometry.bonds import candidate_pairs
 from dem.geometry.neighbours import verlet_pairs
 
@@ -35,8 +35,10 @@ def test_blocks_give_every_pair_in_order_whatever_room_they_are_given(monkeypatc
         assert np.array_equal(i, i_ref) and np.array_equal(j, j_ref), capacity
 
 
-@pytest.mark.parametrize("spread", [1.5, 3.0])  # one radius class (cells), two or more (k-d trees)
-def test_bond_candidates_are_the_overlapping_pairs(spread):
+@pytest.mark.parametrize("cells_from", [10**9, 1000])  # k-d trees always; cells for one class of 1000 or more
+@pytest.mark.parametrize("spread", [1.5, 3.0])  # one radius class, two or more (k-d trees)
+def test_bond_candidates_are_the_overlapping_pairs(monkeypatch, spread, cells_from):
+    monkeypatch.setattr(bonds, "CELL_SEARCH_MIN", cells_from)
     rng = np.random.default_rng(5)
     n = 3000
     r = 1e-4 * rng.uniform(1.0, spread, n)

@@ -1,7 +1,8 @@
 """Bonds from geometry: overlapping particle pairs and particle-wall contacts, with their neck radii.
 
 Two spheres are bonded when they overlap, ``h = r_i + r_j - d > 0`` (Rojek 2022, eq. 21/44). Candidate pairs come
-from cubic cells of the largest diameter searched on numba's threads when no radius is twice the smallest (the
+from cubic cells of the largest diameter searched on numba's threads when no radius is twice the smallest in a large
+packing (the
 neighbour list's binning, :func:`dem.geometry.neighbours.verlet_pairs`), else from k-d trees
 (``scipy.spatial.cKDTree``), the particles grouped in radius classes (a factor 2 apart) so that a polydisperse
 packing never searches with twice the largest radius among its small particles.
@@ -43,7 +44,6 @@ from scipy.spatial import cKDTree
 
 from fem_neck.geometry import max_overlap, neck_radius
 
-from dem.geometry.neighbours import verlet_pairs
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox, canonical_bonds
 
@@ -51,6 +51,9 @@ CONTACT_MODELS = ("newton", "first", "coble", "lens", "union")
 LENS_GEOMETRY = ("lens", "union")  # the contact models whose circle is where the two spheres meet
 OUT_OF_RANGE = ("error", "clip", "drop")
 PAIRS_EXPECTED = 8  # room for pairs per particle in a one-class search (a dense random packing has 5.5)
+# from this many particles on, the cells (numba) search one radius class: importing numba and loading the compiled
+# search costs about what the k-d trees take for 10^5 particles, and below it a static run loads no numba
+CELL_SEARCH_MIN = 100_000
 
 
 @dataclass(frozen=True)
@@ -109,14 +112,16 @@ class Bonds:
 
 
 def candidate_pairs(position: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """All pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j``, sorted by ``(i, j)``: a packing in one radius class
-    (no radius twice the smallest) by cell binning on numba's threads (:func:`dem.geometry.neighbours.verlet_pairs`
-    with no skin), a wider one by k-d trees per radius class."""
+    """All pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j``, sorted by ``(i, j)``: a packing of ``CELL_SEARCH_MIN``
+    particles or more in one radius class (no radius twice the smallest) by cell binning on numba's threads
+    (:func:`dem.geometry.neighbours.verlet_pairs` with no skin), others by k-d trees per radius class."""
     n = len(radius)
     if n < 2:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
     level = np.floor(np.log2(radius / radius.min())).astype(np.int64)
-    if not level.any():
+    if n >= CELL_SEARCH_MIN and not level.any():
+        from dem.geometry.neighbours import verlet_pairs  # compiled: a static run of fewer particles loads no numba
+
         return verlet_pairs(position, radius, 0.0, np.zeros(3), PAIRS_EXPECTED * n)
     classes = [np.flatnonzero(level == k) for k in np.unique(level)]
     trees = [cKDTree(position[idx]) for idx in classes]
