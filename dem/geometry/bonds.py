@@ -206,8 +206,10 @@ def _pair_contacts(p: Particles, i, j, vec, contact, policy):
     if contact in LENS_GEOMETRY:
         bad = (l_i < 0) | (l_j < 0)
         limit = "the lens needs both centres outside the other sphere's cap: d^2 >= |r_j^2 - r_i^2|"
-    else:
-        bad = h > max_overlap(r_i, r_j)
+    else:  # max_overlap is the smaller radius / 3 plus a cap's share >= 0: only the bonds beyond the first need it
+        bad = h > np.minimum(r_i, r_j) / 3.0
+        near = np.flatnonzero(bad)
+        bad[near] = h[near] > max_overlap(r_i[near], r_j[near])
         limit = "overlap h <= max_overlap(r_i, r_j), where the neck reaches the smaller radius"
     first = ""
     if np.any(bad):
