@@ -52,8 +52,9 @@ LENS_GEOMETRY = ("lens", "union")  # the contact models whose circle is where th
 OUT_OF_RANGE = ("error", "clip", "drop")
 PAIRS_EXPECTED = 8  # room for pairs per particle in a one-class search (a dense random packing has 5.5)
 # from this many particles on, the cells (numba) search one radius class: importing numba and loading the compiled
-# search costs about what the k-d trees take for 10^5 particles, and below it a static run loads no numba
-CELL_SEARCH_MIN = 100_000
+# search (about 0.7 s of CPU in a fresh process) costs what the k-d trees take for 2-3 * 10^5 particles, and below it
+# a static run loads no numba
+CELL_SEARCH_MIN = 300_000
 
 
 @dataclass(frozen=True)
