@@ -192,7 +192,7 @@ class AMGSolver(PCGSolver):
     * the constant vector is the near-null space of a graph Laplacian as it is: no relaxation sweeps improve it;
     * every connection is strong (``strength=None``): pyamg's default symmetric measure with ``theta = 0`` keeps
       every entry too, so the aggregates are the same, without computing and scaling a copy of every level
-      (a sixth of the setup on the bench packing's 10^6 unknowns, same iterates to the bit);
+      (the setup takes 0.7 of the CPU time on the bench packing's 10^6 unknowns, the same iterates to the bit);
     * the coarse levels are converted from BSR with 1 x 1 blocks to CSR once built, and their Gauss-Seidel
       smoothers set up again: pyamg's block Gauss-Seidel on 1 x 1 blocks takes four times the time of the scalar
       kernel on the same entries (the same iterates to round-off);
