@@ -211,8 +211,8 @@ def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray
         j = np.empty(slot[-1], dtype=np.int64)
         _pairs_in_blocks(x, radius, skin, box, PAIR_BLOCK, slot, i, j)
         return i, j
-    keep = np.arange(slot[-1]) - np.repeat(slot[:-1], per) < np.repeat(counts, per)  # each slot's filled head
-    return i[keep], j[keep]
+    filled = [slice(start, start + count) for start, count in zip(slot[:-1].tolist(), counts.tolist())]
+    return np.concatenate([i[f] for f in filled]), np.concatenate([j[f] for f in filled])
 
 
 @njit(cache=True)
