@@ -16,8 +16,8 @@ import pathlib
 BYTES_PER_PARTICLE = 1.35e3
 # a steady solve of the benchmarks' 10^6-particle random packing (bonds, conductances, network, AMG-CG; python -m
 # benchmarks dem) took 10.5 s on a quiet 2-core machine before the cell search and the row-by-row assembly, which
-# take 0.81 of its CPU time side by side: about 8.5e-6 s per particle
-SECONDS_PER_PARTICLE = 8.5e-6
+# take 0.74 of its CPU time side by side: about 7.8e-6 s per particle
+SECONDS_PER_PARTICLE = 7.8e-6
 ANNOUNCE_FROM = 1_000_000  # runs of this many particles or more say what they will take before they start
 BASE_BYTES = 0.23e9  # the interpreter, numpy, scipy and the compiled kernels (with the per-particle figure: the fit)
 SMALL_BYTES = 64e6  # a run whose particles need less than this is never refused: the machine is not asked

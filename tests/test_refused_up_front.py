@@ -179,10 +179,10 @@ def test_particle_behind_a_wall_is_named(capsys, tmp_path, kind):
 
 def test_a_large_run_says_what_it_will_take_before_it_starts():
     """From a million particles a run states its memory and time up front (the benchmarks' steady solve: 1.35 kB
-    and about 8.5e-6 s per particle above 0.23 GB); smaller runs say nothing."""
+    and about 7.8e-6 s per particle above 0.23 GB); smaller runs say nothing."""
     from dem import memory
 
     assert memory.estimate(memory.ANNOUNCE_FROM - 1) is None
     line = memory.estimate(4_096_000)
-    assert line == ("4096000 particles: about 5.36 GiB at the peak of a steady solve and about 34.8 s for it on 2 "
+    assert line == ("4096000 particles: about 5.36 GiB at the peak of a steady solve and about 31.9 s for it on 2 "
                     "cores (a transient or moving run takes longer)")
