@@ -2,10 +2,10 @@
 front when the machine does not have it (rather than a ``MemoryError`` deep inside a solve, or the kernel's
 out-of-memory killer).
 
-The figure is the peak of the largest run per particle: a steady solve of a random sintered packing (the bond search,
-the network, the AMG hierarchy) peaks at 0.47 GB for 2.5 * 10^5 particles and 1.40 GB for 10^6 (resident set,
-``python -m dem run`` of the ``packing`` scene with ``n`` raised): about 1.25 kB per particle above the interpreter's
-0.15 GB; ``BYTES_PER_PARTICLE`` leaves a fifth more for denser packings.
+The figure is the peak of a steady solve of the benchmarks' random sintered packing (the bond search, the network,
+the AMG hierarchy; ``python -m benchmarks dem``, whole process, maximum resident set): 1.58 GB for 10^6 particles
+(5.5 * 10^6 bonds) and 13.7 GB for 10^7 (5.6 * 10^7 bonds), which ``BASE_BYTES + BYTES_PER_PARTICLE * n`` gives to
+a per cent: about 240 bytes per bond at 5.6 bonds per particle, so a denser packing needs more in proportion.
 """
 
 from __future__ import annotations
@@ -13,12 +13,13 @@ from __future__ import annotations
 import os
 import pathlib
 
-BYTES_PER_PARTICLE = 1.5e3
-# a steady solve of the benchmarks' 10^6-particle random packing takes 10.5 s on a quiet 2-core machine (bonds,
-# conductances, network, AMG-CG; python -m benchmarks dem): about 1e-5 s per particle
-SECONDS_PER_PARTICLE = 1.05e-5
+BYTES_PER_PARTICLE = 1.35e3
+# a steady solve of the benchmarks' 10^6-particle random packing (bonds, conductances, network, AMG-CG; python -m
+# benchmarks dem) took 10.5 s on a quiet 2-core machine before the cell search and the row-by-row assembly, which
+# take 0.74 of its CPU time side by side: about 7.8e-6 s per particle
+SECONDS_PER_PARTICLE = 7.8e-6
 ANNOUNCE_FROM = 1_000_000  # runs of this many particles or more say what they will take before they start
-BASE_BYTES = 0.2e9  # the interpreter, numpy, scipy and the compiled kernels
+BASE_BYTES = 0.23e9  # the interpreter, numpy, scipy and the compiled kernels (with the per-particle figure: the fit)
 SMALL_BYTES = 64e6  # a run whose particles need less than this is never refused: the machine is not asked
 
 

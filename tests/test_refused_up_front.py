@@ -96,7 +96,7 @@ def test_generated_run_beyond_the_machines_memory_is_refused(monkeypatch):
     big = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]  # room for them: only the memory refuses
     error, peak = peak_bytes(lambda: random_box(2_000_000, 0.5e-3, big))
     limit = int((1.0e9 - memory.BASE_BYTES) / memory.BYTES_PER_PARTICLE)
-    assert "[generator] n: a run of 2000000 particles needs about 2.98 GiB" in str(error)
+    assert "[generator] n: a run of 2000000 particles needs about 2.73 GiB" in str(error)
     assert f"0.931 GiB are available on this machine: use at most about {limit} particles" in str(error)
     assert peak < 1e6
 
@@ -178,11 +178,11 @@ def test_particle_behind_a_wall_is_named(capsys, tmp_path, kind):
 
 
 def test_a_large_run_says_what_it_will_take_before_it_starts():
-    """From a million particles a run states its memory and time up front (the benchmarks' steady solve: 1.5 kB
-    and about 1e-5 s per particle); smaller runs say nothing."""
+    """From a million particles a run states its memory and time up front (the benchmarks' steady solve: 1.35 kB
+    and about 7.8e-6 s per particle above 0.23 GB); smaller runs say nothing."""
     from dem import memory
 
     assert memory.estimate(memory.ANNOUNCE_FROM - 1) is None
     line = memory.estimate(4_096_000)
-    assert line == ("4096000 particles: about 5.91 GiB at the peak of a steady solve and about 43 s for it on 2 "
+    assert line == ("4096000 particles: about 5.36 GiB at the peak of a steady solve and about 31.9 s for it on 2 "
                     "cores (a transient or moving run takes longer)")

@@ -29,7 +29,7 @@ from dem import memory
 from fem_neck.geometry import max_overlap
 
 DISTRIBUTIONS = ("constant", "uniform", "lognormal")
-MAX_PARTICLES = 5_000_000  # larger packings need a distributed backend (the memory: dem.memory)
+MAX_PARTICLES = 20_000_000  # larger packings need a distributed backend; below, dem.memory refuses what does not fit
 RSA_CANDIDATES = 3000  # random points tried per particle by random_box (jamming near a solid fraction of 0.3 in 3D)
 RSA_BLOCK = 1 << 16    # random_box draws its candidates in blocks of this many points
 # the fractions of space that random sequential addition of equal spheres (3) and disks (2) fills when it jams, the

@@ -20,7 +20,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
+
+PAIR_BLOCK = 4096  # particles per block of the pair search (verlet_pairs): the blocks are shared among numba's threads
 
 
 @njit(cache=True)
@@ -47,9 +49,10 @@ def _cell_of(x, lo, size, n):
 
 
 @njit(cache=True)
-def _pairs_in_cells(x, radius, skin, box, out_i, out_j):
-    """The pairs within ``r_i + r_j + skin`` by cell binning, sorted by ``(i, j)``, written into ``out_i``,
-    ``out_j`` while they have room; returns how many there are (arrays that large hold them all)."""
+def _cells(x, radius, skin, box):
+    """The particles binned into cubic cells of edge ``2 r_max + skin`` (wrapped on periodic axes): ``(cell, head,
+    nxt, ncell, wrap)``, each particle's cell indices (n, 3), the first particle of every cell and the next of every
+    particle (-1 ends a cell), the cells per axis and whether an axis wraps."""
     n = x.shape[0]
     r_max = 0.0
     for k in range(n):
@@ -91,62 +94,88 @@ def _pairs_in_cells(x, radius, skin, box, out_i, out_j):
         c = (cell[k, 0] * ncell[1] + cell[k, 1]) * ncell[2] + cell[k, 2]
         nxt[k] = head[c]
         head[c] = k
-    found = 0
-    room = out_i.shape[0]
-    for k in range(n):
-        first = found
-        for d0 in range(-1, 2):
-            c0 = cell[k, 0] + d0
-            if c0 < 0 or c0 >= ncell[0]:
-                if not wrap[0]:
-                    continue
-                c0 %= ncell[0]
-            if ncell[0] == 1 and d0 != 0:
+    return cell, head, nxt, ncell, wrap
+
+
+@njit(cache=True)
+def _partners(k, x, radius, skin, box, cell, head, nxt, ncell, wrap, out_i, out_j, found, room):
+    """The partners ``m > k`` of particle ``k`` within ``r_k + r_m + skin`` (cells of :func:`_cells`), written in
+    order of ``m`` into ``out_i``, ``out_j`` from ``found`` on while below ``room``; returns ``found`` plus their
+    number."""
+    first = found
+    for d0 in range(-1, 2):
+        c0 = cell[k, 0] + d0
+        if c0 < 0 or c0 >= ncell[0]:
+            if not wrap[0]:
                 continue
-            for d1 in range(-1, 2):
-                c1 = cell[k, 1] + d1
-                if c1 < 0 or c1 >= ncell[1]:
-                    if not wrap[1]:
-                        continue
-                    c1 %= ncell[1]
-                if ncell[1] == 1 and d1 != 0:
+            c0 %= ncell[0]
+        if ncell[0] == 1 and d0 != 0:
+            continue
+        for d1 in range(-1, 2):
+            c1 = cell[k, 1] + d1
+            if c1 < 0 or c1 >= ncell[1]:
+                if not wrap[1]:
                     continue
-                for d2 in range(-1, 2):
-                    c2 = cell[k, 2] + d2
-                    if c2 < 0 or c2 >= ncell[2]:
-                        if not wrap[2]:
-                            continue
-                        c2 %= ncell[2]
-                    if ncell[2] == 1 and d2 != 0:
+                c1 %= ncell[1]
+            if ncell[1] == 1 and d1 != 0:
+                continue
+            for d2 in range(-1, 2):
+                c2 = cell[k, 2] + d2
+                if c2 < 0 or c2 >= ncell[2]:
+                    if not wrap[2]:
                         continue
-                    m = head[(c0 * ncell[1] + c1) * ncell[2] + c2]
-                    while m >= 0:
-                        if m > k:
-                            dx = min_image(x[k, 0] - x[m, 0], box[0])
-                            dy = min_image(x[k, 1] - x[m, 1], box[1])
-                            dz = min_image(x[k, 2] - x[m, 2], box[2])
-                            cut = radius[k] + radius[m] + skin
-                            if dx * dx + dy * dy + dz * dz < cut * cut:
-                                if found < room:
-                                    out_i[found] = k
-                                    out_j[found] = m
-                                found += 1
-                        m = nxt[m]
-        for a in range(first + 1, min(found, room)):  # k's partners in order (a handful: insertion sort)
-            partner = out_j[a]
-            b = a - 1
-            while b >= first and out_j[b] > partner:
-                out_j[b + 1] = out_j[b]
-                b -= 1
-            out_j[b + 1] = partner
+                    c2 %= ncell[2]
+                if ncell[2] == 1 and d2 != 0:
+                    continue
+                m = head[(c0 * ncell[1] + c1) * ncell[2] + c2]
+                while m >= 0:
+                    if m > k:
+                        dx = min_image(x[k, 0] - x[m, 0], box[0])
+                        dy = min_image(x[k, 1] - x[m, 1], box[1])
+                        dz = min_image(x[k, 2] - x[m, 2], box[2])
+                        cut = radius[k] + radius[m] + skin
+                        if dx * dx + dy * dy + dz * dz < cut * cut:
+                            if found < room:
+                                out_i[found] = k
+                                out_j[found] = m
+                            found += 1
+                    m = nxt[m]
+    for a in range(first + 1, min(found, room)):  # k's partners in order (a handful: insertion sort)
+        partner = out_j[a]
+        b = a - 1
+        while b >= first and out_j[b] > partner:
+            out_j[b + 1] = out_j[b]
+            b -= 1
+        out_j[b + 1] = partner
     return found
+
+
+@njit(cache=True, parallel=True)
+def _pairs_in_blocks(x, radius, skin, box, block, slot, out_i, out_j):
+    """The pairs within ``r_i + r_j + skin`` by cell binning, sorted by ``(i, j)``: the particles ``b block ...
+    (b + 1) block - 1`` (block ``b``, one block per thread at a time) write theirs into ``out_i``, ``out_j`` from
+    ``slot[b]`` on while below ``slot[b + 1]``; returns every block's number of pairs (a block whose slot is that
+    large holds them all)."""
+    n = x.shape[0]
+    cell, head, nxt, ncell, wrap = _cells(x, radius, skin, box)
+    blocks = slot.shape[0] - 1
+    counts = np.zeros(blocks, dtype=np.int64)
+    for b in prange(blocks):
+        found = slot[b]
+        for k in range(b * block, min(n, (b + 1) * block)):
+            found = _partners(k, x, radius, skin, box, cell, head, nxt, ncell, wrap, out_i, out_j, found,
+                              slot[b + 1])
+        counts[b] = found - slot[b]
+    return counts
 
 
 def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray,
                  capacity: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j + skin`` (minimum image on periodic axes), sorted by
-    ``(i, j)``. ``capacity``: the number of pairs expected (a rebuild passes its last list's length with some
-    room): one pass over the cells when they fit, else a second one.
+    ``(i, j)``. The particles are searched in blocks of ``PAIR_BLOCK`` on numba's threads, each block's pairs
+    written into a slot of its own of ``capacity`` pairs shared out evenly; ``capacity``: the number of pairs
+    expected (a rebuild passes its last list's length with some room): one pass over the cells when every block's
+    pairs fit in its slot, else a second one into slots of the sizes counted.
 
     Parameters
     ----------
@@ -166,17 +195,24 @@ def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray
     tuple of numpy.ndarray
         ``(i, j)``, int, sorted by ``(i, j)``.
     """
-    if len(radius) < 2:
+    n = len(radius)
+    if n < 2:
         empty = np.zeros(0, dtype=np.int64)
         return empty, empty
-    i = np.empty(capacity, dtype=np.int64)
-    j = np.empty(capacity, dtype=np.int64)
-    count = _pairs_in_cells(x, radius, skin, box, i, j)
-    if count > capacity:
-        i = np.empty(count, dtype=np.int64)
-        j = np.empty(count, dtype=np.int64)
-        _pairs_in_cells(x, radius, skin, box, i, j)
-    return i[:count], j[:count]
+    blocks = -(-n // PAIR_BLOCK)
+    per = -(-max(int(capacity), 0) // blocks)
+    slot = np.arange(blocks + 1, dtype=np.int64) * per
+    i = np.empty(slot[-1], dtype=np.int64)
+    j = np.empty(slot[-1], dtype=np.int64)
+    counts = _pairs_in_blocks(x, radius, skin, box, PAIR_BLOCK, slot, i, j)
+    if np.any(counts > per):
+        slot = np.concatenate(([0], np.cumsum(counts)))
+        i = np.empty(slot[-1], dtype=np.int64)
+        j = np.empty(slot[-1], dtype=np.int64)
+        _pairs_in_blocks(x, radius, skin, box, PAIR_BLOCK, slot, i, j)
+        return i, j
+    filled = [slice(start, start + count) for start, count in zip(slot[:-1].tolist(), counts.tolist())]
+    return np.concatenate([i[f] for f in filled]), np.concatenate([j[f] for f in filled])
 
 
 @njit(cache=True)

@@ -51,11 +51,32 @@ def laplacian(n: int, i: np.ndarray, j: np.ndarray, K: np.ndarray) -> sp.csr_mat
     scipy.sparse.csr_matrix
         The (n, n) Laplacian (the unit of ``K``).
     """
+    i, j, K = np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64), np.asarray(K, dtype=float)
     diag = np.bincount(i, K, n) + np.bincount(j, K, n)
-    rows = np.concatenate([i, j, np.arange(n)])
-    cols = np.concatenate([j, i, np.arange(n)])
-    vals = np.concatenate([-K, -K, diag])
-    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    m = len(i)
+    if m and (np.any(i >= j) or np.any(i[1:] * n + j[1:] <= i[:-1] * n + j[:-1])):  # not canonical: summed places
+        rows = np.concatenate([i, j, np.arange(n)])
+        cols = np.concatenate([j, i, np.arange(n)])
+        vals = np.concatenate([-K, -K, diag])
+        return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    # canonical edges (i < j, sorted by (i, j), each once): row r is its lower entries (the edges (i, r), by i), the
+    # diagonal, its upper entries (the edges (r, j), by j), each written where it belongs, without a sort
+    up, lo = np.bincount(i, minlength=n), np.bincount(j, minlength=n)
+    first = np.concatenate(([0], np.cumsum(lo + up + 1)))
+    index = np.int32 if first[-1] < 2**31 else np.int64
+    indices, data = np.empty(first[-1], dtype=index), np.empty(first[-1])
+    rank = np.arange(m)
+    # the edges by (j, i): the column order of the upper triangle, which a CSR -> CSC conversion counts out
+    by_j = sp.csr_matrix((rank, j, np.concatenate(([0], np.cumsum(up)))), shape=(n, n)).tocsc().data
+    at = first[j[by_j]] + rank - (np.cumsum(lo) - lo)[j[by_j]]
+    indices[at], data[at] = i[by_j], -K[by_j]
+    at = first[:-1] + lo
+    indices[at], data[at] = np.arange(n), diag
+    at = first[i] + lo[i] + 1 + rank - (np.cumsum(up) - up)[i]
+    indices[at], data[at] = j, -K
+    L = sp.csr_matrix((data, indices, first.astype(index)), shape=(n, n))
+    L.has_sorted_indices = True
+    return L
 
 
 class BoundedLaplacian:
@@ -278,12 +299,15 @@ class BoundedLaplacian:
         tuple
             ``(count, label, anchored)``: the number of groups, each free node's group, and a bool per group.
         """
-        where = np.full(self.n, -1, dtype=np.int64)
-        where[self.free] = np.arange(len(self.free))
-        a, b = where[self.i], where[self.j]
-        live = (self.K > 0.0) & (a >= 0) & (b >= 0)
-        nf = len(self.free)
-        graph = sp.csr_matrix((np.ones(int(live.sum())), (a[live], b[live])), shape=(nf, nf))
+        if np.all(self.K > 0.0):  # every edge joins: the free block's sparsity is the graph (its diagonal loops)
+            graph = self.L_FF
+        else:
+            where = np.full(self.n, -1, dtype=np.int64)
+            where[self.free] = np.arange(len(self.free))
+            a, b = where[self.i], where[self.j]
+            live = (self.K > 0.0) & (a >= 0) & (b >= 0)
+            nf = len(self.free)
+            graph = sp.csr_matrix((np.ones(int(live.sum())), (a[live], b[live])), shape=(nf, nf))
         n_comp, label = connected_components(graph, directed=False)
         anchor = self.fixed_diag + self.plane_diag
         if anchor_extra is not None:

@@ -52,8 +52,8 @@ AMG_SEED = 0  # the random start vector of pyamg's spectral-radius estimates (AM
 AMG_REUSE_GROWTH = 2.0  # a reused AMG hierarchy is dropped once a solve takes this x the most its own matrix took
 AMG_SMOOTHER = ("gauss_seidel", {"sweep": "symmetric"})  # one symmetric sweep before and after each coarse correction
 AMG_OPTIONS = {  # pyamg.smoothed_aggregation_solver's settings (AMGSolver): the finest level's smoother row-weighted
-    "symmetry": "hermitian", "max_coarse": 500, "improve_candidates": None, "presmoother": AMG_SMOOTHER,
-    "postsmoother": AMG_SMOOTHER,
+    "symmetry": "hermitian", "strength": None, "max_coarse": 500, "improve_candidates": None,
+    "presmoother": AMG_SMOOTHER, "postsmoother": AMG_SMOOTHER,
     "smooth": [("jacobi", {"omega": 1.8, "weighting": "local"})] + [("jacobi", {"omega": 4.0 / 3.0})] * 9}
 
 
@@ -196,6 +196,9 @@ class AMGSolver(PCGSolver):
       packing). Coarse levels (pyamg holds them as BSR, whose ``abs`` is a Python loop) keep the default weighting;
       their Arnoldi is cheap;
     * the constant vector is the near-null space of a graph Laplacian as it is: no relaxation sweeps improve it;
+    * every connection is strong (``strength=None``): pyamg's default symmetric measure with ``theta = 0`` keeps
+      every entry too, so the aggregates are the same, without computing and scaling a copy of every level
+      (the setup takes 0.7 of the CPU time on the bench packing's 10^6 unknowns, the same iterates to the bit);
     * the coarse levels are converted from BSR with 1 x 1 blocks to CSR once built, and their Gauss-Seidel
       smoothers set up again: pyamg's block Gauss-Seidel on 1 x 1 blocks takes four times the time of the scalar
       kernel on the same entries (the same iterates to round-off);

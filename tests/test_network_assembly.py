@@ -1,0 +1,102 @@
+"""The steady network's fast assembly against the general one: the Laplacian of canonical edges written row by row
+against scipy's summed COO entries, the connected groups from the free block against the edge list, and the heat
+flow through a packing (what k_eff is made of) by the cell search, the row-by-row Laplacian and AMG-CG against the
+k-d trees, the summed assembly and a direct solve."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from dem.geometry import bonds as bond_search
+from dem.geometry.bonds import sorted_pairs
+from dem.network.laplacian import BoundedLaplacian, laplacian
+
+
+def summed_laplacian(n, i, j, K):
+    """The Laplacian as scipy sums its COO entries (the general route)."""
+    diag = np.bincount(i, K, n) + np.bincount(j, K, n)
+    return sp.csr_matrix((np.concatenate([-K, -K, diag]), (np.concatenate([i, j, np.arange(n)]),
+                                                            np.concatenate([j, i, np.arange(n)]))), shape=(n, n))
+
+
+@pytest.mark.parametrize("n, m", [(1, 0), (7, 0), (60, 300), (3000, 12000)])
+def test_canonical_edges_give_the_summed_laplacian_to_the_bit(n, m):
+    rng = np.random.default_rng(n)
+    i, j = sorted_pairs(rng.integers(0, n, m), rng.integers(0, n, m), n)
+    i, j = i[i != j], j[i != j]
+    K = rng.uniform(0.0, 2.0, len(i))
+    K[::5] = 0.0  # open contacts stay explicit entries
+    L, ref = laplacian(n, i, j, K), summed_laplacian(n, i, j, K)
+    assert np.array_equal(L.indptr, ref.indptr) and np.array_equal(L.indices, ref.indices)
+    assert np.array_equal(L.data, ref.data)
+    if len(i) > 2:  # the same edges out of order and reversed take the summed route: the same matrix
+        order = rng.permutation(len(i))
+        shuffled = laplacian(n, j[order], i[order], K[order])
+        assert abs(shuffled - L).max() <= 1e-15 * np.abs(L.data).max()
+
+
+@pytest.mark.parametrize("open_every", [0, 3])  # all contacts closed (the free block's graph), some open (edge list)
+def test_groups_are_those_of_the_closed_edges(open_every):
+    rng = np.random.default_rng(2)
+    n = 400
+    i, j = sorted_pairs(rng.integers(0, n, 300), rng.integers(0, n, 300), n)
+    i, j = i[i != j], j[i != j]
+    K = rng.uniform(0.5, 1.0, len(i))
+    if open_every:
+        K[::open_every] = 0.0
+    fixed = np.zeros(n, dtype=bool)
+    fixed[:20] = True
+    g = BoundedLaplacian(n, i, j, K, fixed, np.zeros(0, int), np.zeros(0, int), np.zeros(0), 0)
+    count, label, anchored = g.components()
+    # reference: union-find over the closed edges between free nodes
+    parent = np.arange(n)
+
+    def root(a):
+        while parent[a] != a:
+            a = parent[a]
+        return a
+
+    for a, b, k in zip(i, j, K):
+        if k > 0 and not fixed[a] and not fixed[b]:
+            parent[root(a)] = root(b)
+    roots = np.array([root(a) for a in g.free])
+    assert count == len(np.unique(roots))
+    same = roots[:, None] == roots[None, :]
+    assert np.array_equal(same, label[:, None] == label[None, :])
+    touches = np.zeros(n, dtype=bool)
+    for a, b, k in zip(i, j, K):
+        if k > 0 and fixed[a] != fixed[b]:
+            touches[b if fixed[a] else a] = True
+    assert np.array_equal(anchored[label], np.isin(roots, roots[touches[g.free]]))
+
+
+def test_heat_flow_through_a_packing_is_that_of_the_general_route(monkeypatch):
+    """The cold layer's heat flow (k_eff's numerator) and the temperatures: cells, row-by-row Laplacian and AMG-CG
+    (rtol 1e-10) against k-d trees, the summed Laplacian and a direct solve, to 1e-8 relative."""
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.generators import random_packing
+    from dem.geometry.particles import Particles
+    from dem.network import laplacian as assembly
+    from dem.network.heat import boundary_heat_flow, build_network, steady
+
+    lay = random_packing(8000, 50e-6, 0.15, seed=3)
+    n = len(lay.radius)
+    fixed = np.zeros(n, dtype=bool)
+    fixed[lay.bottom] = fixed[lay.top] = True
+    temp = np.zeros(n)
+    temp[lay.bottom] = 1.0
+    particles = Particles.from_arrays(lay.position, lay.radius, temp, fixed=fixed)
+
+    def cold_flow(cells_from, assemble, linear):
+        monkeypatch.setattr(bond_search, "CELL_SEARCH_MIN", cells_from)
+        monkeypatch.setattr(assembly, "laplacian", assemble)
+        net = build_network(particles, bonds=find_bonds(particles))
+        res = steady(net, floating="mean", linear=linear)
+        flows = boundary_heat_flow(net, res.T)["particles"]
+        return sum(flows[int(k)] for k in lay.top), res.T, res.solver
+
+    fast, T_fast, solver = cold_flow(1000, laplacian, "amg")
+    ref, T_ref, _ = cold_flow(10**9, summed_laplacian, "direct")
+    assert solver == "amg" and ref > 0
+    assert fast == pytest.approx(ref, rel=1e-8)
+    assert np.max(np.abs(T_fast - T_ref)) < 1e-8
