@@ -74,6 +74,7 @@ class Electrodes:
 
     @property
     def fixed_potential(self) -> np.ndarray:
+        """(E,) bool: the electrodes held at a potential (the others drive a current)."""
         return np.isfinite(self.potential)
 
 

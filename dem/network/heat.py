@@ -129,9 +129,9 @@ class Network:
         self._boundary_terms()
 
     # the Laplacian and its blocks live in the graph (refresh() rewrites them in place)
-    L = property(lambda self: self.graph.L)
-    L_FF = property(lambda self: self.graph.L_FF)
-    L_FD = property(lambda self: self.graph.L_FD)
+    L = property(lambda self: self.graph.L, doc="The pair bonds' Laplacian over all particles (W/K, CSR).")
+    L_FF = property(lambda self: self.graph.L_FF, doc="Its block of the free particles (W/K, CSR).")
+    L_FD = property(lambda self: self.graph.L_FD, doc="Its block coupling the free particles to the fixed (W/K, CSR).")
 
     def _boundary_terms(self):
         """The terms that follow from the conductances: wall and fixed-particle coefficients and the constant
@@ -177,6 +177,7 @@ class Network:
 
     @property
     def n_free(self) -> int:
+        """The number of free particles (the unknowns)."""
         return len(self.free)
 
     @property
@@ -331,6 +332,7 @@ class Network:
         return float(allt.min()), float(allt.max())
 
     def temperature_range(self) -> float:
+        """The spread of :meth:`temperature_bounds` (K): the scale of the maximum-principle check."""
         lo, hi = self.temperature_bounds()
         return hi - lo
 

@@ -126,6 +126,7 @@ class Index:
 
     @property
     def blocks(self) -> int:
+        """The number of blocks."""
         return len(self.files)
 
 
