@@ -11,7 +11,8 @@ spheres). This study follows ``k_eff / kappa`` against the solid fraction ``phi`
 * **Random packings**: mirror packings of overlapping spheres (:func:`verification.packings.union_packing`, radii
   +-15 %), FE and DEM alike.
 * **A Luding-sintered compact**: the built-in ``hot-wall-sintering`` scene (Luding 2005's contact, pressed and
-  heated from one wall), its ``k_eff`` between the walls as it densifies (DEM only, its own pair-neck reading).
+  heated from one wall), its ``k_eff`` between the walls as it densifies (DEM only, its own pair-neck reading,
+  each particle handed over to the union once its necks meet: :mod:`dem.engines.handover`).
 
 Beside them: the Wiener bound ``phi`` and the Hashin-Shtrikman upper bound ``2 phi / (3 - phi)`` (no isotropic
 microstructure of solid and insulating pores conducts more), the ``argento-bouvard`` law (Argento & Bouvard 1996: a
@@ -210,7 +211,7 @@ def _figure(rows: list, compact: dict | None, out_dir: pathlib.Path) -> list:
                      marker=markers[law], mfc="none", color=colours[kind], label=f"{kind} {law}")
     if compact and compact["phi"]:
         ax1.plot(compact["phi"], compact["k"], color="tab:purple", lw=2,
-                 label=f"{COMPACT} (DEM, {compact['law']}, pair necks)")
+                 label=f"{COMPACT} (DEM, {compact['law']}, pair necks handed over)")
     for law in LAWS:
         ax1.plot([], [], ls="none", marker=markers[law], mfc="none", color="grey", label=f"DEM {law}, union necks")
     ax1.set_xlabel("solid fraction phi")
