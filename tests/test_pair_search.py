@@ -51,3 +51,17 @@ def test_bond_candidates_are_the_overlapping_pairs(monkeypatch, spread, cells_fr
     i, j = candidate_pairs(x, r)
     assert len(key) > n
     assert np.array_equal(i, key // n) and np.array_equal(j, key % n)
+
+
+def test_a_particle_far_away_does_not_make_the_cell_grid_huge():
+    """400 particles in a 6 mm box and one 1 m away along every axis: cells of the cutoff (1 mm) would number
+    ~1e9 (8 GB of heads); the grid stays within MAX_CELLS_PER_PARTICLE cells per particle and finds the same pairs."""
+    rng = np.random.default_rng(5)
+    x = rng.uniform(0.0, 6e-3, (401, 3))
+    x[400] = 1.0
+    r = rng.uniform(0.2e-3, 0.4e-3, 401)
+    cell, head, nxt, ncell, wrap = neighbours._cells(x, r, 1e-4, np.zeros(3))
+    assert len(head) == np.prod(ncell) <= neighbours.MAX_CELLS_PER_PARTICLE * 401 + 4096
+    i_ref, j_ref = brute_pairs(x, r, 1e-4)
+    i, j = verlet_pairs(x, r, 1e-4, np.zeros(3), 0)
+    assert np.array_equal(i, i_ref) and np.array_equal(j, j_ref)

@@ -4,8 +4,9 @@ Allen & Tildesley 1987, the "Verlet table" of Luding 2005, Sec. 3).
 The list holds every pair ``i < j`` whose surfaces are closer than ``skin``: ``|x_i - x_j| < r_i + r_j + skin``.
 It stays valid as long as no particle has moved more than ``skin / 2`` since it was built (two particles then
 approach by less than ``skin``), so it is rebuilt only when some particle has (:func:`max_displacement`). A
-rebuild bins the particles into cubic cells of edge ``2 r_max + skin`` and compares each particle with those in its
-own and the neighbouring cells: O(N) per rebuild. Periodic axes (``box[k] > 0``) wrap the cells and use the
+rebuild bins the particles into cubic cells of edge ``2 r_max + skin`` (larger where that would make more than
+``MAX_CELLS_PER_PARTICLE`` cells per particle, as a particle far from the others would) and compares each particle
+with those in its own and the neighbouring cells: O(N) per rebuild. Periodic axes (``box[k] > 0``) wrap the cells and use the
 minimum image.
 
 The same binning places particles at random without overlaps (:func:`sequential_addition`, random sequential
@@ -38,6 +39,9 @@ def min_image(d, length):
     return d
 
 
+MAX_CELLS_PER_PARTICLE = 64  # the cell grid's memory bound: a particle far from the rest cannot make it huge
+
+
 @njit(cache=True)
 def _cell_of(x, lo, size, n):
     c = int((x - lo) / size)
@@ -59,22 +63,30 @@ def _cells(x, radius, skin, box):
         r_max = max(r_max, radius[k])
     size = 2.0 * r_max + skin
     lo = np.empty(3)
-    ncell = np.empty(3, dtype=np.int64)
-    wrap = np.zeros(3, dtype=np.bool_)
+    span = np.empty(3)
     for a in range(3):
         if box[a] > 0.0:
-            lo[a] = 0.0
-            ncell[a] = max(1, int(box[a] / size))
-            wrap[a] = ncell[a] >= 3
-            if not wrap[a]:  # fewer than 3 cells across a periodic axis: one cell, every pair compared
-                ncell[a] = 1
+            lo[a], span[a] = 0.0, box[a]
         else:
             xmin, xmax = x[0, a], x[0, a]
             for k in range(n):
                 xmin = min(xmin, x[k, a])
                 xmax = max(xmax, x[k, a])
-            lo[a] = xmin
-            ncell[a] = max(1, min(int((xmax - xmin) / size) + 1, 1 << 20))
+            lo[a], span[a] = xmin, xmax - xmin
+    ncell = np.empty(3, dtype=np.int64)
+    wrap = np.zeros(3, dtype=np.bool_)
+    while True:  # cells no smaller than the cutoff, and at most MAX_CELLS_PER_PARTICLE n + 4096 of them
+        for a in range(3):
+            if box[a] > 0.0:
+                ncell[a] = max(1, int(box[a] / size))
+                wrap[a] = ncell[a] >= 3
+                if not wrap[a]:  # fewer than 3 cells across a periodic axis: one cell, every pair compared
+                    ncell[a] = 1
+            else:
+                ncell[a] = max(1, min(int(span[a] / size) + 1, 1 << 20))
+        if ncell[0] * ncell[1] * ncell[2] <= MAX_CELLS_PER_PARTICLE * n + 4096:
+            break
+        size *= 1.25  # a sparse or scattered sample (a particle far away): fewer, larger cells
     csize = np.empty(3)
     for a in range(3):
         if box[a] > 0.0:
