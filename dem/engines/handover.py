@@ -165,7 +165,7 @@ class Handover:
         return bonds, K_pair, K_wall
 
     def account(self, bonds) -> dict:
-        """The summary's entries of the hand-over, for :func:`dem.geometry.necks.neck_account`: ``readings`` (bonds
+        """The summary's entries of the hand-over, for :func:`dem.laws.verified_range.neck_account`: ``readings`` (bonds
         per reading, those with bonds: the union where a bond's weight is at least 1/2) and ``handed_over``
         (particles), and ``handing_over`` (particles on the way).
 

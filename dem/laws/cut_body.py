@@ -21,7 +21,7 @@ necks small and far apart keep the union law exactly. Where another plane cuts t
 neck (``A_c = 0`` there: the neck's lens lies inside a third sphere) the neck is no contact of the union at all and
 ``Delta R_b`` is infinite (its bond carries nothing). The cross-sections are exact: the disk less a circular segment per plane where
 no two of the planes' lines cross inside it, else the disk clipped by them (:mod:`fem_neck.geometry.cut_kernels`);
-on a uniform grid of :data:`SAMPLES` intervals with the
+on a uniform grid of ``SAMPLES`` intervals with the
 derivative taken on the same grid for both profiles, so that they cancel exactly where they agree.
 """
 
