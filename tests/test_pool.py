@@ -15,7 +15,7 @@ import pytest
 from benchmarks.timing import worker_sweep
 from fem_neck.fit import sweep, sweep_points
 from sinterheat import pool as P
-from verification import sintering_runs as sr
+from verification.luding import runs as sr
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 # a chain of stages (prepare, sinter, cool, vibrate: each starts from its parent's state) and a three-particle

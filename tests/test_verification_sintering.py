@@ -7,19 +7,20 @@ from dataclasses import asdict
 import numpy as np
 import pytest
 
-from verification import sintering as S
-from verification import sintering_causes as cooling
-from verification import sintering_runs as sr
-from verification import sintering_statements as T
-from verification import sintering_study as Y
 from verification.cli import COMMANDS
-from verification.report import check_section_result, jsonable
+from verification.luding import causes as cooling
+from verification.luding import runs as sr
+from verification.luding import section as S
+from verification.luding import statements as T
+from verification.luding import study as Y
+from verification.report import check_section_result, jsonable, section_available, section_module
 
 TINY = sr.Grid(n=(12,), p=(10.0, 100.0), t_s=(1e-4, 2e-3), three_seeds=(1,), no_expansion=False, n3d=12)
 
 
 def test_registered_as_a_command():
     assert COMMANDS["sintering"][0] == ("sintering",)
+    assert section_module("sintering") == S.__name__ and section_available("sintering")
 
 
 def test_tasks_start_from_their_parents_and_name_their_folders():
@@ -113,7 +114,7 @@ def test_isolating_variants_start_where_they_should():
 
 
 def test_scene_docs_of_the_variants(tmp_path, monkeypatch):
-    from verification import sinter_protocol as sp
+    from verification.luding import protocol as sp
 
     prep = sr.scene_doc(sr.Task(sr.PREPARE, 20, 10.0, variant="frictionless-slow"), tmp_path)
     assert prep["phases"] == [{"start": 0.0, "mu": 0.0, "mu_wall": 0.0}]
@@ -245,7 +246,7 @@ def test_frozen_radii_keep_each_particle_its_size(tmp_path):
 
 
 def test_a_contact_cooled_with_its_centres_held_goes_into_tension_as_eqs_9_10_13_predict():
-    from verification.sintering_causes import contact_cooling
+    from verification.luding.causes import contact_cooling
 
     strong = contact_cooling(0.2)  # the paper's mean contact force at p = 100 N/m
     assert strong["hot"]["force"] == pytest.approx(0.2, rel=1e-12)

@@ -1,14 +1,14 @@
 """Luding, Manetsberger & Müllers 2005, Section 4, reproduced with the engine for moving particles.
 
-The samples of Sec. 4 (Table 1, the bi-axial box of Fig. 1, the schedule of Fig. 7; :mod:`verification.sinter_protocol`)
-are prepared, sintered for t_s, cooled and tested over the grid of :mod:`verification.sintering_runs` (N = 100 and
+The samples of Sec. 4 (Table 1, the bi-axial box of Fig. 1, the schedule of Fig. 7; :mod:`verification.luding.protocol`)
+are prepared, sintered for t_s, cooled and tested over the grid of :mod:`verification.luding.runs` (N = 100 and
 300, p = 10 and 100 N/m, t_s from 1e-4 to 1 s; ``--quick``: N = 100 and three t_s), in parallel and resumed where a
 previous run stopped. The section draws the paper's figures from the runs -- nu(t), k1(t), the coordination number
 and the wall stress (Figs. 8-11), the overlap and normal-force distributions after sintering and after cool-down
 (Figs. 12-15), density and stress against strain in the compression test (Figs. 16-19), snapshots of the
 compression and vibration tests (Figs. 20-22) -- runs the three-particle control of Sec. 4.1.3, the same protocol
 in 3D with heated walls (necks, density and effective conductivity together), and writes every quantitative
-statement of Section 4 beside our number (:mod:`verification.sintering_statements`; summary key ``statements``:
+statement of Section 4 beside our number (:mod:`verification.luding.statements`; summary key ``statements``:
 ``statement``, ``paper``, ``ours``, ``holds``).
 """
 
@@ -21,13 +21,13 @@ from dataclasses import asdict
 import numpy as np
 
 from dem.laws.contact.luding import LUDING_TABLE1
-from verification.sinter_protocol import Times
-from verification import sintering_runs as sr
+from verification.luding.protocol import Times
+from verification.luding import runs as sr
 from verification.report import md_table, save_figure
-from verification.sintering_causes import (INTERIOR_MARGIN, box_area, contact_cooling, cool_down, interior_fraction,
+from verification.luding.causes import (INTERIOR_MARGIN, box_area, contact_cooling, cool_down, interior_fraction,
                                            section as causes_section, sintered_preparations)
-from verification.sintering_statements import pct, statements, statements_table
-from verification.sintering_study import Missing, Study, at, bulk_coordination, read_csv
+from verification.luding.statements import pct, statements, statements_table
+from verification.luding.study import Missing, Study, at, bulk_coordination, read_csv
 
 TITLE = "Sintering mechanics: Luding, Manetsberger & Müllers 2005, Section 4"
 DPI = 110
@@ -209,7 +209,7 @@ def wall_segments(snap: dict) -> list:
 
 
 def _draw(ax, a: dict, k: int, title: str, stress_range=None):
-    from verification.packing_picture import draw_packing
+    from verification.luding.picture import draw_packing
 
     snap = {key[len(f"snap{k}_"):]: v for key, v in a.items() if key.startswith(f"snap{k}_")}
     draw_packing(ax, snap["x"], snap["radius"], snap["mean_stress"], snap["i"], snap["j"], snap["fn"], snap["ft"],
@@ -354,7 +354,7 @@ def _speed(st: Study) -> tuple[str, dict]:
             f"({stage_seconds} s: preparation, heating and sintering, cooling and "
             f"relaxation), {ns:.0f} ns per particle-step, in a worker process sharing the machine with the other "
             f"runs of this grid (and whatever else ran). The target is 60 s; "
-            f"`python -m verification.sintering_runs 300 100 1` times it in one process alone.")
+            f"`python -m verification.luding.runs 300 100 1` times it in one process alone.")
     return text, {"seconds": seconds, "steps": steps, "ns_per_particle_step": ns, "n": n, "p": p, "t_s": t_s}
 
 
@@ -670,7 +670,7 @@ def run(out_dir: pathlib.Path, quick: bool = False, workers: int = 2) -> dict:
 
 
 PROTOCOL_TEXT = """\
-**Protocol** (`verification.sinter_protocol`, every stage a scene; the runs in `runs/<stage>/<sample>/`). Disks of height
+**Protocol** (`verification.luding.protocol`, every stage a scene; the runs in `runs/<stage>/<sample>/`). Disks of height
 6 mm, a0 = 1 mm, radii uniform in a0 (1 ± 0.5), Table 1's material (`LUDING_TABLE1`), placed at random (solid
 fraction 0.3) with speeds of 0.01 m/s in a square box whose left and bottom walls are fixed and whose right and top
 walls are stress-controlled at p (eq. 1, m_w = 0.01 kg, γ_w = 0.2 kg/s). *Preparation* at 80 °C with Table 1's
@@ -682,7 +682,7 @@ that the times of Fig. 20 are strains. *Vibration* (Figs. 21-22): the box walls 
 vibrating at 100 Hz with 0.2 mm amplitude for 0.1 s in gravity. ν is the *material density* M/(ρ_p V): the
 sample's mass over ρ_p at 80 °C times the walls' box (Fig. 9's "material density"; the mass is conserved, eq. 8); the
 *solid fraction at the current radii* a(T) of eq. 9 is the same at 80 °C and larger by (a(T)/a(80 °C))² when hot.
-*Fragments* (`verification.fragments`): clusters joined by closed contacts whose tension capacity −f_min (eq. 15) holds at
+*Fragments* (`verification.luding.fragments`): clusters joined by closed contacts whose tension capacity −f_min (eq. 15) holds at
 least the weight of the lighter particle (a disk resting on another under its weight has a capacity ~10⁻⁹ of it, a
 sintered contact ~10³-10⁴ of it). *Failure*: the largest σ_zz before σ_zz first falls below half of it; the
 *stiffness* is the slope of σ_zz against ε_zz while σ_zz rises from p half way to that."""
