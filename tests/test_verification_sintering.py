@@ -275,3 +275,15 @@ def test_a_stage_run_from_a_state_is_read_on_its_own_clock(tmp_path):
     t_heat, t_cool = sr.Task(sr.SINTER, 12, 10.0, 1e-4).times.t_heat, sr.Times(t_s=1e-4).t_cool
     assert st.history(12, 10.0, 1e-4)["t"].tolist() == pytest.approx([0.0, 0.1, 0.2, t_heat + 0.05, t_heat + 0.1,
                                                                        t_cool + 0.1, t_cool + 0.2])
+
+
+def test_the_prose_template_has_every_block_the_section_fills_and_no_other(tmp_path):
+    import re
+
+    used = set(re.findall(r'PROSE\["([^"]+)"\]', pathlib.Path(S.__file__).read_text()))
+    assert used == set(S.PROSE)
+    assert S.PROSE["discussion"] == "**Where ours differs, and why.**"  # (blocks end before their blank lines)
+    template = tmp_path / "t.md"
+    template.write_text("<!-- a comment\nover two lines -->\n\n<!-- one -->\nx = {x:.2f}\n\n<!-- two -->\n y\nz\n")
+    blocks = S.prose_blocks(template)
+    assert blocks == {"one": "x = {x:.2f}", "two": " y\nz"} and blocks["one"].format(x=1) == "x = 1.00"

@@ -9,5 +9,6 @@ verification``), one concern a module, each reading only those before it:
 * :mod:`~verification.luding.statements` -- every quantitative statement of Section 4 beside our number;
 * :mod:`~verification.luding.causes` -- the runs that isolate the cause of each statement that does not hold;
 * :mod:`~verification.luding.picture` -- a packing drawn;
-* :mod:`~verification.luding.section` -- the section: figures, tables and the report.
+* :mod:`~verification.luding.section` -- the section: figures, tables and the report, its prose the template
+  ``prose.md``.
 """
