@@ -1,22 +1,22 @@
 """Effective conductivity of periodic packings of sintered spheres: 3D FE of the mirror cell with two-sided bounds.
 
-Geometry. A :class:`~fem_neck.lattice.cells.PeriodicCell` holds the particles of one period (centres, radii, the period box); every
-overlapping pair of particle images is bonded (Rojek 2022, eq. 21) and gets the volume-conserving cylindrical neck of
-:func:`fem_neck.geometry.neck_geometry` (eqs. 22-33). The solid is the union of all spheres and all neck cylinders, exactly as
-in :mod:`fem_neck.cluster`; it conserves each particle's volume, so the solid volume fraction is
-``phi = sum 4/3 pi r^3 / |period|`` exactly. The pair neck model has an answer only while the necks of one particle
-stay apart: :func:`~fem_neck.lattice.cells.check_cell` refuses a cell where two neck circles on one sphere touch (for the cubic lattices from
-``a/r = sin(theta/2)``, theta the smallest angle between bonds: SC 90 deg, BCC 70.5 deg, FCC 60 deg; see
-:func:`~fem_neck.lattice.cells.max_h_over_r`).
+Geometry. A :class:`~fem_neck.lattice.cells.PeriodicCell` holds the particles of one period (centres, radii, the period
+box); every overlapping pair of particle images is bonded (Rojek 2022, eq. 21) and gets the volume-conserving
+cylindrical neck of :func:`fem_neck.geometry.neck_geometry` (eqs. 22-33). The solid is the union of all spheres and all
+neck cylinders, exactly as in :mod:`fem_neck.cluster`; it conserves each particle's volume, so the solid volume fraction
+is ``phi = sum 4/3 pi r^3 / |period|`` exactly. The pair neck model has an answer only while the necks of one particle
+stay apart: :func:`~fem_neck.lattice.cells.check_cell` refuses a cell where two neck circles on one sphere touch (for
+the cubic lattices from ``a/r = sin(theta/2)``, theta the smallest angle between bonds: SC 90 deg, BCC 70.5 deg, FCC 60
+deg; see :func:`~fem_neck.lattice.cells.max_h_over_r`).
 
-The union reading (``neck = "union"``). The solid is the union of the spheres: Arzt's (1982) truncated spheres, each
-cut by its radical planes (:mod:`fem_neck.geometry.union`), no cylinders. A neck is the circle where two spheres meet
-(:class:`~fem_neck.lattice.mesh.UnionNecks`), second neighbours that overlap are necks too, and the necks of one particle may meet; the
-model holds up to the overlap at which the spheres fill space (:func:`~fem_neck.lattice.cells.union_max_h_over_r`), and ``phi`` is the exact
-volume of the cut spheres over the period. Its circles are re-entrant edges of interior angle ``pi + 2 arccos(a/r)``
-(equal spheres), sharper than a pair neck's, so its first mesh, gap order and mesh prediction are measured on its own
-cells (``UNION_*``). Below ``UNION_MIN_H_OVER_R`` the gap between two spheres at their circle is too thin a wedge to
-mesh.
+The union reading (``neck = "union"``). The solid is the union of the spheres: Arzt's (1982) truncated spheres, each cut
+by its radical planes (:mod:`fem_neck.geometry.union`), no cylinders. A neck is the circle where two spheres meet
+(:class:`~fem_neck.lattice.mesh.UnionNecks`), second neighbours that overlap are necks too, and the necks of one
+particle may meet; the model holds up to the overlap at which the spheres fill space
+(:func:`~fem_neck.lattice.cells.union_max_h_over_r`), and ``phi`` is the exact volume of the cut spheres over the
+period. Its circles are re-entrant edges of interior angle ``pi + 2 arccos(a/r)`` (equal spheres), sharper than a pair
+neck's, so its first mesh, gap order and mesh prediction are measured on its own cells (``UNION_*``). Below
+``UNION_MIN_H_OVER_R`` the gap between two spheres at their circle is too thin a wedge to mesh.
 
 The computational cell. A macroscopic gradient along z through a packing that is mirror-symmetric about the planes
 ``x = 0``, ``y = 0``, ``z = 0`` (hence also about ``x = P_x/2`` etc.) leaves the planes ``z = 0`` and ``z = P_z/2``
@@ -52,28 +52,19 @@ bonds), :mod:`~fem_neck.lattice.mesh` (the computational cell's curved mesh), :m
 bounds on one mesh), :mod:`~fem_neck.lattice.sizes` (the first and refined mesh sizes),
 :mod:`~fem_neck.lattice.budget` (the tetrahedra and memory of a solve, predicted before meshing),
 :mod:`~fem_neck.lattice.driver` (the adaptive run), :mod:`~fem_neck.lattice.network` (the pipe network's lattice sum)
-and :mod:`~fem_neck.lattice.output` (the mesh for ParaView); their public names are importable from here.
+and :mod:`~fem_neck.lattice.output` (the mesh for ParaView); the public names used elsewhere are importable from here.
 """
 
-
-
-from fem_neck.lattice.bounds import Bounds, solve_bounds
-from fem_neck.lattice.budget import memory_estimate, neck_circles, peak_memory, predicted_tetrahedra
-from fem_neck.lattice.cells import (BASIS, COORDINATION, EDGE_OVER_SPACING, KINDS, MIN_NECK_RATIO, NECKS,
+# the public names used elsewhere (verification, benchmarks, tests, the guide), importable from the package
+from fem_neck.lattice.bounds import Bounds, solve_bounds  # noqa: F401
+from fem_neck.lattice.budget import memory_estimate, neck_circles, peak_memory, predicted_tetrahedra  # noqa: F401
+from fem_neck.lattice.cells import (BASIS, COORDINATION, EDGE_OVER_SPACING, KINDS, MIN_NECK_RATIO, NECKS,  # noqa: F401
                                     UNION_MIN_H_OVER_R, PeriodicCell, check_cell, check_h_over_r, lattice_cell,
                                     max_h_over_r, max_neck_ratio, mean_neck_ratio, mirror_symmetry, union_max_h_over_r,
                                     union_neck_ratio)
-from fem_neck.lattice.driver import CellResult, effective_conductivity
-from fem_neck.lattice.mesh import CellMesh, UnionNecks, build_cell_mesh, local_cluster
-from fem_neck.lattice.network import network_conductivity
-from fem_neck.lattice.output import write_vtu
-from fem_neck.lattice.sizes import (FIRST_MESH, GAP_ORDER, UNION_GAP_ORDER, UNION_PORE_ORDER, default_order,
-                                    first_neck_size, first_rtol, mesh_sizes)
-
-__all__ = ["BASIS", "COORDINATION", "EDGE_OVER_SPACING", "FIRST_MESH", "GAP_ORDER", "KINDS", "MIN_NECK_RATIO", "NECKS",
-           "UNION_GAP_ORDER", "UNION_MIN_H_OVER_R", "UNION_PORE_ORDER", "Bounds", "CellMesh", "CellResult",
-           "PeriodicCell", "UnionNecks", "build_cell_mesh", "check_cell", "check_h_over_r", "default_order",
-           "effective_conductivity", "first_neck_size", "first_rtol", "lattice_cell", "local_cluster", "max_h_over_r",
-           "max_neck_ratio", "mean_neck_ratio", "memory_estimate", "mesh_sizes", "mirror_symmetry", "neck_circles",
-           "network_conductivity", "peak_memory", "predicted_tetrahedra", "solve_bounds", "union_max_h_over_r",
-           "union_neck_ratio", "write_vtu"]
+from fem_neck.lattice.driver import CellResult, effective_conductivity  # noqa: F401
+from fem_neck.lattice.mesh import CellMesh, UnionNecks, build_cell_mesh, local_cluster  # noqa: F401
+from fem_neck.lattice.network import network_conductivity  # noqa: F401
+from fem_neck.lattice.output import write_vtu  # noqa: F401
+from fem_neck.lattice.sizes import (FIRST_MESH, GAP_ORDER, UNION_GAP_ORDER, UNION_PORE_ORDER,  # noqa: F401
+                                    default_order, first_neck_size, first_rtol, mesh_sizes)

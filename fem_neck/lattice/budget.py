@@ -100,13 +100,13 @@ def neck_circles(cell: PeriodicCell, samples: int = 360) -> NeckCircles:
 
 
 def predicted_tetrahedra(circles: NeckCircles, size_neck: float) -> float:
-    """Tetrahedra of the mesh of neck size ``size_neck`` (:func:`~fem_neck.lattice.sizes.mesh_sizes`), predicted before meshing, on the
-    safe side. A mesh of local size ``h(x)`` has about ``int dV / h^3`` tetrahedra up to a constant. Around a neck
-    circle of radius ``a`` the size is ``s + GRADING rho`` at the distance ``rho`` (``s = min(size_neck a, h_n)``,
-    :func:`fem_neck.cluster.neck_size_fields`) up to ``U = SIZE_FAR r_min``, so the circle adds
-    ``a (1 / (2 s) - 1 / U + s / (2 U^2))`` times a constant (the solid's angle around it over ``GRADING^2``);
-    the rest of the solid adds its volume over ``SIZE_FAR^3``. The two constants are measured
-    (``TETRAHEDRA_PER_CIRCLE``, ``TETRAHEDRA_PER_VOLUME``), times ``PREDICTION_MARGIN``.
+    """Tetrahedra of the mesh of neck size ``size_neck`` (:func:`~fem_neck.lattice.sizes.mesh_sizes`), predicted before
+    meshing, on the safe side. A mesh of local size ``h(x)`` has about ``int dV / h^3`` tetrahedra up to a constant.
+    Around a neck circle of radius ``a`` the size is ``s + GRADING rho`` at the distance ``rho`` (``s = min(size_neck a,
+    h_n)``, :func:`fem_neck.cluster.neck_size_fields`) up to ``U = SIZE_FAR r_min``, so the circle adds ``a (1 / (2 s) -
+    1 / U + s / (2 U^2))`` times a constant (the solid's angle around it over ``GRADING^2``); the rest of the solid adds
+    its volume over ``SIZE_FAR^3``. The two constants are measured (``TETRAHEDRA_PER_CIRCLE``,
+    ``TETRAHEDRA_PER_VOLUME``), times ``PREDICTION_MARGIN``.
 
     Parameters
     ----------
@@ -125,8 +125,8 @@ def predicted_tetrahedra(circles: NeckCircles, size_neck: float) -> float:
 
 
 def memory_estimate(elements: float, order: int) -> float:
-    """Peak bytes of one :func:`~fem_neck.lattice.bounds.solve_bounds` on ``elements`` tetrahedra (both processes; measured, see
-    ``BYTES_PER_ELEMENT``).
+    """Peak bytes of one :func:`~fem_neck.lattice.bounds.solve_bounds` on ``elements`` tetrahedra (both processes;
+    measured, see ``BYTES_PER_ELEMENT``).
 
     Parameters
     ----------

@@ -214,10 +214,10 @@ def union_necks(local) -> UnionNecks:
 
 def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, grading: float,
                     curvature: int = 12, neck_cells: float = 1.0, method: str = "newton") -> CellMesh:
-    """Mesh the computational cell (:mod:`fem_neck.lattice`): the union of the spheres and necks that reach it, cut to the
-    cell, graded toward every neck circle (``size_neck a`` at the circles, growing by ``grading`` per unit
-    distance up to ``size_far r``; :func:`fem_neck.cluster.neck_size_fields`), its boundary classified onto the
-    exact spheres, cylinders and planes (:mod:`fem_neck.curved`). Lengths are scaled to the largest radius.
+    """Mesh the computational cell (:mod:`fem_neck.lattice`): the union of the spheres and necks that reach it, cut to
+    the cell, graded toward every neck circle (``size_neck a`` at the circles, growing by ``grading`` per unit distance
+    up to ``size_far r``; :func:`fem_neck.cluster.neck_size_fields`), its boundary classified onto the exact spheres,
+    cylinders and planes (:mod:`fem_neck.curved`). Lengths are scaled to the largest radius.
 
     Parameters
     ----------

@@ -1,5 +1,5 @@
-"""The mesh sizes of the adaptive run (:func:`fem_neck.lattice.driver.effective_conductivity`): the first mesh of a cell,
-sized from measured gaps of the bounds, the rule by which a refined mesh is sized, and the default order."""
+"""The mesh sizes of the adaptive run (:func:`fem_neck.lattice.driver.effective_conductivity`): the first mesh of a
+cell, sized from measured gaps of the bounds, the rule by which a refined mesh is sized, and the default order."""
 
 from __future__ import annotations
 
@@ -57,7 +57,7 @@ def mesh_rule(neck: str) -> tuple:
     Parameters
     ----------
     neck : str
-        How the cell's bonds are read (:data:`fem_neck.lattice.cells.NECKS`).
+        How the cell's bonds are read (``NECKS`` of :mod:`fem_neck.lattice.cells`).
     """
     if neck == "union":
         return UNION_FIRST_MESH, UNION_GAP_ORDER, UNION_NECK0, UNION_NECK_RANGE, UNION_FIRST_SIZES
