@@ -342,7 +342,7 @@ def lattice_process(kind: str, h_over_r: float, rtol: float) -> dict:
                         "--rtol", str(rtol), "--json", "--out", tmp], capture_output=True, check=True)
         seconds = time.perf_counter() - t0
         out = json.loads((pathlib.Path(tmp) / "lattice.json").read_text())
-    # peak_memory_gb: the process's peak plus its lower-bound child's (fem_neck.lattice.peak_memory)
+    # peak_memory_gb: the process's peak plus its lower-bound child's (fem_neck.lattice.budget.peak_memory)
     return {**out, "wall_seconds": seconds, "peak_gb": out["peak_memory_gb"]}
 
 

@@ -936,7 +936,7 @@ def study_schedule(section, sizes: Sizes) -> None:
     relaxation; ``sizes.schedule`` = (N, t_s) disks and seconds, p = 100 N/m) in a fresh process, with its seconds
     against the target where it is defined, (300, 1 s)."""
     n, t_s = sizes.schedule
-    code = ("import json; from verification.sintering_runs import schedule_seconds; "
+    code = ("import json; from verification.luding.runs import schedule_seconds; "
             f"print(json.dumps(schedule_seconds({n}, 100.0, {t_s})))")
     row = json.loads(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                                     timeout=3600).stdout.strip().splitlines()[-1])
@@ -944,7 +944,7 @@ def study_schedule(section, sizes: Sizes) -> None:
     section.target("the whole sintering schedule (Luding 2005 Fig. 7), N = 300, t_s = 1 s",
                    row["seconds"] if (n, t_s) == (300, 1.0) else None, SCHEDULE_LIMIT, "s")
     section.add_text("The whole sintering schedule", (
-        f"Luding 2005's protocol in one run (`verification.sintering_runs.schedule_seconds`): N = {n} disks, p = "
+        f"Luding 2005's protocol in one run (`verification.luding.runs.schedule_seconds`): N = {n} disks, p = "
         f"100 N/m, t_s = {t_s:g} s; {row['steps']} steps of t_MD, {row['seconds']:.1f} s in all "
         f"({row['ns_per_particle_step']:.0f} ns per particle-step in the loop), final solid fraction "
         f"{row['volume_fraction']:.4f}, coordination {row['coordination']:.2f}."))

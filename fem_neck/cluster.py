@@ -264,7 +264,7 @@ def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, si
     distance (the same relative grading around small and large necks). The circles are the curves all of whose sample points
     lie at distance ``a`` from the bond axis and at the neck's ends (possibly split into arcs at seams or cut by
     planes); a neck without length (``h_n = 0``: the circle where two spheres of a union meet,
-    :class:`fem_neck.lattice.UnionNecks`) has one circle, and ``size_neck a`` there. ``every_bond``: each bond must
+    :class:`fem_neck.lattice.mesh.UnionNecks`) has one circle, and ``size_neck a`` there. ``every_bond``: each bond must
     have its two circles on the boundary (else ``RuntimeError``); otherwise
     bonds without any are skipped (a neck cut away by a cell face). Returns the Threshold field tags.
 

@@ -10,7 +10,7 @@ from dem import Material, make_scene, run
 from dem.geometry.walls import Wall
 from dem.laws.conductance import ConductanceSpec
 from dem.scene import parse_scene, state_file
-from verification import sinter_protocol as sp
+from verification.luding import protocol as sp
 
 
 @pytest.fixture(scope="module")

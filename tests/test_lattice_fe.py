@@ -231,7 +231,7 @@ def _no_meshing(*args, **kwargs):
 def test_a_first_mesh_that_would_not_fit_is_refused_before_meshing(monkeypatch):
     # BCC h/r = 0.02 at 1e-5: the first mesh is predicted from the cell and refused before gmsh is called, naming
     # the estimate and an rtol whose first mesh is predicted to fit
-    monkeypatch.setattr(lattice, "build_cell_mesh", _no_meshing)
+    monkeypatch.setattr(lattice.driver, "build_cell_mesh", _no_meshing)
     cell = lattice.lattice_cell("bcc", 0.02)
     with pytest.raises(ValueError, match=r"bcc: the first mesh \(neck size 0.00\d+ a, ~\d+ tetrahedra\) needs "
                                          r"~\d+\.\d GB, more than the 1.0 GB available; rtol = \d\.\de-\d\d would fit"):
@@ -265,7 +265,7 @@ def test_a_finer_mesh_that_would_not_fit_is_refused_before_meshing(monkeypatch):
         meshes.append(sizes["size_neck"])
         return build(cell, **sizes)
 
-    monkeypatch.setattr(lattice, "build_cell_mesh", counting)
+    monkeypatch.setattr(lattice.driver, "build_cell_mesh", counting)
     with pytest.raises(ValueError, match=r"chain: rtol = 0.001 needs a finer mesh than the \d+ tetrahedra whose bounds "
                                          r"are \d\.\d\de-03 apart; that mesh \(neck size [\d.]+ a, ~\d+ tetrahedra\) "
                                          r"needs ~0.5 GB, more than the 0.5 GB available; rtol = \d\.\de-03 would fit"):
@@ -341,7 +341,7 @@ def test_lattice_cli_refuses_bad_input_in_one_line(capsys, monkeypatch, argv, ma
     # every refusal comes before any mesh is made
     from fem_neck.cli import main
 
-    monkeypatch.setattr(lattice, "build_cell_mesh", _no_meshing)
+    monkeypatch.setattr(lattice.driver, "build_cell_mesh", _no_meshing)
     try:
         rc = main(["lattice", *argv])
     except SystemExit as exc:  # argparse's own refusals
@@ -361,3 +361,33 @@ def test_lattice_cli_json_and_files(capsys, tmp_path):
     assert out["k_lower_over_kappa"] <= out["k_eff_over_kappa"] < out["phi"]
     assert out["coordination"] == 6 and abs(out["network_rel_error"]) < 0.01  # SC: the network holds
     assert {p.name for p in tmp_path.iterdir()} == {"lattice.json", "cell.vtu"}
+
+
+def test_the_fe_cache_key_covers_every_module_the_lattice_fe_imports():
+    """verification.lattices keys its FE cache by a hash of fe_files(): every fem_neck module that the lattice
+    package imports (also inside functions) and every module of the package itself must be among them."""
+    import ast
+    import pathlib
+
+    from verification.lattices import fe_files
+
+    root = pathlib.Path(lattice.__file__).parents[1]
+    hashed = set(fe_files())
+    package = sorted((root / "lattice").glob("*.py"))
+    assert set(package) <= hashed
+    imported = set()
+    for path in package:
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("fem_neck."):
+                names = [node.module] + [f"{node.module}.{alias.name}" for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module == "fem_neck":
+                names = [f"fem_neck.{alias.name}" for alias in node.names]
+            else:
+                continue
+            for name in names:
+                parts = name.split(".")[1:]
+                for candidate in (root.joinpath(*parts).with_suffix(".py"), root.joinpath(*parts, "__init__.py")):
+                    if candidate.exists():
+                        imported.add(candidate)
+    assert root / "cluster.py" in imported and root / "dual.py" in imported  # (the imports were read)
+    assert imported - hashed == set()

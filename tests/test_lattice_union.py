@@ -170,7 +170,7 @@ def test_a_mesh_whose_curved_element_folds_is_followed_by_one_twice_as_fine(monk
             raise FoldedMesh("a curved element folds")
         return solve(cm, *args)
 
-    monkeypatch.setattr(lattice, "solve_bounds", folding_once)
+    monkeypatch.setattr(lattice.driver, "solve_bounds", folding_once)
     levels = []
     res = lattice.effective_conductivity(lattice.lattice_cell("sc", 0.3, neck="union"), rtol=1e-2, workers=1,
                                          progress=levels.append)
@@ -195,7 +195,7 @@ def test_union_cli_refuses_bad_input_in_one_line(capsys, monkeypatch, argv, matc
     def no_meshing(*args, **kwargs):
         raise AssertionError("a mesh was made")
 
-    monkeypatch.setattr(lattice, "build_cell_mesh", no_meshing)
+    monkeypatch.setattr(lattice.driver, "build_cell_mesh", no_meshing)
     try:
         rc = main(["lattice", *argv])
     except SystemExit as exc:

@@ -15,7 +15,7 @@ import pytest
 from benchmarks.timing import worker_sweep
 from fem_neck.fit import sweep, sweep_points
 from sinterheat import pool as P
-from verification import sintering_runs as sr
+from verification.luding import runs as sr
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 # a chain of stages (prepare, sinter, cool, vibrate: each starts from its parent's state) and a three-particle
@@ -81,10 +81,10 @@ with pool(2, start=sys.argv[1]) as jobs:
 import os, sys, time
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
-from fem_neck import lattice
+from fem_neck.lattice import bounds
 context = get_context(sys.argv[1])
-queue = context.Queue()  # the lower bound's process, as fem_neck.lattice.solve_bounds starts it
-with ProcessPoolExecutor(1, mp_context=context, initializer=lattice._receive_temperatures, initargs=(queue,)) as one:
+queue = context.Queue()  # the lower bound's process, as fem_neck.lattice.bounds.solve_bounds starts it
+with ProcessPoolExecutor(1, mp_context=context, initializer=bounds._receive_temperatures, initargs=(queue,)) as one:
     pid = one.submit(os.getpid).result()
     waiting = one.submit(time.sleep, 120)
     print(pid, flush=True)

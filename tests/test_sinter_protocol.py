@@ -1,13 +1,14 @@
-"""Luding 2005's protocol as scenes (verification.sinter_protocol) and the fragment counter (verification.fragments)."""
+"""Luding 2005's protocol as scenes (verification.luding.protocol) and the fragment counter
+(verification.luding.fragments)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from verification import sinter_protocol as sp
+from verification.luding import protocol as sp
 from dem.engines.verlet.engine import VerletEngine
-from verification.fragments import clusters, fragments, tension_capacity
+from verification.luding.fragments import clusters, fragments, tension_capacity
 from dem.laws.contact.luding import LUDING_TABLE1 as MAT
 from dem.scene import parse_scene
 from dem.driver import run

@@ -7,19 +7,20 @@ from dataclasses import asdict
 import numpy as np
 import pytest
 
-from verification import sintering as S
-from verification import sintering_causes as cooling
-from verification import sintering_runs as sr
-from verification import sintering_statements as T
-from verification import sintering_study as Y
 from verification.cli import COMMANDS
-from verification.report import check_section_result, jsonable
+from verification.luding import causes as cooling
+from verification.luding import runs as sr
+from verification.luding import section as S
+from verification.luding import statements as T
+from verification.luding import study as Y
+from verification.report import check_section_result, jsonable, section_available, section_module
 
 TINY = sr.Grid(n=(12,), p=(10.0, 100.0), t_s=(1e-4, 2e-3), three_seeds=(1,), no_expansion=False, n3d=12)
 
 
 def test_registered_as_a_command():
     assert COMMANDS["sintering"][0] == ("sintering",)
+    assert section_module("sintering") == S.__name__ and section_available("sintering")
 
 
 def test_tasks_start_from_their_parents_and_name_their_folders():
@@ -113,7 +114,7 @@ def test_isolating_variants_start_where_they_should():
 
 
 def test_scene_docs_of_the_variants(tmp_path, monkeypatch):
-    from verification import sinter_protocol as sp
+    from verification.luding import protocol as sp
 
     prep = sr.scene_doc(sr.Task(sr.PREPARE, 20, 10.0, variant="frictionless-slow"), tmp_path)
     assert prep["phases"] == [{"start": 0.0, "mu": 0.0, "mu_wall": 0.0}]
@@ -245,7 +246,7 @@ def test_frozen_radii_keep_each_particle_its_size(tmp_path):
 
 
 def test_a_contact_cooled_with_its_centres_held_goes_into_tension_as_eqs_9_10_13_predict():
-    from verification.sintering_causes import contact_cooling
+    from verification.luding.causes import contact_cooling
 
     strong = contact_cooling(0.2)  # the paper's mean contact force at p = 100 N/m
     assert strong["hot"]["force"] == pytest.approx(0.2, rel=1e-12)
@@ -274,3 +275,15 @@ def test_a_stage_run_from_a_state_is_read_on_its_own_clock(tmp_path):
     t_heat, t_cool = sr.Task(sr.SINTER, 12, 10.0, 1e-4).times.t_heat, sr.Times(t_s=1e-4).t_cool
     assert st.history(12, 10.0, 1e-4)["t"].tolist() == pytest.approx([0.0, 0.1, 0.2, t_heat + 0.05, t_heat + 0.1,
                                                                        t_cool + 0.1, t_cool + 0.2])
+
+
+def test_the_prose_template_has_every_block_the_section_fills_and_no_other(tmp_path):
+    import re
+
+    used = set(re.findall(r'PROSE\["([^"]+)"\]', pathlib.Path(S.__file__).read_text()))
+    assert used == set(S.PROSE)
+    assert S.PROSE["discussion"] == "**Where ours differs, and why.**"  # (blocks end before their blank lines)
+    template = tmp_path / "t.md"
+    template.write_text("<!-- a comment\nover two lines -->\n\n<!-- one -->\nx = {x:.2f}\n\n<!-- two -->\n y\nz\n")
+    blocks = S.prose_blocks(template)
+    assert blocks == {"one": "x = {x:.2f}", "two": " y\nz"} and blocks["one"].format(x=1) == "x = 1.00"

@@ -84,7 +84,7 @@ def standing(cell: lattice.PeriodicCell) -> dict:
 
     Parameters
     ----------
-    cell : fem_neck.lattice.PeriodicCell
+    cell : fem_neck.lattice.cells.PeriodicCell
         The periodic packing, read as the union of its spheres.
 
     Returns

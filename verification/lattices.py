@@ -49,13 +49,24 @@ REFERENCES = {("sc", 0.08): 0.3375947, ("sc", 0.02): 0.1714669, ("bcc", 0.08): 0
               ("fcc", 0.08): 0.7056352, ("fcc", 0.02): 0.4121986}
 
 
-FE_MODULES = ("lattice", "curved", "primal", "dual", "pcg", "simplex")
+# the modules and packages of fem_neck that the periodic-cell FE computes with: its own package, the cluster's meshing
+# (size fields, tetrahedra), gmsh's session, the neck geometry, the curved mesh, both bounds' solvers and quadrature
+FE_MODULES = ("lattice", "cluster", "shapes", "geometry", "curved", "primal", "dual", "pcg", "simplex")
+
+
+def fe_files() -> list:
+    """The source files of ``FE_MODULES`` (every module of a package), in a fixed order."""
+    root = pathlib.Path(lattice.__file__).parents[1]
+    files = []
+    for name in FE_MODULES:
+        package = root / name
+        files += sorted(package.rglob("*.py")) if package.is_dir() else [root / f"{name}.py"]
+    return files
 
 
 def _code_version() -> str:
     """A hash of the FE code, so that cached FE results are recomputed when it changes."""
-    folder = pathlib.Path(lattice.__file__).parent
-    return hashlib.sha1(b"".join((folder / f"{name}.py").read_bytes() for name in FE_MODULES)).hexdigest()[:12]
+    return hashlib.sha1(b"".join(path.read_bytes() for path in fe_files())).hexdigest()[:12]
 
 
 class FECache:
@@ -82,8 +93,8 @@ class FECache:
 
 
 def fe_cell(cell: lattice.PeriodicCell, rtol: float, workers: int = 2) -> dict:
-    """``k_eff / kappa`` of the cell along z with its bounds (:func:`fem_neck.lattice.effective_conductivity`, its
-    two bounds in ``workers`` processes)."""
+    """``k_eff / kappa`` of the cell along z with its bounds
+    (:func:`fem_neck.lattice.driver.effective_conductivity`, its two bounds in ``workers`` processes)."""
     res = lattice.effective_conductivity(cell, rtol=rtol, workers=workers)
     return {"k": res.k_eff_over_kappa, "lower": res.k_lower_over_kappa, "upper": res.k_upper_over_kappa,
             "error_estimate": res.error_estimate, "converged": res.converged, "elements": res.elements,

@@ -1,7 +1,7 @@
 """NGSolve on the mirror cell of a periodic packing: the independent reference of the periodic-cell FE and its peer
 in the benchmarks (optional extra ``pip install .[peers]``).
 
-The same solid as :func:`fem_neck.lattice.build_cell_mesh` -- the spheres and volume-conserving neck cylinders that
+The same solid as :func:`fem_neck.lattice.mesh.build_cell_mesh` -- the spheres and volume-conserving neck cylinders that
 reach the cell, cut to it -- is built in netgen's own OCC kernel, meshed by netgen, refined geometrically toward the
 neck circles (``RefineHP``: anisotropic layers, factor ``hp_factor``), curved to order ``p``, and solved with H1
 elements of order ``p`` (``T = 1`` on ``z = 0``, 0 on ``z = P_z/2``, static condensation, sparse Cholesky). The

@@ -14,7 +14,7 @@ positions (the energy of the whole period, its gradient gathered from the 8 imag
 3. *clean-up*: the overlapping pairs are pulled into the overlap range whose necks lie between ``min_neck`` and
    ``max_neck`` (a/r) and all other pairs pushed apart, until the set of overlapping pairs no longer changes.
 
-The result is checked (:func:`fem_neck.lattice.check_cell`, the neck sizes and the angular margin between neck
+The result is checked (:func:`fem_neck.lattice.cells.check_cell`, the neck sizes and the angular margin between neck
 circles on one sphere) and redrawn from the next attempt until it passes. In a period only a few diameters wide
 the mirror planes act like walls, so these packings jam loose (packing fraction ~0.4, coordination ~4-5).
 

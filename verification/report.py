@@ -336,25 +336,34 @@ def _write_atomic(path: pathlib.Path, text: str) -> None:
     tmp.replace(path)
 
 
+# the sections whose module is not ``verification.<name>``
+SECTION_MODULES = {"sintering": "verification.luding.section"}
+
+
+def section_module(name: str) -> str:
+    """The module of the section ``name``: ``SECTION_MODULES``' or ``verification.<name>``."""
+    return SECTION_MODULES.get(name, f"verification.{name}")
+
+
 def section_available(name: str) -> bool:
-    """True when ``verification.<name>`` exists in this installation."""
-    return importlib.util.find_spec(f"verification.{name}") is not None
+    """True when the module of the section ``name`` (:func:`section_module`) exists in this installation."""
+    return importlib.util.find_spec(section_module(name)) is not None
 
 
 def run_section(name: str, out_dir: pathlib.Path, quick: bool, options: dict | None = None,
                 report: Report | None = None) -> Section:
-    """Import ``verification.<name>`` and call its ``run(out_dir / name, quick, **options)``; never raises. With
-    ``report`` the section is part of it (and rewrites it as it goes)."""
+    """Import the module of the section ``name`` (:func:`section_module`) and call its ``run(out_dir / name, quick,
+    **options)``; never raises. With ``report`` the section is part of it (and rewrites it as it goes)."""
     if report is not None:
         section = report.section(name, name)
     else:
         section = Section(name, RUNNING, name, out_dir=pathlib.Path(out_dir) / name)
     if not section_available(name):
-        section.status, section.error = NOT_AVAILABLE, f"verification.{name} is not available yet"
+        section.status, section.error = NOT_AVAILABLE, f"{section_module(name)} is not available yet"
         section.flush()
         return section
     with section.running():
-        module = importlib.import_module(f"verification.{name}")
+        module = importlib.import_module(section_module(name))
         result = check_section_result(name, module.run(section.folder(), quick=quick, **(options or {})))
         section.summary.update(jsonable(result["summary"]))
         section.title, section.markdown = str(result["title"]), str(result["markdown"])

@@ -48,7 +48,7 @@ def register(subparsers) -> None:
 
 
 def run(args) -> dict:
-    """Solve the lattice cell (:func:`fem_neck.lattice.effective_conductivity`); the result as a JSON-ready dict.
+    """Solve the lattice cell (:func:`fem_neck.lattice.driver.effective_conductivity`); the result as a JSON-ready dict.
 
     Parameters
     ----------

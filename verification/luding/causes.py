@@ -1,8 +1,8 @@
 """Why ours differs from Luding 2005, Sec. 4: the runs that isolate each cause, and one contact cooled by hand.
 
-Three mechanisms stand behind the statements that did not hold (:mod:`verification.sintering_statements`):
+Three mechanisms stand behind the statements that did not hold (:mod:`verification.luding.statements`):
 
-1. *Densification and the three-particle control* -- the preparation (:data:`verification.sintering_runs.VARIANTS`:
+1. *Densification and the three-particle control* -- the preparation (:data:`verification.luding.runs.VARIANTS`:
    the paper's frictionless one and its variants against the protocol's frictional one) and the walls of the
    control (contacts that sinter like pairs, or keep the cold law);
 2. *Cool-down* -- the protocol's cool-down against the same with the box held and without thermal contraction
@@ -25,11 +25,11 @@ import numpy as np
 from scipy.optimize import brentq
 
 from dem.laws.contact.luding import LUDING_TABLE1
-from verification.sinter_protocol import MEAN_RADIUS, RADIUS_SPREAD, T0_SINTER, T_PREPARE, T_SINTER
-from verification import sintering_runs as sr
+from verification.luding.protocol import MEAN_RADIUS, RADIUS_SPREAD, T0_SINTER, T_PREPARE, T_SINTER
+from verification.luding import runs as sr
 from verification.report import md_table
-from verification.sintering_statements import pct
-from verification.sintering_study import Missing, Study, at, bulk_coordination
+from verification.luding.statements import pct
+from verification.luding.study import Missing, Study, at, bulk_coordination
 
 # ------------------------------------------------------------------------------------------------ one contact
 
@@ -148,7 +148,7 @@ PREP_LABELS = {"": "protocol: friction μ = 0.5 on particles and walls", "fricti
 
 def preparations() -> list[tuple[str, str, int]]:
     """``(variant, label, seed)`` of every preparation: the protocol's, each of :data:`PREP_LABELS`, and the
-    protocol's other placements (:data:`sintering_runs.PREP_SEEDS`)."""
+    protocol's other placements (:data:`verification.luding.runs.PREP_SEEDS`)."""
     return ([(variant, label, 1) for variant, label in PREP_LABELS.items()]
             + [("", f"protocol, placement (seed) {seed}", seed) for seed in sr.PREP_SEEDS])
 
@@ -165,7 +165,7 @@ def _run_key(n, p, variant: str, seed: int) -> str:
 
 
 def preparation_table(st: Study) -> tuple[str, dict]:
-    """ν(t_heat) of every preparation run (the protocol's other placements, :data:`sintering_runs.PREP_SEEDS`,
+    """ν(t_heat) of every preparation run (the protocol's other placements, :data:`verification.luding.runs.PREP_SEEDS`,
     as rows of their own), ν half way through it (has it settled?), ν of its interior (:func:`interior_fraction`),
     and the densification of those sintered for the longest t_s and cooled."""
     rows, summary = [], {}
@@ -377,7 +377,7 @@ def coordination_table(st: Study) -> tuple[str, dict]:
 
 def failure_table(st: Study) -> tuple[str, dict]:
     """The shortest-sintered sample at p = 100 compressed to 6 % (the test) and to 15 %: σ_zz in strain windows and
-    the failure (:func:`verification.sintering_study.failure`) of each."""
+    the failure (:func:`verification.luding.study.failure`) of each."""
     n, t_s = st.n_max, st.t_min
     rows, summary = [], {}
     windows = ((0.0, 0.02), (0.02, 0.06), (0.06, 0.15))
@@ -395,7 +395,7 @@ def failure_table(st: Study) -> tuple[str, dict]:
 
 
 def placement_failure_table(st: Study) -> tuple[str, dict]:
-    """The failure strain and stress of every placement :data:`sintering_runs.PLACEMENTS` (each prepared, sintered
+    """The failure strain and stress of every placement :data:`verification.luding.runs.PLACEMENTS` (each prepared, sintered
     for t_s, cooled and compressed), for every N, p and t_s of the grid, and their mean (what the statements read)."""
     rows, summary = [], {}
     for n in st.grid.n:

@@ -1,36 +1,54 @@
 """Luding, Manetsberger & Müllers 2005, Section 4, reproduced with the engine for moving particles.
 
-The samples of Sec. 4 (Table 1, the bi-axial box of Fig. 1, the schedule of Fig. 7; :mod:`verification.sinter_protocol`)
-are prepared, sintered for t_s, cooled and tested over the grid of :mod:`verification.sintering_runs` (N = 100 and
+The samples of Sec. 4 (Table 1, the bi-axial box of Fig. 1, the schedule of Fig. 7; :mod:`verification.luding.protocol`)
+are prepared, sintered for t_s, cooled and tested over the grid of :mod:`verification.luding.runs` (N = 100 and
 300, p = 10 and 100 N/m, t_s from 1e-4 to 1 s; ``--quick``: N = 100 and three t_s), in parallel and resumed where a
 previous run stopped. The section draws the paper's figures from the runs -- nu(t), k1(t), the coordination number
 and the wall stress (Figs. 8-11), the overlap and normal-force distributions after sintering and after cool-down
 (Figs. 12-15), density and stress against strain in the compression test (Figs. 16-19), snapshots of the
 compression and vibration tests (Figs. 20-22) -- runs the three-particle control of Sec. 4.1.3, the same protocol
 in 3D with heated walls (necks, density and effective conductivity together), and writes every quantitative
-statement of Section 4 beside our number (:mod:`verification.sintering_statements`; summary key ``statements``:
-``statement``, ``paper``, ``ours``, ``holds``).
+statement of Section 4 beside our number (:mod:`verification.luding.statements`; summary key ``statements``:
+``statement``, ``paper``, ``ours``, ``holds``). Its prose -- the protocol, the conclusions and the notes beside the
+numbers -- is the template ``prose.md`` beside this module, whose named fields the functions here fill.
 """
 
 from __future__ import annotations
 
 import math
 import pathlib
+import re
 from dataclasses import asdict
 
 import numpy as np
 
 from dem.laws.contact.luding import LUDING_TABLE1
-from verification.sinter_protocol import Times
-from verification import sintering_runs as sr
+from verification.luding.protocol import Times
+from verification.luding import runs as sr
 from verification.report import md_table, save_figure
-from verification.sintering_causes import (INTERIOR_MARGIN, box_area, contact_cooling, cool_down, interior_fraction,
+from verification.luding.causes import (INTERIOR_MARGIN, box_area, contact_cooling, cool_down, interior_fraction,
                                            section as causes_section, sintered_preparations)
-from verification.sintering_statements import pct, statements, statements_table
-from verification.sintering_study import Missing, Study, at, bulk_coordination, read_csv
+from verification.luding.statements import pct, statements, statements_table
+from verification.luding.study import Missing, Study, at, bulk_coordination, read_csv
 
 TITLE = "Sintering mechanics: Luding, Manetsberger & Müllers 2005, Section 4"
 DPI = 110
+
+
+def prose_blocks(path: pathlib.Path) -> dict:
+    """The blocks of a prose template by name: each follows its line ``<!-- name -->`` and ends before the next one
+    (its trailing newlines dropped); their ``{field}`` are filled by ``str.format``.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The template (Markdown).
+    """
+    parts = re.split(r"^<!-- (\S+) -->\n", path.read_text(encoding="utf-8"), flags=re.M)
+    return {name: body.rstrip("\n") for name, body in zip(parts[1::2], parts[2::2])}
+
+
+PROSE = prose_blocks(pathlib.Path(__file__).with_name("prose.md"))  # the section's prose (prose.md)
 
 
 # ------------------------------------------------------------------------------------------------ figures
@@ -209,7 +227,7 @@ def wall_segments(snap: dict) -> list:
 
 
 def _draw(ax, a: dict, k: int, title: str, stress_range=None):
-    from verification.packing_picture import draw_packing
+    from verification.luding.picture import draw_packing
 
     snap = {key[len(f"snap{k}_"):]: v for key, v in a.items() if key.startswith(f"snap{k}_")}
     draw_packing(ax, snap["x"], snap["radius"], snap["mean_stress"], snap["i"], snap["j"], snap["fn"], snap["ft"],
@@ -334,10 +352,9 @@ def _three_d(st: Study) -> tuple[str, dict]:
     s = st.series(st.task(sr.SINTER3D, n, sr.P3D))
     hot = s["t"][np.argmax(s["T_mean"] >= 130.0)] if np.any(s["T_mean"] >= 130.0) else math.nan
     k = s["effective_conductivity"]
-    text = THREE_D_TEXT.format(n=n) + (
-        f" The mean temperature reaches 130 °C after {hot:.3g} s; meanwhile the necks grow and the effective "
-        f"conductivity rises from {k[np.isfinite(k)][0]:.3g} to {k[np.isfinite(k)][-1]:.3g} W/(m K), fastest next "
-        f"to the hot wall (the profiles).")
+    text = (PROSE["three_d"].format(n=n, spread=sr.SPREAD3D, p=sr.P3D, hot=sr.HOT3D[0], cold=sr.HOT3D[1],
+                                    time=sr.SINTER3D_TIME, kappa=sr.CONDUCTIVITY3D, c=sr.SPECIFIC_HEAT3D)
+            + " " + PROSE["three_d.heating"].format(hot=hot, k0=k[np.isfinite(k)][0], k1=k[np.isfinite(k)][-1]))
     table = md_table(["stage", "ν", "C", "neck a/r (mean)", "a/r (90 %)", "k_eff (W/(m K))", "run s"], rows)
     return text + "\n\n" + table, summary
 
@@ -349,12 +366,9 @@ def _speed(st: Study) -> tuple[str, dict]:
     steps = sum(r["steps"] for r in parts)
     ns = 1e9 * seconds / (steps * n)
     stage_seconds = ", ".join(f"{r['seconds']:.1f}" for r in parts)
-    text = (f"The whole schedule for N = {n}, p = {p:g}, t_s = {t_s:g} ({Times(t_s=t_s).t_f:g} s simulated, {steps} "
-            f"steps of {Times(t_s=t_s).t_f / steps:.3g} s) took {seconds:.1f} s in three stages "
-            f"({stage_seconds} s: preparation, heating and sintering, cooling and "
-            f"relaxation), {ns:.0f} ns per particle-step, in a worker process sharing the machine with the other "
-            f"runs of this grid (and whatever else ran). The target is 60 s; "
-            f"`python -m verification.sintering_runs 300 100 1` times it in one process alone.")
+    t_f = Times(t_s=t_s).t_f
+    text = PROSE["speed"].format(n=n, p=p, t_s=t_s, t_f=t_f, steps=steps, dt=t_f / steps, seconds=seconds,
+                                 stages=stage_seconds, ns=ns)
     return text, {"seconds": seconds, "steps": steps, "ns_per_particle_step": ns, "n": n, "p": p, "t_s": t_s}
 
 
@@ -369,15 +383,15 @@ def _control_creep(st: Study, s_end: float) -> str:
     creep = a["snap0_fn"] / (LUDING_TABLE1.k1 * s_end)
     start, end = at(s, task.times.t_heat), at(s, s["t"][-1])
     area = [box_area(row) for row in (start, end)]
-    return (f"In the first placement the pair contacts end with overlaps of "
-            f"{', '.join(f'{1e6 * v:.1f}' for v in overlap)} µm where f/(k1 s) of their forces gives "
-            f"{', '.join(f'{1e6 * v:.1f}' for v in creep)} µm, and the box loses {pct(1.0 - area[1] / area[0])} of its "
-            f"area while ν rises by {pct(end['volume_fraction'] / start['volume_fraction'] - 1.0)}: no rearrangement, "
-            f"the law's creep alone.")
+    return PROSE["control_creep"].format(overlaps=", ".join(f"{1e6 * v:.1f}" for v in overlap),
+                                         creeps=", ".join(f"{1e6 * v:.1f}" for v in creep),
+                                         area=pct(1.0 - area[1] / area[0]),
+                                         rise=pct(end["volume_fraction"] / start["volume_fraction"] - 1.0))
 
 
 def discussion(st: Study) -> str:
-    """Where ours differs from the paper, and why: one bullet per point, with the numbers of these runs."""
+    """Where ours differs from the paper, and why: one bullet per point, with the numbers of these runs (the blocks
+    of prose.md, filled here)."""
     bullets = []
 
     def add(build):
@@ -393,32 +407,23 @@ def discussion(st: Study) -> str:
         dens = {p: st.densification(p) for p in (10.0, 100.0)}
         s = st.series(st.task(sr.SINTER, n, 10.0, st.t_max))
         jump = at(s, 0.01)["volume_fraction"] - s["volume_fraction"][0]
-        text = (f"*Densification and the preparation.* The paper's text prepares with frictionless particles, yet "
-                f"its preparation ends at ν ≈ 0.80, switching \"the wall friction\" off at t_heat densifies at once, "
-                f"and sintering densifies by 5 % (p = 10) and 16 % (p = 100). With Table 1's μ = 0.5 on particles and "
-                f"walls while preparing (the protocol; the paper gives the preparation's wall friction no value) "
-                f"ν(t_heat) = {prep[10.0]:.3f} and {prep[100.0]:.3f} (N = {n}), releasing the wall friction adds "
-                f"{jump:+.4f} within 10 ms (p = 10), and the densification is {pct(dens[10.0][0])} and "
-                f"{pct(dens[100.0][0])}.")
+        text = PROSE["densification"].format(prep10=prep[10.0], prep100=prep[100.0], n=n, jump=jump,
+                                             dens10=pct(dens[10.0][0]), dens100=pct(dens[100.0][0]))
         try:
             fr = st.res(sr.PREPARE, n, 10.0, variant="frictionless")["volume_fraction"]
             fd = st.res(sr.COOL, n, 10.0, st.t_max, variant="frictionless")["volume_fraction"] / fr - 1.0
-            text += (f" Prepared frictionless, the same sample starts at ν = {fr:.3f} and densifies by {pct(fd)} at "
-                     f"p = 10, with no change at t_heat (the isolating runs below; the full grid adds every other "
-                     f"frictionless preparation, for N = 300 too).")
+            text += " " + PROSE["densification.frictionless"].format(start=fr, dens=pct(fd))
         except Missing:
             pass
         other = [st.res(sr.PREPARE, n, 10.0, seed=seed)["volume_fraction"] for seed in sr.PREP_SEEDS]
-        text += (f" One sample of N = {n} is a noisy measure: the same preparation from other random placements "
-                 f"ends at ν(t_heat) = {', '.join(f'{v:.3f}' for v in other)} (p = 10, seeds "
-                 f"{', '.join(str(seed) for seed in sr.PREP_SEEDS)}) against {prep[10.0]:.3f} and densifies by "
-                 f"{', '.join(pct(v) for v in dens[10.0][1:])}, while at p = 100 the three densify alike "
-                 f"({', '.join(pct(v) for v in dens[100.0])}); the statements read the mean over the placements.")
+        text += " " + PROSE["densification.placements"].format(
+            n=n, others=", ".join(f"{v:.3f}" for v in other), seeds=", ".join(str(seed) for seed in sr.PREP_SEEDS),
+            prep10=prep[10.0], dens10=", ".join(pct(v) for v in dens[10.0][1:]),
+            dens100=", ".join(pct(v) for v in dens[100.0]))
         try:
             inner = [interior_fraction(st.state(st.task(sr.PREPARE, n, 10.0, seed=seed))) for seed in sr.PLACEMENTS]
-            text += (f" The placements differ at the walls, not inside: more than {1e3 * INTERIOR_MARGIN:g} mm "
-                     f"(the largest diameter) from every wall their solid fraction is "
-                     f"{', '.join(f'{v:.3f}' for v in inner)}.")
+            text += " " + PROSE["densification.interior"].format(margin_mm=1e3 * INTERIOR_MARGIN,
+                                                                 inner=", ".join(f"{v:.3f}" for v in inner))
         except (Missing, ValueError):  # ValueError: a box smaller than two margins
             pass
         return text
@@ -427,16 +432,9 @@ def discussion(st: Study) -> str:
         a = st.res(sr.SINTER, n, 100.0, st.t_max)
         b = st.res(sr.COOL, n, 100.0, st.t_max)
         c = cool_down(st.series(st.task(sr.COOL, n, 100.0, st.t_max)), 0.0)
-        text = (f"*Density after cool-down (0.94).* The paper puts the rise on cooling down to \"negative thermal "
-                f"expansion\": only a density that keeps each particle's mass and reference volume sees that, so ν is "
-                f"the material density M/(ρ_p V) (the statements' module docstring). Cooling from 140 to 80 °C "
-                f"shrinks the particles' area by {pct(-c['particles'])} (eq. 9) and the stress-controlled box "
-                f"follows them (its area shrinks by {pct(-c['box'])}, σ_zz on the top wall "
-                f"{c['top_min']:.0f}-{c['top_max']:.0f} N/m while cooling): the material density rises from "
-                f"{a['mass_fraction']:.4f} to {b['mass_fraction']:.4f} (N = {n}, p = 100), the solid fraction "
-                f"counted with the current radii stays ({a['volume_fraction']:.4f} to {b['volume_fraction']:.4f}). "
-                f"The paper's \"almost 0.92\" to \"almost 0.94\" is about 2 %, more than eq. 9 gives for 60 K "
-                f"with Table 1's δa_T = 1e-4 /K.")
+        text = PROSE["cooling"].format(particles=pct(-c["particles"]), box=pct(-c["box"]), top_min=c["top_min"],
+                                       top_max=c["top_max"], mass_hot=a["mass_fraction"], mass_cold=b["mass_fraction"],
+                                       n=n, volume_hot=a["volume_fraction"], volume_cold=b["volume_fraction"])
         ends = []
         for variant, label in (("frictionless", "frictionless"), ("no-wall-friction", "with frictionless walls")):
             for m in st.grid.n:
@@ -447,26 +445,22 @@ def discussion(st: Study) -> str:
                 except Missing:
                     pass
         if ends:
-            text += (" Nor does the preparation set the end: prepared "
-                     + "; ".join(f"{label} (N = {m}) the sample starts at {v0:.4f} and ends at {v1:.4f} after "
-                                 f"sintering and {v2:.4f} after cool-down" for label, m, v0, v1, v2 in ends)
-                     + f", against the protocol's {st.res(sr.PREPARE, n, 100.0)['mass_fraction']:.4f}, "
-                     f"{a['mass_fraction']:.4f} and {b['mass_fraction']:.4f} (p = 100, N = {n}): a denser start "
-                     f"leaves less to densify.")
+            text += " " + PROSE["cooling.preparations"].format(
+                ends="; ".join(PROSE["cooling.preparation"].format(label=label, n=m, start=v0, sintered=v1, cooled=v2)
+                               for label, m, v0, v1, v2 in ends),
+                mass_prep=st.res(sr.PREPARE, n, 100.0)["mass_fraction"], mass_hot=a["mass_fraction"],
+                mass_cold=b["mass_fraction"], n=n)
         try:
             e = cool_down(st.series(st.task(sr.COOL, n, 100.0, st.t_max, variant="expansion-text")), 0.0)
             r = st.res(sr.COOL, n, 100.0, st.t_max, variant="expansion-text")
-            text += (f" Sec. 3.2's text says the radius changes \"by one per-cent\" between 80 and 120 °C, which is "
-                     f"δa_T = 2.5e-4 /K, not 1e-4 /K: with it the same sample's material density rises from "
-                     f"{r['mass_fraction'] * (1.0 + e['box']):.4f} to {r['mass_fraction']:.4f}; the paper's rise "
-                     f"lies between the two.")
+            text += " " + PROSE["cooling.expansion_text"].format(before=r["mass_fraction"] * (1.0 + e["box"]),
+                                                                 after=r["mass_fraction"])
         except Missing:
             pass
         try:
             task = st.task(sr.SCHEDULE, min(st.grid.n), 100.0, st.t_max, variant="no-expansion")
             z = cool_down(st.series(task), task.times.t_cool)
-            text += (f" Without thermal expansion (the paper's control, δa_T = 0 throughout, N = {task.n}) the "
-                     f"cool-down changes ν from {z['nu_cool']:.4f} to {z['nu_f']:.4f}: cooling alone adds nothing.")
+            text += " " + PROSE["cooling.no_expansion"].format(n=task.n, nu_cool=z["nu_cool"], nu_f=z["nu_f"])
         except Missing:
             pass
         return text
@@ -477,14 +471,11 @@ def discussion(st: Study) -> str:
         creep = 2.0 * 1e-3 * 10.0 / (1e5 * s_end)  # f/(k1 s) at f = 2 a0 p (eqs. 4, 10-12, Table 1)
         forces = np.concatenate([st.arrays(st.task(sr.SCHEDULE, 3, 10.0, st.t_max, seed))["fn"]
                                  for seed in st.grid.three_seeds])
-        text = (f"*Three-particle control.* With walls that keep the cold law (a wall does not melt; the paper "
-                f"gives its walls only μ_w) the control densifies by {pct(float(np.mean(d[10.0])))} (p = 10) and "
-                f"{pct(float(np.mean(d[100.0])))} (p = 100) over {len(d[10.0])} placements, against the paper's "
-                f"estimated 0.2 % and 8 %.")
+        text = PROSE["three"].format(dens10=pct(float(np.mean(d[10.0]))), dens100=pct(float(np.mean(d[100.0]))),
+                                     placements=len(d[10.0]))
         try:
             w = {p: st.three(p, "walls-sinter", st.grid.three_seeds[:1]) for p in (10.0, 100.0)}
-            text += (f" With walls that sinter like pairs the same placement densifies by {pct(w[10.0][0])} and "
-                     f"{pct(w[100.0][0])}: the box then shrinks at its wall contacts as much as between the disks.")
+            text += " " + PROSE["three.walls_sinter"].format(dens10=pct(w[10.0][0]), dens100=pct(w[100.0][0]))
         except Missing:
             pass
         try:
@@ -493,22 +484,15 @@ def discussion(st: Study) -> str:
             if not ratio:
                 raise Missing("three-particle controls sintered for 0.01 s or longer")
             short = min(ratio)
-            text += (f" The law's creep f/(k1 s) is proportional to the contact force: the first placement densifies "
-                     f"{' and '.join(f'{r:.1f}' for r in ratio.values())} times more at p = 100 than at p = 10 "
-                     f"(t_s = {' and '.join(f'{t:g}' for t in ratio)} s), where the paper's two estimates differ by "
-                     f"a factor of 40; sintered for t_s = {short:g} s instead, p = 10 gives "
-                     f"{pct(st.three(10.0, seeds=(1,), t_s=short)[0])} but p = 100 only "
-                     f"{pct(st.three(100.0, seeds=(1,), t_s=short)[0])}: no sintering time gives both.")
+            text += " " + PROSE["three.pressure"].format(
+                ratios=" and ".join(f"{r:.1f}" for r in ratio.values()), times=" and ".join(f"{t:g}" for t in ratio),
+                short=short, dens10=pct(st.three(10.0, seeds=(1,), t_s=short)[0]),
+                dens100=pct(st.three(100.0, seeds=(1,), t_s=short)[0]))
         except Missing:
             pass
-        return text + (f" At p = 10 the law itself creeps a loaded contact to f/(k1 s), s = k1(140 °C, t_s)/k1 = "
-                       f"{s_end:.4f} (eqs. 4, 10-12): {1e6 * creep:.1f} µm at the paper's mean force 2 a0 p = "
-                       f"0.02 N, {pct(2 * creep / 6e-3)} for a line of three mean disks across the box (two "
-                       f"contacts over 6 a0). Our three disks carry {np.mean(forces[forces > 0]):.3f} N per pair "
-                       f"contact on average (the box side times p) and creep accordingly: "
-                       f"{pct(float(np.mean(d[10.0])))}. {_control_creep(st, s_end)} The paper's 0.2 % needs fewer "
-                       f"or less loaded contacts than any of our placements has; no choice of the walls brings the "
-                       f"law's creep below that of the pair contacts.")
+        return text + " " + PROSE["three.creep"].format(
+            s_end=s_end, creep_um=1e6 * creep, line=pct(2 * creep / 6e-3), force=np.mean(forces[forces > 0]),
+            dens10=pct(float(np.mean(d[10.0]))), control=_control_creep(st, s_end))
 
     def forces():
         rows = {}
@@ -523,28 +507,18 @@ def discussion(st: Study) -> str:
         if "" not in rows:
             raise Missing("cool-down")
         q1, q99 = np.percentile(st.arrays(st.task(sr.COOL, n, 100.0, st.t_max))["fn"], [1, 99])
-        text = (f"*Forces after cool-down.* The paper's striking result, almost equally strong attraction and "
-                f"repulsion in the cooled block, is not reproduced with its stress-controlled walls: at p = 100 "
-                f"(N = {n}, t_s = {st.t_max:g}) the 1 % quantile of the normal force is {q1:.3g} N against a 99 % "
-                f"quantile of {q99:.3g} N, {100 * rows[''][1]:.0f} % of the contacts attract.")
+        text = PROSE["forces"].format(n=n, t_s=st.t_max, q1=q1, q99=q99, attract=100 * rows[""][1])
         if {"held", "cool-no-expansion", "held-no-expansion"} <= set(rows):
-            text += (f" The cool-down runs isolate the cause: with the walls held the ratio is "
-                     f"{rows['held'][0]:.2f} ({100 * rows['held'][1]:.0f} % attract), but only with thermal "
-                     f"contraction (held, δa_T = 0: {rows['held-no-expansion'][0]:.2f}); with walls that follow p, "
-                     f"δa_T = 0 changes nothing ({rows['cool-no-expansion'][0]:.2f}).")
+            text += " " + PROSE["forces.held"].format(held=rows["held"][0], held_attract=100 * rows["held"][1],
+                                                      held_no_expansion=rows["held-no-expansion"][0],
+                                                      no_expansion=rows["cool-no-expansion"][0])
         if {"cool-expansion-x3", "cool-expansion-x5"} <= set(rows):
-            text += (f" Nor does more contraction under those walls: three and five times Table 1's δa_T while "
-                     f"cooling give {rows['cool-expansion-x3'][0]:.2f} and {rows['cool-expansion-x5'][0]:.2f} "
-                     f"({100 * rows['cool-expansion-x3'][1]:.0f} and {100 * rows['cool-expansion-x5'][1]:.0f} % "
-                     f"attract): the box follows the particles.")
+            text += " " + PROSE["forces.contraction"].format(
+                x3=rows["cool-expansion-x3"][0], x5=rows["cool-expansion-x5"][0],
+                x3_attract=100 * rows["cool-expansion-x3"][1], x5_attract=100 * rows["cool-expansion-x5"][1])
         c = contact_cooling(0.2)
-        return text + (f" One contact sintered under 0.2 N and cooled with its centres held ends at {c['held']:.2f} N "
-                       f"(eqs. 9, 10, 13, Fig. 5: its overlap falls by {1e6 * c['shrink']:.0f} µm, its elastic part "
-                       f"was {1e6 * (c['hot']['overlap'] - c['hot']['delta_0']):.1f} µm); with the force held it "
-                       f"stays at 0.2 N. In this model attraction needs a structure that cannot follow its thermal "
-                       f"contraction. The paper's box follows it (its density rises on cool-down) and its control "
-                       f"with δa_T = 0 \"did not change the outcome after cool-down\": both cannot hold here, so the "
-                       f"protocol keeps the paper's stress-controlled walls.")
+        return text + " " + PROSE["forces.contact"].format(
+            held=c["held"], shrink_um=1e6 * c["shrink"], elastic_um=1e6 * (c["hot"]["overlap"] - c["hot"]["delta_0"]))
 
     def coordination():
         c = {(m, p): st.res(sr.SINTER, m, p, st.t_max)["coordination"] for m in st.grid.n for p in st.grid.p}
@@ -554,63 +528,50 @@ def discussion(st: Study) -> str:
             raise Missing("N = 100 or 300")
         bulk = {(m, p): bulk_coordination(st.contacts(sr.SINTER, m, p, st.t_max))[0] for m in st.grid.n
                 for p in st.grid.p}
-        return (f"*Coordination numbers* are lower than the paper's by {min(gap):.2f}-{max(gap):.2f} ("
-                + ", ".join(f"{c[(m, p)]:.2f} for N = {m}, p = {p:g}" for m in st.grid.n for p in st.grid.p)
-                + "; the paper: 4, 4, 4.5, 4.8). We count every particle and no wall contacts; removing the rattlers "
-                "(fewer than two contacts) changes little (see the table). The gap is the wall particles, which the "
-                "paper also names as the reason for a smaller C: the particles touching no wall have C = "
-                + ", ".join(f"{bulk[(m, p)]:.2f}" for m in st.grid.n for p in st.grid.p)
-                + " (the isolating runs' table). The order (p = 100 above p = 10, N = 300 above N = 100) is the "
-                "paper's." + _spread())
+        return PROSE["coordination"].format(
+            gap_min=min(gap), gap_max=max(gap),
+            ours=", ".join(f"{c[(m, p)]:.2f} for N = {m}, p = {p:g}" for m in st.grid.n for p in st.grid.p),
+            bulk=", ".join(f"{bulk[(m, p)]:.2f}" for m in st.grid.n for p in st.grid.p)) + _spread()
 
     def _spread() -> str:
         found = {(m, p): [st.results[task]["coordination"] for _, task in sintered_preparations(st, m, p)]
                  for m in st.grid.n for p in st.grid.p}
         if all(len(v) < 2 for v in found.values()):
             return ""
-        return (" Every preparation and placement the grid sintered gives C = "
-                + ", ".join(f"{min(v):.2f}-{max(v):.2f} for N = {m}, p = {p:g} ({len(v)} samples)"
-                            for (m, p), v in found.items() if len(v) > 1) + ".")
+        return " " + PROSE["coordination.samples"].format(
+            ranges=", ".join(f"{min(v):.2f}-{max(v):.2f} for N = {m}, p = {p:g} ({len(v)} samples)"
+                             for (m, p), v in found.items() if len(v) > 1))
 
     def failure():
         ratio = max(st.compression(m, p, st.t_max)["kinetic_over_work"] for m in st.grid.n for p in st.grid.p)
         late = [f"N = {m}: ε_f = {st.compression(m, 100.0, st.t_min)['failure_strain']:.3f}" for m in st.grid.n]
-        text = ("*Failure.* σ_zz is the top wall's force over the box width; failure is the largest σ_zz before it "
-                "first falls below half of it. Samples sintered long fail by a brittle load drop, and their failure "
-                "stress grows with t_s and p as in the paper. The shortest-sintered samples at p = 100 show no "
-                f"brittle drop ({', '.join(late)} at t_s = {st.t_min:g}: the largest of a fluctuating σ_zz)")
+        text = PROSE["failure"].format(late=", ".join(late), t_s=st.t_min)
         try:
             c = st.compression(n, 100.0, st.t_min, "long")
             flow = c["szz"][c["eps"] > 0.02]
-            text += (f"; carried on to 15 % (the isolating runs) the same sample flows, σ_zz between "
-                     f"{np.min(flow):.0f} and {np.max(flow):.0f} N/m, and first drops below half of its largest at "
-                     f"ε_f = {c['failure_strain']:.3f}: an unsintered packing has no failure strain of its own, so it "
-                     f"cannot order with t_s")
+            text += "; " + PROSE["failure.flow"].format(low=np.min(flow), high=np.max(flow), strain=c["failure_strain"])
         except Missing:
             pass
         try:
             spread = {p: st.placement_failures(n, p, st.t_min, "failure_strain") for p in st.grid.p}
-            text += (f". Between placements ε_f at t_s = {st.t_min:g} (N = {n}) spreads over "
-                     + ", ".join(f"{min(v):.4f}-{max(v):.4f} at p = {p:g}" for p, v in spread.items())
-                     + ", so the statements read the mean of the placements (the isolating runs' table)")
+            ranges = ", ".join(f"{min(v):.4f}-{max(v):.4f} at p = {p:g}" for p, v in spread.items())
+            text += ". " + PROSE["failure.placements"].format(t_s=st.t_min, n=n, ranges=ranges)
         except Missing:
             pass
-        return text + (f". The strain rate (1/s) is not in the paper; at it the kinetic energy before failure stays "
-                       f"below {100 * ratio:.1f} % of the work done by the top wall (longest t_s).")
+        return text + ". " + PROSE["failure.rate"].format(percent=100 * ratio)
 
     def vibration():
         if 0.01 not in st.grid.t_s:
             raise Missing("t_s = 0.01")
         share = {p: [st.res(sr.VIBRATE, n, p, t)["largest_fragment"] / n for t in st.grid.t_s] for p in st.grid.p}
         half = {p: next((t for t, x in zip(st.grid.t_s, share[p]) if x >= 0.5), None) for p in st.grid.p}
-        return ("*Vibration.* The largest fragment first holds half of the particles after t_s = "
-                + " and ".join(f"{half[p]:g} (p = {p:g})" for p in st.grid.p if half[p] is not None)
-                + f": at p = 100 our samples bond sooner than the paper's, whose Fig. 22 still shows pieces after "
-                f"t_s = 0.01 (ours: {share[100.0][st.grid.t_s.index(0.01)]:.0%} of the particles in one piece).")
+        return PROSE["vibration"].format(
+            times=" and ".join(f"{half[p]:g} (p = {p:g})" for p in st.grid.p if half[p] is not None),
+            share=share[100.0][st.grid.t_s.index(0.01)])
 
     for build in (densification, cooling, three, forces, coordination, failure, vibration):
         add(build)
-    return "**Where ours differs, and why.**\n\n" + "\n".join(f"- {b}" for b in bullets)
+    return PROSE["discussion"] + "\n\n" + "\n".join(f"- {b}" for b in bullets)
 
 
 # ------------------------------------------------------------------------------------------------ the section
@@ -645,7 +606,7 @@ def run(out_dir: pathlib.Path, quick: bool = False, workers: int = 2) -> dict:
         f"t_s = {', '.join(f'{t:g}' for t in grid.t_s)} s{' (--quick)' if quick else ''}. "
         f"**{holding} of {len(items)} statements hold** within the tolerances given beside them.",
         "",
-        PROTOCOL_TEXT,
+        PROSE["protocol"],
         "",
         "### Every quantitative statement of Section 4",
         "",
@@ -667,33 +628,3 @@ def run(out_dir: pathlib.Path, quick: bool = False, workers: int = 2) -> dict:
                "sintering.not_checked": skipped, "sintering.failed_runs": failed, "sintering.speed": speed,
                "sintering.3d": three_d, "sintering.causes": causes}
     return {"title": TITLE, "markdown": "\n".join(md), "summary": summary, "figures": figures}
-
-
-PROTOCOL_TEXT = """\
-**Protocol** (`verification.sinter_protocol`, every stage a scene; the runs in `runs/<stage>/<sample>/`). Disks of height
-6 mm, a0 = 1 mm, radii uniform in a0 (1 ± 0.5), Table 1's material (`LUDING_TABLE1`), placed at random (solid
-fraction 0.3) with speeds of 0.01 m/s in a square box whose left and bottom walls are fixed and whose right and top
-walls are stress-controlled at p (eq. 1, m_w = 0.01 kg, γ_w = 0.2 kg/s). *Preparation* at 80 °C with Table 1's
-μ = 0.5 on particles and walls, for 0.2 s; at t_heat the wall friction off (μ_w = 0 as in Table 1), *heating* to
-140 °C in 0.1 s, *sintering* for t_s with t0 = 0.1 s, *cooling* to 80 °C in 0.1 s and *relaxation* for 0.1 s
-(Sec. 4.1, t0 = 10³ s outside sintering). The state after sintering (t_cool) and after relaxation (t_f) are saved;
-the cooled one starts both tests. *Compression* (Sec. 4.4): right wall at σ_xx = p, top wall moving in at ε̇_zz = 1/s to ε_zz = 0.06, so
-that the times of Fig. 20 are strains. *Vibration* (Figs. 21-22): the box walls removed, the sample on a floor
-vibrating at 100 Hz with 0.2 mm amplitude for 0.1 s in gravity. ν is the *material density* M/(ρ_p V): the
-sample's mass over ρ_p at 80 °C times the walls' box (Fig. 9's "material density"; the mass is conserved, eq. 8); the
-*solid fraction at the current radii* a(T) of eq. 9 is the same at 80 °C and larger by (a(T)/a(80 °C))² when hot.
-*Fragments* (`verification.fragments`): clusters joined by closed contacts whose tension capacity −f_min (eq. 15) holds at
-least the weight of the lighter particle (a disk resting on another under its weight has a capacity ~10⁻⁹ of it, a
-sintered contact ~10³-10⁴ of it). *Failure*: the largest σ_zz before σ_zz first falls below half of it; the
-*stiffness* is the slope of σ_zz against ε_zz while σ_zz rises from p half way to that."""
-
-THREE_D_TEXT = f"""\
-The same protocol in 3D with the thermal network on: {{n}} spheres (a0 = 1 mm ± {sr.SPREAD3D:g}, Table 1's
-material) prepared frictionless at 80 °C in a cube under {sr.P3D:g} Pa (three fixed walls, three stress walls; the
-mean contact force of the paper's p = 100 N/m), then, instead of the prescribed schedule, the bottom wall held at
-{sr.HOT3D[0]:g} °C and the top wall at {sr.HOT3D[1]:g} °C for {sr.SINTER3D_TIME:g} s with t0 = 0.1 s, the particles'
-temperatures computed by the pipe network on their contacts (conductance law `fit`, Rojek's necks from the
-overlaps; κ = {sr.CONDUCTIVITY3D:g} W/(m K), the heat capacity scaled down to c = {sr.SPECIFIC_HEAT3D:g} J/(kg K), as
-t0 scales the sintering). The effective conductivity is that of a steady solve of the network between the two
-walls as it is. No cooling stage: with the network's temperatures the engine passes no cooling rate to the contact
-law, so k1 would not freeze on cooling (Sec. 3.4, end) but relax back with t0."""

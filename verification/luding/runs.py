@@ -1,7 +1,7 @@
 """The runs behind the sintering section: Luding 2005's protocol over a grid of N, p and t_s, in worker processes,
 resumed where it stopped.
 
-A :class:`Task` is one stage of :mod:`verification.sinter_protocol` for one sample: ``prepare`` (N, p), ``sinter`` (heating
+A :class:`Task` is one stage of :mod:`verification.luding.protocol` for one sample: ``prepare`` (N, p), ``sinter`` (heating
 and sintering for t_s, from the prepared state), ``cool`` (cooling and relaxation), ``compress`` and ``vibrate``
 (the tests of Sec. 4.4, from the cooled state), ``schedule`` (the whole of Fig. 7 in one scene: the three-particle
 control of Sec. 4.1.3, the control without thermal expansion), and the 3D stages with heated walls (``prepare3d``,
@@ -29,7 +29,7 @@ from dataclasses import asdict, dataclass, field, replace
 import numpy as np
 
 from dem.laws.contact.luding import LUDING_TABLE1, P_MU
-from verification.sinter_protocol import CONTROL_T_HEAT, WALL_DAMPING, Times
+from verification.luding.protocol import CONTROL_T_HEAT, WALL_DAMPING, Times
 
 PREPARE, SINTER, COOL, COMPRESS, VIBRATE, SCHEDULE = "prepare", "sinter", "cool", "compress", "vibrate", "schedule"
 PREPARE3D, SINTER3D = "prepare3d", "sinter3d"
@@ -54,7 +54,7 @@ CONDUCTIVITY3D, SPECIFIC_HEAT3D = 20.0, 10.0
 
 @dataclass(frozen=True)
 class Variant:
-    """A change of the protocol (:mod:`verification.sinter_protocol`) that isolates one cause: ``prep`` keyword arguments of
+    """A change of the protocol (:mod:`verification.luding.protocol`) that isolates one cause: ``prep`` keyword arguments of
     the preparation, ``material`` fields changed in every stage (``prep_material``: in the preparation only),
     ``walls_held`` in the cool-down, ``t_heat`` of the three-particle control, ``heated``: false keeps a schedule
     at the preparation's 80 °C throughout (the three-particle control without heating), ``strain`` of the
@@ -135,7 +135,7 @@ class Task:
     @property
     def times(self) -> Times:
         """The times of the protocol for this task (the three-particle control prepares for longer:
-        :data:`verification.sinter_protocol.CONTROL_T_HEAT`)."""
+        :data:`verification.luding.protocol.CONTROL_T_HEAT`)."""
         t_heat = VARIANTS[self.variant].t_heat if self.variant else None
         if t_heat is None:
             t_heat = CONTROL_T_HEAT if (self.kind == SCHEDULE and self.n == 3) else 0.2
@@ -267,7 +267,7 @@ def _frozen_radii(state: pathlib.Path, out: pathlib.Path, material) -> str:
 
 def scene_doc(task: Task, root: pathlib.Path) -> dict:
     """The scene of ``task`` (its parent's state under ``root``)."""
-    from verification import sinter_protocol as sp
+    from verification.luding import protocol as sp
     from dem.scene import state_file
 
     material = _material(task)
@@ -325,7 +325,7 @@ def snapshot(sim) -> dict:
 def contact_statistics(sim) -> dict:
     """Per closed contact: overlap over a_i + a_j (Figs. 12-13), normal force (Figs. 14-15), tangential force,
     f_min (eq. 15), the activated friction ``mu_t = f_t/(f_n - f_min)`` and ``mu(T, t)`` (eq. 24, Sec. 4.3.3)."""
-    from verification.fragments import tension_capacity
+    from verification.luding.fragments import tension_capacity
 
     mech = sim.mechanics
     s = mech.state
@@ -357,7 +357,7 @@ def run_task(task: Task, root) -> dict:
     """Run ``task`` into ``root/task.folder`` (module docstring); returns what ``result.json`` holds."""
     from dem.scene import state_file
     from dem.engines.verlet.engine import VerletEngine
-    from verification.fragments import fragments
+    from verification.luding.fragments import fragments
     from dem.output.writer import RunWriter
     from dem.scene import parse_scene
 
@@ -473,13 +473,13 @@ def run_tasks(tasks, root, workers: int = 2, progress: bool = True) -> dict:
 
 
 def schedule_seconds(n: int = 300, p: float = 100.0, t_s: float = 1.0, seed: int = 1) -> dict:
-    """The whole schedule of Fig. 7 (:func:`verification.sinter_protocol.schedule_doc`) in this process, without output:
+    """The whole schedule of Fig. 7 (:func:`verification.luding.protocol.schedule_doc`) in this process, without output:
     ``seconds`` of the run (building the simulation, loading the compiled kernels and the time loop),
     ``loop_seconds`` (the time loop alone), ``steps``, ``ns_per_particle_step`` (of the loop) and the final solid
     fraction and coordination number. For the bench row of "the whole schedule, t_s = 1, N = 300"."""
     from dem.engines.verlet.engine import VerletEngine
     from dem.scene import parse_scene
-    from verification.sinter_protocol import schedule_doc
+    from verification.luding.protocol import schedule_doc
 
     t0 = time.perf_counter()
     sim = VerletEngine(parse_scene(schedule_doc(n, p, t_s, seed=seed), "schedule"))
@@ -494,7 +494,7 @@ def schedule_seconds(n: int = 300, p: float = 100.0, t_s: float = 1.0, seed: int
 
 
 def _main(argv=None) -> int:
-    """``python -m verification.sintering_runs [N P T_S]``: time the whole schedule (one JSON line)."""
+    """``python -m verification.luding.runs [N P T_S]``: time the whole schedule (one JSON line)."""
     args = sys.argv[1:] if argv is None else argv
     n, p, t_s = (int(args[0]), float(args[1]), float(args[2])) if args else (300, 100.0, 1.0)
     print(json.dumps(schedule_seconds(n, p, t_s)))

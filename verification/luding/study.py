@@ -13,8 +13,8 @@ import pathlib
 import numpy as np
 
 from dem.laws.contact.luding import LUDING_TABLE1, radius_at
-from verification.sinter_protocol import T_PREPARE, Times
-from verification import sintering_runs as sr
+from verification.luding.protocol import T_PREPARE, Times
+from verification.luding import runs as sr
 
 
 class Missing(LookupError):
@@ -108,7 +108,7 @@ class Study:
 
     def placement_failures(self, n, p, t_s, key: str) -> list[float]:
         """``key`` (``"failure_stress"`` or ``"failure_strain"``) of :meth:`compression` for each of the protocol's
-        placements :data:`sintering_runs.PLACEMENTS`, one per placement."""
+        placements :data:`verification.luding.runs.PLACEMENTS`, one per placement."""
         return [self.compression(n, p, t_s, seed=seed)[key] for seed in sr.PLACEMENTS]
 
     def chain_densification(self, n, p, seed=1, variant: str = "") -> float:
@@ -117,7 +117,7 @@ class Study:
                 / self.res(sr.PREPARE, n, p, seed=seed, variant=variant)["volume_fraction"] - 1.0)
 
     def densification(self, p) -> list[float]:
-        """:meth:`chain_densification` of the protocol's placements :data:`sintering_runs.PLACEMENTS` (N max),
+        """:meth:`chain_densification` of the protocol's placements :data:`verification.luding.runs.PLACEMENTS` (N max),
         one per placement."""
         return [self.chain_densification(self.n_max, p, seed) for seed in sr.PLACEMENTS]
 
@@ -166,7 +166,7 @@ def without_rattlers(i, j, n: int) -> tuple[float, int]:
 
 def bulk_coordination(a: dict, k: int = 0) -> tuple[float, int]:
     """``(C, n)``: the mean number of pair contacts of the ``n`` particles of snapshot ``k`` of an ``analysis.npz``
-    (:func:`verification.sintering_runs.snapshot`) that touch no wall."""
+    (:func:`verification.luding.runs.snapshot`) that touch no wall."""
     x, r, i, j = a[f"snap{k}_x"], a[f"snap{k}_radius"], a[f"snap{k}_i"], a[f"snap{k}_j"]
     gap = x @ a[f"snap{k}_wall_normal"].T - a[f"snap{k}_wall_q"][None, :]
     bulk = ~np.any(gap < r[:, None], axis=1)

@@ -1,6 +1,6 @@
 """Every quantitative statement of Section 4 of Luding, Manetsberger & Müllers 2005, checked against the runs.
 
-Each check reads a :class:`verification.sintering_study.Study` and returns one :class:`Statement` (or a list): the
+Each check reads a :class:`verification.luding.study.Study` and returns one :class:`Statement` (or a list): the
 statement, the paper's value, ours, whether it holds and the tolerance judged fair; a check whose runs are not in
 the grid raises :class:`Missing` and is listed as not checked.
 
@@ -10,7 +10,7 @@ h``, and ρ_p at 80 °C, where the protocol draws the radii (the paper does not 
 hold). The mass is conserved (eq. 8), so ν rises when the particles contract on cooling -- the rise the paper puts
 down to "negative thermal expansion" (Sec. 4.1.4) -- whereas the solid fraction counted with the current radii a(T)
 of eq. 9 stays, because the stress-controlled box follows the particles (the cool-down runs of
-:mod:`verification.sintering_causes`). At 80 °C the two are equal: they differ only for the hot sample.
+:mod:`verification.luding.causes`). At 80 °C the two are equal: they differ only for the hot sample.
 """
 
 from __future__ import annotations
@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from verification.sinter_protocol import T_PREPARE, Times
-from verification import sintering_runs as sr
+from verification.luding.protocol import T_PREPARE, Times
+from verification.luding import runs as sr
 from verification.report import md_table
-from verification.sintering_study import Missing, Study, at, bulk_coordination, without_rattlers
+from verification.luding.study import Missing, Study, at, bulk_coordination, without_rattlers
 
 
 @dataclass
@@ -182,7 +182,7 @@ def _three_particles(st: Study):
                                                                          max(0.3 * paper, 0.005)),
                              "±30 % of the paper's value or ±0.5 points",
                              "walls that keep the cold law, prepared for 0.5 s without wall friction "
-                             "(verification.sinter_protocol.control_doc); the isolating runs show walls that sinter"))
+                             "(verification.luding.protocol.control_doc); the isolating runs show walls that sinter"))
     return out
 
 
