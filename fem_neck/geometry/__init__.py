@@ -381,7 +381,7 @@ def neck_radius(r_i, r_j, h, method: str = "newton"):
     h : float or array_like
         Overlap ``r_i + r_j - d`` (Rojek 2022, eq. 21), m, ``0 < h <= max_overlap(r_i, r_j)``
         (:func:`max_overlap`, where the neck reaches the smaller radius).
-    method : {"newton", "first", "coble"}, optional
+    method : str, optional
         The neck model: ``"newton"`` the volume-conserving cylindrical neck (eqs. 22-33, solved to round-off; the
         default), ``"first"`` its first Newton iterate from Coble's radius (eq. 34), ``"coble"`` Coble's neck
         (eqs. 10-12).
@@ -433,7 +433,7 @@ def neck_geometry(r_i, r_j, h, method: str = "newton") -> NeckGeometry:
         Radii of the two spheres, m, finite and > 0; arrays broadcast.
     h : float or array_like
         Overlap ``r_i + r_j - d`` (eq. 21), m, ``0 < h <= max_overlap(r_i, r_j)``.
-    method : {"newton", "first", "coble"}, optional
+    method : str, optional
         The neck model, as for :func:`neck_radius` (default ``"newton"``).
 
     Returns
