@@ -136,14 +136,15 @@ def test_a_build_with_a_cdn_script_fails(tmp_path):
 
 
 def test_maths_is_served_by_the_site_itself():
-    """conf.py draws the equations with a MathJax the build copies into ``_static`` (the docs extra installs it),
-    never one from a CDN: a page that still loaded a remote MathJax would also fail the build (site_check)."""
+    """conf.py draws the equations with a MathJax the build copies into ``_static`` (the docs extra installs it,
+    ``_ext/offline_maths.py`` registers it), never one from a CDN: a page that still loaded a remote MathJax would
+    also fail the build (site_check)."""
     import importlib.util
     import runpy
     import tomllib
 
     conf = runpy.run_path(str(ROOT / "docs" / "conf.py"))
-    assert {"sphinx.ext.mathjax", "sphinx-mathjax-offline", "site_check"} <= set(conf["extensions"])
+    assert {"sphinx.ext.mathjax", "offline_maths", "site_check"} <= set(conf["extensions"])
     assert not site_check.is_remote(conf.get("mathjax_path", "")) and "mathjax3_config" not in conf
     extra = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]["docs"]
     assert any(req.startswith("sphinx-mathjax-offline") for req in extra)
@@ -156,10 +157,28 @@ def test_maths_is_served_by_the_site_itself():
                 pass
 
         app = App()
-        importlib.import_module("sphinx-mathjax-offline").setup(app)
+        assert importlib.import_module("offline_maths").setup(app) == {"parallel_read_safe": True,
+                                                                      "parallel_write_safe": True}  # -j builds
         assert not site_check.is_remote(app.config.mathjax_path)
         assert (pathlib.Path(spec.origin).parent / "static" / "mathjax" / app.config.mathjax_path.split("/", 1)[1]
                 ).is_file()
+
+
+def test_offline_maths_lets_the_build_run_in_parallel(tmp_path):
+    """``-j`` (the docs command's ``-j auto``) under ``-W`` fails with ``sphinx-mathjax-offline`` registered as it comes
+    (its setup declares nothing, which Sphinx reads as unsafe in parallel, with a warning) and builds through
+    ``offline_maths``, which MathJax's files still reach. Needs the docs extra."""
+    sphinx_cmd = pytest.importorskip("sphinx.cmd.build")
+    pytest.importorskip("sphinx-mathjax-offline")
+    page = "Title\n=====\n\n:math:`a = \\sqrt{2 r h}`\n"
+    (tmp_path / "index.rst").write_text(page)
+    args = ["-W", "-q", "-j", "2", "-b", "html", str(tmp_path), str(tmp_path / "_build")]
+    for extension, built in (("sphinx-mathjax-offline", False), ("offline_maths", True)):
+        (tmp_path / "conf.py").write_text(f"import sys\nsys.path.insert(0, {str(ROOT / 'docs' / '_ext')!r})\n"
+                                          f"extensions = ['sphinx.ext.mathjax', {extension!r}]\n")
+        assert (sphinx_cmd.build_main(args + ["-E"]) == 0) == built, extension
+    assert (tmp_path / "_build" / "_static" / "mathjax" / "tex-chtml.js").is_file()
+    assert "_static/mathjax/tex-chtml.js" in (tmp_path / "_build" / "index.html").read_text()
 
 
 def test_scipy_names_link_through_the_inventory_committed_with_the_docs():
