@@ -181,6 +181,34 @@ def test_offline_maths_lets_the_build_run_in_parallel(tmp_path):
     assert "_static/mathjax/tex-chtml.js" in (tmp_path / "_build" / "index.html").read_text()
 
 
+def test_nav_tree_changes_no_page(tmp_path):
+    """The navigation tree built from the cut tables of contents (``_ext/nav_tree.py``) gives every page byte for byte
+    what the full ones give: a site with sections, API objects in the tables of contents, a toctree under a
+    section, one inside ``only`` and a hidden one, built with furo both ways. Needs the docs extra."""
+    sphinx_cmd = pytest.importorskip("sphinx.cmd.build")
+    pytest.importorskip("furo")
+    pages = {
+        "index": "Site\n====\n\nIntro\n-----\n\n.. toctree::\n   :caption: Guide\n\n   a\n   b\n\n"
+                 ".. only:: html\n\n   .. toctree::\n\n      d\n\n.. toctree::\n   :hidden:\n\n   e\n",
+        "a": "A\n=\n\nOne\n---\n\nTwo\n---\n\n.. py:function:: f(x)\n\n.. py:class:: C\n\n   .. py:method:: m()\n",
+        "b": "B\n=\n\nSection\n-------\n\n.. toctree::\n\n   c\n\nLater\n-----\n",
+        "c": "C\n=\n\n.. py:function:: g()\n\nSub\n---\n\n.. py:function:: h()\n",
+        "d": "D\n=\n\nx\n",
+        "e": "E\n=\n\nSub E\n-----\n",
+    }
+    for name, text in pages.items():
+        (tmp_path / f"{name}.rst").write_text(text)
+    for extensions in ([], ["nav_tree"]):
+        (tmp_path / "conf.py").write_text(f"import sys\nsys.path.insert(0, {str(ROOT / 'docs' / '_ext')!r})\n"
+                                          f"html_theme = 'furo'\nextensions = {extensions!r}\n")
+        out = tmp_path / f"_build{len(extensions)}"
+        assert sphinx_cmd.build_main(["-W", "-q", "-E", "-b", "html", str(tmp_path), str(out)]) == 0
+    built = sorted(path.relative_to(tmp_path / "_build0") for path in (tmp_path / "_build0").rglob("*.html"))
+    assert len(built) == 8 and "c.html" in (tmp_path / "_build1" / "a.html").read_text()  # the nested page is there
+    assert [str(page) for page in built
+            if (tmp_path / "_build0" / page).read_bytes() != (tmp_path / "_build1" / page).read_bytes()] == []
+
+
 def test_scipy_names_link_through_the_inventory_committed_with_the_docs():
     """intersphinx reads SciPy's inventory from the file under docs/ (no request at build time), and the inventory
     holds the names the docstrings use."""
