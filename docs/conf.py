@@ -32,7 +32,7 @@ extensions = [
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
     "offline_maths",  # sphinx-mathjax-offline: MathJax 3 copied into _static/mathjax and loaded from there
-    "nav_tree",  # furo's navigation tree from tables of contents cut to what it shows (a third of the pages' time)
+    "nav_tree",  # furo's navigation tree from tables of contents cut to what it shows (half the pages' CPU time)
     "sphinx.ext.viewcode",
     "sphinx.ext.intersphinx",
     "sphinx_gallery.gen_gallery",
