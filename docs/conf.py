@@ -1,6 +1,7 @@
 """Sphinx configuration of the sinterheat documentation.
 
-Build (offline, warnings as errors): ``python -m sphinx -W -b html docs docs/_build`` after ``pip install '.[docs]'``.
+Build (offline, warnings as errors, pages read and written on every core): ``python -m sphinx -W -j auto -b html docs
+docs/_build`` after ``pip install '.[docs]'``.
 The pages are Markdown (MyST), so ``tests/test_console_blocks.py`` runs their console blocks as it runs the README's;
 the gallery is built by running every script of ``examples/`` (sphinx-gallery); the API reference is autodoc (napoleon)
 over the packages in ``api_packages``, and ``_ext/api_check.py`` fails the build when one of their public functions or
@@ -30,7 +31,8 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
-    "sphinx-mathjax-offline",  # MathJax 3 copied into _static/mathjax and loaded from there, not from a CDN
+    "offline_maths",  # sphinx-mathjax-offline: MathJax 3 copied into _static/mathjax and loaded from there
+    "nav_tree",  # furo's navigation tree from tables of contents cut to what it shows (half the pages' CPU time)
     "sphinx.ext.viewcode",
     "sphinx.ext.intersphinx",
     "sphinx_gallery.gen_gallery",

@@ -45,12 +45,35 @@ _CHUNK = 1 << 14  # neck_radius solves large arrays in blocks of this many bonds
 
 @dataclass(frozen=True)
 class NeckGeometry:
-    """The full geometry of a sintered pair; every field is an array of the broadcast input shape (or a float).
+    """The full geometry of a sintered pair (:func:`neck_geometry`; Rojek 2022, eqs. 21-29).
 
-    a: neck radius; h_ci, h_cj: heights of the caps cut from sphere i and j (eqs. 28-29); h_n: neck (cylinder)
-    length (eq. 24); d: centre distance (eq. 21); z_i, z_j: distance from each centre to its cap's base plane, so the
-    neck spans ``z_i <= z <= z_i + h_n`` measured from centre i and ``z_i + h_n + z_j = d``; volume_residual:
-    ``|V_cyl - V_cap,i - V_cap,j| / V_cyl`` (eq. 22); iterations: Newton iterations taken (0 for Coble).
+    Every length field is an array of the broadcast input shape (a float for scalar input), in the unit of the input
+    lengths (m). The neck spans ``z_i <= z <= z_i + h_n`` measured from centre ``i`` along the line of centres, and
+    ``z_i + h_n + z_j = d``.
+
+    Parameters
+    ----------
+    r_i, r_j : numpy.ndarray or float
+        Radii of spheres ``i`` and ``j``, m.
+    h : numpy.ndarray or float
+        Overlap ``r_i + r_j - d`` (eq. 21), m.
+    a : numpy.ndarray or float
+        Neck radius, m.
+    h_ci, h_cj : numpy.ndarray or float
+        Heights of the caps cut from sphere ``i`` and from sphere ``j`` (eqs. 28-29), m.
+    h_n : numpy.ndarray or float
+        Length of the neck (the cylinder), ``h_ci + h_cj - h`` (eq. 24), m.
+    d : numpy.ndarray or float
+        Distance between the centres (eq. 21), m.
+    z_i, z_j : numpy.ndarray or float
+        Distance from centre ``i`` and from centre ``j`` to the base plane of its cap, ``sqrt(r^2 - a^2)``, m.
+    volume_residual : numpy.ndarray or float
+        ``|V_cyl - V_cap,i - V_cap,j| / V_cyl``, how far the neck is from conserving volume (eq. 22),
+        dimensionless: round-off for ``"newton"``, the model's error for ``"first"`` and ``"coble"``.
+    iterations : int
+        Newton iterations taken (0 for ``"coble"``, 1 for ``"first"``).
+    method : str
+        The neck model: ``"newton"``, ``"first"`` or ``"coble"`` (see :func:`neck_radius`).
     """
 
     r_i: np.ndarray
@@ -71,8 +94,28 @@ class NeckGeometry:
 def check_positive(name: str, value, upper=None, upper_name: str | None = None) -> np.ndarray:
     """Return ``value`` as a float array, raising ``ValueError`` unless every entry is finite and ``> 0``.
 
-    With ``upper`` also require ``value <= upper`` (``upper_name`` says what that bound is). The message names the
-    parameter, the first offending entry and the valid range.
+    The message names the parameter, the first offending entry (its flat index for an array) and the valid range.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name, as the message shows it.
+    value : float or array_like
+        The value to check, in any unit (the bound's).
+    upper : float or array_like, optional
+        If given, also require ``value <= upper`` entry by entry (broadcast against ``value``), in ``value``'s unit.
+    upper_name : str, optional
+        What the bound ``upper`` is, shown in parentheses after the range (e.g. ``"the smaller radius"``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``value`` as a float array (0-d for a scalar).
+
+    Raises
+    ------
+    ValueError
+        One line, ``"name[k] = value: valid range ..."``, if an entry is not finite, not ``> 0`` or above ``upper``.
     """
     arr = np.asarray(value, dtype=float)
     ok = (arr > 0.0) & (arr < np.inf)  # False for NaN as well
@@ -92,10 +135,24 @@ def check_positive(name: str, value, upper=None, upper_name: str | None = None) 
 
 
 def cap_height(r, a):
-    """Height of the spherical cap of radius ``r`` with base radius ``a`` (Rojek 2022, eqs. 28-29).
+    """Height of the spherical cap of radius ``r`` with base radius ``a``, ``r - sqrt(r^2 - a^2)`` (Rojek 2022,
+    eqs. 28-29).
 
     Written as ``a q / (1 + sqrt((1 - q)(1 + q)))`` with ``q = a / r`` (``= a^2 / (r + sqrt(r^2 - a^2))``): small
     caps keep full relative precision and no square of a length is formed, so any radius a float holds works.
+    Not checked: the caller keeps ``0 <= a <= r`` (for ``a > r`` the result, ``a^2 / r``, is no cap height).
+
+    Parameters
+    ----------
+    r : float or array_like
+        Radius of the sphere, m (any length unit, the same as ``a``'s).
+    a : float or array_like
+        Radius of the cap's base circle (the neck radius), m, ``0 <= a <= r``.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The cap height ``h_c``, m, ``0 <= h_c <= r``.
     """
     q = a / r
     return a * q / (1.0 + np.sqrt(np.maximum((1.0 - q) * (1.0 + q), 0.0)))
@@ -111,7 +168,18 @@ def _phi(h_c, r):
 def max_overlap(r_i, r_j):
     """Largest overlap ``h`` for which the cylindrical neck exists: ``a`` reaches ``min(r_i, r_j)``.
 
-    Equal spheres: ``2r/3`` (from eq. 18 with ``h_c = r``). Unequal: the smaller sphere's cap is a hemisphere.
+    Equal spheres: ``2r/3`` (from eq. 18 with ``h_c = r``, Rojek 2022, Section 4.2). Unequal: the smaller sphere's
+    cap is a hemisphere, and ``h`` is eq. (27) solved for it at ``a = min(r_i, r_j)``.
+
+    Parameters
+    ----------
+    r_i, r_j : float or array_like
+        Radii of the two spheres, m (> 0; not checked); arrays broadcast.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The largest overlap, m.
     """
     r_i = np.asarray(r_i, dtype=float)
     r_j = np.asarray(r_j, dtype=float)
@@ -123,8 +191,25 @@ def max_overlap(r_i, r_j):
 def overlap_for_neck(r_i, r_j, a):
     """Inverse of the volume-conserving neck: the overlap ``h`` at which the neck radius is ``a``.
 
-    From ``G(a) = 0``: ``h = phi(h_ci) + phi(h_cj)``; for equal spheres ``h = 2 h_c (3r - 2h_c) / (3 (2r - h_c))``,
-    which is eq. (18) solved for ``h``. Valid for ``0 < a <= min(r_i, r_j)``.
+    From ``G(a) = 0`` (eq. 27 divided by ``3 a^2``, module docstring): ``h = phi(h_ci) + phi(h_cj)``; for equal
+    spheres ``h = 2 h_c (3r - 2h_c) / (3 (2r - h_c))``, which is eq. (18) solved for ``h``.
+
+    Parameters
+    ----------
+    r_i, r_j : float or array_like
+        Radii of the two spheres, m, finite and > 0; arrays broadcast.
+    a : float or array_like
+        Neck radius, m, ``0 < a <= min(r_i, r_j)``.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The overlap ``h = r_i + r_j - d`` (eq. 21), m; a float for scalar input.
+
+    Raises
+    ------
+    ValueError
+        If a radius is not finite and > 0, or ``a`` is outside ``(0, min(r_i, r_j)]``.
     """
     r_i = check_positive("r_i", r_i)
     r_j = check_positive("r_j", r_j)
@@ -134,15 +219,45 @@ def overlap_for_neck(r_i, r_j, a):
 
 
 def coble_radius(r_i, r_j, h):
-    """Coble's neck radius ``sqrt(2 r* h)``, ``r* = 2 r_i r_j / (r_i + r_j)`` (Rojek 2022, eqs. 11-12)."""
+    """Coble's neck radius ``sqrt(2 r* h)``, ``r* = 2 r_i r_j / (r_i + r_j)`` (Rojek 2022, eqs. 11-12).
+
+    Not checked (:func:`neck_radius` with ``method="coble"`` checks its input); it does not conserve volume and
+    over-estimates the neck (eqs. 10-12).
+
+    Parameters
+    ----------
+    r_i, r_j : float or array_like
+        Radii of the two spheres, m; arrays broadcast.
+    h : float or array_like
+        Overlap ``r_i + r_j - d`` (eq. 21), m.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Coble's neck radius, m.
+    """
     return np.sqrt(4.0 * r_i * r_j / (r_i + r_j) * h)
 
 
 def equal_neck_radius(r, h):
     """Closed-form volume-conserving neck of two equal spheres (Rojek 2022, eqs. 18-20).
 
-    The small root of eq. (18) is written as ``2c / (b + sqrt(b^2 - 16c))`` with the discriminant factorised,
-    ``9(2r+h)^2 - 96rh = (2r - 3h)(18r - 3h)``, so it is accurate for small and for limiting overlaps alike.
+    The small root of eq. (18) (eq. 19) is written as ``2c / (b + sqrt(b^2 - 16c))`` with the discriminant
+    factorised, ``9(2r+h)^2 - 96rh = (2r - 3h)(18r - 3h)``, so it is accurate for small and for limiting overlaps
+    alike; the neck radius is then eq. (20). Not checked: :func:`neck_radius` of two equal radii gives the same
+    neck with its input checked.
+
+    Parameters
+    ----------
+    r : float or array_like
+        Radius of both spheres, m.
+    h : float or array_like
+        Overlap ``2r - d`` (eq. 13), m, ``0 < h <= 2r/3`` (at ``2r/3`` the neck reaches ``a = r``).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The neck radius ``a``, m.
     """
     r = np.asarray(r, dtype=float)
     h = np.asarray(h, dtype=float)
@@ -197,6 +312,20 @@ def newton_start(r_i, r_j, h, h_max):
     ``h_max``. Its root is approximated by the root of the quadratic ``c1 u + (h_max - c1) u^2 = h`` (also exact at
     both ends) and one Newton step on the cubic. The start is within ~1 % of the root over the whole range
     (Coble's within ~10 %), which saves two of the six Newton iterations Coble's start needs.
+
+    Parameters
+    ----------
+    r_i, r_j : float or numpy.ndarray
+        Radii of the two spheres in units of the smaller one (dimensionless; the smaller is 1).
+    h : float or numpy.ndarray
+        Overlap in units of the smaller radius (dimensionless), ``0 < h <= h_max``.
+    h_max : float or numpy.ndarray
+        Largest overlap of the model (:func:`max_overlap`) in units of the smaller radius (dimensionless).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The starting neck radius in units of the smaller radius (dimensionless), ``<= 1``.
     """
     inv_i, inv_j = 1.0 / r_i, 1.0 / r_j
     c1 = 0.25 * (inv_i + inv_j)
@@ -241,11 +370,32 @@ def _solve(r_i, r_j, h, method, h_max):
 
 
 def neck_radius(r_i, r_j, h, method: str = "newton"):
-    """Neck radius ``a`` of two spheres of radii ``r_i``, ``r_j`` overlapping by ``h`` (all in metres).
+    """Neck radius ``a`` of two spheres of radii ``r_i``, ``r_j`` overlapping by ``h``.
 
-    Vectorised over arrays (broadcast together); a scalar call returns a float. ``method`` is ``"newton"``
-    (volume-conserving, Rojek 2022 eqs. 27-33, default), ``"first"`` (eq. 34) or ``"coble"`` (eqs. 11-12).
-    Raises ``ValueError`` for non-positive or non-finite input, or ``h`` beyond :func:`max_overlap`.
+    Vectorised over arrays (broadcast together); a scalar call returns a float.
+
+    Parameters
+    ----------
+    r_i, r_j : float or array_like
+        Radii of the two spheres, m, finite and > 0.
+    h : float or array_like
+        Overlap ``r_i + r_j - d`` (Rojek 2022, eq. 21), m, ``0 < h <= max_overlap(r_i, r_j)``
+        (:func:`max_overlap`, where the neck reaches the smaller radius).
+    method : str, optional
+        The neck model: ``"newton"`` the volume-conserving cylindrical neck (eqs. 22-33, solved to round-off; the
+        default), ``"first"`` its first Newton iterate from Coble's radius (eq. 34), ``"coble"`` Coble's neck
+        (eqs. 10-12).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The neck radius, m (the input's length unit).
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``method``, a radius or overlap that is not finite and > 0, or ``h`` beyond
+        :func:`max_overlap`.
     """
     if method not in METHODS:
         raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
@@ -275,7 +425,28 @@ def _neck_radius_blocked(r_i, r_j, h, method):
 
 
 def neck_geometry(r_i, r_j, h, method: str = "newton") -> NeckGeometry:
-    """All of the neck geometry (Rojek 2022, eqs. 21-29); see :class:`NeckGeometry`."""
+    """All of the neck geometry (Rojek 2022, eqs. 21-29); see :class:`NeckGeometry`.
+
+    Parameters
+    ----------
+    r_i, r_j : float or array_like
+        Radii of the two spheres, m, finite and > 0; arrays broadcast.
+    h : float or array_like
+        Overlap ``r_i + r_j - d`` (eq. 21), m, ``0 < h <= max_overlap(r_i, r_j)``.
+    method : str, optional
+        The neck model, as for :func:`neck_radius` (default ``"newton"``).
+
+    Returns
+    -------
+    NeckGeometry
+        Neck radius, cap heights, neck length, centre distance, the cap planes' distances from the centres and the
+        volume residual, each of the broadcast input shape.
+
+    Raises
+    ------
+    ValueError
+        As :func:`neck_radius`.
+    """
     if method not in METHODS:
         raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
     R_i, R_j, H = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (r_i, r_j, h)))
