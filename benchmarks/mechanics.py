@@ -57,6 +57,7 @@ from numba import njit
 
 from dem.engines.contact_forces import forces
 from dem.laws.contact import luding as law
+from dem.laws.contact.binding import ContactLaw
 from dem.laws.contact.luding import LUDING_TABLE1, LudingMaterial
 from verification.report import md_table
 
@@ -257,13 +258,13 @@ def time_ours(make, steps: int, warmup: int) -> dict:
 
 
 @njit  # not cached: numba's cache follows only this file, so a cached copy would keep an old engine's code
-def _force_passes(count, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_fn, p_ft,
+def _force_passes(count, contact_law, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_fn, p_ft,
                   p_const, wn, wq, wdq, wforce, wk, wm, w_hist, w_fn, w_ft, params, dt):
     """``count`` force passes of the engine's loop (:func:`dem.engines.contact_forces.forces`) in one compiled call
     (the pairs' constants computed in the first, as the engine's loop does at a call's first step)."""
     for _ in range(count):
-        forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist, p_fn, p_ft,
-               p_const, _ == 0, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params, dt)
+        forces(contact_law, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist,
+               p_fn, p_ft, p_const, _ == 0, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params, dt)
 
 
 @njit  # not cached (as above)
@@ -291,7 +292,7 @@ def stage_costs(sample: dict, material: LudingMaterial, steps: int) -> dict:
     mech.advance(steps, T0, rate)
     whole = time.process_time() - t0
     rebuilds = mech.rebuilds - rebuilds
-    forces_args = (s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, mech.particle_state, s.T,
+    forces_args = (ContactLaw("luding"), s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, mech.particle_state, s.T,
                    mech.gravity, mech.box, mech.pi, mech.pj, mech.p_hist, mech.p_fn, mech.p_ft, mech.p_const, w.normal,
                    w.q, w.dq, w.force, mech.wk, mech.wm, mech.w_hist, mech.w_fn, mech.w_ft, mech.params, mech.dt)
     material_args = (mech.t, T0, rate, s.T, s.radius, s.radius_ref, mech.particle_state, True, mech.params,

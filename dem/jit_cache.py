@@ -86,7 +86,7 @@ def _imports(root: pathlib.Path, path: pathlib.Path) -> tuple[set[pathlib.Path],
 
 def _sources(package: pathlib.Path) -> list[pathlib.Path]:
     """The package's source files, without ``__pycache__`` (where the cache itself lives, and with it the loops
-    :mod:`dem.engines.compiled` copies for each contact law: were they sources, writing them would change the key)."""
+    :mod:`dem.engines.compiled` copies for more than one thread: were they sources, writing them would change the key)."""
     return sorted(p for p in package.rglob("*.py") if "__pycache__" not in p.relative_to(package).parts)
 
 

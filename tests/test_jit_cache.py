@@ -68,10 +68,10 @@ def test_an_edit_outside_compiled_code_keeps_the_key(copy):
 
 
 def test_the_loops_copied_into_the_cache_keep_the_key(copy):
-    """dem.engines.compiled writes a copy of the loops for each contact law into the cache folder, inside the
-    package: the key of that folder must not follow them (else every run of such a law would compile afresh)."""
+    """dem.engines.compiled writes a copy of the loops for more than one thread into the cache folder, inside the
+    package: the key of that folder must not follow them (else every threaded run would compile afresh)."""
     before = jit_cache.remembered_digest(copy)
-    copied = copy / "__pycache__" / f"numba-{before}" / "specialised" / "jkr" / "contact_forces.py"
+    copied = copy / "__pycache__" / f"numba-{before}" / "threaded" / "contact_forces.py"
     copied.parent.mkdir(parents=True)
     copied.write_text((copy / "engines" / "contact_forces.py").read_text())
     assert jit_cache.digest(copy) == jit_cache.remembered_digest(copy) == before

@@ -13,6 +13,7 @@ from scipy.optimize import brentq, minimize_scalar
 from dem.driver import run
 from dem.engines.verlet.engine import VerletEngine
 from dem.laws.contact import jkr
+from dem.laws.contact.adhesion import jkr as adhesion
 from dem.scene import parse_scene, state_file
 from test_hertz_mindlin import DENSITY, E_STAR, MATERIAL, contact, head_on, run_recording, scene_doc, sphere_mass
 
@@ -68,11 +69,11 @@ def test_force_overlap_curve_is_jkrs(params):
     for a in np.concatenate([np.linspace(1.05 * a_c, a0, 7), np.geomspace(a0, 200 * a0, 7)]):
         (f_n, *_), _ = _force_at(params, overlap(a, r_eff))
         assert f_n == pytest.approx(force(a, r_eff), rel=1e-9, abs=1e-12 * force(a0 * 2, r_eff))
-    assert jkr.contact_radius(overlap(3 * a0, r_eff), r_eff, C) == pytest.approx(3 * a0, rel=1e-13)
+    assert adhesion.contact_radius(overlap(3 * a0, r_eff), r_eff, C) == pytest.approx(3 * a0, rel=1e-13)
     # zero force at delta_0 = a_0^2/(3 R*); far in, Hertz: a -> sqrt(R* delta)
     assert _force_at(params, a0 * a0 / (3 * r_eff))[0][0] == pytest.approx(0.0, abs=1e-12 * force(2 * a0, r_eff))
     delta = 1e4 * a0 * a0 / r_eff
-    assert jkr.contact_radius(delta, r_eff, C) / math.sqrt(r_eff * delta) == pytest.approx(1.0, abs=0.02)
+    assert adhesion.contact_radius(delta, r_eff, C) / math.sqrt(r_eff * delta) == pytest.approx(1.0, abs=0.02)
 
 
 def test_pull_off_force_is_three_halves_pi_w_r_star(params):
@@ -177,7 +178,7 @@ def test_energy_is_conserved_while_adhered_without_damping():
     total = []
     for x, v in zip(rec["x"], rec["v"]):
         delta = 2 * R - (x[1, 0] - x[0, 0])
-        a = jkr.contact_radius(delta, r_eff, C)
+        a = adhesion.contact_radius(delta, r_eff, C)
         total.append(0.5 * m_eff * (v[1, 0] - v[0, 0]) ** 2 + energy(a, r_eff))
     total = np.array(total) - energy(a0, r_eff)
     assert np.ptp(total) < 1e-4 * total[0]  # velocity Verlet: O(dt^2)

@@ -1,60 +1,53 @@
-"""The compiled loops of the engines, specialised for a contact law.
+"""The compiled loops of the engines, bound to a contact law and to one or more threads.
 
 The force loop (:mod:`dem.engines.contact_forces`), the velocity-Verlet loop (:mod:`dem.engines.verlet.loop`) and the
-implicit iteration (:mod:`dem.engines.staggered.kernels`) are written against one contact law, imported in each as
-``from dem.laws.contact import luding as law`` (or importing a template that does). For that law they are used as
-they are. For every other law
-(:data:`dem.laws.contact.CONTACT_LAWS`) :func:`module` writes a copy of each with only that import changed (and their
-imports of each other pointed at the copies) and loads it: numba then compiles the law's kernels inlined into a loop
-of its own -- the law is bound at compile time, nothing is dispatched at run time -- and caches it on disk like any
-module, which it cannot do for a loop made by a Python closure (a closure's compiled code is never found in the cache
-by another process). The copies live in the cache folder of :mod:`dem.jit_cache`, named by the digest of the sources
-they come from, so an edit to a template or a law makes new ones; a law is copied and compiled only when a scene
-uses it.
+implicit iteration (:mod:`dem.engines.staggered.kernels`) take the contact law as their first argument, a
+:class:`dem.laws.contact.binding.ContactLaw`: each law is a numba type of its own, so numba compiles (and caches on
+disk) a loop for each law with the law's kernels inlined -- the law is bound at compile time, nothing is dispatched at
+run time. :func:`loop` hands an engine a template's loop with its law bound.
 
-For more than one thread, ``module(law, template, threaded=True)`` is a copy (for every law, the template's own
-too) with the template's ``THREADED = False`` made true: a compile-time constant that turns its loops over particles
-and pairs into numba's parallel loops (numba drops the branches it rules out, so the one-thread loop carries nothing
-of the threaded one). Which of the two a run gets is decided when the engine is built
-(:func:`sinterheat.threads.count`), never inside the loop.
+For more than one thread, :func:`module` with ``threaded=True`` is a copy of the template with its ``THREADED =
+False`` made true: a compile-time constant that turns its loops over particles and pairs into numba's parallel loops
+(numba drops the branches it rules out, so the one-thread loop carries nothing of the threaded one), and its imports
+of the other templates pointed at their threaded copies. The copies live in the cache folder of
+:mod:`dem.jit_cache`, named by the digest of the sources they come from, so an edit to a template makes new ones.
+Which of the two a run gets is decided when the engine is built (:func:`sinterheat.threads.count`), never inside the
+loop.
 """
+
 
 from __future__ import annotations
 
+import functools
 import importlib
 import importlib.util
 import os
 import pathlib
 import sys
 
-from dem.laws.contact import law_module_name
+from dem.laws.contact.binding import ContactLaw
 
 TEMPLATES = ("dem.engines.contact_forces", "dem.engines.verlet.loop", "dem.engines.staggered.kernels")
-TEMPLATE_LAW = "dem.laws.contact.luding"
-LAW_IMPORT = "from dem.laws.contact import luding as law"
 SERIAL_FLAG, THREADED_FLAG = "\nTHREADED = False", "\nTHREADED = True"
 
 
-def _copy_name(law: str, template: str, threaded: bool) -> str:
-    return f"_dem_compiled_{law}{'_threaded' if threaded else ''}_{template.replace('.', '_')}"
+def _copy_name(template: str) -> str:
+    return f"_dem_compiled_threaded_{template.replace('.', '_')}"
 
 
-def _folder(law: str, threaded: bool) -> pathlib.Path:
-    """Where the copies for ``law`` live: in numba's cache folder, which :func:`dem.jit_cache.configure` named by
-    the digest of the sources."""
+def _folder() -> pathlib.Path:
+    """Where the threaded copies live: in numba's cache folder, which :func:`dem.jit_cache.configure` named by the
+    digest of the sources."""
     from numba.core import config
 
-    return pathlib.Path(config.CACHE_DIR) / "specialised" / (f"{law}-threaded" if threaded else law)
+    return pathlib.Path(config.CACHE_DIR) / "threaded"
 
 
-def module(law: str, template: str, threaded: bool = False):
-    """The module ``template`` (one of ``TEMPLATES``) compiled for the contact law named ``law``; ``threaded``:
-    its copy for more than one thread (module docstring).
+def module(template: str, threaded: bool = False):
+    """The module ``template`` (one of ``TEMPLATES``), or its copy for more than one thread (module docstring).
 
     Parameters
     ----------
-    law : str
-        The contact law (:data:`dem.laws.contact.CONTACT_LAWS`).
     template : str
         The dotted name of the template module, one of ``TEMPLATES``.
     threaded : bool
@@ -63,32 +56,19 @@ def module(law: str, template: str, threaded: bool = False):
     Returns
     -------
     object
-        The compiled module.
-
-    Raises
-    ------
-    ValueError
-        ``law`` is not a known contact law.
-    RuntimeError
-        The template imports its contact law more than once.
+        The module.
     """
-    law_path = law_module_name(law)
-    if law_path == TEMPLATE_LAW and not threaded:
+    if not threaded:
         return importlib.import_module(template)
-    name = _copy_name(law, template, threaded)
+    name = _copy_name(template)
     if name in sys.modules:
         return sys.modules[name]
-    source = pathlib.Path(importlib.util.find_spec(template).origin).read_text()
-    if source.count(LAW_IMPORT) > 1:
-        raise RuntimeError(f"{template}: imports its contact law more than once as {LAW_IMPORT!r}")
-    source = source.replace(LAW_IMPORT, f"import {law_path} as law")
-    if threaded:
-        source = source.replace(SERIAL_FLAG, THREADED_FLAG)
+    source = pathlib.Path(importlib.util.find_spec(template).origin).read_text().replace(SERIAL_FLAG, THREADED_FLAG)
     for other in TEMPLATES:
         if f"from {other} import" in source:
-            module(law, other, threaded)  # loaded first: the copy imports it by name
-            source = source.replace(f"from {other} import", f"from {_copy_name(law, other, threaded)} import")
-    path = _folder(law, threaded) / f"{template.rsplit('.', 1)[1]}.py"
+            module(other, threaded)  # loaded first: the copy imports it by name
+            source = source.replace(f"from {other} import", f"from {_copy_name(other)} import")
+    path = _folder() / f"{template.rsplit('.', 1)[1]}.py"
     if not path.exists() or path.read_text() != source:
         path.parent.mkdir(parents=True, exist_ok=True)
         part = path.with_name(f"{path.name}.{os.getpid()}.part")
@@ -103,3 +83,30 @@ def module(law: str, template: str, threaded: bool = False):
         del sys.modules[name]
         raise
     return loaded
+
+
+def loop(law: str, template: str, function: str, threaded: bool = False):
+    """The compiled loop ``function`` of ``template`` with the contact law ``law`` bound as its first argument.
+
+    Parameters
+    ----------
+    law : str
+        The contact law (:data:`dem.laws.contact.CONTACT_LAWS`).
+    template : str
+        The dotted name of the template module, one of ``TEMPLATES``.
+    function : str
+        The loop's name in the template (``"forces"``, ``"advance"``, ``"iterate"``).
+    threaded : bool
+        Whether the copy for more than one thread is wanted.
+
+    Returns
+    -------
+    functools.partial
+        The loop, to be called with its arguments after the law.
+
+    Raises
+    ------
+    ValueError
+        ``law`` is not a known contact law.
+    """
+    return functools.partial(getattr(module(template, threaded), function), ContactLaw(law))

@@ -2,9 +2,9 @@
 loop of every engine that moves particles.
 
 The loop does the geometry and the bookkeeping; the contact law (:mod:`dem.laws.contact`) does the physics through its
-kernels, bound at compile time: this module is written against the law imported as ``law`` below, and
-:mod:`dem.engines.compiled` makes a copy of it for every other law, with only that import changed, so that numba
-inlines each law's kernels into a loop of its own (no dispatch at run time) and caches it like any other module.
+kernels, bound at compile time: the loop takes the law as its first argument, whose numba type names the law
+(:mod:`dem.laws.contact.binding`), so that numba inlines each law's kernels into a loop of its own (no dispatch at run
+time) and caches it under the law's signature.
 
 Contact geometry (Luding 2005, eqs. 3, 17-18): ``n`` points from j to i, the overlap is ``delta = a_i + a_j -
 |x_i - x_j|``, the relative surface velocity ``v_ij = v_i - v_j + l_i n x omega_i + l_j n x omega_j``; the force on
@@ -14,7 +14,7 @@ angular momentum exactly (with ``a`` it would create ``-delta n x f_t``; the dif
 wall is the partner j with an infinite radius, moving along its normal. A pair acts while its surfaces are closer
 than the law's ``reach``, a particle-wall pair while closer than its ``wall_reach`` (0: while they overlap; an
 adhesive law holds a contact beyond touching until it breaks); the laws whose particles do not rotate
-(``law.SPINS`` false) get no torques.
+(its ``SPINS`` false) get no torques.
 
 Latency: a pair's geometry (a square root, then divisions) and its law form one long chain of dependent
 operations, and the processor overlaps two pairs only as far as its window of instructions reaches. So the
@@ -40,20 +40,17 @@ import math
 
 import numpy as np
 from numba import njit, prange
-from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from dem.geometry.neighbours import min_image
-from dem.laws.contact import luding as law
+from dem.laws.contact import binding
 
 # The force loop's floating-point flags: no NaN, no infinity (positions are checked finite before forces are
 # computed), no signed zeros. They let the compiler drop products with a zero it knows (the y terms of 2D disks),
 # and change no result: without reassociation, contraction or approximate reciprocals every operation on finite
 # numbers stays the IEEE one.
 FINITE_MATH = {"nnan", "ninf", "nsz"}
-N_PARAMS = law.N_PARAMS
 THREADED = False  # True in the copies for more than one thread (dem.engines.compiled)
 LOAD_COLUMNS = 9  # a pair's row of the threaded loop's buffer: g = f_n n + f_t (3), n x f_t (3), l_i, l_j, closed
-KEEPS_PAIR_CONSTANTS = len(law.PAIR_CONSTANTS) > 0  # the law's pair_constants are kept per pair, in (M, 2)
 
 
 @njit(cache=True)
@@ -98,14 +95,14 @@ def split_incidences(pi, pj, n, n_blocks):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="always")
-def add_pair_share(f, tau, k, sign, g0, g1, g2, arm, m0, m1, m2, planar):
+def add_pair_share(law, f, tau, k, sign, g0, g1, g2, arm, m0, m1, m2, planar):
     """Particle ``k``'s share of a pair's force and torque: ``sign g`` into its force (``sign`` +1 for the pair's i,
     -1 for its j) and ``-arm (n x f_t)`` into its torque, ``arm`` its lever ``l_i`` or ``l_j`` (module docstring).
     (``x - g`` and ``x + (-1) g`` are the same number.)"""
     f[k, 0] += sign * g0
     f[k, 1] += sign * g1
     f[k, 2] += sign * g2
-    if law.SPINS:
+    if binding.spins(law):
         tau[k, 1] -= arm * m1
         if not planar:
             tau[k, 0] -= arm * m0
@@ -127,10 +124,11 @@ def pair_geometry(c, x, pi, pj, box, planar):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, parallel=THREADED)
-def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft,
+def forces(law, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft,
            p_const, fresh, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True,
            start=None, pairs=None, load=None, owner=None, n_blocks=1):
-    """Forces and torques of the current state (gravity, the law's drag, pairs, the listed particle-wall pairs
+    """Forces and torques of the current state under the contact law ``law`` (a
+    :class:`~dem.laws.contact.binding.ContactLaw`): gravity, the law's drag, pairs, the listed particle-wall pairs
     ``(wk, wm)``); the normal forces on the walls go into ``wforce``. Returns the index into the wall list of the
     first particle whose centre lies behind its wall, else -1.
 
@@ -138,7 +136,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
     arrays for a step that is taken (velocity Verlet), others for an iterate that may be discarded (the implicit
     scheme). With ``record`` the contact forces are kept (``p_fn``, ``p_ft``, ``w_fn``, ``w_ft``: outputs only, so
     a time loop records them on the last step of a call). ``p_const`` (M, 2) holds the listed pairs' numbers that
-    depend on their radii alone (``law.pair_constants``, where the law keeps any): ``fresh`` computes them (and keeps
+    depend on their radii alone (the law's ``pair_constants``, where it keeps any): ``fresh`` computes them (and keeps
     them there when it has rows), else they are read from there; a time loop passes ``fresh`` where the radii or the
     list changed. ``spin_axes`` (:attr:`dem.geometry.motion.MotionState.spin_axes`): ``(1,)`` for 2D disks in the x-z
     plane, whose pair terms along y vanish.
@@ -154,10 +152,10 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
     planar = len(spin_axes) == 1
     escaped = -1
     n = x.shape[0]
-    params = to_fixed_tuple(params, N_PARAMS)
+    params = binding.params_tuple(law, params)
     for k in range(n):
-        if law.DRAG:
-            drag = law.drag(k, radius, params)
+        if binding.has_drag(law):
+            drag = binding.drag(law, k, radius, params)
             f[k, 0] = mass[k] * gravity[0] - drag * v[k, 0]
             f[k, 1] = mass[k] * gravity[1] - drag * v[k, 1]
             f[k, 2] = mass[k] * gravity[2] - drag * v[k, 2]
@@ -181,15 +179,15 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
             if c + 1 < stop:
                 ahead = pair_geometry(c + 1, x, pi, pj, box, planar)
             ri, rj = radius[i], radius[j]
-            if KEEPS_PAIR_CONSTANTS and not fresh:  # (read here, not by the law: an array passed to a kernel costs)
+            if binding.keeps_pair_constants(law) and not fresh:  # (read here: an array passed to a kernel costs)
                 const = (p_const[c, 0], p_const[c, 1])
             else:  # every listed pair's: it may close later
-                const = law.pair_constants(ri, rj, params)
-                if KEEPS_PAIR_CONSTANTS and p_const.shape[0]:
+                const = binding.pair_constants(law, ri, rj, params)
+                if binding.keeps_pair_constants(law) and p_const.shape[0]:
                     p_const[c, 0], p_const[c, 1] = const
-            cut = ri + rj + law.reach(c, p_hist_in, ri, rj, params)
+            cut = ri + rj + binding.reach(law, c, p_hist_in, ri, rj, params)
             if d2 >= cut * cut or d2 == 0.0:
-                law.forget_pair(c, p_hist_in, p_hist)  # the contact opened: it forgets its history
+                binding.forget_pair(law, c, p_hist_in, p_hist)  # the contact opened: it forgets its history
                 if record:
                     p_fn[c] = 0.0
                     p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = 0.0, 0.0, 0.0
@@ -206,11 +204,12 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
             vr1 = 0.0 if planar else v[i, 1] - v[j, 1] + n2 * c0 - n0 * c2
             vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
             vn = vr0 * n0 + vr1 * n1 + vr2 * n2
-            f_n, ft0, ft1, ft2 = law.pair_force(c, i, j, p_hist_in, p_hist, state, T, delta, d, (n0, n1, n2),
+            f_n, ft0, ft1, ft2 = binding.pair_force(law, c, i, j, p_hist_in, p_hist, state, T, delta, d, (n0, n1, n2),
                                                 (vr0, vr1, vr2), vn, ri, rj, planar, dt, params, const)
-            if record:
+            if record:  # (2D disks: the y force recorded as +0 on any number of threads; under the flag nsz the
+                # compiler may give a zero either sign, and it compiles the threaded loop's body on its own)
                 p_fn[c] = f_n
-                p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, ft1, ft2
+                p_ft[c, 0], p_ft[c, 1], p_ft[c, 2] = ft0, 0.0 if planar else ft1, ft2
             g0, g1, g2 = f_n * n0 + ft0, f_n * n1 + ft1, f_n * n2 + ft2
             # torques -l n x f_t on both (the lever arms -l_i n and +l_j n, the forces f_t and -f_t)
             m0, m1, m2 = n1 * ft2 - n2 * ft1, n2 * ft0 - n0 * ft2, n0 * ft1 - n1 * ft0
@@ -221,9 +220,9 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
                     load[c, 0], load[c, 1], load[c, 2], load[c, 3], load[c, 4], load[c, 5] = g0, g1, g2, m0, m1, m2
                     load[c, 6], load[c, 7], load[c, 8] = li, lj, 1.0
             if add_i:
-                add_pair_share(f, tau, i, 1.0, g0, g1, g2, li, m0, m1, m2, planar)
+                add_pair_share(law, f, tau, i, 1.0, g0, g1, g2, li, m0, m1, m2, planar)
             if add_j:
-                add_pair_share(f, tau, j, -1.0, g0, g1, g2, lj, m0, m1, m2, planar)
+                add_pair_share(law, f, tau, j, -1.0, g0, g1, g2, lj, m0, m1, m2, planar)
     if THREADED:
         for k in range(n):  # each particle the rows of its pairs in later blocks, in the order of the list
             for e in range(start[k], start[k + 1]):
@@ -232,7 +231,7 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
                 c = c if c >= 0 else ~c
                 if load[c, 8] == 0.0:
                     continue
-                add_pair_share(f, tau, k, sign, load[c, 0], load[c, 1], load[c, 2], load[c, arm], load[c, 3],
+                add_pair_share(law, f, tau, k, sign, load[c, 0], load[c, 1], load[c, 2], load[c, arm], load[c, 3],
                                load[c, 4], load[c, 5], planar)
     n_w = wn.shape[0]
     for m in range(n_w):
@@ -245,8 +244,8 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         if dist < 0.0 and escaped < 0:
             escaped = e
         delta = rk - dist
-        if delta <= -law.wall_reach(k, m, w_hist_in, rk, params):
-            if law.forget_wall(k, m, w_hist_in, w_hist):  # (rare: a wall contact opening)
+        if delta <= -binding.wall_reach(law, k, m, w_hist_in, rk, params):
+            if binding.forget_wall(law, k, m, w_hist_in, w_hist):  # (rare: a wall contact opening)
                 w_fn[k, m] = 0.0
                 w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = 0.0, 0.0, 0.0
             continue
@@ -255,14 +254,14 @@ def forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi,
         vr1 = v[k, 1] - wdq[m] * n1 + lk * (n2 * w[k, 0] - n0 * w[k, 2])
         vr2 = v[k, 2] - wdq[m] * n2 + lk * (n0 * w[k, 1] - n1 * w[k, 0])
         vn = vr0 * n0 + vr1 * n1 + vr2 * n2
-        f_n, ft0, ft1, ft2 = law.wall_force(k, m, w_hist_in, w_hist, state, T, delta, dist, (n0, n1, n2),
+        f_n, ft0, ft1, ft2 = binding.wall_force(law, k, m, w_hist_in, w_hist, state, T, delta, dist, (n0, n1, n2),
                                             (vr0, vr1, vr2), vn, rk, dt, params)
         w_fn[k, m] = f_n
         w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = ft0, ft1, ft2
         f[k, 0] += f_n * n0 + ft0
         f[k, 1] += f_n * n1 + ft1
         f[k, 2] += f_n * n2 + ft2
-        if law.SPINS:
+        if binding.spins(law):
             tau[k, 0] -= lk * (n1 * ft2 - n2 * ft1)
             tau[k, 1] -= lk * (n2 * ft0 - n0 * ft2)
             tau[k, 2] -= lk * (n0 * ft1 - n1 * ft0)

@@ -2,8 +2,8 @@
 step (eqs. 22-27) with the forces of the contact law (:func:`dem.engines.contact_forces.forces`), and the touching
 pairs of the Verlet list.
 
-Like :mod:`dem.engines.contact_forces`, this module is compiled for each contact law (:mod:`dem.engines.compiled`):
-its import of the force loop is pointed at the law's copy.
+Like :mod:`dem.engines.contact_forces`, the iteration takes the contact law as its first argument, bound at compile
+time (:mod:`dem.laws.contact.binding`).
 """
 
 from __future__ import annotations
@@ -16,14 +16,14 @@ from numba import njit
 from dem.engines.contact_forces import forces
 from dem.geometry.neighbours import min_image
 
-NO_PAIR_CONSTANTS = np.empty((0, 0))  # the pairs' numbers of the radii are computed at every force evaluation
 
 
 @njit(cache=True, error_model="numpy")
-def iterate(dt, phi, x_L, v_L, f_L, x_prev, v_prev, T, mass, radius, gravity, pi, pj, p_hist_in, p_hist, p_fn,
+def iterate(law, dt, phi, x_L, v_L, f_L, x_prev, v_prev, T, mass, radius, gravity, pi, pj, p_hist_in, p_hist, p_fn,
             p_ft, wn, wq, wdq, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, f, w, tau, spin_axes, state, box, wforce,
             x_new, v_new, x_ref, stats):
-    """One fixed-point iteration K of the trapezoidal step (Zohdi 2014, eqs. 22-27): the forces at the previous
+    """One fixed-point iteration K of the trapezoidal step (Zohdi 2014, eqs. 22-27) under the contact law ``law``:
+    the forces at the previous
     iterate ``(x_prev, v_prev)`` (with the walls where they are at the end of the step; the contacts' histories read
     from ``p_hist_in``/``w_hist_in``, those of the step's start, and written to ``p_hist``/``w_hist``), then::
 
@@ -33,8 +33,10 @@ def iterate(dt, phi, x_L, v_L, f_L, x_prev, v_prev, T, mass, radius, gravity, pi
     ``stats`` receives ``sum |r^K - r^(K-1)|``, ``sum |r^K - r^L|`` (Algorithm 1, step 4a), the largest distance of
     any particle from ``x_ref`` (where the Verlet list was built) and a NaN flag. Returns the escaped wall pair index
     of :func:`~dem.engines.contact_forces.forces` (-1 if none)."""
-    escaped = forces(x_prev, v_prev, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in,
-                     p_hist, p_fn, p_ft, NO_PAIR_CONSTANTS, True, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn,
+    # (the pairs' numbers of the radii computed at every evaluation: no room kept, an empty array made here, as a
+    # global one would be read-only to numba)
+    escaped = forces(law, x_prev, v_prev, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in,
+                     p_hist, p_fn, p_ft, np.empty((0, 0)), True, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn,
                      w_ft, params, dt)
     change, motion, reach, finite = 0.0, 0.0, 0.0, 1.0
     for k in range(x_L.shape[0]):

@@ -24,12 +24,13 @@ import math
 import numpy as np
 
 from dem.engines import compiled
-from dem.engines.staggered.kernels import NO_PAIR_CONSTANTS
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, max_displacement, restore_lists, verlet_pairs, wall_pairs
 from dem.geometry.periodic import PeriodicBox
 from dem.geometry.walls import MOTIONS, WallArrays
 from dem.laws.contact import law_module
+
+NO_PAIR_CONSTANTS = np.empty((0, 0))  # the pairs' numbers of the radii are computed at every force evaluation
 
 
 class StaggeredMechanics:
@@ -73,8 +74,8 @@ class StaggeredMechanics:
                 raise ValueError(f"walls.{wall.name}.motion = \"stress\": the Zohdi 2014 scheme moves walls by "
                                  f"prescribed kinematics only (fixed, strain, vibrate)")
         self.law = law_module(material.law)
-        self._forces = compiled.module(material.law, "dem.engines.contact_forces").forces
-        self._iterate = compiled.module(material.law, "dem.engines.staggered.kernels").iterate
+        self._forces = compiled.loop(material.law, "dem.engines.contact_forces", "forces")
+        self._iterate = compiled.loop(material.law, "dem.engines.staggered.kernels", "iterate")
         self.params = np.ascontiguousarray(material.params(), dtype=float)
         self.gravity = np.asarray(gravity, dtype=float)
         self.skin = float(skin)

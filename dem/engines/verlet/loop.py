@@ -10,14 +10,14 @@ step:
 1. half kick and drift: ``v += dt/2 f/m``, ``x += dt v`` (and ``omega += dt/2 tau/I``); walls move by their law
    (:mod:`dem.geometry.walls`);
 2. material state: the temperature ``T_i(t) = T0_i + rate_i (t - t_first)`` and what the contact law makes of it
-   (``law.update_particles``; Luding 2005: the radius ``a(T)``, eq. 9, the stiffness factor ``k1(T, t)/k1`` relaxed
+   (the law's ``update_particles``; Luding 2005: the radius ``a(T)``, eq. 9, the stiffness factor ``k1(T, t)/k1`` relaxed
    towards ``k1(T)/k1``, eqs. 10-12);
 3. forces: gravity, every listed pair and every particle-wall contact by the contact law, summed into forces and
    torques (:func:`dem.engines.contact_forces.forces`);
 4. second half kick (velocities at the end of the step); stress-controlled walls from eq. 1.
 
-Like :mod:`dem.engines.contact_forces`, this module is written against the contact law imported as ``law`` and
-copied for every other law by :mod:`dem.engines.compiled`; its copies for more than one thread call the threaded
+Like :mod:`dem.engines.contact_forces`, the loop takes the contact law as its first argument, bound at compile time
+(:mod:`dem.laws.contact.binding`); its copy for more than one thread (:mod:`dem.engines.compiled`) calls the threaded
 force pass, which runs on all of numba's threads with the same results to the bit (:mod:`dem.engines.contact_forces`).
 The kicks and the drift stay on one thread: they take a few ns per particle, less than numba's threads may take to
 start a parallel loop (about 1 us on GNU OpenMP, 0.1 ms on numba's ``workqueue``: :mod:`sinterheat.threads`), so a
@@ -32,7 +32,7 @@ from numba import njit
 
 from dem.engines.contact_forces import forces
 from dem.geometry.neighbours import min_image
-from dem.laws.contact import luding as law
+from dem.laws.contact import binding
 
 DONE, REBUILD, NONFINITE, ESCAPED = 0, 1, 2, 3  # how a call of advance() ended
 
@@ -51,12 +51,12 @@ def wall_acceleration(m, wq, wdq, wmode, wpress, wmass, wdamp, wspan, wforce):
 
 
 @njit(cache=True, error_model="numpy")
-def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_mass, inv_inertia, axes, spin_axes, radius,
+def advance(law, n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_mass, inv_inertia, axes, spin_axes, radius,
             radius_ref, T0, T_rate, T, state, uniform_T, t0, gravity, box, pi, pj, p_hist, p_fn, p_ft, p_const, start,
             pairs, load, owner, n_blocks,
             wn, wq, wdq, wacc, wmode, wpress, wmass, wdamp, wq0, wamp, wfreq, wspan, wforce, wk, wm, wq_ref,
             w_hist, w_fn, w_ft, params, x_ref, skin, info):
-    """Up to ``n_steps`` velocity-Verlet steps (module docstring) from global step ``step0`` (t = step0 dt) of an
+    """Up to ``n_steps`` velocity-Verlet steps (module docstring) under the contact law ``law`` from global step ``step0`` (t = step0 dt) of an
     interval that began at step ``first`` with temperatures ``T0`` (``T0 + T_rate (t - first dt)`` after it): times
     come from step counts, so where a run is split into calls (rebuilds, a resume) never changes its arithmetic.
     ``f``/``tau``/``wacc`` must hold the forces of the current state on entry. Returns ``(steps done, status)``;
@@ -105,10 +105,10 @@ def advance(n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_mass,
                 phase = 2.0 * math.pi * wfreq[m] * (t + dt)
                 wq[m] = wq0[m] + wamp[m] * math.sin(phase)
                 wdq[m] = 2.0 * math.pi * wfreq[m] * wamp[m] * math.cos(phase)
-        resized = law.update_particles((step0 + s + 1 - first) * dt, T0, T_rate, T, radius, radius_ref, state,
-                                       uniform_T, params, t0, dt)
+        resized = binding.update_particles(law, (step0 + s + 1 - first) * dt, T0, T_rate, T, radius, radius_ref, state,
+                                            uniform_T, params, t0, dt)
         fresh = s == 0 or resized
-        escaped = forces(x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist,
+        escaped = forces(law, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist,
                          p_fn, p_ft, p_const, fresh, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params,
                          dt, s == n_steps - 1, start, pairs, load, owner, n_blocks)
         worst = 0.0

@@ -84,10 +84,10 @@ class MechanicalModel:
         self.state = state
         self.walls = tuple(walls)
         self.law = law_module(material.law)
-        self._forces = compiled.module(material.law, "dem.engines.contact_forces").forces
+        self._forces = compiled.loop(material.law, "dem.engines.contact_forces", "forces")
         self.n_threads = threads.bind_numba()
         self.threaded = self.n_threads > 1 and state.n >= THREADED_MIN_PARTICLES
-        self._advance = compiled.module(material.law, "dem.engines.verlet.loop", self.threaded).advance
+        self._advance = compiled.loop(material.law, "dem.engines.verlet.loop", "advance", self.threaded)
         self.params = np.ascontiguousarray(material.params(), dtype=float)
         self.dt = float(dt)
         self.skin = float(skin)

@@ -1,6 +1,6 @@
 """Contact laws of particles that move, as plug-ins: each law is one module, registered by one line of
 :data:`CONTACT_LAWS`, and the engines' compiled loops take its kernels in at compile time
-(:mod:`dem.engines.compiled`).
+(:mod:`dem.laws.contact.binding`).
 
 A contact law module defines (SI units; forces on particle i, the unit normal ``n`` from j to i, 3-vectors as
 3-tuples; the compiled kernels ``numba.njit`` with ``inline="always"``):

@@ -15,7 +15,7 @@ wall/gran`` takes a wall).
   ``eta_n = alpha sqrt(m* k_n)``, ``k_n = F_el/delta = 4/3 E* a``: the damping grows as ``delta^(1/4)``, so the
   coefficient of restitution of a head-on collision does not depend on the impact speed. Antypov & Elliott 2011
   (EPL 94, 50004) solved that collision exactly: ``e = exp(-pi b / sqrt(1 - b^2))``, ``b = alpha/sqrt(5)``, i.e.
-  ``alpha = sqrt(5) (-ln e)/sqrt(pi^2 + ln^2 e)`` (:func:`damping_coefficient`): the material takes ``e`` itself.
+  ``alpha = sqrt(5) (-ln e)/sqrt(pi^2 + ln^2 e)`` (:func:`dem.laws.contact.damping.tsuji.damping_coefficient`): the material takes ``e`` itself.
   (This is the damping of LAMMPS's ``damping coeff_restitution`` and of EDEM's Hertz-Mindlin, ``2 sqrt(5/6) beta
   sqrt(m* S_n)`` with ``S_n = 2 E* a``.) The normal force ``F_n = F_el + F_d`` is not cut at zero: at the end of a
   damped contact it pulls briefly, as in Tsuji's model and in LAMMPS.
@@ -40,6 +40,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from dem.laws.contact.damping import tsuji
+from dem.laws.contact.normal import hertz
+from dem.laws.contact.tangential import mindlin
 from dem.laws.fields import check_fields
 
 # Indices into HertzMindlinMaterial.params() (the JKR law extends the list: dem.laws.contact.jkr)
@@ -128,7 +131,7 @@ class HertzMindlinMaterial:
         out = np.empty(N_PARAMS)
         out[P_KN] = 4.0 / 3.0 * self.effective_modulus
         out[P_KT] = 8.0 * self.effective_shear_modulus
-        out[P_ALPHA] = damping_coefficient(self.restitution)
+        out[P_ALPHA] = tsuji.damping_coefficient(self.restitution)
         out[P_XT], out[P_MU], out[P_MU_WALL] = self.tangential_damping, self.mu, self.mu_wall
         out[P_DENSITY] = self.density
         return out
@@ -148,43 +151,6 @@ class HertzMindlinMaterial:
         """
         return (math.pi * radius * math.sqrt(self.density / self.shear_modulus)
                 / (0.1631 * self.poisson_ratio + 0.8766))
-
-
-def damping_coefficient(restitution: float) -> float:
-    """``alpha = sqrt(5) (-ln e)/sqrt(pi^2 + ln^2 e)``: the damping ``eta_n = alpha sqrt(m* k_n)`` whose head-on
-    Hertz collision has the coefficient of restitution e, at every impact speed (Antypov & Elliott 2011, EPL 94,
-    50004: ``e = exp(-pi b/sqrt(1 - b^2))``, ``b = alpha/sqrt(5)``).
-
-    Parameters
-    ----------
-    restitution : float
-        The coefficient of restitution e, in ``(0, 1]``.
-
-    Returns
-    -------
-    float
-        alpha (dimensionless), 0 for e = 1.
-    """
-    log_e = math.log(restitution)
-    return math.sqrt(5.0) * -log_e / math.sqrt(math.pi**2 + log_e**2)
-
-
-def restitution_of(alpha: float) -> float:
-    """The coefficient of restitution of a head-on collision with the damping ``alpha`` (< sqrt(5)): ``exp(-pi b /
-    sqrt(1 - b^2))``, ``b = alpha/sqrt(5)`` (Antypov & Elliott 2011), the inverse of :func:`damping_coefficient`.
-
-    Parameters
-    ----------
-    alpha : float
-        The damping coefficient, in ``[0, sqrt(5))`` (dimensionless).
-
-    Returns
-    -------
-    float
-        The coefficient of restitution e.
-    """
-    b = alpha / math.sqrt(5.0)
-    return math.exp(-math.pi * b / math.sqrt(1.0 - b * b))
 
 
 def time_steps(material: HertzMindlinMaterial, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray,
@@ -220,7 +186,7 @@ def time_steps(material: HertzMindlinMaterial, mass: np.ndarray, inertia: np.nda
     a = r_eff * math.sqrt(STABLE_OVERLAP)
     rotational = 1.0 + float(np.max(mass * radius**2 / inertia))
     k_max = max(2.0 * material.effective_modulus * a, 8.0 * material.effective_shear_modulus * a * rotational)
-    eta = damping_coefficient(material.restitution) * math.sqrt(m_eff * 4.0 / 3.0 * material.effective_modulus * a)
+    eta = tsuji.damping_coefficient(material.restitution) * math.sqrt(m_eff * 4.0 / 3.0 * material.effective_modulus * a)
     stable = 2.0 / (math.sqrt(k_max / m_eff) + eta / (2.0 * m_eff))
     return min(RAYLEIGH_FRACTION * material.rayleigh_time(float(np.min(radius))), stable), stable
 
@@ -232,46 +198,12 @@ IN_LOOP = {**JIT, "inline": "always"}  # the kernels of the force loop, inlined 
 @njit(**IN_LOOP)
 def hertz_force(delta, delta_dot, r_eff, m_eff, params):
     """Hertz's force with its damping: ``(F_n, a, eta_n)`` -- ``F_n = 4/3 E* a delta + eta_n d(delta)/dt``, the
-    contact radius ``a = sqrt(R* delta)`` and ``eta_n = alpha sqrt(m* 4/3 E* a)`` (module docstring) for the overlap
-    ``delta > 0`` and its rate ``delta_dot`` (> 0 approaching)."""
-    a = math.sqrt(r_eff * delta)
-    k_n = params[P_KN] * a
-    eta = params[P_ALPHA] * math.sqrt(m_eff * k_n)
+    contact radius ``a = sqrt(R* delta)`` (:func:`dem.laws.contact.normal.hertz.stiffness`) and ``eta_n = alpha
+    sqrt(m* 4/3 E* a)`` (:func:`dem.laws.contact.damping.tsuji.viscosity`) for the overlap ``delta > 0`` and its rate
+    ``delta_dot`` (> 0 approaching)."""
+    k_n, a = hertz.stiffness(delta, r_eff, params[P_KN])
+    eta = tsuji.viscosity(params[P_ALPHA], m_eff, k_n)
     return k_n * delta + eta * delta_dot, a, eta
-
-
-@njit(**IN_LOOP)
-def mindlin_force(xi, n, vt, k_t, eta_t, f_limit, dt):
-    """Mindlin's tangential force with Coulomb sliding: ``(F_t, xi_new)``, two 3-tuples (module docstring).
-
-    ``xi`` the spring of the previous step, ``n`` the unit normal, ``vt`` the tangential surface velocity of i
-    relative to j; ``k_t`` the stiffness, ``eta_t`` the damping, ``f_limit`` the largest tangential force (``mu
-    F_n``); ``dt`` the step. The spring is turned into the tangent plane keeping its length, advanced by ``vt dt``;
-    ``F_t = -k_t xi - eta_t vt``; beyond ``f_limit`` it slides: ``F_t`` scaled to ``f_limit``, ``xi = -(F_t + eta_t
-    vt)/k_t``."""
-    n0, n1, n2 = n
-    length2 = xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]
-    xn = xi[0] * n0 + xi[1] * n1 + xi[2] * n2
-    x0, x1, x2 = xi[0] - xn * n0, xi[1] - xn * n1, xi[2] - xn * n2
-    if xn != 0.0:  # turned into the tangent plane: the same length
-        plane2 = x0 * x0 + x1 * x1 + x2 * x2
-        scale = math.sqrt(length2 / plane2) if plane2 > 0.0 else 0.0
-        x0, x1, x2 = x0 * scale, x1 * scale, x2 * scale
-    x0 += vt[0] * dt
-    x1 += vt[1] * dt
-    x2 += vt[2] * dt
-    f0 = -k_t * x0 - eta_t * vt[0]
-    f1 = -k_t * x1 - eta_t * vt[1]
-    f2 = -k_t * x2 - eta_t * vt[2]
-    size2 = f0 * f0 + f1 * f1 + f2 * f2
-    if size2 > f_limit * f_limit:
-        scale = f_limit / math.sqrt(size2)
-        f0, f1, f2 = f0 * scale, f1 * scale, f2 * scale
-        inv_k = 1.0 / k_t
-        x0 = -(f0 + eta_t * vt[0]) * inv_k
-        x1 = -(f1 + eta_t * vt[1]) * inv_k
-        x2 = -(f2 + eta_t * vt[2]) * inv_k
-    return (f0, f1, f2), (x0, x1, x2)
 
 
 # ------------------------------------------------------------------------------------------ the plug-in
@@ -361,7 +293,7 @@ def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, pl
     mi, mj = state[i, 0], state[j, 0]
     f_n, a, eta = hertz_force(delta, -vn, ri * rj / (ri + rj), mi * mj / (mi + mj), params)
     n0, n1, n2 = n
-    ft, xi = mindlin_force((hist_in[c, 0], 0.0 if planar else hist_in[c, 1], hist_in[c, 2]), n,
+    ft, xi = mindlin.mindlin_force((hist_in[c, 0], 0.0 if planar else hist_in[c, 1], hist_in[c, 2]), n,
                            (vr[0] - vn * n0, vr[1] - vn * n1, vr[2] - vn * n2), params[P_KT] * a,
                            params[P_XT] * eta, params[P_MU] * max(f_n, 0.0), dt)
     hist[c, 0], hist[c, 1], hist[c, 2] = xi
@@ -388,7 +320,7 @@ def wall_force(k, m, hist_in, hist, state, T, delta, dist, n, vr, vn, rk, dt, pa
     in ``[k, m]``."""
     f_n, a, eta = hertz_force(delta, -vn, rk, state[k, 0], params)
     n0, n1, n2 = n
-    ft, xi = mindlin_force((hist_in[k, m, 0], hist_in[k, m, 1], hist_in[k, m, 2]), n,
+    ft, xi = mindlin.mindlin_force((hist_in[k, m, 0], hist_in[k, m, 1], hist_in[k, m, 2]), n,
                            (vr[0] - vn * n0, vr[1] - vn * n1, vr[2] - vn * n2), params[P_KT] * a,
                            params[P_XT] * eta, params[P_MU_WALL] * max(f_n, 0.0), dt)
     hist[k, m, 0], hist[k, m, 1], hist[k, m, 2] = xi

@@ -11,7 +11,7 @@ gamma of identical surfaces -- LAMMPS's ``jkr`` takes that gamma).
   radius a, the overlap ``delta = a^2/R* - sqrt(2 pi w a/E*)`` and the force ``F_el = 4 E* a^3/(3 R*) - sqrt(8 pi
   w E* a^3)``. At ``F_el = 0``, ``a_0^3 = 9 pi w R*^2/(2 E*)``. The largest pull, ``-3/2 pi w R*`` (the pull-off
   force of a load-controlled test), is reached at ``delta = -a^2/(3 R*)``, ``a^3 = 9 pi w R*^2/(8 E*)``.
-  :func:`contact_radius` inverts the overlap in closed form: with ``s = sqrt(a)`` and ``c = sqrt(2 pi w/E*)`` it
+  :func:`dem.laws.contact.adhesion.jkr.contact_radius` inverts the overlap in closed form: with ``s = sqrt(a)`` and ``c = sqrt(2 pi w/E*)`` it
   is the quartic ``s^4 - c R* s - delta R* = 0``, solved by Ferrari's method through its resolvent cubic ``y^3 +
   delta R* y - c^2 R*^2/8 = 0`` (one real root for every delta above the break, written without cancellation).
 * **Contact and break**: two surfaces that touch (delta reaches 0) jump into contact (``F_el = -4/3 pi w R*`` at
@@ -22,7 +22,7 @@ gamma of identical surfaces -- LAMMPS's ``jkr`` takes that gamma).
   ``-delta_c`` (0 until the pair first touches), the engines' ``reach``: the contact acts while the surfaces are
   closer than that.
 * **Damping**: ``eta_n = alpha sqrt(m* k_n)`` with ``k_n = 4/3 E* a`` at the JKR contact radius a, alpha from the
-  restitution coefficient as in Hertz-Mindlin (:func:`dem.laws.contact.hertz_mindlin.damping_coefficient`): where
+  restitution coefficient as in Hertz-Mindlin (:func:`dem.laws.contact.damping.tsuji.damping_coefficient`): where
   adhesion is weak against the impact (``w -> 0``) a head-on collision rebounds with that e; slow impacts stick.
 * **Tangential**: Mindlin's spring ``k_t = 8 G* a`` on the JKR contact radius, damping ``eta_t``, Coulomb sliding at
   ``mu (F_el + 2 P_c)``, ``P_c = 3/2 pi w R*`` (Thornton & Yin 1991, Powder Technol. 65, 153: adhesion adds to the
@@ -38,8 +38,12 @@ import numpy as np
 from numba import njit
 
 from dem.laws.contact import hertz_mindlin as hm
-from dem.laws.contact.hertz_mindlin import (HertzMindlinMaterial, IN_LOOP, P_ALPHA, P_KN, P_KT, P_MU, P_MU_WALL, P_XT,
-                                            mindlin_force)
+from dem.laws.contact.adhesion import jkr as adhesion
+from dem.laws.contact.damping import tsuji
+from dem.laws.contact.hertz_mindlin import HertzMindlinMaterial, P_ALPHA, P_KN, P_KT, P_MU, P_MU_WALL, P_XT
+from dem.laws.contact.tangential import mindlin
+
+IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}  # inlined into the engines' force loop
 
 # Indices into JKRMaterial.params(): those of hertz_mindlin (P_*), then
 J_E_STAR = hm.N_PARAMS      # E* (Pa)
@@ -118,41 +122,23 @@ time_steps = hm.time_steps  # the same steps: at a contact radius a, the JKR sti
 
 
 @njit(**IN_LOOP)
-def contact_radius(delta, r_eff, c):
-    """The JKR contact radius a at the overlap ``delta`` (above the break, module docstring): the root of ``s^4 - c
-    R* s - delta R* = 0``, ``s = sqrt(a)``, ``c = sqrt(2 pi w/E*)`` on the stable branch.
-
-    Ferrari: ``(s^2 + y)^2 = 2 y (s + c R*/(4 y))^2`` for the root y of ``y^3 + P y - 2 q = 0``, ``P = delta R*``,
-    ``q = c^2 R*^2/16``. Cardano, ``u^3 = q + sqrt(q^2 + (P/3)^3)`` (the discriminant is >= 0 down to the break,
-    where it vanishes), ``y = u - P/(3 u)`` written as ``2 q/(u^2 + P/3 + (P/3)^2/u^2)`` (no cancellation when P >
-    0); then ``s = (sqrt(2 y) + sqrt(2 c R*/sqrt(2 y) - 2 y))/2``."""
-    p3 = delta * r_eff / 3.0
-    q = c * c * r_eff * r_eff / 16.0
-    u2 = (q + math.sqrt(max(q * q + p3 * p3 * p3, 0.0))) ** (2.0 / 3.0)  # u^2 (a power: quicker than cbrt)
-    y2 = 4.0 * q / (u2 + p3 + p3 * p3 / u2)  # 2 y
-    root = math.sqrt(y2)
-    s = 0.5 * (root + math.sqrt(max(2.0 * c * r_eff / root - y2, 0.0)))
-    return s * s
-
-
-@njit(**IN_LOOP)
 def jkr_force(delta, delta_dot, r_eff, m_eff, params):
     """The JKR force with its damping: ``(F_n, F_el, a, eta_n)`` -- ``F_n = F_el + eta_n d(delta)/dt``, ``F_el =
-    4 E* a^3/(3 R*) - sqrt(8 pi w E* a^3)`` at the contact radius ``a`` of ``delta`` (:func:`contact_radius`),
-    ``eta_n = alpha sqrt(m* 4/3 E* a)``."""
+    4 E* a^3/(3 R*) - sqrt(8 pi w E* a^3)`` at the contact radius ``a`` of ``delta``
+    (:mod:`dem.laws.contact.adhesion.jkr`), ``eta_n = alpha sqrt(m* 4/3 E* a)``
+    (:func:`dem.laws.contact.damping.tsuji.viscosity`)."""
     c = params[J_C]
-    a = contact_radius(delta, r_eff, c)
+    a = adhesion.contact_radius(delta, r_eff, c)
     k_n = params[P_KN] * a
-    f_el = k_n * a * a / r_eff - 2.0 * params[J_E_STAR] * c * a * math.sqrt(a)  # sqrt(8 pi w E*) = 2 E* c
-    eta = params[P_ALPHA] * math.sqrt(m_eff * k_n)
+    f_el = adhesion.elastic_force(a, k_n, r_eff, params[J_E_STAR], c)
+    eta = tsuji.viscosity(params[P_ALPHA], m_eff, k_n)
     return f_el + eta * delta_dot, f_el, a, eta
 
 
 @njit(**IN_LOOP)
 def pulloff_distance(r_eff, params):
     """``-delta_c = 3/4 (pi^2 w^2 R*/E*^2)^(1/3)`` (module docstring), m."""
-    w_over_e = params[J_W] / params[J_E_STAR]
-    return 0.75 * np.cbrt(math.pi * math.pi * w_over_e * w_over_e * r_eff)
+    return adhesion.pulloff_distance(r_eff, params[J_W], params[J_E_STAR])
 
 
 # ------------------------------------------------------------------------------------------ the plug-in
@@ -206,7 +192,7 @@ def _contact(xi, pulloff, delta, vn, n, vr, r_eff, m_eff, mu, dt, params):
     """The force of a contact and its new history: ``(f_n, f_t, xi, pulloff)``."""
     f_n, f_el, a, eta = jkr_force(delta, -vn, r_eff, m_eff, params)
     n0, n1, n2 = n
-    ft, xi = mindlin_force(xi, n, (vr[0] - vn * n0, vr[1] - vn * n1, vr[2] - vn * n2), params[P_KT] * a,
+    ft, xi = mindlin.mindlin_force(xi, n, (vr[0] - vn * n0, vr[1] - vn * n1, vr[2] - vn * n2), params[P_KT] * a,
                            params[P_XT] * eta, mu * (f_el + 3.0 * math.pi * params[J_W] * r_eff), dt)
     return f_n, ft, xi, pulloff if pulloff > 0.0 else pulloff_distance(r_eff, params)
 
