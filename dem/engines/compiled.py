@@ -101,8 +101,8 @@ def loop(law: str, template: str, function: str, threaded: bool = False):
 
     Returns
     -------
-    functools.partial
-        The loop, to be called with its arguments after the law.
+    callable
+        The loop with the law bound first (a ``functools.partial``), to be called with its other arguments.
 
     Raises
     ------
