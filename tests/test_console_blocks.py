@@ -163,7 +163,7 @@ def test_console_block(tmp_path, command, expected, files, places):
 PM = r"(?P<{0}>[\d.]+) ± (?P<{0}_pm>[\d.]+)"  # a figure and its spread, as a paragraph prints it
 HOT_WALL = re.compile(
     (r"After 0\.15 s the solid fraction is {hot} next to the hot wall and {top} at the top, the mean neck radius "
-     r"a/r {neck_hot} against {neck_top}, and the effective conductivity between the walls has risen to {k_eff} "
+     r"\$?a/r\$? {neck_hot} against {neck_top}, and the effective conductivity between the walls has risen to {k_eff} "
      r"W/\(m K\).*?(?P<steps>[\d.]+)·10⁵ steps").format(**{k: PM.format(k) for k in
                                                         ("hot", "top", "neck_hot", "neck_top", "k_eff")})
     .replace(" ", r"\s+"), re.S)  # wrapped anywhere
