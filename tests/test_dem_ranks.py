@@ -111,8 +111,7 @@ def test_two_ranks_carry_the_heat_of_the_contacts(tmp_path):
         assert abs(float(p.capacity @ two["T"]) - heat0) <= 1e-12 * heat0  # insulated: total heat conserved
         keys = list(two["summary_keys"])
         assert two["summary_values"][keys.index("energy_error")] < 1e-12
-        assert keys == list(serial["summary_keys"])
-
+        assert keys == without_handover(serial["summary_keys"])
 
 
 def test_two_ranks_take_the_serial_runs_stiff_thermal_steps(tmp_path):
@@ -125,10 +124,19 @@ def test_two_ranks_take_the_serial_runs_stiff_thermal_steps(tmp_path):
     two = launched(2, "stiff-heat", tmp_path / "two.npz")
     spread = 80.0
     assert np.max(np.abs(two["T"] - serial["T"])) <= 1e-8 * spread
-    keys = list(serial["summary_keys"])
-    assert list(two["summary_keys"]) == keys
+    keys = list(two["summary_keys"])
+    assert keys == without_handover(serial["summary_keys"])
     startup = keys.index("startup_steps")
-    assert two["summary_values"][startup] == serial["summary_values"][startup] > 0
+    assert two["summary_values"][startup] == serial["summary_values"][list(serial["summary_keys"]).index(
+        "startup_steps")] > 0
+
+
+def without_handover(keys) -> list:
+    """The serial run's summary keys less the hand-over's: several ranks hand no particle over to the union
+    (dem.engines.verlet.ranks), so their summaries do not carry its counts."""
+    return [k for k in keys if k not in ("particles_handed_over", "particles_handing_over")]
+
+
 def test_two_ranks_report_the_serial_effective_conductivity(tmp_path):
     """Heat from a hot to a cold wall through a lattice column, periodic across: on two ranks the effective
     conductivity is that of the gathered sample (its serial network, solved on rank 0 at each output and on every

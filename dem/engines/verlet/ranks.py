@@ -590,13 +590,25 @@ class RankVerletEngine(VerletEngine):
         once = m.owned[lines[:, 0]]
         return points, lines[once], {k: v[once] for k, v in fields.items()}
 
-    def effective_conductivity(self) -> float | None:
+    def effective_conductivity(self, pair_necks: bool = False) -> float | None:
         """As :meth:`~dem.engines.verlet.engine.VerletEngine.effective_conductivity` on one rank; on more, of the
         gathered sample (rank 0's at an output time, every rank's after the run: the serial network of its contacts
-        now), None on a rank that holds its slab only (module docstring)."""
+        now), None on a rank that holds its slab only (module docstring).
+
+        Parameters
+        ----------
+        pair_necks : bool
+            Every contact read as a pair neck (one rank, which hands particles over to the union); several ranks
+            hand none over, so their network is already that.
+
+        Returns
+        -------
+        float or None
+            k_eff (W/(m K)), or None.
+        """
         m = self.ranks_mechanics
         if m.size == 1:
-            return super().effective_conductivity()
+            return super().effective_conductivity(pair_necks)
         th = self.thermal
         if self.mechanics is m or th is None or th.net is None:
             return None
