@@ -332,7 +332,7 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
     from dem.laws.shared_body import neck_factors
 
     r = particles.radius
-    unit = vectors / np.linalg.norm(vectors, axis=1)[:, None] if bonds.n_pairs else np.zeros((0, 3))
+    unit = vectors / bonds.d[:, None]  # the bonds' lengths, found with them
     particle = np.concatenate([bonds.i, bonds.j, bonds.wall_particle])
     ends = cut_body_resistance(r, particle, np.vstack([unit, -unit, -np.reshape(normals, (-1, 3))]),
                                np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l])) / kappa[particle]
