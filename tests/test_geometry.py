@@ -211,24 +211,6 @@ def test_large_arrays_solved_in_blocks_match_small_calls():
         neck_radius(1e-3, r_j, h_bad)
 
 
-def test_blocks_on_threads_are_the_blocks_on_one_to_the_bit(monkeypatch):
-    """neck_radius's blocks shared among 1, 2 or 3 threads: the same radii to the bit (each block converges on its
-    own, whichever thread solves it), and a bad entry still named by its index."""
-    import sinterheat.threads
-
-    rng = np.random.default_rng(8)
-    r_i, r_j = 1e-3 * rng.uniform(1.0, 3.0, (2, 5 * 2**14 + 17))
-    h = max_overlap(r_i, r_j) * rng.uniform(1e-6, 1.0, r_i.size)
-    radii = []
-    for threads in (1, 2, 3):
-        monkeypatch.setattr(sinterheat.threads, "count", lambda: threads)
-        radii.append(neck_radius(r_i, r_j, h))
-    assert np.array_equal(radii[0], radii[1]) and np.array_equal(radii[0], radii[2])
-    h[3 * 2**14 + 5] = np.nan
-    with pytest.raises(ValueError, match=rf"h\[{3 * 2**14 + 5}\]"):
-        neck_radius(r_i, r_j, h)
-
-
 @pytest.mark.parametrize("ratio", [1.0, 1.5, 3.0, 10.0, 1e3, 1e8])
 def test_newton_start_is_close_and_newton_needs_few_iterations(ratio):
     """The start (a cubic model of G in a^2, exact at both ends of the range) is within 1.5 % of the root over the

@@ -21,8 +21,7 @@ right of the root decreases monotonically onto it, and a step from the left of t
 its right. Where the start has ``Z' <= 0`` the iteration starts from the bracket's right end ``a = min(r_i, r_j)``
 instead, so it never diverges. Cap heights are computed as ``a^2 / (r + sqrt(r^2 - a^2))`` so that small necks
 keep full relative precision. Large arrays are solved in blocks of cache size (``_CHUNK`` bonds), each block
-stopping as soon as its own bonds have converged, the blocks shared among threads (numpy's operations release the
-interpreter's lock; :func:`sinterheat.threads.count` of them), each block's result the same on any thread.
+stopping as soon as its own bonds have converged.
 
 The model's range: a solution exists for ``0 < h <= max_overlap(r_i, r_j)``, where ``a`` reaches the smaller radius
 (``2r/3`` for equal spheres, Section 4.2). Once two necks of one particle meet, no pair-neck model has an answer; the
@@ -411,24 +410,14 @@ def neck_radius(r_i, r_j, h, method: str = "newton"):
 def _neck_radius_blocked(r_i, r_j, h, method):
     """:func:`neck_radius` of large arrays, ``_CHUNK`` bonds at a time: every temporary of the Newton stays in
     the processor's cache instead of being a fresh multi-megabyte array per operation (3-4x faster for 10^6
-    bonds), and each block stops iterating as soon as its own bonds have converged. The blocks are shared among
-    :func:`sinterheat.threads.count` threads; a block's result does not depend on the thread that solves it."""
-    from concurrent.futures import ThreadPoolExecutor
-
-    from sinterheat.threads import count
-
+    bonds), and each block stops iterating as soon as its own bonds have converged."""
     R_i, R_j, H = (np.ascontiguousarray(v).ravel() for v in np.broadcast_arrays(r_i, r_j, h))
     a = np.empty(H.size)
-
-    def solve_block(start):
-        block = slice(start, start + _CHUNK)
-        ri, rj, hb, scale, h_max = _validated(R_i[block], R_j[block], H[block])
-        a[block] = _solve(ri, rj, hb, method, h_max)[0] * scale
-
-    starts = range(0, H.size, _CHUNK)
     try:
-        with ThreadPoolExecutor(min(count(), len(starts))) as threads:
-            list(threads.map(solve_block, starts))  # a block's error is raised here
+        for start in range(0, H.size, _CHUNK):
+            block = slice(start, start + _CHUNK)
+            ri, rj, hb, scale, h_max = _validated(R_i[block], R_j[block], H[block])
+            a[block] = _solve(ri, rj, hb, method, h_max)[0] * scale
     except ValueError:
         _validated(r_i, r_j, h)  # the whole input again: the message names the first bad entry by its own index
         raise
