@@ -267,20 +267,6 @@ def _lens_planes(r_i, r_j, d):
     return l_i, d - l_i
 
 
-def _pair_geometry(x, radius, i, j, vec):
-    """``(r_i, r_j, d, h, L_i, L_j)`` of the pair bonds (:func:`dem.geometry.pair_geometry.pair_geometry`);
-    ``vec``: their vectors ``x_j - x_i`` (to the image in a periodic box), or None to take them from ``x`` on
-    numba's threads (the same to the bit)."""
-    if vec is None:
-        from dem.geometry.pair_geometry import pair_geometry  # compiled: taken where the cells searched (numba loaded)
-
-        return pair_geometry(x, radius, i, j)
-    r_i, r_j = radius[i], radius[j]
-    vx, vy, vz = vec[:, 0], vec[:, 1], vec[:, 2]
-    d = np.sqrt(vx * vx + vy * vy + vz * vz)  # np.linalg.norm(vec, axis=1) to the bit, in a tenth of its time
-    return (r_i, r_j, d, r_i + r_j - d, *_lens_planes(r_i, r_j, d))
-
-
 def _apply_policy(bad, what: str, first: str, policy: str, total: int):
     if not np.any(bad):
         return 0
@@ -290,8 +276,12 @@ def _apply_policy(bad, what: str, first: str, policy: str, total: int):
     return int(bad.sum())
 
 
-def _pair_contacts(i, j, geometry, contact, policy):
-    r_i, r_j, d, h, l_i, l_j = geometry
+def _pair_contacts(p: Particles, i, j, vec, contact, policy):
+    r_i, r_j = p.radius[i], p.radius[j]
+    x, y, z = vec[:, 0], vec[:, 1], vec[:, 2]
+    d = np.sqrt(x * x + y * y + z * z)  # np.linalg.norm(vec, axis=1) to the bit, in a tenth of its time
+    h = r_i + r_j - d
+    l_i, l_j = _lens_planes(r_i, r_j, d)
     if contact in LENS_GEOMETRY:
         bad = (l_i < 0) | (l_j < 0)
         limit = "the lens needs both centres outside the other sphere's cap: d^2 >= |r_j^2 - r_i^2|"
@@ -424,12 +414,8 @@ def find_bonds(particles: Particles, walls=(), contact: str = "newton", out_of_r
             k = int(np.flatnonzero(apart)[0])
             raise ValueError(f"bonds: particles {i[k]} and {j[k]} do not overlap (d = {d[k]:.6g} m >= "
                              f"r_i + r_j = {particles.radius[i[k]] + particles.radius[j[k]]:.6g} m)")
-    if periodic:
-        vec = box.bond_vectors(x, i, j, shift)
-    else:  # a packing the cells search: on numba's threads, the same to the bit
-        vec = None if particles.n >= CELL_SEARCH_MIN else x[j] - x[i]
-    geometry = _pair_geometry(x, particles.radius, i, j, vec)
-    i, j, h, d, a, l_i, l_j, c1, d1, keep = _pair_contacts(i, j, geometry, contact, out_of_range)
+    vec = box.bond_vectors(x, i, j, shift) if periodic else x[j] - x[i]
+    i, j, h, d, a, l_i, l_j, c1, d1, keep = _pair_contacts(particles, i, j, vec, contact, out_of_range)
     wp, wi, wh, wa, wl, c2, d2 = _wall_contacts(particles, tuple(walls), contact, out_of_range)
     return Bonds(i, j, h, d, a, l_i, l_j, wp, wi, wh, wa, wl, contact, c1 + c2, d1 + d2,
                  shift[keep] if periodic else None)
