@@ -299,8 +299,11 @@ class BoundedLaplacian:
         tuple
             ``(count, label, anchored)``: the number of groups, each free node's group, and a bool per group.
         """
-        if np.all(self.K > 0.0):  # every edge joins: the free block's sparsity is the graph (its diagonal loops)
-            graph = self.L_FF
+        if np.all(self.K > 0.0):
+            # every edge joins: the free block's sparsity is the graph (its diagonal loops), symmetric, so its
+            # strongly connected components are its groups, found without the transpose an undirected search makes
+            # (half the search's time)
+            n_comp, label = connected_components(self.L_FF, directed=True, connection="strong")
         else:
             where = np.full(self.n, -1, dtype=np.int64)
             where[self.free] = np.arange(len(self.free))
@@ -308,7 +311,7 @@ class BoundedLaplacian:
             live = (self.K > 0.0) & (a >= 0) & (b >= 0)
             nf = len(self.free)
             graph = sp.csr_matrix((np.ones(int(live.sum())), (a[live], b[live])), shape=(nf, nf))
-        n_comp, label = connected_components(graph, directed=False)
+            n_comp, label = connected_components(graph, directed=False)
         anchor = self.fixed_diag + self.plane_diag
         if anchor_extra is not None:
             anchor = anchor + anchor_extra
