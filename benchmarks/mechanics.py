@@ -354,7 +354,7 @@ def lammps_command(ranks: int = 1) -> tuple[list[str], dict] | None:
 
 def write_lammps_data(path: pathlib.Path, sample: dict, density: float) -> None:
     """``atom_style sphere`` data file of the periodic packing in the box from 0 to ``sample["box"]``
-    (:func:`dem.scene.packing_files.write_lammps_data`; atoms 1..N)."""
+    (:func:`dem.scene.packing_files.lammps.write_lammps_data`; atoms 1..N)."""
     from dem.scene.packing_files import Packing, write_lammps_data as write_data
 
     n = len(sample["radius"])

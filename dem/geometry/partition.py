@@ -11,8 +11,8 @@ bond length (twice the largest radius: two spheres bond only when ``d < r_i + r_
 has its partner among the owned and the halo particles, so a bond search over those finds all of them. On periodic
 axes the distance is taken to the nearest image.
 
-A packing stored in parts (:mod:`dem.scene.packing_parts`) is shared out by its blocks, not its particles: the same
-bisection over the blocks' centres, each weighted by its particle count, so that a rank reads only its blocks and
+A packing stored in parts (:mod:`dem.scene.packing_files.parts`) is shared out by its blocks, not its particles: the
+same bisection over the blocks' centres, each weighted by its particle count, so that a rank reads only its blocks and
 those within ``reach`` of them.
 """
 

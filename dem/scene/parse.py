@@ -199,9 +199,9 @@ class Scene:
         The unit of the scene's temperatures, ``"C"`` or ``"K"`` (:func:`temperature_unit`).
     groups : dict
         The ``[[groups]]`` that hold their particles, ``{name: indices}`` (:func:`dem.scene.groups.apply_groups`).
-    part : dem.scene.packing_parts.Part or None
+    part : dem.scene.packing_files.parts.Part or None
         Where ``particles`` are in the packing when they are one rank's part of a packing in parts
-        (:func:`dem.scene.packing_parts.read_part`); None: they are the whole packing.
+        (:func:`dem.scene.packing_files.parts.read_part`); None: they are the whole packing.
 
     Raises
     ------
@@ -227,7 +227,7 @@ class Scene:
     start: dict | None = None  # the saved state it starts from (dem.scene.state_file.load), else None
     temperature_unit: str = "C"  # the unit of its temperatures, "C" or "K" (:func:`temperature_unit`)
     groups: dict = field(default_factory=dict)  # the [[groups]] that hold their particles, {name: indices}
-    part: object = None  # a rank's part of a packing in parts (dem.scene.packing_parts.Part), else None
+    part: object = None  # a rank's part of a packing in parts (dem.scene.packing_files.parts.Part), else None
 
     def __post_init__(self):
         walls = self.motion.walls if self.motion is not None else self.walls
@@ -575,8 +575,8 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         the working directory.
     part : tuple or None
         ``(ranks, rank)``: a static scene whose ``[particles] file`` is a packing in parts
-        (:mod:`dem.scene.packing_parts`) gets only the particles rank ``rank`` of ``ranks`` holds (``Scene.part``
-        says which); None, or another scene: every particle.
+        (:mod:`dem.scene.packing_files.parts`) gets only the particles rank ``rank`` of ``ranks`` holds
+        (``Scene.part`` says which); None, or another scene: every particle.
 
     Returns
     -------

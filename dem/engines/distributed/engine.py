@@ -4,7 +4,7 @@ steady or in implicit steps of a fixed size, its particles shared out in space a
 Every rank reads the scene, keeps the particles of its cell of a recursive coordinate bisection
 (:func:`dem.geometry.partition.bisection`) and a halo of one bond length around them
 (:func:`dem.geometry.partition.halo`) -- or, from a packing in parts, reads only those
-(:func:`dem.scene.packing_parts.read_part`: the scene's ``part``) --, finds their bonds and conductances as the
+(:func:`dem.scene.packing_files.parts.read_part`: the scene's ``part``) --, finds their bonds and conductances as the
 serial engine does, and keeps those with an owned particle (:mod:`dem.network.distributed`: its rows are the serial
 matrix's to the bit). The summary and the effective conductivity are reduced over the ranks; the snapshots are one
 piece per rank (:class:`dem.output.pieces.PieceWriter`).
