@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from dem.laws.contact import law_module
-from dem.geometry.motion import particle_mass, moment_of_inertia
+from dem.geometry.inertia import moment_of_inertia, particle_mass
 from dem.geometry.particles import finite_array
 from dem.scene.events import TemperatureSchedule
 from dem.scene import zohdi as zscene

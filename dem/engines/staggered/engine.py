@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from dem.geometry.motion import MotionState
+from dem.engines.state import MotionState
 from dem.geometry.neighbours import list_arrays
 from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes

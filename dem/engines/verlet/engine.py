@@ -28,7 +28,7 @@ from dataclasses import replace
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.bonds import find_bonds
-from dem.geometry.motion import MotionState
+from dem.engines.state import MotionState
 from dem.geometry.necks import meeting_in
 from dem.geometry.neighbours import list_arrays
 from dem.geometry.periodic import pair_lines

@@ -62,7 +62,7 @@ from dem.engines.verlet.decomposition import Slabs
 from dem.engines.verlet.engine import VerletEngine
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
 from dem.engines.verlet.mechanics import MechanicalModel, MechanicsError
-from dem.geometry.motion import MotionState
+from dem.engines.state import MotionState
 from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
 from sinterheat import threads
 
