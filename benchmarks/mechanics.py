@@ -176,7 +176,7 @@ def periodic_packing(sizes: Sizes, cache: pathlib.Path, seed: int = 0, coordinat
             return {**{k: data[k] for k in data.files}, "seconds": 0.0}
     from dem.engines.verlet.mechanics import MechanicalModel
     from dem.engines.state import MotionState
-    from dem.scene.motion import time_steps
+    from dem.scene.verlet import time_steps
     from dem.geometry.neighbours import verlet_pairs
     from dem.geometry.periodic import PeriodicBox
 
