@@ -2,7 +2,7 @@
 
 A packing in parts is a folder ``NAME.parts`` of blocks, ``block-NNNNN.npz`` (numpy's own format: arrays read one
 by one, no other library), and ``index.json``, written last, which says what the blocks hold. The blocks are the
-cells of a recursive coordinate bisection of the centres (:func:`dem.geometry.partition.bisection`): compact
+cells of a recursive coordinate bisection of the centres (:func:`dem.geometry.bisection.bisection`): compact
 regions of (almost) equal counts. Each block holds its particles in the packing's order with their place in it
 (``index``, from 0), ids, centres (m), radii (m) and the optional per-particle arrays of a
 :class:`dem.scene.packing_files.packing.Packing` that the packing has. The index gives, per block, its file, its count,
@@ -15,7 +15,7 @@ Read whole (:func:`read_whole`: what ``[particles] file`` reads on one process, 
 packing in parts is the packing it was written from, in its order, to the bit. Read in part (:func:`read_part`),
 rank ``r`` of ``R`` gets its blocks -- a bisection of the blocks' centres weighted by their counts -- and the
 particles of the other blocks within one bond length (two largest radii) of the bounding box of its centres
-(:func:`dem.geometry.partition.halo`, periodic axes wrapped), having opened only the blocks whose boxes come that
+(:func:`dem.geometry.bisection.halo`, periodic axes wrapped), having opened only the blocks whose boxes come that
 close: every bond of an owned particle has its partner among those it holds, so the distributed static engine
 (:mod:`dem.engines.distributed`) builds its rows from them alone. No rank holds the whole packing; the index (some
 hundred bytes per block) is read by all.
@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dem.geometry.partition import HALO_MARGIN, bisection, halo
+from dem.geometry.bisection import HALO_MARGIN, bisection, halo
 from dem.output.atomic import write_aside
 from dem.scene.packing_files.packing import Packing
 
@@ -364,7 +364,7 @@ def block_owner(index: Index, ranks: int, lengths=None) -> np.ndarray:
 
 def _near(lo: np.ndarray, hi: np.ndarray, region_lo: np.ndarray, region_hi: np.ndarray, lengths, periodic):
     """Mask over boxes ``[lo, hi]``: within the region on every axis, periodic axes wrapped (as
-    :func:`dem.geometry.partition.halo` tests a centre)."""
+    :func:`dem.geometry.bisection.halo` tests a centre)."""
     near = np.ones(len(lo), dtype=bool)
     for a in range(3):
         inside = (hi[:, a] >= region_lo[a]) & (lo[:, a] <= region_hi[a])
