@@ -32,11 +32,11 @@ PER_RANK_PROJECTED = 10**6  # particles per rank in the projection (as measured 
 def parts_scene(n: int, folder, blocks: int | None = None, boundary: str = "plates") -> pathlib.Path:
     """A random sintered packing of ~n copper particles between a hot and a cold wall (``boundary`` ``"plates"``
     of the scenes' generator) or with its bottom and top layers held hot and cold (``"fixed"``), rojek law, steady,
-    floating = "mean", written in parts (:mod:`dem.scene.packing_parts`) as ``packing.parts`` in ``folder`` with
-    ``blocks`` blocks (None: the default), and the scene ``packing.toml`` that reads it; returns the scene's
+    floating = "mean", written in parts (:mod:`dem.scene.packing_files.parts`) as ``packing.parts`` in ``folder``
+    with ``blocks`` blocks (None: the default), and the scene ``packing.toml`` that reads it; returns the scene's
     path."""
     from dem.scene.packing_files import packing_from_particles
-    from dem.scene.packing_parts import write_parts
+    from dem.scene.packing_files.parts import write_parts
     from dem.scene.parse import parse_scene
 
     folder = pathlib.Path(folder)

@@ -97,7 +97,7 @@ def step_cost(sim, repeat: int = 5, luding_steps: int = 200) -> dict:
     """ns per particle of the pieces of a Zohdi step and of a Luding velocity-Verlet step, same packing."""
     from dem.laws.contact.luding import LUDING_TABLE1
     from dem.engines.verlet.mechanics import MechanicalModel
-    from dem.geometry.motion import MotionState
+    from dem.engines.state import MotionState
 
     mech, th, cur = sim.mechanics, sim.thermal, sim.current
     n = mech.state.n

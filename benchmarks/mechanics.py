@@ -175,8 +175,8 @@ def periodic_packing(sizes: Sizes, cache: pathlib.Path, seed: int = 0, coordinat
         with np.load(path) as data:
             return {**{k: data[k] for k in data.files}, "seconds": 0.0}
     from dem.engines.verlet.mechanics import MechanicalModel
-    from dem.geometry.motion import MotionState
-    from dem.scene.motion import time_steps
+    from dem.engines.state import MotionState
+    from dem.scene.verlet import time_steps
     from dem.geometry.neighbours import verlet_pairs
     from dem.geometry.periodic import PeriodicBox
 
@@ -354,7 +354,7 @@ def lammps_command(ranks: int = 1) -> tuple[list[str], dict] | None:
 
 def write_lammps_data(path: pathlib.Path, sample: dict, density: float) -> None:
     """``atom_style sphere`` data file of the periodic packing in the box from 0 to ``sample["box"]``
-    (:func:`dem.scene.packing_files.write_lammps_data`; atoms 1..N)."""
+    (:func:`dem.scene.packing_files.lammps.write_lammps_data`; atoms 1..N)."""
     from dem.scene.packing_files import Packing, write_lammps_data as write_data
 
     n = len(sample["radius"])

@@ -155,7 +155,7 @@ def _run_held(scene: Scene, out, progress: bool, resume: bool, comm, cls, root: 
         writer = PieceWriter(out, scene, engine, comm.Get_rank(), comm.Get_size(), resume_step)
     elif out is not None and root:
         writer = RunWriter(out, scene, engine, resume_step=resume_step)
-        if scene.motion is not None and scene.motion.frames:
+        if scene.motion is not None and scene.motion.staggered and scene.motion.staggered.frames:
             from dem.output.frames import WithFrames
 
             writer = WithFrames(writer, scene, out)

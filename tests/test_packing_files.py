@@ -20,8 +20,9 @@ from dem import read_packing
 from dem.geometry import generators
 from dem.scene import state_file
 from dem.laws.contact.luding import LUDING_TABLE1
-from dem.scene.packing_files import (Packing, lammps_ids, packing_from_particles, packing_from_state, write_csv,
-                               write_lammps_data, write_vtu)
+from dem.output.lammps_dump import lammps_ids
+from dem.scene.packing_files import (Packing, packing_from_particles, packing_from_state, write_csv, write_lammps_data,
+                                     write_vtu)
 from dem.geometry.periodic import PeriodicBox
 from dem.scene import load_scene, make_scene, parse_scene
 from dem.driver import run

@@ -1,6 +1,6 @@
-"""Packings in parts (:mod:`dem.scene.packing_parts`), without MPI: read whole, the packing written, to the bit;
+"""Packings in parts (:mod:`dem.scene.packing_files.parts`), without MPI: read whole, the packing written, to the bit;
 read in part, each rank's owned particles partition the packing and its halo is the one the whole packing gives
-(:func:`dem.geometry.partition.halo` over every particle), periodic faces included, from fewer blocks than all;
+(:func:`dem.geometry.bisection.halo` over every particle), periodic faces included, from fewer blocks than all;
 a scene read in part has the whole scene's specimen; what cannot run in parts is refused in one line."""
 
 import json
@@ -10,11 +10,11 @@ import pytest
 
 from dem.cli import main
 from dem.geometry.generators import random_packing
-from dem.geometry.partition import HALO_MARGIN, bisection, halo
+from dem.geometry.bisection import HALO_MARGIN, bisection, halo
 from dem.geometry.periodic import PeriodicBox
 from dem.scene import load_scene
 from dem.scene.packing_files import Packing, read_packing
-from dem.scene.packing_parts import read_index, read_part, read_whole, write_parts
+from dem.scene.packing_files.parts import read_index, read_part, read_whole, write_parts
 
 MATERIALS = '[[materials]]\nname = "copper"\nconductivity = 394.0\ndensity = 8960.0\nspecific_heat = 385.0\n' \
             '[[materials]]\nname = "steel"\nconductivity = 50.0\ndensity = 7850.0\nspecific_heat = 470.0\n'

@@ -1,4 +1,4 @@
-"""The spatial partition of a distributed run (:mod:`dem.geometry.partition`), without MPI: balanced cells, and a
+"""The spatial partition of a distributed run (:mod:`dem.geometry.bisection`), without MPI: balanced cells, and a
 halo that holds the partner of every bond of the cell's particles (so that a bond search over the cell and its
 halo finds all of them), across periodic faces too."""
 
@@ -8,7 +8,7 @@ import pytest
 from dem.geometry.bonds import find_bonds
 from dem.geometry.generators import random_packing
 from dem.geometry.particles import Particles
-from dem.geometry.partition import bisection, halo
+from dem.geometry.bisection import bisection, halo
 from dem.geometry.periodic import PeriodicBox
 from dem.network.comm import launched
 

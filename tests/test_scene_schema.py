@@ -15,7 +15,8 @@ from dem.laws.conductance import ConductanceSpec
 from dem.scene import OutputSpec, SolverSpec, builtin_scenes, load_scene, parse_scene, schema
 from dem.scene.packing_files import SCENE_KEYS
 from dem.scene.parse import GENERATOR_KEYS as KIND_KEYS
-from dem.scene.zohdi import ELECTRODE_KEYS, ZohdiStepping
+from dem.scene.electrical import ELECTRODE_KEYS
+from dem.scene.staggered import ZohdiStepping
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "docs" / "_ext"))

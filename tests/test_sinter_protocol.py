@@ -20,7 +20,7 @@ def test_schedule_scene_has_the_times_temperatures_and_box_of_sec_4_1():
     m = scene.motion
     assert scene.contact == MAT and m.dimension == 2 and m.height == 6e-3
     assert scene.solver.t_end == pytest.approx(0.2 + 0.1 + t_s + 0.1 + 0.1)
-    sched = m.schedule
+    sched = m.verlet.schedule
     assert sched.time == pytest.approx((0.0, 0.2, 0.3, 0.3 + t_s, 0.4 + t_s, 0.5 + t_s))
     assert sched.value == (80.0, 80.0, 140.0, 140.0, 80.0, 80.0)
     assert sched.relaxation_time == (1e3, 1e3, 0.1, 1e3, 1e3)  # t0 = 0.1 s only while sintering (Table 1)
@@ -47,8 +47,8 @@ def test_stage_scenes_continue_from_a_state(tmp_path):
     t_heat = prep.summary["t"]  # the clock goes on from the prepared state's
     assert 0 <= t_heat - times.t_heat < prep.summary["dt"]  # the first step at or after t_end
     assert sinter.start_time == t_heat and sinter.solver.t_end == pytest.approx(t_heat + 0.002 + 0.004 + 0.004)
-    assert sinter.motion.schedule.time[0] == t_heat
-    assert sinter.motion.schedule.value == (80.0, 140.0, 140.0, 80.0, 80.0)
+    assert sinter.motion.verlet.schedule.time[0] == t_heat
+    assert sinter.motion.verlet.schedule.value == (80.0, 140.0, 140.0, 80.0, 80.0)
     assert sinter.motion.phases == ()  # Table 1 friction from the start (t_heat)
     saved_right = prep.engine.mechanics.w.q[2]
     assert {w.name: w for w in sinter.motion.walls}["right"].offset == saved_right
@@ -160,7 +160,8 @@ def test_builtin_scenes_are_the_protocols_schedule(name, doc):
         return [(w.name, w.motion, w.point.tolist(), w.normal.tolist(), w.pressure, w.mass, w.damping) for w in m.walls]
 
     assert walls(a) == walls(b) and len(a.walls) == 4
-    assert (a.schedule, a.phases, a.dt, a.dimension, a.height) == (b.schedule, b.phases, b.dt, b.dimension, b.height)
+    assert (a.verlet.schedule, a.phases, a.dt, a.dimension, a.height) == (b.verlet.schedule, b.phases, b.dt, b.dimension,
+                                                                           b.height)
     assert builtin.solver.t_end == made.solver.t_end
 
 

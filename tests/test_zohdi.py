@@ -12,7 +12,7 @@ import pytest
 from dem.scene import parse_scene
 from dem.laws.contact import zohdi as zohdi_law
 from dem.laws.contact.zohdi import ZohdiMaterial
-from dem.scene.zohdi import ZohdiStepping
+from dem.scene.staggered import ZohdiStepping
 from dem.engines.staggered.engine import StaggeredEngine
 
 R = 0.075

@@ -2,14 +2,14 @@
 [--blocks B] [--json]``: a packing written in another format, e.g. for LAMMPS, or in parts for many MPI ranks.
 
 IN is a packing file (CSV, LAMMPS data file or dump, VTK point set, a packing in parts:
-:func:`dem.scene.packing_files.read_packing`, the format from the name or ``--format``), a saved moving state
+:func:`dem.scene.packing_files.read.read_packing`, the format from the name or ``--format``), a saved moving state
 (``state.npz``: positions, radii, temperatures,
 velocities, and densities from the saved masses; a static run's state: positions, radii, temperatures, materials) or a scene (a TOML file or a built-in name: its particles,
 generated ones included, with its materials' densities and its periodic box). OUT is written by its name: a LAMMPS
 data file of ``atom_style sphere`` (``.data``, ``.lmp``, ``data.*``; ``read_data`` reads it, ``units si``; LAMMPS
 numbers atoms from 1, so ids 0..N-1 become 1..N), ``.csv``, ``.vtu``, or a packing in parts, a folder ``NAME.parts``
-of ``--blocks`` blocks (:mod:`dem.scene.packing_parts`: what ``[particles] file`` reads in parts under MPI, each rank
-only its own). A data file does not say which axes are
+of ``--blocks`` blocks (:mod:`dem.scene.packing_files.parts`: what ``[particles] file`` reads in parts under MPI,
+each rank only its own). A data file does not say which axes are
 periodic: the input script's ``boundary`` command does (the summary lists the periodic axes IN records). The box is
 IN's (a state's or a scene's periodic box, a file's box); a centre outside it is wrapped into it along a periodic axis
 (its image flag counting the periods) and refused along any other. ``--periodic`` is for packing files only (a state
@@ -55,7 +55,7 @@ def register(sub):
 
 
 def read_input(args):
-    """The :class:`dem.scene.packing_files.Packing` of IN and what it was (``packing``, ``state`` or ``scene``).
+    """The :class:`dem.scene.packing_files.packing.Packing` of IN and what it was (``packing``, ``state`` or ``scene``).
 
     Parameters
     ----------
@@ -64,7 +64,7 @@ def read_input(args):
 
     Returns
     -------
-    tuple of (dem.scene.packing_files.Packing, str)
+    tuple of (dem.scene.packing_files.packing.Packing, str)
         The packing and its kind.
 
     Raises
@@ -108,6 +108,7 @@ def run(args) -> dict:
     ValueError
         A bad OUT name, ``--density``, or input.
     """
+    from dem.output.lammps_dump import lammps_ids
     from dem.scene import packing_files
 
     target = pathlib.Path(args.output)
@@ -128,13 +129,13 @@ def run(args) -> dict:
     elif out_format == "csv":
         packing_files.write_csv(target, packing)
     elif out_format == "parts":
-        from dem.scene.packing_parts import read_index, write_parts
+        from dem.scene.packing_files.parts import read_index, write_parts
 
         write_parts(target, packing, args.blocks)
         blocks = read_index(target).blocks
     else:
         packing_files.write_vtu(target, packing)
-    ids = packing_files.lammps_ids(packing.id) if out_format == "lammps-data" else packing.id
+    ids = lammps_ids(packing.id) if out_format == "lammps-data" else packing.id
     result = {"input": args.input, "input_kind": kind, "input_format": packing.format or kind, "output": str(target),
               "output_format": OUTPUTS[out_format], "particles": packing.n,
               "ids": [int(ids.min()), int(ids.max())]}

@@ -11,7 +11,8 @@ also per particle, for up to 1000 of them).
 
 Under ``mpiexec -n N`` (N > 1) a static scene runs on N ranks (:mod:`dem.engines.distributed`; PETSc options through
 ``PETSC_OPTIONS``), each reading only its part of a packing in parts (``[particles] file = "NAME.parts"``,
-:mod:`dem.scene.packing_parts`); rank 0 prints the summary and the one-line errors, the other ranks print nothing.
+:mod:`dem.scene.packing_files.parts`); rank 0 prints the summary and the one-line errors, the other ranks print
+nothing.
 """
 
 import os

@@ -1,7 +1,7 @@
 """The heat network of a packing shared out among MPI ranks: each rank's rows, the groups that span ranks, the steady
 solve and the theta-method steps, all on PETSc (:mod:`dem.network.petsc`).
 
-Each rank holds the particles it owns and a halo (:mod:`dem.geometry.partition`), and a
+Each rank holds the particles it owns and a halo (:mod:`dem.geometry.bisection`), and a
 :class:`dem.network.heat.Network` of them whose bonds are those with at least one owned particle. An owned particle
 has all its bonds there, in the order of the serial run's (both sorted by particle index), so its row of the matrix,
 its boundary terms and its right-hand side are those of the serial network to the bit; the halo's rows are

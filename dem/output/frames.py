@@ -175,7 +175,7 @@ class WithFrames:
         temperatures = [float(np.min(scene.particles.temperature))]
         temperatures += [w.temperature for w in m.walls if w.temperature is not None]
         self.writer = writer
-        self.frames = FrameWriter(out_dir, m.frames, scene.solver.t_end, m.control or 0, min(temperatures),
+        self.frames = FrameWriter(out_dir, m.staggered.frames, scene.solver.t_end, m.staggered.control or 0, min(temperatures),
                                   max(temperatures), scene.temperature_unit)
 
     @property

@@ -3,8 +3,8 @@
 :func:`write_dump` writes one snapshot: ``ITEM: UNITS`` (``si``), ``TIMESTEP``, ``NUMBER OF ATOMS``, ``BOX BOUNDS``
 (``pp`` along the periodic axes, ``ff`` elsewhere) and ``ATOMS id type radius x y z`` followed by ``vx vy vz``,
 ``fx fy fz`` and ``T`` where the run has them. Numbers are written to round-trip (the shortest digits that read back to
-the same double), so :func:`dem.scene.packing_files.read_packing` reads a snapshot back bit for bit. The same
-formatting serves the LAMMPS data files of :mod:`dem.scene.packing_files` (:func:`rows_text`, :func:`lammps_ids`).
+the same double), so :func:`dem.scene.packing_files.read.read_packing` reads a snapshot back bit for bit. The same
+formatting serves the LAMMPS data files of :mod:`dem.scene.packing_files.lammps` (:func:`rows_text`, :func:`lammps_ids`).
 """
 
 from __future__ import annotations

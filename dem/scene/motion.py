@@ -6,37 +6,35 @@ Tables and keys (SI units; the README's scene schema lists them with their defau
 * ``[scene] dimension`` (3: spheres; 2: disks in the x-z plane) and ``height`` (m, the disks' height);
 * ``[particles] velocity``, ``angular_velocity`` (lists of 3-vectors; or the generator's random ``speed``);
 * ``[contact]`` -- the contact law and its parameters (``law = "luding"``, Luding 2005; ``law = "zohdi"``,
-  Zohdi 2014: its stepping, current and electrode keys are those of :mod:`dem.scene.zohdi`);
+  Zohdi 2014);
 * ``[[walls]]`` -- planes that move: ``motion`` fixed | stress | strain | vibrate with ``pressure``, ``mass``,
   ``damping``, ``velocity``, ``amplitude``, ``frequency`` (:mod:`dem.geometry.walls`); ``temperature`` optional;
 * ``[gravity] acceleration`` (m/s^2, a 3-vector);
-* ``[temperature]`` -- a prescribed schedule ``time``, ``value``, ``relaxation_time`` (:mod:`dem.scene.events`);
 * ``[[phases]]`` -- from time ``start`` on, other friction or damping (``mu``, ``mu_wall``, ``gamma_n``,
   ``gamma_t``): Luding 2005 prepares frictionless and switches the friction at t_heat; and other wall speeds
   (``wall_velocity = {name = v}``, m/s inward, for strain walls): a wall pushed, held and pulled away (Zohdi 2014,
   Sec. 7);
 * ``[start] state`` -- begin from a saved state (:mod:`dem.scene.state_file`) instead of ``[particles]``;
-* ``[solver]`` -- ``t_end``; ``dt`` (s, or "auto": t_MD = pi/(50 omega), Luding 2005 eq. 6); ``skin`` (m);
-  ``thermal_interval`` (s) and ``integrator`` (implicit | crank-nicolson) of a coupled thermal network;
+* ``[solver]`` -- ``t_end``; ``skin`` (m, the neighbour list's; its default is the engine's);
 * ``[output]`` -- ``interval`` (s between rows of ``timeseries.csv``), ``vtu_interval`` (s between snapshots).
+
+Each engine that moves particles reads keys of its own, parsed into its own spec (``MotionSpec.verlet`` or
+``MotionSpec.staggered``): :mod:`dem.scene.verlet` (the step, a coupled thermal network's interval, a prescribed
+temperature schedule) and :mod:`dem.scene.staggered` (Zohdi 2014's implicit stepping, the powder bed's axis).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dem.laws.contact import law_module
-from dem.geometry.motion import particle_mass, moment_of_inertia
 from dem.geometry.particles import finite_array
-from dem.scene.events import TemperatureSchedule
-from dem.scene import zohdi as zscene
+from dem.scene.schema import number
+from dem.scene.staggered import STAGGERED_SKIN, StaggeredSpec, parse_staggered
+from dem.scene.verlet import VERLET_SKIN, VerletSpec, parse_verlet, verlet_step
 
-DEFAULT_SKIN = 0.1            # x the mean radius
 DEFAULT_OUTPUT_ROWS = 100     # rows of timeseries.csv when [output] interval is not given
-DEFAULT_THERMAL_STEPS = 1000  # mechanical steps per thermal step when [solver] thermal_interval is not given
 @dataclass(frozen=True)
 class MotionSpec:
     """The moving part of a scene (module docstring), as :func:`parse_motion` reads it.
@@ -55,18 +53,10 @@ class MotionSpec:
         The walls, fixed or moving.
     gravity : tuple of float
         The gravitational acceleration [x, y, z] (m/s^2).
-    schedule : dem.scene.events.TemperatureSchedule or None
-        A prescribed temperature history; None: none.
     dt : float
-        The mechanical time step (s).
-    stable_dt : float
-        The largest stable velocity-Verlet step for the stiffest contact (s).
+        The mechanical time step (s; the staggered engine's first step).
     skin : float
         The neighbour list's skin (m).
-    thermal_interval : float
-        Time between the steps of a coupled thermal network (s).
-    thermal_integrator : str
-        That network's step: ``"implicit"`` or ``"crank-nicolson"``.
     output_interval : float
         Time between rows of ``timeseries.csv`` (s).
     vtu_interval : float
@@ -77,14 +67,10 @@ class MotionSpec:
         The saved state (:func:`dem.scene.state_file.load`) the run begins from; None: the scene's particles.
     wall_phases : tuple
         ``(start time (s), {wall name: inward velocity (m/s)})``, sorted by start.
-    stepping : dem.scene.zohdi.ZohdiStepping or None
-        The implicit stepping of ``law = "zohdi"``; None for other laws.
-    control : int or None
-        With ``law = "zohdi"``: the axis (0, 1, 2) the powder bed stands and is pressed along; None otherwise.
-    frames : int
-        With ``law = "zohdi"``: the number of rendered frames (PNG) over the run.
-    relaxation_time : float
-        The relaxation time of a relaxing material (s; Luding 2005, ``t0`` of eqs. 11-12), 0 without one.
+    verlet : dem.scene.verlet.VerletSpec or None
+        The verlet engine's own keys; None on the staggered engine.
+    staggered : dem.scene.staggered.StaggeredSpec or None
+        The staggered engine's own keys; None on the verlet engine.
     """
 
     dimension: int
@@ -93,70 +79,22 @@ class MotionSpec:
     angular_velocity: np.ndarray | None
     walls: tuple
     gravity: tuple
-    schedule: TemperatureSchedule | None
     dt: float
-    stable_dt: float
     skin: float
-    thermal_interval: float
-    thermal_integrator: str
     output_interval: float
     vtu_interval: float
     phases: tuple = ()        # (start time, {material field: value}), sorted by start
     start: dict | None = None  # a saved state (dem.scene.state_file.load) the run begins from
     wall_phases: tuple = ()   # (start time, {wall name: inward velocity}), sorted by start
-    stepping: object = None   # law = "zohdi": its implicit stepping (dem.scene.zohdi.ZohdiStepping)
-    control: int | None = None  # law = "zohdi": the axis the powder bed stands and is pressed along
-    frames: int = 0           # law = "zohdi": rendered frames (PNG) over the run
-    relaxation_time: float = 0.0  # a law with a relaxing material (Luding 2005: t0 of k1(T, t), eqs. 11-12)
+    verlet: VerletSpec | None = None  # the verlet engine's own keys
+    staggered: StaggeredSpec | None = None  # the staggered engine's own keys
 
 
-def _num(table, section, key, default=None, positive=False, nonnegative=False):
-    if key not in table:
-        return default
-    v = table[key]
-    if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
-        raise ValueError(f"[{section}] {key} = {v!r}: must be a finite number")
-    if positive and v <= 0:
-        raise ValueError(f"[{section}] {key} = {v!r}: must be > 0")
-    if nonnegative and v < 0:
-        raise ValueError(f"[{section}] {key} = {v!r}: must be >= 0")
-    return float(v)
-
-
-def time_steps(contact, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray, dimension: int,
-               height: float | None) -> tuple[float, float]:
-    """``(dt, stable)`` of the contact law ``contact.law`` (its ``time_steps``): the step ``dt = "auto"`` takes, and
-    the largest velocity-Verlet step that stays stable for the stiffest contact; a two-particle contact of the mean
-    radius sets the typical mass.
-
-    Parameters
-    ----------
-    contact : object
-        The contact law's material (:mod:`dem.laws.contact`), with its ``law`` and ``density`` (kg/m^3).
-    mass : numpy.ndarray
-        (N,) particle masses (kg).
-    inertia : numpy.ndarray
-        (N,) moments of inertia (kg m^2).
-    radius : numpy.ndarray
-        (N,) radii (m).
-    dimension : int
-        3 (spheres) or 2 (disks).
-    height : float or None
-        Height of the 2D disks (m); None in 3D.
-
-    Returns
-    -------
-    tuple of (float, float)
-        ``(dt, stable)`` (s).
-    """
-    m_mean = float(particle_mass(dimension, contact.density, np.mean(radius), height))
-    return law_module(contact.law).time_steps(contact, mass, inertia, radius, m_mean)
-
-
-def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, start=None, walls=()) -> MotionSpec:
+def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, start=None, walls=(),
+                 engine: str = "verlet") -> MotionSpec:
     """The moving part of a scene (module docstring); ``particles``, ``solver``, the ``contact`` material and the
     ``walls`` are already parsed (the schema has checked every key); ``velocity`` comes from a generator (its random
-    ``speed``); ``start`` is a saved state.
+    ``speed``); ``start`` is a saved state; the keys of the ``engine`` go into its own spec.
 
     Parameters
     ----------
@@ -176,6 +114,8 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
         A saved state to begin from; None: none.
     walls : tuple of dem.geometry.walls.Wall
         The scene's walls.
+    engine : str
+        The engine that moves the particles: ``"verlet"`` or ``"staggered"`` (:mod:`dem.engines`).
 
     Returns
     -------
@@ -191,7 +131,7 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
     dimension = meta.get("dimension", 3)
     if dimension not in (2, 3) or isinstance(dimension, bool):
         raise ValueError(f"[scene] dimension = {dimension!r}: must be 2 (disks) or 3 (spheres)")
-    height = _num(meta, "scene", "height", positive=True)
+    height = number(meta, "scene", "height", positive=True)
     if dimension == 2 and height is None:
         raise ValueError("[scene] height: required for 2D disks (m)")
     if dimension == 3 and height is not None:
@@ -231,64 +171,37 @@ def parse_motion(doc: dict, particles, solver, physics, contact, velocity=None, 
     phases = tuple(sorted((_phase(k, t, contact) for k, t in enumerate(doc.get("phases", []))), key=lambda p: p[0]))
     wall_phases = tuple((start, walls_v) for start, _, walls_v in phases if walls_v)
     _check_wall_phases(wall_phases, walls)
-    if contact.law == "zohdi":
-        return zscene.zohdi_motion(doc, particles, solver, physics, start, walls, gravity, velocity,
-                                   tuple(p[:2] for p in phases), wall_phases, dimension)
-    relaxation_time = float(getattr(contact, "t0", 0.0))  # the material's relaxation time, where its law has one
-    schedule = None
-    if "temperature" in doc:
-        t = doc["temperature"]
-        if "thermal" in physics:
-            raise ValueError("[temperature]: a prescribed schedule and a thermal network both set the temperature; "
-                             "give one (heat the walls or fix particles instead)")
-        for key in ("time", "value"):
-            if key not in t:
-                raise ValueError(f"[temperature] {key}: required")
-        schedule = TemperatureSchedule.build(t["time"], t["value"], t.get("relaxation_time", relaxation_time))
-    density = np.array([m.density for m in particles.materials])[particles.material]
-    mass = particle_mass(dimension, density, particles.radius, height)
-    t_md, stable = time_steps(contact, mass, moment_of_inertia(dimension, mass, particles.radius), particles.radius,
-                              dimension, height)
-    if solver.dt == "auto":
-        dt = t_md
-    else:
-        dt = float(solver.dt)
-        if dt > stable:
-            raise ValueError(f"[solver] dt = {dt:.6g} s: above the stable step {stable:.6g} s of the stiffest contact "
-                             f"(2/omega of law = \"{contact.law}\" for the lightest pair); use dt <= {stable:.6g} s or "
-                             f"dt = \"auto\" ({t_md:.6g} s)")
-    stable_steps = solver.t_end / dt
-    if stable_steps > 1e10:
-        raise ValueError(f"[solver] t_end / dt = {stable_steps:.3g} steps: beyond what one run can take; shorten t_end")
-    solver_table = doc.get("solver", {})
-    skin = _num(solver_table, "solver", "skin", DEFAULT_SKIN * float(np.mean(particles.radius)), positive=True)
-    out = doc.get("output", {})
-    output_interval = _num(out, "output", "interval", solver.t_end / DEFAULT_OUTPUT_ROWS, positive=True)
-    vtu_interval = _num(out, "output", "vtu_interval", 0.0, nonnegative=True)
-    thermal_interval = _num(solver_table, "solver", "thermal_interval",
-                            min(output_interval, DEFAULT_THERMAL_STEPS * dt), positive=True)
-    return MotionSpec(dimension, height, velocity, angular, walls, gravity, schedule, dt, stable, skin,
-                      thermal_interval, solver.integrator, output_interval, vtu_interval,
+    solver_table, out = doc.get("solver", {}), doc.get("output", {})
+    staggered = parse_staggered(doc, walls, dimension) if engine == "staggered" else None
+    dt = staggered.stepping.dt if staggered else verlet_step(particles, solver, contact, dimension, height)
+    skin = number(solver_table, "solver", "skin", (STAGGERED_SKIN if staggered else VERLET_SKIN)
+                  * float(np.mean(particles.radius)), positive=True)
+    output_interval = number(out, "output", "interval", solver.t_end / DEFAULT_OUTPUT_ROWS, positive=True)
+    vtu_interval = number(out, "output", "vtu_interval", 0.0, nonnegative=True)
+    if staggered:  # Zohdi 2014 starts from the scene's particles and changes no material over the run
+        return MotionSpec(dimension, None, velocity, None, walls, gravity, dt, skin, output_interval, vtu_interval,
+                          wall_phases=wall_phases, staggered=staggered)
+    return MotionSpec(dimension, height, velocity, angular, walls, gravity, dt, skin, output_interval, vtu_interval,
                       phases=tuple(p[:2] for p in phases if p[1]), start=start, wall_phases=wall_phases,
-                      relaxation_time=relaxation_time)
+                      verlet=parse_verlet(doc, physics, contact, solver, dt, output_interval))
 
 
 def _phase(k: int, table: dict, contact) -> tuple:
     """``(start, {material field: value}, {wall: velocity})`` of ``[[phases]]`` entry ``k`` (the schema has checked
     its keys); the material it makes is checked now, not when the phase starts."""
-    start = _num(table, f"phases][{k}", "start", nonnegative=True)
+    start = number(table, f"phases][{k}", "start", nonnegative=True)
     if start is None:
         raise ValueError(f"[phases][{k}] start: required (s)")
     walls = table.get("wall_velocity", {})
     if not isinstance(walls, dict):
         raise ValueError(f"[phases][{k}] wall_velocity: must be a table {{wall name = velocity (m/s, inward)}}")
-    values = {key: v if isinstance(v, bool) else _num(table, f"phases][{k}", key) for key, v in table.items()
+    values = {key: v if isinstance(v, bool) else number(table, f"phases][{k}", key) for key, v in table.items()
               if key not in ("start", "wall_velocity")}
     try:
         replace(contact, **values)
     except ValueError as exc:
         raise ValueError(f"[phases][{k}] {str(exc).removeprefix('contact.')}") from None
-    return start, values, {str(name): _num(walls, f"phases][{k}] wall_velocity", name) for name in walls}
+    return start, values, {str(name): number(walls, f"phases][{k}] wall_velocity", name) for name in walls}
 
 
 def _check_wall_phases(wall_phases, walls) -> None:

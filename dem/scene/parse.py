@@ -20,7 +20,7 @@ from dem.geometry import generators
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.fields import material_from_table
 from dem.laws.contact import CONTACT_LAWS, law_module
-from dem.scene.zohdi import ElectricalSpec, parse_electrical
+from dem.scene.electrical import ElectricalSpec, parse_electrical
 from dem.geometry.particles import COPPER, Material, Particles, material_indices
 from dem.geometry.periodic import AXES, PeriodicBox
 from dem.laws.ambient import RADIATION_T_MAX, Convection, Radiation, Sources
@@ -187,7 +187,7 @@ class Scene:
         The material of the contact law (:mod:`dem.laws.contact`), or None.
     motion : dem.scene.motion.MotionSpec or None
         The particles' motion (physics with ``"mechanical"``), or None for a static packing.
-    electrical : dem.scene.zohdi.ElectricalSpec or None
+    electrical : dem.scene.electrical.ElectricalSpec or None
         The current's scheme and electrodes (``"electrical"`` physics), or None.
     box : dem.geometry.periodic.PeriodicBox or None
         The periodic box, or None.
@@ -199,9 +199,9 @@ class Scene:
         The unit of the scene's temperatures, ``"C"`` or ``"K"`` (:func:`temperature_unit`).
     groups : dict
         The ``[[groups]]`` that hold their particles, ``{name: indices}`` (:func:`dem.scene.groups.apply_groups`).
-    part : dem.scene.packing_parts.Part or None
+    part : dem.scene.packing_files.parts.Part or None
         Where ``particles`` are in the packing when they are one rank's part of a packing in parts
-        (:func:`dem.scene.packing_parts.read_part`); None: they are the whole packing.
+        (:func:`dem.scene.packing_files.parts.read_part`); None: they are the whole packing.
 
     Raises
     ------
@@ -227,7 +227,7 @@ class Scene:
     start: dict | None = None  # the saved state it starts from (dem.scene.state_file.load), else None
     temperature_unit: str = "C"  # the unit of its temperatures, "C" or "K" (:func:`temperature_unit`)
     groups: dict = field(default_factory=dict)  # the [[groups]] that hold their particles, {name: indices}
-    part: object = None  # a rank's part of a packing in parts (dem.scene.packing_parts.Part), else None
+    part: object = None  # a rank's part of a packing in parts (dem.scene.packing_files.parts.Part), else None
 
     def __post_init__(self):
         walls = self.motion.walls if self.motion is not None else self.walls
@@ -575,8 +575,8 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
         the working directory.
     part : tuple or None
         ``(ranks, rank)``: a static scene whose ``[particles] file`` is a packing in parts
-        (:mod:`dem.scene.packing_parts`) gets only the particles rank ``rank`` of ``ranks`` holds (``Scene.part``
-        says which); None, or another scene: every particle.
+        (:mod:`dem.scene.packing_files.parts`) gets only the particles rank ``rank`` of ``ranks`` holds
+        (``Scene.part`` says which); None, or another scene: every particle.
 
     Returns
     -------
@@ -665,7 +665,7 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     output = _spec(OutputSpec, doc.get("output", {}), "output", numeric=("checkpoint_every",),
                    integer=("every", "vtu_every"))
     contact = contact_material_from_scene(doc) if moving else None
-    motion = parse_motion(doc, particles, solver, physics, contact, velocity, start, walls) if moving else None
+    motion = parse_motion(doc, particles, solver, physics, contact, velocity, start, walls, engine) if moving else None
     electrical = parse_electrical(doc, walls, physics)
     if start is not None and solver.mode == "transient" and solver.t_end <= start["t"]:
         raise ValueError(f"[solver] t_end = {solver.t_end:g} s: must be beyond the saved state's time "

@@ -5,11 +5,13 @@ one table the parser checks a scene against (:func:`check`) and the documentatio
 Engines (:mod:`dem.engines`): ``static`` (a packing that does not move), ``verlet`` (particles that move, velocity
 Verlet) and ``staggered`` (Zohdi 2014's implicit scheme). A key the scene's engine does not read is refused, naming the
 engine and those that read it. The ``[contact]`` keys are those of the contact law's material
-(:data:`dem.laws.contact.CONTACT_LAWS`), and a ``[[phases]]`` entry may change any of them but the density.
+(:data:`dem.laws.contact.CONTACT_LAWS`), and a ``[[phases]]`` entry may change any of them but the density. A
+number a key holds is read by :func:`number`, which names the key when it is not one or out of its range.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, fields
 
 ENGINE_NAMES = ("static", "verlet", "staggered")
@@ -245,6 +247,47 @@ ROWS = (
         "(the largest change per sweep relative to the largest wall value) and its sweeps at most"),
 )
 TABLES = tuple(dict.fromkeys(row.table for row in ROWS))
+
+
+def number(table: dict, section: str, key: str, default=None, positive: bool = False,
+           nonnegative: bool = False) -> float | None:
+    """The number ``table[key]`` as a float, ``default`` where the key is not given.
+
+    Parameters
+    ----------
+    table : dict
+        The table (``[solver]``, say).
+    section : str
+        The table's name in errors (``"solver"``, ``"phases][0"``).
+    key : str
+        The key.
+    default : float or None
+        What a missing key reads as.
+    positive : bool
+        Whether the number must be > 0.
+    nonnegative : bool
+        Whether the number must be >= 0.
+
+    Returns
+    -------
+    float or None
+        The number, or ``default``.
+
+    Raises
+    ------
+    ValueError
+        The value is not a finite number, or out of its range (one line naming ``[section] key``).
+    """
+    if key not in table:
+        return default
+    v = table[key]
+    if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
+        raise ValueError(f"[{section}] {key} = {v!r}: must be a finite number")
+    if positive and v <= 0:
+        raise ValueError(f"[{section}] {key} = {v!r}: must be > 0")
+    if nonnegative and v < 0:
+        raise ValueError(f"[{section}] {key} = {v!r}: must be >= 0")
+    return float(v)
 
 
 def keys(table: str, engine: str | None = None) -> set[str]:

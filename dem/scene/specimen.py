@@ -157,7 +157,7 @@ def find_specimen(particles, walls, box=None, named: dict | None = None, bounds=
         Walls that only bound the cross-section (a saved state's), not ends.
     span : tuple or None
         ``(lo, hi)``, (3,) each: the extent of the packing's surfaces (m), where ``particles`` are only a part of
-        it (:mod:`dem.scene.packing_parts`); None: that of ``particles``.
+        it (:mod:`dem.scene.packing_files.parts`); None: that of ``particles``.
 
     Returns
     -------

@@ -1,4 +1,4 @@
-"""A packing in parts (:mod:`dem.scene.packing_parts`) read in part on each rank: no rank holds the whole packing
+"""A packing in parts (:mod:`dem.scene.packing_files.parts`) read in part on each rank: no rank holds the whole packing
 or opens every block, and the run gives the effective conductivity, the temperatures, the bond count, the specimen
 and the held layers' heat flows of the serial run of the same scene read whole, in the same process."""
 

@@ -2,9 +2,9 @@
 steady or in implicit steps of a fixed size, its particles shared out in space and its matrix solved on PETSc.
 
 Every rank reads the scene, keeps the particles of its cell of a recursive coordinate bisection
-(:func:`dem.geometry.partition.bisection`) and a halo of one bond length around them
-(:func:`dem.geometry.partition.halo`) -- or, from a packing in parts, reads only those
-(:func:`dem.scene.packing_parts.read_part`: the scene's ``part``) --, finds their bonds and conductances as the
+(:func:`dem.geometry.bisection.bisection`) and a halo of one bond length around them
+(:func:`dem.geometry.bisection.halo`) -- or, from a packing in parts, reads only those
+(:func:`dem.scene.packing_files.parts.read_part`: the scene's ``part``) --, finds their bonds and conductances as the
 serial engine does, and keeps those with an owned particle (:mod:`dem.network.distributed`: its rows are the serial
 matrix's to the bit). The summary and the effective conductivity are reduced over the ranks; the snapshots are one
 piece per rank (:class:`dem.output.pieces.PieceWriter`).
@@ -31,7 +31,7 @@ import numpy as np
 from dem import memory
 from dem.engines.static import CSV_FLOWS, StaticEngine, boundary_summary
 from dem.geometry.necks import meeting_in
-from dem.geometry.partition import HALO_MARGIN, bisection, halo
+from dem.geometry.bisection import HALO_MARGIN, bisection, halo
 from dem.laws.verified_range import neck_account, wide_necks
 from dem.network import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating

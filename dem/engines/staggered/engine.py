@@ -15,7 +15,7 @@ Each step from ``t`` to ``t + dt`` iterates, K = 1, 2, ...:
 ``Z_K <= 1``: the step is accepted, the current refreshed at the new configuration (step 6d), and the next step is
 ``min(Phi_K dt, dt_lim)`` (steps 6a-c). ``Z_K > 1`` after ``K_d`` iterations: the step restarts from ``t`` with
 ``Phi_K dt`` (step 7). Beyond the paper: an accepted step grows by at most ``growth``, a restart shrinks it by at
-least ``shrink`` (:class:`dem.scene.zohdi.ZohdiStepping`), a displacement below 1e-12 of the mean radius (a
+least ``shrink`` (:class:`dem.scene.staggered.ZohdiStepping`), a displacement below 1e-12 of the mean radius (a
 temperature change below 1e-12 of the temperatures) counts as none, and a step below ``dt_min`` that still cannot
 converge stops the run. Steps end exactly on the start of every ``[[phases]]`` entry (a wall changing speed) and on
 ``t_end``.
@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from dem.geometry.motion import MotionState
+from dem.engines.state import MotionState
 from dem.geometry.neighbours import list_arrays
 from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
@@ -70,7 +70,7 @@ class StaggeredEngine:
         """
         self.scene = scene
         m, p = scene.motion, scene.particles
-        self.stepping = m.stepping
+        self.stepping = m.staggered.stepping
         material = scene.contact
         saved = normalised(dict(restart)) if restart is not None else m.start
         state = MotionState.create(3, p.position, p.radius, material.density, p.temperature, m.velocity)
@@ -101,7 +101,7 @@ class StaggeredEngine:
         if restart is not None:
             self._resume(saved)
         self._apply_phases()
-        axis = m.control
+        axis = m.staggered.control
         if axis is not None:  # the walls facing +axis (bottom) and -axis (top) of the bed's fractions
             normals = self.mechanics.w.normal[:, axis]
             self._bottom = int(np.flatnonzero(np.abs(normals - 1.0) < 1e-12)[0])
@@ -206,7 +206,7 @@ class StaggeredEngine:
         # a step cut short to land on an event does not hold the next one back
         self.dt = min(st.dt_max, max(factor * dt, self.dt) if last else factor * dt)
         self._apply_phases()
-        if self.scene.motion.control is not None:
+        if self.scene.motion.staggered.control is not None:
             self._lowest = min(self._lowest, -mech.w.q[self._top])
         if self.current is not None:
             self.current.book(dt)
@@ -309,7 +309,7 @@ class StaggeredEngine:
 
         Without ``fraction_axis``: ``volume_fraction`` is the solid volume over the volume of the walls' box."""
         s, mech = self.mechanics.state, self.mechanics
-        axis = self.scene.motion.control
+        axis = self.scene.motion.staggered.control
         section = self._cross_section(axis)
         if section is None:
             return {"volume_fraction": None}
@@ -358,7 +358,7 @@ class StaggeredEngine:
     def plates(self) -> list:
         """The bottom and top walls of ``[output] fraction_axis`` as ``(centre, normal, sizes)`` for pictures
         (:mod:`dem.output.frames`); none without that axis."""
-        axis = self.scene.motion.control
+        axis = self.scene.motion.staggered.control
         section = self._cross_section(axis) if axis is not None else None
         if section is None:
             return []

@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from dem.engines import compiled
-from dem.geometry.motion import MotionState
+from dem.engines.state import MotionState
 from dem.geometry.neighbours import carry_history, max_displacement, restore_lists, verlet_pairs, wall_pairs
 from dem.geometry.periodic import PeriodicBox
 from dem.geometry.walls import MOTIONS, WallArrays

@@ -28,7 +28,7 @@ from dataclasses import replace
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.bonds import find_bonds
-from dem.geometry.motion import MotionState
+from dem.engines.state import MotionState
 from dem.geometry.necks import meeting_in
 from dem.geometry.neighbours import list_arrays
 from dem.geometry.periodic import pair_lines
@@ -78,12 +78,12 @@ class VerletEngine:
                 setattr(state, key, np.ascontiguousarray(saved[key], dtype=float).copy())
         self.material = material
         self.mechanics = self.mechanics_class(state, m.walls, material, m.dt, m.skin, m.gravity, scene.box,
-                                              relaxation_time=m.relaxation_time, history=saved)
+                                              relaxation_time=m.verlet.relaxation_time, history=saved)
         self.thermal = None
         if "thermal" in scene.physics:
-            self.thermal = self.thermal_class(p, m.walls, scene.conductance, scene.sources, m.thermal_integrator,
+            self.thermal = self.thermal_class(p, m.walls, scene.conductance, scene.sources, m.verlet.thermal_integrator,
                                                scene.solver.linear, scene.box)
-        self.schedule = m.schedule
+        self.schedule = m.verlet.schedule
         self.steps_start = 0
         if restart is not None:
             self._resume(restart)
@@ -177,7 +177,7 @@ class VerletEngine:
         every = max(1, round(m.output_interval / dt))
         ends.update(range(every, n_end, every))
         if self.thermal is not None:
-            every = max(1, round(m.thermal_interval / dt))
+            every = max(1, round(m.verlet.thermal_interval / dt))
             ends.update(range(every, n_end, every))
         if self.schedule is not None:
             ends.update(k for k in (round((t - t0) / dt) for t in self.schedule.time) if 0 < k < n_end)

@@ -28,7 +28,7 @@ from sinterheat import threads
 from dem.engines import compiled
 from dem.engines.contact_forces import LOAD_COLUMNS, split_incidences
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
-from dem.geometry.motion import MotionState
+from dem.engines.state import MotionState
 from dem.geometry.neighbours import carry_history, restore_lists, verlet_pairs, wall_pairs
 from dem.geometry.periodic import PeriodicBox
 from dem.geometry.walls import WallArrays

@@ -1,4 +1,5 @@
-"""Particles shared out in space among the ranks of a distributed run, and the halo each rank needs.
+"""A packing that does not move shared out in space among the ranks of a distributed run (the static engine's, and a
+packing in parts), and the halo each rank needs.
 
 :func:`bisection` is recursive coordinate bisection (Berger & Bokhari 1987): the particles are split across their
 longest extent at the count that gives each side its share of the parts, and each side again, until there are
@@ -11,9 +12,15 @@ bond length (twice the largest radius: two spheres bond only when ``d < r_i + r_
 has its partner among the owned and the halo particles, so a bond search over those finds all of them. On periodic
 axes the distance is taken to the nearest image.
 
-A packing stored in parts (:mod:`dem.scene.packing_parts`) is shared out by its blocks, not its particles: the same
-bisection over the blocks' centres, each weighted by its particle count, so that a rank reads only its blocks and
+A packing stored in parts (:mod:`dem.scene.packing_files.parts`) is shared out by its blocks, not its particles: the
+same bisection over the blocks' centres, each weighted by its particle count, so that a rank reads only its blocks and
 those within ``reach`` of them.
+
+Particles that move are shared out otherwise, in slabs along one axis (:mod:`dem.engines.verlet.slabs`): they cross
+the cuts all the time, so their cuts are planes fixed for the run, the owner of a particle is computed from one
+coordinate alone (the same answer on every rank, from a ghost's copy too), and the halo includes the Verlet skin. A
+packing that does not move is cut once, into compact cells whose faces -- the off-rank matrix entries -- stay small on
+many ranks; the two jobs want different cuts, hence two modules.
 """
 
 from __future__ import annotations

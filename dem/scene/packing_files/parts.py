@@ -2,11 +2,11 @@
 
 A packing in parts is a folder ``NAME.parts`` of blocks, ``block-NNNNN.npz`` (numpy's own format: arrays read one
 by one, no other library), and ``index.json``, written last, which says what the blocks hold. The blocks are the
-cells of a recursive coordinate bisection of the centres (:func:`dem.geometry.partition.bisection`): compact
+cells of a recursive coordinate bisection of the centres (:func:`dem.geometry.bisection.bisection`): compact
 regions of (almost) equal counts. Each block holds its particles in the packing's order with their place in it
 (``index``, from 0), ids, centres (m), radii (m) and the optional per-particle arrays of a
-:class:`dem.scene.packing_files.Packing` that the packing has. The index gives, per block, its file, its count, the
-bounding box of its centres and its largest radius; for the packing, its count, its box and periodic axes, the
+:class:`dem.scene.packing_files.packing.Packing` that the packing has. The index gives, per block, its file, its count,
+the bounding box of its centres and its largest radius; for the packing, its count, its box and periodic axes, the
 extent of its particles' surfaces and their largest radius. The particles held at their temperature (``fixed``), if
 any, are also in ``held.npz`` (as a block): the ends of the specimen and the groups of ``boundary_heat_flow`` are
 found over all of them (:mod:`dem.scene.specimen`), which every rank reads.
@@ -15,7 +15,7 @@ Read whole (:func:`read_whole`: what ``[particles] file`` reads on one process, 
 packing in parts is the packing it was written from, in its order, to the bit. Read in part (:func:`read_part`),
 rank ``r`` of ``R`` gets its blocks -- a bisection of the blocks' centres weighted by their counts -- and the
 particles of the other blocks within one bond length (two largest radii) of the bounding box of its centres
-(:func:`dem.geometry.partition.halo`, periodic axes wrapped), having opened only the blocks whose boxes come that
+(:func:`dem.geometry.bisection.halo`, periodic axes wrapped), having opened only the blocks whose boxes come that
 close: every bond of an owned particle has its partner among those it holds, so the distributed static engine
 (:mod:`dem.engines.distributed`) builds its rows from them alone. No rank holds the whole packing; the index (some
 hundred bytes per block) is read by all.
@@ -29,13 +29,13 @@ from __future__ import annotations
 import json
 import math
 import pathlib
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from dem.geometry.partition import HALO_MARGIN, bisection, halo
+from dem.geometry.bisection import HALO_MARGIN, bisection, halo
 from dem.output.atomic import write_aside
-from dem.scene.packing_files import Packing
+from dem.scene.packing_files.packing import Packing
 
 SUFFIX = ".parts"
 INDEX = "index.json"
@@ -101,7 +101,8 @@ class Index:
     extent_lo, extent_hi : numpy.ndarray
         (3,) the extent of the particles' surfaces, ``min(x - r)`` and ``max(x + r)`` per axis (m).
     fields : tuple of str
-        The optional per-particle arrays the blocks hold (names of :class:`dem.scene.packing_files.Packing` fields).
+        The optional per-particle arrays the blocks hold (names of
+        :class:`dem.scene.packing_files.packing.Packing` fields).
     fixed : int
         How many particles the packing holds at their temperature (its ``fixed`` flags).
     box_lo, box_hi : numpy.ndarray or None
@@ -138,7 +139,7 @@ def write_parts(path, packing: Packing, blocks: int | None = None) -> pathlib.Pa
     ----------
     path : str or pathlib.Path
         The folder to write, a name ending ``.parts``.
-    packing : dem.scene.packing_files.Packing
+    packing : dem.scene.packing_files.packing.Packing
         The packing (SI units).
     blocks : int or None
         The number of blocks, 1 ... the particle count; None: :func:`default_blocks`.
@@ -281,7 +282,7 @@ def read_whole(path) -> Packing:
 
     Returns
     -------
-    dem.scene.packing_files.Packing
+    dem.scene.packing_files.packing.Packing
         The packing (SI units), its ``format`` ``"parts"``.
 
     Raises
@@ -317,8 +318,8 @@ class Part:
     fixed_places : numpy.ndarray
         (K,) int, the places in the packing of all its particles held at their temperature, sorted.
     fixed : object
-        Those particles: a :class:`dem.scene.packing_files.Packing` (:func:`read_part`), or the scene's
-        :class:`dem.geometry.particles.Particles` of them (:func:`dem.scene.packing_files.scene_particles`); None
+        Those particles: a :class:`dem.scene.packing_files.packing.Packing` (:func:`read_part`), or the scene's
+        :class:`dem.geometry.particles.Particles` of them (:func:`dem.scene.packing_files.scene.scene_particles`); None
         where there are none.
     """
 
@@ -363,7 +364,7 @@ def block_owner(index: Index, ranks: int, lengths=None) -> np.ndarray:
 
 def _near(lo: np.ndarray, hi: np.ndarray, region_lo: np.ndarray, region_hi: np.ndarray, lengths, periodic):
     """Mask over boxes ``[lo, hi]``: within the region on every axis, periodic axes wrapped (as
-    :func:`dem.geometry.partition.halo` tests a centre)."""
+    :func:`dem.geometry.bisection.halo` tests a centre)."""
     near = np.ones(len(lo), dtype=bool)
     for a in range(3):
         inside = (hi[:, a] >= region_lo[a]) & (lo[:, a] <= region_hi[a])
@@ -393,7 +394,7 @@ def read_part(path, ranks: int, rank: int, box=None) -> tuple[Packing, Part]:
 
     Returns
     -------
-    tuple of (dem.scene.packing_files.Packing, Part)
+    tuple of (dem.scene.packing_files.packing.Packing, Part)
         The held particles (in the packing's order) and where they are in it.
 
     Raises
