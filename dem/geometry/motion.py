@@ -1,11 +1,12 @@
-"""State of particles that move, as arrays: positions, velocities, angular velocities, forces, torques, masses,
+r"""State of particles that move, as arrays: positions, velocities, angular velocities, forces, torques, masses,
 moments of inertia, radii and temperatures.
 
 Two kinds of particle:
 
-* ``dimension = 3`` -- spheres, ``m = rho (4/3) pi a^3``, ``I = (2/5) m a^2``;
+* ``dimension = 3`` -- spheres, :math:`m = \rho \frac{4}{3} \pi a^3`, :math:`I = \frac{2}{5} m a^2`;
 * ``dimension = 2`` -- disks (cylinders) of height ``height`` lying in the x-z plane, as in Luding 2005
-  (Sec. 2): ``m = rho pi a^2 h``, ``I = m a^2 / 2`` about the y axis. Their centres keep ``y = 0``; they translate
+  (Sec. 2): :math:`m = \rho \pi a^2 h`, :math:`I = m a^2 / 2` about the y axis. Their centres keep :math:`y = 0`; they
+  translate
   in x and z and rotate about y only (:attr:`MotionState.axes`, :attr:`MotionState.spin_axes`).
 
 The radius follows the temperature by thermal expansion (Luding 2005, eq. 9) while the mass stays constant, so the
@@ -22,14 +23,14 @@ DIMENSIONS = (2, 3)
 
 
 def particle_mass(dimension: int, density, radius, height: float | None = None) -> np.ndarray:
-    """``rho (4/3) pi a^3`` (spheres) or ``rho pi a^2 h`` (disks of height h), kg.
+    r""":math:`\rho \frac{4}{3} \pi a^3` (spheres) or :math:`\rho \pi a^2 h` (disks of height h), kg.
 
     Parameters
     ----------
     dimension : int
         3 (spheres) or 2 (disks in the x-z plane).
     density : float or array_like
-        Density rho (kg/m^3), scalar or one per particle.
+        Density :math:`\rho` (kg/m^3), scalar or one per particle.
     radius : float or array_like
         Radii a (m).
     height : float or None
@@ -47,7 +48,7 @@ def particle_mass(dimension: int, density, radius, height: float | None = None) 
 
 
 def moment_of_inertia(dimension: int, mass, radius) -> np.ndarray:
-    """``(2/5) m a^2`` (sphere) or ``m a^2 / 2`` (disk about its axis), kg m^2.
+    r""":math:`\frac{2}{5} m a^2` (sphere) or :math:`m a^2 / 2` (disk about its axis), kg m^2.
 
     Parameters
     ----------
