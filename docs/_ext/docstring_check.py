@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+import pkgutil
 import re
 
 import api_check
@@ -107,8 +108,8 @@ def formula_lines(docstring: str | None) -> list[str]:
 
 
 def ascii_formulas(package: str) -> list[str]:
-    """``object: line`` for every line of a public docstring of ``package`` (its modules', and those of the objects
-    :func:`undocumented` reads: functions, classes, their public methods and properties) that :func:`formula_lines`
+    """``object: line`` for every line of a public docstring of ``package`` (its public modules', and those of the
+    objects :func:`undocumented` reads: functions, classes, their public methods and properties) that :func:`formula_lines`
     finds an ASCII formula in, each docstring once."""
     import importlib
 
@@ -120,9 +121,12 @@ def ascii_formulas(package: str) -> list[str]:
             seen.add(id(doc))
             found.extend(f"{name}: {line}" for line in formula_lines(doc))
 
+    root = importlib.import_module(package)
+    modules = [package] + [m.name for m in pkgutil.walk_packages(getattr(root, "__path__", []), package + ".")]
+    for module in modules:
+        if not any(part.startswith("_") for part in module.split(".")):  # __main__ too: importing it would run it
+            read(module, importlib.import_module(module))
     objects = api_check.public_objects(package)
-    for module in dict.fromkeys(name.rpartition(".")[0] for name in objects):
-        read(module, importlib.import_module(module))
     for dotted in objects:
         module, _, name = dotted.rpartition(".")
         obj = getattr(importlib.import_module(module), name)
