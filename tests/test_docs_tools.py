@@ -333,7 +333,6 @@ ASCII_FORMULAS_LEFT = {
     "fem_neck.dual": 18,
     "fem_neck.fit": 9,
     "fem_neck.hpmesh": 10,
-    "fem_neck.lattice": 35,
     "fem_neck.pcg": 9,
     "fem_neck.primal": 6,
     "fem_neck.render": 1,
