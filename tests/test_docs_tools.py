@@ -329,12 +329,10 @@ ASCII_FORMULAS_LEFT = {
     "dem.scene.zohdi": 12,
     "fem_neck.cli": 4,
     "fem_neck.convergence": 2,
-    "fem_neck.curved": 10,
     "fem_neck.fit": 9,
     "fem_neck.hpmesh": 10,
     "fem_neck.render": 1,
     "fem_neck.shapes": 6,
-    "fem_neck.simplex": 12,
     "fem_neck.spectral": 12,
     "fem_neck.unequal": 4,
 }

@@ -84,7 +84,7 @@ def formula_lines(docstring: str | None) -> list[str]:
         return re.sub(r"[^\n]", " ", match.group(0))
 
     def literal(match):  # a literal naming a parameter (``kappa``) is code; one holding an expression, a formula
-        return blank(match) if re.fullmatch(r"[\w.*]+(, [\w.*]+)*", match.group(1)) else " " + match.group(1) + " "
+        return blank(match) if re.fullmatch(r"\(?[\w.*]+(, [\w.*]+)*\)?", match.group(1)) else " " + match.group(1) + " "
 
     text = _LITERAL.sub(literal, _OTHER_ROLE.sub(blank, _MATH_ROLE.sub(blank, docstring)))
     found = escaped
