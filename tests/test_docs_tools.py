@@ -327,14 +327,6 @@ ASCII_FORMULAS_LEFT = {
     "dem.scene.motion": 1,
     "dem.scene.packing_files": 1,
     "dem.scene.zohdi": 12,
-    "fem_neck.cli": 4,
-    "fem_neck.convergence": 2,
-    "fem_neck.fit": 9,
-    "fem_neck.hpmesh": 10,
-    "fem_neck.render": 1,
-    "fem_neck.shapes": 6,
-    "fem_neck.spectral": 12,
-    "fem_neck.unequal": 4,
 }
 
 
