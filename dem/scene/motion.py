@@ -1,4 +1,4 @@
-"""The part of a scene that makes particles move (``[scene] physics`` with ``"mechanical"``): TOML into a
+r"""The part of a scene that makes particles move (``[scene] physics`` with ``"mechanical"``): TOML into a
 :class:`MotionSpec`.
 
 Tables and keys (SI units; the README's scene schema lists them with their defaults):
@@ -16,7 +16,7 @@ Tables and keys (SI units; the README's scene schema lists them with their defau
   (``wall_velocity = {name = v}``, m/s inward, for strain walls): a wall pushed, held and pulled away (Zohdi 2014,
   Sec. 7);
 * ``[start] state`` -- begin from a saved state (:mod:`dem.scene.state_file`) instead of ``[particles]``;
-* ``[solver]`` -- ``t_end``; ``dt`` (s, or "auto": t_MD = pi/(50 omega), Luding 2005 eq. 6); ``skin`` (m);
+* ``[solver]`` -- ``t_end``; ``dt`` (s, or "auto": :math:`t_{MD} = \pi/(50 \omega)`, Luding 2005 eq. 6); ``skin`` (m);
   ``thermal_interval`` (s) and ``integrator`` (implicit | crank-nicolson) of a coupled thermal network;
 * ``[output]`` -- ``interval`` (s between rows of ``timeseries.csv``), ``vtu_interval`` (s between snapshots).
 """
