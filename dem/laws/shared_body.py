@@ -15,16 +15,15 @@ Neumann function between two surface points at the angle :math:`\gamma`; from it
 .. math::
 
     G(\gamma) = \frac{1/s - 2 - \ln\left(s (1 + s)\right)}{4 \pi \kappa r}, \qquad
-    s = \sin(\gamma / 2) = |n_b - n_c| / 2:
+    s = \sin(\gamma / 2) = |n_b - n_c| / 2,
 
-the :math:`1/s` is twice the free-space source (a source on a surface), the logarithm the ball's finite size (the
+where the :math:`1/s` is twice the free-space source (a source on a surface), the logarithm the ball's finite size (the
 term that gives the fit law its :math:`x \ln(1/x)`, :mod:`fem_neck.law`). A neck is not a point: its heat crosses the
-disk of radius :math:`a_b` on the cap base plane, at :math:`z_b = \sqrt{r^2 - a_b^2}` from the centre, so the
-free-space part is taken between the disk centres :math:`z_b n_b` (chord :math:`l_{bc} = |z_b n_b - z_c n_c|`), which
-is exact as :math:`a \to 0` and brings wide necks closer. The model keeps the pair-calibrated half resistance
-:math:`R_b = 1 / K_b` of the fit law on the diagonal (a neck's own constriction, its half neck and the sphere) and adds
-the interaction of every other neck relative to the same two necks on opposite poles (:math:`l = z_b + z_c`,
-:math:`s = 1`):
+disk of radius :math:`a_b` on the cap base plane, at :math:`z_b = \sqrt{r^2 - a_b^2}` from the centre, so the free-space
+part is taken between the disk centres :math:`z_b n_b` (chord :math:`l_{bc} = |z_b n_b - z_c n_c|`), which is exact as
+:math:`a \to 0` and brings wide necks closer. The model keeps the pair-calibrated half resistance :math:`R_b = 1 / K_b`
+of the fit law on the diagonal (a neck's own constriction, its half neck and the sphere) and adds the interaction of
+every other neck relative to the same two necks on opposite poles (:math:`l = z_b + z_c`, :math:`s = 1`):
 
 .. math::
 
