@@ -92,7 +92,7 @@ ROUNDOFF = 1e-12  # interactions below this x the smallest half resistance are r
 
 @numba.njit(cache=True)
 def interaction(normal_b, normal_c, base_b: float, base_c: float) -> float:
-    """``4 pi kappa r R_bc`` of two necks with unit normals ``normal_b``, ``normal_c`` and cap-base distances
+    r""":math:`4 \pi \kappa r R_{bc}` of two necks with unit normals ``normal_b``, ``normal_c`` and cap-base distances
     ``base_b``, ``base_c`` (in units of ``r``), relative to the same necks on opposite poles (module docstring)."""
     cos_g = normal_b[0] * normal_c[0] + normal_b[1] * normal_c[1] + normal_b[2] * normal_c[2]
     return _interaction(cos_g, base_b, base_c)

@@ -108,8 +108,9 @@ def formula_lines(docstring: str | None) -> list[str]:
 
 
 def ascii_formulas(package: str) -> list[str]:
-    """``object: line`` for every line of a public docstring of ``package`` (its public modules', and those of the
-    objects :func:`undocumented` reads: functions, classes, their public methods and properties) that :func:`formula_lines`
+    """``object: line`` for every line of a public docstring of ``package`` (its public modules', their compiled
+    (numba) functions', and those of the objects :func:`undocumented` reads: functions, classes, their public methods
+    and properties) that :func:`formula_lines`
     finds an ASCII formula in, each docstring once."""
     import importlib
 
@@ -126,6 +127,9 @@ def ascii_formulas(package: str) -> list[str]:
     for module in modules:
         if not any(part.startswith("_") for part in module.split(".")):  # __main__ too: importing it would run it
             read(module, importlib.import_module(module))
+            for attr, obj in vars(importlib.import_module(module)).items():  # compiled functions, which autodoc shows
+                if not attr.startswith("_") and hasattr(obj, "py_func") and obj.py_func.__module__ == module:
+                    read(f"{module}.{attr}", obj.py_func)
     objects = api_check.public_objects(package)
     for dotted in objects:
         module, _, name = dotted.rpartition(".")
