@@ -1,33 +1,38 @@
-"""Solve to a tolerance: the order-difference error estimate and the grading controller.
+r"""Solve to a tolerance: the order-difference error estimate and the grading controller.
 
 The conductance is computed on one graded mesh with two element orders, ``p - 1`` and ``p`` (curved, isoparametric
-boundary). The reported value is the order-``p`` one; its error estimate is the relative difference of the two::
+boundary). The reported value is the order-``p`` one; its error estimate is the relative difference of the two,
 
-    error_estimate = |K_p - K_(p-1)| / K_p,
+.. math::
 
-which is the error of the order ``p - 1`` solve up to a factor ``1 + e_p / e_(p-1)``. On graded meshes ``e_p`` is
-10-40x smaller than ``e_(p-1)`` (measured), so the estimate bounds the reported value's error with a wide margin:
+    \epsilon = |K_p - K_{p-1}| / K_p,
+
+which is the error of the order ``p - 1`` solve up to a factor :math:`1 + e_p / e_{p-1}`. On graded meshes :math:`e_p`
+is 10-40x smaller than :math:`e_{p-1}` (measured), so the estimate bounds the reported value's error with a wide margin:
 it is honest by construction and pessimistic by that ratio. If the estimate exceeds the tolerance the grading
 factor (element size per distance to the nearest re-entrant corner) is reduced by the observed rate of the order
-``p - 1`` error, ``e ~ grading^RATE``, and the pair is solved again on a new mesh.
+``p - 1`` error, :math:`e \sim g^{\mathrm{RATE}}` in the grading :math:`g`, and the pair is solved again on a new mesh.
 
 Mesh sequences (3D clusters, and any 3D FE whose error is set by the re-entrant neck edges). Where raising the order
 is not available, the same body is meshed at ``levels`` sizes that all shrink by one ``ratio`` per level (element
 size at the necks, away from them, on curved surfaces: every size of the mesh, so that the sequence is a refinement
 and not a re-grading) and solved with one element order. Energy-type values (a conductance from the Dirichlet
-energy or the reaction, a volume mean of the temperature) then converge like ``size^q`` with ``q`` at least the
-corner exponent's ``2 lambda`` (the re-entrant neck edge of interior angle ``pi + arccos(a/r)`` has
-``lambda = pi / (pi + arccos(a/r))``, :func:`corner_exponent`; the 3D edge along the neck circle has the 2D
+energy or the reaction, a volume mean of the temperature) then converge like :math:`\mathrm{size}^q` with ``q`` at
+least the corner exponent's :math:`2 \lambda` (the re-entrant neck edge of interior angle :math:`\pi + \arccos(a/r)`
+has :math:`\lambda = \pi / (\pi + \arccos(a/r))`, :func:`corner_exponent`; the 3D edge along the neck circle has the 2D
 exponent), and faster before the asymptotic range. :func:`mesh_sequence_estimate` turns the last change into the
-error of the finest value::
+error of the finest value,
 
-    error = SAFETY * |v_(L-1) - v_L| / (rate - 1),       rate = min(observed, ratio^(2 lambda)),
+.. math::
 
-where ``observed = (v_(L-2) - v_(L-1)) / (v_(L-1) - v_L)`` with three levels (two levels take the corner rate).
+    \epsilon = S \, \frac{|v_{L-1} - v_L|}{\rho - 1}, \qquad \rho = \min(\rho_{obs}, q^{2 \lambda}),
+
+with ``S`` the ``SAFETY`` factor, ``q`` the ``ratio`` and :math:`\rho_{obs} = (v_{L-2} - v_{L-1}) / (v_{L-1} - v_L)`
+the observed rate with three levels (two levels take the corner rate).
 Taking the slower of the observed and the asymptotic rate keeps the estimate honest before the asymptotic range
 (observed faster: the corner rate is the safe one) and when it is slower than the corner alone would explain.
 A sequence that does not contract (``observed <= 1``: the changes grow or change sign) has no rate; its estimate is
-the larger change over ``ratio^(2 lambda) - 1`` and it is flagged ``monotone = False``. Conforming primal FE
+the larger change over :math:`q^{2 \lambda} - 1` and it is flagged ``monotone = False``. Conforming primal FE
 converges from above (the Dirichlet energy is minimal for the exact field), which the measurements confirm.
 """
 
@@ -160,7 +165,8 @@ def relative_difference(k_high: float, k_low: float) -> float:
 
 
 def next_grading(grading: float, rtol: float, estimate: float, order: int) -> float:
-    """Shrink the grading so that ``estimate * (new/old)^RATE`` lands at ~0.7 rtol; at least 15 %, at most 3x.
+    r"""Shrink the grading so that :math:`\epsilon \, (g_{new}/g_{old})^{\mathrm{RATE}}` (``estimate`` :math:`\epsilon`)
+    lands at ~0.7 rtol; at least 15 %, at most 3x.
 
     Parameters
     ----------
@@ -290,8 +296,9 @@ HP_CORNER_ERROR = {"cylinder": 1e-7, "union": 3e-5}
 
 
 def hp_corner_levels(a_over_r: float, rtol: float, sigma: float = SIGMA, neck: str = "cylinder") -> int:
-    """Geometric refinement levels toward the corner: the corner cell's error ``~ c * sigma^(2 lambda (L - 2))``
-    (``c`` = ``HP_CORNER_ERROR`` of the ``neck``, measured at L = 2) pushed 100x below ``rtol``.
+    r"""Geometric refinement levels toward the corner: the corner cell's error
+    :math:`\sim c \, \sigma^{2 \lambda (L - 2)}` (``c`` = ``HP_CORNER_ERROR`` of the ``neck``, measured at L = 2) pushed
+    100x below ``rtol``.
 
     Parameters
     ----------
@@ -320,13 +327,14 @@ def hp_corner_levels(a_over_r: float, rtol: float, sigma: float = SIGMA, neck: s
 
 
 def corner_exponent(a_over_r, neck: str = "cylinder"):
-    """Singular exponent ``lambda`` of the temperature at the neck's rim, which varies like ``rho^lambda`` there.
+    r"""Singular exponent :math:`\lambda` of the temperature at the neck's rim, which varies like :math:`\rho^\lambda`
+    there.
 
-    ``neck = "cylinder"``: the re-entrant corner where a cylindrical neck of radius ``a`` meets a sphere of radius
-    ``r`` (interior angle ``pi + arccos(a/r)``, both faces insulated), ``lambda = pi / (pi + arccos(a/r))``: 2/3 for
-    a vanishing neck, 1 (no singularity) at ``a = r``. ``neck = "union"``: the corner where the isothermal neck disk
-    meets the insulated sphere (interior angle ``omega = pi/2 + arccos(a/r)``, mixed Dirichlet/Neumann, so
-    ``lambda = pi / (2 omega) = pi / (pi + 2 arccos(a/r))``): 1/2 for a vanishing neck (the rim of a disk on a
+    ``neck = "cylinder"``: the re-entrant corner where a cylindrical neck of radius ``a`` meets a sphere of radius ``r``
+    (interior angle :math:`\pi + \arccos(a/r)`, both faces insulated), :math:`\lambda = \pi / (\pi + \arccos(a/r))`: 2/3
+    for a vanishing neck, 1 (no singularity) at :math:`a = r`. ``neck = "union"``: the corner where the isothermal neck
+    disk meets the insulated sphere (interior angle :math:`\omega = \pi/2 + \arccos(a/r)`, mixed Dirichlet/Neumann, so
+    :math:`\lambda = \pi / (2 \omega) = \pi / (\pi + 2 \arccos(a/r))`): 1/2 for a vanishing neck (the rim of a disk on a
     half-space), 1 at ``a = r``.
 
     Parameters
@@ -356,7 +364,7 @@ SAFETY = 1.25  #: on the extrapolated error of a mesh sequence (Roache's factor 
 
 @dataclass(frozen=True)
 class SequenceEstimate:
-    """The error of the finest value of a mesh sequence (:func:`mesh_sequence_estimate`).
+    r"""The error of the finest value of a mesh sequence (:func:`mesh_sequence_estimate`).
 
     ``relative``: ``error / |value|``. ``amplification = SAFETY / (rate - 1)`` turns the last change of any other
     quantity solved on the same meshes (e.g. particle temperatures) into its error estimate.
@@ -372,10 +380,10 @@ class SequenceEstimate:
     observed_rate : float or None
         The ratio of the last two changes, from three levels; None with two, or when the sequence does not contract.
     observed_order : float or None
-        ``log(observed_rate) / log(ratio)``, the observed convergence order in the mesh size; None where there is no
-        observed rate.
+        :math:`\log(\rho_{obs}) / \log(q)` (``observed_rate`` over ``ratio``), the observed convergence order in the
+        mesh size; None where there is no observed rate.
     corner_order : float
-        ``2 lambda``, the order the re-entrant corner allows.
+        :math:`2 \lambda`, the order the re-entrant corner allows.
     monotone : bool
         Whether the sequence contracts (its changes shrink without changing sign).
     """
@@ -400,7 +408,8 @@ class SequenceEstimate:
 
 
 def mesh_levels(levels: int, ratio: float = MESH_RATIO) -> list[float]:
-    """Size factors of a mesh sequence, coarsest first, the finest 1: ``ratio^(levels-1), ..., ratio, 1``.
+    r"""Size factors of a mesh sequence, coarsest first, the finest 1: :math:`q^{n-1}, \ldots, q, 1` (``ratio`` q,
+    ``levels`` n).
 
     Parameters
     ----------
@@ -425,7 +434,7 @@ def mesh_levels(levels: int, ratio: float = MESH_RATIO) -> list[float]:
 
 
 def mesh_sequence_estimate(values, exponent: float, ratio: float = MESH_RATIO) -> SequenceEstimate:
-    """Error of the last of 2 or 3 values solved on meshes whose every size shrinks by ``ratio`` per level.
+    r"""Error of the last of 2 or 3 values solved on meshes whose every size shrinks by ``ratio`` per level.
 
     ``exponent``: the smallest corner exponent ``lambda`` of the body (:func:`corner_exponent`; 1 if it has no
     re-entrant corner). See the module docstring for the formula and why it bounds the error.
@@ -435,7 +444,7 @@ def mesh_sequence_estimate(values, exponent: float, ratio: float = MESH_RATIO) -
     values : sequence of float
         The 2 or 3 values, coarsest mesh first (any unit, e.g. W/K).
     exponent : float
-        The smallest corner exponent ``lambda`` of the body, ``0.5 <= lambda <= 1``.
+        The smallest corner exponent :math:`\lambda` of the body, :math:`0.5 \le \lambda \le 1`.
     ratio : float
         The factor (> 1) by which every element size shrinks per level.
 

@@ -1,18 +1,17 @@
-"""3D finite-element conduction through small clusters of sintered spheres (gmsh OCC + scikit-fem tetrahedra).
+r"""3D finite-element conduction through small clusters of sintered spheres (gmsh OCC + scikit-fem tetrahedra).
 
 Geometry (Rojek, Kasztelan & Tharmaraj 2022, Sections 4.3, Fig. 8). Each bonded pair ``(i, j)`` with overlap
-``h = r_i + r_j - |c_j - c_i|`` gets the volume-conserving cylindrical neck of
-:func:`fem_neck.geometry.neck_geometry`: radius ``a``, spanning ``c_i + z_i e .. c_i + (z_i + h_n) e`` along the unit
-vector ``e`` from ``c_i`` to ``c_j``. The solid is
+:math:`h = r_i + r_j - |c_j - c_i|` gets the volume-conserving cylindrical neck of
+:func:`fem_neck.geometry.neck_geometry`: radius ``a``, spanning :math:`c_i + z_i e` to :math:`c_i + (z_i + h_n) e`
+along the unit vector ``e`` from ``c_i`` to ``c_j``. The solid is the union of the full spheres and the neck
+cylinders.
 
-    union of the full spheres  U  union of the neck cylinders.
-
-This *is* the truncated-sphere geometry of the paper: the cap of sphere ``i`` beyond its base plane ``z_i`` lies
-inside the neck cylinder (the sphere's cross-section there is narrower than ``a``) or, where it pokes past the
-cylinder's far end (unequal radii), inside the truncated sphere ``j``. So no cap has to be cut explicitly, and for
-necks that do not touch one another the volume is exactly ``sum 4/3 pi r^3`` (volume conservation, eq. 22). Each
-cylinder is extended by ``delta = z/4`` into both spheres so that its side meets each sphere transversally at the
-neck circle instead of along a shared edge, which keeps the OCC boolean robust without changing the union.
+This *is* the truncated-sphere geometry of the paper: the cap of sphere ``i`` beyond its base plane ``z_i`` lies inside
+the neck cylinder (the sphere's cross-section there is narrower than ``a``) or, where it pokes past the cylinder's far
+end (unequal radii), inside the truncated sphere ``j``. So no cap has to be cut explicitly, and for necks that do not
+touch one another the volume is exactly :math:`\sum \frac{4}{3} \pi r^3` (volume conservation, eq. 22). Each cylinder is
+extended by :math:`\delta = z/4` into both spheres so that its side meets each sphere transversally at the neck circle
+instead of along a shared edge, which keeps the OCC boolean robust without changing the union.
 
 Boundary conditions that the pipe network represents exactly (chosen here, see :class:`Terminal`):
 
@@ -21,15 +20,16 @@ Boundary conditions that the pipe network represents exactly (chosen here, see :
   the pipe's half-conductance ``K_i`` (Rojek 2022, Fig. 12, eqs. 36, 43) and the end of the FE pair/chain solves,
   so a DEM particle held at ``T`` with that bond's law is an exact model of this boundary; any difference is the
   law's error, not the boundary's.
-* ``"core"`` -- a concentric ball of radius ``rho r`` (default ``rho = 0.25``) is removed and its surface held at
-  ``T``: the particle's "centre temperature". Usable for particles with several bonds; it is *not* exactly the pipe
-  model's boundary (the half-conductance is defined from the equatorial disk), which the comparison quantifies.
+* ``"core"`` -- a concentric ball of radius :math:`\rho r` (default :math:`\rho` = ``rho`` = 0.25) is removed and its
+  surface held at ``T``: the particle's "centre temperature". Usable for particles with several bonds; it is *not*
+  exactly the pipe model's boundary (the half-conductance is defined from the equatorial disk), which the comparison
+  quantifies.
 
-Everything else is insulated. The effective conductance is ``K = Q / (T_hot - T_cold)`` with ``Q`` from the reaction
-at the hot Dirichlet dofs. The per-particle mean temperature is the volume average over the particle's own share of
-the solid: its truncated sphere plus the part of each neck cylinder next to it whose volume equals its cap's, so
-that each particle owns exactly ``4/3 pi r^3`` (the DEM's mass, ``m = rho 4/3 pi r^3``) less what a terminal cut
-removes. Elements are assigned by their centroids.
+Everything else is insulated. The effective conductance is :math:`K = Q / (T_{hot} - T_{cold})` with ``Q`` from the
+reaction at the hot Dirichlet dofs. The per-particle mean temperature is the volume average over the particle's own
+share of the solid: its truncated sphere plus the part of each neck cylinder next to it whose volume equals its cap's,
+so that each particle owns exactly :math:`\frac{4}{3} \pi r^3` (the DEM's mass, :math:`m = \rho \frac{4}{3} \pi r^3`)
+less what a terminal cut removes. Elements are assigned by their centroids.
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ _EXTEND = 0.25  # neck cylinders reach delta = _EXTEND * z into each sphere (hid
 
 @dataclass(frozen=True)
 class Terminal:
-    """A particle held at a fixed temperature (module docstring).
+    r"""A particle held at a fixed temperature (module docstring).
 
     Parameters
     ----------
@@ -56,7 +56,7 @@ class Terminal:
         Its temperature, K.
     kind : str
         ``"plane"`` (a one-bond particle cut at its centre plane, the cut disk held at ``T``) or ``"core"`` (a ball
-        of radius ``rho r`` at the centre removed, its surface held at ``T``).
+        of radius :math:`\rho r` at the centre removed, its surface held at ``T``).
     rho : float
         Radius of the core ball over the particle radius (dimensionless, ``"core"`` only).
     """
@@ -103,7 +103,7 @@ class Cluster:
         return len(self.radii)
 
     def overlaps(self) -> np.ndarray:
-        """Overlap ``h = r_i + r_j - d`` of every bond (Rojek 2022, eq. 21/44)."""
+        """Overlap :math:`h = r_i + r_j - d` of every bond (Rojek 2022, eq. 21/44)."""
         i, j = self.bonds.T
         return self.radii[i] + self.radii[j] - np.linalg.norm(self.centres[j] - self.centres[i], axis=1)
 
@@ -127,8 +127,8 @@ class Cluster:
         return v / np.linalg.norm(v, axis=1)[:, None]
 
     def corner_exponent(self, method: str = "newton") -> float:
-        """The smallest singular exponent of the re-entrant neck edges (each neck meets two spheres, each side with
-        ``lambda = pi / (pi + arccos(a / r_k))``, :func:`fem_neck.accuracy.corner_exponent`); 1 without bonds.
+        r"""The smallest singular exponent of the re-entrant neck edges (each neck meets two spheres, each side with
+        :math:`\lambda = \pi / (\pi + \arccos(a / r_k))`, :func:`fem_neck.accuracy.corner_exponent`); 1 without bonds.
 
         Parameters
         ----------
@@ -148,10 +148,10 @@ class Cluster:
         return np.bincount(self.bonds.ravel(), minlength=self.n)
 
     def validate(self, method: str = "newton", gap: float = 0.0, angle_margin: float = 0.0) -> None:
-        """Raise ``ValueError`` unless the cluster is a valid union of non-interfering necks.
+        r"""Raise ``ValueError`` unless the cluster is a valid union of non-interfering necks.
 
         Bonded pairs must overlap within the neck model's range; unbonded spheres must stay more than ``gap``
-        (m) apart; two neck circles on one sphere (angular radius ``arcsin(a/r)`` each) must stay more than
+        (m) apart; two neck circles on one sphere (angular radius :math:`\arcsin(a/r)` each) must stay more than
         ``angle_margin`` (radians) apart.
 
         Parameters
@@ -335,16 +335,16 @@ def neck_size_fields(gmsh, cluster: Cluster, geo, surfaces, size_neck: float, si
 
 
 def mesh_tetrahedra(gmsh, curvature: int, size_max: float) -> None:
-    """Generate the 3D mesh from the background size field: ``curvature`` elements per 2 pi of surface curvature,
-    at most ``size_max``; one thread and fixed algorithms (Frontal-Delaunay surfaces, Delaunay volume), so the same
-    input gives the same mesh.
+    r"""Generate the 3D mesh from the background size field: ``curvature`` elements per :math:`2 \pi` of surface
+    curvature, at most ``size_max``; one thread and fixed algorithms (Frontal-Delaunay surfaces, Delaunay volume), so
+    the same input gives the same mesh.
 
     Parameters
     ----------
     gmsh : object
         The ``gmsh`` module, in an open session with the background size field set.
     curvature : int
-        Elements per 2 pi of surface curvature.
+        Elements per :math:`2 \pi` of surface curvature.
     size_max : float
         Largest element size, in the session's length unit.
     """
@@ -413,12 +413,12 @@ def _check_terminals(cluster: Cluster, terminals) -> tuple:
 def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size_far: float = 0.35,
                        curvature: int = 20, method: str = "newton", curved: bool = True,
                        neck_cells: float = 2.0) -> ClusterMesh:
-    """Mesh the cluster with first-order tetrahedra, graded toward every neck circle.
+    r"""Mesh the cluster with first-order tetrahedra, graded toward every neck circle.
 
     ``size_neck`` is the element size at the neck circles as a fraction of the neck radius ``a`` (and at most the
-    neck length over ``neck_cells``; the length is ~a^2/(2r) for small necks); it grows
+    neck length over ``neck_cells``; the length is :math:`\approx a^2/(2r)` for small necks); it grows
     linearly to ``size_far`` times the smaller radius of the bond at a distance ``2 a`` (gmsh Distance + Threshold
-    fields). ``curvature`` is gmsh's elements per 2 pi of surface curvature. ``curved`` returns the quadratic
+    fields). ``curvature`` is gmsh's elements per :math:`2 \pi` of surface curvature. ``curved`` returns the quadratic
     :func:`curved_mesh` (exact boundary edge midpoints; use with ``order=2``). Deterministic (one thread, fixed
     algorithm). Terminals: a sequence of :class:`Terminal`; only the hottest and coldest boundaries are named
     (``"hot"``, ``"cold"``), intermediate temperatures are not supported.
@@ -434,7 +434,7 @@ def build_cluster_mesh(cluster: Cluster, terminals, size_neck: float = 0.2, size
     size_far : float
         Element size at distance ``2 a`` over the bond's smaller radius (dimensionless, > 0).
     curvature : int
-        gmsh's elements per 2 pi of surface curvature.
+        gmsh's elements per :math:`2 \pi` of surface curvature.
     method : str
         Neck model (as in :meth:`Cluster.necks`).
     curved : bool
@@ -554,7 +554,7 @@ def curved_mesh(mesh, cluster: Cluster, geo, terminals, tol: float | None = None
     """Quadratic (isoparametric) version of a first-order cluster mesh: ``skfem.MeshTet2`` whose boundary edge
     midpoints are moved onto the exact surfaces -- the spheres, the neck cylinders, the core balls and the neck
     circles where sphere and cylinder meet. Straight-sided tetrahedra inscribe the spheres (volume and ``K`` too
-    small); with P2 on this mesh the geometric error falls from O(h^2) to O(h^3) or better.
+    small); with P2 on this mesh the geometric error falls from :math:`O(h^2)` to :math:`O(h^3)` or better.
 
     Parameters
     ----------
@@ -643,11 +643,11 @@ def curved_mesh(mesh, cluster: Cluster, geo, terminals, tol: float | None = None
 
 
 def assign_particles(cluster: Cluster, geo, x: np.ndarray) -> np.ndarray:
-    """Owning particle of each point ``x`` (N, 3) of the solid.
+    r"""Owning particle of each point ``x`` (N, 3) of the solid.
 
-    In a neck cylinder of bond ``(i, j)``, the part of length ``V_cap,i / (pi a^2)`` next to ``i`` belongs to ``i``,
-    the rest to ``j``; elsewhere the point belongs to the sphere that contains it on the near side of all of that
-    sphere's cap planes (its truncated sphere). Each particle thus owns the volume ``4/3 pi r^3``.
+    In a neck cylinder of bond ``(i, j)``, the part of length :math:`V_{cap,i} / (\pi a^2)` next to ``i`` belongs to
+    ``i``, the rest to ``j``; elsewhere the point belongs to the sphere that contains it on the near side of all of that
+    sphere's cap planes (its truncated sphere). Each particle thus owns the volume :math:`\frac{4}{3} \pi r^3`.
 
     Parameters
     ----------
@@ -744,7 +744,8 @@ def particle_means(basis, u: np.ndarray, cmesh: ClusterMesh) -> tuple[np.ndarray
 
 
 def solve_cluster(cmesh: ClusterMesh, kappa: float = 1.0, order: int = 2, rtol: float = 1e-10) -> ClusterSolution:
-    """Steady conduction ``div(kappa grad T) = 0`` on the cluster, ``T`` fixed on the terminals, insulated elsewhere.
+    r"""Steady conduction :math:`\nabla \cdot (\kappa \nabla T) = 0` on the cluster, ``T`` fixed on the terminals,
+    insulated elsewhere.
 
     P1 or P2 tetrahedra; the linear system is solved by conjugate gradients with a smoothed-aggregation AMG
     preconditioner (pyamg) to relative residual ``rtol``. ``Q`` is the reaction at the hot dofs (design notes).
@@ -826,7 +827,7 @@ class ClusterResult:
 def cluster_conductance(cluster: Cluster, terminals, kappa: float = 1.0, size_neck: float = 0.12,
                         size_far: float = 0.25, levels: int = 3, curvature: float | None = None,
                         neck_cells: float = 2.0, method: str = "newton") -> ClusterResult:
-    """Steady conductance and particle mean temperatures of a cluster, with an error estimate from a mesh sequence.
+    r"""Steady conductance and particle mean temperatures of a cluster, with an error estimate from a mesh sequence.
 
     The finest level uses the given sizes (:func:`build_cluster_mesh`; ``curvature`` defaults to ``4 / size_far``);
     each coarser level multiplies every size by :data:`fem_neck.accuracy.MESH_RATIO` (``size_neck``, ``size_far``,
@@ -850,7 +851,7 @@ def cluster_conductance(cluster: Cluster, terminals, kappa: float = 1.0, size_ne
     levels : int
         Meshes of the sequence: 1, 2 or 3.
     curvature : float, optional
-        The finest level's elements per 2 pi of surface curvature; default ``4 / size_far``.
+        The finest level's elements per :math:`2 \pi` of surface curvature; default ``4 / size_far``.
     neck_cells : float
         The finest level's elements along the neck length at least.
     method : str

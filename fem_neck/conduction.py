@@ -21,8 +21,8 @@ graded mesh, so the curved sphere surface is followed; ``curved=False`` keeps st
 
 Public API (all plain functions of numbers, safe to call from a process pool; gmsh is opened and closed per mesh):
 
-* :func:`semisphere_conductance` -- the semisphere with a neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Section 5),
-  or the half body of the union of spheres (no neck cylinder);
+* :func:`semisphere_conductance` -- the semisphere with a neck, :math:`r = 1`, :math:`\kappa = 1` (Rojek 2022, Section
+  5), or the half body of the union of spheres (no neck cylinder);
 * :func:`pair_conductance` -- two spheres ``r_i``, ``r_j`` with overlap ``h`` (Section 6);
 * :func:`chain_conductance` -- a collinear chain;
 * :func:`solve_profile` -- one solve on a given mesh and order (for convergence studies).
@@ -42,16 +42,16 @@ from fem_neck.geometry import check_positive, neck_geometry
 
 @dataclass
 class Solution:
-    """One FE solve on one mesh (length-normalised body, ``kappa = 1``): the conductance ``K = K_reaction +
-    geometry_correction``, the basis and the temperature ``u`` (``T = 0`` on ``bottom``, ``1`` on ``top``).
+    r"""One FE solve on one mesh (length-normalised body, :math:`\kappa = 1`): the conductance ``K`` = ``K_reaction``
+    + ``geometry_correction``, the basis and the temperature ``u`` (``T = 0`` on ``bottom``, ``1`` on ``top``).
 
     Parameters
     ----------
     K : float
-        Conductance of the normalised body (lengths over the length scale, ``kappa = 1``): ``K_reaction +
-        geometry_correction``; times ``kappa`` and the length scale it is in W/K.
+        Conductance of the normalised body (lengths over the length scale, :math:`\kappa = 1`): ``K_reaction`` +
+        ``geometry_correction``; times ``kappa`` and the length scale it is in W/K.
     K_reaction : float
-        ``2 pi`` times the reaction at the ``top`` dofs (normalised, as ``K``).
+        :math:`2 \pi` times the reaction at the ``top`` dofs (normalised, as ``K``).
     geometry_correction : float
         The Hadamard correction of :func:`geometry_correction` (normalised, as ``K``).
     dofs : int
@@ -78,7 +78,7 @@ class Solution:
 
 @dataclass
 class Result:
-    """A conductance solved to a tolerance.
+    r"""A conductance solved to a tolerance.
 
     ``solution`` and ``profile`` are what :mod:`fem_neck.render` needs; they are dropped when the result is pickled,
     so results travel cheaply between processes.
@@ -88,8 +88,8 @@ class Result:
     K : float
         Conductance in W/K for the given ``kappa`` and lengths.
     K_over_Kcyl : float
-        ``K / (kappa pi r)`` (dimensionless) with ``r`` the sphere radius (semisphere) or the smallest radius (pair,
-        chain): the normalisation of Rojek 2022, eqs. 38-39.
+        :math:`K / (\kappa \pi r)` (dimensionless) with ``r`` the sphere radius (semisphere) or the smallest radius
+        (pair, chain): the normalisation of Rojek 2022, eqs. 38-39.
     error_estimate : float
         Relative error estimate of ``K`` (dimensionless; :mod:`fem_neck.accuracy`).
     converged : bool
@@ -158,9 +158,10 @@ def _axisymmetric_laplace():
 
 
 def solve_profile(profile: shapes.ProfileMesh, order: int = 2, curved: bool = True, mesh=None) -> Solution:
-    """Solve ``div(x grad T) = 0`` with ``T = 0`` on ``bottom``, ``1`` on ``top``; ``K = 2 pi (reaction)``, kappa = 1.
+    r"""Solve :math:`\nabla \cdot (x \nabla T) = 0` with :math:`T = 0` on ``bottom``, 1 on ``top``; :math:`K = 2 \pi`
+    times the reaction, :math:`\kappa = 1`.
 
-    The SPD system is factorised by SuperLU in symmetric mode with a minimum-degree ordering of ``A + A^T`` (3x
+    The SPD system is factorised by SuperLU in symmetric mode with a minimum-degree ordering of :math:`A + A^T` (3x
     faster than its default column ordering here).
 
     Parameters
@@ -178,7 +179,7 @@ def solve_profile(profile: shapes.ProfileMesh, order: int = 2, curved: bool = Tr
     Returns
     -------
     Solution
-        The conductance of the normalised body (``kappa = 1``), its basis and temperatures.
+        The conductance of the normalised body (:math:`\kappa = 1`), its basis and temperatures.
 
     Raises
     ------
@@ -215,14 +216,14 @@ _REFERENCE_EDGES = np.array([[[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 1.0]],
 
 
 def geometry_correction(profile: shapes.ProfileMesh, basis, u, points: int = 8) -> float:
-    """First-order (Hadamard) correction of ``K`` for the gap between the meshed and the true spherical surfaces.
+    r"""First-order (Hadamard) correction of ``K`` for the gap between the meshed and the true spherical surfaces.
 
     Moving an insulated boundary outwards by ``delta`` changes the conductance by
-    ``dK = int_Gamma kappa |grad T|^2 delta dS`` (the shape derivative of the Dirichlet energy). ``delta`` is the
-    distance from each boundary edge of the mesh (straight, or quadratic isoparametric) to its circle, evaluated at
-    Gauss points along the edge (taken in the reference triangle, so no point inversion is needed); ``kappa = 1``,
-    ``Delta T = 1``, ``dS = 2 pi x ds``. It removes the ``O(h^4)`` geometric error of quadratic boundaries to
-    second order (measured: P4 from -3e-6 to 1e-8 on the reference semisphere).
+    :math:`dK = \int_\Gamma \kappa |\nabla T|^2 \delta \, dS` (the shape derivative of the Dirichlet energy).
+    :math:`\delta` is the distance from each boundary edge of the mesh (straight, or quadratic isoparametric) to its
+    circle, evaluated at Gauss points along the edge (taken in the reference triangle, so no point inversion is needed);
+    :math:`\kappa = 1`, :math:`\Delta T = 1`, :math:`dS = 2 \pi x \, ds`. It removes the :math:`O(h^4)` geometric error
+    of quadratic boundaries to second order (measured: P4 from -3e-6 to 1e-8 on the reference semisphere).
 
     Parameters
     ----------
@@ -238,7 +239,7 @@ def geometry_correction(profile: shapes.ProfileMesh, basis, u, points: int = 8) 
     Returns
     -------
     float
-        ``dK`` for the normalised body (``kappa = 1``, lengths normalised), to add to the reaction conductance.
+        ``dK`` for the normalised body (:math:`\kappa = 1`, lengths normalised), to add to the reaction conductance.
     """
     import skfem
 
@@ -294,11 +295,12 @@ METHODS = ("hp", "gmsh")
 
 def semisphere_conductance(a_over_r: float, rtol: float = 1e-4, order: int | None = None,
                            method: str = "hp", neck: str = "cylinder") -> Result:
-    """Conductance of the semisphere with a cylindrical neck, ``r = 1``, ``kappa = 1`` (Rojek 2022, Sec. 5, Fig. 12).
+    r"""Conductance of the semisphere with a cylindrical neck, :math:`r = 1`, :math:`\kappa = 1` (Rojek 2022, Sec. 5,
+    Fig. 12).
 
     ``neck = "cylinder"`` (default): the half-neck height is ``h_n/2`` of the volume-conserving neck (eqs. 19-20);
     ``neck = "union"``: the half body of the union of spheres, no neck cylinder, ``T = 1`` on the disk of radius ``a``
-    at the cap base ``z_i = sqrt(1 - a^2)``. ``K_over_Kcyl = K / pi`` (eqs. 38-39).
+    at the cap base :math:`z_i = \sqrt{1 - a^2}`. ``K_over_Kcyl`` is :math:`K / \pi` (eqs. 38-39).
 
     Parameters
     ----------
@@ -321,7 +323,7 @@ def semisphere_conductance(a_over_r: float, rtol: float = 1e-4, order: int | Non
     Returns
     -------
     Result
-        ``K`` for ``r = 1`` and ``kappa = 1`` (times ``kappa r`` it is in W/K), with its error estimate.
+        ``K`` for :math:`r = 1` and :math:`\kappa = 1` (times :math:`\kappa r` it is in W/K), with its error estimate.
 
     Raises
     ------
@@ -378,7 +380,7 @@ def chain_conductance(radii, overlaps, kappa: float, rtol: float = 1e-4, order: 
     radii : array_like
         The N sphere radii along the chain, m, each > 0 (neighbours at most 1e6 apart).
     overlaps : array_like
-        The N - 1 overlaps ``h = r_k + r_(k+1) - d`` of neighbouring spheres, m.
+        The N - 1 overlaps :math:`h = r_k + r_{k+1} - d` of neighbouring spheres, m.
     kappa : float
         Thermal conductivity, W/(m K), > 0.
     rtol : float
@@ -427,8 +429,8 @@ def pair_conductance(r_i: float, r_j: float, h: float, kappa: float, rtol: float
         The first element order tried (hp: 2 to 11; gmsh: 2, 3 or 4); default from ``rtol``.
     method : str
         ``"hp"`` -- the two halves of :func:`fem_neck.hpmesh.pair_quad_mesh`, order raised until two orders agree
-        (necks ``1e-4 <= a / r_min < 1``); ``"gmsh"`` -- the chain of two, :func:`chain_conductance`
-        ``([r_i, r_j], [h], kappa)``; ``"auto"`` -- hp (the gmsh path only to refuse too thin a neck).
+        (necks ``1e-4 <= a / r_min < 1``); ``"gmsh"`` -- the chain of two, :func:`chain_conductance` of the radii
+        ``[r_i, r_j]`` and the overlap ``[h]``; ``"auto"`` -- hp (the gmsh path only to refuse too thin a neck).
 
     Returns
     -------

@@ -1,4 +1,4 @@
-"""Mesh convergence of the semisphere conductance (Rojek 2022, Fig. 15 analogue).
+r"""Mesh convergence of the semisphere conductance (Rojek 2022, Fig. 15 analogue).
 
 Series: P1 and P2 elements on meshes graded toward the re-entrant corner (size = grading x distance) and on
 uniform meshes, plus P2 with straight-sided boundary triangles (to show what the curved boundary buys), and the hp
@@ -6,9 +6,9 @@ series: orders 2 to 9 on one geometric quadrilateral mesh with the exact sphere 
 converges exponentially (``hp_error_ratio_per_order``: median factor by which the error falls per order). Each
 triangle level reports the raw reaction conductance (no geometry correction).
 
-:func:`study` runs it all: ``extrapolated`` is the Aitken (Richardson with a fitted exponent) limit of the three
-finest graded P2 levels (:func:`aitken`); ``observed_order`` is the exponent ``q`` of ``|K - K_ref| ~ dofs^-q``
-over those levels (:func:`observed_order`), with ``K_ref`` an hp solve to rtol 1e-9 (``reference``).
+:func:`study` runs it all: ``extrapolated`` is the Aitken (Richardson with a fitted exponent) limit of the three finest
+graded P2 levels (:func:`aitken`); ``observed_order`` is the exponent ``q`` of :math:`|K - K_{ref}| \sim N^{-q}` in the
+dofs :math:`N` over those levels (:func:`observed_order`), with ``K_ref`` an hp solve to rtol 1e-9 (``reference``).
 """
 
 from __future__ import annotations
@@ -36,7 +36,8 @@ REFERENCE_RTOL = 1e-9  # the hp solve the errors are measured against
 
 
 def aitken(k1: float, k2: float, k3: float) -> float:
-    """Limit of a sequence converging geometrically: ``k3 - (k3 - k2)^2 / ((k3 - k2) - (k2 - k1))``.
+    r"""Limit of a sequence converging geometrically:
+    :math:`k_3 - (k_3 - k_2)^2 / \left((k_3 - k_2) - (k_2 - k_1)\right)`.
 
     Parameters
     ----------

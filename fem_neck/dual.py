@@ -1,28 +1,28 @@
-"""The lower bound: a divergence-free heat flux on the exactly curved mesh (Thomson's principle), from the hybridised
+r"""The lower bound: a divergence-free heat flux on the exactly curved mesh (Thomson's principle), from the hybridised
 mixed method with Raviart-Thomas elements of degree ``k`` (Arnold & Brezzi 1985), made exactly admissible whatever
 the face solver's residual.
 
-On every element the flux is a divergence-free field of ``RT_k`` mapped by Piola (:mod:`fem_neck.simplex`); its
-normal traces are tied together by a multiplier ``lambda`` in ``P_k`` on every face (the temperature trace), which is
+On every element the flux is a divergence-free field of ``RT_k`` mapped by Piola (:mod:`fem_neck.simplex`); its normal
+traces are tied together by a multiplier :math:`\lambda` in :math:`P_k` on every face (the temperature trace), which is
 1 on the hot faces, 0 on the cold ones and unknown elsewhere. Eliminating the element fluxes leaves the symmetric
-positive definite face system ``H lambda = 0``, with ``H = sum_K H_K``, ``H_K = T A_K^-1 T^T`` (``A_K`` the element's
-flux mass, ``T`` the reference trace moments); the element flux of ``lambda`` is ``A_K^-1 T^T lambda_K`` and its
-outward trace moments ``H_K lambda_K``. The face system is minimised by conjugate gradients until its energy
-``lambda^T H lambda`` has settled (as the upper bound's, ``fem_neck.primal.ENERGY_RTOL``), so the element fluxes
-of the iterate still jump across the faces by the residual.
+positive definite face system :math:`H \lambda = 0`, with :math:`H = \sum_K H_K`, :math:`H_K = T A_K^{-1} T^T`
+(:math:`A_K` the element's flux mass, ``T`` the reference trace moments); the element flux of :math:`\lambda` is
+:math:`A_K^{-1} T^T \lambda_K` and its outward trace moments :math:`H_K \lambda_K`. The face system is minimised by
+conjugate gradients until its energy :math:`\lambda^T H \lambda` has settled (as the upper bound's,
+``fem_neck.primal.ENERGY_RTOL``), so the element fluxes of the iterate still jump across the faces by the residual.
 
 Equilibration (:func:`equilibrate`): every face gets one flux -- the mean of its two sides' traces, zero on the
 insulated faces -- whose face means are then corrected (the correction of least norm, a sparse direct solve on the
-element graph) so that the net flux out of every element vanishes; the element then takes the divergence-free field
-of least energy with exactly these traces (``lambda_K + mu_K`` with ``H_K mu_K`` the change of its traces; the
-traces of divergence-free ``RT_k`` fields are all of ``P_k`` per face with zero net flux). The result is divergence
-free in every element with one normal flux on every face and none on the insulated ones, to round-off whatever the
-iterate: admissible in the complementary principle on the exact solid, so ``K >= P^2 / E*`` with ``P`` the heat it
-carries through the hot faces and ``E* = int |q|^2`` (the largest normal-flux jump left is reported,
-``flux_defect``). The correction is of the size of the solver's error, which the bound feels only to second order
-(it is the maximum of ``P^2 / E*``); making an iterate's flux admissible to decouple the guarantee from the
-algebraic error follows Jiranek, Strakos & Vohralik 2010. Degree ``k = p - 1`` converges at the rate of the ``P_p``
-upper bound (both errors ``O(h^2p)`` in the energy).
+element graph) so that the net flux out of every element vanishes; the element then takes the divergence-free field of
+least energy with exactly these traces (:math:`\lambda_K + \mu_K` with :math:`H_K \mu_K` the change of its traces; the
+traces of divergence-free ``RT_k`` fields are all of ``P_k`` per face with zero net flux). The result is divergence free
+in every element with one normal flux on every face and none on the insulated ones, to round-off whatever the iterate:
+admissible in the complementary principle on the exact solid, so :math:`K \ge P^2 / E^*` with ``P`` the heat it carries
+through the hot faces and :math:`E^* = \int |q|^2` (the largest normal-flux jump left is reported, ``flux_defect``). The
+correction is of the size of the solver's error, which the bound feels only to second order (it is the maximum of
+:math:`P^2 / E^*`); making an iterate's flux admissible to decouple the guarantee from the algebraic error follows
+Jiranek, Strakos & Vohralik 2010. Degree :math:`k = p - 1` converges at the rate of the :math:`P_p` upper bound (both
+errors :math:`O(h^{2p})` in the energy).
 """
 
 from __future__ import annotations
@@ -41,8 +41,8 @@ CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arr
 
 
 def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np.ndarray) -> np.ndarray:
-    """Flux mass matrices ``(E, m, m)`` of ``elements``: ``int sigma^T J^T J tau / |det J|`` on the reference element
-    (exact on straight elements, quadrature of ``degree`` on curved ones).
+    r"""Flux mass matrices ``(E, m, m)`` of ``elements``: :math:`\int \sigma^T J^T J \tau / |\det J|` on the reference
+    element (exact on straight elements, quadrature of ``degree`` on curved ones).
 
     Parameters
     ----------
@@ -69,13 +69,14 @@ def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np
 
 @dataclass
 class Solution:
-    """The equilibrated flux of :func:`solve`, for the unit temperature difference and ``kappa`` = 1: ``lower`` and
-    ``heat_flow`` are then ``K / kappa`` and ``P / kappa``, in the mesh's length unit (m for a mesh in metres).
+    r"""The equilibrated flux of :func:`solve`, for the unit temperature difference and :math:`\kappa = 1`: ``lower``
+    and ``heat_flow`` are then :math:`K / \kappa` and :math:`P / \kappa`, in the mesh's length unit (m for a mesh in
+    metres).
 
     Parameters
     ----------
     lower : float
-        ``P^2 / E*``: the lower bound of the conductance.
+        :math:`P^2 / E^*`: the lower bound of the conductance.
     heat_flow : float
         ``P``, the heat the flux carries through the hot faces.
     energy : float
@@ -229,7 +230,7 @@ def _symmetric_block_product(data, indices, indptr, x, y):
 
 @dataclass
 class FaceSystem:
-    """The face system on the free faces' moments (:func:`face_system`); ``d`` denotes the faces held at a
+    r"""The face system on the free faces' moments (:func:`face_system`); ``d`` denotes the faces held at a
     temperature, ``f`` the free ones.
 
     Parameters
@@ -237,9 +238,9 @@ class FaceSystem:
     matrix : SymmetricBlocks
         ``H_ff``, one ``n_f`` square block per pair of faces of an element.
     b : numpy.ndarray
-        Right-hand side ``-H_fd lambda_d``.
+        Right-hand side :math:`-H_{fd} \lambda_d`.
     constant : float
-        ``lambda_d^T H_dd lambda_d``.
+        :math:`\lambda_d^T H_{dd} \lambda_d`.
     free : numpy.ndarray
         The free dofs (indices into the face multipliers ``(n_faces n_f,)``).
     diagonal : numpy.ndarray
@@ -253,7 +254,7 @@ class FaceSystem:
     diagonal: np.ndarray
 
     def energy(self, x: np.ndarray) -> float:
-        """``lambda^T H lambda`` of ``lambda`` = ``x`` on the free dofs, the held values elsewhere.
+        r""":math:`\lambda^T H \lambda` of :math:`\lambda` = ``x`` on the free dofs, the held values elsewhere.
 
         Parameters
         ----------
@@ -273,7 +274,7 @@ def face_system(mesh: CurvedMesh, H_K: SymmetricStack, fixed_face: np.ndarray, l
     mesh : fem_neck.curved.CurvedMesh
         The curved tetrahedral mesh.
     H_K : SymmetricStack
-        The element matrices ``T A_K^-1 T^T`` (``4 n_f`` square).
+        The element matrices :math:`T A_K^{-1} T^T` (``4 n_f`` square).
     fixed_face : numpy.ndarray
         Boolean mask over ``mesh.faces``: True on the faces held at a temperature.
     lam : numpy.ndarray
@@ -364,7 +365,7 @@ def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.nda
 
 
 def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_face: np.ndarray) -> np.ndarray:
-    """Element multipliers ``(E, 4 n_f)`` whose element fluxes ``A_K^-1 T^T lambda_K`` form an admissible flux:
+    r"""Element multipliers ``(E, 4 n_f)`` whose element fluxes :math:`A_K^{-1} T^T \lambda_K` form an admissible flux:
     one normal flux on every face, none on the insulated ones (the module docstring), from the element matrices
     ``H_K`` (``4 n_f`` square), any face multipliers ``lam (n_faces n_f,)`` and the faces held at a temperature
     (``fixed_face``, whose flux is free).
@@ -374,7 +375,7 @@ def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_fa
     mesh : fem_neck.curved.CurvedMesh
         The curved tetrahedral mesh.
     H_K : SymmetricStack
-        The element matrices ``T A_K^-1 T^T`` (``4 n_f`` square).
+        The element matrices :math:`T A_K^{-1} T^T` (``4 n_f`` square).
     lam : numpy.ndarray
         Face multipliers ``(n_faces n_f,)`` (any: the CG iterate).
     fixed_face : numpy.ndarray

@@ -1,4 +1,4 @@
-"""The conductance fit: an FE sweep of the semisphere with a neck over a/r, Rojek's linear fit and the full-range law.
+r"""The conductance fit: an FE sweep of the semisphere with a neck over a/r, Rojek's linear fit and the full-range law.
 
 * :func:`sweep_points` -- the a/r of the sweep: ``n // 8`` points log-spaced on [0.001, 0.02) for the small-neck
   end, the rest uniform in a/r on (0, 0.97] (``0.97 k / m``, k = 1..m), the sampling of Rojek 2022, Fig. 16.
@@ -9,14 +9,14 @@
   three); ``run_fit(..., fresh=True)`` recomputes every point.
 * :func:`linear_slope` -- ``K/K_cyl = c a/r`` by least squares through the origin on the uniform points with
   ``a/r <= 0.7`` (Rojek 2022, eq. 40); :func:`slope_sensitivity` shows how c moves with the sampling.
-* :func:`fit_law` -- B, C, E of :class:`fem_neck.law.ConductanceLaw` (A = 5/(4 pi) is derived), least squares on
-  relative residuals.
+* :func:`fit_law` -- B, C, E of :class:`fem_neck.law.ConductanceLaw` (:math:`A = 5/(4 \pi)` is derived), least squares
+  on relative residuals.
 * :func:`run_fit` -- all of it, writing ``fit.json`` (read by the DEM), ``fit.csv`` and ``fit.png`` (the Fig. 16
   analogue) into one folder; the figure is drawn by a process of its own that imports matplotlib while the sweep
   starts (this process never imports matplotlib).
 
 Every step takes ``neck``: ``"cylinder"`` (default) sweeps and fits the semisphere with Rojek's neck cylinder,
-``"union"`` the half body of the union of spheres (no cylinder; A = 1/pi), and fit.json records which.
+``"union"`` the half body of the union of spheres (no cylinder; :math:`A = 1/\pi`), and fit.json records which.
 
 The FE solver is named by ``"module:function"`` (default :data:`SOLVER`, ``semisphere_conductance(a_over_r,
 rtol, method=..., neck=...)`` returning an object with ``K_over_Kcyl``, ``error_estimate`` and ``dofs``), so worker
@@ -52,7 +52,7 @@ CSV_FIELDS = ("a_over_r", "K_over_Kcyl", "error_estimate", "dofs", "seconds", "r
 
 @dataclass(frozen=True)
 class FitPoint:
-    """One FE solve of the semisphere with a neck (or the union's half body): K/K_cyl at a/r to the tolerance
+    r"""One FE solve of the semisphere with a neck (or the union's half body): K/K_cyl at a/r to the tolerance
     ``rtol``.
 
     Parameters
@@ -60,7 +60,7 @@ class FitPoint:
     a_over_r : float
         Neck radius over particle radius, ``a/r`` (dimensionless).
     K_over_Kcyl : float
-        The half body's conductance over ``K_cyl = kappa pi r`` (dimensionless).
+        The half body's conductance over :math:`K_{cyl} = \kappa \pi r` (dimensionless).
     error_estimate : float
         The solver's relative error estimate of ``K_over_Kcyl``.
     dofs : int
@@ -92,10 +92,10 @@ class FitPoint:
 
 
 def sweep_points(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """The sweep's a/r (sorted) and a mask of the uniform ones; ``n >= 4`` points in total.
+    r"""The sweep's a/r (sorted) and a mask of the uniform ones; ``n >= 4`` points in total.
 
     ``n // 8`` points log-spaced on [0.001, 0.02) (the constriction end, where the linear law fails) and
-    ``m = n - n // 8`` uniform points ``0.97 k / m``, k = 1..m.
+    :math:`m = n - \lfloor n / 8 \rfloor` uniform points :math:`0.97 k / m`, :math:`k = 1, \ldots, m`.
 
     Parameters
     ----------
@@ -288,7 +288,7 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
 
 
 def linear_slope(a_over_r, k_over_kcyl, x_max: float = LINEAR_RANGE) -> float:
-    """Least-squares slope through the origin, ``c = sum(x f) / sum(x^2)`` over ``a/r <= x_max`` (eq. 40).
+    r"""Least-squares slope through the origin, :math:`c = \sum x f / \sum x^2` over :math:`a/r \le x_{max}` (eq. 40).
 
     Parameters
     ----------
@@ -326,11 +326,11 @@ def _law_basis(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def fit_law(a_over_r, k_over_kcyl, A: float | None = None, neck: str = "cylinder") -> ConductanceLaw:
-    """Fit B, C, E of the full-range law for ``neck`` (A fixed, default the derived :data:`fem_neck.law.A_LOG` =
-    5/(4 pi) for the neck cylinder, :data:`fem_neck.law.A_LOG_UNION` = 1/pi for the union) to FE points,
-    0 < a/r < 1.
+    r"""Fit B, C, E of the full-range law for ``neck`` (A fixed, default the derived :data:`fem_neck.law.A_LOG` =
+    :math:`5/(4 \pi)` for the neck cylinder, :data:`fem_neck.law.A_LOG_UNION` = :math:`1/\pi` for the union) to FE
+    points, 0 < a/r < 1.
 
-    Least squares on the relative residual: ``1/f - lambda = pi/(4x) P`` is linear in the parameters; Gauss-Newton
+    Least squares on the relative residual: :math:`1/f - \lambda = \pi/(4x) P` is linear in the parameters; Gauss-Newton
     on the exact relative residual ``f_law/f_FE - 1`` from that linear start converges in a few steps.
 
     Parameters
@@ -340,7 +340,7 @@ def fit_law(a_over_r, k_over_kcyl, A: float | None = None, neck: str = "cylinder
     k_over_kcyl : array_like
         The FE points' K/K_cyl (dimensionless, > 0).
     A : float or None
-        The fixed ``x ln(1/x)`` coefficient; None: the derived one for ``neck``.
+        The fixed :math:`x \ln(1/x)` coefficient; None: the derived one for ``neck``.
     neck : str
         The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (the semisphere with Rojek's neck cylinder) or
         ``"union"`` (the union of spheres).
@@ -383,12 +383,12 @@ def fit_law(a_over_r, k_over_kcyl, A: float | None = None, neck: str = "cylinder
 
 
 def slope_sensitivity(law: ConductanceLaw) -> dict:
-    """The least-squares slope c of eq. (40) under other samplings, evaluated on the (FE-fitted) law.
+    r"""The least-squares slope c of eq. (40) under other samplings, evaluated on the (FE-fitted) law.
 
     Keys: continuous uniform a/r on (0, 0.6], (0, 0.7], (0, 0.8]; uniform in h/r for a/r <= 0.7; the paper's four
     h/r of Figs. 13-14 (their a/r reach 0.83). The overlap h of two equal spheres gives a/r through the law's neck:
     the volume-conserving neck (eqs. 18-20) for ``law.neck = "cylinder"``, the circle where the spheres meet,
-    ``a = sqrt(h (r - h/4))``, for the union.
+    :math:`a = \sqrt{h (r - h/4)}`, for the union.
 
     Parameters
     ----------

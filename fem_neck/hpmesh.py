@@ -1,11 +1,11 @@
-"""Geometric quadrilateral meshes of the semisphere with a neck (Rojek 2022, Sec. 5, Fig. 12), for hp elements.
+r"""Geometric quadrilateral meshes of the semisphere with a neck (Rojek 2022, Sec. 5, Fig. 12), for hp elements.
 
 The body (sphere radius 1, neck radius ``a``, meridian half-plane, ``x`` radial) is the sphere cut at its equator
-``z = 0`` and at the cap base ``z_i = sqrt(1 - a^2)``, plus the half neck ``[0, a] x [z_i, z_i + t]`` with
-``t = h_n / 2`` (eqs. 19-20) -- or, for the *union* of spheres, no neck cylinder at all (``t = 0``: the end disk is
-the cap base itself, the circle where two spheres meet). The temperature is singular at the corner ``C = (a, z_i)``
-(re-entrant with the cylinder; with the union, where the isothermal disk meets the insulated sphere); an hp method
-converges exponentially when the elements shrink geometrically toward ``C`` while the order is raised
+:math:`z = 0` and at the cap base :math:`z_i = \sqrt{1 - a^2}`, plus the half neck :math:`[0, a] \times [z_i, z_i + t]`
+with :math:`t = h_n / 2` (eqs. 19-20) -- or, for the *union* of spheres, no neck cylinder at all (:math:`t = 0`: the end
+disk is the cap base itself, the circle where two spheres meet). The temperature is singular at the corner
+``C = (a, z_i)`` (re-entrant with the cylinder; with the union, where the isothermal disk meets the insulated sphere);
+an hp method converges exponentially when the elements shrink geometrically toward ``C`` while the order is raised
 (Babuska-Guo). The mesh is built from three families of quadrilaterals, all from closed-form points (no mesher):
 
 * **corner cells** -- three cells meet at ``C``: the neck square ``[a - R, a] x [z_i, z_i + R]``, the square below
@@ -13,16 +13,15 @@ converges exponentially when the elements shrink geometrically toward ``C`` whil
   refined ``levels`` times by the pattern "corner cell -> corner cell scaled by ``sigma`` + two trapezoids" (far
   edges untouched, so the mesh stays conforming);
 * **rings** around ``C`` (geometric radii from ``R`` to ``a``) and, for small necks, rings around the axis point
-  ``P = (0, z_i)`` (from ``3.5 a`` to ``0.6 z_i``), so every scale from the neck height ``t ~ a^2 / 4`` to the
+  ``P = (0, z_i)`` (from ``3.5 a`` to ``0.6 z_i``), so every scale from the neck height :math:`t \approx a^2 / 4` to the
   sphere radius is covered by elements of its own size;
 * a few **far cells** that reach the equator.
 
-The neck above the cap base is a tensor grid whose columns end at ``x = a - rho`` for the ring radii ``rho``. Two
-layouts of the body below share the corner cells: *small neck* (``a <= 0.6``, ``R = t``: square and wedge rings to
-the axis, then rings around ``P`` and spokes to the equator) and *large neck* (``a > 0.6``, ``R = min(t, z_i / 2)``:
-two rows of the neck's columns, then the wedge down to the equator); the union takes ``R = min(a / 4, z_i / 2)``.
-A pair (:func:`pair_quad_mesh`) is two such half bodies, each in its own sphere radius, glued at the neck's
-mid-plane.
+The neck above the cap base is a tensor grid whose columns end at :math:`x = a - \rho` for the ring radii :math:`\rho`.
+Two layouts of the body below share the corner cells: *small neck* (``a <= 0.6``, ``R = t``: square and wedge rings to
+the axis, then rings around ``P`` and spokes to the equator) and *large neck* (``a > 0.6``, ``R = min(t, z_i / 2)``: two
+rows of the neck's columns, then the wedge down to the equator); the union takes :math:`R = \min(a / 4, z_i / 2)`. A
+pair (:func:`pair_quad_mesh`) is two such half bodies, each in its own sphere radius, glued at the neck's mid-plane.
 
 Coordinates are ``(x, z - z_i)``: relative to the corner's height, so elements of size 1e-15 next to ``C`` keep full
 precision even at ``a = 1e-4`` (where ``t = 2.5e-9``); points on the sphere are given by their angle offset
@@ -50,7 +49,7 @@ LONGEST_ARC = 0.6       # radians of sphere in one far cell before it is split
 
 @dataclass(frozen=True)
 class SemisphereShape:
-    """Dimensions of the body (sphere radius 1): neck radius ``a``, cap base ``z_i``, half-neck height ``t`` (0 for
+    r"""Dimensions of the body (sphere radius 1): neck radius ``a``, cap base ``z_i``, half-neck height ``t`` (0 for
     the union), the corner's polar angle ``phi_c``. Exact volume for checks: :meth:`volume`.
 
     Parameters
@@ -58,12 +57,12 @@ class SemisphereShape:
     a : float
         Neck radius, in units of the sphere radius.
     z_i : float
-        Height of the cap base above the equator, ``sqrt(1 - a^2)``, in units of the sphere radius.
+        Height of the cap base above the equator, :math:`\sqrt{1 - a^2}`, in units of the sphere radius.
     t : float
         Height of the half neck above the cap base, ``h_n / 2`` (eqs. 19-20), in units of the sphere radius; 0 for
         the union.
     phi_c : float
-        Polar angle of the corner ``C`` from the equatorial plane, ``atan2(z_i, a)`` (rad).
+        Polar angle of the corner ``C`` from the equatorial plane, :math:`\arctan(z_i / a)` (rad).
     """
 
     a: float
@@ -104,8 +103,10 @@ class SemisphereShape:
         return math.pi * (self.z_i - self.z_i**3 / 3.0) + math.pi * self.a**2 * self.t
 
     def sphere_point(self, delta):
-        """Points on the sphere at angle offset ``delta`` (toward the equator) from ``C``, in ``(x, z - z_i)``, and
-        their ``delta``-derivatives; ``S - C = 2 sin(delta/2) (sin(phi_c - delta/2), -cos(phi_c - delta/2))``.
+        r"""Points on the sphere at angle offset ``delta`` (toward the equator) from ``C``, in ``(x, z - z_i)``, and
+        their ``delta``-derivatives;
+        :math:`S - C = 2 \sin(\delta/2) \left(\sin(\varphi_c - \delta/2), -\cos(\varphi_c - \delta/2)\right)` with
+        :math:`\delta` the ``delta`` and :math:`\varphi_c` the ``phi_c``.
 
         Parameters
         ----------
@@ -115,8 +116,8 @@ class SemisphereShape:
         Returns
         -------
         tuple of (numpy.ndarray, numpy.ndarray)
-            The points ``(x, z - z_i)`` and their derivatives with respect to ``delta``, shape ``delta.shape + (2,)``
-            each (units of the sphere radius).
+            The points ``(x, z - z_i)`` and their derivatives with respect to ``delta``, of the shape of ``delta`` with
+            a last axis of 2 each (units of the sphere radius).
         """
         delta = np.asarray(delta, dtype=float)
         half = np.sin(0.5 * delta)
@@ -297,9 +298,9 @@ def corner_radius(shape: SemisphereShape) -> float:
 
 
 def half_body(shape: SemisphereShape, R: float, levels: int, sigma: float = SIGMA) -> QuadMesh:
-    """One sphere from its equator to the plane ``t`` above its cap base (the neck's end disk), corner cells of
-    radius ``R <= t``. The neck cylinder is a tensor grid whose columns end at ``x = a - rho`` for the ring radii
-    ``rho`` from ``R`` to ``a`` -- so two halves with the same ``a``, ``t`` and ``R`` share their end disk's nodes
+    r"""One sphere from its equator to the plane ``t`` above its cap base (the neck's end disk), corner cells of
+    radius ``R <= t``. The neck cylinder is a tensor grid whose columns end at :math:`x = a - \rho` for the ring radii
+    :math:`\rho` from ``R`` to ``a`` -- so two halves with the same ``a``, ``t`` and ``R`` share their end disk's nodes
     (:func:`pair_quad_mesh`). With ``t = 0`` (the union) the end disk is the cap base and ``0 < R < a``.
 
     Parameters

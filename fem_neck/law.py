@@ -13,7 +13,7 @@ from it
 The laws:
 
 * :class:`LinearLaw` -- :math:`f(x) = c x`; :data:`ROJEK` is c = 1.064 (Rojek 2022, eq. 40), :data:`ARGENTO_BOUVARD`
-  c = 1/0.899 = 1.112 (eqs. 41-42).
+  :math:`c = 1/0.899 = 1.112` (eqs. 41-42).
 * :class:`ConductanceLaw` -- the full-range law fitted to FE by ``python -m fem_neck fit`` and read from its
   ``fit.json`` (:meth:`ConductanceLaw.from_json`; :meth:`ConductanceLaw.default` is the fit shipped in
   ``fem_neck/data/fit.json``). It splits the half body's resistance (in units of :math:`1/(\kappa \pi r)`) into the
@@ -40,7 +40,7 @@ The laws:
     :math:`1/(4 \kappa a)`), plus :math:`1/(4 \pi)` from the thin half neck (length :math:`l = a x/4`) carrying the
     isothermal disk's rim-singular flux :math:`q \sim (a^2 - \rho^2)^{-1/2}`, which adds
     :math:`(l/(4 \pi \kappa a^2)) \ln(a/l)` to its 1-D resistance. The FE sweep gives 0.398 +- 0.002 for this
-    coefficient between a/r = 3e-4 and 1e-2 (:math:`5/(4 \pi)` = 0.3979).
+    coefficient between :math:`a/r` = 3e-4 and 1e-2 (:math:`5/(4 \pi)` = 0.3979).
     :math:`s = z_i / r` is the thickness of the segment left between the equator and the cap base; it vanishes at
     x = 1, where P(1) = 0 and the half body is a cylinder of radius r and length 2r/3, :math:`f(1) = 3/2` exactly.
 
@@ -59,14 +59,14 @@ The laws:
   :math:`4 \kappa a`). Its :math:`x \ln(1/x)` coefficient is :data:`A_LOG_UNION` = :math:`1/\pi`, the ball's
   Neumann log alone: there is no half neck to carry the disk's rim-singular flux (the rim now sees the sphere at the
   angle :math:`\pi/2 + \arccos(x)`, a change of the geometry of relative size x with a finite energy integral, which
-  moves B, not A). The FE gives 0.3183 for this coefficient between a/r = 3e-4 and 1e-2 (:math:`1/\pi` = 0.31831),
-  against 0.3980 for the neck cylinder. At x -> 1 the half body is a slab of thickness :math:`s = z_i / r`: its
-  resistance vanishes and :math:`f \to \infty`; the exact limit, the 1-D resistance through the cross-sections
+  moves B, not A). The FE gives 0.3183 for this coefficient between :math:`a/r` = 3e-4 and 1e-2 (:math:`1/\pi` =
+  0.31831), against 0.3980 for the neck cylinder. At x -> 1 the half body is a slab of thickness :math:`s = z_i / r`:
+  its resistance vanishes and :math:`f \to \infty`; the exact limit, the 1-D resistance through the cross-sections
   :math:`\pi (r^2 - z^2)`, is :math:`1/f = \operatorname{atanh}(s) + O(s^4)`, and the form gives
-  :math:`1/f \to (\pi/4)(1 + B + C + E) s` (:math:`P_u(1) = 0` from the last term). B, C, E are fitted freely, as
-  for the cylinder: holding the slope at s -> 0 exact (:math:`1 + B + C + E = 4/\pi`) costs the form a factor 5 in
-  accuracy over the sweep, so the fitted slope differs from 1 by what the fit's residual at x = 0.97 allows (see the
-  fit file's ``max_rel_residual``, and the guide for the law's error beyond the fit range).
+  :math:`1/f \to (\pi/4)(1 + B + C + E) s` (:math:`P_u(1) = 0` from the last term). B, C, E are fitted freely, as for
+  the cylinder: holding the slope at s -> 0 exact (:math:`1 + B + C + E = 4/\pi`) costs the form a factor 5 in accuracy
+  over the sweep, so the fitted slope differs from 1 by what the fit's residual at x = 0.97 allows (see the fit file's
+  ``max_rel_residual``, and the guide for the law's error beyond the fit range).
 """
 
 from __future__ import annotations
@@ -121,7 +121,7 @@ def check_neck_ratio(a_over_r, name: str = "a_over_r") -> np.ndarray:
     Parameters
     ----------
     a_over_r : float or array_like
-        Neck radius over particle radius, ``x = a/r`` (dimensionless), any shape.
+        Neck radius over particle radius, :math:`x = a/r` (dimensionless), any shape.
     name : str
         The name the error message gives the value (``"a/r_min"``, say).
 
@@ -148,20 +148,21 @@ def _out(value):
 
 
 def neck_resistance(a_over_r):
-    """``lambda(x)``: resistance of the half neck of an equal pair in units of ``1/(kappa pi r)`` (eqs. 16-20).
+    r""":math:`\lambda(x)`: resistance of the half neck of an equal pair in units of :math:`1/(\kappa \pi r)` (eqs.
+    16-20).
 
-    The half neck is a cylinder of radius ``a = x r`` and length ``h_n/2``; ``lambda = h_n / (2 r x^2)``, finite at
-    x -> 0 (1/4) and 2/3 at x = 1.
+    The half neck is a cylinder of radius :math:`a = x r` and length :math:`h_n/2`; :math:`\lambda = h_n / (2 r x^2)`,
+    finite at x -> 0 (1/4) and 2/3 at x = 1.
 
     Parameters
     ----------
     a_over_r : float or array_like
-        Neck radius over particle radius, ``x = a/r`` in ``[0, 1]`` (dimensionless).
+        Neck radius over particle radius, :math:`x = a/r` in ``[0, 1]`` (dimensionless).
 
     Returns
     -------
     float or numpy.ndarray
-        ``lambda(x)`` (dimensionless: the resistance times ``kappa pi r``), a float for a scalar input.
+        :math:`\lambda(x)` (dimensionless: the resistance times :math:`\kappa \pi r`), a float for a scalar input.
     """
     x = check_neck_ratio(a_over_r)
     s = np.sqrt(1.0 - x * x)
@@ -170,20 +171,20 @@ def neck_resistance(a_over_r):
 
 
 def half_neck_resistance(a_over_r, neck: str = "cylinder"):
-    """The neck's part of the half body's resistance in units of ``1/(kappa pi r)``: ``lambda(x)`` of the half neck
-    cylinder (:func:`neck_resistance`) for ``neck = "cylinder"``, 0 for the union (it has no neck cylinder).
+    r"""The neck's part of the half body's resistance in units of :math:`1/(\kappa \pi r)`: :math:`\lambda(x)` of the
+    half neck cylinder (:func:`neck_resistance`) for ``neck = "cylinder"``, 0 for the union (it has no neck cylinder).
 
     Parameters
     ----------
     a_over_r : float or array_like
-        Neck radius over particle radius, ``x = a/r`` in ``[0, 1]`` (dimensionless).
+        Neck radius over particle radius, :math:`x = a/r` in ``[0, 1]`` (dimensionless).
     neck : str
         The half body (:data:`NECKS`): ``"cylinder"`` or ``"union"``.
 
     Returns
     -------
     float or numpy.ndarray
-        The half neck's resistance times ``kappa pi r`` (dimensionless), a float for a scalar input.
+        The half neck's resistance times :math:`\kappa \pi r` (dimensionless), a float for a scalar input.
 
     Raises
     ------
@@ -210,12 +211,13 @@ class LinearLaw:
     name: str = "linear"
 
     def k_over_kcyl(self, a_over_r):
-        """``K/K_cyl = slope x``: the half-pair conductance over ``K_cyl = kappa pi r`` (eq. 40).
+        r""":math:`K/K_{cyl} = c x` (``slope`` c): the half-pair conductance over :math:`K_{cyl} = \kappa \pi r` (eq.
+        40).
 
         Parameters
         ----------
         a_over_r : float or array_like
-            Neck radius over particle radius, ``x = a/r`` in ``[0, 1]`` (dimensionless).
+            Neck radius over particle radius, :math:`x = a/r` in ``[0, 1]`` (dimensionless).
 
         Returns
         -------
@@ -231,20 +233,20 @@ ARGENTO_BOUVARD = LinearLaw(1.0 / 0.899, "Argento & Bouvard 1996, eq. (42)")  #:
 
 @dataclass(frozen=True)
 class ConductanceLaw:
-    """The full-range law ``f(x) = K/K_cyl`` (module docstring), valid on ``0 <= a/r <= 1``.
+    r"""The full-range law :math:`f(x) = K/K_{cyl}` (module docstring), valid on :math:`0 \le a/r \le 1`.
 
     Outside the fit range the law follows its exact limits (x -> 0 and x = 1).
 
     Parameters
     ----------
     A : float
-        Coefficient of ``x ln(1/x)`` in ``P(x)`` (dimensionless); the fit keeps the derived :data:`A_LOG`.
+        Coefficient of :math:`x \ln(1/x)` in :math:`P(x)` (dimensionless); the fit keeps the derived :data:`A_LOG`.
     B : float
-        Coefficient of ``x`` in ``P(x)`` (dimensionless, fitted).
+        Coefficient of ``x`` in :math:`P(x)` (dimensionless, fitted).
     C : float
-        Coefficient of ``x^2`` in ``P(x)`` (dimensionless, fitted).
+        Coefficient of :math:`x^2` in :math:`P(x)` (dimensionless, fitted).
     E : float
-        Coefficient of ``x^3`` in ``P(x)`` (dimensionless, fitted).
+        Coefficient of :math:`x^3` in :math:`P(x)` (dimensionless, fitted).
     fit_range : tuple of float
         The ``(low, high)`` a/r interval of the FE points the law was fitted to (dimensionless).
     max_rel_residual : float
@@ -254,7 +256,7 @@ class ConductanceLaw:
     source : str
         The fit.json it was read from ("" when made in memory); not compared between laws.
     neck : str
-        The half body the law is for (:data:`NECKS`): ``"cylinder"`` (with the half neck's ``lambda(x)``) or
+        The half body the law is for (:data:`NECKS`): ``"cylinder"`` (with the half neck's :math:`\lambda(x)`) or
         ``"union"`` (without; ``f -> inf`` as x -> 1).
     """
 
@@ -273,7 +275,7 @@ class ConductanceLaw:
 
     @property
     def parameters(self) -> dict:
-        """``{"A": ..., "B": ..., "C": ..., "E": ...}``: the coefficients of ``P(x)``."""
+        """``{"A": ..., "B": ..., "C": ..., "E": ...}``: the coefficients of :math:`P(x)`."""
         return {p: getattr(self, p) for p in PARAMETERS}
 
     @property
@@ -282,17 +284,18 @@ class ConductanceLaw:
         return FORMS[self.neck]
 
     def segment_correction(self, a_over_r):
-        """``P(x)``: sphere-segment resistance over the half-space disk value ``1/(4 kappa a)``; P(0)=1, P(1)=0.
+        r""":math:`P(x)`: sphere-segment resistance over the half-space disk value :math:`1/(4 \kappa a)`;
+        :math:`P(0) = 1`, :math:`P(1) = 0`.
 
         Parameters
         ----------
         a_over_r : float or array_like
-            Neck radius over particle radius, ``x = a/r`` in ``[0, 1]`` (dimensionless).
+            Neck radius over particle radius, :math:`x = a/r` in ``[0, 1]`` (dimensionless).
 
         Returns
         -------
         float or numpy.ndarray
-            ``P(x)`` (dimensionless), a float for a scalar input.
+            :math:`P(x)` (dimensionless), a float for a scalar input.
         """
         x = check_neck_ratio(a_over_r)
         s = np.sqrt(1.0 - x * x)
@@ -302,18 +305,19 @@ class ConductanceLaw:
         return _out(p)
 
     def k_over_kcyl(self, a_over_r):
-        """``K/K_cyl = x / (x lambda(x) + (pi/4) P(x))``; vectorised, 0 at x = 0; at x = 1 3/2 (cylinder) or inf
-        (union: the half body's thickness, and its resistance, vanish).
+        r""":math:`K/K_{cyl} = x / (x \lambda(x) + (\pi/4) P(x))`; vectorised, 0 at :math:`x = 0`; at :math:`x = 1` 3/2
+        (cylinder) or inf (union: the half body's thickness, and its resistance, vanish).
 
         Parameters
         ----------
         a_over_r : float or array_like
-            Neck radius over particle radius, ``x = a/r`` in ``[0, 1]`` (dimensionless).
+            Neck radius over particle radius, :math:`x = a/r` in ``[0, 1]`` (dimensionless).
 
         Returns
         -------
         float or numpy.ndarray
-            ``K/K_cyl``, the half-pair conductance over ``kappa pi r`` (dimensionless), a float for a scalar input.
+            :math:`K/K_{cyl}`, the half-pair conductance over :math:`\kappa \pi r` (dimensionless), a float for a scalar
+            input.
         """
         x = check_neck_ratio(a_over_r)
         with np.errstate(divide="ignore"):
@@ -558,8 +562,8 @@ def pair_conductance(kappa, r_i, r_j, a, law=None, unequal: bool = True):
 
     Each half takes its own ``a/r`` (its own half neck too: the neck length of the volume-conserving model splits
     exactly into the two equal-pair half necks, ``h_n = h_n(r_i, r_i)/2 + h_n(r_j, r_j)/2``). With the linear law
-    both halves equal ``c kappa pi a`` (eqs. 43-45). With the full-range law and ``unequal`` (default) the series is
-    multiplied by :func:`unequal_factor`; the linear laws are the papers' models and are never corrected.
+    both halves equal :math:`c \kappa \pi a` (eqs. 43-45). With the full-range law and ``unequal`` (default) the series
+    is multiplied by :func:`unequal_factor`; the linear laws are the papers' models and are never corrected.
 
     Parameters
     ----------

@@ -1,10 +1,10 @@
 """Sparse assembly of element matrices (:class:`Assembly`), and conjugate gradients with a two-level additive
 Schwarz preconditioner (memory linear in the unknowns).
 
-``M^-1 r = P (P^T A P)^-1 P^T r + D^-1 r``: a coarse space ``P`` (for high-order elements the piecewise-linear hats,
-for the hybridised fluxes the face means), whose Galerkin matrix gets one smoothed-aggregation AMG V-cycle (pyamg),
-plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face). The coarse space
-removes the low-frequency error, the local part the high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994
+:math:`M^{-1} r = P (P^T A P)^{-1} P^T r + D^{-1} r`: a coarse space ``P`` (for high-order elements the piecewise-linear
+hats, for the hybridised fluxes the face means), whose Galerkin matrix gets one smoothed-aggregation AMG V-cycle
+(pyamg), plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face). The coarse
+space removes the low-frequency error, the local part the high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994
 for the p-version).
 """
 
@@ -17,10 +17,10 @@ ENERGY_WINDOW = 10  # steps whose energy drops bound the error left (:func:`solv
 
 
 class TwoLevel:
-    """The preconditioner of the module docstring, as a callable ``r -> M^-1 r``. The coarse matrix ``P^T A P`` is
-    computed unless given (``coarse``, CSR); the local part ``D^-1`` is point Jacobi, or block Jacobi on consecutive
-    groups of unknowns whose diagonal blocks of ``A`` are ``block_matrices (B, n, n)`` (``B n`` = all unknowns;
-    the moments of one face), kept as one block sparse matrix.
+    r"""The preconditioner of the module docstring, as a callable :math:`r \to M^{-1} r`. The coarse matrix
+    :math:`P^T A P` is computed unless given (``coarse``, CSR); the local part :math:`D^{-1}` is point Jacobi, or block
+    Jacobi on consecutive groups of unknowns whose diagonal blocks of ``A`` are ``block_matrices (B, n, n)`` (``B n`` =
+    all unknowns; the moments of one face), kept as one block sparse matrix.
 
     Parameters
     ----------
@@ -29,7 +29,7 @@ class TwoLevel:
     P : scipy.sparse matrix
         The coarse space (n, m): column j holds coarse function j on the unknowns.
     coarse : scipy.sparse.csr_matrix, optional
-        ``P^T A P`` (m, m) if the caller has it; computed otherwise.
+        :math:`P^T A P` (m, m) if the caller has it; computed otherwise.
     block_matrices : numpy.ndarray, optional
         The diagonal blocks (B, k, k) of ``A`` on consecutive groups of ``k`` unknowns (``B k = n``), inverted for the
         block Jacobi part; None for point Jacobi.
@@ -65,7 +65,8 @@ class Assembly:
     (``_pattern``); :meth:`add` adds a chunk's element matrices into those places, which can then be dropped.
     The free dofs ``free`` are numbered in the order the elements first use them, so that an element's rows lie
     near each other in memory (the pattern and the additions take half the time of the global dofs' order).
-    ``A_ff x = b`` gives the free values; :meth:`energy` is ``u^T A u`` of the full vector exactly, whatever ``x``.
+    :math:`A_{ff} x = b` gives the free values; :meth:`energy` is :math:`u^T A u` of the full vector exactly, whatever
+    ``x``.
 
     Parameters
     ----------
@@ -126,8 +127,8 @@ class Assembly:
         return A
 
     def energy(self, A, x: np.ndarray) -> float:
-        """``u^T A u`` of ``u`` = ``x`` on the free dofs, the fixed values elsewhere: ``x A_ff x - 2 x b + u_d A_dd
-        u_d`` (``A_fd u_d = -b``).
+        """:math:`u^T A u` of ``u`` = ``x`` on the free dofs, the fixed values elsewhere:
+        :math:`x A_{ff} x - 2 x b + u_d A_{dd} u_d` (:math:`A_{fd} u_d = -b`).
 
         Parameters
         ----------
@@ -217,7 +218,7 @@ def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None) -> Tw
     P : scipy.sparse matrix
         The coarse space (n, m).
     coarse : scipy.sparse.csr_matrix, optional
-        ``P^T A P`` if the caller has it.
+        :math:`P^T A P` if the caller has it.
     block_matrices : numpy.ndarray, optional
         Diagonal blocks (B, k, k) of ``A`` for block Jacobi; None for point Jacobi.
     """
@@ -226,14 +227,14 @@ def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None) -> Tw
 
 def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 5000,
           x0: np.ndarray | None = None, energy: tuple[float, float] | None = None) -> tuple[np.ndarray, int, float]:
-    """Conjugate gradients on the SPD ``A x = b`` to ``|r| <= rtol |b|``: ``(x, iterations, |r| / |b|)``;
-    ``RuntimeError`` if ``maxiter`` iterations do not reach it.
+    r"""Conjugate gradients on the SPD :math:`A x = b` to :math:`|r| \le \mathrm{rtol} \, |b|`:
+    ``(x, iterations, |r| / |b|)``; ``RuntimeError`` if ``maxiter`` iterations do not reach it.
 
-    ``energy = (E0, etol)`` stops instead on the energy ``E(x) = x A x - 2 b x + const`` (``E0`` at ``x0``), which
-    CG lowers by ``alpha_k r_k . z_k`` in step k: when the last ``ENERGY_WINDOW`` steps together lowered it by less
-    than ``etol E(x)``. The error left is then ~``etol E`` (the steps shrink geometrically), about half the
-    iterations of a residual of ``etol`` -- enough for a Dirichlet energy, which bounds the exact one from above
-    whatever ``x`` (the energy error after step k is the sum of the later drops; Strakos & Tichy 2002).
+    ``energy = (E0, etol)`` stops instead on the energy :math:`E(x) = x A x - 2 b x + \mathrm{const}` (``E0`` at
+    ``x0``), which CG lowers by :math:`\alpha_k r_k \cdot z_k` in step k: when the last ``ENERGY_WINDOW`` steps together
+    lowered it by less than ``etol E(x)``. The error left is then ~``etol E`` (the steps shrink geometrically), about
+    half the iterations of a residual of ``etol`` -- enough for a Dirichlet energy, which bounds the exact one from
+    above whatever ``x`` (the energy error after step k is the sum of the later drops; Strakos & Tichy 2002).
 
     Parameters
     ----------
@@ -242,7 +243,7 @@ def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 50
     b : numpy.ndarray
         Right-hand side (n,).
     precondition : callable
-        ``r -> M^-1 r`` for a symmetric positive definite ``M`` (a :class:`TwoLevel`).
+        :math:`r \to M^{-1} r` for a symmetric positive definite ``M`` (a :class:`TwoLevel`).
     rtol : float
         Relative residual ``|r| / |b|`` to reach (dimensionless; ignored when ``energy`` is given).
     maxiter : int

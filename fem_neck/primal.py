@@ -1,12 +1,12 @@
-"""The upper bound: conforming ``P_p`` finite elements on an exactly curved tetrahedral mesh (Dirichlet's principle).
+r"""The upper bound: conforming ``P_p`` finite elements on an exactly curved tetrahedral mesh (Dirichlet's principle).
 
-The temperature is held at 1 on the hot faces and 0 on the cold ones; every other boundary is insulated. The
-discrete energy ``u^T A u`` of *any* admissible ``u`` is at least the exact conductance ``K`` (Dirichlet's principle),
-and the elements of :mod:`fem_neck.curved` fill the exact solid, so ``u^T A u >= K`` holds for the computed ``u``
+The temperature is held at 1 on the hot faces and 0 on the cold ones; every other boundary is insulated. The discrete
+energy :math:`u^T A u` of *any* admissible ``u`` is at least the exact conductance ``K`` (Dirichlet's principle), and
+the elements of :mod:`fem_neck.curved` fill the exact solid, so :math:`u^T A u \ge K` holds for the computed ``u``
 whatever the solver's residual (which only makes the bound less sharp): CG stops once the energy has settled to
-``ENERGY_RTOL``. The ``(p - 1)(p - 2)(p - 3) / 6`` interior
-nodes of every element are condensed (Schur complement, batched); the skeleton system is solved by conjugate
-gradients preconditioned by :func:`fem_neck.pcg.two_level` (the piecewise-linear hats as coarse space).
+``ENERGY_RTOL``. The ``(p - 1)(p - 2)(p - 3) / 6`` interior nodes of every element are condensed (Schur complement,
+batched); the skeleton system is solved by conjugate gradients preconditioned by :func:`fem_neck.pcg.two_level` (the
+piecewise-linear hats as coarse space).
 """
 
 from __future__ import annotations
@@ -37,8 +37,8 @@ def quadrature_degree(p: int) -> int:
 
 def stiffness_matrices(mesh: CurvedMesh, basis: Lagrange, degree: int | None = None,
                        elements: np.ndarray | None = None) -> np.ndarray:
-    """Element matrices ``(E, n, n)`` of ``int grad phi_a . grad phi_b`` of ``elements`` (default all): exact on
-    straight elements (a combination of the reference matrices), quadrature of ``degree`` on the curved ones.
+    r"""Element matrices ``(E, n, n)`` of :math:`\int \nabla \phi_a \cdot \nabla \phi_b` of ``elements`` (default all):
+    exact on straight elements (a combination of the reference matrices), quadrature of ``degree`` on the curved ones.
 
     Parameters
     ----------
@@ -69,9 +69,9 @@ UPPER = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
 
 def symmetric_products(g: np.ndarray) -> np.ndarray:
-    """``g_i g_j^T`` of reference fields ``g (Q, 3, n)`` for the six ``(i, j)`` of ``UPPER`` (symmetrised for ``i !=
-    j``), each kept as its entries on and above the diagonal in the order of ``numpy.triu_indices(n)``: ``(Q 6, n (n
-    + 1) / 2)``, so that ``sum_q g^T G_q g`` is one matrix product with the entries of
+    r""":math:`g_i g_j^T` of reference fields ``g (Q, 3, n)`` for the six ``(i, j)`` of ``UPPER`` (symmetrised for
+    :math:`i \ne j`), each kept as its entries on and above the diagonal in the order of ``numpy.triu_indices(n)``:
+    shape :math:`(6 Q, n (n + 1) / 2)`, so that :math:`\sum_q g^T G_q g` is one matrix product with the entries of
     :meth:`fem_neck.curved.CurvedMesh.metric`, packed like this (:func:`symmetric_gather` unpacks it).
 
     Parameters
@@ -190,13 +190,13 @@ def face_dofs(mesh: CurvedMesh, basis: Lagrange, faces: np.ndarray) -> np.ndarra
 
 @dataclass
 class Solution:
-    """The conforming solve of :func:`solve`.
+    r"""The conforming solve of :func:`solve`.
 
     Parameters
     ----------
     energy : float
-        ``u^T A u``: the upper bound of the conductance over ``kappa`` (``K / kappa``, for the unit temperature
-        difference), in the mesh's length unit (m for a mesh in metres).
+        :math:`u^T A u`: the upper bound of the conductance over :math:`\kappa` (:math:`K / \kappa`, for the unit
+        temperature difference), in the mesh's length unit (m for a mesh in metres).
     u : numpy.ndarray
         Temperature of every skeleton node (vertices, edges, faces; the interior nodes are condensed), for 1 K on
         the hot faces and 0 on the cold ones.

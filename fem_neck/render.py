@@ -1,10 +1,10 @@
-"""Temperature and heat-flux pictures of a solved neck: VTU (meshio, for ParaView) and PNG (pyvista, off-screen).
+r"""Temperature and heat-flux pictures of a solved neck: VTU (meshio, for ParaView) and PNG (pyvista, off-screen).
 
 The analogues of Rojek 2022, Figs. 13 (temperature), 14 (heat-flux magnitude) and 17 (unequal pair). The field of a
 :class:`fem_neck.conduction.Result` is sampled on a refined linear mesh of its meridian half-plane and mirrored
 across the axis, so the picture shows the full axial section. Units: lengths in the solve's unit (metres for pairs
 and chains, ``r = 1`` for the semisphere), ``T`` in kelvin above the bottom disk for ``delta_t`` across the body,
-heat flux ``q = kappa |grad T|`` in W/m^2 (per unit length^2 of the input unit).
+heat flux :math:`q = \kappa |\nabla T|` in W/m^2 (per square unit of the input's length unit).
 """
 
 from __future__ import annotations

@@ -1,11 +1,11 @@
-"""Axisymmetric meshes of sintered spheres with cylindrical necks: gmsh (OCC kernel) -> scikit-fem.
+r"""Axisymmetric meshes of sintered spheres with cylindrical necks: gmsh (OCC kernel) -> scikit-fem.
 
 Every body here is a solid of revolution about the z axis, so it is meshed in its meridian half-plane
 ``x = radial coordinate >= 0``, ``y = axial coordinate z``:
 
-* :func:`semisphere_mesh` -- the semisphere with a cylindrical neck of Rojek 2022, Section 5, Fig. 12: the sphere
-  of radius ``r`` from its equatorial plane ``z = 0`` to the cap base ``z_i = sqrt(r^2 - a^2)``, then the half neck,
-  a cylinder of radius ``a`` and height ``h_n / 2`` (eqs. 19-20); with ``neck = "union"`` the half body of the
+* :func:`semisphere_mesh` -- the semisphere with a cylindrical neck of Rojek 2022, Section 5, Fig. 12: the sphere of
+  radius ``r`` from its equatorial plane :math:`z = 0` to the cap base :math:`z_i = \sqrt{r^2 - a^2}`, then the half
+  neck, a cylinder of radius ``a`` and height ``h_n / 2`` (eqs. 19-20); with ``neck = "union"`` the half body of the
   union of spheres, the sphere up to the cap base alone (no neck cylinder);
 * :func:`chain_mesh` -- a collinear chain of spheres with arbitrary radii and overlaps, the end particles cut at
   their outer equatorial planes (the unequal pair of Section 6, Figs. 8 and 17, is the chain of two).
@@ -15,10 +15,10 @@ temperature is fixed), ``axis`` (the symmetry axis ``x = 0``), ``sphere{k}`` (th
 ``neck{k}`` (the cylindrical surface of neck k) and ``insulated`` (all sphere and neck surfaces).
 
 Meshing. The temperature is singular at every re-entrant corner circle where a neck meets a sphere (corner exponent
-``lambda = pi / (pi + arccos(a/r))``). The element size grows linearly with the distance ``d`` to the nearest
+:math:`\lambda = \pi / (\pi + \arccos(a/r))`). The element size grows linearly with the distance ``d`` to the nearest
 corner, ``size = min(h_max, h_min + grading * d)``: a geometric grading whose innermost layer is ``h_min`` (far below
 any tolerance) and whose accuracy is set by ``grading``. Inside a neck thinner than ``grading * a`` (small
-``a/r``: the half neck is ``~a^2/(4r)`` high) the size is at most 4 neck heights. The triangles in that thin,
+``a/r``: the half neck is :math:`\approx a^2/(4r)` high) the size is at most 4 neck heights. The triangles in that thin,
 nearly isothermal disk get flat (largest angle up to ~170 degrees at a/r = 0.001), which is harmless there: at
 a/r = 0.001 K changes by < 1e-8 between 1 and 0.1 cells per height, while 1-2 cells per height took 1-2 s to mesh.
 gmsh runs single-threaded with its Frontal-Delaunay mesher, so the same input gives the same mesh; it is initialised and
@@ -480,8 +480,8 @@ def curved_mesh(profile: ProfileMesh):
     """The quadratic (isoparametric) version of ``profile.mesh``: a ``skfem.MeshTri2`` whose edge midpoints on the
     spherical surfaces lie exactly on their circles, so the elements follow the curved boundary.
 
-    Straight-sided triangles inscribe the sphere and lose an ``O(h^2)`` sliver of volume per edge; the quadratic
-    boundary cuts that to ``O(h^4)``. Named boundaries carry over (same facets).
+    Straight-sided triangles inscribe the sphere and lose an :math:`O(h^2)` sliver of volume per edge; the quadratic
+    boundary cuts that to :math:`O(h^4)`. Named boundaries carry over (same facets).
 
     Parameters
     ----------
@@ -509,7 +509,7 @@ def semisphere_mesh(a_over_r: float, r: float = 1.0, grading: float = DEFAULT_GR
                     sizes: SizeField | None = None, neck: str = "cylinder") -> ProfileMesh:
     """Graded mesh of the semisphere with a neck (Rojek 2022, Fig. 12); see :func:`semisphere_profile`.
 
-    ``bottom`` is the equatorial disk (``z = 0``), ``top`` the neck's end disk (``z = z_i + h_n/2``; ``z_i`` for
+    ``bottom`` is the equatorial disk (``z = 0``), ``top`` the neck's end disk (:math:`z = z_i + h_n/2`; ``z_i`` for
     ``neck = "union"``).
 
     Parameters

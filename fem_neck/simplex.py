@@ -1,16 +1,17 @@
-"""Polynomial spaces on the reference tetrahedron ``{xi >= 0, xi_1 + xi_2 + xi_3 <= 1}`` for the periodic-cell FE.
+r"""Polynomial spaces on the reference tetrahedron :math:`\{\xi \ge 0, \ \xi_1 + \xi_2 + \xi_3 \le 1\}` for the
+periodic-cell FE.
 
 * quadrature: on the tetrahedron the fully symmetric rule of Witherden & Vincent (2015) where one is stored for the
   degree (``SYMMETRIC_RULES``), else, and on a face, Stroud's conical product of Gauss-Jacobi rules (exact for
   degree ``2 n - 1`` with ``n`` points per direction);
-* :class:`Lagrange`: the nodal basis of ``P_p`` on the equispaced lattice ``alpha / p`` (``|alpha| = p``), nodes
-  ordered vertices, edges, faces, interior. With the vertices of every element in ascending global order, a node on
-  a shared edge or face has the same barycentric multi-index in both elements, so the global numbering needs no
+* :class:`Lagrange`: the nodal basis of ``P_p`` on the equispaced lattice :math:`\alpha / p` (:math:`|\alpha| = p`),
+  nodes ordered vertices, edges, faces, interior. With the vertices of every element in ascending global order, a node
+  on a shared edge or face has the same barycentric multi-index in both elements, so the global numbering needs no
   orientation logic;
-* :class:`RaviartThomas`: the divergence-free fields of ``RT_k`` (``P_k^3 + x P~_k``, Raviart & Thomas 1977), with
-  the moments of their normal traces against ``P_k`` on the four faces, for the hybridised mixed method
-  (Arnold & Brezzi 1985). The Piola map ``sigma = J sigma^ / |det J|`` keeps a reference field divergence-free and
-  its face moments unchanged on any (curved) element, so only the mass matrix depends on the element.
+* :class:`RaviartThomas`: the divergence-free fields of :math:`RT_k` (:math:`P_k^3 + x \tilde P_k`, Raviart & Thomas
+  1977), with the moments of their normal traces against ``P_k`` on the four faces, for the hybridised mixed method
+  (Arnold & Brezzi 1985). The Piola map :math:`\sigma = J \hat\sigma / |\det J|` keeps a reference field divergence-free
+  and its face moments unchanged on any (curved) element, so only the mass matrix depends on the element.
 """
 
 from __future__ import annotations
@@ -212,7 +213,8 @@ class Lagrange:
 
     @functools.cached_property
     def stiffness(self) -> np.ndarray:
-        """``S[i, j] = int d_i phi d_j phi^T`` (3, 3, n, n) on the reference tetrahedron (exact)."""
+        r"""``S[i, j]`` :math:`= \int \partial_i \phi \, \partial_j \phi^T` (3, 3, n, n) on the reference tetrahedron
+        (exact)."""
         x, w = tet_quadrature(2 * self.p)
         g = self.gradients(x)
         return np.einsum("q,qia,qjb->ijab", w, g, g)
@@ -262,11 +264,12 @@ def face_normal(face: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class RaviartThomas:
-    """Divergence-free fields of ``RT_k`` on the reference tetrahedron (module docstring).
+    r"""Divergence-free fields of ``RT_k`` on the reference tetrahedron (module docstring).
 
-    ``values(xi)`` gives the ``m`` fields at reference points ``(..., 3, m)``; ``traces (4 n_f, m)`` are the moments
-    ``int_F mu tau . n_out dS`` against the face basis ``mu`` (``n_f`` functions of ``(s, t)`` per face, orthonormal
-    on the unit triangle, the first constant); ``mass[i, j] = int tau_i tau_j^T`` (3, 3, m, m).
+    :meth:`values` gives the ``m`` fields at reference points ``xi``, shape (..., 3, m); ``traces`` (4 n_f, m) are the
+    moments :math:`\int_F \mu \, \tau \cdot n_{out} \, dS` against the face basis :math:`\mu` (``n_f`` functions of
+    ``(s, t)`` per face, orthonormal on the unit triangle, the first constant); ``mass[i, j]``
+    :math:`= \int \tau_i \tau_j^T` (3, 3, m, m).
 
     Parameters
     ----------
@@ -317,7 +320,7 @@ class RaviartThomas:
         return np.flatnonzero(self.exponents.sum(axis=1) == self.k)
 
     def values(self, xi: np.ndarray) -> np.ndarray:
-        """The ``m`` fields ``(..., 3, m)`` at reference points ``xi (..., 3)``.
+        """The ``m`` fields (..., 3, m) at reference points ``xi`` (..., 3).
 
         Parameters
         ----------
@@ -327,7 +330,7 @@ class RaviartThomas:
         return self._full(xi) @ self.coefficients
 
     def face_basis(self, st: np.ndarray) -> np.ndarray:
-        """The face functions ``mu (..., n_f)`` at face coordinates ``st (..., 2)``.
+        r"""The face functions :math:`\mu` (..., n_f) at face coordinates ``st`` (..., 2).
 
         Parameters
         ----------
@@ -338,7 +341,8 @@ class RaviartThomas:
 
     @functools.cached_property
     def traces(self) -> np.ndarray:
-        """The face moments ``int_F mu tau . n_out dS``, (4 n_f, m): face-basis function (rows) by field."""
+        r"""The face moments :math:`\int_F \mu \, \tau \cdot n_{out} \, dS`, (4 n_f, m): face-basis function (rows) by
+        field."""
         st, w = triangle_quadrature(2 * self.k + 2)
         mu = self.face_basis(st)                                   # (q, n_f)
         rows = []
@@ -349,7 +353,7 @@ class RaviartThomas:
 
     @functools.cached_property
     def mass(self) -> np.ndarray:
-        """``mass[i, j] = int tau_i tau_j^T`` (3, 3, m, m) on the reference tetrahedron."""
+        r"""``mass[i, j]`` :math:`= \int \tau_i \tau_j^T` (3, 3, m, m) on the reference tetrahedron."""
         x, w = tet_quadrature(2 * self.k + 2)
         v = self.values(x)
         return np.einsum("q,qia,qjb->ijab", w, v, v)

@@ -1,15 +1,15 @@
-"""Curved tensor-product spectral elements: axisymmetric conduction on a quadrilateral mesh (the hp-FEM path).
+r"""Curved tensor-product spectral elements: axisymmetric conduction on a quadrilateral mesh (the hp-FEM path).
 
 An element of order ``p`` is the image of the unit square under a transfinite (Gordon-Hall) map of its four edges,
 so an edge on the sphere follows the circle exactly -- no geometric error, no correction. The shape functions are
-the tensor-product Lagrange polynomials on the Gauss-Lobatto-Legendre nodes (``(p + 1)^2`` per element, continuous
+the tensor-product Lagrange polynomials on the Gauss-Lobatto-Legendre nodes (:math:`(p + 1)^2` per element, continuous
 across edges); the stiffness is integrated with ``p + 2`` Gauss points per direction. On a mesh graded
 geometrically toward the re-entrant corner the conductance converges exponentially in ``p`` (Babuska-Guo), which
 is what makes this path fast: a few hundred to a few thousand unknowns for 1e-6 (see :mod:`fem_neck.hpmesh`).
 
 Physics as in :mod:`fem_neck.conduction`: in the meridian half-plane (``x`` radial, ``z`` axial) the weak form is
 ``int x grad T . grad v`` (the radial weight of axisymmetry), ``T`` is fixed on two straight boundaries, every
-other boundary is insulated, and the conductance is ``K = 2 pi kappa u^T A u`` for a unit temperature difference
+other boundary is insulated, and the conductance is :math:`K = 2 \pi \kappa u^T A u` for a unit temperature difference
 (the energy, equal to the reaction heat flow).
 
 Meshes are plain arrays (:class:`QuadMesh`); coordinates may be given relative to a point of interest (the corner)
@@ -33,7 +33,7 @@ MAX_ORDER = 12
 
 @dataclass(frozen=True)
 class QuadMesh:
-    """Quadrilaterals with straight or circular edges.
+    r"""Quadrilaterals with straight or circular edges.
 
     Parameters
     ----------
@@ -43,13 +43,14 @@ class QuadMesh:
     quads : numpy.ndarray
         Vertex indices ``(E, 4)``, counter-clockwise.
     arc_angles : numpy.ndarray
-        ``(E, 4, 2)``: for edge ``k`` (from vertex ``k`` to ``k + 1``) the angle offsets ``(delta_start,
-        delta_end)`` of its ends along its circle, rad, or NaN for a straight edge.
+        ``(E, 4, 2)``: for edge ``k`` (from vertex ``k`` to ``k + 1``) the angle offsets ``delta_start``,
+        ``delta_end`` of its ends along its circle, rad, or NaN for a straight edge.
     arc_circle : numpy.ndarray
         ``(E, 4)``: index into ``circles`` of a curved edge's circle (-1 for straight edges).
     circles : tuple of callable
-        Functions ``delta (array, rad) -> (points (..., 2), d points / d delta (..., 2))``, cancellation-free in
-        the coordinates of ``points``.
+        Functions of the angle offset :math:`\delta` (array, rad) giving ``(points, d_points)``, the points (..., 2) and
+        their derivatives :math:`d\,\mathrm{points} / d\delta` (..., 2), cancellation-free in the coordinates of the
+        points.
     origin : tuple of float
         ``(0, z0)``: absolute coordinates are ``points + origin`` (only the axial coordinate may be shifted: the
         radial one is the weight of the axisymmetric forms).
@@ -180,10 +181,10 @@ def geometry(mesh: QuadMesh, xi: np.ndarray, eta: np.ndarray):
 
 
 def numbering(mesh: QuadMesh, order: int):
-    """Global dof of every local node ``(E, (p + 1)^2)`` (local node ``a + (p + 1) b``, ``a`` along xi), the dof
-    count, the skeleton dof count and the vertex pair of every global edge ``(NE, 2)``. Vertices come first, then
-    ``p - 1`` nodes per edge (ordered from its lower to its higher vertex index) -- together the skeleton -- then
-    ``(p - 1)^2`` interior nodes per element.
+    r"""Global dof of every local node, shape :math:`(E, (p + 1)^2)` (local node :math:`a + (p + 1) b`, ``a`` along
+    :math:`\xi`), the dof count, the skeleton dof count and the vertex pair of every global edge ``(NE, 2)``. Vertices
+    come first, then ``p - 1`` nodes per edge (ordered from its lower to its higher vertex index) -- together the
+    skeleton -- then :math:`(p - 1)^2` interior nodes per element.
 
     Parameters
     ----------
@@ -279,12 +280,12 @@ def stiffness(mesh: QuadMesh, order: int):
 
 @dataclass
 class Solution:
-    """One solve of :func:`solve`.
+    r"""One solve of :func:`solve`.
 
     Parameters
     ----------
     K_over_kappa : float
-        ``K / kappa`` for a unit temperature difference, in the length unit of the mesh (m for a mesh in metres).
+        :math:`K / \kappa` for a unit temperature difference, in the length unit of the mesh (m for a mesh in metres).
     dofs : int
         Unknowns of the discretisation (all nodes).
     skeleton_dofs : int
@@ -292,7 +293,7 @@ class Solution:
     order : int
         Polynomial order ``p`` of the elements.
     u_local : numpy.ndarray
-        Temperature ``(E, (p + 1)^2)`` at every local node, in the unit of the fixed values (K).
+        Temperature, shape :math:`(E, (p + 1)^2)`, at every local node, in the unit of the fixed values (K).
     jacobian_min : float
         Smallest Jacobian determinant of the element maps at the quadrature points (> 0 for a valid mesh), in the
         square of the length unit.
@@ -325,10 +326,10 @@ def conductance(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
 
 
 def solve(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
-    """Solve ``div(x grad T) = 0`` with ``T`` held at ``value`` on every edge whose two vertices are in
-    ``fixed_vertices[value]`` (a boolean mask over the vertices; two values), insulated elsewhere; return ``K / kappa
-    = 2 pi u^T A u / (Delta T)^2``. Element interiors are condensed (Schur complement, batched) so only the skeleton
-    is factorised; the energy of the condensed system equals that of the full one.
+    r"""Solve :math:`\nabla \cdot (x \nabla T) = 0` with ``T`` held at ``value`` on every edge whose two vertices are in
+    ``fixed_vertices[value]`` (a boolean mask over the vertices; two values), insulated elsewhere; return
+    :math:`K / \kappa = 2 \pi u^T A u / (\Delta T)^2`. Element interiors are condensed (Schur complement, batched) so
+    only the skeleton is factorised; the energy of the condensed system equals that of the full one.
 
     Parameters
     ----------
@@ -392,8 +393,8 @@ def solve(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
 
 
 def measure(mesh: QuadMesh, order: int = 4) -> tuple[float, float]:
-    """``(2 pi int x dA, min det J)``: the volume of revolution of the mesh (a check against the exact body) and its
-    smallest Jacobian determinant at the order's quadrature points (> 0 for a valid mesh).
+    r""":math:`(2 \pi \int x \, dA, \min \det J)`: the volume of revolution of the mesh (a check against the exact body)
+    and its smallest Jacobian determinant at the order's quadrature points (> 0 for a valid mesh).
 
     Parameters
     ----------

@@ -2,18 +2,18 @@ r"""Transient conduction in an insulated sintered pair: axisymmetric FE against 
 
 The pair of spheres ``r_i``, ``r_j`` with the volume-conserving cylindrical neck (Rojek 2022, Sections 4.3) is a
 body of revolution. In its meridian half-plane (``x`` radial >= 0, ``y`` axial, centre i at the origin, centre j at
-``y = d``) the section is the union of two half-disks and the neck rectangle ``[0, a] x [z_i, z_i + h_n]``, built
-with gmsh OCC booleans (as in :mod:`fem_neck.cluster`, the caps need no explicit cut). The neck is split by the line
-``y = z_split`` where each particle's share of the cylinder equals its cap's volume, so that each particle owns
-exactly ``4/3 pi r^3`` -- the DEM's mass -- and the initial field (``T_i`` on particle i, ``T_j`` on j) is sharp.
+``y = d``) the section is the union of two half-disks and the neck rectangle ``[0, a] x [z_i, z_i + h_n]``, built with
+gmsh OCC booleans (as in :mod:`fem_neck.cluster`, the caps need no explicit cut). The neck is split by the line
+``y = z_split`` where each particle's share of the cylinder equals its cap's volume, so that each particle owns exactly
+:math:`\frac{4}{3} \pi r^3` -- the DEM's mass -- and the initial field (``T_i`` on particle i, ``T_j`` on j) is sharp.
 
 The heat equation :math:`\rho c \, \partial T/\partial t = \nabla \cdot (\kappa \nabla T)`, insulated everywhere,
 in axisymmetric weak form (every integrand weighted by the radial coordinate ``x``, design notes): mass
 :math:`M = 2 \pi \rho c \int u v x`, stiffness :math:`A = 2 \pi \kappa \int \nabla u \cdot \nabla v \, x`. Time
 stepping is implicit: backward Euler for the first steps (it damps the stiff modes of the discontinuous start;
 Rannacher's start-up) then Crank-Nicolson, with the step doubling in blocks up to a cap (:func:`time_grid`), each
-distinct step's matrix factorised once. Both conserve ``1^T M T`` exactly (``A 1 = 0``), i.e. the energy ``sum_i C_i
-Tbar_i``.
+distinct step's matrix factorised once. Both conserve :math:`\mathbf{1}^T M T` exactly (:math:`A \mathbf{1} = 0`), i.e.
+the energy :math:`\sum_i C_i \bar T_i`.
 
 The lumped model (Rojek 2022, eqs. 2-4): :math:`C_i \, dT_i/dt = K (T_j - T_i)`, so the particle-temperature
 difference decays as :math:`e^{-\lambda t}` with :math:`\lambda = K (1/C_i + 1/C_j)`,
@@ -35,7 +35,7 @@ _EXTEND = 0.25  # the neck rectangle reaches this fraction of z into each disk (
 
 @dataclass
 class PairMesh:
-    """Meridian-plane mesh of the closed pair (:func:`pair_mesh`).
+    r"""Meridian-plane mesh of the closed pair (:func:`pair_mesh`).
 
     Parameters
     ----------
@@ -46,7 +46,7 @@ class PairMesh:
     z_split : float
         Axial position of the neck split from centre i, m (:func:`split_position`).
     volume_exact : float
-        ``4/3 pi (r_i^3 + r_j^3)``, m^3.
+        :math:`\frac{4}{3} \pi (r_i^3 + r_j^3)`, m^3.
     geometry : fem_neck.geometry.NeckGeometry
         The pair's neck geometry.
     """
@@ -59,7 +59,7 @@ class PairMesh:
 
 
 def split_position(geo, r_i) -> float:
-    """Axial position (from centre i) where the neck is split: ``z_i + V_cap,i / (pi a^2)``.
+    r"""Axial position (from centre i) where the neck is split: :math:`z_i + V_{cap,i} / (\pi a^2)`.
 
     Parameters
     ----------
@@ -164,7 +164,7 @@ def _forms(basis, kappa, rho_c):
 
 @dataclass
 class TransientResult:
-    """The integration of :func:`solve_transient`.
+    r"""The integration of :func:`solve_transient`.
 
     Parameters
     ----------
@@ -173,9 +173,9 @@ class TransientResult:
     T_mean : numpy.ndarray
         Particle-mean temperatures (len(t), 2), K.
     C : numpy.ndarray
-        FE heat capacities of the two particles (2,), J/K: ``rho c`` times each particle's mesh volume.
+        FE heat capacities of the two particles (2,), J/K: :math:`\rho c` times each particle's mesh volume.
     energy : numpy.ndarray
-        Total heat content ``1^T M T`` at each time, J (up to a constant; conserved).
+        Total heat content :math:`\mathbf{1}^T M T` at each time, J (up to a constant; conserved).
     dofs : int
         Unknowns of the FE space.
     """
@@ -281,8 +281,8 @@ def solve_transient(pm: PairMesh, kappa: float, rho: float, c: float, T_i: float
 
 
 def first_decay_rate(pm: PairMesh, kappa: float, rho: float, c: float, order: int = 2) -> float:
-    """Smallest non-zero eigenvalue ``lambda_1`` of ``A x = lambda M x`` (1/s): the late-time decay rate of the
-    insulated pair's temperature difference.
+    r"""Smallest non-zero eigenvalue :math:`\lambda_1` of :math:`A x = \lambda M x` (1/s): the late-time decay rate of
+    the insulated pair's temperature difference.
 
     Parameters
     ----------
@@ -309,7 +309,7 @@ def first_decay_rate(pm: PairMesh, kappa: float, rho: float, c: float, order: in
 
 
 def lumped_pair(t, T_i: float, T_j: float, C_i: float, C_j: float, K: float) -> np.ndarray:
-    """Closed form of the lumped pair (Rojek 2022, eqs. 2-4): temperatures (len(t), 2).
+    r"""Closed form of the lumped pair (Rojek 2022, eqs. 2-4): temperatures (len(t), 2).
 
     Parameters
     ----------
@@ -318,7 +318,7 @@ def lumped_pair(t, T_i: float, T_j: float, C_i: float, C_j: float, K: float) -> 
     T_i, T_j : float
         Initial temperatures of particles i and j, K.
     C_i, C_j : float
-        Heat capacities of the particles, J/K (``rho c 4/3 pi r^3``).
+        Heat capacities of the particles, J/K (:math:`\rho c \frac{4}{3} \pi r^3`).
     K : float
         Conductance of the pipe between them, W/K.
     """

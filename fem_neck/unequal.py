@@ -1,9 +1,9 @@
-"""Unequal radii: does the pair conductance depend on the neck radius only (Rojek 2022, eq. 43)?
+r"""Unequal radii: does the pair conductance depend on the neck radius only (Rojek 2022, eq. 43)?
 
-FE of sintered pairs (``fem_neck.conduction.pair_conductance``, r_i = 1, kappa = 1) for radius ratios
-``q = r_j/r_i`` and necks ``a/r_i``, compared with
+FE of sintered pairs (``fem_neck.conduction.pair_conductance``, :math:`r_i = 1`, :math:`\kappa = 1`) for radius ratios
+:math:`q = r_j/r_i` and necks :math:`a/r_i`, compared with
 
-* ``eq43``: the paper's model, ``K = 1.064 kappa pi a / 2`` whatever the radii (eqs. 43-45);
+* ``eq43``: the paper's model, :math:`K = 1.064 \kappa \pi a / 2` whatever the radii (eqs. 43-45);
 * ``halves``: the full-range law per half at its own ``a/r`` in series (eq. 9), without correction;
 * ``corrected``: the same times :func:`fem_neck.law.unequal_factor`, whose coefficient ``c`` this study fits:
   ``K_halves / K_FE - 1 ~ c (a/r_i) ln q`` (least squares).
@@ -57,7 +57,7 @@ def study(ratios=RATIOS, necks=NECKS, rtol: float = 1e-4, out=None, *, workers: 
     Parameters
     ----------
     ratios : sequence of float
-        Radius ratios ``q = r_j/r_i`` to solve (dimensionless, each in ``[1, 100]``).
+        Radius ratios :math:`q = r_j/r_i` to solve (dimensionless, each in ``[1, 100]``).
     necks : sequence of float
         Neck radii ``a/r_i`` to solve (dimensionless, each in ``[0.001, 0.99]``).
     rtol : float

@@ -133,7 +133,7 @@ def check_overlaps(path, overlap, radius: float) -> None:
 
 
 def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> dict:
-    """One pair contact of two equal particles of radius ``radius`` through the history (see the module
+    r"""One pair contact of two equal particles of radius ``radius`` through the history (see the module
     docstring); returns the per-row arrays named in ``OUTPUTS``.
 
     Parameters
@@ -149,13 +149,13 @@ def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> 
     T : numpy.ndarray
         The rows' temperatures (the unit of ``T_melt``).
     damping : bool
-        Whether the viscous force ``gamma_0 delta_dot`` (eq. 5) is included.
+        Whether the viscous force :math:`\gamma_0 \dot\delta` (eq. 5) is included.
 
     Returns
     -------
     dict
-        ``{name: (rows,) array}`` for the names of ``OUTPUTS``: force (N), delta_max, delta_0 (m), k1, k2, kc
-        (N/m), f_min (N).
+        ``{name: (rows,) array}`` for the names of ``OUTPUTS``: force (N), ``delta_max``, ``delta_0`` (m), ``k1``,
+        ``k2``, ``kc`` (N/m), ``f_min`` (N).
     """
     from dem.laws.contact import luding as law
 
@@ -264,9 +264,10 @@ def print_table(history: dict, rows: dict) -> None:
 
 
 def plot(path: pathlib.Path, material, radius: float, history: dict, rows: dict, temperature_unit: str) -> None:
-    """Left: force against overlap in the style of Luding 2005, Figs. 2, 3 and 5 -- the cold k1 line, the k1(T, t)
-    and -kc(T, t, delta_max) lines of the last row and the path through the rows. Right: the temperature history
-    (in the scene's ``temperature_unit``) and the stiffness factor k1(T, t)/k1 it drives (eqs. 10, 12).
+    r"""Left: force against overlap in the style of Luding 2005, Figs. 2, 3 and 5 -- the cold :math:`k_1` line, the
+    :math:`k_1(T, t)` and :math:`-k_c(T, t, \delta_{max})` lines of the last row and the path through the rows. Right:
+    the temperature history (in the scene's ``temperature_unit``) and the stiffness factor :math:`k_1(T, t)/k_1` it
+    drives (eqs. 10, 12).
 
     Parameters
     ----------

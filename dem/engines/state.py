@@ -1,11 +1,12 @@
-"""The dynamic state of particles that move, what the engines advance, as arrays: positions, velocities, angular
+r"""The dynamic state of particles that move, what the engines advance, as arrays: positions, velocities, angular
 velocities, forces, torques, masses, moments of inertia (:mod:`dem.geometry.inertia`), radii and temperatures.
 
 Two kinds of particle:
 
-* ``dimension = 3`` -- spheres, ``m = rho (4/3) pi a^3``, ``I = (2/5) m a^2``;
+* ``dimension = 3`` -- spheres, :math:`m = \rho \frac{4}{3} \pi a^3`, :math:`I = \frac{2}{5} m a^2`;
 * ``dimension = 2`` -- disks (cylinders) of height ``height`` lying in the x-z plane, as in Luding 2005
-  (Sec. 2): ``m = rho pi a^2 h``, ``I = m a^2 / 2`` about the y axis. Their centres keep ``y = 0``; they translate
+  (Sec. 2): :math:`m = \rho \pi a^2 h`, :math:`I = m a^2 / 2` about the y axis. Their centres keep :math:`y = 0`; they
+  translate
   in x and z and rotate about y only (:attr:`MotionState.axes`, :attr:`MotionState.spin_axes`).
 
 The radius follows the temperature by thermal expansion (Luding 2005, eq. 9) while the mass stays constant, so the

@@ -1,6 +1,6 @@
-"""Bonds from geometry: overlapping particle pairs and particle-wall contacts, with their neck radii.
+r"""Bonds from geometry: overlapping particle pairs and particle-wall contacts, with their neck radii.
 
-Two spheres are bonded when they overlap, ``h = r_i + r_j - d > 0`` (Rojek 2022, eq. 21/44). Candidate pairs come
+Two spheres are bonded when they overlap, :math:`h = r_i + r_j - d > 0` (Rojek 2022, eq. 21/44). Candidate pairs come
 from cubic cells of the largest diameter searched on numba's threads when no radius is twice the smallest in a large
 packing (the
 neighbour list's binning, :func:`dem.geometry.neighbours.verlet_pairs`), else from k-d trees
@@ -12,15 +12,15 @@ The contact radius ``a`` of a bond is given by the *contact geometry* that the c
 * ``"newton"``, ``"first"``, ``"coble"`` -- the neck of :func:`fem_neck.geometry.neck_radius` (volume-conserving neck,
   Rojek 2022 eqs. 27-33, its first iterate eq. 34, or Coble's eqs. 11-12). Its range is
   ``0 < h <= max_overlap(r_i, r_j)``.
-* ``"lens"`` -- the intersection circle of the two spheres (Zohdi 2014, eqs. 7-12): ``a^2 = r_i^2 - L_i^2`` with
-  ``L_i = (d - (r_j^2 - r_i^2)/d)/2``. Its range is ``L_i, L_j >= 0``.
+* ``"lens"`` -- the intersection circle of the two spheres (Zohdi 2014, eqs. 7-12): :math:`a^2 = r_i^2 - L_i^2` with
+  :math:`L_i = (d - (r_j^2 - r_i^2)/d)/2`. Its range is :math:`L_i, L_j \ge 0`.
 * ``"union"`` -- the same circle read as a neck of the union of the spheres (:mod:`fem_neck.geometry.union`: each
   sphere cut by its radical planes, Arzt 1982), defined at every density; the range is the lens'.
 
 A particle touching a wall (plane) is bonded to the wall. With a neck model the contact is the mirror image: a
 sphere sintered to its mirror image across the plane, whose symmetry plane is the isothermal wall, so the wall bond
-is one half of a pair of equal spheres with overlap ``2 delta`` (range ``delta <= r/3``). With the lens, ``a^2 =
-r^2 - L^2`` with ``L`` the distance of the centre from the wall.
+is one half of a pair of equal spheres with overlap :math:`2 \delta` (range :math:`\delta \le r/3`). With the lens,
+:math:`a^2 = r^2 - L^2` with ``L`` the distance of the centre from the wall.
 
 Bonds beyond the model's range are never clipped silently: ``out_of_range = "error"`` (default) raises a
 ``ValueError`` with their count and the first offending pair; ``"clip"`` sets them to the range's end (``a`` =
@@ -59,7 +59,7 @@ CELL_SEARCH_MIN = 300_000
 
 @dataclass(frozen=True)
 class Bonds:
-    """Pair bonds ``(i, j)`` with ``i < j`` and wall bonds ``(wall_particle, wall_index)`` as index arrays
+    r"""Pair bonds ``(i, j)`` with ``i < j`` and wall bonds ``(wall_particle, wall_index)`` as index arrays
     (:func:`find_bonds`). Per-bond arrays have one entry per pair bond (``m``) or per wall bond.
 
     Parameters
@@ -79,7 +79,7 @@ class Bonds:
     wall_index : numpy.ndarray
         The wall of every wall bond (index into the scene's walls).
     wall_h : numpy.ndarray
-        Overlap ``delta = r - L`` of every wall bond, m.
+        Overlap :math:`\delta = r - L` of every wall bond, m.
     wall_a : numpy.ndarray
         Contact radius of every wall bond, m.
     wall_l : numpy.ndarray

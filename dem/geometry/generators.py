@@ -1,4 +1,4 @@
-"""Particle arrangements for scenes: a chain, a cubic lattice block (simple, body- or face-centred cubic), a
+r"""Particle arrangements for scenes: a chain, a cubic lattice block (simple, body- or face-centred cubic), a
 random sintered packing, and particles scattered in a box (for scenes that move).
 
 Every generator returns a :class:`Layout`: positions, radii, the indices of the bottom and top layers and the
@@ -7,7 +7,7 @@ or fixed end particles) and read off an effective conductivity ``k_eff = Q L / (
 random packing also give the ``period`` of the block: repeated with it along every axis they tile space (a
 periodic scene, :mod:`dem.geometry.periodic`).
 
-Overlaps are relative to the smaller radius of a pair: ``h = overlap * min(r_i, r_j)``.
+Overlaps are relative to the smaller radius of a pair: :math:`h = o \min(r_i, r_j)` with ``o`` the ``overlap``.
 
 The random sintered packing is a jittered face-centred cubic lattice with random radii: the sites of an FCC lattice
 block of m x m cells and complete (001) layers (N is rounded up to fill the top layer), each moved by a uniform random jitter, radii drawn from a distribution of the given
@@ -161,9 +161,9 @@ CELL_EDGE = {"sc": 1.0, "bcc": 2.0 / np.sqrt(3.0), "fcc": np.sqrt(2.0)}
 
 
 def lattice(shape, radius, overlap, structure: str = "sc") -> Layout:
-    """A block of ``shape = [nx, ny, nz]`` cubic cells of equal spheres: simple cubic (one sphere per cell, so the
+    r"""A block of ``shape = [nx, ny, nz]`` cubic cells of equal spheres: simple cubic (one sphere per cell, so the
     block is nx x ny x nz spheres), body-centred (two) or face-centred cubic (four), nearest neighbours ``2r - h``
-    apart (``h = overlap * r``). Its ``period`` is the block's size: shape times the cell edge.
+    apart (:math:`h = o r` with ``o`` the ``overlap``). Its ``period`` is the block's size: shape times the cell edge.
 
     Parameters
     ----------

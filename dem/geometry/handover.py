@@ -1,18 +1,19 @@
-"""The hand-over of a moving run from a pair-neck reading to the union of spheres, where a particle's necks meet.
+r"""The hand-over of a moving run from a pair-neck reading to the union of spheres, where a particle's necks meet.
 
 The pair-neck readings (``newton``, ``first``, ``coble``: Rojek 2022, eqs. 21-34) have no answer once two necks of
 one particle meet (:mod:`dem.geometry.necks`); the union of the spheres (:mod:`fem_neck.geometry.union`, the
 truncated spheres of Arzt 1982) has one at every density. In a heat-carrying moving run with a pair-neck reading,
 a particle whose necks meet is read as a truncated sphere from then on:
 
-* **Its solid radius** ``r_s`` grows so that its cut sphere -- its sphere of radius ``r_s`` cut by the radical
-  planes of every neighbour it overlaps (with the neighbours' solid radii) and by the isothermal walls it touches --
-  keeps the particle's volume ``4/3 pi r^3`` (Arzt 1982: the material of the flattened contacts goes to the free
-  surface), :func:`solid_radii`. The volumes are solved together by Newton's method with the exact derivatives of
-  the cut volume ``V_k``: growing ``r_k`` by ``dr`` moves the free surface out (``A_free dr``) and every radical
-  plane of ``k``, at ``l_b = (d_b^2 + r_k^2 - r_j^2) / (2 d_b)``, by ``r_k / d_b dr`` (``A_b r_k / d_b dr``), so
-  ``dV_k/dr_k = A_free + sum_b A_b r_k / d_b`` and ``dV_k/dr_j = -A_b r_j / d_b`` for the neighbour ``j`` across face
-  ``b``. A wall's plane does not move (the particle's mirror image grows with it).
+* **Its solid radius** ``r_s`` grows so that its cut sphere -- its sphere of radius ``r_s`` cut by the radical planes of
+  every neighbour it overlaps (with the neighbours' solid radii) and by the isothermal walls it touches -- keeps the
+  particle's volume :math:`\frac{4}{3} \pi r^3` (Arzt 1982: the material of the flattened contacts goes to the free
+  surface), :func:`solid_radii`. The volumes are solved together by Newton's method with the exact derivatives of the
+  cut volume :math:`V_k`: growing :math:`r_k` by :math:`dr` moves the free surface out (:math:`A_{free} \, dr`) and
+  every radical plane of ``k``, at :math:`l_b = (d_b^2 + r_k^2 - r_j^2) / (2 d_b)`, by :math:`(r_k / d_b) \, dr`
+  (:math:`A_b (r_k / d_b) \, dr`), so :math:`\partial V_k / \partial r_k = A_{free} + \sum_b A_b r_k / d_b` and
+  :math:`\partial V_k / \partial r_j = -A_b r_j / d_b` for the neighbour ``j`` across face ``b``. A wall's plane does
+  not move (the particle's mirror image grows with it).
 * **Its necks** are the lens circles of the grown spheres (:func:`dem.geometry.bonds.find_bonds` with ``"union"``),
   their conductances the scene's law on the union reading
   (:func:`dem.laws.conductance.bond_conductances` with ``neck = "union"``).
@@ -109,13 +110,14 @@ def bond_weights(weight: np.ndarray, bonds) -> tuple[np.ndarray, np.ndarray]:
 
 
 def solid_radii(radius, grow, i, j, vectors, wall_particle, wall_normals, wall_distance, start=None) -> np.ndarray:
-    """The solid radii that keep the cut spheres of the particles ``grow`` at the volumes of their spheres (module
+    r"""The solid radii that keep the cut spheres of the particles ``grow`` at the volumes of their spheres (module
     docstring); the other particles keep their radii.
 
     Parameters
     ----------
     radius : numpy.ndarray
-        Particle radii, m: the volumes ``4/3 pi r^3`` to keep, and the solid radii of the particles not grown.
+        Particle radii, m: the volumes :math:`\frac{4}{3} \pi r^3` to keep, and the solid radii of the particles not
+        grown.
     grow : numpy.ndarray
         Per particle, whether its solid radius is solved for (bool).
     i, j : numpy.ndarray

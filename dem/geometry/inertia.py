@@ -7,14 +7,14 @@ import numpy as np
 
 
 def particle_mass(dimension: int, density, radius, height: float | None = None) -> np.ndarray:
-    """``rho (4/3) pi a^3`` (spheres) or ``rho pi a^2 h`` (disks of height h), kg.
+    r""":math:`\rho \frac{4}{3} \pi a^3` (spheres) or :math:`\rho \pi a^2 h` (disks of height h), kg.
 
     Parameters
     ----------
     dimension : int
         3 (spheres) or 2 (disks in the x-z plane).
     density : float or array_like
-        Density rho (kg/m^3), scalar or one per particle.
+        Density :math:`\rho` (kg/m^3), scalar or one per particle.
     radius : float or array_like
         Radii a (m).
     height : float or None
@@ -32,7 +32,7 @@ def particle_mass(dimension: int, density, radius, height: float | None = None) 
 
 
 def moment_of_inertia(dimension: int, mass, radius) -> np.ndarray:
-    """``(2/5) m a^2`` (sphere) or ``m a^2 / 2`` (disk about its axis), kg m^2.
+    r""":math:`\frac{2}{5} m a^2` (sphere) or :math:`m a^2 / 2` (disk about its axis), kg m^2.
 
     Parameters
     ----------

@@ -1,12 +1,12 @@
-"""Where a packing stands: which particles carry necks that meet, under the scene's neck reading.
+r"""Where a packing stands: which particles carry necks that meet, under the scene's neck reading.
 
-A neck is seen from its particle's centre as a cone (:func:`fem_neck.geometry.union.angular_radius`); two necks of
-one particle *meet* when their cones overlap. The pair-neck readings (``newton``, ``first``, ``coble``: Rojek 2022,
-eqs. 10-34) put the neck's circle on the sphere where the neck cylinder of radius ``a`` meets it, at the angle
-``arcsin(a / r)``; the lens readings (``lens``, ``union``) put it on the radical plane, at ``atan2(a, l)`` with
-``l`` the centre's distance from that plane. Once necks meet, the pair-neck readings have no answer (the necks
-would overlap inside the particle); the union of the spheres (:mod:`fem_neck.geometry.union`) has one at every
-density. A wall bond's neck counts as one of its particle's necks.
+A neck is seen from its particle's centre as a cone (:func:`fem_neck.geometry.union.angular_radius`); two necks of one
+particle *meet* when their cones overlap. The pair-neck readings (``newton``, ``first``, ``coble``: Rojek 2022, eqs.
+10-34) put the neck's circle on the sphere where the neck cylinder of radius ``a`` meets it, at the angle
+:math:`\arcsin(a / r)`; the lens readings (``lens``, ``union``) put it on the radical plane, at :math:`\arctan(a / l)`
+with ``l`` the centre's distance from that plane. Once necks meet, the pair-neck readings have no answer (the necks
+would overlap inside the particle); the union of the spheres (:mod:`fem_neck.geometry.union`) has one at every density.
+A wall bond's neck counts as one of its particle's necks.
 """
 
 from __future__ import annotations

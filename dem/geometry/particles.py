@@ -1,8 +1,8 @@
-"""Particle state as arrays (structure of arrays): the lumped capacities of the pipe network.
+r"""Particle state as arrays (structure of arrays): the lumped capacities of the pipe network.
 
-Rojek, Kasztelan & Tharmaraj 2022, Section 2: every particle is a lumped capacity ``C_i = m_i c`` (eq. 1) at its
-centre with one temperature ``T_i``. The mass is ``m_i = rho (4/3) pi r_i^3``: the volume-conserving neck
-(Section 4.2) moves material from the caps into the neck, so the sphere volume stays exact.
+Rojek, Kasztelan & Tharmaraj 2022, Section 2: every particle is a lumped capacity :math:`C_i = m_i c` (eq. 1) at its
+centre with one temperature :math:`T_i`. The mass is :math:`m_i = \rho \frac{4}{3} \pi r_i^3`: the volume-conserving
+neck (Section 4.2) moves material from the caps into the neck, so the sphere volume stays exact.
 """
 
 from __future__ import annotations
@@ -205,21 +205,21 @@ def check_positive_entries(name: str, arr: np.ndarray, allow_zero: bool = False)
 
 @dataclass(frozen=True)
 class Material:
-    """Thermal properties of one material (SI units): conductivity kappa W/(m K), density kg/m^3, c J/(kg K); the
-    electrical conductivity sigma S/m for electrical physics.
+    r"""Thermal properties of one material (SI units): conductivity :math:`\kappa` in W/(m K), density in kg/m^3, ``c``
+    in J/(kg K); the electrical conductivity :math:`\sigma` in S/m for electrical physics.
 
     Parameters
     ----------
     conductivity : float or None
-        Thermal conductivity kappa (W/(m K)); None for a scene without thermal physics.
+        Thermal conductivity :math:`\kappa` (W/(m K)); None for a scene without thermal physics.
     density : float
-        Density rho (kg/m^3).
+        Density :math:`\rho` (kg/m^3).
     specific_heat : float or None
         Specific heat c (J/(kg K)); None for a scene without thermal physics.
     name : str
         The material's name (in messages and ``[[groups]] material``).
     electrical_conductivity : float or None
-        Electrical conductivity sigma (S/m), for electrical physics; None: none.
+        Electrical conductivity :math:`\sigma` (S/m), for electrical physics; None: none.
 
     Raises
     ------
@@ -384,7 +384,7 @@ class Particles:
 
     @property
     def electrical_conductivity(self) -> np.ndarray:
-        """sigma of each particle, S/m."""
+        r"""Electrical conductivity :math:`\sigma` of each particle, S/m."""
         return self._property("electrical_conductivity", "electrical")
 
     @property
@@ -395,7 +395,7 @@ class Particles:
 
     @property
     def mass(self) -> np.ndarray:
-        """``m_i = rho (4/3) pi r_i^3``."""
+        r""":math:`m_i = \rho \frac{4}{3} \pi r_i^3`, kg."""
         return self._property("density") * self.volume
 
     @property

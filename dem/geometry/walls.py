@@ -1,4 +1,4 @@
-"""Plane walls, and the box they enclose -- one wall for every engine.
+r"""Plane walls, and the box they enclose -- one wall for every engine.
 
 A wall is the plane ``n . x = q`` with unit normal ``n`` pointing into the packing, through ``point``. Particles that
 touch it exchange heat with it when it carries a ``temperature`` (an isothermal plane of the thermal network: the
@@ -6,16 +6,16 @@ static scenes' plates, the heated walls of moving scenes), and push on it when t
 only, so its state is the offset ``q`` and the normal velocity ``dq/dt`` (positive: into the packing):
 
 * ``"fixed"`` -- never moves.
-* ``"stress"`` -- ``m_w d^2q/dt^2 = p L - F_w - gamma_w dq/dt`` (Luding 2005, eq. 1): the external pressure ``p``
-  times the wall's extent ``L`` pushes it in, the particles push it out with the normal force ``F_w`` they exert on
-  it, and the damping ``gamma_w`` (kg/s) calms it. In 2D (disks of height h) ``p`` is a force per length (N/m, as in
-  the paper) and ``L`` the distance between the two walls perpendicular to the wall in the x-z plane; in 3D ``p`` is
-  a stress (Pa) and ``L`` the area between the four perpendicular walls. Stress walls therefore need an axis-aligned
-  box: a wall facing each way along every perpendicular in-plane axis, or a periodic box along it (whose period is
-  the extent there: a stress wall presses a bed in a box periodic across it).
+* ``"stress"`` -- :math:`m_w \ddot q = p L - F_w - \gamma_w \dot q` (Luding 2005, eq. 1): the external pressure ``p``
+  times the wall's extent ``L`` pushes it in, the particles push it out with the normal force ``F_w`` they exert on it,
+  and the damping :math:`\gamma_w` (kg/s) calms it. In 2D (disks of height h) ``p`` is a force per length (N/m, as in
+  the paper) and ``L`` the distance between the two walls perpendicular to the wall in the x-z plane; in 3D ``p`` is a
+  stress (Pa) and ``L`` the area between the four perpendicular walls. Stress walls therefore need an axis-aligned box:
+  a wall facing each way along every perpendicular in-plane axis, or a periodic box along it (whose period is the extent
+  there: a stress wall presses a bed in a box periodic across it).
 * ``"strain"`` -- moves in at the constant ``velocity`` (m/s); a compression at strain rate ``e`` of a box of
-  initial height ``z0`` is ``velocity = e z0`` (Luding 2005, Sec. 4.4: ``eps_zz = 1 - z/z0``).
-* ``"vibrate"`` -- ``q(t) = q0 + A sin(2 pi f t)``: a vibrating base (Luding 2005, Figs. 21-22).
+  initial height :math:`z_0` is a ``velocity`` of :math:`e z_0` (Luding 2005, Sec. 4.4: :math:`\varepsilon_{zz} = 1 - z/z_0`).
+* ``"vibrate"`` -- :math:`q(t) = q_0 + A \sin(2 \pi f t)`: a vibrating base (Luding 2005, Figs. 21-22).
 
 The box (:func:`box_axes`): along each axis, the wall facing +axis and the one facing -axis, where there is exactly
 one of each; the box's extent along that axis is ``-(q_lo + q_hi)`` (:func:`extent`). Stress walls take their
@@ -43,7 +43,7 @@ def _nonnegative(name: str, value, positive: bool = False) -> float:
 
 @dataclass(frozen=True)
 class Wall:
-    """One plane wall (module docstring). ``temperature`` (optional): an isothermal plane; ``motion`` and its
+    r"""One plane wall (module docstring). ``temperature`` (optional): an isothermal plane; ``motion`` and its
     parameters: ``pressure`` N/m (2D) or Pa (3D), ``mass`` kg, ``damping`` kg/s, ``velocity`` m/s, ``amplitude`` m,
     ``frequency`` Hz.
 
@@ -65,7 +65,7 @@ class Wall:
     mass : float
         Mass ``m_w > 0`` of a stress wall (kg).
     damping : float
-        Damping ``gamma_w >= 0`` of a stress wall (kg/s).
+        Damping :math:`\gamma_w \ge 0` of a stress wall (kg/s).
     velocity : float
         Constant normal velocity of a strain wall, positive into the packing (m/s).
     amplitude : float

@@ -1,17 +1,18 @@
-"""Heat sources and boundaries of the particle heat balance (Rojek 2022, eq. 3).
+r"""Heat sources and boundaries of the particle heat balance (Rojek 2022, eq. 3).
 
-``Q_i = sum_j Q_ij^cond + Q_i^int + Q_i^conv + Q_i^rad``. Besides the pipes (``dem.network.heat``) a particle exchanges
-heat with
+:math:`Q_i = \sum_j Q_{ij}^{cond} + Q_i^{int} + Q_i^{conv} + Q_i^{rad}`. Besides the pipes (``dem.network.heat``) a
+particle exchanges heat with
 
-* its internal source ``Q_i^int`` (W, ``Particles.heat``),
-* an ambient by convection ``Q_i^conv = h A_i (T_inf - T_i)`` (:class:`Convection`),
-* an ambient by radiation ``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)`` in absolute temperature (:class:`Radiation`),
+* its internal source :math:`Q_i^{int}` (W, ``Particles.heat``),
+* an ambient by convection :math:`Q_i^{conv} = h A_i (T_\infty - T_i)` (:class:`Convection`),
+* an ambient by radiation :math:`Q_i^{rad} = \varepsilon \sigma A_i (T_\infty^4 - T_i^4)` in absolute temperature
+  (:class:`Radiation`),
 * isothermal plane walls it touches (:class:`dem.geometry.walls.Wall` with a temperature; the contact conductance
   comes from the conductance law).
 
 Particles held at a fixed temperature are a mask of :class:`dem.geometry.particles.Particles`. Every term is linear in
 ``T_i`` except radiation, which the solvers use linearised about the current temperature
-(:func:`linear_sink_terms`); a scene without radiation never evaluates ``T^4``.
+(:func:`linear_sink_terms`); a scene without radiation never evaluates :math:`T^4`.
 """
 
 from __future__ import annotations
@@ -47,8 +48,9 @@ def _area(name: str, fraction, radius: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Convection:
-    """``Q_i^conv = h A_i (T_inf - T_i)`` with ``A_i = area_fraction * 4 pi r_i^2``: by default the exposed part of
-    each surface (``"exposed"``, :mod:`dem.geometry.exposure`); ``area_fraction = 1`` opts in to the whole surface.
+    r""":math:`Q_i^{conv} = h A_i (T_\infty - T_i)` with :math:`A_i = f \, 4 \pi r_i^2` (``area_fraction`` f): by
+    default the exposed part of each surface (``"exposed"``, :mod:`dem.geometry.exposure`); ``area_fraction = 1`` opts
+    in to the whole surface.
 
     Parameters
     ----------
@@ -57,7 +59,7 @@ class Convection:
     T_inf : float
         Ambient temperature (the scene's unit, K or degC).
     area_fraction : str or float or array_like
-        The fraction of each particle's surface ``4 pi r^2`` exposed, in ``[0, 1]`` (a number or one per particle),
+        The fraction of each particle's surface :math:`4 \pi r^2` exposed, in ``[0, 1]`` (a number or one per particle),
         or ``"exposed"`` (computed from the packing, :meth:`Sources.resolved`).
 
     Raises
@@ -99,17 +101,17 @@ class Convection:
 
 @dataclass(frozen=True)
 class Radiation:
-    """``Q_i^rad = eps sigma A_i (T_inf^4 - T_i^4)``; temperatures in ``unit`` ("K" or "C", required), T^4 in
-    kelvin.
+    r""":math:`Q_i^{rad} = \varepsilon \sigma A_i (T_\infty^4 - T_i^4)`; temperatures in ``unit`` ("K" or "C",
+    required), :math:`T^4` in kelvin.
 
     Parameters
     ----------
     emissivity : float
-        Emissivity eps of the particles' surfaces, in ``[0, 1]``.
+        Emissivity :math:`\varepsilon` of the particles' surfaces, in ``[0, 1]``.
     T_inf : float
         Ambient temperature (in ``unit``), between absolute zero and ``RADIATION_T_MAX``.
     area_fraction : str or float or array_like
-        The fraction of each particle's surface ``4 pi r^2`` exposed, in ``[0, 1]`` (a number or one per particle),
+        The fraction of each particle's surface :math:`4 \pi r^2` exposed, in ``[0, 1]`` (a number or one per particle),
         or ``"exposed"`` (computed from the packing, :meth:`Sources.resolved`).
     unit : str
         The unit of the scene's temperatures, ``"K"`` or ``"C"`` (required).
@@ -155,7 +157,7 @@ class Radiation:
         return np.asarray(T, dtype=float) + KELVIN_OFFSET[self.unit]
 
     def coefficient(self, radius: np.ndarray) -> np.ndarray:
-        """``eps sigma A_i`` in W/K^4.
+        r""":math:`\varepsilon \sigma A_i` in W/K^4.
 
         Parameters
         ----------
@@ -165,7 +167,7 @@ class Radiation:
         Returns
         -------
         numpy.ndarray
-            (N,) ``eps sigma A_i`` (W/K^4).
+            (N,) :math:`\varepsilon \sigma A_i` (W/K^4).
 
         Raises
         ------
@@ -231,11 +233,12 @@ class Sources:
 
 
 def linear_sink_terms(sources: Sources, radius: np.ndarray, T_lin: np.ndarray | None) -> dict:
-    """Ambient exchange as ``Q_i = b_i - g_i T_i`` (W): ``{name: (g, b)}`` for each term the scene has.
+    r"""Ambient exchange as :math:`Q_i = b_i - g_i T_i` (W): ``{name: (g, b)}`` for each term the scene has.
 
-    Convection is linear: ``g = h A``, ``b = h A T_inf``. Radiation is linearised about ``T_lin`` (a Newton step
-    of ``T^4``): ``T^4 ~ 4 T0^3 T - 3 T0^4`` in kelvin, so ``g = 4 eps sigma A T0^3 >= 0`` keeps the system
-    matrix symmetric positive definite and the implicit integrators unconditionally stable.
+    Convection is linear: :math:`g = h A`, :math:`b = h A T_\infty`. Radiation is linearised about ``T_lin``
+    (:math:`T_0`, a Newton step of :math:`T^4`): :math:`T^4 \approx 4 T_0^3 T - 3 T_0^4` in kelvin, so
+    :math:`g = 4 \varepsilon \sigma A T_0^3 \ge 0` keeps the system matrix symmetric positive definite and the implicit
+    integrators unconditionally stable.
 
     Parameters
     ----------

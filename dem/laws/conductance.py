@@ -1,32 +1,34 @@
-"""Conductance of the thermal pipes: each bond's two halves (and an optional contact interface) in series.
+r"""Conductance of the thermal pipes: each bond's two halves (and an optional contact interface) in series.
 
-Rojek 2022, Section 3: ``R_ij = R_i + R_j + R_c`` (eq. 5), i.e. ``K_ij = K_i K_j K_c / (K_i K_j + K_j K_c +
-K_i K_c)`` (eq. 8), or eq. (9) without the interface. Every law is a *half* conductance ``K_i`` of one particle's
-side of the contact, evaluated with that particle's own conductivity, radius and contact; putting the halves in
-series makes the mixed-material rule the harmonic combination of the two halves.
+Rojek 2022, Section 3: :math:`R_{ij} = R_i + R_j + R_c` (eq. 5), i.e.
+:math:`K_{ij} = K_i K_j K_c / (K_i K_j + K_j K_c + K_i K_c)` (eq. 8), or eq. (9) without the interface. Every law is a
+*half* conductance ``K_i`` of one particle's side of the contact, evaluated with that particle's own conductivity,
+radius and contact; putting the halves in series makes the mixed-material rule the harmonic combination of the two
+halves.
 
 Laws (``ConductanceSpec.law``):
 
-* ``"rojek"`` -- ``K_i = c kappa_i pi a`` with c = 1.064 (eqs. 40, 43); equal materials give ``K_ij = K_i / 2``
-  (eq. 45). ``slope`` overrides c.
-* ``"argento-bouvard"`` -- the same with c = 1/0.899 = 1.112 (eqs. 41-42).
-* ``"fit"`` -- the full-range FE law ``K_i = kappa_i pi r_i f(a/r_i)`` read from a fit.json written by
+* ``"rojek"`` -- :math:`K_i = c \kappa_i \pi a` with :math:`c = 1.064` (eqs. 40, 43); equal materials give
+  :math:`K_{ij} = K_i / 2` (eq. 45). ``slope`` overrides c.
+* ``"argento-bouvard"`` -- the same with :math:`c = 1/0.899 = 1.112` (eqs. 41-42).
+* ``"fit"`` -- the full-range FE law :math:`K_i = \kappa_i \pi r_i f(a/r_i)` read from a fit.json written by
   ``python -m fem_neck fit`` (``fit_file``; default: the fit shipped in ``fem_neck/data/fit.json``), each half at
   its own ``a/r_i``; for unequal radii the series is multiplied by the FE correction
   :func:`fem_neck.law.unequal_factor` (``unequal = true``, default), as :func:`fem_neck.law.pair_conductance` does.
 * ``"shared-body"`` -- the ``fit`` law's halves, each particle's scaled by one factor for the necks that share its
   body (the particle as a multi-terminal conductor, from the Neumann function of the sphere;
   :mod:`dem.laws.shared_body`); pairs and chains get the ``fit`` law's numbers exactly.
-* ``"zohdi"`` -- ``K_ij = kappa A_c / |x_i - x_j|`` with the lens contact area ``A_c = pi a^2`` (Zohdi 2014,
-  eqs. 11-12, 33), written as halves ``K_i = kappa_i pi a^2 / L_i`` (``L_i + L_j = |x_i - x_j|``, eq. 9), which
-  is eq. (33) exactly for one material. (Zohdi's footnote 4 averages two conductivities arithmetically; the halves
+* ``"zohdi"`` -- :math:`K_{ij} = \kappa A_c / |x_i - x_j|` with the lens contact area :math:`A_c = \pi a^2` (Zohdi 2014,
+  eqs. 11-12, 33), written as halves :math:`K_i = \kappa_i \pi a^2 / L_i` (:math:`L_i + L_j = |x_i - x_j|`, eq. 9),
+  which is eq. (33) exactly for one material. (Zohdi's footnote 4 averages two conductivities arithmetically; the halves
   in series are the harmonic combination this project uses for every law.)
 
-A wall bond is one half (the particle's side; the wall is isothermal) in series with ``K_c``.
+A wall bond is one half (the particle's side; the wall is isothermal) in series with :math:`K_c`.
 
 The ``zohdi`` law on the pairs and particle-wall pairs of a Verlet list, contact geometry included, is compiled
-(:func:`dem.laws.lens_conductance.lens_list_conductances`, apart so that a static run loads no numba): particles that move evaluate it at every fixed-point iteration of their step
-(:mod:`dem.engines.staggered.heat`), on the list as it is, without building bonds.
+(:func:`dem.laws.lens_conductance.lens_list_conductances`, apart so that a static run loads no numba): particles that
+move evaluate it at every fixed-point iteration of their step (:mod:`dem.engines.staggered.heat`), on the list as it
+is, without building bonds.
 """
 
 from __future__ import annotations
@@ -75,15 +77,15 @@ LINEAR_SLOPES = {"rojek": fem_law.ROJEK.slope, "argento-bouvard": fem_law.ARGENT
 
 @dataclass(frozen=True)
 class ConductanceSpec:
-    """Which law, and its options: ``slope`` (linear laws), ``fit_file`` (fit), ``neck`` model for the neck laws,
-    ``contact_conductance`` K_c in W/K (eq. 8; None = no interface resistance), ``out_of_range`` bond policy.
+    r"""Which law, and its options: ``slope`` (linear laws), ``fit_file`` (fit), ``neck`` model for the neck laws,
+    ``contact_conductance`` :math:`K_c` in W/K (eq. 8; None = no interface resistance), ``out_of_range`` bond policy.
 
     Parameters
     ----------
     law : str
         The law, one of ``LAWS`` (module docstring).
     slope : float or None
-        The coefficient c of ``K_i = c kappa_i pi a`` (dimensionless, > 0), for ``"rojek"`` and
+        The coefficient c of :math:`K_i = c \kappa_i \pi a` (dimensionless, > 0), for ``"rojek"`` and
         ``"argento-bouvard"`` only; None: the law's own (1.064, 1.112).
     fit_file : str or None
         Path of a fit.json written by ``python -m fem_neck fit``, for ``"fit"`` and ``"shared-body"`` only; None:
@@ -93,7 +95,7 @@ class ConductanceSpec:
         ``"first"``, ``"coble"``: :func:`fem_neck.geometry.neck_radius`; ``"union"``: the circle where the two
         spheres meet).
     contact_conductance : float or None
-        Interface conductance K_c in series with each bond (W/K, finite and > 0; Rojek 2022, eq. 8); None: no
+        Interface conductance :math:`K_c` in series with each bond (W/K, finite and > 0; Rojek 2022, eq. 8); None: no
         interface resistance.
     out_of_range : str
         What a bond whose overlap lies beyond the neck model's range does, one of
@@ -209,7 +211,7 @@ def half_conductance(spec: ConductanceSpec, kappa, r, a, length):
 
 
 def series(*halves):
-    """Conductances in series, ``1 / sum(1/K)`` (Rojek 2022, eqs. 5-9); an infinite half adds no resistance.
+    r"""Conductances in series, :math:`1 / \sum (1/K)` (Rojek 2022, eqs. 5-9); an infinite half adds no resistance.
 
     Parameters
     ----------
@@ -228,14 +230,14 @@ def series(*halves):
 
 def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds, conductivity=None,
                       shares: bool = False, *, box=None, walls=()):
-    """``(K_pairs, K_walls)`` in W/K for every pair bond and wall bond.
+    r"""``(K_pairs, K_walls)`` in W/K for every pair bond and wall bond.
 
-    ``conductivity`` (per particle) replaces the materials' kappa: the same law with the electrical conductivity
-    sigma gives each contact's electrical conductance in S (the neck is the same Laplace problem, sigma in place of
-    kappa). With ``shares = True`` a third array gives each pair bond's fraction of its resistance on the side of
-    particle i, ``R_i / (R_i + R_j)`` (where that part of the bond's Joule heat is made). ``box``: the periodic box
-    the bonds' image shifts refer to (:mod:`dem.geometry.periodic`); ``walls``: the walls of the wall bonds, whose normals
-    the ``shared-body`` law needs.
+    ``conductivity`` (per particle) replaces the materials' :math:`\kappa`: the same law with the electrical
+    conductivity :math:`\sigma` gives each contact's electrical conductance in S (the neck is the same Laplace problem,
+    :math:`\sigma` in place of :math:`\kappa`). With ``shares = True`` a third array gives each pair bond's fraction of
+    its resistance on the side of particle i, :math:`R_i / (R_i + R_j)` (where that part of the bond's Joule heat is
+    made). ``box``: the periodic box the bonds' image shifts refer to (:mod:`dem.geometry.periodic`); ``walls``: the
+    walls of the wall bonds, whose normals the ``shared-body`` law needs.
 
     Parameters
     ----------
@@ -246,7 +248,7 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     bonds : dem.geometry.bonds.Bonds
         The pair and wall bonds, with their contact radii (m) and centre-to-contact distances (m).
     conductivity : array_like or None
-        (N,) a conductivity per particle in place of the materials' kappa (W/(m K), or S/m for electrical
+        (N,) a conductivity per particle in place of the materials' :math:`\kappa` (W/(m K), or S/m for electrical
         conductances in S); None: the materials'.
     shares : bool
         Whether to return each pair bond's share of its resistance on the side of particle i as well.
@@ -258,7 +260,7 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     Returns
     -------
     tuple of numpy.ndarray
-        ``(K_pairs, K_walls)`` (W/K, or S), and with ``shares`` the share ``R_i / (R_i + R_j)`` per pair bond
+        ``(K_pairs, K_walls)`` (W/K, or S), and with ``shares`` the share :math:`R_i / (R_i + R_j)` per pair bond
         (dimensionless).
 
     Raises

@@ -1,28 +1,33 @@
-"""The half bodies of the union of spheres: how much more a cut sphere resists than the ball the pair law knows.
+r"""The half bodies of the union of spheres: how much more a cut sphere resists than the ball the pair law knows.
 
 Under ``conductance.neck = "union"`` a particle is its sphere cut by the radical planes of all its necks
 (:mod:`fem_neck.geometry.union`: Arzt's truncated sphere). The union's half-body law (``fem_neck/data/fit_union.json``,
 :mod:`fem_neck.law`) is exact for a ball cut by one plane; every other neck of the particle removes a cap more, and
-the heat from the centre to neck ``b`` crosses a narrower body. Along the neck's axis (``z`` from the centre, ``0 <= z
-<= l_b``) the cut body's cross-section ``A_c(z)`` is the disk ``pi (r^2 - z^2)`` of the ball clipped by the other
-planes. A body of revolution of slowly varying radius ``rho(z)`` resists (slender-body expansion of the Laplace
-equation, to second order in ``rho'``)::
+the heat from the centre to neck ``b`` crosses a narrower body. Along the neck's axis (``z`` from the centre,
+:math:`0 \le z \le l_b`) the cut body's cross-section :math:`A_c(z)` is the disk :math:`\pi (r^2 - z^2)` of the ball
+clipped by the other planes. A body of revolution of slowly varying radius :math:`\rho(z)` resists (slender-body
+expansion of the Laplace equation, to second order in :math:`\rho'`)
 
-    R = integral (1 + rho'^2 / 2) / (kappa pi rho^2) dz,
+.. math::
 
-and the difference between the cut body and the ball, with ``rho = sqrt(A / pi)`` for each, is added to the half
-resistance of the law::
+    R = \int \frac{1 + \rho'^2 / 2}{\kappa \pi \rho^2} \, dz,
 
-    1 / K_b = 1 / K_b(union law) + Delta R_b,
-    Delta R_b = integral_0^l_b [(1 + rho_c'^2 / 2) / A_c - (1 + rho_ball'^2 / 2) / A_ball] dz / kappa.
+and the difference between the cut body and the ball, with :math:`\rho = \sqrt{A / \pi}` for each, is added to the
+half resistance of the law:
 
-Where no other plane crosses the half body the two profiles are equal and ``Delta R_b = 0``: a pair, a chain, or
-necks small and far apart keep the union law exactly. Where another plane cuts the axis between the centre and the
-neck (``A_c = 0`` there: the neck's lens lies inside a third sphere) the neck is no contact of the union at all and
-``Delta R_b`` is infinite (its bond carries nothing). The cross-sections are exact: the disk less a circular segment per plane where
-no two of the planes' lines cross inside it, else the disk clipped by them (:mod:`fem_neck.geometry.cut_kernels`);
-on a uniform grid of ``SAMPLES`` intervals with the
-derivative taken on the same grid for both profiles, so that they cancel exactly where they agree.
+.. math::
+
+    \frac{1}{K_b} = \frac{1}{K_b^{union}} + \Delta R_b, \qquad
+    \Delta R_b = \frac{1}{\kappa} \int_0^{l_b} \left[\frac{1 + \rho_c'^2 / 2}{A_c}
+    - \frac{1 + \rho_{ball}'^2 / 2}{A_{ball}}\right] dz,
+
+with :math:`K_b^{union}` the half conductance of the union law. Where no other plane crosses the half body the two
+profiles are equal and :math:`\Delta R_b = 0`: a pair, a chain, or necks small and far apart keep the union law exactly.
+Where another plane cuts the axis between the centre and the neck (:math:`A_c = 0` there: the neck's lens lies inside a
+third sphere) the neck is no contact of the union at all and :math:`\Delta R_b` is infinite (its bond carries nothing).
+The cross-sections are exact: the disk less a circular segment per plane where no two of the planes' lines cross inside
+it, else the disk clipped by them (:mod:`fem_neck.geometry.cut_kernels`); on a uniform grid of ``SAMPLES`` intervals
+with the derivative taken on the same grid for both profiles, so that they cancel exactly where they agree.
 """
 
 from __future__ import annotations
@@ -163,7 +168,7 @@ def _cut_body_kernel(n, particle, normals, planes, radius, samples):
 
 def cut_body_resistance(radius: np.ndarray, particle: np.ndarray, normals: np.ndarray, planes: np.ndarray,
                         samples: int = SAMPLES) -> np.ndarray:
-    """``kappa Delta R`` of every neck end (module docstring): how much more the particle's cut sphere resists from
+    r""":math:`\kappa \Delta R` of every neck end (module docstring): how much more the particle's cut sphere resists from
     its centre to the neck than the ball does.
 
     Parameters
@@ -183,7 +188,7 @@ def cut_body_resistance(radius: np.ndarray, particle: np.ndarray, normals: np.nd
     Returns
     -------
     numpy.ndarray
-        ``kappa Delta R`` per end, 1/m (0 where no other plane crosses the half body; ``inf`` where the neck lies
+        :math:`\kappa \Delta R` per end, 1/m (0 where no other plane crosses the half body; ``inf`` where the neck lies
         inside a third sphere).
     """
     f = np.ascontiguousarray

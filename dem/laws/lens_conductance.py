@@ -1,6 +1,6 @@
 """The ``zohdi`` conductance law (:mod:`dem.laws.conductance`) compiled on the pairs of a Verlet list, contact geometry
-included: particles that move evaluate it at every fixed-point iteration of their step (:mod:`dem.engines.staggered.heat`).
-Apart from :mod:`dem.laws.conductance` so that a static run loads no numba."""
+included: particles that move evaluate it at every fixed-point iteration of their step
+(:mod:`dem.engines.staggered.heat`). Apart from :mod:`dem.laws.conductance` so that a static run loads no numba."""
 
 from __future__ import annotations
 
@@ -15,10 +15,10 @@ LENS_POLICY = {"error": 0, "clip": 1, "drop": 2}  # out_of_range as the compiled
 
 @njit(cache=True, error_model="numpy")
 def lens_conductance(l_i, l_j, area, kappa_i, kappa_j, contact_conductance):
-    """``K_ij`` of the ``zohdi`` law (Zohdi 2014, eq. 33) from the centre-to-contact-plane distances ``l_i``,
-    ``l_j`` (eq. 12) and the lens area ``area`` (eqs. 7-11): the halves ``kappa_i area / l_i`` in series, and
-    ``contact_conductance`` (W/K; inf: none). A half with ``l = 0`` (a centre on the contact plane; the isothermal
-    wall's side of a wall bond) adds no resistance."""
+    r""":math:`K_{ij}` of the ``zohdi`` law (Zohdi 2014, eq. 33) from the centre-to-contact-plane distances ``l_i``,
+    ``l_j`` (eq. 12) and the lens area ``area`` :math:`A` (eqs. 7-11): the halves :math:`\kappa_i A / l_i` in series,
+    and ``contact_conductance`` (W/K; inf: none). A half with :math:`l = 0` (a centre on the contact plane; the
+    isothermal wall's side of a wall bond) adds no resistance."""
     resistance = 1.0 / contact_conductance
     if l_i > 0.0:
         resistance += l_i / (kappa_i * area)
@@ -29,13 +29,13 @@ def lens_conductance(l_i, l_j, area, kappa_i, kappa_j, contact_conductance):
 
 @njit(cache=True, error_model="numpy")
 def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pi, pj, wn, wq, wk, wm, K, K_w, box):
-    """The ``zohdi`` law (:func:`lens_conductance`) on every listed pair ``(pi, pj)`` into ``K`` and every listed
-    particle-wall pair ``(wk, wm)`` (walls ``n_m . x = q_m``) into ``K_w``, with the lens geometry of
+    r"""The ``zohdi`` law (:func:`lens_conductance`) on every listed pair ``(pi, pj)`` into ``K`` and every listed
+    particle-wall pair ``(wk, wm)`` (walls :math:`n_m \cdot x = q_m`) into ``K_w``, with the lens geometry of
     :func:`dem.geometry.bonds.find_bonds` (``contact = "lens"``) at positions ``x``; ``K = 0`` where the pair does not
-    touch (``|x_i - x_j| >= R_i + R_j``, a wall ``dist >= R_k``). Along the axes where ``box`` holds a period (else
-    0) a pair is joined by the minimum image (:func:`dem.geometry.neighbours.min_image`).
+    touch (:math:`|x_i - x_j| \ge R_i + R_j`, a wall at a distance :math:`\ge R_k`). Along the axes where ``box`` holds
+    a period (else 0) a pair is joined by the minimum image (:func:`dem.geometry.neighbours.min_image`).
 
-    A lens beyond its range (a centre inside the other sphere's cap, ``L_i < 0``) is, by ``policy``
+    A lens beyond its range (a centre inside the other sphere's cap, :math:`L_i < 0`) is, by ``policy``
     (``LENS_POLICY``), clipped as ``find_bonds`` clips it (the smaller sphere's centre on the contact plane) or
     dropped (``K = 0``). Returns the number of contacts that ``policy`` cannot take (``"error"``: a lens beyond its
     range; any policy but ``"drop"``: coincident centres, a centre on or behind a wall), whose ``K`` is left 0:

@@ -1,67 +1,78 @@
-"""The ``shared-body`` law: the pipe network corrected for the necks of one particle sharing its body.
+r"""The ``shared-body`` law: the pipe network corrected for the necks of one particle sharing its body.
 
 The pipe network (Rojek 2022, eqs. 4-9) gives every bond two half-conductances in series, each calibrated on one
 sintered pair: the half body from the particle's equatorial plane to the neck (eq. 36). That is exact for chains, but
 a particle with necks in several directions passes heat between them through one body, and the network counts that
 body once per bond: a dense packing conducts less than the network says (FCC by ~35 % at a/r = 0.4).
 
-**The particle as a multi-terminal conductor.** Heat ``Q_c`` entering a ball of radius ``r`` (conductivity kappa)
-through small contacts ``c`` on its surface raises the temperature at contact ``b`` by ``sum_c R_bc Q_c`` (with
-``sum Q = 0`` in steady state). For point contacts ``R_bc`` is the ball's Neumann function between two surface
-points at the angle ``gamma``; from its spherical-harmonic series, ``sum_(l>=1) (2l+1)/l P_l(cos gamma) /
-(4 pi kappa r)`` and the generating functions of ``P_l`` and ``P_l / l``::
+**The particle as a multi-terminal conductor.** Heat :math:`Q_c` entering a ball of radius ``r`` (conductivity
+:math:`\kappa`) through small contacts ``c`` on its surface raises the temperature at contact ``b`` by
+:math:`\sum_c R_{bc} Q_c` (with :math:`\sum Q = 0` in steady state). For point contacts :math:`R_{bc}` is the ball's
+Neumann function between two surface points at the angle :math:`\gamma`; from its spherical-harmonic series,
+:math:`\sum_{l \ge 1} \frac{2l+1}{l} P_l(\cos\gamma) / (4 \pi \kappa r)`, and the generating functions of
+:math:`P_l` and :math:`P_l / l`:
 
-    G(gamma) = (1/s - 2 - ln(s (1 + s))) / (4 pi kappa r),    s = sin(gamma / 2) = |n_b - n_c| / 2:
+.. math::
 
-the ``1/s`` is twice the free-space source (a source on a surface), the logarithm the ball's finite size (the term
-that gives the fit law its ``x ln(1/x)``, :mod:`fem_neck.law`). A neck is not a point: its heat crosses the disk of
-radius ``a_b`` on the cap base plane, at ``z_b = sqrt(r^2 - a_b^2)`` from the centre, so the free-space part is taken
-between the disk centres ``z_b n_b`` (chord ``l_bc = |z_b n_b - z_c n_c|``), which is exact as ``a -> 0`` and brings
-wide necks closer. The model keeps the pair-calibrated half resistance ``R_b = 1 / K_b`` of the fit law on the
-diagonal (a neck's own constriction, its half neck and the sphere) and adds the interaction of every other neck
-relative to the same two necks on opposite poles (``l = z_b + z_c``, ``s = 1``)::
+    G(\gamma) = \frac{1/s - 2 - \ln\left(s (1 + s)\right)}{4 \pi \kappa r}, \qquad
+    s = \sin(\gamma / 2) = |n_b - n_c| / 2,
 
-    R_bb = 1 / K_b,    R_bc = (2 r / l_bc - 2 r / (z_b + z_c) - ln(s (1 + s) / 2)) / (4 pi kappa r),
+where the :math:`1/s` is twice the free-space source (a source on a surface), the logarithm the ball's finite size (the
+term that gives the fit law its :math:`x \ln(1/x)`, :mod:`fem_neck.law`). A neck is not a point: its heat crosses the
+disk of radius :math:`a_b` on the cap base plane, at :math:`z_b = \sqrt{r^2 - a_b^2}` from the centre, so the free-space
+part is taken between the disk centres :math:`z_b n_b` (chord :math:`l_{bc} = |z_b n_b - z_c n_c|`), which is exact as
+:math:`a \to 0` and brings wide necks closer. The model keeps the pair-calibrated half resistance :math:`R_b = 1 / K_b`
+of the fit law on the diagonal (a neck's own constriction, its half neck and the sphere) and adds the interaction of
+every other neck relative to the same two necks on opposite poles (:math:`l = z_b + z_c`, :math:`s = 1`):
 
-so that a particle whose necks are collinear (a pair, a chain) has ``R = diag(1/K_b)``: today's network exactly.
-Nothing is fitted; ``python -m verification lattices`` measures the residuals against periodic-cell FE (the
-disk-centre chord removes most of what point contacts leave at large necks).
+.. math::
+
+    R_{bb} = \frac{1}{K_b}, \qquad
+    R_{bc} = \frac{2 r / l_{bc} - 2 r / (z_b + z_c) - \ln\left(s (1 + s) / 2\right)}{4 \pi \kappa r},
+
+so that a particle whose necks are collinear (a pair, a chain) has :math:`R = \operatorname{diag}(1/K_b)`: today's
+network exactly. Nothing is fitted; ``python -m verification lattices`` measures the residuals against periodic-cell
+FE (the disk-centre chord removes most of what point contacts leave at large necks).
 
 **Back to one temperature per particle.** The network keeps one node per particle, so the multi-terminal conductor
-is reduced to one factor ``s_b`` per neck on the fit law's half conductance ``K_b``. Neck ``b`` sits at
-``x_k + l_b n_b`` (``l_b`` the centre-to-contact-plane distance); a uniform field ``g`` drives the flows
-``Q = Y N g`` (``N`` the rows ``l_b n_b``, ``Y`` the conductance matrix of ``R`` on flows that sum to zero,
-``Y = R^-1 - R^-1 1 1^T R^-1 / (1^T R^-1 1)``). In the field along its own neck, ``g = n_b``, neck ``b`` carries
-``(Y N N^T)_bb``: the factor is that flow over the plain network's (``R = diag(1/K_b)``)::
+is reduced to one factor :math:`s_b` per neck on the fit law's half conductance :math:`K_b`. Neck ``b`` sits at
+:math:`x_k + l_b n_b` (:math:`l_b` the centre-to-contact-plane distance); a uniform field ``g`` drives the flows
+:math:`Q = Y N g` (``N`` the rows :math:`l_b n_b`, ``Y`` the conductance matrix of ``R`` on flows that sum to zero,
+:math:`Y = R^{-1} - R^{-1} \mathbf{1} \mathbf{1}^T R^{-1} / (\mathbf{1}^T R^{-1} \mathbf{1})`). In the field along its
+own neck, :math:`g = n_b`, neck ``b`` carries :math:`(Y N N^T)_{bb}`: the factor is that flow over the plain network's
+(:math:`R = \operatorname{diag}(1/K_b)`):
 
-    s_b = (Y_R N N^T)_bb / (Y_D N N^T)_bb.
+.. math::
 
-Summed over the necks these are the traces of the particle's conductivity tensors ``N^T Y N``: for a cubic lattice,
-whose tensors are isotropic and whose necks are all alike, every ``s_b`` is the ratio of the traces and the
-reduction is exact; for the simple cubic lattice the interactions cancel in every uniform field (``s = 1``, the
-plain network, which the FE finds accurate). Necks close to one another share the body (``s < 1``); two necks
+    s_b = \frac{(Y_R N N^T)_{bb}}{(Y_D N N^T)_{bb}}.
+
+Summed over the necks these are the traces of the particle's conductivity tensors :math:`N^T Y N`: for a cubic
+lattice, whose tensors are isotropic and whose necks are all alike, every :math:`s_b` is the ratio of the traces and
+the reduction is exact; for the simple cubic lattice the interactions cancel in every uniform field (:math:`s = 1`,
+the plain network, which the FE finds accurate). Necks close to one another share the body (:math:`s < 1`); two necks
 closer than opposite poles, as in a bent chain, pass heat between them more easily than two equatorial half bodies
-in series (``s > 1``). Where the plain network's own flow in that field is nearly nil (other necks pointing the same
-way) the particle's trace ratio is used instead. Chains and pairs give ``s = 1`` exactly: interactions below 1e-12
-of the half resistances (collinear bonds to round-off) count as none, so those results are today's ``fit`` law bit
-for bit.
+in series (:math:`s > 1`). Where the plain network's own flow in that field is nearly nil (other necks pointing the
+same way) the particle's trace ratio is used instead. Chains and pairs give :math:`s = 1` exactly: interactions below
+1e-12 of the half resistances (collinear bonds to round-off) count as none, so those results are today's ``fit`` law
+bit for bit.
 
 **Never above the Wiener bound.** For the uniform field the network's energy is at most the sum over particles of
-``sum_b s_b K_b l_b^2 (n_b . g)^2`` (the halves of a bond in series, Cauchy-Schwarz), and the Wiener bound ``phi
-kappa`` is the same field's energy in the solid, ``kappa V_k |g|^2`` per particle. So a particle's factors are
-scaled down together wherever ``lambda_max(sum_b s_b K_b l_b^2 n_b n_b^T)`` exceeds ``kappa V_k`` (``V_k = 4/3 pi
-r^3``, the volume each particle keeps under the volume-conserving neck): a periodic network then never conducts
-more than ``phi kappa``. The cap binds only where the necks overlap (beyond the pair model); it is applied to
-particles with non-collinear necks.
+:math:`\sum_b s_b K_b l_b^2 (n_b \cdot g)^2` (the halves of a bond in series, Cauchy-Schwarz), and the Wiener bound
+:math:`\phi \kappa` is the same field's energy in the solid, :math:`\kappa V_k |g|^2` per particle. So a particle's
+factors are scaled down together wherever :math:`\lambda_{max}\left(\sum_b s_b K_b l_b^2 n_b n_b^T\right)` exceeds
+:math:`\kappa V_k` (:math:`V_k = \frac{4}{3} \pi r^3`, the volume each particle keeps under the volume-conserving
+neck): a periodic network then never conducts more than :math:`\phi \kappa`. The cap binds only where the necks
+overlap (beyond the pair model); it is applied to particles with non-collinear necks.
 
 **Under the union of spheres** (``neck = "union"``, :func:`dem.laws.conductance.bond_conductances`) the half bodies
 are first narrowed to the cut sphere (:mod:`dem.laws.cut_body`), and the cap holds the *mean* of the particle's
-tensor over three directions, ``trace / 3``, to ``kappa V_k`` with ``V_k`` its cut sphere's volume
+tensor over three directions, its trace over 3, to :math:`\kappa V_k` with :math:`V_k` its cut sphere's volume
 (:func:`fem_neck.geometry.union.cut_spheres`). In a random packing of overlapping spheres a particle's tensor is
-anisotropic (its largest eigenvalue up to 1.4 ``kappa V_k`` while its mean stays below), and capping the largest
-eigenvalue particle by particle took 12-22 % off the k_eff of random union packings at ``phi`` 0.6-0.8 that the FE
-does not lose; summed over the particles the trace cap keeps the mean of the network's three principal
-conductivities at or below ``phi kappa`` (on the cubic lattices, whose tensors are isotropic, the two caps agree).
+anisotropic (its largest eigenvalue up to :math:`1.4 \kappa V_k` while its mean stays below), and capping the largest
+eigenvalue particle by particle took 12-22 % off the k_eff of random union packings at :math:`\phi` 0.6-0.8 that the
+FE does not lose; summed over the particles the trace cap keeps the mean of the network's three principal
+conductivities at or below :math:`\phi \kappa` (on the cubic lattices, whose tensors are isotropic, the two caps
+agree).
 
 A wall bond is a neck too (toward the wall, the mirror pair's neck), so it takes part in its particle's factor.
 
@@ -81,7 +92,7 @@ ROUNDOFF = 1e-12  # interactions below this x the smallest half resistance are r
 
 @numba.njit(cache=True)
 def interaction(normal_b, normal_c, base_b: float, base_c: float) -> float:
-    """``4 pi kappa r R_bc`` of two necks with unit normals ``normal_b``, ``normal_c`` and cap-base distances
+    r""":math:`4 \pi \kappa r R_{bc}` of two necks with unit normals ``normal_b``, ``normal_c`` and cap-base distances
     ``base_b``, ``base_c`` (in units of ``r``), relative to the same necks on opposite poles (module docstring)."""
     cos_g = normal_b[0] * normal_c[0] + normal_b[1] * normal_c[1] + normal_b[2] * normal_c[2]
     return _interaction(cos_g, base_b, base_c)

@@ -1,4 +1,4 @@
-"""The current of a scene (``"electrical"`` physics, read by the static and the staggered engines): the
+r"""The current of a scene (``"electrical"`` physics, read by the static and the staggered engines): the
 ``[electrical]`` table and the electrodes among the ``[[walls]]``.
 
 * ``[electrical]`` -- ``scheme`` (``"kirchhoff"`` or ``"zohdi"``), ``absorption`` (a of Zohdi 2014, eq. 35),
@@ -6,7 +6,7 @@
   Zohdi's iteration ``tolerance`` (largest change per sweep relative to the largest wall value) and ``sweeps`` (at most
   per refresh);
 * ``[[walls]]`` -- ``potential`` (V) or ``current`` (A into the packing; Zohdi's scheme: the wall's J_ext) makes a
-  wall an electrode; ``[material] electrical_conductivity`` (S/m) is sigma.
+  wall an electrode; ``[material] electrical_conductivity`` (S/m) is :math:`\sigma`.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The part of a scene that makes particles move (``[scene] physics`` with ``"mechanical"``): TOML into a
+r"""The part of a scene that makes particles move (``[scene] physics`` with ``"mechanical"``): TOML into a
 :class:`MotionSpec`.
 
 Tables and keys (SI units; the README's scene schema lists them with their defaults):

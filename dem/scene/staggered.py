@@ -1,9 +1,9 @@
-"""The keys only the staggered engine reads (:mod:`dem.engines.staggered`, Zohdi 2014's implicit scheme), as its own
+r"""The keys only the staggered engine reads (:mod:`dem.engines.staggered`, Zohdi 2014's implicit scheme), as its own
 spec (:class:`StaggeredSpec`): the implicit stepping in ``[solver]`` and the powder bed's axis and pictures in
 ``[output]``; the contact law is ``[contact] law = "zohdi"`` (:mod:`dem.laws.contact.zohdi`), the current
 :mod:`dem.scene.electrical`.
 
-* ``[solver]`` -- ``dt`` (the first step, s), ``dt_max`` (Delta t_lim, default ``dt``), ``phi``, ``iterations``
+* ``[solver]`` -- ``dt`` (the first step, s), ``dt_max`` (:math:`\Delta t_{lim}`, default ``dt``), ``phi``, ``iterations``
   (K_d), ``tolerance`` (TOL), ``order`` (p), ``growth``, ``shrink``, ``dt_min`` (:class:`ZohdiStepping`); ``skin``
   (m, default ``STAGGERED_SKIN`` x the mean radius);
 * ``[output]`` -- ``fraction_axis`` (``"x"``, ``"y"`` or ``"z"``): the axis along which the powder stands on its
@@ -27,26 +27,26 @@ STAGGERED_SKIN = 0.5  # x the mean radius: a step of the implicit scheme moves p
 
 @dataclass(frozen=True)
 class ZohdiStepping:
-    """The implicit scheme of Zohdi 2014: trapezoidal weight ``phi`` (eqs. 22-24; 0 explicit, 1/2 the trapezoid, 1
+    r"""The implicit scheme of Zohdi 2014: trapezoidal weight ``phi`` (eqs. 22-24; 0 explicit, 1/2 the trapezoid, 1
     backward), the fixed-point iteration within a step to ``tolerance`` (TOL of eqs. 47-48, for positions and
-    temperatures) in a target of ``iterations`` (K_d) iterations, the exponent ``order`` (p of eq. 30, 2 for this
-    second-order system), the first step ``dt`` and its upper bound ``dt_max`` (Delta t_lim) and, beyond the paper,
-    bounds on the step factor Phi: an accepted step grows by at most ``growth`` (>= 1), a restart shrinks it by at
-    least ``shrink`` (in [LEAST_FACTOR, 1)) and at most ``LEAST_FACTOR`` -- eq. (30) assumes the error falls as
-    ``(S dt^p)^K``; where an iteration stalls instead (a force that is steep in the velocity, such as friction below
-    ``v_slip``), Phi of a failed step is close to 1 and the restarts would creep -- and a floor ``dt_min`` below
-    which a step that cannot converge stops the run.
+    temperatures) in a target of ``iterations`` (:math:`K_d`) iterations, the exponent ``order`` (p of eq. 30, 2 for
+    this second-order system), the first step ``dt`` and its upper bound ``dt_max`` (:math:`\Delta t_{lim}`) and, beyond
+    the paper, bounds on the step factor :math:`\Phi`: an accepted step grows by at most ``growth`` (>= 1), a restart
+    shrinks it by at least ``shrink`` (in [LEAST_FACTOR, 1)) and at most ``LEAST_FACTOR`` -- eq. (30) assumes the error
+    falls as :math:`(S \, \Delta t^p)^K`; where an iteration stalls instead (a force that is steep in the velocity, such
+    as friction below ``v_slip``), :math:`\Phi` of a failed step is close to 1 and the restarts would creep -- and a
+    floor ``dt_min`` below which a step that cannot converge stops the run.
 
     Parameters
     ----------
     dt : float
         The first step (s), > 0.
     dt_max : float
-        The upper bound Delta t_lim of the step (s), >= ``dt``.
+        The upper bound :math:`\Delta t_{lim}` of the step (s), >= ``dt``.
     phi : float
         The trapezoidal weight, in ``[0, 1]`` (eqs. 22-24).
     iterations : int
-        K_d, the target number of fixed-point iterations per step (eq. 30), >= 2.
+        :math:`K_d`, the target number of fixed-point iterations per step (eq. 30), >= 2.
     tolerance : float
         TOL, the relative change at which the fixed-point iteration stops (eqs. 47-48), > 0.
     order : float
@@ -104,8 +104,9 @@ class ZohdiStepping:
             bad("dt_min", f"must be in (0, dt = {self.dt!r}] s")
 
     def factor(self, error: float, K: int) -> float:
-        """The step factor Phi_K of eq. (30) / Algorithm 1 (4c) for the relative iteration error ``error`` after
-        ``K`` iterations: ``(TOL/D0)^(1/(p K_d)) / (D_K/D0)^(1/(p K))`` with ``D0 = 1`` (the first iterate's relative
+        r"""The step factor :math:`\Phi_K` of eq. (30) / Algorithm 1 (4c) for the relative iteration error ``error``
+        :math:`D_K` after ``K`` iterations: :math:`(\mathrm{TOL}/D_0)^{1/(p K_d)} / (D_K/D_0)^{1/(p K)}` with
+        :math:`D_0 = 1` (the first iterate's relative
         change is 1 by construction), clipped to ``[LEAST_FACTOR, growth]``.
 
         Parameters
@@ -118,7 +119,7 @@ class ZohdiStepping:
         Returns
         -------
         float
-            Phi_K, the factor the next step is multiplied by.
+            :math:`\Phi_K`, the factor the next step is multiplied by.
         """
         if error <= 0.0:
             return self.growth
@@ -127,12 +128,12 @@ class ZohdiStepping:
         return min(self.growth, max(LEAST_FACTOR, phi))
 
     def restart_factor(self, phi: float) -> float:
-        """The factor of a restarted step: Phi_K, but at least ``shrink`` and at most ``LEAST_FACTOR``.
+        r"""The factor of a restarted step: :math:`\Phi_K`, but at least ``shrink`` and at most ``LEAST_FACTOR``.
 
         Parameters
         ----------
         phi : float
-            Phi_K of the failed step (:meth:`factor`).
+            :math:`\Phi_K` of the failed step (:meth:`factor`).
 
         Returns
         -------

@@ -1,8 +1,8 @@
-"""The keys only the verlet engine reads (:mod:`dem.engines.verlet`, velocity-Verlet steps with any contact law that
+r"""The keys only the verlet engine reads (:mod:`dem.engines.verlet`, velocity-Verlet steps with any contact law that
 spins), as its own spec (:class:`VerletSpec`): the step, the coupled thermal network's interval and step, a prescribed
 temperature schedule.
 
-* ``[solver]`` -- ``dt`` (s, or "auto": t_MD = pi/(50 omega), Luding 2005 eq. 6; a given step at most the stable one);
+* ``[solver]`` -- ``dt`` (s, or "auto": :math:`t_{MD} = \pi/(50 \omega)`, Luding 2005 eq. 6; a given step at most the stable one);
   ``skin`` (m, default ``VERLET_SKIN`` x the mean radius); ``thermal_interval`` (s) and ``integrator`` (implicit |
   crank-nicolson) of a coupled thermal network;
 * ``[temperature]`` -- a prescribed schedule ``time``, ``value``, ``relaxation_time`` (:mod:`dem.scene.events`).

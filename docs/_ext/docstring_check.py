@@ -11,12 +11,16 @@ Every parameter of a public function, of a public class (its constructor) and of
 A class describes its constructor's parameters in its own docstring (or its ``__init__``'s); a dataclass may list
 its fields under ``Attributes`` instead. :func:`undescribed` lists what lacks a description; the tests hold its
 count per package as a ratchet (it may fall, never rise).
+
+Formulas are TeX in a ``:math:`` role or a ``.. math::`` block, which MathJax draws on the site; :func:`ascii_formulas`
+lists the docstring lines that still write one in ASCII (``sqrt(r^2 - a^2)``, ``kappa pi r``, ``h = r_i + r_j - d``).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import inspect
+import pkgutil
 import re
 
 import api_check
@@ -43,6 +47,101 @@ def described(docstring: str | None) -> set[str]:
             entry = line.split(" : ", 1)[0].strip()
             names.update(name.strip().lstrip("*") for name in entry.split(","))
     return names
+
+
+# Greek letters spelled out: alone or with a short subscript (``kappa_i``, ``lambda_1``), a formula's symbols
+GREEK = ("alpha|beta|gamma|Gamma|delta|Delta|epsilon|eps|zeta|eta|theta|Theta|kappa|lambda|Lambda|mu|nu|xi|pi|rho|"
+         "sigma|Sigma|tau|phi|Phi|chi|psi|Psi|omega|Omega")
+FORMULA_SIGNS = {  # what makes a line (outside maths) an ASCII formula
+    "function": re.compile(r"(?<![\w.])(?:sqrt|ln|exp|log|atan2|sin|cos|tan|tanh|atanh|arccos|arcsin|arctan|acos|"
+                           r"asin|atan)\("),
+    "power": re.compile(r"[\w)\]*]\^[-+(\w]|[\w)]\*\*[\w(]"),
+    "Greek name": re.compile(rf"(?<![\w.\"'-])(?:{GREEK})(?:_\w{{1,3}})?(?![\w(\"'-])"),
+    "equation": re.compile(r"(?<![\w.])[A-Za-z][\w*']{0,3}(?:\([\w, ]*\))?\s*(?:=|<=|>=)\s*[^=\s\"']*[\w)]\s*[-+*/]\s*"
+                           r"[\w(]"),
+}
+_MATH_ROLE = re.compile(r":math:`[^`]*`")
+_OTHER_ROLE = re.compile(r":[\w:.-]+:`[^`]*`")
+_LITERAL = re.compile(r"``([^`]+?)``")
+_NOT_POWERS = re.compile(r"(?<![\w)])(?:k?g|m|mm|um|s|K)\^-?\d\b|\b10\^-?\d+\b")  # units (m^3, K^4) and 10^6
+_NUMBER = re.compile(r"(?<![\w.])\d+(?:\.\d*)?[eE][-+]?\d+\b")
+_PARAMETER_ENTRY = re.compile(r"\s*\*{0,2}[\w, *]+ : .*")  # "kappa : float" under Parameters names, not maths
+
+
+def formula_lines(docstring: str | None) -> list[str]:
+    """The lines of ``docstring`` (as written: ``__doc__``) that write a formula in ASCII: outside ``:math:`` roles and
+    ``.. math::`` blocks, a mathematical function called (``sqrt(``, ``ln(`` ...), a power (``a^2``, ``x**2``; not a
+    unit's ``m^3`` nor ``10^6``), a Greek letter spelled out as a symbol (``kappa``, ``lambda_1``; not a parameter's
+    name alone in a literal, nor the name of a ``Parameters`` entry), or an equation whose side is arithmetic
+    (``h = r_i + r_j - d``). A literal counts as text: a formula in one is still ASCII. First, if the docstring holds
+    a control character (what TeX's ``\\frac``, ``\\theta`` or ``\\rho`` become in a docstring that is not raw), a
+    line saying so."""
+    escaped = ["a backslash read as an escape: write the docstring r\"\"\"...\"\"\""] if re.search(
+        r"[\a\b\f\r\t\v]", docstring or "") else []
+    docstring = inspect.cleandoc(docstring or "")
+
+    def blank(match):  # a role or literal may run over lines: keep its line breaks
+        return re.sub(r"[^\n]", " ", match.group(0))
+
+    def literal(match):  # a literal naming a parameter (``kappa``) is code; one holding an expression, a formula
+        return blank(match) if re.fullmatch(r"\(?[\w.*]+(, [\w.*]+)*\)?", match.group(1)) else " " + match.group(1) + " "
+
+    text = _LITERAL.sub(literal, _OTHER_ROLE.sub(blank, _MATH_ROLE.sub(blank, docstring)))
+    found = escaped
+    math_indent = None
+    for line, original in zip(text.splitlines(), docstring.splitlines()):
+        indent = len(line) - len(line.lstrip())
+        if math_indent is not None:
+            if not line.strip() or indent > math_indent:
+                continue  # inside a .. math:: block
+            math_indent = None
+        if line.strip().startswith(".. math::"):
+            math_indent = indent
+            continue
+        if line.strip().startswith(">>>") or _PARAMETER_ENTRY.fullmatch(original):
+            continue
+        line = re.sub(r"\*\*[^*]+\*\*", " ", _NOT_POWERS.sub(" ", line))  # units, powers of ten, bold text
+        line = _NUMBER.sub("1", line)  # 3e-4 is a number, not 3e minus 4
+        if any(sign.search(line) for sign in FORMULA_SIGNS.values()):
+            found.append(original.strip())
+    return found
+
+
+def ascii_formulas(package: str) -> list[str]:
+    """``object: line`` for every line of a public docstring of ``package`` (its public modules', their compiled
+    (numba) functions', and those of the objects :func:`undocumented` reads: functions, classes, their public methods
+    and properties) that :func:`formula_lines`
+    finds an ASCII formula in, each docstring once."""
+    import importlib
+
+    seen, found = set(), []
+
+    def read(name, obj):
+        doc = obj.__doc__ if isinstance(obj, property) else getattr(obj, "__doc__", None)
+        if doc and id(doc) not in seen:
+            seen.add(id(doc))
+            found.extend(f"{name}: {line}" for line in formula_lines(doc))
+
+    root = importlib.import_module(package)
+    modules = [package] + [m.name for m in pkgutil.walk_packages(getattr(root, "__path__", []), package + ".")]
+    for module in modules:
+        if not any(part.startswith("_") for part in module.split(".")):  # __main__ too: importing it would run it
+            read(module, importlib.import_module(module))
+            for attr, obj in vars(importlib.import_module(module)).items():  # compiled functions, which autodoc shows
+                if not attr.startswith("_") and hasattr(obj, "py_func") and obj.py_func.__module__ == module:
+                    read(f"{module}.{attr}", obj.py_func)
+    objects = api_check.public_objects(package)
+    for dotted in objects:
+        module, _, name = dotted.rpartition(".")
+        obj = getattr(importlib.import_module(module), name)
+        read(dotted, obj)
+        for attr, member in (vars(obj).items() if inspect.isclass(obj) else ()):
+            function = member if isinstance(member, property) else getattr(member, "__func__", member)
+            function = getattr(function, "func", function)  # functools.cached_property
+            if (not attr.startswith("_") or attr == "__init__") and (
+                    inspect.isfunction(function) or isinstance(function, property)):
+                read(f"{dotted}.{attr}", function)
+    return found
 
 
 def _parameters(function, drop_first: bool) -> list[str]:

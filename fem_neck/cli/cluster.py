@@ -13,8 +13,9 @@ MAX_SECONDS = 300.0
 
 
 def estimate_seconds(n: int, size_neck: float, size_far: float, levels: int) -> float:
-    """Rough run time (s) of a cluster solve on 2 cores: per particle ~0.75 s x ((0.25/size_far)^2.2 +
-    (0.12/size_neck)^2) for the finest level; the coarser levels (sizes x1.6, x2.56) add about 35 % and 12 %.
+    r"""Rough run time (s) of a cluster solve on 2 cores: per particle
+    :math:`\approx 0.75 \, \mathrm{s} \times \left((0.25/s_f)^{2.2} + (0.12/s_n)^2\right)` (``size_far`` :math:`s_f`,
+    ``size_neck`` :math:`s_n`) for the finest level; the coarser levels (sizes x1.6, x2.56) add about 35 % and 12 %.
 
     Parameters
     ----------

@@ -1,8 +1,8 @@
-"""``python -m fem_neck semisphere | pair | chain``: FE conductances solved to a tolerance (Rojek 2022, Secs. 5-6).
+r"""``python -m fem_neck semisphere | pair | chain``: FE conductances solved to a tolerance (Rojek 2022, Secs. 5-6).
 
 The model conductance compared with the FE is Rojek 2022, eq. (43): each particle's half conducts
-``K_i = 1.064 kappa pi a``; a bond is the two halves in series, ``K_ij = K_i / 2`` (eqs. 44-45), and a chain is its
-bonds in series. ``rel_diff = (K_model - K_fe) / K_fe``.
+:math:`K_i = 1.064 \kappa \pi a`; a bond is the two halves in series, :math:`K_{ij} = K_i / 2` (eqs. 44-45), and a chain
+is its bonds in series. ``rel_diff = (K_model - K_fe) / K_fe``.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ MAX_CHAIN = 50  # spheres in one chain solve (40 take ~28 s and 1.4 GB on 2 core
 
 
 def model_bond_conductance(kappa: float, a):
-    """``K_ij = K_i K_j / (K_i + K_j) = 1.064 kappa pi a / 2`` (Rojek 2022, eqs. 43-45).
+    r""":math:`K_{ij} = K_i K_j / (K_i + K_j) = 1.064 \kappa \pi a / 2` (Rojek 2022, eqs. 43-45).
 
     Parameters
     ----------

@@ -1,26 +1,31 @@
-"""Neck geometry of two sintered spheres (Rojek, Kasztelan & Tharmaraj 2022, Section 4).
+r"""Neck geometry of two sintered spheres (Rojek, Kasztelan & Tharmaraj 2022, Section 4).
 
-Two spheres of radii ``r_i`` and ``r_j`` overlap by ``h = r_i + r_j - d`` (eq. 21). Three models of the neck:
+Two spheres of radii :math:`r_i` and :math:`r_j` overlap by :math:`h = r_i + r_j - d` (eq. 21). Three models of the
+neck:
 
-* ``"coble"`` -- Coble's neck ``a = sqrt(2 r* h)`` with the effective radius ``r* = 2 r_i r_j / (r_i + r_j)``
-  (eqs. 10-12). It does not conserve volume and over-estimates the neck.
+* ``"coble"`` -- Coble's neck :math:`a = \sqrt{2 r^* h}` with the effective radius
+  :math:`r^* = 2 r_i r_j / (r_i + r_j)` (eqs. 10-12). It does not conserve volume and over-estimates the neck.
 * ``"newton"`` -- the volume-conserving cylindrical neck: a cylinder of radius ``a`` and height ``h_n`` whose
   volume equals the two spherical caps it replaces (eqs. 22-29). Solved by Newton's method on ``Z(a)`` (eqs. 27,
   31, 32); the paper starts from Coble's radius (eq. 33), we start from a closer one (:func:`newton_start`). For
   equal radii it reproduces the closed form of eqs. (18)-(20).
 * ``"first"`` -- the first Newton iterate from Coble's start (eq. 34), a cheap approximation.
 
-Numerics. With ``h_c(a) = r - sqrt(r^2 - a^2)`` (eqs. 28-29) the identity ``d/dh_c [h_c^2 (3r - h_c)] = 3 a^2``
-reduces the derivative of eq. (31) to ``Z'(a) = 6 a h_n``. Dividing eq. (27) by ``3 a^2`` gives
+Numerics. With :math:`h_c(a) = r - \sqrt{r^2 - a^2}` (eqs. 28-29) the identity
+:math:`\frac{d}{dh_c} \left[h_c^2 (3r - h_c)\right] = 3 a^2` reduces the derivative of eq. (31) to
+:math:`Z'(a) = 6 a h_n`. Dividing eq. (27) by :math:`3 a^2` gives
 
-    G(a) = Z / (3 a^2) = phi(h_ci; r_i) + phi(h_cj; r_j) - h,   phi(h_c; r) = h_c (3r - 2h_c) / (3 (2r - h_c)),
+.. math::
 
-strictly increasing in ``a`` on ``[0, min(r_i, r_j)]``: the root is unique, and ``h = phi_i + phi_j`` inverts the
-model (:func:`overlap_for_neck`, :func:`max_overlap`). ``Z`` is convex where ``h_n > 0``, so Newton started to the
+    G(a) = \frac{Z}{3 a^2} = \phi(h_{ci}; r_i) + \phi(h_{cj}; r_j) - h, \qquad
+    \phi(h_c; r) = \frac{h_c (3r - 2h_c)}{3 (2r - h_c)},
+
+strictly increasing in ``a`` on ``[0, min(r_i, r_j)]``: the root is unique, and :math:`h = \phi_i + \phi_j` inverts
+the model (:func:`overlap_for_neck`, :func:`max_overlap`). ``Z`` is convex where ``h_n > 0``, so Newton started to the
 right of the root decreases monotonically onto it, and a step from the left of the root (with ``Z' > 0``) lands to
 its right. Where the start has ``Z' <= 0`` the iteration starts from the bracket's right end ``a = min(r_i, r_j)``
-instead, so it never diverges. Cap heights are computed as ``a^2 / (r + sqrt(r^2 - a^2))`` so that small necks
-keep full relative precision. Large arrays are solved in blocks of cache size (``_CHUNK`` bonds), each block
+instead, so it never diverges. Cap heights are computed as :math:`a^2 / (r + \sqrt{r^2 - a^2})` so that small
+necks keep full relative precision. Large arrays are solved in blocks of cache size (``_CHUNK`` bonds), each block
 stopping as soon as its own bonds have converged.
 
 The model's range: a solution exists for ``0 < h <= max_overlap(r_i, r_j)``, where ``a`` reaches the smaller radius
@@ -45,30 +50,30 @@ _CHUNK = 1 << 14  # neck_radius solves large arrays in blocks of this many bonds
 
 @dataclass(frozen=True)
 class NeckGeometry:
-    """The full geometry of a sintered pair (:func:`neck_geometry`; Rojek 2022, eqs. 21-29).
+    r"""The full geometry of a sintered pair (:func:`neck_geometry`; Rojek 2022, eqs. 21-29).
 
     Every length field is an array of the broadcast input shape (a float for scalar input), in the unit of the input
-    lengths (m). The neck spans ``z_i <= z <= z_i + h_n`` measured from centre ``i`` along the line of centres, and
-    ``z_i + h_n + z_j = d``.
+    lengths (m). The neck spans :math:`z_i \le z \le z_i + h_n` measured from centre ``i`` along the line of centres,
+    and :math:`z_i + h_n + z_j = d`.
 
     Parameters
     ----------
     r_i, r_j : numpy.ndarray or float
         Radii of spheres ``i`` and ``j``, m.
     h : numpy.ndarray or float
-        Overlap ``r_i + r_j - d`` (eq. 21), m.
+        Overlap :math:`r_i + r_j - d` (eq. 21), m.
     a : numpy.ndarray or float
         Neck radius, m.
     h_ci, h_cj : numpy.ndarray or float
         Heights of the caps cut from sphere ``i`` and from sphere ``j`` (eqs. 28-29), m.
     h_n : numpy.ndarray or float
-        Length of the neck (the cylinder), ``h_ci + h_cj - h`` (eq. 24), m.
+        Length of the neck (the cylinder), :math:`h_{ci} + h_{cj} - h` (eq. 24), m.
     d : numpy.ndarray or float
         Distance between the centres (eq. 21), m.
     z_i, z_j : numpy.ndarray or float
-        Distance from centre ``i`` and from centre ``j`` to the base plane of its cap, ``sqrt(r^2 - a^2)``, m.
+        Distance from centre ``i`` and from centre ``j`` to the base plane of its cap, :math:`\sqrt{r^2 - a^2}`, m.
     volume_residual : numpy.ndarray or float
-        ``|V_cyl - V_cap,i - V_cap,j| / V_cyl``, how far the neck is from conserving volume (eq. 22),
+        :math:`|V_{cyl} - V_{cap,i} - V_{cap,j}| / V_{cyl}`, how far the neck is from conserving volume (eq. 22),
         dimensionless: round-off for ``"newton"``, the model's error for ``"first"`` and ``"coble"``.
     iterations : int
         Newton iterations taken (0 for ``"coble"``, 1 for ``"first"``).
@@ -135,12 +140,13 @@ def check_positive(name: str, value, upper=None, upper_name: str | None = None) 
 
 
 def cap_height(r, a):
-    """Height of the spherical cap of radius ``r`` with base radius ``a``, ``r - sqrt(r^2 - a^2)`` (Rojek 2022,
+    r"""Height of the spherical cap of radius ``r`` with base radius ``a``, :math:`r - \sqrt{r^2 - a^2}` (Rojek 2022,
     eqs. 28-29).
 
-    Written as ``a q / (1 + sqrt((1 - q)(1 + q)))`` with ``q = a / r`` (``= a^2 / (r + sqrt(r^2 - a^2))``): small
-    caps keep full relative precision and no square of a length is formed, so any radius a float holds works.
-    Not checked: the caller keeps ``0 <= a <= r`` (for ``a > r`` the result, ``a^2 / r``, is no cap height).
+    Written as :math:`a q / (1 + \sqrt{(1 - q)(1 + q)})` with :math:`q = a / r` (:math:`= a^2 / (r + \sqrt{r^2 -
+    a^2})`): small caps keep full relative precision and no square of a length is formed, so any radius a float holds
+    works. Not checked: the caller keeps ``0 <= a <= r`` (for ``a > r`` the result, :math:`a^2 / r`, is no cap
+    height).
 
     Parameters
     ----------
@@ -189,10 +195,10 @@ def max_overlap(r_i, r_j):
 
 
 def overlap_for_neck(r_i, r_j, a):
-    """Inverse of the volume-conserving neck: the overlap ``h`` at which the neck radius is ``a``.
+    r"""Inverse of the volume-conserving neck: the overlap ``h`` at which the neck radius is ``a``.
 
-    From ``G(a) = 0`` (eq. 27 divided by ``3 a^2``, module docstring): ``h = phi(h_ci) + phi(h_cj)``; for equal
-    spheres ``h = 2 h_c (3r - 2h_c) / (3 (2r - h_c))``, which is eq. (18) solved for ``h``.
+    From :math:`G(a) = 0` (eq. 27 divided by :math:`3 a^2`, module docstring): :math:`h = \phi(h_{ci}) + \phi(h_{cj})`;
+    for equal spheres :math:`h = 2 h_c (3r - 2h_c) / (3 (2r - h_c))`, which is eq. (18) solved for ``h``.
 
     Parameters
     ----------
@@ -204,7 +210,7 @@ def overlap_for_neck(r_i, r_j, a):
     Returns
     -------
     float or numpy.ndarray
-        The overlap ``h = r_i + r_j - d`` (eq. 21), m; a float for scalar input.
+        The overlap :math:`h = r_i + r_j - d` (eq. 21), m; a float for scalar input.
 
     Raises
     ------
@@ -219,7 +225,7 @@ def overlap_for_neck(r_i, r_j, a):
 
 
 def coble_radius(r_i, r_j, h):
-    """Coble's neck radius ``sqrt(2 r* h)``, ``r* = 2 r_i r_j / (r_i + r_j)`` (Rojek 2022, eqs. 11-12).
+    r"""Coble's neck radius :math:`\sqrt{2 r^* h}`, :math:`r^* = 2 r_i r_j / (r_i + r_j)` (Rojek 2022, eqs. 11-12).
 
     Not checked (:func:`neck_radius` with ``method="coble"`` checks its input); it does not conserve volume and
     over-estimates the neck (eqs. 10-12).
@@ -229,7 +235,7 @@ def coble_radius(r_i, r_j, h):
     r_i, r_j : float or array_like
         Radii of the two spheres, m; arrays broadcast.
     h : float or array_like
-        Overlap ``r_i + r_j - d`` (eq. 21), m.
+        Overlap :math:`r_i + r_j - d` (eq. 21), m.
 
     Returns
     -------
@@ -240,10 +246,10 @@ def coble_radius(r_i, r_j, h):
 
 
 def equal_neck_radius(r, h):
-    """Closed-form volume-conserving neck of two equal spheres (Rojek 2022, eqs. 18-20).
+    r"""Closed-form volume-conserving neck of two equal spheres (Rojek 2022, eqs. 18-20).
 
-    The small root of eq. (18) (eq. 19) is written as ``2c / (b + sqrt(b^2 - 16c))`` with the discriminant
-    factorised, ``9(2r+h)^2 - 96rh = (2r - 3h)(18r - 3h)``, so it is accurate for small and for limiting overlaps
+    The small root of eq. (18) (eq. 19) is written as :math:`2c / (b + \sqrt{b^2 - 16c})` with the discriminant
+    factorised, :math:`9(2r+h)^2 - 96rh = (2r - 3h)(18r - 3h)`, so it is accurate for small and for limiting overlaps
     alike; the neck radius is then eq. (20). Not checked: :func:`neck_radius` of two equal radii gives the same
     neck with its input checked.
 
@@ -252,7 +258,7 @@ def equal_neck_radius(r, h):
     r : float or array_like
         Radius of both spheres, m.
     h : float or array_like
-        Overlap ``2r - d`` (eq. 13), m, ``0 < h <= 2r/3`` (at ``2r/3`` the neck reaches ``a = r``).
+        Overlap :math:`2r - d` (eq. 13), m, :math:`0 < h \le 2r/3` (at :math:`2r/3` the neck reaches :math:`a = r`).
 
     Returns
     -------
@@ -304,14 +310,15 @@ def _validated(r_i, r_j, h):
 
 
 def newton_start(r_i, r_j, h, h_max):
-    """Start of the Newton iteration for ``"newton"``, in units of the smaller radius: a cheap root of a cubic model
-    of ``G`` in ``u = a^2`` that is exact at both ends of the range.
+    r"""Start of the Newton iteration for ``"newton"``, in units of the smaller radius: a cheap root of a cubic model
+    of ``G`` in :math:`u = a^2` that is exact at both ends of the range.
 
-    ``G(u) = c1 u + c2 u^2 + O(u^3) - h`` with ``c1 = (1/r_i + 1/r_j)/4`` (Coble's linearisation, eq. 11) and
-    ``c2 = (1/r_i^3 + 1/r_j^3)/24``; the model ``c1 u + c2 u^2 + c3 u^3`` takes ``c3`` so that ``u = 1`` gives
-    ``h_max``. Its root is approximated by the root of the quadratic ``c1 u + (h_max - c1) u^2 = h`` (also exact at
-    both ends) and one Newton step on the cubic. The start is within ~1 % of the root over the whole range
-    (Coble's within ~10 %), which saves two of the six Newton iterations Coble's start needs.
+    :math:`G(u) = c_1 u + c_2 u^2 + O(u^3) - h` with :math:`c_1 = (1/r_i + 1/r_j)/4` (Coble's linearisation, eq. 11) and
+    :math:`c_2 = (1/r_i^3 + 1/r_j^3)/24`; the model :math:`c_1 u + c_2 u^2 + c_3 u^3` takes :math:`c_3` so that
+    :math:`u = 1` gives :math:`h_{max}`. Its root is approximated by the root of the quadratic
+    :math:`c_1 u + (h_{max} - c_1) u^2 = h` (also exact at both ends) and one Newton step on the cubic. The start is
+    within ~1 % of the root over the whole range (Coble's within ~10 %), which saves two of the six Newton iterations
+    Coble's start needs.
 
     Parameters
     ----------

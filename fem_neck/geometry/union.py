@@ -1,4 +1,4 @@
-"""The union of spheres: a geometry of sintered particles defined at every density.
+r"""The union of spheres: a geometry of sintered particles defined at every density.
 
 The pair-neck models of :mod:`fem_neck.geometry` (Rojek 2022, eqs. 21-34) describe one neck between two spheres;
 once two necks of one particle meet they have no answer. The *union of the spheres* has one at every density: it is
@@ -8,32 +8,35 @@ the spheres, which partitions space, and the union of the balls meets the power 
 alone. It is also how a packing fitted to X-ray tomography (centres and radii of overlapping spheres) reads.
 
 **A neck** of the union is the circle where two spheres meet (:func:`lens`): with the centre distance ``d``, the
-radical plane lies at ``l_i = (d^2 + r_i^2 - r_j^2) / (2 d)`` from centre ``i`` (``l_j = d - l_i``) and the circle
-has the radius ``a = sqrt(r_i^2 - l_i^2)`` (Zohdi 2014, eqs. 7-12 use the same lens). Second neighbours that
-overlap are necks too. A neck is seen from its particle's centre as a cone of half-angle
-``atan2(a, l)`` (:func:`angular_radius`); two necks of one particle *meet* when their cones overlap
+radical plane lies at :math:`l_i = (d^2 + r_i^2 - r_j^2) / (2 d)` from centre ``i`` (:math:`l_j = d - l_i`) and the
+circle has the radius :math:`a = \sqrt{r_i^2 - l_i^2}` (Zohdi 2014, eqs. 7-12 use the same lens). Second neighbours
+that overlap are necks too. A neck is seen from its particle's centre as a cone of half-angle
+:math:`\arctan(a / l)` (:func:`angular_radius`); two necks of one particle *meet* when their cones overlap
 (:func:`necks_meet`), which is where the pair-neck models end.
 
 **Volumes and areas** (:func:`cut_spheres`). The cut sphere ``k`` (ball ``k`` and the half-spaces
-``n_b . (x - x_k) <= l_b`` of its necks) is convex, and by the divergence theorem with the origin at its centre
-its volume is ``V = (r A_free + sum_b l_b A_b) / 3``, where ``A_free`` is the area of its spherical surface left
-and ``A_b`` the area of its flat face ``b`` (the disk of neck ``b`` less what other faces cut off). With the centre
-inside the cut sphere (every ``l_b > 0``), the faces and the free surface are seen from the centre in disjoint solid
-angles that fill the sphere, so ``A_free = r^2 (4 pi - sum_b Omega_b)``. Each face is a convex polygon (the
+:math:`n_b \cdot (x - x_k) \le l_b` of its necks) is convex, and by the divergence theorem with the origin at its
+centre its volume is :math:`V = (r A_{free} + \sum_b l_b A_b) / 3`, where :math:`A_{free}` is the area of its
+spherical surface left and :math:`A_b` the area of its flat face ``b`` (the disk of neck ``b`` less what other faces
+cut off). With the centre inside the cut sphere (every :math:`l_b > 0`), the faces and the free surface are seen from
+the centre in disjoint solid angles :math:`\Omega_b` that fill the sphere, so
+:math:`A_{free} = r^2 (4 \pi - \sum_b \Omega_b)`. Each face is a convex polygon (the
 half-planes the other faces leave in its plane) intersected with its disk; its area and its solid angle are integrals
-over the face of functions of the distance ``rho`` from the foot of the centre's perpendicular, so they are sums over
-the polygon's edges of signed sectors around that foot, each integrated in closed form (the edge ``rho = p / cos
-phi``: ``int p^2 / (2 cos^2 phi) d phi = p^2 tan(phi) / 2`` for the area and ``int (1 - h cos(phi) / sqrt(h^2
-cos^2 phi + p^2)) d phi = phi - arcsin(h sin(phi) / sqrt(h^2 + p^2))`` for the solid angle, the circle ``rho = a``
-linear in ``phi``). The volumes are exact to round-off, and their sum is the volume of the union.
-These areas also give the derivatives that keep volumes under growth: moving face ``b`` outward by ``dl`` adds
-``A_b dl``, and growing the radius by ``dr`` adds ``A_free dr``.
+over the face of functions of the distance :math:`\rho` from the foot of the centre's perpendicular, so they are
+sums over the polygon's edges of signed sectors around that foot, each integrated in closed form (the edge
+:math:`\rho = p / \cos\varphi`: :math:`\int p^2 / (2 \cos^2\varphi) \, d\varphi = p^2 \tan(\varphi) / 2` for the
+area and :math:`\int \left(1 - h \cos\varphi / \sqrt{h^2 \cos^2\varphi + p^2}\right) d\varphi = \varphi -
+\arcsin\left(h \sin\varphi / \sqrt{h^2 + p^2}\right)` for the solid angle, the circle :math:`\rho = a` linear
+in :math:`\varphi`). The volumes are exact to round-off, and their sum is the volume of the union.
+These areas also give the derivatives that keep volumes under growth: moving face ``b`` outward by :math:`dl` adds
+:math:`A_b \, dl`, and growing the radius by :math:`dr` adds :math:`A_{free} \, dr`.
 
-Where necks do not meet, the cut sphere is the sphere less its caps, ``V = 4/3 pi r^3 - sum_b pi (r - l_b)^2 (2 r +
-l_b) / 3``, and this is what the kernel computes for such particles.
+Where necks do not meet, the cut sphere is the sphere less its caps,
+:math:`V = \frac{4}{3} \pi r^3 - \sum_b \pi (r - l_b)^2 (2 r + l_b) / 3`, and this is what the kernel computes for
+such particles.
 
-The range: two spheres have a neck for ``|r_i - r_j| < d < r_i + r_j``; the cut sphere needs its centre on its own
-side of every radical plane, ``l_b > 0`` (``d^2 > r_j^2 - r_i^2``: the centre of the smaller sphere outside the
+The range: two spheres have a neck for :math:`|r_i - r_j| < d < r_i + r_j`; the cut sphere needs its centre on its own
+side of every radical plane, :math:`l_b > 0` (:math:`d^2 > r_j^2 - r_i^2`: the centre of the smaller sphere outside the
 larger), as the lens of :mod:`dem.geometry.bonds` does.
 """
 
@@ -57,7 +60,7 @@ class Lens:
         Radius of the circle where the two spheres meet, m.
     l_i, l_j : numpy.ndarray or float
         Distances from centre ``i`` and from centre ``j`` to the radical plane that holds the circle, m
-        (``l_i + l_j = d``).
+        (:math:`l_i + l_j = d`).
     """
 
     a: np.ndarray
@@ -101,9 +104,9 @@ def lens(r_i, r_j, d) -> Lens:
 
 
 def angular_radius(a, l):
-    """Half-angle of the cone in which a neck is seen from its particle's centre: ``atan2(a, l)``. For a pair neck
-    (:mod:`fem_neck.geometry`) the circle on the sphere lies at ``l = sqrt(r^2 - a^2)``, so the angle is
-    ``arcsin(a / r)``.
+    r"""Half-angle of the cone in which a neck is seen from its particle's centre: :math:`\arctan(a / l)`. For a pair
+    neck (:mod:`fem_neck.geometry`) the circle on the sphere lies at :math:`l = \sqrt{r^2 - a^2}`, so the angle is
+    :math:`\arcsin(a / r)`.
 
     Parameters
     ----------
@@ -145,7 +148,7 @@ class CutSpheres:
 
 
 def cut_spheres(radius, i, j, vectors) -> CutSpheres:
-    """Cut every sphere by the radical planes of its necks (module docstring).
+    r"""Cut every sphere by the radical planes of its necks (module docstring).
 
     Parameters
     ----------
@@ -155,14 +158,14 @@ def cut_spheres(radius, i, j, vectors) -> CutSpheres:
         The overlapping pairs, integer indices (each pair once; ``j`` may be a periodic image of a particle, given by
         ``vectors``).
     vectors : numpy.ndarray
-        ``x_j - x_i`` of every pair (one row each), m: the image's in a periodic packing.
+        :math:`x_j - x_i` of every pair (one row each), m: the image's in a periodic packing.
 
     Returns
     -------
     CutSpheres
         Volumes, free areas, whether necks meet, per particle; face areas per bond. ``ValueError`` for a pair that
-        does not overlap, one sphere holding the other, or a centre beyond a radical plane (``d^2 <= r_j^2 -
-        r_i^2``), naming the first.
+        does not overlap, one sphere holding the other, or a centre beyond a radical plane
+        (:math:`d^2 \le r_j^2 - r_i^2`), naming the first.
     """
     radius = check_positive("radius", np.asarray(radius, dtype=float).reshape(-1))
     i = np.asarray(i, dtype=np.int64).reshape(-1)

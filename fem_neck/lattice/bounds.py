@@ -13,7 +13,7 @@ from sinterheat.threads import one_blas_thread
 
 @dataclass(frozen=True)
 class Bounds:
-    """Both bounds of one mesh (:func:`solve_bounds`), as ``k / kappa`` of the cell (dimensionless).
+    r"""Both bounds of one mesh (:func:`solve_bounds`), as :math:`k / \kappa` of the cell (dimensionless).
 
     Parameters
     ----------
@@ -79,10 +79,10 @@ def _dual_receiving(mesh, order: int, hot, cold, etol: float):
 
 
 def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2, etol: float | None = None) -> Bounds:
-    """Upper and lower bound of the cell's ``k / kappa`` on the mesh ``cm`` (:mod:`fem_neck.lattice`), the two solves in
-    parallel processes when ``workers >= 2`` (the lower bound assembles its system while the upper bound solves,
-    then starts its CG from the upper bound's temperature). Both integrate the curved elements at the same points,
-    where the elements are mapped once. Both CGs stop when their energy has settled to ``etol`` (default
+    r"""Upper and lower bound of the cell's :math:`k / \kappa` on the mesh ``cm`` (:mod:`fem_neck.lattice`), the two
+    solves in parallel processes when ``workers >= 2`` (the lower bound assembles its system while the upper bound
+    solves, then starts its CG from the upper bound's temperature). Both integrate the curved elements at the same
+    points, where the elements are mapped once. Both CGs stop when their energy has settled to ``etol`` (default
     ``fem_neck.primal.ENERGY_RTOL``).
 
     Parameters

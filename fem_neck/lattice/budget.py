@@ -100,13 +100,14 @@ def neck_circles(cell: PeriodicCell, samples: int = 360) -> NeckCircles:
 
 
 def predicted_tetrahedra(circles: NeckCircles, size_neck: float) -> float:
-    """Tetrahedra of the mesh of neck size ``size_neck`` (:func:`~fem_neck.lattice.sizes.mesh_sizes`), predicted before
-    meshing, on the safe side. A mesh of local size ``h(x)`` has about ``int dV / h^3`` tetrahedra up to a constant.
-    Around a neck circle of radius ``a`` the size is ``s + GRADING rho`` at the distance ``rho`` (``s = min(size_neck a,
-    h_n)``, :func:`fem_neck.cluster.neck_size_fields`) up to ``U = SIZE_FAR r_min``, so the circle adds ``a (1 / (2 s) -
-    1 / U + s / (2 U^2))`` times a constant (the solid's angle around it over ``GRADING^2``); the rest of the solid adds
-    its volume over ``SIZE_FAR^3``. The two constants are measured (``TETRAHEDRA_PER_CIRCLE``,
-    ``TETRAHEDRA_PER_VOLUME``), times ``PREDICTION_MARGIN``.
+    r"""Tetrahedra of the mesh of neck size ``size_neck`` (:func:`~fem_neck.lattice.sizes.mesh_sizes`), predicted before
+    meshing, on the safe side. A mesh of local size :math:`h(x)` has about :math:`\int dV / h^3` tetrahedra up to a
+    constant. Around a neck circle of radius ``a`` the size is :math:`s + G \rho` at the distance :math:`\rho`
+    (``GRADING`` G, :math:`s = \min(s_n a, h_n)` with ``size_neck`` :math:`s_n`,
+    :func:`fem_neck.cluster.neck_size_fields`) up to :math:`U = F r_{min}` (``SIZE_FAR`` F), so the circle adds
+    :math:`a \left(1 / (2 s) - 1 / U + s / (2 U^2)\right)` times a constant (the solid's angle around it over
+    :math:`G^2`); the rest of the solid adds its volume over :math:`F^3`. The two constants are measured
+    (``TETRAHEDRA_PER_CIRCLE``, ``TETRAHEDRA_PER_VOLUME``), times ``PREDICTION_MARGIN``.
 
     Parameters
     ----------

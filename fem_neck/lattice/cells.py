@@ -80,9 +80,9 @@ class PeriodicCell:
 
     @property
     def phi(self) -> float:
-        """Solid volume fraction ``sum 4/3 pi r^3 / |period|`` (exact: the necks conserve each particle's volume);
-        read as the union of the spheres, the sum of the volumes of the spheres cut by their radical planes over
-        ``|period|`` (:func:`fem_neck.geometry.union.cut_spheres`, exact)."""
+        r"""Solid volume fraction :math:`\sum \frac{4}{3} \pi r^3 / |P|` over the period's volume :math:`|P|` (exact:
+        the necks conserve each particle's volume); read as the union of the spheres, the sum of the volumes of the
+        spheres cut by their radical planes over ``|period|`` (:func:`fem_neck.geometry.union.cut_spheres`, exact)."""
         if self.neck == "union":
             i, j, s = self.bonds()
             vectors = self.centres[j] + s * self.period - self.centres[i]
@@ -153,7 +153,7 @@ def lattice_cell(kind: str, h_over_r: float, radius: float = 1.0, neck: str = "n
 
 
 def max_neck_ratio(kind: str) -> float:
-    """Largest ``a/r`` of a cubic lattice: the neck circles of one particle touch at ``a/r = sin(theta/2)``.
+    r"""Largest ``a/r`` of a cubic lattice: the neck circles of one particle touch at :math:`a/r = \sin(\theta/2)`.
 
     Parameters
     ----------
@@ -175,9 +175,10 @@ def max_h_over_r(kind: str) -> float:
 
 
 def union_max_h_over_r(kind: str) -> float:
-    """``h/r`` at which the union of the lattice's spheres fills space: the neighbour distance at which the radius
-    is the lattice's covering radius (SC: the cube's half diagonal, ``d = 2r / sqrt(3)``, h/r = 0.8453; BCC: ``sqrt(5)
-    / 4`` of the cube edge, ``d = 2 sqrt(3 / 5) r``, 0.4508; FCC: half the cube edge, ``d = sqrt(2) r``, 0.5858).
+    r""":math:`h/r` at which the union of the lattice's spheres fills space: the neighbour distance at which the radius
+    is the lattice's covering radius (SC: the cube's half diagonal, :math:`d = 2r / \sqrt{3}`, :math:`h/r` = 0.8453;
+    BCC: :math:`\sqrt{5} / 4` of the cube edge, :math:`d = 2 \sqrt{3 / 5} \, r`, 0.4508; FCC: half the cube edge,
+    :math:`d = \sqrt{2} \, r`, 0.5858).
 
     Parameters
     ----------
@@ -189,8 +190,8 @@ def union_max_h_over_r(kind: str) -> float:
 
 
 def union_neck_ratio(h_over_r: float) -> float:
-    """``a/r`` of the circle where two equal spheres meet: ``a^2 = r h - h^2 / 4`` (:func:`fem_neck.geometry.union.lens`
-    at ``d = 2r - h``).
+    """:math:`a/r` of the circle where two equal spheres meet: :math:`a^2 = r h - h^2 / 4`
+    (:func:`fem_neck.geometry.union.lens` at :math:`d = 2r - h`).
 
     Parameters
     ----------
@@ -232,8 +233,8 @@ def check_h_over_r(kind: str, h_over_r: float, neck: str = "newton") -> float:
 
 
 def check_cell(cell: PeriodicCell, method: str = "newton") -> None:
-    """Raise ``ValueError`` unless some particles overlap and, read as pair necks, every bond's overlap lies in the
-    neck model's range and no two necks of one particle touch (their circles, of angular radius ``arcsin(a/r)``,
+    r"""Raise ``ValueError`` unless some particles overlap and, read as pair necks, every bond's overlap lies in the
+    neck model's range and no two necks of one particle touch (their circles, of angular radius :math:`\arcsin(a/r)`,
     must stay apart on the sphere), or, read as the union of the spheres, no sphere lies inside another.
 
     Parameters

@@ -24,7 +24,7 @@ ALGEBRAIC_SHARE = 1e-3
 
 @dataclass
 class CellResult:
-    """Effective conductivity of a periodic cell (:mod:`fem_neck.lattice`, :func:`effective_conductivity`); the values
+    r"""Effective conductivity of a periodic cell (:mod:`fem_neck.lattice`, :func:`effective_conductivity`); the values
     are the last mesh's. Conductivities are over the particles' ``kappa`` (dimensionless).
 
     Parameters
@@ -38,7 +38,7 @@ class CellResult:
     converged : bool
         Whether ``error_estimate`` met the tolerance asked for.
     phi : float
-        Solid volume fraction (also the Wiener bound of ``k_eff / kappa``).
+        Solid volume fraction (also the Wiener bound of :math:`k_{eff} / \kappa`).
     order : int
         Order ``p`` of the upper bound's elements.
     dofs : int
@@ -86,17 +86,17 @@ def _refined_rtol(gap: float, size: float, new: float, neck: str = "newton") -> 
 def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | None = None,
                            max_memory: float | None = None, max_meshes: int = 4, workers: int = 2,
                            progress=None) -> CellResult:
-    """``k_eff / kappa`` along z of the periodic ``cell`` with two-sided bounds (:mod:`fem_neck.lattice`).
+    r""":math:`k_{eff} / \kappa` along z of the periodic ``cell`` with two-sided bounds (:mod:`fem_neck.lattice`).
 
     The first mesh has the neck size :func:`~fem_neck.lattice.sizes.first_neck_size` (from ``rtol`` and the cell's mean
     neck); while the bounds are more than ``rtol`` apart it predicts the neck size that meets ``rtol`` (the gap falls
-    like ``size_neck^GAP_ORDER``) and solves there, at most ``max_meshes`` meshes. Before each mesh is made, its
-    tetrahedra are predicted (:func:`~fem_neck.lattice.budget.predicted_tetrahedra`, on the safe side; from the second
-    mesh on scaled up if a mesh had more) and the memory of its solve estimated
-    (:func:`~fem_neck.lattice.budget.memory_estimate`): one that would not fit in ``max_memory`` bytes (default: what
-    the machine has available) is refused with a ``ValueError`` naming the estimate and the ``rtol`` that would fit. A
-    mesh too coarse for the curvature of its surfaces (a curved element folds, :class:`fem_neck.curved.FoldedMesh`) is
-    followed by one twice as fine.
+    like :math:`s_n^{\mathrm{GAP\_ORDER}}` in ``size_neck`` :math:`s_n`) and solves there, at most ``max_meshes``
+    meshes. Before each mesh is made, its tetrahedra are predicted
+    (:func:`~fem_neck.lattice.budget.predicted_tetrahedra`, on the safe side; from the second mesh on scaled up if a
+    mesh had more) and the memory of its solve estimated (:func:`~fem_neck.lattice.budget.memory_estimate`): one that
+    would not fit in ``max_memory`` bytes (default: what the machine has available) is refused with a ``ValueError``
+    naming the estimate and the ``rtol`` that would fit. A mesh too coarse for the curvature of its surfaces (a curved
+    element folds, :class:`fem_neck.curved.FoldedMesh`) is followed by one twice as fine.
 
     Parameters
     ----------

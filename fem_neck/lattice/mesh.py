@@ -13,7 +13,7 @@ from fem_neck.lattice.cells import PeriodicCell, mirror_symmetry
 
 @dataclass
 class CellMesh:
-    """The meshed computational cell (:func:`build_cell_mesh`). Lengths in units of the largest radius ``unit``.
+    r"""The meshed computational cell (:func:`build_cell_mesh`). Lengths in units of the largest radius ``unit``.
 
     Parameters
     ----------
@@ -26,8 +26,8 @@ class CellMesh:
     area : float
         Cross-section of the cell normal to z (in units of ``unit`` squared).
     wedge : float
-        The fraction of the half-period box meshed: 1, 1/2 (the wedge ``y <= x``) or 1/4 (with also
-        ``x + y <= P/2``).
+        The fraction of the half-period box meshed: 1, 1/2 (the wedge :math:`y \le x`) or 1/4 (with also
+        :math:`x + y \le P/2`).
     volume_exact : float
         The exact volume of the solid in the cell (in units of ``unit`` cubed).
     volume_cad : float
@@ -51,8 +51,8 @@ class CellMesh:
 
 
 def local_cluster(cell: PeriodicCell, box: np.ndarray):
-    """The particle images whose spheres or necks can reach the box ``[0, box]``, with their bonds, as a
-    :class:`fem_neck.cluster.Cluster` (a neck point lies within ``sqrt(2) r_max`` of its nearer centre).
+    r"""The particle images whose spheres or necks can reach the box ``[0, box]``, with their bonds, as a
+    :class:`fem_neck.cluster.Cluster` (a neck point lies within :math:`\sqrt{2} \, r_{max}` of its nearer centre).
 
     Parameters
     ----------
@@ -113,7 +113,7 @@ def _reaches(halfspaces: list, points: np.ndarray, radius: np.ndarray) -> np.nda
 
 @dataclass(frozen=True)
 class CellFrame:
-    """What the mesh of a cell is built from, before any meshing. Lengths in units of ``unit``.
+    r"""What the mesh of a cell is built from, before any meshing. Lengths in units of ``unit``.
 
     Parameters
     ----------
@@ -134,7 +134,7 @@ class CellFrame:
     diagonal : bool
         Whether the cell is the wedge ``y <= x`` of the box (symmetry under ``x <-> y``).
     anti : bool
-        Whether it is also cut by ``x + y <= P/2`` (the face-centred cubic symmetry).
+        Whether it is also cut by :math:`x + y \le P/2` (the face-centred cubic symmetry).
     fraction : float
         The fraction of the box the cell is (1, 1/2 or 1/4).
     solid_volume : float
@@ -214,7 +214,7 @@ def union_necks(local) -> UnionNecks:
 
 def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, grading: float,
                     curvature: int = 12, neck_cells: float = 1.0, method: str = "newton") -> CellMesh:
-    """Mesh the computational cell (:mod:`fem_neck.lattice`): the union of the spheres and necks that reach it, cut to
+    r"""Mesh the computational cell (:mod:`fem_neck.lattice`): the union of the spheres and necks that reach it, cut to
     the cell, graded toward every neck circle (``size_neck a`` at the circles, growing by ``grading`` per unit distance
     up to ``size_far r``; :func:`fem_neck.cluster.neck_size_fields`), its boundary classified onto the exact spheres,
     cylinders and planes (:mod:`fem_neck.curved`). Lengths are scaled to the largest radius.
@@ -230,7 +230,7 @@ def build_cell_mesh(cell: PeriodicCell, size_neck: float, size_far: float, gradi
     grading : float
         Growth of the element size per unit distance from a neck circle (dimensionless).
     curvature : int
-        gmsh's elements per 2 pi of surface curvature.
+        gmsh's elements per :math:`2 \pi` of surface curvature.
     neck_cells : float
         Elements along a neck's length at least.
     method : str

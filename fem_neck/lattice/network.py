@@ -9,9 +9,10 @@ from fem_neck.lattice.cells import PeriodicCell
 
 
 def network_conductivity(cell: PeriodicCell, pair_conductance) -> float:
-    """``k_zz / kappa`` of the pipe network on the cell's bonds when every particle's temperature follows the
-    uniform gradient (exact for lattices, whose bond stars are centrosymmetric): ``sum_b K_b dz_b^2 / |period|``.
-    ``pair_conductance(r_i, r_j, a)`` gives the bond conductances for kappa = 1.
+    r""":math:`k_{zz} / \kappa` of the pipe network on the cell's bonds when every particle's temperature follows the
+    uniform gradient (exact for lattices, whose bond stars are centrosymmetric): :math:`\sum_b K_b \, dz_b^2 / |P|`
+    over the period's volume :math:`|P|`. ``pair_conductance(r_i, r_j, a)`` gives the bond conductances for
+    :math:`\kappa = 1`.
 
     Parameters
     ----------

@@ -77,9 +77,10 @@ def _neck_factor(neck_ratio: float, order: int, neck: str = "newton", pore: floa
 
 def first_neck_size(rtol: float, neck_ratio: float, order: int, neck: str = "newton",
                     pore: float = UNION_PORE0) -> float:
-    """Neck size of the first mesh of a cell: the size whose gap is predicted at ``margin rtol`` (``FIRST_MESH``:
-    ``rtol0`` at ``size0`` for ``a / r = NECK0``, the gap falling like ``size^GAP_ORDER`` and like ``(a /
-    r)^-neck_order``; the union's ``UNION_*``, its gap also falling with the pore fraction), within ``FIRST_SIZES``.
+    r"""Neck size of the first mesh of a cell: the size whose gap is predicted at ``margin rtol`` (``FIRST_MESH``:
+    ``rtol0`` at ``size0`` for :math:`a / r` = ``NECK0``, the gap falling like the size to the power ``GAP_ORDER`` and
+    like :math:`a / r` to the power ``-neck_order``; the union's ``UNION_*``, its gap also falling with the pore
+    fraction), within ``FIRST_SIZES``.
 
     Parameters
     ----------
@@ -92,7 +93,7 @@ def first_neck_size(rtol: float, neck_ratio: float, order: int, neck: str = "new
     neck : str
         The cell's reading (``NECKS``).
     pore : float
-        The cell's pore fraction ``1 - phi`` (read as the union only).
+        The cell's pore fraction :math:`1 - \phi` (read as the union only).
     """
     first_mesh, gap_order, _, _, first_sizes = mesh_rule(neck)
     size0, rtol0, _, margin = first_mesh[order]
