@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dem.engines import engine_class
-from dem.network.comm import launched, on_root, world
+from dem.parallel.comm import launched, on_root, world
 from dem.output import folder as run_folder
 from dem.output.writer import RunWriter, write_summary
 from dem.scene import Scene
@@ -219,7 +219,7 @@ def _run_distributed(scene: Scene, out, progress: bool, resume: bool, overwrite:
     ``RunResult.T`` holds the temperatures of the particles this rank owns (``engine.owned``: their indices); no
     ``state.npz`` and no plots (they need every particle in one process)."""
     from dem.engines.distributed.engine import DistributedStaticEngine, unsupported
-    from dem.network import comm as mpi
+    from dem.parallel import comm as mpi
 
     why = unsupported(scene, resume)
     if why is not None:  # before MPI is touched: a refused run costs nothing

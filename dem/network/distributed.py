@@ -1,5 +1,5 @@
 """The heat network of a packing shared out among MPI ranks: each rank's rows, the groups that span ranks, the steady
-solve and the theta-method steps, all on PETSc (:mod:`dem.network.petsc`).
+solve and the theta-method steps, all on PETSc (:mod:`dem.parallel.petsc`).
 
 Each rank holds the particles it owns and a halo (:mod:`dem.geometry.partition`), and a
 :class:`dem.network.heat.Network` of them whose bonds are those with at least one owned particle. An owned particle
@@ -24,10 +24,10 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from dem.network import comm as mpi
+from dem.parallel import comm as mpi
 from dem.network.heat import (INTEGRATORS, STARTUP_STEPS, Network, balancing_shift, refuse_energy_error,
                               refuse_out_of_range, surely_stiff)
-from dem.network.petsc import PetscSolver, matrix
+from dem.parallel.petsc import PetscSolver, matrix
 
 
 @dataclass
@@ -96,7 +96,7 @@ class DistributedNetwork:
 
     # ------------------------------------------------------------------------------------------- reductions
     def total(self, value):
-        """Sum over ranks (:func:`dem.network.comm.total`).
+        """Sum over ranks (:func:`dem.parallel.comm.total`).
 
         Parameters
         ----------
@@ -229,7 +229,7 @@ class DistributedNetwork:
 
         Returns
         -------
-        dem.network.petsc.PetscSolver
+        dem.parallel.petsc.PetscSolver
             The solver.
         """
         return PetscSolver(matrix(self.comm, self.rows(M, row), n_global), rtol)

@@ -33,7 +33,7 @@ from dem.engines.static import CSV_FLOWS, StaticEngine, boundary_summary
 from dem.geometry.necks import meeting_in
 from dem.geometry.partition import HALO_MARGIN, bisection, halo
 from dem.laws.verified_range import neck_account, wide_necks
-from dem.network import comm as mpi
+from dem.parallel import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
 from dem.network.distributed import DistributedNetwork
 from dem.network.heat import Network, bonds_and_conductances

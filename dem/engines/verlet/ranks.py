@@ -54,8 +54,8 @@ import os
 
 import numpy as np
 
-from dem.network import comm as mpi
-from dem.network.comm import world
+from dem.parallel import comm as mpi
+from dem.parallel.comm import world
 from dem.network.distributed import DistributedNetwork
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.decomposition import Slabs
@@ -210,7 +210,7 @@ class RankMechanics(MechanicalModel):
         dest = self.slabs.owner(s.x)
         rows = np.column_stack([self._pack(self._arrays(), np.arange(s.n)), self.gid])
         owned = np.flatnonzero(self.owned)
-        r_max = comm.allreduce(float(np.max(s.radius[owned], initial=0.0)), op=_max())
+        r_max = mpi.maximum(comm, float(np.max(s.radius[owned], initial=0.0)))
         own_rows = rows[owned[dest[owned] == self.rank]]
         if not first:  # the particles that left the slab to their new owners; pair histories to both partners'
             leaving = [rows[owned[dest[owned] == r]] if r != self.rank else rows[:0] for r in range(self.size)]
@@ -335,7 +335,7 @@ class RankMechanics(MechanicalModel):
         super()._initial_forces()
         w = self.w
         if len(w.force):
-            w.force[:] = self.comm.allreduce(w.force, op=_sum())
+            w.force[:] = self.comm.allreduce(w.force, op=mpi.reduction("SUM"))
             for m in range(len(self.walls)):
                 w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
         self._refresh_ghosts()
@@ -389,7 +389,7 @@ class RankMechanics(MechanicalModel):
         w = self.w
         failed = status in (NONFINITE, ESCAPED)
         total = np.concatenate([[status == REBUILD, failed], w.force])
-        self.comm.Allreduce(total.copy(), total, op=_sum())  # buffers, not pickles: once per step
+        self.comm.Allreduce(total.copy(), total, op=mpi.reduction("SUM"))  # buffers, not pickles: once per step
         w.force[:] = total[2:]
         h = 0.5 * self.dt
         for m in np.flatnonzero(w.mode == 1):
@@ -455,18 +455,6 @@ class RankMechanics(MechanicalModel):
         view.x_ref = np.ascontiguousarray(x_ref)  # the positions the lists were built at, and the walls' list
         view.wk, view.wm = (np.ascontiguousarray(wall_list[:, c], dtype=np.int64) for c in (0, 1))
         return view
-
-
-def _max():
-    from mpi4py import MPI
-
-    return MPI.MAX
-
-
-def _sum():
-    from mpi4py import MPI
-
-    return MPI.SUM
 
 
 class RankContactThermal(ContactThermalModel):
@@ -634,7 +622,7 @@ class RankVerletEngine(VerletEngine):
             Called as ``checkpoint(make, final)``; None: not called.
         """
         mech = self.mechanics
-        gathered_checkpoints = mech.size > 1 and mech.comm.allreduce(int(checkpoint is not None), op=_max())
+        gathered_checkpoints = mech.size > 1 and mpi.maximum(mech.comm, int(checkpoint is not None))
 
         def checkpointed(make, final: bool = False) -> None:
             view = mech.gathered()
