@@ -64,12 +64,14 @@ from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_accelerati
 from dem.engines.verlet.mechanics import MechanicalModel, MechanicsError
 from dem.geometry.motion import MotionState
 from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
+from dem.output.pieces import refuse_lammps_dump
 from sinterheat import threads
 
 
 def refuse_unsupported(scene, ranks: int, restart: dict | None = None) -> None:
     """A ``ValueError`` naming what a run on ``ranks`` ranks cannot do with ``scene`` (``restart``: the checkpoint
-    it would resume from, which the same number of ranks must have written).
+    it would resume from, which the same number of ranks must have written). An engine other than ``verlet`` under
+    MPI is refused by the registry (:func:`dem.engines.engine_class`).
 
     Parameters
     ----------
@@ -85,9 +87,6 @@ def refuse_unsupported(scene, ranks: int, restart: dict | None = None) -> None:
     ValueError
         The scene or the checkpoint cannot run on ``ranks`` ranks.
     """
-    if scene.engine != "verlet":
-        raise ValueError(f"[solver] engine = {scene.engine!r}: under mpiexec run static packings and the verlet "
-                         f"engine (particles that move), not this one; run this scene without mpiexec")
     written = 1 if restart is None or "ranks" not in restart else int(restart["ranks"])
     if restart is not None and written != ranks:
         how = f"with mpiexec -n {written}" if written > 1 else "without mpiexec or with mpiexec -n 1"
@@ -520,6 +519,26 @@ class RankVerletEngine(VerletEngine):
     summary is the same everywhere."""
 
     mechanics_class = RankMechanics
+
+    @classmethod
+    def refuse(cls, scene, resume: bool) -> None:
+        """A LAMMPS dump on several ranks, refused before the run's folder is touched
+        (:func:`dem.output.pieces.refuse_lammps_dump`); a checkpoint of another number of ranks is refused once read
+        (:func:`refuse_unsupported`).
+
+        Parameters
+        ----------
+        scene : dem.scene.parse.Scene
+            The scene.
+        resume : bool
+            Whether the run would go on from a checkpoint.
+
+        Raises
+        ------
+        ValueError
+            The one-line reason.
+        """
+        refuse_lammps_dump(scene)
 
     def __init__(self, scene, restart: dict | None = None):
         """As :class:`VerletEngine`; unless told (``SINTERHEAT_THREADS``, ``--threads``), each rank's contact loop
