@@ -38,7 +38,9 @@ class RunResult:
     summary : dict
         The run's summary (JSON-ready; what ``summary.json`` holds).
     T : numpy.ndarray
-        Final particle temperatures, in the scene's temperature unit (``[scene] temperature_unit``), in input order.
+        Final particle temperatures, in the scene's temperature unit (``[scene] temperature_unit``), in input order;
+        with an engine whose ranks hold only their pieces (``engine.pieces_only``), those of the particles this rank
+        owns (``engine.owned``: their indices).
     engine : object
         The engine that ran (its ``name`` is the scene's engine).
     """
