@@ -1,5 +1,6 @@
 """The heat network of a packing shared out among MPI ranks: each rank's rows, the groups that span ranks, the steady
-solve and the theta-method steps, all on PETSc (:mod:`dem.parallel.petsc`).
+solve and the theta-method steps, all on PETSc (:mod:`dem.parallel.petsc`); a step is the serial one
+(:class:`dem.network.theta.ThetaStepper`) with the solve over the ranks plugged in (:class:`RankSolves`).
 
 Each rank holds the particles it owns and a halo (:mod:`dem.geometry.partition`), and a
 :class:`dem.network.heat.Network` of them whose bonds are those with at least one owned particle. An owned particle
