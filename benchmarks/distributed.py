@@ -70,7 +70,7 @@ def scaling_worker(n: int, scene_file: str | None = None) -> None:
         scene = make_scene(p.position, p.radius, p.temperature, fixed=p.fixed, law="rojek", mode="steady",
                            floating="mean", name="packing")
     else:
-        from dem.network.comm import world
+        from dem.parallel.comm import world
         from dem.scene import load_scene
 
         comm = world()

@@ -81,7 +81,7 @@ def main(argv=None) -> int:
         print(f"python -m benchmarks.ranks: --steps = {args.steps} must be >= 1 and --warmup = {args.warmup} >= 0",
               file=sys.stderr)
         return 2
-    from dem.network.comm import launched, on_root, world
+    from dem.parallel.comm import launched, on_root, world
     from sinterheat import threads
 
     comm = world() if launched() else None

@@ -1,6 +1,11 @@
 """One DEM run, whatever the engine: build the engine the scene names (:mod:`dem.engines`), run it, and own
 everything around it -- the run folder, the progress bar, Ctrl-C, checkpoints and ``--resume``, the outputs (one
 writer, :mod:`dem.output.writer`), ``state.npz`` and the summary.
+
+Under MPI (:func:`dem.parallel.comm.launched`) the registry gives the engine that shares the sample out among the
+ranks, and the run takes the same path: rank 0 prepares and holds the folder, shows the bar and writes the summary;
+on several ranks (or with an engine whose ranks hold only their pieces of the sample) every rank writes its piece
+of each snapshot (:class:`dem.output.pieces.PieceWriter`).
 """
 
 from __future__ import annotations
@@ -14,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dem.engines import engine_class
-from dem.network.comm import launched, on_root, world
+from dem.parallel.comm import launched, maximum, on_root, world
 from dem.output import folder as run_folder
 from dem.output.writer import RunWriter, write_summary
 from dem.scene import Scene
@@ -33,7 +38,9 @@ class RunResult:
     summary : dict
         The run's summary (JSON-ready; what ``summary.json`` holds).
     T : numpy.ndarray
-        Final particle temperatures, in the scene's temperature unit (``[scene] temperature_unit``), in input order.
+        Final particle temperatures, in the scene's temperature unit (``[scene] temperature_unit``), in input order;
+        with an engine whose ranks hold only their pieces (``engine.pieces_only``), those of the particles this rank
+        owns (``engine.owned``: their indices).
     engine : object
         The engine that ran (its ``name`` is the scene's engine).
     """
@@ -112,18 +119,10 @@ def run(scene: Scene, out=None, progress: bool = False, resume: bool = False, ov
     """
     if out is None and (resume or overwrite):
         raise ValueError("--resume and --overwrite need --out (the folder of the run)")
-    if launched() and scene.output.lammps_dump and world().Get_size() > 1:
-        raise ValueError("[output] lammps_dump = true: not written under MPI (each rank writes its piece of a VTU "
-                         "snapshot); run on one process, or convert a state with python -m dem convert")
-    if launched() and scene.engine == "static":  # under MPI a static packing's network is solved on PETSc
-        return _run_distributed(scene, out, progress, resume, overwrite)
-    comm = world() if launched() else None  # under MPI moving particles are shared by the ranks (their pieces)
-    cls = engine_class(scene.engine)
-    if comm is not None:
-        from dem.engines.verlet.ranks import RankVerletEngine, refuse_unsupported
-
-        refuse_unsupported(scene, comm.Get_size())
-        cls = RankVerletEngine
+    ranks = launched()  # under MPI the scene's engine shares its sample out among the ranks (dem.engines)
+    cls = engine_class(scene.engine, ranks)
+    cls.refuse(scene, resume)  # before MPI or the folder is touched: a refused run costs nothing
+    comm = world() if ranks else None
     root = comm is None or comm.Get_rank() == 0
     if out is not None:
         out, resume = on_root(comm, lambda: run_folder.prepare(out, resume, overwrite))
@@ -149,7 +148,7 @@ def _run_held(scene: Scene, out, progress: bool, resume: bool, comm, cls, root: 
     _announce(scene, progress and root)
     writer = None
     resume_step = engine.steps if resume else None
-    if out is not None and comm is not None and comm.Get_size() > 1:  # a piece of every snapshot per rank
+    if out is not None and comm is not None and (comm.Get_size() > 1 or engine.pieces_only):  # a piece per rank
         from dem.output.pieces import PieceWriter
 
         writer = PieceWriter(out, scene, engine, comm.Get_rank(), comm.Get_size(), resume_step)
@@ -177,10 +176,13 @@ def _run_held(scene: Scene, out, progress: bool, resume: bool, comm, cls, root: 
         _advance(engine, scene, bar, observed if writer is not None else (_nothing if out is not None else None),
                  advanced, checkpointer)
         summary = _summary(scene, engine, restart)
-        summary["seconds"] = time.perf_counter() - start
-        if writer is not None:
+        seconds = time.perf_counter() - start
+        summary["seconds"] = seconds if comm is None else maximum(comm, seconds)
+        if writer is not None and not engine.pieces_only:  # no process holds a piece-only sample's state
             summary["state"] = "state.npz"
             writer.finish(_with_state(summary, engine, out) if root else summary)
+        elif writer is not None:
+            writer.finish(summary)
     except KeyboardInterrupt:  # also while the run's last files are written: the folder says it was interrupted
         if writer is not None and root:
             if checkpointer is not None:
@@ -213,51 +215,6 @@ def _nothing():
     """The observer of a rank that writes nothing (rank 0 writes the run's folder)."""
 
 
-def _run_distributed(scene: Scene, out, progress: bool, resume: bool, overwrite: bool) -> RunResult:
-    """:func:`run` on several MPI ranks (:mod:`dem.engines.distributed`): every rank builds and solves its part;
-    rank 0 prepares the folder, shows the bar and writes the summary, every rank its pieces of the snapshots.
-    ``RunResult.T`` holds the temperatures of the particles this rank owns (``engine.owned``: their indices); no
-    ``state.npz`` and no plots (they need every particle in one process)."""
-    from dem.engines.distributed.engine import DistributedStaticEngine, unsupported
-    from dem.network import comm as mpi
-
-    why = unsupported(scene, resume)
-    if why is not None:  # before MPI is touched: a refused run costs nothing
-        raise ValueError(why)
-    comm = mpi.world()
-    rank = comm.Get_rank()
-    start = time.perf_counter()
-    if out is not None:
-        out = mpi.agree(comm, lambda: run_folder.prepare(out, False, overwrite)[0] if rank == 0 else None)
-        out = comm.bcast(out)
-    try:
-        engine = DistributedStaticEngine(scene)
-        _announce(scene, progress and rank == 0)
-        writer = None
-        if out is not None:
-            from dem.output.pieces import PieceWriter
-
-            writer = PieceWriter(out, scene, engine, rank, comm.Get_size())
-        bar = _progress_bar(scene, engine, progress and rank == 0)
-
-        def advanced(t):
-            if bar is not None:
-                bar.update(min(t - engine.t_start, bar.total) - bar.n)
-
-        _advance(engine, scene, bar, writer.observe if writer is not None else None, advanced, None)
-        summary = _summary(scene, engine, None)
-        summary.pop("T", None)
-        if scene.particle_count <= T_LIST_MAX:
-            summary["T"] = engine.gathered_temperatures().tolist()
-        summary["seconds"] = mpi.maximum(comm, time.perf_counter() - start)
-        if writer is not None:
-            writer.finish(summary)
-        return RunResult(summary, engine.temperatures(), engine)
-    finally:  # rank 0 holds the folder
-        if out is not None and rank == 0:
-            run_folder.unlock(out)
-
-
 def _summary(scene: Scene, engine, restart) -> dict:
     """The summary: the scene, the engine's findings, where the run resumed from, the final temperatures."""
     summary = {"scene": scene.name, "physics": list(scene.physics), "engine": engine.name, **engine.summary()}
@@ -265,14 +222,27 @@ def _summary(scene: Scene, engine, restart) -> dict:
         summary["resumed_from"] = {"t": float(restart["t"]), "steps": int(restart["steps"])}
     if scene.start is not None:
         summary["started_from"] = {"t": scene.start["t"], "steps": scene.start["steps"]}
-    T = engine.temperatures()
-    if len(T) <= T_LIST_MAX:
+    T = _listed_temperatures(scene, engine)
+    if T is not None:
         summary["T"] = T.tolist()
     return _finite(summary)
 
 
+def _listed_temperatures(scene: Scene, engine):
+    """The final temperatures the summary lists (up to ``T_LIST_MAX`` particles), or None: those of the whole
+    sample, gathered from the ranks where each holds its piece (``engine.pieces_only``)."""
+    if engine.pieces_only:
+        return engine.gathered_temperatures() if scene.particle_count <= T_LIST_MAX else None
+    T = engine.temperatures()
+    return T if len(T) <= T_LIST_MAX else None
+
+
 def _safe_summary(engine) -> dict:
-    """What an engine can say of itself after an interrupt or a stop (its summary, or nothing if even that fails)."""
+    """What an engine can say of itself after an interrupt or a stop (its summary, or nothing if even that fails);
+    nothing from an engine whose summary is a reduction over ranks (``pieces_only``), which a rank interrupted alone
+    would wait for."""
+    if engine.pieces_only:
+        return {}
     try:
         return _finite(engine.summary())
     except (ValueError, ArithmeticError, IndexError, KeyError):

@@ -200,6 +200,7 @@ def test_two_ranks_with_stress_walls_write_the_gathered_run_folder(tmp_path):
 
 
 def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):
+    from dem.engines import engine_class
     from dem.engines.verlet.ranks import refuse_unsupported
 
     three = ranks_worker.builtin("luding-three-particles", 0.001)
@@ -209,9 +210,10 @@ def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):
     with pytest.raises(ValueError, match=r"written by 2 rank\(s\), this run has 1; resume with mpiexec -n 2"):
         refuse_unsupported(three, 1, {"ranks": 2})
     refuse_unsupported(three, 2, {"ranks": 2})
-    staggered = ranks_worker.builtin("zohdi-compaction", 0.01)
     with pytest.raises(ValueError, match=r"engine = 'staggered': under mpiexec run static packings and the verlet engine"):
-        refuse_unsupported(staggered, 1)
+        engine_class("staggered", ranks=True)
+    assert engine_class("verlet", ranks=True).__name__ == "RankVerletEngine"
+    assert engine_class("static", ranks=True).__name__ == "DistributedStaticEngine"
 
 
 

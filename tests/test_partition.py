@@ -10,7 +10,7 @@ from dem.geometry.generators import random_packing
 from dem.geometry.particles import Particles
 from dem.geometry.bisection import bisection, halo
 from dem.geometry.periodic import PeriodicBox
-from dem.network.comm import launched
+from dem.parallel.comm import launched
 
 
 @pytest.mark.parametrize("parts", [1, 2, 3, 4, 7])

@@ -91,7 +91,7 @@ def test_a_signal_before_the_first_step_then_resume_starts_the_run(tmp_path, mon
         raise KeyboardInterrupt
 
     if when == "building":
-        monkeypatch.setattr(dem.driver, "engine_class", lambda name: interrupted)
+        monkeypatch.setattr(built, "__init__", interrupted)
     else:
         monkeypatch.setattr(built, "run", interrupted)
     with pytest.raises(KeyboardInterrupt):

@@ -60,7 +60,7 @@ def run(args) -> dict:
     from dem.scene import load_scene
     from dem.driver import run as run_scene
     from dem.memory import available_bytes
-    from dem.network.comm import launched, launcher_rank, world
+    from dem.parallel.comm import launched, launcher_rank, world
 
     if launched() and launcher_rank() > 0:  # one summary, one error line: rank 0's
         sys.stdout = sys.stderr = open(os.devnull, "w")

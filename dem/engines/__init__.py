@@ -9,8 +9,14 @@ and contact law call for):
 * ``"staggered"`` -- Zohdi 2014's staggered, adaptive, implicit scheme of positions, temperatures and current
   (:mod:`dem.engines.staggered`).
 
+A run launched under MPI (:func:`dem.parallel.comm.launched`) takes the scene's engine from :data:`RANK_ENGINES`
+instead: the same scheme with the sample shared out among the ranks (``static``: :mod:`dem.engines.distributed`,
+``verlet``: :mod:`dem.engines.verlet.ranks`); the driver runs either kind alike.
+
 What the driver asks of an engine (the protocol every one of them follows):
 
+* ``Engine.refuse(scene, resume)`` -- what it cannot do with the scene, refused before the run's folder or MPI is
+  touched (:class:`Engine`);
 * ``Engine(scene, restart=None)`` -- built from a scene; ``restart`` is a checkpoint of the same scene's run (the dict
   its ``checkpoint()`` gave): it goes on from there, bit for bit;
 * ``name``; ``link_kind`` (``"bonds"`` or ``"contacts"``: what the lines of its snapshots are); ``t``, ``steps``,
@@ -22,7 +28,8 @@ What the driver asks of an engine (the protocol every one of them follows):
 * ``record()`` (one row: a dict of numbers), ``positions()``, ``particle_fields()``, ``links()`` (``(points, lines,
   fields)``), ``profile()`` (or None), ``plots(out, summary)`` -- what the writer (:mod:`dem.output.writer`) writes;
 * ``summary()`` -- what the run found; ``state()`` -- the sample as it ends (:mod:`dem.scene.state_file`);
-  ``checkpoint()`` -- everything it carries, to go on.
+  ``checkpoint()`` -- everything it carries, to go on;
+* ``pieces_only`` -- true where each process holds only its piece of the sample (:class:`Engine`).
 """
 
 from __future__ import annotations
@@ -37,13 +44,52 @@ ENGINES = {
 }
 
 
-def engine_class(name: str):
-    """The engine registered as ``name`` (:data:`ENGINES`), imported only now: a scene loads the code it runs.
+#: The engines of a run launched under MPI, by the names of :data:`ENGINES` whose scheme they share out among the ranks.
+RANK_ENGINES = {
+    "static": "dem.engines.distributed.engine:DistributedStaticEngine",
+    "verlet": "dem.engines.verlet.ranks:RankVerletEngine",
+}
+
+
+class Engine:
+    """What every engine shares of the protocol (module docstring): what the driver asks of its class before one is
+    built, and the kind of sample it holds."""
+
+    #: Each process holds only its piece of the sample (the static engine on several ranks): the driver writes the
+    #: snapshots in pieces (:class:`dem.output.pieces.PieceWriter`) and no ``state.npz``, and the summary lists the
+    #: temperatures gathered from the ranks (``gathered_temperatures()``).
+    pieces_only = False
+
+    @classmethod
+    def refuse(cls, scene, resume: bool) -> None:
+        """Refuse what this engine cannot do with ``scene`` before the run's folder or MPI is touched; the engines
+        of one process refuse nothing here (they check the scene as they are built).
+
+        Parameters
+        ----------
+        scene : dem.scene.parse.Scene
+            The scene.
+        resume : bool
+            Whether the run would go on from a checkpoint.
+
+        Raises
+        ------
+        ValueError
+            One line naming what the engine cannot do and what to do instead.
+        """
+
+
+def engine_class(name: str, ranks: bool = False):
+    """The engine registered as ``name`` (:data:`ENGINES`, or :data:`RANK_ENGINES` for a run on MPI ranks), imported
+    only now: a scene loads the code it runs.
 
     Parameters
     ----------
     name : str
         The engine's name, a key of :data:`ENGINES`.
+    ranks : bool
+        The run was launched under MPI (:func:`dem.parallel.comm.launched`): the engine that shares the sample out
+        among the ranks.
 
     Returns
     -------
@@ -53,9 +99,12 @@ def engine_class(name: str):
     Raises
     ------
     ValueError
-        ``name`` is not a registered engine.
+        ``name`` is not a registered engine, or has none on MPI ranks.
     """
     if name not in ENGINES:
         raise ValueError(f"[solver] engine = {name!r}: must be one of {', '.join(ENGINES)}")
-    module, cls = ENGINES[name].split(":")
+    if ranks and name not in RANK_ENGINES:
+        raise ValueError(f"[solver] engine = {name!r}: under mpiexec run static packings and the verlet engine "
+                         f"(particles that move), not this one; run this scene without mpiexec")
+    module, cls = (RANK_ENGINES if ranks else ENGINES)[name].split(":")
     return getattr(importlib.import_module(module), cls)

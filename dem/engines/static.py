@@ -15,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from dem import memory
+from dem.engines import Engine
 from dem.geometry.necks import meeting_in
 from dem.laws.verified_range import neck_account, wide_necks
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
@@ -92,7 +93,7 @@ def boundary_summary(scene, walls, into: dict) -> dict:
     return out
 
 
-class StaticEngine:
+class StaticEngine(Engine):
     """The thermal network of a static packing (module docstring), as the driver asks of an engine
     (:mod:`dem.engines`).
 

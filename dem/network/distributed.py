@@ -1,5 +1,6 @@
 """The heat network of a packing shared out among MPI ranks: each rank's rows, the groups that span ranks, the steady
-solve and the theta-method steps, all on PETSc (:mod:`dem.network.petsc`).
+solve and the theta-method steps, all on PETSc (:mod:`dem.parallel.petsc`); a step is the serial one
+(:class:`dem.network.theta.ThetaStepper`) with the solve over the ranks plugged in (:class:`RankSolves`).
 
 Each rank holds the particles it owns and a halo (:mod:`dem.geometry.bisection`), and a
 :class:`dem.network.heat.Network` of them whose bonds are those with at least one owned particle. An owned particle
@@ -24,10 +25,11 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from dem.network import comm as mpi
-from dem.network.heat import (INTEGRATORS, STARTUP_STEPS, Network, balancing_shift, refuse_energy_error,
-                              refuse_out_of_range, surely_stiff)
-from dem.network.petsc import PetscSolver, matrix
+from dem.parallel import comm as mpi
+from dem.network.heat import (INTEGRATORS, STARTUP_STEPS, Network, refuse_energy_error, refuse_out_of_range,
+                              surely_stiff)
+from dem.network.theta import ThetaStepper, balancing_shift
+from dem.parallel.petsc import PetscSolver, matrix
 
 
 @dataclass
@@ -69,6 +71,113 @@ class Groups:
         return np.isin(self.label, labels)
 
 
+class RankSolves:
+    """The linear solves of theta steps over the ranks (:mod:`dem.network.theta`'s plug-in): every rank's owned rows
+    of the step's system on PETSc (:class:`dem.parallel.petsc.PetscSolver`, CG + AMG), the halo's temperatures from
+    their owners, and the uniform shift that makes the residuals summed over the ranks vanish
+    (:func:`dem.network.theta.balancing_shift`). :meth:`release` frees the solvers built.
+
+    Parameters
+    ----------
+    part : DistributedNetwork
+        This rank's part of the network.
+    rtol : float
+        The relative residual of the solves.
+    """
+
+    def __init__(self, part: "DistributedNetwork", rtol: float):
+        self.part, self.rtol = part, rtol
+        self.row, self.n_global = part.numbering(np.ones(len(part.net.free), dtype=bool))
+        self.built: list = []  # the systems built, in order
+
+    @staticmethod
+    def everything_fixed(net) -> bool:
+        """False: a rank with no free particle still takes part in the others' solves.
+
+        Parameters
+        ----------
+        net : dem.network.heat.Network
+            This rank's network.
+
+        Returns
+        -------
+        bool
+            False.
+        """
+        return False
+
+    def build(self, M: sp.csr_matrix, laplacian_diagonal: np.ndarray, previous=None) -> "_RankSystem":
+        """The solver of the step's system ``M`` over the ranks (``laplacian_diagonal`` and ``previous`` unused: the
+        preconditioner is PETSc's).
+
+        Parameters
+        ----------
+        M : scipy.sparse.csr_matrix
+            ``C/dt + theta A`` over the local free particles (W/K).
+        laplacian_diagonal : numpy.ndarray
+            Unused.
+        previous : object or None
+            Unused.
+
+        Returns
+        -------
+        _RankSystem
+            The system and its solver.
+        """
+        system = _RankSystem(M, self.part.solver(M, self.row, self.n_global, self.rtol))
+        self.built.append(system)
+        return system
+
+    def solve(self, system: "_RankSystem", rhs: np.ndarray, guess: np.ndarray) -> np.ndarray:
+        """The step's temperatures of the local free particles (owned ones solved, the halo's from their owners),
+        balanced over the ranks.
+
+        Parameters
+        ----------
+        system : _RankSystem
+            A system of :meth:`build`.
+        rhs : numpy.ndarray
+            The right-hand side per local free particle (W; owned entries used).
+        guess : numpy.ndarray
+            The start of CG per local free particle (K or degC; owned entries used).
+
+        Returns
+        -------
+        numpy.ndarray
+            The free temperatures after the step.
+        """
+        own, M = self.part.own_free, system.M
+        T_new = guess.copy()
+        T_new[own] = system.solver.solve(rhs[own], guess[own])
+        T_new = self.part.halo_filled(T_new)[self.part.net.free]
+        residual, weight = self.part.total(np.array([float(np.sum((rhs - M @ T_new)[own])), float(M[own].sum())]))
+        T_new += balancing_shift(residual, weight)
+        return T_new
+
+    @property
+    def iterations(self) -> int:
+        """The CG iterations of all solves so far."""
+        return sum(system.solver.iterations for system in self.built)
+
+    def release(self) -> None:
+        """Free the PETSc solvers built (:meth:`dem.parallel.petsc.PetscSolver.destroy`)."""
+        for system in self.built:
+            system.solver.destroy()
+
+
+@dataclass
+class _RankSystem:
+    """A step's system over the local free particles (``M``, W/K) and its PETSc solver over the ranks."""
+
+    M: sp.csr_matrix
+    solver: PetscSolver
+
+    @property
+    def name(self) -> str:
+        """The solver's name (``petsc-cg-...``)."""
+        return self.solver.name
+
+
 class DistributedNetwork:
     """This rank's part of the network (module docstring). ``net``: the
     :class:`~dem.network.heat.Network` of the held particles,
@@ -96,7 +205,7 @@ class DistributedNetwork:
 
     # ------------------------------------------------------------------------------------------- reductions
     def total(self, value):
-        """Sum over ranks (:func:`dem.network.comm.total`).
+        """Sum over ranks (:func:`dem.parallel.comm.total`).
 
         Parameters
         ----------
@@ -229,7 +338,7 @@ class DistributedNetwork:
 
         Returns
         -------
-        dem.network.petsc.PetscSolver
+        dem.parallel.petsc.PetscSolver
             The solver.
         """
         return PetscSolver(matrix(self.comm, self.rows(M, row), n_global), rtol)
@@ -433,10 +542,9 @@ class DistributedNetwork:
         T = net.particles.temperature[net.free].astype(float)
         sinks = net.sinks(T)
         A = net.matrix(sinks)
-        r = net.rhs(sinks)
-        row, n_global = self.numbering(np.ones(len(T), dtype=bool))
+        solves = RankSolves(self, rtol_linear)
+        stepper = ThetaStepper(net, theta, solves)
         n_steps = max(1, math.ceil(t_end / dt * (1.0 - 1e-12)))
-        solvers = {}
         lo, hi = net.temperature_bounds()
         lo, hi = mpi.minimum(self.comm, lo), mpi.maximum(self.comm, hi)
         dt_min, dt_max = math.inf, 0.0
@@ -449,6 +557,7 @@ class DistributedNetwork:
         # (dem.network.heat.integrate): taken where the step is surely above it (dem.network.heat.surely_stiff)
         stiff = theta < 1.0 and surely_stiff(dt, A, net.C, own, lambda rate: mpi.maximum(self.comm, rate))
         startup = STARTUP_STEPS if stiff else 0
+        starter = ThetaStepper(net, 1.0, solves) if stiff else None
         if observer is not None:
             observer(0, 0.0, T, self.flows(T, sinks))
         try:  # the PETSc solvers freed however the steps end (PetscSolver.destroy)
@@ -458,24 +567,8 @@ class DistributedNetwork:
                 h = t_end - (step - 1) * dt if last else dt
                 if abs(h - dt) <= 1e-9 * dt:
                     h = dt
-                th = 1.0 if step <= startup else theta
-                if (h, th) not in solvers:
-                    M = (A * th + sp.diags(net.C / h)).tocsr()
-                    solvers[h, th] = (M, self.solver(M, row, n_global, rtol_linear))
-                M, solver = solvers[h, th]
-                rhs = net.C / h * T + r
-                if th < 1.0:
-                    rhs -= (1.0 - th) * (A @ T)
-                T_new = T.copy()
-                T_new[own] = solver.solve(rhs[own], T[own])
-                T_new = self.halo_filled(T_new)[net.free]
-                # a uniform shift of the order of the solver's tolerance makes the residuals sum to zero (the heat
-                # balance of the step to round-off), as in the serial stepper
-                residual, weight = self.total(np.array([float(np.sum((rhs - M @ T_new)[own])),
-                                                        float(M[own].sum())]))
-                T_new += balancing_shift(residual, weight)
+                T_new, T_theta, sinks = (starter if step <= startup else stepper).step(T, h, guess=T)
                 dt_min, dt_max = min(dt_min, h), max(dt_max, h)
-                T_theta = th * T_new + (1.0 - th) * T
                 flows = self.flows(T_theta, sinks)
                 for k, v in flows.items():
                     heat_in[k] += h * v
@@ -495,14 +588,13 @@ class DistributedNetwork:
                 if progress is not None:
                     progress(t)
         finally:
-            for _, solver in solvers.values():
-                solver.destroy()
-        self.linear_iterations = sum(s.iterations for _, s in solvers.values())
+            solves.release()
+        self.linear_iterations = solves.iterations
         energy = self.total(float(net.C[own] @ T[own]))
         scale = self.total(float(net.C[own].sum())) * (hi - lo) + abs_in
         err = abs(energy - energy0 - sum(heat_in.values())) / scale if scale > 0 else 0.0
         mpi.agree(self.comm, lambda: refuse_energy_error(err, integrator, dt))
-        name = next(iter(solvers.values()))[1].name if solvers else "none"
+        name = solves.built[0].name if solves.built else "none"
         return {"T_F": T, "t": t, "steps": n_steps, "energy_error": err, "heat_in": heat_in,
-                "dt_min": dt_min, "dt_max": dt_max, "solver": name, "factorizations": len(solvers),
+                "dt_min": dt_min, "dt_max": dt_max, "solver": name, "factorizations": len(solves.built),
                 "violation": violation if bounded else None, "startup_steps": min(startup, n_steps)}

@@ -64,13 +64,13 @@ import scipy.sparse.linalg as spl
 from dem.geometry.bonds import Bonds, find_bonds
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.network.linsolve import make_solver
+from dem.network.theta import ORDER, LocalSolves, ThetaStepper
 from dem.network.laplacian import BoundedLaplacian, laplacian  # noqa: F401  (laplacian: part of this module's API)
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources, linear_sink_terms
 
 INTEGRATORS = {"explicit": 0.0, "implicit": 1.0, "crank-nicolson": 0.5}
-ORDER = {0.0: 1, 1.0: 1, 0.5: 2}  # order q of the theta method
 AUTO_LOCAL = {1: 10.0, 2: 15.0}  # dt = "auto": local tolerance k_q rtol^((q+1)/q) per step, :func:`step_tolerance`
 AUTO_SAFETY = 0.9  # dt = "auto": safety factor of the step controller; explicit stays below this x the stable limit
 AUTO_MIN_FACTOR, AUTO_MAX_FACTOR = 0.2, 5.0  # dt = "auto": bounds of the change of step per step
@@ -736,125 +736,6 @@ class TransientResult:
     startup_steps: int = 0  # implicit Euler steps that started a stiff Crank-Nicolson run (module docstring)
 
 
-class _Stepper:
-    """Theta-method steps; the system solver is built once per step size (cached, least recently used dropped), and
-    where the matrix changes every step (radiation) the new step's solver reuses the cached one's AMG hierarchy."""
-
-    def __init__(self, net: Network, theta: float, linear: str, rtol_linear: float):
-        self.net, self.theta, self.linear, self.rtol_linear = net, theta, linear, rtol_linear
-        self.linear_sinks = net.sources.radiation is None
-        self._cache: dict = {}
-        self.factorizations = 0
-        self.backend = "none"
-        self.A0 = net.matrix(net.sinks(net.particles.temperature[net.free])) if self.linear_sinks else None
-        self.history: list = []  # (T, dt) at the start of the last two accepted steps: warm starts for CG
-        self._rate: tuple = (None, None)
-
-    def _solver(self, dt: float, A: sp.csr_matrix, same_matrix: bool):
-        """The solver of the step size ``dt``: the cached one when the matrix is that of the last step of this size
-        (``same_matrix``: no radiation), else one for the new matrix, which reuses the cached one's AMG hierarchy
-        (radiation's linearisation changes the diagonal a little from step to step)."""
-        last = self._cache.pop(dt, None)
-        if last is not None and same_matrix:
-            self._cache[dt] = last  # most recently used last
-            return last
-        M = A * self.theta
-        M = (M + sp.diags(self.net.C / dt)).tocsr()
-        solver = make_solver(M, self.linear, self.net.base_diag * self.theta, self.rtol_linear, previous=last)
-        self.factorizations += 0 if getattr(solver, "reused", False) else 1
-        self.backend = solver.name
-        if len(self._cache) >= 8:
-            self._cache.pop(next(iter(self._cache)))
-        self._cache[dt] = solver
-        return solver
-
-    def guess(self, T: np.ndarray, dt: float) -> np.ndarray:
-        """Start of the iterative solve: quadratic extrapolation at a constant step, else linear, else ``T``."""
-        h = self.history
-        if len(h) == 2 and h[0][1] == dt and h[1][1] == dt:
-            return 3.0 * (T - h[0][0]) + h[1][0]
-        if h:
-            return T + (T - h[0][0]) * (dt / h[0][1])
-        return T
-
-    def accept(self, T: np.ndarray, dt: float):
-        """Record an accepted step of size ``dt`` that started from ``T``."""
-        self.history = [(T, dt)] + self.history[:1]
-
-    def rate(self, T: np.ndarray):
-        """``(dT/dt, sinks)`` at ``T``; the last one is kept (an explicit step and its error estimate share it)."""
-        if self._rate[0] is not T:
-            sinks = self.net.sinks(T)
-            A = self.A0 if self.linear_sinks else self.net.matrix(sinks)
-            self._rate = (T, ((self.net.rhs(sinks) - A @ T) / self.net.C, sinks))
-        return self._rate[1]
-
-    def step(self, T: np.ndarray, dt: float, guess: np.ndarray | None = None):
-        """``(T_new, T_theta, sinks)`` for one step of size ``dt`` from ``T``."""
-        net = self.net
-        if net.n_free == 0:  # every particle fixed: nothing evolves
-            return T, T, net.sinks(T)
-        if self.theta == 0.0:
-            f, sinks = self.rate(T)
-            return T + dt * f, T, sinks
-        sinks = net.sinks(T)
-        A = self.A0 if self.linear_sinks else net.matrix(sinks)
-        rhs = net.C / dt * T + net.rhs(sinks)
-        if self.theta < 1.0:
-            rhs -= (1.0 - self.theta) * (A @ T)
-        solver = self._solver(dt, A, self.linear_sinks)
-        T_new = solver.solve(rhs, self.guess(T, dt) if guess is None else guess)
-        self.backend = solver.name
-        if solver.name != "direct":
-            # iterative solve: a uniform shift of the order of its tolerance makes the residuals sum to zero, so
-            # the heat balance of the step (and energy_error) holds to round-off
-            T_new += balancing_shift(float(np.sum(rhs - solver.A @ T_new)), float(solver.A.sum()))
-        return T_new, self.theta * T_new + (1.0 - self.theta) * T, sinks
-
-    def estimated_step(self, T: np.ndarray, dt: float):
-        """One step with an estimate of its local error: ``(T_new, parts, error)`` with ``parts`` the
-        ``(dt, T_theta, sinks)`` of the sub-steps taken (for the energy bookkeeping) and ``error`` the max-norm
-        estimate of the local error of a step of size ``dt``.
-
-        Explicit (forward Euler): the difference to Heun's step, ``dt/2 |f(T_new) - f(T)|``; ``f(T_new)`` starts
-        the next step, so the estimate costs nothing. Implicit and Crank-Nicolson: step doubling, ``|T_2 - T_1| /
-        (2^q - 1)`` with ``T_1`` one step of ``dt`` and ``T_2`` two of ``dt/2`` (the solution kept, the more
-        accurate one); with ``dt`` a power of 2 times a base step both solvers stay cached as the step grows.
-        """
-        if self.theta == 0.0:
-            T_new, T_theta, sinks = self.step(T, dt)
-            f0, f1 = self.rate(T)[0], self.rate(T_new)[0]
-            return T_new, [(dt, T_theta, sinks)], 0.5 * dt * float(np.max(np.abs(f1 - f0), initial=0.0))
-        half = 0.5 * dt
-        T_a, th_a, s_a = self.step(T, half)
-        T_b, th_b, s_b = self.step(T_a, half, 2.0 * T_a - T)
-        T_1 = self.step(T, dt, T_b)[0]
-        q = ORDER[self.theta]
-        err = float(np.max(np.abs(T_b - T_1), initial=0.0)) / (2.0**q - 1.0)
-        return T_b, [(half, th_a, s_a), (half, th_b, s_b)], err
-
-
-def balancing_shift(residual: float, weight: float) -> float:
-    """The uniform shift of an iterative solve's temperatures that makes its residuals sum to zero (the module
-    docstring's energy bookkeeping): ``residual / weight``; 0 where ``weight`` came out 0, the capacities ``C/dt``
-    lost to round-off next to the conductances in the matrix's row sums, whose run the heat balance check then
-    refuses (``energy_error``) instead of dividing by zero.
-
-    Parameters
-    ----------
-    residual : float
-        The sum of the solve's residuals ``b - M T`` (W).
-    weight : float
-        The sum of the entries of the step's matrix ``M = C/dt + theta A`` (W/K).
-
-    Returns
-    -------
-    float
-        The shift (K).
-    """
-    return residual / weight if weight > 0.0 else 0.0
-
-
 def theta_step(net: Network, T_F: np.ndarray, dt: float, integrator: str = "implicit", linear: str = "auto",
                rtol_linear: float = 1e-10) -> tuple[np.ndarray, dict]:
     """One theta-method step of size ``dt`` from the free temperatures ``T_F`` on ``net`` (a network whose
@@ -882,7 +763,7 @@ def theta_step(net: Network, T_F: np.ndarray, dt: float, integrator: str = "impl
     tuple of (numpy.ndarray, dict)
         The free temperatures after the step, and ``{boundary: J}``.
     """
-    T_new, T_theta, sinks = _Stepper(net, INTEGRATORS[integrator], linear, rtol_linear).step(T_F, dt)
+    T_new, T_theta, sinks = ThetaStepper(net, INTEGRATORS[integrator], LocalSolves(linear, rtol_linear)).step(T_F, dt)
     return T_new, {k: dt * v for k, v in net.flows(T_theta, sinks).items()}
 
 
@@ -1075,13 +956,14 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     if not (np.isfinite(t_end) and t_end > 0):
         raise ValueError(f"solver.t_end = {t_end!r}: must be finite and > 0 (s)")
     theta = INTEGRATORS[integrator]
-    stepper = _Stepper(net, theta, linear, rtol_linear)
+    solves = LocalSolves(linear, rtol_linear)
+    stepper = ThetaStepper(net, theta, solves)
     T = net.particles.temperature[net.free].astype(float)
     limit = None
     startup = None  # fixed-step Crank-Nicolson above the stable limit: implicit Euler start-up (module docstring)
     if theta == 0.5 and not isinstance(dt, str) and np.isfinite(dt) and dt > 0 \
             and float(dt) > stable_limit(net, net.sinks(T)):
-        startup = _Stepper(net, 1.0, linear, rtol_linear)
+        startup = ThetaStepper(net, 1.0, solves)
     if theta < 0.5:
         # radiation: the stiffest linearisation within the prescribed temperatures (maximum principle)
         t_hot = np.full(net.n_free, net.temperature_bounds()[1])

@@ -15,6 +15,26 @@ import numpy as np
 
 from dem.output.atomic import write_aside
 from dem.output.writer import DIGITS, RunWriter, listed_snapshots, write_pvd, write_vtu
+from dem.parallel.comm import world
+
+def refuse_lammps_dump(scene) -> None:
+    """Refuse ``[output] lammps_dump`` on several ranks (the dump needs every particle in one process, and each rank
+    writes its piece of a snapshot); MPI is touched only where the scene asks for the dump.
+
+    Parameters
+    ----------
+    scene : dem.scene.parse.Scene
+        The scene.
+
+    Raises
+    ------
+    ValueError
+        The scene asks for a LAMMPS dump and the run has more than one rank.
+    """
+    if scene.output.lammps_dump and world().Get_size() > 1:
+        raise ValueError("[output] lammps_dump = true: not written under MPI (each rank writes its piece of a VTU "
+                         "snapshot); run on one process, or convert a state with python -m dem convert")
+
 
 VTK_TYPES = {np.dtype(k): v for k, v in (("float32", "Float32"), ("float64", "Float64"), ("int8", "Int8"),
                                           ("int16", "Int16"), ("int32", "Int32"), ("int64", "Int64"),

@@ -7,7 +7,7 @@ import pytest
 
 from dem.driver import run
 from dem.engines.static import StaticEngine
-from dem.network import comm as mpi
+from dem.parallel import comm as mpi
 from dem.network.current import electrode_bonds, kirchhoff
 from dem.scene import load_scene, parse_scene
 

@@ -12,7 +12,7 @@ import scipy.sparse as sp
 from dem.driver import run
 from dem.engines.distributed.engine import DistributedStaticEngine
 from dem.engines.static import StaticEngine
-from dem.network import comm as mpi
+from dem.parallel import comm as mpi
 from dem.scene import load_scene
 from dem.scene.parse import parse_scene
 

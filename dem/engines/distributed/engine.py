@@ -33,10 +33,11 @@ from dem.engines.static import CSV_FLOWS, StaticEngine, boundary_summary
 from dem.geometry.necks import meeting_in
 from dem.geometry.bisection import HALO_MARGIN, bisection, halo
 from dem.laws.verified_range import neck_account, wide_necks
-from dem.network import comm as mpi
+from dem.parallel import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
 from dem.network.distributed import DistributedNetwork
 from dem.network.heat import Network, bonds_and_conductances
+from dem.output.pieces import refuse_lammps_dump
 
 
 def unsupported(scene, resume: bool = False) -> str | None:
@@ -79,6 +80,29 @@ class DistributedStaticEngine(StaticEngine):
     (``owned``: their indices in the scene)."""
 
     name = "static"
+    pieces_only = True
+
+    @classmethod
+    def refuse(cls, scene, resume: bool) -> None:
+        """What a static scene cannot do on several ranks (:func:`unsupported`, and a LAMMPS dump:
+        :func:`dem.output.pieces.refuse_lammps_dump`), refused before the run's folder is touched.
+
+        Parameters
+        ----------
+        scene : dem.scene.parse.Scene
+            The scene.
+        resume : bool
+            Whether the run would go on from a checkpoint.
+
+        Raises
+        ------
+        ValueError
+            The one-line reason.
+        """
+        refuse_lammps_dump(scene)
+        why = unsupported(scene, resume)
+        if why is not None:
+            raise ValueError(why)
 
     def __init__(self, scene, restart: dict | None = None):
         """This rank's particles of ``scene`` and their network.

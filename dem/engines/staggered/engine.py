@@ -34,6 +34,7 @@ from dem.engines.state import MotionState
 from dem.geometry.neighbours import list_arrays
 from dem.geometry.periodic import pair_lines
 from dem.geometry.walls import box_axes
+from dem.engines import Engine
 from dem.engines.contact_current import ContactCurrent
 from dem.engines.handover import Handover
 from dem.engines.staggered.heat import LumpedHeat, contact_bonds
@@ -49,7 +50,7 @@ class ConvergenceError(ValueError):
     """A step that cannot converge even at ``dt_min``."""
 
 
-class StaggeredEngine:
+class StaggeredEngine(Engine):
     """A scene with ``[contact] law = "zohdi"`` (module docstring), as the driver asks of an engine
     (:mod:`dem.engines`)."""
 

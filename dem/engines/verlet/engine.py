@@ -25,6 +25,7 @@ import numpy as np
 
 from dataclasses import replace
 
+from dem.engines import Engine
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.bonds import find_bonds
@@ -40,7 +41,7 @@ from dem.network.heat import Network, boundary_heat_flow, bonds_and_conductances
 from fem_neck.geometry import max_overlap, neck_radius
 
 
-class VerletEngine:
+class VerletEngine(Engine):
     """A moving-particle run built from a scene with ``"mechanical"`` physics, as the driver asks of an engine
     (:mod:`dem.engines`)."""
 

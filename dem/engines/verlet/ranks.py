@@ -54,8 +54,8 @@ import os
 
 import numpy as np
 
-from dem.network import comm as mpi
-from dem.network.comm import world
+from dem.parallel import comm as mpi
+from dem.parallel.comm import world
 from dem.network.distributed import DistributedNetwork
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.verlet.slabs import Slabs
@@ -64,12 +64,14 @@ from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_accelerati
 from dem.engines.verlet.mechanics import MechanicalModel, MechanicsError
 from dem.engines.state import MotionState
 from dem.geometry.neighbours import carry_history, verlet_pairs, wall_pairs
+from dem.output.pieces import refuse_lammps_dump
 from sinterheat import threads
 
 
 def refuse_unsupported(scene, ranks: int, restart: dict | None = None) -> None:
     """A ``ValueError`` naming what a run on ``ranks`` ranks cannot do with ``scene`` (``restart``: the checkpoint
-    it would resume from, which the same number of ranks must have written).
+    it would resume from, which the same number of ranks must have written). An engine other than ``verlet`` under
+    MPI is refused by the registry (:func:`dem.engines.engine_class`).
 
     Parameters
     ----------
@@ -85,9 +87,6 @@ def refuse_unsupported(scene, ranks: int, restart: dict | None = None) -> None:
     ValueError
         The scene or the checkpoint cannot run on ``ranks`` ranks.
     """
-    if scene.engine != "verlet":
-        raise ValueError(f"[solver] engine = {scene.engine!r}: under mpiexec run static packings and the verlet "
-                         f"engine (particles that move), not this one; run this scene without mpiexec")
     written = 1 if restart is None or "ranks" not in restart else int(restart["ranks"])
     if restart is not None and written != ranks:
         how = f"with mpiexec -n {written}" if written > 1 else "without mpiexec or with mpiexec -n 1"
@@ -210,7 +209,7 @@ class RankMechanics(MechanicalModel):
         dest = self.slabs.owner(s.x)
         rows = np.column_stack([self._pack(self._arrays(), np.arange(s.n)), self.gid])
         owned = np.flatnonzero(self.owned)
-        r_max = comm.allreduce(float(np.max(s.radius[owned], initial=0.0)), op=_max())
+        r_max = mpi.maximum(comm, float(np.max(s.radius[owned], initial=0.0)))
         own_rows = rows[owned[dest[owned] == self.rank]]
         if not first:  # the particles that left the slab to their new owners; pair histories to both partners'
             leaving = [rows[owned[dest[owned] == r]] if r != self.rank else rows[:0] for r in range(self.size)]
@@ -335,7 +334,7 @@ class RankMechanics(MechanicalModel):
         super()._initial_forces()
         w = self.w
         if len(w.force):
-            w.force[:] = self.comm.allreduce(w.force, op=_sum())
+            w.force[:] = self.comm.allreduce(w.force, op=mpi.reduction("SUM"))
             for m in range(len(self.walls)):
                 w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
         self._refresh_ghosts()
@@ -389,7 +388,7 @@ class RankMechanics(MechanicalModel):
         w = self.w
         failed = status in (NONFINITE, ESCAPED)
         total = np.concatenate([[status == REBUILD, failed], w.force])
-        self.comm.Allreduce(total.copy(), total, op=_sum())  # buffers, not pickles: once per step
+        self.comm.Allreduce(total.copy(), total, op=mpi.reduction("SUM"))  # buffers, not pickles: once per step
         w.force[:] = total[2:]
         h = 0.5 * self.dt
         for m in np.flatnonzero(w.mode == 1):
@@ -457,18 +456,6 @@ class RankMechanics(MechanicalModel):
         return view
 
 
-def _max():
-    from mpi4py import MPI
-
-    return MPI.MAX
-
-
-def _sum():
-    from mpi4py import MPI
-
-    return MPI.SUM
-
-
 class RankContactThermal(ContactThermalModel):
     """The heat of the contacts on several ranks (module docstring): ``T`` and ``rate`` over every particle of the
     scene on every rank, each thermal step solved on PETSc by all ranks together. No hand-over to the union
@@ -532,6 +519,26 @@ class RankVerletEngine(VerletEngine):
     summary is the same everywhere."""
 
     mechanics_class = RankMechanics
+
+    @classmethod
+    def refuse(cls, scene, resume: bool) -> None:
+        """A LAMMPS dump on several ranks, refused before the run's folder is touched
+        (:func:`dem.output.pieces.refuse_lammps_dump`); a checkpoint of another number of ranks is refused once read
+        (:func:`refuse_unsupported`).
+
+        Parameters
+        ----------
+        scene : dem.scene.parse.Scene
+            The scene.
+        resume : bool
+            Whether the run would go on from a checkpoint.
+
+        Raises
+        ------
+        ValueError
+            The one-line reason.
+        """
+        refuse_lammps_dump(scene)
 
     def __init__(self, scene, restart: dict | None = None):
         """As :class:`VerletEngine`; unless told (``SINTERHEAT_THREADS``, ``--threads``), each rank's contact loop
@@ -634,7 +641,7 @@ class RankVerletEngine(VerletEngine):
             Called as ``checkpoint(make, final)``; None: not called.
         """
         mech = self.mechanics
-        gathered_checkpoints = mech.size > 1 and mech.comm.allreduce(int(checkpoint is not None), op=_max())
+        gathered_checkpoints = mech.size > 1 and mpi.maximum(mech.comm, int(checkpoint is not None))
 
         def checkpointed(make, final: bool = False) -> None:
             view = mech.gathered()

@@ -1,5 +1,5 @@
-"""The MPI side of a network solve over several processes: whether this run is one, its communicator, the
-exchange of halo values between ranks and the reductions the distributed engine needs.
+"""The MPI side of a run over several processes: whether this run is one, its communicator, the exchange of halo
+values between ranks and the reductions the engines on several ranks need.
 
 A run is distributed when it was launched by ``mpiexec``/``srun`` with more than one rank (:func:`launched`, read
 from the launcher's environment, so that a run without MPI imports neither mpi4py nor PETSc), or when asked with
@@ -114,6 +114,24 @@ def on_root(comm, action):
     if error is not None:
         raise ValueError(error)
     return result
+
+
+def reduction(name: str):
+    """MPI's reduction operation ``name`` (mpi4py imported now), for a communicator's ``allreduce``.
+
+    Parameters
+    ----------
+    name : str
+        ``"SUM"``, ``"MAX"`` or ``"MIN"``.
+
+    Returns
+    -------
+    object
+        The operation (an ``mpi4py.MPI.Op``).
+    """
+    from mpi4py import MPI
+
+    return {"SUM": MPI.SUM, "MAX": MPI.MAX, "MIN": MPI.MIN}[name]
 
 
 def total(comm, value):
