@@ -72,7 +72,7 @@ class Groups:
 
 
 class RankSolves:
-    """The linear solves of theta steps over the ranks (:mod:`dem.network.theta`'s plug-in): every rank's owned rows
+    r"""The linear solves of :math:`\theta` steps over the ranks (:mod:`dem.network.theta`'s plug-in): every rank's owned rows
     of the step's system on PETSc (:class:`dem.parallel.petsc.PetscSolver`, CG + AMG), the halo's temperatures from
     their owners, and the uniform shift that makes the residuals summed over the ranks vanish
     (:func:`dem.network.theta.balancing_shift`). :meth:`release` frees the solvers built.
@@ -107,13 +107,13 @@ class RankSolves:
         return False
 
     def build(self, M: sp.csr_matrix, laplacian_diagonal: np.ndarray, previous=None) -> "_RankSystem":
-        """The solver of the step's system ``M`` over the ranks (``laplacian_diagonal`` and ``previous`` unused: the
+        r"""The solver of the step's system ``M`` over the ranks (``laplacian_diagonal`` and ``previous`` unused: the
         preconditioner is PETSc's).
 
         Parameters
         ----------
         M : scipy.sparse.csr_matrix
-            ``C/dt + theta A`` over the local free particles (W/K).
+            :math:`C/\Delta t + \theta A` over the local free particles (W/K).
         laplacian_diagonal : numpy.ndarray
             Unused.
         previous : object or None
@@ -255,7 +255,7 @@ class DistributedNetwork:
         return dict(zip(part, map(float, sums)))
 
     def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
-        """The scale of the heat flows over the ranks: the net flow, at least sqrt(eps) times the gross one (W).
+        r"""The scale of the heat flows over the ranks: the net flow, at least :math:`\sqrt{\epsilon}` times the gross one (W).
 
         Parameters
         ----------

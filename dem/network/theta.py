@@ -1,6 +1,6 @@
-"""The theta method's step of a heat network, written once, with its linear solve a plug-in.
+r"""The :math:`\theta` method's step of a heat network, written once, with its linear solve a plug-in.
 
-One step of size ``dt`` from ``T`` solves ``(C/dt + theta A) T+ = (C/dt - (1-theta) A) T + r`` (theta = 0 explicit
+One step of size ``dt`` from ``T`` solves :math:`(C/\Delta t + \theta A) T^+ = (C/\Delta t - (1-\theta) A) T + r` (:math:`\theta` = 0 explicit
 forward Euler, 1 implicit backward Euler, 1/2 Crank-Nicolson; :mod:`dem.network.heat`, Rojek 2022, eqs. 2-4 in
 time). :class:`ThetaStepper` assembles the system and its right-hand side from a :class:`dem.network.heat.Network`,
 keeps one solver per step size and estimates a step's local error (the adaptive controller of
@@ -26,7 +26,7 @@ CACHED_SOLVERS = 8  # the solvers a stepper keeps, one per step size (the least 
 
 
 def balancing_shift(residual: float, weight: float) -> float:
-    """The uniform shift of an iterative solve's temperatures that makes its residuals sum to zero (the module
+    r"""The uniform shift of an iterative solve's temperatures that makes its residuals sum to zero (the module
     docstring's energy bookkeeping): ``residual / weight``; 0 where ``weight`` came out 0, the capacities ``C/dt``
     lost to round-off next to the conductances in the matrix's row sums, whose run the heat balance check then
     refuses (``energy_error``) instead of dividing by zero.
@@ -36,7 +36,7 @@ def balancing_shift(residual: float, weight: float) -> float:
     residual : float
         The sum of the solve's residuals ``b - M T`` (W).
     weight : float
-        The sum of the entries of the step's matrix ``M = C/dt + theta A`` (W/K).
+        The sum of the entries of the step's matrix :math:`M = C/\Delta t + \theta A` (W/K).
 
     Returns
     -------
@@ -47,7 +47,7 @@ def balancing_shift(residual: float, weight: float) -> float:
 
 
 class LocalSolves:
-    """The linear solves of theta steps on one process (module docstring): a solver per system from
+    r"""The linear solves of :math:`\theta` steps on one process (module docstring): a solver per system from
     :func:`dem.network.linsolve.make_solver`, an iterative one's solution balanced (:func:`balancing_shift`).
 
     Parameters
@@ -78,12 +78,12 @@ class LocalSolves:
         return net.n_free == 0
 
     def build(self, M: sp.csr_matrix, laplacian_diagonal: np.ndarray, previous=None):
-        """The solver of the step's system ``M``.
+        r"""The solver of the step's system ``M``.
 
         Parameters
         ----------
         M : scipy.sparse.csr_matrix
-            ``C/dt + theta A`` over the free particles (W/K).
+            :math:`C/\Delta t + \theta A` over the free particles (W/K).
         laplacian_diagonal : numpy.ndarray
             The Laplacian's part of its diagonal (W/K), for the ``"auto"`` choice.
         previous : object or None
@@ -257,8 +257,8 @@ class ThetaStepper:
         estimate of the local error of a step of size ``dt``.
 
         Explicit (forward Euler): the difference to Heun's step, ``dt/2 |f(T_new) - f(T)|``; ``f(T_new)`` starts
-        the next step, so the estimate costs nothing. Implicit and Crank-Nicolson: step doubling, ``|T_2 - T_1| /
-        (2^q - 1)`` with ``T_1`` one step of ``dt`` and ``T_2`` two of ``dt/2`` (the solution kept, the more
+        the next step, so the estimate costs nothing. Implicit and Crank-Nicolson: step doubling, :math:`|T_2 - T_1| /
+        (2^q - 1)` with ``T_1`` one step of ``dt`` and ``T_2`` two of ``dt/2`` (the solution kept, the more
         accurate one); with ``dt`` a power of 2 times a base step both solvers stay cached as the step grows.
 
         Parameters

@@ -1,4 +1,4 @@
-"""A network's matrix over several MPI ranks as a PETSc MPIAIJ matrix, solved by conjugate gradients with an
+r"""A network's matrix over several MPI ranks as a PETSc MPIAIJ matrix, solved by conjugate gradients with an
 algebraic multigrid preconditioner (petsc4py, imported only by a distributed run).
 
 Each rank gives its own rows, in CSR with global column numbers (:func:`matrix`); :class:`PetscSolver` solves with
@@ -13,7 +13,7 @@ them to the project's criterion ``|b - A x| <= rtol |b|`` (the unpreconditioned 
 
 CG stops at that residual or after ``max_iterations``, never on PETSc's divergence test: in a step far above the
 network's stiffest time constant (``C/dt`` far below the conductances) the right-hand side ``|b| ~ C/dt |T|`` is tiny
-next to the residual of the warm start, ``~ K |delta T|``, and the default test (a residual above ``1e5 |b|``) ended
+next to the residual of the warm start, :math:`\sim K |\Delta T|`, and the default test (a residual above ``1e5 |b|``) ended
 such a solve before its first iteration, where the serial CG converges.
 
 Every option can be set by the user through PETSc's options database, which these defaults never override: the
