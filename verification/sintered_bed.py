@@ -256,12 +256,14 @@ def compact(neck: str = "newton") -> dict:
 
 
 def _ends(record: dict) -> dict:
-    """``record`` with its particles, its end (``phi``, ``k_eff``), the bounds there and its largest jump."""
+    """``record`` with its particles, its end (``phi``, ``k_eff``), the bounds there, its largest jump and
+    ``above_wiener``, the largest ``k_eff / (phi kappa) - 1`` over its output times."""
     last, kappa = record["rows"][-1], record["kappa"]
     jumps = [abs(s["jump"]) for s in record["steps"] if s["jump"] is not None]
     record.update(particles=record["summary"]["particles"], phi=last["phi"], k_eff=last["k_eff"],
                   wiener=last["phi"] * kappa, hashin_shtrikman=float(hashin_shtrikman(last["phi"])) * kappa,
-                  largest_jump=max(jumps) if jumps else None)
+                  largest_jump=max(jumps) if jumps else None,
+                  above_wiener=max(r["k_eff"] / (r["phi"] * kappa) - 1.0 for r in record["rows"] if r["k_eff"]))
     return record
 
 
@@ -360,8 +362,8 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
         summary[f"{name} particles_necks_meeting"] = rec["summary"]["particles_necks_meeting"]
         summary[f"{name} k_eff / Wiener"] = rec["k_eff"] / rec["wiener"]
         summary[f"{name} largest jump"] = rec["largest_jump"]
-        targets.append((f"{name}: k_eff above the Wiener bound (relative)", max(rec["k_eff"] / rec["wiener"] - 1, 0.0),
-                        0.0))
+        targets.append((f"{name}: k_eff above the Wiener bound at any output (relative)",
+                        max(rec["above_wiener"], 0.0), 0.0))
         if rec["largest_jump"] is not None:
             targets.append((f"{name}: largest change of k_eff across a hand-over step", rec["largest_jump"], 5e-3))
     md = [__doc__.split("\n\n", 1)[1].strip(), "", table(cases), "",
