@@ -5,18 +5,17 @@ hand-over and below the Wiener bound (runs only where LAMMPS is installed)."""
 import numpy as np
 import pytest
 
-from verification import sintered_bed
-
-pytestmark = [pytest.mark.slow,
-              pytest.mark.skipif(sintered_bed.lammps() is None,
-                                 reason="LAMMPS is not installed (neither the lammps module's lmp nor lmp on "
-                                        "the path)")]
+pytestmark = pytest.mark.slow
 
 
 def test_a_small_lammps_bed_sintered_past_the_meeting_of_its_necks(tmp_path):
     """About 300 spheres in a 0.8 mm box, sintered for 10 ms at 160 degC: necks meet and particles are handed over;
     across every thermal step that hands particles over k_eff changes by at most 0.5 % on the same contacts; k_eff
     stays at or below the Wiener bound phi kappa at every output; the summary says where the law stands."""
+    from verification import sintered_bed
+
+    if sintered_bed.lammps() is None:
+        pytest.skip("LAMMPS is not installed (neither the lammps module's lmp nor lmp on the path)")
     rec = sintered_bed.measure(tmp_path, sintered_bed.QUICK_SPHERES, sintered_bed.QUICK_SIDE, t_end=0.01)
     summary = rec["summary"]
     assert rec["particles"] == 300
