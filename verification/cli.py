@@ -9,6 +9,9 @@ Commands (each writes ``report.md``, ``summary.json`` and ``run.json`` plus PNG 
 * ``densification`` -- k_eff against the solid fraction of the union of spheres up to phi ~0.97: lattices and random
   packings (FE beside DEM), a Luding-sintered compact, the Wiener and Hashin-Shtrikman bounds, Koh & Fortini
   (section ``densification``);
+* ``sintered-bed`` -- a bed poured by LAMMPS and the ``hot-wall-sintering`` compact sintered past the meeting of
+  their necks: k_eff through the hand-over to the union of spheres, against the Wiener and Hashin-Shtrikman bounds
+  (section ``sintered_bed``; needs LAMMPS);
 * ``all``        -- ``paper`` and ``dem-vs-fe``.
 
 Run time against error is ``python -m benchmarks``; the stress cases are tests (``python -m pytest -m stress``).
@@ -40,6 +43,8 @@ COMMANDS = {
     "sintering": (("sintering",), "Luding 2005 Sec. 4 reproduced: sintering, compression and vibration tests"),
     "densification": (("densification",), "k_eff through densification: union-of-spheres lattices, random packings "
                       "and a sintered compact, FE beside DEM, with the bounds and Koh & Fortini"),
+    "sintered-bed": (("sintered_bed",), "a LAMMPS bed and the hot-wall compact sintered past the meeting of their "
+                     "necks: k_eff through the hand-over, against the bounds"),
 }
 
 
