@@ -156,13 +156,6 @@ def particles(state, particle_state: np.ndarray, **replaced) -> Particles:
                      state.radius, state.radius_ref, state.T, particle_state, state.spin_axes)._replace(**replaced)
 
 
-def one_thread() -> tuple:
-    """The threaded force loop's view of a list (:class:`PairList`'s ``owner``, ``start``, ``order``, ``load``) where
-    one thread runs the loop: empty arrays of the right types, which that loop does not read.
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        ``(owner, start, order, load)``.
-    """
-    return np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros((0, LOAD_COLUMNS))
+# The threaded force loop's view of a list (PairList's owner, start, order, load) where one thread runs the loop:
+# empty arrays of the right types, which that loop does not read
+ONE_THREAD = (np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros((0, LOAD_COLUMNS)))

@@ -31,6 +31,7 @@ from dem.geometry.periodic import PeriodicBox
 from dem.geometry.walls import MOTIONS, WallArrays
 from dem.laws.contact import law_module
 
+NO_PAIR_CONSTANTS = np.empty((0, 0))  # the pairs' numbers of the radii are computed at every force evaluation
 
 
 class StaggeredMechanics:
@@ -94,6 +95,8 @@ class StaggeredMechanics:
         # the particles do not rotate: no spin, no torque (the force loop's arrays for them stay zero)
         self._spin, self._torque = np.zeros((n, 3)), np.zeros((n, 3))
         self.particle_state = self.law.initial_state(material, state.T, state.mass)
+        self._bodies = records.particles(state, self.particle_state, w=self._spin, tau=self._torque,
+                                         spin_axes=(0, 1, 2))  # the positions, velocities, forces, T: per call
         n_w = len(self.walls)
         self.w_hist = np.zeros((n, n_w, len(self.law.WALL_HISTORY)))  # committed at each accepted step
         self._w_hist_iter = self.w_hist.copy()
@@ -178,10 +181,9 @@ class StaggeredMechanics:
             :class:`~dem.engines.records.PairList`, :class:`~dem.geometry.walls.WallArrays`,
             :class:`~dem.engines.records.WallList`, :class:`~dem.engines.records.Constants`.
         """
-        particles = records.particles(self.state, self.particle_state, x=x, v=v, w=self._spin, f=f, tau=self._torque,
-                                      T=T, spin_axes=(0, 1, 2))
-        pairs = PairList(self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn, self.p_ft, np.empty((0, 0)),
-                         self.x_ref, *records.one_thread(), 1)
+        particles = self._bodies._replace(x=x, v=v, f=f, T=T)
+        pairs = PairList(self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn, self.p_ft, NO_PAIR_CONSTANTS,
+                         self.x_ref, *records.ONE_THREAD, 1)
         wall_list = WallList(self.wk, self.wm, self.w_hist, self._w_hist_iter, self.w_fn, self.w_ft, self.wq_ref)
         return particles, pairs, self.w, wall_list, Constants(self.gravity, self.box, self.params, self.skin)
 

@@ -167,7 +167,7 @@ class MechanicalModel:
             self.pair_owner, self.pair_start, self.pair_order = split_incidences(i, j, self.state.n, self.n_threads)
             self.pair_load = np.empty((len(i), LOAD_COLUMNS))
         else:  # the one-thread loop reads none of them
-            self.pair_owner, self.pair_start, self.pair_order, self.pair_load = records.one_thread()
+            self.pair_owner, self.pair_start, self.pair_order, self.pair_load = records.ONE_THREAD
 
     def restore_lists(self, saved: dict) -> None:
         """The Verlet lists of a checkpoint (:func:`dem.geometry.neighbours.restore_lists`), with the arrays the loop
