@@ -29,9 +29,9 @@ def lens_conductance(l_i, l_j, area, kappa_i, kappa_j, contact_conductance):
 
 @njit(cache=True, error_model="numpy")
 def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pairs, walls, wall_pairs, K, K_w, box):
-    """The ``zohdi`` law (:func:`lens_conductance`) on every listed pair ``pairs = (pi, pj)`` into ``K`` and every
-    listed particle-wall pair ``wall_pairs = (wk, wm)`` (``walls`` a :class:`dem.geometry.walls.WallArrays`, the
-    planes ``n_m . x = q_m``) into ``K_w``, with the lens geometry of
+    r"""The ``zohdi`` law (:func:`lens_conductance`) on every listed pair of ``pairs``, the arrays ``(pi, pj)``, into
+    ``K`` and every listed particle-wall pair of ``wall_pairs``, the arrays ``(wk, wm)``, into ``K_w`` (``walls`` a
+    :class:`dem.geometry.walls.WallArrays`, the planes :math:`n_m \cdot x = q_m`), with the lens geometry of
     :func:`dem.geometry.bonds.find_bonds` (``contact = "lens"``) at positions ``x``; ``K = 0`` where the pair does not
     touch (``|x_i - x_j| >= R_i + R_j``, a wall ``dist >= R_k``). Along the axes where ``box`` holds a period (else
     0) a pair is joined by the minimum image (:func:`dem.geometry.neighbours.min_image`).

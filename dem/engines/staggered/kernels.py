@@ -20,7 +20,7 @@ from dem.geometry.neighbours import min_image
 
 @njit(cache=True, error_model="numpy")
 def iterate(law, particles, trial, pairs, walls, wall_list, constants, dt, phi):
-    """One fixed-point iteration K of the trapezoidal step (Zohdi 2014, eqs. 22-27) under the contact law ``law``:
+    r"""One fixed-point iteration K of the trapezoidal step (Zohdi 2014, eqs. 22-27) under the contact law ``law``:
     the forces at the previous iterate (with the walls where they are at the end of the step; the contacts' histories
     read from the lists' ``hist_in``, those of the step's start, and written to their ``hist``), then::
 
@@ -32,11 +32,12 @@ def iterate(law, particles, trial, pairs, walls, wall_list, constants, dt, phi):
     law : dem.laws.contact.binding.ContactLaw
         The contact law, bound at compile time.
     particles : dem.engines.records.Particles
-        The previous iterate ``(x, v) = (r^(K-1), v^(K-1))``; its forces ``F^(K-1)`` are written into ``f``.
+        The previous iterate, its positions :math:`r^{K-1}` and velocities :math:`v^{K-1}` as ``x`` and ``v``; its
+        forces :math:`F^{K-1}` are written into ``f``.
     trial : dem.engines.records.Trial
-        The step's start and where the new iterate goes; its ``stats`` receive ``sum |r^K - r^(K-1)|``,
-        ``sum |r^K - r^L|`` (Algorithm 1, step 4a), the largest distance of any particle from where the Verlet list
-        was built and a NaN flag.
+        The step's start and where the new iterate goes; its ``stats`` receive :math:`\sum |r^K - r^{K-1}|`,
+        :math:`\sum |r^K - r^L|` (Algorithm 1, step 4a), the largest distance of any particle from where the Verlet
+        list was built and a NaN flag.
     pairs : dem.engines.records.PairList
         The Verlet list of pairs.
     walls : dem.geometry.walls.WallArrays
