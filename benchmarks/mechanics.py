@@ -258,13 +258,11 @@ def time_ours(make, steps: int, warmup: int) -> dict:
 
 
 @njit  # not cached: numba's cache follows only this file, so a cached copy would keep an old engine's code
-def _force_passes(count, contact_law, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_fn, p_ft,
-                  p_const, wn, wq, wdq, wforce, wk, wm, w_hist, w_fn, w_ft, params, dt):
+def _force_passes(count, contact_law, particles, pairs, walls, wall_list, constants, dt):
     """``count`` force passes of the engine's loop (:func:`dem.engines.contact_forces.forces`) in one compiled call
     (the pairs' constants computed in the first, as the engine's loop does at a call's first step)."""
     for _ in range(count):
-        forces(contact_law, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist,
-               p_fn, p_ft, p_const, _ == 0, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params, dt)
+        forces(contact_law, particles, pairs, walls, wall_list, constants, dt, _ == 0, True)
 
 
 @njit  # not cached (as above)
@@ -284,7 +282,7 @@ def stage_costs(sample: dict, material: LudingMaterial, steps: int) -> dict:
     spread = time_ours(lambda: periodic_simulation({**sample, "position": 3.0 * sample["position"],
                                                     "box": 3.0 * sample["box"]}, material), steps, 10)
     sim = periodic_simulation(sample, material)
-    mech, s, w = sim.mechanics, sim.mechanics.state, sim.mechanics.w
+    mech, s = sim.mechanics, sim.mechanics.state
     mech.advance(10, T0, rate)
     n = s.n
     rebuilds = mech.rebuilds
@@ -292,9 +290,7 @@ def stage_costs(sample: dict, material: LudingMaterial, steps: int) -> dict:
     mech.advance(steps, T0, rate)
     whole = time.process_time() - t0
     rebuilds = mech.rebuilds - rebuilds
-    forces_args = (ContactLaw("luding"), s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, mech.particle_state, s.T,
-                   mech.gravity, mech.box, mech.pi, mech.pj, mech.p_hist, mech.p_fn, mech.p_ft, mech.p_const, w.normal,
-                   w.q, w.dq, w.force, mech.wk, mech.wm, mech.w_hist, mech.w_fn, mech.w_ft, mech.params, mech.dt)
+    forces_args = (ContactLaw("luding"), *mech.records(), mech.dt)
     material_args = (mech.t, T0, rate, s.T, s.radius, s.radius_ref, mech.particle_state, True, mech.params,
                      mech.relaxation_time, mech.dt)
     _force_passes(0, *forces_args)  # compile

@@ -6,7 +6,7 @@ import pytest
 
 from dem.geometry.bonds import find_bonds
 from dem.geometry.particles import Particles
-from dem.geometry.walls import Wall
+from dem.geometry.walls import Wall, WallArrays
 from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.laws.lens_conductance import LENS_POLICY, lens_list_conductances
 
@@ -21,10 +21,9 @@ WALL = Wall("floor", [0.0, 0.0, -0.2], [0.0, 0.0, 1.0], 400.0)
 
 def listed(policy, kc=None):
     K, K_w = np.empty(len(PI)), np.empty(5)
-    bad = lens_list_conductances(X, R, KAPPA, np.inf if kc is None else kc, LENS_POLICY[policy], PI.astype(np.int64),
-                                 PJ.astype(np.int64), np.array([WALL.normal]), np.array([-0.2]),
-                                 np.arange(5, dtype=np.int64), np.zeros(5, dtype=np.int64), K, K_w,
-                                 np.zeros(3))
+    bad = lens_list_conductances(X, R, KAPPA, np.inf if kc is None else kc, LENS_POLICY[policy],
+                                 (PI.astype(np.int64), PJ.astype(np.int64)), WallArrays.build([WALL], 3),
+                                 (np.arange(5, dtype=np.int64), np.zeros(5, dtype=np.int64)), K, K_w, np.zeros(3))
     return bad, K, K_w
 
 

@@ -95,10 +95,12 @@ def split_incidences(pi, pj, n, n_blocks):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="always")
-def add_pair_share(law, f, tau, k, sign, g0, g1, g2, arm, m0, m1, m2, planar):
+def add_pair_share(law, f, tau, k, sign, g, arm, m, planar):
     """Particle ``k``'s share of a pair's force and torque: ``sign g`` into its force (``sign`` +1 for the pair's i,
-    -1 for its j) and ``-arm (n x f_t)`` into its torque, ``arm`` its lever ``l_i`` or ``l_j`` (module docstring).
-    (``x - g`` and ``x + (-1) g`` are the same number.)"""
+    -1 for its j; ``g = f_n n + f_t``, a 3-tuple) and ``-arm m`` into its torque, ``m = n x f_t`` (a 3-tuple) and
+    ``arm`` its lever ``l_i`` or ``l_j`` (module docstring). (``x - g`` and ``x + (-1) g`` are the same number.)"""
+    g0, g1, g2 = g
+    m0, m1, m2 = m
     f[k, 0] += sign * g0
     f[k, 1] += sign * g1
     f[k, 2] += sign * g2
@@ -124,31 +126,62 @@ def pair_geometry(c, x, pi, pj, box, planar):
 
 
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, parallel=THREADED)
-def forces(law, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in, p_hist, p_fn, p_ft,
-           p_const, fresh, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, dt, record=True,
-           start=None, pairs=None, load=None, owner=None, n_blocks=1):
+def forces(law, particles, pairs, walls, wall_list, constants, dt, fresh, record):
     """Forces and torques of the current state under the contact law ``law`` (a
-    :class:`~dem.laws.contact.binding.ContactLaw`): gravity, the law's drag, pairs, the listed particle-wall pairs
-    ``(wk, wm)``); the normal forces on the walls go into ``wforce``. Returns the index into the wall list of the
-    first particle whose centre lies behind its wall, else -1.
+    :class:`~dem.laws.contact.binding.ContactLaw`): gravity, the law's drag, the listed pairs, the listed
+    particle-wall pairs; the normal forces on the walls go into ``walls.force``. Returns the index into the wall list
+    of the first particle whose centre lies behind its wall, else -1.
 
-    Each contact's history is read from ``p_hist_in``/``w_hist_in`` and written to ``p_hist``/``w_hist``: the same
-    arrays for a step that is taken (velocity Verlet), others for an iterate that may be discarded (the implicit
-    scheme). With ``record`` the contact forces are kept (``p_fn``, ``p_ft``, ``w_fn``, ``w_ft``: outputs only, so
-    a time loop records them on the last step of a call). ``p_const`` (M, 2) holds the listed pairs' numbers that
-    depend on their radii alone (the law's ``pair_constants``, where it keeps any): ``fresh`` computes them (and keeps
-    them there when it has rows), else they are read from there; a time loop passes ``fresh`` where the radii or the
-    list changed. ``spin_axes`` (:attr:`dem.geometry.motion.MotionState.spin_axes`): ``(1,)`` for 2D disks in the x-z
-    plane, whose pair terms along y vanish.
+    Parameters
+    ----------
+    law : dem.laws.contact.binding.ContactLaw
+        The contact law, bound at compile time.
+    particles : dem.engines.records.Particles
+        The particles; their forces ``f`` and torques ``tau`` are written.
+    pairs : dem.engines.records.PairList
+        The Verlet list of pairs.
+    walls : dem.geometry.walls.WallArrays
+        The walls.
+    wall_list : dem.engines.records.WallList
+        The particle-wall list.
+    constants : dem.engines.records.Constants
+        Gravity, the periodic box and the law's material.
+    dt : float
+        The step the contacts' histories advance by (s; 0: none).
+    fresh : bool
+        Whether the pairs' numbers of the radii alone are computed (below), not read.
+    record : bool
+        Whether the contact forces are kept (``pairs.fn``, ``pairs.ft``).
+
+    Notes
+    -----
+    Each contact's history is read from ``hist_in`` and written to ``hist`` of its list: the same arrays for a step
+    that is taken (velocity Verlet), others for an iterate that may be discarded (the implicit scheme). With
+    ``record`` the pair forces are kept (outputs only, so a time loop records them on the last step of a call).
+    ``pairs.const`` (M, 2) holds the listed pairs' numbers that depend on their radii alone (the law's
+    ``pair_constants``, where it keeps any): ``fresh`` computes them (and keeps them there when it has rows), else
+    they are read from there; a time loop passes ``fresh`` where the radii or the list changed. ``spin_axes``
+    (:attr:`dem.engines.state.MotionState.spin_axes`): ``(1,)`` for 2D disks in the x-z plane, whose pair terms
+    along y vanish.
 
     The law's kernels are inlined right here, scalars and 3-tuples in and out, with the material as a tuple: an
     array argument costs an atomic reference count per call (a quarter of the loop). The length of ``spin_axes`` is
     part of its type, so 2D and 3D get code of their own, the 2D one without the terms that vanish (a fifth
     faster).
 
-    Where ``THREADED`` (module docstring), ``owner``, ``start`` and ``pairs`` are :func:`split_incidences` of the
-    list for ``n_blocks`` threads and ``load`` a ``(len(pi), LOAD_COLUMNS)`` buffer; the walls stay on one thread (a
-    few particles: the surface's)."""
+    Where ``THREADED`` (module docstring), the list's ``owner``, ``start`` and ``order`` are
+    :func:`split_incidences` of the list for ``n_blocks`` threads and ``load`` a ``(M, LOAD_COLUMNS)`` buffer; the
+    walls stay on one thread (a few particles: the surface's).
+    """
+    x, v, w, f, tau, spin_axes = particles.x, particles.v, particles.w, particles.f, particles.tau, particles.spin_axes
+    mass, radius, state, T = particles.mass, particles.radius, particles.state, particles.T
+    pi, pj, p_hist_in, p_hist, p_fn, p_ft = pairs.i, pairs.j, pairs.hist_in, pairs.hist, pairs.fn, pairs.ft
+    p_const, owner, start, order, load, n_blocks = pairs.const, pairs.owner, pairs.start, pairs.order, pairs.load, \
+        pairs.n_blocks
+    wn, wq, wdq, wforce = walls.normal, walls.q, walls.dq, walls.force
+    wk, wm, w_hist_in, w_hist, w_fn, w_ft = wall_list.k, wall_list.m, wall_list.hist_in, wall_list.hist, \
+        wall_list.fn, wall_list.ft
+    gravity, box, params = constants.gravity, constants.box, constants.params
     planar = len(spin_axes) == 1
     escaped = -1
     n = x.shape[0]
@@ -220,19 +253,19 @@ def forces(law, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box
                     load[c, 0], load[c, 1], load[c, 2], load[c, 3], load[c, 4], load[c, 5] = g0, g1, g2, m0, m1, m2
                     load[c, 6], load[c, 7], load[c, 8] = li, lj, 1.0
             if add_i:
-                add_pair_share(law, f, tau, i, 1.0, g0, g1, g2, li, m0, m1, m2, planar)
+                add_pair_share(law, f, tau, i, 1.0, (g0, g1, g2), li, (m0, m1, m2), planar)
             if add_j:
-                add_pair_share(law, f, tau, j, -1.0, g0, g1, g2, lj, m0, m1, m2, planar)
+                add_pair_share(law, f, tau, j, -1.0, (g0, g1, g2), lj, (m0, m1, m2), planar)
     if THREADED:
         for k in range(n):  # each particle the rows of its pairs in later blocks, in the order of the list
             for e in range(start[k], start[k + 1]):
-                c = pairs[e]
+                c = order[e]
                 sign, arm = (1.0, 6) if c >= 0 else (-1.0, 7)
                 c = c if c >= 0 else ~c
                 if load[c, 8] == 0.0:
                     continue
-                add_pair_share(law, f, tau, k, sign, load[c, 0], load[c, 1], load[c, 2], load[c, arm], load[c, 3],
-                               load[c, 4], load[c, 5], planar)
+                add_pair_share(law, f, tau, k, sign, (load[c, 0], load[c, 1], load[c, 2]), load[c, arm],
+                               (load[c, 3], load[c, 4], load[c, 5]), planar)
     n_w = wn.shape[0]
     for m in range(n_w):
         wforce[m] = 0.0

@@ -45,8 +45,12 @@ def fibonacci_directions(n: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def _hits(x, radius, k, ox, oy, oz, dx, dy, dz, members, start, count, cell):
-    """Does the ray ``o + s d`` (s > 0) meet a particle of cell ``cell`` other than ``k``?"""
+def _hits(x, radius, k, origin, direction, bins, cell):
+    """Does the ray ``o + s d`` (s > 0; ``origin`` o and ``direction`` d as 3-tuples) meet a particle of cell ``cell``
+    other than ``k``? ``bins``: ``(members, start, count)``, the particles of each cell."""
+    ox, oy, oz = origin
+    dx, dy, dz = direction
+    members, start, count = bins
     for e in range(start[cell], start[cell] + count[cell]):
         m = members[e]
         if m == k:
@@ -90,7 +94,7 @@ def _exposed(x, radius, directions, lo, size, ncell, members, start, count):
                 for a in range(max(c0 - 1, 0), min(c0 + 2, ncell[0])):
                     for b in range(max(c1 - 1, 0), min(c1 + 2, ncell[1])):
                         for c in range(max(c2 - 1, 0), min(c2 + 2, ncell[2])):
-                            if _hits(x, radius, k, ox, oy, oz, dx, dy, dz, members, start, count,
+                            if _hits(x, radius, k, (ox, oy, oz), (dx, dy, dz), (members, start, count),
                                      (a * ncell[1] + b) * ncell[2] + c):
                                 hit = True
                                 break

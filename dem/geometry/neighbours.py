@@ -110,10 +110,12 @@ def _cells(x, radius, skin, box):
 
 
 @njit(cache=True)
-def _partners(k, x, radius, skin, box, cell, head, nxt, ncell, wrap, out_i, out_j, found, room):
-    """The partners ``m > k`` of particle ``k`` within ``r_k + r_m + skin`` (cells of :func:`_cells`), written in
-    order of ``m`` into ``out_i``, ``out_j`` from ``found`` on while below ``room``; returns ``found`` plus their
-    number."""
+def _partners(k, x, radius, skin, box, grid, out, found, room):
+    """The partners ``m > k`` of particle ``k`` within ``r_k + r_m + skin`` (``grid``: the cells of :func:`_cells`),
+    written in order of ``m`` into ``out = (out_i, out_j)`` from ``found`` on while below ``room``; returns ``found``
+    plus their number."""
+    cell, head, nxt, ncell, wrap = grid
+    out_i, out_j = out
     first = found
     for d0 in range(-1, 2):
         c0 = cell[k, 0] + d0
@@ -169,14 +171,13 @@ def _pairs_in_blocks(x, radius, skin, box, block, slot, out_i, out_j):
     ``slot[b]`` on while below ``slot[b + 1]``; returns every block's number of pairs (a block whose slot is that
     large holds them all)."""
     n = x.shape[0]
-    cell, head, nxt, ncell, wrap = _cells(x, radius, skin, box)
+    grid = _cells(x, radius, skin, box)
     blocks = slot.shape[0] - 1
     counts = np.zeros(blocks, dtype=np.int64)
     for b in prange(blocks):
         found = slot[b]
         for k in range(b * block, min(n, (b + 1) * block)):
-            found = _partners(k, x, radius, skin, box, cell, head, nxt, ncell, wrap, out_i, out_j, found,
-                              slot[b + 1])
+            found = _partners(k, x, radius, skin, box, grid, (out_i, out_j), found, slot[b + 1])
         counts[b] = found - slot[b]
     return counts
 

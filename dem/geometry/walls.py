@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -242,9 +243,9 @@ def extent(q: np.ndarray, lo: int, hi: int) -> float:
     return float(-(q[lo] + q[hi]))
 
 
-@dataclass
-class WallArrays:
-    """The walls' state and parameters as arrays for the compiled loops (mutated in place); W walls.
+class WallArrays(NamedTuple):
+    """The walls' state and parameters as arrays for the compiled loops (mutated in place); W walls. A named tuple:
+    the compiled loops take it as one argument (:mod:`dem.engines.records`).
 
     Parameters
     ----------

@@ -33,6 +33,7 @@ with the derivative taken on the same grid for both profiles, so that they cance
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba
 import numpy as np
@@ -41,6 +42,9 @@ from fem_neck.geometry.cut_kernels import _clip, _face
 
 SAMPLES = 32  # intervals of the grid along each half body
 EMPTY = 1e-12  # a cross-section below this x pi r^2 is none: the axis has left the cut body
+# A particle's work arrays: the section plane's basis u, w (3,), the other ends' lines in it (z, 3), the clipped
+# polygon and the clipper's room, the areas of the cut and of the ball's sections along the half body (samples + 1)
+Scratch = namedtuple("Scratch", ["u", "w", "lines", "poly", "work", "area", "ball"])
 
 
 @numba.njit(cache=True)
@@ -115,8 +119,10 @@ def _section(r, z, b, lo, hi, normals, planes, u, w, lines, poly, work):
 
 
 @numba.njit(cache=True)
-def _half_body(r, b, lo, hi, normals, planes, u, w, lines, poly, work, area, ball, samples):
-    """``kappa Delta R`` of end ``b`` (module docstring), 1/m; infinite when the axis leaves the cut body."""
+def _half_body(r, b, lo, hi, normals, planes, scratch, samples):
+    """``kappa Delta R`` of end ``b`` (module docstring), 1/m; infinite when the axis leaves the cut body.
+    ``scratch``: the work arrays (:data:`Scratch`)."""
+    u, w, lines, poly, work, area, ball = scratch
     length = planes[b]
     step = length / samples
     _basis(normals[b], u, w)
@@ -157,12 +163,10 @@ def _cut_body_kernel(n, particle, normals, planes, radius, samples):
         lo, hi = offsets[k], offsets[k + 1]
         if hi - lo < 2:
             continue
-        u, w = np.empty(3), np.empty(3)
-        lines, poly, work = np.empty((z_max, 3)), np.empty((z_max + 4, 2)), np.empty((2 * z_max + 8, 2))
-        area, ball = np.empty(samples + 1), np.empty(samples + 1)
+        scratch = Scratch(np.empty(3), np.empty(3), np.empty((z_max, 3)), np.empty((z_max + 4, 2)),
+                          np.empty((2 * z_max + 8, 2)), np.empty(samples + 1), np.empty(samples + 1))
         for b in range(lo, hi):
-            out[order[b]] = _half_body(radius[k], b, lo, hi, sorted_normals, sorted_planes, u, w, lines, poly, work,
-                                       area, ball, samples)
+            out[order[b]] = _half_body(radius[k], b, lo, hi, sorted_normals, sorted_planes, scratch, samples)
     return out
 
 

@@ -28,9 +28,10 @@ def lens_conductance(l_i, l_j, area, kappa_i, kappa_j, contact_conductance):
 
 
 @njit(cache=True, error_model="numpy")
-def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pi, pj, wn, wq, wk, wm, K, K_w, box):
-    r"""The ``zohdi`` law (:func:`lens_conductance`) on every listed pair ``(pi, pj)`` into ``K`` and every listed
-    particle-wall pair ``(wk, wm)`` (walls :math:`n_m \cdot x = q_m`) into ``K_w``, with the lens geometry of
+def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pairs, walls, wall_pairs, K, K_w, box):
+    r"""The ``zohdi`` law (:func:`lens_conductance`) on every listed pair of ``pairs``, the arrays ``(pi, pj)``, into
+    ``K`` and every listed particle-wall pair of ``wall_pairs``, the arrays ``(wk, wm)``, into ``K_w`` (``walls`` a
+    :class:`dem.geometry.walls.WallArrays`, the planes :math:`n_m \cdot x = q_m`), with the lens geometry of
     :func:`dem.geometry.bonds.find_bonds` (``contact = "lens"``) at positions ``x``; ``K = 0`` where the pair does not
     touch (:math:`|x_i - x_j| \ge R_i + R_j`, a wall at a distance :math:`\ge R_k`). Along the axes where ``box`` holds
     a period (else 0) a pair is joined by the minimum image (:func:`dem.geometry.neighbours.min_image`).
@@ -40,6 +41,7 @@ def lens_list_conductances(x, radius, kappa, contact_conductance, policy, pi, pj
     dropped (``K = 0``). Returns the number of contacts that ``policy`` cannot take (``"error"``: a lens beyond its
     range; any policy but ``"drop"``: coincident centres, a centre on or behind a wall), whose ``K`` is left 0:
     ``find_bonds`` then names the first and says what to do."""
+    (pi, pj), (wk, wm), wn, wq = pairs, wall_pairs, walls.normal, walls.q
     bad = 0
     periodic = box[0] > 0.0 or box[1] > 0.0 or box[2] > 0.0  # without a box the loop stays the plain one
     for c in range(pi.shape[0]):

@@ -82,12 +82,26 @@ Gaussian elimination of the ``z x z`` matrix ``R`` with four right-hand sides, w
 
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numba
 import numpy as np
 
 from dem.geometry.bonds import Bonds
 
 ROUNDOFF = 1e-12  # interactions below this x the smallest half resistance are round-off of collinear bonds
+
+# What the compiled loop takes (named tuples of arrays: one argument each to numba)
+PairNecks = namedtuple("PairNecks", ["i", "j", "vec", "a", "l_i", "l_j", "k_i", "k_j"])
+PairNecks.__doc__ = """The pair bonds' necks (m bonds): particles ``i``, ``j`` (int), ``vec`` (m, 3) from ``i`` to the
+partner (m), neck radii ``a`` (m), centre-to-contact distances ``l_i``, ``l_j`` (m), half conductances ``k_i``,
+``k_j`` (W/K)."""
+WallNecks = namedtuple("WallNecks", ["particle", "normal", "a", "l", "k"])
+WallNecks.__doc__ = """The wall bonds' necks: the particle (int), the wall's unit ``normal`` into the packing, neck
+radius ``a`` (m), centre-to-contact distance ``l`` (m), half conductance ``k`` (W/K)."""
+Bodies = namedtuple("Bodies", ["radius", "kappa", "share"])
+Bodies.__doc__ = """Per particle: ``radius`` (m), conductivity ``kappa`` (W/(m K)) and ``share``, the solid it holds
+over its sphere's volume."""
 
 
 @numba.njit(cache=True)
@@ -155,13 +169,12 @@ def _own_flux(x, N, z, flux):
 
 
 @numba.njit(cache=True, parallel=True)
-def _factors(n_particles, i, j, vec, a, l_i, l_j, k_i, k_j, wall_particle, wall_normal, wall_a, wall_l, k_wall,
-             radius, kappa, share, trace_cap):
-    """The factor of every neck end (module docstring): end ``e < m`` is bond ``e``'s half on particle ``i``,
-    ``m <= e < 2m`` its half on ``j``, and the rest the wall bonds' halves. Bonds: ``vec`` (m, 3) from ``i`` to the
-    partner, neck radius ``a``, centre-to-contact distances ``l_i``, ``l_j``, half conductances ``k_i``, ``k_j``;
-    wall bonds: ``wall_normal`` into the packing, ``wall_a``, ``wall_l``, ``k_wall``. The neck ends are grouped by
-    particle (a counting sort) and the particles shared among the threads in chunks."""
+def _factors(n_particles, pairs, walls, bodies, trace_cap):
+    """The factor of every neck end (module docstring) of the ``n_particles`` particles ``bodies``
+    (:class:`Bodies`): end ``e < m`` is pair bond ``e``'s half on its particle ``i``, ``m <= e < 2m`` its half on
+    ``j`` (:class:`PairNecks`), and the rest the wall bonds' halves (:class:`WallNecks`). The neck ends are grouped
+    by particle (a counting sort) and the particles shared among the threads in chunks."""
+    i, j, wall_particle = pairs.i, pairs.j, walls.particle
     m, mw = len(i), len(wall_particle)
     total = 2 * m + mw
     out = np.ones(total)
@@ -179,15 +192,17 @@ def _factors(n_particles, i, j, vec, a, l_i, l_j, k_i, k_j, wall_particle, wall_
     z_max = int(np.max(counts)) if total else 0
     chunk = 4096
     for block in numba.prange((n_particles + chunk - 1) // chunk):
-        _block_factors(block * chunk, min((block + 1) * chunk, n_particles), offsets, ends, m, vec, a, l_i, l_j,
-                       k_i, k_j, wall_normal, wall_a, wall_l, k_wall, radius, kappa, share, trace_cap, z_max, out)
+        _block_factors(block * chunk, min((block + 1) * chunk, n_particles), offsets, ends, pairs, walls, bodies,
+                       trace_cap, z_max, out)
     return out
 
 
 @numba.njit(cache=True)
-def _block_factors(first, last, offsets, ends, m, vec, a, l_i, l_j, k_i, k_j, wall_normal, wall_a, wall_l, k_wall,
-                   radius, kappa, share, trace_cap, z_max, out):
+def _block_factors(first, last, offsets, ends, pairs, walls, bodies, trace_cap, z_max, out):
     """:func:`_factors` for the particles ``first:last``, with work arrays of their own."""
+    m, vec, a, l_i, l_j, k_i, k_j = len(pairs.i), pairs.vec, pairs.a, pairs.l_i, pairs.l_j, pairs.k_i, pairs.k_j
+    wall_normal, wall_a, wall_l, k_wall = walls.normal, walls.a, walls.l, walls.k
+    radius, kappa, share = bodies.radius, bodies.kappa, bodies.share
     normal = np.empty((z_max, 3))
     base = np.empty(z_max)
     arm = np.empty(z_max)
@@ -321,11 +336,12 @@ def neck_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, 
     f = np.ascontiguousarray
     sphere = 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=float) ** 3
     share = np.ones(n) if volume is None else np.asarray(volume, dtype=float) / sphere
-    out = _factors(n, f(bonds.i, dtype=np.int64), f(bonds.j, dtype=np.int64), f(vectors, dtype=float),
-                   f(bonds.a, dtype=float), f(bonds.l_i, dtype=float), f(bonds.l_j, dtype=float), f(k_i, dtype=float),
-                   f(k_j, dtype=float), f(bonds.wall_particle, dtype=np.int64),
-                   f(np.reshape(wall_normals, (-1, 3)), dtype=float), f(bonds.wall_a, dtype=float),
-                   f(bonds.wall_l, dtype=float), f(k_wall, dtype=float), f(radius, dtype=float),
-                   f(conductivity, dtype=float), f(share, dtype=float), bool(trace_cap))
+    pairs = PairNecks(f(bonds.i, dtype=np.int64), f(bonds.j, dtype=np.int64), f(vectors, dtype=float),
+                      f(bonds.a, dtype=float), f(bonds.l_i, dtype=float), f(bonds.l_j, dtype=float),
+                      f(k_i, dtype=float), f(k_j, dtype=float))
+    walls = WallNecks(f(bonds.wall_particle, dtype=np.int64), f(np.reshape(wall_normals, (-1, 3)), dtype=float),
+                      f(bonds.wall_a, dtype=float), f(bonds.wall_l, dtype=float), f(k_wall, dtype=float))
+    bodies = Bodies(f(radius, dtype=float), f(conductivity, dtype=float), f(share, dtype=float))
+    out = _factors(n, pairs, walls, bodies, bool(trace_cap))
     m = bonds.n_pairs
     return out[:m], out[m:2 * m], out[2 * m:]

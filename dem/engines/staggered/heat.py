@@ -172,8 +172,8 @@ class LumpedHeat:
         K, K_w = np.empty(len(mech.pi)), np.empty(len(plane_node))
         if self.spec.law == "zohdi":
             bad = lens_list_conductances(x, self.particles.radius, self.kappa, self.contact_conductance,
-                                         LENS_POLICY[self.spec.out_of_range], mech.pi, mech.pj, mech.w.normal,
-                                         mech.w.q, plane_node, wall, K, K_w, mech.box)
+                                         LENS_POLICY[self.spec.out_of_range], (mech.pi, mech.pj), mech.w,
+                                         (plane_node, wall), K, K_w, mech.box)
             if bad:  # find_bonds names the first contact the policy cannot take
                 contact_bonds(self.particles, mech, x, T, self.thermal_walls, "lens", self.spec.out_of_range)
                 raise RuntimeError(f"{bad} lens contacts out of range that find_bonds accepts")

@@ -19,25 +19,47 @@ from dem.geometry.neighbours import min_image
 
 
 @njit(cache=True, error_model="numpy")
-def iterate(law, dt, phi, x_L, v_L, f_L, x_prev, v_prev, T, mass, radius, gravity, pi, pj, p_hist_in, p_hist, p_fn,
-            p_ft, wn, wq, wdq, wk, wm, w_hist_in, w_hist, w_fn, w_ft, params, f, w, tau, spin_axes, state, box, wforce,
-            x_new, v_new, x_ref, stats):
-    """One fixed-point iteration K of the trapezoidal step (Zohdi 2014, eqs. 22-27) under the contact law ``law``:
-    the forces at the previous
-    iterate ``(x_prev, v_prev)`` (with the walls where they are at the end of the step; the contacts' histories read
-    from ``p_hist_in``/``w_hist_in``, those of the step's start, and written to ``p_hist``/``w_hist``), then::
+def iterate(law, particles, trial, pairs, walls, wall_list, constants, dt, phi):
+    r"""One fixed-point iteration K of the trapezoidal step (Zohdi 2014, eqs. 22-27) under the contact law ``law``:
+    the forces at the previous iterate (with the walls where they are at the end of the step; the contacts' histories
+    read from the lists' ``hist_in``, those of the step's start, and written to their ``hist``), then::
 
         v^K = v^L + dt/m (phi F^(K-1) + (1 - phi) F^L)          (eq. 22)
         r^K = r^L + dt (phi v^K + (1 - phi) v^L)                 (eq. 23; together eq. 26)
 
-    ``stats`` receives ``sum |r^K - r^(K-1)|``, ``sum |r^K - r^L|`` (Algorithm 1, step 4a), the largest distance of
-    any particle from ``x_ref`` (where the Verlet list was built) and a NaN flag. Returns the escaped wall pair index
-    of :func:`~dem.engines.contact_forces.forces` (-1 if none)."""
-    # (the pairs' numbers of the radii computed at every evaluation: no room kept, an empty array made here, as a
-    # global one would be read-only to numba)
-    escaped = forces(law, x_prev, v_prev, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist_in,
-                     p_hist, p_fn, p_ft, np.empty((0, 0)), True, wn, wq, wdq, wforce, wk, wm, w_hist_in, w_hist, w_fn,
-                     w_ft, params, dt)
+    Parameters
+    ----------
+    law : dem.laws.contact.binding.ContactLaw
+        The contact law, bound at compile time.
+    particles : dem.engines.records.Particles
+        The previous iterate, its positions :math:`r^{K-1}` and velocities :math:`v^{K-1}` as ``x`` and ``v``; its
+        forces :math:`F^{K-1}` are written into ``f``.
+    trial : dem.engines.records.Trial
+        The step's start and where the new iterate goes; its ``stats`` receive :math:`\sum |r^K - r^{K-1}|`,
+        :math:`\sum |r^K - r^L|` (Algorithm 1, step 4a), the largest distance of any particle from where the Verlet
+        list was built and a NaN flag.
+    pairs : dem.engines.records.PairList
+        The Verlet list of pairs.
+    walls : dem.geometry.walls.WallArrays
+        The walls.
+    wall_list : dem.engines.records.WallList
+        The particle-wall list.
+    constants : dem.engines.records.Constants
+        Gravity, the periodic box and the law's material.
+    dt : float
+        The step (s).
+    phi : float
+        The trapezoidal weight, in ``[0, 1]`` (eqs. 22-24).
+
+    Returns
+    -------
+    int
+        The escaped wall pair index of :func:`~dem.engines.contact_forces.forces` (-1 if none).
+    """
+    escaped = forces(law, particles, pairs, walls, wall_list, constants, dt, True, True)
+    x_L, v_L, f_L, x_new, v_new, stats = trial.x_start, trial.v_start, trial.f_start, trial.x_new, trial.v_new, \
+        trial.stats
+    x_prev, f, mass, x_ref = particles.x, particles.f, particles.mass, pairs.x_ref
     change, motion, reach, finite = 0.0, 0.0, 0.0, 1.0
     for k in range(x_L.shape[0]):
         h = dt / mass[k]

@@ -23,7 +23,8 @@ import math
 
 import numpy as np
 
-from dem.engines import compiled
+from dem.engines import compiled, records
+from dem.engines.records import Constants, PairList, Trial, WallList
 from dem.engines.state import MotionState
 from dem.geometry.neighbours import carry_history, max_displacement, restore_lists, verlet_pairs, wall_pairs
 from dem.geometry.periodic import PeriodicBox
@@ -47,7 +48,7 @@ class StaggeredMechanics:
 
         Parameters
         ----------
-        state : dem.geometry.motion.MotionState
+        state : dem.engines.state.MotionState
             The particles' state (SI units), advanced in place.
         walls : sequence of dem.geometry.walls.Wall
             The walls (fixed, strain or vibrating; no stress walls).
@@ -88,12 +89,14 @@ class StaggeredMechanics:
         self.x_new, self.v_new = state.x.copy(), state.v.copy()
         self.x_prev, self.v_prev = state.x.copy(), state.v.copy()
         self.q_start = self.w.q.copy()
-        self.wforce = np.zeros(len(self.walls))
+        self.wforce = self.w.force  # the particles' normal forces on the walls, of the latest evaluation
         self.stats = np.zeros(4)
         self.rebuilds = 0
         # the particles do not rotate: no spin, no torque (the force loop's arrays for them stay zero)
         self._spin, self._torque = np.zeros((n, 3)), np.zeros((n, 3))
         self.particle_state = self.law.initial_state(material, state.T, state.mass)
+        self._bodies = records.particles(state, self.particle_state, w=self._spin, tau=self._torque,
+                                         spin_axes=(0, 1, 2))  # the positions, velocities, forces, T: per call
         n_w = len(self.walls)
         self.w_hist = np.zeros((n, n_w, len(self.law.WALL_HISTORY)))  # committed at each accepted step
         self._w_hist_iter = self.w_hist.copy()
@@ -156,13 +159,37 @@ class StaggeredMechanics:
     def _wall_reach(self) -> float:
         return float(np.max(np.abs(self.w.q - self.wq_ref), initial=0.0))
 
+    def records(self, x, v, T, f) -> tuple:
+        """What the compiled loops take (:mod:`dem.engines.records`) for the particles at ``(x, v, T)`` whose forces
+        go into ``f``, made of the model's arrays as they are now: the histories read from those of the step's start
+        and written to the iterate's, the pairs' numbers of the radii computed at every force evaluation (no room
+        kept for them).
+
+        Parameters
+        ----------
+        x, v : numpy.ndarray
+            (N, 3) positions (m) and velocities (m/s).
+        T : numpy.ndarray
+            (N,) temperatures (K).
+        f : numpy.ndarray
+            (N, 3) where the forces go (N).
+
+        Returns
+        -------
+        tuple
+            ``(particles, pairs, walls, wall_list, constants)``: :class:`~dem.engines.records.Particles`,
+            :class:`~dem.engines.records.PairList`, :class:`~dem.geometry.walls.WallArrays`,
+            :class:`~dem.engines.records.WallList`, :class:`~dem.engines.records.Constants`.
+        """
+        particles = self._bodies._replace(x=x, v=v, f=f, T=T)
+        pairs = PairList(self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn, self.p_ft, NO_PAIR_CONSTANTS,
+                         self.x_ref, *records.ONE_THREAD, 1)
+        wall_list = WallList(self.wk, self.wm, self.w_hist, self._w_hist_iter, self.w_fn, self.w_ft, self.wq_ref)
+        return particles, pairs, self.w, wall_list, Constants(self.gravity, self.box, self.params, self.skin)
+
     def _evaluate(self, x, v, T, out):
         """Forces at ``(x, v, T)`` with the walls where they are now; checks that no particle left the box."""
-        w, s = self.w, self.state
-        escaped = self._forces(x, v, self._spin, out, self._torque, (0, 1, 2), s.mass, s.radius, self.particle_state, T,
-                               self.gravity, self.box, self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn,
-                               self.p_ft, NO_PAIR_CONSTANTS, True, w.normal, w.q, w.dq, self.wforce, self.wk, self.wm, self.w_hist,
-                               self._w_hist_iter, self.w_fn, self.w_ft, self.params, 0.0)
+        escaped = self._forces(*self.records(x, v, T, out), 0.0, True, True)
         self._check_escape(escaped, x)
 
     def _check_escape(self, escaped, x):
@@ -249,13 +276,10 @@ class StaggeredMechanics:
         ValueError
             A particle left the box through a wall, or a position became non-finite.
         """
-        s, w = self.state, self.w
-        escaped = self._iterate(dt, phi, s.x, s.v, self.f, self.x_prev, self.v_prev, T, s.mass, s.radius,
-                                self.gravity, self.pi, self.pj, self.p_hist, self._p_hist_iter, self.p_fn, self.p_ft,
-                                w.normal, w.q, w.dq, self.wk, self.wm, self.w_hist, self._w_hist_iter, self.w_fn,
-                                self.w_ft, self.params, self._f_iter, self._spin, self._torque, (0, 1, 2),
-                                self.particle_state, self.box, self.wforce, self.x_new, self.v_new, self.x_ref,
-                                self.stats)
+        s = self.state
+        particles, pairs, walls, wall_list, constants = self.records(self.x_prev, self.v_prev, T, self._f_iter)
+        trial = Trial(s.x, s.v, self.f, self.x_new, self.v_new, self.stats)
+        escaped = self._iterate(particles, trial, pairs, walls, wall_list, constants, dt, phi)
         self._check_escape(escaped, self.x_prev)
         change, motion, reach, finite = self.stats
         if not finite:

@@ -38,34 +38,58 @@ DONE, REBUILD, NONFINITE, ESCAPED = 0, 1, 2, 3  # how a call of advance() ended
 
 
 @njit(cache=True, error_model="numpy")
-def wall_acceleration(m, wq, wdq, wmode, wpress, wmass, wdamp, wspan, wforce):
-    """Eq. (1) of Luding 2005 for stress wall ``m``: ``(p L - F_w - gamma_w dq/dt) / m_w``."""
-    if wmode[m] != 1:
+def wall_acceleration(m, walls):
+    """Eq. (1) of Luding 2005 for stress wall ``m`` of ``walls`` (:class:`dem.geometry.walls.WallArrays`):
+    ``(p L - F_w - gamma_w dq/dt) / m_w``."""
+    if walls.mode[m] != 1:
         return 0.0
+    wq, span = walls.q, walls.span
     extent = 1.0
     for a in range(2):
-        lo, hi = wspan[m, 2 * a], wspan[m, 2 * a + 1]
+        lo, hi = span[m, 2 * a], span[m, 2 * a + 1]
         if lo >= 0:
             extent *= -(wq[lo] + wq[hi])
-    return (wpress[m] * extent - wforce[m] - wdamp[m] * wdq[m]) / wmass[m]
+    return (walls.pressure[m] * extent - walls.force[m] - walls.damping[m] * walls.dq[m]) / walls.mass[m]
 
 
 @njit(cache=True, error_model="numpy")
-def advance(law, n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_mass, inv_inertia, axes, spin_axes, radius,
-            radius_ref, T0, T_rate, T, state, uniform_T, t0, gravity, box, pi, pj, p_hist, p_fn, p_ft, p_const, start,
-            pairs, load, owner, n_blocks,
-            wn, wq, wdq, wacc, wmode, wpress, wmass, wdamp, wq0, wamp, wfreq, wspan, wforce, wk, wm, wq_ref,
-            w_hist, w_fn, w_ft, params, x_ref, skin, info):
-    """Up to ``n_steps`` velocity-Verlet steps (module docstring) under the contact law ``law`` from global step ``step0`` (t = step0 dt) of an
-    interval that began at step ``first`` with temperatures ``T0`` (``T0 + T_rate (t - first dt)`` after it): times
-    come from step counts, so where a run is split into calls (rebuilds, a resume) never changes its arithmetic.
-    ``f``/``tau``/``wacc`` must hold the forces of the current state on entry. Returns ``(steps done, status)``;
-    ``info`` receives the particle (and wall) index of a non-finite or escaped particle (the first such).
-    ``inv_mass``, ``inv_inertia``: ``1/mass`` and ``1/inertia``. ``p_const``: room for the pairs' numbers of the radii
-    alone (:func:`dem.engines.contact_forces.forces`), computed at the first step and at any step whose radii
-    changed, read at the others. ``start``,
-    ``pairs``, ``load``, ``owner``, ``n_blocks``: the threaded force pass's view of the list and its buffer (read by
-    the threaded copies; :func:`dem.engines.contact_forces.forces`)."""
+def advance(law, particles, pairs, walls, wall_list, constants, steps, info):
+    """Up to ``steps.count`` velocity-Verlet steps (module docstring) under the contact law ``law``.
+
+    Parameters
+    ----------
+    law : dem.laws.contact.binding.ContactLaw
+        The contact law, bound at compile time.
+    particles : dem.engines.records.Particles
+        The particles, advanced in place; ``f``/``tau`` must hold the forces of the current state on entry.
+    pairs : dem.engines.records.PairList
+        The Verlet list of pairs (``const``: computed at the first step and at any step whose radii changed, read at
+        the others; the threaded view read by the threaded copies: :func:`dem.engines.contact_forces.forces`).
+    walls : dem.geometry.walls.WallArrays
+        The walls, moved in place; ``acc`` must hold the stress walls' accelerations of the current state on entry.
+    wall_list : dem.engines.records.WallList
+        The particle-wall list.
+    constants : dem.engines.records.Constants
+        Gravity, the periodic box, the law's material and the Verlet list's skin.
+    steps : dem.engines.records.Steps
+        Which steps: from global step ``step0`` (t = step0 dt) of an interval that began at step ``first`` with
+        temperatures ``T0`` (``T0 + T_rate (t - first dt)`` after it). Times come from step counts, so where a run
+        is split into calls (rebuilds, a resume) never changes its arithmetic.
+    info : numpy.ndarray
+        (2,) int, receives the particle (and wall) index of a non-finite or escaped particle (the first such).
+
+    Returns
+    -------
+    tuple of (int, int)
+        The steps done and how the call ended (``DONE``, ``REBUILD``, ``NONFINITE``, ``ESCAPED``).
+    """
+    n_steps, dt, step0, first = steps.count, steps.dt, steps.step0, steps.first
+    x, v, w, f, tau, spin_axes = particles.x, particles.v, particles.w, particles.f, particles.tau, particles.spin_axes
+    inv_mass, inv_inertia = particles.inv_mass, particles.inv_inertia
+    wn, wq, wdq, wacc, wmode = walls.normal, walls.q, walls.dq, walls.acc, walls.mode
+    wq0, wamp, wfreq = walls.q0, walls.amplitude, walls.frequency
+    wk, wm, wq_ref = wall_list.k, wall_list.m, wall_list.q_ref
+    box, x_ref, skin = constants.box, pairs.x_ref, constants.skin
     n = x.shape[0]
     n_w = wn.shape[0]
     h = 0.5 * dt
@@ -105,12 +129,11 @@ def advance(law, n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_
                 phase = 2.0 * math.pi * wfreq[m] * (t + dt)
                 wq[m] = wq0[m] + wamp[m] * math.sin(phase)
                 wdq[m] = 2.0 * math.pi * wfreq[m] * wamp[m] * math.cos(phase)
-        resized = binding.update_particles(law, (step0 + s + 1 - first) * dt, T0, T_rate, T, radius, radius_ref, state,
-                                            uniform_T, params, t0, dt)
+        resized = binding.update_particles(law, (step0 + s + 1 - first) * dt, steps.T0, steps.T_rate, particles.T,
+                                           particles.radius, particles.radius_ref, particles.state, steps.uniform_T,
+                                           constants.params, steps.t0, dt)
         fresh = s == 0 or resized
-        escaped = forces(law, x, v, w, f, tau, spin_axes, mass, radius, state, T, gravity, box, pi, pj, p_hist, p_hist,
-                         p_fn, p_ft, p_const, fresh, wn, wq, wdq, wforce, wk, wm, w_hist, w_hist, w_fn, w_ft, params,
-                         dt, s == n_steps - 1, start, pairs, load, owner, n_blocks)
+        escaped = forces(law, particles, pairs, walls, wall_list, constants, dt, fresh, s == n_steps - 1)
         worst = 0.0
         for k in range(n):
             im, ii = inv_mass[k], inv_inertia[k]
@@ -136,7 +159,7 @@ def advance(law, n_steps, dt, step0, first, x, v, w, f, tau, mass, inertia, inv_
         wall_moved = 0.0
         for m in range(n_w):
             if wmode[m] == 1:
-                wacc[m] = wall_acceleration(m, wq, wdq, wmode, wpress, wmass, wdamp, wspan, wforce)
+                wacc[m] = wall_acceleration(m, walls)
                 wdq[m] += h * wacc[m]
             wall_moved = max(wall_moved, abs(wq[m] + dt * wdq[m] - wq_ref[m]))
         if escaped >= 0:

@@ -25,8 +25,9 @@ import numpy as np
 
 from sinterheat import threads
 
-from dem.engines import compiled
+from dem.engines import compiled, records
 from dem.engines.contact_forces import LOAD_COLUMNS, split_incidences
+from dem.engines.records import Constants, PairList, Steps, WallList
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
 from dem.engines.state import MotionState
 from dem.geometry.neighbours import carry_history, restore_lists, verlet_pairs, wall_pairs
@@ -57,7 +58,7 @@ class MechanicalModel:
 
         Parameters
         ----------
-        state : dem.geometry.motion.MotionState
+        state : dem.engines.state.MotionState
             The particles' state (SI units), advanced in place.
         walls : sequence of dem.geometry.walls.Wall
             The walls.
@@ -166,8 +167,7 @@ class MechanicalModel:
             self.pair_owner, self.pair_start, self.pair_order = split_incidences(i, j, self.state.n, self.n_threads)
             self.pair_load = np.empty((len(i), LOAD_COLUMNS))
         else:  # the one-thread loop reads none of them
-            self.pair_owner, self.pair_start, self.pair_order, self.pair_load = np.zeros(0, np.int64), \
-                np.zeros(1, np.int64), np.zeros(0, np.int64), np.zeros((0, LOAD_COLUMNS))
+            self.pair_owner, self.pair_start, self.pair_order, self.pair_load = records.ONE_THREAD
 
     def restore_lists(self, saved: dict) -> None:
         """The Verlet lists of a checkpoint (:func:`dem.geometry.neighbours.restore_lists`), with the arrays the loop
@@ -186,15 +186,27 @@ class MechanicalModel:
         self.wk, self.wm = wall_pairs(self.state.x, self.state.radius, self.w.normal, self.w.q, self.skin)
         self.wq_ref = self.w.q.copy()
 
+    def records(self) -> tuple:
+        """What the compiled loops take (:mod:`dem.engines.records`), made of the model's arrays as they are now.
+
+        Returns
+        -------
+        tuple
+            ``(particles, pairs, walls, wall_list, constants)``: :class:`~dem.engines.records.Particles`,
+            :class:`~dem.engines.records.PairList`, :class:`~dem.geometry.walls.WallArrays`,
+            :class:`~dem.engines.records.WallList`, :class:`~dem.engines.records.Constants`.
+        """
+        pairs = PairList(self.pi, self.pj, self.p_hist, self.p_hist, self.p_fn, self.p_ft, self.p_const, self.x_ref,
+                         self.pair_owner, self.pair_start, self.pair_order, self.pair_load, self.n_threads)
+        wall_list = WallList(self.wk, self.wm, self.w_hist, self.w_hist, self.w_fn, self.w_ft, self.wq_ref)
+        return (records.particles(self.state, self.particle_state), pairs, self.w, wall_list,
+                Constants(self.gravity, self.box, self.params, self.skin))
+
     def _initial_forces(self):
         """Forces of the initial state (dt = 0: no history increment)."""
-        s, w = self.state, self.w
-        self._forces(s.x, s.v, s.w, s.f, s.tau, s.spin_axes, s.mass, s.radius, self.particle_state, s.T,
-                     self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_hist, self.p_fn, self.p_ft,
-                     self.p_const, True, w.normal, w.q, w.dq, w.force, self.wk, self.wm, self.w_hist, self.w_hist, self.w_fn, self.w_ft,
-                     self.params, 0.0)
+        self._forces(*self.records(), 0.0, True, True)
         for m in range(len(self.walls)):
-            w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
+            self.w.acc[m] = wall_acceleration(m, self.w)
 
     # --------------------------------------------------------------------------------------------- advance
     @property
@@ -228,24 +240,19 @@ class MechanicalModel:
         MechanicsError
             A particle's position or velocity became non-finite, or a particle left the box (a ValueError).
         """
-        s, w = self.state, self.w
-        T0, T_rate, uniform, t0 = self._temperature_arguments(T0, T_rate, relaxation_time)
-        inv_mass, inv_inertia = 1.0 / s.mass, 1.0 / s.inertia
+        s = self.state
+        heating = self._temperature_arguments(T0, T_rate, relaxation_time)
         first = self.steps
         done = 0
+        kernel_records = self.records()
         while done < n_steps:
-            steps, status = self._advance(
-                n_steps - done, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia, inv_mass,
-                inv_inertia, s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.particle_state,
-                uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_fn, self.p_ft,
-                self.p_const, self.pair_start, self.pair_order, self.pair_load, self.pair_owner, self.n_threads,
-                w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
-                w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_hist, self.w_fn, self.w_ft, self.params,
-                self.x_ref, self.skin, self._info)
+            steps, status = self._advance(*kernel_records, Steps(n_steps - done, self.dt, self.steps, first, *heating),
+                                          self._info)
             done += steps
             self.steps += steps
             if status == REBUILD:
                 self._build_list()
+                kernel_records = self.records()
             elif status == NONFINITE:
                 k = int(self._info[0])
                 raise MechanicsError(f"the run stopped at step {self.steps} (t = {self.t:.6g} s): particle {k} has a "

@@ -58,6 +58,7 @@ from dem.parallel import comm as mpi
 from dem.parallel.comm import world
 from dem.network.distributed import DistributedNetwork
 from dem.engines.contact_heat import ContactThermalModel
+from dem.engines.records import Steps
 from dem.engines.verlet.slabs import Slabs
 from dem.engines.verlet.engine import VerletEngine
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
@@ -112,7 +113,7 @@ class RankMechanics(MechanicalModel):
 
         Parameters
         ----------
-        state : dem.geometry.motion.MotionState
+        state : dem.engines.state.MotionState
             Every particle of the scene (each rank keeps its slab).
         walls : sequence of dem.geometry.walls.Wall
             The walls.
@@ -336,7 +337,7 @@ class RankMechanics(MechanicalModel):
         if len(w.force):
             w.force[:] = self.comm.allreduce(w.force, op=mpi.reduction("SUM"))
             for m in range(len(self.walls)):
-                w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
+                w.acc[m] = wall_acceleration(m, w)
         self._refresh_ghosts()
 
     def advance(self, n_steps: int, T0: np.ndarray, T_rate: np.ndarray, relaxation_time: float | None = None):
@@ -359,20 +360,13 @@ class RankMechanics(MechanicalModel):
         MechanicsError
             A particle's position or velocity became non-finite, or a particle left the box (a ValueError).
         """
-        s, w = self.state, self.w
-        T0, T_rate, uniform, t0 = self._temperature_arguments(T0, T_rate, relaxation_time)
+        w = self.w
+        heating = self._temperature_arguments(T0, T_rate, relaxation_time)
         first = self.steps
         h = 0.5 * self.dt
-        for _ in range(n_steps):
+        for _ in range(n_steps):  # (the records anew at each step: a step's exchanges may replace the arrays)
             wdq_half = np.where(w.mode == 1, w.dq + h * w.acc, w.dq)
-            _, status = self._advance(
-                1, self.dt, self.steps, first, s.x, s.v, s.w, s.f, s.tau, s.mass, s.inertia, 1.0 / s.mass,
-                1.0 / s.inertia, s.axes, s.spin_axes, s.radius, s.radius_ref, T0, T_rate, s.T, self.particle_state,
-                uniform, t0, self.gravity, self.box, self.pi, self.pj, self.p_hist, self.p_fn, self.p_ft,
-                self.p_const, self.pair_start, self.pair_order, self.pair_load, self.pair_owner, self.n_threads,
-                w.normal, w.q, w.dq, w.acc, w.mode, w.pressure, w.mass, w.damping, w.q0, w.amplitude, w.frequency,
-                w.span, w.force, self.wk, self.wm, self.wq_ref, self.w_hist, self.w_fn, self.w_ft, self.params,
-                self.x_ref, self.skin, self._info)
+            _, status = self._advance(*self.records(), Steps(1, self.dt, self.steps, first, *heating), self._info)
             self.steps += 1
             status = self._agreed(status, wdq_half)
             if status == REBUILD:
@@ -393,7 +387,7 @@ class RankMechanics(MechanicalModel):
         h = 0.5 * self.dt
         for m in np.flatnonzero(w.mode == 1):
             w.dq[m] = wdq_half[m]  # eq. (1)'s damping acts on the half-kicked velocity, as in the loop
-            w.acc[m] = wall_acceleration(m, w.q, w.dq, w.mode, w.pressure, w.mass, w.damping, w.span, w.force)
+            w.acc[m] = wall_acceleration(m, w)
             w.dq[m] = wdq_half[m] + h * w.acc[m]
         if total[1] > 0:
             k, m = int(self._info[0]), int(self._info[1])

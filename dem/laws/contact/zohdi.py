@@ -4,7 +4,7 @@
 :class:`ZohdiMaterial` holds the material in SI units, named by the paper's symbols; :meth:`ZohdiMaterial.params`
 packs it into the float64 array the compiled kernels take (indices ``Z_*``); the plug-in kernels at the end give the
 engines' loops its forces (:mod:`dem.laws.contact`). The adaptive trapezoidal fixed-point scheme the paper steps it with
-is the staggered engine's (:mod:`dem.engines.staggered`, its parameters :class:`dem.scene.zohdi.ZohdiStepping`).
+is the staggered engine's (:mod:`dem.engines.staggered`, its parameters :class:`dem.scene.staggered.ZohdiStepping`).
 
 Conventions (Zohdi 2014, eqs. 3-4): ``n_ij = (r_j - r_i)/|r_j - r_i|`` points from i to j (the engines' ``n`` is the
 opposite, from j to i); the strain ``E_ij = (|r_i - r_j| - (R_i + R_j))/(R_i + R_j)`` is negative in contact; the
