@@ -147,6 +147,7 @@ def test_quick_path_on_tiny_sizes_writes_every_row(tmp_path):
         [f"biaxial_{mechanics.PREPARATION}_n40_t0.02_s1.npz", f"periodic_{mechanics.PREPARATION}_3x3x3_z6.5_s0.npz"])
 
 
+@pytest.mark.slow  # the study's loop on the packings it first prepares; the log parser and linear limit: quick
 def test_lammps_rows_are_skipped_with_a_note_when_it_is_absent(tmp_path, monkeypatch):
     monkeypatch.setattr(mechanics, "lammps_command", lambda ranks=1: None)
     section = StandInSection(tmp_path / "mechanics")

@@ -112,6 +112,7 @@ def test_sphere_rolls_down_a_frictional_plane_at_five_sevenths_g_sin_theta(theta
     assert abs(s.w[0, 1] * r / s.v[0, 0] - 1) < 0.02  # rolling without slip: omega r = v
 
 
+@pytest.mark.slow  # a 3 ms run rebuilding every few steps (~15 s); the engine's other tests here are the quick check
 def test_rebuilds_carry_the_contact_history():
     """The same run with a skin that forces a rebuild every few steps and with one that never rebuilds."""
     rng = np.random.default_rng(1)

@@ -109,6 +109,7 @@ def test_moving_particles():
     assert ns["floor"] == pytest.approx(ns["weight"], rel=1e-6)  # frictionless side walls: the floor carries it all
 
 
+@pytest.mark.slow  # pressing and sintering 60 spheres (~12 s; the docs build runs the script too)
 def test_pack_sinter_measure():
     ns = run_example("pack_sinter_measure")
     assert ns["sinter"].summary["volume_fraction"] > ns["press"].summary["volume_fraction"] + 0.05  # it densified
