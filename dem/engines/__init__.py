@@ -55,9 +55,9 @@ class Engine:
     """What every engine shares of the protocol (module docstring): what the driver asks of its class before one is
     built, and the kind of sample it holds."""
 
-    #: Each process holds only its piece of the sample (the static engine on several ranks): the driver writes the
-    #: snapshots in pieces (:class:`dem.output.pieces.PieceWriter`) and no ``state.npz``, and the summary lists the
-    #: temperatures gathered from the ranks (``gathered_temperatures()``).
+    #: True where each process holds only its piece of the sample, as the static engine on several ranks does; the
+    #: driver then writes the snapshots in pieces (:class:`dem.output.pieces.PieceWriter`) and no ``state.npz``, and
+    #: the summary lists the temperatures gathered from the ranks (``gathered_temperatures()``).
     pieces_only = False
 
     @classmethod

@@ -147,11 +147,11 @@ def particles(state, particle_state: np.ndarray, **replaced) -> Particles:
     particle_state : numpy.ndarray
         (N, S) the contact law's particle state.
     **replaced : numpy.ndarray or tuple
-        Fields of :class:`Particles` taken from elsewhere than ``state`` (e.g. an iterate's positions).
+        Fields of :class:`dem.engines.records.Particles` taken from elsewhere than ``state`` (e.g. an iterate's positions).
 
     Returns
     -------
-    Particles
+    dem.engines.records.Particles
         The record (references to the arrays, ``inv_mass`` and ``inv_inertia`` computed here).
     """
     return Particles(state.x, state.v, state.w, state.f, state.tau, state.mass, 1.0 / state.mass, 1.0 / state.inertia,

@@ -121,8 +121,8 @@ class RankSolves:
 
         Returns
         -------
-        _RankSystem
-            The system and its solver.
+        object
+            The system and its solver (private to this module).
         """
         system = _RankSystem(M, self.part.solver(M, self.row, self.n_global, self.rtol))
         self.built.append(system)
@@ -134,7 +134,7 @@ class RankSolves:
 
         Parameters
         ----------
-        system : _RankSystem
+        system : object
             A system of :meth:`build`.
         rhs : numpy.ndarray
             The right-hand side per local free particle (W; owned entries used).

@@ -11,7 +11,7 @@
   with optional image flags ``ix iy iz``; a ``Velocities`` section ``id vx vy vz wx wy wz`` is read too). The box
   is the ``xlo xhi``, ``ylo yhi``, ``zlo zhi`` header; a data file does not record which axes are periodic (LAMMPS's
   ``write_data`` writes the bounds only; the periodicity is the ``boundary`` command of the input script), so
-  :attr:`Packing.periodic` is None unless ``periodic`` is given. ``type`` k becomes material index k - 1.
+  :attr:`dem.scene.packing_files.packing.Packing.periodic` is None unless ``periodic`` is given. ``type`` k becomes material index k - 1.
 * ``lammps-dump`` -- a LAMMPS or LIGGGHTS text dump (``dump custom``): the last snapshot or the one at
   ``timestep``; columns ``id``, ``type``, positions ``x y z`` (or unwrapped ``xu yu zu``, scaled ``xs ys zs``,
   scaled unwrapped ``xsu ysu zsu``; unwrapped positions are wrapped into the box along its periodic axes),

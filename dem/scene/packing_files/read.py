@@ -79,7 +79,7 @@ def read_packing(path, format: str | None = None, length_unit: float = 1.0, time
     Raises
     ------
     ValueError
-        A bad argument, or a bad file (:class:`FileError`, one line naming the file, the line and the column).
+        A bad argument, or a bad file (:class:`~dem.scene.packing_files.packing.FileError`, one line naming the file, the line and the column).
     """
     path = pathlib.Path(path)
     fmt = format_of(path) if format is None else format

@@ -20,11 +20,11 @@ DENSITY_RTOL = 1e-3  # a file's density against its material's: printed digits (
 
 def scene_particles(table: dict, materials, base_dir=None, part=None):
     """``[particles] file = "..."`` of a scene: the :class:`dem.geometry.particles.Particles` of the file (``format``,
-    ``length_unit``, ``timestep`` as for :func:`read_packing`; the path relative to ``base_dir``, the scene's folder)
+    ``length_unit``, ``timestep`` as for :func:`~dem.scene.packing_files.read.read_packing`; the path relative to ``base_dir``, the scene's folder)
     and the file's box as a :class:`dem.geometry.periodic.PeriodicBox` (periodic along the axes the file says are, none where
     it cannot say), or None. ``temperature`` (a number or a list), ``fixed``, ``material`` (a name or index, or a
     list of them) and ``heat`` come from the table where given, else from the file; a density the file gives must be
-    its material's. With ``part``, a packing in parts (:mod:`dem.scene.packing_parts`) gives only the particles that
+    its material's. With ``part``, a packing in parts (:mod:`dem.scene.packing_files.parts`) gives only the particles that
     rank holds (a list in the table is of the whole packing, taken at their places), and its ``Part`` the particles
     of the whole packing that its file holds at their temperature (``fixed`` in the table is refused there).
 
@@ -43,7 +43,7 @@ def scene_particles(table: dict, materials, base_dir=None, part=None):
     Returns
     -------
     tuple of (dem.geometry.particles.Particles, dem.geometry.periodic.PeriodicBox or None, object)
-        The particles, the file's box, and the :class:`dem.scene.packing_parts.Part` they are of (None where the
+        The particles, the file's box, and the :class:`dem.scene.packing_files.parts.Part` they are of (None where the
         whole file was read).
 
     Raises
@@ -125,7 +125,7 @@ def scene_particles(table: dict, materials, base_dir=None, part=None):
 
 
 def _part_of(path, table: dict, options: dict, ranks: int, rank: int, box_of):
-    """The packing and :class:`dem.scene.packing_parts.Part` that rank ``rank`` of ``ranks`` holds of the packing in
+    """The packing and :class:`dem.scene.packing_files.parts.Part` that rank ``rank`` of ``ranks`` holds of the packing in
     parts ``path`` (:func:`scene_particles`)."""
     extra = sorted(set(options) - {"format"})
     if extra:
@@ -145,7 +145,7 @@ def _part_of(path, table: dict, options: dict, ranks: int, rank: int, box_of):
 
 
 def packing_from_particles(particles, box=None) -> Packing:
-    """A :class:`Packing` of a scene's :class:`dem.geometry.particles.Particles` (densities from its materials) in the
+    """A :class:`~dem.scene.packing_files.packing.Packing` of a scene's :class:`dem.geometry.particles.Particles` (densities from its materials) in the
     periodic box ``box`` (:class:`dem.geometry.periodic.PeriodicBox`) or none.
 
     Parameters
@@ -170,7 +170,7 @@ def packing_from_particles(particles, box=None) -> Packing:
 
 
 def packing_from_state(state: dict) -> Packing:
-    """A :class:`Packing` of a saved state (:func:`dem.scene.state_file.load`) in its periodic box, if it has one:
+    """A :class:`~dem.scene.packing_files.packing.Packing` of a saved state (:func:`dem.scene.state_file.load`) in its periodic box, if it has one:
     positions, radii, temperatures, ids; of a moving state also velocities, angular velocities and the density that
     gives each particle its saved mass as a sphere (``m / (4/3 pi r^3)``, also what LAMMPS computes the mass from),
     of a static one its materials (no density: the scene's materials have them). 3D states only: a 2D state's disks

@@ -75,7 +75,7 @@ def _data_lines(text: str, first_line: int):
 
 
 def locate(path, text, first_line, names, widths, what, delimiter, usecols) -> None:
-    """Raise :class:`FileError` at the first row of ``text`` with a number of entries not in ``widths`` (or unlike
+    """Raise :class:`~dem.scene.packing_files.packing.FileError` at the first row of ``text`` with a number of entries not in ``widths`` (or unlike
     the first row's), or an entry (of ``usecols``) that is not a finite number; return where there is none.
 
     Parameters
@@ -128,7 +128,7 @@ def row_line(text: str, first_line: int, row: int) -> int:
 
 
 def check_rows(path, bad: np.ndarray, text: str, first_line: int, column: int, name: str, message) -> None:
-    """Raise :class:`FileError` at the first row where ``bad`` holds, ``message(row)`` saying what is wrong.
+    """Raise :class:`~dem.scene.packing_files.packing.FileError` at the first row where ``bad`` holds, ``message(row)`` saying what is wrong.
 
     Parameters
     ----------
@@ -158,7 +158,7 @@ def check_rows(path, bad: np.ndarray, text: str, first_line: int, column: int, n
 
 
 def integers(path, values: np.ndarray, text: str, first_line: int, column: int, name: str) -> np.ndarray:
-    """The column ``values`` of the table ``text`` as integers; a fraction raises :class:`FileError`.
+    """The column ``values`` of the table ``text`` as integers; a fraction raises :class:`~dem.scene.packing_files.packing.FileError`.
 
     Parameters
     ----------

@@ -133,7 +133,7 @@ def _whole(path, values: np.ndarray, name: str) -> np.ndarray:
 
 def write_vtu(path, packing: Packing) -> pathlib.Path:
     """Write ``packing`` as a VTU point set (vertex cells) with the point fields ``id``, ``radius`` and its
-    optional ones: what ParaView opens and :func:`read_packing` reads back.
+    optional ones: what ParaView opens and :func:`~dem.scene.packing_files.read.read_packing` reads back.
 
     Parameters
     ----------
