@@ -453,7 +453,26 @@ class RankMechanics(MechanicalModel):
 class RankContactThermal(ContactThermalModel):
     """The heat of the contacts on several ranks (module docstring): ``T`` and ``rate`` over every particle of the
     scene on every rank, each thermal step solved on PETSc by all ranks together. No hand-over to the union
-    (:mod:`dem.geometry.handover`): its solid radii are solved over the whole sample, which no rank holds."""
+    (:mod:`dem.geometry.handover`): its solid radii are solved over the whole sample, which no rank holds.
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The scene's particles at the start, all of them on every rank
+        (:class:`dem.engines.contact_heat.ContactThermalModel`).
+    walls : sequence of dem.geometry.walls.Wall
+        The scene's walls.
+    spec : dem.laws.conductance.ConductanceSpec
+        The scene's contact geometry and conductance law.
+    sources : dem.laws.ambient.Sources
+        The heat exchanged with the surroundings, if any.
+    integrator : str
+        ``"implicit"`` or ``"crank-nicolson"``.
+    linear : str
+        The linear solver of each step.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box; None without one.
+    """
 
     hands_over = False
 
