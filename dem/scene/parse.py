@@ -29,7 +29,7 @@ from dem.network.heat import INTEGRATORS
 from dem.network.linsolve import BACKENDS
 from dem.output.plots import TEMPERATURE_UNITS
 from dem.scene.motion import MotionSpec, parse_motion
-from dem.scene.schema import ENGINE_NAMES, TABLES, check
+from dem.scene.schema import ENGINE_NAMES, TABLES, check, number
 from dem.scene.groups import apply_groups
 from dem.scene.specimen import Specimen, find_specimen, held_name
 
@@ -341,17 +341,6 @@ def make_scene(position, radius, temperature, *, materials=(COPPER,), material=N
 
 
 # --------------------------------------------------------------------------------------------------- TOML
-def _number(table, section, key, default=None, required=False):
-    if key not in table:
-        if required:
-            raise ValueError(f"[{section}] {key}: required")
-        return default
-    v = table[key]
-    if not _is_number(v) or not math.isfinite(v):
-        raise ValueError(f"[{section}] {key} = {v!r}: must be a finite number")
-    return float(v)
-
-
 def _materials(doc, thermal: bool = True, electrical: bool = False) -> tuple:
     if "material" in doc and "materials" in doc:
         raise ValueError("[material] and [[materials]]: give one or the other")
@@ -363,9 +352,9 @@ def _materials(doc, thermal: bool = True, electrical: bool = False) -> tuple:
     out = []
     for k, t in enumerate(tables):
         section = "material" if "material" in doc else f"materials[{k}]"
-        props = {key: _number(t, section, key, required=thermal or key == "density")
+        props = {key: number(t, section, key, required=thermal or key == "density")
                  for key in ("conductivity", "density", "specific_heat")}
-        props["electrical_conductivity"] = _number(t, section, "electrical_conductivity", required=electrical)
+        props["electrical_conductivity"] = number(t, section, "electrical_conductivity", required=electrical)
         for key, v in props.items():
             if v is not None and v <= 0:
                 raise ValueError(f"[{section}] {key} = {v!r}: must be > 0")
@@ -420,10 +409,10 @@ def _generated_particles(t: dict, materials, dimension: int = 3):
         msg = str(exc)
         raise ValueError(msg if msg.startswith("[") else f"[generator] kind = {kind!r}: bad parameter ({msg})") from None
     n = len(layout.radius)
-    T0 = _number(t, "generator", "temperature", 0.0)
-    hot = _number(t, "generator", "hot", required=boundary != "none")
-    cold = _number(t, "generator", "cold", required=boundary != "none")
-    heat = _number(t, "generator", "heat", 0.0)
+    T0 = number(t, "generator", "temperature", 0.0)
+    hot = number(t, "generator", "hot", required=boundary != "none")
+    cold = number(t, "generator", "cold", required=boundary != "none")
+    heat = number(t, "generator", "heat", 0.0)
     temperature = np.full(n, T0)
     fixed = np.zeros(n, dtype=bool)
     walls, specimen, box = (), None, None
@@ -497,9 +486,9 @@ def _walls(doc, start: dict | None, static: bool) -> tuple:
         for key in ("point", "normal") + (("temperature",) if static else ()):
             if key not in w:
                 raise ValueError(f"[walls][{k}] {key}: required")
-        numbers = {key: _number(w, f"walls][{k}", key) for key in WALL_NUMBERS if key in w}
+        numbers = {key: number(w, f"walls][{k}", key) for key in WALL_NUMBERS if key in w}
         out.append(Wall(str(w.get("name", f"wall{k}")), w["point"], w["normal"],
-                        _number(w, f"walls][{k}", "temperature"), str(w.get("motion", "fixed")), **numbers))
+                        number(w, f"walls][{k}", "temperature"), str(w.get("motion", "fixed")), **numbers))
     names = [w.name for w in out]
     if len(set(names)) != len(names):
         raise ValueError(f"[[walls]] name: names must be unique, got {names}")
@@ -527,7 +516,7 @@ def _spec(cls, table, section, numeric=(), integer=(), words=()):
         if key not in names:
             continue
         if key in numeric and not (key in words and isinstance(v, str)):
-            v = _number(table, section, key)
+            v = number(table, section, key)
         if key in integer and (not isinstance(v, int) or isinstance(v, bool)):
             raise ValueError(f"[{section}] {key} = {v!r}: must be an integer")
         kwargs[key] = v

@@ -250,7 +250,7 @@ TABLES = tuple(dict.fromkeys(row.table for row in ROWS))
 
 
 def number(table: dict, section: str, key: str, default=None, positive: bool = False,
-           nonnegative: bool = False) -> float | None:
+           nonnegative: bool = False, required: bool = False) -> float | None:
     """The number ``table[key]`` as a float, ``default`` where the key is not given.
 
     Parameters
@@ -267,6 +267,8 @@ def number(table: dict, section: str, key: str, default=None, positive: bool = F
         Whether the number must be > 0.
     nonnegative : bool
         Whether the number must be >= 0.
+    required : bool
+        Whether a missing key is an error (else it reads as ``default``).
 
     Returns
     -------
@@ -276,9 +278,12 @@ def number(table: dict, section: str, key: str, default=None, positive: bool = F
     Raises
     ------
     ValueError
-        The value is not a finite number, or out of its range (one line naming ``[section] key``).
+        The value is not a finite number, out of its range, or missing where required (one line naming
+        ``[section] key``).
     """
     if key not in table:
+        if required:
+            raise ValueError(f"[{section}] {key}: required")
         return default
     v = table[key]
     if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
