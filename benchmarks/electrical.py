@@ -26,7 +26,6 @@ compare the ratios measured here side by side.
 
 from __future__ import annotations
 
-import os
 import time
 
 import numpy as np

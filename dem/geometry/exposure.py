@@ -16,8 +16,6 @@ only the particles near it. Compiled with numba (``cache=True``), loaded only by
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
