@@ -323,7 +323,6 @@ ASCII_FORMULAS_LEFT = {
     "dem.cli.contact": 3,
     "dem.engines": 38,
     "dem.laws.contact": 160,
-    "dem.network": 44,
     "dem.scene.packing_files": 1,
 }
 
