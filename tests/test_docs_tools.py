@@ -321,7 +321,6 @@ kappa : float
 # in its module docstring, which is also the command's --help text, read in a terminal.
 ASCII_FORMULAS_LEFT = {
     "dem.cli.contact": 3,
-    "dem.engines": 38,
     "dem.laws.contact": 160,
     "dem.scene.packing_files": 1,
 }
