@@ -322,7 +322,6 @@ kappa : float
 ASCII_FORMULAS_LEFT = {
     "dem.cli.contact": 3,
     "dem.laws.contact": 160,
-    "dem.scene.packing_files": 1,
 }
 
 
