@@ -50,17 +50,18 @@ def test_docstring_as_plain_text():
 
 def parsers():
     """Every parser of the packages' command lines (top level and sub-commands), by its program name."""
+    from benchmarks import cli as benchmarks_cli
     from dem import cli as dem_cli
     from fem_neck import cli as fem_cli
-    from verification.cli import build_parser
+    from verification import cli as verification_cli
 
-    tops = [cli.build_parser("python -m dem", "dem", dem_cli.COMMANDS, "dem.cli"),
-            cli.build_parser("python -m fem_neck", "fem_neck", fem_cli.COMMAND_MODULES, "fem_neck.cli"),
-            build_parser()]
+    tops = [cli.build_parser("python -m dem", dem_cli.__doc__, dem_cli.COMMANDS, "dem.cli"),
+            cli.build_parser("python -m fem_neck", fem_cli.__doc__, fem_cli.COMMAND_MODULES, "fem_neck.cli"),
+            verification_cli.build_parser(), benchmarks_cli.build_parser()]
     found = {}
     for top in tops:
         found[top.prog] = top
-        for action in top._subparsers._group_actions:
+        for action in top._subparsers._group_actions if top._subparsers else ():
             found.update({parser.prog: parser for parser in action.choices.values()})
     return found
 
