@@ -26,13 +26,15 @@ import re
 import sys
 import warnings
 
+from sinterheat.help_text import HelpFormatter
 
 
 class OneLineParser(argparse.ArgumentParser):
     """An argparse parser whose usage errors are one line on stderr and exit code 2.
 
     Negative numbers in scientific notation (``--ri -1e-3``) are read as values, not as options, so that the
-    command can reject them with a message about the value.
+    command can reject them with a message about the value. Its help shows the docstrings it is given (a command's
+    description is its module docstring) as plain text, paragraphs kept (:class:`sinterheat.help_text.HelpFormatter`).
 
     Parameters
     ----------
@@ -43,6 +45,7 @@ class OneLineParser(argparse.ArgumentParser):
     """
 
     def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", HelpFormatter)
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$", re.I)
 

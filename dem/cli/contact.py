@@ -1,22 +1,22 @@
-"""``python -m dem contact SCENE --history FILE.csv [--no-damping] [--json] [--out DIR]``: one Luding 2005 contact
+r"""``python -m dem contact SCENE --history FILE.csv [--no-damping] [--json] [--out DIR]``: one Luding 2005 contact
 driven through a prescribed history.
 
-The pair: two equal particles of the scene's mean radius ``a`` (so ``delta_fluid = fluid_overlap * a``), made of
-the scene's ``[contact]`` material. The history CSV has the columns ``t`` (s, strictly increasing), ``overlap``
-(m; <= 0 opens the contact: no force, and a later overlap starts a fresh contact; below the pair's size ``2 a``,
-where the centres meet) and ``T`` (the scene's
-temperature unit); other columns are ignored. Per row the tool reports the normal force on a particle (N, > 0
-repulsive), ``delta_max``, ``delta_0``, ``k1`` = k1(T, t), ``k2`` = k2(delta_max), ``kc`` = kc(T, t, delta_max)
-(all in N/m) and ``f_min`` (eq. 15).
+The pair: two equal particles of the scene's mean radius :math:`a` (so :math:`\delta_\mathrm{fluid}` is
+``fluid_overlap`` times :math:`a`), made of the scene's ``[contact]`` material. The history CSV has the columns ``t``
+(s, strictly increasing), ``overlap`` (m; :math:`\le 0` opens the contact: no force, and a later overlap starts a
+fresh contact; below the pair's size :math:`2 a`, where the centres meet) and ``T`` (the scene's temperature unit);
+other columns are ignored. Per row the tool reports the normal force on a particle (N, > 0 repulsive),
+``delta_max`` (:math:`\delta_\mathrm{max}`), ``delta_0`` (:math:`\delta_0`), ``k1`` = :math:`k_1(T, t)`, ``k2`` =
+:math:`k_2(\delta_\mathrm{max})`, ``kc`` = :math:`k_c(T, t, \delta_\mathrm{max})` (all in N/m) and ``f_min`` (eq. 15).
 
-k1(T, t) starts at its equilibrium k1(T) of the first row's temperature and relaxes row by row towards k1(T) of
-each row's temperature (eq. 12, :func:`dem.laws.contact.luding.relax_k1`; cooling freezes at once). The viscous force
-``gamma_0 delta_dot`` (eq. 5) uses the backward difference of the overlap between rows (0 on the first row);
-``--no-damping`` leaves it out, giving the elastic-plastic force of Figs. 2, 3 and 5 alone.
+:math:`k_1(T, t)` starts at its equilibrium :math:`k_1(T)` of the first row's temperature and relaxes row by row
+towards :math:`k_1(T)` of each row's temperature (eq. 12, :func:`dem.laws.contact.luding.relax_k1`; cooling freezes at
+once). The viscous force :math:`\gamma_0 \dot\delta` (eq. 5) uses the backward difference of the overlap between rows
+(0 on the first row); ``--no-damping`` leaves it out, giving the elastic-plastic force of Figs. 2, 3 and 5 alone.
 
 Without ``--json`` the rows are printed as a table; ``--out DIR`` writes ``contact.csv`` and ``contact.png`` (force
-against overlap with the cold k1 line, the k1(T, t) and -kc(T, t, delta_max) lines of the last row and the
-path taken; beside it the temperature history and k1(T, t)/k1).
+against overlap with the cold :math:`k_1` line, the :math:`k_1(T, t)` and :math:`-k_c(T, t, \delta_\mathrm{max})` lines
+of the last row and the path taken; beside it the temperature history and :math:`k_1(T, t)/k_1`).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def register(sub):
     parser.add_argument("scene", help="a scene with a [contact] table (TOML file or built-in name, e.g. luding-table1)")
     parser.add_argument("--history", required=True, metavar="FILE.csv", help="CSV with columns t, overlap, T")
     parser.add_argument("--no-damping", action="store_true",
-                        help="leave out the viscous force gamma_0 d(overlap)/dt (eq. 5)")
+                        help=r"leave out the viscous force :math:`\gamma_0 \dot\delta` (eq. 5)")
     add_output_options(parser)
     parser.set_defaults(run=run)
 

@@ -1,14 +1,15 @@
-"""The electrical submodel of the engine: the current through the contacts as they are, and the Joule heating it
+r"""The electrical submodel of the engine: the current through the contacts as they are, and the Joule heating it
 makes in each particle (Zohdi 2014, eqs. 35, 38-44), by either scheme of :mod:`dem.network.current`.
 
-* ``scheme = "kirchhoff"`` -- potentials from one sparse solve per refresh; each contact's electrical conductance is
-  the thermal neck law of the scene with sigma in place of kappa (no interface conductance); electrodes are walls at
-  a fixed ``potential`` (V) or driving a fixed ``current`` (A into the packing). The heating of a particle is the
-  absorption ``a`` times the Joule heat made in it, ``a sum I^2/G`` over its share of its contacts.
+* ``scheme = "kirchhoff"`` -- potentials from one sparse solve per refresh; each contact's electrical conductance is the
+  thermal neck law of the scene with :math:`\sigma` in place of :math:`\kappa` (no interface conductance); electrodes
+  are walls at a fixed ``potential`` (V) or driving a fixed ``current`` (A into the packing). The heating of a particle
+  is the absorption :math:`a` times the Joule heat made in it, :math:`a \sum I^2/G` over its share of its contacts.
 * ``scheme = "zohdi"`` -- the paper's area-weighted iteration (eq. 43) over the lens contact areas, warm-started from
-  the last refresh; an electrified wall's ``current`` is its ``J_ext``; heating ``a J_i^2 V_i / sigma_i`` (eq. 35).
+  the last refresh; an electrified wall's ``current`` is its :math:`J^\mathrm{ext}`; heating
+  :math:`a J_i^2 V_i / \sigma_i` (eq. 35).
 
-The current settles far faster than anything moves (Appendix B: dP/dt = 0), so it is refreshed once per accepted
+The current settles far faster than anything moves (Appendix B: :math:`dP/dt = 0`), so it is refreshed once per accepted
 step (Algorithm 1, step 6d), and held while the next step is solved.
 
 A wall at a fixed potential that touches nothing is an open circuit and carries no current; a wall driving a fixed
@@ -30,7 +31,7 @@ from dem.engines.staggered.heat import contact_bonds
 
 
 class ContactCurrent:
-    """The current of the configuration last refreshed and its heating (module docstring).
+    r"""The current of the configuration last refreshed and its heating (module docstring).
 
     Parameters
     ----------
@@ -41,7 +42,7 @@ class ContactCurrent:
     electrodes : dem.network.current.Electrodes
         The electrified walls, at a potential (V) or a current (A; Zohdi's scheme: ``J_ext``).
     spec : dem.laws.conductance.ConductanceSpec
-        The conductance law, used with sigma for kappa (its interface conductance left out).
+        The conductance law, used with :math:`\sigma` for :math:`\kappa` (its interface conductance left out).
     scheme : str
         ``"kirchhoff"`` or ``"zohdi"``.
     absorption : float

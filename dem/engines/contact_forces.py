@@ -1,4 +1,4 @@
-"""The forces and torques on particles that touch each other and plane walls, for any contact law: the one force
+r"""The forces and torques on particles that touch each other and plane walls, for any contact law: the one force
 loop of every engine that moves particles.
 
 The loop does the geometry and the bookkeeping; the contact law (:mod:`dem.laws.contact`) does the physics through its
@@ -6,15 +6,18 @@ kernels, bound at compile time: the loop takes the law as its first argument, wh
 (:mod:`dem.laws.contact.binding`), so that numba inlines each law's kernels into a loop of its own (no dispatch at run
 time) and caches it under the law's signature.
 
-Contact geometry (Luding 2005, eqs. 3, 17-18): ``n`` points from j to i, the overlap is ``delta = a_i + a_j -
-|x_i - x_j|``, the relative surface velocity ``v_ij = v_i - v_j + l_i n x omega_i + l_j n x omega_j``; the force on
-i is ``f_n n + f_t`` and the torque ``-l_i n x f_t``. The lever arms reach the middle of the overlap, ``l = a -
-delta/2`` (as LAMMPS does), rather than the paper's ``a``: then ``l_i + l_j = |x_i - x_j|`` and a contact conserves
-angular momentum exactly (with ``a`` it would create ``-delta n x f_t``; the difference is of order delta/a). A
-wall is the partner j with an infinite radius, moving along its normal. A pair acts while its surfaces are closer
-than the law's ``reach``, a particle-wall pair while closer than its ``wall_reach`` (0: while they overlap; an
-adhesive law holds a contact beyond touching until it breaks); the laws whose particles do not rotate
-(its ``SPINS`` false) get no torques.
+Contact geometry (Luding 2005, eqs. 3, 17-18): :math:`\mathbf{n}` points from :math:`j` to :math:`i`, the overlap is
+:math:`\delta = a_i + a_j - |\mathbf{x}_i - \mathbf{x}_j|`, the relative surface velocity
+:math:`\mathbf{v}_{ij} = \mathbf{v}_i - \mathbf{v}_j + l_i \mathbf{n} \times \boldsymbol{\omega}_i
++ l_j \mathbf{n} \times \boldsymbol{\omega}_j`; the force on :math:`i` is :math:`f_n \mathbf{n} + \mathbf{f}_t` and the
+torque :math:`-l_i \mathbf{n} \times \mathbf{f}_t`. The lever arms reach the middle of the overlap,
+:math:`l = a - \delta/2` (as LAMMPS does), rather than the paper's :math:`a`: then
+:math:`l_i + l_j = |\mathbf{x}_i - \mathbf{x}_j|` and a contact conserves angular momentum exactly (with :math:`a` it
+would create :math:`-\delta \, \mathbf{n} \times \mathbf{f}_t`; the difference is of order :math:`\delta/a`). A wall is
+the partner :math:`j` with an infinite radius, moving along its normal. A pair acts while its surfaces are closer than
+the law's ``reach``, a particle-wall pair while closer than its ``wall_reach`` (0: while they overlap; an adhesive law
+holds a contact beyond touching until it breaks); the laws whose particles do not rotate (its ``SPINS`` false) get no
+torques.
 
 Latency: a pair's geometry (a square root, then divisions) and its law form one long chain of dependent
 operations, and the processor overlaps two pairs only as far as its window of instructions reaches. So the

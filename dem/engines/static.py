@@ -1,11 +1,11 @@
-"""The engine of a static packing: the pipe network of Rojek 2022 (eqs. 1-9) on bonds found once from the scene's
+r"""The engine of a static packing: the pipe network of Rojek 2022 (eqs. 1-9) on bonds found once from the scene's
 geometry, solved steady or integrated in time (:mod:`dem.network.heat`). It never moves a particle and allocates
 no mechanical state; a scene whose physics is ``"thermal"``, or ``"thermal"`` and ``"electrical"``, runs here.
 
-With ``"electrical"`` physics a current flows between the electrodes (walls with a potential or a current) through
-the same bonds (Kirchhoff's laws, :func:`dem.network.current.kirchhoff`: each contact's conductance the scene's law
-with the electrical conductivity for kappa). Nothing moves and the conductivities do not depend on the temperature,
-so it is solved once, before the heat: the absorbed part of its Joule heat is a constant source in every particle.
+With ``"electrical"`` physics a current flows between the electrodes (walls with a potential or a current) through the
+same bonds (Kirchhoff's laws, :func:`dem.network.current.kirchhoff`: each contact's conductance the scene's law with the
+electrical conductivity for :math:`\kappa`). Nothing moves and the conductivities do not depend on the temperature, so
+it is solved once, before the heat: the absorbed part of its Joule heat is a constant source in every particle.
 """
 
 from __future__ import annotations

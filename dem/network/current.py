@@ -1,31 +1,33 @@
-"""Current through the contacts of a packing and the Joule heat it makes: two schemes side by side.
+r"""Current through the contacts of a packing and the Joule heat it makes: two schemes side by side.
 
 Electrodes are walls: a particle touching an electrified wall exchanges current with it. Two ways to compute the
 current:
 
-* :func:`kirchhoff` -- the physical one (Kirchhoff's laws): a potential on every particle, each contact a
-  conductance ``G`` (the thermal neck law with the electrical conductivity sigma in place of kappa,
-  :func:`dem.laws.conductance.bond_conductances`), electrodes at a fixed potential (V) or driving a fixed total
-  current (A into the packing). One sparse solve (the same network solve as the heat,
-  :class:`dem.network.laplacian.BoundedLaplacian`) gives the potentials; every contact carries ``I = G (phi_i - phi_j)`` and
-  makes the Joule heat ``I^2 / G``, shared by its two particles in proportion to the resistances of their halves
-  (a wall contact's heat is made in the particle's half). The current is conserved at every particle, and the
-  Joule heat of all contacts equals the power the electrodes deliver, ``sum_e V_e I_e`` (Tellegen's theorem), to
-  round-off. A fixed-current electrode is solved by superposition: a unit-potential solve per such electrode with
-  the same factorisation, then the small system ``Y V = I`` for their potentials.
+* :func:`kirchhoff` -- the physical one (Kirchhoff's laws): a potential on every particle, each contact a conductance
+  :math:`G` (the thermal neck law with the electrical conductivity :math:`\sigma` in place of :math:`\kappa`,
+  :func:`dem.laws.conductance.bond_conductances`), electrodes at a fixed potential (V) or driving a fixed total current
+  (A into the packing). One sparse solve (the same network solve as the heat,
+  :class:`dem.network.laplacian.BoundedLaplacian`) gives the potentials; every contact carries
+  :math:`I = G (\phi_i - \phi_j)` and makes the Joule heat :math:`I^2 / G`, shared by its two particles in proportion to
+  the resistances of their halves (a wall contact's heat is made in the particle's half). The current is conserved at
+  every particle, and the Joule heat of all contacts equals the power the electrodes deliver, :math:`\sum_e V_e I_e`
+  (Tellegen's theorem), to round-off. A fixed-current electrode is solved by superposition: a unit-potential solve per
+  such electrode with the same factorisation, then the small system :math:`Y V = I` for their potentials.
 * :func:`area_weighted_current` -- the scheme of Zohdi 2014 (eqs. 40-43, Remarks 2 and 4): a scalar "current"
-  ``J_i`` per particle; a particle touching an electrified wall takes the wall's value ``J_ext`` (Remark 2), every
-  other one the contact-area-weighted mean of its neighbours, ``J_i = sum_j A_ij J_j / sum_j A_ij`` (eq. 43),
-  found by Gauss-Seidel sweeps ("the solution method sweeps through the system, particle by particle, updating the
-  variables as it progresses"). Joule heating ``H_i = a J_i^2 V_i / sigma_i`` (eq. 35).
+  :math:`J_i` per particle; a particle touching an electrified wall takes the wall's value :math:`J^\mathrm{ext}`
+  (Remark 2), every other one the contact-area-weighted mean of its neighbours,
+  :math:`J_i = \sum_j A_{ij} J_j / \sum_j A_{ij}` (eq. 43), found by Gauss-Seidel sweeps ("the solution method sweeps
+  through the system, particle by particle, updating the variables as it progresses"). Joule heating
+  :math:`H_i = a J_i^2 V_i / \sigma_i` (eq. 35).
 
-Where they agree, and where not: eq. (43) is the discrete Laplace equation with weights ``A_ij`` and the wall
-particles held at ``J_ext`` -- the equation Kirchhoff's potential obeys with conductances ``G_ij`` and electrodes at
-fixed potentials. The converged ``J`` therefore *is* a potential (:func:`kirchhoff` with ``G = A`` and the wall
-particles fixed reproduces it to round-off); in a chain of equal contacts both are linear from one end to the other
-(Remark 4: each interior value the mean of its neighbours). But Zohdi reads ``J`` as a current magnitude: two walls
-at the same ``J_ext`` make every connected particle carry ``J_ext`` (Kirchhoff: no potential difference, no
-current), the heat is made in the particles by ``J^2`` rather than at the necks by ``I^2/G`` (where the narrow
+Where they agree, and where not: eq. (43) is the discrete Laplace equation with weights :math:`A_{ij}` and the wall
+particles held at :math:`J^\mathrm{ext}` -- the equation Kirchhoff's potential obeys with conductances :math:`G_{ij}`
+and electrodes at fixed potentials. The converged :math:`J` therefore *is* a potential (:func:`kirchhoff` with
+:math:`G = A` and the wall particles fixed reproduces it to round-off); in a chain of equal contacts both are linear
+from one end to the other (Remark 4: each interior value the mean of its neighbours). But Zohdi reads :math:`J` as a
+current magnitude: two walls at the same :math:`J^\mathrm{ext}` make every connected particle carry
+:math:`J^\mathrm{ext}` (Kirchhoff: no potential difference, no current), the heat is made in the particles by
+:math:`J^2` rather than at the necks by :math:`I^2/G` (where the narrow
 necks get most of it), the weights ignore the neck length and the conductivity, and nothing conserves charge.
 
 Particles in a group that touches no electrode carry no current in both schemes (Kirchhoff: their potential is
@@ -286,9 +288,9 @@ class ElectrodeBonds:
 
 
 def electrode_bonds(particles, bonds, walls, spec, electrodes: Electrodes, box=None) -> ElectrodeBonds:
-    """The electrical conductances of ``bonds`` (:func:`dem.laws.conductance.bond_conductances` with the particles'
-    electrical conductivity for kappa, without the interface conductance) and their wall bonds to the electrodes
-    among ``walls``.
+    r"""The electrical conductances of ``bonds`` (:func:`dem.laws.conductance.bond_conductances` with the particles'
+    electrical conductivity for :math:`\kappa`, without the interface conductance) and their wall bonds to the
+    electrodes among ``walls``.
 
     Parameters
     ----------
@@ -410,7 +412,7 @@ def refuse_floating(floating: np.ndarray, when: str = "") -> None:
 def contact_currents(n: int, i, j, G, share, plane_node, plane_index, G_plane, x, V, live):
     """The currents at the potentials ``x`` (per particle) with the electrodes at ``V``: ``(pair_current`` A from i
     to j, ``wall_current`` A from each electrode into its particle (0 where ``live`` is False), the Joule heat
-    ``I^2/G`` of each pair and wall contact, and the Joule heat made in each particle``)``: a pair contact's shared
+    :math:`I^2/G` of each pair and wall contact, and the Joule heat made in each particle``)``: a pair contact's shared
     by its particles in proportion to the resistances of their halves (``share``: i's), a wall contact's in its
     particle (module docstring).
 
@@ -520,7 +522,7 @@ def area_weighted_current(n: int, i, j, area, plane_node, plane_index, J_ext, J0
     i, j : array_like
         (M,) int, the particles of each pair contact.
     area : array_like
-        (M,) contact areas ``A_ij`` of the pair contacts (m^2), the weights of eq. (43).
+        (M,) contact areas :math:`A_{ij}` of the pair contacts (m^2), the weights of eq. (43).
     plane_node : array_like
         (B,) int, the particle of each electrode contact.
     plane_index : array_like
@@ -564,7 +566,7 @@ def area_weighted_current(n: int, i, j, area, plane_node, plane_index, J_ext, J0
 
 
 def zohdi_joule(J, volume, sigma, absorption: float) -> np.ndarray:
-    """``H_i = a J_i^2 V_i / sigma_i`` (Zohdi 2014, eq. 35), W.
+    r""":math:`H_i = a J_i^2 V_i / \sigma_i` (Zohdi 2014, eq. 35), W.
 
     Parameters
     ----------

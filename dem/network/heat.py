@@ -1,55 +1,65 @@
-"""The thermal pipe network: steady solve and time integration of ``C_i dT_i/dt = Q_i`` (Rojek 2022, eqs. 2-4).
+r"""The thermal pipe network: steady solve and time integration of :math:`C_i \, dT_i/dt = Q_i` (Rojek 2022, eqs.
+2-4).
 
-With the pipes ``Q_ij = K_ij (T_j - T_i)`` (eq. 4), the heat balance of the free (not fixed) particles is linear
-apart from radiation::
+With the pipes :math:`Q_{ij} = K_{ij} (T_j - T_i)` (eq. 4), the heat balance of the free (not fixed) particles is
+linear apart from radiation:
 
-    C dT/dt = r - A T,    A = L_FF + diag(K_wall + g),    r = -L_FD T_D + K_wall T_wall + Q_int + b,
+.. math::
 
-with ``L`` the weighted graph Laplacian of the bonds (symmetric positive semidefinite, rows summing to zero),
-``F``/``D`` the free/fixed particles, ``(g, b)`` the ambient exchange ``Q = b - g T`` (convection; radiation
-linearised about the current temperature, :func:`dem.laws.ambient.linear_sink_terms`). ``A`` is built once as a CSR
-matrix; it is SPD when every connected group of free particles reaches a fixed particle, a wall or the ambient.
+    C \frac{dT}{dt} = r - A T, \qquad A = L_{FF} + \mathrm{diag}(K_\mathrm{wall} + g), \qquad
+    r = -L_{FD} T_D + K_\mathrm{wall} T_\mathrm{wall} + Q_\mathrm{int} + b,
 
-* :func:`steady` -- ``A T = r`` (Newton on the radiation term); singular systems are detected and explained.
-* :func:`integrate` -- the theta method ``(C/dt + theta A) T+ = (C/dt - (1-theta) A) T + r`` with theta = 0
-  (explicit forward Euler), 1 (implicit backward Euler), 1/2 (Crank-Nicolson); the matrix is factorised once per
-  step size and reused. Explicit steps are stable only for ``dt <= 2/lambda_max(C^-1 A)``: a larger ``dt`` is
+with :math:`L` the weighted graph Laplacian of the bonds (symmetric positive semidefinite, rows summing to zero),
+:math:`F`/:math:`D` the free/fixed particles, :math:`(g, b)` the ambient exchange :math:`Q = b - g T` (convection;
+radiation linearised about the current temperature, :func:`dem.laws.ambient.linear_sink_terms`). :math:`A` is built
+once as a CSR matrix; it is SPD when every connected group of free particles reaches a fixed particle, a wall or the
+ambient.
+
+* :func:`steady` -- :math:`A T = r` (Newton on the radiation term); singular systems are detected and explained.
+* :func:`integrate` -- the :math:`\theta` method
+  :math:`(C/\Delta t + \theta A) T^+ = (C/\Delta t - (1 - \theta) A) T + r` with :math:`\theta = 0` (explicit
+  forward Euler), 1 (implicit backward Euler), 1/2 (Crank-Nicolson); the matrix is factorised once per step size
+  and reused. Explicit steps are stable only for :math:`\Delta t \le 2/\lambda_\max(C^{-1} A)`: a larger ``dt`` is
   refused with a message giving the limit. ``dt = "auto"`` controls the error: each step estimates its local
   error (explicit: the difference to Heun's step, free; implicit and Crank-Nicolson: step doubling, one step of
-  dt against two of dt/2, the latter kept), rejects and redoes a step whose error exceeds the per-step tolerance
-  and sets the next step by ``dt * clip(0.9 (tol/err)^(1/(q+1)), 0.2, 5)`` (q the order: 1 for explicit and
-  implicit, 2 for Crank-Nicolson). The per-step tolerance :func:`step_tolerance` is set so that the global
-  error, relative to the temperature range, is about ``rtol``. Implicit steps are ``t_end / 2^k`` on the dyadic
-  grid of [0, t_end], so the few step sizes used are factorised once each and the run ends exactly on t_end;
-  explicit steps stay below 0.9 of the stable limit.
+  :math:`\Delta t` against two of :math:`\Delta t/2`, the latter kept), rejects and redoes a step whose error
+  exceeds the per-step tolerance and sets the next step by
+  :math:`\Delta t \, \mathrm{clip}(0.9 \, (\mathrm{tol}/\mathrm{err})^{1/(q+1)}, 0.2, 5)` (:math:`q` the order: 1
+  for explicit and implicit, 2 for Crank-Nicolson). The per-step tolerance :func:`step_tolerance` is set so that
+  the global error, relative to the temperature range, is about ``rtol``. Implicit steps are
+  :math:`t_\mathrm{end} / 2^k` on the dyadic grid of :math:`[0, t_\mathrm{end}]`, so the few step sizes used are
+  factorised once each and the run ends exactly on :math:`t_\mathrm{end}`; explicit steps stay below 0.9 of the
+  stable limit.
 
-  Stiff steps: Crank-Nicolson's amplification factor ``(1 - z/2)/(1 + z/2)``, ``z = lambda dt``, turns negative
-  for ``dt > 2/lambda`` and tends to -1 for ``z >> 1``: a fixed step far above the stiffest time constant keeps
-  the initial temperature difference alternating for ever (a pair stays at 100 and 0 C). Such a run (fixed ``dt``
-  above the stable limit ``2/lambda_max``) starts with ``STARTUP_STEPS`` implicit Euler steps (Rannacher's
-  start-up; amplification ``1/(1 + z)``, L-stable), which damp the stiff part of the initial data; the finite
-  number of first-order steps keeps the run second order, and a step within the stable limit runs plain
-  Crank-Nicolson as before. Whatever the integrator, a run whose ``max_principle_violation`` exceeds
-  ``MAX_PRINCIPLE_TOLERANCE`` of the scene's temperature range, or whose ``energy_error`` exceeds
-  ``ENERGY_TOLERANCE``, is refused with a message naming ``dt``: its temperatures are wrong.
+  Stiff steps: Crank-Nicolson's amplification factor :math:`(1 - z/2)/(1 + z/2)`, :math:`z = \lambda \Delta t`,
+  turns negative for :math:`\Delta t > 2/\lambda` and tends to -1 for :math:`z \gg 1`: a fixed step far above the
+  stiffest time constant keeps the initial temperature difference alternating for ever (a pair stays at 100 and
+  0 C). Such a run (fixed ``dt`` above the stable limit :math:`2/\lambda_\max`) starts with ``STARTUP_STEPS``
+  implicit Euler steps (Rannacher's start-up; amplification :math:`1/(1 + z)`, L-stable), which damp the stiff part
+  of the initial data; the finite number of first-order steps keeps the run second order, and a step within the
+  stable limit runs plain Crank-Nicolson as before. Whatever the integrator, a run whose
+  ``max_principle_violation`` exceeds ``MAX_PRINCIPLE_TOLERANCE`` of the scene's temperature range, or whose
+  ``energy_error`` exceeds ``ENERGY_TOLERANCE``, is refused with a message naming ``dt``: its temperatures are
+  wrong.
 
   ``python -m benchmarks dem`` measures steps, error and time of each integrator, fixed and ``"auto"`` at rtol
   1e-2 ... 1e-4, on the decay of a 2048-particle packing between plates (section "DEM transient: error against
   time"). The dyadic grid rounds every step down to a power of 2: it costs some more steps for the same error, but
   saves the second factorisation per step that free step sizes would need.
 
-Periodic packings (:mod:`dem.geometry.periodic`): a bond to the image ``shift`` of particle ``j`` sees that image at
-``T_j - g``, ``g = drop . shift`` (the temperature drop per period of the box), so it adds the constant flow
-``-K g`` to ``i`` and ``+K g`` to ``j``; these enter ``r`` as the heat flow ``periodic``, which sums to zero over a
-group of free particles. Such a group (no fixed particle, wall or ambient) has a steady state only up to a constant:
-:func:`steady` fixes it by keeping the group's capacity-weighted mean temperature at its initial value (heat is
-conserved, so the transient ends there too), and :func:`periodic_heat_flow` gives the heat flow across the period
-along each axis.
+Periodic packings (:mod:`dem.geometry.periodic`): a bond to the image ``shift`` of particle :math:`j` sees that
+image at :math:`T_j - g`, :math:`g = \mathrm{drop} \cdot \mathrm{shift}` (the temperature drop per period of the
+box), so it adds the constant flow :math:`-K g` to :math:`i` and :math:`+K g` to :math:`j`; these enter :math:`r` as
+the heat flow ``periodic``, which sums to zero over a group of free particles. Such a group (no fixed particle, wall
+or ambient) has a steady state only up to a constant: :func:`steady` fixes it by keeping the group's
+capacity-weighted mean temperature at its initial value (heat is conserved, so the transient ends there too), and
+:func:`periodic_heat_flow` gives the heat flow across the period along each axis.
 
 Energy bookkeeping: the heat flowing into the free particles through each boundary (fixed particles, walls,
-convection, radiation, internal sources) is integrated with the same theta weighting as the step, so the change
-of ``sum C_i T_i`` must match it to round-off; the relative mismatch is ``energy_error``. (An iterative linear
-solve is shifted uniformly, by an amount of the order of its tolerance, so that its residuals sum to zero.)
+convection, radiation, internal sources) is integrated with the same :math:`\theta` weighting as the step, so the
+change of :math:`\sum_i C_i T_i` must match it to round-off; the relative mismatch is ``energy_error``. (An
+iterative linear solve is shifted uniformly, by an amount of the order of its tolerance, so that its residuals sum
+to zero.)
 """
 
 from __future__ import annotations
@@ -186,7 +196,8 @@ class Network:
         return ("fixed", "walls", "internal", *self.sources.names) + (("periodic",) if self.periodic else ())
 
     def sinks(self, T_F: np.ndarray) -> dict:
-        """The ambient exchange of the free particles as ``Q = b - g T`` (:func:`dem.laws.ambient.linear_sink_terms`).
+        """The ambient exchange of the free particles as :math:`Q = b - g T`
+        (:func:`dem.laws.ambient.linear_sink_terms`).
 
         Parameters
         ----------
@@ -201,7 +212,7 @@ class Network:
         return linear_sink_terms(self.sources, self.radius, T_F)
 
     def matrix(self, sinks: dict) -> sp.csr_matrix:
-        """The system matrix ``A = L_FF + diag(K_wall + g)``, CSR.
+        r"""The system matrix :math:`A = L_{FF} + \mathrm{diag}(K_\mathrm{wall} + g)`, CSR.
 
         Parameters
         ----------
@@ -259,12 +270,13 @@ class Network:
         return out
 
     def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
-        """Sum of the absolute heat flows into or out of each free particle through its boundaries (W): the scale
+        r"""Sum of the absolute heat flows into or out of each free particle through its boundaries (W): the scale
         of the energy balance (hot and cold ends do not cancel in it).
 
-        Each flow is a difference of terms ``K T``. Where (almost) no heat flows, the flows are the round-off of
+        Each flow is a difference of terms :math:`K T`. Where (almost) no heat flows, the flows are the round-off of
         those terms and a balance relative to them means nothing, so the scale is never taken below
-        ``sqrt(eps) sum |K T|``: temperature differences below ~1e-8 of the temperatures count as no flow.
+        :math:`\sqrt{\epsilon} \sum |K T|` (:math:`\epsilon` the machine precision): temperature differences below ~1e-8
+        of the temperatures count as no flow.
 
         Parameters
         ----------
@@ -621,10 +633,11 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
 
 # ------------------------------------------------------------------------------------------------ transient
 def stable_limit(net: Network, sinks: dict | None = None) -> float:
-    """Largest stable explicit step ``2 / lambda_max(C^-1 A)`` (``inf`` without any coupling).
+    r"""Largest stable explicit step :math:`2 / \lambda_\max(C^{-1} A)` (``inf`` without any coupling).
 
-    ``lambda_max`` from Lanczos on the symmetric ``C^-1/2 A C^-1/2`` (dense for small systems); where Lanczos
-    fails the Gershgorin bound ``lambda_max <= max_i 2 A_ii / C_i`` gives a safe (smaller) limit.
+    :math:`\lambda_\max` from Lanczos on the symmetric :math:`C^{-1/2} A C^{-1/2}` (dense for small systems); where
+    Lanczos fails the Gershgorin bound :math:`\lambda_\max \le \max_i 2 A_{ii} / C_i` gives a safe (smaller)
+    limit.
 
     Parameters
     ----------
@@ -656,11 +669,12 @@ def stable_limit(net: Network, sinks: dict | None = None) -> float:
 
 
 def surely_stiff(dt: float, A: sp.csr_matrix, C: np.ndarray, rows=None, largest=None) -> bool:
-    """Whether the step ``dt`` is surely above the stable limit ``2 / lambda_max(C^-1 A)`` (:func:`stable_limit`)
-    without computing an eigenvalue: ``dt > 2 / max_i (A_ii / C_i)``, the largest ``A_ii / C_i`` being a lower bound
-    of ``lambda_max`` (the Rayleigh quotient of a unit vector). Where it is not, Crank-Nicolson keeps the maximum
-    principle (its explicit half ``C/dt - A/2`` has no negative entry) and no mode's amplification factor is below
-    -1/3 (``z = lambda dt <= 2 dt max_i A_ii / C_i <= 4``, Gershgorin): no start-up is needed.
+    r"""Whether the step ``dt`` is surely above the stable limit :math:`2 / \lambda_\max(C^{-1} A)`
+    (:func:`stable_limit`) without computing an eigenvalue: :math:`\Delta t > 2 / \max_i (A_{ii} / C_i)`, the largest
+    :math:`A_{ii} / C_i` being a lower bound of :math:`\lambda_\max` (the Rayleigh quotient of a unit vector). Where
+    it is not, Crank-Nicolson keeps the maximum principle (its explicit half :math:`C/\Delta t - A/2` has no negative
+    entry) and no mode's amplification factor is below -1/3
+    (:math:`z = \lambda \Delta t \le 2 \Delta t \max_i A_{ii} / C_i \le 4`, Gershgorin): no start-up is needed.
 
     Parameters
     ----------
@@ -793,10 +807,11 @@ def check_step_count(t_end: float, dt: float, max_steps: int, what: str):
 
 
 def step_tolerance(rtol: float, order: int) -> float:
-    """Local error allowed per step (relative to the temperature range) for a global error of about ``rtol``.
+    r"""Local error allowed per step (relative to the temperature range) for a global error of about ``rtol``.
 
-    An order-q method whose steps each make a local error ``tau`` ends ``~ c tau^(q/(q+1))`` off (the steps shrink
-    with ``tau^(1/(q+1))``), so ``tau = min(rtol, k_q rtol^((q+1)/q))``; ``k_q`` (``AUTO_LOCAL``) is calibrated
+    An order-:math:`q` method whose steps each make a local error :math:`\tau` ends :math:`\sim c \tau^{q/(q+1)}` off
+    (the steps shrink with :math:`\tau^{1/(q+1)}`), so
+    :math:`\tau = \min(\mathrm{rtol}, k_q \mathrm{rtol}^{(q+1)/q})`; :math:`k_q` (``AUTO_LOCAL``) is calibrated
     on the decay of a pair and of a packing between plates (global errors 0.1-1 x rtol for rtol 1e-2 ... 1e-4).
 
     Parameters
@@ -809,7 +824,7 @@ def step_tolerance(rtol: float, order: int) -> float:
     Returns
     -------
     float
-        ``tau``, relative to the temperature range.
+        :math:`\tau`, relative to the temperature range.
     """
     return min(rtol, AUTO_LOCAL[order] * rtol ** ((order + 1) / order))
 
@@ -824,7 +839,7 @@ def _controller_factor(err: float, tol: float, order: int) -> float:
 
 @dataclass
 class Checkpoint:
-    """Where :func:`integrate` stands after an accepted step: everything its loop carries, so that a run resumed
+    r"""Where :func:`integrate` stands after an accepted step: everything its loop carries, so that a run resumed
     from it ends bit for bit where the uninterrupted run ends (the linear solvers' warm starts included).
 
     Parameters
@@ -838,7 +853,8 @@ class Checkpoint:
     rejected : int
         Rejected steps so far.
     units : int
-        The time on the dyadic grid, ``t = t_end * units / 2^AUTO_LEVELS`` (implicit ``dt = "auto"``).
+        The time on the dyadic grid, :math:`t = t_\mathrm{end} \cdot \mathrm{units} / 2^{\mathrm{AUTO\_LEVELS}}`
+        (implicit ``dt = "auto"``).
     dt_want : float
         The step the controller asks for next (s).
     heat_in : dict

@@ -1,28 +1,31 @@
-"""One network problem, two fields: a weighted graph Laplacian with fixed nodes and planes at a given value.
+r"""One network problem, two fields: a weighted graph Laplacian with fixed nodes and planes at a given value.
 
-Heat between particles (Rojek 2022, eqs. 2-4: temperatures, thermal conductances K in W/K) and current between
-particles (Kirchhoff's laws: potentials, electrical conductances G in S) are the same linear problem on the contact
-graph. Each edge ``c = (i, j)`` carries the flow ``K_c (x_i - x_j)`` from i to j; a node may also be joined to a
-*plane* (a wall at a prescribed temperature, an electrode at a prescribed potential) by ``K_kw``, carrying
-``K_kw (x_k - x_w)`` into the plane; some nodes may be *fixed* (prescribed values). The balance of the free nodes
-``F`` (with the fixed ones ``D``) is::
+Heat between particles (Rojek 2022, eqs. 2-4: temperatures, thermal conductances :math:`K` in W/K) and current
+between particles (Kirchhoff's laws: potentials, electrical conductances :math:`G` in S) are the same linear problem
+on the contact graph. Each edge :math:`c = (i, j)` carries the flow :math:`K_c (x_i - x_j)` from :math:`i` to
+:math:`j`; a node may also be joined to a *plane* (a wall at a prescribed temperature, an electrode at a prescribed
+potential) by :math:`K_{kw}`, carrying :math:`K_{kw} (x_k - x_w)` into the plane; some nodes may be *fixed*
+(prescribed values). The balance of the free nodes :math:`F` (with the fixed ones :math:`D`) is
 
-    A x_F = b,     A = L_FF + diag(sum of the plane conductances of each node),
-                   b = -L_FD x_D + sum_w K_kw x_w (+ sources),
+.. math::
 
-with ``L`` the weighted graph Laplacian (:func:`laplacian`). ``A`` is symmetric positive semidefinite, and definite
-on every connected group of free nodes that reaches a fixed node or a plane (an *anchored* group,
-:meth:`BoundedLaplacian.components`); a group that reaches none floats: its values are undetermined.
+    A x_F = b, \qquad A = L_{FF} + \mathrm{diag}\Big(\sum_w K_{kw}\Big), \qquad
+    b = -L_{FD} x_D + \sum_w K_{kw} x_w \; (+ \text{sources}),
+
+the diagonal term holding the sum of the plane conductances of each node, with :math:`L` the weighted graph
+Laplacian (:func:`laplacian`). :math:`A` is symmetric positive semidefinite, and definite on every connected group of
+free nodes that reaches a fixed node or a plane (an *anchored* group, :meth:`BoundedLaplacian.components`); a group
+that reaches none floats: its values are undetermined.
 
 :class:`BoundedLaplacian` assembles this once as CSR matrices and rewrites their entries in place when only the
 conductances change (:meth:`~BoundedLaplacian.refresh`: contacts whose necks grow, particles that move a little).
-The thermal network (:class:`dem.network.heat.Network`) and the Kirchhoff current solve (:mod:`dem.network.current`) are
-both built on it; :func:`solve_anchored` is the steady solve the current uses. :meth:`~BoundedLaplacian.flux` is the
-net flow into every node at given node values, ``-(L x)_k + sum_w K_kw (x_w - x_k)``: the conducted heat of the
-lumped balance of particles that move (:class:`dem.engines.staggered.heat.LumpedHeat`), whose edges are the pairs of
-a Verlet list, those not in contact with ``K = 0`` (so the graph is refreshed in place until the list is rebuilt). An
-edge with ``K = 0`` carries nothing and joins nothing: :meth:`~BoundedLaplacian.components` counts only edges with
-``K > 0``.
+The thermal network (:class:`dem.network.heat.Network`) and the Kirchhoff current solve (:mod:`dem.network.current`)
+are both built on it; :func:`solve_anchored` is the steady solve the current uses. :meth:`~BoundedLaplacian.flux` is
+the net flow into every node at given node values, :math:`-(L x)_k + \sum_w K_{kw} (x_w - x_k)`: the conducted heat
+of the lumped balance of particles that move (:class:`dem.engines.staggered.heat.LumpedHeat`), whose edges are the
+pairs of a Verlet list, those not in contact with :math:`K = 0` (so the graph is refreshed in place until the list is
+rebuilt). An edge with :math:`K = 0` carries nothing and joins nothing: :meth:`~BoundedLaplacian.components` counts
+only edges with :math:`K > 0`.
 """
 
 from __future__ import annotations
@@ -35,7 +38,7 @@ from dem.network.linsolve import make_solver
 
 
 def laplacian(n: int, i: np.ndarray, j: np.ndarray, K: np.ndarray) -> sp.csr_matrix:
-    """Weighted graph Laplacian ``L_ii = sum_j K_ij``, ``L_ij = -K_ij`` (symmetric, rows sum to zero).
+    r"""Weighted graph Laplacian :math:`L_{ii} = \sum_j K_{ij}`, :math:`L_{ij} = -K_{ij}` (symmetric, rows sum to zero).
 
     Parameters
     ----------
@@ -230,7 +233,7 @@ class BoundedLaplacian:
         return self.L_FF.diagonal()
 
     def matrix(self, extra_diag=None) -> sp.csr_matrix:
-        """``A = L_FF + diag(plane conductances + extra_diag)``, CSR.
+        r""":math:`A = L_{FF} + \mathrm{diag}(\text{plane conductances} + \text{extra\_diag})`, CSR.
 
         Parameters
         ----------

@@ -1,13 +1,13 @@
-"""Sparse symmetric positive definite solves behind one small interface.
+r"""Sparse symmetric positive definite solves behind one small interface.
 
 ``make_solver(A, backend)`` returns an object with ``solve(b, x0=None) -> x`` for a fixed matrix, so a
 factorisation or a multigrid hierarchy is built once and reused for every right-hand side (every time step).
 Backends (``BACKENDS``; a PETSc/MPI backend is one more entry with the same two methods):
 
-* ``"direct"`` -- sparse LU (SuperLU, symmetric mode with a minimum-degree ordering of ``A + A^T``); exact to
+* ``"direct"`` -- sparse LU (SuperLU, symmetric mode with a minimum-degree ordering of :math:`A + A^T`); exact to
   round-off. Fill-in grows fast on 3D networks, so ``"auto"`` uses it for small systems only.
 * ``"cg"`` -- conjugate gradients with a Jacobi (diagonal) preconditioner. Converges in a handful of iterations
-  when the capacity term ``C/dt`` dominates the diagonal (implicit steps of large packings).
+  when the capacity term :math:`C/\Delta t` dominates the diagonal (implicit steps of large packings).
 * ``"amg"`` -- conjugate gradients preconditioned by a smoothed-aggregation algebraic multigrid V-cycle (pyamg),
   for large steady networks, with settings tuned for network matrices (:class:`AMGSolver`); a matrix that changed
   a little since an earlier one of the same size (``make_solver(previous=...)``: a refresh, radiation's Newton and
@@ -16,25 +16,25 @@ Backends (``BACKENDS``; a PETSc/MPI backend is one more entry with the same two 
   10^6-particle bench packing (section "DEM steady network: AMG side by side"; PETSc's rows where petsc4py
   imports).
 
-``"auto"`` (:func:`choose_backend`) looks at the diagonal dominance first: the Jacobi-scaled matrix has condition
-number at most ``1 + 2/rho`` with ``rho = min_i m_i / L_ii`` (``m_i`` the part of the diagonal beyond the
-Laplacian: ``C_i/dt`` in a time step). When that bound is at most ``JACOBI_MAX_CONDITION``, Jacobi-CG reaches a
-relative residual of 1e-10 within about ``sqrt(4000)/2 ln(2 sqrt(4000) / 1e-10) ~ 880`` iterations (1000 are
-allowed), and it is chosen above ``JACOBI_MIN`` unknowns (chains with conductances spread over 1e4 ... 1e12
-at the bound took at most 504 iterations). The target is on the unscaled residual, which floating point may not
-reach on badly scaled systems: should CG fail, the matrix falls back to direct or AMG (:class:`AutoCGSolver`).
-Otherwise (steady networks, very large time steps) direct up to ``DIRECT_MAX`` unknowns, AMG above.
+``"auto"`` (:func:`choose_backend`) looks at the diagonal dominance first: the Jacobi-scaled matrix has condition number
+at most :math:`1 + 2/\rho` with :math:`\rho = \min_i m_i / L_{ii}` (:math:`m_i` the part of the diagonal beyond the
+Laplacian: :math:`C_i/\Delta t` in a time step). When that bound is at most ``JACOBI_MAX_CONDITION``, Jacobi-CG reaches
+a relative residual of 1e-10 within about :math:`\frac{\sqrt{4000}}{2} \ln(2 \sqrt{4000} / 10^{-10}) \approx 880`
+iterations (1000 are allowed), and it is chosen above ``JACOBI_MIN`` unknowns (chains with conductances spread over 1e4
+... 1e12 at the bound took at most 504 iterations). The target is on the unscaled residual, which floating point may not
+reach on badly scaled systems: should CG fail, the matrix falls back to direct or AMG (:class:`AutoCGSolver`). Otherwise
+(steady networks, very large time steps) direct up to ``DIRECT_MAX`` unknowns, AMG above.
 
-The thresholds come from timing the three backends on random sintered packings between fixed plates, steady and
-with the capacity term ``C/dt`` for steps of 1 to 1000 times the cheap explicit bound ``2 min C_i / L_ii``:
+The thresholds come from timing the three backends on random sintered packings between fixed plates, steady and with the
+capacity term :math:`C/\Delta t` for steps of 1 to 1000 times the cheap explicit bound :math:`2 \min_i C_i / L_{ii}`:
 ``python -m benchmarks dem`` prints that table with the choice of ``"auto"`` beside each row (section "DEM linear
-solvers"). What it shows: SuperLU's fill-in on 3D networks makes the factorisation grow about as N^2, while a
-Jacobi-CG solve costs about as much as a direct back-substitution from ~10 000 unknowns on whenever ``C/dt``
-dominates; in a time integration CG is also warm-started from the extrapolated previous steps, and with
-``dt = "auto"`` every step size gets its own solver, which tips the balance further. Without diagonal dominance
-(steady networks, very large dt) a single solve decides: direct costs milliseconds up to a few thousand unknowns;
-above, AMG is chosen for its robustness to conductance contrasts, although plain Jacobi-CG often converges faster
-on benign packings -- it has no convergence guarantee there.
+solvers"). What it shows: SuperLU's fill-in on 3D networks makes the factorisation grow about as :math:`N^2`, while a
+Jacobi-CG solve costs about as much as a direct back-substitution from ~10 000 unknowns on whenever :math:`C/\Delta t`
+dominates; in a time integration CG is also warm-started from the extrapolated previous steps, and with ``dt = "auto"``
+every step size gets its own solver, which tips the balance further. Without diagonal dominance (steady networks, very
+large dt) a single solve decides: direct costs milliseconds up to a few thousand unknowns; above, AMG is chosen for its
+robustness to conductance contrasts, although plain Jacobi-CG often converges faster on benign packings -- it has no
+convergence guarantee there.
 """
 
 from __future__ import annotations
@@ -103,7 +103,7 @@ def _dot(a: np.ndarray, b: np.ndarray) -> float:
 
 
 class PCGSolver:
-    """Preconditioned conjugate gradients to ``|r| <= rtol |b|``, warm-started from ``x0``.
+    r"""Preconditioned conjugate gradients to :math:`|r| \le \mathrm{rtol} \, |b|`, warm-started from ``x0``.
 
     Parameters
     ----------
@@ -112,7 +112,7 @@ class PCGSolver:
     rtol : float
         The relative residual at which the iteration stops.
     max_iterations : int or None
-        The most iterations per solve; None: ``max(1000, 10 sqrt(N))``.
+        The most iterations per solve; None: :math:`\max(1000, 10 \sqrt{N})` (:math:`N` unknowns).
     """
 
     name = "cg"
@@ -185,18 +185,18 @@ class PCGSolver:
 
 
 class AMGSolver(PCGSolver):
-    """CG preconditioned by one smoothed-aggregation V-cycle (pyamg), hierarchy built once (``AMG_OPTIONS``).
+    r"""CG preconditioned by one smoothed-aggregation V-cycle (pyamg), hierarchy built once (``AMG_OPTIONS``).
 
     Three things make it cheap on the network matrices (weighted graph Laplacians plus a positive diagonal):
 
-    * the prolongation smoother of the finest level weights each row by its Gershgorin row sum ``sum_j |A_ij|``
-      (pyamg's ``weighting="local"``) instead of estimating ``rho(D^-1 A)`` by restarted Arnoldi, which costs as
-      much as the rest of the setup on 10^6 unknowns. A Laplacian row sums to ``2 A_ii``, so ``omega = 1.8`` is
-      a damping of 0.9 / A_ii, next to pyamg's default ``4/3 / rho(D^-1 A) = 0.84`` (rho = 1.59 on the bench
-      packing). Coarse levels (pyamg holds them as BSR, whose ``abs`` is a Python loop) keep the default weighting;
-      their Arnoldi is cheap;
+    * the prolongation smoother of the finest level weights each row by its Gershgorin row sum :math:`\sum_j |A_{ij}|`
+      (pyamg's ``weighting="local"``) instead of estimating :math:`\rho(D^{-1} A)` by restarted Arnoldi, which costs as
+      much as the rest of the setup on :math:`10^6` unknowns. A Laplacian row sums to :math:`2 A_{ii}`, so
+      :math:`\omega = 1.8` is a damping of :math:`0.9 / A_{ii}`, next to pyamg's default
+      :math:`\frac{4}{3} / \rho(D^{-1} A) = 0.84` (:math:`\rho = 1.59` on the bench packing). Coarse levels (pyamg holds
+      them as BSR, whose ``abs`` is a Python loop) keep the default weighting; their Arnoldi is cheap;
     * the constant vector is the near-null space of a graph Laplacian as it is: no relaxation sweeps improve it;
-    * every connection is strong (``strength=None``): pyamg's default symmetric measure with ``theta = 0`` keeps
+    * every connection is strong (``strength=None``): pyamg's default symmetric measure with :math:`\theta = 0` keeps
       every entry too, so the aggregates are the same, without computing and scaling a copy of every level
       (the setup takes 0.7 of the CPU time on the bench packing's 10^6 unknowns, the same iterates to the bit);
     * the coarse levels are converted from BSR with 1 x 1 blocks to CSR once built, and their Gauss-Seidel
@@ -219,7 +219,7 @@ class AMGSolver(PCGSolver):
     rtol : float
         The relative residual at which CG stops.
     max_iterations : int or None
-        The most iterations per solve; None: ``max(1000, 10 sqrt(N))``.
+        The most iterations per solve; None: :math:`\max(1000, 10 \sqrt{N})` (:math:`N` unknowns).
     hierarchy_of : AMGSolver or None
         The solver of an earlier matrix of the same size whose hierarchy preconditions this one; None: build one.
     """

@@ -1,24 +1,26 @@
-"""Electrically aided sintering (Zohdi 2014) on the engine: the staggered, adaptive multiphysics step of
+r"""Electrically aided sintering (Zohdi 2014) on the engine: the staggered, adaptive multiphysics step of
 Algorithm 1 (eqs. 45-49) over the mechanical, thermal and electrical submodels.
 
-Each step from ``t`` to ``t + dt`` iterates, K = 1, 2, ...:
+Each step from :math:`t` to :math:`t + \Delta t` iterates, :math:`K = 1, 2, \ldots`:
 
-1. positions ``r^K`` with the temperatures frozen at ``theta^(K-1)`` (:class:`dem.engines.staggered.mechanics.StaggeredMechanics`,
-   eqs. 22-27, 45);
-2. temperatures ``theta^K`` with the positions frozen at ``r^K`` (:class:`dem.engines.staggered.heat.LumpedHeat`, eqs. 36-37,
-   46), with the Joule heating of the current refreshed at the last accepted step;
-3. the normalised changes ``D_r = sum |r^K - r^(K-1)| / sum |r^K - r^L|`` and ``D_theta`` alike (Algorithm 1, step
-   4a; eq. 47), the violation ratio ``Z_K = max(D_r, D_theta) / TOL`` (eq. 48) and the step factor ``Phi_K =
-   min(Phi_r, Phi_theta)``, ``Phi = (TOL/D_0)^(1/(p K_d)) / (D_K/D_0)^(1/(p K))`` (eqs. 30, 49; ``D_0 = 1``, the
-   first iterate's relative change).
+1. positions :math:`r^K` with the temperatures frozen at :math:`\theta^{K-1}`
+   (:class:`dem.engines.staggered.mechanics.StaggeredMechanics`, eqs. 22-27, 45);
+2. temperatures :math:`\theta^K` with the positions frozen at :math:`r^K`
+   (:class:`dem.engines.staggered.heat.LumpedHeat`, eqs. 36-37, 46), with the Joule heating of the current refreshed
+   at the last accepted step;
+3. the normalised changes :math:`D_r = \sum |r^K - r^{K-1}| / \sum |r^K - r^L|` and :math:`D_\theta` alike
+   (Algorithm 1, step 4a; eq. 47), the violation ratio :math:`Z_K = \max(D_r, D_\theta) / \mathrm{TOL}` (eq. 48) and
+   the step factor :math:`\Phi_K = \min(\Phi_r, \Phi_\theta)`,
+   :math:`\Phi = (\mathrm{TOL}/D_0)^{1/(p K_d)} / (D_K/D_0)^{1/(p K)}` (eqs. 30, 49; :math:`D_0 = 1`, the first
+   iterate's relative change).
 
-``Z_K <= 1``: the step is accepted, the current refreshed at the new configuration (step 6d), and the next step is
-``min(Phi_K dt, dt_lim)`` (steps 6a-c). ``Z_K > 1`` after ``K_d`` iterations: the step restarts from ``t`` with
-``Phi_K dt`` (step 7). Beyond the paper: an accepted step grows by at most ``growth``, a restart shrinks it by at
-least ``shrink`` (:class:`dem.scene.staggered.ZohdiStepping`), a displacement below 1e-12 of the mean radius (a
-temperature change below 1e-12 of the temperatures) counts as none, and a step below ``dt_min`` that still cannot
-converge stops the run. Steps end exactly on the start of every ``[[phases]]`` entry (a wall changing speed) and on
-``t_end``.
+:math:`Z_K \le 1`: the step is accepted, the current refreshed at the new configuration (step 6d), and the next step
+is :math:`\min(\Phi_K \Delta t, \Delta t_\mathrm{lim})` (steps 6a-c). :math:`Z_K > 1` after :math:`K_d` iterations:
+the step restarts from :math:`t` with :math:`\Phi_K \Delta t` (step 7). Beyond the paper: an accepted step grows by
+at most ``growth``, a restart shrinks it by at least ``shrink`` (:class:`dem.scene.staggered.ZohdiStepping`), a
+displacement below 1e-12 of the mean radius (a temperature change below 1e-12 of the temperatures) counts as none, and
+a step below ``dt_min`` that still cannot converge stops the run. Steps end exactly on the start of every
+``[[phases]]`` entry (a wall changing speed) and on ``t_end``.
 
 The simulation offers what the outputs ask of an engine (:class:`dem.output.writer.RunWriter`): ``record()``,
 ``particle_fields()``, ``contact_fields()``, ``profile()``, ``summary()`` and ``mechanics.state``.

@@ -1,29 +1,32 @@
-"""The thermal submodel of Zohdi 2014: the lumped heat balance of each particle (eqs. 31-37).
+r"""The thermal submodel of Zohdi 2014: the lumped heat balance of each particle (eqs. 31-37).
 
-``m_i C_i dtheta_i/dt = Q_i + H_i`` (eq. 31): ``Q_i`` the heat conducted through the particle's contacts (with
-walls that carry a temperature: isothermal planes) and ``H_i`` its Joule heating (eq. 35; :mod:`dem.engines.contact_current`).
-The contact conductance is the scene's ``[conductance] law`` on each contact as it is, exactly as for a static
-packing: ``law = "zohdi"`` is the paper's ``K_ij A_ij / |r_i - r_j|`` (eq. 33 with the lens area of eqs. 7-12;
-compiled on the Verlet list, :func:`dem.laws.lens_conductance.lens_list_conductances`), any other law is evaluated on the
-bonds of the touching pairs (:func:`dem.geometry.bonds.find_bonds`, :func:`dem.laws.conductance.bond_conductances`),
-``"fit"`` the FE-verified neck law; with a pair-neck reading, particles whose necks meet are handed over to the union
-of spheres at each accepted step (:mod:`dem.engines.handover`).
+:math:`m_i C_i \, d\theta_i/dt = Q_i + H_i` (eq. 31): :math:`Q_i` the heat conducted through the particle's contacts
+(with walls that carry a temperature: isothermal planes) and :math:`H_i` its Joule heating (eq. 35;
+:mod:`dem.engines.contact_current`). The contact conductance is the scene's ``[conductance] law`` on each contact as
+it is, exactly as for a static packing: ``law = "zohdi"`` is the paper's :math:`K_{ij} A_{ij} / |r_i - r_j|` (eq. 33
+with the lens area of eqs. 7-12; compiled on the Verlet list, :func:`dem.laws.lens_conductance.lens_list_conductances`),
+any other law is evaluated on the bonds of the touching pairs (:func:`dem.geometry.bonds.find_bonds`,
+:func:`dem.laws.conductance.bond_conductances`), ``"fit"`` the FE-verified neck law; with a pair-neck reading,
+particles whose necks meet are handed over to the union of spheres at each accepted step (:mod:`dem.engines.handover`).
 
-``Q`` is the flux of the contact network (:meth:`dem.network.laplacian.BoundedLaplacian.flux`, ``-L theta`` plus the
-walls' terms) whose edges are the pairs of the mechanics' Verlet list and its particle-wall pairs with the
-temperature-carrying walls, the pairs not in contact with ``K = 0``: between two rebuilds of the list the network
+:math:`Q` is the flux of the contact network (:meth:`dem.network.laplacian.BoundedLaplacian.flux`, :math:`-L \theta`
+plus the walls' terms) whose edges are the pairs of the mechanics' Verlet list and its particle-wall pairs with the
+temperature-carrying walls, the pairs not in contact with :math:`K = 0`: between two rebuilds of the list the network
 keeps its edges and only its conductances are rewritten (:meth:`~dem.network.laplacian.BoundedLaplacian.refresh`).
 
-Integrated by the trapezoidal rule of eq. (36) with the weight phi of the mechanics, and solved -- as the positions
-are -- by the fixed-point iteration of eq. (37), with the positions frozen at the iterate of the mechanics (the
-staggering of eqs. 45-46)::
+Integrated by the trapezoidal rule of eq. (36) with the weight :math:`\phi` of the mechanics, and solved -- as the
+positions are -- by the fixed-point iteration of eq. (37), with the positions frozen at the iterate of the mechanics
+(the staggering of eqs. 45-46):
 
-    theta^K = theta^L + dt/C (phi (Q(theta^(K-1); r^K) + H) + (1 - phi) (Q^L + H^L)).
+.. math::
 
-The current is refreshed when a step is accepted (Algorithm 1, step 6d), so ``H`` is the Joule heating of the
+    \theta^K = \theta^L + \frac{\Delta t}{C} \Big(\phi \big(Q(\theta^{K-1}; r^K) + H\big)
+    + (1 - \phi) (Q^L + H^L)\Big).
+
+The current is refreshed when a step is accepted (Algorithm 1, step 6d), so :math:`H` is the Joule heating of the
 configuration at the start of the step, at both ends of it. Every iteration's heat balance is exact: the change of
-``sum C theta`` equals the heat that entered through the walls (and from fixed particles), weighted as in the step,
-plus the Joule heat, to round-off (:meth:`LumpedHeat.energy_error`).
+:math:`\sum C \theta` equals the heat that entered through the walls (and from fixed particles), weighted as in the
+step, plus the Joule heat, to round-off (:meth:`LumpedHeat.energy_error`).
 """
 
 from __future__ import annotations
@@ -228,7 +231,7 @@ class LumpedHeat:
         return g.flux(T, self.wall_T)
 
     def start(self, mech) -> None:
-        """``Q^L`` at the state of ``mech`` (the first step).
+        """:math:`Q^L` at the state of ``mech`` (the first step).
 
         Parameters
         ----------
@@ -238,7 +241,7 @@ class LumpedHeat:
         self.Q = self.conduction(mech, mech.state.x, self.T)
 
     def iterate(self, dt: float, phi: float, mech, T_prev, H) -> np.ndarray:
-        """``theta^K`` of eq. (37) from the previous iterate ``T_prev`` at the positions of the latest iterate of
+        r""":math:`\theta^K` of eq. (37) from the previous iterate ``T_prev`` at the positions of the latest iterate of
         the mechanics ``mech`` with the Joule heating ``H`` (W per particle).
 
         Parameters
@@ -257,7 +260,7 @@ class LumpedHeat:
         Returns
         -------
         numpy.ndarray
-            (N,) ``theta^K`` (K); the fixed particles keep theirs.
+            (N,) :math:`\theta^K` (K); the fixed particles keep theirs.
         """
         self._Q_iter = self.conduction(mech, mech.x_iterate, T_prev)
         T = self.T + dt / self.C * (phi * self._Q_iter + (1.0 - phi) * self.Q + H)
@@ -266,7 +269,7 @@ class LumpedHeat:
 
     def accept(self, dt: float, phi: float, T, mech, H) -> None:
         """The iterate ``T`` becomes the state: the heat of the step is booked (with the flows the iteration used)
-        and ``Q^L`` of the next step is taken at the accepted state.
+        and :math:`Q^L` of the next step is taken at the accepted state.
 
         Parameters
         ----------
@@ -288,8 +291,9 @@ class LumpedHeat:
         self.Q = self.conduction(mech, mech.state.x, self.T, update=True)
 
     def energy_error(self) -> float:
-        """``|sum C (theta - theta_0) - heat in| / scale`` over the free particles (relative; the scale is the
-        capacity times the temperature range plus the heat exchanged)."""
+        r""":math:`|\sum C (\theta - \theta_0) - Q_\mathrm{in}| / \mathrm{scale}`, :math:`Q_\mathrm{in}` the heat in,
+        over the free particles (relative; the scale is the capacity times the temperature range plus the heat
+        exchanged)."""
         f = self.free
         change = float(self.C[f] @ (self.T[f] - self.T0[f]))
         heat = sum(self.heat_in.values())

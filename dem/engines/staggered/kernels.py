@@ -22,10 +22,17 @@ from dem.geometry.neighbours import min_image
 def iterate(law, particles, trial, pairs, walls, wall_list, constants, dt, phi):
     r"""One fixed-point iteration K of the trapezoidal step (Zohdi 2014, eqs. 22-27) under the contact law ``law``:
     the forces at the previous iterate (with the walls where they are at the end of the step; the contacts' histories
-    read from the lists' ``hist_in``, those of the step's start, and written to their ``hist``), then::
+    read from the lists' ``hist_in``, those of the step's start, and written to their ``hist``), then
 
-        v^K = v^L + dt/m (phi F^(K-1) + (1 - phi) F^L)          (eq. 22)
-        r^K = r^L + dt (phi v^K + (1 - phi) v^L)                 (eq. 23; together eq. 26)
+    .. math::
+
+        v^K = v^L + \frac{\Delta t}{m} \big(\phi F^{K-1} + (1 - \phi) F^L\big) \tag{22}
+
+    .. math::
+
+        r^K = r^L + \Delta t \big(\phi v^K + (1 - \phi) v^L\big) \tag{23}
+
+    (together eq. 26).
 
     Parameters
     ----------

@@ -254,8 +254,8 @@ class StaggeredMechanics:
         self.v_prev[:] = self.state.v
 
     def iterate(self, dt: float, phi: float, T: np.ndarray) -> tuple[float, float]:
-        """One fixed-point iteration at the temperatures ``T`` (those of the previous iterate): the new iterate is
-        ``x_new``, ``v_new``. Returns ``(sum |r^K - r^(K-1)|, sum |r^K - r^L|)``.
+        r"""One fixed-point iteration at the temperatures ``T`` (those of the previous iterate): the new iterate is
+        ``x_new``, ``v_new``. Returns :math:`(\sum |r^K - r^{K-1}|, \sum |r^K - r^L|)`.
 
         Parameters
         ----------
@@ -298,7 +298,7 @@ class StaggeredMechanics:
 
     def accept(self, T: np.ndarray) -> None:
         """The latest iterate becomes the state (with the temperatures ``T`` of the step's end); its forces become
-        F^L of the next step and the histories it made are kept (Zohdi 2014: the bonds it activated).
+        :math:`F^L` of the next step and the histories it made are kept (Zohdi 2014: the bonds it activated).
 
         Parameters
         ----------

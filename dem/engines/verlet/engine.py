@@ -255,7 +255,7 @@ class VerletEngine(Engine):
         return volume
 
     def volume_fraction(self) -> float | None:
-        """Solid volume over box volume (Luding 2005's density nu)."""
+        r"""Solid volume over box volume (Luding 2005's density :math:`\nu`)."""
         volume = self.box_volume()
         return None if volume is None else self.mechanics.state.solid_volume() / volume
 
@@ -443,9 +443,11 @@ class VerletEngine(Engine):
         return meeting_in(particles, walls, bonds, th.box), bonds
 
     def particle_fields(self) -> dict:
-        """Per-particle fields for snapshots: velocity, angular velocity, force, temperature, stiffness factor, with
-        thermal physics the heat flow (W) into the particle through its contacts and walls, and the particle stress ``sigma_i = (1/V_i) sum_c l_c (x) f_c`` (l_c from the centre to contact c, f_c the force
-        on i there) with its mean ``tr(sigma)/dim`` (positive in compression)."""
+        r"""Per-particle fields for snapshots: velocity, angular velocity, force, temperature, stiffness factor, with
+        thermal physics the heat flow (W) into the particle through its contacts and walls, and the particle stress
+        :math:`\sigma_i = \frac{1}{V_i} \sum_c \mathbf{l}_c \otimes \mathbf{f}_c` (:math:`\mathbf{l}_c` from the
+        centre to contact :math:`c`, :math:`\mathbf{f}_c` the force on :math:`i` there) with its mean
+        :math:`\mathrm{tr}(\sigma_i)/\mathrm{dim}` (positive in compression)."""
         mech = self.mechanics
         s = mech.state
         i, j, overlap, fn, ft = mech.contacts()

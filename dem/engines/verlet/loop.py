@@ -1,4 +1,4 @@
-"""The compiled time loop of particles that move: velocity-Verlet steps with any contact law.
+r"""The compiled time loop of particles that move: velocity-Verlet steps with any contact law.
 
 One call advances the particles (and the walls) by up to ``n_steps`` steps of ``dt``, entirely in compiled code
 (numba), and returns early only when the caller must act: the Verlet lists are about to become invalid (a
@@ -7,11 +7,12 @@ non-finite, or a particle left through a wall. Besides the pair list there is a 
 within ``radius + skin`` of each wall (the only ones that can touch it or cross it before the next rebuild). Each
 step:
 
-1. half kick and drift: ``v += dt/2 f/m``, ``x += dt v`` (and ``omega += dt/2 tau/I``); walls move by their law
-   (:mod:`dem.geometry.walls`);
-2. material state: the temperature ``T_i(t) = T0_i + rate_i (t - t_first)`` and what the contact law makes of it
-   (the law's ``update_particles``; Luding 2005: the radius ``a(T)``, eq. 9, the stiffness factor ``k1(T, t)/k1`` relaxed
-   towards ``k1(T)/k1``, eqs. 10-12);
+1. half kick and drift: :math:`v \mathrel{+}= \frac{\Delta t}{2} f/m`, :math:`x \mathrel{+}= \Delta t \, v` (and
+   :math:`\omega \mathrel{+}= \frac{\Delta t}{2} \tau/I`); walls move by their law (:mod:`dem.geometry.walls`);
+2. material state: the temperature :math:`T_i(t) = T_{0,i} + \dot T_i \, (t - t_\mathrm{first})` (:math:`T_{0,i}` and
+   :math:`\dot T_i` the ``T0`` and ``T_rate`` of the call) and what the contact law makes of it (the law's
+   ``update_particles``; Luding 2005: the radius :math:`a(T)`, eq. 9, the stiffness factor :math:`k_1(T, t)/k_1` relaxed
+   towards :math:`k_1(T)/k_1`, eqs. 10-12);
 3. forces: gravity, every listed pair and every particle-wall contact by the contact law, summed into forces and
    torques (:func:`dem.engines.contact_forces.forces`);
 4. second half kick (velocities at the end of the step); stress-controlled walls from eq. 1.
@@ -39,8 +40,8 @@ DONE, REBUILD, NONFINITE, ESCAPED = 0, 1, 2, 3  # how a call of advance() ended
 
 @njit(cache=True, error_model="numpy")
 def wall_acceleration(m, walls):
-    """Eq. (1) of Luding 2005 for stress wall ``m`` of ``walls`` (:class:`dem.geometry.walls.WallArrays`):
-    ``(p L - F_w - gamma_w dq/dt) / m_w``."""
+    r"""Eq. (1) of Luding 2005 for stress wall ``m`` of ``walls`` (:class:`dem.geometry.walls.WallArrays`):
+    :math:`(p L - F_w - \gamma_w \, dq/dt) / m_w`."""
     if walls.mode[m] != 1:
         return 0.0
     wq, span = walls.q, walls.span

@@ -170,11 +170,12 @@ def packing_from_particles(particles, box=None) -> Packing:
 
 
 def packing_from_state(state: dict) -> Packing:
-    """A :class:`~dem.scene.packing_files.packing.Packing` of a saved state (:func:`dem.scene.state_file.load`) in its periodic box, if it has one:
-    positions, radii, temperatures, ids; of a moving state also velocities, angular velocities and the density that
-    gives each particle its saved mass as a sphere (``m / (4/3 pi r^3)``, also what LAMMPS computes the mass from),
-    of a static one its materials (no density: the scene's materials have them). 3D states only: a 2D state's disks
-    lie in the x-z plane with a height, which LAMMPS's 2D spheres (x-y plane) do not have.
+    r"""A :class:`~dem.scene.packing_files.packing.Packing` of a saved state (:func:`dem.scene.state_file.load`) in its
+    periodic box, if it has one: positions, radii, temperatures, ids; of a moving state also velocities, angular
+    velocities and the density that gives each particle its saved mass :math:`m` as a sphere of radius :math:`r`
+    (:math:`\rho = m / (\frac{4}{3} \pi r^3)`, also what LAMMPS computes the mass from), of a static one its materials
+    (no density: the scene's materials have them). 3D states only: a 2D state's disks lie in the x-z plane with a
+    height, which LAMMPS's 2D spheres (x-y plane) do not have.
 
     Parameters
     ----------
