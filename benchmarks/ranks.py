@@ -9,7 +9,6 @@ wall time (what ranks shorten) and of CPU time summed over the ranks (what they 
 
 from __future__ import annotations
 
-import argparse
 import json
 import pathlib
 import sys
@@ -17,6 +16,8 @@ import tempfile
 import time
 
 import numpy as np
+
+from sinterheat.cli import OneLineParser
 
 from benchmarks.mechanics import (CACHE, FULL, LUDING_TABLE1, QUICK, T_RUN, _at_rest, _scene, lammps_command,
                                   lammps_input, linear_limit, periodic_packing, time_lammps, write_lammps_data)
@@ -70,7 +71,7 @@ def time_peer(sample: dict, steps: int, warmup: int, ranks: int) -> dict:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.ranks", description=__doc__.split("\n\n")[0])
+    parser = OneLineParser(prog="python -m benchmarks.ranks", description=__doc__.split("\n\n")[0])
     parser.add_argument("--steps", type=int, default=500, help="timed steps (default 500)")
     parser.add_argument("--warmup", type=int, default=100, help="untimed steps before them (default 100)")
     parser.add_argument("--full", action="store_true", help="the full-size packing (10192 spheres; else 2048)")
