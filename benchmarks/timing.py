@@ -125,3 +125,35 @@ def available(package: str) -> bool:
     import importlib.util
 
     return importlib.util.find_spec(package) is not None
+
+
+def children_cpu_seconds() -> float:
+    """CPU time (user + system, s) of this process's children that have ended and been waited for, their own
+    waited-for children included: the operating system's account, as ``/usr/bin/time`` reports a whole command."""
+    import resource
+
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def whole_processes(fns: dict, rounds: int, warmup: int = 1) -> tuple[dict, dict]:
+    """Call every ``fns[name]()`` -- each runs one whole process and waits for it -- once per round, in turn, after
+    ``warmup`` rounds that are not counted; returns ``{name: {"wall": [s per round], "cpu": [s per round]}}`` (wall
+    clock; CPU time of the processes waited for, :func:`children_cpu_seconds`) and each one's last return value."""
+    times = {name: {"wall": [], "cpu": []} for name in fns}
+    values = {}
+    for k in range(warmup + rounds):
+        for name, fn in fns.items():
+            cpu0, t0 = children_cpu_seconds(), time.perf_counter()
+            values[name] = fn()
+            wall, cpu = time.perf_counter() - t0, children_cpu_seconds() - cpu0
+            if k >= warmup:
+                times[name]["wall"].append(wall)
+                times[name]["cpu"].append(cpu)
+    return times, values
+
+
+def paired_ratio(a, b) -> float:
+    """Median of the round-by-round ratios ``a[k] / b[k]`` (two commands timed in turn, :func:`whole_processes`):
+    the pairing keeps the ratio meaningful when the machine's speed drifts between rounds."""
+    return float(np.median(np.asarray(a, float) / np.asarray(b, float)))

@@ -124,3 +124,20 @@ def test_ngsolve_startup_setting_reaches_1e_minus_4_at_the_reference_cases():
         row = SEMISPHERE_BY_H[h_over_r]
         k, _ = ngsolve_semisphere(row.a_over_r, **NGSOLVE_STARTUP)
         assert abs(k / row.K_over_Kcyl - 1) < 1e-4, h_over_r
+
+
+def test_whole_processes_count_the_cpu_of_grandchildren_and_not_of_sleep():
+    """The start-up comparison's clock: a command's CPU time includes the processes it waited for (a grandchild
+    that spins ~0.3 s), a sleeping one costs wall time only, and the ratio is the median of the paired rounds."""
+    from benchmarks.timing import paired_ratio, whole_processes
+
+    spin = "import time; t = time.process_time()\nwhile time.process_time() - t < 0.3: pass"
+    parent = f"import subprocess, sys; subprocess.run([sys.executable, '-c', {spin!r}], check=True)"
+    runs = {"spin": lambda: subprocess.run([sys.executable, "-c", parent], check=True).returncode,
+            "sleep": lambda: subprocess.run([sys.executable, "-c", "import time; time.sleep(0.3)"]).returncode}
+    times, values = whole_processes(runs, rounds=2, warmup=0)
+    assert values == {"spin": 0, "sleep": 0}
+    assert all(len(times[name][kind]) == 2 for name in runs for kind in ("cpu", "wall"))
+    assert min(times["spin"]["cpu"]) >= 0.3 and min(times["spin"]["wall"]) >= 0.3
+    assert max(times["sleep"]["cpu"]) < 0.25 <= min(times["sleep"]["wall"])
+    assert paired_ratio([2.0, 4.0, 9.0], [1.0, 2.0, 3.0]) == 2.0  # rounds 2, 2, 3: their median, not 15 / 6

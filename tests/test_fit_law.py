@@ -228,6 +228,44 @@ def test_fit_command_draws_its_figure_without_importing_matplotlib(tmp_path):
     assert len(json.loads((out / "fit.json").read_text())["points"]) == 4
 
 
+_DRAW = """
+import json, sys
+import numpy as np
+from fem_neck import fit, law
+if sys.argv[1] == "light":
+    fit.import_plotting()
+else:
+    import matplotlib.backends.backend_agg, matplotlib.figure
+from matplotlib.artist import Artist
+from matplotlib.lines import Line2D
+saved = json.loads(law.DEFAULT_FIT.read_text())
+points = [fit.FitPoint(x, k, 1e-6, 500, 0.01, 1e-4, True) for x, k in saved["points"]]
+fit.plot(points, saved["slope"], law.ConductanceLaw.default(), sys.argv[2])
+method = Artist.__dict__["_update_set_signature_and_docstring"].__func__
+print(json.dumps({"mplot3d": "mpl_toolkits.mplot3d" in sys.modules, "set_doc": Line2D.set.__doc__ is not None,
+                  "restored": method.__qualname__ == "Artist._update_set_signature_and_docstring"}))
+"""
+
+
+def test_the_light_plotting_import_draws_the_same_figure(tmp_path):
+    """fit.png drawn after :func:`fem_neck.fit.import_plotting` in a fresh process (matplotlib's set() signatures and
+    3D axes left out) is the figure of a plain import to the pixel, and the import leaves matplotlib as it found it."""
+    from PIL import Image
+
+    seen = {}
+    for kind in ("light", "plain"):
+        proc = subprocess.run([sys.executable, "-c", _DRAW, kind, str(tmp_path / f"{kind}.png")], cwd=ROOT,
+                              capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        assert "Warning" not in proc.stderr, proc.stderr[-2000:]
+        seen[kind] = json.loads(proc.stdout.splitlines()[-1])
+    assert seen["light"] == {"mplot3d": False, "set_doc": False, "restored": True}  # both parts were left out ...
+    assert seen["plain"] == {"mplot3d": True, "set_doc": True, "restored": True}  # ... which a plain import loads
+    light, plain = (np.asarray(Image.open(tmp_path / f"{kind}.png")) for kind in ("light", "plain"))
+    assert light.shape == plain.shape == (936, 832, 4)
+    assert np.array_equal(light, plain)
+
+
 def test_a_figure_that_cannot_be_written_fails_the_fit(tmp_path):
     out = tmp_path / "fit"
     (out / "fit.png").mkdir(parents=True)  # savefig in the plotting process fails
