@@ -10,7 +10,7 @@ import pytest
 import scipy.sparse as sp
 
 from dem.driver import run
-from dem.engines.distributed.engine import DistributedStaticEngine
+from dem.engines.distributed.static import DistributedStaticEngine
 from dem.engines.static import StaticEngine
 from dem.parallel import comm as mpi
 from dem.scene import load_scene

@@ -1,6 +1,6 @@
 """Particles that move, across MPI ranks: spatial slabs, ghosts, migration (mpi4py).
 
-Under ``mpiexec`` every rank reads the scene, keeps the particles of its slab (:mod:`dem.engines.verlet.slabs`)
+Under ``mpiexec`` every rank reads the scene, keeps the particles of its slab (:mod:`dem.geometry.slabs`)
 and runs the compiled loop of :mod:`dem.engines.verlet.loop` on its *local* particles: those it owns and, in the
 same arrays, *ghosts* -- copies of the particles of other ranks within the halo ``2 r_max + skin`` of its slab. The
 local particles are ordered by global id (the particle's index in the scene), so that a local pair ``i < j`` is
@@ -59,7 +59,7 @@ from dem.parallel.comm import world
 from dem.network.distributed import DistributedNetwork
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.records import Steps
-from dem.engines.verlet.slabs import Slabs
+from dem.geometry.slabs import Slabs
 from dem.engines.verlet.engine import VerletEngine
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
 from dem.engines.verlet.mechanics import MechanicalModel, MechanicsError
