@@ -514,10 +514,10 @@ class RankContactThermal(ContactThermalModel):
         part = DistributedNetwork(comm, self.net, mechanics.gid, owner)
         res = mpi.agree(comm, lambda: part.integrate(self.integrator, dt, dt))
         self.assemblies += 1
-        self.startup_steps += res["startup_steps"]  # a stiff Crank-Nicolson step taken as implicit Euler
-        for k, v in res["heat_in"].items():
+        self.startup_steps += res.startup_steps  # a stiff Crank-Nicolson step taken as implicit Euler
+        for k, v in res.heat_in.items():
             self.heat_in[k] = self.heat_in.get(k, 0.0) + v
-        T_local = self.net.full(res["T_F"])
+        T_local = res.T
         T = self.T.copy()
         own = mechanics.owned
         for index, values in comm.allgather((mechanics.gid[own], T_local[own])):
