@@ -141,6 +141,19 @@ def test_fixed_steps_equal_the_serial_steps(integrator):
     assert s["energy_error"] < 1e-12
 
 
+def test_explicit_and_adaptive_steps_are_refused_by_the_ranks_loop():
+    """The ranks take the serial loop (dem.network.heat.integrate) for fixed implicit and Crank-Nicolson steps only:
+    its explicit limit and its error control are reductions of one process, refused up front on every rank alike."""
+    doc = {"material": MATERIAL, "particles": {"position": [[0.0, 0.0, 0.0], [0.0, 0.0, 1.9e-3]],
+                                               "radius": [1e-3, 1e-3], "temperature": [100.0, 0.0]},
+           "solver": {"mode": "transient", "integrator": "implicit", "dt": 1e-3, "t_end": 1e-2}}
+    part = run(parse_scene(doc)).engine.part
+    for integrator, dt in (("explicit", 1e-3), ("implicit", "auto")):
+        with pytest.raises(ValueError, match="on MPI ranks only fixed steps"):
+            part.integrate(integrator, dt, 1e-2)
+    COMM.Barrier()  # every rank got here
+
+
 def test_the_pieces_open_as_one_data_set():
     pyvista = pytest.importorskip("pyvista")
     out = shared_folder()
