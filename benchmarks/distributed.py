@@ -59,7 +59,7 @@ def scaling_worker(n: int, scene_file: str | None = None) -> None:
     """One steady solve of the ~n-particle packing on the ranks of this ``mpiexec``; rank 0 prints one JSON line.
     With ``scene_file`` (:func:`parts_scene`), that scene instead, each rank reading only its part of the packing
     (``packing_seconds``: the reading; ``held``: the particles each rank holds)."""
-    from dem.engines.distributed.engine import DistributedStaticEngine
+    from dem.engines.distributed.static import DistributedStaticEngine
     from dem.scene.parse import make_scene
 
     load = os.getloadavg()[0]

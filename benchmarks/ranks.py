@@ -2,7 +2,7 @@
 Table 1's Luding law at rest), against the serial run and LAMMPS on as many ranks.
 
 ``python -m benchmarks.ranks [--steps N] [--full] [--json]`` times the serial engine;
-``mpiexec -n P python -m benchmarks.ranks ...`` the ranks engine (:mod:`dem.engines.verlet.ranks`) on P ranks;
+``mpiexec -n P python -m benchmarks.ranks ...`` the ranks engine (:mod:`dem.engines.distributed.verlet`) on P ranks;
 ``python -m benchmarks.ranks --lammps P ...`` LAMMPS (``pair_style granular``, the linear limit as in
 :mod:`benchmarks.mechanics`) on P ranks with the ``mpiexec`` beside its wheel. Each prints ns per particle-step of
 wall time (what ranks shorten) and of CPU time summed over the ranks (what they cost)."""
@@ -29,7 +29,7 @@ def time_engine(sample: dict, steps: int, warmup: int, comm=None) -> dict:
 
     engine_class = VerletEngine
     if comm is not None:
-        from dem.engines.verlet.ranks import RankVerletEngine
+        from dem.engines.distributed.verlet import RankVerletEngine
 
         engine_class = RankVerletEngine
     mech = engine_class(_scene(LUDING_TABLE1, 3, _at_rest(sample), box=sample["box"])).mechanics

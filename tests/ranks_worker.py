@@ -140,7 +140,7 @@ RESUMED = {"compaction": short_compaction, "heat": hot_and_cold}  # the runs int
 def interrupted_and_resumed(scene, stop: float, out) -> dict:
     """``scene`` through the driver into ``out``, interrupted (KeyboardInterrupt on every rank, as Ctrl-C) after the
     interval that passes ``stop`` s, then resumed from its folder: the resumed run's :func:`run_scene`."""
-    from dem.engines.verlet.ranks import RankVerletEngine
+    from dem.engines.distributed.verlet import RankVerletEngine
 
     original = RankVerletEngine.run
 
@@ -179,7 +179,7 @@ if __name__ == "__main__":
     from mpi4py import MPI
 
     from dem import parse_scene
-    from dem.engines.verlet.ranks import RankVerletEngine
+    from dem.engines.distributed.verlet import RankVerletEngine
 
     comm = MPI.COMM_WORLD
     if sys.argv[1] == "scene":  # scene NAME T_END FOLDER RESULT

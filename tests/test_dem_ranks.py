@@ -1,4 +1,4 @@
-"""Moving particles across MPI ranks (dem.engines.verlet.ranks), launched with mpiexec -n 1 and -n 2 on
+"""Moving particles across MPI ranks (dem.engines.distributed.verlet), launched with mpiexec -n 1 and -n 2 on
 tests/ranks_worker.py: one rank is the serial run bit for bit; two ranks conserve momentum (periodic box), follow
 the serial elastic collisions (energy and all) to the bit, carry the heat of the contacts as the serial run does
 (conserving it, stiff thermal steps too), resume from their checkpoints to the bit,
@@ -95,7 +95,7 @@ def test_two_ranks_follow_the_serial_elastic_collisions_to_the_bit(tmp_path):
 
 def test_two_ranks_carry_the_heat_of_the_contacts(tmp_path):
     """An insulated periodic gas whose particles start at 20-100 C: on two ranks each thermal step is solved on
-    PETSc (dem.engines.verlet.ranks.RankContactThermal). The mechanics of a periodic run is the serial one, so are
+    PETSc (dem.engines.distributed.verlet.RankContactThermal). The mechanics of a periodic run is the serial one, so are
     the contacts; the temperatures equal the serial run's to CG's tolerance with the default AMG, to round-off with
     a direct solver, and the heat the particles hold stays what it was."""
     serial = ranks_worker.run_scene(ranks_worker.hot_and_cold())
@@ -133,7 +133,7 @@ def test_two_ranks_take_the_serial_runs_stiff_thermal_steps(tmp_path):
 
 def without_handover(keys) -> list:
     """The serial run's summary keys less the hand-over's: several ranks hand no particle over to the union
-    (dem.engines.verlet.ranks), so their summaries do not carry its counts."""
+    (dem.engines.distributed.verlet), so their summaries do not carry its counts."""
     return [k for k in keys if k not in ("particles_handed_over", "particles_handing_over")]
 
 
@@ -201,7 +201,7 @@ def test_two_ranks_with_stress_walls_write_the_gathered_run_folder(tmp_path):
 
 def test_what_ranks_cannot_do_is_refused_in_one_line(tmp_path):
     from dem.engines import engine_class
-    from dem.engines.verlet.ranks import refuse_unsupported
+    from dem.engines.distributed.verlet import refuse_unsupported
 
     three = ranks_worker.builtin("luding-three-particles", 0.001)
     with pytest.raises(ValueError, match=r"--resume: the checkpoint was written by 1 rank\(s\), this run has 2; "
@@ -254,7 +254,7 @@ def test_two_ranks_compact_as_the_serial_runs_do(tmp_path):
 
 def test_a_rank_that_owns_no_particle_packs_empty_rows():
     # three particles on two ranks: one rank may own none at an output time (it crashed gathering them)
-    from dem.engines.verlet.ranks import RankMechanics
+    from dem.engines.distributed.verlet import RankMechanics
 
     arrays = [np.zeros((3, 3)), np.zeros(3), np.zeros((3, 2, 3))]
     assert RankMechanics._pack(arrays, np.array([], dtype=np.int64)).shape == (0, 10)

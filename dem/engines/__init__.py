@@ -10,8 +10,9 @@ and contact law call for):
   (:mod:`dem.engines.staggered`).
 
 A run launched under MPI (:func:`dem.parallel.comm.launched`) takes the scene's engine from :data:`RANK_ENGINES`
-instead: the same scheme with the sample shared out among the ranks (``static``: :mod:`dem.engines.distributed`,
-``verlet``: :mod:`dem.engines.verlet.ranks`); the driver runs either kind alike.
+instead: the same scheme with the sample shared out among the ranks, each in :mod:`dem.engines.distributed` under the
+name of the engine it shares out (``static``: :mod:`dem.engines.distributed.static`, ``verlet``:
+:mod:`dem.engines.distributed.verlet`); the driver runs either kind alike.
 
 What the driver asks of an engine (the protocol every one of them follows):
 
@@ -46,8 +47,8 @@ ENGINES = {
 
 #: The engines of a run launched under MPI, by the names of :data:`ENGINES` whose scheme they share out among the ranks.
 RANK_ENGINES = {
-    "static": "dem.engines.distributed.engine:DistributedStaticEngine",
-    "verlet": "dem.engines.verlet.ranks:RankVerletEngine",
+    "static": "dem.engines.distributed.static:DistributedStaticEngine",
+    "verlet": "dem.engines.distributed.verlet:RankVerletEngine",
 }
 
 

@@ -142,7 +142,7 @@ class ContactThermalModel:
 
     def local(self, mechanics, values: np.ndarray) -> np.ndarray:
         """``values`` (per particle of the scene) for the particles ``mechanics`` holds: all of them, in order
-        (a rank's model holds some, :class:`dem.engines.verlet.ranks.RankContactThermal`).
+        (a rank's model holds some, :class:`dem.engines.distributed.verlet.RankContactThermal`).
 
         Parameters
         ----------

@@ -16,7 +16,7 @@ A packing stored in parts (:mod:`dem.scene.packing_files.parts`) is shared out b
 same bisection over the blocks' centres, each weighted by its particle count, so that a rank reads only its blocks and
 those within ``reach`` of them.
 
-Particles that move are shared out otherwise, in slabs along one axis (:mod:`dem.engines.verlet.slabs`): they cross
+Particles that move are shared out otherwise, in slabs along one axis (:mod:`dem.geometry.slabs`): they cross
 the cuts all the time, so their cuts are planes fixed for the run, the owner of a particle is computed from one
 coordinate alone (the same answer on every rank, from a ghost's copy too), and the halo includes the Verlet skin. A
 packing that does not move is cut once, into compact cells whose faces -- the off-rank matrix entries -- stay small on

@@ -1,6 +1,7 @@
 """The heat network of a packing shared out among MPI ranks: each rank's rows, the groups that span ranks, the steady
-solve and the theta-method steps, all on PETSc (:mod:`dem.parallel.petsc`); a step is the serial one
-(:class:`dem.network.theta.ThetaStepper`) with the solve over the ranks plugged in (:class:`RankSolves`).
+solve and the theta-method steps, all on PETSc (:mod:`dem.parallel.petsc`); the steps are the serial loop
+(:func:`dem.network.heat.integrate`) with this rank's part of the network (its sums and flows over the ranks) and the
+solve over the ranks (:class:`RankSolves`) plugged in.
 
 Each rank holds the particles it owns and a halo (:mod:`dem.geometry.bisection`), and a
 :class:`dem.network.heat.Network` of them whose bonds are those with at least one owned particle. An owned particle
@@ -18,7 +19,6 @@ one solved with its first particle at 0 and shifted to keep its mean.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,9 +26,8 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from dem.parallel import comm as mpi
-from dem.network.heat import (INTEGRATORS, STARTUP_STEPS, Network, refuse_energy_error, refuse_out_of_range,
-                              surely_stiff)
-from dem.network.theta import ThetaStepper, balancing_shift
+from dem.network.heat import Network, TransientResult, integrate, surely_stiff
+from dem.network.theta import balancing_shift
 from dem.parallel.petsc import PetscSolver, matrix
 
 
@@ -84,6 +83,9 @@ class RankSolves:
     rtol : float
         The relative residual of the solves.
     """
+
+    #: CG on PETSc starts from the step's start temperatures (:meth:`dem.network.theta.ThetaStepper.guess`).
+    extrapolated_starts = False
 
     def __init__(self, part: "DistributedNetwork", rtol: float):
         self.part, self.rtol = part, rtol
@@ -218,6 +220,70 @@ class DistributedNetwork:
             The sum.
         """
         return mpi.total(self.comm, value)
+
+    def maximum(self, value: float) -> float:
+        """Largest over ranks (:func:`dem.parallel.comm.maximum`).
+
+        Parameters
+        ----------
+        value : float
+            This rank's value.
+
+        Returns
+        -------
+        float
+            The largest.
+        """
+        return mpi.maximum(self.comm, value)
+
+    def minimum(self, value: float) -> float:
+        """Smallest over ranks (:func:`dem.parallel.comm.minimum`).
+
+        Parameters
+        ----------
+        value : float
+            This rank's value.
+
+        Returns
+        -------
+        float
+            The smallest.
+        """
+        return mpi.minimum(self.comm, value)
+
+    def agree(self, action):
+        """``action()`` on every rank, a ValueError on one raised on all (:func:`dem.parallel.comm.agree`).
+
+        Parameters
+        ----------
+        action : callable
+            Called without arguments.
+
+        Returns
+        -------
+        object
+            This rank's result.
+        """
+        return mpi.agree(self.comm, action)
+
+    def above_stable_limit(self, dt: float, T_F: np.ndarray) -> bool:
+        """Whether a fixed step ``dt`` is surely above the stable limit at ``T_F``, over the ranks without an
+        eigenvalue solve (:func:`dem.network.heat.surely_stiff` on the owned rows): where a Crank-Nicolson run starts
+        with implicit Euler steps (:func:`dem.network.heat.integrate`).
+
+        Parameters
+        ----------
+        dt : float
+            The step (s).
+        T_F : numpy.ndarray
+            Temperatures of the local free particles (K or degC), where the ambient terms are linearised.
+
+        Returns
+        -------
+        bool
+            ``dt`` is surely above the limit.
+        """
+        return surely_stiff(dt, self.net.matrix(self.net.sinks(T_F)), self.net.C, self.own_free, self.maximum)
 
     def halo_filled(self, T_F: np.ndarray) -> np.ndarray:
         """All held temperatures (fixed ones too) from the owned entries of ``T_F`` (over the local free ones).
@@ -507,10 +573,10 @@ class DistributedNetwork:
 
     # ------------------------------------------------------------------------------------------ transient
     def integrate(self, integrator: str, dt: float, t_end: float, rtol_linear: float = 1e-10, observer=None,
-                  progress=None):
-        """Theta-method steps of fixed size ``dt`` to ``t_end`` (:func:`dem.network.heat.integrate` with a fixed
-        step, over the ranks; ``integrator`` implicit or crank-nicolson). ``observer(step, t, T_F, flows)`` after
-        every step and at the start. Returns a dict of what the serial integrator reports.
+                  progress=None) -> TransientResult:
+        """Theta-method steps of fixed size ``dt`` to ``t_end``: the serial loop (:func:`dem.network.heat.integrate`)
+        with this part and the solves over the ranks (:class:`RankSolves`) plugged in; ``observer(step, t, T_F,
+        flows)`` after every step and at the start, with this rank's local free temperatures.
 
         Parameters
         ----------
@@ -529,72 +595,22 @@ class DistributedNetwork:
 
         Returns
         -------
-        dict
-            ``T_F``, ``t``, ``steps``, ``energy_error``, ``heat_in`` and the rest the serial integrator reports.
+        dem.network.heat.TransientResult
+            What the serial integrator reports, ``T`` the held particles' temperatures (owned ones valid).
 
         Raises
         ------
         ValueError
-            The temperatures became non-finite, or came out wrong as the serial integrator refuses them (a
-            maximum-principle violation or a heat balance beyond its tolerance): on every rank alike.
+            An integrator other than implicit or Crank-Nicolson, a step that is not a number, or temperatures that
+            came out wrong as the serial integrator refuses them: on every rank alike.
         """
-        net, theta = self.net, INTEGRATORS[integrator]
-        T = net.particles.temperature[net.free].astype(float)
-        sinks = net.sinks(T)
-        A = net.matrix(sinks)
+        if integrator not in ("implicit", "crank-nicolson") or isinstance(dt, str):
+            raise ValueError(f"solver.integrator = {integrator!r}, dt = {dt!r}: on MPI ranks only fixed steps (s) of "
+                             f"\"implicit\" or \"crank-nicolson\"")
         solves = RankSolves(self, rtol_linear)
-        stepper = ThetaStepper(net, theta, solves)
-        n_steps = max(1, math.ceil(t_end / dt * (1.0 - 1e-12)))
-        lo, hi = net.temperature_bounds()
-        lo, hi = mpi.minimum(self.comm, lo), mpi.maximum(self.comm, hi)
-        dt_min, dt_max = math.inf, 0.0
-        bounded = self.total(int(np.any(net.heat[self.own_free]))) == 0
-        violation, abs_in = 0.0, 0.0
-        heat_in = {k: 0.0 for k in net.flow_names}
-        own = self.own_free
-        energy0 = self.total(float(net.C[own] @ T[own]))
-        # Crank-Nicolson above the stable limit starts with implicit Euler steps, as the serial integrator does
-        # (dem.network.heat.integrate): taken where the step is surely above it (dem.network.heat.surely_stiff)
-        stiff = theta < 1.0 and surely_stiff(dt, A, net.C, own, lambda rate: mpi.maximum(self.comm, rate))
-        startup = STARTUP_STEPS if stiff else 0
-        starter = ThetaStepper(net, 1.0, solves) if stiff else None
-        if observer is not None:
-            observer(0, 0.0, T, self.flows(T, sinks))
         try:  # the PETSc solvers freed however the steps end (PetscSolver.destroy)
-            t = 0.0
-            for step in range(1, n_steps + 1):
-                last = step == n_steps
-                h = t_end - (step - 1) * dt if last else dt
-                if abs(h - dt) <= 1e-9 * dt:
-                    h = dt
-                T_new, T_theta, sinks = (starter if step <= startup else stepper).step(T, h, guess=T)
-                dt_min, dt_max = min(dt_min, h), max(dt_max, h)
-                flows = self.flows(T_theta, sinks)
-                for k, v in flows.items():
-                    heat_in[k] += h * v
-                abs_in += h * self.flow_magnitude(T_theta, sinks)
-                T = T_new
-                t = t_end if last else step * dt
-                if not self.total(int(np.all(np.isfinite(T[own])))) == self.size:
-                    raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {step})")
-                if bounded:
-                    top = mpi.maximum(self.comm, float(T[own].max(initial=-np.inf)))
-                    bottom = mpi.minimum(self.comm, float(T[own].min(initial=np.inf)))
-                    violation = max(violation, top - hi, lo - bottom)
-                    # the serial run's refusal, on every rank at the same step (mpi.agree: none left waiting)
-                    mpi.agree(self.comm, lambda: refuse_out_of_range(violation, lo, hi, t, integrator, dt))
-                if observer is not None:
-                    observer(step, t, T, flows)
-                if progress is not None:
-                    progress(t)
+            return integrate(self.net, integrator, dt, t_end, observer=observer, progress=progress, part=self,
+                             solves=solves)
         finally:
+            self.linear_iterations = solves.iterations
             solves.release()
-        self.linear_iterations = solves.iterations
-        energy = self.total(float(net.C[own] @ T[own]))
-        scale = self.total(float(net.C[own].sum())) * (hi - lo) + abs_in
-        err = abs(energy - energy0 - sum(heat_in.values())) / scale if scale > 0 else 0.0
-        mpi.agree(self.comm, lambda: refuse_energy_error(err, integrator, dt))
-        name = solves.built[0].name if solves.built else "none"
-        return {"T_F": T, "t": t, "steps": n_steps, "energy_error": err, "heat_in": heat_in,
-                "dt_min": dt_min, "dt_max": dt_max, "solver": name, "factorizations": len(solves.built),
-                "violation": violation if bounded else None, "startup_steps": min(startup, n_steps)}

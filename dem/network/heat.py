@@ -919,10 +919,119 @@ class Checkpoint:
                    float(data["dt_max"]), float(data["violation"]), float(data["energy0"]), history)
 
 
+class WholeNetwork:
+    """The network held whole by this one process, as :func:`integrate` takes the processes that share it
+    (``part``): its sums and extremes are this process's own values and its rows all of them. The counterpart on
+    MPI ranks is :class:`dem.network.distributed.DistributedNetwork`, one rank's part of the network.
+
+    Parameters
+    ----------
+    net : Network
+        The network.
+    """
+
+    own_free = slice(None)  # the rows of the free particles this process answers for: all
+
+    def __init__(self, net: Network):
+        self.net = net
+
+    @staticmethod
+    def total(value):
+        """``value`` itself: the sum over the one process.
+
+        Parameters
+        ----------
+        value : float or int
+            This process's part.
+
+        Returns
+        -------
+        float or int
+            The sum.
+        """
+        return value
+
+    minimum = maximum = total
+
+    @staticmethod
+    def agree(action):
+        """``action()``: what raises here raises on every process (the one).
+
+        Parameters
+        ----------
+        action : callable
+            Called without arguments.
+
+        Returns
+        -------
+        object
+            Its result.
+        """
+        return action()
+
+    def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
+        """Heat flow (W) into the free particles through each boundary (:meth:`Network.flows`).
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the free particles (K or degC).
+        sinks : dict
+            The ambient terms ``{name: (g, b)}`` (:meth:`Network.sinks`): W/K and W per particle.
+
+        Returns
+        -------
+        dict
+            ``{boundary: W}``.
+        """
+        return self.net.flows(T_F, sinks)
+
+    def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
+        """The scale of the heat flows (W, :meth:`Network.flow_magnitude`).
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the free particles (K or degC).
+        sinks : dict
+            The ambient terms ``{name: (g, b)}`` (:meth:`Network.sinks`): W/K and W per particle.
+
+        Returns
+        -------
+        float
+            The scale (W).
+        """
+        return self.net.flow_magnitude(T_F, sinks)
+
+    def above_stable_limit(self, dt: float, T_F: np.ndarray) -> bool:
+        """Whether a fixed step ``dt`` is above the stable limit at ``T_F`` (:func:`stable_limit`, from the largest
+        eigenvalue): where a Crank-Nicolson run starts with implicit Euler steps (module docstring).
+
+        Parameters
+        ----------
+        dt : float
+            The step (s).
+        T_F : numpy.ndarray
+            Temperatures of the free particles (K or degC), where the ambient terms are linearised.
+
+        Returns
+        -------
+        bool
+            ``dt`` is above the limit.
+        """
+        return dt > stable_limit(self.net, self.net.sinks(T_F))
+
+
 def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end: float = 1.0, rtol: float = 1e-3,
               linear: str = "auto", max_steps: int = 1_000_000, observer=None, progress=None,
-              rtol_linear: float = 1e-10, resume: Checkpoint | None = None, checkpoint=None) -> TransientResult:
+              rtol_linear: float = 1e-10, resume: Checkpoint | None = None, checkpoint=None, part=None,
+              solves=None) -> TransientResult:
     """Integrate from the particles' initial temperatures to ``t_end`` (module docstring).
+
+    One loop for one process and for MPI ranks: ``part`` is the processes that share the network (sums, extremes
+    and flows over them, refusals on all alike) and ``solves`` the linear solves of the steps
+    (:mod:`dem.network.theta`); on ranks :meth:`dem.network.distributed.DistributedNetwork.integrate` plugs in its
+    part and :class:`dem.network.distributed.RankSolves` (fixed implicit or Crank-Nicolson steps only).
 
     ``observer(step, t, T_F, flows)`` is called after every accepted step (and at t = 0 with step 0);
     ``progress(t)`` reports the simulated time. ``checkpoint(make)`` is called after every accepted step and at the
@@ -955,6 +1064,11 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
         The checkpoint to go on from; None: start at t = 0.
     checkpoint : callable or None
         ``checkpoint(make)`` after every accepted step, ``checkpoint(make, final=True)`` at the end; None: not called.
+    part : WholeNetwork or dem.network.distributed.DistributedNetwork or None
+        The processes that share ``net`` (this one's part of it); None: :class:`WholeNetwork`.
+    solves : dem.network.theta.LocalSolves or dem.network.distributed.RankSolves or None
+        The linear solves of the steps; None: :class:`dem.network.theta.LocalSolves` of ``linear`` and
+        ``rtol_linear``.
 
     Returns
     -------
@@ -972,13 +1086,15 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     if not (np.isfinite(t_end) and t_end > 0):
         raise ValueError(f"solver.t_end = {t_end!r}: must be finite and > 0 (s)")
     theta = INTEGRATORS[integrator]
-    solves = LocalSolves(linear, rtol_linear)
+    part = WholeNetwork(net) if part is None else part
+    solves = LocalSolves(linear, rtol_linear) if solves is None else solves
     stepper = ThetaStepper(net, theta, solves)
+    own = part.own_free
     T = net.particles.temperature[net.free].astype(float)
     limit = None
     startup = None  # fixed-step Crank-Nicolson above the stable limit: implicit Euler start-up (module docstring)
     if theta == 0.5 and not isinstance(dt, str) and np.isfinite(dt) and dt > 0 \
-            and float(dt) > stable_limit(net, net.sinks(T)):
+            and part.above_stable_limit(float(dt), T):
         startup = ThetaStepper(net, 1.0, solves)
     if theta < 0.5:
         # radiation: the stiffest linearisation within the prescribed temperatures (maximum principle)
@@ -1022,12 +1138,13 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     dyadic = auto and theta > 0.0
     grid = 2**AUTO_LEVELS
     units = 0  # dyadic: the time t = t_end * units / grid
-    energy0 = float(net.C @ T)
+    energy0 = part.total(float(net.C[own] @ T[own]))
     # maximum principle: without internal sources the temperatures stay within the prescribed ones (initial, fixed,
     # walls, ambient); backward Euler keeps them there exactly (an M-matrix), Crank-Nicolson and explicit steps only
     # for small enough steps. The largest excursion (in the scene's temperature unit) is reported.
     lo, hi = net.temperature_bounds()
-    bounded = not np.any(net.heat)
+    lo, hi = part.minimum(lo), part.maximum(hi)
+    bounded = not part.total(int(np.any(net.heat[own])))
     violation = 0.0
     heat_in = {k: 0.0 for k in net.flow_names}
     abs_in = 0.0
@@ -1041,7 +1158,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
         energy0 = r.energy0
         stepper.history = [(np.array(h[0]), h[1]) for h in r.history]
     elif observer is not None:
-        observer(0, 0.0, T, net.flows(T, net.sinks(T)))
+        observer(0, 0.0, T, part.flows(T, net.sinks(T)))
 
     def state():
         return Checkpoint(T.copy(), t, steps, rejected, units, dt_want, dict(heat_in), abs_in, dt_min, dt_max,
@@ -1079,11 +1196,10 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
             parts = [(h, T_theta, sinks)]
         flows = {}
         for h_part, T_theta, sinks in parts:
-            part = net.flows(T_theta, sinks)
-            for k, v in part.items():
+            for k, v in part.flows(T_theta, sinks).items():
                 heat_in[k] += h_part * v
                 flows[k] = flows.get(k, 0.0) + h_part * v / h
-            abs_in += h_part * net.flow_magnitude(T_theta, sinks)
+            abs_in += h_part * part.flow_magnitude(T_theta, sinks)
         stepper.accept(T, h)
         T, steps = T_new, steps + 1
         if dyadic:
@@ -1092,11 +1208,13 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
         else:
             t = t_end if last else (steps * dt_want if not auto else t + h)
         dt_min, dt_max = min(dt_min, h), max(dt_max, h)
-        if not np.all(np.isfinite(T)):
+        if not part.minimum(int(np.all(np.isfinite(T[own])))):
             raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {steps})")
-        if bounded and len(T):
-            violation = max(violation, float(T.max()) - hi, lo - float(T.min()))
-            refuse_out_of_range(violation, lo, hi, t, integrator, dt)
+        if bounded:
+            top = part.maximum(float(T[own].max(initial=-np.inf)))
+            bottom = part.minimum(float(T[own].min(initial=np.inf)))
+            violation = max(violation, top - hi, lo - bottom)
+            part.agree(lambda: refuse_out_of_range(violation, lo, hi, t, integrator, dt))
         if observer is not None:
             observer(steps, t, T, flows)
         if progress is not None:
@@ -1121,10 +1239,10 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
             checkpoint(state)
     if checkpoint is not None:
         checkpoint(state, final=True)
-    energy = float(net.C @ T)
-    scale_e = float(net.C.sum()) * net.temperature_range() + abs_in
+    energy = part.total(float(net.C[own] @ T[own]))
+    scale_e = part.total(float(net.C[own].sum())) * (hi - lo) + abs_in
     err = abs(energy - energy0 - sum(heat_in.values())) / scale_e if scale_e > 0 else 0.0
-    refuse_energy_error(err, integrator, dt)
+    part.agree(lambda: refuse_energy_error(err, integrator, dt))
     heat_in = {k: float(v) for k, v in heat_in.items()}
     factorizations = stepper.factorizations + (startup.factorizations if startup is not None else 0)
     return TransientResult(net.full(T), t, steps, rejected, err, heat_in, limit, dt_min, dt_max, stepper.backend,

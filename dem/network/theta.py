@@ -4,7 +4,8 @@ One step of size ``dt`` from ``T`` solves :math:`(C/\Delta t + \theta A) T^+ = (
 forward Euler, 1 implicit backward Euler, 1/2 Crank-Nicolson; :mod:`dem.network.heat`, Rojek 2022, eqs. 2-4 in
 time). :class:`ThetaStepper` assembles the system and its right-hand side from a :class:`dem.network.heat.Network`,
 keeps one solver per step size and estimates a step's local error (the adaptive controller of
-:func:`dem.network.heat.integrate`); the solve itself is a plug-in with ``build``, ``solve`` and ``everything_fixed``:
+:func:`dem.network.heat.integrate`, whose loop around the step is the same on one process and on MPI ranks); the
+solve itself is a plug-in with ``build``, ``solve``, ``everything_fixed`` and ``extrapolated_starts``:
 
 * :class:`LocalSolves` -- one process: scipy's direct solver or CG preconditioned by pyamg's multigrid
   (:func:`dem.network.linsolve.make_solver`);
@@ -57,6 +58,9 @@ class LocalSolves:
     rtol : float
         The relative residual of iterative solves.
     """
+
+    #: An iterative solve starts from the temperatures extrapolated from the last steps (:meth:`ThetaStepper.guess`).
+    extrapolated_starts = True
 
     def __init__(self, linear: str, rtol: float):
         self.linear, self.rtol = linear, rtol
@@ -165,7 +169,8 @@ class ThetaStepper:
         return solver
 
     def guess(self, T: np.ndarray, dt: float) -> np.ndarray:
-        """Start of the iterative solve: quadratic extrapolation at a constant step, else linear, else ``T``.
+        """Start of the iterative solve: quadratic extrapolation at a constant step, else linear, else ``T``; ``T``
+        where the solves take no extrapolated start (``extrapolated_starts``).
 
         Parameters
         ----------
@@ -179,7 +184,7 @@ class ThetaStepper:
         numpy.ndarray
             The start.
         """
-        h = self.history
+        h = self.history if self.solves.extrapolated_starts else []
         if len(h) == 2 and h[0][1] == dt and h[1][1] == dt:
             return 3.0 * (T - h[0][0]) + h[1][0]
         if h:

@@ -10,7 +10,7 @@ import pytest
 import scipy.sparse as sp
 
 from dem.driver import run
-from dem.engines.distributed.engine import DistributedStaticEngine
+from dem.engines.distributed.static import DistributedStaticEngine
 from dem.engines.static import StaticEngine
 from dem.parallel import comm as mpi
 from dem.scene import load_scene
@@ -139,6 +139,19 @@ def test_fixed_steps_equal_the_serial_steps(integrator):
     assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-6  # of 100 K: 1e-8
     assert s["heat_in"]["walls"] == pytest.approx(r["heat_in"]["walls"], rel=1e-8)
     assert s["energy_error"] < 1e-12
+
+
+def test_explicit_and_adaptive_steps_are_refused_by_the_ranks_loop():
+    """The ranks take the serial loop (dem.network.heat.integrate) for fixed implicit and Crank-Nicolson steps only:
+    its explicit limit and its error control are reductions of one process, refused up front on every rank alike."""
+    doc = {"material": MATERIAL, "particles": {"position": [[0.0, 0.0, 0.0], [0.0, 0.0, 1.9e-3]],
+                                               "radius": [1e-3, 1e-3], "temperature": [100.0, 0.0]},
+           "solver": {"mode": "transient", "integrator": "implicit", "dt": 1e-3, "t_end": 1e-2}}
+    part = run(parse_scene(doc)).engine.part
+    for integrator, dt in (("explicit", 1e-3), ("implicit", "auto")):
+        with pytest.raises(ValueError, match="on MPI ranks only fixed steps"):
+            part.integrate(integrator, dt, 1e-2)
+    COMM.Barrier()  # every rank got here
 
 
 def test_the_pieces_open_as_one_data_set():

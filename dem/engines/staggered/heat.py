@@ -27,6 +27,17 @@ The current is refreshed when a step is accepted (Algorithm 1, step 6d), so :mat
 configuration at the start of the step, at both ends of it. Every iteration's heat balance is exact: the change of
 :math:`\sum C \theta` equals the heat that entered through the walls (and from fixed particles), weighted as in the
 step, plus the Joule heat, to round-off (:meth:`LumpedHeat.energy_error`).
+
+This is not the network's :math:`\theta` step (:class:`dem.network.theta.ThetaStepper`, at :math:`\theta = 1/2` the
+trapezoid too; there :math:`\theta` is the method's weight and :math:`T` the temperatures), which solves
+:math:`(C/\Delta t + \theta A)\,T^{+} = (C/\Delta t - (1-\theta) A)\,T + r` with one matrix :math:`A` to the linear
+solver's tolerance. Here the two ends of a step see two networks: :math:`Q^L` on the contacts at the positions
+:math:`r^L`, the new end on those at the iterate's positions :math:`r^K`, whose contacts grow, open and close within the
+step (its conductances, even its edges, change); the weight is the mechanics' :math:`\phi`, any value in :math:`[0, 1]`,
+shared with the positions; and the end is found by the fixed-point iteration above, each iterate explicit in the last
+one and stopped where positions and temperatures together meet the step's tolerance (Zohdi 2014, eq. 48), not by a
+linear solve. Only with the positions frozen and the iteration run to convergence is its limit that step at
+:math:`\theta = \phi = 1/2`; the scheme is the paper's, kept as it is.
 """
 
 from __future__ import annotations

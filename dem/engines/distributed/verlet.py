@@ -1,6 +1,6 @@
 """Particles that move, across MPI ranks: spatial slabs, ghosts, migration (mpi4py).
 
-Under ``mpiexec`` every rank reads the scene, keeps the particles of its slab (:mod:`dem.engines.verlet.slabs`)
+Under ``mpiexec`` every rank reads the scene, keeps the particles of its slab (:mod:`dem.geometry.slabs`)
 and runs the compiled loop of :mod:`dem.engines.verlet.loop` on its *local* particles: those it owns and, in the
 same arrays, *ghosts* -- copies of the particles of other ranks within the halo ``2 r_max + skin`` of its slab. The
 local particles are ordered by global id (the particle's index in the scene), so that a local pair ``i < j`` is
@@ -59,7 +59,7 @@ from dem.parallel.comm import world
 from dem.network.distributed import DistributedNetwork
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.records import Steps
-from dem.engines.verlet.slabs import Slabs
+from dem.geometry.slabs import Slabs
 from dem.engines.verlet.engine import VerletEngine
 from dem.engines.verlet.loop import ESCAPED, NONFINITE, REBUILD, wall_acceleration
 from dem.engines.verlet.mechanics import MechanicalModel, MechanicsError
@@ -514,10 +514,10 @@ class RankContactThermal(ContactThermalModel):
         part = DistributedNetwork(comm, self.net, mechanics.gid, owner)
         res = mpi.agree(comm, lambda: part.integrate(self.integrator, dt, dt))
         self.assemblies += 1
-        self.startup_steps += res["startup_steps"]  # a stiff Crank-Nicolson step taken as implicit Euler
-        for k, v in res["heat_in"].items():
+        self.startup_steps += res.startup_steps  # a stiff Crank-Nicolson step taken as implicit Euler
+        for k, v in res.heat_in.items():
             self.heat_in[k] = self.heat_in.get(k, 0.0) + v
-        T_local = self.net.full(res["T_F"])
+        T_local = res.T
         T = self.T.copy()
         own = mechanics.owned
         for index, values in comm.allgather((mechanics.gid[own], T_local[own])):

@@ -247,12 +247,12 @@ class DistributedStaticEngine(StaticEngine):
             res = mpi.agree(self.comm, lambda: self.part.integrate(
                 s.integrator, float(s.dt), s.t_end - t0, observer=observer,
                 progress=None if progress is None else (lambda t: progress(t0 + t))))
-            out.update(energy_error=res["energy_error"], heat_in=res["heat_in"], integrator=s.integrator, dt=s.dt,
-                       dt_min=res["dt_min"], dt_max=res["dt_max"], rejected_steps=0, stable_limit=None,
-                       linear_solver=res["solver"], factorizations=res["factorizations"],
-                       max_principle_violation=res["violation"])
-            if res["startup_steps"]:  # a stiff Crank-Nicolson run: its first steps were implicit Euler
-                out["startup_steps"] = res["startup_steps"]
+            out.update(energy_error=res.energy_error, heat_in=res.heat_in, integrator=s.integrator, dt=s.dt,
+                       dt_min=res.dt_min, dt_max=res.dt_max, rejected_steps=0, stable_limit=None,
+                       linear_solver=res.solver, factorizations=res.factorizations,
+                       max_principle_violation=res.max_principle_violation)
+            if res.startup_steps:  # a stiff Crank-Nicolson run: its first steps were implicit Euler
+                out["startup_steps"] = res.startup_steps
         out["linear_iterations"] = self.part.linear_iterations
         self.details = out
 

@@ -9,7 +9,7 @@ r_max + skin`` every pair of the Verlet list (``|x_i - x_j| < r_i + r_j + skin``
 with one partner owned is complete on that rank.
 
 The cuts are chosen once, at equal particle counts (:meth:`Slabs.balanced`); a particle that crosses one changes
-owner at the next rebuild of the Verlet list (migration, :mod:`dem.engines.verlet.ranks`). Everything here is
+owner at the next rebuild of the Verlet list (migration, :mod:`dem.engines.distributed.verlet`). Everything here is
 arithmetic on coordinates, the same on every rank: the owner computed from a ghost's copy is the owner's own answer.
 A packing that does not move is shared out by recursive coordinate bisection instead (:mod:`dem.geometry.bisection`:
 compact cells, cut once); why two: there.
