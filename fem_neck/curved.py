@@ -181,6 +181,14 @@ class Projectors:
         """No rows."""
         return cls(np.zeros(0, int), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3)), np.zeros(0))
 
+
+class ProjectorRows:
+    """:class:`Projectors` being collected row by row (:func:`build`): each row kept as it comes, all of them made
+    arrays once at the end (:meth:`projectors`)."""
+
+    def __init__(self):
+        self.rows = []
+
     def append(self, kind, c, e, r, n=np.zeros(3), d=0.0) -> int:
         """Add a row; return its index. Lengths in the mesh's unit.
 
@@ -199,13 +207,9 @@ class Projectors:
         d : float
             Offset of that plane.
         """
-        self.kind = np.append(self.kind, kind)
-        self.c = np.vstack([self.c, c])
-        self.e = np.vstack([self.e, e])
-        self.r = np.append(self.r, r)
-        self.n = np.vstack([self.n, n])
-        self.d = np.append(self.d, d)
-        return len(self.kind) - 1
+        self.rows.append((int(kind), np.asarray(c, dtype=float), np.asarray(e, dtype=float), float(r),
+                          np.asarray(n, dtype=float), float(d)))
+        return len(self.rows) - 1
 
     def project(self, row: int, y: np.ndarray) -> np.ndarray:
         """The projection of the point ``y`` by projector ``row``.
@@ -218,12 +222,18 @@ class Projectors:
             The point ``(3,)``, in the mesh's length unit.
         """
         out, jac = np.empty(3), np.empty((3, 3))
-        _project(self.kind[row], self.c[row], self.e[row], self.r[row], self.n[row], self.d[row],
-                 np.asarray(y, dtype=float), out, jac)
+        _project(*self.rows[row], np.asarray(y, dtype=float), out, jac)
         return out
 
+    def projectors(self) -> Projectors:
+        """The rows as :class:`Projectors`."""
+        if not self.rows:
+            return Projectors.empty()
+        kind, c, e, r, n, d = zip(*self.rows)
+        return Projectors(np.array(kind), np.array(c), np.array(e), np.array(r), np.array(n), np.array(d))
 
-def _surface_projector(proj: Projectors, s: Surface) -> int:
+
+def _surface_projector(proj: ProjectorRows, s: Surface) -> int:
     if s.kind == SPHERE:
         return proj.append(P_SPHERE, s.centre, np.zeros(3), s.radius)
     if s.kind == CYLINDER:
@@ -231,7 +241,7 @@ def _surface_projector(proj: Projectors, s: Surface) -> int:
     return -1
 
 
-def _curve_projector(proj: Projectors, s1: Surface, s2: Surface, on: np.ndarray, tol: float) -> int:
+def _curve_projector(proj: ProjectorRows, s1: Surface, s2: Surface, on: np.ndarray, tol: float) -> int:
     """The projector onto the intersection curve of two surfaces through the points ``on``; -1 if it is straight."""
     kinds = {s1.kind, s2.kind}
     if kinds == {PLANE}:
@@ -652,7 +662,7 @@ def build(points: np.ndarray, tets: np.ndarray, triangles: np.ndarray, triangle_
     for v_, s_ in zip(tri.ravel().tolist(), np.repeat(triangle_surface, 3).tolist()):
         vertex_surfaces.setdefault(v_, set()).add(s_)
 
-    proj = Projectors.empty()
+    proj = ProjectorRows()
     # snap the vertices (exact positions at the vertices make every offset vanish there)
     for v_, ss in vertex_surfaces.items():
         ss = sorted(ss)
@@ -667,7 +677,7 @@ def build(points: np.ndarray, tets: np.ndarray, triangles: np.ndarray, triangle_
             if np.linalg.norm(p - points[v_]) > tol:
                 raise ValueError(f"vertex {v_} lies {np.linalg.norm(p - points[v_]):.2e} from its surface")
             points[v_] = p
-    proj = Projectors.empty()
+    proj = ProjectorRows()
     edge_row = np.full(len(edges), -1, dtype=np.int64)
     surface_row = [_surface_projector(proj, s) for s in surfaces]
     for e_, ss in edge_surfaces.items():
@@ -680,5 +690,5 @@ def build(points: np.ndarray, tets: np.ndarray, triangles: np.ndarray, triangle_
             raise ValueError(f"boundary edge {e_} lies on {len(ss)} surfaces")
     face_row = np.full(len(faces), -1, dtype=np.int64)
     face_row[boundary_faces] = np.array(surface_row, dtype=np.int64)[triangle_surface]
-    return CurvedMesh(points, tets, edges, faces, t2e, t2f, boundary_faces, triangle_surface, list(surfaces), proj,
-                      edge_row[t2e], face_row[t2f])
+    return CurvedMesh(points, tets, edges, faces, t2e, t2f, boundary_faces, triangle_surface, list(surfaces),
+                      proj.projectors(), edge_row[t2e], face_row[t2f])

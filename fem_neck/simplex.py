@@ -39,11 +39,19 @@ def barycentric(xi: np.ndarray) -> np.ndarray:
 
 
 def _gauss_jacobi(n: int, alpha: float) -> tuple[np.ndarray, np.ndarray]:
-    """``n`` points and weights on [0, 1] for the weight ``(1 - t)^alpha``."""
-    from scipy.special import roots_jacobi
-
-    s, w = roots_jacobi(n, alpha, 0.0)
-    return 0.5 * (s + 1.0), w / 2.0 ** (alpha + 1.0)
+    r"""``n`` points and weights on [0, 1] for the weight ``(1 - t)^alpha`` (``alpha > -1``): Gauss-Jacobi on [-1, 1]
+    for :math:`(1 - s)^\alpha` by Golub & Welsch (1969): the points are the eigenvalues of the symmetric tridiagonal
+    matrix of the monic Jacobi polynomials' three-term recurrence (:math:`\beta = 0`), the weights
+    :math:`\mu_0 v_0^2` from the eigenvectors' first components, :math:`\mu_0 = 2^{\alpha + 1} / (\alpha + 1)`
+    the weight's integral; then mapped to [0, 1]."""
+    k = np.arange(n, dtype=float)
+    two = 2.0 * k + alpha                                      # 2 k + alpha + beta
+    diagonal = -alpha**2 / (two * (two + 2.0)) if alpha else np.zeros(n)
+    m = k[1:]
+    two = 2.0 * m + alpha
+    off = m * (m + alpha) * np.sqrt(4.0 / (two**2 * (two + 1.0) * (two - 1.0)))
+    s, v = np.linalg.eigh(np.diag(diagonal) + np.diag(off, 1) + np.diag(off, -1))
+    return 0.5 * (s + 1.0), v[0] ** 2 / (alpha + 1.0)          # mu_0 v_0^2 over 2^(alpha + 1), the map's Jacobian
 
 
 # Fully symmetric rules on the tetrahedron, all points inside, all weights positive (Witherden & Vincent 2015,

@@ -1,5 +1,6 @@
 """fem_neck.simplex: the quadrature rules on the reference tetrahedron integrate every monomial of their degree
-exactly (closed form a! b! c! / (a + b + c + 3)!), with all points inside and all weights positive."""
+exactly (closed form a! b! c! / (a + b + c + 3)!), with all points inside and all weights positive; the Gauss-Jacobi
+rules they and the triangle's are built from are exact to degree 2 n - 1 (closed form: the Beta function)."""
 
 import itertools
 import math
@@ -33,3 +34,14 @@ def test_symmetric_rules_are_inside_positive_and_smaller_than_the_conical_produc
     assert len(w) == points < ((degree + 2) // 2) ** 3
     assert np.all(w > 0.0) and np.all(x > 0.0) and np.all(x.sum(axis=1) < 1.0)
     assert len(np.unique(x.round(12), axis=0)) == points
+
+
+@pytest.mark.parametrize("alpha", [0, 1, 2])
+@pytest.mark.parametrize("n", [1, 2, 5, 9])
+def test_gauss_jacobi_is_gaussian_for_its_weight(alpha, n):
+    t, w = simplex._gauss_jacobi(n, float(alpha))
+    assert np.all((t > 0.0) & (t < 1.0)) and np.all(w > 0.0) and np.all(np.diff(t) > 0.0)
+    for j in range(2 * n + 1):  # int_0^1 (1 - t)^alpha t^j dt = j! alpha! / (j + alpha + 1)!
+        exact = math.factorial(j) * math.factorial(alpha) / math.factorial(j + alpha + 1)
+        error = abs(np.sum(w * t**j) / exact - 1.0)
+        assert error < 1e-13 if j < 2 * n else error > 1e-11  # exact to degree 2 n - 1, not beyond
