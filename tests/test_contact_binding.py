@@ -12,7 +12,7 @@ import pytest
 from numba import njit
 
 from dem.laws.contact import CONTACT_LAWS, Composition, law_module
-from dem.laws.contact.binding import ContactLaw, pair_force, spins
+from dem.laws.contact.binding import ContactLaw, spins
 from test_hertz_mindlin import law_pair
 
 HERTZ_LUDING = dict(youngs_modulus=1e9, poisson_ratio=0.3, restitution=0.6, kt_ratio=0.4, gamma_t=0.002, mu=0.4,
@@ -118,3 +118,7 @@ def test_a_generated_material_checks_its_fields_naming_them():
     cls = law_module("hertz_luding").Material
     with pytest.raises(ValueError, match="contact.kt_ratio"):
         cls(**{**HERTZ_LUDING, "kt_ratio": -1.0})
+    with pytest.raises(ValueError, match=r"contact.poisson_ratio = 0.5: must be in \(-1, 0.5\)"):
+        cls(**{**HERTZ_LUDING, "poisson_ratio": 0.5})
+    with pytest.raises(ValueError, match=r"contact.restitution = 1.5: must be in \(0, 1\]"):
+        cls(**{**HERTZ_LUDING, "restitution": 1.5})

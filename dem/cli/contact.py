@@ -288,7 +288,6 @@ def plot(path: pathlib.Path, material, radius: float, history: dict, rows: dict,
     from matplotlib.figure import Figure
 
     from dem.laws.contact.normal import luding as luding_normal
-    from dem.laws.contact.state import sintering
     from dem.output.plots import temperature_label
 
     delta_fluid = luding_normal.pair_delta_fluid(radius, radius, material.fluid_overlap)

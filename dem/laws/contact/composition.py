@@ -15,8 +15,9 @@ every kernel ``numba.njit`` with ``inline="always"``):
 * every slot: ``PARAMS``, ``(pack, size)``: the function that packs a material into the float64 block its kernels
   read and the block's length, or None (sub-models with one pack function share one block: a paper's material is
   one block); ``FIELDS``, the material fields it reads,
-  each ``name: (kind, unit)`` with kind ``"positive"``, ``"nonnegative"``, ``"number"`` or ``"flag"``, and
-  ``SCHEMA_ROWS``, their rows of the scene schema (:mod:`dem.scene.schema`); ``PAIR_HISTORY`` and ``WALL_HISTORY``,
+  each ``name: (kind, unit)`` with kind ``"positive"``, ``"nonnegative"``, ``"number"`` or ``"flag"``, optionally
+  ``check(material)`` (a range the kinds do not say: ``ValueError`` naming the field), and ``SCHEMA_ROWS``, their
+  rows of the scene schema (:mod:`dem.scene.schema`); ``PAIR_HISTORY`` and ``WALL_HISTORY``,
   the names of its history columns (the slots' columns follow each other in the order normal, damping, tangential,
   adhesion), and ``forget(at, col, hist_in, hist)`` (the contact opened; whether it had a history);
 * ``normal``: ``pair(at, col, hist_in, hist, state, T, i, j, contact, ri, rj, p, const)`` and ``wall(at, col,
@@ -103,8 +104,12 @@ def _generated_material(law: "Law", modules) -> type:
     nonnegative = {key: unit for key, (kind, unit) in fields.items() if kind == "nonnegative"}
     flags = tuple(key for key, (kind, _) in fields.items() if kind == "flag")
 
+    checks = [module.check for module in modules if hasattr(module, "check")]
+
     def post_init(self):
         check_fields(self, "contact", positive, nonnegative, flags=flags)
+        for check in checks:
+            check(self)
 
     def params(self):
         return law.params(self)

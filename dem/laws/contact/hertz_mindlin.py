@@ -91,12 +91,8 @@ class HertzMindlinMaterial:
 
     def __post_init__(self):
         check_fields(self, "contact", _POSITIVE, _NONNEGATIVE)
-        if not -1.0 < self.poisson_ratio < 0.5:
-            raise ValueError(f"contact.poisson_ratio = {self.poisson_ratio!r}: must be in (-1, 0.5) (an isotropic "
-                             f"elastic solid)")
-        if not self.restitution <= 1.0:
-            raise ValueError(f"contact.restitution = {self.restitution!r}: must be in (0, 1] (the coefficient of "
-                             f"restitution of a head-on collision; 1: elastic)")
+        check_poisson_ratio(self)
+        check_restitution(self)
 
     @property
     def effective_modulus(self) -> float:
@@ -132,6 +128,42 @@ class HertzMindlinMaterial:
             The Rayleigh time (s).
         """
         return rayleigh_time(self, radius)
+
+
+def check_poisson_ratio(material) -> None:
+    """Poisson's ratio of an isotropic elastic solid, ``-1 < nu < 0.5``.
+
+    Parameters
+    ----------
+    material : object
+        A material with the field ``poisson_ratio``.
+
+    Raises
+    ------
+    ValueError
+        ``poisson_ratio`` is out of its range.
+    """
+    if not -1.0 < material.poisson_ratio < 0.5:
+        raise ValueError(f"contact.poisson_ratio = {material.poisson_ratio!r}: must be in (-1, 0.5) (an isotropic "
+                         f"elastic solid)")
+
+
+def check_restitution(material) -> None:
+    """The coefficient of restitution of a head-on collision, ``0 < e <= 1``.
+
+    Parameters
+    ----------
+    material : object
+        A material with the field ``restitution``.
+
+    Raises
+    ------
+    ValueError
+        ``restitution`` is out of its range.
+    """
+    if not 0.0 < material.restitution <= 1.0:
+        raise ValueError(f"contact.restitution = {material.restitution!r}: must be in (0, 1] (the coefficient of "
+                         f"restitution of a head-on collision; 1: elastic)")
 
 
 def effective_modulus(material) -> float:

@@ -13,6 +13,8 @@ import math
 import numpy as np
 from numba import njit
 
+from dem.laws.contact import hertz_mindlin as hm
+
 IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}  # inlined into the engines' force loop
 
 
@@ -85,6 +87,9 @@ SCHEMA_ROWS = ((("restitution",), "0 < e ≤ 1, required", "the coefficient of r
                 "at every impact speed: Tsuji's damping η_n = α √(m* k_n) with α from e (Antypov & Elliott 2011)"),)
 PAIR_HISTORY = WALL_HISTORY = ()
 STATE = "mass"  # the particles' masses
+
+check = hm.check_restitution  # the range the field kinds do not say
+
 
 
 @njit(**IN_LOOP)

@@ -47,6 +47,7 @@ SCHEMA_ROWS = ((("youngs_modulus", "poisson_ratio"), "Pa, -; required, E > 0, -1
                 "(Johnson 1985, Sec. 4.2)"),)
 PAIR_HISTORY = WALL_HISTORY = ()
 PAIR_CONSTANTS = ()
+check = hm.check_poisson_ratio  # the range the field kinds do not say
 STATE = None
 
 

@@ -27,7 +27,7 @@ from numba import njit
 
 from dem.laws.contact import luding
 from dem.laws.contact.damping import luding as damping
-from dem.laws.contact.luding import P_FLUID_OVERLAP, P_K1, P_K2, P_KC, P_WALL_SINTERING, LudingMaterial
+from dem.laws.contact.luding import P_FLUID_OVERLAP, P_GAMMA_N, P_K1, P_K2, P_KC, P_WALL_SINTERING, LudingMaterial
 
 def time_step(k2: float, gamma_n: float, m_min: float) -> float:
     """``t_MD = pi/(50 omega)``, ``omega = sqrt(k2/m12 - eta0^2)``, ``eta0 = gamma_0/(2 m12)`` (Luding 2005,
