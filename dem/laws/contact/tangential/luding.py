@@ -134,7 +134,9 @@ def wall(at, col, hist_in, hist, contact, f_n, load, k_n, a, eta, soft, dt, para
 
 @njit(**IN_LOOP)
 def forget(at, col, hist_in, hist):
-    """A contact that opened forgets its spring; whether it had one."""
+    """A contact that opened forgets its spring; whether it had one (written only then: most listed pairs are open,
+    and their rows stay untouched)."""
     had = hist_in[at + (col,)] != 0.0 or hist_in[at + (col + 1,)] != 0.0 or hist_in[at + (col + 2,)] != 0.0
-    hist[at + (col,)], hist[at + (col + 1,)], hist[at + (col + 2,)] = 0.0, 0.0, 0.0
+    if had:
+        hist[at + (col,)], hist[at + (col + 1,)], hist[at + (col + 2,)] = 0.0, 0.0, 0.0
     return had
