@@ -416,18 +416,23 @@ overload(wall_force, inline="always")(_wall_force)
 
 
 def _forgetting(law, wall: bool):
-    """The ``forget`` kernels of the slots with a history of the contact's kind, with their first columns."""
+    """The ``forget`` kernels of the slots with a history of the contact's kind, with their first columns, and
+    whether the first is a normal sub-model whose history guards the others (``GUARDS``: a contact without it has no
+    other history, so an open contact is done with one read)."""
     spec, blocks, columns = _parts(law)
     found = []
     for slot, (pair_column, wall_column) in columns.items():
         module = spec.modules[slot]
         if module.WALL_HISTORY if wall else module.PAIR_HISTORY:
             found.append((module.forget, wall_column if wall else pair_column))
-    return found
+    normal = spec.modules["normal"]
+    guarded = bool(found) and found[0][0] is normal.forget and getattr(normal, "GUARDS", False)
+    return found, guarded
 
 
-def _forget(found):
-    """``forget(at, hist_in, hist)``: every slot's ``forget`` called, whether any had a history."""
+def _forget(found, guarded):
+    """``forget(at, hist_in, hist)``: every slot's ``forget`` called (after a guarding first one only where it had
+    a history), whether any had a history."""
     if not found:
         def forget(at, hist_in, hist):
             return False
@@ -436,6 +441,14 @@ def _forget(found):
 
         def forget(at, hist_in, hist):
             return f0(at, c0, hist_in, hist)
+    elif len(found) == 2 and guarded:
+        (f0, c0), (f1, c1) = found
+
+        def forget(at, hist_in, hist):
+            if not f0(at, c0, hist_in, hist):
+                return False
+            f1(at, c1, hist_in, hist)
+            return True
     elif len(found) == 2:
         (f0, c0), (f1, c1) = found
 
@@ -443,6 +456,15 @@ def _forget(found):
             h0 = f0(at, c0, hist_in, hist)
             h1 = f1(at, c1, hist_in, hist)
             return h0 or h1
+    elif guarded:
+        (f0, c0), (f1, c1), (f2, c2) = found
+
+        def forget(at, hist_in, hist):
+            if not f0(at, c0, hist_in, hist):
+                return False
+            f1(at, c1, hist_in, hist)
+            f2(at, c2, hist_in, hist)
+            return True
     else:
         (f0, c0), (f1, c1), (f2, c2) = found
 
@@ -457,7 +479,7 @@ def _forget(found):
 def _forget_pair(law, c, hist_in, hist):
     if _law(law) is None:
         return None
-    forget = _forget(_forgetting(law, False))
+    forget = _forget(*_forgetting(law, False))
 
     def impl(law, c, hist_in, hist):
         return forget((c,), hist_in, hist)
@@ -470,7 +492,7 @@ overload(forget_pair, inline="always")(_forget_pair)
 def _forget_wall(law, k, m, hist_in, hist):
     if _law(law) is None:
         return None
-    forget = _forget(_forgetting(law, True))
+    forget = _forget(*_forgetting(law, True))
 
     def impl(law, k, m, hist_in, hist):
         return forget((k, m), hist_in, hist)

@@ -299,6 +299,7 @@ PAIR_HISTORY = ("delta_max", "k1_last")
 WALL_HISTORY = PAIR_HISTORY
 PAIR_CONSTANTS = ("delta_fluid", "inv_k2_delta_fluid")  # of the radii only (pair_constants)
 STATE = "sintering"  # the particles' k1(T, t)/k1
+GUARDS = True  # a closed contact has delta_max > 0: one without it has no other history (binding's forget)
 
 
 @njit(**IN_LOOP)
