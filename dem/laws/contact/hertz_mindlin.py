@@ -107,7 +107,7 @@ class HertzMindlinMaterial:
     @property
     def effective_shear_modulus(self) -> float:
         """G* of two particles of the material, ``G/(2 (2 - nu))``, Pa."""
-        return shear_modulus(self) / (2.0 * (2.0 - self.poisson_ratio))
+        return effective_shear_modulus(self)
 
     def params(self) -> np.ndarray:
         """The material as the float64 array the compiled loops take: its law's blocks
@@ -197,6 +197,22 @@ def shear_modulus(material) -> float:
         G (Pa).
     """
     return material.youngs_modulus / (2.0 * (1.0 + material.poisson_ratio))
+
+
+def effective_shear_modulus(material) -> float:
+    """G* of two particles of a material with ``youngs_modulus`` E and ``poisson_ratio`` nu, ``G/(2 (2 - nu))``, Pa.
+
+    Parameters
+    ----------
+    material : object
+        A material with the fields ``youngs_modulus`` (Pa) and ``poisson_ratio``.
+
+    Returns
+    -------
+    float
+        G* (Pa).
+    """
+    return shear_modulus(material) / (2.0 * (2.0 - material.poisson_ratio))
 
 
 def rayleigh_time(material, radius: float) -> float:

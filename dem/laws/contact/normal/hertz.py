@@ -85,7 +85,7 @@ def time_steps(material, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarr
     a = r_eff * math.sqrt(STABLE_OVERLAP)
     rotational = 1.0 + float(np.max(mass * radius**2 / inertia))
     e_star = hm.effective_modulus(material)
-    g_star = hm.shear_modulus(material) / (2.0 * (2.0 - material.poisson_ratio))
+    g_star = hm.effective_shear_modulus(material)
     k_max = max(2.0 * e_star * a, 8.0 * g_star * a * rotational)
     eta = tsuji.damping_coefficient(material.restitution) * math.sqrt(m_eff * 4.0 / 3.0 * e_star * a)
     stable = 2.0 / (math.sqrt(k_max / m_eff) + eta / (2.0 * m_eff))

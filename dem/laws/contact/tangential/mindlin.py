@@ -75,7 +75,7 @@ def params_of(material) -> np.ndarray:
     numpy.ndarray
         (4,) the block.
     """
-    g_star = hm.shear_modulus(material) / (2.0 * (2.0 - material.poisson_ratio))
+    g_star = hm.effective_shear_modulus(material)
     return np.array([8.0 * g_star, material.tangential_damping, material.mu, material.mu_wall])
 
 
