@@ -2,8 +2,11 @@
 22-30, 45-49).
 
 :class:`ZohdiMaterial` holds the material in SI units, named by the paper's symbols; :meth:`ZohdiMaterial.params`
-packs it into the float64 array the compiled kernels take (indices ``Z_*``); the plug-in kernels at the end give the
-engines' loops its forces (:mod:`dem.laws.contact`). The adaptive trapezoidal fixed-point scheme the paper steps it with
+packs it into the float64 array the Zohdi sub-models take (indices ``Z_*``). The law is the composition
+(:data:`dem.laws.contact.CONTACT_LAWS`) of the power-law normal force on the contact area
+(:mod:`dem.laws.contact.normal.zohdi`, eqs. 2-15, Sec. 7), the bonds (:mod:`dem.laws.contact.adhesion.zohdi`, eqs.
+18-19), the sliding friction (:mod:`dem.laws.contact.tangential.zohdi`, eqs. 5-6, 16-17) and the drag
+(:mod:`dem.laws.contact.drag.zohdi`, eq. 20). The adaptive trapezoidal fixed-point scheme the paper steps it with
 is the staggered engine's (:mod:`dem.engines.staggered`, its parameters :class:`dem.scene.staggered.ZohdiStepping`).
 
 Conventions (Zohdi 2014, eqs. 3-4): ``n_ij = (r_j - r_i)/|r_j - r_i|`` points from i to j (the engines' ``n`` is the
@@ -35,11 +38,9 @@ to mean absolute zero.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from dem.laws.fields import check_fields
 
@@ -140,12 +141,7 @@ class ZohdiMaterial:
 
     def params(self) -> np.ndarray:
         """The material as the float64 array the kernels take (indices ``Z_*`` of this module)."""
-        out = np.empty(N_PARAMS)
-        out[Z_KP], out[Z_PP], out[Z_KP_LIM] = self.K_p, self.p_p, self.K_p_lim
-        out[Z_KW], out[Z_PW], out[Z_KW_LIM] = self.K_w, self.p_w, self.K_w_lim
-        out[Z_THETA_STAR], out[Z_KB], out[Z_PB], out[Z_E_STAR] = self.theta_star, self.K_b, self.p_b, self.E_star
-        out[Z_MU], out[Z_C_ENV], out[Z_V_SLIP], out[Z_DENSITY] = self.mu_d, self.c_env, self.v_slip, self.density
-        return out
+        return params_of(self)
 
     def stiffness(self, theta, wall: bool = False):
         """``max(K_0 (1 - theta/theta*), K_lim)`` (Sec. 7), N/m^2.
@@ -166,15 +162,29 @@ class ZohdiMaterial:
         return np.maximum(k0 * (1.0 - np.asarray(theta, dtype=float) / self.theta_star), floor)
 
 
-# ------------------------------------------------------------------------------------------ the plug-in
-# What the engines' compiled loops call (:mod:`dem.laws.contact` lists the names every contact law defines).
-NAME = "zohdi"
+def params_of(material) -> np.ndarray:
+    """The parameter block of the Zohdi sub-models (indices ``Z_*``).
+
+    Parameters
+    ----------
+    material : ZohdiMaterial
+        The material.
+
+    Returns
+    -------
+    numpy.ndarray
+        (``N_PARAMS``,) the block.
+    """
+    m = material
+    out = np.empty(N_PARAMS)
+    out[Z_KP], out[Z_PP], out[Z_KP_LIM] = m.K_p, m.p_p, m.K_p_lim
+    out[Z_KW], out[Z_PW], out[Z_KW_LIM] = m.K_w, m.p_w, m.K_w_lim
+    out[Z_THETA_STAR], out[Z_KB], out[Z_PB], out[Z_E_STAR] = m.theta_star, m.K_b, m.p_b, m.E_star
+    out[Z_MU], out[Z_C_ENV], out[Z_V_SLIP], out[Z_DENSITY] = m.mu_d, m.c_env, m.v_slip, m.density
+    return out
+
+
 Material = ZohdiMaterial
-PAIR_HISTORY = ("bonded",)  # 1: the bond of eq. 19 acts (activated by an accepted step that reached E*)
-WALL_HISTORY = ()
-PARTICLE_STATE = ()
-PAIR_CONSTANTS = ()  # (pair_constants)
-SPINS = False  # the particles do not rotate (Sec. 2)
 SCHEMA_ROWS = (  # the scene keys of the material (dem.scene.schema): keys, type and unit, meaning
     (("K_p", "p_p", "K_p_lim"), "N/m², -, N/m²; required", "particle contact force K_p |E|^p_p A (eqs. 2-12), softened "
      "to max(K_p (1 - θ/θ*), K_p_lim) (Sec. 7)"),
@@ -186,183 +196,3 @@ SCHEMA_ROWS = (  # the scene keys of the material (dem.scene.schema): keys, type
      "= c_env^o 6πR (eq. 20, Sec. 7), the friction's regularisation speed"),
     (("density",), "kg/m³, the `[material]` density", "particle density"),
 )
-DRAG = True  # eq. 20
-JIT = {"cache": True, "error_model": "numpy"}
-IN_LOOP = {**JIT, "inline": "always"}
-
-
-def initial_state(material: ZohdiMaterial, T: np.ndarray, mass: np.ndarray) -> np.ndarray:
-    """No state per particle: the temperatures themselves soften the contacts.
-
-    Parameters
-    ----------
-    material : ZohdiMaterial
-        The contact material (not read by this hook).
-    T : numpy.ndarray
-        (N,) initial temperatures (only their count is read).
-    mass : numpy.ndarray
-        (N,) masses (kg; not read).
-
-    Returns
-    -------
-    numpy.ndarray
-        An (N, 0) array.
-    """
-    return np.zeros((len(T), 0))
-
-
-def reference_radius(material: ZohdiMaterial, radius: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """The radii do not change with temperature.
-
-    Parameters
-    ----------
-    material : ZohdiMaterial
-        The contact material (not read by this hook).
-    radius : numpy.ndarray
-        (N,) radii (m).
-    T : numpy.ndarray
-        (N,) temperatures (not read).
-
-    Returns
-    -------
-    numpy.ndarray
-        (N,) a copy of ``radius`` (m).
-    """
-    return np.array(radius, dtype=float)
-
-
-def largest_reach(material: ZohdiMaterial, radius: np.ndarray) -> float:
-    """The law acts on touching particles only.
-
-    Parameters
-    ----------
-    material : ZohdiMaterial
-        The contact material (not read by this hook).
-    radius : numpy.ndarray
-        (N,) radii (m; not read).
-
-    Returns
-    -------
-    float
-        0.0: the largest gap (m) across which the law acts.
-    """
-    return 0.0
-
-
-def time_steps(material: ZohdiMaterial, mass, inertia, radius, m_mean: float):
-    """The law is stepped by the implicit scheme of the paper (:mod:`dem.engines.staggered`), not by velocity
-    Verlet.
-
-    Parameters
-    ----------
-    material : ZohdiMaterial
-        The contact material.
-    mass, inertia, radius : numpy.ndarray
-        (N,) masses (kg), moments of inertia (kg m^2) and radii (m), as every law's ``time_steps`` takes them.
-    m_mean : float
-        The mass of a particle of the mean radius (kg).
-
-    Raises
-    ------
-    ValueError
-        Always: this law has no velocity-Verlet step.
-    """
-    raise ValueError("[contact] law = \"zohdi\": runs on the staggered implicit scheme of Zohdi 2014 (its [solver] "
-                     "keys dt, dt_max, phi, iterations, tolerance), not on velocity-Verlet steps")
-
-
-@njit(**JIT)
-def softened(k0, k_lim, theta, theta_star):
-    """``max(K_0 (1 - theta/theta*), K_lim)`` (Zohdi 2014, Sec. 7)."""
-    return max(k0 * (1.0 - theta / theta_star), k_lim)
-
-
-@njit(**JIT)
-def lens_area(ri, rj, d):
-    """``pi a^2 = pi (R_i^2 - L_i^2)``, ``L_i = (d - (R_j^2 - R_i^2)/d)/2`` (Zohdi 2014, eqs. 7-12); 0 apart."""
-    if d >= ri + rj or d <= 0.0:
-        return 0.0
-    li = 0.5 * (d - (rj * rj - ri * ri) / d)
-    return math.pi * max(ri * ri - li * li, 0.0)
-
-
-@njit(**IN_LOOP)
-def pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params, const):
-    """Force on particle i of the pair ``c`` = (i, j) at centre distance ``d``: the contact force on the lens area
-    (eqs. 2-12) softened by the pair's mean temperature (Sec. 7), less the bond's pull where the pair is bonded
-    (eq. 19, ``hist_in[c, 0]``), and the friction ``mu_d |F_con|`` against the relative velocity ``-vr`` (eqs. 5-6,
-    regularised). The bond flag written to ``hist[c, 0]`` is set once the strain reaches ``E*`` (eq. 18)."""
-    area = lens_area(ri, rj, d)
-    if area == 0.0:
-        hist[c, 0] = 0.0
-        return 0.0, 0.0, 0.0, 0.0
-    strain = delta / (ri + rj)  # |E_ij| (eq. 3)
-    stiffness = softened(params[Z_KP], params[Z_KP_LIM], 0.5 * (T[i] + T[j]), params[Z_THETA_STAR])
-    f_con = stiffness * strain ** params[Z_PP] * area  # eq. 2
-    bond = hist_in[c, 0] != 0.0  # eq. 19, activated by an earlier accepted step (eq. 18)
-    f_n = f_con - (params[Z_KB] * strain ** params[Z_PB] * area if bond else 0.0)
-    u0, u1, u2 = -vr[0], -vr[1], -vr[2]  # v_j - v_i (eq. 6)
-    scale = params[Z_MU] * f_con / math.sqrt(u0 * u0 + u1 * u1 + u2 * u2 + params[Z_V_SLIP] ** 2)
-    hist[c, 0] = 1.0 if bond or strain >= params[Z_E_STAR] else 0.0
-    return f_n, scale * u0, scale * u1, scale * u2
-
-
-@njit(**IN_LOOP)
-def pair_constants(ri, rj, params):
-    """No numbers of the radii alone are kept per pair (``PAIR_CONSTANTS`` is empty): two zeros."""
-    return 0.0, 0.0
-
-
-@njit(**IN_LOOP)
-def forget_pair(c, hist_in, hist):
-    """A pair that separated forgets its bond."""
-    had = hist_in[c, 0] != 0.0
-    hist[c, 0] = 0.0
-    return had
-
-
-@njit(**IN_LOOP)
-def wall_force(k, m, hist_in, hist, state, T, delta, dist, n, vr, vn, rk, dt, params):
-    """Force on particle k from wall m at the distance ``dist`` of its centre: the wall law on the circle the plane
-    cuts from the sphere (eqs. 13-15), softened by the particle's temperature, and the friction against the
-    tangential velocity (eqs. 16-17)."""
-    strain = delta / rk  # eq. 14
-    stiffness = softened(params[Z_KW], params[Z_KW_LIM], T[k], params[Z_THETA_STAR])
-    f_con = stiffness * strain ** params[Z_PW] * math.pi * max(rk * rk - dist * dist, 0.0)  # eq. 13
-    n0, n1, n2 = n
-    t0, t1, t2 = vr[0] - vn * n0, vr[1] - vn * n1, vr[2] - vn * n2  # the wall slides along none of these
-    scale = params[Z_MU] * f_con / math.sqrt(t0 * t0 + t1 * t1 + t2 * t2 + params[Z_V_SLIP] ** 2)  # eqs. 16-17
-    return f_con, -scale * t0, -scale * t1, -scale * t2
-
-
-@njit(**IN_LOOP)
-def forget_wall(k, m, hist_in, hist):
-    """Wall contacts carry nothing."""
-    return False
-
-
-@njit(**IN_LOOP)
-def reach(c, hist, ri, rj, params):
-    """The law acts on touching pairs only."""
-    return 0.0
-
-
-@njit(**IN_LOOP)
-def wall_reach(k, m, hist, rk, params):
-    """A wall contact acts while it overlaps."""
-    return 0.0
-
-
-@njit(**JIT)
-def update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt):
-    """The temperatures ``T0 + T_rate elapsed``; the radii do not change (returns False)."""
-    n = T.shape[0]
-    for k in range(n):
-        T[k] = T0[0] + T_rate[0] * elapsed if uniform else T0[k] + T_rate[k] * elapsed
-    return False
-
-
-@njit(**IN_LOOP)
-def drag(k, radius, params):
-    """``c_env = c_env^o 6 pi R`` (eq. 20 with Sec. 7's drag on a sphere), kg/s."""
-    return params[Z_C_ENV] * 6.0 * math.pi * radius[k]
