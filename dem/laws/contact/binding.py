@@ -416,9 +416,9 @@ overload(wall_force, inline="always")(_wall_force)
 
 
 def _forgetting(law, wall: bool):
-    """The ``forget`` kernels of the slots with a history of the contact's kind, with their first columns, and
-    whether the first is a normal sub-model whose history guards the others (``GUARDS``: a contact without it has no
-    other history, so an open contact is done with one read)."""
+    """The ``forget`` kernels of the slots with a history of the contact's kind, with their first columns, and,
+    where the first is a normal sub-model whose history guards the others (``GUARDS``), the first column after the
+    normal's and the number of the others' columns (else None)."""
     spec, blocks, columns = _parts(law)
     found, slots = [], []
     for slot, (pair_column, wall_column) in columns.items():
@@ -426,14 +426,45 @@ def _forgetting(law, wall: bool):
         if module.WALL_HISTORY if wall else module.PAIR_HISTORY:
             found.append((module.forget, wall_column if wall else pair_column))
             slots.append(slot)
-    guarded = slots[:1] == ["normal"] and getattr(spec.modules["normal"], "GUARDS", False)
-    return found, guarded
+    normal = spec.modules["normal"]
+    if slots[:1] != ["normal"] or not getattr(normal, "GUARDS", False):
+        return found, None
+    width = len(spec.WALL_HISTORY if wall else spec.PAIR_HISTORY)
+    start = found[0][1] + len(normal.WALL_HISTORY if wall else normal.PAIR_HISTORY)
+    return found, (start, width - start)
+
+
+def _zeroing(clear, column):
+    """``clear(at, hist)`` and then column ``column`` of row ``at`` zeroed (a constant index: one store, as written
+    out by hand; a loop over the columns is slower)."""
+    def then(at, hist):
+        clear(at, hist)
+        hist[at + (column,)] = 0.0
+    return njit(inline="always")(then)
+
+
+@njit(inline="always")
+def _nothing(at, hist):
+    pass
 
 
 def _forget(found, guarded):
-    """``forget(at, hist_in, hist)``: every slot's ``forget`` called (after a guarding first one only where it had
-    a history), whether any had a history."""
-    if not found:
+    """``forget(at, hist_in, hist)``: every slot's ``forget`` called, whether any had a history. Under a guarding
+    normal sub-model (``guarded = (start, count)``) only its own: a contact without its history has no other, and
+    one with it has the ``count`` columns from ``start`` (the other slots') zeroed, which is their ``forget``
+    (:mod:`dem.laws.contact.composition`), without reading them first."""
+    if guarded is not None:
+        (f0, c0), (start, count) = found[0], guarded
+        clear = _nothing
+        for column in range(start, start + count):
+            clear = _zeroing(clear, column)
+
+        def forget(at, hist_in, hist):
+            if not f0(at, c0, hist_in, hist):
+                return False
+            clear(at, hist)
+            return True
+    elif not found:
         def forget(at, hist_in, hist):
             return False
     elif len(found) == 1:
@@ -441,14 +472,6 @@ def _forget(found, guarded):
 
         def forget(at, hist_in, hist):
             return f0(at, c0, hist_in, hist)
-    elif len(found) == 2 and guarded:
-        (f0, c0), (f1, c1) = found
-
-        def forget(at, hist_in, hist):
-            if not f0(at, c0, hist_in, hist):
-                return False
-            f1(at, c1, hist_in, hist)
-            return True
     elif len(found) == 2:
         (f0, c0), (f1, c1) = found
 
@@ -456,15 +479,6 @@ def _forget(found, guarded):
             h0 = f0(at, c0, hist_in, hist)
             h1 = f1(at, c1, hist_in, hist)
             return h0 or h1
-    elif guarded:
-        (f0, c0), (f1, c1), (f2, c2) = found
-
-        def forget(at, hist_in, hist):
-            if not f0(at, c0, hist_in, hist):
-                return False
-            f1(at, c1, hist_in, hist)
-            f2(at, c2, hist_in, hist)
-            return True
     else:
         (f0, c0), (f1, c1), (f2, c2) = found
 

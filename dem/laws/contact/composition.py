@@ -25,7 +25,8 @@ every kernel ``numba.njit`` with ``inline="always"``):
   plastic) normal force, the contact's stiffness (N/m), its size (a contact radius, m, or area, m^2), the largest
   attraction (N, <= 0), the factor that softens friction with temperature (1 without) and the effective radius;
   ``pair_constants(ri, rj, p)`` and ``PAIR_CONSTANTS`` (numbers of the radii alone kept per pair); optionally
-  ``GUARDS`` (a contact without its history has no other: an open one is forgotten with one read); ``STATE``, the
+  ``GUARDS`` (a contact without its history has no other, and the other slots' ``forget`` is to zero their
+  columns: an open contact is forgotten with one read, a closed one's other columns zeroed unread); ``STATE``, the
   ``state`` sub-model it reads particles' state from (None: none); ``time_steps(material, mass, inertia, radius,
   m_mean)`` -> ``(dt, stable)``;
 * ``damping``: ``pair(state, i, j, f_el, delta_dot, k_n, p)`` and ``wall(state, k, f_el, delta_dot, k_n, p)`` ->
