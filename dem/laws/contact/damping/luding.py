@@ -1,5 +1,5 @@
-"""The viscous normal damping of Luding, Manetsberger & Müllers 2005 (Luding 2005, eq. 5): ``f_n = f_el + gamma_0
-delta_dot`` with a constant ``gamma_0`` (kg/s), a damping sub-model of the contact laws
+r"""The viscous normal damping of Luding, Manetsberger & Müllers 2005 (Luding 2005, eq. 5): :math:`f_n = f_{el} +
+\gamma_0 \dot\delta` with a constant :math:`\gamma_0` (kg/s), a damping sub-model of the contact laws
 (:mod:`dem.laws.contact.composition`). Parameters: the block of :func:`dem.laws.contact.luding.params_of`."""
 
 from __future__ import annotations
@@ -20,14 +20,14 @@ STATE = None
 
 @njit(**IN_LOOP)
 def force(f_el, delta_dot, gamma_0):
-    """``f_el + gamma_0 delta_dot`` (eq. 5): the force ``f_el`` (N) with the viscous part of the overlap's rate
+    r""":math:`f_{el} + \gamma_0 \dot\delta` (eq. 5): the force ``f_el`` (N) with the viscous part of the overlap's rate
     ``delta_dot`` (m/s, > 0 approaching) and ``gamma_0`` (kg/s)."""
     return f_el + gamma_0 * delta_dot
 
 
 @njit(**IN_LOOP)
 def pair(state, i, j, f_el, delta_dot, k_n, params):
-    """``(f_el + gamma_0 delta_dot, gamma_0)`` of a pair (:mod:`dem.laws.contact.composition`)."""
+    r""":math:`(f_{el} + \gamma_0 \dot\delta, \gamma_0)` of a pair (:mod:`dem.laws.contact.composition`)."""
     return force(f_el, delta_dot, params[P_GAMMA_N]), params[P_GAMMA_N]
 
 

@@ -1,5 +1,5 @@
-"""The drag of Zohdi 2014 on every particle (eq. 20 with Sec. 7's drag on a sphere): ``-c_env v`` with ``c_env =
-c_env^o 6 pi R``. A drag sub-model of the contact laws (:mod:`dem.laws.contact.composition`). Parameters: the block
+r"""The drag of Zohdi 2014 on every particle (eq. 20 with Sec. 7's drag on a sphere): :math:`-c_{env} v` with
+:math:`c_{env} = c_{env}^o\, 6 \pi R`. A drag sub-model of the contact laws (:mod:`dem.laws.contact.composition`). Parameters: the block
 of :func:`dem.laws.contact.zohdi.params_of`.
 """
 
@@ -21,5 +21,5 @@ SCHEMA_ROWS = tuple(row for row in zohdi.SCHEMA_ROWS if set(row[0]) & set(FIELDS
 
 @njit(**IN_LOOP)
 def drag(k, radius, params):
-    """``c_env = c_env^o 6 pi R`` (eq. 20 with Sec. 7's drag on a sphere) of particle k, kg/s."""
+    r""":math:`c_{env} = c_{env}^o\, 6 \pi R` (eq. 20 with Sec. 7's drag on a sphere) of particle k, kg/s."""
     return params[Z_C_ENV] * 6.0 * math.pi * radius[k]

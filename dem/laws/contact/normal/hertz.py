@@ -1,8 +1,9 @@
-"""Hertz's normal contact of elastic spheres (Hertz 1882; Johnson, Contact Mechanics, 1985, Sec. 4.2): at the overlap
-``delta`` of two spheres of effective radius ``R*`` the contact radius is ``a = sqrt(R* delta)`` and the force ``F_el
-= 4/3 E* a delta``, i.e. a spring of stiffness ``k_n = 4/3 E* a`` that grows with the overlap. A normal sub-model of
-the contact laws (:mod:`dem.laws.contact.composition`): a wall is a partner of infinite radius (``R* = a_k``); the
-material's ``youngs_modulus`` E and ``poisson_ratio`` nu give ``E* = E/(2 (1 - nu^2))``
+r"""Hertz's normal contact of elastic spheres (Hertz 1882; Johnson, Contact Mechanics, 1985, Sec. 4.2): at the overlap
+:math:`\delta` of two spheres of effective radius :math:`R^*` the contact radius is :math:`a = \sqrt{R^* \delta}`
+and the force :math:`F_{el} = \frac{4}{3} E^* a \delta`, i.e. a spring of stiffness :math:`k_n = \frac{4}{3} E^* a`
+that grows with the overlap. A normal sub-model of the contact laws (:mod:`dem.laws.contact.composition`): a wall is
+a partner of infinite radius (:math:`R^* = a_k`); the material's ``youngs_modulus`` E and ``poisson_ratio``
+:math:`\nu` give :math:`E^* = E/(2 (1 - \nu^2))`
 (:func:`dem.laws.contact.hertz_mindlin.effective_modulus`)."""
 
 from __future__ import annotations
@@ -53,12 +54,13 @@ STATE = None
 
 def time_steps(material, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray,
                m_mean: float) -> tuple[float, float]:
-    """``(dt, stable)``: ``dt = "auto"`` is ``RAYLEIGH_FRACTION`` of the Rayleigh time of the smallest particle
-    (:mod:`dem.laws.contact.hertz_mindlin`). Hertz's stiffness ``k = dF/d delta = 2 E* a`` grows with the overlap, so no step is stable at
-    every overlap: ``stable`` is the largest velocity-Verlet step, ``2/(omega + eta_n/(2 m*))``, for the lightest
-    pair at an overlap of ``STABLE_OVERLAP`` R* (beyond the small strains Hertz's law is for), with its
-    stiffest mode: normal, ``2 E* a``, or tangential with rotation, ``8 G* a (1 + m a^2/I)`` (Mindlin's, also where another tangential sub-model
-    is taken), with Tsuji's damping of the ``restitution``.
+    r"""``(dt, stable)``: ``dt = "auto"`` is ``RAYLEIGH_FRACTION`` of the Rayleigh time of the smallest particle
+    (:mod:`dem.laws.contact.hertz_mindlin`). Hertz's stiffness :math:`k = dF/d\delta = 2 E^* a` grows with the
+    overlap, so no step is stable at every overlap: ``stable`` is the largest velocity-Verlet step, :math:`2/(\omega +
+    \eta_n/(2 m^*))`, for the lightest pair at an overlap of ``STABLE_OVERLAP`` :math:`R^*` (beyond the small strains
+    Hertz's law is for), with its stiffest mode: normal, :math:`2 E^* a`, or tangential with rotation, :math:`8 G^* a
+    (1 + m a^2/I)` (Mindlin's, also where another tangential sub-model is taken), with Tsuji's damping of the
+    ``restitution``.
 
     Parameters
     ----------
@@ -94,9 +96,9 @@ def time_steps(material, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarr
 
 @njit(**IN_LOOP)
 def stiffness(delta, r_eff, four_thirds_e_star):
-    """``(k_n, a)``: the secant stiffness ``k_n = F_el/delta = 4/3 E* a`` (N/m) and the contact radius ``a = sqrt(R*
-    delta)`` (m) at the overlap ``delta`` > 0 (m) of a contact of effective radius ``r_eff`` (m);
-    ``four_thirds_e_star`` is 4/3 E* (Pa)."""
+    r"""``(k_n, a)``: the secant stiffness :math:`k_n = F_{el}/\delta = \frac{4}{3} E^* a` (N/m) and the contact
+    radius :math:`a = \sqrt{R^* \delta}` (m) at the overlap ``delta`` > 0 (m) of a contact of effective radius
+    ``r_eff`` (m); ``four_thirds_e_star`` is :math:`\frac{4}{3} E^*` (Pa)."""
     a = math.sqrt(r_eff * delta)
     return four_thirds_e_star * a, a
 

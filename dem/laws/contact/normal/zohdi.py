@@ -1,8 +1,8 @@
-"""The normal contact of Zohdi 2014 (eqs. 2-15, Sec. 7): a power law of the strain on the contact area, softened by
-temperature -- ``K_p |E|^p_p A`` between particles (the strain ``E = delta/(R_i + R_j)``, eq. 3, on the lens area
-``A = pi (R_i^2 - L_i^2)``, eqs. 7-12) and ``K_w E^p_w A`` on a wall (``E = delta/R_k``, eq. 14, on the circle the
-plane cuts from the sphere), with ``K = max(K_0 (1 - theta/theta*), K_lim)`` (Sec. 7; for a pair theta is the mean of
-the two). A normal sub-model of the contact laws (:mod:`dem.laws.contact.composition`) whose contact's size ``a`` is
+r"""The normal contact of Zohdi 2014 (eqs. 2-15, Sec. 7): a power law of the strain on the contact area, softened by
+temperature -- :math:`K_p |E|^{p_p} A` between particles (the strain :math:`E = \delta/(R_i + R_j)`, eq. 3, on the
+lens area :math:`A = \pi (R_i^2 - L_i^2)`, eqs. 7-12) and :math:`K_w E^{p_w} A` on a wall (:math:`E = \delta/R_k`,
+eq. 14, on the circle the plane cuts from the sphere), with :math:`K = \max(K_0 (1 - \theta/\theta^*), K_{lim})`
+(Sec. 7; for a pair :math:`\theta` is the mean of the two). A normal sub-model of the contact laws (:mod:`dem.laws.contact.composition`) whose contact's size ``a`` is
 its area (m^2); the law is stepped by the paper's implicit scheme (:func:`time_steps`). Parameters: the block of
 :func:`dem.laws.contact.zohdi.params_of`.
 """
@@ -53,13 +53,14 @@ def time_steps(material, mass, inertia, radius, m_mean: float):
 
 @njit(**JIT)
 def softened(k0, k_lim, theta, theta_star):
-    """``max(K_0 (1 - theta/theta*), K_lim)`` (Zohdi 2014, Sec. 7)."""
+    r""":math:`\max(K_0 (1 - \theta/\theta^*), K_{lim})` (Zohdi 2014, Sec. 7)."""
     return max(k0 * (1.0 - theta / theta_star), k_lim)
 
 
 @njit(**JIT)
 def lens_area(ri, rj, d):
-    """``pi a^2 = pi (R_i^2 - L_i^2)``, ``L_i = (d - (R_j^2 - R_i^2)/d)/2`` (Zohdi 2014, eqs. 7-12); 0 apart."""
+    r""":math:`\pi a^2 = \pi (R_i^2 - L_i^2)`, :math:`L_i = (d - (R_j^2 - R_i^2)/d)/2` (Zohdi 2014, eqs. 7-12); 0
+    apart."""
     if d >= ri + rj or d <= 0.0:
         return 0.0
     li = 0.5 * (d - (rj * rj - ri * ri) / d)

@@ -26,25 +26,28 @@ PARTICLE_STATE = ("k1_factor",)  # k1(T, t)/k1 of each particle's material (eqs.
 
 @njit(**JIT)
 def radius_at(a_melt, T, T_melt, expansion):
-    """``a(T) = a(T_melt) [1 - delta a_T (T_melt - T)]`` (Luding 2005, eq. 9)."""
+    r""":math:`a(T) = a(T_{melt}) [1 - \delta a_T (T_{melt} - T)]` (Luding 2005, eq. 9)."""
     return a_melt * (1.0 - expansion * (T_melt - T))
 
 
 @njit(**JIT)
 def k1_factor(T, T_melt, T_var):
-    """``k1(T)/k1 = [1 + tanh((T_melt - T)/T_var)]/2`` (Luding 2005, eq. 10), evaluated as the equal logistic
-    ``1/(1 + exp(-2 tau))``: no cancellation in ``1 + tanh`` far above T_melt, so the factor stays > 0 there."""
+    r""":math:`k_1(T)/k_1 = [1 + \tanh((T_{melt} - T)/T_{var})]/2` (Luding 2005, eq. 10), evaluated as the equal
+    logistic :math:`1/(1 + e^{-2 \tau})`: no cancellation in :math:`1 + \tanh` far above :math:`T_{melt}`, so the
+    factor stays > 0 there."""
     return 1.0 / (1.0 + math.exp(-2.0 * (T_melt - T) / T_var))
 
 
 @njit(**JIT)
 def relax_k1(k1t, k1T, dt, t0, cooling):
-    """New factor k1(T, t)/k1 after a step ``dt`` from ``k1t`` towards the target ``k1T = k1(T)/k1``.
+    r"""New factor :math:`k_1(T, t)/k_1` after a step ``dt`` from ``k1t`` towards the target ``k1T``,
+    :math:`k_1(T)/k_1`.
 
-    Eq. (12), ``d k/dt = (K - k)|K - k|/(K t0)``, solved exactly over the step from the previous step's value
-    (footnote 3) at constant target K: with ``u = 1 - k/K``, ``u_new = u/(1 + |u| dt/t0)`` (eq. 11 is this
-    solution for heating). Written as ``k_new = K - d K t0/(K t0 + |d| dt)``, ``d = K - k``: unconditionally
-    stable and finite for K -> 0. Cooling with ``K > k`` freezes at once, ``k_new = K`` (end of Sec. 3.4).
+    Eq. (12), :math:`dk/dt = (K - k)|K - k|/(K t_0)`, solved exactly over the step from the previous step's value
+    (footnote 3) at constant target K: with :math:`u = 1 - k/K`, :math:`u_{new} = u/(1 + |u|\, dt/t_0)` (eq. 11 is
+    this solution for heating). Written as :math:`k_{new} = K - d K t_0/(K t_0 + |d|\, dt)`, :math:`d = K - k`:
+    unconditionally stable and finite for :math:`K \to 0`. Cooling with :math:`K > k` freezes at once,
+    :math:`k_{new} = K` (end of Sec. 3.4).
     """
     d = k1T - k1t
     if cooling and d > 0.0:

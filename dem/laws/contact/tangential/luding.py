@@ -1,9 +1,10 @@
-"""The tangential contact of Luding, Manetsberger & Müllers 2005 (Luding 2005, eqs. 14, 16-24, footnote 5): a
-spring ``xi`` of stiffness ``k_t = alpha k2(delta_max)`` (eq. 23) with viscous damping gamma_t (eq. 19), sticking
-below the Coulomb limit ``f_C = mu(T, t) (f_n - f_min)`` (eqs. 14, 24) and sliding at it (eqs. 20-22); a sliding
-contact keeps no cohesion where ``brittle_sliding`` (footnote 5). A tangential sub-model of the contact laws
-(:mod:`dem.laws.contact.composition`): the stiffness is the normal sub-model's ``k_n`` (k2(delta_max) for Luding's;
-the secant stiffness for another), ``mu(T, t)`` its softening factor times ``mu``. Parameters: the block of
+r"""The tangential contact of Luding, Manetsberger & Müllers 2005 (Luding 2005, eqs. 14, 16-24, footnote 5): a
+spring :math:`\xi` of stiffness :math:`k_t = \alpha k_2(\delta_{max})` (eq. 23) with viscous damping
+:math:`\gamma_t` (eq. 19), sticking below the Coulomb limit :math:`f_C = \mu(T, t) (f_n - f_{min})` (eqs. 14, 24)
+and sliding at it (eqs. 20-22); a sliding contact keeps no cohesion where ``brittle_sliding`` (footnote 5). A
+tangential sub-model of the contact laws (:mod:`dem.laws.contact.composition`): the stiffness is the normal
+sub-model's :math:`k_n` (:math:`k_2(\delta_{max})` for Luding's; the secant stiffness for another),
+:math:`\mu(T, t)` its softening factor times :math:`\mu`. Parameters: the block of
 :func:`dem.laws.contact.luding.params_of`.
 """
 
@@ -22,10 +23,11 @@ IN_LOOP = {**JIT, "inline": "always"}  # inlined into the engines' force loop
 
 @njit(**JIT)
 def relative_velocity(v_i, v_j, w_i, w_j, a_i, a_j, n):
-    """Tangential relative velocity ``v_t`` (eq. 17) and ``delta_dot`` at a contact.
+    r"""Tangential relative velocity :math:`v_t` (eq. 17) and :math:`\dot\delta` at a contact.
 
-    ``v_ij = v_i - v_j + a_i n x w_i + a_j n x w_j`` (Luding 2005, eq. 18) with ``n`` from j to i (eq. 3): the
-    velocity of i's surface relative to j's at the contact point. ``delta_dot = -n . v_ij`` (> 0 approaching). For
+    :math:`v_{ij} = v_i - v_j + a_i\, n \times \omega_i + a_j\, n \times \omega_j` (Luding 2005, eq. 18) with
+    :math:`n` from j to i (eq. 3): the velocity of i's surface relative to j's at the contact point.
+    :math:`\dot\delta = -n \cdot v_{ij}` (> 0 approaching). For
     a wall, pass its velocity as ``v_j``, ``w_j = (0, 0, 0)`` and ``a_j = 0``. 3-vectors are 3-tuples.
     Returns ``(v_t, delta_dot)``.
     """
@@ -39,18 +41,19 @@ def relative_velocity(v_i, v_j, w_i, w_j, a_i, a_j, n):
 
 @njit(**IN_LOOP)
 def tangential_force(xi, n, vt, f_n, f_min_now, k2_now, k1_factor_now, dt, params, is_wall):
-    """Tangential force on particle i and the new spring (Luding 2005, eqs. 14, 16, 19-24, footnote 5).
+    r"""Tangential force on particle i and the new spring (Luding 2005, eqs. 14, 16, 19-24, footnote 5).
 
     ``xi`` the spring of the previous step, ``n`` the unit normal (j to i), ``vt`` the tangential relative
     velocity (eq. 17, :func:`relative_velocity`), all 3-tuples; ``f_n`` the normal force (with its viscous part),
     ``f_min_now`` and ``k2_now`` from :func:`normal_force`, ``dt`` the time step, ``is_wall`` selects mu_wall.
 
-    ``f_C = mu(T, t) (f_n - f_min)``, ``mu(T, t) = (k1(T, t)/k1) mu`` (eqs. 14, 24); ``xi`` is projected into the
-    tangent plane (eq. 16); test force ``f_t0 = -k_t xi - gamma_t v_t``, ``k_t = alpha k2(delta_max)`` (eqs. 19,
-    23). Sticking, ``|f_t0| <= f_C``: ``f_t = f_t0``, ``xi' = xi + v_t dt`` (eq. 20). Sliding: ``f_t = f_C t``,
-    ``t = f_t0/|f_t0|`` (eq. 22), ``xi' = -(f_C t + gamma_t v_t)/k_t`` (eq. 21), and with ``brittle_sliding`` the
-    normal force loses its attraction, ``f_n >= 0`` (footnote 5). ``f_n - f_min <= 0``: no tangential force and
-    ``xi' = 0``.
+    :math:`f_C = \mu(T, t) (f_n - f_{min})`, :math:`\mu(T, t) = (k_1(T, t)/k_1) \mu` (eqs. 14, 24); :math:`\xi` is
+    projected into the tangent plane (eq. 16); test force :math:`f_{t0} = -k_t \xi - \gamma_t v_t`, :math:`k_t =
+    \alpha k_2(\delta_{max})` (eqs. 19, 23). Sticking, :math:`|f_{t0}| \le f_C`: :math:`f_t = f_{t0}`, :math:`\xi'
+    = \xi + v_t\, dt` (eq. 20). Sliding: :math:`f_t = f_C t`, :math:`t = f_{t0}/|f_{t0}|` (eq. 22), :math:`\xi' =
+    -(f_C t + \gamma_t v_t)/k_t` (eq. 21), and with ``brittle_sliding`` the normal force loses its attraction,
+    :math:`f_n \ge 0` (footnote 5). :math:`f_n - f_{min} \le 0`: no tangential force and
+    :math:`\xi' = 0`.
 
     Returns ``(f_t, xi_new, sliding, f_n)``: two 3-tuples, a bool, the (possibly raised) normal force.
     """

@@ -1,15 +1,16 @@
-"""Mindlin's tangential contact with Coulomb sliding (Mindlin 1949; Mindlin & Deresiewicz 1953, J. Appl. Mech. 20, 327;
-the "no-slip" form of Di Renzo & Di Maio 2004): a spring ``xi`` (the tangential displacement of the contact), turned
-into the current tangent plane keeping its length and advanced by the tangential surface velocity ``v_t dt``; the force
-``F_t = -k_t xi - eta_t v_t``; where ``|F_t|`` exceeds the friction limit the contact slides, ``F_t`` is scaled to the
-limit and the spring set to what gives that force, ``xi = -(F_t + eta_t v_t)/k_t`` (as LAMMPS's ``tangential
-mindlin``). The law that uses it gives the stiffness (Mindlin's ``k_t = 8 G* a`` on its contact radius), the damping
-and the limit (Coulomb's ``mu`` times the load the contact carries).
+r"""Mindlin's tangential contact with Coulomb sliding (Mindlin 1949; Mindlin & Deresiewicz 1953, J. Appl. Mech. 20, 327;
+the "no-slip" form of Di Renzo & Di Maio 2004): a spring :math:`\xi` (the tangential displacement of the contact),
+turned into the current tangent plane keeping its length and advanced by the tangential surface velocity :math:`v_t\,
+dt`; the force :math:`F_t = -k_t \xi - \eta_t v_t`; where :math:`|F_t|` exceeds the friction limit the contact
+slides, :math:`F_t` is scaled to the limit and the spring set to what gives that force, :math:`\xi = -(F_t + \eta_t
+v_t)/k_t` (as LAMMPS's ``tangential mindlin``). The law that uses it gives the stiffness (Mindlin's :math:`k_t = 8 G^*
+a` on its contact radius), the damping and the limit (Coulomb's :math:`\mu` times the load the contact carries).
 
-As a tangential sub-model of the contact laws (:mod:`dem.laws.contact.composition`): ``k_t = 8 G* a`` on the normal
-sub-model's contact radius a, ``G* = G/(2 (2 - nu))``, ``eta_t = tangential_damping * eta_n`` of the damping
-sub-model, and the limit ``mu soft max(L, 0)`` of the load L the contact carries (``F_n`` of a cohesionless contact;
-``F_el + 2 P_c`` with JKR's adhesion) and the normal sub-model's softening factor (1 for Hertz); ``mu_wall`` at a wall.
+As a tangential sub-model of the contact laws (:mod:`dem.laws.contact.composition`): :math:`k_t = 8 G^* a` on the
+normal sub-model's contact radius a, :math:`G^* = G/(2 (2 - \nu))`, :math:`\eta_t` the ``tangential_damping`` times
+:math:`\eta_n` of the damping sub-model, and the limit :math:`\mu\, s \max(L, 0)` of the load L the contact carries
+(:math:`F_n` of a cohesionless contact; :math:`F_{el} + 2 P_c` with JKR's adhesion) and the normal sub-model's
+softening factor s (1 for Hertz); ``mu_wall`` at a wall.
 """
 
 from __future__ import annotations
@@ -26,13 +27,13 @@ IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}  # inlined
 
 @njit(**IN_LOOP)
 def mindlin_force(xi, n, vt, k_t, eta_t, f_limit, dt):
-    """Mindlin's tangential force with Coulomb sliding: ``(F_t, xi_new)``, two 3-tuples (module docstring).
+    r"""Mindlin's tangential force with Coulomb sliding: ``(F_t, xi_new)``, two 3-tuples (module docstring).
 
     ``xi`` the spring of the previous step, ``n`` the unit normal, ``vt`` the tangential surface velocity of i
-    relative to j; ``k_t`` the stiffness, ``eta_t`` the damping, ``f_limit`` the largest tangential force (``mu
-    F_n``); ``dt`` the step. The spring is turned into the tangent plane keeping its length, advanced by ``vt dt``;
-    ``F_t = -k_t xi - eta_t vt``; beyond ``f_limit`` it slides: ``F_t`` scaled to ``f_limit``, ``xi = -(F_t + eta_t
-    vt)/k_t``."""
+    relative to j; ``k_t`` the stiffness, ``eta_t`` the damping, ``f_limit`` the largest tangential force
+    (:math:`\mu F_n`); ``dt`` the step. The spring is turned into the tangent plane keeping its length, advanced by
+    :math:`v_t\, dt`; :math:`F_t = -k_t \xi - \eta_t v_t`; beyond ``f_limit`` it slides: :math:`F_t` scaled to
+    ``f_limit``, :math:`\xi = -(F_t + \eta_t v_t)/k_t`."""
     n0, n1, n2 = n
     length2 = xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]
     xn = xi[0] * n0 + xi[1] * n1 + xi[2] * n2
@@ -62,7 +63,7 @@ SIZE = 4  # the block's length
 
 
 def params_of(material) -> np.ndarray:
-    """The block of this sub-model: ``(8 G*, eta_t/eta_n, mu, mu_wall)`` (Pa, -, -, -).
+    r"""The block of this sub-model: :math:`(8 G^*, \eta_t/\eta_n, \mu, \mu_{wall})` (Pa, -, -, -).
 
     Parameters
     ----------

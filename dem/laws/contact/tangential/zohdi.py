@@ -1,8 +1,8 @@
-"""The sliding friction of Zohdi 2014 (eqs. 5-6, 16-17): ``mu_d |F_con| t`` with ``t = (v_j - v_i)/|v_j - v_i|`` the
-whole relative velocity between particles, as the paper writes it (so friction also opposes the approach of two
+r"""The sliding friction of Zohdi 2014 (eqs. 5-6, 16-17): :math:`\mu_d |F_{con}|\, t` with :math:`t = (v_j -
+v_i)/|v_j - v_i|` the whole relative velocity between particles, as the paper writes it (so friction also opposes the approach of two
 particles, which is what makes their collisions inelastic: the law has no normal damping), only the tangential one
-at a wall (eq. 17). The direction is regularised, ``t = dv / sqrt(|dv|^2 + v_slip^2)``: a unit vector while sliding
-faster than ``v_slip``, proportional to the slip below it, so that the fixed-point map stays continuous where the
+at a wall (eq. 17). The direction is regularised, :math:`t = \Delta v/\sqrt{|\Delta v|^2 + v_{slip}^2}`: a unit
+vector while sliding faster than ``v_slip``, proportional to the slip below it, so that the fixed-point map stays continuous where the
 relative velocity passes through zero. The particles do not rotate (Sec. 2). A tangential sub-model of the contact
 laws (:mod:`dem.laws.contact.composition`): ``|F_con|`` is the load it is given. Parameters: the block of
 :func:`dem.laws.contact.zohdi.params_of`.
@@ -28,8 +28,8 @@ SPINS = False  # the particles do not rotate (Sec. 2)
 
 @njit(**IN_LOOP)
 def pair(at, col, hist_in, hist, contact, planar, f_n, load, k_n, a, eta, soft, dt, params):
-    """``(F_n, mu_d L u/sqrt(|u|^2 + v_slip^2))`` with ``u = -v_r = v_j - v_i`` (eqs. 5-6, regularised) and the
-    load L; no force where the contact's area ``a`` vanishes."""
+    r""":math:`(F_n, \mu_d L u/\sqrt{|u|^2 + v_{slip}^2})` with :math:`u = -v_r = v_j - v_i` (eqs. 5-6,
+    regularised) and the load L; no force where the contact's area ``a`` vanishes."""
     if a == 0.0:
         return f_n, 0.0, 0.0, 0.0
     vr = contact[3]
