@@ -13,7 +13,7 @@ time and the loop is the same code it would be written against one law. Its comp
 ``has_drag``, ``keeps_pair_constants``) are functions that return a constant, and the branches they rule out are
 dropped by the compiler.
 
-A contact is passed as one tuple, ``contact = (delta, d, n, vr, vn)``: the overlap (m, positive in contact), the
+A contact is passed as one tuple, ``contact``, of ``(delta, d, n, vr, vn)``: the overlap (m, positive in contact), the
 distance of the centres (of the particle's centre from the wall), the unit normal from j (the wall) to i, the
 relative surface velocity (m/s) and its normal part. The parameters are the law's blocks
 (:meth:`dem.laws.contact.composition.Law.params`), as a tuple of tuples in the force loop (:func:`params_tuple`).

@@ -29,15 +29,16 @@ every kernel ``numba.njit`` with ``inline="always"``):
   columns: an open contact is forgotten with one read, a closed one's other columns zeroed unread); ``STATE``, the
   ``state`` sub-model it reads particles' state from (None: none); ``time_steps(material, mass, inertia, radius,
   m_mean)`` -> ``(dt, stable)``;
-* ``damping``: ``pair(state, i, j, f_el, delta_dot, k_n, p)`` and ``wall(state, k, f_el, delta_dot, k_n, p)`` ->
-  ``(f_n, eta)``: the normal force with its viscous part and the viscous coefficient (kg/s); ``STATE``;
+* ``damping``: ``pair`` of ``(state, i, j, f_el, delta_dot, k_n, p)`` and ``wall`` of
+  ``(state, k, f_el, delta_dot, k_n, p)``, each -> ``(f_n, eta)``: the normal force with its viscous part and the viscous coefficient (kg/s); ``STATE``;
 * ``adhesion``: ``pair(at, col, hist_in, hist, contact, f_el, k_n, a, r_eff, ri, rj, p)`` and ``wall(at, col,
   hist_in, hist, contact, f_el, k_n, a, rk, p)`` -> ``(f_el, k_n, a, load)``: the normal force with the adhesion,
   and the load friction resists (without adhesion that load is ``f_n - f_min``); ``reach(at, col, hist)``, how far
   beyond touching the contact acts, and ``largest_reach(material, radius)``; ``NORMALS``, the normal sub-models it
   applies to;
-* ``tangential``: ``pair(at, col, hist_in, hist, contact, planar, f_n, load, k_n, a, eta, soft, dt, p)`` and
-  ``wall(at, col, hist_in, hist, contact, f_n, load, k_n, a, eta, soft, dt, p)`` -> ``(f_n, ft0, ft1, ft2)``; ``SPINS``
+* ``tangential``: ``pair`` of ``(at, col, hist_in, hist, contact, planar, f_n, load, k_n, a, eta, soft, dt, p)``
+  and ``wall`` of ``(at, col, hist_in, hist, contact, f_n, load, k_n, a, eta, soft, dt, p)``, each -> ``(f_n, ft0,
+  ft1, ft2)``; ``SPINS``
   (its forces make torques);
 * ``state``: ``PARTICLE_STATE``, ``initial_state(material, T, mass)``, ``reference_radius(material, radius, T)`` and
   ``update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform, p, t0, dt)`` (compiled, not

@@ -1,38 +1,41 @@
-"""The Hertz-Mindlin contact of elastic spheres: Hertz's normal force with a viscoelastic damping that gives a chosen
+r"""The Hertz-Mindlin contact of elastic spheres: Hertz's normal force with a viscoelastic damping that gives a chosen
 coefficient of restitution, Mindlin's tangential stiffness and Coulomb sliding -- the contact law of most DEM codes
 for dry, cohesionless grains: its material, the parameter block its sub-models read and its scene keys. The law is the
 composition (:data:`dem.laws.contact.CONTACT_LAWS`) of :mod:`dem.laws.contact.normal.hertz`,
 :mod:`dem.laws.contact.damping.tsuji`, :mod:`dem.laws.contact.tangential.mindlin` and
 :mod:`dem.laws.contact.state.mass`.
 
-Conventions as in every contact law here: ``n`` points from j to i, the overlap ``delta = a_i + a_j - |x_i - x_j|``
-is positive in contact, the forces are those on i. Two spheres of radii a_i, a_j and masses m_i, m_j of one material
-(Young's modulus E, Poisson's ratio nu) touch with ``R* = a_i a_j/(a_i + a_j)``, ``m* = m_i m_j/(m_i + m_j)``,
-``1/E* = 2 (1 - nu^2)/E`` and ``1/G* = 2 (2 - nu)/G``, ``G = E/(2 (1 + nu))``. A wall is a partner of infinite
-radius and mass made of the same material: ``R* = a_k``, ``m* = m_k``, the same E* and G* (as LAMMPS's ``fix
-wall/gran`` takes a wall).
+Conventions as in every contact law here: :math:`n` points from j to i, the overlap :math:`\delta = a_i + a_j - |x_i
+- x_j|` is positive in contact, the forces are those on i. Two spheres of radii :math:`a_i`, :math:`a_j` and masses
+:math:`m_i`, :math:`m_j` of one material (Young's modulus E, Poisson's ratio :math:`\nu`) touch with :math:`R^* = a_i
+a_j/(a_i + a_j)`, :math:`m^* = m_i m_j/(m_i + m_j)`, :math:`1/E^* = 2 (1 - \nu^2)/E` and :math:`1/G^* = 2 (2 -
+\nu)/G`, :math:`G = E/(2 (1 + \nu))`. A wall is a partner of infinite radius and mass made of the same material:
+:math:`R^* = a_k`, :math:`m^* = m_k`, the same :math:`E^*` and :math:`G^*` (as LAMMPS's ``fix wall/gran`` takes a
+wall).
 
-* **Normal** (Hertz 1882; Johnson, Contact Mechanics, 1985, Sec. 4.2): the contact radius ``a = sqrt(R*
-  delta)`` and ``F_el = 4/3 E* a delta = 4/3 E* sqrt(R*) delta^(3/2)``.
-* **Damping** (Tsuji, Tanaka & Ishida 1992, Powder Technol. 71, 239): ``F_d = eta_n d(delta)/dt`` with
-  ``eta_n = alpha sqrt(m* k_n)``, ``k_n = F_el/delta = 4/3 E* a``: the damping grows as ``delta^(1/4)``, so the
-  coefficient of restitution of a head-on collision does not depend on the impact speed. Antypov & Elliott 2011
-  (EPL 94, 50004) solved that collision exactly: ``e = exp(-pi b / sqrt(1 - b^2))``, ``b = alpha/sqrt(5)``, i.e.
-  ``alpha = sqrt(5) (-ln e)/sqrt(pi^2 + ln^2 e)`` (:func:`dem.laws.contact.damping.tsuji.damping_coefficient`): the material takes ``e`` itself.
-  (This is the damping of LAMMPS's ``damping coeff_restitution`` and of EDEM's Hertz-Mindlin, ``2 sqrt(5/6) beta
-  sqrt(m* S_n)`` with ``S_n = 2 E* a``.) The normal force ``F_n = F_el + F_d`` is not cut at zero: at the end of a
+* **Normal** (Hertz 1882; Johnson, Contact Mechanics, 1985, Sec. 4.2): the contact radius :math:`a = \sqrt{R^*
+  \delta}` and :math:`F_{el} = \frac{4}{3} E^* a \delta = \frac{4}{3} E^* \sqrt{R^*} \delta^{3/2}`.
+* **Damping** (Tsuji, Tanaka & Ishida 1992, Powder Technol. 71, 239): :math:`F_d = \eta_n\, d\delta/dt` with
+  :math:`\eta_n = \alpha \sqrt{m^* k_n}`, :math:`k_n = F_{el}/\delta = \frac{4}{3} E^* a`: the damping grows as
+  :math:`\delta^{1/4}`, so the coefficient of restitution of a head-on collision does not depend on the impact
+  speed. Antypov & Elliott 2011 (EPL 94, 50004) solved that collision exactly: :math:`e = \exp(-\pi b/\sqrt{1 -
+  b^2})`, :math:`b = \alpha/\sqrt{5}`, i.e. :math:`\alpha = \sqrt{5}\,(-\ln e)/\sqrt{\pi^2 + \ln^2 e}`
+  (:func:`dem.laws.contact.damping.tsuji.damping_coefficient`): the material takes ``e`` itself. (This is the damping
+  of LAMMPS's ``damping coeff_restitution`` and of EDEM's Hertz-Mindlin, :math:`2 \sqrt{5/6}\, \beta \sqrt{m^*
+  S_n}` with :math:`S_n = 2 E^* a`.) The normal force :math:`F_n = F_{el} + F_d` is not cut at zero: at the end of a
   damped contact it pulls briefly, as in Tsuji's model and in LAMMPS.
 * **Tangential** (Mindlin 1949; Mindlin & Deresiewicz 1953, J. Appl. Mech. 20, 327; the "no-slip" form of Di Renzo
-  & Di Maio 2004): a spring ``xi`` (the tangential displacement of the contact) of stiffness ``k_t = 8 G* a``, turned
-  into the current tangent plane keeping its length, advanced by the tangential surface velocity ``v_t dt``; the
-  force ``F_t = -k_t xi - eta_t v_t`` with ``eta_t = tangential_damping * eta_n`` (LAMMPS's ``x_gamma,t``). Coulomb:
-  where ``|F_t| > mu F_n`` (``mu_wall`` at a wall; no friction while F_n pulls) the contact slides, ``F_t`` is
-  scaled to ``mu F_n`` and the spring set to what gives that force, ``xi = -(F_t + eta_t v_t)/k_t`` (as LAMMPS's
-  ``tangential mindlin``).
+  & Di Maio 2004): a spring :math:`\xi` (the tangential displacement of the contact) of stiffness :math:`k_t = 8 G^*
+  a`, turned into the current tangent plane keeping its length, advanced by the tangential surface velocity
+  :math:`v_t\, dt`; the force :math:`F_t = -k_t \xi - \eta_t v_t` with :math:`\eta_t` the ``tangential_damping``
+  times :math:`\eta_n` (LAMMPS's ``x_gamma,t``). Coulomb: where :math:`|F_t| > \mu F_n` (``mu_wall`` at a wall; no
+  friction while :math:`F_n` pulls) the contact slides, :math:`F_t` is scaled to :math:`\mu F_n` and the spring set to
+  what gives that force, :math:`\xi = -(F_t + \eta_t v_t)/k_t` (as LAMMPS's ``tangential mindlin``).
 
-The time step (:func:`dem.laws.contact.normal.hertz.time_steps`): ``dt = "auto"`` is a tenth of the Rayleigh time ``T_R = pi a sqrt(rho/G)/(0.1631
-nu + 0.8766)`` of the smallest particle (the time a Rayleigh wave takes across it; LIGGGHTS's ``check/timestep/gran``
-warns above fractions of it); a Hertz contact of an impact speed of 1 m/s lasts several T_R.
+The time step (:func:`dem.laws.contact.normal.hertz.time_steps`): ``dt = "auto"`` is a tenth of the Rayleigh time
+:math:`T_R = \pi a \sqrt{\rho/G}/(0.1631 \nu + 0.8766)` of the smallest particle (the time a Rayleigh wave takes
+across it; LIGGGHTS's ``check/timestep/gran`` warns above fractions of it); a Hertz contact of an impact speed of 1 m/s
+lasts several :math:`T_R`.
 """
 
 from __future__ import annotations
@@ -51,9 +54,10 @@ _NONNEGATIVE = {"tangential_damping": "", "mu": "", "mu_wall": ""}
 
 @dataclass(frozen=True)
 class HertzMindlinMaterial:
-    """Material of the Hertz-Mindlin contact (SI units; module docstring): ``youngs_modulus`` E and
-    ``poisson_ratio`` nu of the particles (and of the walls); ``restitution``, the coefficient of restitution e of a
-    head-on collision (0 < e <= 1; 1: no damping); ``tangential_damping`` eta_t/eta_n; ``mu``, ``mu_wall`` the
+    r"""Material of the Hertz-Mindlin contact (SI units; module docstring): ``youngs_modulus`` E and
+    ``poisson_ratio`` :math:`\nu` of the particles (and of the walls); ``restitution``, the coefficient of restitution
+    e of a head-on collision (:math:`0 < e \le 1`; 1: no damping); ``tangential_damping`` :math:`\eta_t/\eta_n`;
+    ``mu``, ``mu_wall`` the
     friction coefficients between particles and with a wall; ``density``.
 
     Parameters
@@ -61,11 +65,11 @@ class HertzMindlinMaterial:
     youngs_modulus : float
         Young's modulus E of the particles and walls (Pa), > 0.
     poisson_ratio : float
-        Poisson's ratio nu, in ``(-1, 0.5)``.
+        Poisson's ratio :math:`\nu`, in ``(-1, 0.5)``.
     restitution : float
         Coefficient of restitution e of a head-on collision, in ``(0, 1]`` (1: no damping).
     tangential_damping : float
-        eta_t / eta_n, the tangential over the normal damping coefficient, >= 0.
+        :math:`\eta_t/\eta_n`, the tangential over the normal damping coefficient, >= 0.
     mu : float
         Particle-particle friction coefficient, >= 0.
     mu_wall : float
@@ -96,17 +100,18 @@ class HertzMindlinMaterial:
 
     @property
     def effective_modulus(self) -> float:
-        """E* of two particles of the material (and of a particle on a wall), ``E/(2 (1 - nu^2))``, Pa."""
+        r""":math:`E^*` of two particles of the material (and of a particle on a wall), :math:`E/(2 (1 - \nu^2))`,
+        Pa."""
         return effective_modulus(self)
 
     @property
     def shear_modulus(self) -> float:
-        """G = E/(2 (1 + nu)), Pa."""
+        r""":math:`G = E/(2 (1 + \nu))`, Pa."""
         return shear_modulus(self)
 
     @property
     def effective_shear_modulus(self) -> float:
-        """G* of two particles of the material, ``G/(2 (2 - nu))``, Pa."""
+        r""":math:`G^*` of two particles of the material, :math:`G/(2 (2 - \nu))`, Pa."""
         return effective_shear_modulus(self)
 
     def params(self) -> np.ndarray:
@@ -115,7 +120,7 @@ class HertzMindlinMaterial:
         return law_module(self.law).params(self)
 
     def rayleigh_time(self, radius: float) -> float:
-        """``T_R = pi a sqrt(rho/G)/(0.1631 nu + 0.8766)`` of a particle of radius ``a`` (s).
+        r""":math:`T_R = \pi a \sqrt{\rho/G}/(0.1631 \nu + 0.8766)` of a particle of radius ``a`` (s).
 
         Parameters
         ----------
@@ -131,7 +136,7 @@ class HertzMindlinMaterial:
 
 
 def check_poisson_ratio(material) -> None:
-    """Poisson's ratio of an isotropic elastic solid, ``-1 < nu < 0.5``.
+    r"""Poisson's ratio of an isotropic elastic solid, :math:`-1 < \nu < 0.5`.
 
     Parameters
     ----------
@@ -167,8 +172,8 @@ def check_restitution(material) -> None:
 
 
 def effective_modulus(material) -> float:
-    """E* of two particles of a material with ``youngs_modulus`` E and ``poisson_ratio`` nu (and of a particle on a
-    wall of it), ``E/(2 (1 - nu^2))``, Pa.
+    r""":math:`E^*` of two particles of a material with ``youngs_modulus`` E and ``poisson_ratio`` :math:`\nu` (and of
+    a particle on a wall of it), :math:`E/(2 (1 - \nu^2))`, Pa.
 
     Parameters
     ----------
@@ -184,7 +189,7 @@ def effective_modulus(material) -> float:
 
 
 def shear_modulus(material) -> float:
-    """G = E/(2 (1 + nu)) of a material with ``youngs_modulus`` E and ``poisson_ratio`` nu, Pa.
+    r""":math:`G = E/(2 (1 + \nu))` of a material with ``youngs_modulus`` E and ``poisson_ratio`` :math:`\nu`, Pa.
 
     Parameters
     ----------
@@ -200,7 +205,8 @@ def shear_modulus(material) -> float:
 
 
 def effective_shear_modulus(material) -> float:
-    """G* of two particles of a material with ``youngs_modulus`` E and ``poisson_ratio`` nu, ``G/(2 (2 - nu))``, Pa.
+    r""":math:`G^*` of two particles of a material with ``youngs_modulus`` E and ``poisson_ratio`` :math:`\nu`,
+    :math:`G/(2 (2 - \nu))`, Pa.
 
     Parameters
     ----------
@@ -216,7 +222,7 @@ def effective_shear_modulus(material) -> float:
 
 
 def rayleigh_time(material, radius: float) -> float:
-    """``T_R = pi a sqrt(rho/G)/(0.1631 nu + 0.8766)`` of a particle of radius ``a`` (s).
+    r""":math:`T_R = \pi a \sqrt{\rho/G}/(0.1631 \nu + 0.8766)` of a particle of radius ``a`` (s).
 
     Parameters
     ----------

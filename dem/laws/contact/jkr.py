@@ -1,34 +1,37 @@
-"""The adhesive contact of Johnson, Kendall & Roberts 1971 (Proc. R. Soc. Lond. A 324, 301): elastic spheres whose
+r"""The adhesive contact of Johnson, Kendall & Roberts 1971 (Proc. R. Soc. Lond. A 324, 301): elastic spheres whose
 surfaces stick with the work of adhesion w, with the damping and the Mindlin tangential contact of
 :mod:`dem.laws.contact.hertz_mindlin`: its material and scene keys. The law is the composition
 (:data:`dem.laws.contact.CONTACT_LAWS`) of Hertz's normal sub-model with the JKR adhesion
 (:mod:`dem.laws.contact.adhesion.jkr`), Tsuji's damping and Mindlin's tangential contact.
 
-Conventions, R*, m*, E* and G* (a wall: a partner of infinite radius and mass of the same material) as in
-:mod:`dem.laws.contact.hertz_mindlin`. ``w`` is the work of adhesion (J/m^2): the energy per unit area it takes to
-part the two surfaces, ``w = gamma_1 + gamma_2 - gamma_12`` (Johnson 1985's Delta gamma; twice the surface energy
-gamma of identical surfaces -- LAMMPS's ``jkr`` takes that gamma).
+Conventions, :math:`R^*`, :math:`m^*`, :math:`E^*` and :math:`G^*` (a wall: a partner of infinite radius and mass of
+the same material) as in :mod:`dem.laws.contact.hertz_mindlin`. ``w`` is the work of adhesion (J/m^2): the energy per
+unit area it takes to part the two surfaces, :math:`w = \gamma_1 + \gamma_2 - \gamma_{12}` (Johnson 1985's
+:math:`\Delta\gamma`; twice the surface energy :math:`\gamma` of identical surfaces -- LAMMPS's ``jkr`` takes that
+:math:`\gamma`).
 
-* **Normal** (Johnson, Contact Mechanics, 1985, Sec. 5.5, with P_1 = 4 E* a^3/(3 R*)): at contact
-  radius a, the overlap ``delta = a^2/R* - sqrt(2 pi w a/E*)`` and the force ``F_el = 4 E* a^3/(3 R*) - sqrt(8 pi
-  w E* a^3)``. At ``F_el = 0``, ``a_0^3 = 9 pi w R*^2/(2 E*)``. The largest pull, ``-3/2 pi w R*`` (the pull-off
-  force of a load-controlled test), is reached at ``delta = -a^2/(3 R*)``, ``a^3 = 9 pi w R*^2/(8 E*)``.
-  :func:`dem.laws.contact.adhesion.jkr.contact_radius` inverts the overlap in closed form: with ``s = sqrt(a)`` and ``c = sqrt(2 pi w/E*)`` it
-  is the quartic ``s^4 - c R* s - delta R* = 0``, solved by Ferrari's method through its resolvent cubic ``y^3 +
-  delta R* y - c^2 R*^2/8 = 0`` (one real root for every delta above the break, written without cancellation).
-* **Contact and break**: two surfaces that touch (delta reaches 0) jump into contact (``F_el = -4/3 pi w R*`` at
-  delta = 0) and then stay in contact when pulled apart, beyond touching, down to ``delta_c = -3 a_c^2/R* = -3/4
-  (pi^2 w^2 R*/E*^2)^(1/3)``, ``a_c = a_0/6^(2/3)``, where d delta/da = 0: the end of the stable branch under
-  displacement control (Johnson 1985, Sec. 5.5; Thornton & Ning 1998, Powder Technol. 99, 154), with ``F_el = -5/6
-  pi w R*``; there the contact breaks and the force drops to zero. The pair's history keeps the pull-off distance
-  ``-delta_c`` (0 until the pair first touches), the engines' ``reach``: the contact acts while the surfaces are
-  closer than that.
-* **Damping**: ``eta_n = alpha sqrt(m* k_n)`` with ``k_n = 4/3 E* a`` at the JKR contact radius a, alpha from the
-  restitution coefficient as in Hertz-Mindlin (:func:`dem.laws.contact.damping.tsuji.damping_coefficient`): where
-  adhesion is weak against the impact (``w -> 0``) a head-on collision rebounds with that e; slow impacts stick.
-* **Tangential**: Mindlin's spring ``k_t = 8 G* a`` on the JKR contact radius, damping ``eta_t``, Coulomb sliding at
-  ``mu (F_el + 2 P_c)``, ``P_c = 3/2 pi w R*`` (Thornton & Yin 1991, Powder Technol. 65, 153: adhesion adds to the
-  load that friction resists; LAMMPS's critical force for ``jkr``).
+* **Normal** (Johnson, Contact Mechanics, 1985, Sec. 5.5, with :math:`P_1 = 4 E^* a^3/(3 R^*)`): at contact radius
+  a, the overlap :math:`\delta = a^2/R^* - \sqrt{2 \pi w a/E^*}` and the force :math:`F_{el} = 4 E^* a^3/(3 R^*) -
+  \sqrt{8 \pi w E^* a^3}`. At :math:`F_{el} = 0`, :math:`a_0^3 = 9 \pi w {R^*}^2/(2 E^*)`. The largest pull,
+  :math:`-\frac{3}{2} \pi w R^*` (the pull-off force of a load-controlled test), is reached at :math:`\delta =
+  -a^2/(3 R^*)`, :math:`a^3 = 9 \pi w {R^*}^2/(8 E^*)`. :func:`dem.laws.contact.adhesion.jkr.contact_radius` inverts
+  the overlap in closed form: with :math:`s = \sqrt{a}` and :math:`c = \sqrt{2 \pi w/E^*}` it is the quartic
+  :math:`s^4 - c R^* s - \delta R^* = 0`, solved by Ferrari's method through its resolvent cubic :math:`y^3 + \delta
+  R^* y - c^2 {R^*}^2/8 = 0` (one real root for every :math:`\delta` above the break, written without cancellation).
+* **Contact and break**: two surfaces that touch (:math:`\delta` reaches 0) jump into contact (:math:`F_{el} =
+  -\frac{4}{3} \pi w R^*` at :math:`\delta = 0`) and then stay in contact when pulled apart, beyond touching, down
+  to :math:`\delta_c = -3 a_c^2/R^* = -\frac{3}{4} (\pi^2 w^2 R^*/{E^*}^2)^{1/3}`, :math:`a_c = a_0/6^{2/3}`, where
+  :math:`d\delta/da = 0`: the end of the stable branch under displacement control (Johnson 1985, Sec. 5.5; Thornton
+  & Ning 1998, Powder Technol. 99, 154), with :math:`F_{el} = -\frac{5}{6} \pi w R^*`; there the contact breaks and
+  the force drops to zero. The pair's history keeps the pull-off distance :math:`-\delta_c` (0 until the pair first
+  touches), the engines' ``reach``: the contact acts while the surfaces are closer than that.
+* **Damping**: :math:`\eta_n = \alpha \sqrt{m^* k_n}` with :math:`k_n = \frac{4}{3} E^* a` at the JKR contact
+  radius a, :math:`\alpha` from the restitution coefficient as in Hertz-Mindlin
+  (:func:`dem.laws.contact.damping.tsuji.damping_coefficient`): where adhesion is weak against the impact
+  (:math:`w \to 0`) a head-on collision rebounds with that e; slow impacts stick.
+* **Tangential**: Mindlin's spring :math:`k_t = 8 G^* a` on the JKR contact radius, damping :math:`\eta_t`, Coulomb
+  sliding at :math:`\mu (F_{el} + 2 P_c)`, :math:`P_c = \frac{3}{2} \pi w R^*` (Thornton & Yin 1991, Powder
+  Technol. 65, 153: adhesion adds to the load that friction resists; LAMMPS's critical force for ``jkr``).
 """
 
 from __future__ import annotations
@@ -44,7 +47,7 @@ from dem.laws.contact.hertz_mindlin import HertzMindlinMaterial
 
 @dataclass(frozen=True)
 class JKRMaterial(HertzMindlinMaterial):
-    """Material of the JKR contact: that of Hertz-Mindlin
+    r"""Material of the JKR contact: that of Hertz-Mindlin
     (:class:`~dem.laws.contact.hertz_mindlin.HertzMindlinMaterial`) and ``work_of_adhesion`` w > 0 (J/m^2; twice the
     surface energy of identical surfaces). ``restitution`` is that of a collision whose adhesion is negligible.
 
@@ -53,11 +56,11 @@ class JKRMaterial(HertzMindlinMaterial):
     youngs_modulus : float
         Young's modulus E of the particles and walls (Pa), > 0.
     poisson_ratio : float
-        Poisson's ratio nu, in ``(-1, 0.5)``.
+        Poisson's ratio :math:`\nu`, in ``(-1, 0.5)``.
     restitution : float
         Coefficient of restitution e of a head-on collision with negligible adhesion, in ``(0, 1]``.
     tangential_damping : float
-        eta_t / eta_n, the tangential over the normal damping coefficient, >= 0.
+        :math:`\eta_t/\eta_n`, the tangential over the normal damping coefficient, >= 0.
     mu : float
         Particle-particle friction coefficient, >= 0.
     mu_wall : float
@@ -84,7 +87,8 @@ class JKRMaterial(HertzMindlinMaterial):
                              f"adhesion use law = \"hertz_mindlin\")")
 
     def pulloff_distance(self, r_eff):
-        """How far beyond touching a contact of effective radius ``R*`` breaks, ``3/4 (pi^2 w^2 R*/E*^2)^(1/3)`` (m).
+        r"""How far beyond touching a contact of effective radius ``R*`` breaks, :math:`\frac{3}{4} (\pi^2 w^2
+        R^*/{E^*}^2)^{1/3}` (m).
 
         Parameters
         ----------

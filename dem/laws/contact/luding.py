@@ -50,16 +50,17 @@ _POSITIVE = {"k1": "N/m", "k2": "N/m", "T_var": "K", "t0": "s", "density": "kg/m
 
 @dataclass(frozen=True)
 class LudingMaterial:
-    """Material of the Luding 2005 contact law (SI units; temperatures in °C or K, only differences matter).
+    r"""Material of the Luding 2005 contact law (SI units; temperatures in °C or K, only differences matter).
 
     ``k1`` loading stiffness and ``kc`` cohesion stiffness in the cold limit, ``k2`` the largest un/reloading
-    stiffness (eq. 4, 7); ``kt_ratio`` alpha = k_t/k2(delta_max) (eq. 23); ``gamma_n`` gamma_0 (eq. 5) and
-    ``gamma_t`` (eq. 19) viscous damping; ``mu``, ``mu_wall`` friction coefficients in the cold limit (eq. 14, 24);
-    ``T_melt``, ``T_var`` of k1(T) (eq. 10); ``expansion`` delta a_T (eq. 9); ``fluid_overlap`` phi =
-    delta_fluid/a (Sec. 3.1.3); ``t0`` the relaxation time of k1(T, t) (eq. 11-12); ``brittle_sliding``: a sliding
-    contact keeps no cohesion, f_n >= 0 (footnote 5); ``density`` of the particles; ``wall_sintering``: a
-    particle-wall contact softens and sinters with the particle's k1(T, t) like a pair (true), or keeps the
-    cold-limit k1 of a wall that does not melt (false; Luding 2005 gives the walls no law beyond mu_w).
+    stiffness (eq. 4, 7); ``kt_ratio`` :math:`\alpha = k_t/k_2(\delta_{max})` (eq. 23); ``gamma_n``
+    :math:`\gamma_0` (eq. 5) and ``gamma_t`` (eq. 19) viscous damping; ``mu``, ``mu_wall`` friction coefficients in
+    the cold limit (eq. 14, 24); ``T_melt``, ``T_var`` of :math:`k_1(T)` (eq. 10); ``expansion`` :math:`\delta a_T`
+    (eq. 9); ``fluid_overlap`` :math:`\phi = \delta_{fluid}/a` (Sec. 3.1.3); ``t0`` the relaxation time of
+    :math:`k_1(T, t)` (eq. 11-12); ``brittle_sliding``: a sliding contact keeps no cohesion, :math:`f_n \ge 0`
+    (footnote 5); ``density`` of the particles; ``wall_sintering``: a particle-wall contact softens and sinters with
+    the particle's :math:`k_1(T, t)` like a pair (true), or keeps the cold-limit :math:`k_1` of a wall that does not
+    melt (false; Luding 2005 gives the walls no law beyond :math:`\mu_w`).
 
     Parameters
     ----------
@@ -70,9 +71,9 @@ class LudingMaterial:
     kc : float
         Cohesion stiffness in the cold limit (N/m), >= 0.
     kt_ratio : float
-        alpha = k_t / k2(delta_max), the tangential stiffness ratio (eq. 23), >= 0.
+        :math:`\alpha = k_t/k_2(\delta_{max})`, the tangential stiffness ratio (eq. 23), >= 0.
     gamma_n : float
-        Normal viscous damping gamma_0 (kg/s), >= 0 (eq. 5).
+        Normal viscous damping :math:`\gamma_0` (kg/s), >= 0 (eq. 5).
     gamma_t : float
         Tangential viscous damping (kg/s), >= 0 (eq. 19).
     mu : float
@@ -84,9 +85,9 @@ class LudingMaterial:
     T_var : float
         Width of the melting transition of k1(T) (K), > 0 (eq. 10).
     expansion : float
-        Thermal expansion coefficient delta a_T (1/K), >= 0 (eq. 9).
+        Thermal expansion coefficient :math:`\delta a_T` (1/K), >= 0 (eq. 9).
     fluid_overlap : float
-        phi = delta_fluid / a, in ``(0, 1)`` (Sec. 3.1.3).
+        :math:`\phi = \delta_{fluid}/a`, in ``(0, 1)`` (Sec. 3.1.3).
     t0 : float
         Relaxation time of k1(T, t) (s), > 0 (eqs. 11-12).
     brittle_sliding : bool

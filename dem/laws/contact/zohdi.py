@@ -1,4 +1,4 @@
-"""The contact material of Zohdi 2014 (eqs. 2-21 and Sec. 7) and the parameters of its implicit stepping (eqs.
+r"""The contact material of Zohdi 2014 (eqs. 2-21 and Sec. 7) and the parameters of its implicit stepping (eqs.
 22-30, 45-49).
 
 :class:`ZohdiMaterial` holds the material in SI units, named by the paper's symbols; :meth:`ZohdiMaterial.params`
@@ -9,31 +9,33 @@ packs it into the float64 array the Zohdi sub-models take (indices ``Z_*``). The
 (:mod:`dem.laws.contact.drag.zohdi`, eq. 20). The adaptive trapezoidal fixed-point scheme the paper steps it with
 is the staggered engine's (:mod:`dem.engines.staggered`, its parameters :class:`dem.scene.staggered.ZohdiStepping`).
 
-Conventions (Zohdi 2014, eqs. 3-4): ``n_ij = (r_j - r_i)/|r_j - r_i|`` points from i to j (the engines' ``n`` is the
-opposite, from j to i); the strain ``E_ij = (|r_i - r_j| - (R_i + R_j))/(R_i + R_j)`` is negative in contact; the
-contact force on i is ``-K_p |E|^p_p A_ij n_ij`` (it pushes i away from j), the bond force ``+K_b |E|^p_b A_ij n_ij``
-pulls it back. The particles do not rotate (Sec. 2: "the effects of their rotation ... unimportant").
+Conventions (Zohdi 2014, eqs. 3-4): :math:`n_{ij} = (r_j - r_i)/|r_j - r_i|` points from i to j (the engines'
+:math:`n` is the opposite, from j to i); the strain :math:`E_{ij} = (|r_i - r_j| - (R_i + R_j))/(R_i + R_j)` is
+negative in contact; the contact force on i is :math:`-K_p |E|^{p_p} A_{ij} n_{ij}` (it pushes i away from j), the
+bond force :math:`+K_b |E|^{p_b} A_{ij} n_{ij}` pulls it back. The particles do not rotate (Sec. 2: "the effects of
+their rotation ... unimportant").
 
-A wall is the plane ``n_w . x = q_w`` (normal into the packing); its contact force on particle k is ``K_w E^p_w A_k
-n_w`` with ``E = (R_k - dist)/R_k`` (eq. 14: the overlap over the radius, as a pair's strain is its overlap over R_i +
-R_j) and ``A_k = pi (R_k^2 - dist^2)`` the circle the plane cuts from the sphere (the lens of eqs. 7-12 with the plane
-for the second particle).
+A wall is the plane :math:`n_w \cdot x = q_w` (normal into the packing); its contact force on particle k is
+:math:`K_w E^{p_w} A_k n_w` with :math:`E = (R_k - \mathrm{dist})/R_k` (eq. 14: the overlap over the radius, as a
+pair's strain is its overlap over :math:`R_i + R_j`) and :math:`A_k = \pi (R_k^2 - \mathrm{dist}^2)` the circle the
+plane cuts from the sphere (the lens of eqs. 7-12 with the plane for the second particle).
 
-Friction (eqs. 5-6): ``mu_d |F_con| t`` with ``t = (v_j - v_i)/|v_j - v_i|`` the whole relative velocity, as the
-paper writes it (so friction also opposes the approach of two particles, which is what makes their collisions
-inelastic: the law has no normal damping). At a wall only the tangential velocity counts (eq. 17). The direction is
-regularised, ``t = dv / sqrt(|dv|^2 + v_slip^2)``: a unit vector while sliding faster than ``v_slip``, proportional
-to the slip below it, so that the fixed-point map stays continuous where the relative velocity passes through zero.
+Friction (eqs. 5-6): :math:`\mu_d |F_{con}|\, t` with :math:`t = (v_j - v_i)/|v_j - v_i|` the whole relative
+velocity, as the paper writes it (so friction also opposes the approach of two particles, which is what makes their
+collisions inelastic: the law has no normal damping). At a wall only the tangential velocity counts (eq. 17). The
+direction is regularised, :math:`t = \Delta v/\sqrt{|\Delta v|^2 + v_{slip}^2}`: a unit vector while sliding faster
+than ``v_slip``, proportional to the slip below it, so that the fixed-point map stays continuous where the relative
+velocity passes through zero.
 
-Bonds (eqs. 18-19): a pair whose strain reaches ``E*`` is bonded from the next step on (the flag is the pair's
+Bonds (eqs. 18-19): a pair whose strain reaches :math:`E^*` is bonded from the next step on (the flag is the pair's
 history, committed when a step is accepted) and stays bonded while it touches. Within a step the flags are fixed: a
-bond switched on between two iterates makes the force jump by ``K_b E*^p_b A``, and the fixed-point iteration then
-stalls at the size of that jump instead of converging.
+bond switched on between two iterates makes the force jump by :math:`K_b {E^*}^{p_b} A`, and the fixed-point
+iteration then stalls at the size of that jump instead of converging.
 
-Units (Sec. 7 states them: "K_po = 10^7 N/m^2"): the contact force ``K_p |E|^p_p A_c`` is in newtons with the
-contact area ``A_c`` in m^2 and the strain ``E`` dimensionless, so ``K_p``, ``K_w`` and ``K_b`` are in N/m^2 (Pa).
-Temperatures are absolute (K): the softening ``K = max(K_0 (1 - theta/theta*), K_lim)`` of Sec. 7 needs theta = 0
-to mean absolute zero.
+Units (Sec. 7 states them: "K_po = 10^7 N/m^2"): the contact force :math:`K_p |E|^{p_p} A_c` is in newtons with the
+contact area :math:`A_c` in m^2 and the strain :math:`E` dimensionless, so ``K_p``, ``K_w`` and ``K_b`` are in N/m^2
+(Pa). Temperatures are absolute (K): the softening :math:`K = \max(K_0 (1 - \theta/\theta^*), K_{lim})` of Sec. 7
+needs :math:`\theta = 0` to mean absolute zero.
 """
 
 from __future__ import annotations
@@ -68,42 +70,43 @@ _NONNEGATIVE = {"K_p_lim": "N/m^2", "K_w_lim": "N/m^2", "K_b": "N/m^2", "E_star"
 
 @dataclass(frozen=True)
 class ZohdiMaterial:
-    """The contact material of Zohdi 2014 (paper's symbols; SI units; module docstring).
+    r"""The contact material of Zohdi 2014 (paper's symbols; SI units; module docstring).
 
-    Normal contact ``K_p |E_ij|^p_p A_ij`` (eqs. 2-12, ``E_ij = (|r_i - r_j| - (R_i + R_j)) / (R_i + R_j)``, the lens
-    area ``A_ij = pi (R_i^2 - L_i^2)``); wall contact ``K_w |E_iw|^p_w A_i`` (eqs. 13-15, ``E_iw`` the overlap over
-    the radius, ``A_i`` the circle the wall cuts from the sphere); thermal softening ``K = max(K_0 (1 -
-    theta/theta*), K_lim)`` (Sec. 7; for a pair, theta is the mean of the two); an adhesive bond ``K_b |E_ij|^p_b
-    A_ij`` (eq. 19), activated once ``|E_ij| >= E_star`` and kept while the particles touch; sliding friction
-    ``mu_d |F_con|`` against the relative velocity (eqs. 5-6; against the tangential one at a wall, eqs. 16-17),
-    its direction regularised below ``v_slip``; drag ``-c_env 6 pi R v`` (eq. 20, Sec. 7); ``density``.
+    Normal contact :math:`K_p |E_{ij}|^{p_p} A_{ij}` (eqs. 2-12, :math:`E_{ij} = (|r_i - r_j| - (R_i + R_j))/(R_i +
+    R_j)`, the lens area :math:`A_{ij} = \pi (R_i^2 - L_i^2)`); wall contact :math:`K_w |E_{iw}|^{p_w} A_i` (eqs.
+    13-15, :math:`E_{iw}` the overlap over the radius, :math:`A_i` the circle the wall cuts from the sphere); thermal
+    softening :math:`K = \max(K_0 (1 - \theta/\theta^*), K_{lim})` (Sec. 7; for a pair, :math:`\theta` is the mean
+    of the two); an adhesive bond :math:`K_b |E_{ij}|^{p_b} A_{ij}` (eq. 19), activated once :math:`|E_{ij}| \ge
+    E^*` and kept while the particles touch; sliding friction :math:`\mu_d |F_{con}|` against the relative velocity
+    (eqs. 5-6; against the tangential one at a wall, eqs. 16-17), its direction regularised below ``v_slip``; drag
+    :math:`-c_{env}^o\, 6 \pi R v` (eq. 20, Sec. 7); ``density``.
 
     Parameters
     ----------
     K_p : float
-        K_p0, the particle-particle contact stiffness when cold (N/m^2), > 0 (eq. 2).
+        :math:`K_{p0}`, the particle-particle contact stiffness when cold (N/m^2), > 0 (eq. 2).
     p_p : float
         The exponent of the particle contact law, > 0 (eq. 2).
     K_p_lim : float
-        K_p^lim, the softened floor of K_p (N/m^2), in ``[0, K_p]`` (Sec. 7).
+        :math:`K_p^{lim}`, the softened floor of ``K_p`` (N/m^2), in ``[0, K_p]`` (Sec. 7).
     K_w : float
-        K_w0, the particle-wall contact stiffness when cold (N/m^2), > 0 (eq. 13).
+        :math:`K_{w0}`, the particle-wall contact stiffness when cold (N/m^2), > 0 (eq. 13).
     p_w : float
         The exponent of the wall contact law, > 0 (eq. 13).
     K_w_lim : float
-        K_w^lim, the softened floor of K_w (N/m^2), in ``[0, K_w]`` (Sec. 7).
+        :math:`K_w^{lim}`, the softened floor of ``K_w`` (N/m^2), in ``[0, K_w]`` (Sec. 7).
     theta_star : float
-        theta*, the softening temperature (K, absolute), > 0 (Sec. 7).
+        :math:`\theta^*`, the softening temperature (K, absolute), > 0 (Sec. 7).
     K_b : float
         The bond stiffness (N/m^2), >= 0 (eq. 19).
     p_b : float
         The exponent of the bond law, > 0 (eq. 19).
     E_star : float
-        E*, the strain magnitude that activates a bond, >= 0 (eqs. 18-19).
+        :math:`E^*`, the strain magnitude that activates a bond, >= 0 (eqs. 18-19).
     mu_d : float
         The dynamic friction coefficient of particles and walls, >= 0 (eqs. 5, 16).
     c_env : float
-        c_env^o of the drag ``c_env = c_env^o 6 pi R`` (kg/(m s)), >= 0 (eq. 20, Sec. 7).
+        :math:`c_{env}^o` of the drag :math:`c_{env} = c_{env}^o\, 6 \pi R` (kg/(m s)), >= 0 (eq. 20, Sec. 7).
     v_slip : float
         The regularisation speed of the friction direction (m/s), > 0.
     density : float
@@ -144,14 +147,15 @@ class ZohdiMaterial:
         return params_of(self)
 
     def stiffness(self, theta, wall: bool = False):
-        """``max(K_0 (1 - theta/theta*), K_lim)`` (Sec. 7), N/m^2.
+        r""":math:`\max(K_0 (1 - \theta/\theta^*), K_{lim})` (Sec. 7), N/m^2.
 
         Parameters
         ----------
         theta : float or array_like
             Temperatures (K, absolute); for a pair the mean of the two.
         wall : bool
-            Whether the wall's stiffness (K_w, K_w^lim) is wanted rather than the particles' (K_p, K_p^lim).
+            Whether the wall's stiffness (``K_w``, ``K_w_lim``) is wanted rather than the particles' (``K_p``,
+            ``K_p_lim``).
 
         Returns
         -------
