@@ -322,7 +322,6 @@ kappa : float
 ASCII_FORMULAS_LEFT = {
     "dem.cli.contact": 3,
     "dem.engines": 38,
-    "dem.laws.contact": 35,
     "dem.network": 44,
     "dem.scene.packing_files": 1,
 }

@@ -1,9 +1,9 @@
-"""The hysteretic sintering normal force of Luding, Manetsberger & Müllers 2005 (Luding 2005, eqs. 4-15, Figs. 2, 3,
+r"""The hysteretic sintering normal force of Luding, Manetsberger & Müllers 2005 (Luding 2005, eqs. 4-15, Figs. 2, 3,
 5), a normal sub-model of the contact laws (:mod:`dem.laws.contact.composition`), and the time step it needs (eq. 6).
 
-Conventions (Sec. 3.1): the unit normal ``n`` points from particle j to particle i (eq. 3), the overlap ``delta = a_i
-+ a_j - |r_i - r_j|`` is positive in contact, ``delta_dot = d delta/dt`` is positive while the particles approach,
-and the force is that **on particle i**. For a wall contact the wall plays j (no radius; the particle's k1(T, t), or
+Conventions (Sec. 3.1): the unit normal :math:`n` points from particle j to particle i (eq. 3), the overlap
+:math:`\delta = a_i + a_j - |r_i - r_j|` is positive in contact, :math:`\dot\delta = d\delta/dt` is positive while
+the particles approach, and the force is that **on particle i**. For a wall contact the wall plays j (no radius; the particle's k1(T, t), or
 with ``wall_sintering`` off the cold-limit k1).
 
 Stiffness history is carried as the dimensionless factor ``s = k1(T, t)/k1`` (eqs. 10-12), a property of each
@@ -30,16 +30,17 @@ from dem.laws.contact.damping import luding as damping
 from dem.laws.contact.luding import P_FLUID_OVERLAP, P_GAMMA_N, P_K1, P_K2, P_KC, P_WALL_SINTERING, LudingMaterial
 
 def time_step(k2: float, gamma_n: float, m_min: float) -> float:
-    """``t_MD = pi/(50 omega)``, ``omega = sqrt(k2/m12 - eta0^2)``, ``eta0 = gamma_0/(2 m12)`` (Luding 2005,
-    eq. 6 and below) for the smallest reduced mass ``m_min = m12`` (kg) of any contact; k2 is the largest
-    stiffness. Overcritical damping (omega^2 <= 0) is refused.
+    r""":math:`t_{MD} = \pi/(50 \omega)`, :math:`\omega = \sqrt{k_2/m_{12} - \eta_0^2}`, :math:`\eta_0 =
+    \gamma_0/(2 m_{12})` (Luding 2005, eq. 6 and below) for the smallest reduced mass ``m_min`` :math:`= m_{12}`
+    (kg) of any contact; :math:`k_2` is the largest stiffness. Overcritical damping (:math:`\omega^2 \le 0`) is
+    refused.
 
     Parameters
     ----------
     k2 : float
         The largest stiffness (N/m).
     gamma_n : float
-        Normal viscous damping gamma_0 (kg/s).
+        Normal viscous damping :math:`\gamma_0` (kg/s).
     m_min : float
         The smallest reduced mass of any contact (kg), > 0.
 
@@ -67,14 +68,14 @@ def time_step(k2: float, gamma_n: float, m_min: float) -> float:
 
 def time_steps(material: LudingMaterial, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray,
                m_mean: float) -> tuple[float, float]:
-    """``(t_MD, stable)``.
+    r"""``(t_MD, stable)``.
 
-    ``t_MD = pi/(50 omega)`` is the "typical time-step" of Luding 2005 (eq. 6 and below, :func:`time_step`) for a
-    contact of two particles of the mean mass ``m_mean``. The lightest pair of a polydisperse sample vibrates faster:
-    with Table 1's radii (a0 +- 50 %) its contact still takes 25 steps per half period. ``stable`` is the largest
-    velocity-Verlet step that stays stable for the stiffest contact, ``2/(omega_max + eta)``: the lightest pair, with
-    the normal stiffness k2 or the tangential spring acting with rotation (``alpha k2 (1 + m a^2/I)``), whichever is
-    stiffer, and the viscous rate ``eta = gamma_n/(2 m12)``.
+    :math:`t_{MD} = \pi/(50 \omega)` is the "typical time-step" of Luding 2005 (eq. 6 and below, :func:`time_step`)
+    for a contact of two particles of the mean mass ``m_mean``. The lightest pair of a polydisperse sample vibrates
+    faster: with Table 1's radii (a0 +- 50 %) its contact still takes 25 steps per half period. ``stable`` is the
+    largest velocity-Verlet step that stays stable for the stiffest contact, :math:`2/(\omega_{max} + \eta)`: the
+    lightest pair, with the normal stiffness :math:`k_2` or the tangential spring acting with rotation (:math:`\alpha
+    k_2 (1 + m a^2/I)`), whichever is stiffer, and the viscous rate :math:`\eta = \gamma_n/(2 m_{12})`.
 
     Parameters
     ----------
@@ -122,7 +123,8 @@ def pair_delta_fluid(a_i, a_j, fluid_overlap):
 # ------------------------------------------------------------------------------------------ normal history
 @njit(**JIT)
 def delta_max_fluid(delta_fluid, params):
-    """``delta_max^fluid = k2 delta_fluid/(k2 - k1)`` (Luding 2005, text above eq. 7; k1 the cold limit)."""
+    r""":math:`\delta_{max}^{fluid} = k_2 \delta_{fluid}/(k_2 - k_1)` (Luding 2005, text above eq. 7; :math:`k_1` the
+    cold limit)."""
     k1 = params[P_K1]
     k2 = params[P_K2]
     return k2 * delta_fluid / (k2 - k1)
@@ -130,8 +132,8 @@ def delta_max_fluid(delta_fluid, params):
 
 @njit(**IN_LOOP)
 def k2_of_delta_max(delta_max, delta_fluid, params):
-    """``k2(delta_max)`` (Luding 2005, eq. 7): ``k1 + (k2 - k1) delta_max/delta_max^fluid`` below the fluid
-    limit, ``k2`` at and above it."""
+    r""":math:`k_2(\delta_{max})` (Luding 2005, eq. 7): :math:`k_1 + (k_2 - k_1) \delta_{max}/\delta_{max}^{fluid}`
+    below the fluid limit, :math:`k_2` at and above it."""
     k1 = params[P_K1]
     k2 = params[P_K2]
     x = (k2 - k1) * delta_max  # delta_max >= delta_max^fluid  <=>  x >= k2 delta_fluid (one division, none if k1 = k2)
@@ -148,20 +150,21 @@ def _plastic_overlap(delta_max, k1_factor_now, delta_fluid, params):
 
 @njit(**JIT)
 def delta_0(delta_max, k1_factor_now, delta_fluid, params):
-    """Force-free overlap ``delta_0 = (1 - k1(T, t)/k2(delta_max)) delta_max`` (Luding 2005, eq. 4 and below),
-    never beyond ``delta_fluid`` (Sec. 3.1.3: there the contact is on the fluid branch)."""
+    r"""Force-free overlap :math:`\delta_0 = (1 - k_1(T, t)/k_2(\delta_{max})) \delta_{max}` (Luding 2005, eq. 4 and
+    below), never beyond :math:`\delta_{fluid}` (Sec. 3.1.3: there the contact is on the fluid branch)."""
     return min(_plastic_overlap(delta_max, k1_factor_now, delta_fluid, params), delta_fluid)
 
 
 @njit(**IN_LOOP)
 def delta_max_for_delta_0(d0, k1_factor_now, delta_fluid, params):
-    """The ``delta_max`` whose force-free overlap (before the fluid cap) is ``d0``: the inverse of
-    ``(1 - s k1/k2(x)) x = d0`` with k2(x) of eq. (7), ``s = k1(T, t)/k1`` (Fig. 5 right: cooling keeps delta_0;
-    the tension branch: reloading starts on a new k2 line).
+    r"""The :math:`\delta_{max}` whose force-free overlap (before the fluid cap) is :math:`d_0`: the inverse of
+    :math:`(1 - s k_1/k_2(x))\, x = d_0` with :math:`k_2(x)` of eq. (7), :math:`s = k_1(T, t)/k_1` (Fig. 5 right:
+    cooling keeps :math:`\delta_0`; the tension branch: reloading starts on a new :math:`k_2` line).
 
-    At or above delta_max^fluid, ``x = d0/(1 - s k1/k2)``. Below, with ``k2(x) = k1 + c x``,
-    ``c = (k2 - k1)/delta_max^fluid``: ``c x^2 + b x - k1 d0 = 0``, ``b = k1 (1 - s) - c d0``, whose positive root
-    is taken in the form without cancellation (``2 k1 d0/(b + sqrt(D))`` for b >= 0).
+    At or above :math:`\delta_{max}^{fluid}`, :math:`x = d_0/(1 - s k_1/k_2)`. Below, with :math:`k_2(x) = k_1 + c
+    x`, :math:`c = (k_2 - k_1)/\delta_{max}^{fluid}`: :math:`c x^2 + b x - k_1 d_0 = 0`, :math:`b = k_1 (1 - s) - c
+    d_0`, whose positive root is taken in the form without cancellation (:math:`2 k_1 d_0/(b + \sqrt{D})` for
+    :math:`b \ge 0`).
     """
     if d0 <= 0.0:
         return 0.0
@@ -181,15 +184,15 @@ def delta_max_for_delta_0(d0, k1_factor_now, delta_fluid, params):
 
 @njit(**JIT)
 def kc_of(delta_max, k1_factor_now, delta_fluid, params):
-    """``kc(T, t, delta_max) = (k1(T, t)/k1) (k2(delta_max)/k2) kc`` (Luding 2005, eq. 13)."""
+    r""":math:`k_c(T, t, \delta_{max}) = (k_1(T, t)/k_1) (k_2(\delta_{max})/k_2)\, k_c` (Luding 2005, eq. 13)."""
     return k1_factor_now * k2_of_delta_max(delta_max, delta_fluid, params) / params[P_K2] * params[P_KC]
 
 
 @njit(**JIT)
 def delta_min(delta_max, k1_factor_now, delta_fluid, params):
-    """Overlap of the largest attraction, where the k2 line meets ``-kc delta``: ``k2 delta_0/(k2 + kc)``, i.e.
-    ``(k2 - k1)/(k2 + kc) delta_max`` of Luding 2005, Sec. 3.1.1, with k2(delta_max), k1(T, t), kc(T, t,
-    delta_max)."""
+    r"""Overlap of the largest attraction, where the :math:`k_2` line meets :math:`-k_c \delta`: :math:`k_2
+    \delta_0/(k_2 + k_c)`, i.e. :math:`(k_2 - k_1)/(k_2 + k_c)\, \delta_{max}` of Luding 2005, Sec. 3.1.1, with
+    :math:`k_2(\delta_{max})`, :math:`k_1(T, t)`, :math:`k_c(T, t, \delta_{max})`."""
     k2m = k2_of_delta_max(delta_max, delta_fluid, params)
     kcm = k1_factor_now * k2m / params[P_K2] * params[P_KC]
     return k2m * delta_0(delta_max, k1_factor_now, delta_fluid, params) / (k2m + kcm)
@@ -197,17 +200,17 @@ def delta_min(delta_max, k1_factor_now, delta_fluid, params):
 
 @njit(**JIT)
 def f_min(delta_max, k1_factor_now, delta_fluid, params):
-    """Largest attraction ``f_min = -kc delta_min = -(k2 - k1(T, t))/(1 + k2/kc) delta_max`` (Luding 2005,
-    eq. 15; with delta_0 capped at delta_fluid on the fluid branch)."""
+    r"""Largest attraction :math:`f_{min} = -k_c \delta_{min} = -(k_2 - k_1(T, t))/(1 + k_2/k_c)\, \delta_{max}`
+    (Luding 2005, eq. 15; with :math:`\delta_0` capped at :math:`\delta_{fluid}` on the fluid branch)."""
     return -kc_of(delta_max, k1_factor_now, delta_fluid, params) * delta_min(delta_max, k1_factor_now,
                                                                             delta_fluid, params)
 
 
 @njit(**IN_LOOP)
 def normal_force(delta, delta_dot, k1_factor_now, delta_max, k1_factor_last, delta_fluid, params):
-    """Normal force on particle i and the new history (Luding 2005, eqs. 4, 5, 7, 13, 15; Figs. 2, 3, 5): the
-    elastic-plastic force of :func:`elastic_plastic` (the contact's ``1/(k2 delta_fluid)`` computed here) with the
-    viscous ``gamma_0 delta_dot`` of eq. (5) (:func:`dem.laws.contact.damping.luding.force`) in contact;
+    r"""Normal force on particle i and the new history (Luding 2005, eqs. 4, 5, 7, 13, 15; Figs. 2, 3, 5): the
+    elastic-plastic force of :func:`elastic_plastic` (the contact's :math:`1/(k_2 \delta_{fluid})` computed here) with
+    the viscous :math:`\gamma_0 \dot\delta` of eq. (5) (:func:`dem.laws.contact.damping.luding.force`) in contact;
     ``delta_dot`` (m/s) is > 0 approaching. Returns what :func:`elastic_plastic` returns, with that force."""
     f, dm, f_min_now, k2m, kcm, d0 = elastic_plastic(delta, k1_factor_now, delta_max, k1_factor_last, delta_fluid,
                                                      1.0 / (params[P_K2] * delta_fluid), params)
@@ -218,31 +221,35 @@ def normal_force(delta, delta_dot, k1_factor_now, delta_max, k1_factor_last, del
 
 @njit(**IN_LOOP)
 def elastic_plastic(delta, k1_factor_now, delta_max, k1_factor_last, delta_fluid, inv_c, params):
-    """Elastic-plastic normal force on particle i and the new history (Luding 2005, eqs. 4, 7, 13, 15; Figs. 2, 3,
+    r"""Elastic-plastic normal force on particle i and the new history (Luding 2005, eqs. 4, 7, 13, 15; Figs. 2, 3,
     5).
 
-    Arguments: overlap ``delta`` (m), the factor ``k1(T, t)/k1`` now and at the contact's previous step, the
-    history ``delta_max`` (0 for a new contact), ``delta_fluid`` of the contact and ``inv_c = 1/(k2 delta_fluid)``
-    (a pair's :func:`pair_constants`), ``params`` (:func:`dem.laws.contact.luding.params_of`).
+    Arguments: overlap ``delta`` (m), the factor :math:`k_1(T, t)/k_1` now and at the contact's previous step, the
+    history ``delta_max`` (0 for a new contact), ``delta_fluid`` of the contact and ``inv_c``, :math:`1/(k_2
+    \delta_{fluid})` (a pair's :func:`pair_constants`), ``params`` (:func:`dem.laws.contact.luding.params_of`).
 
-    Returns ``(f_n, delta_max_new, f_min, k2_now, kc_now, delta_0)``: f_n > 0 repulsive, without the viscous part
-    (eq. 5, the damping sub-model's); f_min of eq. (15), k2(delta_max) of eq. (7), kc(T, t, delta_max) of eq. (13) and
-    the force-free overlap after the update (the tangential kernel takes f_min and k2_now). For ``delta <= 0`` the
-    contact is open: no force, the history is returned unchanged (the engine deletes the contact).
+    Returns ``(f_n, delta_max_new, f_min, k2_now, kc_now, delta_0)``: :math:`f_n > 0` repulsive, without the viscous
+    part (eq. 5, the damping sub-model's); :math:`f_{min}` of eq. (15), :math:`k_2(\delta_{max})` of eq. (7),
+    :math:`k_c(T, t, \delta_{max})` of eq. (13) and the force-free overlap after the update (the tangential kernel
+    takes ``f_min`` and ``k2_now``). For :math:`\delta \le 0` the contact is open: no force, the history is returned
+    unchanged (the engine deletes the contact).
 
-    The elastic-plastic force lies in the cone between the k1(T, t) line and the -kc line:
+    The elastic-plastic force lies in the cone between the :math:`k_1(T, t)` line and the :math:`-k_c` line:
 
-    * temperature (Fig. 5): when k1(T, t) fell since the last step (heating) delta_max is kept, so delta_0 grows;
-      when it rose (cooling) delta_0 is kept and delta_max grows to the root of ``(1 - k1(T, t)/k2(x)) x = delta_0``
-      (:func:`delta_max_for_delta_0`);
-    * loading: beyond delta_max the force follows ``k1(T, t) delta`` and delta_max = delta;
-    * un/reloading: ``k2(delta_max)(delta - delta_0)``, ``delta_0 = (1 - k1(T, t)/k2(delta_max)) delta_max``;
-    * fluid (Sec. 3.1.3): delta_0 never exceeds delta_fluid; from there the contact stays on
-      ``k2(delta_max)(delta - delta_fluid)`` with delta_max frozen (no more plastic deformation; in the cold limit
-      delta_max = delta_max^fluid and the slope is k2);
-    * tension: the force never falls below ``-kc delta``; where it would, it is held there and delta_0 moves to
-      ``delta (1 + kc/k2)`` (kc/k2 = k1(T, t) kc/(k1 k2) by eq. 13, whatever delta_max), delta_max to the matching
-      root, so that reloading departs into the cone on that new k2 line.
+    * temperature (Fig. 5): when :math:`k_1(T, t)` fell since the last step (heating) :math:`\delta_{max}` is kept,
+      so :math:`\delta_0` grows; when it rose (cooling) :math:`\delta_0` is kept and :math:`\delta_{max}` grows to
+      the root of :math:`(1 - k_1(T, t)/k_2(x))\, x = \delta_0` (:func:`delta_max_for_delta_0`);
+    * loading: beyond :math:`\delta_{max}` the force follows :math:`k_1(T, t)\, \delta` and :math:`\delta_{max} =
+      \delta`;
+    * un/reloading: :math:`k_2(\delta_{max}) (\delta - \delta_0)`, :math:`\delta_0 = (1 - k_1(T,
+      t)/k_2(\delta_{max}))\, \delta_{max}`;
+    * fluid (Sec. 3.1.3): :math:`\delta_0` never exceeds :math:`\delta_{fluid}`; from there the contact stays on
+      :math:`k_2(\delta_{max}) (\delta - \delta_{fluid})` with :math:`\delta_{max}` frozen (no more plastic
+      deformation; in the cold limit :math:`\delta_{max} = \delta_{max}^{fluid}` and the slope is :math:`k_2`);
+    * tension: the force never falls below :math:`-k_c \delta`; where it would, it is held there and
+      :math:`\delta_0` moves to :math:`\delta (1 + k_c/k_2)` (:math:`k_c/k_2 = k_1(T, t)\, k_c/(k_1 k_2)` by eq. 13,
+      whatever :math:`\delta_{max}`), :math:`\delta_{max}` to the matching root, so that reloading departs into the
+      cone on that new :math:`k_2` line.
     """
     # Written with one division per call (this runs for every contact at every step): with c = k2 delta_fluid,
     # k2(x) = k1 + (k2 - k1)^2 x / c below the fluid limit (k2 - k1) x < c, 1/k2 = delta_fluid / c, and the
@@ -313,8 +320,9 @@ def pair_constants(ri, rj, params):
 
 @njit(**IN_LOOP)
 def pair(at, col, hist_in, hist, state, T, i, j, contact, ri, rj, params, const):
-    """The elastic-plastic force of the closed pair (i, j) (:func:`elastic_plastic`) at the mean factor of its
-    particles, ``(f_el, k2(delta_max), 0, f_min, k1(T, t)/k1, 0)`` (:mod:`dem.laws.contact.composition`); the
+    r"""The elastic-plastic force of the closed pair (i, j) (:func:`elastic_plastic`) at the mean factor of its
+    particles, :math:`(f_{el}, k_2(\delta_{max}), 0, f_{min}, k_1(T, t)/k_1, 0)` (:mod:`dem.laws.contact.composition`);
+    the
     history ``(delta_max, k1_last)`` in columns ``col``, ``col + 1`` of row ``at``."""
     k1c = 0.5 * (state[i, 0] + state[j, 0])
     delta_fluid, inv_c = const
