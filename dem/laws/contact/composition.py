@@ -30,7 +30,8 @@ every kernel ``numba.njit`` with ``inline="always"``):
   ``state`` sub-model it reads particles' state from (None: none); ``time_steps(material, mass, inertia, radius,
   m_mean)`` -> ``(dt, stable)``;
 * ``damping``: ``pair`` of ``(state, i, j, f_el, delta_dot, k_n, p)`` and ``wall`` of
-  ``(state, k, f_el, delta_dot, k_n, p)``, each -> ``(f_n, eta)``: the normal force with its viscous part and the viscous coefficient (kg/s); ``STATE``;
+  ``(state, k, f_el, delta_dot, k_n, p)``, each -> ``(f_n, eta)``: the normal force with its viscous part and the
+  viscous coefficient (kg/s); ``STATE``;
 * ``adhesion``: ``pair(at, col, hist_in, hist, contact, f_el, k_n, a, r_eff, ri, rj, p)`` and ``wall(at, col,
   hist_in, hist, contact, f_el, k_n, a, rk, p)`` -> ``(f_el, k_n, a, load)``: the normal force with the adhesion,
   and the load friction resists (without adhesion that load is ``f_n - f_min``); ``reach(at, col, hist)``, how far
@@ -197,7 +198,7 @@ class Law:
         Returns
         -------
         int
-            The block's index in :meth:`sizes`.
+            The block's index among the law's blocks, in the order :meth:`params` packs them.
         """
         return self.blocks.index(self.modules[slot].PARAMS)
 

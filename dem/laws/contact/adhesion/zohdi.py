@@ -1,10 +1,10 @@
-r"""The bonds of Zohdi 2014 (eqs. 18-19): a pair whose strain reaches :math:`E^*` is bonded from the next step on
-(the flag is the pair's history, committed when a step is accepted) and stays bonded while it touches; a bond pulls
-with :math:`K_b |E|^{p_b} A` on the pair's contact area. Within a step the flags are fixed: a bond switched on
-between two iterates makes the force jump by :math:`K_b {E^*}^{p_b} A`, and the fixed-point iteration then stalls at the size of that jump instead
-of converging. An adhesion sub-model of the contact laws (:mod:`dem.laws.contact.composition`) on Zohdi's normal force
-(:mod:`dem.laws.contact.normal.zohdi`); friction resists the contact force without the bond's pull; walls do not
-bond. Parameters: the block of :func:`dem.laws.contact.zohdi.params_of`.
+r"""The bonds of Zohdi 2014 (eqs. 18-19): a pair whose strain reaches :math:`E^*` is bonded from the next step on (the
+flag is the pair's history, committed when a step is accepted) and stays bonded while it touches; a bond pulls with
+:math:`K_b |E|^{p_b} A` on the pair's contact area. Within a step the flags are fixed: a bond switched on between two
+iterates makes the force jump by :math:`K_b {E^*}^{p_b} A`, and the fixed-point iteration then stalls at the size of
+that jump instead of converging. An adhesion sub-model of the contact laws (:mod:`dem.laws.contact.composition`) on
+Zohdi's normal force (:mod:`dem.laws.contact.normal.zohdi`); friction resists the contact force without the bond's pull;
+walls do not bond. Parameters: the block of :func:`dem.laws.contact.zohdi.params_of`.
 """
 
 from __future__ import annotations

@@ -58,8 +58,8 @@ def restitution_of(alpha: float) -> float:
 
 @njit(**IN_LOOP)
 def viscosity(alpha, m_eff, k_n):
-    r""":math:`\eta_n = \alpha \sqrt{m^* k_n}` (kg/s): ``alpha`` of :func:`damping_coefficient`, the effective mass ``m_eff``
-    (kg) and the contact's stiffness ``k_n`` (N/m)."""
+    r""":math:`\eta_n = \alpha \sqrt{m^* k_n}` (kg/s): ``alpha`` of :func:`damping_coefficient`, the effective mass
+    ``m_eff`` (kg) and the contact's stiffness ``k_n`` (N/m)."""
     return alpha * math.sqrt(m_eff * k_n)
 
 

@@ -1,6 +1,6 @@
 r"""The drag of Zohdi 2014 on every particle (eq. 20 with Sec. 7's drag on a sphere): :math:`-c_{env} v` with
-:math:`c_{env} = c_{env}^o\, 6 \pi R`. A drag sub-model of the contact laws (:mod:`dem.laws.contact.composition`). Parameters: the block
-of :func:`dem.laws.contact.zohdi.params_of`.
+:math:`c_{env} = c_{env}^o\, 6 \pi R`. A drag sub-model of the contact laws (:mod:`dem.laws.contact.composition`).
+Parameters: the block of :func:`dem.laws.contact.zohdi.params_of`.
 """
 
 from __future__ import annotations

@@ -2,9 +2,9 @@ r"""The hysteretic sintering normal force of Luding, Manetsberger & Müllers 200
 5), a normal sub-model of the contact laws (:mod:`dem.laws.contact.composition`), and the time step it needs (eq. 6).
 
 Conventions (Sec. 3.1): the unit normal :math:`n` points from particle j to particle i (eq. 3), the overlap
-:math:`\delta = a_i + a_j - |r_i - r_j|` is positive in contact, :math:`\dot\delta = d\delta/dt` is positive while
-the particles approach, and the force is that **on particle i**. For a wall contact the wall plays j (no radius; the particle's k1(T, t), or
-with ``wall_sintering`` off the cold-limit k1).
+:math:`\delta = a_i + a_j - |r_i - r_j|` is positive in contact, :math:`\dot\delta = d\delta/dt` is positive while the
+particles approach, and the force is that **on particle i**. For a wall contact the wall plays j (no radius; the
+particle's k1(T, t), or with ``wall_sintering`` off the cold-limit k1).
 
 Stiffness history is carried as the dimensionless factor ``s = k1(T, t)/k1`` (eqs. 10-12), a property of each
 particle's material (:mod:`dem.laws.contact.state.sintering`): a contact uses the mean of its two particles' factors,

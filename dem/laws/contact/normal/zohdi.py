@@ -1,10 +1,10 @@
 r"""The normal contact of Zohdi 2014 (eqs. 2-15, Sec. 7): a power law of the strain on the contact area, softened by
-temperature -- :math:`K_p |E|^{p_p} A` between particles (the strain :math:`E = \delta/(R_i + R_j)`, eq. 3, on the
-lens area :math:`A = \pi (R_i^2 - L_i^2)`, eqs. 7-12) and :math:`K_w E^{p_w} A` on a wall (:math:`E = \delta/R_k`,
-eq. 14, on the circle the plane cuts from the sphere), with :math:`K = \max(K_0 (1 - \theta/\theta^*), K_{lim})`
-(Sec. 7; for a pair :math:`\theta` is the mean of the two). A normal sub-model of the contact laws (:mod:`dem.laws.contact.composition`) whose contact's size ``a`` is
-its area (m^2); the law is stepped by the paper's implicit scheme (:func:`time_steps`). Parameters: the block of
-:func:`dem.laws.contact.zohdi.params_of`.
+temperature -- :math:`K_p |E|^{p_p} A` between particles (the strain :math:`E = \delta/(R_i + R_j)`, eq. 3, on the lens
+area :math:`A = \pi (R_i^2 - L_i^2)`, eqs. 7-12) and :math:`K_w E^{p_w} A` on a wall (:math:`E = \delta/R_k`, eq. 14, on
+the circle the plane cuts from the sphere), with :math:`K = \max(K_0 (1 - \theta/\theta^*), K_{lim})` (Sec. 7; for a
+pair :math:`\theta` is the mean of the two). A normal sub-model of the contact laws
+(:mod:`dem.laws.contact.composition`) whose contact's size ``a`` is its area (m^2); the law is stepped by the paper's
+implicit scheme (:func:`time_steps`). Parameters: the block of :func:`dem.laws.contact.zohdi.params_of`.
 """
 
 from __future__ import annotations

@@ -45,7 +45,8 @@ def tangential_force(xi, n, vt, f_n, f_min_now, k2_now, k1_factor_now, dt, param
 
     ``xi`` the spring of the previous step, ``n`` the unit normal (j to i), ``vt`` the tangential relative
     velocity (eq. 17, :func:`relative_velocity`), all 3-tuples; ``f_n`` the normal force (with its viscous part),
-    ``f_min_now`` and ``k2_now`` from :func:`normal_force`, ``dt`` the time step, ``is_wall`` selects mu_wall.
+    ``f_min_now`` and ``k2_now`` from :func:`dem.laws.contact.normal.luding.normal_force`, ``dt`` the time step,
+    ``is_wall`` selects ``mu_wall``.
 
     :math:`f_C = \mu(T, t) (f_n - f_{min})`, :math:`\mu(T, t) = (k_1(T, t)/k_1) \mu` (eqs. 14, 24); :math:`\xi` is
     projected into the tangent plane (eq. 16); test force :math:`f_{t0} = -k_t \xi - \gamma_t v_t`, :math:`k_t =

@@ -1,10 +1,10 @@
-r"""The sliding friction of Zohdi 2014 (eqs. 5-6, 16-17): :math:`\mu_d |F_{con}|\, t` with :math:`t = (v_j -
-v_i)/|v_j - v_i|` the whole relative velocity between particles, as the paper writes it (so friction also opposes the approach of two
-particles, which is what makes their collisions inelastic: the law has no normal damping), only the tangential one
-at a wall (eq. 17). The direction is regularised, :math:`t = \Delta v/\sqrt{|\Delta v|^2 + v_{slip}^2}`: a unit
-vector while sliding faster than ``v_slip``, proportional to the slip below it, so that the fixed-point map stays continuous where the
-relative velocity passes through zero. The particles do not rotate (Sec. 2). A tangential sub-model of the contact
-laws (:mod:`dem.laws.contact.composition`): ``|F_con|`` is the load it is given. Parameters: the block of
+r"""The sliding friction of Zohdi 2014 (eqs. 5-6, 16-17): :math:`\mu_d |F_{con}|\, t` with :math:`t = (v_j - v_i)/|v_j -
+v_i|` the whole relative velocity between particles, as the paper writes it (so friction also opposes the approach of
+two particles, which is what makes their collisions inelastic: the law has no normal damping), only the tangential one
+at a wall (eq. 17). The direction is regularised, :math:`t = \Delta v/\sqrt{|\Delta v|^2 + v_{slip}^2}`: a unit vector
+while sliding faster than ``v_slip``, proportional to the slip below it, so that the fixed-point map stays continuous
+where the relative velocity passes through zero. The particles do not rotate (Sec. 2). A tangential sub-model of the
+contact laws (:mod:`dem.laws.contact.composition`): ``|F_con|`` is the load it is given. Parameters: the block of
 :func:`dem.laws.contact.zohdi.params_of`.
 """
 
