@@ -1,13 +1,10 @@
 """Moving particles coupled to the thermal network: conductances follow the overlaps, the heat balance stays exact
 through contact changes, and a hot wall softens the contacts it heats (Luding 2005 eq. 10 with Rojek 2022's pipes)."""
 
-import math
-
 import numpy as np
 import pytest
 
 from dem.engines.verlet.engine import VerletEngine
-from dem.laws.conductance import bond_conductances
 from dem.scene import parse_scene
 from fem_neck import neck_radius
 

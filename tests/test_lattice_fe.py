@@ -66,7 +66,7 @@ def test_mapped_mesh_fills_the_exact_solid():
     # every boundary vertex, edge and face point lies on its sphere, cylinder or plane; the straight tetrahedra
     # alone miss the curved solid by ~1e-3 of its volume, the mapped ones by the quadrature error only
     from fem_neck import primal
-    from fem_neck.simplex import FACES, triangle_quadrature, face_points
+    from fem_neck.simplex import triangle_quadrature, face_points
 
     cm = lattice.build_cell_mesh(lattice.lattice_cell("bcc", 0.1), **COARSE)
     mesh = cm.curved

@@ -1,7 +1,6 @@
 """A stress-controlled wall in a box periodic across it takes the box's period for its extent (Luding 2005, eq. 1:
 p L pushes it in): free of particles it accelerates at p Lx Ly / m exactly, and its load is a stress (Pa)."""
 
-import numpy as np
 import pytest
 
 from dem import run
