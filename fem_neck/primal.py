@@ -119,8 +119,11 @@ def volume(mesh: CurvedMesh, degree: int = 10) -> float:
         normal = face_normal(face)                                                # outward, times the face's Jacobian
         for start in range(0, len(elements), CHUNK):
             x, J = mesh.map(elements[start:start + CHUNK], face_points(face, st))
-            cofactor = np.abs(np.linalg.det(J))[..., None, None] * np.linalg.inv(np.swapaxes(J, -1, -2))
-            n = cofactor @ normal                                                 # |det J| J^-T n^: outward n dS
+            a, b, c = J[..., 0], J[..., 1], J[..., 2]                             # the columns of J
+            bc = np.cross(b, c)
+            # |det J| J^-T n^ = sign(det J) (n^_0 b x c + n^_1 c x a + n^_2 a x b): outward n dS
+            n = np.sign(np.einsum("eqi,eqi->eq", a, bc))[..., None] * (
+                normal[0] * bc + normal[1] * np.cross(c, a) + normal[2] * np.cross(a, b))
             total += float(np.einsum("eqi,eqi,q->", x, n, w))
     return total / 3.0
 
