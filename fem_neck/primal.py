@@ -119,8 +119,11 @@ def volume(mesh: CurvedMesh, degree: int = 10) -> float:
         normal = face_normal(face)                                                # outward, times the face's Jacobian
         for start in range(0, len(elements), CHUNK):
             x, J = mesh.map(elements[start:start + CHUNK], face_points(face, st))
-            cofactor = np.abs(np.linalg.det(J))[..., None, None] * np.linalg.inv(np.swapaxes(J, -1, -2))
-            n = cofactor @ normal                                                 # |det J| J^-T n^: outward n dS
+            a, b, c = J[..., 0], J[..., 1], J[..., 2]                             # the columns of J
+            bc = np.cross(b, c)
+            # |det J| J^-T n^ = sign(det J) (n^_0 b x c + n^_1 c x a + n^_2 a x b): outward n dS
+            n = np.sign(np.einsum("eqi,eqi->eq", a, bc))[..., None] * (
+                normal[0] * bc + normal[1] * np.cross(c, a) + normal[2] * np.cross(a, b))
             total += float(np.einsum("eqi,eqi,q->", x, n, w))
     return total / 3.0
 
@@ -248,19 +251,77 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     fixed[hot_dofs] = fixed[face_dofs(mesh, basis, cold)] = True
     values[hot_dofs] = 1.0
     system = pcg.Assembly(num.l2g, fixed, values)
+    hats = hat_values(basis)
+    coarse = np.empty((len(mesh.tets), 4, 4))                               # each element's part of P^T A_ff P
     for start in range(0, len(mesh.tets), CHUNK):
         elements = np.arange(start, min(start + CHUNK, len(mesh.tets)))
-        K = stiffness_matrices(mesh, basis, degree, elements)
-        if basis.n_interior:  # condense the interior nodes
-            Kbb, Kbi, Kii = K[:, :skel, :skel], K[:, :skel, skel:], K[:, skel:, skel:]
-            K = Kbb - np.matmul(Kbi, np.linalg.solve(Kii, np.transpose(Kbi, (0, 2, 1))))
+        K = condensed(stiffness_matrices(mesh, basis, degree, elements), skel)
         system.add(K, elements)
+        free = ~fixed[num.l2g[elements]]                                    # the rows and columns of A_ff
+        coarse[elements] = hats.T @ (K * free[:, :, None] * free[:, None, :]) @ hats
     A = system.matrix()
     P = hat_prolongation(mesh, basis, num)[system.free]
-    x, iterations, residual = pcg.solve(A, system.b, pcg.two_level(A, P), energy=(system.constant, etol))
+    x, iterations, residual = pcg.solve(A, system.b, pcg.two_level(A, P, coarse_matrix(mesh, coarse)),
+                                        energy=(system.constant, etol))
     u = values.copy()
     u[system.free] = x
     return Solution(system.energy(A, x), u, num.n + basis.n_interior * len(mesh.tets), num.n, iterations, residual)
+
+
+def condensed(K: np.ndarray, skel: int) -> np.ndarray:
+    r"""Element matrices ``K (E, n, n)`` with their last ``n - skel`` (interior) nodes condensed out: the Schur
+    complement :math:`K_{bb} - K_{bi} K_{ii}^{-1} K_{ib}`, ``(E, skel, skel)``; for one interior node (``P_4``) the
+    rank-one update :math:`K_{bb} - k_{bi} k_{bi}^T / k_{ii}`.
+
+    Parameters
+    ----------
+    K : numpy.ndarray
+        Symmetric element matrices ``(E, n, n)``, the skeleton nodes first (W/K for a conductance).
+    skel : int
+        Number of skeleton nodes ``(<= n)``.
+    """
+    n = K.shape[1]
+    if n == skel:
+        return K
+    Kbb, Kbi = K[:, :skel, :skel], K[:, :skel, skel:]
+    if n - skel == 1:
+        k = Kbi[:, :, 0]
+        return Kbb - k[:, :, None] * (k / K[:, skel, skel, None])[:, None, :]
+    return Kbb - np.matmul(Kbi, np.linalg.solve(K[:, skel:, skel:], np.transpose(Kbi, (0, 2, 1))))
+
+
+def hat_values(basis: Lagrange) -> np.ndarray:
+    """``(n_skeleton, 4)``: the four vertex hats' values (barycentric coordinates) at the skeleton nodes of the
+    reference element, the coefficients of the hats in the skeleton basis on every element.
+
+    Parameters
+    ----------
+    basis : fem_neck.simplex.Lagrange
+        The reference ``P_p`` basis.
+    """
+    skel = basis.n - basis.n_interior
+    return np.concatenate([1.0 - basis.nodes[:skel].sum(axis=1, keepdims=True), basis.nodes[:skel]], axis=1)
+
+
+def coarse_matrix(mesh: CurvedMesh, blocks: np.ndarray):
+    r"""The Galerkin matrix :math:`P^T A_{ff} P` of the hats (:func:`hat_prolongation` on the free dofs) as the sum
+    of its element parts ``blocks (E, 4, 4)`` on the elements' vertices, :math:`H^T K_e^{ff} H` with ``H`` of
+    :func:`hat_values` and :math:`K_e^{ff}` the element matrix with the fixed dofs' rows and columns zeroed (the same
+    matrix as the sparse product, without it); CSR ``(n_vertices, n_vertices)``.
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    blocks : numpy.ndarray
+        Every element's part ``(E, 4, 4)``, in the unit of the system matrix.
+    """
+    import scipy.sparse as sp
+
+    rows = np.broadcast_to(mesh.tets[:, :, None], blocks.shape).ravel()
+    cols = np.broadcast_to(mesh.tets[:, None, :], blocks.shape).ravel()
+    n = len(mesh.points)
+    return sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))                # (sums the duplicates)
 
 
 def hat_prolongation(mesh: CurvedMesh, basis: Lagrange, num: Numbering):
@@ -278,8 +339,8 @@ def hat_prolongation(mesh: CurvedMesh, basis: Lagrange, num: Numbering):
     """
     import scipy.sparse as sp
 
-    skel = basis.n - basis.n_interior
-    lam = np.concatenate([1.0 - basis.nodes[:skel].sum(axis=1, keepdims=True), basis.nodes[:skel]], axis=1)
+    lam = hat_values(basis)
+    skel = len(lam)
     M = len(mesh.tets)
     rows = np.broadcast_to(num.l2g[:, :, None], (M, skel, 4))
     cols = np.broadcast_to(mesh.tets[:, None, :], (M, skel, 4))

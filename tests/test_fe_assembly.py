@@ -133,3 +133,37 @@ def test_upper_bound_matrix_is_the_conforming_stiffness(cell_mesh):
                          shape=(num.n, num.n))
     free = system.free
     assert abs(system.matrix() - full[free][:, free]).max() <= 1e-12 * abs(full).max()
+
+
+def test_condensed_element_matrix_is_the_energy_minimised_over_the_interior_nodes():
+    rng = np.random.default_rng(5)
+    for interior in (1, 3):  # the rank-one update (P_4) and the general Schur complement
+        n = 6 + interior
+        K = rng.standard_normal((4, n, n))
+        K = np.matmul(K, np.swapaxes(K, 1, 2)) + n * np.eye(n)
+        S = primal.condensed(K, 6)
+        x = rng.standard_normal((4, 6))
+        y = -np.linalg.solve(K[:, 6:, 6:], np.einsum("eib,eb->ei", K[:, 6:, :6], x)[:, :, None])[:, :, 0]
+        u = np.concatenate([x, y], axis=1)                                     # with the minimising interior
+        np.testing.assert_allclose(np.einsum("ea,eab,eb->e", x, S, x), np.einsum("ea,eab,eb->e", u, K, u),
+                                   rtol=1e-12)
+    np.testing.assert_array_equal(primal.condensed(K[:, :6, :6], 6), K[:, :6, :6])  # no interior nodes (P_3)
+
+
+def test_coarse_matrix_of_the_hats_is_the_galerkin_product(cell_mesh):
+    # the upper bound sums P^T A_ff P of the hats element by element, as primal.solve does, at p = 4 (condensed)
+    mesh, basis = cell_mesh.curved, lagrange(4)
+    skel = basis.n - basis.n_interior
+    num = primal.numbering(mesh, basis)
+    fixed = np.zeros(num.n, dtype=bool)
+    fixed[primal.face_dofs(mesh, basis, cell_mesh.hot)] = fixed[primal.face_dofs(mesh, basis, cell_mesh.cold)] = True
+    K = primal.condensed(primal.stiffness_matrices(mesh, basis), skel)
+    system = pcg.Assembly(num.l2g, fixed, fixed.astype(float))
+    system.add(K, np.arange(len(K)))
+    A = system.matrix()
+    P = primal.hat_prolongation(mesh, basis, num)[system.free]
+    free = ~fixed[num.l2g]
+    hats = primal.hat_values(basis)
+    coarse = primal.coarse_matrix(mesh, hats.T @ (K * free[:, :, None] * free[:, None, :]) @ hats)
+    product = (P.T @ A @ P).tocsr()
+    assert abs(coarse - product).max() <= 1e-12 * abs(product).max()
