@@ -56,9 +56,11 @@ import numpy as np
 from numba import njit
 
 from dem.engines.contact_forces import forces
-from dem.laws.contact import luding as law
 from dem.laws.contact.binding import ContactLaw
 from dem.laws.contact.luding import LUDING_TABLE1, LudingMaterial
+from dem.laws.contact.normal import luding as luding_normal
+from dem.laws.contact.state import sintering
+from dem.laws.contact.tangential import luding as luding_tangential
 from verification.report import md_table
 
 TITLE = "DEM mechanics: the time loop against LAMMPS, compile cost, thermal-only path"
@@ -269,7 +271,7 @@ def _force_passes(count, contact_law, particles, pairs, walls, wall_list, consta
 def _material_passes(count, t, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt):
     """``count`` material-state updates of the engine's loop (the law's ``update_particles``)."""
     for k in range(count):
-        law.update_particles(k * dt, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt)
+        sintering.update_particles(k * dt, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt)
 
 
 def stage_costs(sample: dict, material: LudingMaterial, steps: int) -> dict:
@@ -697,20 +699,22 @@ FIRST_CALLS = """
 import dataclasses, json, time
 t = time.perf_counter()
 import numpy as np
-from dem.laws.contact import luding as law
 from dem.laws.contact import luding
+from dem.laws.contact.normal import luding as luding_normal
+from dem.laws.contact.state import sintering
+from dem.laws.contact.tangential import luding as luding_tangential
 from dem.engines.verlet.engine import VerletEngine
 from dem.scene import parse_scene
 imported = time.perf_counter()
 p = luding.LUDING_TABLE1.params()
-law.radius_at(1e-3, 80.0, 120.0, 1e-4)
-law.relax_k1(law.k1_factor(130.0, 120.0, 10.0), 0.5, 1e-3, 1e3, False)
-law.delta_0(1e-4, 1.0, 2e-4, p), law.delta_min(1e-4, 1.0, 2e-4, p), law.f_min(1e-4, 1.0, 2e-4, p)
-law.kc_of(1e-4, 1.0, 2e-4, p), law.delta_max_fluid(2e-4, p)
-f = law.normal_force(1e-5, 0.0, 0.9, 2e-5, 1.0, 2e-4, p)
+sintering.radius_at(1e-3, 80.0, 120.0, 1e-4)
+sintering.relax_k1(sintering.k1_factor(130.0, 120.0, 10.0), 0.5, 1e-3, 1e3, False)
+luding_normal.delta_0(1e-4, 1.0, 2e-4, p), luding_normal.delta_min(1e-4, 1.0, 2e-4, p), luding_normal.f_min(1e-4, 1.0, 2e-4, p)
+luding_normal.kc_of(1e-4, 1.0, 2e-4, p), luding_normal.delta_max_fluid(2e-4, p)
+f = luding_normal.normal_force(1e-5, 0.0, 0.9, 2e-5, 1.0, 2e-4, p)
 z = (0.0, 0.0, 1.0)
-vt, ddot = law.relative_velocity((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 1e-3, 1e-3, z)
-law.tangential_force((0.0, 0.0, 0.0), z, vt, f[0], f[2], f[3], 0.9, 1e-7, p, False)
+vt, ddot = luding_tangential.relative_velocity((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 1e-3, 1e-3, z)
+luding_tangential.tangential_force((0.0, 0.0, 0.0), z, vt, f[0], f[2], f[3], 0.9, 1e-7, p, False)
 kernels = time.perf_counter()
 contact = {k: v for k, v in dataclasses.asdict(luding.LUDING_TABLE1).items() if k != "density"}
 doc = {"scene": {"physics": ["mechanical"]}, "material": {"density": 2000.0},
@@ -763,10 +767,10 @@ def contact_loop(delta, delta_dot, s, delta_max, s_last, delta_fluid, xi, normal
                  delta_max_out):
     """Normal + tangential force of every contact (force on i, new spring, new delta_max) into the out arrays."""
     for c in range(delta.shape[0]):
-        f, dm, fmin, k2m, kcm, d0 = law.normal_force(delta[c], delta_dot[c], s[c], delta_max[c], s_last[c],
+        f, dm, fmin, k2m, kcm, d0 = luding_normal.normal_force(delta[c], delta_dot[c], s[c], delta_max[c], s_last[c],
                                                      delta_fluid[c], params)
         n = (normal[c, 0], normal[c, 1], normal[c, 2])
-        ft, xi_new, sliding, f = law.tangential_force((xi[c, 0], xi[c, 1], xi[c, 2]), n,
+        ft, xi_new, sliding, f = luding_tangential.tangential_force((xi[c, 0], xi[c, 1], xi[c, 2]), n,
                                                       (vt[c, 0], vt[c, 1], vt[c, 2]), f, fmin, k2m, s[c], dt,
                                                       params, False)
         for k in range(3):

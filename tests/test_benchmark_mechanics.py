@@ -94,7 +94,7 @@ def test_linear_limit_is_the_luding_law_without_plasticity_and_cohesion():
     lin = mechanics.linear_limit(mechanics.LUDING_TABLE1)
     assert (lin.k1, lin.k2, lin.kc, lin.brittle_sliding) == (2e5, 2e5, 0.0, False)
     assert (lin.mu, lin.gamma_n, lin.gamma_t) == (0.5, 0.2, 0.05)
-    from dem.laws.contact.luding import k1_factor
+    from dem.laws.contact.state.sintering import k1_factor
 
     assert k1_factor(mechanics.T_RUN, lin.T_melt, lin.T_var) == 1.0  # no softening at the run's temperature
 

@@ -11,8 +11,11 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
+from numba import njit
+
 from dem.engines.verlet.engine import VerletEngine
 from dem.laws.contact import hertz_mindlin as hm
+from dem.laws.contact.binding import ContactLaw, pair_constants, pair_force, params_tuple, wall_force
 from dem.laws.contact.damping import tsuji
 from dem.scene import parse_scene
 
@@ -89,14 +92,37 @@ def run_recording(sim, n_steps=None):
 
 
 # ------------------------------------------------------------------------------------------ kernels
+@njit
+def _bound_pair(law, hist_in, hist, state, contact, ri, rj, dt, params):
+    blocks = params_tuple(law, params)
+    return pair_force(law, 0, 0, 1, hist_in, hist, state, np.zeros(2), contact, ri, rj, False, dt, blocks,
+                      pair_constants(law, ri, rj, blocks))
+
+
+@njit
+def _bound_wall(law, hist_in, hist, state, contact, rk, dt, params):
+    return wall_force(law, 0, 0, hist_in, hist, state, np.zeros(1), contact, rk, dt, params_tuple(law, params))
+
+
+def law_pair(name, params, hist_in, hist, state, delta, n, vr, vn, r1, r2, dt):
+    """The compiled force on i of pair 0 = (0, 1) under the law ``name`` (:mod:`dem.laws.contact.binding`)."""
+    return _bound_pair(ContactLaw(name), hist_in, hist, state, (delta, r1 + r2 - delta, tuple(n), tuple(vr), vn),
+                       r1, r2, dt, params)
+
+
+def law_wall(name, params, hist_in, hist, state, delta, n, vr, vn, rk, dt):
+    """The compiled force on particle 0 from wall 0 under the law ``name``."""
+    return _bound_wall(ContactLaw(name), hist_in, hist, state, (delta, rk - delta, tuple(n), tuple(vr), vn), rk, dt,
+                       params)
+
+
 def _pair(params, delta, vn=0.0, vr=(0.0, 0.0, 0.0), r1=1e-3, r2=2e-3, xi=(0.0, 0.0, 0.0), dt=1e-6,
           n=(1.0, 0.0, 0.0)):
     """The kernel's force on i of one pair, and the spring it writes."""
     state = np.array([[sphere_mass(r1)], [sphere_mass(r2)]])
     hist_in = np.array([xi], dtype=float)
     hist = np.zeros_like(hist_in)
-    out = hm.pair_force(0, 0, 1, hist_in, hist, state, np.zeros(2), delta, r1 + r2 - delta, n,
-                        tuple(vr), vn, r1, r2, False, dt, params, ())
+    out = law_pair("hertz_mindlin", params, hist_in, hist, state, delta, n, vr, vn, r1, r2, dt)
     return out, hist[0]
 
 
@@ -110,8 +136,8 @@ def test_hertz_force_is_four_thirds_e_star_sqrt_r_star_delta_to_three_halves():
     # a wall: R* = the particle's radius
     state = np.array([[sphere_mass(r1)]])
     hist = np.zeros((1, 1, 3))
-    f_n = hm.wall_force(0, 0, hist, hist, state, np.zeros(1), 1e-6, r1 - 1e-6, (0.0, 0.0, 1.0), (0.0, 0.0, 0.0),
-                        0.0, r1, 1e-6, params)[0]
+    f_n = law_wall("hertz_mindlin", params, hist, hist, state, 1e-6, (0.0, 0.0, 1.0), (0.0, 0.0, 0.0), 0.0, r1,
+                   1e-6)[0]
     assert f_n == pytest.approx(4.0 / 3.0 * E_STAR * math.sqrt(r1) * 1e-6**1.5, rel=1e-14)
 
 

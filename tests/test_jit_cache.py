@@ -63,7 +63,7 @@ def test_an_edit_outside_compiled_code_keeps_the_key(copy):
     before = jit_cache.digest(copy)
     _edit(_in_copy(copy, "dem.cli.scenes"), '"""', '"""An edit. ')
     assert jit_cache.digest(copy) == before
-    _edit(_in_copy(copy, ZOHDI_MATERIAL), "NAME = \"zohdi\"", "NAME = \"zohdi\"  # an edit")
+    _edit(_in_copy(copy, ZOHDI_MATERIAL), "Material = ZohdiMaterial", "Material = ZohdiMaterial  # an edit")
     assert jit_cache.digest(copy) != before
 
 

@@ -8,14 +8,17 @@ import math
 
 import numpy as np
 import pytest
+from numba import njit
 from scipy.optimize import brentq, minimize_scalar
 
 from dem.driver import run
 from dem.engines.verlet.engine import VerletEngine
-from dem.laws.contact import jkr
+from dem.laws.contact import jkr, law_module
 from dem.laws.contact.adhesion import jkr as adhesion
+from dem.laws.contact.binding import ContactLaw, forget_pair, reach
 from dem.scene import parse_scene, state_file
-from test_hertz_mindlin import DENSITY, E_STAR, MATERIAL, contact, head_on, run_recording, scene_doc, sphere_mass
+from test_hertz_mindlin import (DENSITY, E_STAR, MATERIAL, contact, head_on, law_pair, run_recording, scene_doc,
+                                sphere_mass)
 
 W = 0.1  # J/m^2, the work of adhesion
 R = 1e-3
@@ -52,8 +55,7 @@ def _force_at(params, delta, r1=R, r2=2 * R, vn=0.0, hist=None, vr=(0.0, 0.0, 0.
     state = np.array([[sphere_mass(r1)], [sphere_mass(r2)]])
     hist_in = np.zeros((1, 4)) if hist is None else np.array([hist], dtype=float)
     out_hist = np.zeros_like(hist_in)
-    out = jkr.pair_force(0, 0, 1, hist_in, out_hist, state, np.zeros(2), delta, r1 + r2 - delta, (1.0, 0.0, 0.0),
-                         vr, vn, r1, r2, False, 1e-7, params, ())
+    out = law_pair("jkr", params, hist_in, out_hist, state, delta, (1.0, 0.0, 0.0), vr, vn, r1, r2, 1e-7)
     return out, out_hist[0]
 
 
@@ -94,13 +96,25 @@ def test_the_contact_reaches_beyond_touching_to_the_pull_off_distance_once_it_to
     pulloff = 0.75 * (math.pi**2 * W**2 * r_eff / E_STAR**2) ** (1 / 3)
     assert pulloff == pytest.approx(3 * radii(r_eff)[1] ** 2 / r_eff, rel=1e-12)  # -delta_c = 3 a_c^2/R*
     hist = np.zeros((1, 4))
-    assert jkr.reach(0, hist, R, 2 * R, params) == 0.0  # not yet touched: no force at a distance
+    law = ContactLaw("jkr")
+    assert _reach(law, hist) == 0.0  # not yet touched: no force at a distance
     _, written = _force_at(params, 1e-8)
-    assert jkr.reach(0, written[None, :], R, 2 * R, params) == pytest.approx(pulloff, rel=1e-14)
+    assert _reach(law, written[None, :]) == pytest.approx(pulloff, rel=1e-14)
     out = np.zeros((1, 4))
-    assert jkr.forget_pair(0, written[None, :], out) and not out.any()
+    assert _forget(law, written[None, :], out) and not out.any()
     material = jkr.JKRMaterial(**MATERIAL, density=DENSITY, work_of_adhesion=W)
-    assert jkr.largest_reach(material, np.array([R, 2 * R])) == pytest.approx(material.pulloff_distance(2 * R))
+    assert law_module("jkr").largest_reach(material, np.array([R, 2 * R])) == pytest.approx(
+        material.pulloff_distance(2 * R), rel=1e-14)
+
+
+@njit
+def _reach(law, hist):
+    return reach(law, 0, hist, R, 2 * R, ())
+
+
+@njit
+def _forget(law, hist_in, hist):
+    return forget_pair(law, 0, hist_in, hist)
 
 
 def test_friction_limit_adds_twice_the_pull_off_force(params):
@@ -227,7 +241,7 @@ def test_a_sphere_hangs_from_a_ceiling_while_its_weight_is_below_the_pull_off_fo
                     walls=[{"name": "ceiling", "point": [0, 0, 0], "normal": [0, 0, -1]}],
                     gravity={"acceleration": [0.0, 0.0, -g]})
     sim = VerletEngine(parse_scene(doc))
-    sim.mechanics.w_hist[0, 0, 3] = jkr.pulloff_distance(R, sim.mechanics.params)  # in contact from the start
+    sim.mechanics.w_hist[0, 0, 3] = jkr.JKRMaterial(**MATERIAL, density=DENSITY, work_of_adhesion=W).pulloff_distance(R)
     sim.run()
     z = sim.mechanics.state.x[0, 2]
     if stays:

@@ -1,4 +1,4 @@
-"""The Luding 2005 sintering contact law (dem.laws.contact.luding): every branch against closed forms written out here.
+"""The Luding 2005 sintering contact law (dem.laws.contact.luding and its sub-models): every branch against closed forms written out here.
 
 The kernels are numba-compiled with ``cache=True``: the first run of this file compiles them (about 10 s cold on
 2 cores); later runs load the cache.
@@ -14,8 +14,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq as _brentq
 
-from dem.laws.contact import luding as law
 from dem.laws.contact import luding
+from dem.laws.contact.normal import luding as luding_normal
+from dem.laws.contact.state import sintering
+from dem.laws.contact.tangential import luding as luding_tangential
 from dem.laws.contact.luding import LUDING_TABLE1 as MAT
 
 P = MAT.params()
@@ -46,7 +48,7 @@ class Normal(NamedTuple):
 
 def normal(*args):
     """normal_force with its results by name (indices in the order f, delta_max, delta_0, f_min, k2, kc)."""
-    f, delta_max, fmin, k2, kc, d0 = law.normal_force(*args)
+    f, delta_max, fmin, k2, kc, d0 = luding_normal.normal_force(*args)
     return Normal(f, delta_max, d0, fmin, k2, kc)
 
 
@@ -121,7 +123,7 @@ def test_temperature_where_the_radius_vanishes_is_refused():
 @pytest.mark.parametrize("T, printed", [(118.0, "0.6"), (122.0, "0.4"), (130.0, "0.12"), (160.0, "3e-04")])
 def test_k1_factor_matches_the_papers_values(T, printed):
     """Sec. 3.3.1: T_melt = 120 °C, T_var = 10 °C gives 0.6, 0.4, 0.12 and 3e-4 (to the printed digits)."""
-    s = law.k1_factor(T, 120.0, 10.0)
+    s = sintering.k1_factor(T, 120.0, 10.0)
     if "e" in printed:
         assert f"{s:.0e}" == printed
     else:
@@ -130,9 +132,9 @@ def test_k1_factor_matches_the_papers_values(T, printed):
 
 
 def test_k1_factor_stays_positive_far_above_melting():
-    s = law.k1_factor(400.0, 120.0, 10.0)  # 1 + tanh(-28) is 0 in double precision
+    s = sintering.k1_factor(400.0, 120.0, 10.0)  # 1 + tanh(-28) is 0 in double precision
     assert 0.0 < s == pytest.approx(math.exp(-56.0), rel=1e-12)
-    assert law.k1_factor(-1e4, 120.0, 10.0) == 1.0
+    assert sintering.k1_factor(-1e4, 120.0, 10.0) == 1.0
 
 
 def eq11(k0, K, t, t0):
@@ -151,7 +153,7 @@ def test_relax_k1_steps_reproduce_eq11(t0, dt_over_t0, k0, K):
     dt = dt_over_t0 * t0
     k, t = k0, 0.0
     for _ in range(200):
-        k = law.relax_k1(k, K, dt, t0, False)
+        k = sintering.relax_k1(k, K, dt, t0, False)
         t += dt
         assert k == pytest.approx(eq11(k0, K, t, t0), rel=1e-12, abs=1e-15)
     assert min(k0, K) <= k <= max(k0, K)
@@ -169,7 +171,7 @@ def test_relax_k1_against_eq12_integrated_numerically(k0, K):
                     rtol=1e-12, atol=1e-14, method="DOP853")
     k = k0
     for t, reference in zip(times, sol.y[0]):
-        k = law.relax_k1(k, K, t0 / 7, t0, False)
+        k = sintering.relax_k1(k, K, t0 / 7, t0, False)
         assert k == pytest.approx(reference, rel=1e-9)
         assert reference == pytest.approx(eq11(k0, K, t, t0), rel=1e-9)
 
@@ -178,48 +180,48 @@ def test_relax_k1_rate_is_eq12():
     """d k/dt = (K - k)|K - k|/(K t0), from the step's own change over a small dt."""
     for k, K in ((1.0, 0.6), (0.2, 0.7)):
         dt, t0 = 1e-6, 10.0
-        rate = (law.relax_k1(k, K, dt, t0, False) - k) / dt
+        rate = (sintering.relax_k1(k, K, dt, t0, False) - k) / dt
         assert rate == pytest.approx((K - k) * abs(K - k) / (K * t0), rel=1e-5)
 
 
 def test_relax_k1_rapid_freeze_and_hot_limit():
     """Cooling with k1(T) > k1(T, t): k1(T, t) = k1(T) at once (end of Sec. 3.4); heating never jumps."""
-    assert law.relax_k1(0.2, 0.9, 1e-9, 1e3, True) == 0.9
-    assert law.relax_k1(0.2, 0.9, 1e-9, 1e3, False) < 0.2 + 1e-9
-    assert law.relax_k1(0.9, 0.2, 1e-9, 1e3, True) > 0.9 - 1e-9  # cooling but K < k: eq. 12 applies
-    assert law.relax_k1(0.9, 0.0, 1e-3, 1e3, False) == 0.0       # K -> 0: the rate 1/K diverges
-    assert law.relax_k1(0.0, 0.0, 1e-3, 1e3, False) == 0.0
+    assert sintering.relax_k1(0.2, 0.9, 1e-9, 1e3, True) == 0.9
+    assert sintering.relax_k1(0.2, 0.9, 1e-9, 1e3, False) < 0.2 + 1e-9
+    assert sintering.relax_k1(0.9, 0.2, 1e-9, 1e3, True) > 0.9 - 1e-9  # cooling but K < k: eq. 12 applies
+    assert sintering.relax_k1(0.9, 0.0, 1e-3, 1e3, False) == 0.0       # K -> 0: the rate 1/K diverges
+    assert sintering.relax_k1(0.0, 0.0, 1e-3, 1e3, False) == 0.0
 
 
 def test_radius_at_eq9():
-    assert law.radius_at(1e-3, 80.0, 120.0, 1e-4) == pytest.approx(1e-3 * (1.0 - 1e-4 * 40.0), rel=1e-15)
-    assert law.radius_at(1e-3, 120.0, 120.0, 1e-4) == 1e-3
+    assert sintering.radius_at(1e-3, 80.0, 120.0, 1e-4) == pytest.approx(1e-3 * (1.0 - 1e-4 * 40.0), rel=1e-15)
+    assert sintering.radius_at(1e-3, 120.0, 120.0, 1e-4) == 1e-3
 
 
 def test_time_step_eq6_and_overcritical_damping():
     m = 2000.0 * math.pi * (0.5e-3) ** 2 * 6e-3  # smallest Table-1 disk, h = 6 mm
     m12 = m / 2
     omega = math.sqrt(K2 / m12 - (0.2 / (2 * m12)) ** 2)
-    assert luding.time_step(K2, 0.2, m12) == pytest.approx(math.pi / (50 * omega), rel=1e-14)
+    assert luding_normal.time_step(K2, 0.2, m12) == pytest.approx(math.pi / (50 * omega), rel=1e-14)
     with pytest.raises(ValueError, match="overcritical"):
-        luding.time_step(K2, 2.0 * math.sqrt(K2 * m12) * 1.0001, m12)
+        luding_normal.time_step(K2, 2.0 * math.sqrt(K2 * m12) * 1.0001, m12)
     with pytest.raises(ValueError, match="m_min"):
-        luding.time_step(K2, 0.2, 0.0)
+        luding_normal.time_step(K2, 0.2, 0.0)
 
 
 # ------------------------------------------------------------------------------------------ eq. 7, 13, 15
 def test_k2_of_delta_max_below_and_above_the_fluid_limit():
-    assert law.delta_max_fluid(DF, P) == pytest.approx(DMF, rel=1e-15)
+    assert luding_normal.delta_max_fluid(DF, P) == pytest.approx(DMF, rel=1e-15)
     assert DMF == pytest.approx(4e-4)  # k2/(k2 - k1) = 2 for Table 1
     for dmax in (0.0, 1e-5, 1e-4, 3.99e-4, 4e-4, 1e-3):
-        assert law.k2_of_delta_max(dmax, DF, P) == pytest.approx(k2_hand(dmax), rel=1e-15)
-    assert law.k2_of_delta_max(1e-4, DF, P) == pytest.approx(1.25e5)
-    assert law.k2_of_delta_max(0.0, DF, P) == K1
+        assert luding_normal.k2_of_delta_max(dmax, DF, P) == pytest.approx(k2_hand(dmax), rel=1e-15)
+    assert luding_normal.k2_of_delta_max(1e-4, DF, P) == pytest.approx(1.25e5)
+    assert luding_normal.k2_of_delta_max(0.0, DF, P) == K1
 
 
 def test_pair_delta_fluid():
-    assert law.pair_delta_fluid(1e-3, 1e-3, 0.2) == pytest.approx(0.2e-3, rel=1e-15)
-    assert law.pair_delta_fluid(1e-3, 3e-3, 0.2) == pytest.approx(0.2 * 2 * 0.75e-3, rel=1e-15)
+    assert luding_normal.pair_delta_fluid(1e-3, 1e-3, 0.2) == pytest.approx(0.2e-3, rel=1e-15)
+    assert luding_normal.pair_delta_fluid(1e-3, 3e-3, 0.2) == pytest.approx(0.2 * 2 * 0.75e-3, rel=1e-15)
 
 
 @pytest.mark.parametrize("dmax", [2e-5, 1e-4, 3e-4])
@@ -237,10 +239,10 @@ def test_loading_then_unloading_gives_delta0_deltamin_fmin(dmax):
     assert (dm, k2_k) == (dmax, pytest.approx(k2m, rel=1e-14))
     assert d0_k == pytest.approx(d0, rel=1e-13) and fmin_k == pytest.approx(fmin, rel=1e-13)
     assert kc_k == pytest.approx(kcm, rel=1e-14)
-    assert law.delta_0(dmax, 1.0, DF, P) == pytest.approx(d0, rel=1e-13)
-    assert law.delta_min(dmax, 1.0, DF, P) == pytest.approx(dmin, rel=1e-13)
-    assert law.f_min(dmax, 1.0, DF, P) == pytest.approx(fmin, rel=1e-13)
-    assert law.kc_of(dmax, 0.4, DF, P) == pytest.approx(0.4 * kcm, rel=1e-14)
+    assert luding_normal.delta_0(dmax, 1.0, DF, P) == pytest.approx(d0, rel=1e-13)
+    assert luding_normal.delta_min(dmax, 1.0, DF, P) == pytest.approx(dmin, rel=1e-13)
+    assert luding_normal.f_min(dmax, 1.0, DF, P) == pytest.approx(fmin, rel=1e-13)
+    assert luding_normal.kc_of(dmax, 0.4, DF, P) == pytest.approx(0.4 * kcm, rel=1e-14)
     # unloading on the k2 line: zero force at delta_0, f_min at delta_min, history unchanged
     for d, expected in ((0.5 * (dmax + d0), k2m * (0.5 * (dmax + d0) - d0)), (d0, 0.0), (dmin, fmin)):
         res = normal(d, 0.0, 1.0, dmax, 1.0, DF, P)
@@ -250,7 +252,7 @@ def test_loading_then_unloading_gives_delta0_deltamin_fmin(dmax):
 
 
 def test_normal_force_returns_its_documented_order():
-    f, dm, fmin, k2m, kcm, d0 = law.normal_force(5e-5, 0.0, 1.0, 1e-4, 1.0, DF, P)
+    f, dm, fmin, k2m, kcm, d0 = luding_normal.normal_force(5e-5, 0.0, 1.0, 1e-4, 1.0, DF, P)
     k2h = k2_hand(1e-4)
     assert (dm, k2m, kcm) == (1e-4, pytest.approx(k2h), pytest.approx(k2h / K2 * KC))
     assert d0 == pytest.approx((1 - K1 / k2h) * 1e-4) and f == pytest.approx(k2h * (5e-5 - d0))
@@ -273,7 +275,7 @@ def test_tension_branch_and_reloading_from_it():
     (1 - k1/k2(x)) x = delta_0; reloading follows the new k2 line up to the k1 line at the new delta_max."""
     for s in (1.0, 0.5):
         dmax = 1e-4
-        d = 0.3 * law.delta_min(dmax, s, DF, P)
+        d = 0.3 * luding_normal.delta_min(dmax, s, DF, P)
         f, dm, d0, fmin, k2m, kcm = normal(d, 0.0, s, dmax, s, DF, P)
         d0_hand = d * (1 + s * KC / K2)
         root = brentq(lambda x: (1 - s * K1 / k2_hand(x)) * x - d0_hand, 0.0, dmax)
@@ -307,7 +309,7 @@ def test_heating_keeps_delta_max_and_cooling_keeps_delta0():
     assert cold[2] == pytest.approx(d0_hot, rel=1e-13) and cold[1] == pytest.approx(root, rel=1e-13)
     assert cold[1] > dmax and cold[0] == pytest.approx(k2_hand(root) * (d - d0_hot), rel=1e-12)
     # a cycle close to melting leaves a contact that looks more strongly loaded (Sec. 3.3.2): stronger attraction
-    assert cold[3] < law.f_min(dmax, 1.0, DF, P)
+    assert cold[3] < luding_normal.f_min(dmax, 1.0, DF, P)
 
 
 def test_heating_at_the_old_force_free_overlap_pulls_up_to_the_cohesion_line():
@@ -323,10 +325,10 @@ def test_heating_at_the_old_force_free_overlap_pulls_up_to_the_cohesion_line():
 def test_delta_max_for_delta0_is_stable_in_both_root_forms():
     for s in (0.0, 0.3, 1.0):
         for d0 in (1e-12, 1e-7, 5e-5, 1.9e-4, 3e-4):
-            x = law.delta_max_for_delta_0(d0, s, DF, P)
-            residual = (1 - s * K1 / law.k2_of_delta_max(x, DF, P)) * x - d0
+            x = luding_normal.delta_max_for_delta_0(d0, s, DF, P)
+            residual = (1 - s * K1 / luding_normal.k2_of_delta_max(x, DF, P)) * x - d0
             assert abs(residual) <= 4e-16 * max(x, d0)
-    assert law.delta_max_for_delta_0(0.0, 1.0, DF, P) == 0.0
+    assert luding_normal.delta_max_for_delta_0(0.0, 1.0, DF, P) == 0.0
 
 
 def test_prestressed_heating_shifts_delta_max_only_after_k1_line_drops_below_the_force():
@@ -413,15 +415,15 @@ N_Z = (0.0, 0.0, 1.0)
 
 def test_relative_velocity_eq18_signs():
     # i above j (n = +z from j to i), i moving down onto j: approaching, delta_dot > 0
-    vt, ddot = law.relative_velocity((0.0, 0.0, -2.0), (0.0, 0.0, 0.0), (0.0,) * 3, (0.0,) * 3, 1e-3, 1e-3, N_Z)
+    vt, ddot = luding_tangential.relative_velocity((0.0, 0.0, -2.0), (0.0, 0.0, 0.0), (0.0,) * 3, (0.0,) * 3, 1e-3, 1e-3, N_Z)
     assert ddot == 2.0 and vt == (0.0, 0.0, 0.0)
     # rolling without slip: i spins +y, j spins -y, i moves +x with a w: contact points move together
     a, w = 1e-3, 10.0
-    vt, ddot = law.relative_velocity((a * w, 0.0, 0.0), (-a * w, 0.0, 0.0), (0.0, w, 0.0), (0.0, w, 0.0), a, a, N_Z)
+    vt, ddot = luding_tangential.relative_velocity((a * w, 0.0, 0.0), (-a * w, 0.0, 0.0), (0.0, w, 0.0), (0.0, w, 0.0), a, a, N_Z)
     # v_ij = 2 a w x + a (z x w y) + a (z x w y) = 2aw x - 2aw x = 0
     assert vt == pytest.approx((0.0, 0.0, 0.0), abs=1e-15) and ddot == 0.0
     # spin only: the surface of i at the contact (below its centre) moves with -a w_y x ... (n x w) a
-    vt, _ = law.relative_velocity((0.0,) * 3, (0.0,) * 3, (0.0, 1.0, 0.0), (0.0,) * 3, 2.0, 0.0, N_Z)
+    vt, _ = luding_tangential.relative_velocity((0.0,) * 3, (0.0,) * 3, (0.0, 1.0, 0.0), (0.0,) * 3, 2.0, 0.0, N_Z)
     assert vt == pytest.approx((-2.0, 0.0, 0.0))  # a n x w = 2 (z x y) = -2 x
 
 
@@ -434,7 +436,7 @@ def test_sticking_then_sliding_at_mu_times_fn_minus_fmin():
     xi, vt = (0.0, 0.0, 0.0), (1e-2, 0.0, 0.0)
     history = []
     for _ in range(400):
-        ft, xi_new, sliding, fn_out = law.tangential_force(xi, N_Z, vt, f_n, fmin, k2m, s, dt, P, False)
+        ft, xi_new, sliding, fn_out = luding_tangential.tangential_force(xi, N_Z, vt, f_n, fmin, k2m, s, dt, P, False)
         history.append((ft, xi, sliding))
         if not sliding:
             assert ft == pytest.approx((-kt * xi[0] - gt * vt[0], 0.0, 0.0), rel=1e-14)
@@ -442,7 +444,7 @@ def test_sticking_then_sliding_at_mu_times_fn_minus_fmin():
         else:
             assert math.hypot(*ft) == pytest.approx(f_c, rel=1e-14) and ft[0] < 0
             assert xi_new[0] == pytest.approx(-(ft[0] + gt * vt[0]) / kt, rel=1e-14)
-            nxt = law.tangential_force(xi_new, N_Z, (0.0,) * 3, f_n, fmin, k2m, s, dt, P, False)
+            nxt = luding_tangential.tangential_force(xi_new, N_Z, (0.0,) * 3, f_n, fmin, k2m, s, dt, P, False)
             assert nxt[0][0] == pytest.approx(-kt * xi_new[0], rel=1e-14)  # = f_C t + gamma_t v_t
             assert fn_out == f_n
             break
@@ -455,23 +457,23 @@ def test_sticking_then_sliding_at_mu_times_fn_minus_fmin():
 def test_brittle_sliding_drops_cohesion_footnote5():
     s, fmin, k2m = 1.0, -0.3, 1.5e5
     big_xi = (1e-3, 0.0, 0.0)
-    ft, _, sliding, fn_out = law.tangential_force(big_xi, N_Z, (0.0,) * 3, -0.1, fmin, k2m, s, 1e-6, P, False)
+    ft, _, sliding, fn_out = luding_tangential.tangential_force(big_xi, N_Z, (0.0,) * 3, -0.1, fmin, k2m, s, 1e-6, P, False)
     assert sliding and fn_out == 0.0 and math.hypot(*ft) == pytest.approx(MAT.mu * (-0.1 - fmin), rel=1e-14)
     p = replace(MAT, brittle_sliding=False).params()
-    _, _, sliding, fn_out = law.tangential_force(big_xi, N_Z, (0.0,) * 3, -0.1, fmin, k2m, s, 1e-6, p, False)
+    _, _, sliding, fn_out = luding_tangential.tangential_force(big_xi, N_Z, (0.0,) * 3, -0.1, fmin, k2m, s, 1e-6, p, False)
     assert sliding and fn_out == -0.1
-    small = law.tangential_force((1e-9, 0.0, 0.0), N_Z, (0.0,) * 3, -0.1, fmin, k2m, s, 1e-6, P, False)
+    small = luding_tangential.tangential_force((1e-9, 0.0, 0.0), N_Z, (0.0,) * 3, -0.1, fmin, k2m, s, 1e-6, P, False)
     assert not small[2] and small[3] == -0.1  # sticking keeps cohesion
 
 
 def test_no_tangential_force_beyond_cohesion_failure_and_wall_friction():
-    out = law.tangential_force((1e-6, 2e-6, 0.0), N_Z, (1.0, 0.0, 0.0), -0.4, -0.3, 1e5, 1.0, 1e-6, P, False)
+    out = luding_tangential.tangential_force((1e-6, 2e-6, 0.0), N_Z, (1.0, 0.0, 0.0), -0.4, -0.3, 1e5, 1.0, 1e-6, P, False)
     assert out[0] == (0.0, 0.0, 0.0) and out[1] == (0.0, 0.0, 0.0)
     # Table 1: mu_wall = 0, so a wall contact slides with no tangential force
-    ft, xi, sliding, _ = law.tangential_force((1e-6, 0.0, 0.0), N_Z, (0.0,) * 3, 1.0, 0.0, 1e5, 1.0, 1e-6, P, True)
+    ft, xi, sliding, _ = luding_tangential.tangential_force((1e-6, 0.0, 0.0), N_Z, (0.0,) * 3, 1.0, 0.0, 1e5, 1.0, 1e-6, P, True)
     assert sliding and ft == (0.0, 0.0, 0.0)
     # friction follows k1(T, t) (eq. 24)
-    hot = law.tangential_force((1.0, 0.0, 0.0), N_Z, (0.0,) * 3, 1.0, 0.0, 1e5, 0.25, 1e-6, P, False)
+    hot = luding_tangential.tangential_force((1.0, 0.0, 0.0), N_Z, (0.0,) * 3, 1.0, 0.0, 1e5, 0.25, 1e-6, P, False)
     assert math.hypot(*hot[0]) == pytest.approx(0.25 * MAT.mu * 1.0, rel=1e-14)
 
 
@@ -480,7 +482,7 @@ def test_spring_projected_when_the_normal_rotates():
     theta = 0.1
     n = (math.sin(theta), 0.0, math.cos(theta))
     xi = (1e-6, 0.0, 0.0)
-    ft, xi_new, sliding, _ = law.tangential_force(xi, n, (0.0,) * 3, 10.0, 0.0, 1e5, 1.0, 1e-6, P, False)
+    ft, xi_new, sliding, _ = luding_tangential.tangential_force(xi, n, (0.0,) * 3, 10.0, 0.0, 1e5, 1.0, 1e-6, P, False)
     projected = np.array(xi) - np.array(n) * (np.array(n) @ np.array(xi))
     assert not sliding and xi_new == pytest.approx(tuple(projected), rel=1e-14, abs=1e-22)
     assert abs(np.dot(xi_new, n)) < 1e-22
@@ -496,6 +498,6 @@ def test_k1_equal_k2_is_the_elastic_limit():
     s = 1.0
     dm = 0.0
     for delta in (1e-6, 3e-6, 2e-6, 0.5e-6):
-        f, dm, f_min, k2m, kcm, d0 = law.normal_force(delta, 0.0, s, dm, s, 2e-4, p)
+        f, dm, f_min, k2m, kcm, d0 = luding_normal.normal_force(delta, 0.0, s, dm, s, 2e-4, p)
         assert f == pytest.approx(2e5 * delta, rel=1e-14) and d0 == 0.0 and k2m == 2e5 and f_min == 0.0
     assert dm == 3e-6

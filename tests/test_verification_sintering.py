@@ -232,7 +232,8 @@ def test_the_cool_down_splits_into_the_box_and_the_particles_area():
 def test_frozen_radii_keep_each_particle_its_size(tmp_path):
     from dataclasses import replace
 
-    from dem.laws.contact.luding import LUDING_TABLE1, radius_at
+    from dem.laws.contact.luding import LUDING_TABLE1
+    from dem.laws.contact.state.sintering import radius_at
 
     state = tmp_path / "state.npz"
     radius, T = np.array([1.002e-3, 0.5e-3]), np.array([140.0, 140.0])

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from dem.scene import parse_scene
-from dem.laws.contact import zohdi as zohdi_law
+from dem.laws.contact.normal import zohdi as zohdi_normal
 from dem.laws.contact.zohdi import ZohdiMaterial
 from dem.scene.staggered import ZohdiStepping
 from dem.engines.staggered.engine import StaggeredEngine
@@ -47,9 +47,9 @@ FLOOR = {"name": "bottom", "point": [-1.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}
 def test_lens_area_and_softening_closed_forms():
     ri, rj, d = 0.075, 0.05, 0.11
     li = 0.5 * (d - (rj**2 - ri**2) / d)
-    assert zohdi_law.lens_area(ri, rj, d) == pytest.approx(math.pi * (ri**2 - li**2), rel=1e-14)
-    assert zohdi_law.lens_area(ri, rj, d) == pytest.approx(math.pi * (rj**2 - (d - li) ** 2), rel=1e-12)  # one circle
-    assert zohdi_law.lens_area(ri, rj, ri + rj) == 0.0
+    assert zohdi_normal.lens_area(ri, rj, d) == pytest.approx(math.pi * (ri**2 - li**2), rel=1e-14)
+    assert zohdi_normal.lens_area(ri, rj, d) == pytest.approx(math.pi * (rj**2 - (d - li) ** 2), rel=1e-12)  # one circle
+    assert zohdi_normal.lens_area(ri, rj, ri + rj) == 0.0
     m = ZohdiMaterial(**{k: v for k, v in CONTACT.items() if k != "law"}, density=RHO)
     assert m.stiffness(300.0) == pytest.approx(4.0e6) and m.stiffness(480.0) == 1.0e6 and m.stiffness(0.0) == 1e7
 

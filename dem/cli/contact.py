@@ -10,9 +10,10 @@ other columns are ignored. Per row the tool reports the normal force on a partic
 :math:`k_2(\delta_\mathrm{max})`, ``kc`` = :math:`k_c(T, t, \delta_\mathrm{max})` (all in N/m) and ``f_min`` (eq. 15).
 
 :math:`k_1(T, t)` starts at its equilibrium :math:`k_1(T)` of the first row's temperature and relaxes row by row
-towards :math:`k_1(T)` of each row's temperature (eq. 12, :func:`dem.laws.contact.luding.relax_k1`; cooling freezes at
-once). The viscous force :math:`\gamma_0 \dot\delta` (eq. 5) uses the backward difference of the overlap between rows
-(0 on the first row); ``--no-damping`` leaves it out, giving the elastic-plastic force of Figs. 2, 3 and 5 alone.
+towards :math:`k_1(T)` of each row's temperature (eq. 12, :func:`dem.laws.contact.state.sintering.relax_k1`;
+cooling freezes at once). The viscous force :math:`\gamma_0 \dot\delta` (eq. 5) uses the backward difference of the
+overlap between rows (0 on the first row); ``--no-damping`` leaves it out, giving the elastic-plastic force of Figs.
+2, 3 and 5 alone.
 
 Without ``--json`` the rows are printed as a table; ``--out DIR`` writes ``contact.csv`` and ``contact.png`` (force
 against overlap with the cold :math:`k_1` line, the :math:`k_1(T, t)` and :math:`-k_c(T, t, \delta_\mathrm{max})` lines
@@ -157,22 +158,24 @@ def drive_pair(material, radius: float, t, overlap, T, damping: bool = True) -> 
         ``{name: (rows,) array}`` for the names of ``OUTPUTS``: force (N), ``delta_max``, ``delta_0`` (m), ``k1``,
         ``k2``, ``kc`` (N/m), ``f_min`` (N).
     """
-    from dem.laws.contact import luding as law
+    from dem.laws.contact.normal import luding as luding_normal
+    from dem.laws.contact.state import sintering
 
     params = material.params()
-    delta_fluid = law.pair_delta_fluid(radius, radius, material.fluid_overlap)
+    delta_fluid = luding_normal.pair_delta_fluid(radius, radius, material.fluid_overlap)
     n = len(t)
     out = {key: np.empty(n) for key in OUTPUTS}
-    s = law.k1_factor(T[0], material.T_melt, material.T_var)
+    s = sintering.k1_factor(T[0], material.T_melt, material.T_var)
     s_last, delta_max = s, 0.0
     for k in range(n):
         if k:
-            target = law.k1_factor(T[k], material.T_melt, material.T_var)
-            s = law.relax_k1(s, target, t[k] - t[k - 1], material.t0, T[k] < T[k - 1])
+            target = sintering.k1_factor(T[k], material.T_melt, material.T_var)
+            s = sintering.relax_k1(s, target, t[k] - t[k - 1], material.t0, T[k] < T[k - 1])
         rate = (overlap[k] - overlap[k - 1]) / (t[k] - t[k - 1]) if k and damping else 0.0
         if overlap[k] <= 0.0:
             delta_max = 0.0  # the contact is open: its history is gone
-        f, delta_max, fmin, k2, kc, d0 = law.normal_force(overlap[k], rate, s, delta_max, s_last, delta_fluid, params)
+        f, delta_max, fmin, k2, kc, d0 = luding_normal.normal_force(overlap[k], rate, s, delta_max, s_last,
+                                                                    delta_fluid, params)
         s_last = s
         for key, value in zip(OUTPUTS, (f, delta_max, d0, s * material.k1, k2, kc, fmin)):
             out[key][k] = value
@@ -197,7 +200,7 @@ def run(args) -> dict:
     ValueError
         A bad scene, history or overlap.
     """
-    from dem.laws.contact.luding import pair_delta_fluid
+    from dem.laws.contact.normal.luding import pair_delta_fluid
     from dem.scene.parse import load_scene, luding_material_from_scene
 
     scene = load_scene(args.scene)
@@ -286,10 +289,10 @@ def plot(path: pathlib.Path, material, radius: float, history: dict, rows: dict,
     """
     from matplotlib.figure import Figure
 
-    from dem.laws.contact import luding as law
+    from dem.laws.contact.normal import luding as luding_normal
     from dem.output.plots import temperature_label
 
-    delta_fluid = law.pair_delta_fluid(radius, radius, material.fluid_overlap)
+    delta_fluid = luding_normal.pair_delta_fluid(radius, radius, material.fluid_overlap)
     x = history["overlap"]
     top = max(float(np.max(x)), float(np.max(rows["delta_max"])), 1e-300)
     line = np.array([0.0, 1.1 * top])

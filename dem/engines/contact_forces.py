@@ -240,8 +240,9 @@ def forces(law, particles, pairs, walls, wall_list, constants, dt, fresh, record
             vr1 = 0.0 if planar else v[i, 1] - v[j, 1] + n2 * c0 - n0 * c2
             vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
             vn = vr0 * n0 + vr1 * n1 + vr2 * n2
-            f_n, ft0, ft1, ft2 = binding.pair_force(law, c, i, j, p_hist_in, p_hist, state, T, delta, d, (n0, n1, n2),
-                                                (vr0, vr1, vr2), vn, ri, rj, planar, dt, params, const)
+            f_n, ft0, ft1, ft2 = binding.pair_force(law, c, i, j, p_hist_in, p_hist, state, T,
+                                                    (delta, d, (n0, n1, n2), (vr0, vr1, vr2), vn), ri, rj, planar, dt,
+                                                    params, const)
             if record:  # (2D disks: the y force recorded as +0 on any number of threads; under the flag nsz the
                 # compiler may give a zero either sign, and it compiles the threaded loop's body on its own)
                 p_fn[c] = f_n
@@ -290,8 +291,8 @@ def forces(law, particles, pairs, walls, wall_list, constants, dt, fresh, record
         vr1 = v[k, 1] - wdq[m] * n1 + lk * (n2 * w[k, 0] - n0 * w[k, 2])
         vr2 = v[k, 2] - wdq[m] * n2 + lk * (n0 * w[k, 1] - n1 * w[k, 0])
         vn = vr0 * n0 + vr1 * n1 + vr2 * n2
-        f_n, ft0, ft1, ft2 = binding.wall_force(law, k, m, w_hist_in, w_hist, state, T, delta, dist, (n0, n1, n2),
-                                            (vr0, vr1, vr2), vn, rk, dt, params)
+        f_n, ft0, ft1, ft2 = binding.wall_force(law, k, m, w_hist_in, w_hist, state, T,
+                                                (delta, dist, (n0, n1, n2), (vr0, vr1, vr2), vn), rk, dt, params)
         w_fn[k, m] = f_n
         w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = ft0, ft1, ft2
         f[k, 0] += f_n * n0 + ft0

@@ -47,11 +47,19 @@ def setup(app):
         has_content = False
 
         def run(self):
+            import importlib
+
             from dem.laws.contact import CONTACT_LAWS, law_module
             from dem.scene import schema
 
-            for module in (schema, *(law_module(name) for name in CONTACT_LAWS)):
-                self.env.note_dependency(module.__file__)  # the page is read again when the table changes
+            modules = {schema}  # the page is read again when a table changes: the schema's, a law's material's or
+            for name in CONTACT_LAWS:  # its sub-models' rows
+                law = law_module(name)
+                modules.update(module for module in law.modules.values() if module is not None)
+                if law.composition.material is not None:
+                    modules.add(importlib.import_module(law.composition.material))
+            for module in sorted(modules, key=lambda m: m.__name__):
+                self.env.note_dependency(module.__file__)
             out = []
             for table, text in sections():
                 title = table_title(table)

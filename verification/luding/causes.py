@@ -67,15 +67,16 @@ def contact_cooling(force: float, material=LUDING_TABLE1, radius: float = 1.0e-3
     held without thermal expansion, and the force held (the centres follow). The kernels of the law
     (:func:`dem.cli.contact.drive_pair`) give the forces; :func:`cooled_force` predicts the centres-held ones."""
     from dem.cli.contact import drive_pair
-    from dem.laws.contact import luding as law
+    from dem.laws.contact.normal import luding as luding_normal
+    from dem.laws.contact.state import sintering
 
     mat = replace(material, t0=T0_SINTER)
-    delta_fluid = law.pair_delta_fluid(radius, radius, mat.fluid_overlap)
-    s = [law.k1_factor(T_PREPARE, mat.T_melt, mat.T_var)]
+    delta_fluid = luding_normal.pair_delta_fluid(radius, radius, mat.fluid_overlap)
+    s = [sintering.k1_factor(T_PREPARE, mat.T_melt, mat.T_var)]
     t = [0.0]
-    target = law.k1_factor(T_SINTER, mat.T_melt, mat.T_var)
+    target = sintering.k1_factor(T_SINTER, mat.T_melt, mat.T_var)
     for tk in np.linspace(t_s / rows, t_s, rows):
-        s.append(law.relax_k1(s[-1], target, tk - t[-1], mat.t0, False))
+        s.append(sintering.relax_k1(s[-1], target, tk - t[-1], mat.t0, False))
         t.append(tk)
     s = np.array(s)
     hot_t = 1.0 + np.array(t)

@@ -20,7 +20,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from dem.laws.contact.luding import P_FLUID_OVERLAP
-from dem.laws.contact.luding import f_min, pair_delta_fluid
+from dem.laws.contact.normal.luding import f_min, pair_delta_fluid
 
 
 def clusters(n: int, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

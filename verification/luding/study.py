@@ -12,7 +12,8 @@ import pathlib
 
 import numpy as np
 
-from dem.laws.contact.luding import LUDING_TABLE1, radius_at
+from dem.laws.contact.luding import LUDING_TABLE1
+from dem.laws.contact.state.sintering import radius_at
 from verification.luding.protocol import T_PREPARE, Times
 from verification.luding import runs as sr
 

@@ -1,49 +1,34 @@
-"""Contact laws of particles that move, as plug-ins: each law is one module, registered by one line of
-:data:`CONTACT_LAWS`, and the engines' compiled loops take its kernels in at compile time
-(:mod:`dem.laws.contact.binding`).
+"""Contact laws of particles that move, each a named choice of sub-models: one line of :data:`CONTACT_LAWS` (a
+:class:`~dem.laws.contact.composition.Composition` of a normal force, a damping, a tangential force, an adhesion, what
+particles carry from step to step and a drag), put together by :class:`~dem.laws.contact.composition.Law` for the
+engines and at compile time by :mod:`dem.laws.contact.binding` for their compiled loops.
 
-A contact law module defines (SI units; forces on particle i, the unit normal ``n`` from j to i, 3-vectors as
-3-tuples; the compiled kernels ``numba.njit`` with ``inline="always"``):
-
-* ``NAME``; ``Material``, a frozen dataclass of its parameters with ``params()`` (a float64 array; ``N_PARAMS``
-  entries) and a ``density``; ``PAIR_HISTORY``, ``WALL_HISTORY`` (the names of the numbers each pair and each
-  particle-wall contact carries from step to step) and ``PARTICLE_STATE`` (those each particle carries); ``SPINS``
-  (its tangential forces make torques) and ``DRAG`` (it has a drag on every particle); ``SCHEMA_ROWS``, its
-  material's fields documented for the scene schema (:mod:`dem.scene.schema`: keys, type and unit, meaning);
-* ``initial_state(material, T, mass)`` -- the particles' state columns from their initial temperatures and masses,
-  (N, S); ``reference_radius(material, radius, T)`` -- the radii the law's thermal expansion starts from;
-  ``time_steps(material, mass, inertia, radius, m_mean)`` -- ``(dt, stable)``: the step ``dt = "auto"`` takes and the
-  largest a velocity-Verlet step may take; ``largest_reach(material, radius)`` -- the farthest beyond touching any
-  contact of these particles acts (the neighbour lists' skin must exceed it; 0 for a law without forces at a
-  distance);
-* ``pair_constants(ri, rj, params)`` -- two numbers of a pair that depend on its radii alone, which the loops keep
-  per pair and compute again only when the radii or the list changed, where ``PAIR_CONSTANTS`` names them (a law
-  that keeps none has ``PAIR_CONSTANTS = ()`` and returns two zeros);
-* ``pair_force(c, i, j, hist_in, hist, state, T, delta, d, n, vr, vn, ri, rj, planar, dt, params, const) -> (f_n,
-  f_t0, f_t1, f_t2)`` -- the force on i of pair ``c`` at overlap ``delta`` (centre distance ``d``) with relative
-  surface velocity ``vr`` (normal part ``vn``) and the pair's ``pair_constants`` ``const``, reading the pair's
-  history from row ``c`` of ``hist_in`` and writing it to row ``c`` of ``hist``;
-  ``forget_pair(c, hist_in, hist)`` -- the pair opened (returns whether it had a history); ``reach(c, hist, ri, rj,
-  params)`` -- how far beyond touching the pair still acts (0 for a law without forces at a distance);
-* ``wall_force(k, m, hist_in, hist, state, T, delta, dist, n, vr, vn, rk, dt, params)``, ``forget_wall(k, m, hist_in,
-  hist)`` and ``wall_reach(k, m, hist, rk, params)`` -- the same for particle k on wall m (histories indexed
-  ``[k, m]``);
-* ``update_particles(elapsed, T0, T_rate, T, radius, radius_ref, state, uniform, params, t0, dt)`` -- before the
-  forces of every step: the temperatures ``T0 + T_rate elapsed`` and what the law makes of them (radii, state);
-  returns whether a radius changed;
-  ``drag(k, radius, params)`` -- the drag coefficient of particle k (kg/s) where ``DRAG``.
+The sub-models live one per module in the slots' folders (``normal/``, ``damping/``, ``tangential/``,
+``adhesion/``, ``state/``, ``drag/``; their interface: :mod:`dem.laws.contact.composition`); a paper's material (its
+dataclass, parameter block and schema rows) in a module of its own (``luding``, ``zohdi``, ``hertz_mindlin``,
+``jkr``). A new combination of existing sub-models is one more line of :data:`CONTACT_LAWS`.
 """
 
 from __future__ import annotations
 
-import importlib
+from dem.laws.contact.composition import Composition, Law
 
-#: The contact laws by the name ``[contact] law`` gives, each as the module that implements it.
+#: The contact laws by the name ``[contact] law`` gives, each a choice of sub-models.
 CONTACT_LAWS = {
-    "luding": "dem.laws.contact.luding",  # Luding, Manetsberger & Mueller 2005: sintering, hysteretic normal law
-    "zohdi": "dem.laws.contact.zohdi",  # Zohdi 2014: power law on the contact area, bonds, thermal softening
-    "hertz_mindlin": "dem.laws.contact.hertz_mindlin",  # Hertz, Tsuji's damping (restitution e), Mindlin, Coulomb
-    "jkr": "dem.laws.contact.jkr",  # Johnson-Kendall-Roberts 1971 adhesion, with Hertz-Mindlin's damping and friction
+    # Luding, Manetsberger & Mueller 2005: sintering, hysteretic normal law
+    "luding": Composition(normal="luding", damping="luding", tangential="luding", state="sintering",
+                          material="dem.laws.contact.luding"),
+    # Zohdi 2014: power law on the contact area, bonds, thermal softening
+    "zohdi": Composition(normal="zohdi", adhesion="zohdi", tangential="zohdi", state="temperature", drag="zohdi",
+                         material="dem.laws.contact.zohdi"),
+    # Hertz, Tsuji's damping (restitution e), Mindlin, Coulomb
+    "hertz_mindlin": Composition(normal="hertz", damping="tsuji", tangential="mindlin", state="mass",
+                                 material="dem.laws.contact.hertz_mindlin"),
+    # Johnson-Kendall-Roberts 1971 adhesion on Hertz, with Tsuji's damping and Mindlin's friction
+    "jkr": Composition(normal="hertz", damping="tsuji", tangential="mindlin", adhesion="jkr", state="mass",
+                       material="dem.laws.contact.jkr"),
+    # Hertz's normal force and Tsuji's damping with Luding's tangential spring and friction (eqs. 14-24)
+    "hertz_luding": Composition(normal="hertz", damping="tsuji", tangential="luding", state="mass"),
 }
 
 
@@ -55,11 +40,13 @@ DESCRIPTIONS = {
     "hertz_mindlin": "elastic spheres: Hertz normal force with Tsuji's damping (restitution e), Mindlin tangential "
                      "stiffness, Coulomb friction",
     "jkr": "Johnson-Kendall-Roberts 1971 adhesion, with Hertz-Mindlin's damping and friction",
+    "hertz_luding": "Hertz normal force with Tsuji's damping (restitution e), Luding's tangential spring and "
+                    "friction (Luding 2005, eqs. 14-24)",
 }
 
 
-def law_module_name(name) -> str:
-    """The module of the contact law ``name``; ``ValueError`` naming the laws for an unknown one.
+def composition_of(name) -> Composition:
+    """The sub-models of the contact law ``name``; ``ValueError`` naming the laws for an unknown one.
 
     Parameters
     ----------
@@ -68,8 +55,8 @@ def law_module_name(name) -> str:
 
     Returns
     -------
-    str
-        The law's dotted module name.
+    Composition
+        Its sub-models.
 
     Raises
     ------
@@ -81,8 +68,11 @@ def law_module_name(name) -> str:
     return CONTACT_LAWS[name]
 
 
-def law_module(name):
-    """The contact law ``name`` (:data:`CONTACT_LAWS`), imported.
+_LAWS = {}  # the laws put together, by name and composition
+
+
+def law_module(name) -> Law:
+    """The contact law ``name`` (:data:`CONTACT_LAWS`), put together from its sub-models (once per composition).
 
     Parameters
     ----------
@@ -91,12 +81,15 @@ def law_module(name):
 
     Returns
     -------
-    object
-        The law's module.
+    Law
+        The law.
 
     Raises
     ------
     ValueError
-        ``name`` is not a known law.
+        ``name`` is not a known law, or its sub-models do not fit together.
     """
-    return importlib.import_module(law_module_name(name))
+    key = (name, composition_of(name))
+    if key not in _LAWS:
+        _LAWS[key] = Law(*key)
+    return _LAWS[key]
