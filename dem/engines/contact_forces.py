@@ -125,12 +125,12 @@ def pair_geometry(c, x, pi, pj, box, planar):
     return d2, d, dx / q, dy / q, dz / q
 
 
-@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH)
+@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="never" if THREADED else "always")
 def contact_tuple(delta, d, n0, n1, n2, vr0, vr1, vr2, vn):
     """The contact as the laws' kernels read it: ``(delta, d, (n0, n1, n2), (vr0, vr1, vr2), vn)``, the overlap (m),
-    the distance of the centres (m), the unit normal, the relative velocity (m/s) and its normal part (m/s). Built in
-    a function numba does not inline: the parallel loop's array analysis reads a tuple built in place as array
-    dimensions and fails on the nested ones."""
+    the distance of the centres (m), the unit normal, the relative velocity (m/s) and its normal part (m/s). In the
+    threaded copies numba does not inline it: the parallel loop's array analysis reads a tuple built in place as
+    array dimensions and fails on the nested ones."""
     return delta, d, (n0, n1, n2), (vr0, vr1, vr2), vn
 
 
