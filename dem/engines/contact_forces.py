@@ -128,6 +128,15 @@ def pair_geometry(c, x, pi, pj, box, planar):
     return d2, d, dx / q, dy / q, dz / q
 
 
+@njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="never" if THREADED else "always")
+def contact_tuple(delta, d, n0, n1, n2, vr0, vr1, vr2, vn):
+    """The contact as the laws' kernels read it: ``(delta, d, (n0, n1, n2), (vr0, vr1, vr2), vn)``, the overlap (m),
+    the distance of the centres (m), the unit normal, the relative velocity (m/s) and its normal part (m/s). In the
+    threaded copies numba does not inline it: the parallel loop's array analysis reads a tuple built in place as
+    array dimensions and fails on the nested ones."""
+    return delta, d, (n0, n1, n2), (vr0, vr1, vr2), vn
+
+
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, parallel=THREADED)
 def forces(law, particles, pairs, walls, wall_list, constants, dt, fresh, record):
     """Forces and torques of the current state under the contact law ``law`` (a
@@ -184,11 +193,11 @@ def forces(law, particles, pairs, walls, wall_list, constants, dt, fresh, record
     wn, wq, wdq, wforce = walls.normal, walls.q, walls.dq, walls.force
     wk, wm, w_hist_in, w_hist, w_fn, w_ft = wall_list.k, wall_list.m, wall_list.hist_in, wall_list.hist, \
         wall_list.fn, wall_list.ft
-    gravity, box, params = constants.gravity, constants.box, constants.params
+    gravity, box, param_array = constants.gravity, constants.box, constants.params
     planar = len(spin_axes) == 1
     escaped = -1
     n = x.shape[0]
-    params = binding.params_tuple(law, params)
+    params = binding.params_tuple(law, param_array)
     for k in range(n):
         if binding.has_drag(law):
             drag = binding.drag(law, k, radius, params)
@@ -206,6 +215,7 @@ def forces(law, particles, pairs, walls, wall_list, constants, dt, fresh, record
     blocks = pair_blocks(n_pairs, n_blocks) if THREADED else 1
     for b in prange(blocks):  # one block on one thread; on more, a block of consecutive pairs per thread
         first, stop = b * n_pairs // blocks, (b + 1) * n_pairs // blocks
+        block_params = binding.params_tuple(law, param_array)  # the block's own: a parallel loop takes no nested tuple
         ahead = (0.0, 0.0, 0.0, 0.0, 0.0)  # the next pair's geometry, begun before this pair's law (module docstring)
         if first < stop:
             ahead = pair_geometry(first, x, pi, pj, box, planar)
@@ -218,10 +228,10 @@ def forces(law, particles, pairs, walls, wall_list, constants, dt, fresh, record
             if binding.keeps_pair_constants(law) and not fresh:  # (read here: an array passed to a kernel costs)
                 const = (p_const[c, 0], p_const[c, 1])
             else:  # every listed pair's: it may close later
-                const = binding.pair_constants(law, ri, rj, params)
+                const = binding.pair_constants(law, ri, rj, block_params)
                 if binding.keeps_pair_constants(law) and p_const.shape[0]:
                     p_const[c, 0], p_const[c, 1] = const
-            cut = ri + rj + binding.reach(law, c, p_hist_in, ri, rj, params)
+            cut = ri + rj + binding.reach(law, c, p_hist_in, ri, rj, block_params)
             if d2 >= cut * cut or d2 == 0.0:
                 binding.forget_pair(law, c, p_hist_in, p_hist)  # the contact opened: it forgets its history
                 if record:
@@ -241,8 +251,8 @@ def forces(law, particles, pairs, walls, wall_list, constants, dt, fresh, record
             vr2 = v[i, 2] - v[j, 2] + n0 * c1 - n1 * c0
             vn = vr0 * n0 + vr1 * n1 + vr2 * n2
             f_n, ft0, ft1, ft2 = binding.pair_force(law, c, i, j, p_hist_in, p_hist, state, T,
-                                                    (delta, d, (n0, n1, n2), (vr0, vr1, vr2), vn), ri, rj, planar, dt,
-                                                    params, const)
+                                                    contact_tuple(delta, d, n0, n1, n2, vr0, vr1, vr2, vn), ri, rj,
+                                                    planar, dt, block_params, const)
             if record:  # (2D disks: the y force recorded as +0 on any number of threads; under the flag nsz the
                 # compiler may give a zero either sign, and it compiles the threaded loop's body on its own)
                 p_fn[c] = f_n
@@ -292,7 +302,8 @@ def forces(law, particles, pairs, walls, wall_list, constants, dt, fresh, record
         vr2 = v[k, 2] - wdq[m] * n2 + lk * (n0 * w[k, 1] - n1 * w[k, 0])
         vn = vr0 * n0 + vr1 * n1 + vr2 * n2
         f_n, ft0, ft1, ft2 = binding.wall_force(law, k, m, w_hist_in, w_hist, state, T,
-                                                (delta, dist, (n0, n1, n2), (vr0, vr1, vr2), vn), rk, dt, params)
+                                                contact_tuple(delta, dist, n0, n1, n2, vr0, vr1, vr2, vn), rk, dt,
+                                                params)
         w_fn[k, m] = f_n
         w_ft[k, m, 0], w_ft[k, m, 1], w_ft[k, m, 2] = ft0, ft1, ft2
         f[k, 0] += f_n * n0 + ft0
