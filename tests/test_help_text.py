@@ -82,4 +82,4 @@ def test_contact_help_reads_the_maths_and_keeps_paragraphs(monkeypatch):
     assert text.count("\n\n") >= 4  # usage, the docstring's four paragraphs, the options
     text = " ".join(text.split())
     assert "k2 = k_2(δ_max), kc = k_c(T, t, δ_max) (all in N/m)" in text
-    assert "(eq. 12, dem.laws.contact.luding.relax_k1; cooling freezes at once)" in text
+    assert "(eq. 12, dem.laws.contact.state.sintering.relax_k1; cooling freezes at once)" in text

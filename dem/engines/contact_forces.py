@@ -130,10 +130,10 @@ def pair_geometry(c, x, pi, pj, box, planar):
 
 @njit(cache=True, error_model="numpy", fastmath=FINITE_MATH, inline="never" if THREADED else "always")
 def contact_tuple(delta, d, n0, n1, n2, vr0, vr1, vr2, vn):
-    """The contact as the laws' kernels read it: ``(delta, d, (n0, n1, n2), (vr0, vr1, vr2), vn)``, the overlap (m),
-    the distance of the centres (m), the unit normal, the relative velocity (m/s) and its normal part (m/s). In the
-    threaded copies numba does not inline it: the parallel loop's array analysis reads a tuple built in place as
-    array dimensions and fails on the nested ones."""
+    r"""The contact as the laws' kernels read it: the tuple :math:`(\delta, d, n, v_{ij}, v_n)` of the overlap (m),
+    the distance of the centres (m), the unit normal (a 3-tuple), the relative velocity (m/s, a 3-tuple) and its
+    normal part (m/s). In the threaded copies numba does not inline it: the parallel loop's array analysis reads a
+    tuple built in place as array dimensions and fails on the nested ones."""
     return delta, d, (n0, n1, n2), (vr0, vr1, vr2), vn
 
 
