@@ -7,12 +7,13 @@ beside NGSolve solving the same points.
   of several rounds after a warm-up; with NGSolve installed (optional extra ``pip install .[peers]``), alternating
   with the whole process of NGSolve solving the same 40 a/r (:func:`benchmarks.fe.ngsolve_sweep` at
   :data:`benchmarks.fe.NGSOLVE_STARTUP`), and the medians of the round-by-round ratios by CPU and by wall time
-  (targets: at most 1 each).
+  (targets: at most 1 each). Both run as from a shell that sets no thread counts (:func:`shell_environment`).
 """
 
 from __future__ import annotations
 
 import json
+import os
 import pathlib
 import subprocess
 import sys
@@ -23,6 +24,7 @@ import numpy as np
 
 from benchmarks.fe import NGSOLVE_STARTUP
 from benchmarks.timing import available, paired_ratio, whole_processes
+from sinterheat import threads
 from verification.report import records_table
 
 TITLE = "The main command: python -m fem_neck fit"
@@ -50,6 +52,13 @@ def study_fit(section, quick: bool) -> None:
         f"including fit.json/csv/png).{note}\n\n" + records_table([row]))
 
 
+def shell_environment() -> dict:
+    """This process's environment without the thread counts (``SINTERHEAT_THREADS`` and the BLAS variables of
+    :data:`sinterheat.threads.BLAS_VARIABLES`) that ``python -m benchmarks`` sets for its own studies
+    (:func:`sinterheat.threads.use`): the commands timed side by side start as a user starts them from a shell."""
+    return {k: v for k, v in os.environ.items() if k not in (threads.ENVIRONMENT, *threads.BLAS_VARIABLES)}
+
+
 def study_startup(section, quick: bool) -> None:
     """The main command as a user runs it, a whole fresh process each time, beside NGSolve solving the same points
     (when installed): CPU time (of the process and every process it waited for) and wall time, medians over the
@@ -59,17 +68,18 @@ def study_startup(section, quick: bool) -> None:
     rounds = 2 if quick else STARTUP_ROUNDS
     worker = (f"from benchmarks.fe import ngsolve_sweep; ngsolve_sweep({STARTUP_POINTS}, {setting['order']}, "
               f"{setting['maxh']}, {setting['hp_levels']})")
+    env = shell_environment()
     with tempfile.TemporaryDirectory() as tmp:
         runs = iter(range(10**6))
 
         def ours():
             out = pathlib.Path(tmp) / f"fit{next(runs)}"  # a fresh folder every time (no resume)
             subprocess.run([sys.executable, "-m", "fem_neck", "fit", "--json", "--out", str(out)], check=True,
-                           capture_output=True)
+                           capture_output=True, env=env)
             return json.loads((out / "fit.json").read_text())
 
         def theirs():
-            proc = subprocess.run([sys.executable, "-c", worker], check=True, capture_output=True, text=True)
+            proc = subprocess.run([sys.executable, "-c", worker], check=True, capture_output=True, text=True, env=env)
             return json.loads(proc.stdout.splitlines()[-1])
 
         peers = {"fit": ours, "ngsolve": theirs} if available("ngsolve") else {"fit": ours}
@@ -83,7 +93,8 @@ def study_startup(section, quick: bool) -> None:
     rows = [{"command": "python -m fem_neck fit --json --out DIR", "cpu_seconds": median["fit"]["cpu"],
              "wall_seconds": median["fit"]["wall"], "points": len(values["fit"]["points"])}]
     how = (f"Whole processes, one uncounted warm-up and {rounds} counted rounds, medians; CPU time is user + system "
-           f"of the process and every process it waited for (its workers and its plotting process)")
+           f"of the process and every process it waited for (its workers and its plotting process); both started "
+           f"as from a shell that sets no thread counts")
     if "ngsolve" not in peers:
         section.csv("startup", rows)
         section.add_text("Start-up of the main command",

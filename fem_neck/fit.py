@@ -13,7 +13,8 @@ r"""The conductance fit: an FE sweep of the semisphere with a neck over a/r, Roj
   on relative residuals.
 * :func:`run_fit` -- all of it, writing ``fit.json`` (read by the DEM), ``fit.csv`` and ``fit.png`` (the Fig. 16
   analogue) into one folder; the figure is drawn by a process of its own that imports matplotlib while the sweep
-  starts (this process never imports matplotlib).
+  starts and then solves points beside this process, one of the sweep's workers (this process never imports
+  matplotlib).
 
 Every step takes ``neck``: ``"cylinder"`` (default) sweeps and fits the semisphere with Rojek's neck cylinder,
 ``"union"`` the half body of the union of spheres (no cylinder; :math:`A = 1/\pi`), and fit.json records which.
@@ -215,7 +216,7 @@ def _append(path: pathlib.Path, point: FitPoint) -> None:
 
 def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int | None = None,
           solver: str = SOLVER, method: str = METHOD, progress: bool = True, reuse=None,
-          neck: str = "cylinder") -> list[FitPoint]:
+          neck: str = "cylinder", alongside=None) -> list[FitPoint]:
     """Solve the semisphere (``neck = "cylinder"``) or the union's half body (``"union"``) at every a/r to ``rtol``
     on ``workers`` processes (default: all cores), or on the Dask cluster of :func:`sinterheat.pool.use_dask`.
 
@@ -246,6 +247,9 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
     neck : str
         The half body (:data:`fem_neck.law.NECKS`): ``"cylinder"`` (the semisphere with Rojek's neck cylinder) or
         ``"union"`` (the union of spheres).
+    alongside : sinterheat.pool.ProcessPool or None
+        A local pool already started (the figure's process of :func:`run_fit`) whose processes solve points beside
+        this process, counted in ``workers`` (:func:`sinterheat.pool.run_jobs`); None: none.
 
     Returns
     -------
@@ -278,7 +282,8 @@ def sweep(a_over_r, uniform, rtol: float = 1e-4, *, csv_path=None, workers: int 
         importlib.import_module(solver.split(":")[0])  # fail early in the parent, and let fork start warm
     jobs = [(_solve_point, (solver, method, neck, xi, rtol)) for xi, _ in todo]
     uniform_of = {_key(xi): ui for xi, ui in todo}
-    for res in run_jobs(jobs, workers, desc="fit sweep", unit="solve", progress=progress, done=len(points)):
+    for res in run_jobs(jobs, workers, desc="fit sweep", unit="solve", progress=progress, done=len(points),
+                        alongside=alongside):
         p = FitPoint(**res, uniform=uniform_of[_key(res["a_over_r"])])
         points[_key(p.a_over_r)] = p
         if csv_path is not None:
@@ -528,9 +533,10 @@ def import_plotting() -> None:
 @contextlib.contextmanager
 def _plotter(draw: bool):
     """The process that draws fit.png (``None`` when ``draw`` is false): forked now, it imports matplotlib at once
-    (:func:`import_plotting`), on the other core while this process imports the solver, and takes :func:`plot`
-    once the fit is known, while this process writes fit.json and fit.csv. A plotting error is raised by the
-    ``result()`` of its job; an error here stops it at once."""
+    (:func:`import_plotting`) while this process starts the sweep, then solves points beside this one (one of the
+    sweep's workers: :func:`sweep`), and takes :func:`plot` once the fit is known, while this process writes
+    fit.json and fit.csv. A plotting error is raised by the ``result()`` of its job; an error here stops it at
+    once."""
     if not draw:
         yield None
         return
@@ -590,9 +596,10 @@ def run_fit(n_points: int = 40, rtol: float = 1e-4, out=None, *, workers: int | 
     out = pathlib.Path(out) if out is not None else None
     csv_path = out / "fit.csv" if out is not None else None
     reuse, other = reusable_points(csv_path, rtol, solver, method, neck) if csv_path and not fresh else ({}, 0)
+    importlib.import_module(solver.split(":")[0])  # before the figure's process is forked: it solves points too
     with _plotter(out is not None and plot_png) as plotter:
         points = sweep(x, uniform, rtol, csv_path=csv_path, workers=workers, solver=solver, method=method,
-                       progress=progress, reuse=reuse, neck=neck)
+                       progress=progress, reuse=reuse, neck=neck, alongside=plotter)
         reused = sum(_key(xi) in reuse for xi in x)
         xa = np.array([p.a_over_r for p in points])
         fa = np.array([p.K_over_Kcyl for p in points])

@@ -23,12 +23,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from sinterheat.threads import one_blas_thread
 
 MAX_ORDER = 12
+LAYER_MAX = 200  #: largest layer of unknowns :func:`solve` eliminates layer by layer; beyond, sparse LU (SuperLU)
 
 
 @dataclass(frozen=True)
@@ -377,10 +376,9 @@ def solve(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
     fd = free_rows & ~free[cols]
     n_free = int(free.sum())
     rhs = -np.bincount(index[rows[fd]], S[fd] * u[cols[fd]], minlength=n_free)
-    # sparse LU, not dense Cholesky: multi-threaded BLAS on these small dense matrices was 5-50x slower on a busy
-    # 2-core machine (measured), SuperLU is single-threaded and steady
-    A = sp.csc_matrix((S[ff], (index[rows[ff]], index[cols[ff]])), shape=(n_free, n_free))
-    u[free] = splu(A, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True}).solve(rhs)
+    layer = np.full(n_skel, np.iinfo(np.int64).max)  # a skeleton dof's layer: the lowest of its elements' layers
+    np.minimum.at(layer, g, element_layers(mesh)[:, None])
+    u[free] = _skeleton_solve(index[rows[ff]], index[cols[ff]], S[ff], rhs, layer[free])
     u_skel = u[g]                                                               # (E, skeleton nodes)
     energy = float(np.einsum("ei,eij,ej->", u_skel, S, u_skel))
     u_local = np.empty((mesh.quads.shape[0], (p + 1) ** 2))
@@ -390,6 +388,88 @@ def solve(mesh: QuadMesh, order: int, fixed_vertices: dict) -> Solution:
     delta = values[-1] - values[0]
     return Solution(K_over_kappa=2.0 * math.pi * energy / delta**2, dofs=n, skeleton_dofs=n_skel, order=p,
                     u_local=u_local, jacobian_min=jac_min)
+
+
+def element_layers(mesh: QuadMesh) -> np.ndarray:
+    """Every element's layer ``(E,)``: its distance, in steps between elements sharing a vertex, from an element at
+    one end of the mesh (a pseudo-peripheral one: the farthest from the farthest from element 0). Elements sharing a
+    vertex are in the same or in neighbouring layers, so a dof's unknowns couple only with those of its own and the
+    two neighbouring layers of dofs (:func:`solve`); on the graded meshes of :mod:`fem_neck.hpmesh` the layers are
+    the rings around the corner.
+
+    Parameters
+    ----------
+    mesh : QuadMesh
+        The quadrilateral mesh (connected: an element that no path of shared vertices reaches gets layer -1).
+    """
+    quads = mesh.quads
+    layers = np.zeros(quads.shape[0], dtype=np.int64)
+    start = 0
+    for _ in range(3):  # from element 0, then twice from the farthest element found
+        layers.fill(-1)
+        layers[start] = 0
+        frontier = np.zeros(quads.shape[0], dtype=bool)
+        frontier[start] = True
+        reached = np.zeros(mesh.points.shape[0], dtype=bool)
+        step = 0
+        while frontier.any():
+            reached[quads[frontier]] = True
+            step += 1
+            frontier = (layers < 0) & reached[quads].any(axis=1)
+            layers[frontier] = step
+        start = int(np.argmax(layers))
+    return layers
+
+
+def _skeleton_solve(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, rhs: np.ndarray,
+                    layer: np.ndarray) -> np.ndarray:
+    """The solution of the condensed skeleton system ``A x = rhs``, ``A`` given by its entries ``A[rows, cols] +=
+    values`` (duplicates summed) and every unknown's ``layer`` (unknowns couple only within a layer and with the
+    neighbouring layers: :func:`element_layers`).
+
+    When no layer holds more than :data:`LAYER_MAX` unknowns, ``A`` is block tridiagonal in the layers and is
+    eliminated layer by layer (block Gaussian elimination, dense LAPACK on the one BLAS thread of
+    :func:`conductance`; the cost grows as the unknowns times the square of a layer's; the Schur complements of a
+    symmetric positive definite matrix stay so, so no pivoting across layers is needed), which needs no scipy:
+    importing scipy's sparse solvers costs a process more CPU than a sweep's hundred solves. Otherwise by sparse LU
+    (SuperLU).
+    """
+    n = rhs.size
+    if layer.min() < 0 or np.bincount(layer).max() > LAYER_MAX:  # a part no layer reaches, or too large a layer
+        import scipy.sparse as sp
+        from scipy.sparse.linalg import splu
+
+        A = sp.csc_matrix((values, (rows, cols)), shape=(n, n))
+        return splu(A, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True}).solve(rhs)
+    layer = np.unique(layer, return_inverse=True)[1]  # layers without an unknown dropped
+    sizes = np.bincount(layer)
+    order = np.argsort(layer, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(sizes)])
+    position = np.empty(n, dtype=np.int64)
+    position[order] = np.arange(n)
+    local = position - starts[layer]                  # an unknown's place within its layer
+    w, m = int(sizes.max()), sizes.size
+    block = layer[rows] + (layer[cols] - layer[rows] + 1) * m  # 0..m-1 below, m..2m-1 diagonal, 2m.. above
+    blocks = np.bincount((block * w + local[rows]) * w + local[cols], values, minlength=3 * m * w * w)
+    blocks = blocks.reshape(3, m, w, w)               # [below (row layer k), diagonal, above][k]
+    b = rhs[order]
+    kept, schur, y = [], blocks[1, 0, :sizes[0], :sizes[0]], b[:sizes[0]]
+    for k in range(m - 1):
+        n0, n1 = sizes[k], sizes[k + 1]
+        z = np.linalg.solve(schur, np.column_stack([blocks[2, k, :n0, :n1], y]))  # S_k^-1 [A_k,k+1 | y_k]
+        kept.append(z)
+        below = blocks[0, k + 1, :n1, :n0]
+        schur = blocks[1, k + 1, :n1, :n1] - below @ z[:, :-1]
+        y = b[starts[k + 1]:starts[k + 2]] - below @ z[:, -1]
+    x = np.empty(n)
+    part = np.linalg.solve(schur, y)
+    x[starts[m - 1]:] = part
+    for k in range(m - 2, -1, -1):
+        part = kept[k][:, -1] - kept[k][:, :-1] @ part
+        x[starts[k]:starts[k + 1]] = part
+    out = np.empty(n)
+    out[order] = x
+    return out
 
 
 def measure(mesh: QuadMesh, order: int = 4) -> tuple[float, float]:

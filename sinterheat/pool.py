@@ -361,9 +361,15 @@ def bar_switch(progress: bool) -> dict:
 
 
 def run_jobs(jobs, workers: int | None = None, *, start: str = "fork", desc: str = "", unit: str = "job",
-             progress: bool = True, done: int = 0):
+             progress: bool = True, done: int = 0, alongside: ProcessPool | None = None):
     """Run ``func(*args)`` for every ``(func, args)`` of ``jobs`` on :func:`pool` (one job: in this process unless
     on Dask); yield the results as they finish.
+
+    ``alongside``: a local pool the caller has started already (the process that draws a sweep's figure, say, idle
+    until the sweep ends), whose processes take jobs beside this process, which runs jobs too: of the ``workers``
+    processes, this one and those of ``alongside`` are counted, and only the rest are started (none, for two workers
+    and one process alongside), so fewer processes are forked, each of which costs more CPU than a short job
+    (:func:`_shared`). Not on Dask, and not for one worker (then the jobs run in this process alone).
 
     A tqdm bar on stderr counts ``done`` jobs finished earlier plus these, and so does the run's
     :func:`sinterheat.interrupt.where` (its step: ``"<desc>: k of n <unit>s done"``). On an interrupt, an error, or
@@ -385,6 +391,8 @@ def run_jobs(jobs, workers: int | None = None, *, start: str = "fork", desc: str
         Draw the bar.
     done : int
         Jobs finished earlier (a resumed sweep), counted in the bar's total.
+    alongside : ProcessPool or None
+        A local pool of the caller's whose processes take jobs beside this one (it is not stopped here).
     """
     from tqdm import tqdm
 
@@ -394,15 +402,51 @@ def run_jobs(jobs, workers: int | None = None, *, start: str = "fork", desc: str
     here.update(step=f"{label}{done} of {total} {unit}s done")
     if not jobs:
         return
+    processes = min(workers or os.cpu_count() or 1, len(jobs))
+    shared = alongside is not None and processes > 1 and _client is None
+    more = processes - 1 - alongside.slots if shared else 0
     with tqdm(total=total, initial=done, desc=desc, unit=unit, file=sys.stderr, **bar_switch(progress)) as bar, \
-            pool(min(workers or os.cpu_count() or 1, len(jobs)), start=start) as jobs_pool:
-        running = [jobs_pool.submit(func, *args) for func, args in jobs]
-        while running:
-            finished = jobs_pool.wait(running)
-            running = [f for f in running if f not in finished]
-            for future in finished:
-                result = future.result()
-                bar.update()
-                yield result
-                done += 1  # counted once the caller has taken it (e.g. written it to a file)
-                here.update(step=f"{label}{done} of {total} {unit}s done")
+            contextlib.ExitStack() as stack:
+        if shared:
+            pools = [alongside] + ([stack.enter_context(ProcessPool(more, start))] if more > 0 else [])
+            results = _shared(jobs, pools)
+        else:
+            results = _submitted(jobs, stack.enter_context(pool(processes, start=start)))
+        for result in results:
+            bar.update()
+            yield result
+            done += 1  # counted once the caller has taken it (e.g. written it to a file)
+            here.update(step=f"{label}{done} of {total} {unit}s done")
+
+
+def _submitted(jobs, jobs_pool):
+    """The results of ``jobs`` (``(func, args)`` pairs), all submitted to ``jobs_pool`` at once, as they finish."""
+    running = [jobs_pool.submit(func, *args) for func, args in jobs]
+    while running:
+        finished = jobs_pool.wait(running)
+        running = [f for f in running if f not in finished]
+        for future in finished:
+            yield future.result()
+
+
+def _shared(jobs, pools):
+    """The results of ``jobs`` (``(func, args)`` pairs) as they finish, run by the local ``pools`` and by this
+    process: each pool is handed the jobs in order, one more than it has slots (so that none of its processes waits
+    for the next), and whenever none of theirs has finished this process runs the last job not yet handed out."""
+    waiting = list(jobs)
+    running = {}  # future: its pool
+    while waiting or running:
+        for jobs_pool in pools:
+            while waiting and sum(p is jobs_pool for p in running.values()) <= jobs_pool.slots:
+                func, args = waiting.pop(0)
+                running[jobs_pool.submit(func, *args)] = jobs_pool
+        finished = {f for f in running if f.done()}
+        if not finished and waiting:
+            func, args = waiting.pop()
+            yield func(*args)
+            continue
+        if not finished:
+            finished = cf.wait(list(running), return_when=cf.FIRST_COMPLETED).done
+        for future in finished:
+            del running[future]
+            yield future.result()

@@ -8,6 +8,10 @@ several on a busy machine. ``python -m dem`` imports the package ``dem`` (and so
 taken over ends the process at once (nothing is written yet, nothing needs cleaning up) with the one line ``<prog>
 <command>: interrupted at start-up; no results written`` and exit code 130, as one after it does; SIGTERM and SIGHUP
 likewise (``interrupted by SIGTERM``, exit code 128 + the signal; a SIGHUP that ``nohup`` ignores stays ignored).
+
+A CLI may name commands whose processes run BLAS on one thread throughout (``one_blas_thread`` of :func:`run_main`):
+for them the BLAS libraries are told so before numpy loads them (:func:`sinterheat.threads.blas_on_one_thread`), so
+that their thread pools are never started.
 """
 
 import functools
@@ -19,7 +23,7 @@ import sys
 
 def _leave(prog: str, signum, frame):
     """The start-up handler: the one line, and out."""
-    command = next((a for a in sys.argv[1:] if not a.startswith("-")), None)
+    command = _command()
     by = "" if signum == signal.SIGINT else f" by {signal.Signals(signum).name}"
     try:
         sys.stderr.write(f"{prog}{'' if command is None else ' ' + command}: interrupted{by} at start-up; "
@@ -27,6 +31,11 @@ def _leave(prog: str, signum, frame):
         sys.stderr.flush()
     finally:
         os._exit(128 + int(signum))
+
+
+def _command():
+    """The sub-command on the command line (its first word that is not an option), or None."""
+    return next((a for a in sys.argv[1:] if not a.startswith("-")), None)
 
 
 def hold(prog: str) -> None:
@@ -44,7 +53,7 @@ def hold(prog: str) -> None:
             signal.signal(signum, functools.partial(_leave, prog))
 
 
-def run_main(prog: str, module: str, **kwargs):
+def run_main(prog: str, module: str, *, one_blas_thread: tuple = (), **kwargs):
     """``sys.exit(main(**kwargs))`` of ``module`` (a dotted name) for ``python -m <package>``, Ctrl-C (and SIGTERM,
     SIGHUP) held to one line from here on (module docstring).
 
@@ -54,10 +63,17 @@ def run_main(prog: str, module: str, **kwargs):
         The command as the user typed it (``"python -m dem"``, say), for the start-up line (:func:`hold`).
     module : str
         Dotted name of the module whose ``main`` runs the command (``"dem.cli"``, say).
+    one_blas_thread : tuple of str
+        Sub-commands whose processes run BLAS on one thread throughout: for them
+        :func:`sinterheat.threads.blas_on_one_thread` is called before ``module`` (and numpy) is imported.
     **kwargs
         Keyword arguments passed on to that ``main``.
     """
     hold(prog)
+    if _command() in one_blas_thread:
+        from sinterheat.threads import blas_on_one_thread
+
+        blas_on_one_thread()
     main = importlib.import_module(module).main
     from sinterheat.interrupt import exit_process
 

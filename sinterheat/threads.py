@@ -85,6 +85,18 @@ def use(number: int) -> None:
     threadpool_limits(_chosen)
 
 
+def blas_on_one_thread() -> None:
+    """BLAS on one thread in this process and its children, for a command whose BLAS work is all many small products
+    (:func:`one_blas_thread`): ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS`` and ``MKL_NUM_THREADS`` set to 1 unless
+    the user has set them. Called before numpy is first imported, it keeps the BLAS libraries from starting their
+    thread pools at all: OpenBLAS's idle threads spin for about a tenth of a second after they start, in this process
+    and again in every forked worker that sets the thread count (as :func:`one_blas_thread` does), which for a
+    command of short solves is CPU time of the same order as the solves themselves. Called later, it reaches only the
+    child processes started by ``spawn`` or a fresh interpreter."""
+    for variable in BLAS_VARIABLES:
+        os.environ.setdefault(variable, "1")
+
+
 @functools.lru_cache(maxsize=None)
 def _blas_pools():
     """The BLAS thread-pool controller (threadpoolctl), made once: limiting a pool then costs ~20 us."""

@@ -141,3 +141,17 @@ def test_whole_processes_count_the_cpu_of_grandchildren_and_not_of_sleep():
     assert min(times["spin"]["cpu"]) >= 0.3 and min(times["spin"]["wall"]) >= 0.3
     assert max(times["sleep"]["cpu"]) < 0.25 <= min(times["sleep"]["wall"])
     assert paired_ratio([2.0, 4.0, 9.0], [1.0, 2.0, 3.0]) == 2.0  # rounds 2, 2, 3: their median, not 15 / 6
+
+
+def test_the_fit_commands_start_without_the_thread_counts_the_benchmarks_set(monkeypatch):
+    """``python -m benchmarks`` sets the BLAS thread variables for its own studies; the commands timed side by side
+    start without them (as from a shell), the rest of the environment kept."""
+    from benchmarks.fit import shell_environment
+    from sinterheat import threads
+
+    monkeypatch.setenv("SINTERHEAT_BENCH_PROBE", "kept")
+    for variable in (threads.ENVIRONMENT, *threads.BLAS_VARIABLES):  # as sinterheat.threads.use sets them
+        monkeypatch.setenv(variable, "2")
+    env = shell_environment()
+    assert env["SINTERHEAT_BENCH_PROBE"] == "kept"
+    assert not {threads.ENVIRONMENT, *threads.BLAS_VARIABLES} & set(env)

@@ -2,6 +2,7 @@
 semispheres and the independent gmsh/scikit-fem triangle path."""
 
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -47,6 +48,65 @@ def test_cylinder_conductance_is_exact(order):
     sol = spectral.conductance(mesh, order, {0.0: pts[:, 1] == 0.0, 1.0: pts[:, 1] == 1.9})
     assert sol.K_over_kappa == pytest.approx(math.pi * 0.7**2 / 1.9, rel=1e-12)
     assert np.all(np.abs(sol.u_local) <= 1.0 + 1e-12)
+
+
+def _meshes():
+    """The meshes the layered elimination is checked on: graded semispheres, a graded pair, the shuffled cylinder."""
+    for a, levels in ((0.001, 12), (0.3, 4), (0.97, 2)):
+        mesh, shape = hpmesh.semisphere_quad_mesh(a, levels)
+        yield f"semisphere {a}", mesh, hpmesh.end_disks(mesh, shape)
+    mesh, _, bottom, top, _ = hpmesh.pair_quad_mesh(1.0, 3.0, float(overlap_for_neck(1.0, 3.0, 0.42)), 5)
+    yield "pair", mesh, {0.0: bottom, 1.0: top}
+    mesh, pts = _cylinder(0.7, 1.9, nx=5, nz=4)
+    yield "cylinder", mesh, {0.0: pts[:, 1] == 0.0, 1.0: pts[:, 1] == 1.9}
+
+
+@pytest.mark.parametrize("order", [2, 4, 7])
+def test_layered_elimination_is_the_sparse_lu_solve(order, monkeypatch):
+    """The skeleton eliminated layer by layer (no scipy) gives the sparse LU's solution to round-off; elements that
+    share a vertex are at most one layer apart (what makes the system block tridiagonal)."""
+    for name, mesh, fixed in _meshes():
+        layers = spectral.element_layers(mesh)
+        assert layers.min() == 0, name
+        for k in range(4):  # vertex k of every element against every vertex of every other element
+            share = np.any(mesh.quads[:, k, None, None] == mesh.quads[None, :, :], axis=2)
+            near = np.abs(layers[:, None] - layers[None, :])
+            assert np.all(near[share] <= 1), name
+        layered = spectral.conductance(mesh, order, fixed)
+        monkeypatch.setattr(spectral, "LAYER_MAX", 0)  # every layer too large: sparse LU
+        sparse = spectral.conductance(mesh, order, fixed)
+        monkeypatch.undo()
+        assert layered.K_over_kappa == pytest.approx(sparse.K_over_kappa, rel=1e-12), name
+        assert np.allclose(layered.u_local, sparse.u_local, rtol=0.0, atol=1e-11), name
+
+
+def test_two_bodies_no_layer_joins_are_solved_by_sparse_lu():
+    """A cylinder and a separate ring around it, both between the same end planes: no path of shared vertices
+    joins them (their elements' layers are -1 on one body), and K is the sum of the two closed forms."""
+    mesh, pts = _cylinder(0.7, 1.9)
+    ring = pts.copy()
+    ring[:, 0] = 1.0 + ring[:, 0]  # the radii 0..0.7 moved to 1.0..1.7
+    both = spectral.QuadMesh(points=np.vstack([pts, ring]), quads=np.vstack([mesh.quads, mesh.quads + len(pts)]),
+                             arc_angles=np.vstack([mesh.arc_angles] * 2), arc_circle=np.vstack([mesh.arc_circle] * 2),
+                             circles=())
+    z = np.concatenate([pts[:, 1], ring[:, 1]])
+    assert spectral.element_layers(both).min() == -1
+    sol = spectral.conductance(both, 3, {0.0: z == 0.0, 1.0: z == 1.9})
+    assert sol.K_over_kappa == pytest.approx(math.pi * (0.7**2 + 1.7**2 - 1.0**2) / 1.9, rel=1e-12)
+
+
+def test_a_sweep_point_imports_no_scipy():
+    """The semisphere solves of ``python -m fem_neck fit`` run without scipy (importing it costs more CPU than a
+    sweep's hundred solves): a fresh interpreter solves a/r = 0.001 at 1e-4, its largest skeleton."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from fem_neck.conduction import semisphere_conductance; "
+            "semisphere_conductance(0.001, rtol=1e-4); print(sorted(m for m in sys.modules if m.startswith('scipy')))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          cwd=str(pathlib.Path(__file__).resolve().parents[1]))
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.strip() == "[]"
 
 
 @pytest.mark.parametrize("h_over_r, k_ref", REFERENCE)

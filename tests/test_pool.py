@@ -53,6 +53,25 @@ def test_local_jobs_come_back_complete_and_an_error_is_raised(workers):
         list(P.run_jobs([(_failing, (k,)) for k in range(5)], workers, progress=False))
 
 
+def _pid_of(k):
+    return k, os.getpid()
+
+
+def test_jobs_alongside_a_pool_of_the_callers_run_there_and_here_and_it_stays_usable():
+    """With a pool of the caller's alongside (one process) and two workers, the jobs run in that pool's process and
+    in this one, no other process is started, every result comes back once; an error is raised; the caller's pool
+    still takes jobs afterwards."""
+    with P.ProcessPool(1, "fork") as helper:
+        first = helper.submit(os.getpid).result()
+        results = list(P.run_jobs([(_pid_of, (k,)) for k in range(40)], 2, progress=False, alongside=helper))
+        assert sorted(k for k, _ in results) == list(range(40))
+        assert {pid for _, pid in results} == {first, os.getpid()}
+        with pytest.raises(ArithmeticError, match="job 3 fails"):
+            list(P.run_jobs([(_failing, (k,)) for k in range(5)], 2, progress=False, alongside=helper))
+        assert helper.submit(os.getpid).result() == first
+        assert [pid for _, pid in P.run_jobs([(_pid_of, (0,))], 2, progress=False, alongside=helper)] == [os.getpid()]
+
+
 @pytest.mark.parametrize("environment, progress, shown", [("", True, True), ("1", True, False), ("", False, False)])
 def test_the_bar_follows_no_progress_of_the_command_line(monkeypatch, capsys, environment, progress, shown):
     """--no-progress sets TQDM_DISABLE; a sweep's own bar (progress left at its default) must then stay silent."""

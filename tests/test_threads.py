@@ -124,6 +124,38 @@ def test_the_environment_variable_sets_the_count_and_the_option_wins(monkeypatch
     assert os.environ[threads.ENVIRONMENT] == os.environ["OPENBLAS_NUM_THREADS"] == str(threads.cores())
 
 
+# A command run by sinterheat.startup.run_main: its BLAS thread counts, and the threads of its process, after numpy
+PROBE = """
+import json, os, sys
+import numpy, threadpoolctl
+
+def main():
+    tasks = len(os.listdir("/proc/self/task")) if os.path.isdir("/proc/self/task") else None
+    counts = [i["num_threads"] for i in threadpoolctl.threadpool_info() if i["user_api"] == "blas"]
+    print(json.dumps({"blas": counts, "tasks": tasks}))
+    return 0
+"""
+
+
+@pytest.mark.parametrize("command, user, blas", [("fit", None, 1), ("solve", None, threads.cores()),
+                                                 ("fit", "2", 2)])
+def test_a_one_blas_thread_command_never_starts_the_blas_thread_pools(tmp_path, command, user, blas):
+    (tmp_path / "probe_cli.py").write_text(PROBE)
+    code = ("import sys; from sinterheat.startup import run_main; "
+            "run_main('python -m probe', 'probe_cli', one_blas_thread=('fit',))")
+    env = {k: v for k, v in _env().items() if k not in threads.BLAS_VARIABLES}
+    env["PYTHONPATH"] += os.pathsep + str(tmp_path)
+    if user is not None:  # the user's own setting is kept
+        env["OPENBLAS_NUM_THREADS"] = user
+    proc = subprocess.run([sys.executable, "-c", code, command, "--json"], env=env, capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    seen = json.loads(proc.stdout)
+    assert seen["blas"] and set(seen["blas"]) == {blas}
+    if seen["tasks"] is not None and blas == 1:
+        assert seen["tasks"] == 1  # no BLAS thread was started, not merely limited afterwards
+
+
 @pytest.mark.skipif(threads.cores() < 2, reason="needs two cores")
 def test_the_engine_binds_its_loop_by_the_thread_count(monkeypatch):
     import dem.engines.verlet.mechanics as mechanics

@@ -7,6 +7,10 @@ says how many on stderr ("reused 38 of 40 points from fit.csv; --fresh recompute
 --neck union sweeps and fits the half body of the union of spheres instead (no neck cylinder; default --out
 results/fit-union); its fit.json records the neck, and a law read from it refuses the other neck
 (fem_neck.law.ConductanceLaw.require_neck).
+
+Its processes run BLAS on one thread (the hp solves are many small products), set before numpy loads
+(``fem_neck/__main__.py``, :func:`sinterheat.threads.blas_on_one_thread`) unless OMP_NUM_THREADS,
+OPENBLAS_NUM_THREADS or MKL_NUM_THREADS say otherwise.
 """
 
 from __future__ import annotations
