@@ -53,6 +53,22 @@ def test_cap_ratio_closed_form_and_range():
             assert 0.0 < rho <= 1.0
 
 
+@pytest.mark.parametrize("beta, psi0", [(-0.1, 3.0), (np.nan, 3.0), (0.8, 0.0), (0.8, np.inf)])
+def test_bad_calibration_is_refused_in_one_line(beta, psi0):
+    with pytest.raises(ValueError, match="beta|psi0") as err:
+        cap_ratio(np.ones(1), np.ones(1), np.ones(1), beta, psi0)
+    assert "\n" not in str(err.value)
+
+
+def test_calibration_picks_the_grid_point_of_least_rms_error():
+    from verification.closing_pores import BETAS, PSI0S, calibrate
+
+    fe = {"a": 0.5, "b": 0.9}
+    best = calibrate(fe, lambda beta, psi0: {case: k * (1 + (beta - BETAS[3]) ** 2 + 0.1 * (psi0 - PSI0S[5]) ** 2)
+                                             for case, k in fe.items()})
+    assert (best["beta"], best["psi0"]) == (BETAS[3], PSI0S[5]) and best["rms"] == 0.0
+
+
 @pytest.mark.parametrize("kind, h", [("sc", 0.2), ("bcc", 0.1), ("fcc", 0.05), ("fcc", 0.1)])
 def test_where_the_cap_does_not_bind_the_law_is_unchanged_bit_for_bit(kind, h):
     cell = lattice_cell(kind, h, neck="union")
