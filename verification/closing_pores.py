@@ -25,8 +25,9 @@ from verification.lattices import FECache, dem_periodic, solve_cells
 from verification.report import jsonable
 
 # union cells none of which the densification study checks (its overlaps and its seeds 1-3)
-OVERLAPS = {"sc": (0.45, 0.55, 0.58, 0.62, 0.65), "bcc": (0.25, 0.28, 0.32, 0.34, 0.38),
-            "fcc": (0.15, 0.18, 0.22, 0.25, 0.28, 0.33)}
+OVERLAPS = {"sc": (0.35, 0.42, 0.45, 0.47, 0.52, 0.55, 0.57, 0.58, 0.62, 0.65),
+            "bcc": (0.22, 0.24, 0.25, 0.26, 0.27, 0.28, 0.29, 0.31, 0.32, 0.33, 0.34, 0.36, 0.38),
+            "fcc": (0.12, 0.14, 0.15, 0.16, 0.18, 0.22, 0.24, 0.25, 0.26, 0.28, 0.31, 0.33)}
 RANDOM = ((4, 0.9), (5, 0.93), (6, 0.85), (7, 0.7))  # (seed, phi aimed at) of the union mirror packings
 QUICK_OVERLAPS, QUICK_RANDOM = {"sc": (0.55,), "fcc": (0.25,)}, ()
 RANDOM_SPHERES = 4  # union_packing(n): 8 n spheres per period
