@@ -9,11 +9,12 @@ limit, the Hashin-Shtrikman bound's slope), more the flatter they are (thin wedg
 them with little volume). The union's lattices measure slopes of 1.6 to 2.5, and the pores there are wedges along
 the faces where spheres meet; a network on particle nodes does not see them, and its cap has slope 1.
 
-**A particle's pores.** Seen from its centre, particle ``k`` is bounded by the planes of its necks
-(:math:`n_b \cdot (x - x_k) \le l_b`: the radical planes and the walls it touches). Where every direction from the
-centre meets one of them, they enclose the particle's *cell* (its power cell, as far as its own necks bound it), and
-what of the cell lies outside its sphere is the pore space next to it. In the direction :math:`\hat n` the cell
-reaches :math:`t(\hat n) = \min_{b:\, n_b \cdot \hat n > 0} l_b / (n_b \cdot \hat n)` and the solid
+**A particle's pores.** Seen from its centre, particle ``k`` is bounded by the radical (power) planes of its
+neighbours :math:`j`, :math:`n_j \cdot (x - x_k) \le l_j` with
+:math:`l_j = (d_j^2 + r_k^2 - r_j^2) / (2 d_j)` (Aurenhammer 1987, the power diagram), of the ones that touch it and
+of the ones that do not touch yet alike, and by the walls near it; it is followed only within the ball of radius
+:math:`R_c = (1 + \gamma) r` around its centre. In the direction :math:`\hat n` the cell reaches
+:math:`t(\hat n) = \min(R_c, \min_{j:\, n_j \cdot \hat n > 0} l_j / (n_j \cdot \hat n))` and the solid
 :math:`\min(r, t)`, so that
 
 .. math::
@@ -25,9 +26,18 @@ reaches :math:`t(\hat n) = \min_{b:\, n_b \cdot \hat n > 0} l_b / (n_b \cdot \ha
 with ``S`` the free spherical surface that bounds the pores; the integrals are sums over ``DIRECTIONS`` directions
 spread evenly over the sphere (a Fibonacci lattice). The pores' porosity is
 :math:`\varepsilon = V_{pore} / (V_{pore} + V_{solid})` and their shape the scale-free
-:math:`\psi = S / V_{pore}^{2/3}` (large for thin pores: the same surface over less volume). A cell left open in some
-direction (no plane ahead: a particle at a free surface or in a loose packing) has no closing pores and keeps the
-Wiener cap.
+:math:`\psi = S / V_{pore}^{2/3}` (large for thin pores: the same surface over less volume).
+
+Every quantity moves continuously with the packing: a neighbour's plane comes in from beyond :math:`R_c` and moves
+to the sphere as the neighbour approaches (it is the plane of their neck once they touch), so a neck that forms
+changes no plane at once, and nothing switches a cell between open and closed. A neighbour whose plane lies beyond
+:math:`R_c` changes nothing, so the neighbours searched within a finite distance are all there are
+(:func:`power_planes`: every pair closer than :math:`2 (1 + \gamma) r_{max}`). :data:`GAMMA` = 0.5 puts the ball
+beyond the vertices of the power cells of the dense lattices, where the cap binds (simple cubic :math:`0.866 d`,
+body-centred :math:`0.645 d`, face-centred :math:`0.707 d` from the centre, ``d`` the nearest neighbours' distance:
+the whole cell for :math:`d \le` 1.73 r, 2.33 r and 2.12 r, so on the simple cubic lattice from :math:`h/r` = 0.27
+and on the others at every overlap); a particle of a loose packing, or at a free surface, sees the large round pore
+of its ball (:math:`\psi` = 2.72 for a lone sphere).
 
 **The cap.** The slope grows with the thinness of the pores, and the particle's mean conductivity is capped at the
 dilute-pore value over its own solid fraction:
@@ -39,17 +49,18 @@ dilute-pore value over its own solid fraction:
     \frac{1}{3} \operatorname{tr} \sum_b s_b K_b l_b^2 n_b n_b^T \le \rho \, \kappa V_k .
 
 ``rho`` is at most 1 (``c >= 1``): the cap is never looser than the Wiener bound, so the law stays below it. Pores
-rounder than :math:`\psi_0` keep :math:`\rho = 1`, today's cap; so does an open cell, and as a cell closes its pore
-volume comes in from infinity (:math:`\psi \to 0`), so the cap does not jump. Where the cap does not bind (the
-particle's tensor below it: necks narrow or far apart) the law is the ``shared-body`` law bit for bit. ``rho`` stays
-positive: the free surface is at most :math:`4 \pi r^2`, so a large porosity forces a small :math:`\psi`.
+rounder than :math:`\psi_0` keep :math:`\rho = 1`, today's cap. Where the cap does not bind (the particle's tensor
+below it: necks narrow or far apart) the law is the ``shared-body`` law bit for bit.
 
-The cell is bounded by the particle's necks only: a neighbour that does not yet touch bounds no pore. When a new neck
-forms at a particle whose cap binds, its plane cuts the cell at once (at the sphere, where the power cell had its face
-farther out), and the cap moves with it: the body-centred cubic lattice, whose second neighbours touch at
-:math:`h/r` = 0.268, has its octahedral cell of eight planes cut to the truncated octahedron of fourteen there, and
-its ``k_eff`` rises from 0.8086 to 0.8318 :math:`\kappa` between :math:`h/r` 0.266 and 0.268 (the Wiener cap's from
-0.8247 to 0.8318). Necks that begin to meet change no plane, and there the cap is continuous.
+**The cap stays positive.** In every free direction the solid is the whole cone :math:`r^3 / 3` and the pore at
+most :math:`(R_c^3 - r^3) / 3`, so with :math:`x = V_{pore} / (S r) \le x_{max} = ((1 + \gamma)^3 - 1) / 3`:
+:math:`\varepsilon \le 3 x / (3 x + 1)` and, since :math:`S \le 4 \pi r^2`,
+:math:`\psi \le A x^{-2/3}` with :math:`A = (4 \pi)^{1/3}`. Then :math:`c \, \varepsilon < 1` whenever
+:math:`3 \beta \, x \ln^+(A x^{-2/3} / \psi_0) < 1`, whose left side is largest at
+:math:`x^* = \min(x_{max}, (A / \psi_0)^{3/2} / e)`: ``rho > 0`` for every cell exactly when
+:math:`\beta < \beta_{max}(\psi_0) = 1 / (3 x^* \ln(A x^{*-2/3} / \psi_0))` (a particle in a spherical shell of
+pore comes as close to the bound as one likes), and :func:`cap_ratio` refuses a calibration beyond it
+(:func:`largest_beta`).
 
 :math:`\beta` and :math:`\psi_0` are not derived: they are calibrated on periodic-cell FE of union cells that are not
 the cases ``python -m verification densification`` checks (other overlaps of the three lattices, other random
@@ -69,6 +80,7 @@ import numpy as np
 
 CALIBRATION = pathlib.Path(__file__).with_name("closing_pores.json")  # written by python -m verification closing-pores
 DIRECTIONS = 2000  # directions of the quadrature over the sphere
+GAMMA = 0.5  # the cell is followed within (1 + GAMMA) r of the centre (module docstring)
 
 
 @functools.lru_cache(maxsize=1)
@@ -109,8 +121,61 @@ def directions(count: int = DIRECTIONS) -> np.ndarray:
     return np.column_stack([s * np.cos(azimuth), s * np.sin(azimuth), z])
 
 
+def power_planes(position: np.ndarray, radius: np.ndarray, box=None, walls=()):
+    """The planes that bound each particle's cell within :math:`(1 + \\gamma) r` of its centre (module docstring):
+    the radical planes of every neighbour (touching or not, images across a periodic box's faces included) and the
+    walls that lie that close.
+
+    Parameters
+    ----------
+    position : numpy.ndarray
+        Particle centres (n, 3), m.
+    radius : numpy.ndarray
+        Particle radii (n,), m, > 0.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box of the packing; None without one.
+    walls : sequence of dem.geometry.walls.Wall
+        Plane walls (their normals point into the packing).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``particle`` (int, the particle each plane bounds), ``normals`` (unit vectors from its centre toward the
+        plane) and ``planes`` (the distance from its centre to the plane, m; negative where the centre lies beyond
+        it, inside a larger sphere), one row per plane.
+    """
+    from dem.geometry.bonds import candidate_pairs, periodic_pairs
+
+    position, radius = np.asarray(position, dtype=float).reshape(-1, 3), np.asarray(radius, dtype=float)
+    reach = (1.0 + GAMMA) * radius
+    # l_k < R_k <=> d < R_k + sqrt(GAMMA (2 + GAMMA) r_k^2 + r_j^2), at most 2 (1 + GAMMA) r_max: every pair closer
+    # than that (the search of the bonds with every radius (1 + GAMMA) r_max), then each end's plane kept or not
+    search = np.full(len(radius), (1.0 + GAMMA) * float(radius.max(initial=0.0)))
+    if box is not None and box.any_periodic:
+        i, j, shift = periodic_pairs(position, search, box)
+        vectors = box.bond_vectors(position, i, j, shift)
+    else:
+        i, j = candidate_pairs(position, search)
+        vectors = position[j] - position[i]
+    d = np.linalg.norm(vectors, axis=1)
+    i, j, vectors, d = i[d > 0.0], j[d > 0.0], vectors[d > 0.0], d[d > 0.0]  # coincident centres share no plane
+    l_i = (d * d + radius[i] ** 2 - radius[j] ** 2) / (2.0 * d)
+    l_j = d - l_i
+    unit = vectors / d[:, None]
+    near_i, near_j = l_i < reach[i], l_j < reach[j]
+    particle, normals, planes = [i[near_i], j[near_j]], [unit[near_i], -unit[near_j]], [l_i[near_i], l_j[near_j]]
+    for wall in walls:
+        distance = wall.distance(position)
+        near = np.flatnonzero(distance < reach)
+        particle.append(near)
+        normals.append(np.tile(-np.asarray(wall.normal, dtype=float), (len(near), 1)))
+        planes.append(distance[near])
+    return (np.concatenate(particle).astype(np.int64), np.concatenate(normals).reshape(-1, 3),
+            np.concatenate(planes).astype(float))
+
+
 @numba.njit(cache=True, parallel=True)
-def _cell_kernel(n, radius, particle, normals, planes, dirs):
+def _cell_kernel(n, radius, ball, particle, normals, planes, dirs):
     m = len(particle)
     counts = np.zeros(n + 1, dtype=np.int64)
     for e in range(m):
@@ -130,12 +195,13 @@ def _cell_kernel(n, radius, particle, normals, planes, dirs):
         lo, hi = offsets[k], offsets[k + 1]
         v_solid = v_pore = area = 0.0
         for d in range(len(dirs)):
-            reach = np.inf
+            reach = ball * r
             for b in range(lo, hi):
                 e = order[b]
                 c = normals[e, 0] * dirs[d, 0] + normals[e, 1] * dirs[d, 1] + normals[e, 2] * dirs[d, 2]
                 if c > 0.0:
                     reach = min(reach, planes[e] / c)
+            reach = max(reach, 0.0)  # a plane behind the centre (inside a larger sphere): no solid that way
             if reach > r:
                 v_solid += r * r * r
                 v_pore += reach ** 3 - r * r * r
@@ -150,31 +216,52 @@ def _cell_kernel(n, radius, particle, normals, planes, dirs):
 
 def particle_cells(radius: np.ndarray, particle: np.ndarray, normals: np.ndarray, planes: np.ndarray,
                    count: int = DIRECTIONS):
-    """Per particle, the solid, the pore volume and the free surface of the cell its necks' planes enclose (module
-    docstring); the pore volume is ``inf`` where the cell is open.
+    """Per particle, the solid, the pore volume and the free surface of its cell within :math:`(1 + \\gamma) r` of its
+    centre, bounded by ``planes`` (module docstring; the planes of :func:`power_planes`).
 
     Parameters
     ----------
     radius : numpy.ndarray
         Particle radii, m.
     particle : numpy.ndarray
-        The particle of every neck end (int).
+        The particle each plane bounds (int).
     normals : numpy.ndarray
-        The unit direction from the particle's centre toward every neck (one row each).
+        The unit direction from the particle's centre toward every plane (one row each).
     planes : numpy.ndarray
-        The distance from the particle's centre to every neck's plane (the radical plane, or the wall), m, > 0.
+        The distance from the particle's centre to every plane (a radical plane, or a wall), m.
     count : int
         Directions of the quadrature (:func:`directions`).
 
     Returns
     -------
     tuple of numpy.ndarray
-        The solid volume (m^3), the pore volume (m^3; ``inf`` for an open cell) and the free spherical surface (m^2).
+        The solid volume (m^3), the pore volume (m^3) and the free spherical surface (m^2).
     """
     f = np.ascontiguousarray
     radius = f(radius, dtype=float)
-    return _cell_kernel(len(radius), radius, f(particle, dtype=np.int64), f(np.reshape(normals, (-1, 3)), dtype=float),
-                        f(planes, dtype=float), directions(count))
+    return _cell_kernel(len(radius), radius, 1.0 + GAMMA, f(particle, dtype=np.int64),
+                        f(np.reshape(normals, (-1, 3)), dtype=float), f(planes, dtype=float), directions(count))
+
+
+def largest_beta(psi0: float, gamma: float = GAMMA) -> float:
+    r""":math:`\beta_{max}(\psi_0)`: every cell's cap stays positive exactly for :math:`\beta` below it (module
+    docstring).
+
+    Parameters
+    ----------
+    psi0 : float
+        The shape :math:`S / V_{pore}^{2/3}` (dimensionless, > 0) up to which pores keep the Wiener cap.
+    gamma : float
+        The cell's ball, :math:`R_c = (1 + \gamma) r` (dimensionless, > 0).
+
+    Returns
+    -------
+    float
+        :math:`\beta_{max}` (dimensionless, > 0).
+    """
+    a = (4.0 * math.pi) ** (1.0 / 3.0) / psi0
+    x = min(((1.0 + gamma) ** 3 - 1.0) / 3.0, a ** 1.5 / math.e)
+    return 1.0 / (3.0 * x * math.log(a * x ** (-2.0 / 3.0)))  # the logarithm is >= 2/3 at x <= a^1.5 / e
 
 
 def cap_ratio(solid: np.ndarray, pore: np.ndarray, free: np.ndarray, beta: float, psi0: float) -> np.ndarray:
@@ -183,10 +270,10 @@ def cap_ratio(solid: np.ndarray, pore: np.ndarray, free: np.ndarray, beta: float
     Parameters
     ----------
     solid, pore, free : numpy.ndarray
-        Per particle, its solid and pore volumes (m^3; the pore ``inf`` for an open cell) and its free surface (m^2)
-        (:func:`particle_cells`).
+        Per particle, its solid and pore volumes (m^3) and its free surface (m^2) (:func:`particle_cells`).
     beta : float
-        How fast the pores' slope grows with their thinness (dimensionless, >= 0).
+        How fast the pores' slope grows with their thinness (dimensionless, in
+        :math:`[0, \beta_{max}(\psi_0))`, :func:`largest_beta`).
     psi0 : float
         The shape :math:`S / V_{pore}^{2/3}` (dimensionless, > 0) up to which pores keep the Wiener cap.
 
@@ -198,16 +285,18 @@ def cap_ratio(solid: np.ndarray, pore: np.ndarray, free: np.ndarray, beta: float
     Raises
     ------
     ValueError
-        ``beta`` or ``psi0`` out of its range.
+        ``psi0`` or ``beta`` out of its range.
     """
-    if not (np.isfinite(beta) and beta >= 0.0):
-        raise ValueError(f"closing pores: beta = {beta!r}: must be finite and >= 0")
     if not (np.isfinite(psi0) and psi0 > 0.0):
         raise ValueError(f"closing pores: psi0 = {psi0!r}: must be finite and > 0")
-    closed = np.isfinite(pore) & (pore > 0.0)
+    top = largest_beta(psi0)
+    if not (np.isfinite(beta) and 0.0 <= beta < top):
+        raise ValueError(f"closing pores: beta = {beta!r}: must be in [0, {top:.6g}) with psi0 = {psi0!r} (beyond it "
+                         f"a cell's cap can reach 0)")
+    porous = pore > 0.0
     rho = np.ones(len(solid))
-    v, s, p = pore[closed], free[closed], solid[closed]
+    v, s, p = pore[porous], free[porous], solid[porous]
     slope = 1.0 + beta * np.maximum(0.0, np.log(s / v ** (2.0 / 3.0) / psi0))
     eps = v / (v + p)
-    rho[closed] = (1.0 - slope * eps) / (1.0 - eps)
+    rho[porous] = (1.0 - slope * eps) / (1.0 - eps)
     return rho

@@ -289,7 +289,7 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
         vectors = bonds.vectors(particles.position, box)
         if spec.neck == "union":
             k_i, k_j, k_w = _shared_union_body(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
-                                               closing_pores)
+                                               closing_pores, box, walls)
         else:
             s_i, s_j, s_w = neck_factors(particles.n, r, bonds, vectors, k_i, k_j, k_w, kappa, normals)
             k_i, k_j, k_w = s_i * k_i, s_j * k_j, s_w * k_w
@@ -308,7 +308,7 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
 
 
 def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_i, k_j, k_w,
-                       closing_pores: dict | None = None):
+                       closing_pores: dict | None = None, box=None, walls=()):
     """The ``shared-body`` halves under the union of spheres: each half body of the union law narrowed to the
     particle's cut sphere (:mod:`dem.laws.cut_body`), then the factors of the necks sharing it
     (:mod:`dem.laws.shared_body`) with the cut sphere's volume in the cap on the mean of the particle's tensor,
@@ -331,6 +331,10 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
         The union law's half conductances of the pair bonds on ``i``, on ``j`` and of the wall bonds, W/K.
     closing_pores : dict or None
         The closing pores' ``beta`` and ``psi0`` (dimensionless); None: the shipped calibration.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box of the packing (the particles' cells take their neighbours across its faces); None without.
+    walls : sequence of dem.geometry.walls.Wall
+        The walls (they bound the particles' cells where they come near).
 
     Returns
     -------
@@ -339,7 +343,7 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
     """
     from fem_neck.geometry.union import cut_spheres
 
-    from dem.laws.closing_pores import calibration, cap_ratio, particle_cells
+    from dem.laws.closing_pores import calibration, cap_ratio, particle_cells, power_planes
     from dem.laws.cut_body import cut_body_resistance
     from dem.laws.shared_body import neck_factors
 
@@ -349,14 +353,14 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
     directions = np.vstack([unit, -unit, -np.reshape(normals, (-1, 3))])
     planes = np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l])
     ends = cut_body_resistance(r, particle, directions, planes) / kappa[particle]
+    fit = closing_pores or calibration()
+    caps = cap_ratio(*particle_cells(r, *power_planes(particles.position, r, box, walls)), fit["beta"], fit["psi0"])
     m = bonds.n_pairs
     with np.errstate(divide="ignore"):  # no extra resistance (0): an infinite conductance in series
         k_i, k_j, k_w = (series(k, 1.0 / dR) for k, dR in ((k_i, ends[:m]), (k_j, ends[m:2 * m]),
                                                          (k_w, ends[2 * m:])))
     pairs, walls = (k_i > 0.0) & (k_j > 0.0), k_w > 0.0
     live = bonds.subset(pairs, walls)
-    fit = closing_pores or calibration()
-    caps = cap_ratio(*particle_cells(r, particle, directions, planes), fit["beta"], fit["psi0"])
     volume = cut_spheres(r, live.i, live.j, vectors[pairs]).volume * caps
     s_i, s_j, s_w = neck_factors(particles.n, r, live, vectors[pairs], k_i[pairs], k_j[pairs], k_w[walls], kappa,
                                  np.reshape(normals, (-1, 3))[walls], volume, trace_cap=True)
