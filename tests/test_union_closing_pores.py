@@ -1,5 +1,6 @@
 """The closing pores' cap of the shared-body law on the union of spheres (dem.laws.closing_pores): the particle's
-cell against closed forms, the cap's properties, and the dense union lattices against their FE."""
+cell against closed forms and its planes against a search of all pairs, the cap's properties and its bound on beta,
+k_eff continuous where necks form, and the dense union lattices against their FE."""
 
 import itertools
 import json
