@@ -120,6 +120,7 @@ def test_the_densification_study_holds_each_case_to_the_declared_evidence():
     row["rel"]["shared-body"] = 0.012  # verified range: +-1 %
     assert outside_evidence(row, "shared-body") == pytest.approx(0.002, abs=1e-15)
     row["widest_neck"] = ev.verified_width + 0.01  # wide: the apart interval
+    row["rel"]["shared-body"] = ev.apart[1]
     assert outside_evidence(row, "shared-body") == 0.0
     row["rel"]["shared-body"] = ev.meeting[0]
     assert outside_evidence(row, "shared-body") == pytest.approx(ev.apart[0] - ev.meeting[0], abs=1e-15)

@@ -12,6 +12,9 @@ Commands (each writes ``report.md``, ``summary.json`` and ``run.json`` plus PNG 
 * ``sintered-bed`` -- a bed poured by LAMMPS and the ``hot-wall-sintering`` compact sintered past the meeting of
   their necks: k_eff through the hand-over to the union of spheres, against the Wiener and Hashin-Shtrikman bounds
   (section ``sintered_bed``; needs LAMMPS);
+* ``closing-pores`` -- the closing pores' cap of the ``shared-body`` law on the union of spheres calibrated on FE cells
+  that ``densification`` does not check; writes ``closing_pores.json``, the file shipped as
+  ``dem/laws/closing_pores.json`` (section ``closing_pores``);
 * ``all``        -- ``paper`` and ``dem-vs-fe``.
 
 Run time against error is ``python -m benchmarks``; the stress cases are tests (``python -m pytest -m stress``).
@@ -45,6 +48,8 @@ COMMANDS = {
                       "and a sintered compact, FE beside DEM, with the bounds and Koh & Fortini"),
     "sintered-bed": (("sintered_bed",), "a LAMMPS bed and the hot-wall compact sintered past the meeting of their "
                      "necks: k_eff through the hand-over, against the bounds"),
+    "closing-pores": (("closing_pores",), "calibrate the closing pores' cap of the union shared-body law on FE cells "
+                      "the densification study does not check (writes closing_pores.json)"),
 }
 
 

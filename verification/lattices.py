@@ -129,9 +129,11 @@ def fe_pair_conductance(r_i: float, r_j: float, h: float) -> float:
     return float(pair_conductance(r_i, r_j, h, kappa=1.0, rtol=1e-8).K)
 
 
-def dem_periodic(cell: lattice.PeriodicCell, law: str, neck: str = "newton") -> float:
+def dem_periodic(cell: lattice.PeriodicCell, law: str, neck: str = "newton",
+                 closing_pores: dict | None = None) -> float:
     """The DEM's ``k_eff / kappa`` of the periodic packing along z (drop of 1 K per period), for a conductance law
-    or :data:`NETWORK_ONLY`, with the neck reading ``neck`` (``conductance.neck``)."""
+    or :data:`NETWORK_ONLY`, with the neck reading ``neck`` (``conductance.neck``) and, for ``shared-body`` on the
+    union, the closing pores' calibration ``closing_pores`` (:func:`dem.laws.conductance.bond_conductances`)."""
     from dem.geometry.bonds import find_bonds
     from dem.laws.conductance import ConductanceSpec, bond_conductances
     from dem.geometry.particles import Material, Particles
@@ -147,7 +149,7 @@ def dem_periodic(cell: lattice.PeriodicCell, law: str, neck: str = "newton") -> 
         K = np.array([fe_pair_conductance(*sorted((float(cell.radii[i]), float(cell.radii[j]))), float(h))
                       for i, j, h in zip(bonds.i, bonds.j, bonds.h)])
     else:
-        K = bond_conductances(spec, particles, bonds, box=box)[0]
+        K = bond_conductances(spec, particles, bonds, box=box, closing_pores=closing_pores)[0]
     net = Network(particles, bonds, K, np.zeros(0), np.zeros(0), box=box)
     T = steady(net, floating="mean").T
     return float(periodic_heat_flow(net, T)[2] * box.lengths[2] / box.cross_section(2))

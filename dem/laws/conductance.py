@@ -229,7 +229,7 @@ def series(*halves):
 
 
 def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds, conductivity=None,
-                      shares: bool = False, *, box=None, walls=()):
+                      shares: bool = False, *, box=None, walls=(), closing_pores: dict | None = None):
     r"""``(K_pairs, K_walls)`` in W/K for every pair bond and wall bond.
 
     ``conductivity`` (per particle) replaces the materials' :math:`\kappa`: the same law with the electrical
@@ -237,7 +237,8 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     :math:`\sigma` in place of :math:`\kappa`). With ``shares = True`` a third array gives each pair bond's fraction of
     its resistance on the side of particle i, :math:`R_i / (R_i + R_j)` (where that part of the bond's Joule heat is
     made). ``box``: the periodic box the bonds' image shifts refer to (:mod:`dem.geometry.periodic`); ``walls``: the
-    walls of the wall bonds, whose normals the ``shared-body`` law needs.
+    walls of the wall bonds, whose normals the ``shared-body`` law needs; ``closing_pores``: the calibration of the
+    closing pores' cap of ``shared-body`` under the union of spheres (:mod:`dem.laws.closing_pores`).
 
     Parameters
     ----------
@@ -256,6 +257,9 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
         The periodic box the bonds' image shifts refer to; None without one.
     walls : sequence of dem.geometry.walls.Wall
         The walls of the wall bonds (indexed by ``bonds.wall_index``), needed by ``"shared-body"``.
+    closing_pores : dict or None
+        ``{"beta": float, "psi0": float}`` of :func:`dem.laws.closing_pores.cap_ratio` (dimensionless); None: the
+        shipped calibration (:data:`dem.laws.closing_pores.CALIBRATION`).
 
     Returns
     -------
@@ -284,7 +288,8 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
         normals = np.array([w.normal for w in walls])[bonds.wall_index] if bonds.n_walls else np.zeros((0, 3))
         vectors = bonds.vectors(particles.position, box)
         if spec.neck == "union":
-            k_i, k_j, k_w = _shared_union_body(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w)
+            k_i, k_j, k_w = _shared_union_body(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
+                                               closing_pores, box, walls)
         else:
             s_i, s_j, s_w = neck_factors(particles.n, r, bonds, vectors, k_i, k_j, k_w, kappa, normals)
             k_i, k_j, k_w = s_i * k_i, s_j * k_j, s_w * k_w
@@ -302,11 +307,13 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     return k_pair, k_wall, share
 
 
-def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_i, k_j, k_w):
+def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_i, k_j, k_w,
+                       closing_pores: dict | None = None, box=None, walls=()):
     """The ``shared-body`` halves under the union of spheres: each half body of the union law narrowed to the
     particle's cut sphere (:mod:`dem.laws.cut_body`), then the factors of the necks sharing it
-    (:mod:`dem.laws.shared_body`) with the cut sphere's volume in the cap on the mean of the particle's tensor; a
-    neck inside a third sphere (its half conductance 0) carries nothing and takes no part in the factors.
+    (:mod:`dem.laws.shared_body`) with the cut sphere's volume in the cap on the mean of the particle's tensor,
+    lowered where the pores around the particle close (:mod:`dem.laws.closing_pores`); a neck inside a third sphere
+    (its half conductance 0) carries nothing and takes no part in the factors.
 
     Parameters
     ----------
@@ -322,6 +329,12 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
         Per particle, its conductivity, W/(m K).
     k_i, k_j, k_w : numpy.ndarray
         The union law's half conductances of the pair bonds on ``i``, on ``j`` and of the wall bonds, W/K.
+    closing_pores : dict or None
+        The closing pores' ``beta`` and ``psi0`` (dimensionless); None: the shipped calibration.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box of the packing (the particles' cells take their neighbours across its faces); None without.
+    walls : sequence of dem.geometry.walls.Wall
+        The walls (they bound the particles' cells where they come near).
 
     Returns
     -------
@@ -330,21 +343,25 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
     """
     from fem_neck.geometry.union import cut_spheres
 
+    from dem.laws.closing_pores import calibration, cap_ratio, particle_cells, power_planes
     from dem.laws.cut_body import cut_body_resistance
     from dem.laws.shared_body import neck_factors
 
     r = particles.radius
     unit = vectors / bonds.d[:, None]  # the bonds' lengths, found with them
     particle = np.concatenate([bonds.i, bonds.j, bonds.wall_particle])
-    ends = cut_body_resistance(r, particle, np.vstack([unit, -unit, -np.reshape(normals, (-1, 3))]),
-                               np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l])) / kappa[particle]
+    directions = np.vstack([unit, -unit, -np.reshape(normals, (-1, 3))])
+    planes = np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l])
+    ends = cut_body_resistance(r, particle, directions, planes) / kappa[particle]
+    fit = closing_pores or calibration()
+    caps = cap_ratio(*particle_cells(r, *power_planes(particles.position, r, box, walls)), fit["beta"], fit["psi0"])
     m = bonds.n_pairs
     with np.errstate(divide="ignore"):  # no extra resistance (0): an infinite conductance in series
         k_i, k_j, k_w = (series(k, 1.0 / dR) for k, dR in ((k_i, ends[:m]), (k_j, ends[m:2 * m]),
                                                          (k_w, ends[2 * m:])))
     pairs, walls = (k_i > 0.0) & (k_j > 0.0), k_w > 0.0
     live = bonds.subset(pairs, walls)
-    volume = cut_spheres(r, live.i, live.j, vectors[pairs]).volume
+    volume = cut_spheres(r, live.i, live.j, vectors[pairs]).volume * caps
     s_i, s_j, s_w = neck_factors(particles.n, r, live, vectors[pairs], k_i[pairs], k_j[pairs], k_w[walls], kappa,
                                  np.reshape(normals, (-1, 3))[walls], volume, trace_cap=True)
     k_i, k_j, k_w = np.where(pairs, k_i, 0.0), np.where(pairs, k_j, 0.0), k_w.copy()

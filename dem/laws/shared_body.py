@@ -72,7 +72,8 @@ anisotropic (its largest eigenvalue up to :math:`1.4 \kappa V_k` while its mean 
 eigenvalue particle by particle took 12-22 % off the k_eff of random union packings at :math:`\phi` 0.6-0.8 that the
 FE does not lose; summed over the particles the trace cap keeps the mean of the network's three principal
 conductivities at or below :math:`\phi \kappa` (on the cubic lattices, whose tensors are isotropic, the two caps
-agree).
+agree). Where the pores around a particle close, its cap is lowered below the Wiener bound by the pores' shape
+(:mod:`dem.laws.closing_pores`: the ``volume`` passed here is then the cut sphere's times that ratio).
 
 A wall bond is a neck too (toward the wall, the mirror pair's neck), so it takes part in its particle's factor.
 
