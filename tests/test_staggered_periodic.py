@@ -105,6 +105,22 @@ def test_a_pair_across_a_face_is_the_pair_in_the_middle(v):
     assert not np.allclose(sb.v, 0.0)  # the contacts pushed them
 
 
+
+@pytest.mark.parametrize("neck", ["newton", "union"])
+def test_the_shared_body_law_across_a_face_is_the_law_in_the_middle(neck):
+    """The ``shared-body`` law turns each neck by the angles between the necks of its particle (here the pair's and
+    the wall's): the heat and the current must see the bond across the face as the minimum image, not the raw
+    difference of the centres, and the current's law needs its electrodes' normals."""
+    docs = [pair(middle) for middle in (False, True)]
+    for doc in docs:
+        doc["conductance"] = {"law": "shared-body", "neck": neck}
+    a, b = (StaggeredEngine(parse_scene(doc)) for doc in docs)
+    a.run()
+    b.run()
+    np.testing.assert_allclose(a.mechanics.state.T, b.mechanics.state.T, rtol=1e-9)
+    assert a.current.joule_energy == pytest.approx(b.current.joule_energy, rel=1e-9)
+    assert a.current.joule_energy > 0.0 and np.all(b.mechanics.state.T > 300.0)
+
 def saved(checkpoint: dict) -> dict:
     """A checkpoint as the driver writes and reads it (``np.savez``, ``np.load``)."""
     buffer = io.BytesIO()

@@ -124,7 +124,9 @@ class ContactCurrent:
             joule = zohdi_joule(self.J, self.volume, self.sigma, 1.0)
             self.joule_heat, self.electrode_power = float(joule.sum()), None
         else:
-            G, G_w, share = bond_conductances(self.spec, now, b, self.sigma, shares=True)
+            G, G_w, share = bond_conductances(self.spec, now, b, self.sigma, shares=True, box=mech.periodic_box,
+                                              walls=[self.walls[k].at(float(mech.w.q[k])) for k in
+                                                     self.electrodes.walls])
             self.flow = kirchhoff(n, b.i, b.j, G, share, b.wall_particle, b.wall_index, G_w, self.electrodes,
                                   self.linear, previous=None if self.flow is None else self.flow.solver)
             require_paths(self.flow, self.electrodes, b.wall_index, f" at t = {t:.6g} s")

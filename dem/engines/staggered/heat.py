@@ -198,8 +198,8 @@ class LumpedHeat:
         else:
             now, b = contact_bonds(self.particles, mech, x, T, self.thermal_walls, self.spec.contact,
                                    self.spec.out_of_range)
-            K_b, K_wb = bond_conductances(self.spec, now, b, walls=[self.walls[k].at(float(mech.w.q[k]))
-                                                                      for k in self.thermal_walls])
+            K_b, K_wb = bond_conductances(self.spec, now, b, box=mech.periodic_box,
+                                          walls=[self.walls[k].at(float(mech.w.q[k])) for k in self.thermal_walls])
         n = self.particles.n
         K[:] = 0.0
         K[np.searchsorted(mech.pi * n + mech.pj, b.i * n + b.j)] = K_b  # the list is sorted by (i, j)
