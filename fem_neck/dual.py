@@ -67,6 +67,76 @@ def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np
     return A
 
 
+def element_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int) -> SymmetricStack:
+    r"""The hybridised element matrices :math:`H_K = T A_K^{-1} T^T` (``4 n_f`` square) of every element, with
+    :math:`A_K` the flux mass (:func:`mass_matrices`) and ``T`` the reference trace moments (``rt.traces``): one
+    compiled pass per batch of elements (Cholesky factor :math:`A_K = L L^T`, :math:`W = L^{-1} T^T`,
+    :math:`H_K = W^T W`, exactly symmetric).
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    rt : fem_neck.simplex.RaviartThomas
+        The reference flux space.
+    degree : int
+        Quadrature degree on the curved elements.
+    """
+    T = np.ascontiguousarray(rt.traces)                                     # (4 nf, m)
+    E = len(mesh.tets)
+    H_K = SymmetricStack(E, len(T))
+    for begin in range(0, E, CHUNK):
+        elements = np.arange(begin, min(begin + CHUNK, E))
+        if not _trace_products(mass_matrices(mesh, rt, degree, elements), T, H_K.packed[begin:begin + CHUNK]):
+            raise ValueError("an element's flux mass matrix is not positive definite: the mesh has a degenerate "
+                             "element")
+    return H_K
+
+
+@njit(cache=True, fastmath=True)
+def _trace_products(A, T, out):
+    """``out[e]`` = the upper triangle (the order of ``numpy.triu_indices``) of :math:`T A_e^{-1} T^T` for every
+    symmetric positive definite ``A[e]``; False if one is not (a pivot of its Cholesky factor not positive)."""
+    E, m, n = A.shape[0], A.shape[1], T.shape[0]
+    L = np.empty((m, m))
+    W = np.empty((m, n))
+    H = np.empty((n, n))
+    for e in range(E):
+        for i in range(m):                                       # A_e = L L^T, row by row
+            for j in range(i + 1):
+                s = A[e, i, j]
+                for k in range(j):
+                    s -= L[i, k] * L[j, k]
+                if i == j:
+                    if not s > 0.0:
+                        return False
+                    L[i, i] = np.sqrt(s)
+                else:
+                    L[i, j] = s / L[j, j]
+        for i in range(m):                                       # W = L^-1 T^T, forward substitution
+            for c in range(n):
+                W[i, c] = T[c, i]
+            for k in range(i):
+                f = L[i, k]
+                for c in range(n):
+                    W[i, c] -= f * W[k, c]
+            f = 1.0 / L[i, i]
+            for c in range(n):
+                W[i, c] *= f
+        H[:, :] = 0.0                                            # W^T W (whole rows: the loops vectorise)
+        for k in range(m):
+            for a in range(n):
+                f = W[k, a]
+                for c in range(n):
+                    H[a, c] += f * W[k, c]
+        p = 0
+        for a in range(n):
+            for c in range(a, n):
+                out[e, p] = H[a, c]
+                p += 1
+    return True
+
+
 @dataclass
 class Solution:
     r"""The equilibrated flux of :func:`solve`, for the unit temperature difference and :math:`\kappa = 1`: ``lower``
@@ -441,18 +511,13 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
 
     rt = raviart_thomas(k)
     nf = rt.n_face
-    T = rt.traces                                                           # (4 nf, m)
     E = len(mesh.tets)
     constant = 1.0 / rt.face_basis(np.zeros((1, 2)))[0, 0]                # coefficient of the function 1
     fixed_face = np.zeros(len(mesh.faces), dtype=bool)
     fixed_face[hot] = fixed_face[cold] = True
     lam = np.zeros(len(mesh.faces) * nf)
     lam[hot * nf] = constant
-    H_K = SymmetricStack(E, 4 * nf)                                         # (made exactly symmetric)
-    for begin in range(0, E, CHUNK):
-        elements = np.arange(begin, min(begin + CHUNK, E))
-        A = mass_matrices(mesh, rt, degree or quadrature_degree(k + 1), elements)
-        H_K[elements] = np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape)))
+    H_K = element_matrices(mesh, rt, degree or quadrature_degree(k + 1))
     system = face_system(mesh, H_K, fixed_face, lam)
     H = system.matrix
     n_free = len(system.diagonal)

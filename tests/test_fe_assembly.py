@@ -59,11 +59,27 @@ def cell_mesh():
 def _element_matrices(mesh, k):
     """``H_K`` of every element, as :func:`fem_neck.dual.solve` makes them."""
     rt = raviart_thomas(k)
-    A = dual.mass_matrices(mesh, rt, primal.quadrature_degree(k + 1), np.arange(len(mesh.tets)))
-    H = np.matmul(rt.traces, np.linalg.solve(A, np.broadcast_to(rt.traces.T, (len(A),) + rt.traces.T.shape)))
-    stack = dual.SymmetricStack(len(H), H.shape[1])
-    stack[np.arange(len(H))] = H
-    return stack, rt.n_face
+    return dual.element_matrices(mesh, rt, primal.quadrature_degree(k + 1)), rt.n_face
+
+
+@pytest.mark.parametrize("k", [1, 3])
+def test_element_matrices_are_the_traces_through_the_inverse_mass(cell_mesh, k):
+    # the compiled Cholesky pass against T A^-1 T^T by LAPACK's dense solve, on curved and straight elements
+    mesh, rt = cell_mesh.curved, raviart_thomas(k)
+    elements = np.arange(len(mesh.tets))
+    A = dual.mass_matrices(mesh, rt, primal.quadrature_degree(k + 1), elements)
+    T = rt.traces
+    H = np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape)))
+    stack = dual.element_matrices(mesh, rt, primal.quadrature_degree(k + 1))
+    assert mesh.is_curved.any() and not mesh.is_curved.all()
+    np.testing.assert_allclose(stack[elements], H, rtol=0, atol=1e-13 * np.abs(H).max())
+
+
+def test_element_matrices_refuse_a_mass_matrix_that_is_not_positive_definite():
+    T = np.ones((2, 3))
+    A = np.stack([np.eye(3), np.diag([1.0, -1.0, 1.0])])
+    assert dual._trace_products(A[:1], T, np.empty((1, 3)))
+    assert not dual._trace_products(A, T, np.empty((2, 3)))
 
 
 def test_face_system_is_the_sum_of_the_element_matrices_on_the_free_faces(cell_mesh):
