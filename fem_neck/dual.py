@@ -208,10 +208,21 @@ class SymmetricStack:
             One vector per matrix, ``(E, n)``.
         """
         out = np.empty_like(x)
-        for begin in range(0, len(self), CHUNK):
-            chunk = slice(begin, begin + CHUNK)
-            out[chunk] = np.matmul(self[chunk], x[chunk, :, None])[:, :, 0]
+        _packed_products(self.packed, self.gather.reshape(self.n, self.n), np.ascontiguousarray(x), out)
         return out
+
+
+@njit(cache=True)
+def _packed_products(packed, position, x, out):
+    """``out[e] = M_e x[e]`` for the symmetric ``M_e`` kept as the upper triangles ``packed`` (entry ``(i, j)`` at
+    ``position[i, j]``)."""
+    E, n = x.shape
+    for e in range(E):
+        for i in range(n):
+            s = 0.0
+            for j in range(n):
+                s += packed[e, position[i, j]] * x[e, j]
+            out[e, i] = s
 
 
 class SymmetricBlocks:
@@ -475,12 +486,46 @@ def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_fa
     # each element's divergence-free field of least energy with these traces: H_K mu = change of the traces (the
     # constant multiplier, H_K's null space, added to make the system regular; the change is orthogonal to it)
     change = (sign[:, None] * flux[faces] - outward).reshape(E, n)
-    null = np.zeros(n)
-    null[::nf] = 1.0
-    for begin in range(0, E, CHUNK):
-        chunk = slice(begin, begin + CHUNK)
-        lam_K[chunk] += np.linalg.solve(H_K[chunk] + np.outer(null, null), change[chunk, :, None])[:, :, 0]
+    if not _add_regularised_solves(H_K.packed, H_K.gather.reshape(n, n), nf, change, lam_K):
+        raise ValueError("an element matrix H_K is not positive definite on the fields of zero net flux")
     return lam_K
+
+
+@njit(cache=True, fastmath=True)
+def _add_regularised_solves(packed, position, nf, rhs, out):
+    """``out[e] += (H_e + c c^T)^-1 rhs[e]`` for the symmetric ``H_e`` kept as the upper triangles ``packed`` (entry
+    ``(i, j)`` at ``position[i, j]``) and ``c`` the constant multiplier (1 at every ``nf``-th entry), by a Cholesky
+    factor of each; False if a pivot is not positive."""
+    E, n = rhs.shape
+    L = np.empty((n, n))
+    y = np.empty(n)
+    for e in range(E):
+        for i in range(n):
+            for j in range(i + 1):
+                s = packed[e, position[i, j]]
+                if i % nf == 0 and j % nf == 0:
+                    s += 1.0
+                for k in range(j):
+                    s -= L[i, k] * L[j, k]
+                if i == j:
+                    if not s > 0.0:
+                        return False
+                    L[i, i] = np.sqrt(s)
+                else:
+                    L[i, j] = s / L[j, j]
+        for i in range(n):                                       # L y = rhs
+            s = rhs[e, i]
+            for k in range(i):
+                s -= L[i, k] * y[k]
+            y[i] = s / L[i, i]
+        for i in range(n - 1, -1, -1):                           # L^T x = y (x over y)
+            s = y[i]
+            for k in range(i + 1, n):
+                s -= L[k, i] * y[k]
+            y[i] = s / L[i, i]
+        for i in range(n):
+            out[e, i] += y[i]
+    return True
 
 
 def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: float = ENERGY_RTOL,
