@@ -168,6 +168,19 @@ def numbering(mesh: CurvedMesh, basis: Lagrange) -> Numbering:
     return Numbering(l2g.reshape(M, -1), nv + ne * pe + len(mesh.faces) * pf)
 
 
+def skeleton_groups(basis: Lagrange) -> list:
+    """The sizes of the groups of an element's skeleton dofs in the order of :func:`numbering` that are one mesh
+    entity's (a vertex, the ``n_edge`` nodes of an edge, the ``n_face`` of a face): consecutive global dofs in every
+    element, fixed or free together (:class:`fem_neck.pcg.Assembly`).
+
+    Parameters
+    ----------
+    basis : fem_neck.simplex.Lagrange
+        The reference ``P_p`` basis.
+    """
+    return [size for size in [1] * 4 + [basis.n_edge] * 6 + [basis.n_face] * 4 if size]
+
+
 def face_dofs(mesh: CurvedMesh, basis: Lagrange, faces: np.ndarray) -> np.ndarray:
     """Global dofs of every node on the given faces.
 
@@ -250,7 +263,7 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     hot_dofs = face_dofs(mesh, basis, hot)
     fixed[hot_dofs] = fixed[face_dofs(mesh, basis, cold)] = True
     values[hot_dofs] = 1.0
-    system = pcg.Assembly(num.l2g, fixed, values)
+    system = pcg.Assembly(num.l2g, fixed, values, skeleton_groups(basis))
     hats = hat_values(basis)
     coarse = np.empty((len(mesh.tets), 4, 4))                               # each element's part of P^T A_ff P
     for start in range(0, len(mesh.tets), CHUNK):

@@ -40,6 +40,54 @@ def test_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs(seed):
     assert system.energy(A, x) == pytest.approx(u @ full @ u, rel=1e-12)
 
 
+def test_grouped_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs():
+    # groups of 1, 3 and 2 local dofs, each a run of consecutive global dofs of one "entity", fixed or free together
+    rng = np.random.default_rng(7)
+    sizes, count = [1, 1, 3, 3, 2], 40                                   # 40 entities of each size
+    size_of = rng.permutation(np.repeat([1, 2, 3], count))
+    base = np.concatenate([[0], np.cumsum(size_of)])                     # entity j owns base[j] .. base[j + 1] - 1
+    held = rng.random(len(size_of)) < 0.2
+    l2g = np.empty((200, 10), dtype=np.int64)
+    for e in range(200):
+        columns = []
+        for size in sizes:
+            entity = rng.choice(np.flatnonzero((size_of == size) & ~np.isin(np.arange(len(size_of)), columns)))
+            columns.append(entity)
+        l2g[e] = np.concatenate([base[j] + np.arange(size_of[j]) for j in columns])
+    fixed = np.repeat(held, size_of)
+    values = np.where(fixed, rng.random(len(fixed)), 0.0)
+    K = rng.standard_normal((200, 10, 10))
+    K = K + np.swapaxes(K, 1, 2)
+    grouped, plain = pcg.Assembly(l2g, fixed, values, sizes), pcg.Assembly(l2g, fixed, values)
+    for system in (grouped, plain):
+        for start in range(0, 200, 64):
+            elements = np.arange(start, min(start + 64, 200))
+            system.add(K[elements], elements)
+    A, B = grouped.matrix(), plain.matrix()
+    n = l2g.shape[1]
+    full = sp.csr_matrix((K.ravel(), (np.repeat(l2g, n, axis=1).ravel(), np.tile(l2g, (1, n)).ravel())),
+                         shape=(len(fixed),) * 2).toarray()
+    free = grouped.free
+    assert A.has_canonical_format
+    np.testing.assert_array_equal(A.indptr, B.indptr)
+    np.testing.assert_array_equal(A.indices, B.indices)
+    np.testing.assert_allclose(A.toarray(), full[np.ix_(free, free)], atol=1e-13)
+    np.testing.assert_allclose(grouped.b, -full[np.ix_(free, np.flatnonzero(fixed))] @ values[fixed], atol=1e-12)
+
+
+@pytest.mark.parametrize("groups, match", [([1, 1, 3, 3, 3], "positive sizes summing to the 3 local dofs"),
+                                           ([3], "consecutive global dofs"),
+                                           ([2, 1], "one group in every element")])
+def test_groups_that_do_not_hold_are_refused(groups, match):
+    # elements (0, 1, 2) and (2, 3, 4): dof 2 starts a group in the second but not in the first; then dofs 4 and 5
+    # fixed and free within a group
+    l2g = np.array([[0, 1, 2], [2, 3, 4]]) if groups != [3] else np.array([[0, 1, 2], [4, 5, 6]])
+    fixed = np.zeros(7, dtype=bool)
+    fixed[4] = True
+    with pytest.raises(ValueError, match=match):
+        pcg.Assembly(l2g, fixed, np.zeros(7), groups)
+
+
 def test_packed_symmetric_products_are_the_full_ones():
     g = np.random.default_rng(2).standard_normal((7, 3, 5))
     packed = primal.symmetric_products(g)
@@ -174,9 +222,12 @@ def test_coarse_matrix_of_the_hats_is_the_galerkin_product(cell_mesh):
     fixed = np.zeros(num.n, dtype=bool)
     fixed[primal.face_dofs(mesh, basis, cell_mesh.hot)] = fixed[primal.face_dofs(mesh, basis, cell_mesh.cold)] = True
     K = primal.condensed(primal.stiffness_matrices(mesh, basis), skel)
-    system = pcg.Assembly(num.l2g, fixed, fixed.astype(float))
+    system = pcg.Assembly(num.l2g, fixed, fixed.astype(float), primal.skeleton_groups(basis))
     system.add(K, np.arange(len(K)))
     A = system.matrix()
+    plain = pcg.Assembly(num.l2g, fixed, fixed.astype(float))                 # one group per dof: the same matrix
+    plain.add(K, np.arange(len(K)))
+    assert abs(A - plain.matrix()).max() == 0.0 and np.array_equal(system.b, plain.b)
     P = primal.hat_prolongation(mesh, basis, num)[system.free]
     free = ~fixed[num.l2g]
     hats = primal.hat_values(basis)
