@@ -41,8 +41,9 @@ CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arr
 
 
 def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np.ndarray) -> np.ndarray:
-    r"""Flux mass matrices ``(E, m, m)`` of ``elements``: :math:`\int \sigma^T J^T J \tau / |\det J|` on the reference
-    element (exact on straight elements, quadrature of ``degree`` on curved ones).
+    r"""Flux mass matrices of ``elements``, :math:`\int \sigma^T J^T J \tau / |\det J|` on the reference element
+    (exact on straight elements, quadrature of ``degree`` on curved ones), each kept as its upper triangle in the order
+    of ``numpy.triu_indices(m)``: ``(E, m (m + 1) / 2)`` (:func:`fem_neck.primal.symmetric_gather` unpacks it).
 
     Parameters
     ----------
@@ -57,13 +58,14 @@ def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np
     """
     J = mesh.affine_jacobians(elements)
     G = np.einsum("eai,eaj->eij", J, J) / np.abs(np.linalg.det(J))[:, None, None]
-    A = np.einsum("eij,ijab->eab", G, rt.mass)
+    a, b = np.triu_indices(rt.m)
+    A = G.reshape(len(G), 9) @ rt.mass[:, :, a, b].reshape(9, -1)
     curved = np.flatnonzero(mesh.is_curved[elements])
     if len(curved):
         xi, w = tet_quadrature(degree)
         products = symmetric_products(rt.values(xi))                          # (6 Q, m (m + 1) / 2)
         G = mesh.metric(elements[curved], xi, w, inverse=False).reshape(len(curved), -1)
-        A[curved] = np.take(G @ products, symmetric_gather(rt.m), axis=1).reshape(len(curved), rt.m, rt.m)
+        A[curved] = G @ products
     return A
 
 
@@ -83,28 +85,31 @@ def element_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int) -> Symmet
         Quadrature degree on the curved elements.
     """
     T = np.ascontiguousarray(rt.traces)                                     # (4 nf, m)
+    position = symmetric_gather(rt.m).reshape(rt.m, rt.m)
     E = len(mesh.tets)
     H_K = SymmetricStack(E, len(T))
     for begin in range(0, E, CHUNK):
         elements = np.arange(begin, min(begin + CHUNK, E))
-        if not _trace_products(mass_matrices(mesh, rt, degree, elements), T, H_K.packed[begin:begin + CHUNK]):
+        if not _trace_products(mass_matrices(mesh, rt, degree, elements), position, T,
+                               H_K.packed[begin:begin + CHUNK]):
             raise ValueError("an element's flux mass matrix is not positive definite: the mesh has a degenerate "
                              "element")
     return H_K
 
 
 @njit(cache=True, fastmath=True)
-def _trace_products(A, T, out):
+def _trace_products(A, position, T, out):
     """``out[e]`` = the upper triangle (the order of ``numpy.triu_indices``) of :math:`T A_e^{-1} T^T` for every
-    symmetric positive definite ``A[e]``; False if one is not (a pivot of its Cholesky factor not positive)."""
-    E, m, n = A.shape[0], A.shape[1], T.shape[0]
+    symmetric positive definite ``A_e``, kept as the upper triangles ``A`` (entry ``(i, j)`` at ``position[i, j]``);
+    False if one is not (a pivot of its Cholesky factor not positive)."""
+    E, m, n = A.shape[0], T.shape[1], T.shape[0]
     L = np.empty((m, m))
     W = np.empty((m, n))
     H = np.empty((n, n))
     for e in range(E):
         for i in range(m):                                       # A_e = L L^T, row by row
             for j in range(i + 1):
-                s = A[e, i, j]
+                s = A[e, position[i, j]]
                 for k in range(j):
                     s -= L[i, k] * L[j, k]
                 if i == j:

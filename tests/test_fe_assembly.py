@@ -115,7 +115,8 @@ def test_element_matrices_are_the_traces_through_the_inverse_mass(cell_mesh, k):
     # the compiled Cholesky pass against T A^-1 T^T by LAPACK's dense solve, on curved and straight elements
     mesh, rt = cell_mesh.curved, raviart_thomas(k)
     elements = np.arange(len(mesh.tets))
-    A = dual.mass_matrices(mesh, rt, primal.quadrature_degree(k + 1), elements)
+    packed = dual.mass_matrices(mesh, rt, primal.quadrature_degree(k + 1), elements)
+    A = packed[:, primal.symmetric_gather(rt.m)].reshape(len(elements), rt.m, rt.m)
     T = rt.traces
     H = np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape)))
     stack = dual.element_matrices(mesh, rt, primal.quadrature_degree(k + 1))
@@ -124,10 +125,10 @@ def test_element_matrices_are_the_traces_through_the_inverse_mass(cell_mesh, k):
 
 
 def test_element_matrices_refuse_a_mass_matrix_that_is_not_positive_definite():
-    T = np.ones((2, 3))
-    A = np.stack([np.eye(3), np.diag([1.0, -1.0, 1.0])])
-    assert dual._trace_products(A[:1], T, np.empty((1, 3)))
-    assert not dual._trace_products(A, T, np.empty((2, 3)))
+    T, position = np.ones((2, 3)), primal.symmetric_gather(3).reshape(3, 3)
+    A = np.array([[1.0, 0, 0, 1, 0, 1], [1, 0, 0, -1, 0, 1]])                 # I and diag(1, -1, 1), packed
+    assert dual._trace_products(A[:1], position, T, np.empty((1, 3)))
+    assert not dual._trace_products(A, position, T, np.empty((2, 3)))
 
 
 def test_face_system_is_the_sum_of_the_element_matrices_on_the_free_faces(cell_mesh):
