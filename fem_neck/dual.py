@@ -84,13 +84,19 @@ def element_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int) -> Symmet
     degree : int
         Quadrature degree on the curved elements.
     """
-    T = np.ascontiguousarray(rt.traces)                                     # (4 nf, m)
+    # the fields rotated (orthogonally, so still orthonormal in the reference mass) to put those without traces
+    # first: their rows of L^-1 T^T vanish, and the kernel skips them
+    _, singular, vt = np.linalg.svd(rt.traces)
+    rank = int(np.sum(singular > 1e-12 * singular[0]))
+    rt = RaviartThomas(rt.k, rt.exponents, rt.coefficients @ np.concatenate([vt[rank:], vt[:rank]]).T,
+                       rt.face_exponents, rt.face_coefficients)
+    T = np.ascontiguousarray(rt.traces)                                     # (4 nf, m), zero in its first m - rank
     position = symmetric_gather(rt.m).reshape(rt.m, rt.m)
     E = len(mesh.tets)
     H_K = SymmetricStack(E, len(T))
     for begin in range(0, E, CHUNK):
         elements = np.arange(begin, min(begin + CHUNK, E))
-        if not _trace_products(mass_matrices(mesh, rt, degree, elements), position, T,
+        if not _trace_products(mass_matrices(mesh, rt, degree, elements), position, T, rt.m - rank,
                                H_K.packed[begin:begin + CHUNK]):
             raise ValueError("an element's flux mass matrix is not positive definite: the mesh has a degenerate "
                              "element")
@@ -98,10 +104,11 @@ def element_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int) -> Symmet
 
 
 @njit(cache=True, fastmath=True)
-def _trace_products(A, position, T, out):
+def _trace_products(A, position, T, first, out):
     """``out[e]`` = the upper triangle (the order of ``numpy.triu_indices``) of :math:`T A_e^{-1} T^T` for every
-    symmetric positive definite ``A_e``, kept as the upper triangles ``A`` (entry ``(i, j)`` at ``position[i, j]``);
-    False if one is not (a pivot of its Cholesky factor not positive)."""
+    symmetric positive definite ``A_e``, kept as the upper triangles ``A`` (entry ``(i, j)`` at ``position[i, j]``),
+    where the first ``first`` columns of ``T`` are zero; False if one is not (a pivot of its Cholesky factor not
+    positive)."""
     E, m, n = A.shape[0], T.shape[1], T.shape[0]
     L = np.empty((m, m))
     W = np.empty((m, n))
@@ -118,10 +125,10 @@ def _trace_products(A, position, T, out):
                     L[i, i] = np.sqrt(s)
                 else:
                     L[i, j] = s / L[j, j]
-        for i in range(m):                                       # W = L^-1 T^T, forward substitution
+        for i in range(first, m):                                # W = L^-1 T^T (zero above first), forward
             for c in range(n):
                 W[i, c] = T[c, i]
-            for k in range(i):
+            for k in range(first, i):
                 f = L[i, k]
                 for c in range(n):
                     W[i, c] -= f * W[k, c]
@@ -129,7 +136,7 @@ def _trace_products(A, position, T, out):
             for c in range(n):
                 W[i, c] *= f
         H[:, :] = 0.0                                            # W^T W (whole rows: the loops vectorise)
-        for k in range(m):
+        for k in range(first, m):
             for a in range(n):
                 f = W[k, a]
                 for c in range(n):

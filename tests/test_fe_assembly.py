@@ -127,8 +127,8 @@ def test_element_matrices_are_the_traces_through_the_inverse_mass(cell_mesh, k):
 def test_element_matrices_refuse_a_mass_matrix_that_is_not_positive_definite():
     T, position = np.ones((2, 3)), primal.symmetric_gather(3).reshape(3, 3)
     A = np.array([[1.0, 0, 0, 1, 0, 1], [1, 0, 0, -1, 0, 1]])                 # I and diag(1, -1, 1), packed
-    assert dual._trace_products(A[:1], position, T, np.empty((1, 3)))
-    assert not dual._trace_products(A, position, T, np.empty((2, 3)))
+    assert dual._trace_products(A[:1], position, T, 0, np.empty((1, 3)))
+    assert not dual._trace_products(A, position, T, 0, np.empty((2, 3)))
 
 
 def test_face_system_is_the_sum_of_the_element_matrices_on_the_free_faces(cell_mesh):
