@@ -3,7 +3,8 @@ Schwarz preconditioner (memory linear in the unknowns).
 
 :math:`M^{-1} r = P (P^T A P)^{-1} P^T r + D^{-1} r`: a coarse space ``P`` (for high-order elements the piecewise-linear
 hats, for the hybridised fluxes the face means), whose Galerkin matrix gets one smoothed-aggregation AMG V-cycle
-(pyamg), plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face). The coarse
+(pyamg), plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face, the nodes
+of one mesh edge or face). The coarse
 space removes the low-frequency error, the local part the high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994
 for the p-version).
 """
@@ -20,7 +21,9 @@ class TwoLevel:
     r"""The preconditioner of the module docstring, as a callable :math:`r \to M^{-1} r`. The coarse matrix
     :math:`P^T A P` is computed unless given (``coarse``, CSR); the local part :math:`D^{-1}` is point Jacobi, or block
     Jacobi on consecutive groups of unknowns whose diagonal blocks of ``A`` are ``block_matrices (B, n, n)`` (``B n`` =
-    all unknowns; the moments of one face), kept as one block sparse matrix.
+    all unknowns; the moments of one face), kept as one block sparse matrix, or block Jacobi on consecutive ``groups``
+    of unknowns of any sizes, the blocks read from ``A`` (CSR; the nodes of one mesh edge or face,
+    :meth:`Assembly.groups`).
 
     Parameters
     ----------
@@ -33,9 +36,13 @@ class TwoLevel:
     block_matrices : numpy.ndarray, optional
         The diagonal blocks (B, k, k) of ``A`` on consecutive groups of ``k`` unknowns (``B k = n``), inverted for the
         block Jacobi part; None for point Jacobi.
+    groups : numpy.ndarray, optional
+        Sizes of consecutive groups of unknowns (summing to n) whose diagonal blocks of ``A`` are inverted for the
+        block Jacobi part (instead of ``block_matrices``).
     """
 
-    def __init__(self, A, P, coarse=None, block_matrices: np.ndarray | None = None):
+    def __init__(self, A, P, coarse=None, block_matrices: np.ndarray | None = None,
+                 groups: np.ndarray | None = None):
         import scipy.sparse as sp
 
         from sinterheat import amg
@@ -45,7 +52,16 @@ class TwoLevel:
         if coarse is None:
             coarse = (self.PT @ A @ self.P).tocsr()
         self.amg = amg.hierarchy(coarse, symmetry="symmetric", max_coarse=500).aspreconditioner(cycle="V")
-        if block_matrices is None:
+        if groups is not None:
+            if block_matrices is not None:
+                raise ValueError("block_matrices and groups: give one of them")
+            if np.sum(groups) != A.shape[0] or np.any(np.asarray(groups) < 1):
+                raise ValueError(f"groups: positive sizes summing to the {A.shape[0]} unknowns")
+            starts = np.concatenate([[0], np.cumsum(groups)]).astype(A.indptr.dtype)
+            indptr = np.concatenate([[0], np.cumsum(np.repeat(groups, groups))]).astype(A.indptr.dtype)
+            inverse, indices = _group_inverses(A.data, A.indices, A.indptr, starts, indptr)
+            self.local = sp.csr_matrix((inverse, indices, indptr), shape=A.shape)
+        elif block_matrices is None:
             self.local = sp.diags(1.0 / A.diagonal(), format="csr")
         else:
             count, n = len(block_matrices), block_matrices.shape[1]
@@ -56,6 +72,41 @@ class TwoLevel:
 
     def __call__(self, r: np.ndarray) -> np.ndarray:
         return self.P @ self.amg(self.PT @ r) + self.local @ r
+
+
+@njit(cache=True)
+def _group_inverses(data, indices, indptr, starts, out_indptr):
+    """The inverses of the diagonal blocks of the CSR matrix ``(data, indices, indptr)`` (sorted columns) on the
+    groups of rows ``starts[g]`` to ``starts[g + 1] - 1``, as the data and column indices of a CSR matrix whose rows
+    start at ``out_indptr`` (each row holds its group's columns); Gauss-Jordan without pivoting (symmetric positive
+    definite blocks)."""
+    out = np.empty(out_indptr[-1])
+    columns = np.empty(out_indptr[-1], dtype=indices.dtype)
+    for g in range(len(starts) - 1):
+        s, h = starts[g], starts[g + 1] - starts[g]
+        block = np.empty((h, 2 * h))
+        for i in range(h):
+            row = s + i
+            k = indptr[row]
+            while indices[k] != s:                               # the group's columns s .. s + h - 1, in a run
+                k += 1
+            for j in range(h):
+                block[i, j] = data[k + j]
+                block[i, h + j] = 1.0 if i == j else 0.0
+        for p in range(h):                                       # [B | I] -> [I | B^-1]
+            f = 1.0 / block[p, p]
+            for j in range(2 * h):
+                block[p, j] *= f
+            for i in range(h):
+                if i != p:
+                    f = block[i, p]
+                    for j in range(2 * h):
+                        block[i, j] -= f * block[p, j]
+        for i in range(h):
+            for j in range(h):
+                out[out_indptr[s + i] + j] = block[i, h + j]
+                columns[out_indptr[s + i] + j] = s + j
+    return out, columns
 
 
 class Assembly:
@@ -137,6 +188,19 @@ class Assembly:
         self.constant -= float(np.sum(known * load))
         chunk = slice(elements[0], elements[-1] + 1)
         _scatter(self.data, self.indptr, self.loc[chunk], self.offsets, self.place[chunk], np.ascontiguousarray(K))
+
+    def groups(self) -> np.ndarray:
+        """Sizes of the groups of consecutive free unknowns that are one group of local dofs (:class:`Assembly`), in
+        order (``TwoLevel``'s ``groups``)."""
+        sizes = np.diff(self.offsets)
+        lead = self.loc[:, self.offsets[:-1]]
+        used = lead >= 0
+        first, index = np.unique(lead[used], return_index=True)
+        size = np.broadcast_to(sizes, lead.shape)[used][index]
+        if len(first) and (first[0] != 0 or np.any(first[1:] != first[:-1] + size[:-1])
+                           or first[-1] + size[-1] != len(self.free)):
+            raise ValueError("groups: the free unknowns are not all in groups (an unknown no element uses)")
+        return size
 
     def matrix(self):
         """``A_ff`` (CSR); frees the element places."""
@@ -261,7 +325,8 @@ def _scatter(data, indptr, loc, offsets, place, K):
                             data[start + b] += K[e, a, b]
 
 
-def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None) -> TwoLevel:
+def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None,
+              groups: np.ndarray | None = None) -> TwoLevel:
     """The preconditioner :class:`TwoLevel` of ``A`` on the coarse space ``P``.
 
     Parameters
@@ -274,8 +339,10 @@ def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None) -> Tw
         :math:`P^T A P` if the caller has it.
     block_matrices : numpy.ndarray, optional
         Diagonal blocks (B, k, k) of ``A`` for block Jacobi; None for point Jacobi.
+    groups : numpy.ndarray, optional
+        Sizes of consecutive groups of unknowns for block Jacobi on ``A``'s own blocks (CSR ``A``).
     """
-    return TwoLevel(A, P, coarse, block_matrices)
+    return TwoLevel(A, P, coarse, block_matrices, groups)
 
 
 def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 5000,

@@ -6,7 +6,7 @@ the elements of :mod:`fem_neck.curved` fill the exact solid, so :math:`u^T A u \
 whatever the solver's residual (which only makes the bound less sharp): CG stops once the energy has settled to
 ``ENERGY_RTOL``. The ``(p - 1)(p - 2)(p - 3) / 6`` interior nodes of every element are condensed (Schur complement,
 batched); the skeleton system is solved by conjugate gradients preconditioned by :func:`fem_neck.pcg.two_level` (the
-piecewise-linear hats as coarse space).
+piecewise-linear hats as coarse space, block Jacobi on the nodes of every vertex, edge and face).
 """
 
 from __future__ import annotations
@@ -274,8 +274,8 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
         coarse[elements] = hats.T @ (K * free[:, :, None] * free[:, None, :]) @ hats
     A = system.matrix()
     P = hat_prolongation(mesh, basis, num)[system.free]
-    x, iterations, residual = pcg.solve(A, system.b, pcg.two_level(A, P, coarse_matrix(mesh, coarse)),
-                                        energy=(system.constant, etol))
+    precondition = pcg.two_level(A, P, coarse_matrix(mesh, coarse), groups=system.groups())  # an entity's nodes
+    x, iterations, residual = pcg.solve(A, system.b, precondition, energy=(system.constant, etol))
     u = values.copy()
     u[system.free] = x
     return Solution(system.energy(A, x), u, num.n + basis.n_interior * len(mesh.tets), num.n, iterations, residual)

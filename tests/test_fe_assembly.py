@@ -40,8 +40,9 @@ def test_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs(seed):
     assert system.energy(A, x) == pytest.approx(u @ full @ u, rel=1e-12)
 
 
-def test_grouped_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs():
-    # groups of 1, 3 and 2 local dofs, each a run of consecutive global dofs of one "entity", fixed or free together
+def _grouped_elements():
+    """Random symmetric element matrices on groups of 1, 1, 3, 3 and 2 local dofs, each a run of consecutive global
+    dofs of one "entity", fixed or free together."""
     rng = np.random.default_rng(7)
     sizes, count = [1, 1, 3, 3, 2], 40                                   # 40 entities of each size
     size_of = rng.permutation(np.repeat([1, 2, 3], count))
@@ -57,7 +58,12 @@ def test_grouped_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs():
     fixed = np.repeat(held, size_of)
     values = np.where(fixed, rng.random(len(fixed)), 0.0)
     K = rng.standard_normal((200, 10, 10))
-    K = K + np.swapaxes(K, 1, 2)
+    return l2g, fixed, values, K + np.swapaxes(K, 1, 2)
+
+
+def test_grouped_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs():
+    l2g, fixed, values, K = _grouped_elements()
+    sizes = [1, 1, 3, 3, 2]
     grouped, plain = pcg.Assembly(l2g, fixed, values, sizes), pcg.Assembly(l2g, fixed, values)
     for system in (grouped, plain):
         for start in range(0, 200, 64):
@@ -176,6 +182,29 @@ def test_the_given_coarse_matrix_of_the_face_means_is_the_galerkin_product(cell_
     given = pcg.two_level(H, P, coarse, system.diagonal)(r)
     computed = pcg.two_level(H.tocsr(), P, None, system.diagonal)(r)
     np.testing.assert_allclose(given, computed, rtol=1e-12)
+
+
+def test_block_jacobi_on_groups_inverts_the_diagonal_blocks_of_the_matrix():
+    # the upper bound's P_4 system: its groups (a vertex, an edge's or a face's nodes) against dense inverses
+    l2g, fixed, values, K = _grouped_elements()
+    system = pcg.Assembly(l2g, fixed, values, [1, 1, 3, 3, 2])
+    for start in range(0, len(K), 64):
+        system.add(K[start:start + 64], np.arange(start, min(start + 64, len(K))))
+    groups = system.groups()
+    A = system.matrix()
+    A = A + sp.identity(A.shape[0]) * 2 * abs(A).sum(axis=1).max()          # positive definite (diagonally dominant)
+    A = A.tocsr()
+    A.sort_indices()
+    starts = np.concatenate([[0], np.cumsum(groups)])
+    assert sorted(set(groups)) == [1, 2, 3] and starts[-1] == A.shape[0]
+    local = pcg.two_level(A, sp.identity(A.shape[0], format="csr"), None, groups=groups).local.toarray()
+    dense = A.toarray()
+    expected = np.zeros_like(dense)
+    for begin, end in zip(starts[:-1], starts[1:]):
+        expected[begin:end, begin:end] = np.linalg.inv(dense[begin:end, begin:end])
+    np.testing.assert_allclose(local, expected, rtol=0, atol=1e-13 * abs(expected).max())
+    with pytest.raises(ValueError, match="groups: positive sizes summing to the"):
+        pcg.two_level(A, sp.identity(A.shape[0], format="csr"), None, groups=groups[1:])
 
 
 def test_block_jacobi_needs_blocks_that_cover_the_unknowns():
