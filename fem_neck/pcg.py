@@ -180,9 +180,11 @@ class Assembly:
         elements : numpy.ndarray
             Indices of consecutive elements (rows of ``l2g``), ascending without gaps.
         """
-        known = np.where(self.fixed[self.l2g[elements]], self.values[self.l2g[elements]], 0.0)
-        load = -np.matmul(K, known[:, :, None])[:, :, 0]
-        loc = self.loc[elements]
+        held = self.fixed[self.l2g[elements]]
+        near = np.flatnonzero(held.any(axis=1))                                # the elements with a fixed dof
+        known = np.where(held[near], self.values[self.l2g[elements[near]]], 0.0)
+        load = -np.matmul(K[near], known[:, :, None])[:, :, 0]
+        loc = self.loc[elements[near]]
         on = loc >= 0
         self.b += np.bincount(loc[on], load[on], minlength=len(self.free))
         self.constant -= float(np.sum(known * load))

@@ -55,7 +55,7 @@ def stiffness_matrices(mesh: CurvedMesh, basis: Lagrange, degree: int | None = N
     J = mesh.affine_jacobians(elements)
     inv = np.linalg.inv(J)
     G = np.abs(np.linalg.det(J))[:, None, None] * np.einsum("eia,eja->eij", inv, inv)   # |det J| J^-1 J^-T
-    K = np.einsum("eij,ijab->eab", G, basis.stiffness)
+    K = (G.reshape(len(G), 9) @ basis.stiffness.reshape(9, -1)).reshape(len(G), basis.n, basis.n)
     curved = np.flatnonzero(mesh.is_curved[elements])
     if len(curved):
         xi, w = tet_quadrature(degree or quadrature_degree(basis.p))
@@ -270,8 +270,7 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
         elements = np.arange(start, min(start + CHUNK, len(mesh.tets)))
         K = condensed(stiffness_matrices(mesh, basis, degree, elements), skel)
         system.add(K, elements)
-        free = ~fixed[num.l2g[elements]]                                    # the rows and columns of A_ff
-        coarse[elements] = hats.T @ (K * free[:, :, None] * free[:, None, :]) @ hats
+        coarse[elements] = hat_parts(K, ~fixed[num.l2g[elements]], hats)
     A = system.matrix()
     P = hat_prolongation(mesh, basis, num)[system.free]
     precondition = pcg.two_level(A, P, coarse_matrix(mesh, coarse), groups=system.groups())  # an entity's nodes
@@ -316,11 +315,33 @@ def hat_values(basis: Lagrange) -> np.ndarray:
     return np.concatenate([1.0 - basis.nodes[:skel].sum(axis=1, keepdims=True), basis.nodes[:skel]], axis=1)
 
 
+def hat_parts(K: np.ndarray, free: np.ndarray, hats: np.ndarray) -> np.ndarray:
+    r"""Every element's part :math:`H^T K_e^{ff} H` ``(E, 4, 4)`` of the hats' coarse matrix (:func:`coarse_matrix`):
+    ``K (E, n, n)`` with the rows and columns of its fixed dofs (``free`` False) zeroed, ``hats`` ``H (n, 4)``
+    (:func:`hat_values`); two matrix products over all elements, the few with a fixed dof redone.
+
+    Parameters
+    ----------
+    K : numpy.ndarray
+        Element matrices ``(E, n, n)`` on the skeleton dofs.
+    free : numpy.ndarray
+        Boolean ``(E, n)``: True where the element's dof is free.
+    hats : numpy.ndarray
+        The hats' coefficients ``(n, 4)`` in the skeleton basis.
+    """
+    E, n = free.shape
+    KH = (K.reshape(E * n, n) @ hats).reshape(E, n, 4)
+    out = (np.ascontiguousarray(KH.transpose(0, 2, 1)).reshape(E * 4, n) @ hats).reshape(E, 4, 4)
+    near = np.flatnonzero(~free.all(axis=1))
+    out[near] = hats.T @ (K[near] * free[near][:, :, None] * free[near][:, None, :]) @ hats
+    return out
+
+
 def coarse_matrix(mesh: CurvedMesh, blocks: np.ndarray):
     r"""The Galerkin matrix :math:`P^T A_{ff} P` of the hats (:func:`hat_prolongation` on the free dofs) as the sum
-    of its element parts ``blocks (E, 4, 4)`` on the elements' vertices, :math:`H^T K_e^{ff} H` with ``H`` of
-    :func:`hat_values` and :math:`K_e^{ff}` the element matrix with the fixed dofs' rows and columns zeroed (the same
-    matrix as the sparse product, without it); CSR ``(n_vertices, n_vertices)``.
+    of its element parts ``blocks (E, 4, 4)`` on the elements' vertices, :math:`H^T K_e^{ff} H` (:func:`hat_parts`)
+    with ``H`` of :func:`hat_values` and :math:`K_e^{ff}` the element matrix with the fixed dofs' rows and columns
+    zeroed (the same matrix as the sparse product, without it); CSR ``(n_vertices, n_vertices)``.
 
     Parameters
     ----------
