@@ -457,7 +457,46 @@ def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.nda
     return out.ravel()
 
 
-def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_face: np.ndarray) -> np.ndarray:
+class MeanCorrection:
+    r"""The face means' correction of least norm that leaves no element a net flux (:func:`equilibrate`): with ``B``
+    the signed incidence of the elements and their live faces (all but the insulated ones), ``c = B^T y``,
+    :math:`B B^T y = -` the elements' net fluxes; :math:`B B^T` depends on the mesh only and is factored once (SuperLU),
+    so that the lower bound's process can factor it while it waits for the upper bound's temperature.
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    fixed_face : numpy.ndarray
+        Boolean mask over ``mesh.faces``: True on the faces held at a temperature (whose flux is free).
+    """
+
+    def __init__(self, mesh: CurvedMesh, fixed_face: np.ndarray):
+        import scipy.sparse as sp
+        from scipy.sparse.linalg import splu
+
+        E, faces = len(mesh.tets), mesh.t2f.ravel()
+        self.sides = mesh.face_sides()
+        self.sign = np.where(mesh.first_sides().ravel(), 1.0, -1.0)
+        self.insulated = (self.sides == 1) & ~fixed_face
+        live = ~self.insulated[faces]
+        self.B = sp.csr_matrix((self.sign[live], (np.repeat(np.arange(E), 4)[live], faces[live])),
+                               shape=(E, len(mesh.faces)))
+        self.factor = splu((self.B @ self.B.T).tocsc())
+
+    def __call__(self, net: np.ndarray) -> np.ndarray:
+        """The correction ``c`` of the face means ``(n_faces,)`` for the elements' net fluxes.
+
+        Parameters
+        ----------
+        net : numpy.ndarray
+            Net flux out of every element ``(E,)``, in the unit of the face moments.
+        """
+        return self.B.T @ self.factor.solve(-net)
+
+
+def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_face: np.ndarray,
+                correction: MeanCorrection | None = None) -> np.ndarray:
     r"""Element multipliers ``(E, 4 n_f)`` whose element fluxes :math:`A_K^{-1} T^T \lambda_K` form an admissible flux:
     one normal flux on every face, none on the insulated ones (the module docstring), from the element matrices
     ``H_K`` (``4 n_f`` square), any face multipliers ``lam (n_faces n_f,)`` and the faces held at a temperature
@@ -473,28 +512,23 @@ def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_fa
         Face multipliers ``(n_faces n_f,)`` (any: the CG iterate).
     fixed_face : numpy.ndarray
         Boolean mask over ``mesh.faces``: True on the faces held at a temperature (whose flux is free).
+    correction : MeanCorrection, optional
+        The factored correction of the face means on this mesh (made here if None).
     """
-    import scipy.sparse as sp
-    from scipy.sparse.linalg import spsolve
-
+    correction = MeanCorrection(mesh, fixed_face) if correction is None else correction
     E, n = len(H_K), H_K.n
     nf = n // 4
     faces = mesh.t2f.ravel()
     lam_K = lam.reshape(-1, nf)[mesh.t2f].reshape(E, n)
     outward = H_K.times(lam_K).reshape(E * 4, nf)
     # each face's flux along the normal out of its first element: the mean of its sides
-    sides = mesh.face_sides()
-    sign = np.where(mesh.first_sides().ravel(), 1.0, -1.0)
+    sign = correction.sign
     flux = np.zeros((len(mesh.faces), nf))
     np.add.at(flux, faces, sign[:, None] * outward)
-    flux /= sides[:, None]
-    insulated = (sides == 1) & ~fixed_face
-    flux[insulated] = 0.0
-    # the face means' correction of least norm that leaves no element a net flux: B c = -(B flux_0), c = B^T y
-    live = ~insulated[faces]
-    B = sp.csr_matrix((sign[live], (np.repeat(np.arange(E), 4)[live], faces[live])), shape=(E, len(mesh.faces)))
-    net = (sign * flux[faces, 0]).reshape(E, 4).sum(axis=1)
-    flux[:, 0] += B.T @ spsolve((B @ B.T).tocsc(), -net)
+    flux /= correction.sides[:, None]
+    flux[correction.insulated] = 0.0
+    # the face means' correction of least norm that leaves no element a net flux
+    flux[:, 0] += correction((sign * flux[faces, 0]).reshape(E, 4).sum(axis=1))
     # each element's divergence-free field of least energy with these traces: H_K mu = change of the traces (the
     # constant multiplier, H_K's null space, added to make the system regular; the change is orthogonal to it)
     change = (sign[:, None] * flux[faces] - outward).reshape(E, n)
@@ -583,13 +617,14 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     P = sp.csr_matrix((np.ones(n_free), (np.arange(n_free) * nf, np.arange(n_free))), shape=(n_free * nf, n_free))
     coarse = H.entries(0, 0)
     precondition = pcg.two_level(H, P, coarse, system.diagonal)
+    correction = MeanCorrection(mesh, fixed_face)                          # (before start(), which may wait)
     x0 = None if start is None else start()[system.free]
     energy0 = system.constant if x0 is None else system.energy(x0)
     x, iterations, residual = pcg.solve(H, system.b, precondition, x0=x0, energy=(energy0, etol))
     lam[system.free] = x
     dofs = len(system.free)
     del H, precondition, system                                             # (memory for the equilibration)
-    lam_K = equilibrate(mesh, H_K, lam, fixed_face)
+    lam_K = equilibrate(mesh, H_K, lam, fixed_face, correction)
     outward = H_K.times(lam_K).reshape(E * 4, nf)
     energy = float(np.einsum("ea,ea->", lam_K, outward.reshape(E, -1)))    # = sum alpha^T A alpha
     jumps = np.zeros((len(mesh.faces), nf))                                 # outward moments summed per face
