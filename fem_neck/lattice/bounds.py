@@ -101,7 +101,8 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2, etol: float | N
 
     import pyamg  # noqa: F401  (imported before the fork: the lower bound's process inherits it, as it does dual)
 
-    from fem_neck import dual, primal  # noqa: F401
+    from fem_neck import dual, pcg, primal  # noqa: F401
+    from sinterheat import amg  # noqa: F401
     from fem_neck.simplex import tet_quadrature
 
     t0 = time.perf_counter()
