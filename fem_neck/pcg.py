@@ -11,6 +11,8 @@ for the p-version).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numba import njit
 
@@ -348,7 +350,8 @@ def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None,
 
 
 def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 5000,
-          x0: np.ndarray | None = None, energy: tuple[float, float] | None = None) -> tuple[np.ndarray, int, float]:
+          x0: np.ndarray | None = None, energy: tuple[float, float] | None = None,
+          settled: tuple[float, Callable[[np.ndarray], None]] | None = None) -> tuple[np.ndarray, int, float]:
     r"""Conjugate gradients on the SPD :math:`A x = b` to :math:`|r| \le \mathrm{rtol} \, |b|`:
     ``(x, iterations, |r| / |b|)``; ``RuntimeError`` if ``maxiter`` iterations do not reach it.
 
@@ -375,6 +378,10 @@ def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 50
     energy : tuple of float, optional
         ``(E0, etol)``: the energy at ``x0`` (in the unit of ``b x``) and the relative energy tolerance
         (dimensionless) of the energy stop above.
+    settled : tuple, optional
+        ``(tol, report)``: ``report(x)`` is called once with a copy of the first iterate whose energy has settled to
+        ``tol`` (relative, looser than ``etol``; by the stop above), or with the result if none did before it (with
+        ``energy`` only).
     """
     x = np.zeros_like(b) if x0 is None else x0.copy()
     r = b - A @ x
@@ -394,7 +401,11 @@ def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 50
         if energy is not None:
             drops.append(alpha * rz)
             left = energy[0] - sum(drops)
-            if len(drops) >= ENERGY_WINDOW and sum(drops[-ENERGY_WINDOW:]) <= energy[1] * abs(left):
+            window = sum(drops[-ENERGY_WINDOW:]) if len(drops) >= ENERGY_WINDOW else np.inf
+            if settled is not None and (window <= settled[0] * abs(left) or window <= energy[1] * abs(left)):
+                settled[1](x.copy())
+                settled = None
+            if window <= energy[1] * abs(left):
                 return x, it, res
         z = precondition(r)
         rz_new = float(r @ z)

@@ -11,6 +11,8 @@ piecewise-linear hats as coarse space, block Jacobi on the nodes of every vertex
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -235,7 +237,7 @@ class Solution:
 
 
 def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: float = ENERGY_RTOL,
-          degree: int | None = None) -> Solution:
+          degree: int | None = None, early: tuple[float, Callable[[np.ndarray], None]] | None = None) -> Solution:
     """The conforming ``P_p`` solution with ``u = 1`` on the ``hot`` faces and 0 on the ``cold`` ones (indices into
     ``mesh.faces``; quadrature of ``degree`` on curved elements, default :func:`quadrature_degree`); see the module
     docstring. CG stops when the energy has settled to ``etol`` (:func:`fem_neck.pcg.solve`).
@@ -252,6 +254,10 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
         Relative energy tolerance of CG's energy stop (dimensionless).
     degree : int, optional
         Quadrature degree on curved elements; default :func:`quadrature_degree`.
+    early : tuple, optional
+        ``(tol, report)``: ``report(u)`` gets the skeleton temperature (as :class:`Solution` ``u``) of the first CG
+        iterate whose energy has settled to ``tol`` (looser than ``etol``), before CG goes on (``settled`` of
+        :func:`fem_neck.pcg.solve`).
     """
     from fem_neck import pcg
 
@@ -274,9 +280,15 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     A = system.matrix()
     P = hat_prolongation(mesh, basis, num)[system.free]
     precondition = pcg.two_level(A, P, coarse_matrix(mesh, coarse), groups=system.groups())  # an entity's nodes
-    x, iterations, residual = pcg.solve(A, system.b, precondition, energy=(system.constant, etol))
-    u = values.copy()
-    u[system.free] = x
+
+    def temperature(x: np.ndarray) -> np.ndarray:
+        u = values.copy()
+        u[system.free] = x
+        return u
+
+    settled = None if early is None else (early[0], lambda x: early[1](temperature(x)))
+    x, iterations, residual = pcg.solve(A, system.b, precondition, energy=(system.constant, etol), settled=settled)
+    u = temperature(x)
     return Solution(system.energy(A, x), u, num.n + basis.n_interior * len(mesh.tets), num.n, iterations, residual)
 
 

@@ -4,6 +4,7 @@ sums they replace: a dense or COO sum of the element matrices, the Galerkin prod
 import numpy as np
 import pytest
 import scipy.sparse as sp
+import scipy.sparse.linalg  # noqa: F401  (for sp.linalg)
 
 from fem_neck import dual, lattice, pcg, primal
 from fem_neck.simplex import lagrange, raviart_thomas, tet_quadrature
@@ -205,6 +206,26 @@ def test_block_jacobi_on_groups_inverts_the_diagonal_blocks_of_the_matrix():
     np.testing.assert_allclose(local, expected, rtol=0, atol=1e-13 * abs(expected).max())
     with pytest.raises(ValueError, match="groups: positive sizes summing to the"):
         pcg.two_level(A, sp.identity(A.shape[0], format="csr"), None, groups=groups[1:])
+
+
+def test_cg_reports_the_first_iterate_settled_to_a_looser_tolerance():
+    # a shifted 1D Laplacian (condition ~ 400; 138 steps): the reported iterate comes well before the end, its energy
+    # above the final one by about the looser tolerance (1.2e-4 of it); the final iterate is the one CG reaches
+    # without a report
+    n = 400
+    A = sp.diags([-np.ones(n - 1), 2.01 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1], format="csr")
+    b = np.random.default_rng(8).random(n)
+    constant = 2.0 * float(b @ sp.linalg.spsolve(A.tocsc(), b))              # the least energy is half of it
+
+    def energy(x):
+        return float(x @ (A @ x) - 2.0 * x @ b + constant)
+
+    reports = []
+    x, iterations, _ = pcg.solve(A, b, lambda r: r / 2.01, energy=(constant, 1e-12), settled=(1e-3, reports.append))
+    y, same, _ = pcg.solve(A, b, lambda r: r / 2.01, energy=(constant, 1e-12))
+    assert len(reports) == 1 and same == iterations and np.array_equal(x, y)
+    early = energy(reports[0]) - energy(x)
+    assert 1e-5 * energy(x) < early <= 1e-2 * energy(x)
 
 
 def test_block_jacobi_needs_blocks_that_cover_the_unknowns():

@@ -174,6 +174,22 @@ def test_primal_cg_stops_when_the_energy_has_settled():
     assert loose.iterations < tight.iterations
 
 
+def test_primal_reports_its_first_iterate_settled_to_a_looser_tolerance_once():
+    # the temperature the lower bound's CG starts from: an earlier iterate, within the looser tolerance of the final
+    # energy, and the final CG unchanged by the report
+    from fem_neck import primal
+
+    cm = lattice.build_cell_mesh(_chain_cell(0.08), **COARSE)
+    reports = []
+    plain = primal.solve(cm.curved, 3, cm.hot, cm.cold, etol=1e-12)
+    final = primal.solve(cm.curved, 3, cm.hot, cm.cold, etol=1e-12, early=(1e-4, reports.append))
+    assert len(reports) == 1 and final.energy == plain.energy and final.iterations == plain.iterations
+    u = reports[0]
+    assert u.shape == final.u.shape and 0.0 < np.max(np.abs(u - final.u)) < 1e-2
+    hot = primal.face_dofs(cm.curved, primal.lagrange(3), cm.hot)
+    np.testing.assert_array_equal(u[hot], 1.0)                               # the held values
+
+
 def _coarse_first_mesh(monkeypatch):
     """A first-mesh rule for p = 3 that believes the bounds 5x closer than they are: the first mesh is too coarse."""
     size0, rtol0, neck_order, margin = lattice.FIRST_MESH[3]
