@@ -2,11 +2,11 @@
 Schwarz preconditioner (memory linear in the unknowns).
 
 :math:`M^{-1} r = P (P^T A P)^{-1} P^T r + D^{-1} r`: a coarse space ``P`` (for high-order elements the piecewise-linear
-hats, for the hybridised fluxes the face means), whose Galerkin matrix gets one smoothed-aggregation AMG V-cycle
-(pyamg), plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face, the nodes
-of one mesh edge or face). The coarse
-space removes the low-frequency error, the local part the high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994
-for the p-version).
+hats, for the hybridised fluxes the face means), whose Galerkin matrix gets one V-cycle of plain (unsmoothed)
+aggregation AMG (pyamg; on the lattice cells as many CG steps as smoothed aggregation, at a fraction of its setup),
+plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face, the nodes of one mesh
+edge or face). The coarse space removes the low-frequency error, the local part the high-order one (Toselli &
+Widlund 2005, Ch. 2; Pavarino 1994 for the p-version).
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ class TwoLevel:
         self.PT = self.P.T.tocsr()
         if coarse is None:
             coarse = (self.PT @ A @ self.P).tocsr()
-        self.amg = amg.hierarchy(coarse, symmetry="symmetric", max_coarse=500).aspreconditioner(cycle="V")
+        self.amg = amg.hierarchy(coarse, symmetry="symmetric", max_coarse=500, smooth=None).aspreconditioner(cycle="V")
         if groups is not None:
             if block_matrices is not None:
                 raise ValueError("block_matrices and groups: give one of them")
