@@ -387,12 +387,9 @@ def hat_prolongation(mesh: CurvedMesh, basis: Lagrange, num: Numbering):
 
     lam = hat_values(basis)
     skel = len(lam)
-    M = len(mesh.tets)
-    rows = np.broadcast_to(num.l2g[:, :, None], (M, skel, 4))
-    cols = np.broadcast_to(mesh.tets[:, None, :], (M, skel, 4))
-    vals = np.broadcast_to(lam[None], (M, skel, 4))
+    dofs, first = np.unique(num.l2g, return_index=True)                    # each node from the first element using it
+    element, node = np.divmod(first, skel)
+    vals = lam[node]                                                       # (the same from every element)
     keep = vals > 0.0
-    key = rows[keep].astype(np.int64) * len(mesh.points) + cols[keep]
-    key, first = np.unique(key, return_index=True)
-    return sp.csr_matrix((vals[keep][first], (key // len(mesh.points), key % len(mesh.points))),
-                         shape=(num.n, len(mesh.points)))
+    rows = np.broadcast_to(dofs[:, None], vals.shape)
+    return sp.csr_matrix((vals[keep], (rows[keep], mesh.tets[element][keep])), shape=(num.n, len(mesh.points)))
