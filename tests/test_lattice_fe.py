@@ -1,6 +1,7 @@
 """3D FE of periodic cells (fem_neck.lattice): bounds that bracket independent references, geometry, refusals."""
 
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -188,6 +189,19 @@ def test_primal_reports_its_first_iterate_settled_to_a_looser_tolerance_once():
     assert u.shape == final.u.shape and 0.0 < np.max(np.abs(u - final.u)) < 1e-2
     hot = primal.face_dofs(cm.curved, primal.lagrange(3), cm.hot)
     np.testing.assert_array_equal(u[hot], 1.0)                               # the held values
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="prctl is Linux's")
+def test_the_bounds_run_without_transparent_huge_pages_and_give_them_back():
+    import ctypes
+
+    from fem_neck.lattice.bounds import small_pages
+
+    prctl = ctypes.CDLL(None).prctl
+    before = prctl(42, 0, 0, 0, 0)                                             # PR_GET_THP_DISABLE
+    with small_pages():
+        assert prctl(42, 0, 0, 0, 0) == 1
+    assert prctl(42, 0, 0, 0, 0) == before
 
 
 def _coarse_first_mesh(monkeypatch):

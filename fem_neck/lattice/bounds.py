@@ -60,6 +60,29 @@ def _dual(mesh, order: int, hot, cold, etol: float, temperature):
         return dual.solve(mesh, order - 1, hot, cold, etol, start=start)
 
 
+@contextlib.contextmanager
+def small_pages():
+    """The process (and the processes it forks meanwhile) without transparent huge pages, as before afterwards
+    (Linux's ``prctl(PR_SET_THP_DISABLE)``; elsewhere nothing). The bounds' large arrays are written once, fresh: a
+    huge page for them can stall the kernel finding or compacting 2 MB of free memory on a busy machine (BCC h/r =
+    0.02 on the shared 2-core machine: the whole run's system time 0.80 s against 1.28 s, its CPU time 0.94 times;
+    SC h/r = 0.02, whose arrays are smaller: 1.03 times, the user time 2 % more with small pages)."""
+    import ctypes
+
+    get, set_ = 42, 41                                            # PR_GET_THP_DISABLE, PR_SET_THP_DISABLE
+    try:
+        prctl = ctypes.CDLL(None, use_errno=True).prctl
+        before = prctl(get, 0, 0, 0, 0)
+        changed = before >= 0 and prctl(set_, 1, 0, 0, 0) == 0
+    except (AttributeError, OSError, TypeError):                  # no prctl: not Linux
+        changed = False
+    try:
+        yield
+    finally:
+        if changed:
+            prctl(set_, before, 0, 0, 0)
+
+
 _TEMPERATURES = None  # in the lower bound's process: the queue on which the upper bound's temperature arrives
 # the upper bound's temperature goes to the lower bound's process once its CG's energy has settled to START_SHARE etol,
 # not at the end: the flux's CG starts as well from it (its distance from the flux's solution is the discretisation's;
@@ -113,24 +136,27 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2, etol: float | N
     t0 = time.perf_counter()
     etol = primal.ENERGY_RTOL if etol is None else etol
     mesh = cm.curved
-    mesh.keep_jacobians(tet_quadrature(primal.quadrature_degree(order))[0])   # = dual's quadrature_degree(order)
-    try:
-        if workers >= 2:
-            context = get_context("fork")
-            queue = context.Queue()      # put does not wait for the reader (which may have failed before reading)
-            queue.cancel_join_thread()   # nor does the exit, if it never read
-            pool = ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures, initargs=(queue,))
-        else:
-            pool = contextlib.nullcontext()
-        with pool:
-            future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold, etol) if workers >= 2 else None
-            with one_blas_thread():
-                early = None if future is None else (START_SHARE * etol, queue.put)
-                up = primal.solve(mesh, order, cm.hot, cm.cold, etol, early=early)
-                volume = primal.volume(mesh)  # (while the lower bound finishes in its process)
-            low = future.result() if future is not None else _dual(mesh, order, cm.hot, cm.cold, etol, lambda: up.u)
-    finally:  # the kept Jacobians (a few hundred MB on a fine mesh) go with the solves, also when one fails
-        mesh.keep_jacobians(None)
+    with small_pages():  # (the lower bound's process, forked inside, inherits it)
+        mesh.keep_jacobians(tet_quadrature(primal.quadrature_degree(order))[0])  # = dual's quadrature_degree(order)
+        try:
+            if workers >= 2:
+                context = get_context("fork")
+                queue = context.Queue()     # put does not wait for the reader (which may have failed before reading)
+                queue.cancel_join_thread()  # nor does the exit, if it never read
+                pool = ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures,
+                                           initargs=(queue,))
+            else:
+                pool = contextlib.nullcontext()
+            with pool:
+                future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold, etol) if workers >= 2 else None
+                with one_blas_thread():
+                    early = None if future is None else (START_SHARE * etol, queue.put)
+                    up = primal.solve(mesh, order, cm.hot, cm.cold, etol, early=early)
+                    volume = primal.volume(mesh)  # (while the lower bound finishes in its process)
+                low = (future.result() if future is not None
+                       else _dual(mesh, order, cm.hot, cm.cold, etol, lambda: up.u))
+        finally:  # the kept Jacobians (a few hundred MB on a fine mesh) go with the solves, also when one fails
+            mesh.keep_jacobians(None)
     scale = cm.height / cm.area
     return Bounds(float(up.energy * scale), float(low.lower * scale), float(low.flux_defect), int(up.dofs),
                   int(low.dofs), len(mesh.tets), float(volume / cm.volume_exact - 1.0), time.perf_counter() - t0)
