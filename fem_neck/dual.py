@@ -459,7 +459,7 @@ def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.nda
 
 class MeanCorrection:
     r"""The face means' correction of least norm that leaves no element a net flux (:func:`equilibrate`): with ``B``
-    the signed incidence of the elements and their live faces (all but the insulated ones), ``c = B^T y``,
+    the signed incidence of the elements and their live faces (all but the insulated ones), :math:`c = B^T y`,
     :math:`B B^T y = -` the elements' net fluxes; :math:`B B^T` depends on the mesh only and is factored once (SuperLU),
     so that the lower bound's process can factor it while it waits for the upper bound's temperature.
 
