@@ -61,7 +61,10 @@ class TwoLevel:
                 raise ValueError(f"groups: positive sizes summing to the {A.shape[0]} unknowns")
             starts = np.concatenate([[0], np.cumsum(groups)]).astype(A.indptr.dtype)
             indptr = np.concatenate([[0], np.cumsum(np.repeat(groups, groups))]).astype(A.indptr.dtype)
-            inverse, indices = _group_inverses(A.data, A.indices, A.indptr, starts, indptr)
+            inverse, indices, ok = _group_inverses(A.data, A.indices, A.indptr, starts, indptr)
+            if not ok:
+                raise ValueError("groups: a diagonal block of A is not stored whole or has a pivot that is not "
+                                 "positive")
             self.local = sp.csr_matrix((inverse, indices, indptr), shape=A.shape)
         elif block_matrices is None:
             self.local = sp.diags(1.0 / A.diagonal(), format="csr")
@@ -80,8 +83,8 @@ class TwoLevel:
 def _group_inverses(data, indices, indptr, starts, out_indptr):
     """The inverses of the diagonal blocks of the CSR matrix ``(data, indices, indptr)`` (sorted columns) on the
     groups of rows ``starts[g]`` to ``starts[g + 1] - 1``, as the data and column indices of a CSR matrix whose rows
-    start at ``out_indptr`` (each row holds its group's columns); Gauss-Jordan without pivoting (symmetric positive
-    definite blocks)."""
+    start at ``out_indptr`` (each row holds its group's columns), and False if a block is not stored whole or a pivot
+    is not positive; Gauss-Jordan without pivoting (symmetric positive definite blocks)."""
     out = np.empty(out_indptr[-1])
     columns = np.empty(out_indptr[-1], dtype=indices.dtype)
     for g in range(len(starts) - 1):
@@ -90,12 +93,16 @@ def _group_inverses(data, indices, indptr, starts, out_indptr):
         for i in range(h):
             row = s + i
             k = indptr[row]
-            while indices[k] != s:                               # the group's columns s .. s + h - 1, in a run
+            while k < indptr[row + 1] and indices[k] != s:       # the group's columns s .. s + h - 1, in a run
                 k += 1
+            if k + h > indptr[row + 1] or indices[k + h - 1] != s + h - 1:
+                return out, columns, False
             for j in range(h):
                 block[i, j] = data[k + j]
                 block[i, h + j] = 1.0 if i == j else 0.0
         for p in range(h):                                       # [B | I] -> [I | B^-1]
+            if not block[p, p] > 0.0:
+                return out, columns, False
             f = 1.0 / block[p, p]
             for j in range(2 * h):
                 block[p, j] *= f
@@ -108,7 +115,7 @@ def _group_inverses(data, indices, indptr, starts, out_indptr):
             for j in range(h):
                 out[out_indptr[s + i] + j] = block[i, h + j]
                 columns[out_indptr[s + i] + j] = s + j
-    return out, columns
+    return out, columns, True
 
 
 class Assembly:
@@ -142,7 +149,7 @@ class Assembly:
         n = l2g.shape[1]
         sizes = np.ones(n, dtype=np.int64) if groups is None else np.asarray(groups, dtype=np.int64)
         if np.any(sizes < 1) or sizes.sum() != n:
-            raise ValueError(f"groups = {list(sizes)}: positive sizes summing to the {n} local dofs")
+            raise ValueError(f"groups = {sizes.tolist()}: positive sizes summing to the {n} local dofs")
         self.offsets = np.concatenate([[0], np.cumsum(sizes)])
         within = np.arange(n) - np.repeat(self.offsets[:-1], sizes)          # each local dof's place in its group
         lead = np.repeat(self.offsets[:-1], sizes)

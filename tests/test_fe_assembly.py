@@ -206,6 +206,10 @@ def test_block_jacobi_on_groups_inverts_the_diagonal_blocks_of_the_matrix():
     np.testing.assert_allclose(local, expected, rtol=0, atol=1e-13 * abs(expected).max())
     with pytest.raises(ValueError, match="groups: positive sizes summing to the"):
         pcg.two_level(A, sp.identity(A.shape[0], format="csr"), None, groups=groups[1:])
+    B = sp.diags([1.0, 1.0, 1.0, 1.0, 1.0, -1.0], format="csr")               # no 2 x 2 block; a negative pivot
+    for sizes in ([2, 2, 2], [1] * 6):
+        with pytest.raises(ValueError, match="a diagonal block of A is not stored whole or has a pivot"):
+            pcg.two_level(B, sp.identity(6, format="csr"), None, groups=np.array(sizes))
 
 
 def test_cg_reports_the_first_iterate_settled_to_a_looser_tolerance():
