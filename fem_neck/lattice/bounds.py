@@ -64,9 +64,8 @@ def _dual(mesh, order: int, hot, cold, etol: float, temperature):
 def small_pages():
     """The process (and the processes it forks meanwhile) without transparent huge pages, as before afterwards
     (Linux's ``prctl(PR_SET_THP_DISABLE)``; elsewhere nothing). The bounds' large arrays are written once, fresh: a
-    huge page for them can stall the kernel finding or compacting 2 MB of free memory on a busy machine (BCC h/r =
-    0.02 on the shared 2-core machine: the whole run's system time 0.80 s against 1.28 s, its CPU time 0.94 times;
-    SC h/r = 0.02, whose arrays are smaller: 1.03 times, the user time 2 % more with small pages)."""
+    huge page for them can stall the kernel finding or compacting 2 MB of free memory on a busy machine (a third of
+    the system time of BCC h/r = 0.02; the benchmarks guide's lattice section)."""
     import ctypes
 
     get, set_ = 42, 41                                            # PR_GET_THP_DISABLE, PR_SET_THP_DISABLE
