@@ -91,17 +91,21 @@ def distinct(surfaces: list, tol: float) -> list:
     tol : float
         Largest difference of centres, axes and radii of one surface, in the mesh's length unit.
     """
-    out = []
-    for s in surfaces:
+    out, kinds = [], []
+    centres, axes, radii = np.empty((len(surfaces), 3)), np.empty((len(surfaces), 3)), np.empty(len(surfaces))
+    for s in surfaces:  # compared with all kept ones at once
+        k = len(out)
+        c, a = centres[:k], axes[:k]
+        near = np.array([kind == s.kind for kind in kinds], dtype=bool) & (np.abs(radii[:k] - s.radius) < tol)
         if s.kind == CYLINDER:
-            same = [t for t in out if t.kind == CYLINDER and abs(t.radius - s.radius) < tol
-                    and np.linalg.norm(np.cross(t.axis, s.axis)) < tol
-                    and np.linalg.norm(np.cross(t.axis, s.centre - t.centre)) < tol]
+            near &= (np.linalg.norm(np.cross(a, s.axis), axis=1) < tol) & (
+                np.linalg.norm(np.cross(a, s.centre - c), axis=1) < tol)
         else:
-            same = [t for t in out if t.kind == s.kind and abs(t.radius - s.radius) < tol
-                    and np.linalg.norm(t.centre - s.centre) < tol and np.linalg.norm(t.axis - s.axis) < tol]
-        if not same:
+            near &= (np.linalg.norm(c - s.centre, axis=1) < tol) & (np.linalg.norm(a - s.axis, axis=1) < tol)
+        if not near.any():
             out.append(s)
+            kinds.append(s.kind)
+            centres[k], axes[k], radii[k] = s.centre, s.axis, s.radius
     return out
 
 
@@ -609,9 +613,18 @@ def _map_kernel(points, tets, edge_row, face_row, kind, pc, pe, pr, pn, pd, elem
     return X, Jout
 
 
-def _unique_rows(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    uniq, inverse = np.unique(a, axis=0, return_inverse=True)
-    return uniq, inverse.reshape(-1)
+def _unique_rows(a: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct rows of ``a`` (integers from 0 to ``n - 1``) in lexicographic order, and the index of each row
+    of ``a`` among them (``numpy.unique(a, axis=0, return_inverse=True)``, by one integer key per row while the
+    keys fit in 63 bits)."""
+    if n ** a.shape[1] >= 2**63:
+        uniq, inverse = np.unique(a, axis=0, return_inverse=True)
+        return uniq, inverse.reshape(-1)
+    key = np.zeros(len(a), dtype=np.int64)
+    for column in a.T:
+        key = key * n + column
+    _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+    return a[first], inverse.reshape(-1)
 
 
 def build(points: np.ndarray, tets: np.ndarray, triangles: np.ndarray, triangle_surface: np.ndarray,
@@ -638,8 +651,8 @@ def build(points: np.ndarray, tets: np.ndarray, triangles: np.ndarray, triangle_
     points = np.array(points, dtype=float)
     tets = np.sort(np.asarray(tets, dtype=np.int64), axis=1)
     M = len(tets)
-    edges, t2e = _unique_rows(tets[:, list(EDGES)].reshape(-1, 2))
-    faces, t2f = _unique_rows(tets[:, list(FACES)].reshape(-1, 3))
+    edges, t2e = _unique_rows(tets[:, list(EDGES)].reshape(-1, 2), len(points))
+    faces, t2f = _unique_rows(tets[:, list(FACES)].reshape(-1, 3), len(points))
     t2e, t2f = t2e.reshape(M, 6), t2f.reshape(M, 4)
     key = lambda f: (f[:, 0] * len(points) + f[:, 1]) * len(points) + f[:, 2]  # noqa: E731
     order = np.argsort(key(faces))

@@ -41,8 +41,9 @@ CHUNK = 2048  # elements per batch of element matrices (bounds the temporary arr
 
 
 def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np.ndarray) -> np.ndarray:
-    r"""Flux mass matrices ``(E, m, m)`` of ``elements``: :math:`\int \sigma^T J^T J \tau / |\det J|` on the reference
-    element (exact on straight elements, quadrature of ``degree`` on curved ones).
+    r"""Flux mass matrices of ``elements``, :math:`\int \sigma^T J^T J \tau / |\det J|` on the reference element
+    (exact on straight elements, quadrature of ``degree`` on curved ones), each kept as its upper triangle in the order
+    of ``numpy.triu_indices(m)``: ``(E, m (m + 1) / 2)`` (:func:`fem_neck.primal.symmetric_gather` unpacks it).
 
     Parameters
     ----------
@@ -57,14 +58,95 @@ def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np
     """
     J = mesh.affine_jacobians(elements)
     G = np.einsum("eai,eaj->eij", J, J) / np.abs(np.linalg.det(J))[:, None, None]
-    A = np.einsum("eij,ijab->eab", G, rt.mass)
+    a, b = np.triu_indices(rt.m)
+    A = G.reshape(len(G), 9) @ rt.mass[:, :, a, b].reshape(9, -1)
     curved = np.flatnonzero(mesh.is_curved[elements])
     if len(curved):
         xi, w = tet_quadrature(degree)
         products = symmetric_products(rt.values(xi))                          # (6 Q, m (m + 1) / 2)
         G = mesh.metric(elements[curved], xi, w, inverse=False).reshape(len(curved), -1)
-        A[curved] = np.take(G @ products, symmetric_gather(rt.m), axis=1).reshape(len(curved), rt.m, rt.m)
+        A[curved] = G @ products
     return A
+
+
+def element_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int) -> SymmetricStack:
+    r"""The hybridised element matrices :math:`H_K = T A_K^{-1} T^T` (``4 n_f`` square) of every element, with
+    :math:`A_K` the flux mass (:func:`mass_matrices`) and ``T`` the reference trace moments (``rt.traces``): one
+    compiled pass per batch of elements (Cholesky factor :math:`A_K = L L^T`, :math:`W = L^{-1} T^T`,
+    :math:`H_K = W^T W`, exactly symmetric).
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    rt : fem_neck.simplex.RaviartThomas
+        The reference flux space.
+    degree : int
+        Quadrature degree on the curved elements.
+    """
+    # the fields rotated (orthogonally, so still orthonormal in the reference mass) to put those without traces
+    # first: their rows of L^-1 T^T vanish, and the kernel skips them
+    _, singular, vt = np.linalg.svd(rt.traces)
+    rank = int(np.sum(singular > 1e-12 * singular[0]))
+    rt = RaviartThomas(rt.k, rt.exponents, rt.coefficients @ np.concatenate([vt[rank:], vt[:rank]]).T,
+                       rt.face_exponents, rt.face_coefficients)
+    T = np.ascontiguousarray(rt.traces)                                     # (4 nf, m), zero in its first m - rank
+    position = symmetric_gather(rt.m).reshape(rt.m, rt.m)
+    E = len(mesh.tets)
+    H_K = SymmetricStack(E, len(T))
+    for begin in range(0, E, CHUNK):
+        elements = np.arange(begin, min(begin + CHUNK, E))
+        if not _trace_products(mass_matrices(mesh, rt, degree, elements), position, T, rt.m - rank,
+                               H_K.packed[begin:begin + CHUNK]):
+            raise ValueError("an element's flux mass matrix is not positive definite: the mesh has a degenerate "
+                             "element")
+    return H_K
+
+
+@njit(cache=True, fastmath=True)
+def _trace_products(A, position, T, first, out):
+    """``out[e]`` = the upper triangle (the order of ``numpy.triu_indices``) of :math:`T A_e^{-1} T^T` for every
+    symmetric positive definite ``A_e``, kept as the upper triangles ``A`` (entry ``(i, j)`` at ``position[i, j]``),
+    where the first ``first`` columns of ``T`` are zero; False if one is not (a pivot of its Cholesky factor not
+    positive)."""
+    E, m, n = A.shape[0], T.shape[1], T.shape[0]
+    L = np.empty((m, m))
+    W = np.empty((m, n))
+    H = np.empty((n, n))
+    for e in range(E):
+        for i in range(m):                                       # A_e = L L^T, row by row
+            for j in range(i + 1):
+                s = A[e, position[i, j]]
+                for k in range(j):
+                    s -= L[i, k] * L[j, k]
+                if i == j:
+                    if not s > 0.0:
+                        return False
+                    L[i, i] = np.sqrt(s)
+                else:
+                    L[i, j] = s / L[j, j]
+        for i in range(first, m):                                # W = L^-1 T^T (zero above first), forward
+            for c in range(n):
+                W[i, c] = T[c, i]
+            for k in range(first, i):
+                f = L[i, k]
+                for c in range(n):
+                    W[i, c] -= f * W[k, c]
+            f = 1.0 / L[i, i]
+            for c in range(n):
+                W[i, c] *= f
+        H[:, :] = 0.0                                            # W^T W (whole rows: the loops vectorise)
+        for k in range(first, m):
+            for a in range(n):
+                f = W[k, a]
+                for c in range(n):
+                    H[a, c] += f * W[k, c]
+        p = 0
+        for a in range(n):
+            for c in range(a, n):
+                out[e, p] = H[a, c]
+                p += 1
+    return True
 
 
 @dataclass
@@ -138,10 +220,21 @@ class SymmetricStack:
             One vector per matrix, ``(E, n)``.
         """
         out = np.empty_like(x)
-        for begin in range(0, len(self), CHUNK):
-            chunk = slice(begin, begin + CHUNK)
-            out[chunk] = np.matmul(self[chunk], x[chunk, :, None])[:, :, 0]
+        _packed_products(self.packed, self.gather.reshape(self.n, self.n), np.ascontiguousarray(x), out)
         return out
+
+
+@njit(cache=True)
+def _packed_products(packed, position, x, out):
+    """``out[e] = M_e x[e]`` for the symmetric ``M_e`` kept as the upper triangles ``packed`` (entry ``(i, j)`` at
+    ``position[i, j]``)."""
+    E, n = x.shape
+    for e in range(E):
+        for i in range(n):
+            s = 0.0
+            for j in range(n):
+                s += packed[e, position[i, j]] * x[e, j]
+            out[e, i] = s
 
 
 class SymmetricBlocks:
@@ -364,7 +457,46 @@ def trace_multipliers(mesh: CurvedMesh, p: int, u: np.ndarray, k: int) -> np.nda
     return out.ravel()
 
 
-def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_face: np.ndarray) -> np.ndarray:
+class MeanCorrection:
+    r"""The face means' correction of least norm that leaves no element a net flux (:func:`equilibrate`): with ``B``
+    the signed incidence of the elements and their live faces (all but the insulated ones), :math:`c = B^T y`,
+    :math:`B B^T y = -` the elements' net fluxes; :math:`B B^T` depends on the mesh only and is factored once (SuperLU),
+    so that the lower bound's process can factor it while it waits for the upper bound's temperature.
+
+    Parameters
+    ----------
+    mesh : fem_neck.curved.CurvedMesh
+        The curved tetrahedral mesh.
+    fixed_face : numpy.ndarray
+        Boolean mask over ``mesh.faces``: True on the faces held at a temperature (whose flux is free).
+    """
+
+    def __init__(self, mesh: CurvedMesh, fixed_face: np.ndarray):
+        import scipy.sparse as sp
+        from scipy.sparse.linalg import splu
+
+        E, faces = len(mesh.tets), mesh.t2f.ravel()
+        self.sides = mesh.face_sides()
+        self.sign = np.where(mesh.first_sides().ravel(), 1.0, -1.0)
+        self.insulated = (self.sides == 1) & ~fixed_face
+        live = ~self.insulated[faces]
+        self.B = sp.csr_matrix((self.sign[live], (np.repeat(np.arange(E), 4)[live], faces[live])),
+                               shape=(E, len(mesh.faces)))
+        self.factor = splu((self.B @ self.B.T).tocsc())
+
+    def __call__(self, net: np.ndarray) -> np.ndarray:
+        """The correction ``c`` of the face means ``(n_faces,)`` for the elements' net fluxes.
+
+        Parameters
+        ----------
+        net : numpy.ndarray
+            Net flux out of every element ``(E,)``, in the unit of the face moments.
+        """
+        return self.B.T @ self.factor.solve(-net)
+
+
+def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_face: np.ndarray,
+                correction: MeanCorrection | None = None) -> np.ndarray:
     r"""Element multipliers ``(E, 4 n_f)`` whose element fluxes :math:`A_K^{-1} T^T \lambda_K` form an admissible flux:
     one normal flux on every face, none on the insulated ones (the module docstring), from the element matrices
     ``H_K`` (``4 n_f`` square), any face multipliers ``lam (n_faces n_f,)`` and the faces held at a temperature
@@ -380,37 +512,66 @@ def equilibrate(mesh: CurvedMesh, H_K: SymmetricStack, lam: np.ndarray, fixed_fa
         Face multipliers ``(n_faces n_f,)`` (any: the CG iterate).
     fixed_face : numpy.ndarray
         Boolean mask over ``mesh.faces``: True on the faces held at a temperature (whose flux is free).
+    correction : MeanCorrection, optional
+        The factored correction of the face means on this mesh (made here if None).
     """
-    import scipy.sparse as sp
-    from scipy.sparse.linalg import spsolve
-
+    correction = MeanCorrection(mesh, fixed_face) if correction is None else correction
     E, n = len(H_K), H_K.n
     nf = n // 4
     faces = mesh.t2f.ravel()
     lam_K = lam.reshape(-1, nf)[mesh.t2f].reshape(E, n)
     outward = H_K.times(lam_K).reshape(E * 4, nf)
     # each face's flux along the normal out of its first element: the mean of its sides
-    sides = mesh.face_sides()
-    sign = np.where(mesh.first_sides().ravel(), 1.0, -1.0)
+    sign = correction.sign
     flux = np.zeros((len(mesh.faces), nf))
     np.add.at(flux, faces, sign[:, None] * outward)
-    flux /= sides[:, None]
-    insulated = (sides == 1) & ~fixed_face
-    flux[insulated] = 0.0
-    # the face means' correction of least norm that leaves no element a net flux: B c = -(B flux_0), c = B^T y
-    live = ~insulated[faces]
-    B = sp.csr_matrix((sign[live], (np.repeat(np.arange(E), 4)[live], faces[live])), shape=(E, len(mesh.faces)))
-    net = (sign * flux[faces, 0]).reshape(E, 4).sum(axis=1)
-    flux[:, 0] += B.T @ spsolve((B @ B.T).tocsc(), -net)
+    flux /= correction.sides[:, None]
+    flux[correction.insulated] = 0.0
+    # the face means' correction of least norm that leaves no element a net flux
+    flux[:, 0] += correction((sign * flux[faces, 0]).reshape(E, 4).sum(axis=1))
     # each element's divergence-free field of least energy with these traces: H_K mu = change of the traces (the
     # constant multiplier, H_K's null space, added to make the system regular; the change is orthogonal to it)
     change = (sign[:, None] * flux[faces] - outward).reshape(E, n)
-    null = np.zeros(n)
-    null[::nf] = 1.0
-    for begin in range(0, E, CHUNK):
-        chunk = slice(begin, begin + CHUNK)
-        lam_K[chunk] += np.linalg.solve(H_K[chunk] + np.outer(null, null), change[chunk, :, None])[:, :, 0]
+    if not _add_regularised_solves(H_K.packed, H_K.gather.reshape(n, n), nf, change, lam_K):
+        raise ValueError("an element matrix H_K is not positive definite on the fields of zero net flux")
     return lam_K
+
+
+@njit(cache=True, fastmath=True)
+def _add_regularised_solves(packed, position, nf, rhs, out):
+    """``out[e] += (H_e + c c^T)^-1 rhs[e]`` for the symmetric ``H_e`` kept as the upper triangles ``packed`` (entry
+    ``(i, j)`` at ``position[i, j]``) and ``c`` the constant multiplier (1 at every ``nf``-th entry), by a Cholesky
+    factor of each; False if a pivot is not positive."""
+    E, n = rhs.shape
+    L = np.empty((n, n))
+    y = np.empty(n)
+    for e in range(E):
+        for i in range(n):
+            for j in range(i + 1):
+                s = packed[e, position[i, j]]
+                if i % nf == 0 and j % nf == 0:
+                    s += 1.0
+                for k in range(j):
+                    s -= L[i, k] * L[j, k]
+                if i == j:
+                    if not s > 0.0:
+                        return False
+                    L[i, i] = np.sqrt(s)
+                else:
+                    L[i, j] = s / L[j, j]
+        for i in range(n):                                       # L y = rhs
+            s = rhs[e, i]
+            for k in range(i):
+                s -= L[i, k] * y[k]
+            y[i] = s / L[i, i]
+        for i in range(n - 1, -1, -1):                           # L^T x = y (x over y)
+            s = y[i]
+            for k in range(i + 1, n):
+                s -= L[k, i] * y[k]
+            y[i] = s / L[i, i]
+        for i in range(n):
+            out[e, i] += y[i]
+    return True
 
 
 def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: float = ENERGY_RTOL,
@@ -441,18 +602,13 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
 
     rt = raviart_thomas(k)
     nf = rt.n_face
-    T = rt.traces                                                           # (4 nf, m)
     E = len(mesh.tets)
     constant = 1.0 / rt.face_basis(np.zeros((1, 2)))[0, 0]                # coefficient of the function 1
     fixed_face = np.zeros(len(mesh.faces), dtype=bool)
     fixed_face[hot] = fixed_face[cold] = True
     lam = np.zeros(len(mesh.faces) * nf)
     lam[hot * nf] = constant
-    H_K = SymmetricStack(E, 4 * nf)                                         # (made exactly symmetric)
-    for begin in range(0, E, CHUNK):
-        elements = np.arange(begin, min(begin + CHUNK, E))
-        A = mass_matrices(mesh, rt, degree or quadrature_degree(k + 1), elements)
-        H_K[elements] = np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape)))
+    H_K = element_matrices(mesh, rt, degree or quadrature_degree(k + 1))
     system = face_system(mesh, H_K, fixed_face, lam)
     H = system.matrix
     n_free = len(system.diagonal)
@@ -461,13 +617,14 @@ def solve(mesh: CurvedMesh, k: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     P = sp.csr_matrix((np.ones(n_free), (np.arange(n_free) * nf, np.arange(n_free))), shape=(n_free * nf, n_free))
     coarse = H.entries(0, 0)
     precondition = pcg.two_level(H, P, coarse, system.diagonal)
+    correction = MeanCorrection(mesh, fixed_face)                          # (before start(), which may wait)
     x0 = None if start is None else start()[system.free]
     energy0 = system.constant if x0 is None else system.energy(x0)
     x, iterations, residual = pcg.solve(H, system.b, precondition, x0=x0, energy=(energy0, etol))
     lam[system.free] = x
     dofs = len(system.free)
     del H, precondition, system                                             # (memory for the equilibration)
-    lam_K = equilibrate(mesh, H_K, lam, fixed_face)
+    lam_K = equilibrate(mesh, H_K, lam, fixed_face, correction)
     outward = H_K.times(lam_K).reshape(E * 4, nf)
     energy = float(np.einsum("ea,ea->", lam_K, outward.reshape(E, -1)))    # = sum alpha^T A alpha
     jumps = np.zeros((len(mesh.faces), nf))                                 # outward moments summed per face

@@ -2,13 +2,16 @@
 Schwarz preconditioner (memory linear in the unknowns).
 
 :math:`M^{-1} r = P (P^T A P)^{-1} P^T r + D^{-1} r`: a coarse space ``P`` (for high-order elements the piecewise-linear
-hats, for the hybridised fluxes the face means), whose Galerkin matrix gets one smoothed-aggregation AMG V-cycle
-(pyamg), plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face). The coarse
-space removes the low-frequency error, the local part the high-order one (Toselli & Widlund 2005, Ch. 2; Pavarino 1994
-for the p-version).
+hats, for the hybridised fluxes the face means), whose Galerkin matrix gets one V-cycle of plain (unsmoothed)
+aggregation AMG (pyamg; on the lattice cells as many CG steps as smoothed aggregation, at a fraction of its setup),
+plus Jacobi: point Jacobi, or block Jacobi on small groups of unknowns (the moments of one face, the nodes of one mesh
+edge or face). The coarse space removes the low-frequency error, the local part the high-order one (Toselli &
+Widlund 2005, Ch. 2; Pavarino 1994 for the p-version).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 from numba import njit
@@ -20,7 +23,9 @@ class TwoLevel:
     r"""The preconditioner of the module docstring, as a callable :math:`r \to M^{-1} r`. The coarse matrix
     :math:`P^T A P` is computed unless given (``coarse``, CSR); the local part :math:`D^{-1}` is point Jacobi, or block
     Jacobi on consecutive groups of unknowns whose diagonal blocks of ``A`` are ``block_matrices (B, n, n)`` (``B n`` =
-    all unknowns; the moments of one face), kept as one block sparse matrix.
+    all unknowns; the moments of one face), kept as one block sparse matrix, or block Jacobi on consecutive ``groups``
+    of unknowns of any sizes, the blocks read from ``A`` (CSR; the nodes of one mesh edge or face,
+    :meth:`Assembly.groups`).
 
     Parameters
     ----------
@@ -33,9 +38,13 @@ class TwoLevel:
     block_matrices : numpy.ndarray, optional
         The diagonal blocks (B, k, k) of ``A`` on consecutive groups of ``k`` unknowns (``B k = n``), inverted for the
         block Jacobi part; None for point Jacobi.
+    groups : numpy.ndarray, optional
+        Sizes of consecutive groups of unknowns (summing to n) whose diagonal blocks of ``A`` are inverted for the
+        block Jacobi part (instead of ``block_matrices``).
     """
 
-    def __init__(self, A, P, coarse=None, block_matrices: np.ndarray | None = None):
+    def __init__(self, A, P, coarse=None, block_matrices: np.ndarray | None = None,
+                 groups: np.ndarray | None = None):
         import scipy.sparse as sp
 
         from sinterheat import amg
@@ -44,8 +53,20 @@ class TwoLevel:
         self.PT = self.P.T.tocsr()
         if coarse is None:
             coarse = (self.PT @ A @ self.P).tocsr()
-        self.amg = amg.hierarchy(coarse, symmetry="symmetric", max_coarse=500).aspreconditioner(cycle="V")
-        if block_matrices is None:
+        self.amg = amg.hierarchy(coarse, symmetry="symmetric", max_coarse=500, smooth=None).aspreconditioner(cycle="V")
+        if groups is not None:
+            if block_matrices is not None:
+                raise ValueError("block_matrices and groups: give one of them")
+            if np.sum(groups) != A.shape[0] or np.any(np.asarray(groups) < 1):
+                raise ValueError(f"groups: positive sizes summing to the {A.shape[0]} unknowns")
+            starts = np.concatenate([[0], np.cumsum(groups)]).astype(A.indptr.dtype)
+            indptr = np.concatenate([[0], np.cumsum(np.repeat(groups, groups))]).astype(A.indptr.dtype)
+            inverse, indices, ok = _group_inverses(A.data, A.indices, A.indptr, starts, indptr)
+            if not ok:
+                raise ValueError("groups: a diagonal block of A is not stored whole or has a pivot that is not "
+                                 "positive")
+            self.local = sp.csr_matrix((inverse, indices, indptr), shape=A.shape)
+        elif block_matrices is None:
             self.local = sp.diags(1.0 / A.diagonal(), format="csr")
         else:
             count, n = len(block_matrices), block_matrices.shape[1]
@@ -58,13 +79,55 @@ class TwoLevel:
         return self.P @ self.amg(self.PT @ r) + self.local @ r
 
 
+@njit(cache=True)
+def _group_inverses(data, indices, indptr, starts, out_indptr):
+    """The inverses of the diagonal blocks of the CSR matrix ``(data, indices, indptr)`` (sorted columns) on the
+    groups of rows ``starts[g]`` to ``starts[g + 1] - 1``, as the data and column indices of a CSR matrix whose rows
+    start at ``out_indptr`` (each row holds its group's columns), and False if a block is not stored whole or a pivot
+    is not positive; Gauss-Jordan without pivoting (symmetric positive definite blocks)."""
+    out = np.empty(out_indptr[-1])
+    columns = np.empty(out_indptr[-1], dtype=indices.dtype)
+    for g in range(len(starts) - 1):
+        s, h = starts[g], starts[g + 1] - starts[g]
+        block = np.empty((h, 2 * h))
+        for i in range(h):
+            row = s + i
+            k = indptr[row]
+            while k < indptr[row + 1] and indices[k] != s:       # the group's columns s .. s + h - 1, in a run
+                k += 1
+            if k + h > indptr[row + 1] or indices[k + h - 1] != s + h - 1:
+                return out, columns, False
+            for j in range(h):
+                block[i, j] = data[k + j]
+                block[i, h + j] = 1.0 if i == j else 0.0
+        for p in range(h):                                       # [B | I] -> [I | B^-1]
+            if not block[p, p] > 0.0:
+                return out, columns, False
+            f = 1.0 / block[p, p]
+            for j in range(2 * h):
+                block[p, j] *= f
+            for i in range(h):
+                if i != p:
+                    f = block[i, p]
+                    for j in range(2 * h):
+                        block[i, j] -= f * block[p, j]
+        for i in range(h):
+            for j in range(h):
+                out[out_indptr[s + i] + j] = block[i, h + j]
+                columns[out_indptr[s + i] + j] = s + j
+    return out, columns, True
+
+
 class Assembly:
     """The system of the free unknowns, assembled chunk by chunk from element matrices on the global dofs ``l2g (E,
     n)``, the dofs marked ``fixed`` held at ``values``. Only the free block is stored, as CSR whose pattern (sorted
-    column indices, no duplicates) and every element entry's place in it are computed once from ``l2g``
+    column indices, no duplicates) and every element block's place in it are computed once from ``l2g``
     (``_pattern``); :meth:`add` adds a chunk's element matrices into those places, which can then be dropped.
     The free dofs ``free`` are numbered in the order the elements first use them, so that an element's rows lie
     near each other in memory (the pattern and the additions take half the time of the global dofs' order).
+    The local dofs may come in ``groups``: consecutive local dofs that are consecutive global dofs in every element
+    (the nodes of one mesh edge or face), all fixed or all free. The rows of one group then have one pattern, found
+    once, and an element keeps one place per pair of its groups instead of one per entry.
     :math:`A_{ff} x = b` gives the free values; :meth:`energy` is :math:`u^T A u` of the full vector exactly, whatever
     ``x``.
 
@@ -77,23 +140,40 @@ class Assembly:
     values : numpy.ndarray
         Value of every global dof (only those marked ``fixed`` are read), in the unit of the unknown (K for a
         temperature).
+    groups : sequence of int, optional
+        Sizes of the groups of consecutive local dofs (summing to ``n``); default every dof its own group.
+        ValueError if ``l2g`` or ``fixed`` breaks a group.
     """
 
-    def __init__(self, l2g: np.ndarray, fixed: np.ndarray, values: np.ndarray):
+    def __init__(self, l2g: np.ndarray, fixed: np.ndarray, values: np.ndarray, groups=None):
+        n = l2g.shape[1]
+        sizes = np.ones(n, dtype=np.int64) if groups is None else np.asarray(groups, dtype=np.int64)
+        if np.any(sizes < 1) or sizes.sum() != n:
+            raise ValueError(f"groups = {sizes.tolist()}: positive sizes summing to the {n} local dofs")
+        self.offsets = np.concatenate([[0], np.cumsum(sizes)])
+        within = np.arange(n) - np.repeat(self.offsets[:-1], sizes)          # each local dof's place in its group
+        lead = np.repeat(self.offsets[:-1], sizes)
+        if np.any(l2g != l2g[:, lead] + within) or np.any(fixed[l2g] != fixed[l2g[:, lead]]):
+            raise ValueError("groups: a group's local dofs must be consecutive global dofs, all fixed or all free, "
+                             "in every element")
+        start, extent = np.full(len(fixed), -1), np.zeros(len(fixed), dtype=np.int64)
+        start[l2g], extent[l2g] = l2g[:, lead], np.repeat(sizes, sizes)         # (the last element's, if they differ)
+        if np.any(start[l2g] != l2g[:, lead]) or np.any(extent[l2g] != np.repeat(sizes, sizes)):
+            raise ValueError("groups: every global dof must lie in one group in every element (the same first dof "
+                             "and size)")
         dofs, first = np.unique(l2g, return_index=True)
         first_use = np.full(len(fixed), l2g.size)
         first_use[dofs] = first
         free = np.flatnonzero(~fixed)
         self.free = free[np.argsort(first_use[free], kind="stable")]            # in the order the elements use them
-        n = l2g.shape[1]
         index_type = np.int32 if len(l2g) * n * n < 2**31 else np.int64
         index = np.full(len(fixed), -1, dtype=index_type)
         index[self.free] = np.arange(len(self.free), dtype=index_type)
         self.l2g, self.fixed, self.values = l2g, fixed, values
         loc = np.ascontiguousarray(index[l2g])                                 # (E, n), -1 on fixed dofs
         self.indptr = np.zeros(len(self.free) + 1, dtype=index_type)
-        self.place = np.empty((len(l2g), n, n), dtype=index_type)
-        self.indices = _pattern(loc, self.indptr, self.place)
+        self.place = np.empty((len(l2g), len(sizes), len(sizes)), dtype=index_type)
+        self.indices = _pattern(loc, self.offsets, self.indptr, self.place)
         self.loc = loc
         self.data = np.zeros(len(self.indices))
         self.b = np.zeros(len(self.free))
@@ -109,13 +189,29 @@ class Assembly:
         elements : numpy.ndarray
             Indices of consecutive elements (rows of ``l2g``), ascending without gaps.
         """
-        known = np.where(self.fixed[self.l2g[elements]], self.values[self.l2g[elements]], 0.0)
-        load = -np.matmul(K, known[:, :, None])[:, :, 0]
-        loc = self.loc[elements]
+        held = self.fixed[self.l2g[elements]]
+        near = np.flatnonzero(held.any(axis=1))                                # the elements with a fixed dof
+        known = np.where(held[near], self.values[self.l2g[elements[near]]], 0.0)
+        load = -np.matmul(K[near], known[:, :, None])[:, :, 0]
+        loc = self.loc[elements[near]]
         on = loc >= 0
         self.b += np.bincount(loc[on], load[on], minlength=len(self.free))
         self.constant -= float(np.sum(known * load))
-        _scatter(self.data, self.place[elements[0]:elements[-1] + 1], np.ascontiguousarray(K))
+        chunk = slice(elements[0], elements[-1] + 1)
+        _scatter(self.data, self.indptr, self.loc[chunk], self.offsets, self.place[chunk], np.ascontiguousarray(K))
+
+    def groups(self) -> np.ndarray:
+        """Sizes of the groups of consecutive free unknowns that are one group of local dofs (:class:`Assembly`), in
+        order (``TwoLevel``'s ``groups``)."""
+        sizes = np.diff(self.offsets)
+        lead = self.loc[:, self.offsets[:-1]]
+        used = lead >= 0
+        first, index = np.unique(lead[used], return_index=True)
+        size = np.broadcast_to(sizes, lead.shape)[used][index]
+        if len(first) and (first[0] != 0 or np.any(first[1:] != first[:-1] + size[:-1])
+                           or first[-1] + size[-1] != len(self.free)):
+            raise ValueError("groups: the free unknowns are not all in groups (an unknown no element uses)")
+        return size
 
     def matrix(self):
         """``A_ff`` (CSR); frees the element places."""
@@ -141,74 +237,107 @@ class Assembly:
 
 
 @njit(cache=True)
-def _pattern(loc, indptr, place):
-    """The CSR pattern of the free block of an assembly on the element dofs ``loc (E, n)`` (-1 on fixed dofs): fills
-    ``indptr`` (free dofs + 1) and ``place (E, n, n)`` (the index in the CSR arrays of each element entry, -1 where
-    either dof is fixed) and returns the column indices, sorted within each row. Row by row, through the elements of
-    each dof: O(entries of the element matrices)."""
+def _pattern(loc, offsets, indptr, place):
+    """The CSR pattern of the free block of an assembly on the element dofs ``loc (E, n)`` (-1 on fixed dofs) whose
+    local dofs come in the groups ``offsets`` (:class:`Assembly`): fills ``indptr`` (free dofs + 1) and ``place (E,
+    G, G)`` (where the columns of group ``j`` start within the rows of group ``i``, -1 where either is fixed) and
+    returns the column indices, sorted within each row. Group by group, through the elements of each group's first
+    dof: O(the element matrices' group pairs), plus the indices written."""
     E, n = loc.shape
+    G = len(offsets) - 1
     rows = len(indptr) - 1
-    first = np.zeros(rows + 1, dtype=np.int64)                   # the dof's (element, local) incidences
+    first = np.zeros(rows + 1, dtype=np.int64)                   # the group's (element, local group) incidences
     for e in range(E):
-        for a in range(n):
-            if loc[e, a] >= 0:
-                first[loc[e, a] + 1] += 1
+        for g in range(G):
+            if loc[e, offsets[g]] >= 0:
+                first[loc[e, offsets[g]] + 1] += 1
     for r in range(rows):
         first[r + 1] += first[r]
     incidence = np.empty(first[rows], dtype=np.int64)
     filled = first[:-1].copy()
     for e in range(E):
-        for a in range(n):
-            r = loc[e, a]
+        for g in range(G):
+            r = loc[e, offsets[g]]
             if r >= 0:
-                incidence[filled[r]] = e * n + a
+                incidence[filled[r]] = e * G + g
                 filled[r] += 1
     seen = np.full(rows, -1, dtype=np.int64)
-    indices = np.empty(max(len(incidence) * (n // 4 + 1), 1), dtype=loc.dtype)  # doubled when short
-    column = np.empty(rows, dtype=loc.dtype)                     # a column's place within the current row
-    k = 0
-    for r in range(rows):
-        for s in range(first[r], first[r + 1]):                  # the distinct columns of row r
-            e = incidence[s] // n
-            for b in range(n):
-                c = loc[e, b]
-                if c >= 0 and seen[c] != r:
-                    seen[c] = r
-                    if k == len(indices):
-                        grown = np.empty(2 * len(indices), dtype=loc.dtype)
-                        grown[:k] = indices
-                        indices = grown
-                    indices[k] = c
-                    k += 1
-        indptr[r + 1] = k
-        indices[indptr[r]:k] = np.sort(indices[indptr[r]:k])
-        for j in range(indptr[r], k):
-            column[indices[j]] = j
-        for s in range(first[r], first[r + 1]):
-            e, a = incidence[s] // n, incidence[s] % n
-            for b in range(n):
-                c = loc[e, b]
-                place[e, a, b] = column[c] if c >= 0 else -1
-    for e in range(E):                                           # the rows of fixed dofs
-        for a in range(n):
-            if loc[e, a] < 0:
-                place[e, a, :] = -1
-    return indices[:k].copy()
+    size = np.zeros(rows, dtype=np.int64)                        # the size of the group a column group starts
+    leads = np.empty(rows, dtype=np.int64)                       # the current rows' column groups (their first dof)
+    column = np.empty(rows, dtype=loc.dtype)                     # a column group's place within the current rows
+    indices = np.empty(0, dtype=loc.dtype)
+    for sweep in range(2):                                       # the rows' lengths, then their columns and places
+        if sweep == 1:
+            indices = np.empty(indptr[rows], dtype=loc.dtype)
+            seen[:] = -1
+        r = 0
+        while r < rows:
+            if first[r] == first[r + 1]:                         # a dof no element uses
+                if sweep == 0:
+                    indptr[r + 1] = indptr[r]
+                r += 1
+                continue
+            g = incidence[first[r]] % G
+            height = offsets[g + 1] - offsets[g]                 # the rows of this group: r to r + height - 1
+            count = 0
+            for s in range(first[r], first[r + 1]):              # the distinct column groups of the group's rows
+                e = incidence[s] // G
+                for h in range(G):
+                    c = loc[e, offsets[h]]
+                    if c >= 0 and seen[c] != r:
+                        seen[c] = r
+                        size[c] = offsets[h + 1] - offsets[h]
+                        leads[count] = c
+                        count += 1
+            if sweep == 0:
+                width = 0
+                for j in range(count):
+                    width += size[leads[j]]
+                for d in range(height):
+                    indptr[r + d + 1] = indptr[r + d] + width
+            else:
+                ordered = np.sort(leads[:count])
+                width = 0
+                for j in range(count):
+                    column[ordered[j]] = width
+                    width += size[ordered[j]]
+                k = indptr[r]
+                for d in range(height):
+                    for j in range(count):
+                        for i in range(size[ordered[j]]):
+                            indices[k] = ordered[j] + i
+                            k += 1
+                for s in range(first[r], first[r + 1]):
+                    e, g = incidence[s] // G, incidence[s] % G
+                    for h in range(G):
+                        c = loc[e, offsets[h]]
+                        place[e, g, h] = column[c] if c >= 0 else -1
+            r += height
+    for e in range(E):                                           # the rows of fixed groups
+        for g in range(G):
+            if loc[e, offsets[g]] < 0:
+                place[e, g, :] = -1
+    return indices
 
 
 @njit(cache=True)
-def _scatter(data, place, K):
-    """``data[place] += K`` over the entries whose place is not -1, element after element."""
-    E, n = K.shape[0], K.shape[1]
+def _scatter(data, indptr, loc, offsets, place, K):
+    """``data += K`` element after element: entry ``(a, b)`` of element ``e``, ``a`` in group ``i`` and ``b`` in
+    group ``j``, goes to ``indptr[loc[e, a]] + place[e, i, j] + (b - offsets[j])`` where that place is not -1."""
+    E, G = K.shape[0], len(offsets) - 1
     for e in range(E):
-        for a in range(n):
-            for b in range(n):
-                k = place[e, a, b]
-                if k >= 0:
-                    data[k] += K[e, a, b]
+        for i in range(G):
+            for j in range(G):
+                base = place[e, i, j]
+                if base >= 0:
+                    for a in range(offsets[i], offsets[i + 1]):
+                        start = indptr[loc[e, a]] + base - offsets[j]
+                        for b in range(offsets[j], offsets[j + 1]):
+                            data[start + b] += K[e, a, b]
 
 
-def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None) -> TwoLevel:
+def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None,
+              groups: np.ndarray | None = None) -> TwoLevel:
     """The preconditioner :class:`TwoLevel` of ``A`` on the coarse space ``P``.
 
     Parameters
@@ -221,12 +350,15 @@ def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None) -> Tw
         :math:`P^T A P` if the caller has it.
     block_matrices : numpy.ndarray, optional
         Diagonal blocks (B, k, k) of ``A`` for block Jacobi; None for point Jacobi.
+    groups : numpy.ndarray, optional
+        Sizes of consecutive groups of unknowns for block Jacobi on ``A``'s own blocks (CSR ``A``).
     """
-    return TwoLevel(A, P, coarse, block_matrices)
+    return TwoLevel(A, P, coarse, block_matrices, groups)
 
 
 def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 5000,
-          x0: np.ndarray | None = None, energy: tuple[float, float] | None = None) -> tuple[np.ndarray, int, float]:
+          x0: np.ndarray | None = None, energy: tuple[float, float] | None = None,
+          settled: tuple[float, Callable[[np.ndarray], None]] | None = None) -> tuple[np.ndarray, int, float]:
     r"""Conjugate gradients on the SPD :math:`A x = b` to :math:`|r| \le \mathrm{rtol} \, |b|`:
     ``(x, iterations, |r| / |b|)``; ``RuntimeError`` if ``maxiter`` iterations do not reach it.
 
@@ -253,6 +385,10 @@ def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 50
     energy : tuple of float, optional
         ``(E0, etol)``: the energy at ``x0`` (in the unit of ``b x``) and the relative energy tolerance
         (dimensionless) of the energy stop above.
+    settled : tuple, optional
+        ``(tol, report)``: ``report(x)`` is called once with a copy of the first iterate whose energy has settled to
+        ``tol`` (relative, looser than ``etol``; by the stop above), or with the result if none did before it (with
+        ``energy`` only).
     """
     x = np.zeros_like(b) if x0 is None else x0.copy()
     r = b - A @ x
@@ -272,7 +408,11 @@ def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 50
         if energy is not None:
             drops.append(alpha * rz)
             left = energy[0] - sum(drops)
-            if len(drops) >= ENERGY_WINDOW and sum(drops[-ENERGY_WINDOW:]) <= energy[1] * abs(left):
+            window = sum(drops[-ENERGY_WINDOW:]) if len(drops) >= ENERGY_WINDOW else np.inf
+            if settled is not None and (window <= settled[0] * abs(left) or window <= energy[1] * abs(left)):
+                settled[1](x.copy())
+                settled = None
+            if window <= energy[1] * abs(left):
                 return x, it, res
         z = precondition(r)
         rz_new = float(r @ z)

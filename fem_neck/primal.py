@@ -6,10 +6,12 @@ the elements of :mod:`fem_neck.curved` fill the exact solid, so :math:`u^T A u \
 whatever the solver's residual (which only makes the bound less sharp): CG stops once the energy has settled to
 ``ENERGY_RTOL``. The ``(p - 1)(p - 2)(p - 3) / 6`` interior nodes of every element are condensed (Schur complement,
 batched); the skeleton system is solved by conjugate gradients preconditioned by :func:`fem_neck.pcg.two_level` (the
-piecewise-linear hats as coarse space).
+piecewise-linear hats as coarse space, block Jacobi on the nodes of every vertex, edge and face).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 from dataclasses import dataclass
 
@@ -55,7 +57,7 @@ def stiffness_matrices(mesh: CurvedMesh, basis: Lagrange, degree: int | None = N
     J = mesh.affine_jacobians(elements)
     inv = np.linalg.inv(J)
     G = np.abs(np.linalg.det(J))[:, None, None] * np.einsum("eia,eja->eij", inv, inv)   # |det J| J^-1 J^-T
-    K = np.einsum("eij,ijab->eab", G, basis.stiffness)
+    K = (G.reshape(len(G), 9) @ basis.stiffness.reshape(9, -1)).reshape(len(G), basis.n, basis.n)
     curved = np.flatnonzero(mesh.is_curved[elements])
     if len(curved):
         xi, w = tet_quadrature(degree or quadrature_degree(basis.p))
@@ -168,6 +170,19 @@ def numbering(mesh: CurvedMesh, basis: Lagrange) -> Numbering:
     return Numbering(l2g.reshape(M, -1), nv + ne * pe + len(mesh.faces) * pf)
 
 
+def skeleton_groups(basis: Lagrange) -> list:
+    """The sizes of the groups of an element's skeleton dofs in the order of :func:`numbering` that are one mesh
+    entity's (a vertex, the ``n_edge`` nodes of an edge, the ``n_face`` of a face): consecutive global dofs in every
+    element, fixed or free together (:class:`fem_neck.pcg.Assembly`).
+
+    Parameters
+    ----------
+    basis : fem_neck.simplex.Lagrange
+        The reference ``P_p`` basis.
+    """
+    return [size for size in [1] * 4 + [basis.n_edge] * 6 + [basis.n_face] * 4 if size]
+
+
 def face_dofs(mesh: CurvedMesh, basis: Lagrange, faces: np.ndarray) -> np.ndarray:
     """Global dofs of every node on the given faces.
 
@@ -222,7 +237,7 @@ class Solution:
 
 
 def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: float = ENERGY_RTOL,
-          degree: int | None = None) -> Solution:
+          degree: int | None = None, early: tuple[float, Callable[[np.ndarray], None]] | None = None) -> Solution:
     """The conforming ``P_p`` solution with ``u = 1`` on the ``hot`` faces and 0 on the ``cold`` ones (indices into
     ``mesh.faces``; quadrature of ``degree`` on curved elements, default :func:`quadrature_degree`); see the module
     docstring. CG stops when the energy has settled to ``etol`` (:func:`fem_neck.pcg.solve`).
@@ -239,6 +254,10 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
         Relative energy tolerance of CG's energy stop (dimensionless).
     degree : int, optional
         Quadrature degree on curved elements; default :func:`quadrature_degree`.
+    early : tuple, optional
+        ``(tol, report)``: ``report(u)`` gets the skeleton temperature (as :class:`Solution` ``u``) of the first CG
+        iterate whose energy has settled to ``tol`` (looser than ``etol``), before CG goes on (``settled`` of
+        :func:`fem_neck.pcg.solve`).
     """
     from fem_neck import pcg
 
@@ -250,21 +269,26 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     hot_dofs = face_dofs(mesh, basis, hot)
     fixed[hot_dofs] = fixed[face_dofs(mesh, basis, cold)] = True
     values[hot_dofs] = 1.0
-    system = pcg.Assembly(num.l2g, fixed, values)
+    system = pcg.Assembly(num.l2g, fixed, values, skeleton_groups(basis))
     hats = hat_values(basis)
     coarse = np.empty((len(mesh.tets), 4, 4))                               # each element's part of P^T A_ff P
     for start in range(0, len(mesh.tets), CHUNK):
         elements = np.arange(start, min(start + CHUNK, len(mesh.tets)))
         K = condensed(stiffness_matrices(mesh, basis, degree, elements), skel)
         system.add(K, elements)
-        free = ~fixed[num.l2g[elements]]                                    # the rows and columns of A_ff
-        coarse[elements] = hats.T @ (K * free[:, :, None] * free[:, None, :]) @ hats
+        coarse[elements] = hat_parts(K, ~fixed[num.l2g[elements]], hats)
     A = system.matrix()
     P = hat_prolongation(mesh, basis, num)[system.free]
-    x, iterations, residual = pcg.solve(A, system.b, pcg.two_level(A, P, coarse_matrix(mesh, coarse)),
-                                        energy=(system.constant, etol))
-    u = values.copy()
-    u[system.free] = x
+    precondition = pcg.two_level(A, P, coarse_matrix(mesh, coarse), groups=system.groups())  # an entity's nodes
+
+    def temperature(x: np.ndarray) -> np.ndarray:
+        u = values.copy()
+        u[system.free] = x
+        return u
+
+    settled = None if early is None else (early[0], lambda x: early[1](temperature(x)))
+    x, iterations, residual = pcg.solve(A, system.b, precondition, energy=(system.constant, etol), settled=settled)
+    u = temperature(x)
     return Solution(system.energy(A, x), u, num.n + basis.n_interior * len(mesh.tets), num.n, iterations, residual)
 
 
@@ -303,11 +327,33 @@ def hat_values(basis: Lagrange) -> np.ndarray:
     return np.concatenate([1.0 - basis.nodes[:skel].sum(axis=1, keepdims=True), basis.nodes[:skel]], axis=1)
 
 
+def hat_parts(K: np.ndarray, free: np.ndarray, hats: np.ndarray) -> np.ndarray:
+    r"""Every element's part :math:`H^T K_e^{ff} H` ``(E, 4, 4)`` of the hats' coarse matrix (:func:`coarse_matrix`):
+    ``K (E, n, n)`` with the rows and columns of its fixed dofs (``free`` False) zeroed, ``hats`` ``H (n, 4)``
+    (:func:`hat_values`); two matrix products over all elements, the few with a fixed dof redone.
+
+    Parameters
+    ----------
+    K : numpy.ndarray
+        Element matrices ``(E, n, n)`` on the skeleton dofs.
+    free : numpy.ndarray
+        Boolean ``(E, n)``: True where the element's dof is free.
+    hats : numpy.ndarray
+        The hats' coefficients ``(n, 4)`` in the skeleton basis.
+    """
+    E, n = free.shape
+    KH = (K.reshape(E * n, n) @ hats).reshape(E, n, 4)
+    out = (np.ascontiguousarray(KH.transpose(0, 2, 1)).reshape(E * 4, n) @ hats).reshape(E, 4, 4)
+    near = np.flatnonzero(~free.all(axis=1))
+    out[near] = hats.T @ (K[near] * free[near][:, :, None] * free[near][:, None, :]) @ hats
+    return out
+
+
 def coarse_matrix(mesh: CurvedMesh, blocks: np.ndarray):
     r"""The Galerkin matrix :math:`P^T A_{ff} P` of the hats (:func:`hat_prolongation` on the free dofs) as the sum
-    of its element parts ``blocks (E, 4, 4)`` on the elements' vertices, :math:`H^T K_e^{ff} H` with ``H`` of
-    :func:`hat_values` and :math:`K_e^{ff}` the element matrix with the fixed dofs' rows and columns zeroed (the same
-    matrix as the sparse product, without it); CSR ``(n_vertices, n_vertices)``.
+    of its element parts ``blocks (E, 4, 4)`` on the elements' vertices, :math:`H^T K_e^{ff} H` (:func:`hat_parts`)
+    with ``H`` of :func:`hat_values` and :math:`K_e^{ff}` the element matrix with the fixed dofs' rows and columns
+    zeroed (the same matrix as the sparse product, without it); CSR ``(n_vertices, n_vertices)``.
 
     Parameters
     ----------
@@ -341,12 +387,9 @@ def hat_prolongation(mesh: CurvedMesh, basis: Lagrange, num: Numbering):
 
     lam = hat_values(basis)
     skel = len(lam)
-    M = len(mesh.tets)
-    rows = np.broadcast_to(num.l2g[:, :, None], (M, skel, 4))
-    cols = np.broadcast_to(mesh.tets[:, None, :], (M, skel, 4))
-    vals = np.broadcast_to(lam[None], (M, skel, 4))
+    dofs, first = np.unique(num.l2g, return_index=True)                    # each node from the first element using it
+    element, node = np.divmod(first, skel)
+    vals = lam[node]                                                       # (the same from every element)
     keep = vals > 0.0
-    key = rows[keep].astype(np.int64) * len(mesh.points) + cols[keep]
-    key, first = np.unique(key, return_index=True)
-    return sp.csr_matrix((vals[keep][first], (key // len(mesh.points), key % len(mesh.points))),
-                         shape=(num.n, len(mesh.points)))
+    rows = np.broadcast_to(dofs[:, None], vals.shape)
+    return sp.csr_matrix((vals[keep], (rows[keep], mesh.tets[element][keep])), shape=(num.n, len(mesh.points)))

@@ -4,6 +4,7 @@ sums they replace: a dense or COO sum of the element matrices, the Galerkin prod
 import numpy as np
 import pytest
 import scipy.sparse as sp
+import scipy.sparse.linalg  # noqa: F401  (for sp.linalg)
 
 from fem_neck import dual, lattice, pcg, primal
 from fem_neck.simplex import lagrange, raviart_thomas, tet_quadrature
@@ -40,6 +41,60 @@ def test_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs(seed):
     assert system.energy(A, x) == pytest.approx(u @ full @ u, rel=1e-12)
 
 
+def _grouped_elements():
+    """Random symmetric element matrices on groups of 1, 1, 3, 3 and 2 local dofs, each a run of consecutive global
+    dofs of one "entity", fixed or free together."""
+    rng = np.random.default_rng(7)
+    sizes, count = [1, 1, 3, 3, 2], 40                                   # 40 entities of each size
+    size_of = rng.permutation(np.repeat([1, 2, 3], count))
+    base = np.concatenate([[0], np.cumsum(size_of)])                     # entity j owns base[j] .. base[j + 1] - 1
+    held = rng.random(len(size_of)) < 0.2
+    l2g = np.empty((200, 10), dtype=np.int64)
+    for e in range(200):
+        columns = []
+        for size in sizes:
+            entity = rng.choice(np.flatnonzero((size_of == size) & ~np.isin(np.arange(len(size_of)), columns)))
+            columns.append(entity)
+        l2g[e] = np.concatenate([base[j] + np.arange(size_of[j]) for j in columns])
+    fixed = np.repeat(held, size_of)
+    values = np.where(fixed, rng.random(len(fixed)), 0.0)
+    K = rng.standard_normal((200, 10, 10))
+    return l2g, fixed, values, K + np.swapaxes(K, 1, 2)
+
+
+def test_grouped_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs():
+    l2g, fixed, values, K = _grouped_elements()
+    sizes = [1, 1, 3, 3, 2]
+    grouped, plain = pcg.Assembly(l2g, fixed, values, sizes), pcg.Assembly(l2g, fixed, values)
+    for system in (grouped, plain):
+        for start in range(0, 200, 64):
+            elements = np.arange(start, min(start + 64, 200))
+            system.add(K[elements], elements)
+    A, B = grouped.matrix(), plain.matrix()
+    n = l2g.shape[1]
+    full = sp.csr_matrix((K.ravel(), (np.repeat(l2g, n, axis=1).ravel(), np.tile(l2g, (1, n)).ravel())),
+                         shape=(len(fixed),) * 2).toarray()
+    free = grouped.free
+    assert A.has_canonical_format
+    np.testing.assert_array_equal(A.indptr, B.indptr)
+    np.testing.assert_array_equal(A.indices, B.indices)
+    np.testing.assert_allclose(A.toarray(), full[np.ix_(free, free)], atol=1e-13)
+    np.testing.assert_allclose(grouped.b, -full[np.ix_(free, np.flatnonzero(fixed))] @ values[fixed], atol=1e-12)
+
+
+@pytest.mark.parametrize("groups, match", [([1, 1, 3, 3, 3], "positive sizes summing to the 3 local dofs"),
+                                           ([3], "consecutive global dofs"),
+                                           ([2, 1], "one group in every element")])
+def test_groups_that_do_not_hold_are_refused(groups, match):
+    # elements (0, 1, 2) and (2, 3, 4): dof 2 starts a group in the second but not in the first; then dofs 4 and 5
+    # fixed and free within a group
+    l2g = np.array([[0, 1, 2], [2, 3, 4]]) if groups != [3] else np.array([[0, 1, 2], [4, 5, 6]])
+    fixed = np.zeros(7, dtype=bool)
+    fixed[4] = True
+    with pytest.raises(ValueError, match=match):
+        pcg.Assembly(l2g, fixed, np.zeros(7), groups)
+
+
 def test_packed_symmetric_products_are_the_full_ones():
     g = np.random.default_rng(2).standard_normal((7, 3, 5))
     packed = primal.symmetric_products(g)
@@ -59,11 +114,28 @@ def cell_mesh():
 def _element_matrices(mesh, k):
     """``H_K`` of every element, as :func:`fem_neck.dual.solve` makes them."""
     rt = raviart_thomas(k)
-    A = dual.mass_matrices(mesh, rt, primal.quadrature_degree(k + 1), np.arange(len(mesh.tets)))
-    H = np.matmul(rt.traces, np.linalg.solve(A, np.broadcast_to(rt.traces.T, (len(A),) + rt.traces.T.shape)))
-    stack = dual.SymmetricStack(len(H), H.shape[1])
-    stack[np.arange(len(H))] = H
-    return stack, rt.n_face
+    return dual.element_matrices(mesh, rt, primal.quadrature_degree(k + 1)), rt.n_face
+
+
+@pytest.mark.parametrize("k", [1, 3])
+def test_element_matrices_are_the_traces_through_the_inverse_mass(cell_mesh, k):
+    # the compiled Cholesky pass against T A^-1 T^T by LAPACK's dense solve, on curved and straight elements
+    mesh, rt = cell_mesh.curved, raviart_thomas(k)
+    elements = np.arange(len(mesh.tets))
+    packed = dual.mass_matrices(mesh, rt, primal.quadrature_degree(k + 1), elements)
+    A = packed[:, primal.symmetric_gather(rt.m)].reshape(len(elements), rt.m, rt.m)
+    T = rt.traces
+    H = np.matmul(T, np.linalg.solve(A, np.broadcast_to(T.T, (len(A),) + T.T.shape)))
+    stack = dual.element_matrices(mesh, rt, primal.quadrature_degree(k + 1))
+    assert mesh.is_curved.any() and not mesh.is_curved.all()
+    np.testing.assert_allclose(stack[elements], H, rtol=0, atol=1e-13 * np.abs(H).max())
+
+
+def test_element_matrices_refuse_a_mass_matrix_that_is_not_positive_definite():
+    T, position = np.ones((2, 3)), primal.symmetric_gather(3).reshape(3, 3)
+    A = np.array([[1.0, 0, 0, 1, 0, 1], [1, 0, 0, -1, 0, 1]])                 # I and diag(1, -1, 1), packed
+    assert dual._trace_products(A[:1], position, T, 0, np.empty((1, 3)))
+    assert not dual._trace_products(A, position, T, 0, np.empty((2, 3)))
 
 
 def test_face_system_is_the_sum_of_the_element_matrices_on_the_free_faces(cell_mesh):
@@ -113,6 +185,53 @@ def test_the_given_coarse_matrix_of_the_face_means_is_the_galerkin_product(cell_
     np.testing.assert_allclose(given, computed, rtol=1e-12)
 
 
+def test_block_jacobi_on_groups_inverts_the_diagonal_blocks_of_the_matrix():
+    # the upper bound's P_4 system: its groups (a vertex, an edge's or a face's nodes) against dense inverses
+    l2g, fixed, values, K = _grouped_elements()
+    system = pcg.Assembly(l2g, fixed, values, [1, 1, 3, 3, 2])
+    for start in range(0, len(K), 64):
+        system.add(K[start:start + 64], np.arange(start, min(start + 64, len(K))))
+    groups = system.groups()
+    A = system.matrix()
+    A = A + sp.identity(A.shape[0]) * 2 * abs(A).sum(axis=1).max()          # positive definite (diagonally dominant)
+    A = A.tocsr()
+    A.sort_indices()
+    starts = np.concatenate([[0], np.cumsum(groups)])
+    assert sorted(set(groups)) == [1, 2, 3] and starts[-1] == A.shape[0]
+    local = pcg.two_level(A, sp.identity(A.shape[0], format="csr"), None, groups=groups).local.toarray()
+    dense = A.toarray()
+    expected = np.zeros_like(dense)
+    for begin, end in zip(starts[:-1], starts[1:]):
+        expected[begin:end, begin:end] = np.linalg.inv(dense[begin:end, begin:end])
+    np.testing.assert_allclose(local, expected, rtol=0, atol=1e-13 * abs(expected).max())
+    with pytest.raises(ValueError, match="groups: positive sizes summing to the"):
+        pcg.two_level(A, sp.identity(A.shape[0], format="csr"), None, groups=groups[1:])
+    B = sp.diags([1.0, 1.0, 1.0, 1.0, 1.0, -1.0], format="csr")               # no 2 x 2 block; a negative pivot
+    for sizes in ([2, 2, 2], [1] * 6):
+        with pytest.raises(ValueError, match="a diagonal block of A is not stored whole or has a pivot"):
+            pcg.two_level(B, sp.identity(6, format="csr"), None, groups=np.array(sizes))
+
+
+def test_cg_reports_the_first_iterate_settled_to_a_looser_tolerance():
+    # a shifted 1D Laplacian (condition ~ 400; 138 steps): the reported iterate comes well before the end, its energy
+    # above the final one by about the looser tolerance (1.2e-4 of it); the final iterate is the one CG reaches
+    # without a report
+    n = 400
+    A = sp.diags([-np.ones(n - 1), 2.01 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1], format="csr")
+    b = np.random.default_rng(8).random(n)
+    constant = 2.0 * float(b @ sp.linalg.spsolve(A.tocsc(), b))              # the least energy is half of it
+
+    def energy(x):
+        return float(x @ (A @ x) - 2.0 * x @ b + constant)
+
+    reports = []
+    x, iterations, _ = pcg.solve(A, b, lambda r: r / 2.01, energy=(constant, 1e-12), settled=(1e-3, reports.append))
+    y, same, _ = pcg.solve(A, b, lambda r: r / 2.01, energy=(constant, 1e-12))
+    assert len(reports) == 1 and same == iterations and np.array_equal(x, y)
+    early = energy(reports[0]) - energy(x)
+    assert 1e-5 * energy(x) < early <= 1e-2 * energy(x)
+
+
 def test_block_jacobi_needs_blocks_that_cover_the_unknowns():
     A = sp.identity(10, format="csr")
     with pytest.raises(ValueError, match="block_matrices: 3 blocks of 3 unknowns for 10 unknowns"):
@@ -158,12 +277,19 @@ def test_coarse_matrix_of_the_hats_is_the_galerkin_product(cell_mesh):
     fixed = np.zeros(num.n, dtype=bool)
     fixed[primal.face_dofs(mesh, basis, cell_mesh.hot)] = fixed[primal.face_dofs(mesh, basis, cell_mesh.cold)] = True
     K = primal.condensed(primal.stiffness_matrices(mesh, basis), skel)
-    system = pcg.Assembly(num.l2g, fixed, fixed.astype(float))
+    system = pcg.Assembly(num.l2g, fixed, fixed.astype(float), primal.skeleton_groups(basis))
     system.add(K, np.arange(len(K)))
     A = system.matrix()
+    plain = pcg.Assembly(num.l2g, fixed, fixed.astype(float))                 # one group per dof: the same matrix
+    plain.add(K, np.arange(len(K)))
+    assert abs(A - plain.matrix()).max() == 0.0 and np.array_equal(system.b, plain.b)
     P = primal.hat_prolongation(mesh, basis, num)[system.free]
     free = ~fixed[num.l2g]
     hats = primal.hat_values(basis)
-    coarse = primal.coarse_matrix(mesh, hats.T @ (K * free[:, :, None] * free[:, None, :]) @ hats)
+    parts = primal.hat_parts(K, free, hats)
+    np.testing.assert_allclose(parts, hats.T @ (K * free[:, :, None] * free[:, None, :]) @ hats, rtol=0,
+                               atol=1e-13 * abs(parts).max())
+    assert (~free).any(axis=1).any() and free.all(axis=1).any()                # elements with and without a fixed dof
+    coarse = primal.coarse_matrix(mesh, parts)
     product = (P.T @ A @ P).tocsr()
     assert abs(coarse - product).max() <= 1e-12 * abs(product).max()

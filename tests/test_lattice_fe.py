@@ -1,6 +1,7 @@
 """3D FE of periodic cells (fem_neck.lattice): bounds that bracket independent references, geometry, refusals."""
 
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -172,6 +173,35 @@ def test_primal_cg_stops_when_the_energy_has_settled():
     assert loose.energy == pytest.approx(tight.energy, rel=10 * primal.ENERGY_RTOL)
     assert loose.energy >= tight.energy * (1.0 - 1e-12)  # CG lowers the energy (up to its round-off)
     assert loose.iterations < tight.iterations
+
+
+def test_primal_reports_its_first_iterate_settled_to_a_looser_tolerance_once():
+    # the temperature the lower bound's CG starts from: an earlier iterate, within the looser tolerance of the final
+    # energy, and the final CG unchanged by the report
+    from fem_neck import primal
+
+    cm = lattice.build_cell_mesh(_chain_cell(0.08), **COARSE)
+    reports = []
+    plain = primal.solve(cm.curved, 3, cm.hot, cm.cold, etol=1e-12)
+    final = primal.solve(cm.curved, 3, cm.hot, cm.cold, etol=1e-12, early=(1e-4, reports.append))
+    assert len(reports) == 1 and final.energy == plain.energy and final.iterations == plain.iterations
+    u = reports[0]
+    assert u.shape == final.u.shape and 0.0 < np.max(np.abs(u - final.u)) < 1e-2
+    hot = primal.face_dofs(cm.curved, primal.lagrange(3), cm.hot)
+    np.testing.assert_array_equal(u[hot], 1.0)                               # the held values
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="prctl is Linux's")
+def test_the_bounds_run_without_transparent_huge_pages_and_give_them_back():
+    import ctypes
+
+    from fem_neck.lattice.bounds import small_pages
+
+    prctl = ctypes.CDLL(None).prctl
+    before = prctl(42, 0, 0, 0, 0)                                             # PR_GET_THP_DISABLE
+    with small_pages():
+        assert prctl(42, 0, 0, 0, 0) == 1
+    assert prctl(42, 0, 0, 0, 0) == before
 
 
 def _coarse_first_mesh(monkeypatch):

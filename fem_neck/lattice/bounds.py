@@ -60,7 +60,33 @@ def _dual(mesh, order: int, hot, cold, etol: float, temperature):
         return dual.solve(mesh, order - 1, hot, cold, etol, start=start)
 
 
+@contextlib.contextmanager
+def small_pages():
+    """The process (and the processes it forks meanwhile) without transparent huge pages, as before afterwards
+    (Linux's ``prctl(PR_SET_THP_DISABLE)``; elsewhere nothing). The bounds' large arrays are written once, fresh: a
+    huge page for them can stall the kernel finding or compacting 2 MB of free memory on a busy machine (a third of
+    the system time of BCC h/r = 0.02; the benchmarks guide's lattice section)."""
+    import ctypes
+
+    get, set_ = 42, 41                                            # PR_GET_THP_DISABLE, PR_SET_THP_DISABLE
+    try:
+        prctl = ctypes.CDLL(None, use_errno=True).prctl
+        before = prctl(get, 0, 0, 0, 0)
+        changed = before >= 0 and prctl(set_, 1, 0, 0, 0) == 0
+    except (AttributeError, OSError, TypeError):                  # no prctl: not Linux
+        changed = False
+    try:
+        yield
+    finally:
+        if changed:
+            prctl(set_, before, 0, 0, 0)
+
+
 _TEMPERATURES = None  # in the lower bound's process: the queue on which the upper bound's temperature arrives
+# the upper bound's temperature goes to the lower bound's process once its CG's energy has settled to START_SHARE etol,
+# not at the end: the flux's CG starts as well from it (its distance from the flux's solution is the discretisation's;
+# on BCC h/r = 0.02 at rtol 1e-4, 21 steps from iterates settled to 1e-5, 1e-4 and 1e-3 as from 1e-7)
+START_SHARE = 100.0
 
 
 def _receive_temperatures(queue) -> None:
@@ -81,7 +107,8 @@ def _dual_receiving(mesh, order: int, hot, cold, etol: float):
 def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2, etol: float | None = None) -> Bounds:
     r"""Upper and lower bound of the cell's :math:`k / \kappa` on the mesh ``cm`` (:mod:`fem_neck.lattice`), the two
     solves in parallel processes when ``workers >= 2`` (the lower bound assembles its system while the upper bound
-    solves, then starts its CG from the upper bound's temperature). Both integrate the curved elements at the same
+    solves, then starts its CG from the upper bound's temperature, sent once the upper bound's CG has settled to
+    ``START_SHARE etol``). Both integrate the curved elements at the same
     points, where the elements are mapped once. Both CGs stop when their energy has settled to ``etol`` (default
     ``fem_neck.primal.ENERGY_RTOL``).
 
@@ -101,31 +128,34 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2, etol: float | N
 
     import pyamg  # noqa: F401  (imported before the fork: the lower bound's process inherits it, as it does dual)
 
-    from fem_neck import dual, primal  # noqa: F401
+    from fem_neck import dual, pcg, primal  # noqa: F401
+    from sinterheat import amg  # noqa: F401
     from fem_neck.simplex import tet_quadrature
 
     t0 = time.perf_counter()
     etol = primal.ENERGY_RTOL if etol is None else etol
     mesh = cm.curved
-    mesh.keep_jacobians(tet_quadrature(primal.quadrature_degree(order))[0])   # = dual's quadrature_degree(order)
-    try:
-        if workers >= 2:
-            context = get_context("fork")
-            queue = context.Queue()      # put does not wait for the reader (which may have failed before reading)
-            queue.cancel_join_thread()   # nor does the exit, if it never read
-            pool = ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures, initargs=(queue,))
-        else:
-            pool = contextlib.nullcontext()
-        with pool:
-            future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold, etol) if workers >= 2 else None
-            with one_blas_thread():
-                up = primal.solve(mesh, order, cm.hot, cm.cold, etol)
-                if future is not None:
-                    queue.put(up.u)
-                volume = primal.volume(mesh)  # (while the lower bound finishes in its process)
-            low = future.result() if future is not None else _dual(mesh, order, cm.hot, cm.cold, etol, lambda: up.u)
-    finally:  # the kept Jacobians (a few hundred MB on a fine mesh) go with the solves, also when one fails
-        mesh.keep_jacobians(None)
+    with small_pages():  # (the lower bound's process, forked inside, inherits it)
+        mesh.keep_jacobians(tet_quadrature(primal.quadrature_degree(order))[0])  # = dual's quadrature_degree(order)
+        try:
+            if workers >= 2:
+                context = get_context("fork")
+                queue = context.Queue()     # put does not wait for the reader (which may have failed before reading)
+                queue.cancel_join_thread()  # nor does the exit, if it never read
+                pool = ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures,
+                                           initargs=(queue,))
+            else:
+                pool = contextlib.nullcontext()
+            with pool:
+                future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold, etol) if workers >= 2 else None
+                with one_blas_thread():
+                    early = None if future is None else (START_SHARE * etol, queue.put)
+                    up = primal.solve(mesh, order, cm.hot, cm.cold, etol, early=early)
+                    volume = primal.volume(mesh)  # (while the lower bound finishes in its process)
+                low = (future.result() if future is not None
+                       else _dual(mesh, order, cm.hot, cm.cold, etol, lambda: up.u))
+        finally:  # the kept Jacobians (a few hundred MB on a fine mesh) go with the solves, also when one fails
+            mesh.keep_jacobians(None)
     scale = cm.height / cm.area
     return Bounds(float(up.energy * scale), float(low.lower * scale), float(low.flux_defect), int(up.dofs),
                   int(low.dofs), len(mesh.tets), float(volume / cm.volume_exact - 1.0), time.perf_counter() - t0)

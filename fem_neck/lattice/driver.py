@@ -18,7 +18,7 @@ from fem_neck.lattice.sizes import (FIRST_MESH, P3_FROM, REFINE_MARGIN, default_
                                     mesh_rule, mesh_sizes)
 
 # the solvers' energy tolerance over the requested rtol: the bounds' algebraic error stays ~1e-3 of the gap asked for
-# (at rtol 1e-4 the bounds of BCC h/r = 0.02 move by 1.4e-9 and 4e-9 against CGs settled to 1e-9)
+# (at rtol 1e-4 the bounds of BCC h/r = 0.02 move by 1.6e-10 and 4.6e-9 against CGs settled to 1e-9)
 ALGEBRAIC_SHARE = 1e-3
 
 
