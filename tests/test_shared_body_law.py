@@ -136,3 +136,27 @@ def test_shared_body_with_walls_needs_the_walls():
     # each particle's wall neck and pair neck are 90 degrees apart: closer than opposite poles, the body between them
     # conducts more than two equatorial half bodies in series
     assert np.all(Kw > Kw_fit) and np.all(K > K_fit)
+
+
+def test_a_swallowed_sphere_falls_back_to_the_plain_halves():
+    # one sphere of a dense union packing grown by a quarter: its neighbours' necks (a/r up to 0.92) are far beyond
+    # the multi-terminal model, whose interactions then outweigh the necks' own resistances (no positive flow); the
+    # law takes the plain halves under the cap there instead of a negative conductance (refused before)
+    from verification.lattices import dem_periodic
+    from fem_neck.lattice import PeriodicCell
+
+    # verification.packings.union_packing(2, 0.9, seed=8) (phi 0.90): two spheres and their mirror images in the
+    # period's mid-planes
+    period = 3.446797
+    base, base_radii = np.array([[1.155395, 1.155395, 0.568004], [0.505324, 0.505324, 1.218075]]), [1.149738, 1.024378]
+    signs = np.array([[sx, sy, sz] for sx in (1, -1) for sy in (1, -1) for sz in (1, -1)])
+    centres = np.vstack([np.where(signs > 0, c, period - c) for c in base])
+    radii = np.repeat(base_radii, len(signs))
+    radii[9] *= 1.26
+    grown = PeriodicCell(centres, radii, np.full(3, period), neck="union")
+    box = PeriodicBox(grown.period, drop=[0.0, 0.0, 1.0])
+    particles = Particles.from_arrays(grown.centres, grown.radii, np.zeros(grown.n), materials=(UNIT,))
+    spec = ConductanceSpec(law="shared-body", neck="union")
+    K = bond_conductances(spec, particles, find_bonds(particles, contact=spec.contact, box=box), box=box)[0]
+    assert np.all(K >= 0.0) and np.count_nonzero(K) > grown.n  # a neck inside a third sphere carries nothing
+    assert 0.0 < dem_periodic(grown, "shared-body", neck="union") <= grown.phi

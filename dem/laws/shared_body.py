@@ -52,9 +52,11 @@ the reduction is exact; for the simple cubic lattice the interactions cancel in 
 the plain network, which the FE finds accurate). Necks close to one another share the body (:math:`s < 1`); two necks
 closer than opposite poles, as in a bent chain, pass heat between them more easily than two equatorial half bodies
 in series (:math:`s > 1`). Where the plain network's own flow in that field is nearly nil (other necks pointing the
-same way) the particle's trace ratio is used instead. Chains and pairs give :math:`s = 1` exactly: interactions below
-1e-12 of the half resistances (collinear bonds to round-off) count as none, so those results are today's ``fit`` law
-bit for bit.
+same way) the particle's trace ratio is used instead; where the interactions outweigh the necks' own
+resistances and leave no positive flow at all (necks far wider than the model's range, on a sphere its neighbours
+have mostly swallowed), the particle keeps its plain halves (:math:`s = 1`) under the cap below.
+Chains and pairs give :math:`s = 1` exactly: interactions below 1e-12 of the half resistances (collinear bonds to
+round-off) count as none, so those results are today's ``fit`` law bit for bit.
 
 **Never above the Wiener bound.** For the uniform field the network's energy is at most the sum over particles of
 :math:`\sum_b s_b K_b l_b^2 (n_b \cdot g)^2` (the halves of a bond in series, Cauchy-Schwarz), and the Wiener bound
@@ -268,11 +270,14 @@ def _block_factors(first, last, offsets, ends, pairs, walls, bodies, trace_cap, 
             total_num += num[b]
             total_den += den[b]
             scale = max(scale, abs(den[b]))
-        trace = total_num / total_den if total_den > 0.0 else 1.0
+        # the interactions outweighing the necks' own resistances (R not positive: necks far wider than the model's
+        # range, on a sphere its neighbours have mostly swallowed) leave no positive flow: the plain halves
+        positive = total_den > 0.0 and total_num > 0.0
+        trace = total_num / total_den if positive else 1.0
         factor = num  # reused: the factors of particle k's necks
         for b in range(z):
             # a neck whose own flow the plain network barely moves (others pointing its way) takes the trace
-            ok = den[b] > 1e-6 * scale and num[b] > 0.0
+            ok = positive and den[b] > 1e-6 * scale and num[b] > 0.0
             factor[b] = num[b] / den[b] if ok else trace
         # Wiener: sum_b s_b K_b l_b^2 n_b n_b^T at most kappa V_k (units K_b = 4 pi / half_r, V_k = 4/3 pi); its
         # trace bounds its largest eigenvalue, which is only computed when the trace exceeds the limit
