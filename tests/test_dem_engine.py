@@ -277,8 +277,8 @@ interval = 1e-6
 """
     path = tmp_path / "escape.toml"
     path.write_text(doc_text)
-    proc = subprocess.run([sys.executable, "-m", "dem", "run", str(path), "--out", str(tmp_path / "out")],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run([sys.executable, "-m", "dem", "run", str(path), "--out", str(tmp_path / "out"), "--quiet"],
+                          capture_output=True, text=True, timeout=120)  # quiet: no bar on a slow (compiling) start
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1 and "left the box through wall 'floor'" in proc.stderr
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
