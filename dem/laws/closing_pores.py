@@ -57,7 +57,7 @@ most :math:`(R_c^3 - r^3) / 3`, so with :math:`x = V_{pore} / (S r) \le x_{max} 
 :math:`\varepsilon \le 3 x / (3 x + 1)` and, since :math:`S \le 4 \pi r^2`,
 :math:`\psi \le A x^{-2/3}` with :math:`A = (4 \pi)^{1/3}`. Then :math:`c \, \varepsilon < 1` whenever
 :math:`3 \beta \, x \ln^+(A x^{-2/3} / \psi_0) < 1`, whose left side is largest at
-:math:`x^* = \min(x_{max}, (A / \psi_0)^{3/2} / e)`: ``rho > 0`` for every cell exactly when
+:math:`x^* = \min(x_{max}, (A / \psi_0)^{3/2} / e)`: :math:`\rho > 0` for every cell exactly when
 :math:`\beta < \beta_{max}(\psi_0) = 1 / (3 x^* \ln(A x^{*-2/3} / \psi_0))` (a particle in a spherical shell of
 pore comes as close to the bound as one likes), and :func:`cap_ratio` refuses a calibration beyond it
 (:func:`largest_beta`).
