@@ -78,6 +78,9 @@ import pathlib
 import numba
 import numpy as np
 
+from dem.geometry.exposure import fibonacci_directions
+from dem.laws.cut_body import ends_by_particle
+
 CALIBRATION = pathlib.Path(__file__).with_name("closing_pores.json")  # written by python -m verification closing-pores
 DIRECTIONS = 2000  # directions of the quadrature over the sphere
 GAMMA = 0.5  # the cell is followed within (1 + GAMMA) r of the centre (module docstring)
@@ -98,27 +101,6 @@ def calibration(path: str | None = None) -> dict:
         Its content: ``beta`` and ``psi0`` (dimensionless), and the calibration's record.
     """
     return json.loads(pathlib.Path(path or CALIBRATION).read_text())
-
-
-def directions(count: int = DIRECTIONS) -> np.ndarray:
-    """``count`` unit vectors spread evenly over the sphere (a Fibonacci lattice), each standing for the solid angle
-    :math:`4 \\pi / count`.
-
-    Parameters
-    ----------
-    count : int
-        How many.
-
-    Returns
-    -------
-    numpy.ndarray
-        (count, 3) unit vectors.
-    """
-    k = np.arange(count) + 0.5
-    z = 1.0 - 2.0 * k / count
-    azimuth = math.pi * (1.0 + math.sqrt(5.0)) * k
-    s = np.sqrt(1.0 - z * z)
-    return np.column_stack([s * np.cos(azimuth), s * np.sin(azimuth), z])
 
 
 def power_planes(position: np.ndarray, radius: np.ndarray, box=None, walls=()):
@@ -176,16 +158,7 @@ def power_planes(position: np.ndarray, radius: np.ndarray, box=None, walls=()):
 
 @numba.njit(cache=True, parallel=True)
 def _cell_kernel(n, radius, ball, particle, normals, planes, dirs):
-    m = len(particle)
-    counts = np.zeros(n + 1, dtype=np.int64)
-    for e in range(m):
-        counts[particle[e] + 1] += 1
-    offsets = np.cumsum(counts)
-    fill = offsets[:-1].copy()
-    order = np.empty(m, dtype=np.int64)
-    for e in range(m):
-        order[fill[particle[e]]] = e
-        fill[particle[e]] += 1
+    offsets, order = ends_by_particle(n, particle)
     weight = 4.0 * np.pi / len(dirs)
     solid = np.empty(n)
     pore = np.empty(n)
@@ -230,7 +203,7 @@ def particle_cells(radius: np.ndarray, particle: np.ndarray, normals: np.ndarray
     planes : numpy.ndarray
         The distance from the particle's centre to every plane (a radical plane, or a wall), m.
     count : int
-        Directions of the quadrature (:func:`directions`).
+        Directions of the quadrature (:func:`dem.geometry.exposure.fibonacci_directions`).
 
     Returns
     -------
@@ -240,7 +213,8 @@ def particle_cells(radius: np.ndarray, particle: np.ndarray, normals: np.ndarray
     f = np.ascontiguousarray
     radius = f(radius, dtype=float)
     return _cell_kernel(len(radius), radius, 1.0 + GAMMA, f(particle, dtype=np.int64),
-                        f(np.reshape(normals, (-1, 3)), dtype=float), f(planes, dtype=float), directions(count))
+                        f(np.reshape(normals, (-1, 3)), dtype=float), f(planes, dtype=float),
+                        fibonacci_directions(count))
 
 
 def largest_beta(psi0: float, gamma: float = GAMMA) -> float:

@@ -143,8 +143,11 @@ def _half_body(r, b, lo, hi, normals, planes, scratch, samples):
     return total
 
 
-@numba.njit(cache=True, parallel=True)
-def _cut_body_kernel(n, particle, normals, planes, radius, samples):
+@numba.njit(cache=True)
+def ends_by_particle(n, particle):
+    """The neck ends grouped by particle (a counting sort): ``(offsets, order)``, the ends of particle ``k`` being
+    ``order[offsets[k]:offsets[k + 1]]`` in their original order; ``particle`` holds the particle (int, < ``n``) of
+    every end."""
     m = len(particle)
     counts = np.zeros(n + 1, dtype=np.int64)
     for e in range(m):
@@ -155,7 +158,14 @@ def _cut_body_kernel(n, particle, normals, planes, radius, samples):
     for e in range(m):
         order[fill[particle[e]]] = e
         fill[particle[e]] += 1
-    z_max = int(np.max(counts)) if m else 0
+    return offsets, order
+
+
+@numba.njit(cache=True, parallel=True)
+def _cut_body_kernel(n, particle, normals, planes, radius, samples):
+    m = len(particle)
+    offsets, order = ends_by_particle(n, particle)
+    z_max = int(np.max(offsets[1:] - offsets[:-1])) if m else 0
     sorted_normals = normals[order]
     sorted_planes = planes[order]
     out = np.zeros(m)
