@@ -246,11 +246,16 @@ class AMGSolver(PCGSolver):
         if self.hierarchy_of is not None:
             self.hierarchy = self.hierarchy_of.hierarchy
             return self.hierarchy_of.precondition
-        from dem.network.amg_cycle import VCycle
+        from dem.network.amg_cycle import COMPILED_FROM, VCycle
         from sinterheat import amg
 
         with one_blas_thread():
-            self.hierarchy = amg.hierarchy(self.A, AMG_SEED, **AMG_OPTIONS)   # seeded, on CSR
+            if self.A.shape[0] >= COMPILED_FROM:  # the finest level compiled, on threads
+                from dem.network import amg_setup
+
+                self.hierarchy = amg_setup.hierarchy(self.A, AMG_SEED, AMG_OPTIONS)
+            else:
+                self.hierarchy = amg.hierarchy(self.A, AMG_SEED, **AMG_OPTIONS)   # seeded, on CSR
         return VCycle(self.hierarchy)
 
     def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
