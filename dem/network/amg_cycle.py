@@ -9,9 +9,10 @@ solved by the hierarchy's own coarse solver.
 
 Its kernels are pyamg's and scipy's (one thread), or from ``COMPILED_FROM`` unknowns of the finest level on, where
 the bond search has loaded numba already, the compiled ones of :mod:`dem.network.amg_kernels` on numba's threads,
-over ``BLOCKS`` fixed row blocks of every level of ``BLOCK_MIN_ROWS`` rows or more (fewer: one block, sequential
-sweeps), with hybrid Gauss-Seidel sweeps. The cycle stays a symmetric positive definite operator either way; the
-result does not depend on the number of threads.
+over ``BLOCKS`` fixed row blocks, with hybrid Gauss-Seidel sweeps, on every level of ``BLOCK_MIN_ROWS`` rows or
+more (a smaller level keeps pyamg's and scipy's kernels: waking a thread for it costs more than its work, many
+times over on a loaded machine). The cycle stays a symmetric positive definite operator either way; the result
+does not depend on the number of threads.
 """
 
 from __future__ import annotations
@@ -88,17 +89,23 @@ class VCycle:
     ml : pyamg.multilevel.MultilevelSolver
         The hierarchy, every level on CSR (one level: the cycle is its coarse solve).
     blocks : int or None
-        Row blocks of the compiled kernels (1: sequential sweeps, pyamg's cycle to round-off); None: ``BLOCKS``
-        from ``COMPILED_FROM`` unknowns of the finest level on, pyamg's and scipy's kernels below.
+        Row blocks of the compiled kernels on every level (one on a level of fewer than ``BLOCK_MIN_ROWS`` rows; 1:
+        sequential sweeps, pyamg's cycle to round-off); None: ``BLOCKS`` on the levels of ``BLOCK_MIN_ROWS`` rows or
+        more from ``COMPILED_FROM`` unknowns of the finest level on, pyamg's and scipy's kernels elsewhere.
     """
 
     def __init__(self, ml, blocks: int | None = None):
-        if blocks is None:
-            blocks = BLOCKS if ml.levels[0].A.shape[0] >= COMPILED_FROM else None
-        elif blocks < 1:
+        if blocks is not None and blocks < 1:
             raise ValueError(f"blocks = {blocks}: must be at least 1")
+        compiled = ml.levels[0].A.shape[0] >= COMPILED_FROM
+
+        def level_blocks(n):
+            if blocks is None:  # the default: a small level's sweeps are pyamg's (no thread is woken for them)
+                return BLOCKS if compiled and n >= BLOCK_MIN_ROWS else None
+            return blocks if n >= BLOCK_MIN_ROWS else 1
+
         last = len(ml.levels) - 1
-        self.levels = [Level(lv.A, lv.R, lv.P, blocks) if k < last else Level(lv.A)
+        self.levels = [Level(lv.A, lv.R, lv.P, level_blocks(lv.A.shape[0])) if k < last else Level(lv.A)
                        for k, lv in enumerate(ml.levels)]
         self.coarse_solver = ml.coarse_solver
 
