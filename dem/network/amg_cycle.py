@@ -49,7 +49,7 @@ class Level:
             self.mixed = amg_kernels.mixed_rows(A.indptr, A.indices, self.A_blocks)
             self.R_blocks = None if R is None else amg_kernels.row_blocks(R.indptr, blocks)
             self.P_blocks = None if P is None else amg_kernels.row_blocks(P.indptr, blocks)
-            self.old = np.zeros(n)
+            self.copies = (np.zeros(n), np.zeros(n))  # x as the last sweep or prolongation left it, and a spare
 
     def smooth(self, x, b):
         """One symmetric Gauss-Seidel sweep of ``A x = b`` (forward, then backward), ``x`` updated in place."""
@@ -59,8 +59,9 @@ class Level:
 
             gauss_seidel(A, x, b, iterations=1, sweep="symmetric")
             return
-        for forward in (True, False):
-            k.hybrid_sweep(A.indptr, A.indices, A.data, x, b, self.old, self.mixed, self.A_blocks, forward)
+        now, spare = self.copies  # ``now`` holds x
+        k.hybrid_sweep(A.indptr, A.indices, A.data, x, b, now, spare, self.mixed, self.A_blocks, True)
+        k.hybrid_sweep(A.indptr, A.indices, A.data, x, b, spare, now, self.mixed, self.A_blocks, False)
 
     def restrict_residual(self, x, b, coarse_b):
         """``coarse_b = R (b - A x)``."""
@@ -77,7 +78,13 @@ class Level:
         if k is None:
             x += P @ coarse_x
             return
-        k.add_matvec(P.indptr, P.indices, P.data, coarse_x, x, self.P_blocks)
+        k.add_matvec(P.indptr, P.indices, P.data, coarse_x, x, self.copies[0], self.P_blocks)
+
+    def zero(self, x):
+        """``x = 0`` (and its copy that the next sweep reads)."""
+        x[:] = 0.0
+        if self.kernels is not None:
+            self.copies[0][:] = 0.0
 
 
 class VCycle:
@@ -125,7 +132,8 @@ class VCycle:
         b = np.asarray(b, dtype=float)
         if len(self.levels) == 1:
             return self.coarse_solver(self.levels[0].A, b)
-        x = np.zeros(len(b))
+        x = np.empty(len(b))
+        self.levels[0].zero(x)
         self._cycle(0, x, b)
         return x
 
@@ -136,7 +144,7 @@ class VCycle:
         if k + 2 == len(self.levels):
             coarse.x[:] = self.coarse_solver(coarse.A, coarse.b)
         else:
-            coarse.x[:] = 0.0
+            coarse.zero(coarse.x)
             self._cycle(k + 1, coarse.x, coarse.b)
         level.prolong_add(coarse.x, x)
         level.smooth(x, b)

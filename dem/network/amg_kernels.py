@@ -39,14 +39,16 @@ def row_blocks(indptr, blocks):
 
 
 @njit(cache=True)
-def _row_products(indptr, indices, data, x, lo, hi, y, add):
-    """``y[i] (+)= (M x)[i]`` for the rows ``[lo, hi)`` (unsigned indices: no test for negative ones per entry)."""
+def _row_products(indptr, indices, data, x, lo, hi, y, add, mirror):
+    """``y[i] = (M x)[i]``, or with ``add`` ``y[i] += (M x)[i]`` and ``mirror[i] = y[i]``, for the rows ``[lo, hi)``
+    (unsigned indices: no test for negative ones per entry)."""
     for i in range(np.uint64(lo), np.uint64(hi)):
         s = 0.0
         for e in range(np.uint64(indptr[i]), np.uint64(indptr[i + 1])):
             s += data[e] * x[np.uint64(indices[e])]
         if add:
             y[i] += s
+            mirror[i] = y[i]
         else:
             y[i] = s
 
@@ -55,14 +57,14 @@ def _row_products(indptr, indices, data, x, lo, hi, y, add):
 def matvec(indptr, indices, data, x, y, bounds):
     """``y = M x`` for the CSR matrix ``M`` (``indptr``, ``indices``, ``data``) over its row blocks ``bounds``."""
     for b in prange(bounds.shape[0] - 1):
-        _row_products(indptr, indices, data, x, bounds[b], bounds[b + 1], y, False)
+        _row_products(indptr, indices, data, x, bounds[b], bounds[b + 1], y, False, y)
 
 
 @njit(cache=True, parallel=True)
-def add_matvec(indptr, indices, data, x, y, bounds):
-    """``y += M x``."""
+def add_matvec(indptr, indices, data, x, y, mirror, bounds):
+    """``y += M x``, and ``mirror = y`` (the copy a hybrid sweep reads next: :func:`hybrid_sweep`)."""
     for b in prange(bounds.shape[0] - 1):
-        _row_products(indptr, indices, data, x, bounds[b], bounds[b + 1], y, True)
+        _row_products(indptr, indices, data, x, bounds[b], bounds[b + 1], y, True, mirror)
 
 
 @njit(cache=True)
@@ -96,10 +98,10 @@ def mixed_rows(indptr, indices, bounds):
 
 
 @njit(cache=True)
-def _sweep_block(indptr, indices, data, x, old, rhs, mixed, lo, hi, forward):
+def _sweep_block(indptr, indices, data, x, read, write, rhs, mixed, lo, hi, forward):
     """The Gauss-Seidel updates (pyamg's ``gauss_seidel``) of the rows ``[lo, hi)`` in order, forward or backward:
-    the block's own unknowns from ``x``, the others' from ``old`` (only in the ``mixed`` rows: the test per entry
-    would double the sweep's time)."""
+    the block's own unknowns from ``x``, the others' from ``read`` (only in the ``mixed`` rows: the test per entry
+    would double the sweep's time); each row's new value also to ``write``."""
     lo, hi = np.uint64(lo), np.uint64(hi)
     for k in range(hi - lo):
         i = lo + k if forward else hi - np.uint64(1) - k
@@ -113,7 +115,7 @@ def _sweep_block(indptr, indices, data, x, old, rhs, mixed, lo, hi, forward):
                 elif lo <= j < hi:
                     s -= data[e] * x[j]
                 else:
-                    s -= data[e] * old[j]
+                    s -= data[e] * read[j]
         else:
             for e in range(np.uint64(indptr[i]), np.uint64(indptr[i + 1])):
                 j = np.uint64(indices[e])
@@ -123,18 +125,16 @@ def _sweep_block(indptr, indices, data, x, old, rhs, mixed, lo, hi, forward):
                     s -= data[e] * x[j]
         if diag != 0.0:
             x[i] = s / diag
+        write[i] = x[i]
 
 
 @njit(cache=True, parallel=True)
-def hybrid_sweep(indptr, indices, data, x, rhs, old, mixed, bounds, forward):
+def hybrid_sweep(indptr, indices, data, x, rhs, read, write, mixed, bounds, forward):
     """One hybrid Gauss-Seidel sweep of ``M x = rhs`` over the row blocks (module docstring), forward or backward;
-    ``old`` is a work array of ``x``'s size, ``mixed`` the rows of :func:`mixed_rows`."""
-    blocks = bounds.shape[0] - 1
-    if blocks > 1:
-        for b in prange(blocks):
-            for i in range(bounds[b], bounds[b + 1]):
-                old[i] = x[i]
-    for b in prange(blocks):
-        _sweep_block(indptr, indices, data, x, old, rhs, mixed, bounds[b], bounds[b + 1], forward)
+    ``mixed`` the rows of :func:`mixed_rows`. ``read`` holds ``x`` as it was before the sweep (the other blocks'
+    unknowns are read there); the sweep leaves the new ``x`` in ``write`` too, for the next sweep to read, so that no
+    copy (and no wait of the threads for it) comes between two sweeps."""
+    for b in prange(bounds.shape[0] - 1):
+        _sweep_block(indptr, indices, data, x, read, write, rhs, mixed, bounds[b], bounds[b + 1], forward)
 
 
