@@ -52,7 +52,15 @@ class Level:
             self.copies = (np.zeros(n), np.zeros(n))  # x as the last sweep or prolongation left it, and a spare
 
     def smooth(self, x, b):
-        """One symmetric Gauss-Seidel sweep of ``A x = b`` (forward, then backward), ``x`` updated in place."""
+        """One symmetric Gauss-Seidel sweep of ``A x = b`` (forward, then backward).
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            The level's unknowns, updated in place.
+        b : numpy.ndarray
+            The level's right-hand side.
+        """
         A, k = self.A, self.kernels
         if k is None:
             from pyamg.relaxation.relaxation import gauss_seidel
@@ -64,7 +72,15 @@ class Level:
         k.hybrid_sweep(A.indptr, A.indices, A.data, x, b, spare, now, self.mixed, self.A_blocks, False)
 
     def restrict_residual(self, x, b, coarse_b):
-        """``coarse_b = R (b - A x)``."""
+        """The restricted residual :math:`R (b - A x)`.
+
+        Parameters
+        ----------
+        x, b : numpy.ndarray
+            The level's unknowns and right-hand side.
+        coarse_b : numpy.ndarray
+            Where the result goes: the next coarser level's right-hand side.
+        """
         A, R, k = self.A, self.R, self.kernels
         if k is None:
             coarse_b[:] = R @ (b - A @ x)
@@ -73,7 +89,15 @@ class Level:
         k.matvec(R.indptr, R.indices, R.data, self.r, coarse_b, self.R_blocks)
 
     def prolong_add(self, coarse_x, x):
-        """``x += P coarse_x``."""
+        """Adds the prolonged correction :math:`P x_c` to ``x``.
+
+        Parameters
+        ----------
+        coarse_x : numpy.ndarray
+            The next coarser level's correction :math:`x_c`.
+        x : numpy.ndarray
+            The level's unknowns, updated in place.
+        """
         P, k = self.P, self.kernels
         if k is None:
             x += P @ coarse_x
@@ -81,7 +105,13 @@ class Level:
         k.add_matvec(P.indptr, P.indices, P.data, coarse_x, x, self.copies[0], self.P_blocks)
 
     def zero(self, x):
-        """``x = 0`` (and its copy that the next sweep reads)."""
+        """Sets the level's unknowns to zero (and the copy of them that the next sweep reads).
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            The level's unknowns.
+        """
         x[:] = 0.0
         if self.kernels is not None:
             self.copies[0][:] = 0.0

@@ -78,7 +78,7 @@ def _row_residuals(indptr, indices, data, x, rhs, lo, hi, r):
 
 @njit(cache=True, parallel=True)
 def residual(indptr, indices, data, x, rhs, r, bounds):
-    """``r = rhs - M x``."""
+    r"""The residual :math:`r = \mathrm{rhs} - M x`."""
     for b in prange(bounds.shape[0] - 1):
         _row_residuals(indptr, indices, data, x, rhs, bounds[b], bounds[b + 1], r)
 
