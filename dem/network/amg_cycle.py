@@ -10,8 +10,8 @@ solved by the hierarchy's own coarse solver.
 Its kernels are pyamg's and scipy's (one thread), or from ``COMPILED_FROM`` unknowns of the finest level on, where
 the bond search has loaded numba already, the compiled ones of :mod:`dem.network.amg_kernels` on numba's threads,
 over ``BLOCKS`` fixed row blocks, with hybrid Gauss-Seidel sweeps, on every level of ``BLOCK_MIN_ROWS`` rows or
-more (a smaller level keeps pyamg's and scipy's kernels: waking a thread for it costs more than its work, many
-times over on a loaded machine). The cycle stays a symmetric positive definite operator either way; the result
+more (a smaller level keeps pyamg's and scipy's kernels: on a loaded machine every parallel loop waits for its
+slowest thread, which the scheduler may have set aside for milliseconds, more than a small level's work on one). The cycle stays a symmetric positive definite operator either way; the result
 does not depend on the number of threads.
 """
 
@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 BLOCKS = 8  # row blocks of a level's matrix: its smoother's hybrid blocks and the threads' shares of every product
-BLOCK_MIN_ROWS = 20_000  # a level of fewer rows is swept in one block (sequential Gauss-Seidel)
+BLOCK_MIN_ROWS = 100_000  # a level of fewer rows is swept in one block (sequential Gauss-Seidel)
 COMPILED_FROM = 300_000  # unknowns of the finest level from which the compiled kernels run the cycle
 
 
