@@ -71,12 +71,15 @@ def test_tuned_amg_reaches_the_criterion_and_agrees_with_lu(make):
     assert solver.iterations <= 1.2 * previous.iterations
 
 
-def test_coarse_levels_are_csr_and_the_cycle_is_that_of_pyamgs_bsr_levels():
-    """Converting the coarse levels from 1 x 1 BSR to CSR changes the kernels, not the cycle: the same result to
-    round-off (the block kernel multiplies by the inverted 1 x 1 block where the scalar one divides)."""
+def test_coarse_levels_are_csr_and_the_one_block_cycle_is_that_of_pyamgs_bsr_levels():
+    """Converting the coarse levels from 1 x 1 BSR to CSR and cycling them by the compiled kernels changes the
+    kernels, not the cycle: with one row block (sequential sweeps) the same result as pyamg's own V-cycle on its BSR
+    levels to round-off (the block kernel multiplies by the inverted 1 x 1 block where the scalar one divides), with
+    pyamg's and scipy's kernels (a system below ``COMPILED_FROM``) as with the compiled ones."""
     import pyamg
     from pyamg.relaxation.smoothing import change_smoothers
 
+    from dem.network.amg_cycle import VCycle
     from dem.network.linsolve import AMG_OPTIONS, AMG_SEED, AMG_SMOOTHER
 
     A, b = packing_system()
@@ -88,8 +91,86 @@ def test_coarse_levels_are_csr_and_the_cycle_is_that_of_pyamgs_bsr_levels():
     np.random.set_state(state)
     assert plain.levels[1].A.format == "bsr"
     change_smoothers(plain, AMG_SMOOTHER, AMG_SMOOTHER)
-    ours_cycle, plain_cycle = ours.precondition(b), plain.aspreconditioner(cycle="V")(b)
-    assert np.max(np.abs(ours_cycle - plain_cycle)) <= 1e-13 * np.max(np.abs(plain_cycle))
+    plain_cycle = plain.aspreconditioner(cycle="V")(b)
+    for ours_cycle in (ours.precondition(b), VCycle(ours.hierarchy, blocks=1)(b)):  # pyamg's kernels, compiled
+        assert np.max(np.abs(ours_cycle - plain_cycle)) <= 1e-13 * np.max(np.abs(plain_cycle))
+
+
+def hybrid_cycle(monkeypatch, A, blocks=8):
+    """The AMG solver of ``A`` with its cycle's sweeps on ``blocks`` row blocks on every level but the coarsest
+    (the test systems are below ``BLOCK_MIN_ROWS``; 1: sequential sweeps)."""
+    import dem.network.amg_cycle as amg_cycle
+
+    monkeypatch.setattr(amg_cycle, "BLOCK_MIN_ROWS", 0)
+    solver = AMGSolver(A, rtol=RTOL)
+    solver.precondition = amg_cycle.VCycle(solver.hierarchy, blocks)
+    assert len(solver.precondition.levels[0].A_blocks) == blocks + 1
+    return solver
+
+
+def test_hybrid_cycle_is_symmetric_positive_and_the_same_on_any_number_of_threads(monkeypatch):
+    """The cycle on row blocks is a valid CG preconditioner (u.M v = v.M u, v.M v > 0), close to the sequential one,
+    and its result does not depend on how many threads share the blocks, to the bit; CG on it meets the criterion
+    in as many iterations as on the sequential cycle, give or take one."""
+    import numba
+
+    A, b = packing_system()
+    solver = hybrid_cycle(monkeypatch, A)
+    cycle = solver.precondition
+    sequential = hybrid_cycle(monkeypatch, A, blocks=1)
+    plain = sequential.precondition(b)
+    assert 0 < np.max(np.abs(cycle(b) - plain)) < 0.1 * np.max(np.abs(plain))
+    rng = np.random.default_rng(0)
+    u, v = rng.standard_normal((2, A.shape[0]))
+    Mu, Mv = cycle(u), cycle(v)
+    assert abs(u @ Mv - v @ Mu) <= 1e-12 * np.sqrt((u @ Mu) * (v @ Mv))
+    assert v @ Mv > 0 and u @ Mu > 0
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = cycle(v)
+    finally:
+        numba.set_num_threads(threads)
+    assert np.array_equal(one, Mv)
+    x, y = solver.solve(b), sequential.solve(b)
+    assert relative_residual(A, x, b) <= RTOL and abs(solver.iterations - sequential.iterations) <= 1
+    assert np.max(np.abs(x - y)) < 1e-8
+
+
+def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterion(monkeypatch):
+    """The finest level built compiled (dem.network.amg_setup): pyamg's aggregates and prolongator to the bit, its
+    Galerkin matrix to round-off (summed in another order); the solver on that hierarchy, with the compiled cycle,
+    reaches the criterion in as many iterations as on pyamg's own, give or take one, at sparse LU's solution."""
+    import dem.network.amg_cycle as amg_cycle
+    from dem.network import amg_setup
+    from dem.network.linsolve import AMG_OPTIONS, AMG_SEED
+    from sinterheat import amg
+
+    A, b = packing_system()
+    ours, plain = amg_setup.hierarchy(A, AMG_SEED, AMG_OPTIONS), amg.hierarchy(A, AMG_SEED, **AMG_OPTIONS)
+    P, P_plain = ours.levels[0].P.copy(), plain.levels[0].P.copy()
+    P.sort_indices()
+    P_plain.sort_indices()
+    assert P.shape == P_plain.shape and P.shape[1] < A.shape[0] / 4  # real aggregates
+    assert np.array_equal(P.indptr, P_plain.indptr) and np.array_equal(P.indices, P_plain.indices)
+    assert np.array_equal(P.data, P_plain.data)
+    assert abs(ours.levels[0].R - P.T).max() == 0
+    A_c, A_c_plain = ours.levels[1].A, plain.levels[1].A
+    assert abs(A_c - A_c_plain).max() <= 1e-13 * abs(A_c_plain).max()
+    assert len(ours.levels) == len(plain.levels)
+    with pytest.raises(ValueError, match="options"):
+        amg_setup.hierarchy(A, AMG_SEED, {**AMG_OPTIONS, "strength": "symmetric"})
+
+    reference = AMGSolver(A, rtol=RTOL)
+    monkeypatch.setattr(amg_cycle, "COMPILED_FROM", 0)
+    monkeypatch.setattr(amg_cycle, "BLOCK_MIN_ROWS", 0)
+    solver = AMGSolver(A, rtol=RTOL)
+    assert solver.precondition.levels[0].kernels is not None and len(solver.precondition.levels[0].A_blocks) > 2
+    assert solver.hierarchy.levels[0].P.nnz == P.nnz  # built by amg_setup
+    x, y = solver.solve(b), reference.solve(b)
+    assert relative_residual(A, x, b) <= RTOL and abs(solver.iterations - reference.iterations) <= 1
+    exact = spl.spsolve(sp.csc_matrix(A), b)
+    assert np.max(np.abs(x - exact)) < 1e-7 and np.max(np.abs(x - y)) < 1e-7
 
 
 def test_reused_hierarchy_gives_the_fresh_answer_to_the_tolerance():

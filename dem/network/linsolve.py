@@ -199,9 +199,11 @@ class AMGSolver(PCGSolver):
     * every connection is strong (``strength=None``): pyamg's default symmetric measure with :math:`\theta = 0` keeps
       every entry too, so the aggregates are the same, without computing and scaling a copy of every level
       (the setup takes 0.7 of the CPU time on the bench packing's 10^6 unknowns, the same iterates to the bit);
-    * the coarse levels are converted from BSR with 1 x 1 blocks to CSR once built, and their Gauss-Seidel
-      smoothers set up again: pyamg's block Gauss-Seidel on 1 x 1 blocks takes four times the time of the scalar
-      kernel on the same entries (the same iterates to round-off);
+    * the coarse levels are converted from BSR with 1 x 1 blocks to CSR once built: pyamg's block Gauss-Seidel on
+      1 x 1 blocks takes four times the time of the scalar kernel on the same entries;
+    * the V-cycle (``AMG_SMOOTHER`` before and after each coarse correction) is :class:`dem.network.amg_cycle.VCycle`:
+      without the two residual norms per cycle of pyamg's ``aspreconditioner``, and on a large system compiled, on
+      numba's threads, with hybrid Gauss-Seidel sweeps over fixed row blocks;
 
     and setup and solves run with one BLAS thread: the Arnoldi and the coarse solve call BLAS on vectors, whose
     spinning threads multiplied the setup time by four on a loaded two-core machine.
@@ -244,14 +246,17 @@ class AMGSolver(PCGSolver):
         if self.hierarchy_of is not None:
             self.hierarchy = self.hierarchy_of.hierarchy
             return self.hierarchy_of.precondition
-        from pyamg.relaxation.smoothing import change_smoothers
-
+        from dem.network.amg_cycle import COMPILED_FROM, VCycle
         from sinterheat import amg
 
         with one_blas_thread():
-            self.hierarchy = amg.hierarchy(self.A, AMG_SEED, **AMG_OPTIONS)   # seeded, on CSR
-        change_smoothers(self.hierarchy, AMG_SMOOTHER, AMG_SMOOTHER)
-        return self.hierarchy.aspreconditioner(cycle="V")
+            if self.A.shape[0] >= COMPILED_FROM:  # the finest level compiled, on threads
+                from dem.network import amg_setup
+
+                self.hierarchy = amg_setup.hierarchy(self.A, AMG_SEED, AMG_OPTIONS)
+            else:
+                self.hierarchy = amg.hierarchy(self.A, AMG_SEED, **AMG_OPTIONS)   # seeded, on CSR
+        return VCycle(self.hierarchy)
 
     def solve(self, b: np.ndarray, x0=None) -> np.ndarray:
         """CG to the criterion. A reused hierarchy (``hierarchy_of``) that needs more than ``AMG_REUSE_GROWTH``

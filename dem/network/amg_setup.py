@@ -1,0 +1,220 @@
+r"""The finest level of :class:`dem.network.linsolve.AMGSolver`'s hierarchy on a large network, built compiled on
+numba's threads; the coarser levels are pyamg's (``sinterheat.amg.hierarchy``).
+
+pyamg's smoothed aggregation (Vaněk, Mandel & Brezina 1996) builds the finest level's prolongator
+:math:`P = (I - \omega D^{-1} A) T` (``jacobi_prolongation_smoother`` with ``weighting="local"``: :math:`D_{ii} =
+\sum_j |A_{ij}|`) through a copy of :math:`|A|`, a scaled copy of :math:`A` and a sparse product on 1 x 1 blocks, and
+the Galerkin product :math:`A_c = P^T A P` through two more such products, all on one thread: most of the setup's
+time at :math:`10^6` unknowns, much of it the kernel's first touch of the copies. Here :math:`P` comes in one pass
+over the rows of :math:`A` (the tentative prolongator :math:`T` has one entry per row: :math:`T_{i, a(i)} = t_i`,
+``a`` the aggregate), and :math:`A_c` from :math:`AP` and :math:`P^T (AP)`, each a row-by-row product (Gustavson)
+over fixed blocks of rows on the threads. The aggregates and :math:`T` are pyamg's (``standard_aggregation``,
+``fit_candidates``), and so are :math:`P`'s entries, to the bit (the same sums in the same order); :math:`A_c` is the
+same to round-off (summed in another order), its column indices sorted.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from numba import njit, prange
+
+from dem.network.amg_kernels import row_blocks
+
+BLOCKS = 8  # row blocks of the products (any number gives the same result)
+
+
+@njit(cache=True, parallel=True)
+def _prolongator(indptr, indices, data, agg, t, n_coarse, omega, bounds):
+    r"""The CSR arrays of :math:`P = T - (\omega D^{-1} A) T` (module docstring), with pyamg's operations in its
+    order: :math:`D_i = \sum_j |A_{ij}|`, :math:`w_{ij} = \omega (A_{ij} / D_i)`, :math:`P_{iJ} = T_{iJ} - \sum_{j:
+    a(j) = J} w_{ij} t_j`. ``agg`` is -1 for a row that no aggregate holds (no entry in ``T``)."""
+    n = indptr.shape[0] - 1
+    count = np.zeros(n + 1, np.int64)
+    blocks = bounds.shape[0] - 1
+    for b in prange(blocks):  # the entries of each row: the distinct aggregates of its columns and its own
+        seen = np.full(n_coarse, -1, np.int64)
+        for i in range(bounds[b], bounds[b + 1]):
+            c = 0
+            if agg[i] >= 0:
+                seen[agg[i]] = i
+                c = 1
+            for e in range(indptr[i], indptr[i + 1]):
+                J = agg[np.uint64(indices[e])]
+                if J >= 0 and seen[J] != i:
+                    seen[J] = i
+                    c += 1
+            count[i + 1] = c
+    P_indptr = np.cumsum(count)
+    P_indices = np.empty(P_indptr[n], np.int32)
+    P_data = np.empty(P_indptr[n])
+    for b in prange(blocks):
+        slot = np.full(n_coarse, -1, np.int64)
+        for i in range(bounds[b], bounds[b + 1]):
+            start = P_indptr[i]
+            d = 0.0
+            for e in range(indptr[i], indptr[i + 1]):
+                d += abs(data[e]) * 1.0
+            d_inv = 1.0 / abs(d) if d != 0.0 else 0.0
+            k = start
+            for e in range(indptr[i], indptr[i + 1]):
+                j = np.uint64(indices[e])
+                J = agg[j]
+                if J < 0:
+                    continue
+                if slot[J] < start:
+                    slot[J] = k
+                    P_indices[k] = J
+                    P_data[k] = 0.0
+                    k += 1
+                P_data[slot[J]] += (omega * (data[e] * d_inv)) * t[j]
+            own = agg[i]
+            if own >= 0 and slot[own] < start:
+                slot[own] = k
+                P_indices[k] = own
+                P_data[k] = 0.0
+                k += 1
+            for q in range(start, k):
+                P_data[q] = (t[i] if P_indices[q] == own else 0.0) - P_data[q]
+    return P_indptr, P_indices, P_data
+
+
+@njit(cache=True, parallel=True)
+def _product(a_indptr, a_indices, a_data, b_indptr, b_indices, b_data, n_cols, bounds):
+    """The CSR arrays of the product of two CSR matrices (Gustavson: row by row, each row's entries summed in the
+    order of the left row's entries), over the row blocks ``bounds`` of the left one."""
+    n = a_indptr.shape[0] - 1
+    count = np.zeros(n + 1, np.int64)
+    blocks = bounds.shape[0] - 1
+    for b in prange(blocks):
+        seen = np.full(n_cols, -1, np.int64)
+        for i in range(bounds[b], bounds[b + 1]):
+            c = 0
+            for e in range(a_indptr[i], a_indptr[i + 1]):
+                j = np.uint64(a_indices[e])
+                for f in range(b_indptr[j], b_indptr[j + 1]):
+                    J = b_indices[f]
+                    if seen[J] != i:
+                        seen[J] = i
+                        c += 1
+            count[i + 1] = c
+    indptr = np.cumsum(count)
+    indices = np.empty(indptr[n], np.int32)
+    values = np.empty(indptr[n])
+    for b in prange(blocks):
+        slot = np.full(n_cols, -1, np.int64)
+        for i in range(bounds[b], bounds[b + 1]):
+            start = indptr[i]
+            k = start
+            for e in range(a_indptr[i], a_indptr[i + 1]):
+                j = np.uint64(a_indices[e])
+                v = a_data[e]
+                for f in range(b_indptr[j], b_indptr[j + 1]):
+                    J = b_indices[f]
+                    if slot[J] < start:
+                        slot[J] = k
+                        indices[k] = J
+                        values[k] = 0.0
+                        k += 1
+                    values[slot[J]] += v * b_data[f]
+    return indptr, indices, values
+
+
+def product(A, B) -> sp.csr_matrix:
+    """``A @ B`` for CSR matrices, on numba's threads (:func:`_product`).
+
+    Parameters
+    ----------
+    A, B : scipy.sparse.csr_matrix
+        The factors, (m, k) and (k, n).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix
+        The product (m, n).
+    """
+    arrays = _product(A.indptr, A.indices, A.data, B.indptr, B.indices, B.data, B.shape[1],
+                      row_blocks(A.indptr, BLOCKS))
+    return sp.csr_matrix(arrays[::-1], shape=(A.shape[0], B.shape[1]))
+
+
+def finest_level(A, omega: float):
+    """The finest level's transfer operators, the next level's matrix and its near-null-space candidates.
+
+    Parameters
+    ----------
+    A : scipy.sparse.csr_matrix
+        The symmetric positive definite matrix (n, n), every connection strong (pyamg's ``strength=None``).
+    omega : float
+        The weight of the prolongation smoother (``weighting="local"``).
+
+    Returns
+    -------
+    tuple
+        ``(P, R, A_c, B_c)``: CSR prolongator (n, n_c) and restriction :math:`R = P^T`, the Galerkin matrix
+        :math:`A_c = R A P` (n_c, n_c; sorted indices) and the coarse candidates (n_c, 1) of pyamg's
+        ``fit_candidates`` for the constant vector.
+    """
+    from pyamg import amg_core
+    from pyamg.aggregation import fit_candidates
+
+    n = A.shape[0]
+    agg = np.empty(n, dtype=A.indptr.dtype)
+    roots = np.empty(n, dtype=A.indptr.dtype)
+    n_coarse = amg_core.standard_aggregation(n, A.indptr, A.indices, agg, roots)
+    held = np.flatnonzero(agg >= 0)
+    aggregates = sp.csr_matrix((np.ones(len(held)), (held, agg[held])), shape=(n, n_coarse))
+    T, B_c = fit_candidates(aggregates, np.ones((n, 1)))
+    T = T.tocsr()
+    t = np.zeros(n)
+    t[np.repeat(np.arange(n), np.diff(T.indptr))] = T.data  # the one entry of each held row
+    P = sp.csr_matrix(_prolongator(A.indptr, A.indices, A.data, agg, t, n_coarse, omega,
+                                   row_blocks(A.indptr, BLOCKS))[::-1], shape=(n, n_coarse))
+    R = P.T.tocsr()
+    A_c = product(R, product(A, P))
+    A_c.sort_indices()
+    return P, R, A_c, B_c
+
+
+def hierarchy(A, seed: int, options: dict):
+    """The hierarchy of ``pyamg.smoothed_aggregation_solver(A, **options)``: the finest level by
+    :func:`finest_level`, the coarser ones by ``sinterheat.amg.hierarchy`` (seeded with ``seed``: the finest level
+    draws no random number, its weighting being local, so the coarser ones see the generator as pyamg's own setup
+    does), every level on CSR.
+
+    Parameters
+    ----------
+    A : scipy.sparse.csr_matrix
+        The symmetric positive definite matrix (n, n).
+    seed : int
+        Seed of numpy's global generator during the coarser levels' setup (restored after).
+    options : dict
+        pyamg's keywords (``dem.network.linsolve.AMG_OPTIONS``): ``strength=None``, ``improve_candidates=None``,
+        ``symmetry="hermitian"`` and a first ``smooth`` entry ``("jacobi", {"omega": w, "weighting": "local"})``.
+
+    Returns
+    -------
+    pyamg.multilevel.MultilevelSolver
+        The hierarchy (its levels' ``A``, ``P``, ``R``; the coarser levels' smoothers are pyamg's).
+
+    Raises
+    ------
+    ValueError
+        ``options`` ask for another finest level than :func:`finest_level` builds.
+    """
+    from pyamg.multilevel import MultilevelSolver
+
+    from sinterheat import amg
+
+    first, *rest = options["smooth"]
+    fixed = {"strength": None, "improve_candidates": None, "symmetry": "hermitian"}
+    if (any(options.get(key) != value for key, value in fixed.items()) or first[0] != "jacobi"
+            or first[1].get("weighting") != "local"):
+        raise ValueError(f"options = {options!r}: the compiled finest level needs {fixed} and a first smooth "
+                         f"entry ('jacobi', {{'omega': w, 'weighting': 'local'}})")
+    P, R, A_c, B_c = finest_level(A, first[1]["omega"])
+    ml = amg.hierarchy(A_c, seed, **{**options, "smooth": rest, "B": B_c})
+    level = MultilevelSolver.Level()
+    level.A, level.P, level.R, level.B = A, P, R, np.ones((A.shape[0], 1))
+    ml.levels.insert(0, level)
+    return ml
