@@ -124,11 +124,13 @@ def _connect(stack: contextlib.ExitStack, scheduler: str, workers: int | None):
 
     if scheduler == LOCAL:
         # SIGINT blocked in its event-loop thread and so in every worker process it spawns; its HTTP server on a
-        # free port (another cluster may hold the default 8787)
+        # free port (another cluster may hold the default 8787); its workers' own log lines silenced (a worker whose
+        # heartbeat finds the scheduler closed while the cluster shuts down logs an error with a traceback on the
+        # shared stderr): a job's error reaches this process as its exception
         with shielded():
             cluster = stack.enter_context(LocalCluster(
                 n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                dashboard_address=":0", scheduler_kwargs={"dashboard": False}, silence_logs=logging.ERROR))
+                dashboard_address=":0", scheduler_kwargs={"dashboard": False}, silence_logs=logging.CRITICAL))
         return stack.enter_context(Client(cluster))
     try:
         return stack.enter_context(Client(scheduler, timeout=CONNECT_TIMEOUT))
