@@ -61,7 +61,7 @@ intersphinx_mapping = {"scipy": ("https://docs.scipy.org/doc/scipy/", str(DOCS /
 nitpicky = True
 nitpick_ignore_regex = [
     (r"py:.*", r"(np|numpy|sp|scipy|skfem|meshio|pyvista|gmsh|argparse|pathlib|concurrent|typing|collections|io|"
-               r"distributed)\b.*"),
+               r"distributed|pyamg)\b.*"),
     (r"py:.*", r"(optional|callable|array|array_like|array-like|ndarray|sequence|iterable|mapping|path|object)"),
 ]
 

@@ -371,7 +371,7 @@ def run_jobs(jobs, workers: int | None = None, *, start: str = "fork", desc: str
     until the sweep ends), whose processes take jobs beside this process, which runs jobs too: of the ``workers``
     processes, this one and those of ``alongside`` are counted, and only the rest are started (none, for two workers
     and one process alongside), so fewer processes are forked, each of which costs more CPU than a short job
-    (:func:`_shared`). Not on Dask, and not for one worker (then the jobs run in this process alone).
+    (``_shared``). Not on Dask, and not for one worker (then the jobs run in this process alone).
 
     A tqdm bar on stderr counts ``done`` jobs finished earlier plus these, and so does the run's
     :func:`sinterheat.interrupt.where` (its step: ``"<desc>: k of n <unit>s done"``). On an interrupt, an error, or

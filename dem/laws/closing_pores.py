@@ -81,9 +81,9 @@ import numpy as np
 from dem.geometry.exposure import fibonacci_directions
 from dem.laws.cut_body import ends_by_particle
 
-CALIBRATION = pathlib.Path(__file__).with_name("closing_pores.json")  # written by python -m verification closing-pores
-DIRECTIONS = 2000  # directions of the quadrature over the sphere
-GAMMA = 0.5  # the cell is followed within (1 + GAMMA) r of the centre (module docstring)
+CALIBRATION = pathlib.Path(__file__).with_name("closing_pores.json")  #: written by python -m verification closing-pores
+DIRECTIONS = 2000  #: directions of the quadrature over the sphere
+GAMMA = 0.5  #: the cell is followed within (1 + GAMMA) r of the centre (module docstring)
 
 
 @functools.lru_cache(maxsize=1)

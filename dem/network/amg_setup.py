@@ -121,7 +121,7 @@ def _product(a_indptr, a_indices, a_data, b_indptr, b_indices, b_data, n_cols, b
 
 
 def product(A, B) -> sp.csr_matrix:
-    """``A @ B`` for CSR matrices, on numba's threads (:func:`_product`).
+    """``A @ B`` for CSR matrices, on numba's threads (``_product``).
 
     Parameters
     ----------
