@@ -79,7 +79,7 @@ import numba
 import numpy as np
 
 from dem.geometry.exposure import fibonacci_directions
-from dem.laws.cut_body import ends_by_particle
+from fem_neck.geometry.cut_kernels import ends_by_particle
 
 CALIBRATION = pathlib.Path(__file__).with_name("closing_pores.json")  #: written by python -m verification closing-pores
 DIRECTIONS = 2000  #: directions of the quadrature over the sphere

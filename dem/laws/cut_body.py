@@ -38,7 +38,7 @@ from collections import namedtuple
 import numba
 import numpy as np
 
-from fem_neck.geometry.cut_kernels import _clip, _face
+from fem_neck.geometry.cut_kernels import _clip, _face, ends_by_particle
 
 SAMPLES = 32  # intervals of the grid along each half body
 EMPTY = 1e-12  # a cross-section below this x pi r^2 is none: the axis has left the cut body
@@ -141,24 +141,6 @@ def _half_body(r, b, lo, hi, normals, planes, scratch, samples):
         weight = 0.5 * step if s == 0 or s == samples else step
         total += weight * ((1.0 + 0.5 * slope_c * slope_c) / area[s] - (1.0 + 0.5 * slope_b * slope_b) / ball[s])
     return total
-
-
-@numba.njit(cache=True)
-def ends_by_particle(n, particle):
-    """The neck ends grouped by particle (a counting sort): ``(offsets, order)``, the ends of particle ``k`` being
-    ``order[offsets[k]:offsets[k + 1]]`` in their original order; ``particle`` holds the particle (int, < ``n``) of
-    every end."""
-    m = len(particle)
-    counts = np.zeros(n + 1, dtype=np.int64)
-    for e in range(m):
-        counts[particle[e] + 1] += 1
-    offsets = np.cumsum(counts)
-    fill = offsets[:-1].copy()
-    order = np.empty(m, dtype=np.int64)
-    for e in range(m):
-        order[fill[particle[e]]] = e
-        fill[particle[e]] += 1
-    return offsets, order
 
 
 @numba.njit(cache=True, parallel=True)

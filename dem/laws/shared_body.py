@@ -91,6 +91,7 @@ import numba
 import numpy as np
 
 from dem.geometry.bonds import Bonds
+from fem_neck.geometry.cut_kernels import ends_by_particle
 
 ROUNDOFF = 1e-12  # interactions below this x the smallest half resistance are round-off of collinear bonds
 
@@ -181,18 +182,8 @@ def _factors(n_particles, pairs, walls, bodies, trace_cap):
     m, mw = len(i), len(wall_particle)
     total = 2 * m + mw
     out = np.ones(total)
-    counts = np.zeros(n_particles + 1, dtype=np.int64)
-    for e in range(total):
-        k = i[e] if e < m else (j[e - m] if e < 2 * m else wall_particle[e - 2 * m])
-        counts[k + 1] += 1
-    offsets = np.cumsum(counts)
-    fill = offsets[:-1].copy()
-    ends = np.empty(total, dtype=np.int64)
-    for e in range(total):
-        k = i[e] if e < m else (j[e - m] if e < 2 * m else wall_particle[e - 2 * m])
-        ends[fill[k]] = e
-        fill[k] += 1
-    z_max = int(np.max(counts)) if total else 0
+    offsets, ends = ends_by_particle(n_particles, np.concatenate((i, j, wall_particle)))
+    z_max = int(np.max(offsets[1:] - offsets[:-1])) if total else 0
     chunk = 4096
     for block in numba.prange((n_particles + chunk - 1) // chunk):
         _block_factors(block * chunk, min((block + 1) * chunk, n_particles), offsets, ends, pairs, walls, bodies,

@@ -11,21 +11,21 @@ from numba import njit
 
 
 @njit(cache=True)
-def _group_ends(n, i, j):
-    """The bond ends grouped by particle (a counting sort): end ``e < m`` is bond ``e`` on ``i``, ``e >= m`` bond
-    ``e - m`` on ``j``; particle ``k``'s ends are ``ends[offsets[k]:offsets[k + 1]]``."""
-    m = len(i)
+def ends_by_particle(n, particle):
+    """Bond ends grouped by particle (a counting sort): ``(offsets, order)``, the ends of particle ``k`` being
+    ``order[offsets[k]:offsets[k + 1]]`` in their original order; ``particle`` holds the particle (int, < ``n``) of
+    every end."""
+    m = len(particle)
     counts = np.zeros(n + 1, dtype=np.int64)
-    for e in range(2 * m):
-        counts[(i[e] if e < m else j[e - m]) + 1] += 1
+    for e in range(m):
+        counts[particle[e] + 1] += 1
     offsets = np.cumsum(counts)
     fill = offsets[:-1].copy()
-    ends = np.empty(2 * m, dtype=np.int64)
-    for e in range(2 * m):
-        k = i[e] if e < m else j[e - m]
-        ends[fill[k]] = e
-        fill[k] += 1
-    return offsets, ends
+    order = np.empty(m, dtype=np.int64)
+    for e in range(m):
+        order[fill[particle[e]]] = e
+        fill[particle[e]] += 1
+    return offsets, order
 
 
 @njit(cache=True)
@@ -118,7 +118,7 @@ def cut_spheres_kernel(n, radius, i, j, vectors, d):
     """Volumes, free areas, meeting flags (per particle) and face areas (per bond end) of the cut spheres
     (:func:`fem_neck.geometry.union.cut_spheres`, which checks the input)."""
     m = len(i)
-    offsets, ends = _group_ends(n, i, j)
+    offsets, ends = ends_by_particle(n, np.concatenate((i, j)))  # end e < m: bond e on i, else e - m on j
     volume = np.empty(n)
     free = np.empty(n)
     meeting = np.zeros(n, dtype=np.uint8)
