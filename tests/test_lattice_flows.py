@@ -21,10 +21,13 @@ def _cut_volumes(cell):
     return cut_spheres(cell.radii, i, j, cell.centres[j] + s * cell.period - cell.centres[i]).volume
 
 
-def test_random_packing_conserves_heat_per_particle_and_its_necks_carry_the_cells_flux():
-    from verification.packings import union_packing
+def test_mirror_packing_conserves_heat_per_particle_and_its_necks_carry_the_cells_flux():
+    from verification.packings import _images
 
-    cell = union_packing(2, 0.9, seed=2)  # 16 spheres, radii +-15 %, necks meeting
+    # 16 spheres of radii 1.15 and 0.95, the 8 mirror images of two, phi 0.855: necks meeting, lenses hidden
+    period = np.array([3.5, 3.5, 3.6])
+    cell = lattice.PeriodicCell(_images(np.array([[0.5, 1.2, 1.15], [1.25, 0.5, 0.6]]), period),
+                                np.tile([1.15, 0.95], 8), period, "two mirrored spheres", neck="union")
     res, f, dz = _solve(cell, 1e-2)
     k = res.k_eff_over_kappa
     scale = np.abs(f.flow).max()
