@@ -41,6 +41,11 @@ def register(subparsers) -> None:
     p.add_argument("--rtol", type=float, default=1e-4,
                    help="relative gap of the bounds to reach (default 1e-4: 10-60 s of CPU and 1-3 GB for the cubic "
                    "lattices; 1e-3 a few seconds)")
+    p.add_argument("--flows", action="store_true",
+                   help="with --neck union: also every neck's heat flow through its face (the flat disc between two "
+                   "spheres, periodic images included) and the face's mean temperature, and every particle's mean "
+                   "temperature, per unit conductivity and mean gradient along -z (flows in m^2, temperatures in m; "
+                   "in full in --json and in --out's lattice.json)")
     p.add_argument("--max-memory", type=float, metavar="GB",
                    help="memory the solve may use (default: what the machine has available)")
     add_output_options(p)
@@ -70,6 +75,8 @@ def run(args) -> dict:
     if args.max_memory is not None and not (0.1 <= args.max_memory < 1e6):
         raise ValueError(f"max_memory = {args.max_memory!r}: valid range 0.1 <= max_memory < 1e6 (GB)")
     union = args.neck == "union"
+    if args.flows and not union:
+        raise ValueError("flows: per-neck flows are read on the union of spheres: add --neck union")
     if args.a_over_r is not None:
         x = args.a_over_r
         if union:
@@ -93,7 +100,8 @@ def run(args) -> dict:
     with tqdm(desc=f"lattice {args.kind}", unit="mesh", leave=False, delay=2.0) as bar:
         res = lattice.effective_conductivity(cell, rtol=args.rtol,
                                              max_memory=None if args.max_memory is None else args.max_memory * 1e9,
-                                             progress=lambda text: (bar.set_postfix_str(text, refresh=False), bar.update(1)))
+                                             progress=lambda text: (bar.set_postfix_str(text, refresh=False), bar.update(1)),
+                                             flows=args.flows)
     out = {"kind": args.kind, **({"neck": "union"} if union else {}), "h_over_r": h,
            "a_over_r": lattice.union_neck_ratio(h) if union else neck_radius(1.0, 1.0, h),
            "coordination": lattice.COORDINATION[args.kind], "k_eff_over_kappa": res.k_eff_over_kappa,
@@ -104,6 +112,8 @@ def run(args) -> dict:
         out.update({"k_network_fit_over_kappa": network, "network_rel_error": network / res.k_eff_over_kappa - 1.0})
     out.update({"order": res.order, "dofs": res.dofs, "elements": res.elements, "meshes": len(res.levels),
            "volume_error": res.volume_error, "memory_estimate_gb": res.memory_estimate / 1e9, "seconds": res.seconds})
+    if args.flows:
+        out["flows"] = res.flows.as_dict()
     if args.out:
         path = pathlib.Path(args.out)
         path.mkdir(parents=True, exist_ok=True)

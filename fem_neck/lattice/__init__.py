@@ -53,7 +53,8 @@ The package, one concern a module: :mod:`~fem_neck.lattice.cells` (periodic cell
 bonds), :mod:`~fem_neck.lattice.mesh` (the computational cell's curved mesh), :mod:`~fem_neck.lattice.bounds` (the two
 bounds on one mesh), :mod:`~fem_neck.lattice.sizes` (the first and refined mesh sizes),
 :mod:`~fem_neck.lattice.budget` (the tetrahedra and memory of a solve, predicted before meshing),
-:mod:`~fem_neck.lattice.driver` (the adaptive run), :mod:`~fem_neck.lattice.network` (the pipe network's lattice sum)
+:mod:`~fem_neck.lattice.driver` (the adaptive run), :mod:`~fem_neck.lattice.flows` (a union cell's per-neck
+flows and temperatures), :mod:`~fem_neck.lattice.network` (the pipe network's lattice sum)
 and :mod:`~fem_neck.lattice.output` (the mesh for ParaView); the public names used elsewhere are importable from here.
 """
 
@@ -65,6 +66,7 @@ from fem_neck.lattice.cells import (BASIS, COORDINATION, EDGE_OVER_SPACING, KIND
                                     max_h_over_r, max_neck_ratio, mean_neck_ratio, mirror_symmetry, union_max_h_over_r,
                                     union_neck_ratio)
 from fem_neck.lattice.driver import CellResult, effective_conductivity  # noqa: F401
+from fem_neck.lattice.flows import NeckFlows, neck_flows  # noqa: F401
 from fem_neck.lattice.mesh import CellMesh, UnionNecks, build_cell_mesh, local_cluster  # noqa: F401
 from fem_neck.lattice.network import network_conductivity  # noqa: F401
 from fem_neck.lattice.output import write_vtu  # noqa: F401

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import contextlib
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+import numpy as np
 
 from fem_neck.lattice.mesh import CellMesh
 from sinterheat.threads import one_blas_thread
@@ -31,6 +33,9 @@ class Bounds:
         The mapped mesh's volume over the exact one, minus 1 (dimensionless).
     seconds : float
         Wall time of both solves, s.
+    temperature : numpy.ndarray, optional
+        The upper bound's skeleton temperatures (:class:`fem_neck.primal.Solution` ``u``), for
+        :func:`fem_neck.lattice.flows.neck_flows`.
     """
 
     upper: float
@@ -41,6 +46,7 @@ class Bounds:
     elements: int
     volume_error: float
     seconds: float
+    temperature: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     @property
     def gap(self) -> float:
@@ -158,4 +164,5 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2, etol: float | N
             mesh.keep_jacobians(None)
     scale = cm.height / cm.area
     return Bounds(float(up.energy * scale), float(low.lower * scale), float(low.flux_defect), int(up.dofs),
-                  int(low.dofs), len(mesh.tets), float(volume / cm.volume_exact - 1.0), time.perf_counter() - t0)
+                  int(low.dofs), len(mesh.tets), float(volume / cm.volume_exact - 1.0), time.perf_counter() - t0,
+                  up.u)

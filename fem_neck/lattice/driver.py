@@ -13,6 +13,7 @@ from fem_neck.lattice.bounds import solve_bounds
 from fem_neck.lattice.budget import (available_memory, check_fits, memory_estimate, neck_circles, predicted_tetrahedra,
                                      size_that_fits)
 from fem_neck.lattice.cells import PeriodicCell, check_cell, mean_neck_ratio
+from fem_neck.lattice.flows import NeckFlows, neck_flows
 from fem_neck.lattice.mesh import CellMesh, build_cell_mesh
 from fem_neck.lattice.sizes import (FIRST_MESH, P3_FROM, REFINE_MARGIN, default_order, first_neck_size, first_rtol,
                                     mesh_rule, mesh_sizes)
@@ -58,6 +59,9 @@ class CellResult:
         Estimated peak memory of the last solve, bytes (:func:`~fem_neck.lattice.budget.memory_estimate`).
     mesh : CellMesh, optional
         The last mesh.
+    flows : NeckFlows, optional
+        Per-neck heat flows and mean temperatures of the union cell's upper-bound solution on the last mesh, when
+        asked for (:func:`fem_neck.lattice.flows.neck_flows`).
     """
 
     k_eff_over_kappa: float
@@ -75,6 +79,7 @@ class CellResult:
     flux_defect: float
     memory_estimate: float
     mesh: CellMesh | None = field(default=None, repr=False)
+    flows: NeckFlows | None = field(default=None, repr=False)
 
 
 def _refined_rtol(gap: float, size: float, new: float, neck: str = "newton") -> float:
@@ -85,7 +90,7 @@ def _refined_rtol(gap: float, size: float, new: float, neck: str = "newton") -> 
 
 def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | None = None,
                            max_memory: float | None = None, max_meshes: int = 4, workers: int = 2,
-                           progress=None) -> CellResult:
+                           progress=None, flows: bool = False) -> CellResult:
     r""":math:`k_{eff} / \kappa` along z of the periodic ``cell`` with two-sided bounds (:mod:`fem_neck.lattice`).
 
     The first mesh has the neck size :func:`~fem_neck.lattice.sizes.first_neck_size` (from ``rtol`` and the cell's mean
@@ -114,8 +119,13 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
         2: the two bounds in parallel processes; 1: one after the other.
     progress : callable, optional
         ``progress(text)`` reports each mesh.
+    flows : bool
+        Also read the per-neck flows and temperatures of the last mesh's solution (a union cell only;
+        :func:`fem_neck.lattice.flows.neck_flows`): ``CellResult.flows``.
     """
     check_positive("rtol", rtol)
+    if flows and cell.neck != "union":
+        raise ValueError(f"flows: per-neck flows are read on the union of spheres (neck = 'union'), not {cell.neck!r}")
     check_cell(cell)
     explicit = order is not None
     order = order or default_order(rtol)
@@ -170,4 +180,5 @@ def effective_conductivity(cell: PeriodicCell, rtol: float = 1e-4, order: int | 
                       error_estimate=b.gap, converged=bool(b.gap <= rtol), phi=cell.phi, order=order, dofs=b.dofs_upper,
                       elements=b.elements, levels=history, seconds=time.perf_counter() - t0,
                       volume_error=b.volume_error, flux_defect=b.flux_defect,
-                      memory_estimate=memory_estimate(b.elements, order), mesh=cm)
+                      memory_estimate=memory_estimate(b.elements, order), mesh=cm,
+                      flows=neck_flows(cell, cm, b.temperature, order) if flows else None)
