@@ -49,6 +49,20 @@ def test_no_other_plane_across_the_half_body_adds_nothing():
     assert dR.tolist() == [0.0, 0.0, 0.0, 0.0]
 
 
+def test_the_cut_body_never_resists_less_than_the_ball():
+    """Removing material never lowers a body's resistance (Rayleigh's monotonicity). A BCC particle at h/r = 0.27: its
+    six second neighbours' planes lie near the surface, where the ball's profile steepens without bound and the cut's,
+    clipped by the eight first neighbours' planes, does not: the slender expansion's slope term alone would make
+    those half bodies resist less than the ball's (-0.015 / kappa r). They get no correction, the first neighbours'
+    ends a positive one."""
+    h = 0.27
+    first = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) / math.sqrt(3)
+    second = np.vstack([np.eye(3), -np.eye(3)])
+    planes = np.r_[np.full(8, (2 - h) / 2), np.full(6, (2 - h) / math.sqrt(3))]
+    dR = cut_body_resistance(np.ones(1), np.zeros(14, dtype=int), np.vstack([first, second]), planes)
+    assert np.all(dR[:8] > 0) and dR[8:].tolist() == [0.0] * 6
+
+
 def test_a_neck_inside_a_third_sphere_is_no_neck_and_carries_nothing():
     """Spheres 0 and 1 overlap, but their lens lies inside the big sphere 2 between them: the union has no face
     between 0 and 1, and its bond gets K = 0 while the others carry the heat."""

@@ -21,7 +21,10 @@ half resistance of the law:
     \Delta R_b = \frac{1}{\kappa} \int_0^{l_b} \left[\frac{1 + \rho_c'^2 / 2}{A_c}
     - \frac{1 + \rho_{ball}'^2 / 2}{A_{ball}}\right] dz,
 
-with :math:`K_b^{union}` the half conductance of the union law. Where no other plane crosses the half body the two
+with :math:`K_b^{union}` the half conductance of the union law, and :math:`\Delta R_b` at least zero: removing material
+never lowers a body's resistance (Rayleigh's monotonicity), while the expansion's slope term, which grows without
+bound where the ball's profile meets its surface, can outweigh the narrower section for a plane near the surface (a
+BCC lattice's second neighbours just after they touch). Where no other plane crosses the half body the two
 profiles are equal and :math:`\Delta R_b = 0`: a pair, a chain, or necks small and far apart keep the union law exactly.
 Where another plane cuts the axis between the centre and the neck (:math:`A_c = 0` there: the neck's lens lies inside a
 third sphere) the neck is no contact of the union at all and :math:`\Delta R_b` is infinite (its bond carries nothing).
@@ -140,7 +143,7 @@ def _half_body(r, b, lo, hi, normals, planes, scratch, samples):
         slope_b = (math.sqrt(ball[q] / math.pi) - math.sqrt(ball[p] / math.pi)) / span
         weight = 0.5 * step if s == 0 or s == samples else step
         total += weight * ((1.0 + 0.5 * slope_c * slope_c) / area[s] - (1.0 + 0.5 * slope_b * slope_b) / ball[s])
-    return total
+    return max(total, 0.0)
 
 
 @numba.njit(cache=True, parallel=True)
