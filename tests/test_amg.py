@@ -139,8 +139,9 @@ def test_hybrid_cycle_is_symmetric_positive_and_the_same_on_any_number_of_thread
 
 def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterion(monkeypatch):
     """The finest level built compiled (dem.network.amg_setup): pyamg's aggregates and prolongator to the bit, its
-    Galerkin matrix to round-off (summed in another order); the solver on that hierarchy, with the compiled cycle,
-    reaches the criterion in as many iterations as on pyamg's own, give or take one, at sparse LU's solution."""
+    Galerkin matrix to round-off (summed in another order) and scipy's product of the same factors to the bit; the
+    solver on that hierarchy, with the compiled cycle, reaches the criterion in as many iterations as on pyamg's own,
+    give or take one, at sparse LU's solution."""
     import dem.network.amg_cycle as amg_cycle
     from dem.network import amg_setup
     from dem.network.linsolve import AMG_OPTIONS, AMG_SEED
@@ -157,6 +158,12 @@ def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterio
     assert abs(ours.levels[0].R - P.T).max() == 0
     A_c, A_c_plain = ours.levels[1].A, plain.levels[1].A
     assert abs(A_c - A_c_plain).max() <= 1e-13 * abs(A_c_plain).max()
+    # the one-pass Galerkin product sums as scipy's row-by-row product does: the same matrix to the bit
+    scipy_A_c = (P.T.tocsr() @ (A @ P)).tocsr()
+    scipy_A_c.sort_indices()
+    for ours_array, scipy_array in ((A_c.indptr, scipy_A_c.indptr), (A_c.indices, scipy_A_c.indices),
+                                    (A_c.data, scipy_A_c.data)):
+        assert np.array_equal(ours_array, scipy_array)
     assert len(ours.levels) == len(plain.levels)
     with pytest.raises(ValueError, match="options"):
         amg_setup.hierarchy(A, AMG_SEED, {**AMG_OPTIONS, "strength": "symmetric"})
