@@ -160,8 +160,9 @@ def galerkin(A, P, R) -> sp.csr_matrix:
     AP = _product(A.indptr, A.indices, A.data, P.indptr[:-1], P.indptr[1:], P.indices, P.data, P.shape[1],
                   row_blocks(A.indptr, BLOCKS))
     bounds = row_blocks(R.indptr, BLOCKS)
-    arrays = _compact(*_product(R.indptr, R.indices, R.data, *AP, P.shape[1], bounds), bounds)
-    return sp.csr_matrix(arrays[::-1], shape=(R.shape[0], P.shape[1]))
+    rows = _product(R.indptr, R.indices, R.data, *AP, P.shape[1], bounds)
+    del AP  # freed before the compaction's arrays are
+    return sp.csr_matrix(_compact(*rows, bounds)[::-1], shape=(R.shape[0], P.shape[1]))
 
 
 def finest_level(A, omega: float):
