@@ -137,10 +137,65 @@ def test_hybrid_cycle_is_symmetric_positive_and_the_same_on_any_number_of_thread
     assert np.max(np.abs(x - y)) < 1e-8
 
 
+def plain_hybrid_sweep(A, x, b, bounds, forward):
+    """A hybrid Gauss-Seidel sweep as its definition reads, every entry of every row in turn (Python)."""
+    read = x.copy()
+    for lo, hi in zip(bounds[:-1], bounds[1:]):
+        for i in (range(lo, hi) if forward else range(hi - 1, lo - 1, -1)):
+            s, diag = b[i], 0.0
+            for e in range(A.indptr[i], A.indptr[i + 1]):
+                j, a = A.indices[e], A.data[e]
+                if j == i:
+                    diag = a
+                else:
+                    s -= a * (x[j] if lo <= j < hi else read[j])
+            x[i] = s / diag
+
+
+def test_sweeps_that_reuse_the_forward_sums_are_the_plain_hybrid_sweeps(monkeypatch):
+    """The backward sweep, which takes each row's own-block sum before the diagonal from the forward sweep before
+    it, and the forward sweep from zero, which reads only the entries before the diagonal, give the plain hybrid
+    sweeps (every entry read) to round-off, on four row blocks with rows reaching into other blocks; a matrix whose
+    column indices are not sorted in their rows is swept as the sorted one, to the bit; a row without its diagonal
+    entry is refused."""
+    import dem.network.amg_cycle as amg_cycle
+
+    monkeypatch.setattr(amg_cycle, "BLOCK_MIN_ROWS", 0)
+    A, b = lattice_system(shape=(8, 8, 8))
+    level = amg_cycle.Level(A, blocks=4)
+    assert level.mixed.any() and not level.mixed.all()
+    x0 = np.random.default_rng(1).standard_normal(A.shape[0])
+    for from_zero in (False, True):
+        expected = np.zeros_like(x0) if from_zero else x0.copy()
+        plain_hybrid_sweep(A, expected, b, level.A_blocks, forward=True)
+        plain_hybrid_sweep(A, expected, b, level.A_blocks, forward=False)
+        x = x0.copy()
+        level.copies[0][:] = x0  # the copy of x the sweep reads (as the cycle keeps it)
+        level.smooth(x, b, from_zero=from_zero)
+        assert np.max(np.abs(x - expected)) <= 1e-13 * np.max(np.abs(expected))
+        unsorted = A.copy()
+        for i in range(A.shape[0]):  # each row's entries in reverse order
+            row = slice(A.indptr[i], A.indptr[i + 1])
+            unsorted.indices[row], unsorted.data[row] = A.indices[row][::-1], A.data[row][::-1]
+        unsorted.has_sorted_indices = False
+        other = amg_cycle.Level(unsorted, blocks=4)
+        y = x0.copy()
+        other.copies[0][:] = x0
+        other.smooth(y, b, from_zero=from_zero)
+        assert np.array_equal(x, y)
+    holed = A.tolil()
+    holed[5, 5] = 0.0
+    holed = holed.tocsr()
+    holed.eliminate_zeros()
+    with pytest.raises(ValueError, match="1 rows without a diagonal entry"):
+        amg_cycle.Level(holed, blocks=4)
+
+
 def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterion(monkeypatch):
     """The finest level built compiled (dem.network.amg_setup): pyamg's aggregates and prolongator to the bit, its
-    Galerkin matrix to round-off (summed in another order); the solver on that hierarchy, with the compiled cycle,
-    reaches the criterion in as many iterations as on pyamg's own, give or take one, at sparse LU's solution."""
+    Galerkin matrix to round-off (summed in another order) and scipy's product of the same factors to the bit; the
+    solver on that hierarchy, with the compiled cycle, reaches the criterion in as many iterations as on pyamg's own,
+    give or take one, at sparse LU's solution."""
     import dem.network.amg_cycle as amg_cycle
     from dem.network import amg_setup
     from dem.network.linsolve import AMG_OPTIONS, AMG_SEED
@@ -157,6 +212,12 @@ def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterio
     assert abs(ours.levels[0].R - P.T).max() == 0
     A_c, A_c_plain = ours.levels[1].A, plain.levels[1].A
     assert abs(A_c - A_c_plain).max() <= 1e-13 * abs(A_c_plain).max()
+    # the one-pass Galerkin product sums as scipy's row-by-row product does: the same matrix to the bit
+    scipy_A_c = (P.T.tocsr() @ (A @ P)).tocsr()
+    scipy_A_c.sort_indices()
+    for ours_array, scipy_array in ((A_c.indptr, scipy_A_c.indptr), (A_c.indices, scipy_A_c.indices),
+                                    (A_c.data, scipy_A_c.data)):
+        assert np.array_equal(ours_array, scipy_array)
     assert len(ours.levels) == len(plain.levels)
     with pytest.raises(ValueError, match="options"):
         amg_setup.hierarchy(A, AMG_SEED, {**AMG_OPTIONS, "strength": "symmetric"})

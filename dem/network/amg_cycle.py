@@ -45,13 +45,19 @@ class Level:
             from dem.network import amg_kernels
 
             self.kernels = amg_kernels
+            A = self.A = A if A.has_sorted_indices else A.sorted_indices()
+            self.diag_at = amg_kernels.diagonal_places(A.indptr, A.indices)
+            if np.any(self.diag_at < 0):
+                raise ValueError(f"A: {int(np.sum(self.diag_at < 0))} rows without a diagonal entry; must be "
+                                 "symmetric positive definite")
+            self.lower = np.zeros(n)  # the forward sweeps' sums for the backward ones (amg_kernels.hybrid_sweep)
             self.A_blocks = amg_kernels.row_blocks(A.indptr, blocks if n >= BLOCK_MIN_ROWS else 1)
             self.mixed = amg_kernels.mixed_rows(A.indptr, A.indices, self.A_blocks)
             self.R_blocks = None if R is None else amg_kernels.row_blocks(R.indptr, blocks)
             self.P_blocks = None if P is None else amg_kernels.row_blocks(P.indptr, blocks)
             self.copies = (np.zeros(n), np.zeros(n))  # x as the last sweep or prolongation left it, and a spare
 
-    def smooth(self, x, b):
+    def smooth(self, x, b, from_zero: bool = False):
         """One symmetric Gauss-Seidel sweep of ``A x = b`` (forward, then backward).
 
         Parameters
@@ -60,16 +66,23 @@ class Level:
             The level's unknowns, updated in place.
         b : numpy.ndarray
             The level's right-hand side.
+        from_zero : bool
+            Sweep from ``x = 0`` (whatever ``x`` holds: it is not read).
         """
         A, k = self.A, self.kernels
         if k is None:
             from pyamg.relaxation.relaxation import gauss_seidel
 
+            if from_zero:
+                x[:] = 0.0
             gauss_seidel(A, x, b, iterations=1, sweep="symmetric")
             return
-        now, spare = self.copies  # ``now`` holds x
-        k.hybrid_sweep(A.indptr, A.indices, A.data, x, b, now, spare, self.mixed, self.A_blocks, True)
-        k.hybrid_sweep(A.indptr, A.indices, A.data, x, b, spare, now, self.mixed, self.A_blocks, False)
+        now, spare = self.copies  # ``now`` holds x (unless from zero)
+        first = k.FROM_ZERO if from_zero else k.FORWARD
+        k.hybrid_sweep(A.indptr, A.indices, A.data, self.diag_at, x, b, now, spare, self.lower, self.mixed,
+                       self.A_blocks, first)
+        k.hybrid_sweep(A.indptr, A.indices, A.data, self.diag_at, x, b, spare, now, self.lower, self.mixed,
+                       self.A_blocks, k.BACKWARD)
 
     def restrict_residual(self, x, b, coarse_b):
         """The restricted residual :math:`R (b - A x)`.
@@ -103,18 +116,6 @@ class Level:
             x += P @ coarse_x
             return
         k.add_matvec(P.indptr, P.indices, P.data, coarse_x, x, self.copies[0], self.P_blocks)
-
-    def zero(self, x):
-        """Sets the level's unknowns to zero (and the copy of them that the next sweep reads).
-
-        Parameters
-        ----------
-        x : numpy.ndarray
-            The level's unknowns.
-        """
-        x[:] = 0.0
-        if self.kernels is not None:
-            self.copies[0][:] = 0.0
 
 
 class VCycle:
@@ -163,18 +164,17 @@ class VCycle:
         if len(self.levels) == 1:
             return self.coarse_solver(self.levels[0].A, b)
         x = np.empty(len(b))
-        self.levels[0].zero(x)
         self._cycle(0, x, b)
         return x
 
     def _cycle(self, k, x, b):
+        """The cycle from level ``k`` on, from ``x = 0`` (whatever ``x`` holds)."""
         level, coarse = self.levels[k], self.levels[k + 1]
-        level.smooth(x, b)
+        level.smooth(x, b, from_zero=True)
         level.restrict_residual(x, b, coarse.b)
         if k + 2 == len(self.levels):
             coarse.x[:] = self.coarse_solver(coarse.A, coarse.b)
         else:
-            coarse.zero(coarse.x)
             self._cycle(k + 1, coarse.x, coarse.b)
         level.prolong_add(coarse.x, x)
         level.smooth(x, b)

@@ -11,13 +11,18 @@ rows in order with the newest values of its own unknowns and the values of the o
 of the sweep, so the blocks sweep at the same time. With :math:`A` symmetric the backward hybrid sweep is the adjoint
 of the forward one (the blocks' lower and upper triangles are each other's transposes), so a forward sweep followed
 by a backward one is self-adjoint, as the sequential symmetric sweep is. With one block it is pyamg's sequential
-sweep (``pyamg.relaxation.relaxation.gauss_seidel``), to the bit.
+sweep (``pyamg.relaxation.relaxation.gauss_seidel``) to round-off: each row's sum is taken in two parts, its own
+block's entries before the diagonal and the rest, so that a backward sweep after a forward one reads only the entries
+after the diagonal (:func:`hybrid_sweep`), and a forward sweep from zero only those before it: a symmetric sweep from
+zero reads the matrix once instead of twice, one from any start one and a half times.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
+
+FORWARD, BACKWARD, FROM_ZERO = 0, 1, 2  # the kinds of sweep of :func:`hybrid_sweep`
 
 
 @njit(cache=True)
@@ -97,44 +102,87 @@ def mixed_rows(indptr, indices, bounds):
     return mixed
 
 
+@njit(cache=True, parallel=True)
+def diagonal_places(indptr, indices):
+    """The place of each row's diagonal entry in the CSR arrays (column indices sorted in each row); -1 where a row
+    has none."""
+    n = indptr.shape[0] - 1
+    at = np.full(n, -1, np.int64)
+    for i in prange(n):
+        for e in range(indptr[i], indptr[i + 1]):
+            if indices[e] == i:
+                at[i] = e
+                break
+    return at
+
+
 @njit(cache=True)
-def _sweep_block(indptr, indices, data, x, read, write, rhs, mixed, lo, hi, forward):
-    """The Gauss-Seidel updates (pyamg's ``gauss_seidel``) of the rows ``[lo, hi)`` in order, forward or backward:
-    the block's own unknowns from ``x``, the others' from ``read`` (only in the ``mixed`` rows: the test per entry
-    would double the sweep's time); each row's new value also to ``write``."""
+def _sweep_block(indptr, indices, data, diag_at, x, read, write, rhs, lower, mixed, lo, hi, kind):
+    """The Gauss-Seidel updates of the rows ``[lo, hi)`` of one block (:func:`hybrid_sweep`, whose docstring says
+    what ``kind`` does): the block's own unknowns from ``x``, the others' from ``read`` (only in the ``mixed``
+    rows: the test per entry would double the sweep's time); each row's new value also to ``write``."""
     lo, hi = np.uint64(lo), np.uint64(hi)
+    one = np.uint64(1)
     for k in range(hi - lo):
-        i = lo + k if forward else hi - np.uint64(1) - k
-        s = rhs[i]
-        diag = 0.0
-        if mixed[i]:
-            for e in range(np.uint64(indptr[i]), np.uint64(indptr[i + 1])):
-                j = np.uint64(indices[e])
-                if j == i:
-                    diag = data[e]
-                elif lo <= j < hi:
-                    s -= data[e] * x[j]
-                else:
-                    s -= data[e] * read[j]
-        else:
-            for e in range(np.uint64(indptr[i]), np.uint64(indptr[i + 1])):
-                j = np.uint64(indices[e])
-                if j == i:
-                    diag = data[e]
-                else:
-                    s -= data[e] * x[j]
-        if diag != 0.0:
-            x[i] = s / diag
+        i = hi - one - k if kind == BACKWARD else lo + k
+        begin, end, d = np.uint64(indptr[i]), np.uint64(indptr[i + 1]), np.uint64(diag_at[i])
+        own = 0.0  # the row's own-block entries before the diagonal (their newest values)
+        rest = 0.0  # the others
+        if kind == FROM_ZERO:  # every unknown but those of the block's rows above is zero
+            if mixed[i]:
+                for e in range(begin, d):
+                    j = np.uint64(indices[e])
+                    if j >= lo:
+                        own += data[e] * x[j]
+            else:
+                for e in range(begin, d):
+                    own += data[e] * x[np.uint64(indices[e])]
+            lower[i] = own
+        elif kind == FORWARD:
+            if mixed[i]:
+                for e in range(begin, end):
+                    j = np.uint64(indices[e])
+                    if e < d and j >= lo:
+                        own += data[e] * x[j]
+                    elif e > d and j < hi:
+                        rest += data[e] * x[j]
+                    elif e != d:
+                        rest += data[e] * read[j]
+            else:
+                for e in range(begin, d):
+                    own += data[e] * x[np.uint64(indices[e])]
+                for e in range(d + one, end):
+                    rest += data[e] * x[np.uint64(indices[e])]
+            lower[i] = own
+        else:  # backward: the own entries before the diagonal are those the forward sweep summed in ``lower``
+            own = lower[i]
+            if mixed[i]:
+                for e in range(begin, end):
+                    j = np.uint64(indices[e])
+                    if e > d and j < hi:
+                        rest += data[e] * x[j]
+                    elif j < lo or j >= hi:
+                        rest += data[e] * read[j]
+            else:
+                for e in range(d + one, end):
+                    rest += data[e] * x[np.uint64(indices[e])]
+        x[i] = (rhs[i] - own - rest) / data[d]
         write[i] = x[i]
 
 
 @njit(cache=True, parallel=True)
-def hybrid_sweep(indptr, indices, data, x, rhs, read, write, mixed, bounds, forward):
-    """One hybrid Gauss-Seidel sweep of ``M x = rhs`` over the row blocks (module docstring), forward or backward;
-    ``mixed`` the rows of :func:`mixed_rows`. ``read`` holds ``x`` as it was before the sweep (the other blocks'
-    unknowns are read there); the sweep leaves the new ``x`` in ``write`` too, for the next sweep to read, so that no
-    copy (and no wait of the threads for it) comes between two sweeps."""
+def hybrid_sweep(indptr, indices, data, diag_at, x, rhs, read, write, lower, mixed, bounds, kind):
+    """One hybrid Gauss-Seidel sweep of ``M x = rhs`` over the row blocks (module docstring); ``mixed`` the rows of
+    :func:`mixed_rows`, ``diag_at`` the places of :func:`diagonal_places` (every row has its diagonal, the column
+    indices sorted). ``read`` holds ``x`` as it was before the sweep (the other blocks' unknowns are read there);
+    the sweep leaves the new ``x`` in ``write`` too, for the next sweep to read, so that no copy (and no wait of the
+    threads for it) comes between two sweeps.
+
+    ``kind``: ``FORWARD``; ``FROM_ZERO``, a forward sweep from ``x = 0`` (``read`` is not read: it reads only the
+    entries before the diagonal); ``BACKWARD``, right after a forward sweep, whose sums over each row's own-block
+    entries before the diagonal it takes from ``lower`` (where the forward sweeps leave them) instead of summing
+    them again: those unknowns have not changed since (Conrad & Wallach 1977), so it reads the entries after the
+    diagonal only, but in the mixed rows."""
     for b in prange(bounds.shape[0] - 1):
-        _sweep_block(indptr, indices, data, x, read, write, rhs, mixed, bounds[b], bounds[b + 1], forward)
-
-
+        _sweep_block(indptr, indices, data, diag_at, x, read, write, rhs, lower, mixed, bounds[b], bounds[b + 1],
+                     kind)

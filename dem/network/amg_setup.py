@@ -8,9 +8,11 @@ the Galerkin product :math:`A_c = P^T A P` through two more such products, all o
 time at :math:`10^6` unknowns, much of it the kernel's first touch of the copies. Here :math:`P` comes in one pass
 over the rows of :math:`A` (the tentative prolongator :math:`T` has one entry per row: :math:`T_{i, a(i)} = t_i`,
 ``a`` the aggregate), and :math:`A_c` from :math:`AP` and :math:`P^T (AP)`, each a row-by-row product (Gustavson)
-over fixed blocks of rows on the threads. The aggregates and :math:`T` are pyamg's (``standard_aggregation``,
-``fit_candidates``), and so are :math:`P`'s entries, to the bit (the same sums in the same order); :math:`A_c` is the
-same to round-off (summed in another order), its column indices sorted.
+over fixed blocks of rows on the threads, in one pass with no count of the entries first (into arrays as long as a
+bound, of which only the part written is touched), :math:`AP` never copied into CSR. The aggregates and :math:`T`
+are pyamg's (``standard_aggregation``, ``fit_candidates``), and so are :math:`P`'s entries, to the bit (the same sums
+in the same order); :math:`A_c` is scipy's :math:`P^T (AP)` to the bit and pyamg's to round-off (summed in another
+order), its column indices sorted.
 """
 
 from __future__ import annotations
@@ -80,62 +82,87 @@ def _prolongator(indptr, indices, data, agg, t, n_coarse, omega, bounds):
 
 
 @njit(cache=True, parallel=True)
-def _product(a_indptr, a_indices, a_data, b_indptr, b_indices, b_data, n_cols, bounds):
-    """The CSR arrays of the product of two CSR matrices (Gustavson: row by row, each row's entries summed in the
-    order of the left row's entries), over the row blocks ``bounds`` of the left one."""
+def _product(a_indptr, a_indices, a_data, b_start, b_stop, b_indices, b_data, n_cols, bounds):
+    """The product of two sparse matrices in one pass (Gustavson: row by row, each row's entries summed in the
+    order of the left row's entries), over the row blocks ``bounds`` of the left one, a CSR matrix. The right one's
+    row ``j`` is ``b_indices[b_start[j]:b_stop[j]]`` (and ``b_data``): CSR, or the rows this function returns.
+
+    No pass counts the entries first: each block writes its rows one after the other into its own part of arrays as
+    long as the rows' bound (the sum of the lengths of the right rows a left row reads), of which only what is
+    written is ever touched. Returns ``(start, stop, indices, values)``, row ``i`` at ``start[i]:stop[i]``."""
     n = a_indptr.shape[0] - 1
-    count = np.zeros(n + 1, np.int64)
     blocks = bounds.shape[0] - 1
+    room = np.zeros(blocks + 1, np.int64)  # where each block's part begins
     for b in prange(blocks):
-        seen = np.full(n_cols, -1, np.int64)
+        c = 0
+        for e in range(a_indptr[bounds[b]], a_indptr[bounds[b + 1]]):
+            j = np.uint64(a_indices[e])
+            c += b_stop[j] - b_start[j]
+        room[b + 1] = c
+    room = np.cumsum(room)
+    indices = np.empty(room[blocks], np.int32)
+    values = np.empty(room[blocks])
+    start = np.empty(n, np.int64)
+    stop = np.empty(n, np.int64)
+    one = np.uint64(1)
+    for b in prange(blocks):  # indices and places unsigned (module docstring of dem.network.amg_kernels)
+        slot = np.zeros(n_cols, np.uint64)  # 1 + the place of each column's entry (none in this row if <= first)
+        k = np.uint64(room[b])
         for i in range(bounds[b], bounds[b + 1]):
-            c = 0
-            for e in range(a_indptr[i], a_indptr[i + 1]):
-                j = np.uint64(a_indices[e])
-                for f in range(b_indptr[j], b_indptr[j + 1]):
-                    J = b_indices[f]
-                    if seen[J] != i:
-                        seen[J] = i
-                        c += 1
-            count[i + 1] = c
-    indptr = np.cumsum(count)
-    indices = np.empty(indptr[n], np.int32)
-    values = np.empty(indptr[n])
-    for b in prange(blocks):
-        slot = np.full(n_cols, -1, np.int64)
-        for i in range(bounds[b], bounds[b + 1]):
-            start = indptr[i]
-            k = start
-            for e in range(a_indptr[i], a_indptr[i + 1]):
+            first = k
+            for e in range(np.uint64(a_indptr[i]), np.uint64(a_indptr[i + 1])):
                 j = np.uint64(a_indices[e])
                 v = a_data[e]
-                for f in range(b_indptr[j], b_indptr[j + 1]):
-                    J = b_indices[f]
-                    if slot[J] < start:
+                for f in range(np.uint64(b_start[j]), np.uint64(b_stop[j])):
+                    J = np.uint64(b_indices[f])
+                    if slot[J] <= first:
+                        k += one
                         slot[J] = k
-                        indices[k] = J
-                        values[k] = 0.0
-                        k += 1
-                    values[slot[J]] += v * b_data[f]
-    return indptr, indices, values
+                        indices[k - one] = b_indices[f]
+                        values[k - one] = 0.0
+                    values[slot[J] - one] += v * b_data[f]
+            start[i], stop[i] = first, k
+    return start, stop, indices, values
 
 
-def product(A, B) -> sp.csr_matrix:
-    """``A @ B`` for CSR matrices, on numba's threads (``_product``).
+@njit(cache=True, parallel=True)
+def _compact(start, stop, indices, values, bounds):
+    """The CSR arrays of the rows ``start[i]:stop[i]`` of :func:`_product`, copied over the row blocks ``bounds``."""
+    n = start.shape[0]
+    indptr = np.zeros(n + 1, np.int64)
+    indptr[1:] = np.cumsum(stop - start)
+    out_indices = np.empty(indptr[n], np.int32)
+    out_values = np.empty(indptr[n])
+    for b in prange(bounds.shape[0] - 1):
+        for i in range(bounds[b], bounds[b + 1]):
+            k = indptr[i]
+            for e in range(start[i], stop[i]):
+                out_indices[k] = indices[e]
+                out_values[k] = values[e]
+                k += 1
+    return indptr, out_indices, out_values
+
+
+def galerkin(A, P, R) -> sp.csr_matrix:
+    """:math:`R (A P)` for CSR matrices, on numba's threads: the rows of :math:`A P` as :func:`_product` leaves
+    them, never copied into CSR.
 
     Parameters
     ----------
-    A, B : scipy.sparse.csr_matrix
-        The factors, (m, k) and (k, n).
+    A, P, R : scipy.sparse.csr_matrix
+        The fine matrix (n, n), the prolongator (n, n_c) and the restriction (n_c, n).
 
     Returns
     -------
     scipy.sparse.csr_matrix
-        The product (m, n).
+        The coarse matrix (n_c, n_c), its column indices in the order the sums met them.
     """
-    arrays = _product(A.indptr, A.indices, A.data, B.indptr, B.indices, B.data, B.shape[1],
-                      row_blocks(A.indptr, BLOCKS))
-    return sp.csr_matrix(arrays[::-1], shape=(A.shape[0], B.shape[1]))
+    AP = _product(A.indptr, A.indices, A.data, P.indptr[:-1], P.indptr[1:], P.indices, P.data, P.shape[1],
+                  row_blocks(A.indptr, BLOCKS))
+    bounds = row_blocks(R.indptr, BLOCKS)
+    rows = _product(R.indptr, R.indices, R.data, *AP, P.shape[1], bounds)
+    del AP  # freed before the compaction's arrays are
+    return sp.csr_matrix(_compact(*rows, bounds)[::-1], shape=(R.shape[0], P.shape[1]))
 
 
 def finest_level(A, omega: float):
@@ -171,7 +198,7 @@ def finest_level(A, omega: float):
     P = sp.csr_matrix(_prolongator(A.indptr, A.indices, A.data, agg, t, n_coarse, omega,
                                    row_blocks(A.indptr, BLOCKS))[::-1], shape=(n, n_coarse))
     R = P.T.tocsr()
-    A_c = product(R, product(A, P))
+    A_c = galerkin(A, P, R)
     A_c.sort_indices()
     return P, R, A_c, B_c
 
