@@ -84,7 +84,7 @@ class TwoLevel:
 @njit(cache=True)
 def _block_inverses(blocks):
     """The inverses of the symmetric positive definite ``blocks (B, n, n)`` by their Cholesky factors
-    (:math:`A^{-1} = L^{-T} L^{-1}`; a third of the flops of LAPACK's solve with the identity that
+    (:math:`A^{-1} = L^{-T} L^{-1}`; about a third of the flops of LAPACK's solve with the identity that
     ``numpy.linalg.inv`` does, without its per-matrix calls), and False if a pivot is not positive."""
     B, n = blocks.shape[0], blocks.shape[1]
     out = np.empty_like(blocks)
