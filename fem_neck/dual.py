@@ -56,11 +56,14 @@ def mass_matrices(mesh: CurvedMesh, rt: RaviartThomas, degree: int, elements: np
     elements : numpy.ndarray
         Indices of the elements (rows of ``mesh.tets``).
     """
-    J = mesh.affine_jacobians(elements)
-    G = np.einsum("eai,eaj->eij", J, J) / np.abs(np.linalg.det(J))[:, None, None]
     a, b = np.triu_indices(rt.m)
-    A = G.reshape(len(G), 9) @ rt.mass[:, :, a, b].reshape(9, -1)
-    curved = np.flatnonzero(mesh.is_curved[elements])
+    A = np.empty((len(elements), len(a)))
+    is_curved = mesh.is_curved[elements]
+    straight, curved = np.flatnonzero(~is_curved), np.flatnonzero(is_curved)
+    if len(straight):
+        J = mesh.affine_jacobians(elements[straight])
+        G = np.einsum("eai,eaj->eij", J, J) / np.abs(np.linalg.det(J))[:, None, None]
+        A[straight] = G.reshape(len(G), 9) @ rt.mass[:, :, a, b].reshape(9, -1)
     if len(curved):
         xi, w = tet_quadrature(degree)
         products = symmetric_products(rt.values(xi))                          # (6 Q, m (m + 1) / 2)
