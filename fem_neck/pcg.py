@@ -72,11 +72,50 @@ class TwoLevel:
             count, n = len(block_matrices), block_matrices.shape[1]
             if count * n != A.shape[0]:
                 raise ValueError(f"block_matrices: {count} blocks of {n} unknowns for {A.shape[0]} unknowns")
-            self.local = sp.bsr_matrix((np.linalg.inv(block_matrices), np.arange(count), np.arange(count + 1)),
-                                       shape=A.shape)
+            inverse, ok = _block_inverses(np.ascontiguousarray(block_matrices, dtype=float))
+            if not ok:
+                raise ValueError("block_matrices: a block has a pivot that is not positive (not positive definite)")
+            self.local = sp.bsr_matrix((inverse, np.arange(count), np.arange(count + 1)), shape=A.shape)
 
     def __call__(self, r: np.ndarray) -> np.ndarray:
         return self.P @ self.amg(self.PT @ r) + self.local @ r
+
+
+@njit(cache=True)
+def _block_inverses(blocks):
+    """The inverses of the symmetric positive definite ``blocks (B, n, n)`` by their Cholesky factors
+    (:math:`A^{-1} = L^{-T} L^{-1}`; about a third of the flops of LAPACK's solve with the identity that
+    ``numpy.linalg.inv`` does, without its per-matrix calls), and False if a pivot is not positive."""
+    B, n = blocks.shape[0], blocks.shape[1]
+    out = np.empty_like(blocks)
+    L = np.empty((n, n))
+    for b in range(B):
+        for j in range(n):                                       # Cholesky, L lower
+            d = blocks[b, j, j]
+            for k in range(j):
+                d -= L[j, k] * L[j, k]
+            if not d > 0.0:
+                return out, False
+            L[j, j] = np.sqrt(d)
+            for i in range(j + 1, n):
+                s = blocks[b, i, j]
+                for k in range(j):
+                    s -= L[i, k] * L[j, k]
+                L[i, j] = s / L[j, j]
+        for j in range(n):                                       # L^-1 in place, column by column
+            L[j, j] = 1.0 / L[j, j]
+            for i in range(j + 1, n):
+                s = 0.0
+                for k in range(j, i):
+                    s -= L[i, k] * L[k, j]
+                L[i, j] = s / L[i, i]
+        for i in range(n):                                       # L^-T L^-1, symmetric
+            for j in range(i + 1):
+                s = 0.0
+                for k in range(i, n):
+                    s += L[k, i] * L[k, j]
+                out[b, i, j] = out[b, j, i] = s
+    return out, True
 
 
 @njit(cache=True)

@@ -54,11 +54,14 @@ def stiffness_matrices(mesh: CurvedMesh, basis: Lagrange, degree: int | None = N
         Indices of the elements (rows of ``mesh.tets``); default all.
     """
     elements = np.arange(len(mesh.tets)) if elements is None else elements
-    J = mesh.affine_jacobians(elements)
-    inv = np.linalg.inv(J)
-    G = np.abs(np.linalg.det(J))[:, None, None] * np.einsum("eia,eja->eij", inv, inv)   # |det J| J^-1 J^-T
-    K = (G.reshape(len(G), 9) @ basis.stiffness.reshape(9, -1)).reshape(len(G), basis.n, basis.n)
-    curved = np.flatnonzero(mesh.is_curved[elements])
+    K = np.empty((len(elements), basis.n, basis.n))
+    is_curved = mesh.is_curved[elements]
+    straight, curved = np.flatnonzero(~is_curved), np.flatnonzero(is_curved)
+    if len(straight):
+        J = mesh.affine_jacobians(elements[straight])
+        inv = np.linalg.inv(J)
+        G = np.abs(np.linalg.det(J))[:, None, None] * np.einsum("eia,eja->eij", inv, inv)   # |det J| J^-1 J^-T
+        K[straight] = (G.reshape(len(G), 9) @ basis.stiffness.reshape(9, -1)).reshape(len(G), basis.n, basis.n)
     if len(curved):
         xi, w = tet_quadrature(degree or quadrature_degree(basis.p))
         products = symmetric_products(basis.gradients(xi))                     # (6 Q, n (n + 1) / 2)

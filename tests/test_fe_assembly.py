@@ -293,3 +293,18 @@ def test_coarse_matrix_of_the_hats_is_the_galerkin_product(cell_mesh):
     coarse = primal.coarse_matrix(mesh, parts)
     product = (P.T @ A @ P).tocsr()
     assert abs(coarse - product).max() <= 1e-12 * abs(product).max()
+
+
+def test_block_jacobi_on_given_blocks_inverts_them():
+    # the lower bound's face blocks (10 x 10 at k = 3): random symmetric positive definite ones against numpy's
+    # inverses; a block with a negative eigenvalue is refused
+    rng = np.random.default_rng(3)
+    M = rng.random((40, 10, 10))
+    blocks = M @ np.transpose(M, (0, 2, 1)) + 0.1 * np.eye(10)
+    A = sp.block_diag(list(blocks), format="csr")
+    local = pcg.two_level(A, sp.identity(400, format="csr"), None, blocks).local.toarray()
+    expected = sp.block_diag(list(np.linalg.inv(blocks))).toarray()
+    np.testing.assert_allclose(local, expected, rtol=0, atol=1e-12 * abs(expected).max())
+    blocks[7, 4, 4] = -1.0
+    with pytest.raises(ValueError, match="block_matrices: a block has a pivot that is not positive"):
+        pcg.two_level(A, sp.identity(400, format="csr"), None, blocks)

@@ -103,7 +103,8 @@ from multiprocessing import get_context
 from fem_neck.lattice import bounds
 context = get_context(sys.argv[1])
 queue = context.Queue()  # the lower bound's process, as fem_neck.lattice.bounds.solve_bounds starts it
-with ProcessPoolExecutor(1, mp_context=context, initializer=bounds._receive_temperatures, initargs=(queue,)) as one:
+with ProcessPoolExecutor(1, mp_context=context, initializer=bounds._receive_temperatures,
+                         initargs=(queue, None)) as one:
     pid = one.submit(os.getpid).result()
     waiting = one.submit(time.sleep, 120)
     print(pid, flush=True)

@@ -89,24 +89,28 @@ def small_pages():
 
 
 _TEMPERATURES = None  # in the lower bound's process: the queue on which the upper bound's temperature arrives
+_JOB = None  # in the lower bound's process: the arguments of its solve, inherited through the fork (not pickled)
 # the upper bound's temperature goes to the lower bound's process once its CG's energy has settled to START_SHARE etol,
 # not at the end: the flux's CG starts as well from it (its distance from the flux's solution is the discretisation's;
 # on BCC h/r = 0.02 at rtol 1e-4, 21 steps from iterates settled to 1e-5, 1e-4 and 1e-3 as from 1e-7)
 START_SHARE = 100.0
 
 
-def _receive_temperatures(queue) -> None:
-    """Initializer of the lower bound's process: the queue of the upper bound's temperature; the process ends with
-    its parent (:func:`sinterheat.pool.end_with_parent`: killed outright, the parent would leave it waiting on the
-    queue for ever, holding the mesh)."""
+def _receive_temperatures(queue, job: tuple) -> None:
+    """Initializer of the lower bound's process: the queue of the upper bound's temperature and the arguments
+    ``(mesh, order, hot, cold, etol)`` of its solve, which a forked process's initializer gets without pickling (a
+    submitted job's arguments are pickled and piped: 40 MB of mesh and kept Jacobians on BCC h/r = 0.02); the
+    process ends with its parent (:func:`sinterheat.pool.end_with_parent`: killed outright, the parent would leave it
+    waiting on the queue for ever, holding the mesh)."""
     from sinterheat.pool import end_with_parent
 
-    global _TEMPERATURES
-    _TEMPERATURES = queue
+    global _TEMPERATURES, _JOB
+    _TEMPERATURES, _JOB = queue, job
     end_with_parent()
 
 
-def _dual_receiving(mesh, order: int, hot, cold, etol: float):
+def _dual_receiving():
+    mesh, order, hot, cold, etol = _JOB
     return _dual(mesh, order, hot, cold, etol, _TEMPERATURES.get)
 
 
@@ -149,11 +153,11 @@ def solve_bounds(cm: CellMesh, order: int = 4, workers: int = 2, etol: float | N
                 queue = context.Queue()     # put does not wait for the reader (which may have failed before reading)
                 queue.cancel_join_thread()  # nor does the exit, if it never read
                 pool = ProcessPoolExecutor(1, mp_context=context, initializer=_receive_temperatures,
-                                           initargs=(queue,))
+                                           initargs=(queue, (mesh, order, cm.hot, cm.cold, etol)))
             else:
                 pool = contextlib.nullcontext()
             with pool:
-                future = pool.submit(_dual_receiving, mesh, order, cm.hot, cm.cold, etol) if workers >= 2 else None
+                future = pool.submit(_dual_receiving) if workers >= 2 else None
                 with one_blas_thread():
                     early = None if future is None else (START_SHARE * etol, queue.put)
                     up = primal.solve(mesh, order, cm.hot, cm.cold, etol, early=early)
