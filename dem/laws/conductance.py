@@ -283,9 +283,7 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     if spec.law == "shared-body":
         from dem.laws.shared_body import neck_factors
 
-        if bonds.n_walls and not len(walls):
-            raise ValueError("conductance.law = \"shared-body\": the wall bonds' walls are needed (their normals)")
-        normals = np.array([w.normal for w in walls])[bonds.wall_index] if bonds.n_walls else np.zeros((0, 3))
+        normals = wall_normals(bonds, walls)
         vectors = bonds.vectors(particles.position, box)
         if spec.neck == "union":
             k_i, k_j, k_w = _shared_union_body(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
@@ -305,6 +303,31 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
         share = k_j / (k_i + k_j)  # R_i / (R_i + R_j); an infinite half (a centre on the contact plane) makes none
     share = np.where(np.isfinite(share), share, np.where(np.isinf(k_i), 0.0, 1.0))
     return k_pair, k_wall, share
+
+
+def wall_normals(bonds: Bonds, walls) -> np.ndarray:
+    """The unit normal (into the packing) of every wall bond's wall, ``(B, 3)``.
+
+    Parameters
+    ----------
+    bonds : dem.geometry.bonds.Bonds
+        The bonds (their ``wall_index``).
+    walls : sequence of dem.geometry.walls.Wall
+        The walls the wall bonds index.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(B, 3)`` unit normals.
+
+    Raises
+    ------
+    ValueError
+        There are wall bonds but no walls.
+    """
+    if bonds.n_walls and not len(walls):
+        raise ValueError("conductance.law = \"shared-body\": the wall bonds' walls are needed (their normals)")
+    return np.array([w.normal for w in walls])[bonds.wall_index] if bonds.n_walls else np.zeros((0, 3))
 
 
 def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_i, k_j, k_w,
@@ -341,11 +364,38 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
     tuple of numpy.ndarray
         The three arrays of half conductances, W/K.
     """
+    from dem.laws.shared_body import neck_factors
+
+    k_i, k_j, k_w, pairs, walls, volume = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
+                                                       closing_pores, box, walls)
+    live = bonds.subset(pairs, walls)
+    s_i, s_j, s_w = neck_factors(particles.n, particles.radius, live, vectors[pairs], k_i[pairs], k_j[pairs],
+                                 k_w[walls], kappa, np.reshape(normals, (-1, 3))[walls], volume, trace_cap=True)
+    k_i, k_j, k_w = np.where(pairs, k_i, 0.0), np.where(pairs, k_j, 0.0), k_w.copy()
+    k_i[pairs] *= s_i
+    k_j[pairs] *= s_j
+    k_w[walls] *= s_w
+    return k_i, k_j, k_w
+
+
+def union_halves(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_i, k_j, k_w,
+                 closing_pores: dict | None = None, box=None, walls=()):
+    """The union law's half conductances narrowed to each particle's cut sphere (:mod:`dem.laws.cut_body`), which
+    bonds are live (a neck inside a third sphere has a half 0 and is none) and each particle's capped volume (its cut
+    sphere's, lowered where the pores around it close, :mod:`dem.laws.closing_pores`): what the ``shared-body``
+    particle is made of under the union of spheres, with one node per particle (:func:`_shared_union_body`) or a
+    node per neck (:mod:`dem.network.necks`). The parameters are those of :func:`_shared_union_body`.
+
+    Returns
+    -------
+    tuple
+        ``(k_i, k_j, k_w, pairs, walls, volume)``: the narrowed halves of all bonds (W/K), the masks of the live pair
+        and wall bonds, and per particle the volume its tensor's trace is capped by (m^3).
+    """
     from fem_neck.geometry.union import cut_spheres
 
     from dem.laws.closing_pores import calibration, cap_ratio, particle_cells, power_planes
     from dem.laws.cut_body import cut_body_resistance
-    from dem.laws.shared_body import neck_factors
 
     r = particles.radius
     unit = vectors / bonds.d[:, None]  # the bonds' lengths, found with them
@@ -359,16 +409,9 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
     with np.errstate(divide="ignore"):  # no extra resistance (0): an infinite conductance in series
         k_i, k_j, k_w = (series(k, 1.0 / dR) for k, dR in ((k_i, ends[:m]), (k_j, ends[m:2 * m]),
                                                          (k_w, ends[2 * m:])))
-    pairs, walls = (k_i > 0.0) & (k_j > 0.0), k_w > 0.0
-    live = bonds.subset(pairs, walls)
-    volume = cut_spheres(r, live.i, live.j, vectors[pairs]).volume * caps
-    s_i, s_j, s_w = neck_factors(particles.n, r, live, vectors[pairs], k_i[pairs], k_j[pairs], k_w[walls], kappa,
-                                 np.reshape(normals, (-1, 3))[walls], volume, trace_cap=True)
-    k_i, k_j, k_w = np.where(pairs, k_i, 0.0), np.where(pairs, k_j, 0.0), k_w.copy()
-    k_i[pairs] *= s_i
-    k_j[pairs] *= s_j
-    k_w[walls] *= s_w
-    return k_i, k_j, k_w
+    pairs, live_walls = (k_i > 0.0) & (k_j > 0.0), k_w > 0.0
+    volume = cut_spheres(r, bonds.i[pairs], bonds.j[pairs], vectors[pairs]).volume * caps
+    return k_i, k_j, k_w, pairs, live_walls, volume
 
 
 def _check_finite(spec: ConductanceSpec, K: np.ndarray, a: np.ndarray, name) -> None:
