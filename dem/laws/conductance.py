@@ -54,6 +54,7 @@ DESCRIPTIONS = {
     "zohdi": "kappa pi a^2 / |x_i - x_j| with the lens contact circle (Zohdi 2014, eqs. 11-12, 33)",
 }
 NECK_MODELS = ("newton", "first", "coble", "union")
+NODES = ("particles", "necks")  # the network's nodes: one per particle, or also one per neck (dem.network.necks)
 
 
 def law_keys(law: str) -> tuple:
@@ -102,6 +103,10 @@ class ConductanceSpec:
         ``dem.geometry.bonds.OUT_OF_RANGE``: ``"error"``, ``"clip"`` or ``"drop"``.
     unequal : bool
         Whether the fit laws multiply a pair of unequal radii by :func:`fem_neck.law.unequal_factor`.
+    nodes : str
+        The network's nodes, one of ``NODES``: ``"particles"`` (one per particle, each bond a conductance) or
+        ``"necks"`` (a node per neck as well, each particle an element, :mod:`dem.network.necks`; ``shared-body``
+        under ``neck = "union"`` without ``contact_conductance`` only).
 
     Raises
     ------
@@ -117,6 +122,7 @@ class ConductanceSpec:
     contact_conductance: float | None = None
     out_of_range: str = "error"
     unequal: bool = True
+    nodes: str = "particles"
 
     def __post_init__(self):
         if self.law not in LAWS:
@@ -137,6 +143,12 @@ class ConductanceSpec:
         kc = self.contact_conductance
         if kc is not None and (not np.isfinite(kc) or kc <= 0):
             raise ValueError(f"conductance.contact_conductance = {kc!r}: must be finite and > 0 (W/K)")
+        if self.nodes not in NODES:
+            raise ValueError(f"conductance.nodes = {self.nodes!r}: must be one of {', '.join(NODES)}")
+        if self.nodes == "necks" and (self.law != "shared-body" or self.neck != "union" or kc is not None):
+            raise ValueError(f"conductance.nodes = \"necks\": only with law = \"shared-body\", neck = \"union\" and no "
+                             f"contact_conductance (here law = {self.law!r}, neck = {self.neck!r}, "
+                             f"contact_conductance = {kc!r})")
         if self.law in FIT_LAWS:
             self.fitted()  # a missing or malformed fit file, or one of the other half body, is reported when read
 
@@ -384,7 +396,28 @@ def union_halves(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_
     bonds are live (a neck inside a third sphere has a half 0 and is none) and each particle's capped volume (its cut
     sphere's, lowered where the pores around it close, :mod:`dem.laws.closing_pores`): what the ``shared-body``
     particle is made of under the union of spheres, with one node per particle (:func:`_shared_union_body`) or a
-    node per neck (:mod:`dem.network.necks`). The parameters are those of :func:`_shared_union_body`.
+    node per neck (:mod:`dem.network.necks`).
+
+    Parameters
+    ----------
+    particles : Particles
+        The particles (radii, m).
+    bonds : Bonds
+        The union bonds (lens radii and radical-plane distances, m).
+    vectors : numpy.ndarray
+        ``x_j - x_i`` of every pair bond, m.
+    normals : numpy.ndarray
+        The unit normal of every wall bond's wall, into the packing.
+    kappa : numpy.ndarray
+        Per particle, its conductivity, W/(m K).
+    k_i, k_j, k_w : numpy.ndarray
+        The union law's half conductances of the pair bonds on ``i``, on ``j`` and of the wall bonds, W/K.
+    closing_pores : dict or None
+        The closing pores' ``beta`` and ``psi0`` (dimensionless); None: the shipped calibration.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box of the packing (the particles' cells take their neighbours across its faces); None without.
+    walls : sequence of dem.geometry.walls.Wall
+        The walls (they bound the particles' cells where they come near).
 
     Returns
     -------
