@@ -216,3 +216,20 @@ def test_a_steady_scene_with_neck_nodes_reports_the_neck_solve():
     with pytest.raises(ValueError, match="nodes = \"necks\": steady heat"):
         run(make_scene(particles.position, particles.radius, particles.temperature, materials=(UNIT,),
                        fixed=particles.fixed, walls=walls, mode="transient", t_end=1.0, conductance=NECKS))
+
+
+@pytest.mark.parametrize("linear", ["direct", "amg"])
+def test_a_tiled_cell_conducts_as_the_cell(linear):
+    """The BCC union cell at h/r 0.25 tiled 3 x 3 x 3 (54 particles, bonds across the inner faces and the box's)
+    has the cell's k_eff, by the direct solve and by AMG-CG on a matrix that is not an M-matrix."""
+    cell = lattice.lattice_cell("bcc", 0.25, neck="union")
+    k_cell = dem_periodic(cell, "shared-body", neck="union", nodes="necks")
+    tiles = np.array([(a, b, c) for a in range(3) for b in range(3) for c in range(3)])
+    x = (cell.centres[None] + (tiles * cell.period)[:, None]).reshape(-1, 3)
+    r = np.tile(cell.radii, len(tiles))
+    box = PeriodicBox(3 * cell.period, drop=[0.0, 0.0, 1.0])
+    particles = Particles.from_arrays(x, r, np.zeros(len(r)), materials=(UNIT,))
+    net = neck_network(NECKS, particles, find_bonds(particles, contact="union", box=box), box=box)
+    res = steady_necks(net, linear=linear)
+    k = res.periodic_heat_flow[2] * box.lengths[2] / box.cross_section(2)
+    assert k == pytest.approx(k_cell, rel=1e-9)
