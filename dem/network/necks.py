@@ -196,22 +196,22 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     # each end's node (a wall's: -1) and the offset it is seen at by its particle (a wall's: its temperature)
     jump = sub.shifts @ box.drop if box is not None else np.zeros(m)
     wall_T = np.array([w.temperature for w in walls], dtype=float)[sub.wall_index] if len(live_walls) else np.zeros(0)
-    node = np.concatenate([n + np.arange(m), n + np.arange(m), np.full(len(live_walls), -1)])
-    offset = np.concatenate([np.zeros(m), jump, wall_T])
+    # (one more place at the end of each: the centre, end -1, seen at offset 0)
+    node = np.concatenate([n + np.arange(m), n + np.arange(m), np.full(len(live_walls), -1), [0]])
+    offset = np.concatenate([np.zeros(m), jump, wall_T, [0.0]])
+    ends = np.append(el.ends, -1)
     # the entries: particle k's block is (z + 1)^2 values row by row, local node p < z its p-th end, z its centre
     z = np.diff(el.offsets)
     size = z + 1
     owner = np.repeat(np.arange(n), size * size)
     local = np.arange(len(el.values)) - el.start[:-1][owner]
-    s = size[owner]
-    p_row, p_col = local // s, local % s
+    p_row, p_col = local // size[owner], local % size[owner]
     first = el.offsets[:-1][owner]
-    at_centre_row, at_centre_col = p_row == z[owner], p_col == z[owner]
-    end_row = np.where(at_centre_row, -1, el.ends[np.where(at_centre_row, 0, first + p_row)] if len(el.ends) else -1)
-    end_col = np.where(at_centre_col, -1, el.ends[np.where(at_centre_col, 0, first + p_col)] if len(el.ends) else -1)
-    row = np.where(at_centre_row, owner, node[np.maximum(end_row, 0)] if len(node) else owner)
-    col = np.where(at_centre_col, owner, node[np.maximum(end_col, 0)] if len(node) else owner)
-    known = np.where(at_centre_col, 0.0, offset[np.maximum(end_col, 0)] if len(offset) else 0.0)
+    end_row = ends[np.where(p_row == z[owner], len(el.ends), first + p_row)]
+    end_col = ends[np.where(p_col == z[owner], len(el.ends), first + p_col)]
+    row = np.where(end_row < 0, owner, node[end_row])
+    col = np.where(end_col < 0, owner, node[end_col])
+    known = offset[end_col]
     value = el.values
     inner, rows = (row >= 0) & (col >= 0), row >= 0  # a wall's row has no equation: the wall takes what it is given
     size_all = n + m
