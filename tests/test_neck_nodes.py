@@ -233,3 +233,12 @@ def test_a_tiled_cell_conducts_as_the_cell(linear):
     res = steady_necks(net, linear=linear)
     k = res.periodic_heat_flow[2] * box.lengths[2] / box.cross_section(2)
     assert k == pytest.approx(k_cell, rel=1e-9)
+
+
+def test_moving_particles_refuse_neck_nodes():
+    from dem import make_scene
+    from dem.scene.parse import Scene
+
+    scene = make_scene(np.zeros((1, 3)), [1e-3], [0.0], mode="steady", conductance=NECKS)
+    with pytest.raises(ValueError, match="static engine only"):
+        Scene(**{**scene.__dict__, "engine": "verlet"})
