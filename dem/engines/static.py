@@ -249,13 +249,14 @@ class StaticEngine(Engine):
 
     def _run(self, observe, progress, checkpoint) -> None:
         s = self.scene.solver
-        out = {"law": self.scene.conductance.law, "contact": self.bonds.contact,
+        law, nodes = self.scene.conductance.law, self.scene.conductance.nodes
+        out = {"law": law, "contact": self.bonds.contact,
                "bonds_clipped": self.bonds.clipped, "bonds_dropped": self.bonds.dropped,
                "wall_bonds": self.bonds.n_walls,
                **neck_account(np.count_nonzero(self.meeting), self.scene.particles.n, self.bonds.contact,
-                              self.bonds.n_pairs + self.bonds.n_walls, self.scene.conductance.law,
-                              np.count_nonzero(wide_necks(self.scene.particles.radius, self.bonds, self.meeting,
-                                                          self.scene.conductance.law)))}
+                              self.bonds.n_pairs + self.bonds.n_walls, law,
+                              np.count_nonzero(wide_necks(self.scene.particles.radius, self.bonds, self.meeting, law,
+                                                          nodes)), nodes=nodes)}
         observer = self._observed(observe)
         t0 = self.t_start
         if s.mode == "steady" and self.necks is not None:
