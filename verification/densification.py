@@ -30,8 +30,8 @@ import time
 
 import numpy as np
 
-from fem_neck import lattice
 from dem.laws.verified_range import evidence_name
+from fem_neck import lattice
 from verification.lattices import FECache, dem_periodic, solve_cells
 from verification.report import jsonable, save_figure
 
