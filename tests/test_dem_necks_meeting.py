@@ -12,14 +12,14 @@ from dem.laws.conductance import ConductanceSpec
 from fem_neck.lattice import BASIS, EDGE_OVER_SPACING, max_h_over_r
 
 
-def lattice(kind: str, d: float, neck: str = "newton", law: str = "rojek"):
+def lattice(kind: str, d: float, neck: str = "newton", law: str = "rojek", nodes: str = "particles"):
     """A periodic cell of the cubic lattice ``kind`` of 1 mm spheres whose neighbours are ``d`` mm apart, 1 K drop
-    per period along z."""
+    per period along z, on the network's ``nodes``."""
     edge = EDGE_OVER_SPACING[kind] * d * 1e-3
     x = np.asarray(BASIS[kind]) * edge + 0.1 * edge
     box = PeriodicBox(np.full(3, edge), drop=[0.0, 0.0, 1.0])
     return make_scene(x, np.full(len(x), 1e-3), np.zeros(len(x)), box=box, mode="steady",
-                      conductance=ConductanceSpec(law=law, neck=neck))
+                      conductance=ConductanceSpec(law=law, neck=neck, nodes=nodes))
 
 
 @pytest.mark.parametrize("kind", ["sc", "fcc"])
@@ -41,7 +41,8 @@ def test_union_reading_runs_where_the_pair_necks_have_no_answer():
     s = result.summary
     assert s["neck_readings"] == {"union": s["bonds"]} and s["particles_necks_meeting"] == s["particles"]
     assert s["warnings"] == ["law 'rojek' was not compared with FE on union necks (python -m verification "
-                             "densification compares shared-body, fit, argento-bouvard): no error bound"]
+                             "densification compares shared-body, shared-body (neck nodes), fit, "
+                             "argento-bouvard): no error bound"]
     assert s["law_in_verified_range"] is False
     a = result.engine.bonds.a
     assert np.allclose(a, math.sqrt(1.0 - 0.8**2) * 1e-3, rtol=1e-12)
@@ -94,6 +95,40 @@ def test_a_union_run_reports_the_fe_evidence_of_its_range(h, stands):
         assert "warnings" not in s
     else:
         assert len(s["warnings"]) == 1 and f"law 'shared-body' at {percent_range(interval)} of k_eff" in s["warnings"][0]
+
+
+@pytest.mark.parametrize("h, stands", [(0.2, "verified"), (0.3, "wide"), (0.6, "meeting")])
+def test_a_neck_node_run_reports_the_evidence_of_the_neck_node_solve(h, stands):
+    """The same SC cells with a node per neck: the summary's range, interval and warning are the neck-node solve's
+    (EVIDENCE["shared-body (neck nodes)"]), not the one-node law's -- at h/r = 0.2 (a/r 0.436) the neck nodes are
+    verified where the one-node law's necks are wide."""
+    from dem.laws.verified_range import EVIDENCE, evidence_name, percent_range
+
+    evidence = EVIDENCE[evidence_name("shared-body", "necks")]
+    s = run(lattice("sc", 2.0 - h, neck="union", law="shared-body", nodes="necks")).summary
+    one = run(lattice("sc", 2.0 - h, neck="union", law="shared-body")).summary
+    assert s["nodes"] == "necks" and s["effective_conductivity"] == pytest.approx(one["effective_conductivity"],
+                                                                                  rel=1e-9)  # SC: the same k_eff
+    n = s["particles"]
+    assert (s["particles_necks_wide"], s["particles_necks_meeting"]) == {"verified": (0, 0), "wide": (n, 0),
+                                                                         "meeting": (0, n)}[stands]
+    assert s["law_in_verified_range"] is (stands == "verified")
+    interval = {"verified": (-0.01, 0.01), "wide": evidence.apart, "meeting": evidence.meeting}[stands]
+    assert s["law_error_range"] == list(interval)
+    if stands == "verified":
+        assert "warnings" not in s and one["particles_necks_wide"] == n and one["law_in_verified_range"] is False
+    else:
+        assert s["law_error_range"] != one["law_error_range"] and len(s["warnings"]) == 1
+        assert f"law 'shared-body (neck nodes)' at {percent_range(interval)} of k_eff" in s["warnings"][0]
+
+
+def test_every_network_of_the_densification_study_has_its_evidence():
+    from dem.laws.verified_range import EVIDENCE, evidence_name
+    from verification.densification import COLUMNS
+
+    assert set(COLUMNS) == set(EVIDENCE)
+    assert [evidence_name(*c) for c in COLUMNS.values()] == list(COLUMNS)
+    assert evidence_name("shared-body") == "shared-body"
 
 
 def test_the_account_joins_the_ranges_a_run_reached():

@@ -7,7 +7,8 @@ spheres). This study follows ``k_eff / kappa`` against the solid fraction ``phi`
 * **Lattices**: simple, body- and face-centred cubic cells of equal spheres whose nearest neighbours overlap by
   ``h`` (``--neck union`` of ``python -m fem_neck lattice``), from ``phi`` ~0.56 (SC, ``h/r = 0.05``) to ~0.97;
   the periodic-cell FE (:mod:`fem_neck.lattice`, two-sided bounds) against the DEM's laws on the same periodic
-  cell with ``conductance.neck = "union"``.
+  cell with ``conductance.neck = "union"``, and the ``shared-body`` law's particle solved exactly with a node per
+  neck (``conductance.nodes = "necks"``, :mod:`dem.network.necks`: the column ``shared-body (neck nodes)``).
 * **Random packings**: mirror packings of overlapping spheres (:func:`verification.packings.union_packing`, radii
   +-15 %), FE and DEM alike.
 * **A Luding-sintered compact**: the built-in ``hot-wall-sintering`` scene (Luding 2005's contact, pressed and
@@ -29,11 +30,16 @@ import time
 
 import numpy as np
 
+from dem.laws.verified_range import evidence_name
 from fem_neck import lattice
 from verification.lattices import FECache, dem_periodic, solve_cells
 from verification.report import jsonable, save_figure
 
-LAWS = ("argento-bouvard", "fit", "shared-body")
+#: The DEM's networks on union necks, by their name in :data:`dem.laws.verified_range.EVIDENCE`: each a conductance
+#: law and the network's nodes (``conductance.nodes``).
+COLUMNS = {evidence_name(law, nodes): (law, nodes) for law, nodes in
+           (("argento-bouvard", "particles"), ("fit", "particles"), ("shared-body", "particles"),
+            ("shared-body", "necks"))}
 OVERLAPS = {"sc": (0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6), "bcc": (0.05, 0.1, 0.2, 0.3, 0.35),
             "fcc": (0.05, 0.1, 0.2, 0.3)}
 QUICK_OVERLAPS = {"sc": (0.3,), "bcc": (0.2,), "fcc": (0.1,)}
@@ -116,7 +122,7 @@ def outside_evidence(row: dict, law: str) -> float:
     row : dict
         A row of the study (``rel``, ``widest_neck``, ``meeting``).
     law : str
-        The law, a key of ``EVIDENCE``.
+        The network, a key of ``EVIDENCE`` and of :data:`COLUMNS`.
 
     Returns
     -------
@@ -139,7 +145,7 @@ def outside_evidence(row: dict, law: str) -> float:
 def _rows(cells: dict, rtol: float, cache: FECache, kinds: list) -> list:
     rows = []
     for (key, cell), kind, fe in zip(cells.items(), kinds, solve_cells(cells, rtol, cache)):
-        nets = {law: dem_periodic(cell, law, neck="union") for law in LAWS}
+        nets = {name: dem_periodic(cell, law, neck="union", nodes=nodes) for name, (law, nodes) in COLUMNS.items()}
         rows.append({"case": key.rsplit(" rtol", 1)[0], "kind": kind, "phi": cell.phi, "fe": fe, "network": nets,
                      **standing(cell),
                      "rel": {law: v / fe["k"] - 1.0 for law, v in nets.items()},
@@ -191,7 +197,7 @@ def _figure(rows: list, compact: dict | None, out_dir: pathlib.Path) -> list:
     import matplotlib.pyplot as plt
 
     colours = {"sc": "tab:blue", "bcc": "tab:orange", "fcc": "tab:green", "random": "tab:red"}
-    markers = {"argento-bouvard": "^", "fit": "s", "shared-body": "o"}
+    markers = {"argento-bouvard": "^", "fit": "s", "shared-body": "o", "shared-body (neck nodes)": "x"}
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 5.6))
     grid = np.linspace(0.5, 1.0, 101)
     ax1.plot(grid, grid, "k-", lw=1, label="Wiener bound phi")
@@ -204,7 +210,7 @@ def _figure(rows: list, compact: dict | None, out_dir: pathlib.Path) -> list:
         phi = [r["phi"] for r in sel]
         ax1.plot(phi, [r["fe"]["k"] for r in sel], "-" if kind != "random" else "none", marker="D", ms=5,
                  color=colours[kind], label=f"{kind.upper() if kind != 'random' else 'random'} FE")
-        for law in LAWS:
+        for law in COLUMNS:
             ax1.plot(phi, [r["network"][law] for r in sel], ls="none", marker=markers[law], mfc="none", ms=6,
                      color=colours[kind])
             ax2.plot(phi, [100 * r["rel"][law] for r in sel], ls=":" if kind != "random" else "none",
@@ -212,7 +218,7 @@ def _figure(rows: list, compact: dict | None, out_dir: pathlib.Path) -> list:
     if compact and compact["phi"]:
         ax1.plot(compact["phi"], compact["k"], color="tab:purple", lw=2,
                  label=f"{COMPACT} (DEM, {compact['law']}, pair necks handed over)")
-    for law in LAWS:
+    for law in COLUMNS:
         ax1.plot([], [], ls="none", marker=markers[law], mfc="none", color="grey", label=f"DEM {law}, union necks")
     ax1.set_xlabel("solid fraction phi")
     ax1.set_ylabel("k_eff / kappa")
@@ -233,13 +239,13 @@ def _figure(rows: list, compact: dict | None, out_dir: pathlib.Path) -> list:
 
 
 def _table(rows: list) -> str:
-    head = ("| packing | phi | k_FE / kappa [lower, upper] | " + " | ".join(LAWS)
+    head = ("| packing | phi | k_FE / kappa [lower, upper] | " + " | ".join(COLUMNS)
             + " | HS bound | Koh & Fortini |")
-    lines = [head, "|" + "---|" * (5 + len(LAWS))]
+    lines = [head, "|" + "---|" * (5 + len(COLUMNS))]
     for r in rows:
         fe = r["fe"]
         lines.append(f"| {r['case']} | {r['phi']:.4f} | {fe['k']:.5f} [{fe['lower']:.5f}, {fe['upper']:.5f}] | "
-                     + " | ".join(f"{100 * r['rel'][law]:+.2f} %" for law in LAWS)
+                     + " | ".join(f"{100 * r['rel'][law]:+.2f} %" for law in COLUMNS)
                      + f" | {r['hashin_shtrikman']:.4f} | {r['koh_fortini']:.4f} |")
     return "\n".join(lines)
 
@@ -274,11 +280,11 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
     for r in rows:
         summary[f"densification {r['case']}"] = {"phi": r["phi"], "k_fe": r["fe"]["k"],
                                                  "fe_error_estimate": r["fe"]["error_estimate"],
-                                                 **{f"rel_err_{law}": r["rel"][law] for law in LAWS}}
-    for law in LAWS:
+                                                 **{f"rel_err_{law}": r["rel"][law] for law in COLUMNS}}
+    for law in COLUMNS:
         summary[f"densification worst |rel err| {law}"] = max(abs(r["rel"][law]) for r in rows)
     targets = [(f"{law}: distance of the worst case outside the FE evidence declared in dem.laws.verified_range",
-                max(outside_evidence(r, law) for r in rows), 0.0) for law in LAWS]
+                max(outside_evidence(r, law) for r in rows), 0.0) for law in COLUMNS]
     summary["densification FE above the HS bound"] = sum(r["fe"]["lower"] > r["hashin_shtrikman"] for r in rows)
     if compact is not None:
         summary["compact particles with necks that meet"] = compact["particles_necks_meeting"]

@@ -130,9 +130,10 @@ def fe_pair_conductance(r_i: float, r_j: float, h: float) -> float:
 
 
 def dem_periodic(cell: lattice.PeriodicCell, law: str, neck: str = "newton",
-                 closing_pores: dict | None = None) -> float:
+                 closing_pores: dict | None = None, nodes: str = "particles") -> float:
     """The DEM's ``k_eff / kappa`` of the periodic packing along z (drop of 1 K per period), for a conductance law
-    or :data:`NETWORK_ONLY`, with the neck reading ``neck`` (``conductance.neck``) and, for ``shared-body`` on the
+    or :data:`NETWORK_ONLY`, with the neck reading ``neck`` (``conductance.neck``), the network's ``nodes``
+    (``conductance.nodes``: ``"necks"`` solves :mod:`dem.network.necks`) and, for ``shared-body`` on the
     union, the closing pores' calibration ``closing_pores`` (:func:`dem.laws.conductance.bond_conductances`)."""
     from dem.geometry.bonds import find_bonds
     from dem.laws.conductance import ConductanceSpec, bond_conductances
@@ -143,8 +144,13 @@ def dem_periodic(cell: lattice.PeriodicCell, law: str, neck: str = "newton",
     box = PeriodicBox(cell.period, drop=[0.0, 0.0, 1.0])
     unit = Material(1.0, 1.0, 1.0, "unit")
     particles = Particles.from_arrays(cell.centres, cell.radii, np.zeros(cell.n), materials=(unit,))
-    spec = ConductanceSpec(law="rojek" if law == NETWORK_ONLY else law, neck=neck)
+    spec = ConductanceSpec(law="rojek" if law == NETWORK_ONLY else law, neck=neck, nodes=nodes)
     bonds = find_bonds(particles, contact=spec.contact, box=box)
+    if nodes == "necks":
+        from dem.network.necks import neck_network, steady_necks
+
+        net = neck_network(spec, particles, bonds, box=box, closing_pores=closing_pores)
+        return float(steady_necks(net).periodic_heat_flow[2] * box.lengths[2] / box.cross_section(2))
     if law == NETWORK_ONLY:
         K = np.array([fe_pair_conductance(*sorted((float(cell.radii[i]), float(cell.radii[j]))), float(h))
                       for i, j, h in zip(bonds.i, bonds.j, bonds.h)])

@@ -21,6 +21,7 @@ from dem.laws.verified_range import neck_account, wide_necks
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
 from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
                               periodic_heat_flow, steady)
+from dem.network.necks import neck_network, steady_necks
 from dem.scene.specimen import group_flows, held_groups
 from dem.scene.state_file import box_arrays
 
@@ -58,6 +59,31 @@ def effective_conductivity(scene, summary: dict) -> float | None:
     kind, name = sp.hot_end
     q = -summary["boundary_heat_flow"]["walls" if kind == "wall" else "groups"][name]
     return q * sp.length / (sp.area * (sp.hot - sp.cold))
+
+
+def refuse_neck_nodes(scene) -> None:
+    """``[conductance] nodes = "necks"`` (:mod:`dem.network.necks`) solves steady heat only, so far: a transient
+    run, an ambient exchange or a current is refused in one line.
+
+    Parameters
+    ----------
+    scene : dem.scene.parse.Scene
+        The scene.
+
+    Raises
+    ------
+    ValueError
+        The scene asks for what the network with a node per neck does not solve yet.
+    """
+    if scene.conductance.nodes != "necks":
+        return
+    what = ("mode = \"transient\"" if scene.solver.mode == "transient" else
+            "convection" if scene.sources.convection is not None else
+            "radiation" if scene.sources.radiation is not None else
+            "electrical physics" if scene.electrical is not None else None)
+    if what is not None:
+        raise ValueError(f"[conductance] nodes = \"necks\": steady heat without convection, radiation or current "
+                         f"only, so far (this scene has {what}); use nodes = \"particles\"")
 
 
 def boundary_summary(scene, walls, into: dict) -> dict:
@@ -118,6 +144,7 @@ class StaticEngine(Engine):
         """``restart``: the checkpoint of this scene's transient run (:func:`dem.output.folder.load`)."""
         self.scene = scene
         memory.check(scene.particles.n, "particles")  # before the bond search: a refused run costs nothing
+        refuse_neck_nodes(scene)
         if scene.solver.mode == "transient":
             self._check_work()
         particles, walls = scene.particles, scene.walls
@@ -128,6 +155,10 @@ class StaticEngine(Engine):
         wall_temperature = np.array([w.temperature for w in walls], dtype=float)
         self.network = Network(particles, bonds, K_pairs, K_walls, wall_temperature, scene.sources, scene.box)
         self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
+        # a node per neck (dem.network.necks): the steady solve and the bonds' flows are its own
+        self.necks = (neck_network(scene.conductance, particles, bonds, box=scene.box, walls=walls)
+                      if scene.conductance.nodes == "necks" else None)
+        self.neck_flows = None
         self.meeting = meeting_in(particles, walls, bonds, scene.box)
         self.restart = Checkpoint.from_arrays(restart) if restart is not None else None
         self.t_start = float(scene.start_time)
@@ -218,16 +249,19 @@ class StaticEngine(Engine):
 
     def _run(self, observe, progress, checkpoint) -> None:
         s = self.scene.solver
-        out = {"law": self.scene.conductance.law, "contact": self.bonds.contact,
+        law, nodes = self.scene.conductance.law, self.scene.conductance.nodes
+        out = {"law": law, "contact": self.bonds.contact,
                "bonds_clipped": self.bonds.clipped, "bonds_dropped": self.bonds.dropped,
                "wall_bonds": self.bonds.n_walls,
                **neck_account(np.count_nonzero(self.meeting), self.scene.particles.n, self.bonds.contact,
-                              self.bonds.n_pairs + self.bonds.n_walls, self.scene.conductance.law,
-                              np.count_nonzero(wide_necks(self.scene.particles.radius, self.bonds, self.meeting,
-                                                          self.scene.conductance.law)))}
+                              self.bonds.n_pairs + self.bonds.n_walls, law,
+                              np.count_nonzero(wide_necks(self.scene.particles.radius, self.bonds, self.meeting, law,
+                                                          nodes)), nodes=nodes)}
         observer = self._observed(observe)
         t0 = self.t_start
-        if s.mode == "steady":
+        if s.mode == "steady" and self.necks is not None:
+            self._steady_necks(observer, out)
+        elif s.mode == "steady":
             res = steady(self.network, s.floating, s.linear)
             observer(0, 0.0, res.T[self.network.free], res.flows)
             out.update(energy_error=res.energy_error, heat_flow=res.flows, linear_solver=res.solver,
@@ -248,6 +282,24 @@ class StaticEngine(Engine):
             if res.startup_steps:  # a stiff Crank-Nicolson run: say that its first steps were implicit Euler
                 out["startup_steps"] = res.startup_steps
         self.details = out
+
+    def _steady_necks(self, observer, out: dict) -> None:
+        """The steady solve with a node per neck (:func:`dem.network.necks.steady_necks`) and what the summary says of
+        it, in the keys of the one-node solve."""
+        res = steady_necks(self.necks, self.scene.solver.floating, self.scene.solver.linear)
+        p, b = self.scene.particles, self.bonds
+        flows = {"fixed": float(res.fixed_flow.sum()), "walls": float(-res.wall_flow.sum()),
+                 "internal": float(p.heat[~p.fixed].sum())}
+        observer(0, 0.0, res.T[self.network.free], flows)
+        self.neck_flows = (res.bond_flow, res.wall_flow)
+        out.update(energy_error=res.energy_error, heat_flow=flows, linear_solver=res.solver, nodes="necks",
+                   neck_nodes=len(self.necks.live), particles_without_interactions=self.necks.plain)
+        if len(self.network.fixed) or len(self.scene.walls):
+            walls = np.bincount(b.wall_index, res.wall_flow, len(self.scene.walls))
+            out["boundary_heat_flow"] = boundary_summary(self.scene, walls,
+                                                         {int(k): float(-res.fixed_flow[k]) for k in self.network.fixed})
+        if self.scene.box is not None:
+            out["periodic_heat_flow"] = res.periodic_heat_flow.tolist()
 
     def _boundary(self, T: np.ndarray) -> dict:
         flows = boundary_heat_flow(self.network, T)
@@ -357,7 +409,10 @@ class StaticEngine(Engine):
                 **box_arrays(self.scene.box)}
 
     def bond_heat_flow(self) -> tuple[np.ndarray, np.ndarray]:
-        """Heat flow (W) along each pair bond from i to j, and from each wall-bonded particle into its wall."""
+        """Heat flow (W) along each pair bond from i to j, and from each wall-bonded particle into its wall (with a
+        node per neck: through the neck, from the steady solve)."""
+        if self.neck_flows is not None:
+            return self.neck_flows
         b, T = self.bonds, self.T
         wall_T = self.network.wall_temperature[b.wall_index]
         return self.K_pairs * (T[b.i] - T[b.j] + self.network.jump), self.K_walls * (T[b.wall_particle] - wall_T)

@@ -54,6 +54,7 @@ DESCRIPTIONS = {
     "zohdi": "kappa pi a^2 / |x_i - x_j| with the lens contact circle (Zohdi 2014, eqs. 11-12, 33)",
 }
 NECK_MODELS = ("newton", "first", "coble", "union")
+NODES = ("particles", "necks")  # the network's nodes: one per particle, or also one per neck (dem.network.necks)
 
 
 def law_keys(law: str) -> tuple:
@@ -102,6 +103,10 @@ class ConductanceSpec:
         ``dem.geometry.bonds.OUT_OF_RANGE``: ``"error"``, ``"clip"`` or ``"drop"``.
     unequal : bool
         Whether the fit laws multiply a pair of unequal radii by :func:`fem_neck.law.unequal_factor`.
+    nodes : str
+        The network's nodes, one of ``NODES``: ``"particles"`` (one per particle, each bond a conductance) or
+        ``"necks"`` (a node per neck as well, each particle an element, :mod:`dem.network.necks`; ``shared-body``
+        under ``neck = "union"`` without ``contact_conductance`` only).
 
     Raises
     ------
@@ -117,6 +122,7 @@ class ConductanceSpec:
     contact_conductance: float | None = None
     out_of_range: str = "error"
     unequal: bool = True
+    nodes: str = "particles"
 
     def __post_init__(self):
         if self.law not in LAWS:
@@ -137,6 +143,12 @@ class ConductanceSpec:
         kc = self.contact_conductance
         if kc is not None and (not np.isfinite(kc) or kc <= 0):
             raise ValueError(f"conductance.contact_conductance = {kc!r}: must be finite and > 0 (W/K)")
+        if self.nodes not in NODES:
+            raise ValueError(f"conductance.nodes = {self.nodes!r}: must be one of {', '.join(NODES)}")
+        if self.nodes == "necks" and (self.law != "shared-body" or self.neck != "union" or kc is not None):
+            raise ValueError(f"conductance.nodes = \"necks\": only with law = \"shared-body\", neck = \"union\" and no "
+                             f"contact_conductance (here law = {self.law!r}, neck = {self.neck!r}, "
+                             f"contact_conductance = {kc!r})")
         if self.law in FIT_LAWS:
             self.fitted()  # a missing or malformed fit file, or one of the other half body, is reported when read
 
@@ -283,9 +295,7 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     if spec.law == "shared-body":
         from dem.laws.shared_body import neck_factors
 
-        if bonds.n_walls and not len(walls):
-            raise ValueError("conductance.law = \"shared-body\": the wall bonds' walls are needed (their normals)")
-        normals = np.array([w.normal for w in walls])[bonds.wall_index] if bonds.n_walls else np.zeros((0, 3))
+        normals = wall_normals(bonds, walls)
         vectors = bonds.vectors(particles.position, box)
         if spec.neck == "union":
             k_i, k_j, k_w = _shared_union_body(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
@@ -305,6 +315,31 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
         share = k_j / (k_i + k_j)  # R_i / (R_i + R_j); an infinite half (a centre on the contact plane) makes none
     share = np.where(np.isfinite(share), share, np.where(np.isinf(k_i), 0.0, 1.0))
     return k_pair, k_wall, share
+
+
+def wall_normals(bonds: Bonds, walls) -> np.ndarray:
+    """The unit normal (into the packing) of every wall bond's wall, ``(B, 3)``.
+
+    Parameters
+    ----------
+    bonds : dem.geometry.bonds.Bonds
+        The bonds (their ``wall_index``).
+    walls : sequence of dem.geometry.walls.Wall
+        The walls the wall bonds index.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(B, 3)`` unit normals.
+
+    Raises
+    ------
+    ValueError
+        There are wall bonds but no walls.
+    """
+    if bonds.n_walls and not len(walls):
+        raise ValueError("conductance.law = \"shared-body\": the wall bonds' walls are needed (their normals)")
+    return np.array([w.normal for w in walls])[bonds.wall_index] if bonds.n_walls else np.zeros((0, 3))
 
 
 def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_i, k_j, k_w,
@@ -341,11 +376,59 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
     tuple of numpy.ndarray
         The three arrays of half conductances, W/K.
     """
+    from dem.laws.shared_body import neck_factors
+
+    k_i, k_j, k_w, pairs, walls, volume = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
+                                                       closing_pores, box, walls)
+    live = bonds.subset(pairs, walls)
+    s_i, s_j, s_w = neck_factors(particles.n, particles.radius, live, vectors[pairs], k_i[pairs], k_j[pairs],
+                                 k_w[walls], kappa, np.reshape(normals, (-1, 3))[walls], volume, trace_cap=True)
+    k_i, k_j, k_w = np.where(pairs, k_i, 0.0), np.where(pairs, k_j, 0.0), k_w.copy()
+    k_i[pairs] *= s_i
+    k_j[pairs] *= s_j
+    k_w[walls] *= s_w
+    return k_i, k_j, k_w
+
+
+def union_halves(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_i, k_j, k_w,
+                 closing_pores: dict | None = None, box=None, walls=()):
+    """The union law's half conductances narrowed to each particle's cut sphere (:mod:`dem.laws.cut_body`), which
+    bonds are live (a neck inside a third sphere has a half 0 and is none) and each particle's capped volume (its cut
+    sphere's, lowered where the pores around it close, :mod:`dem.laws.closing_pores`): what the ``shared-body``
+    particle is made of under the union of spheres, with one node per particle (:func:`_shared_union_body`) or a
+    node per neck (:mod:`dem.network.necks`).
+
+    Parameters
+    ----------
+    particles : Particles
+        The particles (radii, m).
+    bonds : Bonds
+        The union bonds (lens radii and radical-plane distances, m).
+    vectors : numpy.ndarray
+        ``x_j - x_i`` of every pair bond, m.
+    normals : numpy.ndarray
+        The unit normal of every wall bond's wall, into the packing.
+    kappa : numpy.ndarray
+        Per particle, its conductivity, W/(m K).
+    k_i, k_j, k_w : numpy.ndarray
+        The union law's half conductances of the pair bonds on ``i``, on ``j`` and of the wall bonds, W/K.
+    closing_pores : dict or None
+        The closing pores' ``beta`` and ``psi0`` (dimensionless); None: the shipped calibration.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box of the packing (the particles' cells take their neighbours across its faces); None without.
+    walls : sequence of dem.geometry.walls.Wall
+        The walls (they bound the particles' cells where they come near).
+
+    Returns
+    -------
+    tuple
+        ``(k_i, k_j, k_w, pairs, walls, volume)``: the narrowed halves of all bonds (W/K), the masks of the live pair
+        and wall bonds, and per particle the volume its tensor's trace is capped by (m^3).
+    """
     from fem_neck.geometry.union import cut_spheres
 
     from dem.laws.closing_pores import calibration, cap_ratio, particle_cells, power_planes
     from dem.laws.cut_body import cut_body_resistance
-    from dem.laws.shared_body import neck_factors
 
     r = particles.radius
     unit = vectors / bonds.d[:, None]  # the bonds' lengths, found with them
@@ -359,16 +442,9 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
     with np.errstate(divide="ignore"):  # no extra resistance (0): an infinite conductance in series
         k_i, k_j, k_w = (series(k, 1.0 / dR) for k, dR in ((k_i, ends[:m]), (k_j, ends[m:2 * m]),
                                                          (k_w, ends[2 * m:])))
-    pairs, walls = (k_i > 0.0) & (k_j > 0.0), k_w > 0.0
-    live = bonds.subset(pairs, walls)
-    volume = cut_spheres(r, live.i, live.j, vectors[pairs]).volume * caps
-    s_i, s_j, s_w = neck_factors(particles.n, r, live, vectors[pairs], k_i[pairs], k_j[pairs], k_w[walls], kappa,
-                                 np.reshape(normals, (-1, 3))[walls], volume, trace_cap=True)
-    k_i, k_j, k_w = np.where(pairs, k_i, 0.0), np.where(pairs, k_j, 0.0), k_w.copy()
-    k_i[pairs] *= s_i
-    k_j[pairs] *= s_j
-    k_w[walls] *= s_w
-    return k_i, k_j, k_w
+    pairs, live_walls = (k_i > 0.0) & (k_j > 0.0), k_w > 0.0
+    volume = cut_spheres(r, bonds.i[pairs], bonds.j[pairs], vectors[pairs]).volume * caps
+    return k_i, k_j, k_w, pairs, live_walls, volume
 
 
 def _check_finite(spec: ConductanceSpec, K: np.ndarray, a: np.ndarray, name) -> None:

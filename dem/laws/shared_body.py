@@ -81,6 +81,17 @@ A wall bond is a neck too (toward the wall, the mirror pair's neck), so it takes
 
 The factors are computed per particle in one compiled loop (numba, the particles shared among the threads): a
 Gaussian elimination of the ``z x z`` matrix ``R`` with four right-hand sides, without allocating.
+
+**The particle as an element with a node per neck** (``[conductance] nodes = "necks"``, :mod:`dem.network.necks`).
+Solved exactly, with a node per neck, the same conductor needs no factors: :func:`particle_elements` gives each
+particle's conductance matrix over its necks and its centre (the inverse of ``R`` bordered by the centre, scaled down
+by the same trace cap). There the free-space part of the interaction is taken between the necks' actual faces,
+each the flat disc of radius :math:`a_b` at :math:`l_b n_b` clipped by the particle's other planes (the cut sphere's
+face): :math:`2 r \langle 1 / |x - y| \rangle` over the two faces (uniform weight on each, :func:`face_interaction`)
+in place of :math:`2 r / l_{bc}`, relative to the same two faces turned onto opposite poles (face ``c`` rotated
+about :math:`n_c \times n_b` until :math:`n_c = -n_b`) in place of :math:`2 r / (z_b + z_c)`, so that collinear
+necks still interact by nothing. Wide necks at right angles, whose faces come close along the edge where their
+planes meet, are what the disc centres miss (the verification guide measures both against the FE).
 """
 
 from __future__ import annotations
@@ -342,3 +353,293 @@ def neck_factors(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, 
     out = _factors(n, pairs, walls, bodies, bool(trace_cap))
     m = bonds.n_pairs
     return out[:m], out[m:2 * m], out[2 * m:]
+
+
+# ------------------------------------------------------------------------------- the particle with a node per neck
+FACE_RINGS, FACE_ANGLES = 6, 24  # a face's quadrature: Gauss-Legendre rings in (rho / a)^2 (equal area), equal angles
+_nodes, _weights = np.polynomial.legendre.leggauss(FACE_RINGS)
+FACE_T, FACE_W = 0.5 * (_nodes + 1.0), 0.5 * _weights  # on [0, 1], weights summing to 1
+
+
+@numba.njit(cache=True)
+def _face_points(normal, arm, q, z, points, weights):
+    """The quadrature of each of the ``z`` necks' faces (units of ``r``): the disc of radius ``q[b]`` at
+    ``arm[b] normal[b]``, its points beyond another neck's plane weighted 0 (all kept where none is left), the
+    weights summing to 1; into ``points`` (z, FACE_RINGS * FACE_ANGLES, 3) and ``weights``."""
+    for b in range(z):
+        n = normal[b]
+        h = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        t1 = np.cross(n, h)
+        t1 /= np.sqrt(t1[0] ** 2 + t1[1] ** 2 + t1[2] ** 2)
+        t2 = np.cross(n, t1)
+        total = 0.0
+        for ring in range(FACE_RINGS):
+            rho = q[b] * np.sqrt(FACE_T[ring])
+            for k in range(FACE_ANGLES):
+                angle = 2.0 * np.pi * (k + 0.5) / FACE_ANGLES
+                p = ring * FACE_ANGLES + k
+                keep = True
+                for c in range(3):
+                    points[b, p, c] = arm[b] * n[c] + rho * (np.cos(angle) * t1[c] + np.sin(angle) * t2[c])
+                for o in range(z):
+                    if o != b and (points[b, p, 0] * normal[o, 0] + points[b, p, 1] * normal[o, 1]
+                                   + points[b, p, 2] * normal[o, 2]) > arm[o] + 1e-12:
+                        keep = False
+                        break
+                weights[b, p] = FACE_W[ring] / FACE_ANGLES if keep else 0.0
+                total += weights[b, p]
+        if total == 0.0:  # a face the other planes clip away entirely: the whole disc
+            for ring in range(FACE_RINGS):
+                for k in range(FACE_ANGLES):
+                    weights[b, ring * FACE_ANGLES + k] = FACE_W[ring] / FACE_ANGLES
+            total = 1.0
+        for p in range(FACE_RINGS * FACE_ANGLES):
+            weights[b, p] /= total
+
+
+@numba.njit(cache=True)
+def _mean_inverse_distance(x, wx, y, wy, turn):
+    """:math:`\\langle 1 / |x - T y| \\rangle` over two weighted point sets, ``T`` the 3 x 3 matrix ``turn``."""
+    total = 0.0
+    for q in range(y.shape[0]):
+        if wy[q] == 0.0:
+            continue
+        y0 = turn[0, 0] * y[q, 0] + turn[0, 1] * y[q, 1] + turn[0, 2] * y[q, 2]
+        y1 = turn[1, 0] * y[q, 0] + turn[1, 1] * y[q, 1] + turn[1, 2] * y[q, 2]
+        y2 = turn[2, 0] * y[q, 0] + turn[2, 1] * y[q, 1] + turn[2, 2] * y[q, 2]
+        inner = 0.0
+        for p in range(x.shape[0]):
+            if wx[p] != 0.0:
+                d = np.sqrt((x[p, 0] - y0) ** 2 + (x[p, 1] - y1) ** 2 + (x[p, 2] - y2) ** 2)
+                inner += wx[p] / max(d, 1e-9)
+        total += wy[q] * inner
+    return total
+
+
+@numba.njit(cache=True)
+def _turn(u, v):
+    """The rotation taking the unit vector ``u`` to ``v`` (about ``u x v``; the half turn about an axis normal to
+    ``u`` where they are opposite, the identity where they agree)."""
+    w = np.cross(u, v)
+    sn = np.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2)
+    cs = u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+    if sn < 1e-12:
+        if cs > 0.0:
+            return np.eye(3)
+        h = np.array([1.0, 0.0, 0.0]) if abs(u[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        w = np.cross(u, h)
+        w /= np.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2)
+        return 2.0 * np.outer(w, w) - np.eye(3)
+    w /= sn
+    W = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+    return np.eye(3) + sn * W + (1.0 - cs) * (W @ W)
+
+
+@numba.njit(cache=True)
+def _face_matrix(normal, arm, q, z, out):
+    """:math:`4 \\pi \\kappa r R_{bc}` (``b != c``) of the faces' interaction (module docstring) into ``out``."""
+    npts = FACE_RINGS * FACE_ANGLES
+    points = np.empty((z, npts, 3))
+    weights = np.empty((z, npts))
+    _face_points(normal, arm, q, z, points, weights)
+    same = np.eye(3)
+    for b in range(z):
+        for c in range(b):
+            cos_g = normal[b, 0] * normal[c, 0] + normal[b, 1] * normal[c, 1] + normal[b, 2] * normal[c, 2]
+            s = np.sqrt(max(0.5 * (1.0 - cos_g), 1e-24))
+            near = _mean_inverse_distance(points[b], weights[b], points[c], weights[c], same)
+            far = _mean_inverse_distance(points[b], weights[b], points[c], weights[c], _turn(normal[c], -normal[b]))
+            g = 2.0 * near - 2.0 * far - np.log(s * (1.0 + s) * 0.5)
+            out[b, c] = g
+            out[c, b] = g
+
+
+def face_interaction(normals, arms, necks) -> np.ndarray:
+    r""":math:`4 \pi \kappa r R_{bc}` of the faces' interaction between every two of a particle's necks (module
+    docstring), all lengths in units of the particle's radius ``r``.
+
+    Parameters
+    ----------
+    normals : array_like
+        (z, 3) unit normals of the necks, from the centre outward.
+    arms : array_like
+        (z,) distance of each neck's plane from the centre, over ``r``.
+    necks : array_like
+        (z,) neck radii over ``r``.
+
+    Returns
+    -------
+    numpy.ndarray
+        (z, z) the interactions (dimensionless), 0 on the diagonal.
+    """
+    normals = np.ascontiguousarray(normals, dtype=float).reshape(-1, 3)
+    out = np.zeros((len(normals), len(normals)))
+    _face_matrix(normals, np.ascontiguousarray(arms, dtype=float), np.ascontiguousarray(necks, dtype=float),
+                 len(normals), out)
+    return out
+
+
+@numba.njit(cache=True)
+def _positive_definite(A, z) -> bool:
+    """Whether ``A[:z, :z]`` (symmetric) is positive definite (a Cholesky factorisation of a copy succeeds)."""
+    L = np.zeros((z, z))
+    for c in range(z):
+        d = A[c, c]
+        for k in range(c):
+            d -= L[c, k] ** 2
+        if d <= 0.0:
+            return False
+        L[c, c] = np.sqrt(d)
+        for r in range(c + 1, z):
+            v = A[r, c]
+            for k in range(c):
+                v -= L[r, k] * L[c, k]
+            L[r, c] = v / L[c, c]
+    return True
+
+
+@numba.njit(cache=True, parallel=True)
+def _elements(n_particles, pairs, walls, bodies):
+    """Every particle's element (:func:`particle_elements`): ``(offsets, ends, start, values, plain, shrink)``."""
+    i, j, wall_particle = pairs.i, pairs.j, walls.particle
+    m = len(i)
+    offsets, ends = ends_by_particle(n_particles, np.concatenate((i, j, wall_particle)))
+    size = offsets[1:] - offsets[:-1] + 1
+    start = np.zeros(n_particles + 1, dtype=np.int64)
+    start[1:] = np.cumsum(size * size)
+    values = np.zeros(start[-1])
+    plain = np.zeros(n_particles, dtype=np.bool_)
+    shrink = np.ones(n_particles)
+    vec, a, l_i, l_j, k_i, k_j = pairs.vec, pairs.a, pairs.l_i, pairs.l_j, pairs.k_i, pairs.k_j
+    radius, kappa, share = bodies.radius, bodies.kappa, bodies.share
+    for k in numba.prange(n_particles):
+        lo, hi = offsets[k], offsets[k + 1]
+        z = hi - lo
+        if z == 0:
+            continue
+        r = radius[k]
+        normal = np.empty((z, 3))
+        arm = np.empty(z)
+        q = np.empty(z)
+        half_r = np.empty(z)
+        for b in range(z):
+            e = ends[lo + b]
+            if e < 2 * m:
+                bond = e if e < m else e - m
+                sign = 1.0 if e < m else -1.0
+                length = np.sqrt(vec[bond, 0] ** 2 + vec[bond, 1] ** 2 + vec[bond, 2] ** 2)
+                for c in range(3):
+                    normal[b, c] = sign * vec[bond, c] / length
+                neck, arm[b] = a[bond], (l_i[bond] if e < m else l_j[bond]) / r
+                half = k_i[bond] if e < m else k_j[bond]
+            else:
+                w = e - 2 * m
+                for c in range(3):
+                    normal[b, c] = -walls.normal[w, c]
+                neck, arm[b], half = walls.a[w], walls.l[w] / r, walls.k[w]
+            q[b] = min(neck / r, 1.0)
+            half_r[b] = 4.0 * np.pi * kappa[k] * r / half
+        R = np.zeros((z, z))
+        if z > 1:
+            _face_matrix(normal, arm, q, z, R)
+            largest = 0.0
+            small = np.inf
+            for b in range(z):
+                small = min(small, half_r[b])
+                for c in range(z):
+                    largest = max(largest, abs(R[b, c]))
+            if largest <= ROUNDOFF * small:  # collinear necks: the plain halves
+                R[:, :] = 0.0
+        for b in range(z):
+            R[b, b] = half_r[b]
+        if not _positive_definite(R, z):  # interactions outweighing the necks' own resistances: the plain halves
+            plain[k] = True
+            R[:, :] = 0.0
+            for b in range(z):
+                R[b, b] = half_r[b]
+        Y = np.eye(z)
+        _solve_in_place(R.copy(), Y, z)  # R^-1, in units of 4 pi kappa r
+        Y = 0.5 * (Y + Y.T)
+        unit = 4.0 * np.pi * kappa[k] * r
+        # the trace cap (module docstring) on the tensor N^T Y_c N of the centre-free conductance Y_c, N_b = l_b n_b
+        row = Y.sum(axis=1)
+        total = row.sum()
+        trace = 0.0
+        if z > 1 and total > 0.0:
+            for b in range(z):
+                for c in range(z):
+                    dot = normal[b, 0] * normal[c, 0] + normal[b, 1] * normal[c, 1] + normal[b, 2] * normal[c, 2]
+                    trace += (Y[b, c] - row[b] * row[c] / total) * arm[b] * arm[c] * dot
+            trace *= unit * r * r
+        limit = 3.0 * kappa[k] * 4.0 / 3.0 * np.pi * r ** 3 * share[k]
+        if trace > limit:
+            shrink[k] = limit / trace
+        f = unit * shrink[k]
+        s = z + 1
+        at = start[k]
+        for b in range(z):  # local nodes: the necks in the order of ``ends``, then the centre
+            for c in range(z):
+                values[at + b * s + c] = f * Y[b, c]
+            values[at + b * s + z] = -f * row[b]
+            values[at + z * s + b] = -f * row[b]
+        values[at + z * s + z] = f * total
+    return offsets, ends, start, values, plain, shrink
+
+
+ParticleElements = namedtuple("ParticleElements", ["offsets", "ends", "start", "values", "plain", "shrink"])
+ParticleElements.__doc__ = """Every particle's conductance matrix over its necks and its centre (:func:`particle_elements`).
+The ends of particle ``k`` are ``ends[offsets[k]:offsets[k + 1]]`` (end ``e < m``: pair bond ``e``'s neck on its
+``i``; ``m <= e < 2 m``: pair bond ``e - m``'s on its ``j``; the rest the wall bonds'), its ``(z + 1) x (z + 1)``
+matrix (W/K; local nodes: those ends in order, then the centre) row by row at ``values[start[k]:start[k + 1]]``;
+``plain`` marks the particles whose interactions were dropped (their ``R`` not positive definite) and ``shrink``
+holds the trace cap's factor of each."""
+
+
+def particle_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray,
+                      k_j: np.ndarray, k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray,
+                      volume=None) -> ParticleElements:
+    r"""Each particle as an element with a node per neck and one at its centre (module docstring): with ``R`` the
+    multi-terminal resistance (the half resistances :math:`1/K_b` on its diagonal, the faces' interaction between
+    necks), the flows into the particle through its necks are :math:`Q = R^{-1} (T_\mathrm{necks} - T_c \mathbf 1)`
+    and its centre takes :math:`-\sum Q`; the whole matrix is scaled down where the trace of the particle's tensor
+    exceeds :math:`3 \kappa V_k`. A particle whose necks are collinear (a pair, a chain) has ``R`` diagonal: its
+    halves in series, today's network. The arguments are those of :func:`neck_factors`.
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    radius : numpy.ndarray
+        Particle radii, m.
+    bonds : Bonds
+        The pair and wall bonds (all live: a half conductance 0 has no element) with their neck radii (m) and
+        centre-to-contact distances (m).
+    vectors : numpy.ndarray
+        ``x_j - x_i`` of every pair bond (m, 3), m.
+    k_i, k_j : numpy.ndarray
+        Half conductances of every pair bond on the side of ``i`` and of ``j``, W/K.
+    k_wall : numpy.ndarray
+        Half conductance of every wall bond, W/K.
+    conductivity : numpy.ndarray
+        Per particle, its material's conductivity, W/(m K).
+    wall_normals : numpy.ndarray
+        Unit normal of every wall bond's wall (pointing into the packing).
+    volume : numpy.ndarray, optional
+        Per particle, the solid it holds, m^3, whose Wiener bound caps the trace of its tensor (default: its
+        sphere's).
+
+    Returns
+    -------
+    ParticleElements
+        The elements.
+    """
+    f = np.ascontiguousarray
+    sphere = 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=float) ** 3
+    share = np.ones(n) if volume is None else np.asarray(volume, dtype=float) / sphere
+    pairs = PairNecks(f(bonds.i, dtype=np.int64), f(bonds.j, dtype=np.int64), f(vectors, dtype=float),
+                      f(bonds.a, dtype=float), f(bonds.l_i, dtype=float), f(bonds.l_j, dtype=float),
+                      f(k_i, dtype=float), f(k_j, dtype=float))
+    walls = WallNecks(f(bonds.wall_particle, dtype=np.int64), f(np.reshape(wall_normals, (-1, 3)), dtype=float),
+                      f(bonds.wall_a, dtype=float), f(bonds.wall_l, dtype=float), f(k_wall, dtype=float))
+    bodies = Bodies(f(radius, dtype=float), f(conductivity, dtype=float), f(share, dtype=float))
+    return ParticleElements(*_elements(n, pairs, walls, bodies))

@@ -20,6 +20,14 @@ widest neck ``a / r`` (``a`` the lens radius, ``r`` the particle's) and whether 
 The intervals are the measured extremes, widened by the FE's own tolerance (1e-3 on the lattices, 2e-3 on the random
 packings); the study checks every one of its cases against them and fails if one falls outside. A law missing from
 :data:`EVIDENCE` was not compared with FE on union necks.
+
+**The network's nodes.** With a node per neck (``conductance.nodes = "necks"``, :mod:`dem.network.necks`) the
+``shared-body`` particle is solved exactly rather than reduced to one factor per neck: another network, with evidence
+of its own, under the name ``"shared-body (neck nodes)"`` (:func:`evidence_name`). Its intervals also take in the
+cells of ``python -m verification closing-pores``, which the study does not check but where the neck-node solve was
+compared with the same FE: it is within 1 % there up to ``a / r`` 0.456 but +1.1 % and +1.8 % on the BCC lattice
+at ``h / r`` 0.25 and 0.28 (``a / r`` 0.48 and 0.51), and +1.3 % on a random packing at ``phi`` 0.85, so its
+``verified_width`` stops at the widest study neck below them and its intervals reach them.
 """
 
 from __future__ import annotations
@@ -52,12 +60,32 @@ class Evidence:
     meeting: tuple[float, float]
 
 
-#: The FE evidence of each law compared on union necks (module docstring).
+#: The FE evidence of each law compared on union necks, by :func:`evidence_name` (module docstring).
 EVIDENCE = {
     "shared-body": Evidence(verified_width=0.3123, apart=(-0.010, 0.010), meeting=(-0.037, 0.048)),
+    "shared-body (neck nodes)": Evidence(verified_width=0.4360, apart=(-0.010, 0.020), meeting=(-0.043, 0.016)),
     "fit": Evidence(verified_width=0.0, apart=(-0.002, 0.840), meeting=(0.006, 5.47)),
     "argento-bouvard": Evidence(verified_width=0.0, apart=(-0.119, 0.630), meeting=(-0.194, 3.99)),
 }
+
+
+def evidence_name(law: str, nodes: str = "particles") -> str:
+    """The name of a law's network in :data:`EVIDENCE` and in the study's columns: the law on one node per particle,
+    ``"<law> (neck nodes)"`` with a node per neck as well.
+
+    Parameters
+    ----------
+    law : str
+        The conductance law (``dem.laws.conductance.LAWS``).
+    nodes : str
+        The network's nodes (``dem.laws.conductance.NODES``): ``"particles"`` or ``"necks"``.
+
+    Returns
+    -------
+    str
+        The name.
+    """
+    return law if nodes == "particles" else f"{law} (neck nodes)"
 
 
 def percent_range(interval: tuple[float, float]) -> str:
@@ -78,7 +106,7 @@ def percent_range(interval: tuple[float, float]) -> str:
 
 
 def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide: int = 0,
-                 readings: dict | None = None, handed_over: int | None = None) -> dict:
+                 readings: dict | None = None, handed_over: int | None = None, nodes: str = "particles") -> dict:
     """The summary's account of the necks and of where the law stands (module docstring).
 
     Entries: the reading every bond used (``neck_readings``: bonds per reading), how many particles carry necks that
@@ -87,7 +115,8 @@ def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide:
     the union reading, or in a run that hands particles whose necks meet over to it (:mod:`dem.engines.handover`,
     ``particles_handed_over``), a law with FE evidence there also reports ``law_error_range``: the relative error of
     ``k_eff`` (``[low, high]``, dimensionless) the evidence allows over the ranges the run reached; under the union
-    reading also ``particles_necks_wide``.
+    reading also ``particles_necks_wide``. With a node per neck (``nodes``) the evidence and the warnings are those of
+    the neck-node network (:func:`evidence_name`).
 
     Parameters
     ----------
@@ -108,6 +137,8 @@ def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide:
         Bonds per reading where they differ (a hand-over); None: all ``bonds`` read ``reading``.
     handed_over : int or None
         Particles handed over to the union; None: the run hands none over.
+    nodes : str
+        The network's nodes (``conductance.nodes``): ``"particles"`` or ``"necks"``.
 
     Returns
     -------
@@ -132,6 +163,7 @@ def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide:
                                f"every density"]
             return out
         wide = 0  # the pair necks are verified while apart; the union reads only the handed-over particles
+    law = evidence_name(law, nodes)
     evidence = EVIDENCE.get(law)
     if evidence is None:
         out["law_in_verified_range"] = False
@@ -157,9 +189,9 @@ def neck_account(meeting: int, n: int, reading: str, bonds: int, law: str, wide:
     return out
 
 
-def wide_necks(radius: np.ndarray, bonds, meeting: np.ndarray, law: str) -> np.ndarray:
-    """Per particle, whether its necks do not meet but one is wider than the law's ``verified_width`` on union necks
-    (all False under another reading or for a law without FE evidence there).
+def wide_necks(radius: np.ndarray, bonds, meeting: np.ndarray, law: str, nodes: str = "particles") -> np.ndarray:
+    """Per particle, whether its necks do not meet but one is wider than the ``verified_width`` of the law's network
+    on union necks (all False under another reading or for a network without FE evidence there).
 
     Parameters
     ----------
@@ -171,13 +203,15 @@ def wide_necks(radius: np.ndarray, bonds, meeting: np.ndarray, law: str) -> np.n
         Per particle, whether two of its necks meet (bool, :func:`dem.geometry.necks.meeting_in`).
     law : str
         The conductance law.
+    nodes : str
+        The network's nodes (``conductance.nodes``): ``"particles"`` or ``"necks"``.
 
     Returns
     -------
     numpy.ndarray
         Bool per particle.
     """
-    evidence = EVIDENCE.get(law)
+    evidence = EVIDENCE.get(evidence_name(law, nodes))
     if bonds.contact != "union" or evidence is None:
         return np.zeros(len(radius), dtype=bool)
     return ~np.asarray(meeting, dtype=bool) & (widest_necks(radius, bonds) > evidence.verified_width)

@@ -69,6 +69,8 @@ def unsupported(scene, resume: bool = False) -> str | None:
         name = e.names[int(np.flatnonzero(~e.fixed_potential)[0])]
         return (f"walls.{name}.current: an electrode driving a fixed current does not run under MPI (its potential "
                 f"needs a superposition of solves); give it a potential, or run without mpiexec")
+    if scene.conductance.nodes == "necks":
+        return "conductance.nodes = \"necks\" does not run under MPI yet; run it without mpiexec"
     if resume:
         return "--resume does not run under MPI; run the scene again"
     return None
