@@ -18,7 +18,13 @@ BYTES_PER_PARTICLE = 1.35e3
 # benchmarks dem) took 10.5 s on a quiet 2-core machine before the cell search and the row-by-row assembly, which
 # take 0.74 of its CPU time side by side: about 7.8e-6 s per particle
 SECONDS_PER_PARTICLE = 7.8e-6
+#: seconds of CPU per particle of the ``shared-body`` law's steady solve on union necks (``neck = "union"``: the cut
+#: bodies, the closing pores' cells and the factors) and with a node per neck (``nodes = "necks"``: the faces'
+#: quadrature): bonds, conductances and solve of a random union packing at phi 0.8 tiled to 6912 particles (4.75 bonds
+#: each), 0.41-0.46 and 1.84 ms per particle on the 2-core machine at load 5-7
+UNION_SECONDS_PER_PARTICLE = {"particles": 4.5e-4, "necks": 1.9e-3}
 ANNOUNCE_FROM = 1_000_000  # runs of this many particles or more say what they will take before they start
+ANNOUNCE_SECONDS = 10.0  #: so do runs whose estimated steady solve takes this long (s)
 BASE_BYTES = 0.23e9  # the interpreter, numpy, scipy and the compiled kernels (with the per-particle figure: the fit)
 SMALL_BYTES = 64e6  # a run whose particles need less than this is never refused: the machine is not asked
 
@@ -75,23 +81,28 @@ def check(n: int, name: str) -> None:
                          f"{max(int((have - BASE_BYTES) / BYTES_PER_PARTICLE), 0)} particles")
 
 
-def estimate(n: int) -> str | None:
-    """What a run of ``n`` particles will take, said before it starts where it is large (``n >= ANNOUNCE_FROM``):
-    the memory at the peak of a steady solve and its time on 2 cores (module docstring); None for smaller runs.
+def estimate(n: int, neck: str = "newton", nodes: str = "particles") -> str | None:
+    """What a run of ``n`` particles will take, said before it starts where it is large (``n >= ANNOUNCE_FROM``, or a
+    steady solve estimated at ``ANNOUNCE_SECONDS`` or more): the memory at the peak of a steady solve and its time on
+    2 cores (module docstring); None for smaller runs.
 
     Parameters
     ----------
     n : int
         Number of particles.
+    neck : str
+        The scene's neck reading (``[conductance] neck``); ``"union"`` costs :data:`UNION_SECONDS_PER_PARTICLE`.
+    nodes : str
+        The network's nodes under the union (``[conductance] nodes``: ``"particles"`` or ``"necks"``).
 
     Returns
     -------
     str or None
-        One line, or None below ``ANNOUNCE_FROM`` particles.
+        One line, or None for a small run.
     """
-    if n < ANNOUNCE_FROM:
+    rate = UNION_SECONDS_PER_PARTICLE[nodes] if neck == "union" else SECONDS_PER_PARTICLE
+    if n < ANNOUNCE_FROM and rate * n < ANNOUNCE_SECONDS:
         return None
     need = BASE_BYTES + BYTES_PER_PARTICLE * n
     return (f"{n} particles: about {need / 2**30:.3g} GiB at the peak of a steady solve and about "
-            f"{SECONDS_PER_PARTICLE * n:.3g} s for it on 2 cores (a transient or moving run takes longer)")
-
+            f"{rate * n:.3g} s for it on 2 cores (a transient or moving run takes longer)")

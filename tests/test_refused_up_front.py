@@ -186,3 +186,16 @@ def test_a_large_run_says_what_it_will_take_before_it_starts():
     line = memory.estimate(4_096_000)
     assert line == ("4096000 particles: about 5.36 GiB at the peak of a steady solve and about 31.9 s for it on 2 "
                     "cores (a transient or moving run takes longer)")
+
+
+def test_a_union_run_says_so_from_far_fewer_particles():
+    """The union law's cut bodies and cells, and a node per neck, cost tens to hundreds of times the pair-neck
+    network per particle: such a run announces itself once its steady solve is estimated at ten seconds."""
+    from dem import memory
+
+    small = int(memory.ANNOUNCE_SECONDS / memory.UNION_SECONDS_PER_PARTICLE["necks"]) - 1
+    assert memory.estimate(small, "union", "necks") is None and memory.estimate(small, "newton") is None
+    assert memory.estimate(small, "union", "particles") is None
+    line = memory.estimate(100_000, "union", "necks")
+    assert line.endswith("about 190 s for it on 2 cores (a transient or moving run takes longer)")
+    assert "about 45 s" in memory.estimate(100_000, "union")
