@@ -203,11 +203,35 @@ def _factors(n_particles, pairs, walls, bodies, trace_cap):
 
 
 @numba.njit(cache=True)
+def _gather_necks(k, ends, pairs, walls, bodies, normal, arm, q, half_r):
+    """Particle ``k``'s necks (``ends``: its pair ends ``e < 2 m``, ``e - m`` on ``j``, then its wall bonds): the unit
+    normal from its centre, over its radius the arm and the neck radius (at most 1), and :math:`4 \\pi \\kappa r`
+    over the half conductance, into the first ``len(ends)`` rows of ``normal``, ``arm``, ``q`` and ``half_r``."""
+    m = len(pairs.i)
+    r = bodies.radius[k]
+    for b in range(len(ends)):
+        e = ends[b]
+        if e < 2 * m:
+            bond = e if e < m else e - m
+            sign = 1.0 if e < m else -1.0
+            length = np.sqrt(pairs.vec[bond, 0] ** 2 + pairs.vec[bond, 1] ** 2 + pairs.vec[bond, 2] ** 2)
+            for c in range(3):
+                normal[b, c] = sign * pairs.vec[bond, c] / length
+            neck, arm[b] = pairs.a[bond], (pairs.l_i[bond] if e < m else pairs.l_j[bond]) / r
+            half = pairs.k_i[bond] if e < m else pairs.k_j[bond]
+        else:
+            w = e - 2 * m
+            for c in range(3):
+                normal[b, c] = -walls.normal[w, c]
+            neck, arm[b], half = walls.a[w], walls.l[w] / r, walls.k[w]
+        q[b] = min(neck / r, 1.0)
+        half_r[b] = 4.0 * np.pi * bodies.kappa[k] * r / half
+
+
+@numba.njit(cache=True)
 def _block_factors(first, last, offsets, ends, pairs, walls, bodies, trace_cap, z_max, out):
     """:func:`_factors` for the particles ``first:last``, with work arrays of their own."""
-    m, vec, a, l_i, l_j, k_i, k_j = len(pairs.i), pairs.vec, pairs.a, pairs.l_i, pairs.l_j, pairs.k_i, pairs.k_j
-    wall_normal, wall_a, wall_l, k_wall = walls.normal, walls.a, walls.l, walls.k
-    radius, kappa, share = bodies.radius, bodies.kappa, bodies.share
+    radius, share = bodies.radius, bodies.share
     normal = np.empty((z_max, 3))
     base = np.empty(z_max)
     arm = np.empty(z_max)
@@ -224,24 +248,9 @@ def _block_factors(first, last, offsets, ends, pairs, walls, bodies, trace_cap, 
         if z < 2:
             continue
         r = radius[k]
-        for b in range(z):  # the necks of particle k: unit normal, and over r the cap-base distance and the arm
-            e = ends[lo + b]
-            if e < 2 * m:
-                bond = e if e < m else e - m
-                sign = 1.0 if e < m else -1.0
-                length = np.sqrt(vec[bond, 0] ** 2 + vec[bond, 1] ** 2 + vec[bond, 2] ** 2)
-                for c in range(3):
-                    normal[b, c] = sign * vec[bond, c] / length
-                neck, arm[b] = a[bond], (l_i[bond] if e < m else l_j[bond]) / r
-                half = k_i[bond] if e < m else k_j[bond]
-            else:
-                w = e - 2 * m
-                for c in range(3):
-                    normal[b, c] = -wall_normal[w, c]
-                neck, arm[b], half = wall_a[w], wall_l[w] / r, k_wall[w]
-            q = min(neck / r, 1.0)
-            base[b] = np.sqrt((1.0 - q) * (1.0 + q))
-            half_r[b] = 4.0 * np.pi * kappa[k] * r / half
+        _gather_necks(k, ends[lo:hi], pairs, walls, bodies, normal, arm, base, half_r)
+        for b in range(z):  # over r, the cap-base distance
+            base[b] = np.sqrt((1.0 - base[b]) * (1.0 + base[b]))
         small = np.inf
         largest = 0.0
         for b in range(z):
@@ -510,7 +519,6 @@ def _elements(n_particles, pairs, walls, bodies):
     values = np.zeros(start[-1])
     plain = np.zeros(n_particles, dtype=np.bool_)
     shrink = np.ones(n_particles)
-    vec, a, l_i, l_j, k_i, k_j = pairs.vec, pairs.a, pairs.l_i, pairs.l_j, pairs.k_i, pairs.k_j
     radius, kappa, share = bodies.radius, bodies.kappa, bodies.share
     for k in numba.prange(n_particles):
         lo, hi = offsets[k], offsets[k + 1]
@@ -522,23 +530,7 @@ def _elements(n_particles, pairs, walls, bodies):
         arm = np.empty(z)
         q = np.empty(z)
         half_r = np.empty(z)
-        for b in range(z):
-            e = ends[lo + b]
-            if e < 2 * m:
-                bond = e if e < m else e - m
-                sign = 1.0 if e < m else -1.0
-                length = np.sqrt(vec[bond, 0] ** 2 + vec[bond, 1] ** 2 + vec[bond, 2] ** 2)
-                for c in range(3):
-                    normal[b, c] = sign * vec[bond, c] / length
-                neck, arm[b] = a[bond], (l_i[bond] if e < m else l_j[bond]) / r
-                half = k_i[bond] if e < m else k_j[bond]
-            else:
-                w = e - 2 * m
-                for c in range(3):
-                    normal[b, c] = -walls.normal[w, c]
-                neck, arm[b], half = walls.a[w], walls.l[w] / r, walls.k[w]
-            q[b] = min(neck / r, 1.0)
-            half_r[b] = 4.0 * np.pi * kappa[k] * r / half
+        _gather_necks(k, ends[lo:hi], pairs, walls, bodies, normal, arm, q, half_r)
         R = np.zeros((z, z))
         if z > 1:
             _face_matrix(normal, arm, q, z, R)
