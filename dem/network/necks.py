@@ -315,6 +315,7 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
     centre_of = np.full(n_comp, -1)
     centre_of[label[:n][::-1]] = np.arange(n)[::-1]
     ground[centre_of[floating]] = True
+    T[ground] = 0.0
     free = ~fixed & ~ground
     A = net.A[free][:, free].tocsr()
     b = net.rhs[free] - net.A[free][:, fixed] @ T[fixed]
