@@ -142,6 +142,8 @@ class StaticEngine(Engine):
 
     name = "static"
     link_kind = "bonds"
+    necks_heat = None  # a transient run with a node per neck: its network (dem.network.necks.NeckHeat)
+    T_nodes = None  # with a node per neck: all its nodes' temperatures as the run stands (K or degC)
 
     def __init__(self, scene, restart: dict | None = None):
         """``restart``: the checkpoint of this scene's transient run (:func:`dem.output.folder.load`)."""
@@ -158,12 +160,9 @@ class StaticEngine(Engine):
         wall_temperature = np.array([w.temperature for w in walls], dtype=float)
         self.network = Network(particles, bonds, K_pairs, K_walls, wall_temperature, scene.sources, scene.box)
         self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
-        # a node per neck (dem.network.necks): the solves and the bonds' flows are its own (T_nodes: all its nodes'
-        # temperatures as the run stands)
+        # a node per neck (dem.network.necks): the solves and the bonds' flows are its own
         self.necks = (neck_network(scene.conductance, particles, bonds, box=scene.box, walls=walls)
                       if scene.conductance.nodes == "necks" else None)
-        self.T_nodes = None
-        self.heat_net = self.network
         self.meeting = meeting_in(particles, walls, bonds, scene.box)
         self.restart = Checkpoint.from_arrays(restart) if restart is not None else None
         self.t_start = float(scene.start_time)
@@ -247,9 +246,10 @@ class StaticEngine(Engine):
         """The integrator's observer: keeps the step's state for :meth:`record` and passes it on."""
         def observer(step, t, T_free, flows):
             self.steps, self.t, self.flows = step, self.t_start + t, flows
-            self.T = self.heat_net.full(T_free)
-            if isinstance(self.heat_net, NeckHeat):
-                self.T_nodes = self.heat_net.nodes(T_free)
+            if self.necks_heat is None:
+                self.T = self.network.full(T_free)
+            else:
+                self.T, self.T_nodes = self.necks_heat.full(T_free), self.necks_heat.nodes(T_free)
             if observe is not None:
                 observe()
         return observer
@@ -279,10 +279,11 @@ class StaticEngine(Engine):
                 out["periodic_heat_flow"] = periodic_heat_flow(self.network, res.T).tolist()
         else:
             if self.necks is not None:
-                self.heat_net = NeckHeat(self.necks, s.linear)
+                self.necks_heat = NeckHeat(self.necks, s.linear)
                 out.update(nodes="necks", neck_nodes=len(self.necks.live),
                            particles_without_interactions=self.necks.plain)
-            res = integrate(self.heat_net, s.integrator, s.dt, s.t_end - t0, s.rtol, s.linear, s.max_steps, observer,
+            net = self.network if self.necks_heat is None else self.necks_heat
+            res = integrate(net, s.integrator, s.dt, s.t_end - t0, s.rtol, s.linear, s.max_steps, observer,
                             None if progress is None else (lambda t: progress(t0 + t)), resume=self.restart,
                             checkpoint=checkpoint)
             self.T, self.t, self.steps = res.T, t0 + res.t, res.steps
