@@ -170,3 +170,25 @@ def test_a_transient_scene_with_neck_nodes_runs_reports_and_resumes():
     assert again.steps == 20 and Checkpoint.from_arrays(saved[-1]).T.size == 3 + 3  # free centres and necks
     again.run()
     assert np.array_equal(again.T, whole.T) and np.array_equal(again.T_nodes, first.T_nodes)
+
+
+@pytest.mark.parametrize("mode", ["steady", "transient"])
+def test_the_links_of_the_snapshots_carry_the_necks_flows(tmp_path, mode):
+    """Every snapshot's bonds carry the flows through the necks at that step (the steady one was written before
+    the neck solve's flows were kept, with the one-node law's K dT): on the turning chain the two differ."""
+    import meshio
+
+    from dem import make_scene, run
+    from dem.network.necks import neck_flows
+
+    particles, walls = _chain(turn=True)
+    result = run(make_scene(particles.position, particles.radius, particles.temperature, materials=(UNIT,),
+                            fixed=particles.fixed, walls=walls, mode=mode, integrator="implicit", dt=2e-6,
+                            t_end=2e-5, conductance=NECKS), out=tmp_path)
+    last = sorted(tmp_path.glob("bonds_*.vtu"))[-1]
+    written = np.concatenate(meshio.read(last).cell_data["heat_flow"])
+    e = result.engine
+    assert np.array_equal(written, np.concatenate(neck_flows(e.necks, e.T_nodes)[:2]))
+    b, T = e.bonds, e.T
+    one_node = e.K_pairs * (T[b.i] - T[b.j])
+    assert np.max(np.abs(written[:b.n_pairs] - one_node)) > 1e-3 * np.max(np.abs(one_node))
