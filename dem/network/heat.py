@@ -1055,7 +1055,8 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     Parameters
     ----------
     net : Network
-        The network.
+        The network, or one with massless nodes (:class:`dem.network.necks.NeckHeat`: no explicit steps; the
+        maximum principle checked on the nodes with a capacity).
     integrator : str
         ``"explicit"``, ``"implicit"`` or ``"crank-nicolson"``.
     dt : float or str
