@@ -213,9 +213,12 @@ def test_a_steady_scene_with_neck_nodes_reports_the_neck_solve():
     assert flows["walls"]["end"] == pytest.approx(-flows["fixed_total"], rel=1e-12)
     q_pairs, q_walls = result.engine.bond_heat_flow()
     assert q_walls[0] == pytest.approx(flows["walls"]["end"], rel=1e-12) and np.all(q_pairs > 0)
-    with pytest.raises(ValueError, match="nodes = \"necks\": steady heat"):
+    from dem.laws.ambient import Convection, Sources
+
+    with pytest.raises(ValueError, match="nodes = \"necks\": heat without convection"):
         run(make_scene(particles.position, particles.radius, particles.temperature, materials=(UNIT,),
-                       fixed=particles.fixed, walls=walls, mode="transient", t_end=1.0, conductance=NECKS))
+                       fixed=particles.fixed, walls=walls, mode="steady", conductance=NECKS,
+                       sources=Sources(convection=Convection(10.0, 0.0, 1.0))))
 
 
 @pytest.mark.parametrize("linear", ["direct", "amg"])

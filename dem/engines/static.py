@@ -21,7 +21,7 @@ from dem.laws.verified_range import neck_account, wide_necks
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
 from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
                               periodic_heat_flow, steady)
-from dem.network.necks import neck_network, steady_necks
+from dem.network.necks import NeckHeat, neck_flows, neck_network, steady_necks
 from dem.scene.specimen import group_flows, held_groups
 from dem.scene.state_file import box_arrays
 
@@ -62,8 +62,9 @@ def effective_conductivity(scene, summary: dict) -> float | None:
 
 
 def refuse_neck_nodes(scene) -> None:
-    """``[conductance] nodes = "necks"`` (:mod:`dem.network.necks`) solves steady heat only, so far: a transient
-    run, an ambient exchange or a current is refused in one line.
+    """``[conductance] nodes = "necks"`` (:mod:`dem.network.necks`) solves steady heat and integrates it with implicit
+    or Crank-Nicolson steps, so far: an explicit integrator (which cannot carry the massless necks), an ambient
+    exchange or a current is refused in one line.
 
     Parameters
     ----------
@@ -77,13 +78,15 @@ def refuse_neck_nodes(scene) -> None:
     """
     if scene.conductance.nodes != "necks":
         return
-    what = ("mode = \"transient\"" if scene.solver.mode == "transient" else
-            "convection" if scene.sources.convection is not None else
+    if scene.solver.mode == "transient" and scene.solver.integrator == "explicit":
+        raise ValueError("solver.integrator = \"explicit\": an explicit step cannot carry the massless neck nodes of "
+                         "[conductance] nodes = \"necks\"; use \"implicit\" or \"crank-nicolson\"")
+    what = ("convection" if scene.sources.convection is not None else
             "radiation" if scene.sources.radiation is not None else
             "electrical physics" if scene.electrical is not None else None)
     if what is not None:
-        raise ValueError(f"[conductance] nodes = \"necks\": steady heat without convection, radiation or current "
-                         f"only, so far (this scene has {what}); use nodes = \"particles\"")
+        raise ValueError(f"[conductance] nodes = \"necks\": heat without convection, radiation or current only, so "
+                         f"far (this scene has {what}); use nodes = \"particles\"")
 
 
 def boundary_summary(scene, walls, into: dict) -> dict:
@@ -139,6 +142,8 @@ class StaticEngine(Engine):
 
     name = "static"
     link_kind = "bonds"
+    necks_heat = None  # a transient run with a node per neck: its network (dem.network.necks.NeckHeat)
+    T_nodes = None  # with a node per neck: all its nodes' temperatures as the run stands (K or degC)
 
     def __init__(self, scene, restart: dict | None = None):
         """``restart``: the checkpoint of this scene's transient run (:func:`dem.output.folder.load`)."""
@@ -155,10 +160,9 @@ class StaticEngine(Engine):
         wall_temperature = np.array([w.temperature for w in walls], dtype=float)
         self.network = Network(particles, bonds, K_pairs, K_walls, wall_temperature, scene.sources, scene.box)
         self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
-        # a node per neck (dem.network.necks): the steady solve and the bonds' flows are its own
+        # a node per neck (dem.network.necks): the solves and the bonds' flows are its own
         self.necks = (neck_network(scene.conductance, particles, bonds, box=scene.box, walls=walls)
                       if scene.conductance.nodes == "necks" else None)
-        self.neck_flows = None
         self.meeting = meeting_in(particles, walls, bonds, scene.box)
         self.restart = Checkpoint.from_arrays(restart) if restart is not None else None
         self.t_start = float(scene.start_time)
@@ -242,7 +246,10 @@ class StaticEngine(Engine):
         """The integrator's observer: keeps the step's state for :meth:`record` and passes it on."""
         def observer(step, t, T_free, flows):
             self.steps, self.t, self.flows = step, self.t_start + t, flows
-            self.T = self.network.full(T_free)
+            if self.necks_heat is None:
+                self.T = self.network.full(T_free)
+            else:
+                self.T, self.T_nodes = self.necks_heat.full(T_free), self.necks_heat.nodes(T_free)
             if observe is not None:
                 observe()
         return observer
@@ -271,7 +278,12 @@ class StaticEngine(Engine):
             if self.scene.box is not None:
                 out["periodic_heat_flow"] = periodic_heat_flow(self.network, res.T).tolist()
         else:
-            res = integrate(self.network, s.integrator, s.dt, s.t_end - t0, s.rtol, s.linear, s.max_steps, observer,
+            if self.necks is not None:
+                self.necks_heat = NeckHeat(self.necks, s.linear)
+                out.update(nodes="necks", neck_nodes=len(self.necks.live),
+                           particles_without_interactions=self.necks.plain)
+            net = self.network if self.necks_heat is None else self.necks_heat
+            res = integrate(net, s.integrator, s.dt, s.t_end - t0, s.rtol, s.linear, s.max_steps, observer,
                             None if progress is None else (lambda t: progress(t0 + t)), resume=self.restart,
                             checkpoint=checkpoint)
             self.T, self.t, self.steps = res.T, t0 + res.t, res.steps
@@ -290,8 +302,8 @@ class StaticEngine(Engine):
         p, b = self.scene.particles, self.bonds
         flows = {"fixed": float(res.fixed_flow.sum()), "walls": float(-res.wall_flow.sum()),
                  "internal": float(p.heat[~p.fixed].sum())}
+        self.T_nodes = np.concatenate([res.T, res.T_necks])
         observer(0, 0.0, res.T[self.network.free], flows)
-        self.neck_flows = (res.bond_flow, res.wall_flow)
         out.update(energy_error=res.energy_error, heat_flow=flows, linear_solver=res.solver, nodes="necks",
                    neck_nodes=len(self.necks.live), particles_without_interactions=self.necks.plain)
         if len(self.network.fixed) or len(self.scene.walls):
@@ -410,9 +422,9 @@ class StaticEngine(Engine):
 
     def bond_heat_flow(self) -> tuple[np.ndarray, np.ndarray]:
         """Heat flow (W) along each pair bond from i to j, and from each wall-bonded particle into its wall (with a
-        node per neck: through the neck, from the steady solve)."""
-        if self.neck_flows is not None:
-            return self.neck_flows
+        node per neck: through the neck, :func:`dem.network.necks.neck_flows`)."""
+        if self.T_nodes is not None:
+            return neck_flows(self.necks, self.T_nodes)[:2]
         b, T = self.bonds, self.T
         wall_T = self.network.wall_temperature[b.wall_index]
         return self.K_pairs * (T[b.i] - T[b.j] + self.network.jump), self.K_walls * (T[b.wall_particle] - wall_T)

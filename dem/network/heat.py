@@ -191,6 +191,11 @@ class Network:
         return len(self.free)
 
     @property
+    def initial(self) -> np.ndarray:
+        """The free particles' initial temperatures (K or degC), where :func:`integrate` starts."""
+        return self.particles.temperature[self.free].astype(float)
+
+    @property
     def flow_names(self) -> tuple:
         """The boundaries through which heat enters the free particles (keys of :meth:`flows`)."""
         return ("fixed", "walls", "internal", *self.sources.names) + (("periodic",) if self.periodic else ())
@@ -637,12 +642,14 @@ def stable_limit(net: Network, sinks: dict | None = None) -> float:
 
     :math:`\lambda_\max` from Lanczos on the symmetric :math:`C^{-1/2} A C^{-1/2}` (dense for small systems); where
     Lanczos fails the Gershgorin bound :math:`\lambda_\max \le \max_i 2 A_{ii} / C_i` gives a safe (smaller)
-    limit.
+    limit. Massless nodes (``C = 0``: the necks of :mod:`dem.network.necks`) are condensed out first: the limit is
+    that of the Schur complement :math:`S = A_{cc} - A_{cn} A_{nn}^{-1} A_{nc}` on the nodes with a capacity, whose
+    largest eigenvalue is at most that of :math:`A_{cc}` (so the Gershgorin bound on :math:`A_{cc}` stays safe).
 
     Parameters
     ----------
     net : Network
-        The network.
+        The network (or one with massless nodes, :class:`dem.network.necks.NeckHeat`).
     sinks : dict or None
         The ambient terms to linearise with; None: at the initial temperatures.
 
@@ -651,20 +658,27 @@ def stable_limit(net: Network, sinks: dict | None = None) -> float:
     float
         The limit (s).
     """
-    sinks = net.sinks(net.particles.temperature[net.free]) if sinks is None else sinks
+    sinks = net.sinks(net.initial) if sinks is None else sinks
     A = net.matrix(sinks)
     if net.n_free == 0 or A.nnz == 0 or not np.any(A.diagonal() > 0):
         return math.inf
-    s = 1.0 / np.sqrt(net.C)
-    S = sp.diags(s) @ A @ sp.diags(s)
-    if net.n_free <= 400:
-        lam = float(np.linalg.eigvalsh(S.toarray())[-1])
+    heavy = net.C > 0.0
+    C, A_cc = (net.C, A) if np.all(heavy) else (net.C[heavy], A[heavy][:, heavy])
+    s = 1.0 / np.sqrt(C)
+    if A_cc is A:
+        S = sp.diags(s) @ A @ sp.diags(s)
+    else:  # the massless nodes condensed out (the docstring)
+        A_nc, lu = A[~heavy][:, heavy], spl.splu(A[~heavy][:, ~heavy].tocsc())
+        S = spl.LinearOperator(A_cc.shape, dtype=float, matvec=lambda x: s * (
+            A_cc @ (s * np.ravel(x)) - A_nc.T @ lu.solve(A_nc @ (s * np.ravel(x)))))
+    if len(C) <= 400:
+        lam = float(np.linalg.eigvalsh(S @ np.eye(len(C)) if A_cc is not A else S.toarray())[-1])
     else:
         try:
             lam = float(spl.eigsh(S, k=1, which="LA", tol=1e-8, return_eigenvectors=False,
                                   maxiter=5000)[0]) * (1 + 1e-7)
         except spl.ArpackNoConvergence:
-            lam = float(np.max(2.0 * A.diagonal() / net.C))
+            lam = float(np.max(2.0 * A_cc.diagonal() / C))
     return 2.0 / lam if lam > 0 else math.inf
 
 
@@ -1041,7 +1055,8 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     Parameters
     ----------
     net : Network
-        The network.
+        The network, or one with massless nodes (:class:`dem.network.necks.NeckHeat`: no explicit steps; the
+        maximum principle checked on the nodes with a capacity).
     integrator : str
         ``"explicit"``, ``"implicit"`` or ``"crank-nicolson"``.
     dt : float or str
@@ -1086,11 +1101,14 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     if not (np.isfinite(t_end) and t_end > 0):
         raise ValueError(f"solver.t_end = {t_end!r}: must be finite and > 0 (s)")
     theta = INTEGRATORS[integrator]
+    if theta == 0.0 and np.any(net.C == 0.0):
+        raise ValueError("solver.integrator = \"explicit\": an explicit step cannot carry the massless nodes of this "
+                         "network (its necks); use \"implicit\" or \"crank-nicolson\"")
     part = WholeNetwork(net) if part is None else part
     solves = LocalSolves(linear, rtol_linear) if solves is None else solves
     stepper = ThetaStepper(net, theta, solves)
     own = part.own_free
-    T = net.particles.temperature[net.free].astype(float)
+    T = net.initial
     limit = None
     startup = None  # fixed-step Crank-Nicolson above the stable limit: implicit Euler start-up (module docstring)
     if theta == 0.5 and not isinstance(dt, str) and np.isfinite(dt) and dt > 0 \
@@ -1114,7 +1132,7 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
         # temperature makes A singular): measured energy errors 1e-10, 1e-7, 5e-4 at C/dt = 2e-7, 2e-10, 1e-11 of
         # the bond conductance of a free pair. Steps stay below AUTO_CONDITION x the fastest time constant.
         diagonal = net.matrix(net.sinks(T)).diagonal() if net.n_free else np.zeros(0)
-        coupled = diagonal > 0.0  # an unbonded particle without sinks has no time constant
+        coupled = (diagonal > 0.0) & (net.C > 0.0)  # an unbonded particle without sinks, a massless node: none
         tau_min = float(np.min(net.C[coupled] / diagonal[coupled])) if np.any(coupled) else math.inf
         dt_condition = AUTO_CONDITION * tau_min
         dt_cap = min(dt_cap, dt_condition)
@@ -1145,6 +1163,8 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     lo, hi = net.temperature_bounds()
     lo, hi = part.minimum(lo), part.maximum(hi)
     bounded = not part.total(int(np.any(net.heat[own])))
+    # the nodes that hold heat (a massless neck across a periodic face is in the frame of its particle i)
+    watched = net.C > 0.0 if np.any(net.C == 0.0) else own
     violation = 0.0
     heat_in = {k: 0.0 for k in net.flow_names}
     abs_in = 0.0
@@ -1211,8 +1231,8 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
         if not part.minimum(int(np.all(np.isfinite(T[own])))):
             raise ValueError(f"temperatures became non-finite at t = {t:.6g} s (step {steps})")
         if bounded:
-            top = part.maximum(float(T[own].max(initial=-np.inf)))
-            bottom = part.minimum(float(T[own].min(initial=np.inf)))
+            top = part.maximum(float(T[watched].max(initial=-np.inf)))
+            bottom = part.minimum(float(T[watched].min(initial=np.inf)))
             violation = max(violation, top - hi, lo - bottom)
             part.agree(lambda: refuse_out_of_range(violation, lo, hi, t, integrator, dt))
         if observer is not None:

@@ -40,17 +40,21 @@ follows as in the one-node network. The solve is :func:`dem.network.linsolve.mak
 AMG-CG on large): ``A`` is SPD on the anchored groups, though not an M-matrix (``R^{-1}`` may couple two necks with a
 positive entry).
 
-**Transient (not yet implemented).** Neck nodes hold no heat: the capacity matrix is
-:math:`M = \mathrm{diag}(C_1 \dots C_n, 0 \dots 0)`, only semidefinite. The :math:`\theta` scheme
-:math:`(M/\Delta t + \theta A) T^+ = (M/\Delta t - (1 - \theta) A) T + r` stays well-posed for :math:`\theta > 0`:
-:math:`M/\Delta t + \theta A` is SPD on every anchored group and on a group with a particle (any group: a neck node
-always has two particles), since :math:`x^T (M/\Delta t + \theta A) x = 0` needs :math:`x` constant on the group
-(:math:`A` is a Laplacian-like matrix whose kernel on a connected group is the constants) and zero on its centres.
-The neck rows are algebraic constraints (a differential-algebraic system of index 1); implicit Euler and
-Crank-Nicolson treat them as such. An explicit step (:math:`\theta = 0`) cannot invert :math:`M`: it must eliminate the
-neck nodes first (a static condensation per step, :math:`A_{cc} - A_{cn} A_{nn}^{-1} A_{nc}`, a sparse solve on the
-necks whose blocks couple only the necks of neighbouring particles) or give the necks a small capacity, which limits
-the stable step; the stable limit is then that of the condensed matrix.
+**Transient.** Neck nodes hold no heat: the capacity matrix is :math:`M = \mathrm{diag}(C_1 \dots C_n, 0 \dots 0)`,
+only semidefinite. The :math:`\theta` scheme :math:`(M/\Delta t + \theta A) T^+ = (M/\Delta t - (1 - \theta) A) T + r`
+stays well-posed for :math:`\theta > 0`: :math:`M/\Delta t + \theta A` is SPD on every anchored group and on a group
+with a particle (any group: a neck node always has two particles), since :math:`x^T (M/\Delta t + \theta A) x = 0`
+needs :math:`x` constant on the group (:math:`A` is a Laplacian-like matrix whose kernel on a connected group is the
+constants) and zero on its centres. The neck rows are algebraic constraints (a differential-algebraic system of index
+1) that the step holds at :math:`\theta T^+ + (1 - \theta) T`; eliminating them there gives the same scheme on the
+condensed matrix :math:`A_{cc} - A_{cn} A_{nn}^{-1} A_{nc}` of the centres, so a chain (collinear necks: the condensed
+matrix is the halves in series) steps as today's network. :class:`NeckHeat` hands :func:`dem.network.heat.integrate`
+these matrices (its :math:`\theta` scheme, step control, energy bookkeeping and checkpoints are the one of the
+particle network); the necks start where their rows hold at the initial temperatures, which Crank-Nicolson then keeps
+(it would carry an inconsistent start on, alternating). An explicit step (:math:`\theta = 0`) cannot invert :math:`M`
+and is refused: it would have to condense the necks every step (a sparse solve on them, what an implicit step costs,
+without its stability), under the stable limit of the condensed matrix, which :func:`dem.network.heat.stable_limit`
+computes (it decides Crank-Nicolson's implicit start-up).
 
 **MPI (not yet implemented).** A neck node is owned by the lower of the two ranks that own its particles; the other
 rank holds it as a ghost (like a particle across the cut), and the element of a particle is assembled by the rank that
@@ -69,6 +73,7 @@ from scipy.sparse.csgraph import connected_components
 from dem.geometry.bonds import Bonds
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
+from dem.laws.ambient import Sources
 from dem.laws.conductance import ConductanceSpec, half_conductance, union_halves, wall_normals
 from dem.network.linsolve import make_solver
 
@@ -315,6 +320,7 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
     centre_of = np.full(n_comp, -1)
     centre_of[label[:n][::-1]] = np.arange(n)[::-1]
     ground[centre_of[floating]] = True
+    T[ground] = 0.0
     free = ~fixed & ~ground
     A = net.A[free][:, free].tocsr()
     b = net.rhs[free] - net.A[free][:, fixed] @ T[fixed]
@@ -328,18 +334,8 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
         now = np.bincount(label[:n], C * T[:n], n_comp)
         shift = np.where(anchored, 0.0, (target - now) / np.where(weight > 0, weight, 1.0))
         T += shift[label]
-    Q = net.end_flows(T)
+    bond_flow, wall_flow, fixed_flow = neck_flows(net, T)
     m = len(net.live)
-    bond_flow = np.zeros(net.bonds.n_pairs)
-    bond_flow[net.live] = -Q[:m]  # out of i through the neck
-    wall_flow = np.zeros(net.bonds.n_walls)
-    wall_flow[net.live_walls] = -Q[2 * m:]
-    # the heat fed by each fixed centre: its element's centre row (flows into the element there)
-    end, value, known = net.entries[4], net.entries[2], net.entries[3]
-    seen = known + np.where(col >= 0, T[np.maximum(col, 0)], 0.0)
-    centre = end < 0
-    fed = np.bincount(row[centre], value[centre] * seen[centre], N)[:n]
-    fixed_flow = np.where(p.fixed, fed, 0.0)
     shifts = net.bonds.shifts[net.live] if m else np.zeros((0, 3))
     periodic = bond_flow[net.live] @ shifts if m else np.zeros(3)
     boundary = [fixed_flow[p.fixed], -wall_flow, p.heat]
@@ -348,3 +344,227 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
     energy_error = abs(net_in) / scale if scale > 0 else 0.0
     return NeckSteady(T[:n].copy(), T[n:].copy(), bond_flow, wall_flow, fixed_flow, np.asarray(periodic, float),
                       energy_error, "none" if solver is None else solver.name)
+
+
+def neck_flows(net: NeckNetwork, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The heat flows through the necks, into the walls and out of the fixed centres at node temperatures ``T``.
+
+    Parameters
+    ----------
+    net : NeckNetwork
+        The network.
+    T : numpy.ndarray
+        The temperatures of all nodes, centres then necks (K or degC).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(bond_flow, wall_flow, fixed_flow)``: per pair bond (all of them) the heat flowing from ``i`` to ``j``
+        through its neck (0 for a dead one), per wall bond (all of them) the heat flowing from its particle into the
+        wall, per particle the heat its fixed temperature feeds into the network (0 for a free particle); W.
+    """
+    n, m = net.particles.n, len(net.live)
+    Q = net.end_flows(T)
+    bond_flow = np.zeros(net.bonds.n_pairs)
+    bond_flow[net.live] = -Q[:m]  # out of i through the neck
+    wall_flow = np.zeros(net.bonds.n_walls)
+    wall_flow[net.live_walls] = -Q[2 * m:]
+    # the heat fed by each fixed centre: its element's centre row (flows into the element there)
+    row, col, value, known, end = net.entries
+    seen = known + np.where(col >= 0, T[np.maximum(col, 0)], 0.0)
+    centre = end < 0
+    fed = np.bincount(row[centre], value[centre] * seen[centre], len(T))[:n]
+    return bond_flow, wall_flow, np.where(net.particles.fixed, fed, 0.0)
+
+
+class NeckHeat:
+    r"""The transient heat balance of the network with a node per neck (module docstring, "Transient") in the terms
+    in which :func:`dem.network.heat.integrate` and :class:`dem.network.theta.ThetaStepper` take a network, so that
+    one :math:`\theta` scheme serves both: the unknowns are the free centres (their capacities) and then the necks
+    (massless, ``C = 0``), ``A`` the network's matrix on them and ``r`` its right-hand side with the fixed centres'
+    columns moved into it. No ambient exchange. The necks start where their rows hold at the initial temperatures
+    (the constraint :math:`(A T)_n = r_n`), which keeps Crank-Nicolson's neck temperatures from alternating.
+
+    Parameters
+    ----------
+    net : NeckNetwork
+        The network.
+    linear : str
+        The linear solver of the necks' initial solve (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
+    rtol : float
+        The relative residual of that solve if iterative.
+    """
+
+    sources = Sources()  # no ambient exchange
+    flow_names = ("fixed", "walls", "internal")
+
+    def __init__(self, net: NeckNetwork, linear: str = "auto", rtol: float = 1e-12):
+        p = net.particles
+        n, m = p.n, len(net.live)
+        self.net, self.particles = net, p
+        centres = np.flatnonzero(~p.fixed)
+        held = np.flatnonzero(p.fixed)
+        k = len(centres)
+        self.free = np.concatenate([centres, n + np.arange(m)])
+        rows = net.A[self.free]
+        self.A = rows[:, self.free].tocsr()
+        self.r_const = net.rhs[self.free] - rows[:, held] @ p.temperature[held]
+        self.C = np.concatenate([p.capacity[centres], np.zeros(m)])
+        self.heat = np.concatenate([p.heat[centres], np.zeros(m)])
+        self.base_diag = self.A.diagonal()
+        self.n_free = len(self.free)
+        # the boundary terms: the entries of the walls' rows (heat from a wall into the network) and of the fixed
+        # centres' rows (heat a fixed centre feeds into it), grouped by wall end and by fixed centre
+        row, col, value, known, end = net.entries
+        wall = row < 0
+        fed = (row >= 0) & (row < n) & p.fixed[np.clip(row, 0, n - 1)]
+        self._walls = len(net.live_walls)
+        group = np.where(wall, end - 2 * m, self._walls + np.searchsorted(held, np.where(fed, row, 0)))
+        take = wall | fed
+        self._terms = (col[take], value[take], known[take], group[take], self._walls + len(held))
+        self.wall_temperature = known[col < 0]
+        self._initial = np.concatenate([p.temperature[centres].astype(float), np.zeros(m)])
+        if m:  # the necks where their rows hold (the docstring)
+            A_nn, A_nc = self.A[k:, k:], self.A[k:, :k]
+            b = self.r_const[k:] - A_nc @ self._initial[:k]
+            self._initial[k:] = make_solver(A_nn.tocsr(), linear, None, rtol).solve(b)
+
+    @property
+    def initial(self) -> np.ndarray:
+        """The free nodes' initial temperatures (K or degC): the free centres', the necks' where their rows hold."""
+        return self._initial.copy()
+
+    def nodes(self, T_F: np.ndarray) -> np.ndarray:
+        """The temperatures of all nodes from those of the free ones.
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            The temperatures of the free nodes, free centres then necks (K or degC).
+
+        Returns
+        -------
+        numpy.ndarray
+            All nodes' temperatures, centres then necks (K or degC).
+        """
+        T = np.concatenate([self.particles.temperature.astype(float), np.zeros(len(self.net.live))])
+        T[self.free] = T_F
+        return T
+
+    def full(self, T_F: np.ndarray) -> np.ndarray:
+        """The particles' (centres') temperatures from those of the free nodes.
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            The temperatures of the free nodes, free centres then necks (K or degC).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) the particles' temperatures (K or degC).
+        """
+        return self.nodes(T_F)[:self.particles.n]
+
+    def sinks(self, T_F: np.ndarray) -> dict:
+        """The ambient exchange: none.
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            The temperatures of the free nodes, free centres then necks (K or degC).
+
+        Returns
+        -------
+        dict
+            ``{}``.
+        """
+        return {}
+
+    def matrix(self, sinks: dict) -> sp.csr_matrix:
+        """The matrix ``A`` over the free nodes.
+
+        Parameters
+        ----------
+        sinks : dict
+            The ambient terms (none: ``{}``, :meth:`sinks`).
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix
+            ``A`` (W/K).
+        """
+        return self.A
+
+    def rhs(self, sinks: dict) -> np.ndarray:
+        """The right-hand side ``r`` over the free nodes.
+
+        Parameters
+        ----------
+        sinks : dict
+            The ambient terms (none: ``{}``, :meth:`sinks`).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``r`` (W).
+        """
+        return self.r_const
+
+    def _boundary(self, T_F: np.ndarray) -> tuple[np.ndarray, float]:
+        """Per wall end, then per fixed centre, the heat it gives the free nodes (W); and the sum of its terms' sizes
+        (W)."""
+        col, value, known, group, size = self._terms
+        T = self.nodes(T_F)
+        terms = value * (known + np.where(col >= 0, T[np.maximum(col, 0)], 0.0))
+        return np.bincount(group, terms, size), float(np.abs(terms).sum())
+
+    def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
+        """Heat flow into the free nodes through the fixed centres, the walls and the sources: their sum is the
+        change of the centres' heat (the neck rows sum their elements' rows, each of which sums to zero).
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            The temperatures of the free nodes, free centres then necks (K or degC).
+        sinks : dict
+            The ambient terms (none: ``{}``, :meth:`sinks`).
+
+        Returns
+        -------
+        dict
+            ``{"fixed": W, "walls": W, "internal": W}``.
+        """
+        q = self._boundary(T_F)[0]
+        return {"fixed": float(q[self._walls:].sum()), "walls": float(q[:self._walls].sum()),
+                "internal": float(self.heat.sum())}
+
+    def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
+        """The scale of the heat balance, as :meth:`dem.network.heat.Network.flow_magnitude`: the sum of the sizes of
+        the flows through each wall end, fixed centre and source, never below round-off of their terms.
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            The temperatures of the free nodes, free centres then necks (K or degC).
+        sinks : dict
+            The ambient terms (none: ``{}``, :meth:`sinks`).
+
+        Returns
+        -------
+        float
+            The scale (W).
+        """
+        q, gross = self._boundary(T_F)
+        sources = float(np.abs(self.heat).sum())
+        return max(sources + float(np.abs(q).sum()), np.sqrt(np.finfo(float).eps) * (sources + gross))
+
+    def temperature_bounds(self) -> tuple[float, float]:
+        """Lowest and highest temperature the scene prescribes (initial, fixed, walls)."""
+        allt = np.concatenate([self.particles.temperature, self.wall_temperature])
+        return float(allt.min()), float(allt.max())
+
+    def temperature_range(self) -> float:
+        """The spread of :meth:`temperature_bounds` (K)."""
+        lo, hi = self.temperature_bounds()
+        return hi - lo

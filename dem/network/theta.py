@@ -2,7 +2,8 @@ r"""The :math:`\theta` method's step of a heat network, written once, with its l
 
 One step of size ``dt`` from ``T`` solves :math:`(C/\Delta t + \theta A) T^+ = (C/\Delta t - (1-\theta) A) T + r` (:math:`\theta` = 0 explicit
 forward Euler, 1 implicit backward Euler, 1/2 Crank-Nicolson; :mod:`dem.network.heat`, Rojek 2022, eqs. 2-4 in
-time). :class:`ThetaStepper` assembles the system and its right-hand side from a :class:`dem.network.heat.Network`,
+time). :class:`ThetaStepper` assembles the system and its right-hand side from a :class:`dem.network.heat.Network`
+(or a network with massless nodes, :class:`dem.network.necks.NeckHeat`: ``C = 0`` on its necks),
 keeps one solver per step size and estimates a step's local error (the adaptive controller of
 :func:`dem.network.heat.integrate`, whose loop around the step is the same on one process and on MPI ranks); the
 solve itself is a plug-in with ``build``, ``solve``, ``everything_fixed`` and ``extrapolated_starts``:
@@ -145,7 +146,7 @@ class ThetaStepper:
         self._cache: dict = {}
         self.factorizations = 0
         self.backend = "none"
-        self.A0 = net.matrix(net.sinks(net.particles.temperature[net.free])) if self.linear_sinks else None
+        self.A0 = net.matrix(net.sinks(net.initial)) if self.linear_sinks else None
         self.history: list = []  # (T, dt) at the start of the last two accepted steps: warm starts for CG
         self._rate: tuple = (None, None)
         self.everything_fixed = solves.everything_fixed(net)
@@ -219,7 +220,8 @@ class ThetaStepper:
         if self._rate[0] is not T:
             sinks = self.net.sinks(T)
             A = self.A0 if self.linear_sinks else self.net.matrix(sinks)
-            self._rate = (T, ((self.net.rhs(sinks) - A @ T) / self.net.C, sinks))
+            C = self.net.C  # a massless node (a neck, dem.network.necks) has no rate of its own: 0
+            self._rate = (T, (np.divide(self.net.rhs(sinks) - A @ T, C, out=np.zeros(len(C)), where=C > 0.0), sinks))
         return self._rate[1]
 
     def step(self, T: np.ndarray, dt: float, guess: np.ndarray | None = None):
