@@ -38,7 +38,8 @@ ambient.
   implicit Euler steps (Rannacher's start-up; amplification :math:`1/(1 + z)`, L-stable), which damp the stiff part
   of the initial data; the finite number of first-order steps keeps the run second order, and a step within the
   stable limit runs plain Crank-Nicolson as before. Whatever the integrator, a run whose
-  ``max_principle_violation`` exceeds ``MAX_PRINCIPLE_TOLERANCE`` of the scene's temperature range, or whose
+  ``max_principle_violation`` exceeds ``MAX_PRINCIPLE_TOLERANCE`` of the scene's temperature range (a run without
+  internal heat and without a periodic temperature drop, either of which drives the network beyond it), or whose
   ``energy_error`` exceeds ``ENERGY_TOLERANCE``, is refused with a message naming ``dt``: its temperatures are
   wrong.
 
@@ -1157,12 +1158,14 @@ def integrate(net: Network, integrator: str = "crank-nicolson", dt="auto", t_end
     grid = 2**AUTO_LEVELS
     units = 0  # dyadic: the time t = t_end * units / grid
     energy0 = part.total(float(net.C[own] @ T[own]))
-    # maximum principle: without internal sources the temperatures stay within the prescribed ones (initial, fixed,
-    # walls, ambient); backward Euler keeps them there exactly (an M-matrix), Crank-Nicolson and explicit steps only
-    # for small enough steps. The largest excursion (in the scene's temperature unit) is reported.
+    # maximum principle: without internal sources and without a periodic temperature drop (the jumps across the
+    # box's faces drive the network as sources do: a cell at a uniform temperature settles to a drop's spread) the
+    # temperatures stay within the prescribed ones (initial, fixed, walls, ambient); backward Euler keeps them there
+    # exactly (an M-matrix), Crank-Nicolson and explicit steps only for small enough steps. The largest excursion (in
+    # the scene's temperature unit) is reported.
     lo, hi = net.temperature_bounds()
     lo, hi = part.minimum(lo), part.maximum(hi)
-    bounded = not part.total(int(np.any(net.heat[own])))
+    bounded = not part.total(int(np.any(net.heat[own]) or net.periodic))
     # the nodes that hold heat (a massless neck across a periodic face is in the frame of its particle i)
     watched = net.C > 0.0 if np.any(net.C == 0.0) else own
     violation = 0.0

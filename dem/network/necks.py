@@ -411,6 +411,7 @@ class NeckHeat:
         self.r_const = net.rhs[self.free] - rows[:, held] @ p.temperature[held]
         self.C = np.concatenate([p.capacity[centres], np.zeros(m)])
         self.heat = np.concatenate([p.heat[centres], np.zeros(m)])
+        self.periodic = bool(np.any(net.jump != 0.0))  # a temperature drop across the box's faces drives it
         self.base_diag = self.A.diagonal()
         self.n_free = len(self.free)
         # the boundary terms: the entries of the walls' rows (heat from a wall into the network) and of the fixed
