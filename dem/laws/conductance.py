@@ -352,7 +352,7 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
 
     Parameters
     ----------
-    particles : Particles
+    particles : dem.geometry.particles.Particles
         The particles (radii, m).
     bonds : Bonds
         The union bonds (lens radii and radical-plane distances, m).
@@ -395,12 +395,12 @@ def union_halves(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_
     """The union law's half conductances narrowed to each particle's cut sphere (:mod:`dem.laws.cut_body`), which
     bonds are live (a neck inside a third sphere has a half 0 and is none) and each particle's capped volume (its cut
     sphere's, lowered where the pores around it close, :mod:`dem.laws.closing_pores`): what the ``shared-body``
-    particle is made of under the union of spheres, with one node per particle (:func:`_shared_union_body`) or a
+    particle is made of under the union of spheres, with one node per particle (the factors of :mod:`dem.laws.shared_body`) or a
     node per neck (:mod:`dem.network.necks`).
 
     Parameters
     ----------
-    particles : Particles
+    particles : dem.geometry.particles.Particles
         The particles (radii, m).
     bonds : Bonds
         The union bonds (lens radii and radical-plane distances, m).

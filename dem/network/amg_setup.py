@@ -144,7 +144,7 @@ def _compact(start, stop, indices, values, bounds):
 
 
 def galerkin(A, P, R) -> sp.csr_matrix:
-    """:math:`R (A P)` for CSR matrices, on numba's threads: the rows of :math:`A P` as :func:`_product` leaves
+    """:math:`R (A P)` for CSR matrices, on numba's threads: the rows of :math:`A P` as ``_product`` leaves
     them, never copied into CSR.
 
     Parameters

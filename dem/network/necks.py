@@ -432,7 +432,8 @@ class NeckHeat:
 
     @property
     def initial(self) -> np.ndarray:
-        """The free nodes' initial temperatures (K or degC): the free centres', the necks' where their rows hold."""
+        """Initial temperatures of the free nodes, K or degC (the free centres' own, the necks' where their rows
+        hold)."""
         return self._initial.copy()
 
     def nodes(self, T_F: np.ndarray) -> np.ndarray:
