@@ -288,10 +288,7 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     kappa = particles.conductivity if conductivity is None else np.asarray(conductivity, dtype=float)
     r = particles.radius
     kc = spec.contact_conductance
-    k_i = half_conductance(spec, kappa[bonds.i], r[bonds.i], bonds.a, bonds.l_i)
-    k_j = half_conductance(spec, kappa[bonds.j], r[bonds.j], bonds.a, bonds.l_j)
-    p = bonds.wall_particle
-    k_w = half_conductance(spec, kappa[p], r[p], bonds.wall_a, bonds.wall_l)
+    k_i, k_j, k_w = bond_halves(spec, particles, bonds, kappa)
     if spec.law == "shared-body":
         from dem.laws.shared_body import neck_factors
 
@@ -315,6 +312,33 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
         share = k_j / (k_i + k_j)  # R_i / (R_i + R_j); an infinite half (a centre on the contact plane) makes none
     share = np.where(np.isfinite(share), share, np.where(np.isinf(k_i), 0.0, 1.0))
     return k_pair, k_wall, share
+
+
+def bond_halves(spec: ConductanceSpec, particles: Particles, bonds: Bonds, kappa: np.ndarray):
+    """The law's half conductances of every bond, each on its own (:func:`half_conductance`): of the pair bonds on
+    ``i`` and on ``j``, and of the wall bonds.
+
+    Parameters
+    ----------
+    spec : ConductanceSpec
+        The conductance law and its neck reading.
+    particles : dem.geometry.particles.Particles
+        The particles (radii, m).
+    bonds : Bonds
+        The pair and wall bonds (neck radii and centre-to-contact distances, m).
+    kappa : numpy.ndarray
+        Per particle, its conductivity, W/(m K).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(k_i, k_j, k_w)``, W/K.
+    """
+    r = particles.radius
+    k_i = half_conductance(spec, kappa[bonds.i], r[bonds.i], bonds.a, bonds.l_i)
+    k_j = half_conductance(spec, kappa[bonds.j], r[bonds.j], bonds.a, bonds.l_j)
+    p = bonds.wall_particle
+    return k_i, k_j, half_conductance(spec, kappa[p], r[p], bonds.wall_a, bonds.wall_l)
 
 
 def wall_normals(bonds: Bonds, walls) -> np.ndarray:

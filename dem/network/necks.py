@@ -74,7 +74,7 @@ from dem.geometry.bonds import Bonds
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources
-from dem.laws.conductance import ConductanceSpec, half_conductance, union_halves, wall_normals
+from dem.laws.conductance import ConductanceSpec, bond_halves, union_halves, wall_normals
 from dem.network.linsolve import make_solver
 
 
@@ -185,10 +185,7 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
                          f"contact_conductance (here law = {spec.law!r}, neck = {spec.neck!r})")
     n, r = particles.n, particles.radius
     kappa = particles.conductivity
-    k_i = half_conductance(spec, kappa[bonds.i], r[bonds.i], bonds.a, bonds.l_i)
-    k_j = half_conductance(spec, kappa[bonds.j], r[bonds.j], bonds.a, bonds.l_j)
-    p = bonds.wall_particle
-    k_w = half_conductance(spec, kappa[p], r[p], bonds.wall_a, bonds.wall_l)
+    k_i, k_j, k_w = bond_halves(spec, particles, bonds, kappa)
     normals = wall_normals(bonds, walls)
     vectors = bonds.vectors(particles.position, box)
     k_i, k_j, k_w, pairs, live_walls, volume = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
