@@ -81,10 +81,16 @@ def test_a_union_run_reports_the_fe_evidence_of_its_range(h, stands):
     """SC on union necks with the shared-body law: necks of a/r 0.22 are verified (within 1 %, no warning), of 0.53
     are wide (apart), and at h/r = 0.6 the six necks of every sphere meet (cones of 45.6 degrees, 90 degrees apart):
     each range names its interval of EVIDENCE."""
+    s = run(lattice("sc", 2.0 - h, neck="union", law="shared-body")).summary
+    assert_stands(s, stands, "shared-body")
+
+
+def assert_stands(s: dict, stands: str, name: str) -> None:
+    """The summary ``s`` of a union SC run whose every particle ``stands`` verified, wide or meeting reports so, with
+    the interval of ``EVIDENCE[name]`` for that range and one warning naming it outside the verified range."""
     from dem.laws.verified_range import EVIDENCE, percent_range
 
-    evidence = EVIDENCE["shared-body"]
-    s = run(lattice("sc", 2.0 - h, neck="union", law="shared-body")).summary
+    evidence = EVIDENCE[name]
     n = s["particles"]
     assert (s["particles_necks_wide"], s["particles_necks_meeting"]) == {"verified": (0, 0), "wide": (n, 0),
                                                                          "meeting": (0, n)}[stands]
@@ -94,7 +100,7 @@ def test_a_union_run_reports_the_fe_evidence_of_its_range(h, stands):
     if stands == "verified":
         assert "warnings" not in s
     else:
-        assert len(s["warnings"]) == 1 and f"law 'shared-body' at {percent_range(interval)} of k_eff" in s["warnings"][0]
+        assert len(s["warnings"]) == 1 and f"law '{name}' at {percent_range(interval)} of k_eff" in s["warnings"][0]
 
 
 @pytest.mark.parametrize("h, stands", [(0.2, "verified"), (0.3, "wide"), (0.6, "meeting")])
@@ -102,24 +108,17 @@ def test_a_neck_node_run_reports_the_evidence_of_the_neck_node_solve(h, stands):
     """The same SC cells with a node per neck: the summary's range, interval and warning are the neck-node solve's
     (EVIDENCE["shared-body (neck nodes)"]), not the one-node law's -- at h/r = 0.2 (a/r 0.436) the neck nodes are
     verified where the one-node law's necks are wide."""
-    from dem.laws.verified_range import EVIDENCE, evidence_name, percent_range
+    from dem.laws.verified_range import evidence_name
 
-    evidence = EVIDENCE[evidence_name("shared-body", "necks")]
     s = run(lattice("sc", 2.0 - h, neck="union", law="shared-body", nodes="necks")).summary
     one = run(lattice("sc", 2.0 - h, neck="union", law="shared-body")).summary
     assert s["nodes"] == "necks" and s["effective_conductivity"] == pytest.approx(one["effective_conductivity"],
                                                                                   rel=1e-9)  # SC: the same k_eff
-    n = s["particles"]
-    assert (s["particles_necks_wide"], s["particles_necks_meeting"]) == {"verified": (0, 0), "wide": (n, 0),
-                                                                         "meeting": (0, n)}[stands]
-    assert s["law_in_verified_range"] is (stands == "verified")
-    interval = {"verified": (-0.01, 0.01), "wide": evidence.apart, "meeting": evidence.meeting}[stands]
-    assert s["law_error_range"] == list(interval)
+    assert_stands(s, stands, evidence_name("shared-body", "necks"))
     if stands == "verified":
-        assert "warnings" not in s and one["particles_necks_wide"] == n and one["law_in_verified_range"] is False
+        assert one["particles_necks_wide"] == s["particles"] and one["law_in_verified_range"] is False
     else:
-        assert s["law_error_range"] != one["law_error_range"] and len(s["warnings"]) == 1
-        assert f"law 'shared-body (neck nodes)' at {percent_range(interval)} of k_eff" in s["warnings"][0]
+        assert s["law_error_range"] != one["law_error_range"]
 
 
 def test_every_network_of_the_densification_study_has_its_evidence():
