@@ -264,6 +264,8 @@ class StaticEngine(Engine):
                               self.bonds.n_pairs + self.bonds.n_walls, law,
                               np.count_nonzero(wide_necks(self.scene.particles.radius, self.bonds, self.meeting, law,
                                                           nodes)), nodes=nodes)}
+        if self.necks is not None:
+            out.update(nodes="necks", neck_nodes=len(self.necks.live), particles_without_interactions=self.necks.plain)
         observer = self._observed(observe)
         t0 = self.t_start
         if s.mode == "steady" and self.necks is not None:
@@ -280,8 +282,6 @@ class StaticEngine(Engine):
         else:
             if self.necks is not None:
                 self.necks_heat = NeckHeat(self.necks, s.linear)
-                out.update(nodes="necks", neck_nodes=len(self.necks.live),
-                           particles_without_interactions=self.necks.plain)
             net = self.network if self.necks_heat is None else self.necks_heat
             res = integrate(net, s.integrator, s.dt, s.t_end - t0, s.rtol, s.linear, s.max_steps, observer,
                             None if progress is None else (lambda t: progress(t0 + t)), resume=self.restart,
@@ -304,8 +304,7 @@ class StaticEngine(Engine):
                  "internal": float(p.heat[~p.fixed].sum())}
         self.T_nodes = np.concatenate([res.T, res.T_necks])
         observer(0, 0.0, res.T[self.network.free], flows)
-        out.update(energy_error=res.energy_error, heat_flow=flows, linear_solver=res.solver, nodes="necks",
-                   neck_nodes=len(self.necks.live), particles_without_interactions=self.necks.plain)
+        out.update(energy_error=res.energy_error, heat_flow=flows, linear_solver=res.solver)
         if len(self.network.fixed) or len(self.scene.walls):
             walls = np.bincount(b.wall_index, res.wall_flow, len(self.scene.walls))
             out["boundary_heat_flow"] = boundary_summary(self.scene, walls,
