@@ -63,8 +63,8 @@ def effective_conductivity(scene, summary: dict) -> float | None:
 
 def refuse_neck_nodes(scene) -> None:
     """``[conductance] nodes = "necks"`` (:mod:`dem.network.necks`) solves steady heat and integrates it with implicit
-    or Crank-Nicolson steps, so far: an explicit integrator (which cannot carry the massless necks), an ambient
-    exchange or a current is refused in one line.
+    or Crank-Nicolson steps, with convection and radiation on the particles' centres, so far: an explicit integrator
+    (which cannot carry the massless necks) or a current is refused in one line.
 
     Parameters
     ----------
@@ -81,12 +81,9 @@ def refuse_neck_nodes(scene) -> None:
     if scene.solver.mode == "transient" and scene.solver.integrator == "explicit":
         raise ValueError("solver.integrator = \"explicit\": an explicit step cannot carry the massless neck nodes of "
                          "[conductance] nodes = \"necks\"; use \"implicit\" or \"crank-nicolson\"")
-    what = ("convection" if scene.sources.convection is not None else
-            "radiation" if scene.sources.radiation is not None else
-            "electrical physics" if scene.electrical is not None else None)
-    if what is not None:
-        raise ValueError(f"[conductance] nodes = \"necks\": heat without convection, radiation or current only, so "
-                         f"far (this scene has {what}); use nodes = \"particles\"")
+    if scene.electrical is not None:
+        raise ValueError("[conductance] nodes = \"necks\": heat without current only, so far (this scene has "
+                         "electrical physics); use nodes = \"particles\"")
 
 
 def boundary_summary(scene, walls, into: dict) -> dict:
@@ -281,7 +278,7 @@ class StaticEngine(Engine):
                 out["periodic_heat_flow"] = periodic_heat_flow(self.network, res.T).tolist()
         else:
             if self.necks is not None:
-                self.necks_heat = NeckHeat(self.necks, s.linear)
+                self.necks_heat = NeckHeat(self.necks, s.linear, sources=self.network.sources)
             net = self.network if self.necks_heat is None else self.necks_heat
             res = integrate(net, s.integrator, s.dt, s.t_end - t0, s.rtol, s.linear, s.max_steps, observer,
                             None if progress is None else (lambda t: progress(t0 + t)), resume=self.restart,
@@ -298,13 +295,13 @@ class StaticEngine(Engine):
     def _steady_necks(self, observer, out: dict) -> None:
         """The steady solve with a node per neck (:func:`dem.network.necks.steady_necks`) and what the summary says of
         it, in the keys of the one-node solve."""
-        res = steady_necks(self.necks, self.scene.solver.floating, self.scene.solver.linear)
-        p, b = self.scene.particles, self.bonds
-        flows = {"fixed": float(res.fixed_flow.sum()), "walls": float(-res.wall_flow.sum()),
-                 "internal": float(p.heat[~p.fixed].sum())}
+        res = steady_necks(self.necks, self.scene.solver.floating, self.scene.solver.linear,
+                           sources=self.network.sources)
+        b = self.bonds
         self.T_nodes = np.concatenate([res.T, res.T_necks])
-        observer(0, 0.0, res.T[self.network.free], flows)
-        out.update(energy_error=res.energy_error, heat_flow=flows, linear_solver=res.solver)
+        observer(0, 0.0, res.T[self.network.free], res.flows)
+        out.update(energy_error=res.energy_error, heat_flow=res.flows, linear_solver=res.solver,
+                   newton_iterations=res.iterations)
         if len(self.network.fixed) or len(self.scene.walls):
             walls = np.bincount(b.wall_index, res.wall_flow, len(self.scene.walls))
             out["boundary_heat_flow"] = boundary_summary(self.scene, walls,
