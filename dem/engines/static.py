@@ -4,8 +4,10 @@ no mechanical state; a scene whose physics is ``"thermal"``, or ``"thermal"`` an
 
 With ``"electrical"`` physics a current flows between the electrodes (walls with a potential or a current) through the
 same bonds (Kirchhoff's laws, :func:`dem.network.current.kirchhoff`: each contact's conductance the scene's law with the
-electrical conductivity for :math:`\kappa`). Nothing moves and the conductivities do not depend on the temperature, so
-it is solved once, before the heat: the absorbed part of its Joule heat is a constant source in every particle.
+electrical conductivity for :math:`\kappa`; with a node per neck the particles' elements scaled by
+:math:`\sigma / \kappa`, :func:`dem.network.necks.neck_current`, each particle's Joule heat its element's
+dissipation). Nothing moves and the conductivities do not depend on the temperature, so it is solved once, before the
+heat: the absorbed part of its Joule heat is a constant source in every particle.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from dem.laws.verified_range import neck_account, wide_necks
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
 from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
                               periodic_heat_flow, steady)
-from dem.network.necks import NeckHeat, neck_flows, neck_network, steady_necks
+from dem.network.necks import NeckHeat, neck_current, neck_flows, neck_network, steady_necks
 from dem.scene.specimen import group_flows, held_groups
 from dem.scene.state_file import box_arrays
 
@@ -63,8 +65,8 @@ def effective_conductivity(scene, summary: dict) -> float | None:
 
 def refuse_neck_nodes(scene) -> None:
     """``[conductance] nodes = "necks"`` (:mod:`dem.network.necks`) solves steady heat and integrates it with implicit
-    or Crank-Nicolson steps, with convection and radiation on the particles' centres, so far: an explicit integrator
-    (which cannot carry the massless necks) or a current is refused in one line.
+    or Crank-Nicolson steps, with convection, radiation and a current: an explicit integrator (which cannot carry the
+    massless necks) is refused in one line.
 
     Parameters
     ----------
@@ -74,16 +76,13 @@ def refuse_neck_nodes(scene) -> None:
     Raises
     ------
     ValueError
-        The scene asks for what the network with a node per neck does not solve yet.
+        The scene asks for what the network with a node per neck does not solve.
     """
     if scene.conductance.nodes != "necks":
         return
     if scene.solver.mode == "transient" and scene.solver.integrator == "explicit":
         raise ValueError("solver.integrator = \"explicit\": an explicit step cannot carry the massless neck nodes of "
                          "[conductance] nodes = \"necks\"; use \"implicit\" or \"crank-nicolson\"")
-    if scene.electrical is not None:
-        raise ValueError("[conductance] nodes = \"necks\": heat without current only, so far (this scene has "
-                         "electrical physics); use nodes = \"particles\"")
 
 
 def boundary_summary(scene, walls, into: dict) -> dict:
@@ -151,15 +150,15 @@ class StaticEngine(Engine):
             self._check_work()
         particles, walls = scene.particles, scene.walls
         bonds, K_pairs, K_walls = bonds_and_conductances(particles, walls, scene.conductance, box=scene.box)
+        # a node per neck (dem.network.necks): the solves, the current and the bonds' flows are its own
+        self.necks = (neck_network(scene.conductance, particles, bonds, box=scene.box, walls=walls)
+                      if scene.conductance.nodes == "necks" else None)
         self.potential, self.circuit = None, None
         if scene.electrical is not None:
             particles = self._joule_heated(particles, bonds)
         wall_temperature = np.array([w.temperature for w in walls], dtype=float)
         self.network = Network(particles, bonds, K_pairs, K_walls, wall_temperature, scene.sources, scene.box)
         self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
-        # a node per neck (dem.network.necks): the solves and the bonds' flows are its own
-        self.necks = (neck_network(scene.conductance, particles, bonds, box=scene.box, walls=walls)
-                      if scene.conductance.nodes == "necks" else None)
         self.meeting = meeting_in(particles, walls, bonds, scene.box)
         self.restart = Checkpoint.from_arrays(restart) if restart is not None else None
         self.t_start = float(scene.start_time)
@@ -172,16 +171,24 @@ class StaticEngine(Engine):
         """The particles with the absorbed Joule heat of the current (module docstring) added to their heat sources;
         keeps the potentials and what the summary says of the circuit."""
         e = self.scene.electrical
-        net = electrode_bonds(particles, bonds, self.scene.walls, self.scene.conductance, e.electrodes, self.scene.box)
-        flow = kirchhoff(particles.n, bonds.i, bonds.j, net.G, net.share, net.plane_node, net.plane_index, net.G_plane,
-                         e.electrodes, self.scene.solver.linear)
-        require_paths(flow, e.electrodes, net.plane_index)
+        if self.necks is not None:  # the current through the neck nodes, each particle's Joule heat its element's
+            flow, plane_index = neck_current(self.necks, self.scene.walls, e.electrodes, self.scene.solver.linear)
+        else:
+            net = electrode_bonds(particles, bonds, self.scene.walls, self.scene.conductance, e.electrodes,
+                                  self.scene.box)
+            flow = kirchhoff(particles.n, bonds.i, bonds.j, net.G, net.share, net.plane_node, net.plane_index,
+                             net.G_plane, e.electrodes, self.scene.solver.linear)
+            plane_index = net.plane_index
+        require_paths(flow, e.electrodes, plane_index)
         if e.floating == "error":
             refuse_floating(flow.floating)
         self.potential = flow.potential
         self.circuit = circuit(e.electrodes, flow.electrode_potential, flow.electrode_current, flow.joule_heat,
                                flow.electrode_power)
-        return replace(particles, heat=particles.heat + e.absorption * flow.joule_particles)
+        heated = replace(particles, heat=particles.heat + e.absorption * flow.joule_particles)
+        if self.necks is not None:
+            self.necks = replace(self.necks, particles=heated)
+        return heated
 
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """Solve (steady) or integrate (transient) to ``[solver] t_end``; ``observe()`` after every step (and at the

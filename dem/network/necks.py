@@ -67,6 +67,23 @@ on this matrix, whose diagonal alone changes; in time it is linearised about eac
 of nodes with a centre that sees the ambient is anchored by it. The heat balance sums the flows through the walls,
 the fixed centres, the sources and the ambient (:meth:`NeckHeat.flows`); the necks' rows add nothing to it.
 
+**Current.** The current between electrodes (:mod:`dem.network.current`) obeys the same Laplace problem with the
+electrical conductivity :math:`\sigma` for :math:`\kappa`: the half conductances, the faces' interaction and the trace
+cap are each proportional to the particle's conductivity, so its electrical element is :math:`(\sigma_k/\kappa_k)
+E_k`, the thermal one scaled (one assembly for both). Kirchhoff's solve (:func:`dem.network.current.kirchhoff`, its
+superposition for an electrode driving a fixed current and its floating groups included) takes the elements as edges:
+a symmetric matrix whose rows sum to zero is the Laplacian of the graph whose edge ``(p, q)`` has the conductance
+:math:`-E_{pq}` (positive or, between two necks, possibly negative), so every pair of an element's nodes is an edge;
+a wall end on an electrode is a plane bond to it, a wall end on another wall (no current crosses it) a node of its
+own, joined only to its particle's element (which is then that element with the end's row condensed out). There is
+no potential drop across a periodic box's faces: the necks' offsets are the heat's only. The Joule heat made in
+particle ``k`` is its element's dissipation :math:`\Phi_k^T E_k^\sigma \Phi_k = \sum_{p<q} -E^\sigma_{pq} (\Phi_p -
+\Phi_q)^2` (:math:`\Phi_k` the potentials of its centre and its necks), deposited on its centre (its absorbed part a
+source of heat there); summed over the particles it is the power :math:`\sum_e V_e I_e` the electrodes deliver
+(Tellegen's theorem), to round-off. A chain's elements are its halves in series, whose dissipations are the shares
+of :math:`I^2/G` that the particle network gives each particle: today's current, potentials and Joule heat. A particle
+touching two electrodes (its element would join them directly, an edge the solve has no place for) is refused.
+
 **MPI (not yet implemented).** A neck node is owned by the lower of the two ranks that own its particles; the other
 rank holds it as a ghost (like a particle across the cut), and the element of a particle is assembled by the rank that
 owns the particle, its rows for a ghost neck sent to the neck's owner (the same exchange the distributed Laplacian
@@ -75,7 +92,7 @@ makes for its halo rows, :mod:`dem.network.distributed`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -86,6 +103,7 @@ from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources, linear_sink_terms
 from dem.laws.conductance import ConductanceSpec, bond_halves, union_halves, wall_normals
+from dem.network.current import CurrentFlow, Electrodes, kirchhoff
 from dem.network.heat import solve_steady
 from dem.network.linsolve import make_solver
 
@@ -119,6 +137,10 @@ class NeckNetwork:
         The number of particles whose interactions were dropped (``R`` not positive definite).
     jump : numpy.ndarray
         Per live pair bond, the temperature drop its ``j`` sees across the periodic faces (K; 0 without a box).
+    owner : numpy.ndarray
+        Per element entry (in the order of ``entries``), the particle whose element it belongs to.
+    col_end : numpy.ndarray
+        Per element entry, the bond end of its column (``-1``: the centre).
     box : dem.geometry.periodic.PeriodicBox or None
         The periodic box; None: none.
     """
@@ -133,6 +155,8 @@ class NeckNetwork:
     n_ends: int
     plain: int
     jump: np.ndarray
+    owner: np.ndarray
+    col_end: np.ndarray
     box: PeriodicBox | None = None
 
     @property
@@ -234,7 +258,7 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     A = 0.5 * (A + A.T)  # symmetric to round-off (the blocks are; their sums need not be bit for bit)
     rhs = -np.bincount(row[rows], value[rows] * known[rows], size_all)
     return NeckNetwork(particles, bonds, live, live_walls, A.tocsr(), rhs, (row, col, value, known, end_row),
-                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, box)
+                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box)
 
 
 @dataclass
@@ -617,3 +641,74 @@ class NeckHeat:
         """The spread of :meth:`temperature_bounds` (K)."""
         lo, hi = self.temperature_bounds()
         return hi - lo
+
+
+def neck_current(net: NeckNetwork, walls, electrodes: Electrodes, linear: str = "auto") -> tuple[CurrentFlow,
+                                                                                                  np.ndarray]:
+    r"""The current between the electrodes through the network with a node per neck (module docstring, "Current"):
+    Kirchhoff's solve (:func:`dem.network.current.kirchhoff`) on the elements' edges with :math:`\sigma` for
+    :math:`\kappa`, and each particle's Joule heat its element's dissipation.
+
+    Parameters
+    ----------
+    net : NeckNetwork
+        The network (its elements with the thermal conductivity :math:`\kappa`).
+    walls : sequence of dem.geometry.walls.Wall
+        The scene's walls (the bonds' wall indices refer to them).
+    electrodes : dem.network.current.Electrodes
+        The electrodes among ``walls``.
+    linear : str
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
+
+    Returns
+    -------
+    tuple
+        ``(flow, plane_index)``: the :class:`dem.network.current.CurrentFlow` with the particles' (centres')
+        potentials (V), the floating particles, each particle's Joule heat (W) and their sum; its ``pair_current``
+        and ``wall_current`` are those of the elements' edges (A). ``plane_index``: the electrode of each live wall
+        bond to an electrode (for :func:`dem.network.current.require_paths`).
+
+    Raises
+    ------
+    ValueError
+        A particle touches two electrodes (its element would join them directly, which the solve has no edge for),
+        or no electrode is at a fixed potential.
+    """
+    p = net.particles
+    n, m = p.n, len(net.live)
+    row, col, value, _, end = net.entries
+    owner, col_end = net.owner, net.col_end
+    # each end's place: a neck's node, a wall end to an electrode that electrode (a plane), an insulated one a node
+    electrode_of_wall = np.full(len(walls), -1, dtype=np.int64)
+    electrode_of_wall[list(electrodes.walls)] = np.arange(len(electrodes))
+    electrode = electrode_of_wall[net.bonds.wall_index[net.live_walls]]
+    insulated = electrode < 0
+    extra = n + m + np.cumsum(insulated) - 1
+    n_nodes = n + m + int(insulated.sum())
+    wall_node = np.concatenate([np.where(insulated, extra, -1), [-1]])  # per wall end (and a pad for a pair end)
+    wall_plane = np.concatenate([electrode, [-1]])
+    k_row, k_col = np.where(end >= 2 * m, end - 2 * m, -1), np.where(col_end >= 2 * m, col_end - 2 * m, -1)
+    a, b = np.where(row >= 0, row, wall_node[k_row]), np.where(col >= 0, col, wall_node[k_col])
+    plane_a, plane_b = np.where(row >= 0, -1, wall_plane[k_row]), np.where(col >= 0, -1, wall_plane[k_col])
+    upper = end < col_end  # each pair of an element's nodes once (the centre is end -1)
+    both = upper & (plane_a >= 0) & (plane_b >= 0)
+    if np.any(both):
+        k = int(owner[np.flatnonzero(both)[0]])
+        raise ValueError(f"[conductance] nodes = \"necks\": particle {k} touches two electrodes, which its element "
+                         f"would join directly; use nodes = \"particles\"")
+    G = -value * (p.electrical_conductivity / p.conductivity)[owner]  # the element scaled by sigma / kappa
+    edge = upper & (plane_a < 0) & (plane_b < 0)
+    plane = upper & ~edge
+    node = np.where(plane_a >= 0, b, a)[plane]
+    plane_index = np.where(plane_a >= 0, plane_a, plane_b)[plane]
+    flow = kirchhoff(n_nodes, a[edge], b[edge], G[edge], np.zeros(int(edge.sum())), node, plane_index, G[plane],
+                     electrodes, linear)
+    # each element's dissipation: sum over its pairs of nodes of G (phi_a - phi_b)^2 (floating nodes carry nothing)
+    x = np.nan_to_num(flow.potential)
+    V = np.nan_to_num(flow.electrode_potential)
+    live = np.isfinite(flow.potential[node]) & np.isfinite(flow.electrode_potential[plane_index])
+    joule = (np.bincount(owner[edge], G[edge] * (x[a[edge]] - x[b[edge]]) ** 2, n)
+             + np.bincount(owner[plane], np.where(live, G[plane] * (V[plane_index] - x[node]) ** 2, 0.0), n))
+    floating = flow.floating[flow.floating < n]
+    return replace(flow, potential=flow.potential[:n].copy(), floating=floating, joule_particles=joule,
+                   joule_heat=float(joule.sum())), plane_index
