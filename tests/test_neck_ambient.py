@@ -206,3 +206,22 @@ def test_mpi_still_refuses_neck_nodes():
     scene = make_scene(particles.position, particles.radius, particles.temperature, materials=(UNIT,), walls=walls,
                        mode="steady", conductance=NECKS, sources=CONVECTION)
     assert unsupported(scene) == "conductance.nodes = \"necks\" does not run under MPI yet; run it without mpiexec"
+
+
+def test_a_transient_chain_scene_with_an_ambient_on_neck_nodes_is_todays():
+    """The static engine hands the scene's ambient to the transient neck network: on the chain the run ends where
+    the one-node run ends, with the same heat through the ambient."""
+    from dem import make_scene, run
+
+    particles, walls = _hot_chain()
+
+    def scene(conductance):
+        return make_scene(particles.position, particles.radius, particles.temperature, materials=(UNIT,),
+                          fixed=particles.fixed, walls=walls, mode="transient", integrator="crank-nicolson", dt=2e-6,
+                          t_end=1e-4, conductance=conductance, sources=RADIATION)
+
+    a, b = run(scene(NECKS)), run(scene(PARTICLES))
+    assert np.max(np.abs(a.T - b.T)) < 1e-12 * np.max(np.abs(b.T)) and np.ptp(b.T) > 10.0
+    for key in ("convection", "radiation"):
+        assert a.summary["heat_in"][key] == pytest.approx(b.summary["heat_in"][key], rel=1e-9)
+    assert a.summary["nodes"] == "necks" and a.summary["energy_error"] < 1e-12
