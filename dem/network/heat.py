@@ -157,8 +157,11 @@ class Network:
         n = self.particles.n
         self.jump = self.bonds.shifts @ self.box.drop if self.box is not None else np.zeros(self.bonds.n_pairs)
         self.periodic = bool(np.any(self.jump != 0.0))
-        jump_flow = self.K_pairs * self.jump
-        self.jump_rhs = np.bincount(self.bonds.j, jump_flow, n) - np.bincount(self.bonds.i, jump_flow, n)
+        if self.periodic:
+            jump_flow = self.K_pairs * self.jump
+            self.jump_rhs = np.bincount(self.bonds.j, jump_flow, n) - np.bincount(self.bonds.i, jump_flow, n)
+        else:  # what the sums give without a jump, without two passes over the bonds
+            self.jump_rhs = np.zeros(n)
         self.periodic_rhs = self.jump_rhs[self.free]
         self.r_const = self.fixed_rhs + self.wall_rhs + self.heat + self.periodic_rhs
 
