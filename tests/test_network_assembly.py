@@ -35,8 +35,12 @@ def test_canonical_edges_give_the_summed_laplacian_to_the_bit(n, m):
         assert abs(shuffled - L).max() <= 1e-15 * np.abs(L.data).max()
 
 
-@pytest.mark.parametrize("open_every", [0, 3])  # all contacts closed (the free block's graph), some open (edge list)
-def test_groups_are_those_of_the_closed_edges(open_every):
+# all contacts closed (the free block's graph: scipy's search, or compiled as for a large network), some open (edges)
+@pytest.mark.parametrize("open_every, compiled", [(0, False), (0, True), (3, False)])
+def test_groups_are_those_of_the_closed_edges(open_every, compiled, monkeypatch):
+    from dem.network import laplacian as assembly
+
+    monkeypatch.setattr(assembly, "COMPILED_GROUPS_FROM", 0 if compiled else 10**9)
     rng = np.random.default_rng(2)
     n = 400
     i, j = sorted_pairs(rng.integers(0, n, 300), rng.integers(0, n, 300), n)
@@ -68,6 +72,27 @@ def test_groups_are_those_of_the_closed_edges(open_every):
         if k > 0 and fixed[a] != fixed[b]:
             touches[b if fixed[a] else a] = True
     assert np.array_equal(anchored[label], np.isin(roots, roots[touches[g.free]]))
+
+
+def test_compiled_groups_are_scipys_numbered_alike():
+    """The compiled union-find's groups of a symmetric pattern (many groups, single nodes, the diagonal present or
+    not) are scipy's undirected search's, numbered alike (by their smallest nodes)."""
+    from scipy.sparse.csgraph import connected_components
+
+    from dem.network.groups import groups
+
+    rng = np.random.default_rng(7)
+    n = 5000
+    i, j = sorted_pairs(rng.integers(0, n, 3000), rng.integers(0, n, 3000), n)
+    keep = i != j
+    for diagonal in (True, False):
+        L = laplacian(n, i[keep], j[keep], rng.uniform(0.5, 1.0, int(keep.sum())))
+        if not diagonal:
+            L.setdiag(0.0)
+            L.eliminate_zeros()
+        count, label = groups(L.indptr, L.indices)
+        ref_count, ref_label = connected_components(L, directed=False)
+        assert count == ref_count > 1000 and np.array_equal(label, ref_label)
 
 
 def test_heat_flow_through_a_packing_is_that_of_the_general_route(monkeypatch):
