@@ -74,6 +74,26 @@ def test_groups_are_those_of_the_closed_edges(open_every, compiled, monkeypatch)
     assert np.array_equal(anchored[label], np.isin(roots, roots[touches[g.free]]))
 
 
+def test_shared_matrix_is_the_free_block_only_where_the_sum_would_copy_it():
+    """``matrix(shared=True)`` is ``L_FF`` itself where nothing is added to its diagonal; with a diagonal added or a
+    zero entry (an open contact, which the sum drops) it is the sum, as without sharing, to the bit."""
+    rng = np.random.default_rng(3)
+    n = 300
+    chain = np.arange(n)  # every node bonded: no zero diagonal (an isolated node's, which the sum would drop too)
+    i, j = sorted_pairs(np.r_[rng.integers(0, n, 900), chain[:-1]], np.r_[rng.integers(0, n, 900), chain[1:]], n)
+    i, j = i[i != j], j[i != j]
+    fixed = np.zeros(n, dtype=bool)
+    fixed[:10] = True
+    for K, extra, alike in ((rng.uniform(0.5, 1.0, len(i)), None, True),
+                            (rng.uniform(0.5, 1.0, len(i)), rng.uniform(0.0, 1.0, n - 10), False),
+                            (np.where(np.arange(len(i)) % 4 == 0, 0.0, 1.0), None, False)):
+        g = BoundedLaplacian(n, i, j, K, fixed, np.zeros(0, int), np.zeros(0, int), np.zeros(0), 0)
+        A, summed = g.matrix(extra, shared=True), g.matrix(extra)
+        assert (A is g.L_FF) == alike and summed is not g.L_FF
+        assert np.array_equal(A.indptr, summed.indptr) and np.array_equal(A.indices, summed.indices)
+        assert np.array_equal(A.data, summed.data)
+
+
 def test_compiled_groups_are_scipys_numbered_alike():
     """The compiled union-find's groups of a symmetric pattern (many groups, single nodes, the diagonal present or
     not) are scipy's undirected search's, numbered alike (by their smallest nodes)."""

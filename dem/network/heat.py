@@ -220,20 +220,23 @@ class Network:
         """
         return linear_sink_terms(self.sources, self.radius, T_F)
 
-    def matrix(self, sinks: dict) -> sp.csr_matrix:
+    def matrix(self, sinks: dict, shared: bool = False) -> sp.csr_matrix:
         r"""The system matrix :math:`A = L_{FF} + \mathrm{diag}(K_\mathrm{wall} + g)`, CSR.
 
         Parameters
         ----------
         sinks : dict
             The ambient terms ``{name: (g, b)}`` (:meth:`sinks`): W/K and W per free particle.
+        shared : bool
+            True: ``L_FF`` itself where ``A`` would be its copy, for a caller that neither writes into ``A`` nor keeps
+            it past a :meth:`refresh` (:meth:`dem.network.laplacian.BoundedLaplacian.matrix`); False: a new matrix.
 
         Returns
         -------
         scipy.sparse.csr_matrix
             ``A`` (W/K).
         """
-        return self.graph.matrix(sum((g for g, _ in sinks.values()), np.zeros(self.n_free)))
+        return self.graph.matrix(sum((g for g, _ in sinks.values()), np.zeros(self.n_free)), shared)
 
     def rhs(self, sinks: dict) -> np.ndarray:
         """The right-hand side ``r`` of the module docstring.
@@ -610,7 +613,7 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
     for iterations in range(1, max_newton + 1):
         T_F[solve_idx] = T_sub
         sinks = net.sinks(T_F)
-        A, r = net.matrix(sinks), net.rhs(sinks)
+        A, r = net.matrix(sinks, shared=True), net.rhs(sinks)  # the solver, discarded here, only reads A
         if restrict is not None:
             A, r = A[restrict][:, restrict], r[restrict]
         if len(r) == 0:
