@@ -19,9 +19,22 @@ def _root(parent, a):
 
 @njit(cache=True)
 def groups(indptr, indices):
-    """``(count, label)``: the connected groups of the graph whose edges are the entries of a CSR matrix with a
-    symmetric sparsity pattern (``indptr``, ``indices``; the diagonal ignored), each node's group numbered in the order
-    of the groups' smallest nodes, as scipy's search numbers them. The root of a group is its smallest node."""
+    """The connected groups of the graph whose edges are the entries of a CSR matrix with a symmetric sparsity
+    pattern (the diagonal ignored). The root of a group is its smallest node.
+
+    Parameters
+    ----------
+    indptr : numpy.ndarray
+        (n + 1,) int, the matrix's row starts.
+    indices : numpy.ndarray
+        int, the matrix's column indices.
+
+    Returns
+    -------
+    tuple
+        ``(count, label)``: the number of groups and each node's group (int64), numbered in the order of the groups'
+        smallest nodes, as scipy's undirected search numbers them.
+    """
     n = indptr.shape[0] - 1
     parent = np.arange(n)
     for i in range(n):

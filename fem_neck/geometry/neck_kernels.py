@@ -25,9 +25,23 @@ OUT_OF_RANGE, NOT_CONVERGED = 1, 2  # a block's flag: an input outside the model
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def newton_blocks(r_i, r_j, h, out):
-    """The volume-conserving neck radius (Rojek 2022, eqs. 27-33) of every bond into ``out`` (m), ``_CHUNK`` bonds
-    per block; returns a flag per block (0, ``OUT_OF_RANGE`` or ``NOT_CONVERGED``), where ``out`` is then not
-    written. ``r_i``, ``r_j`` and ``h`` are the radii and the overlaps (m), of one length."""
+    """The volume-conserving neck radius (Rojek 2022, eqs. 27-33) of every bond, ``_CHUNK`` bonds per block.
+
+    Parameters
+    ----------
+    r_i, r_j : numpy.ndarray
+        (M,) float, the radii of the bonds' two spheres, m.
+    h : numpy.ndarray
+        (M,) float, the bonds' overlaps, m.
+    out : numpy.ndarray
+        (M,) float, written with the neck radii (m) of every block whose flag is 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        A flag per block (uint8): 0, ``OUT_OF_RANGE`` (an input outside the model's range, as ``_validated`` refuses
+        it) or ``NOT_CONVERGED``.
+    """
     m = h.shape[0]
     chunk = _g._CHUNK
     blocks = (m + chunk - 1) // chunk
