@@ -157,8 +157,11 @@ class Network:
         n = self.particles.n
         self.jump = self.bonds.shifts @ self.box.drop if self.box is not None else np.zeros(self.bonds.n_pairs)
         self.periodic = bool(np.any(self.jump != 0.0))
-        jump_flow = self.K_pairs * self.jump
-        self.jump_rhs = np.bincount(self.bonds.j, jump_flow, n) - np.bincount(self.bonds.i, jump_flow, n)
+        if self.periodic:
+            jump_flow = self.K_pairs * self.jump
+            self.jump_rhs = np.bincount(self.bonds.j, jump_flow, n) - np.bincount(self.bonds.i, jump_flow, n)
+        else:  # what the sums give without a jump, without two passes over the bonds
+            self.jump_rhs = np.zeros(n)
         self.periodic_rhs = self.jump_rhs[self.free]
         self.r_const = self.fixed_rhs + self.wall_rhs + self.heat + self.periodic_rhs
 
@@ -217,20 +220,23 @@ class Network:
         """
         return linear_sink_terms(self.sources, self.radius, T_F)
 
-    def matrix(self, sinks: dict) -> sp.csr_matrix:
+    def matrix(self, sinks: dict, shared: bool = False) -> sp.csr_matrix:
         r"""The system matrix :math:`A = L_{FF} + \mathrm{diag}(K_\mathrm{wall} + g)`, CSR.
 
         Parameters
         ----------
         sinks : dict
             The ambient terms ``{name: (g, b)}`` (:meth:`sinks`): W/K and W per free particle.
+        shared : bool
+            True: ``L_FF`` itself where ``A`` would be its copy, for a caller that neither writes into ``A`` nor keeps
+            it past a :meth:`refresh` (:meth:`dem.network.laplacian.BoundedLaplacian.matrix`); False: a new matrix.
 
         Returns
         -------
         scipy.sparse.csr_matrix
             ``A`` (W/K).
         """
-        return self.graph.matrix(sum((g for g, _ in sinks.values()), np.zeros(self.n_free)))
+        return self.graph.matrix(sum((g for g, _ in sinks.values()), np.zeros(self.n_free)), shared)
 
     def rhs(self, sinks: dict) -> np.ndarray:
         """The right-hand side ``r`` of the module docstring.
@@ -654,7 +660,7 @@ def solve_steady(net, T_F: np.ndarray, solve_idx: np.ndarray, linear: str = "aut
     for iterations in range(1, max_newton + 1):
         T_F[solve_idx] = T_sub
         sinks = net.sinks(T_F)
-        A, r = net.matrix(sinks), net.rhs(sinks)
+        A, r = net.matrix(sinks, shared=True), net.rhs(sinks)  # the solver, discarded here, only reads A
         if restrict is not None:
             A, r = A[restrict][:, restrict], r[restrict]
         if len(r) == 0:

@@ -544,13 +544,16 @@ class NeckHeat:
         return {name: (np.concatenate([g, necks]), np.concatenate([b, necks]))
                 for name, (g, b) in linear_sink_terms(self.sources, self.radius, T_F[:k]).items()}
 
-    def matrix(self, sinks: dict) -> sp.csr_matrix:
+    def matrix(self, sinks: dict, shared: bool = False) -> sp.csr_matrix:
         """The matrix over the free nodes: ``A`` and the ambient's :math:`g` on the centres' diagonal.
 
         Parameters
         ----------
         sinks : dict
             The ambient terms ``{name: (g, b)}`` (:meth:`sinks`).
+        shared : bool
+            As :meth:`dem.network.heat.Network.matrix` has it; without ambient terms ``A`` itself is returned either
+            way (no caller writes into it).
 
         Returns
         -------
