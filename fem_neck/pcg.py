@@ -1,5 +1,5 @@
-"""Sparse assembly of element matrices (:class:`Assembly`), and conjugate gradients with a two-level additive
-Schwarz preconditioner (memory linear in the unknowns).
+"""A system kept as its element matrices and applied element by element (:class:`ElementSystem`), and conjugate
+gradients with a two-level additive Schwarz preconditioner (memory linear in the unknowns).
 
 :math:`M^{-1} r = P (P^T A P)^{-1} P^T r + D^{-1} r`: a coarse space ``P`` (for high-order elements the piecewise-linear
 hats, for the hybridised fluxes the face means), whose Galerkin matrix gets one V-cycle of plain (unsmoothed)
@@ -23,14 +23,14 @@ class TwoLevel:
     r"""The preconditioner of the module docstring, as a callable :math:`r \to M^{-1} r`. The coarse matrix
     :math:`P^T A P` is computed unless given (``coarse``, CSR); the local part :math:`D^{-1}` is point Jacobi, or block
     Jacobi on consecutive groups of unknowns whose diagonal blocks of ``A`` are ``block_matrices (B, n, n)`` (``B n`` =
-    all unknowns; the moments of one face), kept as one block sparse matrix, or block Jacobi on consecutive ``groups``
-    of unknowns of any sizes, the blocks read from ``A`` (CSR; the nodes of one mesh edge or face,
-    :meth:`Assembly.groups`).
+    all unknowns; the moments of one face), kept as one block sparse matrix, or the caller's own ``local`` (block
+    Jacobi on the nodes of one mesh edge or face, :meth:`ElementSystem.block_jacobi`).
 
     Parameters
     ----------
-    A : scipy.sparse matrix
-        The symmetric positive definite system matrix (n, n) of the free unknowns.
+    A : scipy.sparse matrix or ElementSystem
+        The symmetric positive definite system matrix (n, n) of the free unknowns (sparse unless ``coarse`` and the
+        local part are given).
     P : scipy.sparse matrix
         The coarse space (n, m): column j holds coarse function j on the unknowns.
     coarse : scipy.sparse.csr_matrix, optional
@@ -38,13 +38,11 @@ class TwoLevel:
     block_matrices : numpy.ndarray, optional
         The diagonal blocks (B, k, k) of ``A`` on consecutive groups of ``k`` unknowns (``B k = n``), inverted for the
         block Jacobi part; None for point Jacobi.
-    groups : numpy.ndarray, optional
-        Sizes of consecutive groups of unknowns (summing to n) whose diagonal blocks of ``A`` are inverted for the
-        block Jacobi part (instead of ``block_matrices``).
+    local : scipy.sparse matrix, optional
+        The local part :math:`D^{-1}` (n, n) itself (instead of ``block_matrices``).
     """
 
-    def __init__(self, A, P, coarse=None, block_matrices: np.ndarray | None = None,
-                 groups: np.ndarray | None = None):
+    def __init__(self, A, P, coarse=None, block_matrices: np.ndarray | None = None, local=None):
         import scipy.sparse as sp
 
         from sinterheat import amg
@@ -54,18 +52,12 @@ class TwoLevel:
         if coarse is None:
             coarse = (self.PT @ A @ self.P).tocsr()
         self.amg = amg.hierarchy(coarse, symmetry="symmetric", max_coarse=500, smooth=None).aspreconditioner(cycle="V")
-        if groups is not None:
+        if local is not None:
             if block_matrices is not None:
-                raise ValueError("block_matrices and groups: give one of them")
-            if np.sum(groups) != A.shape[0] or np.any(np.asarray(groups) < 1):
-                raise ValueError(f"groups: positive sizes summing to the {A.shape[0]} unknowns")
-            starts = np.concatenate([[0], np.cumsum(groups)]).astype(A.indptr.dtype)
-            indptr = np.concatenate([[0], np.cumsum(np.repeat(groups, groups))]).astype(A.indptr.dtype)
-            inverse, indices, ok = _group_inverses(A.data, A.indices, A.indptr, starts, indptr)
-            if not ok:
-                raise ValueError("groups: a diagonal block of A is not stored whole or has a pivot that is not "
-                                 "positive")
-            self.local = sp.csr_matrix((inverse, indices, indptr), shape=A.shape)
+                raise ValueError("block_matrices and local: give one of them")
+            if local.shape != A.shape:
+                raise ValueError(f"local: shape {local.shape} for a system of shape {A.shape}")
+            self.local = local
         elif block_matrices is None:
             self.local = sp.diags(1.0 / A.diagonal(), format="csr")
         else:
@@ -118,57 +110,17 @@ def _block_inverses(blocks):
     return out, True
 
 
-@njit(cache=True)
-def _group_inverses(data, indices, indptr, starts, out_indptr):
-    """The inverses of the diagonal blocks of the CSR matrix ``(data, indices, indptr)`` (sorted columns) on the
-    groups of rows ``starts[g]`` to ``starts[g + 1] - 1``, as the data and column indices of a CSR matrix whose rows
-    start at ``out_indptr`` (each row holds its group's columns), and False if a block is not stored whole or a pivot
-    is not positive; Gauss-Jordan without pivoting (symmetric positive definite blocks)."""
-    out = np.empty(out_indptr[-1])
-    columns = np.empty(out_indptr[-1], dtype=indices.dtype)
-    for g in range(len(starts) - 1):
-        s, h = starts[g], starts[g + 1] - starts[g]
-        block = np.empty((h, 2 * h))
-        for i in range(h):
-            row = s + i
-            k = indptr[row]
-            while k < indptr[row + 1] and indices[k] != s:       # the group's columns s .. s + h - 1, in a run
-                k += 1
-            if k + h > indptr[row + 1] or indices[k + h - 1] != s + h - 1:
-                return out, columns, False
-            for j in range(h):
-                block[i, j] = data[k + j]
-                block[i, h + j] = 1.0 if i == j else 0.0
-        for p in range(h):                                       # [B | I] -> [I | B^-1]
-            if not block[p, p] > 0.0:
-                return out, columns, False
-            f = 1.0 / block[p, p]
-            for j in range(2 * h):
-                block[p, j] *= f
-            for i in range(h):
-                if i != p:
-                    f = block[i, p]
-                    for j in range(2 * h):
-                        block[i, j] -= f * block[p, j]
-        for i in range(h):
-            for j in range(h):
-                out[out_indptr[s + i] + j] = block[i, h + j]
-                columns[out_indptr[s + i] + j] = s + j
-    return out, columns, True
-
-
-class Assembly:
-    """The system of the free unknowns, assembled chunk by chunk from element matrices on the global dofs ``l2g (E,
-    n)``, the dofs marked ``fixed`` held at ``values``. Only the free block is stored, as CSR whose pattern (sorted
-    column indices, no duplicates) and every element block's place in it are computed once from ``l2g``
-    (``_pattern``); :meth:`add` adds a chunk's element matrices into those places, which can then be dropped.
-    The free dofs ``free`` are numbered in the order the elements first use them, so that an element's rows lie
-    near each other in memory (the pattern and the additions take half the time of the global dofs' order).
-    The local dofs may come in ``groups``: consecutive local dofs that are consecutive global dofs in every element
-    (the nodes of one mesh edge or face), all fixed or all free. The rows of one group then have one pattern, found
-    once, and an element keeps one place per pair of its groups instead of one per entry.
-    :math:`A_{ff} x = b` gives the free values; :meth:`energy` is :math:`u^T A u` of the full vector exactly, whatever
-    ``x``.
+class ElementSystem:
+    r"""The system of the free unknowns kept as its element matrices on the global dofs ``l2g (E, n)``, the dofs marked
+    ``fixed`` held at ``values``, and never assembled: ``A @ x`` is :math:`A_{ff} x = \sum_e K_e^{ff} x_e`, each
+    element's matrix times its unknowns (the held ones zero) added to its free rows, in one compiled pass (as many
+    bytes read as a CSR matrix of the same system, and no sparse pattern to find or place the entries in).
+    :meth:`add` stores a chunk's element matrices; every element's must be added before the first product.
+    The free dofs ``free`` are numbered in the order the elements first use them, so that an element's unknowns lie
+    near each other in memory. The local dofs may come in ``groups``: consecutive local dofs that are consecutive
+    global dofs in every element (the nodes of one mesh edge or face), all fixed or all free; :meth:`block_jacobi`
+    inverts the system's diagonal block on each. :math:`A_{ff} x = b` gives the free values; :meth:`energy` is
+    :math:`u^T A u` of the full vector exactly, whatever ``x``.
 
     Parameters
     ----------
@@ -185,7 +137,7 @@ class Assembly:
     """
 
     def __init__(self, l2g: np.ndarray, fixed: np.ndarray, values: np.ndarray, groups=None):
-        n = l2g.shape[1]
+        E, n = l2g.shape
         sizes = np.ones(n, dtype=np.int64) if groups is None else np.asarray(groups, dtype=np.int64)
         if np.any(sizes < 1) or sizes.sum() != n:
             raise ValueError(f"groups = {sizes.tolist()}: positive sizes summing to the {n} local dofs")
@@ -205,26 +157,24 @@ class Assembly:
         first_use[dofs] = first
         free = np.flatnonzero(~fixed)
         self.free = free[np.argsort(first_use[free], kind="stable")]            # in the order the elements use them
-        index_type = np.int32 if len(l2g) * n * n < 2**31 else np.int64
-        index = np.full(len(fixed), -1, dtype=index_type)
-        index[self.free] = np.arange(len(self.free), dtype=index_type)
+        index = np.full(len(fixed), -1, dtype=np.int64)
+        index[self.free] = np.arange(len(self.free))
         self.l2g, self.fixed, self.values = l2g, fixed, values
-        loc = np.ascontiguousarray(index[l2g])                                 # (E, n), -1 on fixed dofs
-        self.indptr = np.zeros(len(self.free) + 1, dtype=index_type)
-        self.place = np.empty((len(l2g), len(sizes), len(sizes)), dtype=index_type)
-        self.indices = _pattern(loc, self.offsets, self.indptr, self.place)
-        self.loc = loc
-        self.data = np.zeros(len(self.indices))
+        self.loc = np.ascontiguousarray(index[l2g])                            # (E, n), -1 on fixed dofs
+        self.shape = (len(self.free), len(self.free))
+        self.K = np.empty((E, n, n))
+        self.added = 0
         self.b = np.zeros(len(self.free))
         self.constant = 0.0
 
     def add(self, K: np.ndarray, elements: np.ndarray) -> None:
-        """Add the element matrices ``K (len(elements), n, n)`` of consecutive ``elements``.
+        """Store the element matrices ``K (len(elements), n, n)`` of consecutive ``elements``.
 
         Parameters
         ----------
         K : numpy.ndarray
-            Element matrices (len(elements), n, n), in the unit of the system (W/K for a conductance matrix).
+            Symmetric element matrices (len(elements), n, n), in the unit of the system (W/K for a conductance
+            matrix).
         elements : numpy.ndarray
             Indices of consecutive elements (rows of ``l2g``), ascending without gaps.
         """
@@ -236,12 +186,19 @@ class Assembly:
         on = loc >= 0
         self.b += np.bincount(loc[on], load[on], minlength=len(self.free))
         self.constant -= float(np.sum(known * load))
-        chunk = slice(elements[0], elements[-1] + 1)
-        _scatter(self.data, self.indptr, self.loc[chunk], self.offsets, self.place[chunk], np.ascontiguousarray(K))
+        self.K[elements[0]:elements[-1] + 1] = K
+        self.added += len(elements)
+
+    def __matmul__(self, x: np.ndarray) -> np.ndarray:
+        if self.added != len(self.K):
+            raise ValueError(f"ElementSystem: {self.added} of {len(self.K)} element matrices added")
+        y = np.zeros(len(self.free))
+        _element_products(self.K, self.loc, np.ascontiguousarray(x, dtype=float), y)
+        return y
 
     def groups(self) -> np.ndarray:
-        """Sizes of the groups of consecutive free unknowns that are one group of local dofs (:class:`Assembly`), in
-        order (``TwoLevel``'s ``groups``)."""
+        """Sizes of the groups of consecutive free unknowns that are one group of local dofs (:class:`ElementSystem`),
+        in order."""
         sizes = np.diff(self.offsets)
         lead = self.loc[:, self.offsets[:-1]]
         used = lead >= 0
@@ -252,136 +209,99 @@ class Assembly:
             raise ValueError("groups: the free unknowns are not all in groups (an unknown no element uses)")
         return size
 
-    def matrix(self):
-        """``A_ff`` (CSR); frees the element places."""
+    def block_jacobi(self):
+        """The inverse of the system's block diagonal on the groups of :meth:`groups` (the diagonal blocks summed
+        from the element matrices), as CSR: the local part of :class:`TwoLevel`. ValueError if a block has a pivot
+        that is not positive."""
         import scipy.sparse as sp
 
-        A = sp.csr_matrix((self.data, self.indices, self.indptr), shape=(len(self.free), len(self.free)))
-        A.has_sorted_indices = True
-        del self.place
-        return A
+        groups = self.groups()
+        starts = np.concatenate([[0], np.cumsum(groups)])
+        indptr = np.concatenate([[0], np.cumsum(np.repeat(groups, groups))])
+        inverse, columns, ok = _group_inverses(self.K, self.loc, self.offsets, starts, indptr)
+        if not ok:
+            raise ValueError("groups: a diagonal block of the system has a pivot that is not positive")
+        return sp.csr_matrix((inverse, columns, indptr), shape=self.shape)
 
-    def energy(self, A, x: np.ndarray) -> float:
+    def energy(self, x: np.ndarray) -> float:
         """:math:`u^T A u` of ``u`` = ``x`` on the free dofs, the fixed values elsewhere:
         :math:`x A_{ff} x - 2 x b + u_d A_{dd} u_d` (:math:`A_{fd} u_d = -b`).
 
         Parameters
         ----------
-        A : scipy.sparse.csr_matrix
-            ``A_ff``, as :meth:`matrix` returned it.
         x : numpy.ndarray
             Values of the free dofs, in the order of ``free``.
         """
-        return float(x @ (A @ x) - 2.0 * (x @ self.b) + self.constant)
+        return float(x @ (self @ x) - 2.0 * (x @ self.b) + self.constant)
 
 
-@njit(cache=True)
-def _pattern(loc, offsets, indptr, place):
-    """The CSR pattern of the free block of an assembly on the element dofs ``loc (E, n)`` (-1 on fixed dofs) whose
-    local dofs come in the groups ``offsets`` (:class:`Assembly`): fills ``indptr`` (free dofs + 1) and ``place (E,
-    G, G)`` (where the columns of group ``j`` start within the rows of group ``i``, -1 where either is fixed) and
-    returns the column indices, sorted within each row. Group by group, through the elements of each group's first
-    dof: O(the element matrices' group pairs), plus the indices written."""
+@njit(cache=True, fastmath=True)
+def _element_products(K, loc, x, y):
+    """``y += sum_e K_e x_e`` on the free rows: ``x_e`` the element's unknowns ``x[loc[e]]``, zero where ``loc`` is -1
+    (a held dof), whose rows are skipped."""
     E, n = loc.shape
-    G = len(offsets) - 1
-    rows = len(indptr) - 1
-    first = np.zeros(rows + 1, dtype=np.int64)                   # the group's (element, local group) incidences
+    xe = np.empty(n)
     for e in range(E):
-        for g in range(G):
-            if loc[e, offsets[g]] >= 0:
-                first[loc[e, offsets[g]] + 1] += 1
-    for r in range(rows):
-        first[r + 1] += first[r]
-    incidence = np.empty(first[rows], dtype=np.int64)
-    filled = first[:-1].copy()
-    for e in range(E):
-        for g in range(G):
-            r = loc[e, offsets[g]]
-            if r >= 0:
-                incidence[filled[r]] = e * G + g
-                filled[r] += 1
-    seen = np.full(rows, -1, dtype=np.int64)
-    size = np.zeros(rows, dtype=np.int64)                        # the size of the group a column group starts
-    leads = np.empty(rows, dtype=np.int64)                       # the current rows' column groups (their first dof)
-    column = np.empty(rows, dtype=loc.dtype)                     # a column group's place within the current rows
-    indices = np.empty(0, dtype=loc.dtype)
-    for sweep in range(2):                                       # the rows' lengths, then their columns and places
-        if sweep == 1:
-            indices = np.empty(indptr[rows], dtype=loc.dtype)
-            seen[:] = -1
-        r = 0
-        while r < rows:
-            if first[r] == first[r + 1]:                         # a dof no element uses
-                if sweep == 0:
-                    indptr[r + 1] = indptr[r]
-                r += 1
-                continue
-            g = incidence[first[r]] % G
-            height = offsets[g + 1] - offsets[g]                 # the rows of this group: r to r + height - 1
-            count = 0
-            for s in range(first[r], first[r + 1]):              # the distinct column groups of the group's rows
-                e = incidence[s] // G
-                for h in range(G):
-                    c = loc[e, offsets[h]]
-                    if c >= 0 and seen[c] != r:
-                        seen[c] = r
-                        size[c] = offsets[h + 1] - offsets[h]
-                        leads[count] = c
-                        count += 1
-            if sweep == 0:
-                width = 0
-                for j in range(count):
-                    width += size[leads[j]]
-                for d in range(height):
-                    indptr[r + d + 1] = indptr[r + d] + width
-            else:
-                ordered = np.sort(leads[:count])
-                width = 0
-                for j in range(count):
-                    column[ordered[j]] = width
-                    width += size[ordered[j]]
-                k = indptr[r]
-                for d in range(height):
-                    for j in range(count):
-                        for i in range(size[ordered[j]]):
-                            indices[k] = ordered[j] + i
-                            k += 1
-                for s in range(first[r], first[r + 1]):
-                    e, g = incidence[s] // G, incidence[s] % G
-                    for h in range(G):
-                        c = loc[e, offsets[h]]
-                        place[e, g, h] = column[c] if c >= 0 else -1
-            r += height
-    for e in range(E):                                           # the rows of fixed groups
-        for g in range(G):
-            if loc[e, offsets[g]] < 0:
-                place[e, g, :] = -1
-    return indices
+        for a in range(n):
+            c = loc[e, a]
+            xe[a] = x[c] if c >= 0 else 0.0
+        for i in range(n):
+            c = loc[e, i]
+            if c >= 0:
+                s = 0.0
+                for j in range(n):
+                    s += K[e, i, j] * xe[j]
+                y[c] += s
 
 
 @njit(cache=True)
-def _scatter(data, indptr, loc, offsets, place, K):
-    """``data += K`` element after element: entry ``(a, b)`` of element ``e``, ``a`` in group ``i`` and ``b`` in
-    group ``j``, goes to ``indptr[loc[e, a]] + place[e, i, j] + (b - offsets[j])`` where that place is not -1."""
-    E, G = K.shape[0], len(offsets) - 1
-    for e in range(E):
-        for i in range(G):
-            for j in range(G):
-                base = place[e, i, j]
-                if base >= 0:
-                    for a in range(offsets[i], offsets[i + 1]):
-                        start = indptr[loc[e, a]] + base - offsets[j]
-                        for b in range(offsets[j], offsets[j + 1]):
-                            data[start + b] += K[e, a, b]
+def _group_inverses(K, loc, offsets, starts, out_indptr):
+    """The inverses of the diagonal blocks, on the groups of free rows ``starts[g]`` to ``starts[g + 1] - 1``, of the
+    system of the element matrices ``K (E, n, n)`` on the free dofs ``loc`` (-1 where held) whose local dofs come in
+    the groups ``offsets``: the blocks summed from the elements, then inverted (Gauss-Jordan without pivoting:
+    symmetric positive definite blocks); as the data and column indices of a CSR matrix whose rows start at
+    ``out_indptr`` (each row holds its group's columns), and False if a pivot is not positive."""
+    out = np.zeros(out_indptr[-1])
+    columns = np.empty(out_indptr[-1], dtype=np.int64)
+    for e in range(K.shape[0]):                                  # the blocks: row i of a group from its first dof
+        for g in range(len(offsets) - 1):
+            first = loc[e, offsets[g]]
+            if first >= 0:
+                h = offsets[g + 1] - offsets[g]
+                for i in range(h):
+                    for j in range(h):
+                        out[out_indptr[first + i] + j] += K[e, offsets[g] + i, offsets[g] + j]
+    for g in range(len(starts) - 1):
+        s, h = starts[g], starts[g + 1] - starts[g]
+        block = np.empty((h, 2 * h))
+        for i in range(h):
+            for j in range(h):
+                block[i, j] = out[out_indptr[s + i] + j]
+                block[i, h + j] = 1.0 if i == j else 0.0
+        for p in range(h):                                       # [B | I] -> [I | B^-1]
+            if not block[p, p] > 0.0:
+                return out, columns, False
+            f = 1.0 / block[p, p]
+            for j in range(2 * h):
+                block[p, j] *= f
+            for i in range(h):
+                if i != p:
+                    f = block[i, p]
+                    for j in range(2 * h):
+                        block[i, j] -= f * block[p, j]
+        for i in range(h):
+            for j in range(h):
+                out[out_indptr[s + i] + j] = block[i, h + j]
+                columns[out_indptr[s + i] + j] = s + j
+    return out, columns, True
 
 
-def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None,
-              groups: np.ndarray | None = None) -> TwoLevel:
+def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None, local=None) -> TwoLevel:
     """The preconditioner :class:`TwoLevel` of ``A`` on the coarse space ``P``.
 
     Parameters
     ----------
-    A : scipy.sparse matrix
+    A : scipy.sparse matrix or ElementSystem
         The symmetric positive definite system matrix (n, n).
     P : scipy.sparse matrix
         The coarse space (n, m).
@@ -389,10 +309,10 @@ def two_level(A, P, coarse=None, block_matrices: np.ndarray | None = None,
         :math:`P^T A P` if the caller has it.
     block_matrices : numpy.ndarray, optional
         Diagonal blocks (B, k, k) of ``A`` for block Jacobi; None for point Jacobi.
-    groups : numpy.ndarray, optional
-        Sizes of consecutive groups of unknowns for block Jacobi on ``A``'s own blocks (CSR ``A``).
+    local : scipy.sparse matrix, optional
+        The local part itself (:meth:`ElementSystem.block_jacobi`).
     """
-    return TwoLevel(A, P, coarse, block_matrices, groups)
+    return TwoLevel(A, P, coarse, block_matrices, local)
 
 
 def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 5000,
@@ -409,7 +329,7 @@ def solve(A, b: np.ndarray, precondition, rtol: float = 1e-10, maxiter: int = 50
 
     Parameters
     ----------
-    A : scipy.sparse matrix or scipy.sparse.linalg.LinearOperator
+    A : scipy.sparse matrix, ElementSystem or scipy.sparse.linalg.LinearOperator
         The symmetric positive definite matrix (n, n).
     b : numpy.ndarray
         Right-hand side (n,).

@@ -5,8 +5,9 @@ energy :math:`u^T A u` of *any* admissible ``u`` is at least the exact conductan
 the elements of :mod:`fem_neck.curved` fill the exact solid, so :math:`u^T A u \ge K` holds for the computed ``u``
 whatever the solver's residual (which only makes the bound less sharp): CG stops once the energy has settled to
 ``ENERGY_RTOL``. The ``(p - 1)(p - 2)(p - 3) / 6`` interior nodes of every element are condensed (Schur complement,
-batched); the skeleton system is solved by conjugate gradients preconditioned by :func:`fem_neck.pcg.two_level` (the
-piecewise-linear hats as coarse space, block Jacobi on the nodes of every vertex, edge and face).
+batched); the skeleton system, kept as its element matrices (:class:`fem_neck.pcg.ElementSystem`), is solved by
+conjugate gradients preconditioned by :func:`fem_neck.pcg.two_level` (the piecewise-linear hats as coarse space, block
+Jacobi on the nodes of every vertex, edge and face).
 """
 
 from __future__ import annotations
@@ -176,7 +177,7 @@ def numbering(mesh: CurvedMesh, basis: Lagrange) -> Numbering:
 def skeleton_groups(basis: Lagrange) -> list:
     """The sizes of the groups of an element's skeleton dofs in the order of :func:`numbering` that are one mesh
     entity's (a vertex, the ``n_edge`` nodes of an edge, the ``n_face`` of a face): consecutive global dofs in every
-    element, fixed or free together (:class:`fem_neck.pcg.Assembly`).
+    element, fixed or free together (:class:`fem_neck.pcg.ElementSystem`).
 
     Parameters
     ----------
@@ -272,7 +273,7 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
     hot_dofs = face_dofs(mesh, basis, hot)
     fixed[hot_dofs] = fixed[face_dofs(mesh, basis, cold)] = True
     values[hot_dofs] = 1.0
-    system = pcg.Assembly(num.l2g, fixed, values, skeleton_groups(basis))
+    system = pcg.ElementSystem(num.l2g, fixed, values, skeleton_groups(basis))
     hats = hat_values(basis)
     coarse = np.empty((len(mesh.tets), 4, 4))                               # each element's part of P^T A_ff P
     for start in range(0, len(mesh.tets), CHUNK):
@@ -280,9 +281,9 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
         K = condensed(stiffness_matrices(mesh, basis, degree, elements), skel)
         system.add(K, elements)
         coarse[elements] = hat_parts(K, ~fixed[num.l2g[elements]], hats)
-    A = system.matrix()
     P = hat_prolongation(mesh, basis, num)[system.free]
-    precondition = pcg.two_level(A, P, coarse_matrix(mesh, coarse), groups=system.groups())  # an entity's nodes
+    # block Jacobi on the nodes of one vertex, edge or face
+    precondition = pcg.two_level(system, P, coarse_matrix(mesh, coarse), local=system.block_jacobi())
 
     def temperature(x: np.ndarray) -> np.ndarray:
         u = values.copy()
@@ -290,9 +291,10 @@ def solve(mesh: CurvedMesh, p: int, hot: np.ndarray, cold: np.ndarray, etol: flo
         return u
 
     settled = None if early is None else (early[0], lambda x: early[1](temperature(x)))
-    x, iterations, residual = pcg.solve(A, system.b, precondition, energy=(system.constant, etol), settled=settled)
+    x, iterations, residual = pcg.solve(system, system.b, precondition, energy=(system.constant, etol),
+                                        settled=settled)
     u = temperature(x)
-    return Solution(system.energy(A, x), u, num.n + basis.n_interior * len(mesh.tets), num.n, iterations, residual)
+    return Solution(system.energy(x), u, num.n + basis.n_interior * len(mesh.tets), num.n, iterations, residual)
 
 
 def condensed(K: np.ndarray, skel: int) -> np.ndarray:

@@ -1,5 +1,5 @@
-"""The sparse systems of the periodic-cell FE (fem_neck.pcg, fem_neck.dual, fem_neck.primal) against the plain
-sums they replace: a dense or COO sum of the element matrices, the Galerkin product of the coarse space."""
+"""The systems of the periodic-cell FE (fem_neck.pcg, fem_neck.dual, fem_neck.primal) against the plain sums they
+replace: a dense or COO sum of the element matrices, the Galerkin product of the coarse space."""
 
 import numpy as np
 import pytest
@@ -19,26 +19,38 @@ def _random_elements(seed, elements=300, n=10, dofs=500):
     return l2g, fixed, values, K + np.swapaxes(K, 1, 2)
 
 
+def _dense(system):
+    """The matrix of an ElementSystem, column by column from its products."""
+    return np.column_stack([system @ column for column in np.eye(system.shape[0])])
+
+
+def _added(system, K, chunk=64):
+    """``system`` with the element matrices ``K`` added in chunks, as the solvers add them."""
+    for start in range(0, len(K), chunk):
+        system.add(K[start:start + chunk], np.arange(start, min(start + chunk, len(K))))
+    return system
+
+
 @pytest.mark.parametrize("seed", [0, 1])
-def test_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs(seed):
+def test_element_system_is_the_sum_of_the_element_matrices_on_the_free_dofs(seed):
     l2g, fixed, values, K = _random_elements(seed)
-    system = pcg.Assembly(l2g, fixed, values)
-    for start in range(0, len(l2g), 64):  # in chunks, as the solvers add them
-        elements = np.arange(start, min(start + 64, len(l2g)))
-        system.add(K[elements], elements)
-    A = system.matrix()
+    system = pcg.ElementSystem(l2g, fixed, values)
+    system.add(K[:64], np.arange(64))
+    with pytest.raises(ValueError, match="ElementSystem: 64 of 300 element matrices added"):
+        system @ np.ones(system.shape[0])
+    for start in range(64, len(l2g), 64):
+        system.add(K[start:start + 64], np.arange(start, min(start + 64, len(l2g))))
     n = l2g.shape[1]
     full = sp.csr_matrix((K.ravel(), (np.repeat(l2g, n, axis=1).ravel(), np.tile(l2g, (1, n)).ravel())),
                          shape=(len(fixed),) * 2).toarray()
     free = system.free
-    assert sorted(free) == list(np.flatnonzero(~fixed))
-    assert A.has_canonical_format and np.all(np.diff(A.indices[A.indptr[0]:A.indptr[1]]) > 0)
-    np.testing.assert_allclose(A.toarray(), full[np.ix_(free, free)], atol=1e-13)
+    assert sorted(free) == list(np.flatnonzero(~fixed)) and system.shape == (len(free), len(free))
+    np.testing.assert_allclose(_dense(system), full[np.ix_(free, free)], atol=1e-13)
     np.testing.assert_allclose(system.b, -full[np.ix_(free, np.flatnonzero(fixed))] @ values[fixed], atol=1e-12)
     u = values.copy()
     x = np.random.default_rng(seed + 10).random(len(free))
     u[free] = x
-    assert system.energy(A, x) == pytest.approx(u @ full @ u, rel=1e-12)
+    assert system.energy(x) == pytest.approx(u @ full @ u, rel=1e-12)
 
 
 def _grouped_elements():
@@ -62,23 +74,18 @@ def _grouped_elements():
     return l2g, fixed, values, K + np.swapaxes(K, 1, 2)
 
 
-def test_grouped_assembly_is_the_sum_of_the_element_matrices_on_the_free_dofs():
+def test_grouped_element_system_is_the_sum_of_the_element_matrices_on_the_free_dofs():
     l2g, fixed, values, K = _grouped_elements()
     sizes = [1, 1, 3, 3, 2]
-    grouped, plain = pcg.Assembly(l2g, fixed, values, sizes), pcg.Assembly(l2g, fixed, values)
-    for system in (grouped, plain):
-        for start in range(0, 200, 64):
-            elements = np.arange(start, min(start + 64, 200))
-            system.add(K[elements], elements)
-    A, B = grouped.matrix(), plain.matrix()
+    grouped = _added(pcg.ElementSystem(l2g, fixed, values, sizes), K)
+    plain = _added(pcg.ElementSystem(l2g, fixed, values), K)
     n = l2g.shape[1]
     full = sp.csr_matrix((K.ravel(), (np.repeat(l2g, n, axis=1).ravel(), np.tile(l2g, (1, n)).ravel())),
                          shape=(len(fixed),) * 2).toarray()
     free = grouped.free
-    assert A.has_canonical_format
-    np.testing.assert_array_equal(A.indptr, B.indptr)
-    np.testing.assert_array_equal(A.indices, B.indices)
-    np.testing.assert_allclose(A.toarray(), full[np.ix_(free, free)], atol=1e-13)
+    A = _dense(grouped)
+    np.testing.assert_array_equal(A, _dense(plain))
+    np.testing.assert_allclose(A, full[np.ix_(free, free)], atol=1e-13)
     np.testing.assert_allclose(grouped.b, -full[np.ix_(free, np.flatnonzero(fixed))] @ values[fixed], atol=1e-12)
 
 
@@ -92,7 +99,7 @@ def test_groups_that_do_not_hold_are_refused(groups, match):
     fixed = np.zeros(7, dtype=bool)
     fixed[4] = True
     with pytest.raises(ValueError, match=match):
-        pcg.Assembly(l2g, fixed, np.zeros(7), groups)
+        pcg.ElementSystem(l2g, fixed, np.zeros(7), groups)
 
 
 def test_packed_symmetric_products_are_the_full_ones():
@@ -188,28 +195,26 @@ def test_the_given_coarse_matrix_of_the_face_means_is_the_galerkin_product(cell_
 def test_block_jacobi_on_groups_inverts_the_diagonal_blocks_of_the_matrix():
     # the upper bound's P_4 system: its groups (a vertex, an edge's or a face's nodes) against dense inverses
     l2g, fixed, values, K = _grouped_elements()
-    system = pcg.Assembly(l2g, fixed, values, [1, 1, 3, 3, 2])
-    for start in range(0, len(K), 64):
-        system.add(K[start:start + 64], np.arange(start, min(start + 64, len(K))))
+    K = np.matmul(K, K) + np.eye(10)                                         # positive definite element matrices
+    system = _added(pcg.ElementSystem(l2g, fixed, values, [1, 1, 3, 3, 2]), K)
     groups = system.groups()
-    A = system.matrix()
-    A = A + sp.identity(A.shape[0]) * 2 * abs(A).sum(axis=1).max()          # positive definite (diagonally dominant)
-    A = A.tocsr()
-    A.sort_indices()
+    local = system.block_jacobi().toarray()
+    dense = _dense(system)
     starts = np.concatenate([[0], np.cumsum(groups)])
-    assert sorted(set(groups)) == [1, 2, 3] and starts[-1] == A.shape[0]
-    local = pcg.two_level(A, sp.identity(A.shape[0], format="csr"), None, groups=groups).local.toarray()
-    dense = A.toarray()
+    assert sorted(set(groups)) == [1, 2, 3] and starts[-1] == dense.shape[0]
     expected = np.zeros_like(dense)
     for begin, end in zip(starts[:-1], starts[1:]):
         expected[begin:end, begin:end] = np.linalg.inv(dense[begin:end, begin:end])
     np.testing.assert_allclose(local, expected, rtol=0, atol=1e-13 * abs(expected).max())
-    with pytest.raises(ValueError, match="groups: positive sizes summing to the"):
-        pcg.two_level(A, sp.identity(A.shape[0], format="csr"), None, groups=groups[1:])
-    B = sp.diags([1.0, 1.0, 1.0, 1.0, 1.0, -1.0], format="csr")               # no 2 x 2 block; a negative pivot
-    for sizes in ([2, 2, 2], [1] * 6):
-        with pytest.raises(ValueError, match="a diagonal block of A is not stored whole or has a pivot"):
-            pcg.two_level(B, sp.identity(6, format="csr"), None, groups=np.array(sizes))
+    r = np.random.default_rng(4).random(dense.shape[0])
+    identity, coarse = sp.identity(dense.shape[0], format="csr"), sp.csr_matrix(dense)
+    given = pcg.two_level(system, identity, coarse, local=system.block_jacobi())
+    np.testing.assert_allclose(given.local @ r, expected @ r, rtol=1e-12)
+    with pytest.raises(ValueError, match="local: shape"):
+        pcg.two_level(system, identity, coarse, local=sp.identity(3, format="csr"))
+    negative = _added(pcg.ElementSystem(l2g, fixed, values, [1, 1, 3, 3, 2]), -K)   # negative definite blocks
+    with pytest.raises(ValueError, match="a diagonal block of the system has a pivot that is not positive"):
+        negative.block_jacobi()
 
 
 def test_cg_reports_the_first_iterate_settled_to_a_looser_tolerance():
@@ -245,13 +250,16 @@ def test_upper_bound_matrix_is_the_conforming_stiffness(cell_mesh):
     K = primal.stiffness_matrices(mesh, basis)
     fixed = np.zeros(num.n, dtype=bool)
     fixed[primal.face_dofs(mesh, basis, cell_mesh.hot)] = True
-    system = pcg.Assembly(num.l2g, fixed, fixed.astype(float))
+    system = pcg.ElementSystem(num.l2g, fixed, fixed.astype(float))
     system.add(K, np.arange(len(K)))
     n = basis.n
     full = sp.csr_matrix((K.ravel(), (np.repeat(num.l2g, n, axis=1).ravel(), np.tile(num.l2g, (1, n)).ravel())),
                          shape=(num.n, num.n))
     free = system.free
-    assert abs(system.matrix() - full[free][:, free]).max() <= 1e-12 * abs(full).max()
+    x = np.random.default_rng(6).random((len(free), 3))
+    expected = full[free][:, free] @ x
+    for k in range(3):
+        np.testing.assert_allclose(system @ x[:, k], expected[:, k], rtol=0, atol=1e-12 * abs(expected).max())
 
 
 def test_condensed_element_matrix_is_the_energy_minimised_over_the_interior_nodes():
@@ -277,12 +285,11 @@ def test_coarse_matrix_of_the_hats_is_the_galerkin_product(cell_mesh):
     fixed = np.zeros(num.n, dtype=bool)
     fixed[primal.face_dofs(mesh, basis, cell_mesh.hot)] = fixed[primal.face_dofs(mesh, basis, cell_mesh.cold)] = True
     K = primal.condensed(primal.stiffness_matrices(mesh, basis), skel)
-    system = pcg.Assembly(num.l2g, fixed, fixed.astype(float), primal.skeleton_groups(basis))
-    system.add(K, np.arange(len(K)))
-    A = system.matrix()
-    plain = pcg.Assembly(num.l2g, fixed, fixed.astype(float))                 # one group per dof: the same matrix
-    plain.add(K, np.arange(len(K)))
-    assert abs(A - plain.matrix()).max() == 0.0 and np.array_equal(system.b, plain.b)
+    system = pcg.ElementSystem(num.l2g, fixed, fixed.astype(float), primal.skeleton_groups(basis))
+    n = K.shape[1]
+    full = sp.csr_matrix((K.ravel(), (np.repeat(num.l2g, n, axis=1).ravel(), np.tile(num.l2g, (1, n)).ravel())),
+                         shape=(num.n, num.n))
+    A = full[system.free][:, system.free]
     P = primal.hat_prolongation(mesh, basis, num)[system.free]
     free = ~fixed[num.l2g]
     hats = primal.hat_values(basis)
