@@ -16,7 +16,9 @@ import numpy as np
 
 from dem import memory
 from dem.engines import Engine
+from dem.geometry.bonds import find_bonds
 from dem.geometry.necks import meeting_in
+from dem.laws.conductance import bond_conductances
 from dem.laws.verified_range import neck_account, wide_necks
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
 from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
@@ -153,16 +155,22 @@ class StaticEngine(Engine):
         if scene.solver.mode == "transient":
             self._check_work()
         particles, walls = scene.particles, scene.walls
-        bonds, K_pairs, K_walls = bonds_and_conductances(particles, walls, scene.conductance, box=scene.box)
+        spec = scene.conductance
+        if spec.nodes == "necks":  # a node per neck (dem.network.necks): the solves and the bonds' flows are its own,
+            # the one-node law's conductances (the links' field) from the halves its elements are made of
+            bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, box=scene.box)
+            self.necks = neck_network(spec, particles, bonds, box=scene.box, walls=walls)
+            K_pairs, K_walls = bond_conductances(spec, particles, bonds, box=scene.box, walls=tuple(walls),
+                                                 union=self.necks.union)
+        else:
+            self.necks = None
+            bonds, K_pairs, K_walls = bonds_and_conductances(particles, walls, spec, box=scene.box)
         self.potential, self.circuit = None, None
         if scene.electrical is not None:
             particles = self._joule_heated(particles, bonds)
         wall_temperature = np.array([w.temperature for w in walls], dtype=float)
         self.network = Network(particles, bonds, K_pairs, K_walls, wall_temperature, scene.sources, scene.box)
         self.bonds, self.K_pairs, self.K_walls = bonds, K_pairs, K_walls
-        # a node per neck (dem.network.necks): the solves and the bonds' flows are its own
-        self.necks = (neck_network(scene.conductance, particles, bonds, box=scene.box, walls=walls)
-                      if scene.conductance.nodes == "necks" else None)
         self.meeting = meeting_in(particles, walls, bonds, scene.box)
         self.restart = Checkpoint.from_arrays(restart) if restart is not None else None
         self.t_start = float(scene.start_time)

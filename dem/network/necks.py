@@ -108,6 +108,10 @@ class NeckNetwork:
         Per live pair bond, the temperature drop its ``j`` sees across the periodic faces (K; 0 without a box).
     box : dem.geometry.periodic.PeriodicBox or None
         The periodic box; None: none.
+    union : tuple or None
+        The ``shared-body`` halves on the cut spheres the elements are made of (what
+        :func:`dem.laws.conductance.union_halves` returned), from which the one-node law's conductances follow without
+        computing them again (``union`` of :func:`dem.laws.conductance.bond_conductances`).
     """
 
     particles: Particles
@@ -121,6 +125,7 @@ class NeckNetwork:
     plain: int
     jump: np.ndarray
     box: PeriodicBox | None = None
+    union: tuple | None = None
 
     @property
     def n_nodes(self) -> int:
@@ -188,8 +193,8 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     k_i, k_j, k_w = bond_halves(spec, particles, bonds, kappa)
     normals = wall_normals(bonds, walls)
     vectors = bonds.vectors(particles.position, box)
-    k_i, k_j, k_w, pairs, live_walls, volume = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
-                                                            closing_pores, box, walls)
+    union = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w, closing_pores, box, walls)
+    k_i, k_j, k_w, pairs, live_walls, volume = union
     live, live_walls = np.flatnonzero(pairs), np.flatnonzero(live_walls)
     sub = bonds.subset(live, live_walls)
     el = particle_elements(n, r, sub, vectors[live], k_i[live], k_j[live], k_w[live_walls], kappa,
@@ -222,7 +227,7 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     rhs = -np.bincount(row[rows], value[rows] * known[rows], size_all)
     rhs[:n] += particles.heat
     return NeckNetwork(particles, bonds, live, live_walls, A.tocsr(), rhs, (row, col, value, known, end_row),
-                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, box)
+                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, box, union)
 
 
 @dataclass
