@@ -8,10 +8,10 @@ the AMG hierarchy; ``python -m benchmarks dem``, whole process, maximum resident
 a per cent: about 240 bytes per bond at 5.6 bonds per particle, so a denser packing needs more in proportion.
 
 Under the union of spheres (``[conductance] neck = "union"``) a particle costs five times that: the peak of a steady
-solve of a random union packing at phi 0.8 tiled to 2048, 6912, 16384 and 42592 particles (4.75 bonds each; whole
-process, maximum resident set) grows by 7.1 kB per particle with one node per particle and by 7.3 kB with a node per
-neck (``nodes = "necks"``: a node per live bond more and each particle's (z + 1)^2 element entries), above about the
-same base.
+solve of a random union packing at a solid fraction of 0.8 tiled to 2048, 6912, 16384 and 42592 particles (4.75
+bonds each; whole process, maximum resident set) grows by 7.1 kB per particle with one node per particle and by 7.3 kB
+with a node per neck (``nodes = "necks"``: a node per live bond more and each particle's element over its necks and
+its centre), above about the same base.
 """
 
 from __future__ import annotations
@@ -30,8 +30,9 @@ SECONDS_PER_PARTICLE = 7.8e-6
 #: seconds of CPU per particle of the ``shared-body`` law's steady solve on union necks (``neck = "union"``: the cut
 #: bodies, the closing pores' cells and the factors) and with a node per neck (``nodes = "necks"``: the faces'
 #: quadrature): bonds, conductances and solve of a random union packing at phi 0.8 tiled to 6912 particles (4.75 bonds
-#: each), 0.41-0.46 and 1.84 ms per particle on the 2-core machine at load 5-7
-UNION_SECONDS_PER_PARTICLE = {"particles": 4.5e-4, "necks": 1.9e-3}
+#: each), 0.41-0.46 ms per particle on the 2-core machine at load 5-7, and with a node per neck 0.83 ms against the
+#: one node's 0.42 in the same process at load 17 (the faces' sums in SIMD lanes, the union halves computed once)
+UNION_SECONDS_PER_PARTICLE = {"particles": 4.5e-4, "necks": 9.0e-4}
 ANNOUNCE_FROM = 1_000_000  # runs of this many particles or more say what they will take before they start
 ANNOUNCE_SECONDS = 10.0  #: so do runs whose estimated steady solve takes this long (s)
 BASE_BYTES = 0.23e9  # the interpreter, numpy, scipy and the compiled kernels (with the per-particle figure: the fit)

@@ -197,7 +197,7 @@ def test_a_union_run_says_so_from_far_fewer_particles():
     assert memory.estimate(small, "union", "necks") is None and memory.estimate(small, "newton") is None
     assert memory.estimate(small, "union", "particles") is None
     line = memory.estimate(100_000, "union", "necks")
-    assert line.endswith("about 190 s for it on 2 cores (a transient or moving run takes longer)")
+    assert line.endswith("about 90 s for it on 2 cores (a transient or moving run takes longer)")
     assert "about 45 s" in memory.estimate(100_000, "union")
 
 
