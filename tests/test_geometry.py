@@ -211,6 +211,36 @@ def test_large_arrays_solved_in_blocks_match_small_calls():
         neck_radius(1e-3, r_j, h_bad)
 
 
+def test_compiled_blocks_are_the_numpy_blocks_to_the_bit(monkeypatch):
+    """From ``_COMPILED_MIN`` bonds on, neck_radius runs its blocks compiled on numba's threads: the numpy route's radii
+    to the bit (radius ratios 1 to 1e120, overlaps from 1e-12 of the range to its end, blocks of mixed bonds), on one
+    thread or two, and a bad entry still named by its index in the whole input."""
+    import numba
+
+    from fem_neck import geometry
+
+    rng = np.random.default_rng(11)
+    m = 3 * geometry._CHUNK + 1234
+    r_i = 1e-4 * rng.uniform(0.5, 2.0, m)
+    r_j = r_i * np.where(rng.random(m) < 0.9, rng.uniform(0.2, 5.0, m), 10.0 ** rng.uniform(-120, 120, m))
+    h = max_overlap(r_i, r_j) * np.where(rng.random(m) < 0.5, rng.uniform(1e-12, 1.0, m), 1.0)
+    numpy_route = neck_radius(r_i, r_j, h)
+    monkeypatch.setattr(geometry, "_COMPILED_MIN", geometry._CHUNK)
+    threads = numba.get_num_threads()
+    try:
+        for n in {1, min(2, numba.config.NUMBA_NUM_THREADS)}:
+            numba.set_num_threads(n)
+            assert np.array_equal(neck_radius(r_i, r_j, h), numpy_route)
+    finally:
+        numba.set_num_threads(threads)
+    k = np.arange(m) == 40000
+    for args, named in (((r_i, r_j, np.where(k, 2.0 * h, h)), r"h\[40000\]"),
+                        ((r_i, r_j, np.where(k, np.nan, h)), r"h\[40000\]"),
+                        ((np.where(k, -1.0, r_i), r_j, h), r"r_i\[40000\]")):
+        with pytest.raises(ValueError, match=named):
+            neck_radius(*args)
+
+
 @pytest.mark.parametrize("ratio", [1.0, 1.5, 3.0, 10.0, 1e3, 1e8])
 def test_newton_start_is_close_and_newton_needs_few_iterations(ratio):
     """The start (a cubic model of G in a^2, exact at both ends of the range) is within 1.5 % of the root over the

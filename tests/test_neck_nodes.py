@@ -192,7 +192,7 @@ def test_necks_are_refused_outside_the_union_shared_body():
 
 def test_a_steady_scene_with_neck_nodes_reports_the_neck_solve():
     """The static engine with nodes = "necks": the simple cubic union cell's k_eff is the neck-node solve's (a unit
-    material), a chain's boundary flows balance, and what the neck nodes do not solve yet is refused."""
+    material) and a chain's boundary flows balance."""
     from dem import make_scene, run
 
     h = 0.3
@@ -213,12 +213,6 @@ def test_a_steady_scene_with_neck_nodes_reports_the_neck_solve():
     assert flows["walls"]["end"] == pytest.approx(-flows["fixed_total"], rel=1e-12)
     q_pairs, q_walls = result.engine.bond_heat_flow()
     assert q_walls[0] == pytest.approx(flows["walls"]["end"], rel=1e-12) and np.all(q_pairs > 0)
-    from dem.laws.ambient import Convection, Sources
-
-    with pytest.raises(ValueError, match="nodes = \"necks\": heat without convection"):
-        run(make_scene(particles.position, particles.radius, particles.temperature, materials=(UNIT,),
-                       fixed=particles.fixed, walls=walls, mode="steady", conductance=NECKS,
-                       sources=Sources(convection=Convection(10.0, 0.0, 1.0))))
 
 
 def test_a_neck_node_run_computes_the_union_halves_once(monkeypatch):

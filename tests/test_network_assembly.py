@@ -35,8 +35,12 @@ def test_canonical_edges_give_the_summed_laplacian_to_the_bit(n, m):
         assert abs(shuffled - L).max() <= 1e-15 * np.abs(L.data).max()
 
 
-@pytest.mark.parametrize("open_every", [0, 3])  # all contacts closed (the free block's graph), some open (edge list)
-def test_groups_are_those_of_the_closed_edges(open_every):
+# all contacts closed (the free block's graph: scipy's search, or compiled as for a large network), some open (edges)
+@pytest.mark.parametrize("open_every, compiled", [(0, False), (0, True), (3, False)])
+def test_groups_are_those_of_the_closed_edges(open_every, compiled, monkeypatch):
+    from dem.network import laplacian as assembly
+
+    monkeypatch.setattr(assembly, "COMPILED_GROUPS_FROM", 0 if compiled else 10**9)
     rng = np.random.default_rng(2)
     n = 400
     i, j = sorted_pairs(rng.integers(0, n, 300), rng.integers(0, n, 300), n)
@@ -68,6 +72,47 @@ def test_groups_are_those_of_the_closed_edges(open_every):
         if k > 0 and fixed[a] != fixed[b]:
             touches[b if fixed[a] else a] = True
     assert np.array_equal(anchored[label], np.isin(roots, roots[touches[g.free]]))
+
+
+def test_shared_matrix_is_the_free_block_only_where_the_sum_would_copy_it():
+    """``matrix(shared=True)`` is ``L_FF`` itself where nothing is added to its diagonal; with a diagonal added or a
+    zero entry (an open contact, which the sum drops) it is the sum, as without sharing, to the bit."""
+    rng = np.random.default_rng(3)
+    n = 300
+    chain = np.arange(n)  # every node bonded: no zero diagonal (an isolated node's, which the sum would drop too)
+    i, j = sorted_pairs(np.r_[rng.integers(0, n, 900), chain[:-1]], np.r_[rng.integers(0, n, 900), chain[1:]], n)
+    i, j = i[i != j], j[i != j]
+    fixed = np.zeros(n, dtype=bool)
+    fixed[:10] = True
+    for K, extra, alike in ((rng.uniform(0.5, 1.0, len(i)), None, True),
+                            (rng.uniform(0.5, 1.0, len(i)), rng.uniform(0.0, 1.0, n - 10), False),
+                            (np.where(np.arange(len(i)) % 4 == 0, 0.0, 1.0), None, False)):
+        g = BoundedLaplacian(n, i, j, K, fixed, np.zeros(0, int), np.zeros(0, int), np.zeros(0), 0)
+        A, summed = g.matrix(extra, shared=True), g.matrix(extra)
+        assert (A is g.L_FF) == alike and summed is not g.L_FF
+        assert np.array_equal(A.indptr, summed.indptr) and np.array_equal(A.indices, summed.indices)
+        assert np.array_equal(A.data, summed.data)
+
+
+def test_compiled_groups_are_scipys_numbered_alike():
+    """The compiled union-find's groups of a symmetric pattern (many groups, single nodes, the diagonal present or
+    not) are scipy's undirected search's, numbered alike (by their smallest nodes)."""
+    from scipy.sparse.csgraph import connected_components
+
+    from dem.network.groups import groups
+
+    rng = np.random.default_rng(7)
+    n = 5000
+    i, j = sorted_pairs(rng.integers(0, n, 3000), rng.integers(0, n, 3000), n)
+    keep = i != j
+    for diagonal in (True, False):
+        L = laplacian(n, i[keep], j[keep], rng.uniform(0.5, 1.0, int(keep.sum())))
+        if not diagonal:
+            L.setdiag(0.0)
+            L.eliminate_zeros()
+        count, label = groups(L.indptr, L.indices)
+        ref_count, ref_label = connected_components(L, directed=False)
+        assert count == ref_count > 1000 and np.array_equal(label, ref_label)
 
 
 def test_heat_flow_through_a_packing_is_that_of_the_general_route(monkeypatch):

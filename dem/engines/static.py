@@ -4,8 +4,10 @@ no mechanical state; a scene whose physics is ``"thermal"``, or ``"thermal"`` an
 
 With ``"electrical"`` physics a current flows between the electrodes (walls with a potential or a current) through the
 same bonds (Kirchhoff's laws, :func:`dem.network.current.kirchhoff`: each contact's conductance the scene's law with the
-electrical conductivity for :math:`\kappa`). Nothing moves and the conductivities do not depend on the temperature, so
-it is solved once, before the heat: the absorbed part of its Joule heat is a constant source in every particle.
+electrical conductivity for :math:`\kappa`; with a node per neck the particles' elements scaled by
+:math:`\sigma / \kappa`, :func:`dem.network.necks.neck_current`, each particle's Joule heat its element's
+dissipation). Nothing moves and the conductivities do not depend on the temperature, so it is solved once, before the
+heat: the absorbed part of its Joule heat is a constant source in every particle.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from dem.laws.verified_range import neck_account, wide_necks
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
 from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
                               periodic_heat_flow, steady)
-from dem.network.necks import NeckHeat, neck_flows, neck_network, steady_necks
+from dem.network.necks import NeckHeat, neck_current, neck_flows, neck_network, steady_necks
 from dem.scene.specimen import group_flows, held_groups
 from dem.scene.state_file import box_arrays
 
@@ -69,8 +71,8 @@ def effective_conductivity(scene, summary: dict) -> float | None:
 
 def refuse_neck_nodes(scene) -> None:
     """``[conductance] nodes = "necks"`` (:mod:`dem.network.necks`) solves steady heat and integrates it with implicit
-    or Crank-Nicolson steps, so far: an explicit integrator (which cannot carry the massless necks), an ambient
-    exchange or a current is refused in one line.
+    or Crank-Nicolson steps, with convection, radiation and a current: an explicit integrator (which cannot carry the
+    massless necks) is refused in one line.
 
     Parameters
     ----------
@@ -80,19 +82,13 @@ def refuse_neck_nodes(scene) -> None:
     Raises
     ------
     ValueError
-        The scene asks for what the network with a node per neck does not solve yet.
+        The scene asks for what the network with a node per neck does not solve.
     """
     if scene.conductance.nodes != "necks":
         return
     if scene.solver.mode == "transient" and scene.solver.integrator == "explicit":
         raise ValueError("solver.integrator = \"explicit\": an explicit step cannot carry the massless neck nodes of "
                          "[conductance] nodes = \"necks\"; use \"implicit\" or \"crank-nicolson\"")
-    what = ("convection" if scene.sources.convection is not None else
-            "radiation" if scene.sources.radiation is not None else
-            "electrical physics" if scene.electrical is not None else None)
-    if what is not None:
-        raise ValueError(f"[conductance] nodes = \"necks\": heat without convection, radiation or current only, so "
-                         f"far (this scene has {what}); use nodes = \"particles\"")
 
 
 def boundary_summary(scene, walls, into: dict) -> dict:
@@ -160,8 +156,8 @@ class StaticEngine(Engine):
         if scene.solver.mode == "transient":
             self._check_work()
         particles, walls = scene.particles, scene.walls
-        if spec.nodes == "necks":  # a node per neck (dem.network.necks): the solves and the bonds' flows are its own,
-            # the one-node law's conductances (the links' field) from the halves its elements are made of
+        if spec.nodes == "necks":  # a node per neck (dem.network.necks): the solves, the current and the bonds' flows
+            # are its own, the one-node law's conductances (the links' field) from the halves its elements are of
             bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, box=scene.box)
             self.necks = neck_network(spec, particles, bonds, box=scene.box, walls=walls)
             K_pairs, K_walls = bond_conductances(spec, particles, bonds, box=scene.box, walls=tuple(walls),
@@ -187,16 +183,24 @@ class StaticEngine(Engine):
         """The particles with the absorbed Joule heat of the current (module docstring) added to their heat sources;
         keeps the potentials and what the summary says of the circuit."""
         e = self.scene.electrical
-        net = electrode_bonds(particles, bonds, self.scene.walls, self.scene.conductance, e.electrodes, self.scene.box)
-        flow = kirchhoff(particles.n, bonds.i, bonds.j, net.G, net.share, net.plane_node, net.plane_index, net.G_plane,
-                         e.electrodes, self.scene.solver.linear)
-        require_paths(flow, e.electrodes, net.plane_index)
+        if self.necks is not None:  # the current through the neck nodes, each particle's Joule heat its element's
+            flow, plane_index = neck_current(self.necks, self.scene.walls, e.electrodes, self.scene.solver.linear)
+        else:
+            net = electrode_bonds(particles, bonds, self.scene.walls, self.scene.conductance, e.electrodes,
+                                  self.scene.box)
+            flow = kirchhoff(particles.n, bonds.i, bonds.j, net.G, net.share, net.plane_node, net.plane_index,
+                             net.G_plane, e.electrodes, self.scene.solver.linear)
+            plane_index = net.plane_index
+        require_paths(flow, e.electrodes, plane_index)
         if e.floating == "error":
             refuse_floating(flow.floating)
         self.potential = flow.potential
         self.circuit = circuit(e.electrodes, flow.electrode_potential, flow.electrode_current, flow.joule_heat,
                                flow.electrode_power)
-        return replace(particles, heat=particles.heat + e.absorption * flow.joule_particles)
+        heated = replace(particles, heat=particles.heat + e.absorption * flow.joule_particles)
+        if self.necks is not None:
+            self.necks = replace(self.necks, particles=heated)
+        return heated
 
     def run(self, observe=None, progress=None, checkpoint=None) -> None:
         """Solve (steady) or integrate (transient) to ``[solver] t_end``; ``observe()`` after every step (and at the
@@ -295,7 +299,7 @@ class StaticEngine(Engine):
                 out["periodic_heat_flow"] = periodic_heat_flow(self.network, res.T).tolist()
         else:
             if self.necks is not None:
-                self.necks_heat = NeckHeat(self.necks, s.linear)
+                self.necks_heat = NeckHeat(self.necks, s.linear, sources=self.network.sources)
             net = self.network if self.necks_heat is None else self.necks_heat
             res = integrate(net, s.integrator, s.dt, s.t_end - t0, s.rtol, s.linear, s.max_steps, observer,
                             None if progress is None else (lambda t: progress(t0 + t)), resume=self.restart,
@@ -312,13 +316,13 @@ class StaticEngine(Engine):
     def _steady_necks(self, observer, out: dict) -> None:
         """The steady solve with a node per neck (:func:`dem.network.necks.steady_necks`) and what the summary says of
         it, in the keys of the one-node solve."""
-        res = steady_necks(self.necks, self.scene.solver.floating, self.scene.solver.linear)
-        p, b = self.scene.particles, self.bonds
-        flows = {"fixed": float(res.fixed_flow.sum()), "walls": float(-res.wall_flow.sum()),
-                 "internal": float(p.heat[~p.fixed].sum())}
+        res = steady_necks(self.necks, self.scene.solver.floating, self.scene.solver.linear,
+                           sources=self.network.sources)
+        b = self.bonds
         self.T_nodes = np.concatenate([res.T, res.T_necks])
-        observer(0, 0.0, res.T[self.network.free], flows)
-        out.update(energy_error=res.energy_error, heat_flow=flows, linear_solver=res.solver)
+        observer(0, 0.0, res.T[self.network.free], res.flows)
+        out.update(energy_error=res.energy_error, heat_flow=res.flows, linear_solver=res.solver,
+                   newton_iterations=res.iterations)
         if len(self.network.fixed) or len(self.scene.walls):
             walls = np.bincount(b.wall_index, res.wall_flow, len(self.scene.walls))
             out["boundary_heat_flow"] = boundary_summary(self.scene, walls,

@@ -157,8 +157,11 @@ class Network:
         n = self.particles.n
         self.jump = self.bonds.shifts @ self.box.drop if self.box is not None else np.zeros(self.bonds.n_pairs)
         self.periodic = bool(np.any(self.jump != 0.0))
-        jump_flow = self.K_pairs * self.jump
-        self.jump_rhs = np.bincount(self.bonds.j, jump_flow, n) - np.bincount(self.bonds.i, jump_flow, n)
+        if self.periodic:
+            jump_flow = self.K_pairs * self.jump
+            self.jump_rhs = np.bincount(self.bonds.j, jump_flow, n) - np.bincount(self.bonds.i, jump_flow, n)
+        else:  # what the sums give without a jump, without two passes over the bonds
+            self.jump_rhs = np.zeros(n)
         self.periodic_rhs = self.jump_rhs[self.free]
         self.r_const = self.fixed_rhs + self.wall_rhs + self.heat + self.periodic_rhs
 
@@ -217,20 +220,23 @@ class Network:
         """
         return linear_sink_terms(self.sources, self.radius, T_F)
 
-    def matrix(self, sinks: dict) -> sp.csr_matrix:
+    def matrix(self, sinks: dict, shared: bool = False) -> sp.csr_matrix:
         r"""The system matrix :math:`A = L_{FF} + \mathrm{diag}(K_\mathrm{wall} + g)`, CSR.
 
         Parameters
         ----------
         sinks : dict
             The ambient terms ``{name: (g, b)}`` (:meth:`sinks`): W/K and W per free particle.
+        shared : bool
+            True: ``L_FF`` itself where ``A`` would be its copy, for a caller that neither writes into ``A`` nor keeps
+            it past a :meth:`refresh` (:meth:`dem.network.laplacian.BoundedLaplacian.matrix`); False: a new matrix.
 
         Returns
         -------
         scipy.sparse.csr_matrix
             ``A`` (W/K).
         """
-        return self.graph.matrix(sum((g for g, _ in sinks.values()), np.zeros(self.n_free)))
+        return self.graph.matrix(sum((g for g, _ in sinks.values()), np.zeros(self.n_free)), shared)
 
     def rhs(self, sinks: dict) -> np.ndarray:
         """The right-hand side ``r`` of the module docstring.
@@ -600,30 +606,7 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
         target = np.bincount(label, net.C * T_F, n_comp)
         T_F[ground] = 0.0
         solve &= ~ground
-    solve_idx = np.flatnonzero(solve)
-    T_sub = T_F[solve_idx]
-    restrict = None if len(solve_idx) == net.n_free else solve_idx
-    iterations, backend, solver = 0, "none", None
-    for iterations in range(1, max_newton + 1):
-        T_F[solve_idx] = T_sub
-        sinks = net.sinks(T_F)
-        A, r = net.matrix(sinks), net.rhs(sinks)
-        if restrict is not None:
-            A, r = A[restrict][:, restrict], r[restrict]
-        if len(r) == 0:
-            break
-        # Newton on radiation: the matrix changes on the diagonal only, the last AMG hierarchy serves again
-        solver = make_solver(A, linear, net.base_diag if restrict is None else net.base_diag[restrict], rtol,
-                             previous=solver)
-        backend = solver.name
-        T_new = solver.solve(r, T_sub)
-        change = np.max(np.abs(T_new - T_sub)) if net.sources.radiation is not None else 0.0
-        T_sub = T_new
-        if change <= 1e-12 * max(net.temperature_range(), np.max(np.abs(T_sub)), 1e-300):
-            break
-    else:
-        raise ValueError(f"steady radiation (Newton) did not converge in {max_newton} iterations")
-    T_F[solve_idx] = T_sub
+    iterations, backend = solve_steady(net, T_F, np.flatnonzero(solve), linear, max_newton, rtol)
     if np.any(gauged):
         cap = np.bincount(label, net.C, n_comp)
         shift = (target - np.bincount(label, net.C * T_F, n_comp)) / cap
@@ -635,6 +618,65 @@ def steady(net: Network, floating: str = "error", linear: str = "auto", max_newt
     total = net.flow_magnitude(T_F, sinks)
     err = abs(sum(flows.values())) / total if total > 0 else 0.0
     return SteadyResult(net.full(T_F), flows, err, iterations, backend, n_float)
+
+
+def solve_steady(net, T_F: np.ndarray, solve_idx: np.ndarray, linear: str = "auto", max_newton: int = 50,
+                 rtol: float = 1e-10) -> tuple[int, str]:
+    """The steady balance ``A(T) T = r(T)`` of ``net`` on its free nodes ``solve_idx``, written into ``T_F``: one
+    linear solve, or with radiation Newton's iteration on its :math:`T^4` (linearised about the last iterate,
+    :func:`dem.laws.ambient.linear_sink_terms`; the matrix changes on its diagonal only, so the last AMG hierarchy
+    serves again) until no temperature changes by more than 1e-12 of the temperatures' scale. The nodes left out
+    are held where ``T_F`` has them and must not drive the others (held at 0, or in groups of their own). The one
+    solve of :func:`steady` and of the network with a node per neck (:func:`dem.network.necks.steady_necks`).
+
+    Parameters
+    ----------
+    net : Network or dem.network.necks.NeckHeat
+        The network: its ``sinks``, ``matrix``, ``rhs``, ``base_diag``, ``sources`` and ``temperature_range``.
+    T_F : numpy.ndarray
+        Temperatures of its free nodes (K or degC): the start of the iteration; overwritten on ``solve_idx``.
+    solve_idx : numpy.ndarray
+        Positions in the free nodes to solve for.
+    linear : str
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
+    max_newton : int
+        The most Newton iterations on radiation.
+    rtol : float
+        The relative residual of iterative linear solves.
+
+    Returns
+    -------
+    tuple of (int, str)
+        The iterations taken (1 without radiation) and the linear solver that ran.
+
+    Raises
+    ------
+    ValueError
+        Newton's iteration did not converge in ``max_newton`` iterations.
+    """
+    T_sub = T_F[solve_idx]
+    restrict = None if len(solve_idx) == net.n_free else solve_idx
+    iterations, backend, solver = 0, "none", None
+    for iterations in range(1, max_newton + 1):
+        T_F[solve_idx] = T_sub
+        sinks = net.sinks(T_F)
+        A, r = net.matrix(sinks, shared=True), net.rhs(sinks)  # the solver, discarded here, only reads A
+        if restrict is not None:
+            A, r = A[restrict][:, restrict], r[restrict]
+        if len(r) == 0:
+            break
+        solver = make_solver(A, linear, net.base_diag if restrict is None else net.base_diag[restrict], rtol,
+                             previous=solver)
+        backend = solver.name
+        T_new = solver.solve(r, T_sub)
+        change = np.max(np.abs(T_new - T_sub)) if net.sources.radiation is not None else 0.0
+        T_sub = T_new
+        if change <= 1e-12 * max(net.temperature_range(), np.max(np.abs(T_sub)), 1e-300):
+            break
+    else:
+        raise ValueError(f"steady radiation (Newton) did not converge in {max_newton} iterations")
+    T_F[solve_idx] = T_sub
+    return iterations, backend
 
 
 # ------------------------------------------------------------------------------------------------ transient

@@ -36,6 +36,9 @@ from scipy.sparse.csgraph import connected_components
 
 from dem.network.linsolve import make_solver
 
+COMPILED_GROUPS_FROM = 300_000  # free nodes from which the groups are found compiled (dem.network.groups): a network
+# this large loads numba for its solve anyway (dem.network.amg_cycle.COMPILED_FROM)
+
 
 def laplacian(n: int, i: np.ndarray, j: np.ndarray, K: np.ndarray) -> sp.csr_matrix:
     r"""Weighted graph Laplacian :math:`L_{ii} = \sum_j K_{ij}`, :math:`L_{ij} = -K_{ij}` (symmetric, rows sum to zero).
@@ -232,7 +235,7 @@ class BoundedLaplacian:
         """Diagonal of ``L_FF`` (the part of ``A`` that edges make; for the choice of linear solver)."""
         return self.L_FF.diagonal()
 
-    def matrix(self, extra_diag=None) -> sp.csr_matrix:
+    def matrix(self, extra_diag=None, shared: bool = False) -> sp.csr_matrix:
         r""":math:`A = L_{FF} + \mathrm{diag}(\text{plane conductances} + \text{extra\_diag})`, CSR.
 
         Parameters
@@ -240,6 +243,10 @@ class BoundedLaplacian:
         extra_diag : array_like or None
             Per free node, more on the diagonal (e.g. ``C/dt`` or an ambient's conductance; the unit of ``K``);
             None: nothing.
+        shared : bool
+            True: ``L_FF`` itself where the sum would be its copy (nothing added to its diagonal, no zero entry
+            for the sum to drop), for a caller that neither writes into ``A`` nor keeps it past a :meth:`refresh`
+            (no fresh matrix: at :math:`10^6` nodes 143 MB the kernel clears); False: always a new matrix.
 
         Returns
         -------
@@ -247,6 +254,8 @@ class BoundedLaplacian:
             ``A`` on the free nodes.
         """
         extra = self.plane_diag if extra_diag is None else self.plane_diag + extra_diag
+        if shared and not np.any(extra) and np.all(self.L_FF.data):
+            return self.L_FF
         return (self.L_FF + sp.diags(extra)).tocsr()
 
     def plane_rhs(self, x_planes) -> np.ndarray:
@@ -304,9 +313,15 @@ class BoundedLaplacian:
         """
         if np.all(self.K > 0.0):
             # every edge joins: the free block's sparsity is the graph (its diagonal loops), symmetric, so its
-            # strongly connected components are its groups, found without the transpose an undirected search makes
-            # (half the search's time)
-            n_comp, label = connected_components(self.L_FF, directed=True, connection="strong")
+            # groups are those of its pattern; a large one's by union-find compiled (a fifth of scipy's time), a
+            # smaller one's as its strongly connected components, without the transpose an undirected search makes
+            L_FF = self.L_FF
+            if len(self.free) >= COMPILED_GROUPS_FROM:
+                from dem.network.groups import groups  # compiled: a smaller network loads no numba
+
+                n_comp, label = groups(L_FF.indptr, L_FF.indices)
+            else:
+                n_comp, label = connected_components(L_FF, directed=True, connection="strong")
         else:
             where = np.full(self.n, -1, dtype=np.int64)
             where[self.free] = np.arange(len(self.free))

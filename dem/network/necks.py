@@ -56,6 +56,34 @@ and is refused: it would have to condense the necks every step (a sparse solve o
 without its stability), under the stable limit of the condensed matrix, which :func:`dem.network.heat.stable_limit`
 computes (it decides Crank-Nicolson's implicit start-up).
 
+**Ambient.** Convection and radiation (:mod:`dem.laws.ambient`, Rojek 2022 eq. 3) act on a particle's exposed
+surface (:mod:`dem.geometry.exposure`), whose temperature the network holds at its centre node, the node that holds
+its heat capacity: the exchange :math:`Q_k = b_k - g_k T_k` of a free particle enters its centre's row as on one node
+per particle (:math:`g` on the diagonal, :math:`b` on the right-hand side; none on a neck, which has no surface of its
+own in the model). A particle whose necks are collinear is its halves in series between centre nodes with the same
+:math:`g`: a chain is today's network with the ambient, steady and transient. Radiation's :math:`T^4` is linearised
+about the last iterate and solved by the particle network's Newton iteration (:func:`dem.network.heat.solve_steady`)
+on this matrix, whose diagonal alone changes; in time it is linearised about each step's start as there. Every group
+of nodes with a centre that sees the ambient is anchored by it. The heat balance sums the flows through the walls,
+the fixed centres, the sources and the ambient (:meth:`NeckHeat.flows`); the necks' rows add nothing to it.
+
+**Current.** The current between electrodes (:mod:`dem.network.current`) obeys the same Laplace problem with the
+electrical conductivity :math:`\sigma` for :math:`\kappa`: the half conductances, the faces' interaction and the trace
+cap are each proportional to the particle's conductivity, so its electrical element is :math:`(\sigma_k/\kappa_k)
+E_k`, the thermal one scaled (one assembly for both). Kirchhoff's solve (:func:`dem.network.current.kirchhoff`, its
+superposition for an electrode driving a fixed current and its floating groups included) takes the elements as edges:
+a symmetric matrix whose rows sum to zero is the Laplacian of the graph whose edge ``(p, q)`` has the conductance
+:math:`-E_{pq}` (positive or, between two necks, possibly negative), so every pair of an element's nodes is an edge;
+a wall end on an electrode is a plane bond to it, a wall end on another wall (no current crosses it) a node of its
+own, joined only to its particle's element (which is then that element with the end's row condensed out). There is
+no potential drop across a periodic box's faces: the necks' offsets are the heat's only. The Joule heat made in
+particle ``k`` is its element's dissipation :math:`\Phi_k^T E_k^\sigma \Phi_k = \sum_{p<q} -E^\sigma_{pq} (\Phi_p -
+\Phi_q)^2` (:math:`\Phi_k` the potentials of its centre and its necks), deposited on its centre (its absorbed part a
+source of heat there); summed over the particles it is the power :math:`\sum_e V_e I_e` the electrodes deliver
+(Tellegen's theorem), to round-off. A chain's elements are its halves in series, whose dissipations are the shares
+of :math:`I^2/G` that the particle network gives each particle: today's current, potentials and Joule heat. A particle
+touching two electrodes (its element would join them directly, an edge the solve has no place for) is refused.
+
 **MPI (not yet implemented).** A neck node is owned by the lower of the two ranks that own its particles; the other
 rank holds it as a ghost (like a particle across the cut), and the element of a particle is assembled by the rank that
 owns the particle, its rows for a ghost neck sent to the neck's owner (the same exchange the distributed Laplacian
@@ -64,7 +92,7 @@ makes for its halo rows, :mod:`dem.network.distributed`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -73,8 +101,10 @@ from scipy.sparse.csgraph import connected_components
 from dem.geometry.bonds import Bonds
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
-from dem.laws.ambient import Sources
+from dem.laws.ambient import Sources, linear_sink_terms
 from dem.laws.conductance import ConductanceSpec, bond_halves, union_halves, wall_normals
+from dem.network.current import CurrentFlow, Electrodes, kirchhoff
+from dem.network.heat import solve_steady
 from dem.network.linsolve import make_solver
 
 
@@ -95,7 +125,8 @@ class NeckNetwork:
     A : scipy.sparse.csr_matrix
         The matrix over all nodes, centres then necks (W/K), the walls' columns moved to the right-hand side.
     rhs : numpy.ndarray
-        The right-hand side over all nodes from the periodic offsets, the walls and the sources (W).
+        The right-hand side over all nodes from the periodic offsets and the walls (W); the particles' heat sources
+        and the ambient enter where the network is solved (:class:`NeckHeat`).
     entries : tuple
         ``(row, col, value, known, end)`` of every element entry: its row and column nodes (``-1``: a wall's
         neck), its value (W/K), the offset or wall temperature its column is seen at (K), and the bond end of
@@ -106,6 +137,10 @@ class NeckNetwork:
         The number of particles whose interactions were dropped (``R`` not positive definite).
     jump : numpy.ndarray
         Per live pair bond, the temperature drop its ``j`` sees across the periodic faces (K; 0 without a box).
+    owner : numpy.ndarray
+        Per element entry (in the order of ``entries``), the particle whose element it belongs to.
+    col_end : numpy.ndarray
+        Per element entry, the bond end of its column (``-1``: the centre).
     box : dem.geometry.periodic.PeriodicBox or None
         The periodic box; None: none.
     union : tuple or None
@@ -124,6 +159,8 @@ class NeckNetwork:
     n_ends: int
     plain: int
     jump: np.ndarray
+    owner: np.ndarray
+    col_end: np.ndarray
     box: PeriodicBox | None = None
     union: tuple | None = None
 
@@ -225,9 +262,8 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     A = sp.coo_matrix((value[inner], (row[inner], col[inner])), shape=(size_all, size_all)).tocsr()
     A = 0.5 * (A + A.T)  # symmetric to round-off (the blocks are; their sums need not be bit for bit)
     rhs = -np.bincount(row[rows], value[rows] * known[rows], size_all)
-    rhs[:n] += particles.heat
     return NeckNetwork(particles, bonds, live, live_walls, A.tocsr(), rhs, (row, col, value, known, end_row),
-                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, box, union)
+                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box, union)
 
 
 @dataclass
@@ -248,8 +284,13 @@ class NeckSteady:
         Per particle, the heat its fixed temperature feeds into the network (W; 0 for a free particle).
     periodic_heat_flow : numpy.ndarray
         (3,) the heat flow across the period along x, y, z (W).
+    flows : dict
+        The heat flowing into the free nodes through each boundary (W, :meth:`NeckHeat.flows`: fixed centres,
+        walls, internal sources and each ambient exchange, radiation's by its exact :math:`T^4`).
     energy_error : float
-        The heat balance's mismatch relative to the flows through the boundaries.
+        The heat balance's mismatch (the sum of ``flows``) relative to the flows through the boundaries.
+    iterations : int
+        Newton iterations on radiation (1 without).
     solver : str
         The linear solver that ran.
     """
@@ -260,25 +301,34 @@ class NeckSteady:
     wall_flow: np.ndarray
     fixed_flow: np.ndarray
     periodic_heat_flow: np.ndarray
+    flows: dict
     energy_error: float
+    iterations: int
     solver: str
 
 
-def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto", rtol: float = 1e-12) -> NeckSteady:
-    """The steady temperatures of the network with a node per neck (module docstring).
+def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto", rtol: float = 1e-12,
+                 sources: Sources | None = None, max_newton: int = 50) -> NeckSteady:
+    """The steady temperatures of the network with a node per neck (module docstring), with the ambient exchange of
+    ``sources`` on the free centres ("Ambient"): one solve of :class:`NeckHeat`'s balance, or Newton's iteration on
+    radiation (:func:`dem.network.heat.solve_steady`, the one of the particle network).
 
     Parameters
     ----------
     net : NeckNetwork
         The network.
     floating : str
-        What a group of particles that reaches no fixed temperature or wall and holds no bond across a periodic face
-        with a temperature drop does: ``"mean"`` keeps it at its particles' capacity-weighted mean initial
-        temperature, ``"error"`` refuses (as :func:`dem.network.heat.steady`).
+        What a group of particles that reaches no fixed temperature, wall or ambient and holds no bond across a
+        periodic face with a temperature drop does: ``"mean"`` keeps it at its particles' capacity-weighted mean
+        initial temperature, ``"error"`` refuses (as :func:`dem.network.heat.steady`).
     linear : str
         The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
     rtol : float
         The relative residual of iterative linear solves.
+    sources : dem.laws.ambient.Sources or None
+        Convection and radiation to an ambient; None: none.
+    max_newton : int
+        The most Newton iterations on radiation.
 
     Returns
     -------
@@ -288,47 +338,46 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
     Raises
     ------
     ValueError
-        A group of particles that reaches no fixed temperature or wall has a net heat source, or floats with
-        ``floating = "error"``; a bad ``floating``.
+        A group of particles that reaches no fixed temperature, wall or ambient has a net heat source, or floats with
+        ``floating = "error"``; a bad ``floating``; Newton's iteration did not converge.
     """
     if floating not in ("mean", "error"):
         raise ValueError(f"solver.floating = {floating!r}: must be error or mean")
+    system = NeckHeat(net, linear, rtol, sources)
     p = net.particles
     n, N = p.n, net.n_nodes
     fixed = np.zeros(N, dtype=bool)
     fixed[:n] = p.fixed
-    T = np.zeros(N)
-    T[:n] = p.temperature
-    # the groups: anchored where they hold a fixed node or a wall's neck
+    T_F = np.concatenate([p.temperature[~p.fixed], np.zeros(len(net.live))]).astype(float)  # centres: initial
+    # the groups: anchored where they hold a fixed node, a wall's neck or a centre with an ambient exchange
     row, col = net.entries[0], net.entries[1]
     n_comp, label = connected_components(net.A, directed=False)
     anchored = np.zeros(n_comp, dtype=bool)
     anchored[label[fixed]] = True
     anchored[label[row[(col < 0) & (row >= 0)]]] = True
+    ambient = sum((g for g, _ in system.sinks(T_F).values()), np.zeros(system.n_free))
+    anchored[label[system.free[ambient > 0]]] = True
     heat = np.bincount(label[:n], p.heat, n_comp)
     if np.any(~anchored & (np.abs(heat) > 1e-12 * np.maximum(np.bincount(label[:n], np.abs(p.heat), n_comp), 1e-300))):
-        raise ValueError("steady problem has no solution: a floating group of particles (no fixed temperature or "
-                         "wall) has a net internal heat source, so it heats up forever")
+        raise ValueError("steady problem has no solution: a floating group of particles (no fixed temperature, "
+                         "wall or ambient) has a net internal heat source, so it heats up forever")
     jumping = np.zeros(n_comp, dtype=bool)
     jumping[label[n + np.flatnonzero(net.jump != 0.0)]] = True
     lost = ~anchored & ~jumping
     if floating == "error" and np.any(lost):
         first = np.flatnonzero(lost[label[:n]])[:8].tolist()
         raise ValueError(f"steady problem is singular: {int(lost.sum())} connected group(s) of particles (e.g. "
-                         f"{first}) touch no fixed particle or wall, so their temperature is undetermined; fix a "
-                         f"particle's temperature, add a wall, or set solver.floating = \"mean\"")
+                         f"{first}) touch no fixed particle, wall or ambient, so their temperature is undetermined; "
+                         f"fix a particle's temperature, add a wall, or set solver.floating = \"mean\"")
     ground = np.zeros(N, dtype=bool)  # one centre of every floating group held at 0
     floating = np.flatnonzero(~anchored)
     centre_of = np.full(n_comp, -1)
     centre_of[label[:n][::-1]] = np.arange(n)[::-1]
     ground[centre_of[floating]] = True
-    T[ground] = 0.0
-    free = ~fixed & ~ground
-    A = net.A[free][:, free].tocsr()
-    b = net.rhs[free] - net.A[free][:, fixed] @ T[fixed]
-    solver = make_solver(A, linear, None, rtol) if A.shape[0] else None
-    if A.shape[0]:
-        T[free] = solver.solve(b)
+    held = ground[system.free]
+    T_F[held] = 0.0
+    iterations, backend = solve_steady(system, T_F, np.flatnonzero(~held), linear, max_newton, rtol)
+    T = system.nodes(T_F)
     if len(floating):  # each floating group to its particles' capacity-weighted mean initial temperature
         C = p.capacity
         target = np.bincount(label[:n], C * p.temperature, n_comp)
@@ -336,16 +385,17 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
         now = np.bincount(label[:n], C * T[:n], n_comp)
         shift = np.where(anchored, 0.0, (target - now) / np.where(weight > 0, weight, 1.0))
         T += shift[label]
+    T_F = T[system.free]
+    sinks = system.sinks(T_F)  # radiation: the exact T^4 flow at the solution
+    flows = system.flows(T_F, sinks)
+    scale = system.flow_magnitude(T_F, sinks)
+    energy_error = abs(sum(flows.values())) / scale if scale > 0 else 0.0
     bond_flow, wall_flow, fixed_flow = neck_flows(net, T)
     m = len(net.live)
     shifts = net.bonds.shifts[net.live] if m else np.zeros((0, 3))
     periodic = bond_flow[net.live] @ shifts if m else np.zeros(3)
-    boundary = [fixed_flow[p.fixed], -wall_flow, p.heat]
-    net_in = float(sum(x.sum() for x in boundary))
-    scale = float(sum(np.abs(x).sum() for x in boundary))
-    energy_error = abs(net_in) / scale if scale > 0 else 0.0
     return NeckSteady(T[:n].copy(), T[n:].copy(), bond_flow, wall_flow, fixed_flow, np.asarray(periodic, float),
-                      energy_error, "none" if solver is None else solver.name)
+                      flows, energy_error, iterations, backend)
 
 
 def neck_flows(net: NeckNetwork, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -380,12 +430,14 @@ def neck_flows(net: NeckNetwork, T: np.ndarray) -> tuple[np.ndarray, np.ndarray,
 
 
 class NeckHeat:
-    r"""The transient heat balance of the network with a node per neck (module docstring, "Transient") in the terms
-    in which :func:`dem.network.heat.integrate` and :class:`dem.network.theta.ThetaStepper` take a network, so that
-    one :math:`\theta` scheme serves both: the unknowns are the free centres (their capacities) and then the necks
-    (massless, ``C = 0``), ``A`` the network's matrix on them and ``r`` its right-hand side with the fixed centres'
-    columns moved into it. No ambient exchange. The necks start where their rows hold at the initial temperatures
-    (the constraint :math:`(A T)_n = r_n`), which keeps Crank-Nicolson's neck temperatures from alternating.
+    r"""The heat balance of the network with a node per neck over its free nodes (module docstring, "Transient" and
+    "Ambient") in the terms in which :func:`dem.network.heat.integrate`, :class:`dem.network.theta.ThetaStepper` and
+    :func:`dem.network.heat.solve_steady` take a network, so that one :math:`\theta` scheme and one steady solve serve
+    both: the unknowns are the free centres (their capacities) and then the necks (massless, ``C = 0``), ``A`` the
+    network's matrix on them and ``r`` its right-hand side with the fixed centres' columns moved into it and the
+    particles' heat sources added; the ambient exchange :math:`Q = b - g T` (:func:`dem.laws.ambient.linear_sink_terms`)
+    acts on the free centres only. The necks start where their rows hold at the initial temperatures (the
+    constraint :math:`(A T)_n = r_n`), which keeps Crank-Nicolson's neck temperatures from alternating.
 
     Parameters
     ----------
@@ -395,27 +447,30 @@ class NeckHeat:
         The linear solver of the necks' initial solve (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
     rtol : float
         The relative residual of that solve if iterative.
+    sources : dem.laws.ambient.Sources or None
+        Convection and radiation to an ambient (an ``"exposed"`` area fraction resolved against the packing); None:
+        none.
     """
 
-    sources = Sources()  # no ambient exchange
-    flow_names = ("fixed", "walls", "internal")
-
-    def __init__(self, net: NeckNetwork, linear: str = "auto", rtol: float = 1e-12):
+    def __init__(self, net: NeckNetwork, linear: str = "auto", rtol: float = 1e-12, sources: Sources | None = None):
         p = net.particles
         n, m = p.n, len(net.live)
         self.net, self.particles = net, p
         centres = np.flatnonzero(~p.fixed)
         held = np.flatnonzero(p.fixed)
-        k = len(centres)
         self.free = np.concatenate([centres, n + np.arange(m)])
         rows = net.A[self.free]
         self.A = rows[:, self.free].tocsr()
-        self.r_const = net.rhs[self.free] - rows[:, held] @ p.temperature[held]
         self.C = np.concatenate([p.capacity[centres], np.zeros(m)])
         self.heat = np.concatenate([p.heat[centres], np.zeros(m)])
+        self.r_const = net.rhs[self.free] - rows[:, held] @ p.temperature[held] + self.heat
+        self.sources = (Sources() if sources is None else sources).resolved(p.position, p.radius, centres)
+        self.radius = p.radius[centres]
+        self.flow_names = ("fixed", "walls", "internal", *self.sources.names)
         self.periodic = bool(np.any(net.jump != 0.0))  # a temperature drop across the box's faces drives it
         self.base_diag = self.A.diagonal()
         self.n_free = len(self.free)
+        self._centres = len(centres)
         # the boundary terms: the entries of the walls' rows (heat from a wall into the network) and of the fixed
         # centres' rows (heat a fixed centre feeds into it), grouped by wall end and by fixed centre
         row, col, value, known, end = net.entries
@@ -426,16 +481,21 @@ class NeckHeat:
         take = wall | fed
         self._terms = (col[take], value[take], known[take], group[take], self._walls + len(held))
         self.wall_temperature = known[col < 0]
-        self._initial = np.concatenate([p.temperature[centres].astype(float), np.zeros(m)])
-        if m:  # the necks where their rows hold (the docstring)
-            A_nn, A_nc = self.A[k:, k:], self.A[k:, :k]
-            b = self.r_const[k:] - A_nc @ self._initial[:k]
-            self._initial[k:] = make_solver(A_nn.tocsr(), linear, None, rtol).solve(b)
+        self._solve = (linear, rtol)
+        self._initial = None
 
     @property
     def initial(self) -> np.ndarray:
         """Initial temperatures of the free nodes, K or degC (the free centres' own, the necks' where their rows
-        hold)."""
+        hold), solved for when first asked for."""
+        if self._initial is None:
+            k = self._centres
+            T = np.concatenate([self.particles.temperature[self.free[:k]].astype(float), np.zeros(self.n_free - k)])
+            if self.n_free > k:  # the necks where their rows hold (the docstring)
+                A_nn, A_nc = self.A[k:, k:], self.A[k:, :k]
+                T[k:] = make_solver(A_nn.tocsr(), self._solve[0], None, self._solve[1]).solve(
+                    self.r_const[k:] - A_nc @ T[:k])
+            self._initial = T
         return self._initial.copy()
 
     def nodes(self, T_F: np.ndarray) -> np.ndarray:
@@ -471,7 +531,8 @@ class NeckHeat:
         return self.nodes(T_F)[:self.particles.n]
 
     def sinks(self, T_F: np.ndarray) -> dict:
-        """The ambient exchange: none.
+        """The ambient exchange of the free centres as :math:`Q = b - g T` (:func:`dem.laws.ambient.linear_sink_terms`,
+        radiation linearised about ``T_F``); 0 on the necks.
 
         Parameters
         ----------
@@ -481,39 +542,45 @@ class NeckHeat:
         Returns
         -------
         dict
-            ``{}``.
+            ``{name: (g, b)}``: W/K and W per free node (``{}`` without an ambient).
         """
-        return {}
+        k = self._centres
+        necks = np.zeros(self.n_free - k)
+        return {name: (np.concatenate([g, necks]), np.concatenate([b, necks]))
+                for name, (g, b) in linear_sink_terms(self.sources, self.radius, T_F[:k]).items()}
 
-    def matrix(self, sinks: dict) -> sp.csr_matrix:
-        """The matrix ``A`` over the free nodes.
+    def matrix(self, sinks: dict, shared: bool = False) -> sp.csr_matrix:
+        """The matrix over the free nodes: ``A`` and the ambient's :math:`g` on the centres' diagonal.
 
         Parameters
         ----------
         sinks : dict
-            The ambient terms (none: ``{}``, :meth:`sinks`).
+            The ambient terms ``{name: (g, b)}`` (:meth:`sinks`).
+        shared : bool
+            As :meth:`dem.network.heat.Network.matrix` has it; without ambient terms ``A`` itself is returned either
+            way (no caller writes into it).
 
         Returns
         -------
         scipy.sparse.csr_matrix
-            ``A`` (W/K).
+            The matrix (W/K).
         """
-        return self.A
+        return self.A if not sinks else (self.A + sp.diags(sum(g for g, _ in sinks.values()))).tocsr()
 
     def rhs(self, sinks: dict) -> np.ndarray:
-        """The right-hand side ``r`` over the free nodes.
+        """The right-hand side over the free nodes: ``r`` and the ambient's :math:`b` on the centres.
 
         Parameters
         ----------
         sinks : dict
-            The ambient terms (none: ``{}``, :meth:`sinks`).
+            The ambient terms ``{name: (g, b)}`` (:meth:`sinks`).
 
         Returns
         -------
         numpy.ndarray
-            ``r`` (W).
+            The right-hand side (W).
         """
-        return self.r_const
+        return self.r_const if not sinks else self.r_const + sum(b for _, b in sinks.values())
 
     def _boundary(self, T_F: np.ndarray) -> tuple[np.ndarray, float]:
         """Per wall end, then per fixed centre, the heat it gives the free nodes (W); and the sum of its terms' sizes
@@ -524,35 +591,39 @@ class NeckHeat:
         return np.bincount(group, terms, size), float(np.abs(terms).sum())
 
     def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
-        """Heat flow into the free nodes through the fixed centres, the walls and the sources: their sum is the
-        change of the centres' heat (the neck rows sum their elements' rows, each of which sums to zero).
+        """Heat flow into the free nodes through the fixed centres, the walls, the sources and the ambient: their sum
+        is the change of the centres' heat (the neck rows sum their elements' rows, each of which sums to zero).
 
         Parameters
         ----------
         T_F : numpy.ndarray
             The temperatures of the free nodes, free centres then necks (K or degC).
         sinks : dict
-            The ambient terms (none: ``{}``, :meth:`sinks`).
+            The ambient terms ``{name: (g, b)}`` (:meth:`sinks`).
 
         Returns
         -------
         dict
-            ``{"fixed": W, "walls": W, "internal": W}``.
+            ``{"fixed": W, "walls": W, "internal": W}`` and a flow per ambient exchange.
         """
         q = self._boundary(T_F)[0]
-        return {"fixed": float(q[self._walls:].sum()), "walls": float(q[:self._walls].sum()),
-                "internal": float(self.heat.sum())}
+        out = {"fixed": float(q[self._walls:].sum()), "walls": float(q[:self._walls].sum()),
+               "internal": float(self.heat.sum())}
+        for name, (g, b) in sinks.items():
+            out[name] = float(b.sum() - g @ T_F)
+        return out
 
     def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
         """The scale of the heat balance, as :meth:`dem.network.heat.Network.flow_magnitude`: the sum of the sizes of
-        the flows through each wall end, fixed centre and source, never below round-off of their terms.
+        the flows through each wall end, fixed centre, source and ambient exchange, never below round-off of their
+        terms.
 
         Parameters
         ----------
         T_F : numpy.ndarray
             The temperatures of the free nodes, free centres then necks (K or degC).
         sinks : dict
-            The ambient terms (none: ``{}``, :meth:`sinks`).
+            The ambient terms ``{name: (g, b)}`` (:meth:`sinks`).
 
         Returns
         -------
@@ -560,15 +631,92 @@ class NeckHeat:
             The scale (W).
         """
         q, gross = self._boundary(T_F)
-        sources = float(np.abs(self.heat).sum())
-        return max(sources + float(np.abs(q).sum()), np.sqrt(np.finfo(float).eps) * (sources + gross))
+        net = gross_all = float(np.abs(self.heat).sum())
+        net += float(np.abs(q).sum())
+        gross_all += gross
+        for g, b in sinks.values():
+            net += float(np.abs(b - g * T_F).sum())
+            gross_all += float(np.abs(b).sum() + np.abs(g * T_F).sum())
+        return max(net, np.sqrt(np.finfo(float).eps) * gross_all)
 
     def temperature_bounds(self) -> tuple[float, float]:
-        """Lowest and highest temperature the scene prescribes (initial, fixed, walls)."""
-        allt = np.concatenate([self.particles.temperature, self.wall_temperature])
+        """Lowest and highest temperature the scene prescribes (initial, fixed, walls, ambient)."""
+        ambient = [s.T_inf for s in (self.sources.convection, self.sources.radiation) if s is not None]
+        allt = np.concatenate([self.particles.temperature, self.wall_temperature, ambient])
         return float(allt.min()), float(allt.max())
 
     def temperature_range(self) -> float:
         """The spread of :meth:`temperature_bounds` (K)."""
         lo, hi = self.temperature_bounds()
         return hi - lo
+
+
+def neck_current(net: NeckNetwork, walls, electrodes: Electrodes, linear: str = "auto") -> tuple[CurrentFlow,
+                                                                                                  np.ndarray]:
+    r"""The current between the electrodes through the network with a node per neck (module docstring, "Current"):
+    Kirchhoff's solve (:func:`dem.network.current.kirchhoff`) on the elements' edges with :math:`\sigma` for
+    :math:`\kappa`, and each particle's Joule heat its element's dissipation.
+
+    Parameters
+    ----------
+    net : NeckNetwork
+        The network (its elements with the thermal conductivity :math:`\kappa`).
+    walls : sequence of dem.geometry.walls.Wall
+        The scene's walls (the bonds' wall indices refer to them).
+    electrodes : dem.network.current.Electrodes
+        The electrodes among ``walls``.
+    linear : str
+        The linear solver (``dem.network.linsolve.BACKENDS``, or ``"auto"``).
+
+    Returns
+    -------
+    tuple
+        ``(flow, plane_index)``: the :class:`dem.network.current.CurrentFlow` with the particles' (centres')
+        potentials (V), the floating particles, each particle's Joule heat (W) and their sum; its ``pair_current``
+        and ``wall_current`` are those of the elements' edges (A). ``plane_index``: the electrode of each live wall
+        bond to an electrode (for :func:`dem.network.current.require_paths`).
+
+    Raises
+    ------
+    ValueError
+        A particle touches two electrodes (its element would join them directly, which the solve has no edge for),
+        or no electrode is at a fixed potential.
+    """
+    p = net.particles
+    n, m = p.n, len(net.live)
+    row, col, value, _, end = net.entries
+    owner, col_end = net.owner, net.col_end
+    # each end's place: a neck's node, a wall end to an electrode that electrode (a plane), an insulated one a node
+    electrode_of_wall = np.full(len(walls), -1, dtype=np.int64)
+    electrode_of_wall[list(electrodes.walls)] = np.arange(len(electrodes))
+    electrode = electrode_of_wall[net.bonds.wall_index[net.live_walls]]
+    insulated = electrode < 0
+    extra = n + m + np.cumsum(insulated) - 1
+    n_nodes = n + m + int(insulated.sum())
+    wall_node = np.concatenate([np.where(insulated, extra, -1), [-1]])  # per wall end (and a pad for a pair end)
+    wall_plane = np.concatenate([electrode, [-1]])
+    k_row, k_col = np.where(end >= 2 * m, end - 2 * m, -1), np.where(col_end >= 2 * m, col_end - 2 * m, -1)
+    a, b = np.where(row >= 0, row, wall_node[k_row]), np.where(col >= 0, col, wall_node[k_col])
+    plane_a, plane_b = np.where(row >= 0, -1, wall_plane[k_row]), np.where(col >= 0, -1, wall_plane[k_col])
+    upper = end < col_end  # each pair of an element's nodes once (the centre is end -1)
+    both = upper & (plane_a >= 0) & (plane_b >= 0)
+    if np.any(both):
+        k = int(owner[np.flatnonzero(both)[0]])
+        raise ValueError(f"[conductance] nodes = \"necks\": particle {k} touches two electrodes, which its element "
+                         f"would join directly; use nodes = \"particles\"")
+    G = -value * (p.electrical_conductivity / p.conductivity)[owner]  # the element scaled by sigma / kappa
+    edge = upper & (plane_a < 0) & (plane_b < 0)
+    plane = upper & ~edge
+    node = np.where(plane_a >= 0, b, a)[plane]
+    plane_index = np.where(plane_a >= 0, plane_a, plane_b)[plane]
+    flow = kirchhoff(n_nodes, a[edge], b[edge], G[edge], np.zeros(int(edge.sum())), node, plane_index, G[plane],
+                     electrodes, linear)
+    # each element's dissipation: sum over its pairs of nodes of G (phi_a - phi_b)^2 (floating nodes carry nothing)
+    x = np.nan_to_num(flow.potential)
+    V = np.nan_to_num(flow.electrode_potential)
+    live = np.isfinite(flow.potential[node]) & np.isfinite(flow.electrode_potential[plane_index])
+    joule = (np.bincount(owner[edge], G[edge] * (x[a[edge]] - x[b[edge]]) ** 2, n)
+             + np.bincount(owner[plane], np.where(live, G[plane] * (V[plane_index] - x[node]) ** 2, 0.0), n))
+    floating = flow.floating[flow.floating < n]
+    return replace(flow, potential=flow.potential[:n].copy(), floating=floating, joule_particles=joule,
+                   joule_heat=float(joule.sum())), plane_index

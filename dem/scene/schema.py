@@ -179,7 +179,8 @@ ROWS = (
         'conductance; `"necks"`: a node per neck as well, each particle an element joining its centre to its necks '
         '(`dem.network.necks`: the `shared-body` particle solved exactly, its interaction taken between the necks\' '
         'faces), for `law = "shared-body"` with `neck = "union"`; steady heat, or transient with implicit or '
-        'crank-nicolson steps, without convection, radiation or current so far'),
+        'crank-nicolson steps, with convection, radiation and current (the ambient on each particle\'s centre, the '
+        'electrical element the thermal one times sigma / kappa); not under MPI so far'),
     Row("conductance", ("contact_conductance",), ALL, "W/K, none", "K_c of the interface in series (eq. 8)"),
     Row("conductance", ("out_of_range",), ALL, '`"error"`', 'bonds beyond the contact model\'s range (h > '
         'max_overlap; wall overlap > r/3): `"error"` reports their count and the first pair, `"clip"` sets a to the '
