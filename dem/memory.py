@@ -6,6 +6,12 @@ The figure is the peak of a steady solve of the benchmarks' random sintered pack
 the AMG hierarchy; ``python -m benchmarks dem``, whole process, maximum resident set): 1.58 GB for 10^6 particles
 (5.5 * 10^6 bonds) and 13.7 GB for 10^7 (5.6 * 10^7 bonds), which ``BASE_BYTES + BYTES_PER_PARTICLE * n`` gives to
 a per cent: about 240 bytes per bond at 5.6 bonds per particle, so a denser packing needs more in proportion.
+
+Under the union of spheres (``[conductance] neck = "union"``) a particle costs five times that: the peak of a steady
+solve of a random union packing at a solid fraction of 0.8 tiled to 2048, 6912, 16384 and 42592 particles (4.75
+bonds each; whole process, maximum resident set) grows by 7.1 kB per particle with one node per particle and by 7.3 kB
+with a node per neck (``nodes = "necks"``: a node per live bond more and each particle's element over its necks and
+its centre), above about the same base.
 """
 
 from __future__ import annotations
@@ -14,6 +20,9 @@ import os
 import pathlib
 
 BYTES_PER_PARTICLE = 1.35e3
+#: bytes per particle at the peak of a steady solve under the union of spheres, by the network's nodes (module
+#: docstring)
+UNION_BYTES_PER_PARTICLE = {"particles": 7.1e3, "necks": 7.3e3}
 # a steady solve of the benchmarks' 10^6-particle random packing (bonds, conductances, network, AMG-CG; python -m
 # benchmarks dem) took 10.5 s on a quiet 2-core machine before the cell search and the row-by-row assembly, which
 # take 0.74 of its CPU time side by side: about 7.8e-6 s per particle
@@ -21,8 +30,9 @@ SECONDS_PER_PARTICLE = 7.8e-6
 #: seconds of CPU per particle of the ``shared-body`` law's steady solve on union necks (``neck = "union"``: the cut
 #: bodies, the closing pores' cells and the factors) and with a node per neck (``nodes = "necks"``: the faces'
 #: quadrature): bonds, conductances and solve of a random union packing at phi 0.8 tiled to 6912 particles (4.75 bonds
-#: each), 0.41-0.46 and 1.84 ms per particle on the 2-core machine at load 5-7
-UNION_SECONDS_PER_PARTICLE = {"particles": 4.5e-4, "necks": 1.9e-3}
+#: each), 0.41-0.46 ms per particle on the 2-core machine at load 5-7, and with a node per neck 0.83 ms against the
+#: one node's 0.42 in the same process at load 17 (the faces' sums in SIMD lanes, the union halves computed once)
+UNION_SECONDS_PER_PARTICLE = {"particles": 4.5e-4, "necks": 9.0e-4}
 ANNOUNCE_FROM = 1_000_000  # runs of this many particles or more say what they will take before they start
 ANNOUNCE_SECONDS = 10.0  #: so do runs whose estimated steady solve takes this long (s)
 BASE_BYTES = 0.23e9  # the interpreter, numpy, scipy and the compiled kernels (with the per-particle figure: the fit)
@@ -54,7 +64,25 @@ def available_bytes() -> float | None:
     return out
 
 
-def check(n: int, name: str) -> None:
+def bytes_per_particle(neck: str = "newton", nodes: str = "particles") -> float:
+    """The memory a particle takes at the peak of a steady solve (module docstring).
+
+    Parameters
+    ----------
+    neck : str
+        The scene's neck reading (``[conductance] neck``); ``"union"`` costs :data:`UNION_BYTES_PER_PARTICLE`.
+    nodes : str
+        The network's nodes under the union (``[conductance] nodes``: ``"particles"`` or ``"necks"``).
+
+    Returns
+    -------
+    float
+        Bytes per particle.
+    """
+    return UNION_BYTES_PER_PARTICLE[nodes] if neck == "union" else BYTES_PER_PARTICLE
+
+
+def check(n: int, name: str, neck: str = "newton", nodes: str = "particles") -> None:
     """Refuse ``n`` particles (named ``name`` in the message, e.g. ``"[generator] n"``) when a run of them would need
     more memory than is available (module docstring).
 
@@ -64,21 +92,26 @@ def check(n: int, name: str) -> None:
         Number of particles.
     name : str
         What the message calls the count (``"[generator] n"``, say).
+    neck : str
+        The scene's neck reading (``[conductance] neck``: the union of spheres costs more per particle).
+    nodes : str
+        The network's nodes under the union (``[conductance] nodes``: ``"particles"`` or ``"necks"``).
 
     Raises
     ------
     ValueError
         A run of ``n`` particles needs more memory than the machine has available.
     """
-    if BYTES_PER_PARTICLE * n < SMALL_BYTES:  # (the interpreter that asks holds its base already)
+    each = bytes_per_particle(neck, nodes)
+    if each * n < SMALL_BYTES:  # (the interpreter that asks holds its base already)
         return
-    need = BASE_BYTES + BYTES_PER_PARTICLE * n
+    need = BASE_BYTES + each * n
     have = available_bytes()
     if have is not None and need > have:
         raise ValueError(f"{name}: a run of {n} particles needs about {need / 2**30:.3g} GiB (about "
-                         f"{BYTES_PER_PARTICLE / 1e3:.3g} kB per particle at the peak of a steady solve), and "
+                         f"{each / 1e3:.3g} kB per particle at the peak of a steady solve), and "
                          f"{max(have, 0.0) / 2**30:.3g} GiB are available on this machine: use at most about "
-                         f"{max(int((have - BASE_BYTES) / BYTES_PER_PARTICLE), 0)} particles")
+                         f"{max(int((have - BASE_BYTES) / each), 0)} particles")
 
 
 def estimate(n: int, neck: str = "newton", nodes: str = "particles") -> str | None:
@@ -91,7 +124,8 @@ def estimate(n: int, neck: str = "newton", nodes: str = "particles") -> str | No
     n : int
         Number of particles.
     neck : str
-        The scene's neck reading (``[conductance] neck``); ``"union"`` costs :data:`UNION_SECONDS_PER_PARTICLE`.
+        The scene's neck reading (``[conductance] neck``); ``"union"`` costs :data:`UNION_SECONDS_PER_PARTICLE` and
+        :data:`UNION_BYTES_PER_PARTICLE`.
     nodes : str
         The network's nodes under the union (``[conductance] nodes``: ``"particles"`` or ``"necks"``).
 
@@ -103,6 +137,6 @@ def estimate(n: int, neck: str = "newton", nodes: str = "particles") -> str | No
     rate = UNION_SECONDS_PER_PARTICLE[nodes] if neck == "union" else SECONDS_PER_PARTICLE
     if n < ANNOUNCE_FROM and rate * n < ANNOUNCE_SECONDS:
         return None
-    need = BASE_BYTES + BYTES_PER_PARTICLE * n
+    need = BASE_BYTES + bytes_per_particle(neck, nodes) * n
     return (f"{n} particles: about {need / 2**30:.3g} GiB at the peak of a steady solve and about "
             f"{rate * n:.3g} s for it on 2 cores (a transient or moving run takes longer)")

@@ -215,6 +215,38 @@ def test_a_steady_scene_with_neck_nodes_reports_the_neck_solve():
     assert q_walls[0] == pytest.approx(flows["walls"]["end"], rel=1e-12) and np.all(q_pairs > 0)
 
 
+def test_a_neck_node_run_computes_the_union_halves_once(monkeypatch):
+    """The static engine with nodes = "necks" computes the cut spheres' halves once (the neck network's) and takes the
+    one-node law's conductances of its links from them: the same to the bit as the one-node law computed afresh."""
+    from dem import make_scene
+    from dem.engines.static import StaticEngine
+    from dem.laws import conductance
+    from dem.laws.conductance import bond_conductances
+    from dem.network import necks
+
+    rng = np.random.default_rng(5)
+    x = rng.uniform([0.0, 0.0, 0.3e-3], [4e-3, 4e-3, 3.7e-3], (40, 3))
+    r = rng.uniform(0.85e-3, 1.15e-3, 40)
+    walls = (Wall("hot", point=[0.0, 0.0, 0.2e-3], normal=[0.0, 0.0, 1.0], temperature=1.0),
+             Wall("cold", point=[0.0, 0.0, 3.8e-3], normal=[0.0, 0.0, -1.0], temperature=0.0))
+    spec = ConductanceSpec(law="shared-body", neck="union", nodes="necks", out_of_range="drop")
+    scene = make_scene(x, r, np.zeros(40), materials=(UNIT,), walls=walls, mode="steady", conductance=spec)
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return union_halves(*args, **kwargs)
+
+    monkeypatch.setattr(conductance, "union_halves", counted)
+    monkeypatch.setattr(necks, "union_halves", counted)
+    engine = StaticEngine(scene)
+    assert len(calls) == 1 and engine.bonds.n_walls > 4
+    monkeypatch.undo()
+    K_pairs, K_walls = bond_conductances(spec, scene.particles, engine.bonds, walls=walls)
+    assert np.array_equal(engine.K_pairs, K_pairs) and np.array_equal(engine.K_walls, K_walls)
+    assert np.count_nonzero(K_pairs) > 40
+
+
 @pytest.mark.parametrize("linear", ["direct", "amg"])
 def test_a_tiled_cell_conducts_as_the_cell(linear):
     """The BCC union cell at h/r 0.25 tiled 3 x 3 x 3 (54 particles, bonds across the inner faces and the box's)

@@ -197,5 +197,46 @@ def test_a_union_run_says_so_from_far_fewer_particles():
     assert memory.estimate(small, "union", "necks") is None and memory.estimate(small, "newton") is None
     assert memory.estimate(small, "union", "particles") is None
     line = memory.estimate(100_000, "union", "necks")
-    assert line.endswith("about 190 s for it on 2 cores (a transient or moving run takes longer)")
+    assert line.endswith("about 90 s for it on 2 cores (a transient or moving run takes longer)")
     assert "about 45 s" in memory.estimate(100_000, "union")
+
+
+def test_a_neck_node_run_beyond_the_memory_is_refused_with_its_own_figure(monkeypatch):
+    """Under the union of spheres a particle takes about 7 kB at the peak (a node per neck a little more), five times
+    the pair necks' 1.35 kB: 30 000 particles with a node per neck are refused where 0.4 GB are left, before the bond
+    search, with the neck nodes' figure; the same count on pair necks passes."""
+    from dem import make_scene
+    from dem.engines.static import StaticEngine
+    from dem.laws.conductance import ConductanceSpec
+
+    monkeypatch.setattr(memory, "available_bytes", lambda: 0.4e9)
+    memory.check(30_000, "particles")  # 0.27 GB on pair necks
+    n = 30_000
+    x = np.column_stack([np.arange(n) * 3e-3, np.zeros(n), np.zeros(n)])  # apart: no bond, were they searched
+    spec = ConductanceSpec(law="shared-body", neck="union", nodes="necks")
+    scene = make_scene(x, np.full(n, 1e-3), np.zeros(n), mode="steady", conductance=spec)
+    need = memory.BASE_BYTES + memory.UNION_BYTES_PER_PARTICLE["necks"] * n
+    with pytest.raises(ValueError, match=rf"particles: a run of 30000 particles needs about {need / 2**30:.3g} GiB "
+                                         r"\(about 7.3 kB per particle"):
+        StaticEngine(scene)
+    assert memory.bytes_per_particle("union") == memory.UNION_BYTES_PER_PARTICLE["particles"]
+    assert f"about {need / 2**30:.3g} GiB" in memory.estimate(n, "union", "necks")
+
+
+def test_neck_node_steps_are_weighed_up_front():
+    """An implicit step with a node per neck costs NECK_STEP_COST one-node particle-steps: 2e5 steps of 10 particles
+    (2e6 particle-steps, under the 3e6 that max_steps = 1000 allows one node per particle) are refused with neck
+    nodes, with the estimate."""
+    from dem import make_scene
+    from dem.engines import static
+    from dem.laws.conductance import ConductanceSpec
+
+    x = np.column_stack([np.arange(10) * 1.9e-3, np.zeros(10), np.zeros(10)])
+    spec = ConductanceSpec(law="shared-body", neck="union", nodes="necks")
+    scene = make_scene(x, np.full(10, 1e-3), np.zeros(10), mode="transient", integrator="implicit", dt=1e-3,
+                       t_end=200.0, max_steps=1000, conductance=spec)
+    work = 2e5 * 10 * static.NECK_STEP_COST
+    assert 2e6 < static.WORK_PER_STEP_LIMIT * 1000 < work
+    with pytest.raises(ValueError, match=re.escape(f"10 particles x {static.NECK_STEP_COST:g} (a node per neck) = "
+                                                   f"{work:.3g} particle-steps (about ")):
+        static.StaticEngine(scene)

@@ -18,7 +18,9 @@ import numpy as np
 
 from dem import memory
 from dem.engines import Engine
+from dem.geometry.bonds import find_bonds
 from dem.geometry.necks import meeting_in
+from dem.laws.conductance import bond_conductances
 from dem.laws.verified_range import neck_account, wide_necks
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
 from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
@@ -29,6 +31,10 @@ from dem.scene.state_file import box_arrays
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
+# an implicit step with a node per neck (AMG on the centres and necks) costs as many one-node particle-steps: 1.4e-6 s
+# of CPU per particle-step (7 x the figure above) on a random union packing tiled to 6912 particles, dt = 0.1 r^2 rho
+# c / kappa
+NECK_STEP_COST = 7.0
 CSV_FLOWS = ("fixed", "walls", "convection", "radiation", "internal")  # the heat-flow columns of timeseries.csv
 
 
@@ -144,15 +150,21 @@ class StaticEngine(Engine):
     def __init__(self, scene, restart: dict | None = None):
         """``restart``: the checkpoint of this scene's transient run (:func:`dem.output.folder.load`)."""
         self.scene = scene
-        memory.check(scene.particles.n, "particles")  # before the bond search: a refused run costs nothing
+        spec = scene.conductance
+        memory.check(scene.particles.n, "particles", spec.neck, spec.nodes)  # before the bond search: costs nothing
         refuse_neck_nodes(scene)
         if scene.solver.mode == "transient":
             self._check_work()
         particles, walls = scene.particles, scene.walls
-        bonds, K_pairs, K_walls = bonds_and_conductances(particles, walls, scene.conductance, box=scene.box)
-        # a node per neck (dem.network.necks): the solves, the current and the bonds' flows are its own
-        self.necks = (neck_network(scene.conductance, particles, bonds, box=scene.box, walls=walls)
-                      if scene.conductance.nodes == "necks" else None)
+        if spec.nodes == "necks":  # a node per neck (dem.network.necks): the solves, the current and the bonds' flows
+            # are its own, the one-node law's conductances (the links' field) from the halves its elements are of
+            bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, box=scene.box)
+            self.necks = neck_network(spec, particles, bonds, box=scene.box, walls=walls)
+            K_pairs, K_walls = bond_conductances(spec, particles, bonds, box=scene.box, walls=tuple(walls),
+                                                 union=self.necks.union)
+        else:
+            self.necks = None
+            bonds, K_pairs, K_walls = bonds_and_conductances(particles, walls, spec, box=scene.box)
         self.potential, self.circuit = None, None
         if scene.electrical is not None:
             particles = self._joule_heated(particles, bonds)
@@ -216,14 +228,16 @@ class StaticEngine(Engine):
             raise ValueError(self._singular_message(exc)) from None
 
     def _check_work(self) -> None:
-        """Refuse a fixed-step run whose particle-steps exceed ``WORK_PER_STEP_LIMIT * max_steps`` up front, with a
-        time estimate (:data:`SECONDS_PER_PARTICLE_STEP`)."""
+        """Refuse a fixed-step run whose particle-steps (a node per neck: :data:`NECK_STEP_COST` each) exceed
+        ``WORK_PER_STEP_LIMIT * max_steps`` up front, with a time estimate (:data:`SECONDS_PER_PARTICLE_STEP`)."""
         s, n = self.scene.solver, self.scene.particle_count
         if s.dt == "auto":
             return  # the step count is not known in advance; max_steps bounds it while running
-        work = s.t_end / s.dt * n
+        necks = self.scene.conductance.nodes == "necks"
+        work = s.t_end / s.dt * n * (NECK_STEP_COST if necks else 1.0)
         if work > WORK_PER_STEP_LIMIT * s.max_steps:
-            raise ValueError(f"solver: t_end / dt = {s.t_end / s.dt:.3g} steps x {n} particles = {work:.3g} "
+            cost = f" x {NECK_STEP_COST:g} (a node per neck)" if necks else ""
+            raise ValueError(f"solver: t_end / dt = {s.t_end / s.dt:.3g} steps x {n} particles{cost} = {work:.3g} "
                              f"particle-steps (about {SECONDS_PER_PARTICLE_STEP * work:.3g} s) exceeds "
                              f"{WORK_PER_STEP_LIMIT} x solver.max_steps = {WORK_PER_STEP_LIMIT * s.max_steps:.3g}; "
                              f"raise max_steps to run it anyway, or use a larger dt, a shorter t_end or fewer "

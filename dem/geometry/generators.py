@@ -22,7 +22,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 from scipy.spatial import cKDTree
 
 from dem import memory
@@ -319,6 +318,8 @@ def random_packing(n: int, radius, overlap, seed: int = 0, radius_spread: float 
         lo, hi = 0.5 * d.min() / ssum.max(), cutoff / ssum.min()
         if mean_overlap(hi) < target:
             raise ValueError(f"[generator] overlap = {overlap!r}: not reachable with this jitter and spread")
+        from scipy.optimize import brentq  # here: scipy.optimize is most of what `import dem` would load
+
         sigma = brentq(lambda s: mean_overlap(s) - target, lo, hi, xtol=1e-14, rtol=1e-12)
     scale = r_mean / (sigma * shape.mean())  # metres per neighbour distance
     r = sigma * shape * scale

@@ -241,7 +241,8 @@ def series(*halves):
 
 
 def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds, conductivity=None,
-                      shares: bool = False, *, box=None, walls=(), closing_pores: dict | None = None):
+                      shares: bool = False, *, box=None, walls=(), closing_pores: dict | None = None,
+                      union: tuple | None = None):
     r"""``(K_pairs, K_walls)`` in W/K for every pair bond and wall bond.
 
     ``conductivity`` (per particle) replaces the materials' :math:`\kappa`: the same law with the electrical
@@ -250,7 +251,9 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     its resistance on the side of particle i, :math:`R_i / (R_i + R_j)` (where that part of the bond's Joule heat is
     made). ``box``: the periodic box the bonds' image shifts refer to (:mod:`dem.geometry.periodic`); ``walls``: the
     walls of the wall bonds, whose normals the ``shared-body`` law needs; ``closing_pores``: the calibration of the
-    closing pores' cap of ``shared-body`` under the union of spheres (:mod:`dem.laws.closing_pores`).
+    closing pores' cap of ``shared-body`` under the union of spheres (:mod:`dem.laws.closing_pores`); ``union``: that
+    law's halves on the cut spheres already computed (:func:`union_halves`, as the network with a node per neck has
+    them), so that they are not computed again.
 
     Parameters
     ----------
@@ -272,6 +275,9 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     closing_pores : dict or None
         ``{"beta": float, "psi0": float}`` of :func:`dem.laws.closing_pores.cap_ratio` (dimensionless); None: the
         shipped calibration (:data:`dem.laws.closing_pores.CALIBRATION`).
+    union : tuple or None
+        ``shared-body`` under ``neck = "union"``: what :func:`union_halves` returned for these particles and bonds
+        (with ``conductivity`` None); None: computed here.
 
     Returns
     -------
@@ -288,15 +294,17 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
     kappa = particles.conductivity if conductivity is None else np.asarray(conductivity, dtype=float)
     r = particles.radius
     kc = spec.contact_conductance
-    k_i, k_j, k_w = bond_halves(spec, particles, bonds, kappa)
+    k_i, k_j, k_w = bond_halves(spec, particles, bonds, kappa) if union is None else (None, None, None)
     if spec.law == "shared-body":
         from dem.laws.shared_body import neck_factors
 
         normals = wall_normals(bonds, walls)
         vectors = bonds.vectors(particles.position, box)
         if spec.neck == "union":
-            k_i, k_j, k_w = _shared_union_body(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
-                                               closing_pores, box, walls)
+            if union is None:
+                union = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w, closing_pores, box,
+                                     walls)
+            k_i, k_j, k_w = _shared_union_body(particles, bonds, vectors, normals, kappa, union)
         else:
             s_i, s_j, s_w = neck_factors(particles.n, r, bonds, vectors, k_i, k_j, k_w, kappa, normals)
             k_i, k_j, k_w = s_i * k_i, s_j * k_j, s_w * k_w
@@ -366,8 +374,7 @@ def wall_normals(bonds: Bonds, walls) -> np.ndarray:
     return np.array([w.normal for w in walls])[bonds.wall_index] if bonds.n_walls else np.zeros((0, 3))
 
 
-def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kappa, k_i, k_j, k_w,
-                       closing_pores: dict | None = None, box=None, walls=()):
+def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kappa, union: tuple):
     """The ``shared-body`` halves under the union of spheres: each half body of the union law narrowed to the
     particle's cut sphere (:mod:`dem.laws.cut_body`), then the factors of the necks sharing it
     (:mod:`dem.laws.shared_body`) with the cut sphere's volume in the cap on the mean of the particle's tensor,
@@ -386,14 +393,9 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
         The unit normal of every wall bond's wall, into the packing.
     kappa : numpy.ndarray
         Per particle, its conductivity, W/(m K).
-    k_i, k_j, k_w : numpy.ndarray
-        The union law's half conductances of the pair bonds on ``i``, on ``j`` and of the wall bonds, W/K.
-    closing_pores : dict or None
-        The closing pores' ``beta`` and ``psi0`` (dimensionless); None: the shipped calibration.
-    box : dem.geometry.periodic.PeriodicBox or None
-        The periodic box of the packing (the particles' cells take their neighbours across its faces); None without.
-    walls : sequence of dem.geometry.walls.Wall
-        The walls (they bound the particles' cells where they come near).
+    union : tuple
+        What :func:`union_halves` returned for these particles and bonds: the narrowed halves (W/K), the live bonds'
+        masks and the capped volumes (m^3).
 
     Returns
     -------
@@ -402,15 +404,15 @@ def _shared_union_body(particles: Particles, bonds: Bonds, vectors, normals, kap
     """
     from dem.laws.shared_body import neck_factors
 
-    k_i, k_j, k_w, pairs, walls, volume = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
-                                                       closing_pores, box, walls)
-    live = bonds.subset(pairs, walls)
+    k_i, k_j, k_w, pairs, walls_live, volume = union
+    live = bonds.subset(pairs, walls_live)
     s_i, s_j, s_w = neck_factors(particles.n, particles.radius, live, vectors[pairs], k_i[pairs], k_j[pairs],
-                                 k_w[walls], kappa, np.reshape(normals, (-1, 3))[walls], volume, trace_cap=True)
+                                 k_w[walls_live], kappa, np.reshape(normals, (-1, 3))[walls_live], volume,
+                                 trace_cap=True)
     k_i, k_j, k_w = np.where(pairs, k_i, 0.0), np.where(pairs, k_j, 0.0), k_w.copy()
     k_i[pairs] *= s_i
     k_j[pairs] *= s_j
-    k_w[walls] *= s_w
+    k_w[walls_live] *= s_w
     return k_i, k_j, k_w
 
 

@@ -406,21 +406,18 @@ def _face_points(normal, arm, q, z, points, weights):
             weights[b, p] /= total
 
 
-@numba.njit(cache=True)
-def _mean_inverse_distance(x, wx, y, wy, turn):
-    """:math:`\\langle 1 / |x - T y| \\rangle` over two weighted point sets, ``T`` the 3 x 3 matrix ``turn``."""
+@numba.njit(cache=True, fastmath={"reassoc", "nsz", "contract"})
+def _mean_inverse_distance(x, wx, nx, y, wy, ny):
+    """:math:`\\langle 1 / |x - y| \\rangle` over two weighted point sets, the first ``nx`` columns of ``x`` (3, .)
+    and ``wx`` and the first ``ny`` of ``y`` and ``wy`` (the points of weight 0 left out); the inner sum in any order
+    (SIMD lanes: round-off)."""
     total = 0.0
-    for q in range(y.shape[0]):
-        if wy[q] == 0.0:
-            continue
-        y0 = turn[0, 0] * y[q, 0] + turn[0, 1] * y[q, 1] + turn[0, 2] * y[q, 2]
-        y1 = turn[1, 0] * y[q, 0] + turn[1, 1] * y[q, 1] + turn[1, 2] * y[q, 2]
-        y2 = turn[2, 0] * y[q, 0] + turn[2, 1] * y[q, 1] + turn[2, 2] * y[q, 2]
+    for q in range(ny):
+        y0, y1, y2 = y[0, q], y[1, q], y[2, q]
         inner = 0.0
-        for p in range(x.shape[0]):
-            if wx[p] != 0.0:
-                d = np.sqrt((x[p, 0] - y0) ** 2 + (x[p, 1] - y1) ** 2 + (x[p, 2] - y2) ** 2)
-                inner += wx[p] / max(d, 1e-9)
+        for p in range(nx):
+            d2 = (x[0, p] - y0) ** 2 + (x[1, p] - y1) ** 2 + (x[2, p] - y2) ** 2
+            inner += wx[p] / np.sqrt(max(d2, 1e-18))
         total += wy[q] * inner
     return total
 
@@ -451,13 +448,29 @@ def _face_matrix(normal, arm, q, z, out):
     points = np.empty((z, npts, 3))
     weights = np.empty((z, npts))
     _face_points(normal, arm, q, z, points, weights)
-    same = np.eye(3)
+    # each face's points of weight > 0, coordinates in rows (3, count): the inner loop over them runs in SIMD lanes
+    kept = np.zeros((z, 3, npts))
+    kept_w = np.zeros((z, npts))
+    count = np.zeros(z, dtype=np.int64)
+    for b in range(z):
+        for p in range(npts):
+            if weights[b, p] != 0.0:
+                k = count[b]
+                for c in range(3):
+                    kept[b, c, k] = points[b, p, c]
+                kept_w[b, k] = weights[b, p]
+                count[b] = k + 1
+    turned = np.empty((3, npts))
     for b in range(z):
         for c in range(b):
             cos_g = normal[b, 0] * normal[c, 0] + normal[b, 1] * normal[c, 1] + normal[b, 2] * normal[c, 2]
             s = np.sqrt(max(0.5 * (1.0 - cos_g), 1e-24))
-            near = _mean_inverse_distance(points[b], weights[b], points[c], weights[c], same)
-            far = _mean_inverse_distance(points[b], weights[b], points[c], weights[c], _turn(normal[c], -normal[b]))
+            near = _mean_inverse_distance(kept[b], kept_w[b], count[b], kept[c], kept_w[c], count[c])
+            T = _turn(normal[c], -normal[b])
+            for p in range(count[c]):
+                for e in range(3):
+                    turned[e, p] = T[e, 0] * kept[c, 0, p] + T[e, 1] * kept[c, 1, p] + T[e, 2] * kept[c, 2, p]
+            far = _mean_inverse_distance(kept[b], kept_w[b], count[b], turned, kept_w[c], count[c])
             g = 2.0 * near - 2.0 * far - np.log(s * (1.0 + s) * 0.5)
             out[b, c] = g
             out[c, b] = g

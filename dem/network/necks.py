@@ -143,6 +143,10 @@ class NeckNetwork:
         Per element entry, the bond end of its column (``-1``: the centre).
     box : dem.geometry.periodic.PeriodicBox or None
         The periodic box; None: none.
+    union : tuple or None
+        The ``shared-body`` halves on the cut spheres the elements are made of (what
+        :func:`dem.laws.conductance.union_halves` returned), from which the one-node law's conductances follow without
+        computing them again (``union`` of :func:`dem.laws.conductance.bond_conductances`).
     """
 
     particles: Particles
@@ -158,6 +162,7 @@ class NeckNetwork:
     owner: np.ndarray
     col_end: np.ndarray
     box: PeriodicBox | None = None
+    union: tuple | None = None
 
     @property
     def n_nodes(self) -> int:
@@ -225,8 +230,8 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     k_i, k_j, k_w = bond_halves(spec, particles, bonds, kappa)
     normals = wall_normals(bonds, walls)
     vectors = bonds.vectors(particles.position, box)
-    k_i, k_j, k_w, pairs, live_walls, volume = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w,
-                                                            closing_pores, box, walls)
+    union = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w, closing_pores, box, walls)
+    k_i, k_j, k_w, pairs, live_walls, volume = union
     live, live_walls = np.flatnonzero(pairs), np.flatnonzero(live_walls)
     sub = bonds.subset(live, live_walls)
     el = particle_elements(n, r, sub, vectors[live], k_i[live], k_j[live], k_w[live_walls], kappa,
@@ -258,7 +263,7 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     A = 0.5 * (A + A.T)  # symmetric to round-off (the blocks are; their sums need not be bit for bit)
     rhs = -np.bincount(row[rows], value[rows] * known[rows], size_all)
     return NeckNetwork(particles, bonds, live, live_walls, A.tocsr(), rhs, (row, col, value, known, end_row),
-                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box)
+                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box, union)
 
 
 @dataclass

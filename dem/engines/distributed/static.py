@@ -163,7 +163,7 @@ class DistributedStaticEngine(StaticEngine):
                                               None if box is None else box.mask))
             owner_held = owner[held]
             local = p.permuted(held)
-        memory.check(len(held), "particles")
+        memory.check(len(held), "particles", scene.conductance.neck, scene.conductance.nodes)
         self.scene = replace(scene, particles=local)
         mine = owner_held == rank
         try:
