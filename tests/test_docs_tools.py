@@ -320,3 +320,24 @@ kappa : float
 def test_docstring_formulas_are_maths():
     found = [line for package in ("fem_neck", "dem", "sinterheat") for line in docstring_check.ascii_formulas(package)]
     assert found == []
+
+
+def test_no_tracked_file_carries_a_merge_conflict_marker():
+    """A merge resolved by hand leaves no ``<<<<<<<``/``>>>>>>>`` lines behind (the contributing guide carried two
+    such blocks for a while, rendered as text)."""
+    import subprocess
+
+    try:
+        files = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        pytest.skip("not a git checkout")
+    suffixes = {".py", ".md", ".rst", ".toml", ".txt", ".cfg", ".json", ".yml", ".yaml"}
+    marked = []
+    for name in files.decode().split("\0"):
+        path = ROOT / name
+        if not name or path.suffix not in suffixes or not path.is_file():
+            continue
+        for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+            if line.startswith(("<<<<<<< ", ">>>>>>> ")):
+                marked.append(f"{name}:{number}")
+    assert not marked, marked
