@@ -1,4 +1,4 @@
-"""Heat flow through the contacts of particles that move: the pipe network of Rojek 2022 (eqs. 1-9) on the
+r"""Heat flow through the contacts of particles that move: the pipe network of Rojek 2022 (eqs. 1-9) on the
 contacts of the mechanical submodel, with necks that grow as the particles sinter.
 
 Every closed contact is a bond whose overlap is Rojek's ``h``: its neck radius comes from the scene's contact
@@ -242,7 +242,7 @@ class ContactThermalModel:
         self.T[self.free] = T_F
 
     def neck_heat(self, mechanics, bonds) -> NeckHeat:
-        """The network with a node per neck of ``bonds`` (module docstring), at the temperatures ``T``.
+        r"""The network with a node per neck of ``bonds`` (module docstring), at the temperatures ``T``.
 
         Parameters
         ----------
