@@ -130,3 +130,19 @@ def test_what_the_moving_neck_nodes_do_not_do_is_refused():
         VerletEngine(parse_scene({**scene, "convection": {"h": 10.0, "T_inf": 0.0}}))
     with pytest.raises(ValueError, match="on one rank only"):
         refuse_unsupported(parse_scene(scene), 2)
+
+
+def test_necks_that_meet_say_so_with_the_neck_node_evidence():
+    """The squeezed face-centred cluster of the hand-over's tests, its spheres overlapping by 0.25 r and read as their
+    union: lens necks meet (from h/r 0.268 on this lattice) and the summary gives the neck-node network's interval
+    there; the heat balance holds through the contacts' changes."""
+    from test_handover import squeezed
+
+    scene = squeezed(5e-4, h_over_r=0.25, rate=30.0)
+    scene["conductance"] = NECKS
+    s = ran(scene).summary()
+    assert s["particles_necks_meeting"] > 0 and not s["law_in_verified_range"]
+    assert s["law_error_range"][0] == -0.043 and s["law_error_range"][1] >= 0.016
+    assert any("carry necks that meet: FE of the union puts law 'shared-body (neck nodes)' at -4.3 % to +1.6 %" in w
+               for w in s["warnings"])
+    assert s["energy_error"] < 1e-12
