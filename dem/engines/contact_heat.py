@@ -47,9 +47,9 @@ without them. The stiffness test of a Crank-Nicolson step takes the centres' row
 
 from __future__ import annotations
 
-import numpy as np
-
 from dataclasses import replace
+
+import numpy as np
 
 from dem.engines.handover import Handover
 from dem.geometry.bonds import find_bonds
