@@ -264,10 +264,10 @@ def test_a_tiled_cell_conducts_as_the_cell(linear):
     assert k == pytest.approx(k_cell, rel=1e-9)
 
 
-def test_moving_particles_refuse_neck_nodes():
+def test_the_staggered_engine_refuses_neck_nodes():
     from dem import make_scene
     from dem.scene.parse import Scene
 
     scene = make_scene(np.zeros((1, 3)), [1e-3], [0.0], mode="steady", conductance=NECKS)
-    with pytest.raises(ValueError, match="static engine only"):
-        Scene(**{**scene.__dict__, "engine": "verlet"})
+    with pytest.raises(ValueError, match="static and verlet engines only"):
+        Scene(**{**scene.__dict__, "engine": "staggered"})

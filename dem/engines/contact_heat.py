@@ -1,4 +1,4 @@
-"""Heat flow through the contacts of particles that move: the pipe network of Rojek 2022 (eqs. 1-9) on the
+r"""Heat flow through the contacts of particles that move: the pipe network of Rojek 2022 (eqs. 1-9) on the
 contacts of the mechanical submodel, with necks that grow as the particles sinter.
 
 Every closed contact is a bond whose overlap is Rojek's ``h``: its neck radius comes from the scene's contact
@@ -34,18 +34,31 @@ union of spheres (:mod:`dem.engines.handover`): its bonds read the lens circles 
 keep the particles' volumes, blended with the pair reading over the steps of the hand-over. Each thermal step
 advances the hand-overs and solves the solid radii at the configuration of its end; the snapshots read them as the
 last step left them.
+
+**A node per neck** (``[conductance] nodes = "necks"``, :mod:`dem.network.necks`: the ``shared-body`` law under the
+union of spheres, ``neck = "union"``, read so from the start: no pair-neck reading, so no hand-over). Each thermal step
+assembles the neck-node network of the contacts at its end (:func:`dem.network.necks.neck_network`; the elements from
+the particles' radii now, the capacities from their masses, as the one-node network takes them) and takes the step on
+it with the same :math:`\theta` step (:class:`dem.network.necks.NeckHeat`, whose necks start where their rows hold at
+the step's starting temperatures, so each new network starts consistent). The necks are massless and re-solved every
+step: nothing but the particles' temperatures is carried from step to step, so a checkpoint holds what it holds
+without them. The stiffness test of a Crank-Nicolson step takes the centres' rows only (a neck has no time constant).
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from dem.engines.handover import Handover
+from dem.geometry.bonds import find_bonds
 from dem.laws.conductance import ConductanceSpec
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources
 from dem.network.heat import Network, bonds_and_conductances, surely_stiff, theta_step
+from dem.network.necks import NeckHeat, neck_flows, neck_network
 
 
 class ContactThermalModel:
@@ -92,6 +105,7 @@ class ContactThermalModel:
         self.T = particles.temperature.astype(float).copy()
         self.rate = np.zeros_like(self.T)  # dT/dt over the last step: the mechanics extrapolates with it
         self.net: Network | None = None
+        self.necks: NeckHeat | None = None  # with a node per neck: the last step's network (module docstring)
         self.free = np.flatnonzero(~particles.fixed)
         self.heat_in: dict = {}
         self.energy0 = float(particles.capacity @ self.T)
@@ -198,29 +212,63 @@ class ContactThermalModel:
         dt : float
             The step (s), > 0.
         """
-        bonds, K_pairs, K_walls = self.bonds(mechanics, update=True)
-        if self.net is not None and self.net.graph.same_edges(bonds.i, bonds.j, bonds.wall_particle, bonds.wall_index):
-            self.net.refresh(bonds, K_pairs, K_walls)
-            self.refreshes += 1
-        else:
-            self.net = self.network(mechanics, (bonds, K_pairs, K_walls))
+        if self.spec.nodes == "necks":  # the bonds alone: the network takes the halves of its elements
+            now = self._particles_now(mechanics, mechanics.state.radius)
+            bonds = find_bonds(now, self._walls_now(mechanics), self.spec.contact, self.spec.out_of_range,
+                               pairs=mechanics.contacts()[:2], box=self.box)
+            self.necks = net = self.neck_heat(mechanics, bonds)
             self.assemblies += 1
-        T_F = self.T[self.free]
+            T_F = net.initial  # the free centres' temperatures now, the necks' where their rows hold
+        else:
+            bonds, K_pairs, K_walls = self.bonds(mechanics, update=True)
+            if self.net is not None and self.net.graph.same_edges(bonds.i, bonds.j, bonds.wall_particle,
+                                                                  bonds.wall_index):
+                self.net.refresh(bonds, K_pairs, K_walls)
+                self.refreshes += 1
+            else:
+                self.net = self.network(mechanics, (bonds, K_pairs, K_walls))
+                self.assemblies += 1
+            net, T_F = self.net, self.T[self.free]
         integrator = self.integrator
-        if integrator == "crank-nicolson" and surely_stiff(dt, self.net.matrix(self.net.sinks(T_F)), self.net.C):
+        centres = net.C > 0.0 if self.necks is not None else None  # (a neck is massless: no time constant)
+        if integrator == "crank-nicolson" and surely_stiff(dt, net.matrix(net.sinks(T_F)), net.C, rows=centres):
             integrator = "implicit"  # the start-up of a step far above the stiffest time constant (module docstring)
             self.startup_steps += 1
-        T_F, heat = theta_step(self.net, T_F, dt, integrator, self.linear)
+        T_F, heat = theta_step(net, T_F, dt, integrator, self.linear)
         for k, v in heat.items():
             self.heat_in[k] = self.heat_in.get(k, 0.0) + v
+        T_F = T_F[:len(self.free)]  # the free centres (then, with a node per neck, the necks)
         self.rate[self.free] = (T_F - self.T[self.free]) / dt
         self.T[self.free] = T_F
+
+    def neck_heat(self, mechanics, bonds) -> NeckHeat:
+        r"""The network with a node per neck of ``bonds`` (module docstring), at the temperatures ``T``.
+
+        Parameters
+        ----------
+        mechanics : dem.engines.verlet.mechanics.MechanicalModel
+            The mechanical submodel: its positions (m), radii (m) and wall offsets (m).
+        bonds : dem.geometry.bonds.Bonds
+            The union bonds of its contacts now (:meth:`bonds`).
+
+        Returns
+        -------
+        dem.network.necks.NeckHeat
+            The network in the terms of the :math:`\theta` step.
+        """
+        now = self._particles_now(mechanics, mechanics.state.radius)
+        net = neck_network(self.spec, now, bonds, box=self.box, walls=self._walls_now(mechanics))
+        # the capacities from the masses (the initial radii), as the one-node network's: the heat balance's own
+        massive = replace(net, particles=self._particles_now(mechanics, self.local(mechanics, self.particles.radius)))
+        return NeckHeat(massive, self.linear)
 
     def contact_heat(self, mechanics, i: np.ndarray, j: np.ndarray) -> tuple[dict, np.ndarray]:
         """The heat of the contacts ``(i, j)`` of ``mechanics`` now, for the snapshots: per contact its
         ``neck_radius`` (m), ``conductance`` (W/K) and ``heat_flow`` (W, from i to j), all 0 for a contact without
         a bond (``conductance.out_of_range = "drop"``); and the heat flow (W) into each particle through its
-        contacts and walls.
+        contacts and walls. With a node per neck the flows are the necks' (:func:`dem.network.necks.neck_flows`, the
+        necks where their rows hold at ``T``) and ``conductance`` the one-node law's of the bond (a neck-node bond has
+        no conductance of its own: its particles' elements couple it to their other necks).
 
         Parameters
         ----------
@@ -238,10 +286,14 @@ class ContactThermalModel:
         bonds, K_pairs, K_walls = self.bonds(mechanics)
         T = self.local(mechanics, self.T)
         n = len(T)
-        jump = bonds.shifts @ self.box.drop if self.box is not None else 0.0
-        q = K_pairs * (T[bonds.i] - T[bonds.j] + jump)
-        wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
-        q_walls = K_walls * (T[bonds.wall_particle] - wall_T[bonds.wall_index])
+        if self.spec.nodes == "necks":  # the flows through the necks, solved where their rows hold at T
+            heat = self.neck_heat(mechanics, bonds)
+            q, q_walls = neck_flows(heat.net, heat.nodes(heat.initial))[:2]
+        else:
+            jump = bonds.shifts @ self.box.drop if self.box is not None else 0.0
+            q = K_pairs * (T[bonds.i] - T[bonds.j] + jump)
+            wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
+            q_walls = K_walls * (T[bonds.wall_particle] - wall_T[bonds.wall_index])
         into = np.bincount(bonds.j, q, n) - np.bincount(bonds.i, q, n) - np.bincount(bonds.wall_particle, q_walls, n)
         fields = {name: np.zeros(len(i)) for name in ("neck_radius", "conductance", "heat_flow")}
         if not bonds.n_pairs:

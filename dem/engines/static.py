@@ -69,15 +69,19 @@ def effective_conductivity(scene, summary: dict) -> float | None:
     return q * sp.length / (sp.area * (sp.hot - sp.cold))
 
 
-def refuse_neck_nodes(scene) -> None:
+def refuse_neck_nodes(scene, moving: bool = False) -> None:
     """``[conductance] nodes = "necks"`` (:mod:`dem.network.necks`) solves steady heat and integrates it with implicit
-    or Crank-Nicolson steps, with convection, radiation and a current: an explicit integrator (which cannot carry the
-    massless necks) is refused in one line.
+    or Crank-Nicolson steps, on a static packing with convection, radiation and a current: an explicit integrator
+    (which cannot carry the massless necks), and on moving particles an ambient exchange or a current, are refused in
+    one line.
 
     Parameters
     ----------
     scene : dem.scene.parse.Scene
         The scene.
+    moving : bool
+        Whether the particles move (the velocity-Verlet engine's thermal steps on the network of their contacts,
+        :mod:`dem.engines.contact_heat`, which carries no ambient or current with neck nodes so far).
 
     Raises
     ------
@@ -89,6 +93,12 @@ def refuse_neck_nodes(scene) -> None:
     if scene.solver.mode == "transient" and scene.solver.integrator == "explicit":
         raise ValueError("solver.integrator = \"explicit\": an explicit step cannot carry the massless neck nodes of "
                          "[conductance] nodes = \"necks\"; use \"implicit\" or \"crank-nicolson\"")
+    what = ("convection" if scene.sources.convection is not None else
+            "radiation" if scene.sources.radiation is not None else
+            "electrical physics" if scene.electrical is not None else None)
+    if moving and what is not None:
+        raise ValueError(f"[conductance] nodes = \"necks\": moving particles exchange heat without convection, "
+                         f"radiation or current so far (this scene has {what}); use nodes = \"particles\"")
 
 
 def boundary_summary(scene, walls, into: dict) -> dict:

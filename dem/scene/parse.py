@@ -232,9 +232,10 @@ class Scene:
     def __post_init__(self):
         walls = self.motion.walls if self.motion is not None else self.walls
         check_inside(walls, self.particles.position, self.particles.id)
-        if self.conductance.nodes != "particles" and self.engine != "static":
-            raise ValueError(f"[conductance] nodes = {self.conductance.nodes!r}: the static engine only (this scene "
-                             f"runs on {self.engine}); use nodes = \"particles\"")
+        if self.conductance.nodes != "particles" and self.engine not in ("static", "verlet"):
+            raise ValueError(f"[conductance] nodes = {self.conductance.nodes!r}: the static and verlet engines only "
+                             f"(this scene runs on {self.engine}, whose lumped heat is not the network's theta step); "
+                             f"use nodes = \"particles\"")
 
     @property
     def particle_count(self) -> int:

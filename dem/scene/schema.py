@@ -175,12 +175,13 @@ ROWS = (
         '`"coble"` (eqs. 11-12): pair necks, no answer once two necks of a particle meet; `"union"`: the circle '
         'where two spheres meet, the packing read as the union of its spheres (`fem_neck.geometry.union`), defined '
         'at every density'),
-    Row("conductance", ("nodes",), STATIC, '`"particles"`', '`"particles"`: a node per particle, each bond a '
+    Row("conductance", ("nodes",), STATIC_VERLET, '`"particles"`', '`"particles"`: a node per particle, each bond a '
         'conductance; `"necks"`: a node per neck as well, each particle an element joining its centre to its necks '
         '(`dem.network.necks`: the `shared-body` particle solved exactly, its interaction taken between the necks\' '
         'faces), for `law = "shared-body"` with `neck = "union"`; steady heat, or transient with implicit or '
-        'crank-nicolson steps, with convection, radiation and current (the ambient on each particle\'s centre, the '
-        'electrical element the thermal one times sigma / kappa); not under MPI so far'),
+        'crank-nicolson steps, with convection, radiation and current on a static packing (the ambient on each '
+        'particle\'s centre, the electrical element the thermal one times sigma / kappa); moving particles (the verlet '
+        'engine, each thermal step on the network of its contacts) without them so far; not under MPI so far'),
     Row("conductance", ("contact_conductance",), ALL, "W/K, none", "K_c of the interface in series (eq. 8)"),
     Row("conductance", ("out_of_range",), ALL, '`"error"`', 'bonds beyond the contact model\'s range (h > '
         'max_overlap; wall overlap > r/3): `"error"` reports their count and the first pair, `"clip"` sets a to the '

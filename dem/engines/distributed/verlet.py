@@ -88,6 +88,9 @@ def refuse_unsupported(scene, ranks: int, restart: dict | None = None) -> None:
     ValueError
         The scene or the checkpoint cannot run on ``ranks`` ranks.
     """
+    if ranks > 1 and scene.conductance.nodes != "particles":
+        raise ValueError(f"[conductance] nodes = {scene.conductance.nodes!r}: on one rank only so far (this run has "
+                         f"{ranks}); run without mpiexec or use nodes = \"particles\"")
     written = 1 if restart is None or "ranks" not in restart else int(restart["ranks"])
     if restart is not None and written != ranks:
         how = f"with mpiexec -n {written}" if written > 1 else "without mpiexec or with mpiexec -n 1"

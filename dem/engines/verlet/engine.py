@@ -27,6 +27,7 @@ from dataclasses import replace
 
 from dem.engines import Engine
 from dem.engines.contact_heat import ContactThermalModel
+from dem.engines.static import refuse_neck_nodes
 from dem.engines.verlet.mechanics import MechanicalModel
 from dem.geometry.bonds import find_bonds
 from dem.engines.state import MotionState
@@ -38,6 +39,7 @@ from dem.laws.contact import law_module
 from dem.laws.verified_range import neck_account, wide_necks
 from dem.scene.state_file import moving_arrays, normalised
 from dem.network.heat import Network, boundary_heat_flow, bonds_and_conductances, steady
+from dem.network.necks import steady_necks
 from fem_neck.geometry import max_overlap, neck_radius
 
 
@@ -81,6 +83,7 @@ class VerletEngine(Engine):
         self.mechanics = self.mechanics_class(state, m.walls, material, m.dt, m.skin, m.gravity, scene.box,
                                               relaxation_time=m.verlet.relaxation_time, history=saved)
         self.thermal = None
+        refuse_neck_nodes(scene, moving=True)
         if "thermal" in scene.physics:
             self.thermal = self.thermal_class(p, m.walls, scene.conductance, scene.sources, m.verlet.thermal_integrator,
                                                scene.solver.linear, scene.box)
@@ -304,7 +307,9 @@ class VerletEngine(Engine):
     def effective_conductivity(self, pair_necks: bool = False) -> float | None:
         """``k_eff = Q L / (A (T_hot - T_cold))`` of the contact network as it is now, from a steady solve between
         the hot and the cold wall (W/(m K)); None without two such walls, a closed box or a network (or with
-        ambient sources, which are not conduction). Groups of particles touching neither wall carry no heat.
+        ambient sources, which are not conduction). Groups of particles touching neither wall carry no heat. With a
+        node per neck (``[conductance] nodes = "necks"``) the solve is the neck-node network's
+        (:func:`dem.network.necks.steady_necks`) of the contacts of the last thermal step.
 
         Parameters
         ----------
@@ -320,9 +325,17 @@ class VerletEngine(Engine):
         """
         th, pair = self.thermal, self.heated_walls()
         volume = self.box_volume()
-        if th is None or th.net is None or pair is None or volume is None or self.scene.sources.names:
+        if (th is None or (th.net is None and th.necks is None) or pair is None or volume is None
+                or self.scene.sources.names):
             return None
         mech = self.mechanics
+        hot, cold = pair
+        length = -(mech.w.q[hot] + mech.w.q[cold])
+        delta_T = mech.walls[hot].temperature - mech.walls[cold].temperature
+        if th.necks is not None:  # a node per neck: the steady solve of the last step's network
+            res = steady_necks(th.necks.net, floating="mean", linear=self.scene.solver.linear)
+            into = np.bincount(th.necks.net.bonds.wall_index, res.wall_flow, len(th.thermal_walls))
+            return float(-into[th.thermal_walls.index(hot)] * length / (volume / length * delta_T))
         net = th.net
         if pair_necks:
             i, j = mech.contacts()[:2]
@@ -331,12 +344,9 @@ class VerletEngine(Engine):
                 replace(th.spec, out_of_range="clip"), pairs=(i, j), box=th.box)
             net = Network(th._particles_now(mech, th.particles.radius), bonds, K_pairs, K_walls, net.wall_temperature,
                           th.sources, th.box)
-        hot, cold = pair
-        length = -(mech.w.q[hot] + mech.w.q[cold])
         res = steady(net, floating="mean", linear=self.scene.solver.linear)
         into = boundary_heat_flow(net, res.T)["walls"]
         q = -into[th.thermal_walls.index(hot)]  # heat leaving the hot wall
-        delta_T = mech.walls[hot].temperature - mech.walls[cold].temperature
         return float(q * length / (volume / length * delta_T))
 
     def profile(self, bins: int = 8) -> dict | None:
@@ -419,15 +429,18 @@ class VerletEngine(Engine):
             if th.startup_steps:  # stiff Crank-Nicolson thermal steps taken as implicit Euler
                 out["startup_steps"] = th.startup_steps
             meeting, bonds = self.necks()
-            law = self.scene.conductance.law
+            law, nodes = self.scene.conductance.law, self.scene.conductance.nodes
+            if th.necks is not None:
+                out.update(nodes="necks", neck_nodes=len(th.necks.net.live),
+                           particles_without_interactions=th.necks.net.plain)
             readings = handed_over = None
             if th.handing_over(mech):
                 account = th.handover.account(bonds)
                 readings, handed_over = account["readings"], account["handed_over"]
                 out["particles_handing_over"] = account["handing_over"]
             out.update(neck_account(np.count_nonzero(meeting), s.n, bonds.contact, bonds.n_pairs + bonds.n_walls, law,
-                                    np.count_nonzero(wide_necks(s.radius, bonds, meeting, law)), readings,
-                                    handed_over))
+                                    np.count_nonzero(wide_necks(s.radius, bonds, meeting, law, nodes)), readings,
+                                    handed_over, nodes=nodes))
         return out
 
     def necks(self):
