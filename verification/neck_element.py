@@ -125,8 +125,6 @@ def cut_element(normals, arms, betas=(0.0,), order: int = 3, maxh: float = 0.25,
     ValueError
         A bad argument, or a plane that bounds the body with no area (a neck hidden by the other planes).
     """
-    from netgen import occ
-
     normals = np.reshape(np.asarray(normals, dtype=float), (-1, 3))
     arms = np.asarray(arms, dtype=float)
     _check(order, maxh, hp_levels, betas)
@@ -136,6 +134,8 @@ def cut_element(normals, arms, betas=(0.0,), order: int = 3, maxh: float = 0.25,
         raise ValueError("normals: must be unit vectors")
     if np.any(np.abs(arms) >= 1.0):
         raise ValueError(f"arms = {arms.tolist()}: each must be in (-1, 1) (a plane that cuts the unit ball)")
+    from netgen import occ
+
     shape = occ.Sphere(occ.Pnt(0, 0, 0), 1.0)
     for n, l in zip(normals, arms):  # the half space beyond the plane: a box over z >= 0 turned onto n, moved out by l
         box = occ.Box(occ.Pnt(-3, -3, 0), occ.Pnt(3, 3, 3))
@@ -176,11 +176,11 @@ def cap_ball(alpha: float, order: int = 3, maxh: float = 0.25, hp_levels: int = 
     dict
         As :func:`cut_element` (``R`` under ``beta = 0``; faces north, south).
     """
-    from netgen import occ
-
     if not 0 < alpha < np.pi / 2:
         raise ValueError(f"alpha = {alpha}: must be in (0, pi/2) rad")
     _check(order, maxh, hp_levels, ())
+    from netgen import occ
+
     c = np.cos(alpha)
     ball = occ.Sphere(occ.Pnt(0, 0, 0), 1.0)
     north_box, south_box = occ.Box(occ.Pnt(-2, -2, c), occ.Pnt(2, 2, 2)), occ.Box(occ.Pnt(-2, -2, -2), occ.Pnt(2, 2, -c))
