@@ -1,5 +1,5 @@
-r"""The exact flux element of one cut sphere by FE (NGSolve): the particle of a network with a node per neck, with a
-prescribed flux profile on each neck face.
+r"""The exact flux element of one cut sphere by FE (NGSolve, the optional extra ``pip install .[peers]``): the particle
+of a network with a node per neck, with a prescribed flux profile on each neck face.
 
 A particle of the union of spheres is its sphere cut by the radical planes of its overlapping neighbours
 (:mod:`fem_neck.geometry.union`): the body :math:`\Omega = \{|x| \le 1, \; n_b \cdot x \le l_b\}` (lengths in units of
@@ -31,8 +31,10 @@ from __future__ import annotations
 import numpy as np
 
 
-def _solve(shape, names: list, discs: list, betas: tuple, order: int, maxh: float, hp_levels: int,
-           hp_factor: float = 0.2) -> dict:
+HP_FACTOR = 0.2  # the geometric refinement's ratio of each layer toward an edge to the last
+
+
+def _solve(shape, names: list, discs: list, betas: tuple, order: int, maxh: float, hp_levels: int) -> dict:
     """``{beta: R}`` over the named boundaries ``names`` of an OCC solid; ``discs`` per name ``(n, l, a)``: the
     neck's unit normal, plane distance and disc radius (units of ``r``; ignored for ``beta = 0``)."""
     import ngsolve as ngs
@@ -44,7 +46,7 @@ def _solve(shape, names: list, discs: list, betas: tuple, order: int, maxh: floa
             edge.hpref = 1
     mesh = ngs.Mesh(occ.OCCGeometry(shape).GenerateMesh(maxh=maxh))
     if hp_levels:
-        mesh.RefineHP(levels=hp_levels, factor=hp_factor)
+        mesh.RefineHP(levels=hp_levels, factor=HP_FACTOR)
     mesh.Curve(order)
     fes = ngs.H1(mesh, order=order)
     u, v = fes.TnT()
