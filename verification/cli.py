@@ -15,6 +15,9 @@ Commands (each writes ``report.md``, ``summary.json`` and ``run.json`` plus PNG 
 * ``closing-pores`` -- the closing pores' cap of the ``shared-body`` law on the union of spheres calibrated on FE cells
   that ``densification`` does not check; writes ``closing_pores.json``, the file shipped as
   ``dem/laws/closing_pores.json`` (section ``closing_pores``);
+* ``neck-node-bound`` -- a rigorous lower bound on the union's k_eff: the network with a node per neck whose
+  particles are exact flux elements (NGSolve), on SC, BCC and FCC cells, against the periodic-cell FE's upper bound
+  (section ``neck_node_bound``; needs NGSolve);
 * ``all``        -- ``paper`` and ``dem-vs-fe``.
 
 Run time against error is ``python -m benchmarks``; the stress cases are tests (``python -m pytest -m stress``).
@@ -50,6 +53,8 @@ COMMANDS = {
                      "necks: k_eff through the hand-over, against the bounds"),
     "closing-pores": (("closing_pores",), "calibrate the closing pores' cap of the union shared-body law on FE cells "
                       "the densification study does not check (writes closing_pores.json)"),
+    "neck-node-bound": (("neck_node_bound",), "a lower bound on the union's k_eff: the neck-node network of exact "
+                        "flux elements against the periodic-cell FE's upper bound"),
 }
 
 

@@ -130,11 +130,12 @@ def fe_pair_conductance(r_i: float, r_j: float, h: float) -> float:
 
 
 def dem_periodic(cell: lattice.PeriodicCell, law: str, neck: str = "newton",
-                 closing_pores: dict | None = None, nodes: str = "particles") -> float:
+                 closing_pores: dict | None = None, nodes: str = "particles", elements=None) -> float:
     """The DEM's ``k_eff / kappa`` of the periodic packing along z (drop of 1 K per period), for a conductance law
     or :data:`NETWORK_ONLY`, with the neck reading ``neck`` (``conductance.neck``), the network's ``nodes``
-    (``conductance.nodes``: ``"necks"`` solves :mod:`dem.network.necks`) and, for ``shared-body`` on the
-    union, the closing pores' calibration ``closing_pores`` (:func:`dem.laws.conductance.bond_conductances`)."""
+    (``conductance.nodes``: ``"necks"`` solves :mod:`dem.network.necks`, its particles' elements built by
+    ``elements``, :func:`dem.network.necks.neck_network`'s) and, for ``shared-body`` on the union, the closing
+    pores' calibration ``closing_pores`` (:func:`dem.laws.conductance.bond_conductances`)."""
     from dem.geometry.bonds import find_bonds
     from dem.laws.conductance import ConductanceSpec, bond_conductances
     from dem.geometry.particles import Material, Particles
@@ -149,7 +150,7 @@ def dem_periodic(cell: lattice.PeriodicCell, law: str, neck: str = "newton",
     if nodes == "necks":
         from dem.network.necks import neck_network, steady_necks
 
-        net = neck_network(spec, particles, bonds, box=box, closing_pores=closing_pores)
+        net = neck_network(spec, particles, bonds, box=box, closing_pores=closing_pores, elements=elements)
         return float(steady_necks(net).periodic_heat_flow[2] * box.lengths[2] / box.cross_section(2))
     if law == NETWORK_ONLY:
         K = np.array([fe_pair_conductance(*sorted((float(cell.radii[i]), float(cell.radii[j]))), float(h))

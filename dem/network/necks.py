@@ -191,7 +191,7 @@ class NeckNetwork:
 
 
 def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, box: PeriodicBox | None = None,
-                 walls=(), closing_pores: dict | None = None) -> NeckNetwork:
+                 walls=(), closing_pores: dict | None = None, elements=None) -> NeckNetwork:
     """Assemble the network with a node per neck (module docstring) of the ``shared-body`` law under the union of
     spheres.
 
@@ -209,6 +209,11 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
         The walls the wall bonds index (their normals and temperatures).
     closing_pores : dict or None
         The closing pores' calibration (:func:`dem.laws.conductance.bond_conductances`); None: the shipped one.
+    elements : callable or None
+        What builds the particles' elements, called with the arguments of
+        :func:`dem.laws.shared_body.particle_elements` and returning its
+        :class:`~dem.laws.shared_body.ParticleElements` (the same ends, another matrix per particle: e.g. an exact
+        element computed elsewhere); None: :func:`dem.laws.shared_body.particle_elements`.
 
     Returns
     -------
@@ -234,8 +239,8 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     k_i, k_j, k_w, pairs, live_walls, volume = union
     live, live_walls = np.flatnonzero(pairs), np.flatnonzero(live_walls)
     sub = bonds.subset(live, live_walls)
-    el = particle_elements(n, r, sub, vectors[live], k_i[live], k_j[live], k_w[live_walls], kappa,
-                           np.reshape(normals, (-1, 3))[live_walls], volume)
+    el = (elements or particle_elements)(n, r, sub, vectors[live], k_i[live], k_j[live], k_w[live_walls], kappa,
+                                         np.reshape(normals, (-1, 3))[live_walls], volume)
     m = len(live)
     # each end's node (a wall's: -1) and the offset it is seen at by its particle (a wall's: its temperature)
     jump = sub.shifts @ box.drop if box is not None else np.zeros(m)
