@@ -36,6 +36,8 @@ from scipy.sparse.csgraph import connected_components
 
 from dem.network.linsolve import make_solver
 
+COMPILED_ASSEMBLY_FROM = 300_000  # nodes from which the Laplacian and its blocks are written compiled
+# (dem.network.laplacian_kernels), as large a network as loads numba for its bonds and its solve anyway
 COMPILED_GROUPS_FROM = 300_000  # free nodes from which the groups are found compiled (dem.network.groups): a network
 # this large loads numba for its solve anyway (dem.network.amg_cycle.COMPILED_FROM)
 
@@ -137,6 +139,8 @@ class BoundedLaplacian:
         """``(L, L_FF, L_FD)`` of the conductances as they are: assembled the first time, afterwards rewritten in
         place (same sparsity) when :meth:`refresh` changed the conductances."""
         if self._matrices is None:
+            self._matrices = self._compiled() if self.n >= COMPILED_ASSEMBLY_FROM else None
+        if self._matrices is None:
             L = laplacian(self.n, self.i, self.j, self.K)
             if len(self.fixed):
                 rows = L[self.free]
@@ -166,6 +170,33 @@ class BoundedLaplacian:
                 matrix.data[:] = values[slots]
         self._stale = False
         return self._matrices
+
+    def _compiled(self):
+        """``(L, L_FF, L_FD)`` written row by row from canonical edges (:mod:`dem.network.laplacian_kernels`: the
+        Laplacian and scipy's selection of its blocks to the bit, without a temporary of the edges' length); None
+        where the edges are not canonical."""
+        from dem.network.laplacian_kernels import count_rows, write_rows  # compiled: a smaller network loads no numba
+
+        n, nf, blocks = self.n, len(self.free), len(self.fixed) > 0
+        index = np.int32 if 2 * len(self.i) + n < 2**31 else np.int64
+        fixed = np.zeros(n, dtype=bool)
+        fixed[self.fixed] = True
+        position = np.empty(n, dtype=index)
+        position[self.free] = np.arange(nf, dtype=index)
+        position[self.fixed] = np.arange(len(self.fixed), dtype=index)
+        pointers = [np.zeros(n + 1, dtype=index)] + [np.zeros(nf + 1 if blocks else 1, dtype=index) for _ in range(2)]
+        if not count_rows(n, self.i, self.j, position, fixed, *pointers):
+            return None
+        parts = []  # (row pointers, column indices, values) of L, L_FF, L_FD
+        for indptr in pointers:
+            np.cumsum(indptr, out=indptr)
+            parts.append((indptr, np.empty(indptr[-1], dtype=index), np.empty(indptr[-1])))
+        write_rows(n, self.i, self.j, self.K, position, fixed, *parts[0], *parts[1], *parts[2])
+        matrices = []
+        for (indptr, indices, data), shape in zip(parts, ((n, n), (nf, nf), (nf, len(self.fixed)))[:3 if blocks else 1]):
+            matrices.append(sp.csr_matrix((data, indices, indptr), shape=shape, copy=False))
+            matrices[-1].has_sorted_indices = True
+        return tuple(matrices) if blocks else (matrices[0], matrices[0], sp.csr_matrix((n, 0)))
 
     L = property(lambda self: self._current()[0], doc="The weighted graph Laplacian of all nodes (CSR).")
     L_FF = property(lambda self: self._current()[1], doc="Its free-free block (CSR).")
