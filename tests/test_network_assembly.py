@@ -65,6 +65,14 @@ def test_compiled_laplacian_and_blocks_are_scipys_selection_to_the_bit(n, m, n_f
         assert general.data.tobytes() == compiled.data.tobytes()
     if n_fixed == 0:
         assert built[1][1] is built[1][0]
+    # new conductances on the compiled matrices (the blocks first, L written later): rewritten in place as a fresh
+    # general assembly writes them
+    K2 = rng.uniform(0.5, 1.0, len(i))
+    g.L_FF, g.refresh(i, j, K2, np.zeros(0, int), np.zeros(0, int), np.zeros(0))
+    monkeypatch.setattr(assembly, "COMPILED_ASSEMBLY_FROM", 10**9)
+    ref = BoundedLaplacian(n, i, j, K2, fixed, np.zeros(0, int), np.zeros(0, int), np.zeros(0), 0)
+    for a, b in ((g.L, ref.L), (g.L_FF, ref.L_FF), (g.L_FD, ref.L_FD)):
+        assert a.shape == b.shape and np.abs((a - b).toarray()).max(initial=0.0) <= 1e-15 * (1.0 + abs(b).sum())
 
 
 # all contacts closed (the free block's graph: scipy's search, or compiled as for a large network), some open (edges)
