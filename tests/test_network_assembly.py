@@ -35,6 +35,46 @@ def test_canonical_edges_give_the_summed_laplacian_to_the_bit(n, m):
         assert abs(shuffled - L).max() <= 1e-15 * np.abs(L.data).max()
 
 
+@pytest.mark.parametrize("n, m, n_fixed, canonical", [(1, 0, 0, True), (7, 0, 2, True), (60, 300, 0, True),
+                                                      (60, 300, 60, True), (3000, 12000, 150, True),
+                                                      (3000, 12000, 150, False)])
+def test_compiled_laplacian_and_blocks_are_scipys_selection_to_the_bit(n, m, n_fixed, canonical, monkeypatch):
+    """L, L_FF and L_FD written row by row (compiled) are, entry for entry, dtype for dtype and to the bit (the sign
+    of an open contact's zero too), the Laplacian and scipy's row and column selection of its blocks; edges out of
+    order take the general route, whose matrices they are then."""
+    from dem.network import laplacian as assembly
+
+    rng = np.random.default_rng(m + n_fixed)
+    i, j = sorted_pairs(rng.integers(0, n, m), rng.integers(0, n, m), n)
+    i, j = i[i != j], j[i != j]
+    K = rng.uniform(0.0, 2.0, len(i))
+    K[::5] = 0.0
+    if not canonical:
+        i, j = i[::-1], j[::-1]
+    fixed = np.zeros(n, dtype=bool)
+    fixed[rng.permutation(n)[:n_fixed]] = True
+    built = []
+    for compiled_from in (10**9, 0):
+        monkeypatch.setattr(assembly, "COMPILED_ASSEMBLY_FROM", compiled_from)
+        g = BoundedLaplacian(n, i, j, K, fixed, np.zeros(0, int), np.zeros(0, int), np.zeros(0), 0)
+        built.append((g.L, g.L_FF, g.L_FD))
+    for general, compiled in zip(*built):
+        assert general.shape == compiled.shape
+        for a, b in ((general.indptr, compiled.indptr), (general.indices, compiled.indices)):
+            assert a.dtype == b.dtype and np.array_equal(a, b)
+        assert general.data.tobytes() == compiled.data.tobytes()
+    if n_fixed == 0:
+        assert built[1][1] is built[1][0]
+    # new conductances on the compiled matrices (the blocks first, L written later): rewritten in place as a fresh
+    # general assembly writes them
+    K2 = rng.uniform(0.5, 1.0, len(i))
+    g.L_FF, g.refresh(i, j, K2, np.zeros(0, int), np.zeros(0, int), np.zeros(0))
+    monkeypatch.setattr(assembly, "COMPILED_ASSEMBLY_FROM", 10**9)
+    ref = BoundedLaplacian(n, i, j, K2, fixed, np.zeros(0, int), np.zeros(0, int), np.zeros(0), 0)
+    for a, b in ((g.L, ref.L), (g.L_FF, ref.L_FF), (g.L_FD, ref.L_FD)):
+        assert a.shape == b.shape and np.abs((a - b).toarray()).max(initial=0.0) <= 1e-15 * (1.0 + abs(b).sum())
+
+
 # all contacts closed (the free block's graph: scipy's search, or compiled as for a large network), some open (edges)
 @pytest.mark.parametrize("open_every, compiled", [(0, False), (0, True), (3, False)])
 def test_groups_are_those_of_the_closed_edges(open_every, compiled, monkeypatch):

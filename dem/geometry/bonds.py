@@ -262,9 +262,13 @@ def unique_pairs(i, j, n: int) -> tuple[np.ndarray, np.ndarray]:
 def _lens_planes(r_i, r_j, d):
     """``L_i, L_j``: centre-to-radical-plane distances (Zohdi 2014, eq. 12), safe for ``d = 0``."""
     d_safe = np.where(d > 0, d, 1.0)
-    l_i = 0.5 * (d - (r_j**2 - r_i**2) / d_safe)
-    l_i = np.where(d > 0, l_i, -np.inf)
-    return l_i, d - l_i
+    l_i, l_j = r_j**2, r_i**2  # in place from here: 0.5 (d - (r_j^2 - r_i^2) / d_safe), three fresh arrays in all
+    l_i -= l_j
+    l_i /= d_safe
+    np.subtract(d, l_i, out=l_i)
+    l_i *= 0.5
+    np.copyto(l_i, -np.inf, where=~(d > 0))
+    return l_i, np.subtract(d, l_i, out=l_j)
 
 
 def _apply_policy(bad, what: str, first: str, policy: str, total: int):
@@ -279,14 +283,20 @@ def _apply_policy(bad, what: str, first: str, policy: str, total: int):
 def _pair_contacts(p: Particles, i, j, vec, contact, policy):
     r_i, r_j = p.radius[i], p.radius[j]
     x, y, z = vec[:, 0], vec[:, 1], vec[:, 2]
-    d = np.sqrt(x * x + y * y + z * z)  # np.linalg.norm(vec, axis=1) to the bit, in a tenth of its time
-    h = r_i + r_j - d
+    d, square = x * x, y * y  # sqrt(x x + y y + z z) in place: np.linalg.norm(vec, axis=1) to the bit, in a
+    d += square  # tenth of its time
+    d += np.multiply(z, z, out=square)
+    np.sqrt(d, out=d)
+    h = r_i + r_j
+    h -= d
     l_i, l_j = _lens_planes(r_i, r_j, d)
     if contact in LENS_GEOMETRY:
         bad = (l_i < 0) | (l_j < 0)
         limit = "the lens needs both centres outside the other sphere's cap: d^2 >= |r_j^2 - r_i^2|"
     else:  # max_overlap is the smaller radius / 3 plus a cap's share >= 0: only the bonds beyond the first need it
-        bad = h > np.minimum(r_i, r_j) / 3.0
+        third = np.minimum(r_i, r_j)
+        third /= 3.0
+        bad = h > third
         near = np.flatnonzero(bad)
         bad[near] = h[near] > max_overlap(r_i[near], r_j[near])
         limit = "overlap h <= max_overlap(r_i, r_j), where the neck reaches the smaller radius"
@@ -321,7 +331,7 @@ def _pair_contacts(p: Particles, i, j, vec, contact, policy):
     else:
         h_model = np.minimum(h, max_overlap(r_i, r_j)) if clipped else h
         a = np.asarray(neck_radius(r_i, r_j, h_model, method=contact)) if len(h) else np.zeros(0)
-    return i, j, h, d, a, np.maximum(l_i, 0.0), np.maximum(l_j, 0.0), clipped, dropped, keep
+    return i, j, h, d, a, np.maximum(l_i, 0.0, out=l_i), np.maximum(l_j, 0.0, out=l_j), clipped, dropped, keep
 
 
 def _wall_contacts(p: Particles, walls, contact, policy):
@@ -414,7 +424,11 @@ def find_bonds(particles: Particles, walls=(), contact: str = "newton", out_of_r
             k = int(np.flatnonzero(apart)[0])
             raise ValueError(f"bonds: particles {i[k]} and {j[k]} do not overlap (d = {d[k]:.6g} m >= "
                              f"r_i + r_j = {particles.radius[i[k]] + particles.radius[j[k]]:.6g} m)")
-    vec = box.bond_vectors(x, i, j, shift) if periodic else x[j] - x[i]
+    if periodic:
+        vec = box.bond_vectors(x, i, j, shift)
+    else:
+        vec = x[j]
+        vec -= x[i]
     i, j, h, d, a, l_i, l_j, c1, d1, keep = _pair_contacts(particles, i, j, vec, contact, out_of_range)
     wp, wi, wh, wa, wl, c2, d2 = _wall_contacts(particles, tuple(walls), contact, out_of_range)
     return Bonds(i, j, h, d, a, l_i, l_j, wp, wi, wh, wa, wl, contact, c1 + c2, d1 + d2,

@@ -214,8 +214,10 @@ def half_conductance(spec: ConductanceSpec, kappa, r, a, length):
         The half conductance ``K_i`` (W/K; S with an electrical conductivity).
     """
     kappa, r, a, length = (np.asarray(x, dtype=float) for x in (kappa, r, a, length))
-    if spec.law in LINEAR_SLOPES:
-        return (spec.slope or LINEAR_SLOPES[spec.law]) * kappa * np.pi * a          # eqs. (43), (42)
+    if spec.law in LINEAR_SLOPES:                                                     # eqs. (43), (42)
+        k = (spec.slope or LINEAR_SLOPES[spec.law]) * kappa
+        k *= np.pi  # in place: one fresh array of the bonds' length, not three
+        return np.multiply(k, a, out=k) if k.shape == np.broadcast_shapes(k.shape, a.shape) else k * a
     if spec.law in FIT_LAWS:
         return kappa * np.pi * r * np.asarray(spec.fitted().k_over_kcyl(np.minimum(a / r, 1.0)))
     with np.errstate(divide="ignore"):
@@ -235,9 +237,12 @@ def series(*halves):
     numpy.ndarray
         The series conductance (W/K).
     """
-    with np.errstate(divide="ignore"):
-        resistance = sum(1.0 / np.asarray(k, dtype=float) for k in halves if k is not None)
-    return 1.0 / resistance
+    halves = [np.asarray(k, dtype=float) for k in halves if k is not None]
+    with np.errstate(divide="ignore"):  # summed in place: one fresh array of the bonds' length and one per further half
+        resistance = np.divide(1.0, halves[0], out=np.empty(np.broadcast_shapes(*(k.shape for k in halves))))
+        for k in halves[1:]:
+            resistance += 1.0 / k
+        return np.divide(1.0, resistance, out=resistance)[()]
 
 
 def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds, conductivity=None,

@@ -36,6 +36,8 @@ from scipy.sparse.csgraph import connected_components
 
 from dem.network.linsolve import make_solver
 
+COMPILED_ASSEMBLY_FROM = 300_000  # nodes from which the Laplacian and its blocks are written compiled
+# (dem.network.laplacian_kernels), as large a network as loads numba for its bonds and its solve anyway
 COMPILED_GROUPS_FROM = 300_000  # free nodes from which the groups are found compiled (dem.network.groups): a network
 # this large loads numba for its solve anyway (dem.network.amg_cycle.COMPILED_FROM)
 
@@ -137,6 +139,8 @@ class BoundedLaplacian:
         """``(L, L_FF, L_FD)`` of the conductances as they are: assembled the first time, afterwards rewritten in
         place (same sparsity) when :meth:`refresh` changed the conductances."""
         if self._matrices is None:
+            self._matrices = self._compiled(whole=not len(self.fixed)) if self.n >= COMPILED_ASSEMBLY_FROM else None
+        if self._matrices is None:
             L = laplacian(self.n, self.i, self.j, self.K)
             if len(self.fixed):
                 rows = L[self.free]
@@ -167,7 +171,44 @@ class BoundedLaplacian:
         self._stale = False
         return self._matrices
 
-    L = property(lambda self: self._current()[0], doc="The weighted graph Laplacian of all nodes (CSR).")
+    def _compiled(self, whole: bool):
+        """Written row by row from canonical edges (:mod:`dem.network.laplacian_kernels`: the Laplacian and scipy's
+        selection of its blocks to the bit, without a temporary of the edges' length): ``(L, L, empty L_FD)`` where
+        ``whole`` (no fixed node: ``L_FF`` is ``L``), else ``(None, L_FF, L_FD)``, ``L`` written when first asked for
+        (:meth:`_laplacian`: a steady solve reads only the blocks); None where the edges are not canonical."""
+        from dem.network.laplacian_kernels import count_rows, write_rows  # compiled: a smaller network loads no numba
+
+        n, nf, blocks = self.n, len(self.free), not whole
+        index = np.int32 if 2 * len(self.i) + n < 2**31 else np.int64
+        fixed = np.zeros(n, dtype=bool)
+        fixed[self.fixed] = True
+        position = np.empty(n, dtype=index)
+        position[self.free] = np.arange(nf, dtype=index)
+        position[self.fixed] = np.arange(len(self.fixed), dtype=index)
+        pointers = [np.zeros(size + 1 if wanted else 1, dtype=index) for size, wanted in ((n, whole), (nf, blocks),
+                                                                                          (nf, blocks))]
+        if not count_rows(n, self.i, self.j, position, fixed, whole, *pointers):
+            return None
+        parts = []  # (row pointers, column indices, values) of L, L_FF, L_FD
+        for indptr in pointers:
+            np.cumsum(indptr, out=indptr)
+            parts.append((indptr, np.empty(indptr[-1], dtype=index), np.empty(indptr[-1])))
+        write_rows(n, self.i, self.j, self.K, position, fixed, whole, *parts[0], *parts[1], *parts[2])
+        matrices = []
+        for (indptr, indices, data), shape, wanted in zip(parts, ((n, n), (nf, nf), (nf, len(self.fixed))),
+                                                          (whole, blocks, blocks)):
+            matrices.append(sp.csr_matrix((data, indices, indptr), shape=shape, copy=False) if wanted else None)
+            if wanted:
+                matrices[-1].has_sorted_indices = True
+        return (matrices[0], matrices[0], sp.csr_matrix((n, 0))) if whole else tuple(matrices)
+
+    def _laplacian(self):
+        """``L``, written now where the blocks were written without it."""
+        if self._current()[0] is None:
+            self._matrices = (self._compiled(whole=True)[0], *self._matrices[1:])
+        return self._matrices[0]
+
+    L = property(_laplacian, doc="The weighted graph Laplacian of all nodes (CSR).")
     L_FF = property(lambda self: self._current()[1], doc="Its free-free block (CSR).")
     L_FD = property(lambda self: self._current()[2], doc="Its free-fixed block (CSR).")
 
