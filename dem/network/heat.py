@@ -95,8 +95,50 @@ ROUND_OFF = math.sqrt(np.finfo(float).eps)  # ... and never below this x the lar
 ENERGY_TOLERANCE = 1e-6  # energy_error allowed at the end of a transient run
 
 
+class BalanceScales:
+    """The scales a heat balance is judged against, for a network that gives ``flow_sums(T_F, sinks)``, its
+    ``particles``, ``wall_temperature`` and ``sources``: one particle per node (:class:`Network`) or a node per neck as
+    well (:class:`dem.network.necks.NeckHeat`)."""
+
+    def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
+        r"""Sum of the absolute heat flows into or out of each free node through its boundaries (W, the network's
+        ``flow_sums``): the scale of the energy balance (hot and cold ends do not cancel in it).
+
+        Each flow is a difference of terms :math:`K T`. Where (almost) no heat flows, the flows are the round-off of
+        those terms and a balance relative to them means nothing, so the scale is never taken below
+        :math:`\sqrt{\epsilon} \sum |K T|` (:math:`\epsilon` the machine precision): temperature differences below ~1e-8
+        of the temperatures count as no flow.
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the free nodes (K or degC).
+        sinks : dict
+            The ambient terms ``{name: (g, b)}`` (the network's ``sinks``): W/K and W per free node.
+
+        Returns
+        -------
+        float
+            The scale (W).
+        """
+        net, gross = self.flow_sums(T_F, sinks)
+        return float(max(net, np.sqrt(np.finfo(float).eps) * gross))
+
+    def temperature_bounds(self) -> tuple[float, float]:
+        """Lowest and highest temperature the scene prescribes (initial, fixed, walls, ambient)."""
+        temps = [self.particles.temperature, self.wall_temperature]
+        temps += [[s.T_inf] for s in (self.sources.convection, self.sources.radiation) if s is not None]
+        allt = np.concatenate([np.ravel(t) for t in temps])
+        return float(allt.min()), float(allt.max())
+
+    def temperature_range(self) -> float:
+        """The spread of :meth:`temperature_bounds` (K): the scale of the maximum-principle check."""
+        lo, hi = self.temperature_bounds()
+        return hi - lo
+
+
 @dataclass
-class Network:
+class Network(BalanceScales):
     """The linear(ised) heat balance of the free particles (module docstring), assembled once: the generic
     :class:`dem.network.laplacian.BoundedLaplacian` (the same solve serves the electrical current) with the particles'
     capacities, sources and fixed temperatures.
@@ -281,30 +323,6 @@ class Network:
             out["periodic"] = float(self.periodic_rhs[s].sum())
         return out
 
-    def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
-        r"""Sum of the absolute heat flows into or out of each free particle through its boundaries (W): the scale
-        of the energy balance (hot and cold ends do not cancel in it).
-
-        Each flow is a difference of terms :math:`K T`. Where (almost) no heat flows, the flows are the round-off of
-        those terms and a balance relative to them means nothing, so the scale is never taken below
-        :math:`\sqrt{\epsilon} \sum |K T|` (:math:`\epsilon` the machine precision): temperature differences below ~1e-8
-        of the temperatures count as no flow.
-
-        Parameters
-        ----------
-        T_F : numpy.ndarray
-            Temperatures of the free particles (K or degC).
-        sinks : dict
-            The ambient terms ``{name: (g, b)}`` (:meth:`sinks`): W/K and W per free particle.
-
-        Returns
-        -------
-        float
-            The scale (W).
-        """
-        net, gross = self.flow_sums(T_F, sinks)
-        return float(max(net, np.sqrt(np.finfo(float).eps) * gross))
-
     def flow_sums(self, T_F: np.ndarray, sinks: dict, rows=None) -> tuple[float, float]:
         """``(sum |flow|, sum |K T|)`` over the boundaries of the free particles (or of ``rows``, as in
         :meth:`flows`): the two sums behind :meth:`flow_magnitude`.
@@ -347,18 +365,6 @@ class Network:
         T = self.particles.temperature.copy()
         T[self.free] = T_F
         return T
-
-    def temperature_bounds(self) -> tuple[float, float]:
-        """Lowest and highest temperature the scene prescribes (initial, fixed, walls, ambient)."""
-        temps = [self.particles.temperature, self.wall_temperature]
-        temps += [[s.T_inf] for s in (self.sources.convection, self.sources.radiation) if s is not None]
-        allt = np.concatenate([np.ravel(t) for t in temps])
-        return float(allt.min()), float(allt.max())
-
-    def temperature_range(self) -> float:
-        """The spread of :meth:`temperature_bounds` (K): the scale of the maximum-principle check."""
-        lo, hi = self.temperature_bounds()
-        return hi - lo
 
 
 def build_network(particles: Particles, walls=(), spec=None, sources: Sources | None = None, *, pairs=None,

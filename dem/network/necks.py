@@ -104,7 +104,7 @@ from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources, linear_sink_terms
 from dem.laws.conductance import ConductanceSpec, bond_halves, union_halves, wall_normals
 from dem.network.current import CurrentFlow, Electrodes, kirchhoff
-from dem.network.heat import solve_steady
+from dem.network.heat import BalanceScales, solve_steady
 from dem.network.linsolve import make_solver
 
 
@@ -434,7 +434,7 @@ def neck_flows(net: NeckNetwork, T: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     return bond_flow, wall_flow, np.where(net.particles.fixed, fed, 0.0)
 
 
-class NeckHeat:
+class NeckHeat(BalanceScales):
     r"""The heat balance of the network with a node per neck over its free nodes (module docstring, "Transient" and
     "Ambient") in the terms in which :func:`dem.network.heat.integrate`, :class:`dem.network.theta.ThetaStepper` and
     :func:`dem.network.heat.solve_steady` take a network, so that one :math:`\theta` scheme and one steady solve serve
@@ -618,10 +618,9 @@ class NeckHeat:
             out[name] = float(b.sum() - g @ T_F)
         return out
 
-    def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
-        """The scale of the heat balance, as :meth:`dem.network.heat.Network.flow_magnitude`: the sum of the sizes of
-        the flows through each wall end, fixed centre, source and ambient exchange, never below round-off of their
-        terms.
+    def flow_sums(self, T_F: np.ndarray, sinks: dict) -> tuple[float, float]:
+        """``(sum |flow|, sum |terms|)`` over each wall end, fixed centre, source and ambient exchange: the two sums
+        behind :meth:`dem.network.heat.BalanceScales.flow_magnitude`.
 
         Parameters
         ----------
@@ -632,8 +631,8 @@ class NeckHeat:
 
         Returns
         -------
-        float
-            The scale (W).
+        tuple of (float, float)
+            The two sums (W).
         """
         q, gross = self._boundary(T_F)
         net = gross_all = float(np.abs(self.heat).sum())
@@ -642,18 +641,7 @@ class NeckHeat:
         for g, b in sinks.values():
             net += float(np.abs(b - g * T_F).sum())
             gross_all += float(np.abs(b).sum() + np.abs(g * T_F).sum())
-        return max(net, np.sqrt(np.finfo(float).eps) * gross_all)
-
-    def temperature_bounds(self) -> tuple[float, float]:
-        """Lowest and highest temperature the scene prescribes (initial, fixed, walls, ambient)."""
-        ambient = [s.T_inf for s in (self.sources.convection, self.sources.radiation) if s is not None]
-        allt = np.concatenate([self.particles.temperature, self.wall_temperature, ambient])
-        return float(allt.min()), float(allt.max())
-
-    def temperature_range(self) -> float:
-        """The spread of :meth:`temperature_bounds` (K)."""
-        lo, hi = self.temperature_bounds()
-        return hi - lo
+        return net, gross_all
 
 
 def neck_current(net: NeckNetwork, walls, electrodes: Electrodes, linear: str = "auto") -> tuple[CurrentFlow,
