@@ -185,3 +185,20 @@ def test_heat_flow_through_a_packing_is_that_of_the_general_route(monkeypatch):
     assert solver == "amg" and ref > 0
     assert fast == pytest.approx(ref, rel=1e-8)
     assert np.max(np.abs(T_fast - T_ref)) < 1e-8
+
+
+@pytest.mark.parametrize("law", ["rojek", "argento-bouvard"])
+def test_linear_halves_and_series_take_numbers_as_the_arrays_do(law):
+    """The linear laws' halves (Rojek 2022 eq. 43, Argento & Bouvard eq. 42), computed in place for arrays, give a
+    number for numbers (the docstring's ``float or array_like``) equal to the array's entry, and so does ``series``."""
+    from dem.laws.conductance import LINEAR_SLOPES, ConductanceSpec, half_conductance, series
+
+    spec = ConductanceSpec(law=law)
+    kappa, r, a, length = 394.0, 1e-3, 1e-4, 9e-4
+    one = half_conductance(spec, kappa, r, a, length)
+    many = half_conductance(spec, np.full(3, kappa), np.full(3, r), np.full(3, a), np.full(3, length))
+    assert np.ndim(one) == 0 and float(one) == LINEAR_SLOPES[law] * kappa * np.pi * a
+    assert np.array_equal(many, np.full(3, float(one)))
+    assert half_conductance(spec, kappa, r, np.array([a, 2 * a]), length).tolist() == [
+        LINEAR_SLOPES[law] * kappa * np.pi * x for x in (a, 2 * a)]  # a number's conductivity, an array of necks
+    assert float(series(one, one)) == float(series(many, many)[0]) == 1.0 / (1.0 / float(one) + 1.0 / float(one))

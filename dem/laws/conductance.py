@@ -216,8 +216,10 @@ def half_conductance(spec: ConductanceSpec, kappa, r, a, length):
     kappa, r, a, length = (np.asarray(x, dtype=float) for x in (kappa, r, a, length))
     if spec.law in LINEAR_SLOPES:                                                     # eqs. (43), (42)
         k = (spec.slope or LINEAR_SLOPES[spec.law]) * kappa
+        if not isinstance(k, np.ndarray) or k.shape != np.broadcast_shapes(k.shape, a.shape):
+            return k * np.pi * a  # a number, or a shape that a widens
         k *= np.pi  # in place: one fresh array of the bonds' length, not three
-        return np.multiply(k, a, out=k) if k.shape == np.broadcast_shapes(k.shape, a.shape) else k * a
+        return np.multiply(k, a, out=k)
     if spec.law in FIT_LAWS:
         return kappa * np.pi * r * np.asarray(spec.fitted().k_over_kcyl(np.minimum(a / r, 1.0)))
     with np.errstate(divide="ignore"):
