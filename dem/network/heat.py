@@ -325,7 +325,7 @@ class Network(BalanceScales):
 
     def flow_sums(self, T_F: np.ndarray, sinks: dict, rows=None) -> tuple[float, float]:
         """``(sum |flow|, sum |K T|)`` over the boundaries of the free particles (or of ``rows``, as in
-        :meth:`flows`): the two sums behind :meth:`flow_magnitude`.
+        :meth:`flows`): the two sums behind :meth:`BalanceScales.flow_magnitude`.
 
         Parameters
         ----------
@@ -1050,7 +1050,7 @@ class WholeNetwork:
         return self.net.flows(T_F, sinks)
 
     def flow_magnitude(self, T_F: np.ndarray, sinks: dict) -> float:
-        """The scale of the heat flows (W, :meth:`Network.flow_magnitude`).
+        """The scale of the heat flows (W, :meth:`BalanceScales.flow_magnitude`).
 
         Parameters
         ----------
