@@ -591,13 +591,16 @@ def _elements(n_particles, pairs, walls, bodies):
     return offsets, ends, start, values, plain, shrink
 
 
-ParticleElements = namedtuple("ParticleElements", ["offsets", "ends", "start", "values", "plain", "shrink"])
+ParticleElements = namedtuple("ParticleElements", ["offsets", "ends", "start", "values", "plain", "shrink", "modes"],
+                              defaults=(1,))
 ParticleElements.__doc__ = """Every particle's conductance matrix over its necks and its centre (:func:`particle_elements`).
 The ends of particle ``k`` are ``ends[offsets[k]:offsets[k + 1]]`` (end ``e < m``: pair bond ``e``'s neck on its
 ``i``; ``m <= e < 2 m``: pair bond ``e - m``'s on its ``j``; the rest the wall bonds'), its ``(z + 1) x (z + 1)``
 matrix (W/K; local nodes: those ends in order, then the centre) row by row at ``values[start[k]:start[k + 1]]``;
 ``plain`` marks the particles whose interactions were dropped (their ``R`` not positive definite) and ``shrink``
-holds the trace cap's factor of each."""
+holds the trace cap's factor of each. ``modes`` is the number of flux modes per neck (1 here; an element with the
+dipoles, :mod:`dem.network.necks` "Flux modes", has 3 and a ``(3 z + 1) x (3 z + 1)`` matrix whose local node
+``3 p + d`` is mode ``d`` of its ``p``-th end)."""
 
 
 def particle_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray,

@@ -40,6 +40,33 @@ follows as in the one-node network. The solve is :func:`dem.network.linsolve.mak
 AMG-CG on large): ``A`` is SPD on the anchored groups, though not an M-matrix (``R^{-1}`` may couple two necks with a
 positive entry).
 
+**Flux modes.** One number per neck carries the heat through it, not how that heat spreads over the face; on a loose
+packing a neck's flux tilts across its face, which one number cannot carry (the verification guide's floor from
+exact elements). An element may carry ``modes`` flux modes per neck (``modes`` of
+:class:`~dem.laws.shared_body.ParticleElements`): mode 0, the monopole, a unit of heat spread over the face with a
+profile :math:`w / \int w`; modes 1 and 2, the dipoles, :math:`w (\xi_d - \bar\xi_d) / (a \int w)` with
+:math:`\xi_d = t_d \cdot x` along the neck's frame (:func:`neck_frames`: :math:`t_1, t_2` defined by the bond, so
+both particles see the same functions on their common face; :math:`\bar\xi_d` the ``w``-weighted mean, ``a`` the
+neck radius), which carry no net heat. Each mode's node holds the face temperature read with its own function (the
+monopole's the ``w``-weighted mean, a dipole's the moment), so a particle's resistance ``R`` over its ``modes z`` modes
+gives the flows :math:`Q = R^{-1} (\theta - T_c e)` into it (``e`` 1 on the monopoles, 0 on the dipoles: the centre
+exchanges heat with the monopoles only) and its element is
+
+.. math::
+
+    E = \begin{pmatrix} R^{-1} & -R^{-1} e \\ -e^T R^{-1} & e^T R^{-1} e \end{pmatrix},
+
+its local node ``modes p + d`` mode ``d`` of end ``p``, then the centre. Mode ``d`` of live pair bond ``b`` is
+node ``n + modes b + d``, shared by the bond's two particles: what flows into ``i`` through it leaves ``j``
+(Kirchhoff at the node) and its temperature moment is one value on both sides. A uniform
+change of temperature moves the centres and the monopoles and leaves the dipoles' moments (the kernel of ``A`` on a
+connected group is 1 there, 0 on the dipoles); the periodic jump and a wall's temperature act on the monopoles, a
+wall's dipole moments are 0 (it is isothermal). The heat flows (:meth:`NeckNetwork.end_flows`, the flow across the
+period, ``k_eff``) are the monopoles'; a dipole's row in ``entries`` has the bond end :data:`DIPOLE`. The law's
+elements have ``modes = 1``; ``modes = 3`` comes from elements built elsewhere through the ``elements`` hook of
+:func:`neck_network` (:mod:`verification.neck_node_bound`'s exact ones). The current takes ``modes = 1`` only (the rows
+of ``E`` do not sum to zero on the dipoles: no graph's Laplacian).
+
 **Transient.** Neck nodes hold no heat: the capacity matrix is :math:`M = \mathrm{diag}(C_1 \dots C_n, 0 \dots 0)`,
 only semidefinite. The :math:`\theta` scheme :math:`(M/\Delta t + \theta A) T^+ = (M/\Delta t - (1 - \theta) A) T + r`
 stays well-posed for :math:`\theta > 0`: :math:`M/\Delta t + \theta A` is SPD on every anchored group and on a group
@@ -107,6 +134,8 @@ from dem.network.current import CurrentFlow, Electrodes, kirchhoff
 from dem.network.heat import BalanceScales, solve_steady
 from dem.network.linsolve import make_solver
 
+DIPOLE = -2  # the bond end of a dipole mode's row or column in NeckNetwork.entries: it carries no net heat
+
 
 @dataclass
 class NeckNetwork:
@@ -130,7 +159,8 @@ class NeckNetwork:
     entries : tuple
         ``(row, col, value, known, end)`` of every element entry: its row and column nodes (``-1``: a wall's
         neck), its value (W/K), the offset or wall temperature its column is seen at (K), and the bond end of
-        its row (``-1``: the centre), from which :meth:`end_flows` sums the flows.
+        its row (``-1``: the centre; :data:`DIPOLE`: a dipole mode of a neck, which carries no net heat), from which
+        :meth:`end_flows` sums the flows.
     n_ends : int
         The number of bond ends (twice the live pair bonds and the live wall bonds).
     plain : int
@@ -140,13 +170,16 @@ class NeckNetwork:
     owner : numpy.ndarray
         Per element entry (in the order of ``entries``), the particle whose element it belongs to.
     col_end : numpy.ndarray
-        Per element entry, the bond end of its column (``-1``: the centre).
+        Per element entry, the bond end of its column (``-1``: the centre; :data:`DIPOLE`: a dipole mode).
     box : dem.geometry.periodic.PeriodicBox or None
         The periodic box; None: none.
     union : tuple or None
         The ``shared-body`` halves on the cut spheres the elements are made of (what
         :func:`dem.laws.conductance.union_halves` returned), from which the one-node law's conductances follow without
         computing them again (``union`` of :func:`dem.laws.conductance.bond_conductances`).
+    modes : int
+        Flux modes per neck (module docstring, "Flux modes"): 1, the neck's temperature alone (node ``n + k`` of live
+        pair bond ``k``); 3 with two dipoles (mode ``d`` of bond ``k`` at node ``n + 3 k + d``, the monopole ``d = 0``).
     """
 
     particles: Particles
@@ -163,6 +196,7 @@ class NeckNetwork:
     col_end: np.ndarray
     box: PeriodicBox | None = None
     union: tuple | None = None
+    modes: int = 1
 
     @property
     def n_nodes(self) -> int:
@@ -172,12 +206,13 @@ class NeckNetwork:
     def end_flows(self, T: np.ndarray) -> np.ndarray:
         """The heat flowing into each particle through each of its neck ends (W) at node temperatures ``T``: end
         ``k < m`` is live pair bond ``k`` on its ``i``, ``m <= k < 2 m`` the same on its ``j``, the rest the live wall
-        bonds (``m`` live pair bonds).
+        bonds (``m`` live pair bonds); the monopole modes' flows (a dipole carries no net heat).
 
         Parameters
         ----------
         T : numpy.ndarray
-            The temperatures of all nodes, centres then necks (K or degC).
+            The temperatures of all nodes, centres then necks (K or degC; with several modes per neck, the dipoles'
+            temperature moments among them).
 
         Returns
         -------
@@ -213,7 +248,8 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
         What builds the particles' elements, called with the arguments of
         :func:`dem.laws.shared_body.particle_elements` and returning its
         :class:`~dem.laws.shared_body.ParticleElements` (the same ends, another matrix per particle: e.g. an exact
-        element computed elsewhere); None: :func:`dem.laws.shared_body.particle_elements`.
+        element computed elsewhere, with ``modes`` flux modes per neck, module docstring "Flux modes"); None:
+        :func:`dem.laws.shared_body.particle_elements`.
 
     Returns
     -------
@@ -223,7 +259,8 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     Raises
     ------
     ValueError
-        ``spec`` is not the ``shared-body`` law under the union of spheres, or wall bonds without their walls.
+        ``spec`` is not the ``shared-body`` law under the union of spheres, wall bonds without their walls, or
+        elements whose blocks are not ``(modes z + 1)^2`` values.
     """
     from dem.laws.shared_body import particle_elements
 
@@ -242,33 +279,78 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     el = (elements or particle_elements)(n, r, sub, vectors[live], k_i[live], k_j[live], k_w[live_walls], kappa,
                                          np.reshape(normals, (-1, 3))[live_walls], volume)
     m = len(live)
-    # each end's node (a wall's: -1) and the offset it is seen at by its particle (a wall's: its temperature)
+    M = _modes(el)
+    # each end's node (a wall's: -1) and the offset it is seen at by its particle (a wall's: its temperature); mode
+    # ``mode`` of live pair bond b is node n + M b + mode
     jump = sub.shifts @ box.drop if box is not None else np.zeros(m)
     wall_T = np.array([w.temperature for w in walls], dtype=float)[sub.wall_index] if len(live_walls) else np.zeros(0)
     # (one more place at the end of each: the centre, end -1, seen at offset 0)
-    node = np.concatenate([n + np.arange(m), n + np.arange(m), np.full(len(live_walls), -1), [0]])
+    node = np.concatenate([n + M * np.arange(m), n + M * np.arange(m), np.full(len(live_walls), -1), [0]])
     offset = np.concatenate([np.zeros(m), jump, wall_T, [0.0]])
     ends = np.append(el.ends, -1)
-    # the entries: particle k's block is (z + 1)^2 values row by row, local node p < z its p-th end, z its centre
+    # the entries: particle k's block is (M z + 1)^2 values row by row, local node M p + mode (mode < M) the mode of
+    # its p-th end, M z its centre
     z = np.diff(el.offsets)
-    size = z + 1
+    size = M * z + 1
     owner = np.repeat(np.arange(n), size * size)
     local = np.arange(len(el.values)) - el.start[:-1][owner]
     p_row, p_col = local // size[owner], local % size[owner]
     first = el.offsets[:-1][owner]
-    end_row = ends[np.where(p_row == z[owner], len(el.ends), first + p_row)]
-    end_col = ends[np.where(p_col == z[owner], len(el.ends), first + p_col)]
-    row = np.where(end_row < 0, owner, node[end_row])
-    col = np.where(end_col < 0, owner, node[end_col])
-    known = offset[end_col]
+    centre_row, centre_col = p_row == M * z[owner], p_col == M * z[owner]
+    mode_row, mode_col = np.where(centre_row, 0, p_row % M), np.where(centre_col, 0, p_col % M)
+    end_row = ends[np.where(centre_row, len(el.ends), first + p_row // M)]
+    end_col = ends[np.where(centre_col, len(el.ends), first + p_col // M)]
+    row = np.where(end_row < 0, owner, np.where(node[end_row] < 0, -1, node[end_row] + mode_row))
+    col = np.where(end_col < 0, owner, np.where(node[end_col] < 0, -1, node[end_col] + mode_col))
+    known = np.where(mode_col == 0, offset[end_col], 0.0)  # a dipole sees no jump, and a wall's moment is 0
+    end_row, end_col = np.where(mode_row == 0, end_row, DIPOLE), np.where(mode_col == 0, end_col, DIPOLE)
     value = el.values
     inner, rows = (row >= 0) & (col >= 0), row >= 0  # a wall's row has no equation: the wall takes what it is given
-    size_all = n + m
+    size_all = n + M * m
     A = sp.coo_matrix((value[inner], (row[inner], col[inner])), shape=(size_all, size_all)).tocsr()
     A = 0.5 * (A + A.T)  # symmetric to round-off (the blocks are; their sums need not be bit for bit)
     rhs = -np.bincount(row[rows], value[rows] * known[rows], size_all)
     return NeckNetwork(particles, bonds, live, live_walls, A.tocsr(), rhs, (row, col, value, known, end_row),
-                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box, union)
+                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box, union, M)
+
+
+def _modes(el) -> int:
+    """The flux modes per neck of the elements ``el``, their blocks' sizes checked against them."""
+    M = getattr(el, "modes", 1)
+    if int(M) != M or M < 1:
+        raise ValueError(f"elements: modes = {M}: must be an integer >= 1 (flux modes per neck)")
+    M = int(M)
+    z = np.diff(el.offsets)
+    bad = np.flatnonzero(np.diff(el.start) != (M * z + 1) ** 2)
+    if len(bad) or len(el.values) != el.start[-1]:
+        k = int(bad[0]) if len(bad) else len(z) - 1
+        raise ValueError(f"elements: particle {k} has {int(el.start[k + 1] - el.start[k])} values; with {z[k]} necks "
+                         f"and modes = {M} its block needs (modes z + 1)^2 = {(M * z[k] + 1) ** 2}")
+    return M
+
+
+def neck_frames(vectors: np.ndarray) -> np.ndarray:
+    r"""The dipole frame of each pair bond's neck: two unit vectors :math:`t_1, t_2` in the neck's plane, defined by
+    the bond (its unit vector :math:`u` from ``i`` to ``j``) so that both particles see the same dipole modes
+    (module docstring, "Flux modes"): :math:`t_1 = u \times h / |u \times h|` with :math:`h = e_x` where
+    :math:`|u_x| < 0.9`, else :math:`e_y`, and :math:`t_2 = u \times t_1`.
+
+    Parameters
+    ----------
+    vectors : numpy.ndarray
+        (m, 3) ``x_j - x_i`` of the bonds (any length unit; not zero).
+
+    Returns
+    -------
+    numpy.ndarray
+        (m, 2, 3) the unit vectors ``t_1``, ``t_2`` of each bond.
+    """
+    u = np.reshape(np.asarray(vectors, dtype=float), (-1, 3))
+    u = u / np.linalg.norm(u, axis=1)[:, None]
+    h = np.where((np.abs(u[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    t1 = np.cross(u, h)
+    t1 /= np.linalg.norm(t1, axis=1)[:, None]
+    return np.stack([t1, np.cross(u, t1)], axis=1)
 
 
 @dataclass
@@ -280,7 +362,8 @@ class NeckSteady:
     T : numpy.ndarray
         (N,) the particles' (centres') temperatures (K or degC).
     T_necks : numpy.ndarray
-        The live pair bonds' neck temperatures, in the frame of each bond's ``i`` (K or degC).
+        The live pair bonds' neck temperatures, in the frame of each bond's ``i`` (K or degC); with ``modes`` flux
+        modes per neck, ``modes`` values per bond, its temperature (the monopole's) then its dipoles' moments (K).
     bond_flow : numpy.ndarray
         Per pair bond (all of them), the heat flowing from ``i`` to ``j`` through its neck (W; 0 for a dead one).
     wall_flow : numpy.ndarray
@@ -353,7 +436,7 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
     n, N = p.n, net.n_nodes
     fixed = np.zeros(N, dtype=bool)
     fixed[:n] = p.fixed
-    T_F = np.concatenate([p.temperature[~p.fixed], np.zeros(len(net.live))]).astype(float)  # centres: initial
+    T_F = np.concatenate([p.temperature[~p.fixed], np.zeros(N - n)]).astype(float)  # centres: initial
     # the groups: anchored where they hold a fixed node, a wall's neck or a centre with an ambient exchange
     row, col = net.entries[0], net.entries[1]
     n_comp, label = connected_components(net.A, directed=False)
@@ -367,7 +450,7 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
         raise ValueError("steady problem has no solution: a floating group of particles (no fixed temperature, "
                          "wall or ambient) has a net internal heat source, so it heats up forever")
     jumping = np.zeros(n_comp, dtype=bool)
-    jumping[label[n + np.flatnonzero(net.jump != 0.0)]] = True
+    jumping[label[n + net.modes * np.flatnonzero(net.jump != 0.0)]] = True
     lost = ~anchored & ~jumping
     if floating == "error" and np.any(lost):
         first = np.flatnonzero(lost[label[:n]])[:8].tolist()
@@ -389,7 +472,7 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
         weight = np.bincount(label[:n], C, n_comp)
         now = np.bincount(label[:n], C * T[:n], n_comp)
         shift = np.where(anchored, 0.0, (target - now) / np.where(weight > 0, weight, 1.0))
-        T += shift[label]
+        T += shift[label] * _level(net)
     T_F = T[system.free]
     sinks = system.sinks(T_F)  # radiation: the exact T^4 flow at the solution
     flows = system.flows(T_F, sinks)
@@ -401,6 +484,14 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
     periodic = bond_flow[net.live] @ shifts if m else np.zeros(3)
     return NeckSteady(T[:n].copy(), T[n:].copy(), bond_flow, wall_flow, fixed_flow, np.asarray(periodic, float),
                       flows, energy_error, iterations, backend)
+
+
+def _level(net: NeckNetwork) -> np.ndarray:
+    """Per node, 1 where a uniform change of temperature moves it (the centres and the necks' monopoles), 0 on the
+    dipoles' moments (the moment of a uniform temperature is 0)."""
+    level = np.ones(net.n_nodes)
+    level[net.particles.n:] = np.arange(net.n_nodes - net.particles.n) % net.modes == 0
+    return level
 
 
 def neck_flows(net: NeckNetwork, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -429,7 +520,7 @@ def neck_flows(net: NeckNetwork, T: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     # the heat fed by each fixed centre: its element's centre row (flows into the element there)
     row, col, value, known, end = net.entries
     seen = known + np.where(col >= 0, T[np.maximum(col, 0)], 0.0)
-    centre = end < 0
+    centre = end == -1
     fed = np.bincount(row[centre], value[centre] * seen[centre], len(T))[:n]
     return bond_flow, wall_flow, np.where(net.particles.fixed, fed, 0.0)
 
@@ -463,11 +554,12 @@ class NeckHeat(BalanceScales):
         self.net, self.particles = net, p
         centres = np.flatnonzero(~p.fixed)
         held = np.flatnonzero(p.fixed)
-        self.free = np.concatenate([centres, n + np.arange(m)])
+        necks = net.n_nodes - n  # the necks' nodes: their modes
+        self.free = np.concatenate([centres, n + np.arange(necks)])
         rows = net.A[self.free]
         self.A = rows[:, self.free].tocsr()
-        self.C = np.concatenate([p.capacity[centres], np.zeros(m)])
-        self.heat = np.concatenate([p.heat[centres], np.zeros(m)])
+        self.C = np.concatenate([p.capacity[centres], np.zeros(necks)])
+        self.heat = np.concatenate([p.heat[centres], np.zeros(necks)])
         self.r_const = net.rhs[self.free] - rows[:, held] @ p.temperature[held] + self.heat
         self.sources = (Sources() if sources is None else sources).resolved(p.position, p.radius, centres)
         self.radius = p.radius[centres]
@@ -479,13 +571,13 @@ class NeckHeat(BalanceScales):
         # the boundary terms: the entries of the walls' rows (heat from a wall into the network) and of the fixed
         # centres' rows (heat a fixed centre feeds into it), grouped by wall end and by fixed centre
         row, col, value, known, end = net.entries
-        wall = row < 0
+        wall = (row < 0) & (end >= 0)  # (a wall's dipole rows carry no heat)
         fed = (row >= 0) & (row < n) & p.fixed[np.clip(row, 0, n - 1)]
         self._walls = len(net.live_walls)
         group = np.where(wall, end - 2 * m, self._walls + np.searchsorted(held, np.where(fed, row, 0)))
         take = wall | fed
         self._terms = (col[take], value[take], known[take], group[take], self._walls + len(held))
-        self.wall_temperature = known[col < 0]
+        self.wall_temperature = known[(col < 0) & (net.col_end >= 0)]
         self._solve = (linear, rtol)
         self._initial = None
 
@@ -516,7 +608,7 @@ class NeckHeat(BalanceScales):
         numpy.ndarray
             All nodes' temperatures, centres then necks (K or degC).
         """
-        T = np.concatenate([self.particles.temperature.astype(float), np.zeros(len(self.net.live))])
+        T = np.concatenate([self.particles.temperature.astype(float), np.zeros(self.net.n_nodes - self.particles.n)])
         T[self.free] = T_F
         return T
 
@@ -673,8 +765,11 @@ def neck_current(net: NeckNetwork, walls, electrodes: Electrodes, linear: str = 
     ------
     ValueError
         A particle touches two electrodes (its element would join them directly, which the solve has no edge for),
-        or no electrode is at a fixed potential.
+        no electrode is at a fixed potential, or the network has more than one flux mode per neck.
     """
+    if net.modes != 1:
+        raise ValueError(f"neck_current: modes = {net.modes}: the current takes one flux mode per neck (a dipole "
+                         f"node is no node of Kirchhoff's graph)")
     p = net.particles
     n, m = p.n, len(net.live)
     row, col, value, _, end = net.entries
