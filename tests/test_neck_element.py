@@ -8,22 +8,34 @@ import pytest
 from verification import neck_element as E
 
 
-@pytest.mark.parametrize("alpha, tolerance", [(0.3, 1e-3), (0.7, 2e-4)])
-def test_two_caps_against_the_legendre_series(alpha, tolerance):
+@pytest.mark.parametrize("alpha, tolerance, dipole_tolerance", [(0.3, 1e-3, 3e-3), (0.7, 2e-4, 5e-4)])
+def test_two_caps_against_the_legendre_series(alpha, tolerance, dipole_tolerance):
+    """The monopoles against the series in P_l, the dipoles (along x and y on each cap) against the one in P_l^1."""
     pytest.importorskip("ngsolve")
-    res = E.cap_ball(alpha)
+    res = E.cap_ball(alpha, dipoles=True)
     R = res["R"][0.0]
-    assert R[0, 1] == pytest.approx(R[1, 0], rel=1e-12)
-    between = R[0, 0] + R[1, 1] - 2 * R[0, 1]
+    assert R.shape == (6, 6) and np.max(np.abs(R - R.T)) < 1e-12 * np.abs(R).max()
+    M = R[::3, ::3]  # the monopoles
+    between = M[0, 0] + M[1, 1] - 2 * M[0, 1]
     exact = E.cap_ball_exact(alpha)
     # Galerkin's discrete energy is above the exact minimum: the FE's resistance is below the series', and close
     assert 0.0 < 1.0 - between / exact < tolerance
+    own, across = E.cap_ball_dipole_exact(alpha)
+    for d in (1, 2, 4, 5):  # each dipole's own moment: below the series, and close (Galerkin again)
+        assert 0.0 < 1.0 - R[d, d] / own < dipole_tolerance
+    for d in (1, 2):  # the other cap's moment, parallel dipoles; crossed ones and the monopoles do not couple
+        assert R[d, d + 3] == pytest.approx(across, rel=dipole_tolerance)
+        assert abs(R[d, 3 - d]) + abs(R[d, 6 - d]) < 1e-3 * own
+    assert np.max(np.abs(R[0, [1, 2, 4, 5]])) < 1e-3 * own
     assert res["volume"] == pytest.approx(4.0 / 3.0 * np.pi, rel=1e-4)
 
 
 @pytest.mark.parametrize("kwargs, word", [({"arms": [1.2]}, "arms"), ({"betas": (0.5,)}, "beta"),
                                           ({"maxh": 0.0}, "maxh"), ({"order": 0}, "order"),
-                                          ({"normals": [[0.0, 0.0, 2.0]]}, "normals")])
+                                          ({"normals": [[0.0, 0.0, 2.0]]}, "normals"),
+                                          ({"frames": [[[1.0, 0.0, 0.0]]]}, "frames"),
+                                          ({"frames": [[[1.0, 0.0, 0.0], [0.6, 0.8, 0.0]]]}, "frames"),
+                                          ({"frames": [[[0.0, 0.6, 0.8], [1.0, 0.0, 0.0]]]}, "frames")])
 def test_bad_input_is_one_line_naming_the_parameter(kwargs, word):
     args = {"normals": [[0.0, 0.0, 1.0]], "arms": [0.9], **kwargs}
     with pytest.raises(ValueError, match=word) as err:
@@ -89,3 +101,32 @@ def test_the_quick_study_finds_the_bounds_below_the_fe(tmp_path):
     for beta, k in row["bound"].items():
         assert k < row["fe"]["lower"]
         assert row["coarse"][beta] > k  # Galerkin: the coarser element conducts more
+
+
+def test_a_mirror_images_three_modes_are_the_cached_bodys_turned():
+    """The dipoles of a body's mirror image, taken from the cached FE of the body by the symmetry that maps them and
+    turned onto the image's frames, against an FE of the image itself in those frames (another mesh: agreement to
+    the discretisation), and the network's frames are the bonds' (a turn of the frames leaves the monopoles)."""
+    pytest.importorskip("ngsolve")
+    from dem.network.necks import neck_frames
+    from verification.neck_node_bound import ExactElements
+
+    coarse = {"order": 2, "maxh": 0.5, "hp_levels": 1}
+    normals = np.array([[0.0, 0.0, 1.0], [0.8, 0.0, -0.6], [0.0, -0.6, -0.8]])
+    arms = np.array([0.8, 0.75, 0.85])
+    S = np.diag([-1.0, 1.0, 1.0])[[1, 0, 2]]  # a mirror and a swap of axes: not a rotation
+    image = normals @ S.T
+    frames = neck_frames(np.array([[0.3, 0.2, 1.0], [1.0, 0.1, -0.6], [-0.4, -0.6, -0.8]]))  # any in-plane frames
+    frames = frames - np.einsum("bij,bj->bi", frames, image)[:, :, None] * image[:, None, :]  # onto the image's planes
+    frames[:, 0] /= np.linalg.norm(frames[:, 0], axis=1)[:, None]
+    frames[:, 1] = np.cross(image, frames[:, 0])
+    elements = ExactElements((0.0,), coarse, modes=3)
+    elements.resistance(normals, arms, 0.0, neck_frames(normals))  # the FE of the body (or of its least image)
+    assert len(elements.ndof) == 1
+    mapped = elements.resistance(image, arms, 0.0, frames)
+    assert len(elements.ndof) == 1  # the image came from the cache
+    direct = E.cut_element(image, arms, (0.0,), frames=frames, **coarse)["R"][0.0]
+    assert np.max(np.abs(mapped - direct)) < 1e-2 * np.abs(direct).max()
+    assert np.max(np.abs(direct[1::3, 1::3])) > 0.05 * np.abs(direct).max()  # the dipoles are not nothing
+    monopoles = elements.resistance(image, arms, 0.0)
+    assert np.allclose(monopoles, mapped[::3, ::3], rtol=0, atol=1e-14)

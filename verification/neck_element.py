@@ -18,6 +18,14 @@ mean by :math:`R_{ij}`. Galerkin: :math:`a(u, v) = \int \nabla u \cdot \nabla v`
 matrix over its necks with the volume-mean temperature as its centre (:mod:`dem.network.necks`). ``R`` is
 dimensionless; the particle's, in K/W, is :math:`R / (\kappa r)`.
 
+**Dipoles.** With two directions :math:`t_1, t_2` in each face's plane (``frames``; the network's are
+:func:`dem.network.necks.neck_frames`, the bond's, the same for both particles of a neck), each face carries two
+more flux modes (:mod:`dem.network.necks`, "Flux modes"): the densities :math:`w_j (\xi - \bar\xi) / (a_j \int_{F_j}
+w_j)`, :math:`\xi = t_d \cdot x` and :math:`\bar\xi` its ``w``-weighted mean over the face, which carry no net heat
+and so no sink; the face's dipole temperature is read with the same function. ``R`` is then ``3 z x 3 z``, mode
+``3 b + d`` of face ``b`` (the monopole ``d = 0``), and the check is the uncut ball's caps again, a dipole on each
+(:func:`cap_ball_dipole_exact`, the series in :math:`P_l^1`).
+
 The FE: the body built in netgen's OCC kernel, meshed with ``maxh`` (in units of ``r``), refined geometrically toward
 every edge (``RefineHP``, where two faces or a face and the sphere meet: the flux is singular there), curved to order
 ``order`` and solved with H1 elements of that order: one sparse Cholesky factorisation with one vertex held (the
@@ -34,9 +42,11 @@ import numpy as np
 HP_FACTOR = 0.2  # the geometric refinement's ratio of each layer toward an edge to the last
 
 
-def _solve(shape, names: list, discs: list, betas: tuple, order: int, maxh: float, hp_levels: int) -> dict:
+def _solve(shape, names: list, discs: list, betas: tuple, order: int, maxh: float, hp_levels: int,
+           frames=None) -> dict:
     """``{beta: R}`` over the named boundaries ``names`` of an OCC solid; ``discs`` per name ``(n, l, a)``: the
-    neck's unit normal, plane distance and disc radius (units of ``r``; ignored for ``beta = 0``)."""
+    neck's unit normal, plane distance and disc radius (units of ``r``; only ``a`` is used for ``beta = 0``); with
+    ``frames`` (per name two unit vectors in its plane) three modes per face, the monopole and the two dipoles."""
     import ngsolve as ngs
     from netgen import occ
 
@@ -60,7 +70,7 @@ def _solve(shape, names: list, discs: list, betas: tuple, order: int, maxh: floa
     out = {}
     for beta in betas:
         loads = []
-        for name, disc in zip(names, discs):
+        for b, (name, disc) in enumerate(zip(names, discs)):
             if beta == 0:
                 w = ngs.CoefficientFunction(1.0)
             else:
@@ -75,6 +85,13 @@ def _solve(shape, names: list, discs: list, betas: tuple, order: int, maxh: floa
             load += (1.0 / total) * w * v * ngs.ds(definedon=face, bonus_intorder=8) - (1.0 / volume) * v * ngs.dx
             load.Assemble()
             loads.append(load.vec)
+            for t in ([] if frames is None else frames[b]):  # the dipoles: no net heat, no sink
+                xi = t[0] * ngs.x + t[1] * ngs.y + t[2] * ngs.z
+                mean = ngs.Integrate(w * xi, mesh, ngs.BND, definedon=face, order=2 * order + 8) / total
+                load = ngs.LinearForm(fes)
+                load += (1.0 / (disc[2] * total)) * w * (xi - mean) * v * ngs.ds(definedon=face, bonus_intorder=8)
+                load.Assemble()
+                loads.append(load.vec)
         z = len(loads)
         R = np.zeros((z, z))
         for j in range(z):
@@ -97,7 +114,8 @@ def _check(order: int, maxh: float, hp_levels: int, betas) -> None:
             raise ValueError(f"beta = {beta}: must be in [0, 0.5) (the flux density (a^2 - rho^2)^-beta)")
 
 
-def cut_element(normals, arms, betas=(0.0,), order: int = 3, maxh: float = 0.25, hp_levels: int = 2) -> dict:
+def cut_element(normals, arms, betas=(0.0,), order: int = 3, maxh: float = 0.25, hp_levels: int = 2,
+                frames=None) -> dict:
     """The flux elements of the unit ball cut by the planes ``normals[b] . x <= arms[b]``, every plane a neck face
     (module docstring).
 
@@ -115,12 +133,17 @@ def cut_element(normals, arms, betas=(0.0,), order: int = 3, maxh: float = 0.25,
         Largest element size before the refinement, in units of the radius.
     hp_levels : int
         Levels of geometric refinement toward the edges.
+    frames : array_like or None
+        (z, 2, 3) per plane two orthonormal vectors in it, the directions of its two dipole modes (module docstring;
+        :func:`dem.network.necks.neck_frames`); None: the monopoles alone.
 
     Returns
     -------
     dict
         ``R``: ``{beta: (z, z) array}`` (dimensionless; K/W after dividing by ``kappa r``, faces in the order of
-        the planes); ``volume``: the body's volume on the curved mesh (units of ``r^3``); ``ndof``.
+        the planes; with ``frames`` ``(3 z, 3 z)``, mode ``3 b + d`` of face ``b``: its monopole ``d = 0``, its
+        dipole along ``frames[b, d - 1]``); ``volume``: the body's volume on the curved mesh (units of ``r^3``);
+        ``ndof``.
 
     Raises
     ------
@@ -136,6 +159,8 @@ def cut_element(normals, arms, betas=(0.0,), order: int = 3, maxh: float = 0.25,
         raise ValueError("normals: must be unit vectors")
     if np.any(np.abs(arms) >= 1.0):
         raise ValueError(f"arms = {arms.tolist()}: each must be in (-1, 1) (a plane that cuts the unit ball)")
+    if frames is not None:
+        frames = _check_frames(frames, normals)
     from netgen import occ
 
     shape = occ.Sphere(occ.Pnt(0, 0, 0), 1.0)
@@ -159,12 +184,24 @@ def cut_element(normals, arms, betas=(0.0,), order: int = 3, maxh: float = 0.25,
     if hidden:
         raise ValueError(f"normals, arms: the planes {hidden} bound the cut body with no area (hidden necks)")
     discs = [(n, l, np.sqrt(1.0 - l * l)) for n, l in zip(normals, arms)]
-    return _solve(shape, names, discs, tuple(betas), order, maxh, hp_levels)
+    return _solve(shape, names, discs, tuple(betas), order, maxh, hp_levels, frames)
 
 
-def cap_ball(alpha: float, order: int = 3, maxh: float = 0.25, hp_levels: int = 2) -> dict:
+def _check_frames(frames, normals: np.ndarray) -> np.ndarray:
+    """``frames`` as a (z, 2, 3) array, refused unless each is two orthonormal vectors in its plane."""
+    frames = np.asarray(frames, dtype=float)
+    if frames.shape != (len(normals), 2, 3):
+        raise ValueError(f"frames: shape {frames.shape}; must be ({len(normals)}, 2, 3), two vectors per plane")
+    gram = np.einsum("bij,bkj->bik", frames, frames)
+    if np.any(np.abs(gram - np.eye(2)) > 1e-9) or np.any(np.abs(np.einsum("bij,bj->bi", frames, normals)) > 1e-9):
+        raise ValueError("frames: each must be two orthonormal vectors in its plane (normal to its normal)")
+    return frames
+
+
+def cap_ball(alpha: float, order: int = 3, maxh: float = 0.25, hp_levels: int = 2, dipoles: bool = False) -> dict:
     """The closed-form check of :func:`cut_element`'s solver: the uncut unit ball whose two polar caps (half angle
-    ``alpha``, rad) are the faces, uniform flux.
+    ``alpha``, rad) are the faces, uniform flux (:func:`cap_ball_exact`); with ``dipoles`` also the two dipoles
+    along x and y on each cap (:func:`cap_ball_dipole_exact`).
 
     Parameters
     ----------
@@ -172,6 +209,8 @@ def cap_ball(alpha: float, order: int = 3, maxh: float = 0.25, hp_levels: int = 
         The caps' half angle, rad, in (0, pi/2).
     order, maxh, hp_levels
         As :func:`cut_element`.
+    dipoles : bool
+        Three modes per cap (the monopole, the dipoles along x and y, the rim radius ``sin alpha`` for ``a``).
 
     Returns
     -------
@@ -195,7 +234,9 @@ def cap_ball(alpha: float, order: int = 3, maxh: float = 0.25, hp_levels: int = 
             face.name = "north"
         elif p[2] < -c + 1e-9:
             face.name = "south"
-    return _solve(shape, ["north", "south"], [None, None], (0.0,), order, maxh, hp_levels)
+    discs = [((0.0, 0.0, 1.0), c, np.sin(alpha)), ((0.0, 0.0, -1.0), c, np.sin(alpha))]
+    frames = [np.eye(3)[:2]] * 2 if dipoles else None
+    return _solve(shape, ["north", "south"], discs, (0.0,), order, maxh, hp_levels, frames)
 
 
 def cap_ball_exact(alpha: float, terms: int = 20000) -> float:
@@ -225,3 +266,54 @@ def cap_ball_exact(alpha: float, terms: int = 20000) -> float:
     l = np.arange(1, terms + 1, 2)
     d = eval_legendre(l - 1, c) - eval_legendre(l + 1, c)
     return 2.0 * np.sum(d * d / (l * (2 * l + 1))) / (2 * np.pi * (1 - c) ** 2)
+
+
+def cap_ball_dipole_exact(alpha: float, terms: int = 20000) -> tuple[float, float]:
+    r"""The x-dipoles of :func:`cap_ball` with ``dipoles``: ``(R_NN, R_NS)``, the north cap's dipole moment of the
+    temperature for a unit dipole on the north cap, and the south cap's, from the series in :math:`P_l^1`.
+
+    The flux :math:`g = \sin\theta \cos\varphi / (a W)` on the north cap (:math:`a = \sin\alpha`, ``W`` the cap's
+    area :math:`2 \pi (1 - \cos\alpha)`; the mean of ``x`` over the cap is 0) has the coefficients :math:`G_l =
+    I_l / (a W N_l)` on :math:`P_l^1(\mu) \cos\varphi`, :math:`I_l = \int_{\cos\alpha}^1 \sqrt{1 - \mu^2}
+    P_l^1(\mu) d\mu`, :math:`N_l = \frac{2}{2 l + 1} \frac{(l + 1)!}{(l - 1)!}`; the harmonic field
+    :math:`\sum_l G_l r^l P_l^1 \cos\varphi / l` has that normal flux, and its moment against ``g`` is
+
+    .. math::
+
+        R_{NN} = \sum_{l \ge 1} \frac{\pi I_l^2}{l N_l (a W)^2}, \qquad
+        R_{NS} = \sum_{l \ge 1} (-1)^{l + 1} \frac{\pi I_l^2}{l N_l (a W)^2}
+
+    (the south cap's :math:`I_l` is :math:`(-1)^{l+1} I_l`: :math:`P_l^1` has the parity of :math:`l + 1`). With
+    :math:`P_l^1 = -\sqrt{1 - \mu^2} P_l'` and parts, :math:`I_l = (1 - c^2) P_l(c) - 2 \int_c^1 \mu P_l`,
+    :math:`c = \cos\alpha`, where :math:`\mu P_l = ((l + 1) P_{l+1} + l P_{l-1}) / (2 l + 1)` and
+    :math:`\int_c^1 P_k = (P_{k-1}(c) - P_{k+1}(c)) / (2 k + 1)`.
+
+    Parameters
+    ----------
+    alpha : float
+        The caps' half angle, rad, in (0, pi/2).
+    terms : int
+        The series' last degree (its terms fall as ``l^-3``).
+
+    Returns
+    -------
+    tuple of float
+        ``(R_NN, R_NS)``, dimensionless (``kappa = r = 1``).
+    """
+    from scipy.special import eval_legendre
+
+    if not 0 < alpha < np.pi / 2:
+        raise ValueError(f"alpha = {alpha}: must be in (0, pi/2) rad")
+    c = np.cos(alpha)
+    l = np.arange(1, terms + 1)
+
+    def integral(k):  # int_c^1 P_k
+        return np.where(k == 0, 1.0 - c, (eval_legendre(np.maximum(k - 1, 0), c) - eval_legendre(k + 1, c))
+                        / (2 * k + 1))
+
+    moment = ((l + 1) * integral(l + 1) + l * integral(l - 1)) / (2 * l + 1)
+    I = (1 - c * c) * eval_legendre(l, c) - 2 * moment
+    N = 2.0 / (2 * l + 1) * l * (l + 1)
+    aW = np.sin(alpha) * 2 * np.pi * (1 - c)
+    term = np.pi * I * I / (l * N * aW ** 2)
+    return float(term.sum()), float(np.sum(np.where(l % 2 == 1, term, -term)))
