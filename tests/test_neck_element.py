@@ -152,3 +152,51 @@ def test_a_mirror_images_three_modes_are_the_cached_bodys_turned():
     assert np.max(np.abs(direct[1::3, 1::3])) > 0.05 * np.abs(direct).max()  # the dipoles are not nothing
     monopoles = elements.resistance(image, arms, 0.0)
     assert np.allclose(monopoles, mapped[::3, ::3], rtol=0, atol=1e-14)
+
+
+def _chain_flow(axis, spheres: int, elements, modes: int):
+    """The heat flow across the period (W, per 1 K per period along z) of a straight periodic chain of unit spheres
+    overlapping by 0.3 r along ``axis`` (in the x-z plane), ``spheres`` per period, with exact elements; and the
+    necks' nodes."""
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.particles import Material, Particles
+    from dem.geometry.periodic import PeriodicBox
+    from dem.laws.conductance import ConductanceSpec
+    from dem.network.necks import neck_network, steady_necks
+
+    d = 1.7
+    u = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    period = np.array([spheres * d * u[0] or 4.0, 4.0, spheres * d * u[2]])
+    box = PeriodicBox(period, drop=[0.0, 0.0, 1.0])
+    x = np.arange(spheres)[:, None] * d * u + 0.5
+    particles = Particles.from_arrays(x, np.ones(spheres), np.zeros(spheres),
+                                      materials=(Material(1.0, 1.0, 1.0, "unit"),))
+    spec = ConductanceSpec(law="shared-body", neck="union", nodes="necks")
+    net = neck_network(spec, particles, find_bonds(particles, contact=spec.contact, box=box), box=box,
+                       elements=elements.builder(0.25, modes))
+    assert len(net.live) == spheres  # the chain's own bonds: the parallel chains do not touch
+    res = steady_necks(net)
+    return res.periodic_heat_flow, res.T_necks
+
+
+def test_a_chain_across_the_gradient_carries_its_heat_along_itself_and_its_dipoles_nothing():
+    """A straight chain tilted 45 degrees from the drop (along z) in the x-z plane: the drop's transverse part drives
+    nothing in the chain (its bodies are symmetric about its axis), so the dipoles stay at 0, the three modes carry
+    what one does, and the heat flows along the chain: as much across the period along x as along z, a third of what
+    the same chain upright carries (three bonds per period against one)."""
+    pytest.importorskip("ngsolve")
+    from verification.neck_node_bound import ExactElements
+
+    coarse = {"order": 2, "maxh": 0.3, "hp_levels": 1}
+    elements = ExactElements((0.25,), coarse, modes=3)
+    tilted, necks = _chain_flow([1.0, 0.0, 1.0], 3, elements, 3)
+    one, _ = _chain_flow([1.0, 0.0, 1.0], 3, elements, 1)
+    along, _ = _chain_flow([0.0, 0.0, 1.0], 1, elements, 1)
+    assert len(elements.ndof) == 2  # the tilted body and the upright one
+    # (the coarse mesh couples a symmetric body's monopole and dipoles by ~1e-3 of its R)
+    assert np.max(np.abs(necks.reshape(-1, 3)[:, 1:])) < 1e-3 * np.ptp(necks.reshape(-1, 3)[:, 0])
+    assert tilted[2] == pytest.approx(one[2], rel=1e-5)
+    assert tilted[0] == pytest.approx(tilted[2], rel=1e-9) and abs(tilted[1]) < 1e-12 * tilted[2]
+    # 1 K per period along z: each of the tilted chain's three bonds takes 1/3 K, the upright chain's one bond 1 K
+    # (another mesh of the body turned: agreement to the discretisation)
+    assert 3 * tilted[2] == pytest.approx(along[2], rel=2e-3)
