@@ -264,3 +264,24 @@ def test_the_current_refuses_dipoles():
     net = neck_network(NECKS, particles, bonds, box=box, elements=_hook(_uncoupled))
     with pytest.raises(ValueError, match="neck_current: modes = 3"):
         neck_current(net, (), Electrodes((), (), np.zeros(0), np.zeros(0)))
+
+
+def test_heat_in_is_heat_out_with_coupled_dipoles_walls_fixed_particles_and_sources():
+    """Steady: the walls', the fixed particle's and the sources' flows sum to zero and every neck passes on what it
+    takes; transient: the heat stored is the heat that came in (the dipoles' rows hold no heat and carry none)."""
+    one = _random_packing(heat=True)
+    walls = (Wall("hot", point=[0.0, 0.0, 0.2e-3], normal=[0.0, 0.0, 1.0], temperature=1.0),  # _random_packing's
+             Wall("cold", point=[0.0, 0.0, 3.8e-3], normal=[0.0, 0.0, -1.0], temperature=0.0))
+    net = neck_network(NECKS, one.particles, one.bonds, walls=walls, elements=_hook(_coupled))
+    res = steady_necks(net)
+    p = net.particles
+    into = np.concatenate([res.fixed_flow[p.fixed], -res.wall_flow, p.heat])
+    assert abs(into.sum()) < 1e-10 * np.abs(into).sum() and res.energy_error < 1e-10
+    Q = net.end_flows(np.concatenate([res.T, res.T_necks]))
+    m = len(net.live)
+    assert np.max(np.abs(Q[:m] + Q[m:2 * m])) < 1e-10 * np.abs(Q).max()
+    assert np.max(np.abs(res.T_necks.reshape(-1, MODES)[:, 1:])) > 1e-3  # the dipoles did move
+    out = integrate(NeckHeat(net), "implicit", 2e-6, 4e-5)
+    stored = float(p.capacity @ (out.T - p.temperature))
+    assert abs(stored - sum(out.heat_in.values())) < 1e-12 * sum(abs(v) for v in out.heat_in.values())
+    assert out.heat_in["walls"] != 0.0 and out.energy_error < 1e-12

@@ -64,7 +64,7 @@ connected group is 1 there, 0 on the dipoles); the periodic jump and a wall's te
 wall's dipole moments are 0 (it is isothermal). The heat flows (:meth:`NeckNetwork.end_flows`, the flow across the
 period, ``k_eff``) are the monopoles'; a dipole's row in ``entries`` has the bond end :data:`DIPOLE`. The law's
 elements have ``modes = 1``; ``modes = 3`` comes from elements built elsewhere through the ``elements`` hook of
-:func:`neck_network` (:mod:`verification.neck_node_bound`'s exact ones). The current takes ``modes = 1`` only (the rows
+:func:`neck_network` (``python -m verification neck-node-bound``'s exact ones). The current takes ``modes = 1`` only (the rows
 of ``E`` do not sum to zero on the dipoles: no graph's Laplacian).
 
 **Transient.** Neck nodes hold no heat: the capacity matrix is :math:`M = \mathrm{diag}(C_1 \dots C_n, 0 \dots 0)`,
@@ -134,7 +134,7 @@ from dem.network.current import CurrentFlow, Electrodes, kirchhoff
 from dem.network.heat import BalanceScales, solve_steady
 from dem.network.linsolve import make_solver
 
-DIPOLE = -2  # the bond end of a dipole mode's row or column in NeckNetwork.entries: it carries no net heat
+DIPOLE = -2  #: the bond end of a dipole mode's row or column in NeckNetwork.entries (it carries no net heat)
 
 
 @dataclass
