@@ -17,9 +17,9 @@ neck as well (:mod:`dem.network.necks`, "Flux modes": the flux may tilt across t
 particles, so the argument holds as it stands) the network carries three numbers per neck.
 
 Cells: simple, body- and face-centred cubic lattices of equal spheres overlapping by ``h``
-(``python -m fem_neck lattice --neck union``), and the random mirror packing of the densification study at
-:math:`\phi` 0.6 (:func:`verification.packings.union_packing`, seed 1: 32 spheres, radii within 15 %), whose FE is
-that study's (gap 2e-3). One element FE serves every body congruent to another under the cube's symmetries (a
+(``python -m fem_neck lattice --neck union``), and the random mirror packings of the densification study at
+:math:`\phi` 0.6, 0.8 and 0.95 (:func:`verification.packings.union_packing`, seeds 1, 2, 3: 32 spheres, radii within
+15 %), whose FE is that study's (gap 2e-3). One element FE serves every body congruent to another under the cube's symmetries (a
 lattice's translates, a mirror packing's images; :class:`ExactElements`). The elements are P3 on a mesh refined
 toward every edge (:data:`DISC`); Galerkin's resistance lies below the exact one, so a coarser element
 (:data:`COARSE`) gives a network above the finer one's, and their difference is the column ``element step``: what is
@@ -44,7 +44,6 @@ OVERLAPS = {"sc": (0.05, 0.2, 0.3), "bcc": (0.05, 0.2, 0.3), "fcc": (0.05, 0.2, 
 QUICK_OVERLAPS = {"sc": (0.3,)}
 BETAS = (0.0, 0.25)  # the flux profiles' exponents
 COLUMNS = ((0.0, 1), (0.25, 1), (0.25, 3))  # (profile, flux modes per neck) of the study's networks
-RANDOM = ((1, 0.6),)  # (seed, phi aimed at) of the union mirror packings (verification.densification's)
 DISC = {"order": 3, "maxh": 0.25, "hp_levels": 2}  # the element FE (verification.neck_element.cut_element)
 COARSE = {"order": 2, "maxh": 0.3, "hp_levels": 1}
 RTOL, QUICK_RTOL = 1e-3, 1e-2  # the periodic-cell FE's gap (the densification study's)
@@ -223,7 +222,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
     dict
         ``title``, ``markdown``, ``summary``, ``figures`` and ``targets``.
     """
-    from verification.densification import RANDOM_RTOL, RANDOM_SPHERES
+    from verification.densification import RANDOM, RANDOM_RTOL, RANDOM_SPHERES
     from verification.packings import union_packing
 
     out_dir = pathlib.Path(out_dir)
