@@ -58,14 +58,14 @@ exchanges heat with the monopoles only) and its element is
 
 its local node ``modes p + d`` mode ``d`` of end ``p``, then the centre. Mode ``d`` of live pair bond ``b`` is
 node ``n + modes b + d``, shared by the bond's two particles: what flows into ``i`` through it leaves ``j``
-(Kirchhoff at the node) and its temperature moment is one value on both sides. A uniform
-change of temperature moves the centres and the monopoles and leaves the dipoles' moments (the kernel of ``A`` on a
-connected group is 1 there, 0 on the dipoles); the periodic jump and a wall's temperature act on the monopoles, a
-wall's dipole moments are 0 (it is isothermal). The heat flows (:meth:`NeckNetwork.end_flows`, the flow across the
-period, ``k_eff``) are the monopoles'; a dipole's row in ``entries`` has the bond end :data:`DIPOLE`. The law's
-elements have ``modes = 1``; ``modes = 3`` comes from elements built elsewhere through the ``elements`` hook of
-:func:`neck_network` (``python -m verification neck-node-bound``'s exact ones). The current takes ``modes = 1`` only (the rows
-of ``E`` do not sum to zero on the dipoles: no graph's Laplacian).
+(Kirchhoff at the node) and its temperature moment is one value on both sides. A uniform change of temperature moves
+the centres and the monopoles and leaves the dipoles' moments (the kernel of ``A`` on a connected group is 1 there, 0
+on the dipoles); the periodic jump and a wall's temperature act on the monopoles, a wall's dipole moments are 0 (it
+is isothermal). The heat flows (:meth:`NeckNetwork.end_flows`, the flow across the period, ``k_eff``) are the
+monopoles'; a dipole's row in ``entries`` has the bond end :data:`DIPOLE`. The law's elements have ``modes = 1``;
+``modes = 3`` comes from elements built elsewhere through the ``elements`` hook of :func:`neck_network` (``python -m
+verification neck-node-bound``'s exact ones). The current takes ``modes = 1`` only (the rows of ``E`` do not sum to
+zero on the dipoles: no graph's Laplacian).
 
 **Transient.** Neck nodes hold no heat: the capacity matrix is :math:`M = \mathrm{diag}(C_1 \dots C_n, 0 \dots 0)`,
 only semidefinite. The :math:`\theta` scheme :math:`(M/\Delta t + \theta A) T^+ = (M/\Delta t - (1 - \theta) A) T + r`
