@@ -53,7 +53,7 @@ import numpy as np
 
 from dem.engines.handover import Handover
 from dem.geometry.bonds import find_bonds
-from dem.laws.conductance import ConductanceSpec
+from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources
@@ -213,10 +213,7 @@ class ContactThermalModel:
             The step (s), > 0.
         """
         if self.spec.nodes == "necks":  # the bonds alone: the network takes the halves of its elements
-            now = self._particles_now(mechanics, mechanics.state.radius)
-            bonds = find_bonds(now, self._walls_now(mechanics), self.spec.contact, self.spec.out_of_range,
-                               pairs=mechanics.contacts()[:2], box=self.box)
-            self.necks = net = self.neck_heat(mechanics, bonds)
+            self.necks = net = self.neck_heat(mechanics, self._neck_bonds(mechanics)[2])
             self.assemblies += 1
             T_F = net.initial  # the free centres' temperatures now, the necks' where their rows hold
         else:
@@ -240,6 +237,13 @@ class ContactThermalModel:
         T_F = T_F[:len(self.free)]  # the free centres (then, with a node per neck, the necks)
         self.rate[self.free] = (T_F - self.T[self.free]) / dt
         self.T[self.free] = T_F
+
+    def _neck_bonds(self, mechanics) -> tuple:
+        """``(now, walls, bonds)``: the particles now, the thermal walls and the union bonds of the contacts of
+        ``mechanics``, without conductances (a node per neck takes the halves of its elements)."""
+        now, walls = self._particles_now(mechanics, mechanics.state.radius), self._walls_now(mechanics)
+        return now, walls, find_bonds(now, walls, self.spec.contact, self.spec.out_of_range,
+                                      pairs=mechanics.contacts()[:2], box=self.box)
 
     def neck_heat(self, mechanics, bonds) -> NeckHeat:
         r"""The network with a node per neck of ``bonds`` (module docstring), at the temperatures ``T``.
@@ -283,13 +287,17 @@ class ContactThermalModel:
             ``{"neck_radius": m, "conductance": W/K, "heat_flow": W}``, arrays of shape (M,), and the heat flow into
             each particle (W), shape (N,).
         """
-        bonds, K_pairs, K_walls = self.bonds(mechanics)
         T = self.local(mechanics, self.T)
         n = len(T)
         if self.spec.nodes == "necks":  # the flows through the necks, solved where their rows hold at T
+            now, walls, bonds = self._neck_bonds(mechanics)
             heat = self.neck_heat(mechanics, bonds)
+            # the one-node law's conductances from the halves the elements are of (not computed again)
+            K_pairs, K_walls = bond_conductances(self.spec, now, bonds, box=self.box, walls=tuple(walls),
+                                                 union=heat.net.union)
             q, q_walls = neck_flows(heat.net, heat.nodes(heat.initial))[:2]
         else:
+            bonds, K_pairs, K_walls = self.bonds(mechanics)
             jump = bonds.shifts @ self.box.drop if self.box is not None else 0.0
             q = K_pairs * (T[bonds.i] - T[bonds.j] + jump)
             wall_T = np.array([self.walls[k].temperature for k in self.thermal_walls], dtype=float)
