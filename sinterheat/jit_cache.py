@@ -30,7 +30,7 @@ import tempfile
 import warnings
 
 PACKAGE = pathlib.Path(__file__).resolve().parent  # sinterheat/: the cache and the remembered key live here
-ROOT = PACKAGE.parent  # the folder that holds the project's packages
+ROOT = PACKAGE.parent  #: the folder that holds the project's packages
 PROJECT_PACKAGES = ("dem", "fem_neck", "sinterheat")  # the project's top-level packages, side by side in ROOT
 
 

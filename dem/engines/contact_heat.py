@@ -112,7 +112,7 @@ class ContactThermalModel:
         self.assemblies = self.refreshes = 0
         self.startup_steps = 0  # Crank-Nicolson steps taken as implicit Euler steps (module docstring)
         self.handover = Handover(spec, particles.radius)
-        self._kept: dict = {}  # what the contacts of one configuration give (:meth:`_configuration`)
+        self._kept: dict = {}  # what the contacts of one configuration give (``_configuration``)
 
     def handing_over(self, mechanics) -> bool:
         """Whether this run hands particles over to the union (:meth:`dem.engines.handover.Handover.applies`; not on
@@ -134,7 +134,7 @@ class ContactThermalModel:
         """Bonds and conductances ``(bonds, K_pairs, K_walls)`` of the contacts of ``mechanics`` now.
 
         Handing over (:meth:`handing_over`), the bonds as :meth:`dem.engines.handover.Handover.bonds` reads them.
-        Computed once per configuration (:meth:`_configuration`); handing over, once per state of the hand-overs too
+        Computed once per configuration (``_configuration``); handing over, once per state of the hand-overs too
         (an update is computed each time: it advances them).
 
         Parameters
@@ -174,7 +174,7 @@ class ContactThermalModel:
     def _configuration(self, mechanics) -> dict:
         """What the contacts of ``mechanics`` give where it stands now: the particles now (``"now"``) and the
         thermal walls (``"walls"``), and the bonds and conductances (``"bonds"``, :meth:`bonds`) and the neck-node
-        network (``"necks"``, :meth:`_neck_network`) once asked for; computed once and kept until the mechanics takes
+        network (``"necks"``, ``_neck_network``) once asked for; computed once and kept until the mechanics takes
         a step (or the law is another), so that a thermal step and the snapshots at the end of its interval share
         them (the temperatures of ``"now"``, which the step changes, are read by none of them)."""
         kept = self._kept
@@ -270,7 +270,7 @@ class ContactThermalModel:
 
     def _neck_network(self, mechanics) -> NeckNetwork:
         """The network with a node per neck of the union bonds of the contacts of ``mechanics`` now (module
-        docstring), assembled once per configuration (:meth:`_configuration`)."""
+        docstring), assembled once per configuration (``_configuration``)."""
         kept = self._configuration(mechanics)
         if "necks" not in kept:
             now, walls = kept["now"], kept["walls"]
