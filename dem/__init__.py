@@ -17,7 +17,7 @@ if sys.argv[:1] == ["-m"]:  # imported by `python -m dem`, before its __main__: 
 
     hold("python -m dem")
 
-from dem import jit_cache  # noqa: E402
+from sinterheat import jit_cache  # noqa: E402
 
 jit_cache.configure()  # before numba is imported: compiled kernels cached per version of their source
 

@@ -17,7 +17,7 @@ from dem.engines.staggered.engine import StaggeredEngine
 from dem.engines.verlet.engine import VerletEngine
 from dem.geometry import handover
 from dem.geometry.handover import HANDOVER_STEPS, advance, solid_radii, weights
-from dem.network.heat import Network, boundary_heat_flow, steady
+from dem.network.heat import Network, bonds_and_conductances, boundary_heat_flow, steady
 from fem_neck.geometry.union import angular_radius, cut_spheres, lens, necks_meet
 
 NONE = (np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0))  # no walls
@@ -229,6 +229,27 @@ def test_a_resumed_run_goes_on_handing_over_bit_for_bit():
     cut = cut_spheres(np.where(grown, th.handover.solid_radius, mech.state.radius), bonds.i, bonds.j,
                       bonds.vectors(mech.state.x, th.box)).volume
     assert np.any(grown) and np.max(np.abs(cut[grown] / (4.0 / 3.0 * np.pi * mech.state.radius[grown] ** 3) - 1)) < 1e-9
+
+
+def test_a_read_at_one_configuration_follows_the_state_of_the_handovers():
+    """The bonds a moving run keeps for its configuration (the snapshots at the end of a step share one read) are
+    read again where the hand-overs' state is another: with no steps the pair reading, with the run's own steps its
+    reading again, as a read from scratch gives it; a second read in one state is the one kept."""
+    engine = VerletEngine(parse_scene(squeezed(0.003)))
+    engine.run()
+    th, mech = engine.thermal, engine.mechanics
+    own = th.handover.steps.copy()
+    assert np.any(own > 0)
+    first = th.bonds(mech)
+    assert th.bonds(mech) is first
+    th.handover.steps = np.zeros_like(own)
+    pair = th.bonds(mech)
+    now, walls = th._particles_now(mech, mech.state.radius), th._walls_now(mech)
+    scratch = bonds_and_conductances(now, walls, th.spec, pairs=mech.contacts()[:2], box=th.box)
+    assert all(np.array_equal(a, b) for a, b in zip(pair[1:], scratch[1:])) and not np.array_equal(pair[1], first[1])
+    th.handover.steps = own
+    again = th.bonds(mech)
+    assert again is not first and all(np.array_equal(a, b) for a, b in zip(again[1:], first[1:]))
 
 
 def test_the_timeseries_gives_k_eff_on_pair_necks_beside_it():

@@ -1,5 +1,6 @@
 """The compiled kernels' cache follows every module whose code or constants reach compiled code (numba alone follows
-only a function's own file, so a kernel would keep its callees' old code and the constants it was compiled with)."""
+only a function's own file, so a kernel would keep its callees' old code and the constants it was compiled with), in
+dem and fem_neck alike, whichever of them a process imports."""
 
 import importlib
 import os
@@ -12,7 +13,7 @@ import tempfile
 
 import pytest
 
-from dem import jit_cache
+from sinterheat import jit_cache
 
 LUDING_MATERIAL = "dem.laws.contact.luding"  # the module that holds the parameter indices of the Luding law
 ZOHDI_MATERIAL = "dem.laws.contact.zohdi"
@@ -20,16 +21,15 @@ ZOHDI_MATERIAL = "dem.laws.contact.zohdi"
 
 @pytest.fixture
 def copy(tmp_path):
-    """A copy of the project's packages, to edit."""
-    root = jit_cache.PACKAGE.parent
+    """A copy of the project's packages, to edit: the folder that holds them."""
     for name in jit_cache.PROJECT_PACKAGES:
-        shutil.copytree(root / name, tmp_path / name, ignore=shutil.ignore_patterns("__pycache__"))
-    return tmp_path / "dem"
+        shutil.copytree(jit_cache.ROOT / name, tmp_path / name, ignore=shutil.ignore_patterns("__pycache__"))
+    return tmp_path
 
 
 def _in_copy(copy, module):
     """The file of ``module`` (a dotted name) in the copy."""
-    return copy / pathlib.Path(importlib.import_module(module).__file__).relative_to(jit_cache.PACKAGE)
+    return copy / pathlib.Path(importlib.import_module(module).__file__).relative_to(jit_cache.ROOT)
 
 
 def _edit(path, old, new):
@@ -39,11 +39,14 @@ def _edit(path, old, new):
 
 
 def test_the_compiled_modules_are_found_from_their_imports():
-    names = {str(p.relative_to(jit_cache.PACKAGE.parent)) for p in jit_cache.compiled_sources()}
+    names = {str(p.relative_to(jit_cache.ROOT)) for p in jit_cache.compiled_sources()}
     # the loop, its contact law's kernels, and the module whose parameter indices the kernels compile in
     assert {"dem/engines/verlet/loop.py", "dem/laws/contact/luding.py", "dem/laws/contact/zohdi.py",
             "dem/engines/staggered/kernels.py", "dem/network/gauss_seidel.py"} <= names
-    assert "dem/cli/scenes.py" not in names and "dem/__init__.py" not in names
+    # fem_neck's kernels and the module whose functions the neck kernels compile
+    assert {"fem_neck/geometry/neck_kernels.py", "fem_neck/geometry/cut_kernels.py", "fem_neck/geometry/__init__.py",
+            "fem_neck/dual.py"} <= names
+    assert "dem/cli/scenes.py" not in names and "dem/__init__.py" not in names and "fem_neck/cli/fit.py" not in names
 
 
 def test_swapping_two_parameter_indices_changes_the_key(copy):
@@ -71,15 +74,23 @@ def test_the_loops_copied_into_the_cache_keep_the_key(copy):
     """dem.engines.compiled writes a copy of the loops for more than one thread into the cache folder, inside the
     package: the key of that folder must not follow them (else every threaded run would compile afresh)."""
     before = jit_cache.remembered_digest(copy)
-    copied = copy / "__pycache__" / f"numba-{before}" / "threaded" / "contact_forces.py"
+    copied = copy / "sinterheat" / "__pycache__" / f"numba-{before}" / "threaded" / "contact_forces.py"
     copied.parent.mkdir(parents=True)
-    copied.write_text((copy / "engines" / "contact_forces.py").read_text())
+    copied.write_text((copy / "dem" / "engines" / "contact_forces.py").read_text())
     assert jit_cache.digest(copy) == jit_cache.remembered_digest(copy) == before
+
+
+def test_an_edit_to_what_fem_necks_kernels_call_changes_the_key(copy):
+    """The neck kernels compile functions of fem_neck.geometry (numba's own cache would keep their old code)."""
+    before = jit_cache.digest(copy)
+    path = copy / "fem_neck" / "geometry" / "__init__.py"
+    path.write_text(path.read_text() + "\n# an edit\n")
+    assert jit_cache.digest(copy) != before
 
 
 def test_the_remembered_key_follows_an_edit(copy):
     first = jit_cache.remembered_digest(copy)
-    assert (copy / "__pycache__" / "jit_digest.json").exists()
+    assert (copy / "sinterheat" / "__pycache__" / "jit_digest.json").exists()
     assert jit_cache.remembered_digest(copy) == first == jit_cache.digest(copy)
     path = next(p for p in jit_cache.compiled_sources(copy) if p.name == "neighbours.py")
     path.write_text(path.read_text() + "\n# an edit\n")
@@ -104,6 +115,19 @@ def test_import_points_numba_at_the_digests_folder(tmp_path):
     env["NUMBA_CACHE_DIR"] = str(tmp_path / folder)  # a child process of a configured one: the same folder
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
     assert out.split() == [str(tmp_path / folder)] * 2
+
+
+def test_fem_neck_alone_points_numba_at_the_digests_folder():
+    """A script that uses fem_neck's compiled kernels without dem (an FE study) gets the same cache folder, not numba's
+    default one beside each source file, which an edit to a module the kernel calls would leave stale."""
+    folder = f"numba-{jit_cache.digest()}"
+    code = ("import os, sys; import fem_neck.geometry.neck_kernels; from numba.core import config; "
+            "print(os.environ['NUMBA_CACHE_DIR'], config.CACHE_DIR, 'dem' in sys.modules)")
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
+    cache_env, cache_dir, dem_loaded = out.split()
+    assert dem_loaded == "False"
+    assert [pathlib.Path(cache_env).name, pathlib.Path(cache_dir).name] == [folder, folder]
 
 
 def test_a_folder_the_user_chose_that_cannot_be_written_is_named_and_left(tmp_path):

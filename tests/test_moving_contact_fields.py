@@ -5,6 +5,7 @@ contacts' own balance."""
 import math
 
 import meshio
+import pytest
 import numpy as np
 
 from dem import run
@@ -39,3 +40,25 @@ def test_contacts_carry_neck_conductance_and_heat_flow(tmp_path):
     assert above.any() and (~above).any()
     np.testing.assert_allclose(q[above], balance[above], rtol=1e-10, atol=1e-15)
     assert np.all(q[~above] > balance[~above])  # the floor at 150 heats the bottom layer (at 80 and up)
+
+
+@pytest.mark.parametrize("nodes", ["particles", "necks"])
+def test_a_snapshot_at_the_end_of_a_thermal_step_reads_its_bonds(tmp_path, monkeypatch, nodes):
+    """The shared-body law on the union: the cut spheres' halves (union_halves, the costly part of its conductances)
+    are computed once per thermal step, and the snapshots taken at its end (particles and contacts: two reads) reuse
+    them; only the snapshot at the start, before any step, computes its own."""
+    import dem.laws.conductance
+    import dem.network.necks
+
+    calls = []
+    for module in (dem.laws.conductance, dem.network.necks):
+        original = module.union_halves
+        monkeypatch.setattr(module, "union_halves", lambda *a, _f=original, **k: calls.append(1) or _f(*a, **k))
+    doc = pile(t_end=0.002, law="shared-body", thermal_interval=2.5e-4)
+    doc["conductance"].update(neck="union", nodes=nodes)
+    doc["output"] = {"interval": 2.5e-4, "vtu_interval": 2.5e-4}
+    res = run(parse_scene(doc), out=tmp_path / "run")
+    th = res.engine.thermal
+    snapshots = len(list((tmp_path / "run").glob("particles_*.vtu")))
+    assert snapshots == 9 and th.assemblies + th.refreshes == 8
+    assert len(calls) == 8 + 1

@@ -12,11 +12,11 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 PACKAGES = ("dem", "fem_neck", "sinterheat", "verification", "benchmarks")
 
 # The folders (and top-level modules) of dem, lowest first: each may import only from those before it (and from
-# itself). The compiled-code cache, the memory estimate and the MPI plumbing (parallel: communicator, reductions,
-# halo exchange, PETSc) know nothing of the rest, geometry and output only of them; the laws use geometry; the
-# networks both; a scene is parsed into all of these; the engines run scenes; the driver runs engines; the command
-# line and the package's front door come last.
-DEM_LAYERS = (("jit_cache", "memory", "parallel"), ("geometry", "output"), ("laws",), ("network",), ("scene",), ("engines",),
+# itself). The memory estimate and the MPI plumbing (parallel: communicator, reductions, halo exchange, PETSc) know
+# nothing of the rest, geometry and output only of them; the laws use geometry; the networks both; a scene is parsed
+# into all of these; the engines run scenes; the driver runs engines; the command line and the package's front door
+# come last. (The compiled-code cache is the shared plumbing's: sinterheat.jit_cache.)
+DEM_LAYERS = (("memory", "parallel"), ("geometry", "output"), ("laws",), ("network",), ("scene",), ("engines",),
               ("driver",), ("cli", "__main__", "__init__"))
 FEM_NECK_FOR_DEM = ("fem_neck.geometry", "fem_neck.law")
 MAX_PARAMETERS = 16

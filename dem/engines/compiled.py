@@ -10,7 +10,8 @@ For more than one thread, :func:`module` with ``threaded=True`` is a copy of the
 False`` made true: a compile-time constant that turns its loops over particles and pairs into numba's parallel loops
 (numba drops the branches it rules out, so the one-thread loop carries nothing of the threaded one), and its imports
 of the other templates pointed at their threaded copies. The copies live in the cache folder of
-:mod:`dem.jit_cache`, named by the digest of the sources they come from, so an edit to a template makes new ones.
+:mod:`sinterheat.jit_cache`, named by the digest of the sources they come from, so an edit to a template makes new
+ones.
 Which of the two a run gets is decided when the engine is built (:func:`sinterheat.threads.count`), never inside the
 loop.
 """
@@ -36,8 +37,8 @@ def _copy_name(template: str) -> str:
 
 
 def _folder() -> pathlib.Path:
-    """Where the threaded copies live: in numba's cache folder, which :func:`dem.jit_cache.configure` named by the
-    digest of the sources."""
+    """Where the threaded copies live: in numba's cache folder, which :func:`sinterheat.jit_cache.configure` named by
+    the digest of the sources."""
     from numba.core import config
 
     return pathlib.Path(config.CACHE_DIR) / "threaded"

@@ -53,12 +53,12 @@ import numpy as np
 
 from dem.engines.handover import Handover
 from dem.geometry.bonds import find_bonds
-from dem.laws.conductance import ConductanceSpec
+from dem.laws.conductance import ConductanceSpec, bond_conductances
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources
 from dem.network.heat import Network, bonds_and_conductances, surely_stiff, theta_step
-from dem.network.necks import NeckHeat, neck_flows, neck_network
+from dem.network.necks import NeckHeat, NeckNetwork, neck_flows, neck_network
 
 
 class ContactThermalModel:
@@ -112,6 +112,7 @@ class ContactThermalModel:
         self.assemblies = self.refreshes = 0
         self.startup_steps = 0  # Crank-Nicolson steps taken as implicit Euler steps (module docstring)
         self.handover = Handover(spec, particles.radius)
+        self._kept: dict = {}  # what the contacts of one configuration give (``_configuration``)
 
     def handing_over(self, mechanics) -> bool:
         """Whether this run hands particles over to the union (:meth:`dem.engines.handover.Handover.applies`; not on
@@ -133,6 +134,8 @@ class ContactThermalModel:
         """Bonds and conductances ``(bonds, K_pairs, K_walls)`` of the contacts of ``mechanics`` now.
 
         Handing over (:meth:`handing_over`), the bonds as :meth:`dem.engines.handover.Handover.bonds` reads them.
+        Computed once per configuration (``_configuration``); handing over, once per state of the hand-overs too
+        (an update is computed each time: it advances them).
 
         Parameters
         ----------
@@ -148,11 +151,38 @@ class ContactThermalModel:
             The bonds (:func:`dem.network.heat.bonds_and_conductances`), the pair conductances (W/K) and the
             wall conductances (W/K).
         """
-        i, j = mechanics.contacts()[:2]
-        now, walls = self._particles_now(mechanics, mechanics.state.radius), self._walls_now(mechanics)
-        if not self.handing_over(mechanics):
-            return bonds_and_conductances(now, walls, self.spec, pairs=(i, j), box=self.box)
-        return self.handover.bonds(now, walls, (i, j), self.box, update)
+        kept = self._configuration(mechanics)
+        now, walls, pairs = kept["now"], kept["walls"], mechanics.contacts()[:2]
+        if self.handing_over(mechanics):  # the hand-overs' state is read too: a read is kept for as long as it holds
+            handover = self.handover
+            if update:  # (advanced here: a read kept before is of the old state)
+                kept.pop("bonds", None)
+                return handover.bonds(now, walls, pairs, self.box, True)
+            state = (handover.steps, handover.solid_radius)
+            if "bonds" not in kept or not all(map(np.array_equal, kept["handover"], state)):
+                kept["bonds"] = handover.bonds(now, walls, pairs, self.box, False)
+                kept["handover"] = tuple(a.copy() for a in state)
+        elif "bonds" not in kept:
+            if self.spec.nodes == "necks":  # the one-node law's from the halves the elements are of
+                net = self._neck_network(mechanics)
+                kept["bonds"] = (net.bonds, *bond_conductances(self.spec, now, net.bonds, box=self.box,
+                                                               walls=tuple(walls), union=net.union))
+            else:
+                kept["bonds"] = bonds_and_conductances(now, walls, self.spec, pairs=pairs, box=self.box)
+        return kept["bonds"]
+
+    def _configuration(self, mechanics) -> dict:
+        """What the contacts of ``mechanics`` give where it stands now: the particles now (``"now"``) and the
+        thermal walls (``"walls"``), and the bonds and conductances (``"bonds"``, :meth:`bonds`) and the neck-node
+        network (``"necks"``, ``_neck_network``) once asked for; computed once and kept until the mechanics takes
+        a step (or the law is another), so that a thermal step and the snapshots at the end of its interval share
+        them (the temperatures of ``"now"``, which the step changes, are read by none of them)."""
+        kept = self._kept
+        if kept.get("mechanics") is not mechanics or kept["steps"] != mechanics.steps or kept["spec"] is not self.spec:
+            self._kept = kept = {"mechanics": mechanics, "steps": mechanics.steps, "spec": self.spec,
+                                 "now": self._particles_now(mechanics, mechanics.state.radius),
+                                 "walls": self._walls_now(mechanics)}
+        return kept
 
     def local(self, mechanics, values: np.ndarray) -> np.ndarray:
         """``values`` (per particle of the scene) for the particles ``mechanics`` holds: all of them, in order
@@ -213,10 +243,7 @@ class ContactThermalModel:
             The step (s), > 0.
         """
         if self.spec.nodes == "necks":  # the bonds alone: the network takes the halves of its elements
-            now = self._particles_now(mechanics, mechanics.state.radius)
-            bonds = find_bonds(now, self._walls_now(mechanics), self.spec.contact, self.spec.out_of_range,
-                               pairs=mechanics.contacts()[:2], box=self.box)
-            self.necks = net = self.neck_heat(mechanics, bonds)
+            self.necks = net = self.neck_heat(mechanics)
             self.assemblies += 1
             T_F = net.initial  # the free centres' temperatures now, the necks' where their rows hold
         else:
@@ -241,25 +268,34 @@ class ContactThermalModel:
         self.rate[self.free] = (T_F - self.T[self.free]) / dt
         self.T[self.free] = T_F
 
-    def neck_heat(self, mechanics, bonds) -> NeckHeat:
-        r"""The network with a node per neck of ``bonds`` (module docstring), at the temperatures ``T``.
+    def _neck_network(self, mechanics) -> NeckNetwork:
+        """The network with a node per neck of the union bonds of the contacts of ``mechanics`` now (module
+        docstring), assembled once per configuration (``_configuration``)."""
+        kept = self._configuration(mechanics)
+        if "necks" not in kept:
+            now, walls = kept["now"], kept["walls"]
+            bonds = find_bonds(now, walls, self.spec.contact, self.spec.out_of_range, pairs=mechanics.contacts()[:2],
+                               box=self.box)
+            kept["necks"] = neck_network(self.spec, now, bonds, box=self.box, walls=walls)
+        return kept["necks"]
+
+    def neck_heat(self, mechanics) -> NeckHeat:
+        r"""The network with a node per neck of the contacts of ``mechanics`` now (module docstring), at the
+        temperatures ``T``.
 
         Parameters
         ----------
         mechanics : dem.engines.verlet.mechanics.MechanicalModel
-            The mechanical submodel: its positions (m), radii (m) and wall offsets (m).
-        bonds : dem.geometry.bonds.Bonds
-            The union bonds of its contacts now (:meth:`bonds`).
+            The mechanical submodel: its contacts, positions (m), radii (m) and wall offsets (m).
 
         Returns
         -------
         dem.network.necks.NeckHeat
             The network in the terms of the :math:`\theta` step.
         """
-        now = self._particles_now(mechanics, mechanics.state.radius)
-        net = neck_network(self.spec, now, bonds, box=self.box, walls=self._walls_now(mechanics))
         # the capacities from the masses (the initial radii), as the one-node network's: the heat balance's own
-        massive = replace(net, particles=self._particles_now(mechanics, self.local(mechanics, self.particles.radius)))
+        massive = replace(self._neck_network(mechanics),
+                          particles=self._particles_now(mechanics, self.local(mechanics, self.particles.radius)))
         return NeckHeat(massive, self.linear)
 
     def contact_heat(self, mechanics, i: np.ndarray, j: np.ndarray) -> tuple[dict, np.ndarray]:
@@ -287,7 +323,7 @@ class ContactThermalModel:
         T = self.local(mechanics, self.T)
         n = len(T)
         if self.spec.nodes == "necks":  # the flows through the necks, solved where their rows hold at T
-            heat = self.neck_heat(mechanics, bonds)
+            heat = self.neck_heat(mechanics)
             q, q_walls = neck_flows(heat.net, heat.nodes(heat.initial))[:2]
         else:
             jump = bonds.shifts @ self.box.drop if self.box is not None else 0.0

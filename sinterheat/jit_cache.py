@@ -5,14 +5,17 @@ functions of another module (the time loop calls the contact law's kernels and t
 reads another module's constants (the parameter indices of a contact law are compile-time constants of every kernel
 that uses them), keeps the old code after only those were edited -- a researcher who changes the contact law would
 run the old one. So the cache lives in a folder named by a digest of the source of every module whose code or
-constants can reach compiled code: the modules that import numba and, transitively, every module of this project they
-import (:func:`compiled_sources`, found by reading the import statements, not listed by hand). Any edit to any of them
-starts a fresh cache; an unchanged installation reuses its compiled kernels across runs.
+constants can reach compiled code: the modules of the project's packages (``dem``, ``fem_neck``, ``sinterheat``)
+that import numba and, transitively, every module of the project they import (:func:`compiled_sources`, found by
+reading the import statements, not listed by hand). Any edit to any of them starts a fresh cache; an unchanged
+installation reuses its compiled kernels across runs. One folder serves both packages: ``dem`` compiles kernels of
+``fem_neck.geometry``, so a key of its own modules alone would miss an edit there.
 
-:func:`configure` (``import dem`` calls it) points numba there, whether or not numba is imported already (numba
-reads the folder when a function is decorated, and every kernel of this package is decorated after the call;
-without it, a script that imports numba before ``dem`` would run kernels compiled from older sources). A folder the
-user chose with ``NUMBA_CACHE_DIR`` stays the root: the digest's folder is made inside it.
+:func:`configure` points numba there, whether or not numba is imported already (numba reads the folder when a
+function is decorated; without it, a script that imports numba first would run kernels compiled from older sources).
+``import dem`` and ``import fem_neck`` call it before any of their modules is imported, so every kernel of either is
+decorated after the call, however a script reaches it. A folder the user chose with ``NUMBA_CACHE_DIR`` stays the
+root: the digest's folder is made inside it.
 """
 
 from __future__ import annotations
@@ -26,8 +29,9 @@ import sys
 import tempfile
 import warnings
 
-PACKAGE = pathlib.Path(__file__).resolve().parent
-PROJECT_PACKAGES = ("dem", "fem_neck", "sinterheat")  # the top-level packages of this project, beside dem
+PACKAGE = pathlib.Path(__file__).resolve().parent  # sinterheat/: the cache and the remembered key live here
+ROOT = PACKAGE.parent  #: the folder that holds the project's packages
+PROJECT_PACKAGES = ("dem", "fem_neck", "sinterheat")  # the project's top-level packages, side by side in ROOT
 
 
 def _module_file(root: pathlib.Path, dotted: str) -> pathlib.Path | None:
@@ -86,29 +90,30 @@ def _imports(root: pathlib.Path, path: pathlib.Path) -> tuple[set[pathlib.Path],
 
 def _sources(package: pathlib.Path) -> list[pathlib.Path]:
     """The package's source files, without ``__pycache__`` (where the cache itself lives, and with it the loops
-    :mod:`dem.engines.compiled` copies for more than one thread: were they sources, writing them would change the key)."""
+    :mod:`dem.engines.compiled` copies for more than one thread: were they sources, writing them would change the
+    key)."""
     return sorted(p for p in package.rglob("*.py") if "__pycache__" not in p.relative_to(package).parts)
 
 
-def compiled_sources(package: pathlib.Path = PACKAGE) -> list[pathlib.Path]:
-    """Every module whose code or constants can reach compiled code: the modules of ``package`` that import numba,
-    and every project module they import, transitively (module docstring).
+def compiled_sources(root: pathlib.Path = ROOT) -> list[pathlib.Path]:
+    """Every module whose code or constants can reach compiled code: the modules of the project's packages that
+    import numba, and every project module they import, transitively (module docstring).
 
     Parameters
     ----------
-    package : pathlib.Path
-        The package's folder (``dem/`` by default).
+    root : pathlib.Path
+        The folder that holds the project's packages (:data:`ROOT` by default).
 
     Returns
     -------
     list of pathlib.Path
         The source files, sorted.
     """
-    root = package.parent
     seeds = []
-    for path in _sources(package):
-        if b"numba" in path.read_bytes() and _imports(root, path)[1]:
-            seeds.append(path)
+    for name in PROJECT_PACKAGES:
+        for path in _sources(root / name):
+            if b"numba" in path.read_bytes() and _imports(root, path)[1]:
+                seeds.append(path)
     closure, todo = set(seeds), list(seeds)
     while todo:
         for target in _imports(root, todo.pop())[0]:
@@ -118,13 +123,13 @@ def compiled_sources(package: pathlib.Path = PACKAGE) -> list[pathlib.Path]:
     return sorted(closure)
 
 
-def digest(package: pathlib.Path = PACKAGE) -> str:
+def digest(root: pathlib.Path = ROOT) -> str:
     """A short hash of the source of :func:`compiled_sources`.
 
     Parameters
     ----------
-    package : pathlib.Path
-        The package's folder (``dem/`` by default).
+    root : pathlib.Path
+        The folder that holds the project's packages (:data:`ROOT` by default).
 
     Returns
     -------
@@ -132,47 +137,46 @@ def digest(package: pathlib.Path = PACKAGE) -> str:
         The hash, hexadecimal.
     """
     h = hashlib.sha1()
-    root = package.parent
-    for path in compiled_sources(package):
+    for path in compiled_sources(root):
         h.update(str(path.relative_to(root)).encode())
         h.update(path.read_bytes())
     return h.hexdigest()[:12]
 
 
-def _stamp(package: pathlib.Path) -> str:
+def _stamp(root: pathlib.Path) -> str:
     """A hash of the name, size and modification time of every source file of the project's packages."""
     h = hashlib.sha1()
     for name in PROJECT_PACKAGES:
-        for path in _sources(package.parent / name):
+        for path in _sources(root / name):
             st = path.stat()
-            h.update(f"{path.relative_to(package.parent)}:{st.st_size}:{st.st_mtime_ns};".encode())
+            h.update(f"{path.relative_to(root)}:{st.st_size}:{st.st_mtime_ns};".encode())
     return h.hexdigest()
 
 
-def remembered_digest(package: pathlib.Path = PACKAGE) -> str:
-    """:func:`digest`, remembered in ``__pycache__/jit_digest.json`` for as long as no source file of the project
-    changed its size or modification time (as Python's own ``.pyc`` files are): reading the imports of the compiled
-    modules takes a tenth of a second, a look at the files' times a millisecond.
+def remembered_digest(root: pathlib.Path = ROOT) -> str:
+    """:func:`digest`, remembered in ``sinterheat/__pycache__/jit_digest.json`` for as long as no source file of the
+    project changed its size or modification time (as Python's own ``.pyc`` files are): reading the imports of the
+    compiled modules takes a tenth of a second, a look at the files' times a millisecond.
 
     Parameters
     ----------
-    package : pathlib.Path
-        The package's folder (``dem/`` by default).
+    root : pathlib.Path
+        The folder that holds the project's packages (:data:`ROOT` by default).
 
     Returns
     -------
     str
         The hash of :func:`digest`.
     """
-    memo = package / "__pycache__" / "jit_digest.json"
-    stamp = _stamp(package)
+    memo = root / PACKAGE.name / "__pycache__" / "jit_digest.json"
+    stamp = _stamp(root)
     try:
         saved = json.loads(memo.read_text())
         if saved.get("stamp") == stamp:
             return saved["digest"]
     except (OSError, ValueError, KeyError, AttributeError):
         pass
-    key = digest(package)
+    key = digest(root)
     try:
         memo.parent.mkdir(parents=True, exist_ok=True)
         part = memo.with_name(f"{memo.name}.{os.getpid()}.part")
@@ -194,9 +198,9 @@ def _writable(folder: pathlib.Path) -> bool:
 
 
 def configure() -> None:
-    """Point numba's cache at ``numba-<digest>``: in ``__pycache__`` of this package, or inside the folder the user
-    set in ``NUMBA_CACHE_DIR`` (module docstring); where that cannot be written, in the temp folder (a user's folder
-    that cannot be written is named in a warning)."""
+    """Point numba's cache at ``numba-<digest>``: in ``sinterheat/__pycache__``, or inside the folder the user set in
+    ``NUMBA_CACHE_DIR`` (module docstring); where that cannot be written, in the temp folder (a user's folder that
+    cannot be written is named in a warning). ``import dem`` and ``import fem_neck`` call it first."""
     key = remembered_digest()
     name = f"numba-{key}"
     chosen = os.environ.get("NUMBA_CACHE_DIR")
@@ -214,6 +218,6 @@ def configure() -> None:
         folder = fallback
         folder.mkdir(parents=True, exist_ok=True)
     os.environ["NUMBA_CACHE_DIR"] = str(folder)
-    if "numba" in sys.modules:  # imported before this package: its configuration has read the environment already
+    if "numba" in sys.modules:  # numba imported first: its configuration has read the environment already
         from numba.core import config
         config.CACHE_DIR = str(folder)
