@@ -181,7 +181,7 @@ def test_union_packings_against_the_dense_solve(seed, phi):
     assert k == pytest.approx(PACKINGS[(seed, phi)][0], rel=1e-9)
 
 
-def test_necks_are_refused_outside_the_union_shared_body():
+def test_necks_are_refused_outside_the_shared_body_law():
     with pytest.raises(ValueError, match="conductance.nodes"):
         ConductanceSpec(law="fit", neck="union", nodes="necks")
     with pytest.raises(ValueError, match="conductance.nodes"):
