@@ -80,6 +80,38 @@ def test_each_particle_is_its_two_readings_blended_by_its_weight():
     assert np.abs(A - union.A.toarray()).max() < 1e-12 * np.abs(A).max()
 
 
+def test_a_neck_the_union_hides_takes_nothing_from_it_and_has_no_node_once_handed_over():
+    """Two spheres whose lens neck lies inside a third, larger sphere: the union reading has no neck there. Its
+    particles on the way, the neck keeps its node through their pair elements (the blend as above); both handed
+    over, it has no node, and the network is the union reading's, which then holds a fixed temperature to
+    round-off."""
+    x = np.array([[0.0, 0.0, 0.0], [1.9e-3, 0.0, 0.0], [0.95e-3, 0.6e-3, 0.0]])
+    r = np.array([1e-3, 1e-3, 1.2e-3])
+    fixed = np.array([True, False, False])
+    particles = Particles.from_arrays(x, r, np.where(fixed, 1.0, 0.0), materials=(UNIT,), fixed=fixed)
+    pair = find_bonds(particles, (), "newton", "clip")
+    pairs = (pair.i, pair.j)
+    for steps, nodes in (([HANDOVER_STEPS - 1, 30, 0], 3), ([0, HANDOVER_STEPS - 1, HANDOVER_STEPS - 1], 3),
+                         ([HANDOVER_STEPS - 1] * 3, 2)):
+        handover = Handover(SPEC, r)
+        handover.steps = np.array(steps)
+        net = handover.neck_network(particles, (), pairs, None, update=True)
+        w = handover.weight
+        grown = Particles.from_arrays(x, handover.solid_radius, particles.temperature, materials=(UNIT,),
+                                      fixed=fixed)
+        union = neck_network(ConductanceSpec(law="shared-body", neck="union", nodes="necks"), grown,
+                             find_bonds(grown, (), "union", pairs=pairs))
+        assert np.array_equal(union.live, [1, 2]) and len(net.live) == nodes  # bond (0, 1) hidden by sphere 2
+        node = 3 + np.arange(pair.n_pairs)
+        node[net.live] = 3 + np.arange(len(net.live))
+        expected = _assembled(neck_network(SPEC, particles, pair), 1.0 - w, node)[:3 + nodes, :3 + nodes]
+        expected += _assembled(union, w, node)[:3 + nodes, :3 + nodes]
+        expected = 0.5 * (expected + expected.T)
+        assert np.abs(net.A.toarray() - expected).max() < 1e-12 * np.abs(expected).max()
+    assert np.abs(net.A.toarray() - union.A.toarray()).max() < 1e-12 * np.abs(expected).max()
+    assert steady_necks(net).T == pytest.approx(np.ones(3), rel=1e-12)
+
+
 def _run(scene: dict, restart=None) -> VerletEngine:
     engine = VerletEngine(parse_scene(scene), restart=restart)
     engine.run()

@@ -14,7 +14,8 @@ each particle is an element over its centre and its necks. Through the hand-over
 reading's necks, and each particle's element is :math:`(1 - w) E_\mathrm{pair} + w E_\mathrm{union}`
 (:func:`blend_elements`), ``w`` the particle's own weight: :math:`E_\mathrm{pair}` its element on the pair reading of
 its radius, :math:`E_\mathrm{union}` on the union reading of the grown spheres (its solid radius, its neighbours'),
-both over the same necks (a neck the union hides inside a third sphere has no part in the latter). A sum of elements
+both over the same necks (a neck the union hides inside a third sphere has no part in the latter, and no node once
+both its particles are handed over: no element has it then). A sum of elements
 with positive weights is an element (symmetric, positive semidefinite, rows summing to zero), so the network stays
 well posed, and it moves by a hundredth of the difference of the readings a step, as the one-node law's conductances
 do. The weight is the particle's, not its bond's (the larger of its two particles', which the one-node law must take
@@ -222,7 +223,8 @@ class Handover:
         Returns
         -------
         dem.network.necks.NeckNetwork
-            The network: its nodes the pair reading's necks, each particle's element blended by its weight.
+            The network: its nodes the pair reading's necks (but those the union hides between two handed-over
+        particles), each particle's element blended by its weight.
 
         Raises
         ------
@@ -244,13 +246,19 @@ class Handover:
             kept["elements"], kept["bonds"] = particle_elements(*args), args[2]
             return kept["elements"]
 
-        neck_network(replace(spec, neck="union"), union.grown, union.bonds, box=box, walls=walls,
-                     elements=union_elements)
+        union_net = neck_network(replace(spec, neck="union"), union.grown, union.bonds, box=box, walls=walls,
+                                 elements=union_elements)
+        # a neck the union hides inside a third sphere, between handed-over particles: no element has it, no node
+        weight = self.weight
+        done = weight >= 1.0
+        gone = np.ones(pair.n_pairs, dtype=bool), np.ones(pair.n_walls, dtype=bool)
+        gone[0][union_net.live], gone[1][union_net.live_walls] = False, False
+        without = (gone[0] & done[pair.i] & done[pair.j], gone[1] & done[pair.wall_particle])
 
         def blended(*args):
-            return blend_elements(particle_elements(*args), args[2], kept["elements"], kept["bonds"], self.weight)
+            return blend_elements(particle_elements(*args), args[2], kept["elements"], kept["bonds"], weight)
 
-        return neck_network(spec, now, pair, box=box, walls=walls, elements=blended)
+        return neck_network(spec, now, pair, box=box, walls=walls, elements=blended, without=without)
 
     def account(self, bonds) -> dict:
         """The summary's entries of the hand-over, for :func:`dem.laws.verified_range.neck_account`: ``readings`` (bonds

@@ -203,7 +203,7 @@ class NeckNetwork:
 
 
 def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, box: PeriodicBox | None = None,
-                 walls=(), closing_pores: dict | None = None, elements=None) -> NeckNetwork:
+                 walls=(), closing_pores: dict | None = None, elements=None, without=None) -> NeckNetwork:
     """Assemble the network with a node per neck (module docstring) of the ``shared-body`` law under the union of
     spheres or a pair-neck reading ("Pair necks").
 
@@ -226,6 +226,9 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
         :func:`dem.laws.shared_body.particle_elements` and returning its
         :class:`~dem.laws.shared_body.ParticleElements` (the same ends, another matrix per particle: e.g. an exact
         element computed elsewhere); None: :func:`dem.laws.shared_body.particle_elements`.
+    without : tuple of numpy.ndarray or None
+        ``(pairs, walls)``: masks of the pair and wall bonds to leave without a neck node (as a neck hidden inside a
+        third sphere is), whatever their halves; None: none.
 
     Returns
     -------
@@ -256,6 +259,8 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
         if unequal is not None:
             k_i, k_j = k_i * unequal, k_j * unequal
         pairs, live_walls = (k_i > 0.0) & (k_j > 0.0), k_w > 0.0
+    if without is not None:
+        pairs, live_walls = pairs & ~without[0], live_walls & ~without[1]
     live, live_walls = np.flatnonzero(pairs), np.flatnonzero(live_walls)
     sub = bonds.subset(live, live_walls)
     el = (elements or particle_elements)(n, r, sub, vectors[live], k_i[live], k_j[live], k_w[live_walls], kappa,
