@@ -150,6 +150,10 @@ def test_a_run_that_hands_over_says_what_the_one_node_run_says():
     assert s["nodes"] == "necks" and s["law_error_range"] == [-0.043, 0.016]
     assert s["energy_error"] < 1e-12
     assert np.array_equal(necks.thermal.handover.solid_radius, plain.thermal.handover.solid_radius)
+    # the snapshots read the neck-node network through the hand-over as the last step left it
+    links, fields = necks.links()[2], necks.particle_fields()
+    assert np.array_equal(fields["handed_over"], necks.thermal.handover.weight)
+    assert np.all(np.isfinite(links["heat_flow"])) and np.any(links["heat_flow"] != 0.0)
 
 
 @pytest.mark.slow
