@@ -43,7 +43,8 @@ the particles' radii now, the capacities from their masses, as the one-node netw
 it with the same :math:`\theta` step (:class:`dem.network.necks.NeckHeat`, whose necks start where their rows hold at
 the step's starting temperatures, so each new network starts consistent). The necks are massless and re-solved every
 step: nothing but the particles' temperatures (and the hand-over's steps and solid radii, as in a one-node run) is
-carried from step to step, so a checkpoint holds what it holds without them. The stiffness test of a Crank-Nicolson step takes the centres' rows only (a neck has no time constant).
+carried from step to step, so a checkpoint holds what it holds without them. The stiffness test of a Crank-Nicolson
+step takes the centres' rows only (a neck has no time constant).
 """
 
 from __future__ import annotations

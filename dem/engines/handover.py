@@ -218,7 +218,21 @@ class Handover:
 
     def neck_network(self, now, walls, pairs, box, update: bool = False) -> NeckNetwork:
         """The network with a node per neck (:mod:`dem.network.necks`) of the contacts ``pairs`` and the walls
-        ``walls`` through the hand-over (module docstring, "Neck nodes"); the arguments are those of :meth:`bonds`.
+        ``walls`` through the hand-over (module docstring, "Neck nodes").
+
+        Parameters
+        ----------
+        now : dem.geometry.particles.Particles
+            The particles now: positions (m), radii (m), materials.
+        walls : sequence of dem.geometry.walls.Wall
+            The walls that carry a temperature, where they are now.
+        pairs : tuple of numpy.ndarray
+            ``(i, j)``: the contacts.
+        box : dem.geometry.periodic.PeriodicBox or None
+            The periodic box; None without one.
+        update : bool
+            Whether to advance the hand-overs and keep the solid radii of this configuration (a thermal step does;
+            a snapshot reads them as they are).
 
         Returns
         -------
