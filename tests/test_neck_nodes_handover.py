@@ -2,10 +2,14 @@
 particle's element blended by its weight, against the two readings' networks assembled apart; moving runs that hand
 over with neck nodes: what the summary says, k_eff continuous, resumed bit for bit."""
 
+import pathlib
+import tomllib
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
+import dem
 from dem import parse_scene
 from dem.engines.handover import Handover
 from dem.engines.verlet.engine import VerletEngine
@@ -193,3 +197,15 @@ def test_k_eff_is_continuous_through_the_handover():
     assert np.count_nonzero(th.handover.steps) >= 40 and len(jumps) >= 60
     assert np.max(np.abs(jumps)) < 5e-3
     assert np.max(np.abs(at_once)) > 10 * np.max(np.abs(jumps))  # the steps are what keeps it continuous
+
+
+def test_the_timeseries_gives_k_eff_on_pair_necks_beside_it():
+    """With neck nodes too, k_eff of the contacts all read as pair necks is k_eff itself while no particle is handed
+    over (the first milliseconds of hot-wall-sintering), the neck-node network's both."""
+    text = (pathlib.Path(dem.__file__).parent / "scene" / "builtin" / "hot-wall-sintering.toml").read_text()
+    doc = tomllib.loads(text.replace("t_end = 0.15\n", "t_end = 0.004\n"))
+    doc["conductance"]["nodes"] = "necks"
+    engine = _run(doc)
+    row = engine.record()
+    assert not np.any(engine.thermal.handover.steps) and engine.summary()["nodes"] == "necks"
+    assert row["effective_conductivity_pair_necks"] == row["effective_conductivity"] is not None
