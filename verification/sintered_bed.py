@@ -120,13 +120,16 @@ def scene_doc(dump: pathlib.Path, t_end: float | None = None) -> dict:
 
 
 def _k_eff_on(engine, net) -> float:
-    """The engine's k_eff between its heated walls on the network ``net`` in place of its own."""
+    """The engine's k_eff between its heated walls on the network ``net`` (a :class:`dem.network.heat.Network`, or
+    with a node per neck a :class:`dem.network.necks.NeckHeat`) in place of its own."""
     th = engine.thermal
-    kept, th.net = th.net, net
+    name = "necks" if th.necks is not None else "net"
+    kept = getattr(th, name)
+    setattr(th, name, net)
     try:
         return engine.effective_conductivity()
     finally:
-        th.net = kept
+        setattr(th, name, kept)
 
 
 def _k_eff_with_steps(engine, steps) -> float:
@@ -136,6 +139,8 @@ def _k_eff_with_steps(engine, steps) -> float:
     th, mech = engine.thermal, engine.mechanics
     kept, th.handover.steps = th.handover.steps, steps
     try:
+        if th.necks is not None:  # a node per neck: the elements blended with those steps' weights
+            return _k_eff_on(engine, th.neck_heat(mech))
         bonds, K, K_walls = th.bonds(mech)
     finally:
         th.handover.steps = kept
@@ -145,9 +150,11 @@ def _k_eff_with_steps(engine, steps) -> float:
 
 
 def _k_eff_read(engine, law: str, neck: str) -> float:
-    """k_eff of the contacts now with every bond read by ``law`` on ``neck`` (no hand-over)."""
+    """k_eff of the contacts now with every bond read by ``law`` on ``neck`` (no hand-over); a run with a node per
+    neck reads the ``shared-body`` law so too, the other laws on one node per particle."""
     th = engine.thermal
-    kept, th.spec = th.spec, replace(th.spec, law=law, neck=neck)
+    nodes = th.spec.nodes if law == "shared-body" else "particles"
+    kept, th.spec = th.spec, replace(th.spec, law=law, neck=neck, nodes=nodes)
     try:
         return engine.effective_conductivity(pair_necks=True)
     finally:
@@ -181,9 +188,9 @@ def sinter(doc: dict) -> dict:
         before = th.handover.steps.copy()
         step(mech, dt)
         jump = None
-        if np.any(th.handover.steps != before) and th.net is not None:
+        if np.any(th.handover.steps != before) and (th.net is not None or th.necks is not None):
             old = _k_eff_with_steps(engine, before)
-            jump = _k_eff_on(engine, th.net) / old - 1.0 if old else None
+            jump = engine.effective_conductivity() / old - 1.0 if old else None
         weight = th.handover.weight
         steps.append({"t": mech.t, "meeting": int(np.count_nonzero(engine.necks()[0])),
                       "handed_over": int(np.count_nonzero(weight == 1.0)),
@@ -231,7 +238,7 @@ def measure(out_dir: pathlib.Path, spheres: int = SPHERES, side: float = SIDE, t
 
 
 
-def compact(neck: str = "newton") -> dict:
+def compact(neck: str = "newton", nodes: str = "particles") -> dict:
     """The built-in ``hot-wall-sintering`` compact sintered with its conductance read on ``neck`` (:func:`sinter`,
     with its bounds at the end).
 
@@ -240,6 +247,8 @@ def compact(neck: str = "newton") -> dict:
     neck : str
         ``"newton"`` (its own pair-neck reading: particles whose necks meet are handed over to the union) or
         ``"union"`` (the union of spheres from the start: no hand-over).
+    nodes : str
+        The network's nodes (``conductance.nodes``): ``"particles"`` (the scene's) or ``"necks"``.
 
     Returns
     -------
@@ -250,7 +259,7 @@ def compact(neck: str = "newton") -> dict:
 
     doc = tomllib.loads((pathlib.Path(dem.__file__).parent / "scene" / "builtin" / "hot-wall-sintering.toml")
                         .read_text())
-    doc["conductance"]["neck"] = neck
+    doc["conductance"].update(neck=neck, nodes=nodes)
     record = sinter(doc)
     return _ends(record)
 
@@ -356,6 +365,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
     if not quick:
         cases["hot-wall-sintering"] = compact("newton")
         cases["hot-wall-sintering, neck = union"] = compact("union")
+        cases["hot-wall-sintering, nodes = necks"] = compact("newton", "necks")
     (out_dir / "sintered_bed.json").write_text(json.dumps(jsonable(cases), indent=1))
     summary, targets = {}, []
     for name, rec in cases.items():

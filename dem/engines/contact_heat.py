@@ -35,14 +35,16 @@ keep the particles' volumes, blended with the pair reading over the steps of the
 advances the hand-overs and solves the solid radii at the configuration of its end; the snapshots read them as the
 last step left them.
 
-**A node per neck** (``[conductance] nodes = "necks"``, :mod:`dem.network.necks`: the ``shared-body`` law under the
-union of spheres, ``neck = "union"``, read so from the start: no pair-neck reading, so no hand-over). Each thermal step
+**A node per neck** (``[conductance] nodes = "necks"``, :mod:`dem.network.necks`: the ``shared-body`` law on the
+scene's neck reading; with a pair-neck reading in 3D through the hand-over, each particle's element blended from its
+pair and union readings by its weight, :meth:`dem.engines.handover.Handover.neck_network`). Each thermal step
 assembles the neck-node network of the contacts at its end (:func:`dem.network.necks.neck_network`; the elements from
 the particles' radii now, the capacities from their masses, as the one-node network takes them) and takes the step on
 it with the same :math:`\theta` step (:class:`dem.network.necks.NeckHeat`, whose necks start where their rows hold at
 the step's starting temperatures, so each new network starts consistent). The necks are massless and re-solved every
-step: nothing but the particles' temperatures is carried from step to step, so a checkpoint holds what it holds
-without them. The stiffness test of a Crank-Nicolson step takes the centres' rows only (a neck has no time constant).
+step: nothing but the particles' temperatures (and the hand-over's steps and solid radii, as in a one-node run) is
+carried from step to step, so a checkpoint holds what it holds without them. The stiffness test of a Crank-Nicolson
+step takes the centres' rows only (a neck has no time constant).
 """
 
 from __future__ import annotations
@@ -242,8 +244,8 @@ class ContactThermalModel:
         dt : float
             The step (s), > 0.
         """
-        if self.spec.nodes == "necks":  # the bonds alone: the network takes the halves of its elements
-            self.necks = net = self.neck_heat(mechanics)
+        if self.spec.nodes == "necks":  # the network of the contacts now, its elements made of their halves
+            self.necks = net = self.neck_heat(mechanics, update=True)
             self.assemblies += 1
             T_F = net.initial  # the free centres' temperatures now, the necks' where their rows hold
         else:
@@ -268,25 +270,45 @@ class ContactThermalModel:
         self.rate[self.free] = (T_F - self.T[self.free]) / dt
         self.T[self.free] = T_F
 
-    def _neck_network(self, mechanics) -> NeckNetwork:
-        """The network with a node per neck of the union bonds of the contacts of ``mechanics`` now (module
-        docstring), assembled once per configuration (``_configuration``)."""
+    def _neck_network(self, mechanics, update: bool = False, pair_necks: bool = False) -> NeckNetwork:
+        """The network with a node per neck of the contacts of ``mechanics`` now (module docstring; the arguments
+        those of :meth:`neck_heat`), assembled once per configuration (``_configuration``) and, handing over, once
+        per state of the hand-overs too (an update, or every contact read as a pair neck, is assembled each time)."""
         kept = self._configuration(mechanics)
-        if "necks" not in kept:
-            now, walls = kept["now"], kept["walls"]
-            bonds = find_bonds(now, walls, self.spec.contact, self.spec.out_of_range, pairs=mechanics.contacts()[:2],
-                               box=self.box)
+        now, walls, pairs = kept["now"], kept["walls"], mechanics.contacts()[:2]
+        if pair_necks:
+            spec = replace(self.spec, out_of_range="clip")
+            bonds = find_bonds(now, walls, spec.contact, spec.out_of_range, pairs=pairs, box=self.box)
+            return neck_network(spec, now, bonds, box=self.box, walls=walls)
+        if self.handing_over(mechanics):
+            handover = self.handover
+            if update:  # (advanced here: a network kept before is of the old state)
+                kept.pop("necks", None)
+                return handover.neck_network(now, walls, pairs, self.box, True)
+            state = (handover.steps, handover.solid_radius)
+            if "necks" not in kept or not all(map(np.array_equal, kept["necks_handover"], state)):
+                kept["necks"] = handover.neck_network(now, walls, pairs, self.box, False)
+                kept["necks_handover"] = tuple(a.copy() for a in state)
+        elif "necks" not in kept:
+            bonds = find_bonds(now, walls, self.spec.contact, self.spec.out_of_range, pairs=pairs, box=self.box)
             kept["necks"] = neck_network(self.spec, now, bonds, box=self.box, walls=walls)
         return kept["necks"]
 
-    def neck_heat(self, mechanics) -> NeckHeat:
+    def neck_heat(self, mechanics, update: bool = False, pair_necks: bool = False) -> NeckHeat:
         r"""The network with a node per neck of the contacts of ``mechanics`` now (module docstring), at the
-        temperatures ``T``.
+        temperatures ``T``: handing over (:meth:`handing_over`), as :meth:`dem.engines.handover.Handover.neck_network`
+        reads them.
 
         Parameters
         ----------
         mechanics : dem.engines.verlet.mechanics.MechanicalModel
             The mechanical submodel: its contacts, positions (m), radii (m) and wall offsets (m).
+        update : bool
+            Whether to update the hand-over weights and solid radii to this configuration first (a thermal step
+            does; a snapshot reads them as they are).
+        pair_necks : bool
+            Whether to read every contact as a pair neck (the scene's reading, clipped to its range), as if no
+            particle had been handed over.
 
         Returns
         -------
@@ -294,7 +316,7 @@ class ContactThermalModel:
             The network in the terms of the :math:`\theta` step.
         """
         # the capacities from the masses (the initial radii), as the one-node network's: the heat balance's own
-        massive = replace(self._neck_network(mechanics),
+        massive = replace(self._neck_network(mechanics, update, pair_necks),
                           particles=self._particles_now(mechanics, self.local(mechanics, self.particles.radius)))
         return NeckHeat(massive, self.linear)
 

@@ -1,4 +1,4 @@
-"""The conductances of a moving run's contacts through the hand-over from a pair-neck reading to the union of
+r"""The conductances of a moving run's contacts through the hand-over from a pair-neck reading to the union of
 spheres (:mod:`dem.geometry.handover`): the state the hand-over carries through a run (the steps of each particle's
 hand-over, the solid radii) and the bonds it reads, shared by the engines whose particles move
 (:mod:`dem.engines.contact_heat`, :mod:`dem.engines.staggered.heat`).
@@ -8,11 +8,25 @@ the particles' radii, ``K_union`` the same law on the union reading (:func:`dem.
 with ``neck = "union"``) of the solid radii, ``w`` the bond's hand-over weight
 (:func:`dem.geometry.handover.bond_weights`). Where no particle is handed over, the bonds are the pair reading's
 alone, computed as without the hand-over.
+
+**Neck nodes** (``[conductance] nodes = "necks"``, :mod:`dem.network.necks`). A neck node has no conductance to blend:
+each particle is an element over its centre and its necks. Through the hand-over the network's nodes are the pair
+reading's necks, and each particle's element is :math:`(1 - w) E_\mathrm{pair} + w E_\mathrm{union}`
+(:func:`blend_elements`), ``w`` the particle's own weight: :math:`E_\mathrm{pair}` its element on the pair reading of
+its radius, :math:`E_\mathrm{union}` on the union reading of the grown spheres (its solid radius, its neighbours'),
+both over the same necks (a neck the union hides inside a third sphere has no part in the latter, and no node once
+both its particles are handed over: no element has it then). A sum of elements
+with positive weights is an element (symmetric, positive semidefinite, rows summing to zero), so the network stays
+well posed, and it moves by a hundredth of the difference of the readings a step, as the one-node law's conductances
+do. The weight is the particle's, not its bond's (the larger of its two particles', which the one-node law must take
+for one conductance per bond): a particle not yet on the way keeps its pair element even on a bond to a handed-over
+neighbour, whose own element reads that neck as the union. Where every particle is handed over the network is the
+union reading's of the grown spheres; where none is, the pair reading's, computed as without the hand-over.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -22,7 +36,32 @@ from dem.geometry.bonds import find_bonds
 from dem.geometry.handover import advance, bond_weights, solid_radii, weights
 from dem.geometry.necks import PAIR_READINGS, necks_meeting
 from dem.laws.conductance import ConductanceSpec, bond_conductances
-from dem.network.heat import bonds_and_conductances
+from dem.laws.shared_body import ParticleElements, particle_elements
+from dem.network.necks import NeckNetwork, neck_network
+
+
+@dataclass(frozen=True)
+class Reading:
+    """The union reading of a step's contacts through the hand-over (:meth:`Handover.bonds`).
+
+    Parameters
+    ----------
+    bonds : dem.geometry.bonds.Bonds
+        The union bonds of the grown spheres: the contacts of the pair reading, in its order.
+    grown : dem.geometry.particles.Particles
+        The particles with their solid radii (m).
+    w_pair, w_wall : numpy.ndarray
+        The pair and wall bonds' hand-over weights (:func:`dem.geometry.handover.bond_weights`).
+    past, past_wall : numpy.ndarray
+        The pair and wall bonds past the pair reading's range while it still has weight (bool).
+    """
+
+    bonds: object
+    grown: object
+    w_pair: np.ndarray
+    w_wall: np.ndarray
+    past: np.ndarray
+    past_wall: np.ndarray
 
 
 class Handover:
@@ -96,6 +135,39 @@ class Handover:
             self.steps = np.array(saved["handover_steps"], dtype=np.int64)
             self.solid_radius = np.array(saved["solid_radius"], dtype=float)
 
+    def _readings(self, now, walls, pairs, box, update: bool):
+        """The two readings of the contacts ``pairs``: ``(bonds, None)`` where no particle is handed over (the bonds
+        under the scene's reading and ``out_of_range``, as without the hand-over), else ``(pair, union)``: the pair
+        reading clipped to its range and the union reading of the grown spheres (``union.grown``, their solid radii),
+        the same contacts in the same order (the arguments are those of :meth:`bonds`)."""
+        spec = self.spec
+        if not update and not np.any(self.steps):  # nothing handed over and nothing to update: the pair reading
+            return find_bonds(now, walls, spec.contact, spec.out_of_range, pairs=pairs, box=box), None
+        pair = find_bonds(now, walls, spec.contact, "clip", pairs=pairs, box=box)
+        vectors = pair.vectors(now.position, box)
+        normals = np.array([w.normal for w in walls], dtype=float).reshape(-1, 3)[pair.wall_index]
+        if update:
+            self.steps = advance(self.steps, necks_meeting(now.radius, pair, vectors, normals))
+        if not np.any(self.steps):  # nothing handed over: the pair reading alone, as without the hand-over
+            return (pair if spec.out_of_range == "clip" else
+                    find_bonds(now, walls, spec.contact, spec.out_of_range, pairs=pairs, box=box)), None
+        w_pair, w_wall = bond_weights(self.weight, pair)
+        # bonds past the pair reading's range where it still has weight: the scene's out_of_range policy
+        past = (pair.h > max_overlap(now.radius[pair.i], now.radius[pair.j])) & (w_pair < 1.0)
+        past_wall = (pair.wall_h > now.radius[pair.wall_particle] / 3.0) & (w_wall < 1.0)
+        if spec.out_of_range == "error" and (np.any(past) or np.any(past_wall)):
+            find_bonds(now, walls, spec.contact, "error", pairs=(pair.i[past], pair.j[past]), box=box)
+        solid = solid_radii(now.radius, self.weight > 0.0, pair.i, pair.j, vectors, pair.wall_particle, normals,
+                            pair.wall_l, start=self.solid_radius)
+        if update:
+            self.solid_radius = solid
+        grown = replace(now, radius=solid)
+        union = find_bonds(grown, walls, "union", "error", pairs=pairs, box=box)
+        n = now.n  # the grown spheres may touch a wall the particle does not: the contacts' wall bonds only
+        union = union.subset(slice(None), np.isin(union.wall_index * n + union.wall_particle,
+                                                   pair.wall_index * n + pair.wall_particle))
+        return pair, Reading(union, grown, w_pair, w_wall, past, past_wall)
+
     def bonds(self, now, walls, pairs, box, update: bool = False):
         """The bonds of the contacts ``pairs`` and the walls ``walls`` and their conductances (module docstring).
 
@@ -126,43 +198,81 @@ class Handover:
             ``out_of_range = "error"``; a conductance that is not finite.
         """
         spec = self.spec
-        if not update and not np.any(self.steps):  # nothing handed over and nothing to update: the pair reading
-            return bonds_and_conductances(now, walls, spec, pairs=pairs, box=box)
-        pair = find_bonds(now, walls, spec.contact, "clip", pairs=pairs, box=box)
-        vectors = pair.vectors(now.position, box)
-        normals = np.array([w.normal for w in walls], dtype=float).reshape(-1, 3)[pair.wall_index]
-        if update:
-            self.steps = advance(self.steps, necks_meeting(now.radius, pair, vectors, normals))
-        if not np.any(self.steps):  # nothing handed over: the pair reading alone, as without the hand-over
-            return bonds_and_conductances(now, walls, spec, pairs=pairs, box=box,
-                                          bonds=pair if spec.out_of_range == "clip" else None)
-        weight = self.weight
-        w_pair, w_wall = bond_weights(weight, pair)
+        pair, union = self._readings(now, walls, pairs, box, update)
+        if union is None:
+            return (pair, *bond_conductances(spec, now, pair, box=box, walls=tuple(walls)))
         K_pair, K_wall = bond_conductances(spec, now, pair, box=box, walls=walls)
-        # bonds past the pair reading's range where it still has weight: the scene's out_of_range policy
-        past = (pair.h > max_overlap(now.radius[pair.i], now.radius[pair.j])) & (w_pair < 1.0)
-        past_wall = (pair.wall_h > now.radius[pair.wall_particle] / 3.0) & (w_wall < 1.0)
-        if spec.out_of_range == "error" and (np.any(past) or np.any(past_wall)):
-            find_bonds(now, walls, spec.contact, "error", pairs=(pair.i[past], pair.j[past]), box=box)
         if spec.out_of_range == "drop":
-            K_pair[past], K_wall[past_wall] = 0.0, 0.0
-        solid = solid_radii(now.radius, weight > 0.0, pair.i, pair.j, vectors, pair.wall_particle, normals,
-                            pair.wall_l, start=self.solid_radius)
-        if update:
-            self.solid_radius = solid
-        grown = replace(now, radius=solid)
-        union = find_bonds(grown, walls, "union", "error", pairs=pairs, box=box)
-        n = now.n  # the grown spheres may touch a wall the particle does not: the contacts' wall bonds only
-        union = union.subset(slice(None), np.isin(union.wall_index * n + union.wall_particle,
-                                                   pair.wall_index * n + pair.wall_particle))
-        K_union, K_wall_union = bond_conductances(replace(spec, neck="union"), grown, union, box=box, walls=walls)
+            K_pair[union.past], K_wall[union.past_wall] = 0.0, 0.0
+        K_union, K_wall_union = bond_conductances(replace(spec, neck="union"), union.grown, union.bonds, box=box,
+                                                  walls=walls)
+        w_pair, w_wall = union.w_pair, union.w_wall
         K_pair = (1.0 - w_pair) * K_pair + w_pair * K_union
         K_wall = (1.0 - w_wall) * K_wall + w_wall * K_wall_union
         read, read_wall = w_pair >= 0.5, w_wall >= 0.5
-        bonds = replace(pair, a=np.where(read, union.a, pair.a), l_i=np.where(read, union.l_i, pair.l_i),
-                        l_j=np.where(read, union.l_j, pair.l_j), wall_a=np.where(read_wall, union.wall_a, pair.wall_a),
-                        wall_l=np.where(read_wall, union.wall_l, pair.wall_l))
+        u = union.bonds
+        bonds = replace(pair, a=np.where(read, u.a, pair.a), l_i=np.where(read, u.l_i, pair.l_i),
+                        l_j=np.where(read, u.l_j, pair.l_j), wall_a=np.where(read_wall, u.wall_a, pair.wall_a),
+                        wall_l=np.where(read_wall, u.wall_l, pair.wall_l))
         return bonds, K_pair, K_wall
+
+    def neck_network(self, now, walls, pairs, box, update: bool = False) -> NeckNetwork:
+        """The network with a node per neck (:mod:`dem.network.necks`) of the contacts ``pairs`` and the walls
+        ``walls`` through the hand-over (module docstring, "Neck nodes").
+
+        Parameters
+        ----------
+        now : dem.geometry.particles.Particles
+            The particles now: positions (m), radii (m), materials.
+        walls : sequence of dem.geometry.walls.Wall
+            The walls that carry a temperature, where they are now.
+        pairs : tuple of numpy.ndarray
+            ``(i, j)``: the contacts.
+        box : dem.geometry.periodic.PeriodicBox or None
+            The periodic box; None without one.
+        update : bool
+            Whether to advance the hand-overs and keep the solid radii of this configuration (a thermal step does;
+            a snapshot reads them as they are).
+
+        Returns
+        -------
+        dem.network.necks.NeckNetwork
+            The network: its nodes the pair reading's necks (but those the union hides between two handed-over
+        particles), each particle's element blended by its weight.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`bonds`; and a neck of the union reading that the pair reading has dropped
+            (``out_of_range = "drop"``), which has no node to carry it.
+        """
+        spec = self.spec
+        pair, union = self._readings(now, walls, pairs, box, update)
+        if union is None:
+            return neck_network(spec, now, pair, box=box, walls=walls)
+        if spec.out_of_range == "drop" and (np.any(union.past) or np.any(union.past_wall)):
+            raise ValueError("[conductance] out_of_range = \"drop\" with nodes = \"necks\": a pair neck past its "
+                             "range is dropped while its particle is on the way to the union, whose element still "
+                             "has it; use out_of_range = \"clip\" or \"error\"")
+        kept = {}
+
+        def union_elements(*args):  # the union's elements, kept with their bonds (args[2]) for the blend
+            kept["elements"], kept["bonds"] = particle_elements(*args), args[2]
+            return kept["elements"]
+
+        union_net = neck_network(replace(spec, neck="union"), union.grown, union.bonds, box=box, walls=walls,
+                                 elements=union_elements)
+        # a neck the union hides inside a third sphere, between handed-over particles: no element has it, no node
+        weight = self.weight
+        done = weight >= 1.0
+        gone = np.ones(pair.n_pairs, dtype=bool), np.ones(pair.n_walls, dtype=bool)
+        gone[0][union_net.live], gone[1][union_net.live_walls] = False, False
+        without = (gone[0] & done[pair.i] & done[pair.j], gone[1] & done[pair.wall_particle])
+
+        def blended(*args):
+            return blend_elements(particle_elements(*args), args[2], kept["elements"], kept["bonds"], weight)
+
+        return neck_network(spec, now, pair, box=box, walls=walls, elements=blended, without=without)
 
     def account(self, bonds) -> dict:
         """The summary's entries of the hand-over, for :func:`dem.laws.verified_range.neck_account`: ``readings`` (bonds
@@ -185,3 +295,68 @@ class Handover:
         return {"readings": readings,
                 "handed_over": int(np.count_nonzero(self.weight == 1.0)),
                 "handing_over": int(np.count_nonzero((self.weight > 0.0) & (self.weight < 1.0)))}
+
+
+def _end_keys(bonds, n: int) -> np.ndarray:
+    """A key per bond end of ``bonds`` in the order of :class:`dem.laws.shared_body.ParticleElements`' ends (the
+    pair bonds on ``i``, on ``j``, then the wall bonds) that names the same end in any subset of the same contacts:
+    ``3 id + side``, ``id`` the pair ``i n + j`` or the wall bond ``wall n + particle``."""
+    pair = bonds.i.astype(np.int64) * n + bonds.j
+    wall = bonds.wall_index.astype(np.int64) * n + bonds.wall_particle
+    return np.concatenate([3 * pair, 3 * pair + 1, 3 * wall + 2])
+
+
+def blend_elements(pair: ParticleElements, pair_bonds, union: ParticleElements, union_bonds,
+                   weight: np.ndarray) -> ParticleElements:
+    """Each particle's element through the hand-over (module docstring, "Neck nodes"): ``(1 - w) E_pair + w E_union``
+    over the pair reading's ends, ``w`` the particle's hand-over weight; an end the union reading does not have (a
+    neck inside a third sphere) takes nothing from it.
+
+    Parameters
+    ----------
+    pair : dem.laws.shared_body.ParticleElements
+        The elements under the pair reading (W/K).
+    pair_bonds : dem.geometry.bonds.Bonds
+        The bonds of their ends (the live ones of the pair reading).
+    union : dem.laws.shared_body.ParticleElements
+        The elements under the union reading of the grown spheres (W/K).
+    union_bonds : dem.geometry.bonds.Bonds
+        The bonds of their ends (the live ones of the union reading: the same contacts or fewer).
+    weight : numpy.ndarray
+        Per particle, its hand-over weight (0 to 1).
+
+    Returns
+    -------
+    dem.laws.shared_body.ParticleElements
+        The blended elements, on the pair reading's ends.
+
+    Raises
+    ------
+    ValueError
+        An end of the union reading that the pair reading does not have.
+    """
+    n = len(weight)
+    keys_p, keys_u = _end_keys(pair_bonds, n), _end_keys(union_bonds, n)
+    z_p, z_u = np.diff(pair.offsets), np.diff(union.offsets)
+    # the local place of each pair end in its particle's element, found by its key
+    local_p = np.empty(len(pair.ends), dtype=np.int64)
+    local_p[pair.ends] = np.arange(len(pair.ends)) - np.repeat(pair.offsets[:-1], z_p)
+    order = np.argsort(keys_p)
+    at = np.searchsorted(keys_p, keys_u, sorter=order)
+    found = (at < len(order)) & (keys_p[order[np.minimum(at, len(order) - 1)]] == keys_u)
+    if not np.all(found):
+        raise ValueError("the hand-over's union reading has a neck that the pair reading has not")
+    place_u = np.append(local_p[order[at]][union.ends], -1)  # per union local end (in element order), its pair place
+    # every union entry (particle k, local p, q) to its place in k's pair element
+    size_u, size_p = z_u + 1, z_p + 1
+    owner = np.repeat(np.arange(n), size_u * size_u)
+    local = np.arange(len(union.values)) - union.start[:-1][owner]
+    p, q = local // size_u[owner], local % size_u[owner]
+    first = union.offsets[:-1][owner]
+    row = np.where(p == z_u[owner], z_p[owner], place_u[np.where(p == z_u[owner], -1, first + p)])
+    col = np.where(q == z_u[owner], z_p[owner], place_u[np.where(q == z_u[owner], -1, first + q)])
+    w = np.asarray(weight, dtype=float)
+    values = pair.values * (1.0 - np.repeat(w, size_p * size_p))
+    values[pair.start[:-1][owner] + row * size_p[owner] + col] += w[owner] * union.values
+    plain = np.where(w >= 1.0, union.plain, np.where(w > 0.0, pair.plain | union.plain, pair.plain))
+    return pair._replace(values=values, plain=plain, shrink=(1.0 - w) * pair.shrink + w * union.shrink)

@@ -106,7 +106,7 @@ class ConductanceSpec:
     nodes : str
         The network's nodes, one of ``NODES``: ``"particles"`` (one per particle, each bond a conductance) or
         ``"necks"`` (a node per neck as well, each particle an element, :mod:`dem.network.necks`; ``shared-body``
-        under ``neck = "union"`` without ``contact_conductance`` only).
+        without ``contact_conductance`` only, under any neck reading).
 
     Raises
     ------
@@ -145,10 +145,9 @@ class ConductanceSpec:
             raise ValueError(f"conductance.contact_conductance = {kc!r}: must be finite and > 0 (W/K)")
         if self.nodes not in NODES:
             raise ValueError(f"conductance.nodes = {self.nodes!r}: must be one of {', '.join(NODES)}")
-        if self.nodes == "necks" and (self.law != "shared-body" or self.neck != "union" or kc is not None):
-            raise ValueError(f"conductance.nodes = \"necks\": only with law = \"shared-body\", neck = \"union\" and no "
-                             f"contact_conductance (here law = {self.law!r}, neck = {self.neck!r}, "
-                             f"contact_conductance = {kc!r})")
+        if self.nodes == "necks" and (self.law != "shared-body" or kc is not None):
+            raise ValueError(f"conductance.nodes = \"necks\": only with law = \"shared-body\" and no "
+                             f"contact_conductance (here law = {self.law!r}, contact_conductance = {kc!r})")
         if self.law in FIT_LAWS:
             self.fitted()  # a missing or malformed fit file, or one of the other half body, is reported when read
 
@@ -316,8 +315,9 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
             s_i, s_j, s_w = neck_factors(particles.n, r, bonds, vectors, k_i, k_j, k_w, kappa, normals)
             k_i, k_j, k_w = s_i * k_i, s_j * k_j, s_w * k_w
     k_pair = series(k_i, k_j)
-    if spec.law in FIT_LAWS and spec.unequal and spec.neck != "union" and bonds.n_pairs:  # fitted to neck cylinders
-        k_pair = k_pair * fem_law.unequal_factor(r[bonds.i], r[bonds.j], bonds.a)
+    unequal = unequal_factor(spec, r, bonds)
+    if unequal is not None:
+        k_pair = k_pair * unequal
     k_pair, k_wall = series(k_pair, kc), series(k_w, kc)
     _check_finite(spec, k_pair, bonds.a, lambda k: f"bond ({bonds.i[k]}, {bonds.j[k]})")
     _check_finite(spec, k_wall, bonds.wall_a, lambda k: f"wall bond of particle {bonds.wall_particle[k]}")
@@ -327,6 +327,30 @@ def bond_conductances(spec: ConductanceSpec, particles: Particles, bonds: Bonds,
         share = k_j / (k_i + k_j)  # R_i / (R_i + R_j); an infinite half (a centre on the contact plane) makes none
     share = np.where(np.isfinite(share), share, np.where(np.isinf(k_i), 0.0, 1.0))
     return k_pair, k_wall, share
+
+
+def unequal_factor(spec: ConductanceSpec, radius: np.ndarray, bonds: Bonds):
+    """The fit laws' correction of a pair of unequal radii (:func:`fem_neck.law.unequal_factor`, fitted to neck
+    cylinders) on every pair bond's series conductance, where the law takes it: ``unequal = true`` on a pair-neck
+    reading.
+
+    Parameters
+    ----------
+    spec : ConductanceSpec
+        The conductance law and its neck reading.
+    radius : numpy.ndarray
+        Per particle, its radius, m.
+    bonds : Bonds
+        The pair bonds (neck radii, m).
+
+    Returns
+    -------
+    numpy.ndarray or None
+        The factor per pair bond (dimensionless); None where the law takes none (or there are no pair bonds).
+    """
+    if spec.law in FIT_LAWS and spec.unequal and spec.neck != "union" and bonds.n_pairs:
+        return fem_law.unequal_factor(radius[bonds.i], radius[bonds.j], bonds.a)
+    return None
 
 
 def bond_halves(spec: ConductanceSpec, particles: Particles, bonds: Bonds, kappa: np.ndarray):

@@ -24,6 +24,17 @@ bond; a wall bond's neck sits at the wall (its node is the wall's temperature). 
 (a pair, a chain) has ``R`` diagonal: its halves from the centre to each neck, the bonds' halves in series -- today's
 network, to round-off.
 
+**Pair necks.** Under a pair-neck reading (``neck`` ``newton``, ``first`` or ``coble``: Rojek 2022, eqs. 21-34) a
+particle's element is made of the bonds' necks as the reading gives them: neck radius ``a`` and arm ``l`` (the
+centre-to-contact distance), the ``shared-body`` law's pair-calibrated halves of the neck cylinder
+(:func:`dem.laws.conductance.bond_halves`), both halves of a bond of unequal radii times the fit's correction
+(:func:`dem.laws.conductance.unequal_factor`, which multiplies their series as the one-node law does), and its
+sphere's volume :math:`\frac{4}{3} \pi r^3` (which the volume-conserving neck keeps) in the trace cap. No cut body
+narrows the halves and no closing pore lowers the cap: those are the union's. A chain is the one-node law's halves
+in series, to round-off; where necks are not collinear the element solves the particle the one-node law reduces to
+one factor per neck (its interaction taken between the faces, not the cap bases' centres). A moving run hands a
+particle whose necks meet over to the union (:mod:`dem.engines.handover`).
+
 **Assembly.** The unknowns are the particles' centres first (``0 .. n-1``), then the live pair bonds' necks
 (``n + b``; a neck hidden inside a third sphere has a half conductance 0 and no node). The elements' entries are
 computed per particle in one compiled loop (:func:`dem.laws.shared_body.particle_elements`), placed by index arithmetic
@@ -129,7 +140,7 @@ from dem.geometry.bonds import Bonds
 from dem.geometry.particles import Particles
 from dem.geometry.periodic import PeriodicBox
 from dem.laws.ambient import Sources, linear_sink_terms
-from dem.laws.conductance import ConductanceSpec, bond_halves, union_halves, wall_normals
+from dem.laws.conductance import ConductanceSpec, bond_halves, unequal_factor, union_halves, wall_normals
 from dem.network.current import CurrentFlow, Electrodes, kirchhoff
 from dem.network.heat import BalanceScales, solve_steady
 from dem.network.linsolve import make_solver
@@ -174,9 +185,10 @@ class NeckNetwork:
     box : dem.geometry.periodic.PeriodicBox or None
         The periodic box; None: none.
     union : tuple or None
-        The ``shared-body`` halves on the cut spheres the elements are made of (what
+        Under the union of spheres, the ``shared-body`` halves on the cut spheres the elements are made of (what
         :func:`dem.laws.conductance.union_halves` returned), from which the one-node law's conductances follow without
-        computing them again (``union`` of :func:`dem.laws.conductance.bond_conductances`).
+        computing them again (``union`` of :func:`dem.laws.conductance.bond_conductances`); None under a pair-neck
+        reading.
     modes : int
         Flux modes per neck (module docstring, "Flux modes"): 1, the neck's temperature alone (node ``n + k`` of live
         pair bond ``k``); 3 with two dipoles (mode ``d`` of bond ``k`` at node ``n + 3 k + d``, the monopole ``d = 0``).
@@ -226,18 +238,18 @@ class NeckNetwork:
 
 
 def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, box: PeriodicBox | None = None,
-                 walls=(), closing_pores: dict | None = None, elements=None) -> NeckNetwork:
+                 walls=(), closing_pores: dict | None = None, elements=None, without=None) -> NeckNetwork:
     """Assemble the network with a node per neck (module docstring) of the ``shared-body`` law under the union of
-    spheres.
+    spheres or a pair-neck reading ("Pair necks").
 
     Parameters
     ----------
     spec : dem.laws.conductance.ConductanceSpec
-        The law (``shared-body``, ``neck = "union"``).
+        The law (``shared-body``, without ``contact_conductance``) and its neck reading.
     particles : dem.geometry.particles.Particles
         The particles.
     bonds : dem.geometry.bonds.Bonds
-        The union bonds.
+        The bonds under that reading.
     box : dem.geometry.periodic.PeriodicBox or None
         The periodic box; None: none.
     walls : sequence of dem.geometry.walls.Wall
@@ -250,6 +262,9 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
         :class:`~dem.laws.shared_body.ParticleElements` (the same ends, another matrix per particle: e.g. an exact
         element computed elsewhere, with ``modes`` flux modes per neck, module docstring "Flux modes"); None:
         :func:`dem.laws.shared_body.particle_elements`.
+    without : tuple of numpy.ndarray or None
+        ``(pairs, walls)``: masks of the pair and wall bonds to leave without a neck node (as a neck hidden inside a
+        third sphere is), whatever their halves; None: none.
 
     Returns
     -------
@@ -259,21 +274,30 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     Raises
     ------
     ValueError
-        ``spec`` is not the ``shared-body`` law under the union of spheres, wall bonds without their walls, or
+        ``spec`` is not the ``shared-body`` law without ``contact_conductance``, wall bonds without their walls, or
         elements whose blocks are not ``(modes z + 1)^2`` values.
     """
     from dem.laws.shared_body import particle_elements
 
-    if spec.law != "shared-body" or spec.neck != "union" or spec.contact_conductance is not None:
-        raise ValueError(f"conductance.nodes = \"necks\": only with law = \"shared-body\", neck = \"union\" and no "
-                         f"contact_conductance (here law = {spec.law!r}, neck = {spec.neck!r})")
+    if spec.law != "shared-body" or spec.contact_conductance is not None:
+        raise ValueError(f"conductance.nodes = \"necks\": only with law = \"shared-body\" and no contact_conductance "
+                         f"(here law = {spec.law!r}, contact_conductance = {spec.contact_conductance!r})")
     n, r = particles.n, particles.radius
     kappa = particles.conductivity
     k_i, k_j, k_w = bond_halves(spec, particles, bonds, kappa)
     normals = wall_normals(bonds, walls)
     vectors = bonds.vectors(particles.position, box)
-    union = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w, closing_pores, box, walls)
-    k_i, k_j, k_w, pairs, live_walls, volume = union
+    if spec.neck == "union":
+        union = union_halves(particles, bonds, vectors, normals, kappa, k_i, k_j, k_w, closing_pores, box, walls)
+        k_i, k_j, k_w, pairs, live_walls, volume = union
+    else:  # a pair-neck reading (module docstring, "Pair necks")
+        union = volume = None
+        unequal = unequal_factor(spec, r, bonds)
+        if unequal is not None:
+            k_i, k_j = k_i * unequal, k_j * unequal
+        pairs, live_walls = (k_i > 0.0) & (k_j > 0.0), k_w > 0.0
+    if without is not None:
+        pairs, live_walls = pairs & ~without[0], live_walls & ~without[1]
     live, live_walls = np.flatnonzero(pairs), np.flatnonzero(live_walls)
     sub = bonds.subset(live, live_walls)
     el = (elements or particle_elements)(n, r, sub, vectors[live], k_i[live], k_j[live], k_w[live_walls], kappa,

@@ -234,8 +234,9 @@ class Scene:
         check_inside(walls, self.particles.position, self.particles.id)
         if self.conductance.nodes != "particles" and self.engine not in ("static", "verlet"):
             raise ValueError(f"[conductance] nodes = {self.conductance.nodes!r}: the static and verlet engines only "
-                             f"(this scene runs on {self.engine}, whose lumped heat is not the network's theta step); "
-                             f"use nodes = \"particles\"")
+                             f"(this scene runs on {self.engine}, whose step is Zohdi's fixed-point iteration, "
+                             f"explicit in each particle's lumped heat, which a massless neck node does not have: not "
+                             f"the network's theta step, which solves for the necks); use nodes = \"particles\"")
 
     @property
     def particle_count(self) -> int:

@@ -309,14 +309,15 @@ class VerletEngine(Engine):
         the hot and the cold wall (W/(m K)); None without two such walls, a closed box or a network (or with
         ambient sources, which are not conduction). Groups of particles touching neither wall carry no heat. With a
         node per neck (``[conductance] nodes = "necks"``) the solve is the neck-node network's
-        (:func:`dem.network.necks.steady_necks`) of the contacts of the last thermal step.
+        (:func:`dem.network.necks.steady_necks`) of the contacts of the last thermal step (with ``pair_necks``, of the
+        contacts now read as pair necks).
 
         Parameters
         ----------
         pair_necks : bool
             Whether to read every contact as a pair neck (the scene's reading, clipped to its range), as if no
-            particle had been handed over to the union (:mod:`dem.engines.handover`); False: the network as the
-            run conducts.
+            particle had been handed over to the union (:mod:`dem.engines.handover`), on the nodes of the scene's
+            ``conductance.nodes``; False: the network as the run conducts.
 
         Returns
         -------
@@ -332,9 +333,10 @@ class VerletEngine(Engine):
         hot, cold = pair
         length = -(mech.w.q[hot] + mech.w.q[cold])
         delta_T = mech.walls[hot].temperature - mech.walls[cold].temperature
-        if th.necks is not None:  # a node per neck: the steady solve of the last step's network
-            res = steady_necks(th.necks.net, floating="mean", linear=self.scene.solver.linear)
-            into = np.bincount(th.necks.net.bonds.wall_index, res.wall_flow, len(th.thermal_walls))
+        if th.necks is not None and th.spec.nodes == "necks":  # a node per neck: the last step's network solved
+            net = th.neck_heat(mech, pair_necks=True).net if pair_necks else th.necks.net
+            res = steady_necks(net, floating="mean", linear=self.scene.solver.linear)
+            into = np.bincount(net.bonds.wall_index, res.wall_flow, len(th.thermal_walls))
             return float(-into[th.thermal_walls.index(hot)] * length / (volume / length * delta_T))
         net = th.net
         if pair_necks:
@@ -342,8 +344,9 @@ class VerletEngine(Engine):
             bonds, K_pairs, K_walls = bonds_and_conductances(
                 th._particles_now(mech, mech.state.radius), th._walls_now(mech),
                 replace(th.spec, out_of_range="clip"), pairs=(i, j), box=th.box)
-            net = Network(th._particles_now(mech, th.particles.radius), bonds, K_pairs, K_walls, net.wall_temperature,
-                          th.sources, th.box)
+            wall_T = np.array([th.walls[k].temperature for k in th.thermal_walls], dtype=float)
+            net = Network(th._particles_now(mech, th.particles.radius), bonds, K_pairs, K_walls, wall_T, th.sources,
+                          th.box)
         res = steady(net, floating="mean", linear=self.scene.solver.linear)
         into = boundary_heat_flow(net, res.T)["walls"]
         q = -into[th.thermal_walls.index(hot)]  # heat leaving the hot wall
