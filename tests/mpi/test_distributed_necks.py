@@ -1,0 +1,131 @@
+"""The network with a node per neck on several MPI ranks (dem.network.distributed_necks) against the serial run of the
+same scene in the same process: random union packings whose necks meet, periodic and between two walls, each some
+blocks long so that the ranks' halos end inside it. Every owned row is the serial matrix's; k_eff, the heat flows
+and the temperatures are the serial run's to the solver's tolerance, steady and in implicit and Crank-Nicolson steps."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from dem.driver import run
+from dem.engines.distributed.static import DistributedStaticEngine
+from dem.engines.static import StaticEngine
+from dem.geometry.periodic import PeriodicBox
+from dem.network.distributed_necks import node_keys
+from dem.network.necks import NeckHeat
+from dem.parallel import comm as mpi
+from dem.scene.parse import parse_scene
+
+COMM = mpi.world()
+
+MATERIAL = {"conductivity": 394.0, "density": 8960.0, "specific_heat": 385.0}
+NECKS = {"law": "shared-body", "neck": "union", "nodes": "necks"}
+
+
+def serial(scene):
+    engine = StaticEngine(scene)
+    engine.run()
+    return engine
+
+
+def _blocks(boundary: str, solver: dict | None = None, blocks: int = 2):
+    """A random union packing (radii +-15 %, mean overlap 0.15 of the smaller radius: necks meet) repeated
+    ``blocks`` times along x, the longest axis the ranks cut across (periodic: three, as a rank's halo reaches
+    across the period on both sides)."""
+    doc = {"material": MATERIAL, "conductance": NECKS,
+           "generator": {"kind": "random", "n": 200, "radius": 5e-5, "radius_spread": 0.15, "overlap": 0.15,
+                         "seed": 3, "boundary": boundary, "hot": 1.0, "cold": 0.0}}
+    if solver is not None:
+        doc["solver"] = solver
+    scene = parse_scene(doc)
+    p = scene.particles
+    if scene.box is not None:
+        step = scene.box.lengths[0]
+    else:
+        step = float(np.ptp(p.position[:, 0]) + 2.0 * p.radius.max())  # clear of the first block
+    many = dataclasses.replace(
+        p, position=np.vstack([p.position + [k * step, 0.0, 0.0] for k in range(blocks)]),
+        radius=np.tile(p.radius, blocks), temperature=np.tile(p.temperature, blocks),
+        material=np.tile(p.material, blocks), fixed=np.tile(p.fixed, blocks), heat=np.tile(p.heat, blocks),
+        id=np.arange(blocks * p.n))
+    if scene.box is not None:
+        b = scene.box
+        box = PeriodicBox(b.lengths * [blocks, 1.0, 1.0], b.mask, b.origin, b.drop)
+        return dataclasses.replace(scene, particles=many, box=box)
+    return dataclasses.replace(scene, particles=many,
+                               specimen=dataclasses.replace(scene.specimen, area=blocks * scene.specimen.area))
+
+
+def _compare_steady(scene):
+    result = run(scene)
+    ref = serial(scene)
+    s, r = result.summary, ref.summary()
+    assert s["ranks"] == COMM.Get_size() and s["nodes"] == r["nodes"] == "necks"
+    for key in ("neck_nodes", "bonds", "wall_bonds", "particles_necks_meeting", "particles_without_interactions"):
+        assert s[key] == r[key], key
+    assert r["particles_necks_meeting"] > 0.2 * scene.particles.n  # the union's regime: necks meet
+    assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-8  # hot - cold = 1 K
+    assert s["effective_conductivity"] == pytest.approx(r["effective_conductivity"], rel=1e-8)
+    assert s["energy_error"] < 1e-9
+    part = result.engine.part  # the halo ends inside the packing: some held nodes are neither owned nor reached
+    assert len(part.held) > len(part.used) and len(result.engine.held) < scene.particles.n
+    return s, r
+
+
+def test_a_periodic_union_packing_equals_the_serial_run():
+    s, r = _compare_steady(_blocks("periodic", blocks=3))
+    q, q_ref = np.array(s["periodic_heat_flow"]), np.array(r["periodic_heat_flow"])
+    assert np.max(np.abs(q - q_ref)) < 1e-8 * np.max(np.abs(q_ref))
+    assert s["T_mean"] == pytest.approx(r["T_mean"], abs=1e-10)
+
+
+def test_a_union_packing_between_walls_equals_the_serial_run():
+    s, r = _compare_steady(_blocks("plates"))
+    walls, walls_ref = s["boundary_heat_flow"]["walls"], r["boundary_heat_flow"]["walls"]
+    for name in ("hot", "cold"):
+        assert walls[name] == pytest.approx(walls_ref[name], rel=1e-8)
+    assert s["heat_flow"]["walls"] == pytest.approx(0.0, abs=1e-8 * abs(walls_ref["hot"]))
+
+
+def test_owned_rows_are_those_of_the_serial_matrix():
+    """Each rank's rows over the free nodes, centres and necks, by the nodes' global keys: the serial network's to
+    round-off (the halo of three bond lengths holds every element they are summed from)."""
+    scene = _blocks("periodic", blocks=3)
+    engine = DistributedStaticEngine(scene)
+    ref = serial(scene)
+    part, net, ref_heat = engine.part, engine.necks_heat, NeckHeat(ref.necks)
+    ref_keys, _ = node_keys(ref.necks, np.arange(scene.particles.n), np.zeros(scene.particles.n, dtype=np.int64),
+                            COMM)
+    ref_free = ref_keys[ref_heat.free]
+    order = np.argsort(ref_free)
+    place = lambda keys: order[np.searchsorted(ref_free, keys, sorter=order)]  # noqa: E731
+    keys = part.held[net.free]
+    own = np.flatnonzero(part.own_free)
+    assert np.array_equal(ref_free[place(keys[own])], keys[own])
+    ours = net.A[own].tocoo()
+    theirs = ref_heat.A[place(keys[own])].tocsr()
+    ours = type(theirs)((ours.data, (ours.row, place(keys[ours.col]))), shape=theirs.shape).tocsr()
+    scale = np.abs(theirs).max()
+    assert abs(ours - theirs).max() < 1e-12 * scale and ours.nnz == theirs.nnz
+    r_ref = ref_heat.r_const[place(keys[own])]
+    assert np.max(np.abs(net.r_const[own] - r_ref)) <= 1e-12 * max(np.max(np.abs(r_ref)), 1e-300)
+    assert mpi.total(COMM, len(own)) == len(ref_free)
+
+
+@pytest.mark.parametrize("integrator", ["implicit", "crank-nicolson"])
+def test_fixed_steps_equal_the_serial_steps(integrator):
+    """Between the walls from 0 C, steps of 2e-4 s (far above the stable limit: Crank-Nicolson starts with two
+    implicit Euler steps on both)."""
+    scene = _blocks("plates", {"mode": "transient", "integrator": integrator, "dt": 2e-4, "t_end": 1e-3})
+    result = run(scene)
+    ref = serial(scene)
+    s, r = result.summary, ref.summary()
+    assert s["steps"] == r["steps"] == 5
+    assert s.get("startup_steps") == r.get("startup_steps")
+    T, T_ref = result.engine.gathered_temperatures(), ref.T
+    assert 0.05 < np.ptp(T_ref) < 1.0  # heat on its way through
+    assert np.max(np.abs(T - T_ref)) < 1e-8
+    for name in ("walls", "fixed", "internal"):
+        assert s["heat_in"][name] == pytest.approx(r["heat_in"][name], rel=1e-8, abs=1e-14)
+    assert s["energy_error"] < 1e-9
