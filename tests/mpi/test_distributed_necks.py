@@ -12,7 +12,9 @@ from dem.driver import run
 from dem.engines.distributed.static import DistributedStaticEngine
 from dem.engines.static import StaticEngine
 from dem.geometry.periodic import PeriodicBox
+from dem.laws.ambient import Convection, Sources
 from dem.network.distributed_necks import node_keys
+from dem.network.heat import stable_limit
 from dem.network.necks import NeckHeat
 from dem.parallel import comm as mpi
 from dem.scene.parse import parse_scene
@@ -113,19 +115,95 @@ def test_owned_rows_are_those_of_the_serial_matrix():
     assert mpi.total(COMM, len(own)) == len(ref_free)
 
 
-@pytest.mark.parametrize("integrator", ["implicit", "crank-nicolson"])
-def test_fixed_steps_equal_the_serial_steps(integrator):
-    """Between the walls from 0 C, steps of 2e-4 s (far above the stable limit: Crank-Nicolson starts with two
-    implicit Euler steps on both)."""
-    scene = _blocks("plates", {"mode": "transient", "integrator": integrator, "dt": 2e-4, "t_end": 1e-3})
+@pytest.mark.parametrize("integrator, dt", [("implicit", 2e-4), ("crank-nicolson", 2e-4),
+                                          ("crank-nicolson", 2e-5)])
+def test_fixed_steps_equal_the_serial_steps(integrator, dt):
+    """Between the walls from 0 C, five steps: of 2e-4 s (six times the stable limit, 3.2e-5 s: Crank-Nicolson
+    starts with two implicit Euler steps on both) and of 2e-5 s (below it: no start-up on either)."""
+    scene = _blocks("plates", {"mode": "transient", "integrator": integrator, "dt": dt, "t_end": 5 * dt})
     result = run(scene)
     ref = serial(scene)
     s, r = result.summary, ref.summary()
     assert s["steps"] == r["steps"] == 5
-    assert s.get("startup_steps") == r.get("startup_steps")
+    assert s.get("startup_steps") == r.get("startup_steps") == (2 if integrator == "crank-nicolson" and dt > 1e-4
+                                                                else None)
     T, T_ref = result.engine.gathered_temperatures(), ref.T
-    assert 0.05 < np.ptp(T_ref) < 1.0  # heat on its way through
+    assert 0.01 < np.ptp(T_ref) < 1.0  # heat on its way through
     assert np.max(np.abs(T - T_ref)) < 1e-8
     for name in ("walls", "fixed", "internal"):
         assert s["heat_in"][name] == pytest.approx(r["heat_in"][name], rel=1e-8, abs=1e-14)
     assert s["energy_error"] < 1e-9
+
+
+def test_the_ranks_find_the_serial_stable_limit():
+    """Crank-Nicolson's start-up is decided on the condensed matrix's largest eigenvalue, estimated over the ranks:
+    the serial limit (dem.network.heat.stable_limit) to 0.1 %."""
+    scene = _blocks("plates", {"mode": "transient", "integrator": "crank-nicolson", "dt": 2e-4, "t_end": 1e-3})
+    limit = stable_limit(NeckHeat(serial(scene).necks))
+    part = DistributedStaticEngine(scene).part
+    T = part.initial()
+    assert not part.above_stable_limit(0.999 * limit, T) and part.above_stable_limit(1.001 * limit, T)
+
+
+def _fixed_ends(scene, floating: str = "mean", sources=None):
+    """``scene`` with its end layers held at 1 and 0 C in place of its walls and, clear of the packing, a touching
+    pair at 0.2 and 0.6 C across the middle where the two ranks part: a group that floats."""
+    p = scene.particles
+    x = p.position
+    middle, d = 0.5 * (x[:, 0].min() + x[:, 0].max()), 1.7 * float(p.radius.mean())
+    y, z = x[:, 1].max() + 10.0 * float(p.radius.max()), float(np.mean(x[:, 2]))
+    z_lo, z_hi = x[:, 2].min(), x[:, 2].max()
+    ends = (x[:, 2] < z_lo + 0.5 * d) | (x[:, 2] > z_hi - 0.5 * d)
+    T = np.where(x[:, 2] > z_hi - 0.5 * d, 0.0, np.where(ends, 1.0, 0.5))
+    pair = dataclasses.replace(
+        p, position=np.vstack([x, [[middle - d / 2, y, z], [middle + d / 2, y, z]]]),
+        radius=np.r_[p.radius, np.full(2, p.radius.mean())], temperature=np.r_[T, 0.2, 0.6],
+        material=np.r_[p.material, p.material[:2]], fixed=np.r_[ends, False, False], heat=np.r_[p.heat, 0.0, 0.0],
+        id=np.arange(p.n + 2))
+    return dataclasses.replace(scene, particles=pair, walls=(), specimen=None,
+                               sources=scene.sources if sources is None else sources,
+                               solver=dataclasses.replace(scene.solver, floating=floating))
+
+
+def test_fixed_layers_and_a_floating_pair_across_the_ranks():
+    scene = _fixed_ends(_blocks("plates"))
+    result = run(scene)
+    ref = serial(scene)
+    s, r = result.summary, ref.summary()
+    T = result.engine.gathered_temperatures()
+    assert np.max(np.abs(T - ref.T)) < 1e-8
+    assert T[-2] == pytest.approx(0.4, abs=1e-10) and T[-1] == pytest.approx(0.4, abs=1e-10)  # equal capacities
+    flows, flows_ref = s["boundary_heat_flow"], r["boundary_heat_flow"]
+    hot = max(abs(q) for q in flows_ref["groups"].values())
+    assert len(flows_ref["groups"]) == 2 and hot > 0.0
+    for name, q in flows_ref["groups"].items():
+        assert flows["groups"][name] == pytest.approx(q, rel=1e-8)
+    assert flows["fixed_total"] == pytest.approx(flows_ref["fixed_total"], abs=1e-8 * hot)
+    assert s["energy_error"] < 1e-9
+
+
+def test_convection_on_the_exposed_surfaces_across_the_ranks():
+    """The ambient (at the cold end's temperature) acts on each particle's exposed surface (computed from the
+    packing around it) through its centre: a good part of the heat from the hot end leaves through it."""
+    sources = Sources(convection=Convection(h=2e4, T_inf=0.0))
+    scene = _fixed_ends(_blocks("plates"), sources=sources)
+    result = run(scene)
+    ref = serial(scene)
+    s, r = result.summary, ref.summary()
+    assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-8
+    hot = max(abs(q) for q in r["boundary_heat_flow"]["groups"].values())
+    assert 0.02 < -r["heat_flow"]["convection"] / hot < 1.0
+    for name in ("fixed", "convection"):
+        assert s["heat_flow"][name] == pytest.approx(r["heat_flow"][name], rel=1e-8)
+    assert s["energy_error"] < 1e-9
+
+
+def test_a_floating_pair_is_refused_as_in_the_serial_run():
+    scene = _fixed_ends(_blocks("plates"), "error")
+    with pytest.raises(ValueError) as serial_error:
+        serial(scene)
+    with pytest.raises(ValueError) as ours:
+        run(scene)
+    n = scene.particles.n
+    assert f"1 connected group(s) of particles (e.g. [{n - 2}, {n - 1}])" in str(ours.value)
+    assert str(ours.value) == str(serial_error.value)
