@@ -7,7 +7,7 @@ its bond's first particle ``i`` (the lower index; the rank that counts the bond 
 network). The rows a rank solves for are those of its nodes: a centre's is its particle's element, a neck's the sum of
 the elements of its bond's two particles, one of which may be another rank's.
 
-**The halo.** Each rank holds the particles within :data:`NECK_HALO` bond lengths of its own
+**The halo.** Each rank holds the particles within ``NECK_HALO`` bond lengths of its own
 (:func:`dem.geometry.bisection.halo`) and assembles the serial network of them (:func:`dem.network.necks.neck_network`).
 A particle's element is exact where all that shapes it is held: its necks (partners within one bond length), which
 of them are live (a neck hidden inside a third sphere is none: the cut bodies of its partners, whose necks reach one
