@@ -7,8 +7,8 @@ its bond's first particle ``i`` (the lower index; the rank that counts the bond 
 network). The rows a rank solves for are those of its nodes: a centre's is its particle's element, a neck's the sum of
 the elements of its bond's two particles, one of which may be another rank's.
 
-**The halo.** Each rank holds the particles within ``NECK_HALO`` bond lengths of its own
-(:func:`dem.geometry.bisection.halo`) and assembles the serial network of them (:func:`dem.network.necks.neck_network`).
+**The halo.** Each rank holds the particles within three bond lengths of its own
+(``dem.geometry.bisection.NECK_HALO``, :func:`dem.geometry.bisection.halo`) and assembles the serial network of them (:func:`dem.network.necks.neck_network`).
 A particle's element is exact where all that shapes it is held: its necks (partners within one bond length), which
 of them are live (a neck hidden inside a third sphere is none: the cut bodies of its partners, whose necks reach one
 bond length further) and its pores' cells (neighbours within 1.5 bond lengths). The elements of the particles within
@@ -44,8 +44,6 @@ from dem.network.distributed import DistributedNetwork
 from dem.network.necks import NeckHeat, NeckNetwork
 from dem.parallel import comm as mpi
 from dem.parallel.petsc import largest_eigenvalue
-
-NECK_HALO = 3  # the halo of a rank's particles, in bond lengths (module docstring)
 
 
 class RankNeckHeat(NeckHeat):

@@ -207,3 +207,29 @@ def test_a_floating_pair_is_refused_as_in_the_serial_run():
     n = scene.particles.n
     assert f"1 connected group(s) of particles (e.g. [{n - 2}, {n - 1}])" in str(ours.value)
     assert str(ours.value) == str(serial_error.value)
+
+
+def test_a_union_packing_read_in_parts_equals_the_serial_run():
+    """A packing in parts read with neck nodes: each rank reads the particles within three bond lengths of its own
+    (not all of them; with one, as for one node per particle, its rows would be wrong), and the run is the serial run
+    of the packing read whole."""
+    from benchmarks.distributed import parts_scene
+    from dem.scene import load_scene
+    from test_distributed_network import shared_folder
+
+    folder = shared_folder()
+    if COMM.Get_rank() == 0:
+        path = parts_scene(2000, folder, 16, "plates")
+        path.write_text(path.read_text().replace('law = "rojek"', 'law = "shared-body"\nneck = "union"\n'
+                                                                  'nodes = "necks"'))
+    path = COMM.bcast(folder / "packing.toml")
+    scene = load_scene(path, part=(COMM.Get_size(), COMM.Get_rank()))
+    whole = load_scene(path)
+    assert scene.conductance.nodes == "necks"
+    assert scene.particles.n < whole.particles.n == scene.particle_count
+    result = run(scene)
+    ref = serial(whole)
+    s, r = result.summary, ref.summary()
+    assert s["neck_nodes"] == r["neck_nodes"] and s["particles_necks_meeting"] == r["particles_necks_meeting"]
+    assert s["effective_conductivity"] == pytest.approx(r["effective_conductivity"], rel=1e-8)
+    assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-8

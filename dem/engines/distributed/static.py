@@ -18,14 +18,14 @@ hence the current and Joule heat of every contact of its own particles (:func:`d
 the electrodes' currents and the Joule heat are summed over the ranks.
 
 With a node per neck (``[conductance] nodes = "necks"``, :mod:`dem.network.necks`) each rank holds the particles
-within three bond lengths of its own, assembles their network with the serial code and solves the rows of its centres
+within three bond lengths of its own (a packing in parts is read so), assembles their network with the serial code and solves the rows of its centres
 and necks (:mod:`dem.network.distributed_necks`); the heat flows into the walls, the fixed particles and across the
 period are summed from the necks' flows (:func:`dem.network.necks.neck_flows`) of each rank's own particles.
 
 What it does not do, refused up front with the reason: moving particles (another engine's), radiation (a Newton
 iteration), explicit steps and ``dt = "auto"`` (fixed implicit or Crank-Nicolson steps only), the ``clip`` and
 ``drop`` bond policies, an electrode driving a fixed current (a superposition of solves), ``--resume``; with a node
-per neck, a current and a packing in parts (whose halo is one bond length).
+per neck, a current.
 """
 
 from __future__ import annotations
@@ -38,13 +38,13 @@ from dem import memory
 from dem.engines.static import CSV_FLOWS, StaticEngine, boundary_summary
 from dem.geometry.bonds import find_bonds
 from dem.geometry.necks import meeting_in
-from dem.geometry.bisection import HALO_MARGIN, bisection, halo
+from dem.geometry.bisection import HALO_MARGIN, NECK_HALO, bisection, halo
 from dem.laws.conductance import bond_conductances
 from dem.laws.verified_range import neck_account, wide_necks
 from dem.parallel import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
 from dem.network.distributed import DistributedNetwork
-from dem.network.distributed_necks import NECK_HALO, DistributedNecks, RankNeckHeat, node_keys
+from dem.network.distributed_necks import DistributedNecks, RankNeckHeat, node_keys
 from dem.network.heat import Network, bonds_and_conductances
 from dem.network.necks import neck_flows, neck_network
 from dem.output.pieces import refuse_lammps_dump
@@ -82,9 +82,6 @@ def unsupported(scene, resume: bool = False) -> str | None:
     if scene.conductance.nodes == "necks" and scene.electrical is not None:
         return ("conductance.nodes = \"necks\" with \"electrical\" physics does not run under MPI yet (the current "
                 "through the neck nodes is solved on one process); run it without mpiexec")
-    if scene.conductance.nodes == "necks" and scene.part is not None:
-        return (f"conductance.nodes = \"necks\" does not run on a packing in parts (its parts hold a halo of one bond "
-                f"length, the neck nodes need {NECK_HALO}); read the packing whole, or run without mpiexec")
     if resume:
         return "--resume does not run under MPI; run the scene again"
     return None
