@@ -32,8 +32,9 @@ temperature is their initial one, as :func:`dem.network.necks.steady_necks` does
 ranks (:class:`dem.network.distributed.RankSolves`); the necks start where their rows hold at the initial
 temperatures, solved over the ranks (:meth:`DistributedNecks.initial`). A Crank-Nicolson run starts with implicit
 Euler steps where the step is above the stable limit of the centres' condensed matrix (:func:`dem.network.heat.integrate`):
-its largest eigenvalue comes from the Lanczos estimate of conjugate gradients on the condensed operator over the
-ranks (:meth:`DistributedNecks.above_stable_limit`).
+its largest eigenvalue comes from the Lanczos estimate of ``LANCZOS_STEPS`` conjugate gradient steps on the condensed
+operator over the ranks (:meth:`DistributedNecks.stable_limit`; on the packings of ``tests/mpi`` within 3e-5 of the
+serial limit, each step one solve of the necks' rows).
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ from dem.network.necks import NeckHeat, NeckNetwork
 from dem.parallel import comm as mpi
 from dem.parallel.petsc import largest_eigenvalue
 
+LANCZOS_STEPS = 100  # the Lanczos steps of the stable limit's eigenvalue (DistributedNecks.stable_limit)
 
 class RankNeckHeat(NeckHeat):
     """:class:`dem.network.necks.NeckHeat` over one rank's held nodes, counting the flows of its own particles
@@ -218,24 +220,23 @@ class DistributedNecks(DistributedNetwork):
             self._initial = self.halo_filled(T)[net.free]
         return self._initial.copy()
 
-    def above_stable_limit(self, dt: float, T_F: np.ndarray) -> bool:
-        r"""Whether a fixed step ``dt`` is above the stable limit at ``T_F``: :math:`2 / \lambda_\max` of the centres'
-        condensed matrix :math:`C^{-1/2} (A_{cc} - A_{cn} A_{nn}^{-1} A_{nc}) C^{-1/2}`, as the serial run has it
-        (:func:`dem.network.heat.stable_limit`), its largest eigenvalue estimated over the ranks
-        (:func:`dem.parallel.petsc.largest_eigenvalue`; each product solves the necks' rows on PETSc): where a
-        Crank-Nicolson run starts with implicit Euler steps (:func:`dem.network.heat.integrate`).
+    def stable_limit(self, T_F: np.ndarray, steps: int = LANCZOS_STEPS) -> float:
+        r"""The largest stable explicit step at ``T_F`` (s): :math:`2 / \lambda_\max` of the centres' condensed matrix
+        :math:`C^{-1/2} (A_{cc} - A_{cn} A_{nn}^{-1} A_{nc}) C^{-1/2}`, as the serial run has it
+        (:func:`dem.network.heat.stable_limit`), its largest eigenvalue estimated over the ranks in ``steps`` Lanczos
+        steps (:func:`dem.parallel.petsc.largest_eigenvalue`; each product solves the necks' rows on PETSc).
 
         Parameters
         ----------
-        dt : float
-            The step (s).
         T_F : numpy.ndarray
             Temperatures of the local free nodes (K or degC), where the ambient terms are linearised.
+        steps : int
+            The Lanczos steps (conjugate gradient iterations), >= 1.
 
         Returns
         -------
-        bool
-            ``dt`` is above the limit.
+        float
+            The limit (s; ``inf`` without any coupling).
         """
         net = self.net
         M = net.matrix(net.sinks(T_F))
@@ -255,12 +256,29 @@ class DistributedNecks(DistributedNetwork):
             return s * (M @ v)[centres]
 
         try:
-            lam = largest_eigenvalue(self.comm, condensed, int(np.count_nonzero(centres)))
+            lam = largest_eigenvalue(self.comm, condensed, int(np.count_nonzero(centres)), max_iterations=steps)
         finally:
             if solver is not None:
-                self.linear_iterations += solver.iterations
                 solver.destroy()
-        return lam > 0.0 and dt > 2.0 / lam
+        return 2.0 / lam if lam > 0.0 else np.inf
+
+    def above_stable_limit(self, dt: float, T_F: np.ndarray) -> bool:
+        """Whether a fixed step ``dt`` is above the stable limit at ``T_F`` (:meth:`stable_limit`): where a
+        Crank-Nicolson run starts with implicit Euler steps (:func:`dem.network.heat.integrate`).
+
+        Parameters
+        ----------
+        dt : float
+            The step (s).
+        T_F : numpy.ndarray
+            Temperatures of the local free nodes (K or degC), where the ambient terms are linearised.
+
+        Returns
+        -------
+        bool
+            ``dt`` is above the limit.
+        """
+        return dt > self.stable_limit(T_F)
 
     # --------------------------------------------------------------------------------------------- groups
     def anchors(self, sinks: dict) -> np.ndarray:

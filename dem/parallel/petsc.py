@@ -178,10 +178,11 @@ class PetscSolver:
         return self._x.getArray().copy()
 
 
-def largest_eigenvalue(comm, apply, n_local: int, rtol: float = 1e-10, max_iterations: int = 1000) -> float:
+def largest_eigenvalue(comm, apply, n_local: int, rtol: float = 1e-10, max_iterations: int = 100) -> float:
     """The largest eigenvalue of a symmetric positive (semi)definite operator shared out among the ranks: the Lanczos
     estimate of conjugate gradients on it (PETSc's ``KSPComputeExtremeSingularValues``, no preconditioner) from a
-    random start, run to ``rtol`` (by then the extreme eigenvalues of the Krylov space are converged).
+    random start, after ``max_iterations`` steps or where CG reaches ``rtol`` (the largest eigenvalue of the Krylov
+    space converges long before the solve does). It never exceeds the operator's.
 
     Parameters
     ----------
@@ -195,7 +196,7 @@ def largest_eigenvalue(comm, apply, n_local: int, rtol: float = 1e-10, max_itera
     rtol : float
         The relative residual at which CG stops.
     max_iterations : int
-        The most CG iterations.
+        The most CG iterations (Lanczos steps).
 
     Returns
     -------
