@@ -7,15 +7,15 @@ its bond's first particle ``i`` (the lower index; the rank that counts the bond 
 network). The rows a rank solves for are those of its nodes: a centre's is its particle's element, a neck's the sum of
 the elements of its bond's two particles, one of which may be another rank's.
 
-**The halo.** Each rank holds the particles within three bond lengths of its own
-(``dem.geometry.bisection.NECK_HALO``, :func:`dem.geometry.bisection.halo`) and assembles the serial network of them (:func:`dem.network.necks.neck_network`).
-A particle's element is exact where all that shapes it is held: its necks (partners within one bond length), which
-of them are live (a neck hidden inside a third sphere is none: the cut bodies of its partners, whose necks reach one
-bond length further) and its pores' cells (neighbours within 1.5 bond lengths). The elements of the particles within
-one bond length of a rank's own, the partners of its necks, are therefore exact with a halo of three bond lengths,
-and so is every row the rank owns: the serial matrix's row, up to the order of its sums. The nodes those rows reach
-are the rank's *used* nodes; the rest of the halo (its fringe, whose elements miss neighbours) is held but never
-solved for nor exchanged.
+**The halo.** Each rank holds the particles within three bond lengths of its own (``dem.geometry.bisection.NECK_HALO``,
+:func:`dem.geometry.bisection.halo`) and assembles the serial network of them (:func:`dem.network.necks.neck_network`).
+A particle's element is exact where all that shapes it is held: its necks (partners within one bond length), which of
+them are live (a neck hidden inside a third sphere is none: the cut bodies of its partners, whose necks reach one bond
+length further) and its pores' cells (neighbours within 1.5 bond lengths). The elements of the particles within one bond
+length of a rank's own, the partners of its necks, are therefore exact with a halo of three bond lengths, and so is
+every row the rank owns: the serial matrix's row, up to the order of its sums. The nodes those rows reach are the rank's
+*used* nodes; the rest of the halo (its fringe, whose elements miss neighbours) is held but never solved for nor
+exchanged.
 
 **Numbering.** A node is known to every rank by a global key: a centre by its particle's index, a neck by its first
 particle's index and its place among that particle's bonds (sorted by partner and image shift: the same on every rank
@@ -28,13 +28,13 @@ fixed centre, a wall or an ambient is solved as it is; any other group (a period
 floating one) has its first node held at 0 and is then shifted so that its particles' capacity-weighted mean
 temperature is their initial one, as :func:`dem.network.necks.steady_necks` does.
 
-**Time steps.** The serial loop (:func:`dem.network.heat.integrate`) with this rank's part and the solves over the
-ranks (:class:`dem.network.distributed.RankSolves`); the necks start where their rows hold at the initial
-temperatures, solved over the ranks (:meth:`DistributedNecks.initial`). A Crank-Nicolson run starts with implicit
-Euler steps where the step is above the stable limit of the centres' condensed matrix (:func:`dem.network.heat.integrate`):
-its largest eigenvalue comes from the Lanczos estimate of ``LANCZOS_STEPS`` conjugate gradient steps on the condensed
-operator over the ranks (:meth:`DistributedNecks.stable_limit`; on the packings of ``tests/mpi`` within 3e-5 of the
-serial limit, each step one solve of the necks' rows).
+**Time steps.** The serial loop (:func:`dem.network.heat.integrate`) with this rank's part and the solves over the ranks
+(:class:`dem.network.distributed.RankSolves`); the necks start where their rows hold at the initial temperatures, solved
+over the ranks (:meth:`DistributedNecks.initial`). A Crank-Nicolson run starts with implicit Euler steps where the step
+is above the stable limit of the centres' condensed matrix (:func:`dem.network.heat.integrate`): its largest eigenvalue
+comes from the Lanczos estimate of ``LANCZOS_STEPS`` conjugate gradient steps on the condensed operator over the ranks
+(:meth:`DistributedNecks.stable_limit`; on the packings of ``tests/mpi`` within 3e-5 of the serial limit, each step one
+solve of the necks' rows).
 """
 
 from __future__ import annotations
@@ -47,6 +47,7 @@ from dem.parallel import comm as mpi
 from dem.parallel.petsc import largest_eigenvalue
 
 LANCZOS_STEPS = 100  # the Lanczos steps of the stable limit's eigenvalue (DistributedNecks.stable_limit)
+
 
 class RankNeckHeat(NeckHeat):
     """:class:`dem.network.necks.NeckHeat` over one rank's held nodes, counting the flows of its own particles

@@ -18,9 +18,10 @@ hence the current and Joule heat of every contact of its own particles (:func:`d
 the electrodes' currents and the Joule heat are summed over the ranks.
 
 With a node per neck (``[conductance] nodes = "necks"``, :mod:`dem.network.necks`) each rank holds the particles
-within three bond lengths of its own (a packing in parts is read so), assembles their network with the serial code and solves the rows of its centres
-and necks (:mod:`dem.network.distributed_necks`); the heat flows into the walls, the fixed particles and across the
-period are summed from the necks' flows (:func:`dem.network.necks.neck_flows`) of each rank's own particles.
+within three bond lengths of its own (a packing in parts is read so), assembles their network with the serial code
+and solves the rows of its centres and necks (:mod:`dem.network.distributed_necks`); the heat flows into the walls,
+the fixed particles and across the period are summed from the necks' flows (:func:`dem.network.necks.neck_flows`) of
+each rank's own particles.
 
 What it does not do, refused up front with the reason: moving particles (another engine's), radiation (a Newton
 iteration), explicit steps and ``dt = "auto"`` (fixed implicit or Crank-Nicolson steps only), the ``clip`` and
