@@ -198,14 +198,16 @@ def test_a_scene_with_neck_nodes_and_an_ambient_runs_the_neck_solve():
     assert s["T_max"] == pytest.approx(res.T.max(), rel=1e-12) and s["energy_error"] < 1e-12
 
 
-def test_mpi_still_refuses_neck_nodes():
+def test_mpi_takes_neck_nodes_with_an_ambient():
+    """Neck nodes with convection run on MPI ranks (dem.network.distributed_necks; tests/mpi compares them with the
+    serial run)."""
     from dem import make_scene
     from dem.engines.distributed.static import unsupported
 
     particles, walls, _ = _packing()
     scene = make_scene(particles.position, particles.radius, particles.temperature, materials=(UNIT,), walls=walls,
                        mode="steady", conductance=NECKS, sources=CONVECTION)
-    assert unsupported(scene) == "conductance.nodes = \"necks\" does not run under MPI yet; run it without mpiexec"
+    assert unsupported(scene) is None
 
 
 def test_a_transient_chain_scene_with_an_ambient_on_neck_nodes_is_todays():

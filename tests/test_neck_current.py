@@ -162,3 +162,11 @@ def test_a_scene_with_current_and_convection_on_neck_nodes_balances_its_heat():
     assert flows["internal"] == pytest.approx(0.5 * e["joule_heat"], rel=1e-12) and e["joule_heat"] > 0
     assert flows["walls"] + flows["convection"] == pytest.approx(-flows["internal"], rel=1e-10)
     assert s["energy_error"] < 1e-10
+
+
+def test_mpi_refuses_a_current_through_neck_nodes_in_one_line():
+    from dem.engines.distributed.static import unsupported
+
+    assert unsupported(_joule_chain("necks")) == (
+        "conductance.nodes = \"necks\" with \"electrical\" physics does not run under MPI yet (the current through "
+        "the neck nodes is solved on one process); run it without mpiexec")

@@ -10,7 +10,8 @@ not as the slabs' ever larger share.
 :func:`halo` lists the particles within ``reach`` of a cell's particles that another rank owns: with ``reach`` one
 bond length (twice the largest radius: two spheres bond only when ``d < r_i + r_j``), every bond of an owned particle
 has its partner among the owned and the halo particles, so a bond search over those finds all of them. On periodic
-axes the distance is taken to the nearest image.
+axes the distance is taken to the nearest image. The network with a node per neck needs ``NECK_HALO`` bond lengths
+(:mod:`dem.network.distributed_necks`).
 
 A packing stored in parts (:mod:`dem.scene.packing_files.parts`) is shared out by its blocks, not its particles: the
 same bisection over the blocks' centres, each weighted by its particle count, so that a rank reads only its blocks and
@@ -28,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 HALO_MARGIN = 1.0 + 1e-9  # the halo's reach: this x one bond length (two largest radii), against round-off
+NECK_HALO = 3  # the halo of a network with a node per neck, in bond lengths (dem.network.distributed_necks)
 
 
 def bisection(position: np.ndarray, parts: int, lengths: np.ndarray | None = None,

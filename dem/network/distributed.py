@@ -195,14 +195,16 @@ class DistributedNetwork:
         Global indices of the held particles, sorted.
     owner : numpy.ndarray
         The rank owning each held particle.
+    exchange : dem.parallel.comm.HaloExchange or None
+        What brings the halo's values from their owners (:meth:`fill`); None: that of all held particles.
     """
 
-    def __init__(self, comm, net: Network, held: np.ndarray, owner: np.ndarray):
+    def __init__(self, comm, net: Network, held: np.ndarray, owner: np.ndarray, exchange=None):
         self.comm, self.net, self.held = comm, net, held
         self.rank, self.size = comm.Get_rank(), comm.Get_size()
         self.mine = owner == self.rank  # over the held particles
         self.own_free = self.mine[net.free]  # over the local free particles
-        self.exchange = mpi.HaloExchange(comm, held, owner)
+        self.exchange = mpi.HaloExchange(comm, held, owner) if exchange is None else exchange
         self.linear_iterations = 0
 
     # ------------------------------------------------------------------------------------------- reductions
@@ -285,6 +287,38 @@ class DistributedNetwork:
         """
         return surely_stiff(dt, self.net.matrix(self.net.sinks(T_F)), self.net.C, self.own_free, self.maximum)
 
+    def fill(self, values: np.ndarray) -> np.ndarray:
+        """``values`` over the held nodes (owned entries valid) with the halo's entries set from their owners
+        (:meth:`dem.parallel.comm.HaloExchange.fill`).
+
+        Parameters
+        ----------
+        values : numpy.ndarray
+            One value per held node (any unit), changed in place.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``values``.
+        """
+        return self.exchange.fill(values)
+
+    def held_values(self, T_F: np.ndarray) -> np.ndarray:
+        """The temperatures of all held nodes from those of the local free ones (fixed ones their own), before the
+        halo's are brought from their owners.
+
+        Parameters
+        ----------
+        T_F : numpy.ndarray
+            Temperatures of the local free nodes (K or degC).
+
+        Returns
+        -------
+        numpy.ndarray
+            Temperatures of all held nodes (K or degC).
+        """
+        return self.net.full(T_F)
+
     def halo_filled(self, T_F: np.ndarray) -> np.ndarray:
         """All held temperatures (fixed ones too) from the owned entries of ``T_F`` (over the local free ones).
 
@@ -298,7 +332,7 @@ class DistributedNetwork:
         numpy.ndarray
             Temperatures of all held particles, the halo's from their owners.
         """
-        return self.exchange.fill(self.net.full(T_F))
+        return self.fill(self.held_values(T_F))
 
     def flows(self, T_F: np.ndarray, sinks: dict) -> dict:
         """Heat flow (W) into all free particles through each boundary
@@ -359,9 +393,9 @@ class DistributedNetwork:
         n_global = self.total(count)
         row = np.full(len(self.net.free), -1.0)
         row[mine] = offset + np.arange(count)
-        held = np.full(self.net.particles.n, -1.0)
+        held = np.full(len(self.held), -1.0)
         held[self.net.free] = row
-        self.exchange.fill(held)
+        self.fill(held)
         return held[self.net.free].astype(np.int64), n_global
 
     def rows(self, M: sp.csr_matrix, row: np.ndarray) -> sp.csr_matrix:
@@ -430,21 +464,7 @@ class DistributedNetwork:
         where[net.free] = np.arange(n_free)
         a, b = where[g.i], where[g.j]
         live = (g.K > 0.0) & (a >= 0) & (b >= 0)
-        graph = sp.csr_matrix((np.ones(int(live.sum())), (a[live], b[live])), shape=(n_free, n_free))
-        n_comp, comp = connected_components(graph, directed=False)
-        label = self.held[net.free].astype(float)
-        while True:
-            smallest = np.full(n_comp, np.inf)
-            np.minimum.at(smallest, comp, label)
-            new = smallest[comp]
-            held = np.full(net.particles.n, -1.0)
-            held[net.free] = new
-            new = self.exchange.fill(held)[net.free]
-            changed = self.total(int(np.any(new != label)))
-            label = new
-            if not changed:
-                break
-        label = label.astype(np.int64)
+        label = self.components(a[live], b[live], self.held[net.free])
         own = self.own_free
         anchored = self._union(label[own & (anchor > 0)])
         jumping = np.zeros(0, dtype=np.int64)
@@ -456,6 +476,40 @@ class DistributedNetwork:
         others = self._union(label[own])
         floating = np.setdiff1d(others, np.union1d(anchored, jumping))
         return Groups(label, anchored, np.setdiff1d(jumping, anchored), floating)
+
+    def components(self, a: np.ndarray, b: np.ndarray, start: np.ndarray) -> np.ndarray:
+        """The connected components of the graph over all ranks (module docstring): per local free node, the
+        smallest of ``start`` over its component. The edges ``(a, b)`` (local free nodes) must hold every edge of an
+        owned node; the others may be missing.
+
+        Parameters
+        ----------
+        a, b : numpy.ndarray
+            The two local free nodes of each edge.
+        start : numpy.ndarray
+            Per local free node, its own label (a global number, distinct over the ranks; owned entries valid).
+
+        Returns
+        -------
+        numpy.ndarray
+            Per local free node, its component's label (int).
+        """
+        net, n_free = self.net, len(self.net.free)
+        graph = sp.csr_matrix((np.ones(len(a)), (a, b)), shape=(n_free, n_free))
+        n_comp, comp = connected_components(graph, directed=False)
+        label = np.asarray(start, dtype=float)
+        while True:
+            smallest = np.full(n_comp, np.inf)
+            np.minimum.at(smallest, comp, label)
+            new = smallest[comp]
+            held = np.full(len(self.held), -1.0)
+            held[net.free] = new
+            new = self.fill(held)[net.free]
+            changed = self.total(int(np.any(new != label)))
+            label = new
+            if not changed:
+                break
+        return label.astype(np.int64)
 
     def _union(self, labels: np.ndarray) -> np.ndarray:
         """The labels found on any rank, sorted and once each."""

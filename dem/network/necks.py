@@ -122,10 +122,10 @@ source of heat there); summed over the particles it is the power :math:`\sum_e V
 of :math:`I^2/G` that the particle network gives each particle: today's current, potentials and Joule heat. A particle
 touching two electrodes (its element would join them directly, an edge the solve has no place for) is refused.
 
-**MPI (not yet implemented).** A neck node is owned by the lower of the two ranks that own its particles; the other
-rank holds it as a ghost (like a particle across the cut), and the element of a particle is assembled by the rank that
-owns the particle, its rows for a ghost neck sent to the neck's owner (the same exchange the distributed Laplacian
-makes for its halo rows, :mod:`dem.network.distributed`).
+**MPI.** :mod:`dem.network.distributed_necks` shares the network out among ranks: a centre node on the rank that
+owns its particle, a neck node on the rank that owns its bond's first particle, each rank holding a halo of three bond
+lengths so that every row it owns is the serial network's (:class:`NeckHeat`'s ``own``: each rank counts its own
+particles' flows).
 """
 
 from __future__ import annotations
@@ -570,9 +570,13 @@ class NeckHeat(BalanceScales):
     sources : dem.laws.ambient.Sources or None
         Convection and radiation to an ambient (an ``"exposed"`` area fraction resolved against the packing); None:
         none.
+    own : numpy.ndarray or None
+        Per particle, whether :meth:`flows` and :meth:`flow_sums` count its wall ends, its fixed centre, its source
+        and its ambient exchange (a rank's own particles, :mod:`dem.network.distributed_necks`); None: all.
     """
 
-    def __init__(self, net: NeckNetwork, linear: str = "auto", rtol: float = 1e-12, sources: Sources | None = None):
+    def __init__(self, net: NeckNetwork, linear: str = "auto", rtol: float = 1e-12, sources: Sources | None = None,
+                 own: np.ndarray | None = None):
         p = net.particles
         n, m = p.n, len(net.live)
         self.net, self.particles = net, p
@@ -600,6 +604,12 @@ class NeckHeat(BalanceScales):
         self._walls = len(net.live_walls)
         group = np.where(wall, end - 2 * m, self._walls + np.searchsorted(held, np.where(fed, row, 0)))
         take = wall | fed
+        self._counted = slice(None)  # the free nodes whose source and ambient exchange count
+        if own is not None:
+            own = np.asarray(own, dtype=bool)
+            counted = np.concatenate([own[net.bonds.wall_particle[net.live_walls]], own[held]])
+            take[take] = counted[group[take]]
+            self._counted = np.concatenate([own[centres], np.zeros(m, dtype=bool)])
         self._terms = (col[take], value[take], known[take], group[take], self._walls + len(held))
         self.wall_temperature = known[(col < 0) & (net.col_end >= 0)]
         self._solve = (linear, rtol)
@@ -727,11 +737,11 @@ class NeckHeat(BalanceScales):
         dict
             ``{"fixed": W, "walls": W, "internal": W}`` and a flow per ambient exchange.
         """
-        q = self._boundary(T_F)[0]
+        q, s = self._boundary(T_F)[0], self._counted
         out = {"fixed": float(q[self._walls:].sum()), "walls": float(q[:self._walls].sum()),
-               "internal": float(self.heat.sum())}
+               "internal": float(self.heat[s].sum())}
         for name, (g, b) in sinks.items():
-            out[name] = float(b.sum() - g @ T_F)
+            out[name] = float(b[s].sum() - g[s] @ T_F[s])
         return out
 
     def flow_sums(self, T_F: np.ndarray, sinks: dict) -> tuple[float, float]:
@@ -751,12 +761,13 @@ class NeckHeat(BalanceScales):
             The two sums (W).
         """
         q, gross = self._boundary(T_F)
-        net = gross_all = float(np.abs(self.heat).sum())
+        s = self._counted
+        net = gross_all = float(np.abs(self.heat[s]).sum())
         net += float(np.abs(q).sum())
         gross_all += gross
         for g, b in sinks.values():
-            net += float(np.abs(b - g * T_F).sum())
-            gross_all += float(np.abs(b).sum() + np.abs(g * T_F).sum())
+            net += float(np.abs(b[s] - g[s] * T_F[s]).sum())
+            gross_all += float(np.abs(b[s]).sum() + np.abs(g[s] * T_F[s]).sum())
         return net, gross_all
 
 

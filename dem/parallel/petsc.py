@@ -176,3 +176,56 @@ class PetscSolver:
                              f"{self.ksp.getResidualNorm() / max(self._b.norm(), 1e-300):.3g}); set other options "
                              f"in PETSC_OPTIONS (e.g. -pc_type gamg)")
         return self._x.getArray().copy()
+
+
+def largest_eigenvalue(comm, apply, n_local: int, rtol: float = 1e-10, max_iterations: int = 100) -> float:
+    """The largest eigenvalue of a symmetric positive (semi)definite operator shared out among the ranks: the Lanczos
+    estimate of conjugate gradients on it (PETSc's ``KSPComputeExtremeSingularValues``, no preconditioner) from a
+    random start, after ``max_iterations`` steps or where CG reaches ``rtol`` (the largest eigenvalue of the Krylov
+    space converges long before the solve does). It never exceeds the operator's.
+
+    Parameters
+    ----------
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
+    apply : callable
+        ``apply(x)``: this rank's entries of the operator times ``x`` from this rank's entries of ``x``; called on
+        every rank together (it may communicate).
+    n_local : int
+        This rank's entries.
+    rtol : float
+        The relative residual at which CG stops.
+    max_iterations : int
+        The most CG iterations (Lanczos steps).
+
+    Returns
+    -------
+    float
+        The estimate (the operator's unit; 0 for an empty operator).
+    """
+    PETSc = petsc()
+    n_global = comm.allreduce(n_local)
+    if n_global == 0:
+        return 0.0
+
+    class Operator:
+        def mult(self, mat, x, y):
+            y.setArray(apply(x.getArray(readonly=True).copy()))
+
+    A = PETSc.Mat().createPython(((n_local, n_global), (n_local, n_global)), Operator(), comm=comm)
+    A.setUp()
+    ksp = PETSc.KSP().create(comm=comm)
+    b, x = A.createVecs()
+    try:
+        ksp.setOperators(A)
+        ksp.setType("cg")
+        ksp.getPC().setType("none")
+        ksp.setComputeSingularValues(True)
+        ksp.setTolerances(rtol=rtol, atol=0.0, divtol=NO_DIVERGENCE_TEST, max_it=max_iterations)
+        b.setArray(np.random.default_rng(comm.Get_rank()).uniform(-1.0, 1.0, n_local))
+        ksp.solve(b, x)
+        largest, _ = ksp.computeExtremeSingularValues()
+    finally:
+        for obj in (ksp, A, b, x):
+            obj.destroy()
+    return float(largest)

@@ -17,6 +17,7 @@ import numpy as np
 
 from dem.scene import packing_files, state_file
 from dem.geometry import generators
+from dem.geometry.bisection import NECK_HALO
 from dem.laws.conductance import ConductanceSpec
 from dem.laws.fields import material_from_table
 from dem.laws.contact import CONTACT_LAWS, law_module
@@ -623,7 +624,9 @@ def parse_scene(doc: dict, source: str = "scene", base_dir: pathlib.Path | None 
     elif ("particles" in doc) == ("generator" in doc):
         raise ValueError("[particles] or [generator]: give exactly one of them")
     elif "particles" in doc:
-        in_part = None if part is None or engine != "static" else (*part, lambda file_box: _scene_box(doc, file_box))
+        necks = isinstance(doc.get("conductance"), dict) and doc["conductance"].get("nodes") == "necks"
+        in_part = None if part is None or engine != "static" else (*part, lambda file_box: _scene_box(doc, file_box),
+                                                                      NECK_HALO if necks else 1)
         particles, walls, specimen, velocity, box, held = _explicit_particles(doc["particles"], materials, base_dir,
                                                                               in_part)
     else:

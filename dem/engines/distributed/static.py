@@ -17,9 +17,16 @@ serial solve leaves them: they carry nothing). Each rank then has the potentials
 hence the current and Joule heat of every contact of its own particles (:func:`dem.network.current.contact_currents`);
 the electrodes' currents and the Joule heat are summed over the ranks.
 
+With a node per neck (``[conductance] nodes = "necks"``, :mod:`dem.network.necks`) each rank holds the particles
+within three bond lengths of its own (a packing in parts is read so), assembles their network with the serial code
+and solves the rows of its centres and necks (:mod:`dem.network.distributed_necks`); the heat flows into the walls,
+the fixed particles and across the period are summed from the necks' flows (:func:`dem.network.necks.neck_flows`) of
+each rank's own particles.
+
 What it does not do, refused up front with the reason: moving particles (another engine's), radiation (a Newton
 iteration), explicit steps and ``dt = "auto"`` (fixed implicit or Crank-Nicolson steps only), the ``clip`` and
-``drop`` bond policies, an electrode driving a fixed current (a superposition of solves), ``--resume``.
+``drop`` bond policies, an electrode driving a fixed current (a superposition of solves), ``--resume``; with a node
+per neck, a current.
 """
 
 from __future__ import annotations
@@ -30,13 +37,17 @@ import numpy as np
 
 from dem import memory
 from dem.engines.static import CSV_FLOWS, StaticEngine, boundary_summary
+from dem.geometry.bonds import find_bonds
 from dem.geometry.necks import meeting_in
-from dem.geometry.bisection import HALO_MARGIN, bisection, halo
+from dem.geometry.bisection import HALO_MARGIN, NECK_HALO, bisection, halo
+from dem.laws.conductance import bond_conductances
 from dem.laws.verified_range import neck_account, wide_necks
 from dem.parallel import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
 from dem.network.distributed import DistributedNetwork
+from dem.network.distributed_necks import DistributedNecks, RankNeckHeat, node_keys
 from dem.network.heat import Network, bonds_and_conductances
+from dem.network.necks import neck_flows, neck_network
 from dem.output.pieces import refuse_lammps_dump
 
 
@@ -69,8 +80,9 @@ def unsupported(scene, resume: bool = False) -> str | None:
         name = e.names[int(np.flatnonzero(~e.fixed_potential)[0])]
         return (f"walls.{name}.current: an electrode driving a fixed current does not run under MPI (its potential "
                 f"needs a superposition of solves); give it a potential, or run without mpiexec")
-    if scene.conductance.nodes == "necks":
-        return "conductance.nodes = \"necks\" does not run under MPI yet; run it without mpiexec"
+    if scene.conductance.nodes == "necks" and scene.electrical is not None:
+        return ("conductance.nodes = \"necks\" with \"electrical\" physics does not run under MPI yet (the current "
+                "through the neck nodes is solved on one process); run it without mpiexec")
     if resume:
         return "--resume does not run under MPI; run the scene again"
     return None
@@ -130,6 +142,7 @@ class DistributedStaticEngine(StaticEngine):
         self.t_start = float(scene.start_time)
         self.t, self.steps = self.t_start, 0
         self.flows, self.details, self.restart = {}, {}, None
+        self.necks = None  # with a node per neck: the network of the held particles (dem.network.necks)
         owner = mpi.agree(self.comm, lambda: self._build(scene, rank))  # no collective call inside: a bond out of
         particles = self.scene.particles                                  # range stops every rank alike
         self.potential, self.circuit = None, None
@@ -138,11 +151,18 @@ class DistributedStaticEngine(StaticEngine):
         wall_temperature = np.array([w.temperature for w in scene.walls], dtype=float)
         self.network = Network(particles, self.bonds, self.K_pairs, self.K_walls, wall_temperature, scene.sources,
                                scene.box)
-        self.part = DistributedNetwork(self.comm, self.network, self.held, owner)
+        if self.necks is None:
+            self.part = DistributedNetwork(self.comm, self.network, self.held, owner)
+        else:  # a node per neck (dem.network.distributed_necks)
+            self.necks_heat = RankNeckHeat(self.necks, scene.solver.linear, sources=self.network.sources,
+                                           own=self.mine)
+            keys, node_owner = node_keys(self.necks, self.held, owner, self.comm)
+            self.part = DistributedNecks(self.comm, self.necks_heat, keys, node_owner)
 
     def _build(self, scene, rank: int) -> np.ndarray:
         """This rank's particles, bonds and network (no communication); returns the owner of each held particle."""
-        p, box = scene.particles, scene.box
+        p, box, spec = scene.particles, scene.box, scene.conductance
+        nodes = spec.nodes
         if p.n < self.ranks:
             raise ValueError(f"{p.n} particles on {self.ranks} ranks: use at most {p.n} ranks")
         if scene.solver.mode == "transient":
@@ -157,7 +177,7 @@ class DistributedStaticEngine(StaticEngine):
         else:
             lengths = None if box is None else np.where(box.mask, box.lengths, np.inf)
             owner = bisection(p.position, self.ranks, lengths)
-            reach = 2.0 * float(p.radius.max()) * HALO_MARGIN
+            reach = 2.0 * float(p.radius.max()) * HALO_MARGIN * (NECK_HALO if nodes == "necks" else 1)
             self.owned = np.flatnonzero(owner == rank)
             held = np.union1d(self.owned, halo(p.position, owner, rank, reach, None if box is None else box.lengths,
                                               None if box is None else box.mask))
@@ -167,17 +187,39 @@ class DistributedStaticEngine(StaticEngine):
         self.scene = replace(scene, particles=local)
         mine = owner_held == rank
         try:
-            bonds, K_pairs, K_walls = bonds_and_conductances(local, scene.walls, scene.conductance, box=box)
+            if nodes == "necks":  # all the bonds of the held particles (module docstring of distributed_necks)
+                bonds = find_bonds(local, tuple(scene.walls), spec.contact, spec.out_of_range, box=box)
+                self.necks, self.plain = self._neck_network(local, bonds)
+                K_pairs, K_walls = bond_conductances(spec, local, bonds, box=box, walls=tuple(scene.walls),
+                                                     union=self.necks.union)
+            else:
+                bonds, K_pairs, K_walls = bonds_and_conductances(local, scene.walls, spec, box=box)
         except ValueError as exc:  # its counts and indices are of this rank's particles
             raise ValueError(f"rank {rank} of {self.ranks}, its {len(held)} particles numbered from 0 in the "
                              f"scene's order: {exc}") from None
         pairs, walls = mine[bonds.i] | mine[bonds.j], mine[bonds.wall_particle]
+        self.kept = (pairs, walls)  # the bonds of this rank's particles among those found
         self.bonds, self.K_pairs, self.K_walls = bonds.subset(pairs, walls), K_pairs[pairs], K_walls[walls]
         self.held, self.mine = held, mine
         self.meeting = meeting_in(local, scene.walls, self.bonds, box)  # right for the owned: all their bonds are here
-        self.wide = wide_necks(local.radius, self.bonds, self.meeting, scene.conductance.law)
+        self.wide = wide_necks(local.radius, self.bonds, self.meeting, spec.law, nodes)
         self.T = local.temperature.astype(float)
         return owner_held
+
+    def _neck_network(self, local, bonds) -> tuple:
+        """The network with a node per neck of the held particles (:func:`dem.network.necks.neck_network`) and,
+        per held particle, whether its element dropped its interactions (``plain``)."""
+        from dem.laws.shared_body import particle_elements
+
+        made = []
+
+        def elements(*args):
+            made.append(particle_elements(*args))
+            return made[-1]
+
+        scene = self.scene
+        net = neck_network(scene.conductance, local, bonds, box=scene.box, walls=scene.walls, elements=elements)
+        return net, np.asarray(made[0].plain, dtype=bool)
 
     def _joule_heated(self, particles, owner: np.ndarray):
         """The held particles with the absorbed Joule heat of the current added to their heat sources (module
@@ -225,6 +267,7 @@ class DistributedStaticEngine(StaticEngine):
             The network has no solution (a floating group) or the solve failed.
         """
         s = self.scene.solver
+        nodes = self.scene.conductance.nodes
         out = {"law": self.scene.conductance.law, "contact": self.bonds.contact, "bonds_clipped": 0,
                "bonds_dropped": 0, "wall_bonds": self.part.total(int(self.bonds.n_walls)), "ranks": self.ranks}
         b = self.bonds
@@ -232,9 +275,18 @@ class DistributedStaticEngine(StaticEngine):
                                 self.full_scene.particle_count, b.contact,
                                 self.part.total(int(np.count_nonzero(self.mine[b.i]) + b.n_walls)),
                                 self.full_scene.conductance.law,
-                                self.part.total(int(np.count_nonzero(self.wide[self.mine])))))
+                                self.part.total(int(np.count_nonzero(self.wide[self.mine]))), nodes=nodes))
+        if self.necks is not None:
+            live = self.mine[self.necks.bonds.i[self.necks.live]]
+            out.update(nodes="necks", neck_nodes=self.part.total(int(np.count_nonzero(live))),
+                       particles_without_interactions=self.part.total(int(np.count_nonzero(self.plain[self.mine]))))
         observer = self._observed(observe)
-        if s.mode == "steady":
+        if s.mode == "steady" and self.necks is not None:
+            T_F, flows, err, solver = mpi.agree(self.comm, lambda: self.part.steady(s.floating))
+            observer(0, 0.0, T_F, flows)
+            out.update(energy_error=err, heat_flow=flows, linear_solver=solver, newton_iterations=1)
+            self._neck_boundary(out)
+        elif s.mode == "steady":
             T_F, flows, err, n_float, solver = mpi.agree(
                 self.comm, lambda: self.part.steady(s.floating))
             observer(0, 0.0, T_F, flows)
@@ -257,6 +309,34 @@ class DistributedStaticEngine(StaticEngine):
                 out["startup_steps"] = res.startup_steps
         out["linear_iterations"] = self.part.linear_iterations
         self.details = out
+
+    def _neck_boundary(self, out: dict) -> None:
+        """With a node per neck: the heat flow into each wall and each fixed particle and across the period
+        (:func:`dem.network.necks.neck_flows`), each wall bond and fixed particle counted by the rank owning its
+        particle, each neck across the period by the rank owning its bond's first particle; into ``out`` under the
+        serial run's keys."""
+        net, own = self.necks, self.mine
+        bond_flow, wall_flow, fixed_flow = neck_flows(net, self.T_nodes)
+        b = net.bonds
+        if self.part.total(int(np.count_nonzero(self.scene.particles.fixed[own]))) or len(self.scene.walls):
+            mine = own[b.wall_particle]
+            walls = self.part.total(np.bincount(b.wall_index[mine], wall_flow[mine], len(self.scene.walls)))
+            fixed = np.flatnonzero(self.scene.particles.fixed & own)
+            into = {int(k): float(v) for part in self.comm.allgather(
+                dict(zip(self.held[fixed].tolist(), (-fixed_flow[fixed]).tolist()))) for k, v in part.items()}
+            out["boundary_heat_flow"] = boundary_summary(self.full_scene, walls, into)
+        if self.scene.box is not None:
+            first = own[b.i]
+            out["periodic_heat_flow"] = self.part.total(bond_flow[first] @ b.shifts[first]).tolist()
+
+    def bond_heat_flow(self) -> tuple[np.ndarray, np.ndarray]:
+        """Heat flow (W) along each pair bond of this rank's particles from i to j, and from each of its
+        wall-bonded particles into its wall (with a node per neck: through the neck)."""
+        if self.T_nodes is None:
+            return super().bond_heat_flow()
+        q_pairs, q_walls = neck_flows(self.necks, self.T_nodes)[:2]
+        pairs, walls = self.kept
+        return q_pairs[pairs], q_walls[walls]
 
     def _boundary(self, T: np.ndarray) -> dict:
         """Heat flow into each wall and each fixed particle (:func:`dem.network.heat.boundary_heat_flow`), summed

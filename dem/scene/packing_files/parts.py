@@ -376,10 +376,10 @@ def _near(lo: np.ndarray, hi: np.ndarray, region_lo: np.ndarray, region_hi: np.n
     return near
 
 
-def read_part(path, ranks: int, rank: int, box=None) -> tuple[Packing, Part]:
+def read_part(path, ranks: int, rank: int, box=None, bonds: int = 1) -> tuple[Packing, Part]:
     """The particles that rank ``rank`` of ``ranks`` holds of the packing in parts ``path`` (module docstring):
-    those of its blocks and, of the other blocks, those within one bond length of its centres' bounding box; and
-    the packing's fixed particles (``Part.fixed``).
+    those of its blocks and, of the other blocks, those within ``bonds`` bond lengths of its centres' bounding box;
+    and the packing's fixed particles (``Part.fixed``).
 
     Parameters
     ----------
@@ -391,6 +391,8 @@ def read_part(path, ranks: int, rank: int, box=None) -> tuple[Packing, Part]:
         This rank, 0 ... ``ranks - 1``.
     box : dem.geometry.periodic.PeriodicBox or None
         The scene's periodic box, whose periodic axes wrap; None: none.
+    bonds : int
+        The halo's reach in bond lengths, >= 1 (a network with a node per neck: ``dem.geometry.bisection.NECK_HALO``).
 
     Returns
     -------
@@ -408,7 +410,7 @@ def read_part(path, ranks: int, rank: int, box=None) -> tuple[Packing, Part]:
     lengths = None if box is None else np.where(box.mask, box.lengths, np.inf)
     owner = block_owner(index, ranks, lengths)
     mine = owner == rank
-    reach = 2.0 * float(index.radius_max.max()) * HALO_MARGIN
+    reach = 2.0 * float(index.radius_max.max()) * HALO_MARGIN * bonds
     region_lo, region_hi = index.lo[mine].min(axis=0) - reach, index.hi[mine].max(axis=0) + reach
     read = np.flatnonzero(_near(index.lo, index.hi, region_lo, region_hi, None if box is None else box.lengths,
                                 None if box is None else box.mask))

@@ -37,8 +37,9 @@ def scene_particles(table: dict, materials, base_dir=None, part=None):
     base_dir : str or pathlib.Path or None
         The scene's folder, against which a relative ``file`` is read; None: the working directory.
     part : tuple or None
-        ``(ranks, rank, box_of)``: read a packing in parts as rank ``rank`` of ``ranks``, the scene's periodic box
-        ``box_of(file_box)`` (a callable from the file's box, or None, to the scene's); None: read the whole file.
+        ``(ranks, rank, box_of, bonds)``: read a packing in parts as rank ``rank`` of ``ranks``, the scene's periodic
+        box ``box_of(file_box)`` (a callable from the file's box, or None, to the scene's), with a halo of ``bonds``
+        bond lengths (:func:`dem.scene.packing_files.parts.read_part`); None: read the whole file.
 
     Returns
     -------
@@ -124,7 +125,7 @@ def scene_particles(table: dict, materials, base_dir=None, part=None):
     return particles, box, held
 
 
-def _part_of(path, table: dict, options: dict, ranks: int, rank: int, box_of):
+def _part_of(path, table: dict, options: dict, ranks: int, rank: int, box_of, bonds: int):
     """The packing and :class:`dem.scene.packing_files.parts.Part` that rank ``rank`` of ``ranks`` holds of the packing in
     parts ``path`` (:func:`scene_particles`)."""
     extra = sorted(set(options) - {"format"})
@@ -140,7 +141,7 @@ def _part_of(path, table: dict, options: dict, ranks: int, rank: int, box_of):
         from dem.geometry.periodic import PeriodicBox
 
         file_box = PeriodicBox(index.box_hi - index.box_lo, index.periodic or (False,) * 3, index.box_lo)
-    return read_part(path, ranks, rank, box_of(file_box))
+    return read_part(path, ranks, rank, box_of(file_box), bonds)
 
 
 
