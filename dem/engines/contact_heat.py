@@ -155,16 +155,10 @@ class ContactThermalModel:
         """
         kept = self._configuration(mechanics)
         now, walls, pairs = kept["now"], kept["walls"], mechanics.contacts()[:2]
-        if self.handing_over(mechanics):  # the hand-overs' state is read too: a read is kept for as long as it holds
-            handover = self.handover
-            if update:  # (advanced here: a read kept before is of the old state)
-                kept.pop("bonds", None)
-                return handover.bonds(now, walls, pairs, self.box, True)
-            state = (handover.steps, handover.solid_radius)
-            if "bonds" not in kept or not all(map(np.array_equal, kept["handover"], state)):
-                kept["bonds"] = handover.bonds(now, walls, pairs, self.box, False)
-                kept["handover"] = tuple(a.copy() for a in state)
-        elif "bonds" not in kept:
+        if self.handing_over(mechanics):
+            return self._handed_over(kept, "bonds", lambda advance: self.handover.bonds(now, walls, pairs, self.box,
+                                                                                           advance), update)
+        if "bonds" not in kept:
             if self.spec.nodes == "necks":  # the one-node law's from the halves the elements are of
                 net = self._neck_network(mechanics)
                 kept["bonds"] = (net.bonds, *bond_conductances(self.spec, now, net.bonds, box=self.box,
@@ -172,6 +166,18 @@ class ContactThermalModel:
             else:
                 kept["bonds"] = bonds_and_conductances(now, walls, self.spec, pairs=pairs, box=self.box)
         return kept["bonds"]
+
+    def _handed_over(self, kept: dict, key: str, read, update: bool):
+        """``read(update)`` handing over, kept in ``kept[key]`` for as long as the hand-overs' state it was read at
+        holds (an update advances that state and is read each time: a read kept before is of the old state)."""
+        if update:
+            kept.pop(key, None)
+            return read(True)
+        state = (self.handover.steps, self.handover.solid_radius)
+        if key not in kept or not all(map(np.array_equal, kept[key + " at"], state)):
+            kept[key] = read(False)
+            kept[key + " at"] = tuple(a.copy() for a in state)
+        return kept[key]
 
     def _configuration(self, mechanics) -> dict:
         """What the contacts of ``mechanics`` give where it stands now: the particles now (``"now"``) and the
@@ -281,15 +287,10 @@ class ContactThermalModel:
             bonds = find_bonds(now, walls, spec.contact, spec.out_of_range, pairs=pairs, box=self.box)
             return neck_network(spec, now, bonds, box=self.box, walls=walls)
         if self.handing_over(mechanics):
-            handover = self.handover
-            if update:  # (advanced here: a network kept before is of the old state)
-                kept.pop("necks", None)
-                return handover.neck_network(now, walls, pairs, self.box, True)
-            state = (handover.steps, handover.solid_radius)
-            if "necks" not in kept or not all(map(np.array_equal, kept["necks_handover"], state)):
-                kept["necks"] = handover.neck_network(now, walls, pairs, self.box, False)
-                kept["necks_handover"] = tuple(a.copy() for a in state)
-        elif "necks" not in kept:
+            return self._handed_over(kept, "necks", lambda advance: self.handover.neck_network(now, walls, pairs,
+                                                                                                  self.box, advance),
+                                     update)
+        if "necks" not in kept:
             bonds = find_bonds(now, walls, self.spec.contact, self.spec.out_of_range, pairs=pairs, box=self.box)
             kept["necks"] = neck_network(self.spec, now, bonds, box=self.box, walls=walls)
         return kept["necks"]
