@@ -204,6 +204,8 @@ class AMGSolver(PCGSolver):
     * the V-cycle (``AMG_SMOOTHER`` before and after each coarse correction) is :class:`dem.network.amg_cycle.VCycle`:
       without the two residual norms per cycle of pyamg's ``aspreconditioner``, and on a large system compiled, on
       numba's threads, with hybrid Gauss-Seidel sweeps over fixed row blocks;
+    * on a large system the coarsest level has up to ``dem.network.amg_setup.COARSEST_MAX`` unknowns and is solved
+      exactly by its Cholesky factors (13 CG iterations become 10 on the bench packing's 10^6 unknowns);
 
     and setup and solves run with one BLAS thread: the Arnoldi and the coarse solve call BLAS on vectors, whose
     spinning threads multiplied the setup time by four on a loaded two-core machine.
