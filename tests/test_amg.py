@@ -240,6 +240,21 @@ def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterio
     assert np.max(np.abs(x - exact)) < 1e-7 and np.max(np.abs(x - y)) < 1e-7
 
 
+def test_compiled_cg_product_is_scipys_to_the_bit(monkeypatch):
+    """From COMPILED_FROM unknowns on, CG's product A p runs on numba's threads over row blocks, each row summed in
+    scipy's order: scipy's product to the bit, and the solve the same as with scipy's product."""
+    import dem.network.amg_cycle as amg_cycle
+
+    A, b = packing_system()
+    plain = AMGSolver(A, rtol=RTOL)
+    monkeypatch.setattr(amg_cycle, "COMPILED_FROM", 0)
+    solver = AMGSolver(A, rtol=RTOL)
+    p = np.random.default_rng(4).standard_normal(A.shape[0])
+    assert np.array_equal(solver.product(p), A @ p)
+    solver.precondition = plain.precondition  # the same cycle: only the product differs
+    assert np.array_equal(solver.solve(b), plain.solve(b)) and solver.iterations == plain.iterations
+
+
 def test_coarse_cholesky_solves_exactly_and_takes_the_pseudo_inverse_of_a_singular_matrix():
     """The coarsest level's solve (dem.network.amg_setup.CoarseCholesky): sparse LU's solution on a symmetric
     positive definite matrix, factorised once; on a singular graph Laplacian (not positive definite) the
