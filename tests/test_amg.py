@@ -210,6 +210,7 @@ def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterio
     assert np.array_equal(P.indptr, P_plain.indptr) and np.array_equal(P.indices, P_plain.indices)
     assert np.array_equal(P.data, P_plain.data)
     assert abs(ours.levels[0].R - P.T).max() == 0
+    assert np.array_equal(ours.levels[1].B, plain.levels[1].B)  # the coarse candidates of pyamg's fit_candidates
     A_c, A_c_plain = ours.levels[1].A, plain.levels[1].A
     assert abs(A_c - A_c_plain).max() <= 1e-13 * abs(A_c_plain).max()
     # the one-pass Galerkin product sums as scipy's row-by-row product does: the same matrix to the bit

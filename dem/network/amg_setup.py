@@ -10,9 +10,10 @@ time at :math:`10^6` unknowns, much of it the kernel's first touch of the copies
 over the rows of :math:`A` (the tentative prolongator :math:`T` has one entry per row: :math:`T_{i, a(i)} = t_i`,
 ``a`` the aggregate), and :math:`A_c` from :math:`AP` and :math:`P^T (AP)`, each a row-by-row product (Gustavson)
 over fixed blocks of rows on the threads, in one pass with no count of the entries first (into arrays as long as a
-bound, of which only the part written is touched), :math:`AP` never copied into CSR. The aggregates and :math:`T`
-are pyamg's (``standard_aggregation``, ``fit_candidates``), and so are :math:`P`'s entries, to the bit (the same sums
-in the same order); :math:`A_c` is scipy's :math:`P^T (AP)` to the bit and pyamg's to round-off (summed in another
+bound, of which only the part written is touched), :math:`AP` never copied into CSR. The aggregates are pyamg's
+(``standard_aggregation``), :math:`T` and the coarse candidates those of its ``fit_candidates`` for the constant
+vector (:math:`t_i = |a(i)|^{-1/2}`, written without its sparse matrices), and so are :math:`P`'s entries, to the
+bit (the same sums in the same order); :math:`A_c` is scipy's :math:`P^T (AP)` to the bit and pyamg's to round-off (summed in another
 order), its column indices sorted.
 """
 
@@ -187,18 +188,18 @@ def finest_level(A, omega: float):
         ``fit_candidates`` for the constant vector.
     """
     from pyamg import amg_core
-    from pyamg.aggregation import fit_candidates
 
     n = A.shape[0]
     agg = np.empty(n, dtype=A.indptr.dtype)
     roots = np.empty(n, dtype=A.indptr.dtype)
     n_coarse = amg_core.standard_aggregation(n, A.indptr, A.indices, agg, roots)
-    held = np.flatnonzero(agg >= 0)
-    aggregates = sp.csr_matrix((np.ones(len(held)), (held, agg[held])), shape=(n, n_coarse))
-    T, B_c = fit_candidates(aggregates, np.ones((n, 1)))
-    T = T.tocsr()
+    # fit_candidates for the constant vector, to the bit: each aggregate's column of ones normalised, t_i = 1 / |a|^(1/2)
+    # on the rows it holds, and the coarse candidate its norm |a|^(1/2)
+    held = agg >= 0
+    norm = np.sqrt(np.bincount(agg[held], minlength=n_coarse).astype(float))
     t = np.zeros(n)
-    t[np.repeat(np.arange(n), np.diff(T.indptr))] = T.data  # the one entry of each held row
+    t[held] = 1.0 / norm[agg[held]]
+    B_c = norm.reshape(-1, 1)
     P = sp.csr_matrix(_prolongator(A.indptr, A.indices, A.data, agg, t, n_coarse, omega,
                                    row_blocks(A.indptr, BLOCKS))[::-1], shape=(n, n_coarse))
     R = P.T.tocsr()
