@@ -13,8 +13,8 @@ over fixed blocks of rows on the threads, in one pass with no count of the entri
 bound, of which only the part written is touched), :math:`AP` never copied into CSR. The aggregates are pyamg's
 (``standard_aggregation``), :math:`T` and the coarse candidates those of its ``fit_candidates`` for the constant
 vector (:math:`t_i = |a(i)|^{-1/2}`, written without its sparse matrices), and so are :math:`P`'s entries, to the
-bit (the same sums in the same order); :math:`A_c` is scipy's :math:`P^T (AP)` to the bit and pyamg's to round-off (summed in another
-order), its column indices sorted.
+bit (the same sums in the same order); :math:`A_c` is scipy's :math:`P^T (AP)` to the bit and pyamg's to round-off
+(summed in another order), its column indices sorted.
 """
 
 from __future__ import annotations
@@ -193,8 +193,8 @@ def finest_level(A, omega: float):
     agg = np.empty(n, dtype=A.indptr.dtype)
     roots = np.empty(n, dtype=A.indptr.dtype)
     n_coarse = amg_core.standard_aggregation(n, A.indptr, A.indices, agg, roots)
-    # fit_candidates for the constant vector, to the bit: each aggregate's column of ones normalised, t_i = 1 / |a|^(1/2)
-    # on the rows it holds, and the coarse candidate its norm |a|^(1/2)
+    # fit_candidates for the constant vector, to the bit: each aggregate's column of ones normalised,
+    # t_i = 1 / |a|^(1/2) on the rows it holds, and the coarse candidate its norm |a|^(1/2)
     held = agg >= 0
     norm = np.sqrt(np.bincount(agg[held], minlength=n_coarse).astype(float))
     t = np.zeros(n)
