@@ -194,8 +194,8 @@ def test_sweeps_that_reuse_the_forward_sums_are_the_plain_hybrid_sweeps(monkeypa
 def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterion(monkeypatch):
     """The finest level built compiled (dem.network.amg_setup): pyamg's aggregates and prolongator to the bit, its
     Galerkin matrix to round-off (summed in another order) and scipy's product of the same factors to the bit; the
-    solver on that hierarchy, with the compiled cycle, reaches the criterion in as many iterations as on pyamg's own,
-    give or take one, at sparse LU's solution."""
+    solver on that hierarchy (its coarsest level solved exactly), with the compiled cycle, reaches the criterion in
+    at most one iteration more than on pyamg's own, at sparse LU's solution."""
     import dem.network.amg_cycle as amg_cycle
     from dem.network import amg_setup
     from dem.network.linsolve import AMG_OPTIONS, AMG_SEED
@@ -210,6 +210,7 @@ def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterio
     assert np.array_equal(P.indptr, P_plain.indptr) and np.array_equal(P.indices, P_plain.indices)
     assert np.array_equal(P.data, P_plain.data)
     assert abs(ours.levels[0].R - P.T).max() == 0
+    assert np.array_equal(ours.levels[1].B, plain.levels[1].B)  # the coarse candidates of pyamg's fit_candidates
     A_c, A_c_plain = ours.levels[1].A, plain.levels[1].A
     assert abs(A_c - A_c_plain).max() <= 1e-13 * abs(A_c_plain).max()
     # the one-pass Galerkin product sums as scipy's row-by-row product does: the same matrix to the bit
@@ -218,7 +219,13 @@ def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterio
     for ours_array, scipy_array in ((A_c.indptr, scipy_A_c.indptr), (A_c.indices, scipy_A_c.indices),
                                     (A_c.data, scipy_A_c.data)):
         assert np.array_equal(ours_array, scipy_array)
-    assert len(ours.levels) == len(plain.levels)
+    # pyamg's levels down to the first of at most COARSEST_MAX unknowns, which is solved exactly
+    sizes = [level.A.shape[0] for level in plain.levels]
+    coarsest = next(k for k, size in enumerate(sizes) if size <= amg_setup.COARSEST_MAX)
+    assert coarsest >= 1 and [level.A.shape[0] for level in ours.levels] == sizes[:coarsest + 1]
+    A_last = ours.levels[-1].A
+    b_last = np.random.default_rng(0).random(A_last.shape[0])
+    assert relative_residual(A_last, ours.coarse_solver(A_last, b_last), b_last) < 1e-12
     with pytest.raises(ValueError, match="options"):
         amg_setup.hierarchy(A, AMG_SEED, {**AMG_OPTIONS, "strength": "symmetric"})
 
@@ -229,9 +236,48 @@ def test_compiled_finest_level_is_pyamgs_and_the_solver_on_it_meets_the_criterio
     assert solver.precondition.levels[0].kernels is not None and len(solver.precondition.levels[0].A_blocks) > 2
     assert solver.hierarchy.levels[0].P.nnz == P.nnz  # built by amg_setup
     x, y = solver.solve(b), reference.solve(b)
-    assert relative_residual(A, x, b) <= RTOL and abs(solver.iterations - reference.iterations) <= 1
+    assert relative_residual(A, x, b) <= RTOL and solver.iterations <= reference.iterations + 1
     exact = spl.spsolve(sp.csc_matrix(A), b)
     assert np.max(np.abs(x - exact)) < 1e-7 and np.max(np.abs(x - y)) < 1e-7
+
+
+def test_compiled_cg_product_is_scipys_to_the_bit(monkeypatch):
+    """From COMPILED_FROM unknowns on, CG's product A p runs on numba's threads over row blocks, each row summed in
+    scipy's order: scipy's product to the bit, and the solve the same as with scipy's product."""
+    import dem.network.amg_cycle as amg_cycle
+
+    A, b = packing_system()
+    plain = AMGSolver(A, rtol=RTOL)
+    monkeypatch.setattr(amg_cycle, "COMPILED_FROM", 0)
+    solver = AMGSolver(A, rtol=RTOL)
+    p = np.random.default_rng(4).standard_normal(A.shape[0])
+    assert np.array_equal(solver.product(p), A @ p)
+    solver.precondition = plain.precondition  # the same cycle: only the product differs
+    assert np.array_equal(solver.solve(b), plain.solve(b)) and solver.iterations == plain.iterations
+
+
+def test_coarse_cholesky_solves_exactly_and_takes_the_pseudo_inverse_of_a_singular_matrix():
+    """The coarsest level's solve (dem.network.amg_setup.CoarseCholesky): sparse LU's solution on a symmetric
+    positive definite matrix, factorised once; on a singular graph Laplacian (not positive definite) the
+    pseudo-inverse's, the minimum-norm solution of a consistent system, orthogonal to the constants."""
+    from dem.network.amg_setup import CoarseCholesky
+
+    A, _ = lattice_system(shape=(6, 5, 4))
+    b = np.random.default_rng(2).random(A.shape[0])
+    solve = CoarseCholesky()
+    assert np.allclose(solve(A, b), spl.spsolve(sp.csc_matrix(A), b), rtol=1e-12, atol=0)
+    factors = solve.factors
+    assert factors is not None and solve.pseudo_inverse is None
+    solve(A, 2 * b)
+    assert solve.factors is factors  # kept from the first call
+    n = 30
+    path = sp.diags([-np.ones(n - 1), np.r_[1.0, 2 * np.ones(n - 2), 1.0], -np.ones(n - 1)], [-1, 0, 1]).tocsr()
+    rhs = np.random.default_rng(3).random(n)
+    rhs -= rhs.mean()  # consistent: orthogonal to the null space (the constants)
+    singular = CoarseCholesky()
+    x = singular(path, rhs)
+    assert singular.factors is None and singular.pseudo_inverse is not None
+    assert relative_residual(path, x, rhs) < 1e-10 and abs(x.sum()) < 1e-10 * np.abs(x).sum()
 
 
 def test_reused_hierarchy_gives_the_fresh_answer_to_the_tolerance():

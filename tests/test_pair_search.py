@@ -1,5 +1,6 @@
 """The pair search behind the bonds and the neighbour lists: cells searched in blocks on numba's threads against
-brute force, and the bond search's two routes (cells for one radius class, k-d trees for wider ones)."""
+brute force, with the pairs' distances, and the bond search's two routes (cells for one radius class, k-d trees for
+wider ones)."""
 
 import numpy as np
 import pytest
@@ -30,9 +31,14 @@ def test_blocks_give_every_pair_in_order_whatever_room_they_are_given(monkeypatc
     r = rng.uniform(0.2e-3, 0.4e-3, 400)
     i_ref, j_ref = brute_pairs(x, r, 1e-4, box)
     assert len(i_ref) > 400
+    vec = x[j_ref] - x[i_ref]
+    vec -= np.where(np.array(box) > 0, box, 1.0) * np.round(vec / np.where(np.array(box) > 0, box, np.inf))
+    d_ref = np.linalg.norm(vec, axis=1)  # the minimum image's lengths
     for capacity in (0, len(i_ref) // 2, len(i_ref), 3 * len(i_ref)):
         i, j = verlet_pairs(x, r, 1e-4, np.array(box), capacity)
         assert np.array_equal(i, i_ref) and np.array_equal(j, j_ref), capacity
+        i, j, d = verlet_pairs(x, r, 1e-4, np.array(box), capacity, distances=True)
+        assert np.array_equal(i, i_ref) and np.array_equal(j, j_ref) and np.array_equal(d, d_ref), capacity
 
 
 @pytest.mark.parametrize("cells_from", [10**9, 1000])  # k-d trees always; cells for one class of 1000 or more
@@ -51,6 +57,10 @@ def test_bond_candidates_are_the_overlapping_pairs(monkeypatch, spread, cells_fr
     i, j = candidate_pairs(x, r)
     assert len(key) > n
     assert np.array_equal(i, key // n) and np.array_equal(j, key % n)
+    # the distances the search computes as it goes: numpy's norms of the bond vectors to the bit
+    i, j, d = candidate_pairs(x, r, distances=True)
+    assert np.array_equal(i, key // n) and np.array_equal(j, key % n)
+    assert np.array_equal(d, np.linalg.norm(x[j] - x[i], axis=1))
 
 
 def test_a_particle_far_away_does_not_make_the_cell_grid_huge():

@@ -112,10 +112,11 @@ def _cells(x, radius, skin, box):
 @njit(cache=True)
 def _partners(k, x, radius, skin, box, grid, out, found, room):
     """The partners ``m > k`` of particle ``k`` within ``r_k + r_m + skin`` (``grid``: the cells of :func:`_cells`),
-    written in order of ``m`` into ``out = (out_i, out_j)`` from ``found`` on while below ``room``; returns ``found``
-    plus their number."""
+    written in order of ``m`` into ``out = (out_i, out_j, out_d)`` from ``found`` on while below ``room``, with their
+    centre distances in ``out_d`` unless it is empty; returns ``found`` plus their number."""
     cell, head, nxt, ncell, wrap = grid
-    out_i, out_j = out
+    out_i, out_j, out_d = out
+    distances = out_d.shape[0] > 0
     first = found
     for d0 in range(-1, 2):
         c0 = cell[k, 0] + d0
@@ -148,28 +149,36 @@ def _partners(k, x, radius, skin, box, grid, out, found, room):
                         dy = min_image(x[k, 1] - x[m, 1], box[1])
                         dz = min_image(x[k, 2] - x[m, 2], box[2])
                         cut = radius[k] + radius[m] + skin
-                        if dx * dx + dy * dy + dz * dz < cut * cut:
+                        square = dx * dx + dy * dy + dz * dz
+                        if square < cut * cut:
                             if found < room:
                                 out_i[found] = k
                                 out_j[found] = m
+                                if distances:
+                                    out_d[found] = math.sqrt(square)
                             found += 1
                     m = nxt[m]
     for a in range(first + 1, min(found, room)):  # k's partners in order (a handful: insertion sort)
         partner = out_j[a]
+        length = out_d[a] if distances else 0.0
         b = a - 1
         while b >= first and out_j[b] > partner:
             out_j[b + 1] = out_j[b]
+            if distances:
+                out_d[b + 1] = out_d[b]
             b -= 1
         out_j[b + 1] = partner
+        if distances:
+            out_d[b + 1] = length
     return found
 
 
 @njit(cache=True, parallel=True)
-def _pairs_in_blocks(x, radius, skin, box, block, slot, out_i, out_j):
+def _pairs_in_blocks(x, radius, skin, box, block, slot, out_i, out_j, out_d):
     """The pairs within ``r_i + r_j + skin`` by cell binning, sorted by ``(i, j)``: the particles ``b block ...
-    (b + 1) block - 1`` (block ``b``, one block per thread at a time) write theirs into ``out_i``, ``out_j`` from
-    ``slot[b]`` on while below ``slot[b + 1]``; returns every block's number of pairs (a block whose slot is that
-    large holds them all)."""
+    (b + 1) block - 1`` (block ``b``, one block per thread at a time) write theirs into ``out_i``, ``out_j`` (and
+    their centre distances into ``out_d`` unless it is empty) from ``slot[b]`` on while below ``slot[b + 1]``; returns
+    every block's number of pairs (a block whose slot is that large holds them all)."""
     n = x.shape[0]
     grid = _cells(x, radius, skin, box)
     blocks = slot.shape[0] - 1
@@ -177,13 +186,13 @@ def _pairs_in_blocks(x, radius, skin, box, block, slot, out_i, out_j):
     for b in prange(blocks):
         found = slot[b]
         for k in range(b * block, min(n, (b + 1) * block)):
-            found = _partners(k, x, radius, skin, box, grid, (out_i, out_j), found, slot[b + 1])
+            found = _partners(k, x, radius, skin, box, grid, (out_i, out_j, out_d), found, slot[b + 1])
         counts[b] = found - slot[b]
     return counts
 
 
-def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray,
-                 capacity: int = 0) -> tuple[np.ndarray, np.ndarray]:
+def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray, capacity: int = 0,
+                 distances: bool = False) -> tuple:
     """Pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j + skin`` (minimum image on periodic axes), sorted by
     ``(i, j)``. The particles are searched in blocks of ``PAIR_BLOCK`` on numba's threads, each block's pairs
     written into a slot of its own of ``capacity`` pairs shared out evenly; ``capacity``: the number of pairs
@@ -202,30 +211,35 @@ def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray
         (3,) the periodic box's lengths, 0 along non-periodic axes (m).
     capacity : int
         The number of pairs expected.
+    distances : bool
+        Also return the pairs' centre distances, as the search computed them: ``sqrt(dx dx + dy dy + dz dz)`` of
+        the (minimum-image) differences, summed in that order (``np.linalg.norm`` of ``x_j - x_i`` to the bit).
 
     Returns
     -------
     tuple of numpy.ndarray
-        ``(i, j)``, int, sorted by ``(i, j)``.
+        ``(i, j)``, int, sorted by ``(i, j)``; with ``distances``, ``(i, j, d)``, ``d`` in m.
     """
     n = len(radius)
     if n < 2:
         empty = np.zeros(0, dtype=np.int64)
-        return empty, empty
+        return (empty, empty, np.zeros(0)) if distances else (empty, empty)
     blocks = -(-n // PAIR_BLOCK)
     per = -(-max(int(capacity), 0) // blocks)
     slot = np.arange(blocks + 1, dtype=np.int64) * per
-    i = np.empty(slot[-1], dtype=np.int64)
-    j = np.empty(slot[-1], dtype=np.int64)
-    counts = _pairs_in_blocks(x, radius, skin, box, PAIR_BLOCK, slot, i, j)
+
+    def search(slot):
+        out = (np.empty(slot[-1], dtype=np.int64), np.empty(slot[-1], dtype=np.int64),
+               np.empty(slot[-1] if distances else 0))
+        return out, _pairs_in_blocks(x, radius, skin, box, PAIR_BLOCK, slot, *out)
+
+    out, counts = search(slot)
     if np.any(counts > per):
-        slot = np.concatenate(([0], np.cumsum(counts)))
-        i = np.empty(slot[-1], dtype=np.int64)
-        j = np.empty(slot[-1], dtype=np.int64)
-        _pairs_in_blocks(x, radius, skin, box, PAIR_BLOCK, slot, i, j)
-        return i, j
-    filled = [slice(start, start + count) for start, count in zip(slot[:-1].tolist(), counts.tolist())]
-    return np.concatenate([i[f] for f in filled]), np.concatenate([j[f] for f in filled])
+        out, _ = search(np.concatenate(([0], np.cumsum(counts))))
+    else:
+        filled = [slice(start, start + count) for start, count in zip(slot[:-1].tolist(), counts.tolist())]
+        out = [np.concatenate([a[f] for f in filled]) for a in out]
+    return tuple(out) if distances else tuple(out[:2])
 
 
 @njit(cache=True)

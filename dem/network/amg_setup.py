@@ -1,5 +1,6 @@
 r"""The finest level of :class:`dem.network.linsolve.AMGSolver`'s hierarchy on a large network, built compiled on
-numba's threads; the coarser levels are pyamg's (``sinterheat.amg.hierarchy``).
+numba's threads; the coarser levels are pyamg's (``sinterheat.amg.hierarchy``), the coarsest solved exactly
+(:class:`CoarseCholesky`).
 
 pyamg's smoothed aggregation (Vaněk, Mandel & Brezina 1996) builds the finest level's prolongator
 :math:`P = (I - \omega D^{-1} A) T` (``jacobi_prolongation_smoother`` with ``weighting="local"``: :math:`D_{ii} =
@@ -9,10 +10,11 @@ time at :math:`10^6` unknowns, much of it the kernel's first touch of the copies
 over the rows of :math:`A` (the tentative prolongator :math:`T` has one entry per row: :math:`T_{i, a(i)} = t_i`,
 ``a`` the aggregate), and :math:`A_c` from :math:`AP` and :math:`P^T (AP)`, each a row-by-row product (Gustavson)
 over fixed blocks of rows on the threads, in one pass with no count of the entries first (into arrays as long as a
-bound, of which only the part written is touched), :math:`AP` never copied into CSR. The aggregates and :math:`T`
-are pyamg's (``standard_aggregation``, ``fit_candidates``), and so are :math:`P`'s entries, to the bit (the same sums
-in the same order); :math:`A_c` is scipy's :math:`P^T (AP)` to the bit and pyamg's to round-off (summed in another
-order), its column indices sorted.
+bound, of which only the part written is touched), :math:`AP` never copied into CSR. The aggregates are pyamg's
+(``standard_aggregation``), :math:`T` and the coarse candidates those of its ``fit_candidates`` for the constant
+vector (:math:`t_i = |a(i)|^{-1/2}`, written without its sparse matrices), and so are :math:`P`'s entries, to the
+bit (the same sums in the same order); :math:`A_c` is scipy's :math:`P^T (AP)` to the bit and pyamg's to round-off
+(summed in another order), its column indices sorted.
 """
 
 from __future__ import annotations
@@ -24,6 +26,9 @@ from numba import njit, prange
 from dem.network.amg_kernels import row_blocks
 
 BLOCKS = 8  # row blocks of the products (any number gives the same result)
+# the coarsest level of the hierarchy: at most this many unknowns (pyamg's ``max_coarse``), solved exactly by a dense
+# Cholesky factorisation (:class:`CoarseCholesky`: 0.01 s of CPU for 10^3 unknowns, 0.08 s at the bound)
+COARSEST_MAX = 2_000
 
 
 @njit(cache=True, parallel=True)
@@ -183,18 +188,18 @@ def finest_level(A, omega: float):
         ``fit_candidates`` for the constant vector.
     """
     from pyamg import amg_core
-    from pyamg.aggregation import fit_candidates
 
     n = A.shape[0]
     agg = np.empty(n, dtype=A.indptr.dtype)
     roots = np.empty(n, dtype=A.indptr.dtype)
     n_coarse = amg_core.standard_aggregation(n, A.indptr, A.indices, agg, roots)
-    held = np.flatnonzero(agg >= 0)
-    aggregates = sp.csr_matrix((np.ones(len(held)), (held, agg[held])), shape=(n, n_coarse))
-    T, B_c = fit_candidates(aggregates, np.ones((n, 1)))
-    T = T.tocsr()
+    # fit_candidates for the constant vector, to the bit: each aggregate's column of ones normalised,
+    # t_i = 1 / |a|^(1/2) on the rows it holds, and the coarse candidate its norm |a|^(1/2)
+    held = agg >= 0
+    norm = np.sqrt(np.bincount(agg[held], minlength=n_coarse).astype(float))
     t = np.zeros(n)
-    t[np.repeat(np.arange(n), np.diff(T.indptr))] = T.data  # the one entry of each held row
+    t[held] = 1.0 / norm[agg[held]]
+    B_c = norm.reshape(-1, 1)
     P = sp.csr_matrix(_prolongator(A.indptr, A.indices, A.data, agg, t, n_coarse, omega,
                                    row_blocks(A.indptr, BLOCKS))[::-1], shape=(n, n_coarse))
     R = P.T.tocsr()
@@ -203,11 +208,55 @@ def finest_level(A, omega: float):
     return P, R, A_c, B_c
 
 
+class CoarseCholesky:
+    r"""The exact solve of the coarsest level, a pyamg coarse solver (called as ``solve(A, b)``): the dense Cholesky
+    factors of :math:`A`, computed at the first call and kept. A Galerkin matrix :math:`P^T A P` of a symmetric
+    positive definite :math:`A` is one too; should the factorisation still fail (positive definite only to less
+    than round-off), the pseudo-inverse (pyamg's default coarse solver) is taken instead."""
+
+    def __init__(self):
+        self.factors = None
+        self.pseudo_inverse = None
+
+    def __call__(self, A, b: np.ndarray) -> np.ndarray:
+        """The solution of ``A x = b``.
+
+        Parameters
+        ----------
+        A : scipy.sparse.spmatrix
+            The coarsest level's matrix (n, n); the same at every call.
+        b : numpy.ndarray
+            The right-hand side (n,).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``x`` (n,).
+        """
+        import scipy.linalg as la
+
+        if self.factors is None and self.pseudo_inverse is None:
+            dense = A.toarray()
+            try:
+                self.factors = la.cho_factor(dense)
+            except la.LinAlgError:
+                self.pseudo_inverse = la.pinv(dense)
+        if self.factors is None:
+            return self.pseudo_inverse @ b
+        return la.cho_solve(self.factors, b)
+
+
 def hierarchy(A, seed: int, options: dict):
     """The hierarchy of ``pyamg.smoothed_aggregation_solver(A, **options)``: the finest level by
     :func:`finest_level`, the coarser ones by ``sinterheat.amg.hierarchy`` (seeded with ``seed``: the finest level
     draws no random number, its weighting being local, so the coarser ones see the generator as pyamg's own setup
-    does), every level on CSR.
+    does), every level on CSR, down to a coarsest level of at most ``COARSEST_MAX`` unknowns solved exactly
+    (:class:`CoarseCholesky`) instead of ``options``' ``max_coarse`` and coarse solver.
+
+    A V-cycle through a coarsest level of a few unknowns is a rough solve of the level above it, whose aggregates
+    are large (on the bench packing of :math:`10^6` particles the levels have 984 312, 60 865, 951 and 15 unknowns):
+    solving the third level exactly instead takes the conjugate gradients from 13 iterations to 10 at no cost in the
+    setup.
 
     Parameters
     ----------
@@ -240,7 +289,8 @@ def hierarchy(A, seed: int, options: dict):
         raise ValueError(f"options = {options!r}: the compiled finest level needs {fixed} and a first smooth "
                          f"entry ('jacobi', {{'omega': w, 'weighting': 'local'}})")
     P, R, A_c, B_c = finest_level(A, first[1]["omega"])
-    ml = amg.hierarchy(A_c, seed, **{**options, "smooth": rest, "B": B_c})
+    ml = amg.hierarchy(A_c, seed, **{**options, "smooth": rest, "B": B_c, "max_coarse": COARSEST_MAX,
+                                     "coarse_solver": CoarseCholesky()})
     level = MultilevelSolver.Level()
     level.A, level.P, level.R, level.B = A, P, R, np.ones((A.shape[0], 1))
     ml.levels.insert(0, level)
