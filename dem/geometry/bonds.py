@@ -207,7 +207,7 @@ def candidate_pairs(position: np.ndarray, radius: np.ndarray, distances: bool = 
 
 
 def lengths(vec: np.ndarray) -> np.ndarray:
-    """The length of every row of ``vec`` (m, 3): ``sqrt(x x + y y + z z)``, summed in that order into one fresh
+    r"""The length of every row of ``vec`` (m, 3): :math:`\sqrt{x x + y y + z z}`, summed in that order into one fresh
     array: ``np.linalg.norm(vec, axis=1)`` to the bit, in a tenth of its time.
 
     Parameters

@@ -193,7 +193,7 @@ def _pairs_in_blocks(x, radius, skin, box, block, slot, out_i, out_j, out_d):
 
 def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray, capacity: int = 0,
                  distances: bool = False) -> tuple:
-    """Pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j + skin`` (minimum image on periodic axes), sorted by
+    r"""Pairs ``i < j`` with ``|x_i - x_j| < r_i + r_j + skin`` (minimum image on periodic axes), sorted by
     ``(i, j)``. The particles are searched in blocks of ``PAIR_BLOCK`` on numba's threads, each block's pairs
     written into a slot of its own of ``capacity`` pairs shared out evenly; ``capacity``: the number of pairs
     expected (a rebuild passes its last list's length with some room): one pass over the cells when every block's
@@ -212,8 +212,8 @@ def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray
     capacity : int
         The number of pairs expected.
     distances : bool
-        Also return the pairs' centre distances, as the search computed them: ``sqrt(dx dx + dy dy + dz dz)`` of
-        the (minimum-image) differences, summed in that order (``np.linalg.norm`` of ``x_j - x_i`` to the bit).
+        Also return the pairs' centre distances, as the search computed them:
+        :math:`\sqrt{d_x d_x + d_y d_y + d_z d_z}` of the (minimum-image) differences, summed in that order (``np.linalg.norm`` of ``x_j - x_i`` to the bit).
 
     Returns
     -------

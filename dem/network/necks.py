@@ -275,7 +275,7 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     ------
     ValueError
         ``spec`` is not the ``shared-body`` law without ``contact_conductance``, wall bonds without their walls, or
-        elements whose blocks are not ``(modes z + 1)^2`` values.
+        elements whose blocks are not :math:`(m z + 1)^2` values (``m`` the modes per neck).
     """
     from dem.laws.shared_body import particle_elements
 
