@@ -213,7 +213,8 @@ def verlet_pairs(x: np.ndarray, radius: np.ndarray, skin: float, box: np.ndarray
         The number of pairs expected.
     distances : bool
         Also return the pairs' centre distances, as the search computed them:
-        :math:`\sqrt{d_x d_x + d_y d_y + d_z d_z}` of the (minimum-image) differences, summed in that order (``np.linalg.norm`` of ``x_j - x_i`` to the bit).
+        :math:`\sqrt{d_x d_x + d_y d_y + d_z d_z}` of the (minimum-image) differences, summed in that order
+        (``np.linalg.norm`` of ``x_j - x_i`` to the bit).
 
     Returns
     -------
