@@ -18,8 +18,8 @@ of a run on the benchmarks' random sintered packing (copper, mean overlap h/r 0.
 process, maximum resident set) at 2048, 6050, 16384 and 40656 particles grows by 21.8 kB per particle for a steady
 solve and for ten implicit steps alike (1044 MiB at 40656), above a base of 0.21 GB, within 1.4 % at every size; a
 moving run handing its particles over to the union (the velocity-Verlet engine, the same packing at r = 0.5 mm, whose
-necks meet, three thermal steps with nine in ten particles on the way: the elements of both readings) grows by 48.7 kB
-per particle at 500, 2048 and 6050 particles (488 MiB at 6050), within 0.6 %.
+necks meet, three thermal steps with nine in ten particles on the way: the elements of both readings) grows by 51.4 kB
+per particle at 500, 2048, 6050 and 16384 particles (1007 MiB at 16384), within 1.9 %.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ BYTES_PER_PARTICLE = 1.35e3
 UNION_BYTES_PER_PARTICLE = {"particles": 7.1e3, "necks": 7.3e3}
 #: bytes per particle at the peak of a run with a node per neck on a pair-neck reading, static (steady or transient)
 #: and moving through the hand-over (module docstring)
-PAIR_NECK_NODES_BYTES_PER_PARTICLE = {"static": 21.8e3, "moving": 48.7e3}
+PAIR_NECK_NODES_BYTES_PER_PARTICLE = {"static": 21.8e3, "moving": 51.4e3}
 # a steady solve of the benchmarks' 10^6-particle random packing (bonds, conductances, network, AMG-CG; python -m
 # benchmarks dem) took 10.5 s on a quiet 2-core machine before the cell search and the row-by-row assembly, which
 # take 0.74 of its CPU time side by side: about 7.8e-6 s per particle
