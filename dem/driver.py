@@ -77,7 +77,8 @@ def _announce(scene: Scene, enabled: bool) -> None:
     checks have passed; only where it reports its progress (the CLI's)."""
     from dem.memory import estimate
 
-    line = estimate(scene.particle_count, scene.conductance.neck, scene.conductance.nodes) if enabled else None
+    spec = scene.conductance
+    line = estimate(scene.particle_count, spec.neck, spec.nodes, scene.motion is not None) if enabled else None
     if line is not None:
         print(f"python -m dem run: {line}", file=sys.stderr, flush=True)
 

@@ -12,6 +12,14 @@ solve of a random union packing at a solid fraction of 0.8 tiled to 2048, 6912, 
 bonds each; whole process, maximum resident set) grows by 7.1 kB per particle with one node per particle and by 7.3 kB
 with a node per neck (``nodes = "necks"``: a node per live bond more and each particle's element over its necks and
 its centre), above about the same base.
+
+With a node per neck on a pair-neck reading (``newton``, ``first``, ``coble``) a particle costs more again: the peak
+of a run on the benchmarks' random sintered packing (copper, mean overlap h/r 0.15, 5.4 bonds per particle; whole
+process, maximum resident set) at 2048, 6050, 16384 and 40656 particles grows by 21.8 kB per particle for a steady
+solve and for ten implicit steps alike (1044 MiB at 40656), above a base of 0.21 GB, within 1.4 % at every size; a
+moving run handing its particles over to the union (the velocity-Verlet engine, the same packing at r = 0.5 mm, whose
+necks meet, three thermal steps with nine in ten particles on the way: the elements of both readings) grows by 51.4 kB
+per particle at 500, 2048, 6050 and 16384 particles (1007 MiB at 16384), within 1.9 %.
 """
 
 from __future__ import annotations
@@ -23,6 +31,9 @@ BYTES_PER_PARTICLE = 1.35e3
 #: bytes per particle at the peak of a steady solve under the union of spheres, by the network's nodes (module
 #: docstring)
 UNION_BYTES_PER_PARTICLE = {"particles": 7.1e3, "necks": 7.3e3}
+#: bytes per particle at the peak of a run with a node per neck on a pair-neck reading, static (steady or transient)
+#: and moving through the hand-over (module docstring)
+PAIR_NECK_NODES_BYTES_PER_PARTICLE = {"static": 21.8e3, "moving": 51.4e3}
 # a steady solve of the benchmarks' 10^6-particle random packing (bonds, conductances, network, AMG-CG; python -m
 # benchmarks dem) took 10.5 s on a quiet 2-core machine before the cell search and the row-by-row assembly, which
 # take 0.74 of its CPU time side by side: about 7.8e-6 s per particle
@@ -33,6 +44,10 @@ SECONDS_PER_PARTICLE = 7.8e-6
 #: each), 0.41-0.46 ms per particle on the 2-core machine at load 5-7, and with a node per neck 0.83 ms against the
 #: one node's 0.42 in the same process at load 17 (the faces' sums in SIMD lanes, the union halves computed once)
 UNION_SECONDS_PER_PARTICLE = {"particles": 4.5e-4, "necks": 9.0e-4}
+#: seconds of CPU per particle of a steady solve with a node per neck on a pair-neck reading (the elements over the
+#: necks' faces, bonds and solve): 2.01-2.12 ms per particle on the random sintered packing of the module docstring
+#: at 2048 to 40656 particles, 2-core machine at load 5-7
+PAIR_NECK_NODES_SECONDS_PER_PARTICLE = 2.1e-3
 ANNOUNCE_FROM = 1_000_000  # runs of this many particles or more say what they will take before they start
 ANNOUNCE_SECONDS = 10.0  #: so do runs whose estimated steady solve takes this long (s)
 BASE_BYTES = 0.23e9  # the interpreter, numpy, scipy and the compiled kernels (with the per-particle figure: the fit)
@@ -64,25 +79,54 @@ def available_bytes() -> float | None:
     return out
 
 
-def bytes_per_particle(neck: str = "newton", nodes: str = "particles") -> float:
-    """The memory a particle takes at the peak of a steady solve (module docstring).
+def bytes_per_particle(neck: str = "newton", nodes: str = "particles", moving: bool = False) -> float:
+    """The memory a particle takes at the peak of a run (module docstring).
 
     Parameters
     ----------
     neck : str
         The scene's neck reading (``[conductance] neck``); ``"union"`` costs :data:`UNION_BYTES_PER_PARTICLE`.
     nodes : str
-        The network's nodes under the union (``[conductance] nodes``: ``"particles"`` or ``"necks"``).
+        The network's nodes (``[conductance] nodes``: ``"particles"`` or ``"necks"``); a node per neck on a pair-neck
+        reading costs :data:`PAIR_NECK_NODES_BYTES_PER_PARTICLE`.
+    moving : bool
+        Whether the particles move (with a node per neck on a pair-neck reading a run that hands them over to the
+        union holds the elements of both readings).
 
     Returns
     -------
     float
         Bytes per particle.
     """
-    return UNION_BYTES_PER_PARTICLE[nodes] if neck == "union" else BYTES_PER_PARTICLE
+    if neck == "union":
+        return UNION_BYTES_PER_PARTICLE[nodes]
+    if nodes == "necks":
+        return PAIR_NECK_NODES_BYTES_PER_PARTICLE["moving" if moving else "static"]
+    return BYTES_PER_PARTICLE
 
 
-def check(n: int, name: str, neck: str = "newton", nodes: str = "particles") -> None:
+def seconds_per_particle(neck: str = "newton", nodes: str = "particles") -> float:
+    """The CPU time a particle takes in a steady solve on 2 cores (module docstring).
+
+    Parameters
+    ----------
+    neck : str
+        The scene's neck reading (``[conductance] neck``); ``"union"`` costs :data:`UNION_SECONDS_PER_PARTICLE`.
+    nodes : str
+        The network's nodes (``[conductance] nodes``: ``"particles"`` or ``"necks"``); a node per neck on a pair-neck
+        reading costs :data:`PAIR_NECK_NODES_SECONDS_PER_PARTICLE`.
+
+    Returns
+    -------
+    float
+        Seconds per particle.
+    """
+    if neck == "union":
+        return UNION_SECONDS_PER_PARTICLE[nodes]
+    return PAIR_NECK_NODES_SECONDS_PER_PARTICLE if nodes == "necks" else SECONDS_PER_PARTICLE
+
+
+def check(n: int, name: str, neck: str = "newton", nodes: str = "particles", moving: bool = False) -> None:
     """Refuse ``n`` particles (named ``name`` in the message, e.g. ``"[generator] n"``) when a run of them would need
     more memory than is available (module docstring).
 
@@ -95,26 +139,28 @@ def check(n: int, name: str, neck: str = "newton", nodes: str = "particles") -> 
     neck : str
         The scene's neck reading (``[conductance] neck``: the union of spheres costs more per particle).
     nodes : str
-        The network's nodes under the union (``[conductance] nodes``: ``"particles"`` or ``"necks"``).
+        The network's nodes (``[conductance] nodes``: ``"particles"`` or ``"necks"``).
+    moving : bool
+        Whether the particles move (:func:`bytes_per_particle`).
 
     Raises
     ------
     ValueError
         A run of ``n`` particles needs more memory than the machine has available.
     """
-    each = bytes_per_particle(neck, nodes)
+    each = bytes_per_particle(neck, nodes, moving)
     if each * n < SMALL_BYTES:  # (the interpreter that asks holds its base already)
         return
     need = BASE_BYTES + each * n
     have = available_bytes()
     if have is not None and need > have:
         raise ValueError(f"{name}: a run of {n} particles needs about {need / 2**30:.3g} GiB (about "
-                         f"{each / 1e3:.3g} kB per particle at the peak of a steady solve), and "
+                         f"{each / 1e3:.3g} kB per particle at the peak of {_peak(moving)}), and "
                          f"{max(have, 0.0) / 2**30:.3g} GiB are available on this machine: use at most about "
                          f"{max(int((have - BASE_BYTES) / each), 0)} particles")
 
 
-def estimate(n: int, neck: str = "newton", nodes: str = "particles") -> str | None:
+def estimate(n: int, neck: str = "newton", nodes: str = "particles", moving: bool = False) -> str | None:
     """What a run of ``n`` particles will take, said before it starts where it is large (``n >= ANNOUNCE_FROM``, or a
     steady solve estimated at ``ANNOUNCE_SECONDS`` or more): the memory at the peak of a steady solve and its time on
     2 cores (module docstring); None for smaller runs.
@@ -124,19 +170,25 @@ def estimate(n: int, neck: str = "newton", nodes: str = "particles") -> str | No
     n : int
         Number of particles.
     neck : str
-        The scene's neck reading (``[conductance] neck``); ``"union"`` costs :data:`UNION_SECONDS_PER_PARTICLE` and
-        :data:`UNION_BYTES_PER_PARTICLE`.
+        The scene's neck reading (``[conductance] neck``: :func:`seconds_per_particle`, :func:`bytes_per_particle`).
     nodes : str
-        The network's nodes under the union (``[conductance] nodes``: ``"particles"`` or ``"necks"``).
+        The network's nodes (``[conductance] nodes``: ``"particles"`` or ``"necks"``).
+    moving : bool
+        Whether the particles move (:func:`bytes_per_particle`).
 
     Returns
     -------
     str or None
         One line, or None for a small run.
     """
-    rate = UNION_SECONDS_PER_PARTICLE[nodes] if neck == "union" else SECONDS_PER_PARTICLE
+    rate = seconds_per_particle(neck, nodes)
     if n < ANNOUNCE_FROM and rate * n < ANNOUNCE_SECONDS:
         return None
-    need = BASE_BYTES + bytes_per_particle(neck, nodes) * n
-    return (f"{n} particles: about {need / 2**30:.3g} GiB at the peak of a steady solve and about "
+    need = BASE_BYTES + bytes_per_particle(neck, nodes, moving) * n
+    return (f"{n} particles: about {need / 2**30:.3g} GiB at the peak of {_peak(moving)} and about "
             f"{rate * n:.3g} s for it on 2 cores (a transient or moving run takes longer)")
+
+
+def _peak(moving: bool) -> str:
+    """What the memory figure is the peak of, in the messages."""
+    return "a moving run" if moving else "a steady solve"

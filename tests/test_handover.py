@@ -300,3 +300,32 @@ def test_the_staggered_engine_hands_over_and_resumes_bit_for_bit():
     summary = whole.summary()
     assert summary["particles_handed_over"] + summary["particles_handing_over"] == np.count_nonzero(grown)
     assert np.array_equal(whole.particle_fields()["handed_over"], th.handover.weight)
+
+
+def test_a_bond_dropped_past_its_range_on_the_way_conducts_its_union_part():
+    """``out_of_range = "drop"`` with the ``shared-body`` law, squeezed until pair necks pass their range while
+    their particles are on the way: the pair reading's conductances are those of the drop reading (0 on those bonds,
+    whose clipped necks the law cannot read: it divided by zero there), the union's weighed in, and the run goes on
+    with heat in heat out."""
+    from dataclasses import replace
+
+    from dem.geometry.bonds import find_bonds
+    from dem.laws.conductance import bond_conductances
+    from fem_neck.geometry import max_overlap
+
+    scene = squeezed(0.00105, rate=300.0, law="shared-body")
+    scene["conductance"]["out_of_range"] = "drop"
+    engine = VerletEngine(parse_scene(scene))
+    engine.run()
+    th, mech = engine.thermal, engine.mechanics
+    bonds, K, _ = th.bonds(mech)
+    now = th._particles_now(mech, th.particles.radius)
+    past = bonds.h > max_overlap(now.radius[bonds.i], now.radius[bonds.j])
+    w = np.maximum(th.handover.weight[bonds.i], th.handover.weight[bonds.j])
+    assert np.count_nonzero(past) >= 5 and np.all((w > 0.0) & (w < 1.0))
+    grown = replace(now, radius=th.handover.solid_radii(now.radius))
+    union = find_bonds(grown, (), "union", pairs=(bonds.i, bonds.j))
+    K_union = bond_conductances(replace(th.handover.spec, neck="union"), grown, union)[0]
+    assert K[past] == pytest.approx(w[past] * K_union[past], rel=1e-9)
+    assert np.all(np.isfinite(K)) and np.all(K > 0.0)
+    assert engine.summary()["energy_error"] < 1e-12

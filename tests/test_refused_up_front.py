@@ -235,8 +235,66 @@ def test_neck_node_steps_are_weighed_up_front():
     spec = ConductanceSpec(law="shared-body", neck="union", nodes="necks")
     scene = make_scene(x, np.full(10, 1e-3), np.zeros(10), mode="transient", integrator="implicit", dt=1e-3,
                        t_end=200.0, max_steps=1000, conductance=spec)
-    work = 2e5 * 10 * static.NECK_STEP_COST
+    work = 2e5 * 10 * static.NECK_STEP_COST["union"]
     assert 2e6 < static.WORK_PER_STEP_LIMIT * 1000 < work
-    with pytest.raises(ValueError, match=re.escape(f"10 particles x {static.NECK_STEP_COST:g} (a node per neck) = "
-                                                   f"{work:.3g} particle-steps (about ")):
+    cost = static.NECK_STEP_COST["union"]
+    with pytest.raises(ValueError, match=re.escape(f"10 particles x {cost:g} (a node per neck) = {work:.3g} "
+                                                   f"particle-steps (about ")):
         static.StaticEngine(scene)
+
+
+def _apart(n: int):
+    """``n`` spheres of 1 mm in a row, apart: no bond, were they searched."""
+    return np.column_stack([np.arange(n) * 3e-3, np.zeros(n), np.zeros(n)]), np.full(n, 1e-3)
+
+
+def test_a_neck_node_run_on_pair_necks_is_refused_with_its_own_figure(monkeypatch):
+    """With a node per neck on a pair-neck reading a particle takes about 22 kB at the peak of a static run (the
+    elements over the necks' faces), and more through the hand-over of a moving run: 30 000 such particles are
+    refused where 0.8 GB are left, before the bond search, static and moving, each with its figure; one node per
+    particle on the same necks passes (0.27 GB)."""
+    from dem import make_scene, parse_scene
+    from dem.engines.static import StaticEngine
+    from dem.engines.verlet.engine import VerletEngine
+    from dem.laws.conductance import ConductanceSpec
+    from test_handover import LUDING
+
+    monkeypatch.setattr(memory, "available_bytes", lambda: 0.8e9)
+    n = 30_000
+    memory.check(n, "particles", "newton", "particles")
+    x, r = _apart(n)
+    spec = ConductanceSpec(law="shared-body", nodes="necks")
+    need = memory.BASE_BYTES + memory.PAIR_NECK_NODES_BYTES_PER_PARTICLE["static"] * n
+    assert need > 0.8e9
+    with pytest.raises(ValueError, match=rf"particles: a run of 30000 particles needs about {need / 2**30:.3g} GiB "
+                                         r"\(about 21.8 kB per particle at the peak of a steady solve\)"):
+        StaticEngine(make_scene(x, r, np.zeros(n), mode="steady", conductance=spec))
+    each = memory.PAIR_NECK_NODES_BYTES_PER_PARTICLE["moving"]
+    scene = parse_scene({"scene": {"physics": ["mechanical", "thermal"]},
+                         "material": {"density": 7800.0, "conductivity": 50.0, "specific_heat": 500.0},
+                         "contact": LUDING, "particles": {"position": x.tolist(), "radius": r.tolist(), "temperature": [0.0] * n},
+                         "conductance": {"law": "shared-body", "nodes": "necks"},
+                         "solver": {"mode": "transient", "t_end": 1e-3}})
+    with pytest.raises(ValueError, match=rf"about {each / 1e3:.3g} kB per particle at the peak of a moving run\)"):
+        VerletEngine(scene)
+    line = memory.estimate(n, "first", "necks", moving=True)
+    assert f"about {(memory.BASE_BYTES + each * n) / 2**30:.3g} GiB at the peak of a moving run" in line
+
+
+def test_neck_node_steps_on_pair_necks_weigh_more_up_front():
+    """An implicit step with a node per neck on a pair-neck reading costs NECK_STEP_COST["pair"] (23) one-node
+    particle-steps, where the union's 7 would let 2e4 steps of 10 particles (1.4e6) pass under the 3e6 that
+    max_steps = 1000 allows: refused, with the estimate."""
+    from dem import make_scene
+    from dem.engines import static
+    from dem.laws.conductance import ConductanceSpec
+
+    x = np.column_stack([np.arange(10) * 1.9e-3, np.zeros(10), np.zeros(10)])
+    scene = make_scene(x, np.full(10, 1e-3), np.zeros(10), mode="transient", integrator="implicit", dt=1e-3,
+                       t_end=20.0, max_steps=1000, conductance=ConductanceSpec(law="shared-body", nodes="necks"))
+    work = 2e4 * 10 * static.NECK_STEP_COST["pair"]
+    assert 2e4 * 10 * static.NECK_STEP_COST["union"] < static.WORK_PER_STEP_LIMIT * 1000 < work
+    with pytest.raises(ValueError, match=re.escape(f"10 particles x 23 (a node per neck) = {work:.3g} particle-steps")):
+        static.StaticEngine(scene)
+    assert "about 21 s" in memory.estimate(10_000, "coble", "necks")  # 2.1 ms per particle; one node says nothing
+    assert memory.estimate(10_000, "coble") is None

@@ -7,21 +7,25 @@ A bond's conductance is ``(1 - w) K_pair + w K_union``: ``K_pair`` the scene's l
 the particles' radii, ``K_union`` the same law on the union reading (:func:`dem.laws.conductance.bond_conductances`
 with ``neck = "union"``) of the solid radii, ``w`` the bond's hand-over weight
 (:func:`dem.geometry.handover.bond_weights`). Where no particle is handed over, the bonds are the pair reading's
-alone, computed as without the hand-over.
+alone, computed as without the hand-over. Under ``out_of_range = "drop"`` ``K_pair`` is the drop reading's: 0 on a
+bond past the pair reading's range, whose union part still conducts.
 
 **Neck nodes** (``[conductance] nodes = "necks"``, :mod:`dem.network.necks`). A neck node has no conductance to blend:
 each particle is an element over its centre and its necks. Through the hand-over the network's nodes are the pair
 reading's necks, and each particle's element is :math:`(1 - w) E_\mathrm{pair} + w E_\mathrm{union}`
 (:func:`blend_elements`), ``w`` the particle's own weight: :math:`E_\mathrm{pair}` its element on the pair reading of
-its radius, :math:`E_\mathrm{union}` on the union reading of the grown spheres (its solid radius, its neighbours'),
-both over the same necks (a neck the union hides inside a third sphere has no part in the latter, and no node once
-both its particles are handed over: no element has it then). A sum of elements
-with positive weights is an element (symmetric, positive semidefinite, rows summing to zero), so the network stays
-well posed, and it moves by a hundredth of the difference of the readings a step, as the one-node law's conductances
-do. The weight is the particle's, not its bond's (the larger of its two particles', which the one-node law must take
-for one conductance per bond): a particle not yet on the way keeps its pair element even on a bond to a handed-over
-neighbour, whose own element reads that neck as the union. Where every particle is handed over the network is the
-union reading's of the grown spheres; where none is, the pair reading's, computed as without the hand-over.
+its radius, :math:`E_\mathrm{union}` on the union reading of the grown spheres (its solid radius, its neighbours'), both
+over the same necks (a neck the union hides inside a third sphere has no part in the latter, and no node once both its
+particles are handed over: no element has it then). Under ``out_of_range = "drop"`` a pair neck past its range has no
+part in :math:`E_\mathrm{pair}` (the pair reading drops it, as the one-node law's ``K_pair`` is 0 there and its
+``K_union`` weighed in) and keeps its part in :math:`E_\mathrm{union}`: it has a node once one of its particles has
+begun its hand-over, and none before. A sum of elements with positive weights is an element (symmetric, positive
+semidefinite, rows summing to zero), so the network stays well posed, and it moves by a hundredth of the difference of
+the readings a step, as the one-node law's conductances do. The weight is the particle's, not its bond's (the larger of
+its two particles', which the one-node law must take for one conductance per bond): a particle not yet on the way keeps
+its pair element even on a bond to a handed-over neighbour, whose own element reads that neck as the union. Where every
+particle is handed over the network is the union reading's of the grown spheres; where none is, the pair reading's,
+computed as without the hand-over.
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from fem_neck.geometry import max_overlap
+from fem_neck.geometry.cut_kernels import ends_by_particle
 
 from dem.geometry.bonds import find_bonds
 from dem.geometry.handover import advance, bond_weights, solid_radii, weights
@@ -53,7 +58,7 @@ class Reading:
     w_pair, w_wall : numpy.ndarray
         The pair and wall bonds' hand-over weights (:func:`dem.geometry.handover.bond_weights`).
     past, past_wall : numpy.ndarray
-        The pair and wall bonds past the pair reading's range while it still has weight (bool).
+        The pair and wall bonds past the pair reading's range, whatever the weights (bool).
     """
 
     bonds: object
@@ -153,10 +158,11 @@ class Handover:
                     find_bonds(now, walls, spec.contact, spec.out_of_range, pairs=pairs, box=box)), None
         w_pair, w_wall = bond_weights(self.weight, pair)
         # bonds past the pair reading's range where it still has weight: the scene's out_of_range policy
-        past = (pair.h > max_overlap(now.radius[pair.i], now.radius[pair.j])) & (w_pair < 1.0)
-        past_wall = (pair.wall_h > now.radius[pair.wall_particle] / 3.0) & (w_wall < 1.0)
-        if spec.out_of_range == "error" and (np.any(past) or np.any(past_wall)):
-            find_bonds(now, walls, spec.contact, "error", pairs=(pair.i[past], pair.j[past]), box=box)
+        past = pair.h > max_overlap(now.radius[pair.i], now.radius[pair.j])
+        past_wall = pair.wall_h > now.radius[pair.wall_particle] / 3.0
+        weighed, weighed_wall = past & (w_pair < 1.0), past_wall & (w_wall < 1.0)
+        if spec.out_of_range == "error" and (np.any(weighed) or np.any(weighed_wall)):
+            find_bonds(now, walls, spec.contact, "error", pairs=(pair.i[weighed], pair.j[weighed]), box=box)
         solid = solid_radii(now.radius, self.weight > 0.0, pair.i, pair.j, vectors, pair.wall_particle, normals,
                             pair.wall_l, start=self.solid_radius)
         if update:
@@ -201,9 +207,13 @@ class Handover:
         pair, union = self._readings(now, walls, pairs, box, update)
         if union is None:
             return (pair, *bond_conductances(spec, now, pair, box=box, walls=tuple(walls)))
-        K_pair, K_wall = bond_conductances(spec, now, pair, box=box, walls=walls)
-        if spec.out_of_range == "drop":
-            K_pair[union.past], K_wall[union.past_wall] = 0.0, 0.0
+        if spec.out_of_range == "drop":  # the pair reading's conductances without its necks past its range (0 there)
+            K_pair, K_wall = np.zeros(pair.n_pairs), np.zeros(pair.n_walls)
+            on, on_walls = np.flatnonzero(~union.past), np.flatnonzero(~union.past_wall)
+            K_pair[on], K_wall[on_walls] = bond_conductances(spec, now, pair.subset(on, on_walls), box=box,
+                                                             walls=walls)
+        else:
+            K_pair, K_wall = bond_conductances(spec, now, pair, box=box, walls=walls)
         K_union, K_wall_union = bond_conductances(replace(spec, neck="union"), union.grown, union.bonds, box=box,
                                                   walls=walls)
         w_pair, w_wall = union.w_pair, union.w_wall
@@ -237,23 +247,18 @@ class Handover:
         Returns
         -------
         dem.network.necks.NeckNetwork
-            The network: its nodes the pair reading's necks (but those the union hides between two handed-over
-        particles), each particle's element blended by its weight.
+            The network: its nodes the pair reading's necks that some particle's element has (module docstring),
+            each particle's element blended by its weight.
 
         Raises
         ------
         ValueError
-            As :meth:`bonds`; and a neck of the union reading that the pair reading has dropped
-            (``out_of_range = "drop"``), which has no node to carry it.
+            As :meth:`bonds`.
         """
         spec = self.spec
         pair, union = self._readings(now, walls, pairs, box, update)
         if union is None:
             return neck_network(spec, now, pair, box=box, walls=walls)
-        if spec.out_of_range == "drop" and (np.any(union.past) or np.any(union.past_wall)):
-            raise ValueError("[conductance] out_of_range = \"drop\" with nodes = \"necks\": a pair neck past its "
-                             "range is dropped while its particle is on the way to the union, whose element still "
-                             "has it; use out_of_range = \"clip\" or \"error\"")
         kept = {}
 
         def union_elements(*args):  # the union's elements, kept with their bonds (args[2]) for the blend
@@ -262,15 +267,32 @@ class Handover:
 
         union_net = neck_network(replace(spec, neck="union"), union.grown, union.bonds, box=box, walls=walls,
                                  elements=union_elements)
-        # a neck the union hides inside a third sphere, between handed-over particles: no element has it, no node
+        # the necks each reading's elements have: the union's its live ones (not those hidden inside a third
+        # sphere), the pair reading's all but, under out_of_range = "drop", those past its range (as the one-node
+        # law's pair conductance there is 0)
+        drop = spec.out_of_range == "drop"
+        in_pair = (~union.past if drop else np.ones(pair.n_pairs, dtype=bool),
+                   ~union.past_wall if drop else np.ones(pair.n_walls, dtype=bool))
+        in_union = np.zeros(pair.n_pairs, dtype=bool), np.zeros(pair.n_walls, dtype=bool)
+        in_union[0][union_net.live], in_union[1][union_net.live_walls] = True, True
         weight = self.weight
-        done = weight >= 1.0
-        gone = np.ones(pair.n_pairs, dtype=bool), np.ones(pair.n_walls, dtype=bool)
-        gone[0][union_net.live], gone[1][union_net.live_walls] = False, False
-        without = (gone[0] & done[pair.i] & done[pair.j], gone[1] & done[pair.wall_particle])
 
-        def blended(*args):
-            return blend_elements(particle_elements(*args), args[2], kept["elements"], kept["bonds"], weight)
+        def held(k, side):  # whether particle k's blended element has the neck: (1 - w) E_pair + w E_union
+            return ((weight[k] < 1.0) & in_pair[side]) | ((weight[k] > 0.0) & in_union[side])
+
+        # a neck no element has (hidden inside a third sphere between handed-over particles, or dropped by the
+        # pair reading where neither particle is on the way): no node
+        without = ~(held(pair.i, 0) | held(pair.j, 0)), ~held(pair.wall_particle, 1)
+        dropped = pair.subset(np.flatnonzero(~in_pair[0]), np.flatnonzero(~in_pair[1]))
+
+        def blended(n, r, sub, vectors, k_i, k_j, k_w, kappa, normals, volume):
+            keys = _end_keys(sub, n)  # the pair elements over the necks the pair reading keeps
+            m = sub.n_pairs
+            out = np.isin(keys, _end_keys(dropped, n))
+            on, on_walls = np.flatnonzero(~out[:m]), np.flatnonzero(~out[2 * m:])
+            E_pair = particle_elements(n, r, sub.subset(on, on_walls), vectors[on], k_i[on], k_j[on], k_w[on_walls],
+                                       kappa, normals[on_walls], volume)
+            return blend_elements(E_pair, sub.subset(on, on_walls), kept["elements"], kept["bonds"], weight, sub)
 
         return neck_network(spec, now, pair, box=box, walls=walls, elements=blended, without=without)
 
@@ -306,11 +328,11 @@ def _end_keys(bonds, n: int) -> np.ndarray:
     return np.concatenate([3 * pair, 3 * pair + 1, 3 * wall + 2])
 
 
-def blend_elements(pair: ParticleElements, pair_bonds, union: ParticleElements, union_bonds,
-                   weight: np.ndarray) -> ParticleElements:
+def blend_elements(pair: ParticleElements, pair_bonds, union: ParticleElements, union_bonds, weight: np.ndarray,
+                   bonds=None) -> ParticleElements:
     """Each particle's element through the hand-over (module docstring, "Neck nodes"): ``(1 - w) E_pair + w E_union``
-    over the pair reading's ends, ``w`` the particle's hand-over weight; an end the union reading does not have (a
-    neck inside a third sphere) takes nothing from it.
+    over the network's ends, ``w`` the particle's hand-over weight; an end one reading does not have (a neck inside a
+    third sphere, a pair neck dropped past its range) takes nothing from it.
 
     Parameters
     ----------
@@ -324,39 +346,61 @@ def blend_elements(pair: ParticleElements, pair_bonds, union: ParticleElements, 
         The bonds of their ends (the live ones of the union reading: the same contacts or fewer).
     weight : numpy.ndarray
         Per particle, its hand-over weight (0 to 1).
+    bonds : dem.geometry.bonds.Bonds or None
+        The bonds of the blend's ends, those of both readings' ends or more (the network's); None: ``pair_bonds``.
 
     Returns
     -------
     dem.laws.shared_body.ParticleElements
-        The blended elements, on the pair reading's ends.
+        The blended elements, on the ends of ``bonds``.
 
     Raises
     ------
     ValueError
-        An end of the union reading that the pair reading does not have.
+        An end of either reading that ``bonds`` does not have.
     """
     n = len(weight)
-    keys_p, keys_u = _end_keys(pair_bonds, n), _end_keys(union_bonds, n)
-    z_p, z_u = np.diff(pair.offsets), np.diff(union.offsets)
-    # the local place of each pair end in its particle's element, found by its key
-    local_p = np.empty(len(pair.ends), dtype=np.int64)
-    local_p[pair.ends] = np.arange(len(pair.ends)) - np.repeat(pair.offsets[:-1], z_p)
-    order = np.argsort(keys_p)
-    at = np.searchsorted(keys_p, keys_u, sorter=order)
-    found = (at < len(order)) & (keys_p[order[np.minimum(at, len(order) - 1)]] == keys_u)
-    if not np.all(found):
-        raise ValueError("the hand-over's union reading has a neck that the pair reading has not")
-    place_u = np.append(local_p[order[at]][union.ends], -1)  # per union local end (in element order), its pair place
-    # every union entry (particle k, local p, q) to its place in k's pair element
-    size_u, size_p = z_u + 1, z_p + 1
-    owner = np.repeat(np.arange(n), size_u * size_u)
-    local = np.arange(len(union.values)) - union.start[:-1][owner]
-    p, q = local // size_u[owner], local % size_u[owner]
-    first = union.offsets[:-1][owner]
-    row = np.where(p == z_u[owner], z_p[owner], place_u[np.where(p == z_u[owner], -1, first + p)])
-    col = np.where(q == z_u[owner], z_p[owner], place_u[np.where(q == z_u[owner], -1, first + q)])
+    if bonds is None:
+        offsets, ends = pair.offsets, pair.ends
+    else:
+        offsets, ends = ends_by_particle(n, np.concatenate((bonds.i, bonds.j, bonds.wall_particle)))
+    keys = _end_keys(pair_bonds if bonds is None else bonds, n)
+    size = np.diff(offsets) + 1
+    start = np.zeros(n + 1, dtype=np.int64)
+    start[1:] = np.cumsum(size * size)
     w = np.asarray(weight, dtype=float)
-    values = pair.values * (1.0 - np.repeat(w, size_p * size_p))
-    values[pair.start[:-1][owner] + row * size_p[owner] + col] += w[owner] * union.values
+    values = np.zeros(start[-1])
+    at, owner = _places(offsets, ends, start, keys, pair, _end_keys(pair_bonds, n))
+    values[at] = pair.values * (1.0 - w[owner])
+    at, owner = _places(offsets, ends, start, keys, union, _end_keys(union_bonds, n))
+    values[at] += w[owner] * union.values
     plain = np.where(w >= 1.0, union.plain, np.where(w > 0.0, pair.plain | union.plain, pair.plain))
-    return pair._replace(values=values, plain=plain, shrink=(1.0 - w) * pair.shrink + w * union.shrink)
+    return pair._replace(offsets=offsets, ends=ends, start=start, values=values, plain=plain,
+                         shrink=(1.0 - w) * pair.shrink + w * union.shrink)
+
+
+def _places(offsets, ends, start, keys, part: ParticleElements, part_keys):
+    """Where each value of the elements ``part`` goes in elements laid out by ``offsets``, ``ends`` and ``start``
+    (:class:`dem.laws.shared_body.ParticleElements`) over the ends whose keys (:func:`_end_keys`) are ``keys``, an end
+    of ``part`` found by its key ``part_keys``: ``(index, owner)``, the index in the layout's values and the
+    particle of each value of ``part``."""
+    n = len(offsets) - 1
+    z, z_part = np.diff(offsets), np.diff(part.offsets)
+    # the local place of each end in its particle's block, found by its key
+    local = np.empty(len(ends), dtype=np.int64)
+    local[ends] = np.arange(len(ends)) - np.repeat(offsets[:-1], z)
+    order = np.argsort(keys)
+    at = np.searchsorted(keys, part_keys, sorter=order)
+    found = (at < len(order)) & (keys[order[np.minimum(at, len(order) - 1)]] == part_keys)
+    if not np.all(found):
+        raise ValueError("the hand-over's readings have a neck that the network has not")
+    place = np.append(local[order[at]][part.ends], -1)  # per local end of part (in element order), its place
+    # every entry of part (particle k, local p, q) to its place in k's block
+    size_part, size = z_part + 1, z + 1
+    owner = np.repeat(np.arange(n), size_part * size_part)
+    entry = np.arange(len(part.values)) - part.start[:-1][owner]
+    p, q = entry // size_part[owner], entry % size_part[owner]
+    first = part.offsets[:-1][owner]
+    row = np.where(p == z_part[owner], z[owner], place[np.where(p == z_part[owner], -1, first + p)])
+    col = np.where(q == z_part[owner], z[owner], place[np.where(q == z_part[owner], -1, first + q)])
+    return start[:-1][owner] + row * size[owner] + col, owner

@@ -31,10 +31,11 @@ from dem.scene.state_file import box_arrays
 
 WORK_PER_STEP_LIMIT = 3000  # particle-steps allowed per unit of solver.max_steps (default 1e5: 3e8, ~1 min)
 SECONDS_PER_PARTICLE_STEP = 2e-7  # implicit, 2 cores: 1e-7 (10^6-particle lattice) to 6e-7 (random packing, bench)
-# an implicit step with a node per neck (AMG on the centres and necks) costs as many one-node particle-steps: 1.4e-6 s
-# of CPU per particle-step (7 x the figure above) on a random union packing tiled to 6912 particles, dt = 0.1 r^2 rho
-# c / kappa
-NECK_STEP_COST = 7.0
+# an implicit step with a node per neck (AMG on the centres and necks) costs as many one-node particle-steps, by the
+# neck reading: 1.4e-6 s of CPU per particle-step (7 x the figure above) on a random union packing tiled to 6912
+# particles, and 4.6e-6 s (23 x) on a pair-neck reading (the benchmarks' random sintered packing of 6050 particles,
+# 5.2 bonds each, where one node per particle took 1.0e-7 s), dt = 0.1 r^2 rho c / kappa, 30 steps
+NECK_STEP_COST = {"union": 7.0, "pair": 23.0}
 CSV_FLOWS = ("fixed", "walls", "convection", "radiation", "internal")  # the heat-flow columns of timeseries.csv
 
 
@@ -238,15 +239,17 @@ class StaticEngine(Engine):
             raise ValueError(self._singular_message(exc)) from None
 
     def _check_work(self) -> None:
-        """Refuse a fixed-step run whose particle-steps (a node per neck: :data:`NECK_STEP_COST` each) exceed
-        ``WORK_PER_STEP_LIMIT * max_steps`` up front, with a time estimate (:data:`SECONDS_PER_PARTICLE_STEP`)."""
-        s, n = self.scene.solver, self.scene.particle_count
+        """Refuse a fixed-step run whose particle-steps (a node per neck: :data:`NECK_STEP_COST` each, by the neck
+        reading) exceed ``WORK_PER_STEP_LIMIT * max_steps`` up front, with a time estimate
+        (:data:`SECONDS_PER_PARTICLE_STEP`)."""
+        s, n, spec = self.scene.solver, self.scene.particle_count, self.scene.conductance
         if s.dt == "auto":
             return  # the step count is not known in advance; max_steps bounds it while running
-        necks = self.scene.conductance.nodes == "necks"
-        work = s.t_end / s.dt * n * (NECK_STEP_COST if necks else 1.0)
+        necks = spec.nodes == "necks"
+        each = NECK_STEP_COST["union" if spec.neck == "union" else "pair"] if necks else 1.0
+        work = s.t_end / s.dt * n * each
         if work > WORK_PER_STEP_LIMIT * s.max_steps:
-            cost = f" x {NECK_STEP_COST:g} (a node per neck)" if necks else ""
+            cost = f" x {each:g} (a node per neck)" if necks else ""
             raise ValueError(f"solver: t_end / dt = {s.t_end / s.dt:.3g} steps x {n} particles{cost} = {work:.3g} "
                              f"particle-steps (about {SECONDS_PER_PARTICLE_STEP * work:.3g} s) exceeds "
                              f"{WORK_PER_STEP_LIMIT} x solver.max_steps = {WORK_PER_STEP_LIMIT * s.max_steps:.3g}; "

@@ -25,6 +25,7 @@ import numpy as np
 
 from dataclasses import replace
 
+from dem import memory
 from dem.engines import Engine
 from dem.engines.contact_heat import ContactThermalModel
 from dem.engines.static import refuse_neck_nodes
@@ -67,6 +68,8 @@ class VerletEngine(Engine):
         self.scene = scene
         m = scene.motion
         p = scene.particles
+        if "thermal" in scene.physics and scene.conductance.nodes == "necks":  # before anything large: costs nothing
+            memory.check(p.n, "particles", scene.conductance.neck, "necks", moving=True)
         material = scene.contact
         T_init = p.temperature.astype(float)
         law = law_module(material.law)
