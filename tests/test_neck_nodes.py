@@ -106,6 +106,38 @@ def test_a_turning_chain_is_its_particles_two_terminal_resistances_in_series():
     assert res.energy_error < 1e-12
 
 
+def test_a_held_particle_feeds_its_necks_through_their_halves():
+    """A particle held at 1 K in the corner of three walls at 0 (necks at right angles: their interactions couple
+    them): the heat it gives is the sum of its narrowed wall halves (the net flow takes the one-node law's path), not
+    1^T R^-1 1, which the faces' interactions lower; the same particle free between a hot and a cold wall passes on
+    what R^-1 bordered by its sums gives (the centre-free conductance is R's)."""
+    x = np.array([[0.8e-3, 0.8e-3, 0.8e-3]])
+    kappa = 1.0
+    walls = tuple(Wall(f"w{a}", point=[0.0, 0.0, 0.0], normal=np.eye(3)[a], temperature=0.0) for a in range(3))
+    held = Particles.from_arrays(x, [1e-3], [1.0], materials=(UNIT,), fixed=[True])
+    bonds = find_bonds(held, walls, "union")
+    res = steady_necks(neck_network(NECKS, held, bonds, walls=walls))
+    halves = (half_conductance(NECKS, held.conductivity[bonds.wall_particle], held.radius[bonds.wall_particle],
+                               bonds.wall_a, bonds.wall_l),)
+    empty = np.zeros(0)
+    k_w = union_halves(held, bonds, np.zeros((0, 3)), wall_normals(bonds, walls), held.conductivity, empty, empty,
+                       *halves, walls=walls)[2]
+    assert bonds.n_walls == 3
+    assert res.fixed_flow[0] == pytest.approx(k_w.sum(), rel=1e-12)
+    # R of the three necks (units of 1 / (4 pi kappa r)): the halves on the diagonal, the faces' interaction off it
+    unit = 4 * math.pi * kappa * 1e-3
+    G = face_interaction(-np.eye(3), bonds.wall_l / 1e-3, bonds.wall_a / 1e-3)
+    R = G / unit + np.diag(1.0 / k_w)
+    Y = np.linalg.inv(R)
+    assert np.ones(3) @ Y @ np.ones(3) < 0.97 * k_w.sum()  # the path the test tells apart
+    # free, between a wall at 1 (x) and two at 0: the centre eliminated, Y_0 = Y - Y 1 1^T Y / (1^T Y 1)
+    hot = (Wall("w0", point=[0.0, 0.0, 0.0], normal=[1.0, 0.0, 0.0], temperature=1.0),) + walls[1:]
+    free = Particles.from_arrays(x, [1e-3], [0.5], materials=(UNIT,))
+    res = steady_necks(neck_network(NECKS, free, bonds, walls=hot))
+    Y0 = Y - np.outer(Y.sum(axis=1), Y.sum(axis=0)) / Y.sum()
+    assert -res.wall_flow == pytest.approx(Y0 @ np.array([1.0, 0.0, 0.0]), rel=1e-10, abs=1e-14)
+
+
 @pytest.mark.parametrize("h", [0.3, 0.5])
 def test_simple_cubic_lattice_is_todays_law(h):
     """A uniform field loads no interaction on the simple cubic particle: the neck-node solve is the law, with the

@@ -580,6 +580,18 @@ def _elements(n_particles, pairs, walls, bodies):
         if trace > limit:
             shrink[k] = limit / trace
         f = unit * shrink[k]
+        coupled = False
+        for b in range(z):
+            for c in range(b):
+                coupled = coupled or R[b, c] != 0.0
+        if coupled:  # the centre joined to the necks by their halves (particle_elements' docstring)
+            halves = 1.0 / half_r
+            spread = halves.sum()
+            for b in range(z):
+                for c in range(z):
+                    Y[b, c] += halves[b] * halves[c] / spread - row[b] * row[c] / total
+            row = halves
+            total = spread
         s = z + 1
         at = start[k]
         for b in range(z):  # local nodes: the necks in the order of ``ends``, then the centre
@@ -612,6 +624,18 @@ def particle_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndar
     and its centre takes :math:`-\sum Q`; the whole matrix is scaled down where the trace of the particle's tensor
     exceeds :math:`3 \kappa V_k`. A particle whose necks are collinear (a pair, a chain) has ``R`` diagonal: its
     halves in series, today's network. The arguments are those of :func:`neck_factors`.
+
+    ``R`` describes flows through the necks that sum to zero (heat passing through the particle: the interactions
+    are the sphere's Neumann function of such flows); the net flow between the centre and the necks (a particle held
+    at a temperature, a heat source, its heat capacity) takes the one-node law's path, each neck's half
+    :math:`K_b = 1/R_{bb}` from the centre. So the necks' block is :math:`Y_0 + K K^T / \sum K` with
+    :math:`Y_0 = R^{-1} - R^{-1} \mathbf 1 \mathbf 1^T R^{-1} / (\mathbf 1^T R^{-1} \mathbf 1)` the centre-free
+    conductance, the centre's column :math:`-K` and its diagonal :math:`\sum K`: eliminating a free centre with no
+    source leaves :math:`Y_0`, what :math:`R^{-1}` bordered by its own sums leaves, so a network of free particles is
+    the same either way; a held particle whose centre fed its necks through :math:`R^{-1} \mathbf 1` conducted 4-8 %
+    too little on finite clusters held by layers of fixed particles (isolated against exact elements of the cut
+    spheres and full FE of two clusters in a lab run; the one-node law's path sits within 1.2 % of the exact
+    elements' there).
 
     Parameters
     ----------

@@ -8,13 +8,14 @@ particle model exactly instead of reducing it to one factor per neck on one node
 temperature :math:`T_c`, which holds its heat capacity) and one node per neck. With ``R`` the particle's
 multi-terminal resistance (flows :math:`Q` into the particle through its necks raise neck ``b`` to
 :math:`T_b - T_c = \sum_c R_{bc} Q_c`: the cut-body halves :math:`1/K_b` on the diagonal, the sphere's Neumann function
-between necks, its free-space part taken between the necks' faces), :math:`Q = R^{-1} (T_\mathrm{necks} - T_c
-\mathbf 1)` and the centre takes :math:`-\sum Q`: the element's conductance matrix is
+between necks, its free-space part taken between the necks' faces) describes heat passing through the particle
+(flows that sum to zero: :math:`Y_0`, the Schur complement on the necks of :math:`R^{-1}` bordered by its sums), and
+the net flow between the centre and its necks takes the one-node law's halves :math:`K_b = 1/R_{bb}`
+(:func:`dem.laws.shared_body.particle_elements` says why): the element's conductance matrix is
 
 .. math::
 
-    E = \begin{pmatrix} R^{-1} & -R^{-1} \mathbf 1 \\ -\mathbf 1^T R^{-1} & \mathbf 1^T R^{-1} \mathbf 1
-    \end{pmatrix},
+    E = \begin{pmatrix} Y_0 + K K^T / \textstyle\sum K & -K \\ -K^T & \sum K \end{pmatrix},
 
 symmetric, positive semidefinite (``R`` is positive definite: :func:`dem.laws.shared_body.particle_elements` drops the
 interactions of a particle where it is not), its rows summing to zero. The law's trace cap scales ``E`` as it scales a
