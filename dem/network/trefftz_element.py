@@ -572,7 +572,8 @@ def _chain_table(L: int) -> CubicSpline:
     200 two-neck elements: a fraction of a second at ``L`` 10)."""
     first, last, step = CHAIN_GRID
     q = np.round(np.arange(first, last + step / 2, step), 9)
-    return CubicSpline(q, [chain_half(x, L) for x in q])
+    with one_blas_thread():
+        return CubicSpline(q, [chain_half(x, L) for x in q])
 
 
 def chain_shift(a_over_r: np.ndarray, L: int = DEGREE) -> np.ndarray:
