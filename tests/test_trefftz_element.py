@@ -179,3 +179,22 @@ def test_walls_and_a_degree_out_of_range_are_refused_in_one_line():
 
     with pytest.raises(ValueError, match="walls"):
         te.trefftz_elements(1, np.ones(1), Walled(), empty, empty, empty, empty, np.ones(1), empty)
+
+
+def test_the_neck_node_bound_study_has_the_trefftz_column_without_ngsolve(tmp_path, monkeypatch):
+    """python -m verification neck-node-bound --quick where NGSolve is missing: the FE of its cell (SC h/r 0.3) from
+    the cache, the exact elements left out, the Trefftz element's network within 1 % of the FE and below Wiener."""
+    from verification import neck_node_bound as S
+    from verification.lattices import FECache
+    from verification.report import check_section_result
+
+    monkeypatch.setattr(S, "ngsolve_present", lambda: False)
+    lower, upper = 0.60303, 0.60335  # the FE's bounds at gap 1e-3 (tests/test_union_shared_body.py)
+    FECache(tmp_path / "fe_cache.json").put(f"sc union h/r=0.3 rtol={S.QUICK_RTOL:g}",
+                                            {"k": 0.5 * (lower + upper), "lower": lower, "upper": upper})
+    res = check_section_result("neck_node_bound", S.run(tmp_path, quick=True))
+    assert "NGSolve is missing" in res["markdown"] and S.TREFFTZ in res["markdown"]
+    assert [limit for _, _, limit in res["targets"]] == [S.TREFFTZ_TARGET, 0.0]
+    assert all(measured <= limit for _, measured, limit in res["targets"])
+    (row,) = res["summary"].values()
+    assert abs(row[f"rel_{S.TREFFTZ}"]) < 0.01 and row[f"ms_per_particle_{S.TREFFTZ}"] > 0
