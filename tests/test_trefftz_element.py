@@ -111,6 +111,17 @@ def test_the_element_is_symmetric_positive_definite_and_grows_with_the_degree():
     assert np.all(np.diag(R10) >= np.diag(R8) * (1 - 1e-9))
 
 
+def test_a_turned_particle_with_whole_faces_has_the_same_element():
+    """Necks that do not meet (whole discs): the element does not depend on the particle's orientation (measured
+    1e-9: the equal steps in angle integrate the loads, basis times modes, exactly around the disc, the stiffness's
+    face term of higher degree in angle nearly so). Gauss-Legendre in angle instead: 1e-4."""
+    n, arms = _particle(4, (0.2, 0.4))
+    Q, _ = np.linalg.qr(RNG.normal(size=(3, 3)))
+    R = te.resistance(n, arms, neck_frames(n))
+    turned = te.resistance(n @ Q.T, arms, neck_frames(n) @ Q.T)
+    assert np.abs(R - turned).max() < 1e-8 * np.abs(R).max()
+
+
 def test_the_chain_particles_shifted_half_is_the_laws():
     """At the shift table's nodes exactly (to round-off), between them to the spline's 1e-6; outside the table
     (a/r below its first node) solved directly, exactly again."""

@@ -16,7 +16,7 @@ loads are the modes' moments of the basis on the faces. ``R = B^T K^{-1} B`` is 
 Quadrature: on a face, polar coordinates about a point inside the clipped disc, one panel between consecutive
 vertices of its boundary, graded toward the rim by :math:`t = 1 - (1 - s)^4` along each ray (the profile's
 :math:`(a^2 - \rho^2)^{-1/4}` becomes a smooth :math:`(1 - s)^2`) and in angle by :math:`(1 - \cos \pi s)/2` toward the
-vertices; on a cap, rings in the polar angle about the plane's normal between the angles where other caps' rims
+vertices (an unclipped disc: equal steps in angle, which do not depend on its orientation); on a cap, rings in the polar angle about the plane's normal between the angles where other caps' rims
 cross it, each ring's arcs outside the earlier caps by Gauss-Legendre. The rule of degree ``L`` (:func:`rule`) has
 ``L + 2`` radii and ``L + 4`` angles per face panel, ``L + 4`` rings per cap panel and ``2 L + 6`` points per full ring.
 
@@ -190,9 +190,9 @@ def _face_points(j, normals, d, tr, wr, tp, wp, P, W, w, start):
             if graded:
                 tpg = 0.5 * (1 - math.cos(math.pi * tp[ip]))
                 wpg = 0.5 * math.pi * math.sin(math.pi * tp[ip]) * wp[ip]
-            else:
-                tpg = tp[ip]
-                wpg = wp[ip]
+            else:  # the whole circle: equal steps, exact for trigonometric polynomials below len(tp)
+                tpg = (ip + 0.5) / len(tp)
+                wpg = 1.0 / len(tp)
             psi = lo + (hi - lo) * tpg
             ex = math.cos(psi)
             ey = math.sin(psi)
