@@ -122,6 +122,71 @@ def test_a_turned_particle_with_whole_faces_has_the_same_element():
     assert np.abs(R - turned).max() < 1e-8 * np.abs(R).max()
 
 
+def _numpy_basis(P, L, nrm):
+    """The basis and its gradient along ``nrm`` in plain numpy, vectorised over the points: the complex solid
+    harmonics R_l^m = r^l P_l^m e^(i m phi) / (l + m)! by their recurrences in l and the same differentiated."""
+    from math import factorial
+
+    x, y, z = P.T
+    r2, w = (P * P).sum(1), x + 1j * y
+    R = {(0, 0): np.ones(len(P), complex)}
+    G = {(0, 0): np.zeros((3, len(P)), complex)}
+    for m in range(L + 1):
+        if m:
+            R[m, m] = -w / (2 * m) * R[m - 1, m - 1]
+            G[m, m] = -(np.array([R[m - 1, m - 1], 1j * R[m - 1, m - 1], 0 * w]) + w * G[m - 1, m - 1]) / (2 * m)
+        for l in range(m + 1, L + 1):
+            prev2, g2 = (R[l - 2, m], G[l - 2, m]) if l - 2 >= m else (0 * w, np.zeros((3, len(P))))
+            den = (l - m) * (l + m)
+            R[l, m] = ((2 * l - 1) * z * R[l - 1, m] - r2 * prev2) / den
+            G[l, m] = ((2 * l - 1) * (z * G[l - 1, m] + np.array([0 * w, 0 * w, R[l - 1, m]])) - 2 * P.T * prev2
+                       - r2 * g2) / den
+    V, D = [], []
+    for l in range(1, L + 1):
+        for m in range(l + 1):
+            c = np.sqrt((2 * l + 1) / (4 * np.pi) * factorial(l + m) * factorial(l - m)) * (1 if m == 0 else np.sqrt(2))
+            g = (G[l, m] * nrm.T).sum(0)
+            V.append(c * R[l, m].real), D.append(c * g.real)
+            if m:
+                V.append(c * R[l, m].imag), D.append(c * g.imag)
+    V.append(r2), D.append(2 * (P * nrm).sum(1))
+    return np.array(V).T, np.array(D).T
+
+
+def test_the_compiled_element_is_the_same_formulas_in_plain_numpy():
+    """resistance() against its definition written out in numpy at L = 4 on the same quadrature: K from the whole
+    sphere's diag(l) less the caps (their normal derivatives from the gradient, not Euler's shortcut; no SYRK) plus
+    the faces, the |x|^2 entries from the divergence theorem, the loads with the sink, R = B^T K^-1 B."""
+    L = 4
+    n, arms = _particle(8)
+    frames = neck_frames(n)
+    quad = te.quadrature(n, arms, L)
+    (Pc, Wc), (Pf, Wf, wf), fs = quad["caps"], quad["faces"], quad["offsets"]
+    normal_f = np.repeat(n, np.diff(fs), axis=0)
+    Vc, Dc = _numpy_basis(Pc, L, Pc)
+    Vf, Df = _numpy_basis(Pf, L, normal_f)
+    deg = te.degrees(L)
+    K = np.diag(np.append(deg[:-1], 0.0)) - (Vc * Wc[:, None]).T @ Dc + (Vf * Wf[:, None]).T @ Df
+    xn = (Pf * normal_f).sum(1)
+    K[-1, -1] = 16 * np.pi / 5 + 0.8 * ((Wf * Vf[:, -1] * xn).sum() - (Wc * Vc[:, -1]).sum())
+    K[:-1, -1] = K[-1, :-1]
+    K = 0.5 * (K + K.T)
+    mean = ((Vf * (Wf * xn)[:, None]).sum(0) - (Vc * Wc[:, None]).sum(0)) / (deg + 3)
+    mean[-1] += 4 * np.pi / 5
+    volume = 4 * np.pi / 3 + ((Wf * xn).sum() - Wc.sum()) / 3
+    B = np.zeros((len(deg), 3 * len(arms)))
+    for b in range(len(arms)):
+        sl = slice(fs[b], fs[b + 1])
+        ww = Wf[sl] * wf[sl] / (Wf[sl] * wf[sl]).sum()
+        a = np.sqrt(1 - arms[b] ** 2)
+        B[:, 3 * b] = Vf[sl].T @ ww - mean / volume
+        for d in range(2):
+            xi = (Pf[sl] - arms[b] * n[b]) @ frames[b][d]
+            B[:, 3 * b + 1 + d] = Vf[sl].T @ (ww * (xi - ww @ xi) / a)
+    R = B.T @ np.linalg.solve(K, B)
+    assert np.abs(te.resistance(n, arms, frames, L) - R).max() < 1e-12 * np.abs(R).max()
+
+
 def test_the_chain_particles_shifted_half_is_the_laws():
     """At the shift table's nodes exactly (to round-off), between them to the spline's 1e-6; outside the table
     (a/r below its first node) solved directly, exactly again."""
