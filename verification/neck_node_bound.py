@@ -219,8 +219,9 @@ def trefftz(cell: lattice.PeriodicCell) -> dict:
     """The network of the compiled Trefftz element (:func:`dem.network.trefftz_element.trefftz_elements`) on the
     periodic cell: ``k`` its ``k_eff / kappa`` along z, ``ms_per_particle`` the CPU time of its elements per particle
     (ms), ``plain`` the particles that kept the law's element."""
-    from dem.network.trefftz_element import trefftz_elements
+    from dem.network.trefftz_element import chain_shift, trefftz_elements
 
+    chain_shift(0.5)  # the shift table, built once per process (about a second): not a particle's cost
     built = {}
 
     def timed(*args, **kwargs):
