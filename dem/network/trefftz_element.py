@@ -10,7 +10,7 @@ monopole :math:`w / W` with the uniform sink :math:`1/V` that balances it, and t
 integrals, since every basis function is harmonic but :math:`|x|^2`, whose Laplacian is constant:
 :math:`K_{ab} = \int_{\partial\Omega} \phi_a \partial_n \phi_b`, the sphere's part by orthogonality (:math:`\int
 \phi_a \partial_n \phi_b = l \delta_{ab}` on the unit sphere) less the caps the planes cut off plus the faces; the
-loads are the modes' moments of the basis on the faces. ``R = B^T K^{-1} B`` is the element's resistance over its
+loads are the modes' moments of the basis on the faces. :math:`R = B^T K^{-1} B` is the element's resistance over its
 ``3 z`` modes (units :math:`1 / (\kappa r)`), below the exact one (Ritz).
 
 Quadrature: on a face, polar coordinates about a point inside the clipped disc, one panel between consecutive
@@ -54,8 +54,19 @@ TWO_PI = 2.0 * np.pi
 
 
 def rule(L: int) -> tuple:
-    """The quadrature for degree ``L``: ``(n_rho, n_psi, n_theta, n_phi)``, the radii and angles per face panel, the
-    rings per cap panel and the points per full ring (module docstring)."""
+    """The quadrature for a degree (module docstring).
+
+    Parameters
+    ----------
+    L : int
+        The harmonics' largest degree.
+
+    Returns
+    -------
+    tuple of int
+        ``(n_rho, n_psi, n_theta, n_phi)``: the radii and angles per face panel, the rings per cap panel and the
+        points per full ring.
+    """
     return L + 2, L + 4, L + 4, 2 * L + 6
 
 
@@ -411,7 +422,18 @@ def _harmonics(P, L, nrm, V, DN, radial):
 
 
 def degrees(L: int) -> np.ndarray:
-    """The degree of each basis function of :func:`harmonics` (``|x|^2``: 2), as floats."""
+    """The degree of each basis function of :func:`harmonics`, as floats (the last, :math:`|x|^2`: 2).
+
+    Parameters
+    ----------
+    L : int
+        The harmonics' largest degree.
+
+    Returns
+    -------
+    numpy.ndarray
+        :math:`(L + 1)^2` degrees.
+    """
     return np.concatenate([np.repeat(np.arange(1, L + 1), 2 * np.arange(1, L + 1) + 1), [2]]).astype(float)
 
 
@@ -433,7 +455,7 @@ def harmonics(P: np.ndarray, L: int, nrm=None):
     Returns
     -------
     tuple of numpy.ndarray
-        Values and derivatives along ``nrm``, each (N, (L + 1)^2).
+        Values and derivatives along ``nrm``, each of N rows and :math:`(L + 1)^2` columns.
     """
     P = np.ascontiguousarray(P, dtype=float)
     V = np.empty((len(P), (L + 1) ** 2))
@@ -483,8 +505,8 @@ def quadrature(normals: np.ndarray, arms: np.ndarray, L: int):
 
 
 def resistance(normals: np.ndarray, arms: np.ndarray, frames: np.ndarray, L: int = DEGREE):
-    r"""The Ritz resistance of the unit sphere (``kappa = r = 1``) cut by ``normals . x <= arms`` over three flux
-    modes per plane (module docstring; no shift).
+    r"""The Ritz resistance of the unit sphere (:math:`\kappa = r = 1`) cut by the planes :math:`n_b \cdot x \le d_b`
+    over three flux modes per plane (module docstring; no shift).
 
     Parameters
     ----------
@@ -547,8 +569,18 @@ def resistance(normals: np.ndarray, arms: np.ndarray, frames: np.ndarray, L: int
 
 
 def law_half(a_over_r):
-    """The chain particle's exact half resistance, the union law's :math:`1/(\\pi K/K_{cyl})` (:mod:`fem_neck.law`),
-    units :math:`1/(\\kappa r)`; ``a_over_r`` the neck radius over the particle's (array_like, in (0, 1))."""
+    """The chain particle's exact half resistance, the union law's :math:`1/(\\pi K/K_{cyl})` (:mod:`fem_neck.law`).
+
+    Parameters
+    ----------
+    a_over_r : float or array_like
+        The neck radius over the particle's, in (0, 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        The half resistance, units :math:`1/(\\kappa r)`.
+    """
     return 1.0 / (np.pi * np.asarray(_union_law().k_over_kcyl(np.asarray(a_over_r, dtype=float)), dtype=float))
 
 
@@ -558,8 +590,21 @@ def _union_law():
 
 
 def chain_half(a_over_r: float, L: int = DEGREE) -> float:
-    """The chain particle's Trefftz half (two opposite necks of radius ``a_over_r``): :math:`(R_{00} + R_{33} - 2
-    R_{03}) / 2` of :func:`resistance` at degree ``L``, units :math:`1/(\\kappa r)`."""
+    """The chain particle's Trefftz half (two opposite necks): :math:`(R_{00} + R_{33} - 2 R_{03}) / 2` of
+    :func:`resistance`.
+
+    Parameters
+    ----------
+    a_over_r : float
+        The necks' radius over the particle's, in (0, 1).
+    L : int
+        The harmonics' largest degree.
+
+    Returns
+    -------
+    float
+        The half resistance, units :math:`1/(\\kappa r)`.
+    """
     arm = math.sqrt(1 - a_over_r ** 2)
     normals = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
     R = resistance(normals, np.array([arm, arm]), neck_frames(normals), L)
@@ -576,9 +621,21 @@ def _chain_table(L: int) -> CubicSpline:
         return CubicSpline(q, [chain_half(x, L) for x in q])
 
 
-def chain_shift(a_over_r: np.ndarray, L: int = DEGREE) -> np.ndarray:
-    """What the degree ``L`` misses on the chain particle's half (module docstring): the law's half less the
-    Trefftz half, units :math:`1/(\\kappa r)`, per neck radius over particle radius ``a_over_r`` (in (0, 1))."""
+def chain_shift(a_over_r, L: int = DEGREE) -> np.ndarray:
+    """What a degree misses on the chain particle's half (module docstring): the law's half less the Trefftz half.
+
+    Parameters
+    ----------
+    a_over_r : float or array_like
+        The neck radii over the particle's, in (0, 1).
+    L : int
+        The harmonics' largest degree.
+
+    Returns
+    -------
+    numpy.ndarray
+        The shifts, units :math:`1/(\\kappa r)`, one per neck.
+    """
     q = np.atleast_1d(np.asarray(a_over_r, dtype=float))
     first, last, _ = CHAIN_GRID
     table = _chain_table(L)
