@@ -213,6 +213,25 @@ def test_a_chain_of_particles_is_the_one_node_law():
     assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
 
 
+def test_an_element_not_positive_definite_falls_back_to_the_laws_monopoles(monkeypatch):
+    """A shift that breaks positive definiteness (forced here: far below the Trefftz diagonal) leaves every particle
+    the law's element on its monopoles, marked plain, with its unshifted dipoles beside them: on the chain that is
+    the law's k_eff again."""
+    from verification.lattices import dem_periodic
+
+    monkeypatch.setattr(te, "chain_shift", lambda q, L: np.full(np.shape(q), -10.0))
+    built = []
+
+    def hook(*args, **kwargs):
+        built.append(te.trefftz_elements(*args, **kwargs))
+        return built[-1]
+
+    cell = _periodic_chain(0.5)
+    k = dem_periodic(cell, "shared-body", neck="union", nodes="necks", elements=hook)
+    assert built[0].plain.all()
+    assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
+
+
 # FCC, union of spheres, h/r = 0.1: the periodic cell's FE lower and upper bounds at rtol 1e-3 (python -m
 # verification densification; tests/test_union_shared_body.py)
 FCC_FE = (0.65161, 0.65204)
