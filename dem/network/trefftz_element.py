@@ -614,7 +614,7 @@ def chain_half(a_over_r: float, L: int = DEGREE) -> float:
 @functools.lru_cache(maxsize=None)
 def _chain_table(L: int) -> CubicSpline:
     """The chain's Trefftz half on :data:`CHAIN_GRID`, a cubic spline; computed once per ``L`` in the process (about
-    200 two-neck elements: a fraction of a second at ``L`` 10)."""
+    200 two-neck elements: about a second of CPU at ``L`` 10)."""
     first, last, step = CHAIN_GRID
     q = np.round(np.arange(first, last + step / 2, step), 9)
     with one_blas_thread():
