@@ -1,0 +1,295 @@
+"""The compiled three-mode Trefftz element of a cut sphere (dem.network.trefftz_element): its basis against scipy's
+spherical harmonics and finite differences, its sphere and cap quadrature against the Legendre series of a ball with
+two polar caps, its faces and volume against the cut spheres' closed forms, the chain shift, and one lattice cell's
+k_eff against the union's FE."""
+
+import numpy as np
+import pytest
+
+from dem.network import trefftz_element as te
+from dem.network.necks import neck_frames
+
+RNG = np.random.default_rng(7)
+
+
+def test_the_basis_is_the_real_solid_harmonics_with_their_gradients():
+    """Values against scipy's Y_l^m (r^l, real parts, unit mean square over the sphere times 4 pi), derivatives
+    against fourth-order central differences; |x|^2 last."""
+    from scipy.special import sph_harm_y
+
+    L = 5
+    P = RNG.normal(size=(20, 3)) * 0.6
+    nrm = RNG.normal(size=(20, 3))
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    V, DN = te.harmonics(P, L, nrm)
+    r = np.linalg.norm(P, axis=1)
+    theta, phi = np.arccos(P[:, 2] / r), np.arctan2(P[:, 1], P[:, 0])
+    cols = []
+    for l in range(1, L + 1):
+        for m in range(l + 1):
+            Y = sph_harm_y(l, m, theta, phi) * r ** l
+            if m == 0:
+                cols.append(Y.real)
+            else:  # the real and imaginary parts, sqrt 2 times: unit mean square
+                cols += [np.sqrt(2) * Y.real, np.sqrt(2) * Y.imag]
+    cols.append(r ** 2)
+    assert np.abs(V - np.column_stack(cols)).max() < 1e-12
+    h = 1e-3
+    fd = sum(c * te.harmonics(P + s * h * nrm, L)[0] for s, c in ((-2, 1), (-1, -8), (1, 8), (2, -1))) / (12 * h)
+    assert np.abs(DN - fd).max() < 1e-9
+    # on the unit sphere without nrm the derivative is along the radius, Euler's degree times the value
+    S = P / r[:, None]
+    Vs, DNs = te.harmonics(S, L)
+    assert np.allclose(DNs, Vs * te.degrees(L)[None, :], rtol=0, atol=1e-13)
+    assert np.allclose(DNs, te.harmonics(S, L, S)[1], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("alpha", [0.3, 0.9, 1.3])
+def test_a_ball_with_two_polar_caps_is_its_legendre_series_to_degree_l(alpha):
+    """The uncut ball with a unit flux in at the north cap and out at the south (uniform) and the x-dipoles on the
+    caps: on the whole sphere the basis is orthonormal with int phi d_n phi = l, so the Ritz solution is the series cut
+    at degree L (verification.neck_element's cap_ball_exact and cap_ball_dipole_exact with terms = L); the caps are
+    the quadrature the element subtracts from the sphere, whose own error at L 10's rule is below 1e-5 (measured
+    1e-12 to 6e-6, most on the wide caps' dipoles)."""
+    from verification.neck_element import cap_ball_dipole_exact, cap_ball_exact
+
+    L = te.DEGREE
+    c = np.cos(alpha)
+    quad = te.quadrature(np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]), np.array([c, c]), L)
+    P, W = quad["caps"]
+    assert abs(W.sum() - 2 * 2 * np.pi * (1 - c)) < 1e-12
+    V, _ = te.harmonics(P, L)
+    V, deg = V[:, :-1], te.degrees(L)[:-1]
+    north = P[:, 2] > 0
+    area = 2 * np.pi * (1 - c)
+    mono = V.T @ (W * np.where(north, 1.0, -1.0) / area)
+    assert np.sum(mono ** 2 / deg) == pytest.approx(cap_ball_exact(alpha, terms=L), rel=1e-6)
+    g = P[:, 0] / (np.sin(alpha) * area)
+    dn, ds = V.T @ (W * g * north), V.T @ (W * g * ~north)
+    R_nn, R_ns = cap_ball_dipole_exact(alpha, terms=L)
+    assert np.sum(dn ** 2 / deg) == pytest.approx(R_nn, rel=1e-5)
+    assert np.sum(dn * ds / deg) == pytest.approx(R_ns, rel=1e-5)
+
+
+def _particle(z, q_range=(0.45, 0.7)):
+    """A cut sphere with ``z`` necks: Fibonacci directions, jittered, their radii a/r in ``q_range``."""
+    k = np.arange(z) + 0.5
+    n = np.column_stack([np.cos(np.pi * (1 + 5 ** 0.5) * k) * np.sin(np.arccos(1 - 2 * k / z)),
+                         np.sin(np.pi * (1 + 5 ** 0.5) * k) * np.sin(np.arccos(1 - 2 * k / z)), 1 - 2 * k / z])
+    n += 0.05 * RNG.normal(size=n.shape)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    return n, np.sqrt(1 - RNG.uniform(*q_range, size=z) ** 2)
+
+
+def test_the_quadrature_holds_the_cut_spheres_closed_forms():
+    """Volume, free sphere area and face areas of a clipped particle (z = 8: faces clipped by their neighbours)
+    against fem_neck.geometry.union.cut_spheres; an unclipped face's profile integral (4 pi / 3) a^(3/2)."""
+    from fem_neck.geometry.union import cut_spheres
+
+    n, arms = _particle(8)
+    exact = cut_spheres(np.ones(9), np.zeros(8), np.arange(1, 9), 2 * arms[:, None] * n)
+    quad = te.quadrature(n, arms, te.DEGREE)
+    (Pc, Wc), (Pf, Wf, wf), fs = quad["caps"], quad["faces"], quad["offsets"]
+    faces = np.add.reduceat(Wf, fs[:-1])
+    assert np.abs(faces - exact.face_i).max() < 2e-6
+    assert abs(4 * np.pi - Wc.sum() - exact.free_area[0]) < 2e-6
+    xn = np.einsum("pc,pc->p", Pf, np.repeat(n, np.diff(fs), axis=0))
+    assert abs(4 * np.pi / 3 + (np.sum(Wf * xn) - Wc.sum()) / 3 - exact.volume[0]) < 2e-6
+    a = 0.6
+    one = te.quadrature(np.array([[0.0, 0.0, 1.0]]), np.array([np.sqrt(1 - a * a)]), te.DEGREE)["faces"]
+    assert np.sum(one[1] * one[2]) == pytest.approx(4 * np.pi / 3 * a ** 1.5, rel=1e-9)
+
+
+def test_the_element_is_symmetric_positive_definite_and_grows_with_the_degree():
+    """R of a z = 6 particle: symmetric, positive definite; its diagonal rises with the degree toward the exact one
+    from below (Ritz: a larger trial space gives a larger R; the unshifted element)."""
+    n, arms = _particle(6)
+    frames = neck_frames(n)
+    R8, R10 = te.resistance(n, arms, frames, 8), te.resistance(n, arms, frames, 10)
+    assert np.abs(R10 - R10.T).max() < 1e-14 * np.abs(R10).max()
+    assert np.linalg.eigvalsh(R10).min() > 0
+    assert np.all(np.diag(R10) >= np.diag(R8) * (1 - 1e-9))
+
+
+def test_a_turned_particle_with_whole_faces_has_the_same_element():
+    """Necks that do not meet (whole discs): the element does not depend on the particle's orientation (measured
+    1e-9: the equal steps in angle integrate the loads, basis times modes, exactly around the disc, the stiffness's
+    face term of higher degree in angle nearly so). Gauss-Legendre in angle instead: 1e-4."""
+    n, arms = _particle(4, (0.2, 0.4))
+    Q, _ = np.linalg.qr(RNG.normal(size=(3, 3)))
+    R = te.resistance(n, arms, neck_frames(n))
+    turned = te.resistance(n @ Q.T, arms, neck_frames(n) @ Q.T)
+    assert np.abs(R - turned).max() < 1e-8 * np.abs(R).max()
+
+
+def _numpy_basis(P, L, nrm):
+    """The basis and its gradient along ``nrm`` in plain numpy, vectorised over the points: the complex solid
+    harmonics R_l^m = r^l P_l^m e^(i m phi) / (l + m)! by their recurrences in l and the same differentiated."""
+    from math import factorial
+
+    x, y, z = P.T
+    r2, w = (P * P).sum(1), x + 1j * y
+    R = {(0, 0): np.ones(len(P), complex)}
+    G = {(0, 0): np.zeros((3, len(P)), complex)}
+    for m in range(L + 1):
+        if m:
+            R[m, m] = -w / (2 * m) * R[m - 1, m - 1]
+            G[m, m] = -(np.array([R[m - 1, m - 1], 1j * R[m - 1, m - 1], 0 * w]) + w * G[m - 1, m - 1]) / (2 * m)
+        for l in range(m + 1, L + 1):
+            prev2, g2 = (R[l - 2, m], G[l - 2, m]) if l - 2 >= m else (0 * w, np.zeros((3, len(P))))
+            den = (l - m) * (l + m)
+            R[l, m] = ((2 * l - 1) * z * R[l - 1, m] - r2 * prev2) / den
+            G[l, m] = ((2 * l - 1) * (z * G[l - 1, m] + np.array([0 * w, 0 * w, R[l - 1, m]])) - 2 * P.T * prev2
+                       - r2 * g2) / den
+    V, D = [], []
+    for l in range(1, L + 1):
+        for m in range(l + 1):
+            c = np.sqrt((2 * l + 1) / (4 * np.pi) * factorial(l + m) * factorial(l - m)) * (1 if m == 0 else np.sqrt(2))
+            g = (G[l, m] * nrm.T).sum(0)
+            V.append(c * R[l, m].real), D.append(c * g.real)
+            if m:
+                V.append(c * R[l, m].imag), D.append(c * g.imag)
+    V.append(r2), D.append(2 * (P * nrm).sum(1))
+    return np.array(V).T, np.array(D).T
+
+
+def test_the_compiled_element_is_the_same_formulas_in_plain_numpy():
+    """resistance() against its definition written out in numpy at L = 4 on the same quadrature: K from the whole
+    sphere's diag(l) less the caps (their normal derivatives from the gradient, not Euler's shortcut; no SYRK) plus
+    the faces, the |x|^2 entries from the divergence theorem, the loads with the sink, R = B^T K^-1 B."""
+    L = 4
+    n, arms = _particle(8)
+    frames = neck_frames(n)
+    quad = te.quadrature(n, arms, L)
+    (Pc, Wc), (Pf, Wf, wf), fs = quad["caps"], quad["faces"], quad["offsets"]
+    normal_f = np.repeat(n, np.diff(fs), axis=0)
+    Vc, Dc = _numpy_basis(Pc, L, Pc)
+    Vf, Df = _numpy_basis(Pf, L, normal_f)
+    deg = te.degrees(L)
+    K = np.diag(np.append(deg[:-1], 0.0)) - (Vc * Wc[:, None]).T @ Dc + (Vf * Wf[:, None]).T @ Df
+    xn = (Pf * normal_f).sum(1)
+    K[-1, -1] = 16 * np.pi / 5 + 0.8 * ((Wf * Vf[:, -1] * xn).sum() - (Wc * Vc[:, -1]).sum())
+    K[:-1, -1] = K[-1, :-1]
+    K = 0.5 * (K + K.T)
+    mean = ((Vf * (Wf * xn)[:, None]).sum(0) - (Vc * Wc[:, None]).sum(0)) / (deg + 3)
+    mean[-1] += 4 * np.pi / 5
+    volume = 4 * np.pi / 3 + ((Wf * xn).sum() - Wc.sum()) / 3
+    B = np.zeros((len(deg), 3 * len(arms)))
+    for b in range(len(arms)):
+        sl = slice(fs[b], fs[b + 1])
+        ww = Wf[sl] * wf[sl] / (Wf[sl] * wf[sl]).sum()
+        a = np.sqrt(1 - arms[b] ** 2)
+        B[:, 3 * b] = Vf[sl].T @ ww - mean / volume
+        for d in range(2):
+            xi = (Pf[sl] - arms[b] * n[b]) @ frames[b][d]
+            B[:, 3 * b + 1 + d] = Vf[sl].T @ (ww * (xi - ww @ xi) / a)
+    R = B.T @ np.linalg.solve(K, B)
+    assert np.abs(te.resistance(n, arms, frames, L) - R).max() < 1e-12 * np.abs(R).max()
+
+
+def test_the_chain_particles_shifted_half_is_the_laws():
+    """At the shift table's nodes exactly (to round-off), between them to the spline's 1e-6; outside the table
+    (a/r below its first node) solved directly, exactly again."""
+    for q, tol in ((0.5, 1e-12), (0.9, 1e-12), (0.5123, 1e-6), (0.02, 1e-12)):
+        shifted = te.chain_half(q) + te.chain_shift(q)[0]
+        assert shifted == pytest.approx(float(te.law_half(q)), rel=tol)
+
+
+def _periodic_chain(q):
+    from fem_neck.lattice.cells import PeriodicCell
+
+    d = 2e-3 * np.sqrt(1 - q * q)
+    return PeriodicCell(np.array([[2e-3, 2e-3, 0.5 * d], [2e-3, 2e-3, 1.5 * d]]), np.full(2, 1e-3),
+                        np.array([4e-3, 4e-3, 2 * d]), neck="union")
+
+
+def test_a_chain_of_particles_is_the_one_node_law():
+    """A periodic chain (collinear necks): the shifted element's monopoles are the law's halves in series, its
+    dipoles decoupled by symmetry, so k_eff is the shared-body law's with one node per particle."""
+    from verification.lattices import dem_periodic
+
+    cell = _periodic_chain(0.5)
+    k = dem_periodic(cell, "shared-body", neck="union", nodes="necks", elements=te.trefftz_elements)
+    assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
+
+
+def test_an_element_not_positive_definite_falls_back_to_the_laws_monopoles(monkeypatch):
+    """A shift that breaks positive definiteness (forced here: far below the Trefftz diagonal) leaves every particle
+    the law's element on its monopoles, marked plain, with its unshifted dipoles beside them: on the chain that is
+    the law's k_eff again."""
+    from verification.lattices import dem_periodic
+
+    monkeypatch.setattr(te, "chain_shift", lambda q, L: np.full(np.shape(q), -10.0))
+    built = []
+
+    def hook(*args, **kwargs):
+        built.append(te.trefftz_elements(*args, **kwargs))
+        return built[-1]
+
+    cell = _periodic_chain(0.5)
+    k = dem_periodic(cell, "shared-body", neck="union", nodes="necks", elements=hook)
+    assert built[0].plain.all()
+    assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
+
+
+# FCC, union of spheres, h/r = 0.1: the periodic cell's FE lower and upper bounds at rtol 1e-3 (python -m
+# verification densification; tests/test_union_shared_body.py)
+FCC_FE = (0.65161, 0.65204)
+
+
+def test_an_fcc_cell_is_within_one_percent_of_its_fe_and_its_elements_are_conservative():
+    """k_eff of the FCC union cell at h/r 0.1 (z = 12 interacting necks) within 1 % of the FE (measured +0.13 %),
+    below the Wiener bound; each element symmetric, its rows summing to zero over the monopoles and the centre (a
+    uniform temperature moves no heat), none falling back to the law."""
+    from fem_neck.lattice import lattice_cell
+    from verification.lattices import dem_periodic
+
+    built = []
+
+    def hook(*args, **kwargs):
+        built.append(te.trefftz_elements(*args, **kwargs))
+        return built[-1]
+
+    cell = lattice_cell("fcc", 0.1, neck="union")
+    k = dem_periodic(cell, "shared-body", neck="union", nodes="necks", elements=hook)
+    assert FCC_FE[0] * 0.99 < k < FCC_FE[1] * 1.01
+    assert k < cell.phi
+    el = built[0]
+    assert el.modes == 3 and not el.plain.any()
+    for p in range(len(el.offsets) - 1):
+        z = el.offsets[p + 1] - el.offsets[p]
+        E = el.values[el.start[p]:el.start[p + 1]].reshape(3 * z + 1, 3 * z + 1)
+        ones = np.append(np.arange(3 * z) % 3 == 0, True).astype(float)
+        assert np.abs(E - E.T).max() < 1e-12 * np.abs(E).max()
+        assert np.abs(E @ ones).max() < 1e-10 * np.abs(E).max()
+
+
+def test_walls_and_a_degree_out_of_range_are_refused_in_one_line():
+    empty = np.zeros(0)
+    with pytest.raises(ValueError, match="L = 3"):
+        te.trefftz_elements(1, np.ones(1), None, empty, empty, empty, empty, np.ones(1), empty, L=3)
+
+    class Walled:
+        n_walls = 1
+
+    with pytest.raises(ValueError, match="walls"):
+        te.trefftz_elements(1, np.ones(1), Walled(), empty, empty, empty, empty, np.ones(1), empty)
+
+
+def test_the_neck_node_bound_study_has_the_trefftz_column_without_ngsolve(tmp_path, monkeypatch):
+    """python -m verification neck-node-bound --quick where NGSolve is missing: the FE of its cell (SC h/r 0.3) from
+    the cache, the exact elements left out, the Trefftz element's network within 1 % of the FE and below Wiener."""
+    from verification import neck_node_bound as S
+    from verification.lattices import FECache
+    from verification.report import check_section_result
+
+    monkeypatch.setattr(S, "ngsolve_present", lambda: False)
+    lower, upper = 0.60303, 0.60335  # the FE's bounds at gap 1e-3 (tests/test_union_shared_body.py)
+    FECache(tmp_path / "fe_cache.json").put(f"sc union h/r=0.3 rtol={S.QUICK_RTOL:g}",
+                                            {"k": 0.5 * (lower + upper), "lower": lower, "upper": upper})
+    res = check_section_result("neck_node_bound", S.run(tmp_path, quick=True))
+    assert "NGSolve is missing" in res["markdown"] and S.TREFFTZ in res["markdown"]
+    assert [limit for _, _, limit in res["targets"]] == [S.TREFFTZ_TARGET, 0.0]
+    assert all(measured <= limit for _, measured, limit in res["targets"])
+    (row,) = res["summary"].values()
+    assert abs(row[f"rel_{S.TREFFTZ}"]) < 0.01 and row[f"ms_per_particle_{S.TREFFTZ}"] > 0
