@@ -58,8 +58,8 @@ TREFFTZ_TARGET = 0.01  # its network within 1 % of the FE on every cell
 
 def bordered(R: np.ndarray, modes: int = 1) -> np.ndarray:
     r"""The element of a particle with resistance ``R`` over its necks' ``modes`` flux modes and its centre
-    (:mod:`dem.network.necks`, "Flux modes"): :math:`Y = R^{-1}` bordered by :math:`-Y e` and :math:`e^T Y e`, ``e``
-    1 on the monopoles (every ``modes``-th, from the first), 0 on the dipoles.
+    (:mod:`dem.network.necks`, "Flux modes"): :math:`Y = R^{-1}` bordered as
+    :func:`dem.network.necks.bordered` borders it.
 
     Parameters
     ----------
@@ -74,9 +74,9 @@ def bordered(R: np.ndarray, modes: int = 1) -> np.ndarray:
         The conductance matrix, W/K (local nodes: the necks' modes, then the centre).
     """
     Y = np.linalg.inv(R)
-    Y = 0.5 * (Y + Y.T)
-    row = Y[:, ::modes].sum(axis=1)
-    return np.block([[Y, -row[:, None]], [-row[None, :], np.array([[row[::modes].sum()]])]])
+    from dem.network.necks import bordered as border
+
+    return border(0.5 * (Y + Y.T), modes)
 
 
 def _symmetries() -> np.ndarray:

@@ -354,6 +354,27 @@ def _modes(el) -> int:
     return M
 
 
+def bordered(Y: np.ndarray, modes: int = 1) -> np.ndarray:
+    r"""The element of a particle over its necks' ``modes`` flux modes and its centre from its conductance ``Y`` over
+    the modes (module docstring, "Flux modes"): ``Y`` bordered by :math:`-Y e` and :math:`e^T Y e`, ``e`` 1 on the
+    monopoles (every ``modes``-th, from the first), 0 on the dipoles: the centre joins the monopoles only.
+
+    Parameters
+    ----------
+    Y : numpy.ndarray
+        (modes z, modes z) conductance over the modes, W/K, symmetric.
+    modes : int
+        Flux modes per neck.
+
+    Returns
+    -------
+    numpy.ndarray
+        The conductance matrix, W/K (local nodes: the necks' modes, then the centre).
+    """
+    row = Y[:, ::modes].sum(axis=1)
+    return np.block([[Y, -row[:, None]], [-row[None, :], np.array([[row[::modes].sum()]])]])
+
+
 def neck_frames(vectors: np.ndarray) -> np.ndarray:
     r"""The dipole frame of each pair bond's neck: two unit vectors :math:`t_1, t_2` in the neck's plane, defined by
     the bond (its unit vector :math:`u` from ``i`` to ``j``) so that both particles see the same dipole modes

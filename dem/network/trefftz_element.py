@@ -43,7 +43,7 @@ from scipy.linalg.blas import dsyrk
 
 from dem.geometry.bonds import Bonds
 from dem.laws.shared_body import ParticleElements, particle_elements
-from dem.network.necks import neck_frames
+from dem.network.necks import bordered, neck_frames
 from fem_neck.law import ConductanceLaw
 from sinterheat.threads import one_blas_thread
 
@@ -654,13 +654,6 @@ def _positive_definite(R: np.ndarray) -> bool:
     return True
 
 
-def _bordered(Y: np.ndarray) -> np.ndarray:
-    """The element over the modes and the centre from the conductance ``Y`` over the modes (:mod:`dem.network.necks`,
-    "Flux modes"): the centre joins the monopoles only."""
-    row = Y[:, ::3].sum(axis=1)
-    return np.block([[Y, -row[:, None]], [-row[None, :], np.array([[row[::3].sum()]])]])
-
-
 def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray,
                      k_j: np.ndarray, k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray,
                      volume=None, L: int = DEGREE) -> ParticleElements:
@@ -735,6 +728,6 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
                 Y[::3, ::3] = E[:z, :z]
                 dip = np.flatnonzero(np.arange(3 * z) % 3)
                 Y[np.ix_(dip, dip)] = np.linalg.inv(R[np.ix_(dip, dip)] / scale)
-            blocks.append(_bordered(0.5 * (Y + Y.T)).ravel())
+            blocks.append(bordered(0.5 * (Y + Y.T), 3).ravel())
             start.append(start[-1] + len(blocks[-1]))
     return ParticleElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain, np.ones(n), 3)
