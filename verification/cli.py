@@ -16,8 +16,9 @@ Commands (each writes ``report.md``, ``summary.json`` and ``run.json`` plus PNG 
   that ``densification`` does not check; writes ``closing_pores.json``, the file shipped as
   ``dem/laws/closing_pores.json`` (section ``closing_pores``);
 * ``neck-node-bound`` -- a rigorous lower bound on the union's k_eff: the network with a node per neck whose
-  particles are exact flux elements (NGSolve), on SC, BCC and FCC cells, against the periodic-cell FE's upper bound
-  (section ``neck_node_bound``; needs NGSolve);
+  particles are exact flux elements (NGSolve), on SC, BCC and FCC cells and three random packings, against the
+  periodic-cell FE's upper bound, beside the compiled Trefftz element's network (section ``neck_node_bound``; the
+  exact elements need NGSolve, left out without it);
 * ``all``        -- ``paper`` and ``dem-vs-fe``.
 
 Run time against error is ``python -m benchmarks``; the stress cases are tests (``python -m pytest -m stress``).
