@@ -47,7 +47,7 @@ from dem.network.necks import bordered, neck_frames
 from fem_neck.law import ConductanceLaw
 from sinterheat.threads import one_blas_thread
 
-DEGREE = 10  #: the harmonics' largest degree L: within 1 % of the union's FE on every lattice and random cell checked
+DEGREE = 10  #: the harmonics' largest degree L, within 1 % of the union's FE on every lattice and random cell checked
 BETA = 0.25  # the flux profile's exponent, w = (a^2 - rho^2)^-BETA
 CHAIN_GRID = (0.04, 0.995, 0.005)  # a/r of the chain's shift table: first, last, step (outside it: solved directly)
 TWO_PI = 2.0 * np.pi
