@@ -302,11 +302,13 @@ def test_the_staggered_engine_hands_over_and_resumes_bit_for_bit():
     assert np.array_equal(whole.particle_fields()["handed_over"], th.handover.weight)
 
 
-def test_a_bond_dropped_past_its_range_on_the_way_conducts_its_union_part():
-    """``out_of_range = "drop"`` with the ``shared-body`` law, squeezed until pair necks pass their range while
-    their particles are on the way: the pair reading's conductances are those of the drop reading (0 on those bonds,
-    whose clipped necks the law cannot read: it divided by zero there), the union's weighed in, and the run goes on
-    with heat in heat out."""
+@pytest.mark.parametrize("policy", ["drop", "clip"])
+def test_a_bond_past_its_range_on_the_way_blends_the_policys_pair_reading_with_the_union(policy):
+    """The ``shared-body`` law squeezed until pair necks pass their range while their particles are on the way: the
+    pair reading's conductances are those of the scene's ``out_of_range`` reading, the union's weighed in. Under
+    ``"drop"`` the pair part of those bonds is 0 (whose clipped necks the law could not read), under ``"clip"`` the
+    law's at their clipped necks (two of them on one particle divided by zero), and the run goes on with heat in heat
+    out."""
     from dataclasses import replace
 
     from dem.geometry.bonds import find_bonds
@@ -314,7 +316,7 @@ def test_a_bond_dropped_past_its_range_on_the_way_conducts_its_union_part():
     from fem_neck.geometry import max_overlap
 
     scene = squeezed(0.00105, rate=300.0, law="shared-body")
-    scene["conductance"]["out_of_range"] = "drop"
+    scene["conductance"]["out_of_range"] = policy
     engine = VerletEngine(parse_scene(scene))
     engine.run()
     th, mech = engine.thermal, engine.mechanics
@@ -326,6 +328,9 @@ def test_a_bond_dropped_past_its_range_on_the_way_conducts_its_union_part():
     grown = replace(now, radius=th.handover.solid_radii(now.radius))
     union = find_bonds(grown, (), "union", pairs=(bonds.i, bonds.j))
     K_union = bond_conductances(replace(th.handover.spec, neck="union"), grown, union)[0]
-    assert K[past] == pytest.approx(w[past] * K_union[past], rel=1e-9)
-    assert np.all(np.isfinite(K)) and np.all(K > 0.0)
+    read = find_bonds(now, (), "newton", policy, pairs=(bonds.i, bonds.j))
+    K_pair = np.zeros(bonds.n_pairs)
+    K_pair[~past if policy == "drop" else slice(None)] = bond_conductances(th.handover.spec, now, read)[0]
+    assert K == pytest.approx((1.0 - w) * K_pair + w * K_union, rel=1e-9)
+    assert np.all(np.isfinite(K)) and np.all(K > 0.0) and np.all((K_pair[past] > 0.0) == (policy == "clip"))
     assert engine.summary()["energy_error"] < 1e-12

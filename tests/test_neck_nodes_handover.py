@@ -211,25 +211,27 @@ def test_the_timeseries_gives_k_eff_on_pair_necks_beside_it():
     assert row["effective_conductivity_pair_necks"] == row["effective_conductivity"] is not None
 
 
-def test_a_pair_neck_dropped_past_its_range_on_the_way_keeps_the_union_part():
-    """``out_of_range = "drop"``, squeezed hard: pair necks pass their range (h > 2r/3 for equal spheres) while their
-    particles are on the way to the union. As the one-node law's pair conductance of such a bond is 0 and its union
-    one weighed in, each particle's pair element is the drop reading's (without those necks) and its union element
-    has them: the network is that blend, each reading assembled apart; the run goes on (it stopped with an error),
-    heat in is heat out, and its snapshot's one-node conductances are finite."""
+@pytest.mark.parametrize("policy", ["drop", "clip"])
+def test_a_pair_neck_past_its_range_on_the_way_blends_the_policys_pair_reading_with_the_union(policy):
+    """Squeezed hard, pair necks pass their range (h > 2r/3 for equal spheres) while their particles are on the way
+    to the union. As the one-node law's pair conductance of such a bond is the scene's ``out_of_range`` reading's and
+    its union one weighed in, each particle's pair element is that reading's and its union element has those necks:
+    under ``"drop"`` the pair element is without them (the run stopped with an error), under ``"clip"`` it has them
+    at their clipped radius. The network is that blend, each reading assembled apart; the run goes on, heat in is
+    heat out, and its snapshot's one-node conductances are finite."""
     from dataclasses import replace
 
     from fem_neck.geometry import max_overlap
 
     scene = squeezed(0.00105, rate=300.0)
-    scene["conductance"] = {"law": "shared-body", "out_of_range": "drop", "nodes": "necks"}
+    scene["conductance"] = {"law": "shared-body", "out_of_range": policy, "nodes": "necks"}
     engine = _run(scene)
     assert engine.summary()["energy_error"] < 1e-12
     assert all(np.all(np.isfinite(v)) for v in engine.links()[2].values())
     th, mech = engine.thermal, engine.mechanics
     now = th._particles_now(mech, th.particles.radius)
     n, pairs = now.n, mech.contacts()[:2]
-    spec = ConductanceSpec(law="shared-body", out_of_range="drop", nodes="necks")
+    spec = ConductanceSpec(law="shared-body", out_of_range=policy, nodes="necks")
     handover = Handover(spec, th.particles.radius)
     handover.steps, handover.solid_radius = th.handover.steps.copy(), th.handover.solid_radius.copy()
     net = handover.neck_network(now, (), pairs, None)
@@ -237,21 +239,21 @@ def test_a_pair_neck_dropped_past_its_range_on_the_way_keeps_the_union_part():
     clipped = find_bonds(now, (), "newton", "clip", pairs=pairs)
     past = clipped.h > max_overlap(now.radius[clipped.i], now.radius[clipped.j])
     assert np.count_nonzero(past) >= 5 and np.all((w > 0.0) & (w < 1.0))
-    dropped = find_bonds(now, (), "newton", "drop", pairs=pairs)
-    assert dropped.n_pairs == clipped.n_pairs - np.count_nonzero(past)
+    read = find_bonds(now, (), "newton", policy, pairs=pairs)
+    assert read.n_pairs == clipped.n_pairs - (np.count_nonzero(past) if policy == "drop" else 0)
     grown = replace(now, radius=handover.solid_radii(now.radius))
     union = neck_network(ConductanceSpec(law="shared-body", neck="union", nodes="necks"), grown,
                          find_bonds(grown, (), "union", pairs=pairs))
-    plain = neck_network(spec, now, dropped)
+    plain = neck_network(spec, now, read)
     assert np.array_equal(net.live, np.arange(clipped.n_pairs))  # every neck is the union's: each keeps its node
     key = clipped.i.astype(np.int64) * n + clipped.j
     node = n + np.arange(clipped.n_pairs)
-    node_dropped = node[np.searchsorted(key, dropped.i.astype(np.int64) * n + dropped.j)]
+    node_read = node[np.searchsorted(key, read.i.astype(np.int64) * n + read.j)]
     assert np.all(np.diff(key) > 0)
-    expected = _assembled(plain, 1.0 - w, node_dropped, clipped.n_pairs) + _assembled(union, w, node)
+    expected = _assembled(plain, 1.0 - w, node_read, clipped.n_pairs) + _assembled(union, w, node)
     expected = 0.5 * (expected + expected.T)
     A = net.A.toarray()
     assert np.abs(A - expected).max() < 1e-12 * np.abs(expected).max()
-    # the clipped pair necks in the pair elements would be another network (and the law divides by zero there)
+    # a pair neck past its range still joins its particles' centres (through the union part at least)
     at_past = n + np.flatnonzero(past)
     assert np.all(np.abs(A[at_past][:, :n]).sum(axis=1) > 0.0)

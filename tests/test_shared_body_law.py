@@ -56,6 +56,16 @@ def test_interaction_vanishes_for_opposite_necks_and_is_symmetric():
     assert interaction(e, f, 1.0, 1.0) == pytest.approx(1 / s - 1 - np.log(s * (1 + s) / 2), rel=1e-12)
 
 
+def test_a_neck_as_wide_as_the_particle_has_no_free_space_part():
+    """A neck clipped to the particle's radius (base 0: its disc centre at the particle's centre) is as far from
+    another neck's disc centre as that neck's opposite pole, whose interaction is only the ball's finite size,
+    -ln(s (1 + s) / 2); between two such necks too (it divided by zero there)."""
+    e, f = np.array([0.0, 0.0, 1.0]), np.array([np.sin(1.0), 0.0, np.cos(1.0)])
+    s = np.sin(0.5)
+    for base in (0.7, 0.0):
+        assert interaction(e, f, 0.0, base) == pytest.approx(-np.log(s * (1 + s) / 2), rel=1e-12), base
+
+
 def _periodic_lattice(structure, overlap, law):
     doc = {"material": {"conductivity": 1.0, "density": 1.0, "specific_heat": 1.0},
            "generator": {"kind": "lattice", "shape": [2, 2, 2], "radius": 1.0, "overlap": overlap,

@@ -129,13 +129,16 @@ def interaction(normal_b, normal_c, base_b: float, base_c: float) -> float:
 
 @numba.njit(cache=True)
 def _interaction(cos_g: float, base_b: float, base_c: float) -> float:
-    """:func:`interaction` from the cosine of the angle between the necks."""
+    """:func:`interaction` from the cosine of the angle between the necks. A neck as wide as the particle (``a = r``,
+    where ``out_of_range = "clip"`` sets a neck past the pair reading's range) has its disc centre at the particle's
+    centre, from where the chord to another neck's disc centre is that neck's opposite-pole distance: its free-space
+    part is 0, and between two such necks (chord and pole distance both 0) the same 0."""
     s2 = 0.5 * (1.0 - cos_g)
     if s2 >= 1.0:
         return 0.0
     s = np.sqrt(max(s2, 1e-24))
     chord = np.sqrt(max(base_b * base_b + base_c * base_c - 2.0 * base_b * base_c * cos_g, 1e-24))
-    return 2.0 / chord - 2.0 / (base_b + base_c) - np.log(s * (1.0 + s) * 0.5)
+    return 2.0 / chord - 2.0 / max(base_b + base_c, 1e-12) - np.log(s * (1.0 + s) * 0.5)
 
 
 @numba.njit(cache=True)
