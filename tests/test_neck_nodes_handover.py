@@ -116,6 +116,28 @@ def test_a_neck_the_union_hides_takes_nothing_from_it_and_has_no_node_once_hande
     assert steady_necks(net).T == pytest.approx(np.ones(3), rel=1e-12)
 
 
+def test_out_of_range_error_decides_on_what_each_reading_holds():
+    """``out_of_range = "error"``, a pair neck past its range (h = 0.75 r > 2r/3) between a particle handed over and
+    one not on its way: with neck nodes the latter's element is its pair element, which has the neck, so the read
+    stops with the range error (it read the clipped neck: the check took the bond's weight, the larger, 1); the
+    one-node law's bond has that weight and reads the union alone; both handed over, neither reads the pair neck."""
+    r = 1e-3
+    particles = Particles.from_arrays(np.array([[0.0, 0.0, 0.0], [1.25e-3, 0.0, 0.0]]), np.full(2, r), np.zeros(2),
+                                      materials=(UNIT,))
+    pairs = (np.array([0]), np.array([1]))
+    for steps in ([HANDOVER_STEPS, 0], [0, HANDOVER_STEPS], [HANDOVER_STEPS, HANDOVER_STEPS]):
+        one, necks = (Handover(ConductanceSpec(law="shared-body", nodes=nodes), particles.radius)
+                      for nodes in ("particles", "necks"))
+        one.steps = necks.steps = np.array(steps)
+        K = one.bonds(particles, (), pairs, None)[1]
+        assert np.all(np.isfinite(K)) and np.all(K > 0.0)
+        if min(steps) == HANDOVER_STEPS:
+            assert np.array_equal(necks.neck_network(particles, (), pairs, None).live, [0])
+        else:
+            with pytest.raises(ValueError, match="beyond the contact model's range"):
+                necks.neck_network(particles, (), pairs, None)
+
+
 def _run(scene: dict, restart=None) -> VerletEngine:
     engine = VerletEngine(parse_scene(scene), restart=restart)
     engine.run()

@@ -160,7 +160,10 @@ class Handover:
         # bonds past the pair reading's range where it still has weight: the scene's out_of_range policy
         past = pair.h > max_overlap(now.radius[pair.i], now.radius[pair.j])
         past_wall = pair.wall_h > now.radius[pair.wall_particle] / 3.0
-        weighed, weighed_wall = past & (w_pair < 1.0), past_wall & (w_wall < 1.0)
+        # the pair reading has weight on a bond while the bond's weight is below 1, with a node per neck while the
+        # weight of either of its particles is (each particle's element is its own blend)
+        pair_part = np.minimum(self.weight[pair.i], self.weight[pair.j]) if spec.nodes == "necks" else w_pair
+        weighed, weighed_wall = past & (pair_part < 1.0), past_wall & (w_wall < 1.0)
         if spec.out_of_range == "error" and (np.any(weighed) or np.any(weighed_wall)):
             find_bonds(now, walls, spec.contact, "error", pairs=(pair.i[weighed], pair.j[weighed]), box=box)
         solid = solid_radii(now.radius, self.weight > 0.0, pair.i, pair.j, vectors, pair.wall_particle, normals,
@@ -253,7 +256,8 @@ class Handover:
         Raises
         ------
         ValueError
-            As :meth:`bonds`.
+            As :meth:`bonds`, the pair reading having weight on a neck while either of its particles' weight is
+            below 1.
         """
         spec = self.spec
         pair, union = self._readings(now, walls, pairs, box, update)
