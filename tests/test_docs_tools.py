@@ -50,6 +50,17 @@ def test_examples_fit_the_line_length():
     assert long == []
 
 
+def test_the_readme_fits_the_line_length():
+    """Every line of the README's text within the project's 120 characters: all but its code blocks (CI runs the
+    commands in them as they stand) and its table rows (a row is one line)."""
+    long, code = [], False
+    for n, line in enumerate((ROOT / "README.md").read_text().splitlines(), 1):
+        code = code != line.startswith("```")
+        if not code and not line.startswith(("```", "|")) and len(line) > 120:
+            long.append(n)
+    assert long == []
+
+
 def test_getting_started_lists_every_example():
     page = (ROOT / "docs" / "getting-started.md").read_text()
     missing = {p.stem for p in (ROOT / "examples").glob("*.py") if f"<sphx_glr_gallery_{p.stem}.py>`" not in page}
