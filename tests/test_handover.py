@@ -19,6 +19,7 @@ from dem.geometry import handover
 from dem.geometry.handover import HANDOVER_STEPS, advance, solid_radii, weights
 from dem.network.heat import Network, bonds_and_conductances, boundary_heat_flow, steady
 from fem_neck.geometry.union import angular_radius, cut_spheres, lens, necks_meet
+from handover_steps import record_handovers
 
 NONE = (np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0))  # no walls
 
@@ -138,25 +139,20 @@ def conductance(engine, steps) -> float:
 
 def run_through(scene: dict):
     """Run ``scene``, recording at every thermal step that hands particles over the change of the conductance
-    across it (the same contacts, the steps before and after) and the cut spheres of the particles on the way."""
+    across it (:func:`handover_steps.record_handovers`) and the cut spheres of the particles on the way."""
     engine = VerletEngine(parse_scene(scene))
-    th, step = engine.thermal, engine.thermal.step
-    jumps, volumes = [], []
+    th, mech = engine.thermal, engine.mechanics
 
-    def recorded(mech, dt):
-        before = th.handover.steps.copy()
-        step(mech, dt)
-        if np.any(th.handover.steps != before):
-            jumps.append(conductance(engine, th.handover.steps) / conductance(engine, before) - 1.0)
-            bonds = engine.necks()[1]
-            grown = th.handover.weight > 0.0
-            cut = cut_spheres(np.where(grown, th.handover.solid_radius, mech.state.radius), bonds.i, bonds.j,
-                              bonds.vectors(mech.state.x, th.box)).volume
-            volumes.append((cut[grown].sum(), (4.0 / 3.0 * np.pi * mech.state.radius[grown] ** 3).sum()))
+    def volumes(_):
+        bonds = engine.necks()[1]
+        grown = th.handover.weight > 0.0
+        cut = cut_spheres(np.where(grown, th.handover.solid_radius, mech.state.radius), bonds.i, bonds.j,
+                          bonds.vectors(mech.state.x, th.box)).volume
+        return cut[grown].sum(), (4.0 / 3.0 * np.pi * mech.state.radius[grown] ** 3).sum()
 
-    th.step = recorded
+    jumps, kept = record_handovers(engine, conductance, volumes)
     engine.run()
-    return engine, np.array(jumps), np.array(volumes)
+    return engine, np.array(jumps), np.array(kept)
 
 
 @pytest.mark.slow

@@ -19,6 +19,7 @@ from dem.geometry.necks import necks_meeting
 from dem.geometry.particles import Material, Particles
 from dem.laws.conductance import ConductanceSpec
 from dem.network.necks import neck_network, steady_necks
+from handover_steps import record_handovers
 from test_handover import fcc_cluster, squeezed
 
 UNIT = Material(1.0, 1.0, 1.0, "unit")
@@ -203,18 +204,10 @@ def test_k_eff_is_continuous_through_the_handover():
     that hands particles over the conductance between the hot and the cold layer (the same contacts, the steps
     before and after) changes by at most 0.5 %, as the one-node law's; handed over at once it would jump."""
     engine = VerletEngine(parse_scene(_squeezed(0.005)))
-    th, step = engine.thermal, engine.thermal.step
-    jumps, at_once = [], []
-
-    def recorded(mech, dt):
-        before = th.handover.steps.copy()
-        step(mech, dt)
-        if np.any(th.handover.steps != before):
-            old = _conductance(engine, before)
-            jumps.append(_conductance(engine, th.handover.steps) / old - 1.0)
-            at_once.append(_conductance(engine, np.where(th.handover.steps > 0, HANDOVER_STEPS, 0)) / old - 1.0)
-
-    th.step = recorded
+    th = engine.thermal
+    jumps, at_once = record_handovers(
+        engine, _conductance,
+        lambda old: _conductance(engine, np.where(th.handover.steps > 0, HANDOVER_STEPS, 0)) / old - 1.0)
     engine.run()
     assert np.count_nonzero(th.handover.steps) >= 40 and len(jumps) >= 60
     assert np.max(np.abs(jumps)) < 5e-3
