@@ -361,8 +361,7 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     A = sp.coo_matrix((value[inner], (row[inner], col[inner])), shape=(size_all, size_all)).tocsr()
     A = 0.5 * (A + A.T)  # symmetric to round-off (the blocks are; their sums need not be bit for bit)
     rhs = -np.bincount(row[rows], value[rows] * known[rows], size_all)
-    uniform = len(np.unique(M)) <= 1  # one number where all the particles' elements agree
-    modes = (int(M[0]) if n else int(np.max(given, initial=1))) if uniform else bond_modes
+    modes = bond_modes if np.any(M != M[:1]) else int(M[0]) if n else 1  # one number where all particles' agree
     return NeckNetwork(particles, bonds, live, live_walls, A.tocsr(), rhs, (row, col, value, known, end_row),
                        2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box, union,
                        modes)
