@@ -94,7 +94,8 @@ def _flux_formulation(particles, sub, box, el) -> float:
 def test_a_mixed_cell_against_the_flux_formulation_with_its_nodes_per_neck():
     """Half the particles on Trefftz: the nodal network's k_eff is the flux formulation's; each live bond has the
     nodes of the most modes of its two particles, one after another; a mixed neck's dipoles are seen by its Trefftz
-    particle's element only; and the mixture lies apart from both uniform networks (it is another network)."""
+    particle's element only; a floating cell keeps its mean temperature, shifted on the centres and monopoles only;
+    and the mixture lies apart from both uniform networks (it is another network)."""
     particles, bonds, box = _cell()
     seen = {}
     net = _network(HALF, seen)
@@ -110,6 +111,15 @@ def test_a_mixed_cell_against_the_flux_formulation_with_its_nodes_per_neck():
     assert np.all(HALF[net.owner[dipole]]) and np.any(dipole)
     mixed = three & ~(HALF[sub.i] & HALF[sub.j])
     assert np.any(mixed)
+    # the floating cell at 300 K keeps its capacity-weighted mean, the shift moving centres and monopoles only (the
+    # network's rows hold after it), and the flow across the period does not depend on the level
+    warm = Particles.from_arrays(particles.position, particles.radius, np.full(particles.n, 300.0), materials=(UNIT,))
+    hot = neck_network(NECKS, warm, bonds, box=box, elements=functools.partial(trefftz_elements, where=HALF))
+    res = steady_necks(hot)
+    T = np.concatenate([res.T, res.T_necks])
+    assert np.average(res.T, weights=warm.capacity) == pytest.approx(300.0, rel=1e-12)
+    assert np.max(np.abs(hot.A @ T - hot.rhs)) < 1e-10 * np.abs(hot.rhs).max()
+    assert res.periodic_heat_flow[2] * box.lengths[2] / box.cross_section(2) == pytest.approx(k, rel=1e-10)
     k_all = steady_necks(_all_trefftz()).periodic_heat_flow[2] * box.lengths[2] / box.cross_section(2)
     k_law = steady_necks(neck_network(NECKS, particles, bonds, box=box)).periodic_heat_flow[2] * box.lengths[2] \
         / box.cross_section(2)
