@@ -615,7 +615,8 @@ matrix (W/K; local nodes: those ends in order, then the centre) row by row at ``
 ``plain`` marks the particles whose interactions were dropped (their ``R`` not positive definite) and ``shrink``
 holds the trace cap's factor of each. ``modes`` is the number of flux modes per neck (1 here; an element with the
 dipoles, :mod:`dem.network.necks` "Flux modes", has 3 and a ``(3 z + 1) x (3 z + 1)`` matrix whose local node
-``3 p + d`` is mode ``d`` of its ``p``-th end)."""
+``3 p + d`` is mode ``d`` of its ``p``-th end): one number for all the particles, or an int array of one per
+particle where their elements differ."""
 
 
 def particle_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray,

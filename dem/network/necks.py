@@ -68,16 +68,25 @@ exchanges heat with the monopoles only) and its element is
 
     E = \begin{pmatrix} R^{-1} & -R^{-1} e \\ -e^T R^{-1} & e^T R^{-1} e \end{pmatrix},
 
-its local node ``modes p + d`` mode ``d`` of end ``p``, then the centre. Mode ``d`` of live pair bond ``b`` is
-node ``n + modes b + d``, shared by the bond's two particles: what flows into ``i`` through it leaves ``j``
-(Kirchhoff at the node) and its temperature moment is one value on both sides. A uniform change of temperature moves
+its local node ``modes p + d`` mode ``d`` of end ``p``, then the centre. ``modes`` is one number for all the
+particles or one per particle (the three-mode element only where a particle needs it, the law's one-mode element
+elsewhere: :func:`dem.network.trefftz_element.trefftz_elements`' ``where``). A live pair bond's neck carries the modes
+of whichever of its two particles has more (a wall's neck: its particle's), and mode ``d`` of live pair bond ``b`` is
+node ``n + o_b + d``, :math:`o_b` the modes of the live pair bonds before it (``n + modes b + d`` where all
+particles' agree), shared by the bond's two particles: what flows into ``i`` through it leaves ``j`` (Kirchhoff at the
+node) and its temperature moment is one value on both sides. A particle with fewer modes than one of its necks sees
+only its own there, its element padded with zero rows and columns on the neck's other modes: it draws no flux through
+them, so by Kirchhoff at their nodes the other particle's dipoles on that face are flux-free (both see the face's
+flux as the monopole's profile alone: one flux on the common face, so the network stays a flux field of the bodies).
+A uniform change of temperature moves
 the centres and the monopoles and leaves the dipoles' moments (the kernel of ``A`` on a connected group is 1 there, 0
 on the dipoles); the periodic jump and a wall's temperature act on the monopoles, a wall's dipole moments are 0 (it
 is isothermal). The heat flows (:meth:`NeckNetwork.end_flows`, the flow across the period, ``k_eff``) are the
 monopoles'; a dipole's row in ``entries`` has the bond end :data:`DIPOLE`. The law's elements have ``modes = 1``;
-``modes = 3`` comes from elements built elsewhere through the ``elements`` hook of :func:`neck_network` (``python -m
-verification neck-node-bound``'s exact ones). The current takes ``modes = 1`` only (the rows of ``E`` do not sum to
-zero on the dipoles: no graph's Laplacian).
+``modes = 3`` comes from elements built elsewhere through the ``elements`` hook of :func:`neck_network`
+(:func:`dem.network.trefftz_element.trefftz_elements`, ``python -m verification neck-node-bound``'s exact ones). With
+all modes 1, or all 3, the network is the one of uniform modes, bit for bit. The current takes ``modes = 1`` only (the
+rows of ``E`` do not sum to zero on the dipoles: no graph's Laplacian).
 
 **Transient.** Neck nodes hold no heat: the capacity matrix is :math:`M = \mathrm{diag}(C_1 \dots C_n, 0 \dots 0)`,
 only semidefinite. The :math:`\theta` scheme :math:`(M/\Delta t + \theta A) T^+ = (M/\Delta t - (1 - \theta) A) T + r`
@@ -190,9 +199,11 @@ class NeckNetwork:
         :func:`dem.laws.conductance.union_halves` returned), from which the one-node law's conductances follow without
         computing them again (``union`` of :func:`dem.laws.conductance.bond_conductances`); None under a pair-neck
         reading.
-    modes : int
+    modes : int or numpy.ndarray
         Flux modes per neck (module docstring, "Flux modes"): 1, the neck's temperature alone (node ``n + k`` of live
-        pair bond ``k``); 3 with two dipoles (mode ``d`` of bond ``k`` at node ``n + 3 k + d``, the monopole ``d = 0``).
+        pair bond ``k``); 3 with two dipoles (mode ``d`` of bond ``k`` at node ``n + 3 k + d``, the monopole ``d = 0``);
+        where the particles' elements differ, one number per live pair bond (its nodes follow those of the bonds
+        before it: :attr:`monopoles`).
     """
 
     particles: Particles
@@ -215,6 +226,16 @@ class NeckNetwork:
     def n_nodes(self) -> int:
         """Centres and neck nodes."""
         return self.A.shape[0]
+
+    @property
+    def bond_modes(self) -> np.ndarray:
+        """Per live pair bond, its neck's flux modes."""
+        return np.broadcast_to(np.asarray(self.modes, dtype=np.int64), (len(self.live),))
+
+    @property
+    def monopoles(self) -> np.ndarray:
+        """Per live pair bond, the node of its monopole (its neck's temperature; its dipoles follow it)."""
+        return self.particles.n + np.cumsum(self.bond_modes) - self.bond_modes
 
     def end_flows(self, T: np.ndarray) -> np.ndarray:
         """The heat flowing into each particle through each of its neck ends (W) at node temperatures ``T``: end
@@ -261,8 +282,8 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
         What builds the particles' elements, called with the arguments of
         :func:`dem.laws.shared_body.particle_elements` and returning its
         :class:`~dem.laws.shared_body.ParticleElements` (the same ends, another matrix per particle: e.g. an exact
-        element computed elsewhere, with ``modes`` flux modes per neck, module docstring "Flux modes"); None:
-        :func:`dem.laws.shared_body.particle_elements`.
+        element computed elsewhere, with ``modes`` flux modes per neck, one number or one per particle, module
+        docstring "Flux modes"); None: :func:`dem.laws.shared_body.particle_elements`.
     without : tuple of numpy.ndarray or None
         ``(pairs, walls)``: masks of the pair and wall bonds to leave without a neck node (as a neck hidden inside a
         third sphere is), whatever their halves; None: none.
@@ -275,8 +296,9 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     Raises
     ------
     ValueError
-        ``spec`` is not the ``shared-body`` law without ``contact_conductance``, wall bonds without their walls, or
-        elements whose blocks are not :math:`(m z + 1)^2` values (``m`` the modes per neck).
+        ``spec`` is not the ``shared-body`` law without ``contact_conductance``, wall bonds without their walls,
+        elements whose ``modes`` are not integers >= 1 (one, or one per particle), or whose blocks are not
+        :math:`(m z + 1)^2` values (``m`` the particle's modes per neck).
     """
     from dem.laws.shared_body import particle_elements
 
@@ -305,52 +327,66 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
                                          np.reshape(normals, (-1, 3))[live_walls], volume)
     m = len(live)
     M = _modes(el)
-    # each end's node (a wall's: -1) and the offset it is seen at by its particle (a wall's: its temperature); mode
-    # ``mode`` of live pair bond b is node n + M b + mode
+    # each live pair bond's modes: the most of its two particles' (module docstring, "Flux modes"); mode ``mode`` of
+    # live pair bond b is node n + (the modes of the bonds before it) + mode
+    bond_modes = np.maximum(M[sub.i], M[sub.j])
+    monopole = n + np.cumsum(bond_modes) - bond_modes
+    # each end's node (a wall's: -1) and the offset it is seen at by its particle (a wall's: its temperature)
     jump = sub.shifts @ box.drop if box is not None else np.zeros(m)
     wall_T = np.array([w.temperature for w in walls], dtype=float)[sub.wall_index] if len(live_walls) else np.zeros(0)
     # (one more place at the end of each: the centre, end -1, seen at offset 0)
-    node = np.concatenate([n + M * np.arange(m), n + M * np.arange(m), np.full(len(live_walls), -1), [0]])
+    node = np.concatenate([monopole, monopole, np.full(len(live_walls), -1), [0]])
     offset = np.concatenate([np.zeros(m), jump, wall_T, [0.0]])
     ends = np.append(el.ends, -1)
-    # the entries: particle k's block is (M z + 1)^2 values row by row, local node M p + mode (mode < M) the mode of
-    # its p-th end, M z its centre
+    # the entries: particle k's block is (M_k z + 1)^2 values row by row, local node M_k p + mode (mode < M_k) the
+    # mode of its p-th end, M_k z its centre (a particle with fewer modes than a neck: none on the neck's others)
     z = np.diff(el.offsets)
     size = M * z + 1
     owner = np.repeat(np.arange(n), size * size)
     local = np.arange(len(el.values)) - el.start[:-1][owner]
     p_row, p_col = local // size[owner], local % size[owner]
     first = el.offsets[:-1][owner]
-    centre_row, centre_col = p_row == M * z[owner], p_col == M * z[owner]
-    mode_row, mode_col = np.where(centre_row, 0, p_row % M), np.where(centre_col, 0, p_col % M)
-    end_row = ends[np.where(centre_row, len(el.ends), first + p_row // M)]
-    end_col = ends[np.where(centre_col, len(el.ends), first + p_col // M)]
+    M_own, z_own = M[owner], z[owner]
+    centre_row, centre_col = p_row == M_own * z_own, p_col == M_own * z_own
+    mode_row, mode_col = np.where(centre_row, 0, p_row % M_own), np.where(centre_col, 0, p_col % M_own)
+    end_row = ends[np.where(centre_row, len(el.ends), first + p_row // M_own)]
+    end_col = ends[np.where(centre_col, len(el.ends), first + p_col // M_own)]
     row = np.where(end_row < 0, owner, np.where(node[end_row] < 0, -1, node[end_row] + mode_row))
     col = np.where(end_col < 0, owner, np.where(node[end_col] < 0, -1, node[end_col] + mode_col))
     known = np.where(mode_col == 0, offset[end_col], 0.0)  # a dipole sees no jump, and a wall's moment is 0
     end_row, end_col = np.where(mode_row == 0, end_row, DIPOLE), np.where(mode_col == 0, end_col, DIPOLE)
     value = el.values
     inner, rows = (row >= 0) & (col >= 0), row >= 0  # a wall's row has no equation: the wall takes what it is given
-    size_all = n + M * m
+    size_all = n + int(bond_modes.sum())
     A = sp.coo_matrix((value[inner], (row[inner], col[inner])), shape=(size_all, size_all)).tocsr()
     A = 0.5 * (A + A.T)  # symmetric to round-off (the blocks are; their sums need not be bit for bit)
     rhs = -np.bincount(row[rows], value[rows] * known[rows], size_all)
+    modes = bond_modes if np.any(M != M[:1]) else int(M[0]) if n else 1  # one number where all particles' agree
     return NeckNetwork(particles, bonds, live, live_walls, A.tocsr(), rhs, (row, col, value, known, end_row),
-                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box, union, M)
+                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box, union,
+                       modes)
 
 
-def _modes(el) -> int:
-    """The flux modes per neck of the elements ``el``, their blocks' sizes checked against them."""
-    M = getattr(el, "modes", 1)
-    if int(M) != M or M < 1:
-        raise ValueError(f"elements: modes = {M}: must be an integer >= 1 (flux modes per neck)")
-    M = int(M)
+def _modes(el) -> np.ndarray:
+    """Per particle, the flux modes per neck of its element in ``el`` (``el.modes``: one number for all or one per
+    particle), the blocks' sizes checked against them."""
+    n = len(el.offsets) - 1
+    given = np.asarray(getattr(el, "modes", 1))
+    if given.ndim > 1 or (given.ndim == 1 and len(given) != n):
+        raise ValueError(f"elements: modes has shape {given.shape}: must be one number or one per particle ({n})")
+    wrong = np.flatnonzero(np.atleast_1d((given != np.round(given)) | (given < 1))) if given.dtype.kind in "iuf" \
+        else np.zeros(1, dtype=np.int64)
+    if len(wrong):
+        k = int(wrong[0])
+        raise ValueError(f"elements: modes = {np.atleast_1d(given)[k]}: must be an integer >= 1 (flux modes per neck)"
+                         + (f", particle {k}" if given.ndim else ""))
+    M = np.broadcast_to(given, (n,)).astype(np.int64)
     z = np.diff(el.offsets)
     bad = np.flatnonzero(np.diff(el.start) != (M * z + 1) ** 2)
     if len(bad) or len(el.values) != el.start[-1]:
         k = int(bad[0]) if len(bad) else len(z) - 1
         raise ValueError(f"elements: particle {k} has {int(el.start[k + 1] - el.start[k])} values; with {z[k]} necks "
-                         f"and modes = {M} its block needs (modes z + 1)^2 = {(M * z[k] + 1) ** 2}")
+                         f"and modes = {M[k]} its block needs (modes z + 1)^2 = {(M[k] * z[k] + 1) ** 2}")
     return M
 
 
@@ -408,8 +444,9 @@ class NeckSteady:
     T : numpy.ndarray
         (N,) the particles' (centres') temperatures (K or degC).
     T_necks : numpy.ndarray
-        The live pair bonds' neck temperatures, in the frame of each bond's ``i`` (K or degC); with ``modes`` flux
-        modes per neck, ``modes`` values per bond, its temperature (the monopole's) then its dipoles' moments (K).
+        The live pair bonds' neck temperatures, in the frame of each bond's ``i`` (K or degC); with several flux
+        modes per neck (:attr:`NeckNetwork.bond_modes`), as many values per bond, its temperature (the monopole's)
+        then its dipoles' moments (K).
     bond_flow : numpy.ndarray
         Per pair bond (all of them), the heat flowing from ``i`` to ``j`` through its neck (W; 0 for a dead one).
     wall_flow : numpy.ndarray
@@ -496,7 +533,7 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
         raise ValueError("steady problem has no solution: a floating group of particles (no fixed temperature, "
                          "wall or ambient) has a net internal heat source, so it heats up forever")
     jumping = np.zeros(n_comp, dtype=bool)
-    jumping[label[n + net.modes * np.flatnonzero(net.jump != 0.0)]] = True
+    jumping[label[net.monopoles[net.jump != 0.0]]] = True
     lost = ~anchored & ~jumping
     if floating == "error" and np.any(lost):
         first = np.flatnonzero(lost[label[:n]])[:8].tolist()
@@ -536,7 +573,8 @@ def _level(net: NeckNetwork) -> np.ndarray:
     """Per node, 1 where a uniform change of temperature moves it (the centres and the necks' monopoles), 0 on the
     dipoles' moments (the moment of a uniform temperature is 0)."""
     level = np.ones(net.n_nodes)
-    level[net.particles.n:] = np.arange(net.n_nodes - net.particles.n) % net.modes == 0
+    level[net.particles.n:] = 0.0
+    level[net.monopoles] = 1.0
     return level
 
 
@@ -631,7 +669,7 @@ class NeckHeat(BalanceScales):
             own = np.asarray(own, dtype=bool)
             counted = np.concatenate([own[net.bonds.wall_particle[net.live_walls]], own[held]])
             take[take] = counted[group[take]]
-            self._counted = np.concatenate([own[centres], np.zeros(m, dtype=bool)])
+            self._counted = np.concatenate([own[centres], np.zeros(necks, dtype=bool)])
         self._terms = (col[take], value[take], known[take], group[take], self._walls + len(held))
         self.wall_temperature = known[(col < 0) & (net.col_end >= 0)]
         self._solve = (linear, rtol)
@@ -824,9 +862,9 @@ def neck_current(net: NeckNetwork, walls, electrodes: Electrodes, linear: str = 
         A particle touches two electrodes (its element would join them directly, which the solve has no edge for),
         no electrode is at a fixed potential, or the network has more than one flux mode per neck.
     """
-    if net.modes != 1:
-        raise ValueError(f"neck_current: modes = {net.modes}: the current takes one flux mode per neck (a dipole "
-                         f"node is no node of Kirchhoff's graph)")
+    if np.any(net.col_end == DIPOLE):
+        raise ValueError(f"neck_current: modes = {np.max(net.modes)}: the current takes one flux mode per neck (a "
+                         f"dipole node is no node of Kirchhoff's graph)")
     p = net.particles
     n, m = p.n, len(net.live)
     row, col, value, _, end = net.entries

@@ -656,10 +656,13 @@ def _positive_definite(R: np.ndarray) -> bool:
 
 def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray,
                      k_j: np.ndarray, k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray,
-                     volume=None, L: int = DEGREE) -> ParticleElements:
-    r"""Every particle's Trefftz element with three flux modes per neck (module docstring), the ``elements`` hook of
+                     volume=None, L: int = DEGREE, where=None) -> ParticleElements:
+    r"""The particles' Trefftz elements with three flux modes per neck (module docstring), the ``elements`` hook of
     :func:`dem.network.necks.neck_network` (the arguments of :func:`dem.laws.shared_body.particle_elements`, whose
-    ends it keeps: the faces of each particle's cut body).
+    ends it keeps: the faces of each particle's cut body), on every particle or on those of ``where``; the others
+    keep the law's element with one mode per neck, which the network pads with zero dipole rows and columns on a
+    neck it shares with a Trefftz particle (:mod:`dem.network.necks`, "Flux modes": there the Trefftz particle's
+    dipoles carry no flux).
 
     Parameters
     ----------
@@ -683,15 +686,22 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
         Per particle, the solid it holds, m^3 (the fallback's trace cap).
     L : int
         The harmonics' largest degree, 6 to 16 (:data:`DEGREE` is the verified one).
+    where : numpy.ndarray or None
+        (n,) bool: the particles that get the Trefftz element; None: all.
 
     Returns
     -------
     ParticleElements
-        ``modes`` 3; ``plain`` marks the particles that kept the law's monopole element (their shifted ``R`` not
-        positive definite); ``shrink`` is 1 (no trace cap).
+        ``modes`` 3 (with ``where``: per particle, 3 on the Trefftz particles and 1 on the others); ``plain`` marks
+        the Trefftz particles that kept the law's monopole element (their shifted ``R`` not positive definite) and
+        the others whose interactions the law dropped; ``shrink`` is 1 on the Trefftz particles (no trace cap) and
+        the law's trace cap on the others.
     """
     if not 6 <= L <= 16:
         raise ValueError(f"L = {L}: the Trefftz element's degree must be in 6..16")
+    chosen = np.ones(n, dtype=bool) if where is None else np.asarray(where)
+    if chosen.dtype != bool or chosen.shape != (n,):
+        raise ValueError(f"where: {chosen.dtype} of shape {chosen.shape}: must be a bool mask of the {n} particles")
     if bonds.n_walls:
         raise ValueError("the Trefftz element: walls are not supported (a wall's neck is isothermal), periodic or "
                          "free packings only")
@@ -703,6 +713,11 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
     blocks, start = [], [0]
     with one_blas_thread():
         for k in range(n):
+            if not chosen[k]:  # the law's element, one mode per neck
+                plain[k] = law.plain[k]
+                blocks.append(law.values[law.start[k]:law.start[k + 1]])
+                start.append(start[-1] + len(blocks[-1]))
+                continue
             ends = law.ends[law.offsets[k]:law.offsets[k + 1]]
             z = len(ends)
             if not z:
@@ -730,4 +745,7 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
                 Y[np.ix_(dip, dip)] = np.linalg.inv(R[np.ix_(dip, dip)] / scale)
             blocks.append(bordered(0.5 * (Y + Y.T), 3).ravel())
             start.append(start[-1] + len(blocks[-1]))
-    return ParticleElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain, np.ones(n), 3)
+    if where is None:
+        return ParticleElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain, np.ones(n), 3)
+    return ParticleElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain,
+                            np.where(chosen, 1.0, law.shrink), np.where(chosen, 3, 1))
