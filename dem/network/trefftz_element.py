@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections import namedtuple
 
 import numba
 import numpy as np
@@ -696,38 +697,66 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
         raise ValueError("the Trefftz element: walls are not supported (a wall's neck is isothermal), periodic or "
                          "free packings only")
     law = particle_elements(n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume)
-    m = len(bonds.i)
-    unit = vectors / np.linalg.norm(vectors, axis=1)[:, None]
-    frames = neck_frames(vectors)
+    cut = CutBodies(law, bonds, vectors / np.linalg.norm(vectors, axis=1)[:, None], neck_frames(vectors), radius,
+                    conductivity, L)
     plain = np.zeros(n, dtype=bool)
     blocks, start = [], [0]
     with one_blas_thread():
         for k in range(n):
-            ends = law.ends[law.offsets[k]:law.offsets[k + 1]]
-            z = len(ends)
-            if not z:
-                blocks.append(np.zeros(1))
-                start.append(start[-1] + 1)
-                continue
-            on_i = ends < m
-            b = np.where(on_i, ends, ends - m)
-            normals = np.where(on_i[:, None], unit[b], -unit[b])
-            arms = np.where(on_i, bonds.l_i[b], bonds.l_j[b]) / radius[k]
-            R = resistance(normals, arms, frames[b], L)
-            if R is None:
-                raise ValueError(f"the Trefftz element: particle {k} has a neck with no face (inside another's cap)")
-            shifted = R.copy()
-            shifted[::3, ::3][np.diag_indices(z)] += chain_shift(np.sqrt(1 - arms ** 2), L)
-            scale = conductivity[k] * radius[k]
-            if _positive_definite(shifted):
-                Y = np.linalg.inv(shifted / scale)
-            else:  # the law's element on the monopoles, the unshifted dipoles beside them
-                plain[k] = True
-                E = law.values[law.start[k]:law.start[k + 1]].reshape(z + 1, z + 1)
-                Y = np.zeros((3 * z, 3 * z))
-                Y[::3, ::3] = E[:z, :z]
-                dip = np.flatnonzero(np.arange(3 * z) % 3)
-                Y[np.ix_(dip, dip)] = np.linalg.inv(R[np.ix_(dip, dip)] / scale)
-            blocks.append(bordered(0.5 * (Y + Y.T), 3).ravel())
+            E, plain[k] = particle_element(k, cut)
+            blocks.append(E.ravel())
             start.append(start[-1] + len(blocks[-1]))
     return ParticleElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain, np.ones(n), 3)
+
+
+CutBodies = namedtuple("CutBodies", ["law", "bonds", "unit", "frames", "radius", "conductivity", "L"])
+CutBodies.__doc__ = """What :func:`particle_element` reads of a packing (the arguments of :func:`trefftz_elements`):
+``law`` the law's elements (:func:`dem.laws.shared_body.particle_elements`: each particle's ends and the fallback),
+``bonds`` the bonds, ``unit`` and ``frames`` each pair bond's unit vector from ``i`` to ``j`` and its neck's frame
+(:func:`dem.network.necks.neck_frames`), ``radius`` (m) and ``conductivity`` (W/(m K)) per particle, ``L`` the
+harmonics' largest degree."""
+
+
+def particle_element(k: int, cut: CutBodies) -> tuple:
+    """Particle ``k``'s Trefftz element (module docstring) over its ends' three flux modes and its centre.
+
+    Parameters
+    ----------
+    k : int
+        The particle.
+    cut : CutBodies
+        The packing's bonds, the law's elements and the degree.
+
+    Returns
+    -------
+    tuple
+        ``(E, plain)``: the element, W/K, ``(3 z + 1, 3 z + 1)`` (local nodes: mode ``d`` of end ``p`` at ``3 p + d``,
+        then the centre; a particle without necks: ``(1, 1)``, zero), and whether it kept the law's element on its
+        monopoles (its shifted ``R`` not positive definite).
+    """
+    law, bonds, L = cut.law, cut.bonds, cut.L
+    ends = law.ends[law.offsets[k]:law.offsets[k + 1]]
+    z = len(ends)
+    if not z:
+        return np.zeros((1, 1)), False
+    m = len(bonds.i)
+    on_i = ends < m
+    b = np.where(on_i, ends, ends - m)
+    normals = np.where(on_i[:, None], cut.unit[b], -cut.unit[b])
+    arms = np.where(on_i, bonds.l_i[b], bonds.l_j[b]) / cut.radius[k]
+    R = resistance(normals, arms, cut.frames[b], L)
+    if R is None:
+        raise ValueError(f"the Trefftz element: particle {k} has a neck with no face (inside another's cap)")
+    shifted = R.copy()
+    shifted[::3, ::3][np.diag_indices(z)] += chain_shift(np.sqrt(1 - arms ** 2), L)
+    scale = cut.conductivity[k] * cut.radius[k]
+    plain = not _positive_definite(shifted)
+    if not plain:
+        Y = np.linalg.inv(shifted / scale)
+    else:  # the law's element on the monopoles, the unshifted dipoles beside them
+        E = law.values[law.start[k]:law.start[k + 1]].reshape(z + 1, z + 1)
+        Y = np.zeros((3 * z, 3 * z))
+        Y[::3, ::3] = E[:z, :z]
+        dip = np.flatnonzero(np.arange(3 * z) % 3)
+        Y[np.ix_(dip, dip)] = np.linalg.inv(R[np.ix_(dip, dip)] / scale)
+    return bordered(0.5 * (Y + Y.T), 3), plain
