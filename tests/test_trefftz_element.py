@@ -264,16 +264,60 @@ def test_an_fcc_cell_is_within_one_percent_of_its_fe_and_its_elements_are_conser
         assert np.abs(E @ ones).max() < 1e-10 * np.abs(E).max()
 
 
-def test_walls_and_a_degree_out_of_range_are_refused_in_one_line():
+def test_a_degree_out_of_range_is_refused_in_one_line():
     empty = np.zeros(0)
     with pytest.raises(ValueError, match="L = 3"):
         te.trefftz_elements(1, np.ones(1), None, empty, empty, empty, empty, np.ones(1), empty, L=3)
 
-    class Walled:
-        n_walls = 1
 
-    with pytest.raises(ValueError, match="walls"):
-        te.trefftz_elements(1, np.ones(1), Walled(), empty, empty, empty, empty, np.ones(1), empty)
+def _between_walls(x, box=None):
+    """Unit-conductivity particles of radius 1 mm at ``x`` between a wall at 1 K on z = 0 and one at 0 K on the
+    plane z = top (the largest z plus the first particle's z), under the union; the heat into the cold wall (W) with
+    the Trefftz element."""
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.particles import Material, Particles
+    from dem.geometry.walls import Wall
+    from dem.laws.conductance import ConductanceSpec
+    from dem.network.necks import neck_network, steady_necks
+
+    top = x[:, 2].max() + x[:, 2].min()
+    walls = (Wall("hot", point=[0.0, 0.0, 0.0], normal=[0.0, 0.0, 1.0], temperature=1.0),
+             Wall("cold", point=[0.0, 0.0, top], normal=[0.0, 0.0, -1.0], temperature=0.0))
+    particles = Particles.from_arrays(x, np.full(len(x), 1e-3), np.full(len(x), 0.5),
+                                      materials=(Material(1.0, 1.0, 1.0, "unit"),))
+    bonds = find_bonds(particles, walls, "union", box=box)
+    spec = ConductanceSpec(law="shared-body", neck="union", nodes="necks")
+    res = steady_necks(neck_network(spec, particles, bonds, box=box, walls=walls, elements=te.trefftz_elements))
+    assert bonds.n_walls == 2
+    return float(res.wall_flow[bonds.wall_index == 1].sum())
+
+
+@pytest.mark.parametrize("q", [0.3, 0.6])
+def test_a_column_between_walls_at_its_neck_planes_is_the_chain(q):
+    """Three particles in a column, the walls at the planes their necks with a fourth and a zeroth would have: each
+    wall face is a neck face of the periodic chain, whose plane is isothermal by symmetry, so the column conducts the
+    law's halves in series, kappa r / (2 h_law) over three (measured 1e-15)."""
+    d = 2e-3 * np.sqrt(1 - q * q)
+    x = np.column_stack([np.zeros(3), np.zeros(3), (np.arange(3) + 0.5) * d])
+    assert _between_walls(x) == pytest.approx(1e-3 / (2 * float(te.law_half(q))) / 3, rel=1e-12)
+
+
+@pytest.mark.parametrize("h", [0.1, 0.5])
+def test_a_simple_cubic_block_between_walls_at_its_mid_planes_is_the_periodic_cell(h):
+    """Two layers of the SC union lattice, periodic across x and y, between walls on the mid-planes of the necks
+    across z: those planes are mirror planes of the periodic cell under a gradient along z, so isothermal with no
+    dipole moment, and the block's k_eff is the periodic cell's with the same element (measured 1e-15: the wall
+    faces are the same planes, the same halves and the same shift as the necks they replace)."""
+    from dem.geometry.periodic import PeriodicBox
+    from fem_neck.lattice import lattice_cell
+    from verification.lattices import dem_periodic
+
+    d = (2 - h) * 1e-3
+    x = np.array([[d / 2, d / 2, d / 2], [d / 2, d / 2, 1.5 * d]])
+    flow = _between_walls(x, PeriodicBox([d, d, 2 * d], periodic=(True, True, False)))
+    periodic = dem_periodic(lattice_cell("sc", h, neck="union"), "shared-body", neck="union", nodes="necks",
+                            elements=te.trefftz_elements)
+    assert flow * 2 * d / (d * d) == pytest.approx(periodic, rel=1e-12)
 
 
 def test_the_neck_node_bound_study_has_the_trefftz_column_without_ngsolve(tmp_path, monkeypatch):

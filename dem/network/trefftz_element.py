@@ -28,7 +28,11 @@ same radius, where the union law's half :math:`1 / (\pi K/K_{cyl})` is the exact
 single-particle problems only. A particle whose shifted ``R`` is not positive definite keeps the law's element on its
 monopoles (:func:`dem.laws.shared_body.particle_elements`) and its unshifted dipole block, marked ``plain``.
 
-Walls are refused: a wall's neck is an isothermal face, whose modes this element does not have.
+A wall bond's face is a plane cut like a neck's: normal into the wall, arm ``wall_l / r``, dipoles along
+:func:`dem.network.necks.neck_frames` of that normal; the network sets its three modes (the monopole at the wall's
+temperature, the dipoles' moments 0: the wall is isothermal, :mod:`dem.network.necks`). Its monopole takes the same
+chain shift: a particle between two walls at its necks' planes is the chain particle, since the neck plane of a
+symmetric pair is isothermal by symmetry.
 """
 
 from __future__ import annotations
@@ -669,17 +673,18 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
     radius : numpy.ndarray
         Particle radii, m.
     bonds : Bonds
-        The pair bonds (all live), with their centre-to-contact distances ``l_i``, ``l_j`` (m); no wall bonds.
+        The pair and wall bonds (all live), with their centre-to-contact distances ``l_i``, ``l_j`` and ``wall_l``
+        (m).
     vectors : numpy.ndarray
         ``x_j - x_i`` of every pair bond (m, 3), m.
     k_i, k_j : numpy.ndarray
         Half conductances of every pair bond on the side of ``i`` and of ``j``, W/K (the fallback's).
     k_wall : numpy.ndarray
-        Half conductance of every wall bond, W/K (none allowed).
+        Half conductance of every wall bond, W/K (the fallback's).
     conductivity : numpy.ndarray
         Per particle, its material's conductivity, W/(m K).
     wall_normals : numpy.ndarray
-        Unit normal of every wall bond's wall (none allowed).
+        Unit normal of every wall bond's wall, pointing into the packing.
     volume : numpy.ndarray, optional
         Per particle, the solid it holds, m^3 (the fallback's trace cap).
     L : int
@@ -693,12 +698,12 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
     """
     if not 6 <= L <= 16:
         raise ValueError(f"L = {L}: the Trefftz element's degree must be in 6..16")
-    if bonds.n_walls:
-        raise ValueError("the Trefftz element: walls are not supported (a wall's neck is isothermal), periodic or "
-                         "free packings only")
     law = particle_elements(n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume)
-    cut = CutBodies(law, bonds, vectors / np.linalg.norm(vectors, axis=1)[:, None], neck_frames(vectors), radius,
-                    conductivity, L)
+    unit = vectors / np.linalg.norm(vectors, axis=1)[:, None]
+    into_wall = -np.reshape(np.asarray(wall_normals, dtype=float), (-1, 3))
+    frames = neck_frames(vectors)
+    cut = CutBodies(law, np.concatenate([unit, -unit, into_wall]), np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l]),
+                    np.concatenate([frames, frames, neck_frames(into_wall)]), radius, conductivity, L)
     plain = np.zeros(n, dtype=bool)
     blocks, start = [], [0]
     with one_blas_thread():
@@ -709,12 +714,13 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
     return ParticleElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain, np.ones(n), 3)
 
 
-CutBodies = namedtuple("CutBodies", ["law", "bonds", "unit", "frames", "radius", "conductivity", "L"])
+CutBodies = namedtuple("CutBodies", ["law", "normals", "arms", "frames", "radius", "conductivity", "L"])
 CutBodies.__doc__ = """What :func:`particle_element` reads of a packing (the arguments of :func:`trefftz_elements`):
-``law`` the law's elements (:func:`dem.laws.shared_body.particle_elements`: each particle's ends and the fallback),
-``bonds`` the bonds, ``unit`` and ``frames`` each pair bond's unit vector from ``i`` to ``j`` and its neck's frame
-(:func:`dem.network.necks.neck_frames`), ``radius`` (m) and ``conductivity`` (W/(m K)) per particle, ``L`` the
-harmonics' largest degree."""
+``law`` the law's elements (:func:`dem.laws.shared_body.particle_elements`: each particle's ends and the fallback);
+per bond end (pair bonds on ``i``, on ``j``, then the wall bonds) the unit normal of its plane out of its particle
+(into the wall for a wall's), the plane's distance from the particle's centre (m) and the neck's dipole frame
+(:func:`dem.network.necks.neck_frames` of the bond's vector from ``i`` to ``j``, of the normal into a wall);
+``radius`` (m) and ``conductivity`` (W/(m K)) per particle, ``L`` the harmonics' largest degree."""
 
 
 def particle_element(k: int, cut: CutBodies) -> tuple:
@@ -734,17 +740,13 @@ def particle_element(k: int, cut: CutBodies) -> tuple:
         then the centre; a particle without necks: ``(1, 1)``, zero), and whether it kept the law's element on its
         monopoles (its shifted ``R`` not positive definite).
     """
-    law, bonds, L = cut.law, cut.bonds, cut.L
+    law, L = cut.law, cut.L
     ends = law.ends[law.offsets[k]:law.offsets[k + 1]]
     z = len(ends)
     if not z:
         return np.zeros((1, 1)), False
-    m = len(bonds.i)
-    on_i = ends < m
-    b = np.where(on_i, ends, ends - m)
-    normals = np.where(on_i[:, None], cut.unit[b], -cut.unit[b])
-    arms = np.where(on_i, bonds.l_i[b], bonds.l_j[b]) / cut.radius[k]
-    R = resistance(normals, arms, cut.frames[b], L)
+    arms = cut.arms[ends] / cut.radius[k]
+    R = resistance(cut.normals[ends], arms, cut.frames[ends], L)
     if R is None:
         raise ValueError(f"the Trefftz element: particle {k} has a neck with no face (inside another's cap)")
     shifted = R.copy()
