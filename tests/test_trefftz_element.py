@@ -320,6 +320,58 @@ def test_a_simple_cubic_block_between_walls_at_its_mid_planes_is_the_periodic_ce
     assert flow * 2 * d / (d * d) == pytest.approx(periodic, rel=1e-12)
 
 
+def test_a_held_particle_feeds_its_necks_through_the_laws_halves():
+    """A particle held at 1 K in the corner of three walls at 0 (tests/test_neck_nodes.py, the law's own test): the
+    heat it gives is the sum of its narrowed wall halves (the centre joined to the monopoles by the law's halves),
+    where R^-1 bordered by its sums (the body's mean with a uniform sink) gave 53 % more; the same particle free
+    between a hot and a cold wall passes on what its Trefftz element's centre-free conductance Y_0 gives, whatever
+    the centre's path (from te.resistance directly: the wall faces' planes, the chain shift, the dipoles held at 0)."""
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.particles import Material, Particles
+    from dem.geometry.walls import Wall
+    from dem.laws.conductance import ConductanceSpec, half_conductance, union_halves, wall_normals
+    from dem.network.necks import neck_network, steady_necks
+
+    unit, spec = Material(1.0, 1.0, 1.0, "unit"), ConductanceSpec(law="shared-body", neck="union", nodes="necks")
+    x = np.array([[0.8e-3, 0.8e-3, 0.8e-3]])
+    walls = tuple(Wall(f"w{a}", point=[0.0, 0.0, 0.0], normal=np.eye(3)[a], temperature=0.0) for a in range(3))
+    held = Particles.from_arrays(x, [1e-3], [1.0], materials=(unit,), fixed=[True])
+    bonds = find_bonds(held, walls, "union")
+    res = steady_necks(neck_network(spec, held, bonds, walls=walls, elements=te.trefftz_elements))
+    halves = half_conductance(spec, held.conductivity[bonds.wall_particle], held.radius[bonds.wall_particle],
+                              bonds.wall_a, bonds.wall_l)
+    empty = np.zeros(0)
+    k_w = union_halves(held, bonds, np.zeros((0, 3)), wall_normals(bonds, walls), held.conductivity, empty, empty,
+                       halves, walls=walls)[2]
+    assert bonds.n_walls == 3
+    assert res.fixed_flow[0] == pytest.approx(k_w.sum(), rel=1e-12)
+    hot = (Wall("w0", point=[0.0, 0.0, 0.0], normal=[1.0, 0.0, 0.0], temperature=1.0),) + walls[1:]
+    free = Particles.from_arrays(x, [1e-3], [0.5], materials=(unit,))
+    res = steady_necks(neck_network(spec, free, bonds, walls=hot, elements=te.trefftz_elements))
+    normals, arms = -np.eye(3), bonds.wall_l / 1e-3
+    R = te.resistance(normals, arms, neck_frames(normals))
+    R[::3, ::3][np.diag_indices(3)] += te.chain_shift(np.sqrt(1 - arms ** 2))
+    Y = np.linalg.inv(R / 1e-3)
+    row = Y[:, ::3].sum(axis=1)
+    Y0 = (Y - np.outer(row, row) / row[::3].sum())[::3, ::3]
+    assert -res.wall_flow == pytest.approx(Y0 @ np.array([1.0, 0.0, 0.0]), rel=1e-9, abs=1e-15)
+    assert Y[::3, ::3].sum() > 1.1 * k_w.sum()  # e^T Y e, the bordered centre's: the path the test tells apart
+
+
+def test_a_free_periodic_network_does_not_see_the_centres_path(monkeypatch):
+    """A periodic BCC cell (free particles, no source): k_eff with the centre joined by the law's halves equals k_eff
+    with the centre of R^-1 bordered by its sums to round-off (eliminating a free centre leaves Y_0 either way)."""
+    from fem_neck.lattice import lattice_cell
+    from verification.lattices import dem_periodic
+    from dem.network.necks import bordered
+
+    cell = lattice_cell("bcc", 0.2, neck="union")
+    joined = dem_periodic(cell, "shared-body", neck="union", nodes="necks", elements=te.trefftz_elements)
+    monkeypatch.setattr(te, "_joined", lambda Y, halves: bordered(Y, 3))
+    assert joined == pytest.approx(dem_periodic(cell, "shared-body", neck="union", nodes="necks",
+                                                elements=te.trefftz_elements), rel=1e-12)
+
+
 def test_the_neck_node_bound_study_has_the_trefftz_column_without_ngsolve(tmp_path, monkeypatch):
     """python -m verification neck-node-bound --quick where NGSolve is missing: the FE of its cell (SC h/r 0.3) from
     the cache, the exact elements left out, the Trefftz element's network within 1 % of the FE and below Wiener."""
