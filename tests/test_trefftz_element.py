@@ -232,6 +232,65 @@ def test_an_element_not_positive_definite_falls_back_to_the_laws_monopoles(monke
     assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
 
 
+# one particle of a random union packing (seed 2, phi 0.8; its four particles mirrored into a periodic cell of 32):
+# the unit normals and the arms over r of its six planes, where L 12's own rule put a monopole diagonal 4.7 % above
+# the doubled rule's
+SEED2_NORMALS = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0],
+                          [-0.7038288880489364, 0.019192488150706306, -0.7101102342216895],
+                          [-0.8538717952623643, -0.5204362298722238, -0.007006275173935751],
+                          [-0.07747856738268984, -0.6973587758039056, -0.7125221466071102]])
+SEED2_ARMS = np.array([0.7028172066202272, 0.7368147459400058, 0.7134981919961735, 0.8151372626213468,
+                       0.6433945388131563, 0.5666335031850278])
+
+
+def _one_particle(normals, arms, L):
+    """particle_element's input for one unit particle (r 1 mm, kappa 1) with these planes; the law's fallback zero."""
+    from dem.laws.shared_body import ParticleElements
+
+    z = len(arms)
+    law = ParticleElements(np.array([0, z]), np.arange(z), np.array([0, (z + 1) ** 2]), np.zeros((z + 1) ** 2),
+                           np.zeros(1, dtype=bool), np.ones(1))
+    return te.CutBodies(law, normals, 1e-3 * arms, neck_frames(normals), np.full(z, 1e-3), np.array([1e-3]),
+                        np.ones(1), L)
+
+
+@pytest.mark.parametrize("L", [10, 12])
+def test_a_particle_whose_quadrature_fails_its_check_is_refined(L):
+    """The packing's particle: with the degree's own rule its monopole diagonals lie more than 1 % above the doubled
+    rule's (a quadrature failure: the rule, not the trial space, changed), and its defect is above DEFECT; 1.5 times
+    the rule passes the check, its monopole diagonals within 0.05 % of the doubled rule's (measured 0.011 %)."""
+    frames = neck_frames(SEED2_NORMALS)
+    (R1, d1), (R15, d15), (R2, d2) = (te._ritz(SEED2_NORMALS, SEED2_ARMS, frames, L, f) for f in te.REFINE)
+    assert d1 > te.DEFECT >= d15
+    assert np.max(np.diag(R1)[::3] / np.diag(R2)[::3]) > 1.01
+    assert np.abs(np.diag(R15)[::3] / np.diag(R2)[::3] - 1).max() < 5e-4
+    assert np.abs(te.resistance(SEED2_NORMALS, SEED2_ARMS, frames, L, 1.5) - R15).max() == 0.0
+
+
+def test_particle_element_refines_the_failing_particle():
+    """At the default degree the packing's particle is computed with 1.5 times the rule, not marked plain."""
+    E, plain, refine = te.particle_element(0, _one_particle(SEED2_NORMALS, SEED2_ARMS, te.DEGREE))
+    assert refine == 1.5 and not plain and np.isfinite(E).all()
+
+
+def test_a_particle_failing_the_check_at_the_finest_rule_keeps_the_laws_element(monkeypatch):
+    """The check made impossible to pass (DEFECT below 0): every particle of the chain is tried at each rule and
+    keeps the law's element on its monopoles, marked plain: the law's k_eff again."""
+    from verification.lattices import dem_periodic
+
+    monkeypatch.setattr(te, "DEFECT", -1.0)
+    built = []
+
+    def hook(*args, **kwargs):
+        built.append(te.trefftz_elements(*args, **kwargs))
+        return built[-1]
+
+    cell = _periodic_chain(0.5)
+    k = dem_periodic(cell, "shared-body", neck="union", nodes="necks", elements=hook)
+    assert built[0].plain.all() and (built[0].refine == te.REFINE[-1]).all()
+    assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
+
+
 # FCC, union of spheres, h/r = 0.1: the periodic cell's FE lower and upper bounds at rtol 1e-3 (python -m
 # verification densification; tests/test_union_shared_body.py)
 FCC_FE = (0.65161, 0.65204)
@@ -255,7 +314,7 @@ def test_an_fcc_cell_is_within_one_percent_of_its_fe_and_its_elements_are_conser
     assert FCC_FE[0] * 0.99 < k < FCC_FE[1] * 1.01
     assert k < cell.phi
     el = built[0]
-    assert el.modes == 3 and not el.plain.any()
+    assert el.modes == 3 and not el.plain.any() and (el.refine == 1).all()  # the lattices pass the quadrature's check
     for p in range(len(el.offsets) - 1):
         z = el.offsets[p + 1] - el.offsets[p]
         E = el.values[el.start[p]:el.start[p + 1]].reshape(3 * z + 1, 3 * z + 1)
