@@ -42,7 +42,8 @@ positive definite. On the 296 particles of the 39 union cells at ``L`` 10 the de
 monopole diagonals under a doubled rule: the 18 particles above 2e-3 (three distinct ones of the random packings,
 3e-3 to 2e-2) move by 0.5 to 1.7 %, every other one by at most 0.11 % (its defect at most 8e-4; the lattices'
 particles' at most 2e-4), and 1.5 times the rule brings all 18 below the threshold (and within 0.011 % of the doubled
-rule's diagonals). The volume
+rule's diagonals). A refined particle keeps the degree's own shift: the chain particle's half moves by at most 3e-4 of
+itself between the rules (at a/r 0.9; below 1e-7 up to a/r 0.7). The volume
 (:math:`\oint x \cdot n = 3 V` against :func:`fem_neck.geometry.union.cut_spheres`) is within 6e-8 on all of them,
 so it tells nothing at this degree and is not computed.
 
@@ -717,7 +718,7 @@ def _positive_definite(R: np.ndarray) -> bool:
 
 def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray,
                      k_j: np.ndarray, k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray,
-                     volume=None, L: int = DEGREE) -> ParticleElements:
+                     volume=None, L: int = DEGREE) -> TrefftzElements:
     r"""Every particle's Trefftz element with three flux modes per neck (module docstring), the ``elements`` hook of
     :func:`dem.network.necks.neck_network` (the arguments of :func:`dem.laws.shared_body.particle_elements`, whose
     ends it keeps: the faces of each particle's cut body).
