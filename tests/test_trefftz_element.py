@@ -379,34 +379,42 @@ def test_a_simple_cubic_block_between_walls_at_its_mid_planes_is_the_periodic_ce
     assert flow * 2 * d / (d * d) == pytest.approx(periodic, rel=1e-12)
 
 
+def _corner(x, walls, **particle):
+    """One unit particle (r 1 mm, kappa 1) at ``x`` among ``walls`` under the union, ``particle`` its state (the
+    temperature, fixed, heat): its steady solve with the Trefftz element and the law's narrowed wall halves (W/K)."""
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.particles import Material, Particles
+    from dem.laws.conductance import ConductanceSpec, half_conductance, union_halves, wall_normals
+    from dem.network.necks import neck_network, steady_necks
+
+    spec = ConductanceSpec(law="shared-body", neck="union", nodes="necks")
+    one = Particles.from_arrays(x, [1e-3], materials=(Material(1.0, 1.0, 1.0, "unit"),), **particle)
+    bonds = find_bonds(one, walls, "union")
+    halves = half_conductance(spec, one.conductivity[bonds.wall_particle], one.radius[bonds.wall_particle],
+                              bonds.wall_a, bonds.wall_l)
+    empty = np.zeros(0)
+    k_w = union_halves(one, bonds, np.zeros((0, 3)), wall_normals(bonds, walls), one.conductivity, empty, empty,
+                       halves, walls=walls)[2]
+    assert bonds.n_walls == len(walls)
+    return steady_necks(neck_network(spec, one, bonds, walls=walls, elements=te.trefftz_elements)), k_w, bonds
+
+
+def _three_walls(T=(0.0, 0.0, 0.0)):
+    from dem.geometry.walls import Wall
+
+    return tuple(Wall(f"w{a}", point=[0.0, 0.0, 0.0], normal=np.eye(3)[a], temperature=T[a]) for a in range(3))
+
+
 def test_a_held_particle_feeds_its_necks_through_the_laws_halves():
     """A particle held at 1 K in the corner of three walls at 0 (tests/test_neck_nodes.py, the law's own test): the
     heat it gives is the sum of its narrowed wall halves (the centre joined to the monopoles by the law's halves),
     where R^-1 bordered by its sums (the body's mean with a uniform sink) gave 53 % more; the same particle free
     between a hot and a cold wall passes on what its Trefftz element's centre-free conductance Y_0 gives, whatever
     the centre's path (from te.resistance directly: the wall faces' planes, the chain shift, the dipoles held at 0)."""
-    from dem.geometry.bonds import find_bonds
-    from dem.geometry.particles import Material, Particles
-    from dem.geometry.walls import Wall
-    from dem.laws.conductance import ConductanceSpec, half_conductance, union_halves, wall_normals
-    from dem.network.necks import neck_network, steady_necks
-
-    unit, spec = Material(1.0, 1.0, 1.0, "unit"), ConductanceSpec(law="shared-body", neck="union", nodes="necks")
     x = np.array([[0.8e-3, 0.8e-3, 0.8e-3]])
-    walls = tuple(Wall(f"w{a}", point=[0.0, 0.0, 0.0], normal=np.eye(3)[a], temperature=0.0) for a in range(3))
-    held = Particles.from_arrays(x, [1e-3], [1.0], materials=(unit,), fixed=[True])
-    bonds = find_bonds(held, walls, "union")
-    res = steady_necks(neck_network(spec, held, bonds, walls=walls, elements=te.trefftz_elements))
-    halves = half_conductance(spec, held.conductivity[bonds.wall_particle], held.radius[bonds.wall_particle],
-                              bonds.wall_a, bonds.wall_l)
-    empty = np.zeros(0)
-    k_w = union_halves(held, bonds, np.zeros((0, 3)), wall_normals(bonds, walls), held.conductivity, empty, empty,
-                       halves, walls=walls)[2]
-    assert bonds.n_walls == 3
+    res, k_w, bonds = _corner(x, _three_walls(), temperature=[1.0], fixed=[True])
     assert res.fixed_flow[0] == pytest.approx(k_w.sum(), rel=1e-12)
-    hot = (Wall("w0", point=[0.0, 0.0, 0.0], normal=[1.0, 0.0, 0.0], temperature=1.0),) + walls[1:]
-    free = Particles.from_arrays(x, [1e-3], [0.5], materials=(unit,))
-    res = steady_necks(neck_network(spec, free, bonds, walls=hot, elements=te.trefftz_elements))
+    res, _, _ = _corner(x, _three_walls((1.0, 0.0, 0.0)), temperature=[0.5])
     normals, arms = -np.eye(3), bonds.wall_l / 1e-3
     R = te.resistance(normals, arms, neck_frames(normals))
     R[::3, ::3][np.diag_indices(3)] += te.chain_shift(np.sqrt(1 - arms ** 2))
@@ -415,6 +423,16 @@ def test_a_held_particle_feeds_its_necks_through_the_laws_halves():
     Y0 = (Y - np.outer(row, row) / row[::3].sum())[::3, ::3]
     assert -res.wall_flow == pytest.approx(Y0 @ np.array([1.0, 0.0, 0.0]), rel=1e-9, abs=1e-15)
     assert Y[::3, ::3].sum() > 1.1 * k_w.sum()  # e^T Y e, the bordered centre's: the path the test tells apart
+
+
+def test_a_source_leaves_through_the_laws_halves():
+    """A free particle with a 1 mW source in a corner of three walls at 0, at three distances from them (unequal
+    halves): its centre rises by Q / sum K and each wall takes Q K_b / sum K."""
+    x = np.array([[0.8e-3, 0.75e-3, 0.7e-3]])
+    res, k_w, _ = _corner(x, _three_walls(), temperature=[0.0], heat=[1e-3])
+    assert np.ptp(k_w) > 0.2 * k_w.mean()
+    assert res.T[0] == pytest.approx(1e-3 / k_w.sum(), rel=1e-12)
+    assert res.wall_flow == pytest.approx(1e-3 * k_w / k_w.sum(), rel=1e-12)
 
 
 def test_a_free_periodic_network_does_not_see_the_centres_path(monkeypatch):
