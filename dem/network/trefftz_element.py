@@ -761,7 +761,8 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
     unit = vectors / np.linalg.norm(vectors, axis=1)[:, None]
     into_wall = -np.reshape(np.asarray(wall_normals, dtype=float), (-1, 3))
     frames = neck_frames(vectors)
-    cut = CutBodies(law, np.concatenate([unit, -unit, into_wall]), np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l]),
+    cut = CutBodies(law, np.concatenate([unit, -unit, into_wall]),
+                    np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l]),
                     np.concatenate([frames, frames, neck_frames(into_wall)]), np.concatenate([k_i, k_j, k_wall]),
                     radius, conductivity, L)
     plain = np.zeros(n, dtype=bool)
@@ -788,7 +789,8 @@ CutBodies.__doc__ = """What :func:`particle_element` reads of a packing (the arg
 per bond end (pair bonds on ``i``, on ``j``, then the wall bonds) the unit normal of its plane out of its particle
 (into the wall for a wall's), the plane's distance from the particle's centre (m) and the neck's dipole frame
 (:func:`dem.network.necks.neck_frames` of the bond's vector from ``i`` to ``j``, of the normal into a wall) and
-the law's half conductance from the centre to the neck (W/K); ``radius`` (m) and ``conductivity`` (W/(m K)) per particle, ``L`` the harmonics' largest degree."""
+the law's half conductance from the centre to the neck (W/K); ``radius`` (m) and ``conductivity`` (W/(m K)) per
+particle, ``L`` the harmonics' largest degree."""
 
 
 def particle_element(k: int, cut: CutBodies) -> tuple:
@@ -799,7 +801,7 @@ def particle_element(k: int, cut: CutBodies) -> tuple:
     k : int
         The particle.
     cut : CutBodies
-        The packing's bonds, the law's elements and the degree.
+        The packing's planes and halves per bond end, the law's elements and the degree.
 
     Returns
     -------
