@@ -232,6 +232,65 @@ def test_an_element_not_positive_definite_falls_back_to_the_laws_monopoles(monke
     assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
 
 
+# one particle of a random union packing (seed 2, phi 0.8; its four particles mirrored into a periodic cell of 32):
+# the unit normals and the arms over r of its six planes, where L 12's own rule put a monopole diagonal 4.7 % above
+# the doubled rule's
+SEED2_NORMALS = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0],
+                          [-0.7038288880489364, 0.019192488150706306, -0.7101102342216895],
+                          [-0.8538717952623643, -0.5204362298722238, -0.007006275173935751],
+                          [-0.07747856738268984, -0.6973587758039056, -0.7125221466071102]])
+SEED2_ARMS = np.array([0.7028172066202272, 0.7368147459400058, 0.7134981919961735, 0.8151372626213468,
+                       0.6433945388131563, 0.5666335031850278])
+
+
+def _one_particle(normals, arms, L):
+    """particle_element's input for one unit particle (r 1 mm, kappa 1) with these planes; the law's fallback zero."""
+    from dem.laws.shared_body import ParticleElements
+
+    z = len(arms)
+    law = ParticleElements(np.array([0, z]), np.arange(z), np.array([0, (z + 1) ** 2]), np.zeros((z + 1) ** 2),
+                           np.zeros(1, dtype=bool), np.ones(1))
+    return te.CutBodies(law, normals, 1e-3 * arms, neck_frames(normals), np.full(z, 1e-3), np.array([1e-3]),
+                        np.ones(1), L)
+
+
+@pytest.mark.parametrize("L", [10, 12])
+def test_a_particle_whose_quadrature_fails_its_check_is_refined(L):
+    """The packing's particle: with the degree's own rule its monopole diagonals lie more than 1 % above the doubled
+    rule's (a quadrature failure: the rule, not the trial space, changed), and its defect is above DEFECT; 1.5 times
+    the rule passes the check, its monopole diagonals within 0.05 % of the doubled rule's (measured 0.011 %)."""
+    frames = neck_frames(SEED2_NORMALS)
+    (R1, d1), (R15, d15), (R2, d2) = (te._ritz(SEED2_NORMALS, SEED2_ARMS, frames, L, f) for f in te.REFINE)
+    assert d1 > te.DEFECT >= d15
+    assert np.max(np.diag(R1)[::3] / np.diag(R2)[::3]) > 1.01
+    assert np.abs(np.diag(R15)[::3] / np.diag(R2)[::3] - 1).max() < 5e-4
+    assert np.abs(te.resistance(SEED2_NORMALS, SEED2_ARMS, frames, L, 1.5) - R15).max() == 0.0
+
+
+def test_particle_element_refines_the_failing_particle():
+    """At the default degree the packing's particle is computed with 1.5 times the rule, not marked plain."""
+    E, plain, refine = te.particle_element(0, _one_particle(SEED2_NORMALS, SEED2_ARMS, te.DEGREE))
+    assert refine == 1.5 and not plain and np.isfinite(E).all()
+
+
+def test_a_particle_failing_the_check_at_the_finest_rule_keeps_the_laws_element(monkeypatch):
+    """The check made impossible to pass (DEFECT below 0): every particle of the chain is tried at each rule and
+    keeps the law's element on its monopoles, marked plain: the law's k_eff again."""
+    from verification.lattices import dem_periodic
+
+    monkeypatch.setattr(te, "DEFECT", -1.0)
+    built = []
+
+    def hook(*args, **kwargs):
+        built.append(te.trefftz_elements(*args, **kwargs))
+        return built[-1]
+
+    cell = _periodic_chain(0.5)
+    k = dem_periodic(cell, "shared-body", neck="union", nodes="necks", elements=hook)
+    assert built[0].plain.all() and (built[0].refine == te.REFINE[-1]).all()
+    assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
+
+
 # FCC, union of spheres, h/r = 0.1: the periodic cell's FE lower and upper bounds at rtol 1e-3 (python -m
 # verification densification; tests/test_union_shared_body.py)
 FCC_FE = (0.65161, 0.65204)
@@ -255,7 +314,7 @@ def test_an_fcc_cell_is_within_one_percent_of_its_fe_and_its_elements_are_conser
     assert FCC_FE[0] * 0.99 < k < FCC_FE[1] * 1.01
     assert k < cell.phi
     el = built[0]
-    assert el.modes == 3 and not el.plain.any()
+    assert el.modes == 3 and not el.plain.any() and (el.refine == 1).all()  # the lattices pass the quadrature's check
     for p in range(len(el.offsets) - 1):
         z = el.offsets[p + 1] - el.offsets[p]
         E = el.values[el.start[p]:el.start[p + 1]].reshape(3 * z + 1, 3 * z + 1)
@@ -264,16 +323,130 @@ def test_an_fcc_cell_is_within_one_percent_of_its_fe_and_its_elements_are_conser
         assert np.abs(E @ ones).max() < 1e-10 * np.abs(E).max()
 
 
-def test_walls_and_a_degree_out_of_range_are_refused_in_one_line():
+def test_a_degree_out_of_range_is_refused_in_one_line():
     empty = np.zeros(0)
     with pytest.raises(ValueError, match="L = 3"):
         te.trefftz_elements(1, np.ones(1), None, empty, empty, empty, empty, np.ones(1), empty, L=3)
 
-    class Walled:
-        n_walls = 1
 
-    with pytest.raises(ValueError, match="walls"):
-        te.trefftz_elements(1, np.ones(1), Walled(), empty, empty, empty, empty, np.ones(1), empty)
+def _between_walls(x, box=None):
+    """Unit-conductivity particles of radius 1 mm at ``x`` between a wall at 1 K on z = 0 and one at 0 K on the
+    plane z = top (the largest z plus the first particle's z), under the union; the heat into the cold wall (W) with
+    the Trefftz element."""
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.particles import Material, Particles
+    from dem.geometry.walls import Wall
+    from dem.laws.conductance import ConductanceSpec
+    from dem.network.necks import neck_network, steady_necks
+
+    top = x[:, 2].max() + x[:, 2].min()
+    walls = (Wall("hot", point=[0.0, 0.0, 0.0], normal=[0.0, 0.0, 1.0], temperature=1.0),
+             Wall("cold", point=[0.0, 0.0, top], normal=[0.0, 0.0, -1.0], temperature=0.0))
+    particles = Particles.from_arrays(x, np.full(len(x), 1e-3), np.full(len(x), 0.5),
+                                      materials=(Material(1.0, 1.0, 1.0, "unit"),))
+    bonds = find_bonds(particles, walls, "union", box=box)
+    spec = ConductanceSpec(law="shared-body", neck="union", nodes="necks")
+    res = steady_necks(neck_network(spec, particles, bonds, box=box, walls=walls, elements=te.trefftz_elements))
+    assert bonds.n_walls == 2
+    return float(res.wall_flow[bonds.wall_index == 1].sum())
+
+
+@pytest.mark.parametrize("q", [0.3, 0.6])
+def test_a_column_between_walls_at_its_neck_planes_is_the_chain(q):
+    """Three particles in a column, the walls at the planes their necks with a fourth and a zeroth would have: each
+    wall face is a neck face of the periodic chain, whose plane is isothermal by symmetry, so the column conducts the
+    law's halves in series, kappa r / (2 h_law) over three (measured 1e-15)."""
+    d = 2e-3 * np.sqrt(1 - q * q)
+    x = np.column_stack([np.zeros(3), np.zeros(3), (np.arange(3) + 0.5) * d])
+    assert _between_walls(x) == pytest.approx(1e-3 / (2 * float(te.law_half(q))) / 3, rel=1e-12)
+
+
+@pytest.mark.parametrize("h", [0.1, 0.5])
+def test_a_simple_cubic_block_between_walls_at_its_mid_planes_is_the_periodic_cell(h):
+    """Two layers of the SC union lattice, periodic across x and y, between walls on the mid-planes of the necks
+    across z: those planes are mirror planes of the periodic cell under a gradient along z, so isothermal with no
+    dipole moment, and the block's k_eff is the periodic cell's with the same element (measured 1e-15: the wall
+    faces are the same planes, the same halves and the same shift as the necks they replace)."""
+    from dem.geometry.periodic import PeriodicBox
+    from fem_neck.lattice import lattice_cell
+    from verification.lattices import dem_periodic
+
+    d = (2 - h) * 1e-3
+    x = np.array([[d / 2, d / 2, d / 2], [d / 2, d / 2, 1.5 * d]])
+    flow = _between_walls(x, PeriodicBox([d, d, 2 * d], periodic=(True, True, False)))
+    periodic = dem_periodic(lattice_cell("sc", h, neck="union"), "shared-body", neck="union", nodes="necks",
+                            elements=te.trefftz_elements)
+    assert flow * 2 * d / (d * d) == pytest.approx(periodic, rel=1e-12)
+
+
+def _corner(x, walls, **particle):
+    """One unit particle (r 1 mm, kappa 1) at ``x`` among ``walls`` under the union, ``particle`` its state (the
+    temperature, fixed, heat): its steady solve with the Trefftz element and the law's narrowed wall halves (W/K)."""
+    from dem.geometry.bonds import find_bonds
+    from dem.geometry.particles import Material, Particles
+    from dem.laws.conductance import ConductanceSpec, half_conductance, union_halves, wall_normals
+    from dem.network.necks import neck_network, steady_necks
+
+    spec = ConductanceSpec(law="shared-body", neck="union", nodes="necks")
+    one = Particles.from_arrays(x, [1e-3], materials=(Material(1.0, 1.0, 1.0, "unit"),), **particle)
+    bonds = find_bonds(one, walls, "union")
+    halves = half_conductance(spec, one.conductivity[bonds.wall_particle], one.radius[bonds.wall_particle],
+                              bonds.wall_a, bonds.wall_l)
+    empty = np.zeros(0)
+    k_w = union_halves(one, bonds, np.zeros((0, 3)), wall_normals(bonds, walls), one.conductivity, empty, empty,
+                       halves, walls=walls)[2]
+    assert bonds.n_walls == len(walls)
+    return steady_necks(neck_network(spec, one, bonds, walls=walls, elements=te.trefftz_elements)), k_w, bonds
+
+
+def _three_walls(T=(0.0, 0.0, 0.0)):
+    from dem.geometry.walls import Wall
+
+    return tuple(Wall(f"w{a}", point=[0.0, 0.0, 0.0], normal=np.eye(3)[a], temperature=T[a]) for a in range(3))
+
+
+def test_a_held_particle_feeds_its_necks_through_the_laws_halves():
+    """A particle held at 1 K in the corner of three walls at 0 (tests/test_neck_nodes.py, the law's own test): the
+    heat it gives is the sum of its narrowed wall halves (the centre joined to the monopoles by the law's halves),
+    where R^-1 bordered by its sums (the body's mean with a uniform sink) gave 53 % more; the same particle free
+    between a hot and a cold wall passes on what its Trefftz element's centre-free conductance Y_0 gives, whatever
+    the centre's path (from te.resistance directly: the wall faces' planes, the chain shift, the dipoles held at 0)."""
+    x = np.array([[0.8e-3, 0.8e-3, 0.8e-3]])
+    res, k_w, bonds = _corner(x, _three_walls(), temperature=[1.0], fixed=[True])
+    assert res.fixed_flow[0] == pytest.approx(k_w.sum(), rel=1e-12)
+    res, _, _ = _corner(x, _three_walls((1.0, 0.0, 0.0)), temperature=[0.5])
+    normals, arms = -np.eye(3), bonds.wall_l / 1e-3
+    R = te.resistance(normals, arms, neck_frames(normals))
+    R[::3, ::3][np.diag_indices(3)] += te.chain_shift(np.sqrt(1 - arms ** 2))
+    Y = np.linalg.inv(R / 1e-3)
+    row = Y[:, ::3].sum(axis=1)
+    Y0 = (Y - np.outer(row, row) / row[::3].sum())[::3, ::3]
+    assert -res.wall_flow == pytest.approx(Y0 @ np.array([1.0, 0.0, 0.0]), rel=1e-9, abs=1e-15)
+    assert Y[::3, ::3].sum() > 1.1 * k_w.sum()  # e^T Y e, the bordered centre's: the path the test tells apart
+
+
+def test_a_source_leaves_through_the_laws_halves():
+    """A free particle with a 1 mW source in a corner of three walls at 0, at three distances from them (unequal
+    halves): its centre rises by Q / sum K and each wall takes Q K_b / sum K."""
+    x = np.array([[0.8e-3, 0.75e-3, 0.7e-3]])
+    res, k_w, _ = _corner(x, _three_walls(), temperature=[0.0], heat=[1e-3])
+    assert np.ptp(k_w) > 0.2 * k_w.mean()
+    assert res.T[0] == pytest.approx(1e-3 / k_w.sum(), rel=1e-12)
+    assert res.wall_flow == pytest.approx(1e-3 * k_w / k_w.sum(), rel=1e-12)
+
+
+def test_a_free_periodic_network_does_not_see_the_centres_path(monkeypatch):
+    """A periodic BCC cell (free particles, no source): k_eff with the centre joined by the law's halves equals k_eff
+    with the centre of R^-1 bordered by its sums to round-off (eliminating a free centre leaves Y_0 either way)."""
+    from fem_neck.lattice import lattice_cell
+    from verification.lattices import dem_periodic
+    from dem.network.necks import bordered
+
+    cell = lattice_cell("bcc", 0.2, neck="union")
+    joined = dem_periodic(cell, "shared-body", neck="union", nodes="necks", elements=te.trefftz_elements)
+    monkeypatch.setattr(te, "_joined", lambda Y, halves: bordered(Y, 3))
+    assert joined == pytest.approx(dem_periodic(cell, "shared-body", neck="union", nodes="necks",
+                                                elements=te.trefftz_elements), rel=1e-12)
 
 
 def test_the_neck_node_bound_study_has_the_trefftz_column_without_ngsolve(tmp_path, monkeypatch):

@@ -28,13 +28,55 @@ same radius, where the union law's half :math:`1 / (\pi K/K_{cyl})` is the exact
 single-particle problems only. A particle whose shifted ``R`` is not positive definite keeps the law's element on its
 monopoles (:func:`dem.laws.shared_body.particle_elements`) and its unshifted dipole block, marked ``plain``.
 
-Walls are refused: a wall's neck is an isothermal face, whose modes this element does not have.
+**The quadrature's check.** The rule of degree ``L`` is not enough for every cut body: where faces meet at small
+angles or a cap is cut into slivers, the high harmonics are integrated badly and ``R`` can come out wrong by percents
+(a monopole's diagonal even above the exact one, which a Ritz ``R`` never is). Two identities of harmonic functions
+tell it from the same points at no extra cost: Green's identity makes the harmonics' block of the stiffness
+symmetric, :math:`\oint \phi_a \partial_n \phi_b = \oint \phi_b \partial_n \phi_a`, and each harmonic's flux
+vanishes, :math:`\oint \partial_n \phi_a = 0`. Measured on the solution (``C`` the Ritz coefficients of the ``3 z``
+modes, ``h`` the harmonics' rows), the defect is the larger of the skew part's energy
+:math:`|C_h^T (K - K^T)_{hh} C_h|_{bc} / \sqrt{R_{bb} R_{cc}}` and the modes' fluxes :math:`|\oint \partial_n
+u_b|` (of their unit heat). A particle whose defect exceeds :data:`DEFECT` is computed again with the rule's counts
+times 1.5, then 2 (:data:`REFINE`); one that still fails keeps the law's element like a particle whose ``R`` is not
+positive definite. On the 296 particles of the 39 union cells at ``L`` 10 the defect tracks the change of the
+monopole diagonals under a doubled rule: the 18 particles above 2e-3 (three distinct ones of the random packings,
+3e-3 to 2e-2) move by 0.5 to 1.7 %, every other one by at most 0.11 % (its defect at most 8e-4; the lattices'
+particles' at most 2e-4), and 1.5 times the rule brings all 18 below the threshold (and within 0.011 % of the doubled
+rule's diagonals). A refined particle keeps the degree's own shift: the chain particle's half moves by at most 3e-4 of
+itself between the rules (at a/r 0.9; below 1e-7 up to a/r 0.7). The volume
+(:math:`\oint x \cdot n = 3 V` against :func:`fem_neck.geometry.union.cut_spheres`) is within 6e-8 on all of them,
+so it tells nothing at this degree and is not computed.
+
+**The centre.** :math:`Y = R^{-1}` (units :math:`\kappa r`) carries the heat that passes through the particle; its
+centre would be the body's mean temperature with a uniform sink (:func:`dem.network.necks.bordered`). The element
+keeps that through-flow, :math:`Y_0 = Y - Y e e^T Y / (e^T Y e)` (``e`` 1 on the monopoles: the Schur complement on
+the modes of ``Y`` bordered by its sums), and joins the centre to the monopoles by the law's halves :math:`K_b` (the
+half conductances the law's element takes from its centre, :func:`dem.laws.shared_body.particle_elements`), the
+dipoles not touching it:
+
+.. math::
+
+    E = \begin{pmatrix} Y_0 + k k^T / \textstyle\sum K & -k \\ -k^T & \sum K \end{pmatrix},
+    \qquad k = K \text{ on the monopoles, } 0 \text{ on the dipoles}.
+
+Eliminating a free centre without a source leaves :math:`Y_0` either way, so a network of free particles is the same;
+the path matters where the centre's net flow is not zero (a particle held at a temperature, a source, its heat
+capacity). It is the law's because the law's evidence is that: a held particle whose centre fed its necks through
+:math:`R^{-1} \mathbf 1` conducted 4-8 % too little on finite clusters held by layers of fixed particles, where the
+halves' path sat within 1.2 % of exact elements (:func:`dem.laws.shared_body.particle_elements`).
+
+A wall bond's face is a plane cut like a neck's: normal into the wall, arm ``wall_l / r``, dipoles along
+:func:`dem.network.necks.neck_frames` of that normal; the network sets its three modes (the monopole at the wall's
+temperature, the dipoles' moments 0: the wall is isothermal, :mod:`dem.network.necks`). Its monopole takes the same
+chain shift: a particle between two walls at its necks' planes is the chain particle, since the neck plane of a
+symmetric pair is isothermal by symmetry.
 """
 
 from __future__ import annotations
 
 import functools
 import math
+from collections import namedtuple
 
 import numba
 import numpy as np
@@ -51,15 +93,19 @@ DEGREE = 10  #: the harmonics' largest degree L, within 1 % of the union's FE on
 BETA = 0.25  # the flux profile's exponent, w = (a^2 - rho^2)^-BETA
 CHAIN_GRID = (0.04, 0.995, 0.005)  # a/r of the chain's shift table: first, last, step (outside it: solved directly)
 TWO_PI = 2.0 * np.pi
+DEFECT = 2e-3  #: the quadrature's largest defect (module docstring, "The quadrature's check")
+REFINE = (1.0, 1.5, 2.0)  #: the rule's factors tried in turn where the defect is larger
 
 
-def rule(L: int) -> tuple:
+def rule(L: int, refine: float = 1.0) -> tuple:
     """The quadrature for a degree (module docstring).
 
     Parameters
     ----------
     L : int
         The harmonics' largest degree.
+    refine : float
+        Each count times this, rounded up (1: the degree's own rule).
 
     Returns
     -------
@@ -67,7 +113,7 @@ def rule(L: int) -> tuple:
         ``(n_rho, n_psi, n_theta, n_phi)``: the radii and angles per face panel, the rings per cap panel and the
         points per full ring.
     """
-    return L + 2, L + 4, L + 4, 2 * L + 6
+    return tuple(math.ceil(refine * c) for c in (L + 2, L + 4, L + 4, 2 * L + 6))
 
 
 @functools.lru_cache(maxsize=None)
@@ -464,9 +510,9 @@ def harmonics(P: np.ndarray, L: int, nrm=None):
     return V, DN
 
 
-def quadrature(normals: np.ndarray, arms: np.ndarray, L: int):
+def quadrature(normals: np.ndarray, arms: np.ndarray, L: int, refine: float = 1.0):
     """The boundary quadrature of the unit sphere cut by ``normals . x <= arms`` (module docstring), rule of
-    :func:`rule` ``(L)``.
+    :func:`rule` ``(L, refine)``.
 
     Parameters
     ----------
@@ -476,6 +522,8 @@ def quadrature(normals: np.ndarray, arms: np.ndarray, L: int):
         (z,) the planes' distances from the centre, in units of the radius, in (-1, 1).
     L : int
         The degree whose rule is used.
+    refine : float
+        The rule's counts times this (:func:`rule`).
 
     Returns
     -------
@@ -486,7 +534,7 @@ def quadrature(normals: np.ndarray, arms: np.ndarray, L: int):
     """
     normals = np.ascontiguousarray(normals, dtype=float)
     arms = np.ascontiguousarray(arms, dtype=float)
-    n_rho, n_psi, n_theta, n_phi = rule(L)
+    n_rho, n_psi, n_theta, n_phi = rule(L, refine)
     m = len(arms)
     T, Wt = _gauss_table(n_phi + 8)
     capmax = sum((4 + 2 * j + j * j) * n_theta * (n_phi + 6 * (j + 1)) for j in range(m))
@@ -504,7 +552,7 @@ def quadrature(normals: np.ndarray, arms: np.ndarray, L: int):
     return {"caps": (Pc[:nc], Wc[:nc]), "faces": (Pf[:nf], Wf[:nf], wf[:nf]), "offsets": offsets}
 
 
-def resistance(normals: np.ndarray, arms: np.ndarray, frames: np.ndarray, L: int = DEGREE):
+def resistance(normals: np.ndarray, arms: np.ndarray, frames: np.ndarray, L: int = DEGREE, refine: float = 1.0):
     r"""The Ritz resistance of the unit sphere (:math:`\kappa = r = 1`) cut by the planes :math:`n_b \cdot x \le d_b`
     over three flux modes per plane (module docstring; no shift).
 
@@ -518,6 +566,8 @@ def resistance(normals: np.ndarray, arms: np.ndarray, frames: np.ndarray, L: int
         (z, 2, 3) each neck's dipole directions (:func:`dem.network.necks.neck_frames`).
     L : int
         The harmonics' largest degree, >= 2.
+    refine : float
+        The quadrature's counts times this (:func:`rule`).
 
     Returns
     -------
@@ -525,12 +575,18 @@ def resistance(normals: np.ndarray, arms: np.ndarray, frames: np.ndarray, L: int
         ``R`` (3 z, 3 z), mode ``3 b + d`` (``d = 0`` the monopole), units :math:`1/(\kappa r)`; None if a plane
         leaves no face (its neck lies in another's cap).
     """
+    return _ritz(normals, arms, frames, L, refine)[0]
+
+
+def _ritz(normals, arms, frames, L, refine):
+    """:func:`resistance` and its quadrature's defect (module docstring, "The quadrature's check"): ``(R, defect)``,
+    ``(None, inf)`` where a plane leaves no face."""
     normals = np.ascontiguousarray(normals, dtype=float)
-    quad = quadrature(normals, arms, L)
+    quad = quadrature(normals, arms, L, refine)
     (Pc, Wc), (Pf, Wf, wf), fs = quad["caps"], quad["faces"], quad["offsets"]
     z = len(arms)
     if np.any(fs[1:] == fs[:-1]):
-        return None
+        return None, np.inf
     normal_f = np.repeat(normals, np.diff(fs), axis=0)
     Vc, _ = harmonics(Pc, L)
     Vf, DNf = harmonics(Pf, L, normal_f)
@@ -545,6 +601,9 @@ def resistance(normals: np.ndarray, arms: np.ndarray, frames: np.ndarray, L: int
     # |x|^2 against itself: int |grad|x|^2|^2 = 4 int |x|^2 = 4/5 int |x|^2 x.n over the boundary
     K[-1, -1] = 16 * np.pi / 5 + 4.0 / 5.0 * (np.sum(Wf * Vf[:, -1] * xn) - np.sum(Wc * Vc[:, -1]))
     K[:-1, -1] = K[-1, :-1]
+    h = len(deg) - 1  # the harmonics: Green's identity makes their block of K symmetric and their fluxes 0
+    skew = K[:h, :h] - K[:h, :h].T
+    flux = Wf @ DNf[:, :h] - deg[:h] * (Wc @ Vc[:, :h])
     K = 0.5 * (K + K.T)
     # the sink: the basis' mean over the body, int phi = int phi x.n / (deg + 3) (phi homogeneous of degree deg)
     vol_b = ((Vf * (Wf * xn)[:, None]).sum(0) - (Vc * Wc[:, None]).sum(0)) / (deg + 3)
@@ -564,8 +623,11 @@ def resistance(normals: np.ndarray, arms: np.ndarray, frames: np.ndarray, L: int
             S[:, 1 + k] = (xi - (ww * xi).sum() / total) / a
         B[:, 3 * b:3 * b + 3] = Vf[sl].T @ (S * (ww / total)[:, None])
         B[:, 3 * b] -= vol_b / volume
-    R = B.T @ np.linalg.solve(K, B)
-    return 0.5 * (R + R.T)
+    C = np.linalg.solve(K, B)
+    R = B.T @ C
+    root = np.sqrt(np.abs(np.diag(R)))
+    defect = max((np.abs(C[:h].T @ skew @ C[:h]) / np.outer(root, root)).max(), np.abs(flux @ C[:h]).max())
+    return 0.5 * (R + R.T), defect
 
 
 def law_half(a_over_r):
@@ -656,7 +718,7 @@ def _positive_definite(R: np.ndarray) -> bool:
 
 def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray,
                      k_j: np.ndarray, k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray,
-                     volume=None, L: int = DEGREE, where=None) -> ParticleElements:
+                     volume=None, L: int = DEGREE, where=None) -> TrefftzElements:
     r"""The particles' Trefftz elements with three flux modes per neck (module docstring), the ``elements`` hook of
     :func:`dem.network.necks.neck_network` (the arguments of :func:`dem.laws.shared_body.particle_elements`, whose
     ends it keeps: the faces of each particle's cut body), on every particle or on those of ``where``; the others
@@ -671,17 +733,19 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
     radius : numpy.ndarray
         Particle radii, m.
     bonds : Bonds
-        The pair bonds (all live), with their centre-to-contact distances ``l_i``, ``l_j`` (m); no wall bonds.
+        The pair and wall bonds (all live), with their centre-to-contact distances ``l_i``, ``l_j`` and ``wall_l``
+        (m).
     vectors : numpy.ndarray
         ``x_j - x_i`` of every pair bond (m, 3), m.
     k_i, k_j : numpy.ndarray
-        Half conductances of every pair bond on the side of ``i`` and of ``j``, W/K (the fallback's).
+        Half conductances of every pair bond on the side of ``i`` and of ``j``, W/K: the centre's path to the
+        monopoles (module docstring, "The centre"), and the fallback's.
     k_wall : numpy.ndarray
-        Half conductance of every wall bond, W/K (none allowed).
+        Half conductance of every wall bond, W/K (as ``k_i``).
     conductivity : numpy.ndarray
         Per particle, its material's conductivity, W/(m K).
     wall_normals : numpy.ndarray
-        Unit normal of every wall bond's wall (none allowed).
+        Unit normal of every wall bond's wall, pointing into the packing.
     volume : numpy.ndarray, optional
         Per particle, the solid it holds, m^3 (the fallback's trace cap).
     L : int
@@ -691,25 +755,28 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
 
     Returns
     -------
-    ParticleElements
+    TrefftzElements
         ``modes`` 3 (with ``where``: per particle, 3 on the Trefftz particles and 1 on the others); ``plain`` marks
-        the Trefftz particles that kept the law's monopole element (their shifted ``R`` not positive definite) and
-        the others whose interactions the law dropped; ``shrink`` is 1 on the Trefftz particles (no trace cap) and
-        the law's trace cap on the others.
+        the Trefftz particles that kept the law's monopole element (their shifted ``R`` not positive definite, or
+        their quadrature failing its check at the finest rule) and the others whose interactions the law dropped;
+        ``shrink`` is 1 on the Trefftz particles (no trace cap) and the law's trace cap on the others; ``refine``
+        the rule's factor per particle (``refine > 1``: refined by the check; 1 on the law's particles).
     """
     if not 6 <= L <= 16:
         raise ValueError(f"L = {L}: the Trefftz element's degree must be in 6..16")
     chosen = np.ones(n, dtype=bool) if where is None else np.asarray(where)
     if chosen.dtype != bool or chosen.shape != (n,):
         raise ValueError(f"where: {chosen.dtype} of shape {chosen.shape}: must be a bool mask of the {n} particles")
-    if bonds.n_walls:
-        raise ValueError("the Trefftz element: walls are not supported (a wall's neck is isothermal), periodic or "
-                         "free packings only")
     law = particle_elements(n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume)
-    m = len(bonds.i)
     unit = vectors / np.linalg.norm(vectors, axis=1)[:, None]
+    into_wall = -np.reshape(np.asarray(wall_normals, dtype=float), (-1, 3))
     frames = neck_frames(vectors)
+    cut = CutBodies(law, np.concatenate([unit, -unit, into_wall]),
+                    np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l]),
+                    np.concatenate([frames, frames, neck_frames(into_wall)]), np.concatenate([k_i, k_j, k_wall]),
+                    radius, conductivity, L)
     plain = np.zeros(n, dtype=bool)
+    refine = np.ones(n)
     blocks, start = [], [0]
     with one_blas_thread():
         for k in range(n):
@@ -718,34 +785,11 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
                 blocks.append(law.values[law.start[k]:law.start[k + 1]])
                 start.append(start[-1] + len(blocks[-1]))
                 continue
-            ends = law.ends[law.offsets[k]:law.offsets[k + 1]]
-            z = len(ends)
-            if not z:
-                blocks.append(np.zeros(1))
-                start.append(start[-1] + 1)
-                continue
-            on_i = ends < m
-            b = np.where(on_i, ends, ends - m)
-            normals = np.where(on_i[:, None], unit[b], -unit[b])
-            arms = np.where(on_i, bonds.l_i[b], bonds.l_j[b]) / radius[k]
-            R = resistance(normals, arms, frames[b], L)
-            if R is None:
-                raise ValueError(f"the Trefftz element: particle {k} has a neck with no face (inside another's cap)")
-            shifted = R.copy()
-            shifted[::3, ::3][np.diag_indices(z)] += chain_shift(np.sqrt(1 - arms ** 2), L)
-            scale = conductivity[k] * radius[k]
-            if _positive_definite(shifted):
-                Y = np.linalg.inv(shifted / scale)
-            else:  # the law's element on the monopoles, the unshifted dipoles beside them
-                plain[k] = True
-                E = law.values[law.start[k]:law.start[k + 1]].reshape(z + 1, z + 1)
-                Y = np.zeros((3 * z, 3 * z))
-                Y[::3, ::3] = E[:z, :z]
-                dip = np.flatnonzero(np.arange(3 * z) % 3)
-                Y[np.ix_(dip, dip)] = np.linalg.inv(R[np.ix_(dip, dip)] / scale)
-            blocks.append(bordered(0.5 * (Y + Y.T), 3).ravel())
+            E, plain[k], refine[k] = particle_element(k, cut)
+            blocks.append(E.ravel())
             start.append(start[-1] + len(blocks[-1]))
     if where is None:
-        return ParticleElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain, np.ones(n), 3)
-    return ParticleElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain,
-                            np.where(chosen, 1.0, law.shrink), np.where(chosen, 3, 1))
+        return TrefftzElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain, np.ones(n), 3,
+                               refine)
+    return TrefftzElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain,
+                           np.where(chosen, 1.0, law.shrink), np.where(chosen, 3, 1), refine)
