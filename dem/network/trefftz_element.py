@@ -793,3 +793,75 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
                                refine)
     return TrefftzElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain,
                            np.where(chosen, 1.0, law.shrink), np.where(chosen, 3, 1), refine)
+
+
+TrefftzElements = namedtuple("TrefftzElements", ParticleElements._fields + ("refine",))
+TrefftzElements.__doc__ = """:class:`~dem.laws.shared_body.ParticleElements` with ``modes`` 3 and, per particle,
+``refine``: the factor of the quadrature's rule its element was computed with (1: the degree's own; above 1: refined
+by the quadrature's check, module docstring)."""
+
+
+CutBodies = namedtuple("CutBodies", ["law", "normals", "arms", "frames", "halves", "radius", "conductivity", "L"])
+CutBodies.__doc__ = """What :func:`particle_element` reads of a packing (the arguments of :func:`trefftz_elements`):
+``law`` the law's elements (:func:`dem.laws.shared_body.particle_elements`: each particle's ends and the fallback);
+per bond end (pair bonds on ``i``, on ``j``, then the wall bonds) the unit normal of its plane out of its particle
+(into the wall for a wall's), the plane's distance from the particle's centre (m) and the neck's dipole frame
+(:func:`dem.network.necks.neck_frames` of the bond's vector from ``i`` to ``j``, of the normal into a wall) and
+the law's half conductance from the centre to the neck (W/K); ``radius`` (m) and ``conductivity`` (W/(m K)) per
+particle, ``L`` the harmonics' largest degree."""
+
+
+def particle_element(k: int, cut: CutBodies) -> tuple:
+    """Particle ``k``'s Trefftz element (module docstring) over its ends' three flux modes and its centre.
+
+    Parameters
+    ----------
+    k : int
+        The particle.
+    cut : CutBodies
+        The packing's planes and halves per bond end, the law's elements and the degree.
+
+    Returns
+    -------
+    tuple
+        ``(E, plain, refine)``: the element, W/K, ``(3 z + 1, 3 z + 1)`` (local nodes: mode ``d`` of end ``p`` at
+        ``3 p + d``, then the centre; a particle without necks: ``(1, 1)``, zero), whether it kept the law's element
+        on its monopoles (its shifted ``R`` not positive definite, or its quadrature failing the check at the finest
+        rule), and the factor of the rule it was computed with (:data:`REFINE`).
+    """
+    law, L = cut.law, cut.L
+    ends = law.ends[law.offsets[k]:law.offsets[k + 1]]
+    z = len(ends)
+    if not z:
+        return np.zeros((1, 1)), False, 1.0
+    arms = cut.arms[ends] / cut.radius[k]
+    for refine in REFINE:  # the quadrature's check (module docstring)
+        R, defect = _ritz(cut.normals[ends], arms, cut.frames[ends], L, refine)
+        if R is None:
+            raise ValueError(f"the Trefftz element: particle {k} has a neck with no face (inside another's cap)")
+        if defect <= DEFECT:
+            break
+    shifted = R.copy()
+    shifted[::3, ::3][np.diag_indices(z)] += chain_shift(np.sqrt(1 - arms ** 2), L)
+    scale = cut.conductivity[k] * cut.radius[k]
+    if defect <= DEFECT and _positive_definite(shifted):
+        Y = np.linalg.inv(shifted / scale)
+        return _joined(0.5 * (Y + Y.T), cut.halves[ends]), False, refine
+    # the law's element on the monopoles (its own centre path), the unshifted dipoles beside them
+    E = law.values[law.start[k]:law.start[k + 1]].reshape(z + 1, z + 1)
+    Y = np.zeros((3 * z, 3 * z))
+    Y[::3, ::3] = E[:z, :z]
+    dip = np.flatnonzero(np.arange(3 * z) % 3)
+    Y[np.ix_(dip, dip)] = np.linalg.inv(R[np.ix_(dip, dip)] / scale)
+    return bordered(0.5 * (Y + Y.T), 3), True, refine
+
+
+def _joined(Y: np.ndarray, halves: np.ndarray) -> np.ndarray:
+    r"""The element of a particle from its conductance ``Y`` over the modes (W/K) and its necks' halves ``K`` (W/K):
+    :math:`Y_0 + k k^T / \sum K` bordered by :math:`-k` and :math:`\sum K` (module docstring, "The centre"), ``k``
+    the halves on the monopoles and 0 on the dipoles, :math:`Y_0` the Schur complement on the modes of
+    :func:`dem.network.necks.bordered` ``(Y, 3)``."""
+    row = Y[:, ::3].sum(axis=1)
+    k = np.zeros(len(Y))
+    k[::3] = halves
+    return bordered(Y - np.outer(row, row) / row[::3].sum() + np.outer(k, k) / k.sum(), 3)
