@@ -1,0 +1,85 @@
+"""The particles' elements a scene asks for in the network with a node per neck (``[conductance] element``,
+:class:`dem.laws.conductance.ConductanceSpec`), and what building them took, for the run's summary.
+
+``element = "law"`` gives each particle the ``shared-body`` law's element (:func:`dem.laws.shared_body.
+particle_elements`, one flux mode per neck); ``element = "trefftz"`` the Trefftz element of its cut sphere with three
+flux modes per neck (:func:`dem.network.trefftz_element.trefftz_elements`), which keeps the law's element on its
+monopoles where its own is not positive definite (``plain``). Either is the ``elements`` hook of
+:func:`dem.network.necks.neck_network`; :func:`scene_elements` is the one place that calls it.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from dem.laws.conductance import ConductanceSpec
+
+
+class SceneElements:
+    """The ``elements`` hook of :func:`dem.network.necks.neck_network` for ``[conductance] element`` (module
+    docstring), keeping what it built.
+
+    Parameters
+    ----------
+    element : str
+        ``"law"`` or ``"trefftz"`` (``dem.laws.conductance.ELEMENTS``).
+
+    Attributes
+    ----------
+    built : dem.laws.shared_body.ParticleElements or None
+        The elements of the last call; None before it.
+    seconds : float
+        The CPU time of the last call (this process's, on one core: the elements are built on one thread), s.
+    """
+
+    def __init__(self, element: str):
+        self.element = element
+        self.built = None
+        self.seconds = 0.0
+
+    def __call__(self, *args, **kwargs):
+        """The particles' elements from the arguments of :func:`dem.laws.shared_body.particle_elements`."""
+        if self.element == "trefftz":
+            from dem.network.trefftz_element import trefftz_elements as build
+        else:
+            from dem.laws.shared_body import particle_elements as build
+        start = time.process_time()
+        self.built = build(*args, **kwargs)
+        self.seconds = time.process_time() - start
+        return self.built
+
+    def account(self) -> dict:
+        """The summary's entries: ``element`` (its name) and, for ``"trefftz"``, ``element_particles`` (the
+        particles with necks that carry it), ``element_plain`` (those that kept the law's element on their
+        monopoles) and ``element_seconds`` (the CPU time of building them, s).
+
+        Returns
+        -------
+        dict
+            The entries.
+        """
+        if self.element == "law" or self.built is None:
+            return {"element": self.element}
+        el = self.built
+        with_necks = np.diff(el.offsets) > 0
+        plain = np.asarray(el.plain, dtype=bool)
+        return {"element": self.element, "element_particles": int(np.count_nonzero(with_necks & ~plain)),
+                "element_plain": int(np.count_nonzero(with_necks & plain)), "element_seconds": self.seconds}
+
+
+def scene_elements(spec: ConductanceSpec) -> SceneElements:
+    """The ``elements`` hook of :func:`dem.network.necks.neck_network` that ``spec.element`` names (module docstring).
+
+    Parameters
+    ----------
+    spec : dem.laws.conductance.ConductanceSpec
+        The conductance law, its neck reading, nodes and element.
+
+    Returns
+    -------
+    SceneElements
+        The hook, which keeps what it built.
+    """
+    return SceneElements(spec.element)
