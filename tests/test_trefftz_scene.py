@@ -1,13 +1,13 @@
 """``[conductance] element = "trefftz"``: the Trefftz element of each cut sphere as a scene option
 (dem.network.elements): its refusals, a static run equal to neck_network with trefftz_elements, the summary's account
-of the element and of its FE evidence (dem.laws.verified_range)."""
+of the element and of its FE evidence (dem.laws.verified_range), and the up-front estimate of its time (dem.memory)."""
 
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from dem import make_scene, run
+from dem import make_scene, memory, run
 from dem.geometry.bonds import find_bonds
 from dem.geometry.periodic import PeriodicBox
 from dem.geometry.walls import Wall
@@ -114,8 +114,49 @@ def test_the_evidence_of_the_element_holds_where_necks_meet_and_the_laws_does_no
         [-0.006, 0.006]
 
 
+def test_the_estimate_is_the_sum_of_the_necks_squares_said_only_where_large():
+    c = memory.TREFFTZ_SECONDS_PER_NECK_SQUARED
+    assert memory.element_seconds([4, 6, 0]) == pytest.approx(c * (16 + 36), rel=1e-15)
+    assert memory.element_estimate([6] * 100) is None  # 100 particles of 6 necks: about 1.8 s
+    n = int(np.ceil(memory.ANNOUNCE_SECONDS / (c * 144)))
+    line = memory.element_estimate([12] * n)
+    assert line == (f"the Trefftz elements of {n} particles (12 necks each on average): about "
+                    f"{c * 144 * n:.3g} s on one core, before the solve")
+
+
+def test_the_engine_announces_the_estimate_from_its_bonds_before_building(monkeypatch):
+    """With a large figure per neck the engine says, while it is built, what the elements of its particles' bonds
+    will take: the sum of their necks' squares (the pair bonds), before the elements exist; nothing without a
+    listener, nothing for a small estimate."""
+    from dem.engines.static import StaticEngine
+
+    scene = _packing()
+    heard = []
+    with memory.announcing(heard.append):
+        engine = StaticEngine(scene)
+    assert heard == []  # 8 particles: far below ANNOUNCE_SECONDS
+    monkeypatch.setattr(memory, "TREFFTZ_SECONDS_PER_NECK_SQUARED", 10.0)
+    built = []
+    with memory.announcing(lambda line: heard.append((line, len(built)))):
+        monkeypatch.setattr(te, "trefftz_elements", _recording(te.trefftz_elements, built))
+        StaticEngine(scene)
+    b = engine.bonds
+    z = np.bincount(np.concatenate([b.i, b.j]), minlength=scene.particles.n)
+    assert heard == [(f"the Trefftz elements of 8 particles ({z.mean():.3g} necks each on average): about "
+                      f"{10.0 * np.sum(z * z):.3g} s on one core, before the solve", 0)]
+    assert len(built) == 1
+
+
 def _recording(build, built: list):
     def recorded(*args, **kwargs):
         built.append(build(*args, **kwargs))
         return built[-1]
     return recorded
+
+
+def test_the_cli_run_says_the_estimate_on_stderr_where_it_reports_its_progress(monkeypatch, capsys):
+    monkeypatch.setattr(memory, "TREFFTZ_SECONDS_PER_NECK_SQUARED", 10.0)
+    run(_packing(), progress=True)
+    assert "python -m dem run: the Trefftz elements of 8 particles (6.25 necks each" in capsys.readouterr().err
+    run(_packing())
+    assert "Trefftz" not in capsys.readouterr().err
