@@ -80,7 +80,7 @@ def test_walls_moving_particles_and_mpi_are_refused_with_the_reason():
 def test_a_static_run_is_the_neck_network_of_trefftz_elements_and_says_so(seed):
     """The run's k_eff is neck_network(elements=trefftz_elements)'s, solved here directly; it is not the law's
     element's; the summary names the element, counts the particles that carry it and those that kept the law's
-    monopoles (seed 3: one, as the elements built directly say), and the evidence is the element's: +-0.6 % where
+    monopoles (seed 3: one, as the elements built directly say), and the evidence is the element's: +-0.7 % where
     necks meet, where the law's element is outside its verified range."""
     scene = _packing(seed)
     s = run(scene).summary
@@ -97,7 +97,7 @@ def test_a_static_run_is_the_neck_network_of_trefftz_elements_and_says_so(seed):
     plain = int(np.count_nonzero(built[0].plain))
     assert (s["element"], s["element_particles"], s["element_plain"]) == ("trefftz", p.n - plain, plain)
     assert plain == {1: 0, 3: 1}[seed] and s["element_seconds"] > 0.0
-    assert s["law_in_verified_range"] is True and s["law_error_range"] == [-0.006, 0.006] and "warnings" not in s
+    assert s["law_in_verified_range"] is True and s["law_error_range"] == [-0.007, 0.007] and "warnings" not in s
     assert "particles_without_interactions" not in s and law["element"] == "law"
     assert "element_particles" not in law and law["law_in_verified_range"] is False
 
@@ -107,11 +107,11 @@ def test_the_evidence_of_the_element_holds_where_necks_meet_and_the_laws_does_no
 
     element = neck_account(3, 10, "union", 40, "shared-body", wide=2, nodes="necks", element="trefftz")
     law = neck_account(3, 10, "union", 40, "shared-body", wide=2, nodes="necks")
-    assert element["law_in_verified_range"] is True and element["law_error_range"] == [-0.006, 0.006]
+    assert element["law_in_verified_range"] is True and element["law_error_range"] == [-0.007, 0.007]
     assert "warnings" not in element and element["particles_necks_wide"] == 2
     assert law["law_in_verified_range"] is False and len(law["warnings"]) == 2
     assert neck_account(0, 10, "union", 40, "shared-body", nodes="necks", element="trefftz")["law_error_range"] == \
-        [-0.006, 0.006]
+        [-0.007, 0.007]
 
 
 def test_the_estimate_is_the_sum_of_the_necks_squares_said_only_where_large():
