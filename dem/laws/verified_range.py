@@ -38,10 +38,10 @@ at ``h / r`` 0.25 and 0.28 (``a / r`` 0.48 and 0.51), and +1.3 % on a random pac
 ``"shared-body (neck nodes, trefftz element)"``. On the 39 union cells of the ``densification`` and ``closing-pores``
 studies (SC ``h / r`` 0.05-0.65, BCC 0.05-0.38, FCC 0.05-0.33, seven random mirror packings at ``phi`` 0.6-0.95) it
 is within -0.49 % to +0.56 % of the FE's upper bound, necks apart or meeting, where the law's neck-node network is
--4.05 % to +1.81 %: its interval, those extremes widened by the FE's tolerance as the laws' are (-0.69 % to +0.66 %,
-+-0.7 %), holds at every neck width and where necks meet. A range whose interval
-lies within +-1 % is a verified one (:data:`VERIFIED`): such a run stays in its verified range where necks meet, and
-its ``law_error_range`` is its own interval.
+-4.05 % to +1.81 %: its interval, those extremes widened by the FE's tolerance as the laws' are (-0.69 % to
++0.66 %: +-0.7 %), holds at every neck width and where necks meet. A range whose interval lies within +-1 % is a
+verified one (:data:`VERIFIED`): such a run stays in its verified range where necks meet, and its
+``law_error_range`` is its own interval.
 """
 
 from __future__ import annotations
