@@ -160,3 +160,17 @@ def test_the_cli_run_says_the_estimate_on_stderr_where_it_reports_its_progress(m
     assert "python -m dem run: the Trefftz elements of 8 particles (6.25 necks each" in capsys.readouterr().err
     run(_packing())
     assert "Trefftz" not in capsys.readouterr().err
+
+
+def test_a_transient_run_on_trefftz_elements_keeps_its_heat_and_ends_at_the_steady_solve():
+    """Implicit steps on the three-mode network (the dipoles' nodes massless, as the necks'): the heat stored is the
+    heat that came in (none: a periodic box) to round-off, and after many time constants the temperatures are the
+    steady solve's (floating groups at their capacity-weighted mean)."""
+    scene = _packing(1)
+    T0 = np.random.default_rng(2).uniform(0.0, 1.0, scene.particles.n)
+    start = replace(scene, particles=replace(scene.particles, temperature=T0))
+    transient = replace(start, solver=replace(start.solver, mode="transient", integrator="implicit", dt=1e-2,
+                                              t_end=2.0))
+    moved = run(transient)
+    assert moved.summary["element"] == "trefftz" and abs(moved.summary["energy_error"]) < 1e-12
+    assert np.abs(moved.T - run(start).T).max() < 1e-9
