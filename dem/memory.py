@@ -22,8 +22,8 @@ necks meet, three thermal steps with nine in ten particles on the way: the eleme
 per particle at 500, 2048, 6050 and 16384 particles (1007 MiB at 16384), within 1.9 %.
 
 The Trefftz element (``[conductance] element = "trefftz"``, :mod:`dem.network.trefftz_element`) costs far more time
-than the network it goes into, and its time grows with each particle's necks: the static engine estimates it from the
-bonds once they are found, before it builds the elements (:func:`element_estimate`), and says it where it is large
+than the network it goes into, and its time grows with each particle's necks and how many of them meet: it is
+estimated from the live necks just before the elements are built (:func:`element_estimate`), and said where it is large
 (:func:`announce`, heard on stderr where the driver reports the run's progress, :func:`announcing`). Nothing refuses a
 run for its time: no limit bounds a steady solve's (the transient runs' work limit counts the steps, and the elements
 are built once).
@@ -59,16 +59,14 @@ UNION_SECONDS_PER_PARTICLE = {"particles": 4.5e-4, "necks": 9.0e-4}
 #: necks' faces, bonds and solve): 2.01-2.12 ms per particle on the random sintered packing of the module docstring
 #: at 2048 to 40656 particles, 2-core machine at load 5-7
 PAIR_NECK_NODES_SECONDS_PER_PARTICLE = 2.1e-3
-#: seconds of CPU per particle of the Trefftz element (``[conductance] element = "trefftz"``,
-#: :mod:`dem.network.trefftz_element`, one BLAS thread) per square of its necks z. Its cost follows its quadrature's
-#: points, which the necks' sizes and how they cut one another set as well as their number, so z alone gives it within
-#: about a factor 2: the elements took 0.67-1.07 ms times the sum of z^2 on seven random union mirror packings of 32
-#: spheres (``verification.packings.union_packing``, phi 0.6-0.95, z 5-6, wide necks), 0.23-0.32 ms on three generated
-#: periodic union packings (``[generator] kind = "random"``, 72-256 particles, overlap 0.1-0.25, z 5.6-11.8) and 0.34
-#: ms on the FCC cell at h/r 0.1 (z 12; CPU time, 2-core machine at load 4-6); the verification guide's 9, 16, 28
-#: and 67 ms at z 4, 6, 8 and 12 are 0.43-0.54 ms. 0.5 ms is their middle: the estimate is 0.47-0.75 of the time on
-#: the mirror packings, 1.5-2.2 times it on the generated ones.
-TREFFTZ_SECONDS_PER_NECK_SQUARED = 0.5e-3
+#: seconds of CPU the Trefftz element (``[conductance] element = "trefftz"``, :mod:`dem.network.trefftz_element`, one
+#: BLAS thread) takes per neck of a particle and per pair of its necks that meet (its faces and caps cut into more
+#: panels): fitted to the elements' CPU time on fourteen periodic union packings (seven random mirror packings of 32
+#: spheres, ``verification.packings.union_packing``, phi 0.6-0.95; three generated ones, ``[generator] kind =
+#: "random"``, 72-256 particles, overlap 0.1-0.25; SC, BCC and FCC lattices at h/r 0.1-0.3 tiled to 16-32 particles;
+#: 2-core machine at load 4-5), each packing weighing alike, which it gives within -17 % to +19 % (the necks alone,
+#: 2.1 ms each, give 0.33 to 1.42 times it)
+TREFFTZ_SECONDS = {"neck": 1.63e-3, "meeting pair": 1.93e-3}
 ANNOUNCE_FROM = 1_000_000  # runs of this many particles or more say what they will take before they start
 ANNOUNCE_SECONDS = 10.0  #: so do runs whose estimated steady solve takes this long (s)
 BASE_BYTES = 0.23e9  # the interpreter, numpy, scipy and the compiled kernels (with the per-particle figure: the fit)
@@ -210,32 +208,36 @@ def estimate(n: int, neck: str = "newton", nodes: str = "particles", moving: boo
             f"{rate * n:.3g} s for it on 2 cores (a transient or moving run takes longer)")
 
 
-def element_seconds(necks) -> float:
-    """The CPU time of building the Trefftz elements of particles with ``necks`` necks each
-    (:data:`TREFFTZ_SECONDS_PER_NECK_SQUARED`).
+def element_seconds(necks, meeting) -> float:
+    """The CPU time of building the Trefftz elements of particles with ``necks`` necks each, ``meeting`` pairs of which
+    meet (:data:`TREFFTZ_SECONDS`).
 
     Parameters
     ----------
     necks : array_like of int
-        Per particle, its necks (pair bonds).
+        Per particle, its necks.
+    meeting : array_like of int
+        Per particle, the pairs of its necks that meet (:func:`dem.geometry.necks.pairs_meeting`).
 
     Returns
     -------
     float
         Seconds on one core.
     """
-    z = np.asarray(necks, dtype=float)
-    return float(TREFFTZ_SECONDS_PER_NECK_SQUARED * np.sum(z * z))
+    return float(TREFFTZ_SECONDS["neck"] * np.sum(necks) + TREFFTZ_SECONDS["meeting pair"] * np.sum(meeting))
 
 
-def element_estimate(necks) -> str | None:
-    """What building the Trefftz elements of particles with ``necks`` necks each will take (:func:`element_seconds`),
-    said before it starts where it is large (``ANNOUNCE_SECONDS`` or more); None for less.
+def element_estimate(necks, meeting) -> str | None:
+    """What building the Trefftz elements of particles with ``necks`` necks each, ``meeting`` pairs of which meet, will
+    take (:func:`element_seconds`), said before it starts where it is large (``ANNOUNCE_SECONDS`` or more); None for
+    less.
 
     Parameters
     ----------
     necks : array_like of int
-        Per particle, its necks (pair bonds).
+        Per particle, its necks.
+    meeting : array_like of int
+        Per particle, the pairs of its necks that meet.
 
     Returns
     -------
@@ -243,11 +245,11 @@ def element_estimate(necks) -> str | None:
         One line, or None.
     """
     z = np.asarray(necks)
-    seconds = element_seconds(z)
+    seconds = element_seconds(z, meeting)
     if seconds < ANNOUNCE_SECONDS:
         return None
-    return (f"the Trefftz elements of {len(z)} particles ({z.mean():.3g} necks each on average): about "
-            f"{seconds:.3g} s on one core, before the solve")
+    return (f"the Trefftz elements of {len(z)} particles ({z.mean():.3g} necks each on average, "
+            f"{int(np.sum(meeting))} pairs of necks meeting): about {seconds:.3g} s on one core, before the solve")
 
 
 _SAY = contextvars.ContextVar("say", default=None)

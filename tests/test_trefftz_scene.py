@@ -17,6 +17,7 @@ from dem.network.necks import neck_network, steady_necks
 from dem.scene.parse import parse_scene
 
 TREFFTZ = ConductanceSpec(law="shared-body", neck="union", nodes="necks", element="trefftz")
+_TREFFTZ = te.trefftz_elements
 
 
 def _packing(seed: int = 5, conductance: ConductanceSpec = TREFFTZ, **options):
@@ -114,37 +115,66 @@ def test_the_evidence_of_the_element_holds_where_necks_meet_and_the_laws_does_no
         [-0.007, 0.007]
 
 
-def test_the_estimate_is_the_sum_of_the_necks_squares_said_only_where_large():
-    c = memory.TREFFTZ_SECONDS_PER_NECK_SQUARED
-    assert memory.element_seconds([4, 6, 0]) == pytest.approx(c * (16 + 36), rel=1e-15)
-    assert memory.element_estimate([6] * 100) is None  # 100 particles of 6 necks: about 1.8 s
-    n = int(np.ceil(memory.ANNOUNCE_SECONDS / (c * 144)))
-    line = memory.element_estimate([12] * n)
-    assert line == (f"the Trefftz elements of {n} particles (12 necks each on average): about "
-                    f"{c * 144 * n:.3g} s on one core, before the solve")
+def test_the_estimate_is_per_neck_and_per_pair_of_necks_meeting_said_only_where_large():
+    a, b = memory.TREFFTZ_SECONDS["neck"], memory.TREFFTZ_SECONDS["meeting pair"]
+    assert memory.element_seconds([4, 6, 0], [0, 3, 0]) == pytest.approx(10 * a + 3 * b, rel=1e-15)
+    assert memory.element_estimate([6] * 100, [2] * 100) is None  # 100 particles: about 1.4 s
+    n = int(np.ceil(memory.ANNOUNCE_SECONDS / (12 * a + 24 * b)))
+    line = memory.element_estimate([12] * n, [24] * n)
+    assert line == (f"the Trefftz elements of {n} particles (12 necks each on average, {24 * n} pairs of necks "
+                    f"meeting): about {(12 * a + 24 * b) * n:.3g} s on one core, before the solve")
 
 
-def test_the_engine_announces_the_estimate_from_its_bonds_before_building(monkeypatch):
-    """With a large figure per neck the engine says, while it is built, what the elements of its particles' bonds
-    will take: the sum of their necks' squares (the pair bonds), before the elements exist; nothing without a
-    listener, nothing for a small estimate."""
+@pytest.mark.parametrize("kind, h, pairs", [("sc", 0.6, 36), ("fcc", 0.2, 0), ("fcc", 0.3, 24)])
+def test_the_pairs_of_necks_that_meet_are_counted_per_particle(kind, h, pairs):
+    """Union lattices, each neck seen in a cone of half-angle arctan(a / l): SC at h/r 0.6 (six face necks of 45.6
+    degrees, 90 degrees apart: 12 pairs; the twelve second neighbours, 1.98 r away, overlap too, necks of 8.1 degrees
+    45 degrees from two face necks each: 24 pairs), FCC at 0.2 (25.8 degrees, 60 apart: none) and 0.3 (31.8 degrees:
+    each neck meets its four neighbours 60 degrees away, 24 pairs); the particles whose necks meet are those with a
+    pair."""
+    from dem.geometry.necks import meeting_in, pairs_meeting
+    from dem.geometry.particles import Particles
+    from fem_neck.lattice import lattice_cell
+
+    cell = lattice_cell(kind, h, neck="union")
+    p = Particles.from_arrays(cell.centres, cell.radii, np.zeros(cell.n))
+    box = PeriodicBox(cell.period)
+    bonds = find_bonds(p, contact="union", box=box)
+    count = pairs_meeting(p.radius, bonds, bonds.vectors(p.position, box), np.zeros((0, 3)))
+    assert count.tolist() == [pairs] * cell.n
+    assert meeting_in(p, (), bonds, box).tolist() == [pairs > 0] * cell.n
+
+
+def test_the_estimate_is_said_from_the_live_necks_before_the_elements_are_built(monkeypatch):
+    """With a large figure per neck the hook says, before it builds them, what the elements of the live necks it is
+    given will take (their count and the pairs of them that meet, per particle); nothing without a listener, nothing
+    for a small estimate."""
     from dem.engines.static import StaticEngine
+    from dem.geometry.necks import pairs_meeting
 
-    scene = _packing()
+    scene = _packing(1)
     heard = []
     with memory.announcing(heard.append):
-        engine = StaticEngine(scene)
-    assert heard == []  # 8 particles: far below ANNOUNCE_SECONDS
-    monkeypatch.setattr(memory, "TREFFTZ_SECONDS_PER_NECK_SQUARED", 10.0)
-    built = []
-    with memory.announcing(lambda line: heard.append((line, len(built)))):
-        monkeypatch.setattr(te, "trefftz_elements", _recording(te.trefftz_elements, built))
         StaticEngine(scene)
-    b = engine.bonds
-    z = np.bincount(np.concatenate([b.i, b.j]), minlength=scene.particles.n)
-    assert heard == [(f"the Trefftz elements of 8 particles ({z.mean():.3g} necks each on average): about "
-                      f"{10.0 * np.sum(z * z):.3g} s on one core, before the solve", 0)]
-    assert len(built) == 1
+    assert heard == []  # 8 particles: far below ANNOUNCE_SECONDS
+    monkeypatch.setitem(memory.TREFFTZ_SECONDS, "neck", 10.0)
+    given, built = [], []
+
+    def build(*args):
+        given.append(args)
+        built.append(_TREFFTZ(*args))
+        return built[-1]
+
+    monkeypatch.setattr(te, "trefftz_elements", build)
+    with memory.announcing(lambda line: heard.append((line, len(built)))):
+        StaticEngine(scene)
+    n, radius, live, vectors = given[0][:4]
+    z = np.bincount(np.concatenate([live.i, live.j]), minlength=n)
+    m = pairs_meeting(radius, live, vectors, given[0][8])
+    seconds = 10.0 * z.sum() + memory.TREFFTZ_SECONDS["meeting pair"] * m.sum()
+    assert heard == [(f"the Trefftz elements of 8 particles ({z.mean():.3g} necks each on average, {m.sum()} pairs "
+                      f"of necks meeting): about {seconds:.3g} s on one core, before the solve", 0)]
+    assert len(built) == 1 and m.sum() > 0
 
 
 def _recording(build, built: list):
@@ -155,7 +185,7 @@ def _recording(build, built: list):
 
 
 def test_the_cli_run_says_the_estimate_on_stderr_where_it_reports_its_progress(monkeypatch, capsys):
-    monkeypatch.setattr(memory, "TREFFTZ_SECONDS_PER_NECK_SQUARED", 10.0)
+    monkeypatch.setitem(memory.TREFFTZ_SECONDS, "neck", 10.0)
     run(_packing(), progress=True)
     assert "python -m dem run: the Trefftz elements of 8 particles (6.25 necks each" in capsys.readouterr().err
     run(_packing())

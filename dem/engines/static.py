@@ -173,9 +173,6 @@ class StaticEngine(Engine):
             # are its own, the one-node law's conductances (the links' field) from the halves its elements are of
             bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, box=scene.box)
             self.elements = scene_elements(spec)
-            if spec.element == "trefftz":  # what its elements will take, from the particles' necks, said where large
-                memory.announce(memory.element_estimate(np.bincount(np.concatenate([bonds.i, bonds.j]),
-                                                                    minlength=particles.n)))
             self.necks = neck_network(spec, particles, bonds, box=scene.box, walls=walls, elements=self.elements)
             K_pairs, K_walls = bond_conductances(spec, particles, bonds, box=scene.box, walls=tuple(walls),
                                                  union=self.necks.union)

@@ -4,7 +4,8 @@
 ``element = "law"`` gives each particle the ``shared-body`` law's element (:func:`dem.laws.shared_body.
 particle_elements`, one flux mode per neck); ``element = "trefftz"`` the Trefftz element of its cut sphere with three
 flux modes per neck (:func:`dem.network.trefftz_element.trefftz_elements`), which keeps the law's element on its
-monopoles where its own is not positive definite (``plain``). Either is the ``elements`` hook of
+monopoles where its own is not positive definite (``plain``), and whose time is said before they are built where it
+is large (:func:`dem.memory.element_estimate`). Either is the ``elements`` hook of
 :func:`dem.network.necks.neck_network`; :func:`scene_elements` is the one place that calls it.
 """
 
@@ -14,7 +15,9 @@ import time
 
 import numpy as np
 
+from dem.geometry.necks import pairs_meeting
 from dem.laws.conductance import ConductanceSpec
+from dem.memory import announce, element_estimate
 
 
 class SceneElements:
@@ -39,14 +42,20 @@ class SceneElements:
         self.built = None
         self.seconds = 0.0
 
-    def __call__(self, *args, **kwargs):
-        """The particles' elements from the arguments of :func:`dem.laws.shared_body.particle_elements`."""
+    def __call__(self, n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume=None):
+        """The particles' elements from the arguments of :func:`dem.laws.shared_body.particle_elements` (the live
+        bonds among them); the Trefftz elements' time estimated from those necks first and said where it is large
+        (:func:`dem.memory.element_estimate`, :func:`dem.memory.announce`)."""
+        args = (n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume)
         if self.element == "trefftz":
             from dem.network.trefftz_element import trefftz_elements as build
+
+            necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=n)
+            announce(element_estimate(necks, pairs_meeting(radius, bonds, vectors, wall_normals)))
         else:
             from dem.laws.shared_body import particle_elements as build
         start = time.process_time()
-        self.built = build(*args, **kwargs)
+        self.built = build(*args)
         self.seconds = time.process_time() - start
         return self.built
 

@@ -247,7 +247,7 @@ class Scene:
         (a wall's neck is an isothermal face, a mode the element does not have; a current needs walls, its
         electrodes)."""
         why = ("moving particles (engine " + repr(self.engine) + ": every thermal step would rebuild every particle's "
-               "element, about 9 to 67 ms each)" if self.engine != "static" else
+               "element, about 10 to 70 ms each)" if self.engine != "static" else
                "walls (a wall's neck is an isothermal face, a mode the element does not have)" if walls else None)
         if why is not None:
             raise ValueError(f"[conductance] element = \"trefftz\": not with {why}; use element = \"law\"")
