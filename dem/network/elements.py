@@ -1,11 +1,11 @@
 """The particles' elements a scene asks for in the network with a node per neck (``[conductance] element``,
 :class:`dem.laws.conductance.ConductanceSpec`), and what building them took, for the run's summary.
 
-``element = "law"`` gives each particle the ``shared-body`` law's element (:func:`dem.laws.shared_body.
-particle_elements`, one flux mode per neck); ``element = "trefftz"`` the Trefftz element of its cut sphere with three
-flux modes per neck (:func:`dem.network.trefftz_element.trefftz_elements`), which keeps the law's element on its
-monopoles where its own is not positive definite (``plain``), and whose time is said before they are built where it
-is large (:func:`dem.memory.element_estimate`). Either is the ``elements`` hook of
+``element = "law"`` gives each particle the ``shared-body`` law's element
+(:func:`dem.laws.shared_body.particle_elements`, one flux mode per neck); ``element = "trefftz"`` the Trefftz element
+of its cut sphere with three flux modes per neck (:func:`dem.network.trefftz_element.trefftz_elements`), which keeps
+the law's element on its monopoles where its own is not positive definite (``plain``), and whose time is said before
+they are built where it is large (:func:`dem.memory.element_estimate`). Either is the ``elements`` hook of
 :func:`dem.network.necks.neck_network`; :func:`scene_elements` is the one place that calls it.
 """
 
@@ -43,9 +43,37 @@ class SceneElements:
         self.seconds = 0.0
 
     def __call__(self, n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume=None):
-        """The particles' elements from the arguments of :func:`dem.laws.shared_body.particle_elements` (the live
-        bonds among them); the Trefftz elements' time estimated from those necks first and said where it is large
-        (:func:`dem.memory.element_estimate`, :func:`dem.memory.announce`)."""
+        """The particles' elements (:func:`dem.laws.shared_body.particle_elements`'s arguments); the Trefftz elements'
+        time estimated from the necks first and said where it is large (:func:`dem.memory.element_estimate`,
+        :func:`dem.memory.announce`).
+
+        Parameters
+        ----------
+        n : int
+            Number of particles.
+        radius : numpy.ndarray
+            Particle radii, m.
+        bonds : dem.geometry.bonds.Bonds
+            The live pair and wall bonds, with their neck radii and centre-to-contact distances, m.
+        vectors : numpy.ndarray
+            ``x_j - x_i`` of every pair bond, m.
+        k_i, k_j : numpy.ndarray
+            The law's half conductances of every pair bond on the side of ``i`` and of ``j``, W/K.
+        k_wall : numpy.ndarray
+            The law's half conductance of every wall bond, W/K.
+        conductivity : numpy.ndarray
+            Per particle, its material's conductivity, W/(m K).
+        wall_normals : numpy.ndarray
+            The unit normal of every wall bond's wall, into the packing.
+        volume : numpy.ndarray or None
+            Per particle, the solid it holds, m^3, whose Wiener bound caps the trace of its tensor; None: its
+            sphere's.
+
+        Returns
+        -------
+        dem.laws.shared_body.ParticleElements
+            The elements.
+        """
         args = (n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume)
         if self.element == "trefftz":
             from dem.network.trefftz_element import trefftz_elements as build
