@@ -204,3 +204,29 @@ def test_a_transient_run_on_trefftz_elements_keeps_its_heat_and_ends_at_the_stea
     moved = run(transient)
     assert moved.summary["element"] == "trefftz" and abs(moved.summary["energy_error"]) < 1e-12
     assert np.abs(moved.T - run(start).T).max() < 1e-9
+
+
+def test_the_cli_reports_the_element_in_json_and_refuses_a_wrong_scene_with_exit_2(tmp_path, capsys):
+    """python -m dem run --json: the element's entries in the summary; the option with nodes = "particles": one line
+    naming [conductance] element, exit 2."""
+    import json
+    import tomllib
+
+    from dem.cli import main as dem_main
+
+    def write(name, doc):
+        lines = []
+        for table, values in doc.items():
+            lines.append(f"[{table}]")
+            lines += [f"{k} = {json.dumps(v)}" for k, v in values.items()]
+        (tmp_path / name).write_text("\n".join(lines) + "\n")
+        assert tomllib.loads((tmp_path / name).read_text()) == doc
+        return str(tmp_path / name)
+
+    assert dem_main(["run", write("t.toml", _toml()), "--json", "--quiet"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert s["element"] == "trefftz" and s["element_particles"] + s["element_plain"] == s["particles"]
+    assert s["element_seconds"] > 0.0 and s["law_error_range"] == [-0.007, 0.007]
+    assert dem_main(["run", write("p.toml", _toml(nodes="particles")), "--json"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and "[conductance] element = \"trefftz\": only with" in err
