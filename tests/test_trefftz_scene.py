@@ -61,14 +61,9 @@ def test_a_scene_names_the_table_and_the_key():
         parse_scene(_toml(element="none"))
 
 
-def test_walls_moving_particles_and_mpi_are_refused_with_the_reason():
+def test_moving_particles_and_mpi_are_refused_with_the_reason():
     from dem.engines.distributed.static import unsupported
 
-    wall = Wall("cold", point=[0.0, 0.0, -1e-3], normal=[0.0, 0.0, 1.0], temperature=0.0)
-    with pytest.raises(ValueError, match=r"^\[conductance\] element = \"trefftz\": not with walls \(a wall's neck is "
-                                         r"an isothermal face, a mode the element does not have\); use element = "
-                                         r"\"law\"$"):
-        _packing(walls=(wall,))
     law = _packing(conductance=ConductanceSpec(law="shared-body", neck="union", nodes="necks"))
     with pytest.raises(ValueError, match=r"^\[conductance\] element = \"trefftz\": not with moving particles \(engine "
                                          r"'verlet': every thermal step would rebuild"):
@@ -77,11 +72,34 @@ def test_walls_moving_particles_and_mpi_are_refused_with_the_reason():
     assert unsupported(law) is None
 
 
+def test_a_run_between_walls_is_the_neck_network_of_trefftz_elements_and_keeps_its_heat():
+    """A cluster of 40 overlapping spheres between a hot and a cold wall (their faces cut like necks'): the run's wall
+    flows are those of neck_network(elements=trefftz_elements) solved directly, what enters leaves, and they differ
+    from the law's element's (the element is used, not the law's)."""
+    rng = np.random.default_rng(11)
+    x = rng.uniform([0.0, 0.0, 0.3e-3], [4e-3, 4e-3, 3.7e-3], (40, 3))
+    r = rng.uniform(0.85e-3, 1.15e-3, 40)
+    walls = (Wall("hot", point=[0.0, 0.0, 0.2e-3], normal=[0.0, 0.0, 1.0], temperature=1.0),
+             Wall("cold", point=[0.0, 0.0, 3.8e-3], normal=[0.0, 0.0, -1.0], temperature=0.0))
+    spec = replace(TREFFTZ, out_of_range="drop")
+    scene = make_scene(x, r, np.full(40, 0.5), walls=walls, mode="steady", conductance=spec)
+    flows = run(scene).summary["boundary_heat_flow"]["walls"]
+    bonds = find_bonds(scene.particles, walls, "union", out_of_range="drop")
+    assert bonds.n_walls > 4
+    net = neck_network(spec, scene.particles, bonds, walls=walls, elements=_TREFFTZ)
+    into = np.bincount(bonds.wall_index[net.live_walls], steady_necks(net).wall_flow, minlength=2)
+    assert [flows["hot"], flows["cold"]] == pytest.approx(list(into), rel=1e-9)
+    assert abs(flows["hot"] + flows["cold"]) < 1e-9 * abs(flows["hot"])
+    law = run(replace(scene, conductance=replace(spec, element="law"))).summary["boundary_heat_flow"]["walls"]
+    assert abs(law["hot"] / flows["hot"] - 1.0) > 1e-3
+
+
 @pytest.mark.parametrize("seed", [1, 3])
 def test_a_static_run_is_the_neck_network_of_trefftz_elements_and_says_so(seed):
     """The run's k_eff is neck_network(elements=trefftz_elements)'s, solved here directly; it is not the law's
     element's; the summary names the element, counts the particles that carry it and those that kept the law's
-    monopoles (seed 3: one, as the elements built directly say), and the evidence is the element's: +-0.7 % where
+    monopoles and those whose quadrature was refined
+    (as the elements built directly say), and the evidence is the element's: +-0.7 % where
     necks meet, where the law's element is outside its verified range."""
     scene = _packing(seed)
     s = run(scene).summary
@@ -96,8 +114,11 @@ def test_a_static_run_is_the_neck_network_of_trefftz_elements_and_says_so(seed):
     assert abs(s["effective_conductivity"] / law["effective_conductivity"] - 1.0) > 3e-3
     assert s["particles_necks_meeting"] > 0
     plain = int(np.count_nonzero(built[0].plain))
-    assert (s["element"], s["element_particles"], s["element_plain"]) == ("trefftz", p.n - plain, plain)
-    assert plain == {1: 0, 3: 1}[seed] and s["element_seconds"] > 0.0
+    refined = int(np.count_nonzero(built[0].refine > 1.0))
+    assert (s["element"], s["element_particles"], s["element_plain"], s["element_refined"]) == ("trefftz",
+                                                                                               p.n - plain, plain,
+                                                                                               refined)
+    assert s["element_seconds"] > 0.0
     assert s["law_in_verified_range"] is True and s["law_error_range"] == [-0.007, 0.007] and "warnings" not in s
     assert "particles_without_interactions" not in s and law["element"] == "law"
     assert "element_particles" not in law and law["law_in_verified_range"] is False

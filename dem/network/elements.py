@@ -90,7 +90,8 @@ class SceneElements:
     def account(self) -> dict:
         """The summary's entries: ``element`` (its name) and, for ``"trefftz"``, ``element_particles`` (the
         particles with necks that carry it), ``element_plain`` (those that kept the law's element on their
-        monopoles) and ``element_seconds`` (the CPU time of building them, s).
+        monopoles), ``element_refined`` (those whose quadrature failed its check and was refined) and
+        ``element_seconds`` (the CPU time of building them, s).
 
         Returns
         -------
@@ -103,7 +104,9 @@ class SceneElements:
         with_necks = np.diff(el.offsets) > 0
         plain = np.asarray(el.plain, dtype=bool)
         return {"element": self.element, "element_particles": int(np.count_nonzero(with_necks & ~plain)),
-                "element_plain": int(np.count_nonzero(with_necks & plain)), "element_seconds": self.seconds}
+                "element_plain": int(np.count_nonzero(with_necks & plain)),
+                "element_refined": int(np.count_nonzero(with_necks & (np.asarray(el.refine) > 1.0))),
+                "element_seconds": self.seconds}
 
 
 def scene_elements(spec: ConductanceSpec) -> SceneElements:

@@ -238,19 +238,10 @@ class Scene:
                              f"(this scene runs on {self.engine}, whose step is Zohdi's fixed-point iteration, "
                              f"explicit in each particle's lumped heat, which a massless neck node does not have: not "
                              f"the network's theta step, which solves for the necks); use nodes = \"particles\"")
-        if self.conductance.element == "trefftz":
-            self._check_trefftz(walls)
-
-    def _check_trefftz(self, walls) -> None:
-        """``[conductance] element = "trefftz"`` (:mod:`dem.network.trefftz_element`): the static engine only (a
-        moving run would rebuild every particle's element at every thermal step, at tens of ms each), and no walls
-        (a wall's neck is an isothermal face, a mode the element does not have; a current needs walls, its
-        electrodes)."""
-        why = ("moving particles (engine " + repr(self.engine) + ": every thermal step would rebuild every particle's "
-               "element, about 10 to 70 ms each)" if self.engine != "static" else
-               "walls (a wall's neck is an isothermal face, a mode the element does not have)" if walls else None)
-        if why is not None:
-            raise ValueError(f"[conductance] element = \"trefftz\": not with {why}; use element = \"law\"")
+        if self.conductance.element == "trefftz" and self.engine != "static":
+            raise ValueError(f"[conductance] element = \"trefftz\": not with moving particles (engine {self.engine!r}: "
+                             f"every thermal step would rebuild every particle's element, about 10 to 70 ms each); "
+                             f"use element = \"law\"")
 
     @property
     def particle_count(self) -> int:

@@ -186,8 +186,8 @@ ROWS = (
         'neck is the `shared-body` law\'s; `"trefftz"`: the Trefftz element of its cut sphere with three flux modes '
         'per neck (`dem.network.trefftz_element`: within 0.6 % of the union\'s FE on 39 cells, where the law is '
         '−4.05 to +1.81 %; about 1.6 ms of CPU per neck and 1.9 ms per pair of a particle\'s necks that meet), for '
-        '`law = "shared-body"` with `nodes = "necks"` and `neck = "union"`; the static engine on one process, '
-        'without walls'),
+        '`law = "shared-body"` with `nodes = "necks"` and `neck = "union"`; the static engine on one process '
+        '(a wall\'s face cut like a neck\'s)'),
     Row("conductance", ("contact_conductance",), ALL, "W/K, none", "K_c of the interface in series (eq. 8)"),
     Row("conductance", ("out_of_range",), ALL, '`"error"`', 'bonds beyond the contact model\'s range (h > '
         'max_overlap; wall overlap > r/3): `"error"` reports their count and the first pair, `"clip"` sets a to the '
