@@ -1,0 +1,92 @@
+"""``[conductance] element = "trefftz"`` on several MPI ranks (dem.network.distributed_necks: three flux modes per
+neck, each rank building the Trefftz element of its own particles and of their necks' partners) against the serial run
+of the same scene in the same process: random union packings, periodic and between two walls, some blocks long so
+that the ranks' halos end inside them. Every owned row is the serial matrix's; k_eff, the wall flows and the
+temperatures are the serial run's, steady and in implicit steps."""
+
+import numpy as np
+import pytest
+
+from dem.driver import run
+from dem.engines.distributed.static import DistributedStaticEngine
+from dem.network.distributed_necks import node_keys
+from dem.network.necks import NeckHeat
+from dem.parallel import comm as mpi
+from test_distributed_necks import COMM, _blocks, serial
+
+ELEMENT = ("element_particles", "element_plain", "element_refined")
+
+
+def _trefftz(boundary: str, solver: dict | None = None):
+    """Three blocks of 48 spheres (some with necks that meet) with the Trefftz element (in a periodic box the
+    ranks' halos then reach every particle, a fringe of them still unused and on the law's element)."""
+    return _blocks(boundary, solver, blocks=3, n=40, element="trefftz")
+
+
+def _compare(scene):
+    """The run on the ranks and the serial one: the same necks, elements and temperatures; returns both summaries."""
+    result = run(scene)
+    ref = serial(scene)
+    s, r = result.summary, ref.summary()
+    assert s["ranks"] == COMM.Get_size() and s["element"] == r["element"] == "trefftz"
+    assert ref.necks.modes == 3 and r["element_particles"] > 0.9 * scene.particles.n
+    for key in ("neck_nodes", "bonds", "wall_bonds", "particles_necks_meeting", *ELEMENT):
+        assert s[key] == r[key], key
+    assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-9  # hot - cold = 1 K
+    assert s["energy_error"] < 1e-9
+    engine = result.engine  # a fringe of held nodes neither owned nor reached, its particles on the law's element
+    assert len(engine.part.held) > len(engine.part.used)
+    assert scene.box is not None or len(engine.held) < scene.particles.n  # between walls the halo ends inside
+    assert np.any(np.asarray(engine.necks.modes) == 1) and np.any(np.asarray(engine.necks.modes) == 3)
+    return s, r
+
+
+def test_a_periodic_union_packing_equals_the_serial_run():
+    s, r = _compare(_trefftz("periodic"))
+    assert s["effective_conductivity"] == pytest.approx(r["effective_conductivity"], rel=1e-10)
+    q, q_ref = np.array(s["periodic_heat_flow"]), np.array(r["periodic_heat_flow"])
+    assert np.max(np.abs(q - q_ref)) < 1e-10 * np.max(np.abs(q_ref))
+
+
+def test_a_union_packing_between_walls_equals_the_serial_run():
+    s, r = _compare(_trefftz("plates"))
+    assert s["effective_conductivity"] == pytest.approx(r["effective_conductivity"], rel=1e-10)
+    walls, walls_ref = s["boundary_heat_flow"]["walls"], r["boundary_heat_flow"]["walls"]
+    for name in ("hot", "cold"):
+        assert walls[name] == pytest.approx(walls_ref[name], rel=1e-10)
+
+
+def test_owned_rows_are_those_of_the_serial_matrix():
+    """Each rank's rows over the free nodes, centres and the necks' three modes each, by the nodes' global keys: the
+    serial network's to round-off."""
+    scene = _trefftz("periodic")
+    engine = DistributedStaticEngine(scene)
+    ref = serial(scene)
+    part, net, ref_heat = engine.part, engine.necks_heat, NeckHeat(ref.necks)
+    ref_keys, _ = node_keys(ref.necks, np.arange(scene.particles.n), np.zeros(scene.particles.n, dtype=np.int64),
+                            COMM)
+    ref_free = ref_keys[ref_heat.free]
+    order = np.argsort(ref_free)
+    place = lambda keys: order[np.searchsorted(ref_free, keys, sorter=order)]  # noqa: E731
+    keys = part.held[net.free]
+    own = np.flatnonzero(part.own_free)
+    assert np.array_equal(ref_free[place(keys[own])], keys[own])
+    ours = net.A[own].tocoo()
+    theirs = ref_heat.A[place(keys[own])].tocsr()
+    ours = type(theirs)((ours.data, (ours.row, place(keys[ours.col]))), shape=theirs.shape).tocsr()
+    assert abs(ours - theirs).max() < 1e-12 * np.abs(theirs).max() and ours.nnz == theirs.nnz
+    assert mpi.total(COMM, len(own)) == len(ref_free) == scene.particles.n + 3 * len(ref.necks.live)
+
+
+def test_implicit_steps_equal_the_serial_steps():
+    """Between the walls from 0 C, five implicit steps of 2e-4 s."""
+    scene = _trefftz("plates", {"mode": "transient", "integrator": "implicit", "dt": 2e-4, "t_end": 1e-3})
+    result = run(scene)
+    ref = serial(scene)
+    s, r = result.summary, ref.summary()
+    assert s["steps"] == r["steps"] == 5
+    T, T_ref = result.engine.gathered_temperatures(), ref.T
+    assert 0.01 < np.ptp(T_ref) < 1.0  # heat on its way through
+    assert np.max(np.abs(T - T_ref)) < 1e-9
+    assert s["heat_in"]["walls"] == pytest.approx(r["heat_in"]["walls"], rel=1e-9)
+    assert s["energy_error"] < 1e-9
