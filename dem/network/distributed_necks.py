@@ -20,10 +20,12 @@ exchanged.
 **Numbering.** A node is known to every rank by a global key: a centre by its particle's index, a neck's mode ``d``
 by its first particle's index, its place among that particle's bonds (sorted by partner and image shift: the same on
 every rank that holds the particle's bonds, which the halo ensures for every used neck) and ``d``. With the Trefftz
-element (``modes`` 3, :mod:`dem.network.necks`, "Flux modes") a rank builds it for its own particles and the partners
-of their necks, whose elements its rows sum (:class:`dem.network.elements.SceneElements`' ``own``), and the law's
-one-mode element for the rest of the halo: every used neck then has a Trefftz particle and its three modes, as in the
-serial network, and the fringe's necks, never used, may have one. The unknowns of a solve are numbered
+element (``modes`` 3, :mod:`dem.network.necks`, "Flux modes") a rank builds it for its own particles only
+(:class:`dem.network.elements.SceneElements`' ``own``: the expensive part of such a run shared out), the law's
+one-mode element for the rest of its halo, and receives the elements of its own particles' partners, whose elements
+its rows sum, from their owners (:func:`shared_elements`: each particle's element is the same on every rank that holds
+all its necks, its ends in the same order): every used neck then has a Trefftz particle and its three modes, as in
+the serial network, and the fringe's necks, never used, may have one. The unknowns of a solve are numbered
 rank after rank (:meth:`dem.network.distributed.DistributedNetwork.numbering`).
 
 **Groups and the steady solve.** The groups of free nodes are the connected components over the ranks
@@ -97,6 +99,54 @@ def node_keys(net: NeckNetwork, held: np.ndarray, owner: np.ndarray, comm) -> tu
     mode = np.arange(len(bond)) - np.repeat(np.cumsum(modes) - modes, modes)
     necks = n_global + (held[i[bond]] * most + place[bond]) * width + mode
     return np.concatenate([held, necks]).astype(np.int64), np.concatenate([owner, owner[i[bond]]])
+
+
+def shared_elements(comm, built, net: NeckNetwork, held: np.ndarray, owner: np.ndarray, mine: np.ndarray):
+    """``built`` with the elements of the partners of this rank's own particles (over their live pair necks) taken
+    from the ranks that own them (module docstring, "Numbering"): what the owned rows sum.
+
+    Parameters
+    ----------
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
+    built : dem.laws.shared_body.ParticleElements
+        The held particles' elements as this rank built them (its own particles' the ones wanted), in ``net``.
+    net : dem.network.necks.NeckNetwork
+        The rank's network of its held particles, of ``built``.
+    held : numpy.ndarray
+        Global index of each held particle, sorted.
+    owner : numpy.ndarray
+        The rank owning each held particle.
+    mine : numpy.ndarray
+        Per held particle, whether this rank owns it.
+
+    Returns
+    -------
+    dem.laws.shared_body.ParticleElements
+        ``built`` (the same type) with the partners' blocks and per-particle fields (``plain``, ``shrink``,
+        ``modes``, ...) those of their owners.
+    """
+    n = len(held)
+    i, j = net.bonds.i[net.live], net.bonds.j[net.live]
+    need = np.zeros(n, dtype=bool)
+    need[j[mine[i]]] = need[i[mine[j]]] = True
+    wanted = np.flatnonzero(need & ~mine)
+    asks = [held[wanted[owner[wanted] == r]] for r in range(comm.Get_size())]
+    fields = [f for f in built._fields if f not in ("offsets", "ends", "start", "values")]
+    per = {f: np.broadcast_to(np.asarray(getattr(built, f)), (n,)).copy() for f in fields}
+
+    def block(k: int) -> tuple:
+        return (built.values[built.start[k]:built.start[k + 1]], *(per[f][k] for f in fields))
+
+    answers = comm.alltoall([[block(k) for k in np.searchsorted(held, keys)] for keys in comm.alltoall(asks)])
+    blocks = [built.values[built.start[k]:built.start[k + 1]] for k in range(n)]
+    for keys, answer in zip(asks, answers):
+        for k, (values, *rest) in zip(np.searchsorted(held, keys), answer):
+            blocks[k] = values
+            for f, v in zip(fields, rest):
+                per[f][k] = v
+    start = np.concatenate([[0], np.cumsum([len(b) for b in blocks])])
+    return built._replace(start=start, values=np.concatenate(blocks) if n else built.values, **per)
 
 
 class DistributedNecks(DistributedNetwork):

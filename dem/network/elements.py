@@ -30,10 +30,10 @@ class SceneElements:
     element : str
         ``"law"`` or ``"trefftz"`` (``dem.laws.conductance.ELEMENTS``).
     own : numpy.ndarray or None
-        Per particle, whether it is one whose rows this process solves (an MPI rank's own,
-        :mod:`dem.network.distributed_necks`): the Trefftz element then goes to these and to the partners of their
-        live pair necks (whose elements their necks' rows sum), the law's one-mode element to the rest of the halo,
-        whose elements no solved row reads; None: every particle's is built.
+        Per particle, whether it is this process's own (an MPI rank's, :mod:`dem.network.distributed_necks`): the
+        Trefftz element is then built for these only, the law's one-mode element for the rest of the halo (the
+        elements of the own particles' partners come from their owners,
+        :func:`dem.network.distributed_necks.shared_elements`); None: every particle's is built.
 
     Attributes
     ----------
@@ -86,10 +86,7 @@ class SceneElements:
         if self.element == "trefftz":
             from dem.network.trefftz_element import trefftz_elements
 
-            if self.own is not None:  # the own particles and the partners of their necks
-                where = self.own.copy()
-                where[bonds.j[self.own[bonds.i]]] = True
-                where[bonds.i[self.own[bonds.j]]] = True
+            where = self.own
             build = trefftz_elements if where is None else functools.partial(trefftz_elements, where=where)
             necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=n)
             chosen = slice(None) if where is None else where
@@ -105,8 +102,8 @@ class SceneElements:
         """The summary's entries: ``element`` (its name) and, for ``"trefftz"``, ``element_particles`` (the
         particles with necks that carry it), ``element_plain`` (those that kept the law's element on their
         monopoles), ``element_refined`` (those whose quadrature failed its check and was refined) and
-        ``element_seconds`` (the CPU time of building them, s); with ``own``, the counts are of the own particles
-        (a rank's part of the sums over the ranks) and the time that of all this process built.
+        ``element_seconds`` (the CPU time of building them, s); with ``own``, of the own particles (a rank's part
+        of the sums over the ranks).
 
         Returns
         -------

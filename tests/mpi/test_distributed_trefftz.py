@@ -1,8 +1,8 @@
 """``[conductance] element = "trefftz"`` on several MPI ranks (dem.network.distributed_necks: three flux modes per
-neck, each rank building the Trefftz element of its own particles and of their necks' partners) against the serial run
-of the same scene in the same process: random union packings, periodic and between two walls, some blocks long so
-that the ranks' halos end inside them. Every owned row is the serial matrix's; k_eff, the wall flows and the
-temperatures are the serial run's, steady and in implicit steps."""
+neck, each rank building the Trefftz elements of its own particles and receiving those of their necks' partners)
+against the serial run of the same scene in the same process: random union packings, periodic and between two walls,
+some blocks long. Every owned row is the serial matrix's; k_eff, the wall flows and the temperatures are the serial
+run's, steady and in implicit steps."""
 
 import numpy as np
 import pytest
@@ -38,6 +38,8 @@ def _compare(scene):
     assert len(engine.part.held) > len(engine.part.used)
     assert scene.box is not None or len(engine.held) < scene.particles.n  # between walls the halo ends inside
     assert np.any(np.asarray(engine.necks.modes) == 1) and np.any(np.asarray(engine.necks.modes) == 3)
+    built = np.asarray(engine.elements.built.modes) == 3  # each rank built the Trefftz elements of its own only
+    assert np.array_equal(built, engine.mine) and mpi.total(COMM, int(built.sum())) == scene.particles.n
     return s, r
 
 

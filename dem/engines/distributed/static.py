@@ -30,8 +30,9 @@ per neck, a current.
 
 The Trefftz element (``[conductance] element = "trefftz"``, :mod:`dem.network.elements`) runs on the ranks with its
 three flux modes per neck (:func:`dem.network.distributed_necks.node_keys`): each rank builds it for its own particles
-and the partners of their necks only, the expensive part of such a run shared out; the summary's ``element_*`` counts
-are summed over the ranks' own particles and ``element_seconds`` is the CPU time of all the ranks' elements.
+only, the expensive part of such a run shared out, receives those of their necks' partners from their owners
+(:func:`dem.network.distributed_necks.shared_elements`) and assembles its network again with them; the summary's
+``element_*`` entries are summed over the ranks (``element_seconds``: the CPU time of all the ranks' elements).
 """
 
 from __future__ import annotations
@@ -50,7 +51,7 @@ from dem.laws.verified_range import neck_account, wide_necks
 from dem.parallel import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
 from dem.network.distributed import DistributedNetwork
-from dem.network.distributed_necks import DistributedNecks, RankNeckHeat, node_keys
+from dem.network.distributed_necks import DistributedNecks, RankNeckHeat, node_keys, shared_elements
 from dem.network.elements import scene_elements
 from dem.network.heat import Network, bonds_and_conductances
 from dem.network.necks import neck_flows, neck_network
@@ -151,6 +152,11 @@ class DistributedStaticEngine(StaticEngine):
         self.necks = None  # with a node per neck: the network of the held particles (dem.network.necks)
         owner = mpi.agree(self.comm, lambda: self._build(scene, rank))  # no collective call inside: a bond out of
         particles = self.scene.particles                                  # range stops every rank alike
+        if self.necks is not None and scene.conductance.element != "law":  # the partners' elements from their owners
+            el = shared_elements(self.comm, self.elements.built, self.necks, self.held, owner, self.mine)
+            self.necks = mpi.agree(self.comm, lambda: neck_network(
+                scene.conductance, particles, self.necks.bonds, box=scene.box, walls=scene.walls,
+                elements=lambda *args: el))
         self.potential, self.circuit = None, None
         if scene.electrical is not None:
             particles = mpi.agree(self.comm, lambda: self._joule_heated(particles, owner))
@@ -214,9 +220,9 @@ class DistributedStaticEngine(StaticEngine):
 
     def _neck_network(self, local, bonds, mine: np.ndarray) -> tuple:
         """The network with a node per neck of the held particles (:func:`dem.network.necks.neck_network`, the
-        elements of ``[conductance] element``, :func:`dem.network.elements.scene_elements`, the Trefftz element on the
-        own particles ``mine`` and the partners of their necks) and, per held particle, whether its element dropped
-        its interactions (``plain``)."""
+        elements of ``[conductance] element``, :func:`dem.network.elements.scene_elements`, a Trefftz element on the
+        own particles ``mine`` only: the partners' come from their owners after this) and, per held particle,
+        whether its element dropped its interactions (``plain``)."""
         scene = self.scene
         self.elements = scene_elements(scene.conductance, mine)
         net = neck_network(scene.conductance, local, bonds, box=scene.box, walls=scene.walls, elements=self.elements)
