@@ -48,7 +48,7 @@ from __future__ import annotations
 import numpy as np
 
 from dem.network.distributed import DistributedNetwork
-from dem.network.necks import NeckHeat, NeckNetwork, _level
+from dem.network.necks import NeckHeat, NeckNetwork, uniform_level
 from dem.parallel import comm as mpi
 from dem.parallel.petsc import largest_eigenvalue
 
@@ -454,7 +454,7 @@ class DistributedNecks(DistributedNetwork):
             cap = self.group_sums(loose, label, net.C)
             shift = (self.group_sums(loose, label, net.C * T0) - self.group_sums(loose, label, net.C * T_F)) / cap
             inside = np.isin(label, loose)  # (a dipole's moment does not move with a uniform change)
-            T_F[inside] += shift[np.searchsorted(loose, label[inside])] * _level(net.net)[net.free][inside]
+            T_F[inside] += shift[np.searchsorted(loose, label[inside])] * uniform_level(net.net)[net.free][inside]
         T_F = self.halo_filled(T_F)[net.free]
         flows = self.flows(T_F, sinks)
         total = self.flow_magnitude(T_F, sinks)

@@ -556,7 +556,7 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
         weight = np.bincount(label[:n], C, n_comp)
         now = np.bincount(label[:n], C * T[:n], n_comp)
         shift = np.where(anchored, 0.0, (target - now) / np.where(weight > 0, weight, 1.0))
-        T += shift[label] * _level(net)
+        T += shift[label] * uniform_level(net)
     T_F = T[system.free]
     sinks = system.sinks(T_F)  # radiation: the exact T^4 flow at the solution
     flows = system.flows(T_F, sinks)
@@ -570,9 +570,20 @@ def steady_necks(net: NeckNetwork, floating: str = "mean", linear: str = "auto",
                       flows, energy_error, iterations, backend)
 
 
-def _level(net: NeckNetwork) -> np.ndarray:
+def uniform_level(net: NeckNetwork) -> np.ndarray:
     """Per node, 1 where a uniform change of temperature moves it (the centres and the necks' monopoles), 0 on the
-    dipoles' moments (the moment of a uniform temperature is 0)."""
+    dipoles' moments (the moment of a uniform temperature is 0): the kernel of ``A`` on a connected group.
+
+    Parameters
+    ----------
+    net : NeckNetwork
+        The network.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_nodes,) 1.0 or 0.0 per node.
+    """
     level = np.ones(net.n_nodes)
     level[net.particles.n:] = 0.0
     level[net.monopoles] = 1.0
