@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dem.engines import engine_class
+from dem.memory import announcing
 from dem.parallel.comm import launched, maximum, on_root, world
 from dem.output import folder as run_folder
 from dem.output.writer import RunWriter, write_summary
@@ -80,7 +81,12 @@ def _announce(scene: Scene, enabled: bool) -> None:
     spec = scene.conductance
     line = estimate(scene.particle_count, spec.neck, spec.nodes, scene.motion is not None) if enabled else None
     if line is not None:
-        print(f"python -m dem run: {line}", file=sys.stderr, flush=True)
+        _say(line)
+
+
+def _say(line: str) -> None:
+    """One line of what the run will take, on stderr (:func:`dem.memory.announce` while the engine is built)."""
+    print(f"python -m dem run: {line}", file=sys.stderr, flush=True)
 
 
 def _position(scene: Scene, out, progress: bool) -> Where:
@@ -140,7 +146,8 @@ def _run_held(scene: Scene, out, progress: bool, resume: bool, comm, cls, root: 
     here = _position(scene, out, progress and root)
     restart = run_folder.load(out, scene, scene.engine) if resume else None
     try:
-        engine = cls(scene, restart)  # the memory and the work checked and refused up front
+        with announcing(_say if progress and root else None):  # an estimate of what building it takes, where large
+            engine = cls(scene, restart)  # the memory and the work checked and refused up front
     except KeyboardInterrupt:  # nothing written yet: a --resume starts the run again (run_folder.interrupted_at_start)
         if out is not None and root and restart is None:
             write_summary(out / "summary.json", {"scene": scene.name, "mode": scene.solver.mode, "interrupted": True,

@@ -20,12 +20,23 @@ solve and for ten implicit steps alike (1044 MiB at 40656), above a base of 0.21
 moving run handing its particles over to the union (the velocity-Verlet engine, the same packing at r = 0.5 mm, whose
 necks meet, three thermal steps with nine in ten particles on the way: the elements of both readings) grows by 51.4 kB
 per particle at 500, 2048, 6050 and 16384 particles (1007 MiB at 16384), within 1.9 %.
+
+The Trefftz element (``[conductance] element = "trefftz"``, :mod:`dem.network.trefftz_element`) costs far more time
+than the network it goes into, and its time grows with each particle's necks and how many of them meet: it is
+estimated from the live necks just before the elements are built (:func:`element_estimate`), and said where it is large
+(:func:`announce`, heard on stderr where the driver reports the run's progress, :func:`announcing`). Nothing refuses a
+run for its time: no limit bounds a steady solve's (the transient runs' work limit counts the steps, and the elements
+are built once).
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import os
 import pathlib
+
+import numpy as np
 
 BYTES_PER_PARTICLE = 1.35e3
 #: bytes per particle at the peak of a steady solve under the union of spheres, by the network's nodes (module
@@ -48,6 +59,14 @@ UNION_SECONDS_PER_PARTICLE = {"particles": 4.5e-4, "necks": 9.0e-4}
 #: necks' faces, bonds and solve): 2.01-2.12 ms per particle on the random sintered packing of the module docstring
 #: at 2048 to 40656 particles, 2-core machine at load 5-7
 PAIR_NECK_NODES_SECONDS_PER_PARTICLE = 2.1e-3
+#: seconds of CPU the Trefftz element (``[conductance] element = "trefftz"``, :mod:`dem.network.trefftz_element`, one
+#: BLAS thread) takes per neck of a particle and per pair of its necks that meet (its faces and caps cut into more
+#: panels): fitted to the elements' CPU time on fourteen periodic union packings (seven random mirror packings of 32
+#: spheres, ``verification.packings.union_packing``, phi 0.6-0.95; three generated ones, ``[generator] kind =
+#: "random"``, 72-256 particles, overlap 0.1-0.25; SC, BCC and FCC lattices at h/r 0.1-0.3 tiled to 16-32 particles;
+#: 2-core machine at load 4-5), each packing weighing alike, which it gives within -17 % to +19 % (the necks alone,
+#: 2.1 ms each, give 0.33 to 1.42 times it)
+TREFFTZ_SECONDS = {"neck": 1.63e-3, "meeting pair": 1.93e-3}
 ANNOUNCE_FROM = 1_000_000  # runs of this many particles or more say what they will take before they start
 ANNOUNCE_SECONDS = 10.0  #: so do runs whose estimated steady solve takes this long (s)
 BASE_BYTES = 0.23e9  # the interpreter, numpy, scipy and the compiled kernels (with the per-particle figure: the fit)
@@ -187,6 +206,83 @@ def estimate(n: int, neck: str = "newton", nodes: str = "particles", moving: boo
     need = BASE_BYTES + bytes_per_particle(neck, nodes, moving) * n
     return (f"{n} particles: about {need / 2**30:.3g} GiB at the peak of {_peak(moving)} and about "
             f"{rate * n:.3g} s for it on 2 cores (a transient or moving run takes longer)")
+
+
+def element_seconds(necks, meeting) -> float:
+    """The CPU time of building the Trefftz elements of particles with ``necks`` necks each, ``meeting`` pairs of which
+    meet (:data:`TREFFTZ_SECONDS`).
+
+    Parameters
+    ----------
+    necks : array_like of int
+        Per particle, its necks.
+    meeting : array_like of int
+        Per particle, the pairs of its necks that meet (:func:`dem.geometry.necks.pairs_meeting`).
+
+    Returns
+    -------
+    float
+        Seconds on one core.
+    """
+    return float(TREFFTZ_SECONDS["neck"] * np.sum(necks) + TREFFTZ_SECONDS["meeting pair"] * np.sum(meeting))
+
+
+def element_estimate(necks, meeting) -> str | None:
+    """What building the Trefftz elements of particles with ``necks`` necks each, ``meeting`` pairs of which meet, will
+    take (:func:`element_seconds`), said before it starts where it is large (``ANNOUNCE_SECONDS`` or more); None for
+    less.
+
+    Parameters
+    ----------
+    necks : array_like of int
+        Per particle, its necks.
+    meeting : array_like of int
+        Per particle, the pairs of its necks that meet.
+
+    Returns
+    -------
+    str or None
+        One line, or None.
+    """
+    z = np.asarray(necks)
+    seconds = element_seconds(z, meeting)
+    if seconds < ANNOUNCE_SECONDS:
+        return None
+    return (f"the Trefftz elements of {len(z)} particles ({z.mean():.3g} necks each on average, "
+            f"{int(np.sum(meeting))} pairs of necks meeting): about {seconds:.3g} s on one core, before the solve")
+
+
+_SAY = contextvars.ContextVar("say", default=None)
+
+
+@contextlib.contextmanager
+def announcing(say):
+    """Within the block, :func:`announce` hands its lines to ``say`` (the driver's stderr where a run reports its
+    progress); None: they are dropped.
+
+    Parameters
+    ----------
+    say : callable or None
+        Called with each line.
+    """
+    token = _SAY.set(say)
+    try:
+        yield
+    finally:
+        _SAY.reset(token)
+
+
+def announce(line: str | None) -> None:
+    """Say ``line`` where the run announces what it will take (:func:`announcing`); None or no listener: nothing.
+
+    Parameters
+    ----------
+    line : str or None
+        The line (an estimate).
+    """
+    say = _SAY.get()
+    if line is not None and say is not None:
+        say(line)
 
 
 def _peak(moving: bool) -> str:

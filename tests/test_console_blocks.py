@@ -5,11 +5,11 @@ Tolerance: relative 1e-6 (and absolute 1e-12 for numbers at round-off level, suc
 Every command shown is deterministic (seeded, fixed meshes, no timing-dependent choices), so on the machine that
 wrote the README the numbers agree to all printed digits; 1e-6 leaves room for platform round-off amplified by the
 solves (BLAS, libm, SuperLU orderings) while staying 100x tighter than the loosest solver tolerance shown (rtol
-1e-4), so a changed algorithm or a stale README fails. Timings are ignored: ``seconds`` entries, and numbers with
-the unit ``s`` (``1.8 s``). Commands are run with ``python`` replaced by this interpreter, the repository on
-``PYTHONPATH``, and stdout and stderr together, as a terminal shows them (progress bars left out). Input files the
-page shows (a fenced block right after ``<!-- file: NAME -->``) are written into the folder first. A command shown
-with the same output (and the same files it names) on several pages runs once, for all of them.
+1e-4), so a changed algorithm or a stale README fails. Timings are ignored: ``seconds`` and ``*_seconds`` entries,
+and numbers with the unit ``s`` (``1.8 s``). Commands are run with ``python`` replaced by this interpreter, the
+repository on ``PYTHONPATH``, and stdout and stderr together, as a terminal shows them (progress bars left out).
+Input files the page shows (a fenced block right after ``<!-- file: NAME -->``) are written into the folder first. A
+command shown with the same output (and the same files it names) on several pages runs once, for all of them.
 """
 
 from __future__ import annotations
@@ -64,9 +64,14 @@ def console_commands(text: str) -> list[tuple[str, str, int]]:
     return out
 
 
+def _timing(key: str) -> bool:
+    """Whether a summary's key is a timing: ``seconds``, or a name ending in ``_seconds`` (``element_seconds``)."""
+    return key == "seconds" or key.endswith("_seconds")
+
+
 def _drop_seconds(value):
     if isinstance(value, dict):
-        return {k: _drop_seconds(v) for k, v in value.items() if k != "seconds"}
+        return {k: _drop_seconds(v) for k, v in value.items() if not _timing(k)}
     if isinstance(value, list):
         return [_drop_seconds(v) for v in value]
     return value
@@ -78,7 +83,7 @@ def numbers(output: str) -> list[float]:
     if text.startswith("{"):
         text = json.dumps(_drop_seconds(json.loads(text)))
     else:
-        text = "\n".join(line for line in text.splitlines() if line.split()[:1] != ["seconds"])
+        text = "\n".join(line for line in text.splitlines() if not _timing((line.split() or [""])[0]))
     return [float(x) for x in NUMBER.findall(TIMING.sub("", text))]
 
 
@@ -93,8 +98,8 @@ def test_a_bar_without_a_total_is_progress():
 
 
 def test_number_extraction_ignores_timings_and_keeps_the_rest():
-    assert numbers("a  1.5e-3\nseconds  0.4\nb  [2 items]") == [1.5e-3, 2.0]
-    assert numbers('{"K": 0.25, "seconds": 3.1, "n": [1, 2]}') == [0.25, 1.0, 2.0]
+    assert numbers("a  1.5e-3\nseconds  0.4\nb  [2 items]\nelement_seconds  2.5") == [1.5e-3, 2.0]
+    assert numbers('{"K": 0.25, "seconds": 3.1, "n": [1, 2], "element_seconds": 2.5}') == [0.25, 1.0, 2.0]
     assert numbers("paper      ok        1.8 s  Rojek 2022") == [2022.0]
     assert numbers("fit sweep:  50%|#####     | 20/40 [00:00<00:00, 32.95solve/s]\nslope  1.07") == [1.07]
     assert close(5.4e-17, -2e-16) and close(1.0, 1.0 + 5e-7) and not close(1.0, 1.0 + 2e-6)

@@ -42,7 +42,7 @@ def test_union_reading_runs_where_the_pair_necks_have_no_answer():
     assert s["neck_readings"] == {"union": s["bonds"]} and s["particles_necks_meeting"] == s["particles"]
     assert s["warnings"] == ["law 'rojek' was not compared with FE on union necks (python -m verification "
                              "densification compares shared-body, shared-body (neck nodes), fit, "
-                             "argento-bouvard): no error bound"]
+                             "argento-bouvard, shared-body (neck nodes, trefftz element)): no error bound"]
     assert s["law_in_verified_range"] is False
     a = result.engine.bonds.a
     assert np.allclose(a, math.sqrt(1.0 - 0.8**2) * 1e-3, rtol=1e-12)

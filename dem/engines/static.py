@@ -23,6 +23,7 @@ from dem.geometry.necks import meeting_in
 from dem.laws.conductance import bond_conductances
 from dem.laws.verified_range import neck_account, wide_necks
 from dem.network.current import circuit, electrode_bonds, kirchhoff, refuse_floating, require_paths
+from dem.network.elements import scene_elements
 from dem.network.heat import (Checkpoint, Network, bonds_and_conductances, boundary_heat_flow, integrate,
                               periodic_heat_flow, steady)
 from dem.network.necks import NeckHeat, neck_current, neck_flows, neck_network, steady_necks
@@ -157,6 +158,7 @@ class StaticEngine(Engine):
     link_kind = "bonds"
     necks_heat = None  # a transient run with a node per neck: its network (dem.network.necks.NeckHeat)
     T_nodes = None  # with a node per neck: all its nodes' temperatures as the run stands (K or degC)
+    elements = None  # with a node per neck: the particles' elements as built (dem.network.elements.SceneElements)
 
     def __init__(self, scene, restart: dict | None = None):
         """``restart``: the checkpoint of this scene's transient run (:func:`dem.output.folder.load`)."""
@@ -170,7 +172,8 @@ class StaticEngine(Engine):
         if spec.nodes == "necks":  # a node per neck (dem.network.necks): the solves, the current and the bonds' flows
             # are its own, the one-node law's conductances (the links' field) from the halves its elements are of
             bonds = find_bonds(particles, tuple(walls), spec.contact, spec.out_of_range, box=scene.box)
-            self.necks = neck_network(spec, particles, bonds, box=scene.box, walls=walls)
+            self.elements = scene_elements(spec)
+            self.necks = neck_network(spec, particles, bonds, box=scene.box, walls=walls, elements=self.elements)
             K_pairs, K_walls = bond_conductances(spec, particles, bonds, box=scene.box, walls=tuple(walls),
                                                  union=self.necks.union)
         else:
@@ -287,16 +290,19 @@ class StaticEngine(Engine):
 
     def _run(self, observe, progress, checkpoint) -> None:
         s = self.scene.solver
-        law, nodes = self.scene.conductance.law, self.scene.conductance.nodes
+        spec = self.scene.conductance
+        law, nodes, element = spec.law, spec.nodes, spec.element
         out = {"law": law, "contact": self.bonds.contact,
                "bonds_clipped": self.bonds.clipped, "bonds_dropped": self.bonds.dropped,
                "wall_bonds": self.bonds.n_walls,
                **neck_account(np.count_nonzero(self.meeting), self.scene.particles.n, self.bonds.contact,
                               self.bonds.n_pairs + self.bonds.n_walls, law,
                               np.count_nonzero(wide_necks(self.scene.particles.radius, self.bonds, self.meeting, law,
-                                                          nodes)), nodes=nodes)}
-        if self.necks is not None:
-            out.update(nodes="necks", neck_nodes=len(self.necks.live), particles_without_interactions=self.necks.plain)
+                                                          nodes, element)), nodes=nodes, element=element)}
+        if self.necks is not None:  # (a Trefftz element's plain particles keep the law's monopoles: element_plain)
+            out.update(nodes="necks", neck_nodes=len(self.necks.live), **self.elements.account())
+            if element == "law":
+                out["particles_without_interactions"] = self.necks.plain
         observer = self._observed(observe)
         t0 = self.t_start
         if s.mode == "steady" and self.necks is not None:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fem_neck.geometry.union import angular_radius, necks_meet
+from fem_neck.geometry.union import angular_radius, meeting_pairs, necks_meet
 
 from dem.geometry.bonds import LENS_GEOMETRY, Bonds
 
@@ -33,6 +33,29 @@ def necks_meeting(radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, wall_no
     wall_normals : numpy.ndarray
         The unit normal of each wall bond's wall (one row each), pointing into the packing.
     """
+    return necks_meet(len(radius), *_cones(radius, bonds, vectors, wall_normals))
+
+
+def pairs_meeting(radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, wall_normals: np.ndarray) -> np.ndarray:
+    """How many pairs of necks of each particle meet (int per particle; :func:`necks_meeting` on every pair).
+
+    Parameters
+    ----------
+    radius : numpy.ndarray
+        Particle radii, m.
+    bonds : Bonds
+        The pair and wall bonds with their neck radii and reading (``bonds.contact``).
+    vectors : numpy.ndarray
+        ``x_j - x_i`` of every pair bond (one row each), m (the image's across a periodic face).
+    wall_normals : numpy.ndarray
+        The unit normal of each wall bond's wall (one row each), pointing into the packing.
+    """
+    return meeting_pairs(len(radius), *_cones(radius, bonds, vectors, wall_normals))
+
+
+def _cones(radius, bonds: Bonds, vectors, wall_normals) -> tuple:
+    """``(particle, direction, angle)`` of every neck end: its particle, the direction toward it from that particle's
+    centre and the half-angle of the cone it is seen in from there (module docstring)."""
     radius = np.asarray(radius, dtype=float)
     i, j, p = bonds.i, bonds.j, bonds.wall_particle
     if bonds.contact in LENS_GEOMETRY:
@@ -44,7 +67,7 @@ def necks_meeting(radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, wall_no
     particle = np.concatenate([i, j, p])
     direction = np.vstack([np.reshape(vectors, (-1, 3)), -np.reshape(vectors, (-1, 3)),
                            -np.reshape(wall_normals, (-1, 3))])
-    return necks_meet(len(radius), particle, direction, np.concatenate(angles))
+    return particle, direction, np.concatenate(angles)
 
 
 def meeting_in(particles, walls, bonds: Bonds, box=None) -> np.ndarray:

@@ -55,6 +55,9 @@ DESCRIPTIONS = {
 }
 NECK_MODELS = ("newton", "first", "coble", "union")
 NODES = ("particles", "necks")  # the network's nodes: one per particle, or also one per neck (dem.network.necks)
+#: each particle's element with a node per neck: the law's (dem.laws.shared_body.particle_elements) or the Trefftz
+#: element of its cut sphere with three flux modes per neck (dem.network.trefftz_element)
+ELEMENTS = ("law", "trefftz")
 
 
 def law_keys(law: str) -> tuple:
@@ -107,6 +110,11 @@ class ConductanceSpec:
         The network's nodes, one of ``NODES``: ``"particles"`` (one per particle, each bond a conductance) or
         ``"necks"`` (a node per neck as well, each particle an element, :mod:`dem.network.necks`; ``shared-body``
         without ``contact_conductance`` only, under any neck reading).
+    element : str
+        Each particle's element with a node per neck, one of ``ELEMENTS``: ``"law"`` (the ``shared-body`` law's,
+        :func:`dem.laws.shared_body.particle_elements`) or ``"trefftz"`` (the Trefftz element of its cut sphere with
+        three flux modes per neck, :mod:`dem.network.trefftz_element`; built on the cut spheres, so only with
+        ``law = "shared-body"``, ``nodes = "necks"`` and ``neck = "union"``).
 
     Raises
     ------
@@ -123,6 +131,7 @@ class ConductanceSpec:
     out_of_range: str = "error"
     unequal: bool = True
     nodes: str = "particles"
+    element: str = "law"
 
     def __post_init__(self):
         if self.law not in LAWS:
@@ -148,6 +157,12 @@ class ConductanceSpec:
         if self.nodes == "necks" and (self.law != "shared-body" or kc is not None):
             raise ValueError(f"conductance.nodes = \"necks\": only with law = \"shared-body\" and no "
                              f"contact_conductance (here law = {self.law!r}, contact_conductance = {kc!r})")
+        if self.element not in ELEMENTS:
+            raise ValueError(f"conductance.element = {self.element!r}: must be one of {', '.join(ELEMENTS)}")
+        if self.element == "trefftz" and (self.law, self.nodes, self.neck) != ("shared-body", "necks", "union"):
+            raise ValueError(f"conductance.element = \"trefftz\": only with law = \"shared-body\", nodes = \"necks\" "
+                             f"and neck = \"union\" (the element of each cut sphere; here law = {self.law!r}, nodes = "
+                             f"{self.nodes!r}, neck = {self.neck!r})")
         if self.law in FIT_LAWS:
             self.fitted()  # a missing or malformed fit file, or one of the other half body, is reported when read
 

@@ -84,9 +84,10 @@ on the dipoles); the periodic jump and a wall's temperature act on the monopoles
 is isothermal). The heat flows (:meth:`NeckNetwork.end_flows`, the flow across the period, ``k_eff``) are the
 monopoles'; a dipole's row in ``entries`` has the bond end :data:`DIPOLE`. The law's elements have ``modes = 1``;
 ``modes = 3`` comes from elements built elsewhere through the ``elements`` hook of :func:`neck_network`
-(:func:`dem.network.trefftz_element.trefftz_elements`, ``python -m verification neck-node-bound``'s exact ones). With
-all modes 1, or all 3, the network is the one of uniform modes, bit for bit. The current takes ``modes = 1`` only (the
-rows of ``E`` do not sum to zero on the dipoles: no graph's Laplacian).
+(:func:`dem.network.trefftz_element.trefftz_elements`, the element of ``[conductance] element = "trefftz"``,
+:mod:`dem.network.elements`; ``python -m verification neck-node-bound``'s exact ones). With all modes 1, or all 3,
+the network is the one of uniform modes, bit for bit. The current takes ``modes = 1`` only (the rows of ``E`` do not
+sum to zero on the dipoles: no graph's Laplacian).
 
 **Transient.** Neck nodes hold no heat: the capacity matrix is :math:`M = \mathrm{diag}(C_1 \dots C_n, 0 \dots 0)`,
 only semidefinite. The :math:`\theta` scheme :math:`(M/\Delta t + \theta A) T^+ = (M/\Delta t - (1 - \theta) A) T + r`

@@ -238,6 +238,10 @@ class Scene:
                              f"(this scene runs on {self.engine}, whose step is Zohdi's fixed-point iteration, "
                              f"explicit in each particle's lumped heat, which a massless neck node does not have: not "
                              f"the network's theta step, which solves for the necks); use nodes = \"particles\"")
+        if self.conductance.element == "trefftz" and self.engine != "static":
+            raise ValueError(f"[conductance] element = \"trefftz\": not with moving particles (engine {self.engine!r}: "
+                             f"every thermal step would rebuild every particle's element, about 10 to 70 ms each); "
+                             f"use element = \"law\"")
 
     @property
     def particle_count(self) -> int:

@@ -212,6 +212,28 @@ def necks_meet(n: int, particle, direction, angle) -> np.ndarray:
     numpy.ndarray
         Per particle, whether two of its necks meet (bool).
     """
+    return meeting_pairs(n, particle, direction, angle) > 0
+
+
+def meeting_pairs(n: int, particle, direction, angle) -> np.ndarray:
+    """How many pairs of necks of each of ``n`` particles meet (:func:`necks_meet`'s test on every pair).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    particle : numpy.ndarray
+        The particle of each neck end, integer indices (a pair bond has two ends, a wall bond one).
+    direction : numpy.ndarray
+        The direction from that particle's centre toward the neck (one row each, any length but zero).
+    angle : numpy.ndarray
+        Half-angle (rad) of the cone in which the neck is seen from the centre (:func:`angular_radius`).
+
+    Returns
+    -------
+    numpy.ndarray
+        Per particle, the pairs of its necks that meet (int).
+    """
     particle = np.ascontiguousarray(particle, dtype=np.int64).reshape(-1)
     direction = np.ascontiguousarray(direction, dtype=float).reshape(-1, 3)
     angle = np.ascontiguousarray(angle, dtype=float).reshape(-1)
@@ -224,7 +246,7 @@ def necks_meet(n: int, particle, direction, angle) -> np.ndarray:
     order = np.argsort(particle, kind="stable")
     counts = np.bincount(particle, minlength=int(n))
     first = np.concatenate([[0], np.cumsum(counts)[:-1]])  # a particle's ends are order[first : first + count]
-    out = np.zeros(int(n), dtype=bool)
+    out = np.zeros(int(n), dtype=np.int64)
     for z in np.unique(counts[counts >= 2]):  # the particles of one neck count at once: every pair of their necks
         b, c = np.triu_indices(int(z), 1)
         group = np.flatnonzero(counts == z)
@@ -232,7 +254,7 @@ def necks_meet(n: int, particle, direction, angle) -> np.ndarray:
             ends = order[first[block][:, None] + np.arange(z)]  # (particles, z)
             u, half = unit[ends], angle[ends]
             cos_g = np.matmul(u, u.transpose(0, 2, 1))[:, b, c]
-            out[block] = np.any(np.arccos(np.clip(cos_g, -1.0, 1.0)) <= half[:, b] + half[:, c], axis=1)
+            out[block] = np.count_nonzero(np.arccos(np.clip(cos_g, -1.0, 1.0)) <= half[:, b] + half[:, c], axis=1)
     return out
 
 

@@ -26,7 +26,8 @@ each rank's own particles.
 What it does not do, refused up front with the reason: moving particles (another engine's), radiation (a Newton
 iteration), explicit steps and ``dt = "auto"`` (fixed implicit or Crank-Nicolson steps only), the ``clip`` and
 ``drop`` bond policies, an electrode driving a fixed current (a superposition of solves), ``--resume``; with a node
-per neck, a current.
+per neck, a current and the Trefftz element (``[conductance] element = "trefftz"``: the ranks' keys,
+:func:`dem.network.distributed_necks.node_keys`, number one node per neck, not its three flux modes).
 """
 
 from __future__ import annotations
@@ -80,6 +81,9 @@ def unsupported(scene, resume: bool = False) -> str | None:
         name = e.names[int(np.flatnonzero(~e.fixed_potential)[0])]
         return (f"walls.{name}.current: an electrode driving a fixed current does not run under MPI (its potential "
                 f"needs a superposition of solves); give it a potential, or run without mpiexec")
+    if scene.conductance.element != "law":
+        return (f"conductance.element = {scene.conductance.element!r} does not run under MPI yet (the ranks number "
+                f"one node per neck, not its three flux modes); run it without mpiexec")
     if scene.conductance.nodes == "necks" and scene.electrical is not None:
         return ("conductance.nodes = \"necks\" with \"electrical\" physics does not run under MPI yet (the current "
                 "through the neck nodes is solved on one process); run it without mpiexec")

@@ -1,0 +1,125 @@
+"""The particles' elements a scene asks for in the network with a node per neck (``[conductance] element``,
+:class:`dem.laws.conductance.ConductanceSpec`), and what building them took, for the run's summary.
+
+``element = "law"`` gives each particle the ``shared-body`` law's element
+(:func:`dem.laws.shared_body.particle_elements`, one flux mode per neck); ``element = "trefftz"`` the Trefftz element
+of its cut sphere with three flux modes per neck (:func:`dem.network.trefftz_element.trefftz_elements`), which keeps
+the law's element on its monopoles where its own is not positive definite (``plain``), and whose time is said before
+they are built where it is large (:func:`dem.memory.element_estimate`). Either is the ``elements`` hook of
+:func:`dem.network.necks.neck_network`; :func:`scene_elements` is the one place that calls it.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from dem.geometry.necks import pairs_meeting
+from dem.laws.conductance import ConductanceSpec
+from dem.memory import announce, element_estimate
+
+
+class SceneElements:
+    """The ``elements`` hook of :func:`dem.network.necks.neck_network` for ``[conductance] element`` (module
+    docstring), keeping what it built.
+
+    Parameters
+    ----------
+    element : str
+        ``"law"`` or ``"trefftz"`` (``dem.laws.conductance.ELEMENTS``).
+
+    Attributes
+    ----------
+    built : dem.laws.shared_body.ParticleElements or None
+        The elements of the last call; None before it.
+    seconds : float
+        The CPU time of the last call (this process's, on one core: the elements are built on one thread), s.
+    """
+
+    def __init__(self, element: str):
+        self.element = element
+        self.built = None
+        self.seconds = 0.0
+
+    def __call__(self, n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume=None):
+        """The particles' elements (:func:`dem.laws.shared_body.particle_elements`'s arguments); the Trefftz elements'
+        time estimated from the necks first and said where it is large (:func:`dem.memory.element_estimate`,
+        :func:`dem.memory.announce`).
+
+        Parameters
+        ----------
+        n : int
+            Number of particles.
+        radius : numpy.ndarray
+            Particle radii, m.
+        bonds : dem.geometry.bonds.Bonds
+            The live pair and wall bonds, with their neck radii and centre-to-contact distances, m.
+        vectors : numpy.ndarray
+            ``x_j - x_i`` of every pair bond, m.
+        k_i, k_j : numpy.ndarray
+            The law's half conductances of every pair bond on the side of ``i`` and of ``j``, W/K.
+        k_wall : numpy.ndarray
+            The law's half conductance of every wall bond, W/K.
+        conductivity : numpy.ndarray
+            Per particle, its material's conductivity, W/(m K).
+        wall_normals : numpy.ndarray
+            The unit normal of every wall bond's wall, into the packing.
+        volume : numpy.ndarray or None
+            Per particle, the solid it holds, m^3, whose Wiener bound caps the trace of its tensor; None: its
+            sphere's.
+
+        Returns
+        -------
+        dem.laws.shared_body.ParticleElements
+            The elements.
+        """
+        args = (n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume)
+        if self.element == "trefftz":
+            from dem.network.trefftz_element import trefftz_elements as build
+
+            necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=n)
+            announce(element_estimate(necks, pairs_meeting(radius, bonds, vectors, wall_normals)))
+        else:
+            from dem.laws.shared_body import particle_elements as build
+        start = time.process_time()
+        self.built = build(*args)
+        self.seconds = time.process_time() - start
+        return self.built
+
+    def account(self) -> dict:
+        """The summary's entries: ``element`` (its name) and, for ``"trefftz"``, ``element_particles`` (the
+        particles with necks that carry it), ``element_plain`` (those that kept the law's element on their
+        monopoles), ``element_refined`` (those whose quadrature failed its check and was refined) and
+        ``element_seconds`` (the CPU time of building them, s).
+
+        Returns
+        -------
+        dict
+            The entries.
+        """
+        if self.element == "law" or self.built is None:
+            return {"element": self.element}
+        el = self.built
+        with_necks = np.diff(el.offsets) > 0
+        plain = np.asarray(el.plain, dtype=bool)
+        return {"element": self.element, "element_particles": int(np.count_nonzero(with_necks & ~plain)),
+                "element_plain": int(np.count_nonzero(with_necks & plain)),
+                "element_refined": int(np.count_nonzero(with_necks & (np.asarray(el.refine) > 1.0))),
+                "element_seconds": self.seconds}
+
+
+def scene_elements(spec: ConductanceSpec) -> SceneElements:
+    """The ``elements`` hook of :func:`dem.network.necks.neck_network` that ``spec.element`` names (module docstring).
+
+    Parameters
+    ----------
+    spec : dem.laws.conductance.ConductanceSpec
+        The conductance law, its neck reading, nodes and element.
+
+    Returns
+    -------
+    SceneElements
+        The hook, which keeps what it built.
+    """
+    return SceneElements(spec.element)
