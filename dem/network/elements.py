@@ -18,6 +18,7 @@ import numpy as np
 from dem.geometry.necks import pairs_meeting
 from dem.laws.conductance import ConductanceSpec
 from dem.memory import announce, element_estimate
+from sinterheat import threads
 
 
 class SceneElements:
@@ -34,7 +35,8 @@ class SceneElements:
     built : dem.laws.shared_body.ParticleElements or None
         The elements of the last call; None before it.
     seconds : float
-        The CPU time of the last call (this process's, on one core: the elements are built on one thread), s.
+        The CPU time of the last call (this process's, all its threads': the Trefftz elements are built on
+        :func:`sinterheat.threads.count` threads), s.
     """
 
     def __init__(self, element: str):
@@ -79,7 +81,7 @@ class SceneElements:
             from dem.network.trefftz_element import trefftz_elements as build
 
             necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=n)
-            announce(element_estimate(necks, pairs_meeting(radius, bonds, vectors, wall_normals)))
+            announce(element_estimate(necks, pairs_meeting(radius, bonds, vectors, wall_normals), threads.count()))
         else:
             from dem.laws.shared_body import particle_elements as build
         start = time.process_time()
