@@ -17,9 +17,15 @@ every row the rank owns: the serial matrix's row, up to the order of its sums. T
 *used* nodes; the rest of the halo (its fringe, whose elements miss neighbours) is held but never solved for nor
 exchanged.
 
-**Numbering.** A node is known to every rank by a global key: a centre by its particle's index, a neck by its first
-particle's index and its place among that particle's bonds (sorted by partner and image shift: the same on every rank
-that holds the particle's bonds, which the halo ensures for every used neck). The unknowns of a solve are numbered
+**Numbering.** A node is known to every rank by a global key: a centre by its particle's index, a neck's mode ``d``
+by its first particle's index, its place among that particle's bonds (sorted by partner and image shift: the same on
+every rank that holds the particle's bonds, which the halo ensures for every used neck) and ``d``. With the Trefftz
+element (``modes`` 3, :mod:`dem.network.necks`, "Flux modes") a rank builds it for its own particles only
+(:class:`dem.network.elements.SceneElements`' ``own``: the expensive part of such a run shared out), the law's
+one-mode element for the rest of its halo, and receives the elements of its own particles' partners, whose elements
+its rows sum, from their owners (:func:`shared_elements`: each particle's element is the same on every rank that holds
+all its necks, its ends in the same order): every used neck then has a Trefftz particle and its three modes, as in
+the serial network, and the fringe's necks, never used, may have one. The unknowns of a solve are numbered
 rank after rank (:meth:`dem.network.distributed.DistributedNetwork.numbering`).
 
 **Groups and the steady solve.** The groups of free nodes are the connected components over the ranks
@@ -42,7 +48,7 @@ from __future__ import annotations
 import numpy as np
 
 from dem.network.distributed import DistributedNetwork
-from dem.network.necks import NeckHeat, NeckNetwork
+from dem.network.necks import NeckHeat, NeckNetwork, _level
 from dem.parallel import comm as mpi
 from dem.parallel.petsc import largest_eigenvalue
 
@@ -79,16 +85,68 @@ def node_keys(net: NeckNetwork, held: np.ndarray, owner: np.ndarray, comm) -> tu
     Returns
     -------
     tuple of numpy.ndarray
-        ``(keys, owners)`` per node, centres then necks: int64 keys, distinct over the ranks for distinct nodes.
+        ``(keys, owners)`` per node, centres then necks (each live neck's modes one after another): int64 keys,
+        distinct over the ranks for distinct nodes.
     """
     i = net.bonds.i
     first = np.searchsorted(i, i)  # the bonds are sorted by i, then j and shift (dem.geometry.periodic)
     place = np.arange(len(i)) - first
     most = int(mpi.maximum(comm, int(place.max(initial=-1)) + 1))
     n_global = int(mpi.maximum(comm, int(held.max(initial=-1)) + 1))
-    live = net.live
-    necks = n_global + held[i[live]] * most + place[live]
-    return np.concatenate([held, necks]).astype(np.int64), np.concatenate([owner, owner[i[live]]])
+    modes = net.bond_modes
+    width = int(mpi.maximum(comm, int(modes.max(initial=1))))
+    bond = np.repeat(net.live, modes)  # each neck node's bond, its modes in order
+    mode = np.arange(len(bond)) - np.repeat(np.cumsum(modes) - modes, modes)
+    necks = n_global + (held[i[bond]] * most + place[bond]) * width + mode
+    return np.concatenate([held, necks]).astype(np.int64), np.concatenate([owner, owner[i[bond]]])
+
+
+def shared_elements(comm, built, net: NeckNetwork, held: np.ndarray, owner: np.ndarray, mine: np.ndarray):
+    """``built`` with the elements of the partners of this rank's own particles (over their live pair necks) taken
+    from the ranks that own them (module docstring, "Numbering"): what the owned rows sum.
+
+    Parameters
+    ----------
+    comm : object
+        The MPI communicator (an ``mpi4py.MPI.Comm``).
+    built : dem.laws.shared_body.ParticleElements
+        The held particles' elements as this rank built them (its own particles' the ones wanted), in ``net``.
+    net : dem.network.necks.NeckNetwork
+        The rank's network of its held particles, of ``built``.
+    held : numpy.ndarray
+        Global index of each held particle, sorted.
+    owner : numpy.ndarray
+        The rank owning each held particle.
+    mine : numpy.ndarray
+        Per held particle, whether this rank owns it.
+
+    Returns
+    -------
+    dem.laws.shared_body.ParticleElements
+        ``built`` (the same type) with the partners' blocks and per-particle fields (``plain``, ``shrink``,
+        ``modes``, ...) those of their owners.
+    """
+    n = len(held)
+    i, j = net.bonds.i[net.live], net.bonds.j[net.live]
+    need = np.zeros(n, dtype=bool)
+    need[j[mine[i]]] = need[i[mine[j]]] = True
+    wanted = np.flatnonzero(need & ~mine)
+    asks = [held[wanted[owner[wanted] == r]] for r in range(comm.Get_size())]
+    fields = [f for f in built._fields if f not in ("offsets", "ends", "start", "values")]
+    per = {f: np.broadcast_to(np.asarray(getattr(built, f)), (n,)).copy() for f in fields}
+
+    def block(k: int) -> tuple:
+        return (built.values[built.start[k]:built.start[k + 1]], *(per[f][k] for f in fields))
+
+    answers = comm.alltoall([[block(k) for k in np.searchsorted(held, keys)] for keys in comm.alltoall(asks)])
+    blocks = [built.values[built.start[k]:built.start[k + 1]] for k in range(n)]
+    for keys, answer in zip(asks, answers):
+        for k, (values, *rest) in zip(np.searchsorted(held, keys), answer):
+            blocks[k] = values
+            for f, v in zip(fields, rest):
+                per[f][k] = v
+    start = np.concatenate([[0], np.cumsum([len(b) for b in blocks])])
+    return built._replace(start=start, values=np.concatenate(blocks) if n else built.values, **per)
 
 
 class DistributedNecks(DistributedNetwork):
@@ -205,7 +263,7 @@ class DistributedNecks(DistributedNetwork):
         """
         if self._initial is None:
             net = self.net
-            k = net.n_free - len(net.net.live)  # the free centres come first
+            k = net.n_free - (net.net.n_nodes - net.particles.n)  # the free centres come first
             T = np.concatenate([net.particles.temperature[net.free[:k]].astype(float), np.zeros(net.n_free - k)])
             necks = np.arange(net.n_free) >= k
             row, n_global = self.numbering(necks)
@@ -325,7 +383,7 @@ class DistributedNecks(DistributedNetwork):
         return self.components(a, rows.col, start), start
 
     # --------------------------------------------------------------------------------------------- steady
-    def steady(self, floating: str = "mean", rtol: float = 1e-10):
+    def steady(self, floating: str = "mean", rtol: float = 1e-12):
         """Steady temperatures of the free nodes over the ranks (module docstring; no radiation): what
         :func:`dem.network.necks.steady_necks` finds. Returns ``(T_F, flows, energy_error, solver name)``.
 
@@ -336,7 +394,7 @@ class DistributedNecks(DistributedNetwork):
             across a periodic face with a temperature drop keeps its capacity-weighted mean initial temperature) or
             ``"error"`` (it is refused).
         rtol : float
-            The relative residual of the linear solve.
+            The relative residual of the linear solve (:func:`dem.network.necks.steady_necks`' own).
 
         Returns
         -------
@@ -353,7 +411,7 @@ class DistributedNecks(DistributedNetwork):
         if floating not in ("mean", "error"):
             raise ValueError(f"solver.floating = {floating!r}: must be error or mean")
         net = self.net
-        k = net.n_free - len(net.net.live)
+        k = net.n_free - (net.net.n_nodes - net.particles.n)  # the free centres, then the necks' modes
         T_F = np.concatenate([net.particles.temperature[net.free[:k]], np.zeros(net.n_free - k)]).astype(float)
         sinks = net.sinks(T_F)
         label, number = self.neck_groups()
@@ -361,7 +419,7 @@ class DistributedNecks(DistributedNetwork):
         anchored = self._union(label[own & self.anchors(sinks)])
         loose = np.setdiff1d(self._union(label[own]), anchored)  # held at one node, then shifted to their mean
         across = np.zeros(net.n_free, dtype=bool)  # the necks with a temperature drop across a periodic face
-        across[k:] = net.net.jump != 0.0
+        across[net.net.monopoles[net.net.jump != 0.0] - net.particles.n + k] = True
         jumping = self._union(label[own & across])
         if len(loose):
             heat = self.group_sums(loose, label, net.heat)
@@ -395,8 +453,8 @@ class DistributedNecks(DistributedNetwork):
             T0 = np.concatenate([net.particles.temperature[net.free[:k]], np.zeros(net.n_free - k)])
             cap = self.group_sums(loose, label, net.C)
             shift = (self.group_sums(loose, label, net.C * T0) - self.group_sums(loose, label, net.C * T_F)) / cap
-            inside = np.isin(label, loose)
-            T_F[inside] += shift[np.searchsorted(loose, label[inside])]
+            inside = np.isin(label, loose)  # (a dipole's moment does not move with a uniform change)
+            T_F[inside] += shift[np.searchsorted(loose, label[inside])] * _level(net.net)[net.free][inside]
         T_F = self.halo_filled(T_F)[net.free]
         flows = self.flows(T_F, sinks)
         total = self.flow_magnitude(T_F, sinks)

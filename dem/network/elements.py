@@ -11,6 +11,7 @@ they are built where it is large (:func:`dem.memory.element_estimate`). Either i
 
 from __future__ import annotations
 
+import functools
 import time
 
 import numpy as np
@@ -29,6 +30,11 @@ class SceneElements:
     ----------
     element : str
         ``"law"`` or ``"trefftz"`` (``dem.laws.conductance.ELEMENTS``).
+    own : numpy.ndarray or None
+        Per particle, whether it is this process's own (an MPI rank's, :mod:`dem.network.distributed_necks`): the
+        Trefftz element is then built for these only, the law's one-mode element for the rest of the halo (the
+        elements of the own particles' partners come from their owners,
+        :func:`dem.network.distributed_necks.shared_elements`); None: every particle's is built.
 
     Attributes
     ----------
@@ -39,8 +45,9 @@ class SceneElements:
         :func:`sinterheat.threads.count` threads), s.
     """
 
-    def __init__(self, element: str):
+    def __init__(self, element: str, own: np.ndarray | None = None):
         self.element = element
+        self.own = None if own is None else np.asarray(own, dtype=bool)
         self.built = None
         self.seconds = 0.0
 
@@ -77,11 +84,16 @@ class SceneElements:
             The elements.
         """
         args = (n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume)
+        where = None
         if self.element == "trefftz":
-            from dem.network.trefftz_element import trefftz_elements as build
+            from dem.network.trefftz_element import trefftz_elements
 
+            where = self.own
+            build = trefftz_elements if where is None else functools.partial(trefftz_elements, where=where)
             necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=n)
-            announce(element_estimate(necks, pairs_meeting(radius, bonds, vectors, wall_normals), threads.count()))
+            chosen = slice(None) if where is None else where
+            announce(element_estimate(necks[chosen], pairs_meeting(radius, bonds, vectors, wall_normals)[chosen],
+                                      threads.count()))
         else:
             from dem.laws.shared_body import particle_elements as build
         start = time.process_time()
@@ -93,7 +105,8 @@ class SceneElements:
         """The summary's entries: ``element`` (its name) and, for ``"trefftz"``, ``element_particles`` (the
         particles with necks that carry it), ``element_plain`` (those that kept the law's element on their
         monopoles), ``element_refined`` (those whose quadrature failed its check and was refined) and
-        ``element_seconds`` (the CPU time of building them, s).
+        ``element_seconds`` (the CPU time of building them, s); with ``own``, of the own particles (a rank's part
+        of the sums over the ranks).
 
         Returns
         -------
@@ -103,7 +116,7 @@ class SceneElements:
         if self.element == "law" or self.built is None:
             return {"element": self.element}
         el = self.built
-        with_necks = np.diff(el.offsets) > 0
+        with_necks = (np.diff(el.offsets) > 0) & (True if self.own is None else self.own)
         plain = np.asarray(el.plain, dtype=bool)
         return {"element": self.element, "element_particles": int(np.count_nonzero(with_necks & ~plain)),
                 "element_plain": int(np.count_nonzero(with_necks & plain)),
@@ -111,17 +124,19 @@ class SceneElements:
                 "element_seconds": self.seconds}
 
 
-def scene_elements(spec: ConductanceSpec) -> SceneElements:
+def scene_elements(spec: ConductanceSpec, own: np.ndarray | None = None) -> SceneElements:
     """The ``elements`` hook of :func:`dem.network.necks.neck_network` that ``spec.element`` names (module docstring).
 
     Parameters
     ----------
     spec : dem.laws.conductance.ConductanceSpec
         The conductance law, its neck reading, nodes and element.
+    own : numpy.ndarray or None
+        Per particle, whether it is this process's own (:class:`SceneElements`); None: all.
 
     Returns
     -------
     SceneElements
         The hook, which keeps what it built.
     """
-    return SceneElements(spec.element)
+    return SceneElements(spec.element, own)

@@ -31,12 +31,12 @@ def serial(scene):
     return engine
 
 
-def _blocks(boundary: str, solver: dict | None = None, blocks: int = 2):
-    """A random union packing (radii +-15 %, mean overlap 0.15 of the smaller radius: necks meet) repeated
-    ``blocks`` times along x, the longest axis the ranks cut across (periodic: three, as a rank's halo reaches
-    across the period on both sides)."""
-    doc = {"material": MATERIAL, "conductance": NECKS,
-           "generator": {"kind": "random", "n": 200, "radius": 5e-5, "radius_spread": 0.15, "overlap": 0.15,
+def _blocks(boundary: str, solver: dict | None = None, blocks: int = 2, n: int = 200, element: str = "law"):
+    """A random union packing of ``n`` spheres (radii +-15 %, mean overlap 0.15 of the smaller radius: necks meet)
+    repeated ``blocks`` times along x, the longest axis the ranks cut across (periodic: three, as a rank's halo
+    reaches across the period on both sides), with the particles' ``element``."""
+    doc = {"material": MATERIAL, "conductance": {**NECKS, "element": element},
+           "generator": {"kind": "random", "n": n, "radius": 5e-5, "radius_spread": 0.15, "overlap": 0.15,
                          "seed": 3, "boundary": boundary, "hot": 1.0, "cold": 0.0}}
     if solver is not None:
         doc["solver"] = solver

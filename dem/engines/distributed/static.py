@@ -26,8 +26,13 @@ each rank's own particles.
 What it does not do, refused up front with the reason: moving particles (another engine's), radiation (a Newton
 iteration), explicit steps and ``dt = "auto"`` (fixed implicit or Crank-Nicolson steps only), the ``clip`` and
 ``drop`` bond policies, an electrode driving a fixed current (a superposition of solves), ``--resume``; with a node
-per neck, a current and the Trefftz element (``[conductance] element = "trefftz"``: the ranks' keys,
-:func:`dem.network.distributed_necks.node_keys`, number one node per neck, not its three flux modes).
+per neck, a current.
+
+The Trefftz element (``[conductance] element = "trefftz"``, :mod:`dem.network.elements`) runs on the ranks with its
+three flux modes per neck (:func:`dem.network.distributed_necks.node_keys`): each rank builds it for its own particles
+only, the expensive part of such a run shared out, receives those of their necks' partners from their owners
+(:func:`dem.network.distributed_necks.shared_elements`) and assembles its network again with them; the summary's
+``element_*`` entries are summed over the ranks (``element_seconds``: the CPU time of all the ranks' elements).
 """
 
 from __future__ import annotations
@@ -46,7 +51,8 @@ from dem.laws.verified_range import neck_account, wide_necks
 from dem.parallel import comm as mpi
 from dem.network.current import circuit, contact_currents, electrode_bonds, refuse_floating
 from dem.network.distributed import DistributedNetwork
-from dem.network.distributed_necks import DistributedNecks, RankNeckHeat, node_keys
+from dem.network.distributed_necks import DistributedNecks, RankNeckHeat, node_keys, shared_elements
+from dem.network.elements import scene_elements
 from dem.network.heat import Network, bonds_and_conductances
 from dem.network.necks import neck_flows, neck_network
 from dem.output.pieces import refuse_lammps_dump
@@ -81,9 +87,6 @@ def unsupported(scene, resume: bool = False) -> str | None:
         name = e.names[int(np.flatnonzero(~e.fixed_potential)[0])]
         return (f"walls.{name}.current: an electrode driving a fixed current does not run under MPI (its potential "
                 f"needs a superposition of solves); give it a potential, or run without mpiexec")
-    if scene.conductance.element != "law":
-        return (f"conductance.element = {scene.conductance.element!r} does not run under MPI yet (the ranks number "
-                f"one node per neck, not its three flux modes); run it without mpiexec")
     if scene.conductance.nodes == "necks" and scene.electrical is not None:
         return ("conductance.nodes = \"necks\" with \"electrical\" physics does not run under MPI yet (the current "
                 "through the neck nodes is solved on one process); run it without mpiexec")
@@ -149,6 +152,11 @@ class DistributedStaticEngine(StaticEngine):
         self.necks = None  # with a node per neck: the network of the held particles (dem.network.necks)
         owner = mpi.agree(self.comm, lambda: self._build(scene, rank))  # no collective call inside: a bond out of
         particles = self.scene.particles                                  # range stops every rank alike
+        if self.necks is not None and scene.conductance.element != "law":  # the partners' elements from their owners
+            el = shared_elements(self.comm, self.elements.built, self.necks, self.held, owner, self.mine)
+            self.necks = mpi.agree(self.comm, lambda: neck_network(
+                scene.conductance, particles, self.necks.bonds, box=scene.box, walls=scene.walls,
+                elements=lambda *args: el))
         self.potential, self.circuit = None, None
         if scene.electrical is not None:
             particles = mpi.agree(self.comm, lambda: self._joule_heated(particles, owner))
@@ -193,7 +201,7 @@ class DistributedStaticEngine(StaticEngine):
         try:
             if nodes == "necks":  # all the bonds of the held particles (module docstring of distributed_necks)
                 bonds = find_bonds(local, tuple(scene.walls), spec.contact, spec.out_of_range, box=box)
-                self.necks, self.plain = self._neck_network(local, bonds)
+                self.necks, self.plain = self._neck_network(local, bonds, mine)
                 K_pairs, K_walls = bond_conductances(spec, local, bonds, box=box, walls=tuple(scene.walls),
                                                      union=self.necks.union)
             else:
@@ -206,24 +214,19 @@ class DistributedStaticEngine(StaticEngine):
         self.bonds, self.K_pairs, self.K_walls = bonds.subset(pairs, walls), K_pairs[pairs], K_walls[walls]
         self.held, self.mine = held, mine
         self.meeting = meeting_in(local, scene.walls, self.bonds, box)  # right for the owned: all their bonds are here
-        self.wide = wide_necks(local.radius, self.bonds, self.meeting, spec.law, nodes)
+        self.wide = wide_necks(local.radius, self.bonds, self.meeting, spec.law, nodes, spec.element)
         self.T = local.temperature.astype(float)
         return owner_held
 
-    def _neck_network(self, local, bonds) -> tuple:
-        """The network with a node per neck of the held particles (:func:`dem.network.necks.neck_network`) and,
-        per held particle, whether its element dropped its interactions (``plain``)."""
-        from dem.laws.shared_body import particle_elements
-
-        made = []
-
-        def elements(*args):
-            made.append(particle_elements(*args))
-            return made[-1]
-
+    def _neck_network(self, local, bonds, mine: np.ndarray) -> tuple:
+        """The network with a node per neck of the held particles (:func:`dem.network.necks.neck_network`, the
+        elements of ``[conductance] element``, :func:`dem.network.elements.scene_elements`, a Trefftz element on the
+        own particles ``mine`` only: the partners' come from their owners after this) and, per held particle,
+        whether its element dropped its interactions (``plain``)."""
         scene = self.scene
-        net = neck_network(scene.conductance, local, bonds, box=scene.box, walls=scene.walls, elements=elements)
-        return net, np.asarray(made[0].plain, dtype=bool)
+        self.elements = scene_elements(scene.conductance, mine)
+        net = neck_network(scene.conductance, local, bonds, box=scene.box, walls=scene.walls, elements=self.elements)
+        return net, np.asarray(self.elements.built.plain, dtype=bool)
 
     def _joule_heated(self, particles, owner: np.ndarray):
         """The held particles with the absorbed Joule heat of the current added to their heat sources (module
@@ -271,7 +274,7 @@ class DistributedStaticEngine(StaticEngine):
             The network has no solution (a floating group) or the solve failed.
         """
         s = self.scene.solver
-        nodes = self.scene.conductance.nodes
+        nodes, element = self.scene.conductance.nodes, self.scene.conductance.element
         out = {"law": self.scene.conductance.law, "contact": self.bonds.contact, "bonds_clipped": 0,
                "bonds_dropped": 0, "wall_bonds": self.part.total(int(self.bonds.n_walls)), "ranks": self.ranks}
         b = self.bonds
@@ -279,11 +282,16 @@ class DistributedStaticEngine(StaticEngine):
                                 self.full_scene.particle_count, b.contact,
                                 self.part.total(int(np.count_nonzero(self.mine[b.i]) + b.n_walls)),
                                 self.full_scene.conductance.law,
-                                self.part.total(int(np.count_nonzero(self.wide[self.mine]))), nodes=nodes))
+                                self.part.total(int(np.count_nonzero(self.wide[self.mine]))), nodes=nodes,
+                                element=element))
         if self.necks is not None:
             live = self.mine[self.necks.bonds.i[self.necks.live]]
-            out.update(nodes="necks", neck_nodes=self.part.total(int(np.count_nonzero(live))),
-                       particles_without_interactions=self.part.total(int(np.count_nonzero(self.plain[self.mine]))))
+            out.update(nodes="necks", neck_nodes=self.part.total(int(np.count_nonzero(live))))
+            if element == "law":
+                out["particles_without_interactions"] = self.part.total(int(np.count_nonzero(self.plain[self.mine])))
+            else:  # the counts of the own particles and the time of every rank's elements, summed
+                out.update({key: self.part.total(value) if key != "element" else value
+                            for key, value in self.elements.account().items()})
         observer = self._observed(observe)
         if s.mode == "steady" and self.necks is not None:
             T_F, flows, err, solver = mpi.agree(self.comm, lambda: self.part.steady(s.floating))

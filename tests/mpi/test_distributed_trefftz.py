@@ -1,0 +1,126 @@
+"""``[conductance] element = "trefftz"`` on several MPI ranks (dem.network.distributed_necks: three flux modes per
+neck, each rank building the Trefftz elements of its own particles and receiving those of their necks' partners)
+against the serial run of the same scene in the same process: random union packings, periodic and between two walls,
+some blocks long. Every owned row is the serial matrix's; k_eff, the wall flows and the temperatures are the serial
+run's, steady and in implicit and Crank-Nicolson steps."""
+
+import numpy as np
+import pytest
+
+from dem.driver import run
+from dem.engines.distributed.static import DistributedStaticEngine
+from dem.network.distributed_necks import node_keys
+from dem.network.necks import NeckHeat
+from dem.parallel import comm as mpi
+from test_distributed_necks import COMM, _blocks, serial
+
+ELEMENT = ("element_particles", "element_plain", "element_refined")
+
+
+def _trefftz(boundary: str, solver: dict | None = None):
+    """Three blocks of 48 spheres (some with necks that meet) with the Trefftz element (in a periodic box the
+    ranks' halos then reach every particle, a fringe of them still unused and on the law's element)."""
+    return _blocks(boundary, solver, blocks=3, n=40, element="trefftz")
+
+
+def _compare(scene):
+    """The run on the ranks and the serial one: the same necks, elements and temperatures; returns both summaries."""
+    result = run(scene)
+    ref = serial(scene)
+    s, r = result.summary, ref.summary()
+    assert s["ranks"] == COMM.Get_size() and s["element"] == r["element"] == "trefftz"
+    assert ref.necks.modes == 3 and r["element_particles"] > 0.9 * scene.particles.n
+    for key in ("neck_nodes", "bonds", "wall_bonds", "particles_necks_meeting", *ELEMENT):
+        assert s[key] == r[key], key
+    assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-9  # hot - cold = 1 K
+    assert s["energy_error"] < 1e-9
+    engine = result.engine  # a fringe of held nodes neither owned nor reached, its particles on the law's element
+    assert len(engine.part.held) > len(engine.part.used)
+    assert scene.box is not None or len(engine.held) < scene.particles.n  # between walls the halo ends inside
+    assert np.any(np.asarray(engine.necks.modes) == 1) and np.any(np.asarray(engine.necks.modes) == 3)
+    built = np.asarray(engine.elements.built.modes) == 3  # each rank built the Trefftz elements of its own only
+    assert np.array_equal(built, engine.mine) and mpi.total(COMM, int(built.sum())) == scene.particles.n
+    return s, r
+
+
+def test_a_periodic_union_packing_equals_the_serial_run():
+    s, r = _compare(_trefftz("periodic"))
+    assert s["effective_conductivity"] == pytest.approx(r["effective_conductivity"], rel=1e-10)
+    q, q_ref = np.array(s["periodic_heat_flow"]), np.array(r["periodic_heat_flow"])
+    assert np.max(np.abs(q - q_ref)) < 1e-10 * np.max(np.abs(q_ref))
+
+
+def test_a_union_packing_between_walls_equals_the_serial_run():
+    s, r = _compare(_trefftz("plates"))
+    assert s["effective_conductivity"] == pytest.approx(r["effective_conductivity"], rel=1e-10)
+    walls, walls_ref = s["boundary_heat_flow"]["walls"], r["boundary_heat_flow"]["walls"]
+    for name in ("hot", "cold"):
+        assert walls[name] == pytest.approx(walls_ref[name], rel=1e-10)
+
+
+def test_owned_rows_are_those_of_the_serial_matrix():
+    """Each rank's rows over the free nodes, centres and the necks' three modes each, by the nodes' global keys: the
+    serial network's to round-off."""
+    scene = _trefftz("periodic")
+    engine = DistributedStaticEngine(scene)
+    ref = serial(scene)
+    part, net, ref_heat = engine.part, engine.necks_heat, NeckHeat(ref.necks)
+    ref_keys, _ = node_keys(ref.necks, np.arange(scene.particles.n), np.zeros(scene.particles.n, dtype=np.int64),
+                            COMM)
+    ref_free = ref_keys[ref_heat.free]
+    order = np.argsort(ref_free)
+    place = lambda keys: order[np.searchsorted(ref_free, keys, sorter=order)]  # noqa: E731
+    keys = part.held[net.free]
+    own = np.flatnonzero(part.own_free)
+    assert np.array_equal(ref_free[place(keys[own])], keys[own])
+    ours = net.A[own].tocoo()
+    theirs = ref_heat.A[place(keys[own])].tocsr()
+    ours = type(theirs)((ours.data, (ours.row, place(keys[ours.col]))), shape=theirs.shape).tocsr()
+    assert abs(ours - theirs).max() < 1e-12 * np.abs(theirs).max() and ours.nnz == theirs.nnz
+    assert mpi.total(COMM, len(own)) == len(ref_free) == scene.particles.n + 3 * len(ref.necks.live)
+
+
+@pytest.mark.parametrize("integrator", ["implicit", "crank-nicolson"])
+def test_fixed_steps_equal_the_serial_steps(integrator):
+    """Between the walls from 0 C, five steps of 2e-4 s (above the stable limit: Crank-Nicolson starts with implicit
+    Euler steps on both, decided on the condensed matrix of the centres over the ranks)."""
+    scene = _trefftz("plates", {"mode": "transient", "integrator": integrator, "dt": 2e-4, "t_end": 1e-3})
+    result = run(scene)
+    ref = serial(scene)
+    s, r = result.summary, ref.summary()
+    assert s["steps"] == r["steps"] == 5
+    assert s.get("startup_steps") == r.get("startup_steps")
+    assert (r.get("startup_steps") or 0) > 0 or integrator == "implicit"
+    T, T_ref = result.engine.gathered_temperatures(), ref.T
+    assert 0.01 < np.ptp(T_ref) < 1.0  # heat on its way through
+    assert np.max(np.abs(T - T_ref)) < 1e-9
+    assert s["heat_in"]["walls"] == pytest.approx(r["heat_in"]["walls"], rel=1e-9)
+    assert s["energy_error"] < 1e-9
+
+
+def test_a_packing_read_in_parts_equals_the_serial_run():
+    """A packing in parts (16 blocks, 320 particles) read with the Trefftz element: each rank reads the particles
+    within three bond lengths of its own (all of them here; test_distributed_necks' larger one is cut) and builds the
+    elements of its own only; the run is the serial run of the packing read whole."""
+    from benchmarks.distributed import parts_scene
+    from dem.scene import load_scene
+    from test_distributed_network import shared_folder
+
+    folder = shared_folder()
+    if COMM.Get_rank() == 0:
+        path = parts_scene(300, folder, 16, "plates")
+        path.write_text(path.read_text().replace('law = "rojek"', 'law = "shared-body"\nneck = "union"\n'
+                                                                  'nodes = "necks"\nelement = "trefftz"'))
+    path = COMM.bcast(folder / "packing.toml")
+    scene = load_scene(path, part=(COMM.Get_size(), COMM.Get_rank()))
+    whole = load_scene(path)
+    assert scene.conductance.element == "trefftz"
+    assert scene.part is not None and whole.particles.n == scene.particle_count
+    result = run(scene)
+    ref = serial(whole)
+    s, r = result.summary, ref.summary()
+    assert np.array_equal(np.asarray(result.engine.elements.built.modes) == 3, result.engine.mine)
+    for key in ("neck_nodes", "particles_necks_meeting", *ELEMENT):
+        assert s[key] == r[key], key
+    assert s["effective_conductivity"] == pytest.approx(r["effective_conductivity"], rel=1e-10)
+    assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-9
