@@ -227,7 +227,7 @@ def element_seconds(necks, meeting) -> float:
     return float(TREFFTZ_SECONDS["neck"] * np.sum(necks) + TREFFTZ_SECONDS["meeting pair"] * np.sum(meeting))
 
 
-def element_estimate(necks, meeting) -> str | None:
+def element_estimate(necks, meeting, workers: int = 1) -> str | None:
     """What building the Trefftz elements of particles with ``necks`` necks each, ``meeting`` pairs of which meet, will
     take (:func:`element_seconds`), said before it starts where it is large (``ANNOUNCE_SECONDS`` or more); None for
     less.
@@ -238,6 +238,9 @@ def element_estimate(necks, meeting) -> str | None:
         Per particle, its necks.
     meeting : array_like of int
         Per particle, the pairs of its necks that meet.
+    workers : int
+        The threads that will share that CPU time (:func:`dem.network.trefftz_element.trefftz_elements`' ``workers``),
+        named in the line where more than one.
 
     Returns
     -------
@@ -249,7 +252,8 @@ def element_estimate(necks, meeting) -> str | None:
     if seconds < ANNOUNCE_SECONDS:
         return None
     return (f"the Trefftz elements of {len(z)} particles ({z.mean():.3g} necks each on average, "
-            f"{int(np.sum(meeting))} pairs of necks meeting): about {seconds:.3g} s on one core, before the solve")
+            f"{int(np.sum(meeting))} pairs of necks meeting): about {seconds:.3g} s on one core"
+            f"{f', shared by {workers} threads' if workers > 1 else ''}, before the solve")
 
 
 _SAY = contextvars.ContextVar("say", default=None)

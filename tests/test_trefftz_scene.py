@@ -144,6 +144,7 @@ def test_the_estimate_is_per_neck_and_per_pair_of_necks_meeting_said_only_where_
     line = memory.element_estimate([12] * n, [24] * n)
     assert line == (f"the Trefftz elements of {n} particles (12 necks each on average, {24 * n} pairs of necks "
                     f"meeting): about {(12 * a + 24 * b) * n:.3g} s on one core, before the solve")
+    assert memory.element_estimate([12] * n, [24] * n, 4) == line.replace("one core,", "one core, shared by 4 threads,")
 
 
 @pytest.mark.parametrize("kind, h, pairs", [("sc", 0.6, 36), ("fcc", 0.2, 0), ("fcc", 0.3, 24)])
@@ -172,6 +173,7 @@ def test_the_estimate_is_said_from_the_live_necks_before_the_elements_are_built(
     for a small estimate."""
     from dem.engines.static import StaticEngine
     from dem.geometry.necks import pairs_meeting
+    from sinterheat import threads
 
     scene = _packing(1)
     heard = []
@@ -187,6 +189,7 @@ def test_the_estimate_is_said_from_the_live_necks_before_the_elements_are_built(
         return built[-1]
 
     monkeypatch.setattr(te, "trefftz_elements", build)
+    monkeypatch.setattr(threads, "count", lambda: 2)  # the threads that will build them, named in the line
     with memory.announcing(lambda line: heard.append((line, len(built)))):
         StaticEngine(scene)
     n, radius, live, vectors = given[0][:4]
@@ -194,7 +197,8 @@ def test_the_estimate_is_said_from_the_live_necks_before_the_elements_are_built(
     m = pairs_meeting(radius, live, vectors, given[0][8])
     seconds = 10.0 * z.sum() + memory.TREFFTZ_SECONDS["meeting pair"] * m.sum()
     assert heard == [(f"the Trefftz elements of 8 particles ({z.mean():.3g} necks each on average, {m.sum()} pairs "
-                      f"of necks meeting): about {seconds:.3g} s on one core, before the solve", 0)]
+                      f"of necks meeting): about {seconds:.3g} s on one core, shared by 2 threads, before the solve",
+                      0)]
     assert len(built) == 1 and m.sum() > 0
 
 

@@ -19,6 +19,7 @@ import numpy as np
 from dem.geometry.necks import pairs_meeting
 from dem.laws.conductance import ConductanceSpec
 from dem.memory import announce, element_estimate
+from sinterheat import threads
 
 
 class SceneElements:
@@ -40,7 +41,8 @@ class SceneElements:
     built : dem.laws.shared_body.ParticleElements or None
         The elements of the last call; None before it.
     seconds : float
-        The CPU time of the last call (this process's, on one core: the elements are built on one thread), s.
+        The CPU time of the last call (this process's, all its threads': the Trefftz elements are built on
+        :func:`sinterheat.threads.count` threads), s.
     """
 
     def __init__(self, element: str, own: np.ndarray | None = None):
@@ -90,7 +92,8 @@ class SceneElements:
             build = trefftz_elements if where is None else functools.partial(trefftz_elements, where=where)
             necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=n)
             chosen = slice(None) if where is None else where
-            announce(element_estimate(necks[chosen], pairs_meeting(radius, bonds, vectors, wall_normals)[chosen]))
+            announce(element_estimate(necks[chosen], pairs_meeting(radius, bonds, vectors, wall_normals)[chosen],
+                                      threads.count()))
         else:
             from dem.laws.shared_body import particle_elements as build
         start = time.process_time()

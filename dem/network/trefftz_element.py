@@ -70,6 +70,16 @@ A wall bond's face is a plane cut like a neck's: normal into the wall, arm ``wal
 temperature, the dipoles' moments 0: the wall is isothermal, :mod:`dem.network.necks`). Its monopole takes the same
 chain shift: a particle between two walls at its necks' planes is the chain particle, since the neck plane of a
 symmetric pair is isothermal by symmetry.
+
+**On every core.** The particles' elements are independent, and :func:`trefftz_elements` computes them on a pool of
+threads (``workers``, by default :func:`sinterheat.threads.count`: ``--threads``, ``SINTERHEAT_THREADS``, else every
+core the process may run on; one where there is one Trefftz particle). Threads suffice: the compiled kernels (the
+quadrature's points, the basis) run without the GIL (``nogil``), and so do numpy's and scipy's BLAS and LAPACK calls
+and array operations, which are most of the rest. BLAS is held to one thread for the whole pool
+(:func:`sinterheat.threads.one_blas_thread`: the BLAS library's setting is the process's, not a thread's), and the
+tables every particle reads (the chain's shift, the union law) are built before the threads start. The elements are
+computed in parallel and put together in particle order, each by the same operations as on one thread: the result is
+the serial loop's bit for bit.
 """
 
 from __future__ import annotations
@@ -77,6 +87,7 @@ from __future__ import annotations
 import functools
 import math
 from collections import namedtuple
+from concurrent.futures import ThreadPoolExecutor
 
 import numba
 import numpy as np
@@ -87,6 +98,7 @@ from dem.geometry.bonds import Bonds
 from dem.laws.shared_body import ParticleElements, particle_elements
 from dem.network.necks import bordered, neck_frames
 from fem_neck.law import ConductanceLaw
+from sinterheat import threads
 from sinterheat.threads import one_blas_thread
 
 DEGREE = 10  #: the harmonics' largest degree L, within 1 % of the union's FE on every lattice and random cell checked
@@ -150,7 +162,7 @@ def _inside(p0, p1, a, lines, nl):
     return True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _face_points(j, normals, d, tr, wr, tp, wp, P, W, w, start):
     """Append face ``j``'s quadrature (module docstring) at ``P[start:]``: points, area weights ``W``, profile ``w``;
     returns the end (``start``: the face has no area)."""
@@ -300,7 +312,7 @@ def _rim_crossings(ni, ci, nk, ck, n, th_j, out, no):
     return no
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _cap_points(j, normals, d, tt, wt, GT, GW, n_phi, P, W, start):
     """Append cap ``j`` (the sphere beyond plane ``j``) less the caps before it at ``P[start:]``, area weights ``W``
     (module docstring); returns the end."""
@@ -409,7 +421,7 @@ def _cap_points(j, normals, d, tt, wt, GT, GW, n_phi, P, W, start):
     return q
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _harmonics(P, L, nrm, V, DN, radial):
     """The real solid harmonics of degree 1 to ``L``, normalised to :math:`\\int_{S^2} \\phi^2 = 1`, then
     :math:`|x|^2` at the points ``P`` (N, 3): values into ``V`` (N, (L + 1)^2) and derivatives along ``nrm`` (N, 3)
@@ -718,7 +730,7 @@ def _positive_definite(R: np.ndarray) -> bool:
 
 def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarray, k_i: np.ndarray,
                      k_j: np.ndarray, k_wall: np.ndarray, conductivity: np.ndarray, wall_normals: np.ndarray,
-                     volume=None, L: int = DEGREE, where=None) -> TrefftzElements:
+                     volume=None, L: int = DEGREE, where=None, workers=None) -> TrefftzElements:
     r"""The particles' Trefftz elements with three flux modes per neck (module docstring), the ``elements`` hook of
     :func:`dem.network.necks.neck_network` (the arguments of :func:`dem.laws.shared_body.particle_elements`, whose
     ends it keeps: the faces of each particle's cut body), on every particle or on those of ``where``; the others
@@ -752,6 +764,10 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
         The harmonics' largest degree, 6 to 16 (:data:`DEGREE` is the verified one).
     where : numpy.ndarray or None
         (n,) bool: the particles that get the Trefftz element; None: all.
+    workers : int or None
+        The threads that compute the elements, >= 1, at most one per Trefftz particle (module docstring, "On every
+        core"); None: :func:`sinterheat.threads.count` (``--threads``, ``SINTERHEAT_THREADS``, else every core this
+        process may run on). The elements are the same bit for bit on any number.
 
     Returns
     -------
@@ -764,6 +780,9 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
     """
     if not 6 <= L <= 16:
         raise ValueError(f"L = {L}: the Trefftz element's degree must be in 6..16")
+    workers = threads.count() if workers is None else workers
+    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
+        raise ValueError(f"workers = {workers!r}: must be an integer >= 1 (None: every core this process may use)")
     chosen = np.ones(n, dtype=bool) if where is None else np.asarray(where)
     if chosen.dtype != bool or chosen.shape != (n,):
         raise ValueError(f"where: {chosen.dtype} of shape {chosen.shape}: must be a bool mask of the {n} particles")
@@ -775,23 +794,16 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
                     np.concatenate([bonds.l_i, bonds.l_j, bonds.wall_l]),
                     np.concatenate([frames, frames, neck_frames(into_wall)]), np.concatenate([k_i, k_j, k_wall]),
                     radius, conductivity, L)
-    plain = np.zeros(n, dtype=bool)
+    plain = np.where(chosen, False, law.plain)
     refine = np.ones(n)
-    blocks, start = [], [0]
-    with one_blas_thread():
-        for k in range(n):
-            if not chosen[k]:  # the law's element, one mode per neck
-                plain[k] = law.plain[k]
-                blocks.append(law.values[law.start[k]:law.start[k + 1]])
-                start.append(start[-1] + len(blocks[-1]))
-                continue
-            E, plain[k], refine[k] = particle_element(k, cut)
-            blocks.append(E.ravel())
-            start.append(start[-1] + len(blocks[-1]))
+    blocks = [law.values[law.start[k]:law.start[k + 1]] for k in range(n)]  # the law's element, one mode per neck
+    trefftz = np.flatnonzero(chosen)
+    for k, (E, plain_k, refine_k) in zip(trefftz, _particle_elements(trefftz, cut, workers)):
+        blocks[k], plain[k], refine[k] = E.ravel(), plain_k, refine_k
+    start = np.cumsum([0] + [len(b) for b in blocks])
     if where is None:
-        return TrefftzElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain, np.ones(n), 3,
-                               refine)
-    return TrefftzElements(law.offsets, law.ends, np.array(start), np.concatenate(blocks), plain,
+        return TrefftzElements(law.offsets, law.ends, start, np.concatenate(blocks), plain, np.ones(n), 3, refine)
+    return TrefftzElements(law.offsets, law.ends, start, np.concatenate(blocks), plain,
                            np.where(chosen, 1.0, law.shrink), np.where(chosen, 3, 1), refine)
 
 
@@ -809,6 +821,25 @@ per bond end (pair bonds on ``i``, on ``j``, then the wall bonds) the unit norma
 (:func:`dem.network.necks.neck_frames` of the bond's vector from ``i`` to ``j``, of the normal into a wall) and
 the law's half conductance from the centre to the neck (W/K); ``radius`` (m) and ``conductivity`` (W/(m K)) per
 particle, ``L`` the harmonics' largest degree."""
+
+
+def _particle_elements(particles: np.ndarray, cut: CutBodies, workers: int) -> list:
+    """:func:`particle_element` of each of ``particles``, in their order, on up to ``workers`` threads (module
+    docstring, "On every core")."""
+    workers = min(workers, len(particles))
+    if workers > 1:  # the tables every particle reads, built once before the threads share them
+        _chain_table(cut.L)
+        _union_law()
+    with one_blas_thread():  # process-wide (the BLAS library's own setting): one thread in every worker
+        if workers <= 1:
+            return [particle_element(k, cut) for k in particles]
+        with ThreadPoolExecutor(workers, thread_name_prefix="trefftz") as pool:
+            futures = [pool.submit(particle_element, k, cut) for k in particles]
+            try:
+                return [f.result() for f in futures]
+            except BaseException:
+                pool.shutdown(cancel_futures=True)
+                raise
 
 
 def particle_element(k: int, cut: CutBodies) -> tuple:
