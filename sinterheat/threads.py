@@ -68,6 +68,20 @@ def count() -> int:
     return cores() if value is None or not value.strip() else check(value, ENVIRONMENT)
 
 
+def share_among_ranks(ranks: int) -> None:
+    """On ``ranks`` MPI ranks of one machine, each rank's share of its cores (:func:`use` of ``cores() // ranks``, at
+    least 1) unless ``SINTERHEAT_THREADS`` or ``--threads`` chose the number: every rank's threads at once would
+    oversubscribe the cores.
+
+    Parameters
+    ----------
+    ranks : int
+        The ranks of the run (``MPI_COMM_WORLD``'s size).
+    """
+    if not os.environ.get(ENVIRONMENT):
+        use(max(1, cores() // ranks))
+
+
 def use(number: int) -> None:
     """Use ``number`` threads (checked by :func:`check`) from here on: numba's loops and BLAS (module docstring).
 

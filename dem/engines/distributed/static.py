@@ -56,6 +56,7 @@ from dem.network.elements import scene_elements
 from dem.network.heat import Network, bonds_and_conductances
 from dem.network.necks import neck_flows, neck_network
 from dem.output.pieces import refuse_lammps_dump
+from sinterheat import threads
 
 
 def unsupported(scene, resume: bool = False) -> str | None:
@@ -145,6 +146,7 @@ class DistributedStaticEngine(StaticEngine):
             raise ValueError(why)
         self.comm = mpi.world()
         self.ranks, rank = self.comm.Get_size(), self.comm.Get_rank()
+        threads.share_among_ranks(self.ranks)  # (the Trefftz elements are built on threads)
         self.full_scene = self.scene = scene  # self.scene: the local particles once built
         self.t_start = float(scene.start_time)
         self.t, self.steps = self.t_start, 0

@@ -50,8 +50,6 @@ goes on as the uninterrupted run does, on as many ranks as wrote the checkpoint 
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from dem.parallel import comm as mpi
@@ -574,8 +572,7 @@ class RankVerletEngine(VerletEngine):
         """
         size = world().Get_size()
         refuse_unsupported(scene, size, restart)
-        if not os.environ.get(threads.ENVIRONMENT):
-            threads.use(max(1, threads.cores() // size))
+        threads.share_among_ranks(size)
         if size > 1:
             self.thermal_class = RankContactThermal
         super().__init__(scene, restart)
