@@ -156,7 +156,7 @@ class PCGSolver:
         """
         A, M = self.A, self.precondition
         x = np.zeros_like(b) if x0 is None else np.array(x0, dtype=float)
-        r = b - A @ x
+        r = b - A @ x if np.any(x) else np.array(b, dtype=float)  # from zero (a steady start): no pass over A
         target2 = self.rtol**2 * _dot(b, b)
         rr = _dot(r, r)
         if rr <= target2:
