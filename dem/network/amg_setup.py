@@ -162,7 +162,8 @@ def galerkin(A, P, R) -> sp.csr_matrix:
     scipy.sparse.csr_matrix
         The coarse matrix (n_c, n_c), its column indices in the order the sums met them.
     """
-    AP = _product(A.indptr, A.indices, A.data, P.indptr[:-1], P.indptr[1:], P.indices, P.data, P.shape[1],
+    p_rows = P.indptr.astype(np.int64)  # where P's rows begin and end, as A P's: one compiled product, not two
+    AP = _product(A.indptr, A.indices, A.data, p_rows[:-1], p_rows[1:], P.indices, P.data, P.shape[1],
                   row_blocks(A.indptr, BLOCKS))
     bounds = row_blocks(R.indptr, BLOCKS)
     rows = _product(R.indptr, R.indices, R.data, *AP, P.shape[1], bounds)
