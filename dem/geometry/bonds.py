@@ -5,7 +5,9 @@ from cubic cells of the largest diameter searched on numba's threads when no rad
 packing (the
 neighbour list's binning, :func:`dem.geometry.neighbours.verlet_pairs`), else from k-d trees
 (``scipy.spatial.cKDTree``), the particles grouped in radius classes (a factor 2 apart) so that a polydisperse
-packing never searches with twice the largest radius among its small particles.
+packing never searches with twice the largest radius among its small particles. From ``CELL_SEARCH_MIN`` particles
+on, the pairs' radii, overlaps and radical planes come from one compiled pass (:mod:`dem.geometry.bond_kernels`),
+numpy's values to the bit.
 
 The contact radius ``a`` of a bond is given by the *contact geometry* that the conductance law asks for:
 
