@@ -1,6 +1,6 @@
 """The pair search behind the bonds and the neighbour lists: cells searched in blocks on numba's threads against
 brute force, with the pairs' distances, and the bond search's two routes (cells for one radius class, k-d trees for
-wider ones)."""
+wider ones; the bonds' geometry compiled or by numpy)."""
 
 import numpy as np
 import pytest
@@ -9,6 +9,7 @@ from scipy.spatial import cKDTree
 from dem.geometry import bonds, neighbours
 from dem.geometry.bonds import candidate_pairs
 from dem.geometry.neighbours import verlet_pairs
+from dem.geometry.particles import Particles
 
 
 def brute_pairs(x, r, skin=0.0, box=(0.0, 0.0, 0.0)):
@@ -62,6 +63,35 @@ def test_bond_candidates_are_the_overlapping_pairs(monkeypatch, spread, cells_fr
     assert np.array_equal(i, key // n) and np.array_equal(j, key % n)
     assert np.array_equal(d, np.linalg.norm(x[j] - x[i], axis=1))
 
+
+
+@pytest.mark.parametrize("policy", ["error", "clip", "drop"])
+@pytest.mark.parametrize("contact", ["newton", "coble", "lens"])
+def test_the_compiled_bond_geometry_is_numpys_to_the_bit(monkeypatch, contact, policy):
+    """From CELL_SEARCH_MIN particles on the bonds' radii, overlaps, radical planes and range flags come from one
+    compiled pass (dem.geometry.bond_kernels): the same bonds as numpy's route to the bit, bonds beyond the range and
+    two coincident particles (d = 0: the planes at -inf) included, and the same refusal where the policy refuses."""
+    rng = np.random.default_rng(7)
+    n = 3000
+    r = 1e-4 * rng.uniform(1.0, 1.5, n)
+    x = rng.uniform(0.0, 3.2e-3, (n, 3))
+    x[1] = x[0]
+
+    def bonds_or_refusal(cells_from):
+        monkeypatch.setattr(bonds, "CELL_SEARCH_MIN", cells_from)
+        try:
+            return bonds.find_bonds(Particles.from_arrays(x, r, np.zeros(n)), contact=contact, out_of_range=policy)
+        except ValueError as refusal:
+            return str(refusal)
+
+    compiled, by_numpy = bonds_or_refusal(1000), bonds_or_refusal(10**9)
+    if policy == "error" or (policy == "clip" and contact == "lens"):  # d = 0: the lens' conductance is infinite
+        assert isinstance(by_numpy, str) and compiled == by_numpy
+        return
+    assert (compiled.clipped or compiled.dropped) > 10
+    for field in ("i", "j", "h", "d", "a", "l_i", "l_j"):
+        assert np.array_equal(getattr(compiled, field), getattr(by_numpy, field)), field
+    assert (compiled.clipped, compiled.dropped) == (by_numpy.clipped, by_numpy.dropped)
 
 def test_a_particle_far_away_does_not_make_the_cell_grid_huge():
     """400 particles in a 6 mm box and one 1 m away along every axis: cells of the cutoff (1 mm) would number

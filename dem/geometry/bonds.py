@@ -5,7 +5,9 @@ from cubic cells of the largest diameter searched on numba's threads when no rad
 packing (the
 neighbour list's binning, :func:`dem.geometry.neighbours.verlet_pairs`), else from k-d trees
 (``scipy.spatial.cKDTree``), the particles grouped in radius classes (a factor 2 apart) so that a polydisperse
-packing never searches with twice the largest radius among its small particles.
+packing never searches with twice the largest radius among its small particles. From ``CELL_SEARCH_MIN`` particles
+on, the pairs' radii, overlaps and radical planes come from one compiled pass (:mod:`dem.geometry.bond_kernels`),
+numpy's values to the bit.
 
 The contact radius ``a`` of a bond is given by the *contact geometry* that the conductance law asks for:
 
@@ -306,17 +308,25 @@ def _apply_policy(bad, what: str, first: str, policy: str, total: int):
 
 
 def _pair_contacts(p: Particles, i, j, d, contact, policy):
-    r_i, r_j = p.radius[i], p.radius[j]
-    h = r_i + r_j
-    h -= d
-    l_i, l_j = _lens_planes(r_i, r_j, d)
-    if contact in LENS_GEOMETRY:
-        bad = (l_i < 0) | (l_j < 0)
+    lens = contact in LENS_GEOMETRY
+    if p.n >= CELL_SEARCH_MIN:  # numba is loaded (the cell search, the solve): one compiled pass, the same bits
+        from dem.geometry.bond_kernels import pair_geometry
+
+        r_i, r_j, h, l_i, l_j, bad = pair_geometry(p.radius, i, j, d, lens)
+    else:
+        r_i, r_j = p.radius[i], p.radius[j]
+        h = r_i + r_j
+        h -= d
+        l_i, l_j = _lens_planes(r_i, r_j, d)
+        if lens:
+            bad = (l_i < 0) | (l_j < 0)
+        else:  # max_overlap is the smaller radius / 3 plus a cap's share >= 0: only the bonds beyond it need it
+            third = np.minimum(r_i, r_j)
+            third /= 3.0
+            bad = h > third
+    if lens:
         limit = "the lens needs both centres outside the other sphere's cap: d^2 >= |r_j^2 - r_i^2|"
-    else:  # max_overlap is the smaller radius / 3 plus a cap's share >= 0: only the bonds beyond the first need it
-        third = np.minimum(r_i, r_j)
-        third /= 3.0
-        bad = h > third
+    else:
         near = np.flatnonzero(bad)
         bad[near] = h[near] > max_overlap(r_i[near], r_j[near])
         limit = "overlap h <= max_overlap(r_i, r_j), where the neck reaches the smaller radius"

@@ -156,7 +156,7 @@ class PCGSolver:
         """
         A, M = self.A, self.precondition
         x = np.zeros_like(b) if x0 is None else np.array(x0, dtype=float)
-        r = b - A @ x
+        r = b - A @ x if np.any(x) else np.array(b, dtype=float)  # from zero (a steady start): no pass over A
         target2 = self.rtol**2 * _dot(b, b)
         rr = _dot(r, r)
         if rr <= target2:
@@ -397,10 +397,13 @@ def choose_backend(A: sp.spmatrix, laplacian_diagonal: np.ndarray) -> str:
     """
     n = A.shape[0]
     extra = A.diagonal() - laplacian_diagonal
-    with np.errstate(divide="ignore"):
-        rho = np.min(np.where(laplacian_diagonal > 0, extra / laplacian_diagonal, np.inf), initial=np.inf)
-    if n > JACOBI_MIN and rho > 0 and 1.0 + 2.0 / rho <= JACOBI_MAX_CONDITION:
-        return "cg"
+    # rho > 0 needs extra > 0 wherever the Laplacian's diagonal is: a steady network (extra = 0) stops here, before
+    # the quotients (a few fresh arrays of a node each)
+    if n > JACOBI_MIN and np.all((extra > 0) | ~(laplacian_diagonal > 0)):
+        with np.errstate(divide="ignore"):
+            rho = np.min(np.where(laplacian_diagonal > 0, extra / laplacian_diagonal, np.inf), initial=np.inf)
+        if rho > 0 and 1.0 + 2.0 / rho <= JACOBI_MAX_CONDITION:
+            return "cg"
     return "direct" if n <= DIRECT_MAX else "amg"
 
 
