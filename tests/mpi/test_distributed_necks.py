@@ -90,10 +90,10 @@ def test_a_union_packing_between_walls_equals_the_serial_run():
     assert s["heat_flow"]["walls"] == pytest.approx(0.0, abs=1e-8 * abs(walls_ref["hot"]))
 
 
-def test_owned_rows_are_those_of_the_serial_matrix():
-    """Each rank's rows over the free nodes, centres and necks, by the nodes' global keys: the serial network's to
-    round-off (the halo of three bond lengths holds every element they are summed from)."""
-    scene = _blocks("periodic", blocks=3)
+def owned_rows_against_serial(scene) -> tuple:
+    """This rank's owned rows of ``scene``'s neck-node matrix and right-hand side against the serial network's rows
+    of the same nodes (matched by their global keys), and the serial network: ``(ours, theirs, r_ours, r_theirs,
+    owned rows summed over the ranks, serial free nodes, serial engine)``."""
     engine = DistributedStaticEngine(scene)
     ref = serial(scene)
     part, net, ref_heat = engine.part, engine.necks_heat, NeckHeat(ref.necks)
@@ -108,11 +108,17 @@ def test_owned_rows_are_those_of_the_serial_matrix():
     ours = net.A[own].tocoo()
     theirs = ref_heat.A[place(keys[own])].tocsr()
     ours = type(theirs)((ours.data, (ours.row, place(keys[ours.col]))), shape=theirs.shape).tocsr()
-    scale = np.abs(theirs).max()
-    assert abs(ours - theirs).max() < 1e-12 * scale and ours.nnz == theirs.nnz
-    r_ref = ref_heat.r_const[place(keys[own])]
-    assert np.max(np.abs(net.r_const[own] - r_ref)) <= 1e-12 * max(np.max(np.abs(r_ref)), 1e-300)
-    assert mpi.total(COMM, len(own)) == len(ref_free)
+    return (ours, theirs, net.r_const[own], ref_heat.r_const[place(keys[own])], mpi.total(COMM, len(own)),
+            len(ref_free), ref)
+
+
+def test_owned_rows_are_those_of_the_serial_matrix():
+    """Each rank's rows over the free nodes, centres and necks, by the nodes' global keys: the serial network's to
+    round-off (the halo of three bond lengths holds every element they are summed from)."""
+    ours, theirs, r_ours, r_ref, owned, free, _ = owned_rows_against_serial(_blocks("periodic", blocks=3))
+    assert abs(ours - theirs).max() < 1e-12 * np.abs(theirs).max() and ours.nnz == theirs.nnz
+    assert np.max(np.abs(r_ours - r_ref)) <= 1e-12 * max(np.max(np.abs(r_ref)), 1e-300)
+    assert owned == free
 
 
 @pytest.mark.parametrize("integrator, dt", [("implicit", 2e-4), ("crank-nicolson", 2e-4),

@@ -8,11 +8,8 @@ import numpy as np
 import pytest
 
 from dem.driver import run
-from dem.engines.distributed.static import DistributedStaticEngine
-from dem.network.distributed_necks import node_keys
-from dem.network.necks import NeckHeat
 from dem.parallel import comm as mpi
-from test_distributed_necks import COMM, _blocks, serial
+from test_distributed_necks import COMM, _blocks, owned_rows_against_serial, serial
 
 ELEMENT = ("element_particles", "element_plain", "element_refined")
 
@@ -62,22 +59,9 @@ def test_owned_rows_are_those_of_the_serial_matrix():
     """Each rank's rows over the free nodes, centres and the necks' three modes each, by the nodes' global keys: the
     serial network's to round-off."""
     scene = _trefftz("periodic")
-    engine = DistributedStaticEngine(scene)
-    ref = serial(scene)
-    part, net, ref_heat = engine.part, engine.necks_heat, NeckHeat(ref.necks)
-    ref_keys, _ = node_keys(ref.necks, np.arange(scene.particles.n), np.zeros(scene.particles.n, dtype=np.int64),
-                            COMM)
-    ref_free = ref_keys[ref_heat.free]
-    order = np.argsort(ref_free)
-    place = lambda keys: order[np.searchsorted(ref_free, keys, sorter=order)]  # noqa: E731
-    keys = part.held[net.free]
-    own = np.flatnonzero(part.own_free)
-    assert np.array_equal(ref_free[place(keys[own])], keys[own])
-    ours = net.A[own].tocoo()
-    theirs = ref_heat.A[place(keys[own])].tocsr()
-    ours = type(theirs)((ours.data, (ours.row, place(keys[ours.col]))), shape=theirs.shape).tocsr()
+    ours, theirs, _, _, owned, free, ref = owned_rows_against_serial(scene)
     assert abs(ours - theirs).max() < 1e-12 * np.abs(theirs).max() and ours.nnz == theirs.nnz
-    assert mpi.total(COMM, len(own)) == len(ref_free) == scene.particles.n + 3 * len(ref.necks.live)
+    assert owned == free == scene.particles.n + 3 * len(ref.necks.live)
 
 
 @pytest.mark.parametrize("integrator", ["implicit", "crank-nicolson"])
