@@ -213,13 +213,17 @@ def test_a_chain_of_particles_is_the_one_node_law():
     assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
 
 
-def test_an_element_not_positive_definite_falls_back_to_the_laws_monopoles(monkeypatch):
-    """A shift that breaks positive definiteness (forced here: far below the Trefftz diagonal) leaves every particle
-    the law's element on its monopoles, marked plain, with its unshifted dipoles beside them: on the chain that is
-    the law's k_eff again."""
+@pytest.mark.parametrize("name, value, refine", [
+    ("chain_shift", lambda q, L: np.full(np.shape(q), -10.0), 1.0),  # far below the diagonal: not positive definite
+    ("DEFECT", -1.0, None),  # a quadrature check no rule can pass: tried at every rule
+])
+def test_a_particle_whose_element_fails_keeps_the_laws_monopoles(monkeypatch, name, value, refine):
+    """A shift that breaks positive definiteness, or a check made impossible to pass, leaves every particle of the
+    chain the law's element on its monopoles, marked plain, with its unshifted dipoles beside them (the check: after
+    trying every rule): the law's k_eff again."""
     from verification.lattices import dem_periodic
 
-    monkeypatch.setattr(te, "chain_shift", lambda q, L: np.full(np.shape(q), -10.0))
+    monkeypatch.setattr(te, name, value)
     built = []
 
     def hook(*args, **kwargs):
@@ -228,7 +232,7 @@ def test_an_element_not_positive_definite_falls_back_to_the_laws_monopoles(monke
 
     cell = _periodic_chain(0.5)
     k = dem_periodic(cell, "shared-body", neck="union", nodes="necks", elements=hook)
-    assert built[0].plain.all()
+    assert built[0].plain.all() and (built[0].refine == (te.REFINE[-1] if refine is None else refine)).all()
     assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
 
 
@@ -271,24 +275,6 @@ def test_particle_element_refines_the_failing_particle():
     """At the default degree the packing's particle is computed with 1.5 times the rule, not marked plain."""
     E, plain, refine = te.particle_element(0, _one_particle(SEED2_NORMALS, SEED2_ARMS, te.DEGREE))
     assert refine == 1.5 and not plain and np.isfinite(E).all()
-
-
-def test_a_particle_failing_the_check_at_the_finest_rule_keeps_the_laws_element(monkeypatch):
-    """The check made impossible to pass (DEFECT below 0): every particle of the chain is tried at each rule and
-    keeps the law's element on its monopoles, marked plain: the law's k_eff again."""
-    from verification.lattices import dem_periodic
-
-    monkeypatch.setattr(te, "DEFECT", -1.0)
-    built = []
-
-    def hook(*args, **kwargs):
-        built.append(te.trefftz_elements(*args, **kwargs))
-        return built[-1]
-
-    cell = _periodic_chain(0.5)
-    k = dem_periodic(cell, "shared-body", neck="union", nodes="necks", elements=hook)
-    assert built[0].plain.all() and (built[0].refine == te.REFINE[-1]).all()
-    assert k == pytest.approx(dem_periodic(cell, "shared-body", neck="union"), rel=1e-9)
 
 
 # FCC, union of spheres, h/r = 0.1: the periodic cell's FE lower and upper bounds at rtol 1e-3 (python -m
