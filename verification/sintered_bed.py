@@ -119,17 +119,22 @@ def scene_doc(dump: pathlib.Path, t_end: float | None = None) -> dict:
     return doc
 
 
-def _k_eff_on(engine, net) -> float:
+def _k_eff_on(engine, net, spec=None) -> float:
     """The engine's k_eff between its heated walls on the network ``net`` (a :class:`dem.network.heat.Network`, or
-    with a node per neck a :class:`dem.network.necks.NeckHeat`) in place of its own."""
+    with a node per neck a :class:`dem.network.necks.NeckHeat`) in place of its own, read under the conductance
+    ``spec`` (a :class:`dem.laws.conductance.ConductanceSpec`; None: the run's)."""
+    from dem.network.necks import NeckHeat
+
     th = engine.thermal
-    name = "necks" if th.necks is not None else "net"
-    kept = getattr(th, name)
+    name = "necks" if isinstance(net, NeckHeat) else "net"
+    kept, kept_spec = getattr(th, name), th.spec
     setattr(th, name, net)
+    th.spec = kept_spec if spec is None else spec
     try:
         return engine.effective_conductivity()
     finally:
         setattr(th, name, kept)
+        th.spec = kept_spec
 
 
 def _k_eff_with_steps(engine, steps) -> float:
@@ -161,13 +166,70 @@ def _k_eff_read(engine, law: str, neck: str) -> float:
         th.spec = kept
 
 
-def sinter(doc: dict) -> dict:
+def union_now(engine) -> tuple:
+    """The contacts of ``engine`` now read as the union of its spheres as the hand-over grew them: the grown spheres
+    (each particle's solid radius, :meth:`dem.engines.handover.Handover.solid_radii`; its radius where none is handed
+    over) and their union bonds, the run's own union reading (:class:`dem.engines.handover.Handover`), and the walls
+    that carry a temperature where they are now.
+
+    Parameters
+    ----------
+    engine : dem.engines.verlet.engine.VerletEngine
+        The run, at its end.
+
+    Returns
+    -------
+    tuple
+        ``(particles, bonds, walls)``: a :class:`dem.geometry.particles.Particles` (positions and radii, m), a
+        :class:`dem.geometry.bonds.Bonds` under ``contact = "union"`` and the walls.
+    """
+    from dem.geometry.bonds import find_bonds
+
+    th, mech = engine.thermal, engine.mechanics
+    now, walls, pairs = th._particles_now(mech, mech.state.radius), th._walls_now(mech), mech.contacts()[:2]
+    if np.any(th.handover.steps):
+        union = th.handover._readings(now, walls, pairs, th.box, update=False)[1]
+        return union.grown, union.bonds, walls
+    return now, find_bonds(now, walls, "union", th.spec.out_of_range, pairs=pairs, box=th.box), walls
+
+
+def k_eff_trefftz(engine) -> tuple[float, dict]:
+    """The verified k_eff of the contacts of ``engine`` now: the union of its spheres as the hand-over grew them
+    (:func:`union_now`) with a node per neck and the Trefftz element of each cut sphere (``[conductance] nodes =
+    "necks"``, ``element = "trefftz"``, :mod:`dem.network.trefftz_element`), solved steady between its heated walls
+    with its held particles held.
+
+    Parameters
+    ----------
+    engine : dem.engines.verlet.engine.VerletEngine
+        The run, at its end.
+
+    Returns
+    -------
+    tuple
+        ``(k_eff, account)``: k_eff (W/(m K)) and the elements' entries of a run's summary
+        (:meth:`dem.network.elements.SceneElements.account`).
+    """
+    from dem.network.elements import scene_elements
+    from dem.network.necks import NeckHeat, neck_network
+
+    th = engine.thermal
+    spec = replace(th.spec, law="shared-body", neck="union", nodes="necks", element="trefftz")
+    particles, bonds, walls = union_now(engine)
+    elements = scene_elements(spec)
+    net = neck_network(spec, particles, bonds, box=th.box, walls=walls, elements=elements)
+    return _k_eff_on(engine, NeckHeat(net, th.linear), spec), elements.account()
+
+
+def sinter(doc: dict, trefftz: bool = True) -> dict:
     """Run the scene ``doc`` on the velocity-Verlet engine, recording the hand-over (module docstring).
 
     Parameters
     ----------
     doc : dict
         The scene (:func:`scene_doc`).
+    trefftz : bool
+        Whether to read the end's verified k_eff too (:func:`k_eff_trefftz`, :func:`verified`).
 
     Returns
     -------
@@ -175,7 +237,9 @@ def sinter(doc: dict) -> dict:
         ``steps``: per thermal step ``t`` (s), ``meeting``, ``handed_over``, ``handing_over`` (particles) and
         ``jump`` (the relative change of k_eff the step's hand-over makes on the same contacts, None where it hands
         none over); ``rows``: per output time ``t``, ``phi``, ``k_eff`` and ``k_eff_pair_necks`` (W/(m K));
-        ``summary``: the run's summary; ``kappa`` (W/(m K)); ``readings``: ``"law/neck"`` -> k_eff at the end.
+        ``summary``: the run's summary; ``kappa`` (W/(m K)); ``readings``: ``"law/neck"`` -> k_eff at the end;
+        ``neck_ratio``: the median and largest ``a / r`` of the contacts at the end; ``verified``: :func:`verified`
+        (None without ``trefftz``).
     """
     from dem.engines.verlet.engine import VerletEngine
     from dem.scene.parse import parse_scene
@@ -208,11 +272,41 @@ def sinter(doc: dict) -> dict:
     readings = {f"{law}/{neck}": _k_eff_read(engine, law, neck) for law, neck in READINGS}
     bonds, radius = engine.necks()[1], engine.mechanics.state.radius
     ratio = bonds.a / np.minimum(radius[bonds.i], radius[bonds.j])
-    return {"steps": steps, "rows": rows, "summary": summary, "kappa": kappa, "readings": readings,
-            "neck_ratio": {"median": float(np.median(ratio)), "max": float(np.max(ratio))}}
+    record = {"steps": steps, "rows": rows, "summary": summary, "kappa": kappa, "readings": readings,
+              "neck_ratio": {"median": float(np.median(ratio)), "max": float(np.max(ratio))}, "verified": None}
+    if trefftz:
+        record["verified"] = verified(engine.effective_conductivity(), *k_eff_trefftz(engine),
+                                      summary.get("law_error_range"))
+    return record
 
 
-def measure(out_dir: pathlib.Path, spheres: int = SPHERES, side: float = SIDE, t_end: float | None = None) -> dict:
+def verified(own: float, k_eff: float, account: dict, law_error_range) -> dict:
+    """How far a run's own k_eff at its end is from the verified one (:func:`k_eff_trefftz`) of the same contacts.
+
+    Parameters
+    ----------
+    own : float
+        The run's k_eff as it conducts (its pair necks handed over to the union, its law's element), W/(m K).
+    k_eff : float
+        The verified k_eff, W/(m K).
+    account : dict
+        The Trefftz elements' entries (:meth:`dem.network.elements.SceneElements.account`).
+    law_error_range : sequence of two floats or None
+        The run summary's ``law_error_range``: the relative error the FE evidence allows its law where it stands.
+
+    Returns
+    -------
+    dict
+        ``own`` and ``k_eff`` (W/(m K)), ``gap`` (``own / k_eff - 1``), ``law_error_range``, ``within`` (whether
+        the gap lies in it; None without one) and the account.
+    """
+    gap = own / k_eff - 1.0
+    within = None if law_error_range is None else bool(law_error_range[0] <= gap <= law_error_range[1])
+    return {"own": own, "k_eff": k_eff, "gap": gap, "law_error_range": law_error_range, "within": within, **account}
+
+
+def measure(out_dir: pathlib.Path, spheres: int = SPHERES, side: float = SIDE, t_end: float | None = None,
+            trefftz: bool = True) -> dict:
     """Pour a bed (:func:`pour`) into ``out_dir`` and sinter it (:func:`sinter`); the record, with the bounds.
 
     Parameters
@@ -225,6 +319,8 @@ def measure(out_dir: pathlib.Path, spheres: int = SPHERES, side: float = SIDE, t
         The periodic box's side, m.
     t_end : float or None
         The sintering time, s; None: the scene's.
+    trefftz : bool
+        Whether to read the end's verified k_eff too (:func:`sinter`).
 
     Returns
     -------
@@ -233,7 +329,7 @@ def measure(out_dir: pathlib.Path, spheres: int = SPHERES, side: float = SIDE, t
         ``hashin_shtrikman`` (the bounds on k_eff, W/(m K)) and ``largest_jump`` (dimensionless).
     """
     dump = pour(pathlib.Path(out_dir), spheres, side)
-    return _ends(sinter(scene_doc(dump, t_end)))
+    return _ends(sinter(scene_doc(dump, t_end), trefftz))
 
 
 
