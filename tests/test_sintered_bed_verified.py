@@ -83,3 +83,22 @@ def test_the_gap_of_the_run_to_it_is_read_against_its_law_error_range():
     assert verified(0.95, 1.0, {}, [-0.037, 0.048])["within"] is False
     assert verified(1.05, 1.0, {}, [-0.037, 0.048])["within"] is False
     assert verified(1.0, 1.0, {}, None)["within"] is None
+
+
+def test_the_report_says_the_gap_and_fails_a_run_outside_its_range():
+    """report(): the summary carries the verified k_eff, the gap and whether it is within the range; a target fails a
+    run whose gap lies outside it (by the distance outside), and the markdown line says so."""
+    from verification.sintered_bed import report, verified
+
+    def case(own, k_eff):
+        return {"summary": {"particles_necks_meeting": 3}, "k_eff": own, "wiener": 2.0, "largest_jump": None,
+                "above_wiener": -0.5, "kappa": 2.0,
+                "verified": verified(own, k_eff, {"element": "trefftz", "element_particles": 7, "element_plain": 1,
+                                                  "element_seconds": 2.0}, [-0.037, 0.048])}
+
+    summary, targets, lines = report({"in": case(1.02, 1.0), "out": case(1.10, 1.0)})
+    assert summary["in k_eff verified (trefftz)"] == 1.0 and summary["in gap within law_error_range"] is True
+    assert summary["out gap to the verified k_eff"] == pytest.approx(0.10, rel=1e-12)
+    gaps = {label.split(":")[0]: measured for label, measured, limit in targets if "law_error_range" in label}
+    assert gaps["in"] == 0.0 and gaps["out"] == pytest.approx(0.10 - 0.048, rel=1e-12)
+    assert "+2.00 % from the verified 0.5000 kappa (within" in lines[0] and "outside" in lines[1]
