@@ -47,7 +47,7 @@ def ended():
     return engine
 
 
-@pytest.mark.slow  # a minute of CPU: the run and the Trefftz elements of 63 particles with twelve necks each, twice
+@pytest.mark.slow  # some 7 s of CPU: the run, and the Trefftz elements of 63 particles with twelve necks, twice
 def test_the_verified_k_eff_is_the_trefftz_neck_network_of_the_grown_spheres_solved_directly(ended):
     """At the end some particles are handed over (their radii grown): the study's k_eff is the steady heat between the
     walls of neck_network(elements=trefftz_elements) on the grown spheres' union bonds of the run's contacts, over
