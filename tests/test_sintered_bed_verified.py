@@ -91,15 +91,17 @@ def test_the_report_says_the_gap_and_fails_a_run_outside_its_range():
     run whose gap lies outside it (by the distance outside), and the markdown line says so."""
     from verification.sintered_bed import report, verified
 
-    def case(own, k_eff):
+    def case(own, k_eff, pair_read=0):
         return {"summary": {"particles_necks_meeting": 3}, "k_eff": own, "wiener": 2.0, "largest_jump": None,
                 "above_wiener": -0.5, "kappa": 2.0,
                 "verified": verified(own, k_eff, {"element": "trefftz", "element_particles": 7, "element_plain": 1,
-                                                  "element_seconds": 2.0}, [-0.037, 0.048])}
+                                                  "element_seconds": 2.0}, [-0.037, 0.048], pair_read)}
 
-    summary, targets, lines = report({"in": case(1.02, 1.0), "out": case(1.10, 1.0)})
+    summary, targets, lines = report({"in": case(1.02, 1.0), "out": case(1.10, 1.0), "pair": case(1.3, 1.0, 5)})
     assert summary["in k_eff verified (trefftz)"] == 1.0 and summary["in gap within law_error_range"] is True
     assert summary["out gap to the verified k_eff"] == pytest.approx(0.10, rel=1e-12)
     gaps = {label.split(":")[0]: measured for label, measured, limit in targets if "law_error_range" in label}
     assert gaps["in"] == 0.0 and gaps["out"] == pytest.approx(0.10 - 0.048, rel=1e-12)
+    assert "pair" not in gaps and summary["pair gap within law_error_range"] is False  # said, not held: geometries
     assert "+2.00 % from the verified 0.5000 kappa (within" in lines[0] and "outside" in lines[1]
+    assert "5 particles still read as pair necks" in lines[2] and "pair necks" not in lines[0]

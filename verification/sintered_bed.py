@@ -19,7 +19,8 @@ summary's ``law_error_range``, and the same contacts read by the pair-neck laws 
 (:func:`k_eff_trefftz`): the same contacts read as the union of the spheres as the hand-over grew them, with a node
 per neck and the Trefftz element of each cut sphere (:mod:`dem.network.trefftz_element`, within -0.49 to +0.56 % of
 the union's FE on 39 periodic cells), solved steady between the same walls; the run's own k_eff (its pair necks
-handed over to the union, its law's element) is held to it: the gap must lie within the run's ``law_error_range``.
+handed over to the union, its law's element) is held to it: the gap must lie within the run's ``law_error_range``
+where the run reads every particle as the union (:func:`verified`).
 """
 
 from __future__ import annotations
@@ -279,13 +280,22 @@ def sinter(doc: dict, trefftz: bool = True) -> dict:
     record = {"steps": steps, "rows": rows, "summary": summary, "kappa": kappa, "readings": readings,
               "neck_ratio": {"median": float(np.median(ratio)), "max": float(np.max(ratio))}, "verified": None}
     if trefftz:
+        with_necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=len(radius)) > 0
+        pair_read = 0
+        if engine.thermal.handing_over(engine.mechanics):  # a pair-neck reading: those not (fully) handed over
+            pair_read = int(np.count_nonzero(with_necks & (engine.thermal.handover.weight < 1.0)))
         record["verified"] = verified(engine.effective_conductivity(), *k_eff_trefftz(engine),
-                                      summary.get("law_error_range"))
+                                      summary.get("law_error_range"), pair_read)
     return record
 
 
-def verified(own: float, k_eff: float, account: dict, law_error_range) -> dict:
+def verified(own: float, k_eff: float, account: dict, law_error_range, pair_read: int = 0) -> dict:
     """How far a run's own k_eff at its end is from the verified one (:func:`k_eff_trefftz`) of the same contacts.
+
+    The verified k_eff reads every contact as the union of the spheres (those of the particles not handed over at
+    their radii: lens circles). Where a run still reads particles as pair necks (``pair_read``), whose necks are wider
+    than the lens circle of the same overlap (volume-conserving, Rojek 2022), the gap is partly that of the two
+    geometries, not the law's error; it is held to ``law_error_range`` only where every particle is read as the union.
 
     Parameters
     ----------
@@ -297,16 +307,19 @@ def verified(own: float, k_eff: float, account: dict, law_error_range) -> dict:
         The Trefftz elements' entries (:meth:`dem.network.elements.SceneElements.account`).
     law_error_range : sequence of two floats or None
         The run summary's ``law_error_range``: the relative error the FE evidence allows its law where it stands.
+    pair_read : int
+        The particles with necks the run reads, at its end, as pair necks in part or whole (hand-over weight below 1).
 
     Returns
     -------
     dict
         ``own`` and ``k_eff`` (W/(m K)), ``gap`` (``own / k_eff - 1``), ``law_error_range``, ``within`` (whether
-        the gap lies in it; None without one) and the account.
+        the gap lies in it; None without one), ``pair_read`` and the account.
     """
     gap = own / k_eff - 1.0
     within = None if law_error_range is None else bool(law_error_range[0] <= gap <= law_error_range[1])
-    return {"own": own, "k_eff": k_eff, "gap": gap, "law_error_range": law_error_range, "within": within, **account}
+    return {"own": own, "k_eff": k_eff, "gap": gap, "law_error_range": law_error_range, "within": within,
+            "pair_read": pair_read, **account}
 
 
 def measure(out_dir: pathlib.Path, spheres: int = SPHERES, side: float = SIDE, t_end: float | None = None,
@@ -442,7 +455,7 @@ def table(cases: dict) -> str:
         v = rec.get("verified")
         if v is not None:
             rows[-1].update({"verified (trefftz) / kappa": v["k_eff"] / kappa, "run's gap to it (%)": 100 * v["gap"],
-                             "gap within law_error_range": v["within"]})
+                             "gap within law_error_range": v["within"], "read as pair necks": v["pair_read"]})
     return records_table(rows)
 
 
@@ -459,7 +472,7 @@ def report(cases: dict) -> tuple[dict, list, list]:
     tuple
         ``(summary, targets, lines)``: the summary's entries, the targets ``(label, measured, limit)`` (k_eff above
         the Wiener bound, the largest change across a hand-over step, the run's gap to the verified k_eff outside
-        its ``law_error_range``) and markdown lines.
+        its ``law_error_range`` where it reads every particle as the union, :func:`verified`) and markdown lines.
     """
     summary, targets, lines = {}, [], []
     for name, rec in cases.items():
@@ -476,15 +489,17 @@ def report(cases: dict) -> tuple[dict, list, list]:
         summary[f"{name} k_eff verified (trefftz)"] = v["k_eff"]
         summary[f"{name} gap to the verified k_eff"] = v["gap"]
         summary[f"{name} gap within law_error_range"] = v["within"]
-        if v["law_error_range"] is not None:
+        if v["law_error_range"] is not None and not v["pair_read"]:
             low, high = v["law_error_range"]
             targets.append((f"{name}: the run's k_eff outside law_error_range of the verified (Trefftz) k_eff",
                             max(low - v["gap"], v["gap"] - high, 0.0), 0.0))
         kappa = rec["kappa"]
         where = ("no law_error_range" if v["within"] is None else
                  f"{'within' if v['within'] else 'outside'} its law_error_range {v['law_error_range']}")
+        pair = (f"; {v['pair_read']} particles still read as pair necks, wider than the union's lens circles: the "
+                f"gap is partly the two geometries'" if v["pair_read"] else "")
         lines.append(f"- {name}: the run's k_eff {v['own'] / kappa:.4f} kappa is {100 * v['gap']:+.2f} % from the "
-                     f"verified {v['k_eff'] / kappa:.4f} kappa ({where}; Trefftz elements of "
+                     f"verified {v['k_eff'] / kappa:.4f} kappa ({where}{pair}; Trefftz elements of "
                      f"{v['element_particles']} particles, {v['element_plain']} kept the law's element, "
                      f"{v['element_seconds']:.0f} s of CPU).")
     return summary, targets, lines
