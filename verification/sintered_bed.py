@@ -226,15 +226,13 @@ def k_eff_trefftz(engine) -> tuple[float, dict]:
     return _k_eff_on(engine, NeckHeat(net, th.linear), spec), elements.account()
 
 
-def sinter(doc: dict, trefftz: bool = True) -> dict:
+def sinter(doc: dict) -> dict:
     """Run the scene ``doc`` on the velocity-Verlet engine, recording the hand-over (module docstring).
 
     Parameters
     ----------
     doc : dict
         The scene (:func:`scene_doc`).
-    trefftz : bool
-        Whether to read the end's verified k_eff too (:func:`k_eff_trefftz`, :func:`verified`).
 
     Returns
     -------
@@ -243,8 +241,8 @@ def sinter(doc: dict, trefftz: bool = True) -> dict:
         ``jump`` (the relative change of k_eff the step's hand-over makes on the same contacts, None where it hands
         none over); ``rows``: per output time ``t``, ``phi``, ``k_eff`` and ``k_eff_pair_necks`` (W/(m K));
         ``summary``: the run's summary; ``kappa`` (W/(m K)); ``readings``: ``"law/neck"`` -> k_eff at the end;
-        ``neck_ratio``: the median and largest ``a / r`` of the contacts at the end; ``verified``: :func:`verified`
-        (None without ``trefftz``).
+        ``neck_ratio``: the median and largest ``a / r`` of the contacts at the end; ``verified``: :func:`verified` of the
+        run's k_eff and the verified one (:func:`k_eff_trefftz`).
     """
     from dem.engines.verlet.engine import VerletEngine
     from dem.scene.parse import parse_scene
@@ -278,14 +276,13 @@ def sinter(doc: dict, trefftz: bool = True) -> dict:
     bonds, radius = engine.necks()[1], engine.mechanics.state.radius
     ratio = bonds.a / np.minimum(radius[bonds.i], radius[bonds.j])
     record = {"steps": steps, "rows": rows, "summary": summary, "kappa": kappa, "readings": readings,
-              "neck_ratio": {"median": float(np.median(ratio)), "max": float(np.max(ratio))}, "verified": None}
-    if trefftz:
-        with_necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=len(radius)) > 0
-        pair_read = 0
-        if engine.thermal.handing_over(engine.mechanics):  # a pair-neck reading: those not (fully) handed over
-            pair_read = int(np.count_nonzero(with_necks & (engine.thermal.handover.weight < 1.0)))
-        record["verified"] = verified(engine.effective_conductivity(), *k_eff_trefftz(engine),
-                                      summary.get("law_error_range"), pair_read)
+              "neck_ratio": {"median": float(np.median(ratio)), "max": float(np.max(ratio))}}
+    with_necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=len(radius)) > 0
+    pair_read = 0
+    if engine.thermal.handing_over(engine.mechanics):  # a pair-neck reading: those not (fully) handed over
+        pair_read = int(np.count_nonzero(with_necks & (engine.thermal.handover.weight < 1.0)))
+    record["verified"] = verified(engine.effective_conductivity(), *k_eff_trefftz(engine),
+                                  summary.get("law_error_range"), pair_read)
     return record
 
 
@@ -322,8 +319,7 @@ def verified(own: float, k_eff: float, account: dict, law_error_range, pair_read
             "pair_read": pair_read, **account}
 
 
-def measure(out_dir: pathlib.Path, spheres: int = SPHERES, side: float = SIDE, t_end: float | None = None,
-            trefftz: bool = True) -> dict:
+def measure(out_dir: pathlib.Path, spheres: int = SPHERES, side: float = SIDE, t_end: float | None = None) -> dict:
     """Pour a bed (:func:`pour`) into ``out_dir`` and sinter it (:func:`sinter`); the record, with the bounds.
 
     Parameters
@@ -336,8 +332,6 @@ def measure(out_dir: pathlib.Path, spheres: int = SPHERES, side: float = SIDE, t
         The periodic box's side, m.
     t_end : float or None
         The sintering time, s; None: the scene's.
-    trefftz : bool
-        Whether to read the end's verified k_eff too (:func:`sinter`).
 
     Returns
     -------
@@ -346,7 +340,7 @@ def measure(out_dir: pathlib.Path, spheres: int = SPHERES, side: float = SIDE, t
         ``hashin_shtrikman`` (the bounds on k_eff, W/(m K)) and ``largest_jump`` (dimensionless).
     """
     dump = pour(pathlib.Path(out_dir), spheres, side)
-    return _ends(sinter(scene_doc(dump, t_end), trefftz))
+    return _ends(sinter(scene_doc(dump, t_end)))
 
 
 
@@ -428,8 +422,8 @@ def _figure(cases: dict, out_dir: pathlib.Path) -> list:
 
 def table(cases: dict) -> str:
     """The cases' ends as a markdown table: particles, necks meeting, handed over, median a/r, phi, k_eff / kappa
-    against the bounds, the largest change of k_eff across a hand-over step, ``law_error_range``, and the pair-neck
-    and union readings of the same contacts.
+    against the bounds, the largest change of k_eff across a hand-over step, ``law_error_range``, the pair-neck
+    and union readings of the same contacts, and the verified k_eff with the run's gap to it (:func:`verified`).
 
     Parameters
     ----------
@@ -443,7 +437,7 @@ def table(cases: dict) -> str:
     """
     rows = []
     for name, rec in cases.items():
-        s, kappa = rec["summary"], rec["kappa"]
+        s, kappa, v = rec["summary"], rec["kappa"], rec["verified"]
         rows.append({"case": name, "particles": rec["particles"], "necks meeting": s["particles_necks_meeting"],
                      "handed over": s.get("particles_handed_over"), "on the way": s.get("particles_handing_over"),
                      "median a/r": rec["neck_ratio"]["median"], "max a/r": rec["neck_ratio"]["max"],
@@ -451,11 +445,9 @@ def table(cases: dict) -> str:
                      "HS bound": rec["hashin_shtrikman"] / kappa,
                      "largest jump (%)": None if rec["largest_jump"] is None else 100 * rec["largest_jump"],
                      "law_error_range": str(s.get("law_error_range")),
-                     **{f"{key} / kappa": value / kappa for key, value in rec["readings"].items()}})
-        v = rec.get("verified")
-        if v is not None:
-            rows[-1].update({"verified (trefftz) / kappa": v["k_eff"] / kappa, "run's gap to it (%)": 100 * v["gap"],
-                             "gap within law_error_range": v["within"], "read as pair necks": v["pair_read"]})
+                     **{f"{key} / kappa": value / kappa for key, value in rec["readings"].items()},
+                     "verified (trefftz) / kappa": v["k_eff"] / kappa, "run's gap to it (%)": 100 * v["gap"],
+                     "gap within law_error_range": v["within"], "read as pair necks": v["pair_read"]})
     return records_table(rows)
 
 
@@ -483,9 +475,7 @@ def report(cases: dict) -> tuple[dict, list, list]:
                         max(rec["above_wiener"], 0.0), 0.0))
         if rec["largest_jump"] is not None:
             targets.append((f"{name}: largest change of k_eff across a hand-over step", rec["largest_jump"], 5e-3))
-        v = rec.get("verified")
-        if v is None:
-            continue
+        v = rec["verified"]
         summary[f"{name} k_eff verified (trefftz)"] = v["k_eff"]
         summary[f"{name} gap to the verified k_eff"] = v["gap"]
         summary[f"{name} gap within law_error_range"] = v["within"]
