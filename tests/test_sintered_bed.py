@@ -11,7 +11,8 @@ pytestmark = pytest.mark.slow
 def test_a_small_lammps_bed_sintered_past_the_meeting_of_its_necks(tmp_path):
     """About 300 spheres in a 0.8 mm box, sintered for 10 ms at 160 degC: necks meet and particles are handed over;
     across every thermal step that hands particles over k_eff changes by at most 0.5 % on the same contacts; k_eff
-    stays at or below the Wiener bound phi kappa at every output; the summary says where the law stands."""
+    stays at or below the Wiener bound phi kappa at every output; the summary says where the law stands, and the
+    run's k_eff lies within its law_error_range of the verified one (the Trefftz element on the grown spheres)."""
     from verification import sintered_bed
 
     if sintered_bed.lammps() is None:
@@ -29,3 +30,8 @@ def test_a_small_lammps_bed_sintered_past_the_meeting_of_its_necks(tmp_path):
     assert rec["k_eff"] <= rec["wiener"]
     assert summary["law_error_range"] == [-0.037, 0.048]  # shared-body where necks meet (dem.laws.verified_range)
     assert all(np.isfinite(v) and v > 0 for v in rec["readings"].values())
+    # the verified k_eff (union of the grown spheres, neck nodes, Trefftz element): the run within its law_error_range
+    v = rec["verified"]
+    assert v["own"] == rec["k_eff"] and 0.0 < v["k_eff"] <= rec["wiener"]
+    assert v["gap"] == v["own"] / v["k_eff"] - 1.0 and v["within"] is True
+    assert 0 < v["element_particles"] <= 300
