@@ -2,7 +2,7 @@ r"""The pair bonds' geometry of :func:`dem.geometry.bonds.find_bonds` in one com
 radii, the overlap, the distances from the centres to the radical plane and whether the bond may lie beyond the
 contact model's range, where numpy's route makes a fresh array for nearly every operation (about a dozen passes over
 the bonds and five temporaries of a bond each). Every value is the same IEEE operation in the same order as numpy's
-(:func:`dem.geometry.bonds._lens_planes`), so the results are that route's to the bit, on any number of threads.
+(the lens planes of :mod:`dem.geometry.bonds`), so the results are that route's to the bit, on any number of threads.
 Apart from :mod:`dem.geometry.bonds` so that a smaller packing loads no numba."""
 
 from __future__ import annotations

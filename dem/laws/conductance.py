@@ -55,7 +55,7 @@ DESCRIPTIONS = {
 }
 NECK_MODELS = ("newton", "first", "coble", "union")
 NODES = ("particles", "necks")  # the network's nodes: one per particle, or also one per neck (dem.network.necks)
-#: each particle's element with a node per neck: the law's (dem.laws.shared_body.particle_elements) or the Trefftz
+#: each particle's element with a node per neck, the law's (dem.laws.shared_body.particle_elements) or the Trefftz
 #: element of its cut sphere with three flux modes per neck (dem.network.trefftz_element)
 ELEMENTS = ("law", "trefftz")
 
