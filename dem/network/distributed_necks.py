@@ -48,7 +48,7 @@ from __future__ import annotations
 import numpy as np
 
 from dem.network.distributed import DistributedNetwork
-from dem.network.necks import NeckHeat, NeckNetwork, uniform_level
+from dem.network.necks import NeckHeat, NeckNetwork, first_modes, uniform_level
 from dem.parallel import comm as mpi
 from dem.parallel.petsc import largest_eigenvalue
 
@@ -96,7 +96,7 @@ def node_keys(net: NeckNetwork, held: np.ndarray, owner: np.ndarray, comm) -> tu
     modes = net.bond_modes
     width = int(mpi.maximum(comm, int(modes.max(initial=1))))
     bond = np.repeat(net.live, modes)  # each neck node's bond, its modes in order
-    mode = np.arange(len(bond)) - np.repeat(np.cumsum(modes) - modes, modes)
+    mode = np.arange(len(bond)) - np.repeat(first_modes(modes), modes)
     necks = n_global + (held[i[bond]] * most + place[bond]) * width + mode
     return np.concatenate([held, necks]).astype(np.int64), np.concatenate([owner, owner[i[bond]]])
 

@@ -236,7 +236,7 @@ class NeckNetwork:
     @property
     def monopoles(self) -> np.ndarray:
         """Per live pair bond, the node of its monopole (its neck's temperature; its dipoles follow it)."""
-        return self.particles.n + np.cumsum(self.bond_modes) - self.bond_modes
+        return self.particles.n + first_modes(self.bond_modes)
 
     def end_flows(self, T: np.ndarray) -> np.ndarray:
         """The heat flowing into each particle through each of its neck ends (W) at node temperatures ``T``: end
@@ -331,7 +331,7 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     # each live pair bond's modes: the most of its two particles' (module docstring, "Flux modes"); mode ``mode`` of
     # live pair bond b is node n + (the modes of the bonds before it) + mode
     bond_modes = np.maximum(M[sub.i], M[sub.j])
-    monopole = n + np.cumsum(bond_modes) - bond_modes
+    monopole = n + first_modes(bond_modes)
     # each end's node (a wall's: -1) and the offset it is seen at by its particle (a wall's: its temperature)
     jump = sub.shifts @ box.drop if box is not None else np.zeros(m)
     wall_T = np.array([w.temperature for w in walls], dtype=float)[sub.wall_index] if len(live_walls) else np.zeros(0)
@@ -366,6 +366,23 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     return NeckNetwork(particles, bonds, live, live_walls, A.tocsr(), rhs, (row, col, value, known, end_row),
                        2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box, union,
                        modes)
+
+
+def first_modes(bond_modes: np.ndarray) -> np.ndarray:
+    """Per live pair bond, the modes of the bonds before it: where its first mode (the monopole) follows the
+    centres' nodes (module docstring, "Flux modes").
+
+    Parameters
+    ----------
+    bond_modes : numpy.ndarray
+        Per live pair bond, its neck's flux modes.
+
+    Returns
+    -------
+    numpy.ndarray
+        The offsets, int.
+    """
+    return np.cumsum(bond_modes) - bond_modes
 
 
 def _modes(el) -> np.ndarray:
