@@ -277,7 +277,7 @@ def sinter(doc: dict) -> dict:
     ratio = bonds.a / np.minimum(radius[bonds.i], radius[bonds.j])
     record = {"steps": steps, "rows": rows, "summary": summary, "kappa": kappa, "readings": readings,
               "neck_ratio": {"median": float(np.median(ratio)), "max": float(np.max(ratio))}}
-    with_necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=len(radius)) > 0
+    with_necks = bonds.necks_per_particle(len(radius)) > 0
     pair_read = 0
     if engine.thermal.handing_over(engine.mechanics):  # a pair-neck reading: those not (fully) handed over
         pair_read = int(np.count_nonzero(with_necks & (engine.thermal.handover.weight < 1.0)))

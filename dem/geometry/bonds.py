@@ -140,6 +140,16 @@ class Bonds:
         """Number of wall bonds."""
         return len(self.wall_particle)
 
+    def necks_per_particle(self, n: int) -> np.ndarray:
+        """Per particle of ``n``, its bonds' ends: its pair bonds (as ``i`` or ``j``) and its wall bonds (int).
+
+        Parameters
+        ----------
+        n : int
+            Number of particles.
+        """
+        return np.bincount(np.concatenate([self.i, self.j, self.wall_particle]), minlength=n)
+
     def subset(self, pairs: np.ndarray, walls: np.ndarray) -> "Bonds":
         """The pair bonds at ``pairs`` and the wall bonds at ``walls`` (masks or indices), in their order.
 

@@ -84,14 +84,12 @@ class SceneElements:
             The elements.
         """
         args = (n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume)
-        where = None
         if self.element == "trefftz":
             from dem.network.trefftz_element import trefftz_elements
 
-            where = self.own
-            build = trefftz_elements if where is None else functools.partial(trefftz_elements, where=where)
-            necks = np.bincount(np.concatenate([bonds.i, bonds.j, bonds.wall_particle]), minlength=n)
-            chosen = slice(None) if where is None else where
+            build = trefftz_elements if self.own is None else functools.partial(trefftz_elements, where=self.own)
+            necks = bonds.necks_per_particle(n)
+            chosen = slice(None) if self.own is None else self.own
             announce(element_estimate(necks[chosen], pairs_meeting(radius, bonds, vectors, wall_normals)[chosen],
                                       threads.count()))
         else:
