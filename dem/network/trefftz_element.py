@@ -801,10 +801,9 @@ def trefftz_elements(n: int, radius: np.ndarray, bonds: Bonds, vectors: np.ndarr
     for k, (E, plain_k, refine_k) in zip(trefftz, _particle_elements(trefftz, cut, workers)):
         blocks[k], plain[k], refine[k] = E.ravel(), plain_k, refine_k
     start = np.cumsum([0] + [len(b) for b in blocks])
-    if where is None:
-        return TrefftzElements(law.offsets, law.ends, start, np.concatenate(blocks), plain, np.ones(n), 3, refine)
+    modes = 3 if chosen.all() else np.where(chosen, 3, 1)  # one number where every particle has the three
     return TrefftzElements(law.offsets, law.ends, start, np.concatenate(blocks), plain,
-                           np.where(chosen, 1.0, law.shrink), np.where(chosen, 3, 1), refine)
+                           np.where(chosen, 1.0, law.shrink), modes, refine)
 
 
 TrefftzElements = namedtuple("TrefftzElements", ParticleElements._fields + ("refine",))
