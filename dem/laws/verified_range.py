@@ -53,6 +53,9 @@ import numpy as np
 from dem.geometry.necks import PAIR_READINGS, widest_necks
 
 
+VERIFIED = (-0.01, 0.01)  #: the relative error of k_eff within which a range of the necks is a verified one
+
+
 @dataclass(frozen=True)
 class Evidence:
     """The FE evidence of one law on union necks (module docstring).
@@ -75,10 +78,9 @@ class Evidence:
     verified_width: float
     apart: tuple[float, float]
     meeting: tuple[float, float]
-    verified: tuple[float, float] = (-0.01, 0.01)
+    verified: tuple[float, float] = VERIFIED
 
 
-VERIFIED = (-0.01, 0.01)  #: the relative error of k_eff within which a range of the necks is a verified one
 TREFFTZ_BAND = (-0.007, 0.007)  # the Trefftz element's network: -0.49 % to +0.56 % on the 39 cells, any neck
 #: The FE evidence of each law compared on union necks, by :func:`evidence_name` (module docstring).
 EVIDENCE = {
