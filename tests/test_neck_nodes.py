@@ -202,6 +202,14 @@ def test_more_union_lattices_against_the_dense_solve(kind, h):
     assert k == pytest.approx(DENSE_SLOW[(kind, h)], rel=1e-9)
 
 
+# the random packings are not the same on every machine: verification.packings.union_packing runs L-BFGS-B to
+# round-off and jams by bisection on an energy threshold, so the summation order of the BLAS kernels a processor
+# selects (OPENBLAS_CORETYPE) changes the packing (neck radii by up to 0.4 %, overlaps 0.8 %) and its k_eff by up to
+# 1.7e-4 (seed 1 under the Zen, Haswell, Sandybridge, Nehalem and Prescott kernels of one machine: 0.21929-0.21936
+# against the dense solve's 0.21932 on the packing of the machine that built it); the packings are held to twice that
+PACKING_KERNELS_RTOL = 3e-4
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("seed, phi", list(PACKINGS))
 def test_union_packings_against_the_dense_solve(seed, phi):
@@ -210,7 +218,7 @@ def test_union_packings_against_the_dense_solve(seed, phi):
 
     cell = union_packing(RANDOM_SPHERES, phi, seed=seed)
     k = dem_periodic(cell, "shared-body", neck="union", nodes="necks")
-    assert k == pytest.approx(PACKINGS[(seed, phi)][0], rel=1e-9)
+    assert k == pytest.approx(PACKINGS[(seed, phi)][0], rel=PACKING_KERNELS_RTOL)
 
 
 def test_necks_are_refused_outside_the_shared_body_law():
