@@ -5,7 +5,11 @@ Tolerance: relative 1e-6 (and absolute 1e-12 for numbers at round-off level, suc
 ``energy_error`` below ``ENERGY_ROUND_OFF`` reads as 0: it is relative to a scale never taken below the square root
 of the machine precision times the gross flows (``dem.network.heat.BalanceScales.flow_magnitude``), so where no net
 heat flows through the balance, round-off of the flows reads as a few times 1e-8 (a 12-particle bed whose middle
-layer sits at the mean of its neighbours gives 0 or 5e-9 by the summation order of numpy's build).
+layer sits at the mean of its neighbours gives 0 or 5e-9 by the summation order of numpy's build). Two figures of
+``fem_neck converge`` are made of errors near round-off and are compared to ``KEY_RTOL``: the hp levels' error
+ratio and the reference's error estimate (about 2e-10), which the BLAS kernels a processor selects move by up to
+3e-6 and 4e-3 (``OPENBLAS_CORETYPE=Prescott`` against the host's kernels on one machine; 2.5e-5 and 1e-3 between
+two machines).
 Every command shown is deterministic (seeded, fixed meshes, no timing-dependent choices), so on the machine that
 wrote the README the numbers agree to all printed digits; 1e-6 leaves room for platform round-off amplified by the
 solves (BLAS, libm, SuperLU orderings) while staying 100x tighter than the loosest solver tolerance shown (rtol
@@ -34,6 +38,7 @@ README = ROOT / "README.md"
 PAGES = [README, *sorted(p for p in (ROOT / "docs").rglob("*.md") if "_build" not in p.parts)]
 RTOL, ATOL = 1e-6, 1e-12
 ENERGY_ROUND_OFF = 1e-7  # an energy_error below it is round-off (module docstring)
+KEY_RTOL = {"hp_error_ratio_per_order": 1e-4, "reference_error_estimate": 1e-2}  # (module docstring)
 SLOW = ("fem_neck converge", "fem_neck lattice", "fem_neck cluster", "verification", "dem run fcc.toml")  # commands of more than a few seconds: marked slow
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 TIMING = re.compile(r"(?<![\w.])\d+(?:\.\d+)?\s?s\b")  # "1.8 s": a wall time in a table
@@ -88,24 +93,30 @@ def _drop_seconds(value):
     return value
 
 
-def numbers(output: str) -> list[float]:
-    """The numbers of a command's output, timings left out (see the module docstring)."""
+def keyed_numbers(output: str) -> list[tuple[str, float]]:
+    """The numbers of a command's output, timings left out (see the module docstring), each with the key of its
+    line (the first word; empty in JSON output)."""
     text = "\n".join(shown(output))
     if text.startswith("{"):
         text = json.dumps(_drop_seconds(json.loads(text)))
-    else:
-        text = "\n".join(line for line in text.splitlines() if not _timing((line.split() or [""])[0]))
+        return [("", float(x)) for x in NUMBER.findall(TIMING.sub("", text))]
+    text = "\n".join(line for line in text.splitlines() if not _timing((line.split() or [""])[0]))
     out = []
     for line in TIMING.sub("", text).splitlines():
         key = (line.split() or [""])[0]
-        out += [_round_off(key, float(x)) for x in NUMBER.findall(line)]
+        out += [(key, _round_off(key, float(x))) for x in NUMBER.findall(line)]
     return out
 
 
-def close(a: float, b: float) -> bool:
+def numbers(output: str) -> list[float]:
+    """The numbers of a command's output, timings left out (see the module docstring)."""
+    return [value for _, value in keyed_numbers(output)]
+
+
+def close(a: float, b: float, rtol: float = RTOL) -> bool:
     if abs(a) < ATOL and abs(b) < ATOL:
         return True
-    return math.isclose(a, b, rel_tol=RTOL, abs_tol=0.0)
+    return math.isclose(a, b, rel_tol=rtol, abs_tol=0.0)
 
 
 def test_a_bar_without_a_total_is_progress():
@@ -121,6 +132,7 @@ def test_number_extraction_ignores_timings_and_keeps_the_rest():
     assert numbers("energy_error  5.1e-09\nT_mean  5.1e-09") == [0.0, 5.1e-09]
     assert numbers('{"energy_error": 5.1e-09, "flow": 5.1e-09}') == [0.0, 5.1e-09]
     assert numbers("energy_error  2e-07") == [2e-07]
+    assert keyed_numbers("hp_error_ratio_per_order  7.83\nk  1") == [("hp_error_ratio_per_order", 7.83), ("k", 1.0)]
 
 
 def shown_files(text: str) -> dict:
@@ -175,10 +187,10 @@ def test_console_block(tmp_path, command, expected, files, places):
         (tmp_path / name).write_text(content)
     proc = subprocess.run([sys.executable, *argv[1:]], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
                           stderr=subprocess.STDOUT, text=True, timeout=1800)
-    got, want = numbers(proc.stdout), numbers(expected)
+    got, want = keyed_numbers(proc.stdout), keyed_numbers(expected)
     message = f"{', '.join(places)}: `{command}` printed\n{proc.stdout}"
     assert len(got) == len(want), message
-    bad = [(w, g) for w, g in zip(want, got) if not close(w, g)]
+    bad = [(w, g) for (key, w), (_, g) in zip(want, got) if not close(w, g, KEY_RTOL.get(key, RTOL))]
     assert not bad, f"{message}\n(page, now): {bad}"
 
 
