@@ -16,18 +16,34 @@ function is decorated; without it, a script that imports numba first would run k
 ``import dem`` and ``import fem_neck`` call it before any of their modules is imported, so every kernel of either is
 decorated after the call, however a script reaches it. A folder the user chose with ``NUMBA_CACHE_DIR`` stays the
 root: the digest's folder is made inside it.
+
+Processes share the folder (``pytest -n``'s workers, a sweep's pool, MPI ranks), and numba adds a signature to a
+kernel's index by reading the index, adding the entry and writing the index back, unguarded: two processes that
+save two signatures of one kernel at once each write the index they read plus their own entry, and the one written
+last drops the other's, which every later run then compiles again (and both may take the same data file's number, so
+that an entry names the other signature's code). :func:`configure` makes that update hold a lock on a file of the
+kernel's cache folder (``fcntl``; where Python has no ``fcntl`` numba's own update stays). The index's key is
+numba's, unchanged: the signature, the machine, and the hashes of the function's byte code and closure.
 """
 
 from __future__ import annotations
 
 import ast
+import functools
 import hashlib
+import importlib.abc
+import importlib.util
 import json
 import os
 import pathlib
 import sys
 import tempfile
 import warnings
+
+try:
+    import fcntl
+except ImportError:  # not on a POSIX system
+    fcntl = None
 
 PACKAGE = pathlib.Path(__file__).resolve().parent  # sinterheat/: the cache and the remembered key live here
 ROOT = PACKAGE.parent  #: the folder that holds the project's packages
@@ -221,3 +237,55 @@ def configure() -> None:
     if "numba" in sys.modules:  # numba imported first: its configuration has read the environment already
         from numba.core import config
         config.CACHE_DIR = str(folder)
+    _lock_index_updates()
+
+
+def _locked(save):
+    """numba's ``IndexDataCacheFile.save`` (read the index, add the entry, write the index and the data) under an
+    exclusive lock on ``index.lock`` in the kernel's cache folder (module docstring)."""
+    @functools.wraps(save)
+    def locked(self, key, data):
+        with open(os.path.join(self._cache_path, "index.lock"), "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file is closed
+            save(self, key, data)
+    locked.locked = True
+    return locked
+
+
+def _lock_caching(caching) -> None:
+    """Put numba's index update (module ``numba.core.caching``) under the lock of ``_locked``, once."""
+    if not getattr(caching.IndexDataCacheFile.save, "locked", False):
+        caching.IndexDataCacheFile.save = _locked(caching.IndexDataCacheFile.save)
+
+
+class _AfterImport(importlib.abc.MetaPathFinder):
+    """Calls ``_lock_caching`` on ``numba.core.caching`` as soon as it is imported, for a process that has not
+    imported numba yet (as :func:`configure` wants it: importing numba for the lock would cost a run without compiled
+    kernels its import)."""
+
+    name = "numba.core.caching"
+
+    def find_spec(self, fullname, path, target=None):
+        if fullname != self.name:
+            return None
+        sys.meta_path.remove(self)  # the search below is the ordinary one
+        spec = importlib.util.find_spec(fullname)
+        run = spec.loader.exec_module
+
+        def exec_module(module):
+            run(module)
+            _lock_caching(module)
+
+        spec.loader.exec_module = exec_module
+        return spec
+
+
+def _lock_index_updates() -> None:
+    """numba's index updates under a lock in this process (module docstring): now if numba is imported, else when it
+    is."""
+    if fcntl is None:
+        return
+    if _AfterImport.name in sys.modules:
+        _lock_caching(sys.modules[_AfterImport.name])
+    elif not any(isinstance(finder, _AfterImport) for finder in sys.meta_path):
+        sys.meta_path.insert(0, _AfterImport())

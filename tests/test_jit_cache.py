@@ -10,6 +10,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
 import pytest
 
@@ -143,3 +144,54 @@ def test_a_folder_the_user_chose_that_cannot_be_written_is_named_and_left(tmp_pa
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
     assert run.stdout.split() == [str(folder)] * 2
     assert f"NUMBA_CACHE_DIR = '{blocker / 'cache'}': cannot write" in run.stderr and "Traceback" not in run.stderr
+
+
+def _waits_for(path, process, seconds=600):
+    """Wait until ``path`` exists; fail if ``process`` ends first or the time runs out."""
+    end = time.monotonic() + seconds
+    while not path.exists():
+        assert process.poll() is None and time.monotonic() < end, f"no {path.name}"
+        time.sleep(0.01)
+
+
+def test_two_processes_saving_signatures_of_one_kernel_at_once_keep_both(tmp_path):
+    """As pytest's workers do: process A reads a kernel's index to add its signature and is held before it writes the
+    index back; process B saves another signature of the kernel meanwhile. Both must be in the index after (numba's
+    own update writes A's index over B's entry, so that every later run compiles B's signature again)."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    ready, saving, go = tmp_path / "ready", tmp_path / "saving", tmp_path / "go"
+    kernel = "import os, time, numpy as np; from numba.core import caching; from dem.network import groups\n"
+    held = kernel + (  # A: the index read, its write held until go
+        "save = caching.IndexDataCacheFile._save_index\n"
+        "def held(self, overloads):\n"
+        f"    open({str(ready)!r}, 'w').close()\n"
+        f"    while not os.path.exists({str(go)!r}): time.sleep(0.01)\n"
+        "    save(self, overloads)\n"
+        "caching.IndexDataCacheFile._save_index = held\n"
+        "groups._root(np.arange(4), 1)")
+    other = kernel + (  # B: says when it starts to save
+        "save = caching.IndexDataCacheFile.save\n"
+        "def saves(self, key, data):\n"
+        f"    open({str(saving)!r}, 'w').close()\n"
+        "    save(self, key, data)\n"
+        "caching.IndexDataCacheFile.save = saves\n"
+        "groups._root(np.arange(4, dtype=np.int32), 1)")
+    a = subprocess.Popen([sys.executable, "-c", held], env=env)
+    b = subprocess.Popen([sys.executable, "-c", other], env=env)
+    try:
+        _waits_for(ready, a)
+        _waits_for(saving, b)
+        try:
+            b.wait(timeout=1)  # numba's own update finishes at once; a locked one waits for A
+        except subprocess.TimeoutExpired:
+            pass
+        go.touch()
+        assert a.wait(timeout=600) == 0 and b.wait(timeout=600) == 0
+    finally:
+        a.kill()
+        b.kill()
+    check = ("import numpy as np; from dem.network import groups; groups._root(np.arange(4), 1); "
+             "groups._root(np.arange(4, dtype=np.int32), 1); print(sum(groups._root.stats.cache_misses.values()), "
+             "sum(groups._root.stats.cache_hits.values()))")
+    out = subprocess.run([sys.executable, "-c", check], env=env, capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["0", "2"]  # nothing compiled, both signatures loaded
