@@ -32,11 +32,14 @@ _chosen: int | None = None  # set by use()
 
 
 def cores() -> int:
-    """The cores this process may run on."""
+    """The cores this process may run on, at most ``NUMBA_NUM_THREADS`` where the user set it (numba's pool then has
+    no more threads, and asking it for more raises)."""
     try:
-        return len(os.sched_getaffinity(0))
+        number = len(os.sched_getaffinity(0))
     except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
+        number = os.cpu_count() or 1
+    cap = os.environ.get("NUMBA_NUM_THREADS", "").strip()
+    return min(number, int(cap)) if cap.isdigit() and int(cap) >= 1 else number
 
 
 def check(value, name: str = "threads") -> int:
@@ -53,10 +56,10 @@ def check(value, name: str = "threads") -> int:
     try:
         number = int(str(value).strip())
     except ValueError:
-        raise ValueError(f"{name} = {value!r}: must be an integer from 1 to {limit} (the cores of this machine)") \
+        raise ValueError(f"{name} = {value!r}: must be an integer from 1 to {limit} (the cores this process may use)") \
             from None
     if not 1 <= number <= limit:
-        raise ValueError(f"{name} = {number}: must be from 1 to {limit} (the cores of this machine)")
+        raise ValueError(f"{name} = {number}: must be from 1 to {limit} (the cores this process may use)")
     return number
 
 

@@ -194,3 +194,14 @@ def test_quiet_prints_the_result_and_no_progress_bar(tmp_path):
     assert quiet.stderr == ""
     timeless = [{k: v for k, v in json.loads(r.stdout).items() if k != "seconds"} for r in (quiet, loud)]
     assert timeless[0] == timeless[1]
+
+
+def test_a_user_cap_on_numbas_threads_is_the_default_and_the_bound():
+    """With ``NUMBA_NUM_THREADS=1`` (numba's pool made with one thread) an engine's binding asks for one thread
+    instead of every core (numba raised at its bind before), and ``--threads 2`` is refused naming the cap."""
+    code = ("from sinterheat import threads\nprint(threads.bind_numba())\n"
+            "try:\n    threads.check(2)\nexcept ValueError as error:\n    print(error)")
+    out = subprocess.run([sys.executable, "-c", code], env={**os.environ, "NUMBA_NUM_THREADS": "1",
+                                                            "PYTHONPATH": str(ROOT)},
+                         capture_output=True, text=True, check=True).stdout.splitlines()
+    assert out == ["1", "threads = 2: must be from 1 to 1 (the cores this process may use)"]
