@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from dem.driver import run
+from dem.engines.distributed.static import DistributedStaticEngine
 from dem.parallel import comm as mpi
 from test_distributed_necks import COMM, _blocks, owned_rows_against_serial, serial
 
@@ -108,3 +109,45 @@ def test_a_packing_read_in_parts_equals_the_serial_run():
         assert s[key] == r[key], key
     assert s["effective_conductivity"] == pytest.approx(r["effective_conductivity"], rel=1e-10)
     assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-9
+
+
+def test_each_rank_assembles_its_network_once(monkeypatch):
+    """Each rank computes its necks' halves (the cut bodies, the closing pores) once and assembles its network with a
+    node per neck once, from its own particles' Trefftz elements and their partners' received from their owners: the
+    network assembled from scratch with those elements, to the bit."""
+    import dem.engines.distributed.static as engine_module
+    import dem.laws.conductance as conductance
+    import dem.network.necks as necks
+
+    counts = {"halves": 0, "networks": 0}
+    halves, share, given = conductance.union_halves, engine_module.shared_elements, []
+
+    def counted(*args, **kwargs):
+        counts["halves"] += 1
+        return halves(*args, **kwargs)
+
+    class Counted(necks.NeckNetwork):
+        def __init__(self, *args, **kwargs):
+            counts["networks"] += 1
+            super().__init__(*args, **kwargs)
+
+    def shared(*args):
+        given.append(share(*args))
+        return given[-1]
+
+    for module in (conductance, necks):
+        monkeypatch.setattr(module, "union_halves", counted)
+    monkeypatch.setattr(necks, "NeckNetwork", Counted)
+    monkeypatch.setattr(engine_module, "shared_elements", shared)
+    scene = _trefftz("periodic")
+    engine = DistributedStaticEngine(scene)
+    assert COMM.allgather(counts) == [{"halves": 1, "networks": 1}] * COMM.Get_size()
+    assert np.any(np.asarray(given[0].modes) == 3) and not np.array_equal(given[0].values, engine.elements.built.values)
+    local = engine.scene
+    again = necks.neck_network(local.conductance, local.particles, engine.necks.bonds, box=local.box,
+                               walls=local.walls, elements=lambda *args: given[0])
+    net = engine.necks
+    for ours, theirs in ((net.A.data, again.A.data), (net.A.indices, again.A.indices), (net.rhs, again.rhs),
+                         *zip(net.entries, again.entries)):
+        assert np.array_equal(ours, theirs)
+
