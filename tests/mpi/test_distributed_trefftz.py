@@ -151,3 +151,36 @@ def test_each_rank_assembles_its_network_once(monkeypatch):
                          *zip(net.entries, again.entries)):
         assert np.array_equal(ours, theirs)
 
+
+def test_what_the_elements_take_is_said_once_by_rank_0_for_all_the_ranks(monkeypatch, capsys):
+    """With a large figure per neck (so that it is said), a run on the ranks that reports its progress says on
+    stderr one line of what the elements take, on rank 0 only: for the particles, necks and pairs of them meeting of
+    the serial run's live necks, and the busiest rank's share of them (the elements are the law's here: only what is
+    said is looked at)."""
+    from dem import memory
+    from dem.engines.static import StaticEngine
+    from dem.geometry.necks import pairs_meeting
+    from dem.laws.shared_body import particle_elements
+    from dem.network import trefftz_element as te
+    from sinterheat import threads
+
+    given = []
+
+    def law(*args, where=None):
+        given.append(args)
+        return te.TrefftzElements(*particle_elements(*args), refine=np.ones(args[0]))
+
+    monkeypatch.setitem(memory.TREFFTZ_SECONDS, "neck", 10.0)
+    monkeypatch.setattr(te, "trefftz_elements", law)
+    scene = _trefftz("periodic")
+    StaticEngine(scene)  # the serial run's live necks (nothing said: no listener)
+    n, radius, live, vectors = given[0][:4]
+    necks, meeting = live.necks_per_particle(n), pairs_meeting(radius, live, vectors, given[0][8])
+    capsys.readouterr()
+    result = run(scene, progress=True)
+    said = [line for line in capsys.readouterr().err.splitlines() if "Trefftz elements" in line]
+    shares = [(len(own), int(necks[own].sum()), int(meeting[own].sum()), workers)
+              for own, workers in COMM.allgather((result.engine.owned, threads.count()))]
+    line = memory.element_estimate(*zip(*shares))
+    assert f"of {scene.particles.n} particles on {COMM.Get_size()} ranks" in line and meeting.sum() > 0
+    assert COMM.allgather(said) == [[f"python -m dem run: {line}"]] + [[]] * (COMM.Get_size() - 1)

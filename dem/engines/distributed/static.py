@@ -30,7 +30,8 @@ per neck, a current.
 
 The Trefftz element (``[conductance] element = "trefftz"``, :mod:`dem.network.elements`) runs on the ranks with its
 three flux modes per neck (:func:`dem.network.distributed_necks.node_keys`): each rank builds it for its own particles
-only, the expensive part of such a run shared out, receives those of their necks' partners from their owners
+only, the expensive part of such a run shared out (what it will take said once, by rank 0, for all the ranks:
+:class:`dem.network.elements.SceneElements`' ``comm``), receives those of their necks' partners from their owners
 (:func:`dem.network.distributed_necks.shared_elements`) and then assembles its network, once; the summary's
 ``element_*`` entries are summed over the ranks (``element_seconds``: the CPU time of all the ranks' elements).
 """
@@ -171,8 +172,9 @@ class DistributedStaticEngine(StaticEngine):
             self.part = DistributedNecks(self.comm, self.necks_heat, keys, node_owner)
 
     def _build(self, scene, rank: int) -> tuple:
-        """This rank's particles, bonds and conductances (no communication); returns the owner of each held particle and,
-        with a node per neck, the held particles' live necks (:func:`dem.network.necks.live_necks`; None: without)."""
+        """This rank's particles, bonds and conductances (no communication); returns the owner of each held particle
+        and, with a node per neck, the held particles' live necks (:func:`dem.network.necks.live_necks`; None:
+        without)."""
         p, box, spec = scene.particles, scene.box, scene.conductance
         nodes = spec.nodes
         if p.n < self.ranks:
@@ -223,11 +225,11 @@ class DistributedStaticEngine(StaticEngine):
         """The network with a node per neck of the held particles from their live necks ``live``
         (:func:`dem.network.necks.live_necks`), assembled once (:func:`dem.network.necks.assembled`) from the elements
         of ``[conductance] element`` (:func:`dem.network.elements.scene_elements`: a Trefftz element on the own
-        particles only) and, with the Trefftz element, those of the own particles' partners from their owners
-        (:func:`dem.network.distributed_necks.shared_elements`); and, per held particle, whether its element dropped
-        its interactions (``plain``)."""
+        particles only, what it takes said once for all the ranks) and, with the Trefftz element, those of the own
+        particles' partners from their owners (:func:`dem.network.distributed_necks.shared_elements`); and, per held
+        particle, whether its element dropped its interactions (``plain``)."""
         spec = self.scene.conductance
-        self.elements = scene_elements(spec, self.mine)
+        self.elements = scene_elements(spec, self.mine, self.comm)
         el = mpi.agree(self.comm, lambda: self.elements(*live.arguments))
         if spec.element != "law":
             el = shared_elements(self.comm, el, live, self.held, owner, self.mine)
