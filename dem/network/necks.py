@@ -282,7 +282,7 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
         The closing pores' calibration (:func:`dem.laws.conductance.bond_conductances`); None: the shipped one.
     elements : callable or None
         What builds the particles' elements, called with the arguments of
-        :func:`dem.laws.shared_body.particle_elements` (:attr:`LiveNecks.arguments`) and returning its
+        :func:`dem.laws.shared_body.particle_elements` (``arguments`` of :class:`LiveNecks`) and returning its
         :class:`~dem.laws.shared_body.ParticleElements` (the same ends, another matrix per particle: e.g. an exact
         element computed elsewhere, with ``modes`` flux modes per neck, one number or one per particle, module
         docstring "Flux modes"); None: :func:`dem.laws.shared_body.particle_elements`.
@@ -311,7 +311,7 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
 @dataclass
 class LiveNecks:
     """The live necks of a network with a node per neck and their halves, before their particles' elements are built
-    (:func:`live_necks`): what the elements are built from (:attr:`arguments`) and placed by (:func:`assembled`).
+    (:func:`live_necks`): what the elements are built from (``arguments``) and placed by (:func:`assembled`).
 
     Parameters
     ----------
@@ -334,7 +334,7 @@ class LiveNecks:
         The periodic box; None: none.
     union : tuple or None
         Under the union of spheres, what :func:`dem.laws.conductance.union_halves` returned
-        (:attr:`NeckNetwork.union`); None under a pair-neck reading.
+        (``union`` of :class:`NeckNetwork`); None under a pair-neck reading.
     """
 
     particles: Particles
@@ -416,7 +416,7 @@ def assembled(necks: LiveNecks, el) -> NeckNetwork:
         The live necks (:func:`live_necks`).
     el : dem.laws.shared_body.ParticleElements
         Their particles' elements (an ``elements`` hook's of :func:`neck_network`, called with
-        :attr:`LiveNecks.arguments`).
+        ``arguments`` of :class:`LiveNecks`).
 
     Returns
     -------
