@@ -215,9 +215,9 @@ def element_seconds(necks, meeting) -> float:
     Parameters
     ----------
     necks : array_like of int
-        Per particle, its necks.
+        Per particle, its necks (or their sum over some particles).
     meeting : array_like of int
-        Per particle, the pairs of its necks that meet (:func:`dem.geometry.necks.pairs_meeting`).
+        Per particle, the pairs of its necks that meet (:func:`dem.geometry.necks.pairs_meeting`; or their sum).
 
     Returns
     -------
@@ -227,33 +227,42 @@ def element_seconds(necks, meeting) -> float:
     return float(TREFFTZ_SECONDS["neck"] * np.sum(necks) + TREFFTZ_SECONDS["meeting pair"] * np.sum(meeting))
 
 
-def element_estimate(necks, meeting, workers: int = 1) -> str | None:
-    """What building the Trefftz elements of particles with ``necks`` necks each, ``meeting`` pairs of which meet, will
-    take (:func:`element_seconds`), said before it starts where it is large (``ANNOUNCE_SECONDS`` or more); None for
-    less.
+def element_estimate(particles, necks, meeting, workers) -> str | None:
+    """What building the Trefftz elements will take (:func:`element_seconds`), said before it starts where it is large
+    (``ANNOUNCE_SECONDS`` or more on one core in all); None for less. Given per process that builds a share of them:
+    one without MPI; on MPI ranks, each building its own particles', one line for all of them, with the wall time of
+    the busiest rank (the largest of the ranks' CPU times over their threads), which the solve waits for.
 
     Parameters
     ----------
+    particles : array_like of int
+        Per process, the particles whose elements it builds.
     necks : array_like of int
-        Per particle, its necks.
+        Per process, the necks of those particles.
     meeting : array_like of int
-        Per particle, the pairs of its necks that meet.
-    workers : int
-        The threads that will share that CPU time (:func:`dem.network.trefftz_element.trefftz_elements`' ``workers``),
-        named in the line where more than one.
+        Per process, the pairs of those particles' necks that meet (:func:`dem.geometry.necks.pairs_meeting`).
+    workers : array_like of int
+        Per process, the threads that share its CPU time (:func:`dem.network.trefftz_element.trefftz_elements`'
+        ``workers``), named in the line where more than one.
 
     Returns
     -------
     str or None
         One line, or None.
     """
-    z = np.asarray(necks)
-    seconds = element_seconds(z, meeting)
+    n, z, m, w = (np.asarray(v, dtype=np.int64) for v in (particles, necks, meeting, workers))
+    each = np.array([element_seconds(*counts) for counts in zip(z, m)])  # per process, on one core
+    seconds = element_seconds(z, m)
     if seconds < ANNOUNCE_SECONDS:
         return None
-    return (f"the Trefftz elements of {len(z)} particles ({z.mean():.3g} necks each on average, "
-            f"{int(np.sum(meeting))} pairs of necks meeting): about {seconds:.3g} s on one core"
-            f"{f', shared by {workers} threads' if workers > 1 else ''}, before the solve")
+    counts = f"({z.sum() / n.sum():.3g} necks each on average, {int(m.sum())} pairs of necks meeting)"
+    if len(n) == 1:
+        return (f"the Trefftz elements of {int(n[0])} particles {counts}: about {seconds:.3g} s on one core"
+                f"{f', shared by {w[0]} threads' if w[0] > 1 else ''}, before the solve")
+    k = int(np.argmax(each / w))  # the busiest rank
+    return (f"the Trefftz elements of {int(n.sum())} particles on {len(n)} ranks {counts}: about {seconds:.3g} s on "
+            f"one core in all, about {each[k] / w[k]:.3g} s on the busiest rank"
+            f"{f' (its {each[k]:.3g} s shared by {w[k]} threads)' if w[k] > 1 else ''}, before the solve")
 
 
 _SAY = contextvars.ContextVar("say", default=None)

@@ -139,12 +139,31 @@ def test_the_evidence_of_the_element_holds_where_necks_meet_and_the_laws_does_no
 def test_the_estimate_is_per_neck_and_per_pair_of_necks_meeting_said_only_where_large():
     a, b = memory.TREFFTZ_SECONDS["neck"], memory.TREFFTZ_SECONDS["meeting pair"]
     assert memory.element_seconds([4, 6, 0], [0, 3, 0]) == pytest.approx(10 * a + 3 * b, rel=1e-15)
-    assert memory.element_estimate([6] * 100, [2] * 100) is None  # 100 particles: about 1.4 s
+    assert memory.element_estimate([100], [600], [200], [1]) is None  # 100 particles: about 1.4 s
     n = int(np.ceil(memory.ANNOUNCE_SECONDS / (12 * a + 24 * b)))
-    line = memory.element_estimate([12] * n, [24] * n)
+    line = memory.element_estimate([n], [12 * n], [24 * n], [1])
     assert line == (f"the Trefftz elements of {n} particles (12 necks each on average, {24 * n} pairs of necks "
                     f"meeting): about {(12 * a + 24 * b) * n:.3g} s on one core, before the solve")
-    assert memory.element_estimate([12] * n, [24] * n, 4) == line.replace("one core,", "one core, shared by 4 threads,")
+    assert memory.element_estimate([n], [12 * n], [24 * n], [4]) == line.replace("one core,",
+                                                                                "one core, shared by 4 threads,")
+
+
+def test_on_ranks_the_estimate_is_one_line_for_all_of_them_with_the_busiest_ranks_wall_time():
+    """Three ranks building 100, 300 and 200 particles' elements (necks and meeting pairs in proportion, on 2, 4 and 1
+    threads: wall times in the ratio 0.5 : 0.75 : 2): the total over the ranks, and the third rank's wall time."""
+    a, b = memory.TREFFTZ_SECONDS["neck"], memory.TREFFTZ_SECONDS["meeting pair"]
+    each = 10 * a + 3 * b  # one particle's
+    n = int(np.ceil(memory.ANNOUNCE_SECONDS / (600 * each)))
+    particles = [100 * n, 300 * n, 200 * n]
+    line = memory.element_estimate(particles, [10 * k for k in particles], [3 * k for k in particles], [2, 4, 1])
+    assert line == (f"the Trefftz elements of {600 * n} particles on 3 ranks (10 necks each on average, {1800 * n} "
+                    f"pairs of necks meeting): about {600 * n * each:.3g} s on one core in all, about "
+                    f"{200 * n * each:.3g} s on the busiest rank, before the solve")
+    threads = memory.element_estimate(particles, [10 * k for k in particles], [3 * k for k in particles], [2, 4, 4])
+    assert threads == line.replace(f"{200 * n * each:.3g} s on the busiest rank,",  # now the second: 300 n on 4
+                                   f"{75 * n * each:.3g} s on the busiest rank (its {300 * n * each:.3g} s shared "
+                                   f"by 4 threads),")
+    assert memory.element_estimate([100, 100], [600, 600], [200, 200], [1, 1]) is None  # 2.8 s in all
 
 
 @pytest.mark.parametrize("kind, h, pairs", [("sc", 0.6, 36), ("fcc", 0.2, 0), ("fcc", 0.3, 24)])

@@ -24,8 +24,10 @@ element (``modes`` 3, :mod:`dem.network.necks`, "Flux modes") a rank builds it f
 (:class:`dem.network.elements.SceneElements`' ``own``: the expensive part of such a run shared out), the law's
 one-mode element for the rest of its halo, and receives the elements of its own particles' partners, whose elements
 its rows sum, from their owners (:func:`shared_elements`: each particle's element is the same on every rank that holds
-all its necks, its ends in the same order): every used neck then has a Trefftz particle and its three modes, as in
-the serial network, and the fringe's necks, never used, may have one. The unknowns of a solve are numbered
+all its necks, its ends in the same order) before it assembles its network, once (the live necks found first,
+:func:`dem.network.necks.live_necks`, the network of them and the elements after, :func:`dem.network.necks.assembled`):
+every used neck then has a Trefftz particle and its three modes, as in the serial network, and the fringe's necks,
+never used, may have one. The unknowns of a solve are numbered
 rank after rank (:meth:`dem.network.distributed.DistributedNetwork.numbering`).
 
 **Groups and the steady solve.** The groups of free nodes are the connected components over the ranks
@@ -48,7 +50,7 @@ from __future__ import annotations
 import numpy as np
 
 from dem.network.distributed import DistributedNetwork
-from dem.network.necks import NeckHeat, NeckNetwork, first_modes, uniform_level
+from dem.network.necks import LiveNecks, NeckHeat, NeckNetwork, first_modes, uniform_level
 from dem.parallel import comm as mpi
 from dem.parallel.petsc import largest_eigenvalue
 
@@ -101,7 +103,7 @@ def node_keys(net: NeckNetwork, held: np.ndarray, owner: np.ndarray, comm) -> tu
     return np.concatenate([held, necks]).astype(np.int64), np.concatenate([owner, owner[i[bond]]])
 
 
-def shared_elements(comm, built, net: NeckNetwork, held: np.ndarray, owner: np.ndarray, mine: np.ndarray):
+def shared_elements(comm, built, necks: LiveNecks, held: np.ndarray, owner: np.ndarray, mine: np.ndarray):
     """``built`` with the elements of the partners of this rank's own particles (over their live pair necks) taken
     from the ranks that own them (module docstring, "Numbering"): what the owned rows sum.
 
@@ -110,9 +112,9 @@ def shared_elements(comm, built, net: NeckNetwork, held: np.ndarray, owner: np.n
     comm : object
         The MPI communicator (an ``mpi4py.MPI.Comm``).
     built : dem.laws.shared_body.ParticleElements
-        The held particles' elements as this rank built them (its own particles' the ones wanted), in ``net``.
-    net : dem.network.necks.NeckNetwork
-        The rank's network of its held particles, of ``built``.
+        The held particles' elements as this rank built them (its own particles' the ones wanted), over ``necks``.
+    necks : dem.network.necks.LiveNecks
+        The live necks of the rank's held particles, of ``built``.
     held : numpy.ndarray
         Global index of each held particle, sorted.
     owner : numpy.ndarray
@@ -127,7 +129,7 @@ def shared_elements(comm, built, net: NeckNetwork, held: np.ndarray, owner: np.n
         ``modes``, ...) those of their owners.
     """
     n = len(held)
-    i, j = net.bonds.i[net.live], net.bonds.j[net.live]
+    i, j = necks.bonds.i[necks.live], necks.bonds.j[necks.live]
     need = np.zeros(n, dtype=bool)
     need[j[mine[i]]] = need[i[mine[j]]] = True
     wanted = np.flatnonzero(need & ~mine)

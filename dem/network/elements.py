@@ -5,8 +5,9 @@
 (:func:`dem.laws.shared_body.particle_elements`, one flux mode per neck); ``element = "trefftz"`` the Trefftz element
 of its cut sphere with three flux modes per neck (:func:`dem.network.trefftz_element.trefftz_elements`), which keeps
 the law's element on its monopoles where its own is not positive definite (``plain``), and whose time is said before
-they are built where it is large (:func:`dem.memory.element_estimate`). Either is the ``elements`` hook of
-:func:`dem.network.necks.neck_network`; :func:`scene_elements` is the one place that calls it.
+they are built where it is large (:func:`dem.memory.element_estimate`; on MPI ranks, each building its own particles',
+once by rank 0 for all of them). Either is the ``elements`` hook of :func:`dem.network.necks.neck_network`;
+:func:`scene_elements` is the one place that calls it.
 """
 
 from __future__ import annotations
@@ -35,6 +36,10 @@ class SceneElements:
         Trefftz element is then built for these only, the law's one-mode element for the rest of the halo (the
         elements of the own particles' partners come from their owners,
         :func:`dem.network.distributed_necks.shared_elements`); None: every particle's is built.
+    comm : object or None
+        With ``own``, the MPI communicator of the ranks that each build their own particles' elements (an
+        ``mpi4py.MPI.Comm``): the hook is then called on every rank together, and what building them takes is said
+        once, by rank 0, for all the ranks (:func:`dem.memory.element_estimate` of every rank's share); None: no MPI.
 
     Attributes
     ----------
@@ -45,16 +50,17 @@ class SceneElements:
         :func:`sinterheat.threads.count` threads), s.
     """
 
-    def __init__(self, element: str, own: np.ndarray | None = None):
+    def __init__(self, element: str, own: np.ndarray | None = None, comm=None):
         self.element = element
         self.own = None if own is None else np.asarray(own, dtype=bool)
+        self.comm = comm
         self.built = None
         self.seconds = 0.0
 
     def __call__(self, n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume=None):
         """The particles' elements (:func:`dem.laws.shared_body.particle_elements`'s arguments); the Trefftz elements'
         time estimated from the necks first and said where it is large (:func:`dem.memory.element_estimate`,
-        :func:`dem.memory.announce`).
+        :func:`dem.memory.announce`; with ``comm``, by rank 0 for all the ranks).
 
         Parameters
         ----------
@@ -88,10 +94,13 @@ class SceneElements:
             from dem.network.trefftz_element import trefftz_elements
 
             build = trefftz_elements if self.own is None else functools.partial(trefftz_elements, where=self.own)
-            necks = bonds.necks_per_particle(n)
             chosen = slice(None) if self.own is None else self.own
-            announce(element_estimate(necks[chosen], pairs_meeting(radius, bonds, vectors, wall_normals)[chosen],
-                                      threads.count()))
+            necks = bonds.necks_per_particle(n)[chosen]
+            meeting = pairs_meeting(radius, bonds, vectors, wall_normals)[chosen]
+            share = (len(necks), int(necks.sum()), int(meeting.sum()), threads.count())
+            shares = [share] if self.comm is None else self.comm.gather(share)  # (None but on rank 0)
+            if shares is not None:
+                announce(element_estimate(*zip(*shares)))
         else:
             from dem.laws.shared_body import particle_elements as build
         start = time.process_time()
@@ -122,7 +131,7 @@ class SceneElements:
                 "element_seconds": self.seconds}
 
 
-def scene_elements(spec: ConductanceSpec, own: np.ndarray | None = None) -> SceneElements:
+def scene_elements(spec: ConductanceSpec, own: np.ndarray | None = None, comm=None) -> SceneElements:
     """The ``elements`` hook of :func:`dem.network.necks.neck_network` that ``spec.element`` names (module docstring).
 
     Parameters
@@ -131,10 +140,13 @@ def scene_elements(spec: ConductanceSpec, own: np.ndarray | None = None) -> Scen
         The conductance law, its neck reading, nodes and element.
     own : numpy.ndarray or None
         Per particle, whether it is this process's own (:class:`SceneElements`); None: all.
+    comm : object or None
+        The MPI communicator of the ranks that build their own particles' elements (:class:`SceneElements`); None:
+        no MPI.
 
     Returns
     -------
     SceneElements
         The hook, which keeps what it built.
     """
-    return SceneElements(spec.element, own)
+    return SceneElements(spec.element, own, comm)

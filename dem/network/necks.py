@@ -263,7 +263,8 @@ class NeckNetwork:
 def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, box: PeriodicBox | None = None,
                  walls=(), closing_pores: dict | None = None, elements=None, without=None) -> NeckNetwork:
     """Assemble the network with a node per neck (module docstring) of the ``shared-body`` law under the union of
-    spheres or a pair-neck reading ("Pair necks").
+    spheres or a pair-neck reading ("Pair necks"): its live necks (:func:`live_necks`), their particles' elements
+    (``elements``) and the network of them (:func:`assembled`).
 
     Parameters
     ----------
@@ -281,7 +282,7 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
         The closing pores' calibration (:func:`dem.laws.conductance.bond_conductances`); None: the shipped one.
     elements : callable or None
         What builds the particles' elements, called with the arguments of
-        :func:`dem.laws.shared_body.particle_elements` and returning its
+        :func:`dem.laws.shared_body.particle_elements` (``arguments`` of :class:`LiveNecks`) and returning its
         :class:`~dem.laws.shared_body.ParticleElements` (the same ends, another matrix per particle: e.g. an exact
         element computed elsewhere, with ``modes`` flux modes per neck, one number or one per particle, module
         docstring "Flux modes"); None: :func:`dem.laws.shared_body.particle_elements`.
@@ -303,6 +304,82 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     """
     from dem.laws.shared_body import particle_elements
 
+    necks = live_necks(spec, particles, bonds, box=box, walls=walls, closing_pores=closing_pores, without=without)
+    return assembled(necks, (elements or particle_elements)(*necks.arguments))
+
+
+@dataclass
+class LiveNecks:
+    """The live necks of a network with a node per neck and their halves, before their particles' elements are built
+    (:func:`live_necks`): what the elements are built from (``arguments``) and placed by (:func:`assembled`).
+
+    Parameters
+    ----------
+    particles : dem.geometry.particles.Particles
+        The particles.
+    bonds : dem.geometry.bonds.Bonds
+        All pair and wall bonds.
+    live : numpy.ndarray
+        Indices of the pair bonds that have a neck node.
+    live_walls : numpy.ndarray
+        Indices of the wall bonds that carry heat.
+    arguments : tuple
+        The arguments of :func:`dem.laws.shared_body.particle_elements` over the live bonds, with which an
+        ``elements`` hook of :func:`neck_network` is called: the number of particles, their radii (m), the live
+        bonds, their vectors ``x_j - x_i`` (m), half conductances (W/K), the particles' conductivities (W/(m K)),
+        the live wall bonds' normals and the particles' solid volumes (m^3; None: their spheres').
+    walls : sequence of dem.geometry.walls.Wall
+        The walls the wall bonds index (their temperatures).
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box; None: none.
+    union : tuple or None
+        Under the union of spheres, what :func:`dem.laws.conductance.union_halves` returned
+        (``union`` of :class:`NeckNetwork`); None under a pair-neck reading.
+    """
+
+    particles: Particles
+    bonds: Bonds
+    live: np.ndarray
+    live_walls: np.ndarray
+    arguments: tuple
+    walls: tuple = ()
+    box: PeriodicBox | None = None
+    union: tuple | None = None
+
+
+def live_necks(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, box: PeriodicBox | None = None,
+               walls=(), closing_pores: dict | None = None, without=None) -> LiveNecks:
+    """The live necks of the network with a node per neck (:func:`neck_network`, whose parameters these are) and
+    their halves: the ``shared-body`` law's under the union of spheres (its cut bodies) or a pair-neck reading
+    ("Pair necks").
+
+    Parameters
+    ----------
+    spec : dem.laws.conductance.ConductanceSpec
+        The law (``shared-body``, without ``contact_conductance``) and its neck reading.
+    particles : dem.geometry.particles.Particles
+        The particles.
+    bonds : dem.geometry.bonds.Bonds
+        The bonds under that reading.
+    box : dem.geometry.periodic.PeriodicBox or None
+        The periodic box; None: none.
+    walls : sequence of dem.geometry.walls.Wall
+        The walls the wall bonds index (their normals and temperatures).
+    closing_pores : dict or None
+        The closing pores' calibration (:func:`dem.laws.conductance.bond_conductances`); None: the shipped one.
+    without : tuple of numpy.ndarray or None
+        ``(pairs, walls)``: masks of the pair and wall bonds to leave without a neck node; None: none.
+
+    Returns
+    -------
+    LiveNecks
+        The live necks.
+
+    Raises
+    ------
+    ValueError
+        ``spec`` is not the ``shared-body`` law without ``contact_conductance``, or wall bonds without their walls.
+    """
     if spec.law != "shared-body" or spec.contact_conductance is not None:
         raise ValueError(f"conductance.nodes = \"necks\": only with law = \"shared-body\" and no contact_conductance "
                          f"(here law = {spec.law!r}, contact_conductance = {spec.contact_conductance!r})")
@@ -324,8 +401,36 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
         pairs, live_walls = pairs & ~without[0], live_walls & ~without[1]
     live, live_walls = np.flatnonzero(pairs), np.flatnonzero(live_walls)
     sub = bonds.subset(live, live_walls)
-    el = (elements or particle_elements)(n, r, sub, vectors[live], k_i[live], k_j[live], k_w[live_walls], kappa,
-                                         np.reshape(normals, (-1, 3))[live_walls], volume)
+    arguments = (n, r, sub, vectors[live], k_i[live], k_j[live], k_w[live_walls], kappa,
+                 np.reshape(normals, (-1, 3))[live_walls], volume)
+    return LiveNecks(particles, bonds, live, live_walls, arguments, tuple(walls), box, union)
+
+
+def assembled(necks: LiveNecks, el) -> NeckNetwork:
+    """The network with a node per neck (module docstring, "Assembly") of ``necks`` and their particles' elements
+    ``el``, in one sparse matrix.
+
+    Parameters
+    ----------
+    necks : LiveNecks
+        The live necks (:func:`live_necks`).
+    el : dem.laws.shared_body.ParticleElements
+        Their particles' elements (an ``elements`` hook's of :func:`neck_network`, called with
+        ``arguments`` of :class:`LiveNecks`).
+
+    Returns
+    -------
+    NeckNetwork
+        The assembled network.
+
+    Raises
+    ------
+    ValueError
+        Elements whose ``modes`` are not integers >= 1 (one, or one per particle), or whose blocks are not
+        :math:`(m z + 1)^2` values (``m`` the particle's modes per neck).
+    """
+    particles, live, live_walls, box = necks.particles, necks.live, necks.live_walls, necks.box
+    n, sub = particles.n, necks.arguments[2]  # the live bonds
     m = len(live)
     M = _modes(el)
     # each live pair bond's modes: the most of its two particles' (module docstring, "Flux modes"); mode ``mode`` of
@@ -334,7 +439,8 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     monopole = n + first_modes(bond_modes)
     # each end's node (a wall's: -1) and the offset it is seen at by its particle (a wall's: its temperature)
     jump = sub.shifts @ box.drop if box is not None else np.zeros(m)
-    wall_T = np.array([w.temperature for w in walls], dtype=float)[sub.wall_index] if len(live_walls) else np.zeros(0)
+    wall_T = np.array([w.temperature for w in necks.walls], dtype=float)[sub.wall_index] if len(live_walls) \
+        else np.zeros(0)
     # (one more place at the end of each: the centre, end -1, seen at offset 0)
     node = np.concatenate([monopole, monopole, np.full(len(live_walls), -1), [0]])
     offset = np.concatenate([np.zeros(m), jump, wall_T, [0.0]])
@@ -363,9 +469,9 @@ def neck_network(spec: ConductanceSpec, particles: Particles, bonds: Bonds, *, b
     A = 0.5 * (A + A.T)  # symmetric to round-off (the blocks are; their sums need not be bit for bit)
     rhs = -np.bincount(row[rows], value[rows] * known[rows], size_all)
     modes = bond_modes if np.any(M != M[:1]) else int(M[0]) if n else 1  # one number where all particles' agree
-    return NeckNetwork(particles, bonds, live, live_walls, A.tocsr(), rhs, (row, col, value, known, end_row),
-                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box, union,
-                       modes)
+    return NeckNetwork(particles, necks.bonds, live, live_walls, A.tocsr(), rhs, (row, col, value, known, end_row),
+                       2 * m + len(live_walls), int(np.count_nonzero(el.plain)), jump, owner, end_col, box,
+                       necks.union, modes)
 
 
 def first_modes(bond_modes: np.ndarray) -> np.ndarray:

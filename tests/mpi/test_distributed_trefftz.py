@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from dem.driver import run
+from dem.engines.distributed.static import DistributedStaticEngine
 from dem.parallel import comm as mpi
 from test_distributed_necks import COMM, _blocks, owned_rows_against_serial, serial
 
@@ -108,3 +109,78 @@ def test_a_packing_read_in_parts_equals_the_serial_run():
         assert s[key] == r[key], key
     assert s["effective_conductivity"] == pytest.approx(r["effective_conductivity"], rel=1e-10)
     assert np.max(np.abs(result.engine.gathered_temperatures() - ref.T)) < 1e-9
+
+
+def test_each_rank_assembles_its_network_once(monkeypatch):
+    """Each rank computes its necks' halves (the cut bodies, the closing pores) once and assembles its network with a
+    node per neck once, from its own particles' Trefftz elements and their partners' received from their owners: the
+    network assembled from scratch with those elements, to the bit."""
+    import dem.engines.distributed.static as engine_module
+    import dem.laws.conductance as conductance
+    import dem.network.necks as necks
+
+    counts = {"halves": 0, "networks": 0}
+    halves, share, given = conductance.union_halves, engine_module.shared_elements, []
+
+    def counted(*args, **kwargs):
+        counts["halves"] += 1
+        return halves(*args, **kwargs)
+
+    class Counted(necks.NeckNetwork):
+        def __init__(self, *args, **kwargs):
+            counts["networks"] += 1
+            super().__init__(*args, **kwargs)
+
+    def shared(*args):
+        given.append(share(*args))
+        return given[-1]
+
+    for module in (conductance, necks):
+        monkeypatch.setattr(module, "union_halves", counted)
+    monkeypatch.setattr(necks, "NeckNetwork", Counted)
+    monkeypatch.setattr(engine_module, "shared_elements", shared)
+    scene = _trefftz("periodic")
+    engine = DistributedStaticEngine(scene)
+    assert COMM.allgather(counts) == [{"halves": 1, "networks": 1}] * COMM.Get_size()
+    assert np.any(np.asarray(given[0].modes) == 3) and not np.array_equal(given[0].values, engine.elements.built.values)
+    local = engine.scene
+    again = necks.neck_network(local.conductance, local.particles, engine.necks.bonds, box=local.box,
+                               walls=local.walls, elements=lambda *args: given[0])
+    net = engine.necks
+    for ours, theirs in ((net.A.data, again.A.data), (net.A.indices, again.A.indices), (net.rhs, again.rhs),
+                         *zip(net.entries, again.entries)):
+        assert np.array_equal(ours, theirs)
+
+
+def test_what_the_elements_take_is_said_once_by_rank_0_for_all_the_ranks(monkeypatch, capsys):
+    """With a large figure per neck (so that it is said), a run on the ranks that reports its progress says on
+    stderr one line of what the elements take, on rank 0 only: for the particles, necks and pairs of them meeting of
+    the serial run's live necks, and the busiest rank's share of them (the elements are the law's here: only what is
+    said is looked at)."""
+    from dem import memory
+    from dem.engines.static import StaticEngine
+    from dem.geometry.necks import pairs_meeting
+    from dem.laws.shared_body import particle_elements
+    from dem.network import trefftz_element as te
+    from sinterheat import threads
+
+    given = []
+
+    def law(*args, where=None):
+        given.append(args)
+        return te.TrefftzElements(*particle_elements(*args), refine=np.ones(args[0]))
+
+    monkeypatch.setitem(memory.TREFFTZ_SECONDS, "neck", 10.0)
+    monkeypatch.setattr(te, "trefftz_elements", law)
+    scene = _trefftz("periodic")
+    StaticEngine(scene)  # the serial run's live necks (nothing said: no listener)
+    n, radius, live, vectors = given[0][:4]
+    necks, meeting = live.necks_per_particle(n), pairs_meeting(radius, live, vectors, given[0][8])
+    capsys.readouterr()
+    result = run(scene, progress=True)
+    said = [line for line in capsys.readouterr().err.splitlines() if "Trefftz elements" in line]
+    shares = [(len(own), int(necks[own].sum()), int(meeting[own].sum()), workers)
+              for own, workers in COMM.allgather((result.engine.owned, threads.count()))]
+    line = memory.element_estimate(*zip(*shares))
+    assert f"of {scene.particles.n} particles on {COMM.Get_size()} ranks" in line and meeting.sum() > 0
+    assert COMM.allgather(said) == [[f"python -m dem run: {line}"]] + [[]] * (COMM.Get_size() - 1)

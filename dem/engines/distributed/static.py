@@ -30,8 +30,9 @@ per neck, a current.
 
 The Trefftz element (``[conductance] element = "trefftz"``, :mod:`dem.network.elements`) runs on the ranks with its
 three flux modes per neck (:func:`dem.network.distributed_necks.node_keys`): each rank builds it for its own particles
-only, the expensive part of such a run shared out, receives those of their necks' partners from their owners
-(:func:`dem.network.distributed_necks.shared_elements`) and assembles its network again with them; the summary's
+only, the expensive part of such a run shared out (what it will take said once, by rank 0, for all the ranks:
+:class:`dem.network.elements.SceneElements`' ``comm``), receives those of their necks' partners from their owners
+(:func:`dem.network.distributed_necks.shared_elements`) and then assembles its network, once; the summary's
 ``element_*`` entries are summed over the ranks (``element_seconds``: the CPU time of all the ranks' elements).
 """
 
@@ -54,7 +55,7 @@ from dem.network.distributed import DistributedNetwork
 from dem.network.distributed_necks import DistributedNecks, RankNeckHeat, node_keys, shared_elements
 from dem.network.elements import scene_elements
 from dem.network.heat import Network, bonds_and_conductances
-from dem.network.necks import neck_flows, neck_network
+from dem.network.necks import assembled, live_necks, neck_flows
 from dem.output.pieces import refuse_lammps_dump
 from sinterheat import threads
 
@@ -152,13 +153,10 @@ class DistributedStaticEngine(StaticEngine):
         self.t, self.steps = self.t_start, 0
         self.flows, self.details, self.restart = {}, {}, None
         self.necks = None  # with a node per neck: the network of the held particles (dem.network.necks)
-        owner = mpi.agree(self.comm, lambda: self._build(scene, rank))  # no collective call inside: a bond out of
-        particles = self.scene.particles                                  # range stops every rank alike
-        if self.necks is not None and scene.conductance.element != "law":  # the partners' elements from their owners
-            el = shared_elements(self.comm, self.elements.built, self.necks, self.held, owner, self.mine)
-            self.necks = mpi.agree(self.comm, lambda: neck_network(
-                scene.conductance, particles, self.necks.bonds, box=scene.box, walls=scene.walls,
-                elements=lambda *args: el))
+        owner, live = mpi.agree(self.comm, lambda: self._build(scene, rank))  # no collective call inside: a bond out
+        particles = self.scene.particles                                        # of range stops every rank alike
+        if live is not None:
+            self.necks, self.plain = self._neck_network(live, owner)
         self.potential, self.circuit = None, None
         if scene.electrical is not None:
             particles = mpi.agree(self.comm, lambda: self._joule_heated(particles, owner))
@@ -173,8 +171,10 @@ class DistributedStaticEngine(StaticEngine):
             keys, node_owner = node_keys(self.necks, self.held, owner, self.comm)
             self.part = DistributedNecks(self.comm, self.necks_heat, keys, node_owner)
 
-    def _build(self, scene, rank: int) -> np.ndarray:
-        """This rank's particles, bonds and network (no communication); returns the owner of each held particle."""
+    def _build(self, scene, rank: int) -> tuple:
+        """This rank's particles, bonds and conductances (no communication); returns the owner of each held particle
+        and, with a node per neck, the held particles' live necks (:func:`dem.network.necks.live_necks`; None:
+        without)."""
         p, box, spec = scene.particles, scene.box, scene.conductance
         nodes = spec.nodes
         if p.n < self.ranks:
@@ -203,10 +203,11 @@ class DistributedStaticEngine(StaticEngine):
         try:
             if nodes == "necks":  # all the bonds of the held particles (module docstring of distributed_necks)
                 bonds = find_bonds(local, tuple(scene.walls), spec.contact, spec.out_of_range, box=box)
-                self.necks, self.plain = self._neck_network(local, bonds, mine)
+                live = live_necks(spec, local, bonds, box=box, walls=scene.walls)
                 K_pairs, K_walls = bond_conductances(spec, local, bonds, box=box, walls=tuple(scene.walls),
-                                                     union=self.necks.union)
+                                                     union=live.union)
             else:
+                live = None
                 bonds, K_pairs, K_walls = bonds_and_conductances(local, scene.walls, spec, box=box)
         except ValueError as exc:  # its counts and indices are of this rank's particles
             raise ValueError(f"rank {rank} of {self.ranks}, its {len(held)} particles numbered from 0 in the "
@@ -218,17 +219,21 @@ class DistributedStaticEngine(StaticEngine):
         self.meeting = meeting_in(local, scene.walls, self.bonds, box)  # right for the owned: all their bonds are here
         self.wide = wide_necks(local.radius, self.bonds, self.meeting, spec.law, nodes, spec.element)
         self.T = local.temperature.astype(float)
-        return owner_held
+        return owner_held, live
 
-    def _neck_network(self, local, bonds, mine: np.ndarray) -> tuple:
-        """The network with a node per neck of the held particles (:func:`dem.network.necks.neck_network`, the
-        elements of ``[conductance] element``, :func:`dem.network.elements.scene_elements`, a Trefftz element on the
-        own particles ``mine`` only: the partners' come from their owners after this) and, per held particle,
-        whether its element dropped its interactions (``plain``)."""
-        scene = self.scene
-        self.elements = scene_elements(scene.conductance, mine)
-        net = neck_network(scene.conductance, local, bonds, box=scene.box, walls=scene.walls, elements=self.elements)
-        return net, np.asarray(self.elements.built.plain, dtype=bool)
+    def _neck_network(self, live, owner: np.ndarray) -> tuple:
+        """The network with a node per neck of the held particles from their live necks ``live``
+        (:func:`dem.network.necks.live_necks`), assembled once (:func:`dem.network.necks.assembled`) from the elements
+        of ``[conductance] element`` (:func:`dem.network.elements.scene_elements`: a Trefftz element on the own
+        particles only, what it takes said once for all the ranks) and, with the Trefftz element, those of the own
+        particles' partners from their owners (:func:`dem.network.distributed_necks.shared_elements`); and, per held
+        particle, whether its element dropped its interactions (``plain``)."""
+        spec = self.scene.conductance
+        self.elements = scene_elements(spec, self.mine, self.comm)
+        el = mpi.agree(self.comm, lambda: self.elements(*live.arguments))
+        if spec.element != "law":
+            el = shared_elements(self.comm, el, live, self.held, owner, self.mine)
+        return mpi.agree(self.comm, lambda: assembled(live, el)), np.asarray(self.elements.built.plain, dtype=bool)
 
     def _joule_heated(self, particles, owner: np.ndarray):
         """The held particles with the absorbed Joule heat of the current added to their heat sources (module
