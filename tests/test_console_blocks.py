@@ -5,7 +5,9 @@ Tolerance: relative 1e-6 (and absolute 1e-12 for numbers at round-off level, suc
 ``energy_error`` below ``ENERGY_ROUND_OFF`` reads as 0: it is relative to a scale never taken below the square root
 of the machine precision times the gross flows (``dem.network.heat.BalanceScales.flow_magnitude``), so where no net
 heat flows through the balance, round-off of the flows reads as a few times 1e-8 (a 12-particle bed whose middle
-layer sits at the mean of its neighbours gives 0 or 5e-9 by the summation order of numpy's build). Two figures of
+layer sits at the mean of its neighbours gives 0 on the machine that wrote its page and 5e-9 on another, where
+numpy 2.3 or 2.4, numba 0.68.0 or 0.68.1, other OpenBLAS kernels and numpy without AVX2 all give 5e-9: which
+round-off differs was not isolated). Two figures of
 ``fem_neck converge`` are made of errors near round-off and are compared to ``KEY_RTOL``: the hp levels' error
 ratio and the reference's error estimate (about 2e-10), which the BLAS kernels a processor selects move by up to
 3e-6 and 4e-3 (``OPENBLAS_CORETYPE=Prescott`` against the host's kernels on one machine; 2.5e-5 and 1e-3 between
