@@ -201,7 +201,7 @@ def test_a_user_cap_on_numbas_threads_is_the_default_and_the_bound():
     instead of every core (numba raised at its bind before), and ``--threads 2`` is refused naming the cap."""
     code = ("from sinterheat import threads\nprint(threads.bind_numba())\n"
             "try:\n    threads.check(2)\nexcept ValueError as error:\n    print(error)")
-    out = subprocess.run([sys.executable, "-c", code], env={**os.environ, "NUMBA_NUM_THREADS": "1",
-                                                            "PYTHONPATH": str(ROOT)},
+    env = {key: value for key, value in os.environ.items() if key != threads.ENVIRONMENT}  # set by an earlier use()
+    out = subprocess.run([sys.executable, "-c", code], env={**env, "NUMBA_NUM_THREADS": "1", "PYTHONPATH": str(ROOT)},
                          capture_output=True, text=True, check=True).stdout.splitlines()
     assert out == ["1", "threads = 2: must be from 1 to 1 (the cores this process may use)"]
