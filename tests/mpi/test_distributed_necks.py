@@ -221,18 +221,9 @@ def test_a_union_packing_read_in_parts_equals_the_serial_run():
     """A packing in parts read with neck nodes: each rank reads the particles within three bond lengths of its own
     (not all of them; with one, as for one node per particle, its rows would be wrong), and the run is the serial run
     of the packing read whole."""
-    from benchmarks.distributed import parts_scene
-    from dem.scene import load_scene
-    from test_distributed_network import shared_folder
+    from test_distributed_network import union_parts_scene
 
-    folder = shared_folder()
-    if COMM.Get_rank() == 0:
-        path = parts_scene(2000, folder, 16, "plates")
-        path.write_text(path.read_text().replace('law = "rojek"', 'law = "shared-body"\nneck = "union"\n'
-                                                                  'nodes = "necks"'))
-    path = COMM.bcast(folder / "packing.toml")
-    scene = load_scene(path, part=(COMM.Get_size(), COMM.Get_rank()))
-    whole = load_scene(path)
+    scene, whole = union_parts_scene(2000, 'nodes = "necks"')
     assert scene.conductance.nodes == "necks"
     assert scene.particles.n < whole.particles.n == scene.particle_count
     result = run(scene)

@@ -32,6 +32,20 @@ def shared_folder() -> pathlib.Path:
     return pathlib.Path(COMM.bcast(tempfile.mkdtemp(prefix="dem-mpi-") if COMM.Get_rank() == 0 else None))
 
 
+def union_parts_scene(n: int, conductance: str):
+    """A packing of about `n` spheres in parts (16 plates) with the `shared-body` law and union necks, the extra
+    `conductance` lines added to its table: this rank's part and the packing read whole."""
+    from benchmarks.distributed import parts_scene
+
+    folder = shared_folder()
+    if COMM.Get_rank() == 0:
+        path = parts_scene(n, folder, 16, "plates")
+        path.write_text(path.read_text().replace('law = "rojek"',
+                                                 'law = "shared-body"\nneck = "union"\n' + conductance))
+    path = COMM.bcast(folder / "packing.toml")
+    return load_scene(path, part=(COMM.Get_size(), COMM.Get_rank())), load_scene(path)
+
+
 def test_packing_equals_the_serial_run():
     """The built-in packing (2e4 particles, rattlers kept at their initial temperature as floating groups)."""
     scene = load_scene("packing")

@@ -87,18 +87,9 @@ def test_a_packing_read_in_parts_equals_the_serial_run():
     """A packing in parts (16 blocks, 320 particles) read with the Trefftz element: each rank reads the particles
     within three bond lengths of its own (all of them here; test_distributed_necks' larger one is cut) and builds the
     elements of its own only; the run is the serial run of the packing read whole."""
-    from benchmarks.distributed import parts_scene
-    from dem.scene import load_scene
-    from test_distributed_network import shared_folder
+    from test_distributed_network import union_parts_scene
 
-    folder = shared_folder()
-    if COMM.Get_rank() == 0:
-        path = parts_scene(300, folder, 16, "plates")
-        path.write_text(path.read_text().replace('law = "rojek"', 'law = "shared-body"\nneck = "union"\n'
-                                                                  'nodes = "necks"\nelement = "trefftz"'))
-    path = COMM.bcast(folder / "packing.toml")
-    scene = load_scene(path, part=(COMM.Get_size(), COMM.Get_rank()))
-    whole = load_scene(path)
+    scene, whole = union_parts_scene(300, 'nodes = "necks"\nelement = "trefftz"')
     assert scene.conductance.element == "trefftz"
     assert scene.part is not None and whole.particles.n == scene.particle_count
     result = run(scene)
