@@ -11,6 +11,10 @@ from benchmarks.amg_peers import PreviousAMG
 from dem.laws.conductance import ConductanceSpec
 from dem.network.linsolve import AMG_REUSE_GROWTH, AMGSolver, make_solver
 
+# The compiled multigrid's setup and cycle kernels take numba 30 s to compile in a fresh clone, and no quick test
+# solves a network large enough to need them: the module runs with the slow tests.
+pytestmark = pytest.mark.slow
+
 RTOL = 1e-10  # dem.network.heat.steady's criterion
 
 

@@ -40,6 +40,7 @@ def test_neck_methods(method, expected):
         (["--ri", "one", "--rj", "3e-3", "--h", "0.2e-3"], "invalid float value"),
     ],
 )
+@pytest.mark.slow
 def test_bad_input_is_one_line_and_exit_2(args, words):
     proc = run_cli("neck", *args)
     assert proc.returncode == 2

@@ -282,6 +282,7 @@ def test_cluster_run_time_estimate_refuses_huge_meshes(tmp_path, capsys):
                    capsys, "estimated", "budget")
 
 
+@pytest.mark.slow
 def test_cluster_extreme_kappa_scales_exactly(tmp_path, capsys):
     """kappa = 1e-300 used to give wrong temperatures (0.53/0.47 instead of 0.898/0.102): the FE solve underflowed.
     K is linear in kappa and the temperatures independent of it."""

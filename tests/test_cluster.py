@@ -74,6 +74,7 @@ def test_cluster_estimate_bounds_the_axisymmetric_chain():
     assert T_diff <= res.T_error_estimate <= 6.0 * T_diff, (T_diff, res.T_error_estimate)
 
 
+@pytest.mark.slow
 def test_cluster_estimate_bounds_the_axisymmetric_pair():
     # The unequal pair of Rojek 2022, Sec. 6 (r = 1 and 3 mm, h = 0.06 mm) against the hp pair to 1e-8.
     # Measured: difference 2.3e-3 (3D above), estimate 2.1x that.
@@ -122,6 +123,7 @@ def test_mesh_sequence_estimate():
     assert accuracy.corner_exponent(np.array([0.0, 1.0])) == pytest.approx([2 / 3, 1.0])
 
 
+@pytest.mark.slow
 def test_volume_is_conserved_and_terminals_cut_exactly():
     # three unequal spheres, bent; one plane terminal (half sphere removed) and one core terminal (ball removed)
     r = np.array([1.0, 1.5, 0.8])
@@ -194,6 +196,7 @@ def test_cli_cluster(tmp_path, capsys):
     assert capsys.readouterr().err.count("\n") == 1
 
 
+@pytest.mark.slow
 def test_dem_network_of_a_pair_equals_the_fe_pair():
     # verification.clusters against the DEM: for one bonded pair cut at both equators the pipe network with the
     # FE pair conductance is exact, so DEM (network-only) and the 3D FE must agree to the 3D mesh accuracy.

@@ -41,7 +41,10 @@ PAGES = [README, *sorted(p for p in (ROOT / "docs").rglob("*.md") if "_build" no
 RTOL, ATOL = 1e-6, 1e-12
 ENERGY_ROUND_OFF = 1e-7  # an energy_error below it is round-off (module docstring)
 KEY_RTOL = {"hp_error_ratio_per_order": 1e-4, "reference_error_estimate": 1e-2}  # (module docstring)
-SLOW = ("fem_neck converge", "fem_neck lattice", "fem_neck cluster", "verification", "dem run fcc.toml")  # commands of more than a few seconds: marked slow
+# commands of more than a few seconds, or that compile kernels of their own in a fresh clone (the neck-node elements,
+# 40 s, beside a quick test compiling them too; the Trefftz element's): marked slow
+SLOW = ("fem_neck converge", "fem_neck lattice", "fem_neck cluster", "verification", "dem run fcc.toml",
+        "dem run law.toml", "dem run trefftz.toml")
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 TIMING = re.compile(r"(?<![\w.])\d+(?:\.\d+)?\s?s\b")  # "1.8 s": a wall time in a table
 # a tqdm bar on stderr (a terminal overwrites it in place): its percentage, its rate, or its elapsed-time bracket

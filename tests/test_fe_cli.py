@@ -15,6 +15,7 @@ def _run(capsys, argv):
     return rc, json.loads(out)
 
 
+@pytest.mark.slow
 def test_semisphere_json(capsys, tmp_path):
     rc, out = _run(capsys, ["semisphere", "--h-over-r", "0.08", "--json", "--out", str(tmp_path)])
     assert rc == 0
@@ -75,6 +76,7 @@ def test_bad_input_exits_2_with_one_line(capsys, argv):
     assert len(captured.err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_converge_json_and_plot(capsys, tmp_path, monkeypatch):
     monkeypatch.setattr(convergence, "GRADINGS", (0.6, 0.45, 0.3))
     monkeypatch.setattr(convergence, "UNIFORM_SIZES", (0.2, 0.1))

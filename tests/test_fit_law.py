@@ -156,6 +156,7 @@ def _tamper(csv_path, factor):
     return rows
 
 
+@pytest.mark.slow
 def test_fit_reuses_only_points_of_the_same_solver_and_tolerance(tmp_path, capsys):
     out = tmp_path / "fit"
     first = fit.run_fit(6, 1e-4, out, workers=1, progress=False, plot_png=False)
@@ -247,6 +248,7 @@ print(json.dumps({"mplot3d": "mpl_toolkits.mplot3d" in sys.modules, "set_doc": L
 """
 
 
+@pytest.mark.slow
 def test_the_light_plotting_import_draws_the_same_figure(tmp_path):
     """fit.png drawn after :func:`fem_neck.fit.import_plotting` in a fresh process (matplotlib's set() signatures and
     3D axes left out) is the figure of a plain import to the pixel, and the import leaves matplotlib as it found it."""

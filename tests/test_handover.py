@@ -299,6 +299,7 @@ def test_the_staggered_engine_hands_over_and_resumes_bit_for_bit():
 
 
 @pytest.mark.parametrize("policy", ["drop", "clip"])
+@pytest.mark.slow
 def test_a_bond_past_its_range_on_the_way_blends_the_policys_pair_reading_with_the_union(policy):
     """The ``shared-body`` law squeezed until pair necks pass their range while their particles are on the way: the
     pair reading's conductances are those of the scene's ``out_of_range`` reading, the union's weighed in. Under

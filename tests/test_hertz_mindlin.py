@@ -19,6 +19,10 @@ from dem.laws.contact.binding import ContactLaw, pair_constants, pair_force, par
 from dem.laws.contact.damping import tsuji
 from dem.scene import parse_scene
 
+# This module's tests compile the Hertz-Mindlin law's own kernels and force loop (numba takes 10-30 s for them in a fresh
+# clone), so it runs with the slow tests; the quick run moves particles under the default law, Luding's.
+pytestmark = pytest.mark.slow
+
 MATERIAL = {"youngs_modulus": 1.0e8, "poisson_ratio": 0.3, "restitution": 0.5, "tangential_damping": 1.0,
             "mu": 0.5, "mu_wall": 0.3}
 DENSITY = 2500.0

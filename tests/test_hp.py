@@ -118,6 +118,7 @@ def test_reference_semispheres_to_1e_minus_8(h_over_r, k_ref):
 
 
 @pytest.mark.parametrize("rtol", [1e-3, 1e-4, 1e-6])
+@pytest.mark.slow
 def test_estimate_covers_the_error_over_the_range(rtol):
     """Across a/r = 1e-4 .. 0.99 the reported K is within its estimate of a solve 1000x tighter."""
     for a in (1e-4, 0.003, 0.05, 0.2, 0.39, 0.61, 0.75, 0.9, 0.99):
@@ -128,6 +129,7 @@ def test_estimate_covers_the_error_over_the_range(rtol):
 
 
 @pytest.mark.parametrize("a", [1e-3, 0.03, 0.3, 0.61, 0.95])
+@pytest.mark.slow
 def test_hp_agrees_with_the_gmsh_path(a):
     """Two independent discretisations (exact-geometry quads vs graded curved triangles) agree to 1e-6."""
     hp = conduction.semisphere_conductance(a, rtol=1e-8)
@@ -202,6 +204,7 @@ def test_paper_pair_matches_the_converged_gmsh_value():
 
 
 @pytest.mark.parametrize("ratio, a_over_r", [(2.0, 0.42), (10.0, 0.02), (10.0, 0.6)])
+@pytest.mark.slow
 def test_hp_pair_agrees_with_the_gmsh_pair(ratio, a_over_r):
     r_i, r_j = 1e-3, ratio * 1e-3
     h = float(overlap_for_neck(r_i, r_j, a_over_r * r_i))
@@ -211,6 +214,7 @@ def test_hp_pair_agrees_with_the_gmsh_pair(ratio, a_over_r):
 
 
 @pytest.mark.parametrize("ratio, a_over_r", [(1.0, 0.8), (1.5, 0.7), (3.0, 0.95), (10.0, 0.99)])
+@pytest.mark.slow
 def test_large_neck_pairs_agree_with_the_gmsh_pair(ratio, a_over_r):
     """Large necks: the halves' corner radii differ (min(t, z/2) each), the common one keeps the neck's nodes shared;
     hp and gmsh agreed to <= 5e-9 in 15 of 16 cases over ratios 1-10 and a/r_min 0.7-0.99, 9e-8 at ratio 1.5 and

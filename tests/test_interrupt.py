@@ -106,6 +106,7 @@ def test_cluster_interrupted_names_the_mesh_level(tmp_path):
     assert match["out"] is None and re.search(r"cluster(, mesh level [123] of 3)?$", match["at"]), match[0]
 
 
+@pytest.mark.slow
 def test_verification_interrupted_keeps_the_finished_sections(tmp_path):
     proc = _start(["verification", "all", "--quick", "--out", "v", "--no-progress"], tmp_path)
     run_json = tmp_path / "v" / "run.json"

@@ -50,6 +50,7 @@ def test_the_compiled_modules_are_found_from_their_imports():
     assert "dem/cli/scenes.py" not in names and "dem/__init__.py" not in names and "fem_neck/cli/fit.py" not in names
 
 
+@pytest.mark.slow
 def test_swapping_two_parameter_indices_changes_the_key(copy):
     """A change that alters no physics but every compiled kernel that reads the material (the indices are constants
     compiled into them): a cache that missed it would read k2 where k1 is meant."""
@@ -63,6 +64,7 @@ def test_swapping_two_parameter_indices_changes_the_key(copy):
     assert jit_cache.digest(copy) != before
 
 
+@pytest.mark.slow
 def test_an_edit_outside_compiled_code_keeps_the_key(copy):
     before = jit_cache.digest(copy)
     _edit(_in_copy(copy, "dem.cli.scenes"), '"""', '"""An edit. ')
@@ -81,6 +83,7 @@ def test_the_loops_copied_into_the_cache_keep_the_key(copy):
     assert jit_cache.digest(copy) == jit_cache.remembered_digest(copy) == before
 
 
+@pytest.mark.slow
 def test_an_edit_to_what_fem_necks_kernels_call_changes_the_key(copy):
     """The neck kernels compile functions of fem_neck.geometry (numba's own cache would keep their old code)."""
     before = jit_cache.digest(copy)
@@ -89,6 +92,7 @@ def test_an_edit_to_what_fem_necks_kernels_call_changes_the_key(copy):
     assert jit_cache.digest(copy) != before
 
 
+@pytest.mark.slow
 def test_the_remembered_key_follows_an_edit(copy):
     first = jit_cache.remembered_digest(copy)
     assert (copy / "sinterheat" / "__pycache__" / "jit_digest.json").exists()
@@ -99,6 +103,7 @@ def test_the_remembered_key_follows_an_edit(copy):
     assert jit_cache.remembered_digest(copy) == jit_cache.digest(copy) != first
 
 
+@pytest.mark.slow
 def test_import_points_numba_at_the_digests_folder(tmp_path):
     """Also where numba was imported first (numba's own cache, keyed by each file alone, would otherwise serve
     kernels compiled from older sources of the modules they call), and inside a folder the user chose."""
@@ -118,6 +123,7 @@ def test_import_points_numba_at_the_digests_folder(tmp_path):
     assert out.split() == [str(tmp_path / folder)] * 2
 
 
+@pytest.mark.slow
 def test_fem_neck_alone_points_numba_at_the_digests_folder():
     """A script that uses fem_neck's compiled kernels without dem (an FE study) gets the same cache folder, not numba's
     default one beside each source file, which an edit to a module the kernel calls would leave stale."""
@@ -131,6 +137,7 @@ def test_fem_neck_alone_points_numba_at_the_digests_folder():
     assert [pathlib.Path(cache_env).name, pathlib.Path(cache_dir).name] == [folder, folder]
 
 
+@pytest.mark.slow
 def test_a_folder_the_user_chose_that_cannot_be_written_is_named_and_left(tmp_path):
     """NUMBA_CACHE_DIR below a file: the run goes on with the kernels cached in the temp folder, a warning names the
     variable, and a child process finds the same folder."""
@@ -154,6 +161,7 @@ def _waits_for(path, process, seconds=600):
         time.sleep(0.01)
 
 
+@pytest.mark.slow
 def test_two_processes_saving_signatures_of_one_kernel_at_once_keep_both(tmp_path):
     """As pytest's workers do: process A reads a kernel's index to add its signature and is held before it writes the
     index back; process B saves another signature of the kernel meanwhile. Both must be in the index after (numba's

@@ -20,6 +20,10 @@ from dem.scene import parse_scene, state_file
 from test_hertz_mindlin import (DENSITY, E_STAR, MATERIAL, contact, head_on, law_pair, run_recording, scene_doc,
                                 sphere_mass)
 
+# This module's tests compile the JKR law's own kernels and force loop (numba takes 10-30 s for them in a fresh
+# clone), so it runs with the slow tests; the quick run moves particles under the default law, Luding's.
+pytestmark = pytest.mark.slow
+
 W = 0.1  # J/m^2, the work of adhesion
 R = 1e-3
 C = math.sqrt(2 * math.pi * W / E_STAR)

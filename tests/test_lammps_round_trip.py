@@ -60,6 +60,7 @@ def periodic_state(tmp_path):
     return scene, tmp_path / "run" / "state.npz"
 
 
+@pytest.mark.slow
 def test_dem_convert_keeps_a_states_periodic_box(tmp_path):
     scene, state = periodic_state(tmp_path)
     p = packing_from_state(state_file.load(state))
@@ -81,6 +82,7 @@ def test_dem_convert_keeps_a_states_periodic_box(tmp_path):
     assert "--periodic = 'xy': only for a packing file" in proc.stderr
 
 
+@pytest.mark.slow
 def test_a_moving_run_writes_lammps_dumps_that_read_back(tmp_path):
     """[output] lammps_dump: beside every snapshot a LAMMPS text dump; the last one reads back (read_packing) to the
     run's final state bit for bit: ids, centres, radii, velocities, temperatures, and its forces are there."""

@@ -97,6 +97,7 @@ def test_collinear_necks_share_one_cylinder():
     assert len(cm.curved.tets) > 0
 
 
+@pytest.mark.slow
 def test_finer_quadrature_moves_the_bounds_by_less_than_1e7():
     from fem_neck import dual, primal
 
@@ -247,6 +248,7 @@ def test_a_run_that_would_not_fit_is_refused_with_the_rtol_that_would():
 @pytest.mark.parametrize("cell, size_neck", [(_chain_cell(0.02), 0.03), (lattice.lattice_cell("sc", 0.08), 0.1),
                                              (lattice.lattice_cell("bcc", 0.02), 0.03),
                                              (lattice.lattice_cell("fcc", 0.08), 0.3)])
+@pytest.mark.slow
 def test_tetrahedra_predicted_before_meshing_on_the_safe_side(cell, size_neck):
     # the prediction (from the cell and the sizes alone) is at least the mesh's tetrahedra, and not wildly more
     predicted = lattice.predicted_tetrahedra(lattice.neck_circles(cell), size_neck)

@@ -21,6 +21,7 @@ def _cut_volumes(cell):
     return cut_spheres(cell.radii, i, j, cell.centres[j] + s * cell.period - cell.centres[i]).volume
 
 
+@pytest.mark.slow
 def test_mirror_packing_conserves_heat_per_particle_and_its_necks_carry_the_cells_flux():
     from verification.packings import _images
 
@@ -45,6 +46,7 @@ def test_mirror_packing_conserves_heat_per_particle_and_its_necks_carry_the_cell
 
 
 @pytest.mark.parametrize("kind, h", [("sc", 0.3), ("fcc", 0.3)])
+@pytest.mark.slow
 def test_lattice_necks_by_symmetry(kind, h):
     """A Bravais lattice is symmetric under inversion through every site and every bond's midpoint, so the fluctuation
     of the temperature vanishes there: each face's mean temperature is -z of its centre and each particle's -z of its

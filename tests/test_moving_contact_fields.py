@@ -43,6 +43,7 @@ def test_contacts_carry_neck_conductance_and_heat_flow(tmp_path):
 
 
 @pytest.mark.parametrize("nodes", ["particles", "necks"])
+@pytest.mark.slow
 def test_a_snapshot_at_the_end_of_a_thermal_step_reads_its_bonds(tmp_path, monkeypatch, nodes):
     """The shared-body law on the union: the cut spheres' halves (union_halves, the costly part of its conductances)
     are computed once per thermal step, and the snapshots taken at its end (particles and contacts: two reads) reuse

@@ -54,6 +54,7 @@ def _assembled(net, weight, node_of_bond, necks=None):
                          shape=(size, size)).toarray()
 
 
+@pytest.mark.slow
 def test_each_particle_is_its_two_readings_blended_by_its_weight():
     """Weights 0, 0.37 and 1 among the particles of a cluster whose necks meet: the network's matrix is the sum over
     the particles of (1 - w) times its element on the pair reading and w times its element on the union reading of the
@@ -164,6 +165,7 @@ def _conductance(engine, steps) -> float:
     return float(steady_necks(net).fixed_flow[hot].sum()) / 100.0
 
 
+@pytest.mark.slow
 def test_a_run_that_hands_over_says_what_the_one_node_run_says():
     """The squeezed cluster with neck nodes: its necks meet and its particles are handed over as in the one-node
     run of the same contacts (the hand-over reads the pair necks, not the network), and the summary says so; the
@@ -227,6 +229,7 @@ def test_the_timeseries_gives_k_eff_on_pair_necks_beside_it():
 
 
 @pytest.mark.parametrize("policy", ["drop", "clip"])
+@pytest.mark.slow
 def test_a_pair_neck_past_its_range_on_the_way_blends_the_policys_pair_reading_with_the_union(policy):
     """Squeezed hard, pair necks pass their range (h > 2r/3 for equal spheres) while their particles are on the way
     to the union. As the one-node law's pair conductance of such a bond is the scene's ``out_of_range`` reading's and

@@ -232,6 +232,7 @@ def test_the_packing_written_by_lammps_gives_the_same_conductivity(lammps_writte
 
 
 # ---------------------------------------------------------------------------------- our writer, LAMMPS's reader
+@pytest.mark.slow
 def test_a_saved_state_runs_in_lammps_with_its_masses_and_velocities(tmp_path):
     """A moving run's state.npz -> our LAMMPS data file -> LAMMPS read_data: LAMMPS's masses are the saved masses,
     and its write_data gives back positions, radii, velocities and angular velocities."""

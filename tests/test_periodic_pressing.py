@@ -25,6 +25,7 @@ def doc(pressure=1e3, mass=1e-3, periodic=True):
     return d
 
 
+@pytest.mark.slow  # the Hertz-Mindlin law's force loop (20 s for numba to compile in a fresh clone)
 def test_a_stress_wall_in_a_periodic_box_is_pushed_by_p_times_its_area():
     res = run(parse_scene(doc(pressure=1e3, mass=1e-3)))
     mech = res.engine.mechanics

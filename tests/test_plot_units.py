@@ -54,6 +54,7 @@ def test_temperature_unit_from_the_scene_or_radiation_and_refused_when_they_diff
         parse_scene(doc)
 
 
+@pytest.mark.slow
 def test_moving_run_plots_say_the_temperature_unit_and_one_wall_load_unit(tmp_path, labels):
     result = dem.driver.run(parse_scene(small_hot_wall()), tmp_path)
     assert "timeseries.png" in result.summary["plots"]

@@ -46,6 +46,7 @@ class _Section:
 
 # ------------------------------------------------------------------------------------------------ without Dask
 @pytest.mark.parametrize("workers", [1, 2])
+@pytest.mark.slow
 def test_local_jobs_come_back_complete_and_an_error_is_raised(workers):
     jobs = [(abs, (-k,)) for k in range(7)]
     assert sorted(P.run_jobs(jobs, workers, progress=False)) == list(range(7))
@@ -158,6 +159,7 @@ print(before, threads.openmp_started(), numba.threading_layer())
 
 
 @pytest.mark.skipif(os.cpu_count() < 2, reason="needs two cores")
+@pytest.mark.slow
 def test_openmp_is_seen_once_numba_has_started_its_threads():
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_THREADING_LAYER"}
     proc = subprocess.run([sys.executable, "-c", OPENMP_STARTED], capture_output=True, text=True, timeout=300,
@@ -232,6 +234,7 @@ def dask_client(sizes_worker):
         yield client
 
 
+@pytest.mark.slow
 def test_fit_sweep_on_dask_equals_the_local_pool(dask_client):
     x, uniform = sweep_points(16)
     with P.use_dask(dask_client):
@@ -270,6 +273,7 @@ def test_sintering_runs_on_dask_equal_the_local_pool_and_resume(dask_client, tmp
 
 
 @pytest.mark.parametrize("prog", ["verification", "fem_neck", "benchmarks"])
+@pytest.mark.slow
 def test_a_scheduler_out_of_reach_is_one_line_and_exit_2(prog, monkeypatch, capsys, tmp_path):
     pytest.importorskip("distributed")
     from benchmarks.cli import main as benchmarks_main

@@ -125,6 +125,7 @@ def test_random_periodic_packings_below_wiener(jitter, dense):
         assert np.any(K_shared > K_fit)
 
 
+@pytest.mark.slow
 def test_laws_command_lists_every_law():
     out = subprocess.run([sys.executable, "-m", "dem", "laws", "--json"], capture_output=True, text=True, check=True)
     listed = json.loads(out.stdout)

@@ -74,6 +74,7 @@ def test_signal_before_the_first_checkpoint_then_resume(tmp_path, signum):
 
 
 @pytest.mark.parametrize("when", ["building", "stepping"])
+@pytest.mark.slow
 def test_a_signal_before_the_first_step_then_resume_starts_the_run(tmp_path, monkeypatch, when):
     """A signal while the run builds its engine (SIGTERM 3 s into hot-wall-sintering: numba's kernels loading) left
     an empty folder, or, once its first files were written, one whose summary said interrupted with no checkpoint;

@@ -12,6 +12,10 @@ import pytest
 from dem import parse_scene, run
 from dem.engines.staggered.engine import StaggeredEngine
 
+# The Zohdi law's force loop and the staggered engine's iteration take numba 20 s to compile in a fresh clone: the
+# module runs with the slow tests.
+pytestmark = pytest.mark.slow
+
 R = 0.075  # m
 L = 1.0  # m, the period along the periodic axes
 ZOHDI = {"law": "zohdi", "K_p": 1.0e7, "p_p": 2.0, "K_p_lim": 1.0e6, "K_w": 1.0e7, "p_w": 2.0, "K_w_lim": 1.0e6,

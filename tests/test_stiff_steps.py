@@ -127,6 +127,7 @@ def settling_columns(integrator: str, thermal_interval: float, specific_heat: fl
     return engine
 
 
+@pytest.mark.slow
 def test_stiff_crank_nicolson_on_moving_particles_ends_at_the_true_answer():
     """Plain Crank-Nicolson in steps of 2 ms kept the columns alternating: [66.45, -32.68, 66.24] C in the first
     (true: 33.33 C each, 100 C out of its range). Each step is now an implicit Euler step (startup_steps: every
@@ -144,6 +145,7 @@ def test_stiff_crank_nicolson_on_moving_particles_ends_at_the_true_answer():
     assert "startup_steps" not in reference.summary()
 
 
+@pytest.mark.slow  # the Hertz-Mindlin law's force loop (20 s for numba to compile in a fresh clone)
 def test_crank_nicolson_on_moving_particles_within_the_limit_stays_crank_nicolson():
     """The same columns with a specific heat of 30 J/(kg K): the stable limit is 3.4 ms, the bound 2 / max(A_ii /
     C_i) 5.2 ms, so the steps of 2 ms are Crank-Nicolson's. They end 0.026 K from the run at 1/32 of the step

@@ -63,6 +63,7 @@ def check(argv, expect="error", timeout=120.0) -> str:
     ["fem_neck", "pair", "--ri", "1e-3", "--rj", "-3e-3", "--h", "6e-5", "--kappa", "394", "--json"],
     ["dem", "run", "no-such-scene", "--json"],
 ])
+@pytest.mark.slow
 def test_cli_bad_input_is_one_line_exit_2(argv):
     check(argv, "error")
 
@@ -88,12 +89,14 @@ def test_dem_generator_huge_n_refused(tmp_path: pathlib.Path):
 
 
 @pytest.mark.parametrize("argv", [["fem_neck", "semisphere", "--h-over-r", "0.2"], ["dem", "run", "pair"]])
+@pytest.mark.slow
 def test_out_is_an_existing_file(tmp_path: pathlib.Path, argv):
     afile = tmp_path / "afile"
     afile.write_text("")
     check(argv + ["--out", str(afile), "--json"], "error")
 
 
+@pytest.mark.slow
 def test_out_that_cannot_be_created_is_named(tmp_path: pathlib.Path):
     afile = tmp_path / "afile"
     afile.write_text("")

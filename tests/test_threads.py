@@ -91,6 +91,7 @@ def test_each_particle_belongs_to_the_block_of_its_first_pair_and_lists_the_othe
 
 
 @pytest.mark.parametrize("value", ["0", str(threads.cores() + 1), "two", "-1"])
+@pytest.mark.slow
 def test_a_thread_count_outside_the_cores_is_one_line_and_exit_2(value):
     proc = subprocess.run([sys.executable, "-m", "dem", "run", "lattice", "--threads", value], env=_env(),
                           capture_output=True, text=True, timeout=300)

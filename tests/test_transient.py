@@ -18,6 +18,7 @@ def pair():
     return pm, res
 
 
+@pytest.mark.slow
 def test_mesh_volume_and_split(pair):
     pm, res = pair
     # each particle owns 4/3 pi r^3 (neck split by cap volume); straight-sided triangles inscribe the circles

@@ -9,6 +9,10 @@ import pytest
 from dem.network import trefftz_element as te
 from dem.network.necks import neck_frames
 
+# The Trefftz element's quadrature and basis kernels take numba 25 s to compile in a fresh clone: the module runs
+# with the slow tests (the quick run solves neck-node networks with the law's element).
+pytestmark = pytest.mark.slow
+
 SEED = 7  # each test draws from a generator of its own: its numbers do not depend on which tests ran before
 
 

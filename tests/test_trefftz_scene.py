@@ -16,6 +16,9 @@ from dem.network import trefftz_element as te
 from dem.network.necks import neck_network, steady_necks
 from dem.scene.parse import parse_scene
 
+# The Trefftz element's kernels take numba 25 s to compile in a fresh clone: with the slow tests.
+pytestmark = pytest.mark.slow
+
 TREFFTZ = ConductanceSpec(law="shared-body", neck="union", nodes="necks", element="trefftz")
 _TREFFTZ = te.trefftz_elements
 

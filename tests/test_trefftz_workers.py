@@ -17,6 +17,9 @@ from dem.network.necks import neck_network
 from test_mixed_modes import HALF, _cell
 from test_neck_nodes import NECKS, UNIT
 
+# The Trefftz element's kernels take numba 25 s to compile in a fresh clone: with the slow tests.
+pytestmark = pytest.mark.slow
+
 
 class _Captured(Exception):
     """Raised by the hook once it has the elements' arguments: the network itself is not needed."""

@@ -20,6 +20,7 @@ def _run(*args, timeout=600):
 
 
 @pytest.mark.parametrize("args", [[], ["nonsense"], ["paper", "--bogus"], ["paper", "--out"]])
+@pytest.mark.slow
 def test_bad_options_one_line_exit_2(args):
     proc = _run(*args)
     assert proc.returncode == 2 and proc.stdout == ""
@@ -54,6 +55,7 @@ def _check_run(out, proc, sections):
     return summary, (out / "report.md").read_text()
 
 
+@pytest.mark.slow
 def test_paper_quick(tmp_path):
     out = tmp_path / "res"
     proc = _run("paper", "--quick", "--json", "--no-progress", "--out", str(out))

@@ -15,6 +15,11 @@ from dem.laws.contact.zohdi import ZohdiMaterial
 from dem.scene.staggered import ZohdiStepping
 from dem.engines.staggered.engine import StaggeredEngine
 
+# This module's tests compile the Zohdi law's own kernels, its force loop and the staggered engine's iteration (numba
+# takes 10-30 s for them in a fresh clone), so it runs with the slow tests; the quick run moves particles under the
+# default law, Luding's, and the Verlet engine.
+pytestmark = pytest.mark.slow
+
 R = 0.075
 RHO = 2000.0
 MASS = RHO * 4.0 / 3.0 * math.pi * R**3
