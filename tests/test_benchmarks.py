@@ -22,6 +22,7 @@ def _run(*args, timeout=600):
 
 
 @pytest.mark.parametrize("args", [["nonsense"], ["neck", "--bogus"], ["neck", "--out"]])
+@pytest.mark.slow
 def test_bad_options_one_line_exit_2(args):
     proc = _run(*args)
     assert proc.returncode == 2 and proc.stdout == ""
@@ -126,6 +127,7 @@ def test_ngsolve_startup_setting_reaches_1e_minus_4_at_the_reference_cases():
         assert abs(k / row.K_over_Kcyl - 1) < 1e-4, h_over_r
 
 
+@pytest.mark.slow
 def test_whole_processes_count_the_cpu_of_grandchildren_and_not_of_sleep():
     """The start-up comparison's clock: a command's CPU time includes the processes it waited for (a grandchild
     that spins ~0.3 s), a sleeping one costs wall time only, and the ratio is the median of the paired rounds."""

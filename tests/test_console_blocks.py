@@ -44,7 +44,7 @@ KEY_RTOL = {"hp_error_ratio_per_order": 1e-4, "reference_error_estimate": 1e-2} 
 # commands of more than a few seconds, or that compile kernels of their own in a fresh clone (the neck-node elements,
 # 40 s, beside a quick test compiling them too; the Trefftz element's): marked slow
 SLOW = ("fem_neck converge", "fem_neck lattice", "fem_neck cluster", "verification", "dem run fcc.toml",
-        "dem run law.toml", "dem run trefftz.toml")
+        "dem run law.toml", "dem run trefftz.toml", "fem_neck unequal")
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 TIMING = re.compile(r"(?<![\w.])\d+(?:\.\d+)?\s?s\b")  # "1.8 s": a wall time in a table
 # a tqdm bar on stderr (a terminal overwrites it in place): its percentage, its rate, or its elapsed-time bracket

@@ -56,6 +56,7 @@ def test_a_corrupt_start_state_is_one_line_naming_the_file(tmp_path, capsys, kin
 
 
 @pytest.mark.parametrize("kind", ["empty", "truncated", "garbage", "npy"])
+@pytest.mark.slow
 def test_a_corrupt_checkpoint_is_one_line_on_resume(tmp_path, capsys, kind):
     scene = tmp_path / "pair.toml"
     scene.write_text(PAIR_TOML)

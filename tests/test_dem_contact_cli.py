@@ -145,6 +145,7 @@ def test_missing_file_and_scene_without_luding_material(capsys, history, tmp_pat
     assert code == 2 and "no [contact] table" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_real_command_line(history):
     proc = subprocess.run([sys.executable, "-m", "dem", "contact", "luding-table1", "--history", str(history),
                            "--json"], capture_output=True, text=True, timeout=120)

@@ -46,6 +46,7 @@ def test_every_contact_conductance_is_the_law_at_its_overlap():
     assert np.array_equal(K_pairs, th.net.K_pairs) and np.array_equal(K_walls, th.net.K_walls)
 
 
+@pytest.mark.slow
 def test_heat_balance_exact_through_contact_changes():
     """Particles shaken so that contacts open and close while heat flows in from the floor."""
     sim = VerletEngine(parse_scene(pile(t_end=0.01, velocity=0.05, thermal_interval=2e-4)))

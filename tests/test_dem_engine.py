@@ -234,6 +234,7 @@ def test_cli_run_writes_outputs(tmp_path):
     assert (tmp_path / "contacts.pvd").exists() and (tmp_path / "summary.json").exists()
 
 
+@pytest.mark.slow
 def test_a_stopped_run_keeps_its_outputs(tmp_path):
     import json
     import subprocess

@@ -2,6 +2,8 @@
 
 import re
 
+import pytest
+
 from dem import run
 from dem.scene import parse_scene
 
@@ -12,6 +14,7 @@ SPECIMEN = {"material": {"conductivity": 394.0, "density": 8960.0, "specific_hea
             "output": {"vtu_every": 3}}
 
 
+@pytest.mark.slow
 def test_transient_specimen_writes_its_plots_and_lists_every_snapshot(tmp_path):
     res = run(parse_scene(SPECIMEN), out=tmp_path)
     assert {"temperature.png", "heat_flow.png", "profile.png"} <= {p.name for p in tmp_path.glob("*.png")}
@@ -28,6 +31,7 @@ def test_steady_specimen_profile_carries_k_eff(tmp_path):
     assert (tmp_path / "profile.png").exists() and not (tmp_path / "temperature.png").exists()
 
 
+@pytest.mark.slow
 def test_unequal_pair_beyond_the_equal_spheres_neck_range_writes_summary_and_state(tmp_path):
     """r = 0.4 and 0.5 mm overlapping by 0.25 mm between a hot and a cold wall (out_of_range = "clip"): beyond the
     neck model's range for this pair (0.225 mm), inside 2/3 of the smaller radius (0.267 mm, the equal spheres'

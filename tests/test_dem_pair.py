@@ -44,6 +44,7 @@ def decay_error(integrator, dt, law="rojek", t_end=0.2):
 
 
 @pytest.mark.parametrize("law", ["rojek", "argento-bouvard", "zohdi"])
+@pytest.mark.slow
 def test_crank_nicolson_and_explicit_follow_exponential(law):
     err_cn, res_cn = decay_error("crank-nicolson", 1e-3, law)
     err_ex, res_ex = decay_error("explicit", 1e-4, law)

@@ -180,6 +180,7 @@ def test_interrupted_then_resumed_ends_as_the_uninterrupted_run(tmp_path, text, 
         assert listed(part / pvd.name) == listed(pvd)
 
 
+@pytest.mark.slow
 def test_overwrite_clears_and_resume_needs_a_checkpoint(tmp_path):
     scene = tmp_path / "scene.toml"
     scene.write_text(THERMAL.replace("t_end = 0.01", "t_end = 0.001"))

@@ -58,6 +58,7 @@ def test_a_static_scene_reports_the_effective_conductivity_of_a_pressed_compact(
         s["effective_conductivity"]
 
 
+@pytest.mark.slow
 def test_a_run_from_a_state_goes_on_from_its_clock(pressed, tmp_path):
     state, moving = pressed
     saved = state_file.load(state)

@@ -214,6 +214,7 @@ def test_hopeless_tolerance_refused_early():
     assert len(seen) <= 1002
 
 
+@pytest.mark.slow
 def test_fixed_steps_land_on_t_end_without_an_extra_step():
     """t_end / dt = max_steps exactly: the run takes exactly max_steps steps (a running sum of dt used to add one
     more at the end and refuse the run there)."""

@@ -49,6 +49,7 @@ def test_unequal_pair():
     assert ns["K_fe"] == pytest.approx(0.27916769625, rel=1e-6)  # our converged FE (hp at rtol 1e-8, README)
 
 
+@pytest.mark.slow
 def test_chain():
     ns = run_example("chain")
     assert ns["K_pipes"] == pytest.approx(ns["K_fe"], rel=1e-3)  # the fit law's pipes in series vs the chain's FE
@@ -72,6 +73,7 @@ def test_transient_pair():
     assert ns["T_i"] + 3**3 * ns["T_j"] == pytest.approx(100.0, rel=1e-12)  # energy: C ~ r^3, r_j = 3 r_i
 
 
+@pytest.mark.slow
 def test_cluster():
     ns = run_example("cluster")
     assert ns["middle_T"] == pytest.approx(0.5, abs=1e-3)  # symmetry of the L

@@ -125,6 +125,7 @@ def _element_matrices(mesh, k):
 
 
 @pytest.mark.parametrize("k", [1, 3])
+@pytest.mark.slow
 def test_element_matrices_are_the_traces_through_the_inverse_mass(cell_mesh, k):
     # the compiled Cholesky pass against T A^-1 T^T by LAPACK's dense solve, on curved and straight elements
     mesh, rt = cell_mesh.curved, raviart_thomas(k)

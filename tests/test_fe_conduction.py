@@ -130,6 +130,7 @@ def test_conductance_scales_with_length_and_kappa():
     assert small.K == pytest.approx(394.0 * 1e-3 * unit.K, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_chain_of_three_is_two_bonds_in_series_with_a_shared_middle():
     """A symmetric chain r,r,r with equal overlaps: by symmetry the middle equator is isothermal, so the chain's
     resistance is exactly twice that of the pair."""

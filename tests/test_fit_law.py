@@ -130,6 +130,7 @@ def test_linear_slope_and_sampling():
         fit.sweep_points(3)
 
 
+@pytest.mark.slow
 def test_small_fit_run_writes_files_and_resumes(tmp_path):
     out = tmp_path / "fit"
     first = fit.run_fit(8, 1e-4, out, workers=2, progress=False)
@@ -199,6 +200,7 @@ def test_cli_rejects_bad_input(capsys):
     assert "error" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_unequal_pairs_against_fe(tmp_path):
     from fem_neck.unequal import study
 
@@ -214,6 +216,7 @@ def test_unequal_pairs_against_fe(tmp_path):
     assert paper["K_law"] == pytest.approx(paper["K_fe"], rel=2e-3)
 
 
+@pytest.mark.slow
 def test_fit_command_draws_its_figure_without_importing_matplotlib(tmp_path):
     """The command's own process never imports matplotlib (its import, longer than the whole sweep, runs in the
     plotting process on the other core while this one imports the solver), and fit.png is still written."""
@@ -268,6 +271,7 @@ def test_the_light_plotting_import_draws_the_same_figure(tmp_path):
     assert np.array_equal(light, plain)
 
 
+@pytest.mark.slow
 def test_a_figure_that_cannot_be_written_fails_the_fit(tmp_path):
     out = tmp_path / "fit"
     (out / "fit.png").mkdir(parents=True)  # savefig in the plotting process fails

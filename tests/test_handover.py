@@ -189,6 +189,7 @@ def test_handed_over_at_once_the_same_run_jumps(monkeypatch):
     assert np.max(np.abs(jumps)) > 5e-3
 
 
+@pytest.mark.slow
 def test_runs_whose_necks_never_meet_are_unchanged_to_the_bit(monkeypatch):
     """Squeezed less, the necks never meet: the run is the one without the hand-over, bit for bit."""
     scene = squeezed(0.003, h_over_r=0.04, rate=5.0)
@@ -203,6 +204,7 @@ def test_runs_whose_necks_never_meet_are_unchanged_to_the_bit(monkeypatch):
     assert np.array_equal(handed.thermal.T, plain.thermal.T) and "particles_handed_over" not in plain.summary()
 
 
+@pytest.mark.slow
 def test_a_resumed_run_goes_on_handing_over_bit_for_bit():
     """Stopped while particles are on the way and their necks have parted again, the run resumes from its checkpoint
     and ends as the run that did not stop: the hand-overs go on, the solid radii start where they were."""
@@ -248,6 +250,7 @@ def test_a_read_at_one_configuration_follows_the_state_of_the_handovers():
     assert again is not first and all(np.array_equal(a, b) for a, b in zip(again[1:], first[1:]))
 
 
+@pytest.mark.slow
 def test_the_timeseries_gives_k_eff_on_pair_necks_beside_it():
     """A run with heated walls records beside k_eff the k_eff of its contacts all read as pair necks: the same number
     while no particle is handed over (the first milliseconds of hot-wall-sintering)."""

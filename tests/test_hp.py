@@ -233,6 +233,7 @@ def test_pair_at_the_model_limit_is_refused_clearly():
             conduction.pair_conductance(1.0, 2.0, h, 1.0, method=method)
 
 
+@pytest.mark.slow
 def test_pair_with_a_huge_partner_and_the_ratio_limit():
     """r_j / r_i = 1e5 (a / r_j = 5e-8, a sphere on a plane): hp converges where the gmsh path does not (measured:
     estimate 6e-3 at rtol 1e-5); its estimate covers a solve 100x tighter. Beyond 1e6 the FE refuses."""

@@ -73,6 +73,7 @@ def _wait_for_rows(csv, rows, timeout=90.0):
         time.sleep(0.02)
 
 
+@pytest.mark.slow
 def test_fit_sweep_interrupted_at_random_moments(tmp_path):
     # three sweeps (pool of 2 workers each): interrupted at random in start-up and imports, and at a random moment
     # after the sweep has written its first points (a machine's load shifts the phases, so that one waits for them)
@@ -95,6 +96,7 @@ def test_fit_sweep_interrupted_at_random_moments(tmp_path):
     assert rows >= 2
 
 
+@pytest.mark.slow
 def test_cluster_interrupted_names_the_mesh_level(tmp_path):
     (tmp_path / "c.json").write_text(json.dumps({
         "centres": [[0, 0, 0], [0, 0, 1.93e-3], [0, 0, 3.86e-3]], "radii": [1e-3] * 3, "bonds": [[0, 1], [1, 2]],
@@ -128,6 +130,7 @@ def test_verification_interrupted_keeps_the_finished_sections(tmp_path):
     assert "Paper reproduction" in report and "interrupted (Ctrl-C)" in report
 
 
+@pytest.mark.slow
 def test_gmsh_is_finalized_and_the_handler_restored_in_process(tmp_path, capsys):
     # main() called in this process: an interrupt during the cluster's meshing leaves no gmsh session open
     gmsh = pytest.importorskip("gmsh")

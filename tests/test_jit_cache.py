@@ -39,6 +39,7 @@ def _edit(path, old, new):
     path.write_text(text.replace(old, new, 1))
 
 
+@pytest.mark.slow
 def test_the_compiled_modules_are_found_from_their_imports():
     names = {str(p.relative_to(jit_cache.ROOT)) for p in jit_cache.compiled_sources()}
     # the loop, its contact law's kernels, and the module whose parameter indices the kernels compile in
@@ -73,6 +74,7 @@ def test_an_edit_outside_compiled_code_keeps_the_key(copy):
     assert jit_cache.digest(copy) != before
 
 
+@pytest.mark.slow
 def test_the_loops_copied_into_the_cache_keep_the_key(copy):
     """dem.engines.compiled writes a copy of the loops for more than one thread into the cache folder, inside the
     package: the key of that folder must not follow them (else every threaded run would compile afresh)."""

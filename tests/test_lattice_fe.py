@@ -85,6 +85,7 @@ def test_mapped_mesh_fills_the_exact_solid():
         assert surface.distance(x[0]).max() < 1e-12
 
 
+@pytest.mark.slow
 def test_collinear_necks_share_one_cylinder():
     # opposite bonds of a lattice put two necks of one sphere on one cylinder: one surface, so that the edges between
     # its patches are surface edges (at BCC a/r = 0.52 the mesher splits the cylinder there)
@@ -125,6 +126,7 @@ def test_the_lower_bound_is_admissible_whatever_the_face_solvers_iterate():
     assert settled.lower * scale < REFERENCES[("sc", 0.08)]
 
 
+@pytest.mark.slow
 def test_the_lower_bounds_cg_started_from_the_upper_bounds_temperature_takes_fewer_steps_to_the_same_bound():
     from fem_neck import dual, primal
 
@@ -136,6 +138,7 @@ def test_the_lower_bounds_cg_started_from_the_upper_bounds_temperature_takes_few
     assert warm.lower == pytest.approx(cold.lower, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_a_lower_bound_that_fails_before_it_reads_the_temperature_is_reported_not_waited_for(monkeypatch):
     # the upper bound hands its temperature (here > 64 kB, more than a pipe holds) to the lower bound's process
     # after solving; had that process failed first, a blocking hand-over would wait for ever (the alarm fails it)

@@ -70,6 +70,7 @@ def test_lattice_necks_by_symmetry(kind, h):
     assert f.volume == pytest.approx(_cut_volumes(cell), rel=1e-3)
 
 
+@pytest.mark.slow
 def test_flows_refused_on_pair_necks_and_cli_json(capsys):
     from fem_neck.cli import main
 

@@ -72,6 +72,7 @@ def test_union_mesh_fills_the_exact_union_where_necks_meet(kind):
     assert not any(s.kind == "cylinder" for s in cm.curved.surfaces)
 
 
+@pytest.mark.slow
 def test_union_bounds_bracket_and_close_as_the_mesh_is_refined():
     # BCC where its necks meet: two meshes; every lower bound lies below every upper bound, the gap
     # falls with the neck size, and both lie under the Hashin-Shtrikman upper bound of an isotropic solid with pores

@@ -14,6 +14,7 @@ from fem_neck import neck_radius
 from test_dem_coupled import MATERIAL, pile
 
 
+@pytest.mark.slow
 def test_contacts_carry_neck_conductance_and_heat_flow(tmp_path):
     res = run(parse_scene(pile(t_end=0.003, law="rojek")), out=tmp_path / "run")
     last = sorted((tmp_path / "run").glob("contacts_*.vtu"))[-1]

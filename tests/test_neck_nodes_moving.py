@@ -79,6 +79,7 @@ def test_k_eff_is_the_static_neck_node_solve_of_the_same_packing():
 
 
 @pytest.mark.parametrize("integrator", ["implicit", "crank-nicolson"])
+@pytest.mark.slow
 def test_a_chain_is_the_one_node_network(integrator):
     """A column between the walls (collinear necks): the neck-node run's temperatures and k_eff are the one-node
     network's on the same union bonds, to round-off, step after step; its heat balance holds."""
@@ -132,6 +133,7 @@ def test_what_the_moving_neck_nodes_do_not_do_is_refused():
         refuse_unsupported(parse_scene(scene), 2)
 
 
+@pytest.mark.slow
 def test_necks_that_meet_say_so_with_the_neck_node_evidence():
     """The squeezed face-centred cluster of the hand-over's tests, its spheres overlapping by 0.25 r and read as their
     union: lens necks meet (from h/r 0.268 on this lattice) and the summary gives the neck-node network's interval

@@ -116,6 +116,7 @@ def test_the_steady_neck_solve_of_a_floating_periodic_group_holds_at_every_node(
 
 
 @pytest.mark.parametrize("linear", ["direct", "amg"])
+@pytest.mark.slow
 def test_a_periodic_box_ends_at_its_steady_state_and_keeps_its_heat(linear):
     """A tiled BCC union cell with a temperature drop per period and no anchor: the heat stays (sum C T is the
     initial one) and the transient ends at the steady neck solve (which keeps that mean)."""
@@ -173,6 +174,7 @@ def test_a_transient_scene_with_neck_nodes_runs_reports_and_resumes():
 
 
 @pytest.mark.parametrize("mode", ["steady", "transient"])
+@pytest.mark.slow
 def test_the_links_of_the_snapshots_carry_the_necks_flows(tmp_path, mode):
     """Every snapshot's bonds carry the flows through the necks at that step (the steady one was written before
     the neck solve's flows were kept, with the one-node law's K dT): on the turning chain the two differ."""

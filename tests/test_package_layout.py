@@ -8,6 +8,8 @@ import ast
 import pathlib
 import re
 
+import pytest
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PACKAGES = ("dem", "fem_neck", "sinterheat", "verification", "benchmarks")
 
@@ -74,6 +76,7 @@ def layer(name: str) -> int:
     raise AssertionError(f"{name}: its folder is in no layer of DEM_LAYERS")
 
 
+@pytest.mark.slow
 def test_dem_imports_only_downward():
     known = modules()
     wrong, checked = [], 0
@@ -91,6 +94,7 @@ def test_dem_imports_only_downward():
     assert checked > 100 and not wrong, "imports against DEM_LAYERS:\n" + "\n".join(wrong)
 
 
+@pytest.mark.slow
 def test_no_import_cycle():
     """No module imports, at module level or inside a function, a module that imports it back (directly or through
     others): an import inside a function hides a cycle from Python until the function runs, not from this test."""
@@ -119,6 +123,7 @@ def test_no_import_cycle():
     assert not cycles, "import cycles:\n" + "\n".join(cycles)
 
 
+@pytest.mark.slow
 def test_dem_takes_only_the_geometry_and_the_law_from_fem_neck_and_fem_neck_nothing_from_the_others():
     known = modules()
     wrong = []
@@ -137,6 +142,7 @@ def test_dem_takes_only_the_geometry_and_the_law_from_fem_neck_and_fem_neck_noth
     assert not wrong, "\n".join(wrong)
 
 
+@pytest.mark.slow
 def test_every_name_defined_is_used_somewhere():
     """A function, class, constant or method that no other line of the repository (code, tests, examples, README,
     documentation) names is dead code."""

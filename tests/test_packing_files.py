@@ -197,6 +197,7 @@ def reference_k_eff(packing: Packing) -> float:
     return k_eff
 
 
+@pytest.mark.slow
 def test_csv_vtu_and_a_runs_vtu_give_the_same_particles_and_conductivity(tmp_path):
     """A ParaView-style CSV, a Yade-style VTU and the VTU a run writes: the same particles, and the same steady k_eff
     (1 K drop per period along z; the box given by [periodic]) as the packing given as arrays."""
@@ -300,6 +301,7 @@ def test_our_writers_round_trip(tmp_path):
     assert lammps_ids(np.array([0, 5])).tolist() == [1, 6] and lammps_ids(np.array([3, 9])).tolist() == [3, 9]
 
 
+@pytest.mark.slow
 def test_the_cli_converts_a_scene_for_lammps(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "dem", "convert", "lattice", str(tmp_path / "lattice.data"), "--json"],
                           capture_output=True, text=True, timeout=120)
@@ -362,6 +364,7 @@ def test_bad_files_get_one_line_naming_file_line_and_column(tmp_path, name, text
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.slow
 def test_a_bad_file_in_a_scene_is_one_line_and_exit_2(tmp_path):
     (tmp_path / "p.csv").write_text("x,y,z,radius\n0,0,0,1e-3\n0,0,oops,1e-3\n")
     scene = tmp_path / "s.toml"

@@ -47,6 +47,7 @@ def test_read_whole_is_the_packing_written(tmp_path):
 
 @pytest.mark.parametrize("periodic", [False, True])
 @pytest.mark.parametrize("ranks", [1, 2, 5])
+@pytest.mark.slow
 def test_each_rank_holds_its_blocks_and_the_halo_of_the_whole(tmp_path, periodic, ranks):
     p = _packing(periodic=periodic)
     write_parts(tmp_path / "p.parts", p, 40)

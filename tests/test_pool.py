@@ -58,6 +58,7 @@ def _pid_of(k):
     return k, os.getpid()
 
 
+@pytest.mark.slow
 def test_jobs_alongside_a_pool_of_the_callers_run_there_and_here_and_it_stays_usable():
     """With a pool of the caller's alongside (one process) and two workers, the jobs run in that pool's process and
     in this one, no other process is started, every result comes back once; an error is raised; the caller's pool
@@ -115,6 +116,7 @@ with ProcessPoolExecutor(1, mp_context=context, initializer=bounds._receive_temp
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 @pytest.mark.parametrize("script, start", [("pool", "fork"), ("pool", "spawn"), ("lattice", "fork")])
+@pytest.mark.slow
 def test_workers_end_with_a_parent_killed_outright(script, start):
     # a SIGKILL (the OOM killer) gives the parent no chance to stop its pool: the workers must not wait for ever
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
@@ -132,6 +134,7 @@ def test_workers_end_with_a_parent_killed_outright(script, start):
     assert all(_gone(pid) for pid in pids), [pid for pid in pids if not _gone(pid)]
 
 
+@pytest.mark.slow
 def test_a_process_whose_numba_threads_are_openmp_spawns_its_workers(monkeypatch):
     # a child forked from a process that ran GNU OpenMP threads is terminated at its own first parallel loop
     monkeypatch.setattr(P, "openmp_started", lambda: True)
@@ -290,6 +293,7 @@ def test_a_scheduler_out_of_reach_is_one_line_and_exit_2(prog, monkeypatch, caps
 
 
 @pytest.mark.parametrize("on_dask", [False, True])
+@pytest.mark.slow
 def test_size_sweep_keeps_the_sizes_up_to_the_first_failure(sizes_worker, request, on_dask):
     section = _Section()
     with P.use_dask(request.getfixturevalue("dask_client") if on_dask else None):

@@ -34,6 +34,7 @@ def test_a_mesh_keeps_every_signal_handler():
             faulthandler.disable()
 
 
+@pytest.mark.slow
 def test_a_crash_after_a_mesh_still_says_where():
     script = textwrap.dedent("""
         import ctypes, faulthandler

@@ -39,6 +39,7 @@ def test_schedule_scene_has_the_times_temperatures_and_box_of_sec_4_1():
     assert r.min() >= 0.5e-3 and r.max() <= 1.5e-3
 
 
+@pytest.mark.slow
 def test_stage_scenes_continue_from_a_state(tmp_path):
     times = sp.Times(t_s=0.004, t_heat=0.004, heat=0.002, cool=0.002, relax=0.002)
     prep = run(parse_scene(sp.preparation_doc(12, 100.0, times=times)), tmp_path / "prep")
@@ -81,6 +82,7 @@ def test_bad_protocol_input_names_the_parameter(call, words):
     assert words in str(err.value)
 
 
+@pytest.mark.slow
 def test_tiny_schedule_sinters_and_cools_back():
     times = sp.Times(t_s=0.02, t_heat=0.03, heat=0.01, cool=0.01, relax=0.01)
     sim = VerletEngine(parse_scene(sp.schedule_doc(16, 100.0, 0.02, times=times)))

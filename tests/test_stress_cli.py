@@ -77,6 +77,7 @@ def test_semisphere_neck_below_supported_range_explained():
     assert "a_over_r" in outcome, outcome
 
 
+@pytest.mark.slow
 def test_dem_generator_huge_n_refused(tmp_path: pathlib.Path):
     scene = tmp_path / "huge.toml"
     scene.write_text('[material]\nconductivity = 394.0\ndensity = 8960.0\nspecific_heat = 385.0\n'

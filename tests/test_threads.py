@@ -101,6 +101,7 @@ def test_a_thread_count_outside_the_cores_is_one_line_and_exit_2(value):
     assert f"--threads: threads = {shown}: must be" in proc.stderr and f"from 1 to {threads.cores()}" in proc.stderr
 
 
+@pytest.mark.slow
 def test_a_bad_environment_variable_is_refused_naming_it():
     proc = subprocess.run([sys.executable, "-m", "dem", "run", "lattice"], env=_env(SINTERHEAT_THREADS="0"),
                           capture_output=True, text=True, timeout=300)

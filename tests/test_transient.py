@@ -27,6 +27,7 @@ def test_mesh_volume_and_split(pair):
     assert float(pm.geometry.z_i) < pm.z_split < float(pm.geometry.z_i + pm.geometry.h_n)
 
 
+@pytest.mark.slow
 def test_energy_is_conserved(pair):
     _, res = pair
     stored = res.T_mean @ res.C  # sum_i C_i Tbar_i: insulated, so constant

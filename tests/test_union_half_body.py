@@ -40,6 +40,7 @@ def test_corner_exponent_of_the_mixed_corner():
 
 
 @pytest.mark.parametrize("a", [1e-3, 0.05, 0.3, 0.6, 0.61, 0.9, 0.99])
+@pytest.mark.slow
 def test_converges_at_the_requested_tolerance(a):
     """The graded hp mesh with the levels chosen for the union's corner meets rtol = 1e-4 against a 1e-8 solve."""
     reference = conduction.semisphere_conductance(a, rtol=1e-8, neck="union")
@@ -50,6 +51,7 @@ def test_converges_at_the_requested_tolerance(a):
 
 
 @pytest.mark.parametrize("a", [1e-3, 0.3, 0.9])
+@pytest.mark.slow
 def test_hp_agrees_with_the_triangle_path(a):
     hp = conduction.semisphere_conductance(a, rtol=1e-6, neck="union")
     tri = conduction.semisphere_conductance(a, rtol=1e-4, method="gmsh", neck="union")

@@ -112,6 +112,7 @@ def test_fit_law_for_the_union_recovers_known_parameters():
     assert fit.fit_law(x, truth.k_over_kcyl(x)).max_rel_residual > 0.01
 
 
+@pytest.mark.slow
 def test_small_union_fit_run_and_its_csv(tmp_path, capsys):
     out = tmp_path / "fit"
     first = fit.run_fit(6, 1e-4, out, workers=1, progress=False, plot_png=False, neck="union")
