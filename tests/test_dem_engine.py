@@ -159,6 +159,7 @@ def test_a_long_call_keeps_the_pairs_constants_only_while_the_radii_stay(rate):
         assert np.array_equal(a, b)
 
 
+@pytest.mark.slow  # 2D disks: Luding's force loop for them (35-40 s for numba to compile in a fresh clone)
 def test_stress_wall_balances_its_pressure():
     doc = scene_doc([[1e-3, 0, 1e-3], [3.1e-3, 0, 1e-3]], [1e-3, 1e-3], contact=TABLE1, t_end=0.05,
                     walls=[{"name": "left", "point": [0, 0, 0], "normal": [1, 0, 0]},
@@ -287,6 +288,7 @@ interval = 1e-6
     assert len((tmp_path / "out" / "timeseries.csv").read_text().splitlines()) > 2
 
 
+@pytest.mark.slow  # 2D disks: Luding's force loop for them (35-40 s for numba to compile in a fresh clone)
 def test_a_saved_state_goes_on_as_if_the_run_had_not_stopped(tmp_path):
     """Run 2 ms; run 1 ms, save, start a second scene from the state for 1 ms: bit-identical (pairs, walls,
     histories, stress wall and forces of the last step all carried)."""
@@ -404,6 +406,7 @@ def test_phases_change_the_speed_of_a_strain_wall():
         parse_scene(doc)
 
 
+@pytest.mark.slow  # 2D disks: Luding's force loop for them (35-40 s for numba to compile in a fresh clone)
 @pytest.mark.parametrize("sintering", [True, False])
 def test_a_wall_that_does_not_sinter_keeps_the_cold_loading_stiffness(sintering):
     """A disk set down on a floor at 140 °C with the overlap that carries its weight on the loading line: with

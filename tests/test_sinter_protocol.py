@@ -100,6 +100,7 @@ def test_tiny_schedule_sinters_and_cools_back():
     assert nu[-1] > nu[at(times.t_heat)] + 0.01  # sintering densifies
 
 
+@pytest.mark.slow  # 2D disks: Luding's force loop for them (35-40 s for numba to compile in a fresh clone)
 def test_an_interval_starting_just_before_a_knot_takes_the_next_segment():
     """The knot at 1 ms lies at 3333.33 steps of 0.3 us: the interval after it starts at step 3333, 0.1 us early,
     and must still follow the segment after the knot (140 C held), not extend the heating ramp beyond it."""
@@ -122,6 +123,7 @@ def test_clusters_label_by_decreasing_size():
     assert sorted(labels[[3, 6]].tolist()) == [2, 3]
 
 
+@pytest.mark.slow  # 2D disks: Luding's force loop for them (35-40 s for numba to compile in a fresh clone)
 def test_tension_capacity_is_eq_15_and_fragments_split_at_the_threshold():
     """Two pressed pairs, one hard (overlap 20 um) one light (0.2 um), and a lone disk: capacities by eq. 15."""
     a, h = 1e-3, 6e-3
