@@ -20,6 +20,10 @@ from test_neck_modes import _cell, _coupled
 from test_neck_nodes import NECKS, UNIT
 from test_neck_transient import _random_packing
 
+# Mixed modes put some particles on the Trefftz element, whose kernels take numba 25 s to compile in a fresh clone:
+# the module runs with the slow tests.
+pytestmark = pytest.mark.slow
+
 HALF = np.random.default_rng(0).random(27) < 0.5  # the Trefftz particles of the mixed cell
 
 
@@ -52,7 +56,6 @@ def _same(a, b):
             and np.array_equal(sa.T_necks, sb.T_necks) and np.array_equal(sa.periodic_heat_flow, sb.periodic_heat_flow))
 
 
-@pytest.mark.slow
 def test_where_all_is_the_three_mode_network_and_where_none_the_laws_bit_for_bit():
     n = 27
     every = _network(np.ones(n, dtype=bool))
@@ -92,7 +95,6 @@ def _flux_formulation(particles, sub, box, el) -> float:
     return q[at[:-1]] @ sub.shifts[:, 2] * box.lengths[2] / box.cross_section(2)
 
 
-@pytest.mark.slow  # the Trefftz element's kernels (25 s for numba to compile in a fresh clone)
 def test_a_mixed_cell_against_the_flux_formulation_with_its_nodes_per_neck():
     """Half the particles on Trefftz: the nodal network's k_eff is the flux formulation's; each live bond has the
     nodes of the most modes of its two particles, one after another; a mixed neck's dipoles are seen by its Trefftz

@@ -158,6 +158,7 @@ def test_a_one_blas_thread_command_never_starts_the_blas_thread_pools(tmp_path, 
         assert seen["tasks"] == 1  # no BLAS thread was started, not merely limited afterwards
 
 
+@pytest.mark.slow  # 2D disks: Luding's force loop for them (35-40 s for numba to compile in a fresh clone)
 @pytest.mark.skipif(threads.cores() < 2, reason="needs two cores")
 def test_the_engine_binds_its_loop_by_the_thread_count(monkeypatch):
     import dem.engines.verlet.mechanics as mechanics
