@@ -196,6 +196,7 @@ def test_overwrite_clears_and_resume_needs_a_checkpoint(tmp_path):
         run(load_scene(other), out=tmp_path / "out", resume=True)
 
 
+@pytest.mark.slow  # 2D disks: Luding's force loop for them (35-40 s for numba to compile in a fresh clone)
 def test_a_restored_list_brings_the_arrays_sized_by_it(tmp_path):
     """A checkpoint's Verlet list is rarely as long as the one the resumed model built at its start; the arrays the
     loop indexes by pair (the pairs' constants, the threads' rows) must follow it. They did not: the loop wrote past
