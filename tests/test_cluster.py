@@ -59,7 +59,7 @@ def _axisymmetric_means(result, cluster):
     return np.bincount(owner, weights=T * w, minlength=cluster.n) / np.bincount(owner, weights=w, minlength=cluster.n)
 
 
-@pytest.mark.slow  # a reference chain to rtol 1e-6 and the 3D levels (~7 s); the pair below is the quick check
+@pytest.mark.slow  # a reference chain to rtol 1e-6 and the 3D levels (~7 s)
 def test_cluster_estimate_bounds_the_axisymmetric_chain():
     # three spheres of radii 1, 1.6, 0.8 mm in a straight line, a/r_min = 0.3, against fem_neck chain (gmsh
     # triangles, P3/P4, rtol 1e-6): K and the particle mean temperatures. Measured: K difference 2.7e-3, estimate

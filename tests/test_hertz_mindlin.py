@@ -220,7 +220,6 @@ def test_restitution_of_a_head_on_collision_is_the_materials_at_every_speed(e, s
     assert (v[1, 0] - v[0, 0]) / speed == pytest.approx(e, abs=4e-4)
 
 
-@pytest.mark.slow  # (the head-on restitution above is the quick check)
 def test_restitution_against_a_wall_and_between_disks():
     e, speed, r = 0.6, 0.5, 1e-3
     delta_max, t_c = hertz_collision(sphere_mass(r), r, speed)  # a wall: m* = m, R* = r

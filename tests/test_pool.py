@@ -248,7 +248,7 @@ def test_fit_sweep_on_dask_equals_the_local_pool(dask_client):
     assert [p.error_estimate for p in on_dask] == [p.error_estimate for p in local]
 
 
-@pytest.mark.slow  # (the fit sweep on Dask above is the quick check)
+@pytest.mark.slow  # sintering runs on a local Dask cluster, one of them resumed
 def test_sintering_runs_on_dask_equal_the_local_pool_and_resume(dask_client, tmp_path):
     with P.use_dask(dask_client):
         on_dask = sr.run_tasks(TASKS, tmp_path / "dask", progress=False)

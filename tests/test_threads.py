@@ -183,7 +183,7 @@ def quick_moving_scene() -> str:
     return text.replace("t_end = 0.15\n", "t_end = 0.04\n")
 
 
-@pytest.mark.slow  # two moving runs of over 2 s each (the bar waits 2 s); the refusals above are the quick check
+@pytest.mark.slow  # two moving runs of over 2 s each (the bar waits 2 s)
 def test_quiet_prints_the_result_and_no_progress_bar(tmp_path):
     scene = tmp_path / "scene.toml"
     scene.write_text(quick_moving_scene())

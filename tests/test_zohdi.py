@@ -339,7 +339,6 @@ def test_cli_bad_input_is_one_line_and_exit_2(tmp_path, capsys, table, key, valu
     assert message in err and err.count("\n") == 1 and "Traceback" not in err
 
 
-@pytest.mark.slow
 def test_section_7_three_phases_of_fig_9():
     """The built-in scene (1000 spheres, 1 s): poured to 0.5-0.6, pressed to near full density, sprung back to
     between the two; the temperature rises while pouring and pressing and falls after the release."""
@@ -410,7 +409,6 @@ def test_heat_network_is_refreshed_in_place_between_list_rebuilds():
     assert th.refreshes > 10 * th.assemblies and th.assemblies <= sim.mechanics.rebuilds + 1
 
 
-@pytest.mark.slow
 def test_frames_are_rendered_off_screen_in_one_colour_range(tmp_path, monkeypatch):
     from dem.output import frames as frames_module
     from dem.output.frames import FrameWriter
