@@ -28,8 +28,7 @@ from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from dem.laws.contact import composition_of
 from dem.laws.contact.composition import Law
-
-IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}  # inlined into the engines' force loop
+from dem.laws.contact.kernel_options import IN_LOOP
 
 
 class ContactLaw:
@@ -320,8 +319,6 @@ def params_tuple(law, params):
     params : numpy.ndarray
         The law's parameters (:meth:`dem.laws.contact.composition.Law.params`).
     """
-
-
 
 
 # ------------------------------------------------------------------------------------------ the overloads

@@ -12,9 +12,8 @@ from __future__ import annotations
 from numba import njit
 
 from dem.laws.contact import zohdi
+from dem.laws.contact.kernel_options import IN_LOOP
 from dem.laws.contact.zohdi import Z_E_STAR, Z_KB, Z_PB
-
-IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}
 
 PARAMS = (zohdi.params_of, zohdi.N_PARAMS)
 FIELDS = {"K_b": ("nonnegative", "N/m^2"), "p_b": ("positive", ""), "E_star": ("nonnegative", "")}

@@ -7,9 +7,8 @@ from __future__ import annotations
 from numba import njit
 
 from dem.laws.contact import luding
+from dem.laws.contact.kernel_options import IN_LOOP
 from dem.laws.contact.luding import P_GAMMA_N
-
-IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}  # inlined into the engines' force loop
 
 PARAMS = (luding.params_of, luding.N_PARAMS)
 FIELDS = {"gamma_n": ("nonnegative", "kg/s")}

@@ -14,8 +14,7 @@ import numpy as np
 from numba import njit
 
 from dem.laws.contact import hertz_mindlin as hm
-
-IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}  # inlined into the engines' force loop
+from dem.laws.contact.kernel_options import IN_LOOP
 
 
 def damping_coefficient(restitution: float) -> float:
@@ -90,7 +89,6 @@ PAIR_HISTORY = WALL_HISTORY = ()
 STATE = "mass"  # the particles' masses
 
 check = hm.check_restitution  # the range the field kinds do not say
-
 
 
 @njit(**IN_LOOP)

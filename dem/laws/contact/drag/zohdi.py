@@ -10,9 +10,8 @@ import math
 from numba import njit
 
 from dem.laws.contact import zohdi
+from dem.laws.contact.kernel_options import IN_LOOP
 from dem.laws.contact.zohdi import Z_C_ENV
-
-IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}
 
 PARAMS = (zohdi.params_of, zohdi.N_PARAMS)
 FIELDS = {"c_env": ("nonnegative", "kg/(m s)")}

@@ -15,8 +15,7 @@ from numba import njit
 
 from dem.laws.contact import hertz_mindlin as hm
 from dem.laws.contact.damping import tsuji
-
-IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}  # inlined into the engines' force loop
+from dem.laws.contact.kernel_options import IN_LOOP
 
 RAYLEIGH_FRACTION = 0.1  # dt = "auto": this fraction of the Rayleigh time
 STABLE_OVERLAP = 0.1     # the stable step is that of an overlap of this fraction of R* (time_steps)

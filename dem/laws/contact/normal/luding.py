@@ -27,7 +27,9 @@ from numba import njit
 
 from dem.laws.contact import luding
 from dem.laws.contact.damping import luding as damping
+from dem.laws.contact.kernel_options import IN_LOOP, JIT
 from dem.laws.contact.luding import P_FLUID_OVERLAP, P_GAMMA_N, P_K1, P_K2, P_KC, P_WALL_SINTERING, LudingMaterial
+
 
 def time_step(k2: float, gamma_n: float, m_min: float) -> float:
     r""":math:`t_{MD} = \pi/(50 \omega)`, :math:`\omega = \sqrt{k_2/m_{12} - \eta_0^2}`, :math:`\eta_0 =
@@ -63,7 +65,6 @@ def time_step(k2: float, gamma_n: float, m_min: float) -> float:
                          f"mass m12 = {m_min:.6g} kg (k2/m12 - (gamma_n/(2 m12))^2 = {omega2:.6g} <= 0, Luding 2005, "
                          f"eq. 6); must be < 2 sqrt(k2 m12) = {2.0 * math.sqrt(k2 * m_min):.6g} kg/s")
     return math.pi / (50.0 * math.sqrt(omega2))
-
 
 
 def time_steps(material: LudingMaterial, mass: np.ndarray, inertia: np.ndarray, radius: np.ndarray,
@@ -109,15 +110,10 @@ def time_steps(material: LudingMaterial, mass: np.ndarray, inertia: np.ndarray, 
     return min(t_md, stable), stable
 
 
-JIT = {"cache": True, "error_model": "numpy"}  # fastmath stays off: the tests compare closely
-IN_LOOP = {**JIT, "inline": "always"}  # the kernels of the force loop, inlined there by numba (10 % faster)
-
-
 @njit(**IN_LOOP)
 def pair_delta_fluid(a_i, a_j, fluid_overlap):
     """``delta_fluid = fluid_overlap * 2 a_i a_j/(a_i + a_j)`` of a pair (``fluid_overlap * a`` for equal radii)."""
     return fluid_overlap * 2.0 * a_i * a_j / (a_i + a_j)
-
 
 
 # ------------------------------------------------------------------------------------------ normal history

@@ -14,10 +14,8 @@ import math
 from numba import njit
 
 from dem.laws.contact import zohdi
+from dem.laws.contact.kernel_options import IN_LOOP, JIT
 from dem.laws.contact.zohdi import Z_KP, Z_KP_LIM, Z_KW, Z_KW_LIM, Z_PP, Z_PW, Z_THETA_STAR
-
-JIT = {"cache": True, "error_model": "numpy"}
-IN_LOOP = {**JIT, "inline": "always"}
 
 PARAMS = (zohdi.params_of, zohdi.N_PARAMS)
 FIELDS = {"K_p": ("positive", "N/m^2"), "p_p": ("positive", ""), "K_p_lim": ("nonnegative", "N/m^2"),

@@ -13,9 +13,8 @@ import numpy as np
 from numba import njit
 
 from dem.laws.contact import luding
+from dem.laws.contact.kernel_options import JIT
 from dem.laws.contact.luding import P_EXPANSION, P_T_MELT, P_T_VAR, LudingMaterial
-
-JIT = {"cache": True, "error_model": "numpy"}
 
 PARAMS = (luding.params_of, luding.N_PARAMS)
 FIELDS = {"T_melt": ("number", "K"), "T_var": ("positive", "K"), "expansion": ("nonnegative", "1/K"),
@@ -56,7 +55,6 @@ def relax_k1(k1t, k1T, dt, t0, cooling):
     if denominator <= 0.0:
         return k1T
     return k1T - d * (k1T * t0) / denominator
-
 
 
 def initial_state(material: LudingMaterial, T: np.ndarray, mass: np.ndarray) -> np.ndarray:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-JIT = {"cache": True, "error_model": "numpy"}
+from dem.laws.contact.kernel_options import JIT
 
 PARAMS = None  # no parameters
 FIELDS = {}

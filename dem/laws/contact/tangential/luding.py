@@ -15,10 +15,8 @@ import math
 from numba import njit
 
 from dem.laws.contact import luding
+from dem.laws.contact.kernel_options import IN_LOOP, JIT
 from dem.laws.contact.luding import P_BRITTLE_SLIDING, P_GAMMA_T, P_KT_RATIO, P_MU, P_MU_WALL
-
-JIT = {"cache": True, "error_model": "numpy"}
-IN_LOOP = {**JIT, "inline": "always"}  # inlined into the engines' force loop
 
 
 @njit(**JIT)

@@ -21,8 +21,7 @@ import numpy as np
 from numba import njit
 
 from dem.laws.contact import hertz_mindlin as hm
-
-IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}  # inlined into the engines' force loop
+from dem.laws.contact.kernel_options import IN_LOOP
 
 
 @njit(**IN_LOOP)

@@ -15,9 +15,8 @@ import math
 from numba import njit
 
 from dem.laws.contact import zohdi
+from dem.laws.contact.kernel_options import IN_LOOP
 from dem.laws.contact.zohdi import Z_MU, Z_V_SLIP
-
-IN_LOOP = {"cache": True, "error_model": "numpy", "inline": "always"}
 
 PARAMS = (zohdi.params_of, zohdi.N_PARAMS)
 FIELDS = {"mu_d": ("nonnegative", ""), "v_slip": ("positive", "m/s")}
