@@ -18,7 +18,9 @@ from verification.report import records_table
 
 TITLE = "DEM thermal solvers"
 PACKING = {"radius": 50e-6, "overlap": 0.15}  # copper, mean radius 50 um, mean relative overlap 0.15 (rojek law)
-LIMITS = {"dem_steady_1e6_seconds": 30.0, "dem_steady_1e6_peak_gib": 8.0,
+# dem_steady_1e6_seconds: bonds + network + solve on two cores. The run is bound by memory traffic, so the target holds
+# where memory streams about 30 GB/s; on a machine that streams 10 GB/s it takes about twice as long (benchmarks guide)
+LIMITS = {"dem_steady_1e6_seconds": 3.0, "dem_steady_1e6_peak_gib": 8.0,
           "dem_steady_1e7_peak_gib": 20.0, "dem_transient_1e5x1000_seconds": 60.0,
           "dem_over_openpnm": 1.0, "dem_amg_over_petsc": 1.0}
 
