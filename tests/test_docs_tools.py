@@ -92,8 +92,6 @@ def test_the_docs_pages_fit_the_line_length():
     """Every line of the text (``text_lines``) of every page under docs/ within the project's 120 characters."""
     long = []
     for path in sorted(p for p in (ROOT / "docs").rglob("*.md") if "_build" not in p.parts):
-        if path == ROOT / "docs" / "guide" / "benchmarks.md":
-            continue  # rewrapped separately (it was being edited when the other pages were rewrapped)
         long += [f"{path.relative_to(ROOT)}:{n}" for n, line in text_lines(path.read_text()) if len(line) > 120]
     assert long == [], "over 120 characters: " + ", ".join(long)
 
