@@ -39,7 +39,9 @@ class SceneElements:
     comm : object or None
         With ``own``, the MPI communicator of the ranks that each build their own particles' elements (an
         ``mpi4py.MPI.Comm``): the hook is then called on every rank together, and what building them takes is said
-        once, by rank 0, for all the ranks (:func:`dem.memory.element_estimate` of every rank's share); None: no MPI.
+        once, by rank 0, for all the ranks (:func:`dem.memory.element_estimate` of every rank's share, gathered on
+        every rank even where its share raised, which raises after the gather: within
+        :func:`dem.parallel.comm.agree` no rank is left waiting); None: no MPI.
 
     Attributes
     ----------
@@ -95,11 +97,16 @@ class SceneElements:
 
             build = trefftz_elements if self.own is None else functools.partial(trefftz_elements, where=self.own)
             chosen = slice(None) if self.own is None else self.own
-            necks = bonds.necks_per_particle(n)[chosen]
-            meeting = pairs_meeting(radius, bonds, vectors, wall_normals)[chosen]
-            share = (len(necks), int(necks.sum()), int(meeting.sum()), threads.count())
+            try:  # the gather is made on every rank whatever raised before it, which is raised after it
+                necks = bonds.necks_per_particle(n)[chosen]
+                meeting = pairs_meeting(radius, bonds, vectors, wall_normals)[chosen]
+                share, failed = (len(necks), int(necks.sum()), int(meeting.sum()), threads.count()), None
+            except Exception as exc:
+                share, failed = None, exc
             shares = [share] if self.comm is None else self.comm.gather(share)  # (None but on rank 0)
-            if shares is not None:
+            if failed is not None:
+                raise failed
+            if shares is not None and None not in shares:  # (a rank whose share failed raises instead)
                 announce(element_estimate(*zip(*shares)))
         else:
             from dem.laws.shared_body import particle_elements as build
