@@ -2,6 +2,7 @@
 (dem.network.elements): its refusals, a static run equal to neck_network with trefftz_elements, the summary's account
 of the element and of its FE evidence (dem.laws.verified_range), and the up-front estimate of its time (dem.memory)."""
 
+import time
 from dataclasses import replace
 
 import numpy as np
@@ -222,6 +223,44 @@ def test_the_estimate_is_said_from_the_live_necks_before_the_elements_are_built(
                       f"of necks meeting): about {seconds:.3g} s on one core, shared by 2 threads, before the solve",
                       0)]
     assert len(built) == 1 and m.sum() > 0
+
+
+def test_the_elements_time_leaves_numbas_compiling_out(monkeypatch):
+    """``seconds`` is the build's CPU time and ``compile_seconds`` numba's: the hook called again with its kernels
+    loaded compiles nothing; called with a copy of a kernel compiled inside the build (as on a cold cache), its
+    ``compile_seconds`` is the copy's compile as timed outside it and its ``seconds`` those of the build alone."""
+    import numba
+
+    from dem.network.elements import SceneElements
+
+    scene = _packing(2)
+    p, box = scene.particles, scene.box
+    bonds = find_bonds(p, contact="union", box=box)
+    hook = SceneElements("trefftz")
+
+    def built() -> tuple:
+        neck_network(scene.conductance, p, bonds, box=box, elements=hook)
+        return hook.seconds, hook.compile_seconds
+
+    built()  # the kernels compiled or loaded
+    seconds, compiled = built()
+    assert compiled == 0.0 and seconds > 0.0
+    kernel = te._face_points  # compiling a copy takes seconds (numba's cache is the original's)
+
+    def compile_copy() -> float:
+        copy = numba.jit(**kernel.targetoptions)(kernel.py_func)
+        start = time.process_time()
+        for signature in kernel.signatures:
+            copy.compile(signature)
+        return time.process_time() - start
+
+    compile_copy()  # (the first copy compiles more: what the kernel calls, the originals being loaded from a cache)
+    alone = compile_copy()
+    monkeypatch.setattr(te, "trefftz_elements", lambda *args: (compile_copy(), _TREFFTZ(*args))[1])
+    seconds_with, compiled_with = built()
+    assert alone > 0.5 and 0.5 < compiled_with / alone < 2.0
+    assert abs(seconds_with - seconds) < 0.25 * compiled_with
+    assert hook.account()["element_compile_seconds"] == compiled_with
 
 
 def _recording(build, built: list):

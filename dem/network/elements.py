@@ -13,9 +13,11 @@ once by rank 0 for all of them). Either is the ``elements`` hook of :func:`dem.n
 from __future__ import annotations
 
 import functools
+import threading
 import time
 
 import numpy as np
+from numba.core import event
 
 from dem.geometry.necks import pairs_meeting
 from dem.laws.conductance import ConductanceSpec
@@ -39,15 +41,21 @@ class SceneElements:
     comm : object or None
         With ``own``, the MPI communicator of the ranks that each build their own particles' elements (an
         ``mpi4py.MPI.Comm``): the hook is then called on every rank together, and what building them takes is said
-        once, by rank 0, for all the ranks (:func:`dem.memory.element_estimate` of every rank's share); None: no MPI.
+        once, by rank 0, for all the ranks (:func:`dem.memory.element_estimate` of every rank's share, gathered on
+        every rank even where its share raised, which raises after the gather: within
+        :func:`dem.parallel.comm.agree` no rank is left waiting); None: no MPI.
 
     Attributes
     ----------
     built : dem.laws.shared_body.ParticleElements or None
         The elements of the last call; None before it.
     seconds : float
-        The CPU time of the last call (this process's, all its threads': the Trefftz elements are built on
-        :func:`sinterheat.threads.count` threads), s.
+        The CPU time of the last call's build (this process's, all its threads': the Trefftz elements are built on
+        :func:`sinterheat.threads.count` threads), ``compile_seconds`` left out, s.
+    compile_seconds : float
+        The CPU time of the last call's threads while they held numba's compiler lock: compiling the kernels the
+        build calls for the first time in this process, or loading them from numba's cache (0 once they are loaded;
+        measured on numba's ``numba:compiler_lock`` events, ``numba.core.event``), s.
     """
 
     def __init__(self, element: str, own: np.ndarray | None = None, comm=None):
@@ -55,7 +63,7 @@ class SceneElements:
         self.own = None if own is None else np.asarray(own, dtype=bool)
         self.comm = comm
         self.built = None
-        self.seconds = 0.0
+        self.seconds = self.compile_seconds = 0.0
 
     def __call__(self, n, radius, bonds, vectors, k_i, k_j, k_wall, conductivity, wall_normals, volume=None):
         """The particles' elements (:func:`dem.laws.shared_body.particle_elements`'s arguments); the Trefftz elements'
@@ -95,25 +103,34 @@ class SceneElements:
 
             build = trefftz_elements if self.own is None else functools.partial(trefftz_elements, where=self.own)
             chosen = slice(None) if self.own is None else self.own
-            necks = bonds.necks_per_particle(n)[chosen]
-            meeting = pairs_meeting(radius, bonds, vectors, wall_normals)[chosen]
-            share = (len(necks), int(necks.sum()), int(meeting.sum()), threads.count())
+            try:  # the gather is made on every rank whatever raised before it, which is raised after it
+                necks = bonds.necks_per_particle(n)[chosen]
+                meeting = pairs_meeting(radius, bonds, vectors, wall_normals)[chosen]
+                share, failed = (len(necks), int(necks.sum()), int(meeting.sum()), threads.count()), None
+            except Exception as exc:
+                share, failed = None, exc
             shares = [share] if self.comm is None else self.comm.gather(share)  # (None but on rank 0)
-            if shares is not None:
+            if failed is not None:
+                raise failed
+            if shares is not None and None not in shares:  # (a rank whose share failed raises instead)
                 announce(element_estimate(*zip(*shares)))
         else:
             from dem.laws.shared_body import particle_elements as build
+        clock = _CompilerClock()
         start = time.process_time()
-        self.built = build(*args)
-        self.seconds = time.process_time() - start
+        with event.install_listener("numba:compiler_lock", clock):
+            self.built = build(*args)
+        self.compile_seconds = float(sum(clock.seconds))
+        self.seconds = time.process_time() - start - self.compile_seconds
         return self.built
 
     def account(self) -> dict:
         """The summary's entries: ``element`` (its name) and, for ``"trefftz"``, ``element_particles`` (the
         particles with necks that carry it), ``element_plain`` (those that kept the law's element on their
-        monopoles), ``element_refined`` (those whose quadrature failed its check and was refined) and
-        ``element_seconds`` (the CPU time of building them, s); with ``own``, of the own particles (a rank's part
-        of the sums over the ranks).
+        monopoles), ``element_refined`` (those whose quadrature failed its check and was refined),
+        ``element_seconds`` (the CPU time of building them, s) and ``element_compile_seconds`` (that of compiling
+        numba's kernels for it or loading them from its cache, s: ``seconds`` and ``compile_seconds``); with ``own``,
+        of the own particles (a rank's part of the sums over the ranks).
 
         Returns
         -------
@@ -128,7 +145,29 @@ class SceneElements:
         return {"element": self.element, "element_particles": int(np.count_nonzero(with_necks & ~plain)),
                 "element_plain": int(np.count_nonzero(with_necks & plain)),
                 "element_refined": int(np.count_nonzero(with_necks & (np.asarray(el.refine) > 1.0))),
-                "element_seconds": self.seconds}
+                "element_seconds": self.seconds, "element_compile_seconds": self.compile_seconds}
+
+
+class _CompilerClock(event.Listener):
+    """A listener to numba's ``numba:compiler_lock`` events (``numba.core.event``) that keeps, per time a thread held
+    the lock, that thread's CPU time while it did (``time.thread_time``, from its outermost acquiring, the wait
+    for the lock costing none, to its last release), s, in ``seconds``.
+    """
+
+    def __init__(self):
+        self.seconds = []
+        self.held = threading.local()  # per thread, its depth of acquiring and its CPU time at the outermost
+
+    def on_start(self, ev):
+        depth = getattr(self.held, "depth", 0)
+        if depth == 0:
+            self.held.start = time.thread_time()
+        self.held.depth = depth + 1
+
+    def on_end(self, ev):
+        self.held.depth -= 1
+        if self.held.depth == 0:
+            self.seconds.append(time.thread_time() - self.held.start)
 
 
 def scene_elements(spec: ConductanceSpec, own: np.ndarray | None = None, comm=None) -> SceneElements:

@@ -57,7 +57,8 @@ def agree(comm, action):
     comm : object
         The MPI communicator (an ``mpi4py.MPI.Comm``).
     action : callable
-        Called without arguments on every rank.
+        Called without arguments on every rank. It makes no collective call, or makes the same ones on every rank
+        whatever raised before them (raising after them): else a rank that raised first leaves the others waiting.
 
     Returns
     -------

@@ -13,6 +13,7 @@ from dem.parallel import comm as mpi
 from test_distributed_necks import COMM, _blocks, owned_rows_against_serial, serial
 
 ELEMENT = ("element_particles", "element_plain", "element_refined")
+GUARD = 300  # s: a test still running after it is taken for a rank left waiting, ended (exit status 1)
 
 
 def _trefftz(boundary: str, solver: dict | None = None):
@@ -175,3 +176,30 @@ def test_what_the_elements_take_is_said_once_by_rank_0_for_all_the_ranks(monkeyp
     line = memory.element_estimate(*zip(*shares))
     assert f"of {scene.particles.n} particles on {COMM.Get_size()} ranks" in line and meeting.sum() > 0
     assert COMM.allgather(said) == [[f"python -m dem run: {line}"]] + [[]] * (COMM.Get_size() - 1)
+
+
+def test_counting_the_necks_raising_on_one_rank_stops_every_rank(monkeypatch):
+    """The count of what the elements take (the necks and the pairs of them meeting, gathered to rank 0 to be said)
+    raising a ValueError on the last rank only: every rank raises it, none is left waiting in the gather (were one,
+    the run would end, failed, after ``GUARD`` seconds; no elements are built: quick)."""
+    import faulthandler
+
+    from dem.network import elements
+    from dem.network import trefftz_element as te
+
+    message = "the necks of the last rank could not be counted"
+
+    def uncounted(*args):
+        raise ValueError(message)
+
+    if COMM.Get_rank() == COMM.Get_size() - 1:  # not rank 0, which waits in the gather for the others
+        monkeypatch.setattr(elements, "pairs_meeting", uncounted)
+    monkeypatch.setattr(te, "trefftz_elements", lambda *args, where=None: None)  # (the run stops before using them)
+    scene = _trefftz("periodic")
+    faulthandler.dump_traceback_later(GUARD, exit=True)
+    try:
+        with pytest.raises(ValueError) as error:
+            DistributedStaticEngine(scene)
+    finally:
+        faulthandler.cancel_dump_traceback_later()
+    assert COMM.allgather(str(error.value)) == [message] * COMM.Get_size()

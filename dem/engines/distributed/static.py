@@ -33,7 +33,8 @@ three flux modes per neck (:func:`dem.network.distributed_necks.node_keys`): eac
 only, the expensive part of such a run shared out (what it will take said once, by rank 0, for all the ranks:
 :class:`dem.network.elements.SceneElements`' ``comm``), receives those of their necks' partners from their owners
 (:func:`dem.network.distributed_necks.shared_elements`) and then assembles its network, once; the summary's
-``element_*`` entries are summed over the ranks (``element_seconds``: the CPU time of all the ranks' elements).
+``element_*`` entries are summed over the ranks (``element_seconds``: the CPU time of all the ranks' elements,
+``element_compile_seconds`` that of all their compiling).
 """
 
 from __future__ import annotations
