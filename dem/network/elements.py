@@ -13,11 +13,9 @@ once by rank 0 for all of them). Either is the ``elements`` hook of :func:`dem.n
 from __future__ import annotations
 
 import functools
-import threading
 import time
 
 import numpy as np
-from numba.core import event
 
 from dem.geometry.necks import pairs_meeting
 from dem.laws.conductance import ConductanceSpec
@@ -55,7 +53,7 @@ class SceneElements:
     compile_seconds : float
         The CPU time of the last call's threads while they held numba's compiler lock: compiling the kernels the
         build calls for the first time in this process, or loading them from numba's cache (0 once they are loaded;
-        measured on numba's ``numba:compiler_lock`` events, ``numba.core.event``), s.
+        :func:`sinterheat.compile_clock.compiling`), s.
     """
 
     def __init__(self, element: str, own: np.ndarray | None = None, comm=None):
@@ -116,11 +114,12 @@ class SceneElements:
                 announce(element_estimate(*zip(*shares)))
         else:
             from dem.laws.shared_body import particle_elements as build
-        clock = _CompilerClock()
+        from sinterheat.compile_clock import compiling  # (numba: imported by the build anyway)
+
         start = time.process_time()
-        with event.install_listener("numba:compiler_lock", clock):
+        with compiling() as clock:
             self.built = build(*args)
-        self.compile_seconds = float(sum(clock.seconds))
+        self.compile_seconds = clock.total
         self.seconds = time.process_time() - start - self.compile_seconds
         return self.built
 
@@ -146,28 +145,6 @@ class SceneElements:
                 "element_plain": int(np.count_nonzero(with_necks & plain)),
                 "element_refined": int(np.count_nonzero(with_necks & (np.asarray(el.refine) > 1.0))),
                 "element_seconds": self.seconds, "element_compile_seconds": self.compile_seconds}
-
-
-class _CompilerClock(event.Listener):
-    """A listener to numba's ``numba:compiler_lock`` events (``numba.core.event``) that keeps, per time a thread held
-    the lock, that thread's CPU time while it did (``time.thread_time``, from its outermost acquiring, the wait
-    for the lock costing none, to its last release), s, in ``seconds``.
-    """
-
-    def __init__(self):
-        self.seconds = []
-        self.held = threading.local()  # per thread, its depth of acquiring and its CPU time at the outermost
-
-    def on_start(self, ev):
-        depth = getattr(self.held, "depth", 0)
-        if depth == 0:
-            self.held.start = time.thread_time()
-        self.held.depth = depth + 1
-
-    def on_end(self, ev):
-        self.held.depth -= 1
-        if self.held.depth == 0:
-            self.seconds.append(time.thread_time() - self.held.start)
 
 
 def scene_elements(spec: ConductanceSpec, own: np.ndarray | None = None, comm=None) -> SceneElements:
