@@ -1,7 +1,10 @@
 """The steady network's fast assembly against the general one: the Laplacian of canonical edges written row by row
 against scipy's summed COO entries, the connected groups from the free block against the edge list, and the heat
 flow through a packing (what k_eff is made of) by the cell search, the row-by-row Laplacian and AMG-CG against the
-k-d trees, the summed assembly and a direct solve."""
+k-d trees, the summed assembly and a direct solve; and a small static solve without numba."""
+
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -202,3 +205,30 @@ def test_linear_halves_and_series_take_numbers_as_the_arrays_do(law):
     assert half_conductance(spec, kappa, r, np.array([a, 2 * a]), length).tolist() == [
         LINEAR_SLOPES[law] * kappa * np.pi * x for x in (a, 2 * a)]  # a number's conductivity, an array of necks
     assert float(series(one, one)) == float(series(many, many)[0]) == 1.0 / (1.0 / float(one) + 1.0 / float(one))
+
+
+SMALL_STATIC = """
+import sys
+import numpy as np
+import dem.engines.static
+from dem.geometry.bonds import find_bonds
+from dem.geometry.generators import random_packing
+from dem.geometry.particles import Particles
+from dem.network.heat import build_network, steady
+lay = random_packing(2000, 50e-6, 0.15, seed=0)
+fixed = np.zeros(len(lay.radius), dtype=bool)
+fixed[lay.bottom] = fixed[lay.top] = True
+particles = Particles.from_arrays(lay.position, lay.radius, np.where(np.isin(np.arange(len(fixed)), lay.bottom), 1.0,
+                                  0.0), fixed=fixed)
+steady(build_network(particles, bonds=find_bonds(particles)), floating="mean")
+print("numba" in sys.modules)
+"""
+
+
+@pytest.mark.slow  # a fresh process: 2-3 s
+def test_a_small_static_solve_loads_no_numba():
+    """Below the compiled sizes (the cell search's and the compiled cycle's) the static engine's modules, the bonds,
+    the network and the steady solve import no numba, whose import and first kernel load cost a fresh process about
+    0.7 s of CPU."""
+    out = subprocess.run([sys.executable, "-c", SMALL_STATIC], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False"]
