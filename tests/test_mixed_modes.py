@@ -2,7 +2,8 @@
 three-mode Trefftz element on some particles, the law's one-mode element on the others. ``where`` all is the
 all-Trefftz network and ``where`` none the law's, bit for bit; a free chain with one Trefftz particle is the law's
 chain; a mixed cell's k_eff is that of an independent flux formulation in which a neck carries only the modes both its
-particles have; the heat balances with walls, a fixed particle and sources; each neck has the nodes of its modes."""
+particles have; holding the dipoles flux-free on a growing mask lowers k_eff step by step; the heat balances with
+walls, a fixed particle and sources; each neck has the nodes of its modes."""
 
 import functools
 
@@ -14,7 +15,7 @@ from dem.geometry.particles import Particles
 from dem.geometry.walls import Wall
 from dem.laws.shared_body import ParticleElements, particle_elements
 from dem.network.heat import integrate
-from dem.network.necks import DIPOLE, NeckHeat, neck_network, steady_necks
+from dem.network.necks import DIPOLE, NeckHeat, assembled, live_necks, neck_network, steady_necks
 from dem.network.trefftz_element import trefftz_elements
 from test_neck_modes import _cell, _coupled
 from test_neck_nodes import NECKS, UNIT
@@ -128,6 +129,44 @@ def test_a_mixed_cell_against_the_flux_formulation_with_its_nodes_per_neck():
     k_law = steady_necks(neck_network(NECKS, particles, bonds, box=box)).periodic_heat_flow[2] * box.lengths[2] \
         / box.cross_section(2)
     assert min(abs(k / k_all - 1), abs(k / k_law - 1)) > 1e-4
+
+
+def _condensed(E):
+    """A three-mode element with its dipoles' flows held at zero: its Schur complement onto the monopoles and the
+    centre, a one-mode element."""
+    keep = np.append(np.arange(0, len(E) - 1, 3), len(E) - 1)
+    drop = np.setdiff1d(np.arange(len(E)), keep)
+    S = E[np.ix_(keep, keep)] - E[np.ix_(keep, drop)] @ np.linalg.solve(E[np.ix_(drop, drop)], E[np.ix_(drop, keep)])
+    return 0.5 * (S + S.T)
+
+
+def test_dipoles_held_flux_free_on_a_growing_mask_lower_k_eff_step_by_step():
+    """The Trefftz element everywhere, condensed onto its monopoles (one mode) on the particles of a mask: a neck
+    shared with a condensed particle keeps three modes, its dipoles flux-free (module docstring of
+    dem.network.necks, "Flux modes"), which constrains the flux field, so by Thomson's principle k_eff falls as the
+    mask grows, from the three-mode network's to the condensed one's, every mixture between. A mixture of two
+    different elements has no such order (the verification guide, "Mixed flux modes": the law's element against
+    exact ones)."""
+    particles, bonds, box = _cell()
+    necks = live_necks(NECKS, particles, bonds, box=box)
+    el = trefftz_elements(*necks.arguments)
+    three = [el.values[el.start[k]:el.start[k + 1]].reshape(3 * z + 1, -1) for k, z in enumerate(np.diff(el.offsets))]
+    one = [_condensed(E) for E in three]
+
+    def k_eff(mask):
+        blocks = [(one[k] if mask[k] else three[k]).ravel() for k in range(particles.n)]
+        mixed = el._replace(start=np.cumsum([0] + [len(b) for b in blocks]), values=np.concatenate(blocks),
+                            modes=np.where(mask, 1, 3))
+        net = assembled(necks, mixed)
+        assert np.array_equal(net.bond_modes, np.where(mask[necks.arguments[2].i] & mask[necks.arguments[2].j], 1,
+                                                       3))
+        return steady_necks(net).periodic_heat_flow[2] * box.lengths[2] / box.cross_section(2)
+
+    order = np.random.default_rng(3).permutation(particles.n)
+    k = [k_eff(np.isin(np.arange(particles.n), order[:j])) for j in (0, 4, 9, 14, 19, 24, 27)]
+    assert k[0] == pytest.approx(steady_necks(_all_trefftz()).periodic_heat_flow[2] * box.lengths[2]
+                                 / box.cross_section(2), rel=1e-12)
+    assert np.all(np.diff(k) < 0) and k[-1] < (1 - 1e-3) * k[0]
 
 
 def _free_chain(n=5, q=0.5):
