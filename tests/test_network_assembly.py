@@ -209,18 +209,10 @@ def test_linear_halves_and_series_take_numbers_as_the_arrays_do(law):
 
 SMALL_STATIC = """
 import sys
-import numpy as np
 import dem.engines.static
-from dem.geometry.bonds import find_bonds
-from dem.geometry.generators import random_packing
-from dem.geometry.particles import Particles
-from dem.network.heat import build_network, steady
-lay = random_packing(2000, 50e-6, 0.15, seed=0)
-fixed = np.zeros(len(lay.radius), dtype=bool)
-fixed[lay.bottom] = fixed[lay.top] = True
-particles = Particles.from_arrays(lay.position, lay.radius, np.where(np.isin(np.arange(len(fixed)), lay.bottom), 1.0,
-                                  0.0), fixed=fixed)
-steady(build_network(particles, bonds=find_bonds(particles)), floating="mean")
+from benchmarks.dem import packing_network
+from dem.network.heat import steady
+steady(packing_network(2000)[0], floating="mean")
 print("numba" in sys.modules)
 """
 
@@ -228,7 +220,7 @@ print("numba" in sys.modules)
 @pytest.mark.slow  # a fresh process: 2-3 s
 def test_a_small_static_solve_loads_no_numba():
     """Below the compiled sizes (the cell search's and the compiled cycle's) the static engine's modules, the bonds,
-    the network and the steady solve import no numba, whose import and first kernel load cost a fresh process about
+    the network and the steady solve of the bench packing (``benchmarks.dem.packing_network``) import no numba, whose import and first kernel load cost a fresh process about
     0.7 s of CPU."""
     out = subprocess.run([sys.executable, "-c", SMALL_STATIC], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False"]
