@@ -2,6 +2,7 @@
 builds a one-page site of its own, where Sphinx is installed)."""
 
 import pathlib
+import re
 import sys
 
 import pytest
@@ -59,8 +60,6 @@ def text_lines(text):
     directive whose body is not prose, ``NOT_PROSE``; CI runs the commands in them as they stand), its fence lines, its
     table rows (a row is one line) and a directive's ``:name: value`` option lines (MyST reads an option from one
     line). The body of any other directive (``{figure}``, ``{note}``) is text."""
-    import re
-
     fences = []  # the open fences, innermost last: (fence, whether its body is text)
     options = False  # in a directive's option lines
     for n, line in enumerate(text.splitlines(), 1):
@@ -116,8 +115,6 @@ def test_getting_started_lists_every_example():
 def test_every_module_with_public_objects_has_its_automodule():
     """What api_check finds in a build, found without one: every module of a documented package that defines a public
     function or class is named by an ``automodule`` directive of docs/reference/ (dem's modules included)."""
-    import re
-
     text = "\n".join(p.read_text() for p in (ROOT / "docs" / "reference").rglob("*.rst"))
     placed = set(re.findall(r"^\.\. automodule:: (\S+)$", text, re.M))
     for package in ("fem_neck", "dem", "sinterheat"):
